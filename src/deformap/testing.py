@@ -1,0 +1,25 @@
+"""Shared fixtures and tolerance helpers for deformap's tests and for users' own tests."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+__all__ = ["assert_allclose_m", "flat_patch"]
+
+
+def assert_allclose_m(actual: Any, desired: Any, *, atol_m: float, err_msg: str = "") -> None:
+    """Assert two arrays of lengths agree within ``atol_m`` metres (absolute)."""
+    np.testing.assert_allclose(
+        np.asarray(actual, dtype=float), np.asarray(desired, dtype=float), rtol=0, atol=atol_m,
+        err_msg=err_msg,
+    )
+
+
+def flat_patch(n: int = 10, spacing_m: float = 0.005, height_m: float = 0.05) -> NDArray[np.float64]:
+    """``(n*n, 3)`` points of a flat square patch at ``height_m``, row-major in (y, x)."""
+    xs = (np.arange(n) - (n - 1) / 2) * spacing_m
+    gx, gy = np.meshgrid(xs, xs)
+    return np.column_stack([gx.ravel(), gy.ravel(), np.full(n * n, height_m)])

@@ -1,0 +1,5 @@
+"""world (see DESIGN.md)."""
+
+from __future__ import annotations
+
+__all__: list[str] = []
