@@ -1,5 +1,7 @@
-"""eval (see DESIGN.md)."""
+"""Evaluation: metrics against ground truth, studies and benchmarks over many worlds."""
 
 from __future__ import annotations
 
-__all__: list[str] = []
+from deformap.eval._metrics import RegionScores, region_scores
+
+__all__ = ["RegionScores", "region_scores"]

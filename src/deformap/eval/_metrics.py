@@ -1,0 +1,101 @@
+"""How good a β-field is, against a world's ground truth.
+
+Region metrics compare a predicted label map with the true one after the best one-to-one matching
+of labels (the Hungarian algorithm on the overlap counts), so label numbering does not matter:
+
+- ``accuracy``: share of cells whose predicted label, once matched, equals the true one (cells of an
+  unmatched label count as wrong);
+- ``mean_iou``: intersection over union of each true region with its matched prediction, averaged
+  over the true regions (an unmatched true region scores 0);
+- ``kendall_tau``: rank agreement between the mean estimated β over each true region and that
+  region's softness (1 / hardness; a rigid region has softness 0): softer must mean higher β. It is
+  undefined (``None``) for fewer than two regions.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.optimize import linear_sum_assignment
+from scipy.stats import kendalltau
+
+from deformap._validation import check_array
+from deformap.errors import InvalidArgumentError
+
+__all__ = ["RegionScores", "region_scores"]
+
+
+@dataclass(frozen=True)
+class RegionScores:
+    """Region metrics of one map (see the module docstring)."""
+
+    found: int
+    true: int
+    accuracy: float
+    mean_iou: float
+    kendall_tau: float | None
+
+    def to_dict(self) -> dict[str, Any]:
+        return asdict(self)
+
+
+def region_scores(
+    predicted: NDArray[np.integer],
+    truth: NDArray[np.integer],
+    beta_grid: NDArray[np.float64],
+    true_hardness: dict[int, float],
+    *,
+    valid: NDArray[np.bool_] | None = None,
+) -> RegionScores:
+    """Score a predicted region map against the truth.
+
+    Parameters
+    ----------
+    predicted, truth : (ny, nx) int
+        Label maps on the same grid.
+    beta_grid : (ny, nx) float
+        The estimated β-field's mean on that grid.
+    true_hardness : dict
+        Hardness in newtons of each true label; ``math.inf`` for a rigid region.
+    valid : (ny, nx) bool, optional
+        Cells to score (default: all).
+    """
+    pred = np.asarray(predicted)
+    true = np.asarray(truth)
+    beta = check_array("beta_grid", beta_grid, pred.shape)
+    if true.shape != pred.shape:
+        raise InvalidArgumentError(
+            f"`truth` must have the shape of `predicted` {pred.shape}; got {true.shape}"
+        )
+    mask = np.ones(pred.shape, bool) if valid is None else np.asarray(valid, bool)
+    p, t, b = pred[mask], true[mask], beta[mask]
+    if p.size == 0:
+        raise InvalidArgumentError("`valid` must select at least one cell; got none")
+    p_labels, p_idx = np.unique(p, return_inverse=True)
+    t_labels, t_idx = np.unique(t, return_inverse=True)
+    missing = sorted(set(t_labels.tolist()) - set(true_hardness))
+    if missing:
+        raise InvalidArgumentError(f"`true_hardness` lacks the true label(s) {missing}")
+    overlap = np.zeros((t_labels.size, p_labels.size))
+    np.add.at(overlap, (t_idx, p_idx), 1.0)
+    rows, cols = linear_sum_assignment(-overlap)
+    accuracy = float(overlap[rows, cols].sum() / p.size)
+    t_size, p_size = overlap.sum(axis=1), overlap.sum(axis=0)
+    ious = np.zeros(t_labels.size)
+    ious[rows] = overlap[rows, cols] / (t_size[rows] + p_size[cols] - overlap[rows, cols])
+    tau: float | None = None
+    if t_labels.size >= 2:
+        mean_beta = np.array([b[t_idx == i].mean() for i in range(t_labels.size)])
+        softness = np.array([1.0 / true_hardness[int(label)] for label in t_labels])
+        value = kendalltau(mean_beta, softness).statistic
+        tau = None if np.isnan(value) else float(value)
+    return RegionScores(
+        found=int(p_labels.size),
+        true=int(t_labels.size),
+        accuracy=accuracy,
+        mean_iou=float(ious.mean()),
+        kendall_tau=tau,
+    )

@@ -1,0 +1,82 @@
+"""Where to poke next, from the β-field's variance on a grid.
+
+Strategies
+----------
+``paper``
+    Caccamo et al. 2016, Sec. III-D: a random cell among those whose variance exceeds the threshold
+    ``T_h`` (drawn with the explicit generator, so a seed fixes the run).
+``max-variance``
+    The cell of largest variance (ties broken by the first in row-major order).
+``min-max-variance``
+    Beyond the paper: the candidate whose addition leaves the smallest *largest* posterior variance
+    over the grid. A GP's posterior variance does not depend on the observed values, only on where
+    they are (RW2006 Eq. 2.26), so this look-ahead is exact before the poke is made; it reaches
+    ``max variance < T_h`` in fewer pokes than random choice.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Literal
+
+import numpy as np
+from numpy.typing import NDArray
+
+from deformap.errors import InvalidArgumentError
+
+__all__ = ["STRATEGIES", "Strategy", "choose_target"]
+
+Strategy = Literal["paper", "max-variance", "min-max-variance"]
+STRATEGIES: tuple[str, ...] = ("paper", "max-variance", "min-max-variance")
+
+#: ``(candidates (c, 2)) -> (c,)`` largest posterior variance left if that candidate were poked.
+LookAhead = Callable[[NDArray[np.float64]], NDArray[np.float64]]
+
+
+def choose_target(
+    strategy: str,
+    cells_xy: NDArray[np.float64],
+    variance: NDArray[np.float64],
+    threshold: float,
+    rng: np.random.Generator,
+    *,
+    look_ahead: LookAhead | None = None,
+    n_candidates: int = 256,
+) -> NDArray[np.float64] | None:
+    """Pick the next target, or ``None`` when no cell's variance exceeds ``threshold``.
+
+    Parameters
+    ----------
+    strategy : {"paper", "max-variance", "min-max-variance"}
+    cells_xy : (n, 2) float, metres
+        Centres of the grid cells that may be poked.
+    variance : (n,) float
+        β-field posterior variance at those cells.
+    threshold : float
+        ``T_h``: exploration stops when every cell's variance is at or below it.
+    rng : numpy.random.Generator
+        Used by ``paper`` (and to subsample candidates of ``min-max-variance``).
+    look_ahead : callable, optional
+        Required by ``min-max-variance``.
+    n_candidates : int
+        How many above-threshold cells ``min-max-variance`` evaluates (a seeded subsample).
+    """
+    if strategy not in STRATEGIES:
+        raise InvalidArgumentError(f"`strategy` must be one of {list(STRATEGIES)}; got {strategy!r}")
+    above = np.flatnonzero(variance > threshold)
+    if above.size == 0:
+        return None
+    if strategy == "paper":
+        return np.array(cells_xy[rng.choice(above)], dtype=float)
+    if strategy == "max-variance":
+        return np.array(cells_xy[int(np.argmax(variance))], dtype=float)
+    if look_ahead is None:
+        raise InvalidArgumentError("`look_ahead` is required by strategy 'min-max-variance'")
+    candidates = above
+    if candidates.size > n_candidates:
+        candidates = np.sort(rng.choice(candidates, size=n_candidates, replace=False))
+    left = look_ahead(cells_xy[candidates])
+    # Among near-ties prefer the higher current variance: it is the less-known place.
+    best = np.flatnonzero(left <= left.min() + 1e-9)
+    pick = best[np.argmax(variance[candidates[best]])]
+    return np.array(cells_xy[candidates[pick]], dtype=float)
