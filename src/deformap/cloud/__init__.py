@@ -1,11 +1,31 @@
 """Point clouds: the container, filters (crop, statistical outliers, convex hull), tactile points,
-and file I/O.
+and file I/O (in :mod:`deformap.cloud.io`).
 
 All functions are pure: they take ``(n, 3)`` arrays of metres and return masks or new arrays.
 """
 
 from __future__ import annotations
 
+from deformap.cloud._filters import (
+    HULL_TOLERANCE_M,
+    crop_box,
+    points_in_hull,
+    statistical_outlier_mask,
+)
 from deformap.cloud._pointcloud import PointCloud
+from deformap.cloud._tactile import (
+    DEFAULT_CAP_HALF_ANGLE_DEG,
+    tactile_points,
+    tactile_points_from_contact,
+)
 
-__all__ = ["PointCloud"]
+__all__ = [
+    "DEFAULT_CAP_HALF_ANGLE_DEG",
+    "HULL_TOLERANCE_M",
+    "PointCloud",
+    "crop_box",
+    "points_in_hull",
+    "statistical_outlier_mask",
+    "tactile_points",
+    "tactile_points_from_contact",
+]

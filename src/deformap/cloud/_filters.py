@@ -1,0 +1,156 @@
+"""Point filters: axis-aligned crop, statistical outlier removal, convex-hull membership.
+
+Every filter takes ``points : (n, 3) float, metres`` and returns an ``(n,)`` boolean mask of the
+points to keep (or, for :func:`points_in_hull`, of the points inside), so that filters compose with
+``&`` and apply to a :class:`~deformap.cloud.PointCloud` through ``cloud.select(mask)``.
+"""
+
+from __future__ import annotations
+
+import logging
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.spatial import ConvexHull, QhullError, cKDTree
+
+from deformap._validation import check_finite_scalar, check_int, check_points, check_vector
+from deformap.errors import InvalidArgumentError
+
+__all__ = ["HULL_TOLERANCE_M", "crop_box", "points_in_hull", "statistical_outlier_mask"]
+
+logger = logging.getLogger(__name__)
+
+#: Slack in metres by which a point may lie outside a hull facet and still count as inside.
+#: Qhull's facet equations carry round-off of order ``1e-15 · extent``; 1 µm is far above that and
+#: far below any depth camera's resolution (millimetres), so points on the hull's surface count as
+#: inside while no real surface point is swallowed by it.
+HULL_TOLERANCE_M = 1e-6
+
+
+def crop_box(points: Any, lower: Any, upper: Any) -> NDArray[np.bool_]:
+    """Mask of the points inside an axis-aligned box (bounds included).
+
+    Parameters
+    ----------
+    points : (n, 3) float, metres
+        The cloud; an empty cloud gives an empty mask.
+    lower, upper : (3,) float, metres
+        Opposite corners of the box, ``lower <= upper`` on every axis.
+
+    Returns
+    -------
+    mask : (n,) bool
+        ``True`` where ``lower <= p <= upper`` holds on all three axes.
+    """
+    pts = check_points("points", points, min_rows=0)
+    lo = check_vector("lower", lower, 3, what="metres")
+    hi = check_vector("upper", upper, 3, what="metres")
+    if np.any(lo > hi):
+        raise InvalidArgumentError(
+            f"`lower` must be <= `upper` on every axis; got lower={lo.tolist()}, "
+            f"upper={hi.tolist()}"
+        )
+    return np.all((pts >= lo) & (pts <= hi), axis=1)
+
+
+def _mean_neighbour_distances(pts: NDArray[np.float64], k: int) -> NDArray[np.float64]:
+    # Open3D counts the point itself among its k neighbours (distance 0), so query k, not k + 1.
+    dist, _ = cKDTree(pts).query(pts, k=k)
+    dist = dist.reshape(pts.shape[0], k)
+    return np.asarray(dist.mean(axis=1))
+
+
+def statistical_outlier_mask(points: Any, k: int, std_ratio: float) -> NDArray[np.bool_]:
+    """Mask of the points kept by Open3D's statistical outlier rule.
+
+    For each point, average the distances to its ``k`` nearest neighbours, the point itself
+    included (so one of them is 0). Let ``m`` and ``s`` be the mean and the sample standard
+    deviation (ddof = 1) of those averages over the cloud. A point is kept when its average is
+    strictly below ``m + std_ratio · s``.
+
+    Parameters
+    ----------
+    points : (n, 3) float, metres
+        The cloud, with at least ``k`` points (and at least 2, for a sample deviation).
+    k : int
+        Number of neighbours, the point itself included (Open3D's ``nb_neighbors``), ``>= 1``.
+    std_ratio : float
+        Threshold in standard deviations; any finite value (Open3D accepts negatives too).
+
+    Returns
+    -------
+    mask : (n,) bool
+        ``True`` for the points to keep.
+
+    Notes
+    -----
+    With every average equal (a perfect lattice), ``s = 0`` and the strict inequality removes every
+    point, exactly as Open3D does.
+
+    References
+    ----------
+    Open3D, ``PointCloud::RemoveStatisticalOutliers`` (``geometry/PointCloud.cpp``);
+    Rusu et al., "Towards 3D point cloud based object maps for household environments", 2008.
+    """
+    k = check_int("k", k, minimum=1)
+    ratio = check_finite_scalar("std_ratio", std_ratio)
+    pts = check_points("points", points, min_rows=0)
+    n = pts.shape[0]
+    if n < max(k, 2):
+        raise InvalidArgumentError(
+            f"`points` must hold at least k={k} points (and at least 2) for the statistical "
+            f"outlier rule; got {n}"
+        )
+    avg = _mean_neighbour_distances(pts, k)
+    threshold = avg.mean() + ratio * avg.std(ddof=1)
+    mask = avg < threshold
+    logger.debug("statistical outliers: kept %d of %d (threshold %.3g m)", mask.sum(), n, threshold)
+    return np.asarray(mask)
+
+
+def points_in_hull(
+    points: Any, hull_points: Any, *, tolerance_m: float = HULL_TOLERANCE_M
+) -> NDArray[np.bool_]:
+    """Mask of the points inside the convex hull of ``hull_points`` (surface included).
+
+    Used to remove the robot's stick and hand from a cloud: ``cloud.select(~points_in_hull(...))``.
+
+    Parameters
+    ----------
+    points : (n, 3) float, metres
+        The points to test; an empty array gives an empty mask.
+    hull_points : (m, 3) float, metres
+        At least 4 points, not all on one plane.
+    tolerance_m : float
+        A point counts as inside when it lies at most this far outside every facet plane
+        (default :data:`HULL_TOLERANCE_M`, 1 µm, see there why).
+
+    Returns
+    -------
+    mask : (n,) bool
+        ``True`` for the points inside or on the hull.
+    """
+    pts = check_points("points", points, min_rows=0)
+    verts = check_points("hull_points", hull_points, min_rows=4)
+    tol = check_finite_scalar("tolerance_m", tolerance_m)
+    if tol < 0:
+        raise InvalidArgumentError(f"`tolerance_m` must be >= 0; got {tol}")
+    centered = verts - verts.mean(axis=0)
+    singular = np.linalg.svd(centered, compute_uv=False)
+    # Relative rank test: a hull flatter than 1e-9 of its size has no interior worth the name.
+    if singular[2] <= 1e-9 * max(singular[0], np.finfo(float).tiny):
+        raise InvalidArgumentError(
+            "`hull_points` must span a volume (at least 4 points, not all on one plane or line); "
+            f"got {verts.shape[0]} points whose spread is {singular.tolist()} along its axes"
+        )
+    try:
+        hull = ConvexHull(verts)
+    except QhullError as exc:
+        raise InvalidArgumentError(
+            f"`hull_points` do not form a 3-D convex hull (Qhull: {str(exc).splitlines()[0]})"
+        ) from None
+    # Qhull's equations are unit outward normals n and offsets d with n·x + d <= 0 inside.
+    normals, offsets = hull.equations[:, :3], hull.equations[:, 3]
+    signed = pts @ normals.T + offsets
+    return np.asarray(np.all(signed <= tol, axis=1))

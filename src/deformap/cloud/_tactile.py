@@ -1,0 +1,124 @@
+"""Tactile points: where the probe's spherical tip touches the surface while it presses.
+
+The paper adds ten points from the touch sensor to the cloud seen while pressing, because the tip
+and stick hide the very dent being measured (Caccamo et al. 2016, Sec. III-C). Here they are points
+on the spherical cap of the tip that faces along the contact force.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from deformap._validation import check_finite_scalar, check_int, check_positive, check_vector
+from deformap.errors import InvalidArgumentError
+
+if TYPE_CHECKING:
+    from deformap.environment import TactileContact
+
+__all__ = ["DEFAULT_CAP_HALF_ANGLE_DEG", "tactile_points", "tactile_points_from_contact"]
+
+#: Half-angle of the touching cap, measured at the tip's centre from the force direction.
+#: A 30° cap reaches ``r (1 - cos 30°) ≈ 0.13 r`` up from the pole: for a 1 cm tip that is 1.3 mm,
+#: the order of depth over which a soft surface wraps a pressing sphere beyond first contact. Points
+#: farther up the tip's side would claim contact where the surface has usually come away from it.
+DEFAULT_CAP_HALF_ANGLE_DEG = 30.0
+
+_GOLDEN_ANGLE = np.pi * (3.0 - np.sqrt(5.0))
+
+
+def _orthonormal_frame(axis: NDArray[np.float64]) -> tuple[NDArray[np.float64], ...]:
+    # Any fixed vector not parallel to the axis seeds the frame; picking the world axis least
+    # aligned with it keeps the cross product well conditioned.
+    seed = np.zeros(3)
+    seed[int(np.argmin(np.abs(axis)))] = 1.0
+    e1 = np.cross(axis, seed)
+    e1 /= np.linalg.norm(e1)
+    e2 = np.cross(axis, e1)
+    return e1, e2
+
+
+def tactile_points(
+    tip_center: Any,
+    force_vector: Any,
+    tip_radius_m: float,
+    n: int = 10,
+    *,
+    cap_half_angle_deg: float = DEFAULT_CAP_HALF_ANGLE_DEG,
+) -> NDArray[np.float64]:
+    """Deterministic points on the spherical cap of the probe tip that touches the surface.
+
+    Parameters
+    ----------
+    tip_center : (3,) float, metres
+        Centre of the spherical tip.
+    force_vector : (3,) float, newtons
+        Force the probe exerts on the surface (pointing into it); only its direction is used.
+    tip_radius_m : float
+        Radius of the tip, > 0.
+    n : int
+        Number of points, >= 1 (the paper uses 10).
+    cap_half_angle_deg : float
+        Half-angle of the cap, in (0, 90] degrees (default :data:`DEFAULT_CAP_HALF_ANGLE_DEG`).
+
+    Returns
+    -------
+    points : (n, 3) float, metres
+        The first point is the pole ``tip_center + r · u`` with ``u`` the unit force direction (the
+        deepest point of the tip). The other ``n - 1`` follow a golden-angle (Fibonacci) spiral
+        that is uniform in area over the cap, the last one on its rim.
+    """
+    center = check_vector("tip_center", tip_center, 3, what="metres")
+    force = check_vector("force_vector", force_vector, 3, what="newtons")
+    radius = check_positive("tip_radius_m", tip_radius_m)
+    count = check_int("n", n, minimum=1)
+    half_angle = check_finite_scalar("cap_half_angle_deg", cap_half_angle_deg)
+    if not 0.0 < half_angle <= 90.0:
+        raise InvalidArgumentError(f"`cap_half_angle_deg` must lie in (0, 90]; got {half_angle}")
+    norm = float(np.linalg.norm(force))
+    if norm == 0.0:
+        raise InvalidArgumentError("`force_vector` must be a non-zero vector; got (0, 0, 0)")
+    axis = force / norm
+    e1, e2 = _orthonormal_frame(axis)
+
+    i = np.arange(count, dtype=float)
+    frac = i / (count - 1) if count > 1 else np.zeros(1)
+    # Equal cap-area steps: the area of a cap of polar angle θ is proportional to 1 - cos θ.
+    cos_theta = 1.0 - frac * (1.0 - np.cos(np.radians(half_angle)))
+    sin_theta = np.sqrt(np.clip(1.0 - cos_theta**2, 0.0, None))
+    phi = i * _GOLDEN_ANGLE
+    directions = (
+        cos_theta[:, None] * axis
+        + (sin_theta * np.cos(phi))[:, None] * e1
+        + (sin_theta * np.sin(phi))[:, None] * e2
+    )
+    return np.asarray(center + radius * directions)
+
+
+def tactile_points_from_contact(
+    contact: TactileContact,
+    n: int = 10,
+    *,
+    cap_half_angle_deg: float = DEFAULT_CAP_HALF_ANGLE_DEG,
+) -> NDArray[np.float64]:
+    """:func:`tactile_points` for a :class:`~deformap.environment.TactileContact`.
+
+    Returns
+    -------
+    points : (n, 3) float, metres
+    """
+    from deformap.environment import TactileContact
+
+    if not isinstance(contact, TactileContact):
+        raise InvalidArgumentError(
+            f"`contact` must be a deformap.environment.TactileContact; got {type(contact).__name__}"
+        )
+    return tactile_points(
+        contact.tip_center,
+        contact.force,
+        contact.tip_radius_m,
+        n,
+        cap_half_angle_deg=cap_half_angle_deg,
+    )

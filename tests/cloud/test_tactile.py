@@ -1,0 +1,95 @@
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from deformap.cloud import DEFAULT_CAP_HALF_ANGLE_DEG, tactile_points, tactile_points_from_contact
+from deformap.environment import TactileContact
+from deformap.errors import InvalidArgumentError
+
+vec = st.lists(st.floats(min_value=-1.0, max_value=1.0), min_size=3, max_size=3)
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    center=vec,
+    force=vec.filter(lambda f: np.linalg.norm(f) > 1e-3),
+    radius=st.floats(min_value=1e-3, max_value=0.05),
+    n=st.integers(min_value=1, max_value=40),
+    half_angle=st.floats(min_value=1.0, max_value=90.0),
+)
+def test_tactile_points_lie_on_the_sphere_within_the_cap(
+    center: list[float], force: list[float], radius: float, n: int, half_angle: float
+) -> None:
+    pts = tactile_points(center, force, radius, n, cap_half_angle_deg=half_angle)
+    assert pts.shape == (n, 3)
+    c = np.asarray(center)
+    u = np.asarray(force) / np.linalg.norm(force)
+    rel = pts - c
+    np.testing.assert_allclose(np.linalg.norm(rel, axis=1), radius, rtol=1e-12)
+    cos_angle = rel @ u / radius
+    assert np.all(cos_angle >= np.cos(np.radians(half_angle)) - 1e-12)
+    np.testing.assert_allclose(pts[0], c + radius * u, atol=1e-15)
+    if n > 1:  # the spiral ends on the rim and no point repeats
+        np.testing.assert_allclose(cos_angle[-1], np.cos(np.radians(half_angle)), atol=1e-12)
+        gaps = np.linalg.norm(pts[:, None] - pts[None], axis=2) + np.eye(n)
+        assert gaps.min() > 0
+
+
+def test_tactile_points_for_a_press_straight_down_sit_below_the_centre() -> None:
+    pts = tactile_points([0.3, 0.2, 0.05], [0.0, 0.0, -5.0], 0.01)
+    assert pts.shape == (10, 3)
+    np.testing.assert_allclose(pts[0], [0.3, 0.2, 0.04])
+    # Every point of a 30° cap is at most r (1 - cos 30°) above the pole.
+    rise = pts[:, 2] - 0.04
+    assert rise.min() >= 0 and rise.max() == pytest.approx(0.01 * (1 - np.cos(np.radians(30))))
+    assert DEFAULT_CAP_HALF_ANGLE_DEG == 30.0
+    # Deterministic: the same call gives the same points; the force's magnitude does not matter.
+    np.testing.assert_array_equal(pts, tactile_points([0.3, 0.2, 0.05], [0.0, 0.0, -1.0], 0.01))
+
+
+def test_tactile_points_spread_over_the_cap_evenly_in_area() -> None:
+    pts = tactile_points([0, 0, 0], [0, 0, -1], 1.0, 2001, cap_half_angle_deg=60.0)
+    height = 1.0 + pts[:, 2]  # height above the pole, uniform in [0, 1 - cos 60°] for equal area
+    counts, _ = np.histogram(height, bins=5, range=(0, 0.5))
+    assert counts.min() >= 399 and counts.max() <= 401
+
+
+def test_tactile_points_from_contact_matches_the_array_form() -> None:
+    contact = TactileContact(
+        tip_center=np.array([0.1, 0.2, 0.03]), force=np.array([1.0, 0.0, -4.0]), tip_radius_m=0.008
+    )
+    pts = tactile_points_from_contact(contact, 12)
+    np.testing.assert_array_equal(pts, tactile_points([0.1, 0.2, 0.03], [1.0, 0, -4.0], 0.008, 12))
+    np.testing.assert_allclose(pts[0], contact.contact_point)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [
+        ({"force_vector": [0, 0, 0]}, "`force_vector` must be a non-zero"),
+        ({"tip_radius_m": 0.0}, "`tip_radius_m` must be > 0"),
+        ({"n": 0}, "`n` must be an integer >= 1"),
+        ({"cap_half_angle_deg": 0.0}, r"`cap_half_angle_deg` must lie in \(0, 90\]"),
+        ({"cap_half_angle_deg": 120.0}, r"`cap_half_angle_deg` must lie in \(0, 90\]"),
+        ({"tip_center": [0, 0]}, r"`tip_center` must be a \(3,\)"),
+        ({"force_vector": [0, np.inf, 0]}, "`force_vector` .* infinite"),
+    ],
+)
+def test_tactile_points_refuse_bad_input(kwargs: dict[str, object], message: str) -> None:
+    args: dict[str, object] = {
+        "tip_center": [0, 0, 0],
+        "force_vector": [0, 0, -1],
+        "tip_radius_m": 0.01,
+        "n": 10,
+    }
+    args.update(kwargs)
+    with pytest.raises(InvalidArgumentError, match=message):
+        tactile_points(**args)  # type: ignore[arg-type]
+
+
+def test_tactile_points_from_contact_refuses_other_types() -> None:
+    with pytest.raises(InvalidArgumentError, match="TactileContact; got tuple"):
+        tactile_points_from_contact((0, 0, 0))  # type: ignore[arg-type]
