@@ -1,5 +1,7 @@
-"""viz (see DESIGN.md)."""
+"""Figures (matplotlib) and 3D recordings (rerun, optional). A leaf: nothing in the core imports it."""
 
 from __future__ import annotations
 
-__all__: list[str] = []
+from deformap.viz._figures import plot_beta_curve, plot_map, plot_poke
+
+__all__ = ["plot_beta_curve", "plot_map", "plot_poke"]
