@@ -1,0 +1,36 @@
+"""Point-cloud files and ROS 2 bags in and out.
+
+Readers return clouds in metres and refuse what they cannot read faithfully: truncated or corrupted
+files, missing x/y/z, NaN points (unless ``drop_nan=True``), empty clouds, and clouds that look like
+millimetres (unless ``units="mm"``). Every refusal is a :class:`~deformap.errors.FileFormatError`
+that names the file and what was wrong. No file is ever read with pickle.
+
+Formats: PCD (ascii, binary, binary_compressed; through pypcd4), PLY (ascii, binary either byte
+order; numpy), NPZ (``points``, ``colors``), and ROS 2 bags (sqlite3 and MCAP; through the optional
+``rosbags``, extra ``ros``) with ``sensor_msgs/msg/PointCloud2`` and
+``geometry_msgs/msg/WrenchStamped``.
+"""
+
+from __future__ import annotations
+
+from deformap.cloud.io._common import MM_EXTENT_THRESHOLD, UNITS
+from deformap.cloud.io._dispatch import CLOUD_FORMATS, read_cloud, write_cloud
+from deformap.cloud.io._npz import read_npz, write_npz
+from deformap.cloud.io._pcd import PCD_ENCODINGS, read_pcd, write_pcd
+from deformap.cloud.io._ply import PLY_FORMATS, read_ply, write_ply
+
+__all__ = [
+    "CLOUD_FORMATS",
+    "MM_EXTENT_THRESHOLD",
+    "PCD_ENCODINGS",
+    "PLY_FORMATS",
+    "UNITS",
+    "read_cloud",
+    "read_npz",
+    "read_pcd",
+    "read_ply",
+    "write_cloud",
+    "write_npz",
+    "write_pcd",
+    "write_ply",
+]

@@ -1,0 +1,147 @@
+"""What every reader shares: path checks, the units rule, NaN handling, error wrapping.
+
+Readers turn whatever a broken file makes a parser raise into one
+:class:`~deformap.errors.FileFormatError` that names the file and what was wrong, so that callers
+(``deformap map`` skipping a broken poke) need to catch only the ``DeformapError`` family.
+"""
+
+from __future__ import annotations
+
+import logging
+import struct
+import zipfile
+import zlib
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from deformap.cloud._pointcloud import PointCloud
+from deformap.errors import DeformapError, FileFormatError, InvalidArgumentError
+
+__all__ = [
+    "MM_EXTENT_THRESHOLD",
+    "UNITS",
+    "check_units",
+    "finish_cloud",
+    "parse_errors",
+    "readable_path",
+]
+
+logger = logging.getLogger(__name__)
+
+#: Unit names accepted by the readers and the factor that turns them into metres.
+UNITS = {"m": 1.0, "mm": 1e-3}
+
+#: A cloud read as metres whose largest |coordinate| exceeds this many metres is taken to be in
+#: millimetres. A tabletop scene seen by a depth camera lies within a few metres of any sensible
+#: origin (consumer depth cameras stop at ~10 m), while the same scene in millimetres has
+#: coordinates in the hundreds. A millimetre cloud that spans less than 20 mm slips through; it is
+#: far smaller than any surface deformap maps.
+MM_EXTENT_THRESHOLD = 20.0
+
+# What numpy, struct, zipfile, zlib, lzf and pydantic raise on malformed bytes. Anything else is a
+# bug of ours and must surface as such.
+_PARSE_ERRORS: tuple[type[BaseException], ...] = (
+    ValueError,
+    TypeError,
+    KeyError,
+    IndexError,
+    EOFError,
+    OverflowError,
+    MemoryError,
+    RuntimeError,
+    UnicodeDecodeError,
+    struct.error,
+    zipfile.BadZipFile,
+    zlib.error,
+    OSError,
+)
+
+
+def check_units(units: Any) -> float:
+    """Return the metres-per-unit factor of ``units`` (``"m"`` or ``"mm"``)."""
+    if not isinstance(units, str) or units not in UNITS:
+        raise InvalidArgumentError(f"`units` must be one of {sorted(UNITS)}; got {units!r}")
+    return UNITS[units]
+
+
+def readable_path(path: Any) -> Path:
+    """Validate that ``path`` names an existing regular file."""
+    if not isinstance(path, (str, Path)):
+        raise InvalidArgumentError(
+            f"`path` must be a str or pathlib.Path; got {type(path).__name__}"
+        )
+    p = Path(path)
+    if not p.exists():
+        raise FileFormatError(f"{p}: no such file")
+    if not p.is_file():
+        raise FileFormatError(f"{p}: not a regular file")
+    return p
+
+
+@contextmanager
+def parse_errors(path: Path, what: str) -> Iterator[None]:
+    """Turn a parser's exception into a FileFormatError naming ``path`` and ``what`` it read."""
+    try:
+        yield
+    except DeformapError:
+        raise
+    except _PARSE_ERRORS as exc:
+        detail = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        raise FileFormatError(
+            f"{path}: could not read {what}: {type(exc).__name__}: {detail[:200]}"
+        ) from exc
+
+
+def finish_cloud(
+    path: Path,
+    xyz: NDArray[Any],
+    colors: NDArray[Any] | None,
+    extras: dict[str, NDArray[Any]],
+    *,
+    scale: float,
+    drop_nan: bool,
+    frame: str = "world",
+) -> tuple[PointCloud, dict[str, NDArray[Any]]]:
+    """Apply the NaN policy and the units rule, and build the cloud.
+
+    Rows with a NaN or infinite coordinate are refused, or dropped (with a warning in the log, and
+    from ``colors`` and ``extras`` alike) when ``drop_nan``. Empty results are refused.
+    """
+    # Widening a signalling NaN (a corrupted float32) raises "invalid"; NaN is handled just below.
+    with np.errstate(invalid="ignore"):
+        xyz = np.asarray(xyz, dtype=np.float64).reshape(-1, 3)
+    if xyz.shape[0] == 0:
+        raise FileFormatError(f"{path}: the cloud is empty (0 points)")
+    finite = np.isfinite(xyz).all(axis=1)
+    n_bad = int(xyz.shape[0] - finite.sum())
+    if n_bad:
+        if not drop_nan:
+            raise FileFormatError(
+                f"{path}: {n_bad} of {xyz.shape[0]} points have a NaN or infinite x/y/z; "
+                "pass drop_nan=True to drop them"
+            )
+        logger.warning(
+            "%s: dropped %d of %d points with NaN or infinite x/y/z", path, n_bad, xyz.shape[0]
+        )
+        xyz = xyz[finite]
+        colors = None if colors is None else colors[finite]
+        extras = {k: v[finite] for k, v in extras.items()}
+        if xyz.shape[0] == 0:
+            raise FileFormatError(f"{path}: every point has a NaN or infinite x/y/z")
+    largest = float(np.abs(xyz).max())
+    if scale == 1.0 and largest > MM_EXTENT_THRESHOLD:
+        raise FileFormatError(
+            f"{path}: coordinates reach {largest:.4g}, which looks like millimetres, not metres "
+            f"(limit {MM_EXTENT_THRESHOLD:g} m); pass units='mm' if the file is in millimetres"
+        )
+    xyz = xyz * scale
+    try:
+        cloud = PointCloud(xyz, colors, frame=frame)
+    except InvalidArgumentError as exc:
+        raise FileFormatError(f"{path}: {exc}") from exc
+    return cloud, extras
