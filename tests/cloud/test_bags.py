@@ -105,8 +105,9 @@ def _organised_big_endian(points: np.ndarray, height: int) -> object:
     types = typestore().types
     field = types["sensor_msgs/msg/PointField"]
     width = len(points) // height
-    layout = np.dtype({"names": ["z", "x", "y"], "formats": [">f8"] * 3,
-                       "offsets": [0, 16, 8], "itemsize": 32})  # fmt: skip
+    offsets = {"z": 0, "x": 16, "y": 8}
+    layout = np.dtype({"names": list(offsets), "formats": [">f8"] * 3,
+                       "offsets": list(offsets.values()), "itemsize": 32})  # fmt: skip
     table = np.zeros(len(points), dtype=layout)
     for i, axis in enumerate("xyz"):
         table[axis] = points[:, i]
@@ -118,7 +119,7 @@ def _organised_big_endian(points: np.ndarray, height: int) -> object:
     )
     return types["sensor_msgs/msg/PointCloud2"](
         header=header, height=height, width=width,
-        fields=[field(name=a, offset=o, datatype=8, count=1) for a, o in zip("zxy", (0, 16, 8), strict=True)],
+        fields=[field(name=a, offset=o, datatype=8, count=1) for a, o in offsets.items()],
         is_bigendian=True, point_step=32, row_step=width * 32 + 16, data=padded.reshape(-1),
         is_dense=False,
     )  # fmt: skip
