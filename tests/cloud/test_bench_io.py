@@ -16,7 +16,7 @@ def test_bench_io_reports_every_timing_on_a_small_cloud() -> None:
 
 
 def test_bench_io_refuses_bad_arguments() -> None:
-    with pytest.raises(InvalidArgumentError, match="`rng` must be a numpy.random.Generator"):
+    with pytest.raises(InvalidArgumentError, match=r"`rng` must be a numpy\.random\.Generator"):
         bench_io(n_points=10, rng=0)  # type: ignore[arg-type]
     with pytest.raises(InvalidArgumentError, match="`n_points` must be an integer >= 1"):
         bench_io(n_points=0, rng=np.random.default_rng(0))
