@@ -12,7 +12,6 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.spatial import ConvexHull, QhullError, cKDTree
 
 from deformap._validation import check_finite_scalar, check_int, check_points, check_vector
 from deformap.errors import InvalidArgumentError
@@ -55,6 +54,8 @@ def crop_box(points: Any, lower: Any, upper: Any) -> NDArray[np.bool_]:
 
 
 def _mean_neighbour_distances(pts: NDArray[np.float64], k: int) -> NDArray[np.float64]:
+    from scipy.spatial import cKDTree  # imported here: scipy.spatial costs ~0.3 s at start-up
+
     # Open3D counts the point itself among its k neighbours (distance 0), so query k, not k + 1.
     dist, _ = cKDTree(pts).query(pts, k=k)
     dist = dist.reshape(pts.shape[0], k)
@@ -144,6 +145,8 @@ def points_in_hull(
             "`hull_points` must span a volume (at least 4 points, not all on one plane or line); "
             f"got {verts.shape[0]} points whose spread is {singular.tolist()} along its axes"
         )
+    from scipy.spatial import ConvexHull, QhullError
+
     try:
         hull = ConvexHull(verts)
     except QhullError as exc:

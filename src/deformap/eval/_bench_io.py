@@ -38,7 +38,7 @@ def _scene(n_points: int, rng: np.random.Generator) -> PointCloud:
     # A depth-camera-like cloud over the 0.6 × 0.4 m workspace with colours.
     xy = rng.uniform((0.0, 0.0), (0.6, 0.4), (n_points, 2))
     z = 0.05 + 0.01 * np.sin(20 * xy[:, 0]) + rng.normal(0, 5e-4, n_points)
-    return PointCloud(np.column_stack([xy, z]), rng.integers(0, 256, (n_points, 3)))
+    return PointCloud(np.column_stack([xy, z]), rng.integers(0, 256, (n_points, 3)) / 255.0)
 
 
 def bench_io(
