@@ -20,8 +20,8 @@ from deformap.cloud.io._bag import (
     read_bag_clouds,
     read_bag_static_transform,
     read_bag_wrenches,
-    write_bag,
 )
+from deformap.cloud.io._bag_writer import write_bag
 from deformap.cloud.io._common import MM_EXTENT_THRESHOLD, UNITS
 from deformap.cloud.io._dispatch import CLOUD_FORMATS, read_cloud, write_cloud
 from deformap.cloud.io._npz import read_npz, write_npz

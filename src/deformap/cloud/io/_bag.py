@@ -2,8 +2,8 @@
 
 Reads ``sensor_msgs/msg/PointCloud2`` topics into :class:`~deformap.cloud.PointCloud`\\ s (in the
 world frame given a 4×4 ``cam2world``, or one composed from the bag's ``/tf_static``),
-``geometry_msgs/msg/WrenchStamped`` topics into arrays, and writes bags of both for tests and
-simulated recordings. ROS is not needed: rosbags reads and writes the files in pure Python.
+and ``geometry_msgs/msg/WrenchStamped`` topics into arrays (writing is in ``_bag_writer``).
+ROS is not needed: rosbags reads and writes the files in pure Python.
 """
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ import logging
 import sqlite3
 import struct
 from collections import deque
-from collections.abc import Iterator, Sequence
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -23,11 +23,7 @@ from numpy.typing import NDArray
 from deformap._validation import check_array
 from deformap.cloud._pointcloud import PointCloud
 from deformap.cloud.io._common import check_units, finish_cloud
-from deformap.cloud.io._pointcloud2 import (
-    array_to_pointcloud2,
-    pointcloud2_structured,
-    xyz_with_holes,
-)
+from deformap.cloud.io._pointcloud2 import pointcloud2_structured, xyz_with_holes
 from deformap.cloud.io._ros import typestore
 from deformap.errors import (
     DeformapError,
@@ -43,16 +39,15 @@ __all__ = [
     "read_bag_clouds",
     "read_bag_static_transform",
     "read_bag_wrenches",
-    "write_bag",
 ]
 
 logger = logging.getLogger(__name__)
 
 BAG_STORAGES = ("mcap", "sqlite3")
-_CLOUD_TYPE = "sensor_msgs/msg/PointCloud2"
-_WRENCH_TYPE = "geometry_msgs/msg/WrenchStamped"
-_TF_TYPE = "tf2_msgs/msg/TFMessage"
-_TF_STATIC_TOPIC = "/tf_static"
+CLOUD_TYPE = "sensor_msgs/msg/PointCloud2"
+WRENCH_TYPE = "geometry_msgs/msg/WrenchStamped"
+TF_TYPE = "tf2_msgs/msg/TFMessage"
+TF_STATIC_TOPIC = "/tf_static"
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -164,7 +159,7 @@ def _transform_matrix(transform: Any) -> NDArray[np.float64]:
 
 
 def read_bag_static_transform(
-    path: str | Path, source_frame: str, target_frame: str, *, topic: str = _TF_STATIC_TOPIC
+    path: str | Path, source_frame: str, target_frame: str, *, topic: str = TF_STATIC_TOPIC
 ) -> NDArray[np.float64]:
     """The 4×4 ``source2target`` transform composed from a bag's static transforms.
 
@@ -185,7 +180,7 @@ def read_bag_static_transform(
     # Each TransformStamped gives child2parent; walk the tree in both directions.
     edges: dict[str, list[tuple[str, NDArray[np.float64]]]] = {}
     p = Path(path) if isinstance(path, (str, Path)) else path
-    for _, msg in _messages(path, topic, _TF_TYPE):
+    for _, msg in _messages(path, topic, TF_TYPE):
         for tf in msg.transforms:
             try:
                 child2parent = _transform_matrix(tf.transform)
@@ -261,7 +256,7 @@ def read_bag_clouds(
         fixed = check_array("cam2world", cam2world, (4, 4), what="homogeneous transform entries")
     transforms: dict[str, NDArray[np.float64]] = {}
     out = []
-    for index, (log_time, msg) in enumerate(_messages(path, topic, _CLOUD_TYPE)):
+    for index, (log_time, msg) in enumerate(_messages(path, topic, CLOUD_TYPE)):
         where = f"{path} [{topic} message {index}]"
         try:
             table = pointcloud2_structured(msg)
@@ -299,7 +294,7 @@ def read_bag_wrenches(path: str | Path, topic: str) -> WrenchSeries:
         Times, forces (N) and torques (N·m) in the sensor frame, in the bag's order.
     """
     stamps, forces, torques, frames = [], [], [], set()
-    for _, msg in _messages(path, topic, _WRENCH_TYPE):
+    for _, msg in _messages(path, topic, WRENCH_TYPE):
         stamps.append(_stamp_ns(msg.header))
         f, t = msg.wrench.force, msg.wrench.torque
         forces.append([f.x, f.y, f.z])
@@ -314,85 +309,3 @@ def read_bag_wrenches(path: str | Path, topic: str) -> WrenchSeries:
         raise FileFormatError(f"{path}: topic {topic!r} holds NaN or infinite wrenches")
     return WrenchSeries(stamp_ns=np.array(stamps, dtype=np.int64), force_n=force,
                         torque_nm=torque, frame_id=frames.pop())  # fmt: skip
-
-
-def _header(stamp_ns: int, frame_id: str) -> Any:
-    types = typestore().types
-    time = types["builtin_interfaces/msg/Time"](sec=stamp_ns // 10**9, nanosec=stamp_ns % 10**9)
-    return types["std_msgs/msg/Header"](stamp=time, frame_id=frame_id)
-
-
-def _tf_message(transforms: Sequence[tuple[str, str, Any]]) -> Any:
-    from scipy.spatial.transform import Rotation
-
-    types = typestore().types
-    items = []
-    for parent, child, matrix in transforms:
-        mat = check_array("static_transforms matrix", matrix, (4, 4), what="transform entries")
-        x, y, z, w = Rotation.from_matrix(mat[:3, :3]).as_quat()
-        transform = types["geometry_msgs/msg/Transform"](
-            translation=types["geometry_msgs/msg/Vector3"](x=mat[0, 3], y=mat[1, 3], z=mat[2, 3]),
-            rotation=types["geometry_msgs/msg/Quaternion"](x=x, y=y, z=z, w=w),
-        )
-        items.append(types["geometry_msgs/msg/TransformStamped"](
-            header=_header(0, parent), child_frame_id=child, transform=transform))  # fmt: skip
-    return types[_TF_TYPE](transforms=items)
-
-
-def _wrench_message(stamp_ns: int, frame_id: str, force: Any, torque: Any) -> Any:
-    types = typestore().types
-    vec = types["geometry_msgs/msg/Vector3"]
-    wrench = types["geometry_msgs/msg/Wrench"](force=vec(*map(float, force)),
-                                               torque=vec(*map(float, torque)))  # fmt: skip
-    return types[_WRENCH_TYPE](header=_header(stamp_ns, frame_id), wrench=wrench)
-
-
-def write_bag(
-    path: str | Path,
-    *,
-    storage: str = "mcap",
-    clouds: dict[str, Sequence[tuple[int, PointCloud]]] | None = None,
-    wrenches: dict[str, WrenchSeries] | None = None,
-    static_transforms: Sequence[tuple[str, str, Any]] = (),
-    cloud_dtype: str = "float32",
-) -> None:
-    """Write clouds, wrenches and static transforms to a new ROS 2 bag (rosbag2 version 9).
-
-    Parameters
-    ----------
-    path : str or Path
-        The bag folder to create; it must not exist.
-    storage : {"mcap", "sqlite3"}
-    clouds : dict of topic to sequence of (stamp_ns, PointCloud), optional
-        Written as ``sensor_msgs/msg/PointCloud2`` with ``header.frame_id = cloud.frame``.
-    wrenches : dict of topic to WrenchSeries, optional
-        Written as ``geometry_msgs/msg/WrenchStamped``.
-    static_transforms : sequence of (parent, child, (4, 4) child2parent)
-        Written as one ``tf2_msgs/msg/TFMessage`` on ``/tf_static`` at time 0.
-    cloud_dtype : {"float32", "float64"}
-        Storage of the cloud coordinates.
-    """
-    rosbag2, store = _rosbag2(), typestore()
-    if storage not in BAG_STORAGES:
-        raise InvalidArgumentError(f"`storage` must be one of {BAG_STORAGES}; got {storage!r}")
-    plugin = rosbag2.StoragePlugin.MCAP if storage == "mcap" else rosbag2.StoragePlugin.SQLITE3
-    p = Path(path)
-    if p.exists():
-        raise InvalidArgumentError(f"`path` {p} exists already; a bag is written to a new folder")
-    with rosbag2.Writer(p, version=9, storage_plugin=plugin) as writer:
-        if static_transforms:
-            conn = writer.add_connection(_TF_STATIC_TOPIC, _TF_TYPE, typestore=store)
-            msg = _tf_message(static_transforms)
-            writer.write(conn, 0, store.serialize_cdr(msg, _TF_TYPE))
-        for topic, stamped in (clouds or {}).items():
-            conn = writer.add_connection(topic, _CLOUD_TYPE, typestore=store)
-            for stamp, cloud in stamped:
-                msg = array_to_pointcloud2(cloud.points, colors=cloud.colors, frame_id=cloud.frame,
-                                           stamp_ns=stamp, dtype=cloud_dtype)  # fmt: skip
-                writer.write(conn, stamp, store.serialize_cdr(msg, _CLOUD_TYPE))
-        for topic, series in (wrenches or {}).items():
-            conn = writer.add_connection(topic, _WRENCH_TYPE, typestore=store)
-            for stamp, force, torque in zip(series.stamp_ns, series.force_n, series.torque_nm,
-                                            strict=True):  # fmt: skip
-                msg = _wrench_message(int(stamp), series.frame_id, force, torque)
-                writer.write(conn, int(stamp), store.serialize_cdr(msg, _WRENCH_TYPE))
