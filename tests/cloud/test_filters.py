@@ -23,16 +23,18 @@ def _rigid(seed: int) -> tuple[np.ndarray, np.ndarray]:
     return Rotation.random(random_state=rng).as_matrix(), rng.uniform(-1.0, 1.0, 3)
 
 
-def _brute_force_sor(points: np.ndarray, k: int, std_ratio: float) -> np.ndarray:
-    """Open3D's rule written out with an explicit all-pairs distance matrix."""
+def _brute_force_sor(points: np.ndarray, k: int, std_ratio: float) -> tuple[np.ndarray, ...]:
+    """Open3D's RemoveStatisticalOutliers transcribed loop by loop, all pairs, no k-d tree."""
     n = len(points)
     dist = np.sqrt(((points[:, None, :] - points[None, :, :]) ** 2).sum(axis=2))
     avg = np.empty(n)
     for i in range(n):
         avg[i] = np.sort(dist[i])[:k].sum() / k  # the point itself (0) is among its k
-    mean = avg.sum() / n
-    std = np.sqrt(((avg - mean) ** 2).sum() / (n - 1))
-    return avg < mean + std_ratio * std
+    cloud_mean = sum(a for a in avg if a > 0) / n
+    sq_sum = sum((a - cloud_mean) ** 2 for a in avg if a > 0)
+    threshold = cloud_mean + std_ratio * np.sqrt(sq_sum / (n - 1))
+    keep = np.array([a > 0 and a < threshold for a in avg])
+    return keep, avg, threshold
 
 
 # ---- crop_box ----
@@ -91,21 +93,31 @@ def test_crop_box_refuses_bad_input(args: tuple[object, ...], message: str) -> N
     seed=seeds,
     n=st.integers(min_value=2, max_value=60),
     k=st.integers(min_value=1, max_value=12),
-    std_ratio=st.floats(min_value=-2.0, max_value=4.0),
+    std_ratio=st.floats(min_value=0.01, max_value=4.0),
+    duplicates=st.integers(min_value=0, max_value=6),
 )
-def test_outlier_mask_matches_brute_force_rule(seed: int, n: int, k: int, std_ratio: float) -> None:
-    k = min(k, n)
+def test_outlier_mask_matches_brute_force_rule(
+    seed: int, n: int, k: int, std_ratio: float, duplicates: int
+) -> None:
     rng = np.random.default_rng(seed)
     pts = rng.normal(size=(n, 3)) * rng.uniform(0.01, 1.0, 3)
-    expected = _brute_force_sor(pts, k, std_ratio)
+    # Exact duplicates give zero averages, the case where Open3D departs from the textbook rule.
+    pts = np.vstack([pts, np.repeat(pts[:1], duplicates, axis=0)])
+    k = min(k, len(pts))
+    expected, avg, threshold = _brute_force_sor(pts, k, std_ratio)
     got = statistical_outlier_mask(pts, k, std_ratio)
     # Summation order differs between the two, so only points within round-off of the threshold
     # may disagree.
-    dist = np.sqrt(((pts[:, None] - pts[None]) ** 2).sum(axis=2))
-    avg = np.sort(dist, axis=1)[:, :k].mean(axis=1)
-    thr = avg.mean() + std_ratio * avg.std(ddof=1)
-    clear = np.abs(avg - thr) > 1e-12 * max(1.0, abs(thr))
+    clear = np.abs(avg - threshold) > 1e-12 * max(1.0, abs(threshold))
     assert np.array_equal(got[clear], expected[clear])
+
+
+def test_outlier_mask_never_keeps_points_with_k_coincident_neighbours() -> None:
+    rng = np.random.default_rng(5)
+    pts = np.vstack([rng.normal(scale=0.01, size=(100, 3)), np.zeros((4, 3))])
+    mask = statistical_outlier_mask(pts, 4, 3.0)
+    assert not mask[-4:].any()  # average distance 0: Open3D drops them
+    assert mask[:-4].mean() > 0.9
 
 
 def test_outlier_mask_removes_far_points_and_keeps_the_cluster() -> None:
@@ -117,11 +129,13 @@ def test_outlier_mask_removes_far_points_and_keeps_the_cluster() -> None:
     assert mask[:-2].mean() > 0.9
 
 
-def test_outlier_mask_removes_everything_on_a_perfect_lattice_like_open3d() -> None:
-    g = np.arange(4.0)
-    lattice = np.stack(np.meshgrid(g, g, g), axis=-1).reshape(-1, 3)
-    # k = 1: every average is 0, std is 0, and 0 < 0 is false for every point.
-    assert not statistical_outlier_mask(lattice, 1, 1.0).any()
+def test_outlier_mask_removes_every_point_when_all_averages_are_equal_like_open3d() -> None:
+    cube = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)], float)
+    # k = 4: the point and its three edge neighbours, average exactly 3/4 everywhere, so s = 0
+    # and m < m is false for every point.
+    assert not statistical_outlier_mask(cube, 4, 1.0).any()
+    # k = 1: every average is 0, and Open3D keeps only positive averages.
+    assert not statistical_outlier_mask(cube, 1, 1.0).any()
 
 
 @settings(max_examples=20, deadline=None)
@@ -132,9 +146,8 @@ def test_outlier_mask_commutes_with_rigid_motions(seed: int) -> None:
     rot, shift = _rigid(seed)
     a = statistical_outlier_mask(pts, 8, 1.0)
     b = statistical_outlier_mask(pts @ rot.T + shift, 8, 1.0)
-    dist = np.sqrt(((pts[:, None] - pts[None]) ** 2).sum(axis=2))
-    avg = np.sort(dist, axis=1)[:, :8].mean(axis=1)
-    clear = np.abs(avg - avg.mean() - avg.std(ddof=1)) > 1e-12
+    _, avg, threshold = _brute_force_sor(pts, 8, 1.0)
+    clear = np.abs(avg - threshold) > 1e-12
     assert clear.sum() >= len(pts) - 1
     assert np.array_equal(a[clear], b[clear])
 
@@ -159,6 +172,7 @@ def test_outlier_mask_parity_with_open3d() -> None:
         ((np.zeros((5, 3)), 0, 1.0), r"`k` must be an integer >= 1"),
         ((np.zeros((5, 3)), 2.5, 1.0), r"`k` must be an integer"),
         ((np.zeros((5, 3)), 2, float("nan")), r"`std_ratio` must be finite"),
+        ((np.zeros((5, 3)), 2, 0.0), r"`std_ratio` must be > 0"),
         ((np.zeros((5, 2)), 2, 1.0), r"`points` must be a \(n, 3\)"),
     ],
 )

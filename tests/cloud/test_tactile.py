@@ -32,6 +32,9 @@ def test_tactile_points_lie_on_the_sphere_within_the_cap(
     cos_angle = rel @ u / radius
     assert np.all(cos_angle >= np.cos(np.radians(half_angle)) - 1e-12)
     np.testing.assert_allclose(pts[0], c + radius * u, atol=1e-15)
+    # The polar angles do not depend on where the tip is or which way it presses.
+    canonical = tactile_points([0, 0, 0], [0, 0, 1], 1.0, n, cap_half_angle_deg=half_angle)
+    np.testing.assert_allclose(cos_angle, canonical[:, 2], atol=1e-9)
     if n > 1:  # the spiral ends on the rim and no point repeats
         np.testing.assert_allclose(cos_angle[-1], np.cos(np.radians(half_angle)), atol=1e-12)
         gaps = np.linalg.norm(pts[:, None] - pts[None], axis=2) + np.eye(n)

@@ -12,7 +12,6 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.spatial import ConvexHull, QhullError, cKDTree
 
 from deformap._validation import check_finite_scalar, check_int, check_points, check_vector
 from deformap.errors import InvalidArgumentError
@@ -55,6 +54,8 @@ def crop_box(points: Any, lower: Any, upper: Any) -> NDArray[np.bool_]:
 
 
 def _mean_neighbour_distances(pts: NDArray[np.float64], k: int) -> NDArray[np.float64]:
+    from scipy.spatial import cKDTree  # imported here: scipy.spatial costs ~0.3 s at start-up
+
     # Open3D counts the point itself among its k neighbours (distance 0), so query k, not k + 1.
     dist, _ = cKDTree(pts).query(pts, k=k)
     dist = dist.reshape(pts.shape[0], k)
@@ -65,9 +66,9 @@ def statistical_outlier_mask(points: Any, k: int, std_ratio: float) -> NDArray[n
     """Mask of the points kept by Open3D's statistical outlier rule.
 
     For each point, average the distances to its ``k`` nearest neighbours, the point itself
-    included (so one of them is 0). Let ``m`` and ``s`` be the mean and the sample standard
-    deviation (ddof = 1) of those averages over the cloud. A point is kept when its average is
-    strictly below ``m + std_ratio · s``.
+    included (so one of them is 0). Let ``m`` be the mean of those averages and ``s`` their sample
+    standard deviation (ddof = 1). A point is kept when its average is strictly below
+    ``m + std_ratio · s``.
 
     Parameters
     ----------
@@ -76,7 +77,7 @@ def statistical_outlier_mask(points: Any, k: int, std_ratio: float) -> NDArray[n
     k : int
         Number of neighbours, the point itself included (Open3D's ``nb_neighbors``), ``>= 1``.
     std_ratio : float
-        Threshold in standard deviations; any finite value (Open3D accepts negatives too).
+        Threshold in standard deviations, ``> 0`` (Open3D refuses others too).
 
     Returns
     -------
@@ -85,16 +86,21 @@ def statistical_outlier_mask(points: Any, k: int, std_ratio: float) -> NDArray[n
 
     Notes
     -----
-    With every average equal (a perfect lattice), ``s = 0`` and the strict inequality removes every
-    point, exactly as Open3D does.
+    Two details follow Open3D's code rather than the textbook rule, so that results agree point
+    for point. A point whose average is exactly 0 (it has ``k - 1`` exact duplicates, or ``k = 1``)
+    counts in ``n`` and in ``m`` but adds nothing to the squared deviations of ``s``, and is
+    never kept. With every average equal and non-zero, ``s = 0`` and the strict inequality removes
+    every point, as in Open3D.
 
     References
     ----------
-    Open3D, ``PointCloud::RemoveStatisticalOutliers`` (``geometry/PointCloud.cpp``);
+    Open3D, ``PointCloud::RemoveStatisticalOutliers`` (``cpp/open3d/geometry/PointCloud.cpp``);
     Rusu et al., "Towards 3D point cloud based object maps for household environments", 2008.
     """
     k = check_int("k", k, minimum=1)
     ratio = check_finite_scalar("std_ratio", std_ratio)
+    if ratio <= 0:
+        raise InvalidArgumentError(f"`std_ratio` must be > 0 (as in Open3D); got {ratio}")
     pts = check_points("points", points, min_rows=0)
     n = pts.shape[0]
     if n < max(k, 2):
@@ -103,8 +109,11 @@ def statistical_outlier_mask(points: Any, k: int, std_ratio: float) -> NDArray[n
             f"outlier rule; got {n}"
         )
     avg = _mean_neighbour_distances(pts, k)
-    threshold = avg.mean() + ratio * avg.std(ddof=1)
-    mask = avg < threshold
+    positive = avg > 0
+    mean = avg.sum() / n
+    std = np.sqrt(np.sum((avg[positive] - mean) ** 2) / (n - 1))
+    threshold = mean + ratio * std
+    mask = positive & (avg < threshold)
     logger.debug("statistical outliers: kept %d of %d (threshold %.3g m)", mask.sum(), n, threshold)
     return np.asarray(mask)
 
@@ -144,6 +153,8 @@ def points_in_hull(
             "`hull_points` must span a volume (at least 4 points, not all on one plane or line); "
             f"got {verts.shape[0]} points whose spread is {singular.tolist()} along its axes"
         )
+    from scipy.spatial import ConvexHull, QhullError
+
     try:
         hull = ConvexHull(verts)
     except QhullError as exc:

@@ -1,8 +1,14 @@
 """Tactile points: where the probe's spherical tip touches the surface while it presses.
 
 The paper adds ten points from the touch sensor to the cloud seen while pressing, because the tip
-and stick hide the very dent being measured (Caccamo et al. 2016, Sec. III-C). Here they are points
-on the spherical cap of the tip that faces along the contact force.
+and stick hide the very dent being measured; they are "virtually generated considering the position
+and shape of the spherical surface of the sensor along with the contact force direction". Here they
+are points on the spherical cap of the tip that faces along the contact force.
+
+References
+----------
+Caccamo et al., "Active Perception and Modeling of Deformable Surfaces using Gaussian Processes
+and Position-based Dynamics", HUMANOIDS 2016, Sec. III ("The algorithm process flow").
 """
 
 from __future__ import annotations

@@ -13,22 +13,46 @@ order; numpy), NPZ (``points``, ``colors``), and ROS 2 bags (sqlite3 and MCAP; t
 
 from __future__ import annotations
 
+from deformap.cloud.io._bag import (
+    BAG_STORAGES,
+    StampedCloud,
+    WrenchSeries,
+    read_bag_clouds,
+    read_bag_static_transform,
+    read_bag_wrenches,
+)
+from deformap.cloud.io._bag_writer import write_bag
 from deformap.cloud.io._common import MM_EXTENT_THRESHOLD, UNITS
 from deformap.cloud.io._dispatch import CLOUD_FORMATS, read_cloud, write_cloud
 from deformap.cloud.io._npz import read_npz, write_npz
 from deformap.cloud.io._pcd import PCD_ENCODINGS, read_pcd, write_pcd
 from deformap.cloud.io._ply import PLY_FORMATS, read_ply, write_ply
+from deformap.cloud.io._pointcloud2 import (
+    array_to_pointcloud2,
+    pointcloud2_structured,
+    pointcloud2_to_array,
+)
 
 __all__ = [
+    "BAG_STORAGES",
     "CLOUD_FORMATS",
     "MM_EXTENT_THRESHOLD",
     "PCD_ENCODINGS",
     "PLY_FORMATS",
     "UNITS",
+    "StampedCloud",
+    "WrenchSeries",
+    "array_to_pointcloud2",
+    "pointcloud2_structured",
+    "pointcloud2_to_array",
+    "read_bag_clouds",
+    "read_bag_static_transform",
+    "read_bag_wrenches",
     "read_cloud",
     "read_npz",
     "read_pcd",
     "read_ply",
+    "write_bag",
     "write_cloud",
     "write_npz",
     "write_pcd",

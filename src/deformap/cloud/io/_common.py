@@ -98,7 +98,7 @@ def parse_errors(path: Path, what: str) -> Iterator[None]:
 
 
 def finish_cloud(
-    path: Path,
+    path: Path | str,
     xyz: NDArray[Any],
     colors: NDArray[Any] | None,
     extras: dict[str, NDArray[Any]],
@@ -109,6 +109,7 @@ def finish_cloud(
 ) -> tuple[PointCloud, dict[str, NDArray[Any]]]:
     """Apply the NaN policy and the units rule, and build the cloud.
 
+    ``path`` names the source in messages (a file, or a bag with its topic and message index).
     Rows with a NaN or infinite coordinate are refused, or dropped (with a warning in the log, and
     from ``colors`` and ``extras`` alike) when ``drop_nan``. Empty results are refused.
     """

@@ -69,7 +69,9 @@ def _check_header_against_body(path: Path, meta: Any, body: bytes) -> None:
         if len(body) < 8:
             raise FileFormatError(f"{path}: binary_compressed body is truncated (no size words)")
         compressed, uncompressed = struct.unpack("II", body[:8])
-        if uncompressed != need or compressed > len(body) - 8:
+        # An LZF back-reference of 3 bytes expands to at most 264: a ratio above 88 is corrupt,
+        # and checking it first keeps a forged size from allocating gigabytes.
+        if uncompressed != need or compressed > len(body) - 8 or uncompressed > 100 * compressed:
             raise FileFormatError(
                 f"{path}: binary_compressed sizes do not match the header: {compressed} "
                 f"compressed bytes (file holds {len(body) - 8}) and {uncompressed} uncompressed "

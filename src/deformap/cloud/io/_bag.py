@@ -1,0 +1,311 @@
+"""ROS 2 bags (sqlite3 and MCAP) through the optional ``rosbags`` package (extra ``ros``).
+
+Reads ``sensor_msgs/msg/PointCloud2`` topics into :class:`~deformap.cloud.PointCloud`\\ s (in the
+world frame given a 4×4 ``cam2world``, or one composed from the bag's ``/tf_static``),
+and ``geometry_msgs/msg/WrenchStamped`` topics into arrays (writing is in ``_bag_writer``).
+ROS is not needed: rosbags reads and writes the files in pure Python.
+"""
+
+from __future__ import annotations
+
+import logging
+import sqlite3
+import struct
+from collections import deque
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from deformap._validation import check_array
+from deformap.cloud._pointcloud import PointCloud
+from deformap.cloud.io._common import check_units, finish_cloud
+from deformap.cloud.io._pointcloud2 import pointcloud2_structured, xyz_with_holes
+from deformap.cloud.io._ros import typestore
+from deformap.errors import (
+    DeformapError,
+    FileFormatError,
+    InvalidArgumentError,
+    missing_extra,
+)
+
+__all__ = [
+    "BAG_STORAGES",
+    "StampedCloud",
+    "WrenchSeries",
+    "read_bag_clouds",
+    "read_bag_static_transform",
+    "read_bag_wrenches",
+]
+
+logger = logging.getLogger(__name__)
+
+BAG_STORAGES = ("mcap", "sqlite3")
+CLOUD_TYPE = "sensor_msgs/msg/PointCloud2"
+WRENCH_TYPE = "geometry_msgs/msg/WrenchStamped"
+TF_TYPE = "tf2_msgs/msg/TFMessage"
+TF_STATIC_TOPIC = "/tf_static"
+
+
+@dataclass(frozen=True, kw_only=True)
+class StampedCloud:
+    """One PointCloud2 message read from a bag.
+
+    Parameters
+    ----------
+    stamp_ns : int
+        The message header's time, nanoseconds.
+    log_time_ns : int
+        When the bag recorded it, nanoseconds.
+    cloud : PointCloud
+        Points in metres, in frame ``"world"`` when a transform was applied, else in the header's
+        frame.
+    n_dropped : int
+        Points with a NaN or infinite coordinate dropped (holes of an organised cloud).
+    """
+
+    stamp_ns: int
+    log_time_ns: int
+    cloud: PointCloud
+    n_dropped: int
+
+
+@dataclass(frozen=True, kw_only=True)
+class WrenchSeries:
+    """A ``geometry_msgs/msg/WrenchStamped`` topic as arrays.
+
+    Parameters
+    ----------
+    stamp_ns : (n,) int64
+        Header times, nanoseconds.
+    force_n : (n, 3) float
+        Forces in newtons, in the sensor frame ``frame_id``.
+    torque_nm : (n, 3) float
+        Torques in newton-metres.
+    frame_id : str
+        The frame of the first message (all messages must share it).
+    """
+
+    stamp_ns: NDArray[np.int64]
+    force_n: NDArray[np.float64]
+    torque_nm: NDArray[np.float64]
+    frame_id: str
+
+
+def _rosbag2() -> Any:
+    try:
+        import rosbags.rosbag2 as rosbag2
+    except ImportError:
+        raise missing_extra("rosbags", "ros", "reading ROS 2 bags") from None
+    return rosbag2
+
+
+def _stamp_ns(header: Any) -> int:
+    return int(header.stamp.sec) * 10**9 + int(header.stamp.nanosec)
+
+
+def _messages(path: Any, topic: str, msgtype: str) -> Iterator[tuple[int, Any]]:
+    """Yield (log time, deserialised message) of ``topic``; every failure names file and topic."""
+    if not isinstance(topic, str) or not topic:
+        raise InvalidArgumentError(f"`topic` must be a non-empty str; got {topic!r}")
+    if not isinstance(path, (str, Path)):
+        raise InvalidArgumentError(
+            f"`path` must be a str or pathlib.Path; got {type(path).__name__}"
+        )
+    rosbag2, store, p = _rosbag2(), typestore(), Path(path)
+    from rosbags.serde import SerdeError
+
+    if not p.exists():
+        raise FileFormatError(f"{p}: no such bag")
+    # What rosbags, sqlite3 and the CDR decoder raise on damaged bags.
+    errors = (rosbag2.ReaderError, SerdeError, sqlite3.Error, OSError, ValueError, KeyError,
+              IndexError, TypeError, AssertionError, EOFError, struct.error)  # fmt: skip
+    try:
+        with rosbag2.Reader(p) as reader:
+            conns = [c for c in reader.connections if c.topic == topic]
+            if not conns:
+                found = sorted({c.topic for c in reader.connections})
+                raise FileFormatError(f"{p}: bag has no topic {topic!r} (topics: {found})")
+            wrong = [c.msgtype for c in conns if c.msgtype != msgtype]
+            if wrong:
+                raise FileFormatError(
+                    f"{p}: topic {topic!r} carries {wrong[0]}, expected {msgtype}"
+                )
+            for conn, log_time, raw in reader.messages(connections=conns):
+                yield int(log_time), store.deserialize_cdr(raw, conn.msgtype)
+    except DeformapError:
+        raise
+    except errors as exc:
+        raise FileFormatError(
+            f"{p}: could not read topic {topic!r}: {type(exc).__name__}: {str(exc)[:200]}"
+        ) from exc
+
+
+def _transform_matrix(transform: Any) -> NDArray[np.float64]:
+    from scipy.spatial.transform import Rotation
+
+    q = transform.rotation
+    quat = np.array([q.x, q.y, q.z, q.w], dtype=float)
+    if not np.isfinite(quat).all() or abs(np.linalg.norm(quat) - 1.0) > 1e-3:
+        raise ValueError(f"rotation quaternion {quat.tolist()} is not a unit quaternion")
+    mat = np.eye(4)
+    mat[:3, :3] = Rotation.from_quat(quat).as_matrix()
+    t = transform.translation
+    mat[:3, 3] = [t.x, t.y, t.z]
+    return mat
+
+
+def read_bag_static_transform(
+    path: str | Path, source_frame: str, target_frame: str, *, topic: str = TF_STATIC_TOPIC
+) -> NDArray[np.float64]:
+    """The 4×4 ``source2target`` transform composed from a bag's static transforms.
+
+    Parameters
+    ----------
+    path : str or Path
+        The bag (folder, ``.mcap`` or ``.db3``).
+    source_frame, target_frame : str
+        Frame names as in the messages (``"camera_depth_optical_frame"``, ``"world"``).
+    topic : str
+        The ``tf2_msgs/msg/TFMessage`` topic.
+
+    Returns
+    -------
+    source2target : (4, 4) float
+        Maps points in ``source_frame`` to ``target_frame``: ``p_t = T[:3, :3] p_s + T[:3, 3]``.
+    """
+    # Each TransformStamped gives child2parent; walk the tree in both directions.
+    edges: dict[str, list[tuple[str, NDArray[np.float64]]]] = {}
+    p = Path(path) if isinstance(path, (str, Path)) else path
+    for _, msg in _messages(path, topic, TF_TYPE):
+        for tf in msg.transforms:
+            try:
+                child2parent = _transform_matrix(tf.transform)
+            except ValueError as exc:
+                raise FileFormatError(
+                    f"{p}: {topic} transform {tf.header.frame_id!r} -> {tf.child_frame_id!r}: {exc}"
+                ) from None
+            parent, child = tf.header.frame_id, tf.child_frame_id
+            edges.setdefault(child, []).append((parent, child2parent))
+            edges.setdefault(parent, []).append((child, np.asarray(np.linalg.inv(child2parent))))
+    if source_frame == target_frame:
+        return np.eye(4)
+    seen = {source_frame: np.eye(4)}
+    queue = deque([source_frame])
+    while queue:
+        frame = queue.popleft()
+        for neighbour, frame2neighbour in edges.get(frame, []):
+            if neighbour not in seen:
+                seen[neighbour] = frame2neighbour @ seen[frame]
+                queue.append(neighbour)
+    if target_frame not in seen:
+        raise FileFormatError(
+            f"{p}: {topic} does not connect frame {source_frame!r} to {target_frame!r} "
+            f"(frames: {sorted(edges)}); pass cam2world= instead"
+        )
+    return seen[target_frame]
+
+
+def _decode_colors(table: NDArray[Any]) -> NDArray[np.uint8] | None:
+    names = table.dtype.names or ()
+    field = next((c for c in ("rgb", "rgba") if c in names), None)
+    if field is None or table[field].ndim != 1 or table[field].dtype.itemsize != 4:
+        return None
+    packed = np.ascontiguousarray(table[field]).view(table[field].dtype.newbyteorder("="))
+    packed = packed.view(np.uint32) if packed.dtype.kind == "f" else packed.astype(np.uint32)
+    shifts = np.array([16, 8, 0], dtype=np.uint32)
+    return ((packed[:, None] >> shifts) & 0xFF).astype(np.uint8)
+
+
+def read_bag_clouds(
+    path: str | Path,
+    topic: str,
+    *,
+    cam2world: Any = None,
+    world_frame: str = "world",
+    units: str = "m",
+) -> list[StampedCloud]:
+    """Read every ``sensor_msgs/msg/PointCloud2`` message of a topic.
+
+    Parameters
+    ----------
+    path : str or Path
+        The bag: a rosbag2 folder (with ``metadata.yaml``), or a single ``.mcap`` or ``.db3``.
+    topic : str
+    cam2world : None, (4, 4) float, or "tf_static"
+        ``None`` keeps each cloud in its header's frame; a matrix maps the clouds to the world
+        frame; ``"tf_static"`` composes that matrix from the bag's ``/tf_static`` for each
+        message's ``header.frame_id`` up to ``world_frame``.
+    world_frame : str
+        The target frame for ``"tf_static"``.
+    units : {"m", "mm"}
+        Units of the message coordinates; clouds that look like millimetres are refused as metres.
+
+    Returns
+    -------
+    list of StampedCloud
+        In the bag's order. NaN holes are dropped and counted in ``n_dropped``; a message with no
+        finite point is refused.
+    """
+    scale = check_units(units)
+    fixed = None
+    if cam2world is not None and not (isinstance(cam2world, str) and cam2world == "tf_static"):
+        fixed = check_array("cam2world", cam2world, (4, 4), what="homogeneous transform entries")
+    transforms: dict[str, NDArray[np.float64]] = {}
+    out = []
+    for index, (log_time, msg) in enumerate(_messages(path, topic, CLOUD_TYPE)):
+        where = f"{path} [{topic} message {index}]"
+        try:
+            table = pointcloud2_structured(msg)
+            xyz = xyz_with_holes(msg, table)
+        except InvalidArgumentError as exc:
+            raise FileFormatError(f"{where}: {str(exc).replace('`msg` ', '')}") from None
+        colors = _decode_colors(table)
+        finite = np.isfinite(xyz).all(axis=1)
+        dropped = int(finite.size - finite.sum())
+        xyz, colors = xyz[finite], None if colors is None else colors[finite]
+        cloud, _ = finish_cloud(where, xyz, colors, {}, scale=scale, drop_nan=False,
+                                frame=msg.header.frame_id or "sensor")  # fmt: skip
+        if cam2world is not None:
+            if fixed is None:
+                frame = msg.header.frame_id
+                if frame not in transforms:
+                    transforms[frame] = read_bag_static_transform(path, frame, world_frame)
+                matrix = transforms[frame]
+            else:
+                matrix = fixed
+            cloud = cloud.transformed(matrix, world_frame if fixed is None else "world")
+        out.append(StampedCloud(stamp_ns=_stamp_ns(msg.header), log_time_ns=log_time,
+                                cloud=cloud, n_dropped=dropped))  # fmt: skip
+    if not out:
+        raise FileFormatError(f"{path}: topic {topic!r} has no messages")
+    return out
+
+
+def read_bag_wrenches(path: str | Path, topic: str) -> WrenchSeries:
+    """Read a ``geometry_msgs/msg/WrenchStamped`` topic.
+
+    Returns
+    -------
+    WrenchSeries
+        Times, forces (N) and torques (N·m) in the sensor frame, in the bag's order.
+    """
+    stamps, forces, torques, frames = [], [], [], set()
+    for _, msg in _messages(path, topic, WRENCH_TYPE):
+        stamps.append(_stamp_ns(msg.header))
+        f, t = msg.wrench.force, msg.wrench.torque
+        forces.append([f.x, f.y, f.z])
+        torques.append([t.x, t.y, t.z])
+        frames.add(msg.header.frame_id)
+    if not stamps:
+        raise FileFormatError(f"{path}: topic {topic!r} has no messages")
+    if len(frames) > 1:
+        raise FileFormatError(f"{path}: topic {topic!r} mixes frames {sorted(frames)}")
+    force, torque = np.array(forces, dtype=float), np.array(torques, dtype=float)
+    if not (np.isfinite(force).all() and np.isfinite(torque).all()):
+        raise FileFormatError(f"{path}: topic {topic!r} holds NaN or infinite wrenches")
+    return WrenchSeries(stamp_ns=np.array(stamps, dtype=np.int64), force_n=force,
+                        torque_nm=torque, frame_id=frames.pop())  # fmt: skip

@@ -1,0 +1,240 @@
+"""``sensor_msgs/msg/PointCloud2`` to and from arrays, for any field layout.
+
+A PointCloud2 is ``height`` rows of ``width`` points; each point is ``point_step`` bytes holding
+its fields at their ``offset``; rows start every ``row_step`` bytes (``>= width·point_step``: rows
+may be padded). Reading builds a numpy structured dtype with those offsets, so a 300,000-point
+message is viewed, not parsed field by field.
+
+References
+----------
+ROS 2 ``sensor_msgs/msg/PointCloud2`` and ``sensor_msgs/msg/PointField`` message definitions;
+``sensor_msgs_py.point_cloud2`` (the reference reader).
+"""
+
+from __future__ import annotations
+
+import logging
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from deformap._validation import check_array, check_int, check_points
+from deformap.cloud.io._ros import typestore
+from deformap.errors import InvalidArgumentError
+
+__all__ = [
+    "array_to_pointcloud2",
+    "pointcloud2_structured",
+    "pointcloud2_to_array",
+    "xyz_with_holes",
+]
+
+logger = logging.getLogger(__name__)
+
+# sensor_msgs/msg/PointField datatype constants.
+_DATATYPES = {1: "i1", 2: "u1", 3: "i2", 4: "u2", 5: "i4", 6: "u4", 7: "f4", 8: "f8"}
+_FLOAT_CODES = {7: "f4", 8: "f8"}
+
+
+def _message_bytes(msg: Any) -> NDArray[np.uint8]:
+    data = msg.data
+    if isinstance(data, np.ndarray):
+        return data.view(np.uint8).reshape(-1) if data.dtype.itemsize == 1 else data.view(np.uint8)
+    return np.frombuffer(bytes(data), dtype=np.uint8)
+
+
+def _layout(msg: Any) -> tuple[np.dtype[Any], int, int, int, int]:
+    try:
+        height, width = int(msg.height), int(msg.width)
+        point_step, row_step = int(msg.point_step), int(msg.row_step)
+        fields = list(msg.fields)
+        order = ">" if bool(msg.is_bigendian) else "<"
+    except (AttributeError, TypeError, ValueError) as exc:
+        raise InvalidArgumentError(
+            f"`msg` must be a sensor_msgs/msg/PointCloud2 message; got {type(msg).__name__} ({exc})"
+        ) from None
+    if min(height, width, point_step, row_step) < 0:
+        raise InvalidArgumentError(
+            f"`msg` has a negative size: height={height}, width={width}, "
+            f"point_step={point_step}, row_step={row_step}"
+        )
+    names, formats, offsets = [], [], []
+    for f in fields:
+        code = _DATATYPES.get(int(f.datatype))
+        count = int(f.count)
+        if code is None:
+            raise InvalidArgumentError(f"`msg` field {f.name!r} has unknown datatype {f.datatype}")
+        if not f.name or f.name in names or count < 1:
+            continue  # unnamed or repeated fields and count 0 carry nothing we can address
+        end = int(f.offset) + np.dtype(code).itemsize * count
+        if int(f.offset) < 0 or end > point_step:
+            raise InvalidArgumentError(
+                f"`msg` field {f.name!r} spans bytes {f.offset}..{end} of a {point_step}-byte point"
+            )
+        names.append(f.name)
+        formats.append(order + code if count == 1 else (order + code, (count,)))
+        offsets.append(int(f.offset))
+    dtype = np.dtype({"names": names, "formats": formats, "offsets": offsets,
+                      "itemsize": point_step})  # fmt: skip
+    if height > 1 and row_step < width * point_step:
+        raise InvalidArgumentError(
+            f"`msg` row_step {row_step} is shorter than width·point_step = {width * point_step}"
+        )
+    return dtype, height, width, point_step, row_step
+
+
+def pointcloud2_structured(msg: Any) -> NDArray[Any]:
+    """View a PointCloud2's points as a structured array with one named field per PointField.
+
+    Parameters
+    ----------
+    msg : sensor_msgs/msg/PointCloud2
+        A rosbags message, or any object with the same attributes (``data`` as bytes or uint8).
+
+    Returns
+    -------
+    points : (height·width,) structured array
+        Fields in the message's byte order; padding between fields and rows skipped.
+    """
+    dtype, height, width, point_step, row_step = _layout(msg)
+    data = _message_bytes(msg)
+    n = height * width
+    if n == 0:
+        return np.empty(0, dtype=dtype)
+    if point_step == 0:
+        raise InvalidArgumentError(f"`msg` has {n} points but point_step 0")
+    # The last row needs only width·point_step bytes; earlier rows need row_step each.
+    need = (height - 1) * row_step + width * point_step
+    if data.size < need:
+        raise InvalidArgumentError(
+            f"`msg` data holds {data.size} bytes but {height}×{width} points of {point_step} bytes "
+            f"(row_step {row_step}) need {need}"
+        )
+    if row_step == width * point_step or height == 1:
+        return np.frombuffer(data, dtype=dtype, count=n)
+    rows = np.lib.stride_tricks.as_strided(
+        data, shape=(height, width * point_step), strides=(row_step, 1), writeable=False
+    )
+    return np.ascontiguousarray(rows).view(dtype).reshape(-1)
+
+
+def pointcloud2_to_array(msg: Any, *, with_count: bool = False) -> Any:
+    """``(n, 3)`` float64 x, y, z of a PointCloud2, with non-finite points dropped.
+
+    Parameters
+    ----------
+    msg : sensor_msgs/msg/PointCloud2
+        Any field layout: x, y, z as FLOAT32 or FLOAT64 at any offsets, padded points and rows,
+        either byte order. Points with a NaN or infinite coordinate (the holes of an organised
+        depth image, ``is_dense = False``) are dropped and counted; in a message that claims
+        ``is_dense = True`` they are refused.
+    with_count : bool
+        Also return how many points were dropped.
+
+    Returns
+    -------
+    points : (n, 3) float64
+        In the message's units and frame (``msg.header.frame_id``).
+    dropped : int
+        Only with ``with_count``.
+    """
+    xyz = xyz_with_holes(msg, pointcloud2_structured(msg))
+    finite = np.isfinite(xyz).all(axis=1)
+    dropped = int(xyz.shape[0] - np.count_nonzero(finite))
+    if dropped:
+        xyz = xyz[finite]
+        logger.debug("PointCloud2: dropped %d non-finite points of %d", dropped, finite.size)
+    return (xyz, dropped) if with_count else xyz
+
+
+def xyz_with_holes(msg: Any, table: NDArray[Any]) -> NDArray[np.float64]:
+    """``(height·width, 3)`` float64 x, y, z of a viewed PointCloud2, NaN holes included.
+
+    Refuses missing or non-float x/y/z, and NaN or infinite points in a message that says
+    ``is_dense``.
+    """
+    fields = {f.name: f for f in msg.fields}
+    for axis in "xyz":
+        if axis not in fields:
+            raise InvalidArgumentError(
+                f"`msg` has no field {axis!r} (fields: {[f.name for f in msg.fields]})"
+            )
+        if int(fields[axis].datatype) not in _FLOAT_CODES or int(fields[axis].count) != 1:
+            raise InvalidArgumentError(
+                f"`msg` field {axis!r} must be one FLOAT32 or FLOAT64; got datatype "
+                f"{fields[axis].datatype} with count {fields[axis].count}"
+            )
+    xyz = np.empty((table.shape[0], 3))
+    with np.errstate(invalid="ignore"):  # signalling NaNs in the holes widen to quiet ones
+        for i, axis in enumerate("xyz"):
+            xyz[:, i] = table[axis]
+    if bool(msg.is_dense):
+        bad = int(np.count_nonzero(~np.isfinite(xyz).all(axis=1)))
+        if bad:
+            raise InvalidArgumentError(
+                f"`msg` says is_dense but {bad} of {xyz.shape[0]} points are NaN or infinite"
+            )
+    return xyz
+
+
+def array_to_pointcloud2(
+    points: Any,
+    *,
+    colors: Any = None,
+    frame_id: str = "world",
+    stamp_ns: int = 0,
+    dtype: str = "float32",
+) -> Any:
+    """Build a ``sensor_msgs/msg/PointCloud2`` (rosbags message) from points.
+
+    Parameters
+    ----------
+    points : (n, 3) float, metres
+    colors : (n, 3) float in [0, 1], optional
+        Packed into a FLOAT32 ``rgb`` field (the PCL/RViz convention).
+    frame_id : str
+        The header's frame.
+    stamp_ns : int
+        The header's time, in nanoseconds.
+    dtype : {"float32", "float64"}
+        Storage of x, y, z.
+
+    Returns
+    -------
+    msg : rosbags ``sensor_msgs__msg__PointCloud2``
+        An unorganised (height 1), dense, little-endian cloud.
+    """
+    pts = check_points("points", points, min_rows=0)
+    stamp = check_int("stamp_ns", stamp_ns, minimum=0)
+    if dtype not in ("float32", "float64"):
+        raise InvalidArgumentError(f"`dtype` must be 'float32' or 'float64'; got {dtype!r}")
+    if not isinstance(frame_id, str):
+        raise InvalidArgumentError(f"`frame_id` must be a str; got {type(frame_id).__name__}")
+    types = typestore().types
+    point_field, size = types["sensor_msgs/msg/PointField"], np.dtype(dtype).itemsize
+    code = point_field.FLOAT32 if dtype == "float32" else point_field.FLOAT64
+    fields = [point_field(name=a, offset=i * size, datatype=code, count=1)
+              for i, a in enumerate("xyz")]  # fmt: skip
+    layout = [(a, "<" + np.dtype(dtype).str[1:]) for a in "xyz"]
+    if colors is not None:
+        cols = check_array("colors", colors, (pts.shape[0], 3), what="RGB values in [0, 1]")
+        if cols.size and (cols.min() < 0 or cols.max() > 1):
+            raise InvalidArgumentError("`colors` must lie in [0, 1]")
+        fields.append(point_field(name="rgb", offset=3 * size, datatype=7, count=1))
+        layout.append(("rgb", "<u4"))
+    table = np.empty(pts.shape[0], dtype=layout)
+    for i, a in enumerate("xyz"):
+        table[a] = pts[:, i]
+    if colors is not None:
+        rgb = np.round(cols * 255).astype(np.uint32)
+        table["rgb"] = (rgb[:, 0] << 16) | (rgb[:, 1] << 8) | rgb[:, 2]
+    header = types["std_msgs/msg/Header"](
+        stamp=types["builtin_interfaces/msg/Time"](sec=stamp // 10**9, nanosec=stamp % 10**9),
+        frame_id=frame_id,
+    )
+    return types["sensor_msgs/msg/PointCloud2"](
+        header=header, height=1, width=pts.shape[0], fields=fields, is_bigendian=False,
+        point_step=table.dtype.itemsize, row_step=table.nbytes, data=table.view(np.uint8),
+        is_dense=True,
+    )  # fmt: skip

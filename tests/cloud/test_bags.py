@@ -1,0 +1,199 @@
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+pytest.importorskip("rosbags")
+
+from rosbags.rosbag2 import StoragePlugin, Writer
+
+from deformap.cloud import PointCloud
+from deformap.cloud.io import (
+    BAG_STORAGES,
+    WrenchSeries,
+    read_bag_clouds,
+    read_bag_static_transform,
+    read_bag_wrenches,
+    write_bag,
+)
+from deformap.cloud.io._ros import typestore
+from deformap.errors import FileFormatError, InvalidArgumentError
+
+
+def _pose(seed: int) -> np.ndarray:
+    rng = np.random.default_rng(seed)
+    mat = np.eye(4)
+    mat[:3, :3] = Rotation.random(random_state=rng).as_matrix()
+    mat[:3, 3] = rng.uniform(-0.5, 0.5, 3)
+    return mat
+
+
+def _cloud(seed: int, n: int = 200, frame: str = "camera") -> PointCloud:
+    rng = np.random.default_rng(seed)
+    return PointCloud(rng.uniform(-0.3, 0.3, (n, 3)), rng.integers(0, 256, (n, 3)), frame=frame)
+
+
+def _wrenches(n: int = 5) -> WrenchSeries:
+    rng = np.random.default_rng(9)
+    return WrenchSeries(stamp_ns=np.arange(n, dtype=np.int64) * 10**8 + 3,
+                        force_n=rng.normal(size=(n, 3)), torque_nm=rng.normal(size=(n, 3)),
+                        frame_id="ft_sensor")  # fmt: skip
+
+
+@pytest.fixture(params=BAG_STORAGES)
+def storage(request: pytest.FixtureRequest) -> str:
+    return str(request.param)
+
+
+def test_clouds_and_wrenches_round_trip(tmp_path: Path, storage: str) -> None:
+    clouds = [(10**9, _cloud(1)), (2 * 10**9 + 7, _cloud(2))]
+    series = _wrenches()
+    bag = tmp_path / "bag"
+    write_bag(bag, storage=storage, clouds={"/camera/points": clouds},
+              wrenches={"/ft": series}, cloud_dtype="float64")  # fmt: skip
+    got = read_bag_clouds(bag, "/camera/points")
+    assert [g.stamp_ns for g in got] == [10**9, 2 * 10**9 + 7]
+    assert [g.log_time_ns for g in got] == [10**9, 2 * 10**9 + 7]
+    for (_, want), g in zip(clouds, got, strict=True):
+        np.testing.assert_array_equal(g.cloud.points, want.points)
+        np.testing.assert_array_equal(g.cloud.colors, want.colors)  # type: ignore[arg-type]
+        assert g.cloud.frame == "camera" and g.n_dropped == 0
+    w = read_bag_wrenches(bag, "/ft")
+    np.testing.assert_array_equal(w.stamp_ns, series.stamp_ns)
+    np.testing.assert_array_equal(w.force_n, series.force_n)
+    np.testing.assert_array_equal(w.torque_nm, series.torque_nm)
+    assert w.frame_id == "ft_sensor"
+    # A single storage file reads as well as the folder.
+    single = next(bag.glob("*.mcap" if storage == "mcap" else "*.db3"))
+    assert len(read_bag_clouds(single, "/camera/points")) == 2
+
+
+def test_cam2world_matrix_and_tf_static_chain(tmp_path: Path, storage: str) -> None:
+    world2base, base2cam = _pose(1), _pose(2)  # parent-from-child: base in world, cam in base
+    cam2world = world2base @ base2cam
+    bag = tmp_path / "bag"
+    write_bag(bag, storage=storage, clouds={"/pts": [(5, _cloud(3, frame="cam"))]},
+              static_transforms=[("world", "base", world2base), ("base", "cam", base2cam)],
+              cloud_dtype="float64")  # fmt: skip
+    raw = _cloud(3, frame="cam").points
+    expected = raw @ cam2world[:3, :3].T + cam2world[:3, 3]
+    via_tf = read_bag_clouds(bag, "/pts", cam2world="tf_static")[0].cloud
+    via_matrix = read_bag_clouds(bag, "/pts", cam2world=cam2world)[0].cloud
+    assert via_tf.frame == via_matrix.frame == "world"
+    np.testing.assert_allclose(via_tf.points, expected, atol=1e-12)
+    np.testing.assert_allclose(via_matrix.points, expected, atol=1e-12)
+    # The inverse direction walks the tree downwards.
+    np.testing.assert_allclose(read_bag_static_transform(bag, "world", "cam"),
+                               np.linalg.inv(cam2world), atol=1e-12)  # fmt: skip
+    np.testing.assert_array_equal(read_bag_static_transform(bag, "cam", "cam"), np.eye(4))
+
+
+def _write_raw_cloud_bag(bag: Path, storage: str, msgs: list[object]) -> None:
+    store = typestore()
+    plugin = StoragePlugin.MCAP if storage == "mcap" else StoragePlugin.SQLITE3
+    with Writer(bag, version=9, storage_plugin=plugin) as writer:
+        conn = writer.add_connection("/pts", "sensor_msgs/msg/PointCloud2", typestore=store)
+        for i, msg in enumerate(msgs):
+            writer.write(conn, i, store.serialize_cdr(msg, "sensor_msgs/msg/PointCloud2"))
+
+
+def _organised_big_endian(points: np.ndarray, height: int) -> object:
+    """An organised, padded, big-endian float64 cloud with NaN holes, as some drivers send."""
+    types = typestore().types
+    field = types["sensor_msgs/msg/PointField"]
+    width = len(points) // height
+    offsets = {"z": 0, "x": 16, "y": 8}
+    layout = np.dtype({"names": list(offsets), "formats": [">f8"] * 3,
+                       "offsets": list(offsets.values()), "itemsize": 32})  # fmt: skip
+    table = np.zeros(len(points), dtype=layout)
+    for i, axis in enumerate("xyz"):
+        table[axis] = points[:, i]
+    rows = table.view(np.uint8).reshape(height, width * 32)
+    padded = np.zeros((height, width * 32 + 16), np.uint8)
+    padded[:, : width * 32] = rows
+    header = types["std_msgs/msg/Header"](
+        stamp=types["builtin_interfaces/msg/Time"](sec=1, nanosec=2), frame_id="cam"
+    )
+    return types["sensor_msgs/msg/PointCloud2"](
+        header=header, height=height, width=width,
+        fields=[field(name=a, offset=o, datatype=8, count=1) for a, o in offsets.items()],
+        is_bigendian=True, point_step=32, row_step=width * 32 + 16, data=padded.reshape(-1),
+        is_dense=False,
+    )  # fmt: skip
+
+
+def test_organised_clouds_with_holes_drop_and_count_them(tmp_path: Path, storage: str) -> None:
+    rng = np.random.default_rng(4)
+    pts = rng.uniform(-0.2, 0.2, (24, 3))
+    pts[[1, 5, 17]] = np.nan
+    bag = tmp_path / "bag"
+    _write_raw_cloud_bag(bag, storage, [_organised_big_endian(pts, height=4)])
+    (got,) = read_bag_clouds(bag, "/pts")
+    assert got.n_dropped == 3 and got.stamp_ns == 10**9 + 2
+    np.testing.assert_array_equal(got.cloud.points, np.delete(pts, [1, 5, 17], axis=0))
+    assert got.cloud.colors is None
+
+
+def test_bad_bags_name_file_topic_and_problem(tmp_path: Path, storage: str) -> None:
+    bag = tmp_path / "bag"
+    write_bag(bag, storage=storage, clouds={"/pts": [(1, _cloud(1, frame="cam"))]},
+              wrenches={"/ft": _wrenches()})  # fmt: skip
+    with pytest.raises(FileFormatError, match=r"bag: bag has no topic '/nope' \(topics: \['/ft'"):
+        read_bag_clouds(bag, "/nope")
+    with pytest.raises(FileFormatError, match="topic '/pts' carries sensor_msgs/msg/PointCloud2"):
+        read_bag_wrenches(bag, "/pts")
+    with pytest.raises(FileFormatError, match="bag has no topic '/tf_static'"):
+        read_bag_clouds(bag, "/pts", cam2world="tf_static")
+    with pytest.raises(FileFormatError, match="no such bag"):
+        read_bag_clouds(tmp_path / "missing", "/pts")
+    with pytest.raises(InvalidArgumentError, match=r"`cam2world` must be a \(4, 4\)"):
+        read_bag_clouds(bag, "/pts", cam2world=np.eye(3))
+    with pytest.raises(InvalidArgumentError, match="`topic` must be a non-empty str"):
+        read_bag_wrenches(bag, "")
+    with pytest.raises(InvalidArgumentError, match="exists already"):
+        write_bag(bag, storage=storage)
+    with pytest.raises(InvalidArgumentError, match="`storage` must be one of"):
+        write_bag(tmp_path / "other", storage="rosbag1")
+
+
+def test_tf_static_that_does_not_reach_the_world_is_refused(tmp_path: Path) -> None:
+    bag = tmp_path / "bag"
+    write_bag(bag, clouds={"/pts": [(1, _cloud(1, frame="cam"))]},
+              static_transforms=[("robot", "cam", _pose(0))])  # fmt: skip
+    with pytest.raises(FileFormatError, match="does not connect frame 'cam' to 'world'"):
+        read_bag_clouds(bag, "/pts", cam2world="tf_static")
+    assert read_bag_clouds(bag, "/pts", cam2world="tf_static", world_frame="robot")
+
+
+def test_millimetre_and_all_nan_messages_are_refused(tmp_path: Path) -> None:
+    bag = tmp_path / "mm"
+    write_bag(bag, clouds={"/pts": [(1, PointCloud(_cloud(1).points * 1000, frame="cam"))]})
+    with pytest.raises(
+        FileFormatError, match=r"\[/pts message 0\]: coordinates reach .* units='mm'"
+    ):
+        read_bag_clouds(bag, "/pts")
+    got = read_bag_clouds(bag, "/pts", units="mm")[0].cloud
+    np.testing.assert_allclose(got.points, _cloud(1).points, rtol=1e-6)
+    bag = tmp_path / "nan"
+    _write_raw_cloud_bag(bag, "mcap", [_organised_big_endian(np.full((4, 3), np.nan), 2)])
+    with pytest.raises(FileFormatError, match=r"\[/pts message 0\]: the cloud is empty"):
+        read_bag_clouds(bag, "/pts")
+
+
+@pytest.mark.parametrize("cut", [0.3, 0.6, 0.9])
+def test_truncated_and_garbled_bags_raise_file_format_errors(
+    tmp_path: Path, storage: str, cut: float
+) -> None:
+    bag = tmp_path / "bag"
+    write_bag(bag, storage=storage, clouds={"/pts": [(i, _cloud(i)) for i in range(3)]})
+    data_file = next(p for p in bag.iterdir() if p.suffix in (".mcap", ".db3"))
+    data = data_file.read_bytes()
+    data_file.write_bytes(data[: int(len(data) * cut)])
+    with pytest.raises(FileFormatError, match=r"bag"):
+        read_bag_clouds(bag, "/pts")
+    data_file.write_bytes(bytes(b ^ 0x5A for b in data))
+    with pytest.raises(FileFormatError, match=r"bag"):
+        read_bag_clouds(bag, "/pts")
