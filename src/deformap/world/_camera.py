@@ -2,8 +2,8 @@
 
 The camera sits ``height_m`` above the table in front of the workspace (on its ``-y`` side) and
 looks at the workspace centre ``pitch_deg`` below the horizontal. Each of the ``width × height``
-pixels casts one ray (trimesh, with the Embree backend when ``embreex`` is installed and trimesh's
-pure ``ray_triangle`` fallback otherwise) into the scene: table, blocks' deformed surfaces and,
+pixels casts one ray (trimesh's Embree backend when ``embreex`` is installed, else the
+pure-numpy caster) into the scene: table, blocks' deformed surfaces and,
 while pressing, the probe. Then, per pixel, in this order:
 
 1. no return when the ray meets the surface at more than ``grazing_deg`` from its normal;
@@ -32,7 +32,9 @@ import numpy as np
 import trimesh
 from numpy.typing import NDArray
 
-__all__ = ["CameraConfig", "DepthCamera", "cast_rays"]
+from deformap.world._raycast import cast_rays
+
+__all__ = ["CameraConfig", "DepthCamera"]
 
 log = logging.getLogger(__name__)
 
@@ -55,23 +57,7 @@ class CameraConfig:
     grazing_deg: float = 80.0
     edge_jump_m: float = 0.02
     flying_probability: float = 0.3
-
-
-def cast_rays(mesh: trimesh.Trimesh, origins: NDArray[np.float64], directions: NDArray[np.float64]
-              ) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.float64]]:
-    """First hits of rays on a mesh: ``(ray index, triangle index, (k, 3) location)``.
-
-    Uses Embree through trimesh when available, else trimesh's pure-numpy ``ray_triangle``.
-    """
-    try:
-        from trimesh.ray.ray_pyembree import RayMeshIntersector
-    except ImportError:  # embreex missing: slower, same answers up to round-off
-        from trimesh.ray.ray_triangle import RayMeshIntersector
-    intersector = RayMeshIntersector(mesh)
-    tri, ray, loc = intersector.intersects_id(origins, directions, multiple_hits=False,
-                                              return_locations=True)
-    order = np.argsort(ray, kind="stable")
-    return np.asarray(ray[order]), np.asarray(tri[order]), np.asarray(loc[order])
+    use_embree: bool = True
 
 
 class DepthCamera:
@@ -111,7 +97,8 @@ class DepthCamera:
         """``(height, width)`` noise-free depth along the optical axis, NaN where no return."""
         c = self.config
         origins = np.broadcast_to(self.origin, self.directions.shape)
-        ray, tri, loc = cast_rays(mesh, np.ascontiguousarray(origins), self.directions)
+        ray, tri, loc = cast_rays(mesh, np.ascontiguousarray(origins), self.directions,
+                                  use_embree=c.use_embree)
         depth = np.full(c.width * c.height, np.nan)
         cos_incidence = np.abs(np.einsum("ij,ij->i", mesh.face_normals[tri], self.directions[ray]))
         ok = cos_incidence >= np.cos(np.radians(c.grazing_deg))
