@@ -105,7 +105,11 @@ class SimulatedWorld:
     scenario : Scenario
     config : WorldConfig
     rng : numpy.random.Generator
-        Source of the camera and force-sensor noise; the same seed gives the same clouds.
+        Source of the camera and force-sensor noise; the same seed gives the same clouds. One
+        number is drawn from it at construction; each event then draws its noise from a stream
+        keyed by that number and the event itself (the n-th observation at rest; a press by its
+        target and force). So the noise of a press does not depend on what happened before it,
+        and a killed run that is resumed sees exactly the noise the uninterrupted run saw.
 
     Notes
     -----
@@ -121,7 +125,8 @@ class SimulatedWorld:
             raise InvalidArgumentError(f"`rng` must be a numpy.random.Generator; got {type(rng)}")
         self.scenario = scenario
         self.config = config or WorldConfig()
-        self._rng = rng
+        self._noise_key = int(rng.integers(2**62))
+        self._n_observed = 0
         c = self.config
         self.foam = FoamModel(scenario, element_size_m=c.element_size_m, top_layer_m=c.top_layer_m,
                               layer_growth=c.layer_growth, poisson_ratio=c.poisson_ratio)
@@ -138,8 +143,12 @@ class SimulatedWorld:
 
     def observe(self) -> PointCloud:
         """One depth frame of the scene as it is now, world frame."""
-        robot = None if self._pressed is None else self._pressed.contact
-        return self._capture(self._displacement, robot)
+        if self._pressed is None:
+            rng = self._event_rng(0, self._n_observed)
+            self._n_observed += 1
+            return self._capture(self._displacement, None, rng)
+        p = self._pressed
+        return self._capture(self._displacement, p.contact, self._press_rng(p.target_xy, p.force_n, 1))
 
     def press(self, target_xy: Any, force_n: float) -> PressObservation:
         """Press at ``target_xy`` with ``force_n`` newtons along the surface normal and hold."""
@@ -155,10 +164,11 @@ class SimulatedWorld:
                 f"{tuple(np.round(self._pressed.target_xy, 4))}; call release() first")
         dent = self.dent(target, force)
         tip_center = self._tip_center(target, dent)
-        noise = self._rng.normal(0.0, self.config.force_noise_n, size=3)
+        rng = self._press_rng(target, force, 0)
+        noise = rng.normal(0.0, self.config.force_noise_n, size=3)
         contact = TactileContact(tip_center=tip_center, force=-_UP * force + noise,
                                  tip_radius_m=self.config.tip_radius_m)
-        cloud = self._capture(dent.displacement, contact)
+        cloud = self._capture(dent.displacement, contact, rng)
         self._displacement = dent.displacement
         self._pressed = PressObservation(
             cloud=cloud, contact=contact, target_xy=target, force_n=force,
@@ -260,7 +270,16 @@ class SimulatedWorld:
             parts_v.append(np.asarray(probe.vertices))
         return trimesh.Trimesh(np.concatenate(parts_v), np.concatenate(parts_f), process=False)
 
-    def _capture(self, displacement: NDArray[np.float64], contact: TactileContact | None
-                 ) -> PointCloud:
-        points = self.camera.capture(self.scene_mesh(displacement, contact), self._rng)
+    def _event_rng(self, *key: int) -> np.random.Generator:
+        return np.random.default_rng([self._noise_key, *key])
+
+    def _press_rng(self, target: NDArray[np.float64], force: float, view: int
+                   ) -> np.random.Generator:
+        # Micrometres and micronewtons, shifted to be non-negative: SeedSequence takes naturals.
+        x, y = (int(round(v * 1e6)) + 2**40 for v in target)
+        return self._event_rng(1, x, y, int(round(force * 1e6)), view)
+
+    def _capture(self, displacement: NDArray[np.float64], contact: TactileContact | None,
+                 rng: np.random.Generator) -> PointCloud:
+        points = self.camera.capture(self.scene_mesh(displacement, contact), rng)
         return PointCloud(points=points, frame="world")
