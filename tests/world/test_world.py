@@ -61,7 +61,8 @@ def test_noise_free_points_lie_on_the_surfaces() -> None:
 
 def test_axial_noise_follows_the_quadratic_model() -> None:
     w = SimulatedWorld(load_scenario("homogeneous-110"),
-                       config=replace(COARSE, camera=replace(COARSE.camera, flying_probability=0.0)),
+                       config=replace(COARSE, camera=replace(COARSE.camera,
+                                                             flying_probability=0.0)),
                        rng=np.random.default_rng(1))
     cloud = w.observe()
     inner = np.all((cloud.xy > 0.02) & (cloud.xy < np.array([0.58, 0.38])), axis=1)
@@ -142,7 +143,7 @@ def test_press_returns_contact_robot_and_occluding_probe(world) -> None:
     assert dent.depth_m > 0.002
     assert contact.tip_center[2] == pytest.approx(0.05 - dent.depth_m + 0.01)
     hull = Delaunay(obs.robot_points)
-    inside = [contact.tip_center + [0, 0, dz] for dz in (0.0, 0.05, 0.1, 0.15, 0.2)]
+    inside = [contact.tip_center + np.array([0, 0, dz]) for dz in (0.0, 0.05, 0.1, 0.15, 0.2)]
     assert np.all(hull.find_simplex(np.array(inside)) >= 0)  # tip top, stick and hand covered
     pts = obs.cloud.points
     assert np.count_nonzero(pts[:, 2] > 0.17) > 50  # the hand is seen

@@ -5,6 +5,12 @@ pieces, not glued), factorised once when the world is built. A press puts the He
 commanded force on the top surface under the tip; the part of the patch that falls on rigid ground
 (a rigid board or the bare table) is carried by it and loads no foam.
 
+Indentation: inside the contact the surface follows the rigid sphere, ``u(r) = δ − r² / (2R)``, so
+averaging with the Hertz pressure as weight gives ``δ = ū_p + <r²>_p / (2R) = ū_p + 0.2 a² / R``,
+where ``ū_p`` is the pressure-weighted mean FEM displacement (the load's work-conjugate, which
+converges at second order under mesh refinement and does not depend on where the target falls
+between nodes, unlike the displacement interpolated at the target).
+
 Patch radius: Hertz's ``a`` assumes a half-space, but the foam is a layer bonded to the table and
 responds stiffer, so the tip sinks less than Hertz says and touches a smaller disc. The press
 therefore iterates ``a ← sqrt(a · sqrt(R δ_FEM))`` (a damped fixed point of the sphere's geometric
@@ -38,7 +44,8 @@ class Dent:
     displacement : (n_nodes, 3) float, metres
         Displacement of every mesh node of the world (all bodies stacked).
     depth_m : float
-        Downward displacement of the surface at the target (0 on rigid ground).
+        Indentation of the tip: how far its lowest point sinks below the rest surface (0 on
+        rigid ground); see the module docstring.
     contact_radius_m : float
         Radius of the loaded patch after the consistency iteration (0 on rigid ground).
     iterations : int
@@ -128,8 +135,9 @@ class FoamModel:
         a = min(hertz_contact_radius(force_n, tip_radius_m, modulus, self.poisson_ratio),
                 tip_radius_m)
         for iteration in range(1, max_iterations + 1):
-            u = self._solve_patch(target[0], a, force_n)
-            depth = max(0.0, -float(self.top_displacement(target, u)[0, 2]))
+            u, points, forces = self._solve_patch(target[0], a, force_n)
+            mean_u = -float(forces @ self.top_displacement(points, u)[:, 2]) / force_n
+            depth = max(0.0, mean_u + 0.2 * a * a / tip_radius_m)
             a_new = min(np.sqrt(a * np.sqrt(tip_radius_m * depth)), tip_radius_m)
             converged = abs(a_new - a) <= tolerance * a
             log.debug("press iteration %d: a=%.4f m, depth=%.4f m", iteration, a, depth)
@@ -140,7 +148,7 @@ class FoamModel:
                     iterations=iteration)
 
     def _solve_patch(self, center: NDArray[np.float64], radius: float, force_n: float
-                     ) -> NDArray[np.float64]:
+                     ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
         points, forces = hertz_pressure_samples(center, radius, force_n)
         u = self.zero_displacement()
         claimed = np.zeros(len(points), dtype=bool)
@@ -155,4 +163,4 @@ class FoamModel:
             np.add.at(load[:, 2], nodes[inside].ravel(),
                       -(weights[inside] * forces[inside, None]).ravel())
             u[off:off + grid.n_nodes] = body.solve(load)
-        return u
+        return u, points, forces

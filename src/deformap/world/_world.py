@@ -4,10 +4,12 @@ Default press force
 -------------------
 ``default_force_n = 0.6`` N. Hertz contact on the softest foam of the paper's range (60 N,
 E = 4.64 kPa, ν = 0.3) keeps the contact radius within the 1 cm tip, ``a ≤ R``, only for
-``F ≤ 4 E* R² / 3 = 0.68 N``; beyond it the stick would touch the foam and a spherical-tip contact no
-longer describes the press. 0.6 N is that bound rounded down. The FEM dents it gives at the default
-mesh are listed in the package docstring; every foam from 60 to 150 N dents by several millimetres
-(above the ≈2 mm axial noise at the camera's 1.1 m range) and far less than half of a 5 cm block.
+``F ≤ 4 E* R² / 3 = 0.68 N``; beyond it the stick would touch the foam and a spherical-tip
+contact no longer describes the press. 0.6 N is that bound rounded down. At the default mesh,
+on 5 cm blocks, it indents 60, 110 and 150 N foam by 7.5, 4.9 and 4.1 mm (FEM; Hertz on a
+half-space says 9.2, 6.1 and 5.0 mm, the bonded layer is stiffer): every foam of the range dents
+by about twice the axial noise at the camera's 1.1 m range (σ_z ≈ 2.1 mm per pixel, and a dent
+spans hundreds of pixels) and far less than half of the block.
 
 Ground truth
 ------------
