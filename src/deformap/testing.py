@@ -7,7 +7,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["assert_allclose_m", "flat_patch"]
+__all__ = ["assert_allclose_m", "coarse_world", "flat_patch"]
 
 
 def assert_allclose_m(actual: Any, desired: Any, *, atol_m: float, err_msg: str = "") -> None:
@@ -23,3 +23,19 @@ def flat_patch(n: int = 10, spacing_m: float = 0.005, height_m: float = 0.05) ->
     xs = (np.arange(n) - (n - 1) / 2) * spacing_m
     gx, gy = np.meshgrid(xs, xs)
     return np.column_stack([gx.ravel(), gy.ravel(), np.full(n * n, height_m)])
+
+
+# ---- simulated world (deformap.world) ----
+
+
+def coarse_world(scenario: str = "heterogeneous-60-110-rigid", seed: int = 0, **overrides: Any
+                 ) -> Any:
+    """A :class:`deformap.world.SimulatedWorld` on the coarse test mesh (builds in < 1 s).
+
+    For tests of code that drives an ``Environment``; its dents are coarse-mesh numbers, not
+    measurements. ``overrides`` go to :meth:`deformap.world.WorldConfig.coarse`.
+    """
+    from deformap.world import SimulatedWorld, WorldConfig, load_scenario
+
+    return SimulatedWorld(load_scenario(scenario), config=WorldConfig.coarse(**overrides),
+                          rng=np.random.default_rng(seed))

@@ -247,3 +247,23 @@ def test_world_does_not_import_the_estimator() -> None:
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                             check=False)
     assert result.returncode == 0, result.stdout + result.stderr
+
+
+def test_noise_switch_turns_off_camera_and_force_noise() -> None:
+    w = SimulatedWorld(load_scenario("homogeneous-60"), config=WorldConfig.coarse(noise=False),
+                       rng=np.random.default_rng(0))
+    obs = w.press((0.3, 0.2), 0.6)
+    np.testing.assert_array_equal(obs.contact.force, [0.0, 0.0, -0.6])
+    far = np.all((obs.cloud.xy > 0.05) & (obs.cloud.xy < 0.12), axis=1)
+    np.testing.assert_allclose(obs.cloud.z[far], 0.05, atol=1e-6)
+    with pytest.raises(InvalidArgumentError, match="`hand_size_m`"):
+        WorldConfig(hand_size_m=(0.1, 0.0, 0.1))
+    with pytest.raises(InvalidArgumentError, match="`tip_radius_m` must be > 0"):
+        WorldConfig(tip_radius_m=-0.01)
+
+
+def test_testing_helper_builds_a_coarse_world() -> None:
+    from deformap.testing import coarse_world
+
+    w = coarse_world("heterogeneous-60-150", seed=3)
+    assert isinstance(w, Environment) and w.config.element_size_m == 0.02

@@ -20,7 +20,7 @@ on the bare table (neither deforms).
 from __future__ import annotations
 
 import logging
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -57,10 +57,14 @@ class WorldConfig:
     poisson_ratio : float
     default_force_n : float
         Press force the exploration uses when it has no other (see the module docstring).
-    probe : ProbeGeometry
-        Tip radius (1 cm), stick (10 cm), hand box.
+    tip_radius_m, stick_length_m, stick_radius_m : float
+        The probe: spherical tip (1 cm, Optoforce-like), stick (10 cm long).
+    hand_size_m : (3,) float
+        The box standing for the hand that holds the stick.
     force_noise_n : float
         Standard deviation per axis of the force sensor's noise (Optoforce-class resolution).
+    noise : bool
+        False turns off every noise source (camera and force sensor) at once.
     camera : CameraConfig
     table_margin_m : float
         How far the table extends beyond the workspace on every side.
@@ -71,14 +75,24 @@ class WorldConfig:
     layer_growth: float = 1.5
     poisson_ratio: float = 0.3
     default_force_n: float = 0.6
-    probe: ProbeGeometry = field(default_factory=ProbeGeometry)
+    tip_radius_m: float = 0.01
+    stick_length_m: float = 0.10
+    stick_radius_m: float = 0.006
+    hand_size_m: tuple[float, float, float] = (0.08, 0.06, 0.10)
     force_noise_n: float = 0.01
+    noise: bool = True
     camera: CameraConfig = field(default_factory=CameraConfig)
     table_margin_m: float = 0.2
 
     def __post_init__(self) -> None:
-        for name in ("element_size_m", "top_layer_m", "default_force_n", "table_margin_m"):
+        for name in ("element_size_m", "top_layer_m", "default_force_n", "table_margin_m",
+                     "tip_radius_m", "stick_length_m", "stick_radius_m"):
             check_positive(name, getattr(self, name))
+        hand = check_vector("hand_size_m", self.hand_size_m, 3, what="metres")
+        if np.any(hand <= 0):
+            raise InvalidArgumentError(f"`hand_size_m` must be positive; got {self.hand_size_m}")
+        if not isinstance(self.camera, CameraConfig):
+            raise InvalidArgumentError(f"`camera` must be a CameraConfig; got {type(self.camera)}")
         check_positive("force_noise_n", self.force_noise_n, allow_zero=True)
         if not 0.0 <= self.poisson_ratio < 0.5:
             raise InvalidArgumentError(
@@ -87,8 +101,11 @@ class WorldConfig:
             raise InvalidArgumentError(f"`layer_growth` must be >= 1; got {self.layer_growth!r}")
 
     @property
-    def tip_radius_m(self) -> float:
-        return self.probe.tip_radius_m
+    def probe(self) -> ProbeGeometry:
+        """The probe geometry built from the `tip_radius_m`, `stick_*`, `hand_size_m` fields."""
+        return ProbeGeometry(tip_radius_m=self.tip_radius_m, stick_length_m=self.stick_length_m,
+                             stick_radius_m=self.stick_radius_m,
+                             hand_size_m=tuple(self.hand_size_m))  # type: ignore[arg-type]
 
     @classmethod
     def coarse(cls, **overrides: Any) -> WorldConfig:
@@ -127,7 +144,9 @@ class SimulatedWorld:
         c = self.config
         self.foam = FoamModel(scenario, element_size_m=c.element_size_m, top_layer_m=c.top_layer_m,
                               layer_growth=c.layer_growth, poisson_ratio=c.poisson_ratio)
-        self.camera = DepthCamera(c.camera, scenario.workspace.center)
+        camera = c.camera if c.noise else replace(c.camera, noise=False)
+        self.camera = DepthCamera(camera, scenario.workspace.center)
+        self._force_noise_n = c.force_noise_n if c.noise else 0.0
         self._faces = self._surface_triangles()
         self._table = self._table_mesh()
         self._pressed: PressObservation | None = None
@@ -157,7 +176,7 @@ class SimulatedWorld:
                 f"{tuple(np.round(self._pressed.target_xy, 4))}; call release() first")
         dent = self.dent(target, force)
         tip_center = self._tip_center(target, dent)
-        noise = self._rng.normal(0.0, self.config.force_noise_n, size=3)
+        noise = self._rng.normal(0.0, 1.0, size=3) * self._force_noise_n
         contact = TactileContact(tip_center=tip_center, force=-_UP * force + noise,
                                  tip_radius_m=self.config.tip_radius_m)
         cloud = self._capture(dent.displacement, contact)
