@@ -11,6 +11,11 @@ where ``ū_p`` is the pressure-weighted mean FEM displacement (the load's work-c
 converges at second order under mesh refinement and does not depend on where the target falls
 between nodes, unlike the displacement interpolated at the target).
 
+Contact: after the solve, the top nodes inside the contact disc are put on the tip's lower cap
+(``u_z = −δ + R − sqrt(R² − r²)``), since there the foam touches the rigid tip. On a mesh coarser
+than the patch the nodal solution overshoots or undershoots the cap by about a millimetre; this
+projection keeps the surface the camera sees consistent with the tip it sees.
+
 Patch radius: Hertz's ``a`` assumes a half-space, but the foam is a layer bonded to the table and
 responds stiffer, so the tip sinks less than Hertz says and touches a smaller disc. The press
 therefore iterates ``a ← sqrt(a · sqrt(R δ_FEM))`` (a damped fixed point of the sphere's geometric
@@ -144,8 +149,20 @@ class FoamModel:
             if converged or iteration == max_iterations:
                 break
             a = float(a_new)
+        self._conform_to_tip(u, target[0], a, depth, tip_radius_m)
         return Dent(displacement=u, depth_m=depth, contact_radius_m=float(a),
                     iterations=iteration)
+
+    def _conform_to_tip(self, u: NDArray[np.float64], center: NDArray[np.float64], radius: float,
+                        depth: float, tip_radius_m: float) -> None:
+        for index in self.bodies:
+            grid, off = self.grids[index], self.offsets[index]
+            xyz = self.rest_nodes[off:off + grid.n_nodes]
+            r2 = np.sum((xyz[:, :2] - center) ** 2, axis=1)
+            top = np.isclose(xyz[:, 2], grid.levels[-1]) & (r2 < radius**2)
+            top &= np.any(u[off:off + grid.n_nodes] != 0.0, axis=1)  # nodes of the block only
+            cap = -depth + tip_radius_m - np.sqrt(tip_radius_m**2 - r2[top])
+            u[off + np.flatnonzero(top), 2] = cap
 
     def _solve_patch(self, center: NDArray[np.float64], radius: float, force_n: float
                      ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:

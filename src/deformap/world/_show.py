@@ -104,10 +104,10 @@ def _dent_figure(world: SimulatedWorld, out: Path) -> Path:
     ax.plot((tip[0] + r * np.cos(theta)) * 1e3, (tip[2] + r * np.sin(theta)) * 1e3, "k",
             label="tip")
     ax.set_aspect("equal")
-    ax.set(xlabel="x [mm]", ylabel="z [mm]", ylim=(after.min() * 1e3 - 10, before.max() * 1e3 + 30),
+    ax.set(xlabel="x [mm]", ylabel="z [mm]", ylim=(after.min() * 1e3 - 5, before.max() * 1e3 + 25),
            title=f"{force:.2f} N at ({target[0]:.2f}, {target[1]:.2f}): "
                  f"dent {dent.depth_m * 1e3:.1f} mm, a = {dent.contact_radius_m * 1e3:.1f} mm")
-    ax.legend(fontsize=8)
+    ax.legend(fontsize=7, ncol=2, loc="upper left")
     path = out / "dent.png"
     fig.savefig(path, dpi=120, bbox_inches="tight")
     plt_.close(fig)
