@@ -19,7 +19,7 @@ projection keeps the surface the camera sees consistent with the tip it sees.
 Patch radius: Hertz's ``a`` assumes a half-space, but the foam is a layer bonded to the table and
 responds stiffer, so the tip sinks less than Hertz says and touches a smaller disc. The press
 therefore iterates ``a ← sqrt(a · sqrt(R δ_FEM))`` (a damped fixed point of the sphere's geometric
-relation ``a² = R δ``) from the Hertz value until ``a`` changes by less than 1 %, and never lets
+relation ``a² = R δ``) from the Hertz value until ``a`` changes by less than 2 %, and never lets
 ``a`` exceed the tip radius ``R``.
 """
 
@@ -128,7 +128,7 @@ class FoamModel:
         return out
 
     def dent(self, target_xy: NDArray[np.float64], force_n: float, *, tip_radius_m: float,
-             max_iterations: int = 6, tolerance: float = 0.01) -> Dent:
+             max_iterations: int = 6, tolerance: float = 0.02) -> Dent:
         """Solve the press of ``force_n`` newtons at ``target_xy`` (see the module docstring)."""
         target = np.asarray(target_xy, dtype=float).reshape(1, 2)
         labels = self.scenario.labels(target[:, 0], target[:, 1])
