@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import subprocess
 import sys
 from dataclasses import replace
@@ -267,3 +268,20 @@ def test_testing_helper_builds_a_coarse_world() -> None:
 
     w = coarse_world("heterogeneous-60-150", seed=3)
     assert isinstance(w, Environment) and w.config.element_size_m == 0.02
+
+
+@pytest.mark.parametrize("name", ["homogeneous-60", "homogeneous-110", "heterogeneous-60-150",
+                                  "heterogeneous-110-150", "heterogeneous-150-rigid", "random"])
+def test_every_scenario_builds_and_softer_dents_deeper(name) -> None:
+    from deformap.world import random_scenario
+
+    sc = random_scenario(np.random.default_rng(11)) if name == "random" else load_scenario(name)
+    w = SimulatedWorld(sc, config=COARSE, rng=np.random.default_rng(0))
+    depths = {}
+    for k, block in enumerate(w.regions):
+        xy = block.polygon.mean(axis=0)
+        assert w.ground_truth_labels([xy[0]], [xy[1]])[0, 0] == k
+        depths[block.hardness] = w.dent(xy, 0.6).depth_m
+    ordered = [depths[h] for h in sorted(depths)]
+    assert all(a > b for a, b in itertools.pairwise(ordered))
+    assert depths.get(np.inf, 0.0) == 0.0
