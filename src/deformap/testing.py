@@ -10,6 +10,7 @@ from numpy.typing import NDArray
 __all__ = [
     "FOAM_INDENTER_AREA_M2",
     "assert_allclose_m",
+    "coarse_world",
     "elastic_dent",
     "flat_patch",
     "hardness_to_modulus",
@@ -112,3 +113,17 @@ def elastic_dent(xs: Any, ys: Any, z_rest: Any, contact_xy: Any, *, force_n: flo
     contact = TactileContact(tip_center=np.array([cx, cy, z_top + tip_radius_m]),
                              force=np.array([0.0, 0.0, -force_n]), tip_radius_m=tip_radius_m)
     return z_rest - u, contact
+# ---- simulated world (deformap.world) ----
+
+
+def coarse_world(scenario: str = "heterogeneous-60-110-rigid", seed: int = 0, **overrides: Any
+                 ) -> Any:
+    """A :class:`deformap.world.SimulatedWorld` on the coarse test mesh (builds in < 1 s).
+
+    For tests of code that drives an ``Environment``; its dents are coarse-mesh numbers, not
+    measurements. ``overrides`` go to :meth:`deformap.world.WorldConfig.coarse`.
+    """
+    from deformap.world import SimulatedWorld, WorldConfig, load_scenario
+
+    return SimulatedWorld(load_scenario(scenario), config=WorldConfig.coarse(**overrides),
+                          rng=np.random.default_rng(seed))
