@@ -1,4 +1,4 @@
-"""Invariants of Müller's goals: fixed points, rigid motions, exact reproduction, proper rotations."""
+"""Invariants of Müller's goals: fixed points, rigid motions, exact fits, proper rotations."""
 
 from __future__ import annotations
 

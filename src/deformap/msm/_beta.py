@@ -81,7 +81,7 @@ def matching_error(positions: Array, tree: cKDTree) -> Array:
 def _refinement(betas: Array, errors: Array, step: float, resolution: float) -> Array:
     """New β on a ``resolution`` grid within one sweep step of the current minimum."""
     best = float(betas[int(np.argmin(errors))])
-    n = int(round(step / resolution))
+    n = round(step / resolution)
     cand = np.round(best + resolution * np.arange(-n, n + 1), 10)
     cand = cand[(cand >= 0.0) & (cand < 1.0)]
     return np.asarray([c for c in cand if np.min(np.abs(betas - c)) > 0.5 * resolution])

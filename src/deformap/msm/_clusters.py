@@ -29,7 +29,7 @@ import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
 from numpy.typing import NDArray
 
-__all__ = ["Clusters", "polar_rotation"]
+__all__ = ["Clusters", "fast_polar_rotation", "polar_rotation"]
 
 Array = NDArray[np.float64]
 
@@ -39,12 +39,61 @@ def polar_rotation(a: Array) -> Array:
 
     Batched SVD ``A = U Σ Vᵀ``, ``R = U diag(1, 1, det(U Vᵀ)) Vᵀ``: always a proper rotation
     (det R = +1), also for the rank-2 ``A_pq`` of a flat cluster, where the missing direction is
-    completed as the cross product of the other two.
+    completed as the cross product of the other two, and for ``det A < 0`` (the rotation closest
+    to ``A``, Kabsch).
     """
     u, _, vt = np.linalg.svd(a)
     det = np.linalg.det(u @ vt)
     u[..., :, 2] *= np.where(det < 0.0, -1.0, 1.0)[..., None]
     return u @ vt
+
+
+def fast_polar_rotation(a: Array, *, tol: float = 1e-14, max_iter: int = 20) -> Array:
+    """``polar_rotation(a)`` by Higham's scaled Newton iteration where it is safe, SVD elsewhere.
+
+    ``X ← (γ X + X⁻ᵀ / γ) / 2`` with ``X⁻ᵀ = cof(X) / det X`` in closed form and Frobenius scaling
+    ``γ``; it converges quadratically to the polar factor when ``det A > 0``. Matrices with a
+    small or negative determinant (relative to ``‖A‖³``: flat, nearly singular or inverted
+    clusters) and any that are not converged get the SVD answer.
+
+    References
+    ----------
+    Higham, N. J. (1986). Computing the polar decomposition — with applications. SIAM J. Sci.
+    Stat. Comput. 7(4), 1160–1174.
+    """
+    shape = a.shape
+    x = a.reshape(-1, 3, 3)
+    norm = np.sqrt(np.sum(x * x, axis=(1, 2)))
+    x = x / np.maximum(norm, np.finfo(float).tiny)[:, None, None]
+    safe = np.linalg.det(x) > 1e-3
+    out = np.empty_like(x)
+    # component-major layout: nine contiguous 1-D arrays make the closed forms fast
+    m = np.ascontiguousarray(x[safe].reshape(-1, 9).T)
+    ok = np.zeros(m.shape[1], dtype=bool)
+    for _ in range(max_iter):
+        inv_t = _inverse_transpose(m)
+        gamma = np.sqrt(np.sqrt(np.sum(inv_t * inv_t, axis=0) / np.sum(m * m, axis=0)))
+        new = 0.5 * (gamma * m + inv_t / gamma)
+        ok = np.max(np.abs(new - m), axis=0) < tol**0.5  # quadratic: the next step is < tol
+        m = new
+        if np.all(ok):
+            break
+    out[safe] = m.T.reshape(-1, 3, 3)
+    redo = ~safe
+    redo[np.flatnonzero(safe)[~ok]] = True
+    if np.any(redo):
+        out[redo] = polar_rotation(x[redo])
+    return out.reshape(shape)
+
+
+def _inverse_transpose(m: Array) -> Array:
+    """``X⁻ᵀ`` of ``(9, n)`` row-major 3×3 matrices: cofactor matrix over determinant."""
+    a, b, c, d, e, f, g, h, i = m
+    cof = np.stack([e * i - f * h, f * g - d * i, d * h - e * g,
+                    c * h - b * i, a * i - c * g, b * g - a * h,
+                    b * f - c * e, c * d - a * f, a * e - b * d])
+    det = a * cof[0] + b * cof[1] + c * cof[2]
+    return np.asarray(cof / det)
 
 
 class Clusters:
@@ -103,8 +152,8 @@ class Clusters:
         out = np.zeros((b, *self.shape, d))
         nd = len(self.shape)
         for off in np.ndindex(*self.window):
-            dst = (slice(None),) + tuple(slice(o, o + c) for o, c in zip(off, self.cshape,
-                                                                          strict=True))
+            shifted = (slice(o, o + c) for o, c in zip(off, self.cshape, strict=True))
+            dst = (slice(None), *shifted)
             src = (slice(None),) + (slice(None),) * nd + off
             out[dst] += v[src]
         return out
@@ -123,7 +172,7 @@ class Clusters:
         return q, quad
 
     def _projection(self, q: Array, cutoff: Array) -> Array:
-        """``Π[i, j] = q_iᵀ A_qq⁺ q_j w_j`` with eigenvalues of ``A_qq`` below ``cutoff`` dropped."""
+        """``Π[i, j] = q_iᵀ A_qq⁺ q_j w_j``, dropping eigenvalues of ``A_qq`` below ``cutoff``."""
         aqq = np.einsum("cj,cjf,cjg->cfg", self.w, q, q)
         lam, vec = np.linalg.eigh(aqq)
         keep = lam > cutoff[:, None]
@@ -149,7 +198,7 @@ class Clusters:
 
     def rotations(self, xc: Array) -> Array:
         """``(B, C, 3, 3)`` rotations ``R = polar(A_pq)``, ``A_pq = Σ m r sᵀ`` of members ``xc``."""
-        return polar_rotation(np.swapaxes(xc, -1, -2) @ self.ws)
+        return fast_polar_rotation(np.swapaxes(xc, -1, -2) @ self.ws)
 
     def cluster_goals(self, xc: Array, betas: Array) -> Array:
         """Goals ``g_i^c`` ``(B, C, km, 3)`` of members ``xc (B, C, km, 3)`` for ``betas (B,)``."""
@@ -163,6 +212,6 @@ class Clusters:
         return t[:, :, None, :] + (1.0 - beta) * rs + beta * fit
 
     def goals(self, x: Array, betas: Array) -> Array:
-        """Particle goals ``(B, *grid, 3)``: the mean of ``g_i^c`` over the clusters holding ``i``."""
+        """Particle goals ``(B, *grid, 3)``: the mean of ``g_i^c`` over the clusters of ``i``."""
         g = self.cluster_goals(self.gather(x), betas)
         return self.scatter(g) / self.count[None, ..., None]

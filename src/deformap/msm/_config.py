@@ -98,3 +98,5 @@ class ShapeMatchingConfig:
         check_positive("reference_modulus_pa", self.reference_modulus_pa)
         check_in_range("poisson_ratio", self.poisson_ratio, -1.0, 0.5, closed_high=True)
         check_positive("error_tolerance_m", self.error_tolerance_m)
+        check_int("layers", self.layers, minimum=0)
+        check_in_range("layer_growth", self.layer_growth, 1.0, 10.0, closed_high=True)

@@ -199,7 +199,6 @@ def _body(p0: Array, masses: Array, fixed: NDArray[np.bool_], spacing: float,
     k = cfg.cluster_size
     if cfg.layers == 0:
         return p0[None], masses[None], fixed[None], (1, k, k)
-    ny, nx = fixed.shape
     floor = 0.5 * min(float(np.ptp(p0[..., 0])), float(np.ptp(p0[..., 1])))
     steps = spacing * cfg.layer_growth ** np.arange(cfg.layers)
     depths = np.concatenate([[0.0], np.cumsum(steps)]) * (floor / np.sum(steps))
