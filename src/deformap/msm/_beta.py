@@ -140,7 +140,8 @@ def estimate_beta(rest_xs: Any, rest_ys: Any, rest_z: Any, deformed_points: Any,
     if cfg.refine and cfg.beta_resolution < 1.0 / cfg.n_beta:
         extra = _refinement(betas, errors, 1.0 / cfg.n_beta, cfg.beta_resolution)
         if extra.size:
-            sims.append(simulate_poke(grid.rest, grid.masses, grid.fixed, contact, extra, cfg))
+            sims.append(simulate_poke(grid.rest, grid.masses, grid.fixed, contact, extra, cfg,
+                                      stiffness_n_per_m=sims[0].stiffness_n_per_m))
             betas = np.concatenate([betas, extra])
             errors = np.concatenate([errors, matching_error(sims[-1].positions, tree)])
     order = np.argsort(betas, kind="stable")
