@@ -28,7 +28,7 @@ def test_force_equilibrium_satisfies_the_pbd_steady_state(mode):
     # sheet body: the solver's matrix form must agree with the goals computed independently
     xs, ys, z, _, contact = dent_case(60, n=11)
     g = _grid(xs, ys, z)
-    betas = np.array([0.0, 0.5, 0.9])
+    betas = np.array([0.0, 0.5, 0.98])
     cfg = ShapeMatchingConfig(mode=mode, layers=0, tol=1e-10)
     sim = simulate_poke(g.rest, g.masses, g.fixed, contact, betas, cfg)
     assert sim.converged.all()
@@ -40,6 +40,35 @@ def test_force_equilibrium_satisfies_the_pbd_steady_state(mode):
         want[free], (3, *want[free].shape)), rtol=0, atol=1e-9)
     np.testing.assert_array_equal(sim.positions[:, g.fixed], np.broadcast_to(
         g.rest[g.fixed], (3, *g.rest[g.fixed].shape)))
+
+
+def test_layered_body_equilibrium_satisfies_the_pbd_steady_state():
+    from deformap.msm._clusters import Clusters
+    from deformap.msm._simulate import _body
+
+    xs, ys, z, _, contact = dent_case(60, n=11)
+    g = _grid(xs, ys, z)
+    betas = np.array([0.0, 0.6, 0.98])
+    cfg = ShapeMatchingConfig(tol=1e-10)  # force, quadratic, 3 layers
+    sim = simulate_poke(g.rest, g.masses, g.fixed, contact, betas, cfg)
+    body, body_m, body_fixed, window = _body(g.rest, g.masses, g.fixed, g.spacing_m, cfg)
+    assert body.shape[0] == 4 and np.all(body_fixed[-1]) and window == (2, 3, 3)
+    from deformap.msm._poke import Equilibrium
+
+    cl = Clusters(body, body_m, window, cfg.mode, cfg.regularization)
+    eq = Equilibrium(cl, body_fixed, betas)
+    w = np.zeros(body_fixed.shape)
+    w[0] = force_weights(g.rest, g.fixed, contact, g.spacing_m)
+    force = w.reshape(-1, 1) * contact.force
+    x, _, _, conv = eq.solve(body.reshape(-1, 3)[body_fixed.ravel()], force,
+                             sim.stiffness_n_per_m, 1e-10, 500, g.spacing_m)
+    assert conv.all()
+    np.testing.assert_allclose(x[:, 0], sim.positions, atol=1e-12)
+    goals = cl.goals(x, betas)
+    free = ~body_fixed
+    want = (w[..., None] * contact.force / sim.stiffness_n_per_m)[free]
+    np.testing.assert_allclose((x - goals)[:, free], np.broadcast_to(want, (3, *want.shape)),
+                               rtol=0, atol=1e-9)
 
 
 def test_pinned_equilibrium_holds_the_contact_particle_and_relaxes_the_rest():

@@ -136,8 +136,8 @@ class Equilibrium:
             a = self.wsum + b * self.psum
             kff = eye - a[self.free][:, self.free]
             # K is symmetric in pattern and nearly in value: a symmetric fill-reducing order and
-            # diagonal pivoting factorise 3-4x faster than the default COLAMD.
-            self.lus.append(splu(kff.tocsc(), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+            # diagonal-preferring threshold pivoting factorise 3-4x faster than COLAMD.
+            self.lus.append(splu(kff.tocsc(), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.1,
                                  options={"SymmetricMode": True}))
             self.couple.append(a[self.free][:, self.fix])
         # β-part of the constant term: M⁻¹ Σ_c (s − Π p⁰); zero when the features span s.
@@ -197,7 +197,7 @@ class Equilibrium:
             resid[active], iters[active] = r, it
             done = r < tol
             x_new = g.reshape(len(active), -1).copy()
-            for a, j in enumerate(active):
+            for a, j in enumerate(active.tolist()):
                 if done[a]:
                     continue
                 if n_hist[j] and not grew[a]:
