@@ -65,10 +65,14 @@ def fast_polar_rotation(a: Array, *, tol: float = 1e-14, max_iter: int = 20) -> 
     x = a.reshape(-1, 3, 3)
     norm = np.sqrt(np.sum(x * x, axis=(1, 2)))
     x = x / np.maximum(norm, np.finfo(float).tiny)[:, None, None]
-    safe = np.linalg.det(x) > 1e-3
-    out = np.empty_like(x)
     # component-major layout: nine contiguous 1-D arrays make the closed forms fast
-    m = np.ascontiguousarray(x[safe].reshape(-1, 9).T)
+    m = np.ascontiguousarray(x.reshape(-1, 9).T)
+    a0, b0, c0, d0, e0, f0, g0, h0, i0 = m
+    det0 = a0 * (e0 * i0 - f0 * h0) - b0 * (d0 * i0 - f0 * g0) + c0 * (d0 * h0 - e0 * g0)
+    safe = det0 > 1e-3
+    out = np.empty_like(x)
+    if not np.all(safe):
+        m = np.ascontiguousarray(m[:, safe])
     ok = np.zeros(m.shape[1], dtype=bool)
     for _ in range(max_iter):
         inv_t = _inverse_transpose(m)
@@ -96,6 +100,10 @@ def _inverse_transpose(m: Array) -> Array:
     return np.asarray(cof / det)
 
 
+def _cut(axis: int, start: int, stop: int) -> tuple[slice, ...]:
+    return (slice(None),) * axis + (slice(start, stop),)
+
+
 class Clusters:
     """Rest-shape data of all clusters, computed once per ROI.
 
@@ -120,6 +128,7 @@ class Clusters:
         self.n_clusters = int(np.prod(self.cshape))
         self.n_members = int(np.prod(self.window))
         self.rest = rest
+        self.masses = masses
         mw = self._windows(masses[None, ..., None])[0, ..., 0]  # (C, km)
         self.w = mw / mw.sum(axis=1, keepdims=True)
         p0 = self._windows(rest[None])[0]  # (C, km, 3)
@@ -195,6 +204,66 @@ class Clusters:
         if quad is not None:
             hat = hat + self._projection(quad - hat @ quad, cutoff)
         return hat
+
+    # -- separable box filters: the fast path of the solver -------------------------------------
+    def box_sum(self, field: Array) -> Array:
+        """Window sums ``(B, *cshape, d)`` of a particle field ``(B, *grid, d)`` (separable)."""
+        out = field
+        for axis, (w, c) in enumerate(zip(self.window, self.cshape, strict=True), start=1):
+            acc = out[_cut(axis, 0, c)].copy()
+            for o in range(1, w):
+                acc += out[_cut(axis, o, o + c)]
+            out = acc
+        return out
+
+    def box_spread(self, field: Array) -> Array:
+        """Transpose of :meth:`box_sum`: ``(B, *cshape, d)`` → particle sums ``(B, *grid, d)``."""
+        out = field
+        for axis, (w, c) in enumerate(zip(self.window, self.cshape, strict=True), start=1):
+            shape = list(out.shape)
+            shape[axis] = c + w - 1
+            acc = np.zeros(shape)
+            for o in range(w):
+                acc[_cut(axis, o, o + c)] += out
+            out = acc
+        return out
+
+    def _prepare_box(self) -> None:
+        # coordinates relative to the rest centroid keep Σ m x p⁰ᵀ − M t t⁰ᵀ free of cancellation
+        self._origin = self.rest.reshape(-1, 3).mean(axis=0)
+        p0 = (self.rest - self._origin).reshape(*self.shape, 3)
+        self._p0c = p0
+        self._mp0 = self.masses[..., None] * p0
+        self._mass_c = self.box_sum(self.masses[None, ..., None])[0]  # (*cshape, 1)
+        self._t0c = self.box_sum(self._mp0[None])[0] / self._mass_c  # (*cshape, 3)
+
+    def rotation_term(self, x: Array) -> Array:
+        """``(1/M_i) Σ_{c∋i} R_c s_i^c`` ``(B, *grid, 3)`` for positions ``x (B, *grid, 3)``.
+
+        The same quantity as gathering every cluster's members, without the ``(B, C, km, 3)``
+        arrays: ``A_pq = Σ m x p⁰ᵀ / M − t t⁰ᵀ`` from box sums of ``m x ⊗ p⁰`` and ``m x``, and
+        ``Σ_c R_c (p⁰_i − t⁰_c) = (Σ_c R_c) p⁰_i − Σ_c R_c t⁰_c`` from box spreads.
+        """
+        if not hasattr(self, "_p0c"):
+            self._prepare_box()
+        xm = (x - self._origin) * self.masses[None, ..., None]
+        b = x.shape[0]
+        field = np.empty((*xm.shape[:-1], 12))
+        for d in range(3):
+            field[..., 3 * d : 3 * d + 3] = xm[..., d : d + 1] * self._p0c[None]
+        field[..., 9:] = xm
+        sums = self.box_sum(field) / self._mass_c[None]
+        t = sums[..., 9:]
+        apq = sums[..., :9].reshape(*sums.shape[:-1], 3, 3) - t[..., :, None] * self._t0c[
+            None, ..., None, :]
+        rot = fast_polar_rotation(apq)
+        per_cluster = np.empty((b, *self.cshape, 12))
+        per_cluster[..., :9] = rot.reshape(b, *self.cshape, 9)
+        per_cluster[..., 9:] = np.einsum("...de,...e->...d", rot, self._t0c[None])
+        spread = self.box_spread(per_cluster)
+        total_r = spread[..., :9].reshape(b, *self.shape, 3, 3)
+        out = np.einsum("...de,...e->...d", total_r, self._p0c[None]) - spread[..., 9:]
+        return np.asarray(out / self.count[None, ..., None])
 
     def rotations(self, xc: Array) -> Array:
         """``(B, C, 3, 3)`` rotations ``R = polar(A_pq)``, ``A_pq = Σ m r sᵀ`` of members ``xc``."""

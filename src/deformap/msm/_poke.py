@@ -148,12 +148,11 @@ class Equilibrium:
             summed = clusters.scatter(c[None])[0] / clusters.count[..., None]
             self.fit_const = summed.reshape(n, 3)
 
-    def _map(self, x: Array, active: NDArray[np.int64], rot_only: bool = False) -> Array:
+    def _map(self, x: Array, active: NDArray[np.int64]) -> Array:
         """One local–global step ``G(x)`` for the free particles of the ``active`` β."""
         cl = self.cl
         xa = x[active].reshape(len(active), *cl.shape, 3)
-        rs = cl.s @ np.swapaxes(cl.rotations(cl.gather(xa)), -1, -2)
-        rot = (cl.scatter(rs) / cl.count[None, ..., None]).reshape(len(active), -1, 3)
+        rot = cl.rotation_term(xa).reshape(len(active), -1, 3)
         out = np.empty((len(active), len(self.free), 3))
         for a, j in enumerate(active):
             out[a] = self.lus[j].solve(self.rot_weight[j] * rot[a, self.free] + self.const[j])
