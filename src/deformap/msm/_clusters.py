@@ -48,7 +48,7 @@ def polar_rotation(a: Array) -> Array:
     return u @ vt
 
 
-def fast_polar_rotation(a: Array, *, tol: float = 1e-14, max_iter: int = 20) -> Array:
+def fast_polar_rotation(a: Array, *, tol: float = 1e-14, max_iter: int = 30) -> Array:
     """``polar_rotation(a)`` by Higham's scaled Newton iteration where it is safe, SVD elsewhere.
 
     ``X ← (γ X + X⁻ᵀ / γ) / 2`` with ``X⁻ᵀ = cof(X) / det X`` in closed form and Frobenius scaling
@@ -69,7 +69,7 @@ def fast_polar_rotation(a: Array, *, tol: float = 1e-14, max_iter: int = 20) -> 
     m = np.ascontiguousarray(x.reshape(-1, 9).T)
     a0, b0, c0, d0, e0, f0, g0, h0, i0 = m
     det0 = a0 * (e0 * i0 - f0 * h0) - b0 * (d0 * i0 - f0 * g0) + c0 * (d0 * h0 - e0 * g0)
-    safe = det0 > 1e-3
+    safe = det0 > 1e-9  # scaled Newton copes with any positive det; flat ones go to SVD
     out = np.empty_like(x)
     if not np.all(safe):
         m = np.ascontiguousarray(m[:, safe])
