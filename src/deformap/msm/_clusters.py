@@ -139,6 +139,7 @@ class Clusters:
         ones = np.ones((1, self.n_clusters, self.n_members, 1))
         self.count = self.scatter(ones)[0, ..., 0]
         self.hat = None if mode == "rigid" else self._hat_matrices(regularization)
+        self._planar_frames()
 
     # -- window gather / scatter -------------------------------------------------------------
     def _windows(self, x: Array) -> Array:
@@ -256,7 +257,7 @@ class Clusters:
         t = sums[..., 9:]
         apq = sums[..., :9].reshape(*sums.shape[:-1], 3, 3) - t[..., :, None] * self._t0c[
             None, ..., None, :]
-        rot = fast_polar_rotation(apq)
+        rot = self._polar(apq.reshape(b, self.n_clusters, 3, 3)).reshape(apq.shape)
         per_cluster = np.empty((b, *self.cshape, 12))
         per_cluster[..., :9] = rot.reshape(b, *self.cshape, 9)
         per_cluster[..., 9:] = np.einsum("...de,...e->...d", rot, self._t0c[None])
@@ -265,9 +266,36 @@ class Clusters:
         out = np.einsum("...de,...e->...d", total_r, self._p0c[None]) - spread[..., 9:]
         return np.asarray(out / self.count[None, ..., None])
 
+    def _planar_frames(self) -> None:
+        """Rest normal ``n`` and in-plane axes ``u × v = n`` of the exactly planar clusters."""
+        aqq = np.einsum("cj,cjd,cje->cde", self.w, self.s, self.s)
+        lam, vec = np.linalg.eigh(aqq)
+        self.planar = lam[:, 0] <= 1e-12 * lam[:, 2]
+        self.normal = vec[:, :, 0]
+        self.u_axis = vec[:, :, 1]
+        self.v_axis = np.cross(self.normal, self.u_axis)
+
+    def _polar(self, apq: Array) -> Array:
+        """Polar rotations of ``(B, C, 3, 3)`` cluster matrices.
+
+        A planar cluster (normal ``n``) has ``A n = 0``; adding ``ĉ nᵀ ‖A‖`` with
+        ``c = (A u) × (A v)`` (= σ₁σ₂ R n) gives a full-rank matrix with the same polar rotation,
+        which the fast Newton iteration can take instead of an SVD.
+        """
+        if np.any(self.planar):
+            p = self.planar
+            a = apq[:, p]
+            c = np.cross(a @ self.u_axis[p][..., None], a @ self.v_axis[p][..., None], axis=-2)
+            norm_c = np.linalg.norm(c, axis=-2, keepdims=True)
+            scale = np.sqrt(np.sum(a * a, axis=(-2, -1)))[..., None, None]
+            c = c / np.maximum(norm_c, np.finfo(float).tiny) * scale
+            apq = apq.copy()
+            apq[:, p] = a + c * self.normal[p][:, None, :]
+        return fast_polar_rotation(apq)
+
     def rotations(self, xc: Array) -> Array:
         """``(B, C, 3, 3)`` rotations ``R = polar(A_pq)``, ``A_pq = Σ m r sᵀ`` of members ``xc``."""
-        return fast_polar_rotation(np.swapaxes(xc, -1, -2) @ self.ws)
+        return self._polar(np.swapaxes(xc, -1, -2) @ self.ws)
 
     def cluster_goals(self, xc: Array, betas: Array) -> Array:
         """Goals ``g_i^c`` ``(B, C, km, 3)`` of members ``xc (B, C, km, 3)`` for ``betas (B,)``."""
