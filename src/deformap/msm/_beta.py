@@ -10,7 +10,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.spatial import cKDTree
 
-from deformap._validation import check_array, check_points
+from deformap._validation import check_points
 from deformap.environment import TactileContact
 from deformap.msm._config import ShapeMatchingConfig
 from deformap.msm._grid import ParticleGrid
@@ -132,7 +132,6 @@ def estimate_beta(rest_xs: Any, rest_ys: Any, rest_z: Any, deformed_points: Any,
     cfg = _check_config(config)
     grid = ParticleGrid.from_heightmap(rest_xs, rest_ys, rest_z)
     observed = check_points("deformed_points", deformed_points, min_rows=1)
-    check_array("deformed_points", observed, (None, 3), what="points in metres")
     tree = cKDTree(observed)
     sweep = np.arange(cfg.n_beta) / cfg.n_beta
     sims = [simulate_poke(grid.rest, grid.masses, grid.fixed, contact, sweep, cfg)]
