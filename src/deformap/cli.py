@@ -428,8 +428,6 @@ def main() -> None:
     app()
 
 
-if __name__ == "__main__":  # pragma: no cover
-    sys.exit(main())
 
 
 # ---- world commands ----
@@ -516,3 +514,7 @@ def bench_world_command(
         Path(json_file).parent.mkdir(parents=True, exist_ok=True)
         Path(json_file).write_text(json.dumps(result, indent=2))
         console.print(f"wrote {json_file}")
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

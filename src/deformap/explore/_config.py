@@ -116,7 +116,8 @@ class ExplorationConfig:
         on the tip itself for foams down to 60 N (``F <= 4 E* R² / 3`` = 0.68 N) while denting
         them by 4–7 mm, well above the camera's noise.
     region_z : float
-        Separation, in standard deviations, that splits two pokes into different regions.
+        Separation, in standard deviations of their difference, that splits two pokes into
+        different regions (2: about 95 %).
     """
 
     threshold: float = 0.06
@@ -124,7 +125,7 @@ class ExplorationConfig:
     strategy: Literal["paper", "max-variance", "min-max-variance"] = "paper"
     first_target: tuple[float, float] | None = None
     force_n: float = 0.6
-    region_z: float = 3.0
+    region_z: float = 2.0
     surface: SurfaceGPConfig = field(default_factory=SurfaceGPConfig)
     touch: TouchGPConfig = field(default_factory=TouchGPConfig)
     beta_field: BetaFieldConfig = field(default_factory=BetaFieldConfig)

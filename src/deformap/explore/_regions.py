@@ -6,7 +6,8 @@ The paper draws "the best isopleth" of the β-field without saying how. We choos
 field itself, at the poked places, where it is supported by data: the posterior mean β at each poke,
 sorted, is split wherever two neighbours differ by more than they can be told apart —
 ``z · sqrt(σ_i² + σ_j²)`` with σ the posterior standard deviation there and ``z`` the separation in
-standard deviations (default 3), and never by less than ``min_step`` (default 0.05 in β). Each group
+standard deviations (default 2: the
+difference is real at about 95 %), and never by less than ``min_step`` (default 0.05 in β). Each group
 of pokes is one deformability class; the isopleth between two neighbouring classes lies half-way
 between the largest β of the softer-looking group's lower neighbour and the smallest of the next
 (the midpoint of the gap). Cells are labelled by the band of the β-field's mean they fall in, so a
@@ -53,7 +54,7 @@ def segment_regions(
     poke_beta: NDArray[np.float64],
     poke_std: NDArray[np.float64],
     *,
-    z: float = 3.0,
+    z: float = 2.0,
     min_step: float = 0.05,
 ) -> RegionMap:
     """Label the cells of ``beta_grid`` by isopleths chosen from the pokes' posterior β.
