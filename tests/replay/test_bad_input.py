@@ -123,7 +123,7 @@ def test_missing_observation_file(folder: Path) -> None:
 
 def test_missing_or_broken_ground_truth(folder: Path) -> None:
     (folder / "ground_truth.npz").write_bytes(b"PK\x03\x04 truncated")
-    with pytest.raises(FileFormatError, match="ground_truth.npz: not a readable NPZ"):
+    with pytest.raises(FileFormatError, match="ground_truth.npz: could not read the ground-truth NPZ"):
         load_session(folder)
     with open(folder / "ground_truth.npz", "wb") as fh:
         np.savez(fh, xs=np.arange(3.0))

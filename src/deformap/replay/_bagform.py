@@ -41,7 +41,8 @@ def _bag_errors() -> tuple[type[BaseException], ...]:
 
     # What rosbags, sqlite3 and the CDR decoder raise on damaged bags.
     return (_rosbag2().ReaderError, SerdeError, sqlite3.Error, OSError, ValueError, KeyError,
-            IndexError, TypeError, AssertionError, EOFError, struct.error)  # fmt: skip
+            IndexError, TypeError, AssertionError, EOFError, struct.error, MemoryError,
+            OverflowError, UnicodeDecodeError)  # fmt: skip
 
 
 def _stamp(msg: Any) -> int:

@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import io
 import math
-import zipfile
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -19,6 +18,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from deformap._validation import check_array
+from deformap.cloud.io._common import parse_errors
 from deformap.errors import FileFormatError, InvalidArgumentError
 
 __all__ = ["GroundTruth", "read_ground_truth", "write_ground_truth"]
@@ -113,13 +113,12 @@ def read_ground_truth(path: str | Path) -> GroundTruth:
     p = Path(path)
     if not p.is_file():
         raise FileFormatError(f"{p}: no such file (the session's `ground_truth`)")
-    try:
-        with np.load(io.BytesIO(p.read_bytes()), allow_pickle=False) as archive:
+    with parse_errors(p, "the ground-truth NPZ archive"):
+        loaded = np.load(io.BytesIO(p.read_bytes()), allow_pickle=False)
+        if not isinstance(loaded, np.lib.npyio.NpzFile):
+            raise FileFormatError(f"{p}: a single .npy array, not an NPZ archive of named arrays")
+        with loaded as archive:
             arrays = {name: archive[name] for name in archive.files}
-    except (ValueError, OSError, EOFError, KeyError, zipfile.BadZipFile, AttributeError) as exc:
-        # AttributeError: np.load of a bare .npy returns an array, which is no context manager.
-        raise FileFormatError(f"{p}: not a readable NPZ archive ({type(exc).__name__}: {exc})"
-                              ) from None  # fmt: skip
     missing = sorted({"xs", "ys", "labels", "hardness"} - set(arrays))
     if missing:
         raise FileFormatError(f"{p}: ground truth lacks array(s) {missing} (has {sorted(arrays)})")
