@@ -1,5 +1,50 @@
-"""world (see DESIGN.md)."""
+"""The simulated world: foam scenarios, finite-element ground truth, a depth camera and a probe.
+
+It implements :class:`deformap.environment.Environment` and never imports the estimator
+(``msm``, ``gp``, ``explore``): its ground truth is linear elasticity solved by finite elements.
+
+Quick start::
+
+    import numpy as np
+    from deformap.world import SimulatedWorld, load_scenario
+    world = SimulatedWorld(load_scenario("heterogeneous-60-110-rigid"), rng=np.random.default_rng(0))
+    cloud = world.observe()
+    obs = world.press((0.1, 0.2), world.config.default_force_n)
+    world.release()
+"""
 
 from __future__ import annotations
 
-__all__: list[str] = []
+from deformap.world._camera import CameraConfig
+from deformap.world._contact import (
+    hertz_contact_radius,
+    hertz_indentation,
+    hertz_pressure_samples,
+)
+from deformap.world._foam import Dent
+from deformap.world._hardness import hardness_to_youngs_modulus, youngs_modulus_to_hardness
+from deformap.world._probe import ProbeGeometry
+from deformap.world._random import random_scenario
+from deformap.world._scenario import BARE_TABLE, Block, Scenario
+from deformap.world._scenario_io import list_scenarios, load_scenario, save_scenario
+from deformap.world._world import SimulatedWorld, WorldConfig
+
+__all__ = [
+    "BARE_TABLE",
+    "Block",
+    "CameraConfig",
+    "Dent",
+    "ProbeGeometry",
+    "Scenario",
+    "SimulatedWorld",
+    "WorldConfig",
+    "hardness_to_youngs_modulus",
+    "hertz_contact_radius",
+    "hertz_indentation",
+    "hertz_pressure_samples",
+    "list_scenarios",
+    "load_scenario",
+    "random_scenario",
+    "save_scenario",
+    "youngs_modulus_to_hardness",
+]

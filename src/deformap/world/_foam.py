@@ -1,0 +1,158 @@
+"""The foam of a whole scenario: one elastic body per foam block, pressed by the probe.
+
+Each foam block is its own :class:`~deformap.world._fem.FoamBody` (neighbouring blocks are separate
+pieces, not glued), factorised once when the world is built. A press puts the Hertz pressure of the
+commanded force on the top surface under the tip; the part of the patch that falls on rigid ground
+(a rigid board or the bare table) is carried by it and loads no foam.
+
+Patch radius: Hertz's ``a`` assumes a half-space, but the foam is a layer bonded to the table and
+responds stiffer, so the tip sinks less than Hertz says and touches a smaller disc. The press
+therefore iterates ``a ← sqrt(a · sqrt(R δ_FEM))`` (a damped fixed point of the sphere's geometric
+relation ``a² = R δ``) from the Hertz value until ``a`` changes by less than 1 %, and never lets
+``a`` exceed the tip radius ``R``.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from deformap.world._contact import hertz_contact_radius, hertz_pressure_samples
+from deformap.world._fem import FoamBody, HexGrid, graded_levels
+from deformap.world._scenario import Block, Scenario
+
+__all__ = ["Dent", "FoamModel", "block_grid"]
+
+log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True, kw_only=True)
+class Dent:
+    """The foam's response to one press.
+
+    Parameters
+    ----------
+    displacement : (n_nodes, 3) float, metres
+        Displacement of every mesh node of the world (all bodies stacked).
+    depth_m : float
+        Downward displacement of the surface at the target (0 on rigid ground).
+    contact_radius_m : float
+        Radius of the loaded patch after the consistency iteration (0 on rigid ground).
+    iterations : int
+        Solves the press took.
+    """
+
+    displacement: NDArray[np.float64]
+    depth_m: float
+    contact_radius_m: float
+    iterations: int
+
+
+def block_grid(block: Block, *, element_size_m: float, top_layer_m: float,
+               layer_growth: float) -> HexGrid:
+    """The structured mesh of one block (see :mod:`deformap.world._fem`)."""
+    lo, hi = block.polygon.min(axis=0), block.polygon.max(axis=0)
+    nx, ny = (max(1, int(np.ceil((hi[d] - lo[d]) / element_size_m - 1e-9))) for d in (0, 1))
+    dx, dy = (hi[0] - lo[0]) / nx, (hi[1] - lo[1]) / ny
+    cx, cy = np.meshgrid(lo[0] + (np.arange(nx) + 0.5) * dx, lo[1] + (np.arange(ny) + 0.5) * dy)
+    active = block.contains(np.column_stack([cx.ravel(), cy.ravel()])).reshape(ny, nx)
+    levels = graded_levels(block.thickness_m, min(top_layer_m, block.thickness_m), layer_growth)
+    return HexGrid(origin=lo.copy(), dx=dx, dy=dy, nx=nx, ny=ny, levels=levels, active=active)
+
+
+class FoamModel:
+    """All foam bodies of a scenario, with the press solve.
+
+    Parameters
+    ----------
+    scenario : Scenario
+    element_size_m, top_layer_m, layer_growth : float
+        Mesh: in-plane element size, thickness of the top layer, growth of layers downwards.
+    poisson_ratio : float
+    """
+
+    def __init__(self, scenario: Scenario, *, element_size_m: float, top_layer_m: float,
+                 layer_growth: float, poisson_ratio: float) -> None:
+        self.scenario = scenario
+        self.poisson_ratio = poisson_ratio
+        self.grids: list[HexGrid] = []
+        self.bodies: dict[int, FoamBody] = {}
+        self.offsets: list[int] = []
+        n = 0
+        for index, block in enumerate(scenario.blocks):
+            grid = block_grid(block, element_size_m=element_size_m, top_layer_m=top_layer_m,
+                              layer_growth=layer_growth)
+            self.grids.append(grid)
+            self.offsets.append(n)
+            n += grid.n_nodes
+            if not block.rigid:
+                self.bodies[index] = FoamBody(grid, block.modulus_pa, poisson_ratio=poisson_ratio)
+        self.n_nodes = n
+        self.rest_nodes = np.concatenate([g.node_xyz() for g in self.grids])
+
+    @property
+    def n_dofs(self) -> int:
+        """Free displacement unknowns over all foam bodies."""
+        return sum(b.n_dofs for b in self.bodies.values())
+
+    def zero_displacement(self) -> NDArray[np.float64]:
+        return np.zeros((self.n_nodes, 3))
+
+    def top_displacement(self, xy: NDArray[np.float64], displacement: NDArray[np.float64]
+                         ) -> NDArray[np.float64]:
+        """``(n, 3)`` displacement of the top surface at ``(n, 2)`` points (0 off the foam)."""
+        out = np.zeros((len(xy), 3))
+        claimed = np.zeros(len(xy), dtype=bool)
+        for index in self.bodies:
+            grid, off = self.grids[index], self.offsets[index]
+            inside, nodes, weights = grid.locate(xy)
+            inside &= ~claimed
+            u = displacement[off + nodes[inside]]  # (m, 4, 3)
+            out[inside] = np.einsum("mc,mcd->md", weights[inside], u)
+            claimed |= inside
+        return out
+
+    def dent(self, target_xy: NDArray[np.float64], force_n: float, *, tip_radius_m: float,
+             max_iterations: int = 6, tolerance: float = 0.01) -> Dent:
+        """Solve the press of ``force_n`` newtons at ``target_xy`` (see the module docstring)."""
+        target = np.asarray(target_xy, dtype=float).reshape(1, 2)
+        labels = self.scenario.labels(target[:, 0], target[:, 1])
+        index = int(labels[0, 0])
+        if index not in self.bodies:
+            return Dent(displacement=self.zero_displacement(), depth_m=0.0,
+                        contact_radius_m=0.0, iterations=0)
+        modulus = self.scenario.blocks[index].modulus_pa
+        a = min(hertz_contact_radius(force_n, tip_radius_m, modulus, self.poisson_ratio),
+                tip_radius_m)
+        for iteration in range(1, max_iterations + 1):
+            u = self._solve_patch(target[0], a, force_n)
+            depth = max(0.0, -float(self.top_displacement(target, u)[0, 2]))
+            a_new = min(np.sqrt(a * np.sqrt(tip_radius_m * depth)), tip_radius_m)
+            converged = abs(a_new - a) <= tolerance * a
+            log.debug("press iteration %d: a=%.4f m, depth=%.4f m", iteration, a, depth)
+            if converged or iteration == max_iterations:
+                break
+            a = float(a_new)
+        return Dent(displacement=u, depth_m=depth, contact_radius_m=float(a),
+                    iterations=iteration)
+
+    def _solve_patch(self, center: NDArray[np.float64], radius: float, force_n: float
+                     ) -> NDArray[np.float64]:
+        points, forces = hertz_pressure_samples(center, radius, force_n)
+        u = self.zero_displacement()
+        claimed = np.zeros(len(points), dtype=bool)
+        for index, body in self.bodies.items():
+            grid, off = self.grids[index], self.offsets[index]
+            inside, nodes, weights = grid.locate(points)
+            inside &= ~claimed
+            claimed |= inside
+            if not inside.any():
+                continue
+            load = np.zeros((grid.n_nodes, 3))
+            np.add.at(load[:, 2], nodes[inside].ravel(),
+                      -(weights[inside] * forces[inside, None]).ravel())
+            u[off:off + grid.n_nodes] = body.solve(load)
+        return u

@@ -1,0 +1,55 @@
+"""Foam hardness (ISO 2439 indentation force) to Young's modulus and back.
+
+Foam makers grade polyurethane foam by its indentation hardness: the force ``H`` in newtons that a
+flat circular indenter of 323 cm² (203 mm diameter, ISO 2439 / ASTM D3574) needs to compress a
+sample to 40 % of its thickness. Reading that test as uniaxial compression of the material under the
+indenter gives a secant modulus
+
+    E = (H / A) / ε,    A = 0.0323 m²,  ε = 0.4,
+
+so 60, 110 and 150 N foams get 4.6, 8.5 and 11.6 kPa. This ignores the foam around the indenter and
+the non-linearity of foam at 40 % strain; it is the conversion the project takes as its reference
+(issue 3), and every world that uses it states the moduli it produced.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from deformap._validation import check_positive
+
+__all__ = [
+    "INDENTER_AREA_M2",
+    "INDENTATION_STRAIN",
+    "hardness_to_youngs_modulus",
+    "youngs_modulus_to_hardness",
+]
+
+INDENTER_AREA_M2 = 0.0323
+"""Area of the ISO 2439 indenter foot (203 mm diameter), m²."""
+
+INDENTATION_STRAIN = 0.4
+"""Compression at which the hardness force is read (40 % of the thickness)."""
+
+
+def hardness_to_youngs_modulus(hardness_n: float) -> float:
+    """Young's modulus in pascals of a foam of indentation hardness ``hardness_n`` newtons.
+
+    Parameters
+    ----------
+    hardness_n : float, newtons
+        Force to compress the foam to 40 % under a 323 cm² indenter; must be > 0.
+
+    Returns
+    -------
+    float, pascals
+        ``(hardness_n / 0.0323) / 0.4``; 60 N gives about 4644 Pa.
+    """
+    h = check_positive("hardness_n", hardness_n)
+    return float(h / INDENTER_AREA_M2 / INDENTATION_STRAIN)
+
+
+def youngs_modulus_to_hardness(youngs_modulus_pa: float) -> float:
+    """Inverse of :func:`hardness_to_youngs_modulus`: hardness in newtons of a modulus in Pa."""
+    e = check_positive("youngs_modulus_pa", youngs_modulus_pa)
+    return float(np.float64(e) * INDENTER_AREA_M2 * INDENTATION_STRAIN)

@@ -1,0 +1,70 @@
+"""The probe: a spherical tip (Optoforce-like) on a 10 cm stick held by a box-shaped hand.
+
+The probe approaches along the surface normal ``n`` at the target; at the commanded force the tip's
+centre is ``R`` above the dented surface along ``n``, the stick runs from the tip centre along ``n``
+and the hand is a box on top of the stick.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import trimesh
+from numpy.typing import NDArray
+
+__all__ = ["ProbeGeometry"]
+
+
+@dataclass(frozen=True, kw_only=True)
+class ProbeGeometry:
+    """Dimensions of the probe, metres."""
+
+    tip_radius_m: float = 0.01
+    stick_length_m: float = 0.10
+    stick_radius_m: float = 0.006
+    hand_size_m: tuple[float, float, float] = (0.08, 0.06, 0.10)
+
+    def _frame(self, normal: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Rotation whose z axis is ``normal``."""
+        z = normal / np.linalg.norm(normal)
+        helper = np.array([1.0, 0.0, 0.0]) if abs(z[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+        x = np.cross(helper, z)
+        x /= np.linalg.norm(x)
+        return np.column_stack([x, np.cross(z, x), z])
+
+    def mesh(self, tip_center: NDArray[np.float64], normal: NDArray[np.float64]) -> trimesh.Trimesh:
+        """Triangle mesh of tip, stick and hand (for the camera)."""
+        rot = self._frame(normal)
+        pose = np.eye(4)
+        pose[:3, :3] = rot
+        tip = trimesh.creation.icosphere(subdivisions=2, radius=self.tip_radius_m)
+        stick = trimesh.creation.cylinder(radius=self.stick_radius_m, height=self.stick_length_m,
+                                          sections=16)
+        stick.apply_translation([0.0, 0.0, self.stick_length_m / 2])
+        hand = trimesh.creation.box(extents=self.hand_size_m)
+        hand.apply_translation([0.0, 0.0, self.stick_length_m + self.hand_size_m[2] / 2])
+        parts = trimesh.util.concatenate([tip, stick, hand])
+        pose[:3, 3] = tip_center
+        parts.apply_transform(pose)
+        return parts
+
+    def robot_points(self, tip_center: NDArray[np.float64], normal: NDArray[np.float64]
+                     ) -> NDArray[np.float64]:
+        """``(m, 3)`` points whose convex hull covers the tip's upper half, the stick and the hand.
+
+        The tip's lower half is in the dent, so it is left out: a hull around it would swallow the
+        dented surface the estimator needs.
+        """
+        rot = self._frame(normal)
+        r = self.tip_radius_m
+        az = np.linspace(0.0, 2 * np.pi, 16, endpoint=False)
+        circles = [np.column_stack([rad * np.cos(az), rad * np.sin(az), np.full_like(az, z)])
+                   for rad, z in ((r, 0.0), (r * np.cos(np.pi / 6), r * np.sin(np.pi / 6)),
+                                  (r * np.cos(np.pi / 3), r * np.sin(np.pi / 3)))]
+        top = np.array([[0.0, 0.0, r]])
+        hx, hy, hz = (s / 2 for s in self.hand_size_m)
+        corners = np.array([[sx * hx, sy * hy, self.stick_length_m + h]
+                            for sx in (-1, 1) for sy in (-1, 1) for h in (0.0, 2 * hz)])
+        local = np.concatenate([*circles, top, corners])
+        return np.asarray(local @ rot.T + tip_center)

@@ -1,0 +1,255 @@
+"""Scenarios: which foam blocks lie where on the table.
+
+A scenario is a list of blocks on the rigid table. Each block is a convex polygon in the table plane
+(a rectangle is the common case), extruded to its own thickness, made of foam of a given hardness
+(or Young's modulus) or ``rigid`` (a wooden board that does not deform). What no block covers is the
+bare table at ``z = 0``, also rigid. Blocks never overlap; they may touch. Neighbouring blocks are
+separate pieces laid side by side, as in the paper's experiments: each is bonded to the table at its
+bottom but not glued to its neighbours.
+
+Built-in layouts (paper's Table I; its figure of the layouts is lost, so these are our choice), all
+over the 60 × 40 cm workspace with 5 cm thick blocks:
+
+* ``homogeneous-60``, ``homogeneous-110``: one block covering the whole area.
+* ``heterogeneous-60-150``: two blocks side by side, 60 N on ``x < 0.30 m``, 150 N on the rest.
+* ``heterogeneous-110-150``: two blocks, 110 N on ``y < 0.20 m`` (front), 150 N at the back.
+* ``heterogeneous-150-rigid``: 150 N foam on ``x < 0.32 m``, a rigid board of the same thickness on
+  the rest (so the surface is level and the rigid region must be told apart by pressing).
+* ``heterogeneous-60-110-rigid``: three blocks, the first cut not aligned with the axes: 60 N left of
+  the slanted line from (0.18, 0) to (0.30, 0.40), 110 N between it and ``x = 0.44``, rigid beyond.
+
+Ground-truth labels are block indices ``0 .. n-1`` in the order of ``Scenario.blocks``; ``-1`` marks
+the bare table.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from deformap._validation import check_array
+from deformap.environment import Workspace
+from deformap.errors import InvalidArgumentError
+from deformap.world._hardness import hardness_to_youngs_modulus, youngs_modulus_to_hardness
+from deformap.world._polygon import (
+    convex_overlap_area,
+    is_convex,
+    points_in_polygon,
+    polygon_area,
+    rectangle,
+)
+
+__all__ = ["BARE_TABLE", "Block", "Scenario", "builtin_scenarios"]
+
+BARE_TABLE = -1
+"""Ground-truth label of table area that no block covers."""
+
+_OVERLAP_TOL_M2 = 1e-8  # 1 mm² of shared area is a real overlap, less is rounding of touching edges
+
+
+@dataclass(frozen=True, kw_only=True)
+class Block:
+    """One block on the table: a convex prism of foam (or of a rigid material).
+
+    Parameters
+    ----------
+    name : str
+        Region name used in reports (``"soft"``, ``"60 N foam"``).
+    polygon : (k, 2) float, metres
+        Convex footprint, ``k >= 3``; stored counter-clockwise.
+    thickness_m : float
+        Height of the block's top above the table; > 0.
+    hardness_n : float or None
+        ISO 2439 hardness in newtons; give this or ``youngs_modulus_pa`` for foam.
+    youngs_modulus_pa : float or None
+        Young's modulus; derived from ``hardness_n`` when that is given instead.
+    rigid : bool
+        A block that does not deform (then neither hardness nor modulus is given).
+    color : str
+        Matplotlib colour for figures.
+    """
+
+    name: str
+    polygon: NDArray[np.float64]
+    thickness_m: float = 0.05
+    hardness_n: float | None = None
+    youngs_modulus_pa: float | None = None
+    rigid: bool = False
+    color: str = "#c8a165"
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.name, str) or not self.name:
+            raise InvalidArgumentError(f"block `name` must be a non-empty string; got {self.name!r}")
+        poly = check_array(f"block {self.name!r} polygon", self.polygon, (None, 2),
+                           what="vertices (x, y) in metres", min_rows=3)
+        area = polygon_area(poly)
+        if area < 0:
+            poly, area = poly[::-1].copy(), -area
+        if area <= _OVERLAP_TOL_M2 or not is_convex(poly):
+            raise InvalidArgumentError(
+                f"block {self.name!r} polygon must be convex with a positive area; "
+                f"got area {area:.3g} m², convex={is_convex(poly)}"
+            )
+        poly.setflags(write=False)
+        object.__setattr__(self, "polygon", poly)
+        self._check_material()
+        if not (isinstance(self.thickness_m, (int, float)) and np.isfinite(self.thickness_m)
+                and self.thickness_m > 0):
+            raise InvalidArgumentError(
+                f"block {self.name!r} `thickness_m` must be > 0; got {self.thickness_m!r}"
+            )
+        object.__setattr__(self, "thickness_m", float(self.thickness_m))
+
+    def _check_material(self) -> None:
+        given = [self.hardness_n is not None, self.youngs_modulus_pa is not None, bool(self.rigid)]
+        if sum(given) != 1:
+            raise InvalidArgumentError(
+                f"block {self.name!r} needs exactly one of `hardness_n`, `youngs_modulus_pa` or "
+                f"`rigid=True`; got hardness_n={self.hardness_n!r}, "
+                f"youngs_modulus_pa={self.youngs_modulus_pa!r}, rigid={self.rigid!r}"
+            )
+        for key in ("hardness_n", "youngs_modulus_pa"):
+            value = getattr(self, key)
+            if value is not None and not (
+                isinstance(value, (int, float)) and not isinstance(value, bool)
+                and np.isfinite(value) and value > 0
+            ):
+                raise InvalidArgumentError(f"block {self.name!r} `{key}` must be > 0; got {value!r}")
+        if self.hardness_n is not None:
+            object.__setattr__(self, "youngs_modulus_pa",
+                               hardness_to_youngs_modulus(float(self.hardness_n)))
+        elif self.youngs_modulus_pa is not None:
+            object.__setattr__(self, "hardness_n",
+                               youngs_modulus_to_hardness(float(self.youngs_modulus_pa)))
+
+    @property
+    def modulus_pa(self) -> float:
+        """Young's modulus in Pa; ``inf`` for a rigid block."""
+        return float("inf") if self.rigid else float(self.youngs_modulus_pa)  # type: ignore[arg-type]
+
+    @property
+    def hardness(self) -> float:
+        """Hardness in N; ``inf`` for a rigid block."""
+        return float("inf") if self.rigid else float(self.hardness_n)  # type: ignore[arg-type]
+
+    def contains(self, xy: NDArray[np.float64]) -> NDArray[np.bool_]:
+        """Mask of the ``(n, 2)`` points inside the footprint."""
+        return points_in_polygon(np.asarray(xy, dtype=float).reshape(-1, 2), self.polygon)
+
+    def to_dict(self) -> dict[str, Any]:
+        out: dict[str, Any] = {"name": self.name,
+                               "polygon": [[float(x), float(y)] for x, y in self.polygon]}
+        if self.rigid:
+            out["rigid"] = True
+        else:
+            out["hardness_n"] = float(self.hardness_n)  # type: ignore[arg-type]
+        out["thickness_m"] = self.thickness_m
+        out["color"] = self.color
+        return out
+
+
+@dataclass(frozen=True, kw_only=True)
+class Scenario:
+    """A named layout of blocks over a workspace.
+
+    Parameters
+    ----------
+    name : str
+    blocks : tuple of Block
+        At least one; no two may overlap (touching is fine).
+    workspace : Workspace
+        The rectangle to map (60 × 40 cm by default).
+    description : str
+    """
+
+    name: str
+    blocks: tuple[Block, ...]
+    workspace: Workspace = field(default_factory=Workspace)
+    description: str = ""
+
+    def __post_init__(self) -> None:
+        blocks = tuple(self.blocks)
+        if not blocks or not all(isinstance(b, Block) for b in blocks):
+            raise InvalidArgumentError(
+                f"scenario {self.name!r} needs a non-empty sequence of Block; got {self.blocks!r}"
+            )
+        names = [b.name for b in blocks]
+        if len(set(names)) != len(names):
+            raise InvalidArgumentError(f"scenario {self.name!r} has repeated block names: {names}")
+        for i, a in enumerate(blocks):
+            for b in blocks[i + 1:]:
+                area = convex_overlap_area(a.polygon, b.polygon)
+                if area > _OVERLAP_TOL_M2:
+                    raise InvalidArgumentError(
+                        f"scenario {self.name!r}: blocks {a.name!r} and {b.name!r} overlap "
+                        f"by {area * 1e4:.2f} cm²; blocks may touch but not overlap"
+                    )
+        object.__setattr__(self, "blocks", blocks)
+
+    @property
+    def region_names(self) -> list[str]:
+        return [b.name for b in self.blocks]
+
+    def labels(self, xs: Any, ys: Any) -> NDArray[np.int64]:
+        """``(ny, nx)`` block index at each grid point ``(xs[j], ys[i])``; ``-1`` on bare table."""
+        x = check_array("xs", xs, (None,), what="x coordinates in metres", min_rows=1)
+        y = check_array("ys", ys, (None,), what="y coordinates in metres", min_rows=1)
+        gx, gy = np.meshgrid(x, y)
+        pts = np.column_stack([gx.ravel(), gy.ravel()])
+        out = np.full(len(pts), BARE_TABLE, dtype=np.int64)
+        for k, block in enumerate(self.blocks):
+            free = out == BARE_TABLE
+            out[free] = np.where(block.contains(pts[free]), k, BARE_TABLE)
+        return out.reshape(len(y), len(x))
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"name": self.name, "description": self.description,
+                "workspace": self.workspace.to_dict(),
+                "blocks": [b.to_dict() for b in self.blocks]}
+
+
+_FOAM_COLORS = {60: "#f4d35e", 110: "#ee964b", 150: "#c8553d"}
+_RIGID_COLOR = "#6b4f3a"
+
+
+def _foam(name: str, poly: NDArray[np.float64], hardness: int) -> Block:
+    return Block(name=name, polygon=poly, hardness_n=float(hardness), color=_FOAM_COLORS[hardness])
+
+
+def _rigid(name: str, poly: NDArray[np.float64]) -> Block:
+    return Block(name=name, polygon=poly, rigid=True, color=_RIGID_COLOR)
+
+
+def builtin_scenarios() -> dict[str, Scenario]:
+    """The six scenarios of the paper's Table I (layouts in the module docstring)."""
+    full = rectangle(0.0, 0.0, 0.60, 0.40)
+    out = [
+        Scenario(name="homogeneous-60", blocks=(_foam("foam-60", full, 60),),
+                 description="one 60 N foam block over the whole 60x40 cm area"),
+        Scenario(name="homogeneous-110", blocks=(_foam("foam-110", full, 110),),
+                 description="one 110 N foam block over the whole 60x40 cm area"),
+        Scenario(name="heterogeneous-60-150",
+                 blocks=(_foam("foam-60", rectangle(0.0, 0.0, 0.30, 0.40), 60),
+                         _foam("foam-150", rectangle(0.30, 0.0, 0.60, 0.40), 150)),
+                 description="60 N foam on the left half, 150 N on the right half"),
+        Scenario(name="heterogeneous-110-150",
+                 blocks=(_foam("foam-110", rectangle(0.0, 0.0, 0.60, 0.20), 110),
+                         _foam("foam-150", rectangle(0.0, 0.20, 0.60, 0.40), 150)),
+                 description="110 N foam at the front (y < 20 cm), 150 N at the back"),
+        Scenario(name="heterogeneous-150-rigid",
+                 blocks=(_foam("foam-150", rectangle(0.0, 0.0, 0.32, 0.40), 150),
+                         _rigid("rigid", rectangle(0.32, 0.0, 0.60, 0.40))),
+                 description="150 N foam on x < 32 cm, a rigid board of the same height beyond"),
+        Scenario(name="heterogeneous-60-110-rigid",
+                 blocks=(_foam("foam-60", np.array([[0.0, 0.0], [0.18, 0.0], [0.30, 0.40],
+                                                    [0.0, 0.40]]), 60),
+                         _foam("foam-110", np.array([[0.18, 0.0], [0.44, 0.0], [0.44, 0.40],
+                                                     [0.30, 0.40]]), 110),
+                         _rigid("rigid", rectangle(0.44, 0.0, 0.60, 0.40))),
+                 description="60 N | 110 N split by a slanted cut, rigid board on x > 44 cm"),
+    ]
+    return {s.name: s for s in out}
+

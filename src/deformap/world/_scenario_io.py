@@ -1,0 +1,138 @@
+"""Scenario files (YAML) and the catalogue of built-in scenarios.
+
+Format (every key is checked; an unknown key is an error)::
+
+    name: two-foams                      # required
+    description: soft left, hard right   # optional
+    workspace: {lower: [0, 0], upper: [0.6, 0.4]}   # optional, this is the default
+    blocks:                              # required, at least one
+      - name: soft                       # required, unique
+        rect: [0.0, 0.0, 0.3, 0.4]       # x0, y0, x1, y1 in metres ...
+        hardness_n: 60                   # ... one of hardness_n, youngs_modulus_pa, rigid: true
+        thickness_m: 0.05                # optional, default 0.05
+        color: "#f4d35e"                 # optional
+      - name: hard
+        polygon: [[0.3, 0], [0.6, 0], [0.6, 0.4], [0.3, 0.4]]   # or a convex polygon
+        rigid: true
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import yaml
+
+from deformap.environment import Workspace
+from deformap.errors import ConfigError, DeformapError
+from deformap.world._polygon import rectangle
+from deformap.world._scenario import Block, Scenario, builtin_scenarios
+
+__all__ = ["list_scenarios", "load_scenario", "parse_scenario", "save_scenario"]
+
+_SCENARIO_KEYS = {"name", "description", "workspace", "blocks"}
+_BLOCK_KEYS = {"name", "rect", "polygon", "hardness_n", "youngs_modulus_pa", "rigid",
+               "thickness_m", "color"}
+_WORKSPACE_KEYS = {"lower", "upper"}
+
+
+def list_scenarios() -> list[str]:
+    """Names of the built-in scenarios (the paper's Table I), in the paper's order."""
+    return list(builtin_scenarios())
+
+
+def load_scenario(name_or_path: str | Path) -> Scenario:
+    """A built-in scenario by name, or a scenario read from a YAML file.
+
+    Raises
+    ------
+    ConfigError
+        Unknown name, or a file with an unknown key or a bad value.
+    FileFormatError
+        Not raised: a path that does not exist is reported as an unknown name (ConfigError).
+    """
+    catalogue = builtin_scenarios()
+    key = str(name_or_path)
+    if key in catalogue:
+        return catalogue[key]
+    path = Path(key)
+    if not path.is_file():
+        raise ConfigError(
+            f"unknown scenario {key!r}: not a built-in name ({', '.join(catalogue)}) "
+            "and not an existing YAML file"
+        )
+    try:
+        data = yaml.safe_load(path.read_text())
+    except yaml.YAMLError as exc:
+        raise ConfigError(f"{path}: not valid YAML ({exc})") from None
+    return parse_scenario(data, source=str(path))
+
+
+def save_scenario(scenario: Scenario, path: str | Path) -> None:
+    """Write ``scenario`` as YAML that :func:`load_scenario` reads back to an equal scenario."""
+    Path(path).write_text(yaml.safe_dump(scenario.to_dict(), sort_keys=False))
+
+
+def _unknown(where: str, data: dict[str, Any], allowed: set[str]) -> None:
+    extra = sorted(set(data) - allowed)
+    if extra:
+        raise ConfigError(f"{where}: unknown key(s) {extra}; allowed: {sorted(allowed)}")
+
+
+def _block(data: Any, where: str) -> Block:
+    if not isinstance(data, dict):
+        raise ConfigError(f"{where}: a block must be a mapping; got {type(data).__name__}")
+    _unknown(where, data, _BLOCK_KEYS)
+    if ("rect" in data) == ("polygon" in data):
+        raise ConfigError(f"{where}: give exactly one of `rect` or `polygon`")
+    try:
+        if "rect" in data:
+            r = np.asarray(data["rect"], dtype=float)
+            if r.shape != (4,) or not (r[2] > r[0] and r[3] > r[1]):
+                raise ConfigError(
+                    f"{where}: `rect` must be [x0, y0, x1, y1] with x1 > x0 and y1 > y0; "
+                    f"got {data['rect']!r}"
+                )
+            poly = rectangle(*r)
+        else:
+            poly = np.asarray(data["polygon"], dtype=float)
+        rigid = data.get("rigid", False)
+        if not isinstance(rigid, bool):
+            raise ConfigError(f"{where}: `rigid` must be true or false; got {rigid!r}")
+        return Block(
+            name=str(data.get("name", "")), polygon=poly,
+            thickness_m=data.get("thickness_m", 0.05),
+            hardness_n=data.get("hardness_n"), youngs_modulus_pa=data.get("youngs_modulus_pa"),
+            rigid=rigid, color=str(data.get("color", "#6b4f3a" if rigid else "#c8a165")),
+        )
+    except (TypeError, ValueError, DeformapError) as exc:
+        if isinstance(exc, ConfigError):
+            raise
+        raise ConfigError(f"{where}: {exc}") from None
+
+
+def parse_scenario(data: Any, *, source: str = "<scenario>") -> Scenario:
+    """Build a :class:`Scenario` from a parsed YAML mapping (see the module docstring)."""
+    if not isinstance(data, dict):
+        raise ConfigError(f"{source}: a scenario must be a mapping; got {type(data).__name__}")
+    _unknown(source, data, _SCENARIO_KEYS)
+    for key in ("name", "blocks"):
+        if key not in data:
+            raise ConfigError(f"{source}: missing required key `{key}`")
+    if not isinstance(data["blocks"], list) or not data["blocks"]:
+        raise ConfigError(f"{source}: `blocks` must be a non-empty list")
+    blocks = tuple(_block(b, f"{source}: blocks[{i}]") for i, b in enumerate(data["blocks"]))
+    ws = data.get("workspace", {"lower": [0.0, 0.0], "upper": [0.6, 0.4]})
+    if not isinstance(ws, dict):
+        raise ConfigError(f"{source}: `workspace` must be a mapping with `lower` and `upper`")
+    _unknown(f"{source}: workspace", ws, _WORKSPACE_KEYS)
+    try:
+        workspace = Workspace(lower=tuple(ws.get("lower", (0.0, 0.0))),
+                              upper=tuple(ws.get("upper", (0.6, 0.4))))
+        return Scenario(name=str(data["name"]), blocks=blocks, workspace=workspace,
+                        description=str(data.get("description", "")))
+    except DeformapError as exc:
+        if isinstance(exc, ConfigError):
+            raise
+        raise ConfigError(f"{source}: {exc}") from None

@@ -1,0 +1,112 @@
+"""Pictures of a world for a person to check it: layout, one observed cloud, one dent.
+
+Imported only by the CLI (it needs matplotlib); the rest of :mod:`deformap.world` never imports it.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from deformap.world._world import SimulatedWorld
+
+__all__ = ["show_world"]
+
+
+def _press_target(world: SimulatedWorld) -> np.ndarray:
+    """The centroid of the softest foam block (the clearest dent)."""
+    foams = [b for b in world.regions if not b.rigid]
+    if not foams:
+        return np.asarray(world.workspace.center)
+    soft = min(foams, key=lambda b: b.modulus_pa)
+    return np.asarray(soft.polygon.mean(axis=0))
+
+
+def show_world(world: SimulatedWorld, out: Path) -> list[Path]:
+    """Write ``layout.png``, ``cloud.png`` and ``dent.png`` into ``out``; returns their paths."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.patches import Polygon, Rectangle
+
+    out.mkdir(parents=True, exist_ok=True)
+    paths = []
+    # layout
+    fig, ax = plt.subplots(figsize=(7, 5))
+    for k, b in enumerate(world.regions):
+        ax.add_patch(Polygon(b.polygon, closed=True, facecolor=b.color, edgecolor="k", alpha=0.9))
+        cx, cy = b.polygon.mean(axis=0)
+        text = "rigid" if b.rigid else f"{b.hardness:.0f} N\nE = {b.modulus_pa / 1e3:.1f} kPa"
+        ax.text(cx, cy, f"[{k}] {b.name}\n{text}\nt = {b.thickness_m * 100:.0f} cm",
+                ha="center", va="center", fontsize=9)
+    (x0, y0), (w, d) = world.workspace.lower, world.workspace.size
+    ax.add_patch(Rectangle((x0, y0), w, d, fill=False, linestyle="--", edgecolor="b"))
+    cam = world.camera.origin
+    ax.annotate("camera", xy=(cam[0], y0), xytext=(cam[0], y0 - 0.06), ha="center",
+                arrowprops={"arrowstyle": "->"})
+    ax.set(xlim=(x0 - 0.05, x0 + w + 0.05), ylim=(y0 - 0.08, y0 + d + 0.05), aspect="equal",
+           xlabel="x [m]", ylabel="y [m]", title=f"{world.scenario.name}: layout and hardness")
+    paths.append(out / "layout.png")
+    fig.savefig(paths[-1], dpi=120, bbox_inches="tight")
+    plt.close(fig)
+    # cloud
+    cloud = world.observe()
+    fig, (a1, a2) = plt.subplots(1, 2, figsize=(12, 4.5))
+    step = max(1, len(cloud) // 60000)
+    sc = a1.scatter(cloud.xy[::step, 0], cloud.xy[::step, 1], c=cloud.z[::step], s=0.3,
+                    cmap="viridis", vmin=-0.01, vmax=0.07)
+    fig.colorbar(sc, ax=a1, label="z [m]")
+    a1.set(aspect="equal", xlabel="x [m]", ylabel="y [m]",
+           title=f"observed cloud, {len(cloud)} points "
+                 f"({int(world.workspace.contains(cloud.xy).sum())} on the area)")
+    band = np.abs(cloud.xy[:, 0] - world.workspace.center[0]) < 0.01
+    a2.scatter(cloud.xy[band, 1], cloud.z[band], s=0.5)
+    a2.set(xlabel="y [m]", ylabel="z [m]", title="side view of a 2 cm band at the centre x")
+    paths.append(out / "cloud.png")
+    fig.savefig(paths[-1], dpi=120, bbox_inches="tight")
+    plt.close(fig)
+    paths.append(_dent_figure(world, out))
+    return paths
+
+
+def _dent_figure(world: SimulatedWorld, out: Path) -> Path:
+    import matplotlib.pyplot as plt_
+
+    target = _press_target(world)
+    force = world.config.default_force_n
+    obs = world.press(target, force)
+    dent = world.dent(target, force)
+    world.release()
+    xs = np.linspace(target[0] - 0.06, target[0] + 0.06, 121)
+    ys = np.linspace(target[1] - 0.06, target[1] + 0.06, 121)
+    before = world.surface_height(xs, ys)
+    after = world.surface_height(xs, ys, dent.displacement)
+    fig, axes = plt_.subplots(1, 3, figsize=(16, 4.5))
+    ext = (xs[0], xs[-1], ys[0], ys[-1])
+    for ax, img, title in ((axes[0], before, "surface before"), (axes[1], after, "surface pressed")):
+        im = ax.imshow(img * 1e3, origin="lower", extent=ext, cmap="viridis",
+                       vmin=after.min() * 1e3, vmax=before.max() * 1e3)
+        ax.set(title=title, xlabel="x [m]", ylabel="y [m]")
+        fig.colorbar(im, ax=ax, label="height [mm]")
+    ax = axes[2]
+    row = np.argmin(np.abs(ys - target[1]))
+    ax.plot(xs * 1e3, before[row] * 1e3, label="before (FEM)")
+    ax.plot(xs * 1e3, after[row] * 1e3, label="pressed (FEM)")
+    pts = obs.cloud.points
+    band = (np.abs(pts[:, 1] - target[1]) < 0.003) & (np.abs(pts[:, 0] - target[0]) < 0.06)
+    ax.scatter(pts[band, 0] * 1e3, pts[band, 2] * 1e3, s=3, c="gray", label="pressed cloud (±3 mm)")
+    tip = obs.contact.tip_center
+    theta = np.linspace(0, 2 * np.pi, 100)
+    r = obs.contact.tip_radius_m
+    ax.plot((tip[0] + r * np.cos(theta)) * 1e3, (tip[2] + r * np.sin(theta)) * 1e3, "k", label="tip")
+    ax.set_aspect("equal")
+    ax.set(xlabel="x [mm]", ylabel="z [mm]", ylim=(after.min() * 1e3 - 10, before.max() * 1e3 + 30),
+           title=f"{force:.2f} N at ({target[0]:.2f}, {target[1]:.2f}): "
+                 f"dent {dent.depth_m * 1e3:.1f} mm, a = {dent.contact_radius_m * 1e3:.1f} mm")
+    ax.legend(fontsize=8)
+    path = out / "dent.png"
+    fig.savefig(path, dpi=120, bbox_inches="tight")
+    plt_.close(fig)
+    return path

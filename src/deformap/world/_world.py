@@ -1,0 +1,266 @@
+"""The simulated world: scenario + foam FEM + depth camera + probe, as an ``Environment``.
+
+Default press force
+-------------------
+``default_force_n = 0.6`` N. Hertz contact on the softest foam of the paper's range (60 N,
+E = 4.64 kPa, ν = 0.3) keeps the contact radius within the 1 cm tip, ``a ≤ R``, only for
+``F ≤ 4 E* R² / 3 = 0.68 N``; beyond it the stick would touch the foam and a spherical-tip contact no
+longer describes the press. 0.6 N is that bound rounded down. The FEM dents it gives at the default
+mesh are listed in the package docstring; every foam from 60 to 150 N dents by several millimetres
+(above the ≈2 mm axial noise at the camera's 1.1 m range) and far less than half of a 5 cm block.
+
+Ground truth
+------------
+Labels are block indices (``-1`` = bare table). Hardness and modulus are ``inf`` on rigid blocks and
+on the bare table (neither deforms).
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import trimesh
+from numpy.typing import NDArray
+
+from deformap._validation import check_array, check_positive, check_vector
+from deformap.cloud import PointCloud
+from deformap.environment import PressObservation, TactileContact, Workspace
+from deformap.errors import EnvironmentStateError, InvalidArgumentError
+from deformap.world._camera import CameraConfig, DepthCamera
+from deformap.world._foam import Dent, FoamModel
+from deformap.world._probe import ProbeGeometry
+from deformap.world._scenario import BARE_TABLE, Block, Scenario
+
+__all__ = ["SimulatedWorld", "WorldConfig"]
+
+log = logging.getLogger(__name__)
+
+_UP = np.array([0.0, 0.0, 1.0])
+
+
+@dataclass(frozen=True, kw_only=True)
+class WorldConfig:
+    """Settings of the simulated world.
+
+    Parameters
+    ----------
+    element_size_m : float
+        In-plane size of the foam's hexahedra (7.5 mm: the default mesh builds in seconds; see
+        the convergence numbers in the package docstring).
+    top_layer_m, layer_growth : float
+        Thickness of the top element layer and growth factor of the layers below it.
+    poisson_ratio : float
+    default_force_n : float
+        Press force the exploration uses when it has no other (see the module docstring).
+    probe : ProbeGeometry
+        Tip radius (1 cm), stick (10 cm), hand box.
+    force_noise_n : float
+        Standard deviation per axis of the force sensor's noise (Optoforce-class resolution).
+    camera : CameraConfig
+    table_margin_m : float
+        How far the table extends beyond the workspace on every side.
+    """
+
+    element_size_m: float = 0.0075
+    top_layer_m: float = 0.005
+    layer_growth: float = 1.5
+    poisson_ratio: float = 0.3
+    default_force_n: float = 0.6
+    probe: ProbeGeometry = field(default_factory=ProbeGeometry)
+    force_noise_n: float = 0.01
+    camera: CameraConfig = field(default_factory=CameraConfig)
+    table_margin_m: float = 0.2
+
+    def __post_init__(self) -> None:
+        for name in ("element_size_m", "top_layer_m", "default_force_n", "table_margin_m"):
+            check_positive(name, getattr(self, name))
+        check_positive("force_noise_n", self.force_noise_n, allow_zero=True)
+        if not 0.0 <= self.poisson_ratio < 0.5:
+            raise InvalidArgumentError(
+                f"`poisson_ratio` must lie in [0, 0.5); got {self.poisson_ratio!r}")
+        if not self.layer_growth >= 1.0:
+            raise InvalidArgumentError(f"`layer_growth` must be >= 1; got {self.layer_growth!r}")
+
+    @property
+    def tip_radius_m(self) -> float:
+        return self.probe.tip_radius_m
+
+    @classmethod
+    def coarse(cls, **overrides: Any) -> WorldConfig:
+        """A 2 cm mesh and a 320×240 camera, for fast tests (not for measurements)."""
+        settings: dict[str, Any] = {"element_size_m": 0.02, "top_layer_m": 0.01,
+                                    "camera": CameraConfig(width=320, height=240)}
+        settings.update(overrides)
+        return cls(**settings)
+
+
+class SimulatedWorld:
+    """A scenario on a table, seen by a depth camera and pressed by a force-controlled probe.
+
+    Parameters
+    ----------
+    scenario : Scenario
+    config : WorldConfig
+    rng : numpy.random.Generator
+        Source of the camera and force-sensor noise; the same seed gives the same clouds.
+
+    Notes
+    -----
+    Building the world meshes and factorises every foam block (the slow part); each press is then
+    one to a few solves. ``observe`` during a press shows the pressed scene, probe included.
+    """
+
+    def __init__(self, scenario: Scenario, *, config: WorldConfig | None = None,
+                 rng: np.random.Generator) -> None:
+        if not isinstance(scenario, Scenario):
+            raise InvalidArgumentError(f"`scenario` must be a Scenario; got {type(scenario)}")
+        if not isinstance(rng, np.random.Generator):
+            raise InvalidArgumentError(f"`rng` must be a numpy.random.Generator; got {type(rng)}")
+        self.scenario = scenario
+        self.config = config or WorldConfig()
+        self._rng = rng
+        c = self.config
+        self.foam = FoamModel(scenario, element_size_m=c.element_size_m, top_layer_m=c.top_layer_m,
+                              layer_growth=c.layer_growth, poisson_ratio=c.poisson_ratio)
+        self.camera = DepthCamera(c.camera, scenario.workspace.center)
+        self._faces = self._surface_triangles()
+        self._table = self._table_mesh()
+        self._pressed: PressObservation | None = None
+        self._displacement = self.foam.zero_displacement()
+
+    # ---- Environment protocol ----
+    @property
+    def workspace(self) -> Workspace:
+        return self.scenario.workspace
+
+    def observe(self) -> PointCloud:
+        """One depth frame of the scene as it is now, world frame."""
+        robot = None if self._pressed is None else self._pressed.contact
+        return self._capture(self._displacement, robot)
+
+    def press(self, target_xy: Any, force_n: float) -> PressObservation:
+        """Press at ``target_xy`` with ``force_n`` newtons along the surface normal and hold."""
+        target = check_vector("target_xy", target_xy, 2, what="metres")
+        force = check_positive("force_n", force_n)
+        if not self.workspace.contains(target)[0]:
+            raise InvalidArgumentError(
+                f"`target_xy` must lie in the workspace {self.workspace.lower}–"
+                f"{self.workspace.upper}; got {tuple(target)}")
+        if self._pressed is not None:
+            raise EnvironmentStateError(
+                "the probe is still pressing at "
+                f"{tuple(np.round(self._pressed.target_xy, 4))}; call release() first")
+        dent = self.dent(target, force)
+        tip_center = self._tip_center(target, dent)
+        noise = self._rng.normal(0.0, self.config.force_noise_n, size=3)
+        contact = TactileContact(tip_center=tip_center, force=-_UP * force + noise,
+                                 tip_radius_m=self.config.tip_radius_m)
+        cloud = self._capture(dent.displacement, contact)
+        self._displacement = dent.displacement
+        self._pressed = PressObservation(
+            cloud=cloud, contact=contact, target_xy=target, force_n=force,
+            robot_points=self.config.probe.robot_points(tip_center, _UP))
+        return self._pressed
+
+    def release(self) -> None:
+        """Lift the probe; the foam springs back (linear elasticity has no memory)."""
+        self._pressed = None
+        self._displacement = self.foam.zero_displacement()
+
+    # ---- physics and ground truth ----
+    @property
+    def regions(self) -> tuple[Block, ...]:
+        """The blocks, in label order (``.name``, ``.hardness``, ``.modulus_pa``, ``.rigid``)."""
+        return self.scenario.blocks
+
+    @property
+    def region_names(self) -> list[str]:
+        return self.scenario.region_names
+
+    @property
+    def n_dofs(self) -> int:
+        return self.foam.n_dofs
+
+    @property
+    def is_pressing(self) -> bool:
+        return self._pressed is not None
+
+    def dent(self, target_xy: Any, force_n: float) -> Dent:
+        """The FEM response to a press, without touching the world's state (no noise)."""
+        target = check_vector("target_xy", target_xy, 2, what="metres")
+        force = check_positive("force_n", force_n)
+        return self.foam.dent(target, force, tip_radius_m=self.config.tip_radius_m)
+
+    def ground_truth_labels(self, xs: Any, ys: Any) -> NDArray[np.int64]:
+        """``(ny, nx)`` block index at ``(xs[j], ys[i])``; ``-1`` on the bare table."""
+        return self.scenario.labels(xs, ys)
+
+    def ground_truth_hardness(self, xs: Any, ys: Any) -> NDArray[np.float64]:
+        """``(ny, nx)`` hardness in N; ``inf`` on rigid blocks and the bare table."""
+        return self._per_label(self.ground_truth_labels(xs, ys), [b.hardness for b in self.regions])
+
+    def ground_truth_modulus(self, xs: Any, ys: Any) -> NDArray[np.float64]:
+        """``(ny, nx)`` Young's modulus in Pa; ``inf`` on rigid blocks and the bare table."""
+        return self._per_label(self.ground_truth_labels(xs, ys),
+                               [b.modulus_pa for b in self.regions])
+
+    def surface_height(self, xs: Any, ys: Any, displacement: Any = None) -> NDArray[np.float64]:
+        """``(ny, nx)`` height of the top surface in metres, deformed by ``displacement``.
+
+        ``displacement`` is ``Dent.displacement`` (``(n_nodes, 3)``) or None for the rest shape.
+        Lateral displacement of the surface is neglected (it is a fraction of the vertical one).
+        """
+        labels = self.ground_truth_labels(xs, ys)
+        thickness = np.array([b.thickness_m for b in self.regions] + [0.0])
+        height = thickness[labels]  # label -1 picks the table's 0
+        if displacement is not None:
+            u = check_array("displacement", displacement, (self.foam.n_nodes, 3), what="metres")
+            gx, gy = np.meshgrid(np.asarray(xs, float), np.asarray(ys, float))
+            uz = self.foam.top_displacement(np.column_stack([gx.ravel(), gy.ravel()]), u)[:, 2]
+            height = height + uz.reshape(height.shape) * (labels >= 0)
+        return np.asarray(height)
+
+    # ---- internals ----
+    @staticmethod
+    def _per_label(labels: NDArray[np.int64], values: list[float]) -> NDArray[np.float64]:
+        table = np.array([*values, np.inf])
+        return np.asarray(table[labels])
+
+    def _tip_center(self, target: NDArray[np.float64], dent: Dent) -> NDArray[np.float64]:
+        index = int(self.scenario.labels(target[:1], target[1:])[0, 0])
+        top = 0.0 if index == BARE_TABLE else self.regions[index].thickness_m
+        return np.array([target[0], target[1], top - dent.depth_m + self.config.tip_radius_m])
+
+    def _surface_triangles(self) -> NDArray[np.int64]:
+        tris = []
+        for grid, off in zip(self.foam.grids, self.foam.offsets, strict=True):
+            q = grid.surface_quads() + off
+            tris.append(np.concatenate([q[:, [0, 1, 2]], q[:, [0, 2, 3]]]))
+        return np.concatenate(tris)
+
+    def _table_mesh(self) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
+        m = self.config.table_margin_m
+        (x0, y0), (x1, y1) = self.workspace.lower, self.workspace.upper
+        verts = np.array([[x0 - m, y0 - m, 0.0], [x1 + m, y0 - m, 0.0],
+                          [x1 + m, y1 + m, 0.0], [x0 - m, y1 + m, 0.0]])
+        return verts, np.array([[0, 1, 2], [0, 2, 3]])
+
+    def scene_mesh(self, displacement: NDArray[np.float64],
+                   contact: TactileContact | None = None) -> trimesh.Trimesh:
+        """Triangles of the table, the (deformed) blocks and, with a contact, the probe."""
+        verts = self.foam.rest_nodes + displacement
+        table_v, table_f = self._table
+        parts_v, parts_f = [verts, table_v], [self._faces, table_f + len(verts)]
+        if contact is not None:
+            probe = self.config.probe.mesh(contact.tip_center, _UP)
+            parts_f.append(np.asarray(probe.faces) + len(verts) + len(table_v))
+            parts_v.append(np.asarray(probe.vertices))
+        return trimesh.Trimesh(np.concatenate(parts_v), np.concatenate(parts_f), process=False)
+
+    def _capture(self, displacement: NDArray[np.float64], contact: TactileContact | None
+                 ) -> PointCloud:
+        points = self.camera.capture(self.scene_mesh(displacement, contact), self._rng)
+        return PointCloud(points=points, frame="world")

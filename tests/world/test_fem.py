@@ -1,0 +1,112 @@
+"""Foam FEM: parity with scikit-fem's generic assembly, convergence, Hertz, stiffness ordering."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from skfem import Basis, ElementHex1, ElementVectorH1, MeshHex, asm
+from skfem.models.elasticity import lame_parameters, linear_elasticity
+
+from deformap.world import Block, Scenario, hertz_contact_radius, hertz_indentation
+from deformap.world._contact import hertz_pressure_samples
+from deformap.world._fem import FoamBody, HexGrid, graded_levels
+from deformap.world._foam import FoamModel
+from deformap.world._polygon import rectangle
+
+
+def _box_grid(length: float, thickness: float, h: float, top: float, growth: float) -> HexGrid:
+    n = round(length / h)
+    return HexGrid(origin=np.zeros(2), dx=length / n, dy=length / n, nx=n, ny=n,
+                   levels=graded_levels(thickness, top, growth), active=np.ones((n, n), bool))
+
+
+def _press_quarter(grid: HexGrid, body: FoamBody, radius: float, force: float) -> np.ndarray:
+    """Hertz pressure of ``force`` centred on the corner (0, 0) of a quarter model."""
+    points, forces = hertz_pressure_samples(np.zeros(2), radius, force, n_across=240)
+    inside, nodes, weights = grid.locate(points)
+    load = np.zeros((grid.n_nodes, 3))
+    np.add.at(load[:, 2], nodes[inside].ravel(), -(weights[inside] * forces[inside, None]).ravel())
+    assert -load[:, 2].sum() == pytest.approx(force / 4, rel=0.02)
+    return load
+
+
+def test_structured_assembly_equals_scikit_fem_generic_assembly_per_element_modulus() -> None:
+    levels = graded_levels(0.05, 0.01, 1.5)
+    grid = HexGrid(origin=np.zeros(2), dx=0.02, dy=0.015, nx=3, ny=2, levels=levels,
+                   active=np.ones((2, 3), bool))
+    modulus = np.random.default_rng(0).uniform(3e3, 12e3, size=(grid.nz, 2, 3))
+    body = FoamBody(grid, modulus, poisson_ratio=0.3)
+    mesh = MeshHex.init_tensor(np.linspace(0, 0.06, 4), np.linspace(0, 0.03, 3), levels)
+    centroids = mesh.p[:, mesh.t].mean(axis=1).T
+    ref = None
+    for e, c in enumerate(centroids):
+        i, j = int(c[0] // 0.02), int(c[1] // 0.015)
+        k = int(np.searchsorted(levels, c[2]) - 1)
+        basis = Basis(mesh, ElementVectorH1(ElementHex1()), elements=np.array([e]))
+        part = asm(linear_elasticity(*lame_parameters(modulus[k, j, i], 0.3)), basis)
+        ref = part if ref is None else ref + part
+    # our node (i, j, k) -> scikit-fem's node with the same coordinates
+    ours = grid.node_xyz()
+    order = np.lexsort(ours.T[::-1])
+    theirs = np.lexsort(mesh.p[::-1])
+    node_map = np.empty(grid.n_nodes, dtype=int)
+    node_map[order] = theirs
+    perm = (3 * np.arange(grid.n_nodes)[:, None] + np.arange(3)).ravel()
+    skfem_dofs = np.column_stack([Basis(mesh, ElementVectorH1(ElementHex1())).nodal_dofs[c, node_map]
+                                  for c in range(3)]).ravel()
+    assert perm.size == skfem_dofs.size
+    k_ref = ref.toarray()[np.ix_(skfem_dofs, skfem_dofs)]
+    np.testing.assert_allclose(body.stiffness.toarray(), k_ref, atol=1e-10 * np.abs(k_ref).max())
+
+
+def test_thick_block_matches_analytic_hertz_within_20_percent() -> None:
+    modulus, nu, force, tip = 4644.0, 0.3, 0.3, 0.01
+    a = hertz_contact_radius(force, tip, modulus, nu)
+    grid = _box_grid(0.06, 0.06, 0.004, 0.003, 1.3)  # quarter of 12 x 12 x 6 cm, ~8 a deep
+    body = FoamBody(grid, modulus, poisson_ratio=nu, symmetry=("x_min", "y_min"))
+    u = body.solve(_press_quarter(grid, body, a, force))
+    depth = -u[grid.node_id(0, 0, grid.nz), 2]
+    analytic = hertz_indentation(force, tip, modulus, nu)
+    assert depth == pytest.approx(analytic, rel=0.20)
+    assert np.all(u[grid.node_xyz()[:, 2] == 0] == 0)  # bonded to the table
+
+
+def test_compliance_converges_at_second_order_under_refinement() -> None:
+    """Mean displacement under the load (compliance / F) on a small block, h = 8, 4, 2 mm."""
+    values = []
+    for h in (0.008, 0.004, 0.002):
+        grid = _box_grid(0.04, 0.02, h, h, 1.0)
+        body = FoamBody(grid, 4644.0, poisson_ratio=0.3, symmetry=("x_min", "y_min"))
+        load = _press_quarter(grid, body, 0.015, 0.3)
+        u = body.solve(load)
+        values.append(float(load[:, 2] @ u[:, 2]) / float(-load[:, 2].sum()))
+    d1, d2 = values[1] - values[0], values[2] - values[1]
+    rate = np.log2(d1 / d2)
+    assert d1 > d2 > 0  # stiffer-than-exact from below, gaps shrinking
+    assert 1.5 < rate < 2.5, f"observed order {rate:.2f}"
+
+
+def _small_world(hardness: float) -> FoamModel:
+    block = Block(name="f", polygon=rectangle(0.0, 0.0, 0.16, 0.16), hardness_n=hardness)
+    return FoamModel(Scenario(name="s", blocks=(block,)), element_size_m=0.0075,
+                     top_layer_m=0.005, layer_growth=1.5, poisson_ratio=0.3)
+
+
+def test_stiffer_foam_dents_less_and_default_force_dents_clearly() -> None:
+    from deformap.world import WorldConfig
+    from deformap.world._camera import DepthCamera
+
+    config = WorldConfig()
+    camera = DepthCamera(config.camera, (0.3, 0.2))
+    c = config.camera
+    target = np.array([0.08, 0.08])
+    rng_m = float(np.linalg.norm(np.array([*target, 0.05]) - camera.origin))
+    sigma = c.sigma_base_m + c.sigma_quadratic_m * (rng_m - c.sigma_reference_m) ** 2
+    depths = []
+    for hardness in (60.0, 110.0, 150.0):
+        dent = _small_world(hardness).dent(target, config.default_force_n, tip_radius_m=0.01)
+        assert dent.contact_radius_m <= 0.01
+        depths.append(dent.depth_m)
+    assert depths[0] > depths[1] > depths[2]
+    assert depths[2] > 1.5 * sigma  # the 150 N foam still dents beyond the pixel noise
+    assert depths[0] < 0.025  # less than half of the 5 cm block
