@@ -67,15 +67,21 @@ def synthetic() -> Synthetic:
 def write_synthetic(folder: Path, syn: Synthetic, **kwargs: object) -> Path:
     from deformap.replay import write_session
 
-    return write_session(folder, workspace=syn.workspace, observation=syn.observation,
-                         presses=syn.presses, ground_truth=syn.truth, **kwargs)  # type: ignore[arg-type]
+    return write_session(
+        folder,
+        workspace=syn.workspace,
+        observation=syn.observation,
+        presses=syn.presses,
+        ground_truth=syn.truth,
+        **kwargs,
+    )  # type: ignore[arg-type]
 
 
-@pytest.fixture(name="write_synthetic")
+@pytest.fixture(name="write_synthetic", scope="session")
 def _write_synthetic_fixture():  # type: ignore[no-untyped-def]
     return write_synthetic
 
 
-@pytest.fixture(name="make_synthetic")
+@pytest.fixture(name="make_synthetic", scope="session")
 def _make_synthetic_fixture():  # type: ignore[no-untyped-def]
     return make_synthetic

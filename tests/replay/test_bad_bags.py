@@ -106,16 +106,22 @@ def test_missing_topic(bag_session: Path, synthetic, key: str) -> None:  # type:
 
 def test_wrong_message_type(bag_session: Path, synthetic) -> None:  # type: ignore[no-untyped-def]
     _replace_bag(bag_session, synthetic, retype={"tip": "geometry_msgs/msg/Vector3Stamped"})
-    with pytest.raises(FileFormatError, match="'/deformap/press/tip' carries "
-                       "geometry_msgs/msg/Vector3Stamped, expected geometry_msgs/msg/PointStamped"):
+    with pytest.raises(
+        FileFormatError,
+        match="'/deformap/press/tip' carries "
+        "geometry_msgs/msg/Vector3Stamped, expected geometry_msgs/msg/PointStamped",
+    ):
         load_session(bag_session)
 
 
 def test_cloud_frame_mismatch(bag_session: Path, synthetic) -> None:  # type: ignore[no-untyped-def]
     _replace_bag(bag_session, synthetic, cloud_frame="camera")
     session = load_session(bag_session)
-    with pytest.raises(FileFormatError, match=r"/deformap/observation\].*frame_id is 'camera' but "
-                       "the session's frame is 'world'"):
+    with pytest.raises(
+        FileFormatError,
+        match=r"/deformap/observation\].*frame_id is 'camera' but "
+        "the session's frame is 'world'",
+    ):
         session.observation()
     with pytest.raises(FileFormatError, match=r"/deformap/press/cloud stamped 2000000000\]"):
         session.press_observation(1)
@@ -123,7 +129,7 @@ def test_cloud_frame_mismatch(bag_session: Path, synthetic) -> None:  # type: ig
 
 def test_wrench_frame_must_be_world(bag_session: Path, synthetic) -> None:  # type: ignore[no-untyped-def]
     _replace_bag(bag_session, synthetic, wrench_frame="ft_sensor")
-    with pytest.raises(FileFormatError, match="wrench stamped 1000000000.*'ft_sensor'"):
+    with pytest.raises(FileFormatError, match=r"wrench stamped 1000000000.*'ft_sensor'"):
         load_session(bag_session).press_observation(0)
 
 
@@ -148,8 +154,9 @@ def test_poke_without_its_message_breaks_only_that_poke(bag_session: Path, synth
     _replace_bag(bag_session, synthetic, skip_poke={"robot": 2 * 10**9})
     session = load_session(bag_session)
     session.press_observation(0)
-    with pytest.raises(FileFormatError, match="'/deformap/press/robot' has no message stamped "
-                       "2000000000"):
+    with pytest.raises(
+        FileFormatError, match="'/deformap/press/robot' has no message stamped 2000000000"
+    ):
         session.press_observation(1)
     session.press_observation(2)
 

@@ -109,7 +109,7 @@ def test_missing_session(tmp_path: Path) -> None:
     with pytest.raises(FileFormatError, match="no such session"):
         load_session(tmp_path / "nothing")
     (tmp_path / "empty").mkdir()
-    with pytest.raises(FileFormatError, match="has no session.yaml"):
+    with pytest.raises(FileFormatError, match=r"has no session\.yaml"):
         load_session(tmp_path / "empty")
     with pytest.raises(InvalidArgumentError, match="`path`"):
         load_session(3)  # type: ignore[arg-type]
@@ -123,7 +123,9 @@ def test_missing_observation_file(folder: Path) -> None:
 
 def test_missing_or_broken_ground_truth(folder: Path) -> None:
     (folder / "ground_truth.npz").write_bytes(b"PK\x03\x04 truncated")
-    with pytest.raises(FileFormatError, match="ground_truth.npz: could not read the ground-truth NPZ"):
+    with pytest.raises(
+        FileFormatError, match=r"ground_truth\.npz: could not read the ground-truth NPZ"
+    ):
         load_session(folder)
     with open(folder / "ground_truth.npz", "wb") as fh:
         np.savez(fh, xs=np.arange(3.0))
@@ -152,7 +154,10 @@ def _only_poke_broken(folder: Path, broken: int, error: type, match: str) -> Non
         (_set("pokes.1.force", [0.0, 0.0, 0.0]), r"pokes\[1\].force` must be non-zero"),
         (_set("pokes.1.target_xy", [0.3]), r"pokes\[1\].target_xy"),
         (_set("pokes.1.force_n", "one"), r"pokes\[1\].force_n` must be a real number"),
-        (_set("pokes.1.robot_points", [[0, 0, 0]]), r"pokes\[1\].robot_points` must have at least 4"),
+        (
+            _set("pokes.1.robot_points", [[0, 0, 0]]),
+            r"pokes\[1\].robot_points` must have at least 4",
+        ),
         (_set("pokes.1.cloud", 5), r"pokes\[1\].cloud` must be a file name"),
     ],
 )
@@ -200,7 +205,7 @@ def test_missing_xyz_field(folder: Path) -> None:
 
 
 def test_contact_far_from_any_point(folder: Path, synthetic) -> None:  # type: ignore[no-untyped-def]
-    tip = synthetic.presses[1].contact.tip_center + [0, 0, 0.5]
+    tip = synthetic.presses[1].contact.tip_center + np.array([0, 0, 0.5])
     _edit(folder, _set("pokes.1.tip_center", tip.tolist()))
     _only_poke_broken(folder, 1, FileFormatError,
                       r"poke 1: the contact point .* from the nearest surface point")  # fmt: skip
@@ -208,12 +213,14 @@ def test_contact_far_from_any_point(folder: Path, synthetic) -> None:  # type: i
 
 def test_contact_outside_workspace(folder: Path) -> None:
     _edit(folder, _set("pokes.1.tip_center", [0.9, 0.2, 0.05]))
-    _only_poke_broken(folder, 1, FileFormatError, r"poke 1: the contact point .* outside the workspace")
+    _only_poke_broken(
+        folder, 1, FileFormatError, r"poke 1: the contact point .* outside the workspace"
+    )
 
 
 def test_cloud_in_another_frame_is_caught_by_the_contact_check(folder: Path, synthetic) -> None:  # type: ignore[no-untyped-def]
     # A camera-frame cloud declared as world: the contact lands far from its points.
-    cam = synthetic.presses[1].cloud.points + [0.0, 0.0, 0.8]
+    cam = synthetic.presses[1].cloud.points + np.array([0.0, 0.0, 0.8])
     write_cloud(folder / "poke-02.pcd", PointCloud(cam))
     _only_poke_broken(folder, 1, FileFormatError, "different frames or units")
 

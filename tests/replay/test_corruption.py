@@ -20,9 +20,8 @@ SETTINGS = settings(max_examples=40, deadline=None, derandomize=True,
 
 
 @pytest.fixture(scope="module")
-def templates(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
-    from conftest import make_synthetic, write_synthetic  # the fixtures' module
-
+def templates(tmp_path_factory: pytest.TempPathFactory, make_synthetic: Any,
+              write_synthetic: Any) -> dict[str, Path]:  # fmt: skip
     syn = make_synthetic(n_pokes=2, n_points=400)
     root = tmp_path_factory.mktemp("templates")
     out = {"folder": write_synthetic(root / "folder", syn).parent}
@@ -57,10 +56,14 @@ def _copy(template: Path) -> Path:
 
 
 _LEAVES = st.recursive(
-    st.none() | st.booleans() | st.integers(-(10**12), 10**12)
-    | st.floats(allow_nan=True, allow_infinity=True) | st.text(max_size=8),
-    lambda inner: st.lists(inner, max_size=5) | st.dictionaries(st.text(max_size=6), inner,
-                                                                max_size=3),  # fmt: skip
+    st.none()
+    | st.booleans()
+    | st.integers(-(10**12), 10**12)
+    | st.floats(allow_nan=True, allow_infinity=True)
+    | st.text(max_size=8),
+    lambda inner: (
+        st.lists(inner, max_size=5) | st.dictionaries(st.text(max_size=6), inner, max_size=3)
+    ),
     max_leaves=12,
 )
 

@@ -76,7 +76,8 @@ class BagReader:
                         )
                     if found[topic] != msgtype:
                         raise FileFormatError(
-                            f"{self.path}: topic {topic!r} carries {found[topic]}, expected {msgtype}"
+                            f"{self.path}: topic {topic!r} carries {found[topic]}, "
+                            f"expected {msgtype}"
                         )
                 conns = [c for c in reader.connections if c.topic in out]
                 for conn, log_time, raw in reader.messages(connections=conns):
@@ -114,7 +115,9 @@ class BagReader:
         if msg is None:
             bad = self._undecodable.get(topic, [])
             note = f"; {len(bad)} message(s) there could not be decoded ({bad[0]})" if bad else ""
-            raise FileFormatError(f"{self.path}: topic {topic!r} has no message stamped {stamp}{note}")
+            raise FileFormatError(
+                f"{self.path}: topic {topic!r} has no message stamped {stamp}{note}"
+            )
         return msg
 
     def _cloud(self, msg: Any, where: str, frame: str) -> PointCloud:
@@ -174,7 +177,9 @@ class BagReader:
         center = np.array([p.x, p.y, p.z], dtype=float)
         for key, value in (("wrench", force), ("tip", center)):
             if not np.isfinite(value).all():
-                raise FileFormatError(f"{where(key)}: holds NaN or infinite values {value.tolist()}")
+                raise FileFormatError(
+                    f"{where(key)}: holds NaN or infinite values {value.tolist()}"
+                )
         return PressParts(cloud, center, force, np.asarray(robot.points))
 
 

@@ -1,4 +1,4 @@
-"""The folder form of a session: one cloud file per observation, contact values in ``session.yaml``."""
+"""The folder form of a session: a cloud file per observation, contacts in ``session.yaml``."""
 
 from __future__ import annotations
 
@@ -42,7 +42,9 @@ class FolderReader:
         self.header = header
         assert header.observation is not None
         if not header.observation.is_file():
-            raise FileFormatError(f"{header.observation}: no such file (the session's `observation`)")
+            raise FileFormatError(
+                f"{header.observation}: no such file (the session's `observation`)"
+            )
 
     def observation(self) -> PointCloud:
         return _to_world(read_cloud(self._path(self.header.observation), units=self.header.units),

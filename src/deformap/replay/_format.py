@@ -140,7 +140,8 @@ def _check_keys(file: Path, key: str, data: Any, required: set[str], optional: s
     unknown = sorted(keys - required - optional)
     if unknown:
         raise ConfigError(
-            f"{_where(file, key)} has unknown key(s) {unknown}; allowed: {sorted(required | optional)}"
+            f"{_where(file, key)} has unknown key(s) {unknown}; "
+            f"allowed: {sorted(required | optional)}"
         )
     missing = sorted(required - keys)
     if missing:
@@ -244,7 +245,9 @@ def parse_session_yaml(data: Any, file: Path) -> SessionHeader:
     root = file.parent
     _check_keys(file, "(top level)", data, _TOP_REQUIRED, _TOP_OPTIONAL)
     if data["format"] != FORMAT_NAME:
-        raise ConfigError(f"{_where(file, 'format')} must be {FORMAT_NAME!r}; got {data['format']!r}")
+        raise ConfigError(
+            f"{_where(file, 'format')} must be {FORMAT_NAME!r}; got {data['format']!r}"
+        )
     if data["version"] != FORMAT_VERSION or isinstance(data["version"], bool):
         raise ConfigError(
             f"{_where(file, 'version')} must be {FORMAT_VERSION} (this deformap reads format "
@@ -269,7 +272,9 @@ def parse_session_yaml(data: Any, file: Path) -> SessionHeader:
     tip = _value(file, "probe.tip_radius_m", check_positive, data["probe"]["tip_radius_m"])
     source = data.get("source") or {}
     if not isinstance(source, dict):
-        raise ConfigError(f"{_where(file, 'source')} must be a mapping; got {type(source).__name__}")
+        raise ConfigError(
+            f"{_where(file, 'source')} must be a mapping; got {type(source).__name__}"
+        )
     pokes = data["pokes"]
     if not isinstance(pokes, list):
         raise ConfigError(f"{_where(file, 'pokes')} must be a list; got {type(pokes).__name__}")

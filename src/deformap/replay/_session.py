@@ -58,8 +58,8 @@ class RecordedSession:
     path: Path
     header: SessionHeader
     ground_truth: GroundTruth | None
+    _reader: FolderReader | BagReader = field(repr=False)
     contact_gap_m: float = DEFAULT_CONTACT_GAP_M
-    _reader: Any = field(default=None, repr=False)
 
     @property
     def form(self) -> str:
@@ -88,7 +88,7 @@ class RecordedSession:
 
     def observation(self) -> PointCloud:
         """The initial observation of the undisturbed surface, world frame, metres."""
-        return self._reader.observation()  # type: ignore[no-any-return]
+        return self._reader.observation()
 
     def press_observation(self, index: int) -> PressObservation:
         """Poke ``index`` (0-based, in recorded order) as the environment returned it.
@@ -105,6 +105,7 @@ class RecordedSession:
         if spec.error is not None:
             raise spec.error
         parts = self._reader.press_parts(spec)
+        assert spec.target_xy is not None and spec.force_n is not None  # set when no error
         where = f"{self.path / SESSION_FILE}: poke {i}"
         try:
             contact = TactileContact(tip_center=parts.tip_center, force=parts.force,
@@ -190,7 +191,9 @@ def load_session(
         unreadable.
     """
     if not isinstance(path, (str, Path)):
-        raise InvalidArgumentError(f"`path` must be a str or pathlib.Path; got {type(path).__name__}")
+        raise InvalidArgumentError(
+            f"`path` must be a str or pathlib.Path; got {type(path).__name__}"
+        )
     gap = check_positive("contact_gap_m", contact_gap_m)
     file = _session_file(Path(path))
     data = _read_yaml(file)

@@ -45,8 +45,14 @@ def _floats(values: Any) -> list[float]:
 
 
 def _check_inputs(
-    folder: Any, workspace: Any, observation: Any, presses: Any, tip_radius_m: Any, format: Any,
-    cloud_format: Any, ground_truth: Any,
+    folder: Any,
+    workspace: Any,
+    observation: Any,
+    presses: Any,
+    tip_radius_m: Any,
+    format: Any,
+    cloud_format: Any,
+    ground_truth: Any,
 ) -> tuple[Path, list[PressObservation], float]:
     if not isinstance(folder, (str, Path)):
         raise InvalidArgumentError(f"`folder` must be a str or Path; got {type(folder).__name__}")
@@ -54,11 +60,15 @@ def _check_inputs(
     if out.exists() and (not out.is_dir() or any(out.iterdir())):
         raise InvalidArgumentError(f"`folder` {out} exists and is not an empty folder")
     if not isinstance(workspace, Workspace):
-        raise InvalidArgumentError(f"`workspace` must be a Workspace; got {type(workspace).__name__}")
+        raise InvalidArgumentError(
+            f"`workspace` must be a Workspace; got {type(workspace).__name__}"
+        )
     if not isinstance(observation, PointCloud) or len(observation) == 0:
         raise InvalidArgumentError("`observation` must be a non-empty PointCloud")
     if observation.frame != "world":
-        raise InvalidArgumentError(f"`observation` must be in frame 'world'; got {observation.frame!r}")
+        raise InvalidArgumentError(
+            f"`observation` must be in frame 'world'; got {observation.frame!r}"
+        )
     presses = list(presses)
     for i, obs in enumerate(presses):
         if not isinstance(obs, PressObservation):
@@ -77,11 +87,15 @@ def _check_inputs(
         tip_radius_m = radii.pop()
     tip = check_positive("tip_radius_m", tip_radius_m)
     if radii - {tip}:
-        raise InvalidArgumentError(f"every press must use `tip_radius_m` {tip}; got {sorted(radii)}")
+        raise InvalidArgumentError(
+            f"every press must use `tip_radius_m` {tip}; got {sorted(radii)}"
+        )
     if format not in SESSION_FORMATS:
         raise InvalidArgumentError(f"`format` must be one of {SESSION_FORMATS}; got {format!r}")
     if cloud_format not in CLOUD_FORMATS:
-        raise InvalidArgumentError(f"`cloud_format` must be one of {CLOUD_FORMATS}; got {cloud_format!r}")
+        raise InvalidArgumentError(
+            f"`cloud_format` must be one of {CLOUD_FORMATS}; got {cloud_format!r}"
+        )
     if ground_truth is not None and not isinstance(ground_truth, GroundTruth):
         raise InvalidArgumentError(
             f"`ground_truth` must be a GroundTruth or None; got {type(ground_truth).__name__}"
