@@ -289,6 +289,7 @@ def map_command(
 
     from deformap import __version__
     from deformap._config import config_to_dict, dump_yaml
+    from deformap.errors import ConfigError
     from deformap.eval._experiment import (
         _json_default,
         map_report,
@@ -299,8 +300,14 @@ def map_command(
 
     session = load_session(session_path)
     cfg = _session_config(config, session)
-    recorded_seed = session.source.get("seed", cfg.seed)
-    cfg = dataclasses.replace(cfg, seed=int(recorded_seed) if seed is None else seed)
+    if seed is None:
+        seed = session.source.get("seed", cfg.seed)
+        if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
+            raise ConfigError(
+                f"{session.path}/session.yaml: `source.seed` must be an integer >= 0; got "
+                f"{seed!r} (or pass --seed)"
+            )
+    cfg = dataclasses.replace(cfg, seed=seed)
     stem = session.path.name or "session"
     folder = _new_folder(
         out or Path("runs") / f"{stem}-map-{time.strftime('%Y%m%d-%H%M%S')}", "result"
@@ -398,10 +405,10 @@ def estimate_command(
               "beta_std": r["beta_std"], "contact_point": touch.contact_point.tolist(),
               **{k: r[k] for k in ("contact", "force_n", "betas", "errors", "converged",
                                    "iterations", "n_roi_points", "timings")}}  # fmt: skip
-    console.print(f"β = {r['beta']:.3f} ± {r['beta_std']:.3f} ({r['n_roi_points']} ROI points)")
-    if out is None:
+    if out is None:  # the JSON alone on stdout, for pipes
         sys.stdout.write(json.dumps(result) + "\n")
         return
+    console.print(f"β = {r['beta']:.3f} ± {r['beta_std']:.3f} ({r['n_roi_points']} ROI points)")
     folder = Path(out)
     folder.mkdir(parents=True, exist_ok=True)
     (folder / "estimate.json").write_text(json.dumps(result, indent=2))
