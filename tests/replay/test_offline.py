@@ -29,10 +29,10 @@ from deformap.replay import load_session, map_session, write_session  # noqa: E4
 
 SCENARIO = "heterogeneous-150-rigid"
 SEED = 3
-N_BETA = 8
+N_BETA = 6
 SMALL = {
     "world": {"element_size_m": 0.02, "top_layer_m": 0.01,
-              "camera": {"width": 160, "height": 120}},
+              "camera": {"width": 128, "height": 96}},
     "exploration": {
         "max_pokes": 3,
         "surface": {"fit_hyperparameters": False},
@@ -228,3 +228,13 @@ def test_estimate_refuses_bad_input(tmp_path: Path, args: list[str], match: str)
     result = _cli("estimate", *flat)
     assert result.exit_code == 2, result.output
     assert match in " ".join(result.output.split())
+
+
+def test_tip_sphere_points_lie_on_the_tip() -> None:
+    from deformap.replay import tip_sphere_points
+
+    center = np.array([0.1, 0.2, 0.06])
+    pts = tip_sphere_points(center, 0.01)
+    assert pts.shape == (6, 3)
+    np.testing.assert_allclose(np.linalg.norm(pts - center, axis=1), 0.01)
+    np.testing.assert_allclose(pts.mean(axis=0), center)
