@@ -211,11 +211,19 @@ def test_contact_far_from_any_point(folder: Path, synthetic) -> None:  # type: i
                       r"poke 1: the contact point .* from the nearest surface point")  # fmt: skip
 
 
+def synthetic_upper_x(folder: Path) -> float:
+    return float(yaml.safe_load((folder / "session.yaml").read_text())["workspace"]["upper"][0])
+
+
 def test_contact_outside_workspace(folder: Path) -> None:
     _edit(folder, _set("pokes.1.tip_center", [0.9, 0.2, 0.05]))
     _only_poke_broken(
         folder, 1, FileFormatError, r"poke 1: the contact point .* outside the workspace"
     )
+    # just past the edge (2 cm, within the slack) and next to the surface: accepted
+    _edit(folder, _set("pokes.1.tip_center", [0.62, 0.2, 0.06]))
+    got = load_session(folder).press_observation(1)
+    assert got.contact.contact_point[0] > synthetic_upper_x(folder)
 
 
 def test_cloud_in_another_frame_is_caught_by_the_contact_check(folder: Path, synthetic) -> None:  # type: ignore[no-untyped-def]

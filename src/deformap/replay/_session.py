@@ -120,10 +120,15 @@ class RecordedSession:
 
     def _check_contact(self, obs: PressObservation, where: str) -> None:
         point = obs.contact.contact_point
-        if not bool(self.workspace.contains(point[:2])[0]):
+        # A target on the workspace's edge may land a little outside it (sensor noise, slip): the
+        # same slack as for the surface gap below.
+        lo = np.asarray(self.workspace.lower) - self.contact_gap_m
+        hi = np.asarray(self.workspace.upper) + self.contact_gap_m
+        if np.any(point[:2] < lo) or np.any(point[:2] > hi):
             raise FileFormatError(
-                f"{where}: the contact point ({point[0]:.4g}, {point[1]:.4g}) m lies outside the "
-                f"workspace {self.workspace.lower}..{self.workspace.upper}"
+                f"{where}: the contact point ({point[0]:.4g}, {point[1]:.4g}) m lies more than "
+                f"{self.contact_gap_m} m outside the workspace "
+                f"{self.workspace.lower}..{self.workspace.upper}"
             )
         pts = obs.cloud.points
         try:
