@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from deformap.cloud import PointCloud
 from deformap.cloud.io import array_to_pointcloud2, read_bag_static_transform
@@ -61,6 +62,7 @@ class BagReader:
         self._raw = self._index()
         self._decoded: dict[str, dict[int, Any]] | None = None
         self._undecodable: dict[str, list[str]] = {}
+        self._tf_static: NDArray[np.float64] | None = None
 
     def _index(self) -> dict[str, list[_Raw]]:
         rosbag2 = _rosbag2()
@@ -140,7 +142,9 @@ class BagReader:
         if cam2world is None:
             return cloud
         if isinstance(cam2world, str):
-            cam2world = read_bag_static_transform(self.path, self.header.frame, "world")
+            if self._tf_static is None:
+                self._tf_static = read_bag_static_transform(self.path, self.header.frame, "world")
+            cam2world = self._tf_static
         return cloud.transformed(cam2world, "world")
 
     def observation(self) -> PointCloud:
