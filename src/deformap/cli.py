@@ -127,7 +127,9 @@ def world_show_command(
 @bench_app.command("world")
 @friendly_errors
 def bench_world_command(
-    json_file: Annotated[str | None, typer.Option("--json", help="Also write the numbers here.")] = None,
+    json_file: Annotated[
+        str | None, typer.Option("--json", help="Also write the numbers here.")
+    ] = None,
     scenario: Annotated[str, typer.Option(help="Scenario name or YAML file.")] = (
         "heterogeneous-60-110-rigid"),
     seed: Annotated[int, typer.Option(help="Seed of the noise.")] = 0,

@@ -52,8 +52,8 @@ def test_structured_assembly_equals_scikit_fem_generic_assembly_per_element_modu
     node_map = np.empty(grid.n_nodes, dtype=int)
     node_map[order] = theirs
     perm = (3 * np.arange(grid.n_nodes)[:, None] + np.arange(3)).ravel()
-    skfem_dofs = np.column_stack([Basis(mesh, ElementVectorH1(ElementHex1())).nodal_dofs[c, node_map]
-                                  for c in range(3)]).ravel()
+    nodal = Basis(mesh, ElementVectorH1(ElementHex1())).nodal_dofs
+    skfem_dofs = np.column_stack([nodal[c, node_map] for c in range(3)]).ravel()
     assert perm.size == skfem_dofs.size
     k_ref = ref.toarray()[np.ix_(skfem_dofs, skfem_dofs)]
     np.testing.assert_allclose(body.stiffness.toarray(), k_ref, atol=1e-10 * np.abs(k_ref).max())

@@ -126,7 +126,7 @@ def test_block_and_scenario_refuse_bad_values_directly() -> None:
         Block(name="a", polygon=rectangle(0, 0, 1, 1))
     a = Block(name="a", polygon=rectangle(0, 0, 0.2, 0.2), hardness_n=60)
     b = Block(name="b", polygon=rectangle(0.1, 0.1, 0.3, 0.3), rigid=True)
-    with pytest.raises(InvalidArgumentError, match="overlap by 100.00 cm²"):
+    with pytest.raises(InvalidArgumentError, match=r"overlap by 100\.00 cm²"):
         Scenario(name="s", blocks=(a, b))
     touching = Block(name="c", polygon=rectangle(0.2, 0.0, 0.4, 0.2), rigid=True)
     assert len(Scenario(name="s", blocks=(a, touching)).blocks) == 2

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import subprocess
 import sys
 from dataclasses import replace
@@ -61,7 +62,8 @@ def test_noise_free_points_lie_on_the_surfaces() -> None:
 
 def test_axial_noise_follows_the_quadratic_model() -> None:
     w = SimulatedWorld(load_scenario("homogeneous-110"),
-                       config=replace(COARSE, camera=replace(COARSE.camera, flying_probability=0.0)),
+                       config=replace(COARSE, camera=replace(COARSE.camera,
+                                                             flying_probability=0.0)),
                        rng=np.random.default_rng(1))
     cloud = w.observe()
     inner = np.all((cloud.xy > 0.02) & (cloud.xy < np.array([0.58, 0.38])), axis=1)
@@ -142,7 +144,7 @@ def test_press_returns_contact_robot_and_occluding_probe(world) -> None:
     assert dent.depth_m > 0.002
     assert contact.tip_center[2] == pytest.approx(0.05 - dent.depth_m + 0.01)
     hull = Delaunay(obs.robot_points)
-    inside = [contact.tip_center + [0, 0, dz] for dz in (0.0, 0.05, 0.1, 0.15, 0.2)]
+    inside = [contact.tip_center + np.array([0, 0, dz]) for dz in (0.0, 0.05, 0.1, 0.15, 0.2)]
     assert np.all(hull.find_simplex(np.array(inside)) >= 0)  # tip top, stick and hand covered
     pts = obs.cloud.points
     assert np.count_nonzero(pts[:, 2] > 0.17) > 50  # the hand is seen
@@ -246,3 +248,40 @@ def test_world_does_not_import_the_estimator() -> None:
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                             check=False)
     assert result.returncode == 0, result.stdout + result.stderr
+
+
+def test_noise_switch_turns_off_camera_and_force_noise() -> None:
+    w = SimulatedWorld(load_scenario("homogeneous-60"), config=WorldConfig.coarse(noise=False),
+                       rng=np.random.default_rng(0))
+    obs = w.press((0.3, 0.2), 0.6)
+    np.testing.assert_array_equal(obs.contact.force, [0.0, 0.0, -0.6])
+    far = np.all((obs.cloud.xy > 0.05) & (obs.cloud.xy < 0.12), axis=1)
+    np.testing.assert_allclose(obs.cloud.z[far], 0.05, atol=1e-6)
+    with pytest.raises(InvalidArgumentError, match="`hand_size_m`"):
+        WorldConfig(hand_size_m=(0.1, 0.0, 0.1))
+    with pytest.raises(InvalidArgumentError, match="`tip_radius_m` must be > 0"):
+        WorldConfig(tip_radius_m=-0.01)
+
+
+def test_testing_helper_builds_a_coarse_world() -> None:
+    from deformap.testing import coarse_world
+
+    w = coarse_world("heterogeneous-60-150", seed=3)
+    assert isinstance(w, Environment) and w.config.element_size_m == 0.02
+
+
+@pytest.mark.parametrize("name", ["homogeneous-60", "homogeneous-110", "heterogeneous-60-150",
+                                  "heterogeneous-110-150", "heterogeneous-150-rigid", "random"])
+def test_every_scenario_builds_and_softer_dents_deeper(name) -> None:
+    from deformap.world import random_scenario
+
+    sc = random_scenario(np.random.default_rng(11)) if name == "random" else load_scenario(name)
+    w = SimulatedWorld(sc, config=COARSE, rng=np.random.default_rng(0))
+    depths = {}
+    for k, block in enumerate(w.regions):
+        xy = block.polygon.mean(axis=0)
+        assert w.ground_truth_labels([xy[0]], [xy[1]])[0, 0] == k
+        depths[block.hardness] = w.dent(xy, 0.6).depth_m
+    ordered = [depths[h] for h in sorted(depths)]
+    assert all(a > b for a, b in itertools.pairwise(ordered))
+    assert depths.get(np.inf, 0.0) == 0.0

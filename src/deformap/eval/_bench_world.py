@@ -1,4 +1,4 @@
-"""Speed of the simulated world: construction (mesh, assembly, factorisation), press, observation."""
+"""Speed of the simulated world: construction (mesh, assembly, factorisation), press, observe."""
 
 from __future__ import annotations
 

@@ -7,7 +7,8 @@ Quick start::
 
     import numpy as np
     from deformap.world import SimulatedWorld, load_scenario
-    world = SimulatedWorld(load_scenario("heterogeneous-60-110-rigid"), rng=np.random.default_rng(0))
+    scenario = load_scenario("heterogeneous-60-110-rigid")
+    world = SimulatedWorld(scenario, rng=np.random.default_rng(0))
     cloud = world.observe()
     obs = world.press((0.1, 0.2), world.config.default_force_n)
     world.release()

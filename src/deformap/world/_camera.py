@@ -8,10 +8,12 @@ while pressing, the probe. Then, per pixel, in this order:
 
 1. no return when the ray meets the surface at more than ``grazing_deg`` from its normal;
 2. flying pixels: where the depth jumps by more than ``edge_jump_m`` to the right or lower
-   neighbour, with probability ``flying_probability`` the pixel takes a depth drawn uniformly between
+   neighbour, with probability ``flying_probability`` the pixel takes a depth drawn uniformly
+   between
    the two (the mixed returns of structured-light sensors at depth edges);
 3. axial noise ``σ_z = 1.2 mm + 1.9 mm·(z − 0.4 m)²`` (z in metres along the optical axis);
-4. disparity quantisation to ``1 / subpixel`` pixel: ``z = f b / round(f b / z · subpixel) · subpixel``.
+4. disparity quantisation to ``1 / subpixel`` pixel:
+   ``z = f b / (round(f b / z · subpixel) / subpixel)``.
 
 Points are returned in the world frame, one per valid pixel in row-major pixel order.
 

@@ -44,7 +44,8 @@ def graded_levels(thickness_m: float, top_m: float, growth: float) -> NDArray[np
     The top layer is about ``top_m`` thick; the stack is scaled to end exactly at the thickness.
     """
     sizes = [top_m]
-    while sum(sizes) < thickness_m * (1 - 1e-9) and sum(sizes) + sizes[-1] * growth < thickness_m * 1.2:
+    while (sum(sizes) < thickness_m * (1 - 1e-9)
+           and sum(sizes) + sizes[-1] * growth < thickness_m * 1.2):
         sizes.append(sizes[-1] * growth)
     sizes_arr = np.array(sizes[::-1]) * (thickness_m / sum(sizes))
     return np.concatenate([[0.0], np.cumsum(sizes_arr)])
@@ -109,7 +110,7 @@ class HexGrid:
     def n_nodes(self) -> int:
         return (self.nx + 1) * (self.ny + 1) * (self.nz + 1)
 
-    def node_id(self, i: NDArray[np.int64], j: NDArray[np.int64], k: NDArray[np.int64]
+    def node_id(self, i: NDArray[np.int64], j: NDArray[np.int64], k: NDArray[np.int64] | int
                 ) -> NDArray[np.int64]:
         return np.asarray((k * (self.ny + 1) + j) * (self.nx + 1) + i)
 
@@ -138,7 +139,8 @@ class HexGrid:
                 a = (si, sj + (dj > 0))
                 b = (si + 1, sj + (dj > 0))
             for k in range(self.nz):
-                quads.append(np.column_stack([self.node_id(a[0], a[1], k), self.node_id(b[0], b[1], k),
+                quads.append(np.column_stack([self.node_id(a[0], a[1], k),
+                                              self.node_id(b[0], b[1], k),
                                               self.node_id(b[0], b[1], k + 1),
                                               self.node_id(a[0], a[1], k + 1)]))
         return np.concatenate(quads, axis=0)
@@ -197,7 +199,8 @@ class FoamBody:
             self._lu = splu(k_ff, permc_spec="MMD_AT_PLUS_A",
                             options={"SymmetricMode": True})
         except RuntimeError as exc:  # singular: a block that is not held by the table
-            raise NotPositiveDefiniteError(f"foam stiffness could not be factorised: {exc}") from None
+            raise NotPositiveDefiniteError(
+                f"foam stiffness could not be factorised: {exc}") from None
         log.debug("factorised %d DOFs", self.free.size)
 
     @property
@@ -205,7 +208,8 @@ class FoamBody:
         """Number of free displacement unknowns."""
         return int(self.free.size)
 
-    def _element_dofs(self, k: int) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64]]:
+    def _element_dofs(self, k: int
+                      ) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64]]:
         g = self.grid
         jj, ii = np.nonzero(g.active)
         nodes = np.column_stack([g.node_id(ii + c[0], jj + c[1], np.full_like(ii, k + c[2]))

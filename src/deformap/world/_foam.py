@@ -5,10 +5,21 @@ pieces, not glued), factorised once when the world is built. A press puts the He
 commanded force on the top surface under the tip; the part of the patch that falls on rigid ground
 (a rigid board or the bare table) is carried by it and loads no foam.
 
+Indentation: inside the contact the surface follows the rigid sphere, ``u(r) = δ − r² / (2R)``, so
+averaging with the Hertz pressure as weight gives ``δ = ū_p + <r²>_p / (2R) = ū_p + 0.2 a² / R``,
+where ``ū_p`` is the pressure-weighted mean FEM displacement (the load's work-conjugate, which
+converges at second order under mesh refinement and does not depend on where the target falls
+between nodes, unlike the displacement interpolated at the target).
+
+Contact: after the solve, the top nodes inside the contact disc are put on the tip's lower cap
+(``u_z = −δ + R − sqrt(R² − r²)``), since there the foam touches the rigid tip. On a mesh coarser
+than the patch the nodal solution overshoots or undershoots the cap by about a millimetre; this
+projection keeps the surface the camera sees consistent with the tip it sees.
+
 Patch radius: Hertz's ``a`` assumes a half-space, but the foam is a layer bonded to the table and
 responds stiffer, so the tip sinks less than Hertz says and touches a smaller disc. The press
 therefore iterates ``a ← sqrt(a · sqrt(R δ_FEM))`` (a damped fixed point of the sphere's geometric
-relation ``a² = R δ``) from the Hertz value until ``a`` changes by less than 1 %, and never lets
+relation ``a² = R δ``) from the Hertz value until ``a`` changes by less than 2 %, and never lets
 ``a`` exceed the tip radius ``R``.
 """
 
@@ -38,7 +49,8 @@ class Dent:
     displacement : (n_nodes, 3) float, metres
         Displacement of every mesh node of the world (all bodies stacked).
     depth_m : float
-        Downward displacement of the surface at the target (0 on rigid ground).
+        Indentation of the tip: how far its lowest point sinks below the rest surface (0 on
+        rigid ground); see the module docstring.
     contact_radius_m : float
         Radius of the loaded patch after the consistency iteration (0 on rigid ground).
     iterations : int
@@ -116,7 +128,7 @@ class FoamModel:
         return out
 
     def dent(self, target_xy: NDArray[np.float64], force_n: float, *, tip_radius_m: float,
-             max_iterations: int = 6, tolerance: float = 0.01) -> Dent:
+             max_iterations: int = 6, tolerance: float = 0.02) -> Dent:
         """Solve the press of ``force_n`` newtons at ``target_xy`` (see the module docstring)."""
         target = np.asarray(target_xy, dtype=float).reshape(1, 2)
         labels = self.scenario.labels(target[:, 0], target[:, 1])
@@ -128,19 +140,32 @@ class FoamModel:
         a = min(hertz_contact_radius(force_n, tip_radius_m, modulus, self.poisson_ratio),
                 tip_radius_m)
         for iteration in range(1, max_iterations + 1):
-            u = self._solve_patch(target[0], a, force_n)
-            depth = max(0.0, -float(self.top_displacement(target, u)[0, 2]))
+            u, points, forces = self._solve_patch(target[0], a, force_n)
+            mean_u = -float(forces @ self.top_displacement(points, u)[:, 2]) / force_n
+            depth = max(0.0, mean_u + 0.2 * a * a / tip_radius_m)
             a_new = min(np.sqrt(a * np.sqrt(tip_radius_m * depth)), tip_radius_m)
             converged = abs(a_new - a) <= tolerance * a
             log.debug("press iteration %d: a=%.4f m, depth=%.4f m", iteration, a, depth)
             if converged or iteration == max_iterations:
                 break
             a = float(a_new)
+        self._conform_to_tip(u, target[0], a, depth, tip_radius_m)
         return Dent(displacement=u, depth_m=depth, contact_radius_m=float(a),
                     iterations=iteration)
 
+    def _conform_to_tip(self, u: NDArray[np.float64], center: NDArray[np.float64], radius: float,
+                        depth: float, tip_radius_m: float) -> None:
+        for index in self.bodies:
+            grid, off = self.grids[index], self.offsets[index]
+            xyz = self.rest_nodes[off:off + grid.n_nodes]
+            r2 = np.sum((xyz[:, :2] - center) ** 2, axis=1)
+            top = np.isclose(xyz[:, 2], grid.levels[-1]) & (r2 < radius**2)
+            top &= np.any(u[off:off + grid.n_nodes] != 0.0, axis=1)  # nodes of the block only
+            cap = -depth + tip_radius_m - np.sqrt(tip_radius_m**2 - r2[top])
+            u[off + np.flatnonzero(top), 2] = cap
+
     def _solve_patch(self, center: NDArray[np.float64], radius: float, force_n: float
-                     ) -> NDArray[np.float64]:
+                     ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
         points, forces = hertz_pressure_samples(center, radius, force_n)
         u = self.zero_displacement()
         claimed = np.zeros(len(points), dtype=bool)
@@ -155,4 +180,4 @@ class FoamModel:
             np.add.at(load[:, 2], nodes[inside].ravel(),
                       -(weights[inside] * forces[inside, None]).ravel())
             u[off:off + grid.n_nodes] = body.solve(load)
-        return u
+        return u, points, forces

@@ -19,8 +19,8 @@ import numpy as np
 from deformap._validation import check_positive
 
 __all__ = [
-    "INDENTER_AREA_M2",
     "INDENTATION_STRAIN",
+    "INDENTER_AREA_M2",
     "hardness_to_youngs_modulus",
     "youngs_modulus_to_hardness",
 ]

@@ -22,7 +22,7 @@ _EPS = 1e-12
 
 
 def rectangle(x0: float, y0: float, x1: float, y1: float) -> NDArray[np.float64]:
-    """Counter-clockwise ``(4, 2)`` vertices of the axis-aligned rectangle ``[x0, x1] × [y0, y1]``."""
+    """Counter-clockwise ``(4, 2)`` vertices of the rectangle ``[x0, x1] × [y0, y1]``."""
     return np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]], dtype=float)
 
 

@@ -44,7 +44,7 @@ class ProbeGeometry:
         stick.apply_translation([0.0, 0.0, self.stick_length_m / 2])
         hand = trimesh.creation.box(extents=self.hand_size_m)
         hand.apply_translation([0.0, 0.0, self.stick_length_m + self.hand_size_m[2] / 2])
-        parts = trimesh.util.concatenate([tip, stick, hand])
+        parts: trimesh.Trimesh = trimesh.util.concatenate([tip, stick, hand])  # type: ignore[assignment]
         pose[:3, 3] = tip_center
         parts.apply_transform(pose)
         return parts

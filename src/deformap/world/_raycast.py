@@ -82,7 +82,8 @@ def _pinhole_hits(triangles: NDArray[np.float64], origin: NDArray[np.float64],
     c0 = np.floor((puv.min(axis=1) - lo) / size).astype(np.int64)
     c1 = np.floor((puv.max(axis=1) - lo) / size).astype(np.int64)
     keep = np.all(c1 >= 0, axis=1) & np.all(c0 < n_cells, axis=1)
-    tri_ids, c0, c1 = tri_ids[keep], np.clip(c0[keep], 0, n_cells - 1), np.clip(c1[keep], 0, n_cells - 1)
+    tri_ids = tri_ids[keep]
+    c0, c1 = np.clip(c0[keep], 0, n_cells - 1), np.clip(c1[keep], 0, n_cells - 1)
     # expand triangle -> covered cells -> rays in those cells
     ni, nj = c1[:, 0] - c0[:, 0] + 1, c1[:, 1] - c0[:, 1] + 1
     per_tri = ni * nj

@@ -15,8 +15,9 @@ over the 60 × 40 cm workspace with 5 cm thick blocks:
 * ``heterogeneous-110-150``: two blocks, 110 N on ``y < 0.20 m`` (front), 150 N at the back.
 * ``heterogeneous-150-rigid``: 150 N foam on ``x < 0.32 m``, a rigid board of the same thickness on
   the rest (so the surface is level and the rigid region must be told apart by pressing).
-* ``heterogeneous-60-110-rigid``: three blocks, the first cut not aligned with the axes: 60 N left of
-  the slanted line from (0.18, 0) to (0.30, 0.40), 110 N between it and ``x = 0.44``, rigid beyond.
+* ``heterogeneous-60-110-rigid``: three blocks, the first cut not aligned with the axes: 60 N left
+  of the slanted line from (0.18, 0) to (0.30, 0.40), 110 N between it and ``x = 0.44``, rigid
+  beyond.
 
 Ground-truth labels are block indices ``0 .. n-1`` in the order of ``Scenario.blocks``; ``-1`` marks
 the bare table.
@@ -82,7 +83,8 @@ class Block:
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not self.name:
-            raise InvalidArgumentError(f"block `name` must be a non-empty string; got {self.name!r}")
+            raise InvalidArgumentError(
+                f"block `name` must be a non-empty string; got {self.name!r}")
         poly = check_array(f"block {self.name!r} polygon", self.polygon, (None, 2),
                            what="vertices (x, y) in metres", min_rows=3)
         area = polygon_area(poly)
@@ -117,7 +119,8 @@ class Block:
                 isinstance(value, (int, float)) and not isinstance(value, bool)
                 and np.isfinite(value) and value > 0
             ):
-                raise InvalidArgumentError(f"block {self.name!r} `{key}` must be > 0; got {value!r}")
+                raise InvalidArgumentError(
+                    f"block {self.name!r} `{key}` must be > 0; got {value!r}")
         if self.hardness_n is not None:
             object.__setattr__(self, "youngs_modulus_pa",
                                hardness_to_youngs_modulus(float(self.hardness_n)))

@@ -85,7 +85,8 @@ def _dent_figure(world: SimulatedWorld, out: Path) -> Path:
     after = world.surface_height(xs, ys, dent.displacement)
     fig, axes = plt_.subplots(1, 3, figsize=(16, 4.5))
     ext = (xs[0], xs[-1], ys[0], ys[-1])
-    for ax, img, title in ((axes[0], before, "surface before"), (axes[1], after, "surface pressed")):
+    panels = ((axes[0], before, "surface before"), (axes[1], after, "surface pressed"))
+    for ax, img, title in panels:
         im = ax.imshow(img * 1e3, origin="lower", extent=ext, cmap="viridis",
                        vmin=after.min() * 1e3, vmax=before.max() * 1e3)
         ax.set(title=title, xlabel="x [m]", ylabel="y [m]")
@@ -100,12 +101,13 @@ def _dent_figure(world: SimulatedWorld, out: Path) -> Path:
     tip = obs.contact.tip_center
     theta = np.linspace(0, 2 * np.pi, 100)
     r = obs.contact.tip_radius_m
-    ax.plot((tip[0] + r * np.cos(theta)) * 1e3, (tip[2] + r * np.sin(theta)) * 1e3, "k", label="tip")
+    ax.plot((tip[0] + r * np.cos(theta)) * 1e3, (tip[2] + r * np.sin(theta)) * 1e3, "k",
+            label="tip")
     ax.set_aspect("equal")
-    ax.set(xlabel="x [mm]", ylabel="z [mm]", ylim=(after.min() * 1e3 - 10, before.max() * 1e3 + 30),
+    ax.set(xlabel="x [mm]", ylabel="z [mm]", ylim=(after.min() * 1e3 - 5, before.max() * 1e3 + 25),
            title=f"{force:.2f} N at ({target[0]:.2f}, {target[1]:.2f}): "
                  f"dent {dent.depth_m * 1e3:.1f} mm, a = {dent.contact_radius_m * 1e3:.1f} mm")
-    ax.legend(fontsize=8)
+    ax.legend(fontsize=7, ncol=2, loc="upper left")
     path = out / "dent.png"
     fig.savefig(path, dpi=120, bbox_inches="tight")
     plt_.close(fig)

@@ -4,10 +4,12 @@ Default press force
 -------------------
 ``default_force_n = 0.6`` N. Hertz contact on the softest foam of the paper's range (60 N,
 E = 4.64 kPa, ν = 0.3) keeps the contact radius within the 1 cm tip, ``a ≤ R``, only for
-``F ≤ 4 E* R² / 3 = 0.68 N``; beyond it the stick would touch the foam and a spherical-tip contact no
-longer describes the press. 0.6 N is that bound rounded down. The FEM dents it gives at the default
-mesh are listed in the package docstring; every foam from 60 to 150 N dents by several millimetres
-(above the ≈2 mm axial noise at the camera's 1.1 m range) and far less than half of a 5 cm block.
+``F ≤ 4 E* R² / 3 = 0.68 N``; beyond it the stick would touch the foam and a spherical-tip
+contact no longer describes the press. 0.6 N is that bound rounded down. At the default mesh,
+on 5 cm blocks, it indents 60, 110 and 150 N foam by 7.5, 4.9 and 4.1 mm (FEM; Hertz on a
+half-space says 9.2, 6.1 and 5.0 mm, the bonded layer is stiffer): every foam of the range dents
+by about twice the axial noise at the camera's 1.1 m range (σ_z ≈ 2.1 mm per pixel, and a dent
+spans hundreds of pixels) and far less than half of the block.
 
 Ground truth
 ------------
@@ -18,7 +20,7 @@ on the bare table (neither deforms).
 from __future__ import annotations
 
 import logging
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -55,10 +57,14 @@ class WorldConfig:
     poisson_ratio : float
     default_force_n : float
         Press force the exploration uses when it has no other (see the module docstring).
-    probe : ProbeGeometry
-        Tip radius (1 cm), stick (10 cm), hand box.
+    tip_radius_m, stick_length_m, stick_radius_m : float
+        The probe: spherical tip (1 cm, Optoforce-like), stick (10 cm long).
+    hand_size_m : (3,) float
+        The box standing for the hand that holds the stick.
     force_noise_n : float
         Standard deviation per axis of the force sensor's noise (Optoforce-class resolution).
+    noise : bool
+        False turns off every noise source (camera and force sensor) at once.
     camera : CameraConfig
     table_margin_m : float
         How far the table extends beyond the workspace on every side.
@@ -69,14 +75,24 @@ class WorldConfig:
     layer_growth: float = 1.5
     poisson_ratio: float = 0.3
     default_force_n: float = 0.6
-    probe: ProbeGeometry = field(default_factory=ProbeGeometry)
+    tip_radius_m: float = 0.01
+    stick_length_m: float = 0.10
+    stick_radius_m: float = 0.006
+    hand_size_m: tuple[float, float, float] = (0.08, 0.06, 0.10)
     force_noise_n: float = 0.01
+    noise: bool = True
     camera: CameraConfig = field(default_factory=CameraConfig)
     table_margin_m: float = 0.2
 
     def __post_init__(self) -> None:
-        for name in ("element_size_m", "top_layer_m", "default_force_n", "table_margin_m"):
+        for name in ("element_size_m", "top_layer_m", "default_force_n", "table_margin_m",
+                     "tip_radius_m", "stick_length_m", "stick_radius_m"):
             check_positive(name, getattr(self, name))
+        hand = check_vector("hand_size_m", self.hand_size_m, 3, what="metres")
+        if np.any(hand <= 0):
+            raise InvalidArgumentError(f"`hand_size_m` must be positive; got {self.hand_size_m}")
+        if not isinstance(self.camera, CameraConfig):
+            raise InvalidArgumentError(f"`camera` must be a CameraConfig; got {type(self.camera)}")
         check_positive("force_noise_n", self.force_noise_n, allow_zero=True)
         if not 0.0 <= self.poisson_ratio < 0.5:
             raise InvalidArgumentError(
@@ -85,8 +101,11 @@ class WorldConfig:
             raise InvalidArgumentError(f"`layer_growth` must be >= 1; got {self.layer_growth!r}")
 
     @property
-    def tip_radius_m(self) -> float:
-        return self.probe.tip_radius_m
+    def probe(self) -> ProbeGeometry:
+        """The probe geometry built from the `tip_radius_m`, `stick_*`, `hand_size_m` fields."""
+        return ProbeGeometry(tip_radius_m=self.tip_radius_m, stick_length_m=self.stick_length_m,
+                             stick_radius_m=self.stick_radius_m,
+                             hand_size_m=tuple(self.hand_size_m))  # type: ignore[arg-type]
 
     @classmethod
     def coarse(cls, **overrides: Any) -> WorldConfig:
@@ -105,7 +124,11 @@ class SimulatedWorld:
     scenario : Scenario
     config : WorldConfig
     rng : numpy.random.Generator
-        Source of the camera and force-sensor noise; the same seed gives the same clouds.
+        Source of the camera and force-sensor noise; the same seed gives the same clouds. One
+        number is drawn from it at construction; each event then draws its noise from a stream
+        keyed by that number and the event itself (the n-th observation at rest; a press by its
+        target and force). So the noise of a press does not depend on what happened before it,
+        and a killed run that is resumed sees exactly the noise the uninterrupted run saw.
 
     Notes
     -----
@@ -121,11 +144,14 @@ class SimulatedWorld:
             raise InvalidArgumentError(f"`rng` must be a numpy.random.Generator; got {type(rng)}")
         self.scenario = scenario
         self.config = config or WorldConfig()
-        self._rng = rng
+        self._noise_key = int(rng.integers(2**62))
+        self._n_observed = 0
         c = self.config
         self.foam = FoamModel(scenario, element_size_m=c.element_size_m, top_layer_m=c.top_layer_m,
                               layer_growth=c.layer_growth, poisson_ratio=c.poisson_ratio)
-        self.camera = DepthCamera(c.camera, scenario.workspace.center)
+        camera = c.camera if c.noise else replace(c.camera, noise=False)
+        self.camera = DepthCamera(camera, scenario.workspace.center)
+        self._force_noise_n = c.force_noise_n if c.noise else 0.0
         self._faces = self._surface_triangles()
         self._table = self._table_mesh()
         self._pressed: PressObservation | None = None
@@ -138,8 +164,12 @@ class SimulatedWorld:
 
     def observe(self) -> PointCloud:
         """One depth frame of the scene as it is now, world frame."""
-        robot = None if self._pressed is None else self._pressed.contact
-        return self._capture(self._displacement, robot)
+        if self._pressed is None:
+            rng = self._event_rng(0, self._n_observed)
+            self._n_observed += 1
+            return self._capture(self._displacement, None, rng)
+        p = self._pressed
+        return self._capture(self._displacement, p.contact, self._press_rng(p.target_xy, p.force_n, 1))
 
     def press(self, target_xy: Any, force_n: float) -> PressObservation:
         """Press at ``target_xy`` with ``force_n`` newtons along the surface normal and hold."""
@@ -155,10 +185,11 @@ class SimulatedWorld:
                 f"{tuple(np.round(self._pressed.target_xy, 4))}; call release() first")
         dent = self.dent(target, force)
         tip_center = self._tip_center(target, dent)
-        noise = self._rng.normal(0.0, self.config.force_noise_n, size=3)
+        rng = self._press_rng(target, force, 0)
+        noise = rng.normal(0.0, 1.0, size=3) * self._force_noise_n
         contact = TactileContact(tip_center=tip_center, force=-_UP * force + noise,
                                  tip_radius_m=self.config.tip_radius_m)
-        cloud = self._capture(dent.displacement, contact)
+        cloud = self._capture(dent.displacement, contact, rng)
         self._displacement = dent.displacement
         self._pressed = PressObservation(
             cloud=cloud, contact=contact, target_xy=target, force_n=force,
@@ -260,7 +291,16 @@ class SimulatedWorld:
             parts_v.append(np.asarray(probe.vertices))
         return trimesh.Trimesh(np.concatenate(parts_v), np.concatenate(parts_f), process=False)
 
-    def _capture(self, displacement: NDArray[np.float64], contact: TactileContact | None
-                 ) -> PointCloud:
-        points = self.camera.capture(self.scene_mesh(displacement, contact), self._rng)
+    def _event_rng(self, *key: int) -> np.random.Generator:
+        return np.random.default_rng([self._noise_key, *key])
+
+    def _press_rng(self, target: NDArray[np.float64], force: float, view: int
+                   ) -> np.random.Generator:
+        # Micrometres and micronewtons, shifted to be non-negative: SeedSequence takes naturals.
+        x, y = (int(round(v * 1e6)) + 2**40 for v in target)
+        return self._event_rng(1, x, y, int(round(force * 1e6)), view)
+
+    def _capture(self, displacement: NDArray[np.float64], contact: TactileContact | None,
+                 rng: np.random.Generator) -> PointCloud:
+        points = self.camera.capture(self.scene_mesh(displacement, contact), rng)
         return PointCloud(points=points, frame="world")

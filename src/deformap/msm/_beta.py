@@ -1,0 +1,157 @@
+"""β estimation: the β whose simulated poke best matches the observed deformed surface."""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.spatial import cKDTree
+
+from deformap._validation import check_array, check_points
+from deformap.environment import TactileContact
+from deformap.msm._config import ShapeMatchingConfig
+from deformap.msm._grid import ParticleGrid
+from deformap.msm._simulate import _check_config, simulate_poke
+
+__all__ = ["BetaEstimate", "estimate_beta", "matching_error"]
+
+logger = logging.getLogger(__name__)
+Array = NDArray[np.float64]
+
+_TIE_M = 1e-9
+"""E values within a nanometre are ties (round-off): β̂ is then the smallest, most rigid β."""
+
+
+@dataclass(frozen=True, kw_only=True)
+class BetaEstimate:
+    """Result of :func:`estimate_beta`.
+
+    Parameters
+    ----------
+    beta : float
+        β̂, the minimiser of E(β) over the sampled values; E values within 1 nm of the minimum
+        are round-off ties and the smallest (most rigid) of them is taken, so a flat E(β) gives
+        the rigid end β̂ = 0.
+    beta_std : float
+        Uncertainty of β̂ from the curve's shape: the standard deviation (width / √12) of the β
+        interval around β̂ where E(β) ≤ min E + ``config.error_tolerance_m``, at least
+        ``beta_resolution / √12``.
+    betas : (n,) float
+        Every β simulated, sorted (the uniform sweep plus the refinement).
+    errors : (n,) float, metres
+        E(β) at those β.
+    iterations : (n,) int
+    residual : (n,) float
+    converged : (n,) bool
+        Convergence of each β's simulation (see :class:`PokeSimulation`).
+    protocol : str
+        ``"force"`` or ``"pinned"``.
+    mode : str
+    stiffness_n_per_m : float or None
+        Calibrated spring stiffness of the force protocol.
+    """
+
+    beta: float
+    beta_std: float
+    betas: Array
+    errors: Array
+    iterations: NDArray[np.int64]
+    residual: Array
+    converged: NDArray[np.bool_]
+    protocol: str
+    mode: str
+    stiffness_n_per_m: float | None = None
+
+    @property
+    def all_converged(self) -> bool:
+        """Whether every simulated β reached the fixed-point tolerance."""
+        return bool(np.all(self.converged))
+
+
+def matching_error(positions: Array, tree: cKDTree) -> Array:
+    """E(β) = (1/K) Σ_i min_j ‖g_i(β) − x̄_j‖ for positions ``(B, ny, nx, 3)`` → ``(B,)`` metres."""
+    b = positions.shape[0]
+    d, _ = tree.query(positions.reshape(-1, 3), k=1)
+    return np.asarray(d.reshape(b, -1).mean(axis=1))
+
+
+def _refinement(betas: Array, errors: Array, step: float, resolution: float) -> Array:
+    """New β on a ``resolution`` grid within one sweep step of the current minimum."""
+    best = float(betas[int(np.argmin(errors))])
+    n = int(round(step / resolution))
+    cand = np.round(best + resolution * np.arange(-n, n + 1), 10)
+    cand = cand[(cand >= 0.0) & (cand < 1.0)]
+    return np.asarray([c for c in cand if np.min(np.abs(betas - c)) > 0.5 * resolution])
+
+
+def _beta_std(betas: Array, errors: Array, tol: float, resolution: float) -> float:
+    i = int(np.flatnonzero(errors <= errors.min() + _TIE_M)[0])
+    ok = errors <= errors[i] + tol
+    lo = hi = i
+    while lo > 0 and ok[lo - 1]:
+        lo -= 1
+    while hi < len(betas) - 1 and ok[hi + 1]:
+        hi += 1
+    return float(max(betas[hi] - betas[lo], resolution) / np.sqrt(12.0))
+
+
+def estimate_beta(rest_xs: Any, rest_ys: Any, rest_z: Any, deformed_points: Any,
+                  contact: TactileContact, config: ShapeMatchingConfig | None = None,
+                  ) -> BetaEstimate:
+    """Estimate β for one poke (Caccamo et al. 2016, Eq. for E(β)).
+
+    Parameters
+    ----------
+    rest_xs : (nx,) float, rest_ys : (ny,) float, rest_z : (ny, nx) float, metres
+        The ROI's heightmap before the poke (the surface GP's mean); its edges are held fixed.
+    deformed_points : (m, 3) float, metres
+        The observed deformed surface X̄ (e.g. the touch GP's mean on the ROI grid).
+    contact : TactileContact
+        The poke's tip position, force and tip radius.
+    config : ShapeMatchingConfig
+
+    Returns
+    -------
+    BetaEstimate
+
+    Notes
+    -----
+    E(β) is evaluated on a uniform sweep ``β_j = j / n_beta`` over ``[0, 1)``, all β in one
+    batched simulation, then (``refine``) on a ``beta_resolution`` grid within one sweep step of
+    the best β. Each particle's simulated position is its equilibrium position, which equals its
+    goal ``g_i(β)`` except on the particles that carry the tactile force.
+
+    References
+    ----------
+    Caccamo, S. et al. (2016). Active Perception and Modeling of Deformable Surfaces using Gaussian
+    Processes and Position-based Dynamics. IEEE-RAS Humanoids, §III-C.
+    """
+    cfg = _check_config(config)
+    grid = ParticleGrid.from_heightmap(rest_xs, rest_ys, rest_z)
+    observed = check_points("deformed_points", deformed_points, min_rows=1)
+    check_array("deformed_points", observed, (None, 3), what="points in metres")
+    tree = cKDTree(observed)
+    sweep = np.arange(cfg.n_beta) / cfg.n_beta
+    sims = [simulate_poke(grid.rest, grid.masses, grid.fixed, contact, sweep, cfg)]
+    betas, errors = sweep, matching_error(sims[0].positions, tree)
+    if cfg.refine and cfg.beta_resolution < 1.0 / cfg.n_beta:
+        extra = _refinement(betas, errors, 1.0 / cfg.n_beta, cfg.beta_resolution)
+        if extra.size:
+            sims.append(simulate_poke(grid.rest, grid.masses, grid.fixed, contact, extra, cfg))
+            betas = np.concatenate([betas, extra])
+            errors = np.concatenate([errors, matching_error(sims[-1].positions, tree)])
+    order = np.argsort(betas, kind="stable")
+    betas, errors = betas[order], errors[order]
+    its = np.concatenate([s.iterations for s in sims])[order]
+    res = np.concatenate([s.residual for s in sims])[order]
+    conv = np.concatenate([s.converged for s in sims])[order]
+    best = int(np.flatnonzero(errors <= errors.min() + _TIE_M)[0])
+    return BetaEstimate(
+        beta=float(betas[best]),
+        beta_std=_beta_std(betas, errors, cfg.error_tolerance_m, cfg.beta_resolution),
+        betas=betas, errors=errors, iterations=its, residual=res, converged=conv,
+        protocol=cfg.contact, mode=cfg.mode, stiffness_n_per_m=sims[0].stiffness_n_per_m,
+    )

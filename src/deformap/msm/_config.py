@@ -1,0 +1,100 @@
+"""Settings of the shape-matching simulator and the β sweep (one frozen dataclass)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from deformap._validation import check_in_range, check_int, check_positive
+from deformap.errors import InvalidArgumentError
+
+__all__ = ["ShapeMatchingConfig"]
+
+_MODES = ("rigid", "linear", "quadratic")
+_CONTACTS = ("force", "pinned")
+
+
+@dataclass(frozen=True, kw_only=True)
+class ShapeMatchingConfig:
+    """Settings of meshless shape matching and of the β estimation.
+
+    Parameters
+    ----------
+    mode : {"quadratic", "linear", "rigid"}
+        Müller et al. (2005) deformation mode of each cluster. ``"rigid"`` ignores β.
+    cluster_size : int
+        Side ``k`` of the overlapping ``k × k`` particle clusters (every ``k × k`` window of the
+        particle grid is a cluster); the paper's best value is 3.
+    contact : {"force", "pinned"}
+        How the poke enters the simulation. ``"pinned"`` is the paper's protocol: the particle
+        nearest the contact is held at its observed displaced position. ``"force"`` applies the
+        measured tactile force to the particles under the tip and lets the body find its static
+        equilibrium, so that the dent's *depth per newton* (what hardness changes) is simulated
+        instead of being copied from the observation. See :func:`~deformap.msm.simulate_poke`.
+    n_beta : int
+        Number of β values of the uniform sweep ``β_j = j / n_beta`` over ``[0, 1)``.
+    refine : bool
+        Refine around the sweep's minimum down to ``beta_resolution``.
+    beta_resolution : float
+        Step of the local refinement (dimensionless).
+    tol : float
+        Relative fixed-point tolerance: the iteration stops when the largest particle update is
+        below ``tol`` times the largest particle displacement from rest (or below ``tol`` times the
+        particle spacing when nothing moved).
+    max_iter : int
+        Iteration cap; a β that hits it is reported as not converged (never silently accepted).
+    regularization : float
+        Relative eigenvalue cut-off of the (linear 3×3 or quadratic 9×9) moment matrix of each
+        cluster, computed on features scaled by the cluster's RMS radius: directions whose moment
+        is below ``regularization × largest moment`` (e.g. the ``z`` direction of a flat patch, the
+        quadratic terms of a 3×3 cluster that its 9 particles cannot determine) are left out of the
+        fit (spectral truncation). The remaining directions are fitted exactly, which keeps the
+        rest shape an exact fixed point and affine (linear) / quadratic (quadratic mode)
+        deformations exactly reproduced at β = 1.
+    reference_modulus_pa : float, pascals
+        Force protocol only: the particle spring stiffness ``k`` (N/m) is calibrated per ROI so
+        that at β = 0 the simulated body dents, under the measured force and tip, as deep as an
+        elastic half-space of this Young's modulus (Hertz). 100 kPa lies an order of magnitude
+        above the stiffest polyurethane foams (about 20 kPa for a 250 N hardness) and below
+        rubbers, so β = 0 means "a stiff rubber-like body" and every foam maps inside (0, 1).
+    poisson_ratio : float
+        Poisson ratio of that reference half-space (0.5: nearly incompressible, like solid
+        rubber; the value only enters through ``E* = E / (1 − ν²)``).
+    error_tolerance_m : float, metres
+        Tolerance on E(β) that defines ``beta_std``: the β interval where E(β) stays within this
+        much of its minimum is the set of "equally good" β; its standard deviation (width / √12)
+        is reported. 0.1 mm is the order of the touch GP's mean error on a 0.5 cm grid.
+    """
+
+    mode: str = "quadratic"
+    cluster_size: int = 3
+    contact: str = "force"
+    n_beta: int = 50
+    refine: bool = True
+    beta_resolution: float = 0.01
+    tol: float = 1e-6
+    max_iter: int = 500
+    regularization: float = 1e-3
+    reference_modulus_pa: float = 100e3
+    poisson_ratio: float = 0.5
+    error_tolerance_m: float = 1e-4
+    layers: int = 3
+    layer_growth: float = 2.0
+
+    def __post_init__(self) -> None:
+        if self.mode not in _MODES:
+            raise InvalidArgumentError(f"`mode` must be one of {_MODES}; got {self.mode!r}")
+        if self.contact not in _CONTACTS:
+            raise InvalidArgumentError(
+                f"`contact` must be one of {_CONTACTS}; got {self.contact!r}"
+            )
+        check_int("cluster_size", self.cluster_size, minimum=2)
+        check_int("n_beta", self.n_beta, minimum=2)
+        check_int("max_iter", self.max_iter, minimum=1)
+        if not isinstance(self.refine, bool):
+            raise InvalidArgumentError(f"`refine` must be a bool; got {self.refine!r}")
+        check_in_range("beta_resolution", self.beta_resolution, 1e-6, 0.5, closed_high=True)
+        check_in_range("tol", self.tol, 1e-14, 1.0)
+        check_in_range("regularization", self.regularization, 0.0, 1.0)
+        check_positive("reference_modulus_pa", self.reference_modulus_pa)
+        check_in_range("poisson_ratio", self.poisson_ratio, -1.0, 0.5, closed_high=True)
+        check_positive("error_tolerance_m", self.error_tolerance_m)

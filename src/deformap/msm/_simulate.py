@@ -1,0 +1,212 @@
+"""Public entry points of the simulator: goals for given positions, and the poke equilibrium."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from deformap._validation import check_array
+from deformap.environment import TactileContact
+from deformap.errors import InvalidArgumentError
+from deformap.msm._clusters import Clusters
+from deformap.msm._config import ShapeMatchingConfig
+from deformap.msm._poke import (
+    Equilibrium,
+    PokeSimulation,
+    calibrate_stiffness,
+    force_weights,
+)
+
+__all__ = ["shape_matching_goals", "simulate_poke"]
+
+Array = NDArray[np.float64]
+
+
+def check_betas(betas: Any) -> Array:
+    """Validate a 1-D array of β values in ``[0, 1)``."""
+    arr = check_array("betas", np.atleast_1d(betas), (None,), what="β values", min_rows=1)
+    bad = (arr < 0.0) | (arr >= 1.0)
+    if np.any(bad):
+        raise InvalidArgumentError(f"`betas` must lie in [0, 1); got {arr[bad][:5]}")
+    return arr
+
+
+def _check_config(config: Any) -> ShapeMatchingConfig:
+    if config is None:
+        return ShapeMatchingConfig()
+    if not isinstance(config, ShapeMatchingConfig):
+        raise InvalidArgumentError(f"`config` must be a ShapeMatchingConfig; got {type(config)}")
+    return config
+
+
+def _check_rest(rest: Any, k: int) -> Array:
+    arr = check_array("rest", rest, (None, None, 3), what="particle positions in metres")
+    if arr.shape[0] < k or arr.shape[1] < k:
+        raise InvalidArgumentError(
+            f"`rest` must hold at least cluster_size × cluster_size = {k}×{k} particles; "
+            f"got a {arr.shape[0]}×{arr.shape[1]} grid"
+        )
+    return arr
+
+
+def shape_matching_goals(rest: Any, current: Any, betas: Any,
+                         config: ShapeMatchingConfig | None = None) -> Array:
+    """Müller's goal positions of every particle, batched over β.
+
+    Parameters
+    ----------
+    rest : (ny, nx, 3) float, metres
+        Rest positions ``p⁰`` on a grid (equal masses).
+    current : (B, ny, nx, 3) float, metres
+        Current positions, one configuration per β.
+    betas : (B,) float in [0, 1)
+    config : ShapeMatchingConfig
+        ``mode``, ``cluster_size`` and ``regularization`` are used.
+
+    Returns
+    -------
+    goals : (B, ny, nx, 3) float, metres
+        ``g_i = (1/M_i) Σ_{c∋i} [((1 − β) R_c + β A_c) s_i + t_c]`` over the ``M_i`` k×k clusters
+        holding particle ``i`` (``A_c`` the linear 3×3 or quadratic 3×9 fit, ``R_c`` its proper
+        rotation; ``R_c`` alone in rigid mode).
+
+    References
+    ----------
+    Müller et al. (2005), Eqs. 7–9 and §4.3; Caccamo et al. (2016), Eq. for ``g_i``.
+    """
+    cfg = _check_config(config)
+    p0 = _check_rest(rest, cfg.cluster_size)
+    b = check_betas(betas)
+    x = check_array("current", current, (b.size, *p0.shape), what="particle positions in metres")
+    masses = np.ones(p0.shape[:2])
+    k = cfg.cluster_size
+    cl = Clusters(p0, masses, (k, k), cfg.mode, cfg.regularization)
+    return cl.goals(x, b)
+
+
+def _check_contact(contact: Any, rest: Array, fixed: NDArray[np.bool_], spacing: float) -> int:
+    """Validate the contact and return the flat index of the particle nearest to it."""
+    if not isinstance(contact, TactileContact):
+        raise InvalidArgumentError(f"`contact` must be a TactileContact; got {type(contact)}")
+    cp = contact.contact_point
+    lo = rest[..., :2].reshape(-1, 2).min(axis=0) - spacing
+    hi = rest[..., :2].reshape(-1, 2).max(axis=0) + spacing
+    if np.any(cp[:2] < lo) or np.any(cp[:2] > hi):
+        raise InvalidArgumentError(
+            f"`contact` must press inside the ROI [{lo[0] + spacing:.4f}, {hi[0] - spacing:.4f}] × "
+            f"[{lo[1] + spacing:.4f}, {hi[1] - spacing:.4f}] m; got contact point xy "
+            f"({cp[0]:.4f}, {cp[1]:.4f})"
+        )
+    near = int(np.argmin(np.sum((rest[..., :2] - cp[:2]) ** 2, axis=-1)))
+    if fixed.ravel()[near]:
+        raise InvalidArgumentError(
+            "`contact` presses on the ROI's fixed edge (its nearest particle is held at rest); "
+            "centre the ROI on the contact"
+        )
+    return near
+
+
+def _rest_height_at(rest: Array, xy: Array) -> float:
+    """Bilinear interpolation of the rest heightmap at ``xy``."""
+    xs, ys = rest[0, :, 0], rest[:, 0, 1]
+    i = int(np.clip(np.searchsorted(ys, xy[1]) - 1, 0, ys.size - 2))
+    j = int(np.clip(np.searchsorted(xs, xy[0]) - 1, 0, xs.size - 2))
+    ty = float(np.clip((xy[1] - ys[i]) / (ys[i + 1] - ys[i]), 0.0, 1.0))
+    tx = float(np.clip((xy[0] - xs[j]) / (xs[j + 1] - xs[j]), 0.0, 1.0))
+    z = rest[i : i + 2, j : j + 2, 2]
+    return float((1 - ty) * ((1 - tx) * z[0, 0] + tx * z[0, 1])
+                 + ty * ((1 - tx) * z[1, 0] + tx * z[1, 1]))
+
+
+def simulate_poke(rest: Any, masses: Any, fixed: Any, contact: TactileContact, betas: Any,
+                  config: ShapeMatchingConfig | None = None) -> PokeSimulation:
+    """Converged static equilibrium of the shape-matching body under one poke, for every β.
+
+    Parameters
+    ----------
+    rest : (ny, nx, 3) float, metres
+        Rest positions (see :meth:`ParticleGrid.from_heightmap`); a regular grid in x and y.
+    masses : (ny, nx) float
+        Particle masses (only ratios within a cluster matter).
+    fixed : (ny, nx) bool
+        Particles held at rest (the ROI's edges).
+    contact : TactileContact
+        The measured tip position, force and tip radius.
+    betas : (B,) float in [0, 1)
+    config : ShapeMatchingConfig
+
+    Returns
+    -------
+    PokeSimulation
+
+    Notes
+    -----
+    ``contact="pinned"`` (Caccamo et al. 2016): the free particle nearest the contact point is held
+    at its rest position moved by the observed indentation (contact point minus the rest surface
+    under it); no force acts. ``contact="force"``: the force ``contact.force`` is shared by the
+    free particles under the tip (:func:`force_weights`) and each particle's spring to its goal
+    has the stiffness ``k`` calibrated so that the β = 0 body dents like an elastic half-space of
+    ``config.reference_modulus_pa`` (:func:`calibrate_stiffness`); softer surfaces need larger β.
+    Both solve the PBD steady state directly (see :mod:`deformap.msm._poke`).
+    """
+    cfg = _check_config(config)
+    p0 = _check_rest(rest, cfg.cluster_size)
+    m = check_array("masses", masses, p0.shape[:2], what="particle masses")
+    if np.any(m <= 0):
+        raise InvalidArgumentError(f"`masses` must be > 0; got minimum {m.min()}")
+    fx = np.asarray(fixed)
+    if fx.shape != p0.shape[:2] or fx.dtype != np.bool_:
+        raise InvalidArgumentError(
+            f"`fixed` must be a {p0.shape[:2]} bool array; got {np.asarray(fixed).dtype} "
+            f"array of shape {fx.shape}"
+        )
+    b = check_betas(betas)
+    spacing = float(np.mean(np.linalg.norm(np.diff(p0[..., :2], axis=1), axis=-1)))
+    near = _check_contact(contact, p0, fx, spacing)
+    body, body_m, body_fixed, window = _body(p0, m, fx, spacing, cfg)
+    cl = Clusters(body, body_m, window, cfg.mode, cfg.regularization)
+    flat = body.reshape(-1, 3)
+    top = np.zeros(body_fixed.shape, dtype=bool)
+    top[0] = True
+    if cfg.contact == "pinned":
+        pinned = body_fixed.ravel().copy()
+        pinned[near] = True  # the top layer comes first in the flat order
+        eq = Equilibrium(cl, pinned.reshape(body_fixed.shape), b)
+        x_fixed = flat[eq.fix].copy()
+        sink = contact.contact_point[2] - _rest_height_at(p0, contact.contact_point[:2])
+        x_fixed[np.searchsorted(eq.fix, near), 2] += sink
+        x, it, res, conv = eq.solve(x_fixed, np.zeros_like(flat), 1.0, cfg.tol, cfg.max_iter,
+                                    spacing)
+        return PokeSimulation(betas=b, positions=x[:, 0], iterations=it, residual=res,
+                              converged=conv, protocol="pinned")
+    weights = np.zeros(body_fixed.shape)
+    weights[0] = force_weights(p0, fx, contact, spacing)
+    x_fixed = flat[body_fixed.ravel()]
+    eq0 = Equilibrium(cl, body_fixed, np.zeros(1))
+    k = calibrate_stiffness(eq0, x_fixed, weights, contact, cfg, spacing)
+    eq = Equilibrium(cl, body_fixed, b)
+    force = weights.reshape(-1, 1) * contact.force[None, :]
+    x, it, res, conv = eq.solve(x_fixed, force, k, cfg.tol, cfg.max_iter, spacing)
+    return PokeSimulation(betas=b, positions=x[:, 0], iterations=it, residual=res,
+                          converged=conv, protocol="force", stiffness_n_per_m=k)
+
+
+def _body(p0: Array, masses: Array, fixed: NDArray[np.bool_], spacing: float,
+          cfg: ShapeMatchingConfig) -> tuple[Array, Array, NDArray[np.bool_], tuple[int, ...]]:
+    """The simulated body: the surface sheet, or the surface over layers down to a fixed floor."""
+    k = cfg.cluster_size
+    if cfg.layers == 0:
+        return p0[None], masses[None], fixed[None], (1, k, k)
+    ny, nx = fixed.shape
+    floor = 0.5 * min(float(np.ptp(p0[..., 0])), float(np.ptp(p0[..., 1])))
+    steps = spacing * cfg.layer_growth ** np.arange(cfg.layers)
+    depths = np.concatenate([[0.0], np.cumsum(steps)]) * (floor / np.sum(steps))
+    body = np.repeat(p0[None], depths.size, axis=0)
+    body[..., 2] -= depths[:, None, None]
+    thick = np.gradient(depths) if depths.size > 1 else np.ones(1)
+    body_m = masses[None] * thick[:, None, None] / spacing
+    body_fixed = np.repeat(fixed[None], depths.size, axis=0)
+    body_fixed[-1] = True
+    return body, body_m, body_fixed, (2, k, k)
