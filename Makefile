@@ -17,7 +17,7 @@ $(STAMP): pyproject.toml
 	touch $(STAMP)
 
 demo: $(STAMP)
-	$(VENV)/bin/deformap demo --out runs
+	$(VENV)/bin/deformap explore --scenario heterogeneous-60-110-rigid
 
 test: $(STAMP)
 	$(PY) -m pytest -q -p no:cacheprovider
@@ -26,6 +26,7 @@ bench: $(STAMP)
 	mkdir -p benchmarks/results
 	$(VENV)/bin/deformap bench speed --json benchmarks/results/speed.json
 	$(VENV)/bin/deformap bench world --json benchmarks/results/world.json
+	$(VENV)/bin/deformap bench io --json benchmarks/results/io.json
 
 lint: $(STAMP)
 	$(PY) -m pip install --quiet 'ruff>=0.5' 'mypy>=1.10'

@@ -2,9 +2,9 @@
 
 Run: PYTHONPATH=src python examples/msm_hardness_table.py
 
-The dents come from :func:`deformap.testing.elastic_dent` (linear-elastic half-space under a 1 cm-radius
-spherical tip, 0.5 N), never from shape matching. The ROI is 12 cm at 0.5 cm (25 × 25 particles),
-centred on the poke, as in the exploration loop.
+The dents come from :func:`deformap.testing.elastic_dent` (linear-elastic half-space under a
+1 cm-radius spherical tip, 0.5 N), never from shape matching. The ROI is 12 cm at 0.5 cm
+(25 × 25 particles), centred on the poke, as in the exploration loop.
 """
 
 from __future__ import annotations
@@ -49,7 +49,8 @@ def main() -> None:
     for protocol, layers in (("pinned", 0), ("pinned", 3), ("force", 0), ("force", 3)):
         for mode in ("linear", "quadratic"):
             print(f"\n## contact={protocol}, mode={mode}, layers={layers}")
-            print("| hardness N | dent mm | β̂ | β std | E(β̂) mm | E range mm | iters max | all conv | s |")
+            print("| hardness N | dent mm | β̂ | β std | E(β̂) mm | E range mm | iters max "
+                  "| all conv | s |")
             print("|---|---|---|---|---|---|---|---|---|")
             for h, depth, est, span, dt in table(protocol, mode, layers):
                 name = "rigid" if h is None else f"{h:.0f}"

@@ -29,10 +29,10 @@ def config_to_dict(obj: Any) -> Any:
         return {f.name: config_to_dict(getattr(obj, f.name)) for f in dataclasses.fields(obj)}
     if isinstance(obj, (list, tuple)):
         return [config_to_dict(v) for v in obj]
+    if hasattr(obj, "tolist") and callable(obj.tolist):  # numpy array or scalar
+        return obj.tolist()
     if isinstance(obj, dict):
         return {str(k): config_to_dict(v) for k, v in obj.items()}
-    if hasattr(obj, "item") and callable(obj.item):  # numpy scalar
-        return obj.item()
     return obj
 
 
@@ -66,7 +66,8 @@ def _convert(value: Any, hint: Any, where: str) -> Any:
             return tuple(_convert(v, args[0], f"{where}[{i}]") for i, v in enumerate(value))
         if len(value) != len(args):
             raise ConfigError(f"`{where}` must have {len(args)} entries; got {len(value)}")
-        return tuple(_convert(v, a, f"{where}[{i}]") for i, (v, a) in enumerate(zip(value, args)))
+        pairs = enumerate(zip(value, args, strict=True))
+        return tuple(_convert(v, a, f"{where}[{i}]") for i, (v, a) in pairs)
     if dataclasses.is_dataclass(hint):
         return config_from_dict(hint, value, where=where)  # type: ignore[arg-type]
     if hint is bool:
@@ -108,9 +109,7 @@ def config_from_dict(cls: type[T], data: Any, *, where: str = "config") -> T:
             f"`{where}` has unknown key(s) {unknown}; known keys are {sorted(fields)}"
         )
     hints = typing.get_type_hints(cls)
-    kwargs = {
-        name: _convert(value, hints[name], f"{where}.{name}") for name, value in data.items()
-    }
+    kwargs = {name: _convert(value, hints[name], f"{where}.{name}") for name, value in data.items()}
     try:
         return cls(**kwargs)
     except ConfigError:

@@ -8,15 +8,18 @@ from __future__ import annotations
 
 import logging
 import sys
+import time
 from collections.abc import Callable
 from functools import wraps
+from pathlib import Path
 from typing import Annotated, Any, TypeVar
 
+import numpy as np
 import typer
 from rich.console import Console
 
 from deformap import __version__
-from deformap.errors import DeformapError
+from deformap.errors import ConfigError, DeformapError
 
 __all__ = ["app", "main"]
 
@@ -60,7 +63,9 @@ def _version_callback(value: bool) -> None:
 def _root(
     version: Annotated[
         bool,
-        typer.Option("--version", callback=_version_callback, is_eager=True, help="Print the version."),
+        typer.Option(
+            "--version", callback=_version_callback, is_eager=True, help="Print the version."
+        ),
     ] = False,
     verbose: Annotated[bool, typer.Option("--verbose", "-v", help="Log progress details.")] = False,
 ) -> None:
@@ -68,6 +73,354 @@ def _root(
         level=logging.INFO if verbose else logging.WARNING,
         format="%(levelname)s %(name)s: %(message)s",
     )
+
+
+# ---- exploration commands ----
+config_app = typer.Typer(help="The run configuration (YAML).")
+app.add_typer(config_app, name="config")
+
+
+def _default_out(scenario: str, seed: int) -> Path:
+    stem = Path(scenario).stem if scenario.endswith((".yaml", ".yml")) else scenario
+    return Path("runs") / f"{stem}-s{seed}-{time.strftime('%Y%m%d-%H%M%S')}"
+
+
+def _progress_row(table: Any, poke: Any) -> None:
+    r = poke.record
+    t = r["timings"]
+    compute = sum(v for k, v in t.items() if k != "environment_s")
+    console.print(
+        f"  poke {r['index'] + 1:>2}  target ({r['target_xy'][0]:.3f}, {r['target_xy'][1]:.3f}) m"
+        f"  force {r['force_n']:.2f} N  β = {r['beta']:.3f} ± {r['beta_std']:.3f}"
+        f"  max var {r['max_variance_after']:.4f}"
+        f"  [dim](compute {compute:.2f} s, world {t.get('environment_s', 0.0):.2f} s)[/]",
+        highlight=False,
+    )
+
+
+def _summary(report: dict[str, Any], folder: Path) -> None:
+    from rich.table import Table
+
+    reg = report["regions"]
+    tau = "n/a (one region)" if reg["kendall_tau"] is None else f"{reg['kendall_tau']:.2f}"
+    table = Table(title=f"{report['scenario']} (seed {report['seed']})", show_header=False)
+    table.add_row("pokes", f"{report['n_pokes']} (stopped by {report['stop_reason']})")
+    table.add_row("max β variance", f"{report['max_variance']:.4f}")
+    table.add_row("regions found / true", f"{reg['found']} / {reg['true']}")
+    table.add_row("region accuracy", f"{reg['accuracy']:.3f}")
+    table.add_row("mean IoU", f"{reg['mean_iou']:.3f}")
+    table.add_row("Kendall τ (β vs softness)", tau)
+    t = report["timings"]
+    table.add_row(
+        "time",
+        f"{t['total_s'] + t['world_build_s']:.1f} s in all, world build "
+        f"{t['world_build_s']:.1f} s, compute per poke "
+        f"{max(t['per_poke_compute_s'], default=0):.2f} s at most",
+    )
+    table.add_row("results", str(folder))
+    console.print(table)
+
+
+@app.command("explore")
+@friendly_errors
+def explore_command(
+    scenario: Annotated[
+        str | None, typer.Option("--scenario", "-s", help="Built-in scenario name or YAML file.")
+    ] = None,
+    seed: Annotated[int | None, typer.Option(help="Seed of world noise and poke choice.")] = None,
+    out: Annotated[
+        Path | None, typer.Option(help="Run folder (default runs/<scenario>-s<seed>-<time>).")
+    ] = None,
+    strategy: Annotated[
+        str | None, typer.Option(help="paper | max-variance | min-max-variance.")
+    ] = None,
+    threshold: Annotated[
+        float | None, typer.Option(help="T_h: stop when max var(β) is below it.")
+    ] = None,
+    max_pokes: Annotated[int | None, typer.Option(help="Most pokes to make.")] = None,
+    config: Annotated[
+        Path | None, typer.Option(help="Run configuration YAML (see `config dump`).")
+    ] = None,
+    resume: Annotated[
+        Path | None, typer.Option(help="Continue the killed run in this folder.")
+    ] = None,
+    rerun: Annotated[
+        bool, typer.Option("--rerun", help="Also write run.rrd (extra `rerun`).")
+    ] = False,
+) -> None:
+    """Explore a simulated world: poke until the β-field is known, then cut it into regions."""
+    import dataclasses
+
+    from deformap.eval import RunConfig, load_run_config, run_experiment
+
+    if resume is not None:
+        if config is not None:
+            raise ConfigError("--resume reads the run's own config.yaml; do not pass --config too")
+        cfg = load_run_config(resume / "config.yaml")
+        folder = resume
+    else:
+        cfg = load_run_config(config)
+    overrides: dict[str, Any] = {}
+    if scenario is not None:
+        overrides["scenario"] = scenario
+    if seed is not None:
+        overrides["seed"] = seed
+    explore_over = {
+        k: v
+        for k, v in {"strategy": strategy, "threshold": threshold, "max_pokes": max_pokes}.items()
+        if v is not None
+    }
+    if explore_over:
+        overrides["exploration"] = dataclasses.replace(cfg.exploration, **explore_over)
+    if resume is not None and overrides:
+        changed = sorted(overrides)
+        if dataclasses.replace(cfg, **overrides) != cfg:
+            raise ConfigError(
+                f"cannot resume {str(resume)!r} with different settings ({', '.join(changed)}); "
+                "drop those options"
+            )
+    cfg = dataclasses.replace(cfg, **overrides) if overrides else cfg
+    if not isinstance(cfg, RunConfig):  # pragma: no cover - replace keeps the type
+        raise ConfigError("internal: bad configuration")
+    if resume is None:
+        folder = out if out is not None else _default_out(cfg.scenario, cfg.seed)
+    console.print(
+        f"[bold]deformap explore[/] {cfg.scenario} seed {cfg.seed} → {folder}", highlight=False
+    )
+    output = run_experiment(
+        cfg,
+        folder,
+        resume=resume is not None,
+        on_poke=lambda poke: _progress_row(None, poke),
+        rerun=rerun,
+    )
+    _summary(output.report, folder)
+
+
+@config_app.command("dump")
+@friendly_errors
+def config_dump(
+    out: Annotated[Path | None, typer.Option(help="Write to this file instead of stdout.")] = None,
+) -> None:
+    """Write the full default run configuration as YAML."""
+    from deformap._config import dump_yaml
+    from deformap.eval import RunConfig
+
+    text = dump_yaml(RunConfig(), out)
+    if out is None:
+        sys.stdout.write(text)
+    else:
+        console.print(f"wrote {out}")
+
+
+@bench_app.command("speed")
+@friendly_errors
+def bench_speed(
+    json_path: Annotated[
+        Path | None, typer.Option("--json", help="Also write the table as JSON.")
+    ] = None,
+    seed: Annotated[int, typer.Option(help="Seed of the synthetic data.")] = 0,
+    quick: Annotated[bool, typer.Option(help="Smaller sizes (a smoke run).")] = False,
+) -> None:
+    """Surface GP (exact vs grid) and the β sweep (batched vs per-β loop), same run."""
+    import json
+
+    from rich.table import Table
+
+    from deformap.eval._bench_gp import bench_surface_gp
+    from deformap.eval._bench_msm import bench_beta_sweep
+
+    rng = np.random.default_rng(seed)
+    sizes = (1000, 2000) if quick else (3000, 6000, 12000)
+    gp_rows = bench_surface_gp(sizes, rng=rng)
+    sweep = bench_beta_sweep(n_particles_side=20 if quick else 40, rng=rng)
+    table = Table(title="surface GP → mean and std on the 120×80 grid (σw 4 cm, σn 2 mm)")
+    for col in ("points", "exact [s]", "grid [s]", "speed-up", "max |Δmean| [µm]", "max Δstd [%]"):
+        table.add_column(col, justify="right")
+    for row in gp_rows:
+        table.add_row(
+            str(row["n_points"]),
+            f"{row['exact_s']:.3f}",
+            f"{row['grid_s']:.3f}",
+            f"{row['speedup']:.0f}×",
+            f"{row['max_mean_dev_m'] * 1e6:.2f}",
+            f"{row['max_rel_std_dev'] * 100:.3f}",
+        )
+    console.print(table)
+    table = Table(title="β estimation (converged, 3×3 clusters)")
+    for col in ("β values", "particles", "batched [s]", "per-β loop [s]", "speed-up"):
+        table.add_column(col, justify="right")
+    table.add_row(
+        str(sweep["n_beta"]),
+        str(sweep["n_particles"]),
+        f"{sweep['batched_s']:.3f}",
+        f"{sweep['loop_s']:.3f}",
+        f"{sweep['speedup']:.1f}×",
+    )
+    console.print(table)
+    if json_path is not None:
+        json_path.write_text(json.dumps({"surface_gp": gp_rows, "beta_sweep": sweep}, indent=2))
+        console.print(f"wrote {json_path}")
+
+
+study_app = typer.Typer(help="Studies on homogeneous simulated foams (the paper's Fig. 5).")
+app.add_typer(study_app, name="study")
+
+
+def _study_foams(seed: int, hardness: list[float] | None, coarse: bool) -> Any:
+    from deformap.eval import DEFAULT_HARDNESSES, collect_presses
+    from deformap.world import WorldConfig
+
+    foams = DEFAULT_HARDNESSES if not hardness else (*hardness, None)
+    world_config = WorldConfig.coarse() if coarse else WorldConfig()
+    return collect_presses(
+        foams,
+        world_config=world_config,
+        rng=np.random.default_rng(seed),
+        progress=lambda msg: console.print(f"  {msg}", highlight=False),
+    )
+
+
+@study_app.command("hardness")
+@friendly_errors
+def study_hardness(
+    out: Annotated[Path, typer.Option(help="Folder for hardness.png and hardness.json.")] = Path(
+        "runs/study-hardness"
+    ),
+    seed: Annotated[int, typer.Option(help="Seed of the worlds' noise.")] = 0,
+    hardness: Annotated[
+        list[float] | None, typer.Option(help="Foams in N (repeat); rigid is added.")
+    ] = None,
+    coarse: Annotated[bool, typer.Option(help="Coarse FEM mesh (quick look).")] = False,
+) -> None:
+    """β against hardness for each contact protocol (paper Fig. 5a)."""
+    import json
+
+    from rich.table import Table
+
+    from deformap.eval import hardness_study
+    from deformap.viz import plot_hardness_study
+
+    out.mkdir(parents=True, exist_ok=True)
+    study = hardness_study(_study_foams(seed, hardness, coarse))
+    (out / "hardness.json").write_text(json.dumps(study, indent=2))
+    plot_hardness_study(out / "hardness.png", study)
+    table = Table(title="β against hardness")
+    for col in ("protocol", "hardness [N]", "β", "β spread", "β uncertainty", "fit error [mm]"):
+        table.add_column(col, justify="right")
+    for r in study["rows"]:
+        h = "rigid" if r["hardness_n"] is None else f"{r['hardness_n']:g}"
+        table.add_row(
+            r["protocol"],
+            h,
+            f"{r['beta']:.3f}",
+            f"{r['beta_std']:.3f}",
+            f"{r['beta_estimate_std']:.3f}",
+            f"{r['fit_error_m'] * 1e3:.3f}",
+        )
+    console.print(table)
+    for name, ok in study["monotone"].items():
+        console.print(
+            f"  {name}: β {'strictly rises' if ok else 'does NOT strictly rise'} as hardness falls",
+            highlight=False,
+        )
+    console.print(f"wrote {out / 'hardness.json'} and {out / 'hardness.png'}")
+
+
+@study_app.command("cluster-size")
+@friendly_errors
+def study_cluster_size(
+    out: Annotated[Path, typer.Option(help="Folder for cluster-size.png and .json.")] = Path(
+        "runs/study-cluster-size"
+    ),
+    seed: Annotated[int, typer.Option(help="Seed of the worlds' noise.")] = 0,
+    coarse: Annotated[bool, typer.Option(help="Coarse FEM mesh (quick look).")] = False,
+) -> None:
+    """Fit error and β against cluster size 2×2 … 6×6 (paper Fig. 5b)."""
+    import json
+
+    from rich.table import Table
+
+    from deformap.eval import cluster_size_study
+    from deformap.viz import plot_cluster_size_study
+
+    out.mkdir(parents=True, exist_ok=True)
+    study = cluster_size_study(_study_foams(seed, [60.0, 110.0, 150.0], coarse))
+    (out / "cluster-size.json").write_text(json.dumps(study, indent=2))
+    plot_cluster_size_study(out / "cluster-size.png", study)
+    table = Table(title="fit error against cluster size")
+    for col in ("k×k", "hardness [N]", "β", "fit error [mm]"):
+        table.add_column(col, justify="right")
+    for r in study["rows"]:
+        h = "rigid" if r["hardness_n"] is None else f"{r['hardness_n']:g}"
+        table.add_row(
+            f"{r['cluster_size']}", h, f"{r['beta']:.3f}", f"{r['fit_error_m'] * 1e3:.3f}"
+        )
+    console.print(table)
+    console.print(f"wrote {out / 'cluster-size.json'} and {out / 'cluster-size.png'}")
+
+
+@app.command("reproduce")
+@friendly_errors
+def reproduce_command(
+    out: Annotated[
+        Path, typer.Option(help="Folder: one run per scenario, table.md, table.json.")
+    ] = Path("runs/reproduce"),
+    seed: Annotated[int, typer.Option(help="Seed of every run.")] = 0,
+    strategy: Annotated[
+        str, typer.Option(help="paper | max-variance | min-max-variance.")
+    ] = "paper",
+    config: Annotated[Path | None, typer.Option(help="Run configuration YAML.")] = None,
+) -> None:
+    """All six scenarios of the paper's Table I, beside the paper's numbers."""
+    import dataclasses
+
+    from deformap.eval import load_run_config, reproduce
+
+    base = load_run_config(config)
+    base = dataclasses.replace(
+        base, seed=seed, exploration=dataclasses.replace(base.exploration, strategy=strategy)
+    )
+
+    def show(row: dict[str, Any]) -> None:
+        tau = "–" if row["kendall_tau"] is None else f"{row['kendall_tau']:.2f}"
+        console.print(
+            f"  {row['scenario']:<28} pokes {row['pokes']:>2}  regions {row['regions_found']}/"
+            f"{row['regions_true']}  accuracy {row['accuracy']:.3f}  τ {tau}  {row['time_s']:.1f} s",
+            highlight=False,
+        )
+
+    result = reproduce(out, base=base, on_run=show)
+    console.print((out / "table.md").read_text())
+    console.print(f"wrote {out / 'table.md'} and {out / 'table.json'} ({len(result['rows'])} runs)")
+
+
+@bench_app.command("io")
+@friendly_errors
+def bench_io_command(
+    json_path: Annotated[
+        Path | None, typer.Option("--json", help="Also write the table as JSON.")
+    ] = None,
+    seed: Annotated[int, typer.Option(help="Seed of the synthetic cloud.")] = 0,
+) -> None:
+    """Reading a 300,000-point binary PCD and one PointCloud2 message of that size."""
+    import json
+
+    from rich.table import Table
+
+    from deformap.eval._bench_io import bench_io
+
+    row = bench_io(n_points=300_000, rng=np.random.default_rng(seed))
+    table = Table(title="reading 300,000 points (best of repeats; goal < 0.5 s each)")
+    table.add_column("what")
+    table.add_column("seconds", justify="right")
+    for key, value in row.items():
+        if isinstance(value, float) and key != "goal_s":
+            table.add_row(key, f"{value:.4f}")
+    console.print(table)
+    if json_path is not None:
+        json_path.write_text(json.dumps(row, indent=2))
+        console.print(f"wrote {json_path}")
 
 
 def main() -> None:
@@ -131,7 +484,8 @@ def bench_world_command(
         str | None, typer.Option("--json", help="Also write the numbers here.")
     ] = None,
     scenario: Annotated[str, typer.Option(help="Scenario name or YAML file.")] = (
-        "heterogeneous-60-110-rigid"),
+        "heterogeneous-60-110-rigid"
+    ),
     seed: Annotated[int, typer.Option(help="Seed of the noise.")] = 0,
     coarse: Annotated[bool, typer.Option(help="Coarse test mesh instead of the default.")] = False,
 ) -> None:

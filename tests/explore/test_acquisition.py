@@ -33,7 +33,9 @@ def test_max_variance_picks_the_peak_and_paper_stays_above_threshold() -> None:
         i = np.flatnonzero(np.all(cells == xy, axis=1))[0]
         assert variance[i] > 0.5
     assert len({tuple(p) for p in picks}) > 1  # random, not always the peak
-    again = [choose_target("paper", cells, variance, 0.5, np.random.default_rng(1)) for _ in range(1)]
+    again = [
+        choose_target("paper", cells, variance, 0.5, np.random.default_rng(1)) for _ in range(1)
+    ]
     np.testing.assert_array_equal(again[0], picks[0])
 
 
@@ -44,8 +46,14 @@ def test_min_max_variance_uses_the_look_ahead() -> None:
     def look_ahead(candidates: np.ndarray) -> np.ndarray:
         return np.linalg.norm(candidates - target, axis=1)
 
-    pick = choose_target("min-max-variance", cells, np.ones(len(cells)), 0.5,
-                         np.random.default_rng(0), look_ahead=look_ahead)
+    pick = choose_target(
+        "min-max-variance",
+        cells,
+        np.ones(len(cells)),
+        0.5,
+        np.random.default_rng(0),
+        look_ahead=look_ahead,
+    )
     np.testing.assert_allclose(pick, target)
     with pytest.raises(InvalidArgumentError, match="`look_ahead` is required"):
         choose_target("min-max-variance", cells, variance, 0.1, np.random.default_rng(0))

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+
 from deformap.testing import elastic_dent, hardness_to_modulus
 
 

@@ -1,4 +1,4 @@
-"""Invariants of Müller's goals: fixed points, rigid motions, exact reproduction, proper rotations."""
+"""Invariants of Müller's goals: fixed points, rigid motions, exact fits, proper rotations."""
 
 from __future__ import annotations
 
@@ -105,3 +105,16 @@ def test_polar_rotation_of_a_reflection_is_still_proper():
     a = np.diag([1.0, 1.0, -1.0])
     r = polar_rotation(a[None])[0]
     assert np.isclose(np.linalg.det(r), 1.0)
+
+
+def test_planar_cluster_shortcut_matches_the_svd_polar_rotation(rng):
+    n = 7
+    xs = np.arange(n) * 0.005
+    rest = ParticleGrid.from_heightmap(xs, xs, np.full((n, n), 0.05)).rest
+    cl = Clusters(rest, np.ones((n, n)), (3, 3), "quadratic", 1e-3)
+    assert cl.planar.all()
+    r = Rotation.random(3, random_state=7).as_matrix()
+    cur = np.einsum("bde,yxe->byxd", r, rest) + rng.normal(scale=1e-3, size=(3, *rest.shape))
+    apq = np.swapaxes(cl.gather(cur), -1, -2) @ cl.ws
+    np.testing.assert_allclose(cl.rotations(cl.gather(cur)), polar_rotation(apq.copy()),
+                               atol=1e-10)

@@ -62,7 +62,9 @@ def choose_target(
         How many above-threshold cells ``min-max-variance`` evaluates (a seeded subsample).
     """
     if strategy not in STRATEGIES:
-        raise InvalidArgumentError(f"`strategy` must be one of {list(STRATEGIES)}; got {strategy!r}")
+        raise InvalidArgumentError(
+            f"`strategy` must be one of {list(STRATEGIES)}; got {strategy!r}"
+        )
     above = np.flatnonzero(variance > threshold)
     if above.size == 0:
         return None

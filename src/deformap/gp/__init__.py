@@ -1,5 +1,23 @@
-"""gp (see DESIGN.md)."""
+"""Gaussian random fields: the paper's kernel, exact and grid-sparse GP regression, and
+hyperparameter fitting by maximum marginal likelihood.
+
+Shared parameters, in metres (or the units of the modelled value): ``length_scale`` σ_w and
+``signal_std`` σₑ of the kernel k = σₑ² exp(−‖xᵢ − xⱼ‖² / σ_w²) (no factor 2), and ``noise_std``
+σₙ of the observations.
+"""
 
 from __future__ import annotations
 
-__all__: list[str] = []
+from deformap.gp._field import AUTO_EXACT_MAX_POINTS, GaussianRandomField
+from deformap.gp._hyper import GPHyperparameters, fit_hyperparameters, log_marginal_likelihood
+from deformap.gp._kernels import grid_points, squared_exponential
+
+__all__ = [
+    "AUTO_EXACT_MAX_POINTS",
+    "GPHyperparameters",
+    "GaussianRandomField",
+    "fit_hyperparameters",
+    "grid_points",
+    "log_marginal_likelihood",
+    "squared_exponential",
+]

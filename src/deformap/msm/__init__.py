@@ -1,5 +1,22 @@
 """Meshless shape matching (Müller et al. 2005) and the β estimation of Caccamo et al. (2016).
 
+A poke is simulated for every β of a sweep at once, as the converged steady state of position-based
+shape matching (:func:`simulate_poke`), and β̂ minimises the paper's E(β), the mean distance from
+the simulated surface to the observed deformed one (:func:`estimate_beta`).
+
+Two protocols (``ShapeMatchingConfig.contact``):
+
+``"pinned"`` — the paper: the surface sheet, edges fixed, the particle nearest the contact pinned at
+its observed depth. Converged, it does not separate foams: with the depth imposed, the dent of an
+elastic foam is matched best by the most rigid sheet (β̂ = 0 for every hardness on Hertz dents),
+and E(β) changes by only 1–20 % across β.
+
+``"force"`` (default) — the measured tactile force acts on the particles under the tip, the body's
+spring stiffness is calibrated so that β = 0 dents like a 100 kPa elastic half-space, and the body
+is the surface over three layers of particles down to a fixed floor (a sheet fixed at its edges can
+only bend, and its dent is a cone as wide as the ROI). Softer foams dent deeper and need larger β:
+β̂ falls strictly with hardness, with interior minima, and a rigid surface gives β̂ = 0.
+
 References
 ----------
 Müller, M., Heidelberger, B., Teschner, M., Gross, M. (2005). Meshless deformations based on

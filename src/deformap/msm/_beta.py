@@ -10,7 +10,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.spatial import cKDTree
 
-from deformap._validation import check_array, check_points
+from deformap._validation import check_points
 from deformap.environment import TactileContact
 from deformap.msm._config import ShapeMatchingConfig
 from deformap.msm._grid import ParticleGrid
@@ -81,7 +81,7 @@ def matching_error(positions: Array, tree: cKDTree) -> Array:
 def _refinement(betas: Array, errors: Array, step: float, resolution: float) -> Array:
     """New β on a ``resolution`` grid within one sweep step of the current minimum."""
     best = float(betas[int(np.argmin(errors))])
-    n = int(round(step / resolution))
+    n = round(step / resolution)
     cand = np.round(best + resolution * np.arange(-n, n + 1), 10)
     cand = cand[(cand >= 0.0) & (cand < 1.0)]
     return np.asarray([c for c in cand if np.min(np.abs(betas - c)) > 0.5 * resolution])
@@ -132,7 +132,6 @@ def estimate_beta(rest_xs: Any, rest_ys: Any, rest_z: Any, deformed_points: Any,
     cfg = _check_config(config)
     grid = ParticleGrid.from_heightmap(rest_xs, rest_ys, rest_z)
     observed = check_points("deformed_points", deformed_points, min_rows=1)
-    check_array("deformed_points", observed, (None, 3), what="points in metres")
     tree = cKDTree(observed)
     sweep = np.arange(cfg.n_beta) / cfg.n_beta
     sims = [simulate_poke(grid.rest, grid.masses, grid.fixed, contact, sweep, cfg)]
@@ -140,7 +139,8 @@ def estimate_beta(rest_xs: Any, rest_ys: Any, rest_z: Any, deformed_points: Any,
     if cfg.refine and cfg.beta_resolution < 1.0 / cfg.n_beta:
         extra = _refinement(betas, errors, 1.0 / cfg.n_beta, cfg.beta_resolution)
         if extra.size:
-            sims.append(simulate_poke(grid.rest, grid.masses, grid.fixed, contact, extra, cfg))
+            sims.append(simulate_poke(grid.rest, grid.masses, grid.fixed, contact, extra, cfg,
+                                      stiffness_n_per_m=sims[0].stiffness_n_per_m))
             betas = np.concatenate([betas, extra])
             errors = np.concatenate([errors, matching_error(sims[-1].positions, tree)])
     order = np.argsort(betas, kind="stable")

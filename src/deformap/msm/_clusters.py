@@ -29,7 +29,7 @@ import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
 from numpy.typing import NDArray
 
-__all__ = ["Clusters", "polar_rotation"]
+__all__ = ["Clusters", "fast_polar_rotation", "polar_rotation"]
 
 Array = NDArray[np.float64]
 
@@ -39,12 +39,69 @@ def polar_rotation(a: Array) -> Array:
 
     Batched SVD ``A = U Σ Vᵀ``, ``R = U diag(1, 1, det(U Vᵀ)) Vᵀ``: always a proper rotation
     (det R = +1), also for the rank-2 ``A_pq`` of a flat cluster, where the missing direction is
-    completed as the cross product of the other two.
+    completed as the cross product of the other two, and for ``det A < 0`` (the rotation closest
+    to ``A``, Kabsch).
     """
     u, _, vt = np.linalg.svd(a)
     det = np.linalg.det(u @ vt)
     u[..., :, 2] *= np.where(det < 0.0, -1.0, 1.0)[..., None]
     return u @ vt
+
+
+def fast_polar_rotation(a: Array, *, tol: float = 1e-14, max_iter: int = 30) -> Array:
+    """``polar_rotation(a)`` by Higham's scaled Newton iteration where it is safe, SVD elsewhere.
+
+    ``X ← (γ X + X⁻ᵀ / γ) / 2`` with ``X⁻ᵀ = cof(X) / det X`` in closed form and Frobenius scaling
+    ``γ``; it converges quadratically to the polar factor when ``det A > 0``. Matrices with a
+    small or negative determinant (relative to ``‖A‖³``: flat, nearly singular or inverted
+    clusters) and any that are not converged get the SVD answer.
+
+    References
+    ----------
+    Higham, N. J. (1986). Computing the polar decomposition — with applications. SIAM J. Sci.
+    Stat. Comput. 7(4), 1160–1174.
+    """
+    shape = a.shape
+    x = a.reshape(-1, 3, 3)
+    norm = np.sqrt(np.sum(x * x, axis=(1, 2)))
+    x = x / np.maximum(norm, np.finfo(float).tiny)[:, None, None]
+    # component-major layout: nine contiguous 1-D arrays make the closed forms fast
+    m = np.ascontiguousarray(x.reshape(-1, 9).T)
+    a0, b0, c0, d0, e0, f0, g0, h0, i0 = m
+    det0 = a0 * (e0 * i0 - f0 * h0) - b0 * (d0 * i0 - f0 * g0) + c0 * (d0 * h0 - e0 * g0)
+    safe = det0 > 1e-9  # scaled Newton copes with any positive det; flat ones go to SVD
+    out = np.empty_like(x)
+    if not np.all(safe):
+        m = np.ascontiguousarray(m[:, safe])
+    ok = np.zeros(m.shape[1], dtype=bool)
+    for _ in range(max_iter):
+        inv_t = _inverse_transpose(m)
+        gamma = np.sqrt(np.sqrt(np.sum(inv_t * inv_t, axis=0) / np.sum(m * m, axis=0)))
+        new = 0.5 * (gamma * m + inv_t / gamma)
+        ok = np.max(np.abs(new - m), axis=0) < tol**0.5  # quadratic: the next step is < tol
+        m = new
+        if np.all(ok):
+            break
+    out[safe] = m.T.reshape(-1, 3, 3)
+    redo = ~safe
+    redo[np.flatnonzero(safe)[~ok]] = True
+    if np.any(redo):
+        out[redo] = polar_rotation(x[redo])
+    return out.reshape(shape)
+
+
+def _inverse_transpose(m: Array) -> Array:
+    """``X⁻ᵀ`` of ``(9, n)`` row-major 3×3 matrices: cofactor matrix over determinant."""
+    a, b, c, d, e, f, g, h, i = m
+    cof = np.stack([e * i - f * h, f * g - d * i, d * h - e * g,
+                    c * h - b * i, a * i - c * g, b * g - a * h,
+                    b * f - c * e, c * d - a * f, a * e - b * d])
+    det = a * cof[0] + b * cof[1] + c * cof[2]
+    return np.asarray(cof / det)
+
+
+def _cut(axis: int, start: int, stop: int) -> tuple[slice, ...]:
+    return (slice(None),) * axis + (slice(start, stop),)
 
 
 class Clusters:
@@ -71,6 +128,7 @@ class Clusters:
         self.n_clusters = int(np.prod(self.cshape))
         self.n_members = int(np.prod(self.window))
         self.rest = rest
+        self.masses = masses
         mw = self._windows(masses[None, ..., None])[0, ..., 0]  # (C, km)
         self.w = mw / mw.sum(axis=1, keepdims=True)
         p0 = self._windows(rest[None])[0]  # (C, km, 3)
@@ -81,6 +139,7 @@ class Clusters:
         ones = np.ones((1, self.n_clusters, self.n_members, 1))
         self.count = self.scatter(ones)[0, ..., 0]
         self.hat = None if mode == "rigid" else self._hat_matrices(regularization)
+        self._planar_frames()
 
     # -- window gather / scatter -------------------------------------------------------------
     def _windows(self, x: Array) -> Array:
@@ -103,8 +162,8 @@ class Clusters:
         out = np.zeros((b, *self.shape, d))
         nd = len(self.shape)
         for off in np.ndindex(*self.window):
-            dst = (slice(None),) + tuple(slice(o, o + c) for o, c in zip(off, self.cshape,
-                                                                          strict=True))
+            shifted = (slice(o, o + c) for o, c in zip(off, self.cshape, strict=True))
+            dst = (slice(None), *shifted)
             src = (slice(None),) + (slice(None),) * nd + off
             out[dst] += v[src]
         return out
@@ -123,7 +182,7 @@ class Clusters:
         return q, quad
 
     def _projection(self, q: Array, cutoff: Array) -> Array:
-        """``Π[i, j] = q_iᵀ A_qq⁺ q_j w_j`` with eigenvalues of ``A_qq`` below ``cutoff`` dropped."""
+        """``Π[i, j] = q_iᵀ A_qq⁺ q_j w_j``, dropping eigenvalues of ``A_qq`` below ``cutoff``."""
         aqq = np.einsum("cj,cjf,cjg->cfg", self.w, q, q)
         lam, vec = np.linalg.eigh(aqq)
         keep = lam > cutoff[:, None]
@@ -147,9 +206,96 @@ class Clusters:
             hat = hat + self._projection(quad - hat @ quad, cutoff)
         return hat
 
+    # -- separable box filters: the fast path of the solver -------------------------------------
+    def box_sum(self, field: Array) -> Array:
+        """Window sums ``(B, *cshape, d)`` of a particle field ``(B, *grid, d)`` (separable)."""
+        out = field
+        for axis, (w, c) in enumerate(zip(self.window, self.cshape, strict=True), start=1):
+            acc = out[_cut(axis, 0, c)].copy()
+            for o in range(1, w):
+                acc += out[_cut(axis, o, o + c)]
+            out = acc
+        return out
+
+    def box_spread(self, field: Array) -> Array:
+        """Transpose of :meth:`box_sum`: ``(B, *cshape, d)`` → particle sums ``(B, *grid, d)``."""
+        out = field
+        for axis, (w, c) in enumerate(zip(self.window, self.cshape, strict=True), start=1):
+            shape = list(out.shape)
+            shape[axis] = c + w - 1
+            acc = np.zeros(shape)
+            for o in range(w):
+                acc[_cut(axis, o, o + c)] += out
+            out = acc
+        return out
+
+    def _prepare_box(self) -> None:
+        # coordinates relative to the rest centroid keep Σ m x p⁰ᵀ − M t t⁰ᵀ free of cancellation
+        self._origin = self.rest.reshape(-1, 3).mean(axis=0)
+        p0 = (self.rest - self._origin).reshape(*self.shape, 3)
+        self._p0c = p0
+        self._mp0 = self.masses[..., None] * p0
+        self._mass_c = self.box_sum(self.masses[None, ..., None])[0]  # (*cshape, 1)
+        self._t0c = self.box_sum(self._mp0[None])[0] / self._mass_c  # (*cshape, 3)
+
+    def rotation_term(self, x: Array) -> Array:
+        """``(1/M_i) Σ_{c∋i} R_c s_i^c`` ``(B, *grid, 3)`` for positions ``x (B, *grid, 3)``.
+
+        The same quantity as gathering every cluster's members, without the ``(B, C, km, 3)``
+        arrays: ``A_pq = Σ m x p⁰ᵀ / M − t t⁰ᵀ`` from box sums of ``m x ⊗ p⁰`` and ``m x``, and
+        ``Σ_c R_c (p⁰_i − t⁰_c) = (Σ_c R_c) p⁰_i − Σ_c R_c t⁰_c`` from box spreads.
+        """
+        if not hasattr(self, "_p0c"):
+            self._prepare_box()
+        xm = (x - self._origin) * self.masses[None, ..., None]
+        b = x.shape[0]
+        field = np.empty((*xm.shape[:-1], 12))
+        for d in range(3):
+            field[..., 3 * d : 3 * d + 3] = xm[..., d : d + 1] * self._p0c[None]
+        field[..., 9:] = xm
+        sums = self.box_sum(field) / self._mass_c[None]
+        t = sums[..., 9:]
+        apq = sums[..., :9].reshape(*sums.shape[:-1], 3, 3) - t[..., :, None] * self._t0c[
+            None, ..., None, :]
+        rot = self._polar(apq.reshape(b, self.n_clusters, 3, 3)).reshape(apq.shape)
+        per_cluster = np.empty((b, *self.cshape, 12))
+        per_cluster[..., :9] = rot.reshape(b, *self.cshape, 9)
+        per_cluster[..., 9:] = np.einsum("...de,...e->...d", rot, self._t0c[None])
+        spread = self.box_spread(per_cluster)
+        total_r = spread[..., :9].reshape(b, *self.shape, 3, 3)
+        out = np.einsum("...de,...e->...d", total_r, self._p0c[None]) - spread[..., 9:]
+        return np.asarray(out / self.count[None, ..., None])
+
+    def _planar_frames(self) -> None:
+        """Rest normal ``n`` and in-plane axes ``u × v = n`` of the exactly planar clusters."""
+        aqq = np.einsum("cj,cjd,cje->cde", self.w, self.s, self.s)
+        lam, vec = np.linalg.eigh(aqq)
+        self.planar = lam[:, 0] <= 1e-12 * lam[:, 2]
+        self.normal = vec[:, :, 0]
+        self.u_axis = vec[:, :, 1]
+        self.v_axis = np.cross(self.normal, self.u_axis)
+
+    def _polar(self, apq: Array) -> Array:
+        """Polar rotations of ``(B, C, 3, 3)`` cluster matrices.
+
+        A planar cluster (normal ``n``) has ``A n = 0``; adding ``ĉ nᵀ ‖A‖`` with
+        ``c = (A u) × (A v)`` (= σ₁σ₂ R n) gives a full-rank matrix with the same polar rotation,
+        which the fast Newton iteration can take instead of an SVD.
+        """
+        if np.any(self.planar):
+            p = self.planar
+            a = apq[:, p]
+            c = np.cross(a @ self.u_axis[p][..., None], a @ self.v_axis[p][..., None], axis=-2)
+            norm_c = np.linalg.norm(c, axis=-2, keepdims=True)
+            scale = np.sqrt(np.sum(a * a, axis=(-2, -1)))[..., None, None]
+            c = c / np.maximum(norm_c, np.finfo(float).tiny) * scale
+            apq = apq.copy()
+            apq[:, p] = a + c * self.normal[p][:, None, :]
+        return fast_polar_rotation(apq)
+
     def rotations(self, xc: Array) -> Array:
         """``(B, C, 3, 3)`` rotations ``R = polar(A_pq)``, ``A_pq = Σ m r sᵀ`` of members ``xc``."""
-        return polar_rotation(np.swapaxes(xc, -1, -2) @ self.ws)
+        return self._polar(np.swapaxes(xc, -1, -2) @ self.ws)
 
     def cluster_goals(self, xc: Array, betas: Array) -> Array:
         """Goals ``g_i^c`` ``(B, C, km, 3)`` of members ``xc (B, C, km, 3)`` for ``betas (B,)``."""
@@ -163,6 +309,6 @@ class Clusters:
         return t[:, :, None, :] + (1.0 - beta) * rs + beta * fit
 
     def goals(self, x: Array, betas: Array) -> Array:
-        """Particle goals ``(B, *grid, 3)``: the mean of ``g_i^c`` over the clusters holding ``i``."""
+        """Particle goals ``(B, *grid, 3)``: the mean of ``g_i^c`` over the clusters of ``i``."""
         g = self.cluster_goals(self.gather(x), betas)
         return self.scatter(g) / self.count[None, ..., None]

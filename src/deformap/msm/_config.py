@@ -59,6 +59,19 @@ class ShapeMatchingConfig:
     poisson_ratio : float
         Poisson ratio of that reference half-space (0.5: nearly incompressible, like solid
         rubber; the value only enters through ``E* = E / (1 − ν²)``).
+    layers : int or None
+        The simulated body. ``0``: the surface sheet of particles of the paper (the ROI's
+        heightmap, edges fixed). ``L > 0``: the surface over ``L`` layers of particles below it
+        (the same grid in x and y, shifted down; layer spacings grow by ``layer_growth`` and sum
+        to half the ROI's smaller side), with the sides and the bottom layer fixed, and clusters
+        of ``2 × k × k`` particles spanning two adjacent layers. A dent in an elastic body is
+        carried by the material under it; a sheet fixed at its edges can only bend, and its dent
+        is a cone as wide as the ROI. ``None`` picks the protocol's default: 0 for ``"pinned"``
+        (the paper, faithfully) and 3 for ``"force"``. Half the ROI's side is the depth at which
+        the fixed floor is as far from the contact as the fixed sides.
+    layer_growth : float
+        Ratio of successive layer spacings (≥ 1): fine under the surface where strains are large,
+        coarse at depth.
     error_tolerance_m : float, metres
         Tolerance on E(β) that defines ``beta_std``: the β interval where E(β) stays within this
         much of its minimum is the set of "equally good" β; its standard deviation (width / √12)
@@ -77,8 +90,15 @@ class ShapeMatchingConfig:
     reference_modulus_pa: float = 100e3
     poisson_ratio: float = 0.5
     error_tolerance_m: float = 1e-4
-    layers: int = 3
+    layers: int | None = None
     layer_growth: float = 2.0
+
+    @property
+    def body_layers(self) -> int:
+        """Layers under the surface actually simulated (``layers``, or the protocol's default)."""
+        if self.layers is not None:
+            return int(self.layers)
+        return 0 if self.contact == "pinned" else 3
 
     def __post_init__(self) -> None:
         if self.mode not in _MODES:
@@ -98,3 +118,6 @@ class ShapeMatchingConfig:
         check_positive("reference_modulus_pa", self.reference_modulus_pa)
         check_in_range("poisson_ratio", self.poisson_ratio, -1.0, 0.5, closed_high=True)
         check_positive("error_tolerance_m", self.error_tolerance_m)
+        if self.layers is not None:
+            check_int("layers", self.layers, minimum=0)
+        check_in_range("layer_growth", self.layer_growth, 1.0, 10.0, closed_high=True)

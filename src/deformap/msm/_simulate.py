@@ -7,7 +7,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from deformap._validation import check_array
+from deformap._validation import check_array, check_positive
 from deformap.environment import TactileContact
 from deformap.errors import InvalidArgumentError
 from deformap.msm._clusters import Clusters
@@ -121,7 +121,8 @@ def _rest_height_at(rest: Array, xy: Array) -> float:
 
 
 def simulate_poke(rest: Any, masses: Any, fixed: Any, contact: TactileContact, betas: Any,
-                  config: ShapeMatchingConfig | None = None) -> PokeSimulation:
+                  config: ShapeMatchingConfig | None = None, *,
+                  stiffness_n_per_m: float | None = None) -> PokeSimulation:
     """Converged static equilibrium of the shape-matching body under one poke, for every β.
 
     Parameters
@@ -136,6 +137,9 @@ def simulate_poke(rest: Any, masses: Any, fixed: Any, contact: TactileContact, b
         The measured tip position, force and tip radius.
     betas : (B,) float in [0, 1)
     config : ShapeMatchingConfig
+    stiffness_n_per_m : float, optional
+        Force protocol: use this spring stiffness (e.g. the one a previous call calibrated for
+        the same ROI and contact) instead of calibrating it again.
 
     Returns
     -------
@@ -184,8 +188,11 @@ def simulate_poke(rest: Any, masses: Any, fixed: Any, contact: TactileContact, b
     weights = np.zeros(body_fixed.shape)
     weights[0] = force_weights(p0, fx, contact, spacing)
     x_fixed = flat[body_fixed.ravel()]
-    eq0 = Equilibrium(cl, body_fixed, np.zeros(1))
-    k = calibrate_stiffness(eq0, x_fixed, weights, contact, cfg, spacing)
+    if stiffness_n_per_m is None:
+        eq0 = Equilibrium(cl, body_fixed, np.zeros(1))
+        k = calibrate_stiffness(eq0, x_fixed, weights, contact, cfg, spacing)
+    else:
+        k = check_positive("stiffness_n_per_m", stiffness_n_per_m)
     eq = Equilibrium(cl, body_fixed, b)
     force = weights.reshape(-1, 1) * contact.force[None, :]
     x, it, res, conv = eq.solve(x_fixed, force, k, cfg.tol, cfg.max_iter, spacing)
@@ -197,11 +204,11 @@ def _body(p0: Array, masses: Array, fixed: NDArray[np.bool_], spacing: float,
           cfg: ShapeMatchingConfig) -> tuple[Array, Array, NDArray[np.bool_], tuple[int, ...]]:
     """The simulated body: the surface sheet, or the surface over layers down to a fixed floor."""
     k = cfg.cluster_size
-    if cfg.layers == 0:
+    layers = cfg.body_layers
+    if layers == 0:
         return p0[None], masses[None], fixed[None], (1, k, k)
-    ny, nx = fixed.shape
     floor = 0.5 * min(float(np.ptp(p0[..., 0])), float(np.ptp(p0[..., 1])))
-    steps = spacing * cfg.layer_growth ** np.arange(cfg.layers)
+    steps = spacing * cfg.layer_growth ** np.arange(layers)
     depths = np.concatenate([[0.0], np.cumsum(steps)]) * (floor / np.sum(steps))
     body = np.repeat(p0[None], depths.size, axis=0)
     body[..., 2] -= depths[:, None, None]

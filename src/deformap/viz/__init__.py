@@ -3,5 +3,15 @@
 from __future__ import annotations
 
 from deformap.viz._figures import plot_beta_curve, plot_map, plot_poke
+from deformap.viz._rerun import heightmap_mesh, record_run
+from deformap.viz._studies import plot_cluster_size_study, plot_hardness_study
 
-__all__ = ["plot_beta_curve", "plot_map", "plot_poke"]
+__all__ = [
+    "heightmap_mesh",
+    "plot_beta_curve",
+    "plot_cluster_size_study",
+    "plot_hardness_study",
+    "plot_map",
+    "plot_poke",
+    "record_run",
+]

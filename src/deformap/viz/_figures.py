@@ -14,9 +14,9 @@ from typing import Any
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-from numpy.typing import NDArray  # noqa: E402
+import matplotlib.pyplot as plt
+import numpy as np
+from numpy.typing import NDArray
 
 __all__ = ["plot_beta_curve", "plot_map", "plot_poke"]
 
@@ -143,8 +143,14 @@ def plot_poke(
     ax.set_title("ROI before (surface GP)")
     fig.colorbar(im, ax=ax, label="z [mm]")
     ax = axes[1]
-    sc = ax.scatter(roi_points[:, 0], roi_points[:, 1], c=roi_points[:, 2] * 1e3, s=4,
-                    vmin=lo * 1e3, vmax=hi * 1e3)
+    sc = ax.scatter(
+        roi_points[:, 0],
+        roi_points[:, 1],
+        c=roi_points[:, 2] * 1e3,
+        s=4,
+        vmin=lo * 1e3,
+        vmax=hi * 1e3,
+    )
     ax.plot(tactile[:, 0], tactile[:, 1], "r.", ms=6, label="tactile points")
     ax.set_xlim(ext[0], ext[1])
     ax.set_ylim(ext[2], ext[3])
@@ -159,8 +165,14 @@ def plot_poke(
     if simulated_z is not None:
         ax.plot(roi_xs * 1e2, simulated_z[mid] * 1e3, "r-", label="shape matching at β̂")
     near = np.abs(roi_points[:, 1] - roi_ys[mid]) < (roi_ys[1] - roi_ys[0])
-    ax.plot(roi_points[near, 0] * 1e2, roi_points[near, 2] * 1e3, ".", color="0.6", ms=3,
-            label="cloud points on the section")
+    ax.plot(
+        roi_points[near, 0] * 1e2,
+        roi_points[near, 2] * 1e3,
+        ".",
+        color="0.6",
+        ms=3,
+        label="cloud points on the section",
+    )
     ax.set_xlabel("x [cm]")
     ax.set_ylabel("z [mm]")
     ax.set_title("section through the contact")

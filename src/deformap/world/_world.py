@@ -297,8 +297,8 @@ class SimulatedWorld:
     def _press_rng(self, target: NDArray[np.float64], force: float, view: int
                    ) -> np.random.Generator:
         # Micrometres and micronewtons, shifted to be non-negative: SeedSequence takes naturals.
-        x, y = (int(round(v * 1e6)) + 2**40 for v in target)
-        return self._event_rng(1, x, y, int(round(force * 1e6)), view)
+        x, y = (round(v * 1e6) + 2**40 for v in target)
+        return self._event_rng(1, x, y, round(force * 1e6), view)
 
     def _capture(self, displacement: NDArray[np.float64], contact: TactileContact | None,
                  rng: np.random.Generator) -> PointCloud:

@@ -1,0 +1,220 @@
+"""One experiment on the simulated world: explore, score against ground truth, write the run folder.
+
+``runs/<name>/`` receives ``config.yaml`` (the effective configuration), ``journal.jsonl`` (each poke
+as it completes, for ``--resume``), ``report.json``, ``map.png`` and one ``poke-NN.png`` per poke.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from deformap import __version__
+from deformap._config import config_from_dict, config_to_dict, dump_yaml, load_yaml
+from deformap._validation import check_int
+from deformap.errors import ConfigError
+from deformap.eval._metrics import region_scores
+from deformap.explore import ExplorationConfig, ExplorationResult, Journal, PokeResult, explore
+from deformap.explore._journal import JOURNAL_NAME
+from deformap.world import SimulatedWorld, WorldConfig, load_scenario
+
+__all__ = ["RunConfig", "load_run_config", "run_experiment"]
+
+logger = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True, kw_only=True)
+class RunConfig:
+    """The whole configuration of a run: which world, which seed, and every component's settings."""
+
+    scenario: str = "heterogeneous-60-110-rigid"
+    seed: int = 0
+    world: WorldConfig = field(default_factory=WorldConfig)
+    exploration: ExplorationConfig = field(default_factory=ExplorationConfig)
+
+    def __post_init__(self) -> None:
+        check_int("seed", self.seed, minimum=0)
+
+
+def load_run_config(path: str | Path | None) -> RunConfig:
+    """Read a run configuration from YAML (missing keys keep their defaults)."""
+    if path is None:
+        return RunConfig()
+    return config_from_dict(RunConfig, load_yaml(path), where=Path(path).name)
+
+
+def _json_default(value: Any) -> Any:
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, np.generic):
+        return value.item()
+    raise TypeError(f"not JSON serialisable: {type(value)}")
+
+
+def _finite(value: float) -> float | None:
+    return None if value is None or not math.isfinite(value) else float(value)
+
+
+@dataclass
+class RunOutput:
+    """What :func:`run_experiment` returns: the report written and the live objects."""
+
+    report: dict[str, Any]
+    result: ExplorationResult
+    world: SimulatedWorld
+    folder: Path
+
+
+def _prepare_folder(out: Path, header: dict[str, Any], resume: bool) -> tuple[Journal, list]:
+    if resume:
+        if not (out / JOURNAL_NAME).exists():
+            raise ConfigError(f"cannot resume {str(out)!r}: it holds no {JOURNAL_NAME}")
+        journal, contents = Journal.resume(out, header)
+        if contents.broken_line is not None:
+            logger.warning(
+                "%s: the last journal line was cut mid-write and is dropped (%d complete pokes kept)",
+                out / JOURNAL_NAME,
+                len(contents.pokes),
+            )
+        return journal, contents.pokes
+    if out.exists() and any(out.iterdir()):
+        raise ConfigError(
+            f"output folder {str(out)!r} already holds a run; choose another --out or pass --resume"
+        )
+    out.mkdir(parents=True, exist_ok=True)
+    return Journal.create(out, header), []
+
+
+def run_experiment(
+    config: RunConfig,
+    out: str | Path,
+    *,
+    resume: bool = False,
+    figures: bool = True,
+    rerun: bool = False,
+    on_poke: Callable[[PokeResult], None] | None = None,
+) -> RunOutput:
+    """Explore the configured scenario, score the map against ground truth, write the folder."""
+    folder = Path(out)
+    scenario = load_scenario(config.scenario)
+    plain = config_to_dict(config)
+    header = {"deformap": __version__, "config": plain, "scenario": scenario.to_dict()}
+    journal, done = _prepare_folder(folder, header, resume)
+    dump_yaml(config, folder / "config.yaml")
+    world_seq, explore_seq = np.random.SeedSequence(config.seed).spawn(2)
+    t0 = time.perf_counter()
+    world = SimulatedWorld(scenario, config=config.world, rng=np.random.default_rng(world_seq))
+    world_s = time.perf_counter() - t0
+    result = explore(
+        world,
+        config.exploration,
+        rng=np.random.default_rng(explore_seq),
+        journal=journal,
+        done=done,
+        on_poke=on_poke,
+    )
+    report = build_report(config, result, world, world_build_s=world_s)
+    (folder / "report.json").write_text(json.dumps(report, indent=2, default=_json_default))
+    if figures:
+        write_figures(folder, result, world, config)
+    if rerun:
+        from deformap.viz import record_run
+
+        assert result.mapper.surface is not None
+        record_run(folder / "run.rrd", result, initial_points=result.mapper.surface.points)
+    return RunOutput(report=report, result=result, world=world, folder=folder)
+
+
+def build_report(
+    config: RunConfig, result: ExplorationResult, world: SimulatedWorld, *, world_build_s: float
+) -> dict[str, Any]:
+    """The ``report.json`` content (see DESIGN.md, "What done looks like")."""
+    mapper = result.mapper
+    beta, var = mapper.field()
+    regions = mapper.regions()
+    truth = world.ground_truth_labels(mapper.xs, mapper.ys)
+    hardness_grid = world.ground_truth_hardness(mapper.xs, mapper.ys)
+    hardness = {int(label): float(hardness_grid[truth == label][0]) for label in np.unique(truth)}
+    scores = region_scores(regions.labels, truth, beta, hardness)
+    pokes = [dict(p.record) for p in result.pokes]
+    per_poke_compute = [
+        sum(v for k, v in p["timings"].items() if k != "environment_s") for p in pokes
+    ]
+    return {
+        "deformap": __version__,
+        "scenario": config.scenario,
+        "seed": config.seed,
+        "config": config_to_dict(config),
+        "pokes": pokes,
+        "n_pokes": len(pokes),
+        "stop_reason": result.stop_reason,
+        "max_variance": float(var.max()),
+        "regions": {
+            **scores.to_dict(),
+            "levels": regions.levels.tolist(),
+            "class_betas": regions.class_betas.tolist(),
+        },
+        "true_regions": [
+            {"label": label, "hardness_n": _finite(h)} for label, h in sorted(hardness.items())
+        ],
+        "timings": {
+            **result.timings,
+            "world_build_s": world_build_s,
+            "per_poke_s": [
+                p["timings"].get("environment_s", 0.0) + c
+                for p, c in zip(pokes, per_poke_compute, strict=True)
+            ],
+            "per_poke_compute_s": per_poke_compute,
+        },
+    }
+
+
+def write_figures(
+    folder: Path, result: ExplorationResult, world: SimulatedWorld, config: RunConfig
+) -> None:
+    """``map.png`` and one ``poke-NN.png`` per poke processed in this session."""
+    from deformap.viz import plot_map, plot_poke
+
+    mapper = result.mapper
+    beta, var = mapper.field()
+    regions = mapper.regions()
+    contacts = np.array([p.xy for p in result.pokes])
+    plot_map(
+        folder / "map.png",
+        mapper.xs,
+        mapper.ys,
+        beta=beta,
+        variance=var,
+        contacts=contacts,
+        labels=regions.labels,
+        levels=regions.levels,
+        truth_hardness=world.ground_truth_hardness(mapper.xs, mapper.ys),
+        threshold=config.exploration.threshold,
+        title=f"{config.scenario} (seed {config.seed}): {len(contacts)} pokes",
+    )
+    for poke in result.pokes:
+        if poke.roi_xs is None:  # resumed from the journal: no arrays to draw
+            continue
+        r = poke.record
+        plot_poke(
+            folder / f"poke-{r['index'] + 1:02d}.png",
+            roi_xs=poke.roi_xs,
+            roi_ys=poke.roi_ys,
+            rest_z=poke.rest_z,
+            deformed_z=poke.deformed_z,
+            roi_points=poke.roi_points,
+            tactile=poke.tactile,
+            betas=np.asarray(r["betas"]),
+            errors=np.asarray(r["errors"]),
+            beta=r["beta"],
+            beta_std=r["beta_std"],
+            title=f"poke {r['index'] + 1} at ({r['contact_xy'][0]:.3f}, {r['contact_xy'][1]:.3f}) m",
+        )

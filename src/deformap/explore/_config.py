@@ -1,0 +1,143 @@
+"""Settings of the mapper and the exploration loop (one frozen dataclass per component).
+
+Defaults and why
+----------------
+Surface GP ("GPR world"): hyperparameters are fitted by maximum marginal likelihood on the first
+observation (a seeded subset of at most 2,000 points); the fixed values below are the starting
+point and the fallback. The map is read on the paper's 0.5 cm grid.
+
+Touch GP ("GPR-touch"): fitted on a square ROI of the cloud seen while pressing plus the 10 tactile
+points. ROI 12 cm: the dent of a 1 cm tip under about a newton spreads over a few centimetres on
+foam 5 cm thick, and the edges of the ROI must be undisturbed because shape matching fixes them.
+By default the touch GP models the *change* of height against the surface GP's mean before the poke
+(``model="residual"``): far from the dent it reverts to "no change" instead of to a constant, which
+the occlusion by stick and hand would otherwise bias. ``model="height"`` is the paper's literal form.
+Its length scale (1 cm) is the tip's radius: the dent cannot vary faster than the body pressing it.
+
+β-field ("GPR β-field"): prior standard deviation 0.3 (variance 0.09, above the paper's threshold
+0.06 so that the unexplored map asks for a poke); length scale 0.15 m, the size of the regions a
+robot is asked to separate on a 60×40 cm table (a quarter of its width); each poke's β uncertainty is
+its noise, with a floor of 0.03.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Literal
+
+from deformap._validation import check_int, check_positive, check_vector
+from deformap.errors import InvalidArgumentError
+from deformap.explore._acquisition import STRATEGIES
+from deformap.msm import ShapeMatchingConfig
+
+__all__ = [
+    "BetaFieldConfig",
+    "ExplorationConfig",
+    "SurfaceGPConfig",
+    "TouchGPConfig",
+]
+
+
+@dataclass(frozen=True, kw_only=True)
+class SurfaceGPConfig:
+    """Crop, outlier filter and the surface Gaussian random field."""
+
+    z_min_m: float = -0.02
+    z_max_m: float = 0.30
+    outlier_k: int = 20
+    outlier_std_ratio: float = 2.0
+    fit_hyperparameters: bool = True
+    max_fit_points: int = 2000
+    length_scale_m: float = 0.04
+    signal_std_m: float = 0.03
+    noise_std_m: float = 0.002
+    grid_spacing_m: float = 0.005
+
+    def __post_init__(self) -> None:
+        if self.z_max_m <= self.z_min_m:
+            raise InvalidArgumentError(
+                f"`z_max_m` must exceed `z_min_m`; got {self.z_min_m} and {self.z_max_m}"
+            )
+        check_int("outlier_k", self.outlier_k, minimum=2)
+        check_positive("outlier_std_ratio", self.outlier_std_ratio)
+        check_int("max_fit_points", self.max_fit_points, minimum=50)
+        for name in ("length_scale_m", "signal_std_m", "noise_std_m", "grid_spacing_m"):
+            check_positive(name, getattr(self, name))
+
+
+@dataclass(frozen=True, kw_only=True)
+class TouchGPConfig:
+    """The ROI around a poke and the Gaussian random field that reconstructs its dent."""
+
+    roi_size_m: float = 0.12
+    model: Literal["residual", "height"] = "residual"
+    n_tactile: int = 10
+    tactile_noise_std_m: float = 0.0005
+    length_scale_m: float = 0.01
+    signal_std_m: float = 0.01
+    noise_std_m: float = 0.002
+
+    def __post_init__(self) -> None:
+        check_positive("roi_size_m", self.roi_size_m)
+        check_int("n_tactile", self.n_tactile, minimum=1)
+        for name in ("tactile_noise_std_m", "length_scale_m", "signal_std_m", "noise_std_m"):
+            check_positive(name, getattr(self, name))
+
+
+@dataclass(frozen=True, kw_only=True)
+class BetaFieldConfig:
+    """Prior of the β-field Gaussian random field (the paper's σe, σw, σn)."""
+
+    signal_std: float = 0.3
+    length_scale_m: float = 0.15
+    noise_floor: float = 0.03
+
+    def __post_init__(self) -> None:
+        for name in ("signal_std", "length_scale_m", "noise_floor"):
+            check_positive(name, getattr(self, name))
+
+
+@dataclass(frozen=True, kw_only=True)
+class ExplorationConfig:
+    """Everything the mapper and the loop need; written next to every result.
+
+    Parameters
+    ----------
+    threshold : float
+        ``T_h``: stop when the β-field's largest variance on the grid falls below it (paper: 0.06).
+    max_pokes : int
+        Hard limit on the number of pokes.
+    strategy : {"paper", "max-variance", "min-max-variance"}
+        How the next target is chosen (see :mod:`deformap.explore._acquisition`).
+    first_target : (2,) float or None
+        The first poke, in metres; ``None`` means the workspace centre.
+    force_n : float
+        The commanded normal force of every press. 0.6 N keeps the Hertz contact of a 1 cm tip
+        on the tip itself for foams down to 60 N (``F <= 4 E* R² / 3`` = 0.68 N) while denting
+        them by 4–7 mm, well above the camera's noise.
+    region_z : float
+        Separation, in standard deviations, that splits two pokes into different regions.
+    """
+
+    threshold: float = 0.06
+    max_pokes: int = 12
+    strategy: Literal["paper", "max-variance", "min-max-variance"] = "paper"
+    first_target: tuple[float, float] | None = None
+    force_n: float = 0.6
+    region_z: float = 3.0
+    surface: SurfaceGPConfig = field(default_factory=SurfaceGPConfig)
+    touch: TouchGPConfig = field(default_factory=TouchGPConfig)
+    beta_field: BetaFieldConfig = field(default_factory=BetaFieldConfig)
+    shape_matching: ShapeMatchingConfig = field(default_factory=ShapeMatchingConfig)
+
+    def __post_init__(self) -> None:
+        check_positive("threshold", self.threshold)
+        check_int("max_pokes", self.max_pokes, minimum=1)
+        if self.strategy not in STRATEGIES:
+            raise InvalidArgumentError(
+                f"`strategy` must be one of {list(STRATEGIES)}; got {self.strategy!r}"
+            )
+        if self.first_target is not None:
+            check_vector("first_target", self.first_target, 2, what="metres")
+        check_positive("force_n", self.force_n)
+        check_positive("region_z", self.region_z)

@@ -1,0 +1,297 @@
+"""The mapper: surface GP and β-field state, updated one poke at a time.
+
+The live loop (:mod:`deformap.explore._loop`) and a recorded session (:mod:`deformap.replay`) feed
+the same mapper, so a poke gives the same β whichever way it arrives.
+
+References
+----------
+Caccamo et al. (2016), Sec. III-D (the process flow this class follows).
+Rasmussen, C. E., Williams, C. K. I. (2006). Gaussian Processes for Machine Learning, Eq. 2.24.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from deformap.cloud import (
+    PointCloud,
+    crop_box,
+    points_in_hull,
+    statistical_outlier_mask,
+    tactile_points,
+)
+from deformap.environment import PressObservation, TactileContact, Workspace
+from deformap.errors import EnvironmentStateError, InvalidArgumentError
+from deformap.explore._acquisition import choose_target
+from deformap.explore._config import ExplorationConfig
+from deformap.explore._regions import RegionMap, segment_regions
+from deformap.gp import (
+    GaussianRandomField,
+    GPHyperparameters,
+    fit_hyperparameters,
+    squared_exponential,
+)
+from deformap.msm import BetaEstimate, estimate_beta
+
+__all__ = ["Mapper", "PokeResult", "SurfaceModel"]
+
+logger = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class SurfaceModel:
+    """The surface GP ("GPR world") and its heightmap on the workspace grid."""
+
+    gp: GaussianRandomField
+    hyperparameters: GPHyperparameters
+    height: NDArray[np.float64]  # (ny, nx)
+    height_std: NDArray[np.float64]  # (ny, nx)
+    n_raw: int
+    points: NDArray[np.float64]  # (n, 3) the cropped, outlier-filtered cloud the GP was fitted to
+
+
+@dataclass
+class PokeResult:
+    """One processed poke: its record for the journal and the arrays for its figure."""
+
+    record: dict[str, Any]
+    roi_xs: NDArray[np.float64] | None = None
+    roi_ys: NDArray[np.float64] | None = None
+    rest_z: NDArray[np.float64] | None = None
+    deformed_z: NDArray[np.float64] | None = None
+    roi_points: NDArray[np.float64] | None = None
+    tactile: NDArray[np.float64] | None = None
+    estimate: BetaEstimate | None = None
+    extra: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def xy(self) -> NDArray[np.float64]:
+        return np.asarray(self.record["contact_xy"], dtype=float)
+
+
+def _contact_record(contact: TactileContact) -> dict[str, Any]:
+    return {
+        "tip_center": contact.tip_center.tolist(),
+        "force": contact.force.tolist(),
+        "tip_radius_m": contact.tip_radius_m,
+    }
+
+
+class Mapper:
+    """State of one exploration: the surface model and the β-field over the poked places.
+
+    Parameters
+    ----------
+    workspace : Workspace
+        The rectangle to map; its 0.5 cm grid carries every map.
+    config : ExplorationConfig
+        Settings of every stage.
+    """
+
+    def __init__(self, workspace: Workspace, config: ExplorationConfig) -> None:
+        self.workspace = workspace
+        self.config = config
+        self.xs, self.ys = workspace.grid(config.surface.grid_spacing_m)
+        gx, gy = np.meshgrid(self.xs, self.ys)
+        self.cells_xy = np.column_stack([gx.ravel(), gy.ravel()])
+        self.surface: SurfaceModel | None = None
+        self.pokes: list[PokeResult] = []
+        self._field: GaussianRandomField | None = None
+
+    # -- the surface ---------------------------------------------------------------------------
+    def initialise(self, cloud: PointCloud, rng: np.random.Generator) -> SurfaceModel:
+        """Crop and filter the first observation and fit the surface GP to it."""
+        cfg = self.config.surface
+        pts = self._crop(cloud.points, margin=0.0)
+        if pts.shape[0] <= cfg.outlier_k:
+            raise InvalidArgumentError(
+                f"`cloud` must have more than {cfg.outlier_k} points on the workspace; "
+                f"got {pts.shape[0]} (is it in the world frame, in metres?)"
+            )
+        kept = pts[statistical_outlier_mask(pts, cfg.outlier_k, cfg.outlier_std_ratio)]
+        init = GPHyperparameters(
+            length_scale=cfg.length_scale_m,
+            signal_std=cfg.signal_std_m,
+            noise_std=cfg.noise_std_m,
+            log_marginal_likelihood=float("nan"),
+        )
+        hyper = init
+        if cfg.fit_hyperparameters:
+            hyper = fit_hyperparameters(
+                kept[:, :2], kept[:, 2], rng=rng, init=init, max_points=cfg.max_fit_points
+            )
+        gp = GaussianRandomField(
+            length_scale=hyper.length_scale,
+            signal_std=hyper.signal_std,
+            noise_std=hyper.noise_std,
+        ).fit(kept[:, :2], kept[:, 2])
+        height, std = gp.predict_grid(self.xs, self.ys, return_std=True)
+        self.surface = SurfaceModel(gp, hyper, height, std, cloud.points.shape[0], kept)
+        logger.info("surface GP: %d of %d points kept, %s", kept.shape[0], len(cloud), hyper)
+        return self.surface
+
+    def _crop(self, points: NDArray[np.float64], margin: float) -> NDArray[np.float64]:
+        cfg = self.config.surface
+        lo = [self.workspace.lower[0] - margin, self.workspace.lower[1] - margin, cfg.z_min_m]
+        hi = [self.workspace.upper[0] + margin, self.workspace.upper[1] + margin, cfg.z_max_m]
+        return points[crop_box(points, lo, hi)]
+
+    # -- one poke ------------------------------------------------------------------------------
+    def roi_grid(self, center_xy: NDArray[np.float64]) -> tuple[NDArray, NDArray]:
+        """Node coordinates of the square ROI (odd count, so the centre is a node)."""
+        spacing = self.config.surface.grid_spacing_m
+        half = round(self.config.touch.roi_size_m / spacing / 2)
+        offsets = np.arange(-half, half + 1) * spacing
+        return center_xy[0] + offsets, center_xy[1] + offsets
+
+    def process_press(self, obs: PressObservation, index: int) -> PokeResult:
+        """Reconstruct the dent of one press and estimate its β (the β-field is not touched)."""
+        if self.surface is None:
+            raise EnvironmentStateError("the mapper needs `initialise(cloud)` before a poke")
+        t0 = time.perf_counter()
+        cfg = self.config.touch
+        contact = obs.contact
+        center = contact.contact_point[:2]
+        roi_xs, roi_ys = self.roi_grid(center)
+        pts = obs.cloud.points
+        pts = pts[~points_in_hull(pts, obs.robot_points)]
+        half = cfg.roi_size_m / 2
+        lo = [center[0] - half, center[1] - half, self.config.surface.z_min_m]
+        hi = [center[0] + half, center[1] + half, self.config.surface.z_max_m]
+        roi = pts[crop_box(pts, lo, hi)]
+        tactile = tactile_points(
+            contact.tip_center, contact.force, contact.tip_radius_m, n=cfg.n_tactile
+        )
+        t1 = time.perf_counter()
+        rest_z = self.surface.gp.predict_grid(roi_xs, roi_ys)
+        data = np.vstack([roi, tactile])
+        noise = np.concatenate(
+            [np.full(len(roi), cfg.noise_std_m), np.full(len(tactile), cfg.tactile_noise_std_m)]
+        )
+        target = data[:, 2]
+        if cfg.model == "residual":
+            target = target - self.surface.gp.predict(data[:, :2])
+        touch = GaussianRandomField(
+            length_scale=cfg.length_scale_m,
+            signal_std=cfg.signal_std_m,
+            noise_std=cfg.noise_std_m,
+            method="auto",
+        ).fit(data[:, :2], target, noise_std=noise)
+        deformed_z = touch.predict_grid(roi_xs, roi_ys)
+        if cfg.model == "residual":
+            deformed_z = deformed_z + rest_z
+        gx, gy = np.meshgrid(roi_xs, roi_ys)
+        deformed = np.column_stack([gx.ravel(), gy.ravel(), deformed_z.ravel()])
+        t2 = time.perf_counter()
+        est = estimate_beta(roi_xs, roi_ys, rest_z, deformed, contact, self.config.shape_matching)
+        t3 = time.perf_counter()
+        record = {
+            "index": index,
+            "target_xy": obs.target_xy.tolist(),
+            "contact_xy": center.tolist(),
+            "contact": _contact_record(contact),
+            "force_n": obs.force_n,
+            "beta": float(est.beta),
+            "beta_std": float(est.beta_std),
+            "betas": np.asarray(est.betas).tolist(),
+            "errors": np.asarray(est.errors).tolist(),
+            "iterations": int(np.max(est.iterations)),
+            "residual": float(np.max(est.residual)),
+            "converged": bool(np.all(est.converged)),
+            "n_roi_points": len(roi),
+            "timings": {
+                "filter_s": t1 - t0,
+                "touch_gp_s": t2 - t1,
+                "beta_s": t3 - t2,
+            },
+        }
+        return PokeResult(record, roi_xs, roi_ys, rest_z, deformed_z, roi, tactile, est)
+
+    def add(self, poke: PokeResult) -> None:
+        """Add a processed (or journalled) poke to the β-field."""
+        t0 = time.perf_counter()
+        self.pokes.append(poke)
+        self._field = self._fit_field(len(self.pokes))
+        poke.record["max_variance_after"] = float(self.field()[1].max())
+        poke.record.setdefault("timings", {})["field_s"] = time.perf_counter() - t0
+
+    # -- the β-field ---------------------------------------------------------------------------
+    def field(self, upto: int | None = None) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """β-field mean and variance on the workspace grid, each ``(ny, nx)``.
+
+        ``upto`` gives the field as it was after that many pokes (for recordings and figures).
+        """
+        gp = self._field if upto is None or upto == len(self.pokes) else self._fit_field(upto)
+        if gp is None:
+            prior = self.config.beta_field.signal_std**2
+            shape = (self.ys.size, self.xs.size)
+            return np.full(shape, np.nan), np.full(shape, prior)
+        mean, std = gp.predict_grid(self.xs, self.ys, return_std=True)
+        return mean, std**2
+
+    def _fit_field(self, upto: int) -> GaussianRandomField | None:
+        if upto == 0:
+            return None
+        cfg = self.config.beta_field
+        pokes = self.pokes[:upto]
+        xy = np.array([p.xy for p in pokes])
+        beta = np.array([p.record["beta"] for p in pokes])
+        noise = np.maximum([p.record["beta_std"] for p in pokes], cfg.noise_floor)
+        return GaussianRandomField(
+            length_scale=cfg.length_scale_m,
+            signal_std=cfg.signal_std,
+            noise_std=cfg.noise_floor,
+            method="exact",
+        ).fit(xy, beta, noise_std=noise)
+
+    def next_target(self, rng: np.random.Generator) -> NDArray[np.float64] | None:
+        """The next target by the configured strategy, or ``None`` when the map is known."""
+        _, var = self.field()
+        return choose_target(
+            self.config.strategy,
+            self.cells_xy,
+            var.ravel(),
+            self.config.threshold,
+            rng,
+            look_ahead=self._max_variance_after,
+        )
+
+    def _max_variance_after(self, candidates: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Largest posterior variance over the grid if each candidate were poked next.
+
+        Exact rank-one update of the posterior (the variance does not depend on the β that the
+        poke will give); the new poke's noise is taken at the floor.
+        """
+        cfg = self.config.beta_field
+        kern = {"length_scale": cfg.length_scale_m, "signal_std": cfg.signal_std}
+        cells = self.cells_xy
+        k_cc = squared_exponential(cells, candidates, **kern)
+        var_cells = np.full(len(cells), cfg.signal_std**2)
+        var_cand = np.full(len(candidates), cfg.signal_std**2)
+        if self.pokes:
+            xy = np.array([p.xy for p in self.pokes])
+            noise = np.maximum([p.record["beta_std"] for p in self.pokes], cfg.noise_floor)
+            gram = squared_exponential(xy, xy, **kern) + np.diag(noise**2)
+            chol = np.linalg.cholesky(gram)
+            v_cells = np.linalg.solve(chol, squared_exponential(xy, cells, **kern))
+            v_cand = np.linalg.solve(chol, squared_exponential(xy, candidates, **kern))
+            k_cc = k_cc - v_cells.T @ v_cand
+            var_cells = var_cells - np.sum(v_cells**2, axis=0)
+            var_cand = var_cand - np.sum(v_cand**2, axis=0)
+        after = var_cells[:, None] - k_cc**2 / (var_cand + cfg.noise_floor**2)[None, :]
+        return np.asarray(after.max(axis=0))
+
+    def regions(self) -> RegionMap:
+        """Cut the current β-field into regions (see :mod:`deformap.explore._regions`)."""
+        if self._field is None:
+            raise EnvironmentStateError("no poke yet: the β-field has no regions")
+        mean, _ = self.field()
+        xy = np.array([p.xy for p in self.pokes])
+        poke_mean, poke_std = self._field.predict(xy, return_std=True)
+        return segment_regions(mean, poke_mean, poke_std, z=self.config.region_z)

@@ -1,0 +1,65 @@
+"""`deformap explore` and `deformap config dump`: bad input is one line, never a traceback."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+import yaml
+from typer.testing import CliRunner
+
+from deformap.cli import app
+
+runner = CliRunner()
+
+
+def _error_line(result) -> str:  # type: ignore[no-untyped-def]
+    assert result.exit_code == 2, result.output
+    assert "Traceback" not in result.output
+    lines = [line for line in result.output.strip().splitlines() if line.strip()]
+    return " ".join(lines)
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["--scenario", "no-such-world"], "no-such-world"),
+        (["--threshold", "0"], "`threshold` must be > 0"),
+        (["--threshold", "-1"], "`threshold` must be > 0"),
+        (["--max-pokes", "0"], "`max_pokes` must be an integer >= 1"),
+        (["--strategy", "greedy"], "`strategy` must be one of"),
+    ],
+)
+def test_bad_options_are_one_line_errors(tmp_path, args: list[str], message: str) -> None:
+    result = runner.invoke(app, ["explore", "--out", str(tmp_path / "run"), *args])
+    assert message in _error_line(result)
+
+
+def test_config_dump_round_trips_and_bad_configs_name_the_field(tmp_path) -> None:
+    result = runner.invoke(app, ["config", "dump", "--out", str(tmp_path / "c.yaml")])
+    assert result.exit_code == 0, result.output
+    data = yaml.safe_load((tmp_path / "c.yaml").read_text())
+    assert data["exploration"]["threshold"] == 0.06
+    assert data["scenario"] == "heterogeneous-60-110-rigid"
+    data["exploration"]["treshold"] = 0.1
+    (tmp_path / "bad.yaml").write_text(yaml.safe_dump(data))
+    result = runner.invoke(
+        app, ["explore", "--config", str(tmp_path / "bad.yaml"), "--out", str(tmp_path / "run")]
+    )
+    assert "exploration` has unknown key(s) ['treshold']" in _error_line(result)
+    (tmp_path / "worse.yaml").write_text("exploration: {max_pokes: many}\n")
+    result = runner.invoke(
+        app, ["explore", "--config", str(tmp_path / "worse.yaml"), "--out", str(tmp_path / "run")]
+    )
+    assert "`worse.yaml.exploration.max_pokes` must be an integer" in _error_line(result)
+
+
+def test_an_occupied_folder_is_refused_and_nothing_in_it_is_lost(tmp_path) -> None:
+    out = tmp_path / "run"
+    out.mkdir()
+    (out / "report.json").write_text(json.dumps({"precious": True}))
+    result = runner.invoke(app, ["explore", "--out", str(out)])
+    assert "already holds a run" in _error_line(result)
+    assert json.loads((out / "report.json").read_text()) == {"precious": True}
+    result = runner.invoke(app, ["explore", "--resume", str(tmp_path / "empty")])
+    assert "cannot read config file" in _error_line(result)

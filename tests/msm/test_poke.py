@@ -1,0 +1,242 @@
+"""Poke equilibrium and β estimation: fixed points, calibration, rigid end, hardness order."""
+
+from __future__ import annotations
+
+import logging
+
+import numpy as np
+import pytest
+from msm_cases import dent_case
+
+from deformap.environment import TactileContact
+from deformap.msm import (
+    ParticleGrid,
+    ShapeMatchingConfig,
+    estimate_beta,
+    shape_matching_goals,
+    simulate_poke,
+)
+from deformap.msm._poke import force_weights, hertz_depth
+
+
+def _grid(xs, ys, z):
+    return ParticleGrid.from_heightmap(xs, ys, z)
+
+
+@pytest.mark.parametrize("mode", ["linear", "quadratic"])
+def test_force_equilibrium_satisfies_the_pbd_steady_state(mode):
+    # sheet body: the solver's matrix form must agree with the goals computed independently
+    xs, ys, z, _, contact = dent_case(60, n=11)
+    g = _grid(xs, ys, z)
+    betas = np.array([0.0, 0.5, 0.98])
+    cfg = ShapeMatchingConfig(mode=mode, layers=0, tol=1e-10)
+    sim = simulate_poke(g.rest, g.masses, g.fixed, contact, betas, cfg)
+    assert sim.converged.all()
+    goals = shape_matching_goals(g.rest, sim.positions, betas, cfg)
+    w = force_weights(g.rest, g.fixed, contact, g.spacing_m)
+    want = w[..., None] * contact.force / sim.stiffness_n_per_m
+    free = ~g.fixed
+    np.testing.assert_allclose((sim.positions - goals)[:, free], np.broadcast_to(
+        want[free], (3, *want[free].shape)), rtol=0, atol=1e-9)
+    np.testing.assert_array_equal(sim.positions[:, g.fixed], np.broadcast_to(
+        g.rest[g.fixed], (3, *g.rest[g.fixed].shape)))
+
+
+def test_layered_body_equilibrium_satisfies_the_pbd_steady_state():
+    from deformap.msm._clusters import Clusters
+    from deformap.msm._simulate import _body
+
+    xs, ys, z, _, contact = dent_case(60, n=11)
+    g = _grid(xs, ys, z)
+    betas = np.array([0.0, 0.6, 0.98])
+    cfg = ShapeMatchingConfig(tol=1e-10)  # force, quadratic, 3 layers
+    sim = simulate_poke(g.rest, g.masses, g.fixed, contact, betas, cfg)
+    body, body_m, body_fixed, window = _body(g.rest, g.masses, g.fixed, g.spacing_m, cfg)
+    assert body.shape[0] == 4 and np.all(body_fixed[-1]) and window == (2, 3, 3)
+    from deformap.msm._poke import Equilibrium
+
+    cl = Clusters(body, body_m, window, cfg.mode, cfg.regularization)
+    eq = Equilibrium(cl, body_fixed, betas)
+    w = np.zeros(body_fixed.shape)
+    w[0] = force_weights(g.rest, g.fixed, contact, g.spacing_m)
+    force = w.reshape(-1, 1) * contact.force
+    x, _, _, conv = eq.solve(body.reshape(-1, 3)[body_fixed.ravel()], force,
+                             sim.stiffness_n_per_m, 1e-10, 500, g.spacing_m)
+    assert conv.all()
+    np.testing.assert_allclose(x[:, 0], sim.positions, atol=1e-12)
+    goals = cl.goals(x, betas)
+    free = ~body_fixed
+    want = (w[..., None] * contact.force / sim.stiffness_n_per_m)[free]
+    np.testing.assert_allclose((x - goals)[:, free], np.broadcast_to(want, (3, *want.shape)),
+                               rtol=0, atol=1e-9)
+
+
+def test_pinned_equilibrium_holds_the_contact_particle_and_relaxes_the_rest():
+    xs, ys, z, _, contact = dent_case(60, n=11)
+    g = _grid(xs, ys, z)
+    cfg = ShapeMatchingConfig(contact="pinned", mode="quadratic", layers=0, tol=1e-10)
+    sim = simulate_poke(g.rest, g.masses, g.fixed, contact, np.array([0.2, 0.8]), cfg)
+    np.testing.assert_allclose(sim.positions[:, 5, 5], np.broadcast_to(contact.contact_point,
+                                                                       (2, 3)), atol=1e-12)
+    goals = shape_matching_goals(g.rest, sim.positions, np.array([0.2, 0.8]), cfg)
+    free = ~g.fixed
+    free[5, 5] = False
+    np.testing.assert_allclose(sim.positions[:, free], goals[:, free], atol=1e-9)
+
+
+@pytest.mark.parametrize("mode", ["linear", "quadratic"])
+def test_force_calibration_makes_beta_zero_dent_like_the_reference_half_space(mode):
+    xs, ys, z, _, contact = dent_case(60, n=13)
+    g = _grid(xs, ys, z)
+    cfg = ShapeMatchingConfig(mode=mode)
+    sim = simulate_poke(g.rest, g.masses, g.fixed, contact, np.array([0.0]), cfg)
+    w = force_weights(g.rest, g.fixed, contact, g.spacing_m)
+    depth = float(np.sum(w * (g.rest[..., 2] - sim.positions[0, ..., 2])))
+    want = hertz_depth(contact.force_n, contact.tip_radius_m, cfg.reference_modulus_pa,
+                       cfg.poisson_ratio)
+    assert depth == pytest.approx(want, rel=2e-3)
+
+
+def test_force_dent_deepens_with_beta_and_converges_fast_near_one():
+    xs, ys, z, _, contact = dent_case(60, n=13)
+    g = _grid(xs, ys, z)
+    betas = np.array([0.0, 0.3, 0.6, 0.9, 0.98])
+    sim = simulate_poke(g.rest, g.masses, g.fixed, contact, betas, ShapeMatchingConfig())
+    depth = g.rest[6, 6, 2] - sim.positions[:, 6, 6, 2]
+    assert np.all(np.diff(depth) > 0)
+    assert sim.converged.all()
+    assert np.all(sim.residual < 1e-6)
+    assert sim.iterations.max() < 60  # Anderson-accelerated local–global, not PBD's ~n² steps
+
+
+def test_not_converged_is_reported_not_hidden(caplog):
+    xs, ys, z, _, contact = dent_case(60, n=11)
+    g = _grid(xs, ys, z)
+    cfg = ShapeMatchingConfig(max_iter=2, layers=0)
+    with caplog.at_level(logging.WARNING, logger="deformap.msm._poke"):
+        sim = simulate_poke(g.rest, g.masses, g.fixed, contact, np.array([0.5, 0.9]), cfg)
+    assert not sim.converged.any()
+    assert np.all(sim.residual >= cfg.tol)
+    assert np.all(sim.iterations == 2)
+    assert "did not converge" in caplog.text
+
+
+@pytest.mark.parametrize("layers", [0, 3])
+def test_pinned_rigid_surface_has_flat_error_and_rigid_end(layers):
+    xs, ys, z, pts, contact = dent_case(None, n=11)
+    cfg = ShapeMatchingConfig(contact="pinned", layers=layers, n_beta=10)
+    est = estimate_beta(xs, ys, z, pts, contact, cfg)
+    assert np.ptp(est.errors) < 1e-12
+    assert est.beta == 0.0
+    assert est.all_converged
+
+
+@pytest.mark.parametrize("mode", ["linear", "quadratic"])
+def test_force_rigid_surface_gives_the_rigid_end(mode):
+    xs, ys, z, pts, contact = dent_case(None, n=11)
+    est = estimate_beta(xs, ys, z, pts, contact, ShapeMatchingConfig(mode=mode, n_beta=10))
+    assert est.beta == 0.0
+    assert np.all(np.diff(est.errors) > 0)  # any simulated dent is worse than none
+    assert est.all_converged
+
+
+def test_force_protocol_orders_elastic_foams_by_hardness():
+    # Hertz dents of a linear-elastic half-space (not shape matching) for five foams; 12 cm ROI
+    betas = []
+    for hardness in (30.0, 60.0, 110.0, 150.0, 250.0):
+        xs, ys, z, pts, contact = dent_case(hardness, n=17, spacing=0.0075)
+        est = estimate_beta(xs, ys, z, pts, contact, ShapeMatchingConfig(n_beta=25))
+        assert est.all_converged
+        last = est.betas[-1]
+        assert 0.0 < est.beta < last, "the minimum must lie inside the sweep"
+        assert est.errors.min() < est.errors[0] and est.errors.min() < est.errors[-1]
+        betas.append(est.beta)
+    assert np.all(np.diff(betas) < 0), f"β̂ must fall as hardness rises; got {betas}"
+
+
+def test_estimate_reports_curve_refinement_and_uncertainty():
+    xs, ys, z, pts, contact = dent_case(60, n=13)
+    est = estimate_beta(xs, ys, z, pts, contact, ShapeMatchingConfig(n_beta=20))
+    assert est.betas.size > 20  # sweep + refinement
+    assert np.all(np.diff(est.betas) > 0)
+    assert np.all(est.betas >= 0) and np.all(est.betas < 1)
+    step = np.min(np.diff(est.betas[np.abs(est.betas - est.beta) < 0.06]))
+    assert step == pytest.approx(0.01)
+    assert est.beta == est.betas[np.argmin(est.errors)]
+    assert 0.01 / np.sqrt(12) <= est.beta_std <= 1 / np.sqrt(12)
+    assert est.protocol == "force" and est.mode == "quadratic"
+    assert est.stiffness_n_per_m > 0
+
+
+# ---- bad input ---------------------------------------------------------------------------------
+
+def _ok():
+    xs, ys, z, pts, contact = dent_case(60, n=9)
+    return xs, ys, z, pts, contact
+
+
+def test_contact_far_outside_the_roi_is_refused():
+    xs, ys, z, pts, _ = _ok()
+    far = TactileContact(tip_center=np.array([0.9, 0.2, 0.06]), force=np.array([0, 0, -0.5]),
+                         tip_radius_m=0.01)
+    with pytest.raises(Exception, match="`contact` must press inside the ROI"):
+        estimate_beta(xs, ys, z, pts, far)
+
+
+def test_contact_on_the_fixed_edge_is_refused():
+    xs, ys, z, pts, _ = _ok()
+    edge = TactileContact(tip_center=np.array([xs[0], ys[4], 0.06]),
+                          force=np.array([0, 0, -0.5]), tip_radius_m=0.01)
+    with pytest.raises(Exception, match="fixed edge"):
+        estimate_beta(xs, ys, z, pts, edge)
+
+
+@pytest.mark.parametrize("betas", [[-0.1], [1.0], [0.2, 1.5], [np.nan]])
+def test_beta_outside_unit_interval_is_refused(betas):
+    xs, ys, z, _, contact = _ok()
+    g = _grid(xs, ys, z)
+    with pytest.raises(Exception, match="`betas`"):
+        simulate_poke(g.rest, g.masses, g.fixed, contact, betas, ShapeMatchingConfig())
+
+
+def test_bad_shapes_and_values_are_refused():
+    from deformap.errors import InvalidArgumentError
+
+    xs, ys, z, pts, contact = _ok()
+    g = _grid(xs, ys, z)
+    cases = [
+        (lambda: estimate_beta(xs, ys, z[:-1], pts, contact), "`z`"),
+        (lambda: estimate_beta(xs[::-1], ys, z, pts, contact), "`xs`"),
+        (lambda: estimate_beta(xs[:2], ys, z[:, :2], pts, contact), "`xs`"),
+        (lambda: estimate_beta(xs, ys, z, pts[:, :2], contact), "`deformed_points`"),
+        (lambda: estimate_beta(xs, ys, z, np.full((3, 3), np.nan), contact), "`deformed_points`"),
+        (lambda: estimate_beta(xs, ys, z, np.empty((0, 3)), contact), "`deformed_points`"),
+        (lambda: estimate_beta(xs, ys, z, pts, "contact"), "`contact`"),
+        (lambda: estimate_beta(xs, ys, z, pts, contact, config={"mode": "linear"}), "`config`"),
+        (lambda: simulate_poke(g.rest, -g.masses, g.fixed, contact, [0.1]), "`masses`"),
+        (lambda: simulate_poke(g.rest, g.masses, g.fixed.astype(int), contact, [0.1]), "`fixed`"),
+        (lambda: simulate_poke(g.rest[:2], g.masses, g.fixed, contact, [0.1]), "`rest`"),
+        (lambda: shape_matching_goals(g.rest, g.rest[None, None], [0.1]), "`current`"),
+        (lambda: shape_matching_goals(g.rest[..., :2], g.rest[None], [0.1]), "`rest`"),
+    ]
+    for call, name in cases:
+        with pytest.raises(InvalidArgumentError, match=name):
+            call()
+
+
+@pytest.mark.parametrize("kwargs, name", [
+    ({"mode": "affine"}, "`mode`"), ({"contact": "pin"}, "`contact`"),
+    ({"cluster_size": 1}, "`cluster_size`"), ({"n_beta": 1}, "`n_beta`"),
+    ({"beta_resolution": 0.0}, "`beta_resolution`"), ({"tol": 0.0}, "`tol`"),
+    ({"max_iter": 0}, "`max_iter`"), ({"regularization": 1.0}, "`regularization`"),
+    ({"reference_modulus_pa": -1.0}, "`reference_modulus_pa`"),
+    ({"poisson_ratio": 0.6}, "`poisson_ratio`"),
+    ({"error_tolerance_m": 0.0}, "`error_tolerance_m`"),
+    ({"layers": -1}, "`layers`"), ({"layer_growth": 0.5}, "`layer_growth`"),
+    ({"refine": 1}, "`refine`"),
+])
+def test_bad_config_is_refused(kwargs, name):
+    from deformap.errors import InvalidArgumentError
+
+    with pytest.raises(InvalidArgumentError, match=name):
+        ShapeMatchingConfig(**kwargs)
