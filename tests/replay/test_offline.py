@@ -216,6 +216,7 @@ def test_estimate_agrees_with_the_mapper(recorded: Path, live: dict[str, Any], c
         (["--force", "0", "0", "0"], "--contact/--force/--tip-radius: `force` must be a non-zero"),
         (["--tip-radius", "-1"], "`tip_radius_m` must be > 0"),
         (["--before", "missing.pcd"], "missing.pcd: no such file"),
+        (["--contact", "0.1", "0.1", "0.9"], "`after` and `contact`: the contact point"),
     ],
 )
 def test_estimate_refuses_bad_input(tmp_path: Path, args: list[str], match: str) -> None:

@@ -22,7 +22,7 @@ from deformap.cloud import PointCloud
 from deformap.environment import PressObservation, TactileContact, Workspace
 from deformap.errors import DeformapError, InvalidArgumentError
 from deformap.explore import ExplorationConfig, ExplorationResult, Mapper, PokeResult
-from deformap.replay._session import RecordedSession
+from deformap.replay._session import DEFAULT_CONTACT_GAP_M, RecordedSession, check_contact_gap
 
 __all__ = ["ReplayResult", "estimate_poke", "map_session", "tip_sphere_points"]
 
@@ -146,6 +146,7 @@ def estimate_poke(
     *,
     rng: np.random.Generator,
     robot_points: Any = None,
+    contact_gap_m: float = DEFAULT_CONTACT_GAP_M,
 ) -> PokeResult:
     """β of one poke from the clouds before and while pressing.
 
@@ -162,6 +163,9 @@ def estimate_poke(
     robot_points : (m, 3) float, optional
         Points whose convex hull covers stick and hand; default: the tip's sphere
         (:func:`tip_sphere_points`).
+    contact_gap_m : float, metres
+        Refuse a contact point farther than this from every surface point of ``after`` (see
+        :data:`~deformap.replay.DEFAULT_CONTACT_GAP_M`).
 
     Returns
     -------
@@ -185,8 +189,9 @@ def estimate_poke(
     xy = contact.contact_point[:2]
     half = 1.5 * config.touch.roi_size_m
     workspace = Workspace(lower=tuple(xy - half), upper=tuple(xy + half))
-    mapper = Mapper(workspace, config)
-    mapper.initialise(before, rng)
     obs = PressObservation(cloud=after, contact=contact, robot_points=robot, target_xy=xy,
                            force_n=contact.force_n)  # fmt: skip
+    check_contact_gap(obs, check_positive("contact_gap_m", contact_gap_m), "`after` and `contact`")
+    mapper = Mapper(workspace, config)
+    mapper.initialise(before, rng)
     return mapper.process_press(obs, 0)

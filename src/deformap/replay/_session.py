@@ -26,7 +26,7 @@ from deformap.replay._folder import FolderReader
 from deformap.replay._format import SESSION_FILE, SessionHeader, parse_session_yaml
 from deformap.replay._truth import GroundTruth, read_ground_truth
 
-__all__ = ["DEFAULT_CONTACT_GAP_M", "RecordedSession", "load_session"]
+__all__ = ["DEFAULT_CONTACT_GAP_M", "RecordedSession", "check_contact_gap", "load_session"]
 
 logger = logging.getLogger(__name__)
 
@@ -130,18 +130,28 @@ class RecordedSession:
                 f"{self.contact_gap_m} m outside the workspace "
                 f"{self.workspace.lower}..{self.workspace.upper}"
             )
-        pts = obs.cloud.points
-        try:
-            surface = pts[~points_in_hull(pts, obs.robot_points)]
-        except DeformapError as exc:
-            raise FileFormatError(f"{where}: robot points: {exc}") from None
-        gap = float(np.min(np.linalg.norm(surface - point, axis=1))) if len(surface) else np.inf
-        if gap > self.contact_gap_m:
-            raise FileFormatError(
-                f"{where}: the contact point {np.round(point, 4).tolist()} m is {gap:.3g} m from "
-                f"the nearest surface point of the cloud (limit {self.contact_gap_m} m); tip and "
-                "cloud are probably in different frames or units"
-            )
+        check_contact_gap(obs, self.contact_gap_m, where)
+
+
+def check_contact_gap(obs: PressObservation, gap_m: float, where: str) -> None:
+    """Refuse a press whose contact point is farther than ``gap_m`` from every surface point.
+
+    Surface points are the press's cloud without the points inside the robot's hull. ``where``
+    starts the message (the file or poke).
+    """
+    point = obs.contact.contact_point
+    pts = obs.cloud.points
+    try:
+        surface = pts[~points_in_hull(pts, obs.robot_points)]
+    except DeformapError as exc:
+        raise FileFormatError(f"{where}: robot points: {exc}") from None
+    gap = float(np.min(np.linalg.norm(surface - point, axis=1))) if len(surface) else np.inf
+    if gap > gap_m:
+        raise FileFormatError(
+            f"{where}: the contact point {np.round(point, 4).tolist()} m is {gap:.3g} m from "
+            f"the nearest surface point of the cloud (limit {gap_m} m); tip and "
+            "cloud are probably in different frames or units"
+        )
 
 
 def _read_yaml(file: Path) -> Any:
