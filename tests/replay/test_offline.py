@@ -14,18 +14,13 @@ from typing import Any
 import numpy as np
 import pytest
 import yaml
+from typer.testing import CliRunner
 
-explore = pytest.importorskip("deformap.explore")
-if not hasattr(explore, "Mapper"):  # pragma: no cover - until the mapper lands on this branch
-    pytest.skip("deformap.explore has no Mapper yet", allow_module_level=True)
-
-from typer.testing import CliRunner  # noqa: E402
-
-from deformap.cli import app  # noqa: E402
-from deformap.cloud import PointCloud  # noqa: E402
-from deformap.cloud.io import write_cloud  # noqa: E402
-from deformap.eval import load_run_config, run_experiment  # noqa: E402
-from deformap.replay import load_session, map_session, write_session  # noqa: E402
+from deformap.cli import app
+from deformap.cloud import PointCloud
+from deformap.cloud.io import write_cloud
+from deformap.eval import load_run_config, run_experiment
+from deformap.replay import load_session, map_session, write_session
 
 SCENARIO = "heterogeneous-150-rigid"
 SEED = 3
