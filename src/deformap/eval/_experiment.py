@@ -26,7 +26,16 @@ from deformap.explore import ExplorationConfig, ExplorationResult, Journal, Poke
 from deformap.explore._journal import JOURNAL_NAME
 from deformap.world import SimulatedWorld, WorldConfig, load_scenario
 
-__all__ = ["RunConfig", "load_run_config", "run_experiment"]
+__all__ = [
+    "RunConfig",
+    "build_report",
+    "load_run_config",
+    "map_report",
+    "run_experiment",
+    "run_generators",
+    "write_figures",
+    "write_map_figures",
+]
 
 logger = logging.getLogger(__name__)
 
@@ -93,6 +102,16 @@ def _prepare_folder(out: Path, header: dict[str, Any], resume: bool) -> tuple[Jo
     return Journal.create(out, header), []
 
 
+def run_generators(seed: int) -> tuple[np.random.Generator, np.random.Generator]:
+    """The world's and the exploration's generators of a run with ``seed``.
+
+    ``deformap record-sim`` and ``deformap map`` derive theirs the same way, so that a recorded
+    session mapped offline with its seed fits the surface exactly as the live run did.
+    """
+    world_seq, explore_seq = np.random.SeedSequence(check_int("seed", seed, minimum=0)).spawn(2)
+    return np.random.default_rng(world_seq), np.random.default_rng(explore_seq)
+
+
 def run_experiment(
     config: RunConfig,
     out: str | Path,
@@ -109,14 +128,14 @@ def run_experiment(
     header = {"deformap": __version__, "config": plain, "scenario": scenario.to_dict()}
     journal, done = _prepare_folder(folder, header, resume)
     dump_yaml(config, folder / "config.yaml")
-    world_seq, explore_seq = np.random.SeedSequence(config.seed).spawn(2)
+    world_rng, explore_rng = run_generators(config.seed)
     t0 = time.perf_counter()
-    world = SimulatedWorld(scenario, config=config.world, rng=np.random.default_rng(world_seq))
+    world = SimulatedWorld(scenario, config=config.world, rng=world_rng)
     world_s = time.perf_counter() - t0
     result = explore(
         world,
         config.exploration,
-        rng=np.random.default_rng(explore_seq),
+        rng=explore_rng,
         journal=journal,
         done=done,
         on_poke=on_poke,
@@ -133,73 +152,120 @@ def run_experiment(
     return RunOutput(report=report, result=result, world=world, folder=folder)
 
 
-def build_report(
-    config: RunConfig, result: ExplorationResult, world: SimulatedWorld, *, world_build_s: float
-) -> dict[str, Any]:
-    """The ``report.json`` content (see DESIGN.md, "What done looks like")."""
+def map_report(result: ExplorationResult, *, truth: Any = None) -> dict[str, Any]:
+    """The part of ``report.json`` that a live run and a replayed session share.
+
+    Parameters
+    ----------
+    result : ExplorationResult
+    truth : object with ``ground_truth_labels(xs, ys)`` and ``ground_truth_hardness(xs, ys)``
+        A :class:`~deformap.world.SimulatedWorld` or a session's
+        :class:`~deformap.replay.GroundTruth`; ``None`` leaves the ground-truth metrics out.
+    """
     mapper = result.mapper
     beta, var = mapper.field()
-    regions = mapper.regions()
-    truth = world.ground_truth_labels(mapper.xs, mapper.ys)
-    hardness_grid = world.ground_truth_hardness(mapper.xs, mapper.ys)
-    hardness = {int(label): float(hardness_grid[truth == label][0]) for label in np.unique(truth)}
-    scores = region_scores(regions.labels, truth, beta, hardness)
     pokes = [dict(p.record) for p in result.pokes]
     per_poke_compute = [
         sum(v for k, v in p["timings"].items() if k != "environment_s") for p in pokes
     ]
-    return {
-        "deformap": __version__,
-        "scenario": config.scenario,
-        "seed": config.seed,
-        "config": config_to_dict(config),
+    regions: dict[str, Any] | None = None
+    true_regions = None
+    if pokes:
+        found = mapper.regions()
+        regions = {"levels": found.levels.tolist(), "class_betas": found.class_betas.tolist()}
+        if truth is not None:
+            labels = truth.ground_truth_labels(mapper.xs, mapper.ys)
+            hardness_grid = truth.ground_truth_hardness(mapper.xs, mapper.ys)
+            hardness = {
+                int(label): float(hardness_grid[labels == label][0]) for label in np.unique(labels)
+            }
+            scores = region_scores(found.labels, labels, beta, hardness)
+            regions = {**scores.to_dict(), **regions}
+            true_regions = [
+                {"label": label, "hardness_n": _finite(h)} for label, h in sorted(hardness.items())
+            ]
+    report: dict[str, Any] = {
         "pokes": pokes,
         "n_pokes": len(pokes),
         "stop_reason": result.stop_reason,
         "max_variance": float(var.max()),
-        "regions": {
-            **scores.to_dict(),
-            "levels": regions.levels.tolist(),
-            "class_betas": regions.class_betas.tolist(),
-        },
-        "true_regions": [
-            {"label": label, "hardness_n": _finite(h)} for label, h in sorted(hardness.items())
-        ],
-        "timings": {
-            **result.timings,
-            "world_build_s": world_build_s,
-            "per_poke_s": [
-                p["timings"].get("environment_s", 0.0) + c
-                for p, c in zip(pokes, per_poke_compute, strict=True)
-            ],
-            "per_poke_compute_s": per_poke_compute,
-        },
+        "regions": regions,
     }
+    if truth is not None:
+        report["true_regions"] = true_regions
+    report["timings"] = {
+        **result.timings,
+        "per_poke_s": [
+            p["timings"].get("environment_s", 0.0) + c
+            for p, c in zip(pokes, per_poke_compute, strict=True)
+        ],
+        "per_poke_compute_s": per_poke_compute,
+    }
+    return report
+
+
+def build_report(
+    config: RunConfig, result: ExplorationResult, world: SimulatedWorld, *, world_build_s: float
+) -> dict[str, Any]:
+    """The ``report.json`` content (see DESIGN.md, "What done looks like")."""
+    report = {
+        "deformap": __version__,
+        "scenario": config.scenario,
+        "seed": config.seed,
+        "config": config_to_dict(config),
+        **map_report(result, truth=world),
+    }
+    report["timings"]["world_build_s"] = world_build_s
+    return report
 
 
 def write_figures(
     folder: Path, result: ExplorationResult, world: SimulatedWorld, config: RunConfig
 ) -> None:
     """``map.png`` and one ``poke-NN.png`` per poke processed in this session."""
+    write_map_figures(
+        folder,
+        result,
+        truth=world,
+        threshold=config.exploration.threshold,
+        title=f"{config.scenario} (seed {config.seed}): {len(result.pokes)} pokes",
+    )
+
+
+def write_map_figures(
+    folder: Path,
+    result: ExplorationResult,
+    *,
+    truth: Any = None,
+    threshold: float | None = None,
+    title: str = "",
+) -> None:
+    """``map.png`` (when there is a poke) and one ``poke-NN.png`` per poke processed here.
+
+    ``truth`` is as in :func:`map_report`; without it the map has no ground-truth panel.
+    """
     from deformap.viz import plot_map, plot_poke
 
     mapper = result.mapper
-    beta, var = mapper.field()
-    regions = mapper.regions()
-    contacts = np.array([p.xy for p in result.pokes])
-    plot_map(
-        folder / "map.png",
-        mapper.xs,
-        mapper.ys,
-        beta=beta,
-        variance=var,
-        contacts=contacts,
-        labels=regions.labels,
-        levels=regions.levels,
-        truth_hardness=world.ground_truth_hardness(mapper.xs, mapper.ys),
-        threshold=config.exploration.threshold,
-        title=f"{config.scenario} (seed {config.seed}): {len(contacts)} pokes",
-    )
+    if result.pokes:
+        beta, var = mapper.field()
+        regions = mapper.regions()
+        contacts = np.array([p.xy for p in result.pokes])
+        plot_map(
+            folder / "map.png",
+            mapper.xs,
+            mapper.ys,
+            beta=beta,
+            variance=var,
+            contacts=contacts,
+            labels=regions.labels,
+            levels=regions.levels,
+            truth_hardness=None
+            if truth is None
+            else truth.ground_truth_hardness(mapper.xs, mapper.ys),
+            threshold=threshold,
+            title=title,
+        )
     for poke in result.pokes:
         if poke.roi_xs is None:  # resumed from the journal: no arrays to draw
             continue

@@ -1,5 +1,51 @@
-"""replay (see DESIGN.md)."""
+"""Recorded sessions (a folder of cloud files, or a ROS 2 bag) read back and fed, poke by poke, to
+the same mapper the live loop uses.
+
+The format is documented in ``docs/recording-format.md``. :func:`load_session` checks a session's
+``session.yaml`` and opens its data; each poke is read on demand as the
+:class:`~deformap.environment.PressObservation` the environment returned, so a broken poke is
+reported on its own. :func:`write_session` writes the format (``deformap record-sim`` uses it,
+through :class:`RecordingEnvironment`).
+"""
 
 from __future__ import annotations
 
-__all__: list[str] = []
+from typing import Any
+
+from deformap.replay._format import FORMAT_NAME, FORMAT_VERSION, SESSION_FILE, TOPICS
+from deformap.replay._recorder import RecordingEnvironment
+from deformap.replay._session import DEFAULT_CONTACT_GAP_M, RecordedSession, load_session
+from deformap.replay._truth import GroundTruth, read_ground_truth, write_ground_truth
+from deformap.replay._write import SESSION_FORMATS, write_session
+
+# The offline mapper needs deformap.explore (and through it gp and msm): imported on first use, so
+# that reading a session stays light.
+_OFFLINE = ("ReplayResult", "estimate_poke", "map_session", "tip_sphere_points")
+
+__all__ = [
+    "DEFAULT_CONTACT_GAP_M",
+    "FORMAT_NAME",
+    "FORMAT_VERSION",
+    "SESSION_FILE",
+    "SESSION_FORMATS",
+    "TOPICS",
+    "GroundTruth",
+    "RecordedSession",
+    "RecordingEnvironment",
+    "ReplayResult",
+    "estimate_poke",
+    "load_session",
+    "map_session",
+    "read_ground_truth",
+    "tip_sphere_points",
+    "write_ground_truth",
+    "write_session",
+]
+
+
+def __getattr__(name: str) -> Any:
+    if name in _OFFLINE:
+        from deformap.replay import _offline
+
+        return getattr(_offline, name)
+    raise AttributeError(f"module 'deformap.replay' has no attribute {name!r}")

@@ -1,0 +1,232 @@
+"""The bag form of a session: a ROS 2 bag (sqlite3 or MCAP) on the topics of ``TOPICS``.
+
+The messages of one poke share one header stamp, which ``session.yaml`` names (``stamp_ns``) next
+to what no standard message holds (the commanded target and force). The bag is indexed once; each
+message is decoded only when its poke is read, so a corrupted message breaks only its own poke.
+"""
+
+from __future__ import annotations
+
+import sqlite3
+import struct
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from deformap.cloud import PointCloud
+from deformap.cloud.io import array_to_pointcloud2, read_bag_static_transform
+from deformap.cloud.io._bag import _rosbag2
+from deformap.cloud.io._common import check_units, finish_cloud
+from deformap.cloud.io._pointcloud2 import pointcloud2_structured, xyz_with_holes
+from deformap.cloud.io._ros import typestore
+from deformap.environment import PressObservation
+from deformap.errors import DeformapError, FileFormatError, InvalidArgumentError
+from deformap.replay._folder import PressParts
+from deformap.replay._format import TOPICS, PokeSpec, SessionHeader
+
+__all__ = ["BagReader", "write_session_bag"]
+
+
+@dataclass
+class _Raw:
+    log_time_ns: int
+    data: bytes
+
+
+def _bag_errors() -> tuple[type[BaseException], ...]:
+    from rosbags.serde import SerdeError
+
+    # What rosbags, sqlite3 and the CDR decoder raise on damaged bags.
+    return (_rosbag2().ReaderError, SerdeError, sqlite3.Error, OSError, ValueError, KeyError,
+            IndexError, TypeError, AssertionError, EOFError, struct.error, MemoryError,
+            OverflowError, UnicodeDecodeError)  # fmt: skip
+
+
+def _stamp(msg: Any) -> int:
+    return int(msg.header.stamp.sec) * 10**9 + int(msg.header.stamp.nanosec)
+
+
+class BagReader:
+    """Reads the poke messages of a bag-form session, each one when its poke is asked for."""
+
+    def __init__(self, header: SessionHeader) -> None:
+        assert header.bag is not None
+        self.header = header
+        self.path = header.bag
+        if not self.path.exists():
+            raise FileFormatError(f"{self.path}: no such bag (the session's `bag`)")
+        self._raw = self._index()
+        self._decoded: dict[str, dict[int, Any]] | None = None
+        self._undecodable: dict[str, list[str]] = {}
+        self._tf_static: NDArray[np.float64] | None = None
+
+    def _index(self) -> dict[str, list[_Raw]]:
+        rosbag2 = _rosbag2()
+        out: dict[str, list[_Raw]] = {topic: [] for topic, _ in TOPICS.values()}
+        try:
+            with rosbag2.Reader(self.path) as reader:
+                found = {c.topic: c.msgtype for c in reader.connections}
+                for topic, msgtype in TOPICS.values():
+                    if topic not in found:
+                        raise FileFormatError(
+                            f"{self.path}: bag has no topic {topic!r} ({msgtype}); topics found: "
+                            f"{sorted(found)}"
+                        )
+                    if found[topic] != msgtype:
+                        raise FileFormatError(
+                            f"{self.path}: topic {topic!r} carries {found[topic]}, "
+                            f"expected {msgtype}"
+                        )
+                conns = [c for c in reader.connections if c.topic in out]
+                for conn, log_time, raw in reader.messages(connections=conns):
+                    out[conn.topic].append(_Raw(int(log_time), bytes(raw)))
+        except DeformapError:
+            raise
+        except _bag_errors() as exc:
+            raise FileFormatError(
+                f"{self.path}: could not read the bag: {type(exc).__name__}: {str(exc)[:200]}"
+            ) from exc
+        return out
+
+    def _messages_by_stamp(self) -> dict[str, dict[int, Any]]:
+        if self._decoded is not None:
+            return self._decoded
+        store, errors = typestore(), _bag_errors()
+        decoded: dict[str, dict[int, Any]] = {}
+        for key, (topic, msgtype) in TOPICS.items():
+            by_stamp: dict[int, Any] = {}
+            for number, raw in enumerate(self._raw[topic]):
+                try:
+                    msg = store.deserialize_cdr(raw.data, msgtype)
+                    by_stamp.setdefault(_stamp(msg), msg)
+                except errors as exc:
+                    self._undecodable.setdefault(topic, []).append(
+                        f"message {number}: {type(exc).__name__}: {str(exc)[:120]}"
+                    )
+            decoded[key] = by_stamp
+        self._decoded = decoded
+        return decoded
+
+    def _message(self, key: str, stamp: int) -> Any:
+        topic = TOPICS[key][0]
+        msg = self._messages_by_stamp()[key].get(stamp)
+        if msg is None:
+            bad = self._undecodable.get(topic, [])
+            note = f"; {len(bad)} message(s) there could not be decoded ({bad[0]})" if bad else ""
+            raise FileFormatError(
+                f"{self.path}: topic {topic!r} has no message stamped {stamp}{note}"
+            )
+        return msg
+
+    def _cloud(self, msg: Any, where: str, frame: str) -> PointCloud:
+        if msg.header.frame_id != frame:
+            raise FileFormatError(
+                f"{where}: header.frame_id is {msg.header.frame_id!r} but the session's frame is "
+                f"{frame!r} (session.yaml `frame`)"
+            )
+        try:
+            xyz = xyz_with_holes(msg, pointcloud2_structured(msg))
+        except InvalidArgumentError as exc:
+            raise FileFormatError(f"{where}: {str(exc).replace('`msg` ', '')}") from None
+        xyz = xyz[np.isfinite(xyz).all(axis=1)]  # holes of an organised cloud (is_dense false)
+        cloud, _ = finish_cloud(where, xyz, None, {}, scale=check_units(self.header.units),
+                                drop_nan=False, frame=frame)  # fmt: skip
+        return cloud
+
+    def _to_world(self, cloud: PointCloud) -> PointCloud:
+        cam2world = self.header.cam2world
+        if cam2world is None:
+            return cloud
+        if isinstance(cam2world, str):
+            if self._tf_static is None:
+                self._tf_static = read_bag_static_transform(self.path, self.header.frame, "world")
+            cam2world = self._tf_static
+        return cloud.transformed(cam2world, "world")
+
+    def observation(self) -> PointCloud:
+        topic = TOPICS["observation"][0]
+        msgs = list(self._messages_by_stamp()["observation"].values())
+        if len(msgs) != 1:
+            bad = self._undecodable.get(topic, [])
+            raise FileFormatError(
+                f"{self.path}: topic {topic!r} must hold exactly one message; got {len(msgs)}"
+                + (f" ({len(bad)} could not be decoded: {bad[0]})" if bad else "")
+            )
+        where = f"{self.path} [{topic}]"
+        return self._to_world(self._cloud(msgs[0], where, self.header.frame))
+
+    def press_parts(self, spec: PokeSpec) -> PressParts:
+        assert spec.stamp_ns is not None
+        stamp = spec.stamp_ns
+
+        def where(key: str) -> str:
+            return f"{self.path} [{TOPICS[key][0]} stamped {stamp}]"
+
+        cloud = self._to_world(self._cloud(self._message("cloud", stamp), where("cloud"),
+                                           self.header.frame))  # fmt: skip
+        robot = self._cloud(self._message("robot", stamp), where("robot"), "world")
+        wrench, tip = self._message("wrench", stamp), self._message("tip", stamp)
+        for key, msg in (("wrench", wrench), ("tip", tip)):
+            if msg.header.frame_id != "world":
+                raise FileFormatError(
+                    f"{where(key)}: header.frame_id is {msg.header.frame_id!r}; the bag form "
+                    "stores contacts in the 'world' frame"
+                )
+        f, p = wrench.wrench.force, tip.point
+        force = np.array([f.x, f.y, f.z], dtype=float)
+        center = np.array([p.x, p.y, p.z], dtype=float)
+        for key, value in (("wrench", force), ("tip", center)):
+            if not np.isfinite(value).all():
+                raise FileFormatError(
+                    f"{where(key)}: holds NaN or infinite values {value.tolist()}"
+                )
+        return PressParts(cloud, center, force, np.asarray(robot.points))
+
+
+def _point_message(stamp_ns: int, point: Any) -> Any:
+    types = typestore().types
+    time = types["builtin_interfaces/msg/Time"](sec=stamp_ns // 10**9, nanosec=stamp_ns % 10**9)
+    header = types["std_msgs/msg/Header"](stamp=time, frame_id="world")
+    x, y, z = (float(v) for v in point)
+    return types["geometry_msgs/msg/PointStamped"](
+        header=header, point=types["geometry_msgs/msg/Point"](x=x, y=y, z=z)
+    )
+
+
+def _wrench_message(stamp_ns: int, force: Any) -> Any:
+    from deformap.cloud.io._bag_writer import _wrench_message as wrench
+
+    return wrench(stamp_ns, "world", force, np.zeros(3))
+
+
+def write_session_bag(
+    path: Path,
+    *,
+    storage: str,
+    observation: PointCloud,
+    presses: Sequence[PressObservation],
+    stamps_ns: Sequence[int],
+) -> None:
+    """Write the observation and the presses (world frame, float64) to a new bag at ``path``."""
+    rosbag2, store = _rosbag2(), typestore()
+    plugin = rosbag2.StoragePlugin.MCAP if storage == "mcap" else rosbag2.StoragePlugin.SQLITE3
+    with rosbag2.Writer(path, version=9, storage_plugin=plugin) as writer:
+        conns = {key: writer.add_connection(topic, msgtype, typestore=store)
+                 for key, (topic, msgtype) in TOPICS.items()}  # fmt: skip
+
+        def put(key: str, stamp: int, msg: Any) -> None:
+            writer.write(conns[key], stamp, store.serialize_cdr(msg, TOPICS[key][1]))
+
+        put("observation", 0, array_to_pointcloud2(observation.points, frame_id="world",
+                                                   stamp_ns=0, dtype="float64"))  # fmt: skip
+        for stamp, obs in zip(stamps_ns, presses, strict=True):
+            put("cloud", stamp, array_to_pointcloud2(obs.cloud.points, frame_id="world",
+                                                     stamp_ns=stamp, dtype="float64"))  # fmt: skip
+            put("wrench", stamp, _wrench_message(stamp, obs.contact.force))
+            put("tip", stamp, _point_message(stamp, obs.contact.tip_center))
+            put("robot", stamp, array_to_pointcloud2(obs.robot_points, frame_id="world",
+                                                     stamp_ns=stamp, dtype="float64"))  # fmt: skip

@@ -1,0 +1,290 @@
+"""The ``session.yaml`` of a recorded session: its keys, parsed strictly.
+
+The format is documented for users in ``docs/recording-format.md``; this module is its reference.
+Keys are checked in two tiers, so that one broken poke does not hide the others:
+
+- the file as a whole (unknown or missing keys anywhere, a wrong format name or version, bad
+  workspace, probe, frame or units) raises :class:`~deformap.errors.ConfigError` when the session is
+  loaded;
+- the *values* of one poke's entry (a NaN tip centre, a zero force, a target of the wrong length)
+  are kept as that poke's error and raised only when that poke is read.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from deformap._validation import check_array, check_int, check_positive, check_vector
+from deformap.cloud.io import UNITS
+from deformap.environment import Workspace
+from deformap.errors import ConfigError, DeformapError
+
+__all__ = [
+    "FORMAT_NAME",
+    "FORMAT_VERSION",
+    "SESSION_FILE",
+    "TOPICS",
+    "PokeSpec",
+    "SessionHeader",
+    "parse_session_yaml",
+]
+
+FORMAT_NAME = "deformap-session"
+FORMAT_VERSION = 1
+SESSION_FILE = "session.yaml"
+
+#: Topic names of the bag form and their message types.
+TOPICS = {
+    "observation": ("/deformap/observation", "sensor_msgs/msg/PointCloud2"),
+    "cloud": ("/deformap/press/cloud", "sensor_msgs/msg/PointCloud2"),
+    "wrench": ("/deformap/press/wrench", "geometry_msgs/msg/WrenchStamped"),
+    "tip": ("/deformap/press/tip", "geometry_msgs/msg/PointStamped"),
+    "robot": ("/deformap/press/robot", "sensor_msgs/msg/PointCloud2"),
+}
+
+_TOP_REQUIRED = {"format", "version", "workspace", "probe", "pokes"}
+_TOP_OPTIONAL = {"units", "frame", "cam2world", "ground_truth", "source", "observation", "bag"}
+_FOLDER_POKE_KEYS = {"cloud", "tip_center", "force", "target_xy", "force_n", "robot_points"}
+_BAG_POKE_KEYS = {"stamp_ns", "target_xy", "force_n"}
+
+
+@dataclass(frozen=True, kw_only=True)
+class PokeSpec:
+    """One poke's entry in ``session.yaml``, with the values already checked.
+
+    Parameters
+    ----------
+    index : int
+        Position in the ``pokes`` list (0-based).
+    target_xy : (2,) float, metres or None
+    force_n : float or None
+        Commanded target and normal force.
+    cloud : Path or None
+        Folder form: the cloud seen while pressing.
+    tip_center : (3,) float, metres or None
+    force : (3,) float, newtons or None
+        Folder form: the measured contact (world frame, force pointing into the surface).
+    robot_points : Path or (m, 3) float or None
+        Folder form: a cloud file, or the points inline.
+    stamp_ns : int or None
+        Bag form: the header stamp shared by this poke's messages.
+    error : DeformapError or None
+        Why this entry cannot be used (raised when the poke is read).
+    """
+
+    index: int
+    target_xy: NDArray[np.float64] | None = None
+    force_n: float | None = None
+    cloud: Path | None = None
+    tip_center: NDArray[np.float64] | None = None
+    force: NDArray[np.float64] | None = None
+    robot_points: Path | NDArray[np.float64] | None = None
+    stamp_ns: int | None = None
+    error: DeformapError | None = None
+
+
+@dataclass(frozen=True, kw_only=True)
+class SessionHeader:
+    """What ``session.yaml`` says about the whole session.
+
+    Parameters
+    ----------
+    root : Path
+        The session folder; relative file names resolve against it.
+    form : {"folder", "bag"}
+    units : {"m", "mm"}
+        Units of the point coordinates in cloud files and PointCloud2 messages.
+    frame : str
+        The frame the clouds are stored in.
+    cam2world : (4, 4) float, "tf_static" or None
+        Maps clouds from ``frame`` to the world frame (``None`` when ``frame == "world"``).
+    workspace : Workspace
+    tip_radius_m : float
+    observation : Path or None
+        Folder form: the initial observation's cloud file.
+    bag : Path or None
+        Bag form: the rosbag2 folder or ``.mcap`` / ``.db3`` file.
+    ground_truth : Path or None
+    source : dict
+        Free-form provenance (scenario, seed, deformap version), copied into reports.
+    pokes : tuple of PokeSpec
+    """
+
+    root: Path
+    form: str
+    units: str
+    frame: str
+    cam2world: NDArray[np.float64] | str | None
+    workspace: Workspace
+    tip_radius_m: float
+    observation: Path | None
+    bag: Path | None
+    ground_truth: Path | None
+    source: dict[str, Any]
+    pokes: tuple[PokeSpec, ...]
+
+
+def _where(file: Path, key: str) -> str:
+    return f"{file}: `{key}`"
+
+
+def _check_keys(file: Path, key: str, data: Any, required: set[str], optional: set[str]) -> None:
+    if not isinstance(data, dict):
+        raise ConfigError(f"{_where(file, key)} must be a mapping; got {type(data).__name__}")
+    keys = {str(k) for k in data}
+    unknown = sorted(keys - required - optional)
+    if unknown:
+        raise ConfigError(
+            f"{_where(file, key)} has unknown key(s) {unknown}; "
+            f"allowed: {sorted(required | optional)}"
+        )
+    missing = sorted(required - keys)
+    if missing:
+        raise ConfigError(f"{_where(file, key)} lacks required key(s) {missing}")
+
+
+def _value(file: Path, key: str, check: Any, *args: Any, **kwargs: Any) -> Any:
+    """Run a ``check_*`` validator and turn its refusal into a ConfigError naming the key."""
+    try:
+        return check(key, *args, **kwargs)
+    except DeformapError as exc:
+        raise ConfigError(f"{file}: {exc}") from None
+
+
+def _file_name(file: Path, key: str, value: Any, root: Path) -> Path:
+    if not isinstance(value, str) or not value.strip():
+        raise ConfigError(f"{_where(file, key)} must be a file name (a string); got {value!r}")
+    path = Path(value)
+    return path if path.is_absolute() else root / path
+
+
+def _cam2world(file: Path, data: dict[str, Any], frame: str, form: str) -> Any:
+    raw = data.get("cam2world")
+    if frame == "world":
+        if raw is not None:
+            raise ConfigError(
+                f"{_where(file, 'cam2world')} is given but `frame` is 'world': the clouds are "
+                "already in the world frame; remove one of the two"
+            )
+        return None
+    if raw is None:
+        raise ConfigError(
+            f"{_where(file, 'frame')} is {frame!r}, not 'world', so `cam2world` (a 4×4 "
+            "camera-to-world matrix) is required" + (" or 'tf_static'" if form == "bag" else "")
+        )
+    if raw == "tf_static":
+        if form != "bag":
+            raise ConfigError(f"{_where(file, 'cam2world')}: 'tf_static' needs the bag form")
+        return "tf_static"
+    mat = _value(file, "cam2world", check_array, raw, (4, 4), what="transform entries")
+    rot = mat[:3, :3]
+    rigid = (np.allclose(mat[3], [0, 0, 0, 1], atol=1e-9)
+             and np.allclose(rot @ rot.T, np.eye(3), atol=1e-6)
+             and np.linalg.det(rot) > 0)  # fmt: skip
+    if not rigid:
+        raise ConfigError(
+            f"{_where(file, 'cam2world')} must be a rigid transform (orthonormal rotation with "
+            "det +1, last row 0 0 0 1)"
+        )
+    return mat
+
+
+def _poke(file: Path, index: int, data: Any, form: str, root: Path) -> PokeSpec:
+    key = f"pokes[{index}]"
+    allowed = _FOLDER_POKE_KEYS if form == "folder" else _BAG_POKE_KEYS
+    _check_keys(file, key, data, allowed, set())
+    # Schema problems (above) fail the file; value problems (below) fail only this poke.
+    try:
+        target = _value(file, f"{key}.target_xy", check_vector, data["target_xy"], 2, what="metres")
+        force_n = _value(file, f"{key}.force_n", check_positive, data["force_n"])
+        if form == "bag":
+            stamp = _value(file, f"{key}.stamp_ns", check_int, data["stamp_ns"], minimum=0)
+            return PokeSpec(index=index, target_xy=target, force_n=force_n, stamp_ns=stamp)
+        center = _value(file, f"{key}.tip_center", check_vector, data["tip_center"], 3,
+                        what="metres")  # fmt: skip
+        force = _value(file, f"{key}.force", check_vector, data["force"], 3, what="newtons")
+        if not np.any(force):
+            raise ConfigError(f"{_where(file, key + '.force')} must be non-zero; got (0, 0, 0)")
+        cloud = _file_name(file, f"{key}.cloud", data["cloud"], root)
+        robot_raw = data["robot_points"]
+        robot: Path | NDArray[np.float64]
+        if isinstance(robot_raw, str):
+            robot = _file_name(file, f"{key}.robot_points", robot_raw, root)
+        else:
+            robot = _value(file, f"{key}.robot_points", check_array, robot_raw, (None, 3),
+                           what="points in metres", min_rows=4)  # fmt: skip
+        return PokeSpec(index=index, target_xy=target, force_n=force_n, cloud=cloud,
+                        tip_center=center, force=force, robot_points=robot)  # fmt: skip
+    except ConfigError as exc:
+        return PokeSpec(index=index, error=exc)
+
+
+def _workspace(file: Path, data: Any) -> Workspace:
+    _check_keys(file, "workspace", data, {"lower", "upper"}, set())
+    lower = _value(file, "workspace.lower", check_vector, data["lower"], 2, what="metres")
+    upper = _value(file, "workspace.upper", check_vector, data["upper"], 2, what="metres")
+    try:
+        return Workspace(lower=tuple(lower), upper=tuple(upper))
+    except DeformapError as exc:
+        raise ConfigError(f"{_where(file, 'workspace')}: {exc}") from None
+
+
+def parse_session_yaml(data: Any, file: Path) -> SessionHeader:
+    """Check the plain data of a ``session.yaml`` and return its header and poke entries.
+
+    Raises
+    ------
+    ConfigError
+        Naming the file and the key (``pokes[3].force``) on any schema problem.
+    """
+    root = file.parent
+    _check_keys(file, "(top level)", data, _TOP_REQUIRED, _TOP_OPTIONAL)
+    if data["format"] != FORMAT_NAME:
+        raise ConfigError(
+            f"{_where(file, 'format')} must be {FORMAT_NAME!r}; got {data['format']!r}"
+        )
+    if data["version"] != FORMAT_VERSION or isinstance(data["version"], bool):
+        raise ConfigError(
+            f"{_where(file, 'version')} must be {FORMAT_VERSION} (this deformap reads format "
+            f"version {FORMAT_VERSION}); got {data['version']!r}"
+        )
+    has_bag, has_obs = "bag" in data, "observation" in data
+    if has_bag == has_obs:
+        raise ConfigError(
+            f"{file}: give exactly one of `observation` (folder form) and `bag` (bag form); "
+            f"got {'both' if has_bag else 'neither'}"
+        )
+    form = "bag" if has_bag else "folder"
+    units = data.get("units", "m")
+    if not isinstance(units, str) or units not in UNITS:
+        raise ConfigError(f"{_where(file, 'units')} must be one of {sorted(UNITS)}; got {units!r}")
+    frame = data.get("frame", "world")
+    if not isinstance(frame, str) or not frame:
+        raise ConfigError(f"{_where(file, 'frame')} must be a non-empty string; got {frame!r}")
+    cam2world = _cam2world(file, data, frame, form)
+    workspace = _workspace(file, data["workspace"])
+    _check_keys(file, "probe", data["probe"], {"tip_radius_m"}, set())
+    tip = _value(file, "probe.tip_radius_m", check_positive, data["probe"]["tip_radius_m"])
+    source = data.get("source") or {}
+    if not isinstance(source, dict):
+        raise ConfigError(
+            f"{_where(file, 'source')} must be a mapping; got {type(source).__name__}"
+        )
+    pokes = data["pokes"]
+    if not isinstance(pokes, list):
+        raise ConfigError(f"{_where(file, 'pokes')} must be a list; got {type(pokes).__name__}")
+    truth = data.get("ground_truth")
+    return SessionHeader(
+        root=root, form=form, units=units, frame=frame, cam2world=cam2world,
+        workspace=workspace, tip_radius_m=tip,
+        observation=_file_name(file, "observation", data["observation"], root) if has_obs else None,
+        bag=_file_name(file, "bag", data["bag"], root) if has_bag else None,
+        ground_truth=None if truth is None else _file_name(file, "ground_truth", truth, root),
+        source={str(k): v for k, v in source.items()},
+        pokes=tuple(_poke(file, i, p, form, root) for i, p in enumerate(pokes)),
+    )  # fmt: skip

@@ -1,0 +1,197 @@
+"""Recorded pokes fed to the mapper the live loop uses: a whole session, or one poke on its own.
+
+The live loop (:func:`deformap.explore.explore`) initialises a :class:`~deformap.explore.Mapper`
+with the first observation, then for each press calls ``process_press`` and ``add``. Here the same
+calls are made with what a session recorded, in its order, so a poke gives the same β whichever
+way it arrives (with the same seed for the surface fit).
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any, cast
+
+import numpy as np
+from numpy.typing import NDArray
+
+from deformap._validation import check_points, check_positive, check_vector
+from deformap.cloud import PointCloud
+from deformap.environment import PressObservation, TactileContact, Workspace
+from deformap.errors import DeformapError, InvalidArgumentError
+from deformap.explore import ExplorationConfig, ExplorationResult, Mapper, PokeResult
+from deformap.replay._session import DEFAULT_CONTACT_GAP_M, RecordedSession, check_contact_gap
+
+__all__ = ["ReplayResult", "estimate_poke", "map_session", "tip_sphere_points"]
+
+logger = logging.getLogger(__name__)
+
+#: The ``stop_reason`` of a replayed session: its recorded pokes ran out.
+END_OF_SESSION = "end-of-session"
+
+
+@dataclass
+class ReplayResult:
+    """What :func:`map_session` produced.
+
+    Attributes
+    ----------
+    result : ExplorationResult
+        The mapper after every usable poke (``stop_reason`` is ``"end-of-session"``), for the
+        report and figure helpers the live run uses.
+    skipped : list of dict
+        ``{"index": i, "error": message}`` for each poke that could not be used, in order.
+    """
+
+    result: ExplorationResult
+    skipped: list[dict[str, Any]] = field(default_factory=list)
+
+    @property
+    def warnings(self) -> list[str]:
+        """One line per skipped poke, for ``report.json``."""
+        return [f"poke {s['index']} skipped: {s['error']}" for s in self.skipped]
+
+
+def map_session(
+    session: RecordedSession,
+    config: ExplorationConfig,
+    *,
+    rng: np.random.Generator,
+    on_poke: Callable[[PokeResult], None] | None = None,
+) -> ReplayResult:
+    """Feed a session's pokes, in order, to a fresh mapper.
+
+    Parameters
+    ----------
+    session : RecordedSession
+    config : ExplorationConfig
+        Mapper settings. ``max_pokes``, ``threshold`` and ``strategy`` do not apply: every
+        recorded poke is used, where it was made.
+    rng : numpy.random.Generator
+        Split as :func:`deformap.explore.explore` splits it (its first stream fits the surface),
+        so the live run's generator gives the live run's surface model.
+    on_poke : callable, optional
+        Called after each poke added (progress display).
+
+    Returns
+    -------
+    ReplayResult
+        A poke that cannot be read or processed (any :class:`~deformap.errors.DeformapError`) is
+        logged, listed in ``skipped`` and left out; the others still count.
+    """
+    if not isinstance(session, RecordedSession):
+        raise InvalidArgumentError(
+            f"`session` must be a RecordedSession; got {type(session).__name__}"
+        )
+    if not isinstance(config, ExplorationConfig):
+        raise InvalidArgumentError(
+            f"`config` must be an ExplorationConfig; got {type(config).__name__}"
+        )
+    t_start = time.perf_counter()
+    # explore() spawns max_pokes + 1 streams and fits the surface with the first; a spawned
+    # child depends only on its position, so spawning one gives that same stream.
+    surface_rng = rng.spawn(1)[0]
+    mapper = Mapper(session.workspace, config)
+    cloud = session.observation()
+    t_observed = time.perf_counter()
+    mapper.initialise(cloud, surface_rng)
+    t_surface = time.perf_counter()
+    skipped: list[dict[str, Any]] = []
+    read_s = 0.0
+    for index in range(len(session)):
+        t0 = time.perf_counter()
+        try:
+            obs = session.press_observation(index)
+            t1 = time.perf_counter()
+            poke = mapper.process_press(obs, index)
+        except DeformapError as exc:
+            logger.warning("poke %d skipped: %s", index, exc)
+            skipped.append({"index": index, "error": str(exc)})
+            continue
+        mapper.add(poke)
+        # Reading the session stands in for the environment of the live loop.
+        poke.record["timings"]["environment_s"] = t1 - t0
+        read_s += t1 - t0
+        if on_poke is not None:
+            on_poke(poke)
+    timings = {
+        "total_s": time.perf_counter() - t_start,
+        "observe_s": t_observed - t_start,
+        "surface_gp_s": t_surface - t_observed,
+        "environment_s": read_s,
+    }
+    result = ExplorationResult(
+        mapper=mapper, stop_reason=cast(Any, END_OF_SESSION), timings=timings
+    )
+    return ReplayResult(result=result, skipped=skipped)
+
+
+def tip_sphere_points(tip_center: Any, tip_radius_m: float) -> NDArray[np.float64]:
+    """``(6, 3)`` vertices of the octahedron inscribed in the tip's sphere.
+
+    The robot geometry known without a hull file: cloud points inside the tip cannot be surface.
+    """
+    center = check_vector("tip_center", tip_center, 3, what="metres")
+    radius = check_positive("tip_radius_m", tip_radius_m)
+    return center + radius * np.vstack([np.eye(3), -np.eye(3)])
+
+
+def estimate_poke(
+    before: PointCloud,
+    after: PointCloud,
+    contact: TactileContact,
+    config: ExplorationConfig,
+    *,
+    rng: np.random.Generator,
+    robot_points: Any = None,
+    contact_gap_m: float = DEFAULT_CONTACT_GAP_M,
+) -> PokeResult:
+    """β of one poke from the clouds before and while pressing.
+
+    Parameters
+    ----------
+    before, after : PointCloud
+        World frame, metres: the undisturbed surface, and the surface while pressing.
+    contact : TactileContact
+        Tip centre, force on the surface and tip radius at the press.
+    config : ExplorationConfig
+        The surface GP, touch GP and shape-matching settings are used.
+    rng : numpy.random.Generator
+        For the surface fit.
+    robot_points : (m, 3) float, optional
+        Points whose convex hull covers stick and hand; default: the tip's sphere
+        (:func:`tip_sphere_points`).
+    contact_gap_m : float, metres
+        Refuse a contact point farther than this from every surface point of ``after`` (see
+        :data:`~deformap.replay.DEFAULT_CONTACT_GAP_M`).
+
+    Returns
+    -------
+    PokeResult
+        ``record`` holds β, its uncertainty and the E(β) curve; the arrays draw the poke figure.
+
+    Notes
+    -----
+    The mapper works on a workspace: here the square of side three ROIs centred on the contact,
+    so that the surface fit covers the ROI and its surroundings and nothing far away.
+    """
+    for name, cloud in (("before", before), ("after", after)):
+        if not isinstance(cloud, PointCloud):
+            raise InvalidArgumentError(f"`{name}` must be a PointCloud; got {type(cloud).__name__}")
+    if not isinstance(contact, TactileContact):
+        raise InvalidArgumentError(
+            f"`contact` must be a TactileContact; got {type(contact).__name__}"
+        )
+    robot = (tip_sphere_points(contact.tip_center, contact.tip_radius_m) if robot_points is None
+             else check_points("robot_points", robot_points, min_rows=4))  # fmt: skip
+    xy = contact.contact_point[:2]
+    half = 1.5 * config.touch.roi_size_m
+    workspace = Workspace(lower=tuple(xy - half), upper=tuple(xy + half))
+    obs = PressObservation(cloud=after, contact=contact, robot_points=robot, target_xy=xy,
+                           force_n=contact.force_n)  # fmt: skip
+    check_contact_gap(obs, check_positive("contact_gap_m", contact_gap_m), "`after` and `contact`")
+    mapper = Mapper(workspace, config)
+    mapper.initialise(before, rng)
+    return mapper.process_press(obs, 0)

@@ -1,0 +1,222 @@
+"""A recorded session read back: ``load_session`` and ``RecordedSession``.
+
+A session is a folder holding ``session.yaml`` (see ``docs/recording-format.md``) and either one
+cloud file per observation (the folder form) or a ROS 2 bag (the bag form). Loading checks the
+whole ``session.yaml`` and the presence of the observation and the bag's topics; each poke is read,
+checked and turned into a :class:`~deformap.environment.PressObservation` only when asked for, so
+that one broken poke does not stop the others.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import yaml
+
+from deformap._validation import check_int, check_positive
+from deformap.cloud import PointCloud, points_in_hull
+from deformap.environment import PressObservation, TactileContact, Workspace
+from deformap.errors import ConfigError, DeformapError, FileFormatError, InvalidArgumentError
+from deformap.replay._bagform import BagReader
+from deformap.replay._folder import FolderReader
+from deformap.replay._format import SESSION_FILE, SessionHeader, parse_session_yaml
+from deformap.replay._truth import GroundTruth, read_ground_truth
+
+__all__ = ["DEFAULT_CONTACT_GAP_M", "RecordedSession", "check_contact_gap", "load_session"]
+
+logger = logging.getLogger(__name__)
+
+#: A poke whose contact point lies farther than this from every surface point of its cloud (robot
+#: removed) is refused. The probe touches the surface, and the stick and hand hide at most a few
+#: centimetres around the tip, so genuine contacts have surface points well within 5 cm; a tip or a
+#: cloud in the wrong frame or units lands tens of centimetres (or metres) away.
+DEFAULT_CONTACT_GAP_M = 0.05
+
+
+@dataclass(eq=False)
+class RecordedSession:
+    """A recorded session: its settings, and its observation and pokes read on demand.
+
+    Use :func:`load_session` to build one.
+
+    Attributes
+    ----------
+    path : Path
+        The session folder.
+    header : SessionHeader
+        Everything ``session.yaml`` says (form, units, frame, pokes' entries).
+    ground_truth : GroundTruth or None
+        Present for sessions recorded from a simulation.
+    contact_gap_m : float
+        See :data:`DEFAULT_CONTACT_GAP_M`.
+    """
+
+    path: Path
+    header: SessionHeader
+    ground_truth: GroundTruth | None
+    _reader: FolderReader | BagReader = field(repr=False)
+    contact_gap_m: float = DEFAULT_CONTACT_GAP_M
+
+    @property
+    def form(self) -> str:
+        """``"folder"`` or ``"bag"``."""
+        return self.header.form
+
+    @property
+    def workspace(self) -> Workspace:
+        return self.header.workspace
+
+    @property
+    def tip_radius_m(self) -> float:
+        return self.header.tip_radius_m
+
+    @property
+    def source(self) -> dict[str, Any]:
+        """Free-form provenance from ``session.yaml`` (scenario, seed, ...)."""
+        return dict(self.header.source)
+
+    def __len__(self) -> int:
+        return len(self.header.pokes)
+
+    @property
+    def n_pokes(self) -> int:
+        return len(self)
+
+    def observation(self) -> PointCloud:
+        """The initial observation of the undisturbed surface, world frame, metres."""
+        return self._reader.observation()
+
+    def press_observation(self, index: int) -> PressObservation:
+        """Poke ``index`` (0-based, in recorded order) as the environment returned it.
+
+        Raises
+        ------
+        FileFormatError, ConfigError
+            Naming the file, key or topic of this poke and what is wrong with it.
+        """
+        i = check_int("index", index, minimum=0)
+        if i >= len(self):
+            raise InvalidArgumentError(f"`index` must be < {len(self)} (the pokes); got {i}")
+        spec = self.header.pokes[i]
+        if spec.error is not None:
+            raise spec.error
+        parts = self._reader.press_parts(spec)
+        assert spec.target_xy is not None and spec.force_n is not None  # set when no error
+        where = f"{self.path / SESSION_FILE}: poke {i}"
+        try:
+            contact = TactileContact(tip_center=parts.tip_center, force=parts.force,
+                                     tip_radius_m=self.tip_radius_m)  # fmt: skip
+            obs = PressObservation(cloud=parts.cloud, contact=contact,
+                                   robot_points=parts.robot_points, target_xy=spec.target_xy,
+                                   force_n=spec.force_n)  # fmt: skip
+        except InvalidArgumentError as exc:
+            raise FileFormatError(f"{where}: {exc}") from None
+        self._check_contact(obs, where)
+        return obs
+
+    def _check_contact(self, obs: PressObservation, where: str) -> None:
+        point = obs.contact.contact_point
+        # A target on the workspace's edge may land a little outside it (sensor noise, slip): the
+        # same slack as for the surface gap below.
+        lo = np.asarray(self.workspace.lower) - self.contact_gap_m
+        hi = np.asarray(self.workspace.upper) + self.contact_gap_m
+        if np.any(point[:2] < lo) or np.any(point[:2] > hi):
+            raise FileFormatError(
+                f"{where}: the contact point ({point[0]:.4g}, {point[1]:.4g}) m lies more than "
+                f"{self.contact_gap_m} m outside the workspace "
+                f"{self.workspace.lower}..{self.workspace.upper}"
+            )
+        check_contact_gap(obs, self.contact_gap_m, where)
+
+
+def check_contact_gap(obs: PressObservation, gap_m: float, where: str) -> None:
+    """Refuse a press whose contact point is farther than ``gap_m`` from every surface point.
+
+    Surface points are the press's cloud without the points inside the robot's hull. ``where``
+    starts the message (the file or poke).
+    """
+    point = obs.contact.contact_point
+    pts = obs.cloud.points
+    try:
+        surface = pts[~points_in_hull(pts, obs.robot_points)]
+    except DeformapError as exc:
+        raise FileFormatError(f"{where}: robot points: {exc}") from None
+    gap = float(np.min(np.linalg.norm(surface - point, axis=1))) if len(surface) else np.inf
+    if gap > gap_m:
+        raise FileFormatError(
+            f"{where}: the contact point {np.round(point, 4).tolist()} m is {gap:.3g} m from "
+            f"the nearest surface point of the cloud (limit {gap_m} m); tip and "
+            "cloud are probably in different frames or units"
+        )
+
+
+def _read_yaml(file: Path) -> Any:
+    try:
+        text = file.read_bytes().decode("utf-8")
+    except OSError as exc:
+        raise FileFormatError(f"{file}: cannot read: {exc.strerror or exc}") from None
+    except UnicodeDecodeError as exc:
+        raise ConfigError(f"{file}: not UTF-8 text (byte {exc.start})") from None
+    try:
+        return yaml.safe_load(text)
+    except (yaml.YAMLError, RecursionError, ValueError) as exc:
+        # ValueError: PyYAML's timestamp constructor on an impossible date.
+        detail = str(exc).replace("\n", " ")[:300]
+        raise ConfigError(f"{file}: not valid YAML: {type(exc).__name__}: {detail}") from None
+
+
+def _session_file(path: Path) -> Path:
+    if path.is_dir():
+        file = path / SESSION_FILE
+        if not file.is_file():
+            raise FileFormatError(f"{path}: not a session folder (it has no {SESSION_FILE})")
+        return file
+    if path.is_file():
+        return path
+    raise FileFormatError(f"{path}: no such session folder or file")
+
+
+def load_session(
+    path: str | Path, *, contact_gap_m: float = DEFAULT_CONTACT_GAP_M
+) -> RecordedSession:
+    """Open a recorded session (folder or bag form) and check its ``session.yaml``.
+
+    Parameters
+    ----------
+    path : str or Path
+        The session folder, or its ``session.yaml``.
+    contact_gap_m : float, metres
+        Refuse pokes whose contact point is farther than this from every surface point.
+
+    Returns
+    -------
+    RecordedSession
+        Pokes are read on demand with :meth:`RecordedSession.press_observation`.
+
+    Raises
+    ------
+    ConfigError
+        ``session.yaml`` is not valid YAML, has unknown or missing keys, or bad values.
+    FileFormatError
+        The observation file or the bag is missing, the bag lacks a topic, the ground truth is
+        unreadable.
+    """
+    if not isinstance(path, (str, Path)):
+        raise InvalidArgumentError(
+            f"`path` must be a str or pathlib.Path; got {type(path).__name__}"
+        )
+    gap = check_positive("contact_gap_m", contact_gap_m)
+    file = _session_file(Path(path))
+    data = _read_yaml(file)
+    header = parse_session_yaml(data, file)
+    reader = FolderReader(header) if header.form == "folder" else BagReader(header)
+    truth = None if header.ground_truth is None else read_ground_truth(header.ground_truth)
+    broken = [p.index for p in header.pokes if p.error is not None]
+    if broken:
+        logger.warning("%s: poke(s) %s have bad entries and will be refused", file, broken)
+    return RecordedSession(path=file.parent, header=header, ground_truth=truth,
+                           contact_gap_m=gap, _reader=reader)  # fmt: skip

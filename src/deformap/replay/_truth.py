@@ -1,0 +1,128 @@
+"""Ground truth of a session recorded from a simulation: region labels and hardness on a grid.
+
+Stored as ``ground_truth.npz`` (never pickled) with ``xs`` (nx,), ``ys`` (ny,) cell centres in
+metres, ``labels`` (ny, nx) integers and ``hardness`` (ny, nx) newtons (``inf`` for a rigid region,
+``nan`` where no region is). A real recording has none, and ``deformap map`` then reports no
+ground-truth metrics.
+"""
+
+from __future__ import annotations
+
+import io
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from deformap._validation import check_array
+from deformap.cloud.io._common import parse_errors
+from deformap.errors import FileFormatError, InvalidArgumentError
+
+__all__ = ["GroundTruth", "read_ground_truth", "write_ground_truth"]
+
+
+@dataclass(frozen=True, eq=False)
+class GroundTruth:
+    """Region labels and hardness on a regular grid, looked up at any points by nearest cell.
+
+    Parameters
+    ----------
+    xs : (nx,) float, metres, increasing
+    ys : (ny,) float, metres, increasing
+    labels : (ny, nx) int
+    hardness : (ny, nx) float, newtons
+        Constant over each label; ``inf`` for rigid, ``nan`` for no region (bare table).
+    """
+
+    xs: NDArray[np.float64]
+    ys: NDArray[np.float64]
+    labels: NDArray[np.int64]
+    hardness: NDArray[np.float64]
+
+    def __post_init__(self) -> None:
+        xs = check_array("xs", self.xs, (None,), what="metres", min_rows=1)
+        ys = check_array("ys", self.ys, (None,), what="metres", min_rows=1)
+        for name, axis in (("xs", xs), ("ys", ys)):
+            if np.any(np.diff(axis) <= 0):
+                raise InvalidArgumentError(f"`{name}` must be strictly increasing")
+        labels = np.asarray(self.labels)
+        if labels.shape != (ys.size, xs.size) or labels.dtype.kind not in "iu":
+            raise InvalidArgumentError(
+                f"`labels` must be ({ys.size}, {xs.size}) integers; got shape {labels.shape} "
+                f"and dtype {labels.dtype}"
+            )
+        hard = check_array("hardness", self.hardness, (ys.size, xs.size), what="newtons",
+                           finite=False)  # fmt: skip
+        if np.any(hard <= 0) or np.any(np.isneginf(hard)):
+            raise InvalidArgumentError("`hardness` must be > 0 (inf for rigid, nan for none)")
+        for label in np.unique(labels):
+            values = hard[labels == label]
+            same = np.all(values == values[0]) or np.all(np.isnan(values))
+            if not same:
+                raise InvalidArgumentError(
+                    f"`hardness` must be constant over each label; label {label} has "
+                    f"{np.unique(values).size} values"
+                )
+        for name, value in (("xs", xs), ("ys", ys), ("labels", labels.astype(np.int64)),
+                            ("hardness", hard)):  # fmt: skip
+            value.setflags(write=False)
+            object.__setattr__(self, name, value)
+
+    def _cells(self, xs: Any, ys: Any) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
+        qx = check_array("xs", xs, (None,), what="metres")
+        qy = check_array("ys", ys, (None,), what="metres")
+
+        def nearest(axis: NDArray[np.float64], q: NDArray[np.float64]) -> NDArray[np.intp]:
+            return np.abs(axis[None, :] - q[:, None]).argmin(axis=1)
+
+        return nearest(self.ys, qy), nearest(self.xs, qx)
+
+    def ground_truth_labels(self, xs: Any, ys: Any) -> NDArray[np.int64]:
+        """``(ny, nx)`` labels at the grid ``xs`` × ``ys`` (nearest stored cell)."""
+        iy, ix = self._cells(xs, ys)
+        return self.labels[np.ix_(iy, ix)]
+
+    def ground_truth_hardness(self, xs: Any, ys: Any) -> NDArray[np.float64]:
+        """``(ny, nx)`` hardness in newtons at the grid ``xs`` × ``ys`` (nearest stored cell)."""
+        iy, ix = self._cells(xs, ys)
+        return self.hardness[np.ix_(iy, ix)]
+
+    def hardness_by_label(self) -> dict[int, float]:
+        """Hardness of each label (``math.inf`` for rigid, ``nan`` for none)."""
+        out = {}
+        for label in np.unique(self.labels):
+            value = float(self.hardness[self.labels == label][0])
+            out[int(label)] = math.inf if np.isposinf(value) else value
+        return out
+
+
+def write_ground_truth(path: str | Path, truth: GroundTruth) -> None:
+    """Write ``truth`` to an NPZ archive (compressed, no pickle)."""
+    if not isinstance(truth, GroundTruth):
+        raise InvalidArgumentError(f"`truth` must be a GroundTruth; got {type(truth).__name__}")
+    with open(path, "wb") as fh:
+        np.savez_compressed(fh, xs=truth.xs, ys=truth.ys, labels=truth.labels,
+                            hardness=truth.hardness)  # fmt: skip
+
+
+def read_ground_truth(path: str | Path) -> GroundTruth:
+    """Read a ``ground_truth.npz``; every problem is a FileFormatError naming the file."""
+    p = Path(path)
+    if not p.is_file():
+        raise FileFormatError(f"{p}: no such file (the session's `ground_truth`)")
+    with parse_errors(p, "the ground-truth NPZ archive"):
+        loaded = np.load(io.BytesIO(p.read_bytes()), allow_pickle=False)
+        if not isinstance(loaded, np.lib.npyio.NpzFile):
+            raise FileFormatError(f"{p}: a single .npy array, not an NPZ archive of named arrays")
+        with loaded as archive:
+            arrays = {name: archive[name] for name in archive.files}
+    missing = sorted({"xs", "ys", "labels", "hardness"} - set(arrays))
+    if missing:
+        raise FileFormatError(f"{p}: ground truth lacks array(s) {missing} (has {sorted(arrays)})")
+    try:
+        return GroundTruth(arrays["xs"], arrays["ys"], arrays["labels"], arrays["hardness"])
+    except InvalidArgumentError as exc:
+        raise FileFormatError(f"{p}: {exc}") from None

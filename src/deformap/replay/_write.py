@@ -1,0 +1,185 @@
+"""Writing a session (folder or bag form), as ``deformap record-sim`` does."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import yaml
+
+from deformap._validation import check_positive
+from deformap.cloud import PointCloud
+from deformap.cloud.io import BAG_STORAGES, CLOUD_FORMATS, write_cloud
+from deformap.environment import PressObservation, Workspace
+from deformap.errors import InvalidArgumentError
+from deformap.replay._bagform import write_session_bag
+from deformap.replay._format import FORMAT_NAME, FORMAT_VERSION, SESSION_FILE
+from deformap.replay._truth import GroundTruth, write_ground_truth
+
+__all__ = ["SESSION_FORMATS", "write_session"]
+
+#: ``"folder"``: one cloud file per observation; ``"mcap"`` / ``"sqlite3"``: a ROS 2 bag.
+SESSION_FORMATS = ("folder", *BAG_STORAGES)
+
+#: Poke ``i`` (0-based) of a bag written here is stamped ``(i + 1)`` seconds; the observation 0.
+_STAMP_STEP_NS = 10**9
+
+
+class _Dumper(yaml.SafeDumper):
+    """Vectors (lists of numbers) on one line; everything else in block style."""
+
+
+def _represent_list(dumper: yaml.SafeDumper, data: list[Any]) -> Any:
+    flow = all(isinstance(v, (int, float)) for v in data)
+    return dumper.represent_sequence("tag:yaml.org,2002:seq", data, flow_style=flow)
+
+
+_Dumper.add_representer(list, _represent_list)
+
+
+def _floats(values: Any) -> list[float]:
+    # Python floats: PyYAML writes their repr, which reads back bit for bit.
+    return [float(v) for v in np.asarray(values, dtype=float).ravel()]
+
+
+def _check_inputs(
+    folder: Any,
+    workspace: Any,
+    observation: Any,
+    presses: Any,
+    tip_radius_m: Any,
+    format: Any,
+    cloud_format: Any,
+    ground_truth: Any,
+) -> tuple[Path, list[PressObservation], float]:
+    if not isinstance(folder, (str, Path)):
+        raise InvalidArgumentError(f"`folder` must be a str or Path; got {type(folder).__name__}")
+    out = Path(folder)
+    if out.exists() and (not out.is_dir() or any(out.iterdir())):
+        raise InvalidArgumentError(f"`folder` {out} exists and is not an empty folder")
+    if not isinstance(workspace, Workspace):
+        raise InvalidArgumentError(
+            f"`workspace` must be a Workspace; got {type(workspace).__name__}"
+        )
+    if not isinstance(observation, PointCloud) or len(observation) == 0:
+        raise InvalidArgumentError("`observation` must be a non-empty PointCloud")
+    if observation.frame != "world":
+        raise InvalidArgumentError(
+            f"`observation` must be in frame 'world'; got {observation.frame!r}"
+        )
+    presses = list(presses)
+    for i, obs in enumerate(presses):
+        if not isinstance(obs, PressObservation):
+            raise InvalidArgumentError(
+                f"`presses[{i}]` must be a PressObservation; got {type(obs).__name__}"
+            )
+        if obs.cloud.frame != "world":
+            raise InvalidArgumentError(f"`presses[{i}].cloud` must be in frame 'world'")
+    radii = {obs.contact.tip_radius_m for obs in presses}
+    if tip_radius_m is None:
+        if len(radii) != 1:
+            raise InvalidArgumentError(
+                "`tip_radius_m` is needed: the presses do not give exactly one tip radius "
+                f"(got {sorted(radii)})"
+            )
+        tip_radius_m = radii.pop()
+    tip = check_positive("tip_radius_m", tip_radius_m)
+    if radii - {tip}:
+        raise InvalidArgumentError(
+            f"every press must use `tip_radius_m` {tip}; got {sorted(radii)}"
+        )
+    if format not in SESSION_FORMATS:
+        raise InvalidArgumentError(f"`format` must be one of {SESSION_FORMATS}; got {format!r}")
+    if cloud_format not in CLOUD_FORMATS:
+        raise InvalidArgumentError(
+            f"`cloud_format` must be one of {CLOUD_FORMATS}; got {cloud_format!r}"
+        )
+    if ground_truth is not None and not isinstance(ground_truth, GroundTruth):
+        raise InvalidArgumentError(
+            f"`ground_truth` must be a GroundTruth or None; got {type(ground_truth).__name__}"
+        )
+    return out, presses, tip
+
+
+def write_session(
+    folder: str | Path,
+    *,
+    workspace: Workspace,
+    observation: PointCloud,
+    presses: Sequence[PressObservation],
+    tip_radius_m: float | None = None,
+    ground_truth: GroundTruth | None = None,
+    source: dict[str, Any] | None = None,
+    format: str = "folder",
+    cloud_format: str = "pcd",
+) -> Path:
+    """Write a session that :func:`load_session` reads back exactly.
+
+    Parameters
+    ----------
+    folder : str or Path
+        A new (or empty) folder; it receives ``session.yaml`` and the data.
+    workspace : Workspace
+    observation : PointCloud
+        The initial observation, world frame, metres.
+    presses : sequence of PressObservation
+        In order. Clouds and robot points are written in float64, so they read back bit for bit.
+    tip_radius_m : float, optional
+        Defaults to the presses' (which must agree).
+    ground_truth : GroundTruth, optional
+        Written to ``ground_truth.npz``.
+    source : dict, optional
+        Provenance copied into ``session.yaml`` (plain YAML data: scenario, seed, ...).
+    format : {"folder", "mcap", "sqlite3"}
+        Cloud files, or a ROS 2 bag in the ``bag`` sub-folder.
+    cloud_format : {"pcd", "ply", "npz"}
+        File type of the folder form's clouds (binary, float64).
+
+    Returns
+    -------
+    Path
+        The ``session.yaml`` written.
+    """
+    out, presses, tip = _check_inputs(folder, workspace, observation, presses, tip_radius_m,
+                                      format, cloud_format, ground_truth)  # fmt: skip
+    out.mkdir(parents=True, exist_ok=True)
+    doc: dict[str, Any] = {
+        "format": FORMAT_NAME,
+        "version": FORMAT_VERSION,
+        "units": "m",
+        "frame": "world",
+        "workspace": {"lower": list(workspace.lower), "upper": list(workspace.upper)},
+        "probe": {"tip_radius_m": tip},
+    }
+    if source:
+        doc["source"] = dict(source)
+    if ground_truth is not None:
+        write_ground_truth(out / "ground_truth.npz", ground_truth)
+        doc["ground_truth"] = "ground_truth.npz"
+    if format == "folder":
+        doc["observation"] = f"observation.{cloud_format}"
+        write_cloud(out / doc["observation"], observation)
+        doc["pokes"] = []
+        for i, obs in enumerate(presses, start=1):
+            cloud, robot = f"poke-{i:02d}.{cloud_format}", f"poke-{i:02d}-robot.{cloud_format}"
+            write_cloud(out / cloud, obs.cloud)
+            write_cloud(out / robot, PointCloud(obs.robot_points))
+            doc["pokes"].append({
+                "cloud": cloud, "tip_center": _floats(obs.contact.tip_center),
+                "force": _floats(obs.contact.force), "target_xy": _floats(obs.target_xy),
+                "force_n": float(obs.force_n), "robot_points": robot,
+            })  # fmt: skip
+    else:
+        stamps = [(i + 1) * _STAMP_STEP_NS for i in range(len(presses))]
+        write_session_bag(out / "bag", storage=format, observation=observation,
+                          presses=presses, stamps_ns=stamps)  # fmt: skip
+        doc["bag"] = "bag"
+        doc["pokes"] = [
+            {"stamp_ns": s, "target_xy": _floats(o.target_xy), "force_n": float(o.force_n)}
+            for s, o in zip(stamps, presses, strict=True)
+        ]
+    file = out / SESSION_FILE
+    file.write_text(yaml.dump(doc, Dumper=_Dumper, sort_keys=False), encoding="utf-8")
+    return file
