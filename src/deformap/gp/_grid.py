@@ -78,9 +78,19 @@ class GridState:
             inv, info = lapack.dpotri(self.factor[0], lower=1)
             if info != 0:
                 raise NotPositiveDefiniteError(f"inverting B failed (LAPACK info {info})")
-            lower = np.tril(inv)
-            self._b_inv = lower + np.tril(lower, -1).T
+            self._b_inv = _symmetrise_from_lower(inv)
         return self._b_inv
+
+
+def _symmetrise_from_lower(mat: NDArray[np.float64], block: int = 256) -> NDArray[np.float64]:
+    """Copy the lower triangle of square ``mat`` onto its upper triangle, in place, by blocks."""
+    size = mat.shape[0]
+    for i0 in range(0, size, block):
+        i1 = min(i0 + block, size)
+        diag = mat[i0:i1, i0:i1]
+        diag[...] = np.tril(diag) + np.tril(diag, -1).T
+        mat[i0:i1, i1:] = mat[i1:, i0:i1].T
+    return mat
 
 
 def inducing_axis(lo: float, hi: float, spacing: float, margin: float) -> NDArray[np.float64]:
