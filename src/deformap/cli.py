@@ -467,7 +467,7 @@ def world_show_command(
     import numpy as np
 
     from deformap.world import SimulatedWorld, WorldConfig, load_scenario
-    from deformap.world._show import show_world
+    from deformap.viz import show_world
 
     config = WorldConfig.coarse() if coarse else WorldConfig()
     world = SimulatedWorld(load_scenario(name), config=config, rng=np.random.default_rng(seed))

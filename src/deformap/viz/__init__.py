@@ -5,6 +5,7 @@ from __future__ import annotations
 from deformap.viz._figures import plot_beta_curve, plot_map, plot_poke
 from deformap.viz._rerun import heightmap_mesh, record_run
 from deformap.viz._studies import plot_cluster_size_study, plot_hardness_study
+from deformap.viz._world import show_world
 
 __all__ = [
     "heightmap_mesh",
@@ -14,4 +15,5 @@ __all__ = [
     "plot_map",
     "plot_poke",
     "record_run",
+    "show_world",
 ]

@@ -1,15 +1,17 @@
 """Pictures of a world for a person to check it: layout, one observed cloud, one dent.
 
-Imported only by the CLI (it needs matplotlib); the rest of :mod:`deformap.world` never imports it.
+Figures live in :mod:`deformap.viz`, a leaf: the world itself never imports matplotlib.
 """
 
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from deformap.world._world import SimulatedWorld
+if TYPE_CHECKING:
+    from deformap.world import SimulatedWorld
 
 __all__ = ["show_world"]
 
