@@ -165,7 +165,7 @@ def explore_command(
         overrides["scenario"] = scenario
     if seed is not None:
         overrides["seed"] = seed
-    explore_over = {
+    explore_over: dict[str, Any] = {
         k: v
         for k, v in {"strategy": strategy, "threshold": threshold, "max_pokes": max_pokes}.items()
         if v is not None
@@ -379,7 +379,7 @@ def reproduce_command(
 
     base = load_run_config(config)
     base = dataclasses.replace(
-        base, seed=seed, exploration=dataclasses.replace(base.exploration, strategy=strategy)
+        base, seed=seed, exploration=dataclasses.replace(base.exploration, strategy=strategy),  # type: ignore[arg-type]
     )
 
     def show(row: dict[str, Any]) -> None:
@@ -466,8 +466,8 @@ def world_show_command(
 
     import numpy as np
 
-    from deformap.world import SimulatedWorld, WorldConfig, load_scenario
     from deformap.viz import show_world
+    from deformap.world import SimulatedWorld, WorldConfig, load_scenario
 
     config = WorldConfig.coarse() if coarse else WorldConfig()
     world = SimulatedWorld(load_scenario(name), config=config, rng=np.random.default_rng(seed))
@@ -790,4 +790,4 @@ def _estimate_figures(folder: Any, poke: Any) -> None:
 
 
 if __name__ == "__main__":  # pragma: no cover
-    sys.exit(main())
+    main()

@@ -87,8 +87,8 @@ class Workspace:
         step = check_positive("spacing_m", spacing_m)
         (x0, y0), (w, d) = self.lower, self.size
         nx, ny = max(1, round(w / step)), max(1, round(d / step))
-        xs = x0 + (np.arange(nx) + 0.5) * (w / nx)
-        ys = y0 + (np.arange(ny) + 0.5) * (d / ny)
+        xs = np.asarray(x0 + (np.arange(nx) + 0.5) * (w / nx), dtype=np.float64)
+        ys = np.asarray(y0 + (np.arange(ny) + 0.5) * (d / ny), dtype=np.float64)
         return xs, ys
 
     def to_dict(self) -> dict[str, list[float]]:

@@ -108,5 +108,5 @@ class PointCloud:
             )
         pts = np.concatenate([c.points for c in clouds])
         have_colors = all(c.colors is not None for c in clouds)
-        cols = np.concatenate([c.colors for c in clouds]) if have_colors else None  # type: ignore[misc]
+        cols = np.concatenate([c.colors for c in clouds]) if have_colors else None
         return PointCloud(pts, cols, frame=clouds[0].frame)

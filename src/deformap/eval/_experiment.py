@@ -267,17 +267,26 @@ def write_map_figures(
             title=title,
         )
     for poke in result.pokes:
+        arrays = (
+            poke.roi_xs,
+            poke.roi_ys,
+            poke.rest_z,
+            poke.deformed_z,
+            poke.roi_points,
+            poke.tactile,
+        )
         if poke.roi_xs is None:  # resumed from the journal: no arrays to draw
             continue
+        roi_xs, roi_ys, rest_z, deformed_z, roi_points, tactile = (np.asarray(a) for a in arrays)
         r = poke.record
         plot_poke(
             folder / f"poke-{r['index'] + 1:02d}.png",
-            roi_xs=poke.roi_xs,
-            roi_ys=poke.roi_ys,
-            rest_z=poke.rest_z,
-            deformed_z=poke.deformed_z,
-            roi_points=poke.roi_points,
-            tactile=poke.tactile,
+            roi_xs=roi_xs,
+            roi_ys=roi_ys,
+            rest_z=rest_z,
+            deformed_z=deformed_z,
+            roi_points=roi_points,
+            tactile=tactile,
             betas=np.asarray(r["betas"]),
             errors=np.asarray(r["errors"]),
             beta=r["beta"],

@@ -80,14 +80,15 @@ def explore(
     env_s = 0.0
     while len(mapper.pokes) < config.max_pokes:
         index = len(mapper.pokes)
-        if index == 0:
-            first = config.first_target
-            target = np.array(env.workspace.center if first is None else first, dtype=float)
-        else:
-            target = mapper.next_target(streams[index + 1])
-            if target is None:
-                stop = "threshold"
-                break
+        first = config.first_target
+        target = (
+            np.array(env.workspace.center if first is None else first, dtype=float)
+            if index == 0
+            else mapper.next_target(streams[index + 1])
+        )
+        if target is None:
+            stop = "threshold"
+            break
         t0 = time.perf_counter()
         obs = env.press(target, config.force_n)
         try:

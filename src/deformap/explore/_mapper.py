@@ -169,7 +169,7 @@ class Mapper:
             contact.tip_center, contact.force, contact.tip_radius_m, n=cfg.n_tactile
         )
         t1 = time.perf_counter()
-        rest_z = self.surface.gp.predict_grid(roi_xs, roi_ys)
+        rest_z = np.asarray(self.surface.gp.predict_grid(roi_xs, roi_ys))
         data = np.vstack([roi, tactile])
         noise = np.concatenate(
             [np.full(len(roi), cfg.noise_std_m), np.full(len(tactile), cfg.tactile_noise_std_m)]
@@ -183,7 +183,7 @@ class Mapper:
             noise_std=cfg.noise_std_m,
             method="auto",
         ).fit(data[:, :2], target, noise_std=noise)
-        deformed_z = touch.predict_grid(roi_xs, roi_ys)
+        deformed_z = np.asarray(touch.predict_grid(roi_xs, roi_ys))
         if cfg.model == "residual":
             deformed_z = deformed_z + rest_z
         gx, gy = np.meshgrid(roi_xs, roi_ys)
