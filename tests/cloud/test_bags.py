@@ -197,3 +197,42 @@ def test_truncated_and_garbled_bags_raise_file_format_errors(
     data_file.write_bytes(bytes(b ^ 0x5A for b in data))
     with pytest.raises(FileFormatError, match=r"bag"):
         read_bag_clouds(bag, "/pts")
+
+
+@pytest.mark.parametrize("storage_name", BAG_STORAGES)
+def test_hypothesis_corrupted_bags_only_raise_deformap_errors(
+    tmp_path_factory: pytest.TempPathFactory, storage_name: str
+) -> None:
+    from hypothesis import HealthCheck, given, settings
+    from hypothesis import strategies as st
+
+    from deformap.errors import DeformapError
+
+    source = tmp_path_factory.mktemp("bag") / "bag"
+    write_bag(source, storage=storage_name, clouds={"/pts": [(i, _cloud(i, n=50)) for i in range(2)]},
+              wrenches={"/w": _wrenches()})  # fmt: skip
+    data_file = next(p for p in source.iterdir() if p.suffix in (".mcap", ".db3"))
+    original = data_file.read_bytes()
+
+    @settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+    @given(
+        cut=st.integers(min_value=0, max_value=len(original)),
+        flips=st.lists(st.tuples(st.integers(0, len(original) - 1), st.integers(1, 255)),
+                       max_size=8),
+    )
+    def check(cut: int, flips: list[tuple[int, int]]) -> None:
+        data = bytearray(original[:cut] if cut < len(original) else original)
+        for offset, mask in flips:
+            if offset < len(data):
+                data[offset] ^= mask
+        data_file.write_bytes(bytes(data))
+        for read in (lambda: read_bag_clouds(source, "/pts"), lambda: read_bag_wrenches(source, "/w")):
+            try:
+                read()
+            except DeformapError:
+                pass
+
+    try:
+        check()
+    finally:
+        data_file.write_bytes(original)

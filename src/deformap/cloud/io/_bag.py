@@ -120,9 +120,11 @@ def _messages(path: Any, topic: str, msgtype: str) -> Iterator[tuple[int, Any]]:
 
     if not p.exists():
         raise FileFormatError(f"{p}: no such bag")
-    # What rosbags, sqlite3 and the CDR decoder raise on damaged bags.
+    # What rosbags, sqlite3 and the CDR decoder raise on damaged bags; a corrupted length field
+    # can also ask for an absurd allocation (MemoryError).
     errors = (rosbag2.ReaderError, SerdeError, sqlite3.Error, OSError, ValueError, KeyError,
-              IndexError, TypeError, AssertionError, EOFError, struct.error)  # fmt: skip
+              IndexError, TypeError, AssertionError, EOFError, struct.error,
+              MemoryError)  # fmt: skip
     try:
         with rosbag2.Reader(p) as reader:
             conns = [c for c in reader.connections if c.topic == topic]
