@@ -14,7 +14,8 @@ from deformap._validation import check_points
 from deformap.environment import TactileContact
 from deformap.msm._config import ShapeMatchingConfig
 from deformap.msm._grid import ParticleGrid
-from deformap.msm._simulate import _check_config, simulate_poke
+from deformap.msm._poke import PokeSimulation
+from deformap.msm._simulate import PokeModel, _check_config
 
 __all__ = ["BetaEstimate", "estimate_beta", "matching_error"]
 
@@ -78,13 +79,76 @@ def matching_error(positions: Array, tree: cKDTree) -> Array:
     return np.asarray(d.reshape(b, -1).mean(axis=1))
 
 
-def _refinement(betas: Array, errors: Array, step: float, resolution: float) -> Array:
-    """New β on a ``resolution`` grid within one sweep step of the current minimum."""
-    best = float(betas[int(np.argmin(errors))])
+_GOLDEN = (np.sqrt(5.0) - 1.0) / 2.0
+
+
+class _Sweep:
+    """E(β) of one poke, each β solved once and started from the nearest β already solved."""
+
+    def __init__(self, model: PokeModel, tree: cKDTree):
+        self.model, self.tree = model, tree
+        self.sims: list[PokeSimulation] = []
+        self.errors: dict[float, float] = {}
+        self._body: dict[float, Array] = {}
+
+    def run(self, betas: Array) -> None:
+        """Solve the new β of ``betas (B,)`` in one batch."""
+        betas = np.asarray([b for b in np.round(betas, 10) if float(b) not in self.errors])
+        if betas.size == 0:
+            return
+        x0 = None
+        if self._body:
+            known = np.fromiter(self._body, dtype=float)
+            near = known[np.argmin(np.abs(known[None, :] - betas[:, None]), axis=1)]
+            x0 = np.stack([self._body[float(b)] for b in near])
+        sim = self.model.solve(betas, x0)
+        self.sims.append(sim)
+        for j, (b, e) in enumerate(zip(betas, matching_error(sim.positions, self.tree),
+                                       strict=True)):
+            self.errors[float(b)] = float(e)
+            self._body[float(b)] = self.model.last_body[j]
+
+    def __call__(self, beta: float) -> float:
+        key = float(np.round(beta, 10))
+        self.run(np.array([key]))
+        return self.errors[key]
+
+
+def _refine(sweep: _Sweep, step: float, resolution: float) -> None:
+    """Golden-section search for the minimum of E on the ``resolution`` grid within one ``step``
+    of the best swept β, then the grid neighbours of its final bracket.
+
+    E(β) is smooth, so within one sweep step of the sampled minimum it is unimodal and a
+    golden-section search finds the grid minimum in ``log_φ(2 step / resolution)`` solves instead
+    of the ``2 step / resolution`` of an exhaustive grid.
+    """
+    known = np.fromiter(sweep.errors, dtype=float)
+    errs = np.fromiter(sweep.errors.values(), dtype=float)
+    best = float(known[np.flatnonzero(errs <= errs.min() + _TIE_M)[0]])
     n = round(step / resolution)
-    cand = np.round(best + resolution * np.arange(-n, n + 1), 10)
-    cand = cand[(cand >= 0.0) & (cand < 1.0)]
-    return np.asarray([c for c in cand if np.min(np.abs(betas - c)) > 0.5 * resolution])
+    idx = np.arange(-n, n + 1)
+    vals = np.round(best + resolution * idx, 10)
+    ok = (vals >= 0.0) & (vals < 1.0)
+    a, b = int(idx[ok][0]), int(idx[ok][-1])
+
+    def e(i: int) -> float:
+        return sweep(best + resolution * i)
+
+    c = b - round(_GOLDEN * (b - a))
+    d = a + b - c
+    while b - a > 3:
+        if c > d:
+            c, d = d, c
+        if c == d:
+            d += 1
+        if e(c) <= e(d) + _TIE_M:
+            b, d = d, c
+            c = a + b - d
+        else:
+            a, c = c, d
+            d = a + b - c
+    for i in range(a, b + 1):
+        e(i)
 
 
 def _beta_std(betas: Array, errors: Array, tol: float, resolution: float) -> float:
@@ -132,17 +196,14 @@ def estimate_beta(rest_xs: Any, rest_ys: Any, rest_z: Any, deformed_points: Any,
     cfg = _check_config(config)
     grid = ParticleGrid.from_heightmap(rest_xs, rest_ys, rest_z)
     observed = check_points("deformed_points", deformed_points, min_rows=1)
-    tree = cKDTree(observed)
-    sweep = np.arange(cfg.n_beta) / cfg.n_beta
-    sims = [simulate_poke(grid.rest, grid.masses, grid.fixed, contact, sweep, cfg)]
-    betas, errors = sweep, matching_error(sims[0].positions, tree)
+    model = PokeModel(grid.rest, grid.masses, grid.fixed, contact, cfg)
+    sweep = _Sweep(model, cKDTree(observed))
+    sweep.run(np.arange(cfg.n_beta) / cfg.n_beta)
     if cfg.refine and cfg.beta_resolution < 1.0 / cfg.n_beta:
-        extra = _refinement(betas, errors, 1.0 / cfg.n_beta, cfg.beta_resolution)
-        if extra.size:
-            sims.append(simulate_poke(grid.rest, grid.masses, grid.fixed, contact, extra, cfg,
-                                      stiffness_n_per_m=sims[0].stiffness_n_per_m))
-            betas = np.concatenate([betas, extra])
-            errors = np.concatenate([errors, matching_error(sims[-1].positions, tree)])
+        _refine(sweep, 1.0 / cfg.n_beta, cfg.beta_resolution)
+    sims = sweep.sims
+    betas = np.concatenate([s.betas for s in sims])
+    errors = np.concatenate([[sweep.errors[float(b)] for b in s.betas] for s in sims])
     order = np.argsort(betas, kind="stable")
     betas, errors = betas[order], errors[order]
     its = np.concatenate([s.iterations for s in sims])[order]
@@ -153,5 +214,5 @@ def estimate_beta(rest_xs: Any, rest_ys: Any, rest_z: Any, deformed_points: Any,
         beta=float(betas[best]),
         beta_std=_beta_std(betas, errors, cfg.error_tolerance_m, cfg.beta_resolution),
         betas=betas, errors=errors, iterations=its, residual=res, converged=conv,
-        protocol=cfg.contact, mode=cfg.mode, stiffness_n_per_m=sims[0].stiffness_n_per_m,
+        protocol=cfg.contact, mode=cfg.mode, stiffness_n_per_m=model.stiffness,
     )
