@@ -83,7 +83,7 @@ _GOLDEN = (np.sqrt(5.0) - 1.0) / 2.0
 
 
 class _Sweep:
-    """E(β) of one poke, each β solved once and started from the nearest β already solved."""
+    """E(β) of one poke, each β solved once and started from the β already solved."""
 
     def __init__(self, model: PokeModel, tree: cKDTree):
         self.model, self.tree = model, tree
@@ -98,15 +98,23 @@ class _Sweep:
             return
         x0 = None
         if self._body:
-            known = np.fromiter(self._body, dtype=float)
-            near = known[np.argmin(np.abs(known[None, :] - betas[:, None]), axis=1)]
-            x0 = np.stack([self._body[float(b)] for b in near])
+            x0 = np.stack([self._start(float(b)) for b in betas])
         sim = self.model.solve(betas, x0)
         self.sims.append(sim)
         for j, (b, e) in enumerate(zip(betas, matching_error(sim.positions, self.tree),
                                        strict=True)):
             self.errors[float(b)] = float(e)
             self._body[float(b)] = self.model.last_body[j]
+
+    def _start(self, beta: float) -> Array:
+        """Starting positions for ``beta``: linear in β through the two nearest solved β."""
+        known = np.fromiter(self._body, dtype=float)
+        near = known[np.argsort(np.abs(known - beta), kind="stable")[:2]]
+        if near.size == 1:
+            return self._body[float(near[0])]
+        b0, b1 = float(near[0]), float(near[1])
+        t = (beta - b0) / (b1 - b0)
+        return (1.0 - t) * self._body[b0] + t * self._body[b1]
 
     def __call__(self, beta: float) -> float:
         key = float(np.round(beta, 10))

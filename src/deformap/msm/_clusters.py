@@ -183,12 +183,13 @@ class Clusters:
 
     def _projection(self, q: Array, cutoff: Array) -> Array:
         """``Π[i, j] = q_iᵀ A_qq⁺ q_j w_j``, dropping eigenvalues of ``A_qq`` below ``cutoff``."""
-        aqq = np.einsum("cj,cjf,cjg->cfg", self.w, q, q)
+        wq = self.w[..., None] * q
+        aqq = np.swapaxes(wq, 1, 2) @ q
         lam, vec = np.linalg.eigh(aqq)
         keep = lam > cutoff[:, None]
         inv = np.where(keep, 1.0 / np.where(keep, lam, 1.0), 0.0)
-        aqq_pinv = np.einsum("cfe,ce,cge->cfg", vec, inv, vec)
-        return np.einsum("cif,cfg,cjg,cj->cij", q, aqq_pinv, q, self.w)
+        aqq_pinv = (vec * inv[:, None, :]) @ np.swapaxes(vec, 1, 2)
+        return np.asarray(q @ aqq_pinv @ np.swapaxes(wq, 1, 2))
 
     def _hat_matrices(self, regularization: float) -> Array:
         """``(C, km, km)`` weighted least-squares projections onto the feature span.

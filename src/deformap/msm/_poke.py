@@ -51,6 +51,8 @@ __all__ = ["Equilibrium", "PokeSimulation", "force_weights", "hertz_depth"]
 logger = logging.getLogger(__name__)
 Array = NDArray[np.float64]
 
+_ROT_BATCH = 1
+
 
 @dataclass(frozen=True, kw_only=True)
 class PokeSimulation:
@@ -126,12 +128,15 @@ class Equilibrium:
     def _map(self, x: Array, active: NDArray[np.int64]) -> Array:
         """One local–global step ``G(x)`` for the free particles of the ``active`` β."""
         cl = self.cl
-        xa = x[active].reshape(len(active), *cl.shape, 3)
-        rot = cl.rotation_term(xa).reshape(len(active), -1, 3)
         out = np.empty((len(active), len(self.free), 3))
-        for a, j in enumerate(active):
-            out[a] = self.system.solve(self.fit_weight[j],
-                                       self.rot_weight[j] * rot[a, self.free] + self.const[j])
+        # a few β per batch: the per-cluster temporaries of larger batches fall out of cache
+        for lo in range(0, len(active), _ROT_BATCH):
+            part = active[lo : lo + _ROT_BATCH]
+            xa = x[part].reshape(len(part), *cl.shape, 3)
+            rot = cl.rotation_term(xa).reshape(len(part), -1, 3)
+            for a, j in enumerate(part, start=lo):
+                out[a] = self.system.solve(self.fit_weight[j], self.rot_weight[j]
+                                           * rot[a - lo, self.free] + self.const[j])
         return out
 
     def solve(self, x_fixed: Array, force: Array, stiffness: float, tol: float, max_iter: int,
