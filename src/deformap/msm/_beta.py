@@ -79,9 +79,6 @@ def matching_error(positions: Array, tree: cKDTree) -> Array:
     return np.asarray(d.reshape(b, -1).mean(axis=1))
 
 
-_GOLDEN = (np.sqrt(5.0) - 1.0) / 2.0
-
-
 class _Sweep:
     """E(β) of one poke, each β solved once and started from the β already solved."""
 
@@ -123,12 +120,14 @@ class _Sweep:
 
 
 def _refine(sweep: _Sweep, step: float, resolution: float) -> None:
-    """Golden-section search for the minimum of E on the ``resolution`` grid within one ``step``
-    of the best swept β, then the grid neighbours of its final bracket.
+    """Find the minimum of E on the ``resolution`` grid within one ``step`` of the best swept β.
 
-    E(β) is smooth, so within one sweep step of the sampled minimum it is unimodal and a
-    golden-section search finds the grid minimum in ``log_φ(2 step / resolution)`` solves instead
-    of the ``2 step / resolution`` of an exhaustive grid.
+    E(β) is smooth, so there it is unimodal, and a grid point whose two grid neighbours are both
+    higher is the minimum. The search starts at the vertex of the parabola through the best
+    swept β and its two swept neighbours (solving that grid point and its neighbours in one
+    batch), then walks downhill one grid step at a time until the lowest point has both
+    neighbours solved: a handful of solves instead of the ``2 step / resolution`` of an
+    exhaustive grid, and the same grid minimum.
     """
     known = np.fromiter(sweep.errors, dtype=float)
     errs = np.fromiter(sweep.errors.values(), dtype=float)
@@ -136,27 +135,37 @@ def _refine(sweep: _Sweep, step: float, resolution: float) -> None:
     n = round(step / resolution)
     idx = np.arange(-n, n + 1)
     vals = np.round(best + resolution * idx, 10)
-    ok = (vals >= 0.0) & (vals < 1.0)
-    a, b = int(idx[ok][0]), int(idx[ok][-1])
+    inside = idx[(vals >= 0.0) & (vals < 1.0)]
+    a, b = int(inside[0]), int(inside[-1])
 
-    def e(i: int) -> float:
-        return sweep(best + resolution * i)
+    def key(i: int) -> float:
+        return float(np.round(best + resolution * i, 10))
 
-    c = b - round(_GOLDEN * (b - a))
-    d = a + b - c
-    while b - a > 3:
-        if c > d:
-            c, d = d, c
-        if c == d:
-            d += 1
-        if e(c) <= e(d) + _TIE_M:
-            b, d = d, c
-            c = a + b - d
-        else:
-            a, c = c, d
-            d = a + b - c
-    for i in range(a, b + 1):
-        e(i)
+    guess = int(np.clip(round(_vertex(known, errs, best) / resolution), a, b))
+    sweep.run(np.array([key(i) for i in (guess - 1, guess, guess + 1) if a <= i <= b]))
+    while True:
+        done = [i for i in range(a, b + 1) if key(i) in sweep.errors]
+        e = np.array([sweep.errors[key(i)] for i in done])
+        m = done[int(np.flatnonzero(e <= e.min() + _TIE_M)[0])]
+        missing = [i for i in (m - 1, m + 1) if a <= i <= b and key(i) not in sweep.errors]
+        if not missing:
+            return
+        sweep.run(np.array([key(i) for i in missing]))
+
+
+def _vertex(betas: Array, errors: Array, best: float) -> float:
+    """Offset from ``best`` of the vertex of the parabola through it and its two nearest swept
+    neighbours (0 when that parabola has no minimum)."""
+    near = np.sort(betas[np.argsort(np.abs(betas - best), kind="stable")[:3]])
+    if near.size < 3:
+        return 0.0
+    e = np.array([errors[int(np.flatnonzero(betas == b)[0])] for b in near])
+    x = near - best
+    curv = ((e[2] - e[1]) / (x[2] - x[1]) - (e[1] - e[0]) / (x[1] - x[0])) / (x[2] - x[0])
+    if not curv > 0.0:
+        return 0.0
+    slope = (e[1] - e[0]) / (x[1] - x[0]) - curv * (x[0] + x[1])
+    return float(-slope / (2.0 * curv))
 
 
 def _beta_std(betas: Array, errors: Array, tol: float, resolution: float) -> float:
