@@ -38,8 +38,8 @@ class BetaEstimate:
         the rigid end β̂ = 0.
     beta_std : float
         Uncertainty of β̂ from the curve's shape: the standard deviation (width / √12) of the β
-        interval around β̂ where E(β) ≤ min E + ``config.error_tolerance_m``, at least
-        ``beta_resolution / √12``.
+        interval around β̂ where E(β) ≤ min E + ``config.error_tolerance_m`` (its ends linearly
+        interpolated between the sampled β), at least ``beta_resolution / √12``.
     betas : (n,) float
         Every β simulated, sorted (the uniform sweep plus the refinement).
     errors : (n,) float, metres
@@ -169,14 +169,25 @@ def _vertex(betas: Array, errors: Array, best: float) -> float:
 
 
 def _beta_std(betas: Array, errors: Array, tol: float, resolution: float) -> float:
+    """Width / √12 of the β interval around β̂ where E ≤ E(β̂) + ``tol``; its ends are found by
+    linear interpolation of E between the sampled β, so that the width does not depend on how
+    densely the sweep sampled the curve (at least ``resolution``)."""
     i = int(np.flatnonzero(errors <= errors.min() + _TIE_M)[0])
-    ok = errors <= errors[i] + tol
+    level = errors[i] + tol
+    ok = errors <= level
     lo = hi = i
     while lo > 0 and ok[lo - 1]:
         lo -= 1
     while hi < len(betas) - 1 and ok[hi + 1]:
         hi += 1
-    return float(max(betas[hi] - betas[lo], resolution) / np.sqrt(12.0))
+    left, right = float(betas[lo]), float(betas[hi])
+    if lo > 0:
+        t = (level - errors[lo - 1]) / (errors[lo] - errors[lo - 1])
+        left = float(betas[lo - 1] + t * (betas[lo] - betas[lo - 1]))
+    if hi < len(betas) - 1:
+        t = (level - errors[hi]) / (errors[hi + 1] - errors[hi])
+        right = float(betas[hi] + t * (betas[hi + 1] - betas[hi]))
+    return float(max(right - left, resolution) / np.sqrt(12.0))
 
 
 def estimate_beta(rest_xs: Any, rest_ys: Any, rest_z: Any, deformed_points: Any,

@@ -42,40 +42,57 @@ class StepMatrices:
 
     def __init__(self, clusters: Clusters, fixed: NDArray[np.bool_]):
         n = fixed.size
-        self.free = np.flatnonzero(~fixed.ravel())
-        self.fix = np.flatnonzero(fixed.ravel())
+        is_fixed = fixed.ravel()
+        self.free = np.flatnonzero(~is_fixed)
+        self.fix = np.flatnonzero(is_fixed)
+        nf = len(self.free)
         idx = np.arange(n).reshape(fixed.shape)[None, ..., None].astype(float)
         members = clusters.gather(idx)[0, ..., 0].astype(np.int64)  # (C, km)
-        kk = members.shape[1]
-        rows = np.repeat(members[:, :, None], kk, axis=2).ravel()
-        cols = np.repeat(members[:, None, :], kk, axis=1).ravel()
-        wdat = np.broadcast_to(clusters.w[:, None, :], (members.shape[0], kk, kk)).ravel()
-        minv = sp.diags(1.0 / clusters.count.ravel())
-        wsum = (minv @ sp.csr_matrix((wdat, (rows, cols)), shape=(n, n))).tocsr()
+        nc, kk = members.shape
+        rows = np.broadcast_to(members[:, :, None], (nc, kk, kk)).ravel()
+        cols = np.broadcast_to(members[:, None, :], (nc, kk, kk)).ravel()
+        # row i of cluster c: W_c[i, j] = w_j (centre of mass), Π_c[i, j] = hat[c, i, j]
+        wdat = np.broadcast_to(clusters.w[:, None, :], (nc, kk, kk)).ravel()
         hat = clusters.hat
         self.rigid = hat is None
-        psum = (sp.csr_matrix((n, n)) if hat is None else
-                (minv @ sp.csr_matrix((hat.ravel(), (rows, cols)), shape=(n, n))).tocsr())
-        free, fix = self.free, self.fix
-        self.couple_w = wsum[free][:, fix].tocsr()
-        self.couple_p = psum[free][:, fix].tocsr()
+        pdat = np.zeros_like(wdat) if hat is None else hat.ravel()
+        pos = np.full(n, -1, dtype=np.int64)
+        pos[self.free] = np.arange(nf)
+        pos[self.fix] = np.arange(len(self.fix))
+        count = clusters.count.ravel()
+        # coupling of the free rows to the fixed particles, M⁻¹ Σ_c (W_c + β Π_c)
+        fc = ~is_fixed[rows] & is_fixed[cols]
+        r, c, inv_m = pos[rows[fc]], pos[cols[fc]], 1.0 / count[rows[fc]]
+        shape = (nf, len(self.fix))
+        self.couple_w = sp.csr_matrix((wdat[fc] * inv_m, (r, c)), shape=shape)
+        self.couple_p = sp.csr_matrix((pdat[fc] * inv_m, (r, c)), shape=shape)
         # β-part of the constant term: M⁻¹ Σ_c (s − Π p⁰); zero when the features span s.
         if hat is None:
-            self.fit_const = np.zeros((len(free), 3))
+            self.fit_const = np.zeros((nf, 3))
         else:
-            c = clusters.s - np.einsum("cij,cjd->cid", hat, clusters.p0)
-            summed = clusters.scatter(c[None])[0] / clusters.count[..., None]
-            self.fit_const = summed.reshape(n, 3)[free]
-        self._scale = (clusters.masses * clusters.count).ravel()[free]
+            cst = clusters.s - np.einsum("cij,cjd->cid", hat, clusters.p0)
+            summed = clusters.scatter(cst[None])[0] / clusters.count[..., None]
+            self.fit_const = summed.reshape(n, 3)[self.free]
+        self._scale = (clusters.masses.ravel() * count)[self.free]
         self._perm = _band_order(fixed)
-        wff = wsum[free][:, free]
-        pff = psum[free][:, free]
-        d = sp.diags(self._scale)
-        s0 = (d - d @ wff)[self._perm][:, self._perm]
-        s1 = (d @ pff)[self._perm][:, self._perm]
-        self._wff, self._pff = wff, pff
-        self._bw = int(max(_half_bandwidth(s0), _half_bandwidth(s1)))
-        self._band0, self._band1 = _upper_band(s0, self._bw), _upper_band(s1, self._bw)
+        # S₀ = diag(m M) − diag(m) Σ_c W_c and S₁ = diag(m) Σ_c Π_c on the free particles, in
+        # band order; only the upper triangle is kept (they are symmetric)
+        band_pos = np.full(n, -1, dtype=np.int64)
+        band_pos[self.free[self._perm]] = np.arange(nf)
+        ff = ~is_fixed[rows] & ~is_fixed[cols]
+        br, bc = band_pos[rows[ff]], band_pos[cols[ff]]
+        up = br <= bc
+        br, bc = br[up], bc[up]
+        mass = clusters.masses.ravel()[rows[ff][up]]
+        self._bw = int(np.max(bc - br)) if bc.size else 0
+        self._upper = (br, bc)
+        flat = (self._bw + br - bc) * nf + bc
+        size = (self._bw + 1) * nf
+        self._band0 = -np.bincount(flat, weights=mass * wdat[ff][up], minlength=size).reshape(
+            self._bw + 1, nf)
+        self._band0[self._bw] += self._scale[self._perm]
+        self._band1 = np.bincount(flat, weights=mass * pdat[ff][up], minlength=size).reshape(
+            self._bw + 1, nf)
         self._factors: dict[float, object] = {}
 
     def couple(self, beta_fit: float) -> sp.csr_matrix:
@@ -101,9 +118,25 @@ class StepMatrices:
         try:
             return cholesky_banded(band, lower=False, check_finite=False)
         except LinAlgError:
-            kff = sp.identity(len(self.free), format="csc") - (self._wff + beta_fit * self._pff)
-            return splu(kff.tocsc(), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.1,
+            return _SparseFallback(band, self._bw, self._scale, self._perm)
+
+
+class _SparseFallback:
+    """SuperLU of the symmetric band matrix, solving like the banded Cholesky does."""
+
+    def __init__(self, band: Array, bw: int, scale: Array, perm: NDArray[np.int64]):
+        n = band.shape[1]
+        diags = [band[bw - k, k:] for k in range(bw + 1)]
+        upper = sp.diags(diags, list(range(bw + 1)), shape=(n, n))
+        full = (upper + sp.triu(upper, k=1).T).tocsc()
+        self._lu = splu(full, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.1,
                         options={"SymmetricMode": True})
+        self._scale, self._perm = scale, perm
+
+    def solve(self, rhs: Array) -> Array:
+        out = np.empty_like(rhs)
+        out[self._perm] = self._lu.solve((self._scale[:, None] * rhs)[self._perm])
+        return out
 
 
 def _band_order(fixed: NDArray[np.bool_]) -> NDArray[np.int64]:
@@ -117,16 +150,3 @@ def _band_order(fixed: NDArray[np.bool_]) -> NDArray[np.int64]:
     pos[free] = np.arange(int(free.sum()))
     order = pos[grid.ravel()]
     return order[order >= 0]
-
-
-def _half_bandwidth(m: sp.spmatrix) -> int:
-    coo = m.tocoo()
-    return int(np.max(np.abs(coo.row - coo.col))) if coo.nnz else 0
-
-
-def _upper_band(m: sp.spmatrix, bw: int) -> Array:
-    """LAPACK upper band storage ``ab[bw + i − j, j] = m[i, j]`` for ``i ≤ j``."""
-    up = sp.triu(m).tocoo()
-    ab = np.zeros((bw + 1, m.shape[0]))
-    ab[bw + up.row - up.col, up.col] = up.data
-    return ab
