@@ -133,3 +133,14 @@ def test_layered_rotation_term_matches_the_per_cluster_sum(rng):
     rs = cl.s @ np.swapaxes(cl.rotations(cl.gather(x)), -1, -2)
     want = cl.scatter(rs) / cl.count[None, ..., None]
     np.testing.assert_allclose(cl.rotation_term(x), want, rtol=0, atol=1e-14)
+
+
+def test_fast_polar_rotation_matches_the_svd_polar(rng):
+    from deformap.msm._clusters import fast_polar_rotation
+
+    a = rng.normal(size=(300, 3, 3))
+    a[:100] = np.eye(3) + 0.05 * a[:100]  # near rotations, as in a converging solve
+    a[250:260, :, 2] = 0.0  # singular: the SVD fallback
+    a[260:270, :, 0] *= -np.sign(np.linalg.det(a[260:270]))[:, None]  # det < 0: fallback
+    np.testing.assert_allclose(fast_polar_rotation(a.copy()), polar_rotation(a.copy()),
+                               atol=1e-12)
