@@ -51,7 +51,7 @@ __all__ = ["Equilibrium", "PokeSimulation", "force_weights", "hertz_depth"]
 logger = logging.getLogger(__name__)
 Array = NDArray[np.float64]
 
-_ROT_BATCH = 1
+_ROT_BATCH = 4
 
 
 @dataclass(frozen=True, kw_only=True)
