@@ -155,17 +155,24 @@ def _refine(sweep: _Sweep, step: float, resolution: float) -> None:
 
 def _vertex(betas: Array, errors: Array, best: float) -> float:
     """Offset from ``best`` of the vertex of the parabola through it and its two nearest swept
-    neighbours (0 when that parabola has no minimum)."""
+    neighbours (0 when that parabola has no minimum).
+
+    The parabola is fitted in ``u = −log(1 − β)``: the β-dependent part of the goals stiffens
+    the body in proportion to ``1 − β`` (``K_β``'s smallest eigenvalues, see
+    :mod:`deformap.msm._linsys`), so the simulated dent, and E, change on that scale, and a
+    parabola in β alone puts the vertex systematically on the rigid side.
+    """
     near = np.sort(betas[np.argsort(np.abs(betas - best), kind="stable")[:3]])
     if near.size < 3:
         return 0.0
     e = np.array([errors[int(np.flatnonzero(betas == b)[0])] for b in near])
-    x = near - best
+    x = -np.log1p(-near)
     curv = ((e[2] - e[1]) / (x[2] - x[1]) - (e[1] - e[0]) / (x[1] - x[0])) / (x[2] - x[0])
     if not curv > 0.0:
         return 0.0
     slope = (e[1] - e[0]) / (x[1] - x[0]) - curv * (x[0] + x[1])
-    return float(-slope / (2.0 * curv))
+    u = -slope / (2.0 * curv)
+    return float(-np.expm1(-u) - best)
 
 
 def _beta_std(betas: Array, errors: Array, tol: float, resolution: float) -> float:
