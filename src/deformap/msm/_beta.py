@@ -96,12 +96,12 @@ class _Sweep:
         x0 = None
         if self._body:
             x0 = np.stack([self._start(float(b)) for b in betas])
-        sim = self.model.solve(betas, x0)
+        sim, body = self.model.solve(betas, x0)
         self.sims.append(sim)
         for j, (b, e) in enumerate(zip(betas, matching_error(sim.positions, self.tree),
                                        strict=True)):
             self.errors[float(b)] = float(e)
-            self._body[float(b)] = self.model.last_body[j]
+            self._body[float(b)] = body[j]
 
     def _start(self, beta: float) -> Array:
         """Starting positions for ``beta``: linear in β through the two nearest solved β."""

@@ -160,7 +160,7 @@ def simulate_poke(rest: Any, masses: Any, fixed: Any, contact: TactileContact, b
     p0 = _check_rest(rest, cfg.cluster_size)
     b = check_betas(betas)
     model = PokeModel(p0, masses, fixed, contact, cfg, stiffness_n_per_m=stiffness_n_per_m)
-    return model.solve(b)
+    return model.solve(b)[0]
 
 
 class PokeModel:
@@ -215,21 +215,21 @@ class PokeModel:
                                                     self.spacing)
         self.stiffness = float(stiffness_n_per_m)
 
-    def solve(self, betas: Array, x0: Array | None = None) -> PokeSimulation:
+    def solve(self, betas: Array, x0: Array | None = None) -> tuple[PokeSimulation, Array]:
         """Equilibria for ``betas (B,)``, optionally started from positions ``x0 (B, *body, 3)``.
 
-        Returns the surface layer's positions; :attr:`last_body` keeps the whole body's (to
-        warm-start a later solve).
+        Returns the simulation (the surface layer's positions) and the whole body's positions
+        ``(B, *body, 3)`` (to warm-start a later solve).
         """
         cfg = self.cfg
         eq = Equilibrium(self.clusters, self.fixed, betas, system=self.system)
         k = 1.0 if self.stiffness is None else self.stiffness
         x, it, res, conv = eq.solve(self.x_fixed, self.force, k, cfg.tol, cfg.max_iter,
                                     self.spacing, x0=x0)
-        self.last_body = x
-        return PokeSimulation(betas=betas, positions=x[:, 0], iterations=it, residual=res,
-                              converged=conv, protocol=cfg.contact,
-                              stiffness_n_per_m=self.stiffness)
+        sim = PokeSimulation(betas=betas, positions=x[:, 0], iterations=it, residual=res,
+                             converged=conv, protocol=cfg.contact,
+                             stiffness_n_per_m=self.stiffness)
+        return sim, x
 
 
 def _body(p0: Array, masses: Array, fixed: NDArray[np.bool_], spacing: float,
