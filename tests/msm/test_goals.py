@@ -118,3 +118,29 @@ def test_planar_cluster_shortcut_matches_the_svd_polar_rotation(rng):
     apq = np.swapaxes(cl.gather(cur), -1, -2) @ cl.ws
     np.testing.assert_allclose(cl.rotations(cl.gather(cur)), polar_rotation(apq.copy()),
                                atol=1e-10)
+
+
+def test_layered_rotation_term_matches_the_per_cluster_sum(rng):
+    # the solver's component-major box-filter path against gathering every cluster's members
+    n, h = 7, 0.005
+    xs = np.arange(n) * h
+    sheet = ParticleGrid.from_heightmap(xs, xs, np.full((n, n), 0.05)).rest
+    body = np.stack([sheet - [0.0, 0.0, d] for d in (0.0, 0.004, 0.012)])
+    masses = np.ones(body.shape[:3]) * np.array([1.0, 1.5, 3.0])[:, None, None]
+    cl = Clusters(body, masses, (2, 3, 3), "quadratic", 1e-3)
+    assert not cl.planar.any()
+    x = body[None] + rng.normal(scale=1e-3, size=(2, *body.shape))
+    rs = cl.s @ np.swapaxes(cl.rotations(cl.gather(x)), -1, -2)
+    want = cl.scatter(rs) / cl.count[None, ..., None]
+    np.testing.assert_allclose(cl.rotation_term(x), want, rtol=0, atol=1e-14)
+
+
+def test_fast_polar_rotation_matches_the_svd_polar(rng):
+    from deformap.msm._clusters import fast_polar_rotation
+
+    a = rng.normal(size=(300, 3, 3))
+    a[:100] = np.eye(3) + 0.05 * a[:100]  # near rotations, as in a converging solve
+    a[250:260, :, 2] = 0.0  # singular: the SVD fallback
+    a[260:270, :, 0] *= -np.sign(np.linalg.det(a[260:270]))[:, None]  # det < 0: fallback
+    np.testing.assert_allclose(fast_polar_rotation(a.copy()), polar_rotation(a.copy()),
+                               atol=1e-12)

@@ -240,3 +240,51 @@ def test_bad_config_is_refused(kwargs, name):
 
     with pytest.raises(InvalidArgumentError, match=name):
         ShapeMatchingConfig(**kwargs)
+
+
+@pytest.mark.parametrize("beta", [0.0, 0.5, 0.95])
+def test_banded_step_solve_inverts_the_cluster_operator(rng, beta):
+    # K_β x = x − M⁻¹ Σ_c (W_c + β Π_c) x on the free particles, applied cluster by cluster
+    from deformap.msm._clusters import Clusters
+    from deformap.msm._linsys import StepMatrices, _SparseFallback
+    from deformap.msm._simulate import _body
+
+    xs, ys, z, _, _ = dent_case(60, n=9)
+    g = _grid(xs, ys, z)
+    body, body_m, body_fixed, window = _body(g.rest, g.masses, g.fixed, g.spacing_m,
+                                             ShapeMatchingConfig())
+    cl = Clusters(body, body_m, window, "quadratic", 1e-3)
+    sm = StepMatrices(cl, body_fixed)
+    rhs = rng.normal(size=(len(sm.free), 3))
+    x = sm.solve(beta, rhs)
+    full = np.zeros((body_fixed.size, 3))
+    full[sm.free] = x
+    xc = cl.gather(full.reshape(1, *body_fixed.shape, 3))[0]
+    t = np.einsum("cj,cjd->cd", cl.w, xc)
+    per = t[:, None, :] + beta * (cl.hat @ xc)
+    mapped = (cl.scatter(per[None])[0] / cl.count[..., None]).reshape(-1, 3)
+    np.testing.assert_allclose((full - mapped)[sm.free], rhs, rtol=0, atol=1e-10)
+    band = sm._band0 - beta * sm._band1
+    lu = _SparseFallback(band, sm._bw, sm._scale, sm._perm)
+    np.testing.assert_allclose(lu.solve(rhs), x, rtol=0, atol=1e-10)
+
+
+def test_refinement_finds_the_minimum_of_the_exhaustive_grid():
+    # the coarse sweep + downhill walk must land where E is lowest on the whole 0.01 grid
+    # around the sweep's minimum (computed here by brute force, one batched simulation)
+    from scipy.spatial import cKDTree
+
+    from deformap.msm._beta import matching_error
+
+    xs, ys, z, pts, contact = dent_case(110, n=13)
+    cfg = ShapeMatchingConfig()
+    est = estimate_beta(xs, ys, z, pts, contact, cfg)
+    coarse = est.betas[np.isclose(est.betas * cfg.n_beta, np.round(est.betas * cfg.n_beta))]
+    lo = max(0.0, float(coarse[np.argmin(est.errors[np.isin(est.betas, coarse)])]) - 0.1)
+    grid = np.round(np.arange(lo, min(lo + 0.2, 0.99) + 1e-9, 0.01), 10)
+    g = _grid(xs, ys, z)
+    sim = simulate_poke(g.rest, g.masses, g.fixed, contact, grid, cfg,
+                        stiffness_n_per_m=est.stiffness_n_per_m)
+    errors = matching_error(sim.positions, cKDTree(pts))
+    assert est.beta == pytest.approx(grid[np.argmin(errors)])
+    assert est.betas.size < cfg.n_beta + grid.size / 2  # far fewer solves than the grid

@@ -1,10 +1,12 @@
 """Benchmark of the β estimation: one batched sweep against a naive per-β loop, same run.
 
 Both sides compute the same thing: the converged poke equilibrium of every β that
-:func:`deformap.msm.estimate_beta` visits (the uniform sweep plus the refinement to 0.01) and
-E(β) for each, on a Hertz dent of a 60 N foam (an elastic half-space, not shape matching) with
-0.1 mm of seeded observation noise. The loop reuses the batched run's calibrated stiffness, so it
-differs only in simulating one β at a time.
+:func:`deformap.msm.estimate_beta` visits (the coarse uniform sweep plus the refinement to 0.01)
+and E(β) for each, on a Hertz dent of a 60 N foam (an elastic half-space, not shape matching) with
+0.1 mm of seeded observation noise. The estimate sets the ROI up once, solves the sweep in one
+batch and starts each refinement β from the β already solved; the naive loop simulates each of
+the same β on its own (its own set-up and factorisation, started from rest), reusing only the
+calibrated stiffness. "n_beta" is the number of β values simulated.
 """
 
 from __future__ import annotations

@@ -14,7 +14,8 @@ from deformap._validation import check_points
 from deformap.environment import TactileContact
 from deformap.msm._config import ShapeMatchingConfig
 from deformap.msm._grid import ParticleGrid
-from deformap.msm._simulate import _check_config, simulate_poke
+from deformap.msm._poke import PokeSimulation
+from deformap.msm._simulate import PokeModel, _check_config
 
 __all__ = ["BetaEstimate", "estimate_beta", "matching_error"]
 
@@ -37,8 +38,8 @@ class BetaEstimate:
         the rigid end β̂ = 0.
     beta_std : float
         Uncertainty of β̂ from the curve's shape: the standard deviation (width / √12) of the β
-        interval around β̂ where E(β) ≤ min E + ``config.error_tolerance_m``, at least
-        ``beta_resolution / √12``.
+        interval around β̂ where E(β) ≤ min E + ``config.error_tolerance_m`` (its ends linearly
+        interpolated between the sampled β), at least ``beta_resolution / √12``.
     betas : (n,) float
         Every β simulated, sorted (the uniform sweep plus the refinement).
     errors : (n,) float, metres
@@ -78,24 +79,122 @@ def matching_error(positions: Array, tree: cKDTree) -> Array:
     return np.asarray(d.reshape(b, -1).mean(axis=1))
 
 
-def _refinement(betas: Array, errors: Array, step: float, resolution: float) -> Array:
-    """New β on a ``resolution`` grid within one sweep step of the current minimum."""
-    best = float(betas[int(np.argmin(errors))])
+class _Sweep:
+    """E(β) of one poke, each β solved once and started from the β already solved."""
+
+    def __init__(self, model: PokeModel, tree: cKDTree):
+        self.model, self.tree = model, tree
+        self.sims: list[PokeSimulation] = []
+        self.errors: dict[float, float] = {}
+        self._body: dict[float, Array] = {}
+
+    def run(self, betas: Array) -> None:
+        """Solve the new β of ``betas (B,)`` in one batch."""
+        betas = np.asarray([b for b in np.round(betas, 10) if float(b) not in self.errors])
+        if betas.size == 0:
+            return
+        x0 = None
+        if self._body:
+            x0 = np.stack([self._start(float(b)) for b in betas])
+        sim, body = self.model.solve(betas, x0)
+        self.sims.append(sim)
+        for j, (b, e) in enumerate(zip(betas, matching_error(sim.positions, self.tree),
+                                       strict=True)):
+            self.errors[float(b)] = float(e)
+            self._body[float(b)] = body[j]
+
+    def _start(self, beta: float) -> Array:
+        """Starting positions for ``beta``: linear in β through the two nearest solved β."""
+        known = np.fromiter(self._body, dtype=float)
+        near = known[np.argsort(np.abs(known - beta), kind="stable")[:2]]
+        if near.size == 1:
+            return self._body[float(near[0])]
+        b0, b1 = float(near[0]), float(near[1])
+        t = (beta - b0) / (b1 - b0)
+        return (1.0 - t) * self._body[b0] + t * self._body[b1]
+
+    def __call__(self, beta: float) -> float:
+        key = float(np.round(beta, 10))
+        self.run(np.array([key]))
+        return self.errors[key]
+
+
+def _refine(sweep: _Sweep, step: float, resolution: float) -> None:
+    """Find the minimum of E on the ``resolution`` grid within one ``step`` of the best swept β.
+
+    E(β) is smooth, so there it is unimodal, and a grid point whose two grid neighbours are both
+    higher is the minimum. The search starts at the vertex of the parabola through the best
+    swept β and its two swept neighbours (solving that grid point and its neighbours in one
+    batch), then walks downhill one grid step at a time until the lowest point has both
+    neighbours solved: a handful of solves instead of the ``2 step / resolution`` of an
+    exhaustive grid, and the same grid minimum.
+    """
+    known = np.fromiter(sweep.errors, dtype=float)
+    errs = np.fromiter(sweep.errors.values(), dtype=float)
+    best = float(known[np.flatnonzero(errs <= errs.min() + _TIE_M)[0]])
     n = round(step / resolution)
-    cand = np.round(best + resolution * np.arange(-n, n + 1), 10)
-    cand = cand[(cand >= 0.0) & (cand < 1.0)]
-    return np.asarray([c for c in cand if np.min(np.abs(betas - c)) > 0.5 * resolution])
+    idx = np.arange(-n, n + 1)
+    vals = np.round(best + resolution * idx, 10)
+    inside = idx[(vals >= 0.0) & (vals < 1.0)]
+    a, b = int(inside[0]), int(inside[-1])
+
+    def key(i: int) -> float:
+        return float(np.round(best + resolution * i, 10))
+
+    guess = int(np.clip(round(_vertex(known, errs, best) / resolution), a, b))
+    sweep.run(np.array([key(i) for i in (guess - 1, guess, guess + 1) if a <= i <= b]))
+    while True:
+        done = [i for i in range(a, b + 1) if key(i) in sweep.errors]
+        e = np.array([sweep.errors[key(i)] for i in done])
+        m = done[int(np.flatnonzero(e <= e.min() + _TIE_M)[0])]
+        missing = [i for i in (m - 1, m + 1) if a <= i <= b and key(i) not in sweep.errors]
+        if not missing:
+            return
+        sweep.run(np.array([key(i) for i in missing]))
+
+
+def _vertex(betas: Array, errors: Array, best: float) -> float:
+    """Offset from ``best`` of the vertex of the parabola through it and its two nearest swept
+    neighbours (0 when that parabola has no minimum).
+
+    The parabola is fitted in ``u = −log(1 − β)``: the β-dependent part of the goals stiffens
+    the body in proportion to ``1 − β`` (``K_β``'s smallest eigenvalues, see
+    :mod:`deformap.msm._linsys`), so the simulated dent, and E, change on that scale, and a
+    parabola in β alone puts the vertex systematically on the rigid side.
+    """
+    near = np.sort(betas[np.argsort(np.abs(betas - best), kind="stable")[:3]])
+    if near.size < 3:
+        return 0.0
+    e = np.array([errors[int(np.flatnonzero(betas == b)[0])] for b in near])
+    x = -np.log1p(-near)
+    curv = ((e[2] - e[1]) / (x[2] - x[1]) - (e[1] - e[0]) / (x[1] - x[0])) / (x[2] - x[0])
+    if not curv > 0.0:
+        return 0.0
+    slope = (e[1] - e[0]) / (x[1] - x[0]) - curv * (x[0] + x[1])
+    u = -slope / (2.0 * curv)
+    return float(-np.expm1(-u) - best)
 
 
 def _beta_std(betas: Array, errors: Array, tol: float, resolution: float) -> float:
+    """Width / √12 of the β interval around β̂ where E ≤ E(β̂) + ``tol``; its ends are found by
+    linear interpolation of E between the sampled β, so that the width does not depend on how
+    densely the sweep sampled the curve (at least ``resolution``)."""
     i = int(np.flatnonzero(errors <= errors.min() + _TIE_M)[0])
-    ok = errors <= errors[i] + tol
+    level = errors[i] + tol
+    ok = errors <= level
     lo = hi = i
     while lo > 0 and ok[lo - 1]:
         lo -= 1
     while hi < len(betas) - 1 and ok[hi + 1]:
         hi += 1
-    return float(max(betas[hi] - betas[lo], resolution) / np.sqrt(12.0))
+    left, right = float(betas[lo]), float(betas[hi])
+    if lo > 0:
+        t = (level - errors[lo - 1]) / (errors[lo] - errors[lo - 1])
+        left = float(betas[lo - 1] + t * (betas[lo] - betas[lo - 1]))
+    if hi < len(betas) - 1:
+        t = (level - errors[hi]) / (errors[hi + 1] - errors[hi])
+        right = float(betas[hi] + t * (betas[hi + 1] - betas[hi]))
+    return float(max(right - left, resolution) / np.sqrt(12.0))
 
 
 def estimate_beta(rest_xs: Any, rest_ys: Any, rest_z: Any, deformed_points: Any,
@@ -132,17 +231,14 @@ def estimate_beta(rest_xs: Any, rest_ys: Any, rest_z: Any, deformed_points: Any,
     cfg = _check_config(config)
     grid = ParticleGrid.from_heightmap(rest_xs, rest_ys, rest_z)
     observed = check_points("deformed_points", deformed_points, min_rows=1)
-    tree = cKDTree(observed)
-    sweep = np.arange(cfg.n_beta) / cfg.n_beta
-    sims = [simulate_poke(grid.rest, grid.masses, grid.fixed, contact, sweep, cfg)]
-    betas, errors = sweep, matching_error(sims[0].positions, tree)
+    model = PokeModel(grid.rest, grid.masses, grid.fixed, contact, cfg)
+    sweep = _Sweep(model, cKDTree(observed))
+    sweep.run(np.arange(cfg.n_beta) / cfg.n_beta)
     if cfg.refine and cfg.beta_resolution < 1.0 / cfg.n_beta:
-        extra = _refinement(betas, errors, 1.0 / cfg.n_beta, cfg.beta_resolution)
-        if extra.size:
-            sims.append(simulate_poke(grid.rest, grid.masses, grid.fixed, contact, extra, cfg,
-                                      stiffness_n_per_m=sims[0].stiffness_n_per_m))
-            betas = np.concatenate([betas, extra])
-            errors = np.concatenate([errors, matching_error(sims[-1].positions, tree)])
+        _refine(sweep, 1.0 / cfg.n_beta, cfg.beta_resolution)
+    sims = sweep.sims
+    betas = np.concatenate([s.betas for s in sims])
+    errors = np.concatenate([[sweep.errors[float(b)] for b in s.betas] for s in sims])
     order = np.argsort(betas, kind="stable")
     betas, errors = betas[order], errors[order]
     its = np.concatenate([s.iterations for s in sims])[order]
@@ -153,5 +249,5 @@ def estimate_beta(rest_xs: Any, rest_ys: Any, rest_z: Any, deformed_points: Any,
         beta=float(betas[best]),
         beta_std=_beta_std(betas, errors, cfg.error_tolerance_m, cfg.beta_resolution),
         betas=betas, errors=errors, iterations=its, residual=res, converged=conv,
-        protocol=cfg.contact, mode=cfg.mode, stiffness_n_per_m=sims[0].stiffness_n_per_m,
+        protocol=cfg.contact, mode=cfg.mode, stiffness_n_per_m=model.stiffness,
     )

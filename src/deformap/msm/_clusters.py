@@ -29,7 +29,7 @@ import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
 from numpy.typing import NDArray
 
-__all__ = ["Clusters", "fast_polar_rotation", "polar_rotation"]
+__all__ = ["Clusters", "fast_polar_rotation", "polar_components", "polar_rotation"]
 
 Array = NDArray[np.float64]
 
@@ -51,10 +51,10 @@ def polar_rotation(a: Array) -> Array:
 def fast_polar_rotation(a: Array, *, tol: float = 1e-14, max_iter: int = 30) -> Array:
     """``polar_rotation(a)`` by Higham's scaled Newton iteration where it is safe, SVD elsewhere.
 
-    ``X ← (γ X + X⁻ᵀ / γ) / 2`` with ``X⁻ᵀ = cof(X) / det X`` in closed form and Frobenius scaling
-    ``γ``; it converges quadratically to the polar factor when ``det A > 0``. Matrices with a
-    small or negative determinant (relative to ``‖A‖³``: flat, nearly singular or inverted
-    clusters) and any that are not converged get the SVD answer.
+    ``X ← (γ X + X⁻ᵀ / γ) / 2`` with ``X⁻ᵀ = cof(X) / det X`` in closed form and determinant
+    scaling ``γ = |det X|^(−1/3)``; it converges quadratically to the polar factor when
+    ``det A > 0``. Matrices with a small or negative determinant (relative to ``‖A‖³``: flat,
+    nearly singular or inverted clusters) and any that are not converged get the SVD answer.
 
     References
     ----------
@@ -62,42 +62,53 @@ def fast_polar_rotation(a: Array, *, tol: float = 1e-14, max_iter: int = 30) -> 
     Stat. Comput. 7(4), 1160–1174.
     """
     shape = a.shape
-    x = a.reshape(-1, 3, 3)
-    norm = np.sqrt(np.sum(x * x, axis=(1, 2)))
-    x = x / np.maximum(norm, np.finfo(float).tiny)[:, None, None]
-    # component-major layout: nine contiguous 1-D arrays make the closed forms fast
-    m = np.ascontiguousarray(x.reshape(-1, 9).T)
-    a0, b0, c0, d0, e0, f0, g0, h0, i0 = m
+    m = np.ascontiguousarray(a.reshape(-1, 9).T)
+    return np.asarray(polar_components(m, tol=tol, max_iter=max_iter).T.reshape(shape))
+
+
+def polar_components(m: Array, *, tol: float = 1e-14, max_iter: int = 30) -> Array:
+    """:func:`fast_polar_rotation` of ``(9, n)`` component-major (row-major 3×3) matrices.
+
+    Nine contiguous 1-D arrays make the closed-form cofactors fast; returns ``(9, n)``.
+    """
+    norm = np.sqrt(np.sum(m * m, axis=0))
+    x = m / np.maximum(norm, np.finfo(float).tiny)
+    a0, b0, c0, d0, e0, f0, g0, h0, i0 = x
     det0 = a0 * (e0 * i0 - f0 * h0) - b0 * (d0 * i0 - f0 * g0) + c0 * (d0 * h0 - e0 * g0)
     safe = det0 > 1e-9  # scaled Newton copes with any positive det; flat ones go to SVD
-    out = np.empty_like(x)
-    if not np.all(safe):
-        m = np.ascontiguousarray(m[:, safe])
-    ok = np.zeros(m.shape[1], dtype=bool)
+    all_safe = bool(np.all(safe))
+    cur = x if all_safe else np.ascontiguousarray(x[:, safe])
+    ok = np.zeros(cur.shape[1], dtype=bool)
     for _ in range(max_iter):
-        inv_t = _inverse_transpose(m)
-        gamma = np.sqrt(np.sqrt(np.sum(inv_t * inv_t, axis=0) / np.sum(m * m, axis=0)))
-        new = 0.5 * (gamma * m + inv_t / gamma)
-        ok = np.max(np.abs(new - m), axis=0) < tol**0.5  # quadratic: the next step is < tol
-        m = new
+        cof, det = _cofactors(cur)
+        # determinant scaling γ = |det X|^(-1/3) (Higham 1986, §3): no extra norms to compute
+        gamma = np.cbrt(det)
+        new = cur / gamma
+        new += cof / (det / gamma)
+        new *= 0.5
+        ok = np.max(np.abs(new - cur), axis=0) < tol**0.5  # quadratic: the next step is < tol
+        cur = new
         if np.all(ok):
             break
-    out[safe] = m.T.reshape(-1, 3, 3)
+    if all_safe and np.all(ok):
+        return cur
+    out = np.empty_like(x)
+    out[:, safe] = cur
     redo = ~safe
     redo[np.flatnonzero(safe)[~ok]] = True
-    if np.any(redo):
-        out[redo] = polar_rotation(x[redo])
-    return out.reshape(shape)
+    out[:, redo] = polar_rotation(x[:, redo].T.reshape(-1, 3, 3)).reshape(-1, 9).T
+    return out
 
 
-def _inverse_transpose(m: Array) -> Array:
-    """``X⁻ᵀ`` of ``(9, n)`` row-major 3×3 matrices: cofactor matrix over determinant."""
+def _cofactors(m: Array) -> tuple[Array, Array]:
+    """Cofactor matrices ``(9, n)`` and determinants ``(n,)`` of ``(9, n)`` row-major 3×3
+    matrices (``X⁻ᵀ = cof(X) / det X``)."""
     a, b, c, d, e, f, g, h, i = m
     cof = np.stack([e * i - f * h, f * g - d * i, d * h - e * g,
                     c * h - b * i, a * i - c * g, b * g - a * h,
                     b * f - c * e, c * d - a * f, a * e - b * d])
     det = a * cof[0] + b * cof[1] + c * cof[2]
-    return np.asarray(cof / det)
+    return cof, det
 
 
 def _cut(axis: int, start: int, stop: int) -> tuple[slice, ...]:
@@ -183,12 +194,13 @@ class Clusters:
 
     def _projection(self, q: Array, cutoff: Array) -> Array:
         """``Π[i, j] = q_iᵀ A_qq⁺ q_j w_j``, dropping eigenvalues of ``A_qq`` below ``cutoff``."""
-        aqq = np.einsum("cj,cjf,cjg->cfg", self.w, q, q)
+        wq = self.w[..., None] * q
+        aqq = np.swapaxes(wq, 1, 2) @ q
         lam, vec = np.linalg.eigh(aqq)
         keep = lam > cutoff[:, None]
         inv = np.where(keep, 1.0 / np.where(keep, lam, 1.0), 0.0)
-        aqq_pinv = np.einsum("cfe,ce,cge->cfg", vec, inv, vec)
-        return np.einsum("cif,cfg,cjg,cj->cij", q, aqq_pinv, q, self.w)
+        aqq_pinv = (vec * inv[:, None, :]) @ np.swapaxes(vec, 1, 2)
+        return np.asarray(q @ aqq_pinv @ np.swapaxes(wq, 1, 2))
 
     def _hat_matrices(self, regularization: float) -> Array:
         """``(C, km, km)`` weighted least-squares projections onto the feature span.
@@ -237,6 +249,8 @@ class Clusters:
         self._mp0 = self.masses[..., None] * p0
         self._mass_c = self.box_sum(self.masses[None, ..., None])[0]  # (*cshape, 1)
         self._t0c = self.box_sum(self._mp0[None])[0] / self._mass_c  # (*cshape, 3)
+        self._p0c_t = np.ascontiguousarray(np.moveaxis(p0, -1, 0))
+        self._t0c_t = np.ascontiguousarray(np.moveaxis(self._t0c, -1, 0))
 
     def rotation_term(self, x: Array) -> Array:
         """``(1/M_i) Σ_{c∋i} R_c s_i^c`` ``(B, *grid, 3)`` for positions ``x (B, *grid, 3)``.
@@ -247,6 +261,8 @@ class Clusters:
         """
         if not hasattr(self, "_p0c"):
             self._prepare_box()
+        if not np.any(self.planar):
+            return self._rotation_term_components(x)
         xm = (x - self._origin) * self.masses[None, ..., None]
         b = x.shape[0]
         field = np.empty((*xm.shape[:-1], 12))
@@ -265,6 +281,29 @@ class Clusters:
         total_r = spread[..., :9].reshape(b, *self.shape, 3, 3)
         out = np.einsum("...de,...e->...d", total_r, self._p0c[None]) - spread[..., 9:]
         return np.asarray(out / self.count[None, ..., None])
+
+    def _rotation_term_components(self, x: Array) -> Array:
+        """:meth:`rotation_term` with every field component-major, ``(12, B, *grid)``: the
+        polar decomposition then works on contiguous component arrays with no transposes."""
+        b, shape, cshape = x.shape[0], self.shape, self.cshape
+        p0 = self._p0c_t  # (3, *grid)
+        xm = np.moveaxis(x - self._origin, -1, 0) * self.masses  # (3, B, *grid)
+        field = np.empty((12, b, *shape))
+        field[:9] = (xm[:, None] * p0[None, :, None]).reshape(9, b, *shape)
+        field[9:] = xm
+        sums = self.box_sum(field.reshape(12 * b, *shape, 1)).reshape(12, b, *cshape)
+        sums /= self._mass_c[..., 0]
+        t = sums[9:]
+        apq = sums[:9] - (t[:, None] * self._t0c_t[None, :, None]).reshape(9, b, *cshape)
+        rot = polar_components(apq.reshape(9, -1)).reshape(3, 3, b, *cshape)
+        per_cluster = np.empty((12, b, *cshape))
+        per_cluster[:9] = rot.reshape(9, b, *cshape)
+        per_cluster[9:] = np.sum(rot * self._t0c_t[None, :, None], axis=1)
+        spread = self.box_spread(per_cluster.reshape(12 * b, *cshape, 1)).reshape(12, b, *shape)
+        out = np.sum(spread[:9].reshape(3, 3, b, *shape) * p0[None, :, None], axis=1)
+        out -= spread[9:]
+        out /= self.count
+        return np.moveaxis(out, 0, -1)
 
     def _planar_frames(self) -> None:
         """Rest normal ``n`` and in-plane axes ``u × v = n`` of the exactly planar clusters."""

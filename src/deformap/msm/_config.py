@@ -31,9 +31,14 @@ class ShapeMatchingConfig:
         equilibrium, so that the dent's *depth per newton* (what hardness changes) is simulated
         instead of being copied from the observation. See :func:`~deformap.msm.simulate_poke`.
     n_beta : int
-        Number of β values of the uniform sweep ``β_j = j / n_beta`` over ``[0, 1)``.
+        Number of β values of the coarse uniform sweep ``β_j = j / n_beta`` over ``[0, 1)``
+        (solved in one batch). E(β) is smooth, so 10 values (a step of 0.1) bracket its minimum;
+        the refinement then finds β̂ to ``beta_resolution``.
     refine : bool
-        Refine around the sweep's minimum down to ``beta_resolution``.
+        Refine around the sweep's minimum down to ``beta_resolution``: a golden-section search
+        on the ``beta_resolution`` grid within one sweep step of the best swept β (about
+        ``log_φ(2 / (n_beta · beta_resolution))`` further solves, each started from the
+        equilibrium of the nearest β already solved).
     beta_resolution : float
         Step of the local refinement (dimensionless).
     tol : float
@@ -81,7 +86,7 @@ class ShapeMatchingConfig:
     mode: str = "quadratic"
     cluster_size: int = 3
     contact: str = "force"
-    n_beta: int = 50
+    n_beta: int = 10
     refine: bool = True
     beta_resolution: float = 0.01
     tol: float = 1e-6

@@ -16,7 +16,8 @@ particles,
 
 with ``M`` the number of clusters holding each particle (the paper's averaged goal), ``W_c`` the
 centre-of-mass rows and ``b_β`` the fixed particles' and the force's terms. ``K_β`` is sparse, the
-same for x, y and z, and constant over the iterations: it is factorised once per β (SuperLU) and
+same for x, y and z, and constant over the iterations: it is factorised once per β (a banded
+Cholesky of its symmetric scaling, :mod:`deformap.msm._linsys`) and
 each iteration only recomputes the rotations and back-substitutes (a local–global scheme like
 projective dynamics, Bouaziz et al. 2014, but with the β-dependent linear part solved exactly, so
 that the iteration count does not grow as β → 1), accelerated by Anderson mixing (Walker & Ni
@@ -38,18 +39,19 @@ import logging
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.sparse as sp
 from numpy.typing import NDArray
-from scipy.sparse.linalg import splu
 
 from deformap.environment import TactileContact
 from deformap.msm._clusters import Clusters
 from deformap.msm._config import ShapeMatchingConfig
+from deformap.msm._linsys import StepMatrices
 
 __all__ = ["Equilibrium", "PokeSimulation", "force_weights", "hertz_depth"]
 
 logger = logging.getLogger(__name__)
 Array = NDArray[np.float64]
+
+_ROT_BATCH = 4
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -106,60 +108,39 @@ def force_weights(rest: Array, fixed: NDArray[np.bool_], contact: TactileContact
 
 
 class Equilibrium:
-    """Factorised ``K_β`` for a set of β on one ROI, and the local–global fixed-point iteration."""
+    """``K_β`` for a set of β on one ROI, and the local–global fixed-point iteration.
 
-    def __init__(self, clusters: Clusters, fixed: NDArray[np.bool_], betas: Array):
-        self.cl, self.betas = clusters, betas
-        n = fixed.size
-        self.free = np.flatnonzero(~fixed.ravel())
-        self.fix = np.flatnonzero(fixed.ravel())
-        idx = np.arange(n).reshape(fixed.shape)[None, ..., None].astype(float)
-        members = clusters.gather(idx)[0, ..., 0].astype(np.int64)  # (C, km)
-        kk = members.shape[1]
-        rows = np.repeat(members[:, :, None], kk, axis=2).ravel()
-        cols = np.repeat(members[:, None, :], kk, axis=1).ravel()
-        wdat = np.broadcast_to(clusters.w[:, None, :], (members.shape[0], kk, kk)).ravel()
-        minv = sp.diags(1.0 / clusters.count.ravel())
-        self.wsum = (minv @ sp.csr_matrix((wdat, (rows, cols)), shape=(n, n))).tocsr()
-        if clusters.hat is None:
-            self.psum = sp.csr_matrix((n, n))
-            self.rot_weight = np.ones_like(betas)
-            self.fit_weight = np.zeros_like(betas)
+    ``system`` (a :class:`StepMatrices` of the same clusters and fixed set) may be shared between
+    equilibria of the same ROI, so that the assembly and each β's factorisation happen once.
+    """
+
+    def __init__(self, clusters: Clusters, fixed: NDArray[np.bool_], betas: Array, *,
+                 system: StepMatrices | None = None):
+        self.cl, self.betas = clusters, np.asarray(betas, dtype=float)
+        self.system = StepMatrices(clusters, fixed) if system is None else system
+        self.free, self.fix = self.system.free, self.system.fix
+        if self.system.rigid:
+            self.rot_weight = np.ones_like(self.betas)
+            self.fit_weight = np.zeros_like(self.betas)
         else:
-            self.psum = (minv @ sp.csr_matrix((clusters.hat.ravel(), (rows, cols)),
-                                              shape=(n, n))).tocsr()
-            self.rot_weight, self.fit_weight = 1.0 - betas, betas.copy()
-        self.lus = []
-        self.couple = []
-        eye = sp.identity(len(self.free), format="csc")
-        for b in self.fit_weight:
-            a = self.wsum + b * self.psum
-            kff = eye - a[self.free][:, self.free]
-            # K is symmetric in pattern and nearly in value: a symmetric fill-reducing order and
-            # diagonal-preferring threshold pivoting factorise 3-4x faster than COLAMD.
-            self.lus.append(splu(kff.tocsc(), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.1,
-                                 options={"SymmetricMode": True}))
-            self.couple.append(a[self.free][:, self.fix])
-        # β-part of the constant term: M⁻¹ Σ_c (s − Π p⁰); zero when the features span s.
-        if clusters.hat is None:
-            self.fit_const = np.zeros((n, 3))
-        else:
-            c = clusters.s - np.einsum("cij,cjd->cid", clusters.hat, clusters.p0)
-            summed = clusters.scatter(c[None])[0] / clusters.count[..., None]
-            self.fit_const = summed.reshape(n, 3)
+            self.rot_weight, self.fit_weight = 1.0 - self.betas, self.betas.copy()
 
     def _map(self, x: Array, active: NDArray[np.int64]) -> Array:
         """One local–global step ``G(x)`` for the free particles of the ``active`` β."""
         cl = self.cl
-        xa = x[active].reshape(len(active), *cl.shape, 3)
-        rot = cl.rotation_term(xa).reshape(len(active), -1, 3)
         out = np.empty((len(active), len(self.free), 3))
-        for a, j in enumerate(active):
-            out[a] = self.lus[j].solve(self.rot_weight[j] * rot[a, self.free] + self.const[j])
+        # a few β per batch: the per-cluster temporaries of larger batches fall out of cache
+        for lo in range(0, len(active), _ROT_BATCH):
+            part = active[lo : lo + _ROT_BATCH]
+            xa = x[part].reshape(len(part), *cl.shape, 3)
+            rot = cl.rotation_term(xa).reshape(len(part), -1, 3)
+            for a, j in enumerate(part, start=lo):
+                out[a] = self.system.solve(self.fit_weight[j], self.rot_weight[j]
+                                           * rot[a - lo, self.free] + self.const[j])
         return out
 
     def solve(self, x_fixed: Array, force: Array, stiffness: float, tol: float, max_iter: int,
-              spacing: float, memory: int = 6,
+              spacing: float, memory: int = 6, x0: Array | None = None,
               ) -> tuple[Array, NDArray[np.int64], Array, NDArray[np.bool_]]:
         """Iterate ``x ← G(x)`` to its fixed point for every β, with Anderson acceleration.
 
@@ -167,14 +148,20 @@ class Equilibrium:
         Returns positions ``(B, ny, nx, 3)``, iterations, residuals ``max‖G(x) − x‖ / max‖G(x) −
         p⁰‖`` and converged flags. Anderson acceleration (type II, ``memory`` past steps, Walker &
         Ni 2011) replaces the plain step; it is restarted whenever it increases the residual.
+        ``x0 (B, *grid, 3)``, optional: starting positions (only the free particles' are used, e.g.
+        the equilibrium of a nearby β); the rest shape by default. The fixed point does not
+        depend on it.
         """
         cl, nb = self.cl, len(self.betas)
         rest = cl.rest.reshape(-1, 3)
         self.const = np.empty((nb, len(self.free), 3))
         for j in range(nb):
-            self.const[j] = (self.fit_weight[j] * self.fit_const[self.free]
-                             + self.couple[j] @ x_fixed + force[self.free] / stiffness)
+            self.const[j] = (self.fit_weight[j] * self.system.fit_const
+                             + self.system.couple(self.fit_weight[j]) @ x_fixed
+                             + force[self.free] / stiffness)
         x = np.broadcast_to(rest, (nb, *rest.shape)).copy()
+        if x0 is not None:
+            x[:, self.free] = np.asarray(x0).reshape(nb, -1, 3)[:, self.free]
         x[:, self.fix] = x_fixed
         nf = len(self.free) * 3
         iters = np.zeros(nb, dtype=np.int64)
@@ -240,10 +227,14 @@ def calibrate_stiffness(eq0: Equilibrium, x_fixed: Array, weights: Array, contac
     delta_ref = hertz_depth(f_mag, contact.tip_radius_m, config.reference_modulus_pa,
                             config.poisson_ratio)
     k = f_mag / delta_ref  # a first guess: one particle carrying the whole load
+    x0 = None
     for _ in range(8):
-        x, _, _, _ = eq0.solve(x_fixed, force, k, config.tol, config.max_iter, spacing)
+        x, _, _, _ = eq0.solve(x_fixed, force, k, config.tol, config.max_iter, spacing, x0=x0)
         depth = float(np.sum(weights.ravel() * ((x[0].reshape(-1, 3) - rest) @ contact.direction)))
         if abs(depth / delta_ref - 1.0) < 1e-3:
             break
-        k *= depth / delta_ref  # secant on the (nearly 1/k) depth–stiffness relation
+        ratio = depth / delta_ref
+        k *= ratio  # secant on the (nearly 1/k) depth–stiffness relation
+        # displacements scale nearly as 1/k: start the next solve from the scaled equilibrium
+        x0 = rest + (x.reshape(1, -1, 3) - rest) / ratio
     return k

@@ -12,6 +12,7 @@ from deformap.environment import TactileContact
 from deformap.errors import InvalidArgumentError
 from deformap.msm._clusters import Clusters
 from deformap.msm._config import ShapeMatchingConfig
+from deformap.msm._linsys import StepMatrices
 from deformap.msm._poke import (
     Equilibrium,
     PokeSimulation,
@@ -19,7 +20,7 @@ from deformap.msm._poke import (
     force_weights,
 )
 
-__all__ = ["shape_matching_goals", "simulate_poke"]
+__all__ = ["PokeModel", "shape_matching_goals", "simulate_poke"]
 
 Array = NDArray[np.float64]
 
@@ -157,47 +158,78 @@ def simulate_poke(rest: Any, masses: Any, fixed: Any, contact: TactileContact, b
     """
     cfg = _check_config(config)
     p0 = _check_rest(rest, cfg.cluster_size)
-    m = check_array("masses", masses, p0.shape[:2], what="particle masses")
-    if np.any(m <= 0):
-        raise InvalidArgumentError(f"`masses` must be > 0; got minimum {m.min()}")
-    fx = np.asarray(fixed)
-    if fx.shape != p0.shape[:2] or fx.dtype != np.bool_:
-        raise InvalidArgumentError(
-            f"`fixed` must be a {p0.shape[:2]} bool array; got {np.asarray(fixed).dtype} "
-            f"array of shape {fx.shape}"
-        )
     b = check_betas(betas)
-    spacing = float(np.mean(np.linalg.norm(np.diff(p0[..., :2], axis=1), axis=-1)))
-    near = _check_contact(contact, p0, fx, spacing)
-    body, body_m, body_fixed, window = _body(p0, m, fx, spacing, cfg)
-    cl = Clusters(body, body_m, window, cfg.mode, cfg.regularization)
-    flat = body.reshape(-1, 3)
-    top = np.zeros(body_fixed.shape, dtype=bool)
-    top[0] = True
-    if cfg.contact == "pinned":
-        pinned = body_fixed.ravel().copy()
-        pinned[near] = True  # the top layer comes first in the flat order
-        eq = Equilibrium(cl, pinned.reshape(body_fixed.shape), b)
-        x_fixed = flat[eq.fix].copy()
-        sink = contact.contact_point[2] - _rest_height_at(p0, contact.contact_point[:2])
-        x_fixed[np.searchsorted(eq.fix, near), 2] += sink
-        x, it, res, conv = eq.solve(x_fixed, np.zeros_like(flat), 1.0, cfg.tol, cfg.max_iter,
-                                    spacing)
-        return PokeSimulation(betas=b, positions=x[:, 0], iterations=it, residual=res,
-                              converged=conv, protocol="pinned")
-    weights = np.zeros(body_fixed.shape)
-    weights[0] = force_weights(p0, fx, contact, spacing)
-    x_fixed = flat[body_fixed.ravel()]
-    if stiffness_n_per_m is None:
-        eq0 = Equilibrium(cl, body_fixed, np.zeros(1))
-        k = calibrate_stiffness(eq0, x_fixed, weights, contact, cfg, spacing)
-    else:
-        k = check_positive("stiffness_n_per_m", stiffness_n_per_m)
-    eq = Equilibrium(cl, body_fixed, b)
-    force = weights.reshape(-1, 1) * contact.force[None, :]
-    x, it, res, conv = eq.solve(x_fixed, force, k, cfg.tol, cfg.max_iter, spacing)
-    return PokeSimulation(betas=b, positions=x[:, 0], iterations=it, residual=res,
-                          converged=conv, protocol="force", stiffness_n_per_m=k)
+    model = PokeModel(p0, masses, fixed, contact, cfg, stiffness_n_per_m=stiffness_n_per_m)
+    return model.solve(b)[0]
+
+
+class PokeModel:
+    """One poke on one ROI, ready to be solved for any β (see :func:`simulate_poke`).
+
+    The body, its clusters, ``K_β``'s assembly and factorisations, and the force protocol's
+    calibrated stiffness are computed once and shared by every :meth:`solve`, so that a β search
+    can solve one β at a time, each started from the equilibrium of a nearby β.
+    """
+
+    def __init__(self, rest: Any, masses: Any, fixed: Any, contact: TactileContact,
+                 config: ShapeMatchingConfig, *, stiffness_n_per_m: float | None = None):
+        cfg = config
+        p0 = _check_rest(rest, cfg.cluster_size)
+        m = check_array("masses", masses, p0.shape[:2], what="particle masses")
+        if np.any(m <= 0):
+            raise InvalidArgumentError(f"`masses` must be > 0; got minimum {m.min()}")
+        fx = np.asarray(fixed)
+        if fx.shape != p0.shape[:2] or fx.dtype != np.bool_:
+            raise InvalidArgumentError(
+                f"`fixed` must be a {p0.shape[:2]} bool array; got {np.asarray(fixed).dtype} "
+                f"array of shape {fx.shape}"
+            )
+        if stiffness_n_per_m is not None:
+            check_positive("stiffness_n_per_m", stiffness_n_per_m)
+        self.cfg = cfg
+        self.spacing = float(np.mean(np.linalg.norm(np.diff(p0[..., :2], axis=1), axis=-1)))
+        near = _check_contact(contact, p0, fx, self.spacing)
+        body, body_m, body_fixed, window = _body(p0, m, fx, self.spacing, cfg)
+        self.clusters = Clusters(body, body_m, window, cfg.mode, cfg.regularization)
+        flat = body.reshape(-1, 3)
+        self.stiffness: float | None = None
+        if cfg.contact == "pinned":
+            pinned = body_fixed.ravel().copy()
+            pinned[near] = True  # the top layer comes first in the flat order
+            self.fixed = pinned.reshape(body_fixed.shape)
+            self.system = StepMatrices(self.clusters, self.fixed)
+            self.x_fixed = flat[self.system.fix].copy()
+            sink = contact.contact_point[2] - _rest_height_at(p0, contact.contact_point[:2])
+            self.x_fixed[np.searchsorted(self.system.fix, near), 2] += sink
+            self.force = np.zeros_like(flat)
+            return
+        self.fixed = body_fixed
+        self.system = StepMatrices(self.clusters, self.fixed)
+        weights = np.zeros(body_fixed.shape)
+        weights[0] = force_weights(p0, fx, contact, self.spacing)
+        self.x_fixed = flat[body_fixed.ravel()]
+        self.force = weights.reshape(-1, 1) * contact.force[None, :]
+        if stiffness_n_per_m is None:
+            eq0 = Equilibrium(self.clusters, body_fixed, np.zeros(1), system=self.system)
+            stiffness_n_per_m = calibrate_stiffness(eq0, self.x_fixed, weights, contact, cfg,
+                                                    self.spacing)
+        self.stiffness = float(stiffness_n_per_m)
+
+    def solve(self, betas: Array, x0: Array | None = None) -> tuple[PokeSimulation, Array]:
+        """Equilibria for ``betas (B,)``, optionally started from positions ``x0 (B, *body, 3)``.
+
+        Returns the simulation (the surface layer's positions) and the whole body's positions
+        ``(B, *body, 3)`` (to warm-start a later solve).
+        """
+        cfg = self.cfg
+        eq = Equilibrium(self.clusters, self.fixed, betas, system=self.system)
+        k = 1.0 if self.stiffness is None else self.stiffness
+        x, it, res, conv = eq.solve(self.x_fixed, self.force, k, cfg.tol, cfg.max_iter,
+                                    self.spacing, x0=x0)
+        sim = PokeSimulation(betas=betas, positions=x[:, 0], iterations=it, residual=res,
+                             converged=conv, protocol=cfg.contact,
+                             stiffness_n_per_m=self.stiffness)
+        return sim, x
 
 
 def _body(p0: Array, masses: Array, fixed: NDArray[np.bool_], spacing: float,

@@ -1,0 +1,152 @@
+"""The sparse linear part ``K_β`` of the local–global step: assembled once per ROI, one banded
+Cholesky factorisation per β.
+
+``K_β = I − M⁻¹ (Σ_c W_c + β Σ_c Π_c)`` restricted to the free particles (see
+:mod:`deformap.msm._poke`). ``W_c`` (centre of mass) and ``Π_c`` (the mass-weighted least-squares
+fit) are orthogonal projections in the inner product of the particle masses ``m``, so
+``S_β = diag(m M) K_β = diag(m M) − diag(m) Σ_c (W_c + β Π_c)`` is symmetric, and positive
+definite for β < 1 once a boundary is held fixed (``W_c + β Π_c ≤ I`` with equality only for a
+common translation, which the fixed particles forbid). Ordered row by row with the layer index
+innermost, the clusters only couple particles ``(k − 1)`` rows apart, so ``S_β`` is a band matrix
+of half-width ``(k − 1)(n_x n_z + n_z) + n_z − 1``, and a dense banded Cholesky (LAPACK
+``pbtrf``) factorises it several times faster than a general sparse LU, with no pivoting.
+``S_β = S₀ − β S₁`` is affine in β, so both bands are assembled once and each β costs one
+factorisation only. A matrix that is not positive definite (never expected) falls back to
+SuperLU.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+from numpy.typing import NDArray
+from scipy.linalg import LinAlgError, cho_solve_banded, cholesky_banded
+from scipy.sparse.linalg import splu
+
+from deformap.msm._clusters import Clusters
+
+__all__ = ["StepMatrices"]
+
+Array = NDArray[np.float64]
+
+
+class StepMatrices:
+    """``K_β`` of one ROI's body for any β: coupling to the fixed particles and factorisations.
+
+    Parameters
+    ----------
+    clusters : Clusters
+    fixed : grid-shaped bool
+        Particles held at their given positions.
+    """
+
+    def __init__(self, clusters: Clusters, fixed: NDArray[np.bool_]):
+        n = fixed.size
+        is_fixed = fixed.ravel()
+        self.free = np.flatnonzero(~is_fixed)
+        self.fix = np.flatnonzero(is_fixed)
+        nf = len(self.free)
+        idx = np.arange(n).reshape(fixed.shape)[None, ..., None].astype(float)
+        members = clusters.gather(idx)[0, ..., 0].astype(np.int64)  # (C, km)
+        nc, kk = members.shape
+        rows = np.broadcast_to(members[:, :, None], (nc, kk, kk)).ravel()
+        cols = np.broadcast_to(members[:, None, :], (nc, kk, kk)).ravel()
+        # row i of cluster c: W_c[i, j] = w_j (centre of mass), Π_c[i, j] = hat[c, i, j]
+        wdat = np.broadcast_to(clusters.w[:, None, :], (nc, kk, kk)).ravel()
+        hat = clusters.hat
+        self.rigid = hat is None
+        pdat = np.zeros_like(wdat) if hat is None else hat.ravel()
+        pos = np.full(n, -1, dtype=np.int64)
+        pos[self.free] = np.arange(nf)
+        pos[self.fix] = np.arange(len(self.fix))
+        count = clusters.count.ravel()
+        # coupling of the free rows to the fixed particles, M⁻¹ Σ_c (W_c + β Π_c)
+        fc = ~is_fixed[rows] & is_fixed[cols]
+        r, c, inv_m = pos[rows[fc]], pos[cols[fc]], 1.0 / count[rows[fc]]
+        shape = (nf, len(self.fix))
+        self.couple_w = sp.csr_matrix((wdat[fc] * inv_m, (r, c)), shape=shape)
+        self.couple_p = sp.csr_matrix((pdat[fc] * inv_m, (r, c)), shape=shape)
+        # β-part of the constant term: M⁻¹ Σ_c (s − Π p⁰); zero when the features span s.
+        if hat is None:
+            self.fit_const = np.zeros((nf, 3))
+        else:
+            cst = clusters.s - np.einsum("cij,cjd->cid", hat, clusters.p0)
+            summed = clusters.scatter(cst[None])[0] / clusters.count[..., None]
+            self.fit_const = summed.reshape(n, 3)[self.free]
+        self._scale = (clusters.masses.ravel() * count)[self.free]
+        self._perm = _band_order(fixed)
+        # S₀ = diag(m M) − diag(m) Σ_c W_c and S₁ = diag(m) Σ_c Π_c on the free particles, in
+        # band order; only the upper triangle is kept (they are symmetric)
+        band_pos = np.full(n, -1, dtype=np.int64)
+        band_pos[self.free[self._perm]] = np.arange(nf)
+        ff = ~is_fixed[rows] & ~is_fixed[cols]
+        br, bc = band_pos[rows[ff]], band_pos[cols[ff]]
+        up = br <= bc
+        br, bc = br[up], bc[up]
+        mass = clusters.masses.ravel()[rows[ff][up]]
+        self._bw = int(np.max(bc - br)) if bc.size else 0
+        self._upper = (br, bc)
+        flat = (self._bw + br - bc) * nf + bc
+        size = (self._bw + 1) * nf
+        self._band0 = -np.bincount(flat, weights=mass * wdat[ff][up], minlength=size).reshape(
+            self._bw + 1, nf)
+        self._band0[self._bw] += self._scale[self._perm]
+        self._band1 = np.bincount(flat, weights=mass * pdat[ff][up], minlength=size).reshape(
+            self._bw + 1, nf)
+        self._factors: dict[float, object] = {}
+
+    def couple(self, beta_fit: float) -> sp.csr_matrix:
+        """``(n_free, n_fix)`` block that carries the fixed particles into the free rows."""
+        return self.couple_w + beta_fit * self.couple_p
+
+    def solve(self, beta_fit: float, rhs: Array) -> Array:
+        """``K_β⁻¹ rhs`` for ``rhs (n_free, 3)``; factorises ``K_β`` on first use and keeps it."""
+        key = float(beta_fit)
+        fac = self._factors.get(key)
+        if fac is None:
+            fac = self._factor(key)
+            self._factors[key] = fac
+        if isinstance(fac, np.ndarray):
+            out = np.empty_like(rhs)
+            out[self._perm] = cho_solve_banded((fac, False), (self._scale[:, None] * rhs)[
+                self._perm], check_finite=False)
+            return out
+        return np.asarray(fac.solve(rhs))  # type: ignore[attr-defined]
+
+    def _factor(self, beta_fit: float) -> object:
+        band = self._band0 - beta_fit * self._band1
+        try:
+            return cholesky_banded(band, lower=False, check_finite=False)
+        except LinAlgError:
+            return _SparseFallback(band, self._bw, self._scale, self._perm)
+
+
+class _SparseFallback:
+    """SuperLU of the symmetric band matrix, solving like the banded Cholesky does."""
+
+    def __init__(self, band: Array, bw: int, scale: Array, perm: NDArray[np.int64]):
+        n = band.shape[1]
+        diags = [band[bw - k, k:] for k in range(bw + 1)]
+        upper = sp.diags(diags, list(range(bw + 1)), shape=(n, n))
+        full = (upper + sp.triu(upper, k=1).T).tocsc()
+        self._lu = splu(full, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.1,
+                        options={"SymmetricMode": True})
+        self._scale, self._perm = scale, perm
+
+    def solve(self, rhs: Array) -> Array:
+        out = np.empty_like(rhs)
+        out[self._perm] = self._lu.solve((self._scale[:, None] * rhs)[self._perm])
+        return out
+
+
+def _band_order(fixed: NDArray[np.bool_]) -> NDArray[np.int64]:
+    """Free-particle indices (positions in the free list) sorted row by row, layer innermost."""
+    n = fixed.size
+    grid = np.arange(n).reshape(fixed.shape)
+    if grid.ndim == 3:  # (layers, ny, nx) → (ny, nx, layers)
+        grid = grid.transpose(1, 2, 0)
+    pos = np.full(n, -1, dtype=np.int64)
+    free = ~fixed.ravel()
+    pos[free] = np.arange(int(free.sum()))
+    order = pos[grid.ravel()]
+    return order[order >= 0]
