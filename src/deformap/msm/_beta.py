@@ -16,6 +16,7 @@ from deformap.msm._config import ShapeMatchingConfig
 from deformap.msm._grid import ParticleGrid
 from deformap.msm._poke import PokeSimulation
 from deformap.msm._simulate import PokeModel, _check_config
+from deformap.msm._uncertainty import bootstrap_beta_std
 
 __all__ = ["BetaEstimate", "estimate_beta", "matching_error"]
 
@@ -72,11 +73,16 @@ class BetaEstimate:
         return bool(np.all(self.converged))
 
 
+def particle_distances(positions: Array, tree: cKDTree) -> Array:
+    """min_j ‖g_i(β) − x̄_j‖ of each particle: positions ``(B, ny, nx, 3)`` → ``(B, ny, nx)``."""
+    d, _ = tree.query(positions.reshape(-1, 3), k=1)
+    return np.asarray(d.reshape(positions.shape[:-1]))
+
+
 def matching_error(positions: Array, tree: cKDTree) -> Array:
     """E(β) = (1/K) Σ_i min_j ‖g_i(β) − x̄_j‖ for positions ``(B, ny, nx, 3)`` → ``(B,)`` metres."""
-    b = positions.shape[0]
-    d, _ = tree.query(positions.reshape(-1, 3), k=1)
-    return np.asarray(d.reshape(b, -1).mean(axis=1))
+    d = particle_distances(positions, tree)
+    return np.asarray(d.reshape(d.shape[0], -1).mean(axis=1))
 
 
 class _Sweep:
@@ -86,6 +92,7 @@ class _Sweep:
         self.model, self.tree = model, tree
         self.sims: list[PokeSimulation] = []
         self.errors: dict[float, float] = {}
+        self.distances: dict[float, Array] = {}
         self._body: dict[float, Array] = {}
 
     def run(self, betas: Array) -> None:
@@ -98,9 +105,10 @@ class _Sweep:
             x0 = np.stack([self._start(float(b)) for b in betas])
         sim, body = self.model.solve(betas, x0)
         self.sims.append(sim)
-        for j, (b, e) in enumerate(zip(betas, matching_error(sim.positions, self.tree),
-                                       strict=True)):
-            self.errors[float(b)] = float(e)
+        dist = particle_distances(sim.positions, self.tree)
+        for j, b in enumerate(betas):
+            self.errors[float(b)] = float(dist[j].mean())
+            self.distances[float(b)] = dist[j]
             self._body[float(b)] = body[j]
 
     def _start(self, beta: float) -> Array:
@@ -245,9 +253,15 @@ def estimate_beta(rest_xs: Any, rest_ys: Any, rest_z: Any, deformed_points: Any,
     res = np.concatenate([s.residual for s in sims])[order]
     conv = np.concatenate([s.converged for s in sims])[order]
     best = int(np.flatnonzero(errors <= errors.min() + _TIE_M)[0])
+    if cfg.uncertainty == "bootstrap":
+        tile = max(1, round(cfg.bootstrap_tile_m / grid.spacing_m))
+        distances = np.stack([sweep.distances[float(b)] for b in betas])
+        beta_std = bootstrap_beta_std(betas, distances, tile=tile, resolution=cfg.beta_resolution)
+    else:
+        beta_std = _beta_std(betas, errors, cfg.error_tolerance_m, cfg.beta_resolution)
     return BetaEstimate(
         beta=float(betas[best]),
-        beta_std=_beta_std(betas, errors, cfg.error_tolerance_m, cfg.beta_resolution),
+        beta_std=beta_std,
         betas=betas, errors=errors, iterations=its, residual=res, converged=conv,
         protocol=cfg.contact, mode=cfg.mode, stiffness_n_per_m=model.stiffness,
     )

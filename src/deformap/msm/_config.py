@@ -77,10 +77,18 @@ class ShapeMatchingConfig:
     layer_growth : float
         Ratio of successive layer spacings (≥ 1): fine under the surface where strains are large,
         coarse at depth.
+    uncertainty : {"bootstrap", "tolerance"}
+        How ``beta_std`` is obtained. ``"bootstrap"`` (default): the spread of β̂ when blocks of
+        particles are resampled (:mod:`deformap.msm._uncertainty`) — paired across β, so the
+        undisturbed part of the ROI, which adds the same distance at every β, does not blur it.
+        ``"tolerance"``: the β interval where E(β) stays within ``error_tolerance_m`` of its
+        minimum, its standard deviation (width / √12).
+    bootstrap_tile_m : float, metres
+        Side of the resampled blocks: 2 cm, twice the tip radius and the touch GP's correlation
+        length, so that neighbouring (correlated) particles are resampled together.
     error_tolerance_m : float, metres
-        Tolerance on E(β) that defines ``beta_std``: the β interval where E(β) stays within this
-        much of its minimum is the set of "equally good" β; its standard deviation (width / √12)
-        is reported. 0.1 mm is the order of the touch GP's mean error on a 0.5 cm grid.
+        Tolerance on E(β) of the ``"tolerance"`` uncertainty. 0.1 mm is the order of the touch
+        GP's mean error on a 0.5 cm grid.
     """
 
     mode: str = "quadratic"
@@ -94,6 +102,8 @@ class ShapeMatchingConfig:
     regularization: float = 1e-3
     reference_modulus_pa: float = 100e3
     poisson_ratio: float = 0.5
+    uncertainty: str = "bootstrap"
+    bootstrap_tile_m: float = 0.02
     error_tolerance_m: float = 1e-4
     layers: int | None = None
     layer_growth: float = 2.0
@@ -123,6 +133,11 @@ class ShapeMatchingConfig:
         check_positive("reference_modulus_pa", self.reference_modulus_pa)
         check_in_range("poisson_ratio", self.poisson_ratio, -1.0, 0.5, closed_high=True)
         check_positive("error_tolerance_m", self.error_tolerance_m)
+        check_positive("bootstrap_tile_m", self.bootstrap_tile_m)
+        if self.uncertainty not in ("bootstrap", "tolerance"):
+            raise InvalidArgumentError(
+                f"`uncertainty` must be 'bootstrap' or 'tolerance'; got {self.uncertainty!r}"
+            )
         if self.layers is not None:
             check_int("layers", self.layers, minimum=0)
         check_in_range("layer_growth", self.layer_growth, 1.0, 10.0, closed_high=True)
