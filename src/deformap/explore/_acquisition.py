@@ -8,10 +8,12 @@ Strategies
 ``max-variance``
     The cell of largest variance (ties broken by the first in row-major order).
 ``min-max-variance``
-    Beyond the paper: the candidate whose addition leaves the smallest *largest* posterior variance
-    over the grid. A GP's posterior variance does not depend on the observed values, only on where
-    they are (RW2006 Eq. 2.26), so this look-ahead is exact before the poke is made; it reaches
-    ``max variance < T_h`` in fewer pokes than random choice.
+    A one-step look-ahead: the candidate whose addition leaves the smallest *largest* posterior
+    variance over the grid. A GP's posterior variance does not depend on the observed values, only
+    on where they are (RW2006 Eq. 2.26), so the look-ahead is exact before the poke is made. It is
+    myopic, though: measured on the 60×40 cm workspace with the default β-field (σw = 0.2 m,
+    T_h = 0.06, 5 seeds), ``max-variance`` stops after 7 pokes every time, ``paper`` after 8–11
+    and ``min-max-variance`` after 9, so ``max-variance`` is the default.
 """
 
 from __future__ import annotations

@@ -100,6 +100,11 @@ class Mapper:
         self.xs, self.ys = workspace.grid(config.surface.grid_spacing_m)
         gx, gy = np.meshgrid(self.xs, self.ys)
         self.cells_xy = np.column_stack([gx.ravel(), gy.ravel()])
+        # Targets keep half a ROI inside the workspace, so that each ROI lies on the surveyed
+        # surface (not over its edge, where shape matching would have to explain a cliff).
+        margin = min(config.touch.roi_size_m / 2, 0.25 * min(workspace.size))
+        lo, hi = np.asarray(workspace.lower) + margin, np.asarray(workspace.upper) - margin
+        self.target_mask = np.all((self.cells_xy >= lo) & (self.cells_xy <= hi), axis=1)
         self.surface: SurfaceModel | None = None
         self.pokes: list[PokeResult] = []
         self._field: GaussianRandomField | None = None
@@ -124,7 +129,12 @@ class Mapper:
         hyper = init
         if cfg.fit_hyperparameters:
             hyper = fit_hyperparameters(
-                kept[:, :2], kept[:, 2], rng=rng, init=init, max_points=cfg.max_fit_points
+                kept[:, :2],
+                kept[:, 2],
+                rng=rng,
+                init=init,
+                max_points=cfg.max_fit_points,
+                n_restarts=cfg.fit_restarts,
             )
         gp = GaussianRandomField(
             length_scale=hyper.length_scale,
@@ -160,11 +170,17 @@ class Mapper:
         center = contact.contact_point[:2]
         roi_xs, roi_ys = self.roi_grid(center)
         pts = obs.cloud.points
-        pts = pts[~points_in_hull(pts, obs.robot_points)]
         half = cfg.roi_size_m / 2
         lo = [center[0] - half, center[1] - half, self.config.surface.z_min_m]
         hi = [center[0] + half, center[1] + half, self.config.surface.z_max_m]
-        roi = pts[crop_box(pts, lo, hi)]
+        pts = pts[crop_box(pts, lo, hi)]
+        robot = points_in_hull(pts, obs.robot_points, tolerance_m=cfg.robot_margin_m)
+        tip = contact.tip_radius_m + cfg.tip_margin_m
+        robot |= np.linalg.norm(pts - contact.tip_center, axis=1) < tip
+        pts = pts[~robot]
+        rest_at = self.surface.gp.predict(pts[:, :2])
+        on_surface = pts[:, 2] - rest_at <= cfg.above_surface_m
+        roi, rest_at = pts[on_surface], rest_at[on_surface]
         tactile = tactile_points(
             contact.tip_center, contact.force, contact.tip_radius_m, n=cfg.n_tactile
         )
@@ -176,7 +192,7 @@ class Mapper:
         )
         target = data[:, 2]
         if cfg.model == "residual":
-            target = target - self.surface.gp.predict(data[:, :2])
+            target = target - np.concatenate([rest_at, self.surface.gp.predict(tactile[:, :2])])
         touch = GaussianRandomField(
             length_scale=cfg.length_scale_m,
             signal_std=cfg.signal_std_m,
@@ -253,10 +269,18 @@ class Mapper:
     def next_target(self, rng: np.random.Generator) -> NDArray[np.float64] | None:
         """The next target by the configured strategy, or ``None`` when the map is known."""
         _, var = self.field()
+        variance = var.ravel()
+        if variance.max() <= self.config.threshold:
+            return None
+        cells, reachable = self.cells_xy[self.target_mask], variance[self.target_mask]
+        if reachable.max() <= self.config.threshold:
+            # Only the edge band is still uncertain: poke the reachable cell nearest to it in
+            # variance, which is the one that lowers it most.
+            return np.array(cells[int(np.argmax(reachable))], dtype=float)
         return choose_target(
             self.config.strategy,
-            self.cells_xy,
-            var.ravel(),
+            cells,
+            reachable,
             self.config.threshold,
             rng,
             look_ahead=self._max_variance_after,
@@ -292,6 +316,7 @@ class Mapper:
         if self._field is None:
             raise EnvironmentStateError("no poke yet: the β-field has no regions")
         mean, _ = self.field()
-        xy = np.array([p.xy for p in self.pokes])
-        poke_mean, poke_std = self._field.predict(xy, return_std=True)
-        return segment_regions(mean, poke_mean, poke_std, z=self.config.region_z)
+        beta = np.array([p.record["beta"] for p in self.pokes])
+        floor = self.config.beta_field.noise_floor
+        std = np.maximum([p.record["beta_std"] for p in self.pokes], floor)
+        return segment_regions(mean, beta, std, z=self.config.region_z)

@@ -2,12 +2,13 @@
 
 How the contour levels are chosen
 ---------------------------------
-The paper draws "the best isopleth" of the β-field without saying how. We choose the levels from the
-field itself, at the poked places, where it is supported by data: the posterior mean β at each poke,
-sorted, is split wherever two neighbours differ by more than they can be told apart —
-``z · sqrt(σ_i² + σ_j²)`` with σ the posterior standard deviation there and ``z`` the separation in
-standard deviations (default 2: the
-difference is real at about 95 %), and never by less than ``min_step`` (default 0.05 in β). Each group
+The paper draws "the best isopleth" of the β-field without saying how. We choose the levels from
+the data the field is trained on, the pokes' own estimates (the field's posterior at a poke is
+smoothed toward its neighbours, which fills the very gaps that separate classes): the βs, sorted,
+are split wherever two neighbours differ by more than they can be told apart —
+``z · sqrt(σ_i² + σ_j²)`` with σ each estimate's uncertainty (at least the β-field's noise floor)
+and ``z`` the separation in standard deviations (default 2: the difference is real at about
+95 %), and never by less than ``min_step`` (default 0.05 in β). Each group
 of pokes is one deformability class; the isopleth between two neighbouring classes lies half-way
 between the largest β of the softer-looking group's lower neighbour and the smallest of the next
 (the midpoint of the gap). Cells are labelled by the band of the β-field's mean they fall in, so a
@@ -64,7 +65,7 @@ def segment_regions(
     beta_grid : (ny, nx) float
         Posterior mean of the β-field on the grid.
     poke_beta, poke_std : (k,) float
-        Posterior mean and standard deviation of the β-field at the k poked places.
+        The k pokes' β estimates and their uncertainties.
     z : float
         Separation, in combined standard deviations, needed to call two pokes different.
     min_step : float
