@@ -9,12 +9,28 @@ from deformap.explore._regions import segment_regions
 
 def test_three_separated_classes_give_three_bands() -> None:
     grid = np.tile(np.linspace(0.0, 0.9, 10), (4, 1))
-    result = segment_regions(grid, np.array([0.05, 0.1, 0.5, 0.85]), np.full(4, 0.02))
+    betas = np.array([0.02, 0.0, 0.01, 0.5, 0.52, 0.48, 0.85, 0.86, 0.84])
+    result = segment_regions(grid, betas, np.full(betas.size, 0.02))
     assert result.n_regions == 3
-    np.testing.assert_allclose(result.levels, [0.3, 0.675])
-    np.testing.assert_allclose(result.class_betas, [0.075, 0.5, 0.85])
+    np.testing.assert_allclose(result.class_betas, [0.01, 0.5, 0.85], atol=1e-9)
+    np.testing.assert_allclose(result.levels, [0.255, 0.675], atol=1e-9)
     assert result.labels[0, 0] == 0 and result.labels[0, -1] == 2
     assert np.all(np.diff(result.labels[0]) >= 0)  # monotone along a monotone field
+
+
+def test_one_material_is_one_region_whatever_its_scatter() -> None:
+    rng = np.random.default_rng(0)
+    for seed in range(20):
+        rng = np.random.default_rng(seed)
+        betas = 0.7 + rng.normal(0.0, 0.06, size=10)  # scatter larger than claimed
+        result = segment_regions(np.zeros((2, 2)), betas, np.full(10, 0.03))
+        assert result.n_regions == 1, (seed, np.sort(betas))
+
+
+def test_a_poke_on_a_boundary_does_not_bridge_two_classes() -> None:
+    betas = np.array([0.86, 0.84, 0.87, 0.85, 0.78, 0.65, 0.66, 0.59, 0.67, 0.65])
+    result = segment_regions(np.zeros((2, 2)), betas, np.full(betas.size, 0.08))
+    assert result.n_regions == 2
 
 
 def test_uncertain_pokes_are_not_split() -> None:
@@ -22,13 +38,9 @@ def test_uncertain_pokes_are_not_split() -> None:
     result = segment_regions(grid, np.array([0.3, 0.45]), np.array([0.1, 0.1]))
     assert result.n_regions == 1 and result.levels.size == 0
     assert np.all(result.labels == 0)
-    # the same gap with tight uncertainties is two classes
-    assert segment_regions(grid, np.array([0.3, 0.45]), np.array([0.01, 0.01])).n_regions == 2
-
-
-def test_small_gaps_below_min_step_never_split() -> None:
-    result = segment_regions(np.zeros((2, 2)), np.array([0.30, 0.33]), np.zeros(2), min_step=0.05)
-    assert result.n_regions == 1
+    # groups that differ by less than min_step are never split
+    close = np.array([0.30, 0.30, 0.31, 0.33, 0.33, 0.34])
+    assert segment_regions(grid, close, np.full(6, 0.001), min_step=0.05).n_regions == 1
 
 
 def test_bad_input() -> None:
@@ -36,3 +48,5 @@ def test_bad_input() -> None:
         segment_regions(np.zeros((2, 2)), np.zeros(0), np.zeros(0))
     with pytest.raises(InvalidArgumentError, match="`poke_std`"):
         segment_regions(np.zeros((2, 2)), np.zeros(2), np.zeros(3))
+    with pytest.raises(InvalidArgumentError, match="`max_regions`"):
+        segment_regions(np.zeros((2, 2)), np.zeros(2), np.zeros(2), max_regions=0)

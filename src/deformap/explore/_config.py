@@ -136,9 +136,8 @@ class ExplorationConfig:
         The commanded normal force of every press. 0.6 N keeps the Hertz contact of a 1 cm tip
         on the tip itself for foams down to 60 N (``F <= 4 E* R² / 3`` = 0.68 N) while denting
         them by 4–7 mm, well above the camera's noise.
-    region_z : float
-        Separation, in standard deviations of their difference, that splits two pokes into
-        different regions (2: about 95 %).
+    max_regions : int
+        Most regions the β-field is cut into (see :mod:`deformap.explore._regions`).
     """
 
     threshold: float = 0.06
@@ -146,7 +145,7 @@ class ExplorationConfig:
     strategy: Literal["paper", "max-variance", "min-max-variance"] = "max-variance"
     first_target: tuple[float, float] | None = None
     force_n: float = 0.6
-    region_z: float = 2.0
+    max_regions: int = 6
     surface: SurfaceGPConfig = field(default_factory=SurfaceGPConfig)
     touch: TouchGPConfig = field(default_factory=TouchGPConfig)
     beta_field: BetaFieldConfig = field(default_factory=BetaFieldConfig)
@@ -162,4 +161,4 @@ class ExplorationConfig:
         if self.first_target is not None:
             check_vector("first_target", self.first_target, 2, what="metres")
         check_positive("force_n", self.force_n)
-        check_positive("region_z", self.region_z)
+        check_int("max_regions", self.max_regions, minimum=1)

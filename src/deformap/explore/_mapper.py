@@ -319,4 +319,6 @@ class Mapper:
         beta = np.array([p.record["beta"] for p in self.pokes])
         floor = self.config.beta_field.noise_floor
         std = np.maximum([p.record["beta_std"] for p in self.pokes], floor)
-        return segment_regions(mean, beta, std, z=self.config.region_z)
+        return segment_regions(
+            mean, beta, std, floor=floor, max_regions=self.config.max_regions
+        )
