@@ -30,7 +30,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.linalg as sla
 from numpy.typing import NDArray
-from scipy.linalg import blas, lapack
+from scipy.linalg import lapack
 
 from deformap.errors import InvalidArgumentError, NotPositiveDefiniteError
 from deformap.gp._grid_basis import (
@@ -56,7 +56,6 @@ GRID_MARGIN_FRACTION = 1.0
 #: Largest number of grid nodes accepted (their 1-D factors are cheap; B is at most this size,
 #: 8·M² bytes = 1.2 GB).
 MAX_INDUCING = 12_000
-_GRID_CHUNK = 16  # test rows per block in the Kronecker variance contraction
 _BLOCK_BYTES = 32 * 2**20  # bound on the intermediate of one block of cells in the data term
 #: Candidate cell widths (× σ_w) for the interpolated data term; the cheapest by the flop model in
 #: :func:`_cell_layout` is used.
@@ -85,25 +84,21 @@ class GridState:
         """Compressed inducing features ra·rb, the size of B."""
         return self.axis_a.rank * self.axis_b.rank
 
-    def b_inv(self) -> NDArray[np.float64]:
-        """B⁻¹ (M, M), computed once from the Cholesky factor."""
+    def b_inv_blocks(self) -> NDArray[np.float64]:
+        """The blocks B⁻¹[(a, ·), (a', ·)] for a ≥ a' (``tril_indices(ra)`` order), each (rb, rb)
+        flattened: ``(ra (ra + 1) / 2, rb²)``, computed once. B⁻¹ is symmetric, so the other
+        blocks are their transposes."""
         if self._b_inv is None:
-            inv, info = lapack.dpotri(self.factor[0], lower=1)
+            inv, info = lapack.dpotri(self.factor[0], lower=1)  # fills the lower triangle only
             if info != 0:
                 raise NotPositiveDefiniteError(f"inverting B failed (LAPACK info {info})")
-            self._b_inv = _symmetrise_from_lower(inv)
+            ra, rb = self.axis_a.rank, self.axis_b.rank
+            rows, cols = np.tril_indices(ra)
+            blocks = inv.reshape(ra, rb, ra, rb)[rows, :, cols, :]  # (pairs, rb, rb)
+            diag = blocks[rows == cols]
+            blocks[rows == cols] = np.tril(diag) + np.swapaxes(np.tril(diag, -1), 1, 2)
+            self._b_inv = blocks.reshape(rows.size, rb * rb)
         return self._b_inv
-
-
-def _symmetrise_from_lower(mat: NDArray[np.float64], block: int = 256) -> NDArray[np.float64]:
-    """Copy the lower triangle of square ``mat`` onto its upper triangle, in place, by blocks."""
-    size = mat.shape[0]
-    for i0 in range(0, size, block):
-        i1 = min(i0 + block, size)
-        diag = mat[i0:i1, i0:i1]
-        diag[...] = np.tril(diag) + np.tril(diag, -1).T
-        mat[i0:i1, i1:] = mat[i1:, i0:i1].T
-    return mat
 
 
 def inducing_axis(lo: float, hi: float, spacing: float, margin: float) -> NDArray[np.float64]:
@@ -160,7 +155,7 @@ def fit_grid(
 def _cell_layout(span: float, n: int, ra: int, rb: int, length_scale: float) -> tuple[int, int]:
     """``(cells, nodes per cell)`` that minimise the data term's flops over ``_CELL_WIDTHS``.
 
-    Per-cell Gram matrices cost n (R·rb)² and spreading them onto B costs 2 (ra·rb)² R per cell;
+    Per-cell Gram matrices cost 2n (R·rb)² and spreading them onto B costs 2 (ra·rb)² R per cell;
     R follows from :func:`chebyshev_degree` at half the tolerance (the data covariance moves by
     twice the feature error).
     """
@@ -168,7 +163,7 @@ def _cell_layout(span: float, n: int, ra: int, rb: int, length_scale: float) -> 
     for width in _CELL_WIDTHS:
         cells = max(1, math.ceil(span / (width * length_scale) - 1e-9))
         degree = chebyshev_degree(span / cells / 2.0, length_scale, FEATURE_TOLERANCE / 2.0)
-        flops = n * (degree * rb) ** 2 + 2.0 * (ra * rb) ** 2 * degree * cells
+        flops = 2.0 * n * (degree * rb) ** 2 + 2.0 * (ra * rb) ** 2 * degree * cells
         if best is None or flops < best[0]:
             best = (flops, cells, degree)
     assert best is not None
@@ -186,17 +181,17 @@ def _data_terms(
 
     Along axis ``a`` the points are binned into cells; within a cell h_a(t) = Σ_r ℓ_r(t) h_a(ξ_r)
     over the cell's Chebyshev nodes ξ, so the cell's share of the matrix is
-    (H_c ⊗ I) E_c (H_c ⊗ I)ᵀ with E_c = Σᵢ wᵢ (ℓᵢ ℓᵢᵀ) ⊗ (h_b,ᵢ h_b,ᵢᵀ), one SYRK of (R·rb)-long
-    rows, and the n per-point outer products of length M never appear.
+    (H_c ⊗ I) E_c (H_c ⊗ I)ᵀ with E_c = Σᵢ wᵢ (ℓᵢ ℓᵢᵀ) ⊗ (h_b,ᵢ h_b,ᵢᵀ), the Gram matrix of
+    (R·rb)-long rows, and the n per-point outer products of length M never appear.
     """
     n, rb = hb.shape
     ra = basis_a.rank
     lo, hi = float(coord_a.min()), float(coord_a.max())
     cells, degree = _cell_layout(hi - lo, n, ra, rb, basis_a.length_scale)
     width = (hi - lo) / cells
-    cell = np.zeros(n, np.int64)
+    cell = np.zeros(n, np.intp)
     if width > 0.0:
-        cell = np.minimum(((coord_a - lo) / width).astype(np.int64), cells - 1)
+        cell = np.minimum(((coord_a - lo) / width).astype(np.intp), cells - 1)
     centres = lo + width * (np.arange(cells) + 0.5)
     cheb = chebyshev_points(degree)
     h_nodes = basis_a.features((centres[:, None] + 0.5 * width * cheb).ravel())
@@ -205,18 +200,18 @@ def _data_terms(
     lag = lagrange_weights(scaled, cheb)
     order = np.argsort(cell, kind="stable")
     bounds = np.concatenate([[0], np.cumsum(np.bincount(cell, minlength=cells))])
-    root_hb = hb * np.sqrt(weight)[:, None]
-    gram = np.zeros((cells, degree * rb, degree * rb))
-    rhs = np.zeros((ra, rb))
+    lag, hb = lag[order], hb[order]
+    root_w, weighted_resid = np.sqrt(weight[order]), weighted_resid[order]
+    rows = (lag[:, :, None] * (hb * root_w[:, None])[:, None, :]).reshape(n, degree * rb)
+    gram = np.empty((cells, degree * rb, degree * rb))
+    moments = np.empty((cells, degree, rb))  # Σ_p∈c ℓ_p ⊗ (w r)_p h_b,p
     for c in range(cells):
-        idx = order[bounds[c] : bounds[c + 1]]
-        if idx.size == 0:
-            continue
-        rows = (lag[idx, :, None] * root_hb[idx, None, :]).reshape(idx.size, degree * rb)
-        # rows.T is Fortran-ordered, so SYRK reads it without a copy.
-        low = blas.dsyrk(1.0, rows.T, trans=0, lower=1)
-        gram[c] = low + np.tril(low, -1).T
-        rhs += h_nodes[c].T @ (lag[idx].T @ (weighted_resid[idx, None] * hb[idx]))
+        seg = slice(bounds[c], bounds[c + 1])
+        # A full GEMM, not SYRK: the next step reads all of E_c, and OpenBLAS's GEMM runs at
+        # twice SYRK's rate here, so it costs the same as SYRK plus the symmetrisation.
+        np.matmul(rows[seg].T, rows[seg], out=gram[c])
+        np.matmul(lag[seg].T, weighted_resid[seg, None] * hb[seg], out=moments[c])
+    rhs = np.einsum("cra,crb->ab", h_nodes, moments)  # Σ_p (w r)_p ĥ_a,p ⊗ h_b,p
     return _spread_cells(gram, h_nodes, rb), rhs
 
 
@@ -290,16 +285,13 @@ def predict_on_grid(
     std = None
     if return_std:
         ra, rb = state.axis_a.rank, state.axis_b.rank
-        b_inv = state.b_inv().reshape(ra * rb * ra, rb)  # rows (a, b, a'), column b'
-        ha_pair = (ha[:, :, None] * ha[:, None, :]).reshape(ha.shape[0], ra * ra)
-        var = np.empty((ha.shape[0], hb.shape[0]))
-        for s in range(0, hb.shape[0], _GRID_CHUNK):
-            hbk = hb[s : s + _GRID_CHUNK]
-            # T[(a, a'), q] = Σ_{b, b'} h_b[q, b] B⁻¹[a, b, a', b'] h_b[q, b']: one GEMM over b',
-            # then a weighted sum over b.
-            half = (b_inv @ hbk.T).reshape(ra, rb, ra, -1)
-            t = np.einsum("abcq,qb->acq", half, hbk, optimize=True).reshape(ra * ra, -1)
-            var[:, s : s + _GRID_CHUNK] = ha_pair @ t
+        # T[q, (a, a')] = Σ_{b, b'} h_b[q, b] h_b[q, b'] B⁻¹[a, b, a', b'] for a ≥ a': one GEMM
+        # with inner dimension rb², then var[p, q] = Σ_{a, a'} h_a[p, a] h_a[p, a'] T[q, (a, a')],
+        # the pairs a > a' counted twice.
+        rows, cols = np.tril_indices(ra)
+        pairs_a = ha[:, rows] * ha[:, cols] * np.where(rows == cols, 1.0, 2.0)
+        pairs_b = (hb[:, :, None] * hb[:, None, :]).reshape(hb.shape[0], rb * rb)
+        var = pairs_a @ (pairs_b @ state.b_inv_blocks().T).T
         var += 1.0 - np.outer(np.einsum("ij,ij->i", ha, ha), np.einsum("ij,ij->i", hb, hb))
         std = signal_std * np.sqrt(np.maximum(var, 0.0))
     if state.a_is_x:
