@@ -69,3 +69,22 @@ def test_auto_picks_exact_small_and_grid_large() -> None:
         xy = rng.uniform(0.0, 0.1, size=(n, 2))
         field = GaussianRandomField(length_scale=W, signal_std=S, noise_std=N)
         assert field.fit(xy, np.zeros(n)).method_ == expected
+
+
+def test_grid_path_limits_blas_threads_and_restores_them(monkeypatch) -> None:
+    threadpoolctl = pytest.importorskip("threadpoolctl")
+    from deformap.gp import _grid
+
+    def blas_threads() -> list[int]:
+        return [
+            p["num_threads"] for p in threadpoolctl.threadpool_info() if p["user_api"] == "blas"
+        ]
+
+    with threadpoolctl.threadpool_limits(2, user_api="blas"):
+        before = blas_threads()
+        with _grid.grid_blas_threads():
+            assert set(blas_threads()) == {1}
+        assert blas_threads() == before
+        monkeypatch.setattr(_grid, "GRID_BLAS_THREADS", None)
+        with _grid.grid_blas_threads():
+            assert blas_threads() == before

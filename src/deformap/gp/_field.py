@@ -15,6 +15,7 @@ from deformap.gp._grid import (
     GRID_SPACING_FRACTION,
     GridState,
     fit_grid,
+    grid_blas_threads,
     predict_grid_points,
     predict_on_grid,
 )
@@ -164,16 +165,17 @@ class GaussianRandomField:
             self.log_marginal_likelihood_: float | None = exact.log_marginal_likelihood
         else:
             spacing = self.inducing_spacing or GRID_SPACING_FRACTION * self.length_scale
-            state = fit_grid(
-                pts,
-                resid,
-                noise_var,
-                length_scale=self.length_scale,
-                signal_std=self.signal_std,
-                spacing=spacing,
-                jitter=self.jitter,
-                max_jitter=self.max_jitter,
-            )
+            with grid_blas_threads():
+                state = fit_grid(
+                    pts,
+                    resid,
+                    noise_var,
+                    length_scale=self.length_scale,
+                    signal_std=self.signal_std,
+                    spacing=spacing,
+                    jitter=self.jitter,
+                    max_jitter=self.max_jitter,
+                )
             self.n_inducing_ = state.n_inducing
             self.log_marginal_likelihood_ = None
         _LOG.debug("fitted %s GP on %d points", method, pts.shape[0])
@@ -227,13 +229,14 @@ class GaussianRandomField:
         if isinstance(state, ExactState):
             mean, std = predict_exact(state, pts, return_std=return_std, **hyper)
         else:
-            mean, std = predict_grid_points(
-                state,
-                pts,
-                return_std=return_std,
-                length_scale=self.length_scale,
-                signal_std=self.signal_std,
-            )
+            with grid_blas_threads():
+                mean, std = predict_grid_points(
+                    state,
+                    pts,
+                    return_std=return_std,
+                    length_scale=self.length_scale,
+                    signal_std=self.signal_std,
+                )
         mean += self.mean_
         return (mean, std) if return_std and std is not None else mean
 
@@ -265,6 +268,7 @@ class GaussianRandomField:
             mean = mean.reshape(y.size, x.size)
             std = None if std is None else std.reshape(y.size, x.size)
         else:
-            mean, std = predict_on_grid(state, x, y, return_std=return_std, **hyper)
+            with grid_blas_threads():
+                mean, std = predict_on_grid(state, x, y, return_std=return_std, **hyper)
         mean = mean + self.mean_
         return (mean, std) if return_std and std is not None else mean

@@ -24,8 +24,12 @@ Axis ``a`` is the axis with more inducing nodes; the flattened feature index is 
 
 from __future__ import annotations
 
+import contextlib
+import functools
 import math
+from collections.abc import Iterator
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 import scipy.linalg as sla
@@ -42,7 +46,7 @@ from deformap.gp._grid_basis import (
     lagrange_weights,
 )
 
-__all__ = ["GRID_MARGIN_FRACTION", "GRID_SPACING_FRACTION", "MAX_INDUCING"]
+__all__ = ["GRID_BLAS_THREADS", "GRID_MARGIN_FRACTION", "GRID_SPACING_FRACTION", "MAX_INDUCING"]
 
 #: Default inducing spacing = σ_w × this. The SE spectrum exp(−σ_w²ω²/4) at the grid's Nyquist
 #: frequency π/h is exp(−π²·9/4) ≈ 2e-10 for h = σ_w/3; the measured 1-D Nyström residual inside the
@@ -56,10 +60,37 @@ GRID_MARGIN_FRACTION = 1.0
 #: Largest number of grid nodes accepted (their 1-D factors are cheap; B is at most this size,
 #: 8·M² bytes = 1.2 GB).
 MAX_INDUCING = 12_000
+#: BLAS threads while the grid path runs (None: leave the process's setting). Its BLAS calls are
+#: mid-sized (M ≈ 1,400; per-cell products of a few hundred) and many, and every threaded call waits
+#: for all its threads: on the shared 2-core machine with other jobs running, fit + mean and std at
+#: 12,000 points took 1.9–4.0 s with 2 OpenBLAS threads and 0.24–0.25 s with 1 (best of 3, four
+#: alternating rounds). Applied with threadpoolctl where it is installed (it comes with
+#: scikit-learn); without it the process's setting stays.
+GRID_BLAS_THREADS: int | None = 1
 _BLOCK_BYTES = 32 * 2**20  # bound on the intermediate of one block of cells in the data term
 #: Candidate cell widths (× σ_w) for the interpolated data term; the cheapest by the flop model in
 #: :func:`_cell_layout` is used.
 _CELL_WIDTHS = tuple(k / 6.0 for k in range(1, 13))
+
+
+@functools.cache
+def _thread_controller() -> Any:
+    try:
+        from threadpoolctl import ThreadpoolController
+    except ImportError:
+        return None
+    return ThreadpoolController()  # after numpy and scipy are loaded: it finds their BLAS
+
+
+@contextlib.contextmanager
+def grid_blas_threads() -> Iterator[None]:
+    """Limit BLAS to ``GRID_BLAS_THREADS`` threads for the duration (see there)."""
+    controller = None if GRID_BLAS_THREADS is None else _thread_controller()
+    if controller is None:
+        yield
+        return
+    with controller.limit(limits=GRID_BLAS_THREADS, user_api="blas"):
+        yield
 
 
 @dataclass(kw_only=True)
@@ -200,17 +231,17 @@ def _data_terms(
     lag = lagrange_weights(scaled, cheb)
     order = np.argsort(cell, kind="stable")
     bounds = np.concatenate([[0], np.cumsum(np.bincount(cell, minlength=cells))])
-    lag, hb = lag[order], hb[order]
-    root_w, weighted_resid = np.sqrt(weight[order]), weighted_resid[order]
-    rows = (lag[:, :, None] * (hb * root_w[:, None])[:, None, :]).reshape(n, degree * rb)
+    lag, root_hb = lag[order], hb[order] * np.sqrt(weight[order])[:, None]
+    resid_hb = hb[order] * weighted_resid[order, None]
     gram = np.empty((cells, degree * rb, degree * rb))
     moments = np.empty((cells, degree, rb))  # Σ_p∈c ℓ_p ⊗ (w r)_p h_b,p
     for c in range(cells):
         seg = slice(bounds[c], bounds[c + 1])
+        rows = (lag[seg, :, None] * root_hb[seg, None, :]).reshape(-1, degree * rb)
         # A full GEMM, not SYRK: the next step reads all of E_c, and OpenBLAS's GEMM runs at
         # twice SYRK's rate here, so it costs the same as SYRK plus the symmetrisation.
-        np.matmul(rows[seg].T, rows[seg], out=gram[c])
-        np.matmul(lag[seg].T, weighted_resid[seg, None] * hb[seg], out=moments[c])
+        np.matmul(rows.T, rows, out=gram[c])
+        np.matmul(lag[seg].T, resid_hb[seg], out=moments[c])
     rhs = np.einsum("cra,crb->ab", h_nodes, moments)  # Σ_p (w r)_p ĥ_a,p ⊗ h_b,p
     return _spread_cells(gram, h_nodes, rb), rhs
 
