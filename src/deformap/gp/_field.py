@@ -25,11 +25,15 @@ __all__ = ["AUTO_EXACT_MAX_POINTS", "GaussianRandomField"]
 _LOG = logging.getLogger(__name__)
 
 #: ``method="auto"`` uses the exact GP up to this many points and the grid GP above. Measured on
-#: the shared 2-core development machine (fit + mean and std on the 120×80 grid, 60×40 cm,
-#: σ_w = 4 cm, best of 2): exact 2.6 s vs grid 3.0 s at 1,500 points, 4.5 s vs 4.9 s at 2,000 —
-#: the paths cost about the same here, so below it the exact answer comes at no extra cost.
-#: A smaller surface (fewer inducing points) moves the crossover lower.
-AUTO_EXACT_MAX_POINTS = 1500
+#: the shared 2-core machine (fit + mean and std on the prediction grid, best of 3, one BLAS thread
+#: for both paths): on the 60×40 cm surface (σ_w = 4 cm, 120×80 grid) exact 0.17 s vs grid 0.17 s
+#: at 500 points and 0.48 s vs 0.19 s at 1,000; on a 12 cm ROI (σ_w = 1 cm, 25×25 grid) exact
+#: 0.045 s vs grid 0.15 s at 1,000 and 0.10 s vs 0.15 s at 1,500. The grid path costs about the
+#: same at any n (its size follows the extent over σ_w); the exact path's grows as n² × the
+#: number of predicted points, so the crossover lies between these: 1,000 keeps the small
+#: problems exact and moves the large ones to the grid (which the speed bench measures within
+#: 1e-6 σₑ of exact in mean and 2e-6 relative in std).
+AUTO_EXACT_MAX_POINTS = 1000
 _METHODS = ("auto", "exact", "grid")
 
 
@@ -53,7 +57,7 @@ class GaussianRandomField:
         ``"exact"``: Cholesky of the n×n covariance (RW2006 Alg. 2.1), O(n³).
         ``"grid"``: DTC/SGPR with inducing points on a regular grid and Kronecker algebra,
         near-exact for the SE kernel at the default spacing (see ``deformap.gp._grid``).
-        ``"auto"``: exact for n ≤ ``AUTO_EXACT_MAX_POINTS`` (1,500), grid above.
+        ``"auto"``: exact for n ≤ ``AUTO_EXACT_MAX_POINTS`` (1,000), grid above.
     inducing_spacing : float, metres, optional
         Grid method's node spacing; default σ_w / 3.
     jitter, max_jitter : float
