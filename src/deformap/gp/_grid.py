@@ -34,7 +34,7 @@ from typing import Any
 import numpy as np
 import scipy.linalg as sla
 from numpy.typing import NDArray
-from scipy.linalg import lapack
+from scipy.linalg import blas, lapack
 
 from deformap.errors import InvalidArgumentError, NotPositiveDefiniteError
 from deformap.gp._grid_basis import (
@@ -233,42 +233,49 @@ def _data_terms(
     bounds = np.concatenate([[0], np.cumsum(np.bincount(cell, minlength=cells))])
     lag, root_hb = lag[order], hb[order] * np.sqrt(weight[order])[:, None]
     resid_hb = hb[order] * weighted_resid[order, None]
-    gram = np.empty((cells, degree * rb, degree * rb))
-    moments = np.empty((cells, degree, rb))  # Σ_p∈c ℓ_p ⊗ (w r)_p h_b,p
-    for c in range(cells):
-        seg = slice(bounds[c], bounds[c + 1])
-        rows = (lag[seg, :, None] * root_hb[seg, None, :]).reshape(-1, degree * rb)
-        # A full GEMM, not SYRK: the next step reads all of E_c, and OpenBLAS's GEMM runs at
-        # twice SYRK's rate here, so it costs the same as SYRK plus the symmetrisation.
-        np.matmul(rows.T, rows, out=gram[c])
-        np.matmul(lag[seg].T, resid_hb[seg], out=moments[c])
-    rhs = np.einsum("cra,crb->ab", h_nodes, moments)  # Σ_p (w r)_p ĥ_a,p ⊗ h_b,p
-    return _spread_cells(gram, h_nodes, rb), rhs
+    system = np.zeros((ra * rb, ra * rb))
+    rhs = np.zeros((ra, rb))  # Σ_p (w r)_p ĥ_a,p ⊗ h_b,p
+    step = max(1, _BLOCK_BYTES // (degree * rb * ra * rb * 8))
+    for c0 in range(0, cells, step):
+        block = range(c0, min(c0 + step, cells))
+        gram = np.empty((len(block), degree * rb, degree * rb))
+        for i, c in enumerate(block):
+            seg = slice(bounds[c], bounds[c + 1])
+            rows = (lag[seg, :, None] * root_hb[seg, None, :]).reshape(-1, degree * rb)
+            # A full GEMM, not SYRK: the next step reads all of E_c, and OpenBLAS's GEMM runs at
+            # twice SYRK's rate here, so it costs the same as SYRK plus the symmetrisation.
+            np.matmul(rows.T, rows, out=gram[i])
+            rhs += h_nodes[c].T @ (lag[seg].T @ resid_hb[seg])
+        _spread_cells(system, gram, h_nodes[c0 : block.stop])
+    return system, rhs
 
 
 def _spread_cells(
-    gram: NDArray[np.float64], h_nodes: NDArray[np.float64], rb: int
-) -> NDArray[np.float64]:
-    """Σ_c (H_c ⊗ I) E_c (H_c ⊗ I)ᵀ (M, M).
+    system: NDArray[np.float64], gram: NDArray[np.float64], h_nodes: NDArray[np.float64]
+) -> None:
+    """Add Σ_c (H_c ⊗ I) E_c (H_c ⊗ I)ᵀ to ``system`` (M, M) in place.
 
     ``gram`` (cells, R·rb, R·rb) holds the E_c, ``h_nodes`` (cells, R, ra) the H_c.
     """
     cells, degree, ra = h_nodes.shape
-    system = np.zeros((ra * rb, ra * rb))
-    step = max(1, _BLOCK_BYTES // (degree * rb * ra * rb * 8))
-    for c0 in range(0, cells, step):
-        blk = slice(c0, min(c0 + step, cells))
-        nb = blk.stop - blk.start
-        # half[c, r', b', a, b] = Σ_r E_c[r', b', r, b] H_c[r, a]
-        half = np.matmul(
-            h_nodes[blk].transpose(0, 2, 1)[:, None],
-            gram[blk].reshape(nb, degree * rb, degree, rb),
-        )
-        # B[(a', b'), (a, b)] += Σ_{c, r'} H_c[r', a'] half[c, r', b', a, b]: one GEMM per block
-        system += (
-            h_nodes[blk].reshape(nb * degree, ra).T @ half.reshape(nb * degree, rb * ra * rb)
-        ).reshape(ra * rb, ra * rb)
-    return system
+    rb = gram.shape[1] // degree
+    # half[c, r', b', a, b] = Σ_r E_c[r', b', r, b] H_c[r, a]
+    half = np.matmul(
+        h_nodes.transpose(0, 2, 1)[:, None], gram.reshape(cells, degree * rb, degree, rb)
+    )
+    # B[(a', b'), (a, b)] += Σ_{c, r'} H_c[r', a'] half[c, r', b', a, b]: one GEMM, written as
+    # Bᵀ += halfᵀ H on the Fortran-ordered transpose so that it accumulates in place.
+    target = system.reshape(ra, rb * ra * rb).T
+    out = blas.dgemm(
+        1.0,
+        half.reshape(cells * degree, rb * ra * rb).T,
+        np.asfortranarray(h_nodes.reshape(cells * degree, ra)),
+        beta=1.0,
+        c=target,
+        overwrite_c=1,
+    )
+    if not np.shares_memory(out, system):  # the wrapper copied after all
+        target[...] = out
 
 
 def predict_grid_points(
