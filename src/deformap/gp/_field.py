@@ -56,7 +56,9 @@ class GaussianRandomField:
     method : {"auto", "exact", "grid"}
         ``"exact"``: Cholesky of the n×n covariance (RW2006 Alg. 2.1), O(n³).
         ``"grid"``: DTC/SGPR with inducing points on a regular grid and Kronecker algebra,
-        near-exact for the SE kernel at the default spacing (see ``deformap.gp._grid``).
+        near-exact for the SE kernel at the default spacing (see ``deformap.gp._grid``); each
+        axis's whitened inducing features are compressed to the modes the data's extent
+        excites, so its cost follows the extent over σ_w, hardly n (``deformap.gp._grid_basis``).
         ``"auto"``: exact for n ≤ ``AUTO_EXACT_MAX_POINTS`` (1,000), grid above.
     inducing_spacing : float, metres, optional
         Grid method's node spacing; default σ_w / 3.
@@ -75,7 +77,8 @@ class GaussianRandomField:
     jitter_used_ : float
         The relative jitter the factorisation needed.
     n_inducing_ : int
-        Number of inducing points (0 for the exact method).
+        Number of inducing grid points (0 for the exact method); the linear algebra runs on
+        fewer compressed features, see ``deformap.gp._grid_basis``.
     log_marginal_likelihood_ : float or None
         log p(z | hyperparameters) of the exact method (RW2006 Eq. 2.30); None for the grid method.
 
