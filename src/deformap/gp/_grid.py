@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import contextlib
 import functools
+import logging
 import math
 from collections.abc import Iterator
 from dataclasses import dataclass, field
@@ -48,6 +49,8 @@ from deformap.gp._grid_basis import (
 
 __all__ = ["GRID_BLAS_THREADS", "GRID_MARGIN_FRACTION", "GRID_SPACING_FRACTION", "MAX_INDUCING"]
 
+_LOG = logging.getLogger(__name__)
+
 #: Default inducing spacing = σ_w × this. The SE spectrum exp(−σ_w²ω²/4) at the grid's Nyquist
 #: frequency π/h is exp(−π²·9/4) ≈ 2e-10 for h = σ_w/3; the measured 1-D Nyström residual inside the
 #: grid is 2e-10 (relative to σₑ²), i.e. the grid loses nothing a float64 Cholesky would keep.
@@ -63,8 +66,8 @@ MAX_INDUCING = 12_000
 #: BLAS threads while the grid path runs (None: leave the process's setting). Its BLAS calls are
 #: mid-sized (M ≈ 1,400; per-cell products of a few hundred) and many, and every threaded call waits
 #: for all its threads: on the shared 2-core machine with other jobs running, fit + mean and std at
-#: 12,000 points took 1.9–4.0 s with 2 OpenBLAS threads and 0.24–0.25 s with 1 (best of 3, four
-#: alternating rounds). Applied with threadpoolctl where it is installed (it comes with
+#: 12,000 points took 1.9–3.8 s with 2 OpenBLAS threads and 0.24–0.25 s with 1 (best of 3 in
+#: each of four alternating rounds). Applied with threadpoolctl where it is installed (it comes with
 #: scikit-learn); without it the process's setting stays.
 GRID_BLAS_THREADS: int | None = 1
 _BLOCK_BYTES = 32 * 2**20  # bound on the intermediate of one block of cells in the data term
@@ -219,6 +222,7 @@ def _data_terms(
     ra = basis_a.rank
     lo, hi = float(coord_a.min()), float(coord_a.max())
     cells, degree = _cell_layout(hi - lo, n, ra, rb, basis_a.length_scale)
+    _LOG.debug("grid GP: %d×%d features, %d cells × %d Chebyshev nodes", ra, rb, cells, degree)
     width = (hi - lo) / cells
     cell = np.zeros(n, np.intp)
     if width > 0.0:
