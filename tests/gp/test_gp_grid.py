@@ -69,3 +69,38 @@ def test_auto_picks_exact_small_and_grid_large() -> None:
         xy = rng.uniform(0.0, 0.1, size=(n, 2))
         field = GaussianRandomField(length_scale=W, signal_std=S, noise_std=N)
         assert field.fit(xy, np.zeros(n)).method_ == expected
+
+
+def test_grid_path_limits_blas_threads_and_restores_them(monkeypatch) -> None:
+    threadpoolctl = pytest.importorskip("threadpoolctl")
+    from deformap.gp import _grid
+
+    def blas_threads() -> list[int]:
+        return [
+            p["num_threads"] for p in threadpoolctl.threadpool_info() if p["user_api"] == "blas"
+        ]
+
+    with threadpoolctl.threadpool_limits(2, user_api="blas"):
+        before = blas_threads()
+        with _grid.grid_blas_threads():
+            assert set(blas_threads()) == {1}
+        assert blas_threads() == before
+        monkeypatch.setattr(_grid, "GRID_BLAS_THREADS", None)
+        with _grid.grid_blas_threads():
+            assert blas_threads() == before
+
+
+def test_grid_matches_exact_for_points_on_a_line() -> None:
+    # One axis has a single coordinate: one compressed feature and one interpolation cell there.
+    rng = np.random.default_rng(5)
+    xy = np.column_stack([np.full(400, 0.05), rng.uniform(0.0, 0.2, 400)])
+    z = S * np.sin(xy[:, 1] / 0.02) + N * rng.standard_normal(400)
+    test = np.column_stack([rng.uniform(0.0, 0.1, 200), rng.uniform(0.0, 0.2, 200)])
+    out = [
+        GaussianRandomField(length_scale=W, signal_std=S, noise_std=N, method=m)
+        .fit(xy, z)
+        .predict(test, return_std=True)
+        for m in ("exact", "grid")
+    ]
+    assert np.max(np.abs(out[1][0] - out[0][0])) <= 1e-8
+    np.testing.assert_allclose(out[1][1], out[0][1], rtol=1e-5)

@@ -15,6 +15,7 @@ from deformap.gp._grid import (
     GRID_SPACING_FRACTION,
     GridState,
     fit_grid,
+    grid_blas_threads,
     predict_grid_points,
     predict_on_grid,
 )
@@ -24,11 +25,15 @@ __all__ = ["AUTO_EXACT_MAX_POINTS", "GaussianRandomField"]
 _LOG = logging.getLogger(__name__)
 
 #: ``method="auto"`` uses the exact GP up to this many points and the grid GP above. Measured on
-#: the shared 2-core development machine (fit + mean and std on the 120×80 grid, 60×40 cm,
-#: σ_w = 4 cm, best of 2): exact 2.6 s vs grid 3.0 s at 1,500 points, 4.5 s vs 4.9 s at 2,000 —
-#: the paths cost about the same here, so below it the exact answer comes at no extra cost.
-#: A smaller surface (fewer inducing points) moves the crossover lower.
-AUTO_EXACT_MAX_POINTS = 1500
+#: the shared 2-core machine (fit + mean and std on the prediction grid, best of 3, one BLAS thread
+#: for both paths): on the 60×40 cm surface (σ_w = 4 cm, 120×80 grid) exact 0.17 s vs grid 0.17 s
+#: at 500 points and 0.48 s vs 0.19 s at 1,000; on a 12 cm ROI (σ_w = 1 cm, 25×25 grid) exact
+#: 0.045 s vs grid 0.15 s at 1,000 and 0.10 s vs 0.15 s at 1,500. The grid path costs about the
+#: same at any n (its size follows the extent over σ_w); the exact path's grows as n² × the
+#: number of predicted points, so the crossover lies between these: 1,000 keeps the small
+#: problems exact and moves the large ones to the grid (which the speed bench measures within
+#: 1e-6 σₑ of exact in mean and 2e-6 relative in std).
+AUTO_EXACT_MAX_POINTS = 1000
 _METHODS = ("auto", "exact", "grid")
 
 
@@ -51,8 +56,10 @@ class GaussianRandomField:
     method : {"auto", "exact", "grid"}
         ``"exact"``: Cholesky of the n×n covariance (RW2006 Alg. 2.1), O(n³).
         ``"grid"``: DTC/SGPR with inducing points on a regular grid and Kronecker algebra,
-        near-exact for the SE kernel at the default spacing (see ``deformap.gp._grid``).
-        ``"auto"``: exact for n ≤ ``AUTO_EXACT_MAX_POINTS`` (1,500), grid above.
+        near-exact for the SE kernel at the default spacing (see ``deformap.gp._grid``); each
+        axis's whitened inducing features are compressed to the modes the data's extent
+        excites, so its cost follows the extent over σ_w, hardly n (``deformap.gp._grid_basis``).
+        ``"auto"``: exact for n ≤ ``AUTO_EXACT_MAX_POINTS`` (1,000), grid above.
     inducing_spacing : float, metres, optional
         Grid method's node spacing; default σ_w / 3.
     jitter, max_jitter : float
@@ -70,7 +77,8 @@ class GaussianRandomField:
     jitter_used_ : float
         The relative jitter the factorisation needed.
     n_inducing_ : int
-        Number of inducing points (0 for the exact method).
+        Number of inducing grid points (0 for the exact method); the linear algebra runs on
+        fewer compressed features, see ``deformap.gp._grid_basis``.
     log_marginal_likelihood_ : float or None
         log p(z | hyperparameters) of the exact method (RW2006 Eq. 2.30); None for the grid method.
 
@@ -164,16 +172,17 @@ class GaussianRandomField:
             self.log_marginal_likelihood_: float | None = exact.log_marginal_likelihood
         else:
             spacing = self.inducing_spacing or GRID_SPACING_FRACTION * self.length_scale
-            state = fit_grid(
-                pts,
-                resid,
-                noise_var,
-                length_scale=self.length_scale,
-                signal_std=self.signal_std,
-                spacing=spacing,
-                jitter=self.jitter,
-                max_jitter=self.max_jitter,
-            )
+            with grid_blas_threads():
+                state = fit_grid(
+                    pts,
+                    resid,
+                    noise_var,
+                    length_scale=self.length_scale,
+                    signal_std=self.signal_std,
+                    spacing=spacing,
+                    jitter=self.jitter,
+                    max_jitter=self.max_jitter,
+                )
             self.n_inducing_ = state.n_inducing
             self.log_marginal_likelihood_ = None
         _LOG.debug("fitted %s GP on %d points", method, pts.shape[0])
@@ -227,13 +236,14 @@ class GaussianRandomField:
         if isinstance(state, ExactState):
             mean, std = predict_exact(state, pts, return_std=return_std, **hyper)
         else:
-            mean, std = predict_grid_points(
-                state,
-                pts,
-                return_std=return_std,
-                length_scale=self.length_scale,
-                signal_std=self.signal_std,
-            )
+            with grid_blas_threads():
+                mean, std = predict_grid_points(
+                    state,
+                    pts,
+                    return_std=return_std,
+                    length_scale=self.length_scale,
+                    signal_std=self.signal_std,
+                )
         mean += self.mean_
         return (mean, std) if return_std and std is not None else mean
 
@@ -265,6 +275,7 @@ class GaussianRandomField:
             mean = mean.reshape(y.size, x.size)
             std = None if std is None else std.reshape(y.size, x.size)
         else:
-            mean, std = predict_on_grid(state, x, y, return_std=return_std, **hyper)
+            with grid_blas_threads():
+                mean, std = predict_on_grid(state, x, y, return_std=return_std, **hyper)
         mean = mean + self.mean_
         return (mean, std) if return_std and std is not None else mean
