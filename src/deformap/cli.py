@@ -368,8 +368,9 @@ def reproduce_command(
     ] = Path("runs/reproduce"),
     seed: Annotated[int, typer.Option(help="Seed of every run.")] = 0,
     strategy: Annotated[
-        str, typer.Option(help="paper | max-variance | min-max-variance.")
-    ] = "paper",
+        str | None,
+        typer.Option(help="paper | max-variance | min-max-variance (default: the config's)."),
+    ] = None,
     config: Annotated[Path | None, typer.Option(help="Run configuration YAML.")] = None,
 ) -> None:
     """All six scenarios of the paper's Table I, beside the paper's numbers."""
@@ -378,9 +379,10 @@ def reproduce_command(
     from deformap.eval import load_run_config, reproduce
 
     base = load_run_config(config)
-    base = dataclasses.replace(
-        base, seed=seed, exploration=dataclasses.replace(base.exploration, strategy=strategy),  # type: ignore[arg-type]
-    )
+    exploration = base.exploration
+    if strategy is not None:
+        exploration = dataclasses.replace(exploration, strategy=strategy)  # type: ignore[arg-type]
+    base = dataclasses.replace(base, seed=seed, exploration=exploration)
 
     def show(row: dict[str, Any]) -> None:
         tau = "–" if row["kendall_tau"] is None else f"{row['kendall_tau']:.2f}"
