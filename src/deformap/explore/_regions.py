@@ -179,7 +179,8 @@ def segment_regions(
     check_int("max_regions", max_regions, minimum=1)
     order = np.argsort(betas, kind="stable")
     b, s = betas[order], np.maximum(stds[order], floor)
-    pending, done = [np.arange(b.size)], []
+    pending: list[NDArray[np.int64]] = [np.arange(b.size)]
+    done: list[NDArray[np.int64]] = []
     while pending:
         group = pending.pop()
         room = max_regions - len(done) - len(pending)
