@@ -85,7 +85,7 @@ def _default_out(scenario: str, seed: int) -> Path:
     return Path("runs") / f"{stem}-s{seed}-{time.strftime('%Y%m%d-%H%M%S')}"
 
 
-def _progress_row(table: Any, poke: Any) -> None:
+def _progress_row(poke: Any) -> None:
     r = poke.record
     t = r["timings"]
     compute = sum(v for k, v in t.items() if k != "environment_s")
@@ -191,7 +191,7 @@ def explore_command(
         cfg,
         folder,
         resume=resume is not None,
-        on_poke=lambda poke: _progress_row(None, poke),
+        on_poke=_progress_row,
         rerun=rerun,
     )
     _summary(output.report, folder)
