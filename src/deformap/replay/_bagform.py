@@ -7,8 +7,6 @@ message is decoded only when its poke is read, so a corrupted message breaks onl
 
 from __future__ import annotations
 
-import sqlite3
-import struct
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -38,12 +36,9 @@ class _Raw:
 
 
 def _bag_errors() -> tuple[type[BaseException], ...]:
-    from rosbags.serde import SerdeError
+    from deformap.cloud.io._bag import bag_read_errors
 
-    # What rosbags, sqlite3 and the CDR decoder raise on damaged bags.
-    return (_rosbag2().ReaderError, SerdeError, sqlite3.Error, OSError, ValueError, KeyError,
-            IndexError, TypeError, AssertionError, EOFError, struct.error, MemoryError,
-            OverflowError, UnicodeDecodeError)  # fmt: skip
+    return bag_read_errors()
 
 
 def _stamp(msg: Any) -> int:

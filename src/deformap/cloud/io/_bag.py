@@ -107,6 +107,26 @@ def _stamp_ns(header: Any) -> int:
     return int(header.stamp.sec) * 10**9 + int(header.stamp.nanosec)
 
 
+def bag_read_errors() -> tuple[type[BaseException], ...]:
+    """What rosbags, its SQLite driver and the CDR decoder raise on a damaged bag.
+
+    Recent rosbags read sqlite3 bags through ``apsw`` (its ``CorruptError`` is not a
+    ``sqlite3.Error``); a corrupted length field can ask for an absurd allocation (MemoryError).
+    """
+    from rosbags.serde import SerdeError
+
+    errors: tuple[type[BaseException], ...] = (
+        _rosbag2().ReaderError, SerdeError, sqlite3.Error, OSError, ValueError, KeyError,
+        IndexError, TypeError, AssertionError, EOFError, struct.error, MemoryError,
+        OverflowError, UnicodeDecodeError,
+    )  # fmt: skip
+    try:
+        import apsw
+    except ImportError:
+        return errors
+    return (*errors, apsw.Error)
+
+
 def _messages(path: Any, topic: str, msgtype: str) -> Iterator[tuple[int, Any]]:
     """Yield (log time, deserialised message) of ``topic``; every failure names file and topic."""
     if not isinstance(topic, str) or not topic:
@@ -116,15 +136,9 @@ def _messages(path: Any, topic: str, msgtype: str) -> Iterator[tuple[int, Any]]:
             f"`path` must be a str or pathlib.Path; got {type(path).__name__}"
         )
     rosbag2, store, p = _rosbag2(), typestore(), Path(path)
-    from rosbags.serde import SerdeError
-
     if not p.exists():
         raise FileFormatError(f"{p}: no such bag")
-    # What rosbags, sqlite3 and the CDR decoder raise on damaged bags; a corrupted length field
-    # can also ask for an absurd allocation (MemoryError).
-    errors = (rosbag2.ReaderError, SerdeError, sqlite3.Error, OSError, ValueError, KeyError,
-              IndexError, TypeError, AssertionError, EOFError, struct.error,
-              MemoryError)  # fmt: skip
+    errors = bag_read_errors()
     try:
         with rosbag2.Reader(p) as reader:
             conns = [c for c in reader.connections if c.topic == topic]
