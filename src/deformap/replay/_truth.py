@@ -8,7 +8,6 @@ ground-truth metrics.
 
 from __future__ import annotations
 
-import io
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -18,7 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from deformap._validation import check_array
-from deformap.cloud.io._common import parse_errors
+from deformap.cloud.io._npz import load_npz_arrays
 from deformap.errors import FileFormatError, InvalidArgumentError
 
 __all__ = ["GroundTruth", "read_ground_truth", "write_ground_truth"]
@@ -113,12 +112,7 @@ def read_ground_truth(path: str | Path) -> GroundTruth:
     p = Path(path)
     if not p.is_file():
         raise FileFormatError(f"{p}: no such file (the session's `ground_truth`)")
-    with parse_errors(p, "the ground-truth NPZ archive"):
-        loaded = np.load(io.BytesIO(p.read_bytes()), allow_pickle=False)
-        if not isinstance(loaded, np.lib.npyio.NpzFile):
-            raise FileFormatError(f"{p}: a single .npy array, not an NPZ archive of named arrays")
-        with loaded as archive:
-            arrays = {name: archive[name] for name in archive.files}
+    arrays = load_npz_arrays(p, "the ground-truth NPZ archive")
     missing = sorted({"xs", "ys", "labels", "hardness"} - set(arrays))
     if missing:
         raise FileFormatError(f"{p}: ground truth lacks array(s) {missing} (has {sorted(arrays)})")

@@ -66,8 +66,10 @@ def record_run(path: str | Path, result: Any, *, initial_points: NDArray[np.floa
         "world/observation",
         rr.Points3D(pts, radii=0.0015, colors=_colors(pts[:, 2], "viridis", 0.0, 0.08)),
     )
+    surface_mesh = None
     if mapper.surface is not None:
-        vertices, triangles = heightmap_mesh(mapper.xs, mapper.ys, mapper.surface.height)
+        surface_mesh = heightmap_mesh(mapper.xs, mapper.ys, mapper.surface.height)
+        vertices, triangles = surface_mesh
         rec.log(
             "world/surface",
             rr.Mesh3D(
@@ -93,8 +95,8 @@ def record_run(path: str | Path, result: Any, *, initial_points: NDArray[np.floa
                 rr.Mesh3D(vertex_positions=v, triangle_indices=t, vertex_colors=[60, 120, 230]),
             )
         mean, var = mapper.field(upto=k)
-        if mapper.surface is not None:
-            v, t = heightmap_mesh(mapper.xs, mapper.ys, mapper.surface.height)
+        if surface_mesh is not None:
+            v, t = surface_mesh
             rec.log(
                 "world/beta_field",
                 rr.Mesh3D(

@@ -14,7 +14,21 @@ from deformap.cloud.io._common import check_units, finish_cloud, parse_errors, r
 from deformap.cloud.io._pcd import _check_cloud_and_extras
 from deformap.errors import FileFormatError
 
-__all__ = ["read_npz", "write_npz"]
+__all__ = ["load_npz_arrays", "read_npz", "write_npz"]
+
+
+def load_npz_arrays(p: Path, what: str) -> dict[str, NDArray[Any]]:
+    """All named arrays of an NPZ archive, without pickle; a damaged file is a FileFormatError.
+
+    ``what`` names the archive in messages (``"the NPZ archive"``).
+    """
+    with parse_errors(p, what):
+        # Loading from memory, so that a corrupted archive leaves no file handle open.
+        loaded = np.load(io.BytesIO(p.read_bytes()), allow_pickle=False)
+        if not isinstance(loaded, np.lib.npyio.NpzFile):
+            raise FileFormatError(f"{p}: a single .npy array, not an NPZ archive of named arrays")
+        with loaded as archive:
+            return {name: archive[name] for name in archive.files}
 
 
 def read_npz(
@@ -40,13 +54,7 @@ def read_npz(
     """
     scale = check_units(units)
     p = readable_path(path)
-    with parse_errors(p, "the NPZ archive"):
-        # Loading from memory, so that a corrupted archive leaves no file handle open.
-        loaded = np.load(io.BytesIO(p.read_bytes()), allow_pickle=False)
-        if not isinstance(loaded, np.lib.npyio.NpzFile):
-            raise FileFormatError(f"{p}: a single .npy array, not an NPZ archive of named arrays")
-        with loaded as archive:
-            arrays = {name: archive[name] for name in archive.files}
+    arrays = load_npz_arrays(p, "the NPZ archive")
     if "points" not in arrays:
         raise FileFormatError(f"{p}: NPZ has no array 'points' (has: {sorted(arrays)})")
     points = arrays.pop("points")
