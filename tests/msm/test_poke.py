@@ -168,6 +168,35 @@ def test_estimate_reports_curve_refinement_and_uncertainty():
     assert est.stiffness_n_per_m > 0
 
 
+def test_loose_sweep_tolerance_keeps_the_estimate_and_compares_only_converged_beta():
+    # the coarse sweep at sweep_tol only brackets the minimum: β̂ is the one of an all-tight
+    # estimate, and β̂ and its grid neighbours are solved to tol
+    xs, ys, z, pts, contact = dent_case(110, n=13)
+    loose = estimate_beta(xs, ys, z, pts, contact, ShapeMatchingConfig())
+    tight = estimate_beta(xs, ys, z, pts, contact, ShapeMatchingConfig(sweep_tol=1e-6))
+    cfg = ShapeMatchingConfig()
+    assert cfg.sweep_tol > cfg.tol
+    assert loose.beta == tight.beta
+    near = np.abs(loose.betas - loose.beta) < 0.0101
+    assert near.sum() == 3
+    assert np.all(loose.residual[near] < cfg.tol)
+    assert np.all(loose.residual < cfg.sweep_tol) and loose.all_converged
+    assert np.any(loose.residual[~near] >= cfg.tol), "the sweep was not solved loosely"
+    assert np.all(loose.tolerances[near] == cfg.tol)
+    assert set(loose.tolerances.tolist()) == {cfg.tol, cfg.sweep_tol}
+    np.testing.assert_allclose(loose.errors[near], tight.errors[np.isin(tight.betas,
+                                                                        loose.betas[near])],
+                               rtol=0, atol=1e-8)
+
+
+def test_without_refinement_every_beta_is_solved_to_tol():
+    xs, ys, z, pts, contact = dent_case(60, n=9)
+    cfg = ShapeMatchingConfig(refine=False)
+    est = estimate_beta(xs, ys, z, pts, contact, cfg)
+    assert est.betas.size == cfg.n_beta and cfg.coarse_tol == cfg.tol
+    assert np.all(est.residual < cfg.tol)
+
+
 # ---- bad input ---------------------------------------------------------------------------------
 
 def _ok():
@@ -233,7 +262,7 @@ def test_bad_shapes_and_values_are_refused():
     ({"poisson_ratio": 0.6}, "`poisson_ratio`"),
     ({"error_tolerance_m": 0.0}, "`error_tolerance_m`"),
     ({"layers": -1}, "`layers`"), ({"layer_growth": 0.5}, "`layer_growth`"),
-    ({"refine": 1}, "`refine`"),
+    ({"refine": 1}, "`refine`"), ({"sweep_tol": 1e-7}, "`sweep_tol`"),
 ])
 def test_bad_config_is_refused(kwargs, name):
     from deformap.errors import InvalidArgumentError

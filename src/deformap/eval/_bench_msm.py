@@ -5,12 +5,13 @@ Both sides compute the same thing: the converged poke equilibrium of every β th
 and E(β) for each, on a Hertz dent of a 60 N foam (an elastic half-space, not shape matching) with
 0.1 mm of seeded observation noise. The estimate sets the ROI up once, solves the sweep in one
 batch and starts each refinement β from the β already solved; the naive loop simulates each of
-the same β on its own (its own set-up and factorisation, started from rest), reusing only the
-calibrated stiffness. "n_beta" is the number of β values simulated.
+the same β on its own, to the same tolerance (its own set-up and factorisation, started from
+rest), reusing only the calibrated stiffness. "n_beta" is the number of β values simulated.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from typing import Any
 
@@ -70,8 +71,9 @@ def bench_beta_sweep(*, n_particles_side: int = 40, cluster_size: int = 3,
     tree = cKDTree(pts)
     t0 = time.perf_counter()
     loop_errors = []
-    for beta in est.betas:
-        sim = simulate_poke(grid.rest, grid.masses, grid.fixed, contact, np.array([beta]), cfg,
+    for beta, tol in zip(est.betas, est.tolerances, strict=True):
+        sim = simulate_poke(grid.rest, grid.masses, grid.fixed, contact, np.array([beta]),
+                            dataclasses.replace(cfg, tol=tol, sweep_tol=max(tol, cfg.sweep_tol)),
                             stiffness_n_per_m=est.stiffness_n_per_m)
         loop_errors.append(matching_error(sim.positions, tree)[0])
     loop = time.perf_counter() - t0

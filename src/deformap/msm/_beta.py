@@ -48,7 +48,11 @@ class BetaEstimate:
     iterations : (n,) int
     residual : (n,) float
     converged : (n,) bool
-        Convergence of each β's simulation (see :class:`PokeSimulation`).
+        Convergence of each β's simulation (see :class:`PokeSimulation`), of its last solve: to
+        ``config.tol`` for every β the refinement compared (and for all β without refinement),
+        to ``config.sweep_tol`` for the other swept β.
+    tolerances : (n,) float
+        The relative fixed-point tolerance each β was last solved to.
     protocol : str
         ``"force"`` or ``"pinned"``.
     mode : str
@@ -63,6 +67,7 @@ class BetaEstimate:
     iterations: NDArray[np.int64]
     residual: Array
     converged: NDArray[np.bool_]
+    tolerances: Array
     protocol: str
     mode: str
     stiffness_n_per_m: float | None = None
@@ -86,33 +91,47 @@ def matching_error(positions: Array, tree: cKDTree) -> Array:
 
 
 class _Sweep:
-    """E(β) of one poke, each β solved once and started from the β already solved."""
+    """E(β) of one poke, each β solved once per tolerance and started from the β already solved.
+
+    A β first solved to a loose tolerance (the coarse sweep) is solved again, from its own
+    equilibrium, when it is asked for at a tighter one.
+    """
 
     def __init__(self, model: PokeModel, tree: cKDTree):
         self.model, self.tree = model, tree
-        self.sims: list[PokeSimulation] = []
+        self.sims: dict[float, tuple[PokeSimulation, int]] = {}
         self.errors: dict[float, float] = {}
         self.distances: dict[float, Array] = {}
+        self.tols: dict[float, float] = {}
         self._body: dict[float, Array] = {}
 
-    def run(self, betas: Array) -> None:
-        """Solve the new β of ``betas (B,)`` in one batch."""
-        betas = np.asarray([b for b in np.round(betas, 10) if float(b) not in self.errors])
+    def solved(self, beta: float, tol: float) -> bool:
+        """Whether ``beta`` has been solved to ``tol`` or tighter."""
+        return self.tols.get(beta, np.inf) <= tol
+
+    def run(self, betas: Array, tol: float) -> None:
+        """Solve those of ``betas (B,)`` not yet solved to ``tol``, in one batch."""
+        betas = np.asarray([b for b in np.round(betas, 10) if not self.solved(float(b), tol)])
         if betas.size == 0:
             return
         x0 = None
         if self._body:
             x0 = np.stack([self._start(float(b)) for b in betas])
-        sim, body = self.model.solve(betas, x0)
-        self.sims.append(sim)
+        sim, body = self.model.solve(betas, x0, tol)
         dist = particle_distances(sim.positions, self.tree)
         for j, b in enumerate(betas):
-            self.errors[float(b)] = float(dist[j].mean())
-            self.distances[float(b)] = dist[j]
-            self._body[float(b)] = body[j]
+            key = float(b)
+            self.sims[key] = (sim, j)
+            self.errors[key] = float(dist[j].mean())
+            self.distances[key] = dist[j]
+            self.tols[key] = tol
+            self._body[key] = body[j]
 
     def _start(self, beta: float) -> Array:
-        """Starting positions for ``beta``: linear in β through the two nearest solved β."""
+        """Starting positions for ``beta``: its own loosely solved equilibrium, else linear in β
+        through the two nearest solved β."""
+        if beta in self._body:
+            return self._body[beta]
         known = np.fromiter(self._body, dtype=float)
         near = known[np.argsort(np.abs(known - beta), kind="stable")[:2]]
         if near.size == 1:
@@ -121,13 +140,20 @@ class _Sweep:
         t = (beta - b0) / (b1 - b0)
         return (1.0 - t) * self._body[b0] + t * self._body[b1]
 
-    def __call__(self, beta: float) -> float:
-        key = float(np.round(beta, 10))
-        self.run(np.array([key]))
-        return self.errors[key]
+    def curve(self) -> tuple[Array, Array, NDArray[np.int64], Array, NDArray[np.bool_], Array]:
+        """Sorted β, E(β), iterations, residuals, converged flags and tolerances of every β
+        solved (its latest, tightest solve)."""
+        betas = np.array(sorted(self.sims))
+        rows = [self.sims[float(b)] for b in betas]
+        errors = np.array([self.errors[float(b)] for b in betas])
+        its = np.array([sim.iterations[j] for sim, j in rows], dtype=np.int64)
+        res = np.array([sim.residual[j] for sim, j in rows])
+        conv = np.array([sim.converged[j] for sim, j in rows], dtype=bool)
+        tols = np.array([self.tols[float(b)] for b in betas])
+        return betas, errors, its, res, conv, tols
 
 
-def _refine(sweep: _Sweep, step: float, resolution: float) -> None:
+def _refine(sweep: _Sweep, step: float, resolution: float, tol: float) -> None:
     """Find the minimum of E on the ``resolution`` grid within one ``step`` of the best swept β.
 
     E(β) is smooth, so there it is unimodal, and a grid point whose two grid neighbours are both
@@ -135,7 +161,7 @@ def _refine(sweep: _Sweep, step: float, resolution: float) -> None:
     swept β and its two swept neighbours (solving that grid point and its neighbours in one
     batch), then walks downhill one grid step at a time until the lowest point has both
     neighbours solved: a handful of solves instead of the ``2 step / resolution`` of an
-    exhaustive grid, and the same grid minimum.
+    exhaustive grid, and the same grid minimum. Every β compared is solved to ``tol``.
     """
     known = np.fromiter(sweep.errors, dtype=float)
     errs = np.fromiter(sweep.errors.values(), dtype=float)
@@ -150,15 +176,15 @@ def _refine(sweep: _Sweep, step: float, resolution: float) -> None:
         return float(np.round(best + resolution * i, 10))
 
     guess = int(np.clip(round(_vertex(known, errs, best) / resolution), a, b))
-    sweep.run(np.array([key(i) for i in (guess - 1, guess, guess + 1) if a <= i <= b]))
+    sweep.run(np.array([key(i) for i in (guess - 1, guess, guess + 1) if a <= i <= b]), tol)
     while True:
-        done = [i for i in range(a, b + 1) if key(i) in sweep.errors]
+        done = [i for i in range(a, b + 1) if sweep.solved(key(i), tol)]
         e = np.array([sweep.errors[key(i)] for i in done])
         m = done[int(np.flatnonzero(e <= e.min() + _TIE_M)[0])]
-        missing = [i for i in (m - 1, m + 1) if a <= i <= b and key(i) not in sweep.errors]
+        missing = [i for i in (m - 1, m + 1) if a <= i <= b and not sweep.solved(key(i), tol)]
         if not missing:
             return
-        sweep.run(np.array([key(i) for i in missing]))
+        sweep.run(np.array([key(i) for i in missing]), tol)
 
 
 def _vertex(betas: Array, errors: Array, best: float) -> float:
@@ -241,17 +267,10 @@ def estimate_beta(rest_xs: Any, rest_ys: Any, rest_z: Any, deformed_points: Any,
     observed = check_points("deformed_points", deformed_points, min_rows=1)
     model = PokeModel(grid.rest, grid.masses, grid.fixed, contact, cfg)
     sweep = _Sweep(model, cKDTree(observed))
-    sweep.run(np.arange(cfg.n_beta) / cfg.n_beta)
-    if cfg.refine and cfg.beta_resolution < 1.0 / cfg.n_beta:
-        _refine(sweep, 1.0 / cfg.n_beta, cfg.beta_resolution)
-    sims = sweep.sims
-    betas = np.concatenate([s.betas for s in sims])
-    errors = np.concatenate([[sweep.errors[float(b)] for b in s.betas] for s in sims])
-    order = np.argsort(betas, kind="stable")
-    betas, errors = betas[order], errors[order]
-    its = np.concatenate([s.iterations for s in sims])[order]
-    res = np.concatenate([s.residual for s in sims])[order]
-    conv = np.concatenate([s.converged for s in sims])[order]
+    sweep.run(np.arange(cfg.n_beta) / cfg.n_beta, cfg.coarse_tol)
+    if cfg.refines:
+        _refine(sweep, 1.0 / cfg.n_beta, cfg.beta_resolution, cfg.tol)
+    betas, errors, its, res, conv, tols = sweep.curve()
     best = int(np.flatnonzero(errors <= errors.min() + _TIE_M)[0])
     if cfg.uncertainty == "bootstrap":
         tile = max(1, round(cfg.bootstrap_tile_m / grid.spacing_m))
@@ -263,5 +282,5 @@ def estimate_beta(rest_xs: Any, rest_ys: Any, rest_z: Any, deformed_points: Any,
         beta=float(betas[best]),
         beta_std=beta_std,
         betas=betas, errors=errors, iterations=its, residual=res, converged=conv,
-        protocol=cfg.contact, mode=cfg.mode, stiffness_n_per_m=model.stiffness,
+        tolerances=tols, protocol=cfg.contact, mode=cfg.mode, stiffness_n_per_m=model.stiffness,
     )

@@ -78,7 +78,7 @@ def polar_components(m: Array, *, tol: float = 1e-14, max_iter: int = 30) -> Arr
     safe = det0 > 1e-9  # scaled Newton copes with any positive det; flat ones go to SVD
     all_safe = bool(np.all(safe))
     cur = x if all_safe else np.ascontiguousarray(x[:, safe])
-    ok = np.zeros(cur.shape[1], dtype=bool)
+    step = np.inf
     for _ in range(max_iter):
         cof, det = _cofactors(cur)
         # determinant scaling γ = |det X|^(-1/3) (Higham 1986, §3): no extra norms to compute
@@ -86,12 +86,17 @@ def polar_components(m: Array, *, tol: float = 1e-14, max_iter: int = 30) -> Arr
         new = cur / gamma
         new += cof / (det / gamma)
         new *= 0.5
-        ok = np.max(np.abs(new - cur), axis=0) < tol**0.5  # quadratic: the next step is < tol
+        cur -= new
+        np.abs(cur, out=cur)
+        step = float(cur.max()) if cur.size else 0.0
         cur = new
-        if np.all(ok):
+        if step < tol**0.5:  # quadratic convergence: the next step would be below tol
             break
-    if all_safe and np.all(ok):
+    if all_safe and step < tol**0.5:
         return cur
+    cof, det = _cofactors(cur)
+    gamma = np.cbrt(det)
+    ok = np.max(np.abs(0.5 * (cur / gamma + cof / (det / gamma)) - cur), axis=0) < tol**0.5
     out = np.empty_like(x)
     out[:, safe] = cur
     redo = ~safe

@@ -35,16 +35,24 @@ class ShapeMatchingConfig:
         (solved in one batch). E(β) is smooth, so 10 values (a step of 0.1) bracket its minimum;
         the refinement then finds β̂ to ``beta_resolution``.
     refine : bool
-        Refine around the sweep's minimum down to ``beta_resolution``: a golden-section search
-        on the ``beta_resolution`` grid within one sweep step of the best swept β (about
-        ``log_φ(2 / (n_beta · beta_resolution))`` further solves, each started from the
-        equilibrium of the nearest β already solved).
+        Refine around the sweep's minimum down to ``beta_resolution``: on the
+        ``beta_resolution`` grid within one sweep step of the best swept β, start at the vertex
+        of the parabola through the best swept β and its neighbours and walk downhill until the
+        lowest grid point has both grid neighbours solved (a handful of further solves, each
+        started from the equilibrium of the nearest β already solved).
     beta_resolution : float
         Step of the local refinement (dimensionless).
     tol : float
         Relative fixed-point tolerance: the iteration stops when the largest particle update is
         below ``tol`` times the largest particle displacement from rest (or below ``tol`` times the
-        particle spacing when nothing moved).
+        particle spacing when nothing moved). Every β that the refinement compares, and every β
+        when ``refine`` is off, is solved to ``tol``.
+    sweep_tol : float
+        Tolerance of the coarse sweep and of the stiffness calibration when ``refine`` is on (at
+        least ``tol``). The sweep only has to bracket the minimum: its E(β) differ by
+        micrometres, and ``1e-4`` moves a 5 mm dent's particles by under 0.5 µm, at half the
+        iterations of ``1e-6``. A swept β that the refinement then compares is solved again to
+        ``tol``, started from its swept equilibrium.
     max_iter : int
         Iteration cap; a β that hits it is reported as not converged (never silently accepted).
     regularization : float
@@ -98,6 +106,7 @@ class ShapeMatchingConfig:
     refine: bool = True
     beta_resolution: float = 0.01
     tol: float = 1e-6
+    sweep_tol: float = 1e-4
     max_iter: int = 500
     regularization: float = 1e-3
     reference_modulus_pa: float = 100e3
@@ -107,6 +116,17 @@ class ShapeMatchingConfig:
     error_tolerance_m: float = 1e-4
     layers: int | None = None
     layer_growth: float = 2.0
+
+    @property
+    def coarse_tol(self) -> float:
+        """Tolerance of the coarse sweep and the calibration: ``sweep_tol`` when the sweep is
+        refined (``refine`` and ``beta_resolution`` finer than the sweep's step), else ``tol``."""
+        return self.sweep_tol if self.refines else self.tol
+
+    @property
+    def refines(self) -> bool:
+        """Whether the coarse sweep is refined: ``refine`` and ``beta_resolution < 1 / n_beta``."""
+        return self.refine and self.beta_resolution < 1.0 / self.n_beta
 
     @property
     def body_layers(self) -> int:
@@ -129,6 +149,11 @@ class ShapeMatchingConfig:
             raise InvalidArgumentError(f"`refine` must be a bool; got {self.refine!r}")
         check_in_range("beta_resolution", self.beta_resolution, 1e-6, 0.5, closed_high=True)
         check_in_range("tol", self.tol, 1e-14, 1.0)
+        check_in_range("sweep_tol", self.sweep_tol, 1e-14, 1.0)
+        if self.sweep_tol < self.tol:
+            raise InvalidArgumentError(
+                f"`sweep_tol` must be >= `tol` ({self.tol:g}); got {self.sweep_tol:g}"
+            )
         check_in_range("regularization", self.regularization, 0.0, 1.0)
         check_positive("reference_modulus_pa", self.reference_modulus_pa)
         check_in_range("poisson_ratio", self.poisson_ratio, -1.0, 0.5, closed_high=True)

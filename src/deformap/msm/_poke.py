@@ -213,13 +213,18 @@ class Equilibrium:
 
 
 def calibrate_stiffness(eq0: Equilibrium, x_fixed: Array, weights: Array, contact: TactileContact,
-                        config: ShapeMatchingConfig, spacing: float) -> float:
+                        config: ShapeMatchingConfig, spacing: float) -> tuple[float, Array | None]:
     """Spring stiffness ``k`` (N/m) such that the β = 0 body dents like the reference half-space.
 
     ``eq0`` must hold the single β = 0. ``k`` is found by fixed-point (secant) iteration on
     ``k ← k δ(k) / δ_Hertz(E_ref, F, tip)`` until the force-weighted depth of the loaded
     particles at the measured force matches the Hertz depth to 0.1 % (depth ∝ 1/k for a linear
     body, so this converges in a few steps; the body's geometric non-linearity is included).
+    Each equilibrium is solved to ``config.coarse_tol`` (a relative tolerance far below the
+    0.1 % asked of the depth).
+
+    Returns ``k`` and the β = 0 equilibrium ``(1, *body, 3)`` at that ``k`` (``None`` if the
+    depth did not match within 8 steps, when ``k`` is the last secant estimate).
     """
     f_mag = contact.force_n
     force = weights.reshape(-1, 1) * contact.force[None, :]
@@ -229,12 +234,13 @@ def calibrate_stiffness(eq0: Equilibrium, x_fixed: Array, weights: Array, contac
     k = f_mag / delta_ref  # a first guess: one particle carrying the whole load
     x0 = None
     for _ in range(8):
-        x, _, _, _ = eq0.solve(x_fixed, force, k, config.tol, config.max_iter, spacing, x0=x0)
+        x, _, _, _ = eq0.solve(x_fixed, force, k, config.coarse_tol, config.max_iter, spacing,
+                               x0=x0)
         depth = float(np.sum(weights.ravel() * ((x[0].reshape(-1, 3) - rest) @ contact.direction)))
-        if abs(depth / delta_ref - 1.0) < 1e-3:
-            break
         ratio = depth / delta_ref
+        if abs(ratio - 1.0) < 1e-3:
+            return k, x
         k *= ratio  # secant on the (nearly 1/k) depth–stiffness relation
         # displacements scale nearly as 1/k: start the next solve from the scaled equilibrium
         x0 = rest + (x.reshape(1, -1, 3) - rest) / ratio
-    return k
+    return k, None

@@ -211,12 +211,19 @@ class PokeModel:
         self.force = weights.reshape(-1, 1) * contact.force[None, :]
         if stiffness_n_per_m is None:
             eq0 = Equilibrium(self.clusters, body_fixed, np.zeros(1), system=self.system)
-            stiffness_n_per_m = calibrate_stiffness(eq0, self.x_fixed, weights, contact, cfg,
-                                                    self.spacing)
+            stiffness_n_per_m, self.start = calibrate_stiffness(
+                eq0, self.x_fixed, weights, contact, cfg, self.spacing)
         self.stiffness = float(stiffness_n_per_m)
 
-    def solve(self, betas: Array, x0: Array | None = None) -> tuple[PokeSimulation, Array]:
-        """Equilibria for ``betas (B,)``, optionally started from positions ``x0 (B, *body, 3)``.
+    start: Array | None = None
+    """``(1, *body, 3)`` β = 0 equilibrium found by the calibration (to ``coarse_tol``), or
+    ``None``: a start for solves that have none closer."""
+
+    def solve(self, betas: Array, x0: Array | None = None, tol: float | None = None,
+              ) -> tuple[PokeSimulation, Array]:
+        """Equilibria for ``betas (B,)``, optionally started from positions ``x0 (B, *body, 3)``
+        (default: :attr:`start` if there is one, else the rest shape), to the relative tolerance
+        ``tol`` (default ``config.tol``).
 
         Returns the simulation (the surface layer's positions) and the whole body's positions
         ``(B, *body, 3)`` (to warm-start a later solve).
@@ -224,8 +231,10 @@ class PokeModel:
         cfg = self.cfg
         eq = Equilibrium(self.clusters, self.fixed, betas, system=self.system)
         k = 1.0 if self.stiffness is None else self.stiffness
-        x, it, res, conv = eq.solve(self.x_fixed, self.force, k, cfg.tol, cfg.max_iter,
-                                    self.spacing, x0=x0)
+        if x0 is None and self.start is not None:
+            x0 = np.broadcast_to(self.start, (len(betas), *self.start.shape[1:]))
+        x, it, res, conv = eq.solve(self.x_fixed, self.force, k, cfg.tol if tol is None else tol,
+                                    cfg.max_iter, self.spacing, x0=x0)
         sim = PokeSimulation(betas=betas, positions=x[:, 0], iterations=it, residual=res,
                              converged=conv, protocol=cfg.contact,
                              stiffness_n_per_m=self.stiffness)
