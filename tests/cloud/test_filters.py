@@ -10,6 +10,7 @@ from deformap.cloud import (
     HULL_TOLERANCE_M,
     PointCloud,
     crop_box,
+    height_field_mask,
     points_in_hull,
     statistical_outlier_mask,
 )
@@ -254,3 +255,66 @@ def test_points_in_hull_refuses_negative_tolerance() -> None:
     cube = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)], float)
     with pytest.raises(InvalidArgumentError, match="`tolerance_m` must be >= 0"):
         points_in_hull(np.zeros((2, 3)), cube, tolerance_m=-1.0)
+
+
+# ---- height field (steep faces) -------------------------------------------------------------
+
+def _block_with_front_face(rng: np.random.Generator, noise: float = 0.0015) -> tuple:
+    """The top of a 5 cm block seen by a camera in front: the top (z = 0.05) and its front face
+    (y = 0, z from 0 to 0.05), with camera-like depth noise."""
+    gx, gy = np.meshgrid(np.arange(0.0, 0.3, 0.003), np.arange(0.0, 0.2, 0.003))
+    top = np.column_stack([gx.ravel(), gy.ravel(), np.full(gx.size, 0.05)])
+    fx, fz = np.meshgrid(np.arange(0.0, 0.3, 0.003), np.arange(0.0, 0.05, 0.003))
+    face = np.column_stack([fx.ravel(), np.zeros(fx.size), fz.ravel()])
+    pts = np.vstack([top, face])
+    pts += rng.normal(scale=noise / np.sqrt(3), size=pts.shape)
+    return pts, len(top)
+
+
+def test_height_field_mask_removes_a_vertical_face_and_keeps_the_top() -> None:
+    pts, n_top = _block_with_front_face(np.random.default_rng(0))
+    keep = height_field_mask(pts, k=20, max_slope_deg=60.0)
+    top, face = keep[:n_top], keep[n_top:]
+    face_z = pts[n_top:, 2]
+    # the face below its top centimetre (where neighbourhoods mix with the top) is gone
+    assert not np.any(face[face_z < 0.04])
+    assert top.mean() > 0.98
+    # what survives of the face is at the top edge, where it is a height anyway
+    assert np.all(face_z[face] > 0.04)
+
+
+@pytest.mark.parametrize("slope_deg, kept", [(0.0, True), (30.0, True), (50.0, True),
+                                             (70.0, False), (85.0, False)])
+def test_height_field_mask_keeps_planes_by_their_slope(slope_deg: float, kept: bool) -> None:
+    rng = np.random.default_rng(1)
+    uv = rng.uniform(-0.05, 0.05, size=(2000, 2))
+    pts = np.column_stack([uv[:, 0], uv[:, 1], np.tan(np.radians(slope_deg)) * uv[:, 0]])
+    keep = height_field_mask(pts, k=20, max_slope_deg=60.0)
+    assert np.all(keep) if kept else not np.any(keep)
+
+
+def test_height_field_mask_at_ninety_degrees_keeps_everything_and_is_rotation_invariant_in_z(
+) -> None:
+    pts, _ = _block_with_front_face(np.random.default_rng(2))
+    assert np.all(height_field_mask(pts, max_slope_deg=90.0))
+    rot = Rotation.from_euler("z", 37.0, degrees=True).as_matrix()
+    moved = pts @ rot.T + np.array([1.0, -2.0, 0.3])
+    np.testing.assert_array_equal(height_field_mask(moved), height_field_mask(pts))
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    ({"k": 2}, "`k`"), ({"max_slope_deg": 0.0}, "`max_slope_deg`"),
+    ({"max_slope_deg": 91.0}, "`max_slope_deg`"), ({"max_slope_deg": float("nan")},
+                                                   "`max_slope_deg`"),
+])
+def test_height_field_mask_refuses_bad_arguments(kwargs: dict, message: str) -> None:
+    pts, _ = _block_with_front_face(np.random.default_rng(3))
+    with pytest.raises(InvalidArgumentError, match=message):
+        height_field_mask(pts, **kwargs)
+
+
+def test_height_field_mask_refuses_too_few_points_and_bad_points() -> None:
+    with pytest.raises(InvalidArgumentError, match=r"`points`.*k=20"):
+        height_field_mask(np.zeros((5, 3)))
+    with pytest.raises(InvalidArgumentError, match="`points`"):
+        height_field_mask(np.full((30, 3), np.nan))

@@ -1,5 +1,5 @@
-"""Point clouds: the container, filters (crop, statistical outliers, convex hull), tactile points,
-and file I/O (in :mod:`deformap.cloud.io`).
+"""Point clouds: the container, filters (crop, statistical outliers, steep faces, convex hull),
+tactile points, and file I/O (in :mod:`deformap.cloud.io`).
 
 All functions are pure: they take ``(n, 3)`` arrays of metres and return masks or new arrays.
 """
@@ -9,6 +9,7 @@ from __future__ import annotations
 from deformap.cloud._filters import (
     HULL_TOLERANCE_M,
     crop_box,
+    height_field_mask,
     points_in_hull,
     statistical_outlier_mask,
 )
@@ -24,6 +25,7 @@ __all__ = [
     "HULL_TOLERANCE_M",
     "PointCloud",
     "crop_box",
+    "height_field_mask",
     "points_in_hull",
     "statistical_outlier_mask",
     "tactile_points",

@@ -1,4 +1,5 @@
-"""Point filters: axis-aligned crop, statistical outlier removal, convex-hull membership.
+"""Point filters: axis-aligned crop, statistical outlier removal, steep-face removal, convex-hull
+membership.
 
 Every filter takes ``points : (n, 3) float, metres`` and returns an ``(n,)`` boolean mask of the
 points to keep (or, for :func:`points_in_hull`, of the points inside), so that filters compose with
@@ -16,7 +17,13 @@ from numpy.typing import NDArray
 from deformap._validation import check_finite_scalar, check_int, check_points, check_vector
 from deformap.errors import InvalidArgumentError
 
-__all__ = ["HULL_TOLERANCE_M", "crop_box", "points_in_hull", "statistical_outlier_mask"]
+__all__ = [
+    "HULL_TOLERANCE_M",
+    "crop_box",
+    "height_field_mask",
+    "points_in_hull",
+    "statistical_outlier_mask",
+]
 
 logger = logging.getLogger(__name__)
 
@@ -115,6 +122,67 @@ def statistical_outlier_mask(points: Any, k: int, std_ratio: float) -> NDArray[n
     threshold = mean + ratio * std
     mask = positive & (avg < threshold)
     logger.debug("statistical outliers: kept %d of %d (threshold %.3g m)", mask.sum(), n, threshold)
+    return np.asarray(mask)
+
+
+def height_field_mask(points: Any, k: int = 20, max_slope_deg: float = 60.0) -> NDArray[np.bool_]:
+    """Mask of the points whose local surface is flat enough to belong to a height field.
+
+    A Gaussian random field over ``(x, y)`` models the surface as a height field ``z = f(x, y)``.
+    A depth camera that looks at the scene from the side also sees what is not a height field:
+    the vertical faces of objects (the front of a foam block, the step between two blocks), and
+    the "flying pixels" at depth edges, which form veils along the camera's rays behind a
+    foreground object (the robot's stick). Fitted as heights, such points pull the surface
+    down or up by centimetres at the edge and make a smooth GP ring across the whole map. This
+    filter keeps a point when the normal of the plane fitted to its ``k`` nearest neighbours (the
+    point included; the eigenvector of their covariance with the smallest eigenvalue) is within
+    ``max_slope_deg`` of the vertical.
+
+    Parameters
+    ----------
+    points : (n, 3) float, metres
+        The cloud in a frame whose ``z`` points up (the world frame); at least ``k`` points.
+    k : int
+        Neighbours of the local plane fit, the point included, ``>= 3``.
+    max_slope_deg : float
+        Steepest surface kept, in degrees from horizontal, in ``(0, 90]`` (90 keeps everything).
+        60° keeps the walls of a probe's dent (about 40° for a 7 mm dent under a 1 cm tip) with
+        margin for the normals' noise, and removes vertical faces and veils.
+
+    Returns
+    -------
+    mask : (n,) bool
+        ``True`` for the points to keep.
+
+    References
+    ----------
+    Rusu, R. B. (2009). Semantic 3D object maps for everyday manipulation in human living
+    environments, §4.1 (normals by PCA of the k nearest neighbours).
+    """
+    from scipy.spatial import cKDTree
+
+    k = check_int("k", k, minimum=3)
+    slope = check_finite_scalar("max_slope_deg", max_slope_deg)
+    if not 0.0 < slope <= 90.0:
+        raise InvalidArgumentError(f"`max_slope_deg` must lie in (0, 90] degrees; got {slope}")
+    pts = check_points("points", points, min_rows=0)
+    n = pts.shape[0]
+    if n < k:
+        raise InvalidArgumentError(
+            f"`points` must hold at least k={k} points for the local plane fits; got {n}"
+        )
+    if slope == 90.0:
+        return np.ones(n, dtype=bool)
+    _, idx = cKDTree(pts).query(pts, k=k)
+    normal_z = np.empty(n)
+    for lo in range(0, n, 65536):  # bounded memory: (chunk, k, 3) neighbourhoods
+        nb = pts[idx[lo : lo + 65536]]
+        nb = nb - nb.mean(axis=1, keepdims=True)
+        cov = np.einsum("nki,nkj->nij", nb, nb)
+        _, vec = np.linalg.eigh(cov)
+        normal_z[lo : lo + 65536] = vec[:, 2, 0]
+    mask = np.abs(normal_z) >= np.cos(np.radians(slope))
+    logger.debug("height field: kept %d of %d points (max slope %.0f°)", mask.sum(), n, slope)
     return np.asarray(mask)
 
 

@@ -5,13 +5,21 @@ Defaults and why
 Surface GP ("GPR world"): hyperparameters are fitted by maximum marginal likelihood on the first
 observation, on a seeded subset of 800 points (their mean spacing, about 2 cm over 60×40 cm, is
 well below any length scale a table-top surface has, and each likelihood evaluation costs n³), from
-the values below and one random restart; the map is read on the paper's 0.5 cm grid.
+the values below and one random restart; the map is read on the paper's 0.5 cm grid. Before the
+fit, points on surfaces steeper than 60° are dropped (``max_slope_deg``,
+:func:`deformap.cloud.height_field_mask`): a camera at 45° sees the front faces of the blocks, and
+fitted as heights those walls made the GP ring by ±1–2 mm over the whole map (measured on a
+homogeneous block: ±0.03 mm without them). The fitted length scale is kept at or above 1.5 cm
+(``min_length_scale_m``, three map cells): a flat surface leaves it undetermined (the fitted
+signal is then micrometres and any length scale fits), the camera's disparity steps pull it to
+millimetres, and features shorter than that are below what the camera resolves at table range.
 
 Robot removal: the convex hull of the robot's points (plus 2 mm: proprioception and camera do not
 agree to the millimetre), a ball of the tip's radius plus 3 mm around the tip (the tactile points
 stand for what it hides), and every point more than 1 cm above the surface as it was before the
 poke — a dent goes down, so anything that high is the stick, the hand or a flying pixel between
-them and the surface (1 cm is five times the camera's depth noise at the table).
+them and the surface (1 cm is five times the camera's depth noise at the table). The same 60° slope
+filter as for the surface removes the flying-pixel veils that hang lower than that behind the stick.
 
 Touch GP ("GPR-touch"): fitted on a square ROI of the cloud seen while pressing plus the 10 tactile
 points. ROI 12 cm: the dent of a 1 cm tip under about a newton spreads over a few centimetres on
@@ -46,6 +54,13 @@ __all__ = [
 ]
 
 
+def check_slope(value: float) -> None:
+    """``max_slope_deg`` in ``(0, 90]`` degrees (90 keeps every point)."""
+    check_positive("max_slope_deg", value)
+    if value > 90.0:
+        raise InvalidArgumentError(f"`max_slope_deg` must be at most 90 degrees; got {value}")
+
+
 @dataclass(frozen=True, kw_only=True)
 class SurfaceGPConfig:
     """Crop, outlier filter and the surface Gaussian random field."""
@@ -54,6 +69,8 @@ class SurfaceGPConfig:
     z_max_m: float = 0.30
     outlier_k: int = 20
     outlier_std_ratio: float = 2.0
+    max_slope_deg: float = 60.0
+    min_length_scale_m: float = 0.015
     fit_hyperparameters: bool = True
     max_fit_points: int = 800
     fit_restarts: int = 1
@@ -69,9 +86,11 @@ class SurfaceGPConfig:
             )
         check_int("outlier_k", self.outlier_k, minimum=2)
         check_positive("outlier_std_ratio", self.outlier_std_ratio)
+        check_slope(self.max_slope_deg)
         check_int("max_fit_points", self.max_fit_points, minimum=50)
         check_int("fit_restarts", self.fit_restarts, minimum=0)
-        for name in ("length_scale_m", "signal_std_m", "noise_std_m", "grid_spacing_m"):
+        for name in ("length_scale_m", "signal_std_m", "noise_std_m", "grid_spacing_m",
+                     "min_length_scale_m"):
             check_positive(name, getattr(self, name))
 
 
@@ -86,6 +105,7 @@ class TouchGPConfig:
     robot_margin_m: float = 0.002
     tip_margin_m: float = 0.003
     above_surface_m: float = 0.01
+    max_slope_deg: float = 60.0
     length_scale_m: float = 0.01
     signal_std_m: float = 0.01
     noise_std_m: float = 0.002
@@ -95,6 +115,7 @@ class TouchGPConfig:
         check_int("n_tactile", self.n_tactile, minimum=1)
         check_positive("robot_margin_m", self.robot_margin_m, allow_zero=True)
         check_positive("tip_margin_m", self.tip_margin_m, allow_zero=True)
+        check_slope(self.max_slope_deg)
         for name in (
             "tactile_noise_std_m",
             "length_scale_m",

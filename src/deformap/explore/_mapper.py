@@ -22,6 +22,7 @@ from numpy.typing import NDArray
 from deformap.cloud import (
     PointCloud,
     crop_box,
+    height_field_mask,
     points_in_hull,
     statistical_outlier_mask,
     tactile_points,
@@ -34,6 +35,7 @@ from deformap.explore._regions import RegionMap, segment_regions
 from deformap.gp import (
     GaussianRandomField,
     GPHyperparameters,
+    default_bounds,
     fit_hyperparameters,
     squared_exponential,
 )
@@ -120,6 +122,8 @@ class Mapper:
                 f"got {pts.shape[0]} (is it in the world frame, in metres?)"
             )
         kept = pts[statistical_outlier_mask(pts, cfg.outlier_k, cfg.outlier_std_ratio)]
+        if kept.shape[0] >= cfg.outlier_k:
+            kept = kept[height_field_mask(kept, cfg.outlier_k, cfg.max_slope_deg)]
         init = GPHyperparameters(
             length_scale=cfg.length_scale_m,
             signal_std=cfg.signal_std_m,
@@ -128,6 +132,8 @@ class Mapper:
         )
         hyper = init
         if cfg.fit_hyperparameters:
+            bounds = default_bounds(kept[:, :2], kept[:, 2])
+            bounds[0] = np.maximum(bounds[0], cfg.min_length_scale_m)
             hyper = fit_hyperparameters(
                 kept[:, :2],
                 kept[:, 2],
@@ -135,6 +141,7 @@ class Mapper:
                 init=init,
                 max_points=cfg.max_fit_points,
                 n_restarts=cfg.fit_restarts,
+                bounds=bounds,
             )
         gp = GaussianRandomField(
             length_scale=hyper.length_scale,
@@ -178,6 +185,9 @@ class Mapper:
         tip = contact.tip_radius_m + cfg.tip_margin_m
         robot |= np.linalg.norm(pts - contact.tip_center, axis=1) < tip
         pts = pts[~robot]
+        k = self.config.surface.outlier_k
+        if pts.shape[0] >= k:
+            pts = pts[height_field_mask(pts, k, cfg.max_slope_deg)]
         rest_at = self.surface.gp.predict(pts[:, :2])
         on_surface = pts[:, 2] - rest_at <= cfg.above_surface_m
         roi, rest_at = pts[on_surface], rest_at[on_surface]

@@ -9,13 +9,19 @@ Shared parameters, in metres (or the units of the modelled value): ``length_scal
 from __future__ import annotations
 
 from deformap.gp._field import AUTO_EXACT_MAX_POINTS, GaussianRandomField
-from deformap.gp._hyper import GPHyperparameters, fit_hyperparameters, log_marginal_likelihood
+from deformap.gp._hyper import (
+    GPHyperparameters,
+    default_bounds,
+    fit_hyperparameters,
+    log_marginal_likelihood,
+)
 from deformap.gp._kernels import grid_points, squared_exponential
 
 __all__ = [
     "AUTO_EXACT_MAX_POINTS",
     "GPHyperparameters",
     "GaussianRandomField",
+    "default_bounds",
     "fit_hyperparameters",
     "grid_points",
     "log_marginal_likelihood",

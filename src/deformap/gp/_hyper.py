@@ -20,7 +20,7 @@ from scipy.optimize import minimize
 from deformap._validation import check_array, check_int, check_positive, describe
 from deformap.errors import InvalidArgumentError, NotPositiveDefiniteError
 
-__all__ = ["GPHyperparameters", "fit_hyperparameters", "log_marginal_likelihood"]
+__all__ = ["GPHyperparameters", "default_bounds", "fit_hyperparameters", "log_marginal_likelihood"]
 
 _LOG = logging.getLogger(__name__)
 _NAMES = ("length_scale", "signal_std", "noise_std")
@@ -122,15 +122,16 @@ def _check_data(xy: Any, z: Any) -> tuple[NDArray[np.float64], NDArray[np.float6
     return pts, vals
 
 
-def default_bounds(xy: NDArray[np.float64], z: NDArray[np.float64]) -> NDArray[np.float64]:
-    """``(3, 2)`` bounds (low, high) on (σ_w, σₑ, σₙ), scaled by the data.
+def default_bounds(xy: Any, z: Any) -> NDArray[np.float64]:
+    """``(3, 2)`` bounds (low, high) on (σ_w, σₑ, σₙ), scaled by the data ``xy (n, 2)``, ``z (n,)``.
 
     σ_w from 1/1000 to 2× the bounding-box diagonal D (shorter is unresolvable noise, longer a
     plane); σₑ from 1/100 to 100× the data's std s; σₙ from 1e-4 s (a near-interpolant that a
     Cholesky still factorises) to 10 s.
     """
+    xy = np.asarray(xy, dtype=float)
     diag = float(np.hypot(*np.ptp(xy, axis=0)))
-    spread = float(np.std(z))
+    spread = float(np.std(np.asarray(z, dtype=float)))
     return np.array(
         [[1e-3 * diag, 2.0 * diag], [1e-2 * spread, 1e2 * spread], [1e-4 * spread, 1e1 * spread]]
     )
