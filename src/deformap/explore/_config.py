@@ -34,7 +34,7 @@ Its length scale (1 cm) is the tip's radius: the dent cannot vary faster than th
 0.06 so that the unexplored map asks for a poke); length scale 0.2 m, a third of the table's width:
 the size of the foam pieces a robot is asked to tell apart; each poke's β uncertainty is its noise,
 with a floor of 0.03. Next pokes by ``max-variance`` (the paper's random choice is ``paper``):
-with these settings it needs 7 pokes to bring every cell below 0.06 where ``paper`` needs 8–11.
+with these settings it needs 7 pokes to bring every cell below 0.06 where ``paper`` needs 8–12.
 """
 
 from __future__ import annotations
