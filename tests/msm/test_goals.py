@@ -144,3 +144,15 @@ def test_fast_polar_rotation_matches_the_svd_polar(rng):
     a[260:270, :, 0] *= -np.sign(np.linalg.det(a[260:270]))[:, None]  # det < 0: fallback
     np.testing.assert_allclose(fast_polar_rotation(a.copy()), polar_rotation(a.copy()),
                                atol=1e-12)
+
+
+@pytest.mark.parametrize("max_iter", [1, 2])
+def test_fast_polar_rotation_falls_back_to_svd_when_newton_stops_early(rng, max_iter):
+    # every matrix is safe for Newton, but the iteration budget ends before convergence: the
+    # unconverged ones must get the SVD answer of the *input*, not of a half-updated iterate
+    from deformap.msm._clusters import fast_polar_rotation
+
+    a = np.eye(3) + 0.5 * rng.normal(size=(200, 3, 3))
+    a = a[np.linalg.det(a) > 0.1]
+    np.testing.assert_allclose(fast_polar_rotation(a.copy(), max_iter=max_iter),
+                               polar_rotation(a.copy()), atol=1e-12)

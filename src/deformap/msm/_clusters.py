@@ -86,9 +86,9 @@ def polar_components(m: Array, *, tol: float = 1e-14, max_iter: int = 30) -> Arr
         new = cur / gamma
         new += cof / (det / gamma)
         new *= 0.5
-        cur -= new
-        np.abs(cur, out=cur)
-        step = float(cur.max()) if cur.size else 0.0
+        diff = cur - new  # not in place: ``cur`` may be ``x``, which the SVD fallback reads
+        np.abs(diff, out=diff)
+        step = float(diff.max()) if diff.size else 0.0
         cur = new
         if step < tol**0.5:  # quadratic convergence: the next step would be below tol
             break
