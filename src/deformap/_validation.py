@@ -23,6 +23,7 @@ __all__ = [
     "check_int",
     "check_points",
     "check_positive",
+    "check_slope_deg",
     "check_vector",
     "describe",
 ]
@@ -146,6 +147,14 @@ def check_in_range(
     if not ok:
         interval = f"[{low}, {high}]" if closed_high else f"[{low}, {high})"
         raise InvalidArgumentError(f"`{name}` must lie in {interval}; got {out}")
+    return out
+
+
+def check_slope_deg(name: str, value: Any) -> float:
+    """Validate a surface slope limit in degrees from horizontal, in ``(0, 90]``."""
+    out = check_finite_scalar(name, value)
+    if not 0.0 < out <= 90.0:
+        raise InvalidArgumentError(f"`{name}` must lie in (0, 90] degrees; got {out}")
     return out
 
 

@@ -14,7 +14,13 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from deformap._validation import check_finite_scalar, check_int, check_points, check_vector
+from deformap._validation import (
+    check_finite_scalar,
+    check_int,
+    check_points,
+    check_slope_deg,
+    check_vector,
+)
 from deformap.errors import InvalidArgumentError
 
 __all__ = [
@@ -162,9 +168,7 @@ def height_field_mask(points: Any, k: int = 20, max_slope_deg: float = 60.0) -> 
     from scipy.spatial import cKDTree
 
     k = check_int("k", k, minimum=3)
-    slope = check_finite_scalar("max_slope_deg", max_slope_deg)
-    if not 0.0 < slope <= 90.0:
-        raise InvalidArgumentError(f"`max_slope_deg` must lie in (0, 90] degrees; got {slope}")
+    slope = check_slope_deg("max_slope_deg", max_slope_deg)
     pts = check_points("points", points, min_rows=0)
     n = pts.shape[0]
     if n < k:

@@ -42,7 +42,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Literal
 
-from deformap._validation import check_int, check_positive, check_vector
+from deformap._validation import check_int, check_positive, check_slope_deg, check_vector
 from deformap.errors import InvalidArgumentError
 from deformap.explore._acquisition import STRATEGIES
 from deformap.msm import ShapeMatchingConfig
@@ -53,13 +53,6 @@ __all__ = [
     "SurfaceGPConfig",
     "TouchGPConfig",
 ]
-
-
-def check_slope(value: float) -> None:
-    """``max_slope_deg`` in ``(0, 90]`` degrees (90 keeps every point)."""
-    check_positive("max_slope_deg", value)
-    if value > 90.0:
-        raise InvalidArgumentError(f"`max_slope_deg` must be at most 90 degrees; got {value}")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -87,7 +80,7 @@ class SurfaceGPConfig:
             )
         check_int("outlier_k", self.outlier_k, minimum=2)
         check_positive("outlier_std_ratio", self.outlier_std_ratio)
-        check_slope(self.max_slope_deg)
+        check_slope_deg("max_slope_deg", self.max_slope_deg)
         check_int("max_fit_points", self.max_fit_points, minimum=50)
         check_int("fit_restarts", self.fit_restarts, minimum=0)
         for name in ("length_scale_m", "signal_std_m", "noise_std_m", "grid_spacing_m",
@@ -116,7 +109,7 @@ class TouchGPConfig:
         check_int("n_tactile", self.n_tactile, minimum=1)
         check_positive("robot_margin_m", self.robot_margin_m, allow_zero=True)
         check_positive("tip_margin_m", self.tip_margin_m, allow_zero=True)
-        check_slope(self.max_slope_deg)
+        check_slope_deg("max_slope_deg", self.max_slope_deg)
         for name in (
             "tactile_noise_std_m",
             "length_scale_m",

@@ -193,6 +193,9 @@ class PokeModel:
         self.clusters = Clusters(body, body_m, window, cfg.mode, cfg.regularization)
         flat = body.reshape(-1, 3)
         self.stiffness: float | None = None
+        # the β = 0 equilibrium found by the calibration (to ``coarse_tol``), or None: a start
+        # for solves that have none closer
+        self.start: Array | None = None
         if cfg.contact == "pinned":
             pinned = body_fixed.ravel().copy()
             pinned[near] = True  # the top layer comes first in the flat order
@@ -214,10 +217,6 @@ class PokeModel:
             stiffness_n_per_m, self.start = calibrate_stiffness(
                 eq0, self.x_fixed, weights, contact, cfg, self.spacing)
         self.stiffness = float(stiffness_n_per_m)
-
-    start: Array | None = None
-    """``(1, *body, 3)`` β = 0 equilibrium found by the calibration (to ``coarse_tol``), or
-    ``None``: a start for solves that have none closer."""
 
     def solve(self, betas: Array, x0: Array | None = None, tol: float | None = None,
               ) -> tuple[PokeSimulation, Array]:
