@@ -18,13 +18,39 @@ def test_three_separated_classes_give_three_bands() -> None:
     assert np.all(np.diff(result.labels[0]) >= 0)  # monotone along a monotone field
 
 
-def test_one_material_is_one_region_whatever_its_scatter() -> None:
-    rng = np.random.default_rng(0)
+def test_one_material_with_the_claimed_scatter_is_one_region_at_the_test_level() -> None:
+    splits = 0
+    for seed in range(100):
+        rng = np.random.default_rng(seed)
+        n = int(rng.integers(5, 13))
+        stds = rng.uniform(0.03, 0.06, size=n)
+        betas = 0.6 + rng.normal(0.0, stds)
+        splits += segment_regions(np.zeros((2, 2)), betas, stds).n_regions > 1
+    assert splits <= 10  # a 5 % test (Bonferroni over the 2- and 3-part splits)
+
+
+def test_without_prior_dof_the_test_is_scale_free() -> None:
+    # The uncertainties claimed are half the real scatter: trusting them splits one material;
+    # prior_dof=0 estimates the scatter from the βs alone and keeps it whole.
+    trusted = untrusted = 0
     for seed in range(20):
         rng = np.random.default_rng(seed)
-        betas = 0.7 + rng.normal(0.0, 0.06, size=10)  # scatter larger than claimed
-        result = segment_regions(np.zeros((2, 2)), betas, np.full(10, 0.03))
-        assert result.n_regions == 1, (seed, np.sort(betas))
+        betas = 0.7 + rng.normal(0.0, 0.06, size=10)
+        trusted += segment_regions(np.zeros((2, 2)), betas, np.full(10, 0.03)).n_regions > 1
+        untrusted += segment_regions(
+            np.zeros((2, 2)), betas, np.full(10, 0.03), prior_dof=0.0
+        ).n_regions > 1
+    assert untrusted == 0 and trusted > untrusted
+
+
+def test_two_close_materials_are_told_apart_with_a_few_pokes() -> None:
+    # 0.12 apart, each poke known to 0.03: seven pokes suffice; the scale-free test cannot tell.
+    betas = np.array([0.55, 0.59, 0.62, 0.72, 0.73, 0.74, 0.75])
+    stds = np.full(betas.size, 0.03)
+    result = segment_regions(np.zeros((2, 2)), betas, stds)
+    assert result.n_regions == 2
+    np.testing.assert_allclose(result.class_betas, [0.5867, 0.735], atol=1e-3)
+    assert segment_regions(np.zeros((2, 2)), betas, stds, prior_dof=0.0).n_regions == 1
 
 
 def test_a_poke_on_a_boundary_does_not_bridge_two_classes() -> None:
@@ -48,5 +74,7 @@ def test_bad_input() -> None:
         segment_regions(np.zeros((2, 2)), np.zeros(0), np.zeros(0))
     with pytest.raises(InvalidArgumentError, match="`poke_std`"):
         segment_regions(np.zeros((2, 2)), np.zeros(2), np.zeros(3))
+    with pytest.raises(InvalidArgumentError, match="`prior_dof`"):
+        segment_regions(np.zeros((2, 2)), np.zeros(2), np.zeros(2), prior_dof=-1.0)
     with pytest.raises(InvalidArgumentError, match="`max_regions`"):
         segment_regions(np.zeros((2, 2)), np.zeros(2), np.zeros(2), max_regions=0)

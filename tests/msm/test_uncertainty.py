@@ -43,3 +43,76 @@ def test_floor_and_bad_input() -> None:
         bootstrap_beta_std(BETAS[::-1], exact, tile=2, resolution=0.01)
     with pytest.raises(InvalidArgumentError, match="`tile`"):
         bootstrap_beta_std(BETAS, exact, tile=0, resolution=0.01)
+
+
+
+def test_observation_noise_spread_grows_with_the_noise() -> None:
+    from msm_cases import dent_case
+
+    from deformap.msm import ShapeMatchingConfig, estimate_beta
+
+    xs, ys, z, pts, contact = dent_case(110, n=13)
+    cfg = ShapeMatchingConfig()
+    rng = np.random.default_rng(3)
+    spreads = []
+    for noise in (1e-7, 3e-4, 1e-3):
+        samples = rng.normal(0.0, noise, size=(24, pts.shape[0]))
+        spreads.append(estimate_beta(xs, ys, z, pts, contact, cfg, height_samples=samples).beta_std)
+    assert spreads[0] == pytest.approx(cfg.beta_resolution / np.sqrt(12))  # below resolution
+    assert spreads[0] < spreads[1] < spreads[2]
+    again = estimate_beta(xs, ys, z, pts, contact, cfg, height_samples=samples).beta_std
+    assert again == spreads[2]
+
+
+def test_sample_spread_equals_the_brute_force_with_exact_nearest_points() -> None:
+    """The candidate-neighbour shortcut gives the argmins a fresh k-d tree per sample gives."""
+    from msm_cases import dent_case
+    from scipy.spatial import cKDTree
+
+    from deformap.msm import ParticleGrid, ShapeMatchingConfig, simulate_poke
+    from deformap.msm._beta import matching_error
+    from deformap.msm._uncertainty import _argmins, sample_beta_std
+
+    xs, ys, z, pts, contact = dent_case(110, n=13)
+    grid = ParticleGrid.from_heightmap(xs, ys, z)
+    betas = np.arange(0.5, 0.96, 0.02)
+    sim = simulate_poke(grid.rest, grid.masses, grid.fixed, contact, betas, ShapeMatchingConfig())
+    samples = np.random.default_rng(5).normal(0.0, 5e-4, size=(16, pts.shape[0]))
+    curves = []
+    for row in samples:
+        moved = pts.copy()
+        moved[:, 2] += row
+        curves.append(matching_error(sim.positions, cKDTree(moved)))
+    expected = max(float(np.std(_argmins(betas, np.array(curves)), ddof=1)), 0.01 / np.sqrt(12))
+    got = sample_beta_std(betas, sim.positions, pts, samples, resolution=0.01)
+    assert got == pytest.approx(expected, abs=1e-12)
+    assert got > 0.01  # the noise does move β̂ here: the comparison is not trivially 0 = 0
+
+
+def test_sample_spread_bad_input() -> None:
+    from deformap.msm._uncertainty import sample_beta_std
+
+    pos = np.zeros((3, 4, 4, 3))
+    obs = np.zeros((16, 3))
+    with pytest.raises(InvalidArgumentError, match="`height_samples`"):
+        sample_beta_std(np.array([0.0, 0.5, 0.9]), pos, obs, np.zeros((1, 16)), resolution=0.01)
+    with pytest.raises(InvalidArgumentError, match="`height_samples`"):
+        sample_beta_std(np.array([0.0, 0.5, 0.9]), pos, obs, np.zeros((4, 15)), resolution=0.01)
+    with pytest.raises(InvalidArgumentError, match="`positions`"):
+        sample_beta_std(np.array([0.0, 0.5]), pos, obs, np.zeros((4, 16)), resolution=0.01)
+    with pytest.raises(InvalidArgumentError, match="strictly increasing"):
+        sample_beta_std(np.array([0.0, 0.5, 0.5]), pos, obs, np.zeros((4, 16)), resolution=0.01)
+
+
+def test_argmins_find_the_vertex_between_uneven_samples() -> None:
+    from deformap.msm._uncertainty import _argmins
+
+    betas = np.array([0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.61, 0.62, 0.7, 0.8, 0.9])
+    u = -np.log1p(-betas)
+    truth = np.array([0.05, 0.45, 0.615, 0.66, 0.85])
+    curves = (u[None, :] + np.log1p(-truth)[:, None]) ** 2  # parabolas in u, vertex at truth
+    np.testing.assert_allclose(_argmins(betas, curves), truth, atol=1e-12)
+    # a minimum at the rigid end stays there; a flat run of ties stays between its samples
+    assert _argmins(betas, (u[None, :] + 0.0) ** 2)[0] == pytest.approx(0.0, abs=1e-12)
+    flat = np.where(np.abs(betas - 0.3) < 0.15, 0.0, 1.0)[None, :]
+    assert 0.2 <= _argmins(betas, flat)[0] <= 0.4

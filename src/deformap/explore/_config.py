@@ -103,10 +103,14 @@ class TouchGPConfig:
     length_scale_m: float = 0.01
     signal_std_m: float = 0.01
     noise_std_m: float = 0.002
+    noise_samples: int = 64
 
     def __post_init__(self) -> None:
         check_positive("roi_size_m", self.roi_size_m)
         check_int("n_tactile", self.n_tactile, minimum=1)
+        check_int("noise_samples", self.noise_samples, minimum=0)
+        if self.noise_samples == 1:
+            raise InvalidArgumentError("`noise_samples` must be 0 (off) or at least 2; got 1")
         check_positive("robot_margin_m", self.robot_margin_m, allow_zero=True)
         check_positive("tip_margin_m", self.tip_margin_m, allow_zero=True)
         check_slope_deg("max_slope_deg", self.max_slope_deg)
@@ -153,6 +157,10 @@ class ExplorationConfig:
         them by 4–7 mm, well above the camera's noise.
     max_regions : int
         Most regions the β-field is cut into (see :mod:`deformap.explore._regions`).
+    region_prior_dof : float
+        How many degrees of freedom the pokes' uncertainties count for when the region test
+        judges whether the βs scatter more than one material would (7: as much as the eight
+        presses on one foam the noise floor was measured from; 0: ignore them, scale-free).
     """
 
     threshold: float = 0.06
@@ -161,6 +169,7 @@ class ExplorationConfig:
     first_target: tuple[float, float] | None = None
     force_n: float = 0.6
     max_regions: int = 6
+    region_prior_dof: float = 7.0
     surface: SurfaceGPConfig = field(default_factory=SurfaceGPConfig)
     touch: TouchGPConfig = field(default_factory=TouchGPConfig)
     beta_field: BetaFieldConfig = field(default_factory=BetaFieldConfig)
@@ -177,3 +186,4 @@ class ExplorationConfig:
             check_vector("first_target", self.first_target, 2, what="metres")
         check_positive("force_n", self.force_n)
         check_int("max_regions", self.max_regions, minimum=1)
+        check_positive("region_prior_dof", self.region_prior_dof, allow_zero=True)

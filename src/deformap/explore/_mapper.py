@@ -31,6 +31,7 @@ from deformap.environment import PressObservation, TactileContact, Workspace
 from deformap.errors import EnvironmentStateError, InvalidArgumentError
 from deformap.explore._acquisition import choose_target
 from deformap.explore._config import ExplorationConfig
+from deformap.explore._dent_noise import dent_error_samples
 from deformap.explore._regions import RegionMap, segment_regions
 from deformap.gp import (
     GaussianRandomField,
@@ -215,7 +216,15 @@ class Mapper:
         gx, gy = np.meshgrid(roi_xs, roi_ys)
         deformed = np.column_stack([gx.ravel(), gy.ravel(), deformed_z.ravel()])
         t2 = time.perf_counter()
-        est = estimate_beta(roi_xs, roi_ys, rest_z, deformed, contact, self.config.shape_matching)
+        samples = None
+        if cfg.noise_samples:
+            samples = dent_error_samples(
+                roi_xs, roi_ys, roi[:, :2], cfg.noise_std_m, tactile[:, :2],
+                cfg.tactile_noise_std_m, length_scale_m=cfg.length_scale_m,
+                signal_std_m=cfg.signal_std_m, n_samples=cfg.noise_samples,
+            )  # fmt: skip
+        est = estimate_beta(roi_xs, roi_ys, rest_z, deformed, contact, self.config.shape_matching,
+                            height_samples=samples)  # fmt: skip
         t3 = time.perf_counter()
         record = {
             "index": index,
@@ -330,5 +339,6 @@ class Mapper:
         floor = self.config.beta_field.noise_floor
         std = np.maximum([p.record["beta_std"] for p in self.pokes], floor)
         return segment_regions(
-            mean, beta, std, floor=floor, max_regions=self.config.max_regions
-        )
+            mean, beta, std, floor=floor, max_regions=self.config.max_regions,
+            prior_dof=self.config.region_prior_dof,
+        )  # fmt: skip

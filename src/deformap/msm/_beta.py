@@ -16,7 +16,7 @@ from deformap.msm._config import ShapeMatchingConfig
 from deformap.msm._grid import ParticleGrid
 from deformap.msm._poke import PokeSimulation
 from deformap.msm._simulate import PokeModel, _check_config
-from deformap.msm._uncertainty import bootstrap_beta_std
+from deformap.msm._uncertainty import bootstrap_beta_std, sample_beta_std
 
 __all__ = ["BetaEstimate", "estimate_beta", "matching_error"]
 
@@ -233,7 +233,7 @@ def _beta_std(betas: Array, errors: Array, tol: float, resolution: float) -> flo
 
 def estimate_beta(rest_xs: Any, rest_ys: Any, rest_z: Any, deformed_points: Any,
                   contact: TactileContact, config: ShapeMatchingConfig | None = None,
-                  ) -> BetaEstimate:
+                  *, height_samples: Any = None) -> BetaEstimate:
     """Estimate β for one poke (Caccamo et al. 2016, Eq. for E(β)).
 
     Parameters
@@ -245,6 +245,11 @@ def estimate_beta(rest_xs: Any, rest_ys: Any, rest_z: Any, deformed_points: Any,
     contact : TactileContact
         The poke's tip position, force and tip radius.
     config : ShapeMatchingConfig
+    height_samples : (S, m) float, metres, optional
+        Plausible vertical errors of ``deformed_points`` (for example draws from the touch GP's
+        posterior), S ≥ 2. When given, ``beta_std`` is the spread of β̂ over the observed surfaces
+        they give (:func:`deformap.msm._uncertainty.sample_beta_std`: the observation noise
+        propagated through the estimate) and ``config.uncertainty`` is not used.
 
     Returns
     -------
@@ -272,7 +277,12 @@ def estimate_beta(rest_xs: Any, rest_ys: Any, rest_z: Any, deformed_points: Any,
         _refine(sweep, 1.0 / cfg.n_beta, cfg.beta_resolution, cfg.tol)
     betas, errors, its, res, conv, tols = sweep.curve()
     best = int(np.flatnonzero(errors <= errors.min() + _TIE_M)[0])
-    if cfg.uncertainty == "bootstrap":
+    if height_samples is not None:
+        positions = np.stack([sweep.sims[float(b)][0].positions[sweep.sims[float(b)][1]]
+                              for b in betas])  # fmt: skip
+        beta_std = sample_beta_std(betas, positions, observed, height_samples,
+                                   resolution=cfg.beta_resolution)  # fmt: skip
+    elif cfg.uncertainty == "bootstrap":
         tile = max(1, round(cfg.bootstrap_tile_m / grid.spacing_m))
         distances = np.stack([sweep.distances[float(b)] for b in betas])
         beta_std = bootstrap_beta_std(betas, distances, tile=tile, resolution=cfg.beta_resolution)

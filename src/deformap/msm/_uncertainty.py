@@ -22,11 +22,12 @@ from __future__ import annotations
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy.spatial import cKDTree
 
 from deformap._validation import check_array, check_int, check_positive
 from deformap.errors import InvalidArgumentError
 
-__all__ = ["BOOTSTRAP_SEED", "bootstrap_beta_std"]
+__all__ = ["BOOTSTRAP_SEED", "bootstrap_beta_std", "sample_beta_std"]
 
 BOOTSTRAP_SEED = 20161115
 """The fixed seed of the resampling (a deterministic statistic, not a source of randomness)."""
@@ -83,3 +84,80 @@ def bootstrap_beta_std(
     resampled = counts @ sums.T  # (n_boot, B): each row a resampled E(β), up to a constant factor
     picks = b[np.argmin(resampled, axis=1)]
     return float(max(picks.std(ddof=1), floor))
+
+
+_CANDIDATES = 8
+"""Nearest observed points per particle among which a perturbed surface's nearest is sought."""
+
+
+def sample_beta_std(
+    betas: NDArray[np.float64],
+    positions: NDArray[np.float64],
+    observed: NDArray[np.float64],
+    height_samples: NDArray[np.float64],
+    *,
+    resolution: float,
+) -> float:
+    """Standard deviation of β̂ over plausible observed surfaces (observation noise propagated).
+
+    Each sample moves the observed surface's points vertically by one draw of the error of its
+    reconstruction (for example the touch GP's posterior); E(β) is re-evaluated for every
+    simulated β against the moved points, and the spread of the argmins is returned. The
+    simulations are not repeated: only the observation changes. Each particle's nearest moved
+    point is sought among its ``8`` nearest unmoved ones, which holds while the samples move
+    the points by less than the grid spacing's order; that is the case for millimetre errors on
+    a 5 mm grid.
+
+    Parameters
+    ----------
+    betas : (B,) float
+        The β values simulated, increasing.
+    positions : (B, ny, nx, 3) float, metres
+        The simulated particle positions at each β.
+    observed : (m, 3) float, metres
+        The observed deformed surface X̄ the estimate was made against.
+    height_samples : (S, m) float, metres
+        Vertical errors of ``observed``, one row per sample (S ≥ 2).
+    resolution : float
+        The β resolution of the estimate; the result is never below ``resolution / sqrt(12)``.
+    """
+    b = check_array("betas", betas, (None,), min_rows=2)
+    if np.any(np.diff(b) <= 0):
+        raise InvalidArgumentError("`betas` must be strictly increasing")
+    pos = check_array("positions", positions, (b.size, None, None, 3), what="positions in metres")
+    obs = check_array("observed", observed, (None, 3), min_rows=1, what="points in metres")
+    dz = check_array("height_samples", height_samples, (None, obs.shape[0]), min_rows=2,
+                     what="height errors in metres")  # fmt: skip
+    floor = check_positive("resolution", resolution) / np.sqrt(12.0)
+    k = min(_CANDIDATES, obs.shape[0])
+    particles = pos.reshape(b.size, -1, 3)
+    _, near = cKDTree(obs).query(particles.reshape(-1, 3), k=k)
+    near = near.reshape(b.size, -1, k)
+    offset = obs[near] - particles[:, :, None, :]  # (B, K, k, 3) to the unmoved candidates
+    planar = offset[..., 0] ** 2 + offset[..., 1] ** 2
+    curves = np.empty((dz.shape[0], b.size))
+    for s, row in enumerate(dz):  # one sample at a time keeps memory at one (B, K, k) array
+        curves[s] = np.sqrt(planar + (offset[..., 2] + row[near]) ** 2).min(axis=2).mean(axis=1)
+    return float(max(_argmins(b, curves).std(ddof=1), floor))
+
+
+def _argmins(betas: NDArray[np.float64], curves: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Minimiser of each row of ``curves (S, B)`` between the sampled ``betas``.
+
+    The sampled β are uneven (a coarse sweep and a fine refinement around β̂), so a sample's
+    minimum that falls beyond the refined few would snap to a coarse β a whole sweep step away;
+    instead each row's minimum is the vertex of the parabola through its lowest sample and the
+    two beside it, in ``u = −log(1 − β)`` (the scale on which the simulated dent changes, see
+    :func:`deformap.msm._beta._vertex`), kept between those two.
+    """
+    s_idx = np.arange(curves.shape[0])
+    i = np.clip(np.argmin(curves, axis=1), 1, betas.size - 2)
+    u = -np.log1p(-betas)
+    u0, u1, u2 = u[i - 1], u[i], u[i + 1]
+    e0, e1, e2 = curves[s_idx, i - 1], curves[s_idx, i], curves[s_idx, i + 1]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        curv = ((e2 - e1) / (u2 - u1) - (e1 - e0) / (u1 - u0)) / (u2 - u0)
+        slope = (e1 - e0) / (u1 - u0) - curv * (u0 + u1)
+        vertex = np.where(curv > 0, -slope / (2.0 * curv), u[np.argmin(curves, axis=1)])
+    vertex = np.clip(vertex, u0, u2)
+    return np.asarray(-np.expm1(-vertex))
