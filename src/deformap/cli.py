@@ -156,6 +156,11 @@ def explore_command(
     if resume is not None:
         if config is not None:
             raise ConfigError("--resume reads the run's own config.yaml; do not pass --config too")
+        if not (resume / "config.yaml").is_file():  # a run writes it before anything else
+            raise ConfigError(
+                f"cannot resume {str(resume)!r}: it holds no config.yaml, so no run started "
+                "there; start one without --resume"
+            )
         cfg = load_run_config(resume / "config.yaml")
         folder = resume
     else:
