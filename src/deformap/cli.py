@@ -240,7 +240,7 @@ def bench_speed(
     gp_rows = bench_surface_gp(sizes, rng=rng)
     sweep = bench_beta_sweep(n_particles_side=20 if quick else 40, rng=rng)
     table = Table(title="surface GP → mean and std on the 120×80 grid (σw 4 cm, σn 2 mm)")
-    for col in ("points", "exact [s]", "grid [s]", "speed-up", "max |Δmean| [µm]", "max Δstd [%]"):
+    for col in ("points", "exact \\[s]", "grid \\[s]", "speed-up", "max |Δmean| [µm]", "max Δstd [%]"):
         table.add_column(col, justify="right")
     for row in gp_rows:
         table.add_row(
@@ -253,7 +253,7 @@ def bench_speed(
         )
     console.print(table)
     table = Table(title="β estimation (converged, 3×3 clusters)")
-    for col in ("β values", "particles", "batched [s]", "per-β loop [s]", "speed-up"):
+    for col in ("β values", "particles", "batched \\[s]", "per-β loop \\[s]", "speed-up"):
         table.add_column(col, justify="right")
     table.add_row(
         str(sweep["n_beta"]),
@@ -311,7 +311,7 @@ def study_hardness(
     (out / "hardness.json").write_text(json.dumps(study, indent=2))
     plot_hardness_study(out / "hardness.png", study)
     table = Table(title="β against hardness")
-    for col in ("protocol", "hardness [N]", "β", "β spread", "β uncertainty", "fit error [mm]"):
+    for col in ("protocol", "hardness [N]", "β", "β spread", "β uncertainty", "fit error \\[mm]"):
         table.add_column(col, justify="right")
     for r in study["rows"]:
         h = "rigid" if r["hardness_n"] is None else f"{r['hardness_n']:g}"
@@ -354,7 +354,7 @@ def study_cluster_size(
     (out / "cluster-size.json").write_text(json.dumps(study, indent=2))
     plot_cluster_size_study(out / "cluster-size.png", study)
     table = Table(title="fit error against cluster size")
-    for col in ("k×k", "hardness [N]", "β", "fit error [mm]"):
+    for col in ("k×k", "hardness [N]", "β", "fit error \\[mm]"):
         table.add_column(col, justify="right")
     for r in study["rows"]:
         h = "rigid" if r["hardness_n"] is None else f"{r['hardness_n']:g}"
