@@ -33,7 +33,9 @@ app = typer.Typer(
     add_completion=False,
     pretty_exceptions_enable=False,
 )
-bench_app = typer.Typer(help="Speed benchmarks (tables with a baseline measured in the same run).")
+bench_app = typer.Typer(
+    help="Speed and memory benchmarks (tables with a baseline measured in the same run)."
+)
 app.add_typer(bench_app, name="bench")
 
 F = TypeVar("F", bound=Callable[..., Any])
@@ -427,6 +429,59 @@ def bench_io_command(
     console.print(table)
     if json_path is not None:
         json_path.write_text(json.dumps(row, indent=2))
+        console.print(f"wrote {json_path}")
+
+
+def _memory_table(title: str, rows: list[dict[str, Any]], size_label: str) -> Any:
+    from rich.table import Table
+
+    table = Table(title=title)
+    for col in (size_label, "path", "traced [MiB]", "RSS+ [MiB]", "time \\[s]", "baseline [MiB]",
+                "vs baseline"):  # fmt: skip
+        table.add_column(col, justify="right")
+    by_key = {(r["case"], r["size"]): r for r in rows}
+    for r in rows:
+        base = by_key.get((r["baseline"], r["size"]))
+        if r["baseline"] is None:
+            base_text, ratio = "–", "(baseline)"
+        elif base is None:
+            base_text, ratio = f"{r['baseline']} not run", ""
+        else:
+            base_text = f"{base['traced_peak_mib']:.1f}"
+            x = base["traced_peak_mib"] / r["traced_peak_mib"]
+            ratio = f"{x:.1f}× less" if x >= 1 else f"{1 / x:.1f}× more"
+        added = "n/a" if r["rss_added_mib"] is None else f"{r['rss_added_mib']:.1f}"
+        table.add_row(f"{r['size']:,}", r["case"].split("-", 1)[1], f"{r['traced_peak_mib']:.1f}",
+                      added, f"{r['seconds']:.2f}", base_text, ratio)  # fmt: skip
+    return table
+
+
+@bench_app.command("memory")
+@friendly_errors
+def bench_memory_command(
+    json_path: Annotated[
+        Path | None, typer.Option("--json", help="Also write the rows as JSON.")
+    ] = None,
+    seed: Annotated[int, typer.Option(help="Seed of the synthetic data.")] = 0,
+    quick: Annotated[bool, typer.Option(help="Smaller sizes (a smoke run).")] = False,
+) -> None:
+    """Peak memory: surface GP (grid vs exact) and one β estimation (batched vs per-β loop)."""
+    import json
+
+    from deformap.eval._bench_memory import bench_memory
+
+    sizes, exact_max, side = ((500, 2000), 2000, 12) if quick else ((3000, 12000), 3000, 40)
+    result = bench_memory(gp_sizes=sizes, exact_max_points=exact_max, beta_side=side, seed=seed)
+    dense = ", ".join(f"{n:,}: {n * n * 8 / 2**20:,.0f} MiB" for n in sizes if n > exact_max)
+    note = f"; exact's N×N covariance alone at {dense}" if dense else ""
+    console.print(_memory_table(f"peak memory, surface GP → mean and std on the 120×80 grid{note}",
+                                result["surface_gp"], "points"))  # fmt: skip
+    console.print(_memory_table("peak memory, one β estimation (converged, 3×3 clusters)",
+                                result["beta_estimation"], "side"))  # fmt: skip
+    console.print("traced: numpy + Python (tracemalloc); RSS+: resident set rise, all libraries; "
+                  "one fresh process per row; baseline: the same size", style="dim")
+    if json_path is not None:
+        json_path.write_text(json.dumps(result, indent=2))
         console.print(f"wrote {json_path}")
 
 
