@@ -445,7 +445,7 @@ def _memory_table(title: str, rows: list[dict[str, Any]], size_label: str) -> An
         if r["baseline"] is None:
             base_text, ratio = "–", "(baseline)"
         elif base is None:
-            base_text, ratio = f"{r['baseline']} not run", ""
+            base_text, ratio = f"{r['baseline'].split('-', 1)[1]} not run", ""
         else:
             base_text = f"{base['traced_peak_mib']:.1f}"
             x = base["traced_peak_mib"] / r["traced_peak_mib"]
