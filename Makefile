@@ -22,15 +22,13 @@ demo: $(STAMP)
 test: $(STAMP)
 	$(PY) -m pytest -q -p no:cacheprovider
 
+# Speed and memory tables, each with its baseline (benchmarks/README.md); JSON in benchmarks/results.
 bench: $(STAMP)
-	mkdir -p benchmarks/results
-	$(VENV)/bin/deformap bench speed --json benchmarks/results/speed.json
-	$(VENV)/bin/deformap bench world --json benchmarks/results/world.json
-	$(VENV)/bin/deformap bench io --json benchmarks/results/io.json
+	$(PY) benchmarks/run.py --json-dir benchmarks/results
 
 lint: $(STAMP)
 	$(PY) -m pip install --quiet 'ruff>=0.5' 'mypy>=1.10'
-	$(VENV)/bin/ruff check src tests
+	$(VENV)/bin/ruff check src tests benchmarks
 	$(VENV)/bin/mypy
 
 clean:

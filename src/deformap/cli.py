@@ -33,7 +33,9 @@ app = typer.Typer(
     add_completion=False,
     pretty_exceptions_enable=False,
 )
-bench_app = typer.Typer(help="Speed benchmarks (tables with a baseline measured in the same run).")
+bench_app = typer.Typer(
+    help="Speed and memory benchmarks (tables with a baseline measured in the same run)."
+)
 app.add_typer(bench_app, name="bench")
 
 F = TypeVar("F", bound=Callable[..., Any])
@@ -156,6 +158,11 @@ def explore_command(
     if resume is not None:
         if config is not None:
             raise ConfigError("--resume reads the run's own config.yaml; do not pass --config too")
+        if not (resume / "config.yaml").is_file():  # a run writes it before anything else
+            raise ConfigError(
+                f"cannot resume {str(resume)!r}: it holds no config.yaml, so no run started "
+                "there; start one without --resume"
+            )
         cfg = load_run_config(resume / "config.yaml")
         folder = resume
     else:
@@ -235,7 +242,7 @@ def bench_speed(
     gp_rows = bench_surface_gp(sizes, rng=rng)
     sweep = bench_beta_sweep(n_particles_side=20 if quick else 40, rng=rng)
     table = Table(title="surface GP → mean and std on the 120×80 grid (σw 4 cm, σn 2 mm)")
-    for col in ("points", "exact [s]", "grid [s]", "speed-up", "max |Δmean| [µm]", "max Δstd [%]"):
+    for col in ("points", "exact \\[s]", "grid \\[s]", "speed-up", "max |Δmean| [µm]", "max Δstd [%]"):
         table.add_column(col, justify="right")
     for row in gp_rows:
         table.add_row(
@@ -248,7 +255,7 @@ def bench_speed(
         )
     console.print(table)
     table = Table(title="β estimation (converged, 3×3 clusters)")
-    for col in ("β values", "particles", "batched [s]", "per-β loop [s]", "speed-up"):
+    for col in ("β values", "particles", "batched \\[s]", "per-β loop \\[s]", "speed-up"):
         table.add_column(col, justify="right")
     table.add_row(
         str(sweep["n_beta"]),
@@ -306,7 +313,7 @@ def study_hardness(
     (out / "hardness.json").write_text(json.dumps(study, indent=2))
     plot_hardness_study(out / "hardness.png", study)
     table = Table(title="β against hardness")
-    for col in ("protocol", "hardness [N]", "β", "β spread", "β uncertainty", "fit error [mm]"):
+    for col in ("protocol", "hardness [N]", "β", "β spread", "β uncertainty", "fit error \\[mm]"):
         table.add_column(col, justify="right")
     for r in study["rows"]:
         h = "rigid" if r["hardness_n"] is None else f"{r['hardness_n']:g}"
@@ -349,7 +356,7 @@ def study_cluster_size(
     (out / "cluster-size.json").write_text(json.dumps(study, indent=2))
     plot_cluster_size_study(out / "cluster-size.png", study)
     table = Table(title="fit error against cluster size")
-    for col in ("k×k", "hardness [N]", "β", "fit error [mm]"):
+    for col in ("k×k", "hardness [N]", "β", "fit error \\[mm]"):
         table.add_column(col, justify="right")
     for r in study["rows"]:
         h = "rigid" if r["hardness_n"] is None else f"{r['hardness_n']:g}"
@@ -422,6 +429,59 @@ def bench_io_command(
     console.print(table)
     if json_path is not None:
         json_path.write_text(json.dumps(row, indent=2))
+        console.print(f"wrote {json_path}")
+
+
+def _memory_table(title: str, rows: list[dict[str, Any]], size_label: str) -> Any:
+    from rich.table import Table
+
+    table = Table(title=title)
+    for col in (size_label, "path", "traced [MiB]", "RSS+ [MiB]", "time \\[s]", "baseline [MiB]",
+                "vs baseline"):  # fmt: skip
+        table.add_column(col, justify="right")
+    by_key = {(r["case"], r["size"]): r for r in rows}
+    for r in rows:
+        base = by_key.get((r["baseline"], r["size"]))
+        if r["baseline"] is None:
+            base_text, ratio = "–", "(baseline)"
+        elif base is None:
+            base_text, ratio = f"{r['baseline'].split('-', 1)[1]} not run", ""
+        else:
+            base_text = f"{base['traced_peak_mib']:.1f}"
+            x = base["traced_peak_mib"] / r["traced_peak_mib"]
+            ratio = f"{x:.1f}× less" if x >= 1 else f"{1 / x:.1f}× more"
+        added = "n/a" if r["rss_added_mib"] is None else f"{r['rss_added_mib']:.1f}"
+        table.add_row(f"{r['size']:,}", r["case"].split("-", 1)[1], f"{r['traced_peak_mib']:.1f}",
+                      added, f"{r['seconds']:.2f}", base_text, ratio)  # fmt: skip
+    return table
+
+
+@bench_app.command("memory")
+@friendly_errors
+def bench_memory_command(
+    json_path: Annotated[
+        Path | None, typer.Option("--json", help="Also write the rows as JSON.")
+    ] = None,
+    seed: Annotated[int, typer.Option(help="Seed of the synthetic data.")] = 0,
+    quick: Annotated[bool, typer.Option(help="Smaller sizes (a smoke run).")] = False,
+) -> None:
+    """Peak memory: surface GP (grid vs exact) and one β estimation (batched vs per-β loop)."""
+    import json
+
+    from deformap.eval._bench_memory import bench_memory
+
+    sizes, exact_max, side = ((500, 2000), 2000, 12) if quick else ((3000, 12000), 3000, 40)
+    result = bench_memory(gp_sizes=sizes, exact_max_points=exact_max, beta_side=side, seed=seed)
+    dense = ", ".join(f"{n:,}: {n * n * 8 / 2**20:,.0f} MiB" for n in sizes if n > exact_max)
+    note = f"; exact's N×N covariance alone at {dense}" if dense else ""
+    console.print(_memory_table(f"peak memory, surface GP → mean and std on the 120×80 grid{note}",
+                                result["surface_gp"], "points"))  # fmt: skip
+    console.print(_memory_table("peak memory, one β estimation (converged, 3×3 clusters)",
+                                result["beta_estimation"], "side"))  # fmt: skip
+    console.print("traced: numpy + Python (tracemalloc); RSS+: resident set rise, all libraries; "
+                  "one fresh process per row; baseline: the same size", style="dim")
+    if json_path is not None:
+        json_path.write_text(json.dumps(result, indent=2))
         console.print(f"wrote {json_path}")
 
 

@@ -1,13 +1,26 @@
-"""A whole run on a coarse simulated world: the report, the figures, and resuming a killed run."""
+"""A whole run on a coarse simulated world: the report, the figures, and resuming a killed run.
+
+One test kills a real ``deformap explore`` process with SIGKILL mid-run and resumes it.
+"""
 
 from __future__ import annotations
 
 import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
 
 import pytest
 
-from deformap.eval import RunConfig, run_experiment
+import deformap
+from deformap._config import dump_yaml
+from deformap.errors import ConfigError
+from deformap.eval import RunConfig, load_run_config, run_experiment
 from deformap.explore import ExplorationConfig, SurfaceGPConfig, read_journal
+from deformap.explore._journal import JOURNAL_NAME
 from deformap.world import WorldConfig
 
 
@@ -77,9 +90,114 @@ def test_a_killed_run_resumes_to_the_same_result(tmp_path, full_run) -> None:  #
     assert len(read_journal(journal).pokes) == 3
 
 
-def test_resume_refuses_a_different_configuration(tmp_path, full_run) -> None:  # type: ignore[no-untyped-def]
-    from deformap.errors import ConfigError
+def test_a_run_killed_before_its_journal_existed_resumes_from_poke_one(tmp_path, full_run) -> None:  # type: ignore[no-untyped-def]
+    # Regression: the journal used to be created before config.yaml, so a SIGKILL in between left
+    # a folder that `explore --resume` could not read and a fresh run refused as occupied.
+    out = tmp_path / "early"
+    out.mkdir()
+    dump_yaml(_config(), out / "config.yaml")  # what a kill right after the first write leaves
+    (out / "journal.tmp").write_text('{"kind": "hea')
+    other = RunConfig(**{**_config().__dict__, "seed": 5})
+    with pytest.raises(ConfigError, match=r"its config\.yaml differs"):
+        run_experiment(other, out, resume=True, figures=False)
+    resumed = run_experiment(_config(), out, resume=True, figures=False).report
+    assert [p["beta"] for p in resumed["pokes"]] == [p["beta"] for p in full_run.report["pokes"]]
+    assert len(read_journal(out / JOURNAL_NAME).pokes) == 3
 
+
+def test_resume_refuses_a_different_configuration(tmp_path, full_run) -> None:  # type: ignore[no-untyped-def]
     other = RunConfig(**{**_config().__dict__, "seed": 5})
     with pytest.raises(ConfigError, match="differs from this one"):
         run_experiment(other, full_run.folder, resume=True, figures=False)
+
+
+def _journalled_pokes(path: Path) -> list[str]:
+    """The complete poke lines of a journal (a line cut mid-write is not complete)."""
+    try:
+        text = path.read_text(encoding="utf-8", errors="replace")
+    except FileNotFoundError:
+        return []
+    complete = text.split("\n")[:-1]
+    return [line for line in complete if json.loads(line).get("kind") == "poke"]
+
+
+def _deformap(*args: str) -> list[str]:
+    return [sys.executable, "-m", "deformap", *args]
+
+
+def _child_env() -> dict[str, str]:
+    """The child imports this deformap (the tree under test), single-threaded like the suite."""
+    src = str(Path(deformap.__file__).resolve().parents[1])
+    path = os.pathsep.join(p for p in (src, os.environ.get("PYTHONPATH")) if p)
+    return {**os.environ, "PYTHONPATH": path, "OMP_NUM_THREADS": "1"}
+
+
+def _kill_after_a_poke(config_file: Path, out: Path, *, timeout_s: float = 120.0) -> list[str]:
+    """Run `deformap explore` and SIGKILL it once 1 or 2 pokes are journalled; return those lines.
+
+    Returns an empty list when the run got past its second poke (or ended) before the kill landed,
+    as a starved poller might let it, so that the caller can try again.
+    """
+    journal = out / JOURNAL_NAME
+    log = out.with_suffix(".log")
+    with open(log, "wb") as sink:  # a file, not a pipe: a full pipe would stall the child
+        child = subprocess.Popen(
+            _deformap("explore", "--config", str(config_file), "--out", str(out)),
+            env=_child_env(),
+            stdout=sink,
+            stderr=subprocess.STDOUT,
+        )
+    try:
+        deadline = time.monotonic() + timeout_s
+        while not _journalled_pokes(journal):
+            if child.poll() is not None:
+                raise AssertionError(f"explore ended before its first poke:\n{log.read_text()}")
+            if time.monotonic() > deadline:
+                raise AssertionError(f"no poke journalled within {timeout_s:.0f} s")
+            time.sleep(0.005)
+        os.kill(child.pid, signal.SIGKILL)
+        killed = child.wait(timeout=30) == -signal.SIGKILL
+    finally:
+        if child.poll() is None:
+            child.kill()
+            child.wait()
+    kept = _journalled_pokes(journal)
+    return kept if killed and len(kept) < 3 else []
+
+
+@pytest.mark.skipif(not hasattr(signal, "SIGKILL"), reason="needs SIGKILL (POSIX)")
+def test_a_run_killed_with_sigkill_resumes_to_the_same_result(tmp_path, full_run) -> None:  # type: ignore[no-untyped-def]
+    config_file = tmp_path / "config.yaml"
+    dump_yaml(_config(), config_file)
+    assert load_run_config(config_file) == _config()  # the CLI runs what full_run ran
+    for attempt in range(3):
+        out = tmp_path / f"killed-{attempt}"
+        kept = _kill_after_a_poke(config_file, out)
+        if kept:
+            break
+        print(f"attempt {attempt}: three pokes were journalled before SIGKILL landed")
+    else:
+        pytest.fail("the run finished its pokes before SIGKILL landed, three times")
+    assert not (out / "report.json").exists()
+
+    resumed = subprocess.run(
+        _deformap("explore", "--resume", str(out)),
+        env=_child_env(),
+        capture_output=True,
+        text=True,
+        timeout=300,
+        check=False,
+    )
+    assert resumed.returncode == 0, resumed.stderr
+    report = json.loads((out / "report.json").read_text())
+    full = json.loads((full_run.folder / "report.json").read_text())
+    assert report["config"] == full["config"]
+    assert [p["target_xy"] for p in report["pokes"]] == [p["target_xy"] for p in full["pokes"]]
+    assert [p["beta"] for p in report["pokes"]] == [p["beta"] for p in full["pokes"]]
+    assert report["regions"] == full["regions"]
+    # Nothing journalled before the kill was lost or rewritten: those lines lead the journal.
+    after = _journalled_pokes(out / JOURNAL_NAME)
+    assert len(after) == 3 and after[: len(kept)] == kept
+    assert [json.loads(line)["beta"] for line in kept] == [
+        p["beta"] for p in report["pokes"][: len(kept)]
+    ]

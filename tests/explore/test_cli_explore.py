@@ -62,4 +62,4 @@ def test_an_occupied_folder_is_refused_and_nothing_in_it_is_lost(tmp_path) -> No
     assert "already holds a run" in _error_line(result)
     assert json.loads((out / "report.json").read_text()) == {"precious": True}
     result = runner.invoke(app, ["explore", "--resume", str(tmp_path / "empty")])
-    assert "cannot read config file" in _error_line(result)
+    assert "holds no config.yaml, so no run started there" in _error_line(result)

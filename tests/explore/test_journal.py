@@ -45,3 +45,18 @@ def test_resume_refuses_another_run_and_a_damaged_middle(tmp_path) -> None:
         read_journal(journal.path)
     with pytest.raises(FileFormatError, match="cannot read journal"):
         read_journal(tmp_path / "nothing.jsonl")
+
+
+def test_a_journal_is_created_whole_or_not_at_all(tmp_path, monkeypatch) -> None:
+    import deformap.explore._journal as journal_module
+
+    def killed(*args: object) -> None:
+        raise KeyboardInterrupt  # the process dies between writing the header and renaming it
+
+    monkeypatch.setattr(journal_module.os, "replace", killed)
+    with pytest.raises(KeyboardInterrupt):
+        Journal.create(tmp_path, {"seed": 1})
+    assert not (tmp_path / "journal.jsonl").exists()
+    monkeypatch.undo()
+    journal = Journal.create(tmp_path, {"seed": 1})  # a leftover temporary file is no obstacle
+    assert read_journal(journal.path).header == {"kind": "header", "seed": 1}

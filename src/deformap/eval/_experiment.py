@@ -9,6 +9,7 @@ from __future__ import annotations
 import json
 import logging
 import math
+import os
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -82,10 +83,35 @@ class RunOutput:
     folder: Path
 
 
-def _prepare_folder(out: Path, header: dict[str, Any], resume: bool) -> tuple[Journal, list]:
+def _write_whole(path: Path, text: str) -> None:
+    """Write ``text`` through a temporary file: a kill leaves the old file or the new, not half."""
+    tmp = path.with_name(path.name + ".tmp")
+    with open(tmp, "w", encoding="utf-8") as fh:
+        fh.write(text)
+        fh.flush()
+        os.fsync(fh.fileno())
+    os.replace(tmp, path)
+
+
+def _prepare_folder(
+    out: Path, config: RunConfig, header: dict[str, Any], resume: bool
+) -> tuple[Journal, list]:
+    """Check the run folder and open its journal; ``config.yaml`` is always written first.
+
+    So a run killed at any moment leaves ``config.yaml`` beside any journal, and a folder with
+    ``config.yaml`` but no journal (killed before its journal was created) resumes from poke 1.
+    """
+    config_file = out / "config.yaml"
     if resume:
         if not (out / JOURNAL_NAME).exists():
-            raise ConfigError(f"cannot resume {str(out)!r}: it holds no {JOURNAL_NAME}")
+            if not config_file.exists():
+                raise ConfigError(f"cannot resume {str(out)!r}: it holds no {JOURNAL_NAME}")
+            if load_run_config(config_file) != config:
+                raise ConfigError(
+                    f"cannot resume {str(out)!r}: its config.yaml differs from this run's"
+                )
+            logger.warning("%s: killed before its journal was created; starting over", out)
+            return Journal.create(out, header), []
         journal, contents = Journal.resume(out, header)
         if contents.broken_line is not None:
             logger.warning(
@@ -99,6 +125,7 @@ def _prepare_folder(out: Path, header: dict[str, Any], resume: bool) -> tuple[Jo
             f"output folder {str(out)!r} already holds a run; choose another --out or pass --resume"
         )
     out.mkdir(parents=True, exist_ok=True)
+    _write_whole(config_file, dump_yaml(config))
     return Journal.create(out, header), []
 
 
@@ -126,8 +153,9 @@ def run_experiment(
     scenario = load_scenario(config.scenario)
     plain = config_to_dict(config)
     header = {"deformap": __version__, "config": plain, "scenario": scenario.to_dict()}
-    journal, done = _prepare_folder(folder, header, resume)
-    dump_yaml(config, folder / "config.yaml")
+    journal, done = _prepare_folder(folder, config, header, resume)
+    if resume:  # matched the journal header; restores a copy a kill or a user removed
+        _write_whole(folder / "config.yaml", dump_yaml(config))
     world_rng, explore_rng = run_generators(config.seed)
     t0 = time.perf_counter()
     world = SimulatedWorld(scenario, config=config.world, rng=world_rng)

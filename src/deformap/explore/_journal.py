@@ -81,11 +81,20 @@ class Journal:
 
     @classmethod
     def create(cls, folder: str | Path, header: dict[str, Any]) -> Journal:
+        """Start a journal holding ``header``; :class:`FileExistsError` if the folder has one.
+
+        The header goes to a temporary file that is renamed into place, so a run killed here
+        leaves either no journal or one with its whole header, never an empty one.
+        """
         path = Path(folder) / JOURNAL_NAME
         path.parent.mkdir(parents=True, exist_ok=True)
+        if path.exists():
+            raise FileExistsError(f"{str(path)!r} already exists")
         journal = cls(path)
-        with open(path, "x", encoding="utf-8") as fh:
+        tmp = path.with_suffix(".tmp")
+        with open(tmp, "w", encoding="utf-8") as fh:
             journal._write(fh, {"kind": "header", **header})
+        os.replace(tmp, path)
         return journal
 
     @classmethod

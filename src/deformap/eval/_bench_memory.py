@@ -1,0 +1,236 @@
+"""Memory benchmark: the peak memory of the surface GP (grid against exact) and of a β estimation.
+
+Each case runs in a fresh Python process (``python -m deformap.eval._bench_memory CASE SIZE SEED``)
+so that one case's heap never inflates another's numbers. The child imports everything and builds
+its inputs first, then measures two peaks over the case alone:
+
+- ``traced_peak_mib``: the largest total of live Python and numpy allocations (:mod:`tracemalloc`;
+  numpy reports its array buffers to it). It misses memory that C libraries allocate by
+  themselves (BLAS/LAPACK workspaces, SuperLU), and it is the same on every platform.
+- ``rss_peak_mib`` and ``rss_added_mib``: the process's peak resident set during the case and how
+  far it rose above the resident set just before (Linux: ``VmHWM``, reset before the case through
+  ``/proc/self/clear_refs``, after the set-up's freed heap went back to the OS through glibc's
+  ``malloc_trim``, so that the case cannot reuse it unseen). Everything counts here, C libraries
+  included; ``None`` where the platform cannot reset the peak (it would then include the set-up).
+
+Cases (the same problems as the speed benchmarks, whose code they call):
+
+- ``gp-exact`` / ``gp-grid``: fit the surface GP to ``size`` noisy points over the 60 × 40 cm
+  workspace and predict mean and std on the 120 × 80 grid (:mod:`deformap.eval._bench_gp`).
+- ``beta-batched``: one converged β estimation (:func:`deformap.msm.estimate_beta`) on
+  ``size × size`` particles; ``beta-loop``: its baseline, the same β simulated one at a time
+  (:mod:`deformap.eval._bench_msm`).
+"""
+
+from __future__ import annotations
+
+import gc
+import json
+import os
+import subprocess
+import sys
+import time
+import tracemalloc
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from deformap._validation import check_int
+from deformap.errors import InvalidArgumentError
+
+__all__ = ["CASES", "bench_memory", "measure_case"]
+
+CASES = ("gp-exact", "gp-grid", "beta-batched", "beta-loop")
+#: The case each measured case is compared with (the baselines have none).
+BASELINE = {"gp-grid": "gp-exact", "beta-batched": "beta-loop"}
+
+_MIB = 2.0**20
+_STATUS = Path("/proc/self/status")
+_CLEAR_REFS = Path("/proc/self/clear_refs")
+
+
+def _prepare(case: str, size: int, seed: int) -> Callable[[], Any]:
+    """Build the case's inputs (outside the measurement) and return the call to measure."""
+    rng = np.random.default_rng(seed)
+    if case.startswith("gp-"):
+        from deformap.eval import _bench_gp as gp
+
+        xs = np.arange(gp.CELL_M / 2, gp.WORKSPACE_M[0], gp.CELL_M)
+        ys = np.arange(gp.CELL_M / 2, gp.WORKSPACE_M[1], gp.CELL_M)
+        xy = rng.uniform((0.0, 0.0), gp.WORKSPACE_M, size=(size, 2))
+        z = gp._relief(xy) + gp.NOISE_STD_M * rng.standard_normal(size)
+        method = case.removeprefix("gp-")
+        return lambda: gp._timed_fit_predict(method, xy, z, xs, ys)
+    from scipy.spatial import cKDTree
+
+    from deformap.eval._bench_msm import dent_problem, per_beta_loop
+    from deformap.msm import ParticleGrid, ShapeMatchingConfig, estimate_beta
+
+    cfg = ShapeMatchingConfig(cluster_size=3)
+    xs, ys, z, pts, contact = dent_problem(size, rng)
+    if case == "beta-batched":
+        return lambda: estimate_beta(xs, ys, z, pts, contact, cfg)
+    est = estimate_beta(xs, ys, z, pts, contact, cfg)  # which β, to which tolerance
+    grid = ParticleGrid.from_heightmap(xs, ys, z)
+    tree = cKDTree(pts)
+    return lambda: per_beta_loop(grid, tree, contact, est, cfg)
+
+
+def _status_kib(key: str) -> float | None:
+    try:
+        for line in _STATUS.read_text().splitlines():
+            if line.startswith(key + ":"):
+                return float(line.split()[1])
+    except OSError:
+        pass
+    return None
+
+
+def _trim_heap() -> None:
+    """Hand freed heap pages back to the OS (glibc), so the set-up's garbage is not reused unseen."""
+    gc.collect()
+    try:
+        import ctypes
+
+        ctypes.CDLL("libc.so.6").malloc_trim(0)
+    except (OSError, AttributeError):  # not glibc: the RSS fields may then read low
+        pass
+
+
+def _reset_peak_rss() -> bool:
+    """Reset the kernel's peak-RSS mark of this process (Linux >= 4.0); False where impossible."""
+    try:
+        _CLEAR_REFS.write_text("5")
+    except OSError:
+        return False
+    return _status_kib("VmHWM") is not None
+
+
+def _run_case(case: str, size: int, seed: int) -> dict[str, Any]:
+    """Measure ``case`` in this process (the child's side; see the module docstring)."""
+    run = _prepare(case, size, seed)
+    _trim_heap()
+    rss_before = _status_kib("VmRSS")
+    peak_reset = rss_before is not None and _reset_peak_rss()
+    tracing = tracemalloc.is_tracing()  # someone else's tracing (isolate=False) is left running
+    if not tracing:
+        tracemalloc.start()
+    tracemalloc.reset_peak()
+    traced_before = tracemalloc.get_traced_memory()[0]
+    start = time.perf_counter()
+    run()
+    seconds = time.perf_counter() - start
+    traced_peak = tracemalloc.get_traced_memory()[1] - traced_before
+    if not tracing:
+        tracemalloc.stop()
+    rss_peak = _status_kib("VmHWM") if peak_reset else None
+    row: dict[str, Any] = {
+        "case": case,
+        "size": size,
+        "traced_peak_mib": traced_peak / _MIB,
+        "rss_before_mib": None if rss_before is None else rss_before / 1024,
+        "rss_peak_mib": None,
+        "rss_added_mib": None,
+        "seconds": seconds,
+        "baseline": BASELINE.get(case),
+    }
+    if rss_peak is not None and rss_before is not None:
+        row["rss_peak_mib"] = rss_peak / 1024
+        row["rss_added_mib"] = (rss_peak - rss_before) / 1024
+    return row
+
+
+def _child_env() -> dict[str, str]:
+    # The child must import this very deformap, also when it runs from a source tree.
+    src = str(Path(__file__).resolve().parents[2])
+    path = os.pathsep.join(p for p in (src, os.environ.get("PYTHONPATH")) if p)
+    return {**os.environ, "PYTHONPATH": path}
+
+
+def measure_case(case: str, size: int, *, seed: int = 0, isolate: bool = True) -> dict[str, Any]:
+    """Peak memory of one case.
+
+    Parameters
+    ----------
+    case : {"gp-exact", "gp-grid", "beta-batched", "beta-loop"}
+    size : int
+        Points of the cloud (``gp-*``) or particles per ROI side (``beta-*``).
+    seed : int
+        Seed of the synthetic data.
+    isolate : bool
+        Run in a fresh Python process (the default). ``False`` measures in this process: the
+        traced peak is still the case's own, but the RSS fields are ``None`` (this process's
+        history would count).
+
+    Returns
+    -------
+    dict
+        ``case``, ``size``, ``traced_peak_mib``, ``rss_before_mib``, ``rss_peak_mib``,
+        ``rss_added_mib`` (MiB, ``None`` where unmeasured), ``seconds`` (the case's wall time
+        while traced; tracing slows Python-heavy code) and ``baseline`` (the case it is compared
+        with, or ``None`` for a baseline).
+    """
+    if case not in CASES:
+        raise InvalidArgumentError(f"`case` must be one of {list(CASES)}; got {case!r}")
+    size = check_int("size", size, minimum=5 if case.startswith("beta-") else 2)
+    seed = check_int("seed", seed, minimum=0)
+    if not isolate:
+        row = _run_case(case, size, seed)
+        return {**row, "rss_before_mib": None, "rss_peak_mib": None, "rss_added_mib": None}
+    done = subprocess.run(
+        [sys.executable, "-m", __name__, case, str(size), str(seed)],
+        env=_child_env(),
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    if done.returncode != 0:
+        raise RuntimeError(f"memory case {case} {size} failed:\n{done.stderr[-2000:]}")
+    return dict(json.loads(done.stdout.strip().splitlines()[-1]))
+
+
+def bench_memory(
+    *,
+    gp_sizes: Sequence[int] = (3000, 12000),
+    exact_max_points: int = 3000,
+    beta_side: int = 40,
+    seed: int = 0,
+    isolate: bool = True,
+) -> dict[str, list[dict[str, Any]]]:
+    """Peak memory of the surface GP and of one β estimation, each beside its baseline.
+
+    Parameters
+    ----------
+    gp_sizes : sequence of int
+        Cloud sizes; the grid path runs at each, the exact path (its baseline) at those up to
+        ``exact_max_points`` (its N × N covariance needs N² × 8 bytes several times over).
+    exact_max_points : int
+    beta_side : int
+        Particles per ROI side of the β estimation (and of its per-β-loop baseline).
+    seed : int
+    isolate : bool
+        See :func:`measure_case`.
+
+    Returns
+    -------
+    dict
+        ``{"surface_gp": [rows], "beta_estimation": [rows]}``, rows as :func:`measure_case`
+        returns them, baselines first.
+    """
+    sizes = [check_int("gp_sizes[i]", n, minimum=2) for n in gp_sizes]
+    exact_max = check_int("exact_max_points", exact_max_points, minimum=2)
+
+    def measure(case: str, size: int) -> dict[str, Any]:
+        return measure_case(case, size, seed=seed, isolate=isolate)
+
+    gp_rows = [measure("gp-exact", n) for n in sizes if n <= exact_max]
+    gp_rows += [measure("gp-grid", n) for n in sizes]
+    beta_rows = [measure("beta-loop", beta_side), measure("beta-batched", beta_side)]
+    return {"surface_gp": gp_rows, "beta_estimation": beta_rows}
+
+
+if __name__ == "__main__":  # the child of measure_case: one case, one JSON line on stdout
+    _case, _size, _seed = sys.argv[1], int(sys.argv[2]), int(sys.argv[3])
+    print(json.dumps(_run_case(_case, _size, _seed)))
