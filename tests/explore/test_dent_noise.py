@@ -60,3 +60,14 @@ def test_draws_are_deterministic_and_bad_input_is_refused() -> None:
         dent_error_samples(XS, YS, xy, 0.002, np.zeros((0, 2)), 5e-4, n_samples=1, **KERNEL)
     with pytest.raises(InvalidArgumentError, match="`points_noise_m`"):
         dent_error_samples(XS, YS, xy, 0.0, np.zeros((0, 2)), 5e-4, n_samples=4, **KERNEL)
+
+
+def test_the_camera_noise_is_measured_robustly() -> None:
+    from deformap.explore._mapper import _robust_std
+
+    rng = np.random.default_rng(2)
+    residuals = rng.normal(0.0, 0.0016, size=4000)
+    assert _robust_std(residuals) == pytest.approx(0.0016, rel=0.05)
+    residuals[:200] = 0.05  # flying pixels and the dent's rim
+    assert _robust_std(residuals) == pytest.approx(0.0016, rel=0.12)
+    assert _robust_std(np.zeros(5)) == 1e-6 and _robust_std(np.zeros(0)) == 1e-6

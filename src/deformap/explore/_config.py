@@ -33,12 +33,13 @@ Its length scale (1 cm) is the tip's radius: the dent cannot vary faster than th
 β-field ("GPR β-field"): prior standard deviation 0.3 (variance 0.09, above the paper's threshold
 0.06 so that the unexplored map asks for a poke); length scale 0.2 m, a third of the table's width:
 the size of the foam pieces a robot is asked to tell apart; each poke's β uncertainty is its noise,
-with a floor of 0.03. That uncertainty is the camera's noise carried through the estimate
-(``TouchGPConfig.noise_samples`` = 64 draws of the touch GP's smoother applied to noise, β̂ re-read
-on each, :mod:`deformap.explore._dent_noise`): about 0.01 / 0.03 / 0.05 / 0.13 on 60 / 110 / 150 /
-250 N blocks, two to four times the spread of repeated presses at one place (0.004 / 0.014 / 0.012
-/ 0.047), so it errs on the safe side. The floor stands for what the noise does not explain: β̂
-moves by 0.03 between eight places on one 150 N block (0.004 on 60 N, 0.009 on 110 N). Next pokes by ``max-variance`` (the paper's random choice is ``paper``):
+with a floor of 0.03. That uncertainty is the camera's noise (measured in the ROI) carried
+through the estimate (``TouchGPConfig.noise_samples`` = 64 draws of the touch GP's smoother applied
+to noise, β̂ re-read on each, :mod:`deformap.explore._dent_noise`): about 0.01 / 0.025 / 0.05 /
+0.12 on 60 / 110 / 150 / 250 N blocks, about twice the spread of β̂ over eight places on one block
+(0.004 / 0.015 / 0.028 / 0.050), so it errs on the safe side. The floor stands for what the noise
+does not explain (a 150 N block's eight places spread by 0.03).
+Next pokes by ``max-variance`` (the paper's random choice is ``paper``):
 with these settings it needs 7 pokes to bring every cell below 0.06 where ``paper`` needs 8–12.
 """
 

@@ -78,6 +78,19 @@ class PokeResult:
         return np.asarray(self.record["contact_xy"], dtype=float)
 
 
+_MAD_TO_STD = 1.4826
+"""Standard deviation per median absolute deviation of a normal distribution."""
+
+
+def _robust_std(residuals: NDArray[np.float64], floor: float = 1e-6) -> float:
+    """Scatter of ``residuals`` as a normal standard deviation, from their median absolute
+    deviation (so flying pixels and the dent's rim do not inflate it); at least ``floor``."""
+    if residuals.size == 0:
+        return floor
+    mad = float(np.median(np.abs(residuals - np.median(residuals))))
+    return max(_MAD_TO_STD * mad, floor)
+
+
 def _contact_record(contact: TactileContact) -> dict[str, Any]:
     return {
         "tip_center": contact.tip_center.tolist(),
@@ -216,10 +229,14 @@ class Mapper:
         gx, gy = np.meshgrid(roi_xs, roi_ys)
         deformed = np.column_stack([gx.ravel(), gy.ravel(), deformed_z.ravel()])
         t2 = time.perf_counter()
-        samples = None
+        samples, camera_noise = None, None
         if cfg.noise_samples:
+            # The camera's noise here, from the points' scatter about the reconstruction (robust:
+            # median absolute deviation); the touch GP's σₙ is a prior setting, not a measurement.
+            fitted = np.asarray(touch.predict(roi[:, :2])) if len(roi) else np.zeros(0)
+            camera_noise = _robust_std(np.asarray(target[: len(roi)]) - fitted)
             samples = dent_error_samples(
-                roi_xs, roi_ys, roi[:, :2], cfg.noise_std_m, tactile[:, :2],
+                roi_xs, roi_ys, roi[:, :2], camera_noise, tactile[:, :2],
                 cfg.tactile_noise_std_m, length_scale_m=cfg.length_scale_m,
                 signal_std_m=cfg.signal_std_m, n_samples=cfg.noise_samples,
             )  # fmt: skip
@@ -240,6 +257,7 @@ class Mapper:
             "residual": float(np.max(est.residual)),
             "converged": bool(np.all(est.converged)),
             "n_roi_points": len(roi),
+            "camera_noise_m": camera_noise,
             "timings": {
                 "filter_s": t1 - t0,
                 "touch_gp_s": t2 - t1,
