@@ -28,6 +28,8 @@ __all__ = ["bench_beta_sweep"]
 
 _SPACING_M = 0.005
 _NOISE_M = 1e-4
+_TIGHT_ATOL_M = 1e-6
+_LOOSE_ATOL_M = 3e-6
 
 
 def bench_beta_sweep(*, n_particles_side: int = 40, cluster_size: int = 3,
@@ -77,7 +79,13 @@ def bench_beta_sweep(*, n_particles_side: int = 40, cluster_size: int = 3,
                             stiffness_n_per_m=est.stiffness_n_per_m)
         loop_errors.append(matching_error(sim.positions, tree)[0])
     loop = time.perf_counter() - t0
-    if not np.allclose(loop_errors, est.errors, rtol=0, atol=1e-6):
-        raise RuntimeError("the per-β loop disagrees with the batched sweep by more than 1 µm")
+    # a β solved only to the loose sweep tolerance is good to about a micrometre of E (both sides
+    # stop within ``sweep_tol`` of the fixed point, from different starts); tight ones agree far
+    # better
+    atol = np.where(est.tolerances > cfg.tol, _LOOSE_ATOL_M, _TIGHT_ATOL_M)
+    if np.any(np.abs(np.asarray(loop_errors) - est.errors) > atol):
+        raise RuntimeError("the per-β loop disagrees with the estimate by more than "
+                           f"{_TIGHT_ATOL_M * 1e6:g} µm (β solved to `tol`) or "
+                           f"{_LOOSE_ATOL_M * 1e6:g} µm (to `sweep_tol`)")
     return {"n_beta": int(est.betas.size), "n_particles": n * n, "batched_s": batched,
             "loop_s": loop, "speedup": loop / batched}

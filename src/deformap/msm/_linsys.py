@@ -11,8 +11,10 @@ innermost, the clusters only couple particles ``(k − 1)`` rows apart, so ``S_�
 of half-width ``(k − 1)(n_x n_z + n_z) + n_z − 1``, and a dense banded Cholesky (LAPACK
 ``pbtrf``) factorises it several times faster than a general sparse LU, with no pivoting.
 ``S_β = S₀ − β S₁`` is affine in β, so both bands are assembled once and each β costs one
-factorisation only. A matrix that is not positive definite (never expected) falls back to
-SuperLU.
+factorisation only, or none: a β may step with the factorisation of a smaller β′ through the
+convergent splitting ``S_β = S_β′ − (β − β′) S₁`` (:meth:`StepMatrices.solve`), one sparse
+product with ``S₁`` per step instead of a factorisation per β. A matrix that is not positive
+definite (never expected) falls back to SuperLU.
 """
 
 from __future__ import annotations
@@ -23,6 +25,7 @@ from numpy.typing import NDArray
 from scipy.linalg import LinAlgError, cho_solve_banded, cholesky_banded
 from scipy.sparse.linalg import splu
 
+from deformap.errors import InvalidArgumentError
 from deformap.msm._clusters import Clusters
 
 __all__ = ["StepMatrices"]
@@ -94,49 +97,91 @@ class StepMatrices:
         self._band1 = np.bincount(flat, weights=mass * pdat[ff][up], minlength=size).reshape(
             self._bw + 1, nf)
         self._factors: dict[float, object] = {}
+        self._s1_csr: sp.csr_matrix | None = None
 
     def couple(self, beta_fit: float) -> sp.csr_matrix:
         """``(n_free, n_fix)`` block that carries the fixed particles into the free rows."""
         return self.couple_w + beta_fit * self.couple_p
 
-    def solve(self, beta_fit: float, rhs: Array) -> Array:
-        """``K_β⁻¹ rhs`` for ``rhs (n_free, 3)``; factorises ``K_β`` on first use and keeps it."""
+    def prepare(self, beta_fit: float, max_split: float = 0.0) -> float:
+        """Factorise what solving ``beta_fit`` needs and return the β′ whose factorisation it
+        steps with: the largest β′ ≤ ``beta_fit`` already factorised with ``(beta_fit − β′) /
+        (1 − β′) ≤ max_split`` (the splitting of :meth:`solve`), else ``beta_fit`` itself."""
         key = float(beta_fit)
-        fac = self._factors.get(key)
-        if fac is None:
-            fac = self._factor(key)
-            self._factors[key] = fac
+        below = [b for b in self._factors if b <= key and (key - b) / (1.0 - b) <= max_split]
+        if key in self._factors or not below:
+            self._factor_of(key)
+            return key
+        return max(below)
+
+    def solve(self, beta_fit: float, rhs: Array, *, factor_beta: float | None = None,
+              x: Array | None = None) -> Array:
+        """``K_β⁻¹ rhs`` for ``rhs (n_free, 3)``; factorises ``K_β`` on first use and keeps it.
+
+        With ``factor_beta = β′ < beta_fit`` and the current free positions ``x (n_free, 3)``,
+        returns instead ``K_β′⁻¹ (rhs + (β − β′) M⁻¹ Σ_c Π_c x)``, the step of the splitting
+        ``S_β = S_β′ − (β − β′) S₁`` that reuses β′'s factorisation: the same fixed point, and,
+        since ``S₁ ≥ 0`` and ``S_β > 0``, a convergent splitting whose contraction is at most
+        ``(β − β′) / (1 − β′)`` (the generalised eigenvalues of ``(S₁, S₀)`` lie in [0, 1]).
+        """
+        beta = float(beta_fit)
+        key = beta if factor_beta is None else float(factor_beta)
+        fac = self._factor_of(key)
+        scaled = (self._scale[:, None] * rhs)[self._perm]
+        if key != beta:
+            if x is None or key > beta:
+                raise InvalidArgumentError(
+                    "a split step needs `factor_beta` <= `beta_fit` and the positions `x`")
+            scaled += (beta - key) * (self._s1() @ x[self._perm])
+        out = np.empty_like(rhs)
         if isinstance(fac, np.ndarray):
-            out = np.empty_like(rhs)
-            out[self._perm] = cho_solve_banded((fac, False), (self._scale[:, None] * rhs)[
-                self._perm], check_finite=False)
-            return out
-        return np.asarray(fac.solve(rhs))  # type: ignore[attr-defined]
+            out[self._perm] = cho_solve_banded((fac, False), scaled, check_finite=False)
+        else:
+            out[self._perm] = fac.solve(scaled)  # type: ignore[attr-defined]
+        return out
+
+    def _factor_of(self, beta_fit: float) -> object:
+        fac = self._factors.get(beta_fit)
+        if fac is None:
+            fac = self._factor(beta_fit)
+            self._factors[beta_fit] = fac
+        return fac
+
+    def _s1(self) -> sp.csr_matrix:
+        """``S₁`` in band order as a full symmetric sparse matrix (built on first use)."""
+        if self._s1_csr is None:
+            bw, n = self._bw, self._band1.shape[1]
+            r, j = np.nonzero(self._band1)
+            i = j - (bw - r)  # band[bw + i − j, j] = S[i, j], i ≤ j
+            v = self._band1[r, j]
+            off = i != j
+            rows = np.concatenate([i, j[off]])
+            cols = np.concatenate([j, i[off]])
+            self._s1_csr = sp.csr_matrix((np.concatenate([v, v[off]]), (rows, cols)),
+                                         shape=(n, n))
+        return self._s1_csr
 
     def _factor(self, beta_fit: float) -> object:
         band = self._band0 - beta_fit * self._band1
         try:
             return cholesky_banded(band, lower=False, check_finite=False)
         except LinAlgError:
-            return _SparseFallback(band, self._bw, self._scale, self._perm)
+            return _SparseFallback(band, self._bw)
 
 
 class _SparseFallback:
-    """SuperLU of the symmetric band matrix, solving like the banded Cholesky does."""
+    """SuperLU of the symmetric band matrix (in band order), solving like ``cho_solve_banded``."""
 
-    def __init__(self, band: Array, bw: int, scale: Array, perm: NDArray[np.int64]):
+    def __init__(self, band: Array, bw: int):
         n = band.shape[1]
         diags = [band[bw - k, k:] for k in range(bw + 1)]
         upper = sp.diags(diags, list(range(bw + 1)), shape=(n, n))
         full = (upper + sp.triu(upper, k=1).T).tocsc()
         self._lu = splu(full, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.1,
                         options={"SymmetricMode": True})
-        self._scale, self._perm = scale, perm
 
     def solve(self, rhs: Array) -> Array:
-        out = np.empty_like(rhs)
-        out[self._perm] = self._lu.solve((self._scale[:, None] * rhs)[self._perm])
-        return out
+        return np.asarray(self._lu.solve(rhs))
 
 
 def _band_order(fixed: NDArray[np.bool_]) -> NDArray[np.int64]:

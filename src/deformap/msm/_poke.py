@@ -115,7 +115,7 @@ class Equilibrium:
     """
 
     def __init__(self, clusters: Clusters, fixed: NDArray[np.bool_], betas: Array, *,
-                 system: StepMatrices | None = None):
+                 system: StepMatrices | None = None, max_split: float = 0.0):
         self.cl, self.betas = clusters, np.asarray(betas, dtype=float)
         self.system = StepMatrices(clusters, fixed) if system is None else system
         self.free, self.fix = self.system.free, self.system.fix
@@ -124,6 +124,13 @@ class Equilibrium:
             self.fit_weight = np.zeros_like(self.betas)
         else:
             self.rot_weight, self.fit_weight = 1.0 - self.betas, self.betas.copy()
+        # the factorisation each β steps with: its own, or (``max_split`` > 0) a smaller β's
+        # already factorised, through the splitting of :meth:`StepMatrices.solve`, whose
+        # contraction bound ``split`` tightens that β's stopping test (see :meth:`solve`)
+        self.factor_beta = np.empty_like(self.fit_weight)
+        for j in np.argsort(self.fit_weight, kind="stable"):
+            self.factor_beta[j] = self.system.prepare(self.fit_weight[j], max_split)
+        self.split = (self.fit_weight - self.factor_beta) / (1.0 - self.factor_beta)
 
     def _map(self, x: Array, active: NDArray[np.int64]) -> Array:
         """One local–global step ``G(x)`` for the free particles of the ``active`` β."""
@@ -135,8 +142,9 @@ class Equilibrium:
             xa = x[part].reshape(len(part), *cl.shape, 3)
             rot = cl.rotation_term(xa).reshape(len(part), -1, 3)
             for a, j in enumerate(part, start=lo):
-                out[a] = self.system.solve(self.fit_weight[j], self.rot_weight[j]
-                                           * rot[a - lo, self.free] + self.const[j])
+                out[a] = self.system.solve(
+                    self.fit_weight[j], self.rot_weight[j] * rot[a - lo, self.free]
+                    + self.const[j], factor_beta=self.factor_beta[j], x=x[j, self.free])
         return out
 
     def solve(self, x_fixed: Array, force: Array, stiffness: float, tol: float, max_iter: int,
@@ -151,6 +159,11 @@ class Equilibrium:
         ``x0 (B, *grid, 3)``, optional: starting positions (only the free particles' are used, e.g.
         the equilibrium of a nearby β); the rest shape by default. The fixed point does not
         depend on it.
+
+        A β that steps with a smaller β's factorisation (contraction bound ``ρ`` of the splitting,
+        see :meth:`StepMatrices.solve`) stops at ``tol (1 − ρ)`` instead of ``tol``: its steps
+        contract more slowly, and the distance to the fixed point, about ``step / (1 −
+        contraction)``, is then bounded as with its own factorisation.
         """
         cl, nb = self.cl, len(self.betas)
         rest = cl.rest.reshape(-1, 3)
@@ -173,6 +186,7 @@ class Equilibrium:
         prev_g = np.zeros((nb, nf))
         active = np.arange(nb)
         floor = 1e-6 * spacing
+        stop = tol * (1.0 - self.split)
         for it in range(1, max_iter + 1):
             g = self._map(x, active)
             f = (g - x[active][:, self.free]).reshape(len(active), -1)
@@ -181,7 +195,7 @@ class Equilibrium:
             r = step / np.maximum(disp, floor)
             grew = r > resid[active]
             resid[active], iters[active] = r, it
-            done = r < tol
+            done = r < stop[active]
             x_new = g.reshape(len(active), -1).copy()
             for a, j in enumerate(active.tolist()):
                 if done[a]:
@@ -205,7 +219,7 @@ class Equilibrium:
             active = active[~done]
             if active.size == 0:
                 break
-        converged = resid < tol
+        converged = resid < stop
         if not np.all(converged):
             logger.warning("shape matching did not converge for β = %s within %d iterations",
                            self.betas[~converged], max_iter)
