@@ -281,8 +281,9 @@ def estimate_beta(rest_xs: Any, rest_ys: Any, rest_z: Any, deformed_points: Any,
     -----
     E(β) is evaluated on a uniform sweep ``β_j = j / n_beta`` over ``[0, 1)``, each β started
     from the equilibria of those already solved, then (``refine``) on a ``beta_resolution`` grid
-    within one sweep step of the best β (a parabolic search that ends at the grid minimum). Each particle's simulated position is its equilibrium position, which equals its
-    goal ``g_i(β)`` except on the particles that carry the tactile force.
+    within one sweep step of the best β (a parabolic search that ends at the grid minimum). Each
+    particle's simulated position is its equilibrium position, which equals its goal ``g_i(β)``
+    except on the particles that carry the tactile force.
 
     References
     ----------
