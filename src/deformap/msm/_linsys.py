@@ -49,53 +49,43 @@ class StepMatrices:
         self.free = np.flatnonzero(~is_fixed)
         self.fix = np.flatnonzero(is_fixed)
         nf = len(self.free)
-        idx = np.arange(n).reshape(fixed.shape)[None, ..., None].astype(float)
-        members = clusters.gather(idx)[0, ..., 0].astype(np.int64)  # (C, km)
-        nc, kk = members.shape
-        rows = np.broadcast_to(members[:, :, None], (nc, kk, kk)).ravel()
-        cols = np.broadcast_to(members[:, None, :], (nc, kk, kk)).ravel()
-        # row i of cluster c: W_c[i, j] = w_j (centre of mass), Π_c[i, j] = hat[c, i, j]
-        wdat = np.broadcast_to(clusters.w[:, None, :], (nc, kk, kk)).ravel()
         hat = clusters.hat
         self.rigid = hat is None
-        pdat = np.zeros_like(wdat) if hat is None else hat.ravel()
+        count = clusters.count.ravel()
+        mass = clusters.masses.ravel()
+        # every nonzero (i, j) of diag(m) Σ_c W_c and diag(m) Σ_c Π_c, each once
+        i, j, vw, vp = _pair_sums(clusters)
         pos = np.full(n, -1, dtype=np.int64)
         pos[self.free] = np.arange(nf)
         pos[self.fix] = np.arange(len(self.fix))
-        count = clusters.count.ravel()
         # coupling of the free rows to the fixed particles, M⁻¹ Σ_c (W_c + β Π_c)
-        fc = ~is_fixed[rows] & is_fixed[cols]
-        r, c, inv_m = pos[rows[fc]], pos[cols[fc]], 1.0 / count[rows[fc]]
+        fc = ~is_fixed[i] & is_fixed[j]
+        r, c, inv_mm = pos[i[fc]], pos[j[fc]], 1.0 / (mass * count)[i[fc]]
         shape = (nf, len(self.fix))
-        self.couple_w = sp.csr_matrix((wdat[fc] * inv_m, (r, c)), shape=shape)
-        self.couple_p = sp.csr_matrix((pdat[fc] * inv_m, (r, c)), shape=shape)
+        self.couple_w = sp.csr_matrix((vw[fc] * inv_mm, (r, c)), shape=shape)
+        self.couple_p = sp.csr_matrix((vp[fc] * inv_mm, (r, c)), shape=shape)
         # β-part of the constant term: M⁻¹ Σ_c (s − Π p⁰); zero when the features span s.
         if hat is None:
             self.fit_const = np.zeros((nf, 3))
         else:
-            cst = clusters.s - np.einsum("cij,cjd->cid", hat, clusters.p0)
-            summed = clusters.scatter(cst[None])[0] / clusters.count[..., None]
-            self.fit_const = summed.reshape(n, 3)[self.free]
-        self._scale = (clusters.masses.ravel() * count)[self.free]
+            summed = clusters.scatter((clusters.s - hat @ clusters.p0)[None])[0]
+            self.fit_const = (summed / clusters.count[..., None]).reshape(n, 3)[self.free]
+        self._scale = (mass * count)[self.free]
         self._perm = _band_order(fixed)
         # S₀ = diag(m M) − diag(m) Σ_c W_c and S₁ = diag(m) Σ_c Π_c on the free particles, in
         # band order; only the upper triangle is kept (they are symmetric)
         band_pos = np.full(n, -1, dtype=np.int64)
         band_pos[self.free[self._perm]] = np.arange(nf)
-        ff = ~is_fixed[rows] & ~is_fixed[cols]
-        br, bc = band_pos[rows[ff]], band_pos[cols[ff]]
+        ff = ~is_fixed[i] & ~is_fixed[j]
+        br, bc = band_pos[i[ff]], band_pos[j[ff]]
         up = br <= bc
         br, bc = br[up], bc[up]
-        mass = clusters.masses.ravel()[rows[ff][up]]
         self._bw = int(np.max(bc - br)) if bc.size else 0
-        self._upper = (br, bc)
-        flat = (self._bw + br - bc) * nf + bc
-        size = (self._bw + 1) * nf
-        self._band0 = -np.bincount(flat, weights=mass * wdat[ff][up], minlength=size).reshape(
-            self._bw + 1, nf)
+        self._band0 = np.zeros((self._bw + 1, nf))
+        self._band0[self._bw + br - bc, bc] = -vw[ff][up]
         self._band0[self._bw] += self._scale[self._perm]
-        self._band1 = np.bincount(flat, weights=mass * pdat[ff][up], minlength=size).reshape(
-            self._bw + 1, nf)
+        self._band1 = np.zeros((self._bw + 1, nf))
+        self._band1[self._bw + br - bc, bc] = vp[ff][up]
         self._factors: dict[float, object] = {}
         self._s1_csr: sp.csr_matrix | None = None
 
@@ -182,6 +172,44 @@ class _SparseFallback:
 
     def solve(self, rhs: Array) -> Array:
         return np.asarray(self._lu.solve(rhs))
+
+
+def _pair_sums(clusters: Clusters) -> tuple[NDArray[np.int64], NDArray[np.int64], Array, Array]:
+    """Particle pairs ``(i, j)`` sharing a cluster and their sums ``Σ_c m_i W_c[i, j]``,
+    ``Σ_c m_i Π_c[i, j]`` (zeros in rigid mode), each pair once.
+
+    The members ``a`` and ``b`` of every cluster are a fixed grid offset ``δ = b − a`` apart,
+    so the sums are accumulated per offset on particle-shaped arrays (per member ``a``, one
+    addition of all its partners ``b`` over all clusters at once) instead of per (cluster,
+    member, member) entry.
+    """
+    shape, window, cshape = clusters.shape, clusters.window, clusters.cshape
+    members = np.array(list(np.ndindex(*window)))  # (km, nd) offsets in the window
+    n_m, nd = members.shape
+    deltas = (members[None, :, :] - members[:, None, :]).reshape(-1, nd)
+    uniq, which = np.unique(deltas, axis=0, return_inverse=True)
+    which = which.reshape(n_m, n_m)  # which[a, b]: the offset of the pair (a, b)
+    sum_w = np.zeros((len(uniq), *shape))
+    sum_p = np.zeros((len(uniq), *shape))
+    w = np.moveaxis(clusters.w.reshape(*cshape, n_m), -1, 0)  # (km, *cshape)
+    hat = clusters.hat
+    for a in range(n_m):
+        rows = tuple(slice(o, o + c) for o, c in zip(members[a], cshape, strict=True))
+        m_a = clusters.masses[rows]
+        sum_w[(which[a], *rows)] += m_a * w
+        if hat is not None:
+            sum_p[(which[a], *rows)] += m_a * np.moveaxis(hat[:, a, :].reshape(*cshape, n_m),
+                                                          -1, 0)
+    index = np.arange(int(np.prod(shape))).reshape(shape)
+    parts = []
+    for k, delta in enumerate(uniq.tolist()):
+        src = tuple(slice(max(0, -d), n - max(0, d)) for d, n in zip(delta, shape, strict=True))
+        dst = tuple(slice(max(0, d), n - max(0, -d)) for d, n in zip(delta, shape, strict=True))
+        parts.append((index[src].ravel(), index[dst].ravel(), sum_w[k][src].ravel(),
+                      sum_p[k][src].ravel()))
+    i, j, vw, vp = (np.concatenate(p) for p in zip(*parts, strict=True))
+    keep = vw != 0.0  # pairs that share no cluster (e.g. the corners of the offset box)
+    return i[keep], j[keep], vw[keep], vp[keep]
 
 
 def _band_order(fixed: NDArray[np.bool_]) -> NDArray[np.int64]:
