@@ -22,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 from numpy.typing import NDArray
-from scipy.linalg import LinAlgError, cho_solve_banded, cholesky_banded
+from scipy.linalg import LinAlgError, cholesky_banded, get_lapack_funcs
 from scipy.sparse.linalg import splu
 
 from deformap.errors import InvalidArgumentError
@@ -72,6 +72,8 @@ class StepMatrices:
             self.fit_const = (summed / clusters.count[..., None]).reshape(n, 3)[self.free]
         self._scale = (mass * count)[self.free]
         self._perm = _band_order(fixed)
+        self._unperm = np.argsort(self._perm)
+        self._band_scale = self._scale[self._perm]
         # S₀ = diag(m M) − diag(m) Σ_c W_c and S₁ = diag(m) Σ_c Π_c on the free particles, in
         # band order; only the upper triangle is kept (they are symmetric)
         band_pos = np.full(n, -1, dtype=np.int64)
@@ -88,6 +90,7 @@ class StepMatrices:
         self._band1[self._bw + br - bc, bc] = vp[ff][up]
         self._factors: dict[float, object] = {}
         self._s1_csr: sp.csr_matrix | None = None
+        self._pbtrs = get_lapack_funcs("pbtrs", (self._band0,))
 
     def couple(self, beta_fit: float) -> sp.csr_matrix:
         """``(n_free, n_fix)`` block that carries the fixed particles into the free rows."""
@@ -117,18 +120,21 @@ class StepMatrices:
         beta = float(beta_fit)
         key = beta if factor_beta is None else float(factor_beta)
         fac = self._factor_of(key)
-        scaled = (self._scale[:, None] * rhs)[self._perm]
+        # np.take: several times faster than fancy indexing on (n, 3) rows
+        scaled = np.take(rhs, self._perm, axis=0)
+        scaled *= self._band_scale[:, None]
         if key != beta:
             if x is None or key > beta:
                 raise InvalidArgumentError(
                     "a split step needs `factor_beta` <= `beta_fit` and the positions `x`")
-            scaled += (beta - key) * (self._s1() @ x[self._perm])
-        out = np.empty_like(rhs)
+            scaled += (beta - key) * (self._s1() @ np.take(x, self._perm, axis=0))
         if isinstance(fac, np.ndarray):
-            out[self._perm] = cho_solve_banded((fac, False), scaled, check_finite=False)
+            sol, info = self._pbtrs(fac, scaled, lower=0)
+            if info != 0:
+                raise LinAlgError(f"banded Cholesky solve failed (LAPACK info {info})")
         else:
-            out[self._perm] = fac.solve(scaled)  # type: ignore[attr-defined]
-        return out
+            sol = fac.solve(scaled)  # type: ignore[attr-defined]
+        return np.take(sol, self._unperm, axis=0)
 
     def _factor_of(self, beta_fit: float) -> object:
         fac = self._factors.get(beta_fit)
