@@ -135,19 +135,22 @@ class _Sweep:
 
     def _start(self, beta: float) -> Array | None:
         """Starting positions for ``beta``: its own loosely solved equilibrium, else linear in
-        ``1 / (1 − β)`` through the two nearest solved β (the scale on which the dent deepens,
-        see :func:`_vertex`), or a copy of the only one; ``None`` (the model's own start) when no
-        β is solved yet."""
+        ``v = 1 / (1 − β)`` through the two nearest solved β (the scale on which the dent
+        deepens, see :func:`_vertex`), or the only one's displacements scaled by the ratio of
+        ``v``; ``None`` (the model's own start) when no β is solved yet."""
         if beta in self._body:
             return self._body[beta]
         if not self._body:
             return None
         known = np.fromiter(self._body, dtype=float)
         near = known[np.argsort(np.abs(known - beta), kind="stable")[:2]]
+        v = 1.0 / (1.0 - beta)
         if near.size == 1:
-            return self._body[float(near[0])]
+            b0 = float(near[0])
+            rest = self.model.clusters.rest
+            return rest + (self._body[b0] - rest) * (v * (1.0 - b0))
         b0, b1 = float(near[0]), float(near[1])
-        v, v0, v1 = 1.0 / (1.0 - beta), 1.0 / (1.0 - b0), 1.0 / (1.0 - b1)
+        v0, v1 = 1.0 / (1.0 - b0), 1.0 / (1.0 - b1)
         t = (v - v0) / (v1 - v0)
         return (1.0 - t) * self._body[b0] + t * self._body[b1]
 
