@@ -68,7 +68,8 @@ class PokeSimulation:
     residual : (B,) float
         Last relative fixed-point update (largest particle move over the largest displacement).
     converged : (B,) bool
-        ``residual < config.tol`` before ``config.max_iter``.
+        ``residual < config.tol`` before ``config.max_iter`` (``tol (1 − ρ)`` for a β that
+        stepped with a smaller β's factorisation, see :meth:`Equilibrium.solve`).
     protocol : str
         ``"force"`` or ``"pinned"``.
     stiffness_n_per_m : float or None
