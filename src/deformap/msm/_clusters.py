@@ -81,11 +81,12 @@ def polar_components(m: Array, *, tol: float = 1e-14, max_iter: int = 30) -> Arr
     step = np.inf
     for _ in range(max_iter):
         cof, det = _cofactors(cur)
-        # determinant scaling γ = |det X|^(-1/3) (Higham 1986, §3): no extra norms to compute
+        # determinant scaling γ = |det X|^(-1/3) (Higham 1986, §3): no extra norms to compute;
+        # X ← (X / c + c X⁻ᵀ) / 2 with c = ∛det, the halving folded into the n-long factors
         gamma = np.cbrt(det)
-        new = cur / gamma
-        new += cof / (det / gamma)
-        new *= 0.5
+        new = cur * (0.5 / gamma)
+        cof *= 0.5 * gamma / det
+        new += cof
         diff = cur - new  # not in place: ``cur`` may be ``x``, which the SVD fallback reads
         np.abs(diff, out=diff)
         step = float(diff.max()) if diff.size else 0.0
@@ -109,9 +110,12 @@ def _cofactors(m: Array) -> tuple[Array, Array]:
     """Cofactor matrices ``(9, n)`` and determinants ``(n,)`` of ``(9, n)`` row-major 3×3
     matrices (``X⁻ᵀ = cof(X) / det X``)."""
     a, b, c, d, e, f, g, h, i = m
-    cof = np.stack([e * i - f * h, f * g - d * i, d * h - e * g,
-                    c * h - b * i, a * i - c * g, b * g - a * h,
-                    b * f - c * e, c * d - a * f, a * e - b * d])
+    cof = np.empty_like(m)
+    for row, (p, q, r, t) in enumerate(((e, i, f, h), (f, g, d, i), (d, h, e, g),
+                                        (c, h, b, i), (a, i, c, g), (b, g, a, h),
+                                        (b, f, c, e), (c, d, a, f), (a, e, b, d))):
+        np.multiply(p, q, out=cof[row])
+        cof[row] -= r * t
     det = a * cof[0] + b * cof[1] + c * cof[2]
     return cof, det
 
