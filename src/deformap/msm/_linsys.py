@@ -185,9 +185,8 @@ def _pair_sums(clusters: Clusters) -> tuple[NDArray[np.int64], NDArray[np.int64]
     ``Σ_c m_i Π_c[i, j]`` (zeros in rigid mode), each pair once.
 
     The members ``a`` and ``b`` of every cluster are a fixed grid offset ``δ = b − a`` apart,
-    so the sums are accumulated per offset on particle-shaped arrays (per member ``a``, one
-    addition of all its partners ``b`` over all clusters at once) instead of per (cluster,
-    member, member) entry.
+    so the sums are accumulated per offset on particle-shaped arrays (one slice addition per
+    member pair, over all clusters at once) instead of per (cluster, member, member) entry.
     """
     shape, window, cshape = clusters.shape, clusters.window, clusters.cshape
     members = np.array(list(np.ndindex(*window)))  # (km, nd) offsets in the window
@@ -197,15 +196,19 @@ def _pair_sums(clusters: Clusters) -> tuple[NDArray[np.int64], NDArray[np.int64]
     which = which.reshape(n_m, n_m)  # which[a, b]: the offset of the pair (a, b)
     sum_w = np.zeros((len(uniq), *shape))
     sum_p = np.zeros((len(uniq), *shape))
-    w = np.moveaxis(clusters.w.reshape(*cshape, n_m), -1, 0)  # (km, *cshape)
-    hat = clusters.hat
+    # member-major copies: each (a, b) slice below is then contiguous
+    w = np.ascontiguousarray(np.moveaxis(clusters.w.reshape(*cshape, n_m), -1, 0))
+    hat = None
+    if clusters.hat is not None:
+        hat = np.ascontiguousarray(np.moveaxis(clusters.hat.reshape(*cshape, n_m, n_m),
+                                               (-2, -1), (0, 1)))
     for a in range(n_m):
         rows = tuple(slice(o, o + c) for o, c in zip(members[a], cshape, strict=True))
         m_a = clusters.masses[rows]
-        sum_w[(which[a], *rows)] += m_a * w
-        if hat is not None:
-            sum_p[(which[a], *rows)] += m_a * np.moveaxis(hat[:, a, :].reshape(*cshape, n_m),
-                                                          -1, 0)
+        for b in range(n_m):
+            sum_w[which[a, b]][rows] += m_a * w[b]
+            if hat is not None:
+                sum_p[which[a, b]][rows] += m_a * hat[a, b]
     index = np.arange(int(np.prod(shape))).reshape(shape)
     parts = []
     for k, delta in enumerate(uniq.tolist()):
