@@ -404,3 +404,28 @@ def test_refinement_search_finds_the_grid_minimum_of_any_unimodal_curve(seed):
     found = min(tight, key=lambda b: (fake.errors[b], b))
     assert found == pytest.approx(grid[np.argmin([curve(b) for b in grid])])
     assert len(tight) <= 8
+
+
+def test_failed_in_place_factorisation_falls_back_to_the_intact_matrix(rng):
+    # the banded Cholesky overwrites its input; a matrix that is not positive definite
+    # (β > 1 here, never reached by the estimate) must still be solved exactly by SuperLU
+    import scipy.sparse as sp
+
+    from deformap.msm._clusters import Clusters
+    from deformap.msm._linsys import StepMatrices, _SparseFallback
+    from deformap.msm._simulate import _body
+
+    xs, ys, z, _, _ = dent_case(60, n=9)
+    g = _grid(xs, ys, z)
+    body, body_m, body_fixed, window = _body(g.rest, g.masses, g.fixed, g.spacing_m,
+                                             ShapeMatchingConfig())
+    sm = StepMatrices(Clusters(body, body_m, window, "quadratic", 1e-3), body_fixed)
+    rhs = rng.normal(size=(len(sm.free), 3))
+    x = sm.solve(1.5, rhs)
+    assert isinstance(sm._factors[1.5], _SparseFallback)
+    band, bw = sm._band0 - 1.5 * sm._band1, sm._bw
+    n = band.shape[1]
+    upper = sp.diags([band[bw - k, k:] for k in range(bw + 1)], list(range(bw + 1)), shape=(n, n))
+    full = (upper + sp.triu(upper, k=1).T).tocsr()
+    np.testing.assert_allclose(full @ x[sm._perm], (sm._scale[:, None] * rhs)[sm._perm],
+                               rtol=0, atol=1e-10)

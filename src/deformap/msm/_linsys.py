@@ -83,10 +83,11 @@ class StepMatrices:
         up = br <= bc
         br, bc = br[up], bc[up]
         self._bw = int(np.max(bc - br)) if bc.size else 0
-        self._band0 = np.zeros((self._bw + 1, nf))
+        # column-major, as LAPACK stores bands: a factorisation then copies nothing
+        self._band0 = np.zeros((self._bw + 1, nf), order="F")
         self._band0[self._bw + br - bc, bc] = -vw[ff][up]
         self._band0[self._bw] += self._scale[self._perm]
-        self._band1 = np.zeros((self._bw + 1, nf))
+        self._band1 = np.zeros((self._bw + 1, nf), order="F")
         self._band1[self._bw + br - bc, bc] = vp[ff][up]
         self._factors: dict[float, object] = {}
         self._s1_csr: sp.csr_matrix | None = None
@@ -158,11 +159,12 @@ class StepMatrices:
         return self._s1_csr
 
     def _factor(self, beta_fit: float) -> object:
-        band = self._band0 - beta_fit * self._band1
+        band = np.multiply(self._band1, -beta_fit, order="F")
+        band += self._band0
         try:
-            return cholesky_banded(band, lower=False, check_finite=False)
-        except LinAlgError:
-            return _SparseFallback(band, self._bw)
+            return cholesky_banded(band, overwrite_ab=True, lower=False, check_finite=False)
+        except LinAlgError:  # ``band`` was overwritten by the failed factorisation
+            return _SparseFallback(self._band0 - beta_fit * self._band1, self._bw)
 
 
 class _SparseFallback:
