@@ -294,8 +294,8 @@ def test_banded_step_solve_inverts_the_cluster_operator(rng, beta):
     mapped = (cl.scatter(per[None])[0] / cl.count[..., None]).reshape(-1, 3)
     np.testing.assert_allclose((full - mapped)[sm.free], rhs, rtol=0, atol=1e-10)
     band = sm._band0 - beta * sm._band1
-    lu = _SparseFallback(band, sm._bw, sm._scale, sm._perm)
-    np.testing.assert_allclose(lu.solve(rhs), x, rtol=0, atol=1e-10)
+    sm._factors[float(beta)] = _SparseFallback(band, sm._bw)
+    np.testing.assert_allclose(sm.solve(beta, rhs), x, rtol=0, atol=1e-10)
 
 
 def test_refinement_finds_the_minimum_of_the_exhaustive_grid():
@@ -317,3 +317,115 @@ def test_refinement_finds_the_minimum_of_the_exhaustive_grid():
     errors = matching_error(sim.positions, cKDTree(pts))
     assert est.beta == pytest.approx(grid[np.argmin(errors)])
     assert est.betas.size < cfg.n_beta + grid.size / 2  # far fewer solves than the grid
+
+
+def test_shared_factorisation_gives_the_equilibrium_of_a_fresh_one():
+    # a β stepping with a smaller β's factorisation (the splitting S_β = S_β′ − (β − β′) S₁)
+    # must reach the equilibrium of its own factorisation, to the solver's tolerance
+    from deformap.msm._simulate import PokeModel
+
+    xs, ys, z, _, contact = dent_case(60, n=13)
+    g = _grid(xs, ys, z)
+    cfg = ShapeMatchingConfig()
+    own = PokeModel(g.rest, g.masses, g.fixed, contact, cfg)
+    shared = PokeModel(g.rest, g.masses, g.fixed, contact, cfg,
+                       stiffness_n_per_m=own.stiffness)
+    betas = np.array([0.3, 0.45, 0.6])
+    sim_own, x_own = own.solve(betas, tol=1e-9)
+    shared.solve(np.array([0.3]), tol=1e-9)
+    sim_shared, x_shared = shared.solve(betas, tol=1e-9, max_split=0.5)
+    assert sorted(shared.system._factors) == [0.3]  # 0.45 and 0.6 stepped with β′ = 0.3
+    assert sorted(own.system._factors) == [0.0, 0.3, 0.45, 0.6]
+    assert sim_shared.converged.all() and sim_own.converged.all()
+    split = (betas - 0.3) / (1.0 - 0.3)  # a split step stops at tol (1 − ρ)
+    assert np.all(sim_shared.residual < 1e-9 * (1.0 - split))
+    dent = np.abs(x_own - own.clusters.rest[None]).max()
+    np.testing.assert_allclose(x_shared, x_own, rtol=0, atol=1e-7 * dent)
+
+
+def test_split_step_needs_a_smaller_factorised_beta_and_the_positions(rng):
+    from deformap.errors import InvalidArgumentError
+    from deformap.msm._clusters import Clusters
+    from deformap.msm._linsys import StepMatrices
+    from deformap.msm._simulate import _body
+
+    xs, ys, z, _, _ = dent_case(60, n=9)
+    g = _grid(xs, ys, z)
+    body, body_m, body_fixed, window = _body(g.rest, g.masses, g.fixed, g.spacing_m,
+                                             ShapeMatchingConfig())
+    sm = StepMatrices(Clusters(body, body_m, window, "quadratic", 1e-3), body_fixed)
+    assert sm.prepare(0.5, max_split=0.3) == 0.5  # nothing factorised below
+    assert sm.prepare(0.6, max_split=0.3) == 0.5  # (0.6 − 0.5) / 0.5 = 0.2
+    assert sm.prepare(0.9, max_split=0.3) == 0.9  # (0.9 − 0.5) / 0.5 = 0.8
+    assert sm.prepare(0.95, max_split=0.0) == 0.95
+    rhs = rng.normal(size=(len(sm.free), 3))
+    with pytest.raises(InvalidArgumentError, match="split"):
+        sm.solve(0.6, rhs, factor_beta=0.5)
+    with pytest.raises(InvalidArgumentError, match="split"):
+        sm.solve(0.5, rhs, factor_beta=0.6, x=rhs)
+    # one split step from the exact solution returns it
+    x = sm.solve(0.6, rhs)
+    np.testing.assert_allclose(sm.solve(0.6, rhs, factor_beta=0.5, x=x), x, rtol=0, atol=1e-10)
+
+
+@pytest.mark.parametrize("seed", range(20))
+def test_refinement_search_finds_the_grid_minimum_of_any_unimodal_curve(seed):
+    # the parabolic search only chooses which β to solve: on any unimodal E it must stop at the
+    # argmin of the exhaustive grid (here E is a function, the "solves" are look-ups)
+    from deformap.msm._beta import _refine
+
+    r = np.random.default_rng(seed)
+    centre, power = r.uniform(0.0, 0.99), r.uniform(1.0, 3.0)
+    scale = (lambda b: b) if seed % 2 else (lambda b: 1.0 / (1.0 - b))  # symmetric or skewed
+
+    def curve(b):
+        return float(abs(scale(b) - scale(centre)) ** power)
+
+    class _Fake:
+        def __init__(self):
+            self.errors, self.tols = {}, {}
+
+        def solved(self, b, tol):
+            return self.tols.get(b, np.inf) <= tol
+
+        def run(self, betas, tol):
+            for b in np.round(betas, 10):
+                if not self.solved(float(b), tol):
+                    self.errors[float(b)], self.tols[float(b)] = curve(float(b)), tol
+
+    fake = _Fake()
+    fake.run(np.arange(10) / 10, 1e-4)
+    _refine(fake, 0.1, 0.01, 1e-6)  # type: ignore[arg-type]
+    coarse = np.arange(10) / 10
+    best = coarse[np.argmin([curve(b) for b in coarse])]
+    grid = np.round(np.arange(-10, 11) * 0.01 + best, 10)
+    grid = grid[(grid >= 0) & (grid < 1)]
+    tight = [b for b in fake.errors if fake.tols[b] == 1e-6]
+    found = min(tight, key=lambda b: (fake.errors[b], b))
+    assert found == pytest.approx(grid[np.argmin([curve(b) for b in grid])])
+    assert len(tight) <= 8
+
+
+def test_failed_in_place_factorisation_falls_back_to_the_intact_matrix(rng):
+    # the banded Cholesky overwrites its input; a matrix that is not positive definite
+    # (β > 1 here, never reached by the estimate) must still be solved exactly by SuperLU
+    import scipy.sparse as sp
+
+    from deformap.msm._clusters import Clusters
+    from deformap.msm._linsys import StepMatrices, _SparseFallback
+    from deformap.msm._simulate import _body
+
+    xs, ys, z, _, _ = dent_case(60, n=9)
+    g = _grid(xs, ys, z)
+    body, body_m, body_fixed, window = _body(g.rest, g.masses, g.fixed, g.spacing_m,
+                                             ShapeMatchingConfig())
+    sm = StepMatrices(Clusters(body, body_m, window, "quadratic", 1e-3), body_fixed)
+    rhs = rng.normal(size=(len(sm.free), 3))
+    x = sm.solve(1.5, rhs)
+    assert isinstance(sm._factors[1.5], _SparseFallback)
+    band, bw = sm._band0 - 1.5 * sm._band1, sm._bw
+    n = band.shape[1]
+    upper = sp.diags([band[bw - k, k:] for k in range(bw + 1)], list(range(bw + 1)), shape=(n, n))
+    full = (upper + sp.triu(upper, k=1).T).tocsr()
+    np.testing.assert_allclose(full @ x[sm._perm], (sm._scale[:, None] * rhs)[sm._perm],
+                               rtol=0, atol=1e-10)

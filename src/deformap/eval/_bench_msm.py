@@ -1,12 +1,13 @@
-"""Benchmark of the β estimation: one batched sweep against a naive per-β loop, same run.
+"""Benchmark of the β estimation: the estimate against a naive per-β loop, same run.
 
 Both sides compute the same thing: the converged poke equilibrium of every β that
 :func:`deformap.msm.estimate_beta` visits (the coarse uniform sweep plus the refinement to 0.01)
 and E(β) for each, on a Hertz dent of a 60 N foam (an elastic half-space, not shape matching) with
-0.1 mm of seeded observation noise. The estimate sets the ROI up once, solves the sweep in one
-batch and starts each refinement β from the β already solved; the naive loop simulates each of
-the same β on its own, to the same tolerance (its own set-up and factorisation, started from
-rest), reusing only the calibrated stiffness. "n_beta" is the number of β values simulated.
+0.1 mm of seeded observation noise. The estimate sets the ROI up once, starts each β from the
+β already solved and shares banded factorisations between nearby β; the naive loop simulates
+each of the same β on its own, to the same tolerance (its own set-up and factorisation, started
+from rest), reusing only the calibrated stiffness. "n_beta" is the number of β values simulated
+("batched_s" is the estimate's time, a name kept from when the sweep was one batch).
 """
 
 from __future__ import annotations
@@ -28,6 +29,8 @@ __all__ = ["bench_beta_sweep"]
 
 _SPACING_M = 0.005
 _NOISE_M = 1e-4
+_TIGHT_ATOL_M = 1e-6
+_LOOSE_ATOL_M = 3e-6
 
 
 def bench_beta_sweep(*, n_particles_side: int = 40, cluster_size: int = 3,
@@ -65,8 +68,14 @@ def bench_beta_sweep(*, n_particles_side: int = 40, cluster_size: int = 3,
     t0 = time.perf_counter()
     loop_errors = per_beta_loop(grid, tree, contact, est, cfg)
     loop = time.perf_counter() - t0
-    if not np.allclose(loop_errors, est.errors, rtol=0, atol=1e-6):
-        raise RuntimeError("the per-β loop disagrees with the batched sweep by more than 1 µm")
+    # a β solved only to the loose sweep tolerance is good to about a micrometre of E (both sides
+    # stop within ``sweep_tol`` of the fixed point, from different starts); tight ones agree far
+    # better
+    atol = np.where(est.tolerances > cfg.tol, _LOOSE_ATOL_M, _TIGHT_ATOL_M)
+    if np.any(np.abs(np.asarray(loop_errors) - est.errors) > atol):
+        raise RuntimeError("the per-β loop disagrees with the estimate by more than "
+                           f"{_TIGHT_ATOL_M * 1e6:g} µm (β solved to `tol`) or "
+                           f"{_LOOSE_ATOL_M * 1e6:g} µm (to `sweep_tol`)")
     return {"n_beta": int(est.betas.size), "n_particles": n * n, "batched_s": batched,
             "loop_s": loop, "speedup": loop / batched}
 

@@ -2,9 +2,10 @@
 
 A poke is simulated for every β of a sweep at once, as the converged steady state of position-based
 shape matching (:func:`simulate_poke`), and β̂ minimises the paper's E(β), the mean distance from
-the simulated surface to the observed deformed one (:func:`estimate_beta`: a coarse batched sweep,
+the simulated surface to the observed deformed one (:func:`estimate_beta`: a coarse sweep,
 then a search on the ``beta_resolution`` grid around its minimum, each β started from the nearby
-solved ones; the ROI's clusters and each β's banded Cholesky factorisation are computed once).
+solved ones; the ROI's clusters and the banded Cholesky factorisations, shared by nearby β, are
+computed once).
 
 Two protocols (``ShapeMatchingConfig.contact``):
 

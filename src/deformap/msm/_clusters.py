@@ -81,11 +81,12 @@ def polar_components(m: Array, *, tol: float = 1e-14, max_iter: int = 30) -> Arr
     step = np.inf
     for _ in range(max_iter):
         cof, det = _cofactors(cur)
-        # determinant scaling γ = |det X|^(-1/3) (Higham 1986, §3): no extra norms to compute
+        # determinant scaling γ = |det X|^(-1/3) (Higham 1986, §3): no extra norms to compute;
+        # X ← (X / c + c X⁻ᵀ) / 2 with c = ∛det, the halving folded into the n-long factors
         gamma = np.cbrt(det)
-        new = cur / gamma
-        new += cof / (det / gamma)
-        new *= 0.5
+        new = cur * (0.5 / gamma)
+        cof *= 0.5 * gamma / det
+        new += cof
         diff = cur - new  # not in place: ``cur`` may be ``x``, which the SVD fallback reads
         np.abs(diff, out=diff)
         step = float(diff.max()) if diff.size else 0.0
@@ -109,9 +110,12 @@ def _cofactors(m: Array) -> tuple[Array, Array]:
     """Cofactor matrices ``(9, n)`` and determinants ``(n,)`` of ``(9, n)`` row-major 3×3
     matrices (``X⁻ᵀ = cof(X) / det X``)."""
     a, b, c, d, e, f, g, h, i = m
-    cof = np.stack([e * i - f * h, f * g - d * i, d * h - e * g,
-                    c * h - b * i, a * i - c * g, b * g - a * h,
-                    b * f - c * e, c * d - a * f, a * e - b * d])
+    cof = np.empty_like(m)
+    for row, (p, q, r, t) in enumerate(((e, i, f, h), (f, g, d, i), (d, h, e, g),
+                                        (c, h, b, i), (a, i, c, g), (b, g, a, h),
+                                        (b, f, c, e), (c, d, a, f), (a, e, b, d))):
+        np.multiply(p, q, out=cof[row])
+        cof[row] -= r * t
     det = a * cof[0] + b * cof[1] + c * cof[2]
     return cof, det
 
@@ -154,6 +158,8 @@ class Clusters:
         self.ws = self.w[..., None] * self.s
         ones = np.ones((1, self.n_clusters, self.n_members, 1))
         self.count = self.scatter(ones)[0, ..., 0]
+        # eigen-decomposition of the rest moment Σ w s sᵀ: the planar frames and the linear fit
+        self._moment = np.linalg.eigh(np.swapaxes(self.ws, 1, 2) @ self.s)
         self.hat = None if mode == "rigid" else self._hat_matrices(regularization)
         self._planar_frames()
 
@@ -188,20 +194,24 @@ class Clusters:
     def features(self) -> tuple[Array, Array | None]:
         """Centred features ``(C, km, 3)`` ``s / L`` and, in quadratic mode, ``(C, km, 6)`` the
         quadratic terms ``sx², sy², sz², sx sy, sy sz, sz sx`` of ``s / L`` (centred)."""
-        radius = np.sqrt(np.einsum("cj,cjd->c", self.w, self.s**2))
-        q = self.s / np.maximum(radius, np.finfo(float).tiny)[:, None, None]
+        q = self.s / np.maximum(self._radius(), np.finfo(float).tiny)[:, None, None]
         if self.mode != "quadratic":
             return q, None
         x, y, z = q[..., 0], q[..., 1], q[..., 2]
         quad = np.stack([x * x, y * y, z * z, x * y, y * z, z * x], axis=-1)
-        quad -= np.einsum("cj,cjf->cf", self.w, quad)[:, None, :]
+        quad -= (self.w[:, None, :] @ quad)
         return q, quad
 
-    def _projection(self, q: Array, cutoff: Array) -> Array:
-        """``Π[i, j] = q_iᵀ A_qq⁺ q_j w_j``, dropping eigenvalues of ``A_qq`` below ``cutoff``."""
+    def _radius(self) -> Array:
+        """RMS radius ``√(Σ w |s|²)`` of each cluster (the trace of its rest moment)."""
+        return np.asarray(np.sqrt(np.maximum(np.sum(self._moment[0], axis=1), 0.0)))
+
+    def _projection(self, q: Array, cutoff: Array,
+                    eig: tuple[Array, Array] | None = None) -> Array:
+        """``Π[i, j] = q_iᵀ A_qq⁺ q_j w_j``, dropping eigenvalues of ``A_qq`` below ``cutoff``
+        (``eig``: the eigen-decomposition of ``A_qq`` if already known)."""
         wq = self.w[..., None] * q
-        aqq = np.swapaxes(wq, 1, 2) @ q
-        lam, vec = np.linalg.eigh(aqq)
+        lam, vec = np.linalg.eigh(np.swapaxes(wq, 1, 2) @ q) if eig is None else eig
         keep = lam > cutoff[:, None]
         inv = np.where(keep, 1.0 / np.where(keep, lam, 1.0), 0.0)
         aqq_pinv = (vec * inv[:, None, :]) @ np.swapaxes(vec, 1, 2)
@@ -215,11 +225,15 @@ class Clusters:
         never spoils the exact fit of rigid and affine motions. Both blocks drop eigenvalues below
         ``regularization`` times the largest linear moment.
         """
-        q, quad = self.features()
-        lam_max = np.linalg.eigvalsh(np.einsum("cj,cjf,cjg->cfg", self.w, q, q))[:, -1]
-        cutoff = regularization * lam_max
-        hat = self._projection(q, cutoff)
+        _, quad = self.features()
+        lam = self._moment[0]
+        # the linear fit on s itself: the projection and the relative cut-off do not depend on
+        # the scale of the features, and the rest moment is already decomposed
+        hat = self._projection(self.s, regularization * lam[:, -1], self._moment)
         if quad is not None:
+            # the quadratic features are built from s / L: their cut-off in the same units
+            cutoff = regularization * lam[:, -1] / np.maximum(self._radius(),
+                                                              np.finfo(float).tiny) ** 2
             hat = hat + self._projection(quad - hat @ quad, cutoff)
         return hat
 
@@ -312,8 +326,7 @@ class Clusters:
 
     def _planar_frames(self) -> None:
         """Rest normal ``n`` and in-plane axes ``u × v = n`` of the exactly planar clusters."""
-        aqq = np.einsum("cj,cjd,cje->cde", self.w, self.s, self.s)
-        lam, vec = np.linalg.eigh(aqq)
+        lam, vec = self._moment
         self.planar = lam[:, 0] <= 1e-12 * lam[:, 2]
         self.normal = vec[:, :, 0]
         self.u_axis = vec[:, :, 1]

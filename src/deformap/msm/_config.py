@@ -32,14 +32,16 @@ class ShapeMatchingConfig:
         instead of being copied from the observation. See :func:`~deformap.msm.simulate_poke`.
     n_beta : int
         Number of β values of the coarse uniform sweep ``β_j = j / n_beta`` over ``[0, 1)``
-        (solved in one batch). E(β) is smooth, so 10 values (a step of 0.1) bracket its minimum;
-        the refinement then finds β̂ to ``beta_resolution``.
+        (solved in increasing order, each started from the β already solved). E(β) is smooth, so
+        10 values (a step of 0.1) bracket its minimum; the refinement then finds β̂ to
+        ``beta_resolution``.
     refine : bool
         Refine around the sweep's minimum down to ``beta_resolution``: on the
-        ``beta_resolution`` grid within one sweep step of the best swept β, start at the vertex
-        of the parabola through the best swept β and its neighbours and walk downhill until the
-        lowest grid point has both grid neighbours solved (a handful of further solves, each
-        started from the equilibrium of the nearest β already solved).
+        ``beta_resolution`` grid within one sweep step of the best swept β, solve one grid point
+        at a time, at the vertex of the parabola (in ``1 / (1 − β)``) through the lowest β
+        solved so far and its neighbours, until the lowest grid point has both grid neighbours
+        solved (three to five further solves, each started from the equilibria of the nearest β
+        already solved).
     beta_resolution : float
         Step of the local refinement (dimensionless).
     tol : float

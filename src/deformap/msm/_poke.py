@@ -68,7 +68,8 @@ class PokeSimulation:
     residual : (B,) float
         Last relative fixed-point update (largest particle move over the largest displacement).
     converged : (B,) bool
-        ``residual < config.tol`` before ``config.max_iter``.
+        ``residual < config.tol`` before ``config.max_iter`` (``tol (1 − ρ)`` for a β that
+        stepped with a smaller β's factorisation, see :meth:`Equilibrium.solve`).
     protocol : str
         ``"force"`` or ``"pinned"``.
     stiffness_n_per_m : float or None
@@ -115,7 +116,7 @@ class Equilibrium:
     """
 
     def __init__(self, clusters: Clusters, fixed: NDArray[np.bool_], betas: Array, *,
-                 system: StepMatrices | None = None):
+                 system: StepMatrices | None = None, max_split: float = 0.0):
         self.cl, self.betas = clusters, np.asarray(betas, dtype=float)
         self.system = StepMatrices(clusters, fixed) if system is None else system
         self.free, self.fix = self.system.free, self.system.fix
@@ -124,19 +125,28 @@ class Equilibrium:
             self.fit_weight = np.zeros_like(self.betas)
         else:
             self.rot_weight, self.fit_weight = 1.0 - self.betas, self.betas.copy()
+        # the factorisation each β steps with: its own, or (``max_split`` > 0) a smaller β's
+        # already factorised, through the splitting of :meth:`StepMatrices.solve`, whose
+        # contraction bound ``split`` tightens that β's stopping test (see :meth:`solve`)
+        self.factor_beta = np.empty_like(self.fit_weight)
+        for j in np.argsort(self.fit_weight, kind="stable"):
+            self.factor_beta[j] = self.system.prepare(self.fit_weight[j], max_split)
+        self.split = (self.fit_weight - self.factor_beta) / (1.0 - self.factor_beta)
 
-    def _map(self, x: Array, active: NDArray[np.int64]) -> Array:
-        """One local–global step ``G(x)`` for the free particles of the ``active`` β."""
+    def _map(self, x: Array, x_free: Array, active: NDArray[np.int64]) -> Array:
+        """One local–global step ``G(x)`` for the free particles of the ``active`` β
+        (``x (B, n, 3)`` all positions, ``x_free (B, n_free, 3)`` the free ones)."""
         cl = self.cl
         out = np.empty((len(active), len(self.free), 3))
         # a few β per batch: the per-cluster temporaries of larger batches fall out of cache
         for lo in range(0, len(active), _ROT_BATCH):
             part = active[lo : lo + _ROT_BATCH]
             xa = x[part].reshape(len(part), *cl.shape, 3)
-            rot = cl.rotation_term(xa).reshape(len(part), -1, 3)
+            rot = np.take(cl.rotation_term(xa).reshape(len(part), -1, 3), self.free, axis=1)
             for a, j in enumerate(part, start=lo):
-                out[a] = self.system.solve(self.fit_weight[j], self.rot_weight[j]
-                                           * rot[a - lo, self.free] + self.const[j])
+                out[a] = self.system.solve(
+                    self.fit_weight[j], self.rot_weight[j] * rot[a - lo] + self.const[j],
+                    factor_beta=self.factor_beta[j], x=x_free[j])
         return out
 
     def solve(self, x_fixed: Array, force: Array, stiffness: float, tol: float, max_iter: int,
@@ -151,6 +161,11 @@ class Equilibrium:
         ``x0 (B, *grid, 3)``, optional: starting positions (only the free particles' are used, e.g.
         the equilibrium of a nearby β); the rest shape by default. The fixed point does not
         depend on it.
+
+        A β that steps with a smaller β's factorisation (contraction bound ``ρ`` of the splitting,
+        see :meth:`StepMatrices.solve`) stops at ``tol (1 − ρ)`` instead of ``tol``: its steps
+        contract more slowly, and the distance to the fixed point, about ``step / (1 −
+        contraction)``, is then bounded as with its own factorisation.
         """
         cl, nb = self.cl, len(self.betas)
         rest = cl.rest.reshape(-1, 3)
@@ -163,6 +178,12 @@ class Equilibrium:
         if x0 is not None:
             x[:, self.free] = np.asarray(x0).reshape(nb, -1, 3)[:, self.free]
         x[:, self.fix] = x_fixed
+        # the free positions, kept in step with ``x`` (flat indices: np.take / put on the
+        # flattened rows are several times faster than fancy indexing of (n, 3) rows)
+        x_free = np.take(x, self.free, axis=1)
+        flat_free = (3 * self.free[:, None] + np.arange(3)).ravel()
+        rest_free = np.take(rest, self.free, axis=0)
+        x_rows = x.reshape(nb, -1)  # a view: x is contiguous
         nf = len(self.free) * 3
         iters = np.zeros(nb, dtype=np.int64)
         resid = np.full(nb, np.inf)
@@ -173,15 +194,16 @@ class Equilibrium:
         prev_g = np.zeros((nb, nf))
         active = np.arange(nb)
         floor = 1e-6 * spacing
+        stop = tol * (1.0 - self.split)
         for it in range(1, max_iter + 1):
-            g = self._map(x, active)
-            f = (g - x[active][:, self.free]).reshape(len(active), -1)
-            step = np.max(np.linalg.norm(f.reshape(len(active), -1, 3), axis=2), axis=1)
-            disp = np.max(np.linalg.norm(g - rest[self.free], axis=2), axis=1)
+            g = self._map(x, x_free, active)
+            f = (g - x_free[active]).reshape(len(active), -1)
+            step = np.sqrt(np.max(_row_norm2(f.reshape(g.shape)), axis=1))
+            disp = np.sqrt(np.max(_row_norm2(g - rest_free), axis=1))
             r = step / np.maximum(disp, floor)
             grew = r > resid[active]
             resid[active], iters[active] = r, it
-            done = r < tol
+            done = r < stop[active]
             x_new = g.reshape(len(active), -1).copy()
             for a, j in enumerate(active.tolist()):
                 if done[a]:
@@ -200,16 +222,23 @@ class Equilibrium:
                 else:
                     n_hist[j] = 1
                 prev_f[j], prev_g[j] = f[a], g[a].ravel()
-            x[np.ix_(active, self.free)] = np.where(done[:, None, None], g,
-                                                    x_new.reshape(g.shape))
+            new = np.where(done[:, None, None], g, x_new.reshape(g.shape))
+            x_free[active] = new
+            for a, j in enumerate(active.tolist()):
+                x_rows[j, flat_free] = new[a].reshape(-1)
             active = active[~done]
             if active.size == 0:
                 break
-        converged = resid < tol
+        converged = resid < stop
         if not np.all(converged):
             logger.warning("shape matching did not converge for β = %s within %d iterations",
                            self.betas[~converged], max_iter)
         return x.reshape(nb, *cl.shape, 3), iters, resid, converged
+
+
+def _row_norm2(v: Array) -> Array:
+    """Squared norms ``(..., n)`` of the rows of ``v (..., n, 3)``."""
+    return np.asarray(np.einsum("...i,...i->...", v, v))
 
 
 def calibrate_stiffness(eq0: Equilibrium, x_fixed: Array, weights: Array, contact: TactileContact,

@@ -218,17 +218,20 @@ class PokeModel:
                 eq0, self.x_fixed, weights, contact, cfg, self.spacing)
         self.stiffness = float(stiffness_n_per_m)
 
-    def solve(self, betas: Array, x0: Array | None = None, tol: float | None = None,
-              ) -> tuple[PokeSimulation, Array]:
+    def solve(self, betas: Array, x0: Array | None = None, tol: float | None = None, *,
+              max_split: float = 0.0) -> tuple[PokeSimulation, Array]:
         """Equilibria for ``betas (B,)``, optionally started from positions ``x0 (B, *body, 3)``
         (default: :attr:`start` if there is one, else the rest shape), to the relative tolerance
-        ``tol`` (default ``config.tol``).
+        ``tol`` (default ``config.tol``). ``max_split > 0`` lets a β step with the factorisation
+        of a smaller β already factorised (see :meth:`StepMatrices.prepare`) instead of its own;
+        the equilibrium is the same.
 
         Returns the simulation (the surface layer's positions) and the whole body's positions
         ``(B, *body, 3)`` (to warm-start a later solve).
         """
         cfg = self.cfg
-        eq = Equilibrium(self.clusters, self.fixed, betas, system=self.system)
+        eq = Equilibrium(self.clusters, self.fixed, betas, system=self.system,
+                         max_split=max_split)
         k = 1.0 if self.stiffness is None else self.stiffness
         if x0 is None and self.start is not None:
             x0 = np.broadcast_to(self.start, (len(betas), *self.start.shape[1:]))
