@@ -343,8 +343,8 @@ def test_shared_factorisation_gives_the_equilibrium_of_a_fresh_one():
     np.testing.assert_allclose(x_shared, x_own, rtol=0, atol=1e-7 * dent)
 
 
-def test_split_step_needs_a_smaller_factorised_beta_and_the_positions(rng):
-    from deformap.errors import InvalidArgumentError
+def _step_matrices_9x9():
+    """The force protocol's step matrices of a 9×9 ROI on a 60 N dent (quadratic, 3×3)."""
     from deformap.msm._clusters import Clusters
     from deformap.msm._linsys import StepMatrices
     from deformap.msm._simulate import _body
@@ -353,7 +353,13 @@ def test_split_step_needs_a_smaller_factorised_beta_and_the_positions(rng):
     g = _grid(xs, ys, z)
     body, body_m, body_fixed, window = _body(g.rest, g.masses, g.fixed, g.spacing_m,
                                              ShapeMatchingConfig())
-    sm = StepMatrices(Clusters(body, body_m, window, "quadratic", 1e-3), body_fixed)
+    return StepMatrices(Clusters(body, body_m, window, "quadratic", 1e-3), body_fixed)
+
+
+def test_split_step_needs_a_smaller_factorised_beta_and_the_positions(rng):
+    from deformap.errors import InvalidArgumentError
+
+    sm = _step_matrices_9x9()
     assert sm.prepare(0.5, max_split=0.3) == 0.5  # nothing factorised below
     assert sm.prepare(0.6, max_split=0.3) == 0.5  # (0.6 − 0.5) / 0.5 = 0.2
     assert sm.prepare(0.9, max_split=0.3) == 0.9  # (0.9 − 0.5) / 0.5 = 0.8
@@ -411,15 +417,9 @@ def test_failed_in_place_factorisation_falls_back_to_the_intact_matrix(rng):
     # (β > 1 here, never reached by the estimate) must still be solved exactly by SuperLU
     import scipy.sparse as sp
 
-    from deformap.msm._clusters import Clusters
-    from deformap.msm._linsys import StepMatrices, _SparseFallback
-    from deformap.msm._simulate import _body
+    from deformap.msm._linsys import _SparseFallback
 
-    xs, ys, z, _, _ = dent_case(60, n=9)
-    g = _grid(xs, ys, z)
-    body, body_m, body_fixed, window = _body(g.rest, g.masses, g.fixed, g.spacing_m,
-                                             ShapeMatchingConfig())
-    sm = StepMatrices(Clusters(body, body_m, window, "quadratic", 1e-3), body_fixed)
+    sm = _step_matrices_9x9()
     rhs = rng.normal(size=(len(sm.free), 3))
     x = sm.solve(1.5, rhs)
     assert isinstance(sm._factors[1.5], _SparseFallback)
