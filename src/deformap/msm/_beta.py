@@ -14,6 +14,7 @@ from deformap._validation import check_points
 from deformap.environment import TactileContact
 from deformap.msm._config import ShapeMatchingConfig
 from deformap.msm._grid import ParticleGrid
+from deformap.msm._parabola import parabola_vertex
 from deformap.msm._poke import PokeSimulation
 from deformap.msm._simulate import PokeModel, _check_config
 from deformap.msm._uncertainty import bootstrap_beta_std, sample_beta_std
@@ -233,10 +234,10 @@ def _vertex(betas: Array, errors: Array) -> float:
     order = np.argsort(betas[pick])
     x = 1.0 / (1.0 - betas[pick][order])
     e = errors[pick][order]
-    curv = ((e[2] - e[1]) / (x[2] - x[1]) - (e[1] - e[0]) / (x[1] - x[0])) / (x[2] - x[0])
-    if not curv > 0.0:
+    vertex, ok = parabola_vertex(x, e)
+    if not ok:
         return float(betas[c])
-    v = -((e[1] - e[0]) / (x[1] - x[0]) - curv * (x[0] + x[1])) / (2.0 * curv)
+    v = float(vertex)
     return float(1.0 - 1.0 / v) if v >= 1.0 else 0.0
 
 

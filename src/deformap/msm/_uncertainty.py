@@ -26,6 +26,7 @@ from scipy.spatial import cKDTree
 
 from deformap._validation import check_array, check_int, check_positive
 from deformap.errors import InvalidArgumentError
+from deformap.msm._parabola import parabola_vertex
 
 __all__ = ["BOOTSTRAP_SEED", "bootstrap_beta_std", "sample_beta_std"]
 
@@ -147,17 +148,15 @@ def _argmins(betas: NDArray[np.float64], curves: NDArray[np.float64]) -> NDArray
     The sampled β are uneven (a coarse sweep and a fine refinement around β̂), so a sample's
     minimum that falls beyond the refined few would snap to a coarse β a whole sweep step away;
     instead each row's minimum is the vertex of the parabola through its lowest sample and the
-    two beside it, in ``u = −log(1 − β)`` (the scale on which the simulated dent changes, see
-    :func:`deformap.msm._beta._vertex`), kept between those two.
+    two beside it, in ``u = −log(1 − β)`` (like the refinement's ``1 / (1 − β)`` in
+    :func:`deformap.msm._beta._vertex`, a scale that stretches the soft end, where the simulated
+    dent changes fastest), kept between those two.
     """
     s_idx = np.arange(curves.shape[0])
-    i = np.clip(np.argmin(curves, axis=1), 1, betas.size - 2)
+    lowest = np.argmin(curves, axis=1)
+    i = np.clip(lowest, 1, betas.size - 2)
     u = -np.log1p(-betas)
-    u0, u1, u2 = u[i - 1], u[i], u[i + 1]
-    e0, e1, e2 = curves[s_idx, i - 1], curves[s_idx, i], curves[s_idx, i + 1]
-    with np.errstate(invalid="ignore", divide="ignore"):
-        curv = ((e2 - e1) / (u2 - u1) - (e1 - e0) / (u1 - u0)) / (u2 - u0)
-        slope = (e1 - e0) / (u1 - u0) - curv * (u0 + u1)
-        vertex = np.where(curv > 0, -slope / (2.0 * curv), u[np.argmin(curves, axis=1)])
-    vertex = np.clip(vertex, u0, u2)
+    three = np.stack([i - 1, i, i + 1], axis=1)
+    vertex, ok = parabola_vertex(u[three], curves[s_idx[:, None], three])
+    vertex = np.clip(np.where(ok, vertex, u[lowest]), u[i - 1], u[i + 1])
     return np.asarray(-np.expm1(-vertex))
