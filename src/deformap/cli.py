@@ -134,7 +134,7 @@ def explore_command(
         Path | None, typer.Option(help="Run folder (default runs/<scenario>-s<seed>-<time>).")
     ] = None,
     strategy: Annotated[
-        str | None, typer.Option(help="paper | max-variance | min-max-variance.")
+        str | None, typer.Option(help="paper | max-variance | min-max-variance | planned.")
     ] = None,
     threshold: Annotated[
         float | None, typer.Option(help="T_h: stop when max var(β) is below it.")
@@ -376,7 +376,7 @@ def reproduce_command(
     seed: Annotated[int, typer.Option(help="Seed of every run.")] = 0,
     strategy: Annotated[
         str | None,
-        typer.Option(help="paper | max-variance | min-max-variance (default: the config's)."),
+        typer.Option(help="paper | max-variance | min-max-variance | planned (default: the config's)."),
     ] = None,
     config: Annotated[Path | None, typer.Option(help="Run configuration YAML.")] = None,
 ) -> None:

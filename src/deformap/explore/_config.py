@@ -158,7 +158,7 @@ class ExplorationConfig:
         ``T_h``: stop when the β-field's largest variance on the grid falls below it (paper: 0.06).
     max_pokes : int
         Hard limit on the number of pokes.
-    strategy : {"paper", "max-variance", "min-max-variance"}
+    strategy : {"paper", "max-variance", "min-max-variance", "planned"}
         How the next target is chosen (see :mod:`deformap.explore._acquisition`).
     first_target : (2,) float or None
         The first poke, in metres; ``None`` means the workspace centre.
@@ -176,7 +176,7 @@ class ExplorationConfig:
 
     threshold: float = 0.06
     max_pokes: int = 12
-    strategy: Literal["paper", "max-variance", "min-max-variance"] = "max-variance"
+    strategy: Literal["paper", "max-variance", "min-max-variance", "planned"] = "planned"
     first_target: tuple[float, float] | None = None
     force_n: float = 0.6
     max_regions: int = 6

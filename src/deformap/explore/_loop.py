@@ -81,6 +81,7 @@ def explore(
     while len(mapper.pokes) < config.max_pokes:
         index = len(mapper.pokes)
         first = config.first_target
+        t_target = time.perf_counter()
         target = (
             np.array(env.workspace.center if first is None else first, dtype=float)
             if index == 0
@@ -90,6 +91,7 @@ def explore(
             stop = "threshold"
             break
         t0 = time.perf_counter()
+        target_s = t0 - t_target
         obs = env.press(target, config.force_n)
         try:
             t1 = time.perf_counter()
@@ -99,6 +101,7 @@ def explore(
             env.release()
         t3 = time.perf_counter()
         mapper.add(poke)
+        poke.record["timings"]["target_s"] = target_s
         poke.record["timings"]["environment_s"] = (t1 - t0) + (t3 - t2)
         env_s += poke.record["timings"]["environment_s"]
         if journal is not None:

@@ -32,6 +32,7 @@ from deformap.errors import EnvironmentStateError, InvalidArgumentError
 from deformap.explore._acquisition import choose_target
 from deformap.explore._config import ExplorationConfig
 from deformap.explore._dent_noise import dent_error_samples
+from deformap.explore._planning import PokePlan, plan_pokes
 from deformap.explore._regions import RegionMap, segment_regions
 from deformap.gp import (
     GaussianRandomField,
@@ -99,6 +100,26 @@ def _contact_record(contact: TactileContact) -> dict[str, Any]:
     }
 
 
+_PLAN_DOMAIN_M = 0.02
+_PLAN_CANDIDATE_M = 0.02
+
+
+def _strided(nx: int, ny: int, step_m: float, spacing_m: float,
+             within: NDArray[np.bool_] | None = None) -> NDArray[np.int64]:
+    """Flat indices of the ``(ny, nx)`` grid's cells about ``step_m`` apart, its first and last
+    rows and columns included (of the cells in ``within`` only, whose box they then span)."""
+    inside = np.ones(ny * nx, dtype=bool) if within is None else within
+    rows, cols = np.nonzero(inside.reshape(ny, nx))
+    stride = max(1, round(step_m / spacing_m))
+
+    def keep(lo: int, hi: int) -> NDArray[np.int64]:
+        return np.unique(np.append(np.arange(lo, hi + 1, stride), hi))
+
+    ys, xs = keep(rows.min(), rows.max()), keep(cols.min(), cols.max())
+    flat = (ys[:, None] * nx + xs[None, :]).ravel()
+    return flat[inside[flat]]
+
+
 class Mapper:
     """State of one exploration: the surface model and the β-field over the poked places.
 
@@ -121,6 +142,15 @@ class Mapper:
         margin = min(config.touch.roi_size_m / 2, 0.25 * min(workspace.size))
         lo, hi = np.asarray(workspace.lower) + margin, np.asarray(workspace.upper) - margin
         self.target_mask = np.all((self.cells_xy >= lo) & (self.cells_xy <= hi), axis=1)
+        # the planner's grids, every 2 cm (edges included): of the workspace, where the variance
+        # must fall (the σw = 0.2 m field's largest variance on it is within 1e-4 of the 0.5 cm
+        # grid's), and of the targets, where a poke may be planned
+        self._plan_domain = self.cells_xy[_strided(self.xs.size, self.ys.size, _PLAN_DOMAIN_M,
+                                                   config.surface.grid_spacing_m)]
+        sub = _strided(self.xs.size, self.ys.size, _PLAN_CANDIDATE_M,
+                       config.surface.grid_spacing_m, within=self.target_mask)
+        self._plan_candidates = self.cells_xy[sub]
+        self.last_plan: PokePlan | None = None
         self.surface: SurfaceModel | None = None
         self.pokes: list[PokeResult] = []
         self._field: GaussianRandomField | None = None
@@ -321,7 +351,21 @@ class Mapper:
             self.config.threshold,
             rng,
             look_ahead=self._max_variance_after,
+            planner=self._planned_target,
         )
+
+    def _planned_target(self) -> NDArray[np.float64]:
+        """The next poke of the plan with the fewest further pokes (``planned`` strategy)."""
+        cfg = self.config.beta_field
+        xy = np.array([p.xy for p in self.pokes]).reshape(-1, 2)
+        noise = np.maximum([p.record["beta_std"] for p in self.pokes], cfg.noise_floor)
+        self.last_plan = plan_pokes(
+            xy, noise.reshape(-1), self._plan_candidates, self._plan_domain,
+            signal_std=cfg.signal_std, length_scale=cfg.length_scale_m,
+            new_noise=cfg.noise_floor, threshold=self.config.threshold,
+            max_new=max(1, self.config.max_pokes - len(self.pokes)),
+        )  # fmt: skip
+        return np.array(self.last_plan.targets[0], dtype=float)
 
     def _max_variance_after(self, candidates: NDArray[np.float64]) -> NDArray[np.float64]:
         """Largest posterior variance over the grid if each candidate were poked next.

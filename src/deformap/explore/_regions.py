@@ -24,7 +24,12 @@ splitting with a calibrated test:
    tests is used, at 5 % with a Bonferroni correction for testing both.
 4. A split is kept only if neighbouring parts' means differ by at least ``min_step`` and by more
    than ``z`` standard errors (from the pokes' own uncertainties, at least ``floor``); each part
-   is then split in turn, down to groups of 3.
+   is then split in turn. A group is tested while the test has two degrees of freedom for the
+   scatter, ``ν₀ + n − 2 ≥ 2`` for ``n ≥ 3`` pokes: down to groups of 4 for the scale-free test,
+   which learns the scatter from the βs alone, and of 3 when the claimed noise counts
+   (``ν₀ ≥ 1``), so that a material met by a single poke beside two of another is still told
+   apart (three blocks met by five pokes, the fewest a 60×40 cm map needs with a planned
+   exploration).
 
 Why not the scale-free test alone (``prior_dof=0``, this module's rule until the pokes' noise was
 measured, see :mod:`deformap.explore._dent_noise`): with the 7 pokes a 60×40 cm map needs, it
@@ -213,7 +218,7 @@ def segment_regions(
     while pending:
         group = pending.pop()
         room = max_regions - len(done) - len(pending)
-        if group.size < 4 or room < 2:
+        if group.size < 3 or prior_dof + group.size - 2 < 2 or room < 2:
             done.append(group)
             continue
         parts = _split(b, s, group, room, min_step=min_step, z=z, prior_dof=prior_dof)

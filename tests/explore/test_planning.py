@@ -1,0 +1,113 @@
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from deformap.environment import Workspace
+from deformap.errors import InvalidArgumentError
+from deformap.explore import ExplorationConfig
+from deformap.explore._acquisition import choose_target
+from deformap.explore._mapper import Mapper
+from deformap.explore._planning import plan_pokes
+from deformap.gp import GaussianRandomField
+
+PRIOR = {"signal_std": 0.3, "length_scale": 0.2}
+FLOOR = 0.03
+T_H = 0.06
+
+
+def _grid(lo: tuple[float, float], hi: tuple[float, float], step: float) -> np.ndarray:
+    gx, gy = np.meshgrid(np.arange(lo[0], hi[0] + 1e-9, step), np.arange(lo[1], hi[1] + 1e-9, step))
+    return np.column_stack([gx.ravel(), gy.ravel()])
+
+
+def _variance(xy: np.ndarray, noise: np.ndarray, where: np.ndarray) -> np.ndarray:
+    """The β-field's posterior variance at ``where``, by the library's own GP (exact path)."""
+    gp = GaussianRandomField(length_scale=PRIOR["length_scale"], signal_std=PRIOR["signal_std"],
+                             noise_std=FLOOR, method="exact")
+    gp.fit(xy, np.zeros(len(xy)), noise_std=noise)
+    return np.asarray(gp.predict(where, return_std=True)[1] ** 2)
+
+
+DOMAIN = _grid((0.0, 0.0), (0.6, 0.4), 0.01)
+CANDIDATES = _grid((0.06, 0.06), (0.54, 0.34), 0.02)
+
+
+def test_the_plan_reaches_the_threshold_with_fewer_pokes_than_max_variance() -> None:
+    centre = np.array([[0.3, 0.2]])
+    plan = plan_pokes(centre, np.array([FLOOR]), CANDIDATES, DOMAIN, new_noise=FLOOR,
+                      threshold=T_H, max_new=10, **PRIOR)
+    assert plan.reaches
+    everything = np.vstack([centre, plan.targets])
+    var = _variance(everything, np.full(len(everything), FLOOR), DOMAIN)
+    assert var.max() <= T_H + 1e-9
+    np.testing.assert_allclose(var.max(), plan.max_variance, rtol=1e-6)
+    # one poke fewer does not reach it: the plan is as short as this search can make it
+    short = plan_pokes(centre, np.array([FLOOR]), CANDIDATES, DOMAIN, new_noise=FLOOR,
+                       threshold=T_H, max_new=len(plan.targets) - 1, **PRIOR)
+    assert not short.reaches and short.max_variance > T_H
+    # the myopic rule (largest variance first, from the same centre) needs more pokes
+    poked = centre
+    while _variance(poked, np.full(len(poked), FLOOR), DOMAIN).max() > T_H:
+        var_c = _variance(poked, np.full(len(poked), FLOOR), CANDIDATES)
+        poked = np.vstack([poked, CANDIDATES[np.argmax(var_c)]])
+    assert len(everything) < len(poked)
+
+
+def test_the_first_planned_poke_is_where_the_field_is_least_known_and_noise_counts() -> None:
+    done = np.array([[0.1, 0.1], [0.5, 0.3]])
+    plan = plan_pokes(done, np.full(2, FLOOR), CANDIDATES, DOMAIN, new_noise=FLOOR,
+                      threshold=T_H, max_new=10, **PRIOR)
+    now = _variance(done, np.full(2, FLOOR), plan.targets)
+    assert np.all(now[0] >= now[1:] - 1e-12)
+    # pokes that told little (large β uncertainty) leave more to plan
+    noisy = plan_pokes(done, np.full(2, 0.25), CANDIDATES, DOMAIN, new_noise=FLOOR,
+                       threshold=T_H, max_new=10, **PRIOR)
+    assert len(noisy.targets) >= len(plan.targets)
+    assert noisy.max_variance <= T_H
+
+
+def test_a_small_domain_needs_one_poke_and_none_reach_with_too_few() -> None:
+    domain = _grid((0.2, 0.2), (0.3, 0.3), 0.01)
+    plan = plan_pokes(np.zeros((0, 2)), np.zeros(0), CANDIDATES, domain, new_noise=FLOOR,
+                      threshold=T_H, max_new=5, **PRIOR)
+    assert len(plan.targets) == 1 and plan.reaches
+    far = plan_pokes(np.zeros((0, 2)), np.zeros(0), CANDIDATES, DOMAIN, new_noise=FLOOR,
+                     threshold=0.001, max_new=2, **PRIOR)
+    assert not far.reaches and len(far.targets) == 2
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"poked_xy": np.zeros((2, 3))}, "`poked_xy`"),
+        ({"poked_noise": np.zeros(3)}, "`poked_noise`"),
+        ({"candidates": np.zeros((0, 2))}, "`candidates`"),
+        ({"domain": np.full((4, 2), np.nan)}, "`domain`"),
+        ({"threshold": 0.0}, "`threshold`"),
+        ({"max_new": 0}, "`max_new`"),
+        ({"length_scale": -1.0}, "`length_scale`"),
+    ],
+)
+def test_bad_input_names_the_argument(kwargs: dict, match: str) -> None:
+    args = {"poked_xy": np.zeros((2, 2)), "poked_noise": np.full(2, FLOOR),
+            "candidates": CANDIDATES, "domain": DOMAIN, "new_noise": FLOOR, "threshold": T_H,
+            "max_new": 3, **PRIOR}
+    args.update(kwargs)
+    with pytest.raises(InvalidArgumentError, match=match):
+        plan_pokes(**args)
+
+
+def test_the_mapper_plans_over_the_whole_workspace_from_reachable_targets() -> None:
+    mapper = Mapper(Workspace(lower=(0.0, 0.0), upper=(0.6, 0.4)),
+                    ExplorationConfig(strategy="planned"))
+    target = mapper.next_target(np.random.default_rng(0))
+    assert target is not None and mapper.last_plan is not None
+    # the planner sees the workspace's corners and plans only where a ROI fits
+    assert mapper._plan_domain.min(axis=0) == pytest.approx([0.0025, 0.0025])
+    assert mapper._plan_domain.max(axis=0) == pytest.approx([0.5975, 0.3975])
+    reach = mapper.cells_xy[mapper.target_mask]
+    assert np.all(mapper.last_plan.targets >= reach.min(axis=0) - 1e-12)
+    assert np.all(mapper.last_plan.targets <= reach.max(axis=0) + 1e-12)
+    with pytest.raises(InvalidArgumentError, match="`planner` is required"):
+        choose_target("planned", reach, np.ones(len(reach)), T_H, np.random.default_rng(0))
