@@ -7,7 +7,7 @@ from deformap.environment import Workspace
 from deformap.errors import InvalidArgumentError
 from deformap.explore import ExplorationConfig
 from deformap.explore._acquisition import choose_target
-from deformap.explore._mapper import Mapper
+from deformap.explore._mapper import Mapper, PokeResult
 from deformap.explore._planning import plan_pokes
 from deformap.gp import GaussianRandomField
 
@@ -111,3 +111,26 @@ def test_the_mapper_plans_over_the_whole_workspace_from_reachable_targets() -> N
     assert np.all(mapper.last_plan.targets <= reach.max(axis=0) + 1e-12)
     with pytest.raises(InvalidArgumentError, match="`planner` is required"):
         choose_target("planned", reach, np.ones(len(reach)), T_H, np.random.default_rng(0))
+
+
+def _pokes_until_known(config: ExplorationConfig) -> tuple[Mapper, int]:
+    """Run the planner against a mapper fed fake pokes (β 0.5, uncertainty at the floor)."""
+    mapper = Mapper(Workspace(lower=(0.0, 0.0), upper=(0.6, 0.4)), config)
+    rng = np.random.default_rng(0)
+    target: np.ndarray | None = np.array([0.3, 0.2])
+    while target is not None and len(mapper.pokes) < config.max_pokes:
+        mapper.add(PokeResult({"contact_xy": target.tolist(), "beta": 0.5, "beta_std": FLOOR}))
+        target = mapper.next_target(rng)
+    return mapper, len(mapper.pokes)
+
+
+def test_the_paper_stop_rule_on_targets_only_stops_sooner() -> None:
+    whole, n_whole = _pokes_until_known(ExplorationConfig())
+    targets, n_targets = _pokes_until_known(ExplorationConfig(stop_region="targets"))
+    assert n_whole == 5 and n_targets < n_whole
+    _, var = targets.field()
+    assert targets.max_variance() <= T_H < var.max()  # the edge band is left above T_h
+    assert whole.max_variance() == pytest.approx(whole.field()[1].max())
+    assert whole.max_variance() <= T_H
+    with pytest.raises(InvalidArgumentError, match="`stop_region` must be one of"):
+        ExplorationConfig(stop_region="edges")  # type: ignore[arg-type]

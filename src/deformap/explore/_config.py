@@ -162,6 +162,11 @@ class ExplorationConfig:
         How the next target is chosen (see :mod:`deformap.explore._acquisition`).
     first_target : (2,) float or None
         The first poke, in metres; ``None`` means the workspace centre.
+    stop_region : {"workspace", "targets"}
+        Where the variance must fall below ``T_h``: ``workspace``, every cell of the map;
+        ``targets``, only the cells a poke can be centred on (half a ROI inside the edges), the
+        paper's literal rule ("until the ROI detector block does not find a new candidate point"),
+        which stops sooner and leaves the edge band to extrapolation.
     force_n : float
         The commanded normal force of every press. 0.6 N keeps the Hertz contact of a 1 cm tip
         on the tip itself for foams down to 60 N (``F <= 4 E* R² / 3`` = 0.68 N) while denting
@@ -178,6 +183,7 @@ class ExplorationConfig:
     max_pokes: int = 12
     strategy: Literal["paper", "max-variance", "min-max-variance", "planned"] = "planned"
     first_target: tuple[float, float] | None = None
+    stop_region: Literal["workspace", "targets"] = "workspace"
     force_n: float = 0.6
     max_regions: int = 6
     region_prior_dof: float = 7.0
@@ -192,6 +198,10 @@ class ExplorationConfig:
         if self.strategy not in STRATEGIES:
             raise InvalidArgumentError(
                 f"`strategy` must be one of {list(STRATEGIES)}; got {self.strategy!r}"
+            )
+        if self.stop_region not in ("workspace", "targets"):
+            raise InvalidArgumentError(
+                f"`stop_region` must be one of ['workspace', 'targets']; got {self.stop_region!r}"
             )
         if self.first_target is not None:
             check_vector("first_target", self.first_target, 2, what="metres")

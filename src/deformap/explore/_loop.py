@@ -109,8 +109,7 @@ def explore(
         if on_poke is not None:
             on_poke(poke)
     else:
-        _, var = mapper.field()
-        if var.max() < config.threshold:
+        if mapper.max_variance() <= config.threshold:
             stop = "threshold"
     total = time.perf_counter() - t_start
     timings = {

@@ -142,11 +142,15 @@ class Mapper:
         margin = min(config.touch.roi_size_m / 2, 0.25 * min(workspace.size))
         lo, hi = np.asarray(workspace.lower) + margin, np.asarray(workspace.upper) - margin
         self.target_mask = np.all((self.cells_xy >= lo) & (self.cells_xy <= hi), axis=1)
+        # where the variance must fall below T_h
+        self.stop_mask = (self.target_mask if config.stop_region == "targets"
+                          else np.ones(len(self.cells_xy), dtype=bool))
         # the planner's grids, every 2 cm (edges included): of the workspace, where the variance
         # must fall (the σw = 0.2 m field's largest variance on it is within 1e-4 of the 0.5 cm
         # grid's), and of the targets, where a poke may be planned
         self._plan_domain = self.cells_xy[_strided(self.xs.size, self.ys.size, _PLAN_DOMAIN_M,
-                                                   config.surface.grid_spacing_m)]
+                                                   config.surface.grid_spacing_m,
+                                                   within=self.stop_mask)]
         sub = _strided(self.xs.size, self.ys.size, _PLAN_CANDIDATE_M,
                        config.surface.grid_spacing_m, within=self.target_mask)
         self._plan_candidates = self.cells_xy[sub]
@@ -301,7 +305,7 @@ class Mapper:
         t0 = time.perf_counter()
         self.pokes.append(poke)
         self._field = self._fit_field(len(self.pokes))
-        poke.record["max_variance_after"] = float(self.field()[1].max())
+        poke.record["max_variance_after"] = self.max_variance()
         poke.record.setdefault("timings", {})["field_s"] = time.perf_counter() - t0
 
     # -- the β-field ---------------------------------------------------------------------------
@@ -333,11 +337,15 @@ class Mapper:
             method="exact",
         ).fit(xy, beta, noise_std=noise)
 
+    def max_variance(self) -> float:
+        """The β-field's largest variance where it must fall below ``T_h`` (``stop_region``)."""
+        return float(self.field()[1].ravel()[self.stop_mask].max())
+
     def next_target(self, rng: np.random.Generator) -> NDArray[np.float64] | None:
         """The next target by the configured strategy, or ``None`` when the map is known."""
         _, var = self.field()
         variance = var.ravel()
-        if variance.max() <= self.config.threshold:
+        if variance[self.stop_mask].max() <= self.config.threshold:
             return None
         cells, reachable = self.cells_xy[self.target_mask], variance[self.target_mask]
         if reachable.max() <= self.config.threshold:
