@@ -1,6 +1,8 @@
 from __future__ import annotations
 
 import json
+import os
+import stat
 
 import pytest
 
@@ -60,3 +62,18 @@ def test_a_journal_is_created_whole_or_not_at_all(tmp_path, monkeypatch) -> None
     monkeypatch.undo()
     journal = Journal.create(tmp_path, {"seed": 1})  # a leftover temporary file is no obstacle
     assert read_journal(journal.path).header == {"kind": "header", "seed": 1}
+
+
+@pytest.mark.skipif(os.name != "posix", reason="folders are fsynced on POSIX only")
+def test_the_rename_that_creates_a_journal_is_made_durable(tmp_path, monkeypatch) -> None:
+    # After the rename the folder itself is fsynced, else a power cut may lose the new name.
+    synced: list[bool] = []
+    real_fsync = os.fsync
+
+    def recording_fsync(fd: int) -> None:
+        synced.append(stat.S_ISDIR(os.fstat(fd).st_mode))
+        real_fsync(fd)
+
+    monkeypatch.setattr(os, "fsync", recording_fsync)
+    Journal.create(tmp_path, {"seed": 1})
+    assert synced[-1] is True and False in synced  # the file's data first, then its folder

@@ -24,7 +24,7 @@ from deformap._validation import check_int
 from deformap.errors import ConfigError
 from deformap.eval._metrics import region_scores
 from deformap.explore import ExplorationConfig, ExplorationResult, Journal, PokeResult, explore
-from deformap.explore._journal import JOURNAL_NAME
+from deformap.explore._journal import JOURNAL_NAME, replace_durably
 from deformap.world import SimulatedWorld, WorldConfig, load_scenario
 
 __all__ = [
@@ -90,7 +90,7 @@ def _write_whole(path: Path, text: str) -> None:
         fh.write(text)
         fh.flush()
         os.fsync(fh.fileno())
-    os.replace(tmp, path)
+    replace_durably(tmp, path)
 
 
 def _prepare_folder(

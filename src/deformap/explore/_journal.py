@@ -17,11 +17,23 @@ from typing import Any
 
 from deformap.errors import ConfigError, FileFormatError
 
-__all__ = ["Journal", "JournalContents", "read_journal"]
+__all__ = ["Journal", "JournalContents", "read_journal", "replace_durably"]
 
 logger = logging.getLogger(__name__)
 
 JOURNAL_NAME = "journal.jsonl"
+
+
+def replace_durably(tmp: Path, path: Path) -> None:
+    """Rename the written and fsynced ``tmp`` onto ``path``, then fsync the folder, so that the
+    rename itself survives a power cut (POSIX leaves it in the folder's cache until then)."""
+    os.replace(tmp, path)
+    if os.name == "posix":  # folders cannot be opened for fsync on Windows
+        fd = os.open(path.parent, os.O_RDONLY)
+        try:
+            os.fsync(fd)
+        finally:
+            os.close(fd)
 
 
 @dataclass
@@ -94,7 +106,7 @@ class Journal:
         tmp = path.with_suffix(".tmp")
         with open(tmp, "w", encoding="utf-8") as fh:
             journal._write(fh, {"kind": "header", **header})
-        os.replace(tmp, path)
+        replace_durably(tmp, path)
         return journal
 
     @classmethod
@@ -124,7 +136,7 @@ class Journal:
         with open(tmp, "w", encoding="utf-8") as fh:
             for record in [contents.header, *contents.pokes]:
                 self._write(fh, record)
-        os.replace(tmp, self.path)
+        replace_durably(tmp, self.path)
 
     @staticmethod
     def _write(fh: Any, record: dict[str, Any]) -> None:
