@@ -29,8 +29,7 @@ from numpy.typing import NDArray
 
 from deformap._validation import check_array, check_int, check_positive
 from deformap.errors import InvalidArgumentError
-from deformap.gp import squared_exponential
-from deformap.gp._exact import cholesky_with_jitter
+from deformap.gp import cholesky_with_jitter, squared_exponential
 
 __all__ = ["DENT_NOISE_SEED", "dent_error_samples"]
 

@@ -8,6 +8,7 @@ Shared parameters, in metres (or the units of the modelled value): ``length_scal
 
 from __future__ import annotations
 
+from deformap.gp._exact import cholesky_with_jitter
 from deformap.gp._field import AUTO_EXACT_MAX_POINTS, GaussianRandomField
 from deformap.gp._hyper import (
     GPHyperparameters,
@@ -21,6 +22,7 @@ __all__ = [
     "AUTO_EXACT_MAX_POINTS",
     "GPHyperparameters",
     "GaussianRandomField",
+    "cholesky_with_jitter",
     "default_bounds",
     "fit_hyperparameters",
     "grid_points",
