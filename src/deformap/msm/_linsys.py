@@ -91,11 +91,18 @@ class StepMatrices:
         self._band1[self._bw + br - bc, bc] = vp[ff][up]
         self._factors: dict[float, object] = {}
         self._s1_csr: sp.csr_matrix | None = None
+        self._pull: tuple[Array, Array, Array] | None = None
         self._pbtrs = get_lapack_funcs("pbtrs", (self._band0,))
 
-    def couple(self, beta_fit: float) -> sp.csr_matrix:
-        """``(n_free, n_fix)`` block that carries the fixed particles into the free rows."""
-        return self.couple_w + beta_fit * self.couple_p
+    def pull(self, x_fixed: Array) -> tuple[Array, Array]:
+        """``(couple_w @ x_fixed, couple_p @ x_fixed)``, each ``(n_free, 3)``: the term that
+        carries the fixed particles into the free rows is ``w + β p`` for any β (kept for the
+        last ``x_fixed``, which a β search passes unchanged to every solve)."""
+        last = self._pull
+        if last is None or not np.array_equal(last[0], x_fixed):
+            x = np.array(x_fixed, dtype=float)
+            last = self._pull = (x, np.asarray(self.couple_w @ x), np.asarray(self.couple_p @ x))
+        return last[1], last[2]
 
     def prepare(self, beta_fit: float, max_split: float = 0.0) -> float:
         """Factorise what solving ``beta_fit`` needs and return the β′ whose factorisation it
@@ -128,7 +135,11 @@ class StepMatrices:
             if x is None or key > beta:
                 raise InvalidArgumentError(
                     "a split step needs `factor_beta` <= `beta_fit` and the positions `x`")
-            scaled += (beta - key) * (self._s1() @ np.take(x, self._perm, axis=0))
+            s1, xp = self._s1(), np.take(x, self._perm, axis=0)
+            # one column at a time: scipy's multi-vector CSR product is slower than three
+            # single-vector ones (the same sums, in the same order)
+            for d in range(scaled.shape[1]):
+                scaled[:, d] += (beta - key) * (s1 @ xp[:, d])
         if isinstance(fac, np.ndarray):
             sol, info = self._pbtrs(fac, scaled, lower=0)
             if info != 0:

@@ -170,10 +170,11 @@ class Equilibrium:
         cl, nb = self.cl, len(self.betas)
         rest = cl.rest.reshape(-1, 3)
         self.const = np.empty((nb, len(self.free), 3))
+        pull_w, pull_p = self.system.pull(x_fixed)
+        load = force[self.free] / stiffness
         for j in range(nb):
-            self.const[j] = (self.fit_weight[j] * self.system.fit_const
-                             + self.system.couple(self.fit_weight[j]) @ x_fixed
-                             + force[self.free] / stiffness)
+            self.const[j] = (self.fit_weight[j] * (self.system.fit_const + pull_p)
+                             + pull_w + load)
         x = np.broadcast_to(rest, (nb, *rest.shape)).copy()
         if x0 is not None:
             x[:, self.free] = np.asarray(x0).reshape(nb, -1, 3)[:, self.free]
