@@ -29,6 +29,9 @@ _MAX_SPLIT = 0.3
 contraction bound ``(β − β′) / (1 − β′)`` is at most this (:meth:`StepMatrices.solve`): on four
 40 × 40 bench dents (30–250 N foams), 22 factorisations instead of 53 for 4 % more iterations."""
 
+_KEEP_FACTORS = 3
+"""Banded factorisations a β search keeps (:attr:`StepMatrices.max_factors`)."""
+
 _TIE_M = 1e-9
 """E values within a nanometre are ties (round-off): β̂ is then the smallest, most rigid β."""
 
@@ -107,6 +110,10 @@ class _Sweep:
 
     def __init__(self, model: PokeModel, tree: cKDTree):
         self.model, self.tree = model, tree
+        # each solve needs one factorisation and the sweep moves on through β: a few kept
+        # suffice, and reusing their arrays spares fresh memory (page faults cost as much as a
+        # banded factorisation on the 40 × 40 bench)
+        model.system.max_factors = _KEEP_FACTORS
         self.sims: dict[float, tuple[PokeSimulation, int]] = {}
         self.errors: dict[float, float] = {}
         self.distances: dict[float, Array] = {}

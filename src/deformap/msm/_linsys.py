@@ -83,16 +83,26 @@ class StepMatrices:
         up = br <= bc
         br, bc = br[up], bc[up]
         self._bw = int(np.max(bc - br)) if bc.size else 0
-        # column-major, as LAPACK stores bands: a factorisation then copies nothing
-        self._band0 = np.zeros((self._bw + 1, nf), order="F")
-        self._band0[self._bw + br - bc, bc] = -vw[ff][up]
-        self._band0[self._bw] += self._scale[self._perm]
-        self._band1 = np.zeros((self._bw + 1, nf), order="F")
-        self._band1[self._bw + br - bc, bc] = vp[ff][up]
+        # the nonzeros of both bands, as flat indices into a column-major (LAPACK) band array:
+        # entry S[i, j], i ≤ j, is band[bw + i − j, j]; a factorisation fills a band from them
+        # (in a recycled array when the number of factorisations kept is bounded)
+        self._band_shape = (self._bw + 1, nf)
+        diag = self._bw + (self._bw + 1) * np.arange(nf)
+        at = np.concatenate([(self._bw + br - bc) + (self._bw + 1) * bc, diag])
+        self._band_at, slot = np.unique(at, return_inverse=True)
+        zeros = np.zeros(nf)
+        self._band_v0 = np.bincount(slot, np.concatenate([-vw[ff][up], self._scale[self._perm]]),
+                                    minlength=self._band_at.size)
+        self._band_v1 = np.bincount(slot, np.concatenate([vp[ff][up], zeros]),
+                                    minlength=self._band_at.size)
         self._factors: dict[float, object] = {}
+        # at most this many factorisations are kept (None: all), the least recently used
+        # dropped first and its array reused: for a β search that moves on through β (a batch
+        # of β needing more factorisations than this at once would refactorise every step)
+        self.max_factors: int | None = None
         self._s1_csr: sp.csr_matrix | None = None
         self._pull: tuple[Array, Array, Array] | None = None
-        self._pbtrs = get_lapack_funcs("pbtrs", (self._band0,))
+        self._pbtrs = get_lapack_funcs("pbtrs", (np.empty((1, 1)),))
 
     def pull(self, x_fixed: Array) -> tuple[Array, Array]:
         """``(couple_w @ x_fixed, couple_p @ x_fixed)``, each ``(n_free, 3)``: the term that
@@ -148,20 +158,37 @@ class StepMatrices:
             sol = fac.solve(scaled)  # type: ignore[attr-defined]
         return np.take(sol, self._unperm, axis=0)
 
+    def band(self, beta_fit: float, out: Array | None = None) -> Array:
+        """``S_β = S₀ − β S₁`` in LAPACK's upper band storage ``(bw + 1, n_free)``, column-major,
+        in band order (into ``out``, a column-major array of that shape, if given)."""
+        if out is None:
+            out = np.zeros(self._band_shape, order="F")
+        else:
+            out.fill(0.0)
+        flat = out.T.reshape(-1)  # a view: out.T is row-major
+        flat[self._band_at] = self._band_v0 - beta_fit * self._band_v1
+        return out
+
     def _factor_of(self, beta_fit: float) -> object:
-        fac = self._factors.get(beta_fit)
+        fac = self._factors.pop(beta_fit, None)
         if fac is None:
-            fac = self._factor(beta_fit)
-            self._factors[beta_fit] = fac
+            reuse = None
+            if self.max_factors is not None and len(self._factors) >= max(self.max_factors, 1):
+                old = self._factors.pop(next(iter(self._factors)))  # least recently used
+                if isinstance(old, np.ndarray):
+                    reuse = old
+            fac = self._factor(beta_fit, reuse)
+        self._factors[beta_fit] = fac  # the most recently used last
         return fac
 
     def _s1(self) -> sp.csr_matrix:
         """``S₁`` in band order as a full symmetric sparse matrix (built on first use)."""
         if self._s1_csr is None:
-            bw, n = self._bw, self._band1.shape[1]
-            r, j = np.nonzero(self._band1)
+            bw, n = self._bw, self._band_shape[1]
+            nz = self._band_v1 != 0.0
+            r, j = np.divmod(self._band_at[nz], bw + 1)[::-1]
             i = j - (bw - r)  # band[bw + i − j, j] = S[i, j], i ≤ j
-            v = self._band1[r, j]
+            v = self._band_v1[nz]
             off = i != j
             rows = np.concatenate([i, j[off]])
             cols = np.concatenate([j, i[off]])
@@ -169,13 +196,12 @@ class StepMatrices:
                                          shape=(n, n))
         return self._s1_csr
 
-    def _factor(self, beta_fit: float) -> object:
-        band = np.multiply(self._band1, -beta_fit, order="F")
-        band += self._band0
+    def _factor(self, beta_fit: float, reuse: Array | None = None) -> object:
+        band = self.band(beta_fit, reuse)
         try:
             return cholesky_banded(band, overwrite_ab=True, lower=False, check_finite=False)
         except LinAlgError:  # ``band`` was overwritten by the failed factorisation
-            return _SparseFallback(self._band0 - beta_fit * self._band1, self._bw)
+            return _SparseFallback(self.band(beta_fit), self._bw)
 
 
 class _SparseFallback:
