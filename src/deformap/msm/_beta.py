@@ -48,7 +48,8 @@ class BetaEstimate:
     Parameters
     ----------
     beta : float
-        β̂, the minimiser of E(β) over the sampled values; E values within 1 nm of the minimum
+        β̂, the minimiser of E(β) over the β solved to ``config.tol`` (those the refinement
+        compared, or every sampled β without refinement); E values within 1 nm of the minimum
         are round-off ties and the smallest (most rigid) of them is taken, so a flat E(β) gives
         the rigid end β̂ = 0.
     beta_std : float
@@ -330,7 +331,10 @@ def estimate_beta(rest_xs: Any, rest_ys: Any, rest_z: Any, deformed_points: Any,
     if cfg.refines:
         _refine(sweep, 1.0 / cfg.n_beta, cfg.beta_resolution, cfg.tol)
     betas, errors, its, res, conv, tols = sweep.curve()
-    best = int(np.flatnonzero(errors <= errors.min() + _TIE_M)[0])
+    # β̂ among the β the refinement compared (solved to tol): a loosely swept β's E is good to
+    # the sweep tolerance only and may fall below the converged minimum
+    compared = np.where(tols <= cfg.tol, errors, np.inf)
+    best = int(np.flatnonzero(compared <= compared.min() + _TIE_M)[0])
     if height_samples is not None:
         positions = np.stack([sweep.sims[float(b)][0].positions[sweep.sims[float(b)][1]]
                               for b in betas])  # fmt: skip
