@@ -343,29 +343,6 @@ def test_shared_factorisation_gives_the_equilibrium_of_a_fresh_one():
     np.testing.assert_allclose(x_shared, x_own, rtol=0, atol=1e-7 * dent)
 
 
-def test_carried_anderson_history_reaches_the_same_equilibrium():
-    # a β search starts each solve with the Anderson memory of the previous, nearby β: the first
-    # step mixes with another β's differences, but the fixed point and the test are the same
-    from deformap.errors import InvalidArgumentError
-    from deformap.msm._poke import AndersonHistory
-    from deformap.msm._simulate import PokeModel
-
-    xs, ys, z, _, contact = dent_case(60, n=13)
-    g = _grid(xs, ys, z)
-    model = PokeModel(g.rest, g.masses, g.fixed, contact, ShapeMatchingConfig())
-    history = AndersonHistory()
-    model.solve(np.array([0.5]), tol=1e-9, history=history)
-    assert history.beta == 0.5 and history.pairs > 0
-    assert history.estimate is not None and history.estimate.shape == (1, *model.clusters.shape, 3)
-    _, x_plain = model.solve(np.array([0.52]), tol=1e-9)
-    carried, x_carried = model.solve(np.array([0.52]), tol=1e-9, history=history)
-    assert carried.converged.all() and np.all(carried.residual < 1e-9) and history.beta == 0.52
-    dent = np.abs(x_plain - model.clusters.rest[None]).max()
-    np.testing.assert_allclose(x_carried, x_plain, rtol=0, atol=1e-7 * dent)
-    with pytest.raises(InvalidArgumentError, match="single-β"):
-        model.solve(np.array([0.3, 0.4]), history=AndersonHistory())
-
-
 def _step_matrices_9x9():
     """The force protocol's step matrices of a 9×9 ROI on a 60 N dent (quadratic, 3×3)."""
     from deformap.msm._clusters import Clusters

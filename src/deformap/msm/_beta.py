@@ -15,7 +15,7 @@ from deformap.environment import TactileContact
 from deformap.msm._config import ShapeMatchingConfig
 from deformap.msm._grid import ParticleGrid
 from deformap.msm._parabola import parabola_vertex
-from deformap.msm._poke import AndersonHistory, PokeSimulation
+from deformap.msm._poke import PokeSimulation
 from deformap.msm._simulate import PokeModel, _check_config
 from deformap.msm._uncertainty import bootstrap_beta_std, sample_beta_std
 
@@ -31,11 +31,6 @@ contraction bound ``(β − β′) / (1 − β′)`` is at most this (:meth:`Ste
 
 _KEEP_FACTORS = 3
 """Banded factorisations a β search keeps (:attr:`StepMatrices.max_factors`)."""
-
-_CARRY_DBETA = 0.0201
-"""A solve starts with the Anderson memory of the previous one (:class:`AndersonHistory`)
-when their β are at most this apart (the 50-value sweep's step, the refinement's 0.01): on the
-40 × 40 bench the sweep and refinement then need about 8 % fewer steps."""
 
 _TIE_M = 1e-9
 """E values within a nanometre are ties (round-off): β̂ is then the smallest, most rigid β."""
@@ -111,10 +106,7 @@ class _Sweep:
     A β first solved to a loose tolerance (the coarse sweep) is solved again, from its own
     equilibrium, when it is asked for at a tighter one. A β steps with the banded factorisation
     of a smaller β already factorised when the splitting's contraction bound is at most
-    ``_MAX_SPLIT`` (see :meth:`StepMatrices.solve`), else with its own. A solve carries on the
-    Anderson memory of the previous one when their β are within ``_CARRY_DBETA``, and the start
-    of later β is built from each β's Anderson estimate of its fixed point (closer to it than
-    the last mapped step, which is what is reported and compared).
+    ``_MAX_SPLIT`` (see :meth:`StepMatrices.solve`), else with its own.
     """
 
     def __init__(self, model: PokeModel, tree: cKDTree):
@@ -128,7 +120,6 @@ class _Sweep:
         self.distances: dict[float, Array] = {}
         self.tols: dict[float, float] = {}
         self._body: dict[float, Array] = {}
-        self._history = AndersonHistory()
 
     def solved(self, beta: float, tol: float) -> bool:
         """Whether ``beta`` has been solved to ``tol`` or tighter."""
@@ -142,22 +133,17 @@ class _Sweep:
             if self.solved(key, tol):
                 continue
             x0 = self._start(key)
-            last = self._history.beta
-            if last is None or abs(last - key) > _CARRY_DBETA:
-                self._history = AndersonHistory()
             sim, body = self.model.solve(np.array([key]), None if x0 is None else x0[None], tol,
-                                         max_split=_MAX_SPLIT, history=self._history)
+                                         max_split=_MAX_SPLIT)
             dist = particle_distances(sim.positions, self.tree)[0]
             self.sims[key] = (sim, 0)
             self.errors[key] = float(dist.mean())
             self.distances[key] = dist
             self.tols[key] = tol
-            guess = self._history.estimate
-            self._body[key] = body[0] if guess is None else guess[0]
+            self._body[key] = body[0]
 
     def _start(self, beta: float) -> Array | None:
-        """Starting positions for ``beta``: its own loosely solved equilibrium (the Anderson
-        estimate of it, as for every β below), else linear in
+        """Starting positions for ``beta``: its own loosely solved equilibrium, else linear in
         ``v = 1 / (1 − β)`` through the two nearest solved β (the scale on which the dent
         deepens, see :func:`_vertex`), or the only one's displacements scaled by the ratio of
         ``v``; ``None`` (the model's own start) when no β is solved yet."""

@@ -42,12 +42,11 @@ import numpy as np
 from numpy.typing import NDArray
 
 from deformap.environment import TactileContact
-from deformap.errors import InvalidArgumentError
 from deformap.msm._clusters import Clusters
 from deformap.msm._config import ShapeMatchingConfig
 from deformap.msm._linsys import StepMatrices
 
-__all__ = ["AndersonHistory", "Equilibrium", "PokeSimulation", "force_weights", "hertz_depth"]
+__all__ = ["Equilibrium", "PokeSimulation", "force_weights", "hertz_depth"]
 
 logger = logging.getLogger(__name__)
 Array = NDArray[np.float64]
@@ -84,23 +83,6 @@ class PokeSimulation:
     converged: NDArray[np.bool_]
     protocol: str
     stiffness_n_per_m: float | None = None
-
-
-@dataclass
-class AndersonHistory:
-    """Anderson memory carried from one single-β solve to the next (see
-    :meth:`Equilibrium.solve`): the last ``memory`` differences of residuals ``df`` and of
-    mapped positions ``dg`` ``(memory, n_free · 3)``, ``pairs`` of them valid, ``added`` ever
-    stored (the ring position); and, after a solve, its β and ``estimate``, the Anderson
-    extrapolation of the fixed point from the last step ``(1, *body, 3)`` (a start for nearby β,
-    not the reported equilibrium, which is the last mapped step ``G(x)``)."""
-
-    df: Array | None = None
-    dg: Array | None = None
-    pairs: int = 0
-    added: int = 0
-    beta: float | None = None
-    estimate: Array | None = None
 
 
 def hertz_depth(force_n: float, tip_radius_m: float, modulus_pa: float, poisson: float) -> float:
@@ -169,7 +151,6 @@ class Equilibrium:
 
     def solve(self, x_fixed: Array, force: Array, stiffness: float, tol: float, max_iter: int,
               spacing: float, memory: int = 6, x0: Array | None = None,
-              history: AndersonHistory | None = None,
               ) -> tuple[Array, NDArray[np.int64], Array, NDArray[np.bool_]]:
         """Iterate ``x ← G(x)`` to its fixed point for every β, with Anderson acceleration.
 
@@ -185,12 +166,6 @@ class Equilibrium:
         see :meth:`StepMatrices.solve`) stops at ``tol (1 − ρ)`` instead of ``tol``: its steps
         contract more slowly, and the distance to the fixed point, about ``step / (1 −
         contraction)``, is then bounded as with its own factorisation.
-
-        ``history`` (a single β only): the Anderson memory of the previous solve of a nearby β.
-        Its pairs, differences of that β's map, stand in for the current map's until they are
-        pushed out: the first step is already a mixing step, not a plain one. It is updated in
-        place with this solve's memory, β and Anderson estimate. The convergence test and the
-        returned positions (the last mapped step) are the same as without it.
         """
         cl, nb = self.cl, len(self.betas)
         rest = cl.rest.reshape(-1, 3)
@@ -213,26 +188,11 @@ class Equilibrium:
         nf = len(self.free) * 3
         iters = np.zeros(nb, dtype=np.int64)
         resid = np.full(nb, np.inf)
-        if history is not None:
-            if nb != 1:
-                raise InvalidArgumentError("an Anderson history carries over single-β solves only")
-            df_all, dg_all = history.df, history.dg
-            if df_all is None or dg_all is None or df_all.shape != (memory, nf):
-                df_all, dg_all = np.zeros((memory, nf)), np.zeros((memory, nf))
-                history.df, history.dg = df_all, dg_all
-                history.pairs = history.added = 0
-            hist_f, hist_g = df_all[None], dg_all[None]  # views: updated in place
-            pairs = np.array([history.pairs])
-            added = np.array([history.added])
-        else:
-            hist_f = np.zeros((nb, memory, nf))
-            hist_g = np.zeros((nb, memory, nf))
-            pairs = np.zeros(nb, dtype=np.int64)
-            added = np.zeros(nb, dtype=np.int64)
-        have_prev = np.zeros(nb, dtype=bool)  # a previous step of this map to difference with
+        hist_f = np.zeros((nb, memory, nf))
+        hist_g = np.zeros((nb, memory, nf))
+        n_hist = np.zeros(nb, dtype=np.int64)
         prev_f = np.zeros((nb, nf))
         prev_g = np.zeros((nb, nf))
-        estimate = np.zeros((nb, nf))
         active = np.arange(nb)
         floor = 1e-6 * spacing
         stop = tol * (1.0 - self.split)
@@ -247,26 +207,22 @@ class Equilibrium:
             done = r < stop[active]
             x_new = g.reshape(len(active), -1).copy()
             for a, j in enumerate(active.tolist()):
-                if grew[a]:  # restart: drop the memory, take the plain step
-                    pairs[j] = added[j] = 0
-                else:
-                    if have_prev[j]:
-                        slot = added[j] % memory
-                        hist_f[j, slot] = f[a] - prev_f[j]
-                        hist_g[j, slot] = g[a].ravel() - prev_g[j]
-                        added[j] += 1
-                        pairs[j] = min(pairs[j] + 1, memory)
-                    if pairs[j]:
-                        m = pairs[j]
-                        df, dg = hist_f[j, :m], hist_g[j, :m]
-                        gram = df @ df.T
-                        gamma = np.linalg.lstsq(gram + 1e-14 * np.trace(gram) * np.eye(m),
-                                                df @ f[a], rcond=None)[0]
-                        x_new[a] -= gamma @ dg
-                have_prev[j] = True
-                prev_f[j], prev_g[j] = f[a], g[a].ravel()
                 if done[a]:
-                    estimate[j] = x_new[a]
+                    continue
+                if n_hist[j] and not grew[a]:
+                    slot = (n_hist[j] - 1) % memory
+                    hist_f[j, slot] = f[a] - prev_f[j]
+                    hist_g[j, slot] = g[a].ravel() - prev_g[j]
+                    m = min(n_hist[j], memory)
+                    df, dg = hist_f[j, :m], hist_g[j, :m]
+                    gram = df @ df.T
+                    gamma = np.linalg.lstsq(gram + 1e-14 * np.trace(gram) * np.eye(m),
+                                            df @ f[a], rcond=None)[0]
+                    x_new[a] -= gamma @ dg
+                    n_hist[j] += 1
+                else:
+                    n_hist[j] = 1
+                prev_f[j], prev_g[j] = f[a], g[a].ravel()
             new = np.where(done[:, None, None], g, x_new.reshape(g.shape))
             x_free[active] = new
             for a, j in enumerate(active.tolist()):
@@ -274,13 +230,6 @@ class Equilibrium:
             active = active[~done]
             if active.size == 0:
                 break
-        if history is not None:
-            history.pairs, history.added = int(pairs[0]), int(added[0])
-            history.beta = float(self.betas[0])
-            guess = x.copy()
-            guess.reshape(nb, -1)[0, flat_free] = estimate[0] if iters[0] and resid[0] < stop[0] \
-                else x_free[0].reshape(-1)
-            history.estimate = guess.reshape(nb, *cl.shape, 3)
         converged = resid < stop
         if not np.all(converged):
             logger.warning("shape matching did not converge for β = %s within %d iterations",

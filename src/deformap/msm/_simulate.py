@@ -14,7 +14,6 @@ from deformap.msm._clusters import Clusters
 from deformap.msm._config import ShapeMatchingConfig
 from deformap.msm._linsys import StepMatrices
 from deformap.msm._poke import (
-    AndersonHistory,
     Equilibrium,
     PokeSimulation,
     calibrate_stiffness,
@@ -220,14 +219,12 @@ class PokeModel:
         self.stiffness = float(stiffness_n_per_m)
 
     def solve(self, betas: Array, x0: Array | None = None, tol: float | None = None, *,
-              max_split: float = 0.0, history: AndersonHistory | None = None,
-              ) -> tuple[PokeSimulation, Array]:
+              max_split: float = 0.0) -> tuple[PokeSimulation, Array]:
         """Equilibria for ``betas (B,)``, optionally started from positions ``x0 (B, *body, 3)``
         (default: :attr:`start` if there is one, else the rest shape), to the relative tolerance
         ``tol`` (default ``config.tol``). ``max_split > 0`` lets a β step with the factorisation
         of a smaller β already factorised (see :meth:`StepMatrices.prepare`) instead of its own;
-        the equilibrium is the same. ``history`` (one β): the Anderson memory of a previous solve
-        of a nearby β, updated in place (see :meth:`Equilibrium.solve`).
+        the equilibrium is the same.
 
         Returns the simulation (the surface layer's positions) and the whole body's positions
         ``(B, *body, 3)`` (to warm-start a later solve).
@@ -239,7 +236,7 @@ class PokeModel:
         if x0 is None and self.start is not None:
             x0 = np.broadcast_to(self.start, (len(betas), *self.start.shape[1:]))
         x, it, res, conv = eq.solve(self.x_fixed, self.force, k, cfg.tol if tol is None else tol,
-                                    cfg.max_iter, self.spacing, x0=x0, history=history)
+                                    cfg.max_iter, self.spacing, x0=x0)
         sim = PokeSimulation(betas=betas, positions=x[:, 0], iterations=it, residual=res,
                              converged=conv, protocol=cfg.contact,
                              stiffness_n_per_m=self.stiffness)
