@@ -48,6 +48,9 @@ class StepMatrices:
         is_fixed = fixed.ravel()
         self.free = np.flatnonzero(~is_fixed)
         self.fix = np.flatnonzero(is_fixed)
+        # the same as indices into flattened (n, 3) positions
+        self.flat_free = (3 * self.free[:, None] + np.arange(3)).ravel()
+        self.flat_fix = (3 * self.fix[:, None] + np.arange(3)).ravel()
         nf = len(self.free)
         hat = clusters.hat
         self.rigid = hat is None
