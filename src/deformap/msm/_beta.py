@@ -317,7 +317,7 @@ def estimate_beta(rest_xs: Any, rest_ys: Any, rest_z: Any, deformed_points: Any,
     grid = ParticleGrid.from_heightmap(rest_xs, rest_ys, rest_z)
     observed = check_points("deformed_points", deformed_points, min_rows=1)
     model = PokeModel(grid.rest, grid.masses, grid.fixed, contact, cfg)
-    sweep = _Sweep(model, cKDTree(observed))
+    sweep = _Sweep(model, cKDTree(observed, balanced_tree=False))  # faster queries, same distances
     sweep.run(np.arange(cfg.n_beta) / cfg.n_beta, cfg.coarse_tol)
     if cfg.refines:
         _refine(sweep, 1.0 / cfg.n_beta, cfg.beta_resolution, cfg.tol)
