@@ -103,7 +103,7 @@ class StepMatrices:
         # dropped first and its array reused: for a β search that moves on through β (a batch
         # of β needing more factorisations than this at once would refactorise every step)
         self.max_factors: int | None = None
-        self._s1_csr: sp.csr_matrix | None = None
+        self._s1_mat: sp.csr_matrix | sp.dia_matrix | None = None
         self._pull: tuple[Array, Array, Array] | None = None
         self._pbtrs = get_lapack_funcs("pbtrs", (np.empty((1, 1)),))
 
@@ -184,9 +184,12 @@ class StepMatrices:
         self._factors[beta_fit] = fac  # the most recently used last
         return fac
 
-    def _s1(self) -> sp.csr_matrix:
-        """``S₁`` in band order as a full symmetric sparse matrix (built on first use)."""
-        if self._s1_csr is None:
+    def _s1(self) -> sp.csr_matrix | sp.dia_matrix:
+        """``S₁`` in band order as a full symmetric sparse matrix (built on first use): by
+        diagonals when its nonzeros lie on few of them (the free particles of a body with fixed
+        sides and floor form a box, and a cluster couples a fixed set of index offsets), which
+        multiplies faster; else in CSR."""
+        if self._s1_mat is None:
             bw, n = self._bw, self._band_shape[1]
             nz = self._band_v1 != 0.0
             r, j = np.divmod(self._band_at[nz], bw + 1)[::-1]
@@ -195,9 +198,11 @@ class StepMatrices:
             off = i != j
             rows = np.concatenate([i, j[off]])
             cols = np.concatenate([j, i[off]])
-            self._s1_csr = sp.csr_matrix((np.concatenate([v, v[off]]), (rows, cols)),
-                                         shape=(n, n))
-        return self._s1_csr
+            csr = sp.csr_matrix((np.concatenate([v, v[off]]), (rows, cols)), shape=(n, n))
+            offsets = np.unique(cols - rows)
+            dense = offsets.size * n  # the entries of the diagonal storage
+            self._s1_mat = csr.todia() if dense <= 2 * max(csr.nnz, 1) else csr
+        return self._s1_mat
 
     def _factor(self, beta_fit: float, reuse: Array | None = None) -> object:
         band = self.band(beta_fit, reuse)
