@@ -149,7 +149,7 @@ class StepMatrices:
                 raise InvalidArgumentError(
                     "a split step needs `factor_beta` <= `beta_fit` and the positions `x`")
             s1, xp = self._s1(), np.take(x, self._perm, axis=0)
-            # one column at a time: scipy's multi-vector CSR product is slower than three
+            # one column at a time: scipy's multi-vector sparse product is slower than three
             # single-vector ones (the same sums, in the same order)
             for d in range(scaled.shape[1]):
                 scaled[:, d] += (beta - key) * (s1 @ xp[:, d])
