@@ -293,7 +293,7 @@ def test_banded_step_solve_inverts_the_cluster_operator(rng, beta):
     per = t[:, None, :] + beta * (cl.hat @ xc)
     mapped = (cl.scatter(per[None])[0] / cl.count[..., None]).reshape(-1, 3)
     np.testing.assert_allclose((full - mapped)[sm.free], rhs, rtol=0, atol=1e-10)
-    band = sm._band0 - beta * sm._band1
+    band = sm.band(beta)
     sm._factors[float(beta)] = _SparseFallback(band, sm._bw)
     np.testing.assert_allclose(sm.solve(beta, rhs), x, rtol=0, atol=1e-10)
 
@@ -374,6 +374,19 @@ def test_split_step_needs_a_smaller_factorised_beta_and_the_positions(rng):
     np.testing.assert_allclose(sm.solve(0.6, rhs, factor_beta=0.5, x=x), x, rtol=0, atol=1e-10)
 
 
+def test_bounded_factorisations_reuse_arrays_and_refactorise_what_was_dropped(rng):
+    # a β search keeps a few factorisations (least recently used dropped, its array reused):
+    # every solve must be the one of an unbounded cache, also for a β dropped and refactorised
+    free = _step_matrices_9x9()
+    bounded = _step_matrices_9x9()
+    bounded.max_factors = 2
+    rhs = rng.normal(size=(len(free.free), 3))
+    for beta in (0.1, 0.5, 0.9, 0.1, 0.5):
+        np.testing.assert_array_equal(bounded.solve(beta, rhs), free.solve(beta, rhs))
+        assert len(bounded._factors) <= 2
+    assert sorted(bounded._factors) == [0.1, 0.5] and sorted(free._factors) == [0.1, 0.5, 0.9]
+
+
 @pytest.mark.parametrize("seed", range(20))
 def test_refinement_search_finds_the_grid_minimum_of_any_unimodal_curve(seed):
     # the parabolic search only chooses which β to solve: on any unimodal E it must stop at the
@@ -423,7 +436,7 @@ def test_failed_in_place_factorisation_falls_back_to_the_intact_matrix(rng):
     rhs = rng.normal(size=(len(sm.free), 3))
     x = sm.solve(1.5, rhs)
     assert isinstance(sm._factors[1.5], _SparseFallback)
-    band, bw = sm._band0 - 1.5 * sm._band1, sm._bw
+    band, bw = sm.band(1.5), sm._bw
     n = band.shape[1]
     upper = sp.diags([band[bw - k, k:] for k in range(bw + 1)], list(range(bw + 1)), shape=(n, n))
     full = (upper + sp.triu(upper, k=1).T).tocsr()

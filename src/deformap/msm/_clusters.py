@@ -73,11 +73,17 @@ def polar_components(m: Array, *, tol: float = 1e-14, max_iter: int = 30) -> Arr
     """
     norm = np.sqrt(np.sum(m * m, axis=0))
     x = m / np.maximum(norm, np.finfo(float).tiny)
-    a0, b0, c0, d0, e0, f0, g0, h0, i0 = x
-    det0 = a0 * (e0 * i0 - f0 * h0) - b0 * (d0 * i0 - f0 * g0) + c0 * (d0 * h0 - e0 * g0)
+    cof0, det0 = _cofactors(x)
     safe = det0 > 1e-9  # scaled Newton copes with any positive det; flat ones go to SVD
     all_safe = bool(np.all(safe))
-    cur = x if all_safe else np.ascontiguousarray(x[:, safe])
+    # Newton converges to the polar factor of its start: started from R h(U), the closed-form
+    # estimate below (h ≈ 1, symmetric positive definite), it lands on the R of x = R U in one
+    # or two steps instead of five or six from x itself
+    if all_safe:
+        cur = _polar_start(x, cof0, det0)
+    else:
+        cur = _polar_start(np.ascontiguousarray(x[:, safe]), np.ascontiguousarray(cof0[:, safe]),
+                           det0[safe])
     step = np.inf
     for _ in range(max_iter):
         cof, det = _cofactors(cur)
@@ -87,7 +93,7 @@ def polar_components(m: Array, *, tol: float = 1e-14, max_iter: int = 30) -> Arr
         new = cur * (0.5 / gamma)
         cof *= 0.5 * gamma / det
         new += cof
-        diff = cur - new  # not in place: ``cur`` may be ``x``, which the SVD fallback reads
+        diff = np.subtract(cur, new, out=cur)  # ``cur`` is a start or an iterate, never ``x``
         np.abs(diff, out=diff)
         step = float(diff.max()) if diff.size else 0.0
         cur = new
@@ -103,6 +109,48 @@ def polar_components(m: Array, *, tol: float = 1e-14, max_iter: int = 30) -> Arr
     redo = ~safe
     redo[np.flatnonzero(safe)[~ok]] = True
     out[:, redo] = polar_rotation(x[:, redo].T.reshape(-1, 3, 3)).reshape(-1, 9).T
+    return out
+
+
+def _polar_start(x: Array, cof: Array, det: Array) -> Array:
+    """``R h(U)`` for ``(9, n)`` row-major matrices ``x = R U`` of unit Frobenius norm and
+    positive determinant (``cof``, ``det``: their :func:`_cofactors`, overwritten), with
+    ``h(U) ≈ I`` symmetric positive definite: the closed-form polar
+    factor ``R = x U⁻¹``, ``U = √(xᵀx)``, as
+    ``R = [(I_U² − II_U) x + I_U cof(x) − x xᵀx] / (I_U II_U − det x)`` (``I_U``, ``II_U`` the
+    invariants of ``U``, from the eigenvalues of ``xᵀx``; ``cof(x) = det(x) x⁻ᵀ``; the
+    interpolation of ``σ⁻¹`` on the singular values by ``α + β σ⁻² + γ σ²``).
+
+    The combination is exact for the right invariants; with inexact ones (a nearly repeated
+    eigenvalue) it is still ``R`` times a symmetric positive definite function of ``U``, whose
+    polar factor is exactly ``R``: the Newton iteration that follows removes it.
+    """
+    a, b, c, d, e, f, g, h, i = x
+    # invariants of C = xᵀx from sums of squares: tr C = ‖x‖² = 1, II_C = ‖cof x‖², det C = det²
+    ii = np.sum(cof * cof, axis=0)
+    # largest eigenvalue of C (trigonometric solution of its characteristic cubic)
+    p = np.sqrt(np.maximum(1.0 / 9.0 - ii / 3.0, 0.0))
+    half = np.maximum(2.0 * p**3, np.finfo(float).tiny)
+    r = np.clip((2.0 / 27.0 - ii / 3.0 + det * det) / half, -1.0, 1.0)
+    lam1 = 1.0 / 3.0 + 2.0 * p * np.cos(np.arccos(r) / 3.0)
+    # the singular values σ₁ = √λ₁ and σ₂ σ₃ = det / σ₁, σ₂ + σ₃ = √(λ₂ + λ₃ + 2 σ₂ σ₃)
+    s1 = np.sqrt(lam1)
+    s23 = det / s1
+    s2_s3 = np.sqrt(np.maximum((ii - det * det / lam1) / lam1, 0.0) + 2.0 * s23)
+    i_u = s1 + s2_s3
+    ii_u = s1 * s2_s3 + s23
+    denom = i_u * ii_u - det
+    # x C, C = xᵀx symmetric
+    c11, c22, c33 = a * a + d * d + g * g, b * b + e * e + h * h, c * c + f * f + i * i
+    c12, c13, c23 = a * b + d * e + g * h, a * c + d * f + g * i, b * c + e * f + h * i
+    out = x * ((i_u * i_u - ii_u) / denom)
+    cof *= i_u / denom
+    out += cof
+    inv = 1.0 / denom
+    for row, (u, v, w) in enumerate(((a, b, c), (d, e, f), (g, h, i))):
+        out[3 * row] -= (u * c11 + v * c12 + w * c13) * inv
+        out[3 * row + 1] -= (u * c12 + v * c22 + w * c23) * inv
+        out[3 * row + 2] -= (u * c13 + v * c23 + w * c33) * inv
     return out
 
 
@@ -254,8 +302,10 @@ class Clusters:
         for axis, (w, c) in enumerate(zip(self.window, self.cshape, strict=True), start=1):
             shape = list(out.shape)
             shape[axis] = c + w - 1
-            acc = np.zeros(shape)
-            for o in range(w):
+            acc = np.empty(shape)
+            acc[_cut(axis, 0, c)] = out  # the first shift copied, not added to zeros
+            acc[_cut(axis, c, c + w - 1)] = 0.0
+            for o in range(1, w):
                 acc[_cut(axis, o, o + c)] += out
             out = acc
         return out

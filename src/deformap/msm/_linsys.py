@@ -48,6 +48,9 @@ class StepMatrices:
         is_fixed = fixed.ravel()
         self.free = np.flatnonzero(~is_fixed)
         self.fix = np.flatnonzero(is_fixed)
+        # the same as indices into flattened (n, 3) positions
+        self.flat_free = (3 * self.free[:, None] + np.arange(3)).ravel()
+        self.flat_fix = (3 * self.fix[:, None] + np.arange(3)).ravel()
         nf = len(self.free)
         hat = clusters.hat
         self.rigid = hat is None
@@ -83,19 +86,36 @@ class StepMatrices:
         up = br <= bc
         br, bc = br[up], bc[up]
         self._bw = int(np.max(bc - br)) if bc.size else 0
-        # column-major, as LAPACK stores bands: a factorisation then copies nothing
-        self._band0 = np.zeros((self._bw + 1, nf), order="F")
-        self._band0[self._bw + br - bc, bc] = -vw[ff][up]
-        self._band0[self._bw] += self._scale[self._perm]
-        self._band1 = np.zeros((self._bw + 1, nf), order="F")
-        self._band1[self._bw + br - bc, bc] = vp[ff][up]
+        # the nonzeros of both bands, as flat indices into a column-major (LAPACK) band array:
+        # entry S[i, j], i ≤ j, is band[bw + i − j, j]; a factorisation fills a band from them
+        # (in a recycled array when the number of factorisations kept is bounded)
+        self._band_shape = (self._bw + 1, nf)
+        diag = self._bw + (self._bw + 1) * np.arange(nf)
+        at = np.concatenate([(self._bw + br - bc) + (self._bw + 1) * bc, diag])
+        self._band_at, slot = np.unique(at, return_inverse=True)
+        zeros = np.zeros(nf)
+        self._band_v0 = np.bincount(slot, np.concatenate([-vw[ff][up], self._scale[self._perm]]),
+                                    minlength=self._band_at.size)
+        self._band_v1 = np.bincount(slot, np.concatenate([vp[ff][up], zeros]),
+                                    minlength=self._band_at.size)
         self._factors: dict[float, object] = {}
-        self._s1_csr: sp.csr_matrix | None = None
-        self._pbtrs = get_lapack_funcs("pbtrs", (self._band0,))
+        # at most this many factorisations are kept (None: all), the least recently used
+        # dropped first and its array reused: for a β search that moves on through β (a batch
+        # of β needing more factorisations than this at once would refactorise every step)
+        self.max_factors: int | None = None
+        self._s1_mat: sp.csr_matrix | sp.dia_matrix | None = None
+        self._pull: tuple[Array, Array, Array] | None = None
+        self._pbtrs = get_lapack_funcs("pbtrs", (np.empty((1, 1)),))
 
-    def couple(self, beta_fit: float) -> sp.csr_matrix:
-        """``(n_free, n_fix)`` block that carries the fixed particles into the free rows."""
-        return self.couple_w + beta_fit * self.couple_p
+    def pull(self, x_fixed: Array) -> tuple[Array, Array]:
+        """``(couple_w @ x_fixed, couple_p @ x_fixed)``, each ``(n_free, 3)``: the term that
+        carries the fixed particles into the free rows is ``w + β p`` for any β (kept for the
+        last ``x_fixed``, which a β search passes unchanged to every solve)."""
+        last = self._pull
+        if last is None or not np.array_equal(last[0], x_fixed):
+            x = np.array(x_fixed, dtype=float)
+            last = self._pull = (x, np.asarray(self.couple_w @ x), np.asarray(self.couple_p @ x))
+        return last[1], last[2]
 
     def prepare(self, beta_fit: float, max_split: float = 0.0) -> float:
         """Factorise what solving ``beta_fit`` needs and return the β′ whose factorisation it
@@ -128,7 +148,11 @@ class StepMatrices:
             if x is None or key > beta:
                 raise InvalidArgumentError(
                     "a split step needs `factor_beta` <= `beta_fit` and the positions `x`")
-            scaled += (beta - key) * (self._s1() @ np.take(x, self._perm, axis=0))
+            s1, xp = self._s1(), np.take(x, self._perm, axis=0)
+            # one column at a time: scipy's multi-vector sparse product is slower than three
+            # single-vector ones (the same sums, in the same order)
+            for d in range(scaled.shape[1]):
+                scaled[:, d] += (beta - key) * (s1 @ xp[:, d])
         if isinstance(fac, np.ndarray):
             sol, info = self._pbtrs(fac, scaled, lower=0)
             if info != 0:
@@ -137,34 +161,55 @@ class StepMatrices:
             sol = fac.solve(scaled)  # type: ignore[attr-defined]
         return np.take(sol, self._unperm, axis=0)
 
+    def band(self, beta_fit: float, out: Array | None = None) -> Array:
+        """``S_β = S₀ − β S₁`` in LAPACK's upper band storage ``(bw + 1, n_free)``, column-major,
+        in band order (into ``out``, a column-major array of that shape, if given)."""
+        if out is None:
+            out = np.zeros(self._band_shape, order="F")
+        else:
+            out.fill(0.0)
+        flat = out.T.reshape(-1)  # a view: out.T is row-major
+        flat[self._band_at] = self._band_v0 - beta_fit * self._band_v1
+        return out
+
     def _factor_of(self, beta_fit: float) -> object:
-        fac = self._factors.get(beta_fit)
+        fac = self._factors.pop(beta_fit, None)
         if fac is None:
-            fac = self._factor(beta_fit)
-            self._factors[beta_fit] = fac
+            reuse = None
+            if self.max_factors is not None and len(self._factors) >= max(self.max_factors, 1):
+                old = self._factors.pop(next(iter(self._factors)))  # least recently used
+                if isinstance(old, np.ndarray):
+                    reuse = old
+            fac = self._factor(beta_fit, reuse)
+        self._factors[beta_fit] = fac  # the most recently used last
         return fac
 
-    def _s1(self) -> sp.csr_matrix:
-        """``S₁`` in band order as a full symmetric sparse matrix (built on first use)."""
-        if self._s1_csr is None:
-            bw, n = self._bw, self._band1.shape[1]
-            r, j = np.nonzero(self._band1)
+    def _s1(self) -> sp.csr_matrix | sp.dia_matrix:
+        """``S₁`` in band order as a full symmetric sparse matrix (built on first use): by
+        diagonals when its nonzeros lie on few of them (the free particles of a body with fixed
+        sides and floor form a box, and a cluster couples a fixed set of index offsets), which
+        multiplies faster; else in CSR."""
+        if self._s1_mat is None:
+            bw, n = self._bw, self._band_shape[1]
+            nz = self._band_v1 != 0.0
+            r, j = np.divmod(self._band_at[nz], bw + 1)[::-1]
             i = j - (bw - r)  # band[bw + i − j, j] = S[i, j], i ≤ j
-            v = self._band1[r, j]
+            v = self._band_v1[nz]
             off = i != j
             rows = np.concatenate([i, j[off]])
             cols = np.concatenate([j, i[off]])
-            self._s1_csr = sp.csr_matrix((np.concatenate([v, v[off]]), (rows, cols)),
-                                         shape=(n, n))
-        return self._s1_csr
+            csr = sp.csr_matrix((np.concatenate([v, v[off]]), (rows, cols)), shape=(n, n))
+            offsets = np.unique(cols - rows)
+            dense = offsets.size * n  # the entries of the diagonal storage
+            self._s1_mat = csr.todia() if dense <= 2 * max(csr.nnz, 1) else csr
+        return self._s1_mat
 
-    def _factor(self, beta_fit: float) -> object:
-        band = np.multiply(self._band1, -beta_fit, order="F")
-        band += self._band0
+    def _factor(self, beta_fit: float, reuse: Array | None = None) -> object:
+        band = self.band(beta_fit, reuse)
         try:
             return cholesky_banded(band, overwrite_ab=True, lower=False, check_finite=False)
         except LinAlgError:  # ``band`` was overwritten by the failed factorisation
-            return _SparseFallback(self._band0 - beta_fit * self._band1, self._bw)
+            return _SparseFallback(self.band(beta_fit), self._bw)
 
 
 class _SparseFallback:

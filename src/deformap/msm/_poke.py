@@ -170,20 +170,22 @@ class Equilibrium:
         cl, nb = self.cl, len(self.betas)
         rest = cl.rest.reshape(-1, 3)
         self.const = np.empty((nb, len(self.free), 3))
+        pull_w, pull_p = self.system.pull(x_fixed)
+        load = np.take(force, self.free, axis=0) / stiffness
         for j in range(nb):
-            self.const[j] = (self.fit_weight[j] * self.system.fit_const
-                             + self.system.couple(self.fit_weight[j]) @ x_fixed
-                             + force[self.free] / stiffness)
+            self.const[j] = (self.fit_weight[j] * (self.system.fit_const + pull_p)
+                             + pull_w + load)
+        # flat indices: np.take / put on the flattened rows are several times faster than
+        # fancy indexing of (n, 3) rows
+        flat_free, flat_fix = self.system.flat_free, self.system.flat_fix
         x = np.broadcast_to(rest, (nb, *rest.shape)).copy()
-        if x0 is not None:
-            x[:, self.free] = np.asarray(x0).reshape(nb, -1, 3)[:, self.free]
-        x[:, self.fix] = x_fixed
-        # the free positions, kept in step with ``x`` (flat indices: np.take / put on the
-        # flattened rows are several times faster than fancy indexing of (n, 3) rows)
-        x_free = np.take(x, self.free, axis=1)
-        flat_free = (3 * self.free[:, None] + np.arange(3)).ravel()
-        rest_free = np.take(rest, self.free, axis=0)
         x_rows = x.reshape(nb, -1)  # a view: x is contiguous
+        if x0 is not None:
+            x_rows[:, flat_free] = np.take(np.asarray(x0).reshape(nb, -1), flat_free, axis=1)
+        x_rows[:, flat_fix] = np.asarray(x_fixed).reshape(-1)
+        # the free positions, kept in step with ``x``
+        x_free = np.take(x, self.free, axis=1)
+        rest_free = np.take(rest, self.free, axis=0)
         nf = len(self.free) * 3
         iters = np.zeros(nb, dtype=np.int64)
         resid = np.full(nb, np.inf)
@@ -241,8 +243,14 @@ def _row_norm2(v: Array) -> Array:
     return np.asarray(np.einsum("...i,...i->...", v, v))
 
 
+Solution = tuple[Array, NDArray[np.int64], Array, NDArray[np.bool_]]
+"""Positions ``(B, *body, 3)``, iterations, residuals and converged flags of
+:meth:`Equilibrium.solve`."""
+
+
 def calibrate_stiffness(eq0: Equilibrium, x_fixed: Array, weights: Array, contact: TactileContact,
-                        config: ShapeMatchingConfig, spacing: float) -> tuple[float, Array | None]:
+                        config: ShapeMatchingConfig, spacing: float,
+                        ) -> tuple[float, Solution | None]:
     """Spring stiffness ``k`` (N/m) such that the β = 0 body dents like the reference half-space.
 
     ``eq0`` must hold the single β = 0. ``k`` is found by fixed-point (secant) iteration on
@@ -252,8 +260,9 @@ def calibrate_stiffness(eq0: Equilibrium, x_fixed: Array, weights: Array, contac
     Each equilibrium is solved to ``config.coarse_tol`` (a relative tolerance far below the
     0.1 % asked of the depth).
 
-    Returns ``k`` and the β = 0 equilibrium ``(1, *body, 3)`` at that ``k`` (``None`` if the
-    depth did not match within 8 steps, when ``k`` is the last secant estimate).
+    Returns ``k`` and the β = 0 solve at that ``k`` (:meth:`Equilibrium.solve`'s positions
+    ``(1, *body, 3)``, iterations, residual and converged flag; ``None`` if the depth did not
+    match within 8 steps, when ``k`` is the last secant estimate).
     """
     f_mag = contact.force_n
     force = weights.reshape(-1, 1) * contact.force[None, :]
@@ -263,12 +272,13 @@ def calibrate_stiffness(eq0: Equilibrium, x_fixed: Array, weights: Array, contac
     k = f_mag / delta_ref  # a first guess: one particle carrying the whole load
     x0 = None
     for _ in range(8):
-        x, _, _, _ = eq0.solve(x_fixed, force, k, config.coarse_tol, config.max_iter, spacing,
-                               x0=x0)
+        solution = eq0.solve(x_fixed, force, k, config.coarse_tol, config.max_iter, spacing,
+                             x0=x0)
+        x = solution[0]
         depth = float(np.sum(weights.ravel() * ((x[0].reshape(-1, 3) - rest) @ contact.direction)))
         ratio = depth / delta_ref
         if abs(ratio - 1.0) < 1e-3:
-            return k, x
+            return k, solution
         k *= ratio  # secant on the (nearly 1/k) depth–stiffness relation
         # displacements scale nearly as 1/k: start the next solve from the scaled equilibrium
         x0 = rest + (x.reshape(1, -1, 3) - rest) / ratio

@@ -16,6 +16,7 @@ from deformap.msm._linsys import StepMatrices
 from deformap.msm._poke import (
     Equilibrium,
     PokeSimulation,
+    Solution,
     calibrate_stiffness,
     force_weights,
 )
@@ -196,6 +197,7 @@ class PokeModel:
         # the β = 0 equilibrium found by the calibration (to ``coarse_tol``), or None: a start
         # for solves that have none closer
         self.start: Array | None = None
+        self._calibrated: Solution | None = None
         if cfg.contact == "pinned":
             pinned = body_fixed.ravel().copy()
             pinned[near] = True  # the top layer comes first in the flat order
@@ -214,9 +216,25 @@ class PokeModel:
         self.force = weights.reshape(-1, 1) * contact.force[None, :]
         if stiffness_n_per_m is None:
             eq0 = Equilibrium(self.clusters, body_fixed, np.zeros(1), system=self.system)
-            stiffness_n_per_m, self.start = calibrate_stiffness(
+            stiffness_n_per_m, self._calibrated = calibrate_stiffness(
                 eq0, self.x_fixed, weights, contact, cfg, self.spacing)
+            if self._calibrated is not None:
+                self.start = self._calibrated[0]
         self.stiffness = float(stiffness_n_per_m)
+
+    def calibrated(self, tol: float) -> tuple[PokeSimulation, Array] | None:
+        """The β = 0 equilibrium that the stiffness calibration solved (to ``coarse_tol``), as
+        :meth:`solve` would return it, if that is ``tol`` or looser and it converged; else
+        ``None``."""
+        if self._calibrated is None or tol < self.cfg.coarse_tol:
+            return None
+        x, it, res, conv = self._calibrated
+        if not conv.all():
+            return None
+        sim = PokeSimulation(betas=np.zeros(1), positions=x[:, 0], iterations=it, residual=res,
+                             converged=conv, protocol=self.cfg.contact,
+                             stiffness_n_per_m=self.stiffness)
+        return sim, x
 
     def solve(self, betas: Array, x0: Array | None = None, tol: float | None = None, *,
               max_split: float = 0.0) -> tuple[PokeSimulation, Array]:
