@@ -39,8 +39,9 @@ to noise, β̂ re-read on each, :mod:`deformap.explore._dent_noise`): about 0.01
 0.12 on 60 / 110 / 150 / 250 N blocks, about twice the spread of β̂ over eight places on one block
 (0.004 / 0.015 / 0.028 / 0.050), so it errs on the safe side. The floor stands for what the noise
 does not explain (a 150 N block's eight places spread by 0.03).
-Next pokes by ``max-variance`` (the paper's random choice is ``paper``):
-with these settings it needs 7 pokes to bring every cell below 0.06 where ``paper`` needs 8–12.
+Next pokes by ``planned`` (:mod:`deformap.explore._planning`): with these settings it needs 5
+pokes, the centre included, to bring every cell of a 60×40 cm table below 0.06, where
+``max-variance`` needs 7 and the paper's random choice (``paper``) 8–12.
 """
 
 from __future__ import annotations
