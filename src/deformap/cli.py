@@ -95,7 +95,8 @@ def _progress_row(poke: Any) -> None:
         f"  poke {r['index'] + 1:>2}  target ({r['target_xy'][0]:.3f}, {r['target_xy'][1]:.3f}) m"
         f"  force {r['force_n']:.2f} N  β = {r['beta']:.3f} ± {r['beta_std']:.3f}"
         f"  max var {r['max_variance_after']:.4f}"
-        f"  [dim](compute {compute:.2f} s, world {t.get('environment_s', 0.0):.2f} s)[/]",
+        + (f"  plan: {r['planned_after']} more" if "planned_after" in r else "")
+        + f"  [dim](compute {compute:.2f} s, world {t.get('environment_s', 0.0):.2f} s)[/]",
         highlight=False,
     )
 

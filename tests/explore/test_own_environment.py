@@ -9,6 +9,7 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+import pytest
 
 from deformap.cloud import PointCloud
 from deformap.environment import PressObservation, Workspace
@@ -89,11 +90,12 @@ class TwoFoamTable:
         self.pressing = False
 
 
-def test_the_loop_maps_an_environment_written_by_a_user() -> None:
+@pytest.mark.parametrize("strategy", ["max-variance", "planned"])
+def test_the_loop_maps_an_environment_written_by_a_user(strategy: str) -> None:
     env = TwoFoamTable(np.random.default_rng(3))
     config = ExplorationConfig(
         max_pokes=4,
-        strategy="max-variance",
+        strategy=strategy,  # type: ignore[arg-type]
         first_target=(0.06, 0.08),
         surface=SurfaceGPConfig(fit_hyperparameters=False, length_scale_m=0.02),
         beta_field=BetaFieldConfig(length_scale_m=0.06),
@@ -103,7 +105,13 @@ def test_the_loop_maps_an_environment_written_by_a_user() -> None:
     assert not env.pressing  # every press was released
     soft = [p.record["beta"] for p in result.pokes if p.xy[0] < 0.11]
     hard = [p.record["beta"] for p in result.pokes if p.xy[0] > 0.13]
-    assert soft and hard, "max-variance must visit both halves"
+    assert soft and hard, f"{strategy} must visit both halves"
+    planned = [p.record.get("planned_after") for p in result.pokes[1:]]
+    if strategy == "planned":  # each later poke came from a plan, which shrinks as pokes are made
+        assert all(isinstance(n, int) and n >= 0 for n in planned)
+        assert planned == sorted(planned, reverse=True)
+    else:
+        assert planned == [None] * len(planned)
     assert min(soft) > max(hard), (soft, hard)
     regions = result.mapper.regions()
     assert regions.n_regions == 2

@@ -342,7 +342,9 @@ class Mapper:
         return float(self.field()[1].ravel()[self.stop_mask].max())
 
     def next_target(self, rng: np.random.Generator) -> NDArray[np.float64] | None:
-        """The next target by the configured strategy, or ``None`` when the map is known."""
+        """The next target by the configured strategy, or ``None`` when the map is known
+        (``planned``: the plan it came from is kept in ``last_plan``)."""
+        self.last_plan = None
         _, var = self.field()
         variance = var.ravel()
         if variance[self.stop_mask].max() <= self.config.threshold:
