@@ -84,11 +84,13 @@ class RegionMap:
         return int(self.class_betas.size)
 
 
-def _shares(values: NDArray[np.float64]) -> tuple[NDArray, NDArray, NDArray, NDArray]:
+def _best_splits(values: NDArray[np.float64]) -> tuple[NDArray, NDArray, NDArray, NDArray,
+                                                       NDArray]:  # fmt: skip
     """Best 2- and 3-part splits of each sorted row of ``values (m, n)``.
 
-    Returns the shares of variance they explain, ``r2 (m,)`` and ``r3 (m,)`` (0 for rows without
-    spread), and their cut indices, ``cut2 (m,)`` and ``cuts3 (m, 2)``.
+    Returns the between-part sums of squares of the best splits, ``b2 (m,)`` and ``b3 (m,)``, the
+    rows' total sums of squares ``spread (m,)``, and the cut indices, ``cut2 (m,)`` and ``cuts3
+    (m, 2)``.
     """
     m, n = values.shape
     csum = np.concatenate([np.zeros((m, 1)), np.cumsum(values, axis=1)], axis=1)
@@ -109,22 +111,21 @@ def _shares(values: NDArray[np.float64]) -> tuple[NDArray, NDArray, NDArray, NDA
     else:
         between3 = np.zeros((m, 1))
         i3 = j3 = np.array([1])
-    with np.errstate(invalid="ignore", divide="ignore"):
-        r2 = np.where(spread > 0, between2.max(axis=1) / spread, 0.0)
-        r3 = np.where(spread > 0, between3.max(axis=1) / spread, 0.0)
+    # round-off can leave a tiny between-sum on a row without spread
+    b2 = np.where(spread > 0, between2.max(axis=1), 0.0)
+    b3 = np.where(spread > 0, between3.max(axis=1), 0.0)
     best3 = np.argmax(between3, axis=1)
-    return r2, r3, cut2[np.argmax(between2, axis=1)], np.column_stack([i3[best3], j3[best3]])
+    return b2, b3, spread, cut2[np.argmax(between2, axis=1)], np.column_stack([i3[best3], j3[best3]])
 
 
 def _statistics(values: NDArray[np.float64], prior: float) -> tuple[NDArray, NDArray, NDArray,
                                                                      NDArray]:  # fmt: skip
     """Split statistics ``T = between / (prior + within)`` of the best 2- and 3-part splits of
-    each sorted row of ``values (m, n)``, with their cuts (see :func:`_shares`)."""
-    r2, r3, cut2, cuts3 = _shares(values)
-    spread = np.sum((values - values.mean(axis=1, keepdims=True)) ** 2, axis=1)
+    each sorted row of ``values (m, n)``, with their cuts (see :func:`_best_splits`)."""
+    b2, b3, spread, cut2, cuts3 = _best_splits(values)
     with np.errstate(invalid="ignore", divide="ignore"):
-        t2 = np.nan_to_num(r2 * spread / (prior + (1.0 - r2) * spread))
-        t3 = np.nan_to_num(r3 * spread / (prior + (1.0 - r3) * spread))
+        t2 = np.nan_to_num(b2 / (prior + (spread - b2)))
+        t3 = np.nan_to_num(b3 / (prior + (spread - b3)))
     return t2, t3, cut2, cuts3
 
 
