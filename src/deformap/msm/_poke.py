@@ -194,6 +194,13 @@ class Equilibrium:
         n_hist = np.zeros(nb, dtype=np.int64)
         prev_f = np.zeros((nb, nf))
         prev_g = np.zeros((nb, nf))
+        # residual at the last accepted point, and whether the current point is an Anderson
+        # extrapolation (and not a plain step) from it
+        accepted_r = np.full(nb, np.inf)
+        mixed = np.zeros(nb, dtype=bool)
+        # plain steps still to take before mixing again, and consecutive rejections
+        wait = np.zeros(nb, dtype=np.int64)
+        rejected = np.zeros(nb, dtype=np.int64)
         active = np.arange(nb)
         floor = 1e-6 * spacing
         stop = tol * (1.0 - self.split)
@@ -203,14 +210,28 @@ class Equilibrium:
             step = np.sqrt(np.max(_row_norm2(f.reshape(g.shape)), axis=1))
             disp = np.sqrt(np.max(_row_norm2(g - rest_free), axis=1))
             r = step / np.maximum(disp, floor)
-            grew = r > resid[active]
+            grew = r > accepted_r[active]
             resid[active], iters[active] = r, it
             done = r < stop[active]
             x_new = g.reshape(len(active), -1).copy()
             for a, j in enumerate(active.tolist()):
                 if done[a]:
                     continue
-                if n_hist[j] and not grew[a]:
+                if mixed[j] and grew[a]:
+                    # safeguard: an extrapolation that increased the residual is rejected and
+                    # the plain step from the last accepted point taken instead (its image
+                    # ``prev_g``), with a fresh history
+                    x_new[a] = prev_g[j]
+                    n_hist[j], mixed[j] = 1, False
+                    rejected[j] += 1
+                    wait[j] = 2 ** min(int(rejected[j]), 6)
+                    continue
+                if mixed[j]:
+                    rejected[j] = 0
+                accepted_r[j] = r[a]
+                mixed[j] = bool(n_hist[j]) and not grew[a] and not wait[j]
+                wait[j] = max(int(wait[j]) - 1, 0)
+                if mixed[j]:
                     slot = (n_hist[j] - 1) % memory
                     hist_f[j, slot] = f[a] - prev_f[j]
                     hist_g[j, slot] = g[a].ravel() - prev_g[j]
