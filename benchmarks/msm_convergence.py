@@ -62,7 +62,8 @@ def main() -> None:
     elif args.cases:
         pick = np.random.default_rng(1).choice(len(grid), size=args.cases, replace=False)
         grid = [grid[i] for i in sorted(pick)]
-    print("   n  h_mm    F tip_mm  hard nb   beta_hat ok  max_it sum_it  time_s  failed β (steps, resid)")
+    print("   n  h_mm    F tip_mm  hard nb   beta_hat ok  max_it sum_it  time_s"
+          "  failed β (steps, resid)")
     for case in grid:
         r = run_case(*case)
         fails = " ".join(f"{b:g}({i},{res:.1e})" for b, i, res in r["failed"])

@@ -53,6 +53,10 @@ Array = NDArray[np.float64]
 
 _ROT_BATCH = 4
 
+_MAX_WAIT_LOG2 = 6
+"""After the ``n``-th consecutive rejected Anderson step a β takes ``2^min(n, 6) − 1`` plain
+steps before mixing again (see :meth:`Equilibrium.solve`)."""
+
 
 @dataclass(frozen=True, kw_only=True)
 class PokeSimulation:
@@ -157,7 +161,14 @@ class Equilibrium:
         ``x_fixed (n_fix, 3)``: positions of the fixed particles; ``force (n, 3)`` newtons.
         Returns positions ``(B, ny, nx, 3)``, iterations, residuals ``max‖G(x) − x‖ / max‖G(x) −
         p⁰‖`` and converged flags. Anderson acceleration (type II, ``memory`` past steps, Walker &
-        Ni 2011) replaces the plain step; it is restarted whenever it increases the residual.
+        Ni 2011) replaces the plain step, safeguarded: an extrapolated point whose residual exceeds
+        that of the point it was extrapolated from is rejected, and the plain step from that point
+        (already computed) taken instead, with a fresh history; after ``n`` consecutive rejections
+        ``2^min(n, 6) − 1`` plain steps follow before mixing again. A plain step that increases
+        the residual restarts the history. Near large rotations (clusters under a deep dent
+        turning inside out at high β) the step map is strongly non-linear: the residual of plain
+        steps first grows, then contracts, and unguarded extrapolations kept throwing the iterate
+        back into the growing phase (a cycle of ~27 steps until ``max_iter``).
         ``x0 (B, *grid, 3)``, optional: starting positions (only the free particles' are used, e.g.
         the equilibrium of a nearby β); the rest shape by default. The fixed point does not
         depend on it.
@@ -220,11 +231,12 @@ class Equilibrium:
                 if mixed[j] and grew[a]:
                     # safeguard: an extrapolation that increased the residual is rejected and
                     # the plain step from the last accepted point taken instead (its image
-                    # ``prev_g``), with a fresh history
+                    # ``prev_g``), with a fresh history; repeated rejections wait longer
+                    # (plain steps) before mixing again
                     x_new[a] = prev_g[j]
                     n_hist[j], mixed[j] = 1, False
                     rejected[j] += 1
-                    wait[j] = 2 ** min(int(rejected[j]), 6)
+                    wait[j] = 2 ** min(int(rejected[j]), _MAX_WAIT_LOG2) - 1
                     continue
                 if mixed[j]:
                     rejected[j] = 0
