@@ -53,6 +53,10 @@ Array = NDArray[np.float64]
 
 _ROT_BATCH = 4
 
+_MAX_WAIT_LOG2 = 6
+"""After the ``n``-th consecutive rejected Anderson step a β takes ``2^min(n, 6) − 1`` plain
+steps before mixing again (see :meth:`Equilibrium.solve`)."""
+
 
 @dataclass(frozen=True, kw_only=True)
 class PokeSimulation:
@@ -157,7 +161,14 @@ class Equilibrium:
         ``x_fixed (n_fix, 3)``: positions of the fixed particles; ``force (n, 3)`` newtons.
         Returns positions ``(B, ny, nx, 3)``, iterations, residuals ``max‖G(x) − x‖ / max‖G(x) −
         p⁰‖`` and converged flags. Anderson acceleration (type II, ``memory`` past steps, Walker &
-        Ni 2011) replaces the plain step; it is restarted whenever it increases the residual.
+        Ni 2011) replaces the plain step, safeguarded: an extrapolated point whose residual exceeds
+        that of the point it was extrapolated from is rejected, and the plain step from that point
+        (already computed) taken instead, with a fresh history; after ``n`` consecutive rejections
+        ``2^min(n, 6) − 1`` plain steps follow before mixing again. A plain step that increases
+        the residual restarts the history. Near large rotations (clusters under a deep dent
+        turning inside out at high β) the step map is strongly non-linear: the residual of plain
+        steps first grows, then contracts, and unguarded extrapolations kept throwing the iterate
+        back into the growing phase (a cycle of ~27 steps until ``max_iter``).
         ``x0 (B, *grid, 3)``, optional: starting positions (only the free particles' are used, e.g.
         the equilibrium of a nearby β); the rest shape by default. The fixed point does not
         depend on it.
@@ -194,6 +205,13 @@ class Equilibrium:
         n_hist = np.zeros(nb, dtype=np.int64)
         prev_f = np.zeros((nb, nf))
         prev_g = np.zeros((nb, nf))
+        # residual at the last accepted point, and whether the current point is an Anderson
+        # extrapolation (and not a plain step) from it
+        accepted_r = np.full(nb, np.inf)
+        mixed = np.zeros(nb, dtype=bool)
+        # plain steps still to take before mixing again, and consecutive rejections
+        wait = np.zeros(nb, dtype=np.int64)
+        rejected = np.zeros(nb, dtype=np.int64)
         active = np.arange(nb)
         floor = 1e-6 * spacing
         stop = tol * (1.0 - self.split)
@@ -203,14 +221,29 @@ class Equilibrium:
             step = np.sqrt(np.max(_row_norm2(f.reshape(g.shape)), axis=1))
             disp = np.sqrt(np.max(_row_norm2(g - rest_free), axis=1))
             r = step / np.maximum(disp, floor)
-            grew = r > resid[active]
+            grew = r > accepted_r[active]
             resid[active], iters[active] = r, it
             done = r < stop[active]
             x_new = g.reshape(len(active), -1).copy()
             for a, j in enumerate(active.tolist()):
                 if done[a]:
                     continue
-                if n_hist[j] and not grew[a]:
+                if mixed[j] and grew[a]:
+                    # safeguard: an extrapolation that increased the residual is rejected and
+                    # the plain step from the last accepted point taken instead (its image
+                    # ``prev_g``), with a fresh history; repeated rejections wait longer
+                    # (plain steps) before mixing again
+                    x_new[a] = prev_g[j]
+                    n_hist[j], mixed[j] = 1, False
+                    rejected[j] += 1
+                    wait[j] = 2 ** min(int(rejected[j]), _MAX_WAIT_LOG2) - 1
+                    continue
+                if mixed[j]:
+                    rejected[j] = 0
+                accepted_r[j] = r[a]
+                mixed[j] = bool(n_hist[j]) and not grew[a] and not wait[j]
+                wait[j] = max(int(wait[j]) - 1, 0)
+                if mixed[j]:
                     slot = (n_hist[j] - 1) % memory
                     hist_f[j, slot] = f[a] - prev_f[j]
                     hist_g[j, slot] = g[a].ravel() - prev_g[j]
