@@ -442,3 +442,15 @@ def test_failed_in_place_factorisation_falls_back_to_the_intact_matrix(rng):
     full = (upper + sp.triu(upper, k=1).T).tocsr()
     np.testing.assert_allclose(full @ x[sm._perm], (sm._scale[:, None] * rhs)[sm._perm],
                                rtol=0, atol=1e-10)
+
+
+def test_beta_hat_skips_loose_and_unconverged_beta() -> None:
+    from deformap.msm._beta import _best_index
+
+    errors = np.array([3.0, 1.0, 2.0, 2.5, 0.5])
+    compared = np.array([True, True, True, True, False])  # the last was only swept loosely
+    converged = np.array([True, False, True, True, True])  # the lowest compared one stalled
+    assert _best_index(errors, compared, converged) == 2
+    assert _best_index(errors, compared, np.ones(5, dtype=bool)) == 1
+    # none converged: the lowest compared one, and the estimate reports all_converged False
+    assert _best_index(errors, compared, np.zeros(5, dtype=bool)) == 1

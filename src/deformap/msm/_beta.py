@@ -44,7 +44,8 @@ class BetaEstimate:
     ----------
     beta : float
         β̂, the minimiser of E(β) over the β solved to ``config.tol`` (those the refinement
-        compared, or every sampled β without refinement); E values within 1 nm of the minimum
+        compared, or every sampled β without refinement) that converged (over all of them if
+        none did, which ``all_converged`` reports); E values within 1 nm of the minimum
         are round-off ties and the smallest (most rigid) of them is taken, so a flat E(β) gives
         the rigid end β̂ = 0.
     beta_std : float
@@ -254,6 +255,18 @@ def _vertex(betas: Array, errors: Array) -> float:
     return float(1.0 - 1.0 / v) if v >= 1.0 else 0.0
 
 
+def _best_index(errors: Array, compared: NDArray[np.bool_], converged: NDArray[np.bool_]) -> int:
+    """Index of β̂: the lowest E among the β the refinement compared (solved to ``tol``; a loosely
+    swept β's E is good to the sweep tolerance only and may fall below the converged minimum)
+    that also converged (a β stopped by ``max_iter`` has an E of a state that is not its
+    equilibrium); among all compared β when none converged (``all_converged`` then says so)."""
+    usable = compared & converged
+    if not usable.any():
+        usable = compared
+    masked = np.where(usable, errors, np.inf)
+    return int(np.flatnonzero(masked <= masked.min() + _TIE_M)[0])
+
+
 def _beta_std(betas: Array, errors: Array, tol: float, resolution: float) -> float:
     """Width / √12 of the β interval around β̂ where E ≤ E(β̂) + ``tol``; its ends are found by
     linear interpolation of E between the sampled β, so that the width does not depend on how
@@ -322,10 +335,7 @@ def estimate_beta(rest_xs: Any, rest_ys: Any, rest_z: Any, deformed_points: Any,
     if cfg.refines:
         _refine(sweep, 1.0 / cfg.n_beta, cfg.beta_resolution, cfg.tol)
     betas, errors, its, res, conv, tols = sweep.curve()
-    # β̂ among the β the refinement compared (solved to tol): a loosely swept β's E is good to
-    # the sweep tolerance only and may fall below the converged minimum
-    compared = np.where(tols <= cfg.tol, errors, np.inf)
-    best = int(np.flatnonzero(compared <= compared.min() + _TIE_M)[0])
+    best = _best_index(errors, tols <= cfg.tol, conv)
     if height_samples is not None:
         positions = np.stack([sweep.sims[float(b)][0].positions[sweep.sims[float(b)][1]]
                               for b in betas])  # fmt: skip
