@@ -67,6 +67,14 @@ def test_the_first_planned_poke_is_where_the_field_is_least_known_and_noise_coun
     assert noisy.max_variance <= T_H
 
 
+def test_a_plan_never_pokes_one_place_twice() -> None:
+    few = np.array([[0.1, 0.1], [0.5, 0.3], [0.3, 0.2]])
+    plan = plan_pokes(np.zeros((0, 2)), np.zeros(0), few, DOMAIN, new_noise=FLOOR,
+                      threshold=1e-4, max_new=10, **PRIOR)
+    assert not plan.reaches and len(plan.targets) == 3
+    assert len({tuple(t) for t in plan.targets}) == 3
+
+
 def test_a_small_domain_needs_one_poke_and_none_reach_with_too_few() -> None:
     domain = _grid((0.2, 0.2), (0.3, 0.3), 0.01)
     plan = plan_pokes(np.zeros((0, 2)), np.zeros(0), CANDIDATES, domain, new_noise=FLOOR,
@@ -86,6 +94,7 @@ def test_a_small_domain_needs_one_poke_and_none_reach_with_too_few() -> None:
         ({"domain": np.full((4, 2), np.nan)}, "`domain`"),
         ({"threshold": 0.0}, "`threshold`"),
         ({"max_new": 0}, "`max_new`"),
+        ({"poked_noise": np.array([0.03, -0.01])}, "`poked_noise` must be positive"),
         ({"length_scale": -1.0}, "`length_scale`"),
     ],
 )

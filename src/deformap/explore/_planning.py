@@ -31,6 +31,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from deformap._validation import check_array, check_int, check_positive
+from deformap.errors import InvalidArgumentError
 from deformap.gp import squared_exponential
 
 __all__ = ["PokePlan", "plan_pokes"]
@@ -102,6 +103,16 @@ class _Design:
         return excess, np.asarray(after.max(axis=1))
 
 
+def _best_addition(design: _Design, chosen: list[int], threshold: float
+                   ) -> tuple[int, tuple[float, float]]:  # fmt: skip
+    """The candidate not in ``chosen`` whose addition leaves the least variance above
+    ``threshold`` (then the smallest largest variance), and that score."""
+    excess, worst = design.after(chosen, threshold)
+    excess[chosen] = np.inf  # a second poke on the same place is never the better plan
+    pick = int(np.lexsort((worst, excess))[0])
+    return pick, (float(excess[pick]), float(worst[pick]))
+
+
 def plan_pokes(poked_xy: Array, poked_noise: Array, candidates: Array, domain: Array, *,
                signal_std: float, length_scale: float, new_noise: float, threshold: float,
                max_new: int, max_passes: int = 4) -> PokePlan:
@@ -125,7 +136,7 @@ def plan_pokes(poked_xy: Array, poked_noise: Array, candidates: Array, domain: A
     threshold : float
         ``T_h``.
     max_new : int
-        Most further pokes to plan.
+        Most further pokes to plan (at most one per candidate).
     max_passes : int
         Most exchange passes per plan size.
     """
@@ -136,23 +147,23 @@ def plan_pokes(poked_xy: Array, poked_noise: Array, candidates: Array, domain: A
     for name, value in (("signal_std", signal_std), ("length_scale", length_scale),
                         ("new_noise", new_noise), ("threshold", threshold)):
         check_positive(name, value)
+    if np.any(poked_noise <= 0):
+        raise InvalidArgumentError(
+            f"`poked_noise` must be positive standard deviations; got {poked_noise.min()!r}")
     max_new = check_int("max_new", max_new, minimum=1)
     max_passes = check_int("max_passes", max_passes, minimum=0)
     design = _Design(poked_xy, poked_noise, candidates, domain, signal_std, length_scale,
                      new_noise)
     chosen: list[int] = []
     best = (np.inf, np.inf)
-    for _ in range(max_new):
-        excess, worst = design.after(chosen, threshold)
-        pick = int(np.lexsort((worst, excess))[0])
-        chosen, best = [*chosen, pick], (float(excess[pick]), float(worst[pick]))
+    for _ in range(min(max_new, candidates.shape[0])):
+        pick, best = _best_addition(design, chosen, threshold)
+        chosen = [*chosen, pick]
         for _ in range(max_passes):
             moved = False
             for i in range(len(chosen)):
                 others = chosen[:i] + chosen[i + 1:]
-                excess, worst = design.after(others, threshold)
-                pick = int(np.lexsort((worst, excess))[0])
-                score = (float(excess[pick]), float(worst[pick]))
+                pick, score = _best_addition(design, others, threshold)
                 if score < best and pick != chosen[i]:
                     chosen, best, moved = [*others[:i], pick, *others[i:]], score, True
             if not moved:
