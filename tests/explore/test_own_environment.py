@@ -107,14 +107,32 @@ def test_the_loop_maps_an_environment_written_by_a_user(strategy: str) -> None:
     hard = [p.record["beta"] for p in result.pokes if p.xy[0] > 0.13]
     assert soft and hard, f"{strategy} must visit both halves"
     planned = [p.record.get("planned_after") for p in result.pokes[1:]]
-    if strategy == "planned":  # each later poke came from a plan, which shrinks as pokes are made
-        assert all(isinstance(n, int) and n >= 0 for n in planned)
-        assert planned == sorted(planned, reverse=True)
-    else:
-        assert planned == [None] * len(planned)
+    if strategy == "planned":
+        # 4 pokes cannot bring this table under T_h = 0.06 (σw = 6 cm): no plan reaches it, so
+        # none foresees how many pokes are left
+        assert result.stop_reason == "max_pokes"
+        assert result.mapper.last_plan is not None and not result.mapper.last_plan.reaches
+    assert planned == [None] * len(planned)
     assert min(soft) > max(hard), (soft, hard)
     regions = result.mapper.regions()
     assert regions.n_regions == 2
     mean, var = result.mapper.field()
     assert mean[:, :10].mean() > mean[:, -10:].mean()
     assert var.shape == (32, 48)
+
+
+def test_a_planned_run_reports_how_many_pokes_its_plan_foresees() -> None:
+    # σw = 12 cm on the 24×16 cm table: a handful of pokes reaches T_h, so each plan reaches it
+    env = TwoFoamTable(np.random.default_rng(3))
+    config = ExplorationConfig(
+        max_pokes=8,
+        strategy="planned",
+        surface=SurfaceGPConfig(fit_hyperparameters=False, length_scale_m=0.02),
+        beta_field=BetaFieldConfig(length_scale_m=0.12),
+    )
+    result = explore(env, config, rng=np.random.default_rng(0))
+    assert result.stop_reason == "threshold"
+    planned = [p.record["planned_after"] for p in result.pokes[1:]]
+    assert planned[-1] == 0  # the last poke was the last of its plan
+    assert all(isinstance(n, int) and 0 <= n < config.max_pokes for n in planned)
+    assert "planned_after" not in result.pokes[0].record  # the first poke is the configured one

@@ -100,9 +100,10 @@ def explore(
             t2 = time.perf_counter()
             env.release()
         t3 = time.perf_counter()
-        if index > 0 and mapper.last_plan is not None:
+        plan = mapper.last_plan if index > 0 else None
+        if plan is not None and plan.reaches:
             # the pokes the plan still foresees after this one (the progress display shows it)
-            poke.record["planned_after"] = len(mapper.last_plan.targets) - 1
+            poke.record["planned_after"] = len(plan.targets) - 1
         mapper.add(poke)
         poke.record["timings"]["target_s"] = target_s
         poke.record["timings"]["environment_s"] = (t1 - t0) + (t3 - t2)

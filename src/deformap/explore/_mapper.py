@@ -32,14 +32,13 @@ from deformap.errors import EnvironmentStateError, InvalidArgumentError
 from deformap.explore._acquisition import choose_target
 from deformap.explore._config import ExplorationConfig
 from deformap.explore._dent_noise import dent_error_samples
-from deformap.explore._planning import PokePlan, plan_pokes
+from deformap.explore._planning import PokePlan, VarianceDesign, plan_pokes
 from deformap.explore._regions import RegionMap, segment_regions
 from deformap.gp import (
     GaussianRandomField,
     GPHyperparameters,
     default_bounds,
     fit_hyperparameters,
-    squared_exponential,
 )
 from deformap.msm import BetaEstimate, estimate_beta
 
@@ -107,7 +106,8 @@ _PLAN_CANDIDATE_M = 0.02
 def _strided(nx: int, ny: int, step_m: float, spacing_m: float,
              within: NDArray[np.bool_] | None = None) -> NDArray[np.int64]:
     """Flat indices of the ``(ny, nx)`` grid's cells about ``step_m`` apart, its first and last
-    rows and columns included (of the cells in ``within`` only, whose box they then span)."""
+    rows and columns included (of the cells in ``within`` only, which must be a non-empty
+    rectangle of cells, as the workspace and its targets are; the lattice then spans it)."""
     inside = np.ones(ny * nx, dtype=bool) if within is None else within
     rows, cols = np.nonzero(inside.reshape(ny, nx))
     stride = max(1, round(step_m / spacing_m))
@@ -145,9 +145,10 @@ class Mapper:
         # where the variance must fall below T_h
         self.stop_mask = (self.target_mask if config.stop_region == "targets"
                           else np.ones(len(self.cells_xy), dtype=bool))
-        # the planner's grids, every 2 cm (edges included): of the workspace, where the variance
-        # must fall (the σw = 0.2 m field's largest variance on it is within 1e-4 of the 0.5 cm
-        # grid's), and of the targets, where a poke may be planned
+        # the planner's grids, every 2 cm (edges included): of the stop region, where the variance
+        # must fall (the σw = 0.2 m field's largest variance on it was within 1.2e-4 of the 0.5 cm
+        # grid's on the 60×40 cm table; a plan short by that is planned again), and of the
+        # targets, where a poke may be planned
         self._plan_domain = self.cells_xy[_strided(self.xs.size, self.ys.size, _PLAN_DOMAIN_M,
                                                    config.surface.grid_spacing_m,
                                                    within=self.stop_mask)]
@@ -351,9 +352,12 @@ class Mapper:
             return None
         cells, reachable = self.cells_xy[self.target_mask], variance[self.target_mask]
         if reachable.max() <= self.config.threshold:
-            # Only the edge band is still uncertain: poke the reachable cell nearest to it in
-            # variance, which is the one that lowers it most.
-            return np.array(cells[int(np.argmax(reachable))], dtype=float)
+            # Only the edge band, where no poke fits, is still uncertain: the plan already
+            # covers it; otherwise poke the reachable place whose poke leaves the least there.
+            if self.config.strategy == "planned":
+                return self._planned_target()
+            worst = self._worst_after(self._plan_candidates, self._plan_domain)
+            return np.array(self._plan_candidates[int(np.argmin(worst))], dtype=float)
         return choose_target(
             self.config.strategy,
             cells,
@@ -367,10 +371,9 @@ class Mapper:
     def _planned_target(self) -> NDArray[np.float64]:
         """The next poke of the plan with the fewest further pokes (``planned`` strategy)."""
         cfg = self.config.beta_field
-        xy = np.array([p.xy for p in self.pokes]).reshape(-1, 2)
-        noise = np.maximum([p.record["beta_std"] for p in self.pokes], cfg.noise_floor)
+        xy, noise = self._poked()
         self.last_plan = plan_pokes(
-            xy, noise.reshape(-1), self._plan_candidates, self._plan_domain,
+            xy, noise, self._plan_candidates, self._plan_domain,
             signal_std=cfg.signal_std, length_scale=cfg.length_scale_m,
             new_noise=cfg.noise_floor, threshold=self.config.threshold,
             max_new=max(1, self.config.max_pokes - len(self.pokes)),
@@ -378,29 +381,27 @@ class Mapper:
         return np.array(self.last_plan.targets[0], dtype=float)
 
     def _max_variance_after(self, candidates: NDArray[np.float64]) -> NDArray[np.float64]:
-        """Largest posterior variance over the grid if each candidate were poked next.
+        """Largest posterior variance where it must fall below ``T_h`` (``stop_region``) if each
+        candidate were poked next (``min-max-variance``)."""
+        return self._worst_after(candidates, self.cells_xy[self.stop_mask])
 
-        Exact rank-one update of the posterior (the variance does not depend on the β that the
-        poke will give); the new poke's noise is taken at the floor.
-        """
+    def _worst_after(self, candidates: NDArray[np.float64], domain: NDArray[np.float64]
+                     ) -> NDArray[np.float64]:  # fmt: skip
+        """Largest posterior variance over ``domain`` if each of ``candidates`` were poked next:
+        an exact rank-one update of the posterior (the variance does not depend on the β that
+        the poke will give), the new poke's noise at the floor."""
         cfg = self.config.beta_field
-        kern = {"length_scale": cfg.length_scale_m, "signal_std": cfg.signal_std}
-        cells = self.cells_xy
-        k_cc = squared_exponential(cells, candidates, **kern)
-        var_cells = np.full(len(cells), cfg.signal_std**2)
-        var_cand = np.full(len(candidates), cfg.signal_std**2)
-        if self.pokes:
-            xy = np.array([p.xy for p in self.pokes])
-            noise = np.maximum([p.record["beta_std"] for p in self.pokes], cfg.noise_floor)
-            gram = squared_exponential(xy, xy, **kern) + np.diag(noise**2)
-            chol = np.linalg.cholesky(gram)
-            v_cells = np.linalg.solve(chol, squared_exponential(xy, cells, **kern))
-            v_cand = np.linalg.solve(chol, squared_exponential(xy, candidates, **kern))
-            k_cc = k_cc - v_cells.T @ v_cand
-            var_cells = var_cells - np.sum(v_cells**2, axis=0)
-            var_cand = var_cand - np.sum(v_cand**2, axis=0)
-        after = var_cells[:, None] - k_cc**2 / (var_cand + cfg.noise_floor**2)[None, :]
-        return np.asarray(after.max(axis=0))
+        xy, noise = self._poked()
+        design = VarianceDesign(xy, noise, candidates, domain, cfg.signal_std, cfg.length_scale_m,
+                         cfg.noise_floor)
+        return design.after([], self.config.threshold)[1]
+
+    def _poked(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Where the pokes were, ``(p, 2)``, and the noise the β-field gives each, ``(p,)``."""
+        floor = self.config.beta_field.noise_floor
+        xy = np.array([p.xy for p in self.pokes], dtype=float).reshape(-1, 2)
+        noise = np.maximum([p.record["beta_std"] for p in self.pokes], floor)
+        return xy, np.asarray(noise, dtype=float).reshape(-1)
 
     def regions(self) -> RegionMap:
         """Cut the current β-field into regions (see :mod:`deformap.explore._regions`)."""

@@ -4,12 +4,14 @@ A Gaussian process's posterior variance depends on where the observations are an
 never on the values observed (RW2006 Eq. 2.26). So the set of further pokes after which the
 β-field's largest variance over the workspace falls below ``T_h`` can be planned before any of
 them is made. Finding the smallest such set is a minimax (covering) design problem. It is solved
-here approximately, for ``m = 1, 2, …`` further pokes in turn, over a grid of candidate places:
-the plan for ``m`` starts from the plan for ``m − 1`` plus the candidate that leaves the smallest
-largest variance (a greedy step), then each planned poke in turn is moved to the candidate that
-best complements the others (exchange passes, as in Fedorov's exchange algorithm for optimal
-designs) until no move lowers the largest variance. The first ``m`` whose plan reaches ``T_h`` is
-the plan.
+here approximately, for ``m = 1, 2, …`` further pokes in turn, over a grid of candidate places.
+A design is scored by the variance above ``T_h`` summed over the domain (smooth where the largest
+variance is not: it still falls when a move helps one corner and leaves the worst one as it was),
+ties broken by the largest variance. The plan for ``m`` starts from the plan for ``m − 1`` plus
+the candidate that scores best (a greedy step); then each planned poke in turn is moved to the
+candidate that best complements the others (exchange passes, as in Fedorov's exchange algorithm
+for optimal designs), until a pass moves none or after ``max_passes`` passes. The first ``m``
+whose plan reaches ``T_h`` is the plan.
 
 Every planned poke is assumed to come with the β-field's noise floor; a real poke often reports
 more, so the loop plans again after every poke with the uncertainties actually measured. Greedy
@@ -28,13 +30,14 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.linalg as sla
 from numpy.typing import NDArray
 
 from deformap._validation import check_array, check_int, check_positive
 from deformap.errors import InvalidArgumentError
-from deformap.gp import squared_exponential
+from deformap.gp import cholesky_with_jitter, squared_exponential
 
-__all__ = ["PokePlan", "plan_pokes"]
+__all__ = ["PokePlan", "VarianceDesign", "plan_pokes"]
 
 Array = NDArray[np.float64]
 
@@ -60,7 +63,7 @@ class PokePlan:
     reaches: bool
 
 
-class _Design:
+class VarianceDesign:
     """The β-field's posterior over ``domain`` for the pokes made plus chosen candidates."""
 
     def __init__(self, poked_xy: Array, poked_noise: Array, candidates: Array, domain: Array,
@@ -85,9 +88,15 @@ class _Design:
         if k_ss.size == 0:
             return (np.full(self.k_cd.shape[1], self.prior), self.k_cd.copy(),
                     np.full(self.k_cd.shape[0], self.prior))
-        chol = np.linalg.cholesky(k_ss + np.diag(noise))
-        v_d = np.linalg.solve(chol, np.vstack([self.k_pd, self.k_cd[idx]]))
-        v_c = np.linalg.solve(chol, np.vstack([self.k_pc, self.k_cc[idx]]))
+        # factor the covariance scaled to unit prior variance (the jitter is relative to σe²)
+        (chol, lower), _ = cholesky_with_jitter((k_ss + np.diag(noise)) / self.prior,
+                                                jitter=1e-12, max_jitter=1e-6,
+                                                what="the β-field covariance of the pokes planned")
+        scale = 1.0 / np.sqrt(self.prior)
+        v_d = sla.solve_triangular(chol, scale * np.vstack([self.k_pd, self.k_cd[idx]]),
+                                   lower=lower, check_finite=False)
+        v_c = sla.solve_triangular(chol, scale * np.vstack([self.k_pc, self.k_cc[idx]]),
+                                   lower=lower, check_finite=False)
         var_d = self.prior - np.sum(v_d**2, axis=0)
         cov = self.k_cd - v_c.T @ v_d
         var_c = self.prior - np.sum(v_c**2, axis=0)
@@ -103,7 +112,7 @@ class _Design:
         return excess, np.asarray(after.max(axis=1))
 
 
-def _best_addition(design: _Design, chosen: list[int], threshold: float
+def _best_addition(design: VarianceDesign, chosen: list[int], threshold: float
                    ) -> tuple[int, tuple[float, float]]:  # fmt: skip
     """The candidate not in ``chosen`` whose addition leaves the least variance above
     ``threshold`` (then the smallest largest variance), and that score."""
@@ -152,7 +161,7 @@ def plan_pokes(poked_xy: Array, poked_noise: Array, candidates: Array, domain: A
             f"`poked_noise` must be positive standard deviations; got {poked_noise.min()!r}")
     max_new = check_int("max_new", max_new, minimum=1)
     max_passes = check_int("max_passes", max_passes, minimum=0)
-    design = _Design(poked_xy, poked_noise, candidates, domain, signal_std, length_scale,
+    design = VarianceDesign(poked_xy, poked_noise, candidates, domain, signal_std, length_scale,
                      new_noise)
     chosen: list[int] = []
     best = (np.inf, np.inf)
