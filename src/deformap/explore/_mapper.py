@@ -352,12 +352,14 @@ class Mapper:
             return None
         cells, reachable = self.cells_xy[self.target_mask], variance[self.target_mask]
         if reachable.max() <= self.config.threshold:
-            # Only the edge band, where no poke fits, is still uncertain: the plan already
-            # covers it; otherwise poke the reachable place whose poke leaves the least there.
+            # Only the edge band, where no poke fits, is still uncertain. The plan covers it;
+            # the other strategies poke the reachable cell of largest variance, the one nearest
+            # the band's worst corner. (Poking where one poke leaves the least largest variance
+            # instead is myopic: it splits the difference between two corners and took 12 pokes
+            # with `paper` on homogeneous-60, seed 0, where this rule took 10.)
             if self.config.strategy == "planned":
                 return self._planned_target()
-            worst = self._worst_after(self._plan_candidates, self._plan_domain)
-            return np.array(self._plan_candidates[int(np.argmin(worst))], dtype=float)
+            return np.array(cells[int(np.argmax(reachable))], dtype=float)
         return choose_target(
             self.config.strategy,
             cells,
@@ -382,18 +384,13 @@ class Mapper:
 
     def _max_variance_after(self, candidates: NDArray[np.float64]) -> NDArray[np.float64]:
         """Largest posterior variance where it must fall below ``T_h`` (``stop_region``) if each
-        candidate were poked next (``min-max-variance``)."""
-        return self._worst_after(candidates, self.cells_xy[self.stop_mask])
-
-    def _worst_after(self, candidates: NDArray[np.float64], domain: NDArray[np.float64]
-                     ) -> NDArray[np.float64]:  # fmt: skip
-        """Largest posterior variance over ``domain`` if each of ``candidates`` were poked next:
-        an exact rank-one update of the posterior (the variance does not depend on the β that
-        the poke will give), the new poke's noise at the floor."""
+        candidate were poked next (``min-max-variance``): an exact rank-one update of the
+        posterior (the variance does not depend on the β that the poke will give), the new
+        poke's noise at the floor."""
         cfg = self.config.beta_field
         xy, noise = self._poked()
-        design = VarianceDesign(xy, noise, candidates, domain, cfg.signal_std, cfg.length_scale_m,
-                         cfg.noise_floor)
+        design = VarianceDesign(xy, noise, candidates, self.cells_xy[self.stop_mask],
+                                cfg.signal_std, cfg.length_scale_m, cfg.noise_floor)
         return design.after([], self.config.threshold)[1]
 
     def _poked(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
