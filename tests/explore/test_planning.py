@@ -5,7 +5,8 @@ import pytest
 
 from deformap.environment import Workspace
 from deformap.errors import InvalidArgumentError
-from deformap.explore import ExplorationConfig
+from deformap.eval._experiment import map_report
+from deformap.explore import ExplorationConfig, ExplorationResult
 from deformap.explore._acquisition import choose_target
 from deformap.explore._mapper import Mapper, PokeResult
 from deformap.explore._planning import plan_pokes
@@ -127,7 +128,8 @@ def _pokes_until_known(config: ExplorationConfig, size: tuple[float, float] = (0
     target: np.ndarray | None = np.array(size) / 2
     while target is not None and len(mapper.pokes) < config.max_pokes:
         std = 0.06 if len(mapper.pokes) < noisy else FLOOR
-        mapper.add(PokeResult({"contact_xy": target.tolist(), "beta": 0.5, "beta_std": std}))
+        mapper.add(PokeResult({"contact_xy": target.tolist(), "beta": 0.5, "beta_std": std,
+                               "timings": {}}))
         target = mapper.next_target(rng)
     return mapper, len(mapper.pokes)
 
@@ -146,6 +148,10 @@ def test_the_paper_stop_rule_on_targets_only_stops_sooner() -> None:
     assert n_whole == 5 and n_targets < n_whole
     _, var = targets.field()
     assert targets.max_variance() <= T_H < var.max()  # the edge band is left above T_h
+    # the report's max variance is the one the stopping rule compared with T_h
+    report = map_report(ExplorationResult(mapper=targets, stop_reason="threshold"))
+    assert report["max_variance"] == targets.max_variance() <= T_H
+    assert report["max_variance_map"] == var.max()
     assert whole.max_variance() == pytest.approx(whole.field()[1].max())
     assert whole.max_variance() <= T_H
     with pytest.raises(InvalidArgumentError, match="`stop_region` must be one of"):

@@ -216,7 +216,9 @@ def map_report(result: ExplorationResult, *, truth: Any = None) -> dict[str, Any
         "pokes": pokes,
         "n_pokes": len(pokes),
         "stop_reason": result.stop_reason,
-        "max_variance": float(var.max()),
+        # what the stopping rule compared with T_h (over ``stop_region``), and over the whole map
+        "max_variance": mapper.max_variance(),
+        "max_variance_map": float(var.max()),
         "regions": regions,
     }
     if truth is not None:
