@@ -154,12 +154,13 @@ def explore_command(
     """Explore a simulated world: poke until the β-field is known, then cut it into regions."""
     import dataclasses
 
+    from deformap.cloud.io._common import path_kind
     from deformap.eval import RunConfig, load_run_config, run_experiment
 
     if resume is not None:
         if config is not None:
             raise ConfigError("--resume reads the run's own config.yaml; do not pass --config too")
-        if not (resume / "config.yaml").is_file():  # a run writes it before anything else
+        if path_kind(resume / "config.yaml") != "file":  # a run writes it before anything else
             raise ConfigError(
                 f"cannot resume {str(resume)!r}: it holds no config.yaml, so no run started "
                 "there; start one without --resume"

@@ -289,6 +289,12 @@ def test_unknown_suffix_missing_file_and_bad_arguments(tmp_path: Path) -> None:
         write_npz(tmp_path / "e.npz", _cloud(), extra_fields={"x": np.zeros(50)})
 
 
+@pytest.mark.parametrize("suffix", [".pcd", ".ply", ".npz"])
+def test_a_file_name_the_system_refuses_is_a_file_format_error(tmp_path: Path, suffix: str) -> None:
+    with pytest.raises(FileFormatError, match="File name too long"):
+        read_cloud(tmp_path / ("a" * 300 + suffix))
+
+
 @pytest.mark.parametrize(
     ("mutate", "message"),
     [

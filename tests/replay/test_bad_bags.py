@@ -191,3 +191,8 @@ def test_missing_and_truncated_bag(bag_session: Path) -> None:
     shutil.rmtree(bag_session / "bag")
     with pytest.raises(FileFormatError, match="no such bag"):
         load_session(bag_session)
+    doc = yaml.safe_load((bag_session / "session.yaml").read_text())
+    doc["bag"] = "a" * 300  # over NAME_MAX (255)
+    (bag_session / "session.yaml").write_text(yaml.safe_dump(doc))
+    with pytest.raises(FileFormatError, match="File name too long"):
+        load_session(bag_session)

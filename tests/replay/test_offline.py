@@ -179,6 +179,10 @@ def test_map_refuses_bad_arguments(recorded: Path, tmp_path: Path) -> None:
     result = _cli("record-sim", "--scenario", SCENARIO, "--out", str(tmp_path / "r"),
                   "--format", "rosbag1")  # fmt: skip
     assert result.exit_code == 2 and "--format must be one of" in result.output
+    too_long = str(tmp_path / ("a" * 300))  # longer than any file name the system allows
+    for args in (["map", too_long], ["explore", "--resume", too_long]):
+        result = _cli(*args)
+        assert result.exit_code == 2 and "File name too long" in result.output, result.output
 
 
 def test_estimate_agrees_with_the_mapper(recorded: Path, live: dict[str, Any], config_file: Path,

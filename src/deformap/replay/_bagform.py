@@ -18,7 +18,7 @@ from numpy.typing import NDArray
 from deformap.cloud import PointCloud
 from deformap.cloud.io import array_to_pointcloud2, read_bag_static_transform
 from deformap.cloud.io._bag import _rosbag2
-from deformap.cloud.io._common import check_units, finish_cloud
+from deformap.cloud.io._common import check_units, finish_cloud, path_kind
 from deformap.cloud.io._pointcloud2 import pointcloud2_structured, xyz_with_holes
 from deformap.cloud.io._ros import typestore
 from deformap.environment import PressObservation
@@ -52,7 +52,7 @@ class BagReader:
         assert header.bag is not None
         self.header = header
         self.path = header.bag
-        if not self.path.exists():
+        if path_kind(self.path) == "missing":
             raise FileFormatError(f"{self.path}: no such bag (the session's `bag`)")
         self._raw = self._index()
         self._decoded: dict[str, dict[int, Any]] | None = None
