@@ -59,3 +59,20 @@ def test_unreadable_and_invalid_yaml(tmp_path) -> None:
     bad.write_text("a: [1, 2\n")
     with pytest.raises(ConfigError, match="is not valid YAML"):
         load_yaml(bad)
+
+
+@pytest.mark.parametrize(
+    ("content", "message"),
+    [
+        (b"\xff\xfeseed: 1\n", r"not UTF-8 text \(byte 0\)"),
+        (b"seed: 2020-02-30\n", "is not valid YAML.*day is out of range"),  # PyYAML's timestamps
+        (b"a: " + b"[" * 5000 + b"]" * 5000 + b"\n", "is not valid YAML.*RecursionError"),
+    ],
+)
+def test_yaml_that_the_parser_cannot_take_is_a_config_error(
+    tmp_path, content: bytes, message: str
+) -> None:
+    bad = tmp_path / "bad.yaml"
+    bad.write_bytes(content)
+    with pytest.raises(ConfigError, match=rf"bad\.yaml.*{message}"):
+        load_yaml(bad)

@@ -122,13 +122,17 @@ def load_yaml(path: str | Path) -> Any:
     """Read a YAML file safely (no arbitrary objects); errors name the file."""
     p = Path(path)
     try:
-        text = p.read_text(encoding="utf-8")
+        text = p.read_bytes().decode("utf-8")
     except OSError as exc:
         raise ConfigError(f"cannot read config file {str(p)!r}: {exc.strerror or exc}") from None
+    except UnicodeDecodeError as exc:
+        raise ConfigError(f"{str(p)!r} is not UTF-8 text (byte {exc.start})") from None
     try:
         return yaml.safe_load(text)
-    except yaml.YAMLError as exc:
-        raise ConfigError(f"{str(p)!r} is not valid YAML: {exc}".replace("\n", " ")) from None
+    except (yaml.YAMLError, RecursionError, ValueError) as exc:
+        # ValueError: PyYAML's timestamp constructor on an impossible date (2020-02-30).
+        detail = f"{type(exc).__name__}: {exc}".replace("\n", " ")[:300]
+        raise ConfigError(f"{str(p)!r} is not valid YAML: {detail}") from None
 
 
 def dump_yaml(data: Any, path: str | Path | None = None) -> str:

@@ -154,12 +154,13 @@ def explore_command(
     """Explore a simulated world: poke until the β-field is known, then cut it into regions."""
     import dataclasses
 
+    from deformap.cloud.io._common import path_kind
     from deformap.eval import RunConfig, load_run_config, run_experiment
 
     if resume is not None:
         if config is not None:
             raise ConfigError("--resume reads the run's own config.yaml; do not pass --config too")
-        if not (resume / "config.yaml").is_file():  # a run writes it before anything else
+        if path_kind(resume / "config.yaml") != "file":  # a run writes it before anything else
             raise ConfigError(
                 f"cannot resume {str(resume)!r}: it holds no config.yaml, so no run started "
                 "there; start one without --resume"
@@ -604,16 +605,29 @@ def _replay_progress(poke: Any) -> None:
 
 
 def _new_folder(out: Any, what: str) -> Any:
+    """Create the empty ``--out`` folder now, so that one that cannot be made fails before the work."""
     from pathlib import Path
 
+    from deformap.cloud.io._common import path_kind
     from deformap.errors import ConfigError
 
     folder = Path(out)
-    if folder.exists() and (not folder.is_dir() or any(folder.iterdir())):
+    kind = path_kind(folder)
+    if kind != "missing" and (kind != "dir" or any(folder.iterdir())):
         raise ConfigError(
             f"{what} folder {str(folder)!r} exists and is not empty; choose another --out"
         )
+    _make_folder(folder, what)
     return folder
+
+
+def _make_folder(folder: Path, what: str) -> None:
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise ConfigError(
+            f"cannot create {what} folder {str(folder)!r} (--out): {exc.strerror or exc}"
+        ) from None
 
 
 @app.command("record-sim")
@@ -644,8 +658,8 @@ def record_sim_command(
 
     if format not in SESSION_FORMATS:
         raise ConfigError(f"--format must be one of {list(SESSION_FORMATS)}; got {format!r}")
-    folder = _new_folder(out, "session")
     cfg = load_run_config(config)
+    folder = _new_folder(out, "session")
     cfg = dataclasses.replace(cfg, scenario=scenario, seed=cfg.seed if seed is None else seed)
     if pokes is not None:
         cfg = dataclasses.replace(
@@ -736,7 +750,6 @@ def map_command(
     )
     _, explore_rng = run_generators(cfg.seed)
     replay = map_session(session, cfg.exploration, rng=explore_rng, on_poke=_replay_progress)
-    folder.mkdir(parents=True, exist_ok=True)
     dump_yaml(cfg, folder / "config.yaml")
     report = {"deformap": __version__, "session": str(session.path), "form": session.form,
               "source": {k: v for k, v in session.source.items() if k != "config"},
@@ -815,6 +828,8 @@ def estimate_command(
     hull = None if robot_hull is None else read_cloud(robot_hull, units=units).points
     cfg = load_run_config(config)
     clouds = read_cloud(before, units=units), read_cloud(after, units=units)
+    if out is not None:
+        _make_folder(Path(out), "result")
     poke = estimate_poke(*clouds, touch, cfg.exploration, rng=np.random.default_rng(seed),
                          robot_points=hull)  # fmt: skip
     r = poke.record
@@ -827,7 +842,6 @@ def estimate_command(
         return
     console.print(f"β = {r['beta']:.3f} ± {r['beta_std']:.3f} ({r['n_roi_points']} ROI points)")
     folder = Path(out)
-    folder.mkdir(parents=True, exist_ok=True)
     (folder / "estimate.json").write_text(json.dumps(result, indent=2))
     _estimate_figures(folder, poke)
     console.print(f"wrote {folder / 'estimate.json'}, beta-curve.png and poke.png")

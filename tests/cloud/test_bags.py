@@ -149,6 +149,8 @@ def test_bad_bags_name_file_topic_and_problem(tmp_path: Path, storage: str) -> N
         read_bag_clouds(bag, "/pts", cam2world="tf_static")
     with pytest.raises(FileFormatError, match="no such bag"):
         read_bag_clouds(tmp_path / "missing", "/pts")
+    with pytest.raises(FileFormatError, match="File name too long"):  # over NAME_MAX (255)
+        read_bag_clouds(tmp_path / ("a" * 300), "/pts")
     with pytest.raises(InvalidArgumentError, match=r"`cam2world` must be a \(4, 4\)"):
         read_bag_clouds(bag, "/pts", cam2world=np.eye(3))
     with pytest.raises(InvalidArgumentError, match="`topic` must be a non-empty str"):

@@ -289,6 +289,12 @@ def test_unknown_suffix_missing_file_and_bad_arguments(tmp_path: Path) -> None:
         write_npz(tmp_path / "e.npz", _cloud(), extra_fields={"x": np.zeros(50)})
 
 
+@pytest.mark.parametrize("suffix", [".pcd", ".ply", ".npz"])
+def test_a_file_name_the_system_refuses_is_a_file_format_error(tmp_path: Path, suffix: str) -> None:
+    with pytest.raises(FileFormatError, match="File name too long"):
+        read_cloud(tmp_path / ("a" * 300 + suffix))
+
+
 @pytest.mark.parametrize(
     ("mutate", "message"),
     [
@@ -320,6 +326,62 @@ def test_truncated_ply_and_compressed_pcd_name_the_problem(tmp_path: Path) -> No
     path.write_bytes(path.read_bytes()[:-10])
     with pytest.raises(FileFormatError, match=r"t\.pcd: binary_compressed sizes do not match"):
         read_cloud(path)
+
+
+_ASCII_PLY_HEADER = (
+    "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
+    "property float z\n{extra}end_header\n"
+)
+
+
+@pytest.mark.parametrize(
+    "body",
+    [
+        "\n0.1 0.2 0.3\n0.4 0.5 0.6\n",  # a blank line before the rows
+        "0.1 0.2 0.3\n\n0.4 0.5 0.6\n",  # and between them
+        "# made by hand\n0.1 0.2 0.3\n0.4 0.5 0.6\n",
+    ],
+)
+def test_ascii_ply_rows_are_read_as_written_or_refused(tmp_path: Path, body: str) -> None:
+    path = tmp_path / "rows.ply"
+    path.write_text(_ASCII_PLY_HEADER.format(extra="") + body)
+    try:
+        cloud, _ = read_ply(path)
+    except FileFormatError as exc:
+        assert "rows.ply" in str(exc)
+    else:
+        np.testing.assert_allclose(cloud.points, [[0.1, 0.2, 0.3], [0.4, 0.5, 0.6]], rtol=1e-7)
+
+
+def test_ascii_ply_with_more_rows_than_declared_is_refused(tmp_path: Path) -> None:
+    path = tmp_path / "more.ply"
+    path.write_text(_ASCII_PLY_HEADER.format(extra="") + "0.1 0.2 0.3\n0.4 0.5 0.6\n0.7 0.8 0.9\n")
+    with pytest.raises(FileFormatError, match=r"more\.ply: .*declares 2 .*3"):
+        read_ply(path)
+
+
+@pytest.mark.parametrize(
+    ("prop", "values", "match"),
+    [
+        ("uchar red", ("300", "0"), r"'red' .*uchar.* 300"),
+        ("uchar red", ("-5", "0"), r"'red' .*uchar.* -5"),
+        ("int ring", ("2.5", "1"), r"'ring' .*int.* 2\.5"),
+        ("float intensity", ("1e300", "1"), r"'intensity' .*float.* 1e\+300"),
+    ],
+)
+def test_ascii_ply_values_that_do_not_fit_their_type_are_refused(
+    tmp_path: Path, prop: str, values: tuple[str, str], match: str
+) -> None:
+    if prop.endswith("red"):
+        extra = "property uchar red\nproperty uchar green\nproperty uchar blue\n"
+        rows = [f"0.1 0.2 0.3 {values[0]} 0 0", f"0.4 0.5 0.6 {values[1]} 0 0"]
+    else:
+        extra = f"property {prop}\n"
+        rows = [f"0.1 0.2 0.3 {values[0]}", f"0.4 0.5 0.6 {values[1]}"]
+    path = tmp_path / "fit.ply"
+    path.write_text(_ASCII_PLY_HEADER.format(extra=extra) + "\n".join(rows) + "\n")
+    with pytest.raises(FileFormatError, match=rf"fit\.ply: .*{match}"):
+        read_ply(path)
 
 
 # ---- corruption fuzzing: succeed or raise a DeformapError, nothing else ----

@@ -14,7 +14,7 @@ pytest.importorskip("rosbags")
 
 from rosbags.rosbag2 import StoragePlugin, Writer
 
-from deformap.cloud.io import array_to_pointcloud2
+from deformap.cloud.io import array_to_pointcloud2, pointcloud2_structured
 from deformap.cloud.io._ros import typestore
 from deformap.errors import ConfigError, FileFormatError
 from deformap.replay import TOPICS, load_session
@@ -31,11 +31,13 @@ def _write_variant(
     retype: dict[str, str] | None = None,
     skip_poke: dict[str, int] | None = None,
     static_cam2world: np.ndarray | None = None,
+    repeat: dict[str, Any] | None = None,
 ) -> None:
     """A bag like write_session's, with one thing changed; poke i is stamped (i + 1) s."""
     store = typestore()
     retype = retype or {}
     skip_poke = skip_poke or {}
+    repeat = repeat or {}  # topic key -> a second message with the same stamp, made from the first
     with Writer(path, version=9, storage_plugin=StoragePlugin.MCAP) as writer:
         conns = {}
         for key, (topic, msgtype) in TOPICS.items():
@@ -48,6 +50,9 @@ def _write_variant(
                 msg = store.types[retype[key]](header=msg.header, vector=vec)
             if key in conns and skip_poke.get(key) != stamp:
                 writer.write(conns[key], stamp, store.serialize_cdr(msg, conns[key].msgtype))
+            if key in repeat and (key == "observation" or stamp == 2 * 10**9):
+                again = store.serialize_cdr(repeat[key](msg), conns[key].msgtype)
+                writer.write(conns[key], stamp + 1, again)
 
         world2cam = np.eye(4) if static_cam2world is None else np.linalg.inv(static_cam2world)
         obs = syn.observation.transformed(world2cam, cloud_frame)
@@ -161,6 +166,40 @@ def test_poke_without_its_message_breaks_only_that_poke(bag_session: Path, synth
     session.press_observation(2)
 
 
+def _shifted(msg: Any) -> Any:
+    """The same cloud 2 cm higher, under the same header stamp."""
+    table = pointcloud2_structured(msg).copy()
+    table["z"] += 0.02
+    msg.data = table.view(np.uint8)
+    return msg
+
+
+def test_two_messages_with_one_stamp_are_refused_not_one_silently_kept(
+    bag_session: Path, synthetic
+) -> None:  # type: ignore[no-untyped-def]
+    _replace_bag(bag_session, synthetic, repeat={"cloud": _shifted})
+    session = load_session(bag_session)
+    session.press_observation(0)
+    with pytest.raises(
+        FileFormatError, match="'/deformap/press/cloud' has 2 messages stamped 2000000000"
+    ):
+        session.press_observation(1)
+    session.press_observation(2)
+    _replace_bag(bag_session, synthetic, repeat={"observation": _shifted})
+    with pytest.raises(FileFormatError, match="must hold exactly one message; got 2"):
+        load_session(bag_session).observation()
+
+
+def test_two_pokes_with_one_stamp_are_refused(bag_session: Path) -> None:
+    doc = yaml.safe_load((bag_session / "session.yaml").read_text())
+    doc["pokes"][2]["stamp_ns"] = doc["pokes"][0]["stamp_ns"]
+    (bag_session / "session.yaml").write_text(yaml.safe_dump(doc))
+    session = load_session(bag_session)
+    session.press_observation(0)
+    with pytest.raises(ConfigError, match=r"`pokes\[2\].stamp_ns` .*already .*`pokes\[0\]`"):
+        session.press_observation(2)
+
+
 def test_sidecar_stamp_not_in_bag(bag_session: Path) -> None:
     doc = yaml.safe_load((bag_session / "session.yaml").read_text())
     doc["pokes"][2]["stamp_ns"] = 5
@@ -190,4 +229,9 @@ def test_missing_and_truncated_bag(bag_session: Path) -> None:
             session.press_observation(i)
     shutil.rmtree(bag_session / "bag")
     with pytest.raises(FileFormatError, match="no such bag"):
+        load_session(bag_session)
+    doc = yaml.safe_load((bag_session / "session.yaml").read_text())
+    doc["bag"] = "a" * 300  # over NAME_MAX (255)
+    (bag_session / "session.yaml").write_text(yaml.safe_dump(doc))
+    with pytest.raises(FileFormatError, match="File name too long"):
         load_session(bag_session)

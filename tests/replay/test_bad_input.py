@@ -175,6 +175,22 @@ def test_missing_poke_file(folder: Path) -> None:
         session.press_observation(2)
 
 
+_TOO_LONG = "a" * 300 + ".pcd"  # longer than any file name the system allows (NAME_MAX 255)
+
+
+def test_file_names_the_system_refuses_are_file_format_errors(folder: Path) -> None:
+    with pytest.raises(FileFormatError, match="File name too long"):
+        load_session(folder / _TOO_LONG)
+    _edit(folder, _set("pokes.1.cloud", _TOO_LONG))
+    _only_poke_broken(folder, 1, FileFormatError, "File name too long")
+    _edit(folder, _set("ground_truth", _TOO_LONG))
+    with pytest.raises(FileFormatError, match="File name too long"):
+        load_session(folder)
+    _edit(folder, _set("observation", _TOO_LONG))
+    with pytest.raises(FileFormatError, match="File name too long"):
+        load_session(folder)
+
+
 def test_truncated_poke_file(folder: Path) -> None:
     data = (folder / "poke-02.pcd").read_bytes()
     (folder / "poke-02.pcd").write_bytes(data[: len(data) // 2])

@@ -179,6 +179,15 @@ def test_map_refuses_bad_arguments(recorded: Path, tmp_path: Path) -> None:
     result = _cli("record-sim", "--scenario", SCENARIO, "--out", str(tmp_path / "r"),
                   "--format", "rosbag1")  # fmt: skip
     assert result.exit_code == 2 and "--format must be one of" in result.output
+    (tmp_path / "file").write_text("x")
+    for args in (["map", str(recorded), "--out", str(tmp_path / "file" / "sub")],
+                 ["record-sim", "--scenario", SCENARIO, "--out", str(tmp_path / "file" / "r")]):
+        result = _cli(*args)  # refused before any work, not after it
+        assert result.exit_code == 2 and "cannot create" in result.output, result.output
+    too_long = str(tmp_path / ("a" * 300))  # longer than any file name the system allows
+    for args in (["map", too_long], ["explore", "--resume", too_long]):
+        result = _cli(*args)
+        assert result.exit_code == 2 and "File name too long" in result.output, result.output
 
 
 def test_estimate_agrees_with_the_mapper(recorded: Path, live: dict[str, Any], config_file: Path,
@@ -224,6 +233,16 @@ def test_estimate_refuses_bad_input(tmp_path: Path, args: list[str], match: str)
     result = _cli("estimate", *flat)
     assert result.exit_code == 2, result.output
     assert match in " ".join(result.output.split())
+
+
+def test_estimate_refuses_an_out_folder_it_cannot_create(tmp_path: Path) -> None:
+    cloud = tmp_path / "c.pcd"
+    write_cloud(cloud, PointCloud(np.random.default_rng(0).uniform(0, 0.3, (50, 3))))
+    result = _cli("estimate", "--before", str(cloud), "--after", str(cloud), "--contact", "0.1",
+                  "0.1", "0.05", "--force", "0", "0", "-1", "--tip-radius", "0.01",
+                  "--out", str(cloud))  # fmt: skip
+    assert result.exit_code == 2, result.output
+    assert "cannot create" in result.output
 
 
 def test_tip_sphere_points_lie_on_the_tip() -> None:

@@ -121,6 +121,28 @@ def test_unknown_name_and_broken_yaml(tmp_path) -> None:
         load_scenario(path)
 
 
+@pytest.mark.parametrize(
+    ("content", "message"),
+    [
+        (b"\xff\xfename: x\n", r"not UTF-8 text \(byte 0\)"),
+        (b"name: 2020-02-30\n", "not valid YAML.*day is out of range"),  # PyYAML's timestamps
+        (b"name: " + b"[" * 5000 + b"]" * 5000 + b"\n", "not valid YAML.*RecursionError"),
+    ],
+)
+def test_yaml_that_the_parser_cannot_take_is_a_config_error(
+    tmp_path, content: bytes, message: str
+) -> None:
+    path = tmp_path / "bad.yaml"
+    path.write_bytes(content)
+    with pytest.raises(ConfigError, match=rf"bad\.yaml.*{message}"):
+        load_scenario(path)
+
+
+def test_a_scenario_path_the_system_refuses_is_a_config_error(tmp_path) -> None:
+    with pytest.raises(ConfigError, match="cannot read the scenario file: File name too long"):
+        load_scenario(str(tmp_path / ("a" * 300 + ".yaml")))
+
+
 def test_block_and_scenario_refuse_bad_values_directly() -> None:
     with pytest.raises(InvalidArgumentError, match="exactly one"):
         Block(name="a", polygon=rectangle(0, 0, 1, 1))

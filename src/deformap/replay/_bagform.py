@@ -18,7 +18,7 @@ from numpy.typing import NDArray
 from deformap.cloud import PointCloud
 from deformap.cloud.io import array_to_pointcloud2, read_bag_static_transform
 from deformap.cloud.io._bag import _rosbag2
-from deformap.cloud.io._common import check_units, finish_cloud
+from deformap.cloud.io._common import check_units, finish_cloud, path_kind
 from deformap.cloud.io._pointcloud2 import pointcloud2_structured, xyz_with_holes
 from deformap.cloud.io._ros import typestore
 from deformap.environment import PressObservation
@@ -52,11 +52,12 @@ class BagReader:
         assert header.bag is not None
         self.header = header
         self.path = header.bag
-        if not self.path.exists():
+        if path_kind(self.path) == "missing":
             raise FileFormatError(f"{self.path}: no such bag (the session's `bag`)")
         self._raw = self._index()
         self._decoded: dict[str, dict[int, Any]] | None = None
         self._undecodable: dict[str, list[str]] = {}
+        self._repeated: dict[str, dict[int, int]] = {}  # topic -> stamp -> messages sharing it
         self._tf_static: NDArray[np.float64] | None = None
 
     def _index(self) -> dict[str, list[_Raw]]:
@@ -97,7 +98,11 @@ class BagReader:
             for number, raw in enumerate(self._raw[topic]):
                 try:
                     msg = store.deserialize_cdr(raw.data, msgtype)
-                    by_stamp.setdefault(_stamp(msg), msg)
+                    stamp = _stamp(msg)
+                    if stamp in by_stamp:  # which one is the poke's? neither is kept silently
+                        counts = self._repeated.setdefault(topic, {})
+                        counts[stamp] = counts.get(stamp, 1) + 1
+                    by_stamp.setdefault(stamp, msg)
                 except errors as exc:
                     self._undecodable.setdefault(topic, []).append(
                         f"message {number}: {type(exc).__name__}: {str(exc)[:120]}"
@@ -109,6 +114,12 @@ class BagReader:
     def _message(self, key: str, stamp: int) -> Any:
         topic = TOPICS[key][0]
         msg = self._messages_by_stamp()[key].get(stamp)
+        repeated = self._repeated.get(topic, {}).get(stamp)
+        if repeated:
+            raise FileFormatError(
+                f"{self.path}: topic {topic!r} has {repeated} messages stamped {stamp}; "
+                "a poke needs exactly one on each topic"
+            )
         if msg is None:
             bad = self._undecodable.get(topic, [])
             note = f"; {len(bad)} message(s) there could not be decoded ({bad[0]})" if bad else ""
@@ -145,10 +156,11 @@ class BagReader:
     def observation(self) -> PointCloud:
         topic = TOPICS["observation"][0]
         msgs = list(self._messages_by_stamp()["observation"].values())
-        if len(msgs) != 1:
+        count = len(msgs) + sum(n - 1 for n in self._repeated.get(topic, {}).values())
+        if count != 1:
             bad = self._undecodable.get(topic, [])
             raise FileFormatError(
-                f"{self.path}: topic {topic!r} must hold exactly one message; got {len(msgs)}"
+                f"{self.path}: topic {topic!r} must hold exactly one message; got {count}"
                 + (f" ({len(bad)} could not be decoded: {bad[0]})" if bad else "")
             )
         where = f"{self.path} [{topic}]"

@@ -10,6 +10,7 @@ from numpy.typing import NDArray
 
 from deformap.cloud import PointCloud
 from deformap.cloud.io import read_cloud
+from deformap.cloud.io._common import path_kind
 from deformap.errors import FileFormatError
 from deformap.replay._format import PokeSpec, SessionHeader
 
@@ -41,7 +42,7 @@ class FolderReader:
     def __init__(self, header: SessionHeader) -> None:
         self.header = header
         assert header.observation is not None
-        if not header.observation.is_file():
+        if path_kind(header.observation) != "file":
             raise FileFormatError(
                 f"{header.observation}: no such file (the session's `observation`)"
             )
@@ -63,6 +64,6 @@ class FolderReader:
     @staticmethod
     def _path(path: Path | None) -> Path:
         assert path is not None
-        if not path.is_file():
+        if path_kind(path) != "file":
             raise FileFormatError(f"{path}: no such file")
         return path

@@ -279,6 +279,7 @@ def parse_session_yaml(data: Any, file: Path) -> SessionHeader:
     if not isinstance(pokes, list):
         raise ConfigError(f"{_where(file, 'pokes')} must be a list; got {type(pokes).__name__}")
     truth = data.get("ground_truth")
+    specs = [_poke(file, i, p, form, root) for i, p in enumerate(pokes)]
     return SessionHeader(
         root=root, form=form, units=units, frame=frame, cam2world=cam2world,
         workspace=workspace, tip_radius_m=tip,
@@ -286,5 +287,23 @@ def parse_session_yaml(data: Any, file: Path) -> SessionHeader:
         bag=_file_name(file, "bag", data["bag"], root) if has_bag else None,
         ground_truth=None if truth is None else _file_name(file, "ground_truth", truth, root),
         source={str(k): v for k, v in source.items()},
-        pokes=tuple(_poke(file, i, p, form, root) for i, p in enumerate(pokes)),
+        pokes=tuple(_unique_stamps(file, specs)),
     )  # fmt: skip
+
+
+def _unique_stamps(file: Path, specs: list[PokeSpec]) -> list[PokeSpec]:
+    """Refuse a bag-form poke whose ``stamp_ns`` an earlier poke has: it would read that poke."""
+    first: dict[int, int] = {}
+    out = []
+    for spec in specs:
+        if spec.stamp_ns is not None and spec.stamp_ns in first:
+            key = f"pokes[{spec.index}].stamp_ns"
+            error = ConfigError(
+                f"{_where(file, key)} is {spec.stamp_ns}, already the stamp of "
+                f"`pokes[{first[spec.stamp_ns]}]`; each poke needs its own messages"
+            )
+            spec = PokeSpec(index=spec.index, error=error)
+        elif spec.stamp_ns is not None:
+            first[spec.stamp_ns] = spec.index
+        out.append(spec)
+    return out

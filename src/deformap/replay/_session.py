@@ -19,6 +19,7 @@ import yaml
 
 from deformap._validation import check_int, check_positive
 from deformap.cloud import PointCloud, points_in_hull
+from deformap.cloud.io._common import path_kind
 from deformap.environment import PressObservation, TactileContact, Workspace
 from deformap.errors import ConfigError, DeformapError, FileFormatError, InvalidArgumentError
 from deformap.replay._bagform import BagReader
@@ -170,12 +171,13 @@ def _read_yaml(file: Path) -> Any:
 
 
 def _session_file(path: Path) -> Path:
-    if path.is_dir():
+    kind = path_kind(path)
+    if kind == "dir":
         file = path / SESSION_FILE
-        if not file.is_file():
+        if path_kind(file) != "file":
             raise FileFormatError(f"{path}: not a session folder (it has no {SESSION_FILE})")
         return file
-    if path.is_file():
+    if kind == "file":
         return path
     raise FileFormatError(f"{path}: no such session folder or file")
 

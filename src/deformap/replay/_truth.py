@@ -17,6 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from deformap._validation import check_array
+from deformap.cloud.io._common import path_kind
 from deformap.cloud.io._npz import load_npz_arrays
 from deformap.errors import FileFormatError, InvalidArgumentError
 
@@ -110,7 +111,7 @@ def write_ground_truth(path: str | Path, truth: GroundTruth) -> None:
 def read_ground_truth(path: str | Path) -> GroundTruth:
     """Read a ``ground_truth.npz``; every problem is a FileFormatError naming the file."""
     p = Path(path)
-    if not p.is_file():
+    if path_kind(p) != "file":
         raise FileFormatError(f"{p}: no such file (the session's `ground_truth`)")
     arrays = load_npz_arrays(p, "the ground-truth NPZ archive")
     missing = sorted({"xs", "ys", "labels", "hardness"} - set(arrays))

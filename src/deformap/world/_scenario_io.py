@@ -57,15 +57,23 @@ def load_scenario(name_or_path: str | Path) -> Scenario:
     if key in catalogue:
         return catalogue[key]
     path = Path(key)
-    if not path.is_file():
+    try:
+        text = path.read_bytes().decode("utf-8") if path.is_file() else None
+    except OSError as exc:  # a name too long, no permission: not a file we can read
+        raise ConfigError(f"{path}: cannot read the scenario file: {exc.strerror or exc}") from None
+    except UnicodeDecodeError as exc:
+        raise ConfigError(f"{path}: not UTF-8 text (byte {exc.start})") from None
+    if text is None:
         raise ConfigError(
             f"unknown scenario {key!r}: not a built-in name ({', '.join(catalogue)}) "
             "and not an existing YAML file"
         )
     try:
-        data = yaml.safe_load(path.read_text())
-    except yaml.YAMLError as exc:
-        raise ConfigError(f"{path}: not valid YAML ({exc})") from None
+        data = yaml.safe_load(text)
+    except (yaml.YAMLError, RecursionError, ValueError) as exc:
+        # ValueError: PyYAML's timestamp constructor on an impossible date (2020-02-30).
+        detail = f"{type(exc).__name__}: {exc}".replace("\n", " ")[:300]
+        raise ConfigError(f"{path}: not valid YAML ({detail})") from None
     return parse_scenario(data, source=str(path))
 
 

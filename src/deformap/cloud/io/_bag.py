@@ -22,7 +22,7 @@ from numpy.typing import NDArray
 
 from deformap._validation import check_array
 from deformap.cloud._pointcloud import PointCloud
-from deformap.cloud.io._common import check_units, finish_cloud
+from deformap.cloud.io._common import check_units, finish_cloud, path_kind
 from deformap.cloud.io._pointcloud2 import pointcloud2_structured, xyz_with_holes
 from deformap.cloud.io._ros import typestore
 from deformap.errors import (
@@ -136,7 +136,7 @@ def _messages(path: Any, topic: str, msgtype: str) -> Iterator[tuple[int, Any]]:
             f"`path` must be a str or pathlib.Path; got {type(path).__name__}"
         )
     rosbag2, store, p = _rosbag2(), typestore(), Path(path)
-    if not p.exists():
+    if path_kind(p) == "missing":
         raise FileFormatError(f"{p}: no such bag")
     errors = bag_read_errors()
     try:

@@ -28,6 +28,7 @@ __all__ = [
     "check_units",
     "finish_cloud",
     "parse_errors",
+    "path_kind",
     "readable_path",
 ]
 
@@ -69,6 +70,23 @@ def check_units(units: Any) -> float:
     return UNITS[units]
 
 
+def path_kind(path: Path) -> str:
+    """``"file"``, ``"dir"``, ``"other"`` or ``"missing"``: what ``path`` names.
+
+    ``Path.is_file`` and its kin answer False for a missing path but raise OSError for a name the
+    system refuses (longer than 255 bytes, a parent without search permission); that is a
+    FileFormatError naming the path.
+    """
+    try:
+        if path.is_file():
+            return "file"
+        if path.is_dir():
+            return "dir"
+        return "other" if path.exists() else "missing"
+    except OSError as exc:
+        raise FileFormatError(f"{path}: cannot look this path up: {exc.strerror or exc}") from None
+
+
 def readable_path(path: Any) -> Path:
     """Validate that ``path`` names an existing regular file."""
     if not isinstance(path, (str, Path)):
@@ -76,9 +94,10 @@ def readable_path(path: Any) -> Path:
             f"`path` must be a str or pathlib.Path; got {type(path).__name__}"
         )
     p = Path(path)
-    if not p.exists():
+    kind = path_kind(p)
+    if kind == "missing":
         raise FileFormatError(f"{p}: no such file")
-    if not p.is_file():
+    if kind != "file":
         raise FileFormatError(f"{p}: not a regular file")
     return p
 

@@ -93,7 +93,14 @@ def _read_vertices(path: Path, data: bytes) -> NDArray[Any]:
     vertex = elements[index]
     dtype = _vertex_dtype(path, vertex, fmt)
     if fmt == "ascii":
-        lines = data[body_start:].decode("ascii").splitlines()
+        # One element per line; blank lines separate nothing, and would shift every row after them.
+        lines = [line for line in data[body_start:].decode("ascii").splitlines() if line.strip()]
+        total = sum(e.count for e in elements)
+        if len(lines) > total:
+            raise FileFormatError(
+                f"{path}: PLY header declares {total} element rows, the ascii body holds "
+                f"{len(lines)}; the counts are wrong or the file is corrupted"
+            )
         skip = sum(e.count for e in elements[:index])
         rows = lines[skip : skip + vertex.count]
         if len(rows) < vertex.count:
@@ -102,16 +109,13 @@ def _read_vertices(path: Path, data: bytes) -> NDArray[Any]:
             )
         if vertex.count == 0:
             return np.empty(0, dtype=dtype)
-        table = np.loadtxt(io.StringIO("\n".join(rows)), dtype=np.float64, ndmin=2)
+        table = np.loadtxt(io.StringIO("\n".join(rows)), dtype=np.float64, ndmin=2, comments=None)
         if table.shape[1] != len(dtype.names or ()):
             raise FileFormatError(
                 f"{path}: PLY vertex rows have {table.shape[1]} values, the header declares "
                 f"{len(dtype.names or ())} properties"
             )
-        out = np.empty(vertex.count, dtype=dtype)
-        for i, name in enumerate(dtype.names or ()):
-            out[name] = table[:, i]
-        return out
+        return _fill_ascii(path, table, dtype)
     offset = body_start
     for element in elements[:index]:
         if element.has_list:
@@ -127,6 +131,28 @@ def _read_vertices(path: Path, data: bytes) -> NDArray[Any]:
             f"{max(len(data) - offset, 0)}; the file is truncated"
         )
     return np.frombuffer(data, dtype=dtype, count=vertex.count, offset=offset).copy()
+
+
+def _fill_ascii(path: Path, table: NDArray[np.float64], dtype: np.dtype[Any]) -> NDArray[Any]:
+    """Store ascii values in their declared types; refuse a value the type cannot hold."""
+    out = np.empty(table.shape[0], dtype=dtype)
+    for i, name in enumerate(dtype.names or ()):
+        column = table[:, i]
+        with np.errstate(over="ignore", invalid="ignore"):
+            out[name] = column
+            stored = out[name].astype(np.float64)
+        if dtype[name].kind == "f":
+            bad = np.isfinite(column) & ~np.isfinite(stored)  # overflow to inf
+        else:
+            bad = stored != column  # out of range, fractional, or NaN
+        if np.any(bad):
+            row = int(np.argmax(bad))
+            kind = _NUMPY_TO_PLY[dtype[name].str[1:]]
+            raise FileFormatError(
+                f"{path}: PLY vertex property {name!r} is declared {kind}, but vertex {row} "
+                f"holds {float(column[row]):g}, which {kind} cannot hold"
+            )
+    return out
 
 
 def read_ply(
