@@ -96,6 +96,7 @@ def _progress_row(poke: Any) -> None:
         f"  force {r['force_n']:.2f} N  β = {r['beta']:.3f} ± {r['beta_std']:.3f}"
         f"  max var {r['max_variance_after']:.4f}"
         + (f"  plan: {r['planned_after']} more" if "planned_after" in r else "")
+        + ("  boundary poke" if r.get("purpose") == "boundary" else "")
         + f"  [dim](compute {compute:.2f} s, world {t.get('environment_s', 0.0):.2f} s)[/]",
         highlight=False,
     )

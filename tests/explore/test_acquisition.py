@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 
 from deformap.errors import InvalidArgumentError
-from deformap.explore._acquisition import choose_target
+from deformap.explore import ExplorationConfig
+from deformap.explore._acquisition import boundary_score, choose_target
 
 
 def _cells() -> tuple[np.ndarray, np.ndarray]:
@@ -59,3 +60,21 @@ def test_min_max_variance_uses_the_look_ahead() -> None:
         choose_target("min-max-variance", cells, variance, 0.1, np.random.default_rng(0))
     with pytest.raises(InvalidArgumentError, match="`strategy` must be one of"):
         choose_target("greedy", cells, variance, 0.1, np.random.default_rng(0))
+
+
+def test_the_boundary_score_prefers_uncertain_cells_on_an_isopleth() -> None:
+    mean = np.array([0.50, 0.50, 0.70, 0.30, 0.55])
+    std = np.array([0.10, 0.20, 0.20, 0.20, 0.05])
+    levels = np.array([0.35, 0.50])
+    score = boundary_score(mean, std, levels)
+    np.testing.assert_allclose(score, 1.96 * std - [0.0, 0.0, 0.2, 0.05, 0.05])
+    assert int(np.argmax(score)) == 1  # on an isopleth and the least known there
+    # one class, no isopleth: the least known cell
+    np.testing.assert_array_equal(boundary_score(mean, std, np.array([])), std)
+
+
+def test_boundary_settings_are_checked() -> None:
+    with pytest.raises(InvalidArgumentError, match="`region_labels` must be one of"):
+        ExplorationConfig(region_labels="voronoi")  # type: ignore[arg-type]
+    with pytest.raises(InvalidArgumentError, match="`boundary_pokes` must be an integer >= 0"):
+        ExplorationConfig(boundary_pokes=-1)

@@ -136,3 +136,38 @@ def test_a_planned_run_reports_how_many_pokes_its_plan_foresees() -> None:
     assert planned[-1] == 0  # the last poke was the last of its plan
     assert all(isinstance(n, int) and 0 <= n < config.max_pokes for n in planned)
     assert "planned_after" not in result.pokes[0].record  # the first poke is the configured one
+
+
+def test_boundary_pokes_come_after_the_threshold_and_regions_by_nearest_poke() -> None:
+    env = TwoFoamTable(np.random.default_rng(3))
+    config = ExplorationConfig(
+        max_pokes=12,
+        strategy="planned",
+        boundary_pokes=3,
+        region_labels="nearest",
+        surface=SurfaceGPConfig(fit_hyperparameters=False, length_scale_m=0.02),
+        beta_field=BetaFieldConfig(length_scale_m=0.12),
+    )
+    result = explore(env, config, rng=np.random.default_rng(0))
+    purposes = [p.record["purpose"] for p in result.pokes]
+    n_variance = purposes.count("variance")
+    assert purposes == ["first"] + ["variance"] * n_variance + ["boundary"] * 3
+    assert result.stop_reason == "threshold"
+    records = [p.record for p in result.pokes]
+    # the variance was under T_h before the first boundary poke, not before
+    assert records[n_variance]["max_variance_after"] <= config.threshold
+    assert all(r["max_variance_after"] > config.threshold for r in records[:n_variance])
+    xy = np.array([p.xy for p in result.pokes])
+    for k in range(n_variance + 1, len(xy)):  # a quarter ROI (3 cm) from every earlier poke
+        assert np.min(np.linalg.norm(xy[:k] - xy[k], axis=1)) >= 0.25 * config.touch.roi_size_m
+    mapper = result.mapper
+    regions = mapper.regions()
+    assert regions.n_regions == 2
+    # soft foam (x < 12 cm) is the higher-β class: label 1
+    truth = (mapper.cells_xy[:, 0] < 0.12).astype(int).reshape(regions.labels.shape)
+    assert np.mean(regions.labels == truth) >= 0.85
+    # each cell has the class of a poke nearest to it (any of a tie)
+    d = np.linalg.norm(mapper.cells_xy[:, None] - xy[None], axis=-1)
+    nearest = d <= d.min(axis=1, keepdims=True) + 1e-12
+    own = regions.poke_labels[None, :] == regions.labels.reshape(-1, 1)
+    assert np.all(np.any(nearest & own, axis=1))

@@ -78,3 +78,33 @@ def test_bad_input() -> None:
         segment_regions(np.zeros((2, 2)), np.zeros(2), np.zeros(2), prior_dof=-1.0)
     with pytest.raises(InvalidArgumentError, match="`max_regions`"):
         segment_regions(np.zeros((2, 2)), np.zeros(2), np.zeros(2), max_regions=0)
+
+
+def test_each_poke_gets_the_class_its_beta_was_grouped_in() -> None:
+    betas = np.array([0.86, 0.01, 0.5, 0.0, 0.84, 0.52, 0.02, 0.48, 0.85])
+    result = segment_regions(np.zeros((2, 2)), betas, np.full(betas.size, 0.02))
+    np.testing.assert_array_equal(result.poke_labels, [2, 0, 1, 0, 2, 1, 0, 1, 2])
+    for k in range(result.n_regions):
+        assert betas[result.poke_labels == k].mean() == pytest.approx(result.class_betas[k])
+
+
+def test_nearest_poke_labels_give_each_cell_its_nearest_pokes_class() -> None:
+    xs, ys = np.linspace(0.0, 0.6, 13), np.linspace(0.0, 0.4, 9)
+    gx, gy = np.meshgrid(xs, ys)
+    cells = np.column_stack([gx.ravel(), gy.ravel()])
+    pokes = np.array([[0.1, 0.2], [0.2, 0.1], [0.45, 0.2], [0.5, 0.3]])
+    betas = np.array([0.85, 0.84, 0.30, 0.31])
+    # a field whose isopleth lies far from the pokes' midline (reverting to its mean at the left)
+    field = np.where(gx < 0.05, 0.4, np.where(gx < 0.35, 0.85, 0.3))
+    found = segment_regions(field, betas, np.full(4, 0.02))
+    assert found.n_regions == 2 and found.labels[4, 0] == 0  # the left edge cut off by the band
+    near = found.nearest_poke(pokes, cells)
+    d = np.linalg.norm(cells[:, None, :] - pokes[None], axis=-1)
+    expected = found.poke_labels[np.argmin(d, axis=1)].reshape(gx.shape)
+    np.testing.assert_array_equal(near.labels, expected)
+    assert near.labels[4, 0] == 1  # the left edge goes to the soft pokes beside it
+    np.testing.assert_array_equal(near.levels, found.levels)
+    with pytest.raises(InvalidArgumentError, match="`poke_xy`"):
+        found.nearest_poke(pokes[:3], cells)
+    with pytest.raises(InvalidArgumentError, match="`cells_xy`"):
+        found.nearest_poke(pokes, cells[:-1])

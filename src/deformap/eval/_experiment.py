@@ -289,7 +289,7 @@ def write_map_figures(
             variance=var,
             contacts=contacts,
             labels=regions.labels,
-            levels=regions.levels,
+            levels=regions.levels if mapper.config.region_labels == "isopleth" else None,
             truth_hardness=None
             if truth is None
             else truth.ground_truth_hardness(mapper.xs, mapper.ys),

@@ -178,6 +178,14 @@ class ExplorationConfig:
         How many degrees of freedom the pokes' uncertainties count for when the region test
         judges whether the βs scatter more than one material would (7: as much as the eight
         presses on one foam the noise floor was measured from; 0: ignore them, scale-free).
+    region_labels : {"isopleth", "nearest"}
+        How cells get their region once the classes are found (:mod:`deformap.explore._regions`):
+        ``isopleth``, the paper's, by the band of the β-field's mean a cell falls in;
+        ``nearest``, by the class of the poke nearest to the cell.
+    boundary_pokes : int
+        Pokes made after the variance has fallen below ``T_h``, each where a region boundary is
+        least certain (:mod:`deformap.explore._acquisition`, "boundary pokes"); 0, the paper's
+        rule, stops there.
     """
 
     threshold: float = 0.06
@@ -188,6 +196,8 @@ class ExplorationConfig:
     force_n: float = 0.6
     max_regions: int = 6
     region_prior_dof: float = 7.0
+    region_labels: Literal["isopleth", "nearest"] = "isopleth"
+    boundary_pokes: int = 0
     surface: SurfaceGPConfig = field(default_factory=SurfaceGPConfig)
     touch: TouchGPConfig = field(default_factory=TouchGPConfig)
     beta_field: BetaFieldConfig = field(default_factory=BetaFieldConfig)
@@ -209,3 +219,8 @@ class ExplorationConfig:
         check_positive("force_n", self.force_n)
         check_int("max_regions", self.max_regions, minimum=1)
         check_positive("region_prior_dof", self.region_prior_dof, allow_zero=True)
+        if self.region_labels not in ("isopleth", "nearest"):
+            raise InvalidArgumentError(
+                f"`region_labels` must be one of ['isopleth', 'nearest']; got {self.region_labels!r}"
+            )
+        check_int("boundary_pokes", self.boundary_pokes, minimum=0)

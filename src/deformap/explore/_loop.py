@@ -100,6 +100,8 @@ def explore(
             t2 = time.perf_counter()
             env.release()
         t3 = time.perf_counter()
+        # why this place: the first poke, the strategy's (until T_h), or a boundary poke
+        poke.record["purpose"] = "first" if index == 0 else mapper.last_purpose
         plan = mapper.last_plan if index > 0 else None
         if plan is not None and plan.reaches:
             # the pokes the plan still foresees after this one (the progress display shows it)

@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy.spatial import cKDTree
 
 from deformap.cloud import (
     PointCloud,
@@ -29,7 +30,7 @@ from deformap.cloud import (
 )
 from deformap.environment import PressObservation, TactileContact, Workspace
 from deformap.errors import EnvironmentStateError, InvalidArgumentError
-from deformap.explore._acquisition import choose_target
+from deformap.explore._acquisition import boundary_score, choose_target
 from deformap.explore._config import ExplorationConfig
 from deformap.explore._dent_noise import dent_error_samples
 from deformap.explore._planning import PokePlan, VarianceDesign, plan_pokes
@@ -101,6 +102,9 @@ def _contact_record(contact: TactileContact) -> dict[str, Any]:
 
 _PLAN_DOMAIN_M = 0.02
 _PLAN_CANDIDATE_M = 0.02
+_BOUNDARY_SPACING_ROI = 0.25
+"""Boundary pokes keep this many ROI sizes (3 cm with the 12 cm ROI) from every poke: a dent
+spreads a few centimetres, so closer pokes would measure much the same foam again."""
 
 
 def _strided(nx: int, ny: int, step_m: float, spacing_m: float,
@@ -156,6 +160,9 @@ class Mapper:
                        config.surface.grid_spacing_m, within=self.target_mask)
         self._plan_candidates = self.cells_xy[sub]
         self.last_plan: PokePlan | None = None
+        # why the last target of next_target was chosen: "variance" (the strategy, until T_h)
+        # or "boundary" (a boundary poke after it)
+        self.last_purpose = "variance"
         self.surface: SurfaceModel | None = None
         self.pokes: list[PokeResult] = []
         self._field: GaussianRandomField | None = None
@@ -346,10 +353,15 @@ class Mapper:
         """The next target by the configured strategy, or ``None`` when the map is known
         (``planned``: the plan it came from is kept in ``last_plan``)."""
         self.last_plan = None
+        self.last_purpose = "variance"
         _, var = self.field()
         variance = var.ravel()
         if variance[self.stop_mask].max() <= self.config.threshold:
-            return None
+            made = sum(p.record.get("purpose") == "boundary" for p in self.pokes)
+            if made >= self.config.boundary_pokes:
+                return None
+            self.last_purpose = "boundary"
+            return self._boundary_target()
         cells, reachable = self.cells_xy[self.target_mask], variance[self.target_mask]
         if reachable.max() <= self.config.threshold:
             # Only the edge band, where no poke fits, is still uncertain. The plan covers it;
@@ -369,6 +381,19 @@ class Mapper:
             look_ahead=self._max_variance_after,
             planner=self._planned_target,
         )
+
+    def _boundary_target(self) -> NDArray[np.float64] | None:
+        """Where a region boundary is least certain (:func:`boundary_score`), among the reachable
+        cells at least a quarter ROI from every poke; ``None`` when no such cell is left."""
+        mean, var = self.field()
+        xy, _ = self._poked()
+        spacing = _BOUNDARY_SPACING_ROI * self.config.touch.roi_size_m
+        allowed = self.target_mask & (cKDTree(xy).query(self.cells_xy, k=1)[0] >= spacing)
+        if not allowed.any():
+            return None
+        score = boundary_score(mean.ravel()[allowed], np.sqrt(var.ravel()[allowed]),
+                               self.regions().levels)
+        return np.array(self.cells_xy[allowed][int(np.argmax(score))], dtype=float)
 
     def _planned_target(self) -> NDArray[np.float64]:
         """The next poke of the plan with the fewest further pokes (``planned`` strategy)."""
@@ -408,7 +433,10 @@ class Mapper:
         beta = np.array([p.record["beta"] for p in self.pokes])
         floor = self.config.beta_field.noise_floor
         std = np.maximum([p.record["beta_std"] for p in self.pokes], floor)
-        return segment_regions(
+        found = segment_regions(
             mean, beta, std, floor=floor, max_regions=self.config.max_regions,
             prior_dof=self.config.region_prior_dof,
         )  # fmt: skip
+        if self.config.region_labels == "nearest":
+            return found.nearest_poke(self._poked()[0], self.cells_xy)
+        return found

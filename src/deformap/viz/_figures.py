@@ -62,7 +62,8 @@ def plot_map(
     contacts : (k, 2) float, metres
         Poked places in order.
     labels, levels : optional
-        Region label map and the isopleths drawn as contours.
+        Region label map and the isopleths drawn as contours of ``beta``; without ``levels``, the
+        edges between the labels are drawn (regions labelled by nearest poke).
     truth_hardness : (ny, nx) float, optional
         Ground-truth hardness in newtons (``inf`` rigid, ``nan`` bare table); omitted without truth.
     """
@@ -83,6 +84,9 @@ def plot_map(
     im = ax.imshow(beta, origin="lower", extent=ext, cmap="magma", vmin=0.0, vmax=1.0)
     if levels is not None and len(levels):
         ax.contour(xs, ys, beta, levels=np.sort(levels), colors="c", linewidths=2)
+    elif labels is not None and np.ptp(labels) > 0:
+        edges = np.arange(int(labels.min()), int(labels.max())) + 0.5
+        ax.contour(xs, ys, labels.astype(float), levels=edges, colors="c", linewidths=2)
     fig.colorbar(im, ax=ax, label="β (deformability)")
     n_regions = "" if labels is None else f", {len(np.unique(labels))} region(s)"
     ax.set_title(f"β-field{n_regions}")
