@@ -118,19 +118,24 @@ def config_from_dict(cls: type[T], data: Any, *, where: str = "config") -> T:
         raise ConfigError(f"`{where}`: {exc}") from None
 
 
-def load_yaml(path: str | Path) -> Any:
-    """Read a YAML file safely (no arbitrary objects); errors name the file."""
+def load_yaml(path: str | Path, *, what: str = "config file",
+              unreadable: type[DeformapError] = ConfigError) -> Any:
+    """Read a YAML file safely (no arbitrary objects); errors name the file.
+
+    A file that cannot be read raises ``unreadable`` (``cannot read {what}``); bytes that are not
+    UTF-8 text, or text PyYAML cannot take (a syntax error, nesting too deep, an impossible date
+    such as 2020-02-30 from its timestamp constructor), raise :class:`ConfigError`.
+    """
     p = Path(path)
     try:
         text = p.read_bytes().decode("utf-8")
     except OSError as exc:
-        raise ConfigError(f"cannot read config file {str(p)!r}: {exc.strerror or exc}") from None
+        raise unreadable(f"cannot read {what} {str(p)!r}: {exc.strerror or exc}") from None
     except UnicodeDecodeError as exc:
         raise ConfigError(f"{str(p)!r} is not UTF-8 text (byte {exc.start})") from None
     try:
         return yaml.safe_load(text)
     except (yaml.YAMLError, RecursionError, ValueError) as exc:
-        # ValueError: PyYAML's timestamp constructor on an impossible date (2020-02-30).
         detail = f"{type(exc).__name__}: {exc}".replace("\n", " ")[:300]
         raise ConfigError(f"{str(p)!r} is not valid YAML: {detail}") from None
 

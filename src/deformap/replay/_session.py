@@ -15,13 +15,13 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import yaml
 
+from deformap._config import load_yaml
 from deformap._validation import check_int, check_positive
 from deformap.cloud import PointCloud, points_in_hull
 from deformap.cloud.io._common import path_kind
 from deformap.environment import PressObservation, TactileContact, Workspace
-from deformap.errors import ConfigError, DeformapError, FileFormatError, InvalidArgumentError
+from deformap.errors import DeformapError, FileFormatError, InvalidArgumentError
 from deformap.replay._bagform import BagReader
 from deformap.replay._folder import FolderReader
 from deformap.replay._format import SESSION_FILE, SessionHeader, parse_session_yaml
@@ -156,18 +156,7 @@ def check_contact_gap(obs: PressObservation, gap_m: float, where: str) -> None:
 
 
 def _read_yaml(file: Path) -> Any:
-    try:
-        text = file.read_bytes().decode("utf-8")
-    except OSError as exc:
-        raise FileFormatError(f"{file}: cannot read: {exc.strerror or exc}") from None
-    except UnicodeDecodeError as exc:
-        raise ConfigError(f"{file}: not UTF-8 text (byte {exc.start})") from None
-    try:
-        return yaml.safe_load(text)
-    except (yaml.YAMLError, RecursionError, ValueError) as exc:
-        # ValueError: PyYAML's timestamp constructor on an impossible date.
-        detail = str(exc).replace("\n", " ")[:300]
-        raise ConfigError(f"{file}: not valid YAML: {type(exc).__name__}: {detail}") from None
+    return load_yaml(file, what="the session file", unreadable=FileFormatError)
 
 
 def _session_file(path: Path) -> Path:

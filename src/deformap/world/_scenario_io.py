@@ -24,6 +24,7 @@ from typing import Any
 import numpy as np
 import yaml
 
+from deformap._config import load_yaml
 from deformap.environment import Workspace
 from deformap.errors import ConfigError, DeformapError
 from deformap.world._polygon import rectangle
@@ -58,22 +59,15 @@ def load_scenario(name_or_path: str | Path) -> Scenario:
         return catalogue[key]
     path = Path(key)
     try:
-        text = path.read_bytes().decode("utf-8") if path.is_file() else None
+        is_file = path.is_file()
     except OSError as exc:  # a name too long, no permission: not a file we can read
         raise ConfigError(f"{path}: cannot read the scenario file: {exc.strerror or exc}") from None
-    except UnicodeDecodeError as exc:
-        raise ConfigError(f"{path}: not UTF-8 text (byte {exc.start})") from None
-    if text is None:
+    if not is_file:
         raise ConfigError(
             f"unknown scenario {key!r}: not a built-in name ({', '.join(catalogue)}) "
             "and not an existing YAML file"
         )
-    try:
-        data = yaml.safe_load(text)
-    except (yaml.YAMLError, RecursionError, ValueError) as exc:
-        # ValueError: PyYAML's timestamp constructor on an impossible date (2020-02-30).
-        detail = f"{type(exc).__name__}: {exc}".replace("\n", " ")[:300]
-        raise ConfigError(f"{path}: not valid YAML ({detail})") from None
+    data = load_yaml(path, what="the scenario file")
     return parse_scenario(data, source=str(path))
 
 
