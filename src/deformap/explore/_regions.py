@@ -45,8 +45,8 @@ of the band of the β-field it falls in (:meth:`RegionMap.nearest_poke`). The is
 with a 0.2 m length scale are smooth curves that revert towards the field's mean away from the
 pokes, and pokes placed to pin a boundary do not move them much: on the simulated 110-150 and
 60-110-rigid worlds with 20 pokes (15 of them boundary pokes), isopleths gave region accuracy
-0.74–0.85 where the nearest-poke labels of the same pokes gave 0.90–0.94 (0.79 where the region
-test found a third class; README, "Region accuracy"). With the 5 pokes of the default run the
+0.74–0.85 where the nearest-poke labels of the same pokes gave 0.897–0.942 (0.79 where the
+region test found a third class; README, "Region accuracy"). With the 5 pokes of the default run the
 nearest-poke labels have the better minimum (0.79 against 0.66–0.70) but not ≥ 0.9 everywhere,
 and the paper's isopleths stay the default.
 
