@@ -139,7 +139,8 @@ def explore_command(
         str | None, typer.Option(help="paper | max-variance | min-max-variance | planned.")
     ] = None,
     threshold: Annotated[
-        float | None, typer.Option(help="T_h: stop when max var(β) is below it.")
+        float | None,
+        typer.Option(help="T_h: stop when max var(β) is below it (then any boundary pokes)."),
     ] = None,
     max_pokes: Annotated[int | None, typer.Option(help="Most pokes to make.")] = None,
     config: Annotated[

@@ -105,6 +105,32 @@ def test_a_run_killed_before_its_journal_existed_resumes_from_poke_one(tmp_path,
     assert len(read_journal(out / JOURNAL_NAME).pokes) == 3
 
 
+def test_a_run_journalled_before_a_config_field_existed_resumes(tmp_path, full_run) -> None:  # type: ignore[no-untyped-def]
+    # A run begun before `region_labels` and `boundary_pokes` existed: its journal header and
+    # config.yaml lack them. Read at their defaults (the behaviour before them) it is this run.
+    out = tmp_path / "older"
+
+    def kill(poke) -> None:  # type: ignore[no-untyped-def]
+        if poke.record["index"] == 1:
+            raise Killed
+
+    with pytest.raises(Killed):
+        run_experiment(_config(), out, on_poke=kill, figures=False)
+    journal = out / JOURNAL_NAME
+    lines = journal.read_text().splitlines()
+    header = json.loads(lines[0])
+    for key in ("region_labels", "boundary_pokes"):
+        del header["config"]["exploration"][key]
+    journal.write_text("\n".join([json.dumps(header), *lines[1:]]) + "\n")
+    resumed = run_experiment(_config(), out, resume=True, figures=False).report
+    assert [p["beta"] for p in resumed["pokes"]] == [p["beta"] for p in full_run.report["pokes"]]
+    # a real difference in such a header is still refused
+    header["config"]["seed"] = 5
+    journal.write_text("\n".join([json.dumps(header), *lines[1:]]) + "\n")
+    with pytest.raises(ConfigError, match="differs from this one"):
+        run_experiment(_config(), out, resume=True, figures=False)
+
+
 def test_resume_refuses_a_different_configuration(tmp_path, full_run) -> None:  # type: ignore[no-untyped-def]
     other = RunConfig(**{**_config().__dict__, "seed": 5})
     with pytest.raises(ConfigError, match="differs from this one"):

@@ -171,3 +171,19 @@ def test_boundary_pokes_come_after_the_threshold_and_regions_by_nearest_poke() -
     nearest = d <= d.min(axis=1, keepdims=True) + 1e-12
     own = regions.poke_labels[None, :] == regions.labels.reshape(-1, 1)
     assert np.all(np.any(nearest & own, axis=1))
+
+
+def test_a_poke_limit_that_cuts_the_boundary_pokes_short_is_the_stop_reason() -> None:
+    env = TwoFoamTable(np.random.default_rng(3))
+    config = ExplorationConfig(
+        max_pokes=4,  # the variance is under T_h after 3 pokes (see above): one boundary poke
+        strategy="planned",
+        boundary_pokes=3,
+        surface=SurfaceGPConfig(fit_hyperparameters=False, length_scale_m=0.02),
+        beta_field=BetaFieldConfig(length_scale_m=0.12),
+    )
+    result = explore(env, config, rng=np.random.default_rng(0))
+    assert [p.record["purpose"] for p in result.pokes][-1] == "boundary"
+    assert result.mapper.max_variance() <= config.threshold
+    assert result.mapper.boundary_owed() == 2
+    assert result.stop_reason == "max_pokes"

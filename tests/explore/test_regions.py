@@ -99,9 +99,13 @@ def test_nearest_poke_labels_give_each_cell_its_nearest_pokes_class() -> None:
     found = segment_regions(field, betas, np.full(4, 0.02))
     assert found.n_regions == 2 and found.labels[4, 0] == 0  # the left edge cut off by the band
     near = found.nearest_poke(pokes, cells)
-    d = np.linalg.norm(cells[:, None, :] - pokes[None], axis=-1)
-    expected = found.poke_labels[np.argmin(d, axis=1)].reshape(gx.shape)
-    np.testing.assert_array_equal(near.labels, expected)
+    np.testing.assert_array_equal(found.poke_labels, [1, 1, 0, 0])
+    # the soft pokes' side of the perpendicular bisector between (0.2, 0.1) and (0.45, 0.2),
+    # the two pokes of different classes that face each other across the middle
+    soft = gx < 0.30
+    np.testing.assert_array_equal(near.labels[:, :5], 1)  # x ≤ 0.2 m: nearer a soft poke
+    np.testing.assert_array_equal(near.labels[:, 8:], 0)  # x ≥ 0.4 m: nearer a stiff poke
+    assert np.mean(near.labels == soft) > 0.9
     assert near.labels[4, 0] == 1  # the left edge goes to the soft pokes beside it
     np.testing.assert_array_equal(near.levels, found.levels)
     with pytest.raises(InvalidArgumentError, match="`poke_xy`"):

@@ -21,9 +21,16 @@ import numpy as np
 from deformap import __version__
 from deformap._config import config_from_dict, config_to_dict, dump_yaml, load_yaml
 from deformap._validation import check_int
-from deformap.errors import ConfigError
+from deformap.errors import ConfigError, DeformapError
 from deformap.eval._metrics import region_scores
-from deformap.explore import ExplorationConfig, ExplorationResult, Journal, PokeResult, explore
+from deformap.explore import (
+    ExplorationConfig,
+    ExplorationResult,
+    Journal,
+    PokeResult,
+    explore,
+    read_journal,
+)
 from deformap.explore._journal import JOURNAL_NAME, replace_durably
 from deformap.world import SimulatedWorld, WorldConfig, load_scenario
 
@@ -93,6 +100,26 @@ def _write_whole(path: Path, text: str) -> None:
     replace_durably(tmp, path)
 
 
+def _stored_if_same(out: Path, config: RunConfig, header: dict[str, Any]) -> dict[str, Any]:
+    """The journal's own header if it names this run in an older form, else ``header``.
+
+    A configuration field added since the run began is missing from its journal header; read
+    with that field at its default (new fields default to the behaviour before them), the stored
+    configuration may equal this run's, which then resumes. Anything else is left for
+    :meth:`Journal.resume` to compare (and refuse, naming what differs).
+    """
+    try:
+        stored = read_journal(out / JOURNAL_NAME).header
+        same = (
+            {k: v for k, v in stored.items() if k not in ("kind", "config")}
+            == json.loads(json.dumps({k: v for k, v in header.items() if k != "config"}))
+            and config_from_dict(RunConfig, stored["config"], where="journal header") == config
+        )
+    except (DeformapError, KeyError, TypeError):
+        return header
+    return {k: v for k, v in stored.items() if k != "kind"} if same else header
+
+
 def _prepare_folder(
     out: Path, config: RunConfig, header: dict[str, Any], resume: bool
 ) -> tuple[Journal, list]:
@@ -112,7 +139,7 @@ def _prepare_folder(
                 )
             logger.warning("%s: killed before its journal was created; starting over", out)
             return Journal.create(out, header), []
-        journal, contents = Journal.resume(out, header)
+        journal, contents = Journal.resume(out, _stored_if_same(out, config, header))
         if contents.broken_line is not None:
             logger.warning(
                 "%s: the last journal line was cut mid-write and is dropped (%d complete pokes kept)",
@@ -200,7 +227,11 @@ def map_report(result: ExplorationResult, *, truth: Any = None) -> dict[str, Any
     true_regions = None
     if pokes:
         found = mapper.regions()
-        regions = {"levels": found.levels.tolist(), "class_betas": found.class_betas.tolist()}
+        # under region_labels "nearest" the cells take their nearest poke's class, and the
+        # levels only separate the classes' βs
+        regions = {"levels": found.levels.tolist(), "class_betas": found.class_betas.tolist(),
+                   "poke_labels": found.poke_labels.tolist(),
+                   "labels_by": mapper.config.region_labels}
         if truth is not None:
             labels = truth.ground_truth_labels(mapper.xs, mapper.ys)
             hardness_grid = truth.ground_truth_hardness(mapper.xs, mapper.ys)

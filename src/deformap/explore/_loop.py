@@ -48,7 +48,8 @@ def explore(
     done: Sequence[dict[str, Any]] = (),
     on_poke: Callable[[PokeResult], None] | None = None,
 ) -> ExplorationResult:
-    """Observe, then poke where the β-field is least known until its variance is below ``T_h``.
+    """Observe, then poke where the β-field is least known until its variance is below ``T_h``,
+    then make the ``boundary_pokes`` (if any) where a region boundary is least certain.
 
     Parameters
     ----------
@@ -115,7 +116,9 @@ def explore(
         if on_poke is not None:
             on_poke(poke)
     else:
-        if mapper.max_variance() <= config.threshold:
+        # the poke limit stopped it unless the map was done: variance under T_h and no boundary
+        # poke owed
+        if mapper.max_variance() <= config.threshold and mapper.boundary_owed() == 0:
             stop = "threshold"
     total = time.perf_counter() - t_start
     timings = {

@@ -350,18 +350,25 @@ class Mapper:
         return float(self.field()[1].ravel()[self.stop_mask].max())
 
     def next_target(self, rng: np.random.Generator) -> NDArray[np.float64] | None:
-        """The next target by the configured strategy, or ``None`` when the map is known
-        (``planned``: the plan it came from is kept in ``last_plan``)."""
+        """The next target by the configured strategy until the variance is under ``T_h``, then
+        the boundary pokes (``boundary_pokes``; ``last_purpose`` says which); ``None`` when the
+        variance is under ``T_h`` and no boundary poke is owed or none has a place left
+        (``planned``: the plan a target came from is kept in ``last_plan``)."""
         self.last_plan = None
         self.last_purpose = "variance"
         _, var = self.field()
         variance = var.ravel()
         if variance[self.stop_mask].max() <= self.config.threshold:
-            made = sum(p.record.get("purpose") == "boundary" for p in self.pokes)
-            if made >= self.config.boundary_pokes:
+            if self.boundary_owed() == 0:
                 return None
             self.last_purpose = "boundary"
-            return self._boundary_target()
+            target = self._boundary_target()
+            if target is None:
+                logger.warning(
+                    "%d of %d boundary pokes left undone: no reachable place is %.3g m from "
+                    "every poke", self.boundary_owed(), self.config.boundary_pokes,
+                    _BOUNDARY_SPACING_ROI * self.config.touch.roi_size_m)
+            return target
         cells, reachable = self.cells_xy[self.target_mask], variance[self.target_mask]
         if reachable.max() <= self.config.threshold:
             # Only the edge band, where no poke fits, is still uncertain. The plan covers it;
@@ -381,6 +388,11 @@ class Mapper:
             look_ahead=self._max_variance_after,
             planner=self._planned_target,
         )
+
+    def boundary_owed(self) -> int:
+        """Boundary pokes still to make (``boundary_pokes`` less those made)."""
+        made = sum(p.record.get("purpose") == "boundary" for p in self.pokes)
+        return max(0, self.config.boundary_pokes - made)
 
     def _boundary_target(self) -> NDArray[np.float64] | None:
         """Where a region boundary is least certain (:func:`boundary_score`), among the reachable

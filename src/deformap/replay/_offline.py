@@ -67,8 +67,8 @@ def map_session(
     ----------
     session : RecordedSession
     config : ExplorationConfig
-        Mapper settings. ``max_pokes``, ``threshold`` and ``strategy`` do not apply: every
-        recorded poke is used, where it was made.
+        Mapper settings. ``max_pokes``, ``threshold``, ``strategy`` and ``boundary_pokes`` do
+        not apply: every recorded poke is used, where it was made.
     rng : numpy.random.Generator
         Split as :func:`deformap.explore.explore` splits it (its first stream fits the surface),
         so the live run's generator gives the live run's surface model.

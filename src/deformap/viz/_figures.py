@@ -85,8 +85,11 @@ def plot_map(
     if levels is not None and len(levels):
         ax.contour(xs, ys, beta, levels=np.sort(levels), colors="c", linewidths=2)
     elif labels is not None and np.ptp(labels) > 0:
-        edges = np.arange(int(labels.min()), int(labels.max())) + 0.5
-        ax.contour(xs, ys, labels.astype(float), levels=edges, colors="c", linewidths=2)
+        # each region's outline (contours of the label values would draw two lines where
+        # regions 0 and 2 meet)
+        for label in np.unique(labels):
+            ax.contour(xs, ys, (labels == label).astype(float), levels=[0.5], colors="c",
+                       linewidths=2)
     fig.colorbar(im, ax=ax, label="β (deformability)")
     n_regions = "" if labels is None else f", {len(np.unique(labels))} region(s)"
     ax.set_title(f"β-field{n_regions}")
