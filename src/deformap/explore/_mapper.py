@@ -356,13 +356,13 @@ class Mapper:
         (``planned``: the plan a target came from is kept in ``last_plan``)."""
         self.last_plan = None
         self.last_purpose = "variance"
-        _, var = self.field()
+        mean, var = self.field()
         variance = var.ravel()
         if variance[self.stop_mask].max() <= self.config.threshold:
             if self.boundary_owed() == 0:
                 return None
             self.last_purpose = "boundary"
-            target = self._boundary_target()
+            target = self._boundary_target(mean, var)
             if target is None:
                 logger.warning(
                     "%d of %d boundary pokes left undone: no reachable place is %.3g m from "
@@ -394,17 +394,18 @@ class Mapper:
         made = sum(p.record.get("purpose") == "boundary" for p in self.pokes)
         return max(0, self.config.boundary_pokes - made)
 
-    def _boundary_target(self) -> NDArray[np.float64] | None:
-        """Where a region boundary is least certain (:func:`boundary_score`), among the reachable
-        cells at least a quarter ROI from every poke; ``None`` when no such cell is left."""
-        mean, var = self.field()
+    def _boundary_target(self, mean: NDArray[np.float64],
+                         var: NDArray[np.float64]) -> NDArray[np.float64] | None:
+        """Where a region boundary is least certain (:func:`boundary_score`) on the current
+        β-field (``mean``, ``var``), among the reachable cells at least a quarter ROI from every
+        poke; ``None`` when no such cell is left."""
         xy, _ = self._poked()
         spacing = _BOUNDARY_SPACING_ROI * self.config.touch.roi_size_m
         allowed = self.target_mask & (cKDTree(xy).query(self.cells_xy, k=1)[0] >= spacing)
         if not allowed.any():
             return None
         score = boundary_score(mean.ravel()[allowed], np.sqrt(var.ravel()[allowed]),
-                               self.regions().levels)
+                               self._classes(mean).levels)
         return np.array(self.cells_xy[allowed][int(np.argmax(score))], dtype=float)
 
     def _planned_target(self) -> NDArray[np.float64]:
@@ -437,18 +438,21 @@ class Mapper:
         noise = np.maximum([p.record["beta_std"] for p in self.pokes], floor)
         return xy, np.asarray(noise, dtype=float).reshape(-1)
 
+    def _classes(self, mean: NDArray[np.float64]) -> RegionMap:
+        """The pokes' classes and the isopleth labels of the β-field mean ``mean``."""
+        beta = np.array([p.record["beta"] for p in self.pokes])
+        floor = self.config.beta_field.noise_floor
+        std = np.maximum([p.record["beta_std"] for p in self.pokes], floor)
+        return segment_regions(
+            mean, beta, std, floor=floor, max_regions=self.config.max_regions,
+            prior_dof=self.config.region_prior_dof,
+        )  # fmt: skip
+
     def regions(self) -> RegionMap:
         """Cut the current β-field into regions (see :mod:`deformap.explore._regions`)."""
         if self._field is None:
             raise EnvironmentStateError("no poke yet: the β-field has no regions")
-        mean, _ = self.field()
-        beta = np.array([p.record["beta"] for p in self.pokes])
-        floor = self.config.beta_field.noise_floor
-        std = np.maximum([p.record["beta_std"] for p in self.pokes], floor)
-        found = segment_regions(
-            mean, beta, std, floor=floor, max_regions=self.config.max_regions,
-            prior_dof=self.config.region_prior_dof,
-        )  # fmt: skip
+        found = self._classes(self.field()[0])
         if self.config.region_labels == "nearest":
             return found.nearest_poke(self._poked()[0], self.cells_xy)
         return found
