@@ -69,8 +69,8 @@ def test_report_and_figures(full_run) -> None:  # type: ignore[no-untyped-def]
     assert variances[-1] <= variances[0]
 
 
-def test_a_killed_run_resumes_to_the_same_result(tmp_path, full_run) -> None:  # type: ignore[no-untyped-def]
-    out = tmp_path / "killed"
+def _run_killed_after_two_pokes(out: Path) -> None:
+    """Start the test run in ``out`` and kill it right after its second poke was journalled."""
 
     def kill(poke) -> None:  # type: ignore[no-untyped-def]
         if poke.record["index"] == 1:
@@ -78,6 +78,11 @@ def test_a_killed_run_resumes_to_the_same_result(tmp_path, full_run) -> None:  #
 
     with pytest.raises(Killed):
         run_experiment(_config(), out, on_poke=kill, figures=False)
+
+
+def test_a_killed_run_resumes_to_the_same_result(tmp_path, full_run) -> None:  # type: ignore[no-untyped-def]
+    out = tmp_path / "killed"
+    _run_killed_after_two_pokes(out)
     journal = out / "journal.jsonl"
     assert len(read_journal(journal).pokes) == 2
     with open(journal, "a") as fh:  # and the kill cut a third line mid-write
@@ -109,24 +114,22 @@ def test_a_run_journalled_before_a_config_field_existed_resumes(tmp_path, full_r
     # A run begun before `region_labels` and `boundary_pokes` existed: its journal header and
     # config.yaml lack them. Read at their defaults (the behaviour before them) it is this run.
     out = tmp_path / "older"
-
-    def kill(poke) -> None:  # type: ignore[no-untyped-def]
-        if poke.record["index"] == 1:
-            raise Killed
-
-    with pytest.raises(Killed):
-        run_experiment(_config(), out, on_poke=kill, figures=False)
+    _run_killed_after_two_pokes(out)
     journal = out / JOURNAL_NAME
     lines = journal.read_text().splitlines()
     header = json.loads(lines[0])
+
+    def with_header(header: dict) -> None:  # type: ignore[type-arg]
+        journal.write_text("\n".join([json.dumps(header), *lines[1:]]) + "\n")
+
     for key in ("region_labels", "boundary_pokes"):
         del header["config"]["exploration"][key]
-    journal.write_text("\n".join([json.dumps(header), *lines[1:]]) + "\n")
+    with_header(header)
     resumed = run_experiment(_config(), out, resume=True, figures=False).report
     assert [p["beta"] for p in resumed["pokes"]] == [p["beta"] for p in full_run.report["pokes"]]
     # a real difference in such a header is still refused
     header["config"]["seed"] = 5
-    journal.write_text("\n".join([json.dumps(header), *lines[1:]]) + "\n")
+    with_header(header)
     with pytest.raises(ConfigError, match="differs from this one"):
         run_experiment(_config(), out, resume=True, figures=False)
 
