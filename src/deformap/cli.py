@@ -89,15 +89,14 @@ def _default_out(scenario: str, seed: int) -> Path:
 
 def _progress_row(poke: Any) -> None:
     r = poke.record
-    t = r["timings"]
-    compute = sum(v for k, v in t.items() if k != "environment_s")
+    t = r.timings
     console.print(
-        f"  poke {r['index'] + 1:>2}  target ({r['target_xy'][0]:.3f}, {r['target_xy'][1]:.3f}) m"
-        f"  force {r['force_n']:.2f} N  β = {r['beta']:.3f} ± {r['beta_std']:.3f}"
-        f"  max var {r['max_variance_after']:.4f}"
-        + (f"  plan: {r['planned_after']} more" if "planned_after" in r else "")
-        + ("  boundary poke" if r.get("purpose") == "boundary" else "")
-        + f"  [dim](compute {compute:.2f} s, world {t.get('environment_s', 0.0):.2f} s)[/]",
+        f"  poke {r.index + 1:>2}  target ({r.target_xy[0]:.3f}, {r.target_xy[1]:.3f}) m"
+        f"  force {r.force_n:.2f} N  β = {r.beta:.3f} ± {r.beta_std:.3f}"
+        f"  max var {r.max_variance_after:.4f}"
+        + (f"  plan: {r.planned_after} more" if r.planned_after is not None else "")
+        + ("  boundary poke" if r.purpose == "boundary" else "")
+        + f"  [dim](compute {t.compute_s:.2f} s, world {t.environment_s or 0.0:.2f} s)[/]",
         highlight=False,
     )
 
@@ -599,9 +598,9 @@ def _session_config(config: Any, session: Any) -> Any:
 def _replay_progress(poke: Any) -> None:
     r = poke.record
     console.print(
-        f"  poke {r['index'] + 1:>2}  "
-        f"contact ({r['contact_xy'][0]:.3f}, {r['contact_xy'][1]:.3f}) m"
-        f"  β = {r['beta']:.3f} ± {r['beta_std']:.3f}  max var {r['max_variance_after']:.4f}",
+        f"  poke {r.index + 1:>2}  "
+        f"contact ({r.contact_xy[0]:.3f}, {r.contact_xy[1]:.3f}) m"
+        f"  β = {r.beta:.3f} ± {r.beta_std:.3f}  max var {r.max_variance_after:.4f}",
         highlight=False,
     )
 
@@ -682,7 +681,7 @@ def record_sim_command(
         "recorded_by": f"deformap {__version__} record-sim",
         "scenario": cfg.scenario,
         "seed": cfg.seed,
-        "live_betas": [p.record["beta"] for p in result.pokes],
+        "live_betas": [p.record.beta for p in result.pokes],
         "config": config_to_dict(cfg),
     }
     file = write_session(
@@ -834,7 +833,7 @@ def estimate_command(
         _make_folder(Path(out), "result")
     poke = estimate_poke(*clouds, touch, cfg.exploration, rng=np.random.default_rng(seed),
                          robot_points=hull)  # fmt: skip
-    r = poke.record
+    r = poke.record.to_dict()
     result = {"before": str(before), "after": str(after), "beta": r["beta"],
               "beta_std": r["beta_std"], "contact_point": touch.contact_point.tolist(),
               **{k: r[k] for k in ("contact", "force_n", "betas", "errors", "converged",
@@ -855,16 +854,17 @@ def _estimate_figures(folder: Any, poke: Any) -> None:
     from deformap.viz import plot_beta_curve, plot_poke
     from deformap.viz._figures import plt
 
-    r = poke.record
-    betas, errors = np.asarray(r["betas"]), np.asarray(r["errors"])
+    r, dent = poke.record, poke.dent
+    assert dent is not None  # estimate_poke processes the press here
+    betas, errors = np.asarray(r.betas), np.asarray(r.errors)
     fig, ax = plt.subplots(figsize=(5.0, 3.6), constrained_layout=True)
-    plot_beta_curve(ax, betas, errors, r["beta"], r["beta_std"])
+    plot_beta_curve(ax, betas, errors, r.beta, r.beta_std)
     ax.set_title("shape-matching error E(β)")
     fig.savefig(folder / "beta-curve.png", dpi=110)
     plt.close(fig)
-    plot_poke(folder / "poke.png", roi_xs=poke.roi_xs, roi_ys=poke.roi_ys, rest_z=poke.rest_z,
-              deformed_z=poke.deformed_z, roi_points=poke.roi_points, tactile=poke.tactile,
-              betas=betas, errors=errors, beta=r["beta"], beta_std=r["beta_std"],
+    plot_poke(folder / "poke.png", roi_xs=dent.roi_xs, roi_ys=dent.roi_ys, rest_z=dent.rest_z,
+              deformed_z=dent.deformed_z, roi_points=dent.roi_points, tactile=dent.tactile,
+              betas=betas, errors=errors, beta=r.beta, beta_std=r.beta_std,
               title="one poke")  # fmt: skip
 
 

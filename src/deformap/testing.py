@@ -15,6 +15,7 @@ __all__ = [
     "flat_patch",
     "hardness_to_modulus",
     "hertz_surface_deflection",
+    "synthetic_poke",
 ]
 
 
@@ -127,3 +128,23 @@ def coarse_world(scenario: str = "heterogeneous-60-110-rigid", seed: int = 0, **
 
     return SimulatedWorld(load_scenario(scenario), config=WorldConfig.coarse(**overrides),
                           rng=np.random.default_rng(seed))
+
+
+def synthetic_poke(xy: Any, beta: float, beta_std: float = 0.03, *, index: int = 0,
+                   purpose: str | None = None) -> Any:
+    """A :class:`deformap.explore.PokeResult` made up for tests of the β-field, target choice
+    and regions: a poke at ``xy`` (metres) that read ``beta`` with uncertainty ``beta_std``
+    (no dent, no estimate; its other fields are placeholders)."""
+    from deformap.explore import ContactRecord, PokeRecord, PokeResult, PokeTimings
+
+    x, y = (float(v) for v in np.asarray(xy, dtype=float).reshape(2))
+    record = PokeRecord(
+        index=index, target_xy=(x, y), contact_xy=(x, y),
+        contact=ContactRecord(tip_center=(x, y, 0.06), force=(0.0, 0.0, -0.6),
+                              tip_radius_m=0.01),
+        force_n=0.6, beta=float(beta), beta_std=float(beta_std), betas=(), errors=(),
+        iterations=0, residual=0.0, converged=True, n_roi_points=0, camera_noise_m=None,
+        timings=PokeTimings(filter_s=0.0, touch_gp_s=0.0, beta_s=0.0),
+        purpose=purpose,  # type: ignore[arg-type]
+    )  # fmt: skip
+    return PokeResult(record)

@@ -73,7 +73,7 @@ def _run_killed_after_two_pokes(out: Path) -> None:
     """Start the test run in ``out`` and kill it right after its second poke was journalled."""
 
     def kill(poke) -> None:  # type: ignore[no-untyped-def]
-        if poke.record["index"] == 1:
+        if poke.record.index == 1:
             raise Killed
 
     with pytest.raises(Killed):

@@ -5,9 +5,9 @@ import pytest
 
 from deformap.environment import Workspace
 from deformap.errors import InvalidArgumentError
-from deformap.explore import ExplorationConfig
+from deformap.explore import ExplorationConfig, Mapper, Target
 from deformap.explore._acquisition import boundary_score, choose_target
-from deformap.explore._mapper import Mapper, PokeResult
+from deformap.testing import synthetic_poke
 
 
 def _cells() -> tuple[np.ndarray, np.ndarray]:
@@ -87,26 +87,26 @@ def test_boundary_pokes_go_onto_the_isopleth_not_to_the_least_known_place() -> N
     config = ExplorationConfig(boundary_pokes=2)
     mapper = Mapper(Workspace(lower=(0.0, 0.0), upper=(0.6, 0.4)), config)
     rng = np.random.default_rng(0)
-    target: np.ndarray | None = np.array([0.3, 0.2])
-    purpose = "first"
+    target: Target | None = Target(np.array([0.3, 0.2]), "first")
     boundary = []
     while target is not None:
-        if purpose == "boundary":
-            mean, var = mapper.field()
+        xy_t = target.xy
+        if target.purpose == "boundary":
+            mean, var = mapper.field.mean, mapper.field.variance
             level = mapper.regions().levels
             assert level.size == 1
-            at = int(np.argmin(np.sum((mapper.cells_xy - target) ** 2, axis=1)))
+            at = int(np.argmin(np.sum((mapper.grid.cells_xy - xy_t) ** 2, axis=1)))
             # on the isopleth, where the least known reachable cell is not
             assert abs(mean.ravel()[at] - level[0]) < 0.02
-            least_known = int(np.argmax(np.where(mapper.target_mask, var.ravel(), -1.0)))
+            least_known = int(np.argmax(np.where(mapper.grid.target_mask, var.ravel(), -1.0)))
             assert abs(mean.ravel()[least_known] - level[0]) > 0.05
             xy = np.array([p.xy for p in mapper.pokes])
-            assert np.min(np.linalg.norm(xy - target, axis=1)) >= 0.25 * config.touch.roi_size_m
-            boundary.append(target)
-        beta = 0.8 if target[0] < 0.3 else 0.5
-        mapper.add(PokeResult({"contact_xy": target.tolist(), "beta": beta, "beta_std": 0.03,
-                               "purpose": purpose}))
+            assert np.min(np.linalg.norm(xy - xy_t, axis=1)) >= 0.25 * config.touch.roi_size_m
+            boundary.append(xy_t)
+        beta = 0.8 if xy_t[0] < 0.3 else 0.5
+        poke = synthetic_poke(xy_t, beta, 0.03, index=len(mapper.pokes))
+        added = mapper.add(poke, target=target)
+        assert added.record.purpose == target.purpose
         target = mapper.next_target(rng)
-        purpose = mapper.last_purpose
     assert len(boundary) == 2 and mapper.boundary_owed() == 0
     assert all(abs(t[0] - 0.3) < 0.08 for t in boundary)  # near the true edge

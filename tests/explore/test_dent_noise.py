@@ -63,7 +63,7 @@ def test_draws_are_deterministic_and_bad_input_is_refused() -> None:
 
 
 def test_the_camera_noise_is_measured_robustly() -> None:
-    from deformap.explore._mapper import _robust_std
+    from deformap.explore._dent import _robust_std
 
     rng = np.random.default_rng(2)
     residuals = rng.normal(0.0, 0.0016, size=4000)

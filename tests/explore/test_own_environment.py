@@ -103,20 +103,19 @@ def test_the_loop_maps_an_environment_written_by_a_user(strategy: str) -> None:
     result = explore(env, config, rng=np.random.default_rng(0))
     assert env.presses == len(result.pokes) >= 2
     assert not env.pressing  # every press was released
-    soft = [p.record["beta"] for p in result.pokes if p.xy[0] < 0.11]
-    hard = [p.record["beta"] for p in result.pokes if p.xy[0] > 0.13]
+    soft = [p.record.beta for p in result.pokes if p.xy[0] < 0.11]
+    hard = [p.record.beta for p in result.pokes if p.xy[0] > 0.13]
     assert soft and hard, f"{strategy} must visit both halves"
-    planned = [p.record.get("planned_after") for p in result.pokes[1:]]
+    planned = [p.record.planned_after for p in result.pokes[1:]]
     if strategy == "planned":
         # 4 pokes cannot bring this table under T_h = 0.06 (σw = 6 cm): no plan reaches it, so
         # none foresees how many pokes are left
         assert result.stop_reason == "max_pokes"
-        assert result.mapper.last_plan is not None and not result.mapper.last_plan.reaches
     assert planned == [None] * len(planned)
     assert min(soft) > max(hard), (soft, hard)
-    regions = result.mapper.regions()
-    assert regions.n_regions == 2
-    mean, var = result.mapper.field()
+    regions = result.regions
+    assert regions is not None and regions.n_regions == 2
+    mean, var = result.field.mean, result.field.variance
     assert mean[:, :10].mean() > mean[:, -10:].mean()
     assert var.shape == (32, 48)
 
@@ -132,10 +131,10 @@ def test_a_planned_run_reports_how_many_pokes_its_plan_foresees() -> None:
     )
     result = explore(env, config, rng=np.random.default_rng(0))
     assert result.stop_reason == "threshold"
-    planned = [p.record["planned_after"] for p in result.pokes[1:]]
+    planned = [p.record.planned_after for p in result.pokes[1:]]
     assert planned[-1] == 0  # the last poke was the last of its plan
     assert all(isinstance(n, int) and 0 <= n < config.max_pokes for n in planned)
-    assert "planned_after" not in result.pokes[0].record  # the first poke is the configured one
+    assert result.pokes[0].record.planned_after is None  # the first poke is the configured one
 
 
 def test_boundary_pokes_come_after_the_threshold_and_regions_by_nearest_poke() -> None:
@@ -149,25 +148,24 @@ def test_boundary_pokes_come_after_the_threshold_and_regions_by_nearest_poke() -
         beta_field=BetaFieldConfig(length_scale_m=0.12),
     )
     result = explore(env, config, rng=np.random.default_rng(0))
-    purposes = [p.record["purpose"] for p in result.pokes]
+    purposes = [p.record.purpose for p in result.pokes]
     n_variance = purposes.count("variance")
     assert purposes == ["first"] + ["variance"] * n_variance + ["boundary"] * 3
     assert result.stop_reason == "threshold"
     records = [p.record for p in result.pokes]
     # the variance was under T_h before the first boundary poke, not before
-    assert records[n_variance]["max_variance_after"] <= config.threshold
-    assert all(r["max_variance_after"] > config.threshold for r in records[:n_variance])
+    assert records[n_variance].max_variance_after <= config.threshold
+    assert all(r.max_variance_after > config.threshold for r in records[:n_variance])
     xy = np.array([p.xy for p in result.pokes])
     for k in range(n_variance + 1, len(xy)):  # a quarter ROI (3 cm) from every earlier poke
         assert np.min(np.linalg.norm(xy[:k] - xy[k], axis=1)) >= 0.25 * config.touch.roi_size_m
-    mapper = result.mapper
-    regions = mapper.regions()
-    assert regions.n_regions == 2
+    regions = result.regions
+    assert regions is not None and regions.n_regions == 2
     # soft foam (x < 12 cm) is the higher-β class: label 1
-    truth = (mapper.cells_xy[:, 0] < 0.12).astype(int).reshape(regions.labels.shape)
+    truth = (result.grid.cells_xy[:, 0] < 0.12).astype(int).reshape(regions.labels.shape)
     assert np.mean(regions.labels == truth) >= 0.85
     # each cell has the class of a poke nearest to it (any of a tie)
-    d = np.linalg.norm(mapper.cells_xy[:, None] - xy[None], axis=-1)
+    d = np.linalg.norm(result.grid.cells_xy[:, None] - xy[None], axis=-1)
     nearest = d <= d.min(axis=1, keepdims=True) + 1e-12
     own = regions.poke_labels[None, :] == regions.labels.reshape(-1, 1)
     assert np.all(np.any(nearest & own, axis=1))
@@ -183,7 +181,8 @@ def test_a_poke_limit_that_cuts_the_boundary_pokes_short_is_the_stop_reason() ->
         beta_field=BetaFieldConfig(length_scale_m=0.12),
     )
     result = explore(env, config, rng=np.random.default_rng(0))
-    assert [p.record["purpose"] for p in result.pokes][-1] == "boundary"
-    assert result.mapper.max_variance() <= config.threshold
-    assert result.mapper.boundary_owed() == 2
+    assert [p.record.purpose for p in result.pokes][-1] == "boundary"
+    assert result.max_variance <= config.threshold
+    # two of the three boundary pokes are still owed
+    assert sum(p.record.purpose == "boundary" for p in result.pokes) == 1
     assert result.stop_reason == "max_pokes"

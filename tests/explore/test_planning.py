@@ -6,11 +6,11 @@ import pytest
 from deformap.environment import Workspace
 from deformap.errors import InvalidArgumentError
 from deformap.eval._experiment import map_report
-from deformap.explore import ExplorationConfig, ExplorationResult
+from deformap.explore import ExplorationConfig, Mapper
 from deformap.explore._acquisition import choose_target
-from deformap.explore._mapper import Mapper, PokeResult
 from deformap.explore._planning import plan_pokes
 from deformap.gp import GaussianRandomField
+from deformap.testing import synthetic_poke
 
 PRIOR = {"signal_std": 0.3, "length_scale": 0.2}
 FLOOR = 0.03
@@ -108,13 +108,13 @@ def test_the_mapper_plans_over_the_whole_workspace_from_reachable_targets() -> N
     mapper = Mapper(Workspace(lower=(0.0, 0.0), upper=(0.6, 0.4)),
                     ExplorationConfig(strategy="planned"))
     target = mapper.next_target(np.random.default_rng(0))
-    assert target is not None and mapper.last_plan is not None
+    assert target is not None and target.plan is not None
     # the planner sees the workspace's corners and plans only where a ROI fits
-    assert mapper._plan_domain.min(axis=0) == pytest.approx([0.0025, 0.0025])
-    assert mapper._plan_domain.max(axis=0) == pytest.approx([0.5975, 0.3975])
-    reach = mapper.cells_xy[mapper.target_mask]
-    assert np.all(mapper.last_plan.targets >= reach.min(axis=0) - 1e-12)
-    assert np.all(mapper.last_plan.targets <= reach.max(axis=0) + 1e-12)
+    assert mapper.grid.plan_domain.min(axis=0) == pytest.approx([0.0025, 0.0025])
+    assert mapper.grid.plan_domain.max(axis=0) == pytest.approx([0.5975, 0.3975])
+    reach = mapper.grid.cells_xy[mapper.grid.target_mask]
+    assert np.all(target.plan.targets >= reach.min(axis=0) - 1e-12)
+    assert np.all(target.plan.targets <= reach.max(axis=0) + 1e-12)
     with pytest.raises(InvalidArgumentError, match="`planner` is required"):
         choose_target("planned", reach, np.ones(len(reach)), T_H, np.random.default_rng(0))
 
@@ -125,12 +125,12 @@ def _pokes_until_known(config: ExplorationConfig, size: tuple[float, float] = (0
     of 0.06, the others at the floor), from the workspace's centre until it stops."""
     mapper = Mapper(Workspace(lower=(0.0, 0.0), upper=size), config)
     rng = np.random.default_rng(0)
-    target: np.ndarray | None = np.array(size) / 2
-    while target is not None and len(mapper.pokes) < config.max_pokes:
+    xy: np.ndarray | None = np.array(size) / 2
+    while xy is not None and len(mapper.pokes) < config.max_pokes:
         std = 0.06 if len(mapper.pokes) < noisy else FLOOR
-        mapper.add(PokeResult({"contact_xy": target.tolist(), "beta": 0.5, "beta_std": std,
-                               "timings": {}}))
+        mapper.add(synthetic_poke(xy, 0.5, std))
         target = mapper.next_target(rng)
+        xy = None if target is None else target.xy
     return mapper, len(mapper.pokes)
 
 
@@ -146,13 +146,13 @@ def test_the_paper_stop_rule_on_targets_only_stops_sooner() -> None:
     whole, n_whole = _pokes_until_known(ExplorationConfig())
     targets, n_targets = _pokes_until_known(ExplorationConfig(stop_region="targets"))
     assert n_whole == 5 and n_targets < n_whole
-    _, var = targets.field()
+    var = targets.field.variance
     assert targets.max_variance() <= T_H < var.max()  # the edge band is left above T_h
     # the report's max variance is the one the stopping rule compared with T_h
-    report = map_report(ExplorationResult(mapper=targets, stop_reason="threshold"))
+    report = map_report(targets.result("threshold", {}))
     assert report["max_variance"] == targets.max_variance() <= T_H
     assert report["max_variance_map"] == var.max()
-    assert whole.max_variance() == pytest.approx(whole.field()[1].max())
+    assert whole.max_variance() == pytest.approx(whole.field.variance.max())
     assert whole.max_variance() <= T_H
     with pytest.raises(InvalidArgumentError, match="`stop_region` must be one of"):
         ExplorationConfig(stop_region="edges")  # type: ignore[arg-type]

@@ -164,7 +164,7 @@ def test_map_session_api_skips_every_broken_poke(recorded: Path, config_file: Pa
         (broken / name).write_bytes(b"")
     cfg = load_run_config(config_file)
     replay = map_session(load_session(broken), cfg.exploration, rng=np.random.default_rng(0))
-    assert replay.result.pokes == []
+    assert replay.result.pokes == ()
     assert [s["index"] for s in replay.skipped] == [0, 1, 2]
     assert [f"poke-0{i + 1}.pcd" in w for i, w in enumerate(replay.warnings)] == [True] * 3
 

@@ -202,8 +202,8 @@ def run_experiment(
     if rerun:
         from deformap.viz import record_run
 
-        assert result.mapper.surface is not None
-        record_run(folder / "run.rrd", result, initial_points=result.mapper.surface.points)
+        assert result.surface is not None
+        record_run(folder / "run.rrd", result, initial_points=result.surface.points)
     return RunOutput(report=report, result=result, world=world, folder=folder)
 
 
@@ -217,24 +217,22 @@ def map_report(result: ExplorationResult, *, truth: Any = None) -> dict[str, Any
         A :class:`~deformap.world.SimulatedWorld` or a session's
         :class:`~deformap.replay.GroundTruth`; ``None`` leaves the ground-truth metrics out.
     """
-    mapper = result.mapper
-    beta, var = mapper.field()
-    pokes = [dict(p.record) for p in result.pokes]
-    per_poke_compute = [
-        sum(v for k, v in p["timings"].items() if k != "environment_s") for p in pokes
-    ]
+    beta, var = result.field.mean, result.field.variance
+    xs, ys = result.xs, result.ys
+    pokes = [p.record.to_dict() for p in result.pokes]
+    per_poke_compute = [p.record.timings.compute_s for p in result.pokes]
     regions: dict[str, Any] | None = None
     true_regions = None
-    if pokes:
-        found = mapper.regions()
+    found = result.regions
+    if found is not None:
         # under region_labels "nearest" the cells take their nearest poke's class, and the
         # levels only separate the classes' βs
         regions = {"levels": found.levels.tolist(), "class_betas": found.class_betas.tolist(),
                    "poke_labels": found.poke_labels.tolist(),
-                   "labels_by": mapper.config.region_labels}
+                   "labels_by": result.config.region_labels}
         if truth is not None:
-            labels = truth.ground_truth_labels(mapper.xs, mapper.ys)
-            hardness_grid = truth.ground_truth_hardness(mapper.xs, mapper.ys)
+            labels = truth.ground_truth_labels(xs, ys)
+            hardness_grid = truth.ground_truth_hardness(xs, ys)
             hardness = {
                 int(label): float(hardness_grid[labels == label][0]) for label in np.unique(labels)
             }
@@ -248,7 +246,7 @@ def map_report(result: ExplorationResult, *, truth: Any = None) -> dict[str, Any
         "n_pokes": len(pokes),
         "stop_reason": result.stop_reason,
         # what the stopping rule compared with T_h (over ``stop_region``), and over the whole map
-        "max_variance": mapper.max_variance(),
+        "max_variance": result.max_variance,
         "max_variance_map": float(var.max()),
         "regions": regions,
     }
@@ -307,50 +305,39 @@ def write_map_figures(
     """
     from deformap.viz import plot_map, plot_poke
 
-    mapper = result.mapper
-    if result.pokes:
-        beta, var = mapper.field()
-        regions = mapper.regions()
+    if result.regions is not None:
+        regions = result.regions
         contacts = np.array([p.xy for p in result.pokes])
         plot_map(
             folder / "map.png",
-            mapper.xs,
-            mapper.ys,
-            beta=beta,
-            variance=var,
+            result.xs,
+            result.ys,
+            beta=result.field.mean,
+            variance=result.field.variance,
             contacts=contacts,
             labels=regions.labels,
-            levels=regions.levels if mapper.config.region_labels == "isopleth" else None,
+            levels=regions.levels if result.config.region_labels == "isopleth" else None,
             truth_hardness=None
             if truth is None
-            else truth.ground_truth_hardness(mapper.xs, mapper.ys),
+            else truth.ground_truth_hardness(result.xs, result.ys),
             threshold=threshold,
             title=title,
         )
     for poke in result.pokes:
-        arrays = (
-            poke.roi_xs,
-            poke.roi_ys,
-            poke.rest_z,
-            poke.deformed_z,
-            poke.roi_points,
-            poke.tactile,
-        )
-        if poke.roi_xs is None:  # resumed from the journal: no arrays to draw
+        dent, r = poke.dent, poke.record
+        if dent is None:  # resumed from the journal: no arrays to draw
             continue
-        roi_xs, roi_ys, rest_z, deformed_z, roi_points, tactile = (np.asarray(a) for a in arrays)
-        r = poke.record
         plot_poke(
-            folder / f"poke-{r['index'] + 1:02d}.png",
-            roi_xs=roi_xs,
-            roi_ys=roi_ys,
-            rest_z=rest_z,
-            deformed_z=deformed_z,
-            roi_points=roi_points,
-            tactile=tactile,
-            betas=np.asarray(r["betas"]),
-            errors=np.asarray(r["errors"]),
-            beta=r["beta"],
-            beta_std=r["beta_std"],
-            title=f"poke {r['index'] + 1} at ({r['contact_xy'][0]:.3f}, {r['contact_xy'][1]:.3f}) m",
+            folder / f"poke-{r.index + 1:02d}.png",
+            roi_xs=dent.roi_xs,
+            roi_ys=dent.roi_ys,
+            rest_z=dent.rest_z,
+            deformed_z=dent.deformed_z,
+            roi_points=dent.roi_points,
+            tactile=dent.tactile,
+            betas=np.asarray(r.betas),
+            errors=np.asarray(r.errors),
+            beta=r.beta,
+            beta_std=r.beta_std,
+            title=f"poke {r.index + 1} at ({r.contact_xy[0]:.3f}, {r.contact_xy[1]:.3f}) m",
         )

@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 
 from deformap.environment import PressObservation, Workspace
-from deformap.explore import ExplorationConfig, Mapper
+from deformap.explore import ExplorationConfig, Mapper, PokeRecord, measure_press
 from deformap.msm import ShapeMatchingConfig
 from deformap.world import Block, Scenario, SimulatedWorld, WorldConfig
 
@@ -101,23 +101,23 @@ def collect_presses(
     return out
 
 
-def _betas(foam: FoamPresses, shape_matching: ShapeMatchingConfig) -> list[dict[str, Any]]:
+def _betas(foam: FoamPresses, shape_matching: ShapeMatchingConfig) -> list[PokeRecord]:
     base = foam.mapper
+    assert base.surface is not None  # collect_presses fitted it
     config = dataclasses.replace(base.config, shape_matching=shape_matching)
-    mapper = Mapper(base.workspace, config)
-    mapper.surface = base.surface
-    return [mapper.process_press(obs, i).record for i, obs in enumerate(foam.presses)]
+    return [measure_press(obs, i, base.surface, config).record
+            for i, obs in enumerate(foam.presses)]
 
 
-def _summary(records: list[dict[str, Any]]) -> dict[str, float]:
-    betas = np.array([r["beta"] for r in records])
+def _summary(records: list[PokeRecord]) -> dict[str, float]:
+    betas = np.array([r.beta for r in records])
     return {
         "beta": float(betas.mean()),
         "beta_std": float(betas.std(ddof=1)) if betas.size > 1 else float("nan"),
-        "beta_estimate_std": float(np.mean([r["beta_std"] for r in records])),
-        "fit_error_m": float(np.mean([min(r["errors"]) for r in records])),
-        "iterations": int(max(r["iterations"] for r in records)),
-        "converged": bool(all(r["converged"] for r in records)),
+        "beta_estimate_std": float(np.mean([r.beta_std for r in records])),
+        "fit_error_m": float(np.mean([min(r.errors) for r in records])),
+        "iterations": int(max(r.iterations for r in records)),
+        "converged": bool(all(r.converged for r in records)),
     }
 
 

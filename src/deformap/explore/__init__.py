@@ -1,5 +1,6 @@
-"""Active exploration: the mapper, the loop that drives an ``Environment`` with it, acquisition
-strategies, region segmentation and the session journal."""
+"""Active exploration: the mapper and its concepts (surface model, dent and β, β-field, target
+choice, regions), the loop that drives an ``Environment`` with it, the typed poke records and the
+session journal."""
 
 from __future__ import annotations
 
@@ -10,26 +11,57 @@ from deformap.explore._config import (
     SurfaceGPConfig,
     TouchGPConfig,
 )
+from deformap.explore._dent import measure_press, roi_grid
+from deformap.explore._field import BetaField, PokeSet
+from deformap.explore._grid import MapGrid
 from deformap.explore._journal import Journal, JournalContents, read_journal
-from deformap.explore._loop import ExplorationResult, explore
-from deformap.explore._mapper import Mapper, PokeResult, SurfaceModel
-from deformap.explore._regions import RegionMap, segment_regions
+from deformap.explore._loop import explore, poke_step
+from deformap.explore._mapper import Mapper
+from deformap.explore._records import (
+    PURPOSES,
+    ContactRecord,
+    Dent,
+    PokeRecord,
+    PokeResult,
+    PokeTimings,
+    Purpose,
+    Target,
+)
+from deformap.explore._regions import RegionMap, map_regions, segment_regions
+from deformap.explore._result import ExplorationResult, StopReason
+from deformap.explore._surface import SurfaceModel, fit_surface
 
 __all__ = [
+    "PURPOSES",
     "STRATEGIES",
+    "BetaField",
     "BetaFieldConfig",
+    "ContactRecord",
+    "Dent",
     "ExplorationConfig",
     "ExplorationResult",
     "Journal",
     "JournalContents",
+    "MapGrid",
     "Mapper",
+    "PokeRecord",
     "PokeResult",
+    "PokeSet",
+    "PokeTimings",
+    "Purpose",
     "RegionMap",
+    "StopReason",
     "SurfaceGPConfig",
     "SurfaceModel",
+    "Target",
     "TouchGPConfig",
     "choose_target",
     "explore",
+    "fit_surface",
+    "map_regions",
+    "measure_press",
+    "poke_step",
     "read_journal",
+    "roi_grid",
     "segment_regions",
 ]

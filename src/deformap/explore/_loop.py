@@ -1,42 +1,51 @@
 """The exploration loop: drive any ``Environment`` with the mapper until the β-field is known.
 
 The loop speaks only to the :class:`~deformap.environment.Environment` protocol; it never knows
-whether a simulated world or a robot answers (DESIGN.md, rule 1).
+whether a simulated world or a robot answers. One poke, live or replayed, is one
+:func:`poke_step`: acquire the press, reconstruct and estimate, add to the β-field.
 """
 
 from __future__ import annotations
 
-import logging
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
-from typing import Any, Literal
+from functools import partial
+from typing import Any
 
 import numpy as np
 
-from deformap.environment import Environment
+from deformap.environment import Environment, PressObservation
 from deformap.explore._config import ExplorationConfig
 from deformap.explore._journal import Journal
-from deformap.explore._mapper import Mapper, PokeResult
+from deformap.explore._mapper import Mapper
+from deformap.explore._records import PokeRecord, PokeResult, Target
+from deformap.explore._result import ExplorationResult
 
-__all__ = ["ExplorationResult", "explore"]
-
-logger = logging.getLogger(__name__)
-
-StopReason = Literal["threshold", "max_pokes"]
+__all__ = ["explore", "poke_step"]
 
 
-@dataclass
-class ExplorationResult:
-    """What one exploration produced."""
+def poke_step(mapper: Mapper, index: int, acquire: Callable[[], PressObservation], *,
+              finish: Callable[[], None] | None = None, target: Target | None = None,
+              target_s: float | None = None) -> PokeResult:
+    """One poke: ``acquire()`` the press, reconstruct its dent and β, ``finish()`` (the live
+    loop's release; called even when the estimate fails), add it to the β-field.
 
-    mapper: Mapper
-    stop_reason: StopReason
-    timings: dict[str, float] = field(default_factory=dict)
-
-    @property
-    def pokes(self) -> list[PokeResult]:
-        return self.mapper.pokes
+    ``environment_s`` of the record is the time spent in ``acquire`` and ``finish``.
+    """
+    t0 = time.perf_counter()
+    obs = acquire()
+    try:
+        t1 = time.perf_counter()
+        poke = mapper.process_press(obs, index)
+    finally:
+        t2 = time.perf_counter()
+        if finish is not None:
+            finish()
+        t3 = time.perf_counter()
+    timings = {"environment_s": (t1 - t0) + (t3 - t2)}
+    if target_s is not None:
+        timings = {"target_s": target_s, **timings}
+    return mapper.add(poke, target=target, timings=timings)
 
 
 def explore(
@@ -75,44 +84,28 @@ def explore(
     t_observed = time.perf_counter()
     mapper.initialise(cloud, streams[0])
     t_surface = time.perf_counter()
-    for record in done:
-        mapper.add(PokeResult(dict(record)))
-    stop: StopReason = "max_pokes"
+    for k, record in enumerate(done):
+        mapper.add(PokeResult(PokeRecord.from_dict(record, where=f"journal poke {k + 1}")))
+    stop = "max_pokes"
     env_s = 0.0
     while len(mapper.pokes) < config.max_pokes:
         index = len(mapper.pokes)
-        first = config.first_target
         t_target = time.perf_counter()
-        target = (
-            np.array(env.workspace.center if first is None else first, dtype=float)
-            if index == 0
-            else mapper.next_target(streams[index + 1])
-        )
+        if index == 0:
+            first = config.first_target
+            xy = env.workspace.center if first is None else first
+            target: Target | None = Target(np.array(xy, dtype=float), "first")
+        else:
+            target = mapper.next_target(streams[index + 1])
         if target is None:
             stop = "threshold"
             break
-        t0 = time.perf_counter()
-        target_s = t0 - t_target
-        obs = env.press(target, config.force_n)
-        try:
-            t1 = time.perf_counter()
-            poke = mapper.process_press(obs, index)
-        finally:
-            t2 = time.perf_counter()
-            env.release()
-        t3 = time.perf_counter()
-        # why this place: the first poke, the strategy's (until T_h), or a boundary poke
-        poke.record["purpose"] = "first" if index == 0 else mapper.last_purpose
-        plan = mapper.last_plan if index > 0 else None
-        if plan is not None and plan.reaches:
-            # the pokes the plan still foresees after this one (the progress display shows it)
-            poke.record["planned_after"] = len(plan.targets) - 1
-        mapper.add(poke)
-        poke.record["timings"]["target_s"] = target_s
-        poke.record["timings"]["environment_s"] = (t1 - t0) + (t3 - t2)
-        env_s += poke.record["timings"]["environment_s"]
+        poke = poke_step(mapper, index, partial(env.press, target.xy, config.force_n),
+                         finish=env.release, target=target,
+                         target_s=time.perf_counter() - t_target)  # fmt: skip
+        env_s += poke.record.timings.environment_s or 0.0
         if journal is not None:
-            journal.append(poke.record)
+            journal.append(poke.record.to_dict())
         if on_poke is not None:
             on_poke(poke)
     else:
@@ -120,11 +113,10 @@ def explore(
         # poke owed
         if mapper.max_variance() <= config.threshold and mapper.boundary_owed() == 0:
             stop = "threshold"
-    total = time.perf_counter() - t_start
     timings = {
-        "total_s": total,
+        "total_s": time.perf_counter() - t_start,
         "observe_s": t_observed - t_start,
         "surface_gp_s": t_surface - t_observed,
         "environment_s": env_s,
     }
-    return ExplorationResult(mapper=mapper, stop_reason=stop, timings=timings)
+    return mapper.result(stop, timings)

@@ -66,8 +66,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from deformap._validation import check_array, check_int, check_positive
+from deformap.explore._config import ExplorationConfig
+from deformap.explore._field import PokeSet
 
-__all__ = ["RegionMap", "segment_regions"]
+__all__ = ["RegionMap", "map_regions", "segment_regions"]
 
 _NULL_SAMPLES = 4000
 _NULL_SEED = 20161115
@@ -275,3 +277,17 @@ def segment_regions(
     labels = np.searchsorted(levels, grid, side="right").astype(np.int64)
     return RegionMap(labels=labels, levels=levels, class_betas=class_betas,
                      poke_labels=poke_labels)
+
+
+def map_regions(mean: NDArray[np.float64], pokes: PokeSet, cells_xy: NDArray[np.float64],
+                config: ExplorationConfig) -> RegionMap:
+    """The regions of a β-field with mean ``mean (ny, nx)`` fitted to ``pokes``, as the
+    exploration settings ask: classes by :func:`segment_regions` (``max_regions``,
+    ``region_prior_dof``, the β-field's noise floor), cells labelled by isopleth or by nearest
+    poke (``region_labels``; ``cells_xy (ny · nx, 2)`` are the grid's cells)."""
+    floor = config.beta_field.noise_floor
+    found = segment_regions(mean, pokes.beta, pokes.noise, floor=floor,
+                            max_regions=config.max_regions, prior_dof=config.region_prior_dof)
+    if config.region_labels == "nearest":
+        return found.nearest_poke(pokes.xy, cells_xy)
+    return found

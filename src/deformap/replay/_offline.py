@@ -1,8 +1,8 @@
 """Recorded pokes fed to the mapper the live loop uses: a whole session, or one poke on its own.
 
 The live loop (:func:`deformap.explore.explore`) initialises a :class:`~deformap.explore.Mapper`
-with the first observation, then for each press calls ``process_press`` and ``add``. Here the same
-calls are made with what a session recorded, in its order, so a poke gives the same β whichever
+with the first observation, then makes each poke with :func:`deformap.explore.poke_step`. Here the
+same step is taken with what a session recorded, in its order, so a poke gives the same β whichever
 way it arrives (with the same seed for the surface fit).
 """
 
@@ -12,7 +12,8 @@ import logging
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any, cast
+from functools import partial
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -21,7 +22,13 @@ from deformap._validation import check_points, check_positive, check_vector
 from deformap.cloud import PointCloud
 from deformap.environment import PressObservation, TactileContact, Workspace
 from deformap.errors import DeformapError, InvalidArgumentError
-from deformap.explore import ExplorationConfig, ExplorationResult, Mapper, PokeResult
+from deformap.explore import (
+    ExplorationConfig,
+    ExplorationResult,
+    Mapper,
+    PokeResult,
+    poke_step,
+)
 from deformap.replay._session import DEFAULT_CONTACT_GAP_M, RecordedSession, check_contact_gap
 
 __all__ = ["ReplayResult", "estimate_poke", "map_session", "tip_sphere_points"]
@@ -101,19 +108,14 @@ def map_session(
     skipped: list[dict[str, Any]] = []
     read_s = 0.0
     for index in range(len(session)):
-        t0 = time.perf_counter()
         try:
-            obs = session.press_observation(index)
-            t1 = time.perf_counter()
-            poke = mapper.process_press(obs, index)
+            poke = poke_step(mapper, index, partial(session.press_observation, index))
         except DeformapError as exc:
             logger.warning("poke %d skipped: %s", index, exc)
             skipped.append({"index": index, "error": str(exc)})
             continue
-        mapper.add(poke)
-        # Reading the session stands in for the environment of the live loop.
-        poke.record["timings"]["environment_s"] = t1 - t0
-        read_s += t1 - t0
+        # reading the session stands in for the environment of the live loop
+        read_s += poke.record.timings.environment_s or 0.0
         if on_poke is not None:
             on_poke(poke)
     timings = {
@@ -122,9 +124,7 @@ def map_session(
         "surface_gp_s": t_surface - t_observed,
         "environment_s": read_s,
     }
-    result = ExplorationResult(
-        mapper=mapper, stop_reason=cast(Any, END_OF_SESSION), timings=timings
-    )
+    result = mapper.result(END_OF_SESSION, timings)
     return ReplayResult(result=result, skipped=skipped)
 
 

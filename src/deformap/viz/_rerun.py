@@ -48,7 +48,7 @@ def record_run(path: str | Path, result: Any, *, initial_points: NDArray[np.floa
     path : str or Path
         The ``.rrd`` file to write.
     result : ExplorationResult
-        A finished exploration (its mapper holds the surface and every poke).
+        A finished exploration (its surface model, every poke and the β-field after each).
     initial_points : (n, 3) float, metres
         The first observation, as the camera saw it.
     """
@@ -56,7 +56,6 @@ def record_run(path: str | Path, result: Any, *, initial_points: NDArray[np.floa
         import rerun as rr
     except ImportError:
         raise missing_extra("rerun-sdk", "rerun", "writing 3D recordings") from None
-    mapper = result.mapper
     rec = rr.RecordingStream("deformap")
     out = Path(path)
     rec.save(out)
@@ -67,8 +66,8 @@ def record_run(path: str | Path, result: Any, *, initial_points: NDArray[np.floa
         rr.Points3D(pts, radii=0.0015, colors=_colors(pts[:, 2], "viridis", 0.0, 0.08)),
     )
     surface_mesh = None
-    if mapper.surface is not None:
-        surface_mesh = heightmap_mesh(mapper.xs, mapper.ys, mapper.surface.height)
+    if result.surface is not None:
+        surface_mesh = heightmap_mesh(result.xs, result.ys, result.surface.height)
         vertices, triangles = surface_mesh
         rec.log(
             "world/surface",
@@ -78,23 +77,24 @@ def record_run(path: str | Path, result: Any, *, initial_points: NDArray[np.floa
                 vertex_colors=_colors(vertices[:, 2], "viridis", 0, 0.08),
             ),
         )
-    for k, poke in enumerate(mapper.pokes, start=1):
+    for k, poke in enumerate(result.pokes, start=1):
         rec.set_time("poke", sequence=k)
-        r = poke.record
-        if poke.roi_points is not None:
+        dent = poke.dent
+        if dent is not None:
             rec.log(
                 "world/press/cloud",
-                rr.Points3D(poke.roi_points, radii=0.001, colors=[200, 200, 200]),
+                rr.Points3D(dent.roi_points, radii=0.001, colors=[200, 200, 200]),
             )
             rec.log(
-                "world/press/tactile", rr.Points3D(poke.tactile, radii=0.002, colors=[230, 40, 40])
+                "world/press/tactile", rr.Points3D(dent.tactile, radii=0.002, colors=[230, 40, 40])
             )
-            v, t = heightmap_mesh(poke.roi_xs, poke.roi_ys, poke.deformed_z)
+            v, t = heightmap_mesh(dent.roi_xs, dent.roi_ys, dent.deformed_z)
             rec.log(
                 "world/press/dent",
                 rr.Mesh3D(vertex_positions=v, triangle_indices=t, vertex_colors=[60, 120, 230]),
             )
-        mean, var = mapper.field(upto=k)
+        field = result.field_after(k)
+        mean, var = field.mean, field.variance
         if surface_mesh is not None:
             v, t = surface_mesh
             rec.log(
@@ -107,7 +107,7 @@ def record_run(path: str | Path, result: Any, *, initial_points: NDArray[np.floa
             )
         rec.log("maps/beta", rr.Image(_colors(mean[::-1], "magma", 0.0, 1.0)))
         rec.log("maps/variance", rr.Image(_colors(var[::-1], "Blues", 0.0, float(var.max()))))
-        rec.log("metrics/beta", rr.Scalars(r["beta"]))
+        rec.log("metrics/beta", rr.Scalars(poke.record.beta))
         rec.log("metrics/max_variance", rr.Scalars(float(var.max())))
     rec.flush()
     return out

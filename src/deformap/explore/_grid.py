@@ -1,0 +1,89 @@
+"""The map's grid: every cell of the workspace, where a poke may go, where the variance must fall.
+
+Targets keep half a ROI inside the workspace, so that each ROI lies on the surveyed surface (not
+over its edge, where shape matching would have to explain a cliff). The planner of
+:mod:`deformap.explore._planning` works on two coarser lattices of the same grid: the cells where
+the variance must fall (``plan_domain``) and the cells a poke may be planned on
+(``plan_candidates``), every 2 cm with the edges included; a plan short by the difference between
+the lattice and the full grid is planned again after the next poke.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from deformap.environment import Workspace
+from deformap.explore._config import ExplorationConfig
+
+__all__ = ["MapGrid"]
+
+_PLAN_DOMAIN_M = 0.02
+_PLAN_CANDIDATE_M = 0.02
+
+
+def _strided(nx: int, ny: int, step_m: float, spacing_m: float,
+             within: NDArray[np.bool_] | None = None) -> NDArray[np.int64]:
+    """Flat indices of the ``(ny, nx)`` grid's cells about ``step_m`` apart, its first and last
+    rows and columns included (of the cells in ``within`` only, which must be a non-empty
+    rectangle of cells, as the workspace and its targets are; the lattice then spans it)."""
+    inside = np.ones(ny * nx, dtype=bool) if within is None else within
+    rows, cols = np.nonzero(inside.reshape(ny, nx))
+    stride = max(1, round(step_m / spacing_m))
+
+    def keep(lo: int, hi: int) -> NDArray[np.int64]:
+        return np.unique(np.append(np.arange(lo, hi + 1, stride), hi))
+
+    ys, xs = keep(rows.min(), rows.max()), keep(cols.min(), cols.max())
+    flat = (ys[:, None] * nx + xs[None, :]).ravel()
+    return flat[inside[flat]]
+
+
+@dataclass(frozen=True, eq=False)
+class MapGrid:
+    """Cells of the workspace at the surface grid's spacing, and the masks over them.
+
+    Attributes
+    ----------
+    xs : (nx,) float, ys : (ny,) float, metres
+        Cell centres; every map of the run is ``(ny, nx)``.
+    cells_xy : (ny * nx, 2) float
+        The cells in row-major order.
+    target_mask : (ny * nx,) bool
+        Cells a poke may be centred on (half a ROI, at most a quarter of the workspace, inside
+        the edges).
+    stop_mask : (ny * nx,) bool
+        Cells whose variance must fall under ``T_h`` (``stop_region``).
+    plan_domain, plan_candidates : (d, 2), (c, 2) float
+        The planner's lattices of ``stop_mask`` and ``target_mask`` cells.
+    """
+
+    xs: NDArray[np.float64]
+    ys: NDArray[np.float64]
+    cells_xy: NDArray[np.float64]
+    target_mask: NDArray[np.bool_]
+    stop_mask: NDArray[np.bool_]
+    plan_domain: NDArray[np.float64]
+    plan_candidates: NDArray[np.float64]
+
+    @classmethod
+    def build(cls, workspace: Workspace, config: ExplorationConfig) -> MapGrid:
+        """The grid of ``workspace`` at ``config.surface.grid_spacing_m``."""
+        spacing = config.surface.grid_spacing_m
+        xs, ys = workspace.grid(spacing)
+        gx, gy = np.meshgrid(xs, ys)
+        cells = np.column_stack([gx.ravel(), gy.ravel()])
+        margin = min(config.touch.roi_size_m / 2, 0.25 * min(workspace.size))
+        lo, hi = np.asarray(workspace.lower) + margin, np.asarray(workspace.upper) - margin
+        target = np.all((cells >= lo) & (cells <= hi), axis=1)
+        stop = target if config.stop_region == "targets" else np.ones(len(cells), dtype=bool)
+        domain = cells[_strided(xs.size, ys.size, _PLAN_DOMAIN_M, spacing, within=stop)]
+        candidates = cells[_strided(xs.size, ys.size, _PLAN_CANDIDATE_M, spacing, within=target)]
+        return cls(xs, ys, cells, target, stop, domain, candidates)
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        """``(ny, nx)``."""
+        return (self.ys.size, self.xs.size)

@@ -1,0 +1,310 @@
+"""Typed records of an exploration: what one poke gave, and why a place was chosen.
+
+A poke's record is a frozen value built once, when the poke has entered the β-field; it becomes
+plain data only at the journal and report boundary (:meth:`PokeRecord.to_dict`) and comes back
+from a journal through :meth:`PokeRecord.from_dict`, which refuses a line that is not a poke.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, fields
+from typing import Any, Literal, get_args
+
+import numpy as np
+from numpy.typing import NDArray
+
+from deformap.environment import TactileContact
+from deformap.errors import FileFormatError
+from deformap.explore._planning import PokePlan
+from deformap.msm import BetaEstimate
+
+__all__ = [
+    "PURPOSES",
+    "ContactRecord",
+    "Dent",
+    "PokeRecord",
+    "PokeResult",
+    "PokeTimings",
+    "Purpose",
+    "Target",
+]
+
+Purpose = Literal["first", "variance", "boundary"]
+"""Why a place was poked: the configured first poke, the strategy's (until the β-field's variance
+is under ``T_h``), or a boundary poke after it."""
+PURPOSES: tuple[str, ...] = get_args(Purpose)
+
+
+def _floats(value: Any, n: int | None, where: str) -> tuple[float, ...]:
+    if not isinstance(value, (list, tuple)) or (n is not None and len(value) != n):
+        size = "a list" if n is None else f"a list of {n} numbers"
+        raise FileFormatError(f"`{where}` must be {size}; got {value!r}")
+    out = []
+    for v in value:
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+            raise FileFormatError(f"`{where}` must hold finite numbers; got {v!r}")
+        out.append(float(v))
+    return tuple(out)
+
+
+def _number(data: Mapping[str, Any], key: str, where: str, *, kind: type = float,
+            optional: bool = False) -> Any:
+    if key not in data:
+        if optional:
+            return None
+        raise FileFormatError(f"`{where}` has no `{key}`")
+    value = data[key]
+    if value is None and optional:
+        return None
+    if kind is bool:
+        if not isinstance(value, bool):
+            raise FileFormatError(f"`{where}.{key}` must be true or false; got {value!r}")
+        return value
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise FileFormatError(f"`{where}.{key}` must be a number; got {value!r}")
+    if kind is int:
+        if float(value) != int(value):
+            raise FileFormatError(f"`{where}.{key}` must be an integer; got {value!r}")
+        return int(value)
+    if not math.isfinite(value):
+        raise FileFormatError(f"`{where}.{key}` must be finite; got {value!r}")
+    return float(value)
+
+
+@dataclass(frozen=True, kw_only=True)
+class ContactRecord:
+    """The tactile contact of a poke as plain numbers (world frame, SI units)."""
+
+    tip_center: tuple[float, float, float]
+    force: tuple[float, float, float]
+    tip_radius_m: float
+
+    @classmethod
+    def of(cls, contact: TactileContact) -> ContactRecord:
+        c, f = contact.tip_center, contact.force
+        return cls(tip_center=(float(c[0]), float(c[1]), float(c[2])),
+                   force=(float(f[0]), float(f[1]), float(f[2])),
+                   tip_radius_m=float(contact.tip_radius_m))  # fmt: skip
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"tip_center": list(self.tip_center), "force": list(self.force),
+                "tip_radius_m": self.tip_radius_m}  # fmt: skip
+
+    @classmethod
+    def from_dict(cls, data: Any, where: str) -> ContactRecord:
+        if not isinstance(data, Mapping):
+            raise FileFormatError(f"`{where}` must be a mapping; got {data!r}")
+        center = _floats(data.get("tip_center"), 3, f"{where}.tip_center")
+        force = _floats(data.get("force"), 3, f"{where}.force")
+        return cls(tip_center=(center[0], center[1], center[2]),
+                   force=(force[0], force[1], force[2]),
+                   tip_radius_m=_number(data, "tip_radius_m", where))  # fmt: skip
+
+
+@dataclass(frozen=True, kw_only=True)
+class PokeTimings:
+    """Seconds spent on one poke, by stage; a stage a poke did not pass through is ``None``.
+
+    ``filter_s`` crop and robot removal, ``touch_gp_s`` the dent's reconstruction, ``beta_s`` the
+    β estimate and its uncertainty, ``field_s`` the β-field update, ``target_s`` choosing the
+    place, ``environment_s`` the world or robot (or reading the recording).
+    """
+
+    filter_s: float
+    touch_gp_s: float
+    beta_s: float
+    field_s: float | None = None
+    target_s: float | None = None
+    environment_s: float | None = None
+
+    @property
+    def compute_s(self) -> float:
+        """Everything but the environment's own time."""
+        return sum(getattr(self, f.name) or 0.0 for f in fields(self)
+                   if f.name != "environment_s")  # fmt: skip
+
+    def to_dict(self) -> dict[str, float]:
+        return {f.name: getattr(self, f.name) for f in fields(self)
+                if getattr(self, f.name) is not None}  # fmt: skip
+
+    @classmethod
+    def from_dict(cls, data: Any, where: str) -> PokeTimings:
+        if not isinstance(data, Mapping):
+            raise FileFormatError(f"`{where}` must be a mapping; got {data!r}")
+        names = [f.name for f in fields(cls)]
+        unknown = sorted(set(data) - set(names))
+        if unknown:
+            raise FileFormatError(f"`{where}` has unknown key(s) {unknown}")
+        required = ("filter_s", "touch_gp_s", "beta_s")
+        return cls(**{n: _number(data, n, where, optional=n not in required) for n in names})
+
+
+@dataclass(frozen=True, kw_only=True)
+class PokeRecord:
+    """What one poke gave: where, the contact, β with its uncertainty and E(β), and timings.
+
+    Attributes
+    ----------
+    index : int
+        The poke's place in its run, from 0.
+    target_xy, contact_xy : (2,) float, metres
+        Where the poke was aimed, and where the tip touched (the β-field's input location).
+    force_n : float
+        The commanded normal force.
+    beta, beta_std : float
+        β̂ and its uncertainty (the β-field's noise for this poke, before the floor).
+    betas, errors : tuple of float
+        The compared β and their shape-matching errors E(β) in metres.
+    iterations, residual, converged
+        The shape-matching solver's largest iteration count and residual, and whether every
+        compared β converged.
+    n_roi_points : int
+        Cloud points of the ROI the dent was reconstructed from.
+    camera_noise_m : float or None
+        The camera's noise measured in the ROI (``None`` when β's uncertainty is not sampled).
+    purpose : {"first", "variance", "boundary"} or None
+        Why this place (``None`` outside the live loop: a replayed or single poke).
+    planned_after : int or None
+        Under ``planned``, how many more pokes the plan this target came from foresaw.
+    max_variance_after : float or None
+        The largest β-field variance where it must fall under ``T_h``, this poke included
+        (``None`` until the poke has entered a β-field).
+    """
+
+    index: int
+    target_xy: tuple[float, float]
+    contact_xy: tuple[float, float]
+    contact: ContactRecord
+    force_n: float
+    beta: float
+    beta_std: float
+    betas: tuple[float, ...]
+    errors: tuple[float, ...]
+    iterations: int
+    residual: float
+    converged: bool
+    n_roi_points: int
+    camera_noise_m: float | None
+    timings: PokeTimings
+    purpose: Purpose | None = None
+    planned_after: int | None = None
+    max_variance_after: float | None = None
+
+    @property
+    def xy(self) -> NDArray[np.float64]:
+        """``contact_xy`` as an array."""
+        return np.asarray(self.contact_xy, dtype=float)
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain data for the journal and ``report.json`` (optional fields left out when unset,
+        ``camera_noise_m`` always written)."""
+        out: dict[str, Any] = {
+            "index": self.index, "target_xy": list(self.target_xy),
+            "contact_xy": list(self.contact_xy), "contact": self.contact.to_dict(),
+            "force_n": self.force_n, "beta": self.beta, "beta_std": self.beta_std,
+            "betas": list(self.betas), "errors": list(self.errors),
+            "iterations": self.iterations, "residual": self.residual,
+            "converged": self.converged, "n_roi_points": self.n_roi_points,
+            "camera_noise_m": self.camera_noise_m, "timings": self.timings.to_dict(),
+        }  # fmt: skip
+        for name in ("purpose", "planned_after", "max_variance_after"):
+            if getattr(self, name) is not None:
+                out[name] = getattr(self, name)
+        return out
+
+    @classmethod
+    def from_dict(cls, data: Any, *, where: str = "poke") -> PokeRecord:
+        """The record a journal line holds (:meth:`to_dict`'s form).
+
+        Raises
+        ------
+        FileFormatError
+            If a field is missing, of the wrong type or unknown; the message names it.
+        """
+        if not isinstance(data, Mapping):
+            raise FileFormatError(f"`{where}` must be a mapping; got {data!r}")
+        names = {f.name for f in fields(cls)}
+        unknown = sorted(set(data) - names - {"kind"})
+        if unknown:
+            raise FileFormatError(f"`{where}` has unknown key(s) {unknown}")
+        purpose = data.get("purpose")
+        if purpose is not None and purpose not in PURPOSES:
+            raise FileFormatError(f"`{where}.purpose` must be one of {list(PURPOSES)}; "
+                                  f"got {purpose!r}")  # fmt: skip
+        target = _floats(data.get("target_xy"), 2, f"{where}.target_xy")
+        contact_xy = _floats(data.get("contact_xy"), 2, f"{where}.contact_xy")
+        return cls(
+            index=_number(data, "index", where, kind=int),
+            target_xy=(target[0], target[1]),
+            contact_xy=(contact_xy[0], contact_xy[1]),
+            contact=ContactRecord.from_dict(data.get("contact"), f"{where}.contact"),
+            force_n=_number(data, "force_n", where),
+            beta=_number(data, "beta", where),
+            beta_std=_number(data, "beta_std", where),
+            betas=_floats(data.get("betas"), None, f"{where}.betas"),
+            errors=_floats(data.get("errors"), None, f"{where}.errors"),
+            iterations=_number(data, "iterations", where, kind=int),
+            residual=_number(data, "residual", where),
+            converged=_number(data, "converged", where, kind=bool),
+            n_roi_points=_number(data, "n_roi_points", where, kind=int),
+            camera_noise_m=_number(data, "camera_noise_m", where, optional=True),
+            timings=PokeTimings.from_dict(data.get("timings"), f"{where}.timings"),
+            purpose=purpose,
+            planned_after=_number(data, "planned_after", where, kind=int, optional=True),
+            max_variance_after=_number(data, "max_variance_after", where, optional=True),
+        )
+
+
+@dataclass(frozen=True, eq=False)
+class Dent:
+    """A poke's reconstructed dent on its ROI grid, for figures and recordings.
+
+    ``roi_xs (nx,)``, ``roi_ys (ny,)`` the ROI grid; ``rest_z``, ``deformed_z (ny, nx)`` the
+    surface before and while pressing (metres); ``roi_points (m, 3)`` the cloud points kept;
+    ``tactile (k, 3)`` the tactile points on the tip.
+    """
+
+    roi_xs: NDArray[np.float64]
+    roi_ys: NDArray[np.float64]
+    rest_z: NDArray[np.float64]
+    deformed_z: NDArray[np.float64]
+    roi_points: NDArray[np.float64]
+    tactile: NDArray[np.float64]
+
+
+@dataclass(frozen=True, eq=False)
+class PokeResult:
+    """One processed poke: its record, and (when processed in this session, not resumed from a
+    journal) the dent it was estimated from and the full β estimate."""
+
+    record: PokeRecord
+    dent: Dent | None = None
+    estimate: BetaEstimate | None = None
+
+    @property
+    def xy(self) -> NDArray[np.float64]:
+        """Where the tip touched, ``(2,)`` metres."""
+        return self.record.xy
+
+
+@dataclass(frozen=True, eq=False)
+class Target:
+    """The next place to poke and why.
+
+    ``xy (2,)`` metres; ``purpose`` as in :class:`PokeRecord`; ``plan`` the plan it came from
+    (strategy ``planned``), else ``None``.
+    """
+
+    xy: NDArray[np.float64]
+    purpose: Purpose
+    plan: PokePlan | None = None
+
+    @property
+    def planned_after(self) -> int | None:
+        """How many more pokes the plan foresees after this one (only a plan that reaches
+        ``T_h`` foresees any)."""
+        if self.plan is None or not self.plan.reaches:
+            return None
+        return len(self.plan.targets) - 1

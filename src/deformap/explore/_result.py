@@ -1,0 +1,78 @@
+"""What an exploration (or a replayed session) produced: its pokes, the β-field and regions on
+the map's grid, and why it stopped — values, not the live mapper."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+from numpy.typing import NDArray
+
+from deformap.environment import Workspace
+from deformap.explore._config import ExplorationConfig
+from deformap.explore._field import BetaField, PokeSet
+from deformap.explore._grid import MapGrid
+from deformap.explore._records import PokeResult
+from deformap.explore._regions import RegionMap
+from deformap.explore._surface import SurfaceModel
+
+__all__ = ["ExplorationResult", "StopReason"]
+
+StopReason = Literal["threshold", "max_pokes", "end-of-session"]
+"""``threshold``: the variance fell under ``T_h`` and no boundary poke was owed; ``max_pokes``:
+the poke limit came first; ``end-of-session``: a replayed session's pokes ran out."""
+
+
+@dataclass(frozen=True, kw_only=True, eq=False)
+class ExplorationResult:
+    """What one exploration produced.
+
+    Attributes
+    ----------
+    config : ExplorationConfig
+    workspace : Workspace
+    grid : MapGrid
+        The map's cells; ``xs``, ``ys`` and every map below are on it.
+    surface : SurfaceModel or None
+    pokes : tuple of PokeResult
+        In order.
+    field : BetaField
+        The β-field after the last poke (``field.mean``, ``field.variance``: ``(ny, nx)``).
+    regions : RegionMap or None
+        The regions of that field (``None`` without pokes).
+    max_variance : float
+        What the stopping rule compared with ``T_h`` (over ``stop_region``).
+    stop_reason : str
+        A :data:`StopReason`.
+    timings : mapping of str to float
+        ``total_s``, ``observe_s``, ``surface_gp_s``, ``environment_s``.
+    """
+
+    config: ExplorationConfig
+    workspace: Workspace
+    grid: MapGrid
+    surface: SurfaceModel | None
+    pokes: tuple[PokeResult, ...]
+    field: BetaField
+    regions: RegionMap | None
+    max_variance: float
+    stop_reason: str
+    timings: Mapping[str, float]
+
+    @property
+    def xs(self) -> NDArray[np.float64]:
+        return self.grid.xs
+
+    @property
+    def ys(self) -> NDArray[np.float64]:
+        return self.grid.ys
+
+    def field_after(self, n_pokes: int) -> BetaField:
+        """The β-field as it was after the first ``n_pokes`` pokes (recordings, figures)."""
+        if n_pokes == len(self.pokes):
+            return self.field
+        records = [p.record for p in self.pokes[:n_pokes]]
+        cfg = self.config.beta_field
+        return BetaField(PokeSet.of(records, cfg.noise_floor), self.grid.xs, self.grid.ys, cfg)

@@ -1,0 +1,116 @@
+"""The next place to poke: the configured strategy until the β-field's variance is under ``T_h``,
+then the boundary pokes (strategies and scores in :mod:`deformap.explore._acquisition`).
+
+When only the edge band, where no poke fits, is still above ``T_h``, ``planned`` plans it like
+any other place; the other strategies poke the reachable cell of largest variance, the one nearest
+the band's worst corner (poking where one poke leaves the least largest variance instead is
+myopic: it splits the difference between two corners).
+"""
+
+from __future__ import annotations
+
+import logging
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.spatial import cKDTree
+
+from deformap.explore._acquisition import boundary_score, choose_target
+from deformap.explore._config import ExplorationConfig
+from deformap.explore._field import BetaField, PokeSet
+from deformap.explore._grid import MapGrid
+from deformap.explore._planning import PokePlan, VarianceDesign, plan_pokes
+from deformap.explore._records import Target
+from deformap.explore._regions import segment_regions
+
+__all__ = ["BOUNDARY_SPACING_ROI", "choose_next"]
+
+logger = logging.getLogger(__name__)
+
+BOUNDARY_SPACING_ROI = 0.25
+"""Boundary pokes keep this many ROI sizes from every poke: a dent spreads a few centimetres, so
+closer pokes would measure much the same foam again."""
+
+
+def _plan(grid: MapGrid, pokes: PokeSet, config: ExplorationConfig, n_made: int) -> PokePlan:
+    """The plan with the fewest further pokes that brings the variance under ``T_h``."""
+    cfg = config.beta_field
+    return plan_pokes(
+        pokes.xy, pokes.noise, grid.plan_candidates, grid.plan_domain,
+        signal_std=cfg.signal_std, length_scale=cfg.length_scale_m,
+        new_noise=cfg.noise_floor, threshold=config.threshold,
+        max_new=max(1, config.max_pokes - n_made),
+    )  # fmt: skip
+
+
+def _boundary(grid: MapGrid, field: BetaField, pokes: PokeSet,
+              config: ExplorationConfig) -> NDArray[np.float64] | None:
+    """Where a region boundary is least certain (:func:`boundary_score`) among the reachable
+    cells at least ``BOUNDARY_SPACING_ROI`` ROIs from every poke; ``None`` when none is left."""
+    spacing = BOUNDARY_SPACING_ROI * config.touch.roi_size_m
+    allowed = grid.target_mask & (cKDTree(pokes.xy).query(grid.cells_xy, k=1)[0] >= spacing)
+    if not allowed.any():
+        return None
+    mean, var = field.mean, field.variance
+    levels = segment_regions(mean, pokes.beta, pokes.noise, floor=config.beta_field.noise_floor,
+                             max_regions=config.max_regions,
+                             prior_dof=config.region_prior_dof).levels  # fmt: skip
+    score = boundary_score(mean.ravel()[allowed], np.sqrt(var.ravel()[allowed]), levels)
+    return np.array(grid.cells_xy[allowed][int(np.argmax(score))], dtype=float)
+
+
+def choose_next(grid: MapGrid, field: BetaField, config: ExplorationConfig,
+                rng: np.random.Generator, *, boundary_owed: int) -> Target | None:
+    """The next target after the pokes ``field`` was fitted to, or ``None`` when the variance is
+    under ``T_h`` and no boundary poke is owed or none has a place left.
+
+    Parameters
+    ----------
+    grid : MapGrid
+    field : BetaField
+        The current β-field (its ``pokes`` are the pokes made).
+    config : ExplorationConfig
+    rng : numpy.random.Generator
+        This choice's stream (``paper`` draws from it; ``min-max-variance`` subsamples with it).
+    boundary_owed : int
+        Boundary pokes still to make.
+    """
+    pokes = field.pokes
+    variance = field.variance.ravel()
+    if variance[grid.stop_mask].max() <= config.threshold:
+        if boundary_owed == 0:
+            return None
+        xy = _boundary(grid, field, pokes, config)
+        if xy is None:
+            logger.warning("%d of %d boundary pokes left undone: no reachable place is %.3g m "
+                           "from every poke", boundary_owed, config.boundary_pokes,
+                           BOUNDARY_SPACING_ROI * config.touch.roi_size_m)  # fmt: skip
+            return None
+        return Target(xy, "boundary")
+    cells, reachable = grid.cells_xy[grid.target_mask], variance[grid.target_mask]
+    plans: list[PokePlan] = []
+
+    def planner() -> NDArray[np.float64]:
+        plans.append(_plan(grid, pokes, config, len(pokes)))
+        return np.array(plans[-1].targets[0], dtype=float)
+
+    if reachable.max() <= config.threshold:  # only the edge band is left
+        if config.strategy == "planned":
+            xy = planner()
+        else:
+            xy = np.array(cells[int(np.argmax(reachable))], dtype=float)
+    else:
+        def look_ahead(candidates: NDArray[np.float64]) -> NDArray[np.float64]:
+            # exact rank-one updates of the posterior: the variance does not depend on the βs
+            cfg = config.beta_field
+            design = VarianceDesign(pokes.xy, pokes.noise, candidates,
+                                    grid.cells_xy[grid.stop_mask], cfg.signal_std,
+                                    cfg.length_scale_m, cfg.noise_floor)  # fmt: skip
+            return design.after([], config.threshold)[1]
+
+        chosen = choose_target(config.strategy, cells, reachable, config.threshold, rng,
+                               look_ahead=look_ahead, planner=planner)  # fmt: skip
+        if chosen is None:  # pragma: no cover - reachable.max() > threshold above
+            return None
+        xy = chosen
+    return Target(xy, "variance", plans[-1] if plans else None)

@@ -1,0 +1,97 @@
+"""Typed poke records: plain data only at the journal and report boundary, refused when broken."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+
+import numpy as np
+import pytest
+
+from deformap.environment import TactileContact
+from deformap.errors import FileFormatError
+from deformap.explore import (
+    ContactRecord,
+    PokeRecord,
+    PokeTimings,
+    Target,
+)
+from deformap.explore._planning import PokePlan
+
+
+def _record(**changes: object) -> PokeRecord:
+    base = PokeRecord(
+        index=2, target_xy=(0.3, 0.2), contact_xy=(0.301, 0.199),
+        contact=ContactRecord.of(TactileContact(tip_center=np.array([0.301, 0.199, 0.052]),
+                                                force=np.array([0.0, 0.0, -0.6]),
+                                                tip_radius_m=0.01)),
+        force_n=0.6, beta=0.71, beta_std=0.012, betas=(0.0, 0.5, 0.71), errors=(2e-3, 1e-3, 5e-4),
+        iterations=42, residual=1e-7, converged=True, n_roi_points=812, camera_noise_m=0.0011,
+        timings=PokeTimings(filter_s=0.01, touch_gp_s=0.02, beta_s=0.3, field_s=0.001,
+                            target_s=0.02, environment_s=0.2),
+        purpose="variance", planned_after=3, max_variance_after=0.071,
+    )  # fmt: skip
+    return dataclasses.replace(base, **changes)  # type: ignore[arg-type]
+
+
+def test_a_record_survives_the_journal_round_trip() -> None:
+    record = _record()
+    line = json.dumps(record.to_dict(), allow_nan=False)
+    assert PokeRecord.from_dict(json.loads(line)) == record
+    # a journal line carries its kind beside the record
+    assert PokeRecord.from_dict({"kind": "poke", **record.to_dict()}) == record
+
+
+def test_unset_fields_are_left_out_and_read_back_unset() -> None:
+    record = _record(purpose=None, planned_after=None, max_variance_after=None,
+                     camera_noise_m=None,
+                     timings=PokeTimings(filter_s=0.1, touch_gp_s=0.2, beta_s=0.3))
+    data = record.to_dict()
+    assert "purpose" not in data and "planned_after" not in data
+    assert "max_variance_after" not in data
+    assert data["camera_noise_m"] is None  # always written
+    assert data["timings"] == {"filter_s": 0.1, "touch_gp_s": 0.2, "beta_s": 0.3}
+    assert PokeRecord.from_dict(data) == record
+
+
+def test_compute_time_leaves_out_the_environment() -> None:
+    t = PokeTimings(filter_s=0.1, touch_gp_s=0.2, beta_s=0.3, field_s=0.05, environment_s=5.0)
+    assert t.compute_s == pytest.approx(0.65)
+
+
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        (lambda d: d.pop("beta"), "has no `beta`"),
+        (lambda d: d.update(beta="0.7"), "`poke.beta` must be a number"),
+        (lambda d: d.update(beta=float("nan")), "`poke.beta` must be finite"),
+        (lambda d: d.update(index=1.5), "`poke.index` must be an integer"),
+        (lambda d: d.update(converged=1), "`poke.converged` must be true or false"),
+        (lambda d: d.update(purpose="curiosity"), "`poke.purpose` must be one of"),
+        (lambda d: d.update(contact_xy=[0.3]), "`poke.contact_xy` must be a list of 2"),
+        (lambda d: d["contact"].pop("force"), "`poke.contact.force` must be a list of 3"),
+        (lambda d: d["timings"].pop("beta_s"), "`poke.timings` has no `beta_s`"),
+        (lambda d: d["timings"].update(warp_s=1.0), "unknown key"),
+        (lambda d: d.update(betas="0.1 0.2"), "`poke.betas` must be a list"),
+        (lambda d: d.update(colour="red"), "unknown key"),
+    ],
+)
+def test_a_broken_record_is_refused_naming_the_field(change, message) -> None:  # type: ignore[no-untyped-def]
+    data = json.loads(json.dumps(_record().to_dict()))
+    change(data)
+    with pytest.raises(FileFormatError, match=message):
+        PokeRecord.from_dict(data)
+
+
+def test_a_target_says_how_many_pokes_its_plan_foresees() -> None:
+    targets = np.array([[0.1, 0.1], [0.2, 0.2], [0.3, 0.3]])
+    reaching = PokePlan(targets=targets, max_variance=0.05, reaches=True)
+    short = PokePlan(targets=targets, max_variance=0.07, reaches=False)
+    assert Target(targets[0], "variance", reaching).planned_after == 2
+    assert Target(targets[0], "variance", short).planned_after is None
+    assert Target(targets[0], "first").planned_after is None
+
+
+def test_records_are_frozen() -> None:
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        _record().beta = 0.2  # type: ignore[misc]
