@@ -1,0 +1,106 @@
+"""The import table of docs/architecture.md, enforced on every module of the package.
+
+The table is read from the document itself, so the document and the code cannot drift apart:
+each package may import only the packages its row names, never another package's private module
+or name, and no production module imports :mod:`deformap.testing`.
+"""
+
+from __future__ import annotations
+
+import ast
+import re
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+SRC = ROOT / "src" / "deformap"
+DOC = ROOT / "docs" / "architecture.md"
+
+
+def _table() -> dict[str, set[str] | None]:
+    """``{package: allowed imports}`` from the document's package table (``None``: anything)."""
+    rows: dict[str, set[str] | None] = {}
+    for line in DOC.read_text(encoding="utf-8").splitlines():
+        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        if len(cells) != 3 or not re.fullmatch(r"`deformap(\.[\w.]+)?`", cells[0]):
+            continue
+        allowed = cells[2]
+        rows[cells[0].strip("`")] = (
+            None if allowed.startswith("anything") else set(re.findall(r"`([\w.]+)`", allowed))
+        )
+    return rows
+
+
+TABLE = _table()
+
+
+def _package(module: str) -> str:
+    """The table row a module belongs to: the longest row name that is a prefix of it."""
+    parts = module.split(".")
+    for n in range(len(parts), 0, -1):
+        name = ".".join(parts[:n])
+        if name in TABLE and (name != "deformap" or module in ("deformap", "deformap.__main__")):
+            return name
+    raise AssertionError(f"{module} belongs to no package of docs/architecture.md")
+
+
+def _module_name(path: Path) -> str:
+    rel = path.relative_to(SRC.parent).with_suffix("")
+    parts = list(rel.parts)
+    if parts[-1] == "__init__":
+        parts = parts[:-1]
+    return ".".join(parts)
+
+
+def _imports(path: Path) -> list[tuple[int, str, list[str]]]:
+    """``(line, module, names)`` of every deformap import in the file (in functions too)."""
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    own = _module_name(path).split(".")
+    is_pkg = path.name == "__init__.py"
+    out = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            out += [(node.lineno, a.name, []) for a in node.names if a.name.startswith("deformap")]
+        elif isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = own if is_pkg else own[:-1]
+                base = base[: len(base) - (node.level - 1)]
+                module = ".".join([*base, *(node.module.split(".") if node.module else [])])
+            else:
+                module = node.module or ""
+            if module.startswith("deformap"):
+                out.append((node.lineno, module, [a.name for a in node.names]))
+    return out
+
+
+MODULES = sorted(SRC.rglob("*.py"))
+
+
+def test_the_document_has_a_row_for_every_package() -> None:
+    assert len(TABLE) >= 10
+    for path in MODULES:
+        _package(_module_name(path))  # raises when a module has no row
+
+
+@pytest.mark.parametrize("path", MODULES, ids=lambda p: str(p.relative_to(SRC)))
+def test_imports_follow_the_table(path: Path) -> None:
+    me = _module_name(path)
+    mine = _package(me)
+    allowed = TABLE[mine]
+    problems = []
+    for line, module, names in _imports(path):
+        target = _package(module)
+        if target == mine:
+            continue
+        where = f"{path.relative_to(ROOT)}:{line}"
+        if target == "deformap.testing" and mine != "deformap.testing":
+            problems.append(f"{where}: production code imports deformap.testing")
+        if allowed is not None and target not in allowed:
+            problems.append(f"{where}: {mine} may not import {target} ({module})")
+        rest = module[len(target):].split(".")
+        if any(part.startswith("_") for part in rest if part):
+            problems.append(f"{where}: private module of another package ({module})")
+        if any(n.startswith("_") and not n.endswith("__") for n in names):
+            problems.append(f"{where}: private name of another package ({module}: {names})")
+    assert not problems, "\n".join(problems)
