@@ -313,7 +313,6 @@ def write_map_figures(
         regions = mapper.regions()
         contacts = np.array([p.xy for p in result.pokes])
         plot_map(
-            folder / "map.png",
             mapper.xs,
             mapper.ys,
             beta=beta,
@@ -326,6 +325,7 @@ def write_map_figures(
             else truth.ground_truth_hardness(mapper.xs, mapper.ys),
             threshold=threshold,
             title=title,
+            path=folder / "map.png",
         )
     for poke in result.pokes:
         arrays = (
@@ -341,7 +341,6 @@ def write_map_figures(
         roi_xs, roi_ys, rest_z, deformed_z, roi_points, tactile = (np.asarray(a) for a in arrays)
         r = poke.record
         plot_poke(
-            folder / f"poke-{r['index'] + 1:02d}.png",
             roi_xs=roi_xs,
             roi_ys=roi_ys,
             rest_z=rest_z,
@@ -353,4 +352,5 @@ def write_map_figures(
             beta=r["beta"],
             beta_std=r["beta_std"],
             title=f"poke {r['index'] + 1} at ({r['contact_xy'][0]:.3f}, {r['contact_xy'][1]:.3f}) m",
+            path=folder / f"poke-{r['index'] + 1:02d}.png",
         )
