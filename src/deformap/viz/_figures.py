@@ -8,7 +8,7 @@ the error curve E(β).
 Every ``plot_*`` function returns its figure and, given ``path``, also writes it there atomically
 (a temporary file in the same folder, renamed onto ``path`` once complete). No backend is selected,
 ``pyplot`` is never imported and no global state is touched, so the functions are safe in notebooks
-and GUI applications: a notebook displays a returned ``Figure`` as a cell's value.
+and GUI applications, which keep their own backend and display the returned figure their own way.
 """
 
 from __future__ import annotations
