@@ -314,7 +314,7 @@ def study_hardness(
     out.mkdir(parents=True, exist_ok=True)
     study = hardness_study(_study_foams(seed, hardness, coarse))
     (out / "hardness.json").write_text(json.dumps(study, indent=2))
-    plot_hardness_study(out / "hardness.png", study)
+    plot_hardness_study(study, path=out / "hardness.png")
     table = Table(title="β against hardness")
     for col in ("protocol", "hardness [N]", "β", "β spread", "β uncertainty", "fit error \\[mm]"):
         table.add_column(col, justify="right")
@@ -357,7 +357,7 @@ def study_cluster_size(
     out.mkdir(parents=True, exist_ok=True)
     study = cluster_size_study(_study_foams(seed, [60.0, 110.0, 150.0], coarse))
     (out / "cluster-size.json").write_text(json.dumps(study, indent=2))
-    plot_cluster_size_study(out / "cluster-size.png", study)
+    plot_cluster_size_study(study, path=out / "cluster-size.png")
     table = Table(title="fit error against cluster size")
     for col in ("k×k", "hardness [N]", "β", "fit error \\[mm]"):
         table.add_column(col, justify="right")
@@ -851,21 +851,16 @@ def estimate_command(
 def _estimate_figures(folder: Any, poke: Any) -> None:
     import numpy as np
 
-    from deformap.viz import plot_beta_curve, plot_poke
-    from deformap.viz._figures import plt
+    from deformap.viz import plot_error_curve, plot_poke
 
     r, dent = poke.record, poke.dent
     assert dent is not None  # estimate_poke processes the press here
     betas, errors = np.asarray(r.betas), np.asarray(r.errors)
-    fig, ax = plt.subplots(figsize=(5.0, 3.6), constrained_layout=True)
-    plot_beta_curve(ax, betas, errors, r.beta, r.beta_std)
-    ax.set_title("shape-matching error E(β)")
-    fig.savefig(folder / "beta-curve.png", dpi=110)
-    plt.close(fig)
-    plot_poke(folder / "poke.png", roi_xs=dent.roi_xs, roi_ys=dent.roi_ys, rest_z=dent.rest_z,
+    plot_error_curve(betas, errors, r.beta, r.beta_std, path=folder / "beta-curve.png")
+    plot_poke(roi_xs=dent.roi_xs, roi_ys=dent.roi_ys, rest_z=dent.rest_z,
               deformed_z=dent.deformed_z, roi_points=dent.roi_points, tactile=dent.tactile,
               betas=betas, errors=errors, beta=r.beta, beta_std=r.beta_std,
-              title="one poke")  # fmt: skip
+              title="one poke", path=folder / "poke.png")  # fmt: skip
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -1,53 +1,313 @@
+"""Figures: each plot function returns its Figure, writes it only when given a path, atomically,
+and nothing in deformap.viz touches matplotlib's global state (backend, rcParams, pyplot)."""
+
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+from typing import Any
+
 import numpy as np
+import pytest
+from matplotlib.figure import Figure
 from matplotlib.image import imread
 
-from deformap.viz import plot_map, plot_poke
+from deformap.errors import InvalidArgumentError
+from deformap.viz import (
+    plot_cluster_size_study,
+    plot_error_curve,
+    plot_hardness_study,
+    plot_map,
+    plot_poke,
+    show_world,
+)
+
+PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 
 
-def test_map_figure_has_three_panels_and_is_written(tmp_path) -> None:
+def _map_args(truth: bool = True) -> tuple[tuple[Any, ...], dict[str, Any]]:
     xs, ys = np.linspace(0.0025, 0.5975, 120), np.linspace(0.0025, 0.3975, 80)
     gx, _ = np.meshgrid(xs, ys)
-    beta = np.where(gx < 0.3, 0.8, 0.2)
-    var = 0.05 + 0.04 * (gx / 0.6)
-    hardness = np.where(gx < 0.3, 60.0, np.inf)
-    path = plot_map(
-        tmp_path / "map.png",
-        xs,
-        ys,
-        beta=beta,
-        variance=var,
-        contacts=np.array([[0.3, 0.2], [0.1, 0.1], [0.5, 0.3]]),
-        labels=(gx >= 0.3).astype(int),
-        levels=np.array([0.5]),
-        truth_hardness=hardness,
-        threshold=0.06,
-    )
-    image = imread(path)
-    assert image.shape[1] > 2.5 * image.shape[0]  # three panels side by side
-    assert image[..., :3].std() > 0.05  # not a blank canvas
+    kwargs = {
+        "beta": np.where(gx < 0.3, 0.8, 0.2),
+        "variance": 0.05 + 0.04 * (gx / 0.6),
+        "contacts": np.array([[0.3, 0.2], [0.1, 0.1], [0.5, 0.3]]),
+        "labels": (gx >= 0.3).astype(int),
+        "levels": np.array([0.5]),
+        "truth_hardness": np.where(gx < 0.3, 60.0, np.inf) if truth else None,
+        "threshold": 0.06,
+        "title": "two blocks",
+    }
+    return (xs, ys), kwargs
 
 
-def test_poke_figure(tmp_path) -> None:
+def _poke_kwargs() -> dict[str, Any]:
     xs = ys = np.linspace(-0.06, 0.06, 25)
     gx, gy = np.meshgrid(xs, ys)
     rest = np.full(gx.shape, 0.05)
     dent = rest - 0.005 * np.exp(-(gx**2 + gy**2) / 0.01**2)
     pts = np.column_stack([gx.ravel(), gy.ravel(), dent.ravel()])
     betas = np.linspace(0, 0.98, 50)
-    path = plot_poke(
-        tmp_path / "poke-01.png",
-        roi_xs=xs,
-        roi_ys=ys,
-        rest_z=rest,
-        deformed_z=dent,
-        roi_points=pts,
-        tactile=pts[:10],
-        betas=betas,
-        errors=(betas - 0.4) ** 2 + 1e-3,
-        beta=0.4,
-        beta_std=0.05,
-        simulated_z=dent,
+    return {
+        "roi_xs": xs, "roi_ys": ys, "rest_z": rest, "deformed_z": dent, "roi_points": pts,
+        "tactile": pts[:10], "betas": betas, "errors": (betas - 0.4) ** 2 + 1e-3, "beta": 0.4,
+        "beta_std": 0.05, "simulated_z": dent, "title": "poke 1",
+    }  # fmt: skip
+
+
+def _hardness_study() -> dict[str, Any]:
+    rows = [
+        {"protocol": protocol, "hardness_n": h, "beta": b + shift, "beta_std": 0.03}
+        for protocol, shift in (("paper", 0.0), ("force", 0.05))
+        for h, b in ((None, 0.02), (150.0, 0.3), (110.0, 0.45), (60.0, 0.7))
+    ]
+    return {"rows": rows, "monotone": {"paper": True, "force": False}}
+
+
+def _cluster_size_study() -> dict[str, Any]:
+    rows = [
+        {"cluster_size": k, "hardness_n": h, "fit_error_m": 0.0005 * k}
+        for k in (2, 3, 4, 5, 6)
+        for h in (60.0, 150.0, None)
+    ]
+    return {"rows": rows}
+
+
+def _panels(fig: Figure) -> list[Any]:
+    return [ax for ax in fig.axes if ax.get_label() != "<colorbar>"]
+
+
+def _colorbar_labels(fig: Figure) -> list[str]:
+    return [ax.get_ylabel() for ax in fig.axes if ax.get_label() == "<colorbar>"]
+
+
+# every public plot function, called with its data and a path
+CALLS = {
+    "map": lambda path: plot_map(*_map_args()[0], **_map_args()[1], path=path),
+    "poke": lambda path: plot_poke(**_poke_kwargs(), path=path),
+    "error_curve": lambda path: plot_error_curve(
+        np.linspace(0, 0.98, 50), np.linspace(0.002, 0.001, 50), 0.4, 0.05, path=path
+    ),
+    "hardness": lambda path: plot_hardness_study(_hardness_study(), path=path),
+    "cluster_size": lambda path: plot_cluster_size_study(_cluster_size_study(), path=path),
+}
+
+
+@pytest.fixture(autouse=True)
+def _no_pyplot_figure_left_open() -> Any:
+    import matplotlib.pyplot as plt  # here, not at the top: the subprocess below imports this module
+
+    plt.close("all")
+    yield
+    assert plt.get_fignums() == []
+
+
+@pytest.mark.parametrize("name", sorted(CALLS))
+def test_returns_a_figure_and_writes_a_png_only_when_given_a_path(
+    name: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.chdir(tmp_path)  # a stray write to a relative default name would land here
+    fig = CALLS[name](None)
+    assert isinstance(fig, Figure)
+    assert list(tmp_path.iterdir()) == []
+    path = tmp_path / f"{name}.png"
+    fig = CALLS[name](path)
+    assert isinstance(fig, Figure)
+    assert sorted(tmp_path.iterdir()) == [path]  # no temporary file left beside it
+    data = path.read_bytes()
+    assert data[:8] == PNG_MAGIC
+    image = imread(path)
+    assert image[..., :3].std() > 0.05  # not a blank canvas
+    width, height = fig.get_size_inches()
+    dpi = 100 if name == "poke" else 110
+    assert image.shape[:2] == (round(height * dpi), round(width * dpi))
+
+
+def test_path_may_be_a_string_and_the_format_follows_the_suffix(tmp_path: Path) -> None:
+    path = tmp_path / "curve.svg"
+    plot_error_curve(np.array([0.0, 0.5, 0.9]), np.array([2e-3, 1e-3, 3e-3]), 0.5, 0.1,
+                     path=str(path))  # fmt: skip
+    assert path.read_text().lstrip().startswith("<?xml")
+
+
+def test_map_figure_panels_labels_and_colour_bars() -> None:
+    args, kwargs = _map_args()
+    fig = plot_map(*args, **kwargs)
+    panels = _panels(fig)
+    assert [ax.get_title() for ax in panels] == [
+        "ground truth",
+        "β-field, 2 region(s)",
+        "β-field variance and contacts",
+    ]
+    assert all((ax.get_xlabel(), ax.get_ylabel()) == ("x [m]", "y [m]") for ax in panels)
+    assert _colorbar_labels(fig) == [
+        "hardness H [N] (grey: rigid)",
+        "β (deformability)",
+        "var(β)",
+    ]
+    assert fig.get_suptitle() == "two blocks"
+    # without ground truth: two panels
+    args, kwargs = _map_args(truth=False)
+    fig = plot_map(*args, **kwargs)
+    assert [ax.get_title() for ax in _panels(fig)] == [
+        "β-field, 2 region(s)",
+        "β-field variance and contacts",
+    ]
+
+
+def test_poke_figure_panels_and_labels() -> None:
+    fig = plot_poke(**_poke_kwargs())
+    panels = _panels(fig)
+    assert [ax.get_title() for ax in panels] == [
+        "ROI before (surface GP)",
+        "cloud while pressing (robot removed)",
+        "section through the contact",
+        "shape-matching error E(β)",
+    ]
+    assert [(ax.get_xlabel(), ax.get_ylabel()) for ax in panels] == [
+        ("x [m]", "y [m]"),
+        ("x [m]", "y [m]"),
+        ("x [cm]", "z [mm]"),
+        ("β", "E(β) [mm]"),
+    ]
+    assert _colorbar_labels(fig) == ["z [mm]", "z [mm]"]
+    section = panels[2].get_legend()
+    assert [t.get_text() for t in section.get_texts()] == [
+        "before",
+        "observed dent (touch GP)",
+        "shape matching at β̂",
+        "cloud points on the section",
+    ]
+
+
+def test_error_curve_figure() -> None:
+    betas = np.array([0.9, 0.0, 0.5])  # any order: drawn sorted
+    fig = plot_error_curve(betas, np.array([3e-3, 2e-3, 1e-3]), 0.5, 0.1)
+    (ax,) = fig.axes
+    assert (ax.get_title(), ax.get_xlabel(), ax.get_ylabel()) == (
+        "shape-matching error E(β)",
+        "β",
+        "E(β) [mm]",
     )
-    assert imread(path).shape[0] > 100
+    curve = ax.get_lines()[0]
+    assert np.array_equal(curve.get_xdata(), [0.0, 0.5, 0.9])
+    assert np.allclose(curve.get_ydata(), [2.0, 1.0, 3.0])  # millimetres
+    assert [t.get_text() for t in ax.get_legend().get_texts()] == ["β̂ = 0.500 ± 0.100"]
+
+
+def test_study_figures() -> None:
+    fig = plot_hardness_study(_hardness_study())
+    (ax,) = fig.axes
+    assert ax.get_ylabel() == "estimated β"
+    assert ax.get_xlabel().startswith("hardness H [N]")
+    assert ax.get_xscale() == "log" and ax.xaxis_inverted()
+    assert [t.get_text() for t in ax.get_legend().get_texts()] == [
+        "paper ✓ monotone",
+        "force ✗ not monotone",
+    ]
+    fig = plot_cluster_size_study(_cluster_size_study())
+    (ax,) = fig.axes
+    assert (ax.get_xlabel(), ax.get_ylabel()) == (
+        "cluster size k (k×k particles)",
+        "fit error min E(β) [mm]",
+    )
+    assert [t.get_text() for t in ax.get_legend().get_texts()] == ["60 N", "150 N", "rigid"]
+    assert np.allclose(ax.get_lines()[0].get_ydata(), [1.0, 1.5, 2.0, 2.5, 3.0])
+
+
+def test_show_world_writes_three_pictures_and_nothing_else(tmp_path: Path) -> None:
+    from deformap.testing import coarse_world
+
+    out = tmp_path / "new" / "folder"
+    paths = show_world(coarse_world("heterogeneous-150-rigid"), str(out))
+    assert paths == [out / "layout.png", out / "cloud.png", out / "dent.png"]
+    assert sorted(out.iterdir()) == sorted(paths)
+    for path in paths:
+        assert path.read_bytes()[:8] == PNG_MAGIC
+
+
+def test_a_failed_write_keeps_the_previous_file(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    path = tmp_path / "map.png"
+    path.write_bytes(b"the previous figure")
+
+    def broken_savefig(self: Figure, fname: Any, **kwargs: Any) -> None:
+        if isinstance(fname, (str, os.PathLike)):
+            with open(fname, "wb") as fh:
+                fh.write(PNG_MAGIC + b"half an image")
+        else:
+            fname.write(PNG_MAGIC + b"half an image")
+        raise OSError("killed mid-write")
+
+    monkeypatch.setattr(Figure, "savefig", broken_savefig)
+    with pytest.raises(OSError, match="killed mid-write"):
+        CALLS["map"](path)
+    assert path.read_bytes() == b"the previous figure"
+    assert sorted(tmp_path.iterdir()) == [path]
+
+
+def test_an_existing_file_is_replaced(tmp_path: Path) -> None:
+    path = tmp_path / "map.png"
+    path.write_bytes(b"the previous figure")
+    CALLS["map"](path)
+    assert path.read_bytes()[:8] == PNG_MAGIC
+    assert sorted(tmp_path.iterdir()) == [path]
+
+
+@pytest.mark.parametrize(
+    ("name", "match"),
+    [("map.unknown", r"`path` must end in a figure format .*\.png.*map\.unknown"),
+     ("map", r"`path` must end in a figure format"),
+     ("missing/map.png", r"`path` must be in an existing folder.*missing")],
+)  # fmt: skip
+def test_a_bad_path_is_refused_before_anything_is_written(
+    tmp_path: Path, name: str, match: str
+) -> None:
+    with pytest.raises(InvalidArgumentError, match=match):
+        CALLS["map"](tmp_path / name)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_importing_and_drawing_leave_matplotlib_global_state_alone(tmp_path: Path) -> None:
+    # a fresh interpreter with a backend that is not Agg: the old module called
+    # matplotlib.use("Agg") at import, which switched every user's backend
+    script = textwrap.dedent(
+        f"""
+        import sys
+        from pathlib import Path
+
+        import matplotlib
+
+        backend = matplotlib.get_backend()
+        assert backend == "svg", backend
+        rc = dict(matplotlib.rcParams)
+
+        import deformap.viz
+        assert matplotlib.get_backend() == backend, ("after import", matplotlib.get_backend())
+        assert dict(matplotlib.rcParams) == rc, "rcParams changed by the import"
+
+        sys.path.insert(0, {str(Path(__file__).parent)!r})
+        import test_figures
+
+        out = Path({str(tmp_path)!r})
+        for name, call in sorted(test_figures.CALLS.items()):
+            call(out / (name + ".png"))
+        from deformap.testing import coarse_world
+        deformap.viz.show_world(coarse_world("heterogeneous-150-rigid"), out / "world")
+        assert matplotlib.get_backend() == backend, ("after drawing", matplotlib.get_backend())
+        assert dict(matplotlib.rcParams) == rc, "rcParams changed by drawing"
+        assert "matplotlib.pyplot" not in sys.modules, "pyplot imported"
+        print("ok")
+        """
+    )
+    env = {**os.environ, "MPLBACKEND": "svg"}
+    done = subprocess.run([sys.executable, "-c", script], env=env, capture_output=True, text=True,
+                          timeout=120)  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == "ok"
+    assert len(list(tmp_path.glob("*.png"))) == len(CALLS)
+    assert len(list((tmp_path / "world").glob("*.png"))) == 3

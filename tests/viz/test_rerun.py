@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import sys
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -27,9 +28,21 @@ def test_record_run_writes_a_recording_rerun_can_read(tmp_path) -> None:
     result = explore(env, config, rng=np.random.default_rng(0))
     path = record_run(tmp_path / "run.rrd", result, initial_points=env.observe().points)
     assert path.stat().st_size > 50_000
+    assert sorted(tmp_path.iterdir()) == [path]  # written under a temporary name, then renamed
     from rerun.chunk import RrdReader
 
     reader = RrdReader(path)
     entities = {str(chunk.entity_path) for chunk in reader.stream()}
     for entity in ("/world/observation", "/world/press/dent", "/maps/beta", "/metrics/beta"):
         assert entity in entities, (entity, sorted(entities))
+
+
+def test_a_failed_recording_leaves_no_file(tmp_path) -> None:
+    pytest.importorskip("rerun")
+    from deformap.viz import record_run
+
+    # fails after the observation is logged: a poke without its arrays
+    result = SimpleNamespace(mapper=SimpleNamespace(surface=None, pokes=[object()]))
+    with pytest.raises(AttributeError):
+        record_run(tmp_path / "run.rrd", result, initial_points=np.zeros((3, 3)))
+    assert list(tmp_path.iterdir()) == []

@@ -309,7 +309,6 @@ def write_map_figures(
         regions = result.regions
         contacts = np.array([p.xy for p in result.pokes])
         plot_map(
-            folder / "map.png",
             result.xs,
             result.ys,
             beta=result.field.mean,
@@ -322,13 +321,13 @@ def write_map_figures(
             else truth.ground_truth_hardness(result.xs, result.ys),
             threshold=threshold,
             title=title,
+            path=folder / "map.png",
         )
     for poke in result.pokes:
         dent, r = poke.dent, poke.record
         if dent is None:  # resumed from the journal: no arrays to draw
             continue
         plot_poke(
-            folder / f"poke-{r.index + 1:02d}.png",
             roi_xs=dent.roi_xs,
             roi_ys=dent.roi_ys,
             rest_z=dent.rest_z,
@@ -340,4 +339,5 @@ def write_map_figures(
             beta=r.beta,
             beta_std=r.beta_std,
             title=f"poke {r.index + 1} at ({r.contact_xy[0]:.3f}, {r.contact_xy[1]:.3f}) m",
+            path=folder / f"poke-{r.index + 1:02d}.png",
         )

@@ -1,24 +1,28 @@
-"""Figures of a run, with matplotlib (Agg backend, files only).
+"""Figures of a run, each a :class:`matplotlib.figure.Figure` built without ``pyplot``.
 
 ``map.png`` follows the paper's Fig. 6: ground truth | β-field with region contours and the contacts
 | variance with the contacts (first contact a circle, later ones triangles). ``poke-NN.png``
 follows its Fig. 4: the ROI before, after (cloud and reconstructed surface), the fitted dent, and
 the error curve E(β).
+
+Every ``plot_*`` function returns its figure and, given ``path``, also writes it there atomically
+(a temporary file in the same folder, renamed onto ``path`` once complete). No backend is selected,
+``pyplot`` is never imported and no global state is touched, so the functions are safe in notebooks
+and GUI applications, which keep their own backend and display the returned figure their own way.
 """
 
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt
 import numpy as np
+from matplotlib.axes import Axes
+from matplotlib.figure import Figure
 from numpy.typing import NDArray
 
-__all__ = ["plot_beta_curve", "plot_map", "plot_poke"]
+from deformap.viz._save import save_figure
+
+__all__ = ["plot_beta_curve", "plot_error_curve", "plot_map", "plot_poke"]
 
 
 def _extent(xs: NDArray, ys: NDArray) -> list[float]:
@@ -27,7 +31,7 @@ def _extent(xs: NDArray, ys: NDArray) -> list[float]:
     return [xs[0] - dx, xs[-1] + dx, ys[0] - dy, ys[-1] + dy]
 
 
-def _contacts(ax: Any, contacts: NDArray[np.float64]) -> None:
+def _contacts(ax: Axes, contacts: NDArray[np.float64]) -> None:
     if contacts.size == 0:
         return
     ax.plot(contacts[0, 0], contacts[0, 1], "o", mfc="none", mec="k", ms=10, mew=2)
@@ -38,7 +42,6 @@ def _contacts(ax: Any, contacts: NDArray[np.float64]) -> None:
 
 
 def plot_map(
-    path: str | Path,
     xs: NDArray[np.float64],
     ys: NDArray[np.float64],
     *,
@@ -50,8 +53,9 @@ def plot_map(
     truth_hardness: NDArray[np.float64] | None = None,
     threshold: float | None = None,
     title: str = "",
-) -> Path:
-    """Write the three-panel map figure and return its path.
+    path: str | Path | None = None,
+) -> Figure:
+    """The map figure: ground truth (when given) | β-field and regions | variance and contacts.
 
     Parameters
     ----------
@@ -66,9 +70,21 @@ def plot_map(
         edges between the labels are drawn (regions labelled by nearest poke).
     truth_hardness : (ny, nx) float, optional
         Ground-truth hardness in newtons (``inf`` rigid, ``nan`` bare table); omitted without truth.
+    threshold : float, optional
+        The variance threshold, drawn as a contour on the variance panel where the field crosses it.
+    title : str
+        The figure's title.
+    path : str or Path, optional
+        Where to write the figure (110 dpi, format from the suffix); nothing is written without it.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The figure, one panel per map, each with its colour bar.
     """
     panels = 3 if truth_hardness is not None else 2
-    fig, axes = plt.subplots(1, panels, figsize=(5.2 * panels, 4.0), constrained_layout=True)
+    fig = Figure(figsize=(5.2 * panels, 4.0), layout="constrained")
+    axes = fig.subplots(1, panels)
     ext = _extent(xs, ys)
     axes = list(np.atleast_1d(axes))
     if truth_hardness is not None:
@@ -107,13 +123,12 @@ def plot_map(
             a.set_ylabel("y [m]")
     if title:
         fig.suptitle(title)
-    out = Path(path)
-    fig.savefig(out, dpi=110)
-    plt.close(fig)
-    return out
+    if path is not None:
+        save_figure(fig, path, dpi=110)
+    return fig
 
 
-def plot_beta_curve(ax: Any, betas: NDArray, errors: NDArray, beta_hat: float, std: float) -> None:
+def plot_beta_curve(ax: Axes, betas: NDArray, errors: NDArray, beta_hat: float, std: float) -> None:
     """Draw E(β) with the estimate and its uncertainty band on ``ax``."""
     order = np.argsort(betas)
     ax.plot(np.asarray(betas)[order], np.asarray(errors)[order] * 1e3, "-", color="k")
@@ -124,8 +139,38 @@ def plot_beta_curve(ax: Any, betas: NDArray, errors: NDArray, beta_hat: float, s
     ax.legend(fontsize=8)
 
 
+def plot_error_curve(
+    betas: NDArray[np.float64],
+    errors: NDArray[np.float64],
+    beta: float,
+    beta_std: float,
+    *,
+    title: str = "shape-matching error E(β)",
+    path: str | Path | None = None,
+) -> Figure:
+    """A figure of its own holding :func:`plot_beta_curve`: E(β), β̂ and its uncertainty band.
+
+    Parameters
+    ----------
+    betas, errors : (m,) float
+        The βs tried and their error E(β) in metres (drawn in millimetres), in any order.
+    beta, beta_std : float
+        The estimate β̂ and its standard deviation.
+    title : str
+        The axes' title.
+    path : str or Path, optional
+        Where to write the figure (110 dpi, format from the suffix); nothing is written without it.
+    """
+    fig = Figure(figsize=(5.0, 3.6), layout="constrained")
+    ax = fig.subplots()
+    plot_beta_curve(ax, betas, errors, beta, beta_std)
+    ax.set_title(title)
+    if path is not None:
+        save_figure(fig, path, dpi=110)
+    return fig
+
+
 def plot_poke(
-    path: str | Path,
     *,
     roi_xs: NDArray[np.float64],
     roi_ys: NDArray[np.float64],
@@ -139,15 +184,40 @@ def plot_poke(
     beta_std: float,
     simulated_z: NDArray[np.float64] | None = None,
     title: str = "",
-) -> Path:
-    """Write one poke's figure: before, after, the fitted dent (and simulated one), E(β)."""
-    fig, axes = plt.subplots(1, 4, figsize=(19, 4.0), constrained_layout=True)
+    path: str | Path | None = None,
+) -> Figure:
+    """One poke's figure: the ROI before, the cloud while pressing, a section, E(β).
+
+    Parameters
+    ----------
+    roi_xs, roi_ys : (nx,), (ny,) float, metres
+        Grid of the region of interest around the contact.
+    rest_z, deformed_z : (ny, nx) float, metres
+        Heights before (surface GP) and while pressing (touch GP).
+    roi_points : (n, 3) float, metres
+        The cloud in the ROI while pressing, the robot removed.
+    tactile : (t, 3) float, metres
+        The tactile points added on the probe's tip.
+    betas, errors : (m,) float
+        The βs tried and their error E(β) in metres.
+    beta, beta_std : float
+        The estimate β̂ and its standard deviation.
+    simulated_z : (ny, nx) float, metres, optional
+        The shape-matching surface at β̂, drawn on the section when given.
+    title : str
+        The figure's title.
+    path : str or Path, optional
+        Where to write the figure (100 dpi, format from the suffix); nothing is written without it.
+    """
+    fig = Figure(figsize=(19, 4.0), layout="constrained")
+    axes = fig.subplots(1, 4)
     ext = _extent(roi_xs, roi_ys)
     lo = float(min(rest_z.min(), deformed_z.min()))
     hi = float(max(rest_z.max(), deformed_z.max()))
     ax = axes[0]
     im = ax.imshow(rest_z * 1e3, origin="lower", extent=ext, vmin=lo * 1e3, vmax=hi * 1e3)
     ax.set_title("ROI before (surface GP)")
+    ax.set(xlabel="x [m]", ylabel="y [m]")
     fig.colorbar(im, ax=ax, label="z [mm]")
     ax = axes[1]
     sc = ax.scatter(
@@ -164,6 +234,7 @@ def plot_poke(
     ax.set_aspect("equal")
     ax.legend(fontsize=8, loc="upper right")
     ax.set_title("cloud while pressing (robot removed)")
+    ax.set(xlabel="x [m]", ylabel="y [m]")
     fig.colorbar(sc, ax=ax, label="z [mm]")
     ax = axes[2]
     mid = rest_z.shape[0] // 2
@@ -183,12 +254,12 @@ def plot_poke(
     ax.set_xlabel("x [cm]")
     ax.set_ylabel("z [mm]")
     ax.set_title("section through the contact")
-    ax.legend(fontsize=8)
+    # below the axes: inside, it would cover the dent, which is at the section's middle
+    ax.legend(fontsize=8, ncol=2, loc="upper center", bbox_to_anchor=(0.5, -0.16))
     plot_beta_curve(axes[3], betas, errors, beta, beta_std)
     axes[3].set_title("shape-matching error E(β)")
     if title:
         fig.suptitle(title)
-    out = Path(path)
-    fig.savefig(out, dpi=100)
-    plt.close(fig)
-    return out
+    if path is not None:
+        save_figure(fig, path, dpi=100)
+    return fig

@@ -15,6 +15,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from deformap.errors import missing_extra
+from deformap.viz._save import writing_atomically
 
 __all__ = ["heightmap_mesh", "record_run"]
 
@@ -46,7 +47,7 @@ def record_run(path: str | Path, result: Any, *, initial_points: NDArray[np.floa
     Parameters
     ----------
     path : str or Path
-        The ``.rrd`` file to write.
+        The ``.rrd`` file to write, atomically (under a temporary name, renamed once complete).
     result : ExplorationResult
         A finished exploration (its surface model, every poke and the β-field after each).
     initial_points : (n, 3) float, metres
@@ -56,11 +57,20 @@ def record_run(path: str | Path, result: Any, *, initial_points: NDArray[np.floa
         import rerun as rr
     except ImportError:
         raise missing_extra("rerun-sdk", "rerun", "writing 3D recordings") from None
-    rec = rr.RecordingStream("deformap")
     out = Path(path)
-    rec.save(out)
+    with writing_atomically(out) as tmp:
+        rec = rr.RecordingStream("deformap")
+        rec.save(tmp)
+        _log_run(rec, result, np.asarray(initial_points))
+        rec.flush()
+        rec.disconnect()  # closes the file
+    return out
+
+
+def _log_run(rec: Any, result: Any, pts: NDArray[np.float64]) -> None:
+    import rerun as rr
+
     rec.set_time("poke", sequence=0)
-    pts = np.asarray(initial_points)
     rec.log(
         "world/observation",
         rr.Points3D(pts, radii=0.0015, colors=_colors(pts[:, 2], "viridis", 0.0, 0.08)),
@@ -109,5 +119,3 @@ def record_run(path: str | Path, result: Any, *, initial_points: NDArray[np.floa
         rec.log("maps/variance", rr.Image(_colors(var[::-1], "Blues", 0.0, float(var.max()))))
         rec.log("metrics/beta", rr.Scalars(poke.record.beta))
         rec.log("metrics/max_variance", rr.Scalars(float(var.max())))
-    rec.flush()
-    return out

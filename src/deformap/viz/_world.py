@@ -1,6 +1,8 @@
 """Pictures of a world for a person to check it: layout, one observed cloud, one dent.
 
-Figures live in :mod:`deformap.viz`, a leaf: the world itself never imports matplotlib.
+Figures live in :mod:`deformap.viz`, a leaf: the world itself never imports matplotlib. They are
+built on :class:`matplotlib.figure.Figure` without ``pyplot`` and written atomically, so no backend
+is selected and no global state is touched.
 """
 
 from __future__ import annotations
@@ -9,6 +11,11 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
+from matplotlib.figure import Figure
+from matplotlib.layout_engine import ConstrainedLayoutEngine
+from matplotlib.patches import Polygon, Rectangle
+
+from deformap.viz._save import save_figure
 
 if TYPE_CHECKING:
     from deformap.world import SimulatedWorld
@@ -25,18 +32,18 @@ def _press_target(world: SimulatedWorld) -> np.ndarray:
     return np.asarray(soft.polygon.mean(axis=0))
 
 
-def show_world(world: SimulatedWorld, out: Path) -> list[Path]:
-    """Write ``layout.png``, ``cloud.png`` and ``dent.png`` into ``out``; returns their paths."""
-    import matplotlib
+def show_world(world: SimulatedWorld, out: str | Path) -> list[Path]:
+    """Write ``layout.png``, ``cloud.png`` and ``dent.png`` into ``out``; returns their paths.
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    from matplotlib.patches import Polygon, Rectangle
-
+    The folder is created if needed; each file is written atomically. ``cloud.png`` observes the
+    world once, and ``dent.png`` presses the centroid of its softest foam block once and releases it.
+    """
+    out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     paths = []
     # layout
-    fig, ax = plt.subplots(figsize=(7, 5))
+    fig = Figure(figsize=(7, 5), layout="constrained")
+    ax = fig.subplots()
     for k, b in enumerate(world.regions):
         ax.add_patch(Polygon(b.polygon, closed=True, facecolor=b.color, edgecolor="k", alpha=0.9))
         cx, cy = b.polygon.mean(axis=0)
@@ -50,12 +57,12 @@ def show_world(world: SimulatedWorld, out: Path) -> list[Path]:
                 arrowprops={"arrowstyle": "->"})
     ax.set(xlim=(x0 - 0.05, x0 + w + 0.05), ylim=(y0 - 0.08, y0 + d + 0.05), aspect="equal",
            xlabel="x [m]", ylabel="y [m]", title=f"{world.scenario.name}: layout and hardness")
-    paths.append(out / "layout.png")
-    fig.savefig(paths[-1], dpi=120, bbox_inches="tight")
-    plt.close(fig)
+    paths.append(save_figure(fig, out / "layout.png", dpi=120, bbox_inches="tight"))
     # cloud
     cloud = world.observe()
-    fig, (a1, a2) = plt.subplots(1, 2, figsize=(12, 4.5))
+    # wspace: the colour bar's label apart from the next panel's y label
+    fig = Figure(figsize=(12, 4.5), layout=ConstrainedLayoutEngine(wspace=0.08))
+    a1, a2 = fig.subplots(1, 2)
     step = max(1, len(cloud) // 60000)
     sc = a1.scatter(cloud.xy[::step, 0], cloud.xy[::step, 1], c=cloud.z[::step], s=0.3,
                     cmap="viridis", vmin=-0.01, vmax=0.07)
@@ -66,16 +73,12 @@ def show_world(world: SimulatedWorld, out: Path) -> list[Path]:
     band = np.abs(cloud.xy[:, 0] - world.workspace.center[0]) < 0.01
     a2.scatter(cloud.xy[band, 1], cloud.z[band], s=0.5)
     a2.set(xlabel="y [m]", ylabel="z [m]", title="side view of a 2 cm band at the centre x")
-    paths.append(out / "cloud.png")
-    fig.savefig(paths[-1], dpi=120, bbox_inches="tight")
-    plt.close(fig)
+    paths.append(save_figure(fig, out / "cloud.png", dpi=120, bbox_inches="tight"))
     paths.append(_dent_figure(world, out))
     return paths
 
 
 def _dent_figure(world: SimulatedWorld, out: Path) -> Path:
-    import matplotlib.pyplot as plt_
-
     target = _press_target(world)
     force = world.config.default_force_n
     obs = world.press(target, force)
@@ -85,7 +88,8 @@ def _dent_figure(world: SimulatedWorld, out: Path) -> Path:
     ys = np.linspace(target[1] - 0.06, target[1] + 0.06, 121)
     before = world.surface_height(xs, ys)
     after = world.surface_height(xs, ys, dent.displacement)
-    fig, axes = plt_.subplots(1, 3, figsize=(16, 4.5))
+    fig = Figure(figsize=(16, 4.5), layout="constrained")
+    axes = fig.subplots(1, 3)
     ext = (xs[0], xs[-1], ys[0], ys[-1])
     panels = ((axes[0], before, "surface before"), (axes[1], after, "surface pressed"))
     for ax, img, title in panels:
@@ -109,8 +113,6 @@ def _dent_figure(world: SimulatedWorld, out: Path) -> Path:
     ax.set(xlabel="x [mm]", ylabel="z [mm]", ylim=(after.min() * 1e3 - 5, before.max() * 1e3 + 25),
            title=f"{force:.2f} N at ({target[0]:.2f}, {target[1]:.2f}): "
                  f"dent {dent.depth_m * 1e3:.1f} mm, a = {dent.contact_radius_m * 1e3:.1f} mm")
-    ax.legend(fontsize=7, ncol=2, loc="upper left")
-    path = out / "dent.png"
-    fig.savefig(path, dpi=120, bbox_inches="tight")
-    plt_.close(fig)
-    return path
+    # beside the axes: inside, the legend would cover the tip (the equal aspect leaves the panel short)
+    ax.legend(fontsize=7, loc="center left", bbox_to_anchor=(1.02, 0.5))
+    return save_figure(fig, out / "dent.png", dpi=120, bbox_inches="tight")
