@@ -49,18 +49,26 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Literal
 
-from deformap._validation import check_int, check_positive, check_slope_deg, check_vector
-from deformap.errors import InvalidArgumentError
-from deformap.explore._acquisition import STRATEGIES
+from deformap._validation import SettingError, check_settings, setting
+from deformap.explore._acquisition import Strategy
 from deformap.msm import ShapeMatchingConfig
 
 __all__ = [
     "BetaFieldConfig",
     "ExplorationConfig",
+    "RegionLabels",
+    "StopRegion",
     "SurfaceGPConfig",
     "TouchGPConfig",
+    "TouchModel",
 ]
 
+#: How the touch GP models the dent (``TouchGPConfig.model``).
+TouchModel = Literal["residual", "height"]
+#: Where the variance must fall below ``T_h`` (``ExplorationConfig.stop_region``).
+StopRegion = Literal["workspace", "targets"]
+#: How cells get their region (``ExplorationConfig.region_labels``).
+RegionLabels = Literal["isopleth", "nearest"]
 
 @dataclass(frozen=True, kw_only=True)
 class SurfaceGPConfig:
@@ -68,31 +76,28 @@ class SurfaceGPConfig:
 
     z_min_m: float = -0.02
     z_max_m: float = 0.30
-    outlier_k: int = 20
-    outlier_std_ratio: float = 2.0
-    max_slope_deg: float = 60.0
-    min_length_scale_m: float = 0.03
+    # each point's k neighbours are held at once (n·k distances and indices)
+    outlier_k: int = setting(20, ge=2, le=1000)
+    outlier_std_ratio: float = setting(2.0, gt=0.0)
+    max_slope_deg: float = setting(60.0, gt=0.0, le=90.0)
+    min_length_scale_m: float = setting(0.03, gt=0.0)
     fit_hyperparameters: bool = True
-    max_fit_points: int = 800
-    fit_restarts: int = 1
-    length_scale_m: float = 0.04
-    signal_std_m: float = 0.03
-    noise_std_m: float = 0.002
-    grid_spacing_m: float = 0.005
+    # each likelihood evaluation factorises an n × n matrix: 10⁴ points is 0.8 GB and ~3·10¹¹ flops
+    max_fit_points: int = setting(800, ge=50, le=10_000)
+    fit_restarts: int = setting(1, ge=0, le=100)  # each restart is a whole optimisation
+    length_scale_m: float = setting(0.04, gt=0.0)
+    signal_std_m: float = setting(0.03, gt=0.0)
+    noise_std_m: float = setting(0.002, gt=0.0)
+    # below 1 mm is finer than a depth camera resolves on a table (a pixel spans millimetres at
+    # a metre), while every map's cell count grows as 1 / spacing²
+    grid_spacing_m: float = setting(0.005, gt=0.0, ge=0.001)
 
     def __post_init__(self) -> None:
+        check_settings(self)
         if self.z_max_m <= self.z_min_m:
-            raise InvalidArgumentError(
-                f"`z_max_m` must exceed `z_min_m`; got {self.z_min_m} and {self.z_max_m}"
+            raise SettingError(
+                "z_max_m", f"must exceed `z_min_m` ({self.z_min_m}); got {self.z_max_m}"
             )
-        check_int("outlier_k", self.outlier_k, minimum=2)
-        check_positive("outlier_std_ratio", self.outlier_std_ratio)
-        check_slope_deg("max_slope_deg", self.max_slope_deg)
-        check_int("max_fit_points", self.max_fit_points, minimum=50)
-        check_int("fit_restarts", self.fit_restarts, minimum=0)
-        for name in ("length_scale_m", "signal_std_m", "noise_std_m", "grid_spacing_m",
-                     "min_length_scale_m"):
-            check_positive(name, getattr(self, name))
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -104,49 +109,38 @@ class TouchGPConfig:
     ``ShapeMatchingConfig.uncertainty`` (the tile bootstrap of E(β) by default).
     """
 
-    roi_size_m: float = 0.12
-    model: Literal["residual", "height"] = "residual"
-    n_tactile: int = 10
-    tactile_noise_std_m: float = 0.0005
-    robot_margin_m: float = 0.002
-    tip_margin_m: float = 0.003
-    above_surface_m: float = 0.01
-    max_slope_deg: float = 60.0
-    length_scale_m: float = 0.01
-    signal_std_m: float = 0.01
-    noise_std_m: float = 0.002
-    noise_samples: int = 64
+    roi_size_m: float = setting(0.12, gt=0.0)
+    model: TouchModel = "residual"
+    # the tactile points join the touch GP's data; a thousand on a fingertip's cap are already
+    # closer together than the camera's own points
+    n_tactile: int = setting(10, ge=1, le=1000)
+    tactile_noise_std_m: float = setting(0.0005, gt=0.0)
+    robot_margin_m: float = setting(0.002, ge=0.0)
+    tip_margin_m: float = setting(0.003, ge=0.0)
+    above_surface_m: float = setting(0.01, gt=0.0)
+    max_slope_deg: float = setting(60.0, gt=0.0, le=90.0)
+    length_scale_m: float = setting(0.01, gt=0.0)
+    signal_std_m: float = setting(0.01, gt=0.0)
+    noise_std_m: float = setting(0.002, gt=0.0)
+    # each draw re-reads β̂ over the whole E(β) sweep: the cost is linear in the draws
+    noise_samples: int = setting(64, ge=0, le=10_000)
 
     def __post_init__(self) -> None:
-        check_positive("roi_size_m", self.roi_size_m)
-        check_int("n_tactile", self.n_tactile, minimum=1)
-        check_int("noise_samples", self.noise_samples, minimum=0)
+        check_settings(self)
         if self.noise_samples == 1:
-            raise InvalidArgumentError("`noise_samples` must be 0 (off) or at least 2; got 1")
-        check_positive("robot_margin_m", self.robot_margin_m, allow_zero=True)
-        check_positive("tip_margin_m", self.tip_margin_m, allow_zero=True)
-        check_slope_deg("max_slope_deg", self.max_slope_deg)
-        for name in (
-            "tactile_noise_std_m",
-            "length_scale_m",
-            "signal_std_m",
-            "noise_std_m",
-            "above_surface_m",
-        ):
-            check_positive(name, getattr(self, name))
+            raise SettingError("noise_samples", "must be 0 (off) or at least 2; got 1")
 
 
 @dataclass(frozen=True, kw_only=True)
 class BetaFieldConfig:
     """Prior of the β-field Gaussian random field (the paper's σe, σw, σn)."""
 
-    signal_std: float = 0.3
-    length_scale_m: float = 0.2
-    noise_floor: float = 0.03
+    signal_std: float = setting(0.3, gt=0.0)
+    length_scale_m: float = setting(0.2, gt=0.0)
+    noise_floor: float = setting(0.03, gt=0.0)
 
     def __post_init__(self) -> None:
-        for name in ("signal_std", "length_scale_m", "noise_floor"):
-            check_positive(name, getattr(self, name))
+        check_settings(self)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -188,39 +182,22 @@ class ExplorationConfig:
         rule, stops there.
     """
 
-    threshold: float = 0.06
-    max_pokes: int = 12
-    strategy: Literal["paper", "max-variance", "min-max-variance", "planned"] = "planned"
+    threshold: float = setting(0.06, gt=0.0)
+    # every poke is a press and a β sweep (seconds), and the β-field's and the planner's matrices
+    # grow with the pokes
+    max_pokes: int = setting(12, ge=1, le=1000)
+    strategy: Strategy = "planned"
     first_target: tuple[float, float] | None = None
-    stop_region: Literal["workspace", "targets"] = "workspace"
-    force_n: float = 0.6
-    max_regions: int = 6
-    region_prior_dof: float = 7.0
-    region_labels: Literal["isopleth", "nearest"] = "isopleth"
-    boundary_pokes: int = 0
+    stop_region: StopRegion = "workspace"
+    force_n: float = setting(0.6, gt=0.0)
+    max_regions: int = setting(6, ge=1)
+    region_prior_dof: float = setting(7.0, ge=0.0)
+    region_labels: RegionLabels = "isopleth"
+    boundary_pokes: int = setting(0, ge=0, le=1000)  # as for max_pokes
     surface: SurfaceGPConfig = field(default_factory=SurfaceGPConfig)
     touch: TouchGPConfig = field(default_factory=TouchGPConfig)
     beta_field: BetaFieldConfig = field(default_factory=BetaFieldConfig)
     shape_matching: ShapeMatchingConfig = field(default_factory=ShapeMatchingConfig)
 
     def __post_init__(self) -> None:
-        check_positive("threshold", self.threshold)
-        check_int("max_pokes", self.max_pokes, minimum=1)
-        if self.strategy not in STRATEGIES:
-            raise InvalidArgumentError(
-                f"`strategy` must be one of {list(STRATEGIES)}; got {self.strategy!r}"
-            )
-        if self.stop_region not in ("workspace", "targets"):
-            raise InvalidArgumentError(
-                f"`stop_region` must be one of ['workspace', 'targets']; got {self.stop_region!r}"
-            )
-        if self.first_target is not None:
-            check_vector("first_target", self.first_target, 2, what="metres")
-        check_positive("force_n", self.force_n)
-        check_int("max_regions", self.max_regions, minimum=1)
-        check_positive("region_prior_dof", self.region_prior_dof, allow_zero=True)
-        if self.region_labels not in ("isopleth", "nearest"):
-            raise InvalidArgumentError(
-                f"`region_labels` must be one of ['isopleth', 'nearest']; got {self.region_labels!r}"
-            )
-        check_int("boundary_pokes", self.boundary_pokes, minimum=0)
+        check_settings(self)

@@ -27,7 +27,13 @@ import numpy as np
 import trimesh
 from numpy.typing import NDArray
 
-from deformap._validation import check_array, check_positive, check_vector
+from deformap._validation import (
+    check_array,
+    check_positive,
+    check_settings,
+    check_vector,
+    setting,
+)
 from deformap.cloud import PointCloud
 from deformap.environment import PressObservation, TactileContact, Workspace
 from deformap.errors import EnvironmentStateError, InvalidArgumentError
@@ -70,35 +76,25 @@ class WorldConfig:
         How far the table extends beyond the workspace on every side.
     """
 
-    element_size_m: float = 0.0075
-    top_layer_m: float = 0.005
-    layer_growth: float = 1.5
-    poisson_ratio: float = 0.3
-    default_force_n: float = 0.6
-    tip_radius_m: float = 0.01
-    stick_length_m: float = 0.10
-    stick_radius_m: float = 0.006
-    hand_size_m: tuple[float, float, float] = (0.08, 0.06, 0.10)
-    force_noise_n: float = 0.01
+    # finer than 1 mm resolves nothing the 1 cm tip or the camera can tell, and the element count
+    # grows as 1 / size² (see check_world_budget for the mesh as a whole)
+    element_size_m: float = setting(0.0075, gt=0.0, ge=0.001)
+    # the layer count grows as thickness / top layer when the layers do not grow (growth 1)
+    top_layer_m: float = setting(0.005, gt=0.0, ge=0.001)
+    layer_growth: float = setting(1.5, ge=1.0, le=10.0)
+    poisson_ratio: float = setting(0.3, ge=0.0, lt=0.5)  # 0.5 makes the FEM's λ infinite
+    default_force_n: float = setting(0.6, gt=0.0)
+    tip_radius_m: float = setting(0.01, gt=0.0)
+    stick_length_m: float = setting(0.10, gt=0.0)
+    stick_radius_m: float = setting(0.006, gt=0.0)
+    hand_size_m: tuple[float, float, float] = setting((0.08, 0.06, 0.10), gt=0.0)
+    force_noise_n: float = setting(0.01, ge=0.0)
     noise: bool = True
     camera: CameraConfig = field(default_factory=CameraConfig)
-    table_margin_m: float = 0.2
+    table_margin_m: float = setting(0.2, gt=0.0)
 
     def __post_init__(self) -> None:
-        for name in ("element_size_m", "top_layer_m", "default_force_n", "table_margin_m",
-                     "tip_radius_m", "stick_length_m", "stick_radius_m"):
-            check_positive(name, getattr(self, name))
-        hand = check_vector("hand_size_m", self.hand_size_m, 3, what="metres")
-        if np.any(hand <= 0):
-            raise InvalidArgumentError(f"`hand_size_m` must be positive; got {self.hand_size_m}")
-        if not isinstance(self.camera, CameraConfig):
-            raise InvalidArgumentError(f"`camera` must be a CameraConfig; got {type(self.camera)}")
-        check_positive("force_noise_n", self.force_noise_n, allow_zero=True)
-        if not 0.0 <= self.poisson_ratio < 0.5:
-            raise InvalidArgumentError(
-                f"`poisson_ratio` must lie in [0, 0.5); got {self.poisson_ratio!r}")
-        if not self.layer_growth >= 1.0:
-            raise InvalidArgumentError(f"`layer_growth` must be >= 1; got {self.layer_growth!r}")
+        check_settings(self)
 
     @property
     def probe(self) -> ProbeGeometry:
