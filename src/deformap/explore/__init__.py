@@ -9,6 +9,7 @@ from deformap.explore._config import (
     ExplorationConfig,
     SurfaceGPConfig,
     TouchGPConfig,
+    check_exploration_budget,
 )
 from deformap.explore._journal import Journal, JournalContents, read_journal
 from deformap.explore._loop import ExplorationResult, explore
@@ -28,6 +29,7 @@ __all__ = [
     "SurfaceGPConfig",
     "SurfaceModel",
     "TouchGPConfig",
+    "check_exploration_budget",
     "choose_target",
     "explore",
     "read_journal",

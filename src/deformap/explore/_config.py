@@ -50,10 +50,14 @@ from dataclasses import dataclass, field
 from typing import Literal
 
 from deformap._validation import SettingError, check_settings, setting
+from deformap.environment import Workspace
 from deformap.explore._acquisition import Strategy
 from deformap.msm import ShapeMatchingConfig
 
 __all__ = [
+    "MAX_MAP_CELLS",
+    "MAX_PLAN_CELLS",
+    "MAX_ROI_BAND_BYTES",
     "BetaFieldConfig",
     "ExplorationConfig",
     "RegionLabels",
@@ -61,6 +65,7 @@ __all__ = [
     "SurfaceGPConfig",
     "TouchGPConfig",
     "TouchModel",
+    "check_exploration_budget",
 ]
 
 #: How the touch GP models the dent (``TouchGPConfig.model``).
@@ -69,6 +74,21 @@ TouchModel = Literal["residual", "height"]
 StopRegion = Literal["workspace", "targets"]
 #: How cells get their region (``ExplorationConfig.region_labels``).
 RegionLabels = Literal["isopleth", "nearest"]
+
+#: Most bytes of one band of the ROI's shape-matching system (:mod:`deformap.msm._linsys`): the
+#: β sweep holds its two assembled bands and a few factorisations of that size at once, so 512 MiB
+#: keeps the sweep within a few GiB.
+MAX_ROI_BAND_BYTES = 512 * 2**20
+#: Most cells of the map grid: every map is a dense grid, and the ``min-max-variance`` look-ahead
+#: holds a (256 candidates × cells) float64 matrix, 2 GB at this size.
+MAX_MAP_CELLS = 1_000_000
+#: Most cells of the planner's 2 cm grids (``planned``, ``min-max-variance``): it holds
+#: (candidates × domain) and (candidates × candidates) float64 kernel matrices, 0.8 GB each at
+#: this size (4 m² of workspace).
+MAX_PLAN_CELLS = 10_000
+#: Spacing of the planner's grids (``explore._mapper._PLAN_DOMAIN_M``; a test keeps them equal).
+_PLAN_GRID_M = 0.02
+
 
 @dataclass(frozen=True, kw_only=True)
 class SurfaceGPConfig:
@@ -201,3 +221,72 @@ class ExplorationConfig:
 
     def __post_init__(self) -> None:
         check_settings(self)
+        self._check_roi()
+
+    def _check_roi(self) -> None:
+        """The ROI's particle grid (``Mapper.roi_grid``: the surface grid's spacing, an odd node
+        count per side) must hold one cluster and keep its linear system's band within
+        :data:`MAX_ROI_BAND_BYTES` (half-width as in :mod:`deformap.msm._linsys`)."""
+        spacing = self.surface.grid_spacing_m
+        side = 2 * round(self.touch.roi_size_m / spacing / 2) + 1
+        sm = self.shape_matching
+        k, nz = sm.cluster_size, sm.body_layers + 1
+        where = f"at `surface.grid_spacing_m` = {spacing:g} m"
+        if side < k:
+            raise SettingError(
+                "touch.roi_size_m",
+                f"must span at least `shape_matching.cluster_size` = {k} grid nodes per side "
+                f"{where}; got {self.touch.roi_size_m:g} m ({side} nodes)",
+            )
+        half_width = (k - 1) * (side * nz + nz) + nz - 1
+        band = 8 * side * side * nz * (half_width + 1)
+        if band > MAX_ROI_BAND_BYTES:
+            raise SettingError(
+                "touch.roi_size_m",
+                f"makes a shape-matching body of {side} × {side} × {nz} particles {where} "
+                f"(cluster size {k}), whose linear system needs {band / 2**20:,.0f} MiB per band; "
+                f"at most {MAX_ROI_BAND_BYTES / 2**20:,.0f} MiB: use a smaller ROI, a coarser "
+                f"grid or fewer `shape_matching.layers`; got {self.touch.roi_size_m:g} m",
+            )
+
+
+def check_exploration_budget(config: ExplorationConfig, workspace: Workspace) -> None:
+    """Refuse, before any work, an exploration whose maps of ``workspace`` would be absurdly large.
+
+    The bounds that depend on a single settings object hold from its construction; these depend
+    on the workspace too. The map grid (``Workspace.grid`` at ``surface.grid_spacing_m``) must
+    have at most :data:`MAX_MAP_CELLS` cells and, for the strategies that plan (``planned``,
+    ``min-max-variance``), the planner's 2 cm grid at most :data:`MAX_PLAN_CELLS`.
+
+    Parameters
+    ----------
+    config : ExplorationConfig
+    workspace : Workspace
+        The rectangle to map (``Environment.workspace``).
+
+    Raises
+    ------
+    SettingError
+        Naming ``surface.grid_spacing_m`` or ``strategy``, the cells asked for and the limit.
+    """
+    if not isinstance(config, ExplorationConfig):
+        raise SettingError("config", f"must be an ExplorationConfig; got {type(config).__name__}")
+    if not isinstance(workspace, Workspace):
+        raise SettingError("workspace", f"must be a Workspace; got {type(workspace).__name__}")
+    (width, depth), spacing = workspace.size, config.surface.grid_spacing_m
+    cells = max(1, round(width / spacing)) * max(1, round(depth / spacing))
+    area = f"a {width:g} × {depth:g} m workspace"
+    if cells > MAX_MAP_CELLS:
+        raise SettingError(
+            "surface.grid_spacing_m",
+            f"makes {cells:,} map cells over {area}; at most {MAX_MAP_CELLS:,}: use a coarser "
+            f"spacing or a smaller workspace; got {spacing:g} m",
+        )
+    plan = (round(width / _PLAN_GRID_M) + 1) * (round(depth / _PLAN_GRID_M) + 1)
+    if config.strategy in ("planned", "min-max-variance") and plan > MAX_PLAN_CELLS:
+        raise SettingError(
+            "strategy",
+            f"{config.strategy!r} plans on {plan:,} cells of {_PLAN_GRID_M * 100:g} cm over "
+            f"{area}; at most {MAX_PLAN_CELLS:,}: use 'max-variance' or 'paper', or a smaller "
+            f"workspace",
+        )

@@ -20,6 +20,7 @@ on the bare table (neither deforms).
 from __future__ import annotations
 
 import logging
+import math
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -28,6 +29,7 @@ import trimesh
 from numpy.typing import NDArray
 
 from deformap._validation import (
+    SettingError,
     check_array,
     check_positive,
     check_settings,
@@ -42,7 +44,7 @@ from deformap.world._foam import Dent, FoamModel
 from deformap.world._probe import ProbeGeometry
 from deformap.world._scenario import BARE_TABLE, Block, Scenario
 
-__all__ = ["SimulatedWorld", "WorldConfig"]
+__all__ = ["MAX_FEM_UNKNOWNS", "SimulatedWorld", "WorldConfig", "check_world_budget"]
 
 log = logging.getLogger(__name__)
 
@@ -112,6 +114,53 @@ class WorldConfig:
         return cls(**settings)
 
 
+#: Most displacement unknowns (3 per mesh node, all blocks) of the foam FEM: each foam block's
+#: stiffness matrix is factorised once by a sparse direct solver and kept, and on a 3-D mesh its
+#: fill-in grows faster than the unknowns; a million is already several GB.
+MAX_FEM_UNKNOWNS = 1_000_000
+
+
+def _layer_count(thickness_m: float, top_m: float, growth: float) -> int:
+    """Upper bound on the layers of :func:`~deformap.world._fem.graded_levels` (no loop, so that
+    an absurd request is refused at once): layers ``top·gⁱ`` until they sum to the thickness."""
+    top = min(top_m, thickness_m)
+    if growth <= 1.0 + 1e-12:
+        return math.ceil(thickness_m / top) + 1
+    return math.ceil(math.log1p(thickness_m * (growth - 1.0) / top) / math.log(growth)) + 1
+
+
+def check_world_budget(config: WorldConfig, scenario: Scenario) -> None:
+    """Refuse, before any work, a world whose foam mesh would be absurdly large.
+
+    Counts the nodes of every block's structured mesh (``element_size_m`` in plane over the
+    block's bounding box, the graded layers of ``top_layer_m`` and ``layer_growth`` through its
+    thickness) and refuses more than :data:`MAX_FEM_UNKNOWNS` unknowns. :class:`SimulatedWorld`
+    calls it first; a run can call it before it starts anything else.
+
+    Raises
+    ------
+    SettingError
+        Naming ``element_size_m``, the unknowns asked for and the limit.
+    """
+    if not isinstance(config, WorldConfig):
+        raise SettingError("config", f"must be a WorldConfig; got {type(config).__name__}")
+    if not isinstance(scenario, Scenario):
+        raise SettingError("scenario", f"must be a Scenario; got {type(scenario).__name__}")
+    size = config.element_size_m
+    unknowns = 0
+    for block in scenario.blocks:
+        extent = block.polygon.max(axis=0) - block.polygon.min(axis=0)
+        nx, ny = (max(1, math.ceil(e / size - 1e-9)) for e in extent)
+        nz = _layer_count(block.thickness_m, config.top_layer_m, config.layer_growth)
+        unknowns += 3 * (nx + 1) * (ny + 1) * (nz + 1)
+    if unknowns > MAX_FEM_UNKNOWNS:
+        raise SettingError(
+            "element_size_m",
+            f"meshes scenario {scenario.name!r} with about {unknowns:,} FEM unknowns; at most "
+            f"{MAX_FEM_UNKNOWNS:,}: use larger elements or a thicker `top_layer_m`; got {size:g} m",
+        )
+
+
 class SimulatedWorld:
     """A scenario on a table, seen by a depth camera and pressed by a force-controlled probe.
 
@@ -140,6 +189,7 @@ class SimulatedWorld:
             raise InvalidArgumentError(f"`rng` must be a numpy.random.Generator; got {type(rng)}")
         self.scenario = scenario
         self.config = config or WorldConfig()
+        check_world_budget(self.config, scenario)
         self._noise_key = int(rng.integers(2**62))
         self._n_observed = 0
         c = self.config
