@@ -17,7 +17,7 @@ import pytest
 
 from deformap._config import config_from_dict, config_to_dict, dump_yaml, load_yaml
 from deformap._validation import SettingError
-from deformap.errors import ConfigError
+from deformap.errors import ConfigError, InvalidArgumentError
 from deformap.eval._experiment import RunConfig
 from deformap.explore import BetaFieldConfig, ExplorationConfig, SurfaceGPConfig, TouchGPConfig
 from deformap.msm import ShapeMatchingConfig
@@ -103,6 +103,15 @@ def test_a_bad_value_is_refused_from_python_and_from_yaml_naming_the_field(
         assert message.endswith("must be a mapping of settings; got 3")
     else:
         assert message.endswith(from_python.value.detail)
+
+
+@pytest.mark.parametrize(("name", "value"), [("scenario", 3), ("seed", 1.5), ("seed", -1),
+                                             ("world", 3), ("exploration", "planned")])
+def test_the_run_config_checks_its_own_fields(name: str, value: Any) -> None:
+    with pytest.raises(InvalidArgumentError, match=f"`{name}`"):
+        RunConfig(**{name: value})
+    with pytest.raises(ConfigError, match=f"^`config.{name}`"):
+        config_from_dict(RunConfig, {name: value})
 
 
 def test_every_settings_class_is_covered() -> None:
