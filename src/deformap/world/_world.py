@@ -116,7 +116,8 @@ class WorldConfig:
 
 #: Most displacement unknowns (3 per mesh node, all blocks) of the foam FEM: each foam block's
 #: stiffness matrix is factorised once by a sparse direct solver and kept, and on a 3-D mesh its
-#: fill-in grows faster than the unknowns; a million is already several GB.
+#: fill-in grows faster than the unknowns (as N^(4/3) for a 3-D mesh under a nested-dissection
+#: ordering), into gigabytes at a million.
 MAX_FEM_UNKNOWNS = 1_000_000
 
 
