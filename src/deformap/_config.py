@@ -1,9 +1,11 @@
 """Frozen settings dataclasses to and from plain dicts and YAML, strictly.
 
 Every component has one frozen, keyword-only dataclass of settings. This module turns any tree of
-them into plain data (for ``config.yaml`` next to each result) and back, refusing unknown keys, wrong
-types and out-of-range values with a :class:`~deformap.errors.ConfigError` that names the field by
-its dotted path (``exploration.threshold``).
+them into plain data (for ``config.yaml`` next to each result) and back. Reading back refuses
+unknown keys itself and leaves every value to the dataclasses' own check
+(:func:`deformap._validation.check_settings`, the one rule set for Python and YAML alike); either
+refusal is a :class:`~deformap.errors.ConfigError` that names the field by its dotted path
+(``exploration.threshold``).
 """
 
 from __future__ import annotations
@@ -12,10 +14,11 @@ import dataclasses
 import types
 import typing
 from pathlib import Path
-from typing import Any, Literal, TypeVar, get_args, get_origin
+from typing import Any, TypeVar, get_args, get_origin
 
 import yaml
 
+from deformap._validation import SettingError
 from deformap.errors import ConfigError, DeformapError
 
 __all__ = ["config_from_dict", "config_to_dict", "dump_yaml", "load_yaml"]
@@ -36,67 +39,38 @@ def config_to_dict(obj: Any) -> Any:
     return obj
 
 
-def _convert(value: Any, hint: Any, where: str) -> Any:
+def _shape(value: Any, hint: Any, where: str) -> Any:
+    """Give plain data the shape ``hint`` asks for: a mapping becomes the nested settings dataclass,
+    a list a tuple. Nothing is judged here: the dataclass's own :func:`check_settings` does that."""
     origin = get_origin(hint)
-    if hint is Any:
-        return value
     if origin in (typing.Union, types.UnionType):
-        options = get_args(hint)
-        if value is None and type(None) in options:
-            return None
-        errors = []
-        for option in options:
-            if option is type(None):
-                continue
-            try:
-                return _convert(value, option, where)
-            except ConfigError as exc:
-                errors.append(str(exc))
-        raise ConfigError(errors[0] if errors else f"`{where}`: unexpected value {value!r}")
-    if origin is Literal:
-        choices = get_args(hint)
-        if value not in choices:
-            raise ConfigError(f"`{where}` must be one of {list(choices)}; got {value!r}")
-        return value
-    if origin is tuple:
+        options = [a for a in get_args(hint) if a is not type(None)]
+        return value if value is None or len(options) != 1 else _shape(value, options[0], where)
+    if origin is tuple and isinstance(value, list):
         args = get_args(hint)
-        if not isinstance(value, (list, tuple)):
-            raise ConfigError(f"`{where}` must be a list; got {value!r}")
         if len(args) == 2 and args[1] is Ellipsis:
-            return tuple(_convert(v, args[0], f"{where}[{i}]") for i, v in enumerate(value))
-        if len(value) != len(args):
-            raise ConfigError(f"`{where}` must have {len(args)} entries; got {len(value)}")
+            args = (args[0],) * len(value)
+        if len(args) != len(value):
+            return tuple(value)  # the dataclass names the wrong length
         pairs = enumerate(zip(value, args, strict=True))
-        return tuple(_convert(v, a, f"{where}[{i}]") for i, (v, a) in pairs)
-    if dataclasses.is_dataclass(hint):
-        return config_from_dict(hint, value, where=where)  # type: ignore[arg-type]
-    if hint is bool:
-        if not isinstance(value, bool):
-            raise ConfigError(f"`{where}` must be true or false; got {value!r}")
-        return value
-    if hint is int:
-        if isinstance(value, bool) or not isinstance(value, int):
-            raise ConfigError(f"`{where}` must be an integer; got {value!r}")
-        return value
-    if hint is float:
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
-            raise ConfigError(f"`{where}` must be a number; got {value!r}")
-        return float(value)
-    if hint is str:
-        if not isinstance(value, str):
-            raise ConfigError(f"`{where}` must be a string; got {value!r}")
-        return value
+        return tuple(_shape(v, a, f"{where}[{i}]") for i, (v, a) in pairs)
+    if isinstance(hint, type) and dataclasses.is_dataclass(hint):
+        return config_from_dict(hint, value, where=where)
     return value
 
 
 def config_from_dict(cls: type[T], data: Any, *, where: str = "config") -> T:
     """Build the settings dataclass ``cls`` from plain data; missing keys keep their defaults.
 
+    The data is only shaped (mappings into nested dataclasses, lists into tuples) and handed to
+    the constructor, whose ``__post_init__`` checks every field (:func:`check_settings`): a value
+    is refused or accepted exactly as it would be from Python.
+
     Raises
     ------
     ConfigError
-        On an unknown key, a value of the wrong type, or a value the dataclass itself refuses;
-        the message names the field's dotted path.
+        On an unknown key, or a value the dataclass refuses; the message names the field's dotted
+        path (``config.exploration.touch.model``).
     """
     if data is None:
         data = {}
@@ -109,11 +83,13 @@ def config_from_dict(cls: type[T], data: Any, *, where: str = "config") -> T:
             f"`{where}` has unknown key(s) {unknown}; known keys are {sorted(fields)}"
         )
     hints = typing.get_type_hints(cls)
-    kwargs = {name: _convert(value, hints[name], f"{where}.{name}") for name, value in data.items()}
+    kwargs = {name: _shape(value, hints[name], f"{where}.{name}") for name, value in data.items()}
     try:
         return cls(**kwargs)
     except ConfigError:
         raise
+    except SettingError as exc:
+        raise ConfigError(f"`{where}.{exc.field}` {exc.detail}") from None
     except (DeformapError, TypeError, ValueError) as exc:
         raise ConfigError(f"`{where}`: {exc}") from None
 

@@ -1,15 +1,25 @@
 """``check_*`` validators used at the public boundary.
 
-Each returns a clean array (float64, C-contiguous, a copy when it had to convert) or raises
-:class:`~deformap.errors.InvalidArgumentError` with a message that names the argument, what was
-expected and what came. Internal code calls them once at the entry of a public function and then
-trusts its arrays.
+The array and scalar validators each return a clean value (arrays: float64, C-contiguous, a copy
+when they had to convert) or raise :class:`~deformap.errors.InvalidArgumentError` with a message
+that names the argument, what was expected and what came. Internal code calls them once at the
+entry of a public function and then trusts its arrays.
+
+Settings dataclasses have one validator, :func:`check_settings`, which every one of them calls
+first in its ``__post_init__``: it checks each field against its type annotation and against the
+bounds declared beside the field with :func:`setting`, and raises :class:`SettingError` naming the
+field. The YAML loader adds no rule of its own, so Python and YAML are checked alike.
 """
 
 from __future__ import annotations
 
+import math
+import operator
 from collections.abc import Sequence
-from typing import Any
+from dataclasses import field, fields, is_dataclass
+from functools import cache
+from types import UnionType
+from typing import Any, Literal, Union, get_args, get_origin, get_type_hints
 
 import numpy as np
 from numpy.typing import NDArray
@@ -17,15 +27,18 @@ from numpy.typing import NDArray
 from deformap.errors import InvalidArgumentError
 
 __all__ = [
+    "SettingError",
     "check_array",
     "check_finite_scalar",
     "check_in_range",
     "check_int",
     "check_points",
     "check_positive",
+    "check_settings",
     "check_slope_deg",
     "check_vector",
     "describe",
+    "setting",
 ]
 
 
@@ -166,3 +179,171 @@ def check_int(name: str, value: Any, *, minimum: int | None = None) -> int:
     if minimum is not None and out < minimum:
         raise InvalidArgumentError(f"`{name}` must be an integer >= {minimum}; got {out}")
     return out
+
+
+# -- settings dataclasses -------------------------------------------------------------------------
+
+_BOUNDS = "deformap.bounds"
+_BOUND_TEXT = {"gt": ">", "ge": ">=", "lt": "<", "le": "<="}
+
+
+class SettingError(InvalidArgumentError):
+    """A field of a settings dataclass has a bad value.
+
+    ``field`` is the field's name as the dataclass spells it (``"grid_spacing_m"``, or a dotted
+    name such as ``"touch.roi_size_m"`` for a rule over nested settings); ``detail`` says what was
+    expected and what came. The YAML loader prefixes ``field`` with the section's dotted path.
+    """
+
+    def __init__(self, field: str, detail: str) -> None:
+        super().__init__(f"`{field}` {detail}")
+        self.field = field
+        self.detail = detail
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        return (type(self), (self.field, self.detail))
+
+
+def setting(
+    default: Any,
+    *,
+    gt: float | None = None,
+    ge: float | None = None,
+    lt: float | None = None,
+    le: float | None = None,
+    finite: bool = True,
+) -> Any:
+    """A dataclass field whose bounds are declared beside it, for :func:`check_settings`.
+
+    Parameters
+    ----------
+    default : object
+        The field's default (immutable: a number, a string, a tuple, ``None``).
+    gt, ge, lt, le : float, optional
+        Bounds ``value > gt``, ``value >= ge``, ``value < lt``, ``value <= le``; each one given is
+        checked, in that order, and the first one broken is reported. On a tuple they hold for
+        every entry; on an optional field, for a value that is not ``None``.
+    finite : bool
+        Refuse NaN and infinite values of a float field (the default).
+    """
+    bounds = {key: bound for key, bound in (("gt", gt), ("ge", ge), ("lt", lt), ("le", le))
+              if bound is not None}
+    return field(default=default, metadata={_BOUNDS: {"finite": finite, **bounds}})
+
+
+@cache
+def _settings_fields(cls: Any) -> tuple[tuple[str, Any, dict[str, Any]], ...]:
+    hints = get_type_hints(cls)
+    return tuple((f.name, hints[f.name], dict(f.metadata.get(_BOUNDS, {"finite": True})))
+                 for f in fields(cls))
+
+
+def check_settings(obj: Any) -> None:
+    """Check every field of the settings dataclass ``obj`` against its annotation and bounds.
+
+    Every settings dataclass calls this first in its ``__post_init__``; the YAML loader
+    (:func:`deformap._config.config_from_dict`) only shapes plain data and constructs, so the same
+    rules hold from Python and from YAML. By annotation:
+
+    - ``bool``: ``True`` or ``False``; ``int``: an integer, not a bool; ``float``: a real number,
+      finite unless the field's ``setting(finite=False)`` says otherwise; ``str``: a string;
+    - ``Literal[...]``: one of its choices (the ``Literal`` is the one list of choices);
+    - ``tuple[X, Y]`` (fixed length) and ``tuple[X, ...]``: a sequence of such entries;
+    - ``X | None``: ``None`` or an ``X``; a dataclass: an instance of it (which checked itself);
+    - any other annotation (an array): left to the dataclass's own checks.
+
+    Then the bounds declared with :func:`setting`. Accepted values are stored in their canonical
+    type (a numpy or Python int in a float field becomes ``float``, a list or array in a tuple
+    field a ``tuple``), so that equal settings compare and serialise equal.
+
+    Raises
+    ------
+    SettingError
+        Naming the first bad field, what was expected and what came.
+    """
+    for name, hint, bounds in _settings_fields(obj.__class__):
+        value = getattr(obj, name)
+        clean = _check_value(name, value, hint, bounds)
+        if clean is not value:
+            object.__setattr__(obj, name, clean)
+
+
+def _check_value(name: str, value: Any, hint: Any, bounds: dict[str, Any]) -> Any:
+    origin = get_origin(hint)
+    if origin in (Union, UnionType):
+        options = [a for a in get_args(hint) if a is not type(None)]
+        if value is None and len(options) < len(get_args(hint)):
+            return None
+        if len(options) == 1:
+            return _check_value(name, value, options[0], bounds)
+        for option in options:  # no settings field has such a union today; first fit wins
+            try:
+                return _check_value(name, value, option, bounds)
+            except SettingError:
+                continue
+        raise SettingError(name, f"must be one of the types {options}; got {describe(value)}")
+    if origin is Literal:
+        choices = get_args(hint)
+        if not any(type(value) is type(c) and value == c for c in choices):
+            raise SettingError(name, f"must be one of {list(choices)}; got {value!r}")
+        return value
+    if origin is tuple:
+        return _check_tuple(name, value, get_args(hint), bounds)
+    if isinstance(hint, type) and is_dataclass(hint):
+        if not isinstance(value, hint):
+            raise SettingError(name, f"must be a {hint.__name__}; got {describe(value)}")
+        return value
+    if hint is bool:
+        if not isinstance(value, (bool, np.bool_)):
+            raise SettingError(name, f"must be True or False; got {describe(value)}")
+        return value if isinstance(value, bool) else bool(value)
+    if hint is int:
+        if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
+            raise SettingError(name, f"must be an integer; got {describe(value)}")
+        out: int | float = value if type(value) is int else int(value)
+        return _check_bounds(name, out, bounds, "an integer ")
+    if hint is float:
+        if isinstance(value, (bool, np.bool_)) or not isinstance(
+            value, (int, float, np.integer, np.floating)
+        ):
+            raise SettingError(name, f"must be a real number; got {describe(value)}")
+        out = value if type(value) is float else float(value)
+        if bounds.get("finite", True) and not math.isfinite(out):
+            raise SettingError(name, f"must be finite; got {out}")
+        return _check_bounds(name, out, bounds, "")
+    if hint is str:
+        if not isinstance(value, str):
+            raise SettingError(name, f"must be a string; got {describe(value)}")
+        return value
+    return value
+
+
+def _check_tuple(name: str, value: Any, args: tuple[Any, ...], bounds: dict[str, Any]) -> Any:
+    if not isinstance(value, (tuple, list, np.ndarray)) or np.ndim(value) != 1:
+        raise SettingError(name, f"must be a tuple; got {describe(value)}")
+    items = list(value)
+    if len(args) == 2 and args[1] is Ellipsis:
+        hints = [args[0]] * len(items)
+    else:
+        if len(items) != len(args):
+            raise SettingError(name, f"must have {len(args)} entries; got {len(items)}")
+        hints = list(args)
+    out = []
+    for i, (item, hint) in enumerate(zip(items, hints, strict=True)):
+        try:
+            out.append(_check_value(name, item, hint, bounds))
+        except SettingError as exc:
+            raise SettingError(name, f"entry {i} {exc.detail}") from None
+    clean = tuple(out)
+    if type(value) is tuple and all(a is b for a, b in zip(clean, value, strict=True)):
+        return value
+    return clean
+
+
+def _check_bounds(name: str, value: float, bounds: dict[str, Any], kind: str) -> float:
+    for key, holds in (("gt", operator.gt), ("ge", operator.ge), ("lt", operator.lt),
+                       ("le", operator.le)):
+        bound = bounds.get(key)
+        if bound is not None and not holds(value, bound):
+            raise SettingError(name, f"must be {kind}{_BOUND_TEXT[key]} {bound:g}; got {value!r}")
+    return value

@@ -237,8 +237,13 @@ def test_softer_region_dents_deeper_in_the_same_world() -> None:
     assert soft.depth_m > hard.depth_m > 0
 
 
-def test_camera_settings_are_validated_by_the_world_config() -> None:
-    assert CameraConfig().width == 640 and CameraConfig().fov_deg == (58.0, 45.0)
+def test_camera_settings_are_validated() -> None:
+    for bad in ({"width": -1}, {"pitch_deg": 0.0}, {"height_m": float("nan")},
+                {"flying_probability": 5.0}):
+        with pytest.raises(InvalidArgumentError, match=f"`{next(iter(bad))}`"):
+            CameraConfig(**bad)
+    with pytest.raises(InvalidArgumentError, match="`camera` must be a CameraConfig"):
+        WorldConfig(camera={"width": 320})  # type: ignore[arg-type]
 
 
 def test_world_does_not_import_the_estimator() -> None:

@@ -20,7 +20,7 @@ import numpy as np
 
 from deformap import __version__
 from deformap._config import config_from_dict, config_to_dict, dump_yaml, load_yaml
-from deformap._validation import check_int
+from deformap._validation import check_int, check_settings, setting
 from deformap.errors import ConfigError, DeformapError
 from deformap.eval._metrics import region_scores
 from deformap.explore import (
@@ -53,12 +53,12 @@ class RunConfig:
     """The whole configuration of a run: which world, which seed, and every component's settings."""
 
     scenario: str = "heterogeneous-60-110-rigid"
-    seed: int = 0
+    seed: int = setting(0, ge=0)
     world: WorldConfig = field(default_factory=WorldConfig)
     exploration: ExplorationConfig = field(default_factory=ExplorationConfig)
 
     def __post_init__(self) -> None:
-        check_int("seed", self.seed, minimum=0)
+        check_settings(self)
 
 
 def load_run_config(path: str | Path | None) -> RunConfig:

@@ -10,6 +10,7 @@ from deformap.explore._config import (
     ExplorationConfig,
     SurfaceGPConfig,
     TouchGPConfig,
+    check_exploration_budget,
 )
 from deformap.explore._dent import measure_press, roi_grid
 from deformap.explore._field import BetaField, PokeSet
@@ -55,6 +56,7 @@ __all__ = [
     "SurfaceModel",
     "Target",
     "TouchGPConfig",
+    "check_exploration_budget",
     "choose_target",
     "explore",
     "fit_surface",

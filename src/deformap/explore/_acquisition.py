@@ -40,7 +40,7 @@ Active learning for identifying function threshold boundaries. NIPS 18.
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import Literal
+from typing import Literal, get_args
 
 import numpy as np
 from numpy.typing import NDArray
@@ -49,8 +49,9 @@ from deformap.errors import InvalidArgumentError
 
 __all__ = ["STRATEGIES", "Strategy", "boundary_score", "choose_target"]
 
+#: The strategies' names: the one list, which ``ExplorationConfig.strategy`` is annotated with.
 Strategy = Literal["paper", "max-variance", "min-max-variance", "planned"]
-STRATEGIES: tuple[str, ...] = ("paper", "max-variance", "min-max-variance", "planned")
+STRATEGIES: tuple[Strategy, ...] = get_args(Strategy)
 
 #: ``(candidates (c, 2)) -> (c,)`` largest posterior variance left if that candidate were poked.
 LookAhead = Callable[[NDArray[np.float64]], NDArray[np.float64]]

@@ -49,17 +49,45 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Literal
 
-from deformap._validation import check_int, check_positive, check_slope_deg, check_vector
-from deformap.errors import InvalidArgumentError
-from deformap.explore._acquisition import STRATEGIES
+from deformap._validation import SettingError, check_settings, setting
+from deformap.environment import Workspace
+from deformap.explore._acquisition import Strategy
 from deformap.msm import ShapeMatchingConfig
 
 __all__ = [
+    "MAX_MAP_CELLS",
+    "MAX_PLAN_CELLS",
+    "MAX_ROI_BAND_BYTES",
     "BetaFieldConfig",
     "ExplorationConfig",
+    "RegionLabels",
+    "StopRegion",
     "SurfaceGPConfig",
     "TouchGPConfig",
+    "TouchModel",
+    "check_exploration_budget",
 ]
+
+#: How the touch GP models the dent (``TouchGPConfig.model``).
+TouchModel = Literal["residual", "height"]
+#: Where the variance must fall below ``T_h`` (``ExplorationConfig.stop_region``).
+StopRegion = Literal["workspace", "targets"]
+#: How cells get their region (``ExplorationConfig.region_labels``).
+RegionLabels = Literal["isopleth", "nearest"]
+
+#: Most bytes of one band of the ROI's shape-matching system (:mod:`deformap.msm._linsys`): the
+#: β sweep holds its two assembled bands and a few factorisations of that size at once, so 512 MiB
+#: keeps the sweep within a few GiB.
+MAX_ROI_BAND_BYTES = 512 * 2**20
+#: Most cells of the map grid: every map is a dense grid, and the ``min-max-variance`` look-ahead
+#: holds a (256 candidates × cells) float64 matrix, 2 GB at this size.
+MAX_MAP_CELLS = 1_000_000
+#: Most cells of the planner's 2 cm grids (``planned``, ``min-max-variance``): it holds
+#: (candidates × domain) and (candidates × candidates) float64 kernel matrices, 0.8 GB each at
+#: this size (4 m² of workspace).
+MAX_PLAN_CELLS = 10_000
+#: Spacing of the planner's grids (``explore._mapper._PLAN_DOMAIN_M``; a test keeps them equal).
+_PLAN_GRID_M = 0.02
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -68,31 +96,28 @@ class SurfaceGPConfig:
 
     z_min_m: float = -0.02
     z_max_m: float = 0.30
-    outlier_k: int = 20
-    outlier_std_ratio: float = 2.0
-    max_slope_deg: float = 60.0
-    min_length_scale_m: float = 0.03
+    # each point's k neighbours are held at once (n·k distances and indices)
+    outlier_k: int = setting(20, ge=2, le=1000)
+    outlier_std_ratio: float = setting(2.0, gt=0.0)
+    max_slope_deg: float = setting(60.0, gt=0.0, le=90.0)
+    min_length_scale_m: float = setting(0.03, gt=0.0)
     fit_hyperparameters: bool = True
-    max_fit_points: int = 800
-    fit_restarts: int = 1
-    length_scale_m: float = 0.04
-    signal_std_m: float = 0.03
-    noise_std_m: float = 0.002
-    grid_spacing_m: float = 0.005
+    # each likelihood evaluation factorises an n × n matrix: 10⁴ points is 0.8 GB and ~3·10¹¹ flops
+    max_fit_points: int = setting(800, ge=50, le=10_000)
+    fit_restarts: int = setting(1, ge=0, le=100)  # each restart is a whole optimisation
+    length_scale_m: float = setting(0.04, gt=0.0)
+    signal_std_m: float = setting(0.03, gt=0.0)
+    noise_std_m: float = setting(0.002, gt=0.0)
+    # below 1 mm is finer than a depth camera resolves on a table (a pixel spans millimetres at
+    # a metre), while every map's cell count grows as 1 / spacing²
+    grid_spacing_m: float = setting(0.005, gt=0.0, ge=0.001)
 
     def __post_init__(self) -> None:
+        check_settings(self)
         if self.z_max_m <= self.z_min_m:
-            raise InvalidArgumentError(
-                f"`z_max_m` must exceed `z_min_m`; got {self.z_min_m} and {self.z_max_m}"
+            raise SettingError(
+                "z_max_m", f"must exceed `z_min_m` ({self.z_min_m}); got {self.z_max_m}"
             )
-        check_int("outlier_k", self.outlier_k, minimum=2)
-        check_positive("outlier_std_ratio", self.outlier_std_ratio)
-        check_slope_deg("max_slope_deg", self.max_slope_deg)
-        check_int("max_fit_points", self.max_fit_points, minimum=50)
-        check_int("fit_restarts", self.fit_restarts, minimum=0)
-        for name in ("length_scale_m", "signal_std_m", "noise_std_m", "grid_spacing_m",
-                     "min_length_scale_m"):
-            check_positive(name, getattr(self, name))
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -104,49 +129,38 @@ class TouchGPConfig:
     ``ShapeMatchingConfig.uncertainty`` (the tile bootstrap of E(β) by default).
     """
 
-    roi_size_m: float = 0.12
-    model: Literal["residual", "height"] = "residual"
-    n_tactile: int = 10
-    tactile_noise_std_m: float = 0.0005
-    robot_margin_m: float = 0.002
-    tip_margin_m: float = 0.003
-    above_surface_m: float = 0.01
-    max_slope_deg: float = 60.0
-    length_scale_m: float = 0.01
-    signal_std_m: float = 0.01
-    noise_std_m: float = 0.002
-    noise_samples: int = 64
+    roi_size_m: float = setting(0.12, gt=0.0)
+    model: TouchModel = "residual"
+    # the tactile points join the touch GP's data; a thousand on a fingertip's cap are already
+    # closer together than the camera's own points
+    n_tactile: int = setting(10, ge=1, le=1000)
+    tactile_noise_std_m: float = setting(0.0005, gt=0.0)
+    robot_margin_m: float = setting(0.002, ge=0.0)
+    tip_margin_m: float = setting(0.003, ge=0.0)
+    above_surface_m: float = setting(0.01, gt=0.0)
+    max_slope_deg: float = setting(60.0, gt=0.0, le=90.0)
+    length_scale_m: float = setting(0.01, gt=0.0)
+    signal_std_m: float = setting(0.01, gt=0.0)
+    noise_std_m: float = setting(0.002, gt=0.0)
+    # each draw re-reads β̂ over the whole E(β) sweep: the cost is linear in the draws
+    noise_samples: int = setting(64, ge=0, le=10_000)
 
     def __post_init__(self) -> None:
-        check_positive("roi_size_m", self.roi_size_m)
-        check_int("n_tactile", self.n_tactile, minimum=1)
-        check_int("noise_samples", self.noise_samples, minimum=0)
+        check_settings(self)
         if self.noise_samples == 1:
-            raise InvalidArgumentError("`noise_samples` must be 0 (off) or at least 2; got 1")
-        check_positive("robot_margin_m", self.robot_margin_m, allow_zero=True)
-        check_positive("tip_margin_m", self.tip_margin_m, allow_zero=True)
-        check_slope_deg("max_slope_deg", self.max_slope_deg)
-        for name in (
-            "tactile_noise_std_m",
-            "length_scale_m",
-            "signal_std_m",
-            "noise_std_m",
-            "above_surface_m",
-        ):
-            check_positive(name, getattr(self, name))
+            raise SettingError("noise_samples", "must be 0 (off) or at least 2; got 1")
 
 
 @dataclass(frozen=True, kw_only=True)
 class BetaFieldConfig:
     """Prior of the β-field Gaussian random field (the paper's σe, σw, σn)."""
 
-    signal_std: float = 0.3
-    length_scale_m: float = 0.2
-    noise_floor: float = 0.03
+    signal_std: float = setting(0.3, gt=0.0)
+    length_scale_m: float = setting(0.2, gt=0.0)
+    noise_floor: float = setting(0.03, gt=0.0)
 
     def __post_init__(self) -> None:
-        for name in ("signal_std", "length_scale_m", "noise_floor"):
-            check_positive(name, getattr(self, name))
+        check_settings(self)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -188,39 +202,91 @@ class ExplorationConfig:
         rule, stops there.
     """
 
-    threshold: float = 0.06
-    max_pokes: int = 12
-    strategy: Literal["paper", "max-variance", "min-max-variance", "planned"] = "planned"
+    threshold: float = setting(0.06, gt=0.0)
+    # every poke is a press and a β sweep (seconds), and the β-field's and the planner's matrices
+    # grow with the pokes
+    max_pokes: int = setting(12, ge=1, le=1000)
+    strategy: Strategy = "planned"
     first_target: tuple[float, float] | None = None
-    stop_region: Literal["workspace", "targets"] = "workspace"
-    force_n: float = 0.6
-    max_regions: int = 6
-    region_prior_dof: float = 7.0
-    region_labels: Literal["isopleth", "nearest"] = "isopleth"
-    boundary_pokes: int = 0
+    stop_region: StopRegion = "workspace"
+    force_n: float = setting(0.6, gt=0.0)
+    max_regions: int = setting(6, ge=1)
+    region_prior_dof: float = setting(7.0, ge=0.0)
+    region_labels: RegionLabels = "isopleth"
+    boundary_pokes: int = setting(0, ge=0, le=1000)  # as for max_pokes
     surface: SurfaceGPConfig = field(default_factory=SurfaceGPConfig)
     touch: TouchGPConfig = field(default_factory=TouchGPConfig)
     beta_field: BetaFieldConfig = field(default_factory=BetaFieldConfig)
     shape_matching: ShapeMatchingConfig = field(default_factory=ShapeMatchingConfig)
 
     def __post_init__(self) -> None:
-        check_positive("threshold", self.threshold)
-        check_int("max_pokes", self.max_pokes, minimum=1)
-        if self.strategy not in STRATEGIES:
-            raise InvalidArgumentError(
-                f"`strategy` must be one of {list(STRATEGIES)}; got {self.strategy!r}"
+        check_settings(self)
+        self._check_roi()
+
+    def _check_roi(self) -> None:
+        """The ROI's particle grid (``Mapper.roi_grid``: the surface grid's spacing, an odd node
+        count per side) must hold one cluster and keep its linear system's band within
+        :data:`MAX_ROI_BAND_BYTES` (half-width as in :mod:`deformap.msm._linsys`)."""
+        spacing = self.surface.grid_spacing_m
+        side = 2 * round(self.touch.roi_size_m / spacing / 2) + 1
+        sm = self.shape_matching
+        k, nz = sm.cluster_size, sm.body_layers + 1
+        where = f"at `surface.grid_spacing_m` = {spacing:g} m"
+        if side < k:
+            raise SettingError(
+                "touch.roi_size_m",
+                f"must span at least `shape_matching.cluster_size` = {k} grid nodes per side "
+                f"{where}; got {self.touch.roi_size_m:g} m ({side} nodes)",
             )
-        if self.stop_region not in ("workspace", "targets"):
-            raise InvalidArgumentError(
-                f"`stop_region` must be one of ['workspace', 'targets']; got {self.stop_region!r}"
+        half_width = (k - 1) * (side * nz + nz) + nz - 1
+        band = 8 * side * side * nz * (half_width + 1)
+        if band > MAX_ROI_BAND_BYTES:
+            raise SettingError(
+                "touch.roi_size_m",
+                f"makes a shape-matching body of {side} × {side} × {nz} particles {where} "
+                f"(cluster size {k}), whose linear system needs {band / 2**20:,.0f} MiB per band; "
+                f"at most {MAX_ROI_BAND_BYTES / 2**20:,.0f} MiB: use a smaller ROI, a coarser "
+                f"grid or fewer `shape_matching.layers`; got {self.touch.roi_size_m:g} m",
             )
-        if self.first_target is not None:
-            check_vector("first_target", self.first_target, 2, what="metres")
-        check_positive("force_n", self.force_n)
-        check_int("max_regions", self.max_regions, minimum=1)
-        check_positive("region_prior_dof", self.region_prior_dof, allow_zero=True)
-        if self.region_labels not in ("isopleth", "nearest"):
-            raise InvalidArgumentError(
-                f"`region_labels` must be one of ['isopleth', 'nearest']; got {self.region_labels!r}"
-            )
-        check_int("boundary_pokes", self.boundary_pokes, minimum=0)
+
+
+def check_exploration_budget(config: ExplorationConfig, workspace: Workspace) -> None:
+    """Refuse, before any work, an exploration whose maps of ``workspace`` would be absurdly large.
+
+    The bounds that depend on a single settings object hold from its construction; these depend
+    on the workspace too. The map grid (``Workspace.grid`` at ``surface.grid_spacing_m``) must
+    have at most :data:`MAX_MAP_CELLS` cells and, for the strategies that plan (``planned``,
+    ``min-max-variance``), the planner's 2 cm grid at most :data:`MAX_PLAN_CELLS`.
+
+    Parameters
+    ----------
+    config : ExplorationConfig
+    workspace : Workspace
+        The rectangle to map (``Environment.workspace``).
+
+    Raises
+    ------
+    SettingError
+        Naming ``surface.grid_spacing_m`` or ``strategy``, the cells asked for and the limit.
+    """
+    if not isinstance(config, ExplorationConfig):
+        raise SettingError("config", f"must be an ExplorationConfig; got {type(config).__name__}")
+    if not isinstance(workspace, Workspace):
+        raise SettingError("workspace", f"must be a Workspace; got {type(workspace).__name__}")
+    (width, depth), spacing = workspace.size, config.surface.grid_spacing_m
+    cells = max(1, round(width / spacing)) * max(1, round(depth / spacing))
+    area = f"a {width:g} × {depth:g} m workspace"
+    if cells > MAX_MAP_CELLS:
+        raise SettingError(
+            "surface.grid_spacing_m",
+            f"makes {cells:,} map cells over {area}; at most {MAX_MAP_CELLS:,}: use a coarser "
+            f"spacing or a smaller workspace; got {spacing:g} m",
+        )
+    plan = (round(width / _PLAN_GRID_M) + 1) * (round(depth / _PLAN_GRID_M) + 1)
+    if config.strategy in ("planned", "min-max-variance") and plan > MAX_PLAN_CELLS:
+        raise SettingError(
+            "strategy",
+            f"{config.strategy!r} plans on {plan:,} cells of {_PLAN_GRID_M * 100:g} cm over "
+            f"{area}; at most {MAX_PLAN_CELLS:,}: use 'max-variance' or 'paper', or a smaller "
+            f"workspace",
+        )

@@ -3,14 +3,18 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Literal
 
-from deformap._validation import check_in_range, check_int, check_positive
-from deformap.errors import InvalidArgumentError
+from deformap._validation import SettingError, check_settings, setting
 
-__all__ = ["ShapeMatchingConfig"]
+__all__ = ["ContactProtocol", "DeformationMode", "ShapeMatchingConfig", "UncertaintyMethod"]
 
-_MODES = ("rigid", "linear", "quadratic")
-_CONTACTS = ("force", "pinned")
+#: Müller et al.'s deformation modes of a cluster.
+DeformationMode = Literal["quadratic", "linear", "rigid"]
+#: How the poke enters the simulation (see ``ShapeMatchingConfig.contact``).
+ContactProtocol = Literal["force", "pinned"]
+#: How ``beta_std`` is obtained (see ``ShapeMatchingConfig.uncertainty``).
+UncertaintyMethod = Literal["bootstrap", "tolerance"]
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -101,23 +105,29 @@ class ShapeMatchingConfig:
         GP's mean error on a 0.5 cm grid.
     """
 
-    mode: str = "quadratic"
-    cluster_size: int = 3
-    contact: str = "force"
-    n_beta: int = 10
+    mode: DeformationMode = "quadratic"
+    cluster_size: int = setting(3, ge=2)
+    contact: ContactProtocol = "force"
+    # each β is one solve of the whole body; 1000 is a step of 0.001, finer than the refinement
+    # ever needs from the sweep
+    n_beta: int = setting(10, ge=2, le=1000)
     refine: bool = True
-    beta_resolution: float = 0.01
-    tol: float = 1e-6
-    sweep_tol: float = 1e-4
-    max_iter: int = 500
-    regularization: float = 1e-3
-    reference_modulus_pa: float = 100e3
-    poisson_ratio: float = 0.5
-    uncertainty: str = "bootstrap"
-    bootstrap_tile_m: float = 0.02
-    error_tolerance_m: float = 1e-4
-    layers: int | None = None
-    layer_growth: float = 2.0
+    beta_resolution: float = setting(0.01, ge=1e-6, le=0.5)
+    tol: float = setting(1e-6, ge=1e-14, lt=1.0)  # below 1e-14 is float64 rounding
+    sweep_tol: float = setting(1e-4, ge=1e-14, lt=1.0)
+    # the cap is what bounds the time of a β that does not converge (each iteration is a pass
+    # over every particle)
+    max_iter: int = setting(500, ge=1, le=100_000)
+    regularization: float = setting(1e-3, ge=0.0, lt=1.0)
+    reference_modulus_pa: float = setting(100e3, gt=0.0)
+    poisson_ratio: float = setting(0.5, ge=-1.0, le=0.5)  # the range of an isotropic solid
+    uncertainty: UncertaintyMethod = "bootstrap"
+    bootstrap_tile_m: float = setting(0.02, gt=0.0)
+    error_tolerance_m: float = setting(1e-4, gt=0.0)
+    # each layer copies the surface's particles and widens the linear system's band, so memory
+    # grows as the square of the layer count: 32 layers is about 70 times the default 3's
+    layers: int | None = setting(None, ge=0, le=32)
+    layer_growth: float = setting(2.0, ge=1.0, le=10.0)
 
     @property
     def coarse_tol(self) -> float:
@@ -138,33 +148,8 @@ class ShapeMatchingConfig:
         return 0 if self.contact == "pinned" else 3
 
     def __post_init__(self) -> None:
-        if self.mode not in _MODES:
-            raise InvalidArgumentError(f"`mode` must be one of {_MODES}; got {self.mode!r}")
-        if self.contact not in _CONTACTS:
-            raise InvalidArgumentError(
-                f"`contact` must be one of {_CONTACTS}; got {self.contact!r}"
-            )
-        check_int("cluster_size", self.cluster_size, minimum=2)
-        check_int("n_beta", self.n_beta, minimum=2)
-        check_int("max_iter", self.max_iter, minimum=1)
-        if not isinstance(self.refine, bool):
-            raise InvalidArgumentError(f"`refine` must be a bool; got {self.refine!r}")
-        check_in_range("beta_resolution", self.beta_resolution, 1e-6, 0.5, closed_high=True)
-        check_in_range("tol", self.tol, 1e-14, 1.0)
-        check_in_range("sweep_tol", self.sweep_tol, 1e-14, 1.0)
+        check_settings(self)
         if self.sweep_tol < self.tol:
-            raise InvalidArgumentError(
-                f"`sweep_tol` must be >= `tol` ({self.tol:g}); got {self.sweep_tol:g}"
+            raise SettingError(
+                "sweep_tol", f"must be >= `tol` ({self.tol:g}); got {self.sweep_tol:g}"
             )
-        check_in_range("regularization", self.regularization, 0.0, 1.0)
-        check_positive("reference_modulus_pa", self.reference_modulus_pa)
-        check_in_range("poisson_ratio", self.poisson_ratio, -1.0, 0.5, closed_high=True)
-        check_positive("error_tolerance_m", self.error_tolerance_m)
-        check_positive("bootstrap_tile_m", self.bootstrap_tile_m)
-        if self.uncertainty not in ("bootstrap", "tolerance"):
-            raise InvalidArgumentError(
-                f"`uncertainty` must be 'bootstrap' or 'tolerance'; got {self.uncertainty!r}"
-            )
-        if self.layers is not None:
-            check_int("layers", self.layers, minimum=0)
-        check_in_range("layer_growth", self.layer_growth, 1.0, 10.0, closed_high=True)

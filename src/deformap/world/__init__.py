@@ -28,7 +28,7 @@ from deformap.world._probe import ProbeGeometry
 from deformap.world._random import random_scenario
 from deformap.world._scenario import BARE_TABLE, Block, Scenario
 from deformap.world._scenario_io import list_scenarios, load_scenario, save_scenario
-from deformap.world._world import SimulatedWorld, WorldConfig
+from deformap.world._world import SimulatedWorld, WorldConfig, check_world_budget
 
 __all__ = [
     "BARE_TABLE",
@@ -39,6 +39,7 @@ __all__ = [
     "Scenario",
     "SimulatedWorld",
     "WorldConfig",
+    "check_world_budget",
     "hardness_to_youngs_modulus",
     "hertz_contact_radius",
     "hertz_indentation",

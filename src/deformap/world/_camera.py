@@ -34,6 +34,7 @@ import numpy as np
 import trimesh
 from numpy.typing import NDArray
 
+from deformap._validation import check_settings, setting
 from deformap.world._raycast import cast_rays
 
 __all__ = ["CameraConfig", "DepthCamera"]
@@ -43,23 +44,56 @@ log = logging.getLogger(__name__)
 
 @dataclass(frozen=True, kw_only=True)
 class CameraConfig:
-    """Settings of the simulated depth camera (defaults: PrimeSense Carmine 1.08 at 45°)."""
+    """Settings of the simulated depth camera (defaults: PrimeSense Carmine 1.08 at 45°).
 
-    width: int = 640
-    height: int = 480
-    fov_deg: tuple[float, float] = (58.0, 45.0)
-    height_m: float = 0.80
-    pitch_deg: float = 45.0
+    Parameters
+    ----------
+    width, height : int
+        Pixels per row and per column; one ray each.
+    fov_deg : (2,) float, degrees
+        Horizontal and vertical field of view, each in ``(0, 180)``.
+    height_m : float, metres
+        Height of the optical centre above the table.
+    pitch_deg : float, degrees
+        Angle of the optical axis below the horizontal, in ``(0, 90]`` (90: straight down); the
+        axis passes through the workspace centre.
+    noise : bool
+        False turns off flying pixels, axial noise and quantisation.
+    sigma_base_m, sigma_quadratic_m, sigma_reference_m : float, metres
+        Axial noise ``σ_z = sigma_base + sigma_quadratic·(z − sigma_reference)²``.
+    baseline_m : float, metres
+        Projector–sensor baseline ``b`` of the disparity.
+    subpixel : float
+        Disparity resolution is ``1 / subpixel`` pixel.
+    grazing_deg : float, degrees
+        No return beyond this angle between the ray and the surface normal, in ``(0, 90]``.
+    edge_jump_m : float, metres
+        Depth jump to a neighbour that makes a pixel a flying-pixel candidate.
+    flying_probability : float
+        Probability in ``[0, 1]`` that a candidate pixel flies.
+    use_embree : bool
+        Use trimesh's Embree ray caster when ``embreex`` is installed.
+    """
+
+    # a ray per pixel, with a few float64 arrays each: 4096 × 4096 rays is gigabytes per frame
+    width: int = setting(640, ge=1, le=4096)
+    height: int = setting(480, ge=1, le=4096)
+    fov_deg: tuple[float, float] = setting((58.0, 45.0), gt=0.0, lt=180.0)
+    height_m: float = setting(0.80, gt=0.0)
+    pitch_deg: float = setting(45.0, gt=0.0, le=90.0)  # at 0 the camera would sit infinitely far
     noise: bool = True
-    sigma_base_m: float = 0.0012
-    sigma_quadratic_m: float = 0.0019
-    sigma_reference_m: float = 0.4
-    baseline_m: float = 0.075
-    subpixel: float = 8.0
-    grazing_deg: float = 80.0
-    edge_jump_m: float = 0.02
-    flying_probability: float = 0.3
+    sigma_base_m: float = setting(0.0012, ge=0.0)
+    sigma_quadratic_m: float = setting(0.0019, ge=0.0)
+    sigma_reference_m: float = setting(0.4, ge=0.0)
+    baseline_m: float = setting(0.075, gt=0.0)
+    subpixel: float = setting(8.0, gt=0.0)
+    grazing_deg: float = setting(80.0, gt=0.0, le=90.0)
+    edge_jump_m: float = setting(0.02, gt=0.0)
+    flying_probability: float = setting(0.3, ge=0.0, le=1.0)
     use_embree: bool = True
+
+    def __post_init__(self) -> None:
+        check_settings(self)
 
 
 class DepthCamera:

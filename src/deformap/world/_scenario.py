@@ -31,7 +31,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from deformap._validation import check_array
+from deformap._validation import SettingError, check_array, check_settings, setting
 from deformap.environment import Workspace
 from deformap.errors import InvalidArgumentError
 from deformap.world._hardness import hardness_to_youngs_modulus, youngs_modulus_to_hardness
@@ -43,12 +43,16 @@ from deformap.world._polygon import (
     rectangle,
 )
 
-__all__ = ["BARE_TABLE", "Block", "Scenario", "builtin_scenarios"]
+__all__ = ["BARE_TABLE", "MAX_EXTENT_M", "Block", "Scenario", "builtin_scenarios"]
 
 BARE_TABLE = -1
 """Ground-truth label of table area that no block covers."""
 
 _OVERLAP_TOL_M2 = 1e-8  # 1 mm² of shared area is a real overlap, less is rounding of touching edges
+#: Largest side of a workspace and of a block's footprint, and largest block thickness, in metres:
+#: a table-top scene, ten metres beyond what any arm over a table reaches, while every map and
+#: every mesh grows with the area.
+MAX_EXTENT_M = 10.0
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -60,9 +64,10 @@ class Block:
     name : str
         Region name used in reports (``"soft"``, ``"60 N foam"``).
     polygon : (k, 2) float, metres
-        Convex footprint, ``k >= 3``; stored counter-clockwise.
+        Convex footprint, ``k >= 3``, at most :data:`MAX_EXTENT_M` across on each axis; stored
+        counter-clockwise.
     thickness_m : float
-        Height of the block's top above the table; > 0.
+        Height of the block's top above the table, in ``(0, MAX_EXTENT_M]``.
     hardness_n : float or None
         ISO 2439 hardness in newtons; give this or ``youngs_modulus_pa`` for foam.
     youngs_modulus_pa : float or None
@@ -75,14 +80,18 @@ class Block:
 
     name: str
     polygon: NDArray[np.float64]
-    thickness_m: float = 0.05
-    hardness_n: float | None = None
-    youngs_modulus_pa: float | None = None
+    thickness_m: float = setting(0.05, gt=0.0, le=MAX_EXTENT_M)
+    hardness_n: float | None = setting(None, gt=0.0)
+    youngs_modulus_pa: float | None = setting(None, gt=0.0)
     rigid: bool = False
     color: str = "#c8a165"
 
     def __post_init__(self) -> None:
-        if not isinstance(self.name, str) or not self.name:
+        try:
+            check_settings(self)
+        except SettingError as exc:
+            raise SettingError(exc.field, f"{exc.detail} (block {self.name!r})") from None
+        if not self.name:
             raise InvalidArgumentError(
                 f"block `name` must be a non-empty string; got {self.name!r}")
         poly = check_array(f"block {self.name!r} polygon", self.polygon, (None, 2),
@@ -95,15 +104,15 @@ class Block:
                 f"block {self.name!r} polygon must be convex with a positive area; "
                 f"got area {area:.3g} m², convex={is_convex(poly)}"
             )
+        extent = poly.max(axis=0) - poly.min(axis=0)
+        if np.any(extent > MAX_EXTENT_M):
+            raise SettingError(
+                "polygon", f"must span at most {MAX_EXTENT_M:g} m on each axis; got "
+                f"{extent[0]:g} × {extent[1]:g} m (block {self.name!r})"
+            )
         poly.setflags(write=False)
         object.__setattr__(self, "polygon", poly)
         self._check_material()
-        if not (isinstance(self.thickness_m, (int, float)) and np.isfinite(self.thickness_m)
-                and self.thickness_m > 0):
-            raise InvalidArgumentError(
-                f"block {self.name!r} `thickness_m` must be > 0; got {self.thickness_m!r}"
-            )
-        object.__setattr__(self, "thickness_m", float(self.thickness_m))
 
     def _check_material(self) -> None:
         given = [self.hardness_n is not None, self.youngs_modulus_pa is not None, bool(self.rigid)]
@@ -113,14 +122,6 @@ class Block:
                 f"`rigid=True`; got hardness_n={self.hardness_n!r}, "
                 f"youngs_modulus_pa={self.youngs_modulus_pa!r}, rigid={self.rigid!r}"
             )
-        for key in ("hardness_n", "youngs_modulus_pa"):
-            value = getattr(self, key)
-            if value is not None and not (
-                isinstance(value, (int, float)) and not isinstance(value, bool)
-                and np.isfinite(value) and value > 0
-            ):
-                raise InvalidArgumentError(
-                    f"block {self.name!r} `{key}` must be > 0; got {value!r}")
         if self.hardness_n is not None:
             object.__setattr__(self, "youngs_modulus_pa",
                                hardness_to_youngs_modulus(float(self.hardness_n)))
@@ -164,7 +165,7 @@ class Scenario:
     blocks : tuple of Block
         At least one; no two may overlap (touching is fine).
     workspace : Workspace
-        The rectangle to map (60 × 40 cm by default).
+        The rectangle to map (60 × 40 cm by default), at most :data:`MAX_EXTENT_M` on each side.
     description : str
     """
 
@@ -174,10 +175,15 @@ class Scenario:
     description: str = ""
 
     def __post_init__(self) -> None:
-        blocks = tuple(self.blocks)
-        if not blocks or not all(isinstance(b, Block) for b in blocks):
-            raise InvalidArgumentError(
-                f"scenario {self.name!r} needs a non-empty sequence of Block; got {self.blocks!r}"
+        check_settings(self)
+        blocks = self.blocks
+        if not blocks:
+            raise SettingError("blocks", f"must hold at least one Block (scenario {self.name!r})")
+        size = self.workspace.size
+        if max(size) > MAX_EXTENT_M:
+            raise SettingError(
+                "workspace", f"must span at most {MAX_EXTENT_M:g} m on each axis; got "
+                f"{size[0]:g} × {size[1]:g} m (scenario {self.name!r})"
             )
         names = [b.name for b in blocks]
         if len(set(names)) != len(names):
@@ -190,7 +196,6 @@ class Scenario:
                         f"scenario {self.name!r}: blocks {a.name!r} and {b.name!r} overlap "
                         f"by {area * 1e4:.2f} cm²; blocks may touch but not overlap"
                     )
-        object.__setattr__(self, "blocks", blocks)
 
     @property
     def region_names(self) -> list[str]:

@@ -20,6 +20,7 @@ on the bare table (neither deforms).
 from __future__ import annotations
 
 import logging
+import math
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -27,7 +28,14 @@ import numpy as np
 import trimesh
 from numpy.typing import NDArray
 
-from deformap._validation import check_array, check_positive, check_vector
+from deformap._validation import (
+    SettingError,
+    check_array,
+    check_positive,
+    check_settings,
+    check_vector,
+    setting,
+)
 from deformap.cloud import PointCloud
 from deformap.environment import PressObservation, TactileContact, Workspace
 from deformap.errors import EnvironmentStateError, InvalidArgumentError
@@ -36,7 +44,7 @@ from deformap.world._foam import Dent, FoamModel
 from deformap.world._probe import ProbeGeometry
 from deformap.world._scenario import BARE_TABLE, Block, Scenario
 
-__all__ = ["SimulatedWorld", "WorldConfig"]
+__all__ = ["MAX_FEM_UNKNOWNS", "SimulatedWorld", "WorldConfig", "check_world_budget"]
 
 log = logging.getLogger(__name__)
 
@@ -70,35 +78,25 @@ class WorldConfig:
         How far the table extends beyond the workspace on every side.
     """
 
-    element_size_m: float = 0.0075
-    top_layer_m: float = 0.005
-    layer_growth: float = 1.5
-    poisson_ratio: float = 0.3
-    default_force_n: float = 0.6
-    tip_radius_m: float = 0.01
-    stick_length_m: float = 0.10
-    stick_radius_m: float = 0.006
-    hand_size_m: tuple[float, float, float] = (0.08, 0.06, 0.10)
-    force_noise_n: float = 0.01
+    # finer than 1 mm resolves nothing the 1 cm tip or the camera can tell, and the element count
+    # grows as 1 / size² (see check_world_budget for the mesh as a whole)
+    element_size_m: float = setting(0.0075, gt=0.0, ge=0.001)
+    # the layer count grows as thickness / top layer when the layers do not grow (growth 1)
+    top_layer_m: float = setting(0.005, gt=0.0, ge=0.001)
+    layer_growth: float = setting(1.5, ge=1.0, le=10.0)
+    poisson_ratio: float = setting(0.3, ge=0.0, lt=0.5)  # 0.5 makes the FEM's λ infinite
+    default_force_n: float = setting(0.6, gt=0.0)
+    tip_radius_m: float = setting(0.01, gt=0.0)
+    stick_length_m: float = setting(0.10, gt=0.0)
+    stick_radius_m: float = setting(0.006, gt=0.0)
+    hand_size_m: tuple[float, float, float] = setting((0.08, 0.06, 0.10), gt=0.0)
+    force_noise_n: float = setting(0.01, ge=0.0)
     noise: bool = True
     camera: CameraConfig = field(default_factory=CameraConfig)
-    table_margin_m: float = 0.2
+    table_margin_m: float = setting(0.2, gt=0.0)
 
     def __post_init__(self) -> None:
-        for name in ("element_size_m", "top_layer_m", "default_force_n", "table_margin_m",
-                     "tip_radius_m", "stick_length_m", "stick_radius_m"):
-            check_positive(name, getattr(self, name))
-        hand = check_vector("hand_size_m", self.hand_size_m, 3, what="metres")
-        if np.any(hand <= 0):
-            raise InvalidArgumentError(f"`hand_size_m` must be positive; got {self.hand_size_m}")
-        if not isinstance(self.camera, CameraConfig):
-            raise InvalidArgumentError(f"`camera` must be a CameraConfig; got {type(self.camera)}")
-        check_positive("force_noise_n", self.force_noise_n, allow_zero=True)
-        if not 0.0 <= self.poisson_ratio < 0.5:
-            raise InvalidArgumentError(
-                f"`poisson_ratio` must lie in [0, 0.5); got {self.poisson_ratio!r}")
-        if not self.layer_growth >= 1.0:
-            raise InvalidArgumentError(f"`layer_growth` must be >= 1; got {self.layer_growth!r}")
+        check_settings(self)
 
     @property
     def probe(self) -> ProbeGeometry:
@@ -114,6 +112,54 @@ class WorldConfig:
                                     "camera": CameraConfig(width=320, height=240)}
         settings.update(overrides)
         return cls(**settings)
+
+
+#: Most displacement unknowns (3 per mesh node, all blocks) of the foam FEM: each foam block's
+#: stiffness matrix is factorised once by a sparse direct solver and kept, and on a 3-D mesh its
+#: fill-in grows faster than the unknowns (as N^(4/3) for a 3-D mesh under a nested-dissection
+#: ordering), into gigabytes at a million.
+MAX_FEM_UNKNOWNS = 1_000_000
+
+
+def _layer_count(thickness_m: float, top_m: float, growth: float) -> int:
+    """Upper bound on the layers of :func:`~deformap.world._fem.graded_levels` (no loop, so that
+    an absurd request is refused at once): layers ``top·gⁱ`` until they sum to the thickness."""
+    top = min(top_m, thickness_m)
+    if growth <= 1.0 + 1e-12:
+        return math.ceil(thickness_m / top) + 1
+    return math.ceil(math.log1p(thickness_m * (growth - 1.0) / top) / math.log(growth)) + 1
+
+
+def check_world_budget(config: WorldConfig, scenario: Scenario) -> None:
+    """Refuse, before any work, a world whose foam mesh would be absurdly large.
+
+    Counts the nodes of every block's structured mesh (``element_size_m`` in plane over the
+    block's bounding box, the graded layers of ``top_layer_m`` and ``layer_growth`` through its
+    thickness) and refuses more than :data:`MAX_FEM_UNKNOWNS` unknowns. :class:`SimulatedWorld`
+    calls it first; a run can call it before it starts anything else.
+
+    Raises
+    ------
+    SettingError
+        Naming ``element_size_m``, the unknowns asked for and the limit.
+    """
+    if not isinstance(config, WorldConfig):
+        raise SettingError("config", f"must be a WorldConfig; got {type(config).__name__}")
+    if not isinstance(scenario, Scenario):
+        raise SettingError("scenario", f"must be a Scenario; got {type(scenario).__name__}")
+    size = config.element_size_m
+    unknowns = 0
+    for block in scenario.blocks:
+        extent = block.polygon.max(axis=0) - block.polygon.min(axis=0)
+        nx, ny = (max(1, math.ceil(e / size - 1e-9)) for e in extent)
+        nz = _layer_count(block.thickness_m, config.top_layer_m, config.layer_growth)
+        unknowns += 3 * (nx + 1) * (ny + 1) * (nz + 1)
+    if unknowns > MAX_FEM_UNKNOWNS:
+        raise SettingError(
+            "element_size_m",
+            f"meshes scenario {scenario.name!r} with about {unknowns:,} FEM unknowns; at most "
+            f"{MAX_FEM_UNKNOWNS:,}: use larger elements or a thicker `top_layer_m`; got {size:g} m",
+        )
 
 
 class SimulatedWorld:
@@ -144,6 +190,7 @@ class SimulatedWorld:
             raise InvalidArgumentError(f"`rng` must be a numpy.random.Generator; got {type(rng)}")
         self.scenario = scenario
         self.config = config or WorldConfig()
+        check_world_budget(self.config, scenario)
         self._noise_key = int(rng.integers(2**62))
         self._n_observed = 0
         c = self.config
