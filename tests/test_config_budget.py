@@ -17,10 +17,8 @@ from deformap.explore import (
     ExplorationConfig,
     SurfaceGPConfig,
     TouchGPConfig,
-    _mapper,
     check_exploration_budget,
 )
-from deformap.explore import _config as explore_config
 from deformap.explore._acquisition import Strategy
 from deformap.msm import ShapeMatchingConfig
 from deformap.world import Block, Scenario, SimulatedWorld, WorldConfig, check_world_budget
@@ -83,10 +81,6 @@ def test_planning_over_a_workspace_too_large_for_its_matrices_is_refused() -> No
         assert info.value.field == "strategy"
     for strategy in ("max-variance", "paper"):  # no planner: the map grid alone counts
         check_exploration_budget(ExplorationConfig(strategy=strategy), big)
-
-
-def test_the_budget_uses_the_planners_own_grid() -> None:
-    assert explore_config._PLAN_GRID_M == _mapper._PLAN_DOMAIN_M == _mapper._PLAN_CANDIDATE_M
 
 
 def test_a_mesh_too_fine_for_the_scenario_is_refused_before_the_world_is_built(

@@ -86,8 +86,9 @@ MAX_MAP_CELLS = 1_000_000
 #: (candidates × domain) and (candidates × candidates) float64 kernel matrices, 0.8 GB each at
 #: this size (4 m² of workspace).
 MAX_PLAN_CELLS = 10_000
-#: Spacing of the planner's grids (``explore._mapper._PLAN_DOMAIN_M``; a test keeps them equal).
-_PLAN_GRID_M = 0.02
+#: Spacing of the planner's grids (:class:`deformap.explore.MapGrid`'s ``plan_domain`` and
+#: ``plan_candidates``), the budget's and the grid's one value.
+PLAN_GRID_M = 0.02
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -282,11 +283,11 @@ def check_exploration_budget(config: ExplorationConfig, workspace: Workspace) ->
             f"makes {cells:,} map cells over {area}; at most {MAX_MAP_CELLS:,}: use a coarser "
             f"spacing or a smaller workspace; got {spacing:g} m",
         )
-    plan = (round(width / _PLAN_GRID_M) + 1) * (round(depth / _PLAN_GRID_M) + 1)
+    plan = (round(width / PLAN_GRID_M) + 1) * (round(depth / PLAN_GRID_M) + 1)
     if config.strategy in ("planned", "min-max-variance") and plan > MAX_PLAN_CELLS:
         raise SettingError(
             "strategy",
-            f"{config.strategy!r} plans on {plan:,} cells of {_PLAN_GRID_M * 100:g} cm over "
+            f"{config.strategy!r} plans on {plan:,} cells of {PLAN_GRID_M * 100:g} cm over "
             f"{area}; at most {MAX_PLAN_CELLS:,}: use 'max-variance' or 'paper', or a smaller "
             f"workspace",
         )

@@ -16,12 +16,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from deformap.environment import Workspace
-from deformap.explore._config import ExplorationConfig
+from deformap.explore._config import PLAN_GRID_M, ExplorationConfig
 
 __all__ = ["MapGrid"]
-
-_PLAN_DOMAIN_M = 0.02
-_PLAN_CANDIDATE_M = 0.02
 
 
 def _strided(nx: int, ny: int, step_m: float, spacing_m: float,
@@ -79,8 +76,8 @@ class MapGrid:
         lo, hi = np.asarray(workspace.lower) + margin, np.asarray(workspace.upper) - margin
         target = np.all((cells >= lo) & (cells <= hi), axis=1)
         stop = target if config.stop_region == "targets" else np.ones(len(cells), dtype=bool)
-        domain = cells[_strided(xs.size, ys.size, _PLAN_DOMAIN_M, spacing, within=stop)]
-        candidates = cells[_strided(xs.size, ys.size, _PLAN_CANDIDATE_M, spacing, within=target)]
+        domain = cells[_strided(xs.size, ys.size, PLAN_GRID_M, spacing, within=stop)]
+        candidates = cells[_strided(xs.size, ys.size, PLAN_GRID_M, spacing, within=target)]
         return cls(xs, ys, cells, target, stop, domain, candidates)
 
     @property
