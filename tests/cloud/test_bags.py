@@ -17,9 +17,9 @@ from deformap.cloud.io import (
     read_bag_clouds,
     read_bag_static_transform,
     read_bag_wrenches,
+    typestore,
     write_bag,
 )
-from deformap.cloud.io._ros import typestore
 from deformap.errors import FileFormatError, InvalidArgumentError
 
 
