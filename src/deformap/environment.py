@@ -1,7 +1,9 @@
 """The ``Environment`` protocol: all the exploration loop needs from a world or a robot.
 
 The simulated world (:mod:`deformap.world`) and a real robot adapter both implement it, and the loop
-in :mod:`deformap.explore` never knows which one it drives.
+in :mod:`deformap.explore` never knows which one it drives. :class:`TactileContact` is contact
+mechanics, defined in :mod:`deformap.mechanics` (so that the estimator can take it without this
+protocol) and re-exported here: ``deformap.environment.TactileContact`` is the same class.
 
 Frames and units
 ----------------
@@ -30,6 +32,7 @@ from deformap._validation import (
 )
 from deformap.cloud import PointCloud
 from deformap.errors import InvalidArgumentError
+from deformap.mechanics import TactileContact
 
 __all__ = [
     "Environment",
@@ -93,52 +96,6 @@ class Workspace:
 
     def to_dict(self) -> dict[str, list[float]]:
         return {"lower": list(self.lower), "upper": list(self.upper)}
-
-
-@dataclass(frozen=True, kw_only=True)
-class TactileContact:
-    """What the force sensor and proprioception say at the moment of the press.
-
-    Parameters
-    ----------
-    tip_center : (3,) float, metres
-        Centre of the probe's spherical tip in the world frame.
-    force : (3,) float, newtons
-        Force the probe exerts on the surface (it points into the surface: about ``(0, 0, -F)``
-        for a press straight down). The tactile points lie on the tip's cap that faces along it.
-    tip_radius_m : float
-        Radius of the spherical tip.
-    """
-
-    tip_center: NDArray[np.float64]
-    force: NDArray[np.float64]
-    tip_radius_m: float
-
-    def __post_init__(self) -> None:
-        center = check_vector("tip_center", self.tip_center, 3, what="metres")
-        force = check_vector("force", self.force, 3, what="newtons")
-        if not np.any(force):
-            raise InvalidArgumentError("`force` must be a non-zero force vector; got (0, 0, 0)")
-        center.setflags(write=False)
-        force.setflags(write=False)
-        object.__setattr__(self, "tip_center", center)
-        object.__setattr__(self, "force", force)
-        object.__setattr__(self, "tip_radius_m", check_positive("tip_radius_m", self.tip_radius_m))
-
-    @property
-    def force_n(self) -> float:
-        """Magnitude of the contact force in newtons."""
-        return float(np.linalg.norm(self.force))
-
-    @property
-    def direction(self) -> NDArray[np.float64]:
-        """Unit vector of the force the probe exerts on the surface."""
-        return np.asarray(self.force / np.linalg.norm(self.force))
-
-    @property
-    def contact_point(self) -> NDArray[np.float64]:
-        """The point of the tip farthest along the force: where it presses the surface."""
-        return np.asarray(self.tip_center + self.tip_radius_m * self.direction)
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -17,9 +17,9 @@ from deformap.cloud.io import (
     read_bag_clouds,
     read_bag_static_transform,
     read_bag_wrenches,
+    typestore,
     write_bag,
 )
-from deformap.cloud.io._ros import typestore
 from deformap.errors import FileFormatError, InvalidArgumentError
 
 
@@ -253,3 +253,31 @@ def test_sqlite_bags_cut_anywhere_raise_file_format_errors(tmp_path: Path) -> No
             read_bag_clouds(bag, "/pts")
         except FileFormatError:
             pass
+
+
+def test_one_reader_yields_several_topics_in_bag_order(tmp_path: Path, storage: str) -> None:
+    from deformap.cloud.io import iter_bag_messages, pointcloud2_to_cloud
+
+    bag = tmp_path / "bag"
+    series = _wrenches(2)
+    write_bag(bag, storage=storage, clouds={"/pts": [(7, _cloud(4)), (10**9, _cloud(5))]},
+              wrenches={"/ft": series}, cloud_dtype="float64")  # fmt: skip
+    topics = {"/pts": "sensor_msgs/msg/PointCloud2", "/ft": "geometry_msgs/msg/WrenchStamped"}
+    raws = list(iter_bag_messages(bag, topics))
+    times = [m.log_time_ns for m in raws]
+    assert times == sorted(times) and len(raws) == 4
+    assert sorted(m.topic for m in raws) == ["/ft", "/ft", "/pts", "/pts"]
+    first = next(m for m in raws if m.topic == "/pts")
+    msg = typestore().deserialize_cdr(bytes(first.data), topics["/pts"])
+    cloud, dropped = pointcloud2_to_cloud(msg, where="here", frame="world", colors=False)
+    np.testing.assert_array_equal(cloud.points, _cloud(4).points)
+    assert cloud.colors is None and cloud.frame == "world" and dropped == 0
+    with_colors, _ = pointcloud2_to_cloud(msg, where="here")
+    np.testing.assert_array_equal(with_colors.colors, _cloud(4).colors)  # type: ignore[arg-type]
+    assert with_colors.frame == "camera"
+    with pytest.raises(FileFormatError, match=r"no topic '/nope' .*carrying sensor_msgs"):
+        list(iter_bag_messages(bag, {**topics, "/nope": "sensor_msgs/msg/PointCloud2"}))
+    with pytest.raises(FileFormatError, match="topic '/ft' carries geometry_msgs"):
+        list(iter_bag_messages(bag, {"/ft": "sensor_msgs/msg/PointCloud2"}))
+    with pytest.raises(InvalidArgumentError, match="`topics` must be a non-empty mapping"):
+        list(iter_bag_messages(bag, {}))

@@ -12,8 +12,7 @@ from hypothesis import strategies as st
 
 pytest.importorskip("rosbags")
 
-from deformap.cloud.io import array_to_pointcloud2, pointcloud2_to_array
-from deformap.cloud.io._ros import typestore
+from deformap.cloud.io import array_to_pointcloud2, pointcloud2_to_array, typestore
 from deformap.errors import InvalidArgumentError, MissingDependencyError
 
 _CODES = {"f4": (7, "f", 4), "f8": (8, "d", 8), "u2": (4, "H", 2), "u4": (6, "I", 4)}

@@ -5,7 +5,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from deformap.cloud import DEFAULT_CAP_HALF_ANGLE_DEG, tactile_points, tactile_points_from_contact
+from deformap.cloud import DEFAULT_CAP_HALF_ANGLE_DEG, tactile_points
 from deformap.environment import TactileContact
 from deformap.errors import InvalidArgumentError
 
@@ -60,13 +60,12 @@ def test_tactile_points_spread_over_the_cap_evenly_in_area() -> None:
     assert counts.min() >= 399 and counts.max() <= 401
 
 
-def test_tactile_points_from_contact_matches_the_array_form() -> None:
+def test_the_first_tactile_point_is_the_contact_point_of_the_contact() -> None:
     contact = TactileContact(
         tip_center=np.array([0.1, 0.2, 0.03]), force=np.array([1.0, 0.0, -4.0]), tip_radius_m=0.008
     )
-    pts = tactile_points_from_contact(contact, 12)
-    np.testing.assert_array_equal(pts, tactile_points([0.1, 0.2, 0.03], [1.0, 0, -4.0], 0.008, 12))
-    np.testing.assert_allclose(pts[0], contact.contact_point)
+    pts = tactile_points(contact.tip_center, contact.force, contact.tip_radius_m, 12)
+    np.testing.assert_allclose(pts[0], contact.contact_point, rtol=0, atol=1e-15)
 
 
 @pytest.mark.parametrize(
@@ -91,8 +90,3 @@ def test_tactile_points_refuse_bad_input(kwargs: dict[str, object], message: str
     args.update(kwargs)
     with pytest.raises(InvalidArgumentError, match=message):
         tactile_points(**args)  # type: ignore[arg-type]
-
-
-def test_tactile_points_from_contact_refuses_other_types() -> None:
-    with pytest.raises(InvalidArgumentError, match="TactileContact; got tuple"):
-        tactile_points_from_contact((0, 0, 0))  # type: ignore[arg-type]

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from deformap.errors import InvalidArgumentError
-from deformap.explore._dent_noise import dent_error_samples
-from deformap.gp import GaussianRandomField
+from deformap.explore._dent_noise import DENT_NOISE_SEED, dent_error_samples
+from deformap.gp import GaussianRandomField, squared_exponential
 
 XS = 0.30 + np.arange(-6, 7) * 0.005
 YS = 0.20 + np.arange(-6, 7) * 0.005
@@ -71,3 +71,28 @@ def test_the_camera_noise_is_measured_robustly() -> None:
     residuals[:200] = 0.05  # flying pixels and the dent's rim
     assert _robust_std(residuals) == pytest.approx(0.0016, rel=0.12)
     assert _robust_std(np.zeros(5)) == 1e-6 and _robust_std(np.zeros(0)) == 1e-6
+
+
+def test_draws_are_the_dense_smoother_on_the_binned_points_and_the_reference_values() -> None:
+    rng = np.random.default_rng(0)
+    xy = rng.uniform([XS[0], YS[0]], [XS[-1], YS[-1]], size=(300, 2))
+    tactile = np.array([[0.30, 0.20]])
+    draws = dent_error_samples(XS, YS, xy, 0.002, tactile, 5e-4, n_samples=3, **KERNEL)
+    # the same draws by the dense formula K*ₓ (K + Σ)⁻¹ ε over the binned nodes
+    ix = np.rint((xy[:, 0] - XS[0]) / 0.005).astype(int)
+    iy = np.rint((xy[:, 1] - YS[0]) / 0.005).astype(int)
+    counts = np.bincount(iy * XS.size + ix, minlength=XS.size * YS.size)
+    gx, gy = np.meshgrid(XS, YS)
+    nodes = np.column_stack([gx.ravel(), gy.ravel()])
+    data = np.vstack([nodes[counts > 0], tactile])
+    sigma = np.concatenate([0.002 / np.sqrt(counts[counts > 0]), [5e-4]])
+    eps = sigma[:, None] * np.random.default_rng(DENT_NOISE_SEED).standard_normal((len(data), 3))
+    k = squared_exponential(data, data, length_scale=0.01, signal_std=0.01) + np.diag(sigma**2)
+    want = squared_exponential(nodes, data, length_scale=0.01, signal_std=0.01) @ np.linalg.solve(
+        k, eps)
+    np.testing.assert_allclose(draws, want.T, rtol=1e-6, atol=1e-12)
+    # reference values recorded before the smoother moved to deformap.gp
+    np.testing.assert_allclose(draws[:, [0, 84, 168]], [
+        [2.84683230e-03, 3.10594242e-05, -1.93929342e-03],
+        [-6.53373005e-04, -8.88782277e-04, -1.28122519e-03],
+        [-1.95187594e-04, 6.58626403e-04, 1.05702950e-03]], rtol=1e-8, atol=1e-14)

@@ -9,6 +9,7 @@ import pytest
 from msm_cases import dent_case
 
 from deformap.environment import TactileContact
+from deformap.mechanics import hertz_indentation
 from deformap.msm import (
     ParticleGrid,
     ShapeMatchingConfig,
@@ -16,7 +17,7 @@ from deformap.msm import (
     shape_matching_goals,
     simulate_poke,
 )
-from deformap.msm._poke import force_weights, hertz_depth
+from deformap.msm._poke import force_weights
 
 
 def _grid(xs, ys, z):
@@ -92,8 +93,8 @@ def test_force_calibration_makes_beta_zero_dent_like_the_reference_half_space(mo
     sim = simulate_poke(g.rest, g.masses, g.fixed, contact, np.array([0.0]), cfg)
     w = force_weights(g.rest, g.fixed, contact, g.spacing_m)
     depth = float(np.sum(w * (g.rest[..., 2] - sim.positions[0, ..., 2])))
-    want = hertz_depth(contact.force_n, contact.tip_radius_m, cfg.reference_modulus_pa,
-                       cfg.poisson_ratio)
+    want = hertz_indentation(contact.force_n, contact.tip_radius_m, cfg.reference_modulus_pa,
+                             cfg.poisson_ratio)
     assert depth == pytest.approx(want, rel=2e-3)
 
 

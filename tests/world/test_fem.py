@@ -7,8 +7,13 @@ import pytest
 from skfem import Basis, ElementHex1, ElementVectorH1, MeshHex, asm
 from skfem.models.elasticity import lame_parameters, linear_elasticity
 
-from deformap.world import Block, Scenario, hertz_contact_radius, hertz_indentation
-from deformap.world._contact import hertz_pressure_samples
+from deformap.world import (
+    Block,
+    Scenario,
+    hertz_contact_radius,
+    hertz_indentation,
+    hertz_pressure_samples,
+)
 from deformap.world._fem import FoamBody, HexGrid, graded_levels
 from deformap.world._foam import FoamModel
 from deformap.world._polygon import rectangle

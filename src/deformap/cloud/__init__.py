@@ -14,11 +14,7 @@ from deformap.cloud._filters import (
     statistical_outlier_mask,
 )
 from deformap.cloud._pointcloud import PointCloud
-from deformap.cloud._tactile import (
-    DEFAULT_CAP_HALF_ANGLE_DEG,
-    tactile_points,
-    tactile_points_from_contact,
-)
+from deformap.cloud._tactile import DEFAULT_CAP_HALF_ANGLE_DEG, tactile_points
 
 __all__ = [
     "DEFAULT_CAP_HALF_ANGLE_DEG",
@@ -29,5 +25,4 @@ __all__ = [
     "points_in_hull",
     "statistical_outlier_mask",
     "tactile_points",
-    "tactile_points_from_contact",
 ]

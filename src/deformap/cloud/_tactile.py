@@ -13,7 +13,7 @@ and Position-based Dynamics", HUMANOIDS 2016, Sec. III ("The algorithm process f
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -21,10 +21,7 @@ from numpy.typing import NDArray
 from deformap._validation import check_finite_scalar, check_int, check_positive, check_vector
 from deformap.errors import InvalidArgumentError
 
-if TYPE_CHECKING:
-    from deformap.environment import TactileContact
-
-__all__ = ["DEFAULT_CAP_HALF_ANGLE_DEG", "tactile_points", "tactile_points_from_contact"]
+__all__ = ["DEFAULT_CAP_HALF_ANGLE_DEG", "tactile_points"]
 
 #: Half-angle of the touching cap, measured at the tip's centre from the force direction.
 #: A 30° cap reaches ``r (1 - cos 30°) ≈ 0.13 r`` up from the pole: for a 1 cm tip that is 1.3 mm,
@@ -101,30 +98,3 @@ def tactile_points(
         + (sin_theta * np.sin(phi))[:, None] * e2
     )
     return np.asarray(center + radius * directions)
-
-
-def tactile_points_from_contact(
-    contact: TactileContact,
-    n: int = 10,
-    *,
-    cap_half_angle_deg: float = DEFAULT_CAP_HALF_ANGLE_DEG,
-) -> NDArray[np.float64]:
-    """:func:`tactile_points` for a :class:`~deformap.environment.TactileContact`.
-
-    Returns
-    -------
-    points : (n, 3) float, metres
-    """
-    from deformap.environment import TactileContact
-
-    if not isinstance(contact, TactileContact):
-        raise InvalidArgumentError(
-            f"`contact` must be a deformap.environment.TactileContact; got {type(contact).__name__}"
-        )
-    return tactile_points(
-        contact.tip_center,
-        contact.force,
-        contact.tip_radius_m,
-        n,
-        cap_half_angle_deg=cap_half_angle_deg,
-    )

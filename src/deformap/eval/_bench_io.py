@@ -89,9 +89,9 @@ def _bench_pointcloud2(cloud: PointCloud, tmp: Path, repeats: int) -> dict[str, 
             array_to_pointcloud2,
             pointcloud2_to_array,
             read_bag_clouds,
+            typestore,
             write_bag,
         )
-        from deformap.cloud.io._ros import typestore
 
         store = typestore()
     except ImportError:  # MissingDependencyError is an ImportError too

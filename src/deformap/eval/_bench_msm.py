@@ -21,9 +21,14 @@ from scipy.spatial import cKDTree
 
 from deformap._validation import check_int
 from deformap.errors import InvalidArgumentError
-from deformap.msm import ParticleGrid, ShapeMatchingConfig, estimate_beta, simulate_poke
-from deformap.msm._beta import matching_error
-from deformap.testing import elastic_dent, hardness_to_modulus
+from deformap.mechanics import elastic_dent, hardness_to_youngs_modulus
+from deformap.msm import (
+    ParticleGrid,
+    ShapeMatchingConfig,
+    estimate_beta,
+    matching_error,
+    simulate_poke,
+)
 
 __all__ = ["bench_beta_sweep"]
 
@@ -87,7 +92,7 @@ def dent_problem(n: int, rng: np.random.Generator) -> tuple[Any, Any, Any, Any, 
     ys = 0.20 + (np.arange(n) - (n - 1) / 2) * _SPACING_M
     z = np.full((n, n), 0.05)
     zd, contact = elastic_dent(xs, ys, z, (0.30, 0.20), force_n=0.5, tip_radius_m=0.01,
-                               modulus_pa=hardness_to_modulus(60.0))
+                               modulus_pa=hardness_to_youngs_modulus(60.0))
     gx, gy = np.meshgrid(xs, ys)
     pts = np.column_stack([gx.ravel(), gy.ravel(), (zd + rng.normal(scale=_NOISE_M,
                                                                     size=zd.shape)).ravel()])

@@ -18,18 +18,17 @@ cells are half the kernel's length scale or less. The tactile points enter as th
 References
 ----------
 Rasmussen, C. E., Williams, C. K. I. (2006). Gaussian Processes for Machine Learning, Eq. 2.23
-and §2.6 (the mean as a linear smoother).
+and §2.6 (the mean as a linear smoother, :func:`deformap.gp.apply_smoother`).
 """
 
 from __future__ import annotations
 
 import numpy as np
-import scipy.linalg as sla
 from numpy.typing import NDArray
 
 from deformap._validation import check_array, check_int, check_positive
 from deformap.errors import InvalidArgumentError
-from deformap.gp import cholesky_with_jitter, squared_exponential
+from deformap.gp import apply_smoother
 
 __all__ = ["DENT_NOISE_SEED", "dent_error_samples"]
 
@@ -93,11 +92,8 @@ def dent_error_samples(
     data = np.vstack([nodes[seen], extra])
     noise = np.concatenate([points_noise_m / np.sqrt(counts[seen]),
                             np.full(extra.shape[0], extra_noise_m)])  # fmt: skip
-    kern = {"length_scale": length_scale_m, "signal_std": 1.0}  # in units of σe
-    gram = squared_exponential(data, data, **kern) + np.diag((noise / signal_std_m) ** 2)
-    factor, _ = cholesky_with_jitter(gram, jitter=1e-10, max_jitter=1e-4,
-                                     what="the binned touch GP's matrix")  # fmt: skip
     rng = np.random.default_rng(DENT_NOISE_SEED)
     noise_draws = noise[:, None] * rng.standard_normal((data.shape[0], n_samples))
-    weights = sla.cho_solve(factor, noise_draws, check_finite=False)
-    return np.asarray(squared_exponential(nodes, data, **kern) @ weights).T
+    smoothed = apply_smoother(data, noise, nodes, noise_draws, length_scale=length_scale_m,
+                              signal_std=signal_std_m, jitter=1e-10, max_jitter=1e-4)
+    return np.asarray(smoothed.T)

@@ -21,7 +21,8 @@ a plan made at the first poke needs 5 (README, Results).
 
 References
 ----------
-Rasmussen, C. E., Williams, C. K. I. (2006). Gaussian Processes for Machine Learning, Eq. 2.26.
+Rasmussen, C. E., Williams, C. K. I. (2006). Gaussian Processes for Machine Learning, Eq. 2.26
+(the posterior algebra is :class:`deformap.gp.PosteriorDesign`).
 Fedorov, V. V. (1972). Theory of Optimal Experiments. Academic Press (the exchange algorithm).
 """
 
@@ -30,12 +31,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.linalg as sla
 from numpy.typing import NDArray
 
 from deformap._validation import check_array, check_int, check_positive
 from deformap.errors import InvalidArgumentError
-from deformap.gp import cholesky_with_jitter, squared_exponential
+from deformap.gp import PosteriorDesign
 
 __all__ = ["PokePlan", "VarianceDesign", "plan_pokes"]
 
@@ -64,50 +64,20 @@ class PokePlan:
 
 
 class VarianceDesign:
-    """The β-field's posterior over ``domain`` for the pokes made plus chosen candidates."""
+    """The planner's view of the β-field's posterior (:class:`deformap.gp.PosteriorDesign`): the
+    pokes made, the candidates, the domain, and the score of each candidate added."""
 
     def __init__(self, poked_xy: Array, poked_noise: Array, candidates: Array, domain: Array,
                  signal_std: float, length_scale: float, new_noise: float):
-        kern = {"length_scale": length_scale, "signal_std": signal_std}
-        self.prior = signal_std**2
-        self.new_var = new_noise**2
-        self.poked_noise = poked_noise
-        self.k_pp = squared_exponential(poked_xy, poked_xy, **kern)
-        self.k_pc = squared_exponential(poked_xy, candidates, **kern)
-        self.k_pd = squared_exponential(poked_xy, domain, **kern)
-        self.k_cc = squared_exponential(candidates, candidates, **kern)
-        self.k_cd = squared_exponential(candidates, domain, **kern)
-
-    def posterior(self, chosen: list[int]) -> tuple[Array, Array, Array]:
-        """Variance on the domain ``(d,)``, candidate–domain covariance ``(c, d)`` and the
-        candidates' variance ``(c,)`` given the pokes made and the ``chosen`` candidates."""
-        idx = np.asarray(chosen, dtype=np.int64)
-        noise = np.concatenate([self.poked_noise**2, np.full(idx.size, self.new_var)])
-        k_ss = np.block([[self.k_pp, self.k_pc[:, idx]],
-                         [self.k_pc[:, idx].T, self.k_cc[np.ix_(idx, idx)]]])
-        if k_ss.size == 0:
-            return (np.full(self.k_cd.shape[1], self.prior), self.k_cd.copy(),
-                    np.full(self.k_cd.shape[0], self.prior))
-        # factor the covariance scaled to unit prior variance (the jitter is relative to σe²)
-        (chol, lower), _ = cholesky_with_jitter((k_ss + np.diag(noise)) / self.prior,
-                                                jitter=1e-12, max_jitter=1e-6,
-                                                what="the β-field covariance of the pokes planned")
-        scale = 1.0 / np.sqrt(self.prior)
-        v_d = sla.solve_triangular(chol, scale * np.vstack([self.k_pd, self.k_cd[idx]]),
-                                   lower=lower, check_finite=False)
-        v_c = sla.solve_triangular(chol, scale * np.vstack([self.k_pc, self.k_cc[idx]]),
-                                   lower=lower, check_finite=False)
-        var_d = self.prior - np.sum(v_d**2, axis=0)
-        cov = self.k_cd - v_c.T @ v_d
-        var_c = self.prior - np.sum(v_c**2, axis=0)
-        return var_d, cov, var_c
+        self.gp = PosteriorDesign(poked_xy, poked_noise, candidates, domain,
+                                  length_scale=length_scale, signal_std=signal_std,
+                                  candidate_noise_std=new_noise)  # fmt: skip
 
     def after(self, chosen: list[int], threshold: float) -> tuple[Array, Array]:
         """For each candidate added to ``chosen`` (an exact rank-one update of the posterior):
         the variance above ``threshold`` summed over the domain, and the largest variance
         ``(c,)`` each."""
-        var_d, cov, var_c = self.posterior(chosen)
-        after = var_d[None, :] - cov**2 / (var_c + self.new_var)[:, None]
+        after = self.gp.variance_after_adding(chosen)
         excess = np.maximum(after - threshold, 0.0).sum(axis=1)
         return excess, np.asarray(after.max(axis=1))
 
@@ -180,7 +150,7 @@ def plan_pokes(poked_xy: Array, poked_noise: Array, candidates: Array, domain: A
         if best[1] <= threshold:
             break
     # poke first where the field is least known now
-    _, _, var_now = design.posterior([])
+    _, _, var_now = design.gp.posterior([])
     order = sorted(range(len(chosen)), key=lambda i: (-var_now[chosen[i]], i))
     targets = candidates[np.array([chosen[i] for i in order])]
     return PokePlan(targets=np.array(targets, dtype=float), max_variance=best[1],

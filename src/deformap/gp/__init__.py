@@ -1,5 +1,6 @@
-"""Gaussian random fields: the paper's kernel, exact and grid-sparse GP regression, and
-hyperparameter fitting by maximum marginal likelihood.
+"""Gaussian random fields: the paper's kernel, exact and grid-sparse GP regression,
+hyperparameter fitting by maximum marginal likelihood, and the posterior algebra that needs no
+observed values (the variance of a design of observations, the mean's linear smoother).
 
 Shared parameters, in metres (or the units of the modelled value): ``length_scale`` σ_w and
 ``signal_std`` σₑ of the kernel k = σₑ² exp(−‖xᵢ − xⱼ‖² / σ_w²) (no factor 2), and ``noise_std``
@@ -17,15 +18,19 @@ from deformap.gp._hyper import (
     log_marginal_likelihood,
 )
 from deformap.gp._kernels import grid_points, squared_exponential
+from deformap.gp._posterior import PosteriorDesign, apply_smoother, variance_after_adding
 
 __all__ = [
     "AUTO_EXACT_MAX_POINTS",
     "GPHyperparameters",
     "GaussianRandomField",
+    "PosteriorDesign",
+    "apply_smoother",
     "cholesky_with_jitter",
     "default_bounds",
     "fit_hyperparameters",
     "grid_points",
     "log_marginal_likelihood",
     "squared_exponential",
+    "variance_after_adding",
 ]

@@ -19,6 +19,7 @@ from scipy.optimize import minimize
 
 from deformap._validation import check_array, check_int, check_positive, describe
 from deformap.errors import InvalidArgumentError, NotPositiveDefiniteError
+from deformap.gp._kernels import _se_of_sqdist, _sqdist
 
 __all__ = ["GPHyperparameters", "default_bounds", "fit_hyperparameters", "log_marginal_likelihood"]
 
@@ -48,17 +49,12 @@ class GPHyperparameters:
     log_marginal_likelihood: float = float("nan")
 
 
-def _sqdist(xy: NDArray[np.float64]) -> NDArray[np.float64]:
-    """``(n, n)`` squared distances, computed once per optimisation."""
-    return (xy[:, 0, None] - xy[None, :, 0]) ** 2 + (xy[:, 1, None] - xy[None, :, 1]) ** 2
-
-
 def _lml_and_grad(
     theta: NDArray[np.float64], d2: NDArray[np.float64], resid: NDArray[np.float64]
 ) -> tuple[float, NDArray[np.float64]]:
     """log p(r | θ) and its gradient in θ = log(σ_w, σₑ, σₙ); ``d2`` are squared distances."""
     w, s, sn = np.exp(theta)
-    unit = np.exp(-d2 / w**2)
+    unit = _se_of_sqdist(d2, w)  # the kernel of _kernels, on distances computed once
     kmat = s**2 * unit
     kmat[np.diag_indices_from(kmat)] += sn**2
     try:
@@ -108,7 +104,7 @@ def log_marginal_likelihood(
             for name, value in zip(_NAMES, (length_scale, signal_std, noise_std), strict=True)
         ]
     )
-    lml, grad = _lml_and_grad(theta, _sqdist(pts), vals - vals.mean())
+    lml, grad = _lml_and_grad(theta, _sqdist(pts, pts), vals - vals.mean())
     return (lml, grad) if eval_gradient else lml
 
 
@@ -192,7 +188,7 @@ def fit_hyperparameters(
             raise InvalidArgumentError(f"`bounds` must have 0 < low <= high per row; got {box}")
     log_box = np.log(box)
     resid = vals - vals.mean()
-    d2 = _sqdist(pts)
+    d2 = _sqdist(pts, pts)
     starts = [_first_start(init, pts, vals, log_box)]
     starts += [rng.uniform(log_box[:, 0], log_box[:, 1]) for _ in range(n_restarts)]
     best: tuple[float, NDArray[np.float64]] | None = None

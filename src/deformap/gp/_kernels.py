@@ -18,19 +18,26 @@ from deformap._validation import check_array, check_positive
 __all__ = ["grid_points", "squared_exponential"]
 
 
+def _sqdist(x1: NDArray[np.float64], x2: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``(n, m)`` squared distances between validated ``(n, d)`` and ``(m, d)`` arrays."""
+    # Differences, not the expanded quadratic form: at 1e-10 relative accuracy the expansion
+    # cancels badly for coordinates far from the origin (0.6 m apart, σ_w a few cm).
+    d2 = (x1[:, 0, None] - x2[None, :, 0]) ** 2
+    for axis in range(1, x1.shape[1]):
+        d2 += (x1[:, axis, None] - x2[None, :, axis]) ** 2
+    return d2
+
+
+def _se_of_sqdist(d2: NDArray[np.float64], length_scale: float) -> NDArray[np.float64]:
+    """Unit-variance squared exponential exp(−d² / σ_w²) of squared distances ``d2``."""
+    return np.exp(-d2 / length_scale**2)
+
+
 def _se(
     x1: NDArray[np.float64], x2: NDArray[np.float64], length_scale: float
 ) -> NDArray[np.float64]:
     """Unit-variance squared exponential between validated ``(n, d)`` and ``(m, d)`` arrays."""
-    # Differences, not the expanded quadratic form: at 1e-10 relative accuracy the expansion
-    # cancels badly for coordinates far from the origin (0.6 m apart, σ_w a few cm).
-    if x1.shape[1] == 1:
-        d2 = (x1[:, 0, None] - x2[None, :, 0]) ** 2
-    else:
-        d2 = (x1[:, 0, None] - x2[None, :, 0]) ** 2
-        for axis in range(1, x1.shape[1]):
-            d2 += (x1[:, axis, None] - x2[None, :, axis]) ** 2
-    return np.exp(-d2 / length_scale**2)
+    return _se_of_sqdist(_sqdist(x1, x2), length_scale)
 
 
 def _se_1d(

@@ -30,7 +30,7 @@ Deformable Surfaces using Gaussian Processes and Position-based Dynamics. IEEE-R
 
 from __future__ import annotations
 
-from deformap.msm._beta import BetaEstimate, estimate_beta
+from deformap.msm._beta import BetaEstimate, estimate_beta, matching_error
 from deformap.msm._clusters import polar_rotation
 from deformap.msm._config import ShapeMatchingConfig
 from deformap.msm._grid import ParticleGrid
@@ -43,6 +43,7 @@ __all__ = [
     "PokeSimulation",
     "ShapeMatchingConfig",
     "estimate_beta",
+    "matching_error",
     "polar_rotation",
     "shape_matching_goals",
     "simulate_poke",

@@ -11,7 +11,7 @@ from numpy.typing import NDArray
 from scipy.spatial import cKDTree
 
 from deformap._validation import check_points
-from deformap.environment import TactileContact
+from deformap.mechanics import TactileContact
 from deformap.msm._config import ShapeMatchingConfig
 from deformap.msm._grid import ParticleGrid
 from deformap.msm._parabola import parabola_vertex
@@ -96,7 +96,20 @@ def particle_distances(positions: Array, tree: cKDTree) -> Array:
 
 
 def matching_error(positions: Array, tree: cKDTree) -> Array:
-    """E(β) = (1/K) Σ_i min_j ‖g_i(β) − x̄_j‖ for positions ``(B, ny, nx, 3)`` → ``(B,)`` metres."""
+    """The paper's E(β) = (1/K) Σ_i min_j ‖g_i(β) − x̄_j‖ of each simulated body.
+
+    Parameters
+    ----------
+    positions : (B, ny, nx, 3) float, metres
+        Simulated particle positions for ``B`` values of β (``PokeSimulation.positions``).
+    tree : scipy.spatial.cKDTree
+        Built on the observed deformed points ``x̄`` (``(n, 3)``, metres).
+
+    Returns
+    -------
+    (B,) float, metres
+        Mean distance from the ``K`` particles to their nearest observed point.
+    """
     d = particle_distances(positions, tree)
     return np.asarray(d.reshape(d.shape[0], -1).mean(axis=1))
 

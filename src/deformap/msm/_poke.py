@@ -41,12 +41,12 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from deformap.environment import TactileContact
+from deformap.mechanics import TactileContact, hertz_indentation
 from deformap.msm._clusters import Clusters
 from deformap.msm._config import ShapeMatchingConfig
 from deformap.msm._linsys import StepMatrices
 
-__all__ = ["Equilibrium", "PokeSimulation", "force_weights", "hertz_depth"]
+__all__ = ["Equilibrium", "PokeSimulation", "force_weights"]
 
 logger = logging.getLogger(__name__)
 Array = NDArray[np.float64]
@@ -87,13 +87,6 @@ class PokeSimulation:
     converged: NDArray[np.bool_]
     protocol: str
     stiffness_n_per_m: float | None = None
-
-
-def hertz_depth(force_n: float, tip_radius_m: float, modulus_pa: float, poisson: float) -> float:
-    """Hertz depth ``δ = a² / R``, ``a = (3 F R / 4 E*)^(1/3)``, of a sphere on a half-space."""
-    e_star = modulus_pa / (1.0 - poisson**2)
-    a = (3.0 * force_n * tip_radius_m / (4.0 * e_star)) ** (1.0 / 3.0)
-    return float(a * a / tip_radius_m)
 
 
 def force_weights(rest: Array, fixed: NDArray[np.bool_], contact: TactileContact,
@@ -300,8 +293,8 @@ def calibrate_stiffness(eq0: Equilibrium, x_fixed: Array, weights: Array, contac
     f_mag = contact.force_n
     force = weights.reshape(-1, 1) * contact.force[None, :]
     rest = eq0.cl.rest.reshape(-1, 3)
-    delta_ref = hertz_depth(f_mag, contact.tip_radius_m, config.reference_modulus_pa,
-                            config.poisson_ratio)
+    delta_ref = hertz_indentation(f_mag, contact.tip_radius_m, config.reference_modulus_pa,
+                                  config.poisson_ratio)
     k = f_mag / delta_ref  # a first guess: one particle carrying the whole load
     x0 = None
     for _ in range(8):

@@ -8,8 +8,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from deformap._validation import check_array, check_positive
-from deformap.environment import TactileContact
 from deformap.errors import InvalidArgumentError
+from deformap.mechanics import TactileContact
 from deformap.msm._clusters import Clusters
 from deformap.msm._config import ShapeMatchingConfig
 from deformap.msm._linsys import StepMatrices

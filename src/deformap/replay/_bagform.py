@@ -16,13 +16,19 @@ import numpy as np
 from numpy.typing import NDArray
 
 from deformap.cloud import PointCloud
-from deformap.cloud.io import array_to_pointcloud2, read_bag_static_transform
-from deformap.cloud.io._bag import _rosbag2
-from deformap.cloud.io._common import check_units, finish_cloud, path_kind
-from deformap.cloud.io._pointcloud2 import pointcloud2_structured, xyz_with_holes
-from deformap.cloud.io._ros import typestore
+from deformap.cloud.io import (
+    array_to_pointcloud2,
+    bag_read_errors,
+    bag_writer,
+    iter_bag_messages,
+    path_kind,
+    pointcloud2_to_cloud,
+    read_bag_static_transform,
+    typestore,
+    wrench_message,
+)
 from deformap.environment import PressObservation
-from deformap.errors import DeformapError, FileFormatError, InvalidArgumentError
+from deformap.errors import FileFormatError
 from deformap.replay._folder import PressParts
 from deformap.replay._format import TOPICS, PokeSpec, SessionHeader
 
@@ -33,12 +39,6 @@ __all__ = ["BagReader", "write_session_bag"]
 class _Raw:
     log_time_ns: int
     data: bytes
-
-
-def _bag_errors() -> tuple[type[BaseException], ...]:
-    from deformap.cloud.io._bag import bag_read_errors
-
-    return bag_read_errors()
 
 
 def _stamp(msg: Any) -> int:
@@ -61,37 +61,15 @@ class BagReader:
         self._tf_static: NDArray[np.float64] | None = None
 
     def _index(self) -> dict[str, list[_Raw]]:
-        rosbag2 = _rosbag2()
         out: dict[str, list[_Raw]] = {topic: [] for topic, _ in TOPICS.values()}
-        try:
-            with rosbag2.Reader(self.path) as reader:
-                found = {c.topic: c.msgtype for c in reader.connections}
-                for topic, msgtype in TOPICS.values():
-                    if topic not in found:
-                        raise FileFormatError(
-                            f"{self.path}: bag has no topic {topic!r} ({msgtype}); topics found: "
-                            f"{sorted(found)}"
-                        )
-                    if found[topic] != msgtype:
-                        raise FileFormatError(
-                            f"{self.path}: topic {topic!r} carries {found[topic]}, "
-                            f"expected {msgtype}"
-                        )
-                conns = [c for c in reader.connections if c.topic in out]
-                for conn, log_time, raw in reader.messages(connections=conns):
-                    out[conn.topic].append(_Raw(int(log_time), bytes(raw)))
-        except DeformapError:
-            raise
-        except _bag_errors() as exc:
-            raise FileFormatError(
-                f"{self.path}: could not read the bag: {type(exc).__name__}: {str(exc)[:200]}"
-            ) from exc
+        for raw in iter_bag_messages(self.path, dict(TOPICS.values())):
+            out[raw.topic].append(_Raw(raw.log_time_ns, bytes(raw.data)))
         return out
 
     def _messages_by_stamp(self) -> dict[str, dict[int, Any]]:
         if self._decoded is not None:
             return self._decoded
-        store, errors = typestore(), _bag_errors()
+        store, errors = typestore(), bag_read_errors()
         decoded: dict[str, dict[int, Any]] = {}
         for key, (topic, msgtype) in TOPICS.items():
             by_stamp: dict[int, Any] = {}
@@ -134,13 +112,9 @@ class BagReader:
                 f"{where}: header.frame_id is {msg.header.frame_id!r} but the session's frame is "
                 f"{frame!r} (session.yaml `frame`)"
             )
-        try:
-            xyz = xyz_with_holes(msg, pointcloud2_structured(msg))
-        except InvalidArgumentError as exc:
-            raise FileFormatError(f"{where}: {str(exc).replace('`msg` ', '')}") from None
-        xyz = xyz[np.isfinite(xyz).all(axis=1)]  # holes of an organised cloud (is_dense false)
-        cloud, _ = finish_cloud(where, xyz, None, {}, scale=check_units(self.header.units),
-                                drop_nan=False, frame=frame)  # fmt: skip
+        # holes of an organised cloud (is_dense false) are dropped; colours are not read
+        cloud, _ = pointcloud2_to_cloud(msg, where=where, units=self.header.units, frame=frame,
+                                        colors=False)  # fmt: skip
         return cloud
 
     def _to_world(self, cloud: PointCloud) -> PointCloud:
@@ -205,9 +179,7 @@ def _point_message(stamp_ns: int, point: Any) -> Any:
 
 
 def _wrench_message(stamp_ns: int, force: Any) -> Any:
-    from deformap.cloud.io._bag_writer import _wrench_message as wrench
-
-    return wrench(stamp_ns, "world", force, np.zeros(3))
+    return wrench_message(stamp_ns, "world", force, np.zeros(3))
 
 
 def write_session_bag(
@@ -219,9 +191,8 @@ def write_session_bag(
     stamps_ns: Sequence[int],
 ) -> None:
     """Write the observation and the presses (world frame, float64) to a new bag at ``path``."""
-    rosbag2, store = _rosbag2(), typestore()
-    plugin = rosbag2.StoragePlugin.MCAP if storage == "mcap" else rosbag2.StoragePlugin.SQLITE3
-    with rosbag2.Writer(path, version=9, storage_plugin=plugin) as writer:
+    store = typestore()
+    with bag_writer(path, storage) as writer:
         conns = {key: writer.add_connection(topic, msgtype, typestore=store)
                  for key, (topic, msgtype) in TOPICS.items()}  # fmt: skip
 

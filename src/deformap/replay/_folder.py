@@ -9,8 +9,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from deformap.cloud import PointCloud
-from deformap.cloud.io import read_cloud
-from deformap.cloud.io._common import path_kind
+from deformap.cloud.io import path_kind, read_cloud
 from deformap.errors import FileFormatError
 from deformap.replay._format import PokeSpec, SessionHeader
 

@@ -19,7 +19,7 @@ import numpy as np
 from deformap._config import load_yaml
 from deformap._validation import check_int, check_positive
 from deformap.cloud import PointCloud, points_in_hull
-from deformap.cloud.io._common import path_kind
+from deformap.cloud.io import path_kind
 from deformap.environment import PressObservation, TactileContact, Workspace
 from deformap.errors import DeformapError, FileFormatError, InvalidArgumentError
 from deformap.replay._bagform import BagReader

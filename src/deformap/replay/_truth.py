@@ -17,8 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from deformap._validation import check_array
-from deformap.cloud.io._common import path_kind
-from deformap.cloud.io._npz import load_npz_arrays
+from deformap.cloud.io import load_npz_arrays, path_kind
 from deformap.errors import FileFormatError, InvalidArgumentError
 
 __all__ = ["GroundTruth", "read_ground_truth", "write_ground_truth"]

@@ -2,6 +2,8 @@
 
 It implements :class:`deformap.environment.Environment` and never imports the estimator
 (``msm``, ``gp``, ``explore``): its ground truth is linear elasticity solved by finite elements.
+Hertz contact and the hardness–modulus conversion live in :mod:`deformap.mechanics` (shared with
+the estimator, part of neither) and are re-exported here.
 
 Quick start::
 
@@ -16,14 +18,15 @@ Quick start::
 
 from __future__ import annotations
 
-from deformap.world._camera import CameraConfig
-from deformap.world._contact import (
+from deformap.mechanics import (
+    hardness_to_youngs_modulus,
     hertz_contact_radius,
     hertz_indentation,
     hertz_pressure_samples,
+    youngs_modulus_to_hardness,
 )
+from deformap.world._camera import CameraConfig
 from deformap.world._foam import Dent
-from deformap.world._hardness import hardness_to_youngs_modulus, youngs_modulus_to_hardness
 from deformap.world._probe import ProbeGeometry
 from deformap.world._random import random_scenario
 from deformap.world._scenario import BARE_TABLE, Block, Scenario

@@ -31,7 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from deformap.world._contact import hertz_contact_radius, hertz_pressure_samples
+from deformap.mechanics import hertz_contact_radius, hertz_pressure_samples
 from deformap.world._fem import FoamBody, HexGrid, graded_levels
 from deformap.world._scenario import Block, Scenario
 

@@ -34,7 +34,7 @@ from numpy.typing import NDArray
 from deformap._validation import SettingError, check_array, check_settings, setting
 from deformap.environment import Workspace
 from deformap.errors import InvalidArgumentError
-from deformap.world._hardness import hardness_to_youngs_modulus, youngs_modulus_to_hardness
+from deformap.mechanics import hardness_to_youngs_modulus, youngs_modulus_to_hardness
 from deformap.world._polygon import (
     convex_overlap_area,
     is_convex,

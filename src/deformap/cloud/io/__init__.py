@@ -8,23 +8,29 @@ that names the file and what was wrong. No file is ever read with pickle.
 Formats: PCD (ascii, binary, binary_compressed; through pypcd4), PLY (ascii, binary either byte
 order; numpy), NPZ (``points``, ``colors``), and ROS 2 bags (sqlite3 and MCAP; through the optional
 ``rosbags``, extra ``ros``) with ``sensor_msgs/msg/PointCloud2`` and
-``geometry_msgs/msg/WrenchStamped``.
+``geometry_msgs/msg/WrenchStamped``. :func:`iter_bag_messages` is the one place a bag is opened
+and read, :func:`bag_writer` the one place one is written; :func:`pointcloud2_to_cloud` turns a
+message into a cloud under the file readers' rules.
 """
 
 from __future__ import annotations
 
 from deformap.cloud.io._bag import (
     BAG_STORAGES,
+    RawBagMessage,
     StampedCloud,
     WrenchSeries,
+    bag_read_errors,
+    iter_bag_messages,
+    pointcloud2_to_cloud,
     read_bag_clouds,
     read_bag_static_transform,
     read_bag_wrenches,
 )
-from deformap.cloud.io._bag_writer import write_bag
-from deformap.cloud.io._common import MM_EXTENT_THRESHOLD, UNITS
+from deformap.cloud.io._bag_writer import bag_writer, wrench_message, write_bag
+from deformap.cloud.io._common import MM_EXTENT_THRESHOLD, UNITS, path_kind
 from deformap.cloud.io._dispatch import CLOUD_FORMATS, read_cloud, write_cloud
-from deformap.cloud.io._npz import read_npz, write_npz
+from deformap.cloud.io._npz import load_npz_arrays, read_npz, write_npz
 from deformap.cloud.io._pcd import PCD_ENCODINGS, read_pcd, write_pcd
 from deformap.cloud.io._ply import PLY_FORMATS, read_ply, write_ply
 from deformap.cloud.io._pointcloud2 import (
@@ -32,6 +38,7 @@ from deformap.cloud.io._pointcloud2 import (
     pointcloud2_structured,
     pointcloud2_to_array,
 )
+from deformap.cloud.io._ros import ROS_DISTRO, typestore
 
 __all__ = [
     "BAG_STORAGES",
@@ -39,12 +46,20 @@ __all__ = [
     "MM_EXTENT_THRESHOLD",
     "PCD_ENCODINGS",
     "PLY_FORMATS",
+    "ROS_DISTRO",
     "UNITS",
+    "RawBagMessage",
     "StampedCloud",
     "WrenchSeries",
     "array_to_pointcloud2",
+    "bag_read_errors",
+    "bag_writer",
+    "iter_bag_messages",
+    "load_npz_arrays",
+    "path_kind",
     "pointcloud2_structured",
     "pointcloud2_to_array",
+    "pointcloud2_to_cloud",
     "read_bag_clouds",
     "read_bag_static_transform",
     "read_bag_wrenches",
@@ -52,6 +67,8 @@ __all__ = [
     "read_npz",
     "read_pcd",
     "read_ply",
+    "typestore",
+    "wrench_message",
     "write_bag",
     "write_cloud",
     "write_npz",

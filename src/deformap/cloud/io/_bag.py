@@ -12,7 +12,7 @@ import logging
 import sqlite3
 import struct
 from collections import deque
-from collections.abc import Iterator
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -34,8 +34,12 @@ from deformap.errors import (
 
 __all__ = [
     "BAG_STORAGES",
+    "RawBagMessage",
     "StampedCloud",
     "WrenchSeries",
+    "bag_read_errors",
+    "iter_bag_messages",
+    "pointcloud2_to_cloud",
     "read_bag_clouds",
     "read_bag_static_transform",
     "read_bag_wrenches",
@@ -127,37 +131,91 @@ def bag_read_errors() -> tuple[type[BaseException], ...]:
     return (*errors, apsw.Error)
 
 
-def _messages(path: Any, topic: str, msgtype: str) -> Iterator[tuple[int, Any]]:
-    """Yield (log time, deserialised message) of ``topic``; every failure names file and topic."""
-    if not isinstance(topic, str) or not topic:
-        raise InvalidArgumentError(f"`topic` must be a non-empty str; got {topic!r}")
+@dataclass(frozen=True)
+class RawBagMessage:
+    """One message of a bag, not yet deserialised.
+
+    Attributes
+    ----------
+    topic : str
+    log_time_ns : int
+        When the bag recorded it, nanoseconds.
+    data : bytes or memoryview
+        The CDR bytes (``typestore().deserialize_cdr(data, msgtype)`` decodes them); a view may
+        be valid only until the next message is read, so keep ``bytes(data)``.
+    """
+
+    topic: str
+    log_time_ns: int
+    data: bytes | memoryview
+
+
+def iter_bag_messages(path: Any, topics: Mapping[str, str]) -> Iterator[RawBagMessage]:
+    """The messages of ``topics`` in a ROS 2 bag, in the bag's order: the one bag reader.
+
+    Opens the bag (a rosbag2 folder, ``.mcap`` or ``.db3``) through rosbags, checks that each
+    topic is there and carries only its message type, and yields the raw messages. Whatever
+    rosbags or its storage drivers raise on a damaged bag (:func:`bag_read_errors`) becomes a
+    :class:`~deformap.errors.FileFormatError` that names the file.
+
+    Parameters
+    ----------
+    path : str or Path
+    topics : mapping of str to str
+        Topic name → message type (``"sensor_msgs/msg/PointCloud2"``); at least one.
+    """
     if not isinstance(path, (str, Path)):
         raise InvalidArgumentError(
             f"`path` must be a str or pathlib.Path; got {type(path).__name__}"
         )
-    rosbag2, store, p = _rosbag2(), typestore(), Path(path)
+    if not isinstance(topics, Mapping) or not topics:
+        raise InvalidArgumentError(f"`topics` must be a non-empty mapping; got {topics!r}")
+    rosbag2, p = _rosbag2(), Path(path)
     if path_kind(p) == "missing":
         raise FileFormatError(f"{p}: no such bag")
+    what = f"topic {next(iter(topics))!r}" if len(topics) == 1 else "the bag"
     errors = bag_read_errors()
     try:
         with rosbag2.Reader(p) as reader:
-            conns = [c for c in reader.connections if c.topic == topic]
-            if not conns:
-                found = sorted({c.topic for c in reader.connections})
-                raise FileFormatError(f"{p}: bag has no topic {topic!r} (topics: {found})")
-            wrong = [c.msgtype for c in conns if c.msgtype != msgtype]
-            if wrong:
-                raise FileFormatError(
-                    f"{p}: topic {topic!r} carries {wrong[0]}, expected {msgtype}"
-                )
+            found = sorted({c.topic for c in reader.connections})
+            for topic, msgtype in topics.items():
+                conns = [c for c in reader.connections if c.topic == topic]
+                if not conns:
+                    raise FileFormatError(
+                        f"{p}: bag has no topic {topic!r} (topics: {found}); expected one "
+                        f"carrying {msgtype}"
+                    )
+                wrong = [c.msgtype for c in conns if c.msgtype != msgtype]
+                if wrong:
+                    raise FileFormatError(
+                        f"{p}: topic {topic!r} carries {wrong[0]}, expected {msgtype}"
+                    )
+            conns = [c for c in reader.connections if c.topic in topics]
             for conn, log_time, raw in reader.messages(connections=conns):
-                yield int(log_time), store.deserialize_cdr(raw, conn.msgtype)
+                yield RawBagMessage(conn.topic, int(log_time), raw)
     except DeformapError:
         raise
     except errors as exc:
         raise FileFormatError(
-            f"{p}: could not read topic {topic!r}: {type(exc).__name__}: {str(exc)[:200]}"
+            f"{p}: could not read {what}: {type(exc).__name__}: {str(exc)[:200]}"
         ) from exc
+
+
+def _messages(path: Any, topic: str, msgtype: str) -> Iterator[tuple[int, Any]]:
+    """Yield (log time, deserialised message) of ``topic``; every failure names file and topic."""
+    if not isinstance(topic, str) or not topic:
+        raise InvalidArgumentError(f"`topic` must be a non-empty str; got {topic!r}")
+    _rosbag2()  # a missing extra is named for reading bags, before the typestore asks for it
+    store, errors = typestore(), bag_read_errors()
+    for raw in iter_bag_messages(path, {topic: msgtype}):
+        try:
+            msg = store.deserialize_cdr(raw.data, msgtype)
+        except errors as exc:
+            raise FileFormatError(
+                f"{Path(path)}: could not read topic {topic!r}: {type(exc).__name__}: "
+                f"{str(exc)[:200]}"
+            ) from exc
+        yield raw.log_time_ns, msg
 
 
 def _transform_matrix(transform: Any) -> NDArray[np.float64]:
@@ -236,6 +294,53 @@ def _decode_colors(table: NDArray[Any]) -> NDArray[np.uint8] | None:
     return ((packed[:, None] >> shifts) & 0xFF).astype(np.uint8)
 
 
+def _to_cloud(msg: Any, where: str, scale: float, frame: str, colors: bool
+              ) -> tuple[PointCloud, int]:  # fmt: skip
+    try:
+        table = pointcloud2_structured(msg)
+        xyz = xyz_with_holes(msg, table)
+    except InvalidArgumentError as exc:
+        raise FileFormatError(f"{where}: {str(exc).replace('`msg` ', '')}") from None
+    rgb = _decode_colors(table) if colors else None
+    finite = np.isfinite(xyz).all(axis=1)
+    dropped = int(finite.size - finite.sum())
+    xyz, rgb = xyz[finite], None if rgb is None else rgb[finite]
+    cloud, _ = finish_cloud(where, xyz, rgb, {}, scale=scale, drop_nan=False, frame=frame)
+    return cloud, dropped
+
+
+def pointcloud2_to_cloud(msg: Any, *, where: str, units: str = "m", frame: str | None = None,
+                         colors: bool = True) -> tuple[PointCloud, int]:
+    """A deserialised ``sensor_msgs/msg/PointCloud2`` as a :class:`~deformap.cloud.PointCloud`.
+
+    The rules of the file readers apply: NaN or infinite points (the holes of an organised cloud)
+    are dropped and counted, an empty cloud and coordinates that look like millimetres read as
+    metres are refused.
+
+    Parameters
+    ----------
+    msg : rosbags PointCloud2 message
+    where : str
+        Names the message in errors (``"run.mcap [/camera message 3]"``).
+    units : {"m", "mm"}
+        Units of the coordinates.
+    frame : str, optional
+        The cloud's frame name; default the header's ``frame_id`` (``"sensor"`` when empty).
+    colors : bool
+        Decode a packed ``rgb``/``rgba`` field when there is one.
+
+    Returns
+    -------
+    cloud : PointCloud
+        Points in metres.
+    n_dropped : int
+        Points dropped for a non-finite coordinate.
+    """
+    scale = check_units(units)
+    name = (msg.header.frame_id or "sensor") if frame is None else frame
+    return _to_cloud(msg, where, scale, name, colors)
+
+
 def read_bag_clouds(
     path: str | Path,
     topic: str,
@@ -274,17 +379,7 @@ def read_bag_clouds(
     out = []
     for index, (log_time, msg) in enumerate(_messages(path, topic, CLOUD_TYPE)):
         where = f"{path} [{topic} message {index}]"
-        try:
-            table = pointcloud2_structured(msg)
-            xyz = xyz_with_holes(msg, table)
-        except InvalidArgumentError as exc:
-            raise FileFormatError(f"{where}: {str(exc).replace('`msg` ', '')}") from None
-        colors = _decode_colors(table)
-        finite = np.isfinite(xyz).all(axis=1)
-        dropped = int(finite.size - finite.sum())
-        xyz, colors = xyz[finite], None if colors is None else colors[finite]
-        cloud, _ = finish_cloud(where, xyz, colors, {}, scale=scale, drop_nan=False,
-                                frame=msg.header.frame_id or "sensor")  # fmt: skip
+        cloud, dropped = _to_cloud(msg, where, scale, msg.header.frame_id or "sensor", True)
         if cam2world is not None:
             if fixed is None:
                 frame = msg.header.frame_id

@@ -5,7 +5,8 @@ Used by the tests and by simulated recordings, so that the bag-reading path runs
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -24,7 +25,7 @@ from deformap.cloud.io._pointcloud2 import array_to_pointcloud2
 from deformap.cloud.io._ros import typestore
 from deformap.errors import InvalidArgumentError
 
-__all__ = ["write_bag"]
+__all__ = ["bag_writer", "wrench_message", "write_bag"]
 
 
 def _header(stamp_ns: int, frame_id: str) -> Any:
@@ -50,12 +51,41 @@ def _tf_message(transforms: Sequence[tuple[str, str, Any]]) -> Any:
     return types[TF_TYPE](transforms=items)
 
 
-def _wrench_message(stamp_ns: int, frame_id: str, force: Any, torque: Any) -> Any:
+def wrench_message(stamp_ns: int, frame_id: str, force: Any, torque: Any) -> Any:
+    """A ``geometry_msgs/msg/WrenchStamped`` (rosbags message) of ``force`` (N) and ``torque``
+    (N·m), each ``(3,)``, stamped ``stamp_ns`` nanoseconds in frame ``frame_id``."""
     types = typestore().types
     vec = types["geometry_msgs/msg/Vector3"]
     wrench = types["geometry_msgs/msg/Wrench"](force=vec(*map(float, force)),
                                                torque=vec(*map(float, torque)))  # fmt: skip
     return types[WRENCH_TYPE](header=_header(stamp_ns, frame_id), wrench=wrench)
+
+
+@contextmanager
+def bag_writer(path: str | Path, storage: str = "mcap") -> Iterator[Any]:
+    """A rosbags ``Writer`` open on a new ROS 2 bag (rosbag2 version 9): the one bag writer.
+
+    Parameters
+    ----------
+    path : str or Path
+        The bag folder to create; it must not exist.
+    storage : {"mcap", "sqlite3"}
+
+    Yields
+    ------
+    rosbags.rosbag2.Writer
+        Add connections with ``typestore=typestore()`` and write serialised messages; the bag is
+        closed (its metadata written) when the block ends.
+    """
+    rosbag2 = _rosbag2()
+    if storage not in BAG_STORAGES:
+        raise InvalidArgumentError(f"`storage` must be one of {BAG_STORAGES}; got {storage!r}")
+    plugin = rosbag2.StoragePlugin.MCAP if storage == "mcap" else rosbag2.StoragePlugin.SQLITE3
+    p = Path(path)
+    if p.exists():
+        raise InvalidArgumentError(f"`path` {p} exists already; a bag is written to a new folder")
+    with rosbag2.Writer(p, version=9, storage_plugin=plugin) as writer:
+        yield writer
 
 
 def write_bag(
@@ -83,14 +113,8 @@ def write_bag(
     cloud_dtype : {"float32", "float64"}
         Storage of the cloud coordinates.
     """
-    rosbag2, store = _rosbag2(), typestore()
-    if storage not in BAG_STORAGES:
-        raise InvalidArgumentError(f"`storage` must be one of {BAG_STORAGES}; got {storage!r}")
-    plugin = rosbag2.StoragePlugin.MCAP if storage == "mcap" else rosbag2.StoragePlugin.SQLITE3
-    p = Path(path)
-    if p.exists():
-        raise InvalidArgumentError(f"`path` {p} exists already; a bag is written to a new folder")
-    with rosbag2.Writer(p, version=9, storage_plugin=plugin) as writer:
+    store = typestore()
+    with bag_writer(path, storage) as writer:
         if static_transforms:
             conn = writer.add_connection(TF_STATIC_TOPIC, TF_TYPE, typestore=store)
             msg = _tf_message(static_transforms)
@@ -105,5 +129,5 @@ def write_bag(
             conn = writer.add_connection(topic, WRENCH_TYPE, typestore=store)
             for stamp, force, torque in zip(series.stamp_ns, series.force_n, series.torque_nm,
                                             strict=True):  # fmt: skip
-                msg = _wrench_message(int(stamp), series.frame_id, force, torque)
+                msg = wrench_message(int(stamp), series.frame_id, force, torque)
                 writer.write(conn, int(stamp), store.serialize_cdr(msg, WRENCH_TYPE))

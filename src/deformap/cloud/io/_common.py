@@ -70,13 +70,14 @@ def check_units(units: Any) -> float:
     return UNITS[units]
 
 
-def path_kind(path: Path) -> str:
+def path_kind(path: str | Path) -> str:
     """``"file"``, ``"dir"``, ``"other"`` or ``"missing"``: what ``path`` names.
 
     ``Path.is_file`` and its kin answer False for a missing path but raise OSError for a name the
     system refuses (longer than 255 bytes, a parent without search permission); that is a
     FileFormatError naming the path.
     """
+    path = Path(path)
     try:
         if path.is_file():
             return "file"

@@ -17,11 +17,12 @@ from deformap.errors import FileFormatError
 __all__ = ["load_npz_arrays", "read_npz", "write_npz"]
 
 
-def load_npz_arrays(p: Path, what: str) -> dict[str, NDArray[Any]]:
+def load_npz_arrays(path: str | Path, what: str) -> dict[str, NDArray[Any]]:
     """All named arrays of an NPZ archive, without pickle; a damaged file is a FileFormatError.
 
     ``what`` names the archive in messages (``"the NPZ archive"``).
     """
+    p = Path(path)
     with parse_errors(p, what):
         # Loading from memory, so that a corrupted archive leaves no file handle open.
         loaded = np.load(io.BytesIO(p.read_bytes()), allow_pickle=False)

@@ -10,6 +10,11 @@ indenter gives a secant modulus
 so 60, 110 and 150 N foams get 4.6, 8.5 and 11.6 kPa. This ignores the foam around the indenter and
 the non-linearity of foam at 40 % strain; it is the conversion the project takes as its reference
 (issue 3), and every world that uses it states the moduli it produced.
+
+References
+----------
+ISO 2439 (2008). Flexible cellular polymeric materials — Determination of hardness (indentation
+technique). ASTM D3574, test B1 (indentation force deflection).
 """
 
 from __future__ import annotations

@@ -1,0 +1,205 @@
+"""Posterior algebra that needs no observed values: variance of a design, and the linear smoother.
+
+A Gaussian process's posterior covariance depends on where the observations are and on their
+noise, never on the values observed (RW2006 Eq. 2.24 and 2.26), so it can be computed for
+observations not yet made: :class:`PosteriorDesign` gives the posterior over a domain for the
+observations made plus any subset of candidate places, and :func:`variance_after_adding` the
+variance after one more observation at each candidate (an exact rank-one update,
+``σ²ₐ(x) = σ²(x) − cov(c, x)² / (σ²(c) + σₙ²)``). The posterior mean is linear in the data,
+``m = K*ₓ (K + Σ)⁻¹ y`` (RW2006 §2.6): :func:`apply_smoother` applies that linear map to any
+vectors ``y`` (draws of noise, for instance) without forming it.
+
+References
+----------
+Rasmussen, C. E., Williams, C. K. I. (2006). Gaussian Processes for Machine Learning, Eq. 2.24,
+2.26 and §2.6.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+import scipy.linalg as sla
+from numpy.typing import NDArray
+
+from deformap._validation import check_array, check_positive
+from deformap.errors import InvalidArgumentError
+from deformap.gp._exact import cholesky_with_jitter
+from deformap.gp._kernels import _se, squared_exponential
+
+__all__ = ["PosteriorDesign", "apply_smoother", "variance_after_adding"]
+
+Array = NDArray[np.float64]
+
+
+def variance_after_adding(variance: Any, covariance: Any, candidate_variance: Any,
+                          noise_var: float) -> Array:
+    """Posterior variance over a domain after one more observation at each candidate.
+
+    Parameters
+    ----------
+    variance : (d,) float
+        Posterior variance on the domain now.
+    covariance : (c, d) float
+        Posterior covariance between each candidate and the domain now.
+    candidate_variance : (c,) float
+        Posterior variance at each candidate now.
+    noise_var : float
+        Noise variance of the new observation (≥ 0).
+
+    Returns
+    -------
+    (c, d) float
+        Row ``j``: the variance on the domain once candidate ``j`` is observed,
+        ``variance − covariance[j]² / (candidate_variance[j] + noise_var)``.
+    """
+    var = np.asarray(variance, dtype=float)
+    cov = np.asarray(covariance, dtype=float)
+    var_c = np.asarray(candidate_variance, dtype=float)
+    if cov.shape != (var_c.size, var.size):
+        raise InvalidArgumentError(
+            f"`covariance` must be (candidates, domain) = ({var_c.size}, {var.size}); "
+            f"got {cov.shape}"
+        )
+    noise = check_positive("noise_var", noise_var, allow_zero=True)
+    return np.asarray(var[None, :] - cov**2 / (var_c + noise)[:, None])
+
+
+class PosteriorDesign:
+    """A GP's posterior over a domain given noisy observations made and chosen candidates.
+
+    The kernel matrices between the observations made, the candidates and the domain are
+    computed once; :meth:`posterior` then conditions on the observations made plus any subset of
+    candidates, and :meth:`variance_after_adding` adds one candidate more to it, each in turn.
+
+    Parameters
+    ----------
+    observed_xy : (p, 2) float, metres
+        Where the observations made are (``p`` may be 0).
+    observed_noise_std : (p,) float
+        Their noise standard deviations (> 0).
+    candidates : (c, 2) float, metres
+        Places where an observation may be added.
+    domain : (d, 2) float, metres
+        Where the posterior is wanted.
+    length_scale, signal_std : float
+        The kernel (σ_w, σₑ) of :func:`squared_exponential`.
+    candidate_noise_std : float
+        The noise standard deviation of an observation at a candidate (> 0).
+    """
+
+    def __init__(self, observed_xy: Any, observed_noise_std: Any, candidates: Any, domain: Any,
+                 *, length_scale: float, signal_std: float, candidate_noise_std: float) -> None:
+        xy = check_array("observed_xy", observed_xy, (None, 2), what="metres")
+        noise = check_array("observed_noise_std", observed_noise_std, (xy.shape[0],))
+        if np.any(noise <= 0):
+            raise InvalidArgumentError(
+                f"`observed_noise_std` must be positive standard deviations; got {noise.min()!r}")
+        cand = check_array("candidates", candidates, (None, 2), what="metres")
+        dom = check_array("domain", domain, (None, 2), what="metres")
+        new_noise = check_positive("candidate_noise_std", candidate_noise_std)
+        kern = {"length_scale": length_scale, "signal_std": signal_std}
+        self.prior = check_positive("signal_std", signal_std) ** 2
+        self.new_var = new_noise**2
+        self.observed_noise = noise
+        self.k_pp = squared_exponential(xy, xy, **kern)
+        self.k_pc = squared_exponential(xy, cand, **kern)
+        self.k_pd = squared_exponential(xy, dom, **kern)
+        self.k_cc = squared_exponential(cand, cand, **kern)
+        self.k_cd = squared_exponential(cand, dom, **kern)
+
+    @property
+    def n_candidates(self) -> int:
+        """Number of candidates ``c``."""
+        return int(self.k_cc.shape[0])
+
+    def posterior(self, chosen: Sequence[int]) -> tuple[Array, Array, Array]:
+        """The posterior given the observations made and the ``chosen`` candidates.
+
+        Parameters
+        ----------
+        chosen : sequence of int
+            Indices into the candidates, each observed once with ``candidate_noise_std``.
+
+        Returns
+        -------
+        variance : (d,) float
+            Posterior variance on the domain.
+        covariance : (c, d) float
+            Posterior covariance between each candidate and the domain.
+        candidate_variance : (c,) float
+            Posterior variance at each candidate.
+        """
+        idx = np.asarray(chosen, dtype=np.int64).reshape(-1)
+        if idx.size and (idx.min() < 0 or idx.max() >= self.n_candidates):
+            raise InvalidArgumentError(
+                f"`chosen` must index the {self.n_candidates} candidates; got {idx.tolist()}")
+        noise = np.concatenate([self.observed_noise**2, np.full(idx.size, self.new_var)])
+        k_ss = np.block([[self.k_pp, self.k_pc[:, idx]],
+                         [self.k_pc[:, idx].T, self.k_cc[np.ix_(idx, idx)]]])
+        if k_ss.size == 0:
+            return (np.full(self.k_cd.shape[1], self.prior), self.k_cd.copy(),
+                    np.full(self.k_cd.shape[0], self.prior))
+        # RW2006 Eq. 2.24 through the Cholesky factor of the covariance scaled to unit prior
+        # variance (the jitter is relative to σe²)
+        (chol, lower), _ = cholesky_with_jitter((k_ss + np.diag(noise)) / self.prior,
+                                                jitter=1e-12, max_jitter=1e-6,
+                                                what="the covariance of the observations")
+        scale = 1.0 / np.sqrt(self.prior)
+        v_d = sla.solve_triangular(chol, scale * np.vstack([self.k_pd, self.k_cd[idx]]),
+                                   lower=lower, check_finite=False)
+        v_c = sla.solve_triangular(chol, scale * np.vstack([self.k_pc, self.k_cc[idx]]),
+                                   lower=lower, check_finite=False)
+        var_d = self.prior - np.sum(v_d**2, axis=0)
+        cov = self.k_cd - v_c.T @ v_d
+        var_c = self.prior - np.sum(v_c**2, axis=0)
+        return var_d, cov, var_c
+
+    def variance_after_adding(self, chosen: Sequence[int]) -> Array:
+        """``(c, d)`` variance on the domain after the ``chosen`` candidates and one more: row
+        ``j`` adds candidate ``j`` (:func:`variance_after_adding` on :meth:`posterior`)."""
+        var_d, cov, var_c = self.posterior(chosen)
+        return variance_after_adding(var_d, cov, var_c, self.new_var)
+
+
+def apply_smoother(data_xy: Any, noise_std: Any, query_xy: Any, values: Any, *,
+                   length_scale: float, signal_std: float, jitter: float = 1e-10,
+                   max_jitter: float = 1e-4) -> Array:
+    """The GP mean's linear map applied to ``values``: ``K(query, data) (K + Σ)⁻¹ values``.
+
+    Parameters
+    ----------
+    data_xy : (n, 2) float, metres
+        Where the data are.
+    noise_std : (n,) float
+        Their noise standard deviations (``Σ = diag(noise_std²)``).
+    query_xy : (q, 2) float, metres
+    values : (n,) or (n, k) float
+        One or ``k`` data vectors.
+    length_scale, signal_std : float
+        The kernel (σ_w, σₑ).
+    jitter, max_jitter : float
+        Relative to σₑ², as in :func:`cholesky_with_jitter`.
+
+    Returns
+    -------
+    (q,) or (q, k) float
+        The posterior mean each data vector would give (zero prior mean).
+    """
+    data = check_array("data_xy", data_xy, (None, 2), what="metres", min_rows=1)
+    noise = check_array("noise_std", noise_std, (data.shape[0],))
+    query = check_array("query_xy", query_xy, (None, 2), what="metres")
+    vals = np.asarray(values, dtype=float)
+    if vals.ndim not in (1, 2) or vals.shape[0] != data.shape[0]:
+        raise InvalidArgumentError(
+            f"`values` must be ({data.shape[0]},) or ({data.shape[0]}, k); got {vals.shape}")
+    w = check_positive("length_scale", length_scale)
+    s = check_positive("signal_std", signal_std)
+    # the unit-variance kernel and the noise in units of σe: the σe² of K* and of K cancel
+    gram = _se(data, data, w) + np.diag((noise / s) ** 2)
+    factor, _ = cholesky_with_jitter(gram, jitter=jitter, max_jitter=max_jitter,
+                                     what="the data covariance K + Σ")  # fmt: skip
+    weights = sla.cho_solve(factor, vals, check_finite=False)
+    return np.asarray(_se(query, data, w) @ weights)

@@ -1,0 +1,47 @@
+"""Contact mechanics: the tactile contact, Hertz contact of the probe's sphere, foam hardness.
+
+The one home of the physics that both the simulated world (:mod:`deformap.world`) and the estimator
+(:mod:`deformap.msm`) use. It sits at the bottom of the package graph: it imports numpy and the
+validators only, so that ``world`` can use it without importing the estimator and ``msm`` without
+importing the robot protocol (:mod:`deformap.environment` re-exports :class:`TactileContact`).
+
+Units are SI: metres, newtons, pascals.
+
+References
+----------
+Johnson, K. L. (1985). Contact Mechanics, §3.4 and §4.2. Cambridge University Press.
+ISO 2439 (2008). Flexible cellular polymeric materials — Determination of hardness (indentation
+technique).
+"""
+
+from __future__ import annotations
+
+from deformap.mechanics._contact import TactileContact
+from deformap.mechanics._hardness import (
+    INDENTATION_STRAIN,
+    INDENTER_AREA_M2,
+    hardness_to_youngs_modulus,
+    youngs_modulus_to_hardness,
+)
+from deformap.mechanics._hertz import (
+    elastic_dent,
+    hertz_contact_radius,
+    hertz_indentation,
+    hertz_pressure_samples,
+    hertz_surface_deflection,
+    reduced_modulus,
+)
+
+__all__ = [
+    "INDENTATION_STRAIN",
+    "INDENTER_AREA_M2",
+    "TactileContact",
+    "elastic_dent",
+    "hardness_to_youngs_modulus",
+    "hertz_contact_radius",
+    "hertz_indentation",
+    "hertz_pressure_samples",
+    "hertz_surface_deflection",
+    "reduced_modulus",
+    "youngs_modulus_to_hardness",
+]
