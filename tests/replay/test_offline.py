@@ -19,8 +19,8 @@ from typer.testing import CliRunner
 from deformap.cli import app
 from deformap.cloud import PointCloud
 from deformap.cloud.io import write_cloud
-from deformap.eval import load_run_config, run_experiment
 from deformap.replay import load_session, map_session, write_session
+from deformap.run import explore_scenario, load_run_config
 
 SCENARIO = "heterogeneous-150-rigid"
 SEED = 3
@@ -60,7 +60,7 @@ def live(tmp_path_factory: pytest.TempPathFactory, config_file: Path) -> dict[st
     import dataclasses
 
     cfg = dataclasses.replace(load_run_config(config_file), scenario=SCENARIO, seed=SEED)
-    out = run_experiment(cfg, tmp_path_factory.mktemp("live") / "run", figures=False)
+    out = explore_scenario(cfg, tmp_path_factory.mktemp("live") / "run", figures=False)
     return out.report
 
 

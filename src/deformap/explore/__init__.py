@@ -10,12 +10,19 @@ from deformap.explore._config import (
     SurfaceGPConfig,
     TouchGPConfig,
 )
-from deformap.explore._journal import Journal, JournalContents, read_journal
+from deformap.explore._journal import (
+    JOURNAL_NAME,
+    Journal,
+    JournalContents,
+    read_journal,
+    replace_durably,
+)
 from deformap.explore._loop import ExplorationResult, explore
 from deformap.explore._mapper import Mapper, PokeResult, SurfaceModel
 from deformap.explore._regions import RegionMap, segment_regions
 
 __all__ = [
+    "JOURNAL_NAME",
     "STRATEGIES",
     "BetaFieldConfig",
     "ExplorationConfig",
@@ -31,5 +38,6 @@ __all__ = [
     "choose_target",
     "explore",
     "read_journal",
+    "replace_durably",
     "segment_regions",
 ]

@@ -22,7 +22,7 @@ from deformap.cloud.io._bag import (
     read_bag_wrenches,
 )
 from deformap.cloud.io._bag_writer import write_bag
-from deformap.cloud.io._common import MM_EXTENT_THRESHOLD, UNITS
+from deformap.cloud.io._common import MM_EXTENT_THRESHOLD, UNITS, path_kind
 from deformap.cloud.io._dispatch import CLOUD_FORMATS, read_cloud, write_cloud
 from deformap.cloud.io._npz import read_npz, write_npz
 from deformap.cloud.io._pcd import PCD_ENCODINGS, read_pcd, write_pcd
@@ -43,6 +43,7 @@ __all__ = [
     "StampedCloud",
     "WrenchSeries",
     "array_to_pointcloud2",
+    "path_kind",
     "pointcloud2_structured",
     "pointcloud2_to_array",
     "read_bag_clouds",

@@ -59,7 +59,7 @@ def test_an_occupied_folder_is_refused_and_nothing_in_it_is_lost(tmp_path) -> No
     out.mkdir()
     (out / "report.json").write_text(json.dumps({"precious": True}))
     result = runner.invoke(app, ["explore", "--out", str(out)])
-    assert "already holds a run" in _error_line(result)
+    assert "exists and is not empty; choose another --out or pass --resume" in _error_line(result)
     assert json.loads((out / "report.json").read_text()) == {"precious": True}
     result = runner.invoke(app, ["explore", "--resume", str(tmp_path / "empty")])
     assert "holds no config.yaml, so no run started there" in _error_line(result)

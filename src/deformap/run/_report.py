@@ -1,0 +1,232 @@
+"""The one ``report.json`` schema, with one builder per kind of run.
+
+Every report of a mapped surface (a live exploration, :func:`live_report`; a recorded session,
+:func:`session_report`) holds the same core, built once by :func:`shared_report`:
+
+- ``pokes`` (one record per poke, as the mapper wrote it), ``n_pokes``, ``stop_reason``;
+- ``max_variance`` (what the stopping rule compared with T_h, over ``stop_region``) and
+  ``max_variance_map`` (over the whole map);
+- ``regions``: ``levels``, ``class_betas``, ``poke_labels``, ``labels_by`` and, with a ground
+  truth, the scores of :func:`deformap.eval.region_scores` (``None`` without a poke);
+- ``true_regions`` (only with a ground truth) and ``timings`` (the loop's, plus per poke).
+
+Around it, every report names the version (``deformap``), the ``seed`` and the effective
+``config``; a live run adds its ``scenario`` and ``timings.world_build_s``, a session its path,
+``form``, ``source``, ``skipped`` and ``warnings``. One poke estimated alone
+(:func:`estimate_report`) has no map and its own small schema.
+
+This module and :mod:`deformap.run._figures` are the only readers of poke records and of the
+exploration's mapper in the application layer.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from deformap import __version__
+from deformap._config import config_to_dict
+from deformap.environment import TactileContact
+from deformap.eval import region_scores
+from deformap.explore import ExplorationResult, PokeResult
+from deformap.replay import RecordedSession, ReplayResult
+from deformap.run._config import RunConfig
+from deformap.world import SimulatedWorld
+
+__all__ = [
+    "SHARED_KEYS",
+    "PokeProgress",
+    "estimate_report",
+    "live_report",
+    "poke_progress",
+    "session_report",
+    "shared_report",
+]
+
+SHARED_KEYS = (
+    "pokes",
+    "n_pokes",
+    "stop_reason",
+    "max_variance",
+    "max_variance_map",
+    "regions",
+    "timings",
+)
+"""The keys :func:`shared_report` always writes (``true_regions`` too, with a ground truth)."""
+
+_ESTIMATE_KEYS = ("contact", "force_n", "betas", "errors", "converged", "iterations",
+                  "n_roi_points", "timings")  # fmt: skip
+
+
+@dataclass(frozen=True, kw_only=True)
+class PokeProgress:
+    """One finished poke, for progress displays.
+
+    Attributes
+    ----------
+    index : int
+        0-based poke index in its run.
+    target_xy, contact_xy : tuple of float
+        Where the poke aimed and where the tip touched, metres.
+    force_n, beta, beta_std, max_variance_after : float
+        The press force, β̂ with its uncertainty, and the β-field's largest variance after it.
+    planned_after : int or None
+        Pokes the plan still holds after this one (the ``planned`` strategy only).
+    purpose : str or None
+        Why the poke was made there (``"first"``, ``"variance"``, ``"boundary"``, ...).
+    compute_s, environment_s : float
+        Seconds of estimation, and of the environment (pressing, or reading a recording).
+    """
+
+    index: int
+    target_xy: tuple[float, float]
+    contact_xy: tuple[float, float]
+    force_n: float
+    beta: float
+    beta_std: float
+    max_variance_after: float
+    planned_after: int | None
+    purpose: str | None
+    compute_s: float
+    environment_s: float
+
+
+def _xy(values: Any) -> tuple[float, float]:
+    return float(values[0]), float(values[1])
+
+
+def poke_progress(poke: PokeResult) -> PokeProgress:
+    """The progress view of a poke the mapper has added."""
+    r = poke.record
+    timings = r["timings"]
+    return PokeProgress(
+        index=int(r["index"]),
+        target_xy=_xy(r["target_xy"]),
+        contact_xy=_xy(r["contact_xy"]),
+        force_n=float(r["force_n"]),
+        beta=float(r["beta"]),
+        beta_std=float(r["beta_std"]),
+        max_variance_after=float(r["max_variance_after"]),
+        planned_after=r.get("planned_after"),
+        purpose=r.get("purpose"),
+        compute_s=sum(v for k, v in timings.items() if k != "environment_s"),
+        environment_s=float(timings.get("environment_s", 0.0)),
+    )
+
+
+def _finite(value: float | None) -> float | None:
+    return None if value is None or not math.isfinite(value) else float(value)
+
+
+def _regions(
+    result: ExplorationResult, beta: Any, truth: Any
+) -> tuple[dict[str, Any], list[Any] | None]:
+    """``regions`` and ``true_regions`` (``None`` without a ground truth) of a mapped surface
+    whose β-field mean on the grid is ``beta``."""
+    mapper = result.mapper
+    found = mapper.regions()
+    # under region_labels "nearest" the cells take their nearest poke's class, and the levels
+    # only separate the classes' βs
+    regions: dict[str, Any] = {"levels": found.levels.tolist(),
+                               "class_betas": found.class_betas.tolist(),
+                               "poke_labels": found.poke_labels.tolist(),
+                               "labels_by": mapper.config.region_labels}  # fmt: skip
+    if truth is None:
+        return regions, None
+    labels = truth.ground_truth_labels(mapper.xs, mapper.ys)
+    hardness_grid = truth.ground_truth_hardness(mapper.xs, mapper.ys)
+    hardness = {int(label): float(hardness_grid[labels == label][0]) for label in np.unique(labels)}
+    scores = region_scores(found.labels, labels, beta, hardness)
+    true_regions = [
+        {"label": label, "hardness_n": _finite(h)} for label, h in sorted(hardness.items())
+    ]
+    return {**scores.to_dict(), **regions}, true_regions
+
+
+def shared_report(result: ExplorationResult, *, truth: Any = None) -> dict[str, Any]:
+    """The part of ``report.json`` that a live run and a recorded session share.
+
+    Parameters
+    ----------
+    result : ExplorationResult
+    truth : object with ``ground_truth_labels(xs, ys)`` and ``ground_truth_hardness(xs, ys)``
+        A :class:`~deformap.world.SimulatedWorld` or a session's
+        :class:`~deformap.replay.GroundTruth`; ``None`` leaves the ground-truth metrics out.
+    """
+    mapper = result.mapper
+    beta, var = mapper.field()
+    pokes = [dict(p.record) for p in result.pokes]
+    per_poke_compute = [
+        sum(v for k, v in p["timings"].items() if k != "environment_s") for p in pokes
+    ]
+    regions, true_regions = _regions(result, beta, truth) if pokes else (None, None)
+    report: dict[str, Any] = {
+        "pokes": pokes,
+        "n_pokes": len(pokes),
+        "stop_reason": result.stop_reason,
+        "max_variance": mapper.max_variance(),
+        "max_variance_map": float(var.max()),
+        "regions": regions,
+    }
+    if truth is not None:
+        report["true_regions"] = true_regions
+    report["timings"] = {
+        **result.timings,
+        "per_poke_s": [
+            p["timings"].get("environment_s", 0.0) + c
+            for p, c in zip(pokes, per_poke_compute, strict=True)
+        ],
+        "per_poke_compute_s": per_poke_compute,
+    }
+    return report
+
+
+def live_report(
+    config: RunConfig, result: ExplorationResult, world: SimulatedWorld, *, world_build_s: float
+) -> dict[str, Any]:
+    """``report.json`` of a live exploration of a simulated world (scored against its truth)."""
+    report = {
+        "deformap": __version__,
+        "scenario": config.scenario,
+        "seed": config.seed,
+        "config": config_to_dict(config),
+        **shared_report(result, truth=world),
+    }
+    report["timings"]["world_build_s"] = world_build_s
+    return report
+
+
+def session_report(
+    config: RunConfig, session: RecordedSession, replay: ReplayResult
+) -> dict[str, Any]:
+    """``report.json`` of a recorded session mapped offline (scored if it holds a ground truth)."""
+    return {
+        "deformap": __version__,
+        "session": str(session.path),
+        "form": session.form,
+        "source": {k: v for k, v in session.source.items() if k != "config"},
+        "seed": config.seed,
+        "config": config_to_dict(config),
+        **shared_report(replay.result, truth=session.ground_truth),
+        "skipped": replay.skipped,
+        "warnings": replay.warnings,
+    }
+
+
+def estimate_report(
+    before: Path, after: Path, contact: TactileContact, poke: PokeResult
+) -> dict[str, Any]:
+    """``estimate.json``: β of one poke with its uncertainty and E(β) curve."""
+    r = poke.record
+    return {
+        "before": str(before),
+        "after": str(after),
+        "beta": r["beta"],
+        "beta_std": r["beta_std"],
+        "contact_point": contact.contact_point.tolist(),
+        **{k: r[k] for k in _ESTIMATE_KEYS},
+    }
