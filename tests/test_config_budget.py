@@ -11,7 +11,6 @@ from deformap._config import config_from_dict
 from deformap._validation import SettingError
 from deformap.environment import Workspace
 from deformap.errors import ConfigError
-from deformap.eval._experiment import RunConfig
 from deformap.explore import (
     STRATEGIES,
     ExplorationConfig,
@@ -21,6 +20,7 @@ from deformap.explore import (
 )
 from deformap.explore._acquisition import Strategy
 from deformap.msm import ShapeMatchingConfig
+from deformap.run import RunConfig
 from deformap.world import Block, Scenario, SimulatedWorld, WorldConfig, check_world_budget
 from deformap.world import _world as world_module
 from deformap.world._fem import graded_levels

@@ -18,9 +18,9 @@ import pytest
 from deformap._config import config_from_dict, config_to_dict, dump_yaml, load_yaml
 from deformap._validation import SettingError
 from deformap.errors import ConfigError, InvalidArgumentError
-from deformap.eval._experiment import RunConfig
 from deformap.explore import BetaFieldConfig, ExplorationConfig, SurfaceGPConfig, TouchGPConfig
 from deformap.msm import ShapeMatchingConfig
+from deformap.run import RunConfig
 from deformap.world import CameraConfig, WorldConfig
 
 _BOUNDS = "deformap.bounds"

@@ -5,11 +5,11 @@ import pytest
 
 from deformap.environment import Workspace
 from deformap.errors import InvalidArgumentError
-from deformap.eval._experiment import map_report
 from deformap.explore import ExplorationConfig, Mapper
 from deformap.explore._acquisition import choose_target
 from deformap.explore._planning import plan_pokes
 from deformap.gp import GaussianRandomField
+from deformap.run import shared_report
 from deformap.testing import synthetic_poke
 
 PRIOR = {"signal_std": 0.3, "length_scale": 0.2}
@@ -149,7 +149,7 @@ def test_the_paper_stop_rule_on_targets_only_stops_sooner() -> None:
     var = targets.field.variance
     assert targets.max_variance() <= T_H < var.max()  # the edge band is left above T_h
     # the report's max variance is the one the stopping rule compared with T_h
-    report = map_report(targets.result("threshold", {}))
+    report = shared_report(targets.result("threshold", {}))
     assert report["max_variance"] == targets.max_variance() <= T_H
     assert report["max_variance_map"] == var.max()
     assert whole.max_variance() == pytest.approx(whole.field.variance.max())

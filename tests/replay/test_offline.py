@@ -19,8 +19,8 @@ from typer.testing import CliRunner
 from deformap.cli import app
 from deformap.cloud import PointCloud
 from deformap.cloud.io import write_cloud
-from deformap.eval import load_run_config, run_experiment
 from deformap.replay import load_session, map_session, write_session
+from deformap.run import SHARED_KEYS, explore_scenario, load_run_config
 
 SCENARIO = "heterogeneous-150-rigid"
 SEED = 3
@@ -60,7 +60,7 @@ def live(tmp_path_factory: pytest.TempPathFactory, config_file: Path) -> dict[st
     import dataclasses
 
     cfg = dataclasses.replace(load_run_config(config_file), scenario=SCENARIO, seed=SEED)
-    out = run_experiment(cfg, tmp_path_factory.mktemp("live") / "run", figures=False)
+    out = explore_scenario(cfg, tmp_path_factory.mktemp("live") / "run", figures=False)
     return out.report
 
 
@@ -92,6 +92,29 @@ def test_offline_map_gives_the_live_betas(recorded: Path, live: dict[str, Any],
     assert report["true_regions"] == live["true_regions"]
     assert report["max_variance"] == live["max_variance"]
     assert sorted(p.name for p in out.iterdir()) == ["config.yaml", "report.json"]
+
+
+def test_live_and_map_reports_share_one_schema(recorded: Path, live: dict[str, Any],
+                                               tmp_path: Path) -> None:  # fmt: skip
+    out = tmp_path / "map"
+    result = _cli("map", str(recorded), "--out", str(out), "--no-figures", "--json", "-")
+    assert result.exit_code == 0, result.output
+    report = json.loads(result.stdout)  # --json - : the report alone on stdout
+    assert report == json.loads((out / "report.json").read_text())
+    # the keys other tools read, in the order they were always written
+    head = ["deformap", "seed", "config"]
+    core = [*SHARED_KEYS[:-1], "true_regions", SHARED_KEYS[-1]]
+    assert list(live) == ["deformap", "scenario", "seed", "config", *core]
+    assert list(report) == ["deformap", "session", "form", "source", "seed", "config", *core,
+                            "skipped", "warnings"]  # fmt: skip
+    assert set(head) <= set(live) and set(head) <= set(report)
+    assert list(live["regions"]) == list(report["regions"])
+    assert set(live["timings"]) - set(report["timings"]) == {"world_build_s"}
+    for live_poke, mapped_poke in zip(live["pokes"], report["pokes"], strict=True):
+        # the live loop adds why it chose the target and how long choosing took
+        assert set(live_poke) - set(mapped_poke) <= {"purpose", "planned_after"}
+        assert set(mapped_poke) <= set(live_poke)
+        assert set(mapped_poke["timings"]) == set(live_poke["timings"]) - {"target_s"}
 
 
 def test_bag_form_maps_like_the_folder_form(recorded: Path, live: dict[str, Any],
@@ -212,6 +235,8 @@ def test_estimate_agrees_with_the_mapper(recorded: Path, live: dict[str, Any], c
     assert np.allclose(est["contact_point"], c.contact_point)
     assert (tmp_path / "est" / "beta-curve.png").stat().st_size > 0
     assert (tmp_path / "est" / "poke.png").stat().st_size > 0
+    assert sorted(p.name for p in (tmp_path / "est").iterdir()) == [
+        "beta-curve.png", "estimate.json", "poke.png"]  # fmt: skip
 
 
 @pytest.mark.parametrize(

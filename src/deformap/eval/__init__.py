@@ -1,35 +1,78 @@
-"""Evaluation: metrics against ground truth, studies and benchmarks over many worlds."""
+"""Evaluation: metrics against ground truth, studies, the paper's Table I, and benchmarks.
+
+The runs that write folders (an exploration, the reproduction of Table I) belong to
+:mod:`deformap.run`, which uses this package; this package never imports it.
+
+The names are imported on first use: the studies and benchmarks pull in the simulated world and the
+whole estimator (about a second), which ``deformap --help`` and a metric alone never need.
+"""
 
 from __future__ import annotations
 
-from deformap.eval._experiment import RunConfig, RunOutput, load_run_config, run_experiment
-from deformap.eval._metrics import RegionScores, region_scores
-from deformap.eval._reproduce import PAPER_TABLE_I, markdown_table, reproduce
-from deformap.eval._studies import (
-    DEFAULT_HARDNESSES,
-    DEFAULT_POSITIONS,
-    PROTOCOLS,
-    FoamPresses,
-    cluster_size_study,
-    collect_presses,
-    hardness_study,
-)
+import importlib
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from deformap.eval._bench_gp import bench_surface_gp
+    from deformap.eval._bench_io import IO_GOAL_S, bench_io
+    from deformap.eval._bench_memory import bench_memory, measure_case
+    from deformap.eval._bench_msm import bench_beta_sweep
+    from deformap.eval._bench_world import bench_world
+    from deformap.eval._metrics import RegionScores, region_scores
+    from deformap.eval._studies import (
+        DEFAULT_HARDNESSES,
+        DEFAULT_POSITIONS,
+        PROTOCOLS,
+        FoamPresses,
+        cluster_size_study,
+        collect_presses,
+        hardness_study,
+    )
+    from deformap.eval._table_i import PAPER_TABLE_I, markdown_table, table_row
+
+_MODULES = {
+    "_bench_gp": ("bench_surface_gp",),
+    "_bench_io": ("IO_GOAL_S", "bench_io"),
+    "_bench_memory": ("bench_memory", "measure_case"),
+    "_bench_msm": ("bench_beta_sweep",),
+    "_bench_world": ("bench_world",),
+    "_metrics": ("RegionScores", "region_scores"),
+    "_studies": ("DEFAULT_HARDNESSES", "DEFAULT_POSITIONS", "PROTOCOLS", "FoamPresses",
+                 "cluster_size_study", "collect_presses", "hardness_study"),
+    "_table_i": ("PAPER_TABLE_I", "markdown_table", "table_row"),
+}  # fmt: skip
+_HOME = {name: module for module, names in _MODULES.items() for name in names}
 
 __all__ = [
     "DEFAULT_HARDNESSES",
     "DEFAULT_POSITIONS",
+    "IO_GOAL_S",
     "PAPER_TABLE_I",
     "PROTOCOLS",
     "FoamPresses",
     "RegionScores",
-    "RunConfig",
-    "RunOutput",
+    "bench_beta_sweep",
+    "bench_io",
+    "bench_memory",
+    "bench_surface_gp",
+    "bench_world",
     "cluster_size_study",
     "collect_presses",
     "hardness_study",
-    "load_run_config",
     "markdown_table",
+    "measure_case",
     "region_scores",
-    "reproduce",
-    "run_experiment",
+    "table_row",
 ]
+
+
+def __getattr__(name: str) -> Any:
+    if name in _HOME:
+        value = getattr(importlib.import_module(f"deformap.eval.{_HOME[name]}"), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module 'deformap.eval' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))

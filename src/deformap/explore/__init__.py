@@ -15,7 +15,13 @@ from deformap.explore._config import (
 from deformap.explore._dent import measure_press, roi_grid
 from deformap.explore._field import BetaField, PokeSet
 from deformap.explore._grid import MapGrid
-from deformap.explore._journal import Journal, JournalContents, read_journal
+from deformap.explore._journal import (
+    JOURNAL_NAME,
+    Journal,
+    JournalContents,
+    read_journal,
+    replace_durably,
+)
 from deformap.explore._loop import explore, poke_step
 from deformap.explore._mapper import Mapper
 from deformap.explore._records import (
@@ -33,6 +39,7 @@ from deformap.explore._result import ExplorationResult, StopReason
 from deformap.explore._surface import SurfaceModel, fit_surface
 
 __all__ = [
+    "JOURNAL_NAME",
     "PURPOSES",
     "STRATEGIES",
     "BetaField",
@@ -64,6 +71,7 @@ __all__ = [
     "measure_press",
     "poke_step",
     "read_journal",
+    "replace_durably",
     "roi_grid",
     "segment_regions",
 ]

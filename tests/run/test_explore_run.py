@@ -18,9 +18,8 @@ import pytest
 import deformap
 from deformap._config import dump_yaml
 from deformap.errors import ConfigError
-from deformap.eval import RunConfig, load_run_config, run_experiment
-from deformap.explore import ExplorationConfig, SurfaceGPConfig, read_journal
-from deformap.explore._journal import JOURNAL_NAME
+from deformap.explore import JOURNAL_NAME, ExplorationConfig, SurfaceGPConfig, read_journal
+from deformap.run import RunConfig, RunHooks, explore_scenario, load_run_config
 from deformap.world import WorldConfig
 
 
@@ -45,7 +44,7 @@ def _config() -> RunConfig:
 @pytest.fixture(scope="module")
 def full_run(tmp_path_factory):  # type: ignore[no-untyped-def]
     out = tmp_path_factory.mktemp("runs") / "full"
-    return run_experiment(_config(), out)
+    return explore_scenario(_config(), out)
 
 
 def test_report_and_figures(full_run) -> None:  # type: ignore[no-untyped-def]
@@ -73,11 +72,11 @@ def _run_killed_after_two_pokes(out: Path) -> None:
     """Start the test run in ``out`` and kill it right after its second poke was journalled."""
 
     def kill(poke) -> None:  # type: ignore[no-untyped-def]
-        if poke.record.index == 1:
+        if poke.index == 1:
             raise Killed
 
     with pytest.raises(Killed):
-        run_experiment(_config(), out, on_poke=kill, figures=False)
+        explore_scenario(_config(), out, hooks=RunHooks(on_poke=kill), figures=False)
 
 
 def test_a_killed_run_resumes_to_the_same_result(tmp_path, full_run) -> None:  # type: ignore[no-untyped-def]
@@ -87,7 +86,7 @@ def test_a_killed_run_resumes_to_the_same_result(tmp_path, full_run) -> None:  #
     assert len(read_journal(journal).pokes) == 2
     with open(journal, "a") as fh:  # and the kill cut a third line mid-write
         fh.write('{"kind": "poke", "index": 2, "be')
-    resumed = run_experiment(_config(), out, resume=True, figures=False).report
+    resumed = explore_scenario(_config(), out, resume=True, figures=False).report
     full = full_run.report
     assert [p["target_xy"] for p in resumed["pokes"]] == [p["target_xy"] for p in full["pokes"]]
     assert [p["beta"] for p in resumed["pokes"]] == [p["beta"] for p in full["pokes"]]
@@ -104,8 +103,8 @@ def test_a_run_killed_before_its_journal_existed_resumes_from_poke_one(tmp_path,
     (out / "journal.tmp").write_text('{"kind": "hea')
     other = RunConfig(**{**_config().__dict__, "seed": 5})
     with pytest.raises(ConfigError, match=r"its config\.yaml differs"):
-        run_experiment(other, out, resume=True, figures=False)
-    resumed = run_experiment(_config(), out, resume=True, figures=False).report
+        explore_scenario(other, out, resume=True, figures=False)
+    resumed = explore_scenario(_config(), out, resume=True, figures=False).report
     assert [p["beta"] for p in resumed["pokes"]] == [p["beta"] for p in full_run.report["pokes"]]
     assert len(read_journal(out / JOURNAL_NAME).pokes) == 3
 
@@ -125,19 +124,19 @@ def test_a_run_journalled_before_a_config_field_existed_resumes(tmp_path, full_r
     for key in ("region_labels", "boundary_pokes"):
         del header["config"]["exploration"][key]
     with_header(header)
-    resumed = run_experiment(_config(), out, resume=True, figures=False).report
+    resumed = explore_scenario(_config(), out, resume=True, figures=False).report
     assert [p["beta"] for p in resumed["pokes"]] == [p["beta"] for p in full_run.report["pokes"]]
     # a real difference in such a header is still refused
     header["config"]["seed"] = 5
     with_header(header)
     with pytest.raises(ConfigError, match="differs from this one"):
-        run_experiment(_config(), out, resume=True, figures=False)
+        explore_scenario(_config(), out, resume=True, figures=False)
 
 
 def test_resume_refuses_a_different_configuration(tmp_path, full_run) -> None:  # type: ignore[no-untyped-def]
     other = RunConfig(**{**_config().__dict__, "seed": 5})
     with pytest.raises(ConfigError, match="differs from this one"):
-        run_experiment(other, full_run.folder, resume=True, figures=False)
+        explore_scenario(other, full_run.folder, resume=True, figures=False)
 
 
 def _journalled_pokes(path: Path) -> list[str]:

@@ -8,7 +8,9 @@ import pytest
 import yaml
 from typer.testing import CliRunner
 
+from deformap._config import dump_yaml
 from deformap.cli import app
+from deformap.run import RunConfig
 
 runner = CliRunner()
 
@@ -59,7 +61,18 @@ def test_an_occupied_folder_is_refused_and_nothing_in_it_is_lost(tmp_path) -> No
     out.mkdir()
     (out / "report.json").write_text(json.dumps({"precious": True}))
     result = runner.invoke(app, ["explore", "--out", str(out)])
-    assert "already holds a run" in _error_line(result)
+    assert "exists and is not empty; choose another --out or pass --resume" in _error_line(result)
     assert json.loads((out / "report.json").read_text()) == {"precious": True}
     result = runner.invoke(app, ["explore", "--resume", str(tmp_path / "empty")])
     assert "holds no config.yaml, so no run started there" in _error_line(result)
+
+
+def test_resume_refuses_other_settings_before_any_work(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    run = tmp_path / "run"
+    run.mkdir()
+    dump_yaml(RunConfig(seed=4), run / "config.yaml")
+    result = runner.invoke(app, ["explore", "--resume", str(run), "--seed", "5", "--max-pokes", "2"])
+    assert "with different settings (max_pokes, seed); drop those options" in _error_line(result)
+    result = runner.invoke(app, ["explore", "--resume", str(run), "--config", str(run / "config.yaml")])
+    assert "do not pass --config too" in _error_line(result)
+    assert sorted(p.name for p in run.iterdir()) == ["config.yaml"]

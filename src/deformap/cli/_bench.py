@@ -1,0 +1,140 @@
+"""``deformap bench speed | world | io | memory``: tables with a baseline measured in the same run."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Annotated, Any
+
+import numpy as np
+import typer
+from rich.table import Table
+
+from deformap import eval as evaluation
+from deformap.cli._app import JsonOption, app, emit_json, friendly_errors, out_console, progress
+
+__all__ = ["bench_app"]
+
+bench_app = typer.Typer(
+    help="Speed and memory benchmarks (tables with a baseline measured in the same run)."
+)
+app.add_typer(bench_app, name="bench")
+
+SeedOption = Annotated[int, typer.Option(help="Seed of the synthetic data.")]
+QuickOption = Annotated[bool, typer.Option(help="Smaller sizes (a smoke run).")]
+
+
+def _table(title: str, columns: Sequence[str], rows: Sequence[Sequence[str]]) -> Table:
+    table = Table(title=title)
+    for col in columns:
+        table.add_column(col, justify="right")
+    for row in rows:
+        table.add_row(*row)
+    return table
+
+
+@bench_app.command("speed")
+@friendly_errors
+def bench_speed(json_path: JsonOption = None, seed: SeedOption = 0, quick: QuickOption = False) -> None:
+    """Surface GP (exact vs grid) and the β sweep (batched vs per-β loop), same run."""
+    rng = np.random.default_rng(seed)
+    shown = out_console(json_path)
+    with progress(shown, "timing the surface GP and the β sweep"):
+        gp_rows = evaluation.bench_surface_gp((1000, 2000) if quick else (3000, 6000, 12000), rng=rng)
+        sweep = evaluation.bench_beta_sweep(n_particles_side=20 if quick else 40, rng=rng)
+    shown.print(_table(
+        "surface GP → mean and std on the 120×80 grid (σw 4 cm, σn 2 mm)",
+        ("points", "exact \\[s]", "grid \\[s]", "speed-up", "max |Δmean| [µm]", "max Δstd [%]"),
+        [(str(r["n_points"]), f"{r['exact_s']:.3f}", f"{r['grid_s']:.3f}", f"{r['speedup']:.0f}×",
+          f"{r['max_mean_dev_m'] * 1e6:.2f}", f"{r['max_rel_std_dev'] * 100:.3f}") for r in gp_rows],
+    ))  # fmt: skip
+    shown.print(_table(
+        "β estimation (converged, 3×3 clusters)",
+        ("β values", "particles", "batched \\[s]", "per-β loop \\[s]", "speed-up"),
+        [(str(sweep["n_beta"]), str(sweep["n_particles"]), f"{sweep['batched_s']:.3f}",
+          f"{sweep['loop_s']:.3f}", f"{sweep['speedup']:.1f}×")],
+    ))  # fmt: skip
+    emit_json(json_path, {"surface_gp": gp_rows, "beta_sweep": sweep})
+
+
+@bench_app.command("world")
+@friendly_errors
+def bench_world_command(
+    json_path: JsonOption = None,
+    scenario: Annotated[str, typer.Option(help="Scenario name or YAML file.")] = (
+        "heterogeneous-60-110-rigid"
+    ),
+    seed: Annotated[int, typer.Option(help="Seed of the noise.")] = 0,
+    coarse: Annotated[bool, typer.Option(help="Coarse test mesh instead of the default.")] = False,
+) -> None:
+    """Time world construction (with factorisation), one press and one observation."""
+    from deformap.world import WorldConfig  # the whole simulated world: only when benchmarked
+
+    shown = out_console(json_path)
+    with progress(shown, "building and pressing the world"):
+        config = WorldConfig.coarse() if coarse else WorldConfig()
+        result = evaluation.bench_world(scenario=scenario, rng=np.random.default_rng(seed),
+                                        config=config)  # fmt: skip
+    goals = {"construction_s": 20.0, "press_s": 1.0, "observe_s": 0.5}
+    rows = [(key, f"{value:.4g}" if isinstance(value, float) else str(value),
+             f"≤ {goals[key]:g} s" if key in goals else "")
+            for key, value in result.items() if key != "scenario"]  # fmt: skip
+    shown.print(_table(f"simulated world: {result['scenario']}", ("measure", "value", "goal"), rows))
+    emit_json(json_path, result)
+
+
+@bench_app.command("io")
+@friendly_errors
+def bench_io_command(
+    json_path: JsonOption = None,
+    seed: Annotated[int, typer.Option(help="Seed of the synthetic cloud.")] = 0,
+) -> None:
+    """Reading a 300,000-point binary PCD and one PointCloud2 message of that size."""
+    shown = out_console(json_path)
+    with progress(shown, "reading 300,000 points"):
+        row = evaluation.bench_io(n_points=300_000, rng=np.random.default_rng(seed))
+    rows = [(key, f"{value:.4f}") for key, value in row.items()
+            if isinstance(value, float) and key != "goal_s"]  # fmt: skip
+    shown.print(_table("reading 300,000 points (best of repeats; goal < 0.5 s each)",
+                       ("what", "seconds"), rows))  # fmt: skip
+    emit_json(json_path, row)
+
+
+def _memory_table(title: str, rows: list[dict[str, Any]], size_label: str) -> Table:
+    by_key = {(r["case"], r["size"]): r for r in rows}
+    cells = []
+    for r in rows:
+        base = by_key.get((r["baseline"], r["size"]))
+        if r["baseline"] is None:
+            base_text, ratio = "–", "(baseline)"
+        elif base is None:
+            base_text, ratio = f"{r['baseline'].split('-', 1)[1]} not run", ""
+        else:
+            base_text = f"{base['traced_peak_mib']:.1f}"
+            x = base["traced_peak_mib"] / r["traced_peak_mib"]
+            ratio = f"{x:.1f}× less" if x >= 1 else f"{1 / x:.1f}× more"
+        added = "n/a" if r["rss_added_mib"] is None else f"{r['rss_added_mib']:.1f}"
+        cells.append((f"{r['size']:,}", r["case"].split("-", 1)[1], f"{r['traced_peak_mib']:.1f}",
+                      added, f"{r['seconds']:.2f}", base_text, ratio))  # fmt: skip
+    return _table(title, (size_label, "path", "traced [MiB]", "RSS+ [MiB]", "time \\[s]",
+                          "baseline [MiB]", "vs baseline"), cells)  # fmt: skip
+
+
+@bench_app.command("memory")
+@friendly_errors
+def bench_memory_command(json_path: JsonOption = None, seed: SeedOption = 0,
+                         quick: QuickOption = False) -> None:  # fmt: skip
+    """Peak memory: surface GP (grid vs exact) and one β estimation (batched vs per-β loop)."""
+    sizes, exact_max, side = ((500, 2000), 2000, 12) if quick else ((3000, 12000), 3000, 40)
+    shown = out_console(json_path)
+    with progress(shown, "measuring peak memory, one process per case"):
+        result = evaluation.bench_memory(gp_sizes=sizes, exact_max_points=exact_max,
+                                         beta_side=side, seed=seed)  # fmt: skip
+    dense = ", ".join(f"{n:,}: {n * n * 8 / 2**20:,.0f} MiB" for n in sizes if n > exact_max)
+    note = f"; exact's N×N covariance alone at {dense}" if dense else ""
+    shown.print(_memory_table(f"peak memory, surface GP → mean and std on the 120×80 grid{note}",
+                              result["surface_gp"], "points"))  # fmt: skip
+    shown.print(_memory_table("peak memory, one β estimation (converged, 3×3 clusters)",
+                              result["beta_estimation"], "side"))  # fmt: skip
+    shown.print("traced: numpy + Python (tracemalloc); RSS+: resident set rise, all libraries; "
+                "one fresh process per row; baseline: the same size", style="dim")
+    emit_json(json_path, result)

@@ -1,0 +1,129 @@
+"""``deformap explore`` and ``deformap config dump``."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+from typing import TYPE_CHECKING, Annotated, Any
+
+import typer
+from rich.console import Console
+from rich.table import Table
+
+from deformap import run
+from deformap.cli._app import (
+    JsonOption,
+    app,
+    emit_json,
+    friendly_errors,
+    out_console,
+    progress,
+    run_hooks,
+)
+from deformap.errors import ConfigError
+
+if TYPE_CHECKING:  # the CLI loads the estimator only when a command runs
+    from deformap.explore import PokeRecord
+
+__all__ = ["config_app"]
+
+config_app = typer.Typer(help="The run configuration (YAML).")
+app.add_typer(config_app, name="config")
+
+
+def poke_row(p: PokeRecord) -> str:
+    """One progress line of a live poke."""
+    return (
+        f"  poke {p.index + 1:>2}  target ({p.target_xy[0]:.3f}, {p.target_xy[1]:.3f}) m"
+        f"  force {p.force_n:.2f} N  β = {p.beta:.3f} ± {p.beta_std:.3f}"
+        f"  max var {p.max_variance_after:.4f}"
+        + (f"  plan: {p.planned_after} more" if p.planned_after is not None else "")
+        + ("  boundary poke" if p.purpose == "boundary" else "")
+        + f"  [dim](compute {p.timings.compute_s:.2f} s,"
+        f" world {p.timings.environment_s or 0.0:.2f} s)[/]"
+    )
+
+
+def _summary(out: Console, report: dict[str, Any], folder: Path) -> None:
+    reg = report["regions"]
+    tau = "n/a (one region)" if reg["kendall_tau"] is None else f"{reg['kendall_tau']:.2f}"
+    table = Table(title=f"{report['scenario']} (seed {report['seed']})", show_header=False)
+    table.add_row("pokes", f"{report['n_pokes']} (stopped by {report['stop_reason']})")
+    table.add_row("max β variance", f"{report['max_variance']:.4f}")
+    table.add_row("regions found / true", f"{reg['found']} / {reg['true']}")
+    table.add_row("region accuracy", f"{reg['accuracy']:.3f}")
+    table.add_row("mean IoU", f"{reg['mean_iou']:.3f}")
+    table.add_row("Kendall τ (β vs softness)", tau)
+    t = report["timings"]
+    table.add_row(
+        "time",
+        f"{t['total_s'] + t['world_build_s']:.1f} s in all, world build "
+        f"{t['world_build_s']:.1f} s, compute per poke "
+        f"{max(t['per_poke_compute_s'], default=0):.2f} s at most",
+    )
+    table.add_row("results", str(folder))
+    out.print(table)
+
+
+@app.command("explore")
+@friendly_errors
+def explore_command(
+    scenario: Annotated[
+        str | None, typer.Option("--scenario", "-s", help="Built-in scenario name or YAML file.")
+    ] = None,
+    seed: Annotated[int | None, typer.Option(help="Seed of world noise and poke choice.")] = None,
+    out: Annotated[
+        Path | None,
+        typer.Option(help="Run folder (default runs/<scenario>-explore-s<seed>-<time>)."),
+    ] = None,
+    strategy: Annotated[
+        str | None, typer.Option(help="paper | max-variance | min-max-variance | planned.")
+    ] = None,
+    threshold: Annotated[
+        float | None,
+        typer.Option(help="T_h: stop when max var(β) is below it (then any boundary pokes)."),
+    ] = None,
+    max_pokes: Annotated[int | None, typer.Option(help="Most pokes to make.")] = None,
+    config: Annotated[
+        Path | None, typer.Option(help="Run configuration YAML (see `config dump`).")
+    ] = None,
+    resume: Annotated[
+        Path | None, typer.Option(help="Continue the killed run in this folder.")
+    ] = None,
+    rerun: Annotated[
+        bool, typer.Option("--rerun", help="Also write run.rrd (extra `rerun`).")
+    ] = False,
+    json_path: JsonOption = None,
+) -> None:
+    """Explore a simulated world: poke until the β-field is known, then cut it into regions."""
+    overrides = run.RunOverrides(scenario=scenario, seed=seed, strategy=strategy,
+                                 threshold=threshold, max_pokes=max_pokes)  # fmt: skip
+    if resume is not None:
+        if config is not None:
+            raise ConfigError("--resume reads the run's own config.yaml; do not pass --config too")
+        cfg = run.resume_run_config(resume, overrides)
+    else:
+        cfg = run.apply_overrides(run.load_run_config(config), overrides)
+    shown = out_console(json_path)
+    with progress(shown) as bar:
+        output = run.explore_scenario(cfg, resume or out, resume=resume is not None, rerun=rerun,
+                                      hooks=run_hooks(bar, poke_row=poke_row))  # fmt: skip
+    _summary(shown, output.report, output.folder)
+    emit_json(json_path, output.report)
+
+
+@config_app.command("dump")
+@friendly_errors
+def config_dump(
+    out: Annotated[Path | None, typer.Option(help="Write to this file instead of stdout.")] = None,
+) -> None:
+    """Write the full default run configuration as YAML."""
+    text = run.config_yaml(run.RunConfig())
+    if out is None:
+        sys.stdout.write(text)
+        return
+    try:
+        run.write_text(out, text)
+    except OSError as exc:
+        raise ConfigError(f"cannot write --out {str(out)!r}: {exc.strerror or exc}") from None
+    out_console(None).print(f"wrote {out}")

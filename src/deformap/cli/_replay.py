@@ -1,0 +1,153 @@
+"""``deformap record-sim``, ``deformap map`` and ``deformap estimate``: recorded sessions."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+from typing import TYPE_CHECKING, Annotated
+
+import typer
+
+from deformap import run
+from deformap.cli._app import (
+    JsonOption,
+    app,
+    emit_json,
+    err_console,
+    friendly_errors,
+    out_console,
+    progress,
+    run_hooks,
+)
+
+if TYPE_CHECKING:  # the CLI loads the estimator only when a command runs
+    from deformap.explore import PokeRecord
+
+__all__ = ["poke_row"]
+
+ConfigOption = Annotated[
+    Path | None, typer.Option(help="Run configuration YAML (see `config dump`).")
+]
+
+
+def poke_row(p: PokeRecord) -> str:
+    """One progress line of a recorded poke."""
+    return (f"  poke {p.index + 1:>2}  contact ({p.contact_xy[0]:.3f}, {p.contact_xy[1]:.3f}) m"
+            f"  β = {p.beta:.3f} ± {p.beta_std:.3f}  max var {p.max_variance_after:.4f}")  # fmt: skip
+
+
+@app.command("record-sim")
+@friendly_errors
+def record_sim_command(
+    scenario: Annotated[
+        str, typer.Option("--scenario", "-s", help="Built-in scenario name or YAML file.")
+    ],
+    out: Annotated[
+        Path | None,
+        typer.Option(help="New session folder (default runs/<scenario>-record-s<seed>-<time>)."),
+    ] = None,
+    format: Annotated[str, typer.Option("--format", help="folder | mcap | sqlite3.")] = "folder",
+    seed: Annotated[int | None, typer.Option(help="Seed of world noise and poke choice.")] = None,
+    pokes: Annotated[int | None, typer.Option("--pokes", help="Most pokes to make.")] = None,
+    config: ConfigOption = None,
+) -> None:
+    """Explore a simulated world; record what it returned as a session (see docs)."""
+    overrides = run.RunOverrides(scenario=scenario, seed=seed, max_pokes=pokes)
+    cfg = run.apply_overrides(run.load_run_config(config), overrides)
+    with progress(out_console(None)) as bar:
+        output = run.record_simulation(cfg, out, format=format,
+                                       hooks=run_hooks(bar, poke_row=poke_row))  # fmt: skip
+    out_console(None).print(f"wrote {output.session_file} ({output.n_pokes} pokes, "
+                            f"{output.format} form)", highlight=False)  # fmt: skip
+
+
+@app.command("map")
+@friendly_errors
+def map_command(
+    session: Annotated[
+        Path, typer.Argument(metavar="SESSION", help="Session folder or its session.yaml.")
+    ],
+    out: Annotated[
+        Path | None,
+        typer.Option(help="Result folder (default runs/<session>-map-s<seed>-<time>)."),
+    ] = None,
+    config: Annotated[
+        Path | None, typer.Option(help="Run configuration YAML; default: the session's own.")
+    ] = None,
+    seed: Annotated[
+        int | None, typer.Option(help="Seed of the surface fit; default: the session's.")
+    ] = None,
+    figures: Annotated[bool, typer.Option(help="Write map.png and poke-NN.png.")] = True,
+    json_path: JsonOption = None,
+) -> None:
+    """Map a recorded session: its pokes, in order, through the live loop's mapper."""
+    cfg = None if config is None else run.load_run_config(config)
+    shown = out_console(json_path)
+    with progress(shown) as bar:
+        output = run.map_recorded_session(session, out, config=cfg, seed=seed, figures=figures,
+                                          hooks=run_hooks(bar, poke_row=poke_row))  # fmt: skip
+    report = output.report
+    for line in report["warnings"]:
+        err_console.print(f"[yellow]warning:[/] {line}", highlight=False, soft_wrap=True)
+    regions = report["regions"]
+    found = (
+        "no poke usable" if regions is None else f"{len(regions['class_betas'])} region class(es)"
+    )
+    scored = ""
+    if regions is not None and "accuracy" in regions:
+        scored = f", accuracy {regions['accuracy']:.3f} against the ground truth"
+    shown.print(f"{report['n_pokes']} of {len(output.session)} pokes used, {found}{scored}; "
+                f"wrote {output.folder / 'report.json'}", highlight=False)  # fmt: skip
+    emit_json(json_path, report)
+
+
+@app.command("estimate")
+@friendly_errors
+def estimate_command(
+    before: Annotated[
+        Path, typer.Option("--before", help="Cloud of the undisturbed surface (PCD, PLY, NPZ).")
+    ],
+    after: Annotated[Path, typer.Option("--after", help="Cloud while pressing.")],
+    contact: Annotated[
+        tuple[float, float, float],
+        typer.Option("--contact", help="Tip centre X Y Z at the press, metres."),
+    ],
+    force: Annotated[
+        tuple[float, float, float],
+        typer.Option("--force", help="Force FX FY FZ on the surface, newtons."),
+    ],
+    tip_radius: Annotated[
+        float, typer.Option("--tip-radius", help="Radius of the spherical tip, metres.")
+    ],
+    robot_hull: Annotated[
+        Path | None,
+        typer.Option("--robot-hull", help="Cloud file of points whose hull covers stick and hand."),
+    ] = None,
+    out: Annotated[
+        Path | None, typer.Option(help="New folder for estimate.json, beta-curve.png, poke.png.")
+    ] = None,
+    units: Annotated[str, typer.Option(help="Units of the cloud files: m | mm.")] = "m",
+    config: Annotated[
+        Path | None, typer.Option(help="Run configuration YAML (its exploration part).")
+    ] = None,
+    seed: Annotated[int, typer.Option(help="Seed of the surface fit.")] = 0,
+    json_path: Annotated[
+        Path | None,
+        typer.Option("--json", help="Also write the result as JSON to this file (- for stdout; "
+                     "the default without --out)."),
+    ] = None,
+) -> None:
+    """β of one poke from two clouds and the tactile contact (world frame, SI units)."""
+    if json_path is None and out is None:  # the JSON alone on stdout, for pipes
+        json_path = Path("-")
+    output = run.estimate_one_poke(
+        before=before, after=after, tip_center=contact, force=force, tip_radius_m=tip_radius,
+        config=run.load_run_config(config), robot_hull=robot_hull, units=units, seed=seed, out=out,
+    )  # fmt: skip
+    r = output.report
+    shown = out_console(json_path)
+    shown.print(f"β = {r['beta']:.3f} ± {r['beta_std']:.3f} ({r['n_roi_points']} ROI points)")
+    if output.folder is not None:
+        shown.print(f"wrote {output.folder / 'estimate.json'}, beta-curve.png and poke.png")
+    emit_json(json_path, r)
+    sys.stdout.flush()

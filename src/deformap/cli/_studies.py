@@ -1,0 +1,135 @@
+"""``deformap study hardness``, ``deformap study cluster-size`` and ``deformap reproduce``."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated, Any
+
+import typer
+from rich.table import Table
+
+from deformap import run
+from deformap.cli._app import (
+    JsonOption,
+    app,
+    emit_json,
+    friendly_errors,
+    out_console,
+    progress,
+    run_hooks,
+)
+
+__all__ = ["study_app"]
+
+study_app = typer.Typer(help="Studies on homogeneous simulated foams (the paper's Fig. 5).")
+app.add_typer(study_app, name="study")
+
+CoarseOption = Annotated[bool, typer.Option(help="Coarse FEM mesh (quick look).")]
+SeedOption = Annotated[int, typer.Option(help="Seed of the worlds' noise.")]
+
+
+def _hardness(value: float | None) -> str:
+    return "rigid" if value is None else f"{value:g}"
+
+
+@study_app.command("hardness")
+@friendly_errors
+def study_hardness(
+    out: Annotated[
+        Path | None,
+        typer.Option(help="New folder for hardness.png and hardness.json "
+                     "(default runs/hardness-study-s<seed>-<time>)."),
+    ] = None,
+    seed: SeedOption = 0,
+    hardness: Annotated[
+        list[float] | None, typer.Option(help="Foams in N (repeat); rigid is added.")
+    ] = None,
+    coarse: CoarseOption = False,
+    json_path: JsonOption = None,
+) -> None:
+    """β against hardness for each contact protocol (paper Fig. 5a)."""
+    shown = out_console(json_path)
+    with progress(shown) as bar:
+        output = run.run_hardness_study(out, seed=seed, hardness=hardness, coarse=coarse,
+                                        hooks=run_hooks(bar))  # fmt: skip
+    table = Table(title="β against hardness")
+    for col in ("protocol", "hardness [N]", "β", "β spread", "β uncertainty", "fit error \\[mm]"):
+        table.add_column(col, justify="right")
+    for r in output.study["rows"]:
+        table.add_row(r["protocol"], _hardness(r["hardness_n"]), f"{r['beta']:.3f}",
+                      f"{r['beta_std']:.3f}", f"{r['beta_estimate_std']:.3f}",
+                      f"{r['fit_error_m'] * 1e3:.3f}")  # fmt: skip
+    shown.print(table)
+    for name, ok in output.study["monotone"].items():
+        rises = "strictly rises" if ok else "does NOT strictly rise"
+        shown.print(f"  {name}: β {rises} as hardness falls", highlight=False)
+    shown.print(f"wrote {' and '.join(map(str, output.files))}", highlight=False)
+    emit_json(json_path, output.study)
+
+
+@study_app.command("cluster-size")
+@friendly_errors
+def study_cluster_size(
+    out: Annotated[
+        Path | None,
+        typer.Option(help="New folder for cluster-size.png and .json "
+                     "(default runs/cluster-size-study-s<seed>-<time>)."),
+    ] = None,
+    seed: SeedOption = 0,
+    coarse: CoarseOption = False,
+    json_path: JsonOption = None,
+) -> None:
+    """Fit error and β against cluster size 2×2 … 6×6 (paper Fig. 5b)."""
+    shown = out_console(json_path)
+    with progress(shown) as bar:
+        output = run.run_cluster_size_study(out, seed=seed, coarse=coarse, hooks=run_hooks(bar))
+    table = Table(title="fit error against cluster size")
+    for col in ("k×k", "hardness [N]", "β", "fit error \\[mm]"):
+        table.add_column(col, justify="right")
+    for r in output.study["rows"]:
+        table.add_row(f"{r['cluster_size']}", _hardness(r["hardness_n"]), f"{r['beta']:.3f}",
+                      f"{r['fit_error_m'] * 1e3:.3f}")  # fmt: skip
+    shown.print(table)
+    shown.print(f"wrote {' and '.join(map(str, output.files))}", highlight=False)
+    emit_json(json_path, output.study)
+
+
+@app.command("reproduce")
+@friendly_errors
+def reproduce_command(
+    out: Annotated[
+        Path | None,
+        typer.Option(help="New folder: one run per scenario, table.md, table.json "
+                     "(default runs/table-i-reproduce-s<seed>-<time>)."),
+    ] = None,
+    seed: Annotated[int, typer.Option(help="Seed of every run.")] = 0,
+    strategy: Annotated[
+        str | None,
+        typer.Option(help="paper | max-variance | min-max-variance | planned (default: the config's)."),
+    ] = None,
+    config: Annotated[Path | None, typer.Option(help="Run configuration YAML.")] = None,
+    scenario: Annotated[
+        list[str] | None, typer.Option("--scenario", help="Only this scenario (repeat).")
+    ] = None,
+    json_path: JsonOption = None,
+) -> None:
+    """All six scenarios of the paper's Table I, beside the paper's numbers."""
+    base = run.apply_overrides(run.load_run_config(config),
+                               run.RunOverrides(seed=seed, strategy=strategy))  # fmt: skip
+    shown = out_console(json_path)
+
+    def show(row: dict[str, Any]) -> None:
+        tau = "–" if row["kendall_tau"] is None else f"{row['kendall_tau']:.2f}"
+        shown.print(
+            f"  {row['scenario']:<28} pokes {row['pokes']:>2}  regions {row['regions_found']}/"
+            f"{row['regions_true']}  accuracy {row['accuracy']:.3f}  τ {tau}  {row['time_s']:.1f} s",
+            highlight=False,
+        )
+
+    with progress(shown) as bar:
+        output = run.reproduce(out, base=base, scenarios=scenario, on_run=show,
+                               hooks=run_hooks(bar, step_rows=False))  # fmt: skip
+    shown.print(output.markdown)
+    shown.print(f"wrote {output.folder / 'table.md'} and {output.folder / 'table.json'} "
+                f"({len(output.table['rows'])} runs)", highlight=False)  # fmt: skip
+    emit_json(json_path, output.table)

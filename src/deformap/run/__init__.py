@@ -1,0 +1,157 @@
+"""The application layer: a run's configuration, its folder, its report, and the workflows.
+
+One concept per module:
+
+- ``_config``: :class:`RunConfig` (the world, the seed, every component's settings), read from
+  YAML (:func:`load_run_config`), changed by :class:`RunOverrides`, checked against a run that is
+  resumed (:func:`resume_run_config`) or taken from a recorded session
+  (:func:`session_run_config`); the run's random streams (:func:`run_generators`).
+- ``_folder``: the one run-folder policy: one naming scheme (:func:`default_run_folder`), new
+  folders only (:func:`create_run_folder`), every file written atomically (:func:`write_json`,
+  :func:`write_text`, :func:`atomic_path`).
+- ``_report``: the one ``report.json`` schema, one builder per kind of run
+  (:func:`live_report`, :func:`session_report`, :func:`estimate_report`) around the shared part
+  (:func:`shared_report`).
+- ``_figures``: the figures of a run folder.
+- ``_hooks``: :class:`RunHooks`, the progress callbacks every workflow takes.
+- the workflows, each a function with typed arguments returning a typed result:
+  :func:`explore_scenario` (``_explore``), :func:`record_simulation` (``_record``),
+  :func:`map_recorded_session` (``_map``), :func:`estimate_one_poke` (``_estimate``),
+  :func:`reproduce` (``_reproduce``), :func:`run_hardness_study` and
+  :func:`run_cluster_size_study` (``_studies``), :func:`show_scenario` and
+  :func:`scenario_summaries` (``_world``).
+
+This package may import every library package (``eval`` included); none of them imports it.
+
+The names are imported on first use: a run needs the simulated world and the whole estimator
+(about a second to import), which ``deformap --help`` never does.
+"""
+
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from deformap.run._config import (
+        CONFIG_NAME,
+        RunConfig,
+        RunOverrides,
+        apply_overrides,
+        config_yaml,
+        load_run_config,
+        resume_run_config,
+        run_generators,
+        session_run_config,
+    )
+    from deformap.run._estimate import EstimateOutput, estimate_one_poke
+    from deformap.run._explore import RunOutput, explore_scenario
+    from deformap.run._figures import write_estimate_figures, write_map_figures, write_rerun
+    from deformap.run._folder import (
+        RUNS_ROOT,
+        atomic_path,
+        create_run_folder,
+        default_run_folder,
+        run_stem,
+        to_json,
+        write_json,
+        write_text,
+    )
+    from deformap.run._hooks import RunHooks, RunStart
+    from deformap.run._map import MapOutput, map_recorded_session
+    from deformap.run._record import RecordOutput, record_simulation
+    from deformap.run._report import (
+        SHARED_KEYS,
+        estimate_report,
+        live_report,
+        session_report,
+        shared_report,
+    )
+    from deformap.run._reproduce import ReproduceOutput, reproduce
+    from deformap.run._studies import (
+        CLUSTER_SIZE_FOAMS,
+        StudyOutput,
+        run_cluster_size_study,
+        run_hardness_study,
+    )
+    from deformap.run._world import ScenarioSummary, scenario_summaries, show_scenario
+
+_MODULES = {
+    "_config": ("CONFIG_NAME", "RunConfig", "RunOverrides", "apply_overrides", "config_yaml",
+                "load_run_config",
+                "resume_run_config", "run_generators", "session_run_config"),
+    "_estimate": ("EstimateOutput", "estimate_one_poke"),
+    "_explore": ("RunOutput", "explore_scenario"),
+    "_figures": ("write_estimate_figures", "write_map_figures", "write_rerun"),
+    "_folder": ("RUNS_ROOT", "atomic_path", "create_run_folder", "default_run_folder", "run_stem",
+                "to_json", "write_json", "write_text"),
+    "_hooks": ("RunHooks", "RunStart"),
+    "_map": ("MapOutput", "map_recorded_session"),
+    "_record": ("RecordOutput", "record_simulation"),
+    "_report": ("SHARED_KEYS", "estimate_report", "live_report",
+                "session_report", "shared_report"),
+    "_reproduce": ("ReproduceOutput", "reproduce"),
+    "_studies": ("CLUSTER_SIZE_FOAMS", "StudyOutput", "run_cluster_size_study",
+                 "run_hardness_study"),
+    "_world": ("ScenarioSummary", "scenario_summaries", "show_scenario"),
+}  # fmt: skip
+_HOME = {name: module for module, names in _MODULES.items() for name in names}
+
+__all__ = [
+    "CLUSTER_SIZE_FOAMS",
+    "CONFIG_NAME",
+    "RUNS_ROOT",
+    "SHARED_KEYS",
+    "EstimateOutput",
+    "MapOutput",
+    "RecordOutput",
+    "ReproduceOutput",
+    "RunConfig",
+    "RunHooks",
+    "RunOutput",
+    "RunOverrides",
+    "RunStart",
+    "ScenarioSummary",
+    "StudyOutput",
+    "apply_overrides",
+    "atomic_path",
+    "config_yaml",
+    "create_run_folder",
+    "default_run_folder",
+    "estimate_one_poke",
+    "estimate_report",
+    "explore_scenario",
+    "live_report",
+    "load_run_config",
+    "map_recorded_session",
+    "record_simulation",
+    "reproduce",
+    "resume_run_config",
+    "run_cluster_size_study",
+    "run_generators",
+    "run_hardness_study",
+    "run_stem",
+    "scenario_summaries",
+    "session_report",
+    "session_run_config",
+    "shared_report",
+    "show_scenario",
+    "to_json",
+    "write_estimate_figures",
+    "write_json",
+    "write_map_figures",
+    "write_rerun",
+    "write_text",
+]
+
+
+def __getattr__(name: str) -> Any:
+    if name in _HOME:
+        value = getattr(importlib.import_module(f"deformap.run.{_HOME[name]}"), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module 'deformap.run' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))

@@ -1,0 +1,162 @@
+"""The run's configuration: one :class:`RunConfig`, read from YAML, changed by overrides, checked
+against the folder of a run that is resumed, or taken from the session a recording holds.
+
+A run's randomness derives from its seed alone (:func:`run_generators`), so the live run, a resumed
+run and a recorded session mapped offline draw the same numbers.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from deformap._config import config_from_dict, dump_yaml, load_yaml
+from deformap._validation import check_int, check_settings, setting
+from deformap.cloud.io import path_kind
+from deformap.errors import ConfigError
+from deformap.explore import ExplorationConfig
+from deformap.replay import RecordedSession
+from deformap.world import WorldConfig
+
+__all__ = [
+    "CONFIG_NAME",
+    "RunConfig",
+    "RunOverrides",
+    "apply_overrides",
+    "config_yaml",
+    "load_run_config",
+    "resume_run_config",
+    "run_generators",
+    "session_run_config",
+]
+
+CONFIG_NAME = "config.yaml"
+"""The effective configuration in every run folder (written before anything else)."""
+
+
+@dataclass(frozen=True, kw_only=True)
+class RunConfig:
+    """The whole configuration of a run: which world, which seed, and every component's settings."""
+
+    scenario: str = "heterogeneous-60-110-rigid"
+    seed: int = setting(0, ge=0)
+    world: WorldConfig = field(default_factory=WorldConfig)
+    exploration: ExplorationConfig = field(default_factory=ExplorationConfig)
+
+    def __post_init__(self) -> None:
+        check_settings(self)
+
+
+@dataclass(frozen=True, kw_only=True)
+class RunOverrides:
+    """Settings given on the command line; ``None`` keeps the configuration's own.
+
+    ``strategy``, ``threshold`` and ``max_pokes`` are fields of
+    :class:`~deformap.explore.ExplorationConfig`, which validates them.
+    """
+
+    scenario: str | None = None
+    seed: int | None = None
+    strategy: str | None = None
+    threshold: float | None = None
+    max_pokes: int | None = None
+
+    def given(self) -> dict[str, Any]:
+        """The overrides that were given, by field name."""
+        return {f.name: v for f in dataclasses.fields(self) if (v := getattr(self, f.name)) is not None}
+
+
+def load_run_config(path: str | Path | None) -> RunConfig:
+    """Read a run configuration from YAML (missing keys keep their defaults); ``None``: defaults.
+
+    Raises
+    ------
+    ConfigError
+        The file cannot be read, or a key is unknown or has a bad value (named by its dotted path).
+    """
+    if path is None:
+        return RunConfig()
+    return config_from_dict(RunConfig, load_yaml(path), where=Path(path).name)
+
+
+def config_yaml(config: RunConfig) -> str:
+    """``config`` as the YAML of ``config.yaml`` (every field, in definition order)."""
+    return dump_yaml(config)
+
+
+def apply_overrides(config: RunConfig, overrides: RunOverrides) -> RunConfig:
+    """``config`` with the given overrides; every changed dataclass validates itself again."""
+    given = overrides.given()
+    top: dict[str, Any] = {k: given.pop(k) for k in ("scenario", "seed") if k in given}
+    if given:
+        top["exploration"] = dataclasses.replace(config.exploration, **given)
+    return dataclasses.replace(config, **top) if top else config
+
+
+def resume_run_config(folder: Path, overrides: RunOverrides | None = None) -> RunConfig:
+    """The configuration of the run in ``folder``, read from its ``config.yaml``.
+
+    Overrides are accepted only when they repeat the run's own settings: a resumed run is the run
+    that was killed, or it would not give the uninterrupted run's result.
+
+    Raises
+    ------
+    ConfigError
+        ``folder`` holds no ``config.yaml`` (no run started there), or an override differs.
+    """
+    if path_kind(folder / CONFIG_NAME) != "file":  # a run writes it before anything else
+        raise ConfigError(
+            f"cannot resume {str(folder)!r}: it holds no {CONFIG_NAME}, so no run started "
+            "there; start one without --resume"
+        )
+    config = load_run_config(folder / CONFIG_NAME)
+    overrides = overrides or RunOverrides()
+    changed = apply_overrides(config, overrides)
+    if changed != config:
+        names = ", ".join(sorted(overrides.given()))
+        raise ConfigError(
+            f"cannot resume {str(folder)!r} with different settings ({names}); drop those options"
+        )
+    return config
+
+
+def session_run_config(
+    session: RecordedSession, config: RunConfig | None = None, seed: int | None = None
+) -> RunConfig:
+    """The configuration to map ``session`` with.
+
+    ``config`` if given, else the one the session was recorded with (``source.config``), else the
+    defaults; the seed is ``seed`` if given, else the session's ``source.seed``, else the
+    configuration's.
+
+    Raises
+    ------
+    ConfigError
+        The recorded configuration or seed is malformed (named by its place in ``session.yaml``).
+    """
+    if config is None:
+        recorded = session.source.get("config")
+        where = f"{session.path}/session.yaml source.config"
+        config = RunConfig() if recorded is None else config_from_dict(RunConfig, recorded, where=where)
+    if seed is None:
+        seed = session.source.get("seed", config.seed)
+        if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
+            raise ConfigError(
+                f"{session.path}/session.yaml: `source.seed` must be an integer >= 0; got "
+                f"{seed!r} (or pass --seed)"
+            )
+    return dataclasses.replace(config, seed=seed)
+
+
+def run_generators(seed: int) -> tuple[np.random.Generator, np.random.Generator]:
+    """The world's and the exploration's generators of a run with ``seed``.
+
+    Live runs, recorded simulations and mapped sessions derive theirs the same way, so that a
+    recorded session mapped offline with its seed fits the surface exactly as the live run did.
+    """
+    world_seq, explore_seq = np.random.SeedSequence(check_int("seed", seed, minimum=0)).spawn(2)
+    return np.random.default_rng(world_seq), np.random.default_rng(explore_seq)

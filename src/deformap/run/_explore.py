@@ -1,0 +1,182 @@
+"""Explore a simulated scenario: poke until the β-field is known, score the map against the
+world's ground truth, and write the run folder.
+
+A run folder receives, in this order, ``config.yaml`` (the effective configuration, before
+anything else), ``journal.jsonl`` (each poke as it completes, for resuming), ``report.json``,
+``map.png``, one ``poke-NN.png`` per poke, and with ``rerun`` the recording ``run.rrd``. A run
+killed at any moment resumes from its folder to the uninterrupted run's result.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from deformap import __version__
+from deformap._config import config_from_dict, config_to_dict
+from deformap.errors import ConfigError, DeformapError
+from deformap.explore import JOURNAL_NAME, ExplorationResult, Journal, explore, read_journal
+from deformap.run._config import (
+    CONFIG_NAME,
+    RunConfig,
+    config_yaml,
+    load_run_config,
+    run_generators,
+)
+from deformap.run._figures import write_map_figures, write_rerun
+from deformap.run._folder import (
+    create_run_folder,
+    default_run_folder,
+    run_stem,
+    write_json,
+    write_text,
+)
+from deformap.run._hooks import NO_HOOKS, RunHooks, RunStart
+from deformap.run._report import live_report
+from deformap.world import SimulatedWorld, load_scenario
+
+__all__ = ["RunOutput", "explore_scenario"]
+
+logger = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True, kw_only=True)
+class RunOutput:
+    """What :func:`explore_scenario` wrote and the objects it made.
+
+    Attributes
+    ----------
+    report : dict
+        The content of ``report.json`` (see :mod:`deformap.run._report`).
+    result : ExplorationResult
+    world : SimulatedWorld
+    folder : Path
+    """
+
+    report: dict[str, Any]
+    result: ExplorationResult
+    world: SimulatedWorld
+    folder: Path
+
+
+def _stored_if_same(out: Path, config: RunConfig, header: dict[str, Any]) -> dict[str, Any]:
+    """The journal's own header if it names this run in an older form, else ``header``.
+
+    A configuration field added since the run began is missing from its journal header; read
+    with that field at its default (new fields default to the behaviour before them), the stored
+    configuration may equal this run's, which then resumes. Anything else is left for
+    :meth:`Journal.resume` to compare (and refuse, naming what differs).
+    """
+    try:
+        stored = read_journal(out / JOURNAL_NAME).header
+        same = (
+            {k: v for k, v in stored.items() if k not in ("kind", "config")}
+            == json.loads(json.dumps({k: v for k, v in header.items() if k != "config"}))
+            and config_from_dict(RunConfig, stored["config"], where="journal header") == config
+        )
+    except (DeformapError, KeyError, TypeError):
+        return header
+    return {k: v for k, v in stored.items() if k != "kind"} if same else header
+
+
+def _resume_journal(
+    out: Path, config: RunConfig, header: dict[str, Any]
+) -> tuple[Journal, list[dict[str, Any]]]:
+    """Open the journal of the run in ``out`` and the pokes it holds.
+
+    A folder with ``config.yaml`` but no journal (killed before its journal was created) resumes
+    from poke 1 when its configuration is this run's.
+    """
+    if not (out / JOURNAL_NAME).exists():
+        if not (out / CONFIG_NAME).exists():
+            raise ConfigError(f"cannot resume {str(out)!r}: it holds no {JOURNAL_NAME}")
+        if load_run_config(out / CONFIG_NAME) != config:
+            raise ConfigError(f"cannot resume {str(out)!r}: its config.yaml differs from this run's")
+        logger.warning("%s: killed before its journal was created; starting over", out)
+        return Journal.create(out, header), []
+    journal, contents = Journal.resume(out, _stored_if_same(out, config, header))
+    if contents.broken_line is not None:
+        logger.warning(
+            "%s: the last journal line was cut mid-write and is dropped (%d complete pokes kept)",
+            out / JOURNAL_NAME,
+            len(contents.pokes),
+        )
+    return journal, contents.pokes
+
+
+def explore_scenario(
+    config: RunConfig,
+    out: Path | None = None,
+    *,
+    resume: bool = False,
+    figures: bool = True,
+    rerun: bool = False,
+    hooks: RunHooks = NO_HOOKS,
+) -> RunOutput:
+    """Explore ``config.scenario``, score the map against ground truth, write the run folder.
+
+    Parameters
+    ----------
+    config : RunConfig
+    out : Path, optional
+        The run folder; new or empty unless ``resume`` (default:
+        :func:`~deformap.run.default_run_folder` of the scenario, kind ``explore``).
+    resume : bool
+        Continue the run killed in ``out``: the pokes in its journal are not made again, and a
+        configuration other than the run's is refused.
+    figures : bool
+        Write ``map.png`` and the ``poke-NN.png``.
+    rerun : bool
+        Write ``run.rrd`` (extra ``rerun``).
+    hooks : RunHooks
+        Progress callbacks.
+
+    Returns
+    -------
+    RunOutput
+
+    Raises
+    ------
+    ConfigError
+        Unknown scenario; ``out`` not empty, or not creatable (before any work); on resume, no
+        run there or a different configuration.
+    """
+    if resume and out is None:
+        raise ConfigError("`out` must name the run folder to resume; got None")
+    scenario = load_scenario(config.scenario)
+    folder = out or default_run_folder(run_stem(config.scenario), "explore", config.seed)
+    header = {"deformap": __version__, "config": config_to_dict(config),
+              "scenario": scenario.to_dict()}  # fmt: skip
+    if resume:
+        journal, done = _resume_journal(folder, config, header)
+        # matched the journal header; restores a copy a kill or a user removed
+        write_text(folder / CONFIG_NAME, config_yaml(config))
+    else:
+        create_run_folder(folder, what="output", resume_hint=True)
+        write_text(folder / CONFIG_NAME, config_yaml(config))
+        journal, done = Journal.create(folder, header), []
+    hooks.start(RunStart(kind="explore", title=f"{config.scenario} seed {config.seed}",
+                         folder=folder, total=config.exploration.max_pokes, done=len(done)))  # fmt: skip
+    hooks.stage("building the world")
+    world_rng, explore_rng = run_generators(config.seed)
+    t0 = time.perf_counter()
+    world = SimulatedWorld(scenario, config=config.world, rng=world_rng)
+    world_s = time.perf_counter() - t0
+    hooks.stage("exploring")
+    result = explore(world, config.exploration, rng=explore_rng, journal=journal, done=done,
+                     on_poke=lambda poke: hooks.poke(poke.record))  # fmt: skip
+    report = live_report(config, result, world, world_build_s=world_s)
+    write_json(folder / "report.json", report)
+    if figures:
+        hooks.stage("drawing figures")
+        title = f"{config.scenario} (seed {config.seed}): {len(result.pokes)} pokes"
+        write_map_figures(folder, result, truth=world, threshold=config.exploration.threshold,
+                          title=title)  # fmt: skip
+    if rerun:
+        hooks.stage("writing run.rrd")
+        write_rerun(folder / "run.rrd", result)
+    return RunOutput(report=report, result=result, world=world, folder=folder)

@@ -1,0 +1,99 @@
+"""The figures of a run folder: ``map.png`` and ``poke-NN.png``, ``beta-curve.png`` and
+``poke.png`` of one estimated poke, and the 3D recording ``run.rrd``.
+
+Each file is written atomically (by :mod:`deformap.viz`). :mod:`deformap.viz` is
+imported when a figure is drawn, not with this module: it loads matplotlib (and rerun), which a run
+without figures never needs.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from deformap.explore import ExplorationResult, PokeResult
+
+__all__ = ["write_estimate_figures", "write_map_figures", "write_rerun"]
+
+
+def write_map_figures(
+    folder: Path,
+    result: ExplorationResult,
+    *,
+    truth: Any = None,
+    threshold: float | None = None,
+    title: str = "",
+) -> list[Path]:
+    """``map.png`` (when there is a poke) and one ``poke-NN.png`` per poke processed here.
+
+    Parameters
+    ----------
+    folder : Path
+    result : ExplorationResult
+    truth : object with ``ground_truth_hardness(xs, ys)``, optional
+        As in :func:`~deformap.run.shared_report`; without it the map has no ground-truth panel.
+    threshold : float, optional
+        T_h, drawn on the variance panel.
+    title : str
+
+    Returns
+    -------
+    list of Path
+        The files written. A poke resumed from a journal has no arrays and no figure.
+    """
+    from deformap.viz import plot_map
+
+    written = []
+    regions = result.regions
+    if regions is not None:
+        contacts = np.array([p.xy for p in result.pokes])
+        truth_hardness = None if truth is None else truth.ground_truth_hardness(result.xs, result.ys)
+        levels = regions.levels if result.config.region_labels == "isopleth" else None
+        plot_map(result.xs, result.ys, beta=result.field.mean, variance=result.field.variance,
+                 contacts=contacts, labels=regions.labels, levels=levels,
+                 truth_hardness=truth_hardness, threshold=threshold, title=title,
+                 path=folder / "map.png")  # fmt: skip
+        written.append(folder / "map.png")
+    for poke in result.pokes:
+        if poke.dent is None:  # resumed from the journal: no arrays to draw
+            continue
+        r = poke.record
+        path = folder / f"poke-{r.index + 1:02d}.png"
+        _plot_poke(path, poke, f"poke {r.index + 1} at ({r.contact_xy[0]:.3f}, "
+                               f"{r.contact_xy[1]:.3f}) m")  # fmt: skip
+        written.append(path)
+    return written
+
+
+def _plot_poke(path: Path, poke: PokeResult, title: str) -> None:
+    from deformap.viz import plot_poke
+
+    r, dent = poke.record, poke.dent
+    assert dent is not None  # the callers skip pokes without a dent
+    plot_poke(roi_xs=dent.roi_xs, roi_ys=dent.roi_ys, rest_z=dent.rest_z,
+              deformed_z=dent.deformed_z, roi_points=dent.roi_points, tactile=dent.tactile,
+              betas=np.asarray(r.betas), errors=np.asarray(r.errors), beta=r.beta,
+              beta_std=r.beta_std, title=title, path=path)  # fmt: skip
+
+
+def write_estimate_figures(folder: Path, poke: PokeResult) -> list[Path]:
+    """``beta-curve.png`` (the shape-matching error E(β)) and ``poke.png`` of one poke."""
+    from deformap.viz import plot_error_curve
+
+    r = poke.record
+    plot_error_curve(np.asarray(r.betas), np.asarray(r.errors), r.beta, r.beta_std,
+                     path=folder / "beta-curve.png")  # fmt: skip
+    _plot_poke(folder / "poke.png", poke, "one poke")
+    return [folder / "beta-curve.png", folder / "poke.png"]
+
+
+def write_rerun(path: Path, result: ExplorationResult) -> Path:
+    """The run as a rerun recording (extra ``rerun``), starting from the surface's points."""
+    from deformap.viz import record_run
+
+    surface = result.surface
+    if surface is None:  # pragma: no cover - explore() fits the surface before any poke
+        raise RuntimeError("the exploration has no surface model")
+    return Path(record_run(path, result, initial_points=surface.points))

@@ -1,0 +1,140 @@
+"""The one policy for the folders runs write into, and for the files written there.
+
+- **Naming**: a run without ``--out`` goes to ``runs/<stem>-<kind>-s<seed>-<YYYYmmdd-HHMMSS>``
+  (:func:`default_run_folder`), whatever its kind (explore, record, map, study, reproduce).
+- **Creating**: :func:`create_run_folder` makes the folder before any work, so that one that
+  cannot be made fails at once (naming ``--out``); an existing folder must be empty, so that no
+  result of an earlier run is ever overwritten. A run that is resumed reuses its own folder.
+- **Writing**: every file goes to a temporary file in the same folder, is flushed and fsynced,
+  renamed onto its name (``os.replace``) and the folder fsynced (:func:`write_text`,
+  :func:`write_json`, :func:`atomic_path`): a run killed at any moment leaves the old file or the
+  new one, never half of one.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+import time
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from deformap.cloud.io import path_kind
+from deformap.errors import ConfigError
+from deformap.explore import replace_durably
+
+__all__ = [
+    "RUNS_ROOT",
+    "atomic_path",
+    "create_run_folder",
+    "default_run_folder",
+    "run_stem",
+    "to_json",
+    "write_json",
+    "write_text",
+]
+
+RUNS_ROOT = Path("runs")
+"""Where runs without ``--out`` go, relative to the working directory."""
+
+
+def run_stem(name: str | Path) -> str:
+    """The stem of a run's folder name: a scenario name, or a file's or folder's own name."""
+    text = str(name)
+    if text.endswith((".yaml", ".yml")):
+        return Path(text).stem
+    return Path(text).name or text.strip("/") or "run"
+
+
+def default_run_folder(
+    stem: str, kind: str, seed: int, *, root: Path = RUNS_ROOT, when: float | None = None
+) -> Path:
+    """``root/<stem>-<kind>-s<seed>-<YYYYmmdd-HHMMSS>``, local time ``when`` (default: now)."""
+    stamp = time.strftime("%Y%m%d-%H%M%S", time.localtime(when))
+    return root / f"{stem}-{kind}-s{seed}-{stamp}"
+
+
+def create_run_folder(folder: Path, *, what: str = "run", resume_hint: bool = False) -> Path:
+    """Create ``folder`` (and its parents) for a new run; it may exist only as an empty folder.
+
+    Parameters
+    ----------
+    folder : Path
+    what : str
+        What the folder holds, for the messages ("run", "session", "result").
+    resume_hint : bool
+        Say that ``--resume`` continues the run already there.
+
+    Raises
+    ------
+    ConfigError
+        ``folder`` is a folder that is not empty, or a file, or cannot be created; the message
+        names ``--out``.
+    """
+    kind = path_kind(folder)
+    if kind == "dir" and any(folder.iterdir()):
+        hint = " or pass --resume" if resume_hint else ""
+        raise ConfigError(
+            f"{what} folder {str(folder)!r} exists and is not empty; choose another --out{hint}"
+        )
+    if kind in ("file", "other"):
+        raise ConfigError(
+            f"cannot create {what} folder {str(folder)!r} (--out): something that is not a "
+            "folder has that name"
+        )
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise ConfigError(
+            f"cannot create {what} folder {str(folder)!r} (--out): {exc.strerror or exc}"
+        ) from None
+    return folder
+
+
+@contextlib.contextmanager
+def atomic_path(path: Path) -> Iterator[Path]:
+    """A temporary path beside ``path`` (same suffix) to write; renamed onto ``path`` on success.
+
+    For writers that take a path (figures, recordings). On an exception the temporary file is
+    removed and ``path`` is left as it was.
+    """
+    # named by the process, and created by the writer, so it gets the permissions a plain write
+    # would (mkstemp's are owner-only)
+    tmp = path.with_name(f".{path.stem}.tmp-{os.getpid()}{path.suffix}")
+    tmp.unlink(missing_ok=True)
+    try:
+        yield tmp
+        with open(tmp, "rb+") as fh:
+            os.fsync(fh.fileno())
+        replace_durably(tmp, path)
+    finally:
+        tmp.unlink(missing_ok=True)
+
+
+def write_text(path: Path, text: str) -> Path:
+    """Write ``text`` (UTF-8) to ``path`` atomically; returns ``path``."""
+    with atomic_path(path) as tmp, open(tmp, "w", encoding="utf-8") as fh:
+        fh.write(text)
+    return path
+
+
+def _json_default(value: Any) -> Any:
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, np.generic):
+        return value.item()
+    raise TypeError(f"not JSON serialisable: {type(value)}")
+
+
+def to_json(data: Any) -> str:
+    """``data`` as indented JSON; numpy arrays and scalars become lists and numbers."""
+    return json.dumps(data, indent=2, default=_json_default)
+
+
+def write_json(path: Path, data: Any) -> Path:
+    """Write ``data`` as indented JSON to ``path`` atomically (see :func:`to_json`)."""
+    return write_text(path, to_json(data))

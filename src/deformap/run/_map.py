@@ -1,0 +1,109 @@
+"""Map a recorded session: its pokes, in order, through the live loop's mapper; write the result
+folder as a live run does (``config.yaml``, ``report.json``, ``map.png``, ``poke-NN.png``).
+
+A poke that cannot be read or processed is skipped and listed in the report; the others count.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from deformap.replay import RecordedSession, ReplayResult, load_session, map_session
+from deformap.run._config import (
+    CONFIG_NAME,
+    RunConfig,
+    config_yaml,
+    run_generators,
+    session_run_config,
+)
+from deformap.run._figures import write_map_figures
+from deformap.run._folder import (
+    create_run_folder,
+    default_run_folder,
+    run_stem,
+    write_json,
+    write_text,
+)
+from deformap.run._hooks import NO_HOOKS, RunHooks, RunStart
+from deformap.run._report import session_report
+
+__all__ = ["MapOutput", "map_recorded_session"]
+
+
+@dataclass(frozen=True, kw_only=True)
+class MapOutput:
+    """What :func:`map_recorded_session` wrote and the objects it made.
+
+    Attributes
+    ----------
+    report : dict
+        The content of ``report.json`` (see :mod:`deformap.run._report`).
+    session : RecordedSession
+    replay : ReplayResult
+    config : RunConfig
+        The configuration the session was mapped with.
+    folder : Path
+    """
+
+    report: dict[str, Any]
+    session: RecordedSession
+    replay: ReplayResult
+    config: RunConfig
+    folder: Path
+
+
+def map_recorded_session(
+    session: Path,
+    out: Path | None = None,
+    *,
+    config: RunConfig | None = None,
+    seed: int | None = None,
+    figures: bool = True,
+    hooks: RunHooks = NO_HOOKS,
+) -> MapOutput:
+    """Map the session at ``session`` (its folder or its ``session.yaml``) into ``out``.
+
+    Parameters
+    ----------
+    session : Path
+    out : Path, optional
+        A new or empty folder (default: :func:`~deformap.run.default_run_folder` of the
+        session's folder name, kind ``map``).
+    config : RunConfig, optional
+        Default: the configuration the session was recorded with, else the defaults (see
+        :func:`~deformap.run.session_run_config`).
+    seed : int, optional
+        Seed of the surface fit; default: the session's, so a recorded simulation maps to the βs
+        of its live run.
+    figures : bool
+        Write ``map.png`` and the ``poke-NN.png``.
+    hooks : RunHooks
+
+    Raises
+    ------
+    ConfigError, FileFormatError
+        The session cannot be loaded, its recorded configuration is malformed, or ``out`` is not
+        empty or not creatable (before any poke is mapped).
+    """
+    recorded = load_session(session)
+    cfg = session_run_config(recorded, config, seed)
+    stem = recorded.path.name or "session"
+    folder = out or default_run_folder(run_stem(stem), "map", cfg.seed)
+    create_run_folder(folder, what="result")
+    title = f"{recorded.path} ({len(recorded)} pokes, {recorded.form} form)"
+    hooks.start(RunStart(kind="map", title=title, folder=folder, total=len(recorded)))
+    _, explore_rng = run_generators(cfg.seed)
+    hooks.stage("mapping")
+    replay = map_session(recorded, cfg.exploration, rng=explore_rng,
+                         on_poke=lambda poke: hooks.poke(poke.record))  # fmt: skip
+    write_text(folder / CONFIG_NAME, config_yaml(cfg))
+    report = session_report(cfg, recorded, replay)
+    write_json(folder / "report.json", report)
+    if figures:
+        hooks.stage("drawing figures")
+        write_map_figures(folder, replay.result, truth=recorded.ground_truth,
+                          threshold=cfg.exploration.threshold,
+                          title=f"{stem}: {len(replay.result.pokes)} pokes")  # fmt: skip
+    return MapOutput(report=report, session=recorded, replay=replay, config=cfg, folder=folder)

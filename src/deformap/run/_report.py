@@ -1,0 +1,170 @@
+"""The one ``report.json`` schema, with one builder per kind of run.
+
+Every report of a mapped surface (a live exploration, :func:`live_report`; a recorded session,
+:func:`session_report`) holds the same core, built once by :func:`shared_report`:
+
+- ``pokes`` (one record per poke, as the mapper wrote it), ``n_pokes``, ``stop_reason``;
+- ``max_variance`` (what the stopping rule compared with T_h, over ``stop_region``) and
+  ``max_variance_map`` (over the whole map);
+- ``regions``: ``levels``, ``class_betas``, ``poke_labels``, ``labels_by`` and, with a ground
+  truth, the scores of :func:`deformap.eval.region_scores` (``None`` without a poke);
+- ``true_regions`` (only with a ground truth) and ``timings`` (the loop's, plus per poke).
+
+Around it, every report names the version (``deformap``), the ``seed`` and the effective
+``config``; a live run adds its ``scenario`` and ``timings.world_build_s``, a session its path,
+``form``, ``source``, ``skipped`` and ``warnings``. One poke estimated alone
+(:func:`estimate_report`) has no map and its own small schema.
+
+Poke records become plain data here (:meth:`deformap.explore.PokeRecord.to_dict`), at the report
+boundary.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from deformap import __version__
+from deformap._config import config_to_dict
+from deformap.environment import TactileContact
+from deformap.eval import region_scores
+from deformap.explore import ExplorationResult, PokeResult
+from deformap.replay import RecordedSession, ReplayResult
+from deformap.run._config import RunConfig
+from deformap.world import SimulatedWorld
+
+__all__ = [
+    "SHARED_KEYS",
+    "estimate_report",
+    "live_report",
+    "session_report",
+    "shared_report",
+]
+
+SHARED_KEYS = (
+    "pokes",
+    "n_pokes",
+    "stop_reason",
+    "max_variance",
+    "max_variance_map",
+    "regions",
+    "timings",
+)
+"""The keys :func:`shared_report` always writes (``true_regions`` too, with a ground truth)."""
+
+_ESTIMATE_KEYS = ("contact", "force_n", "betas", "errors", "converged", "iterations",
+                  "n_roi_points", "timings")  # fmt: skip
+
+
+def _finite(value: float | None) -> float | None:
+    return None if value is None or not math.isfinite(value) else float(value)
+
+
+def _regions(
+    result: ExplorationResult, beta: Any, truth: Any
+) -> tuple[dict[str, Any], list[Any] | None]:
+    """``regions`` and ``true_regions`` (``None`` without a ground truth) of a mapped surface
+    whose β-field mean on the grid is ``beta``."""
+    found = result.regions
+    assert found is not None  # shared_report asks only when there are pokes
+    # under region_labels "nearest" the cells take their nearest poke's class, and the levels
+    # only separate the classes' βs
+    regions: dict[str, Any] = {"levels": found.levels.tolist(),
+                               "class_betas": found.class_betas.tolist(),
+                               "poke_labels": found.poke_labels.tolist(),
+                               "labels_by": result.config.region_labels}  # fmt: skip
+    if truth is None:
+        return regions, None
+    labels = truth.ground_truth_labels(result.xs, result.ys)
+    hardness_grid = truth.ground_truth_hardness(result.xs, result.ys)
+    hardness = {int(label): float(hardness_grid[labels == label][0]) for label in np.unique(labels)}
+    scores = region_scores(found.labels, labels, beta, hardness)
+    true_regions = [
+        {"label": label, "hardness_n": _finite(h)} for label, h in sorted(hardness.items())
+    ]
+    return {**scores.to_dict(), **regions}, true_regions
+
+
+def shared_report(result: ExplorationResult, *, truth: Any = None) -> dict[str, Any]:
+    """The part of ``report.json`` that a live run and a recorded session share.
+
+    Parameters
+    ----------
+    result : ExplorationResult
+    truth : object with ``ground_truth_labels(xs, ys)`` and ``ground_truth_hardness(xs, ys)``
+        A :class:`~deformap.world.SimulatedWorld` or a session's
+        :class:`~deformap.replay.GroundTruth`; ``None`` leaves the ground-truth metrics out.
+    """
+    beta, var = result.field.mean, result.field.variance
+    pokes = [p.record.to_dict() for p in result.pokes]
+    per_poke_compute = [p.record.timings.compute_s for p in result.pokes]
+    regions, true_regions = _regions(result, beta, truth) if pokes else (None, None)
+    report: dict[str, Any] = {
+        "pokes": pokes,
+        "n_pokes": len(pokes),
+        "stop_reason": result.stop_reason,
+        "max_variance": result.max_variance,
+        "max_variance_map": float(var.max()),
+        "regions": regions,
+    }
+    if truth is not None:
+        report["true_regions"] = true_regions
+    report["timings"] = {
+        **result.timings,
+        "per_poke_s": [
+            (p.record.timings.environment_s or 0.0) + c
+            for p, c in zip(result.pokes, per_poke_compute, strict=True)
+        ],
+        "per_poke_compute_s": per_poke_compute,
+    }
+    return report
+
+
+def live_report(
+    config: RunConfig, result: ExplorationResult, world: SimulatedWorld, *, world_build_s: float
+) -> dict[str, Any]:
+    """``report.json`` of a live exploration of a simulated world (scored against its truth)."""
+    report = {
+        "deformap": __version__,
+        "scenario": config.scenario,
+        "seed": config.seed,
+        "config": config_to_dict(config),
+        **shared_report(result, truth=world),
+    }
+    report["timings"]["world_build_s"] = world_build_s
+    return report
+
+
+def session_report(
+    config: RunConfig, session: RecordedSession, replay: ReplayResult
+) -> dict[str, Any]:
+    """``report.json`` of a recorded session mapped offline (scored if it holds a ground truth)."""
+    return {
+        "deformap": __version__,
+        "session": str(session.path),
+        "form": session.form,
+        "source": {k: v for k, v in session.source.items() if k != "config"},
+        "seed": config.seed,
+        "config": config_to_dict(config),
+        **shared_report(replay.result, truth=session.ground_truth),
+        "skipped": replay.skipped,
+        "warnings": replay.warnings,
+    }
+
+
+def estimate_report(
+    before: Path, after: Path, contact: TactileContact, poke: PokeResult
+) -> dict[str, Any]:
+    """``estimate.json``: β of one poke with its uncertainty and E(β) curve."""
+    r = poke.record.to_dict()
+    return {
+        "before": str(before),
+        "after": str(after),
+        "beta": r["beta"],
+        "beta_std": r["beta_std"],
+        "contact_point": contact.contact_point.tolist(),
+        **{k: r[k] for k in _ESTIMATE_KEYS},
+    }

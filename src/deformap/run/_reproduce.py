@@ -1,0 +1,87 @@
+"""Reproduce the paper's Table I on the simulated world: one live run per scenario, in
+``out/<scenario>/``, and the table beside the paper's numbers in ``out/table.md`` and
+``out/table.json`` (rows and markdown from :mod:`deformap.eval`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from deformap.eval import PAPER_TABLE_I, markdown_table, table_row
+from deformap.run._config import RunConfig
+from deformap.run._explore import explore_scenario
+from deformap.run._folder import create_run_folder, default_run_folder, write_json, write_text
+from deformap.run._hooks import NO_HOOKS, RunHooks, RunStart
+
+__all__ = ["ReproduceOutput", "reproduce"]
+
+
+@dataclass(frozen=True, kw_only=True)
+class ReproduceOutput:
+    """What :func:`reproduce` wrote: ``table`` (``{"seed", "strategy", "rows"}``, the content of
+    ``table.json``), ``markdown`` (of ``table.md``) and the ``folder``."""
+
+    table: dict[str, Any]
+    markdown: str
+    folder: Path
+
+
+def _scenario_stage(hooks: RunHooks, scenario: str, text: str) -> None:
+    hooks.stage(f"{scenario}: {text}")
+
+
+def reproduce(
+    out: Path | None = None,
+    *,
+    base: RunConfig | None = None,
+    scenarios: Sequence[str] | None = None,
+    figures: bool = True,
+    on_run: Callable[[dict[str, Any]], None] | None = None,
+    hooks: RunHooks = NO_HOOKS,
+) -> ReproduceOutput:
+    """Run every scenario of Table I (or ``scenarios``) with ``base``'s settings.
+
+    Parameters
+    ----------
+    out : Path, optional
+        A new or empty folder (default: :func:`~deformap.run.default_run_folder`, stem
+        ``table-i``, kind ``reproduce``).
+    base : RunConfig, optional
+        Settings of every run; its ``scenario`` is replaced by each scenario's.
+    scenarios : sequence of str, optional
+        A subset (built-in names or YAML files); default: the six of Table I.
+    figures : bool
+        Write each run's figures.
+    on_run : callable, optional
+        Called with each table row as its run ends.
+    hooks : RunHooks
+        ``on_start`` once (total: the scenarios), ``on_stage`` per scenario and per stage of its
+        run, ``on_step`` per run.
+    """
+    base = base or RunConfig()
+    names = list(scenarios) if scenarios else list(PAPER_TABLE_I)
+    folder = out or default_run_folder("table-i", "reproduce", base.seed)
+    create_run_folder(folder, what="reproduction")
+    hooks.start(RunStart(kind="reproduce", title=f"{len(names)} scenarios, seed {base.seed}",
+                         folder=folder, total=len(names)))  # fmt: skip
+    rows = []
+    for name in names:
+        cfg = dataclasses.replace(base, scenario=name)
+        hooks.stage(name)
+        inner = RunHooks(on_stage=functools.partial(_scenario_stage, hooks, name))
+        report = explore_scenario(cfg, folder / name, figures=figures, hooks=inner).report
+        row = table_row(name, report, threshold=cfg.exploration.threshold)
+        rows.append(row)
+        if on_run is not None:
+            on_run(row)
+        hooks.step(name)
+    table = {"seed": base.seed, "strategy": base.exploration.strategy, "rows": rows}
+    markdown = markdown_table(table)
+    write_json(folder / "table.json", table)
+    write_text(folder / "table.md", markdown)
+    return ReproduceOutput(table=table, markdown=markdown, folder=folder)

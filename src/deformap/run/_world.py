@@ -1,0 +1,71 @@
+"""A look at the simulated world: the built-in scenarios in one table, and the pictures of one
+scenario (its layout, a camera cloud, a pressed dent).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from deformap.run._folder import create_run_folder
+from deformap.run._hooks import NO_HOOKS, RunHooks, RunStart
+from deformap.world import SimulatedWorld, WorldConfig, list_scenarios, load_scenario
+
+__all__ = ["ScenarioSummary", "scenario_summaries", "show_scenario"]
+
+
+@dataclass(frozen=True, kw_only=True)
+class ScenarioSummary:
+    """One built-in scenario: its ``name``, its ``regions`` (``"60 N"``, ``"rigid"``, ...) in
+    block order, and its ``description``."""
+
+    name: str
+    regions: tuple[str, ...]
+    description: str
+
+
+def scenario_summaries() -> list[ScenarioSummary]:
+    """Every built-in scenario (the paper's Table I), in :func:`deformap.world.list_scenarios`
+    order."""
+    out = []
+    for name in list_scenarios():
+        sc = load_scenario(name)
+        regions = tuple("rigid" if b.rigid else f"{b.hardness:.0f} N" for b in sc.blocks)
+        out.append(ScenarioSummary(name=name, regions=regions, description=sc.description))
+    return out
+
+
+def show_scenario(
+    name: str, out: Path, *, seed: int = 0, coarse: bool = False, hooks: RunHooks = NO_HOOKS
+) -> list[Path]:
+    """Write ``layout.png``, ``cloud.png`` and ``dent.png`` of scenario ``name`` into ``out``.
+
+    Parameters
+    ----------
+    name : str
+        Built-in scenario name or YAML file.
+    out : Path
+        A new or empty folder, created before the world is built.
+    seed : int
+        Seed of the camera and sensor noise.
+    coarse : bool
+        The coarse test mesh (fast).
+    hooks : RunHooks
+
+    Returns
+    -------
+    list of Path
+        The pictures written.
+    """
+    from deformap.viz import show_world  # matplotlib: only when pictures are drawn
+
+    scenario = load_scenario(name)
+    create_run_folder(out, what="picture")
+    hooks.start(RunStart(kind="world", title=f"{name} seed {seed}", folder=out))
+    hooks.stage("building the world")
+    config = WorldConfig.coarse() if coarse else WorldConfig()
+    world = SimulatedWorld(scenario, config=config, rng=np.random.default_rng(seed))
+    hooks.stage("drawing")
+    return show_world(world, out)
