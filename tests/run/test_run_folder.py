@@ -9,6 +9,7 @@ from pathlib import Path
 
 import pytest
 
+from deformap._validation import SettingError
 from deformap.errors import ConfigError
 from deformap.run import (
     RunConfig,
@@ -113,3 +114,16 @@ def test_a_writer_that_raises_leaves_the_old_file(tmp_path: Path) -> None:
         raise RuntimeError("plot failed")
     assert path.read_bytes() == b"old picture"
     assert os.listdir(tmp_path) == ["map.png"]
+
+
+def test_a_map_too_large_for_its_workspace_is_refused_before_the_folder(tmp_path: Path) -> None:
+    # an 8 × 8 m workspace at the default 0.5 cm grid: 2.56 million map cells
+    scenario = tmp_path / "hall.yaml"
+    scenario.write_text("name: hall\nworkspace: {lower: [0, 0], upper: [8, 8]}\nblocks:\n"
+                        "  - {name: soft, rect: [0.0, 0.0, 0.3, 0.4], hardness_n: 60}\n")
+    out = tmp_path / "run"
+    with pytest.raises(SettingError, match="surface.grid_spacing_m.*2,560,000 map cells"):
+        explore_scenario(RunConfig(scenario=str(scenario)), out)
+    with pytest.raises(SettingError, match="surface.grid_spacing_m"):
+        record_simulation(RunConfig(scenario=str(scenario)), out)
+    assert not out.exists()

@@ -23,7 +23,7 @@ from numpy.typing import NDArray
 from deformap.cloud import PointCloud
 from deformap.environment import PressObservation, Workspace
 from deformap.errors import EnvironmentStateError
-from deformap.explore._config import ExplorationConfig
+from deformap.explore._config import ExplorationConfig, check_exploration_budget
 from deformap.explore._dent import measure_press
 from deformap.explore._field import BetaField, PokeSet
 from deformap.explore._grid import MapGrid
@@ -48,6 +48,7 @@ class Mapper:
     """
 
     def __init__(self, workspace: Workspace, config: ExplorationConfig) -> None:
+        check_exploration_budget(config, workspace)
         self.workspace = workspace
         self.config = config
         self.grid = MapGrid.build(workspace, config)

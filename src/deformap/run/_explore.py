@@ -19,7 +19,14 @@ from typing import Any
 from deformap import __version__
 from deformap._config import config_from_dict, config_to_dict
 from deformap.errors import ConfigError, DeformapError
-from deformap.explore import JOURNAL_NAME, ExplorationResult, Journal, explore, read_journal
+from deformap.explore import (
+    JOURNAL_NAME,
+    ExplorationResult,
+    Journal,
+    check_exploration_budget,
+    explore,
+    read_journal,
+)
 from deformap.run._config import (
     CONFIG_NAME,
     RunConfig,
@@ -148,6 +155,7 @@ def explore_scenario(
     if resume and out is None:
         raise ConfigError("`out` must name the run folder to resume; got None")
     scenario = load_scenario(config.scenario)
+    check_exploration_budget(config.exploration, scenario.workspace)  # before any folder or work
     folder = out or default_run_folder(run_stem(config.scenario), "explore", config.seed)
     header = {"deformap": __version__, "config": config_to_dict(config),
               "scenario": scenario.to_dict()}  # fmt: skip

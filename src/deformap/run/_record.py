@@ -15,7 +15,7 @@ from pathlib import Path
 from deformap import __version__
 from deformap._config import config_to_dict
 from deformap.errors import ConfigError
-from deformap.explore import explore
+from deformap.explore import check_exploration_budget, explore
 from deformap.replay import SESSION_FORMATS, GroundTruth, RecordingEnvironment, write_session
 from deformap.run._config import RunConfig, run_generators
 from deformap.run._folder import create_run_folder, default_run_folder, run_stem
@@ -76,6 +76,7 @@ def record_simulation(
     if format not in SESSION_FORMATS:
         raise ConfigError(f"--format must be one of {list(SESSION_FORMATS)}; got {format!r}")
     scenario = load_scenario(config.scenario)
+    check_exploration_budget(config.exploration, scenario.workspace)  # before any folder or work
     folder = out or default_run_folder(run_stem(config.scenario), "record", config.seed)
     create_run_folder(folder, what="session")
     hooks.start(RunStart(kind="record", title=f"{config.scenario} seed {config.seed}",
