@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from deformap._validation import SettingError
 from deformap.environment import Workspace
 from deformap.errors import EnvironmentStateError
 from deformap.explore import (
@@ -14,6 +15,7 @@ from deformap.explore import (
     MapGrid,
     Mapper,
     PokeSet,
+    TouchGPConfig,
     map_regions,
     measure_press,
     poke_step,
@@ -138,3 +140,21 @@ def test_a_step_releases_the_press_even_when_the_estimate_fails() -> None:
         poke_step(mapper, 0, lambda: world.press(np.array([0.3, 0.2]), 0.6),
                   finish=lambda: released.append(world.release()))
     assert len(released) == 1 and mapper.pokes == ()
+
+
+def test_one_switch_says_where_beta_uncertainty_comes_from() -> None:
+    with pytest.raises(SettingError, match=r"touch\.noise_samples.*at least 2.*camera-noise"):
+        ExplorationConfig(touch=TouchGPConfig(noise_samples=0))
+    with pytest.raises(SettingError, match=r"touch\.noise_samples.*must be 0.*shape-matching"):
+        ExplorationConfig(beta_uncertainty="shape-matching")
+    world = coarse_world("homogeneous-60", seed=0)
+    config = ExplorationConfig(beta_uncertainty="shape-matching",
+                               touch=TouchGPConfig(noise_samples=0))
+    mapper = Mapper(world.workspace, config)
+    surface = mapper.initialise(world.observe(), np.random.default_rng(0))
+    obs = world.press(np.array([0.3, 0.2]), config.force_n)
+    world.release()
+    poke = measure_press(obs, 0, surface, config)
+    # the shape matcher's own uncertainty (the tile bootstrap): no camera noise is measured
+    assert poke.record.camera_noise_m is None
+    assert poke.estimate is not None and poke.record.beta_std == poke.estimate.beta_std > 0

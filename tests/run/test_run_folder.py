@@ -122,8 +122,8 @@ def test_a_map_too_large_for_its_workspace_is_refused_before_the_folder(tmp_path
     scenario.write_text("name: hall\nworkspace: {lower: [0, 0], upper: [8, 8]}\nblocks:\n"
                         "  - {name: soft, rect: [0.0, 0.0, 0.3, 0.4], hardness_n: 60}\n")
     out = tmp_path / "run"
-    with pytest.raises(SettingError, match="surface.grid_spacing_m.*2,560,000 map cells"):
+    with pytest.raises(SettingError, match=r"surface\.grid_spacing_m.*2,560,000 map cells"):
         explore_scenario(RunConfig(scenario=str(scenario)), out)
-    with pytest.raises(SettingError, match="surface.grid_spacing_m"):
+    with pytest.raises(SettingError, match=r"surface\.grid_spacing_m"):
         record_simulation(RunConfig(scenario=str(scenario)), out)
     assert not out.exists()

@@ -59,6 +59,7 @@ __all__ = [
     "MAX_PLAN_CELLS",
     "MAX_ROI_BAND_BYTES",
     "BetaFieldConfig",
+    "BetaUncertainty",
     "ExplorationConfig",
     "RegionLabels",
     "StopRegion",
@@ -74,6 +75,8 @@ TouchModel = Literal["residual", "height"]
 StopRegion = Literal["workspace", "targets"]
 #: How cells get their region (``ExplorationConfig.region_labels``).
 RegionLabels = Literal["isopleth", "nearest"]
+#: Where a poke's β uncertainty comes from (``ExplorationConfig.beta_uncertainty``).
+BetaUncertainty = Literal["camera-noise", "shape-matching"]
 
 #: Most bytes of one band of the ROI's shape-matching system (:mod:`deformap.msm._linsys`): the
 #: β sweep holds its two assembled bands and a few factorisations of that size at once, so 512 MiB
@@ -125,9 +128,9 @@ class SurfaceGPConfig:
 class TouchGPConfig:
     """The ROI around a poke and the Gaussian random field that reconstructs its dent.
 
-    ``noise_samples`` draws of the camera's noise through the touch GP give each poke's β
-    uncertainty (:mod:`deformap.explore._dent_noise`); 0 falls back to
-    ``ShapeMatchingConfig.uncertainty`` (the tile bootstrap of E(β) by default).
+    ``noise_samples``: how many draws of the camera's noise are carried through the touch GP when
+    β's uncertainty is the camera's noise (``ExplorationConfig.beta_uncertainty``, the one
+    switch; :mod:`deformap.explore._dent_noise`); 0 when it is not.
     """
 
     roi_size_m: float = setting(0.12, gt=0.0)
@@ -201,6 +204,12 @@ class ExplorationConfig:
         Pokes made after the variance has fallen below ``T_h``, each where a region boundary is
         least certain (:mod:`deformap.explore._acquisition`, "boundary pokes"); 0, the paper's
         rule, stops there.
+    beta_uncertainty : {"camera-noise", "shape-matching"}
+        The one switch for where each poke's β uncertainty (its noise in the β-field) comes from:
+        ``camera-noise``, the camera's noise measured in the ROI carried through the touch GP and
+        the estimate (``touch.noise_samples`` draws, at least 2); ``shape-matching``, the shape
+        matcher's own (``shape_matching.uncertainty``: the tile bootstrap or the E(β) tolerance;
+        ``touch.noise_samples`` must then be 0, so that no setting is silently ignored).
     """
 
     threshold: float = setting(0.06, gt=0.0)
@@ -215,6 +224,7 @@ class ExplorationConfig:
     region_prior_dof: float = setting(7.0, ge=0.0)
     region_labels: RegionLabels = "isopleth"
     boundary_pokes: int = setting(0, ge=0, le=1000)  # as for max_pokes
+    beta_uncertainty: BetaUncertainty = "camera-noise"
     surface: SurfaceGPConfig = field(default_factory=SurfaceGPConfig)
     touch: TouchGPConfig = field(default_factory=TouchGPConfig)
     beta_field: BetaFieldConfig = field(default_factory=BetaFieldConfig)
@@ -223,6 +233,19 @@ class ExplorationConfig:
     def __post_init__(self) -> None:
         check_settings(self)
         self._check_roi()
+        samples = self.touch.noise_samples
+        if self.beta_uncertainty == "camera-noise" and samples == 0:
+            raise SettingError(
+                "touch.noise_samples",
+                "must be at least 2 when `beta_uncertainty` is 'camera-noise' (or set "
+                "`beta_uncertainty` to 'shape-matching'); got 0",
+            )
+        if self.beta_uncertainty == "shape-matching" and samples != 0:
+            raise SettingError(
+                "touch.noise_samples",
+                "must be 0 when `beta_uncertainty` is 'shape-matching' (the shape matcher's "
+                f"`shape_matching.uncertainty` gives β's uncertainty then); got {samples}",
+            )
 
     def _check_roi(self) -> None:
         """The ROI's particle grid (``Mapper.roi_grid``: the surface grid's spacing, an odd node

@@ -10,7 +10,8 @@
 3. Shape matching from the ROI's heightmap before the press gives β̂
    (:func:`deformap.msm.estimate_beta`). Its uncertainty is the camera's noise, measured in the
    ROI by the points' median absolute deviation about X̄, carried through the estimate
-   (:func:`deformap.explore._dent_noise.dent_error_samples`), when ``noise_samples`` > 0.
+   (:func:`deformap.explore._dent_noise.dent_error_samples`) when ``beta_uncertainty`` is
+   ``camera-noise``; else the shape matcher's own (``shape_matching.uncertainty``).
 
 References
 ----------
@@ -125,7 +126,7 @@ def measure_press(obs: PressObservation, index: int, surface: SurfaceModel,
     deformed = np.column_stack([gx.ravel(), gy.ravel(), deformed_z.ravel()])
     t2 = time.perf_counter()
     samples, camera_noise = None, None
-    if cfg.noise_samples:
+    if config.beta_uncertainty == "camera-noise":
         # The camera's noise here, from the points' scatter about the reconstruction; the touch
         # GP's σₙ is a prior setting, not a measurement.
         fitted = np.asarray(touch.predict(roi[:, :2])) if len(roi) else np.zeros(0)
