@@ -168,8 +168,10 @@ def test_structural_yaml_corruption(templates: dict[str, Path], data: st.DataObj
 
 
 def _depends_on(form: str, file: str) -> set[str]:
-    """The reads that touch ``file`` (relative to the session folder); "load" touches all."""
-    if file in ("session.yaml", "ground_truth.npz"):
+    """The reads that touch ``file`` (relative to the session folder)."""
+    if file == "session.yaml":  # says what every read reads
+        return {"load", "observation", "press-0", "press-1"}
+    if file == "ground_truth.npz":
         return {"load"}
     if form == "folder":
         if file == "observation.pcd":
