@@ -29,6 +29,7 @@ def _surface_error(max_slope_deg: float) -> float:
     return float(np.max(np.abs(mapper.surface.height - truth)[np.ix_(rows, inner)]))
 
 
+@pytest.mark.slow
 def test_flat_block_surface_is_flat_once_its_front_face_is_dropped() -> None:
     # a camera at 45° sees the block's front face; fitted as heights, that wall made the GP ring
     # by millimetres across the whole map

@@ -9,6 +9,7 @@ import pytest
 from msm_cases import dent_case
 
 from deformap.environment import TactileContact
+from deformap.errors import InvalidArgumentError
 from deformap.mechanics import hertz_indentation
 from deformap.msm import (
     ParticleGrid,
@@ -209,7 +210,7 @@ def test_contact_far_outside_the_roi_is_refused():
     xs, ys, z, pts, _ = _ok()
     far = TactileContact(tip_center=np.array([0.9, 0.2, 0.06]), force=np.array([0, 0, -0.5]),
                          tip_radius_m=0.01)
-    with pytest.raises(Exception, match="`contact` must press inside the ROI"):
+    with pytest.raises(InvalidArgumentError, match="`contact` must press inside the ROI"):
         estimate_beta(xs, ys, z, pts, far)
 
 
@@ -217,7 +218,7 @@ def test_contact_on_the_fixed_edge_is_refused():
     xs, ys, z, pts, _ = _ok()
     edge = TactileContact(tip_center=np.array([xs[0], ys[4], 0.06]),
                           force=np.array([0, 0, -0.5]), tip_radius_m=0.01)
-    with pytest.raises(Exception, match="fixed edge"):
+    with pytest.raises(InvalidArgumentError, match="fixed edge"):
         estimate_beta(xs, ys, z, pts, edge)
 
 
@@ -225,13 +226,11 @@ def test_contact_on_the_fixed_edge_is_refused():
 def test_beta_outside_unit_interval_is_refused(betas):
     xs, ys, z, _, contact = _ok()
     g = _grid(xs, ys, z)
-    with pytest.raises(Exception, match="`betas`"):
+    with pytest.raises(InvalidArgumentError, match="`betas`"):
         simulate_poke(g.rest, g.masses, g.fixed, contact, betas, ShapeMatchingConfig())
 
 
 def test_bad_shapes_and_values_are_refused():
-    from deformap.errors import InvalidArgumentError
-
     xs, ys, z, pts, contact = _ok()
     g = _grid(xs, ys, z)
     cases = [

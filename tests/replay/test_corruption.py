@@ -1,17 +1,29 @@
-"""Hypothesis-generated corruptions of a session never crash with anything but a DeformapError."""
+"""Hypothesis-generated corruptions of a session: each read is refused with a DeformapError that
+names the session, or returns the right data.
+
+"Right" is what can be known without the bytes that were lost: a read that does not touch the
+corrupted file returns exactly what the intact session gives; a cut (truncated) data file is
+always refused; the ground truth (a zip with CRCs) is refused or read unchanged; a damaged
+``session.yaml`` that still loads gives as many pokes as it lists, each with the target and force
+it states. What cannot be checked is a flipped byte inside a cloud's raw floats (PCD and bag
+payloads carry no checksum): such a read must only not crash.
+"""
 
 from __future__ import annotations
 
 import shutil
 import tempfile
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pytest
 import yaml
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from deformap.cloud import PointCloud
 from deformap.errors import DeformapError
 from deformap.replay import load_session
 
@@ -34,19 +46,57 @@ def templates(tmp_path_factory: pytest.TempPathFactory, make_synthetic: Any,
     return out
 
 
-def _read_all(folder: Path) -> None:
-    """Load the session and read everything in it; only DeformapError may come out."""
+@pytest.fixture(scope="module")
+def intact(templates: dict[str, Path]) -> dict[str, dict[str, Any]]:
+    """What each intact template reads as (every read must succeed)."""
+    out = {form: _read_all(folder) for form, folder in templates.items()}
+    for form, outcomes in out.items():
+        assert not any(isinstance(o, DeformapError) for o in outcomes.values()), form
+        assert len(outcomes) == 4, form  # load, observation, two pokes
+    return out
+
+
+def _snapshot(value: Any) -> tuple[Any, ...]:
+    """What a read returned, as comparable bytes."""
+    if hasattr(value, "contact"):  # a PressObservation
+        return (value.cloud.points.tobytes(), value.robot_points.tobytes(),
+                value.contact.tip_center.tobytes(), value.contact.force.tobytes(),
+                np.asarray(value.target_xy).tobytes(), value.force_n)  # fmt: skip
+    if isinstance(value, PointCloud):
+        return (value.points.tobytes(),)
+    truth = value
+    if truth is None:
+        return (None,)
+    return (truth.xs.tobytes(), truth.ys.tobytes(), truth.labels.tobytes(),
+            truth.hardness.tobytes())  # fmt: skip
+
+
+def _read_all(folder: Path) -> dict[str, Any]:
+    """Load the session and read everything in it.
+
+    Returns ``{"load": ..., "observation": ..., "press-0": ..., ...}``, each a snapshot of what
+    came or the DeformapError raised; anything else raised fails the test.
+    """
     try:
         session = load_session(folder)
-    except DeformapError:
-        return
-    for read in [session.observation] + [
-        (lambda i=i: session.press_observation(i)) for i in range(len(session))
-    ]:
+    except DeformapError as exc:
+        return {"load": exc}
+    out: dict[str, Any] = {"load": (len(session), _snapshot(session.ground_truth))}
+    reads: list[tuple[str, Callable[[], Any]]] = [("observation", session.observation)]
+    for i in range(len(session)):
+        reads.append((f"press-{i}", (lambda i=i: session.press_observation(i))))
+    for name, read in reads:
         try:
-            read()
-        except DeformapError:
-            pass
+            out[name] = _snapshot(read())
+        except DeformapError as exc:
+            out[name] = exc
+    return out
+
+
+def _check_refusals_name_the_session(outcomes: dict[str, Any], folder: Path) -> None:
+    for name, outcome in outcomes.items():
+        if isinstance(outcome, DeformapError):
+            assert str(folder) in str(outcome), f"{name}: the error does not name the session"
 
 
 def _copy(template: Path) -> Path:
@@ -98,20 +148,50 @@ def test_structural_yaml_corruption(templates: dict[str, Path], data: st.DataObj
             else:
                 parent[where[-1]] = data.draw(_LEAVES)
         file.write_text(yaml.safe_dump(doc))
-        _read_all(folder)
+        outcomes = _read_all(folder)
+        _check_refusals_name_the_session(outcomes, folder)
+        if isinstance(outcomes["load"], DeformapError):
+            return
+        # it loaded, so the file's pokes are a list of entries, each read as the file states it
+        n_pokes, _ = outcomes["load"]
+        assert n_pokes == len(doc["pokes"])
+        for i, entry in enumerate(doc["pokes"]):
+            got = outcomes[f"press-{i}"]
+            if isinstance(got, DeformapError):
+                continue
+            force = entry["force_n"]
+            assert isinstance(force, (int, float)) and not isinstance(force, bool), force
+            assert got[5] == force
+            np.testing.assert_array_equal(np.frombuffer(got[4]), entry["target_xy"])
     finally:
         shutil.rmtree(folder.parent)
 
 
+def _depends_on(form: str, file: str) -> set[str]:
+    """The reads that touch ``file`` (relative to the session folder)."""
+    if file == "session.yaml":  # says what every read reads
+        return {"load", "observation", "press-0", "press-1"}
+    if file == "ground_truth.npz":
+        return {"load"}
+    if form == "folder":
+        if file == "observation.pcd":
+            return {"observation"}
+        return {f"press-{int(file[5:7]) - 1}"}  # poke-NN.pcd, poke-NN-robot.pcd
+    return {"observation", "press-0", "press-1"}  # bag/: the one bag holds every message
+
+
 @SETTINGS
 @given(data=st.data())
-def test_byte_corruption_of_any_file(templates: dict[str, Path], data: st.DataObject) -> None:
+def test_byte_corruption_of_any_file(
+    templates: dict[str, Path], intact: dict[str, dict[str, Any]], data: st.DataObject
+) -> None:
     form = data.draw(st.sampled_from(sorted(templates)))
     folder = _copy(templates[form])
     try:
         files = sorted(p for p in folder.rglob("*") if p.is_file())
         target = data.draw(st.sampled_from(files))
-        raw = bytearray(target.read_bytes())
+        original = target.read_bytes()
+        raw = bytearray(original)
         action = data.draw(st.sampled_from(["truncate", "flip", "insert"]))
         if action == "truncate" or not raw:
             raw = raw[: data.draw(st.integers(0, max(len(raw) - 1, 0)))]
@@ -123,6 +203,23 @@ def test_byte_corruption_of_any_file(templates: dict[str, Path], data: st.DataOb
             i = data.draw(st.integers(0, len(raw)))
             raw[i:i] = data.draw(st.binary(min_size=1, max_size=16))
         target.write_bytes(bytes(raw))
-        _read_all(folder)
+        outcomes = _read_all(folder)
+        _check_refusals_name_the_session(outcomes, folder)
+        name = target.relative_to(folder).as_posix()
+        touched = _depends_on(form, name) if bytes(raw) != original else set()
+        if action == "truncate" and name.endswith((".pcd", ".npz", ".mcap")):
+            # a cut data file is always refused, by the load or by each read of it
+            for read in touched:
+                assert isinstance(outcomes.get(read, outcomes["load"]), DeformapError), read
+        if name == "ground_truth.npz" and not isinstance(outcomes["load"], DeformapError):
+            assert outcomes["load"] == intact[form]["load"]  # zip CRCs: refused or unchanged
+        if isinstance(outcomes["load"], DeformapError):
+            assert "load" in touched or touched >= {"observation"}, "an untouched session refused"
+            return
+        for read, want in intact[form].items():
+            if read not in touched and read != "load":
+                assert outcomes[read] == want, f"{read} changed though {name} is not in it"
+        if "load" not in touched:
+            assert outcomes["load"] == intact[form]["load"]
     finally:
         shutil.rmtree(folder.parent)
