@@ -9,6 +9,7 @@ from pathlib import Path
 
 import pytest
 
+from deformap import _files as files_module
 from deformap._validation import SettingError
 from deformap.errors import ConfigError
 from deformap.run import (
@@ -22,7 +23,6 @@ from deformap.run import (
     write_json,
     write_text,
 )
-from deformap.run import _folder as folder_module
 
 
 def test_one_naming_scheme_for_every_kind_of_run() -> None:
@@ -98,7 +98,7 @@ def test_a_write_that_fails_leaves_the_old_file_and_no_temporary(tmp_path: Path,
     def cut(tmp: Path, target: Path) -> None:  # the rename never happens: killed before it
         raise OSError("killed")
 
-    monkeypatch.setattr(folder_module, "replace_durably", cut)
+    monkeypatch.setattr(files_module, "replace_durably", cut)
     with pytest.raises(OSError, match="killed"):
         write_text(path, "new: 2\n")
     assert path.read_text() == "old: 1\n"

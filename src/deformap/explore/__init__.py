@@ -20,7 +20,6 @@ from deformap.explore._journal import (
     Journal,
     JournalContents,
     read_journal,
-    replace_durably,
 )
 from deformap.explore._loop import explore, poke_step
 from deformap.explore._mapper import Mapper
@@ -71,7 +70,6 @@ __all__ = [
     "measure_press",
     "poke_step",
     "read_journal",
-    "replace_durably",
     "roi_grid",
     "segment_regions",
 ]

@@ -15,25 +15,14 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from deformap._files import replace_durably
 from deformap.errors import ConfigError, FileFormatError
 
-__all__ = ["Journal", "JournalContents", "read_journal", "replace_durably"]
+__all__ = ["JOURNAL_NAME", "Journal", "JournalContents", "read_journal"]
 
 logger = logging.getLogger(__name__)
 
 JOURNAL_NAME = "journal.jsonl"
-
-
-def replace_durably(tmp: Path, path: Path) -> None:
-    """Rename the written and fsynced ``tmp`` onto ``path``, then fsync the folder, so that the
-    rename itself survives a power cut (POSIX leaves it in the folder's cache until then)."""
-    os.replace(tmp, path)
-    if os.name == "posix":  # folders cannot be opened for fsync on Windows
-        fd = os.open(path.parent, os.O_RDONLY)
-        try:
-            os.fsync(fd)
-        finally:
-            os.close(fd)
 
 
 @dataclass

@@ -13,19 +13,16 @@
 
 from __future__ import annotations
 
-import contextlib
 import json
-import os
 import time
-from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from deformap._files import atomic_path, write_text_atomically
 from deformap.cloud.io import path_kind
 from deformap.errors import ConfigError
-from deformap.explore import replace_durably
 
 __all__ = [
     "RUNS_ROOT",
@@ -95,31 +92,9 @@ def create_run_folder(folder: Path, *, what: str = "run", resume_hint: bool = Fa
     return folder
 
 
-@contextlib.contextmanager
-def atomic_path(path: Path) -> Iterator[Path]:
-    """A temporary path beside ``path`` (same suffix) to write; renamed onto ``path`` on success.
-
-    For writers that take a path (figures, recordings). On an exception the temporary file is
-    removed and ``path`` is left as it was.
-    """
-    # named by the process, and created by the writer, so it gets the permissions a plain write
-    # would (mkstemp's are owner-only)
-    tmp = path.with_name(f".{path.stem}.tmp-{os.getpid()}{path.suffix}")
-    tmp.unlink(missing_ok=True)
-    try:
-        yield tmp
-        with open(tmp, "rb+") as fh:
-            os.fsync(fh.fileno())
-        replace_durably(tmp, path)
-    finally:
-        tmp.unlink(missing_ok=True)
-
-
 def write_text(path: Path, text: str) -> Path:
     """Write ``text`` (UTF-8) to ``path`` atomically; returns ``path``."""
-    with atomic_path(path) as tmp, open(tmp, "w", encoding="utf-8") as fh:
-        fh.write(text)
-    return path
+    return write_text_atomically(path, text)
 
 
 def _json_default(value: Any) -> Any:

@@ -22,7 +22,7 @@ from deformap.eval import (
     collect_presses,
     hardness_study,
 )
-from deformap.run._folder import atomic_path, create_run_folder, default_run_folder, write_json
+from deformap.run._folder import create_run_folder, default_run_folder, write_json
 from deformap.run._hooks import NO_HOOKS, RunHooks, RunStart
 from deformap.world import WorldConfig
 
@@ -54,8 +54,7 @@ def _foams(
 
 def _write(folder: Path, stem: str, study: dict[str, Any], plot: Any) -> list[Path]:
     json_file = write_json(folder / f"{stem}.json", study)
-    with atomic_path(folder / f"{stem}.png") as tmp:
-        plot(tmp, study)
+    plot(study, path=folder / f"{stem}.png")  # written atomically by viz
     return [json_file, folder / f"{stem}.png"]
 
 

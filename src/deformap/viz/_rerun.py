@@ -14,8 +14,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from deformap._files import atomic_path
 from deformap.errors import missing_extra
-from deformap.viz._save import writing_atomically
 
 __all__ = ["heightmap_mesh", "record_run"]
 
@@ -58,7 +58,7 @@ def record_run(path: str | Path, result: Any, *, initial_points: NDArray[np.floa
     except ImportError:
         raise missing_extra("rerun-sdk", "rerun", "writing 3D recordings") from None
     out = Path(path)
-    with writing_atomically(out) as tmp:
+    with atomic_path(out) as tmp:
         rec = rr.RecordingStream("deformap")
         rec.save(tmp)
         _log_run(rec, result, np.asarray(initial_points))
