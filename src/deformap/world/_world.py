@@ -10,8 +10,8 @@ says it indents 60, 110 and 150 N foam by 9.2, 6.1 and 5.0 mm; a 5 cm block bond
 is stiffer and dents less, but every foam of the range still dents by more than the axial noise
 at the camera's 1.1 m range (σ_z ≈ 2.1 mm per pixel, and a dent spans hundreds of pixels) and by
 less than half of the block (``tests/world/test_fem.py``,
-``test_stiffer_foam_dents_less_and_default_force_dents_clearly``; ``deformap world show`` draws
-one dent with its depth).
+``test_stiffer_foam_dents_less_and_default_force_dents_clearly``; the depths on the default mesh
+are in the README, "β separates hardness only under the force-driven protocol").
 
 Ground truth
 ------------
