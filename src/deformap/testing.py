@@ -58,7 +58,7 @@ hardness_to_modulus = hardness_to_youngs_modulus
 
 def coarse_world(scenario: str = "heterogeneous-60-110-rigid", seed: int = 0, **overrides: Any
                  ) -> Any:
-    """A :class:`deformap.world.SimulatedWorld` on the coarse test mesh (builds in < 1 s).
+    """A :class:`deformap.world.SimulatedWorld` on the coarse test mesh (quick to build).
 
     For tests of code that drives an ``Environment``; its dents are coarse-mesh numbers, not
     measurements. ``overrides`` go to :meth:`deformap.world.WorldConfig.coarse`.

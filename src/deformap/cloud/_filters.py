@@ -67,7 +67,7 @@ def crop_box(points: Any, lower: Any, upper: Any) -> NDArray[np.bool_]:
 
 
 def _mean_neighbour_distances(pts: NDArray[np.float64], k: int) -> NDArray[np.float64]:
-    from scipy.spatial import cKDTree  # imported here: scipy.spatial costs ~0.3 s at start-up
+    from scipy.spatial import cKDTree  # imported here: scipy.spatial is slow to import
 
     # Open3D counts the point itself among its k neighbours (distance 0), so query k, not k + 1.
     dist, _ = cKDTree(pts).query(pts, k=k)

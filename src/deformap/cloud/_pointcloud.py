@@ -22,8 +22,9 @@ class PointCloud:
     ----------
     points : (n, 3) float
         Positions in metres, in the frame named by ``frame``. Converted to float64; NaN and
-        infinite values are refused (drop them with :meth:`finite` on raw sensor data first, or
-        build the cloud from ``points[np.isfinite(points).all(axis=1)]``).
+        infinite values are refused (build the cloud of raw sensor data from
+        ``points[np.isfinite(points).all(axis=1)]``; the file readers drop them with
+        ``drop_nan=True``).
     colors : (n, 3) float in [0, 1], optional
         RGB colours. Integer input in [0, 255] is scaled to [0, 1].
     frame : str

@@ -4,7 +4,7 @@ The runs that write folders (an exploration, the reproduction of Table I) belong
 :mod:`deformap.run`, which uses this package; this package never imports it.
 
 The names are imported on first use: the studies and benchmarks pull in the simulated world and the
-whole estimator (about a second), which ``deformap --help`` and a metric alone never need.
+whole estimator (slow to import), which ``deformap --help`` and a metric alone never need.
 """
 
 from __future__ import annotations

@@ -11,25 +11,25 @@ Strategies
     A one-step look-ahead: the candidate whose addition leaves the smallest *largest* posterior
     variance over the grid. A GP's posterior variance does not depend on the observed values, only
     on where they are (RW2006 Eq. 2.26), so the look-ahead is exact before the poke is made. It is
-    myopic, though: measured on the 60×40 cm workspace with the default β-field (σw = 0.2 m,
-    T_h = 0.06, 5 seeds), ``max-variance`` stops after 7 pokes every time, ``paper`` after 8–11
-    and ``min-max-variance`` after 9.
+    myopic, though: the poke that lowers the worst cell most now is not the first of the fewest
+    pokes that bring every cell under ``T_h``.
 ``planned`` (the default)
     The first of the fewest further pokes that bring the largest variance under ``T_h``, planned
-    all together (:mod:`deformap.explore._planning`) and planned again after every poke: 5 pokes
-    on that workspace (the centre and four more), where ``max-variance`` needs 7 for the same
-    stopping rule.
+    all together (:mod:`deformap.explore._planning`) and planned again after every poke. How
+    many pokes each strategy needs on the simulated scenarios is in the README ("Results", the
+    paper's Table I).
 
 Boundary pokes (``boundary_pokes`` > 0, after any strategy)
     Once the variance is below ``T_h`` everywhere, the map is "known" in the paper's sense, but its
-    region boundaries are not: the β-field's length scale (0.2 m) smooths a block edge over
-    decimetres, and more pokes placed for variance alone leave the isopleths where they were
-    (measured in the README: region accuracy 0.83–0.90 with 11–16 pokes at T_h = 0.02). Each
+    region boundaries are not: the β-field's length scale (``BetaFieldConfig.length_scale_m``)
+    smooths a block edge over as much, and more pokes placed for variance alone leave the isopleths
+    where they were (README, "Region accuracy": a lower ``T_h`` against boundary pokes). Each
     boundary poke goes where a region boundary is least certain, by the *straddle* score of
-    level-set estimation (Bryan et al. 2005), ``1.96 σ(x) − min_l |μ(x) − h_l|`` over the
-    isopleths ``h_l`` between the classes found so far (``σ(x)`` alone while one class is found:
-    a region not yet met is looked for where the field is least known), among the reachable cells
-    at least a quarter ROI (3 cm) from every poke, where a new dent would overlap an old one.
+    level-set estimation (Bryan et al. 2005), ``1.96 σ(x) − min_l |μ(x) − h_l|`` over the isopleths
+    ``h_l`` between the classes found so far (``σ(x)`` alone while one class is found: a region not
+    yet met is looked for where the field is least known), among the reachable cells at least a
+    quarter ROI (``_targets.BOUNDARY_SPACING_ROI``) from every poke, where a new dent would
+    overlap an old one.
 
 References
 ----------

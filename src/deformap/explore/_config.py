@@ -8,12 +8,13 @@ well below any length scale a table-top surface has, and each likelihood evaluat
 the values below and one random restart; the map is read on the paper's 0.5 cm grid. Before the
 fit, points on surfaces steeper than 60° are dropped (``max_slope_deg``,
 :func:`deformap.cloud.height_field_mask`): a camera at 45° sees the front faces of the blocks, and
-fitted as heights those walls made the GP ring by ±1–2 mm over the whole map (measured on a
-homogeneous block: ±0.03 mm without them). The fitted length scale is kept at or above 3 cm
-(``min_length_scale_m``): a flat surface leaves it undetermined (the fitted signal is then
-micrometres and any length scale fits) and the camera's disparity steps pull it to millimetres,
-while the grid GP's cost grows steeply below it (fit and map of 46,000 points over 60×40 cm:
-28 s at 1.5 cm, 6.5 s at 2 cm, 0.9 s at 3 cm). The dents themselves are the touch GP's (1 cm).
+fitted as heights those walls make the GP ring over the whole map (README, "β separates hardness
+only under the force-driven protocol", says by how much). The fitted length scale is kept at or
+above 3 cm (``min_length_scale_m``): a flat surface leaves it undetermined (the fitted signal is
+then micrometres and any length scale fits) and the camera's disparity steps pull it to
+millimetres, while the grid GP's cost grows steeply below it (its compressed inducing features
+number about (extent / σ_w)², and its fit costs their cube, :mod:`deformap.gp`). The dents
+themselves are the touch GP's (1 cm).
 
 Robot removal: the convex hull of the robot's points (plus 2 mm: proprioception and camera do not
 agree to the millimetre), a ball of the tip's radius plus 3 mm around the tip (the tactile points
@@ -33,15 +34,15 @@ Its length scale (1 cm) is the tip's radius: the dent cannot vary faster than th
 β-field ("GPR β-field"): prior standard deviation 0.3 (variance 0.09, above the paper's threshold
 0.06 so that the unexplored map asks for a poke); length scale 0.2 m, a third of the table's width:
 the size of the foam pieces a robot is asked to tell apart; each poke's β uncertainty is its noise,
-with a floor of 0.03. That uncertainty is the camera's noise (measured in the ROI) carried
-through the estimate (``TouchGPConfig.noise_samples`` = 64 draws of the touch GP's smoother applied
-to noise, β̂ re-read on each, :mod:`deformap.explore._dent_noise`): about 0.01 / 0.025 / 0.05 /
-0.12 on 60 / 110 / 150 / 250 N blocks, about twice the spread of β̂ over eight places on one block
-(0.004 / 0.015 / 0.028 / 0.050), so it errs on the safe side. The floor stands for what the noise
-does not explain (a 150 N block's eight places spread by 0.03).
-Next pokes by ``planned`` (:mod:`deformap.explore._planning`): with these settings it needs 5
-pokes, the centre included, to bring every cell of a 60×40 cm table below 0.06, where
-``max-variance`` needs 7 and the paper's random choice (``paper``) 8–12.
+with a floor of 0.03. That uncertainty is the camera's noise (measured in each poke's ROI)
+carried through the estimate (``TouchGPConfig.noise_samples`` draws of the touch GP's smoother
+applied to noise, β̂ re-read on each, :mod:`deformap.explore._dent_noise`): a repeatability, which
+the README ("β separates hardness only under the force-driven protocol") compares with the spread
+of β̂ between places on one block. The floor stands for what the camera's noise does not explain
+(the rest of that spread, largest on the hard foams).
+Next pokes by ``planned`` (:mod:`deformap.explore._planning`): the fewest pokes, the centre
+included, that bring every cell below ``T_h``; the README ("Results", the paper's Table I) gives
+the pokes each strategy needs on the simulated scenarios.
 """
 
 from __future__ import annotations
@@ -189,7 +190,8 @@ class ExplorationConfig:
     force_n : float
         The commanded normal force of every press. 0.6 N keeps the Hertz contact of a 1 cm tip
         on the tip itself for foams down to 60 N (``F <= 4 E* R² / 3`` = 0.68 N) while denting
-        them by 4–7 mm, well above the camera's noise.
+        them by millimetres, well above the camera's noise (:mod:`deformap.world._world`,
+        "Default press force").
     max_regions : int
         Most regions the β-field is cut into (see :mod:`deformap.explore._regions`).
     region_prior_dof : float
@@ -248,7 +250,7 @@ class ExplorationConfig:
             )
 
     def _check_roi(self) -> None:
-        """The ROI's particle grid (``Mapper.roi_grid``: the surface grid's spacing, an odd node
+        """The ROI's particle grid (``_dent.roi_grid``: the surface grid's spacing, an odd node
         count per side) must hold one cluster and keep its linear system's band within
         :data:`MAX_ROI_BAND_BYTES` (half-width as in :mod:`deformap.msm._linsys`)."""
         spacing = self.surface.grid_spacing_m

@@ -6,14 +6,15 @@ another draw of its noise is what the β-field should take as the poke's noise (
 The GP's mean is linear in the data, ``m = W y`` with ``W = K*ₓ (K + Σ)⁻¹``, so the error that the
 noise ``ε ~ N(0, Σ)`` leaves in it is ``W ε``: drawn here without the data's values. This is the
 sampling spread of the reconstruction, not the GP's posterior: the posterior adds what the prior
-does not know about the surface (±0.75 mm on a typical ROI, which made β̂ look two to seven
-times less repeatable than repeated presses on one foam showed); what the reconstruction gets
-systematically wrong is left to the β-field's noise floor.
+does not know about the surface, which is not noise that another press would draw afresh (taken
+as the poke's noise, it made β̂ look far less repeatable than repeated presses on one foam are);
+what the reconstruction gets systematically wrong is left to the β-field's noise floor.
 
 The touch GP sees thousands of points in the ROI; here they are binned onto the ROI's own grid
 (a cell's points become one observation at its node, with noise σₙ/√count), which keeps the
-smoother exact on a few hundred pseudo-observations (milliseconds) and changes it little: the
-cells are half the kernel's length scale or less. The tactile points enter as they are.
+smoother exact on a few hundred pseudo-observations (one small Cholesky factorisation) and
+changes it little: the cells are half the kernel's length scale or less. The tactile points enter
+as they are.
 
 References
 ----------

@@ -72,8 +72,8 @@ def explore(
     journal : Journal, optional
         Each completed poke is appended (and fsynced) before the next one starts.
     done : sequence of dict
-        Poke records of a killed run, from its journal: they enter the β-field without being
-        pressed or estimated again.
+        Poke records of a killed run, as its journal holds them (:meth:`PokeRecord.to_dict`'s
+        form): they enter the β-field without being pressed or estimated again.
     on_poke : callable, optional
         Called after each new poke (progress display).
     """

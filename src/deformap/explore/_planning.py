@@ -16,8 +16,8 @@ whose plan reaches ``T_h`` is the plan.
 Every planned poke is assumed to come with the β-field's noise floor; a real poke often reports
 more, so the loop plans again after every poke with the uncertainties actually measured. Greedy
 one-step look-ahead (``min-max-variance``) and largest-variance-first (``max-variance``) are
-myopic: on the 60 × 40 cm workspace with the default prior they stop after 9 and 7 pokes, where
-a plan made at the first poke needs 5 (README, Results).
+myopic: each poke serves the worst cell now, not the set of pokes that covers the domain; the
+README ("Results", the paper's Table I) gives the pokes each strategy needs.
 
 References
 ----------

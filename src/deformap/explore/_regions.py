@@ -28,26 +28,25 @@ splitting with a calibrated test:
    scatter, ``ν₀ + n − 2 ≥ 2`` for ``n ≥ 3`` pokes: down to groups of 4 for the scale-free test,
    which learns the scatter from the βs alone, and of 3 when the claimed noise counts
    (``ν₀ ≥ 1``), so that a material met by a single poke beside two of another is still told
-   apart (three blocks met by five pokes, the fewest a 60×40 cm map needs with a planned
-   exploration).
+   apart (as when the few pokes a planned exploration needs meet three blocks; README,
+   "Results").
 
-Why not the scale-free test alone (``prior_dof=0``, this module's rule until the pokes' noise was
-measured, see :mod:`deformap.explore._dent_noise`): with the 7 pokes a 60×40 cm map needs, it
-cannot tell two foams 0.12 apart in β (110 and 150 N: 0.55–0.65 against 0.71–0.75), because it
-must learn the scatter from the same seven numbers. The isopleth between two neighbouring classes
-is the midpoint of their means; cells are labelled by the band of the β-field's mean they fall
-in, so a region is a level set of the map, and ``n_regions`` is the number of classes found.
+Why not the scale-free test alone (``prior_dof=0``): with the few pokes a map needs, it must learn
+the scatter from the same few βs it splits (``n − 2`` degrees of freedom), so its null distribution
+is wide and two neighbouring foams go untold; the pokes' measured noise
+(:mod:`deformap.explore._dent_noise`) is the information it lacks. The isopleth between two
+neighbouring classes is the midpoint of their means; cells are labelled by the band of the β-field's
+mean they fall in, so a region is a level set of the map, and ``n_regions`` is the number of classes
+found.
 
 Labelling by nearest poke (``ExplorationConfig.region_labels = "nearest"``)
 -----------------------------------------------------------------------------
 The classes are found as above; each cell then takes the class of the poke nearest to it instead
 of the band of the β-field it falls in (:meth:`RegionMap.nearest_poke`). The isopleths of a field
-with a 0.2 m length scale are smooth curves that revert towards the field's mean away from the
-pokes, and pokes placed to pin a boundary do not move them much: on the simulated 110-150 and
-60-110-rigid worlds with 20 pokes (15 of them boundary pokes), isopleths gave region accuracy
-0.74–0.85 where the nearest-poke labels of the same pokes gave 0.897–0.942 (0.79 where the
-region test found a third class; README, "Region accuracy"). With the 5 pokes of the default run the
-nearest-poke labels have the better minimum (0.79 against 0.66–0.70) but not ≥ 0.9 everywhere,
+with a decimetre length scale are smooth curves that revert towards the field's mean away from
+the pokes, and pokes placed to pin a boundary do not move them much; the nearest-poke labels of
+the same pokes follow the pokes instead. The README ("Region accuracy") compares the two, with
+the default pokes and with boundary pokes; with the default pokes neither labels every map well,
 and the paper's isopleths stay the default.
 
 References

@@ -24,15 +24,13 @@ __all__ = ["AUTO_EXACT_MAX_POINTS", "GaussianRandomField"]
 
 _LOG = logging.getLogger(__name__)
 
-#: ``method="auto"`` uses the exact GP up to this many points and the grid GP above. Measured on
-#: the shared 2-core machine (fit + mean and std on the prediction grid, best of 3, one BLAS thread
-#: for both paths): on the 60×40 cm surface (σ_w = 4 cm, 120×80 grid) exact 0.17 s vs grid 0.17 s
-#: at 500 points and 0.48 s vs 0.19 s at 1,000; on a 12 cm ROI (σ_w = 1 cm, 25×25 grid) exact
-#: 0.045 s vs grid 0.15 s at 1,000 and 0.10 s vs 0.15 s at 1,500. The grid path costs about the
-#: same at any n (its size follows the extent over σ_w); the exact path's grows as n² × the
-#: number of predicted points, so the crossover lies between these: 1,000 keeps the small
-#: problems exact and moves the large ones to the grid (which the speed bench measures within
-#: 1e-6 σₑ of exact in mean and 2e-6 relative in std).
+#: ``method="auto"`` uses the exact GP up to this many points and the grid GP above. The grid
+#: path costs about the same at any n (its size follows the extent over σ_w); the exact path's
+#: fit grows as n³ and its std as n² × the number of predicted points, so it is the cheaper one
+#: only for small n. The crossover depends on the problem (the surface's 120×80 grid, a ROI's
+#: 25×25) and on the machine; 1,000 keeps the small problems exact and moves the large ones to
+#: the grid, which ``deformap bench speed`` compares with the exact path in time and accuracy
+#: (``benchmarks/README.md``).
 AUTO_EXACT_MAX_POINTS = 1000
 _METHODS = ("auto", "exact", "grid")
 

@@ -64,11 +64,11 @@ GRID_MARGIN_FRACTION = 1.0
 #: 8·M² bytes = 1.2 GB).
 MAX_INDUCING = 12_000
 #: BLAS threads while the grid path runs (None: leave the process's setting). Its BLAS calls are
-#: mid-sized (M ≈ 1,400; per-cell products of a few hundred) and many, and every threaded call waits
-#: for all its threads: on the shared 2-core machine with other jobs running, fit + mean and std at
-#: 12,000 points took 1.9–3.8 s with 2 OpenBLAS threads and 0.24–0.25 s with 1 (best of 3 in
-#: each of four alternating rounds). Applied with threadpoolctl where it is installed (it comes with
-#: scikit-learn); without it the process's setting stays.
+#: mid-sized (M of the order of a thousand; per-cell products of a few hundred) and many, and every
+#: threaded call waits for all its threads: on a machine shared with other jobs one descheduled
+#: thread stalls each call, which costs far more than a second thread gains on calls this small.
+#: Applied with threadpoolctl where it is installed (it comes with scikit-learn); without it the
+#: process's setting stays.
 GRID_BLAS_THREADS: int | None = 1
 _BLOCK_BYTES = 32 * 2**20  # bound on the intermediate of one block of cells in the data term
 #: Candidate cell widths (× σ_w) for the interpolated data term; the cheapest by the flop model in
@@ -246,8 +246,8 @@ def _data_terms(
         for i, c in enumerate(block):
             seg = slice(bounds[c], bounds[c + 1])
             rows = (lag[seg, :, None] * root_hb[seg, None, :]).reshape(-1, degree * rb)
-            # A full GEMM, not SYRK: the next step reads all of E_c, and OpenBLAS's GEMM runs at
-            # twice SYRK's rate here, so it costs the same as SYRK plus the symmetrisation.
+            # A full GEMM, not SYRK: the next step reads all of E_c, and OpenBLAS's GEMM runs
+            # faster than its SYRK, which would then need a symmetrisation too.
             np.matmul(rows.T, rows, out=gram[i])
             rhs += h_nodes[c].T @ (lag[seg].T @ resid_hb[seg])
         _spread_cells(system, gram, h_nodes[c0 : block.stop])

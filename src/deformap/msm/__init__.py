@@ -10,15 +10,16 @@ computed once).
 Two protocols (``ShapeMatchingConfig.contact``):
 
 ``"pinned"`` — the paper: the surface sheet, edges fixed, the particle nearest the contact pinned at
-its observed depth. Converged, it does not separate foams: with the depth imposed, the dent of an
-elastic foam is matched best by the most rigid sheet (β̂ = 0 for every hardness on Hertz dents),
-and E(β) changes by only 1–20 % across β.
+its observed depth. Converged, it does not separate foams: with the depth imposed, and depth is
+what hardness changes, the dent of an elastic foam is matched best by the most rigid sheet
+(β̂ = 0 whatever the hardness) on a nearly flat E(β).
 
 ``"force"`` (default) — the measured tactile force acts on the particles under the tip, the body's
 spring stiffness is calibrated so that β = 0 dents like a 100 kPa elastic half-space, and the body
 is the surface over three layers of particles down to a fixed floor (a sheet fixed at its edges can
 only bend, and its dent is a cone as wide as the ROI). Softer foams dent deeper and need larger β:
-β̂ falls strictly with hardness, with interior minima, and a rigid surface gives β̂ = 0.
+β̂ falls with hardness, and a rigid surface gives β̂ = 0. The README ("β separates hardness only
+under the force-driven protocol") has both protocols' βs on analytic and simulated dents.
 
 References
 ----------

@@ -26,8 +26,9 @@ Array = NDArray[np.float64]
 
 _MAX_SPLIT = 0.3
 """A β steps with the factorisation of a smaller β already factorised when the splitting's
-contraction bound ``(β − β′) / (1 − β′)`` is at most this (:meth:`StepMatrices.solve`): on four
-40 × 40 bench dents (30–250 N foams), 22 factorisations instead of 53 for 4 % more iterations."""
+contraction bound ``(β − β′) / (1 − β′)`` is at most this (:meth:`StepMatrices.solve`): a
+splitting that removes at least 70 % of the error per step costs the β only a few iterations more
+than its own factorisation would, and saves that factorisation."""
 
 _KEEP_FACTORS = 3
 """Banded factorisations a β search keeps (:attr:`StepMatrices.max_factors`)."""
@@ -126,8 +127,8 @@ class _Sweep:
     def __init__(self, model: PokeModel, tree: cKDTree):
         self.model, self.tree = model, tree
         # each solve needs one factorisation and the sweep moves on through β: a few kept
-        # suffice, and reusing their arrays spares fresh memory (page faults cost as much as a
-        # banded factorisation on the 40 × 40 bench)
+        # suffice, and reusing their arrays spares fresh memory (whose page faults cost about as
+        # much as a banded factorisation)
         model.system.max_factors = _KEEP_FACTORS
         self.sims: dict[float, tuple[PokeSimulation, int]] = {}
         self.errors: dict[float, float] = {}
@@ -203,11 +204,10 @@ def _refine(sweep: _Sweep, step: float, resolution: float, tol: float) -> None:
     parabola (:func:`_vertex`) through the lowest β solved so far and its nearest solved
     neighbours, rounded to the grid, or, when that point is already solved to ``tol``, the
     unsolved grid neighbour of the lowest point solved to ``tol`` nearest that vertex; it stops
-    when that lowest point has both grid neighbours solved to ``tol``. That is three to five
-    solves on the Hertz dents of the tests and the bench (the former unit walk from the sweep's
-    parabola needed up to nine) instead of the ``2 step / resolution`` of an exhaustive grid, and
-    the same grid minimum. Every β compared is solved to ``tol``; the loosely swept β only guide
-    the parabola.
+    when that lowest point has both grid neighbours solved to ``tol``. That is a few solves
+    (README, "Speed and memory", counts them) instead of the ``2 step / resolution`` of an
+    exhaustive grid, and the same grid minimum. Every β compared is solved to ``tol``; the loosely
+    swept β only guide the parabola.
     """
     known = np.fromiter(sweep.errors, dtype=float)
     errs = np.fromiter(sweep.errors.values(), dtype=float)

@@ -78,7 +78,7 @@ def polar_components(m: Array, *, tol: float = 1e-14, max_iter: int = 30) -> Arr
     all_safe = bool(np.all(safe))
     # Newton converges to the polar factor of its start: started from R h(U), the closed-form
     # estimate below (h ≈ 1, symmetric positive definite), it lands on the R of x = R U in one
-    # or two steps instead of five or six from x itself
+    # or two steps instead of the several it takes from x itself
     if all_safe:
         cur = _polar_start(x, cof0, det0)
     else:

@@ -44,8 +44,8 @@ class ShapeMatchingConfig:
         ``beta_resolution`` grid within one sweep step of the best swept β, solve one grid point
         at a time, at the vertex of the parabola (in ``1 / (1 − β)``) through the lowest β
         solved so far and its neighbours, until the lowest grid point has both grid neighbours
-        solved (three to five further solves, each started from the equilibria of the nearest β
-        already solved).
+        solved (a few further solves, each started from the equilibria of the nearest β already
+        solved).
     beta_resolution : float
         Step of the local refinement (dimensionless).
     tol : float
@@ -56,9 +56,9 @@ class ShapeMatchingConfig:
     sweep_tol : float
         Tolerance of the coarse sweep and of the stiffness calibration when ``refine`` is on (at
         least ``tol``). The sweep only has to bracket the minimum: its E(β) differ by
-        micrometres, and ``1e-4`` moves a 5 mm dent's particles by under 0.5 µm, at half the
-        iterations of ``1e-6``. A swept β that the refinement then compares is solved again to
-        ``tol``, started from its swept equilibrium.
+        micrometres, and ``1e-4`` of a 5 mm dent is 0.5 µm, reached in fewer iterations than
+        ``1e-6``. A swept β that the refinement then compares is solved again to ``tol``, started
+        from its swept equilibrium.
     max_iter : int
         Iteration cap; a β that hits it is reported as not converged (never silently accepted).
     regularization : float

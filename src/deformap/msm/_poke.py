@@ -161,7 +161,7 @@ class Equilibrium:
         the residual restarts the history. Near large rotations (clusters under a deep dent
         turning inside out at high β) the step map is strongly non-linear: the residual of plain
         steps first grows, then contracts, and unguarded extrapolations kept throwing the iterate
-        back into the growing phase (a cycle of ~27 steps until ``max_iter``).
+        back into the growing phase, in a cycle that lasted until ``max_iter``.
         ``x0 (B, *grid, 3)``, optional: starting positions (only the free particles' are used, e.g.
         the equilibrium of a nearby β); the rest shape by default. The fixed point does not
         depend on it.

@@ -46,8 +46,8 @@ class ReplayResult:
     Attributes
     ----------
     result : ExplorationResult
-        The mapper after every usable poke (``stop_reason`` is ``"end-of-session"``), for the
-        report and figure helpers the live run uses.
+        What the mapper produced from every usable poke (``stop_reason`` is
+        ``"end-of-session"``), for the report and figure helpers the live run uses.
     skipped : list of dict
         ``{"index": i, "error": message}`` for each poke that could not be used, in order.
     """

@@ -24,7 +24,7 @@ One concept per module:
 This package may import every library package (``eval`` included); none of them imports it.
 
 The names are imported on first use: a run needs the simulated world and the whole estimator
-(about a second to import), which ``deformap --help`` never does.
+(slow to import), which ``deformap --help`` never needs.
 """
 
 from __future__ import annotations

@@ -13,8 +13,8 @@ between nodes, unlike the displacement interpolated at the target).
 
 Contact: after the solve, the top nodes inside the contact disc are put on the tip's lower cap
 (``u_z = −δ + R − sqrt(R² − r²)``), since there the foam touches the rigid tip. On a mesh coarser
-than the patch the nodal solution overshoots or undershoots the cap by about a millimetre; this
-projection keeps the surface the camera sees consistent with the tip it sees.
+than the patch the nodal solution overshoots or undershoots the cap; this projection keeps the
+surface the camera sees consistent with the tip it sees.
 
 Patch radius: Hertz's ``a`` assumes a half-space, but the foam is a layer bonded to the table and
 responds stiffer, so the tip sinks less than Hertz says and touches a smaller disc. The press

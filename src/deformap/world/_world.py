@@ -5,11 +5,13 @@ Default press force
 ``default_force_n = 0.6`` N. Hertz contact on the softest foam of the paper's range (60 N,
 E = 4.64 kPa, ν = 0.3) keeps the contact radius within the 1 cm tip, ``a ≤ R``, only for
 ``F ≤ 4 E* R² / 3 = 0.68 N``; beyond it the stick would touch the foam and a spherical-tip
-contact no longer describes the press. 0.6 N is that bound rounded down. At the default mesh,
-on 5 cm blocks, it indents 60, 110 and 150 N foam by 7.5, 4.9 and 4.1 mm (FEM; Hertz on a
-half-space says 9.2, 6.1 and 5.0 mm, the bonded layer is stiffer): every foam of the range dents
-by about twice the axial noise at the camera's 1.1 m range (σ_z ≈ 2.1 mm per pixel, and a dent
-spans hundreds of pixels) and far less than half of the block.
+contact no longer describes the press. 0.6 N is that bound rounded down. On a half-space, Hertz
+says it indents 60, 110 and 150 N foam by 9.2, 6.1 and 5.0 mm; a 5 cm block bonded to the table
+is stiffer and dents less, but every foam of the range still dents by more than the axial noise
+at the camera's 1.1 m range (σ_z ≈ 2.1 mm per pixel, and a dent spans hundreds of pixels) and by
+less than half of the block (``tests/world/test_fem.py``,
+``test_stiffer_foam_dents_less_and_default_force_dents_clearly``; the depths on the default mesh
+are in the README, "β separates hardness only under the force-driven protocol").
 
 Ground truth
 ------------
@@ -58,8 +60,10 @@ class WorldConfig:
     Parameters
     ----------
     element_size_m : float
-        In-plane size of the foam's hexahedra (7.5 mm: the default mesh builds in seconds; see
-        the convergence numbers in the package docstring).
+        In-plane size of the foam's hexahedra. 7.5 mm resolves the dent of the 1 cm tip (the
+        press's compliance converges at second order under refinement,
+        ``tests/world/test_fem.py``) while a world stays quick to build (``deformap bench world``,
+        ``benchmarks/README.md``).
     top_layer_m, layer_growth : float
         Thickness of the top element layer and growth factor of the layers below it.
     poisson_ratio : float
