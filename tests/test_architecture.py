@@ -53,6 +53,12 @@ def _module_name(path: Path) -> str:
     return ".".join(parts)
 
 
+def _is_module(name: str) -> bool:
+    """Whether ``name`` (``deformap.x.y``) is a module or package of the source tree."""
+    base = SRC.parent.joinpath(*name.split("."))
+    return base.with_suffix(".py").is_file() or (base / "__init__.py").is_file()
+
+
 def _imports(path: Path) -> list[tuple[int, str, list[str]]]:
     """``(line, module, names)`` of every deformap import in the file (in functions too)."""
     tree = ast.parse(path.read_text(encoding="utf-8"))
@@ -69,8 +75,15 @@ def _imports(path: Path) -> list[tuple[int, str, list[str]]]:
                 module = ".".join([*base, *(node.module.split(".") if node.module else [])])
             else:
                 module = node.module or ""
-            if module.startswith("deformap"):
-                out.append((node.lineno, module, [a.name for a in node.names]))
+            if not module.startswith("deformap"):
+                continue
+            names = [a.name for a in node.names]
+            # ``from deformap import run`` imports the subpackage ``deformap.run``
+            subs = [n for n in names if _is_module(f"{module}.{n}")]
+            out += [(node.lineno, f"{module}.{n}", []) for n in subs]
+            rest = [n for n in names if n not in subs]
+            if rest or not subs:
+                out.append((node.lineno, module, rest))
     return out
 
 
