@@ -168,3 +168,17 @@ def test_yaml_that_the_parser_cannot_take_is_a_config_error(
     bad.write_bytes(content)
     with pytest.raises(ConfigError, match=rf"bad\.yaml.*{message}"):
         load_yaml(bad)
+
+
+def test_a_retired_setting_in_an_older_file_is_ignored_with_a_warning(caplog) -> None:  # type: ignore[no-untyped-def]
+    from deformap.run import RunConfig
+    from deformap.world import WorldConfig
+
+    older = {"world": {"default_force_n": 0.6, "element_size_m": 0.02}}
+    with caplog.at_level("WARNING", logger="deformap._config"):
+        config = config_from_dict(RunConfig, older)
+    assert config.world == WorldConfig(element_size_m=0.02)
+    assert "`config.world.default_force_n` is no longer a setting" in caplog.text
+    # a key that never was a setting is still refused
+    with pytest.raises(ConfigError, match="unknown key"):
+        config_from_dict(RunConfig, {"world": {"default_force": 0.6}})

@@ -11,6 +11,7 @@ refusal is a :class:`~deformap.errors.ConfigError` that names the field by its d
 from __future__ import annotations
 
 import dataclasses
+import logging
 import types
 import typing
 from pathlib import Path
@@ -22,6 +23,8 @@ from deformap._validation import SettingError
 from deformap.errors import ConfigError, DeformapError
 
 __all__ = ["config_from_dict", "config_to_dict", "dump_yaml", "load_yaml"]
+
+logger = logging.getLogger(__name__)
 
 T = TypeVar("T")
 
@@ -62,6 +65,8 @@ def _shape(value: Any, hint: Any, where: str) -> Any:
 def config_from_dict(cls: type[T], data: Any, *, where: str = "config") -> T:
     """Build the settings dataclass ``cls`` from plain data; missing keys keep their defaults.
 
+    A key the class lists in its ``RETIRED_SETTINGS`` (a setting that was removed, with why) is
+    accepted with a logged warning and dropped, so configuration files written before still load.
     The data is only shaped (mappings into nested dataclasses, lists into tuples) and handed to
     the constructor, whose ``__post_init__`` checks every field (:func:`check_settings`): a value
     is refused or accepted exactly as it would be from Python.
@@ -77,6 +82,11 @@ def config_from_dict(cls: type[T], data: Any, *, where: str = "config") -> T:
     if not isinstance(data, dict):
         raise ConfigError(f"`{where}` must be a mapping of settings; got {data!r}")
     fields = {f.name: f for f in dataclasses.fields(cls) if f.init}  # type: ignore[arg-type]
+    # settings that were removed: accepted in files written before, said once, and dropped
+    retired: dict[str, str] = getattr(cls, "RETIRED_SETTINGS", {})
+    for key in sorted(set(data) & set(retired)):
+        logger.warning("`%s.%s` is no longer a setting (%s); ignored", where, key, retired[key])
+    data = {k: v for k, v in data.items() if k not in retired}
     unknown = sorted(set(data) - set(fields))
     if unknown:
         raise ConfigError(

@@ -222,7 +222,7 @@ def test_show_world_writes_three_pictures_and_nothing_else(tmp_path: Path) -> No
     from deformap.testing import coarse_world
 
     out = tmp_path / "new" / "folder"
-    paths = show_world(coarse_world("heterogeneous-150-rigid"), str(out))
+    paths = show_world(coarse_world("heterogeneous-150-rigid"), str(out), force_n=0.6)
     assert paths == [out / "layout.png", out / "cloud.png", out / "dent.png"]
     assert sorted(out.iterdir()) == sorted(paths)
     for path in paths:
@@ -297,7 +297,7 @@ def test_importing_and_drawing_leave_matplotlib_global_state_alone(tmp_path: Pat
         for name, call in sorted(test_figures.CALLS.items()):
             call(out / (name + ".png"))
         from deformap.testing import coarse_world
-        deformap.viz.show_world(coarse_world("heterogeneous-150-rigid"), out / "world")
+        deformap.viz.show_world(coarse_world("heterogeneous-150-rigid"), out / "world", force_n=0.6)
         assert matplotlib.get_backend() == backend, ("after drawing", matplotlib.get_backend())
         assert dict(matplotlib.rcParams) == rc, "rcParams changed by drawing"
         assert "matplotlib.pyplot" not in sys.modules, "pyplot imported"

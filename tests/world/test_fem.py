@@ -7,6 +7,7 @@ import pytest
 from skfem import Basis, ElementHex1, ElementVectorH1, MeshHex, asm
 from skfem.models.elasticity import lame_parameters, linear_elasticity
 
+from deformap.explore import ExplorationConfig
 from deformap.world import (
     Block,
     Scenario,
@@ -109,7 +110,7 @@ def test_stiffer_foam_dents_less_and_default_force_dents_clearly() -> None:
     sigma = c.sigma_base_m + c.sigma_quadratic_m * (rng_m - c.sigma_reference_m) ** 2
     depths = []
     for hardness in (60.0, 110.0, 150.0):
-        dent = _small_world(hardness).dent(target, config.default_force_n, tip_radius_m=0.01)
+        dent = _small_world(hardness).dent(target, ExplorationConfig().force_n, tip_radius_m=0.01)
         assert dent.contact_radius_m <= 0.01
         depths.append(dent.depth_m)
     assert depths[0] > depths[1] > depths[2]

@@ -15,6 +15,7 @@ from scipy.spatial import Delaunay
 from deformap.cloud import PointCloud
 from deformap.environment import Environment, PressObservation
 from deformap.errors import EnvironmentStateError, InvalidArgumentError
+from deformap.explore import ExplorationConfig
 from deformap.world import (
     CameraConfig,
     SimulatedWorld,
@@ -134,7 +135,7 @@ def test_world_seen_through_the_numpy_caster_equals_embree() -> None:
 def test_press_returns_contact_robot_and_occluding_probe(world) -> None:
     w = _fresh(world)
     before = w.observe()
-    force = w.config.default_force_n
+    force = ExplorationConfig().force_n
     obs = w.press((0.08, 0.2), force)
     assert isinstance(obs, PressObservation)
     contact = obs.contact

@@ -7,11 +7,14 @@ from typing import Any
 
 import numpy as np
 
+from deformap.explore import ExplorationConfig
+
 __all__ = ["bench_world"]
 
 
 def bench_world(*, scenario: str = "heterogeneous-60-110-rigid", rng: np.random.Generator,
-                config: Any = None, n_presses: int = 3) -> dict[str, Any]:
+                config: Any = None, n_presses: int = 3,
+                force_n: float = ExplorationConfig().force_n) -> dict[str, Any]:
     """Time one world at its default mesh (goals: build ≤ 20 s, press ≤ 1 s, observe ≤ 0.5 s).
 
     Parameters
@@ -23,6 +26,8 @@ def bench_world(*, scenario: str = "heterogeneous-60-110-rigid", rng: np.random.
         Defaults to ``WorldConfig()`` (the default mesh).
     n_presses : int
         Presses timed (median reported) at points spread over the workspace.
+    force_n : float
+        Their force (default: the exploration's).
 
     Returns
     -------
@@ -45,7 +50,7 @@ def bench_world(*, scenario: str = "heterogeneous-60-110-rigid", rng: np.random.
     press_times = []
     for f in np.linspace(0.2, 0.8, n_presses):
         t0 = time.perf_counter()
-        world.press((x0 + f * (x1 - x0), y0 + 0.5 * (y1 - y0)), cfg.default_force_n)
+        world.press((x0 + f * (x1 - x0), y0 + 0.5 * (y1 - y0)), force_n)
         press_times.append(time.perf_counter() - t0)
         world.release()
     return {

@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
+from deformap.explore import ExplorationConfig
 from deformap.run._folder import create_run_folder
 from deformap.run._hooks import NO_HOOKS, RunHooks, RunStart
 from deformap.world import SimulatedWorld, WorldConfig, list_scenarios, load_scenario
@@ -38,7 +39,8 @@ def scenario_summaries() -> list[ScenarioSummary]:
 
 
 def show_scenario(
-    name: str, out: Path, *, seed: int = 0, coarse: bool = False, hooks: RunHooks = NO_HOOKS
+    name: str, out: Path, *, seed: int = 0, coarse: bool = False,
+    force_n: float = ExplorationConfig().force_n, hooks: RunHooks = NO_HOOKS,
 ) -> list[Path]:
     """Write ``layout.png``, ``cloud.png`` and ``dent.png`` of scenario ``name`` into ``out``.
 
@@ -52,6 +54,8 @@ def show_scenario(
         Seed of the camera and sensor noise.
     coarse : bool
         The coarse test mesh (fast).
+    force_n : float
+        The press of ``dent.png`` (default: the exploration's).
     hooks : RunHooks
 
     Returns
@@ -68,4 +72,4 @@ def show_scenario(
     config = WorldConfig.coarse() if coarse else WorldConfig()
     world = SimulatedWorld(scenario, config=config, rng=np.random.default_rng(seed))
     hooks.stage("drawing")
-    return show_world(world, out)
+    return show_world(world, out, force_n=force_n)

@@ -32,11 +32,12 @@ def _press_target(world: SimulatedWorld) -> np.ndarray:
     return np.asarray(soft.polygon.mean(axis=0))
 
 
-def show_world(world: SimulatedWorld, out: str | Path) -> list[Path]:
+def show_world(world: SimulatedWorld, out: str | Path, *, force_n: float) -> list[Path]:
     """Write ``layout.png``, ``cloud.png`` and ``dent.png`` into ``out``; returns their paths.
 
     The folder is created if needed; each file is written atomically. ``cloud.png`` observes the
-    world once, and ``dent.png`` presses the centroid of its softest foam block once and releases it.
+    world once, and ``dent.png`` presses the centroid of its softest foam block once with
+    ``force_n`` newtons and releases it.
     """
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
@@ -74,13 +75,12 @@ def show_world(world: SimulatedWorld, out: str | Path) -> list[Path]:
     a2.scatter(cloud.xy[band, 1], cloud.z[band], s=0.5)
     a2.set(xlabel="y [m]", ylabel="z [m]", title="side view of a 2 cm band at the centre x")
     paths.append(save_figure(fig, out / "cloud.png", dpi=120, bbox_inches="tight"))
-    paths.append(_dent_figure(world, out))
+    paths.append(_dent_figure(world, out, force_n))
     return paths
 
 
-def _dent_figure(world: SimulatedWorld, out: Path) -> Path:
+def _dent_figure(world: SimulatedWorld, out: Path, force: float) -> Path:
     target = _press_target(world)
-    force = world.config.default_force_n
     obs = world.press(target, force)
     dent = world.dent(target, force)
     world.release()

@@ -12,7 +12,7 @@ Quick start::
     scenario = load_scenario("heterogeneous-60-110-rigid")
     world = SimulatedWorld(scenario, rng=np.random.default_rng(0))
     cloud = world.observe()
-    obs = world.press((0.1, 0.2), world.config.default_force_n)
+    obs = world.press((0.1, 0.2), 0.6)   # target (m), force (N)
     world.release()
 """
 

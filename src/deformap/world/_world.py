@@ -1,17 +1,12 @@
 """The simulated world: scenario + foam FEM + depth camera + probe, as an ``Environment``.
 
-Default press force
--------------------
-``default_force_n = 0.6`` N. Hertz contact on the softest foam of the paper's range (60 N,
-E = 4.64 kPa, ν = 0.3) keeps the contact radius within the 1 cm tip, ``a ≤ R``, only for
-``F ≤ 4 E* R² / 3 = 0.68 N``; beyond it the stick would touch the foam and a spherical-tip
-contact no longer describes the press. 0.6 N is that bound rounded down. On a half-space, Hertz
-says it indents 60, 110 and 150 N foam by 9.2, 6.1 and 5.0 mm; a 5 cm block bonded to the table
-is stiffer and dents less, but every foam of the range still dents by more than the axial noise
-at the camera's 1.1 m range (σ_z ≈ 2.1 mm per pixel, and a dent spans hundreds of pixels) and by
-less than half of the block (``tests/world/test_fem.py``,
-``test_stiffer_foam_dents_less_and_default_force_dents_clearly``; the depths on the default mesh
-are in the README, "β separates hardness only under the force-driven protocol").
+Press force
+-----------
+The world is pressed with whatever force its caller commands (``press(target_xy, force_n)``); it
+owns no press force of its own. The exploration's (``ExplorationConfig.force_n``, 0.6 N) keeps a
+spherical-tip contact on every foam of the paper's range; the world's tests check that it dents
+every foam by more than the camera's noise and by less than half of the block
+(``tests/world/test_fem.py``).
 
 Ground truth
 ------------
@@ -24,7 +19,7 @@ from __future__ import annotations
 import logging
 import math
 from dataclasses import dataclass, field, replace
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 import trimesh
@@ -67,8 +62,6 @@ class WorldConfig:
     top_layer_m, layer_growth : float
         Thickness of the top element layer and growth factor of the layers below it.
     poisson_ratio : float
-    default_force_n : float
-        Press force the exploration uses when it has no other (see the module docstring).
     tip_radius_m, stick_length_m, stick_radius_m : float
         The probe: spherical tip (1 cm, Optoforce-like), stick (10 cm long).
     hand_size_m : (3,) float
@@ -89,7 +82,6 @@ class WorldConfig:
     top_layer_m: float = setting(0.005, gt=0.0, ge=0.001)
     layer_growth: float = setting(1.5, ge=1.0, le=10.0)
     poisson_ratio: float = setting(0.3, ge=0.0, lt=0.5)  # 0.5 makes the FEM's λ infinite
-    default_force_n: float = setting(0.6, gt=0.0)
     tip_radius_m: float = setting(0.01, gt=0.0)
     stick_length_m: float = setting(0.10, gt=0.0)
     stick_radius_m: float = setting(0.006, gt=0.0)
@@ -98,6 +90,11 @@ class WorldConfig:
     noise: bool = True
     camera: CameraConfig = field(default_factory=CameraConfig)
     table_margin_m: float = setting(0.2, gt=0.0)
+
+    #: Settings that were removed, accepted (and ignored) in configuration files written before.
+    RETIRED_SETTINGS: ClassVar[dict[str, str]] = {
+        "default_force_n": "the press force is the exploration's `force_n`",
+    }
 
     def __post_init__(self) -> None:
         check_settings(self)
