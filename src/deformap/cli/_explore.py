@@ -77,7 +77,9 @@ def explore_command(
         typer.Option(help="Run folder (default runs/<scenario>-explore-s<seed>-<time>)."),
     ] = None,
     strategy: Annotated[
-        str | None, typer.Option(help="paper | max-variance | min-max-variance | planned.")
+        str | None,
+        typer.Option(help="How the next poke is chosen: `exploration.strategy` (a name it does "
+                     "not know is refused with the list of choices)."),
     ] = None,
     threshold: Annotated[
         float | None,

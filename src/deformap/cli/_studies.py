@@ -105,7 +105,8 @@ def reproduce_command(
     seed: Annotated[int, typer.Option(help="Seed of every run.")] = 0,
     strategy: Annotated[
         str | None,
-        typer.Option(help="paper | max-variance | min-max-variance | planned (default: the config's)."),
+        typer.Option(help="`exploration.strategy` of every run (default: the config's; a name it "
+                     "does not know is refused with the list of choices)."),
     ] = None,
     config: Annotated[Path | None, typer.Option(help="Run configuration YAML.")] = None,
     scenario: Annotated[
