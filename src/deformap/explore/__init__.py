@@ -21,7 +21,7 @@ from deformap.explore._journal import (
     JournalContents,
     read_journal,
 )
-from deformap.explore._loop import explore, poke_step
+from deformap.explore._loop import MappingRun, explore, poke_step
 from deformap.explore._mapper import Mapper
 from deformap.explore._records import (
     PURPOSES,
@@ -51,6 +51,7 @@ __all__ = [
     "JournalContents",
     "MapGrid",
     "Mapper",
+    "MappingRun",
     "PokeRecord",
     "PokeResult",
     "PokeSet",

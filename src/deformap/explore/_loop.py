@@ -14,14 +14,15 @@ from typing import Any
 
 import numpy as np
 
-from deformap.environment import Environment, PressObservation
+from deformap.cloud import PointCloud
+from deformap.environment import Environment, PressObservation, Workspace
 from deformap.explore._config import ExplorationConfig
 from deformap.explore._journal import Journal
 from deformap.explore._mapper import Mapper
 from deformap.explore._records import PokeRecord, PokeResult, Target
 from deformap.explore._result import ExplorationResult
 
-__all__ = ["explore", "poke_step"]
+__all__ = ["MappingRun", "explore", "poke_step"]
 
 
 def poke_step(mapper: Mapper, index: int, acquire: Callable[[], PressObservation], *,
@@ -46,6 +47,48 @@ def poke_step(mapper: Mapper, index: int, acquire: Callable[[], PressObservation
     if target_s is not None:
         timings = {"target_s": target_s, **timings}
     return mapper.add(poke, target=target, timings=timings)
+
+
+class MappingRun:
+    """What every exploration shares around its pokes, live or replayed: observe and fit the
+    surface model (timed), one :func:`poke_step` per poke (its environment time counted), and the
+    result with the run's timings.
+
+    Parameters
+    ----------
+    workspace : Workspace
+    config : ExplorationConfig
+    observe : callable
+        ``() -> PointCloud``, the first observation (``Environment.observe``, or a session's).
+    surface_rng : numpy.random.Generator
+        The stream that fits the surface model.
+    """
+
+    def __init__(self, workspace: Workspace, config: ExplorationConfig,
+                 observe: Callable[[], PointCloud], surface_rng: np.random.Generator) -> None:
+        self._t_start = time.perf_counter()
+        self.mapper = Mapper(workspace, config)
+        cloud = observe()
+        t_observed = time.perf_counter()
+        self.mapper.initialise(cloud, surface_rng)
+        self._timings = {"observe_s": t_observed - self._t_start,
+                         "surface_gp_s": time.perf_counter() - t_observed}  # fmt: skip
+        self._environment_s = 0.0
+
+    def step(self, index: int, acquire: Callable[[], PressObservation], *,
+             finish: Callable[[], None] | None = None, target: Target | None = None,
+             target_s: float | None = None) -> PokeResult:
+        """:func:`poke_step` on this run's mapper."""
+        poke = poke_step(self.mapper, index, acquire, finish=finish, target=target,
+                         target_s=target_s)  # fmt: skip
+        self._environment_s += poke.record.timings.environment_s or 0.0
+        return poke
+
+    def result(self, stop_reason: str) -> ExplorationResult:
+        """The result, with ``total_s``, ``observe_s``, ``surface_gp_s`` and ``environment_s``."""
+        timings = {"total_s": time.perf_counter() - self._t_start, **self._timings,
+                   "environment_s": self._environment_s}  # fmt: skip
+        return self.mapper.result(stop_reason, timings)
 
 
 def explore(
@@ -77,17 +120,12 @@ def explore(
     on_poke : callable, optional
         Called after each new poke (progress display).
     """
-    t_start = time.perf_counter()
     streams = rng.spawn(config.max_pokes + 1)
-    mapper = Mapper(env.workspace, config)
-    cloud = env.observe()
-    t_observed = time.perf_counter()
-    mapper.initialise(cloud, streams[0])
-    t_surface = time.perf_counter()
+    run = MappingRun(env.workspace, config, env.observe, streams[0])
+    mapper = run.mapper
     for k, record in enumerate(done):
         mapper.add(PokeResult(PokeRecord.from_dict(record, where=f"journal poke {k + 1}")))
     stop = "max_pokes"
-    env_s = 0.0
     while len(mapper.pokes) < config.max_pokes:
         index = len(mapper.pokes)
         t_target = time.perf_counter()
@@ -100,10 +138,8 @@ def explore(
         if target is None:
             stop = "threshold"
             break
-        poke = poke_step(mapper, index, partial(env.press, target.xy, config.force_n),
-                         finish=env.release, target=target,
-                         target_s=time.perf_counter() - t_target)  # fmt: skip
-        env_s += poke.record.timings.environment_s or 0.0
+        poke = run.step(index, partial(env.press, target.xy, config.force_n), finish=env.release,
+                        target=target, target_s=time.perf_counter() - t_target)  # fmt: skip
         if journal is not None:
             journal.append(poke.record.to_dict())
         if on_poke is not None:
@@ -113,10 +149,4 @@ def explore(
         # poke owed
         if mapper.max_variance() <= config.threshold and mapper.boundary_owed() == 0:
             stop = "threshold"
-    timings = {
-        "total_s": time.perf_counter() - t_start,
-        "observe_s": t_observed - t_start,
-        "surface_gp_s": t_surface - t_observed,
-        "environment_s": env_s,
-    }
-    return mapper.result(stop, timings)
+    return run.result(stop)

@@ -9,7 +9,6 @@ way it arrives (with the same seed for the surface fit).
 from __future__ import annotations
 
 import logging
-import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from functools import partial
@@ -26,8 +25,8 @@ from deformap.explore import (
     ExplorationConfig,
     ExplorationResult,
     Mapper,
+    MappingRun,
     PokeResult,
-    poke_step,
 )
 from deformap.replay._session import DEFAULT_CONTACT_GAP_M, RecordedSession, check_contact_gap
 
@@ -96,35 +95,21 @@ def map_session(
         raise InvalidArgumentError(
             f"`config` must be an ExplorationConfig; got {type(config).__name__}"
         )
-    t_start = time.perf_counter()
     # explore() spawns max_pokes + 1 streams and fits the surface with the first; a spawned
     # child depends only on its position, so spawning one gives that same stream.
-    surface_rng = rng.spawn(1)[0]
-    mapper = Mapper(session.workspace, config)
-    cloud = session.observation()
-    t_observed = time.perf_counter()
-    mapper.initialise(cloud, surface_rng)
-    t_surface = time.perf_counter()
+    run = MappingRun(session.workspace, config, session.observation, rng.spawn(1)[0])
     skipped: list[dict[str, Any]] = []
-    read_s = 0.0
     for index in range(len(session)):
         try:
-            poke = poke_step(mapper, index, partial(session.press_observation, index))
+            # reading the session stands in for the environment of the live loop
+            poke = run.step(index, partial(session.press_observation, index))
         except DeformapError as exc:
             logger.warning("poke %d skipped: %s", index, exc)
             skipped.append({"index": index, "error": str(exc)})
             continue
-        # reading the session stands in for the environment of the live loop
-        read_s += poke.record.timings.environment_s or 0.0
         if on_poke is not None:
             on_poke(poke)
-    timings = {
-        "total_s": time.perf_counter() - t_start,
-        "observe_s": t_observed - t_start,
-        "surface_gp_s": t_surface - t_observed,
-        "environment_s": read_s,
-    }
-    result = mapper.result(END_OF_SESSION, timings)
+    result = run.result(END_OF_SESSION)
     return ReplayResult(result=result, skipped=skipped)
 
 
