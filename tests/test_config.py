@@ -182,3 +182,15 @@ def test_a_retired_setting_in_an_older_file_is_ignored_with_a_warning(caplog) ->
     # a key that never was a setting is still refused
     with pytest.raises(ConfigError, match="unknown key"):
         config_from_dict(RunConfig, {"world": {"default_force": 0.6}})
+
+
+def test_an_older_file_that_turned_the_camera_noise_off_keeps_its_meaning() -> None:
+    from deformap.run import RunConfig
+
+    # before `beta_uncertainty` existed, noise_samples 0 meant the shape matcher's own uncertainty
+    older = config_from_dict(RunConfig, {"exploration": {"touch": {"noise_samples": 0}}})
+    assert older.exploration.beta_uncertainty == "shape-matching"
+    # a file that names the switch is read as written, and refused when it contradicts itself
+    with pytest.raises(ConfigError, match=r"touch\.noise_samples"):
+        config_from_dict(RunConfig, {"exploration": {"beta_uncertainty": "camera-noise",
+                                                     "touch": {"noise_samples": 0}}})

@@ -65,7 +65,9 @@ def _shape(value: Any, hint: Any, where: str) -> Any:
 def config_from_dict(cls: type[T], data: Any, *, where: str = "config") -> T:
     """Build the settings dataclass ``cls`` from plain data; missing keys keep their defaults.
 
-    A key the class lists in its ``RETIRED_SETTINGS`` (a setting that was removed, with why) is
+    A class may read files written by an older version through a static ``upgrade_settings(data)
+    -> data`` (called first, on its own level of the data). A key the class lists in its
+    ``RETIRED_SETTINGS`` (a setting that was removed, with why) is
     accepted with a logged warning and dropped, so configuration files written before still load.
     The data is only shaped (mappings into nested dataclasses, lists into tuples) and handed to
     the constructor, whose ``__post_init__`` checks every field (:func:`check_settings`): a value
@@ -82,6 +84,10 @@ def config_from_dict(cls: type[T], data: Any, *, where: str = "config") -> T:
     if not isinstance(data, dict):
         raise ConfigError(f"`{where}` must be a mapping of settings; got {data!r}")
     fields = {f.name: f for f in dataclasses.fields(cls) if f.init}  # type: ignore[arg-type]
+    # files written by an older version: the class reads them as they were meant
+    upgrade = getattr(cls, "upgrade_settings", None)
+    if upgrade is not None:
+        data = upgrade(dict(data))
     # settings that were removed: accepted in files written before, said once, and dropped
     retired: dict[str, str] = getattr(cls, "RETIRED_SETTINGS", {})
     for key in sorted(set(data) & set(retired)):

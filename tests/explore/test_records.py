@@ -95,3 +95,35 @@ def test_a_target_says_how_many_pokes_its_plan_foresees() -> None:
 def test_records_are_frozen() -> None:
     with pytest.raises(dataclasses.FrozenInstanceError):
         _record().beta = 0.2  # type: ignore[misc]
+
+
+#: A journal line exactly as deformap 179946e wrote it (``deformap reproduce``, homogeneous-60,
+#: seed 0, its first poke).
+OLD_LINE = (
+    '{"kind": "poke", "index": 0, "target_xy": [0.3, 0.2], "contact_xy": [0.29983638551331826, '
+    '0.19965923332812302], "contact": {"tip_center": [0.3, 0.2, 0.05254550737716549], "force": '
+    '[-0.010007937524023595, -0.020843946227377206, -0.6112407842648694], "tip_radius_m": 0.01}, '
+    '"force_n": 0.6, "beta": 0.84, "beta_std": 0.008250152362627425, "betas": [0.0, 0.1, 0.2, '
+    '0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.83, 0.84, 0.85, 0.9], "errors": [0.0007108014353514295, '
+    '0.0007082795558651988, 0.0007051626308674533, 0.0007012134859064481, 0.0006960489887286717, '
+    '0.0006890181425795369, 0.0006789215878648256, 0.0006633755879424201, 0.0006383415140023154, '
+    '0.000630160873817498, 0.0006285408798056407, 0.0006287739404293335, 0.0006991194325470164], '
+    '"iterations": 7, "residual": 8.333270929676657e-05, "converged": true, "n_roi_points": 2558, '
+    '"camera_noise_m": 0.0014825174977852475, "timings": {"filter_s": 0.026820267999994485, '
+    '"touch_gp_s": 0.09715296199999557, "beta_s": 0.2328804889999958, "field_s": '
+    '0.001231501000006574, "target_s": 1.59329999860347e-05, "environment_s": 0.2596760909999887}, '
+    '"purpose": "first", "max_variance_after": 0.08985003756925422}'
+)
+
+
+def test_journal_lines_of_earlier_versions_are_read_as_written() -> None:
+    old = json.loads(OLD_LINE)
+    record = PokeRecord.from_dict(old)
+    assert record.beta == 0.84 and record.purpose == "first" and record.planned_after is None
+    assert record.timings.environment_s == pytest.approx(0.2596760909999887)
+    # the same line written back is the line read (kind aside)
+    assert record.to_dict() == {k: v for k, v in old.items() if k != "kind"}
+    # lines from before purpose, planned_after and camera_noise_m existed
+    for key in ("purpose", "camera_noise_m"):
+        older = {k: v for k, v in old.items() if k != key}
+        assert getattr(PokeRecord.from_dict(older), key) is None

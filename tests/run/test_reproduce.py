@@ -40,3 +40,24 @@ def test_reproduce_a_subset_writes_a_run_per_scenario_and_the_table(tmp_path: Pa
     assert (out.folder / "table.md").read_text() == markdown_table(table) == out.markdown
     with pytest.raises(ConfigError, match="exists and is not empty"):
         reproduce(out.folder, base=base, scenarios=["homogeneous-60"])
+
+
+def test_a_scenario_file_runs_in_a_folder_named_by_its_stem_and_twice_is_refused(
+    tmp_path: Path,
+) -> None:
+    scenario = tmp_path / "files" / "bench.yaml"
+    scenario.parent.mkdir()
+    scenario.write_text("name: bench\nblocks:\n"
+                        "  - {name: soft, rect: [0.0, 0.0, 0.6, 0.4], hardness_n: 60}\n")
+    base = RunConfig(world=WorldConfig.coarse(),
+                     exploration=ExplorationConfig(max_pokes=1,
+                                                   surface=SurfaceGPConfig(fit_hyperparameters=False),
+                                                   shape_matching=ShapeMatchingConfig(
+                                                       n_beta=6, refine=False, max_iter=200)))
+    out = reproduce(tmp_path / "t", base=base, scenarios=[str(scenario)], figures=False)
+    assert (out.folder / "bench" / "report.json").is_file()
+    with pytest.raises(ConfigError, match="each scenario once"):
+        reproduce(tmp_path / "t2", base=base, scenarios=[str(scenario), str(scenario)])
+    with pytest.raises(ConfigError, match="nope"):
+        reproduce(tmp_path / "t3", base=base, scenarios=["nope"])
+    assert not (tmp_path / "t2").exists() and not (tmp_path / "t3").exists()

@@ -95,7 +95,7 @@ def emit_json(json_path: Path | None, data: Any) -> None:
     if json_path is None:
         return
     if _to_stdout(json_path):
-        sys.stdout.write(run.to_json(data) + "\n")
+        sys.stdout.write(run.to_json(data, indent=None) + "\n")  # one line, for pipes
         return
     try:
         json_path.parent.mkdir(parents=True, exist_ok=True)

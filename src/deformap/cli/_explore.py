@@ -100,12 +100,7 @@ def explore_command(
     """Explore a simulated world: poke until the β-field is known, then cut it into regions."""
     overrides = run.RunOverrides(scenario=scenario, seed=seed, strategy=strategy,
                                  threshold=threshold, max_pokes=max_pokes)  # fmt: skip
-    if resume is not None:
-        if config is not None:
-            raise ConfigError("--resume reads the run's own config.yaml; do not pass --config too")
-        cfg = run.resume_run_config(resume, overrides)
-    else:
-        cfg = run.apply_overrides(run.load_run_config(config), overrides)
+    cfg = run.explore_run_config(config, overrides, resume)
     shown = out_console(json_path)
     with progress(shown) as bar:
         output = run.explore_scenario(cfg, resume or out, resume=resume is not None, rerun=rerun,

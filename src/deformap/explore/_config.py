@@ -48,7 +48,7 @@ the pokes each strategy needs on the simulated scenarios.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Literal
+from typing import Any, Literal
 
 from deformap._validation import SettingError, check_settings, setting
 from deformap.environment import Workspace
@@ -231,6 +231,16 @@ class ExplorationConfig:
     touch: TouchGPConfig = field(default_factory=TouchGPConfig)
     beta_field: BetaFieldConfig = field(default_factory=BetaFieldConfig)
     shape_matching: ShapeMatchingConfig = field(default_factory=ShapeMatchingConfig)
+
+    @staticmethod
+    def upgrade_settings(data: dict[str, Any]) -> dict[str, Any]:
+        """Files written before ``beta_uncertainty`` existed chose β's uncertainty with
+        ``touch.noise_samples`` alone (0: the shape matcher's own): read them as they meant."""
+        touch = data.get("touch")
+        if ("beta_uncertainty" not in data and isinstance(touch, dict)
+                and touch.get("noise_samples") == 0):
+            return {**data, "beta_uncertainty": "shape-matching"}
+        return data
 
     def __post_init__(self) -> None:
         check_settings(self)

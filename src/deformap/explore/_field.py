@@ -62,6 +62,12 @@ class BetaField:
         Posterior mean (NaN without pokes) and variance, computed once on first use.
     """
 
+    @classmethod
+    def of(cls, records: Sequence[PokeRecord], xs: NDArray[np.float64], ys: NDArray[np.float64],
+           config: BetaFieldConfig) -> BetaField:
+        """The β-field of the pokes ``records`` (each one's uncertainty raised to the floor)."""
+        return cls(PokeSet.of(records, config.noise_floor), xs, ys, config)
+
     def __init__(self, pokes: PokeSet, xs: NDArray[np.float64], ys: NDArray[np.float64],
                  config: BetaFieldConfig) -> None:
         self.pokes = pokes

@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from deformap._files import replace_durably
+from deformap._files import atomic_path
 from deformap.errors import ConfigError, FileFormatError
 
 __all__ = ["JOURNAL_NAME", "Journal", "JournalContents", "read_journal"]
@@ -92,10 +92,8 @@ class Journal:
         if path.exists():
             raise FileExistsError(f"{str(path)!r} already exists")
         journal = cls(path)
-        tmp = path.with_suffix(".tmp")
-        with open(tmp, "w", encoding="utf-8") as fh:
+        with atomic_path(path) as tmp, open(tmp, "w", encoding="utf-8") as fh:
             journal._write(fh, {"kind": "header", **header})
-        replace_durably(tmp, path)
         return journal
 
     @classmethod
@@ -121,11 +119,9 @@ class Journal:
             self._write(fh, {"kind": "poke", **record})
 
     def _rewrite(self, contents: JournalContents) -> None:
-        tmp = self.path.with_suffix(".tmp")
-        with open(tmp, "w", encoding="utf-8") as fh:
+        with atomic_path(self.path) as tmp, open(tmp, "w", encoding="utf-8") as fh:
             for record in [contents.header, *contents.pokes]:
                 self._write(fh, record)
-        replace_durably(tmp, self.path)
 
     @staticmethod
     def _write(fh: Any, record: dict[str, Any]) -> None:

@@ -10,7 +10,6 @@ from __future__ import annotations
 import time
 from collections.abc import Callable, Sequence
 from functools import partial
-from typing import Any
 
 import numpy as np
 
@@ -97,7 +96,7 @@ def explore(
     *,
     rng: np.random.Generator,
     journal: Journal | None = None,
-    done: Sequence[dict[str, Any]] = (),
+    done: Sequence[PokeRecord] = (),
     on_poke: Callable[[PokeResult], None] | None = None,
 ) -> ExplorationResult:
     """Observe, then poke where the β-field is least known until its variance is below ``T_h``,
@@ -114,17 +113,17 @@ def explore(
         one per poke), so a resumed run draws exactly what the uninterrupted run drew.
     journal : Journal, optional
         Each completed poke is appended (and fsynced) before the next one starts.
-    done : sequence of dict
-        Poke records of a killed run, as its journal holds them (:meth:`PokeRecord.to_dict`'s
-        form): they enter the β-field without being pressed or estimated again.
+    done : sequence of PokeRecord
+        The pokes of a killed run, read from its journal (:meth:`PokeRecord.from_dict`): they
+        enter the β-field without being pressed or estimated again.
     on_poke : callable, optional
         Called after each new poke (progress display).
     """
     streams = rng.spawn(config.max_pokes + 1)
     run = MappingRun(env.workspace, config, env.observe, streams[0])
     mapper = run.mapper
-    for k, record in enumerate(done):
-        mapper.add(PokeResult(PokeRecord.from_dict(record, where=f"journal poke {k + 1}")))
+    for record in done:
+        mapper.add(PokeResult(record))
     stop = "max_pokes"
     while len(mapper.pokes) < config.max_pokes:
         index = len(mapper.pokes)

@@ -25,7 +25,7 @@ from deformap.environment import PressObservation, Workspace
 from deformap.errors import EnvironmentStateError
 from deformap.explore._config import ExplorationConfig, check_exploration_budget
 from deformap.explore._dent import measure_press
-from deformap.explore._field import BetaField, PokeSet
+from deformap.explore._field import BetaField
 from deformap.explore._grid import MapGrid
 from deformap.explore._records import PokeResult, Target
 from deformap.explore._regions import RegionMap, map_regions
@@ -67,9 +67,8 @@ class Mapper:
         return self._field
 
     def _fit(self, pokes: list[PokeResult]) -> BetaField:
-        records = [p.record for p in pokes]
-        return BetaField(PokeSet.of(records, self.config.beta_field.noise_floor),
-                         self.grid.xs, self.grid.ys, self.config.beta_field)  # fmt: skip
+        return BetaField.of([p.record for p in pokes], self.grid.xs, self.grid.ys,
+                            self.config.beta_field)  # fmt: skip
 
     def initialise(self, cloud: PointCloud, rng: np.random.Generator) -> SurfaceModel:
         """Fit the surface model to the first observation (:func:`fit_surface`)."""

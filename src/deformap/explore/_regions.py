@@ -68,7 +68,7 @@ from deformap._validation import check_array, check_int, check_positive
 from deformap.explore._config import ExplorationConfig
 from deformap.explore._field import PokeSet
 
-__all__ = ["RegionMap", "map_regions", "segment_regions"]
+__all__ = ["RegionMap", "map_regions", "poke_classes", "segment_regions"]
 
 _NULL_SAMPLES = 4000
 _NULL_SEED = 20161115
@@ -278,15 +278,22 @@ def segment_regions(
                      poke_labels=poke_labels)
 
 
+def poke_classes(mean: NDArray[np.float64], pokes: PokeSet,
+                 config: ExplorationConfig) -> RegionMap:
+    """The pokes' classes and the isopleth labels of the β-field mean ``mean (ny, nx)``, by
+    :func:`segment_regions` with the exploration's settings (``max_regions``,
+    ``region_prior_dof``, the β-field's noise floor)."""
+    return segment_regions(mean, pokes.beta, pokes.noise, floor=config.beta_field.noise_floor,
+                           max_regions=config.max_regions, prior_dof=config.region_prior_dof)
+
+
 def map_regions(mean: NDArray[np.float64], pokes: PokeSet, cells_xy: NDArray[np.float64],
                 config: ExplorationConfig) -> RegionMap:
     """The regions of a β-field with mean ``mean (ny, nx)`` fitted to ``pokes``, as the
     exploration settings ask: classes by :func:`segment_regions` (``max_regions``,
     ``region_prior_dof``, the β-field's noise floor), cells labelled by isopleth or by nearest
     poke (``region_labels``; ``cells_xy (ny · nx, 2)`` are the grid's cells)."""
-    floor = config.beta_field.noise_floor
-    found = segment_regions(mean, pokes.beta, pokes.noise, floor=floor,
-                            max_regions=config.max_regions, prior_dof=config.region_prior_dof)
+    found = poke_classes(mean, pokes, config)
     if config.region_labels == "nearest":
         return found.nearest_poke(pokes.xy, cells_xy)
     return found

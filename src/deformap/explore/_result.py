@@ -12,7 +12,7 @@ from numpy.typing import NDArray
 
 from deformap.environment import Workspace
 from deformap.explore._config import ExplorationConfig
-from deformap.explore._field import BetaField, PokeSet
+from deformap.explore._field import BetaField
 from deformap.explore._grid import MapGrid
 from deformap.explore._records import PokeResult
 from deformap.explore._regions import RegionMap
@@ -73,6 +73,5 @@ class ExplorationResult:
         """The β-field as it was after the first ``n_pokes`` pokes (recordings, figures)."""
         if n_pokes == len(self.pokes):
             return self.field
-        records = [p.record for p in self.pokes[:n_pokes]]
-        cfg = self.config.beta_field
-        return BetaField(PokeSet.of(records, cfg.noise_floor), self.grid.xs, self.grid.ys, cfg)
+        return BetaField.of([p.record for p in self.pokes[:n_pokes]], self.grid.xs, self.grid.ys,
+                            self.config.beta_field)  # fmt: skip

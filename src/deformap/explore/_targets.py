@@ -21,7 +21,7 @@ from deformap.explore._field import BetaField, PokeSet
 from deformap.explore._grid import MapGrid
 from deformap.explore._planning import PokePlan, VarianceDesign, plan_pokes
 from deformap.explore._records import Target
-from deformap.explore._regions import segment_regions
+from deformap.explore._regions import poke_classes
 
 __all__ = ["BOUNDARY_SPACING_ROI", "choose_next"]
 
@@ -52,9 +52,7 @@ def _boundary(grid: MapGrid, field: BetaField, pokes: PokeSet,
     if not allowed.any():
         return None
     mean, var = field.mean, field.variance
-    levels = segment_regions(mean, pokes.beta, pokes.noise, floor=config.beta_field.noise_floor,
-                             max_regions=config.max_regions,
-                             prior_dof=config.region_prior_dof).levels  # fmt: skip
+    levels = poke_classes(mean, pokes, config).levels
     score = boundary_score(mean.ravel()[allowed], np.sqrt(var.ravel()[allowed]), levels)
     return np.array(grid.cells_xy[allowed][int(np.argmax(score))], dtype=float)
 

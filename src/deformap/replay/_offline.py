@@ -84,8 +84,9 @@ def map_session(
     Returns
     -------
     ReplayResult
-        A poke that cannot be read or processed (any :class:`~deformap.errors.DeformapError`) is
-        logged, listed in ``skipped`` and left out; the others still count.
+        A poke that cannot be read, processed or added to the β-field (any
+        :class:`~deformap.errors.DeformapError`) is logged, listed in ``skipped`` and left out;
+        the others still count.
     """
     if not isinstance(session, RecordedSession):
         raise InvalidArgumentError(

@@ -39,6 +39,7 @@ if TYPE_CHECKING:
         RunOverrides,
         apply_overrides,
         config_yaml,
+        explore_run_config,
         load_run_config,
         resume_run_config,
         run_generators,
@@ -78,7 +79,7 @@ if TYPE_CHECKING:
 
 _MODULES = {
     "_config": ("CONFIG_NAME", "RunConfig", "RunOverrides", "apply_overrides", "config_yaml",
-                "load_run_config",
+                "explore_run_config", "load_run_config",
                 "resume_run_config", "run_generators", "session_run_config"),
     "_estimate": ("EstimateOutput", "estimate_one_poke"),
     "_explore": ("RunOutput", "explore_scenario"),
@@ -120,6 +121,7 @@ __all__ = [
     "default_run_folder",
     "estimate_one_poke",
     "estimate_report",
+    "explore_run_config",
     "explore_scenario",
     "live_report",
     "load_run_config",

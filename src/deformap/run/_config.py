@@ -28,6 +28,7 @@ __all__ = [
     "RunOverrides",
     "apply_overrides",
     "config_yaml",
+    "explore_run_config",
     "load_run_config",
     "resume_run_config",
     "run_generators",
@@ -122,6 +123,24 @@ def resume_run_config(folder: Path, overrides: RunOverrides | None = None) -> Ru
             f"cannot resume {str(folder)!r} with different settings ({names}); drop those options"
         )
     return config
+
+
+def explore_run_config(config: Path | None, overrides: RunOverrides,
+                       resume: Path | None = None) -> RunConfig:
+    """The configuration of ``deformap explore``: the resumed run's own (``resume``), else the file
+    ``config`` (or the defaults) with ``overrides`` applied.
+
+    Raises
+    ------
+    ConfigError
+        Both ``config`` and ``resume`` given, or as :func:`resume_run_config` and
+        :func:`load_run_config`.
+    """
+    if resume is None:
+        return apply_overrides(load_run_config(config), overrides)
+    if config is not None:
+        raise ConfigError("--resume reads the run's own config.yaml; do not pass --config too")
+    return resume_run_config(resume, overrides)
 
 
 def session_run_config(

@@ -23,6 +23,7 @@ from deformap.explore import (
     JOURNAL_NAME,
     ExplorationResult,
     Journal,
+    PokeRecord,
     check_exploration_budget,
     explore,
     read_journal,
@@ -92,8 +93,9 @@ def _stored_if_same(out: Path, config: RunConfig, header: dict[str, Any]) -> dic
 
 def _resume_journal(
     out: Path, config: RunConfig, header: dict[str, Any]
-) -> tuple[Journal, list[dict[str, Any]]]:
-    """Open the journal of the run in ``out`` and the pokes it holds.
+) -> tuple[Journal, list[PokeRecord]]:
+    """Open the journal of the run in ``out`` and the pokes it holds (read as records here,
+    before any work, so that a broken line is refused naming it).
 
     A folder with ``config.yaml`` but no journal (killed before its journal was created) resumes
     from poke 1 when its configuration is this run's.
@@ -106,13 +108,16 @@ def _resume_journal(
         logger.warning("%s: killed before its journal was created; starting over", out)
         return Journal.create(out, header), []
     journal, contents = Journal.resume(out, _stored_if_same(out, config, header))
+    where = out / JOURNAL_NAME
+    done = [PokeRecord.from_dict(r, where=f"{where} poke {k + 1}")
+            for k, r in enumerate(contents.pokes)]  # fmt: skip
     if contents.broken_line is not None:
         logger.warning(
             "%s: the last journal line was cut mid-write and is dropped (%d complete pokes kept)",
             out / JOURNAL_NAME,
             len(contents.pokes),
         )
-    return journal, contents.pokes
+    return journal, done
 
 
 def explore_scenario(

@@ -105,9 +105,10 @@ def _json_default(value: Any) -> Any:
     raise TypeError(f"not JSON serialisable: {type(value)}")
 
 
-def to_json(data: Any) -> str:
-    """``data`` as indented JSON; numpy arrays and scalars become lists and numbers."""
-    return json.dumps(data, indent=2, default=_json_default)
+def to_json(data: Any, *, indent: int | None = 2) -> str:
+    """``data`` as JSON (indented, or on one line with ``indent=None``); numpy arrays and scalars
+    become lists and numbers."""
+    return json.dumps(data, indent=indent, default=_json_default)
 
 
 def write_json(path: Path, data: Any) -> Path:

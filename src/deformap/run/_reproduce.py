@@ -12,11 +12,19 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from deformap.errors import ConfigError
 from deformap.eval import PAPER_TABLE_I, markdown_table, table_row
 from deformap.run._config import RunConfig
 from deformap.run._explore import explore_scenario
-from deformap.run._folder import create_run_folder, default_run_folder, write_json, write_text
+from deformap.run._folder import (
+    create_run_folder,
+    default_run_folder,
+    run_stem,
+    write_json,
+    write_text,
+)
 from deformap.run._hooks import NO_HOOKS, RunHooks, RunStart
+from deformap.world import load_scenario
 
 __all__ = ["ReproduceOutput", "reproduce"]
 
@@ -65,16 +73,22 @@ def reproduce(
     """
     base = base or RunConfig()
     names = list(scenarios) if scenarios else list(PAPER_TABLE_I)
+    stems = [run_stem(name) for name in names]  # a YAML path's run is named by its file's stem
+    repeated = sorted({s for s in stems if stems.count(s) > 1})
+    if repeated:
+        raise ConfigError(f"`scenarios` must name each scenario once; got {repeated} twice or more")
+    for name in names:  # an unknown scenario fails here, before any folder or run
+        load_scenario(name)
     folder = out or default_run_folder("table-i", "reproduce", base.seed)
     create_run_folder(folder, what="reproduction")
     hooks.start(RunStart(kind="reproduce", title=f"{len(names)} scenarios, seed {base.seed}",
                          folder=folder, total=len(names)))  # fmt: skip
     rows = []
-    for name in names:
+    for name, stem in zip(names, stems, strict=True):
         cfg = dataclasses.replace(base, scenario=name)
         hooks.stage(name)
         inner = RunHooks(on_stage=functools.partial(_scenario_stage, hooks, name))
-        report = explore_scenario(cfg, folder / name, figures=figures, hooks=inner).report
+        report = explore_scenario(cfg, folder / stem, figures=figures, hooks=inner).report
         row = table_row(name, report, threshold=cfg.exploration.threshold)
         rows.append(row)
         if on_run is not None:
