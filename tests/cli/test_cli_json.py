@@ -36,6 +36,8 @@ SPEED = {"surface_gp": [], "beta_sweep": {"n_beta": 1, "n_particles": 1, "batche
 WORLD = {"scenario": "x", "construction_s": 1.0, "n_dofs": 10}
 IO = {"n_points": 10, "goal_s": 0.5, "pcd_s": 0.1}
 MEMORY = {"surface_gp": [], "beta_estimation": []}
+RECORD = {"session_file": "s/session.yaml", "folder": "s", "n_pokes": 2, "format": "folder",
+          "live_betas": [0.5, 0.6]}  # fmt: skip
 
 
 def _stubs(tmp_path: Path) -> dict[str, Any]:
@@ -43,10 +45,14 @@ def _stubs(tmp_path: Path) -> dict[str, Any]:
     out = SimpleNamespace(report=REPORT, folder=tmp_path, session=[1], files=[tmp_path / "a"],
                           study=STUDY, table=TABLE, markdown="| table |")  # fmt: skip
     estimate = SimpleNamespace(report=ESTIMATE, folder=None)
+    recorded = SimpleNamespace(session_file=Path(RECORD["session_file"]),
+                               folder=Path(RECORD["folder"]), n_pokes=2, format="folder",
+                               live_betas=RECORD["live_betas"])  # fmt: skip
     return {
         "explore_scenario": (run, lambda *a, **k: out),
         "map_recorded_session": (run, lambda *a, **k: out),
         "estimate_one_poke": (run, lambda *a, **k: estimate),
+        "record_simulation": (run, lambda *a, **k: recorded),
         "run_hardness_study": (run, lambda *a, **k: out),
         "run_cluster_size_study": (run, lambda *a, **k: out),
         "reproduce": (run, lambda *a, **k: out),
@@ -64,6 +70,7 @@ COMMANDS = [
     (["explore"], REPORT),
     (["map", "session"], REPORT),
     (ESTIMATE_ARGS, ESTIMATE),
+    (["record-sim", "--scenario", "homogeneous-60"], RECORD),
     (["study", "hardness"], STUDY),
     (["study", "cluster-size"], STUDY),
     (["reproduce"], TABLE),
@@ -98,6 +105,7 @@ def test_estimate_without_out_writes_its_json_to_stdout(tmp_path: Path, monkeypa
     result = runner.invoke(app, ESTIMATE_ARGS)
     assert result.exit_code == 0, result.output
     assert json.loads(result.stdout) == ESTIMATE
+    assert result.stdout.count("\n") == 1  # one line, for pipes
 
 
 def test_a_json_file_that_cannot_be_written_is_one_line(tmp_path: Path, monkeypatch) -> None:  # type: ignore[no-untyped-def]

@@ -50,15 +50,20 @@ def record_sim_command(
     seed: Annotated[int | None, typer.Option(help="Seed of world noise and poke choice.")] = None,
     pokes: Annotated[int | None, typer.Option("--pokes", help="Most pokes to make.")] = None,
     config: ConfigOption = None,
+    json_path: JsonOption = None,
 ) -> None:
     """Explore a simulated world; record what it returned as a session (see docs)."""
     overrides = run.RunOverrides(scenario=scenario, seed=seed, max_pokes=pokes)
     cfg = run.apply_overrides(run.load_run_config(config), overrides)
-    with progress(out_console(None)) as bar:
+    shown = out_console(json_path)
+    with progress(shown) as bar:
         output = run.record_simulation(cfg, out, format=format,
                                        hooks=run_hooks(bar, poke_row=poke_row))  # fmt: skip
-    out_console(None).print(f"wrote {output.session_file} ({output.n_pokes} pokes, "
-                            f"{output.format} form)", highlight=False)  # fmt: skip
+    shown.print(f"wrote {output.session_file} ({output.n_pokes} pokes, {output.format} form)",
+                highlight=False)  # fmt: skip
+    emit_json(json_path, {"session_file": str(output.session_file), "folder": str(output.folder),
+                          "n_pokes": output.n_pokes, "format": output.format,
+                          "live_betas": output.live_betas})  # fmt: skip
 
 
 @app.command("map")
