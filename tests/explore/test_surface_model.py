@@ -23,9 +23,9 @@ def _surface_error(max_slope_deg: float) -> float:
         base, surface=dataclasses.replace(base.surface, max_slope_deg=max_slope_deg))
     mapper = Mapper(world.workspace, cfg)
     mapper.initialise(world.observe(), np.random.default_rng(1))
-    inner = (mapper.xs > 0.02) & (mapper.xs < 0.58)
-    rows = (mapper.ys > 0.02) & (mapper.ys < 0.38)
-    truth = world.surface_height(mapper.xs, mapper.ys)
+    inner = (mapper.grid.xs > 0.02) & (mapper.grid.xs < 0.58)
+    rows = (mapper.grid.ys > 0.02) & (mapper.grid.ys < 0.38)
+    truth = world.surface_height(mapper.grid.xs, mapper.grid.ys)
     return float(np.max(np.abs(mapper.surface.height - truth)[np.ix_(rows, inner)]))
 
 

@@ -9,8 +9,9 @@ whole estimator (slow to import), which ``deformap --help`` and a metric alone n
 
 from __future__ import annotations
 
-import importlib
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
+
+from deformap._lazy import lazy_exports
 
 if TYPE_CHECKING:
     from deformap.eval._bench_gp import bench_surface_gp
@@ -41,7 +42,6 @@ _MODULES = {
                  "cluster_size_study", "collect_presses", "hardness_study"),
     "_table_i": ("PAPER_TABLE_I", "markdown_table", "table_row"),
 }  # fmt: skip
-_HOME = {name: module for module, names in _MODULES.items() for name in names}
 
 __all__ = [
     "DEFAULT_HARDNESSES",
@@ -66,13 +66,4 @@ __all__ = [
 ]
 
 
-def __getattr__(name: str) -> Any:
-    if name in _HOME:
-        value = getattr(importlib.import_module(f"deformap.eval.{_HOME[name]}"), name)
-        globals()[name] = value
-        return value
-    raise AttributeError(f"module 'deformap.eval' has no attribute {name!r}")
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(__all__))
+__getattr__, __dir__ = lazy_exports(__name__, _MODULES, __all__, globals())

@@ -18,7 +18,6 @@ import time
 from collections.abc import Mapping
 
 import numpy as np
-from numpy.typing import NDArray
 
 from deformap.cloud import PointCloud
 from deformap.environment import PressObservation, Workspace
@@ -134,11 +133,3 @@ class Mapper:
             regions=self.regions() if self._pokes else None,
             max_variance=self.max_variance(), stop_reason=stop_reason, timings=dict(timings),
         )  # fmt: skip
-
-    @property
-    def xs(self) -> NDArray[np.float64]:
-        return self.grid.xs
-
-    @property
-    def ys(self) -> NDArray[np.float64]:
-        return self.grid.ys

@@ -29,8 +29,9 @@ The names are imported on first use: a run needs the simulated world and the who
 
 from __future__ import annotations
 
-import importlib
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
+
+from deformap._lazy import lazy_exports
 
 if TYPE_CHECKING:
     from deformap.run._config import (
@@ -96,7 +97,6 @@ _MODULES = {
                  "run_hardness_study"),
     "_world": ("ScenarioSummary", "scenario_summaries", "show_scenario"),
 }  # fmt: skip
-_HOME = {name: module for module, names in _MODULES.items() for name in names}
 
 __all__ = [
     "CLUSTER_SIZE_FOAMS",
@@ -147,13 +147,4 @@ __all__ = [
 ]
 
 
-def __getattr__(name: str) -> Any:
-    if name in _HOME:
-        value = getattr(importlib.import_module(f"deformap.run.{_HOME[name]}"), name)
-        globals()[name] = value
-        return value
-    raise AttributeError(f"module 'deformap.run' has no attribute {name!r}")
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(__all__))
+__getattr__, __dir__ = lazy_exports(__name__, _MODULES, __all__, globals())
