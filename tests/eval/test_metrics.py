@@ -43,3 +43,31 @@ def test_single_region_and_bad_input() -> None:
         region_scores(truth, np.zeros((2, 2), int), np.zeros((3, 3)), {0: 60.0})
     with pytest.raises(InvalidArgumentError, match="lacks the true label"):
         region_scores(truth, truth + 1, np.zeros((3, 3)), {0: 60.0})
+
+
+def test_the_order_of_what_the_map_reports_not_only_of_its_field() -> None:
+    from deformap.eval import ordering_scores
+
+    truth = np.repeat([[0, 0, 1, 1]], 3, axis=0)  # soft 60 N left, rigid right
+    hardness = {0: 60.0, 1: math.inf}
+    beta = np.where(truth == 0, 0.8, 0.1)
+    # a map whose two materials merged into one region: the field's means still order them ...
+    merged = np.zeros_like(truth)
+    assert region_scores(merged, truth, beta, hardness).kendall_tau == 1.0
+    # ... but the map reports one value, so it is credited with no order
+    scores = ordering_scores(merged, np.array([0.45]), truth, hardness, np.array([0.8, 0.1]),
+                             np.array([0, 1]))
+    assert scores.kendall_tau_regions is None and scores.kendall_tau_pokes == 1.0
+    # two found regions, right and wrong way round; pokes read the wrong way round
+    right = ordering_scores(1 - truth, np.array([0.1, 0.8]), truth, hardness,
+                            np.array([0.1, 0.8]), np.array([0, 1]))
+    wrong = ordering_scores(truth, np.array([0.1, 0.8]), truth, hardness,
+                            np.array([0.1, 0.8]), np.array([0, 1]))
+    assert right.kendall_tau_regions == 1.0 and wrong.kendall_tau_regions == -1.0
+    assert right.kendall_tau_pokes == -1.0
+    with pytest.raises(InvalidArgumentError, match="`found` must hold indices"):
+        ordering_scores(truth + 5, np.array([0.1, 0.8]), truth, hardness, np.zeros(2),
+                        np.array([0, 1]))
+    with pytest.raises(InvalidArgumentError, match="lacks the true label"):
+        ordering_scores(truth, np.array([0.1, 0.8]), truth, hardness, np.zeros(2),
+                        np.array([0, 7]))

@@ -19,7 +19,12 @@ if TYPE_CHECKING:
     from deformap.eval._bench_memory import bench_memory, measure_case
     from deformap.eval._bench_msm import bench_beta_sweep
     from deformap.eval._bench_world import bench_world
-    from deformap.eval._metrics import RegionScores, region_scores
+    from deformap.eval._metrics import (
+        OrderingScores,
+        RegionScores,
+        ordering_scores,
+        region_scores,
+    )
     from deformap.eval._studies import (
         DEFAULT_HARDNESSES,
         DEFAULT_POSITIONS,
@@ -37,7 +42,7 @@ _MODULES = {
     "_bench_memory": ("bench_memory", "measure_case"),
     "_bench_msm": ("bench_beta_sweep",),
     "_bench_world": ("bench_world",),
-    "_metrics": ("RegionScores", "region_scores"),
+    "_metrics": ("OrderingScores", "RegionScores", "ordering_scores", "region_scores"),
     "_studies": ("DEFAULT_HARDNESSES", "DEFAULT_POSITIONS", "PROTOCOLS", "FoamPresses",
                  "cluster_size_study", "collect_presses", "hardness_study"),
     "_table_i": ("PAPER_TABLE_I", "markdown_table", "table_row"),
@@ -50,6 +55,7 @@ __all__ = [
     "PAPER_TABLE_I",
     "PROTOCOLS",
     "FoamPresses",
+    "OrderingScores",
     "RegionScores",
     "bench_beta_sweep",
     "bench_io",
@@ -61,6 +67,7 @@ __all__ = [
     "hardness_study",
     "markdown_table",
     "measure_case",
+    "ordering_scores",
     "region_scores",
     "table_row",
 ]

@@ -9,7 +9,16 @@ of labels (the Hungarian algorithm on the overlap counts), so label numbering do
   over the true regions (an unmatched true region scores 0);
 - ``kendall_tau``: rank agreement between the mean estimated β over each true region and that
   region's softness (1 / hardness; a rigid region has softness 0): softer must mean higher β. It is
-  undefined (``None``) for fewer than two regions.
+  undefined (``None``) for fewer than two regions. It judges the field, not the regions the map
+  reports: a map whose two regions merged into one can still order the field's means right.
+
+What the map reports is judged by :func:`ordering_scores`:
+
+- ``kendall_tau_regions``: rank agreement between each *found* region's value (its class β) and
+  the softness of the material under most of its cells; ``None`` unless two found regions exist
+  and lie on materials of different softness (a merged map is not credited with an order);
+- ``kendall_tau_pokes``: rank agreement between each poke's own reading and the softness of the
+  material under it; ``None`` for fewer than two pokes or a single material.
 """
 
 from __future__ import annotations
@@ -25,7 +34,7 @@ from scipy.stats import kendalltau
 from deformap._validation import check_array
 from deformap.errors import InvalidArgumentError
 
-__all__ = ["RegionScores", "region_scores"]
+__all__ = ["OrderingScores", "RegionScores", "ordering_scores", "region_scores"]
 
 
 @dataclass(frozen=True)
@@ -98,4 +107,83 @@ def region_scores(
         accuracy=accuracy,
         mean_iou=float(ious.mean()),
         kendall_tau=tau,
+    )
+
+
+@dataclass(frozen=True)
+class OrderingScores:
+    """Whether what a map reports orders the materials (see the module docstring)."""
+
+    kendall_tau_regions: float | None
+    kendall_tau_pokes: float | None
+
+    def to_dict(self) -> dict[str, Any]:
+        return asdict(self)
+
+
+def _tau(values: NDArray[np.float64], softness: NDArray[np.float64]) -> float | None:
+    if values.size < 2 or np.unique(softness).size < 2:
+        return None
+    value = kendalltau(values, softness).statistic
+    return None if np.isnan(value) else float(value)
+
+
+def ordering_scores(
+    found: NDArray[np.integer],
+    class_values: NDArray[np.float64],
+    truth: NDArray[np.integer],
+    true_hardness: dict[int, float],
+    poke_values: NDArray[np.float64],
+    poke_truth: NDArray[np.integer],
+) -> OrderingScores:
+    """Score the order of what a map reports against the materials' softness.
+
+    Parameters
+    ----------
+    found : (ny, nx) int
+        The map's region labels, each an index into ``class_values``.
+    class_values : (k,) float
+        The value the map reports for each region (the class β).
+    truth : (ny, nx) int
+        The true labels on the same grid.
+    true_hardness : dict
+        Hardness in newtons of each true label; ``math.inf`` for a rigid region.
+    poke_values : (p,) float
+        Each poke's reading.
+    poke_truth : (p,) int
+        The true label under each poke.
+    """
+    labels = np.asarray(found)
+    true = np.asarray(truth)
+    values = check_array("class_values", class_values, (None,))
+    readings = check_array("poke_values", poke_values, (None,))
+    under = np.asarray(poke_truth).reshape(-1)
+    if true.shape != labels.shape:
+        raise InvalidArgumentError(
+            f"`truth` must have the shape of `found` {labels.shape}; got {true.shape}"
+        )
+    if under.size != readings.size:
+        raise InvalidArgumentError(
+            f"`poke_truth` must have one label per poke ({readings.size}); got {under.size}"
+        )
+    if labels.size and (labels.min() < 0 or labels.max() >= values.size):
+        raise InvalidArgumentError(
+            f"`found` must hold indices into `class_values` (0 to {values.size - 1}); got "
+            f"{int(labels.min())} to {int(labels.max())}"
+        )
+    missing = sorted((set(np.unique(true).tolist()) | set(under.tolist())) - set(true_hardness))
+    if missing:
+        raise InvalidArgumentError(f"`true_hardness` lacks the true label(s) {missing}")
+
+    def softness(label: int) -> float:
+        return 1.0 / true_hardness[int(label)]
+
+    present = np.unique(labels)
+    region_softness = []
+    for label in present:
+        under_region, counts = np.unique(true[labels == label], return_counts=True)
+        region_softness.append(softness(under_region[np.argmax(counts)]))
+    return OrderingScores(
+        kendall_tau_regions=_tau(values[present], np.array(region_softness)),
+        kendall_tau_pokes=_tau(readings, np.array([softness(t) for t in under])),
     )

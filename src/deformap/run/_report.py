@@ -30,7 +30,7 @@ import numpy as np
 from deformap import __version__
 from deformap._config import config_to_dict
 from deformap.environment import TactileContact
-from deformap.eval import region_scores
+from deformap.eval import ordering_scores, region_scores
 from deformap.explore import ExplorationResult, PokeResult
 from deformap.replay import RecordedSession, ReplayResult
 from deformap.run._config import RunConfig
@@ -82,10 +82,16 @@ def _regions(
     hardness_grid = truth.ground_truth_hardness(result.xs, result.ys)
     hardness = {int(label): float(hardness_grid[labels == label][0]) for label in np.unique(labels)}
     scores = region_scores(found.labels, labels, beta, hardness)
+    # the true label under each poke: the grid cell nearest its contact
+    xy = np.array([p.xy for p in result.pokes])
+    col = np.abs(result.xs[None, :] - xy[:, :1]).argmin(axis=1)
+    row = np.abs(result.ys[None, :] - xy[:, 1:]).argmin(axis=1)
+    order = ordering_scores(found.labels, found.class_betas, labels, hardness,
+                            np.array([p.record.beta for p in result.pokes]), labels[row, col])
     true_regions = [
         {"label": label, "hardness_n": _finite(h)} for label, h in sorted(hardness.items())
     ]
-    return {**scores.to_dict(), **regions}, true_regions
+    return {**scores.to_dict(), **order.to_dict(), **regions}, true_regions
 
 
 def shared_report(result: ExplorationResult, *, truth: Any = None) -> dict[str, Any]:
