@@ -48,12 +48,17 @@ def _summary(out: Console, report: dict[str, Any], folder: Path) -> None:
     reg = report["regions"]
     tau = "n/a (one region)" if reg["kendall_tau"] is None else f"{reg['kendall_tau']:.2f}"
     table = Table(title=f"{report['scenario']} (seed {report['seed']})", show_header=False)
+    table.add_column()
+    table.add_column(overflow="fold")  # the results folder in full, not cut with "…"
     table.add_row("pokes", f"{report['n_pokes']} (stopped by {report['stop_reason']})")
     table.add_row("max β variance", f"{report['max_variance']:.4f}")
     table.add_row("regions found / true", f"{reg['found']} / {reg['true']}")
     table.add_row("region accuracy", f"{reg['accuracy']:.3f}")
     table.add_row("mean IoU", f"{reg['mean_iou']:.3f}")
     table.add_row("Kendall τ (β vs softness)", tau)
+    for key, what in (("kendall_tau_regions", "found regions"), ("kendall_tau_pokes", "pokes")):
+        value = reg.get(key)
+        table.add_row(f"Kendall τ of the {what}", "n/a" if value is None else f"{value:.2f}")
     t = report["timings"]
     table.add_row(
         "time",
