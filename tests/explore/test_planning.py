@@ -168,3 +168,33 @@ def test_a_plan_is_the_one_this_configuration_has_always_given() -> None:
                                               [0.54, 0.14]], rtol=0, atol=1e-12)
     assert plan.max_variance == pytest.approx(0.05891248853723685, rel=1e-9)
     assert plan.reaches
+
+
+def test_a_place_whose_readings_are_noisy_is_not_chased() -> None:
+    # the right third reads β with an uncertainty of 0.3 (a hard foam the camera barely sees
+    # dent); the planner used to expect the floor (0.03) from a further press there, planned one
+    # more press at the same place after each, and spent the poke budget on two places
+    config = ExplorationConfig(max_pokes=15)
+    mapper = Mapper(Workspace(lower=(0.0, 0.0), upper=(0.6, 0.4)), config)
+    rng = np.random.default_rng(0)
+    xy: np.ndarray | None = np.array([0.3, 0.2])
+    while xy is not None and len(mapper.pokes) < config.max_pokes:
+        std = 0.3 if xy[0] > 0.4 else FLOOR
+        mapper.add(synthetic_poke(xy, 0.5, std, index=len(mapper.pokes)))
+        target = mapper.next_target(rng)
+        xy = None if target is None else target.xy
+    pts = np.array([p.xy for p in mapper.pokes])
+    gaps = np.linalg.norm(pts[:, None] - pts[None], axis=-1) + np.eye(len(pts))
+    assert gaps.min() >= 0.03  # no place pressed twice (a quarter ROI apart at least)
+    assert len(pts) < config.max_pokes and mapper.max_variance() <= T_H
+
+
+def test_a_further_press_is_expected_as_noisy_as_the_place_has_read() -> None:
+    from deformap.explore import PokeSet
+    from deformap.explore._targets import expected_noise
+
+    pokes = PokeSet.of([synthetic_poke((0.3, 0.2), 0.5, 0.2).record,
+                        synthetic_poke((0.1, 0.1), 0.5, 0.001).record], noise_floor=FLOOR)
+    config = ExplorationConfig()
+    noise = expected_noise(np.array([[0.3, 0.21], [0.1, 0.1], [0.5, 0.3]]), pokes, config)
+    assert noise.tolist() == [0.2, FLOOR, FLOOR]  # near the noisy poke; the floor elsewhere

@@ -92,3 +92,23 @@ def test_bad_input_is_named() -> None:
         variance_after_adding(np.ones(3), np.ones((2, 2)), np.ones(2), 0.1)
     with pytest.raises(InvalidArgumentError, match=r"`values` must be \(2,\) or \(2, k\)"):
         apply_smoother([[0, 0], [1, 1]], [0.1, 0.1], [[0, 0]], np.ones(3), **KERN)
+
+
+def test_each_candidate_may_have_its_own_noise(design) -> None:
+    d, obs, noise, cand, dom = design
+    per = np.full(len(cand), 0.05)
+    per[3] = 0.4  # a candidate whose observations are noisy
+    e = PosteriorDesign(obs, noise, cand, dom, candidate_noise_std=per, **KERN)
+    # the dense formula with each chosen candidate's own noise
+    chosen = [3, 1]
+    x = np.vstack([obs, cand[chosen]])
+    sigma = np.concatenate([noise, per[chosen]])
+    np.testing.assert_allclose(e.posterior(chosen)[0],
+                               np.diag(_dense_posterior(x, sigma, dom, dom)), atol=1e-12)
+    after, same = e.variance_after_adding([]), d.variance_after_adding([])
+    np.testing.assert_array_equal(np.delete(after, 3, axis=0), np.delete(same, 3, axis=0))
+    assert np.all(after[3] >= same[3] - 1e-15)  # the noisy candidate reduces less
+    with pytest.raises(InvalidArgumentError, match="`candidate_noise_std` must be"):
+        PosteriorDesign(obs, noise, cand, dom, candidate_noise_std=per[:3], **KERN)
+    with pytest.raises(InvalidArgumentError, match="`noise_var` must be"):
+        variance_after_adding(*e.posterior([]), -per)

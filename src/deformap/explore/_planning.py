@@ -68,7 +68,7 @@ class VarianceDesign:
     pokes made, the candidates, the domain, and the score of each candidate added."""
 
     def __init__(self, poked_xy: Array, poked_noise: Array, candidates: Array, domain: Array,
-                 signal_std: float, length_scale: float, new_noise: float):
+                 signal_std: float, length_scale: float, new_noise: float | Array):
         self.gp = PosteriorDesign(poked_xy, poked_noise, candidates, domain,
                                   length_scale=length_scale, signal_std=signal_std,
                                   candidate_noise_std=new_noise)  # fmt: skip
@@ -93,7 +93,7 @@ def _best_addition(design: VarianceDesign, chosen: list[int], threshold: float
 
 
 def plan_pokes(poked_xy: Array, poked_noise: Array, candidates: Array, domain: Array, *,
-               signal_std: float, length_scale: float, new_noise: float, threshold: float,
+               signal_std: float, length_scale: float, new_noise: float | Array, threshold: float,
                max_new: int, max_passes: int = 4) -> PokePlan:
     """The fewest further pokes among ``candidates`` that bring the β-field's largest variance
     over ``domain`` to ``threshold`` or below (see the module docstring for the method).
@@ -110,8 +110,9 @@ def plan_pokes(poked_xy: Array, poked_noise: Array, candidates: Array, domain: A
         Where the variance must fall below ``threshold``.
     signal_std, length_scale : float
         The β-field's prior (σe, σw).
-    new_noise : float
-        The β standard deviation assumed for each planned poke.
+    new_noise : float or (c,) float
+        The β standard deviation assumed for a poke planned at each candidate (the same for
+        all, or one each).
     threshold : float
         ``T_h``.
     max_new : int
@@ -124,8 +125,15 @@ def plan_pokes(poked_xy: Array, poked_noise: Array, candidates: Array, domain: A
     candidates = check_array("candidates", candidates, (None, 2), what="metres", min_rows=1)
     domain = check_array("domain", domain, (None, 2), what="metres", min_rows=1)
     for name, value in (("signal_std", signal_std), ("length_scale", length_scale),
-                        ("new_noise", new_noise), ("threshold", threshold)):
+                        ("threshold", threshold)):
         check_positive(name, value)
+    if np.ndim(new_noise) == 0:
+        new_noise = check_positive("new_noise", new_noise)
+    else:
+        new_noise = check_array("new_noise", new_noise, (candidates.shape[0],))
+        if np.any(new_noise <= 0):
+            raise InvalidArgumentError(
+                f"`new_noise` must be positive standard deviations; got {new_noise.min()!r}")
     if np.any(poked_noise <= 0):
         raise InvalidArgumentError(
             f"`poked_noise` must be positive standard deviations; got {poked_noise.min()!r}")

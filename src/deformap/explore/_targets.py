@@ -23,7 +23,7 @@ from deformap.explore._planning import PokePlan, VarianceDesign, plan_pokes
 from deformap.explore._records import Target
 from deformap.explore._regions import poke_classes
 
-__all__ = ["BOUNDARY_SPACING_ROI", "choose_next"]
+__all__ = ["BOUNDARY_SPACING_ROI", "choose_next", "expected_noise"]
 
 logger = logging.getLogger(__name__)
 
@@ -32,14 +32,33 @@ BOUNDARY_SPACING_ROI = 0.25
 closer pokes would measure much the same foam again."""
 
 
+def expected_noise(candidates: NDArray[np.float64], pokes: PokeSet,
+                   config: ExplorationConfig) -> NDArray[np.float64]:
+    """The β uncertainty a poke at each of ``candidates (c, 2)`` is expected to have: the largest
+    of the pokes already made within ``BOUNDARY_SPACING_ROI`` ROIs of it (a dent spreads a few
+    centimetres, so a press there measures that foam again, no better), else the β-field's noise
+    floor. So the target choice knows what a further press at a place can still reduce, and does
+    not return to a place whose readings are noisy expecting a reading at the floor."""
+    floor = config.beta_field.noise_floor
+    noise = np.full(len(candidates), floor)
+    if len(pokes) == 0:
+        return noise
+    radius = BOUNDARY_SPACING_ROI * config.touch.roi_size_m
+    near = cKDTree(pokes.xy).query_ball_point(candidates, r=radius)
+    for i, found in enumerate(near):
+        if found:
+            noise[i] = max(floor, float(pokes.noise[found].max()))
+    return noise
+
+
 def _plan(grid: MapGrid, pokes: PokeSet, config: ExplorationConfig, n_made: int) -> PokePlan:
     """The plan with the fewest further pokes that brings the variance under ``T_h``."""
     cfg = config.beta_field
     return plan_pokes(
         pokes.xy, pokes.noise, grid.plan_candidates, grid.plan_domain,
         signal_std=cfg.signal_std, length_scale=cfg.length_scale_m,
-        new_noise=cfg.noise_floor, threshold=config.threshold,
-        max_new=max(1, config.max_pokes - n_made),
+        new_noise=expected_noise(grid.plan_candidates, pokes, config),
+        threshold=config.threshold, max_new=max(1, config.max_pokes - n_made),
     )  # fmt: skip
 
 
@@ -103,7 +122,8 @@ def choose_next(grid: MapGrid, field: BetaField, config: ExplorationConfig,
             cfg = config.beta_field
             design = VarianceDesign(pokes.xy, pokes.noise, candidates,
                                     grid.cells_xy[grid.stop_mask], cfg.signal_std,
-                                    cfg.length_scale_m, cfg.noise_floor)  # fmt: skip
+                                    cfg.length_scale_m,
+                                    expected_noise(candidates, pokes, config))  # fmt: skip
             return design.after([], config.threshold)[1]
 
         chosen = choose_target(config.strategy, cells, reachable, config.threshold, rng,

@@ -35,7 +35,7 @@ Array = NDArray[np.float64]
 
 
 def variance_after_adding(variance: Any, covariance: Any, candidate_variance: Any,
-                          noise_var: float) -> Array:
+                          noise_var: float | Array) -> Array:
     """Posterior variance over a domain after one more observation at each candidate.
 
     Parameters
@@ -46,8 +46,8 @@ def variance_after_adding(variance: Any, covariance: Any, candidate_variance: An
         Posterior covariance between each candidate and the domain now.
     candidate_variance : (c,) float
         Posterior variance at each candidate now.
-    noise_var : float
-        Noise variance of the new observation (≥ 0).
+    noise_var : float or (c,) float
+        Noise variance of the new observation (≥ 0), or of one at each candidate.
 
     Returns
     -------
@@ -63,7 +63,12 @@ def variance_after_adding(variance: Any, covariance: Any, candidate_variance: An
             f"`covariance` must be (candidates, domain) = ({var_c.size}, {var.size}); "
             f"got {cov.shape}"
         )
-    noise = check_positive("noise_var", noise_var, allow_zero=True)
+    noise = np.asarray(noise_var, dtype=float)
+    if noise.ndim == 0:
+        noise = np.full(var_c.size, check_positive("noise_var", float(noise), allow_zero=True))
+    elif noise.shape != var_c.shape or not np.all(np.isfinite(noise)) or np.any(noise < 0):
+        raise InvalidArgumentError(
+            f"`noise_var` must be a number >= 0 or ({var_c.size},) of them; got {noise_var!r}")
     return np.asarray(var[None, :] - cov**2 / (var_c + noise)[:, None])
 
 
@@ -86,12 +91,13 @@ class PosteriorDesign:
         Where the posterior is wanted.
     length_scale, signal_std : float
         The kernel (σ_w, σₑ) of :func:`squared_exponential`.
-    candidate_noise_std : float
-        The noise standard deviation of an observation at a candidate (> 0).
+    candidate_noise_std : float or (c,) float
+        The noise standard deviation of an observation at a candidate (> 0), the same at every
+        candidate or one each.
     """
 
     def __init__(self, observed_xy: Any, observed_noise_std: Any, candidates: Any, domain: Any,
-                 *, length_scale: float, signal_std: float, candidate_noise_std: float) -> None:
+                 *, length_scale: float, signal_std: float, candidate_noise_std: Any) -> None:
         xy = check_array("observed_xy", observed_xy, (None, 2), what="metres")
         noise = check_array("observed_noise_std", observed_noise_std, (xy.shape[0],))
         if np.any(noise <= 0):
@@ -99,7 +105,15 @@ class PosteriorDesign:
                 f"`observed_noise_std` must be positive standard deviations; got {noise.min()!r}")
         cand = check_array("candidates", candidates, (None, 2), what="metres")
         dom = check_array("domain", domain, (None, 2), what="metres")
-        new_noise = check_positive("candidate_noise_std", candidate_noise_std)
+        new_noise = np.asarray(candidate_noise_std, dtype=float)
+        if new_noise.ndim == 0:
+            new_noise = np.full(cand.shape[0], check_positive("candidate_noise_std",
+                                                              float(new_noise)))
+        elif (new_noise.shape != (cand.shape[0],) or not np.all(np.isfinite(new_noise))
+              or np.any(new_noise <= 0)):
+            raise InvalidArgumentError(
+                f"`candidate_noise_std` must be a number > 0 or ({cand.shape[0]},) of them; got "
+                f"{candidate_noise_std!r}")
         kern = {"length_scale": length_scale, "signal_std": signal_std}
         self.prior = check_positive("signal_std", signal_std) ** 2
         self.new_var = new_noise**2
@@ -121,7 +135,7 @@ class PosteriorDesign:
         Parameters
         ----------
         chosen : sequence of int
-            Indices into the candidates, each observed once with ``candidate_noise_std``.
+            Indices into the candidates, each observed once with its ``candidate_noise_std``.
 
         Returns
         -------
@@ -136,7 +150,7 @@ class PosteriorDesign:
         if idx.size and (idx.min() < 0 or idx.max() >= self.n_candidates):
             raise InvalidArgumentError(
                 f"`chosen` must index the {self.n_candidates} candidates; got {idx.tolist()}")
-        noise = np.concatenate([self.observed_noise**2, np.full(idx.size, self.new_var)])
+        noise = np.concatenate([self.observed_noise**2, self.new_var[idx]])
         k_ss = np.block([[self.k_pp, self.k_pc[:, idx]],
                          [self.k_pc[:, idx].T, self.k_cc[np.ix_(idx, idx)]]])
         if k_ss.size == 0:
