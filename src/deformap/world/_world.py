@@ -8,6 +8,14 @@ spherical-tip contact on every foam of the paper's range; the world's tests chec
 every foam by more than the camera's noise and by less than half of the block
 (``tests/world/test_fem.py``).
 
+Force–travel record
+-------------------
+Each press also returns its force–travel record (``PressObservation.force_travel``): the FEM
+solved at ``force_travel_levels`` loads from the contact threshold to the commanded force, with the
+noise of arm encoders and a force sensor, drawn from a stream of its own so that the press's other
+draws (contact force, clouds) are those of a world without the record
+(:mod:`deformap.world._force_travel`).
+
 Ground truth
 ------------
 Labels are block indices (``-1`` = bare table). Hardness and modulus are ``inf`` on rigid blocks and
