@@ -35,7 +35,13 @@ from deformap.errors import InvalidArgumentError
 from deformap.mechanics import TactileContact
 
 __all__ = [
+    "FORCE_MISMATCH_ABS_N",
+    "FORCE_MISMATCH_REL",
+    "MAX_TRAVEL_M",
+    "MIN_FORCE_RISE_N",
+    "TRAVEL_BACKWARDS_TOLERANCE_M",
     "Environment",
+    "ForceTravel",
     "PressObservation",
     "TactileContact",
     "Workspace",
@@ -98,6 +104,110 @@ class Workspace:
         return {"lower": list(self.lower), "upper": list(self.upper)}
 
 
+#: A travel sample may lie this far below the largest travel before it (encoder noise, not a
+#: retraction). Arm encoders read the tip's position to about 0.05 mm (one standard deviation);
+#: 0.5 mm is ten of them, so the noise of a rigid press, whose travel is only that noise around
+#: zero, stays inside it even over thousands of samples (the range of 10⁴ normal draws is about
+#: eight standard deviations), while a slip or a retraction of half a millimetre is refused.
+TRAVEL_BACKWARDS_TOLERANCE_M = 5e-4
+
+#: Largest travel accepted [m]. The probe presses a few newtons into foams at most 10 cm thick;
+#: a dent of 5 cm would put a 1 cm tip's stick into the foam, so larger numbers are millimetres
+#: (a 0.05–50 mm dent read in millimetres is 0.05–50 "metres"). A record in millimetres of a dent
+#: shallower than 0.05 mm cannot be told from metres; it reads as a rigid press.
+MAX_TRAVEL_M = 0.05
+
+#: The force must rise by more than this from the first sample to the last [N]: four times the
+#: 5 mN noise floor of the force sensors a probe carries, so that a flat record with noise is not
+#: taken for a press, while a press from contact to the smallest useful force (0.3 N) rises by far
+#: more.
+MIN_FORCE_RISE_N = 0.02
+
+#: A record's final force may differ from the commanded force by at most
+#: ``FORCE_MISMATCH_REL · force_n + FORCE_MISMATCH_ABS_N``. The record ends when the force
+#: controller reaches the command, so its last sample lies within the controller's overshoot and
+#: the sensor's noise (about 1 % + 5 mN) of it; a quarter of the command is far beyond both, and a
+#: record that misses it by more belongs to another press or is scaled wrong (grams, a wrong axis).
+FORCE_MISMATCH_REL = 0.25
+FORCE_MISMATCH_ABS_N = 0.05
+
+
+@dataclass(frozen=True, kw_only=True)
+class ForceTravel:
+    """The press's force–travel record, from first contact to the commanded force.
+
+    Samples in time order of the probe's travel along the press direction since first contact and
+    of the normal force it exerts on the surface. A robot reads the travel from its joints through
+    forward kinematics and the force from its force sensor (``docs/robot.md``); the simulated
+    world from its own physics with the noise of such sensors.
+
+    Parameters
+    ----------
+    travel_m : (n,) float, metres
+        How far the tip has moved along the press direction (into the surface) since first
+        contact; about 0 at the first sample. It may fall back by sensor noise, at most
+        :data:`TRAVEL_BACKWARDS_TOLERANCE_M` below the largest travel before it, and never
+        exceeds :data:`MAX_TRAVEL_M` in magnitude (larger numbers are millimetres).
+    force_n : (n,) float, newtons
+        The normal component of the force on the surface (positive pushing into it). The last
+        sample must exceed the first by more than :data:`MIN_FORCE_RISE_N` and be positive.
+
+    Notes
+    -----
+    ``n >= 3``. The arrays are stored as read-only float64 copies. The record holds no times: its
+    samples are in time order by contract (a reader with time stamps sorts or refuses them).
+    Every refusal is an :class:`~deformap.errors.InvalidArgumentError` naming the field.
+    """
+
+    travel_m: NDArray[np.float64]
+    force_n: NDArray[np.float64]
+
+    def __post_init__(self) -> None:
+        travel = np.array(check_array("travel_m", self.travel_m, (None,), what="metres",
+                                      min_rows=3))  # fmt: skip
+        force = np.array(check_array("force_n", self.force_n, (None,), what="newtons",
+                                     min_rows=3))  # fmt: skip
+        if travel.shape != force.shape:
+            raise InvalidArgumentError(
+                f"`force_n` must have one sample per `travel_m` sample ({travel.size}); "
+                f"got {force.size}"
+            )
+        largest = float(np.max(np.abs(travel)))
+        if largest > MAX_TRAVEL_M:
+            raise InvalidArgumentError(
+                f"`travel_m` must be metres, at most {MAX_TRAVEL_M} m in magnitude (a press does "
+                f"not sink the tip that far; millimetres?); got {largest:.4g}"
+            )
+        behind = np.maximum.accumulate(travel) - travel
+        worst = int(np.argmax(behind))
+        if behind[worst] > TRAVEL_BACKWARDS_TOLERANCE_M:
+            raise InvalidArgumentError(
+                f"`travel_m` must not go backwards by more than {TRAVEL_BACKWARDS_TOLERANCE_M} m "
+                f"(encoder noise); sample {worst} lies {behind[worst]:.4g} m below the largest "
+                "travel before it"
+            )
+        rise = float(force[-1] - force[0])
+        if force[-1] <= 0.0 or rise <= MIN_FORCE_RISE_N:
+            raise InvalidArgumentError(
+                f"`force_n` must rise from contact to the commanded force: the last sample "
+                f"positive and more than {MIN_FORCE_RISE_N} N above the first; got first "
+                f"{force[0]:.4g} N, last {force[-1]:.4g} N"
+            )
+        travel.setflags(write=False)
+        force.setflags(write=False)
+        object.__setattr__(self, "travel_m", travel)
+        object.__setattr__(self, "force_n", force)
+
+    def __len__(self) -> int:
+        return int(self.travel_m.size)
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, ForceTravel):
+            return NotImplemented
+        return bool(np.array_equal(self.travel_m, other.travel_m)
+                    and np.array_equal(self.force_n, other.force_n))
+
+
 @dataclass(frozen=True, kw_only=True)
 class PressObservation:
     """Everything one press returns.
@@ -116,6 +226,10 @@ class PressObservation:
         The commanded target.
     force_n : float
         The commanded normal force.
+    force_travel : ForceTravel or None
+        The press's force–travel record from first contact to ``force_n``; None where the
+        environment cannot provide it. Its last force must lie within
+        ``FORCE_MISMATCH_REL · force_n + FORCE_MISMATCH_ABS_N`` of ``force_n``.
     """
 
     cloud: PointCloud
@@ -123,6 +237,7 @@ class PressObservation:
     robot_points: NDArray[np.float64]
     target_xy: NDArray[np.float64]
     force_n: float
+    force_travel: ForceTravel | None = None
 
     def __post_init__(self) -> None:
         if not isinstance(self.cloud, PointCloud):
@@ -137,7 +252,22 @@ class PressObservation:
         target.setflags(write=False)
         object.__setattr__(self, "robot_points", robot)
         object.__setattr__(self, "target_xy", target)
-        object.__setattr__(self, "force_n", check_positive("force_n", self.force_n))
+        force_n = check_positive("force_n", self.force_n)
+        object.__setattr__(self, "force_n", force_n)
+        record = self.force_travel
+        if record is None:
+            return
+        if not isinstance(record, ForceTravel):
+            raise InvalidArgumentError(
+                f"`force_travel` must be a ForceTravel or None; got {type(record).__name__}"
+            )
+        final = float(record.force_n[-1])
+        allowed = FORCE_MISMATCH_REL * force_n + FORCE_MISMATCH_ABS_N
+        if abs(final - force_n) > allowed:
+            raise InvalidArgumentError(
+                f"`force_travel` must end at the commanded force {force_n:.4g} N (within "
+                f"{allowed:.3g} N); its last force is {final:.4g} N"
+            )
 
 
 @runtime_checkable

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from deformap.cloud import PointCloud
-from deformap.environment import PressObservation, TactileContact, Workspace
+from deformap.environment import ForceTravel, PressObservation, TactileContact, Workspace
 from deformap.replay import GroundTruth
 
 TOP_M = 0.05
@@ -42,6 +42,7 @@ def _robot(tip: np.ndarray) -> np.ndarray:
 
 def make_synthetic(seed: int = 0, n_pokes: int = 3, n_points: int = 1500) -> Synthetic:
     rng = np.random.default_rng(seed)
+    record_rng = np.random.default_rng([seed, 1])
     presses = []
     for i in range(n_pokes):
         target = np.array([0.1 + 0.4 * i / max(n_pokes - 1, 1), 0.2])
@@ -50,8 +51,14 @@ def make_synthetic(seed: int = 0, n_pokes: int = 3, n_points: int = 1500) -> Syn
         cloud = PointCloud(np.vstack([_surface(rng, n_points, [(target, depth)]), _robot(tip)]))
         contact = TactileContact(tip_center=tip, force=np.array([0.0, 0.0, -1.0]),
                                  tip_radius_m=TIP_M)  # fmt: skip
+        # a force–travel record on every poke but the second (adapters may lack it), its noise
+        # from its own stream so that the clouds stay what they were before records existed
+        record = None if i == 1 else ForceTravel(
+            travel_m=np.linspace(0.0, depth, 9) + record_rng.normal(0, 5e-5, 9),
+            force_n=np.linspace(0.02, 1.0, 9) + record_rng.normal(0, 0.01, 9))
         presses.append(PressObservation(cloud=cloud, contact=contact, robot_points=_robot(tip),
-                                        target_xy=target, force_n=1.0))  # fmt: skip
+                                        target_xy=target, force_n=1.0,
+                                        force_travel=record))  # fmt: skip
     xs, ys = np.linspace(0.0025, 0.5975, 120), np.linspace(0.0025, 0.3975, 80)
     labels = (xs[None, :] > 0.3).astype(np.int64) * np.ones((80, 1), dtype=np.int64)
     hardness = np.where(labels == 1, np.inf, 80.0)

@@ -16,9 +16,10 @@ from rosbags.rosbag2 import StoragePlugin, Writer
 
 from deformap.cloud.io import array_to_pointcloud2, pointcloud2_structured
 from deformap.cloud.io._ros import typestore
+from deformap.environment import ForceTravel
 from deformap.errors import ConfigError, FileFormatError
-from deformap.replay import TOPICS, load_session
-from deformap.replay._bagform import _point_message, _wrench_message
+from deformap.replay import OPTIONAL_TOPICS, TOPICS, load_session
+from deformap.replay._bagform import _point_message, _wrench_message, force_travel_message
 
 
 def _write_variant(
@@ -32,8 +33,14 @@ def _write_variant(
     skip_poke: dict[str, int] | None = None,
     static_cam2world: np.ndarray | None = None,
     repeat: dict[str, Any] | None = None,
+    records: dict[int, list[Any]] | None = None,
+    record_type: str = OPTIONAL_TOPICS["force_travel"][1],
 ) -> None:
-    """A bag like write_session's, with one thing changed; poke i is stamped (i + 1) s."""
+    """A bag like write_session's, with one thing changed; poke i is stamped (i + 1) s.
+
+    ``records`` maps a poke index to the messages to log on the force–travel topic at its stamp
+    (without it, the bag has no such topic).
+    """
     store = typestore()
     retype = retype or {}
     skip_poke = skip_poke or {}
@@ -69,6 +76,12 @@ def _write_variant(
             put("tip", stamp, _point_message(stamp, press.contact.tip_center))
             put("robot", stamp, array_to_pointcloud2(press.robot_points, stamp_ns=stamp,
                                                      dtype="float64"))  # fmt: skip
+        if records is not None:
+            conn = writer.add_connection(OPTIONAL_TOPICS["force_travel"][0], record_type,
+                                         typestore=store)  # fmt: skip
+            for i, msgs in records.items():
+                for msg in msgs:
+                    writer.write(conn, (i + 1) * 10**9, store.serialize_cdr(msg, record_type))
         if static_cam2world is not None:
             from deformap.cloud.io._bag_writer import _tf_message
 
@@ -100,6 +113,7 @@ def test_variant_writer_matches_write_session(bag_session: Path, synthetic) -> N
     for i in range(len(session)):
         assert np.array_equal(session.press_observation(i).cloud.points,
                               synthetic.presses[i].cloud.points)  # fmt: skip
+        assert session.press_observation(i).force_travel is None  # a bag without the topic
 
 
 @pytest.mark.parametrize("key", list(TOPICS))
@@ -234,4 +248,61 @@ def test_missing_and_truncated_bag(bag_session: Path) -> None:
     doc["bag"] = "a" * 300  # over NAME_MAX (255)
     (bag_session / "session.yaml").write_text(yaml.safe_dump(doc))
     with pytest.raises(FileFormatError, match="File name too long"):
+        load_session(bag_session)
+
+
+# -- the force–travel record on its optional topic ----------------------------------------------
+def _record_message(travel: Any, force: Any, dims: tuple[str, str] | None = None) -> Any:
+    record = ForceTravel(travel_m=[0.0, 0.001, 0.002], force_n=[0.02, 0.5, 1.0])
+    msg = force_travel_message(record)
+    msg.data = np.column_stack([travel, force]).ravel().astype(float)
+    msg.layout.dim[0].size = len(travel)
+    if dims is not None:
+        msg.layout.dim[0].label, msg.layout.dim[1].label = dims
+    return msg
+
+
+GOOD = ([0.0, 0.001, 0.002, 0.003], [0.02, 0.4, 0.7, 1.0])
+
+
+def test_bag_records_are_read_per_poke(bag_session: Path, synthetic) -> None:  # type: ignore[no-untyped-def]
+    _replace_bag(bag_session, synthetic, records={0: [_record_message(*GOOD)]})
+    session = load_session(bag_session)
+    got = session.press_observation(0).force_travel
+    assert got == ForceTravel(travel_m=GOOD[0], force_n=GOOD[1])
+    assert session.press_observation(1).force_travel is None  # no message for that poke
+    assert session.press_observation(2).force_travel is None
+
+
+@pytest.mark.parametrize(
+    ("messages", "match"),
+    [
+        ([_record_message([0.0, np.nan, 0.002, 0.003], GOOD[1])], "`travel_m`.*NaN or infinite"),
+        ([_record_message(GOOD[0], [0.02, 0.4, 0.7, 1.0], dims=("rows", "cols"))],
+         "layout must be 'samples'"),
+        ([_record_message([0.0, 0.001], [0.02, 1.0])], "`travel_m` must have at least 3"),
+        ([_record_message(GOOD[0], GOOD[1][::-1])], "`force_n` must rise"),
+        ([_record_message([0.0, 3.0, 2.0, 4.0], GOOD[1])], "`travel_m` must be metres"),
+        ([_record_message([0.0, 0.003, 0.001, 0.003], GOOD[1])], "must not go backwards"),
+        ([_record_message(*GOOD), _record_message(*GOOD)], "2 messages"),
+        ([_record_message(GOOD[0], [0.02, 0.1, 0.2, 0.4])], "`force_travel` must end at"),
+    ],
+)
+def test_bad_bag_record_breaks_only_its_poke(bag_session: Path, synthetic, messages: list[Any],  # type: ignore[no-untyped-def]
+                                             match: str) -> None:  # fmt: skip
+    _replace_bag(bag_session, synthetic, records={1: messages})
+    session = load_session(bag_session)
+    with pytest.raises(FileFormatError, match=match):
+        session.press_observation(1)
+    session.press_observation(0)
+    session.press_observation(2)
+
+
+def test_bag_record_topic_of_another_type_is_refused_at_load(bag_session: Path, synthetic) -> None:  # type: ignore[no-untyped-def]
+    store = typestore()
+    msg = store.types["std_msgs/msg/Float32MultiArray"](
+        layout=_record_message(*GOOD).layout, data=np.zeros(8, dtype=np.float32))
+    _replace_bag(bag_session, synthetic, records={0: [msg]},
+                 record_type="std_msgs/msg/Float32MultiArray")
+    with pytest.raises(FileFormatError, match="force_travel' carries std_msgs/msg/Float32"):
         load_session(bag_session)

@@ -255,3 +255,68 @@ def test_poke_index_out_of_range(folder: Path) -> None:
         session.press_observation(3)
     with pytest.raises(InvalidArgumentError, match="`index`"):
         session.press_observation(-1)
+
+
+# -- the force–travel record of a poke -----------------------------------------------------------
+_GOOD_TRAVEL = [0.0, 0.001, 0.002, 0.003, 0.004]
+_GOOD_FORCE = [0.02, 0.25, 0.5, 0.75, 1.0]
+
+
+def _record(travel: Any = None, force: Any = None) -> dict[str, Any]:
+    return {"travel_m": _GOOD_TRAVEL if travel is None else travel,
+            "force_n": _GOOD_FORCE if force is None else force}
+
+
+@pytest.mark.parametrize(
+    ("change", "match"),
+    [
+        (_set("pokes.1.force_travel", [1.0, 2.0]), r"`pokes\[1\].force_travel` must be a mapping"),
+        (_set("pokes.1.force_travel", {**_record(), "time_s": [0, 1, 2, 3, 4]}),
+         r"`pokes\[1\].force_travel` has unknown key\(s\) \['time_s'\]"),
+        (_set("pokes.1.force_travel", {"travel_m": _GOOD_TRAVEL}),
+         r"`pokes\[1\].force_travel` lacks required key\(s\) \['force_n'\]"),
+    ],
+)
+def test_force_travel_schema_is_refused_at_load(folder: Path, change: Edit, match: str) -> None:
+    _edit(folder, change)
+    with pytest.raises(ConfigError, match=match):
+        load_session(folder)
+
+
+@pytest.mark.parametrize(
+    ("record", "match"),
+    [
+        (_record(travel=[0.0, float("nan"), 0.002, 0.003, 0.004]), "`travel_m`.*NaN or infinite"),
+        (_record(force=[0.02, 0.25, float("inf"), 0.75, 1.0]), "`force_n`.*NaN or infinite"),
+        (_record(travel=[0.0, 0.001], force=[0.02, 1.0]), "`travel_m` must have at least 3"),
+        (_record(force=[0.02, 0.5, 1.0]), "`force_n` must have one sample per"),
+        (_record(travel=[0.0, 0.003, 0.001, 0.003, 0.004]), "`travel_m` must not go backwards"),
+        (_record(force=[1.0, 0.75, 0.5, 0.25, 0.02]), "`force_n` must rise"),
+        (_record(force=[1.0, 1.0, 1.0, 1.0, 1.0]), "`force_n` must rise"),
+        (_record(travel=[0.0, 1.0, 2.0, 3.0, 4.0]), "`travel_m` must be metres.*millimetres"),
+        (_record(travel="0 1 2"), "`travel_m` must be a"),
+    ],
+)
+def test_bad_force_travel_values_break_only_that_poke(folder: Path, record: dict[str, Any],
+                                                      match: str) -> None:  # fmt: skip
+    _edit(folder, _set("pokes.1.force_travel", record))
+    _only_poke_broken(folder, 1, ConfigError, r"`pokes\[1\].force_travel`: " + match)
+
+
+def test_force_travel_far_from_the_commanded_force_breaks_only_that_poke(folder: Path) -> None:
+    _edit(folder, _set("pokes.1.force_travel", _record(force=[0.02, 0.1, 0.2, 0.3, 0.5])))
+    _only_poke_broken(folder, 1, FileFormatError, "poke 1: `force_travel` must end at the "
+                                                  "commanded force 1 N")
+
+
+def test_a_good_record_added_by_hand_is_read(folder: Path) -> None:
+    _edit(folder, _set("pokes.1.force_travel", _record()))
+    got = load_session(folder).press_observation(1).force_travel
+    assert got is not None
+    assert got.travel_m.tolist() == _GOOD_TRAVEL and got.force_n.tolist() == _GOOD_FORCE
+
+
+def test_a_session_without_records_loads_with_none(folder: Path) -> None:
+    _edit(folder, lambda doc: [poke.pop("force_travel", None) for poke in doc["pokes"]])
+    session = load_session(folder)
+    assert all(session.press_observation(i).force_travel is None for i in range(len(session)))

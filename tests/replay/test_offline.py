@@ -143,6 +143,8 @@ def test_record_sim_writes_a_bag(config_file: Path, tmp_path: Path) -> None:
     assert session.form == "bag" and len(session) == 1
     assert session.source["seed"] == SEED and session.ground_truth is not None
     assert session.press_observation(0).contact.tip_radius_m > 0
+    record = session.press_observation(0).force_travel  # the world's record, through the bag
+    assert record is not None and len(record) >= 9
 
 
 def test_broken_poke_is_reported_and_skipped(recorded: Path, live: dict[str, Any],
@@ -278,3 +280,37 @@ def test_tip_sphere_points_lie_on_the_tip() -> None:
     assert pts.shape == (6, 3)
     np.testing.assert_allclose(np.linalg.norm(pts - center, axis=1), 0.01)
     np.testing.assert_allclose(pts.mean(axis=0), center)
+
+
+def test_record_sim_keeps_each_press_force_travel_record(recorded: Path) -> None:
+    session = load_session(recorded)
+    text = (recorded / "session.yaml").read_text()
+    assert text.count("force_travel:") == len(session) >= 2
+    for i in range(len(session)):
+        obs = session.press_observation(i)
+        assert obs.force_travel is not None and len(obs.force_travel) >= 9
+        assert obs.force_travel.force_n[-1] == pytest.approx(obs.force_n, rel=0.1)
+
+
+@pytest.mark.parametrize("form", ["folder", "mcap"])
+def test_recorded_world_presses_read_back_identical(tmp_path: Path, form: str) -> None:
+    if form != "folder":
+        pytest.importorskip("rosbags")
+    from deformap.replay import RecordingEnvironment
+    from deformap.world import SimulatedWorld, WorldConfig, load_scenario
+
+    world = SimulatedWorld(load_scenario(SCENARIO), config=WorldConfig.coarse(),
+                           rng=np.random.default_rng(SEED))
+    env = RecordingEnvironment(world)
+    env.observe()
+    for xy in ((0.1, 0.2), (0.5, 0.2)):  # a foam and the rigid board
+        env.press(xy, 0.6)
+        env.release()
+    write_session(tmp_path / "s", workspace=world.workspace, observation=env.observation,
+                  presses=env.presses, format=form)  # fmt: skip
+    session = load_session(tmp_path / "s")
+    for i, want in enumerate(env.presses):
+        got = session.press_observation(i)
+        assert want.force_travel is not None
+        assert got.force_travel == want.force_travel
+        assert np.array_equal(got.cloud.points, want.cloud.points)

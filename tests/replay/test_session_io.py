@@ -41,6 +41,7 @@ def _assert_same(session: RecordedSession, syn) -> None:  # type: ignore[no-unty
         assert got.contact.tip_radius_m == want.contact.tip_radius_m
         assert np.array_equal(got.target_xy, want.target_xy)
         assert got.force_n == want.force_n
+        assert got.force_travel == want.force_travel  # bit for bit, or both None
     truth = session.ground_truth
     assert truth is not None
     for name in ("xs", "ys", "labels", "hardness"):
@@ -75,8 +76,11 @@ def test_session_yaml_is_documented_shape(tmp_path: Path, synthetic, write_synth
     file = write_synthetic(tmp_path / "s", synthetic)
     doc = yaml.safe_load(file.read_text())
     assert doc["format"] == FORMAT_NAME and doc["version"] == FORMAT_VERSION
-    assert list(doc["pokes"][0]) == ["cloud", "tip_center", "force", "target_xy", "force_n",
-                                     "robot_points"]  # fmt: skip
+    keys = ["cloud", "tip_center", "force", "target_xy", "force_n", "robot_points"]
+    assert list(doc["pokes"][1]) == keys  # a press without a force–travel record
+    assert list(doc["pokes"][0]) == [*keys, "force_travel"]
+    assert list(doc["pokes"][0]["force_travel"]) == ["travel_m", "force_n"]
+    assert len(doc["pokes"][0]["force_travel"]["travel_m"]) == 9
     assert doc["ground_truth"] == "ground_truth.npz"
 
 

@@ -12,7 +12,13 @@ from __future__ import annotations
 
 from typing import Any
 
-from deformap.replay._format import FORMAT_NAME, FORMAT_VERSION, SESSION_FILE, TOPICS
+from deformap.replay._format import (
+    FORMAT_NAME,
+    FORMAT_VERSION,
+    OPTIONAL_TOPICS,
+    SESSION_FILE,
+    TOPICS,
+)
 from deformap.replay._recorder import RecordingEnvironment
 from deformap.replay._session import DEFAULT_CONTACT_GAP_M, RecordedSession, load_session
 from deformap.replay._truth import GroundTruth, read_ground_truth, write_ground_truth
@@ -26,6 +32,7 @@ __all__ = [
     "DEFAULT_CONTACT_GAP_M",
     "FORMAT_NAME",
     "FORMAT_VERSION",
+    "OPTIONAL_TOPICS",
     "SESSION_FILE",
     "SESSION_FORMATS",
     "TOPICS",

@@ -3,6 +3,11 @@
 The messages of one poke share one header stamp, which ``session.yaml`` names (``stamp_ns``) next
 to what no standard message holds (the commanded target and force). The bag is indexed once; each
 message is decoded only when its poke is read, so a corrupted message breaks only its own poke.
+
+The force–travel record (``OPTIONAL_TOPICS``) is a ``std_msgs/msg/Float64MultiArray`` with two
+dimensions, ``samples`` (n) and ``travel_m,force_n`` (2), its data the n rows ``(travel, force)``
+row by row. That message has no header: the bag's log time of the message is the poke's stamp.
+A bag without the topic, or a poke without a message on it, has no record (``force_travel`` None).
 """
 
 from __future__ import annotations
@@ -27,12 +32,15 @@ from deformap.cloud.io import (
     typestore,
     wrench_message,
 )
-from deformap.environment import PressObservation
-from deformap.errors import FileFormatError
+from deformap.environment import ForceTravel, PressObservation
+from deformap.errors import DeformapError, FileFormatError
 from deformap.replay._folder import PressParts
-from deformap.replay._format import TOPICS, PokeSpec, SessionHeader
+from deformap.replay._format import OPTIONAL_TOPICS, TOPICS, PokeSpec, SessionHeader
 
-__all__ = ["BagReader", "write_session_bag"]
+#: Labels of the record's two dimensions in its ``Float64MultiArray`` layout.
+FORCE_TRAVEL_DIMS = ("samples", "travel_m,force_n")
+
+__all__ = ["FORCE_TRAVEL_DIMS", "BagReader", "force_travel_message", "write_session_bag"]
 
 
 @dataclass
@@ -61,10 +69,44 @@ class BagReader:
         self._tf_static: NDArray[np.float64] | None = None
 
     def _index(self) -> dict[str, list[_Raw]]:
-        out: dict[str, list[_Raw]] = {topic: [] for topic, _ in TOPICS.values()}
-        for raw in iter_bag_messages(self.path, dict(TOPICS.values())):
+        every = {**TOPICS, **OPTIONAL_TOPICS}
+        out: dict[str, list[_Raw]] = {topic: [] for topic, _ in every.values()}
+        for raw in iter_bag_messages(self.path, dict(TOPICS.values()),
+                                     optional=dict(OPTIONAL_TOPICS.values())):  # fmt: skip
             out[raw.topic].append(_Raw(raw.log_time_ns, bytes(raw.data)))
         return out
+
+    def _force_travel(self, stamp: int) -> ForceTravel | None:
+        """The record whose message is logged at ``stamp``, or None when there is none."""
+        topic, msgtype = OPTIONAL_TOPICS["force_travel"]
+        where = f"{self.path} [{topic} logged at {stamp}]"
+        raws = [r for r in self._raw[topic] if r.log_time_ns == stamp]
+        if not raws:
+            return None
+        if len(raws) > 1:
+            raise FileFormatError(
+                f"{where}: {len(raws)} messages; a poke needs at most one force–travel record"
+            )
+        try:
+            msg = typestore().deserialize_cdr(raws[0].data, msgtype)
+        except bag_read_errors() as exc:
+            raise FileFormatError(
+                f"{where}: could not be decoded: {type(exc).__name__}: {str(exc)[:120]}"
+            ) from None
+        dims = [(str(d.label), int(d.size)) for d in msg.layout.dim]
+        data = np.asarray(msg.data, dtype=float)
+        if (len(dims) != 2 or (dims[0][0], dims[1][0]) != FORCE_TRAVEL_DIMS or dims[1][1] != 2
+                or msg.layout.data_offset != 0 or data.size != 2 * dims[0][1]):
+            raise FileFormatError(
+                f"{where}: layout must be {FORCE_TRAVEL_DIMS[0]!r} (n) × "
+                f"{FORCE_TRAVEL_DIMS[1]!r} (2) with 2n values from offset 0; got dims {dims}, "
+                f"offset {msg.layout.data_offset}, {data.size} values"
+            )
+        rows = data.reshape(-1, 2)
+        try:
+            return ForceTravel(travel_m=rows[:, 0], force_n=rows[:, 1])
+        except DeformapError as exc:
+            raise FileFormatError(f"{where}: {exc}") from None
 
     def _messages_by_stamp(self) -> dict[str, dict[int, Any]]:
         if self._decoded is not None:
@@ -165,7 +207,8 @@ class BagReader:
                 raise FileFormatError(
                     f"{where(key)}: holds NaN or infinite values {value.tolist()}"
                 )
-        return PressParts(cloud, center, force, np.asarray(robot.points))
+        return PressParts(cloud, center, force, np.asarray(robot.points),
+                          self._force_travel(stamp))
 
 
 def _point_message(stamp_ns: int, point: Any) -> Any:
@@ -182,6 +225,19 @@ def _wrench_message(stamp_ns: int, force: Any) -> Any:
     return wrench_message(stamp_ns, "world", force, np.zeros(3))
 
 
+def force_travel_message(record: ForceTravel) -> Any:
+    """The record as a ``std_msgs/msg/Float64MultiArray`` (see the module docstring)."""
+    types = typestore().types
+    n = len(record)
+    dims = [types["std_msgs/msg/MultiArrayDimension"](label=FORCE_TRAVEL_DIMS[0], size=n,
+                                                      stride=2 * n),
+            types["std_msgs/msg/MultiArrayDimension"](label=FORCE_TRAVEL_DIMS[1], size=2,
+                                                      stride=2)]  # fmt: skip
+    layout = types["std_msgs/msg/MultiArrayLayout"](dim=dims, data_offset=0)
+    data = np.column_stack([record.travel_m, record.force_n]).ravel()
+    return types["std_msgs/msg/Float64MultiArray"](layout=layout, data=data)
+
+
 def write_session_bag(
     path: Path,
     *,
@@ -192,12 +248,16 @@ def write_session_bag(
 ) -> None:
     """Write the observation and the presses (world frame, float64) to a new bag at ``path``."""
     store = typestore()
+    # the record's topic only where a press has one: a bag of presses without stays as before
+    topics = dict(TOPICS)
+    if any(obs.force_travel is not None for obs in presses):
+        topics.update(OPTIONAL_TOPICS)
     with bag_writer(path, storage) as writer:
         conns = {key: writer.add_connection(topic, msgtype, typestore=store)
-                 for key, (topic, msgtype) in TOPICS.items()}  # fmt: skip
+                 for key, (topic, msgtype) in topics.items()}  # fmt: skip
 
         def put(key: str, stamp: int, msg: Any) -> None:
-            writer.write(conns[key], stamp, store.serialize_cdr(msg, TOPICS[key][1]))
+            writer.write(conns[key], stamp, store.serialize_cdr(msg, topics[key][1]))
 
         put("observation", 0, array_to_pointcloud2(observation.points, frame_id="world",
                                                    stamp_ns=0, dtype="float64"))  # fmt: skip
@@ -208,3 +268,5 @@ def write_session_bag(
             put("tip", stamp, _point_message(stamp, obs.contact.tip_center))
             put("robot", stamp, array_to_pointcloud2(obs.robot_points, frame_id="world",
                                                      stamp_ns=stamp, dtype="float64"))  # fmt: skip
+            if obs.force_travel is not None:
+                put("force_travel", stamp, force_travel_message(obs.force_travel))

@@ -10,6 +10,7 @@ from numpy.typing import NDArray
 
 from deformap.cloud import PointCloud
 from deformap.cloud.io import path_kind, read_cloud
+from deformap.environment import ForceTravel
 from deformap.errors import FileFormatError
 from deformap.replay._format import PokeSpec, SessionHeader
 
@@ -24,6 +25,7 @@ class PressParts:
     tip_center: NDArray[np.float64]
     force: NDArray[np.float64]
     robot_points: NDArray[np.float64]
+    force_travel: ForceTravel | None = None
 
 
 def _to_world(cloud: PointCloud, header: SessionHeader) -> PointCloud:
@@ -58,7 +60,7 @@ class FolderReader:
             # Robot geometry comes from the robot model in the world (base) frame, not the camera's.
             robot = np.asarray(read_cloud(self._path(robot), units=self.header.units).points)
         assert robot is not None
-        return PressParts(cloud, spec.tip_center, spec.force, robot)
+        return PressParts(cloud, spec.tip_center, spec.force, robot, spec.force_travel)
 
     @staticmethod
     def _path(path: Path | None) -> Path:

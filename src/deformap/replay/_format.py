@@ -21,12 +21,13 @@ from numpy.typing import NDArray
 
 from deformap._validation import check_array, check_int, check_positive, check_vector
 from deformap.cloud.io import UNITS
-from deformap.environment import Workspace
+from deformap.environment import ForceTravel, Workspace
 from deformap.errors import ConfigError, DeformapError
 
 __all__ = [
     "FORMAT_NAME",
     "FORMAT_VERSION",
+    "OPTIONAL_TOPICS",
     "SESSION_FILE",
     "TOPICS",
     "PokeSpec",
@@ -47,9 +48,18 @@ TOPICS = {
     "robot": ("/deformap/press/robot", "sensor_msgs/msg/PointCloud2"),
 }
 
+#: Topics of the bag form that a bag may lack (then no poke has what they carry). The force–travel
+#: record is a ``Float64MultiArray`` of ``n × 2`` rows ``(travel_m, force_n)``; the message has no
+#: header, so its bag log time is the poke's ``stamp_ns``.
+OPTIONAL_TOPICS = {
+    "force_travel": ("/deformap/press/force_travel", "std_msgs/msg/Float64MultiArray"),
+}
+
 _TOP_REQUIRED = {"format", "version", "workspace", "probe", "pokes"}
 _TOP_OPTIONAL = {"units", "frame", "cam2world", "ground_truth", "source", "observation", "bag"}
 _FOLDER_POKE_KEYS = {"cloud", "tip_center", "force", "target_xy", "force_n", "robot_points"}
+_FOLDER_POKE_OPTIONAL = {"force_travel"}
+_FORCE_TRAVEL_KEYS = {"travel_m", "force_n"}
 _BAG_POKE_KEYS = {"stamp_ns", "target_xy", "force_n"}
 
 
@@ -73,6 +83,8 @@ class PokeSpec:
         Folder form: a cloud file, or the points inline.
     stamp_ns : int or None
         Bag form: the header stamp shared by this poke's messages.
+    force_travel : ForceTravel or None
+        Folder form: the press's force–travel record, when the entry has one.
     error : DeformapError or None
         Why this entry cannot be used (raised when the poke is read).
     """
@@ -85,6 +97,7 @@ class PokeSpec:
     force: NDArray[np.float64] | None = None
     robot_points: Path | NDArray[np.float64] | None = None
     stamp_ns: int | None = None
+    force_travel: ForceTravel | None = None
     error: DeformapError | None = None
 
 
@@ -196,8 +209,13 @@ def _cam2world(file: Path, data: dict[str, Any], frame: str, form: str) -> Any:
 
 def _poke(file: Path, index: int, data: Any, form: str, root: Path) -> PokeSpec:
     key = f"pokes[{index}]"
-    allowed = _FOLDER_POKE_KEYS if form == "folder" else _BAG_POKE_KEYS
-    _check_keys(file, key, data, allowed, set())
+    if form == "folder":
+        _check_keys(file, key, data, _FOLDER_POKE_KEYS, _FOLDER_POKE_OPTIONAL)
+        if "force_travel" in data:
+            _check_keys(file, f"{key}.force_travel", data["force_travel"], _FORCE_TRAVEL_KEYS,
+                        set())  # fmt: skip
+    else:
+        _check_keys(file, key, data, _BAG_POKE_KEYS, set())
     # Schema problems (above) fail the file; value problems (below) fail only this poke.
     try:
         target = _value(file, f"{key}.target_xy", check_vector, data["target_xy"], 2, what="metres")
@@ -218,10 +236,24 @@ def _poke(file: Path, index: int, data: Any, form: str, root: Path) -> PokeSpec:
         else:
             robot = _value(file, f"{key}.robot_points", check_array, robot_raw, (None, 3),
                            what="points in metres", min_rows=4)  # fmt: skip
+        record = None
+        if "force_travel" in data:
+            raw = data["force_travel"]
+            record = _value(file, f"{key}.force_travel", _force_travel, raw["travel_m"],
+                            raw["force_n"])  # fmt: skip
         return PokeSpec(index=index, target_xy=target, force_n=force_n, cloud=cloud,
-                        tip_center=center, force=force, robot_points=robot)  # fmt: skip
+                        tip_center=center, force=force, robot_points=robot,
+                        force_travel=record)  # fmt: skip
     except ConfigError as exc:
         return PokeSpec(index=index, error=exc)
+
+
+def _force_travel(name: str, travel: Any, force: Any) -> ForceTravel:
+    """A ``ForceTravel`` from plain data; its refusal names the entry and the field."""
+    try:
+        return ForceTravel(travel_m=travel, force_n=force)
+    except DeformapError as exc:
+        raise ConfigError(f"`{name}`: {exc}") from None
 
 
 def _workspace(file: Path, data: Any) -> Workspace:

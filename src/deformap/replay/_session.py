@@ -113,7 +113,8 @@ class RecordedSession:
                                      tip_radius_m=self.tip_radius_m)  # fmt: skip
             obs = PressObservation(cloud=parts.cloud, contact=contact,
                                    robot_points=parts.robot_points, target_xy=spec.target_xy,
-                                   force_n=spec.force_n)  # fmt: skip
+                                   force_n=spec.force_n,
+                                   force_travel=parts.force_travel)  # fmt: skip
         except InvalidArgumentError as exc:
             raise FileFormatError(f"{where}: {exc}") from None
         self._check_contact(obs, where)

@@ -125,7 +125,9 @@ def write_session(
     observation : PointCloud
         The initial observation, world frame, metres.
     presses : sequence of PressObservation
-        In order. Clouds and robot points are written in float64, so they read back bit for bit.
+        In order. Clouds and robot points are written in float64, so they read back bit for bit;
+        so is a press's force–travel record (in ``session.yaml``, or on the bag's
+        ``/deformap/press/force_travel``).
     tip_radius_m : float, optional
         Defaults to the presses' (which must agree).
     ground_truth : GroundTruth, optional
@@ -166,11 +168,15 @@ def write_session(
             cloud, robot = f"poke-{i:02d}.{cloud_format}", f"poke-{i:02d}-robot.{cloud_format}"
             write_cloud(out / cloud, obs.cloud)
             write_cloud(out / robot, PointCloud(obs.robot_points))
-            doc["pokes"].append({
+            entry: dict[str, Any] = {
                 "cloud": cloud, "tip_center": _floats(obs.contact.tip_center),
                 "force": _floats(obs.contact.force), "target_xy": _floats(obs.target_xy),
                 "force_n": float(obs.force_n), "robot_points": robot,
-            })  # fmt: skip
+            }  # fmt: skip
+            if obs.force_travel is not None:
+                entry["force_travel"] = {"travel_m": _floats(obs.force_travel.travel_m),
+                                         "force_n": _floats(obs.force_travel.force_n)}
+            doc["pokes"].append(entry)
     else:
         stamps = [(i + 1) * _STAMP_STEP_NS for i in range(len(presses))]
         write_session_bag(out / "bag", storage=format, observation=observation,

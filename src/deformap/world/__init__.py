@@ -13,6 +13,7 @@ Quick start::
     world = SimulatedWorld(scenario, rng=np.random.default_rng(0))
     cloud = world.observe()
     obs = world.press((0.1, 0.2), 0.6)   # target (m), force (N)
+    obs.force_travel.travel_m, obs.force_travel.force_n   # contact → 0.6 N, 9 samples
     world.release()
 """
 
@@ -31,10 +32,16 @@ from deformap.world._probe import ProbeGeometry
 from deformap.world._random import random_scenario
 from deformap.world._scenario import BARE_TABLE, Block, Scenario
 from deformap.world._scenario_io import list_scenarios, load_scenario, save_scenario
-from deformap.world._world import SimulatedWorld, WorldConfig, check_world_budget
+from deformap.world._world import (
+    MIN_RECORD_FORCE_N,
+    SimulatedWorld,
+    WorldConfig,
+    check_world_budget,
+)
 
 __all__ = [
     "BARE_TABLE",
+    "MIN_RECORD_FORCE_N",
     "Block",
     "CameraConfig",
     "Dent",

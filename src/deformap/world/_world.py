@@ -8,6 +8,14 @@ spherical-tip contact on every foam of the paper's range; the world's tests chec
 every foam by more than the camera's noise and by less than half of the block
 (``tests/world/test_fem.py``).
 
+Force–travel record
+-------------------
+Each press also returns its force–travel record (``PressObservation.force_travel``): the FEM
+solved at ``force_travel_levels`` loads from the contact threshold to the commanded force, with the
+noise of arm encoders and a force sensor, drawn from a stream of its own so that the press's other
+draws (contact force, clouds) are those of a world without the record
+(:mod:`deformap.world._force_travel`).
+
 Ground truth
 ------------
 Labels are block indices (``-1`` = bare table). Hardness and modulus are ``inf`` on rigid blocks and
@@ -34,18 +42,36 @@ from deformap._validation import (
     setting,
 )
 from deformap.cloud import PointCloud
-from deformap.environment import PressObservation, TactileContact, Workspace
+from deformap.environment import (
+    MIN_FORCE_RISE_N,
+    ForceTravel,
+    PressObservation,
+    TactileContact,
+    Workspace,
+)
 from deformap.errors import EnvironmentStateError, InvalidArgumentError
 from deformap.world._camera import CameraConfig, DepthCamera
 from deformap.world._foam import Dent, FoamModel
+from deformap.world._force_travel import force_levels, simulated_force_travel
 from deformap.world._probe import ProbeGeometry
 from deformap.world._scenario import BARE_TABLE, Block, Scenario
 
-__all__ = ["MAX_FEM_UNKNOWNS", "SimulatedWorld", "WorldConfig", "check_world_budget"]
+__all__ = [
+    "MAX_FEM_UNKNOWNS",
+    "MIN_RECORD_FORCE_N",
+    "SimulatedWorld",
+    "WorldConfig",
+    "check_world_budget",
+]
 
 log = logging.getLogger(__name__)
 
 _UP = np.array([0.0, 0.0, 1.0])
+
+#: The world records force against travel only for presses of at least this force [N]: the
+#: record must rise by more than ``MIN_FORCE_RISE_N`` from contact, with room for the force
+#: sensor's noise (the exploration presses with 0.3 N or more).
+MIN_RECORD_FORCE_N = 0.1 + 5 * MIN_FORCE_RISE_N
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -68,8 +94,20 @@ class WorldConfig:
         The box standing for the hand that holds the stick.
     force_noise_n : float
         Standard deviation per axis of the force sensor's noise (Optoforce-class resolution).
+    force_travel_levels : int
+        Load levels of the press's force–travel record above contact: it has this many plus one
+        samples, evenly spaced in force from ``contact_threshold_n`` to the commanded force, each
+        solved by the FEM (see :mod:`deformap.world._force_travel`).
+    contact_threshold_n : float
+        The force at which the probe detects contact: the record's first sample, where its
+        travel starts. Presses at less than :data:`MIN_RECORD_FORCE_N` give no record.
+    encoder_noise_m : float
+        Standard deviation of the arm's reading of the tip's position along the press direction
+        (joint encoders through forward kinematics), for the record's travel.
+    force_travel_noise_rel, force_travel_noise_n : float
+        Standard deviation of the record's force samples: ``rel · F + n`` at force ``F``.
     noise : bool
-        False turns off every noise source (camera and force sensor) at once.
+        False turns off every noise source (camera, force sensor, force–travel record) at once.
     camera : CameraConfig
     table_margin_m : float
         How far the table extends beyond the workspace on every side.
@@ -87,6 +125,12 @@ class WorldConfig:
     stick_radius_m: float = setting(0.006, gt=0.0)
     hand_size_m: tuple[float, float, float] = setting((0.08, 0.06, 0.10), gt=0.0)
     force_noise_n: float = setting(0.01, ge=0.0)
+    # 8 levels resolve the curvature of a sphere's F ∝ δ^(3/2); each level costs one press solve
+    force_travel_levels: int = setting(8, ge=2, le=1000)
+    contact_threshold_n: float = setting(0.02, gt=0.0, le=0.1)
+    encoder_noise_m: float = setting(5e-5, ge=0.0, le=1e-3)  # arm encoders: about 0.05 mm
+    force_travel_noise_rel: float = setting(0.01, ge=0.0, le=0.1)  # force sensors: 1 % + 5 mN
+    force_travel_noise_n: float = setting(0.005, ge=0.0, le=0.1)
     noise: bool = True
     camera: CameraConfig = field(default_factory=CameraConfig)
     table_margin_m: float = setting(0.2, gt=0.0)
@@ -241,7 +285,8 @@ class SimulatedWorld:
         self._displacement = dent.displacement
         self._pressed = PressObservation(
             cloud=cloud, contact=contact, target_xy=target, force_n=force,
-            robot_points=self.config.probe.robot_points(tip_center, _UP))
+            robot_points=self.config.probe.robot_points(tip_center, _UP),
+            force_travel=self.force_travel(target, force, dent))
         return self._pressed
 
     def release(self) -> None:
@@ -272,6 +317,48 @@ class SimulatedWorld:
         target = check_vector("target_xy", target_xy, 2, what="metres")
         force = check_positive("force_n", force_n)
         return self.foam.dent(target, force, tip_radius_m=self.config.tip_radius_m)
+
+    def force_travel(self, target_xy: Any, force_n: float, dent: Dent | None = None
+                     ) -> ForceTravel | None:
+        """The force–travel record of the press at ``target_xy`` with ``force_n`` newtons.
+
+        One FEM press solve per load level (:mod:`deformap.world._force_travel`); ``dent``, the
+        press's own solve at ``force_n``, is the last level. The noise comes from the
+        press's own stream for the record (the same for the same press, whatever came before),
+        none with ``noise=False``. None for a press under :data:`MIN_RECORD_FORCE_N`.
+        """
+        target = check_vector("target_xy", target_xy, 2, what="metres")
+        force = check_positive("force_n", force_n)
+        if force < MIN_RECORD_FORCE_N:
+            return None
+        c = self.config
+        final = dent if dent is not None else self.dent(target, force)
+        levels = force_levels(c.contact_threshold_n, force, c.force_travel_levels)
+
+        depths = self._level_depths(target, levels, final)
+        noisy = c.noise
+        return simulated_force_travel(
+            depths, levels, self._press_rng(target, force, 2),
+            encoder_noise_m=c.encoder_noise_m if noisy else 0.0,
+            force_noise_rel=c.force_travel_noise_rel if noisy else 0.0,
+            force_noise_n=c.force_travel_noise_n if noisy else 0.0)
+
+    def _level_depths(self, target: NDArray[np.float64], levels: NDArray[np.float64],
+                      final: Dent) -> NDArray[np.float64]:
+        """The tip's indentation at each force of ``levels`` (increasing, ending at ``final``'s).
+
+        Solved from the top level down, each patch iteration started from the level above's patch
+        scaled as Hertz's ``a ∝ F^(1/3)``: close to its fixed point, so one or two solves a level
+        on the stiffness factorised when the world was built.
+        """
+        depths = np.empty(levels.size)
+        depths[-1], patch = final.depth_m, final
+        for k in range(levels.size - 2, -1, -1):
+            start = patch.contact_radius_m * (levels[k] / levels[k + 1]) ** (1.0 / 3.0)
+            patch = self.foam.dent(target, float(levels[k]), tip_radius_m=self.config.tip_radius_m,
+                                   initial_radius_m=start)
+            depths[k] = patch.depth_m
+        return depths
 
     def ground_truth_labels(self, xs: Any, ys: Any) -> NDArray[np.int64]:
         """``(ny, nx)`` block index at ``(xs[j], ys[i])``; ``-1`` on the bare table."""

@@ -150,7 +150,8 @@ class RawBagMessage:
     data: bytes | memoryview
 
 
-def iter_bag_messages(path: Any, topics: Mapping[str, str]) -> Iterator[RawBagMessage]:
+def iter_bag_messages(path: Any, topics: Mapping[str, str],
+                      optional: Mapping[str, str] | None = None) -> Iterator[RawBagMessage]:
     """The messages of ``topics`` in a ROS 2 bag, in the bag's order: the one bag reader.
 
     Opens the bag (a rosbag2 folder, ``.mcap`` or ``.db3``) through rosbags, checks that each
@@ -163,6 +164,9 @@ def iter_bag_messages(path: Any, topics: Mapping[str, str]) -> Iterator[RawBagMe
     path : str or Path
     topics : mapping of str to str
         Topic name → message type (``"sensor_msgs/msg/PointCloud2"``); at least one.
+    optional : mapping of str to str, optional
+        Topics the bag may lack; when present, they must carry only their type, and their
+        messages are yielded with the others'.
     """
     if not isinstance(path, (str, Path)):
         raise InvalidArgumentError(
@@ -173,13 +177,20 @@ def iter_bag_messages(path: Any, topics: Mapping[str, str]) -> Iterator[RawBagMe
     rosbag2, p = _rosbag2(), Path(path)
     if path_kind(p) == "missing":
         raise FileFormatError(f"{p}: no such bag")
-    what = f"topic {next(iter(topics))!r}" if len(topics) == 1 else "the bag"
+    if optional is not None and not isinstance(optional, Mapping):
+        raise InvalidArgumentError(f"`optional` must be a mapping or None; got {optional!r}")
+    what = f"topic {next(iter(topics))!r}" if len(topics) == 1 and not optional else "the bag"
+    wanted = dict(topics)
+    for topic, msgtype in (optional or {}).items():
+        wanted.setdefault(topic, msgtype)
     errors = bag_read_errors()
     try:
         with rosbag2.Reader(p) as reader:
             found = sorted({c.topic for c in reader.connections})
-            for topic, msgtype in topics.items():
+            for topic, msgtype in wanted.items():
                 conns = [c for c in reader.connections if c.topic == topic]
+                if not conns and topic not in topics:
+                    continue
                 if not conns:
                     raise FileFormatError(
                         f"{p}: bag has no topic {topic!r} (topics: {found}); expected one "
@@ -190,7 +201,7 @@ def iter_bag_messages(path: Any, topics: Mapping[str, str]) -> Iterator[RawBagMe
                     raise FileFormatError(
                         f"{p}: topic {topic!r} carries {wrong[0]}, expected {msgtype}"
                     )
-            conns = [c for c in reader.connections if c.topic in topics]
+            conns = [c for c in reader.connections if c.topic in wanted]
             for conn, log_time, raw in reader.messages(connections=conns):
                 yield RawBagMessage(conn.topic, int(log_time), raw)
     except DeformapError:

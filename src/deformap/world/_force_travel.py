@@ -1,0 +1,66 @@
+"""The force–travel record of a simulated press, from the world's own physics.
+
+A real arm records, from first contact to the commanded force, the tip's travel along the press
+direction (joint encoders through forward kinematics) and the normal force (the force sensor);
+``docs/robot.md`` says how. The simulated world gives the same record from its FEM:
+
+- Load levels: ``n_levels + 1`` forces evenly spaced from the contact threshold ``F_c`` (the force
+  at which a robot detects contact, its first sample) to the commanded force ``F``.
+- Travel: the foam's contact patch grows with the force (a sphere on an elastic layer), so each
+  level is its own press solve (:meth:`~deformap.world._foam.FoamModel.dent`), on the stiffness
+  factorised when the world was built, each started from the patch of the level above it (so
+  one or two solves a level); the commanded level is the press's own dent. The tip's
+  true descent at level ``k`` is the dent depth ``δ(F_k)``; on rigid ground it is 0.
+- Sensor noise, as a real arm's: the encoders read the tip's position with an error of
+  ``encoder_noise_m`` at every sample, and the travel is the position minus the position at first
+  contact (so the first travel is exactly 0, and every later one carries the difference of two
+  errors); the force sensor reads ``F_k`` with an error of ``rel · F_k + abs`` (one standard
+  deviation). A rigid board therefore gives a travel of encoder noise around zero.
+
+The noise comes from a generator of its own (the world keys it by the press, apart from the
+camera's and the contact's), so the record adds draws without moving any draw the press made
+before it existed.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from deformap.environment import ForceTravel
+
+__all__ = ["force_levels", "simulated_force_travel"]
+
+
+def force_levels(contact_n: float, force_n: float, n_levels: int) -> NDArray[np.float64]:
+    """``(n_levels + 1,)`` forces evenly spaced from ``contact_n`` to ``force_n`` (both kept)."""
+    return np.linspace(contact_n, force_n, n_levels + 1)
+
+
+def simulated_force_travel(
+    depths: NDArray[np.float64],
+    levels: NDArray[np.float64],
+    rng: np.random.Generator,
+    *,
+    encoder_noise_m: float,
+    force_noise_rel: float,
+    force_noise_n: float,
+) -> ForceTravel:
+    """The record of a press whose tip sinks ``depths[k]`` metres under ``levels[k]`` newtons.
+
+    Parameters
+    ----------
+    depths : (n,) float, metres
+        The tip's true indentation at each level.
+    levels : (n,) float, newtons
+        The true forces of the samples, increasing (:func:`force_levels`).
+    rng : numpy.random.Generator
+        The record's own noise stream: ``n`` encoder draws, then ``n`` force draws.
+    encoder_noise_m, force_noise_rel, force_noise_n : float
+        Standard deviations of the position reading, and of the force reading as
+        ``force_noise_rel · F + force_noise_n``. Zeros give the exact record.
+    """
+    position = depths + rng.normal(0.0, 1.0, size=depths.size) * encoder_noise_m
+    force = levels + rng.normal(0.0, 1.0, size=levels.size) * (
+        force_noise_rel * levels + force_noise_n)
+    return ForceTravel(travel_m=position - position[0], force_n=force)

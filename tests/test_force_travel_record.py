@@ -1,0 +1,123 @@
+"""The press's force–travel record: what it accepts, and every refusal naming its field."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from deformap.cloud import PointCloud
+from deformap.environment import (
+    FORCE_MISMATCH_ABS_N,
+    FORCE_MISMATCH_REL,
+    MAX_TRAVEL_M,
+    MIN_FORCE_RISE_N,
+    TRAVEL_BACKWARDS_TOLERANCE_M,
+    ForceTravel,
+    PressObservation,
+    TactileContact,
+)
+from deformap.errors import InvalidArgumentError
+
+TRAVEL = np.linspace(0.0, 0.004, 9)  # a 4 mm dent
+FORCE = np.linspace(0.05, 0.6, 9)
+
+
+def _press(record: ForceTravel | None, force_n: float = 0.6) -> PressObservation:
+    contact = TactileContact(tip_center=[0.3, 0.2, 0.056], force=[0, 0, -force_n],
+                             tip_radius_m=0.01)
+    robot = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1.0]])
+    return PressObservation(cloud=PointCloud(np.zeros((3, 3))), contact=contact,
+                            robot_points=robot, target_xy=[0.3, 0.2], force_n=force_n,
+                            force_travel=record)
+
+
+def test_a_good_record_is_kept_as_read_only_float_copies() -> None:
+    travel, force = TRAVEL.copy(), [float(f) for f in FORCE]
+    record = ForceTravel(travel_m=travel, force_n=force)
+    assert len(record) == 9
+    assert record.travel_m.dtype == np.float64 and not record.travel_m.flags.writeable
+    assert not record.force_n.flags.writeable
+    travel[0] = 1.0  # the caller's array stays the caller's
+    assert record.travel_m[0] == 0.0
+    assert travel.flags.writeable
+    assert record == ForceTravel(travel_m=TRAVEL, force_n=FORCE)
+    assert record != ForceTravel(travel_m=TRAVEL * 0.5, force_n=FORCE)
+
+
+def test_a_rigid_press_within_encoder_noise_is_accepted() -> None:
+    rng = np.random.default_rng(0)
+    for _ in range(200):  # 0.05 mm encoder noise around zero, 1000 samples
+        travel = rng.normal(0.0, 5e-5, size=1000)
+        ForceTravel(travel_m=travel, force_n=np.linspace(0.02, 0.6, 1000))
+
+
+@pytest.mark.parametrize("field", ["travel_m", "force_n"])
+@pytest.mark.parametrize("bad", [np.nan, np.inf, -np.inf])
+def test_non_finite_values_are_refused(field: str, bad: float) -> None:
+    values = {"travel_m": TRAVEL.copy(), "force_n": FORCE.copy()}
+    values[field][4] = bad
+    with pytest.raises(InvalidArgumentError, match=f"`{field}`.*NaN or infinite"):
+        ForceTravel(**values)
+
+
+@pytest.mark.parametrize("field", ["travel_m", "force_n"])
+def test_fewer_than_three_samples_are_refused(field: str) -> None:
+    values = {"travel_m": TRAVEL, "force_n": FORCE}
+    values[field] = values[field][:2]
+    with pytest.raises(InvalidArgumentError, match=f"`{field}` must have at least 3 rows"):
+        ForceTravel(**values)
+
+
+def test_shapes_that_differ_are_refused() -> None:
+    with pytest.raises(InvalidArgumentError, match="`force_n` must have one sample per"):
+        ForceTravel(travel_m=TRAVEL, force_n=FORCE[:-1])
+    with pytest.raises(InvalidArgumentError, match="`travel_m` must be a \\(n,\\) array"):
+        ForceTravel(travel_m=TRAVEL.reshape(3, 3), force_n=FORCE)
+
+
+def test_travel_going_backwards_beyond_encoder_noise_is_refused() -> None:
+    travel = TRAVEL.copy()
+    travel[5] = travel[4] - 0.9 * TRAVEL_BACKWARDS_TOLERANCE_M  # within noise: kept
+    ForceTravel(travel_m=travel, force_n=FORCE)
+    travel[5] = travel[4] - 1.1 * TRAVEL_BACKWARDS_TOLERANCE_M
+    with pytest.raises(InvalidArgumentError, match=r"`travel_m` must not go backwards.*sample 5"):
+        ForceTravel(travel_m=travel, force_n=FORCE)
+    with pytest.raises(InvalidArgumentError, match="`travel_m` must not go backwards"):
+        ForceTravel(travel_m=TRAVEL[::-1], force_n=FORCE)  # a release, not a press
+
+
+def test_force_not_rising_is_refused() -> None:
+    for force in (FORCE[::-1], np.full(9, 0.6), 0.6 + np.linspace(0, 0.9 * MIN_FORCE_RISE_N, 9),
+                  np.linspace(-0.6, -0.05, 9)):
+        with pytest.raises(InvalidArgumentError, match="`force_n` must rise"):
+            ForceTravel(travel_m=TRAVEL, force_n=force)
+
+
+def test_travel_in_millimetres_is_refused() -> None:
+    ForceTravel(travel_m=TRAVEL * (MAX_TRAVEL_M / TRAVEL[-1]), force_n=FORCE)  # the limit itself
+    with pytest.raises(InvalidArgumentError, match=r"`travel_m` must be metres.*millimetres"):
+        ForceTravel(travel_m=TRAVEL * 1000.0, force_n=FORCE)
+
+
+def test_press_observation_carries_the_record_or_none() -> None:
+    assert _press(None).force_travel is None
+    record = ForceTravel(travel_m=TRAVEL, force_n=FORCE)
+    assert _press(record).force_travel is record
+    with pytest.raises(InvalidArgumentError, match="`force_travel` must be a ForceTravel"):
+        _press((TRAVEL, FORCE))  # type: ignore[arg-type]
+
+
+def test_press_observation_refuses_a_record_far_from_the_commanded_force() -> None:
+    allowed = FORCE_MISMATCH_REL * 0.6 + FORCE_MISMATCH_ABS_N
+    for final, ok in ((0.6 + 0.9 * allowed, True), (0.6 - 0.9 * allowed, True),
+                      (0.6 + 1.1 * allowed, False), (0.6 - 1.1 * allowed, False)):
+        record = ForceTravel(travel_m=TRAVEL, force_n=np.linspace(0.02, final, 9))
+        if ok:
+            _press(record)
+        else:
+            with pytest.raises(InvalidArgumentError, match="`force_travel` must end at the "
+                                                           "commanded force"):
+                _press(record)
+    grams = ForceTravel(travel_m=TRAVEL, force_n=FORCE * 1000 / 9.81)  # grams-force
+    with pytest.raises(InvalidArgumentError, match="`force_travel`"):
+        _press(grams)

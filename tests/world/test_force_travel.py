@@ -1,0 +1,113 @@
+"""The simulated press's force–travel record: from the FEM, with sensor noise on its own stream."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from deformap.environment import ForceTravel
+from deformap.world import MIN_RECORD_FORCE_N, SimulatedWorld, WorldConfig, load_scenario
+
+SCENARIO = "heterogeneous-60-110-rigid"  # foam 60 N at x < 0.2, 110 N up to 0.4, then rigid
+SOFT, HARD, RIGID = (0.1, 0.2), (0.3, 0.2), (0.55, 0.2)
+
+
+@pytest.fixture(scope="module")
+def world() -> SimulatedWorld:
+    return SimulatedWorld(load_scenario(SCENARIO), config=WorldConfig.coarse(),
+                          rng=np.random.default_rng(7))
+
+
+@pytest.fixture(scope="module")
+def exact() -> SimulatedWorld:
+    return SimulatedWorld(load_scenario(SCENARIO), config=WorldConfig.coarse(noise=False),
+                          rng=np.random.default_rng(7))
+
+
+def _press(world: SimulatedWorld, xy: tuple[float, float], force_n: float = 0.6) -> ForceTravel:
+    obs = world.press(xy, force_n)
+    world.release()
+    assert obs.force_travel is not None
+    return obs.force_travel
+
+
+def test_noise_free_record_is_the_fem_descent_from_contact(exact) -> None:
+    c = exact.config
+    record = _press(exact, SOFT)
+    levels = np.linspace(c.contact_threshold_n, 0.6, c.force_travel_levels + 1)
+    assert len(record) == c.force_travel_levels + 1 >= 9
+    np.testing.assert_array_equal(record.force_n, levels)
+    # each level is the world's press solve at that force (its patch iteration warm-started,
+    # so it agrees with a cold-started solve to the iteration's tolerance, not to the bit)
+    depths = np.array([exact.dent(SOFT, f).depth_m for f in levels])
+    np.testing.assert_allclose(record.travel_m, depths - depths[0], rtol=0,
+                               atol=0.01 * depths[-1])
+    assert record.travel_m[0] == 0.0 and np.all(np.diff(record.travel_m) > 0)
+    # exactly the world's level solves, the last being the press's own dent
+    dent = exact.dent(SOFT, 0.6)
+    solved = exact._level_depths(np.array(SOFT), levels, dent)
+    assert solved[-1] == dent.depth_m
+    np.testing.assert_array_equal(record.travel_m, solved - solved[0])
+
+
+def test_softer_foam_travels_farther_and_rigid_not_at_all(exact) -> None:
+    soft, hard, rigid = (_press(exact, xy).travel_m[-1] for xy in (SOFT, HARD, RIGID))
+    assert soft > hard > 0.0
+    assert rigid == 0.0
+
+
+def test_noisy_record_has_the_sensors_noise(world, exact) -> None:
+    c = world.config
+    truth = _press(exact, SOFT)
+    record = _press(world, SOFT)
+    assert record.travel_m[0] == 0.0  # travel is counted from the first sample's position
+    travel_err = record.travel_m - truth.travel_m
+    force_err = record.force_n - truth.force_n
+    assert 0 < np.max(np.abs(travel_err)) < 10 * c.encoder_noise_m
+    sigma_f = c.force_travel_noise_rel * truth.force_n + c.force_travel_noise_n
+    assert 0 < np.max(np.abs(force_err / sigma_f)) < 5
+
+
+def test_rigid_board_gives_encoder_noise_around_zero_and_is_accepted(world) -> None:
+    records = [_press(world, (0.45 + 0.01 * k, 0.1 + 0.02 * k)) for k in range(10)]
+    travel = np.concatenate([r.travel_m for r in records])
+    assert np.max(np.abs(travel)) < 10 * world.config.encoder_noise_m
+    assert np.any(np.diff(travel) < 0)  # noise does go "backwards", within the tolerance
+
+
+def test_same_press_same_record_whatever_came_before() -> None:
+    def run(seed: int, first: tuple[float, float]) -> ForceTravel:
+        w = SimulatedWorld(load_scenario(SCENARIO), config=WorldConfig.coarse(),
+                           rng=np.random.default_rng(seed))
+        _press(w, first)
+        return _press(w, SOFT)
+
+    assert run(5, HARD) == run(5, RIGID)
+    assert run(5, HARD) != run(6, HARD)
+
+
+def test_record_draws_leave_every_other_draw_of_the_press_unchanged() -> None:
+    # the record's noise has its own stream: other record settings (more levels, more noise)
+    # change the record and nothing else the press returns or shows
+    def run(**record_settings: float) -> list[np.ndarray]:
+        w = SimulatedWorld(load_scenario(SCENARIO), config=WorldConfig.coarse(**record_settings),
+                           rng=np.random.default_rng(3))
+        rest = w.observe().points
+        obs = w.press(SOFT, 0.6)
+        during = w.observe().points
+        assert obs.force_travel is not None
+        return [rest, obs.cloud.points, obs.contact.force, obs.contact.tip_center,
+                obs.robot_points, during, obs.force_travel.travel_m]
+
+    a = run()
+    b = run(force_travel_levels=20, encoder_noise_m=1e-4, force_travel_noise_rel=0.05)
+    for x, y in zip(a[:-1], b[:-1], strict=True):
+        np.testing.assert_array_equal(x, y)
+    assert a[-1].shape != b[-1].shape
+
+
+def test_a_press_too_light_to_record_gives_none(world) -> None:
+    obs = world.press(SOFT, 0.5 * MIN_RECORD_FORCE_N)
+    world.release()
+    assert obs.force_travel is None
+    assert world.force_travel(SOFT, MIN_RECORD_FORCE_N) is not None
