@@ -10,6 +10,7 @@ import pytest
 from deformap.errors import InvalidArgumentError
 from deformap.mechanics import (
     hertz_indentation,
+    layer_chi_limit,
     layer_correction,
     layer_correction_coefficients,
     layer_indentation_force,
@@ -80,3 +81,13 @@ def test_bad_input_is_refused_naming_the_argument(kwargs, name):
     for function in (layer_indentation_force, layer_indentation_stiffness):
         with pytest.raises(InvalidArgumentError, match=f"`{name}`"):
             function(**args)
+
+
+def test_force_rises_up_to_the_chi_limit_and_turns_there():
+    for nu, want in [(0.0, 1.747), (0.33, 2.185), (0.5, 8.045)]:
+        limit = layer_chi_limit(nu)
+        assert limit == pytest.approx(want, abs=1e-3)
+        h = 0.02
+        depth = (np.array([0.98, 1.0, 1.02]) * limit * h) ** 2 / R
+        k = layer_indentation_stiffness(depth, R, h, 1e4, nu)
+        assert k[0] > 0 and abs(k[1]) < 1e-6 * k[0] and k[2] < 0

@@ -35,6 +35,7 @@ from deformap.mechanics._hertz import (
     reduced_modulus,
 )
 from deformap.mechanics._layer import (
+    layer_chi_limit,
     layer_correction,
     layer_correction_coefficients,
     layer_indentation_force,
@@ -51,6 +52,7 @@ __all__ = [
     "hertz_indentation",
     "hertz_pressure_samples",
     "hertz_surface_deflection",
+    "layer_chi_limit",
     "layer_correction",
     "layer_correction_coefficients",
     "layer_indentation_force",

@@ -32,8 +32,10 @@ Range of validity
 -----------------
 - ``χ ≲ 1``: the series is an expansion in the contact radius over the thickness; the authors
   derive and check it for contact radii up to about the layer's thickness. Beyond it the
-  polynomial is an extrapolation (it stays finite and monotone, so a fit can still step there, and
-  :func:`deformap.explore.estimate_stiffness` reports the ``χ`` it reached).
+  polynomial is an extrapolation, and its negative χ⁴ term makes the force stop rising at
+  :func:`layer_chi_limit` (``χ ≈ 2.2`` at ``ν = 0.33``, 1.7 at ``ν = 0``): past that it means
+  nothing. :func:`deformap.explore.estimate_stiffness` stays below it and reports the ``χ`` it
+  reached.
 - small strain: Hertz's paraboloidal sphere and linear elasticity need ``a ≪ R`` (``δ ≪ R``) and
   strains in the material's linear range; a foam pressed to a sizeable fraction of its thickness
   is outside both.
@@ -61,6 +63,7 @@ from deformap.errors import InvalidArgumentError
 from deformap.mechanics._hertz import reduced_modulus
 
 __all__ = [
+    "layer_chi_limit",
     "layer_correction",
     "layer_correction_coefficients",
     "layer_indentation_force",
@@ -94,6 +97,18 @@ def layer_correction_coefficients(poisson_ratio: float) -> NDArray[np.float64]:
         -8.0 / pi**3 * (alpha**3 + 4.0 * pi**2 / 15.0 * beta),
         16.0 * alpha / pi**4 * (alpha**3 + 3.0 * pi**2 / 5.0 * beta),
     ])
+
+
+def layer_chi_limit(poisson_ratio: float) -> float:
+    """The ``χ`` at which the bonded layer's force stops rising with depth (module docstring).
+
+    ``dF/dδ ∝ 3 P(χ) + χ P'(χ) = Σ (3 + k) cₖ χᵏ``; this is its smallest positive root (``inf`` if
+    it has none). The series holds well below it (``χ ≲ 1``).
+    """
+    coeffs = layer_correction_coefficients(poisson_ratio)
+    roots = np.polynomial.polynomial.polyroots((3.0 + np.arange(coeffs.size)) * coeffs)
+    real = [float(r.real) for r in roots if abs(r.imag) < 1e-12 and r.real > 0]
+    return min(real) if real else float("inf")
 
 
 def layer_correction(chi: Any, poisson_ratio: float) -> NDArray[np.float64]:
