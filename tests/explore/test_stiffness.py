@@ -126,6 +126,26 @@ def test_stiffness_matches_the_true_slope():
     assert est.n_samples == 12 and est.reduced_chi2 is not None
 
 
+def test_three_samples_are_enough():
+    rng = np.random.default_rng(29)
+    travel, measured = synthetic_record(rng, layer_law(2e4, 0.05), 2.0, 3)
+    est = estimate_stiffness(travel, measured, tip_radius_m=R, thickness_m=0.05)
+    assert est.n_samples == 3 and not est.rigid
+    assert est.modulus_std_pa is not None and np.isfinite(est.modulus_std_pa)
+    assert est.modulus_std_pa > 0
+
+
+def test_poisson_ratio_is_the_callers_assumption():
+    rng = np.random.default_rng(31)
+    travel, measured = synthetic_record(rng, layer_law(2e4, 0.05), 1.0, 10)
+    default = estimate_stiffness(travel, measured, tip_radius_m=R, thickness_m=0.05)
+    other = estimate_stiffness(travel, measured, tip_radius_m=R, thickness_m=0.05,
+                               config=StiffnessConfig(poisson_ratio=0.45))
+    assert StiffnessConfig().poisson_ratio == NU
+    assert default.modulus_pa is not None and other.modulus_pa is not None
+    assert other.modulus_pa < default.modulus_pa  # E ∝ 1 − ν² at a fixed E*
+
+
 def test_modulus_and_stiffness_are_monotone_in_the_true_modulus():
     moduli = 2e3 * 1.5 ** np.arange(12)  # 2 kPa to 173 kPa
     for force, thickness in [(0.3, 0.03), (3.0, 0.08)]:

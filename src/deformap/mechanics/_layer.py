@@ -30,8 +30,8 @@ two bonded readings differ by less than 5 % of ``F`` for ``χ ≤ 1``).
 
 Range of validity
 -----------------
-- ``χ ≲ 1``: the series is an expansion in the contact radius over the thickness; the authors
-  derive and check it for contact radii up to about the layer's thickness. Beyond it the
+- ``χ ≲ 1``: the series is an expansion in the contact radius over the thickness, meant for
+  contact radii up to about the layer's thickness. Beyond it the
   polynomial is an extrapolation, and its negative χ⁴ term makes the force stop rising at
   :func:`layer_chi_limit` (``χ ≈ 2.2`` at ``ν = 0.33``, 1.7 at ``ν = 0``): past that it means
   nothing. :func:`deformap.explore.estimate_stiffness` stays below it and reports the ``χ`` it
