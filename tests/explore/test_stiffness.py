@@ -126,6 +126,16 @@ def test_stiffness_matches_the_true_slope():
     assert est.n_samples == 12 and est.reduced_chi2 is not None
 
 
+def test_a_press_nearly_through_the_layer_stays_inside_the_model():
+    # a straight line to 19 mm on a 2 cm layer: no bonded-layer curve explains it; the estimate
+    # stays finite, at most the layer deep, and says it does not fit
+    travel = np.linspace(0.0, 0.019, 10)
+    est = estimate_stiffness(travel, np.linspace(0.02, 3.0, 10), tip_radius_m=R,
+                             thickness_m=0.02)
+    assert est.modulus_pa is not None and np.isfinite(est.modulus_pa)
+    assert est.depth_m <= 0.02 and est.reduced_chi2 is not None and est.reduced_chi2 > 10
+
+
 def test_three_samples_are_enough():
     rng = np.random.default_rng(29)
     travel, measured = synthetic_record(rng, layer_law(2e4, 0.05), 2.0, 3)

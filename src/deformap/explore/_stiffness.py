@@ -36,8 +36,9 @@ variable relative to its span (0.05 mm on a few tenths of a millimetre, against 
 force), and a noisy regressor biases a non-linear fit low (regression dilution); the force's
 smaller noise only enters through the effective variance. ``g⁻¹`` is read from a table of ``g``
 (log–log interpolation) that stops short of the depth where the series' force turns down
-(:func:`deformap.mechanics.layer_chi_limit`). For a given ``E`` the best ``δ₀`` is a weighted mean
-(variable projection), and ``log E`` is found by a grid refined with Brent's bounded method. The
+(:func:`deformap.mechanics.layer_chi_limit`) and at the layer's thickness. For a given ``E`` the
+best ``δ₀`` is a weighted mean (variable projection), and ``log E`` is found by a grid refined
+with Brent's bounded method. The
 covariance of ``(E, δ₀)`` is ``(JᵀJ)⁻¹`` of the weighted residuals, scaled by the reduced χ² when
 that exceeds 1 (Birge's ratio: a curve the model does not explain widens the interval instead of
 hiding it). The stiffness at the commanded force ``F_c`` is ``k = E g'(δ_c)`` with
@@ -233,12 +234,14 @@ def _travel_span(travel: NDArray[np.float64], force: NDArray[np.float64], force_
 
 class _LayerTable:
     """The bonded-layer force at unit modulus, ``g(δ)``, tabulated on ``[0, δ_lim]`` for its
-    inverse; ``δ_lim`` stays below the depth where the series' force stops rising."""
+    inverse; ``δ_lim`` stays below the depth where the series' force stops rising and at most the
+    layer's thickness."""
 
     def __init__(self, radius: float, thickness: float, nu: float) -> None:
         self.radius, self.thickness, self.nu = radius, thickness, nu
         chi_lim = min(_CHI_FRACTION * layer_chi_limit(nu), _CHI_CAP)
-        self.depth_limit = (chi_lim * thickness) ** 2 / radius
+        # nor deeper than the layer: with R < h that comes first (χ = √(R/h) < 1 at δ = h)
+        self.depth_limit = min((chi_lim * thickness) ** 2 / radius, thickness)
         self.depth = self.depth_limit * np.geomspace(1e-9, 1.0, _TABLE_SIZE)
         self.log_depth = np.log(self.depth)
         self.log_force = np.log(layer_indentation_force(self.depth, radius, thickness, 1.0, nu))

@@ -36,9 +36,11 @@ Range of validity
   :func:`layer_chi_limit` (``χ ≈ 2.2`` at ``ν = 0.33``, 1.7 at ``ν = 0``): past that it means
   nothing. :func:`deformap.explore.estimate_stiffness` stays below it and reports the ``χ`` it
   reached.
-- small strain: Hertz's paraboloidal sphere and linear elasticity need ``a ≪ R`` (``δ ≪ R``) and
-  strains in the material's linear range; a foam pressed to a sizeable fraction of its thickness
-  is outside both.
+- small strain: Hertz's paraboloidal sphere and linear elasticity need ``a ≪ R`` (``δ ≪ R``),
+  ``δ ≪ h`` and strains in the material's linear range; a foam pressed to a sizeable fraction of
+  its thickness is outside all three. With a tip smaller than the layer (``R < h``) the depth
+  reaches ``h`` before ``χ`` reaches 1 (``χ = √(R/h)`` at ``δ = h``), so there the strain, not
+  ``χ``, bounds the model.
 - frictionless contact at the tip, a flat and homogeneous, isotropic layer.
 
 References
