@@ -38,12 +38,11 @@ smaller noise only enters through the effective variance. ``g⁻¹`` is read fro
 (log–log interpolation) that stops short of the depth where the series' force turns down
 (:func:`deformap.mechanics.layer_chi_limit`) and at the layer's thickness. For a given ``E`` the
 best ``δ₀`` is a weighted mean (variable projection), and ``log E`` is found by a grid refined
-with Brent's bounded method. The
-covariance of ``(E, δ₀)`` is ``(JᵀJ)⁻¹`` of the weighted residuals, scaled by the reduced χ² when
-that exceeds 1 (Birge's ratio: a curve the model does not explain widens the interval instead of
-hiding it). The stiffness at the commanded force ``F_c`` is ``k = E g'(δ_c)`` with
-``E g(δ_c) = F_c``; its standard deviation follows from ``E``'s by the delta method (``k`` at a
-fixed force depends on ``E`` only).
+with Brent's bounded method. The covariance of ``(E, δ₀)`` is ``(JᵀJ)⁻¹`` of the weighted
+residuals, scaled by the reduced χ² when that exceeds 1 (Birge's ratio: a curve the model does not
+explain widens the interval instead of hiding it). The stiffness at the commanded force ``F_c`` is
+``k = E g'(δ_c)`` with ``E g(δ_c) = F_c``; its standard deviation follows from ``E``'s by the
+delta method (``k`` at a fixed force depends on ``E`` only).
 
 Rigid
 -----
