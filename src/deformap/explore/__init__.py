@@ -1,6 +1,6 @@
 """Active exploration: the mapper and its concepts (surface model, dent and β, β-field, target
-choice, regions), the loop that drives an ``Environment`` with it, the typed poke records and the
-session journal."""
+choice, regions, stiffness and modulus from a force–travel record), the loop that drives an
+``Environment`` with it, the typed poke records and the session journal."""
 
 from __future__ import annotations
 
@@ -35,10 +35,17 @@ from deformap.explore._records import (
 )
 from deformap.explore._regions import RegionMap, map_regions, segment_regions
 from deformap.explore._result import ExplorationResult, StopReason
+from deformap.explore._stiffness import (
+    LAYER_MODEL,
+    StiffnessConfig,
+    StiffnessEstimate,
+    estimate_stiffness,
+)
 from deformap.explore._surface import SurfaceModel, fit_surface
 
 __all__ = [
     "JOURNAL_NAME",
+    "LAYER_MODEL",
     "PURPOSES",
     "STRATEGIES",
     "BetaField",
@@ -58,6 +65,8 @@ __all__ = [
     "PokeTimings",
     "Purpose",
     "RegionMap",
+    "StiffnessConfig",
+    "StiffnessEstimate",
     "StopReason",
     "SurfaceGPConfig",
     "SurfaceModel",
@@ -65,6 +74,7 @@ __all__ = [
     "TouchGPConfig",
     "check_exploration_budget",
     "choose_target",
+    "estimate_stiffness",
     "explore",
     "fit_surface",
     "map_regions",

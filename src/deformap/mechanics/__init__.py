@@ -1,4 +1,5 @@
-"""Contact mechanics: the tactile contact, Hertz contact of the probe's sphere, foam hardness.
+"""Contact mechanics: the tactile contact, Hertz contact of the probe's sphere, a sphere on an elastic
+layer bonded to the table, foam hardness.
 
 The one home of the physics that both the simulated world (:mod:`deformap.world`) and the estimator
 (:mod:`deformap.msm`) use. It sits at the bottom of the package graph: it imports numpy and the
@@ -9,6 +10,8 @@ Units are SI: metres, newtons, pascals.
 
 References
 ----------
+Dimitriadis, E. K., et al. (2002). Determination of elastic moduli of thin layers of soft material
+using the atomic force microscope. Biophysical Journal 82(5), 2798–2810.
 Johnson, K. L. (1985). Contact Mechanics, §3.4 and §4.2. Cambridge University Press.
 ISO 2439 (2008). Flexible cellular polymeric materials — Determination of hardness (indentation
 technique).
@@ -31,6 +34,13 @@ from deformap.mechanics._hertz import (
     hertz_surface_deflection,
     reduced_modulus,
 )
+from deformap.mechanics._layer import (
+    layer_chi_limit,
+    layer_correction,
+    layer_correction_coefficients,
+    layer_indentation_force,
+    layer_indentation_stiffness,
+)
 
 __all__ = [
     "INDENTATION_STRAIN",
@@ -42,6 +52,11 @@ __all__ = [
     "hertz_indentation",
     "hertz_pressure_samples",
     "hertz_surface_deflection",
+    "layer_chi_limit",
+    "layer_correction",
+    "layer_correction_coefficients",
+    "layer_indentation_force",
+    "layer_indentation_stiffness",
     "reduced_modulus",
     "youngs_modulus_to_hardness",
 ]

@@ -1,0 +1,420 @@
+"""Stiffness and Young's modulus in physical units from a press's force–travel record.
+
+A press records, from first contact to the commanded force, the probe's travel along the press
+direction ``t`` [m] and the normal force ``F`` [N]. This module reads from it, as pure functions:
+
+- the local stiffness ``k = dF/dδ`` [N/m] at the commanded force, and
+- Young's modulus ``E`` [Pa] of the surface under the probe,
+
+each with a standard deviation, or says that the surface is *rigid*: stiffer than the probe and
+arm can tell apart.
+
+Model
+-----
+The surface is an elastic layer of thickness ``h`` (the surface model's height above the table at
+the contact) bonded to the rigid table, pressed by the rigid spherical tip of radius ``R``:
+``F = E · g(δ)`` with ``g`` the bonded-layer force at unit modulus
+(:func:`deformap.mechanics.layer_indentation_force`, Hertz with the finite-thickness series of
+Dimitriadis et al. 2002; its docstring gives the range of validity, and each estimate reports the
+``χ = √(Rδ)/h`` it reached).
+
+Contact offset
+--------------
+The record starts where the force first crossed a contact threshold, so at zero travel the tip is
+already sunk by a small, unknown ``δ₀`` (and the zero itself is one noisy encoder reading). The
+indentation is ``δ = t + δ₀``, and ``δ₀`` is fitted with ``E``: a free parameter kept at or above
+``−3 σ_t`` (below zero only by what the zero reading's noise explains). Its uncertainty enters
+``E``'s through the joint covariance.
+
+Fit
+---
+Weighted least squares with errors in both variables by the effective-variance method (Orear
+1982), written for the travel: ``tᵢ = g⁻¹(Fᵢ / E) − δ₀``, each sample's variance
+``σ_t² + (σ_F(Fᵢ) · dδ/dF)²``, evaluated on the current fit and re-evaluated a few times (weights
+fixed within one solve). The travel is the response because on stiff surfaces it is the noisier
+variable relative to its span (0.05 mm on a few tenths of a millimetre, against 1–3 % on the
+force), and a noisy regressor biases a non-linear fit low (regression dilution); the force's
+smaller noise only enters through the effective variance. ``g⁻¹`` is read from a table of ``g``
+(log–log interpolation) that stops short of the depth where the series' force turns down
+(:func:`deformap.mechanics.layer_chi_limit`) and at the layer's thickness. For a given ``E`` the
+best ``δ₀`` is a weighted mean (variable projection), and ``log E`` is found by a grid refined
+with Brent's bounded method. The covariance of ``(E, δ₀)`` is ``(JᵀJ)⁻¹`` of the weighted
+residuals, scaled by the reduced χ² when that exceeds 1 (Birge's ratio: a curve the model does not
+explain widens the interval instead of hiding it). The stiffness at the commanded force ``F_c`` is
+``k = E g'(δ_c)`` with ``E g(δ_c) = F_c``; its standard deviation follows from ``E``'s by the
+delta method (``k`` at a fixed force depends on ``E`` only).
+
+Rigid
+-----
+Before any fit, the travel gained from the first sample to the commanded force is estimated by a
+straight line of travel against force (model-free; its standard deviation from the travel noise).
+When that span is below ``rigid_travel_sigmas`` times the travel noise, the surface is reported
+rigid: no ``E`` or ``k``, but a lower bound on ``k``: the force gained over the span's upper bound
+(the span plus two of its standard deviations), which bounds the slope at the commanded force from
+below for any curve that stiffens as it is pressed (a convex ``F(δ)``, as contact curves are).
+
+Sensor defaults
+---------------
+The noise defaults are sensor specifications, not fitted to any world: 0.05 mm for the travel (a
+robot arm's joint encoders through its forward kinematics) and ``1 % of reading + 5 mN`` for the
+force (a wrist force–torque sensor's class). The Poisson ratio defaults to 0.33, the value of
+open-cell foams in Gibson & Ashby's analysis (cell edges that bend give ``G ≈ 3E/8``, so
+``ν = E/(2G) − 1 ≈ 1/3``); it is an assumption the caller may change: ``E`` scales with
+``1 − ν²`` (about 2 % between 0.3 and 0.36) and the layer correction moves with it.
+
+References
+----------
+Dimitriadis, E. K., et al. (2002). Determination of elastic moduli of thin layers of soft material
+using the atomic force microscope. Biophysical Journal 82(5), 2798–2810.
+Gibson, L. J., Ashby, M. F. (1997). Cellular Solids, 2nd ed., ch. 5. Cambridge University Press.
+Orear, J. (1982). Least squares when both variables have uncertainties. American Journal of
+Physics 50(10), 912–916.
+Birge, R. T. (1932). The calculation of errors by the method of least squares. Physical Review
+40, 207–227.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.optimize import minimize_scalar
+
+from deformap._validation import check_array, check_positive, check_settings, setting
+from deformap.errors import InvalidArgumentError
+from deformap.mechanics import (
+    layer_chi_limit,
+    layer_indentation_force,
+    layer_indentation_stiffness,
+)
+
+__all__ = ["LAYER_MODEL", "StiffnessConfig", "StiffnessEstimate", "estimate_stiffness"]
+
+#: The contact model's name in :attr:`StiffnessEstimate.model`.
+LAYER_MODEL = "sphere-on-bonded-layer (Hertz + Dimitriadis 2002)"
+
+_MIN_SAMPLES = 3
+_EFFECTIVE_VARIANCE_ROUNDS = 4
+_MODULUS_GRID = 61
+_TABLE_SIZE = 800
+# the fit stays below the depth where the series' force turns down (and at most χ = 3, far past
+# the series' range), where the inverse's slope still means something
+_CHI_FRACTION = 0.95
+_CHI_CAP = 3.0
+# thicker than any foam a table-top probe presses: a larger value is a unit slip (millimetres)
+_MAX_THICKNESS_M = 2.0
+
+
+@dataclass(frozen=True, kw_only=True)
+class StiffnessConfig:
+    """How a force–travel record is read (module docstring: model, fit, rigid test, defaults).
+
+    Parameters
+    ----------
+    poisson_ratio : float
+        ``ν`` of the surface's material, an assumption (open-cell foam: 0.33).
+    travel_noise_m : float
+        Standard deviation of one travel reading (encoders through kinematics).
+    force_noise_rel, force_noise_abs_n : float
+        Standard deviation of one force reading: ``rel · |F| + abs``.
+    rigid_travel_sigmas : float
+        A record whose travel span at the commanded force is below this many ``travel_noise_m``
+        is rigid.
+    backwards_sigmas : float
+        How far, in standard deviations of the difference of two readings, travel or force may
+        step back between samples before the record is refused (noise moves them a little).
+    force_tolerance_rel : float
+        When the commanded force is given, the record's last force may differ from it by this
+        fraction (or three force standard deviations, if larger) before it is refused.
+    """
+
+    poisson_ratio: float = setting(0.33, ge=0.0, le=0.5)
+    travel_noise_m: float = setting(5e-5, gt=0.0, lt=0.01)
+    force_noise_rel: float = setting(0.01, ge=0.0, lt=1.0)
+    force_noise_abs_n: float = setting(0.005, gt=0.0)
+    rigid_travel_sigmas: float = setting(3.0, gt=0.0)
+    backwards_sigmas: float = setting(4.0, gt=0.0)
+    force_tolerance_rel: float = setting(0.1, gt=0.0)
+
+    def __post_init__(self) -> None:
+        check_settings(self)
+
+
+@dataclass(frozen=True, kw_only=True)
+class StiffnessEstimate:
+    """What one force–travel record says about the surface, in SI units.
+
+    Parameters
+    ----------
+    stiffness_n_per_m, stiffness_std_n_per_m : float or None
+        ``k = dF/dδ`` at the commanded force and its standard deviation; ``None`` when rigid.
+    stiffness_lower_n_per_m : float or None
+        When rigid, a lower bound on ``k`` (module docstring); otherwise ``None``.
+    modulus_pa, modulus_std_pa : float or None
+        Young's modulus from the contact model and its standard deviation; ``None`` when rigid.
+    contact_offset_m : float or None
+        The fitted indentation ``δ₀`` at zero travel; ``None`` when rigid.
+    depth_m : float
+        Indentation at the commanded force (the model's ``δ_c``); when rigid, the travel span
+        estimated by the rigid test.
+    max_chi : float or None
+        ``√(R δ_c) / h`` at the commanded force: the contact model holds for ``χ ≲ 1``.
+    reduced_chi2 : float or None
+        The fit's χ² per degree of freedom: about 1 when the model and the noise settings explain
+        the record, well above it when they do not; ``None`` when rigid.
+    rigid : bool
+        The surface is stiffer than the probe and arm can tell apart.
+    n_samples : int
+    model : str
+        The contact model (:data:`LAYER_MODEL`).
+    """
+
+    stiffness_n_per_m: float | None
+    stiffness_std_n_per_m: float | None
+    stiffness_lower_n_per_m: float | None
+    modulus_pa: float | None
+    modulus_std_pa: float | None
+    contact_offset_m: float | None
+    depth_m: float
+    max_chi: float | None
+    reduced_chi2: float | None
+    rigid: bool
+    n_samples: int
+    model: str = LAYER_MODEL
+
+
+def _force_std(force: NDArray[np.float64], config: StiffnessConfig) -> NDArray[np.float64]:
+    return np.asarray(config.force_noise_rel * np.abs(force) + config.force_noise_abs_n)
+
+
+def _check_record(travel_m: Any, force_n: Any, thickness: float, config: StiffnessConfig,
+                  ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    travel = check_array("travel_m", travel_m, (None,), what="travels in metres",
+                         min_rows=_MIN_SAMPLES)
+    force = check_array("force_n", force_n, (None,), what="forces in newtons",
+                        min_rows=_MIN_SAMPLES)
+    if force.shape != travel.shape:
+        raise InvalidArgumentError(f"`force_n` must have one value per travel sample "
+                                   f"({travel.size}); got {force.size}")
+    if travel.max() >= thickness:
+        raise InvalidArgumentError(
+            f"`travel_m` must be in metres and below the layer's thickness ({thickness} m); got "
+            f"a travel of {travel.max()} (millimetres?)")
+    step_t = config.backwards_sigmas * np.sqrt(2.0) * config.travel_noise_m
+    if np.any(np.diff(travel) < -step_t):
+        at = int(np.argmax(np.diff(travel) < -step_t)) + 1
+        raise InvalidArgumentError(
+            f"`travel_m` must not go backwards by more than its noise ({step_t:.3g} m); sample "
+            f"{at} goes back by {travel[at - 1] - travel[at]:.3g} m")
+    sigma = _force_std(force, config)
+    step_f = config.backwards_sigmas * np.hypot(sigma[:-1], sigma[1:])
+    rise = force[-1] - force[0]
+    if rise <= config.backwards_sigmas * np.hypot(sigma[0], sigma[-1]) or np.any(
+            np.diff(force) < -step_f):
+        raise InvalidArgumentError(
+            f"`force_n` must rise from contact to the commanded force (no step back beyond its "
+            f"noise); got {force[0]:.4g} N to {force[-1]:.4g} N, smallest step "
+            f"{np.diff(force).min():.4g} N")
+    return travel, force
+
+
+def _travel_span(travel: NDArray[np.float64], force: NDArray[np.float64], force_c: float,
+                 sigma_t: float) -> tuple[float, float]:
+    """Travel gained from the first force to ``force_c`` by a straight line of travel against
+    force, and its standard deviation from the travel noise."""
+    centred = force - force.mean()
+    sxx = float(centred @ centred)
+    slope = float(centred @ travel) / sxx
+    span = slope * (force_c - force[0])
+    return span, sigma_t * abs(force_c - force[0]) / np.sqrt(sxx)
+
+
+class _LayerTable:
+    """The bonded-layer force at unit modulus, ``g(δ)``, tabulated on ``[0, δ_lim]`` for its
+    inverse; ``δ_lim`` stays below the depth where the series' force stops rising and at most the
+    layer's thickness."""
+
+    def __init__(self, radius: float, thickness: float, nu: float) -> None:
+        self.radius, self.thickness, self.nu = radius, thickness, nu
+        chi_lim = min(_CHI_FRACTION * layer_chi_limit(nu), _CHI_CAP)
+        # nor deeper than the layer: with R < h that comes first (χ = √(R/h) < 1 at δ = h)
+        self.depth_limit = min((chi_lim * thickness) ** 2 / radius, thickness)
+        self.depth = self.depth_limit * np.geomspace(1e-9, 1.0, _TABLE_SIZE)
+        self.log_depth = np.log(self.depth)
+        self.log_force = np.log(layer_indentation_force(self.depth, radius, thickness, 1.0, nu))
+
+    @property
+    def force_limit(self) -> float:
+        """``g(δ_lim)``: the largest force per pascal the table holds."""
+        return float(np.exp(self.log_force[-1]))
+
+    def depth_at(self, force_per_pa: NDArray[np.float64]) -> NDArray[np.float64]:
+        """``g⁻¹``: log–log interpolation, Hertz's ``δ ∝ F^(2/3)`` below the table, ``δ_lim``
+        above it."""
+        u = np.log(np.maximum(force_per_pa, 1e-300))
+        below = self.log_depth[0] + (u - self.log_force[0]) / 1.5
+        inside = np.interp(u, self.log_force, self.log_depth)
+        return np.asarray(np.exp(np.where(u < self.log_force[0], below, inside)))
+
+    def slope(self, depth: NDArray[np.float64]) -> NDArray[np.float64]:
+        """``g'(δ)`` at unit modulus, N/m per Pa."""
+        return layer_indentation_stiffness(np.maximum(depth, self.depth[0]), self.radius,
+                                           self.thickness, 1.0, self.nu)
+
+
+class _Fit:
+    """Effective-variance weighted least squares of ``t = g⁻¹(F / E) − δ₀`` (module
+    docstring)."""
+
+    def __init__(self, travel: NDArray[np.float64], force: NDArray[np.float64],
+                 table: _LayerTable, config: StiffnessConfig) -> None:
+        self.travel, self.force, self.table, self.config = travel, force, table, config
+        self.force_std = _force_std(force, config)
+        self.weights = np.full(travel.size, 1.0 / config.travel_noise_m**2)
+
+    def depths(self, modulus: float) -> NDArray[np.float64]:
+        return self.table.depth_at(self.force / modulus)
+
+    def offset(self, modulus: float) -> float:
+        """The weighted least-squares ``δ₀`` at ``modulus`` (closed form), kept at or above
+        ``−3 σ_t``."""
+        gap = self.depths(modulus) - self.travel
+        return max(float(self.weights @ gap / self.weights.sum()),
+                   -3.0 * self.config.travel_noise_m)
+
+    def chi2(self, log_modulus: float) -> float:
+        modulus = float(np.exp(log_modulus))
+        r = self.travel + self.offset(modulus) - self.depths(modulus)
+        return float(self.weights @ (r * r))
+
+    def reweight(self, modulus: float) -> None:
+        """Each sample's variance: the travel's plus the force's carried through ``g⁻¹``."""
+        ddepth_dforce = 1.0 / (modulus * self.table.slope(self.depths(modulus)))
+        self.weights = 1.0 / (self.config.travel_noise_m**2
+                              + (self.force_std * ddepth_dforce) ** 2)
+
+    def solve(self) -> float:
+        f_max = float(self.force.max())
+        # the softest modulus keeps the largest force inside the table; the stiffest sinks the
+        # tip by a thousandth of the travel noise
+        low = np.log(f_max / self.table.force_limit)
+        high = np.log(f_max / float(layer_indentation_force(
+            1e-3 * self.config.travel_noise_m, self.table.radius, self.table.thickness, 1.0,
+            self.table.nu)))
+        log_modulus = low
+        for _ in range(_EFFECTIVE_VARIANCE_ROUNDS):
+            grid = np.linspace(low, high, _MODULUS_GRID)
+            values = [self.chi2(x) for x in grid]
+            best = int(np.argmin(values))
+            lo, hi = grid[max(best - 1, 0)], grid[min(best + 1, grid.size - 1)]
+            found = minimize_scalar(self.chi2, bounds=(lo, hi), method="bounded",
+                                    options={"xatol": 1e-6})
+            log_modulus = float(found.x) if found.fun <= values[best] else float(grid[best])
+            self.reweight(float(np.exp(log_modulus)))
+        return float(np.exp(log_modulus))
+
+    def covariance(self, modulus: float) -> tuple[NDArray[np.float64], float]:
+        """Covariance of ``(E, δ₀)`` from the weighted residuals' Jacobian, Birge-scaled, and
+        the reduced χ²."""
+        sw = np.sqrt(self.weights)
+        depth = self.depths(modulus)
+        # ∂δᵢ/∂E = −(Fᵢ / E²) / g'(δᵢ); the residual is t + δ₀ − δ
+        d_depth = -(self.force / modulus**2) / self.table.slope(depth)
+        # columns in relative units (E's fraction, δ₀ in travel-noise units): the raw ones differ
+        # by ten orders of magnitude
+        scale = np.array([modulus, self.config.travel_noise_m])
+        jac = np.column_stack([-d_depth * sw, sw]) * scale
+        dof = self.force.size - 2
+        chi2_red = self.chi2(float(np.log(modulus))) / dof if dof > 0 else float("nan")
+        cov = np.linalg.pinv(jac.T @ jac) * np.outer(scale, scale)
+        if dof > 0 and chi2_red > 1.0:
+            cov = cov * chi2_red
+        return cov, chi2_red
+
+
+def estimate_stiffness(travel_m: Any, force_n: Any, *, tip_radius_m: float, thickness_m: float,
+                       commanded_force_n: float | None = None,
+                       config: StiffnessConfig | None = None) -> StiffnessEstimate:
+    """Stiffness and Young's modulus with their uncertainties from one force–travel record.
+
+    Parameters
+    ----------
+    travel_m : (n,) float, metres
+        The probe's travel along the press direction since first contact, in time order,
+        ``n >= 3``; it may step back by no more than its noise.
+    force_n : (n,) float, newtons
+        The normal force at each sample; it rises from the contact threshold to the commanded
+        force.
+    tip_radius_m : float
+        Radius of the probe's spherical tip.
+    thickness_m : float
+        The elastic layer's thickness at the contact (the surface's height above the table), in
+        ``(0, 2]`` m; the travel must stay below it.
+    commanded_force_n : float, optional
+        The force the press was commanded to; the record's last force must be near it
+        (``config.force_tolerance_rel``). Default: the record's largest force.
+    config : StiffnessConfig, optional
+
+    Returns
+    -------
+    StiffnessEstimate
+        ``k`` at the commanded force and ``E`` with their standard deviations (module docstring),
+        or ``rigid=True`` with ``None`` for both.
+
+    Raises
+    ------
+    InvalidArgumentError
+        Naming the argument: NaN or infinite values, fewer than three samples, travel or force
+        going backwards beyond their noise, force not rising, a travel not below the thickness
+        (millimetres for metres), a last force far from the commanded one, a bad radius or
+        thickness.
+    """
+    config = StiffnessConfig() if config is None else config
+    radius = check_positive("tip_radius_m", tip_radius_m)
+    thickness = check_positive("thickness_m", thickness_m)
+    if thickness > _MAX_THICKNESS_M:
+        raise InvalidArgumentError(
+            f"`thickness_m` must be in metres, at most {_MAX_THICKNESS_M}; got {thickness} "
+            f"(millimetres?)")
+    travel, force = _check_record(travel_m, force_n, thickness, config)
+    if commanded_force_n is None:
+        force_c = float(force.max())
+    else:
+        force_c = check_positive("commanded_force_n", commanded_force_n)
+        allowed = max(config.force_tolerance_rel * force_c,
+                      3.0 * float(_force_std(np.array([force_c]), config)[0]))
+        if abs(force[-1] - force_c) > allowed:
+            raise InvalidArgumentError(
+                f"`force_n` must end near the commanded force {force_c} N (within {allowed:.3g} "
+                f"N); its last value is {force[-1]:.4g} N")
+    span, span_std = _travel_span(travel, force, force_c, config.travel_noise_m)
+    if span < config.rigid_travel_sigmas * config.travel_noise_m:
+        bound = max(span, 0.0) + 2.0 * span_std
+        return StiffnessEstimate(
+            stiffness_n_per_m=None, stiffness_std_n_per_m=None,
+            stiffness_lower_n_per_m=float((force_c - force[0]) / bound), modulus_pa=None,
+            modulus_std_pa=None, contact_offset_m=None, depth_m=float(span), max_chi=None,
+            reduced_chi2=None, rigid=True, n_samples=int(travel.size))
+
+    table = _LayerTable(radius, thickness, config.poisson_ratio)
+    fit = _Fit(travel, force, table, config)
+    modulus = fit.solve()
+    offset = fit.offset(modulus)
+    cov, chi2_red = fit.covariance(modulus)
+    modulus_std = float(np.sqrt(max(cov[0, 0], 0.0)))
+
+    def stiffness_at(e: float) -> float:
+        return float(e * table.slope(table.depth_at(np.array([force_c / e])))[0])
+
+    depth_c = float(table.depth_at(np.array([force_c / modulus]))[0])
+    step = 1e-4 * modulus
+    dk_de = (stiffness_at(modulus + step) - stiffness_at(modulus - step)) / (2.0 * step)
+    return StiffnessEstimate(
+        stiffness_n_per_m=stiffness_at(modulus),
+        stiffness_std_n_per_m=float(abs(dk_de) * modulus_std), stiffness_lower_n_per_m=None,
+        modulus_pa=modulus, modulus_std_pa=modulus_std, contact_offset_m=offset,
+        depth_m=depth_c, max_chi=float(np.sqrt(radius * depth_c) / thickness),
+        reduced_chi2=None if np.isnan(chi2_red) else float(chi2_red), rigid=False,
+        n_samples=int(travel.size))
