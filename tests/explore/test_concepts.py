@@ -158,3 +158,30 @@ def test_one_switch_says_where_beta_uncertainty_comes_from() -> None:
     # the shape matcher's own uncertainty (the tile bootstrap): no camera noise is measured
     assert poke.record.camera_noise_m is None
     assert poke.estimate is not None and poke.record.beta_std == poke.estimate.beta_std > 0
+
+
+def test_a_press_with_a_force_travel_record_reads_stiffness_and_modulus() -> None:
+    from deformap.environment import ForceTravel, PressObservation
+
+    world = coarse_world("homogeneous-60", seed=0)
+    config = ExplorationConfig()
+    mapper = Mapper(world.workspace, config)
+    surface = mapper.initialise(world.observe(), np.random.default_rng(0))
+    obs = world.press(np.array([0.3, 0.2]), config.force_n)
+    world.release()
+    assert obs.force_travel is not None  # the simulated world records it
+    poke = measure_press(obs, 0, surface, config)
+    r = poke.record
+    assert r.stiffness is not None and not r.stiffness.rigid and r.stiffness_error is None
+    assert r.layer_thickness_m == pytest.approx(0.05, abs=0.003)  # the block's 5 cm
+    true = world.ground_truth_modulus(np.array([0.3]), np.array([0.2]))[0, 0]
+    assert r.stiffness.modulus_pa == pytest.approx(true, rel=0.5)  # coarse mesh: the scale
+    assert r.timings.stiffness_s is not None
+    # a record the estimator refuses leaves the poke to the camera, and says why
+    ft = obs.force_travel
+    bent = ForceTravel(travel_m=ft.travel_m, force_n=ft.force_n * 0.85)
+    odd = PressObservation(cloud=obs.cloud, contact=obs.contact, robot_points=obs.robot_points,
+                           target_xy=obs.target_xy, force_n=obs.force_n, force_travel=bent)
+    fallback = measure_press(odd, 0, surface, config).record
+    assert fallback.stiffness is None and "force" in (fallback.stiffness_error or "")
+    assert fallback.beta == r.beta  # β does not depend on the record

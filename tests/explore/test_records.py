@@ -127,3 +127,26 @@ def test_journal_lines_of_earlier_versions_are_read_as_written() -> None:
     for key in ("purpose", "camera_noise_m"):
         older = {k: v for k, v in old.items() if k != key}
         assert getattr(PokeRecord.from_dict(older), key) is None
+
+
+def test_a_record_with_its_stiffness_survives_the_round_trip() -> None:
+    from deformap.explore import StiffnessEstimate
+
+    soft = StiffnessEstimate(stiffness_n_per_m=120.0, stiffness_std_n_per_m=4.0,
+                             stiffness_lower_n_per_m=None, modulus_pa=5000.0, modulus_std_pa=150.0,
+                             contact_offset_m=1e-4, depth_m=0.006, max_chi=0.18, reduced_chi2=0.9,
+                             rigid=False, n_samples=9)
+    rigid = StiffnessEstimate(stiffness_n_per_m=None, stiffness_std_n_per_m=None,
+                              stiffness_lower_n_per_m=5000.0, modulus_pa=None, modulus_std_pa=None,
+                              contact_offset_m=None, depth_m=2e-5, max_chi=None, reduced_chi2=None,
+                              rigid=True, n_samples=9)
+    for estimate in (soft, rigid):
+        record = _record(stiffness=estimate, layer_thickness_m=0.05)
+        data = json.loads(json.dumps(record.to_dict(), allow_nan=False))
+        assert PokeRecord.from_dict(data) == record
+    refused = _record(stiffness_error="`force_travel`: force not rising", layer_thickness_m=0.05)
+    assert PokeRecord.from_dict(refused.to_dict()) == refused
+    data = _record(stiffness=soft).to_dict()
+    data["stiffness"]["rigid"] = "no"
+    with pytest.raises(FileFormatError, match=r"`poke\.stiffness\.rigid` must be true or false"):
+        PokeRecord.from_dict(data)

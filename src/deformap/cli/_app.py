@@ -90,6 +90,16 @@ def out_console(json_path: Path | None) -> Console:
     return err_console if _to_stdout(json_path) else console
 
 
+def modulus_text(p: PokeRecord) -> str:
+    """The poke's Young's modulus for a progress line ("" without a force–travel estimate)."""
+    s = p.stiffness
+    if s is None:
+        return ""
+    if s.rigid or s.modulus_pa is None:
+        return "  rigid"
+    return f"  E = {s.modulus_pa / 1e3:.1f} ± {(s.modulus_std_pa or 0.0) / 1e3:.1f} kPa"
+
+
 def emit_json(json_path: Path | None, data: Any) -> None:
     """Write ``data`` as JSON where ``--json`` says (nothing when it was not given)."""
     if json_path is None:

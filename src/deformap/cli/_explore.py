@@ -16,6 +16,7 @@ from deformap.cli._app import (
     app,
     emit_json,
     friendly_errors,
+    modulus_text,
     out_console,
     progress,
     run_hooks,
@@ -36,7 +37,8 @@ def poke_row(p: PokeRecord) -> str:
     return (
         f"  poke {p.index + 1:>2}  target ({p.target_xy[0]:.3f}, {p.target_xy[1]:.3f}) m"
         f"  force {p.force_n:.2f} N  β = {p.beta:.3f} ± {p.beta_std:.3f}"
-        f"  max var {p.max_variance_after:.4f}"
+        + modulus_text(p)
+        + f"  max var {p.max_variance_after:.4f}"
         + (f"  plan: {p.planned_after} more" if p.planned_after is not None else "")
         + ("  boundary poke" if p.purpose == "boundary" else "")
         + f"  [dim](compute {p.timings.compute_s:.2f} s,"

@@ -15,6 +15,7 @@ from deformap.cli._app import (
     emit_json,
     err_console,
     friendly_errors,
+    modulus_text,
     out_console,
     progress,
     run_hooks,
@@ -33,7 +34,8 @@ ConfigOption = Annotated[
 def poke_row(p: PokeRecord) -> str:
     """One progress line of a recorded poke."""
     return (f"  poke {p.index + 1:>2}  contact ({p.contact_xy[0]:.3f}, {p.contact_xy[1]:.3f}) m"
-            f"  β = {p.beta:.3f} ± {p.beta_std:.3f}  max var {p.max_variance_after:.4f}")  # fmt: skip
+            f"  β = {p.beta:.3f} ± {p.beta_std:.3f}{modulus_text(p)}"
+            f"  max var {p.max_variance_after:.4f}")  # fmt: skip
 
 
 @app.command("record-sim")

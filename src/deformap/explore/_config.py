@@ -53,6 +53,7 @@ from typing import Any, Literal
 from deformap._validation import SettingError, check_settings, setting
 from deformap.environment import Workspace
 from deformap.explore._acquisition import Strategy
+from deformap.explore._stiffness import StiffnessConfig
 from deformap.msm import ShapeMatchingConfig
 
 __all__ = [
@@ -206,6 +207,9 @@ class ExplorationConfig:
         Pokes made after the variance has fallen below ``T_h``, each where a region boundary is
         least certain (:mod:`deformap.explore._acquisition`, "boundary pokes"); 0, the paper's
         rule, stops there.
+    stiffness : StiffnessConfig
+        Reading stiffness and Young's modulus from a press's force–travel record, when the
+        environment gives one (:func:`deformap.explore.estimate_stiffness`).
     beta_uncertainty : {"camera-noise", "shape-matching"}
         The one switch for where each poke's β uncertainty (its noise in the β-field) comes from:
         ``camera-noise``, the camera's noise measured in the ROI carried through the touch GP and
@@ -231,6 +235,7 @@ class ExplorationConfig:
     touch: TouchGPConfig = field(default_factory=TouchGPConfig)
     beta_field: BetaFieldConfig = field(default_factory=BetaFieldConfig)
     shape_matching: ShapeMatchingConfig = field(default_factory=ShapeMatchingConfig)
+    stiffness: StiffnessConfig = field(default_factory=StiffnessConfig)
 
     @staticmethod
     def upgrade_settings(data: dict[str, Any]) -> dict[str, Any]:

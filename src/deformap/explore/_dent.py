@@ -20,6 +20,7 @@ Caccamo et al. (2016), Sec. III-B and III-C.
 
 from __future__ import annotations
 
+import logging
 import time
 
 import numpy as np
@@ -27,14 +28,18 @@ from numpy.typing import NDArray
 
 from deformap.cloud import height_field_mask, points_in_hull, tactile_points
 from deformap.environment import PressObservation
+from deformap.errors import DeformapError
 from deformap.explore._config import ExplorationConfig
 from deformap.explore._dent_noise import dent_error_samples
 from deformap.explore._records import ContactRecord, Dent, PokeRecord, PokeResult, PokeTimings
+from deformap.explore._stiffness import StiffnessEstimate, estimate_stiffness
 from deformap.explore._surface import SurfaceModel, crop_to
 from deformap.gp import GaussianRandomField
 from deformap.msm import estimate_beta
 
 __all__ = ["measure_press", "roi_grid"]
+
+logger = logging.getLogger(__name__)
 
 _MAD_TO_STD = 1.4826
 """Standard deviation per median absolute deviation of a normal distribution."""
@@ -75,6 +80,27 @@ def _roi_points(obs: PressObservation, surface: SurfaceModel, config: Exploratio
     rest_at = surface.gp.predict(pts[:, :2])
     on_surface = pts[:, 2] - rest_at <= cfg.above_surface_m
     return pts[on_surface], rest_at[on_surface]
+
+
+def _stiffness(obs: PressObservation, surface: SurfaceModel, config: ExplorationConfig
+               ) -> tuple[StiffnessEstimate | None, float | None, str | None]:
+    """Stiffness and modulus from the press's force–travel record, the layer thickness they were
+    read with (the surface model's height above the table, z = 0, at the contact), and why a
+    record gave none (the poke then stands on the camera alone); all ``None`` without a record."""
+    record = obs.force_travel
+    if record is None:
+        return None, None, None
+    center = obs.contact.contact_point[:2]
+    thickness = float(np.asarray(surface.gp.predict(center[None, :])).reshape(-1)[0])
+    try:
+        estimate = estimate_stiffness(record.travel_m, record.force_n,
+                                      tip_radius_m=obs.contact.tip_radius_m,
+                                      thickness_m=thickness, commanded_force_n=obs.force_n,
+                                      config=config.stiffness)  # fmt: skip
+    except DeformapError as exc:
+        logger.warning("force–travel record not used (the camera alone reads this poke): %s", exc)
+        return None, thickness, str(exc)
+    return estimate, thickness, None
 
 
 def measure_press(obs: PressObservation, index: int, surface: SurfaceModel,
@@ -139,6 +165,8 @@ def measure_press(obs: PressObservation, index: int, surface: SurfaceModel,
     est = estimate_beta(roi_xs, roi_ys, rest_z, deformed, contact, config.shape_matching,
                         height_samples=samples)  # fmt: skip
     t3 = time.perf_counter()
+    stiffness, thickness, stiffness_error = _stiffness(obs, surface, config)
+    t4 = time.perf_counter()
     target_xy = obs.target_xy
     record = PokeRecord(
         index=index,
@@ -155,7 +183,9 @@ def measure_press(obs: PressObservation, index: int, surface: SurfaceModel,
         converged=bool(np.all(est.converged)),
         n_roi_points=len(roi),
         camera_noise_m=camera_noise,
-        timings=PokeTimings(filter_s=t1 - t0, touch_gp_s=t2 - t1, beta_s=t3 - t2),
+        timings=PokeTimings(filter_s=t1 - t0, touch_gp_s=t2 - t1, beta_s=t3 - t2,
+                            stiffness_s=None if obs.force_travel is None else t4 - t3),
+        stiffness=stiffness, layer_thickness_m=thickness, stiffness_error=stiffness_error,
     )
     dent = Dent(roi_xs, roi_ys, rest_z, deformed_z, roi, tactile)
     return PokeResult(record, dent, est)

@@ -18,6 +18,7 @@ from numpy.typing import NDArray
 from deformap.environment import TactileContact
 from deformap.errors import FileFormatError
 from deformap.explore._planning import PokePlan
+from deformap.explore._stiffness import LAYER_MODEL, StiffnessEstimate
 from deformap.msm import BetaEstimate
 
 __all__ = [
@@ -73,6 +74,37 @@ def _number(data: Mapping[str, Any], key: str, where: str, *, kind: type = float
     return float(value)
 
 
+def _text(data: Mapping[str, Any], key: str, where: str) -> str | None:
+    value = data.get(key)
+    if value is not None and not isinstance(value, str):
+        raise FileFormatError(f"`{where}.{key}` must be text; got {value!r}")
+    return value
+
+
+def _stiffness_to_dict(estimate: StiffnessEstimate) -> dict[str, Any]:
+    return {f.name: getattr(estimate, f.name) for f in fields(estimate)}
+
+
+def _stiffness_from_dict(data: Any, where: str) -> StiffnessEstimate | None:
+    if data is None:
+        return None
+    if not isinstance(data, Mapping):
+        raise FileFormatError(f"`{where}` must be a mapping; got {data!r}")
+    names = {f.name for f in fields(StiffnessEstimate)}
+    unknown = sorted(set(data) - names)
+    if unknown:
+        raise FileFormatError(f"`{where}` has unknown key(s) {unknown}")
+    numbers = {n: _number(data, n, where, optional=True)
+               for n in names - {"rigid", "n_samples", "model", "depth_m"}}  # fmt: skip
+    model = _text(data, "model", where)
+    return StiffnessEstimate(
+        **numbers, depth_m=_number(data, "depth_m", where),
+        rigid=_number(data, "rigid", where, kind=bool),
+        n_samples=_number(data, "n_samples", where, kind=int),
+        model=LAYER_MODEL if model is None else model,
+    )  # fmt: skip
+
+
 @dataclass(frozen=True, kw_only=True)
 class ContactRecord:
     """The tactile contact of a poke as plain numbers (world frame, SI units)."""
@@ -108,13 +140,15 @@ class PokeTimings:
     """Seconds spent on one poke, by stage; a stage a poke did not pass through is ``None``.
 
     ``filter_s`` crop and robot removal, ``touch_gp_s`` the dent's reconstruction, ``beta_s`` the
-    β estimate and its uncertainty, ``field_s`` the β-field update, ``target_s`` choosing the
-    place, ``environment_s`` the world or robot (or reading the recording).
+    β estimate and its uncertainty, ``stiffness_s`` the force–travel fit, ``field_s`` the β-field
+    update, ``target_s`` choosing the place, ``environment_s`` the world or robot (or reading the
+    recording).
     """
 
     filter_s: float
     touch_gp_s: float
     beta_s: float
+    stiffness_s: float | None = None
     field_s: float | None = None
     target_s: float | None = None
     environment_s: float | None = None
@@ -164,6 +198,14 @@ class PokeRecord:
         Cloud points of the ROI the dent was reconstructed from.
     camera_noise_m : float or None
         The camera's noise measured in the ROI (``None`` when β's uncertainty is not sampled).
+    stiffness : StiffnessEstimate or None
+        Stiffness and Young's modulus from the press's force–travel record
+        (:func:`deformap.explore.estimate_stiffness`); ``None`` without a record.
+    layer_thickness_m : float or None
+        The layer thickness the modulus was read with (the surface's height at the contact).
+    stiffness_error : str or None
+        Why a record that came with the press gave no estimate (the poke then stands on the
+        camera alone).
     purpose : {"first", "variance", "boundary"} or None
         Why this place (``None`` outside the live loop: a replayed or single poke).
     planned_after : int or None
@@ -188,6 +230,9 @@ class PokeRecord:
     n_roi_points: int
     camera_noise_m: float | None
     timings: PokeTimings
+    stiffness: StiffnessEstimate | None = None
+    layer_thickness_m: float | None = None
+    stiffness_error: str | None = None
     purpose: Purpose | None = None
     planned_after: int | None = None
     max_variance_after: float | None = None
@@ -209,7 +254,10 @@ class PokeRecord:
             "converged": self.converged, "n_roi_points": self.n_roi_points,
             "camera_noise_m": self.camera_noise_m, "timings": self.timings.to_dict(),
         }  # fmt: skip
-        for name in ("purpose", "planned_after", "max_variance_after"):
+        if self.stiffness is not None:
+            out["stiffness"] = _stiffness_to_dict(self.stiffness)
+        for name in ("layer_thickness_m", "stiffness_error", "purpose", "planned_after",
+                     "max_variance_after"):
             if getattr(self, name) is not None:
                 out[name] = getattr(self, name)
         return out
@@ -251,6 +299,9 @@ class PokeRecord:
             n_roi_points=_number(data, "n_roi_points", where, kind=int),
             camera_noise_m=_number(data, "camera_noise_m", where, optional=True),
             timings=PokeTimings.from_dict(data.get("timings"), f"{where}.timings"),
+            stiffness=_stiffness_from_dict(data.get("stiffness"), f"{where}.stiffness"),
+            layer_thickness_m=_number(data, "layer_thickness_m", where, optional=True),
+            stiffness_error=_text(data, "stiffness_error", where),
             purpose=purpose,
             planned_after=_number(data, "planned_after", where, kind=int, optional=True),
             max_variance_after=_number(data, "max_variance_after", where, optional=True),
