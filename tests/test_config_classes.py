@@ -18,7 +18,13 @@ import pytest
 from deformap._config import config_from_dict, config_to_dict, dump_yaml, load_yaml
 from deformap._validation import SettingError
 from deformap.errors import ConfigError, InvalidArgumentError
-from deformap.explore import BetaFieldConfig, ExplorationConfig, SurfaceGPConfig, TouchGPConfig
+from deformap.explore import (
+    BetaFieldConfig,
+    ExplorationConfig,
+    StiffnessConfig,
+    SurfaceGPConfig,
+    TouchGPConfig,
+)
 from deformap.msm import ShapeMatchingConfig
 from deformap.run import RunConfig
 from deformap.world import CameraConfig, WorldConfig
@@ -32,6 +38,7 @@ SECTIONS: dict[type, str] = {
     TouchGPConfig: "exploration.touch",
     BetaFieldConfig: "exploration.beta_field",
     ShapeMatchingConfig: "exploration.shape_matching",
+    StiffnessConfig: "exploration.stiffness",
     WorldConfig: "world",
     CameraConfig: "world.camera",
 }
