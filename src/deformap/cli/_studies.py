@@ -28,6 +28,13 @@ CoarseOption = Annotated[bool, typer.Option(help="Coarse FEM mesh (quick look)."
 SeedOption = Annotated[int, typer.Option(help="Seed of the worlds' noise.")]
 
 
+def _kpa(row: dict[str, Any], key: str = "modulus_pa") -> str:
+    if key == "modulus_pa" and row.get("rigid"):
+        return "rigid"
+    value = row.get(key)
+    return "–" if value is None else f"{value / 1e3:.2f}"
+
+
 def _hardness(value: float | None) -> str:
     return "rigid" if value is None else f"{value:g}"
 
@@ -53,16 +60,20 @@ def study_hardness(
         output = run.run_hardness_study(out, seed=seed, hardness=hardness, coarse=coarse,
                                         hooks=run_hooks(bar))  # fmt: skip
     table = Table(title="β against hardness")
-    for col in ("protocol", "hardness [N]", "β", "β spread", "β uncertainty", "fit error \\[mm]"):
+    for col in ("protocol", "hardness [N]", "β", "β spread", "β uncertainty", "fit error \\[mm]",
+                "E \\[kPa]", "true E \\[kPa]"):
         table.add_column(col, justify="right")
     for r in output.study["rows"]:
         table.add_row(r["protocol"], _hardness(r["hardness_n"]), f"{r['beta']:.3f}",
                       f"{r['beta_std']:.3f}", f"{r['beta_estimate_std']:.3f}",
-                      f"{r['fit_error_m'] * 1e3:.3f}")  # fmt: skip
+                      f"{r['fit_error_m'] * 1e3:.3f}", _kpa(r), _kpa(r, "true_modulus_pa"))  # fmt: skip
     shown.print(table)
     for name, ok in output.study["monotone"].items():
         rises = "strictly rises" if ok else "does NOT strictly rise"
         shown.print(f"  {name}: β {rises} as hardness falls", highlight=False)
+    if output.study.get("modulus_monotone") is not None:
+        rises = "strictly rises" if output.study["modulus_monotone"] else "does NOT strictly rise"
+        shown.print(f"  force–travel: E {rises} with hardness (rigid read rigid)", highlight=False)
     shown.print(f"wrote {' and '.join(map(str, output.files))}", highlight=False)
     emit_json(json_path, output.study)
 

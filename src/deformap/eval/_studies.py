@@ -56,6 +56,7 @@ class FoamPresses:
     hardness_n: float | None
     mapper: Mapper
     presses: list[PressObservation]
+    true_modulus_pa: float | None = None  # the world's own, at the presses (None: rigid)
 
 
 def _block_scenario(hardness_n: float | None, workspace: Workspace) -> Scenario:
@@ -95,7 +96,9 @@ def collect_presses(
         for xy in positions:
             presses.append(world.press(np.asarray(xy), config.force_n))
             world.release()
-        out.append(FoamPresses(hardness, mapper, presses))
+        x, y = positions[0]
+        true = float(world.ground_truth_modulus(np.array([x]), np.array([y]))[0, 0])
+        out.append(FoamPresses(hardness, mapper, presses, true if math.isfinite(true) else None))
         if progress is not None:
             progress(f"pressed {'rigid' if hardness is None else f'{hardness:g} N'} foam")
     return out
@@ -121,6 +124,28 @@ def _summary(records: list[PokeRecord]) -> dict[str, float]:
     }
 
 
+def _stiffness_summary(records: list[PokeRecord], true_modulus_pa: float | None
+                       ) -> dict[str, Any]:
+    """What the presses' force–travel records read: the mean stiffness and Young's modulus over
+    the presses that gave one, the mean claimed σ of E, its spread between places, the world's
+    true modulus and E's relative error; ``rigid`` when every press was read rigid."""
+    estimates = [r.stiffness for r in records]
+    read = [s for s in estimates if s is not None and not s.rigid and s.modulus_pa is not None]
+    moduli = np.array([s.modulus_pa for s in read], dtype=float)
+    out: dict[str, Any] = {
+        "rigid": bool(estimates) and all(s is not None and s.rigid for s in estimates),
+        "stiffness_n_per_m": float(np.mean([s.stiffness_n_per_m for s in read])) if read else None,
+        "modulus_pa": float(moduli.mean()) if read else None,
+        "modulus_std_pa": float(np.mean([s.modulus_std_pa for s in read])) if read else None,
+        "modulus_spread_pa": float(moduli.std(ddof=1)) if moduli.size > 1 else None,
+        "true_modulus_pa": true_modulus_pa,
+        "modulus_rel_error": None,
+    }
+    if read and true_modulus_pa:
+        out["modulus_rel_error"] = float((moduli.mean() - true_modulus_pa) / true_modulus_pa)
+    return out
+
+
 def hardness_study(
     foams: list[FoamPresses],
     *,
@@ -139,14 +164,32 @@ def hardness_study(
         cfg = dataclasses.replace(base, **settings)
         proto_rows = []
         for foam in foams:
-            row = {"protocol": name, "hardness_n": foam.hardness_n, **_summary(_betas(foam, cfg))}
+            records = _betas(foam, cfg)
+            row = {"protocol": name, "hardness_n": foam.hardness_n, **_summary(records),
+                   **_stiffness_summary(records, foam.true_modulus_pa)}  # fmt: skip
             proto_rows.append(row)
         rows.extend(proto_rows)
         ordered = sorted(
             proto_rows, key=lambda r: math.inf if r["hardness_n"] is None else r["hardness_n"]
         )
         monotone[name] = bool(np.all(np.diff([r["beta"] for r in ordered]) < 0))
-    return {"rows": rows, "monotone": monotone}
+    return {"rows": rows, "monotone": monotone, "modulus_monotone": _modulus_monotone(rows)}
+
+
+def _modulus_monotone(rows: list[dict[str, Any]]) -> bool | None:
+    """Whether the force–travel records order the foams: E strictly rises with hardness and a
+    rigid board is read rigid (``None`` when the presses had no records)."""
+    first = rows[0]["protocol"] if rows else None
+    own = sorted((r for r in rows if r["protocol"] == first),
+                 key=lambda r: math.inf if r["hardness_n"] is None else r["hardness_n"])
+    if not own or all(r["modulus_pa"] is None and not r["rigid"] for r in own):
+        return None
+    foams = [r for r in own if r["hardness_n"] is not None]
+    moduli = [r["modulus_pa"] for r in foams]
+    if any(m is None for m in moduli) or any(r["rigid"] for r in foams):
+        return False
+    rigid_ok = all(r["rigid"] for r in own if r["hardness_n"] is None)
+    return bool(np.all(np.diff(moduli) > 0) and rigid_ok)
 
 
 def cluster_size_study(
