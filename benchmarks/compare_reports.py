@@ -8,7 +8,8 @@ OLD and NEW are run folders (``report.json``) or folders of them (``deformap rep
 every ``report.json`` and ``table.json`` under OLD is compared with the one at the same relative
 path under NEW. Timings (any key ending in ``_s`` or named ``timings``), the version string and
 absolute paths are left out, and so is every key ``--ignore`` names by its dotted path (a setting
-added or retired on purpose, e.g. ``--ignore config.world.default_force_n``); floats must agree to
+added or retired on purpose, e.g. ``--ignore config.world.default_force_n``; ``[]`` stands for
+any list index: ``--ignore pokes[].stiffness``); floats must agree to
 ``--rtol`` (default: exactly). Exit code 0 when everything agrees, 1 otherwise, with one line per
 difference.
 """
@@ -18,6 +19,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import re
 import sys
 from pathlib import Path
 from typing import Any
@@ -29,7 +31,7 @@ def _differences(old: Any, new: Any, where: str, rtol: float,
                  ignore: frozenset[str] = frozenset()) -> list[str]:
     if isinstance(old, dict) and isinstance(new, dict):
         keys = {k for k in old.keys() | new.keys() if k not in IGNORED and not k.endswith("_s")
-                and f"{where}.{k}".lstrip(".") not in ignore}
+                and re.sub(r"\[\d+\]", "[]", f"{where}.{k}").lstrip(".") not in ignore}
         out = []
         for k in sorted(keys):
             if k not in old or k not in new:
