@@ -60,7 +60,8 @@ def study_hardness(
         output = run.run_hardness_study(out, seed=seed, hardness=hardness, coarse=coarse,
                                         hooks=run_hooks(bar))  # fmt: skip
     table = Table(title="β against hardness")
-    for col in ("protocol", "hardness [N]", "β", "β spread", "β uncertainty", "fit error \\[mm]",
+    table.add_column("protocol", no_wrap=True)  # the row's name, never cut
+    for col in ("hardness [N]", "β", "β spread", "β uncertainty", "fit error \\[mm]",
                 "E \\[kPa]", "true E \\[kPa]"):
         table.add_column(col, justify="right")
     for r in output.study["rows"]:
