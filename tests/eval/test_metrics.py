@@ -57,14 +57,21 @@ def test_the_order_of_what_the_map_reports_not_only_of_its_field() -> None:
     # ... but the map reports one value, so it is credited with no order
     scores = ordering_scores(merged, np.array([0.45]), truth, hardness, np.array([0.8, 0.1]),
                              np.array([0, 1]))
-    assert scores.kendall_tau_regions is None and scores.kendall_tau_pokes == 1.0
+    assert scores.order_regions is None and scores.order_pokes == 1.0
     # two found regions, right and wrong way round; pokes read the wrong way round
     right = ordering_scores(1 - truth, np.array([0.1, 0.8]), truth, hardness,
                             np.array([0.1, 0.8]), np.array([0, 1]))
     wrong = ordering_scores(truth, np.array([0.1, 0.8]), truth, hardness,
                             np.array([0.1, 0.8]), np.array([0, 1]))
-    assert right.kendall_tau_regions == 1.0 and wrong.kendall_tau_regions == -1.0
-    assert right.kendall_tau_pokes == -1.0
+    assert right.order_regions == 1.0 and wrong.order_regions == 0.0
+    assert right.order_pokes == 0.0
+    # pokes that share a material do not lower the order (Kendall's τ-b would read 0.82 here)
+    five = ordering_scores(truth, np.array([0.8, 0.1]), truth, hardness,
+                           np.array([0.6, 0.62, 0.59, 0.0, 0.0]), np.array([0, 0, 0, 1, 1]))
+    assert five.order_pokes == 1.0
+    half = ordering_scores(truth, np.array([0.8, 0.1]), truth, hardness, np.array([0.3, 0.3]),
+                           np.array([0, 1]))
+    assert half.order_pokes == 0.5  # a tie across materials counts half
     with pytest.raises(InvalidArgumentError, match="`found` must hold indices"):
         ordering_scores(truth + 5, np.array([0.1, 0.8]), truth, hardness, np.zeros(2),
                         np.array([0, 1]))

@@ -58,9 +58,9 @@ def _summary(out: Console, report: dict[str, Any], folder: Path) -> None:
     table.add_row("region accuracy", f"{reg['accuracy']:.3f}")
     table.add_row("mean IoU", f"{reg['mean_iou']:.3f}")
     table.add_row("Kendall τ (β vs softness)", tau)
-    for key, what in (("kendall_tau_regions", "found regions"), ("kendall_tau_pokes", "pokes")):
+    for key, what in (("order_regions", "found regions"), ("order_pokes", "pokes")):
         value = reg.get(key)
-        table.add_row(f"Kendall τ of the {what}", "n/a" if value is None else f"{value:.2f}")
+        table.add_row(f"order of the {what} (1: right)", "n/a" if value is None else f"{value:.2f}")
     t = report["timings"]
     table.add_row(
         "time",

@@ -14,11 +14,17 @@ of labels (the Hungarian algorithm on the overlap counts), so label numbering do
 
 What the map reports is judged by :func:`ordering_scores`:
 
-- ``kendall_tau_regions``: rank agreement between each *found* region's value (its class β) and
-  the softness of the material under most of its cells; ``None`` unless two found regions exist
-  and lie on materials of different softness (a merged map is not credited with an order);
-- ``kendall_tau_pokes``: rank agreement between each poke's own reading and the softness of the
-  material under it; ``None`` for fewer than two pokes or a single material.
+- ``order_regions``: over the pairs of *found* regions that lie on materials of different
+  softness (the material under most of a region's cells), the share whose values (class βs) are
+  ordered as the softness is (a tie in value counts half): 1 when the map orders what it found,
+  0.5 as by chance, 0 reversed; ``None`` without such a pair (a merged map is credited with no
+  order);
+- ``order_pokes``: the same over the pairs of pokes on materials of different softness, each
+  poke's own reading against the material under it.
+
+These are concordances (Harrell's C) rather than Kendall's τ: τ-b counts pairs on one material
+as ties and so reads below 1 for a perfectly ordered set of pokes whenever two pokes share a
+material.
 """
 
 from __future__ import annotations
@@ -114,18 +120,23 @@ def region_scores(
 class OrderingScores:
     """Whether what a map reports orders the materials (see the module docstring)."""
 
-    kendall_tau_regions: float | None
-    kendall_tau_pokes: float | None
+    order_regions: float | None
+    order_pokes: float | None
 
     def to_dict(self) -> dict[str, Any]:
         return asdict(self)
 
 
-def _tau(values: NDArray[np.float64], softness: NDArray[np.float64]) -> float | None:
-    if values.size < 2 or np.unique(softness).size < 2:
+def _concordance(values: NDArray[np.float64], softness: NDArray[np.float64]) -> float | None:
+    """Share of the pairs with different softness whose values are ordered as the softness is
+    (ties in value count half); ``None`` without such a pair."""
+    i, j = np.triu_indices(values.size, k=1)
+    differ = softness[i] != softness[j]
+    if not differ.any():
         return None
-    value = kendalltau(values, softness).statistic
-    return None if np.isnan(value) else float(value)
+    i, j = i[differ], j[differ]
+    agree = np.sign(values[i] - values[j]) * np.sign(softness[i] - softness[j])
+    return float(np.mean(np.where(agree > 0, 1.0, np.where(agree == 0, 0.5, 0.0))))
 
 
 def ordering_scores(
@@ -184,6 +195,6 @@ def ordering_scores(
         under_region, counts = np.unique(true[labels == label], return_counts=True)
         region_softness.append(softness(under_region[np.argmax(counts)]))
     return OrderingScores(
-        kendall_tau_regions=_tau(values[present], np.array(region_softness)),
-        kendall_tau_pokes=_tau(readings, np.array([softness(t) for t in under])),
+        order_regions=_concordance(values[present], np.array(region_softness)),
+        order_pokes=_concordance(readings, np.array([softness(t) for t in under])),
     )
