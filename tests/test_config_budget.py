@@ -22,6 +22,7 @@ from deformap.explore._acquisition import Strategy
 from deformap.msm import ShapeMatchingConfig
 from deformap.run import RunConfig
 from deformap.world import Block, Scenario, SimulatedWorld, WorldConfig, check_world_budget
+from deformap.world import _config as world_config_module
 from deformap.world import _world as world_module
 from deformap.world._fem import graded_levels
 from deformap.world._polygon import rectangle
@@ -107,7 +108,7 @@ def test_a_mesh_too_fine_for_the_scenario_is_refused_before_the_world_is_built(
                           (0.2, 0.001, 1.1), (0.05, 0.1, 2.0), (1.0, 0.001, 10.0)])
 def test_the_layer_count_bound_holds(thickness: float, top: float, growth: float) -> None:
     actual = len(graded_levels(thickness, min(top, thickness), growth)) - 1
-    bound = world_module._layer_count(thickness, top, growth)
+    bound = world_config_module._layer_count(thickness, top, growth)
     assert actual <= bound <= actual + 2
 
 

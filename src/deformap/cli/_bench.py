@@ -10,7 +10,8 @@ import typer
 from rich.table import Table
 
 from deformap import eval as evaluation
-from deformap.cli._app import JsonOption, app, emit_json, friendly_errors, out_console, progress
+from deformap.cli._app import JsonOption, app, emit_json, friendly_errors, out_console
+from deformap.cli._progress import progress
 
 __all__ = ["bench_app"]
 

@@ -16,11 +16,9 @@ from deformap.cli._app import (
     app,
     emit_json,
     friendly_errors,
-    modulus_text,
     out_console,
-    progress,
-    run_hooks,
 )
+from deformap.cli._progress import modulus_text, progress, run_hooks
 from deformap.errors import ConfigError
 
 if TYPE_CHECKING:  # the CLI loads the estimator only when a command runs

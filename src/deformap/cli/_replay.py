@@ -15,11 +15,9 @@ from deformap.cli._app import (
     emit_json,
     err_console,
     friendly_errors,
-    modulus_text,
     out_console,
-    progress,
-    run_hooks,
 )
+from deformap.cli._progress import modulus_text, progress, run_hooks
 
 if TYPE_CHECKING:  # the CLI loads the estimator only when a command runs
     from deformap.explore import PokeRecord

@@ -15,9 +15,8 @@ from deformap.cli._app import (
     emit_json,
     friendly_errors,
     out_console,
-    progress,
-    run_hooks,
 )
+from deformap.cli._progress import progress, run_hooks
 
 __all__ = ["study_app"]
 

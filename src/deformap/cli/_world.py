@@ -9,7 +9,8 @@ import typer
 from rich.table import Table
 
 from deformap import run
-from deformap.cli._app import app, console, friendly_errors, progress, run_hooks
+from deformap.cli._app import app, console, friendly_errors
+from deformap.cli._progress import progress, run_hooks
 
 __all__ = ["world_app"]
 

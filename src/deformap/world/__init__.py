@@ -27,17 +27,13 @@ from deformap.mechanics import (
     youngs_modulus_to_hardness,
 )
 from deformap.world._camera import CameraConfig
+from deformap.world._config import WorldConfig, check_world_budget
 from deformap.world._foam import Dent
 from deformap.world._probe import ProbeGeometry
 from deformap.world._random import random_scenario
 from deformap.world._scenario import BARE_TABLE, Block, Scenario
 from deformap.world._scenario_io import list_scenarios, load_scenario, save_scenario
-from deformap.world._world import (
-    MIN_RECORD_FORCE_N,
-    SimulatedWorld,
-    WorldConfig,
-    check_world_budget,
-)
+from deformap.world._world import MIN_RECORD_FORCE_N, SimulatedWorld
 
 __all__ = [
     "BARE_TABLE",

@@ -1,0 +1,149 @@
+"""Settings of the simulated world (:class:`WorldConfig`) and the budget that keeps a world from
+asking for absurd memory or time (:func:`check_world_budget`), checked before any mesh is built.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any, ClassVar
+
+from deformap._validation import SettingError, check_settings, setting
+from deformap.world._camera import CameraConfig
+from deformap.world._probe import ProbeGeometry
+from deformap.world._scenario import Scenario
+
+__all__ = ["MAX_FEM_UNKNOWNS", "WorldConfig", "check_world_budget"]
+
+
+@dataclass(frozen=True, kw_only=True)
+class WorldConfig:
+    """Settings of the simulated world.
+
+    Parameters
+    ----------
+    element_size_m : float
+        In-plane size of the foam's hexahedra. 7.5 mm resolves the dent of the 1 cm tip (the
+        press's compliance converges at second order under refinement,
+        ``tests/world/test_fem.py``) while a world stays quick to build (``deformap bench world``,
+        ``benchmarks/README.md``).
+    top_layer_m, layer_growth : float
+        Thickness of the top element layer and growth factor of the layers below it.
+    poisson_ratio : float
+    tip_radius_m, stick_length_m, stick_radius_m : float
+        The probe: spherical tip (1 cm, Optoforce-like), stick (10 cm long).
+    hand_size_m : (3,) float
+        The box standing for the hand that holds the stick.
+    force_noise_n : float
+        Standard deviation per axis of the force sensor's noise (Optoforce-class resolution).
+    force_travel_levels : int
+        Load levels of the press's force–travel record above contact: it has this many plus one
+        samples, evenly spaced in force from ``contact_threshold_n`` to the commanded force, each
+        solved by the FEM (see :mod:`deformap.world._force_travel`).
+    contact_threshold_n : float
+        The force at which the probe detects contact: the record's first sample, where its
+        travel starts. Presses at less than :data:`MIN_RECORD_FORCE_N` give no record.
+    encoder_noise_m : float
+        Standard deviation of the arm's reading of the tip's position along the press direction
+        (joint encoders through forward kinematics), for the record's travel.
+    force_travel_noise_rel, force_travel_noise_n : float
+        Standard deviation of the record's force samples: ``rel · F + n`` at force ``F``.
+    noise : bool
+        False turns off every noise source (camera, force sensor, force–travel record) at once.
+    camera : CameraConfig
+    table_margin_m : float
+        How far the table extends beyond the workspace on every side.
+    """
+
+    # finer than 1 mm resolves nothing the 1 cm tip or the camera can tell, and the element count
+    # grows as 1 / size² (see check_world_budget for the mesh as a whole)
+    element_size_m: float = setting(0.0075, gt=0.0, ge=0.001)
+    # the layer count grows as thickness / top layer when the layers do not grow (growth 1)
+    top_layer_m: float = setting(0.005, gt=0.0, ge=0.001)
+    layer_growth: float = setting(1.5, ge=1.0, le=10.0)
+    poisson_ratio: float = setting(0.3, ge=0.0, lt=0.5)  # 0.5 makes the FEM's λ infinite
+    tip_radius_m: float = setting(0.01, gt=0.0)
+    stick_length_m: float = setting(0.10, gt=0.0)
+    stick_radius_m: float = setting(0.006, gt=0.0)
+    hand_size_m: tuple[float, float, float] = setting((0.08, 0.06, 0.10), gt=0.0)
+    force_noise_n: float = setting(0.01, ge=0.0)
+    # 8 levels resolve the curvature of a sphere's F ∝ δ^(3/2); each level costs one press solve
+    force_travel_levels: int = setting(8, ge=2, le=1000)
+    contact_threshold_n: float = setting(0.02, gt=0.0, le=0.1)
+    encoder_noise_m: float = setting(5e-5, ge=0.0, le=1e-3)  # arm encoders: about 0.05 mm
+    force_travel_noise_rel: float = setting(0.01, ge=0.0, le=0.1)  # force sensors: 1 % + 5 mN
+    force_travel_noise_n: float = setting(0.005, ge=0.0, le=0.1)
+    noise: bool = True
+    camera: CameraConfig = field(default_factory=CameraConfig)
+    table_margin_m: float = setting(0.2, gt=0.0)
+
+    #: Settings that were removed, accepted (and ignored) in configuration files written before.
+    RETIRED_SETTINGS: ClassVar[dict[str, str]] = {
+        "default_force_n": "the press force is the exploration's `force_n`",
+    }
+
+    def __post_init__(self) -> None:
+        check_settings(self)
+
+    @property
+    def probe(self) -> ProbeGeometry:
+        """The probe geometry built from the `tip_radius_m`, `stick_*`, `hand_size_m` fields."""
+        return ProbeGeometry(tip_radius_m=self.tip_radius_m, stick_length_m=self.stick_length_m,
+                             stick_radius_m=self.stick_radius_m,
+                             hand_size_m=tuple(self.hand_size_m))  # type: ignore[arg-type]
+
+    @classmethod
+    def coarse(cls, **overrides: Any) -> WorldConfig:
+        """A 2 cm mesh and a 320×240 camera, for fast tests (not for measurements)."""
+        settings: dict[str, Any] = {"element_size_m": 0.02, "top_layer_m": 0.01,
+                                    "camera": CameraConfig(width=320, height=240)}
+        settings.update(overrides)
+        return cls(**settings)
+
+
+#: Most displacement unknowns (3 per mesh node, all blocks) of the foam FEM: each foam block's
+#: stiffness matrix is factorised once by a sparse direct solver and kept, and on a 3-D mesh its
+#: fill-in grows faster than the unknowns (as N^(4/3) for a 3-D mesh under a nested-dissection
+#: ordering), into gigabytes at a million.
+MAX_FEM_UNKNOWNS = 1_000_000
+
+
+def _layer_count(thickness_m: float, top_m: float, growth: float) -> int:
+    """Upper bound on the layers of :func:`~deformap.world._fem.graded_levels` (no loop, so that
+    an absurd request is refused at once): layers ``top·gⁱ`` until they sum to the thickness."""
+    top = min(top_m, thickness_m)
+    if growth <= 1.0 + 1e-12:
+        return math.ceil(thickness_m / top) + 1
+    return math.ceil(math.log1p(thickness_m * (growth - 1.0) / top) / math.log(growth)) + 1
+
+
+def check_world_budget(config: WorldConfig, scenario: Scenario) -> None:
+    """Refuse, before any work, a world whose foam mesh would be absurdly large.
+
+    Counts the nodes of every block's structured mesh (``element_size_m`` in plane over the
+    block's bounding box, the graded layers of ``top_layer_m`` and ``layer_growth`` through its
+    thickness) and refuses more than :data:`MAX_FEM_UNKNOWNS` unknowns. :class:`SimulatedWorld`
+    calls it first; a run can call it before it starts anything else.
+
+    Raises
+    ------
+    SettingError
+        Naming ``element_size_m``, the unknowns asked for and the limit.
+    """
+    if not isinstance(config, WorldConfig):
+        raise SettingError("config", f"must be a WorldConfig; got {type(config).__name__}")
+    if not isinstance(scenario, Scenario):
+        raise SettingError("scenario", f"must be a Scenario; got {type(scenario).__name__}")
+    size = config.element_size_m
+    unknowns = 0
+    for block in scenario.blocks:
+        extent = block.polygon.max(axis=0) - block.polygon.min(axis=0)
+        nx, ny = (max(1, math.ceil(e / size - 1e-9)) for e in extent)
+        nz = _layer_count(block.thickness_m, config.top_layer_m, config.layer_growth)
+        unknowns += 3 * (nx + 1) * (ny + 1) * (nz + 1)
+    if unknowns > MAX_FEM_UNKNOWNS:
+        raise SettingError(
+            "element_size_m",
+            f"meshes scenario {scenario.name!r} with about {unknowns:,} FEM unknowns; at most "
+            f"{MAX_FEM_UNKNOWNS:,}: use larger elements or a thicker `top_layer_m`; got {size:g} m",
+        )
