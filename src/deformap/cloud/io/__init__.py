@@ -22,7 +22,6 @@ from deformap.cloud.io._bag import (
     WrenchSeries,
     bag_read_errors,
     iter_bag_messages,
-    pointcloud2_to_cloud,
     read_bag_clouds,
     read_bag_static_transform,
     read_bag_wrenches,
@@ -37,6 +36,7 @@ from deformap.cloud.io._pointcloud2 import (
     array_to_pointcloud2,
     pointcloud2_structured,
     pointcloud2_to_array,
+    pointcloud2_to_cloud,
 )
 from deformap.cloud.io._ros import ROS_DISTRO, typestore
 

@@ -20,13 +20,16 @@ import numpy as np
 from numpy.typing import NDArray
 
 from deformap._validation import check_array, check_int, check_points
+from deformap.cloud._pointcloud import PointCloud
+from deformap.cloud.io._common import check_units, finish_cloud
 from deformap.cloud.io._ros import typestore
-from deformap.errors import InvalidArgumentError
+from deformap.errors import FileFormatError, InvalidArgumentError
 
 __all__ = [
     "array_to_pointcloud2",
     "pointcloud2_structured",
     "pointcloud2_to_array",
+    "pointcloud2_to_cloud",
     "xyz_with_holes",
 ]
 
@@ -238,3 +241,61 @@ def array_to_pointcloud2(
         point_step=table.dtype.itemsize, row_step=table.nbytes, data=table.view(np.uint8),
         is_dense=True,
     )  # fmt: skip
+
+
+def _decode_colors(table: NDArray[Any]) -> NDArray[np.uint8] | None:
+    names = table.dtype.names or ()
+    field = next((c for c in ("rgb", "rgba") if c in names), None)
+    if field is None or table[field].ndim != 1 or table[field].dtype.itemsize != 4:
+        return None
+    packed = np.ascontiguousarray(table[field]).view(table[field].dtype.newbyteorder("="))
+    packed = packed.view(np.uint32) if packed.dtype.kind == "f" else packed.astype(np.uint32)
+    shifts = np.array([16, 8, 0], dtype=np.uint32)
+    return ((packed[:, None] >> shifts) & 0xFF).astype(np.uint8)
+
+
+def _to_cloud(msg: Any, where: str, scale: float, frame: str, colors: bool
+              ) -> tuple[PointCloud, int]:  # fmt: skip
+    try:
+        table = pointcloud2_structured(msg)
+        xyz = xyz_with_holes(msg, table)
+    except InvalidArgumentError as exc:
+        raise FileFormatError(f"{where}: {str(exc).replace('`msg` ', '')}") from None
+    rgb = _decode_colors(table) if colors else None
+    finite = np.isfinite(xyz).all(axis=1)
+    dropped = int(finite.size - finite.sum())
+    xyz, rgb = xyz[finite], None if rgb is None else rgb[finite]
+    cloud, _ = finish_cloud(where, xyz, rgb, {}, scale=scale, drop_nan=False, frame=frame)
+    return cloud, dropped
+
+
+def pointcloud2_to_cloud(msg: Any, *, where: str, units: str = "m", frame: str | None = None,
+                         colors: bool = True) -> tuple[PointCloud, int]:
+    """A deserialised ``sensor_msgs/msg/PointCloud2`` as a :class:`~deformap.cloud.PointCloud`.
+
+    The rules of the file readers apply: NaN or infinite points (the holes of an organised cloud)
+    are dropped and counted, an empty cloud and coordinates that look like millimetres read as
+    metres are refused.
+
+    Parameters
+    ----------
+    msg : rosbags PointCloud2 message
+    where : str
+        Names the message in errors (``"run.mcap [/camera message 3]"``).
+    units : {"m", "mm"}
+        Units of the coordinates.
+    frame : str, optional
+        The cloud's frame name; default the header's ``frame_id`` (``"sensor"`` when empty).
+    colors : bool
+        Decode a packed ``rgb``/``rgba`` field when there is one.
+
+    Returns
+    -------
+    cloud : PointCloud
+        Points in metres.
+    n_dropped : int
+        Points dropped for a non-finite coordinate.
+    """
+    scale = check_units(units)
+    name = (msg.header.frame_id or "sensor") if frame is None else frame
+    return _to_cloud(msg, where, scale, name, colors)
