@@ -185,3 +185,28 @@ def test_a_press_with_a_force_travel_record_reads_stiffness_and_modulus() -> Non
     fallback = measure_press(odd, 0, surface, config).record
     assert fallback.stiffness is None and "force" in (fallback.stiffness_error or "")
     assert fallback.beta == r.beta  # β does not depend on the record
+
+
+def test_the_modulus_does_not_depend_on_the_tips_absolute_height() -> None:
+    # an arm's tip height is off by a millimetre or so; the record's travel is counted from
+    # first contact, so E does not see it (β does: it reads the dent against the tip)
+    from deformap.environment import PressObservation, TactileContact
+
+    world = coarse_world("homogeneous-60", seed=0)
+    config = ExplorationConfig()
+    mapper = Mapper(world.workspace, config)
+    surface = mapper.initialise(world.observe(), np.random.default_rng(0))
+    obs = world.press(np.array([0.3, 0.2]), config.force_n)
+    world.release()
+    moduli = []
+    for dz in (0.0, -0.001, 0.001):
+        c = obs.contact
+        tip = TactileContact(tip_center=c.tip_center + np.array([0.0, 0.0, dz]), force=c.force,
+                             tip_radius_m=c.tip_radius_m)
+        shifted = PressObservation(cloud=obs.cloud, contact=tip, robot_points=obs.robot_points,
+                                   target_xy=obs.target_xy, force_n=obs.force_n,
+                                   force_travel=obs.force_travel)
+        stiffness = measure_press(shifted, 0, surface, config).record.stiffness
+        assert stiffness is not None and stiffness.modulus_pa is not None
+        moduli.append(stiffness.modulus_pa)
+    assert moduli[1] == moduli[0] == moduli[2]
