@@ -82,15 +82,17 @@ def test_travel_going_backwards_beyond_encoder_noise_is_refused() -> None:
     travel[5] = travel[4] - 1.1 * TRAVEL_BACKWARDS_TOLERANCE_M
     with pytest.raises(InvalidArgumentError, match=r"`travel_m` must not go backwards.*sample 5"):
         ForceTravel(travel_m=travel, force_n=FORCE)
+    release = np.r_[0.0, np.linspace(0.004, 0.0005, 8)]  # pressed, then let go: not a press
     with pytest.raises(InvalidArgumentError, match="`travel_m` must not go backwards"):
-        ForceTravel(travel_m=TRAVEL[::-1], force_n=FORCE)  # a release, not a press
+        ForceTravel(travel_m=release, force_n=FORCE)
 
 
 def test_force_not_rising_is_refused() -> None:
-    for force in (FORCE[::-1], np.full(9, 0.6), 0.6 + np.linspace(0, 0.9 * MIN_FORCE_RISE_N, 9),
-                  np.linspace(-0.6, -0.05, 9)):
+    for force in (FORCE[::-1], np.full(9, 0.6), 0.6 + np.linspace(0, 0.9 * MIN_FORCE_RISE_N, 9)):
         with pytest.raises(InvalidArgumentError, match="`force_n` must rise"):
             ForceTravel(travel_m=TRAVEL, force_n=force)
+    with pytest.raises(InvalidArgumentError, match="`force_n` must be the force pressing"):
+        ForceTravel(travel_m=TRAVEL, force_n=np.linspace(-0.6, -0.05, 9))  # sign flipped
 
 
 def test_travel_in_millimetres_is_refused() -> None:
@@ -121,3 +123,16 @@ def test_press_observation_refuses_a_record_far_from_the_commanded_force() -> No
     grams = ForceTravel(travel_m=TRAVEL, force_n=FORCE * 1000 / 9.81)  # grams-force
     with pytest.raises(InvalidArgumentError, match="`force_travel`"):
         _press(grams)
+
+
+def test_a_travel_that_does_not_start_at_contact_is_refused() -> None:
+    # an absolute tip position passed for the travel since contact
+    ForceTravel(travel_m=TRAVEL + 0.9 * TRAVEL_BACKWARDS_TOLERANCE_M, force_n=FORCE)  # noise
+    with pytest.raises(InvalidArgumentError, match=r"`travel_m` must be the travel since first"):
+        ForceTravel(travel_m=TRAVEL + 0.005, force_n=FORCE)
+
+
+def test_a_force_that_was_not_zeroed_or_points_away_is_refused() -> None:
+    ForceTravel(travel_m=TRAVEL, force_n=FORCE - 0.05 - 0.9 * MIN_FORCE_RISE_N)  # noise at 0
+    with pytest.raises(InvalidArgumentError, match=r"`force_n` must be the force pressing"):
+        ForceTravel(travel_m=TRAVEL, force_n=FORCE - 0.5)

@@ -178,6 +178,18 @@ class ForceTravel:
                 f"`travel_m` must be metres, at most {MAX_TRAVEL_M} m in magnitude (a press does "
                 f"not sink the tip that far; millimetres?); got {largest:.4g}"
             )
+        if abs(travel[0]) > TRAVEL_BACKWARDS_TOLERANCE_M:
+            raise InvalidArgumentError(
+                f"`travel_m` must be the travel since first contact, its first sample 0 within "
+                f"{TRAVEL_BACKWARDS_TOLERANCE_M} m (encoder noise); got {travel[0]:.4g} m (an "
+                "absolute position?)"
+            )
+        if float(force.min()) < -MIN_FORCE_RISE_N:
+            raise InvalidArgumentError(
+                f"`force_n` must be the force pressing the surface, >= 0 within "
+                f"{MIN_FORCE_RISE_N} N (sensor noise); got {float(force.min()):.4g} N (a sensor "
+                "not zeroed, or its reaction force not negated?)"
+            )
         behind = np.maximum.accumulate(travel) - travel
         worst = int(np.argmax(behind))
         if behind[worst] > TRAVEL_BACKWARDS_TOLERANCE_M:

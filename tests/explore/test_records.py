@@ -150,3 +150,9 @@ def test_a_record_with_its_stiffness_survives_the_round_trip() -> None:
     data["stiffness"]["rigid"] = "no"
     with pytest.raises(FileFormatError, match=r"`poke\.stiffness\.rigid` must be true or false"):
         PokeRecord.from_dict(data)
+    # an estimate that cannot be: rigid with a modulus, a negative modulus, an unknown model
+    for change in ({"rigid": True}, {"modulus_pa": -3.0}, {"model": "guess"}, {"n_samples": 1}):
+        data = _record(stiffness=soft).to_dict()
+        data["stiffness"].update(change)
+        with pytest.raises(FileFormatError, match=r"`poke\.stiffness`"):
+            PokeRecord.from_dict(data)

@@ -52,6 +52,13 @@ def synthetic_record(rng: np.random.Generator, law: Law, force_n: float, n: int,
     return travel, force
 
 
+def in_range(travel: np.ndarray, thickness: float) -> bool:
+    """Whether a press stays in the range the estimator reads (indentation at most half the
+    layer, ``χ`` at most 1); a record beyond it is refused, tested on its own below."""
+    depth = float(travel.max())
+    return depth <= 0.45 * thickness and np.sqrt(R * depth) / thickness <= 0.95
+
+
 def layer_law(modulus: float, thickness: float) -> Law:
     return lambda d: float(layer_indentation_force(d, R, thickness, modulus, NU))
 
@@ -76,7 +83,7 @@ def layer_estimates() -> list[tuple[float, StiffnessEstimate]]:
     while len(out) < 150:
         modulus, thickness, force, n = _draw(rng)
         travel, measured = synthetic_record(rng, layer_law(modulus, thickness), force, n)
-        if travel.max() >= thickness:  # pressed through the layer: no such press exists
+        if not in_range(travel, thickness):
             continue
         out.append((modulus, estimate_stiffness(travel, measured, tip_radius_m=R,
                                                 thickness_m=thickness)))
@@ -84,7 +91,7 @@ def layer_estimates() -> list[tuple[float, StiffnessEstimate]]:
 
 
 def test_modulus_on_the_contact_model_is_accurate(layer_estimates):
-    # measured: median |relative error| 1.8 % over this draw (90th percentile 7 %)
+    # measured: median |relative error| 1.9 % over this draw (90th percentile 8 %)
     assert not any(est.rigid for _, est in layer_estimates)
     errors = np.array([est.modulus_pa / e - 1.0 for e, est in layer_estimates])
     assert np.median(np.abs(errors)) <= 0.05
@@ -92,7 +99,7 @@ def test_modulus_on_the_contact_model_is_accurate(layer_estimates):
 
 
 def test_claimed_sigma_is_honest(layer_estimates):
-    # |E error| ≤ 2σ in at least 90 % of the records (measured 96 % here and over 400 others),
+    # |E error| ≤ 2σ in at least 90 % of the records (measured 95 % here),
     # and the claim is not inflated either: within 1σ about two thirds of the time (69 %)
     z = np.array([(est.modulus_pa - e) / est.modulus_std_pa for e, est in layer_estimates])
     assert np.mean(np.abs(z) <= 2.0) >= 0.90
@@ -126,14 +133,18 @@ def test_stiffness_matches_the_true_slope():
     assert est.n_samples == 12 and est.reduced_chi2 is not None
 
 
-def test_a_press_nearly_through_the_layer_stays_inside_the_model():
-    # a straight line to 19 mm on a 2 cm layer: no bonded-layer curve explains it; the estimate
-    # stays finite, at most the layer deep, and says it does not fit
+def test_a_press_nearly_through_the_layer_is_refused_not_read():
+    # a straight line to 19 mm on a 2 cm layer: the tip is nearly on the table and no
+    # bonded-layer curve explains it; a modulus read from it would be the fit's lower bound
     travel = np.linspace(0.0, 0.019, 10)
-    est = estimate_stiffness(travel, np.linspace(0.02, 3.0, 10), tip_radius_m=R,
-                             thickness_m=0.02)
-    assert est.modulus_pa is not None and np.isfinite(est.modulus_pa)
-    assert est.depth_m <= 0.02 and est.reduced_chi2 is not None and est.reduced_chi2 > 10
+    with pytest.raises(InvalidArgumentError, match="leave the contact model's range"):
+        estimate_stiffness(travel, np.linspace(0.02, 3.0, 10), tip_radius_m=R, thickness_m=0.02)
+    # a soft layer pressed past half its thickness is refused too
+    rng = np.random.default_rng(3)
+    travel, measured = synthetic_record(rng, layer_law(2e3, 0.03), 3.0, 10)
+    assert travel.max() > 0.5 * 0.03
+    with pytest.raises(InvalidArgumentError, match="at most 50%"):
+        estimate_stiffness(travel, measured, tip_radius_m=R, thickness_m=0.03)
 
 
 def test_three_samples_are_enough():
@@ -159,8 +170,13 @@ def test_poisson_ratio_is_the_callers_assumption():
 def test_modulus_and_stiffness_are_monotone_in_the_true_modulus():
     moduli = 2e3 * 1.5 ** np.arange(12)  # 2 kPa to 173 kPa
     for force, thickness in [(0.3, 0.03), (3.0, 0.08)]:
+        # from the softest modulus the press stays in the model's range at
+        kept = moduli[[in_range(synthetic_record(np.random.default_rng(7),
+                                                 layer_law(m, thickness), force, 8)[0],
+                                thickness) for m in moduli]]
+        assert kept.size >= 8
         es, ks = [], []
-        for modulus in moduli:
+        for modulus in kept:
             rng = np.random.default_rng(7)  # the same noise draws for every modulus
             travel, measured = synthetic_record(rng, layer_law(modulus, thickness), force, 8)
             est = estimate_stiffness(travel, measured, tip_radius_m=R, thickness_m=thickness)
@@ -216,7 +232,7 @@ def test_half_space_physics_read_as_a_layer():
     while len(errors) < 100:
         modulus, _, force, n = _draw(rng)
         travel, measured = synthetic_record(rng, half_space_law(modulus), force, n)
-        if travel.max() >= 0.10:
+        if not in_range(travel, 0.10):
             continue
         est = estimate_stiffness(travel, measured, tip_radius_m=R, thickness_m=0.10)
         assert est.modulus_pa is not None and est.max_chi is not None
@@ -231,7 +247,7 @@ def test_stiffening_foam():
     """A foam that stiffens as it is pressed, ``F ∝ δ²`` (a local modulus growing as ``√δ``);
     its true modulus is the one at the commanded force's depth.
 
-    Measured over this draw: median |E error| 8 % (median +4 %, 5–95 %: −29 % to +22 %; the
+    Measured over this draw: median |E error| 8 % (median +6 %, 5–95 %: −12 % to +23 %; the
     claimed 2σ covers 61 %), the stiffness at the commanded force 13 % low (the model's δ^1.5
     shape is flatter than δ² at the end). Bounds: median |E error| ≤ 15 %; median k error in
     [−25 %, 0].
@@ -247,7 +263,7 @@ def test_stiffening_foam():
             return base(d) * np.sqrt(d / depth_c)
 
         travel, measured = synthetic_record(rng, law, force, n)
-        if travel.max() >= thickness:
+        if not in_range(travel, thickness):
             continue
         est = estimate_stiffness(travel, measured, tip_radius_m=R, thickness_m=thickness)
         assert est.modulus_pa is not None and est.stiffness_n_per_m is not None

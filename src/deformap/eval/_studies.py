@@ -128,12 +128,14 @@ def _stiffness_summary(records: list[PokeRecord], true_modulus_pa: float | None
                        ) -> dict[str, Any]:
     """What the presses' force–travel records read: the mean stiffness and Young's modulus over
     the presses that gave one, the mean claimed σ of E, its spread between places, the world's
-    true modulus and E's relative error; ``rigid`` when every press was read rigid."""
+    true modulus and E's relative error; ``rigid`` when every press was read rigid, ``n_rigid``
+    how many were (a foam some of whose presses read rigid is not averaged over silently)."""
     estimates = [r.stiffness for r in records]
     read = [s for s in estimates if s is not None and not s.rigid and s.modulus_pa is not None]
     moduli = np.array([s.modulus_pa for s in read], dtype=float)
     out: dict[str, Any] = {
         "rigid": bool(estimates) and all(s is not None and s.rigid for s in estimates),
+        "n_rigid": sum(s is not None and s.rigid for s in estimates),
         "stiffness_n_per_m": float(np.mean([s.stiffness_n_per_m for s in read])) if read else None,
         "modulus_pa": float(moduli.mean()) if read else None,
         "modulus_std_pa": float(np.mean([s.modulus_std_pa for s in read])) if read else None,

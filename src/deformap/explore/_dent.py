@@ -91,11 +91,13 @@ def _stiffness(obs: PressObservation, surface: SurfaceModel, config: Exploration
     if record is None:
         return None, None, None
     center = obs.contact.contact_point[:2]
-    thickness = float(np.asarray(surface.gp.predict(center[None, :])).reshape(-1)[0])
+    mean, std = surface.gp.predict(center[None, :], return_std=True)
+    thickness = float(np.asarray(mean).reshape(-1)[0])
     try:
         estimate = estimate_stiffness(record.travel_m, record.force_n,
                                       tip_radius_m=obs.contact.tip_radius_m,
                                       thickness_m=thickness, commanded_force_n=obs.force_n,
+                                      thickness_std_m=float(np.asarray(std).reshape(-1)[0]),
                                       config=config.stiffness)  # fmt: skip
     except DeformapError as exc:
         logger.warning("force–travel record not used (the camera alone reads this poke): %s", exc)

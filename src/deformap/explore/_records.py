@@ -16,7 +16,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from deformap.environment import TactileContact
-from deformap.errors import FileFormatError
+from deformap.errors import FileFormatError, InvalidArgumentError
 from deformap.explore._planning import PokePlan
 from deformap.explore._stiffness import LAYER_MODEL, StiffnessEstimate
 from deformap.msm import BetaEstimate
@@ -97,6 +97,14 @@ def _stiffness_from_dict(data: Any, where: str) -> StiffnessEstimate | None:
     numbers = {n: _number(data, n, where, optional=True)
                for n in names - {"rigid", "n_samples", "model", "depth_m"}}  # fmt: skip
     model = _text(data, "model", where)
+    try:
+        return _stiffness_estimate(data, numbers, model, where)
+    except InvalidArgumentError as exc:
+        raise FileFormatError(f"`{where}`: {exc}") from None
+
+
+def _stiffness_estimate(data: Mapping[str, Any], numbers: dict[str, Any], model: str | None,
+                        where: str) -> StiffnessEstimate:
     return StiffnessEstimate(
         **numbers, depth_m=_number(data, "depth_m", where),
         rigid=_number(data, "rigid", where, kind=bool),

@@ -105,6 +105,12 @@ _CHI_FRACTION = 0.95
 _CHI_CAP = 3.0
 # thicker than any foam a table-top probe presses: a larger value is a unit slip (millimetres)
 _MAX_THICKNESS_M = 2.0
+# the range the contact model is read in: the finite-thickness series holds for χ ≲ 1 (Dimitriadis
+# et al. 2002); past half the layer the tip nears the table and the foam under it nears its
+# collapse plateau (Gibson & Ashby, ch. 5), far outside the small-strain expansion the series is
+# (which a 1 cm tip pressed some millimetres into foam already stretches; README)
+_MAX_CHI = 1.0
+_MAX_STRAIN = 0.5
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -125,9 +131,11 @@ class StiffnessConfig:
     backwards_sigmas : float
         How far, in standard deviations of the difference of two readings, travel or force may
         step back between samples before the record is refused (noise moves them a little).
-    force_tolerance_rel : float
-        When the commanded force is given, the record's last force may differ from it by this
-        fraction (or three force standard deviations, if larger) before it is refused.
+    force_tolerance_rel, force_tolerance_abs_n : float
+        When the commanded force is given, the record's last force may differ from it by
+        ``rel · F + abs`` (or three force standard deviations, if larger) before it is refused:
+        the same rule as :class:`deformap.environment.PressObservation`'s, so that a record the
+        protocol accepts is read.
     """
 
     poisson_ratio: float = setting(0.33, ge=0.0, le=0.5)
@@ -136,7 +144,8 @@ class StiffnessConfig:
     force_noise_abs_n: float = setting(0.005, gt=0.0)
     rigid_travel_sigmas: float = setting(3.0, gt=0.0)
     backwards_sigmas: float = setting(4.0, gt=0.0)
-    force_tolerance_rel: float = setting(0.1, gt=0.0)
+    force_tolerance_rel: float = setting(0.25, ge=0.0, le=1.0)
+    force_tolerance_abs_n: float = setting(0.05, ge=0.0)
 
     def __post_init__(self) -> None:
         check_settings(self)
@@ -184,12 +193,33 @@ class StiffnessEstimate:
     n_samples: int
     model: str = LAYER_MODEL
 
+    def __post_init__(self) -> None:
+        if self.model != LAYER_MODEL:
+            raise InvalidArgumentError(f"`model` must be {LAYER_MODEL!r}; got {self.model!r}")
+        if isinstance(self.n_samples, bool) or not isinstance(self.n_samples, int) \
+                or self.n_samples < _MIN_SAMPLES:
+            raise InvalidArgumentError(
+                f"`n_samples` must be an integer >= {_MIN_SAMPLES}; got {self.n_samples!r}")
+        read = ("stiffness_n_per_m", "stiffness_std_n_per_m", "modulus_pa", "modulus_std_pa")
+        if self.rigid:
+            if any(getattr(self, n) is not None for n in read) or not (
+                    self.stiffness_lower_n_per_m is not None and self.stiffness_lower_n_per_m > 0):
+                raise InvalidArgumentError(
+                    "a rigid estimate has no stiffness or modulus, and a positive "
+                    "`stiffness_lower_n_per_m`")
+        elif any(getattr(self, n) is None or not np.isfinite(getattr(self, n))
+                 or getattr(self, n) < 0 or (getattr(self, n) == 0 and "std" not in n)
+                 for n in read):
+            raise InvalidArgumentError(
+                f"an estimate that is not rigid has finite {', '.join(read)}, the values "
+                "positive and their standard deviations not negative")
+
 
 def _force_std(force: NDArray[np.float64], config: StiffnessConfig) -> NDArray[np.float64]:
     return np.asarray(config.force_noise_rel * np.abs(force) + config.force_noise_abs_n)
 
 
-def _check_record(travel_m: Any, force_n: Any, thickness: float, config: StiffnessConfig,
+def _check_record(travel_m: Any, force_n: Any, config: StiffnessConfig,
                   ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     travel = check_array("travel_m", travel_m, (None,), what="travels in metres",
                          min_rows=_MIN_SAMPLES)
@@ -198,10 +228,15 @@ def _check_record(travel_m: Any, force_n: Any, thickness: float, config: Stiffne
     if force.shape != travel.shape:
         raise InvalidArgumentError(f"`force_n` must have one value per travel sample "
                                    f"({travel.size}); got {force.size}")
-    if travel.max() >= thickness:
+    if abs(travel[0]) > config.backwards_sigmas * config.travel_noise_m:
         raise InvalidArgumentError(
-            f"`travel_m` must be in metres and below the layer's thickness ({thickness} m); got "
-            f"a travel of {travel.max()} (millimetres?)")
+            f"`travel_m` must start at first contact (0 within its noise, "
+            f"{config.backwards_sigmas * config.travel_noise_m:.3g} m); got {travel[0]:.4g} m "
+            "(an absolute position rather than the travel since contact?)")
+    if force.min() < -3.0 * config.force_noise_abs_n:
+        raise InvalidArgumentError(
+            f"`force_n` must be the force pressing the surface, >= 0 within its noise; got "
+            f"{force.min():.4g} N (a sensor not zeroed, or its reaction force not negated?)")
     step_t = config.backwards_sigmas * np.sqrt(2.0) * config.travel_noise_m
     if np.any(np.diff(travel) < -step_t):
         at = int(np.argmax(np.diff(travel) < -step_t)) + 1
@@ -238,6 +273,7 @@ class _LayerTable:
 
     def __init__(self, radius: float, thickness: float, nu: float) -> None:
         self.radius, self.thickness, self.nu = radius, thickness, nu
+        self.low_bound = 0.0  # the softest modulus the fit may return (set by the fit)
         chi_lim = min(_CHI_FRACTION * layer_chi_limit(nu), _CHI_CAP)
         # nor deeper than the layer: with R < h that comes first (χ = √(R/h) < 1 at δ = h)
         self.depth_limit = min((chi_lim * thickness) ** 2 / radius, thickness)
@@ -273,6 +309,7 @@ class _Fit:
         self.travel, self.force, self.table, self.config = travel, force, table, config
         self.force_std = _force_std(force, config)
         self.weights = np.full(travel.size, 1.0 / config.travel_noise_m**2)
+        self.low_bound = 0.0
 
     def depths(self, modulus: float) -> NDArray[np.float64]:
         return self.table.depth_at(self.force / modulus)
@@ -303,6 +340,7 @@ class _Fit:
         high = np.log(f_max / float(layer_indentation_force(
             1e-3 * self.config.travel_noise_m, self.table.radius, self.table.thickness, 1.0,
             self.table.nu)))
+        self.low_bound = float(np.exp(low))
         log_modulus = low
         for _ in range(_EFFECTIVE_VARIANCE_ROUNDS):
             grid = np.linspace(low, high, _MODULUS_GRID)
@@ -326,16 +364,48 @@ class _Fit:
         # by ten orders of magnitude
         scale = np.array([modulus, self.config.travel_noise_m])
         jac = np.column_stack([-d_depth * sw, sw]) * scale
-        dof = self.force.size - 2
+        if self.offset_clamped(modulus):  # δ₀ sits on its bound: not a free parameter there
+            scale, jac = scale[:1], jac[:, :1]
+        dof = self.force.size - jac.shape[1]
         chi2_red = self.chi2(float(np.log(modulus))) / dof if dof > 0 else float("nan")
         cov = np.linalg.pinv(jac.T @ jac) * np.outer(scale, scale)
         if dof > 0 and chi2_red > 1.0:
             cov = cov * chi2_red
         return cov, chi2_red
 
+    def offset_clamped(self, modulus: float) -> bool:
+        """Whether the best ``δ₀`` at ``modulus`` lies on its ``−3 σ_t`` bound."""
+        gap = self.depths(modulus) - self.travel
+        return float(self.weights @ gap / self.weights.sum()) < -3.0 * self.config.travel_noise_m
+
+
+def _check_thickness(thickness_m: float, travel: NDArray[np.float64]) -> float:
+    thickness = check_positive("thickness_m", thickness_m)
+    if thickness > _MAX_THICKNESS_M:
+        raise InvalidArgumentError(
+            f"`thickness_m` must be in metres, at most {_MAX_THICKNESS_M}; got {thickness} "
+            f"(millimetres?)")
+    if travel.max() >= thickness:
+        raise InvalidArgumentError(
+            f"`travel_m` must be in metres and below the layer's thickness ({thickness} m); got "
+            f"a travel of {travel.max()} (millimetres?)")
+    return thickness
+
+
+def _fit(travel: NDArray[np.float64], force: NDArray[np.float64], radius: float,
+         thickness: float, config: StiffnessConfig
+         ) -> tuple[float, float, NDArray[np.float64], float, _LayerTable]:
+    """``(E, δ₀, cov(E, δ₀), reduced χ², table)`` of the record on a layer of ``thickness``."""
+    table = _LayerTable(radius, thickness, config.poisson_ratio)
+    fit = _Fit(travel, force, table, config)
+    modulus = fit.solve()
+    table.low_bound = fit.low_bound
+    cov, chi2_red = fit.covariance(modulus)
+    return modulus, fit.offset(modulus), cov, chi2_red, table
+
 
 def estimate_stiffness(travel_m: Any, force_n: Any, *, tip_radius_m: float, thickness_m: float,
-                       commanded_force_n: float | None = None,
+                       commanded_force_n: float | None = None, thickness_std_m: float = 0.0,
                        config: StiffnessConfig | None = None) -> StiffnessEstimate:
     """Stiffness and Young's modulus with their uncertainties from one force–travel record.
 
@@ -354,7 +424,11 @@ def estimate_stiffness(travel_m: Any, force_n: Any, *, tip_radius_m: float, thic
         ``(0, 2]`` m; the travel must stay below it.
     commanded_force_n : float, optional
         The force the press was commanded to; the record's last force must be near it
-        (``config.force_tolerance_rel``). Default: the record's largest force.
+        (``config.force_tolerance_rel`` and ``force_tolerance_abs_n``). Default: the record's
+        largest force.
+    thickness_std_m : float
+        Standard deviation of ``thickness_m`` (the surface model's at the contact); E's
+        standard deviation includes what it moves E by (a refit at ``h ± σ_h``).
     config : StiffnessConfig, optional
 
     Returns
@@ -366,29 +440,27 @@ def estimate_stiffness(travel_m: Any, force_n: Any, *, tip_radius_m: float, thic
     Raises
     ------
     InvalidArgumentError
-        Naming the argument: NaN or infinite values, fewer than three samples, travel or force
-        going backwards beyond their noise, force not rising, a travel not below the thickness
-        (millimetres for metres), a last force far from the commanded one, a bad radius or
-        thickness.
+        Naming the argument: NaN or infinite values, fewer than three samples, a travel that does
+        not start at contact, a negative force, travel or force going backwards beyond their
+        noise, force not rising, a travel not below the thickness (millimetres for metres), a
+        last force far from the commanded one, a bad radius or thickness, or a record that leaves
+        the contact model's range (``χ`` above 1, an indentation deeper than half the layer,
+        or a modulus on the fit's lower bound): the tip sank too deep to read the layer.
     """
     config = StiffnessConfig() if config is None else config
     radius = check_positive("tip_radius_m", tip_radius_m)
-    thickness = check_positive("thickness_m", thickness_m)
-    if thickness > _MAX_THICKNESS_M:
-        raise InvalidArgumentError(
-            f"`thickness_m` must be in metres, at most {_MAX_THICKNESS_M}; got {thickness} "
-            f"(millimetres?)")
-    travel, force = _check_record(travel_m, force_n, thickness, config)
+    travel, force = _check_record(travel_m, force_n, config)
     if commanded_force_n is None:
         force_c = float(force.max())
     else:
         force_c = check_positive("commanded_force_n", commanded_force_n)
-        allowed = max(config.force_tolerance_rel * force_c,
+        allowed = max(config.force_tolerance_rel * force_c + config.force_tolerance_abs_n,
                       3.0 * float(_force_std(np.array([force_c]), config)[0]))
         if abs(force[-1] - force_c) > allowed:
             raise InvalidArgumentError(
                 f"`force_n` must end near the commanded force {force_c} N (within {allowed:.3g} "
                 f"N); its last value is {force[-1]:.4g} N")
+    # rigid needs no layer: a board or the bare table, which a surface model may read as thin
     span, span_std = _travel_span(travel, force, force_c, config.travel_noise_m)
     if span < config.rigid_travel_sigmas * config.travel_noise_m:
         bound = max(span, 0.0) + 2.0 * span_std
@@ -397,24 +469,33 @@ def estimate_stiffness(travel_m: Any, force_n: Any, *, tip_radius_m: float, thic
             stiffness_lower_n_per_m=float((force_c - force[0]) / bound), modulus_pa=None,
             modulus_std_pa=None, contact_offset_m=None, depth_m=float(span), max_chi=None,
             reduced_chi2=None, rigid=True, n_samples=int(travel.size))
-
-    table = _LayerTable(radius, thickness, config.poisson_ratio)
-    fit = _Fit(travel, force, table, config)
-    modulus = fit.solve()
-    offset = fit.offset(modulus)
-    cov, chi2_red = fit.covariance(modulus)
-    modulus_std = float(np.sqrt(max(cov[0, 0], 0.0)))
+    thickness = _check_thickness(thickness_m, travel)
+    thickness_std = check_positive("thickness_std_m", thickness_std_m, allow_zero=True)
+    modulus, offset, cov, chi2_red, table = _fit(travel, force, radius, thickness, config)
+    depth_c = float(table.depth_at(np.array([force_c / modulus]))[0])
+    chi = float(np.sqrt(radius * depth_c) / thickness)
+    strain = depth_c / thickness
+    if chi > _MAX_CHI or strain > _MAX_STRAIN or modulus <= 1.001 * table.low_bound:
+        raise InvalidArgumentError(
+            f"`force_n`/`travel_m` leave the contact model's range (χ = {chi:.2f}, at most "
+            f"{_MAX_CHI}; indentation {strain:.0%} of the {thickness:.3g} m layer, at most "
+            f"{_MAX_STRAIN:.0%}): the tip presses too deep into this layer to read its modulus")
+    modulus_var = max(cov[0, 0], 0.0)
+    if thickness_std > 0:  # the layer's thickness is read from the surface model: its error too
+        moduli = [_fit(travel, force, radius, max(thickness + d, 1.01 * travel.max()), config)[0]
+                  for d in (-thickness_std, thickness_std)]
+        modulus_var += ((moduli[1] - moduli[0]) / 2.0) ** 2
+    modulus_std = float(np.sqrt(modulus_var))
 
     def stiffness_at(e: float) -> float:
         return float(e * table.slope(table.depth_at(np.array([force_c / e])))[0])
 
-    depth_c = float(table.depth_at(np.array([force_c / modulus]))[0])
     step = 1e-4 * modulus
     dk_de = (stiffness_at(modulus + step) - stiffness_at(modulus - step)) / (2.0 * step)
     return StiffnessEstimate(
         stiffness_n_per_m=stiffness_at(modulus),
         stiffness_std_n_per_m=float(abs(dk_de) * modulus_std), stiffness_lower_n_per_m=None,
         modulus_pa=modulus, modulus_std_pa=modulus_std, contact_offset_m=offset,
-        depth_m=depth_c, max_chi=float(np.sqrt(radius * depth_c) / thickness),
+        depth_m=depth_c, max_chi=chi,
         reduced_chi2=None if np.isnan(chi2_red) else float(chi2_red), rigid=False,
         n_samples=int(travel.size))

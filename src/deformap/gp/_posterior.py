@@ -63,7 +63,12 @@ def variance_after_adding(variance: Any, covariance: Any, candidate_variance: An
             f"`covariance` must be (candidates, domain) = ({var_c.size}, {var.size}); "
             f"got {cov.shape}"
         )
-    noise = np.asarray(noise_var, dtype=float)
+    try:
+        noise = np.asarray(noise_var, dtype=float)
+    except (TypeError, ValueError):
+        raise InvalidArgumentError(
+            f"`noise_var` must be a number >= 0 or ({var_c.size},) of them; got {noise_var!r}"
+        ) from None
     if noise.ndim == 0:
         noise = np.full(var_c.size, check_positive("noise_var", float(noise), allow_zero=True))
     elif noise.shape != var_c.shape or not np.all(np.isfinite(noise)) or np.any(noise < 0):
@@ -105,7 +110,12 @@ class PosteriorDesign:
                 f"`observed_noise_std` must be positive standard deviations; got {noise.min()!r}")
         cand = check_array("candidates", candidates, (None, 2), what="metres")
         dom = check_array("domain", domain, (None, 2), what="metres")
-        new_noise = np.asarray(candidate_noise_std, dtype=float)
+        try:
+            new_noise = np.asarray(candidate_noise_std, dtype=float)
+        except (TypeError, ValueError):
+            raise InvalidArgumentError(
+                f"`candidate_noise_std` must be a number > 0 or ({cand.shape[0]},) of them; got "
+                f"{candidate_noise_std!r}") from None
         if new_noise.ndim == 0:
             new_noise = np.full(cand.shape[0], check_positive("candidate_noise_std",
                                                               float(new_noise)))
