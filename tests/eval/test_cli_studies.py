@@ -107,3 +107,30 @@ def test_reproduce_runs_every_scenario_and_writes_the_table(tmp_path: Path) -> N
         assert 0.0 < row["accuracy"] <= 1.0 and row["time_s"] > 0
         _check_png(out / name / "map.png")
         assert f"| {name} | {PAPER_TABLE_I[name]['interactions']} |" in markdown
+
+
+def test_camera_presets_are_named_cameras_with_their_specs() -> None:
+    from deformap.errors import InvalidArgumentError
+    from deformap.world import CAMERA_PRESETS, CameraConfig, camera_preset
+
+    assert camera_preset("primesense") == CameraConfig()
+    kinect, d435 = camera_preset("kinect-v1"), camera_preset("realsense-d435")
+    assert (kinect.width, kinect.height, kinect.height_m) == (320, 240, 1.0)
+    assert (d435.fov_deg, d435.baseline_m) == ((87.0, 58.0), 0.05)
+    assert set(CAMERA_PRESETS) == {"primesense", "kinect-v1", "realsense-d435"}
+    with pytest.raises(InvalidArgumentError, match="`camera` must be one of"):
+        camera_preset("webcam")
+
+
+@pytest.mark.slow
+def test_the_hardness_study_runs_under_another_camera_and_thickness(tmp_path: Path) -> None:
+    from deformap import run
+
+    out = run.run_hardness_study(tmp_path / "s", hardness=[60.0], coarse=True,
+                                 camera="kinect-v1", thickness_m=0.03)
+    study = json.loads((out.folder / "hardness.json").read_text())
+    assert (study["camera"], study["thickness_m"], study["force_n"]) == ("kinect-v1", 0.03, 0.6)
+    rows = {(r["protocol"], r["hardness_n"]): r for r in study["rows"]}
+    foam, board = rows[("force/quadratic", 60.0)], rows[("force/quadratic", None)]
+    assert foam["camera"] == "kinect-v1" and foam["thickness_m"] == 0.03
+    assert foam["modulus_pa"] is not None and not foam["rigid"] and board["rigid"]

@@ -51,14 +51,22 @@ def study_hardness(
         list[float] | None, typer.Option(help="Foams in N (repeat); rigid is added.")
     ] = None,
     coarse: CoarseOption = False,
+    camera: Annotated[
+        str | None, typer.Option(help="Camera preset: primesense | kinect-v1 | realsense-d435.")
+    ] = None,
+    thickness: Annotated[float, typer.Option(help="Foam thickness in metres.")] = 0.05,
+    force: Annotated[float | None, typer.Option(help="Press force in N (default 0.6).")] = None,
     json_path: JsonOption = None,
 ) -> None:
-    """β against hardness for each contact protocol (paper Fig. 5a)."""
+    """β and Young's modulus against hardness for each contact protocol (paper Fig. 5a)."""
     shown = out_console(json_path)
     with progress(shown) as bar:
         output = run.run_hardness_study(out, seed=seed, hardness=hardness, coarse=coarse,
+                                        camera=camera, thickness_m=thickness, force_n=force,
                                         hooks=run_hooks(bar))  # fmt: skip
-    table = Table(title="β against hardness")
+    s = output.study
+    where = ", ".join(f"{s[k]}" for k in ("camera", "physics") if k in s)
+    table = Table(title=f"β and E against hardness{f' ({where})' if where else ''}")
     table.add_column("protocol", no_wrap=True)  # the row's name, never cut
     for col in ("hardness [N]", "β", "β spread", "β uncertainty", "fit error \\[mm]",
                 "E \\[kPa]", "true E \\[kPa]"):

@@ -59,14 +59,16 @@ class FoamPresses:
     true_modulus_pa: float | None = None  # the world's own, at the presses (None: rigid)
 
 
-def _block_scenario(hardness_n: float | None, workspace: Workspace) -> Scenario:
+def _block_scenario(hardness_n: float | None, workspace: Workspace,
+                    thickness_m: float = 0.05) -> Scenario:
     (x0, y0), (x1, y1) = workspace.lower, workspace.upper
     polygon = np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]])
     if hardness_n is None:
-        block = Block(name="rigid", polygon=polygon, rigid=True)
+        block = Block(name="rigid", polygon=polygon, rigid=True, thickness_m=thickness_m)
         name = "homogeneous-rigid"
     else:
-        block = Block(name=f"{hardness_n:g} N foam", polygon=polygon, hardness_n=hardness_n)
+        block = Block(name=f"{hardness_n:g} N foam", polygon=polygon, hardness_n=hardness_n,
+                      thickness_m=thickness_m)
         name = f"homogeneous-{hardness_n:g}"
     return Scenario(name=name, blocks=(block,), workspace=workspace)
 
@@ -79,8 +81,10 @@ def collect_presses(
     positions: Sequence[tuple[float, float]] = DEFAULT_POSITIONS,
     rng: np.random.Generator,
     progress: Callable[[str], None] | None = None,
+    thickness_m: float = 0.05,
 ) -> list[FoamPresses]:
-    """Build one world per foam, observe it, and press it at ``positions``."""
+    """Build one world per foam (a block ``thickness_m`` thick over the workspace), observe it,
+    and press it at ``positions`` with the configuration's ``force_n``."""
     world_config = world_config or WorldConfig()
     config = config or ExplorationConfig()
     streams = rng.spawn(len(hardnesses))
@@ -88,7 +92,8 @@ def collect_presses(
     for hardness, stream in zip(hardnesses, streams, strict=True):
         world_rng, fit_rng = stream.spawn(2)
         world = SimulatedWorld(
-            _block_scenario(hardness, Workspace()), config=world_config, rng=world_rng
+            _block_scenario(hardness, Workspace(), thickness_m), config=world_config,
+            rng=world_rng,
         )
         mapper = Mapper(world.workspace, config)
         mapper.initialise(world.observe(), fit_rng)

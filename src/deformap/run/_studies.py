@@ -8,6 +8,7 @@ reports progress.
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -22,9 +23,10 @@ from deformap.eval import (
     collect_presses,
     hardness_study,
 )
+from deformap.explore import ExplorationConfig
 from deformap.run._folder import create_run_folder, default_run_folder, write_json
 from deformap.run._hooks import NO_HOOKS, RunHooks, RunStart
-from deformap.world import WorldConfig
+from deformap.world import WorldConfig, camera_preset
 
 __all__ = ["CLUSTER_SIZE_FOAMS", "StudyOutput", "run_cluster_size_study", "run_hardness_study"]
 
@@ -43,12 +45,17 @@ class StudyOutput:
 
 def _foams(
     name: str, foams: Sequence[float | None], folder: Path, *, seed: int, coarse: bool,
-    hooks: RunHooks,
+    hooks: RunHooks, camera: str | None = None, thickness_m: float = 0.05,
+    force_n: float | None = None,
 ) -> list[FoamPresses]:  # fmt: skip
     hooks.start(RunStart(kind="study", title=f"{name}, seed {seed}", folder=folder,
                          total=len(foams)))  # fmt: skip
     hooks.stage("pressing the foams")
-    return collect_presses(foams, world_config=WorldConfig.coarse() if coarse else WorldConfig(),
+    world = WorldConfig.coarse() if coarse else WorldConfig()
+    if camera is not None:
+        world = dataclasses.replace(world, camera=camera_preset(camera))
+    explore = ExplorationConfig() if force_n is None else ExplorationConfig(force_n=force_n)
+    return collect_presses(foams, world_config=world, config=explore, thickness_m=thickness_m,
                            rng=np.random.default_rng(seed), progress=hooks.step)  # fmt: skip
 
 
@@ -64,9 +71,13 @@ def run_hardness_study(
     seed: int = 0,
     hardness: Sequence[float] | None = None,
     coarse: bool = False,
+    camera: str | None = None,
+    thickness_m: float = 0.05,
+    force_n: float | None = None,
     hooks: RunHooks = NO_HOOKS,
 ) -> StudyOutput:
-    """β against hardness for each contact protocol (:func:`deformap.eval.hardness_study`).
+    """β (each contact protocol) and the force–travel reading (stiffness, Young's modulus)
+    against hardness (:func:`deformap.eval.hardness_study`).
 
     Parameters
     ----------
@@ -80,15 +91,28 @@ def run_hardness_study(
         :data:`~deformap.eval.DEFAULT_HARDNESSES`.
     coarse : bool
         The coarse FEM mesh (a quick look).
+    camera : str, optional
+        A :data:`deformap.world.CAMERA_PRESETS` name (default: the world's own camera).
+    thickness_m : float
+        The foam blocks' thickness.
+    force_n : float, optional
+        The press force (default: the exploration's).
     hooks : RunHooks
     """
     from deformap.viz import plot_hardness_study  # matplotlib: only when a study is drawn
 
     folder = create_run_folder(out or default_run_folder("hardness", "study", seed), what="study")
     foams = DEFAULT_HARDNESSES if not hardness else (*hardness, None)
-    presses = _foams("hardness study", foams, folder, seed=seed, coarse=coarse, hooks=hooks)
+    if camera is not None:
+        camera_preset(camera)  # an unknown name fails here, before any world is built
+    presses = _foams("hardness study", foams, folder, seed=seed, coarse=coarse, hooks=hooks,
+                     camera=camera, thickness_m=thickness_m, force_n=force_n)
     hooks.stage("estimating β per protocol")
-    study = hardness_study(presses)
+    conditions = {"camera": camera or "primesense", "thickness_m": thickness_m,
+                  "force_n": presses[0].presses[0].force_n if presses else force_n,
+                  "physics": "linear elastic FEM"}
+    study = {**conditions, **hardness_study(presses)}
+    study["rows"] = [{**row, **conditions} for row in study["rows"]]
     return StudyOutput(study=study, folder=folder,
                        files=_write(folder, "hardness", study, plot_hardness_study))  # fmt: skip
 

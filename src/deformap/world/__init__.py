@@ -26,7 +26,7 @@ from deformap.mechanics import (
     hertz_pressure_samples,
     youngs_modulus_to_hardness,
 )
-from deformap.world._camera import CameraConfig
+from deformap.world._camera import CAMERA_PRESETS, CameraConfig, camera_preset
 from deformap.world._config import WorldConfig, check_world_budget
 from deformap.world._foam import Dent
 from deformap.world._probe import ProbeGeometry
@@ -37,6 +37,7 @@ from deformap.world._world import MIN_RECORD_FORCE_N, SimulatedWorld
 
 __all__ = [
     "BARE_TABLE",
+    "CAMERA_PRESETS",
     "MIN_RECORD_FORCE_N",
     "Block",
     "CameraConfig",
@@ -45,6 +46,7 @@ __all__ = [
     "Scenario",
     "SimulatedWorld",
     "WorldConfig",
+    "camera_preset",
     "check_world_budget",
     "hardness_to_youngs_modulus",
     "hertz_contact_radius",

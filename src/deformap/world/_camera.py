@@ -23,11 +23,17 @@ Khoshelham, K., Elberink, S. O. (2012). Accuracy and resolution of Kinect depth 
 mapping applications. Sensors 12(2), 1437–1454.
 Nguyen, C. V., Izadi, S., Lovell, D. (2012). Modeling Kinect sensor noise for improved 3D
 reconstruction and tracking. 3DIMPVT.
+Grunnet-Jepsen, A., Sweetser, J. N., Woodfill, J. (2018). Best-known-methods for tuning Intel
+RealSense D400 depth cameras for best performance. Intel white paper, rev. 1.9 (depth RMS error
+``z² · subpixel / (f · b)`` with a subpixel RMS of about 0.08 pixel).
+Intel RealSense D400 series product family datasheet (2019): D435 depth field of view 87° × 58°,
+baseline 50 mm, 848 × 480 at 90 fps.
 """
 
 from __future__ import annotations
 
 import logging
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -35,9 +41,10 @@ import trimesh
 from numpy.typing import NDArray
 
 from deformap._validation import check_settings, setting
+from deformap.errors import InvalidArgumentError
 from deformap.world._raycast import cast_rays
 
-__all__ = ["CameraConfig", "DepthCamera"]
+__all__ = ["CAMERA_PRESETS", "CameraConfig", "DepthCamera", "camera_preset"]
 
 log = logging.getLogger(__name__)
 
@@ -94,6 +101,43 @@ class CameraConfig:
 
     def __post_init__(self) -> None:
         check_settings(self)
+
+
+def _kinect_v1() -> CameraConfig:
+    # Kinect v1 in its 320 × 240 depth mode, 1 m above the table: field of view 57° × 43°,
+    # baseline 7.5 cm, disparity in 1/8 pixel (at half the resolution, twice the quantisation
+    # step in depth), random error about 1.6 mm · z² (Khoshelham & Elberink 2012, Fig. 9)
+    return CameraConfig(width=320, height=240, fov_deg=(57.0, 43.0), height_m=1.0,
+                        sigma_base_m=0.0, sigma_quadratic_m=0.0016, sigma_reference_m=0.0,
+                        baseline_m=0.075, subpixel=8.0)
+
+
+def _realsense_d435() -> CameraConfig:
+    # RealSense D435 at 848 × 480, 0.6 m above the table (its minimum range is about 0.2 m):
+    # field of view 87° × 58°, baseline 5 cm; depth RMS z² · 0.08 px / (f b) with
+    # f = 424 px / tan(43.5°) ≈ 447 px, i.e. 3.6 mm · z² (Grunnet-Jepsen et al. 2018); its
+    # disparity is finer than that noise (1/32 pixel)
+    return CameraConfig(width=848, height=480, fov_deg=(87.0, 58.0), height_m=0.6,
+                        sigma_base_m=0.0, sigma_quadratic_m=0.0036, sigma_reference_m=0.0,
+                        baseline_m=0.05, subpixel=32.0)
+
+
+#: Named depth cameras of the kind a robot carries, each a :class:`CameraConfig` built from the
+#: maker's or the literature's figures (see the references): ``primesense`` (the default, a
+#: PrimeSense Carmine 1.08 at 0.8 m and 45°), ``kinect-v1`` and ``realsense-d435``.
+CAMERA_PRESETS: dict[str, Callable[[], CameraConfig]] = {
+    "primesense": CameraConfig,
+    "kinect-v1": _kinect_v1,
+    "realsense-d435": _realsense_d435,
+}
+
+
+def camera_preset(name: str) -> CameraConfig:
+    """The :class:`CameraConfig` of the preset ``name`` (one of :data:`CAMERA_PRESETS`)."""
+    if name not in CAMERA_PRESETS:
+        raise InvalidArgumentError(
+            f"`camera` must be one of {sorted(CAMERA_PRESETS)}; got {name!r}")
+    return CAMERA_PRESETS[name]()
 
 
 class DepthCamera:
