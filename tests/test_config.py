@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import os
 import pickle
 from dataclasses import dataclass, field
 from typing import Literal
@@ -151,6 +152,40 @@ def test_unreadable_and_invalid_yaml(tmp_path) -> None:
     bad.write_text("a: [1, 2\n")
     with pytest.raises(ConfigError, match="is not valid YAML"):
         load_yaml(bad)
+
+
+def test_a_config_that_is_not_a_regular_file_is_refused_without_reading(tmp_path) -> None:
+    fifo = tmp_path / "fifo.yaml"
+    os.mkfifo(fifo)  # opening it to read would block until a writer came
+    for path in (fifo, "/dev/zero", tmp_path):
+        with pytest.raises(ConfigError, match=r"cannot read config file .*not a regular file"):
+            load_yaml(path)
+
+
+def test_a_config_larger_than_the_limit_is_refused(tmp_path, monkeypatch) -> None:  # type: ignore[no-untyped-def]
+    import deformap._config as config_module
+
+    monkeypatch.setattr(config_module, "MAX_YAML_BYTES", 64)
+    big = tmp_path / "big.yaml"
+    big.write_text("seed: 1\n" + "# padding\n" * 10)
+    with pytest.raises(ConfigError, match=r"big\.yaml.*larger than"):
+        load_yaml(big)
+    big.write_text("seed: 1\n")
+    assert load_yaml(big) == {"seed": 1}
+
+
+def test_an_integer_too_large_for_a_float_field_is_one_setting_error() -> None:
+    @dataclass(frozen=True)
+    class Settings:
+        value: float = setting(1.0, gt=0.0)
+
+        def __post_init__(self) -> None:
+            check_settings(self)
+
+    with pytest.raises(SettingError, match=r"`value` must be a real number within .*401 digits"):
+        Settings(value=10**400)
+    with pytest.raises(ConfigError, match=r"`f\.value` must be a real number within"):
+        config_from_dict(Settings, {"value": 10**400}, where="f")
 
 
 @pytest.mark.parametrize(

@@ -12,6 +12,8 @@ from __future__ import annotations
 
 import dataclasses
 import logging
+import os
+import stat
 import types
 import typing
 from pathlib import Path
@@ -21,6 +23,10 @@ import yaml
 
 from deformap._validation import SettingError
 from deformap.errors import ConfigError, DeformapError
+
+#: Largest YAML file read (config, scenario, session): a session lists its pokes and files, never
+#: their data, so even thousands of pokes stay far below this.
+MAX_YAML_BYTES = 16 * 2**20
 
 __all__ = ["config_from_dict", "config_to_dict", "dump_yaml", "load_yaml"]
 
@@ -120,7 +126,14 @@ def load_yaml(path: str | Path, *, what: str = "config file",
     """
     p = Path(path)
     try:
-        text = p.read_bytes().decode("utf-8")
+        if not stat.S_ISREG(os.stat(p).st_mode):  # a FIFO would block, a device never end
+            raise unreadable(f"cannot read {what} {str(p)!r}: not a regular file")
+        with p.open("rb") as stream:
+            raw = stream.read(MAX_YAML_BYTES + 1)
+        if len(raw) > MAX_YAML_BYTES:
+            raise unreadable(f"cannot read {what} {str(p)!r}: larger than "
+                             f"{MAX_YAML_BYTES // 2**20} MiB")
+        text = raw.decode("utf-8")
     except OSError as exc:
         raise unreadable(f"cannot read {what} {str(p)!r}: {exc.strerror or exc}") from None
     except UnicodeDecodeError as exc:

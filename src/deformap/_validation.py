@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import math
 import operator
+import sys
 from collections.abc import Sequence
 from dataclasses import field, fields, is_dataclass
 from functools import cache
@@ -307,7 +308,11 @@ def _check_value(name: str, value: Any, hint: Any, bounds: dict[str, Any]) -> An
             value, (int, float, np.integer, np.floating)
         ):
             raise SettingError(name, f"must be a real number; got {describe(value)}")
-        out = value if type(value) is float else float(value)
+        try:
+            out = value if type(value) is float else float(value)
+        except OverflowError:  # an integer with hundreds of digits
+            raise SettingError(name, f"must be a real number within ±{sys.float_info.max:.3g}; "
+                               f"got an integer of {len(str(abs(int(value))))} digits") from None
         if bounds.get("finite", True) and not math.isfinite(out):
             raise SettingError(name, f"must be finite; got {out}")
         return _check_bounds(name, out, bounds, "")

@@ -127,3 +127,24 @@ def test_a_map_too_large_for_its_workspace_is_refused_before_the_folder(tmp_path
     with pytest.raises(SettingError, match=r"surface\.grid_spacing_m"):
         record_simulation(RunConfig(scenario=str(scenario)), out)
     assert not out.exists()
+
+
+def test_json_is_strict_nan_as_null_dates_as_iso(tmp_path: Path) -> None:
+    import datetime
+    import json
+
+    import numpy as np
+
+    from deformap.run import to_json
+
+    data = {"nan": float("nan"), "inf": np.float64("inf"), "arr": np.array([1.0, np.nan]),
+            "when": datetime.date(2020, 1, 2), "where": tmp_path, "ok": (1, True, None, "x")}
+    text = to_json(data)
+    assert "NaN" not in text and "Infinity" not in text
+    assert json.loads(text) == {"nan": None, "inf": None, "arr": [1.0, None],
+                                "when": "2020-01-02", "where": str(tmp_path),
+                                "ok": [1, True, None, "x"]}
+    write_json(tmp_path / "r.json", data)
+    assert json.loads((tmp_path / "r.json").read_text())["when"] == "2020-01-02"
+    with pytest.raises(TypeError, match="not JSON serialisable: object"):
+        to_json({"bad": object()})

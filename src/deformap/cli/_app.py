@@ -20,6 +20,7 @@ from typing import Annotated, Any, TypeVar
 
 import typer
 from rich.console import Console
+from rich.text import Text
 
 from deformap import __version__, run
 from deformap.errors import ConfigError, DeformapError
@@ -31,11 +32,19 @@ __all__ = [
     "emit_json",
     "err_console",
     "friendly_errors",
+    "labelled",
     "out_console",
 ]
 
-console = Console()
-err_console = Console(stderr=True)
+# Markup off: file names, scenario names and messages are the user's text, where "[" and "]" are
+# characters, not styles; the few styled words are Text with a style (``labelled``).
+console = Console(markup=False, highlight=False)
+err_console = Console(stderr=True, markup=False, highlight=False)
+
+
+def labelled(label: str, style: str, text: str) -> Text:
+    """``label`` in ``style``, a space, then ``text`` as it is (no markup)."""
+    return Text.assemble((label, style), " ", text)
 
 app = typer.Typer(
     name="deformap",
@@ -61,7 +70,7 @@ def friendly_errors(func: F) -> F:
         try:
             return func(*args, **kwargs)
         except DeformapError as exc:
-            err_console.print(f"[bold red]error:[/] {exc}", highlight=False, soft_wrap=True)
+            err_console.print(labelled("error:", "bold red", str(exc)), soft_wrap=True)
             raise typer.Exit(code=2) from None
 
     return wrapper  # type: ignore[return-value]

@@ -39,8 +39,8 @@ def poke_row(p: PokeRecord) -> str:
         + f"  max var {p.max_variance_after:.4f}"
         + (f"  plan: {p.planned_after} more" if p.planned_after is not None else "")
         + ("  boundary poke" if p.purpose == "boundary" else "")
-        + f"  [dim](compute {p.timings.compute_s:.2f} s,"
-        f" world {p.timings.environment_s or 0.0:.2f} s)[/]"
+        + f"  (compute {p.timings.compute_s:.2f} s,"
+        f" world {p.timings.environment_s or 0.0:.2f} s)"
     )
 
 

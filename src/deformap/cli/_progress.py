@@ -17,6 +17,7 @@ from rich.progress import (
 )
 
 from deformap import run
+from deformap.cli._app import labelled
 
 if TYPE_CHECKING:  # the CLI loads the estimator only when a command runs
     from deformap.explore import PokeRecord
@@ -56,7 +57,7 @@ def run_hooks(
 
     def start(event: run.RunStart) -> None:
         where = "" if event.folder is None else f" → {event.folder}"
-        bar.console.print(f"[bold]deformap {event.kind}[/] {event.title}{where}", highlight=False)
+        bar.console.print(labelled(f"deformap {event.kind}", "bold", f"{event.title}{where}"))
         bar.update(task, total=event.total, completed=event.done, description=event.kind)
 
     def poke(event: PokeRecord) -> None:

@@ -15,6 +15,7 @@ from deformap.cli._app import (
     emit_json,
     err_console,
     friendly_errors,
+    labelled,
     out_console,
 )
 from deformap.cli._progress import modulus_text, progress, run_hooks
@@ -93,7 +94,7 @@ def map_command(
                                           hooks=run_hooks(bar, poke_row=poke_row))  # fmt: skip
     report = output.report
     for line in report["warnings"]:
-        err_console.print(f"[yellow]warning:[/] {line}", highlight=False, soft_wrap=True)
+        err_console.print(labelled("warning:", "yellow", line), soft_wrap=True)
     regions = report["regions"]
     found = (
         "no poke usable" if regions is None else f"{len(regions['class_betas'])} region class(es)"
@@ -104,6 +105,11 @@ def map_command(
     shown.print(f"{report['n_pokes']} of {len(output.session)} pokes used, {found}{scored}; "
                 f"wrote {output.folder / 'report.json'}", highlight=False)  # fmt: skip
     emit_json(json_path, report)
+    if regions is None:  # the report is written (nothing lost), but there is no map
+        err_console.print(labelled("error:", "bold red", (
+            f"no poke of the session {str(session)!r} was usable: expected at least one, got 0 "
+            f"of {len(output.session)} (the warnings and report.json say why)")), soft_wrap=True)
+        raise typer.Exit(code=2)
 
 
 @app.command("estimate")

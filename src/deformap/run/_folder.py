@@ -13,7 +13,9 @@
 
 from __future__ import annotations
 
+import datetime
 import json
+import math
 import time
 from pathlib import Path
 from typing import Any
@@ -97,18 +99,33 @@ def write_text(path: Path, text: str) -> Path:
     return write_text_atomically(path, text)
 
 
-def _json_default(value: Any) -> Any:
+def _plain(value: Any) -> Any:
+    """``value`` as strict JSON data: numpy arrays and scalars as lists and numbers, a non-finite
+    number as ``null`` (JSON has no NaN or infinity), dates and times in ISO 8601 (a YAML date a
+    user wrote in a session's ``source``), tuples as lists."""
+    if isinstance(value, dict):
+        return {str(k): _plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
     if isinstance(value, np.ndarray):
-        return value.tolist()
+        return _plain(value.tolist())
     if isinstance(value, np.generic):
-        return value.item()
-    raise TypeError(f"not JSON serialisable: {type(value)}")
+        return _plain(value.item())
+    if isinstance(value, float):
+        return value if math.isfinite(value) else None
+    if isinstance(value, (datetime.date, datetime.time)):
+        return value.isoformat()
+    if isinstance(value, Path):
+        return str(value)
+    if value is None or isinstance(value, (str, int)):
+        return value
+    raise TypeError(f"not JSON serialisable: {type(value).__name__}")
 
 
 def to_json(data: Any, *, indent: int | None = 2) -> str:
-    """``data`` as JSON (indented, or on one line with ``indent=None``); numpy arrays and scalars
-    become lists and numbers."""
-    return json.dumps(data, indent=indent, default=_json_default)
+    """``data`` as strict JSON (indented, or on one line with ``indent=None``), see
+    :func:`_plain`: never a bare ``NaN``."""
+    return json.dumps(_plain(data), indent=indent, allow_nan=False)
 
 
 def write_json(path: Path, data: Any) -> Path:

@@ -1,0 +1,46 @@
+"""`deformap map`'s exit code says whether there is a map: 0 with one, 2 when no poke was usable
+(the report is still written, nothing lost); user text is printed as written, never as markup."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from typer.testing import CliRunner
+
+from deformap.cli import app
+
+runner = CliRunner()
+
+
+def test_a_session_with_no_usable_poke_exits_2_after_writing_its_report(
+    tmp_path: Path, synthetic, write_synthetic  # type: ignore[no-untyped-def]
+) -> None:
+    session = write_synthetic(tmp_path / "session", synthetic)
+    for cloud in (tmp_path / "session").glob("poke-0[0-9].pcd"):
+        cloud.unlink()
+    out = tmp_path / "map"
+    result = runner.invoke(app, ["map", str(session), "--out", str(out), "--no-figures"])
+    assert result.exit_code == 2, result.output
+    assert "error: no poke of the session" in result.output
+    assert "expected at least one, got 0 of 3" in result.output
+    report = json.loads((out / "report.json").read_text())
+    assert report["n_pokes"] == 0 and report["regions"] is None
+    assert len(report["warnings"]) == 3
+
+
+def test_a_session_with_usable_pokes_exits_0(tmp_path: Path, synthetic, write_synthetic) -> None:  # type: ignore[no-untyped-def]
+    session = write_synthetic(tmp_path / "session", synthetic)
+    result = runner.invoke(app, ["map", str(session), "--out", str(tmp_path / "map"),
+                                 "--no-figures"])
+    assert result.exit_code == 0, result.output
+
+
+def test_user_text_with_brackets_is_printed_as_written(tmp_path: Path) -> None:
+    for name in ("[red]nope[/red", "[bold]x[/bold]"):
+        result = runner.invoke(app, ["map", str(tmp_path / name), "--out", str(tmp_path / "o")])
+        assert result.exit_code == 2
+        assert f"{name}: no such session folder or file" in result.output, result.output
+    result = runner.invoke(app, ["world", "show", "[bold]x[/bold].yaml", "--out",
+                                 str(tmp_path / "w")])
+    assert result.exit_code == 2 and "'[bold]x[/bold].yaml'" in result.output, result.output
