@@ -35,6 +35,7 @@ __all__ = [
     "check_int",
     "check_points",
     "check_positive",
+    "check_rigid_transform",
     "check_settings",
     "check_slope_deg",
     "check_vector",
@@ -95,10 +96,8 @@ def check_array(
         raise InvalidArgumentError(
             f"`{name}` must be {expected}; got {describe(value)} that numpy cannot read ({exc})"
         ) from None
-    if arr.dtype == object or not (
-        np.issubdtype(arr.dtype, np.floating)
-        or np.issubdtype(arr.dtype, np.integer)
-        or arr.dtype == np.bool_
+    if arr.dtype == object or not (  # booleans are not numbers: a mask passed as points
+        np.issubdtype(arr.dtype, np.floating) or np.issubdtype(arr.dtype, np.integer)
     ):
         raise InvalidArgumentError(f"`{name}` must be {expected}; got dtype {arr.dtype}")
     if arr.ndim != len(shape) or any(
@@ -121,6 +120,19 @@ def check_array(
 def check_points(name: str, value: Any, *, min_rows: int = 1) -> NDArray[np.float64]:
     """Validate ``(n, 3)`` points in metres with at least ``min_rows`` rows."""
     return check_array(name, value, (None, 3), what="points (x, y, z) in metres", min_rows=min_rows)
+
+
+def check_rigid_transform(name: str, value: Any) -> NDArray[np.float64]:
+    """Validate a 4×4 homogeneous rigid transform: an orthonormal rotation with determinant +1
+    (to 1e-6), a finite translation, last row ``0 0 0 1``."""
+    mat = check_array(name, value, (4, 4), what="homogeneous transform entries")
+    rot = mat[:3, :3]
+    if not (np.allclose(mat[3], [0.0, 0.0, 0.0, 1.0], atol=1e-9)
+            and np.allclose(rot @ rot.T, np.eye(3), atol=1e-6) and np.linalg.det(rot) > 0):
+        raise InvalidArgumentError(
+            f"`{name}` must be a rigid transform (orthonormal rotation with det +1, last row "
+            f"0 0 0 1); got rotation det {np.linalg.det(rot):.3g}, last row {mat[3].tolist()}")
+    return mat
 
 
 def check_vector(name: str, value: Any, size: int, *, what: str = "floats") -> NDArray[np.float64]:

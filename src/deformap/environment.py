@@ -37,6 +37,7 @@ from deformap.mechanics import TactileContact
 __all__ = [
     "FORCE_MISMATCH_ABS_N",
     "FORCE_MISMATCH_REL",
+    "MAX_GRID_CELLS",
     "MAX_TRAVEL_M",
     "MIN_FORCE_RISE_N",
     "TRAVEL_BACKWARDS_TOLERANCE_M",
@@ -46,6 +47,12 @@ __all__ = [
     "TactileContact",
     "Workspace",
 ]
+
+
+#: Most cells of a :meth:`Workspace.grid`: 25 million float cells are 200 MB per map layer, far
+#: more than a table-top map needs (the exploration's own, smaller budget is in
+#: ``deformap.explore``); a spacing that asks for more is refused before any array exists.
+MAX_GRID_CELLS = 25_000_000
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -91,11 +98,16 @@ class Workspace:
         """Cell-centre coordinates ``(xs, ys)`` of a regular grid covering the rectangle.
 
         The grid has ``round(width / spacing)`` columns and ``round(depth / spacing)`` rows, so a
-        60×40 cm workspace at the paper's 0.5 cm gives 120×80 cells.
+        60×40 cm workspace at the paper's 0.5 cm gives 120×80 cells; more than
+        :data:`MAX_GRID_CELLS` are refused before anything is allocated.
         """
         step = check_positive("spacing_m", spacing_m)
         (x0, y0), (w, d) = self.lower, self.size
         nx, ny = max(1, round(w / step)), max(1, round(d / step))
+        if nx * ny > MAX_GRID_CELLS:
+            raise InvalidArgumentError(
+                f"`spacing_m` must give at most {MAX_GRID_CELLS:,} cells over the "
+                f"{w:g}×{d:g} m workspace; got {step:g} m ({nx:,}×{ny:,} cells)")
         xs = np.asarray(x0 + (np.arange(nx) + 0.5) * (w / nx), dtype=np.float64)
         ys = np.asarray(y0 + (np.arange(ny) + 0.5) * (d / ny), dtype=np.float64)
         return xs, ys

@@ -8,7 +8,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from deformap._validation import check_array, check_points
+from deformap._validation import check_array, check_points, check_rigid_transform
 from deformap.errors import InvalidArgumentError
 
 __all__ = ["PointCloud"]
@@ -88,12 +88,17 @@ class PointCloud:
             raise InvalidArgumentError(
                 f"`mask` must be booleans or integer indices; got dtype {index.dtype}"
             )
+        if index.dtype != np.bool_ and index.size and (
+                index.min() < -len(self) or index.max() >= len(self)):
+            raise InvalidArgumentError(
+                f"`mask` indices must lie in [-{len(self)}, {len(self) - 1}]; got "
+                f"{int(index.min())} to {int(index.max())}")
         colors = None if self.colors is None else self.colors[index]
         return PointCloud(self.points[index], colors, frame=self.frame)
 
     def transformed(self, a2b: Any, frame: str) -> PointCloud:
         """Apply the 4×4 rigid transform ``a2b`` and return the cloud in ``frame``."""
-        mat = check_array("a2b", a2b, (4, 4), what="homogeneous transform entries")
+        mat = check_rigid_transform("a2b", a2b)
         pts = self.points @ mat[:3, :3].T + mat[:3, 3]
         return PointCloud(pts, self.colors, frame=frame)
 

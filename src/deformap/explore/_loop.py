@@ -13,8 +13,10 @@ from functools import partial
 
 import numpy as np
 
+from deformap._validation import describe
 from deformap.cloud import PointCloud
 from deformap.environment import Environment, PressObservation, Workspace
+from deformap.errors import InvalidArgumentError
 from deformap.explore._config import ExplorationConfig
 from deformap.explore._journal import Journal
 from deformap.explore._mapper import Mapper
@@ -90,6 +92,26 @@ class MappingRun:
         return self.mapper.result(stop_reason, timings)
 
 
+def _check_arguments(env: object, config: object, rng: object, journal: object, done: object,
+                     on_poke: object) -> None:
+    """Refuse, naming the argument, what :func:`explore` cannot take (before any work)."""
+    expected = (
+        ("env", env, Environment, "an Environment (workspace, observe, press, release)"),
+        ("config", config, ExplorationConfig, "an ExplorationConfig"),
+        ("rng", rng, np.random.Generator, "a numpy.random.Generator"),
+    )
+    for name, value, kind, what in expected:
+        if not isinstance(value, kind):
+            raise InvalidArgumentError(f"`{name}` must be {what}; got {describe(value)}")
+    if journal is not None and not isinstance(journal, Journal):
+        raise InvalidArgumentError(f"`journal` must be a Journal or None; got {describe(journal)}")
+    if isinstance(done, (str, bytes)) or not isinstance(done, Sequence) or not all(
+            isinstance(r, PokeRecord) for r in done):
+        raise InvalidArgumentError(f"`done` must be a sequence of PokeRecord; got {describe(done)}")
+    if on_poke is not None and not callable(on_poke):
+        raise InvalidArgumentError(f"`on_poke` must be callable or None; got {describe(on_poke)}")
+
+
 def explore(
     env: Environment,
     config: ExplorationConfig,
@@ -119,6 +141,7 @@ def explore(
     on_poke : callable, optional
         Called after each new poke (progress display).
     """
+    _check_arguments(env, config, rng, journal, done, on_poke)
     streams = rng.spawn(config.max_pokes + 1)
     run = MappingRun(env.workspace, config, env.observe, streams[0])
     mapper = run.mapper

@@ -34,6 +34,19 @@ _LOG = logging.getLogger(__name__)
 AUTO_EXACT_MAX_POINTS = 1000
 _METHODS = ("auto", "exact", "grid")
 
+#: Range of every hyperparameter and per-point noise (in its own units). Their squares and
+#: ratios then stay far inside double precision (about 1e±308): outside it the covariance
+#: overflows to infinity or underflows to a singular matrix and predictions turn to NaN.
+HYPERPARAMETER_RANGE = (1e-12, 1e12)
+
+
+def _hyperparameter(name: str, value: Any) -> float:
+    out = check_positive(name, value)
+    lo, hi = HYPERPARAMETER_RANGE
+    if not lo <= out <= hi:
+        raise InvalidArgumentError(f"`{name}` must lie in [{lo:g}, {hi:g}]; got {out:g}")
+    return out
+
 
 class GaussianRandomField:
     """GP regression of a scalar field z(x, y) with the paper's squared-exponential kernel.
@@ -97,9 +110,9 @@ class GaussianRandomField:
         jitter: float = 1e-10,
         max_jitter: float = 1e-4,
     ) -> None:
-        self.length_scale = check_positive("length_scale", length_scale)
-        self.signal_std = check_positive("signal_std", signal_std)
-        self.noise_std = check_positive("noise_std", noise_std)
+        self.length_scale = _hyperparameter("length_scale", length_scale)
+        self.signal_std = _hyperparameter("signal_std", signal_std)
+        self.noise_std = _hyperparameter("noise_std", noise_std)
         if method not in _METHODS:
             raise InvalidArgumentError(
                 f"`method` must be one of {_METHODS}; got {describe(method)}"
@@ -194,12 +207,13 @@ class GaussianRandomField:
         if noise_std is None:
             return np.full(n, self.noise_std)
         if np.ndim(noise_std) == 0:
-            return np.full(n, check_positive("noise_std", noise_std))
+            return np.full(n, _hyperparameter("noise_std", noise_std))
         noise = check_array("noise_std", noise_std, (n,), what="noise standard deviations")
-        if np.any(noise <= 0):
+        lo, hi = HYPERPARAMETER_RANGE
+        if np.any(noise < lo) or np.any(noise > hi):
             raise InvalidArgumentError(
-                f"`noise_std` must be > 0 everywhere; got minimum {noise.min():g}"
-            )
+                f"`noise_std` must lie in [{lo:g}, {hi:g}] everywhere; got {noise.min():g} to "
+                f"{noise.max():g}")
         return noise
 
     # --------------------------------------------------------------- prediction
