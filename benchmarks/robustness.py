@@ -4,7 +4,8 @@
     python benchmarks/robustness.py --mutants 300 --seed 1  # a quick run
 
 Templates (a small cloud as PCD ascii/binary/binary_compressed, PLY ascii/binary, NPZ, and a
-folder session written by ``write_session``, plus an MCAP session when ``rosbags`` is installed)
+folder session written by ``write_session``, plus MCAP and sqlite3 sessions when ``rosbags`` is
+installed)
 are mutated by seeded byte flips, truncations, appended bytes, header field edits and point-count
 changes (and, for NPZ, the same inside a member, plus edits of its .npy header and shape, with
 the member's zip CRC made to match; for sessions,
@@ -127,8 +128,9 @@ def make_templates(root: Path) -> dict[str, Path]:
         import rosbags  # noqa: F401
     except ImportError:
         return out
-    out["session-mcap"] = write_session(root / "session-mcap", format="mcap",
-                                        **_session_parts()).parent  # fmt: skip
+    for storage in ("mcap", "sqlite3"):
+        out[f"session-{storage}"] = write_session(root / f"session-{storage}", format=storage,
+                                                  **_session_parts()).parent  # fmt: skip
     return out
 
 

@@ -75,6 +75,10 @@ def _read_member(path: Path, archive: zipfile.ZipFile, info: zipfile.ZipInfo) ->
                 f"{path}: NPZ member {info.filename!r} holds Python objects (dtype {dtype}), "
                 "which would need pickle; refused"
             )
+        if any(int(n) < 0 for n in shape):
+            raise FileFormatError(
+                f"{path}: NPZ member {info.filename!r}: expected a shape of sizes >= 0, got {shape}"
+            )
         need = math.prod(int(n) for n in shape) * dtype.itemsize
         what = f"NPZ member {info.filename!r} of shape {shape} × {dtype.itemsize} bytes"
         check_body_size(path, what, need, info.file_size - fh.tell())
