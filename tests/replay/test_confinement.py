@@ -56,6 +56,20 @@ def test_names_outside_the_folder_fail_the_load(folder: Path, key: str, value: s
         load_session(folder)
 
 
+def test_a_name_that_cannot_be_resolved_is_refused_by_name(folder: Path) -> None:
+    doc = _unsealed(folder)
+    doc["observation"] = "obs\x00ervation.pcd"
+    _save(folder, doc)
+    with pytest.raises(ConfigError, match=r"`observation` is 'obs\\x00ervation\.pcd', which "
+                                          r"cannot be resolved: embedded null byte"):
+        load_session(folder)
+    os.symlink("loop", folder / "loop")
+    doc["observation"] = "loop"
+    _save(folder, doc)
+    with pytest.raises(ConfigError, match=r"`observation` is 'loop', which cannot be resolved"):
+        load_session(folder)
+
+
 def test_a_link_out_of_the_folder_is_refused_and_one_inside_is_read(folder: Path,
                                                                      tmp_path: Path) -> None:
     outside = tmp_path / "elsewhere.pcd"

@@ -47,8 +47,8 @@ def confined_path(where: str, value: Any, root: Path) -> Path:
     path = root / name
     try:
         real, base = path.resolve(), root.resolve()
-    except (OSError, RuntimeError) as exc:  # a link loop, a name the system refuses
-        raise ConfigError(f"{where} is {value!r}, which cannot be resolved: {exc}") from None
+    except (OSError, RuntimeError, ValueError) as exc:  # a link loop, a NUL, a name too long
+        raise ConfigError(f"{where} is {value!r:.120}, which cannot be resolved: {exc}") from None
     if not real.is_relative_to(base):
         raise ConfigError(
             f"{where} is {value!r}, a link to {str(real)!r}, outside the session folder; {_RULE}"
