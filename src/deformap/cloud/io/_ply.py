@@ -3,7 +3,9 @@
 The ``vertex`` element must carry ``x``, ``y`` and ``z``; ``red``, ``green``, ``blue`` become the
 cloud's colours and every other scalar vertex property comes back as an extra field. Other elements
 (faces, ...) are skipped when they follow the vertices, or, in binary files, when they precede them
-and have no list properties.
+and have no list properties. In a binary file every byte after the header must belong to a declared
+element (the elements after the vertices are walked to their end): a vertex count lowered by a
+corruption is refused, not read as fewer points.
 
 References
 ----------
