@@ -256,7 +256,8 @@ def test_missing_xyz_fields_are_named(tmp_path: Path) -> None:
 def test_pickled_npz_is_refused(tmp_path: Path) -> None:
     path = tmp_path / "pickled.npz"
     np.savez(path, points=np.array([object(), 1], dtype=object))
-    with pytest.raises(FileFormatError, match=r"pickled\.npz: could not read .*allow_pickle"):
+    with pytest.raises(FileFormatError,
+                       match=r"pickled\.npz: NPZ member 'points\.npy' holds Python objects"):
         read_cloud(path)
 
 
@@ -324,7 +325,7 @@ def test_truncated_ply_and_compressed_pcd_name_the_problem(tmp_path: Path) -> No
     write_pcd(path, PointCloud(np.tile([0.1, 0.2, 0.3], (500, 1))), encoding="binary_compressed")
     assert b"DATA binary_compressed" in path.read_bytes()
     path.write_bytes(path.read_bytes()[:-10])
-    with pytest.raises(FileFormatError, match=r"t\.pcd: binary_compressed sizes do not match"):
+    with pytest.raises(FileFormatError, match=r"t\.pcd: binary_compressed body .*truncated"):
         read_cloud(path)
 
 

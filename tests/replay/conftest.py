@@ -71,10 +71,15 @@ def synthetic() -> Synthetic:
     return make_synthetic()
 
 
-def write_synthetic(folder: Path, syn: Synthetic, **kwargs: object) -> Path:
+def write_synthetic(folder: Path, syn: Synthetic, *, sealed: bool = True,
+                    **kwargs: object) -> Path:  # fmt: skip
+    """``write_session`` of ``syn``; ``sealed=False`` drops ``n_pokes`` and the ``sha256``
+    manifest, as for a session whose files a test then edits by hand."""
+    import yaml
+
     from deformap.replay import write_session
 
-    return write_session(
+    file = write_session(
         folder,
         workspace=syn.workspace,
         observation=syn.observation,
@@ -82,6 +87,11 @@ def write_synthetic(folder: Path, syn: Synthetic, **kwargs: object) -> Path:
         ground_truth=syn.truth,
         **kwargs,
     )  # type: ignore[arg-type]
+    if not sealed:
+        doc = yaml.safe_load(file.read_text())
+        del doc["n_pokes"], doc["sha256"]
+        file.write_text(yaml.safe_dump(doc, sort_keys=False))
+    return file
 
 
 @pytest.fixture(name="write_synthetic", scope="session")

@@ -92,7 +92,7 @@ def _write_variant(
 
 @pytest.fixture
 def bag_session(tmp_path: Path, synthetic, write_synthetic) -> Path:  # type: ignore[no-untyped-def]
-    return write_synthetic(tmp_path / "s", synthetic, format="mcap").parent  # type: ignore[no-any-return]
+    return write_synthetic(tmp_path / "s", synthetic, format="mcap", sealed=False).parent  # type: ignore[no-any-return]
 
 
 def _replace_bag(folder: Path, syn: Any, **kwargs: Any) -> None:

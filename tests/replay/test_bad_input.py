@@ -20,7 +20,7 @@ Edit = Callable[[dict[str, Any]], None]
 
 @pytest.fixture
 def folder(tmp_path: Path, synthetic, write_synthetic) -> Path:  # type: ignore[no-untyped-def]
-    return write_synthetic(tmp_path / "s", synthetic).parent  # type: ignore[no-any-return]
+    return write_synthetic(tmp_path / "s", synthetic, sealed=False).parent  # type: ignore[no-any-return]
 
 
 def _edit(folder: Path, change: Edit) -> None:

@@ -85,7 +85,7 @@ def test_session_yaml_is_documented_shape(tmp_path: Path, synthetic, write_synth
 
 
 def test_camera_frame_folder_is_mapped_to_world(tmp_path: Path, synthetic, write_synthetic) -> None:
-    file = write_synthetic(tmp_path / "s", synthetic)
+    file = write_synthetic(tmp_path / "s", synthetic, sealed=False)
     rng = np.random.default_rng(4)
     cam2world = np.eye(4)
     cam2world[:3, :3] = Rotation.random(random_state=rng).as_matrix()
@@ -118,7 +118,7 @@ def test_inline_robot_points(tmp_path: Path, synthetic, write_synthetic) -> None
 
 
 def test_millimetre_session(tmp_path: Path, synthetic, write_synthetic) -> None:
-    file = write_synthetic(tmp_path / "s", synthetic)
+    file = write_synthetic(tmp_path / "s", synthetic, sealed=False)
     folder = file.parent
     mm = PointCloud(synthetic.presses[0].cloud.points * 1e3)
     write_cloud(folder / "poke-01.pcd", mm)

@@ -34,8 +34,10 @@ from deformap.cloud.io import (
 )
 from deformap.environment import ForceTravel, PressObservation
 from deformap.errors import DeformapError, FileFormatError
+from deformap.replay._confine import check_bag_confined
 from deformap.replay._folder import PressParts
 from deformap.replay._format import OPTIONAL_TOPICS, TOPICS, PokeSpec, SessionHeader
+from deformap.replay._manifest import verify_digest
 
 #: Labels of the record's two dimensions in its ``Float64MultiArray`` layout.
 FORCE_TRAVEL_DIMS = ("samples", "travel_m,force_n")
@@ -62,6 +64,9 @@ class BagReader:
         self.path = header.bag
         if path_kind(self.path) == "missing":
             raise FileFormatError(f"{self.path}: no such bag (the session's `bag`)")
+        for file in check_bag_confined(self.path):
+            if path_kind(file) == "file":  # a missing one: rosbags names it
+                verify_digest(header, file)
         self._raw = self._index()
         self._decoded: dict[str, dict[int, Any]] | None = None
         self._undecodable: dict[str, list[str]] = {}

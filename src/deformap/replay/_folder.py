@@ -13,6 +13,7 @@ from deformap.cloud.io import path_kind, read_cloud
 from deformap.environment import ForceTravel
 from deformap.errors import FileFormatError
 from deformap.replay._format import PokeSpec, SessionHeader
+from deformap.replay._manifest import verify_digest
 
 __all__ = ["FolderReader", "PressParts"]
 
@@ -62,9 +63,9 @@ class FolderReader:
         assert robot is not None
         return PressParts(cloud, spec.tip_center, spec.force, robot, spec.force_travel)
 
-    @staticmethod
-    def _path(path: Path | None) -> Path:
+    def _path(self, path: Path | None) -> Path:
         assert path is not None
         if path_kind(path) != "file":
             raise FileFormatError(f"{path}: no such file")
+        verify_digest(self.header, path)
         return path

@@ -12,7 +12,9 @@ Keys are checked in two tiers, so that one broken poke does not hide the others:
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import logging
+import re
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -23,6 +25,7 @@ from deformap._validation import check_array, check_int, check_positive, check_v
 from deformap.cloud.io import UNITS
 from deformap.environment import ForceTravel, Workspace
 from deformap.errors import ConfigError, DeformapError
+from deformap.replay._confine import confined_path
 
 __all__ = [
     "FORMAT_NAME",
@@ -34,6 +37,8 @@ __all__ = [
     "SessionHeader",
     "parse_session_yaml",
 ]
+
+logger = logging.getLogger(__name__)
 
 FORMAT_NAME = "deformap-session"
 FORMAT_VERSION = 1
@@ -56,7 +61,8 @@ OPTIONAL_TOPICS = {
 }
 
 _TOP_REQUIRED = {"format", "version", "workspace", "probe", "pokes"}
-_TOP_OPTIONAL = {"units", "frame", "cam2world", "ground_truth", "source", "observation", "bag"}
+_TOP_OPTIONAL = {"units", "frame", "cam2world", "ground_truth", "source", "observation", "bag",
+                 "n_pokes", "sha256"}
 _FOLDER_POKE_KEYS = {"cloud", "tip_center", "force", "target_xy", "force_n", "robot_points"}
 _FOLDER_POKE_OPTIONAL = {"force_travel"}
 _FORCE_TRAVEL_KEYS = {"travel_m", "force_n"}
@@ -126,6 +132,9 @@ class SessionHeader:
     source : dict
         Free-form provenance (scenario, seed, deformap version), copied into reports.
     pokes : tuple of PokeSpec
+    sha256 : dict of Path to str
+        The manifest: each listed file's SHA-256 (hex), checked when the file is read. Empty
+        when ``session.yaml`` has none (sessions not written by ``record-sim``).
     """
 
     root: Path
@@ -140,6 +149,7 @@ class SessionHeader:
     ground_truth: Path | None
     source: dict[str, Any]
     pokes: tuple[PokeSpec, ...]
+    sha256: dict[Path, str] = field(default_factory=dict)
 
 
 def _where(file: Path, key: str) -> str:
@@ -170,10 +180,7 @@ def _value(file: Path, key: str, check: Any, *args: Any, **kwargs: Any) -> Any:
 
 
 def _file_name(file: Path, key: str, value: Any, root: Path) -> Path:
-    if not isinstance(value, str) or not value.strip():
-        raise ConfigError(f"{_where(file, key)} must be a file name (a string); got {value!r}")
-    path = Path(value)
-    return path if path.is_absolute() else root / path
+    return confined_path(_where(file, key), value, root)
 
 
 def _cam2world(file: Path, data: dict[str, Any], frame: str, form: str) -> Any:
@@ -216,7 +223,12 @@ def _poke(file: Path, index: int, data: Any, form: str, root: Path) -> PokeSpec:
                         set())  # fmt: skip
     else:
         _check_keys(file, key, data, _BAG_POKE_KEYS, set())
-    # Schema problems (above) fail the file; value problems (below) fail only this poke.
+    # Schema problems and names outside the session folder (above) fail the file; value
+    # problems (below) fail only this poke.
+    if form == "folder":
+        for name in ("cloud", "robot_points"):
+            if isinstance(data[name], str):
+                _file_name(file, f"{key}.{name}", data[name], root)
     try:
         target = _value(file, f"{key}.target_xy", check_vector, data["target_xy"], 2, what="metres")
         force_n = _value(file, f"{key}.force_n", check_positive, data["force_n"])
@@ -310,6 +322,8 @@ def parse_session_yaml(data: Any, file: Path) -> SessionHeader:
     pokes = data["pokes"]
     if not isinstance(pokes, list):
         raise ConfigError(f"{_where(file, 'pokes')} must be a list; got {type(pokes).__name__}")
+    _check_poke_count(file, data, pokes)
+    digests = _manifest(file, data.get("sha256"), root)
     truth = data.get("ground_truth")
     specs = [_poke(file, i, p, form, root) for i, p in enumerate(pokes)]
     return SessionHeader(
@@ -319,8 +333,50 @@ def parse_session_yaml(data: Any, file: Path) -> SessionHeader:
         bag=_file_name(file, "bag", data["bag"], root) if has_bag else None,
         ground_truth=None if truth is None else _file_name(file, "ground_truth", truth, root),
         source={str(k): v for k, v in source.items()},
-        pokes=tuple(_unique_stamps(file, specs)),
+        pokes=tuple(_unique_stamps(file, specs)), sha256=digests,
     )  # fmt: skip
+
+
+def _check_poke_count(file: Path, data: dict[str, Any], pokes: list[Any]) -> None:
+    """``n_pokes``, when given, must equal the entries of ``pokes``: a file cut at a poke
+    boundary is still valid YAML, and must not load as fewer pokes."""
+    if "n_pokes" not in data:
+        logger.info("%s: no `n_pokes`; cannot check that the poke list is complete", file)
+        return
+    count = data["n_pokes"]
+    if not isinstance(count, int) or isinstance(count, bool) or count < 0:
+        raise ConfigError(
+            f"{_where(file, 'n_pokes')} must be a whole number >= 0; got {count!r}"
+        )
+    if count != len(pokes):
+        raise ConfigError(
+            f"{_where(file, 'n_pokes')} is {count} but `pokes` lists {len(pokes)} entries; "
+            "the file was cut or edited"
+        )
+
+
+_HEX64 = re.compile(r"[0-9a-f]{64}")
+
+
+def _manifest(file: Path, raw: Any, root: Path) -> dict[Path, str]:
+    """The ``sha256`` manifest: file name (inside the session folder) → lowercase hex digest."""
+    if raw is None:
+        return {}
+    if not isinstance(raw, dict) or not raw:
+        raise ConfigError(
+            f"{_where(file, 'sha256')} must be a non-empty mapping of file name to SHA-256; "
+            f"got {raw!r:.80}"
+        )
+    out = {}
+    for name, digest in raw.items():
+        key = f"sha256[{name!r}]"
+        path = confined_path(_where(file, key), name, root)
+        if not isinstance(digest, str) or not _HEX64.fullmatch(digest):
+            raise ConfigError(
+                f"{_where(file, key)} must be 64 lowercase hex digits; got {digest!r:.80}"
+            )
+        out[path] = digest
+    return out
 
 
 def _unique_stamps(file: Path, specs: list[PokeSpec]) -> list[PokeSpec]:

@@ -25,6 +25,7 @@ from deformap.errors import DeformapError, FileFormatError, InvalidArgumentError
 from deformap.replay._bagform import BagReader
 from deformap.replay._folder import FolderReader
 from deformap.replay._format import SESSION_FILE, SessionHeader, parse_session_yaml
+from deformap.replay._manifest import verify_digest
 from deformap.replay._truth import GroundTruth, read_ground_truth
 
 __all__ = ["DEFAULT_CONTACT_GAP_M", "RecordedSession", "check_contact_gap", "load_session"]
@@ -206,7 +207,11 @@ def load_session(
     data = _read_yaml(file)
     header = parse_session_yaml(data, file)
     reader = FolderReader(header) if header.form == "folder" else BagReader(header)
-    truth = None if header.ground_truth is None else read_ground_truth(header.ground_truth)
+    truth = None
+    if header.ground_truth is not None:
+        if path_kind(header.ground_truth) == "file":
+            verify_digest(header, header.ground_truth)
+        truth = read_ground_truth(header.ground_truth)
     broken = [p.index for p in header.pokes if p.error is not None]
     if broken:
         logger.warning("%s: poke(s) %s have bad entries and will be refused", file, broken)

@@ -16,6 +16,7 @@ from deformap.environment import PressObservation, Workspace
 from deformap.errors import InvalidArgumentError
 from deformap.replay._bagform import write_session_bag
 from deformap.replay._format import FORMAT_NAME, FORMAT_VERSION, SESSION_FILE
+from deformap.replay._manifest import manifest_of
 from deformap.replay._truth import GroundTruth, write_ground_truth
 
 __all__ = ["SESSION_FORMATS", "write_session"]
@@ -117,6 +118,9 @@ def write_session(
 ) -> Path:
     """Write a session that :func:`load_session` reads back exactly.
 
+    ``session.yaml`` is written last, with ``n_pokes`` and the ``sha256`` manifest of every file
+    written before it (see ``docs/recording-format.md``).
+
     Parameters
     ----------
     folder : str or Path
@@ -163,7 +167,7 @@ def write_session(
     if format == "folder":
         doc["observation"] = f"observation.{cloud_format}"
         write_cloud(out / doc["observation"], observation)
-        doc["pokes"] = []
+        pokes = []
         for i, obs in enumerate(presses, start=1):
             cloud, robot = f"poke-{i:02d}.{cloud_format}", f"poke-{i:02d}-robot.{cloud_format}"
             write_cloud(out / cloud, obs.cloud)
@@ -176,16 +180,20 @@ def write_session(
             if obs.force_travel is not None:
                 entry["force_travel"] = {"travel_m": _floats(obs.force_travel.travel_m),
                                          "force_n": _floats(obs.force_travel.force_n)}
-            doc["pokes"].append(entry)
+            pokes.append(entry)
     else:
         stamps = [(i + 1) * _STAMP_STEP_NS for i in range(len(presses))]
         write_session_bag(out / "bag", storage=format, observation=observation,
                           presses=presses, stamps_ns=stamps)  # fmt: skip
         doc["bag"] = "bag"
-        doc["pokes"] = [
+        pokes = [
             {"stamp_ns": s, "target_xy": _floats(o.target_xy), "force_n": float(o.force_n)}
             for s, o in zip(stamps, presses, strict=True)
         ]
+    # The count and the manifest come before the pokes: a file cut in its poke list keeps them.
+    doc["n_pokes"] = len(pokes)
+    doc["sha256"] = manifest_of(out, (p for p in out.rglob("*") if p.is_file()))
+    doc["pokes"] = pokes
     file = out / SESSION_FILE
     file.write_text(yaml.dump(doc, Dumper=_Dumper, sort_keys=False), encoding="utf-8")
     return file

@@ -5,12 +5,16 @@ files, missing x/y/z, NaN points (unless ``drop_nan=True``), empty clouds, and c
 millimetres (unless ``units="mm"``). Every refusal is a :class:`~deformap.errors.FileFormatError`
 that names the file and what was wrong. No file is ever read with pickle.
 
+Every size a header declares (a point count, a record size, a compressed length, an array's
+shape) is checked against the bytes present before anything is allocated, and a binary body that
+holds more data than its header declares is refused, not cut (``_common.check_body_size``).
+
 Formats: PCD (ascii, binary, binary_compressed; through pypcd4), PLY (ascii, binary either byte
-order; numpy), NPZ (``points``, ``colors``), and ROS 2 bags (sqlite3 and MCAP; through the optional
-``rosbags``, extra ``ros``) with ``sensor_msgs/msg/PointCloud2`` and
-``geometry_msgs/msg/WrenchStamped``. :func:`iter_bag_messages` is the one place a bag is opened
-and read, :func:`bag_writer` the one place one is written; :func:`pointcloud2_to_cloud` turns a
-message into a cloud under the file readers' rules.
+order; numpy), NPZ (``points``, ``colors``; at most :data:`MAX_NPZ_BYTES` once decompressed), and
+ROS 2 bags (sqlite3 and MCAP; through the optional ``rosbags``, extra ``ros``) with
+``sensor_msgs/msg/PointCloud2`` and ``geometry_msgs/msg/WrenchStamped``. :func:`iter_bag_messages`
+is the one place a bag is opened and read, :func:`bag_writer` the one place one is written;
+:func:`pointcloud2_to_cloud` turns a message into a cloud under the file readers' rules.
 """
 
 from __future__ import annotations
@@ -29,7 +33,7 @@ from deformap.cloud.io._bag import (
 from deformap.cloud.io._bag_writer import bag_writer, wrench_message, write_bag
 from deformap.cloud.io._common import MM_EXTENT_THRESHOLD, UNITS, path_kind
 from deformap.cloud.io._dispatch import CLOUD_FORMATS, read_cloud, write_cloud
-from deformap.cloud.io._npz import load_npz_arrays, read_npz, write_npz
+from deformap.cloud.io._npz import MAX_NPZ_BYTES, load_npz_arrays, read_npz, write_npz
 from deformap.cloud.io._pcd import PCD_ENCODINGS, read_pcd, write_pcd
 from deformap.cloud.io._ply import PLY_FORMATS, read_ply, write_ply
 from deformap.cloud.io._pointcloud2 import (
@@ -43,6 +47,7 @@ from deformap.cloud.io._ros import ROS_DISTRO, typestore
 __all__ = [
     "BAG_STORAGES",
     "CLOUD_FORMATS",
+    "MAX_NPZ_BYTES",
     "MM_EXTENT_THRESHOLD",
     "PCD_ENCODINGS",
     "PLY_FORMATS",

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import logging
 import struct
+import tokenize
 import zipfile
 import zlib
 from collections.abc import Iterator
@@ -25,6 +26,7 @@ from deformap.errors import DeformapError, FileFormatError, InvalidArgumentError
 __all__ = [
     "MM_EXTENT_THRESHOLD",
     "UNITS",
+    "check_body_size",
     "check_units",
     "finish_cloud",
     "parse_errors",
@@ -60,7 +62,16 @@ _PARSE_ERRORS: tuple[type[BaseException], ...] = (
     zipfile.BadZipFile,
     zlib.error,
     OSError,
+    SyntaxError,  # ast.literal_eval of a malformed .npy header
+    tokenize.TokenError,  # the same, when the header's brackets do not close
 )
+
+# Bytes of ascii numbers and their separators: a body made only of these is text.
+_TEXT_BYTES = frozenset(b"0123456789+-.eEnaifNAIF \t\r\n")
+# A binary body at least this long and made only of those bytes is an ascii body under a binary
+# header: random float bits fall in that set with probability 27/256 per byte, so 16 bytes of real
+# binary data are all in it with probability below 1e-15.
+_TEXT_MIN_BYTES = 16
 
 
 def check_units(units: Any) -> float:
@@ -68,6 +79,60 @@ def check_units(units: Any) -> float:
     if not isinstance(units, str) or units not in UNITS:
         raise InvalidArgumentError(f"`units` must be one of {sorted(UNITS)}; got {units!r}")
     return UNITS[units]
+
+
+def check_body_size(
+    path: Path,
+    what: str,
+    need: int,
+    body: bytes | memoryview | int,
+    *,
+    exact: bool = True,
+    text: bool = False,
+) -> None:
+    """Refuse a data section whose size disagrees with what its header declares.
+
+    Every reader calls this with the byte count its header implies (a count times a record size,
+    both plain Python integers) *before* it allocates anything for the data, so that a forged
+    count cannot ask for gigabytes, a truncated file is refused, and (``exact``) a count lowered
+    by a corruption does not silently drop the surplus. Surplus bytes that are all ASCII
+    whitespace are tolerated (some writers end the file with a newline).
+
+    Parameters
+    ----------
+    path : Path
+        Named in the message.
+    what : str
+        The section and the header fields behind ``need`` (``"binary body of POINTS 50 × 24
+        bytes"``).
+    need : int
+        Bytes the header declares.
+    body : bytes or int
+        The bytes present for that section (to the end of the file), or only their number
+        (then any surplus is refused).
+    exact : bool
+        Refuse surplus bytes too (else only a shortfall).
+    text : bool
+        The section is text (an ascii body). A binary section made only of the bytes of ascii
+        numbers is refused as an ascii body under a binary header.
+    """
+    have = body if isinstance(body, int) else len(body)
+    if (not text and not isinstance(body, int) and have >= _TEXT_MIN_BYTES
+            and _TEXT_BYTES.issuperset(bytes(body[:4096]))):  # fmt: skip
+        raise FileFormatError(
+            f"{path}: {what}: expected {need} bytes of binary data, got {have} bytes of text "
+            "(an ascii body under a binary header?)"
+        )
+    if have < need:
+        raise FileFormatError(
+            f"{path}: {what}: expected {need} bytes, the file holds {have}; the file is "
+            "truncated or the header's count is wrong"
+        )
+    if exact and have > need and (isinstance(body, int) or bytes(body[need:]).strip()):
+        raise FileFormatError(
+            f"{path}: {what}: expected {need} bytes, the file holds {have} ({have - need} "
+            "more); the header's count is too low or the file is corrupted"
+        )
 
 
 def path_kind(path: str | Path) -> str:

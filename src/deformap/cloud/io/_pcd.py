@@ -21,7 +21,13 @@ import numpy as np
 from numpy.typing import NDArray
 
 from deformap.cloud._pointcloud import PointCloud
-from deformap.cloud.io._common import check_units, finish_cloud, parse_errors, readable_path
+from deformap.cloud.io._common import (
+    check_body_size,
+    check_units,
+    finish_cloud,
+    parse_errors,
+    readable_path,
+)
 from deformap.errors import FileFormatError, InvalidArgumentError
 
 __all__ = ["PCD_ENCODINGS", "read_pcd", "write_pcd"]
@@ -46,6 +52,12 @@ def _split_header(data: bytes) -> tuple[list[str], int]:
 
 
 def _check_header_against_body(path: Path, meta: Any, body: bytes) -> None:
+    """Check every size the header declares against the body, before anything is allocated.
+
+    pypcd4 builds one numpy field per ``COUNT`` element and allocates ``POINTS`` records, so the
+    record size is computed here from ``SIZE`` × ``COUNT`` (Python integers) and checked against
+    the bytes present first: a ``COUNT 1000000000`` or a forged ``POINTS`` is refused at once.
+    """
     n_fields = len(meta.fields)
     if not (len(meta.size) == len(meta.type) == len(meta.count) == n_fields):
         raise FileFormatError(
@@ -57,30 +69,38 @@ def _check_header_against_body(path: Path, meta: Any, body: bytes) -> None:
             f"{path}: header says POINTS {meta.points} but WIDTH×HEIGHT is "
             f"{meta.width}×{meta.height}"
         )
-    itemsize = meta.build_dtype().itemsize
+    if meta.points == 0:
+        raise FileFormatError(f"{path}: header says POINTS 0: the cloud is empty")
+    bad_size = [s for s in meta.size if s not in (1, 2, 4, 8)]
+    if bad_size:
+        raise FileFormatError(f"{path}: header SIZE must be 1, 2, 4 or 8; got {bad_size[0]}")
+    values = sum(meta.count)
+    itemsize = sum(s * c for s, c in zip(meta.size, meta.count, strict=True))
     need = meta.points * itemsize
     encoding = meta.data.value
-    if encoding == "binary" and len(body) < need:
+    what = f"{encoding} body of POINTS {meta.points} × {itemsize} bytes"
+    if encoding == "ascii":
+        # Each value takes at least one character and one separator.
+        check_body_size(path, f"ascii body of POINTS {meta.points} × {values} values",
+                        meta.points * values, body, exact=False, text=True)  # fmt: skip
+        return
+    if encoding == "binary":
+        check_body_size(path, what, need, body)
+        return
+    if len(body) < 8:
         raise FileFormatError(
-            f"{path}: binary body holds {len(body)} bytes but {meta.points} points of "
-            f"{itemsize} bytes need {need}; the file is truncated"
+            f"{path}: {encoding} body: expected 8 bytes of sizes, the file holds {len(body)}"
         )
-    if encoding.startswith("binary") and encoding != "binary" and meta.points:
-        if len(body) < 8:
-            raise FileFormatError(f"{path}: binary_compressed body is truncated (no size words)")
-        compressed, uncompressed = struct.unpack("II", body[:8])
-        # An LZF back-reference of 3 bytes expands to at most 264: a ratio above 88 is corrupt,
-        # and checking it first keeps a forged size from allocating gigabytes.
-        if uncompressed != need or compressed > len(body) - 8 or uncompressed > 100 * compressed:
-            raise FileFormatError(
-                f"{path}: binary_compressed sizes do not match the header: {compressed} "
-                f"compressed bytes (file holds {len(body) - 8}) and {uncompressed} uncompressed "
-                f"(header needs {need})"
-            )
-    if encoding == "ascii" and meta.points > len(body):
+    compressed, uncompressed = struct.unpack("<II", body[:8])
+    # An LZF back-reference of 3 bytes expands to at most 264: a ratio above 88 is corrupt,
+    # and checking it first keeps a forged size from allocating gigabytes.
+    if uncompressed != need or uncompressed > 100 * compressed:
         raise FileFormatError(
-            f"{path}: header says POINTS {meta.points} but the ascii body has {len(body)} bytes"
+            f"{path}: {what}: expected {need} uncompressed bytes, the size word says "
+            f"{uncompressed} (from {compressed} compressed)"
         )
+    check_body_size(path, f"{encoding} body of {compressed} compressed bytes + 8 size bytes",
+                    compressed + 8, body)  # fmt: skip
 
 
 def _decode_rgb(values: NDArray[Any], ascii: bool) -> NDArray[np.uint8]:

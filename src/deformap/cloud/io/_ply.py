@@ -3,7 +3,9 @@
 The ``vertex`` element must carry ``x``, ``y`` and ``z``; ``red``, ``green``, ``blue`` become the
 cloud's colours and every other scalar vertex property comes back as an extra field. Other elements
 (faces, ...) are skipped when they follow the vertices, or, in binary files, when they precede them
-and have no list properties.
+and have no list properties. In a binary file every byte after the header must belong to a declared
+element (the elements after the vertices are walked to their end): a vertex count lowered by a
+corruption is refused, not read as fewer points.
 
 References
 ----------
@@ -21,7 +23,13 @@ import numpy as np
 from numpy.typing import NDArray
 
 from deformap.cloud._pointcloud import PointCloud
-from deformap.cloud.io._common import check_units, finish_cloud, parse_errors, readable_path
+from deformap.cloud.io._common import (
+    check_body_size,
+    check_units,
+    finish_cloud,
+    parse_errors,
+    readable_path,
+)
 from deformap.cloud.io._pcd import _check_cloud_and_extras
 from deformap.errors import FileFormatError, InvalidArgumentError
 
@@ -47,6 +55,8 @@ class _Element:
     count: int
     props: list[tuple[str, str]] = field(default_factory=list)  # (name, numpy type code)
     has_list: bool = False
+    # Every property in order: (numpy code of a list's count, or "", numpy code of the values).
+    layout: list[tuple[str, str]] = field(default_factory=list)
 
 
 def _parse_header(path: Path, data: bytes) -> tuple[str, list[_Element], int]:
@@ -64,10 +74,14 @@ def _parse_header(path: Path, data: bytes) -> tuple[str, list[_Element], int]:
             fmt = words[1]
         elif words[0] == "element" and len(words) == 3 and words[2].isdigit():
             elements.append(_Element(words[1], int(words[2])))
-        elif words[0] == "property" and elements and len(words) == 5 and words[1] == "list":
+        elif (words[0] == "property" and elements and len(words) == 5 and words[1] == "list"
+              and words[2] in _PLY_TYPES and words[3] in _PLY_TYPES
+              and _PLY_TYPES[words[2]][0] in "iu"):  # fmt: skip
             elements[-1].has_list = True
+            elements[-1].layout.append((_PLY_TYPES[words[2]], _PLY_TYPES[words[3]]))
         elif words[0] == "property" and elements and len(words) == 3 and words[1] in _PLY_TYPES:
             elements[-1].props.append((words[2], _PLY_TYPES[words[1]]))
+            elements[-1].layout.append(("", _PLY_TYPES[words[1]]))
         else:
             raise FileFormatError(f"{path}: PLY header line {number} not understood: {raw!r}")
     if not fmt:
@@ -124,13 +138,66 @@ def _read_vertices(path: Path, data: bytes) -> NDArray[Any]:
                 "cannot skip it in a binary file"
             )
         offset += element.count * _vertex_dtype(path, element, fmt).itemsize
+    # Every byte must belong to an element: a lowered vertex count must not drop points silently.
     need = vertex.count * dtype.itemsize
-    if len(data) - offset < need:
-        raise FileFormatError(
-            f"{path}: PLY binary vertex data needs {need} bytes, the file holds "
-            f"{max(len(data) - offset, 0)}; the file is truncated"
-        )
+    after = offset + need
+    for element in elements[index + 1 :]:
+        after = _skip_binary_element(path, data, after, element, fmt)
+    what = (f"binary vertex data of {vertex.count} vertices × {dtype.itemsize} bytes"
+            + (" and the elements after them" if index + 1 < len(elements) else ""))  # fmt: skip
+    check_body_size(path, what, after - offset, memoryview(data)[offset:])
     return np.frombuffer(data, dtype=dtype, count=vertex.count, offset=offset).copy()
+
+
+def _skip_binary_element(path: Path, data: bytes, offset: int, element: _Element, fmt: str) -> int:
+    """Where the binary rows of ``element`` that start at ``offset`` end.
+
+    A row of fixed-size properties is skipped in one step. Rows with list properties are walked
+    with numpy when every row's lists have the first row's lengths (faces of a triangle mesh), and
+    row by row otherwise; a walk that runs past the end of the data stops there (truncated).
+    """
+    order = ">" if fmt == "binary_big_endian" else "<"
+    if not element.has_list:
+        return offset + element.count * _vertex_dtype(path, element, fmt).itemsize
+    end = len(data)
+
+    def row_end(start: int) -> int:
+        at = start
+        for count_code, code in element.layout:
+            if count_code and at + int(count_code[1]) <= end:
+                n = int(np.frombuffer(data, order + count_code, 1, at)[0])
+                if n < 0:
+                    raise FileFormatError(f"{path}: PLY element {element.name!r} has a list "
+                                          f"of negative length {n} at byte {at}")  # fmt: skip
+                at += int(count_code[1]) + n * int(code[1])
+            else:
+                at += int(count_code[1]) if count_code else int(code[1])
+        return at
+
+    if element.count == 0 or offset >= end:
+        return offset + element.count  # a row takes at least a byte: too short, or empty
+    first = row_end(offset)
+    width = first - offset
+    if offset + width * element.count <= end:
+        # Uniform rows: every list-count word must then hold the first row's value.
+        view = np.frombuffer(data, np.uint8, width * element.count, offset).reshape(-1, width)
+        at, uniform = 0, True
+        for count_code, code in element.layout:
+            size = int(count_code[1]) if count_code else int(code[1])
+            if count_code:
+                words = view[:, at : at + size].copy().view(order + count_code).ravel()
+                uniform = uniform and bool(np.all(words == words[0]))
+                at += size + int(words[0]) * int(code[1])
+            else:
+                at += size
+        if uniform:
+            return offset + width * element.count
+    at = offset
+    for _ in range(element.count):
+        if at >= end:
+            return at + 1  # past the end: the caller reports the shortfall
+        at = row_end(at)
+    return at
 
 
 def _fill_ascii(path: Path, table: NDArray[np.float64], dtype: np.dtype[Any]) -> NDArray[Any]:

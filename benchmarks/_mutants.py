@@ -1,0 +1,284 @@
+"""Templates and seeded mutators of ``benchmarks/robustness.py`` (see its docstring).
+
+Every mutator takes the bytes (or a session folder) and a ``numpy.random.Generator`` and returns
+the damaged copy; the same seed gives the same mutant.
+"""
+
+from __future__ import annotations
+
+import io
+import os
+import re
+import shutil
+import zipfile
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+__all__ = ["FILE_MUTATORS", "KINDS", "make_templates", "mutate_file", "mutate_session"]
+
+Mutator = Callable[[bytes, np.random.Generator], bytes]
+
+#: Reader family → the kinds of mutation tried on it.
+KINDS: dict[str, tuple[str, ...]] = {
+    "pcd": ("flip", "truncate", "extend", "header", "count"),
+    "ply": ("flip", "truncate", "extend", "header", "count"),
+    "npz": ("flip", "truncate", "extend", "member-flip", "member-truncate", "member-extend",
+            "member-npy-header", "member-shape"),
+    "session": ("yaml", "file", "link"),
+}
+
+
+# ----------------------------------------------------------------------------- templates
+
+
+def _cloud(n: int = 120) -> Any:
+    from deformap.cloud import PointCloud
+
+    rng = np.random.default_rng(7)
+    # On a 1 mm lattice, so that binary_compressed really compresses (LZF needs repeats).
+    pts = np.round(rng.uniform([0.0, 0.0, 0.04], [0.3, 0.2, 0.06], (n, 3)), 3)
+    return PointCloud(pts, rng.uniform(0, 1, (n, 3)).round(2))
+
+
+def _session_parts() -> dict[str, Any]:
+    """A flat foam top at 5 cm with a dent under each of three pokes (no simulator needed)."""
+    from deformap.cloud import PointCloud
+    from deformap.environment import ForceTravel, PressObservation, TactileContact, Workspace
+
+    rng = np.random.default_rng(11)
+
+    def surface(dents: list[tuple[np.ndarray, float]]) -> np.ndarray:
+        xy = rng.uniform([0.0, 0.0], [0.6, 0.4], (300, 2))
+        z = 0.05 + rng.normal(0, 5e-4, 300)
+        for center, depth in dents:
+            z -= depth * np.exp(-np.sum((xy - center) ** 2, axis=1) / 0.015**2)
+        return np.column_stack([xy, z])
+
+    presses = []
+    for i in range(3):
+        target, depth = np.array([0.1 + 0.2 * i, 0.2]), 0.004 + 0.002 * i
+        tip = np.array([target[0], target[1], 0.05 - depth + 0.01])
+        corners = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]]) * 0.006
+        robot = np.vstack([np.column_stack([tip[:2] + corners, np.full(4, z)])
+                           for z in (tip[2], tip[2] + 0.25)])  # fmt: skip
+        record = ForceTravel(travel_m=np.linspace(0.0, depth, 5), force_n=np.linspace(0.05, 1, 5))
+        presses.append(PressObservation(
+            cloud=PointCloud(np.vstack([surface([(target, depth)]), robot])),
+            contact=TactileContact(tip_center=tip, force=np.array([0.0, 0.0, -1.0]),
+                                   tip_radius_m=0.01),
+            robot_points=robot, target_xy=target, force_n=1.0, force_travel=record))  # fmt: skip
+    from deformap.replay import GroundTruth
+
+    xs, ys = np.linspace(0.01, 0.59, 30), np.linspace(0.01, 0.39, 20)
+    labels = np.repeat((xs > 0.3)[None, :], 20, axis=0).astype(np.int64)
+    truth = GroundTruth(xs, ys, labels, np.where(labels == 1, np.inf, 80.0))
+    return {"workspace": Workspace(), "observation": PointCloud(surface([])), "presses": presses,
+            "ground_truth": truth}
+
+
+def make_templates(root: Path) -> dict[str, Path]:
+    """Write every template under ``root``: reader kind → file or session folder."""
+    from deformap.cloud.io import write_npz, write_pcd, write_ply
+    from deformap.replay import write_session
+
+    cloud = _cloud()
+    root.mkdir(parents=True, exist_ok=True)
+    out: dict[str, Path] = {}
+    for enc in ("ascii", "binary", "binary_compressed"):
+        out[f"pcd-{enc}"] = root / f"t-{enc}.pcd"
+        write_pcd(out[f"pcd-{enc}"], cloud, encoding=enc)
+    assert b"DATA binary_compressed" in out["pcd-binary_compressed"].read_bytes()
+    for fmt in ("ascii", "binary_little_endian"):
+        key = "ply-" + fmt.split("_")[0]
+        out[key] = root / f"t-{fmt}.ply"
+        write_ply(out[key], cloud, format=fmt, extra_fields={"i": np.arange(len(cloud), dtype=np.int32)})
+    out["npz"] = root / "t.npz"
+    write_npz(out["npz"], cloud)
+    out["session-folder"] = write_session(root / "session", **_session_parts()).parent
+    try:
+        import rosbags  # noqa: F401
+    except ImportError:
+        return out
+    for storage in ("mcap", "sqlite3"):
+        out[f"session-{storage}"] = write_session(root / f"session-{storage}", format=storage,
+                                                  **_session_parts()).parent  # fmt: skip
+    return out
+
+
+# ----------------------------------------------------------------------------- mutators
+
+
+def _flip(data: bytes, rng: np.random.Generator) -> bytes:
+    out = bytearray(data)
+    for _ in range(int(rng.integers(1, 5))):
+        out[int(rng.integers(len(out)))] ^= 1 << int(rng.integers(8))
+    return bytes(out)
+
+
+def _truncate(data: bytes, rng: np.random.Generator) -> bytes:
+    return data[: int(rng.integers(0, len(data)))]
+
+
+def _extend(data: bytes, rng: np.random.Generator) -> bytes:
+    if rng.random() < 0.5:
+        return data + rng.bytes(int(rng.integers(1, 65)))
+    k = int(rng.integers(1, 97))
+    return data + data[-k:]  # what looks like one more record
+
+
+_NUMBERS = ("0", "-1", "1", "2", "3", "7", "1000000000", "1000000000000", "4294967296",
+            "18446744073709551617", "nan", "1e308", "-0", "x", "")  # fmt: skip
+
+
+def _header_end(data: bytes) -> int:
+    for marker in (b"end_header\n", b"DATA ascii\n", b"DATA binary_compressed\n",
+                   b"DATA binary\n"):  # fmt: skip
+        at = data.find(marker)
+        if at >= 0:
+            return at + len(marker)
+    return min(len(data), 512)
+
+
+def _header(data: bytes, rng: np.random.Generator) -> bytes:
+    """Edit one header line: a token replaced (a number, or another word of the header), the
+    line dropped or repeated."""
+    end = _header_end(data)
+    lines = data[:end].split(b"\n")
+    i = int(rng.integers(len(lines)))
+    words = lines[i].split(b" ")
+    choice = rng.random()
+    if choice < 0.15:
+        del lines[i]
+    elif choice < 0.3:
+        lines.insert(i, lines[i])
+    else:
+        j = int(rng.integers(len(words)))
+        vocabulary = [w for line in lines for w in line.split(b" ") if w]
+        if rng.random() < 0.7 or not vocabulary:
+            words[j] = _NUMBERS[int(rng.integers(len(_NUMBERS)))].encode()
+        else:
+            words[j] = vocabulary[int(rng.integers(len(vocabulary)))]
+        lines[i] = b" ".join(words)
+    return b"\n".join(lines) + data[end:]
+
+
+def _count(data: bytes, rng: np.random.Generator) -> bytes:
+    """Change the declared point count (PCD: POINTS and WIDTH together; PLY: element vertex)."""
+    pattern = (rb"element vertex (\d+)" if data.startswith(b"ply")
+               else rb"POINTS (\d+)")  # fmt: skip
+    match = re.search(pattern, data[: _header_end(data)])
+    if match is None:
+        return _header(data, rng)
+    n = int(match.group(1))
+    new = [n - 1, n + 1, n // 2, 2 * n, 0, n - 7, 10**9, 10**12][int(rng.integers(8))]
+    out = data.replace(match.group(0), match.group(0).replace(match.group(1), str(new).encode()), 1)
+    if not data.startswith(b"ply"):
+        out = out.replace(f"WIDTH {n}".encode(), f"WIDTH {new}".encode(), 1)
+    return out
+
+
+FILE_MUTATORS: dict[str, Mutator] = {
+    "flip": _flip, "truncate": _truncate, "extend": _extend, "header": _header, "count": _count,
+}  # fmt: skip
+
+
+def _npz_member(data: bytes, rng: np.random.Generator, kind: str) -> bytes:
+    """Mutate one member's .npy bytes (``kind``: flip, truncate, extend, npy-header, shape) and
+    rebuild the zip, so that the member's CRC matches the damage."""
+    src = zipfile.ZipFile(io.BytesIO(data))
+    names = src.namelist()
+    victim = names[int(rng.integers(len(names)))]
+    buf = io.BytesIO()
+    with zipfile.ZipFile(buf, "w", compression=zipfile.ZIP_DEFLATED) as dst:
+        for name in names:
+            raw = src.read(name)
+            if name == victim:
+                if kind == "npy-header":
+                    raw = _header_npy(raw, rng)
+                elif kind == "shape":
+                    raw = _shape_npy(raw, rng)
+                else:
+                    raw = FILE_MUTATORS[kind](raw, rng)
+            dst.writestr(name, raw)
+    return buf.getvalue()
+
+
+def _header_npy(raw: bytes, rng: np.random.Generator) -> bytes:
+    end = raw.find(b"\n", 10)
+    header = bytearray(raw[10:end])
+    for _ in range(int(rng.integers(1, 4))):
+        at = int(rng.integers(len(header)))
+        header[at] = b"{}()[]',: 0123456789<>fiuUOb"[int(rng.integers(28))]
+    return raw[:10] + bytes(header) + raw[end:]
+
+
+def _shape_npy(raw: bytes, rng: np.random.Generator) -> bytes:
+    match = re.search(rb"'shape': \(([^)]*)\)", raw[:200])
+    if match is None:
+        return raw
+    new = [b"0, 3", b"1, 3", b"1000000000, 3", b"119, 3", b"121, 3", b"3,", b"120, 3, 1",
+           b"-1, 3", b"10000000000000, 3"][int(rng.integers(9))]  # fmt: skip
+    padded = match.group(0).replace(match.group(1), new)
+    return raw.replace(match.group(0), padded, 1)
+
+
+# ----------------------------------------------------------------------------- sessions
+
+
+def _yaml_edit(text: str, rng: np.random.Generator) -> str:
+    lines = text.split("\n")
+    choice = rng.random()
+    if choice < 0.2:  # cut after a random line
+        return "\n".join(lines[: int(rng.integers(1, len(lines)))]) + "\n"
+    if choice < 0.35:  # cut at a poke boundary
+        starts = [i for i, line in enumerate(lines) if line.startswith("- ")]
+        if starts:
+            return "\n".join(lines[: starts[int(rng.integers(len(starts)))]]) + "\n"
+    i = int(rng.integers(len(lines)))
+    if choice < 0.5:
+        del lines[i]
+    elif choice < 0.6:
+        lines.insert(i, lines[i])
+    elif choice < 0.75:  # a file name outside the folder
+        names = [j for j, line in enumerate(lines) if ".pcd" in line or ".npz" in line
+                 or line.startswith("bag:")]  # fmt: skip
+        if names:
+            j = names[int(rng.integers(len(names)))]
+            key, _, value = lines[j].partition(":")
+            bad = ("../", "/tmp/", "./../s/", "sub/../../")[int(rng.integers(4))]
+            lines[j] = f"{key}: {bad}{value.strip()}"
+    else:  # a number replaced
+        numbers = list(re.finditer(r"-?\d+(\.\d+)?(e-?\d+)?", lines[i]))
+        if numbers:
+            m = numbers[int(rng.integers(len(numbers)))]
+            new = _NUMBERS[int(rng.integers(len(_NUMBERS)))] or "1"
+            lines[i] = lines[i][: m.start()] + new + lines[i][m.end():]
+    return "\n".join(lines)
+
+
+def mutate_session(template: Path, out: Path, kind: str, rng: np.random.Generator) -> None:
+    """Copy the session folder ``template`` to ``out`` and damage it (``kind``)."""
+    shutil.copytree(template, out, symlinks=True)
+    data_files = sorted(p for p in out.rglob("*") if p.is_file() and p.name != "session.yaml")
+    if kind == "yaml":
+        file = out / "session.yaml"
+        file.write_text(_yaml_edit(file.read_text(), rng))
+    elif kind == "link":
+        victim = data_files[int(rng.integers(len(data_files)))]
+        outside = out.parent / f"{out.name}-outside-{victim.name}"
+        shutil.move(victim, outside)
+        os.symlink(outside, victim)
+    else:
+        victim = data_files[int(rng.integers(len(data_files)))]
+        name = ("flip", "truncate", "extend", "header", "count")[int(rng.integers(5))]
+        victim.write_bytes(FILE_MUTATORS[name](victim.read_bytes(), rng))
+
+
+def mutate_file(data: bytes, kind: str, rng: np.random.Generator) -> bytes:
+    """One file mutant: a ``FILE_MUTATORS`` kind, or ``member-KIND`` inside an NPZ member."""
+    if kind.startswith("member-"):
+        return _npz_member(data, rng, kind.removeprefix("member-"))
+    return FILE_MUTATORS[kind](data, rng)

@@ -1,0 +1,268 @@
+"""Seeded mutants of every reader's input: each must load to a valid result or raise a DeformapError.
+
+    python benchmarks/robustness.py --mutants 3000          # the table in the README
+    python benchmarks/robustness.py --mutants 300 --seed 1  # a quick run
+
+Templates (a small cloud as PCD ascii/binary/binary_compressed, PLY ascii/binary, NPZ, and a
+folder session written by ``write_session``, plus MCAP and sqlite3 sessions when ``rosbags`` is
+installed)
+are mutated by seeded byte flips, truncations, appended bytes, header field edits and point-count
+changes (and, for NPZ, the same inside a member, plus edits of its .npy header and shape, with
+the member's zip CRC made to match; for sessions,
+edits of ``session.yaml``, of one of its files, and links out of the folder). Each mutant is read
+in a worker process under a per-case time limit, and counted as:
+
+- ``clean``: refused with a DeformapError (a session: at load, or at least one of its reads);
+- ``same``: accepted, and the data read equal the template's (the mutant touched nothing read);
+- ``changed``: accepted with other data, where no check could know (a flipped bit in a coordinate
+  of a format without checksum, a number edited in ``session.yaml``);
+- ``silent``: accepted with other data where a check could have caught it: a different number of
+  points or pokes, a structural mutant (truncation, count change, appended bytes) accepted as
+  different data, or any change to a file covered by a checksum (NPZ members, a session's
+  ``sha256`` manifest);
+- ``traceback``: any other exception; ``hang``: over the time limit.
+
+From a source checkout the ``src/`` beside this folder is imported, installed or not. The test
+``tests/robustness/test_reader_mutants.py`` runs the same machinery on a few hundred mutants.
+"""
+
+from __future__ import annotations
+
+import argparse
+import hashlib
+import logging
+import multiprocessing as mp
+import shutil
+import sys
+import tempfile
+import time
+from collections import Counter
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+_SRC = Path(__file__).resolve().parents[1] / "src"
+for _path in (_SRC, Path(__file__).resolve().parent):
+    if _path.is_dir() and str(_path) not in sys.path:
+        sys.path.insert(0, str(_path))
+
+from _mutants import KINDS, make_templates, mutate_file, mutate_session  # noqa: E402
+
+OUTCOMES = ("clean", "same", "changed", "silent", "traceback", "hang")
+STRUCTURAL = {"truncate", "count", "extend", "member-truncate", "member-extend", "member-shape"}
+
+# ----------------------------------------------------------------------------- reading
+
+
+def _digest(*arrays: Any) -> str:
+    h = hashlib.sha256()
+    for a in arrays:
+        h.update(b"-" if a is None else np.ascontiguousarray(a).tobytes())
+    return h.hexdigest()[:16]
+
+
+def read_snapshot(reader: str, path: str) -> tuple[str, Any]:
+    """Read ``path`` as ``reader`` does; ``("ok", snapshot)``, ``("clean", message)`` or
+    ``("traceback", message)``. A session's snapshot lists each read (load, observation, pokes)."""
+    from deformap.errors import DeformapError
+
+    try:
+        if not reader.startswith("session"):
+            from deformap.cloud.io import read_npz, read_pcd, read_ply
+
+            read = {"pcd": read_pcd, "ply": read_ply, "npz": read_npz}[reader.split("-")[0]]
+            cloud, extras = read(path)
+            return "ok", (len(cloud), _digest(cloud.points, cloud.colors,
+                                              *[extras[k] for k in sorted(extras)]))  # fmt: skip
+        from deformap.replay import load_session
+
+        session = load_session(path)
+        reads: list[Any] = [("obs", _safe(lambda: _digest(session.observation().points)))]
+        for i in range(len(session)):
+            reads.append((i, _safe(lambda i=i: _press_digest(session.press_observation(i)))))
+        truth = session.ground_truth
+        reads.append(("truth", None if truth is None else _digest(truth.labels, truth.hardness)))
+        return "ok", (len(session), tuple(reads))
+    except DeformapError as exc:
+        return "clean", str(exc)[:300]
+    except Exception as exc:  # counting what escapes is the point
+        return "traceback", f"{type(exc).__name__}: {str(exc)[:300]}"
+
+
+def _press_digest(obs: Any) -> str:
+    record = obs.force_travel
+    return _digest(obs.cloud.points, obs.robot_points, obs.contact.tip_center, obs.contact.force,
+                   obs.target_xy, np.float64(obs.force_n),
+                   None if record is None else record.travel_m,
+                   None if record is None else record.force_n)  # fmt: skip
+
+
+def _safe(read: Callable[[], str]) -> str:
+    from deformap.errors import DeformapError
+
+    try:
+        return read()
+    except DeformapError:
+        return "refused"
+
+
+def classify(reader: str, kind: str, status: str, got: Any, want: Any) -> str:
+    """One of :data:`OUTCOMES` for a mutant read (``want``: the template's snapshot)."""
+    if status != "ok":
+        return status
+    if got == want:
+        return "same"
+    if reader.startswith("session"):
+        n_got, reads = got
+        if any(value == "refused" for _, value in reads):
+            changed = [k for (k, v), (_, w) in zip(reads, want[1], strict=False)
+                       if v not in ("refused", w)]  # fmt: skip
+            return "clean" if not changed and n_got == want[0] else _session_change(kind, got, want)
+        return _session_change(kind, got, want)
+    # A zip holds a CRC-32 of each member; the member-* mutants forge it to match.
+    checksummed = reader == "npz" and not kind.startswith("member-")
+    if got[0] != want[0] or kind in STRUCTURAL or checksummed:
+        return "silent"
+    return "changed"
+
+
+def _session_change(kind: str, got: Any, want: Any) -> str:
+    # Files are covered by the manifest; session.yaml is text a user may edit: only a lost poke
+    # (a count that disagrees) is then something a check could see.
+    if kind != "yaml" or got[0] < want[0]:
+        return "silent"
+    return "changed"
+
+
+def _worker(conn: Any) -> None:
+    while True:
+        job = conn.recv()
+        if job is None:
+            return
+        conn.send(read_snapshot(*job))
+
+
+@dataclass
+class Worker:
+    """A reader process; a case over the time limit kills it (a hang) and a new one starts."""
+
+    limit_s: float
+    _proc: Any = None
+    _conn: Any = None
+
+    def read(self, reader: str, path: Path) -> tuple[str, Any]:
+        if self._proc is None:
+            ctx = mp.get_context("fork")
+            self._conn, child = ctx.Pipe()
+            self._proc = ctx.Process(target=_worker, args=(child,), daemon=True)
+            self._proc.start()
+        self._conn.send((reader, str(path)))
+        if self._conn.poll(self.limit_s):
+            try:
+                return self._conn.recv()  # type: ignore[no-any-return]
+            except EOFError:  # the worker died (killed for memory, a crash in C)
+                self.close()
+                return "traceback", "the reader process died"
+        self.close()
+        return "hang", f"over {self.limit_s} s"
+
+    def close(self) -> None:
+        if self._proc is not None:
+            self._proc.kill()
+            self._proc.join()
+            self._proc = None
+
+
+# ----------------------------------------------------------------------------- the run
+
+
+@dataclass
+class Case:
+    reader: str
+    kind: str
+    outcome: str
+    detail: str
+
+
+def run(n_mutants: int, seed: int, limit_s: float, work: Path,
+        readers: tuple[str, ...] | None = None) -> list[Case]:  # fmt: skip
+    """Make the templates in ``work``, then ``n_mutants`` mutants spread over readers and kinds."""
+    templates = make_templates(work / "templates")
+    names = [r for r in templates if readers is None or r in readers]
+    worker = Worker(limit_s)
+    want = {r: read_snapshot(r, str(templates[r])) for r in names}
+    for r, (status, snap) in want.items():
+        if status != "ok":
+            raise RuntimeError(f"template {r} does not read: {snap}")
+    plan = [(r, k) for r in names for k in KINDS[r.split("-")[0]]]
+    cases = []
+    try:
+        for index in range(n_mutants):
+            reader, kind = plan[index % len(plan)]
+            rng = np.random.default_rng([seed, index])
+            target = work / f"m{index}"
+            if reader.startswith("session"):
+                mutate_session(templates[reader], target, kind, rng)
+            else:
+                target = target.with_suffix(templates[reader].suffix)
+                data = templates[reader].read_bytes()
+                mutated = mutate_file(data, kind, rng)
+                target.write_bytes(mutated)
+            status, got = worker.read(reader, target)
+            outcome = classify(reader, kind, status, got, want[reader][1])
+            cases.append(Case(reader, kind, outcome, str(got)[:300]))
+            if target.is_dir():
+                shutil.rmtree(target)
+                for link in work.glob(f"{target.name}-outside-*"):
+                    link.unlink()
+            else:
+                target.unlink()
+    finally:
+        worker.close()
+    return cases
+
+
+def table(cases: list[Case]) -> str:
+    """A markdown table: one row per reader, the kinds tried and the count of each outcome."""
+    rows = ["| reader | kinds tried | mutants | clean errors | accepted, same | accepted, changed "
+            "(undetectable) | silently accepted corruptions | tracebacks | hangs |",
+            "|---|---|---:|---:|---:|---:|---:|---:|---:|"]  # fmt: skip
+    for reader in dict.fromkeys(c.reader for c in cases):
+        mine = [c for c in cases if c.reader == reader]
+        n = Counter(c.outcome for c in mine)
+        kinds = ", ".join(dict.fromkeys(c.kind for c in mine))
+        rows.append(f"| {reader} | {kinds} | {len(mine)} | {n['clean']} | {n['same']} | "
+                    f"{n['changed']} | {n['silent']} | {n['traceback']} | {n['hang']} |")  # fmt: skip
+    n = Counter(c.outcome for c in cases)
+    rows.append(f"| **all** | | {len(cases)} | {n['clean']} | {n['same']} | {n['changed']} | "
+                f"{n['silent']} | {n['traceback']} | {n['hang']} |")  # fmt: skip
+    return "\n".join(rows)
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--mutants", type=int, default=3000, help="how many mutants (default 3000)")
+    parser.add_argument("--seed", type=int, default=0, help="seed of the mutants (default 0)")
+    parser.add_argument("--limit", type=float, default=10.0,
+                        help="seconds a case may take before it counts as a hang (default 10)")
+    args = parser.parse_args(argv)
+    if args.mutants < 1 or args.seed < 0 or not args.limit > 0:
+        parser.error("--mutants must be >= 1, --seed >= 0 and --limit > 0")
+    logging.disable(logging.WARNING)  # refused pokes are counted, not logged
+    start = time.perf_counter()
+    with tempfile.TemporaryDirectory(prefix="deformap-robustness-") as tmp:
+        cases = run(args.mutants, args.seed, args.limit, Path(tmp))
+    print(table(cases))
+    print(f"\n{len(cases)} mutants (seed {args.seed}) in {time.perf_counter() - start:.0f} s, "
+          f"per-case limit {args.limit:g} s")
+    bad = [c for c in cases if c.outcome in ("traceback", "hang", "silent")]
+    for case in bad[:20]:
+        print(f"{case.outcome}: {case.reader} {case.kind}: {case.detail}")
+    return 1 if bad else 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,72 @@
+"""Seeded mutants of every reader's input (PCD ascii/binary/compressed, PLY ascii/binary, NPZ, and
+folder and MCAP sessions) load to a valid result or raise a DeformapError: never another
+exception, never a hang, never a corruption a check could have caught accepted (issue 14).
+
+The mutants, the per-case time limit and the classification are ``benchmarks/robustness.py``'s,
+which runs thousands of them for the README's table; here a few hundred, each kind ten times.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import sys
+import time
+from pathlib import Path
+from types import ModuleType
+
+import pytest
+
+_BENCH = Path(__file__).resolve().parents[2] / "benchmarks" / "robustness.py"
+
+
+@pytest.fixture(scope="module")
+def bench() -> ModuleType:
+    spec = importlib.util.spec_from_file_location("deformap_bench_robustness", _BENCH)
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module  # dataclasses look their module up
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_every_mutant_is_read_or_cleanly_refused(bench: ModuleType, tmp_path: Path) -> None:
+    plan = sum(len(kinds) for kinds in bench.KINDS.values())
+    start = time.perf_counter()
+    cases = bench.run(10 * (plan + 3), seed=2026, limit_s=10.0, work=tmp_path)
+    bad = [c for c in cases if c.outcome in ("traceback", "hang", "silent")]
+    assert not bad, "\n" + bench.table(cases) + "\n" + "\n".join(
+        f"{c.outcome}: {c.reader} {c.kind}: {c.detail}" for c in bad[:10])
+    outcomes = {c.outcome for c in cases}
+    assert "clean" in outcomes and "same" in outcomes  # the mutants reach both sides
+    readers = {c.reader for c in cases}
+    assert {"pcd-ascii", "pcd-binary", "pcd-binary_compressed", "ply-ascii", "ply-binary", "npz",
+            "session-folder"} <= readers  # fmt: skip
+    assert time.perf_counter() - start < 60
+
+
+def test_the_classifier_flags_what_it_must(bench: ModuleType) -> None:
+    """The suite can fail: a lost point, a changed checksummed file, an escaped exception."""
+    assert bench.classify("pcd-binary", "count", "ok", (119, "a"), (120, "b")) == "silent"
+    assert bench.classify("ply-binary", "flip", "ok", (120, "a"), (120, "b")) == "changed"
+    assert bench.classify("npz", "flip", "ok", (120, "a"), (120, "b")) == "silent"
+    assert bench.classify("npz", "member-flip", "ok", (120, "a"), (120, "b")) == "changed"
+    lost = (2, (("obs", "o"), (0, "p0"), (1, "p1"), ("truth", "t")))
+    full = (3, (("obs", "o"), (0, "p0"), (1, "p1"), (2, "p2"), ("truth", "t")))
+    assert bench.classify("session-folder", "yaml", "ok", lost, full) == "silent"
+    changed = (3, (("obs", "o"), (0, "p0"), (1, "XX"), (2, "p2"), ("truth", "t")))
+    assert bench.classify("session-folder", "file", "ok", changed, full) == "silent"
+    refused = (3, (("obs", "o"), (0, "p0"), (1, "refused"), (2, "p2"), ("truth", "t")))
+    assert bench.classify("session-folder", "file", "ok", refused, full) == "clean"
+    assert bench.read_snapshot("no-such-reader", "x")[0] == "traceback"
+
+
+def test_a_hanging_reader_is_cut_at_the_limit(bench: ModuleType, monkeypatch: pytest.MonkeyPatch,
+                                              tmp_path: Path) -> None:  # fmt: skip
+    monkeypatch.setattr(bench, "read_snapshot", lambda reader, path: time.sleep(30))
+    worker = bench.Worker(limit_s=0.5)
+    start = time.perf_counter()
+    try:
+        assert worker.read("pcd-ascii", tmp_path / "x.pcd")[0] == "hang"
+    finally:
+        worker.close()
+    assert time.perf_counter() - start < 5
