@@ -229,3 +229,13 @@ def test_an_older_file_that_turned_the_camera_noise_off_keeps_its_meaning() -> N
     with pytest.raises(ConfigError, match=r"touch\.noise_samples"):
         config_from_dict(RunConfig, {"exploration": {"beta_uncertainty": "camera-noise",
                                                      "touch": {"noise_samples": 0}}})
+
+
+def test_a_key_repeated_in_one_mapping_is_refused_with_its_line(tmp_path) -> None:
+    bad = tmp_path / "twice.yaml"
+    bad.write_text("exploration:\n  threshold: 0.1\n  max_pokes: 3\n  threshold: 0.2\n")
+    with pytest.raises(ConfigError, match=r"twice\.yaml.*'threshold' appears twice.*line 4"):
+        load_yaml(bad)
+    fine = tmp_path / "fine.yaml"
+    fine.write_text("a: {threshold: 1}\nb: {threshold: 2}\nc: [1, 1]\n")
+    assert load_yaml(fine) == {"a": {"threshold": 1}, "b": {"threshold": 2}, "c": [1, 1]}

@@ -116,6 +116,26 @@ def config_from_dict(cls: type[T], data: Any, *, where: str = "config") -> T:
         raise ConfigError(f"`{where}`: {exc}") from None
 
 
+class _UniqueKeyLoader(yaml.SafeLoader):
+    """PyYAML's safe loader, refusing a mapping that repeats a key (PyYAML keeps the last one
+    silently: a session or config edited by hand would lose the first)."""
+
+    def construct_mapping(self, node: yaml.MappingNode, deep: bool = False) -> dict[Any, Any]:
+        seen: set[Any] = set()
+        for key_node, _ in node.value:
+            key = self.construct_object(key_node, deep=deep)  # type: ignore[no-untyped-call]
+            try:
+                repeated = key in seen
+                seen.add(key)
+            except TypeError:  # an unhashable key: PyYAML's own error follows
+                continue
+            if repeated:
+                raise yaml.constructor.ConstructorError(
+                    None, None, f"the key {key!r} appears twice in one mapping",
+                    key_node.start_mark)
+        return super().construct_mapping(node, deep=deep)
+
+
 def load_yaml(path: str | Path, *, what: str = "config file",
               unreadable: type[DeformapError] = ConfigError) -> Any:
     """Read a YAML file safely (no arbitrary objects); errors name the file.
@@ -139,7 +159,7 @@ def load_yaml(path: str | Path, *, what: str = "config file",
     except UnicodeDecodeError as exc:
         raise ConfigError(f"{str(p)!r} is not UTF-8 text (byte {exc.start})") from None
     try:
-        return yaml.safe_load(text)
+        return yaml.load(text, Loader=_UniqueKeyLoader)  # a SafeLoader: plain data only
     except (yaml.YAMLError, RecursionError, ValueError) as exc:
         detail = f"{type(exc).__name__}: {exc}".replace("\n", " ")[:300]
         raise ConfigError(f"{str(p)!r} is not valid YAML: {detail}") from None
