@@ -17,7 +17,7 @@ import pytest
 
 import deformap
 from deformap._config import dump_yaml
-from deformap.errors import ConfigError
+from deformap.errors import ConfigError, FileFormatError
 from deformap.explore import JOURNAL_NAME, ExplorationConfig, SurfaceGPConfig, read_journal
 from deformap.run import RunConfig, RunHooks, explore_scenario, load_run_config
 from deformap.world import WorldConfig
@@ -130,6 +130,24 @@ def test_a_run_journalled_before_a_config_field_existed_resumes(tmp_path, full_r
     header["config"]["seed"] = 5
     with_header(header)
     with pytest.raises(ConfigError, match="differs from this one"):
+        explore_scenario(_config(), out, resume=True, figures=False)
+
+
+@pytest.mark.parametrize("edit", ["repeat", "drop", "swap"])
+def test_a_journal_whose_poke_lines_are_not_in_order_is_refused_on_resume(
+    tmp_path: Path, edit: str
+) -> None:
+    out = tmp_path / "killed"
+    _run_killed_after_two_pokes(out)
+    journal = out / JOURNAL_NAME
+    header, first, second = journal.read_text().splitlines()
+    lines = {"repeat": [first, first, second], "drop": [second],
+             "swap": [second, first]}[edit]  # fmt: skip
+    journal.write_text("\n".join([header, *lines]) + "\n")
+    got = {"repeat": 0, "drop": 1, "swap": 1}[edit]
+    where = {"repeat": 2, "drop": 1, "swap": 1}[edit]
+    with pytest.raises(FileFormatError, match=rf"poke line {where} must hold poke index "
+                       rf"{where - 1}; got {got} \(a line repeated, missing or out of order\)"):
         explore_scenario(_config(), out, resume=True, figures=False)
 
 

@@ -18,7 +18,7 @@ from typing import Any
 
 from deformap import __version__
 from deformap._config import config_from_dict, config_to_dict
-from deformap.errors import ConfigError, DeformapError
+from deformap.errors import ConfigError, DeformapError, FileFormatError
 from deformap.explore import (
     JOURNAL_NAME,
     ExplorationResult,
@@ -111,6 +111,11 @@ def _resume_journal(
     where = out / JOURNAL_NAME
     done = [PokeRecord.from_dict(r, where=f"{where} poke {k + 1}")
             for k, r in enumerate(contents.pokes)]  # fmt: skip
+    for k, record in enumerate(done):  # a line copied, lost or moved would be a poke counted wrong
+        if record.index != k:
+            raise FileFormatError(
+                f"journal {str(where)!r}: poke line {k + 1} must hold poke index {k}; got "
+                f"{record.index} (a line repeated, missing or out of order)")
     if contents.broken_line is not None:
         logger.warning(
             "%s: the last journal line was cut mid-write and is dropped (%d complete pokes kept)",
