@@ -114,4 +114,20 @@ def test_a_json_file_that_cannot_be_written_is_one_line(tmp_path: Path, monkeypa
     (tmp_path / "file").write_text("x")
     result = runner.invoke(app, ["bench", "io", "--json", str(tmp_path / "file" / "io.json")])
     assert result.exit_code == 2
-    assert "cannot write --json" in result.stderr and "Traceback" not in result.output
+    assert "--json must name a file that can be written" in result.stderr
+    assert "Traceback" not in result.output
+
+
+@pytest.mark.parametrize("where", ["folder", "under-a-file", "unwritable"])
+def test_a_json_target_that_cannot_be_written_is_refused_before_the_work(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, where: str
+) -> None:
+    ran: list[str] = []
+    monkeypatch.setattr(evaluation, "bench_io", lambda *a, **k: ran.append("bench") or {})
+    (tmp_path / "afile").write_text("x")
+    target = {"folder": tmp_path, "under-a-file": tmp_path / "afile" / "r.json",
+              "unwritable": Path("/proc/deformap-none/r.json")}[where]  # fmt: skip
+    result = CliRunner().invoke(app, ["bench", "io", "--json", str(target)])
+    assert result.exit_code == 2, result.output
+    assert "--json must name a file that can be written" in result.output
+    assert str(target) in result.output and ran == []

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import logging
 import sys
+import tempfile
 from collections.abc import Callable
 from functools import wraps
 from pathlib import Path
@@ -54,9 +55,38 @@ app = typer.Typer(
     pretty_exceptions_enable=False,
 )
 
+def _json_target(value: Path | None) -> Path | None:
+    """``--json``'s check at parse time, before the command's work: the file must be creatable
+    (its folder exists or can be made, and it is not a folder), so that a long run or benchmark
+    does not fail only when it is done."""
+    if value is None or str(value) == "-":
+        return value
+    try:
+        parent = value.parent
+        while not parent.exists() and parent != parent.parent:  # the nearest folder that exists
+            parent = parent.parent
+        problem = (
+            "it is a folder" if value.is_dir()
+            else f"{str(parent)!r} is not a folder" if not parent.is_dir()
+            else None
+        )  # fmt: skip
+        if problem is None:
+            with tempfile.TemporaryFile(dir=parent):  # what the folder's file system will take
+                pass
+    except OSError as exc:
+        problem = exc.strerror or str(exc)
+    if problem is not None:
+        err_console.print(labelled("error:", "bold red", (
+            f"--json must name a file that can be written; got {str(value)!r}: {problem}")),
+            soft_wrap=True)
+        raise typer.Exit(code=2)
+    return value
+
+
 JsonOption = Annotated[
     Path | None,
-    typer.Option("--json", help="Also write the result as JSON to this file (- for stdout)."),
+    typer.Option("--json", help="Also write the result as JSON to this file (- for stdout).",
+                 callback=_json_target),
 ]
 
 F = TypeVar("F", bound=Callable[..., Any])
