@@ -242,7 +242,9 @@ class PressObservation:
         The cloud seen while pressing, world frame. It contains the robot's stick and hand and
         misses what they occlude.
     contact : TactileContact
-        Tip position, measured force and tip radius at the commanded force.
+        Tip position, measured force and tip radius at the commanded force. The force pushes
+        into the surface (negative z in the world frame) and its magnitude lies within
+        ``FORCE_MISMATCH_REL · force_n + FORCE_MISMATCH_ABS_N`` of ``force_n``.
     robot_points : (m, 3) float, metres
         Points whose convex hull covers the stick and hand at that moment, from the robot model
         and proprioception (at least 4 points, not all on a plane).
@@ -278,6 +280,7 @@ class PressObservation:
         object.__setattr__(self, "target_xy", target)
         force_n = check_positive("force_n", self.force_n)
         object.__setattr__(self, "force_n", force_n)
+        self._check_contact_force(force_n)
         record = self.force_travel
         if record is None:
             return
@@ -292,6 +295,23 @@ class PressObservation:
                 f"`force_travel` must end at the commanded force {force_n:.4g} N (within "
                 f"{allowed:.3g} N); its last force is {final:.4g} N"
             )
+
+
+    def _check_contact_force(self, force_n: float) -> None:
+        """The measured contact force must be a press (into the surface, world z up) of about the
+        commanded size: a force pointing away from the surface, or far from the commanded one
+        (a sensor in other units, a wrong frame), is no observation of this press."""
+        force = self.contact.force
+        if force[2] >= 0.0:
+            raise InvalidArgumentError(
+                "`contact.force` must push into the surface (negative z in the world frame, z up); "
+                f"got {tuple(float(f) for f in force)} N")
+        measured = self.contact.force_n
+        allowed = FORCE_MISMATCH_REL * force_n + FORCE_MISMATCH_ABS_N
+        if abs(measured - force_n) > allowed:
+            raise InvalidArgumentError(
+                f"`contact.force` must be near the commanded force {force_n:.4g} N (within "
+                f"{allowed:.3g} N); its magnitude is {measured:.4g} N")
 
 
 @runtime_checkable

@@ -320,3 +320,13 @@ def test_a_session_without_records_loads_with_none(folder: Path) -> None:
     _edit(folder, lambda doc: [poke.pop("force_travel", None) for poke in doc["pokes"]])
     session = load_session(folder)
     assert all(session.press_observation(i).force_travel is None for i in range(len(session)))
+
+
+@pytest.mark.parametrize(("force", "match"), [
+    ([0.0, 0.0, 1.0], r"poke 1: `contact.force` must push into the surface"),
+    ([0.0, 0.0, -1e6], r"poke 1: `contact.force` must be near the commanded force 1 N"),
+])
+def test_an_impossible_contact_force_breaks_only_that_poke(folder: Path, force: list[float],
+                                                           match: str) -> None:
+    _edit(folder, _set("pokes.1.force", force))
+    _only_poke_broken(folder, 1, FileFormatError, match)
