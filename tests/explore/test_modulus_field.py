@@ -59,7 +59,8 @@ def _field(pokes: list[PokeResult]) -> ModulusField:
 def test_the_field_is_over_ln_e_and_interpolates_the_pokes_within_their_noise() -> None:
     moduli = [5e3, 2e4, 8e4]
     places = [(0.1, 0.1), (0.3, 0.3), (0.5, 0.1)]
-    field = _field([_poke(xy, _soft(e), i) for i, (xy, e) in enumerate(zip(places, moduli))])
+    pairs = enumerate(zip(places, moduli, strict=True))
+    field = _field([_poke(xy, _soft(e), i) for i, (xy, e) in pairs])
     assert np.allclose(field.pokes.beta, np.log(moduli))
     for (x, y), e in zip(places, moduli, strict=True):
         col, row = int(np.argmin(abs(XS - x))), int(np.argmin(abs(YS - y)))
@@ -167,7 +168,7 @@ def test_the_map_runs_on_the_modulus_field_when_asked() -> None:
 
 def test_field_modulus_without_a_record_is_refused_at_the_first_poke() -> None:
     mapper = _mapper("modulus")
-    with pytest.raises(EnvironmentStateError, match="exploration.field.*no force–travel record"):
+    with pytest.raises(EnvironmentStateError, match=r"exploration\.field.*no force–travel record"):
         mapper.add(_poke((0.3, 0.2), None))
     # the β-field's map takes the same poke
     assert len(_mapper("beta").add(_poke((0.3, 0.2), None)).record.contact_xy) == 2

@@ -1,6 +1,6 @@
 """Active exploration: the mapper and its concepts (surface model, dent and β, β-field, target
-choice, regions, stiffness and modulus from a force–travel record, the modulus field), the loop that drives an
-``Environment`` with it, the typed poke records and the session journal."""
+choice, regions, stiffness and modulus from a force–travel record, the modulus field), the loop
+that drives an ``Environment`` with it, the typed poke records and the session journal."""
 
 from __future__ import annotations
 

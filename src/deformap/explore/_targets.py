@@ -1,6 +1,7 @@
 """The next place to poke: the configured strategy until the map field's variance is under
 ``T_h`` (the β-field's, or the modulus field's under ``ExplorationConfig.field = "modulus"``, with
-its own ``T_h``: :func:`deformap.explore.field_settings`), then the boundary pokes (strategies and scores in :mod:`deformap.explore._acquisition`).
+its own ``T_h``: :func:`deformap.explore.field_settings`), then the boundary pokes (strategies
+and scores in :mod:`deformap.explore._acquisition`).
 
 When only the edge band, where no poke fits, is still above ``T_h``, ``planned`` plans it like
 any other place; the other strategies poke the reachable cell of largest variance, the one nearest
@@ -38,8 +39,9 @@ def expected_noise(candidates: NDArray[np.float64], pokes: PokeSet,
     """The β uncertainty a poke at each of ``candidates (c, 2)`` is expected to have: the largest
     of the pokes already made within ``BOUNDARY_SPACING_ROI`` ROIs of it (a dent spreads a few
     centimetres, so a press there measures that foam again, no better), else the map field's
-    noise floor (:func:`deformap.explore.field_settings`). So the target choice knows what a further press at a place can still reduce, and does
-    not return to a place whose readings are noisy expecting a reading at the floor."""
+    noise floor (:func:`deformap.explore.field_settings`). So the target choice knows what a
+    further press at a place can still reduce, and does not return to a place whose readings are
+    noisy expecting a reading at the floor."""
     floor = field_settings(config).noise_floor
     noise = np.full(len(candidates), floor)
     if len(pokes) == 0:

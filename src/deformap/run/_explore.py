@@ -188,7 +188,8 @@ def explore_scenario(
     if figures:
         hooks.stage("drawing figures")
         title = f"{config.scenario} (seed {config.seed}): {len(result.pokes)} pokes"
-        write_map_figures(folder, result, truth=world, threshold=field_settings(config.exploration).threshold,
+        threshold = field_settings(config.exploration).threshold
+        write_map_figures(folder, result, truth=world, threshold=threshold,
                           title=title)  # fmt: skip
     if rerun:
         hooks.stage("writing run.rrd")

@@ -84,7 +84,8 @@ def _class_values(result: ExplorationResult) -> dict[str, Any]:
     assert found is not None
     field = result.map_field
     betas = np.array([p.record.beta for p in result.pokes])
-    by_index = {int(i): int(k) for i, k in zip(field.pokes.index, found.poke_labels, strict=True)}
+    index = np.arange(len(field.pokes)) if field.pokes.index is None else field.pokes.index
+    by_index = {int(i): int(k) for i, k in zip(index, found.poke_labels, strict=True)}
     class_betas = []
     for k in range(found.n_regions):
         members = [betas[i] for i, label in by_index.items() if label == k]

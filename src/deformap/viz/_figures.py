@@ -170,7 +170,7 @@ def _modulus_panel(fig: Figure, ax: Axes, ext: list[float], modulus_pa: NDArray)
     mid = np.sqrt(low * high)
     if high / low < 10.0:
         low, high = mid / np.sqrt(10.0), mid * np.sqrt(10.0)
-    im = ax.imshow(kpa, origin="lower", extent=ext, cmap="viridis",
+    im = ax.imshow(kpa, origin="lower", extent=(ext[0], ext[1], ext[2], ext[3]), cmap="viridis",
                    norm=LogNorm(vmin=low, vmax=high))  # fmt: skip
     bar = fig.colorbar(im, ax=ax, label="Young's modulus E [kPa] (log scale)")
     plain = FuncFormatter(lambda v, _: f"{v:g}")
