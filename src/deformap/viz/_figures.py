@@ -173,9 +173,15 @@ def _modulus_panel(fig: Figure, ax: Axes, ext: list[float], modulus_pa: NDArray)
     im = ax.imshow(kpa, origin="lower", extent=(ext[0], ext[1], ext[2], ext[3]), cmap="viridis",
                    norm=LogNorm(vmin=low, vmax=high))  # fmt: skip
     bar = fig.colorbar(im, ax=ax, label="Young's modulus E [kPa] (log scale)")
-    plain = FuncFormatter(lambda v, _: f"{v:g}")
-    bar.ax.yaxis.set_major_formatter(plain)
-    bar.ax.yaxis.set_minor_formatter(plain)
+    decades = float(np.log10(high / low))
+
+    def minor(value: float, _: object) -> str:
+        # over less than two decades, label the 2s and 5s between the powers of ten
+        lead = round(value / 10 ** np.floor(np.log10(value)))
+        return f"{value:g}" if decades < 2.0 and lead in (2, 5) else ""
+
+    bar.ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+    bar.ax.yaxis.set_minor_formatter(FuncFormatter(minor))
 
 
 def plot_beta_curve(ax: Axes, betas: NDArray, errors: NDArray, beta_hat: float, std: float) -> None:
