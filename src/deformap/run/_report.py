@@ -5,7 +5,7 @@ Every report of a mapped surface (a live exploration, :func:`live_report`; a rec
 
 - ``pokes`` (one record per poke, as the mapper wrote it), ``n_pokes``, ``stop_reason``;
 - ``max_variance`` (what the stopping rule compared with T_h, over ``stop_region``) and
-  ``max_variance_map`` (over the whole map);
+  ``max_variance_map`` (over the whole map), both of the map field (``field``), in its units;
 - ``field`` (the field the regions, the targets and the stop rule ran on: ``beta`` or
   ``modulus``) and ``threshold`` (its ``T_h``, in its units: :func:`deformap.explore.field_settings`);
 - ``regions``: ``levels`` and ``class_values`` (in the map field's units: β, or ln E [ln Pa]),
