@@ -21,6 +21,7 @@ from deformap.errors import ConfigError, InvalidArgumentError
 from deformap.explore import (
     BetaFieldConfig,
     ExplorationConfig,
+    ModulusFieldConfig,
     StiffnessConfig,
     SurfaceGPConfig,
     TouchGPConfig,
@@ -37,6 +38,7 @@ SECTIONS: dict[type, str] = {
     SurfaceGPConfig: "exploration.surface",
     TouchGPConfig: "exploration.touch",
     BetaFieldConfig: "exploration.beta_field",
+    ModulusFieldConfig: "exploration.modulus_field",
     ShapeMatchingConfig: "exploration.shape_matching",
     StiffnessConfig: "exploration.stiffness",
     WorldConfig: "world",

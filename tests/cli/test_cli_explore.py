@@ -30,6 +30,7 @@ def _error_line(result) -> str:  # type: ignore[no-untyped-def]
         (["--threshold", "-1"], "`threshold` must be > 0"),
         (["--max-pokes", "0"], "`max_pokes` must be an integer >= 1"),
         (["--strategy", "greedy"], "`strategy` must be one of"),
+        (["--field", "hardness"], "`field` must be one of"),
     ],
 )
 def test_bad_options_are_one_line_errors(tmp_path, args: list[str], message: str) -> None:
@@ -76,3 +77,16 @@ def test_resume_refuses_other_settings_before_any_work(tmp_path) -> None:  # typ
     result = runner.invoke(app, ["explore", "--resume", str(run), "--config", str(run / "config.yaml")])
     assert "do not pass --config too" in _error_line(result)
     assert sorted(p.name for p in run.iterdir()) == ["config.yaml"]
+
+
+def test_the_summary_line_on_the_modulus_field() -> None:
+    from deformap.cli._explore import modulus_summary
+
+    assert "no poke has a modulus" in modulus_summary({"modulus_field": None})
+    pokes = [{"used": True, "rigid": False}, {"used": True, "rigid": True},
+             {"used": False, "rigid": False}]
+    report = {"modulus_field": {"n_used": 2, "pokes": pokes},
+              "regions": {"class_modulus_median_pa": [7_500.0, 2.5e6]}}
+    line = modulus_summary(report)
+    assert "median E per region [kPa]: 7.5, 2.5e+03" in line
+    assert "from 2 poke(s), 1 rigid" in line and "1 left out" in line

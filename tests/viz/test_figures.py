@@ -158,6 +158,38 @@ def test_map_figure_panels_labels_and_colour_bars() -> None:
     ]
 
 
+def test_map_figure_gains_a_modulus_panel_in_kpa_on_a_log_scale() -> None:
+    from matplotlib.colors import LogNorm
+
+    args, kwargs = _map_args()
+    gx, _ = np.meshgrid(*args)
+    modulus = np.where(gx < 0.3, 6e3, 2e4)
+    fig = plot_map(*args, **kwargs, modulus_pa=modulus)
+    panels = _panels(fig)
+    assert [ax.get_title() for ax in panels] == [
+        "ground truth",
+        "β-field, 2 region(s)",
+        "modulus field",
+        "β-field variance and contacts",
+    ]
+    assert _colorbar_labels(fig)[2] == "Young's modulus E [kPa] (log scale)"
+    image = panels[2].get_images()[0]
+    assert isinstance(image.norm, LogNorm)
+    assert image.get_array().max() == pytest.approx(20.0)  # kPa
+    assert image.norm.vmax / image.norm.vmin >= 10.0
+    # regions cut from the modulus field: its panel has them and the variance is of ln E
+    kwargs.update(levels=np.array([np.log(1.1e4)]), variance=kwargs["variance"] * 30)
+    fig = plot_map(*args, **kwargs, modulus_pa=modulus, region_field="modulus")
+    assert [ax.get_title() for ax in _panels(fig)][1:] == [
+        "β-field",
+        "modulus field, 2 region(s)",
+        "modulus-field variance and contacts",
+    ]
+    assert _colorbar_labels(fig)[-1] == "var(ln E)"
+    with pytest.raises(ValueError, match="modulus_pa"):
+        plot_map(*args, **kwargs, region_field="modulus")
+
+
 def test_poke_figure_panels_and_labels() -> None:
     fig = plot_poke(**_poke_kwargs())
     panels = _panels(fig)

@@ -46,3 +46,42 @@ def test_a_failed_recording_leaves_no_file(tmp_path) -> None:
     with pytest.raises(AttributeError):
         record_run(tmp_path / "run.rrd", result, initial_points=np.zeros((3, 3)))
     assert list(tmp_path.iterdir()) == []
+
+
+def test_the_recording_logs_the_modulus_field_when_a_poke_has_a_modulus(tmp_path) -> None:
+    pytest.importorskip("rerun")
+    import dataclasses
+
+    from test_own_environment import TwoFoamTable  # type: ignore[import-not-found]
+
+    from deformap.explore import (
+        ExplorationConfig,
+        ModulusField,
+        PokeResult,
+        StiffnessEstimate,
+        SurfaceGPConfig,
+        explore,
+    )
+    from deformap.viz import record_run
+
+    env = TwoFoamTable(np.random.default_rng(1))
+    config = ExplorationConfig(
+        max_pokes=2, strategy="max-variance", first_target=(0.06, 0.08),
+        surface=SurfaceGPConfig(fit_hyperparameters=False, length_scale_m=0.02),
+    )  # fmt: skip
+    result = explore(env, config, rng=np.random.default_rng(0))
+    estimate = StiffnessEstimate(
+        stiffness_n_per_m=500.0, stiffness_std_n_per_m=10.0, stiffness_lower_n_per_m=None,
+        modulus_pa=2e4, modulus_std_pa=1e3, contact_offset_m=0.0, depth_m=0.002, max_chi=0.3,
+        reduced_chi2=1.0, rigid=False, n_samples=8)  # fmt: skip
+    pokes = tuple(PokeResult(dataclasses.replace(p.record, stiffness=estimate), p.dent)
+                  for p in result.pokes)  # fmt: skip
+    field = ModulusField.of_records([p.record for p in pokes], result.xs, result.ys,
+                                    config.modulus_field, 0.33)  # fmt: skip
+    result = dataclasses.replace(result, pokes=pokes, modulus_field=field)
+    path = record_run(tmp_path / "run.rrd", result, initial_points=env.observe().points)
+    from rerun.chunk import RrdReader
+
+    entities = {str(chunk.entity_path) for chunk in RrdReader(path).stream()}
+    for entity in ("/maps/modulus_kpa", "/metrics/modulus_kpa", "/metrics/modulus_max_variance"):
+        assert entity in entities, (entity, sorted(entities))

@@ -44,6 +44,22 @@ def poke_row(p: PokeRecord) -> str:
     )
 
 
+def modulus_summary(report: dict[str, Any]) -> str:
+    """One line on the modulus field of a ``report.json``: the found regions' median E in kPa and
+    how many pokes it holds."""
+    field = report.get("modulus_field")
+    if field is None:
+        return "no poke has a modulus (no usable force–travel record)"
+    regions = report.get("regions") or {}
+    medians = regions.get("class_modulus_median_pa") or []
+    shown = ", ".join("–" if m is None else f"{m / 1e3:.3g}" for m in medians)
+    rigid = sum(bool(p["rigid"]) for p in field["pokes"] if p["used"])
+    left = len(field["pokes"]) - field["n_used"]
+    return (f"median E per region [kPa]: {shown or '–'}; from {field['n_used']} poke(s)"
+            + (f", {rigid} rigid (at its detection bound)" if rigid else "")
+            + (f", {left} left out (no usable record)" if left else ""))
+
+
 def _summary(out: Console, report: dict[str, Any], folder: Path) -> None:
     reg = report["regions"]
     tau = "n/a (one region)" if reg["kendall_tau"] is None else f"{reg['kendall_tau']:.2f}"
@@ -51,7 +67,10 @@ def _summary(out: Console, report: dict[str, Any], folder: Path) -> None:
     table.add_column()
     table.add_column(overflow="fold")  # the results folder in full, not cut with "…"
     table.add_row("pokes", f"{report['n_pokes']} (stopped by {report['stop_reason']})")
-    table.add_row("max β variance", f"{report['max_variance']:.4f}")
+    name = "ln E" if report.get("field") == "modulus" else "β"
+    table.add_row("map field", f"{report.get('field', 'beta')} (regions, targets and stop rule)")
+    table.add_row(f"max {name} variance", f"{report['max_variance']:.4f} "
+                  f"(T_h {report.get('threshold', float('nan')):.4g})")  # fmt: skip
     table.add_row("regions found / true", f"{reg['found']} / {reg['true']}")
     table.add_row("region accuracy", f"{reg['accuracy']:.3f}")
     table.add_row("mean IoU", f"{reg['mean_iou']:.3f}")
@@ -59,6 +78,7 @@ def _summary(out: Console, report: dict[str, Any], folder: Path) -> None:
     for key, what in (("order_regions", "found regions"), ("order_pokes", "pokes")):
         value = reg.get(key)
         table.add_row(f"order of the {what} (1: right)", "n/a" if value is None else f"{value:.2f}")
+    table.add_row("modulus", modulus_summary(report))
     t = report["timings"]
     table.add_row(
         "time",
@@ -88,9 +108,15 @@ def explore_command(
     ] = None,
     threshold: Annotated[
         float | None,
-        typer.Option(help="T_h: stop when max var(β) is below it (then any boundary pokes)."),
+        typer.Option(help="T_h: stop when max var(β) is below it (then any boundary pokes); "
+                     "with --field modulus, read as the same fraction of its prior variance."),
     ] = None,
     max_pokes: Annotated[int | None, typer.Option(help="Most pokes to make.")] = None,
+    field: Annotated[
+        str | None,
+        typer.Option(help="The field regions, targets and the stop rule run on: "
+                     "`exploration.field`, 'beta' or 'modulus' (from the force–travel records)."),
+    ] = None,
     config: Annotated[
         Path | None, typer.Option(help="Run configuration YAML (see `config dump`).")
     ] = None,
@@ -104,7 +130,8 @@ def explore_command(
 ) -> None:
     """Explore a simulated world: poke until the β-field is known, then cut it into regions."""
     overrides = run.RunOverrides(scenario=scenario, seed=seed, strategy=strategy,
-                                 threshold=threshold, max_pokes=max_pokes)  # fmt: skip
+                                 threshold=threshold, max_pokes=max_pokes,
+                                 field=field)  # fmt: skip
     cfg = run.explore_run_config(config, overrides, resume)
     shown = out_console(json_path)
     with progress(shown) as bar:

@@ -18,6 +18,7 @@ from deformap.cli._app import (
     labelled,
     out_console,
 )
+from deformap.cli._explore import modulus_summary
 from deformap.cli._progress import modulus_text, progress, run_hooks
 
 if TYPE_CHECKING:  # the CLI loads the estimator only when a command runs
@@ -104,6 +105,7 @@ def map_command(
         scored = f", accuracy {regions['accuracy']:.3f} against the ground truth"
     shown.print(f"{report['n_pokes']} of {len(output.session)} pokes used, {found}{scored}; "
                 f"wrote {output.folder / 'report.json'}", highlight=False)  # fmt: skip
+    shown.print(f"modulus: {modulus_summary(report)}", highlight=False)
     emit_json(json_path, report)
     if regions is None:  # the report is written (nothing lost), but there is no map
         err_console.print(labelled("error:", "bold red", (

@@ -1,6 +1,6 @@
 """Active exploration: the mapper and its concepts (surface model, dent and β, β-field, target
-choice, regions, stiffness and modulus from a force–travel record), the loop that drives an
-``Environment`` with it, the typed poke records and the session journal."""
+choice, regions, stiffness and modulus from a force–travel record, the modulus field), the loop
+that drives an ``Environment`` with it, the typed poke records and the session journal."""
 
 from __future__ import annotations
 
@@ -8,12 +8,14 @@ from deformap.explore._acquisition import STRATEGIES, choose_target
 from deformap.explore._config import (
     BetaFieldConfig,
     ExplorationConfig,
+    FieldName,
+    ModulusFieldConfig,
     SurfaceGPConfig,
     TouchGPConfig,
     check_exploration_budget,
 )
 from deformap.explore._dent import measure_press, roi_grid
-from deformap.explore._field import BetaField, PokeSet
+from deformap.explore._field import BetaField, FieldSettings, PokeSet, field_settings
 from deformap.explore._grid import MapGrid
 from deformap.explore._journal import (
     JOURNAL_NAME,
@@ -23,6 +25,12 @@ from deformap.explore._journal import (
 )
 from deformap.explore._loop import MappingRun, explore, poke_step
 from deformap.explore._mapper import Mapper
+from deformap.explore._modulus import (
+    ModulusField,
+    ModulusReading,
+    modulus_reading,
+    rigid_modulus_bound,
+)
 from deformap.explore._records import (
     PURPOSES,
     ContactRecord,
@@ -54,11 +62,16 @@ __all__ = [
     "Dent",
     "ExplorationConfig",
     "ExplorationResult",
+    "FieldName",
+    "FieldSettings",
     "Journal",
     "JournalContents",
     "MapGrid",
     "Mapper",
     "MappingRun",
+    "ModulusField",
+    "ModulusFieldConfig",
+    "ModulusReading",
     "PokeRecord",
     "PokeResult",
     "PokeSet",
@@ -76,11 +89,14 @@ __all__ = [
     "choose_target",
     "estimate_stiffness",
     "explore",
+    "field_settings",
     "fit_surface",
     "map_regions",
     "measure_press",
+    "modulus_reading",
     "poke_step",
     "read_journal",
+    "rigid_modulus_bound",
     "roi_grid",
     "segment_regions",
 ]

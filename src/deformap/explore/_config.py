@@ -40,6 +40,22 @@ applied to noise, β̂ re-read on each, :mod:`deformap.explore._dent_noise`): a 
 the README ("β separates hardness only under the force-driven protocol") compares with the spread
 of β̂ between places on one block. The floor stands for what the camera's noise does not explain
 (the rest of that spread, largest on the hard foams).
+Modulus field (``ExplorationConfig.field = "modulus"``, :mod:`deformap.explore._modulus`): a
+Gaussian random field over ln E [ln Pa] from the pokes' force–travel records. Its prior standard
+deviation 1.73 is a quarter of ln(10⁶ Pa / 10³ Pa) = 6.9: the soft foams to rubbers a table-top
+robot presses span about 1 kPa to 1 MPa (Gibson & Ashby 1997, ch. 5, flexible foams; rubbers at
+0.5–5 MPa), so ±2σ about the data's mean spans that range. Its length scale is the β-field's
+0.2 m, for the β-field's reason (the size of the pieces to tell apart, a property of the layout,
+not of what is measured). Noise floor 0.1 (10 % in E): an open-cell foam's modulus goes as its
+density squared (Gibson & Ashby, Eq. 5.6), and a foam sheet's density varies by a few per cent
+from place to place (±5 % in density is ±10 % in E); the contact model's own error is of that
+order too (issue 13 asks ≤ 10 % on linear-elastic foams). A rigid poke sits on the ln E axis at
+its detection bound with ``rigid_log_std`` (0.75): the bound is the record's travel span plus two
+of its standard deviations, so its relative error is about 1/2, and E goes as travel^(−3/2)
+(Hertz): 1.5 × 1/2 = 0.75. Settings given in β units take their modulus-field counterpart as
+the same fraction of the prior: ``T_h`` scales with the prior variance (0.06 of 0.09, two thirds,
+is 2.0 of 3.0 in (ln E)²) and the regions' smallest step with the prior standard deviation
+(:func:`deformap.explore.field_settings`).
 Next pokes by ``planned`` (:mod:`deformap.explore._planning`): the fewest pokes, the centre
 included, that bring every cell below ``T_h``; the README ("Results", the paper's Table I) gives
 the pokes each strategy needs on the simulated scenarios.
@@ -47,7 +63,8 @@ the pokes each strategy needs on the simulated scenarios.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
+from dataclasses import field as _field
 from typing import Any, Literal
 
 from deformap._validation import SettingError, check_settings, setting
@@ -63,6 +80,8 @@ __all__ = [
     "BetaFieldConfig",
     "BetaUncertainty",
     "ExplorationConfig",
+    "FieldName",
+    "ModulusFieldConfig",
     "RegionLabels",
     "StopRegion",
     "SurfaceGPConfig",
@@ -77,6 +96,8 @@ TouchModel = Literal["residual", "height"]
 StopRegion = Literal["workspace", "targets"]
 #: How cells get their region (``ExplorationConfig.region_labels``).
 RegionLabels = Literal["isopleth", "nearest"]
+#: Which field the regions and the next-poke choice run on (``ExplorationConfig.field``).
+FieldName = Literal["beta", "modulus"]
 #: Where a poke's β uncertainty comes from (``ExplorationConfig.beta_uncertainty``).
 BetaUncertainty = Literal["camera-noise", "shape-matching"]
 
@@ -170,6 +191,32 @@ class BetaFieldConfig:
 
 
 @dataclass(frozen=True, kw_only=True)
+class ModulusFieldConfig:
+    """Prior of the modulus field, a Gaussian random field over ln E (E in Pa; module docstring,
+    "Modulus field", argues the defaults).
+
+    Parameters
+    ----------
+    signal_std : float
+        Prior standard deviation of ln E about the pokes' weighted mean.
+    length_scale_m : float
+        σ_w, metres.
+    noise_floor : float
+        Smallest standard deviation of a poke's ln E (σ_E / E raised to it).
+    rigid_log_std : float
+        Standard deviation of ln E given to a rigid poke at its detection bound.
+    """
+
+    signal_std: float = setting(1.73, gt=0.0)
+    length_scale_m: float = setting(0.2, gt=0.0)
+    noise_floor: float = setting(0.1, gt=0.0)
+    rigid_log_std: float = setting(0.75, gt=0.0)
+
+    def __post_init__(self) -> None:
+        check_settings(self)
+
+
+@dataclass(frozen=True, kw_only=True)
 class ExplorationConfig:
     """Everything the mapper and the loop need; written next to every result.
 
@@ -210,6 +257,15 @@ class ExplorationConfig:
     stiffness : StiffnessConfig
         Reading stiffness and Young's modulus from a press's force–travel record, when the
         environment gives one (:func:`deformap.explore.estimate_stiffness`).
+    field : {"beta", "modulus"}
+        The field the regions, the next-poke choice and the stopping rule run on: ``beta``, the
+        β-field (the paper's); ``modulus``, the modulus field over ln E from the force–travel
+        records (:mod:`deformap.explore._modulus`; ``threshold`` is then read as the same fraction
+        of its prior variance). With ``modulus``, a run whose pokes give no usable record is
+        refused at its first poke (:class:`deformap.errors.EnvironmentStateError`).
+    modulus_field : ModulusFieldConfig
+        Prior of the modulus field; it is computed whenever a poke has a modulus, whichever
+        ``field`` is chosen.
     beta_uncertainty : {"camera-noise", "shape-matching"}
         The one switch for where each poke's β uncertainty (its noise in the β-field) comes from:
         ``camera-noise``, the camera's noise measured in the ROI carried through the touch GP and
@@ -231,11 +287,13 @@ class ExplorationConfig:
     region_labels: RegionLabels = "isopleth"
     boundary_pokes: int = setting(0, ge=0, le=1000)  # as for max_pokes
     beta_uncertainty: BetaUncertainty = "camera-noise"
-    surface: SurfaceGPConfig = field(default_factory=SurfaceGPConfig)
-    touch: TouchGPConfig = field(default_factory=TouchGPConfig)
-    beta_field: BetaFieldConfig = field(default_factory=BetaFieldConfig)
-    shape_matching: ShapeMatchingConfig = field(default_factory=ShapeMatchingConfig)
-    stiffness: StiffnessConfig = field(default_factory=StiffnessConfig)
+    field: FieldName = "beta"
+    surface: SurfaceGPConfig = _field(default_factory=SurfaceGPConfig)
+    touch: TouchGPConfig = _field(default_factory=TouchGPConfig)
+    beta_field: BetaFieldConfig = _field(default_factory=BetaFieldConfig)
+    modulus_field: ModulusFieldConfig = _field(default_factory=ModulusFieldConfig)
+    shape_matching: ShapeMatchingConfig = _field(default_factory=ShapeMatchingConfig)
+    stiffness: StiffnessConfig = _field(default_factory=StiffnessConfig)
 
     @staticmethod
     def upgrade_settings(data: dict[str, Any]) -> dict[str, Any]:

@@ -1,5 +1,7 @@
 """The β-field ("GPR β-field"): a Gaussian random field over the pokes' βs, each poke's
-uncertainty its noise (with a floor), read on the map's grid.
+uncertainty its noise (with a floor), read on the map's grid; and the settings any field the map
+runs on takes (:func:`field_settings`: the β-field's, or the modulus field's of
+:mod:`deformap.explore._modulus`, which is built on the same class).
 
 References
 ----------
@@ -16,24 +18,83 @@ from functools import cached_property
 import numpy as np
 from numpy.typing import NDArray
 
-from deformap.explore._config import BetaFieldConfig
+from deformap.explore._config import (
+    BetaFieldConfig,
+    ExplorationConfig,
+    FieldName,
+    ModulusFieldConfig,
+)
 from deformap.explore._records import PokeRecord
 from deformap.gp import GaussianRandomField
 
-__all__ = ["BetaField", "PokeSet"]
+__all__ = ["REGION_MIN_STEP_BETA", "BetaField", "FieldSettings", "PokeSet", "field_settings"]
+
+#: Smallest difference of two region classes' mean β that separates them
+#: (:func:`deformap.explore.segment_regions`'s ``min_step`` under the β-field).
+REGION_MIN_STEP_BETA = 0.05
+
+
+@dataclass(frozen=True)
+class FieldSettings:
+    """What the target choice, the stopping rule and the regions read of the field they run on,
+    in that field's units (β, or ln E for the modulus field).
+
+    Attributes
+    ----------
+    name : {"beta", "modulus"}
+    signal_std, length_scale_m, noise_floor : float
+        The field's prior (σe, σw) and its noise floor.
+    threshold : float
+        ``T_h`` on the field's variance.
+    min_step : float
+        Smallest difference of two region classes' means.
+    """
+
+    name: FieldName
+    signal_std: float
+    length_scale_m: float
+    noise_floor: float
+    threshold: float
+    min_step: float
+
+
+def field_settings(config: ExplorationConfig, name: FieldName | None = None) -> FieldSettings:
+    """The settings of the field ``name`` (default: the one ``config.field`` chooses).
+
+    ``threshold`` (``T_h``) and the regions' smallest step are given in β units; the modulus field
+    takes them as the same fraction of its prior: ``T_h`` scaled by the ratio of the prior
+    variances, the step by the ratio of the prior standard deviations (``_config``'s docstring,
+    "Modulus field").
+    """
+    beta = config.beta_field
+    if (name or config.field) == "beta":
+        return FieldSettings("beta", beta.signal_std, beta.length_scale_m, beta.noise_floor,
+                             config.threshold, REGION_MIN_STEP_BETA)  # fmt: skip
+    modulus = config.modulus_field
+    ratio = modulus.signal_std / beta.signal_std
+    return FieldSettings("modulus", modulus.signal_std, modulus.length_scale_m,
+                         modulus.noise_floor, config.threshold * ratio**2,
+                         REGION_MIN_STEP_BETA * ratio)  # fmt: skip
 
 
 @dataclass(frozen=True, eq=False)
 class PokeSet:
     """Where the pokes were and what they gave, as arrays.
 
-    ``xy (p, 2)`` metres, ``beta (p,)``, ``noise (p,)`` each poke's uncertainty raised to the
-    β-field's noise floor (what the field and the planner take as its noise).
+    ``xy (p, 2)`` metres, ``beta (p,)`` the values the field is fitted to (β for the β-field, ln E
+    for the modulus field), ``noise (p,)`` each poke's uncertainty raised to the field's noise
+    floor (what the field and the planner take as its noise), ``index (p,)`` the pokes' indices
+    in their run (default ``0 .. p-1``; the modulus field leaves out pokes without a modulus).
     """
 
     xy: NDArray[np.float64]
     beta: NDArray[np.float64]
     noise: NDArray[np.float64]
+    index: NDArray[np.int64] | None = None
+
+    def __post_init__(self) -> None:
+        if self.index is None:
+            object.__setattr__(self, "index", np.arange(self.beta.size, dtype=np.int64))
 
     @classmethod
     def of(cls, records: Sequence[PokeRecord], noise_floor: float) -> PokeSet:
@@ -49,12 +110,17 @@ class PokeSet:
 class BetaField:
     """The β-field of a set of pokes on the grid ``xs``, ``ys`` (no poke: the prior).
 
+    The prior mean is a constant, the pokes' inverse-noise-variance weighted mean
+    (:class:`deformap.gp.GaussianRandomField`), so far from every poke the field reverts to what
+    the pokes say on average, not to an arbitrary zero.
+
     Parameters
     ----------
     pokes : PokeSet
     xs : (nx,) float, ys : (ny,) float, metres
     config : BetaFieldConfig
-        Prior standard deviation σe, length scale σw and the noise floor.
+        Prior standard deviation σe, length scale σw and the noise floor (any object with
+        ``signal_std``, ``length_scale_m`` and ``noise_floor``: the modulus field passes its own).
 
     Attributes
     ----------
@@ -68,8 +134,10 @@ class BetaField:
         """The β-field of the pokes ``records`` (each one's uncertainty raised to the floor)."""
         return cls(PokeSet.of(records, config.noise_floor), xs, ys, config)
 
+    name: FieldName = "beta"
+
     def __init__(self, pokes: PokeSet, xs: NDArray[np.float64], ys: NDArray[np.float64],
-                 config: BetaFieldConfig) -> None:
+                 config: BetaFieldConfig | ModulusFieldConfig) -> None:
         self.pokes = pokes
         self.xs, self.ys = xs, ys
         self.config = config

@@ -169,6 +169,6 @@ def explore(
     else:
         # the poke limit stopped it unless the map was done: variance under T_h and no boundary
         # poke owed
-        if mapper.max_variance() <= config.threshold and mapper.boundary_owed() == 0:
+        if mapper.max_variance() <= mapper.threshold and mapper.boundary_owed() == 0:
             stop = "threshold"
     return run.result(stop)

@@ -24,8 +24,9 @@ from deformap.environment import PressObservation, Workspace
 from deformap.errors import EnvironmentStateError
 from deformap.explore._config import ExplorationConfig, check_exploration_budget
 from deformap.explore._dent import measure_press
-from deformap.explore._field import BetaField
+from deformap.explore._field import BetaField, field_settings
 from deformap.explore._grid import MapGrid
+from deformap.explore._modulus import ModulusField
 from deformap.explore._records import PokeResult, Target
 from deformap.explore._regions import RegionMap, map_regions
 from deformap.explore._result import ExplorationResult
@@ -53,7 +54,8 @@ class Mapper:
         self.grid = MapGrid.build(workspace, config)
         self.surface: SurfaceModel | None = None
         self._pokes: list[PokeResult] = []
-        self._field = self._fit([])
+        self._field, self._modulus = self._fit([])
+        self.threshold = field_settings(config).threshold
 
     @property
     def pokes(self) -> tuple[PokeResult, ...]:
@@ -65,9 +67,23 @@ class Mapper:
         """The current β-field."""
         return self._field
 
-    def _fit(self, pokes: list[PokeResult]) -> BetaField:
-        return BetaField.of([p.record for p in pokes], self.grid.xs, self.grid.ys,
-                            self.config.beta_field)  # fmt: skip
+    @property
+    def modulus_field(self) -> ModulusField:
+        """The current modulus field (the prior while no poke has a modulus)."""
+        return self._modulus
+
+    @property
+    def map_field(self) -> BetaField:
+        """The field the regions, the next target and the stopping rule run on
+        (``config.field``); ``threshold`` is its ``T_h``."""
+        return self._modulus if self.config.field == "modulus" else self._field
+
+    def _fit(self, pokes: list[PokeResult]) -> tuple[BetaField, ModulusField]:
+        records = [p.record for p in pokes]
+        return (BetaField.of(records, self.grid.xs, self.grid.ys, self.config.beta_field),
+                ModulusField.of_records(records, self.grid.xs, self.grid.ys,
+                                        self.config.modulus_field,
+                                        self.config.stiffness.poisson_ratio))  # fmt: skip
 
     def initialise(self, cloud: PointCloud, rng: np.random.Generator) -> SurfaceModel:
         """Fit the surface model to the first observation (:func:`fit_surface`)."""
@@ -89,24 +105,32 @@ class Mapper:
         stage times measured outside the mapper (``target_s``, ``environment_s``).
         """
         t0 = time.perf_counter()
-        field = self._fit([*self._pokes, poke])
+        field, modulus = self._fit([*self._pokes, poke])
+        if self.config.field == "modulus" and not len(modulus.pokes):
+            why = modulus.readings[-1].excluded
+            raise EnvironmentStateError(
+                f"`exploration.field` is 'modulus', but poke {poke.record.index + 1} gave no "
+                f"modulus ({why}); map with `exploration.field` 'beta', or give the presses "
+                "force–travel records")
+        active = modulus if self.config.field == "modulus" else field
         record = poke.record
         if target is not None:
             record = dataclasses.replace(record, purpose=target.purpose,
                                          planned_after=target.planned_after)  # fmt: skip
         record = dataclasses.replace(
-            record, max_variance_after=field.max_variance(self.grid.stop_mask),
+            record, max_variance_after=active.max_variance(self.grid.stop_mask),
             timings=dataclasses.replace(record.timings, field_s=time.perf_counter() - t0,
                                         **dict(timings or {})),
         )  # fmt: skip
         added = dataclasses.replace(poke, record=record)
         self._pokes.append(added)
-        self._field = field
+        self._field, self._modulus = field, modulus
         return added
 
     def max_variance(self) -> float:
-        """The β-field's largest variance where it must fall below ``T_h`` (``stop_region``)."""
-        return self._field.max_variance(self.grid.stop_mask)
+        """The map field's largest variance where it must fall below ``threshold``
+        (``stop_region``)."""
+        return self.map_field.max_variance(self.grid.stop_mask)
 
     def boundary_owed(self) -> int:
         """Boundary pokes still to make (``boundary_pokes`` less those made)."""
@@ -116,20 +140,21 @@ class Mapper:
     def next_target(self, rng: np.random.Generator) -> Target | None:
         """The next target (:func:`deformap.explore._targets.choose_next`), or ``None`` when the
         map is done."""
-        return choose_next(self.grid, self._field, self.config, rng,
+        return choose_next(self.grid, self.map_field, self.config, rng,
                            boundary_owed=self.boundary_owed())  # fmt: skip
 
     def regions(self) -> RegionMap:
-        """Cut the current β-field into regions (:func:`map_regions`)."""
+        """Cut the current map field into regions (:func:`map_regions`)."""
         if not self._pokes:
-            raise EnvironmentStateError("no poke yet: the β-field has no regions")
-        return map_regions(self._field.mean, self._field.pokes, self.grid.cells_xy, self.config)
+            raise EnvironmentStateError("no poke yet: the field has no regions")
+        field = self.map_field
+        return map_regions(field.mean, field.pokes, self.grid.cells_xy, self.config)
 
     def result(self, stop_reason: str, timings: Mapping[str, float]) -> ExplorationResult:
         """What the exploration produced, with the β-field and regions read once."""
         return ExplorationResult(
             config=self.config, workspace=self.workspace, grid=self.grid, surface=self.surface,
-            pokes=self.pokes, field=self._field,
+            pokes=self.pokes, field=self._field, modulus_field=self._modulus,
             regions=self.regions() if self._pokes else None,
             max_variance=self.max_variance(), stop_reason=stop_reason, timings=dict(timings),
         )  # fmt: skip

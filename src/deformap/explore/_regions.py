@@ -66,7 +66,7 @@ from numpy.typing import NDArray
 
 from deformap._validation import check_array, check_int, check_positive
 from deformap.explore._config import ExplorationConfig
-from deformap.explore._field import PokeSet
+from deformap.explore._field import PokeSet, field_settings
 
 __all__ = ["RegionMap", "map_regions", "poke_classes", "segment_regions"]
 
@@ -81,11 +81,12 @@ class RegionMap:
     Attributes
     ----------
     labels : (ny, nx) int
-        Region of each cell, 0 for the lowest β band (the stiffest class) upwards.
+        Region of each cell, 0 for the lowest band of the field upwards (β-field: the stiffest
+        class first; modulus field, ln E: the softest first).
     levels : (n_regions - 1,) float
         The isopleths between bands, increasing.
     class_betas : (n_regions,) float
-        Mean β of the pokes in each class.
+        Mean value of the pokes in each class (β, or ln E [ln Pa] for the modulus field).
     poke_labels : (k,) int
         The class of each poke, in the order the pokes were given (a class is a run of the sorted
         βs, so a poke's class is not always the band its β falls in).
@@ -280,11 +281,14 @@ def segment_regions(
 
 def poke_classes(mean: NDArray[np.float64], pokes: PokeSet,
                  config: ExplorationConfig) -> RegionMap:
-    """The pokes' classes and the isopleth labels of the β-field mean ``mean (ny, nx)``, by
+    """The pokes' classes and the isopleth labels of the map field's mean ``mean (ny, nx)``, by
     :func:`segment_regions` with the exploration's settings (``max_regions``,
-    ``region_prior_dof``, the β-field's noise floor)."""
-    return segment_regions(mean, pokes.beta, pokes.noise, floor=config.beta_field.noise_floor,
-                           max_regions=config.max_regions, prior_dof=config.region_prior_dof)
+    ``region_prior_dof``) and the map field's noise floor and smallest step
+    (:func:`deformap.explore.field_settings`: β, or ln E under ``field = "modulus"``)."""
+    cfg = field_settings(config)
+    return segment_regions(mean, pokes.beta, pokes.noise, floor=cfg.noise_floor,
+                           min_step=cfg.min_step, max_regions=config.max_regions,
+                           prior_dof=config.region_prior_dof)  # fmt: skip
 
 
 def map_regions(mean: NDArray[np.float64], pokes: PokeSet, cells_xy: NDArray[np.float64],

@@ -14,6 +14,7 @@ from deformap.environment import Workspace
 from deformap.explore._config import ExplorationConfig
 from deformap.explore._field import BetaField
 from deformap.explore._grid import MapGrid
+from deformap.explore._modulus import ModulusField
 from deformap.explore._records import PokeResult
 from deformap.explore._regions import RegionMap
 from deformap.explore._surface import SurfaceModel
@@ -40,10 +41,14 @@ class ExplorationResult:
         In order.
     field : BetaField
         The β-field after the last poke (``field.mean``, ``field.variance``: ``(ny, nx)``).
+    modulus_field : ModulusField
+        The modulus field over ln E after the last poke (the prior when no poke has a modulus;
+        ``modulus_field.readings`` says which pokes it holds and why the others are left out).
     regions : RegionMap or None
-        The regions of that field (``None`` without pokes).
+        The regions of the map field (``map_field``: ``config.field``'s; ``None`` without pokes).
     max_variance : float
-        What the stopping rule compared with ``T_h`` (over ``stop_region``).
+        What the stopping rule compared with ``T_h`` (over ``stop_region``, in the map field's
+        units: :func:`deformap.explore.field_settings`).
     stop_reason : str
         A :data:`StopReason`.
     timings : mapping of str to float
@@ -56,6 +61,7 @@ class ExplorationResult:
     surface: SurfaceModel | None
     pokes: tuple[PokeResult, ...]
     field: BetaField
+    modulus_field: ModulusField
     regions: RegionMap | None
     max_variance: float
     stop_reason: str
@@ -69,9 +75,27 @@ class ExplorationResult:
     def ys(self) -> NDArray[np.float64]:
         return self.grid.ys
 
+    @property
+    def map_field(self) -> BetaField:
+        """The field the regions and the stopping rule ran on (``config.field``)."""
+        return self.modulus_field if self.config.field == "modulus" else self.field
+
+    @property
+    def has_modulus(self) -> bool:
+        """Whether at least one poke has a modulus (the modulus field is more than its prior)."""
+        return len(self.modulus_field.pokes) > 0
+
     def field_after(self, n_pokes: int) -> BetaField:
         """The β-field as it was after the first ``n_pokes`` pokes (recordings, figures)."""
         if n_pokes == len(self.pokes):
             return self.field
         return BetaField.of([p.record for p in self.pokes[:n_pokes]], self.grid.xs, self.grid.ys,
                             self.config.beta_field)  # fmt: skip
+
+    def modulus_field_after(self, n_pokes: int) -> ModulusField:
+        """The modulus field as it was after the first ``n_pokes`` pokes."""
+        if n_pokes == len(self.pokes):
+            return self.modulus_field
+        return ModulusField.of_records([p.record for p in self.pokes[:n_pokes]], self.grid.xs,
+                                       self.grid.ys, self.config.modulus_field,
+                                       self.config.stiffness.poisson_ratio)  # fmt: skip

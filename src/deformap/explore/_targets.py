@@ -1,5 +1,7 @@
-"""The next place to poke: the configured strategy until the β-field's variance is under ``T_h``,
-then the boundary pokes (strategies and scores in :mod:`deformap.explore._acquisition`).
+"""The next place to poke: the configured strategy until the map field's variance is under
+``T_h`` (the β-field's, or the modulus field's under ``ExplorationConfig.field = "modulus"``, with
+its own ``T_h``: :func:`deformap.explore.field_settings`), then the boundary pokes (strategies
+and scores in :mod:`deformap.explore._acquisition`).
 
 When only the edge band, where no poke fits, is still above ``T_h``, ``planned`` plans it like
 any other place; the other strategies poke the reachable cell of largest variance, the one nearest
@@ -17,7 +19,7 @@ from scipy.spatial import cKDTree
 
 from deformap.explore._acquisition import boundary_score, choose_target
 from deformap.explore._config import ExplorationConfig
-from deformap.explore._field import BetaField, PokeSet
+from deformap.explore._field import BetaField, PokeSet, field_settings
 from deformap.explore._grid import MapGrid
 from deformap.explore._planning import PokePlan, VarianceDesign, plan_pokes
 from deformap.explore._records import Target
@@ -36,10 +38,11 @@ def expected_noise(candidates: NDArray[np.float64], pokes: PokeSet,
                    config: ExplorationConfig) -> NDArray[np.float64]:
     """The β uncertainty a poke at each of ``candidates (c, 2)`` is expected to have: the largest
     of the pokes already made within ``BOUNDARY_SPACING_ROI`` ROIs of it (a dent spreads a few
-    centimetres, so a press there measures that foam again, no better), else the β-field's noise
-    floor. So the target choice knows what a further press at a place can still reduce, and does
-    not return to a place whose readings are noisy expecting a reading at the floor."""
-    floor = config.beta_field.noise_floor
+    centimetres, so a press there measures that foam again, no better), else the map field's
+    noise floor (:func:`deformap.explore.field_settings`). So the target choice knows what a
+    further press at a place can still reduce, and does not return to a place whose readings are
+    noisy expecting a reading at the floor."""
+    floor = field_settings(config).noise_floor
     noise = np.full(len(candidates), floor)
     if len(pokes) == 0:
         return noise
@@ -53,12 +56,12 @@ def expected_noise(candidates: NDArray[np.float64], pokes: PokeSet,
 
 def _plan(grid: MapGrid, pokes: PokeSet, config: ExplorationConfig, n_made: int) -> PokePlan:
     """The plan with the fewest further pokes that brings the variance under ``T_h``."""
-    cfg = config.beta_field
+    cfg = field_settings(config)
     return plan_pokes(
         pokes.xy, pokes.noise, grid.plan_candidates, grid.plan_domain,
         signal_std=cfg.signal_std, length_scale=cfg.length_scale_m,
         new_noise=expected_noise(grid.plan_candidates, pokes, config),
-        threshold=config.threshold, max_new=max(1, config.max_pokes - n_made),
+        threshold=cfg.threshold, max_new=max(1, config.max_pokes - n_made),
     )  # fmt: skip
 
 
@@ -85,7 +88,9 @@ def choose_next(grid: MapGrid, field: BetaField, config: ExplorationConfig,
     ----------
     grid : MapGrid
     field : BetaField
-        The current β-field (its ``pokes`` are the pokes made).
+        The current map field (the β-field, or the modulus field under ``config.field =
+        "modulus"``; its ``pokes`` are the pokes it holds), read with
+        :func:`deformap.explore.field_settings`.
     config : ExplorationConfig
     rng : numpy.random.Generator
         This choice's stream (``paper`` draws from it; ``min-max-variance`` subsamples with it).
@@ -94,7 +99,8 @@ def choose_next(grid: MapGrid, field: BetaField, config: ExplorationConfig,
     """
     pokes = field.pokes
     variance = field.variance.ravel()
-    if variance[grid.stop_mask].max() <= config.threshold:
+    threshold = field_settings(config).threshold
+    if variance[grid.stop_mask].max() <= threshold:
         if boundary_owed == 0:
             return None
         xy = _boundary(grid, field, pokes, config)
@@ -111,7 +117,7 @@ def choose_next(grid: MapGrid, field: BetaField, config: ExplorationConfig,
         plans.append(_plan(grid, pokes, config, len(pokes)))
         return np.array(plans[-1].targets[0], dtype=float)
 
-    if reachable.max() <= config.threshold:  # only the edge band is left
+    if reachable.max() <= threshold:  # only the edge band is left
         if config.strategy == "planned":
             xy = planner()
         else:
@@ -119,14 +125,14 @@ def choose_next(grid: MapGrid, field: BetaField, config: ExplorationConfig,
     else:
         def look_ahead(candidates: NDArray[np.float64]) -> NDArray[np.float64]:
             # exact rank-one updates of the posterior: the variance does not depend on the βs
-            cfg = config.beta_field
+            cfg = field_settings(config)
             design = VarianceDesign(pokes.xy, pokes.noise, candidates,
                                     grid.cells_xy[grid.stop_mask], cfg.signal_std,
                                     cfg.length_scale_m,
                                     expected_noise(candidates, pokes, config))  # fmt: skip
-            return design.after([], config.threshold)[1]
+            return design.after([], threshold)[1]
 
-        chosen = choose_target(config.strategy, cells, reachable, config.threshold, rng,
+        chosen = choose_target(config.strategy, cells, reachable, threshold, rng,
                                look_ahead=look_ahead, planner=planner)  # fmt: skip
         if chosen is None:  # pragma: no cover - reachable.max() > threshold above
             return None

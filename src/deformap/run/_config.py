@@ -56,7 +56,7 @@ class RunConfig:
 class RunOverrides:
     """Settings given on the command line; ``None`` keeps the configuration's own.
 
-    ``strategy``, ``threshold`` and ``max_pokes`` are fields of
+    ``strategy``, ``threshold``, ``max_pokes`` and ``field`` are fields of
     :class:`~deformap.explore.ExplorationConfig`, which validates them.
     """
 
@@ -65,6 +65,7 @@ class RunOverrides:
     strategy: str | None = None
     threshold: float | None = None
     max_pokes: int | None = None
+    field: str | None = None
 
     def given(self) -> dict[str, Any]:
         """The overrides that were given, by field name."""

@@ -26,6 +26,7 @@ from deformap.explore import (
     PokeRecord,
     check_exploration_budget,
     explore,
+    field_settings,
     read_journal,
 )
 from deformap.run._config import (
@@ -192,7 +193,8 @@ def explore_scenario(
     if figures:
         hooks.stage("drawing figures")
         title = f"{config.scenario} (seed {config.seed}): {len(result.pokes)} pokes"
-        write_map_figures(folder, result, truth=world, threshold=config.exploration.threshold,
+        threshold = field_settings(config.exploration).threshold
+        write_map_figures(folder, result, truth=world, threshold=threshold,
                           title=title)  # fmt: skip
     if rerun:
         hooks.stage("writing run.rrd")

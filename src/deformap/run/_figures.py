@@ -35,7 +35,8 @@ def write_map_figures(
     truth : object with ``ground_truth_hardness(xs, ys)``, optional
         As in :func:`~deformap.run.shared_report`; without it the map has no ground-truth panel.
     threshold : float, optional
-        T_h, drawn on the variance panel.
+        T_h of the map field (``field_settings(config).threshold``), drawn on the variance
+        panel.
     title : str
 
     Returns
@@ -51,10 +52,12 @@ def write_map_figures(
         contacts = np.array([p.xy for p in result.pokes])
         truth_hardness = None if truth is None else truth.ground_truth_hardness(result.xs, result.ys)
         levels = regions.levels if result.config.region_labels == "isopleth" else None
-        plot_map(result.xs, result.ys, beta=result.field.mean, variance=result.field.variance,
-                 contacts=contacts, labels=regions.labels, levels=levels,
-                 truth_hardness=truth_hardness, threshold=threshold, title=title,
-                 path=folder / "map.png")  # fmt: skip
+        modulus = result.modulus_field.median_pa if result.has_modulus else None
+        plot_map(result.xs, result.ys, beta=result.field.mean,
+                 variance=result.map_field.variance, contacts=contacts, labels=regions.labels,
+                 levels=levels, truth_hardness=truth_hardness, threshold=threshold, title=title,
+                 path=folder / "map.png", modulus_pa=modulus,
+                 region_field=result.config.field)  # fmt: skip
         written.append(folder / "map.png")
     for poke in result.pokes:
         if poke.dent is None:  # resumed from the journal: no arrays to draw

@@ -10,6 +10,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from deformap.explore import field_settings
 from deformap.replay import RecordedSession, ReplayResult, load_session, map_session
 from deformap.run._config import (
     CONFIG_NAME,
@@ -104,6 +105,6 @@ def map_recorded_session(
     if figures:
         hooks.stage("drawing figures")
         write_map_figures(folder, replay.result, truth=recorded.ground_truth,
-                          threshold=cfg.exploration.threshold,
+                          threshold=field_settings(cfg.exploration).threshold,
                           title=f"{stem}: {len(replay.result.pokes)} pokes")  # fmt: skip
     return MapOutput(report=report, session=recorded, replay=replay, config=cfg, folder=folder)

@@ -5,9 +5,20 @@ Every report of a mapped surface (a live exploration, :func:`live_report`; a rec
 
 - ``pokes`` (one record per poke, as the mapper wrote it), ``n_pokes``, ``stop_reason``;
 - ``max_variance`` (what the stopping rule compared with T_h, over ``stop_region``) and
-  ``max_variance_map`` (over the whole map);
-- ``regions``: ``levels``, ``class_betas``, ``poke_labels``, ``labels_by`` and, with a ground
-  truth, the scores of :func:`deformap.eval.region_scores` (``None`` without a poke);
+  ``max_variance_map`` (over the whole map), both of the map field (``field``), in its units;
+- ``field`` (the field the regions, the targets and the stop rule ran on: ``beta`` or
+  ``modulus``) and ``threshold`` (its ``T_h``, in its units: :func:`deformap.explore.field_settings`);
+- ``regions``: ``levels`` and ``class_values`` (in the map field's units: β, or ln E [ln Pa]),
+  ``class_betas`` (the mean β of each class's pokes), ``class_modulus_median_pa`` (the median of
+  the modulus field's E [Pa] over each found region's cells; ``None`` without a modulus),
+  ``poke_labels``, ``labels_by`` and, with a ground truth, the scores of
+  :func:`deformap.eval.region_scores` (``None`` without a poke; the ordering scores read the
+  modulus field as ``−ln E``, which grows with softness as β does);
+- ``modulus_field`` (``None`` while no poke has a modulus): the modulus field on the map's grid,
+  ``xs_m``, ``ys_m``, ``log_mean_ln_pa`` (posterior mean of ln E, rows along y) and
+  ``log_std`` (standard deviation of ln E, ≈ the relative error of E), ``max_variance``, the
+  per-poke ``pokes`` (``log_modulus_ln_pa``, ``rigid``, ``used``, ``excluded_because``) and
+  ``n_used``;
 - ``true_regions`` (only with a ground truth) and ``timings`` (the loop's, plus per poke).
 
 Around it, every report names the version (``deformap``), the ``seed`` and the effective
@@ -31,7 +42,7 @@ from deformap import __version__
 from deformap._config import config_to_dict
 from deformap.environment import TactileContact
 from deformap.eval import ordering_scores, region_scores
-from deformap.explore import ExplorationResult, PokeResult
+from deformap.explore import ExplorationResult, PokeResult, field_settings
 from deformap.replay import RecordedSession, ReplayResult
 from deformap.run._config import RunConfig
 from deformap.world import SimulatedWorld
@@ -40,6 +51,7 @@ __all__ = [
     "SHARED_KEYS",
     "estimate_report",
     "live_report",
+    "modulus_report",
     "session_report",
     "shared_report",
 ]
@@ -48,9 +60,12 @@ SHARED_KEYS = (
     "pokes",
     "n_pokes",
     "stop_reason",
+    "field",
+    "threshold",
     "max_variance",
     "max_variance_map",
     "regions",
+    "modulus_field",
     "timings",
 )
 """The keys :func:`shared_report` always writes (``true_regions`` too, with a ground truth)."""
@@ -63,17 +78,36 @@ def _finite(value: float | None) -> float | None:
     return None if value is None or not math.isfinite(value) else float(value)
 
 
-def _regions(
-    result: ExplorationResult, beta: Any, truth: Any
-) -> tuple[dict[str, Any], list[Any] | None]:
-    """``regions`` and ``true_regions`` (``None`` without a ground truth) of a mapped surface
-    whose β-field mean on the grid is ``beta``."""
+def _class_values(result: ExplorationResult) -> dict[str, Any]:
+    """The found classes' mean β (from their pokes) and median E over their cells."""
+    found = result.regions
+    assert found is not None
+    field = result.map_field
+    betas = np.array([p.record.beta for p in result.pokes])
+    index = np.arange(len(field.pokes)) if field.pokes.index is None else field.pokes.index
+    by_index = {int(i): int(k) for i, k in zip(index, found.poke_labels, strict=True)}
+    class_betas = []
+    for k in range(found.n_regions):
+        members = [betas[i] for i, label in by_index.items() if label == k]
+        class_betas.append(float(np.mean(members)) if members else None)
+    medians: list[float | None] | None = None
+    if result.has_modulus:
+        median = result.modulus_field.median_pa
+        medians = [float(np.median(median[found.labels == k])) if np.any(found.labels == k)
+                   else None for k in range(found.n_regions)]  # fmt: skip
+    return {"class_betas": class_betas, "class_modulus_median_pa": medians}
+
+
+def _regions(result: ExplorationResult, truth: Any) -> tuple[dict[str, Any], list[Any] | None]:
+    """``regions`` and ``true_regions`` (``None`` without a ground truth) of a mapped surface."""
     found = result.regions
     assert found is not None  # shared_report asks only when there are pokes
+    field = result.map_field
     # under region_labels "nearest" the cells take their nearest poke's class, and the levels
-    # only separate the classes' βs
+    # only separate the classes' values
     regions: dict[str, Any] = {"levels": found.levels.tolist(),
-                               "class_betas": found.class_betas.tolist(),
+                               "class_values": found.class_betas.tolist(),
+                               **_class_values(result),
                                "poke_labels": found.poke_labels.tolist(),
                                "labels_by": result.config.region_labels}  # fmt: skip
     if truth is None:
@@ -81,13 +115,15 @@ def _regions(
     labels = truth.ground_truth_labels(result.xs, result.ys)
     hardness_grid = truth.ground_truth_hardness(result.xs, result.ys)
     hardness = {int(label): float(hardness_grid[labels == label][0]) for label in np.unique(labels)}
-    scores = region_scores(found.labels, labels, beta, hardness)
-    # the true label under each poke: the grid cell nearest its contact
-    xy = np.array([p.xy for p in result.pokes])
+    # the metrics order by softness: β grows with it, ln E falls
+    sign = -1.0 if field.name == "modulus" else 1.0
+    scores = region_scores(found.labels, labels, sign * field.mean, hardness)
+    # the true label under each of the field's pokes: the grid cell nearest its contact
+    xy = field.pokes.xy
     col = np.abs(result.xs[None, :] - xy[:, :1]).argmin(axis=1)
     row = np.abs(result.ys[None, :] - xy[:, 1:]).argmin(axis=1)
-    order = ordering_scores(found.labels, found.class_betas, labels, hardness,
-                            np.array([p.record.beta for p in result.pokes]), labels[row, col])
+    order = ordering_scores(found.labels, sign * found.class_betas, labels, hardness,
+                            sign * field.pokes.beta, labels[row, col])
     true_regions = [
         {"label": label, "hardness_n": _finite(h)} for label, h in sorted(hardness.items())
     ]
@@ -104,17 +140,20 @@ def shared_report(result: ExplorationResult, *, truth: Any = None) -> dict[str, 
         A :class:`~deformap.world.SimulatedWorld` or a session's
         :class:`~deformap.replay.GroundTruth`; ``None`` leaves the ground-truth metrics out.
     """
-    beta, var = result.field.mean, result.field.variance
+    var = result.map_field.variance
     pokes = [p.record.to_dict() for p in result.pokes]
     per_poke_compute = [p.record.timings.compute_s for p in result.pokes]
-    regions, true_regions = _regions(result, beta, truth) if pokes else (None, None)
+    regions, true_regions = _regions(result, truth) if pokes else (None, None)
     report: dict[str, Any] = {
         "pokes": pokes,
         "n_pokes": len(pokes),
         "stop_reason": result.stop_reason,
+        "field": result.config.field,
+        "threshold": field_settings(result.config).threshold,
         "max_variance": result.max_variance,
         "max_variance_map": float(var.max()),
         "regions": regions,
+        "modulus_field": modulus_report(result),
     }
     if truth is not None:
         report["true_regions"] = true_regions
@@ -127,6 +166,30 @@ def shared_report(result: ExplorationResult, *, truth: Any = None) -> dict[str, 
         "per_poke_compute_s": per_poke_compute,
     }
     return report
+
+
+def _rounded(grid: Any) -> list[Any]:
+    """A grid as nested lists at 6 significant digits (far below the field's own uncertainty)."""
+    return [[float(f"{v:.6g}") for v in row] for row in np.asarray(grid, dtype=float)]
+
+
+def modulus_report(result: ExplorationResult) -> dict[str, Any] | None:
+    """``report.json``'s ``modulus_field`` (module docstring), ``None`` while no poke has a
+    modulus."""
+    if not result.has_modulus:
+        return None
+    field = result.modulus_field
+    return {
+        "units": {"xs_m": "m", "ys_m": "m", "log_mean_ln_pa": "ln Pa (E in Pa)",
+                  "log_std": "1 (standard deviation of ln E)"},
+        "xs_m": result.xs.tolist(),
+        "ys_m": result.ys.tolist(),
+        "log_mean_ln_pa": _rounded(field.mean),
+        "log_std": _rounded(field.std),
+        "max_variance": field.max_variance(result.grid.stop_mask),
+        "n_used": len(field.pokes),
+        "pokes": [r.to_dict() for r in field.readings],
+    }  # fmt: skip
 
 
 def live_report(

@@ -1,7 +1,9 @@
 """Figures of a run, each a :class:`matplotlib.figure.Figure` built without ``pyplot``.
 
 ``map.png`` follows the paper's Fig. 6: ground truth | β-field with region contours and the contacts
-| variance with the contacts (first contact a circle, later ones triangles). ``poke-NN.png``
+| variance with the contacts (first contact a circle, later ones triangles); with a modulus field, a
+panel of E in kPa (log colour scale) comes before the variance, which is the variance of the field
+the regions ran on. ``poke-NN.png``
 follows its Fig. 4: the ROI before, after (cloud and reconstructed surface), the fitted dent, and
 the error curve E(β).
 
@@ -17,7 +19,9 @@ from pathlib import Path
 
 import numpy as np
 from matplotlib.axes import Axes
+from matplotlib.colors import LogNorm
 from matplotlib.figure import Figure
+from matplotlib.ticker import FuncFormatter
 from numpy.typing import NDArray
 
 from deformap.viz._save import save_figure
@@ -54,20 +58,26 @@ def plot_map(
     threshold: float | None = None,
     title: str = "",
     path: str | Path | None = None,
+    modulus_pa: NDArray[np.float64] | None = None,
+    region_field: str = "beta",
 ) -> Figure:
-    """The map figure: ground truth (when given) | β-field and regions | variance and contacts.
+    """The map figure: ground truth (when given) | β-field | modulus field (when given) |
+    variance and contacts; the regions drawn on the field they were cut from.
 
     Parameters
     ----------
     xs, ys : (nx,), (ny,) float, metres
         Grid of the maps.
-    beta, variance : (ny, nx) float
-        β-field mean and variance.
+    beta : (ny, nx) float
+        β-field mean.
+    variance : (ny, nx) float
+        Variance of the field the regions ran on (``region_field``'s: β², or (ln E)²).
     contacts : (k, 2) float, metres
         Poked places in order.
     labels, levels : optional
-        Region label map and the isopleths drawn as contours of ``beta``; without ``levels``, the
-        edges between the labels are drawn (regions labelled by nearest poke).
+        Region label map and the isopleths drawn as contours of ``region_field``'s mean (β, or
+        ln E of ``modulus_pa``); without ``levels``, the edges between the labels are drawn
+        (regions labelled by nearest poke). The other field's panel shows the labels' edges.
     truth_hardness : (ny, nx) float, optional
         Ground-truth hardness in newtons (``inf`` rigid, ``nan`` bare table); omitted without truth.
     threshold : float, optional
@@ -76,13 +86,19 @@ def plot_map(
         The figure's title.
     path : str or Path, optional
         Where to write the figure (110 dpi, format from the suffix); nothing is written without it.
+    modulus_pa : (ny, nx) float, optional
+        The modulus field's median E in pascals, drawn in kPa on a log colour scale.
+    region_field : {"beta", "modulus"}
+        The field the regions were cut from (``modulus`` needs ``modulus_pa``).
 
     Returns
     -------
     matplotlib.figure.Figure
         The figure, one panel per map, each with its colour bar.
     """
-    panels = 3 if truth_hardness is not None else 2
+    if region_field == "modulus" and modulus_pa is None:
+        raise ValueError("`modulus_pa` is required when `region_field` is 'modulus'")
+    panels = 2 + (truth_hardness is not None) + (modulus_pa is not None)
     fig = Figure(figsize=(5.2 * panels, 4.0), layout="constrained")
     axes = fig.subplots(1, panels)
     ext = _extent(xs, ys)
@@ -96,26 +112,29 @@ def plot_map(
             ax.contourf(xs, ys, rigid.astype(float), levels=[0.5, 1.5], colors="0.3")
         fig.colorbar(im, ax=ax, label="hardness H [N] (grey: rigid)")
         ax.set_title("ground truth")
-    ax = axes[0]
-    im = ax.imshow(beta, origin="lower", extent=ext, cmap="magma", vmin=0.0, vmax=1.0)
-    if levels is not None and len(levels):
-        ax.contour(xs, ys, beta, levels=np.sort(levels), colors="c", linewidths=2)
-    elif labels is not None and np.ptp(labels) > 0:
-        # each region's outline (contours of the label values would draw two lines where
-        # regions 0 and 2 meet)
-        for label in np.unique(labels):
-            ax.contour(xs, ys, (labels == label).astype(float), levels=[0.5], colors="c",
-                       linewidths=2)
-    fig.colorbar(im, ax=ax, label="β (deformability)")
     n_regions = "" if labels is None else f", {len(np.unique(labels))} region(s)"
-    ax.set_title(f"β-field{n_regions}")
+    ax = axes.pop(0)
+    im = ax.imshow(beta, origin="lower", extent=ext, cmap="magma", vmin=0.0, vmax=1.0)
+    _regions(ax, xs, ys, beta, labels, levels if region_field == "beta" else None,
+             main=region_field == "beta")  # fmt: skip
+    fig.colorbar(im, ax=ax, label="β (deformability)")
+    ax.set_title(f"β-field{n_regions if region_field == 'beta' else ''}")
     _contacts(ax, contacts)
-    ax = axes[1]
+    if modulus_pa is not None:
+        ax = axes.pop(0)
+        _modulus_panel(fig, ax, ext, modulus_pa)
+        log_e = np.log(modulus_pa)
+        _regions(ax, xs, ys, log_e, labels, levels if region_field == "modulus" else None,
+                 main=region_field == "modulus")  # fmt: skip
+        ax.set_title(f"modulus field{n_regions if region_field == 'modulus' else ''}")
+        _contacts(ax, contacts)
+    ax = axes.pop(0)
     im = ax.imshow(variance, origin="lower", extent=ext, cmap="Blues")
     if threshold is not None and variance.max() > threshold > variance.min():
         ax.contour(xs, ys, variance, levels=[threshold], colors="r", linewidths=1)
-    fig.colorbar(im, ax=ax, label="var(β)")
-    ax.set_title("β-field variance and contacts")
+    name = "ln E" if region_field == "modulus" else "β"
+    fig.colorbar(im, ax=ax, label=f"var({name})")
+    ax.set_title(f"{'modulus' if region_field == 'modulus' else 'β'}-field variance and contacts")
     _contacts(ax, contacts)
     for a in fig.axes:
         if a.get_label() != "<colorbar>":
@@ -126,6 +145,43 @@ def plot_map(
     if path is not None:
         save_figure(fig, path, dpi=110)
     return fig
+
+
+def _regions(ax: Axes, xs: NDArray, ys: NDArray, values: NDArray, labels: NDArray | None,
+             levels: NDArray | None, *, main: bool) -> None:
+    """The regions on one field's panel: its isopleths ``levels`` when given, else the labels'
+    outlines (dashed on the panel of the field they were not cut from)."""
+    if levels is not None and len(levels):
+        ax.contour(xs, ys, values, levels=np.sort(levels), colors="c", linewidths=2)
+    elif labels is not None and np.ptp(labels) > 0:
+        # each region's outline (contours of the label values would draw two lines where
+        # regions 0 and 2 meet)
+        for label in np.unique(labels):
+            ax.contour(xs, ys, (labels == label).astype(float), levels=[0.5], colors="c",
+                       linewidths=2 if main else 1,
+                       linestyles="solid" if main else "dashed")  # fmt: skip
+
+
+def _modulus_panel(fig: Figure, ax: Axes, ext: list[float], modulus_pa: NDArray) -> None:
+    """E in kPa on a log colour scale spanning at least a factor of ten."""
+    kpa = np.asarray(modulus_pa, dtype=float) / 1e3
+    finite = kpa[np.isfinite(kpa) & (kpa > 0)]
+    low, high = (float(finite.min()), float(finite.max())) if finite.size else (1.0, 10.0)
+    mid = np.sqrt(low * high)
+    if high / low < 10.0:
+        low, high = mid / np.sqrt(10.0), mid * np.sqrt(10.0)
+    im = ax.imshow(kpa, origin="lower", extent=(ext[0], ext[1], ext[2], ext[3]), cmap="viridis",
+                   norm=LogNorm(vmin=low, vmax=high))  # fmt: skip
+    bar = fig.colorbar(im, ax=ax, label="Young's modulus E [kPa] (log scale)")
+    decades = float(np.log10(high / low))
+
+    def minor(value: float, _: object) -> str:
+        # over less than two decades, label the 2s and 5s between the powers of ten
+        lead = round(value / 10 ** np.floor(np.log10(value)))
+        return f"{value:g}" if decades < 2.0 and lead in (2, 5) else ""
+
+    bar.ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+    bar.ax.yaxis.set_minor_formatter(FuncFormatter(minor))
 
 
 def plot_beta_curve(ax: Axes, betas: NDArray, errors: NDArray, beta_hat: float, std: float) -> None:

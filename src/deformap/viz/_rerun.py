@@ -119,3 +119,22 @@ def _log_run(rec: Any, result: Any, pts: NDArray[np.float64]) -> None:
         rec.log("maps/variance", rr.Image(_colors(var[::-1], "Blues", 0.0, float(var.max()))))
         rec.log("metrics/beta", rr.Scalars(poke.record.beta))
         rec.log("metrics/max_variance", rr.Scalars(float(var.max())))
+        _log_modulus(rec, result, k)
+
+
+def _log_modulus(rec: Any, result: Any, k: int) -> None:
+    """The modulus field after ``k`` pokes: ``maps/modulus_kpa`` (log₁₀ E in kPa coloured over
+    0.1 kPa – 10 MPa: soft foams to stiff rubbers), ``metrics/modulus_kpa`` (the poke's E, or
+    its detection bound when rigid) and ``metrics/modulus_max_variance`` (of ln E); nothing while
+    no poke has a modulus."""
+    import rerun as rr
+
+    field = result.modulus_field_after(k)
+    if not len(field.pokes):
+        return
+    log_kpa = np.log10(field.median_pa / 1e3)
+    rec.log("maps/modulus_kpa", rr.Image(_colors(log_kpa[::-1], "viridis", -1.0, 4.0)))
+    reading = field.readings[-1]
+    if reading.log_modulus is not None:
+        rec.log("metrics/modulus_kpa", rr.Scalars(float(np.exp(reading.log_modulus) / 1e3)))
+    rec.log("metrics/modulus_max_variance", rr.Scalars(float(field.variance.max())))

@@ -1,0 +1,151 @@
+"""The modulus field: a Gaussian random field over ln E (E in Pa) from the pokes' force–travel
+records, beside the β-field and built on the same class (:class:`deformap.explore.BetaField`).
+
+Each poke's value and noise
+---------------------------
+A poke whose record gave a modulus (:class:`deformap.explore.StiffnessEstimate`) enters as
+``ln E`` with the standard deviation ``σ_E / E`` (the delta method's σ of ln E), raised to the
+field's noise floor. A *rigid* poke has no modulus: it enters at its detection bound, the
+smallest modulus whose press would have travelled as far as the record's travel bound
+(:func:`rigid_modulus_bound`), with ``rigid_log_std``; never a huge number, which would drag the
+field's prior mean (the pokes' weighted mean) and every region threshold with it. A poke without
+a usable record (none came with the press, or the estimator refused it) is left out of the
+modulus field; :attr:`ModulusField.readings` says which and why, per poke.
+
+Prior mean
+----------
+:class:`deformap.gp.GaussianRandomField` subtracts a constant prior mean, the pokes'
+inverse-noise-variance weighted mean. For ln E a zero mean would be 1 Pa, nine orders below any
+foam, and a fixed physical mean (say the geometric centre of 1 kPa–1 MPa) would pull every
+unexplored place to a material that may not be on the table; the pokes' own mean is the
+empirical-Bayes choice the β-field makes too, and the prior variance (``signal_std²``) still says
+how little is known there.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+from numpy.typing import NDArray
+
+from deformap.errors import InvalidArgumentError
+from deformap.explore._config import ModulusFieldConfig
+from deformap.explore._field import BetaField, PokeSet
+from deformap.explore._records import PokeRecord
+from deformap.mechanics import layer_indentation_force
+
+__all__ = ["ModulusField", "ModulusReading", "modulus_reading", "rigid_modulus_bound"]
+
+
+@dataclass(frozen=True)
+class ModulusReading:
+    """One poke on the modulus field's axis.
+
+    Attributes
+    ----------
+    index : int
+        The poke's index in its run.
+    log_modulus, log_std : float or None
+        ln E [ln Pa] and its standard deviation before the floor; ``None`` when left out.
+    rigid : bool
+        The record read rigid: ``log_modulus`` is the detection bound.
+    excluded : str or None
+        Why the poke is not in the modulus field (``None`` when it is).
+    """
+
+    index: int
+    log_modulus: float | None
+    log_std: float | None
+    rigid: bool
+    excluded: str | None
+
+    def to_dict(self) -> dict[str, object]:
+        return {"index": self.index, "log_modulus_ln_pa": self.log_modulus,
+                "log_modulus_std": self.log_std, "rigid": self.rigid,
+                "used": self.excluded is None, "excluded_because": self.excluded}  # fmt: skip
+
+
+def rigid_modulus_bound(record: PokeRecord, poisson_ratio: float) -> float:
+    """The smallest Young's modulus [Pa] a rigid poke's record could not tell from rigid.
+
+    The record's lower bound on the stiffness bounds the travel from zero force to the commanded
+    force ``F`` from above, ``δ_b = F / k_lower`` (at least the rigid test's travel bound: the
+    travel span plus two of its standard deviations, :func:`deformap.explore.estimate_stiffness`);
+    a surface of modulus ``E_b = F / g(δ_b)`` (``g`` the bonded-layer force at unit modulus on the
+    poke's layer, Hertz's half-space force without a layer thickness) would have travelled that
+    far. A stiffer one travels less and reads rigid too, so ``E_b`` is where the record's
+    knowledge ends.
+    """
+    estimate = record.stiffness
+    if estimate is None or not estimate.rigid or estimate.stiffness_lower_n_per_m is None:
+        raise InvalidArgumentError("`record` must be a poke whose force–travel record read rigid")
+    force = record.force_n
+    radius = record.contact.tip_radius_m
+    depth = force / estimate.stiffness_lower_n_per_m
+    thickness = record.layer_thickness_m
+    if thickness is not None and np.isfinite(thickness) and thickness > depth:
+        unit = float(layer_indentation_force(np.array([depth]), radius, thickness, 1.0,
+                                             poisson_ratio)[0])  # fmt: skip
+    else:
+        unit = 4.0 / 3.0 / (1.0 - poisson_ratio**2) * np.sqrt(radius) * depth**1.5
+    return float(force / unit)
+
+
+def modulus_reading(record: PokeRecord, config: ModulusFieldConfig,
+                    poisson_ratio: float) -> ModulusReading:
+    """Where one poke sits on the ln E axis, or why it is left out (module docstring)."""
+    estimate = record.stiffness
+    if estimate is None:
+        why = record.stiffness_error
+        reason = ("no force–travel record came with the press" if why is None
+                  else f"its force–travel record was not used: {why}")  # fmt: skip
+        return ModulusReading(record.index, None, None, False, reason)
+    if estimate.rigid:
+        bound = rigid_modulus_bound(record, poisson_ratio)
+        return ModulusReading(record.index, float(np.log(bound)), config.rigid_log_std, True, None)
+    assert estimate.modulus_pa is not None and estimate.modulus_std_pa is not None
+    return ModulusReading(record.index, float(np.log(estimate.modulus_pa)),
+                          float(estimate.modulus_std_pa / estimate.modulus_pa), False, None)
+
+
+class ModulusField(BetaField):
+    """The modulus field over ln E of the pokes that have a modulus (no such poke: the prior).
+
+    ``mean`` and ``variance`` are of ln E [ln Pa] on the grid; :attr:`median_pa` is ``exp(mean)``
+    (the median of the log-normal posterior of E), :attr:`std` the standard deviation of ln E.
+    """
+
+    name = "modulus"
+
+    def __init__(self, pokes: PokeSet, xs: NDArray[np.float64], ys: NDArray[np.float64],
+                 config: ModulusFieldConfig,
+                 readings: Sequence[ModulusReading] = ()) -> None:
+        super().__init__(pokes, xs, ys, config)
+        self.readings = tuple(readings)
+
+    @classmethod
+    def of_records(cls, records: Sequence[PokeRecord], xs: NDArray[np.float64],
+                   ys: NDArray[np.float64], config: ModulusFieldConfig,
+                   poisson_ratio: float) -> ModulusField:
+        """The modulus field of the pokes ``records`` that have a modulus or read rigid."""
+        readings = [modulus_reading(r, config, poisson_ratio) for r in records]
+        used = [(r, m) for r, m in zip(records, readings, strict=True) if m.excluded is None]
+        xy = np.array([r.contact_xy for r, _ in used], dtype=float).reshape(-1, 2)
+        values = np.array([m.log_modulus for _, m in used], dtype=float)
+        noise = np.maximum(np.array([m.log_std for _, m in used], dtype=float),
+                           config.noise_floor)  # fmt: skip
+        index = np.array([m.index for _, m in used], dtype=np.int64)
+        return cls(PokeSet(xy, values, noise.reshape(-1), index), xs, ys, config, readings)
+
+    @property
+    def std(self) -> NDArray[np.float64]:
+        """Posterior standard deviation of ln E on the grid."""
+        return np.sqrt(self.variance)
+
+    @cached_property
+    def median_pa(self) -> NDArray[np.float64]:
+        """``exp(mean)``: the posterior median of E [Pa] on the grid (NaN without a poke)."""
+        return np.exp(self.mean)

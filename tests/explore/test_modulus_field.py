@@ -1,0 +1,174 @@
+"""The modulus field over ln E (issue 13, item 3): each poke's value and noise, rigid pokes at
+their detection bound, pokes without a record left out, the settings, and the map running on it."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from deformap._validation import SettingError
+from deformap.environment import Workspace
+from deformap.errors import EnvironmentStateError, InvalidArgumentError
+from deformap.explore import (
+    ExplorationConfig,
+    Mapper,
+    ModulusField,
+    ModulusFieldConfig,
+    PokeResult,
+    StiffnessEstimate,
+    field_settings,
+    modulus_reading,
+    rigid_modulus_bound,
+)
+from deformap.testing import synthetic_poke
+
+CONFIG = ModulusFieldConfig()
+NU = 0.33
+XS = np.linspace(0.0, 0.6, 31)
+YS = np.linspace(0.0, 0.4, 21)
+
+
+def _soft(modulus: float, rel_std: float = 0.03) -> StiffnessEstimate:
+    return StiffnessEstimate(
+        stiffness_n_per_m=500.0, stiffness_std_n_per_m=10.0, stiffness_lower_n_per_m=None,
+        modulus_pa=modulus, modulus_std_pa=rel_std * modulus, contact_offset_m=0.0,
+        depth_m=0.002, max_chi=0.3, reduced_chi2=1.0, rigid=False, n_samples=8)  # fmt: skip
+
+
+def _rigid(lower: float = 2.0e4) -> StiffnessEstimate:
+    return StiffnessEstimate(
+        stiffness_n_per_m=None, stiffness_std_n_per_m=None, stiffness_lower_n_per_m=lower,
+        modulus_pa=None, modulus_std_pa=None, contact_offset_m=None, depth_m=1e-5,
+        max_chi=None, reduced_chi2=None, rigid=True, n_samples=8)  # fmt: skip
+
+
+def _poke(xy: tuple[float, float], estimate: StiffnessEstimate | None, index: int = 0, *,
+          error: str | None = None, thickness: float | None = 0.05) -> PokeResult:
+    poke = synthetic_poke(xy, 0.5, index=index)
+    record = dataclasses.replace(poke.record, stiffness=estimate, stiffness_error=error,
+                                 layer_thickness_m=thickness)  # fmt: skip
+    return PokeResult(record)
+
+
+def _field(pokes: list[PokeResult]) -> ModulusField:
+    return ModulusField.of_records([p.record for p in pokes], XS, YS, CONFIG, NU)
+
+
+def test_the_field_is_over_ln_e_and_interpolates_the_pokes_within_their_noise() -> None:
+    moduli = [5e3, 2e4, 8e4]
+    places = [(0.1, 0.1), (0.3, 0.3), (0.5, 0.1)]
+    pairs = enumerate(zip(places, moduli, strict=True))
+    field = _field([_poke(xy, _soft(e), i) for i, (xy, e) in pairs])
+    assert np.allclose(field.pokes.beta, np.log(moduli))
+    for (x, y), e in zip(places, moduli, strict=True):
+        col, row = int(np.argmin(abs(XS - x))), int(np.argmin(abs(YS - y)))
+        # within two of the poke's noise on the ln E axis (its 3 % raised to the 10 % floor)
+        assert abs(field.mean[row, col] - np.log(e)) < 2 * CONFIG.noise_floor
+        assert field.median_pa[row, col] == pytest.approx(e, rel=0.25)
+        assert field.std[row, col] < CONFIG.noise_floor
+    # far from every poke the std returns toward the prior's
+    assert field.std.max() > 0.5 * CONFIG.signal_std
+
+
+def test_a_pokes_relative_error_is_its_noise_raised_to_the_floor() -> None:
+    field = _field([_poke((0.1, 0.1), _soft(1e4, 0.02), 0),
+                    _poke((0.5, 0.3), _soft(1e4, 0.4), 1)])
+    assert field.pokes.noise.tolist() == pytest.approx([CONFIG.noise_floor, 0.4])
+
+
+def test_a_rigid_poke_sits_at_its_detection_bound_not_at_a_huge_number() -> None:
+    rigid = _poke((0.3, 0.2), _rigid(2.0e4), 0, thickness=None)
+    reading = modulus_reading(rigid.record, CONFIG, NU)
+    assert reading.rigid and reading.excluded is None
+    assert reading.log_std == CONFIG.rigid_log_std
+    # Hertz: F = 4/3 E/(1-ν²) √R δ^1.5 with δ = F / k_lower (0.6 N over 2·10⁴ N/m = 30 µm)
+    depth = 0.6 / 2.0e4
+    expected = 0.6 / (4 / 3 / (1 - NU**2) * np.sqrt(0.01) * depth**1.5)
+    assert np.exp(reading.log_modulus) == pytest.approx(expected, rel=1e-9)
+    assert 1e5 < expected < 1e9
+    # on a bonded layer the same travel means a lower modulus (the layer is stiffer at unit E)
+    on_layer = rigid_modulus_bound(_poke((0.3, 0.2), _rigid(2.0e4), thickness=0.01).record, NU)
+    assert on_layer < expected
+    # a stiffer record (a larger lower bound on k) gives a larger bound
+    assert rigid_modulus_bound(_poke((0.3, 0.2), _rigid(4.0e4), thickness=None).record, NU) \
+        > expected
+    with pytest.raises(InvalidArgumentError, match="record"):
+        rigid_modulus_bound(_poke((0.3, 0.2), _soft(1e4)).record, NU)
+
+
+def test_pokes_without_a_usable_record_are_left_out_and_say_why() -> None:
+    pokes = [_poke((0.1, 0.1), _soft(1e4), 0), _poke((0.3, 0.2), None, 1),
+             _poke((0.5, 0.3), None, 2, error="`force_n` must rise"), _poke((0.5, 0.1), _rigid(), 3)]
+    field = _field(pokes)
+    assert field.pokes.index.tolist() == [0, 3]
+    why = [r.excluded for r in field.readings]
+    assert why[0] is None and why[3] is None
+    assert "no force–travel record" in why[1]
+    assert "`force_n` must rise" in why[2]
+    assert [r.to_dict()["used"] for r in field.readings] == [True, False, False, True]
+
+
+def test_without_a_modulus_the_field_is_its_prior() -> None:
+    field = _field([_poke((0.1, 0.1), None)])
+    assert not len(field.pokes)
+    assert np.isnan(field.mean).all()
+    assert np.allclose(field.variance, CONFIG.signal_std**2)
+
+
+def test_settings_in_beta_units_are_the_same_fraction_of_the_modulus_prior() -> None:
+    config = ExplorationConfig(field="modulus", threshold=0.06)
+    beta, modulus = field_settings(config, "beta"), field_settings(config)
+    assert modulus.name == "modulus" and beta.name == "beta"
+    prior_beta = config.beta_field.signal_std**2
+    prior_modulus = config.modulus_field.signal_std**2
+    assert modulus.threshold / prior_modulus == pytest.approx(beta.threshold / prior_beta)
+    assert modulus.min_step / config.modulus_field.signal_std == pytest.approx(
+        beta.min_step / config.beta_field.signal_std)
+    assert field_settings(ExplorationConfig()).name == "beta"
+
+
+@pytest.mark.parametrize("bad", [{"signal_std": 0.0}, {"length_scale_m": -0.1},
+                                 {"noise_floor": 0.0}, {"rigid_log_std": -1.0}])
+def test_bad_modulus_settings_are_refused_naming_the_field(bad: dict[str, float]) -> None:
+    (name,) = bad
+    with pytest.raises(SettingError, match=name):
+        ModulusFieldConfig(**bad)
+
+
+def test_an_unknown_field_is_refused() -> None:
+    with pytest.raises(SettingError, match="field"):
+        ExplorationConfig(field="hardness")  # type: ignore[arg-type]
+
+
+def _mapper(field: str) -> Mapper:
+    config = ExplorationConfig(field=field, max_pokes=6)  # type: ignore[arg-type]
+    return Mapper(Workspace(), config)
+
+
+def test_the_map_runs_on_the_modulus_field_when_asked() -> None:
+    mapper = _mapper("modulus")
+    soft, stiff = [(0.1, 0.1), (0.15, 0.3), (0.1, 0.2)], [(0.5, 0.1), (0.45, 0.3), (0.5, 0.2)]
+    pokes = [_poke(xy, _soft(5e3 * (1 + 0.05 * i)), i) for i, xy in enumerate(soft)]
+    pokes += [_poke(xy, _soft(5e4 * (1 + 0.05 * i)), 3 + i) for i, xy in enumerate(stiff)]
+    for poke in pokes:  # every poke the same β: only the modulus tells the two halves apart
+        mapper.add(poke)
+    assert mapper.map_field is mapper.modulus_field
+    assert mapper.threshold == field_settings(mapper.config).threshold
+    assert mapper.max_variance() == mapper.modulus_field.max_variance(mapper.grid.stop_mask)
+    regions = mapper.regions()
+    assert regions.n_regions == 2
+    assert regions.poke_labels.tolist() == [0, 0, 0, 1, 1, 1]  # ln E: the softest class first
+    on_beta = _mapper("beta")
+    for poke in pokes:
+        on_beta.add(poke)
+    assert on_beta.regions().n_regions == 1
+
+
+def test_field_modulus_without_a_record_is_refused_at_the_first_poke() -> None:
+    mapper = _mapper("modulus")
+    with pytest.raises(EnvironmentStateError, match=r"exploration\.field.*no force–travel record"):
+        mapper.add(_poke((0.3, 0.2), None))
+    # the β-field's map takes the same poke
+    assert len(_mapper("beta").add(_poke((0.3, 0.2), None)).record.contact_xy) == 2
