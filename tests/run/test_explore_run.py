@@ -151,6 +151,26 @@ def test_a_journal_whose_poke_lines_are_not_in_order_is_refused_on_resume(
         explore_scenario(_config(), out, resume=True, figures=False)
 
 
+def test_a_killed_and_resumed_run_has_every_poke_figure(tmp_path: Path, full_run) -> None:  # type: ignore[no-untyped-def]
+    out = tmp_path / "killed"
+
+    def kill(poke) -> None:  # type: ignore[no-untyped-def]
+        if poke.index == 1:
+            raise Killed
+
+    with pytest.raises(Killed):
+        explore_scenario(_config(), out, hooks=RunHooks(on_poke=kill))
+    # drawn as the pokes were made: the kill keeps them
+    assert sorted(p.name for p in out.glob("poke-*.png")) == ["poke-01.png", "poke-02.png"]
+    (out / "poke-02.png").unlink()  # as if killed between poke 2's journal line and its figure
+    resumed = explore_scenario(_config(), out, resume=True)
+    assert sorted(p.name for p in out.glob("poke-*.png")) == [
+        "poke-01.png", "poke-02.png", "poke-03.png"]
+    assert (out / "poke-02.png").stat().st_size > 10_000
+    assert [p["beta"] for p in resumed.report["pokes"]] == [
+        p["beta"] for p in full_run.report["pokes"]]
+
+
 def test_resume_refuses_a_different_configuration(tmp_path, full_run) -> None:  # type: ignore[no-untyped-def]
     other = RunConfig(**{**_config().__dict__, "seed": 5})
     with pytest.raises(ConfigError, match="differs from this one"):

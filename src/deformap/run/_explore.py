@@ -21,12 +21,15 @@ from deformap._config import config_from_dict, config_to_dict
 from deformap.errors import ConfigError, DeformapError, FileFormatError
 from deformap.explore import (
     JOURNAL_NAME,
+    ExplorationConfig,
     ExplorationResult,
     Journal,
     PokeRecord,
+    PokeResult,
     check_exploration_budget,
     explore,
     field_settings,
+    measure_press,
     read_journal,
 )
 from deformap.run._config import (
@@ -36,7 +39,12 @@ from deformap.run._config import (
     load_run_config,
     run_generators,
 )
-from deformap.run._figures import write_map_figures, write_rerun
+from deformap.run._figures import (
+    poke_figure_path,
+    write_map_figures,
+    write_poke_figure,
+    write_rerun,
+)
 from deformap.run._folder import (
     create_run_folder,
     default_run_folder,
@@ -126,6 +134,31 @@ def _resume_journal(
     return journal, done
 
 
+def _redraw_resumed_pokes(folder: Path, result: ExplorationResult, world: SimulatedWorld,
+                          config: ExplorationConfig) -> None:
+    """Draw ``poke-NN.png`` of the journalled pokes that have none (the run was killed between a
+    poke's journal line and its figure, or before figures were drawn as pokes were made).
+
+    The journal holds no arrays, so the poke is pressed again: the simulated world's noise is
+    keyed by the press and the dent's estimate is a function of the press and the surface model,
+    so it is the same poke. Its β is compared with the journalled one before anything is drawn;
+    a poke that does not come out the same gets no figure and a warning.
+    """
+    for poke in result.pokes:
+        index = poke.record.index
+        if poke.dent is not None or poke_figure_path(folder, index).exists():
+            continue
+        assert result.surface is not None  # explore() fits it before any poke
+        obs = world.press(poke.record.target_xy, poke.record.force_n)
+        world.release()
+        again = measure_press(obs, index, result.surface, config)
+        if again.record.beta != poke.record.beta:
+            logger.warning("poke %d pressed again reads β %.4f, its journal %.4f: no figure",
+                           index + 1, again.record.beta, poke.record.beta)
+            continue
+        write_poke_figure(folder, again)
+
+
 def explore_scenario(
     config: RunConfig,
     out: Path | None = None,
@@ -186,8 +219,14 @@ def explore_scenario(
     world = SimulatedWorld(scenario, config=config.world, rng=world_rng)
     world_s = time.perf_counter() - t0
     hooks.stage("exploring")
+
+    def on_poke(poke: PokeResult) -> None:
+        if figures:  # drawn as each poke is made, so a killed run keeps its pokes' figures
+            write_poke_figure(folder, poke)
+        hooks.poke(poke.record)
+
     result = explore(world, config.exploration, rng=explore_rng, journal=journal, done=done,
-                     on_poke=lambda poke: hooks.poke(poke.record))  # fmt: skip
+                     on_poke=on_poke)  # fmt: skip
     report = live_report(config, result, world, world_build_s=world_s)
     write_json(folder / "report.json", report)
     if figures:
@@ -195,7 +234,8 @@ def explore_scenario(
         title = f"{config.scenario} (seed {config.seed}): {len(result.pokes)} pokes"
         threshold = field_settings(config.exploration).threshold
         write_map_figures(folder, result, truth=world, threshold=threshold,
-                          title=title)  # fmt: skip
+                          title=title, poke_figures=False)  # fmt: skip
+        _redraw_resumed_pokes(folder, result, world, config.exploration)
     if rerun:
         hooks.stage("writing run.rrd")
         write_rerun(folder / "run.rrd", result)

@@ -15,7 +15,8 @@ import numpy as np
 
 from deformap.explore import ExplorationResult, PokeResult
 
-__all__ = ["write_estimate_figures", "write_map_figures", "write_rerun"]
+__all__ = ["poke_figure_path", "write_estimate_figures", "write_map_figures", "write_poke_figure",
+           "write_rerun"]
 
 
 def write_map_figures(
@@ -25,8 +26,10 @@ def write_map_figures(
     truth: Any = None,
     threshold: float | None = None,
     title: str = "",
+    poke_figures: bool = True,
 ) -> list[Path]:
-    """``map.png`` (when there is a poke) and one ``poke-NN.png`` per poke processed here.
+    """``map.png`` (when there is a poke) and, with ``poke_figures``, one ``poke-NN.png`` per
+    poke processed here (:func:`write_poke_figure`).
 
     Parameters
     ----------
@@ -38,11 +41,13 @@ def write_map_figures(
         T_h of the map field (``field_settings(config).threshold``), drawn on the variance
         panel.
     title : str
+    poke_figures : bool
+        False when the caller drew each poke's figure as the poke was made.
 
     Returns
     -------
     list of Path
-        The files written. A poke resumed from a journal has no arrays and no figure.
+        The files written. A poke resumed from a journal has no arrays and no figure here.
     """
     from deformap.viz import plot_map
 
@@ -59,15 +64,24 @@ def write_map_figures(
                  path=folder / "map.png", modulus_pa=modulus,
                  region_field=result.config.field)  # fmt: skip
         written.append(folder / "map.png")
-    for poke in result.pokes:
-        if poke.dent is None:  # resumed from the journal: no arrays to draw
-            continue
-        r = poke.record
-        path = folder / f"poke-{r.index + 1:02d}.png"
-        _plot_poke(path, poke, f"poke {r.index + 1} at ({r.contact_xy[0]:.3f}, "
-                               f"{r.contact_xy[1]:.3f}) m")  # fmt: skip
-        written.append(path)
+    if poke_figures:
+        written += [write_poke_figure(folder, poke) for poke in result.pokes
+                    if poke.dent is not None]  # a poke resumed from a journal has no arrays
     return written
+
+
+def poke_figure_path(folder: Path, index: int) -> Path:
+    """Where the figure of poke ``index`` (0-based) goes: ``poke-NN.png``, NN from 01."""
+    return folder / f"poke-{index + 1:02d}.png"
+
+
+def write_poke_figure(folder: Path, poke: PokeResult) -> Path:
+    """``poke-NN.png`` of one processed poke (it must carry its dent's arrays)."""
+    r = poke.record
+    path = poke_figure_path(folder, r.index)
+    _plot_poke(path, poke, f"poke {r.index + 1} at ({r.contact_xy[0]:.3f}, "
+                           f"{r.contact_xy[1]:.3f}) m")  # fmt: skip
+    return path
 
 
 def _plot_poke(path: Path, poke: PokeResult, title: str) -> None:
