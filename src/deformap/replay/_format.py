@@ -21,7 +21,13 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from deformap._validation import check_array, check_int, check_positive, check_vector
+from deformap._validation import (
+    check_array,
+    check_int,
+    check_positive,
+    check_rigid_transform,
+    check_vector,
+)
 from deformap.cloud.io import UNITS
 from deformap.environment import ForceTravel, Workspace
 from deformap.errors import ConfigError, DeformapError
@@ -201,16 +207,7 @@ def _cam2world(file: Path, data: dict[str, Any], frame: str, form: str) -> Any:
         if form != "bag":
             raise ConfigError(f"{_where(file, 'cam2world')}: 'tf_static' needs the bag form")
         return "tf_static"
-    mat = _value(file, "cam2world", check_array, raw, (4, 4), what="transform entries")
-    rot = mat[:3, :3]
-    rigid = (np.allclose(mat[3], [0, 0, 0, 1], atol=1e-9)
-             and np.allclose(rot @ rot.T, np.eye(3), atol=1e-6)
-             and np.linalg.det(rot) > 0)  # fmt: skip
-    if not rigid:
-        raise ConfigError(
-            f"{_where(file, 'cam2world')} must be a rigid transform (orthonormal rotation with "
-            "det +1, last row 0 0 0 1)"
-        )
+    mat = _value(file, "cam2world", check_rigid_transform, raw)
     return mat
 
 
