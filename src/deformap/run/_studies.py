@@ -26,7 +26,7 @@ from deformap.eval import (
 from deformap.explore import ExplorationConfig
 from deformap.run._folder import create_run_folder, default_run_folder, write_json
 from deformap.run._hooks import NO_HOOKS, RunHooks, RunStart
-from deformap.world import WorldConfig, camera_preset
+from deformap.world import Physics, WorldConfig, camera_preset
 
 __all__ = ["CLUSTER_SIZE_FOAMS", "StudyOutput", "run_cluster_size_study", "run_hardness_study"]
 
@@ -46,7 +46,7 @@ class StudyOutput:
 def _foams(
     name: str, foams: Sequence[float | None], folder: Path, *, seed: int, coarse: bool,
     hooks: RunHooks, camera: str | None = None, thickness_m: float = 0.05,
-    force_n: float | None = None, physics: str = "linear-fem",
+    force_n: float | None = None, physics: Physics = "linear-fem",
 ) -> list[FoamPresses]:  # fmt: skip
     hooks.start(RunStart(kind="study", title=f"{name}, seed {seed}", folder=folder,
                          total=len(foams)))  # fmt: skip
@@ -108,9 +108,10 @@ def run_hardness_study(
     foams = DEFAULT_HARDNESSES if not hardness else (*hardness, None)
     if camera is not None:
         camera_preset(camera)  # an unknown name fails here, before any world is built
-    WorldConfig(physics=physics)  # so does an unknown physics (one line naming `physics`)
+    # so does an unknown physics (one line naming `physics`)
+    checked = WorldConfig(physics=physics).physics  # type: ignore[arg-type]
     presses = _foams("hardness study", foams, folder, seed=seed, coarse=coarse, hooks=hooks,
-                     camera=camera, thickness_m=thickness_m, force_n=force_n, physics=physics)
+                     camera=camera, thickness_m=thickness_m, force_n=force_n, physics=checked)
     hooks.stage("estimating β per protocol")
     conditions = {"camera": camera or "primesense", "thickness_m": thickness_m,
                   "force_n": presses[0].presses[0].force_n if presses else force_n,

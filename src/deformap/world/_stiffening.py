@@ -70,7 +70,7 @@ from __future__ import annotations
 
 import logging
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import scipy.sparse as sp
@@ -92,7 +92,9 @@ _CORE_RADII = 2.0  # the uniform core spans ±2 a
 _GROWTH = 1.2  # cell growth outside the core
 _REACH_LENGTHS = 8.0  # the grid reaches 8 ℓ beyond the core (the dent decays as exp(−r / ℓ))
 _MAX_NEWTON = 80
-_MAX_GRIDS = 4
+_MAX_ROUNDS = 12  # solves a press may take to settle its grid and its mode shape
+_DECAY_TOLERANCE = 0.01
+_SETTLING_STEPS = 3
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -104,9 +106,11 @@ class FoundationLayer:
     modulus_pa, poisson_ratio, thickness_m : float
         The block's small-strain Young's modulus, Poisson ratio and thickness.
     densification_strain : float
-        ``ε_d``: the column strain at which the stress becomes unbounded.
+        ``ε_d``: the strain at which the stress becomes unbounded.
     stiffening_exponent : float
         ``m``; 0 is a linear spring.
+    decay : float
+        ``γ`` of the mode shape ``φ(z) = sinh(γ z / H) / sinh γ`` (0: linear, ``z / H``).
     shear : bool
         False drops the shear layer (``G_p = 0``: a Winkler foundation).
     """
@@ -116,6 +120,7 @@ class FoundationLayer:
     thickness_m: float
     densification_strain: float = 0.95
     stiffening_exponent: float = 1.0
+    decay: float = 0.0
     shear: bool = True
 
     @property
@@ -124,16 +129,35 @@ class FoundationLayer:
         return self.modulus_pa * (1 - nu) / ((1 + nu) * (1 - 2 * nu))
 
     @property
+    def shear_modulus_pa(self) -> float:
+        return self.modulus_pa / (2 * (1 + self.poisson_ratio))
+
+    def mode(self, z: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """``φ(z)`` and ``φ'(z)`` [1/m] at heights ``z`` above the table."""
+        h, g = self.thickness_m, self.decay
+        if g < 1e-6:
+            return z / h, np.full_like(z, 1.0 / h)
+        return np.sinh(g * z / h) / np.sinh(g), g / h * np.cosh(g * z / h) / np.sinh(g)
+
+    def _moments(self) -> tuple[float, float]:
+        """``∫ φ'² dz`` [1/m] and ``∫ φ² dz`` [m] over the thickness, in closed form."""
+        h, g = self.thickness_m, self.decay
+        if g < 1e-6:
+            return 1.0 / h, h / 3.0
+        s2 = math.sinh(g) ** 2
+        half = math.sinh(2 * g) / (4 * g)
+        return g * g / h * (half + 0.5) / s2, h * (half - 0.5) / s2
+
+    @property
     def spring_pa_per_m(self) -> float:
-        """Small-strain Winkler modulus ``k = M / H`` [Pa/m]."""
-        return self.constrained_modulus_pa / self.thickness_m
+        """Small-strain spring modulus ``k = M ∫ φ'² dz`` [Pa/m] (``M / H`` when linear)."""
+        return self.constrained_modulus_pa * self._moments()[0]
 
     @property
     def shear_n_per_m(self) -> float:
-        """Pasternak shear parameter ``G_p = G H / 3`` [N/m] (0 without shear)."""
-        if not self.shear:
-            return 0.0
-        return self.modulus_pa / (2 * (1 + self.poisson_ratio)) * self.thickness_m / 3
+        """Pasternak shear parameter ``G_p = G ∫ φ² dz`` [N/m] (``G H / 3`` when linear; 0
+        without shear)."""
+        return self.shear_modulus_pa * self._moments()[1] if self.shear else 0.0
 
     @property
     def influence_length_m(self) -> float:
@@ -142,22 +166,43 @@ class FoundationLayer:
 
     @property
     def max_deflection_m(self) -> float:
-        """The deflection at which the column strain reaches ``ε_d`` (inf when linear)."""
+        """The deflection at which the largest strain (at the top) reaches ``ε_d``, as the
+        quadrature through the thickness sees it (its highest point): where its pressure is
+        unbounded (inf when linear)."""
         if self.stiffening_exponent == 0.0:
             return math.inf
-        return self.densification_strain * self.thickness_m
+        slope = self.mode(_through_thickness(self.thickness_m)[0])[1]
+        return self.densification_strain / float(np.max(slope))
+
+    def decay_for(self, w: NDArray[np.float64], grid: FoundationGrid) -> float:
+        """Vallabhan & Das's ``γ`` for the surface deflection ``w`` on ``grid``:
+        ``(γ / H)² = (G / M) ∫ |∇w|² dA / ∫ w² dA``."""
+        ratio = float(w @ (grid.laplacian @ w)) / float(np.sum(grid.area * w * w))
+        return self.thickness_m * math.sqrt(self.shear_modulus_pa
+                                            / self.constrained_modulus_pa * ratio)
 
     def pressure(self, w: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """Spring pressure ``σ(w / H)`` [Pa] and its derivative in ``w`` [Pa/m], elementwise."""
-        eps = w / self.thickness_m
-        m, ed = self.stiffening_exponent, self.densification_strain
-        big_m = self.constrained_modulus_pa
-        if m == 0.0:
-            return big_m * eps, np.full_like(eps, self.spring_pa_per_m)
+        """Spring pressure ``p(w) = ∫ σ(w φ') φ' dz`` [Pa] and ``dp/dw`` [Pa/m], elementwise
+        (Gauss–Legendre through the thickness; closed form when linear)."""
+        if self.stiffening_exponent == 0.0:
+            return self.spring_pa_per_m * w, np.full_like(w, self.spring_pa_per_m)
+        z, weight = _through_thickness(self.thickness_m)
+        slope = self.mode(z)[1]  # (q,)
+        eps = w[:, None] * slope  # (n, q) strains
+        m, ed, big_m = self.stiffening_exponent, self.densification_strain, \
+            self.constrained_modulus_pa
         squeeze = np.where(eps > 0.0, 1.0 - eps / ed, 1.0)
         sigma = big_m * eps * squeeze**-m
-        dsigma = big_m * (squeeze**-m + np.where(eps > 0.0, eps * m / ed * squeeze**(-m - 1), 0.0))
-        return sigma, dsigma / self.thickness_m
+        dsigma = big_m * (squeeze**-m + np.where(eps > 0.0, eps * m / ed * squeeze**(-m - 1),
+                                                 0.0))
+        return (sigma * slope) @ weight, (dsigma * slope**2) @ weight
+
+
+def _through_thickness(thickness_m: float) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """32 Gauss–Legendre heights and weights over ``[0, H]`` (exact for ``φ'²`` polynomials of
+    degree 63; ``cosh²(γ z / H)`` to machine precision for the decays met here)."""
+    x, wt = np.polynomial.legendre.leggauss(32)
+    return 0.5 * thickness_m * (x + 1.0), 0.5 * thickness_m * wt
 
 
 def graded_axis(center: float, lo: float, hi: float, *, step: float, core: float,
@@ -252,8 +297,8 @@ class NewtonResult:
 
 def solve_press(layer: FoundationLayer, grid: FoundationGrid, center: NDArray[np.float64],
                 force_n: float, tip_radius_m: float, depth_guess_m: float,
-                start: tuple[NDArray[np.float64], NDArray[np.bool_]] | None = None
-                ) -> NewtonResult:
+                start: tuple[NDArray[np.float64], NDArray[np.bool_]] | None = None,
+                max_steps: int = _MAX_NEWTON) -> NewtonResult:
     """Force-controlled sphere contact on the foundation by Newton's method with active sets.
 
     Unknowns: the deflections off the contact and the tip's sink ``δ`` (on the contact
@@ -261,7 +306,8 @@ def solve_press(layer: FoundationLayer, grid: FoundationGrid, center: NDArray[np
     contact and the contact's total force minus ``F``; its Jacobian is the tangent stiffness
     reduced the same way (symmetric positive definite while ``ε < ε_d``). ``start`` is a first
     ``(w, active)`` (a coarser grid's solution); default: the nodes under the tip sunk
-    ``depth_guess_m`` in contact.
+    ``depth_guess_m`` in contact. ``max_steps`` caps the Newton steps (an inexact solve, for
+    a press still settling its grid and mode shape).
     """
     r2 = np.sum((grid.xy - center) ** 2, axis=1)
     cap = np.full(r2.size, np.inf)
@@ -270,12 +316,12 @@ def solve_press(layer: FoundationLayer, grid: FoundationGrid, center: NDArray[np
     w_max = layer.max_deflection_m * (1.0 - 1e-6)
     gp = layer.shear_n_per_m
     n = r2.size
-    delta = min(depth_guess_m, 0.5 * w_max)
+    # start strictly inside the densification limit (a start from another mode shape may not be)
     if start is None:
-        active, w = cap <= delta, np.zeros(n)
+        active, w = cap <= depth_guess_m, np.zeros(n)
     else:
-        w, active = np.minimum(start[0], 0.5 * w_max), start[1] & np.isfinite(cap)
-        delta = max(delta, float(np.max(w, initial=0.0)))
+        w, active = np.minimum(start[0], 0.9 * w_max), start[1] & np.isfinite(cap)
+    delta = min(max(depth_guess_m, float(np.max(w, initial=0.0))), 0.9 * w_max)
     active[np.argmin(cap)] = True
     w = np.where(active, delta - cap, w)
     tol = 1e-9 * force_n
@@ -286,7 +332,8 @@ def solve_press(layer: FoundationLayer, grid: FoundationGrid, center: NDArray[np
         return grid.area * sigma + gp * (grid.laplacian @ w), grid.area * dsigma
 
     f, _ = internal(w)
-    for iteration in range(1, _MAX_NEWTON + 1):
+    while iteration < max_steps:
+        iteration += 1
         free = np.flatnonzero(~active)
         # w = T x + w0 with x = (w_free, δ): T picks the free nodes and spreads δ on the contact
         t = sp.csr_matrix((np.ones(n), (np.r_[free, np.flatnonzero(active)],
@@ -320,7 +367,7 @@ def solve_press(layer: FoundationLayer, grid: FoundationGrid, center: NDArray[np
             if not active.any():
                 active[np.argmin(cap)] = True
             w = np.where(active, delta - cap, w)
-    if not converged:
+    if not converged and max_steps == _MAX_NEWTON:
         log.warning("foundation press did not converge in %d Newton steps (residual %.2e N)",
                     iteration, residual)
     return NewtonResult(w=w, depth_m=float(delta), active=active,
@@ -372,7 +419,11 @@ class StiffeningFoam(FoamMesh):
             thickness_m=scenario.blocks[index].thickness_m,
             densification_strain=densification_strain,
             stiffening_exponent=stiffening_exponent, shear=shear) for index in self.foam_blocks}
-        self.last: NewtonResult | None = None  # the last press's Newton solve, for checks
+        self.shear = shear
+        # the last press's Newton solve and its layer (mode shape), for checks
+        self.last: NewtonResult | None = None
+        self.last_layer: FoundationLayer | None = None
+        self.last_grid: FoundationGrid | None = None
 
     @property
     def n_dofs(self) -> int:
@@ -390,35 +441,60 @@ class StiffeningFoam(FoamMesh):
         if index is None:
             return Dent(displacement=self.zero_displacement(), depth_m=0.0,
                         contact_radius_m=0.0, iterations=0)
-        layer, block = self.layers[index], self.scenario.blocks[index]
+        block = self.scenario.blocks[index]
+        layer = replace(self.layers[index], decay=1.0) if self.shear else self.layers[index]
         depth = _depth_guess(layer, force_n, tip_radius_m)
         # the contact disc of a dragged surface is smaller than the cap's sqrt(2 R δ)
         radius = (initial_radius_m if initial_radius_m else
                   math.sqrt(tip_radius_m * min(depth, tip_radius_m)))
+        if self.shear:
+            # a first mode shape: the influence length of a thick layer, H sqrt(G / 2M) / γ, is
+            # about the contact radius (as the solved presses find)
+            decay = layer.thickness_m * math.sqrt(
+                layer.shear_modulus_pa / (2 * layer.constrained_modulus_pa)) / radius
+            layer = replace(layer, decay=max(decay, 0.1))
+            depth = _depth_guess(layer, force_n, tip_radius_m)
         lo, hi = block.polygon.min(axis=0), block.polygon.max(axis=0)
         finest, coarsest = tip_radius_m / 200, tip_radius_m / _CORE_CELLS_PER_RADIUS
-        iterations, field = 0, None
-        for _ in range(_MAX_GRIDS):
+        iterations, field, grid, reach, grid_step = 0, None, None, 0.0, 0.0
+        settled = False
+        for _ in range(_MAX_ROUNDS):
             step = min(max(radius / _CORE_CELLS_PER_RADIUS, finest), coarsest)
-            reach = _REACH_LENGTHS * layer.influence_length_m + 2 * step
-            axes = [graded_axis(float(target[d]), float(lo[d]), float(hi[d]), step=step,
-                                core=_CORE_RADII * radius, reach=reach) for d in (0, 1)]
-            grid = FoundationGrid.build(block, *axes)
+            if grid is None or not math.isclose(step, grid_step) or \
+                    layer.influence_length_m * _REACH_LENGTHS > reach:
+                grid_step = step
+                reach = 1.5 * _REACH_LENGTHS * layer.influence_length_m + 2 * step
+                axes = [graded_axis(float(target[d]), float(lo[d]), float(hi[d]), step=step,
+                                    core=_CORE_RADII * radius, reach=reach) for d in (0, 1)]
+                grid = FoundationGrid.build(block, *axes)
             start = (np.zeros(len(grid.xy)) if field is None else field(grid.xy[:, ::-1]),
                      np.sum((grid.xy - target) ** 2, axis=1) <= radius**2)
-            result = solve_press(layer, grid, target, force_n, tip_radius_m, depth, start)
+            # while the grid and the mode shape settle, a few Newton steps a round; then in full
+            result = solve_press(layer, grid, target, force_n, tip_radius_m, depth, start,
+                                 max_steps=_MAX_NEWTON if settled else _SETTLING_STEPS)
             iterations += result.iterations
             depth = result.depth_m
             solved = math.sqrt(float(grid.area[result.active].sum()) / math.pi)
             field = self._field(grid, result.w)
-            fits = 4 * step <= solved <= 9 * step
-            if fits or (step == finest and solved < 4 * step) or (step == coarsest
-                                                                  and solved > 9 * step):
+            if settled:
                 break
-            radius = solved
-        self.last = result
-        return Dent(displacement=self._displace(index, grid, result.w), depth_m=result.depth_m,
-                    contact_radius_m=min(solved, tip_radius_m), iterations=iterations)
+            fits = (4 * step <= solved <= 9 * step or (step == finest and solved < 4 * step)
+                    or (step == coarsest and solved > 9 * step))
+            decay = layer.decay_for(result.w, grid) if self.shear else 0.0
+            settled = fits and abs(decay - layer.decay) <= _DECAY_TOLERANCE * max(layer.decay,
+                                                                                  1.0)
+            log.debug("foundation press: a=%.5f m, δ=%.5f m, γ=%.3f", solved, depth, decay)
+            if settled and result.converged:
+                break
+            if not fits:
+                radius = solved
+            layer = replace(layer, decay=decay)
+            settled = settled or _ == _MAX_ROUNDS - 2  # the last round solves in full
+        assert grid is not None  # _MAX_ROUNDS ≥ 1
+        self.last, self.last_layer, self.last_grid = result, layer, grid
+        return Dent(displacement=self._displace(layer, index, result.w, grid),
+                    depth_m=result.depth_m, contact_radius_m=min(solved, tip_radius_m),
+                    iterations=iterations)
 
     @staticmethod
     def _field(grid: FoundationGrid, w: NDArray[np.float64]) -> RegularGridInterpolator:
@@ -428,13 +504,12 @@ class StiffeningFoam(FoamMesh):
         return RegularGridInterpolator((grid.y, grid.x), full.reshape(grid.y.size, grid.x.size),
                                        bounds_error=False, fill_value=0.0)
 
-    def _displace(self, index: int, grid: FoundationGrid, w: NDArray[np.float64]
-                  ) -> NDArray[np.float64]:
-        """The display mesh's displacement: ``u_z = −w z / H`` in the pressed block."""
+    def _displace(self, layer: FoundationLayer, index: int, w: NDArray[np.float64],
+                  grid: FoundationGrid) -> NDArray[np.float64]:
+        """The display mesh's displacement: ``u_z = −w φ(z)`` in the pressed block."""
         field = self._field(grid, w)
         u = self.zero_displacement()
         off, hex_grid = self.offsets[index], self.grids[index]
         xyz = self.rest_nodes[off:off + hex_grid.n_nodes]
-        thickness = self.layers[index].thickness_m
-        u[off:off + hex_grid.n_nodes, 2] = -field(xyz[:, [1, 0]]) * xyz[:, 2] / thickness
+        u[off:off + hex_grid.n_nodes, 2] = -field(xyz[:, [1, 0]]) * layer.mode(xyz[:, 2])[0]
         return u

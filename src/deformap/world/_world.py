@@ -197,10 +197,11 @@ class SimulatedWorld:
                      ) -> ForceTravel | None:
         """The force–travel record of the press at ``target_xy`` with ``force_n`` newtons.
 
-        One press solve of the world's physics per load level (:mod:`deformap.world._force_travel`); ``dent``, the
-        press's own solve at ``force_n``, is the last level. The noise comes from the
-        press's own stream for the record (the same for the same press, whatever came before),
-        none with ``noise=False``. None for a press under :data:`MIN_RECORD_FORCE_N`.
+        One press solve of the world's physics per load level
+        (:mod:`deformap.world._force_travel`); ``dent``, the press's own solve at ``force_n``,
+        is the last level. The noise comes from the press's own stream for the record (the
+        same for the same press, whatever came before), none with ``noise=False``. None for a
+        press under :data:`MIN_RECORD_FORCE_N`.
         """
         target = check_vector("target_xy", target_xy, 2, what="metres")
         force = check_positive("force_n", force_n)
