@@ -10,13 +10,8 @@ import numpy as np
 import pytest
 
 from deformap.world import Block, Scenario, SimulatedWorld, WorldConfig
-from deformap.world._stiffening import (
-    FoundationGrid,
-    FoundationLayer,
-    StiffeningFoam,
-    graded_axis,
-    max_grid_nodes,
-)
+from deformap.world._foundation import FoundationGrid, FoundationLayer
+from deformap.world._stiffening import StiffeningFoam, graded_axis, max_grid_nodes
 
 R = 0.01  # the tip's radius
 CENTER = np.array([0.3, 0.2])
