@@ -152,9 +152,12 @@ class StiffeningFoam(FoamMesh):
 
     def dent(self, target_xy: NDArray[np.float64], force_n: float, *, tip_radius_m: float,
              initial_radius_m: float | None = None) -> Dent:
-        """Solve the press of ``force_n`` newtons at ``target_xy``. ``initial_radius_m`` is the
-        contact radius expected, which sets the grid (default: a Winkler foundation's,
-        ``a² = 2 R δ`` with ``F = π k R δ²``)."""
+        """Solve the press of ``force_n`` newtons at ``target_xy`` (see the module docstring).
+
+        ``initial_radius_m`` is the contact radius expected (a nearby level's, scaled), which
+        sets the first grid and mode shape; default ``sqrt(R δ)`` from a first guess of the
+        sink (:func:`_depth_guess`). Logs a warning when Newton's method did not converge.
+        """
         target = np.asarray(target_xy, dtype=float).reshape(2)
         index = self.block_at(target)
         if index is None:
@@ -177,7 +180,7 @@ class StiffeningFoam(FoamMesh):
         finest, coarsest = tip_radius_m / 200, tip_radius_m / _CORE_CELLS_PER_RADIUS
         iterations, field, grid, reach, grid_step = 0, None, None, 0.0, 0.0
         settled = False
-        for _ in range(_MAX_ROUNDS):
+        for round_index in range(_MAX_ROUNDS):
             step = min(max(radius / _CORE_CELLS_PER_RADIUS, finest), coarsest)
             if grid is None or not math.isclose(step, grid_step) or \
                     layer.influence_length_m * _REACH_LENGTHS > reach:
@@ -208,7 +211,7 @@ class StiffeningFoam(FoamMesh):
             if not fits:
                 radius = solved
             layer = replace(layer, decay=decay)
-            settled = settled or _ == _MAX_ROUNDS - 2  # the last round solves in full
+            settled = settled or round_index == _MAX_ROUNDS - 2  # the last round solves in full
         assert grid is not None  # _MAX_ROUNDS ≥ 1
         self.last, self.last_layer, self.last_grid = result, layer, grid
         return Dent(displacement=self._displace(layer, index, result.w, grid),

@@ -225,7 +225,8 @@ class SimulatedWorld:
 
         Solved from the top level down, each patch iteration started from the level above's patch
         scaled as Hertz's ``a ∝ F^(1/3)``: close to its fixed point, so one or two solves a level
-        on the stiffness factorised when the world was built.
+        on the stiffness factorised when the world was built (the FEM), or a grid and mode shape
+        near the level's own (the stiffening foam).
         """
         depths = np.empty(levels.size)
         depths[-1], patch = final.depth_m, final
