@@ -179,8 +179,8 @@ class StiffeningFoam(FoamMesh):
         lo, hi = block.polygon.min(axis=0), block.polygon.max(axis=0)
         finest, coarsest = tip_radius_m / 200, tip_radius_m / _CORE_CELLS_PER_RADIUS
         iterations, field, grid, reach, grid_step = 0, None, None, 0.0, 0.0
-        settled = False
-        for round_index in range(_MAX_ROUNDS):
+        precise = False  # full Newton solves from here on
+        for _round in range(_MAX_ROUNDS):
             step = min(max(radius / _CORE_CELLS_PER_RADIUS, finest), coarsest)
             if grid is None or not math.isclose(step, grid_step) or \
                     layer.influence_length_m * _REACH_LENGTHS > reach:
@@ -193,25 +193,26 @@ class StiffeningFoam(FoamMesh):
                      np.sum((grid.xy - target) ** 2, axis=1) <= radius**2)
             # while the grid and the mode shape settle, a few Newton steps a round; then in full
             result = solve_press(layer, grid, target, force_n, tip_radius_m, depth, start,
-                                 max_steps=MAX_NEWTON_STEPS if settled else _SETTLING_STEPS)
+                                 max_steps=MAX_NEWTON_STEPS if precise else _SETTLING_STEPS)
             iterations += result.iterations
             depth = result.depth_m
             solved = math.sqrt(float(grid.area[result.active].sum()) / math.pi)
             field = self._field(grid, result.w)
-            if settled:
-                break
             fits = (4 * step <= solved <= 9 * step or (step == finest and solved < 4 * step)
                     or (step == coarsest and solved > 9 * step))
             decay = layer.decay_for(result.w, grid) if self.shear else 0.0
-            settled = fits and abs(decay - layer.decay) <= _DECAY_TOLERANCE * max(layer.decay,
-                                                                                  1.0)
+            change = abs(decay - layer.decay) / max(layer.decay, 1.0)
             log.debug("foundation press: a=%.5f m, δ=%.5f m, γ=%.3f", solved, depth, decay)
-            if settled and result.converged:
+            # done when a converged solve on a fitting grid asks for the mode shape it had
+            if fits and change <= _DECAY_TOLERANCE and result.converged:
                 break
+            precise = precise or (fits and change <= 10 * _DECAY_TOLERANCE)
             if not fits:
                 radius = solved
             layer = replace(layer, decay=decay)
-            settled = settled or round_index == _MAX_ROUNDS - 2  # the last round solves in full
+        else:
+            log.warning("foundation press at %s, %.3g N: the grid or the mode shape did not "
+                        "settle in %d solves", target, force_n, _MAX_ROUNDS)
         assert grid is not None  # _MAX_ROUNDS ≥ 1
         self.last, self.last_layer, self.last_grid = result, layer, grid
         return Dent(displacement=self._displace(layer, index, result.w, grid),
