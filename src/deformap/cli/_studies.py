@@ -56,6 +56,9 @@ def study_hardness(
     ] = None,
     thickness: Annotated[float, typer.Option(help="Foam thickness in metres.")] = 0.05,
     force: Annotated[float | None, typer.Option(help="Press force in N (default 0.6).")] = None,
+    physics: Annotated[
+        str, typer.Option(help="World physics: linear-fem | stiffening-foam (`world.physics`).")
+    ] = "linear-fem",
     json_path: JsonOption = None,
 ) -> None:
     """β and Young's modulus against hardness for each contact protocol (paper Fig. 5a)."""
@@ -63,7 +66,7 @@ def study_hardness(
     with progress(shown) as bar:
         output = run.run_hardness_study(out, seed=seed, hardness=hardness, coarse=coarse,
                                         camera=camera, thickness_m=thickness, force_n=force,
-                                        hooks=run_hooks(bar))  # fmt: skip
+                                        physics=physics, hooks=run_hooks(bar))  # fmt: skip
     s = output.study
     where = ", ".join(f"{s[k]}" for k in ("camera", "physics") if k in s)
     table = Table(title=f"β and E against hardness{f' ({where})' if where else ''}")

@@ -26,7 +26,7 @@ from deformap.eval import (
 from deformap.explore import ExplorationConfig
 from deformap.run._folder import create_run_folder, default_run_folder, write_json
 from deformap.run._hooks import NO_HOOKS, RunHooks, RunStart
-from deformap.world import WorldConfig, camera_preset
+from deformap.world import Physics, WorldConfig, camera_preset
 
 __all__ = ["CLUSTER_SIZE_FOAMS", "StudyOutput", "run_cluster_size_study", "run_hardness_study"]
 
@@ -46,12 +46,12 @@ class StudyOutput:
 def _foams(
     name: str, foams: Sequence[float | None], folder: Path, *, seed: int, coarse: bool,
     hooks: RunHooks, camera: str | None = None, thickness_m: float = 0.05,
-    force_n: float | None = None,
+    force_n: float | None = None, physics: Physics = "linear-fem",
 ) -> list[FoamPresses]:  # fmt: skip
     hooks.start(RunStart(kind="study", title=f"{name}, seed {seed}", folder=folder,
                          total=len(foams)))  # fmt: skip
     hooks.stage("pressing the foams")
-    world = WorldConfig.coarse() if coarse else WorldConfig()
+    world = WorldConfig.coarse(physics=physics) if coarse else WorldConfig(physics=physics)
     if camera is not None:
         world = dataclasses.replace(world, camera=camera_preset(camera))
     explore = ExplorationConfig() if force_n is None else ExplorationConfig(force_n=force_n)
@@ -74,6 +74,7 @@ def run_hardness_study(
     camera: str | None = None,
     thickness_m: float = 0.05,
     force_n: float | None = None,
+    physics: str = "linear-fem",
     hooks: RunHooks = NO_HOOKS,
 ) -> StudyOutput:
     """β (each contact protocol) and the force–travel reading (stiffness, Young's modulus)
@@ -97,6 +98,8 @@ def run_hardness_study(
         The foam blocks' thickness.
     force_n : float, optional
         The press force (default: the exploration's).
+    physics : str
+        The world's contact physics, a :data:`deformap.world.PHYSICS` name (``WorldConfig.physics``).
     hooks : RunHooks
     """
     from deformap.viz import plot_hardness_study  # matplotlib: only when a study is drawn
@@ -105,12 +108,14 @@ def run_hardness_study(
     foams = DEFAULT_HARDNESSES if not hardness else (*hardness, None)
     if camera is not None:
         camera_preset(camera)  # an unknown name fails here, before any world is built
+    # so does an unknown physics (one line naming `physics`)
+    checked = WorldConfig(physics=physics).physics  # type: ignore[arg-type]
     presses = _foams("hardness study", foams, folder, seed=seed, coarse=coarse, hooks=hooks,
-                     camera=camera, thickness_m=thickness_m, force_n=force_n)
+                     camera=camera, thickness_m=thickness_m, force_n=force_n, physics=checked)
     hooks.stage("estimating β per protocol")
     conditions = {"camera": camera or "primesense", "thickness_m": thickness_m,
                   "force_n": presses[0].presses[0].force_n if presses else force_n,
-                  "physics": "linear elastic FEM"}
+                  "physics": physics}
     study = {**conditions, **hardness_study(presses)}
     study["rows"] = [{**row, **conditions} for row in study["rows"]]
     return StudyOutput(study=study, folder=folder,

@@ -1,7 +1,9 @@
 """The simulated world: foam scenarios, finite-element ground truth, a depth camera and a probe.
 
 It implements :class:`deformap.environment.Environment` and never imports the estimator
-(``msm``, ``gp``, ``explore``): its ground truth is linear elasticity solved by finite elements.
+(``msm``, ``gp``, ``explore``): its ground truth is linear elasticity solved by finite elements,
+or (``WorldConfig(physics="stiffening-foam")``) a foam layer that stiffens as it is compressed,
+a two-parameter foundation solved by Newton's method.
 Hertz contact and the hardness–modulus conversion live in :mod:`deformap.mechanics` (shared with
 the estimator, part of neither) and are re-exported here.
 
@@ -27,7 +29,7 @@ from deformap.mechanics import (
     youngs_modulus_to_hardness,
 )
 from deformap.world._camera import CAMERA_PRESETS, CameraConfig, camera_preset
-from deformap.world._config import WorldConfig, check_world_budget
+from deformap.world._config import PHYSICS, Physics, WorldConfig, check_world_budget
 from deformap.world._foam import Dent
 from deformap.world._probe import ProbeGeometry
 from deformap.world._random import random_scenario
@@ -39,9 +41,11 @@ __all__ = [
     "BARE_TABLE",
     "CAMERA_PRESETS",
     "MIN_RECORD_FORCE_N",
+    "PHYSICS",
     "Block",
     "CameraConfig",
     "Dent",
+    "Physics",
     "ProbeGeometry",
     "Scenario",
     "SimulatedWorld",

@@ -6,14 +6,21 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any, ClassVar
+from typing import Any, ClassVar, Literal, get_args
 
 from deformap._validation import SettingError, check_settings, setting
 from deformap.world._camera import CameraConfig
 from deformap.world._probe import ProbeGeometry
 from deformap.world._scenario import Scenario
+from deformap.world._stiffening import max_grid_nodes
 
-__all__ = ["MAX_FEM_UNKNOWNS", "WorldConfig", "check_world_budget"]
+__all__ = ["MAX_FEM_UNKNOWNS", "PHYSICS", "Physics", "WorldConfig", "check_world_budget"]
+
+#: The world's contact physics: 3-D linear elasticity by FEM (:mod:`deformap.world._foam`), or a
+#: stiffening two-parameter foundation solved by Newton's method
+#: (:mod:`deformap.world._stiffening`).
+Physics = Literal["linear-fem", "stiffening-foam"]
+PHYSICS: tuple[str, ...] = get_args(Physics)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -22,6 +29,15 @@ class WorldConfig:
 
     Parameters
     ----------
+    physics : {"linear-fem", "stiffening-foam"}
+        How the foam answers a press: linear elasticity of each block by finite elements, or each
+        block as a foam layer that stiffens toward densification, a two-parameter foundation
+        whose contact with the tip is solved by Newton's method (:mod:`deformap.world._stiffening`).
+        Either way a block's ``modulus_pa`` is its small-strain Young's modulus.
+    densification_strain, stiffening_exponent : float
+        The stiffening foam's column law ``σ = M ε / (1 − ε / ε_d)^m`` (``stiffening-foam`` only):
+        ``ε_d`` from Gibson & Ashby's ``1 − 1.4 ρ*/ρ_s`` at a relative density of 0.035 (a
+        flexible polyurethane foam), ``m = 1`` their densification fit; ``m = 0`` is linear.
     element_size_m : float
         In-plane size of the foam's hexahedra. 7.5 mm resolves the dent of the 1 cm tip (the
         press's compliance converges at second order under refinement,
@@ -55,6 +71,10 @@ class WorldConfig:
         How far the table extends beyond the workspace on every side.
     """
 
+    physics: Physics = "linear-fem"
+    densification_strain: float = setting(0.95, gt=0.0, le=1.0)  # a strain: at most full collapse
+    # m > 10 is a wall, not a foam; each unit of m steepens σ near ε_d by another 1 / (1 − ε/ε_d)
+    stiffening_exponent: float = setting(1.0, ge=0.0, le=10.0)
     # finer than 1 mm resolves nothing the 1 cm tip or the camera can tell, and the element count
     # grows as 1 / size² (see check_world_budget for the mesh as a whole)
     element_size_m: float = setting(0.0075, gt=0.0, ge=0.001)
@@ -122,8 +142,12 @@ def check_world_budget(config: WorldConfig, scenario: Scenario) -> None:
 
     Counts the nodes of every block's structured mesh (``element_size_m`` in plane over the
     block's bounding box, the graded layers of ``top_layer_m`` and ``layer_growth`` through its
-    thickness) and refuses more than :data:`MAX_FEM_UNKNOWNS` unknowns. :class:`SimulatedWorld`
-    calls it first; a run can call it before it starts anything else.
+    thickness) and refuses more than :data:`MAX_FEM_UNKNOWNS` unknowns: the FEM's, and under the
+    ``stiffening-foam`` physics the camera's mesh of the same nodes. That physics solves each press
+    on a grid of its own, graded from the tip outward, whose nodes are bounded by
+    :func:`~deformap.world._stiffening.max_grid_nodes` (they grow with the logarithm of the block's
+    size over the tip's radius) and refused over the same limit. :class:`SimulatedWorld` calls it
+    first; a run can call it before it starts anything else.
 
     Raises
     ------
@@ -141,6 +165,13 @@ def check_world_budget(config: WorldConfig, scenario: Scenario) -> None:
         nx, ny = (max(1, math.ceil(e / size - 1e-9)) for e in extent)
         nz = _layer_count(block.thickness_m, config.top_layer_m, config.layer_growth)
         unknowns += 3 * (nx + 1) * (ny + 1) * (nz + 1)
+        if config.physics == "stiffening-foam" and not block.rigid:
+            nodes = max_grid_nodes(extent, config.tip_radius_m)
+            if nodes > MAX_FEM_UNKNOWNS:
+                raise SettingError(
+                    "tip_radius_m",
+                    f"grades a press grid of up to {nodes:,} nodes over block {block.name!r}; at "
+                    f"most {MAX_FEM_UNKNOWNS:,}: use a larger tip; got {config.tip_radius_m:g} m")
     if unknowns > MAX_FEM_UNKNOWNS:
         raise SettingError(
             "element_size_m",

@@ -35,7 +35,7 @@ from deformap.mechanics import hertz_contact_radius, hertz_pressure_samples
 from deformap.world._fem import FoamBody, HexGrid, graded_levels
 from deformap.world._scenario import Block, Scenario
 
-__all__ = ["Dent", "FoamModel", "block_grid"]
+__all__ = ["Dent", "FoamMesh", "FoamModel", "block_grid"]
 
 log = logging.getLogger(__name__)
 
@@ -75,8 +75,61 @@ def block_grid(block: Block, *, element_size_m: float, top_layer_m: float,
     return HexGrid(origin=lo.copy(), dx=dx, dy=dy, nx=nx, ny=ny, levels=levels, active=active)
 
 
-class FoamModel:
-    """All foam bodies of a scenario, with the press solve.
+class FoamMesh:
+    """The structured hexahedral meshes of a scenario's blocks, stacked: what the camera sees.
+
+    Every contact physics of the world displaces these nodes; the press solve is the physics'
+    own (:class:`FoamModel` here, :class:`~deformap.world._stiffening.StiffeningFoam`).
+
+    Parameters
+    ----------
+    scenario : Scenario
+    element_size_m, top_layer_m, layer_growth : float
+        Mesh: in-plane element size, thickness of the top layer, growth of layers downwards.
+    """
+
+    def __init__(self, scenario: Scenario, *, element_size_m: float, top_layer_m: float,
+                 layer_growth: float) -> None:
+        self.scenario = scenario
+        self.grids: list[HexGrid] = []
+        self.offsets: list[int] = []
+        n = 0
+        for block in scenario.blocks:
+            grid = block_grid(block, element_size_m=element_size_m, top_layer_m=top_layer_m,
+                              layer_growth=layer_growth)
+            self.grids.append(grid)
+            self.offsets.append(n)
+            n += grid.n_nodes
+        self.n_nodes = n
+        self.rest_nodes = np.concatenate([g.node_xyz() for g in self.grids])
+        #: indices of the blocks that deform (not rigid)
+        self.foam_blocks = tuple(i for i, b in enumerate(scenario.blocks) if not b.rigid)
+
+    def zero_displacement(self) -> NDArray[np.float64]:
+        return np.zeros((self.n_nodes, 3))
+
+    def block_at(self, target: NDArray[np.float64]) -> int | None:
+        """Index of the foam block under the ``(2,)`` point, None on rigid ground."""
+        index = int(self.scenario.labels(target[:1], target[1:])[0, 0])
+        return index if index in self.foam_blocks else None
+
+    def top_displacement(self, xy: NDArray[np.float64], displacement: NDArray[np.float64]
+                         ) -> NDArray[np.float64]:
+        """``(n, 3)`` displacement of the top surface at ``(n, 2)`` points (0 off the foam)."""
+        out = np.zeros((len(xy), 3))
+        claimed = np.zeros(len(xy), dtype=bool)
+        for index in self.foam_blocks:
+            grid, off = self.grids[index], self.offsets[index]
+            inside, nodes, weights = grid.locate(xy)
+            inside &= ~claimed
+            u = displacement[off + nodes[inside]]  # (m, 4, 3)
+            out[inside] = np.einsum("mc,mcd->md", weights[inside], u)
+            claimed |= inside
+        return out
+
+
+class FoamModel(FoamMesh):
+    """All foam bodies of a scenario as linear-elastic FEM, with the press solve.
 
     Parameters
     ----------
@@ -88,44 +141,18 @@ class FoamModel:
 
     def __init__(self, scenario: Scenario, *, element_size_m: float, top_layer_m: float,
                  layer_growth: float, poisson_ratio: float) -> None:
-        self.scenario = scenario
+        super().__init__(scenario, element_size_m=element_size_m, top_layer_m=top_layer_m,
+                         layer_growth=layer_growth)
         self.poisson_ratio = poisson_ratio
-        self.grids: list[HexGrid] = []
-        self.bodies: dict[int, FoamBody] = {}
-        self.offsets: list[int] = []
-        n = 0
-        for index, block in enumerate(scenario.blocks):
-            grid = block_grid(block, element_size_m=element_size_m, top_layer_m=top_layer_m,
-                              layer_growth=layer_growth)
-            self.grids.append(grid)
-            self.offsets.append(n)
-            n += grid.n_nodes
-            if not block.rigid:
-                self.bodies[index] = FoamBody(grid, block.modulus_pa, poisson_ratio=poisson_ratio)
-        self.n_nodes = n
-        self.rest_nodes = np.concatenate([g.node_xyz() for g in self.grids])
+        self.bodies: dict[int, FoamBody] = {
+            index: FoamBody(self.grids[index], scenario.blocks[index].modulus_pa,
+                            poisson_ratio=poisson_ratio)
+            for index in self.foam_blocks}
 
     @property
     def n_dofs(self) -> int:
         """Free displacement unknowns over all foam bodies."""
         return sum(b.n_dofs for b in self.bodies.values())
-
-    def zero_displacement(self) -> NDArray[np.float64]:
-        return np.zeros((self.n_nodes, 3))
-
-    def top_displacement(self, xy: NDArray[np.float64], displacement: NDArray[np.float64]
-                         ) -> NDArray[np.float64]:
-        """``(n, 3)`` displacement of the top surface at ``(n, 2)`` points (0 off the foam)."""
-        out = np.zeros((len(xy), 3))
-        claimed = np.zeros(len(xy), dtype=bool)
-        for index in self.bodies:
-            grid, off = self.grids[index], self.offsets[index]
-            inside, nodes, weights = grid.locate(xy)
-            inside &= ~claimed
-            u = displacement[off + nodes[inside]]  # (m, 4, 3)
-            out[inside] = np.einsum("mc,mcd->md", weights[inside], u)
-            claimed |= inside
-        return out
 
     def dent(self, target_xy: NDArray[np.float64], force_n: float, *, tip_radius_m: float,
              max_iterations: int = 6, tolerance: float = 0.02,

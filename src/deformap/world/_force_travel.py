@@ -2,7 +2,8 @@
 
 A real arm records, from first contact to the commanded force, the tip's travel along the press
 direction (joint encoders through forward kinematics) and the normal force (the force sensor);
-``docs/robot.md`` says how. The simulated world gives the same record from its FEM:
+``docs/robot.md`` says how. The simulated world gives the same record from its physics
+(``WorldConfig.physics``; said here for the FEM, the foundation's press is alike):
 
 - Load levels: ``n_levels + 1`` forces evenly spaced from the contact threshold ``F_c`` (the force
   at which a robot detects contact, its first sample) to the commanded force ``F``.

@@ -1,4 +1,11 @@
-"""The simulated world: scenario + foam FEM + depth camera + probe, as an ``Environment``.
+"""The simulated world: scenario + foam physics + depth camera + probe, as an ``Environment``.
+
+Physics
+-------
+``WorldConfig.physics`` picks how the foam answers a press: 3-D linear elasticity by FEM
+(:mod:`deformap.world._foam`, the default) or a stiffening two-parameter foundation solved by
+Newton's method (:mod:`deformap.world._stiffening`). Both displace the same hexahedral mesh, which
+is what the camera sees, and both give the press's depth for the force–travel record.
 
 Press force
 -----------
@@ -10,7 +17,7 @@ every foam by more than the camera's noise and by less than half of the block
 
 Force–travel record
 -------------------
-Each press also returns its force–travel record (``PressObservation.force_travel``): the FEM
+Each press also returns its force–travel record (``PressObservation.force_travel``): the physics
 solved at ``force_travel_levels`` loads from the contact threshold to the commanded force, with the
 noise of arm encoders and a force sensor, drawn from a stream of its own so that the press's other
 draws (contact force, clouds) are those of a world without the record
@@ -51,6 +58,7 @@ from deformap.world._config import WorldConfig, check_world_budget
 from deformap.world._foam import Dent, FoamModel
 from deformap.world._force_travel import force_levels, simulated_force_travel
 from deformap.world._scenario import BARE_TABLE, Block, Scenario
+from deformap.world._stiffening import StiffeningFoam
 
 __all__ = ["MIN_RECORD_FORCE_N", "SimulatedWorld"]
 
@@ -96,8 +104,17 @@ class SimulatedWorld:
         self._noise_key = int(rng.integers(2**62))
         self._n_observed = 0
         c = self.config
-        self.foam = FoamModel(scenario, element_size_m=c.element_size_m, top_layer_m=c.top_layer_m,
-                              layer_growth=c.layer_growth, poisson_ratio=c.poisson_ratio)
+        self.foam: FoamModel | StiffeningFoam
+        if c.physics == "linear-fem":
+            self.foam = FoamModel(scenario, element_size_m=c.element_size_m,
+                                  top_layer_m=c.top_layer_m, layer_growth=c.layer_growth,
+                                  poisson_ratio=c.poisson_ratio)
+        else:
+            self.foam = StiffeningFoam(
+                scenario, element_size_m=c.element_size_m, top_layer_m=c.top_layer_m,
+                layer_growth=c.layer_growth, poisson_ratio=c.poisson_ratio,
+                densification_strain=c.densification_strain,
+                stiffening_exponent=c.stiffening_exponent)
         camera = c.camera if c.noise else replace(c.camera, noise=False)
         self.camera = DepthCamera(camera, scenario.workspace.center)
         self._force_noise_n = c.force_noise_n if c.noise else 0.0
@@ -170,7 +187,8 @@ class SimulatedWorld:
         return self._pressed is not None
 
     def dent(self, target_xy: Any, force_n: float) -> Dent:
-        """The FEM response to a press, without touching the world's state (no noise)."""
+        """The foam's response to a press (FEM or foundation, ``config.physics``), without
+        touching the world's state (no noise)."""
         target = check_vector("target_xy", target_xy, 2, what="metres")
         force = check_positive("force_n", force_n)
         return self.foam.dent(target, force, tip_radius_m=self.config.tip_radius_m)
@@ -179,10 +197,11 @@ class SimulatedWorld:
                      ) -> ForceTravel | None:
         """The force–travel record of the press at ``target_xy`` with ``force_n`` newtons.
 
-        One FEM press solve per load level (:mod:`deformap.world._force_travel`); ``dent``, the
-        press's own solve at ``force_n``, is the last level. The noise comes from the
-        press's own stream for the record (the same for the same press, whatever came before),
-        none with ``noise=False``. None for a press under :data:`MIN_RECORD_FORCE_N`.
+        One press solve of the world's physics per load level
+        (:mod:`deformap.world._force_travel`); ``dent``, the press's own solve at ``force_n``,
+        is the last level. The noise comes from the press's own stream for the record (the
+        same for the same press, whatever came before), none with ``noise=False``. None for a
+        press under :data:`MIN_RECORD_FORCE_N`.
         """
         target = check_vector("target_xy", target_xy, 2, what="metres")
         force = check_positive("force_n", force_n)
@@ -206,7 +225,8 @@ class SimulatedWorld:
 
         Solved from the top level down, each patch iteration started from the level above's patch
         scaled as Hertz's ``a ∝ F^(1/3)``: close to its fixed point, so one or two solves a level
-        on the stiffness factorised when the world was built.
+        on the stiffness factorised when the world was built (the FEM), or a grid and mode shape
+        near the level's own (the stiffening foam).
         """
         depths = np.empty(levels.size)
         depths[-1], patch = final.depth_m, final

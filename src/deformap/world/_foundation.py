@@ -1,0 +1,330 @@
+"""A foam layer on the rigid table as a stiffening two-parameter foundation, and the sphere's
+force-controlled contact with it solved by Newton's method (the physics of
+:mod:`deformap.world._stiffening`).
+
+Layer theory (Vlasov & Leontiev 1966; Vallabhan & Das 1988)
+-----------------------------------------------------------
+Each foam block of thickness ``H`` bonded to the rigid table deforms as
+``u(x, y, z) = (0, 0, −w(x, y) φ(z))``: vertical displacement only, the surface deflection ``w``
+(positive down) times a mode shape ``φ`` from 0 at the table (``z = 0``) to 1 at the top.
+Integrating the strain energy of that field through the thickness gives a two-parameter
+(Pasternak) foundation,
+
+    Π[w] = ∫ Φ(w) dA + ½ G_p ∫ |∇w|² dA,
+
+whose compression is carried at the constrained (oedometric) modulus
+``M = E (1 − ν) / ((1 + ν)(1 − 2ν))`` (lateral strain suppressed by the kinematics), with the
+strain ``ε(z) = w φ'(z)``, so ``Φ'(w) = p(w) = ∫ σ(w φ') φ' dz`` and the small-strain spring
+modulus ``k = M ∫ φ'² dz`` [Pa/m], and whose shear layer (shear modulus
+``G = E / (2 (1 + ν))``) gives ``G_p = G ∫ φ² dz`` [N/m]. ``E`` is the block's ``modulus_pa``: the
+small-strain Young's modulus stays the world's ground truth.
+
+The mode shape is the modified Vlasov model's, ``φ = sinh(γ z / H) / sinh γ``, with ``γ`` fixed by
+the solved surface itself, ``(γ / H)² = (G / M) ∫ |∇w|² dA / ∫ w² dA`` (the condition that makes
+the small-strain energy stationary in ``φ`` as well; Vallabhan & Das 1988): the press iterates it to 1 %.
+A dent much narrower than the layer (the 1 cm tip on 3–10 cm of foam) then decays within about
+its own width below the surface, so a thicker layer is softer and tends to a depth-independent
+limit, as an elastic layer does; the linear ``φ = z / H`` of Vlasov's first model would instead
+make a thick layer stiffer in shear under a small tip (``G_p = G H / 3``). The influence length
+``ℓ = sqrt(G_p / k)`` is how far a dent spreads beyond the tip (about the contact radius here).
+A restricted displacement field is stiffer than the elastic solid (Ritz): at small strain the
+tip sinks less than in a half-space of the same ``E`` (Hertz).
+
+Stiffening (Gibson & Ashby 1997, ch. 5)
+---------------------------------------
+Compressing a foam toward densification brings its cell walls into contact and the stress rises
+without bound as the strain nears the densification strain ``ε_d``. The law is
+
+    σ(ε) = M ε / (1 − ε / ε_d)^m      (ε ≥ 0; linear ``M ε`` in extension),
+
+with ``ε_d`` the world's ``densification_strain`` (Gibson & Ashby: ``ε_D ≈ 1 − 1.4 ρ*/ρ_s``;
+0.95 for a flexible polyurethane foam of relative density 0.035) and ``m`` its
+``stiffening_exponent`` (their densification fit has ``m ≈ 1``; ``m = 0`` is linear). The strain
+is largest at the top, ``w φ'(H)``; ``p(w)`` is integrated through the thickness by 32-point
+Gauss–Legendre, and the deflection is held below the quadrature's densification limit. The
+plateau of elastomeric foams (elastic buckling of the cell walls) is left out: this physics lies
+on the stiff side of linear elasticity.
+
+Contact, force control, Newton
+------------------------------
+The rigid sphere of radius ``R`` sinks ``δ`` below the rest surface; a surface point at distance
+``r`` from the target may not pass the tip's lower cap: ``w ≥ δ − c(r)``, ``c = R − sqrt(R² − r²)``
+(Signorini conditions, with a non-negative contact force where equality holds). The press
+commands the force ``F``, so ``δ`` is an unknown and ``Π[w] − F δ`` is minimised. Discretised on a
+tensor grid of bilinear elements (lumped spring term, consistent shear term), the active set of
+nodes in contact ties ``w = δ − c`` there and Newton's method solves for ``δ`` and the free
+deflections; after each step, nodes that penetrate the tip join the active set and nodes whose
+contact force pulls leave it (a primal–dual active-set method, Hintermüller, Ito & Kunisch 2002).
+Steps are shortened so that no strain reaches ``ε_d``.
+
+References
+----------
+Vlasov, V. Z., Leontiev, N. N. (1966). Beams, Plates and Shells on Elastic Foundations. Israel
+Program for Scientific Translations (ch. 1: the two-parameter model from the layer's mode shape).
+Kerr, A. D. (1964). Elastic and viscoelastic foundation models. J. Appl. Mech. 31(3), 491–498.
+Gibson, L. J., Ashby, M. F. (1997). Cellular Solids, 2nd ed., Cambridge University Press, ch. 5.
+Vallabhan, C. V. G., Das, Y. C. (1988). Parametric study of beams on elastic foundations. J. Eng.
+Mech. 114(12), 2072–2082 (the modified Vlasov model and its γ).
+Hintermüller, M., Ito, K., Kunisch, K. (2002). The primal-dual active set strategy as a semismooth
+Newton method. SIAM J. Optim. 13(3), 865–888.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+from numpy.typing import NDArray
+from scipy.sparse.linalg import splu
+
+from deformap.world._scenario import Block
+
+__all__ = ["MAX_NEWTON_STEPS", "FoundationGrid", "FoundationLayer", "NewtonResult", "solve_press"]
+
+log = logging.getLogger(__name__)
+
+MAX_NEWTON_STEPS = 80  # a press that needs more is reported (logged) as not converged
+
+
+@dataclass(frozen=True, kw_only=True)
+class FoundationLayer:
+    """The foundation parameters of one foam block (see the module docstring).
+
+    Parameters
+    ----------
+    modulus_pa, poisson_ratio, thickness_m : float
+        The block's small-strain Young's modulus, Poisson ratio and thickness.
+    densification_strain : float
+        ``ε_d``: the strain at which the stress becomes unbounded.
+    stiffening_exponent : float
+        ``m``; 0 is a linear spring.
+    decay : float
+        ``γ`` of the mode shape ``φ(z) = sinh(γ z / H) / sinh γ`` (0: linear, ``z / H``).
+    shear : bool
+        False drops the shear layer (``G_p = 0``: a Winkler foundation).
+    """
+
+    modulus_pa: float
+    poisson_ratio: float
+    thickness_m: float
+    densification_strain: float = 0.95
+    stiffening_exponent: float = 1.0
+    decay: float = 0.0
+    shear: bool = True
+
+    @property
+    def constrained_modulus_pa(self) -> float:
+        nu = self.poisson_ratio
+        return self.modulus_pa * (1 - nu) / ((1 + nu) * (1 - 2 * nu))
+
+    @property
+    def shear_modulus_pa(self) -> float:
+        return self.modulus_pa / (2 * (1 + self.poisson_ratio))
+
+    def mode(self, z: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """``φ(z)`` and ``φ'(z)`` [1/m] at heights ``z`` above the table."""
+        h, g = self.thickness_m, self.decay
+        if g < 1e-6:
+            return z / h, np.full_like(z, 1.0 / h)
+        return np.sinh(g * z / h) / np.sinh(g), g / h * np.cosh(g * z / h) / np.sinh(g)
+
+    def _moments(self) -> tuple[float, float]:
+        """``∫ φ'² dz`` [1/m] and ``∫ φ² dz`` [m] over the thickness, in closed form."""
+        h, g = self.thickness_m, self.decay
+        if g < 1e-6:
+            return 1.0 / h, h / 3.0
+        s2 = math.sinh(g) ** 2
+        half = math.sinh(2 * g) / (4 * g)
+        return g * g / h * (half + 0.5) / s2, h * (half - 0.5) / s2
+
+    @property
+    def spring_pa_per_m(self) -> float:
+        """Small-strain spring modulus ``k = M ∫ φ'² dz`` [Pa/m] (``M / H`` when linear)."""
+        return self.constrained_modulus_pa * self._moments()[0]
+
+    @property
+    def shear_n_per_m(self) -> float:
+        """Pasternak shear parameter ``G_p = G ∫ φ² dz`` [N/m] (``G H / 3`` when linear; 0
+        without shear)."""
+        return self.shear_modulus_pa * self._moments()[1] if self.shear else 0.0
+
+    @property
+    def influence_length_m(self) -> float:
+        """``ℓ = sqrt(G_p / k)``; 0 without shear."""
+        return math.sqrt(self.shear_n_per_m / self.spring_pa_per_m)
+
+    @property
+    def max_deflection_m(self) -> float:
+        """The deflection at which the largest strain (at the top) reaches ``ε_d``, as the
+        quadrature through the thickness sees it (its highest point): where its pressure is
+        unbounded (inf when linear)."""
+        if self.stiffening_exponent == 0.0:
+            return math.inf
+        slope = self.mode(_through_thickness(self.thickness_m)[0])[1]
+        return self.densification_strain / float(np.max(slope))
+
+    def decay_for(self, w: NDArray[np.float64], grid: FoundationGrid) -> float:
+        """Vallabhan & Das's ``γ`` for the surface deflection ``w`` on ``grid``:
+        ``(γ / H)² = (G / M) ∫ |∇w|² dA / ∫ w² dA``."""
+        ratio = float(w @ (grid.laplacian @ w)) / float(np.sum(grid.area * w * w))
+        return self.thickness_m * math.sqrt(self.shear_modulus_pa
+                                            / self.constrained_modulus_pa * ratio)
+
+    def pressure(self, w: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Spring pressure ``p(w) = ∫ σ(w φ') φ' dz`` [Pa] and ``dp/dw`` [Pa/m], elementwise
+        (Gauss–Legendre through the thickness; closed form when linear)."""
+        if self.stiffening_exponent == 0.0:
+            return self.spring_pa_per_m * w, np.full_like(w, self.spring_pa_per_m)
+        z, weight = _through_thickness(self.thickness_m)
+        slope = self.mode(z)[1]  # (q,)
+        eps = w[:, None] * slope  # (n, q) strains
+        m, ed, big_m = self.stiffening_exponent, self.densification_strain, \
+            self.constrained_modulus_pa
+        squeeze = np.where(eps > 0.0, 1.0 - eps / ed, 1.0)
+        sigma = big_m * eps * squeeze**-m
+        dsigma = big_m * (squeeze**-m + np.where(eps > 0.0, eps * m / ed * squeeze**(-m - 1),
+                                                 0.0))
+        return (sigma * slope) @ weight, (dsigma * slope**2) @ weight
+
+
+def _through_thickness(thickness_m: float) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """32 Gauss–Legendre heights and weights over ``[0, H]`` (exact for ``φ'²`` polynomials of
+    degree 63; ``cosh²(γ z / H)`` to machine precision for the decays met here)."""
+    x, wt = np.polynomial.legendre.leggauss(32)
+    return 0.5 * thickness_m * (x + 1.0), 0.5 * thickness_m * wt
+
+
+@dataclass(frozen=True, kw_only=True)
+class FoundationGrid:
+    """A tensor grid of bilinear cells over part of one block (nodes outside it dropped)."""
+
+    x: NDArray[np.float64]
+    y: NDArray[np.float64]
+    used: NDArray[np.int64]  # flat ids (j * nx + i) of the nodes that belong to active cells
+    xy: NDArray[np.float64]  # (n, 2) of the used nodes
+    area: NDArray[np.float64]  # (n,) lumped area per node
+    laplacian: sp.csr_matrix  # (n, n) ∫ ∇φ_i · ∇φ_j
+
+    @classmethod
+    def build(cls, block: Block, x: NDArray[np.float64], y: NDArray[np.float64]
+              ) -> FoundationGrid:
+        """The grid of nodes ``x × y`` whose cells (centres) lie in ``block``."""
+        nx, ny = x.size, y.size
+        hx, hy = np.diff(x), np.diff(y)
+        cx, cy = np.meshgrid(0.5 * (x[1:] + x[:-1]), 0.5 * (y[1:] + y[:-1]))
+        active = block.contains(np.column_stack([cx.ravel(), cy.ravel()]))
+        jj, ii = np.divmod(np.flatnonzero(active), nx - 1)
+        corners = np.column_stack([jj * nx + ii, jj * nx + ii + 1,
+                                   (jj + 1) * nx + ii, (jj + 1) * nx + ii + 1])  # i + 2 j
+        ax, ay = hx[ii], hy[jj]
+        k1 = np.array([[1.0, -1.0], [-1.0, 1.0]])
+        m1 = np.array([[2.0, 1.0], [1.0, 2.0]]) / 6.0
+        # bilinear rectangle: Ke = M_y ⊗ K_x + K_y ⊗ M_x (1-D stiffness k1 / h, mass m1 h)
+        ke = (np.einsum("c,ab,de->cadbe", ay / ax, m1, k1)
+              + np.einsum("c,ab,de->cadbe", ax / ay, k1, m1)).reshape(-1, 4, 4)
+        rows = np.repeat(corners, 4, axis=1).ravel()
+        cols = np.tile(corners, (1, 4)).ravel()
+        full = sp.csr_matrix((ke.ravel(), (rows, cols)), shape=(nx * ny, nx * ny))
+        area_full = np.zeros(nx * ny)
+        np.add.at(area_full, corners.ravel(), np.repeat(ax * ay / 4.0, 4))
+        used = np.flatnonzero(area_full > 0.0)
+        gx, gy = np.meshgrid(x, y)
+        xy = np.column_stack([gx.ravel()[used], gy.ravel()[used]])
+        return cls(x=x, y=y, used=used, xy=xy, area=area_full[used],
+                   laplacian=full[used][:, used].tocsr())
+
+
+@dataclass(frozen=True, kw_only=True)
+class NewtonResult:
+    """The solved press on one grid: deflections, the tip's sink, the contact, convergence."""
+
+    w: NDArray[np.float64]  # (n,) deflection of the grid's nodes, metres, positive down
+    depth_m: float
+    active: NDArray[np.bool_]  # nodes in contact with the tip
+    contact_force_n: NDArray[np.float64]  # (n,) nodal contact forces (0 off the contact)
+    residual_n: float  # largest out-of-balance force (free nodes, and total against F)
+    iterations: int
+    converged: bool
+
+
+def solve_press(layer: FoundationLayer, grid: FoundationGrid, center: NDArray[np.float64],
+                force_n: float, tip_radius_m: float, depth_guess_m: float,
+                start: tuple[NDArray[np.float64], NDArray[np.bool_]] | None = None,
+                max_steps: int = MAX_NEWTON_STEPS) -> NewtonResult:
+    """Force-controlled sphere contact on the foundation by Newton's method with active sets.
+
+    Unknowns: the deflections off the contact and the tip's sink ``δ`` (on the contact
+    ``w = δ − c``). Their residual is the gradient of ``Π − F δ``: the nodal forces off the
+    contact and the contact's total force minus ``F``; its Jacobian is the tangent stiffness
+    reduced the same way (symmetric positive definite while ``ε < ε_d``). ``start`` is a first
+    ``(w, active)`` (a coarser grid's solution); default: the nodes under the tip sunk
+    ``depth_guess_m`` in contact. ``max_steps`` caps the Newton steps (an inexact solve, for
+    a press still settling its grid and mode shape).
+    """
+    r2 = np.sum((grid.xy - center) ** 2, axis=1)
+    cap = np.full(r2.size, np.inf)
+    under = r2 < tip_radius_m**2
+    cap[under] = tip_radius_m - np.sqrt(tip_radius_m**2 - r2[under])
+    w_max = layer.max_deflection_m * (1.0 - 1e-6)
+    gp = layer.shear_n_per_m
+    n = r2.size
+    # start strictly inside the densification limit (a start from another mode shape may not be)
+    if start is None:
+        active, w = cap <= depth_guess_m, np.zeros(n)
+    else:
+        w, active = np.minimum(start[0], 0.9 * w_max), start[1] & np.isfinite(cap)
+    delta = min(max(depth_guess_m, float(np.max(w, initial=0.0))), 0.9 * w_max)
+    active[np.argmin(cap)] = True
+    w = np.where(active, delta - cap, w)
+    tol = 1e-9 * force_n
+    converged, residual, iteration = False, math.inf, 0
+
+    def internal(w: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        sigma, dsigma = layer.pressure(w)
+        return grid.area * sigma + gp * (grid.laplacian @ w), grid.area * dsigma
+
+    f, _ = internal(w)
+    while iteration < max_steps:
+        iteration += 1
+        free = np.flatnonzero(~active)
+        # w = T x + w0 with x = (w_free, δ): T picks the free nodes and spreads δ on the contact
+        t = sp.csr_matrix((np.ones(n), (np.r_[free, np.flatnonzero(active)],
+                                        np.r_[np.arange(free.size),
+                                              np.full(n - free.size, free.size)])),
+                          shape=(n, free.size + 1))
+        f, spring = internal(w)
+        grad = t.T @ f - np.r_[np.zeros(free.size), force_n]
+        jac = (t.T @ (sp.diags(spring) + gp * grid.laplacian) @ t).tocsc()
+        # symmetric positive definite: a symmetric fill-reducing ordering, diagonal pivots
+        step = -splu(jac, permc_spec="MMD_AT_PLUS_A",
+                     options={"SymmetricMode": True}).solve(grad)
+        dw = t @ step
+        rising = dw > 0  # shorten the step so that no column reaches densification
+        alpha = 1.0
+        if np.any(rising):
+            alpha = min(1.0, 0.9 * float(np.min((w_max - w[rising]) / dw[rising])))
+        w = w + alpha * dw
+        delta += alpha * float(step[-1])
+        f, _ = internal(w)
+        contact = np.where(active, f, 0.0)
+        entering = ~active & (w < delta - cap - 1e-9 * max(delta, 1e-12))
+        leaving = active & (contact < -tol)
+        residual = max(float(np.max(np.abs(f[~active]), initial=0.0)),
+                       abs(float(contact.sum()) - force_n))
+        if not entering.any() and not leaving.any() and residual <= tol and alpha == 1.0:
+            converged = True
+            break
+        if entering.any() or leaving.any():
+            active = (active & ~leaving) | entering
+            if not active.any():
+                active[np.argmin(cap)] = True
+            w = np.where(active, delta - cap, w)
+    if not converged and max_steps == MAX_NEWTON_STEPS:
+        log.warning("foundation press did not converge in %d Newton steps (residual %.2e N)",
+                    iteration, residual)
+    return NewtonResult(w=w, depth_m=float(delta), active=active,
+                        contact_force_n=np.where(active, f, 0.0), residual_n=residual,
+                        iterations=iteration, converged=converged)
