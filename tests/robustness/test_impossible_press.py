@@ -36,3 +36,31 @@ def test_a_press_with_sensor_noise_and_a_tilt_is_accepted() -> None:
     tilted = 0.6 * np.array([np.sin(0.5), 0.0, -np.cos(0.5)])  # 29° off the vertical
     assert _press(list(tilted)).contact.force_n == pytest.approx(0.6)
     assert _press([0.01, -0.02, -0.74]).force_n == 0.6  # 23 % over: a controller's overshoot
+
+
+def test_the_world_refuses_a_press_that_would_crush_the_foam_onto_the_table() -> None:
+    from deformap.testing import coarse_world
+
+    world = coarse_world("heterogeneous-60-150")
+    with pytest.raises(InvalidArgumentError,
+                       match=r"`force_n` of 100000 N would sink the tip .* m into 'foam-60', "
+                             r"which is 0.05 m thick"):
+        world.press([0.15, 0.2], 1e5)
+    assert not world.is_pressing
+    assert world.press([0.15, 0.2], 0.6).contact.tip_center[2] > 0.03  # a press it can take
+
+
+@pytest.mark.parametrize(("field", "value", "message"), [
+    ("hardness_n", 1e-9, r"`hardness_n` must be >= 0.1; got 1e-09 \(block 'x'\)"),
+    ("hardness_n", 1e9, r"`hardness_n` must be <= 1.3e\+08"),
+    ("youngs_modulus_pa", 1.0, r"`youngs_modulus_pa` must be >= 10"),
+    ("youngs_modulus_pa", 1e12, r"`youngs_modulus_pa` must be <= 1e\+10"),
+])
+def test_a_scenario_material_no_world_can_press_is_refused(field: str, value: float,
+                                                           message: str) -> None:
+    from deformap.errors import DeformapError
+    from deformap.world import Block
+
+    square = np.array([[0.0, 0.0], [0.1, 0.0], [0.1, 0.1], [0.0, 0.1]])
+    with pytest.raises(DeformapError, match=message):
+        Block(name="x", polygon=square, **{field: value})

@@ -81,8 +81,11 @@ class Block:
     name: str
     polygon: NDArray[np.float64]
     thickness_m: float = setting(0.05, gt=0.0, le=MAX_EXTENT_M)
-    hardness_n: float | None = setting(None, gt=0.0)
-    youngs_modulus_pa: float | None = setting(None, gt=0.0)
+    # Flexible foams are graded from about 20 N (super soft) to about 1 kN (ISO 2439); the bounds
+    # are far outside that and only refuse what is no material the world can press: 0.1 N is
+    # 7.7 Pa, far softer than any foam sold; 10 GPa is wood or stone, a block to declare rigid.
+    hardness_n: float | None = setting(None, ge=0.1, le=1.3e8)
+    youngs_modulus_pa: float | None = setting(None, ge=10.0, le=1e10)
     rigid: bool = False
     color: str = "#c8a165"
 

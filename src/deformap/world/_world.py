@@ -188,10 +188,26 @@ class SimulatedWorld:
 
     def dent(self, target_xy: Any, force_n: float) -> Dent:
         """The foam's response to a press (FEM or foundation, ``config.physics``), without
-        touching the world's state (no noise)."""
+        touching the world's state (no noise).
+
+        Raises
+        ------
+        InvalidArgumentError
+            When the tip would sink as deep as the block is thick (a force far too large for
+            the foam, which neither physics models: it would be crushed onto the table).
+        """
         target = check_vector("target_xy", target_xy, 2, what="metres")
         force = check_positive("force_n", force_n)
-        return self.foam.dent(target, force, tip_radius_m=self.config.tip_radius_m)
+        dent = self.foam.dent(target, force, tip_radius_m=self.config.tip_radius_m)
+        label = int(self.scenario.labels(target[:1], target[1:])[0, 0])
+        if label >= 0 and dent.depth_m >= self.scenario.blocks[label].thickness_m:
+            block = self.scenario.blocks[label]
+            raise InvalidArgumentError(
+                f"`force_n` of {force:g} N would sink the tip {dent.depth_m:.3g} m into "
+                f"{block.name!r}, which is {block.thickness_m:g} m thick: the foam would be "
+                "crushed onto the table, where the world's physics does not hold; press with "
+                "less force")
+        return dent
 
     def force_travel(self, target_xy: Any, force_n: float, dent: Dent | None = None
                      ) -> ForceTravel | None:
