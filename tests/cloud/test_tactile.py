@@ -5,7 +5,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from deformap.cloud import DEFAULT_CAP_HALF_ANGLE_DEG, tactile_points
+from deformap.cloud import DEFAULT_CAP_HALF_ANGLE_DEG, contact_cap, tactile_points
 from deformap.environment import TactileContact
 from deformap.errors import InvalidArgumentError
 
@@ -90,3 +90,42 @@ def test_tactile_points_refuse_bad_input(kwargs: dict[str, object], message: str
     args.update(kwargs)
     with pytest.raises(InvalidArgumentError, match=message):
         tactile_points(**args)  # type: ignore[arg-type]
+
+
+def test_the_contact_cap_follows_the_indentation() -> None:
+    r = 0.01
+    # Hertz contact radius √(Rδ): a 1 mm dent on a 1 cm tip touches within 3.16 mm (18.4°)
+    angle, count = contact_cap(r, 0.001)
+    assert angle == pytest.approx(np.degrees(np.arcsin(np.sqrt(r * 0.001) / r)))
+    assert angle == pytest.approx(18.43, abs=0.01)
+    # the paper's density, ten points per 30° cap: (1 - cos 18.4°) / (1 - cos 30°) of ten
+    assert count == round(10 * (1 - np.cos(np.radians(angle))) / (1 - np.cos(np.radians(30))))
+    assert count == 4
+    depths = [0.0, 1e-5, 2e-4, 5e-4, 1e-3, 2e-3, 4e-3, 8e-3, 0.02]
+    caps = [contact_cap(r, d) for d in depths]
+    angles = [a for a, _ in caps]
+    counts = [n for _, n in caps]
+    assert np.all(np.diff(angles) > 0) and np.all(np.diff(counts) >= 0)
+    assert counts[0] == 1 and angles[0] < 0.01  # nothing sunk: the pole alone
+    assert counts[-1] == 10 and angles[-1] == 90.0  # sunk past its radius: the half sphere
+    assert contact_cap(r, 0.002, n=1)[1] == 1
+    # points on that cap lie no higher above the pole than the tip sinks below the surface's
+    # contact edge: (1 - cos θ) R = R - √(R² - Rδ) ≤ δ for δ ≤ R
+    for d in (2e-4, 1e-3, 4e-3):
+        angle, count = contact_cap(r, d)
+        pts = tactile_points([0, 0, 0], [0, 0, -1], r, count, cap_half_angle_deg=angle)
+        assert (pts[:, 2] + r).max() <= d + 1e-12
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        ((0.0, 0.001), "`tip_radius_m` must be > 0"),
+        ((0.01, -1e-4), "`indentation_m` must be >= 0"),
+        ((0.01, float("nan")), "`indentation_m`"),
+        ((0.01, 0.001, 0), "`n` must be an integer >= 1"),
+    ],
+)
+def test_the_contact_cap_refuses_bad_input(args: tuple[float, ...], message: str) -> None:
+    with pytest.raises(InvalidArgumentError, match=message):
+        contact_cap(*args)  # type: ignore[arg-type]

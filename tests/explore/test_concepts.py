@@ -187,12 +187,15 @@ def test_a_press_with_a_force_travel_record_reads_stiffness_and_modulus() -> Non
     fallback = measure_press(odd, 0, surface, config).record
     assert fallback.stiffness is None
     assert "must start at first contact" in (fallback.stiffness_error or "")
-    assert fallback.beta == r.beta  # β does not depend on the record
+    # the read record anchors the tactile points; the refused one leaves them on the tip
+    assert r.depth_anchored is True and fallback.depth_anchored is False
+    assert r.indentation_m == pytest.approx(r.stiffness.depth_m)
+    assert fallback.indentation_m is not None and fallback.indentation_m > 0
 
 
 def test_the_modulus_does_not_depend_on_the_tips_absolute_height() -> None:
     # an arm's tip height is off by a millimetre or so; the record's travel is counted from
-    # first contact, so E does not see it (β does: it reads the dent against the tip)
+    # first contact, so E does not see it (nor β: tests/explore/test_dent_record.py)
     from deformap.environment import PressObservation, TactileContact
 
     world = coarse_world("homogeneous-60", seed=0)

@@ -14,12 +14,13 @@ from deformap.cloud._filters import (
     statistical_outlier_mask,
 )
 from deformap.cloud._pointcloud import PointCloud
-from deformap.cloud._tactile import DEFAULT_CAP_HALF_ANGLE_DEG, tactile_points
+from deformap.cloud._tactile import DEFAULT_CAP_HALF_ANGLE_DEG, contact_cap, tactile_points
 
 __all__ = [
     "DEFAULT_CAP_HALF_ANGLE_DEG",
     "HULL_TOLERANCE_M",
     "PointCloud",
+    "contact_cap",
     "crop_box",
     "height_field_mask",
     "points_in_hull",

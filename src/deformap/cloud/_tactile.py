@@ -5,10 +5,20 @@ and stick hide the very dent being measured; they are "virtually generated consi
 and shape of the spherical surface of the sensor along with the contact force direction". Here they
 are points on the spherical cap of the tip that faces along the contact force.
 
+Which cap touches depends on how deep the tip sinks: a sphere of radius ``R`` pressed ``δ`` into
+an elastic surface touches it within the Hertz contact radius ``a = √(R δ)`` (Johnson 1985,
+§4.2; Dimitriadis et al. 2002 expand the bonded layer's force in ``χ = a / h`` with the same
+``a``), beyond which the surface falls away from the tip. :func:`contact_cap` gives that cap's
+half-angle ``asin(a / R)`` and how many points keep the paper's density on it (ten on a 30° cap),
+at least the pole: points farther up the tip would lie above the real surface and make the dent
+look shallower (a 1–2 mm dent on a 1 cm tip touches a cap of 18–27°, not a fixed 30°).
+
 References
 ----------
 Caccamo et al., "Active Perception and Modeling of Deformable Surfaces using Gaussian Processes
 and Position-based Dynamics", HUMANOIDS 2016, Sec. III ("The algorithm process flow").
+Johnson, K. L. (1985). Contact Mechanics, §4.2. Cambridge University Press.
+Dimitriadis, E. K., et al. (2002). Biophysical Journal 82(5), 2798–2810.
 """
 
 from __future__ import annotations
@@ -21,7 +31,7 @@ from numpy.typing import NDArray
 from deformap._validation import check_finite_scalar, check_int, check_positive, check_vector
 from deformap.errors import InvalidArgumentError
 
-__all__ = ["DEFAULT_CAP_HALF_ANGLE_DEG", "tactile_points"]
+__all__ = ["DEFAULT_CAP_HALF_ANGLE_DEG", "contact_cap", "tactile_points"]
 
 #: Half-angle of the touching cap, measured at the tip's centre from the force direction.
 #: A 30° cap reaches ``r (1 - cos 30°) ≈ 0.13 r`` up from the pole: for a 1 cm tip that is 1.3 mm,
@@ -41,6 +51,38 @@ def _orthonormal_frame(axis: NDArray[np.float64]) -> tuple[NDArray[np.float64], 
     e1 /= np.linalg.norm(e1)
     e2 = np.cross(axis, e1)
     return e1, e2
+
+
+def contact_cap(tip_radius_m: float, indentation_m: float,
+                n: int = 10) -> tuple[float, int]:
+    """The cap of the tip in contact at an indentation, and the points that sample it.
+
+    Parameters
+    ----------
+    tip_radius_m : float
+        Radius ``R`` of the tip, > 0.
+    indentation_m : float
+        How deep ``δ`` the tip sinks into the surface, >= 0.
+    n : int
+        Points on a cap of :data:`DEFAULT_CAP_HALF_ANGLE_DEG` (the paper's ten), >= 1.
+
+    Returns
+    -------
+    half_angle_deg : float
+        ``asin(min(a / R, 1))`` with the contact radius ``a = √(R δ)`` (module docstring); a
+        small positive angle when ``δ = 0`` (the pole alone touches).
+    count : int
+        Points on that cap at the density of ``n`` points on the default cap (the cap's area is
+        proportional to ``1 − cos θ``), rounded, between 1 (the pole) and ``n``.
+    """
+    radius = check_positive("tip_radius_m", tip_radius_m)
+    depth = check_positive("indentation_m", indentation_m, allow_zero=True)
+    most = check_int("n", n, minimum=1)
+    ratio = min(np.sqrt(radius * depth) / radius, 1.0)
+    half_angle = max(float(np.degrees(np.arcsin(ratio))), 1e-3)
+    area = (1.0 - np.cos(np.radians(half_angle))) / (
+        1.0 - np.cos(np.radians(DEFAULT_CAP_HALF_ANGLE_DEG)))
+    return half_angle, int(np.clip(round(most * area), 1, most))
 
 
 def tactile_points(

@@ -79,12 +79,14 @@ __all__ = [
     "MAX_ROI_BAND_BYTES",
     "BetaFieldConfig",
     "BetaUncertainty",
+    "DepthAnchor",
     "ExplorationConfig",
     "FieldName",
     "ModulusFieldConfig",
     "RegionLabels",
     "StopRegion",
     "SurfaceGPConfig",
+    "TactileCap",
     "TouchGPConfig",
     "TouchModel",
     "check_exploration_budget",
@@ -92,6 +94,10 @@ __all__ = [
 
 #: How the touch GP models the dent (``TouchGPConfig.model``).
 TouchModel = Literal["residual", "height"]
+#: Which cap of the tip carries the tactile points (``TouchGPConfig.tactile_cap``).
+TactileCap = Literal["contact", "fixed"]
+#: What the dent's depth at the tip is read from (``TouchGPConfig.depth_anchor``).
+DepthAnchor = Literal["record", "tip"]
 #: Where the variance must fall below ``T_h`` (``ExplorationConfig.stop_region``).
 StopRegion = Literal["workspace", "targets"]
 #: How cells get their region (``ExplorationConfig.region_labels``).
@@ -154,6 +160,25 @@ class TouchGPConfig:
     ``noise_samples``: how many draws of the camera's noise are carried through the touch GP when
     β's uncertainty is the camera's noise (``ExplorationConfig.beta_uncertainty``, the one
     switch; :mod:`deformap.explore._dent_noise`); 0 when it is not.
+
+    ``tactile_cap``: ``"contact"`` (default) puts the tactile points only on the cap of the tip
+    that touches at the poke's indentation (Hertz contact radius ``√(R δ)``, at the paper's
+    density of ``n_tactile`` points per 30° cap, at least the pole;
+    :func:`deformap.cloud.contact_cap`); ``"fixed"``, the paper's ``n_tactile`` points on a
+    fixed 30° cap.
+
+    ``depth_anchor``: ``"record"`` (default) places the tactile points, when the press has a
+    force–travel record the stiffness estimate could read, at the surface model's height at the
+    contact minus the record's indentation (so that an error in the tip's absolute height does
+    not move the dent), with the record's uncertainty of that indentation as their noise;
+    ``"tip"``, and every press without such a record, places them on the tip where
+    proprioception says it is, with ``tactile_noise_std_m``.
+
+    ``dent_visible_sigmas``: with β's uncertainty from the camera's noise, a dent whose depth at
+    the contact's edge (half the indentation, Hertz) is below this many standard deviations of
+    the camera's mean height over the points seen around the tip is within the camera's noise:
+    β's claimed σ is then that of knowing nothing about β, a uniform over [0, 1) (1/√12).
+    2: a one-sided test at about 98 %.
     """
 
     roi_size_m: float = setting(0.12, gt=0.0)
@@ -162,6 +187,9 @@ class TouchGPConfig:
     # closer together than the camera's own points
     n_tactile: int = setting(10, ge=1, le=1000)
     tactile_noise_std_m: float = setting(0.0005, gt=0.0)
+    tactile_cap: TactileCap = "contact"
+    depth_anchor: DepthAnchor = "record"
+    dent_visible_sigmas: float = setting(2.0, ge=0.0)
     robot_margin_m: float = setting(0.002, ge=0.0)
     tip_margin_m: float = setting(0.003, ge=0.0)
     above_surface_m: float = setting(0.01, gt=0.0)

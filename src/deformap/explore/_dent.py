@@ -4,14 +4,30 @@
    robot's points are removed (the convex hull of its stick and hand plus ``robot_margin_m``, a
    ball of the tip's radius plus ``tip_margin_m``), then steep faces, then every point more than
    ``above_surface_m`` above the surface model (a dent goes down).
-2. The touch GP ("GPR-touch") is fitted to those points and ``n_tactile`` tactile points on the
-   tip's cap, by default as the change of height against the surface model (``model="residual"``),
-   and read on the ROI's grid: the deformed heightmap X̄.
+2. The touch GP ("GPR-touch") is fitted to those points and the tactile points on the tip's cap,
+   by default as the change of height against the surface model (``model="residual"``), and read
+   on the ROI's grid: the deformed heightmap X̄. The tactile points cover only the cap that
+   touches at the poke's indentation δ (``touch.tactile_cap``; :func:`deformap.cloud.contact_cap`):
+   δ is the force–travel record's when the stiffness estimate read one (its model indentation at
+   the commanded force; 0 when it read the surface rigid), else the tip's depth below the
+   surface model at the contact. With a record (``touch.depth_anchor="record"``) the points'
+   heights are anchored to it: the pole at the surface model's height at the contact minus δ,
+   with δ's uncertainty as their noise (the travel's noise and what E's σ moves δ by), so that an
+   error in the tip's absolute height, which a real arm's calibration makes by a millimetre, no
+   longer moves the dent. Without a record the points lie on the tip as proprioception places
+   it.
 3. Shape matching from the ROI's heightmap before the press gives β̂
    (:func:`deformap.msm.estimate_beta`). Its uncertainty is the camera's noise, measured in the
    ROI by the points' median absolute deviation about X̄, carried through the estimate
    (:func:`deformap.explore._dent_noise.dent_error_samples`) when ``beta_uncertainty`` is
-   ``camera-noise``; else the shape matcher's own (``shape_matching.uncertainty``).
+   ``camera-noise``; else the shape matcher's own (``shape_matching.uncertainty``). Draws of the
+   camera's noise cannot show a dent that the camera does not see at all (β̂ then sits at the
+   β = 0 end under every draw, and the draws claim a small σ): when the dent's depth at the
+   contact's edge, δ/2 (Hertz), is below ``touch.dent_visible_sigmas`` standard deviations of the
+   camera's mean height over the points within two tip radii of the contact, the claimed σ is
+   that of a uniform over [0, 1), 1/√12 (:func:`dent_visible`), and the poke says so
+   (``PokeRecord.dent_visible``); unless the record read the surface rigid, which is β = 0
+   measured without the camera.
 
 References
 ----------
@@ -26,8 +42,8 @@ import time
 import numpy as np
 from numpy.typing import NDArray
 
-from deformap.cloud import height_field_mask, points_in_hull, tactile_points
-from deformap.environment import PressObservation
+from deformap.cloud import contact_cap, height_field_mask, points_in_hull, tactile_points
+from deformap.environment import PressObservation, TactileContact
 from deformap.errors import DeformapError
 from deformap.explore._config import ExplorationConfig
 from deformap.explore._dent_noise import dent_error_samples
@@ -37,12 +53,21 @@ from deformap.explore._surface import SurfaceModel, crop_to
 from deformap.gp import GaussianRandomField
 from deformap.msm import estimate_beta
 
-__all__ = ["measure_press", "roi_grid"]
+__all__ = ["dent_visible", "measure_press", "roi_grid"]
 
 logger = logging.getLogger(__name__)
 
 _MAD_TO_STD = 1.4826
 """Standard deviation per median absolute deviation of a normal distribution."""
+
+UNINFORMED_BETA_STD = 1.0 / np.sqrt(12.0)
+"""Standard deviation of a uniform β over [0, 1): the claim of a poke whose dent the camera
+cannot see."""
+
+_FLANK_TIP_RADII = 2.0
+"""The dent's flank, where the camera must see it: within two tip radii of the contact (a Hertz
+dent's surface has fallen to under a third of δ there; the tip and stick hide the part inside one
+radius from most views)."""
 
 
 def _robust_std(residuals: NDArray[np.float64], floor: float = 1e-6) -> float:
@@ -105,6 +130,43 @@ def _stiffness(obs: PressObservation, surface: SurfaceModel, config: Exploration
     return estimate, thickness, None
 
 
+def dent_visible(indentation_m: float, camera_noise_m: float, n_points: int,
+                 sigmas: float) -> bool:
+    """Whether the camera sees a dent of ``indentation_m`` at all: its depth at the contact's
+    edge, half the indentation (Hertz), against the standard deviation of the mean height of the
+    ``n_points`` camera points around the tip, ``camera_noise_m / √n``; ``False`` without
+    points."""
+    if n_points <= 0:
+        return False
+    return bool(indentation_m / 2.0 >= sigmas * camera_noise_m / np.sqrt(n_points))
+
+
+def _indentation(obs: PressObservation, surface: SurfaceModel, config: ExplorationConfig,
+                 stiffness: StiffnessEstimate | None
+                 ) -> tuple[float, float | None, TactileContact]:
+    """The poke's indentation δ at the tip, the noise of tactile points anchored to it (``None``
+    when they are not: no record read, or ``depth_anchor="tip"``), and the contact with the tip
+    moved to that anchor (the measured one when not anchored)."""
+    contact = obs.contact
+    point = contact.contact_point
+    rest = float(np.asarray(surface.gp.predict(point[None, :2])).reshape(-1)[0])
+    if stiffness is None:
+        return max(rest - float(point[2]), 0.0), None, contact
+    if stiffness.rigid:
+        depth, std = 0.0, config.stiffness.travel_noise_m
+    else:
+        depth = max(float(stiffness.depth_m), 0.0)
+        # δ ∝ E^(−2/3) at a fixed force (Hertz), so E's relative σ moves δ by 2/3 of it
+        rel = float(stiffness.modulus_std_pa or 0.0) / float(stiffness.modulus_pa or 1.0)
+        std = float(np.hypot(config.stiffness.travel_noise_m, 2.0 / 3.0 * depth * rel))
+    if config.touch.depth_anchor != "record":
+        return depth, None, contact
+    shift = np.array([0.0, 0.0, (rest - depth) - float(point[2])])
+    anchored = TactileContact(tip_center=contact.tip_center + shift, force=contact.force,
+                              tip_radius_m=contact.tip_radius_m)
+    return depth, std, anchored
+
+
 def measure_press(obs: PressObservation, index: int, surface: SurfaceModel,
                   config: ExplorationConfig) -> PokeResult:
     """Reconstruct the dent of one press and estimate its β.
@@ -132,13 +194,20 @@ def measure_press(obs: PressObservation, index: int, surface: SurfaceModel,
     center = contact.contact_point[:2]
     roi_xs, roi_ys = roi_grid(center, cfg.roi_size_m, config.surface.grid_spacing_m)
     roi, rest_at = _roi_points(obs, surface, config)
-    tactile = tactile_points(contact.tip_center, contact.force, contact.tip_radius_m,
-                             n=cfg.n_tactile)  # fmt: skip
+    t_stiff = time.perf_counter()
+    stiffness, thickness, stiffness_error = _stiffness(obs, surface, config)
+    t_stiff = time.perf_counter() - t_stiff
+    depth, anchored_noise, anchored = _indentation(obs, surface, config, stiffness)
+    half_angle, n_tactile = (contact_cap(contact.tip_radius_m, depth, cfg.n_tactile)
+                             if cfg.tactile_cap == "contact" else (30.0, cfg.n_tactile))
+    tactile = tactile_points(anchored.tip_center, anchored.force, anchored.tip_radius_m,
+                             n=n_tactile, cap_half_angle_deg=half_angle)  # fmt: skip
+    tactile_noise = cfg.tactile_noise_std_m if anchored_noise is None else anchored_noise
     t1 = time.perf_counter()
     rest_z = np.asarray(surface.gp.predict_grid(roi_xs, roi_ys))
     data = np.vstack([roi, tactile])
     noise = np.concatenate(
-        [np.full(len(roi), cfg.noise_std_m), np.full(len(tactile), cfg.tactile_noise_std_m)]
+        [np.full(len(roi), cfg.noise_std_m), np.full(len(tactile), tactile_noise)]
     )
     target = data[:, 2]
     if cfg.model == "residual":
@@ -153,7 +222,7 @@ def measure_press(obs: PressObservation, index: int, surface: SurfaceModel,
     gx, gy = np.meshgrid(roi_xs, roi_ys)
     deformed = np.column_stack([gx.ravel(), gy.ravel(), deformed_z.ravel()])
     t2 = time.perf_counter()
-    samples, camera_noise = None, None
+    samples, camera_noise, visible = None, None, None
     if config.beta_uncertainty == "camera-noise":
         # The camera's noise here, from the points' scatter about the reconstruction; the touch
         # GP's σₙ is a prior setting, not a measurement.
@@ -161,14 +230,18 @@ def measure_press(obs: PressObservation, index: int, surface: SurfaceModel,
         camera_noise = _robust_std(np.asarray(target[: len(roi)]) - fitted)
         samples = dent_error_samples(
             roi_xs, roi_ys, roi[:, :2], camera_noise, tactile[:, :2],
-            cfg.tactile_noise_std_m, length_scale_m=cfg.length_scale_m,
+            tactile_noise, length_scale_m=cfg.length_scale_m,
             signal_std_m=cfg.signal_std_m, n_samples=cfg.noise_samples,
         )  # fmt: skip
-    est = estimate_beta(roi_xs, roi_ys, rest_z, deformed, contact, config.shape_matching,
+        near = np.linalg.norm(roi[:, :2] - center, axis=1) <= _FLANK_TIP_RADII * contact.tip_radius_m
+        visible = dent_visible(depth, camera_noise, int(near.sum()), cfg.dent_visible_sigmas)
+    est = estimate_beta(roi_xs, roi_ys, rest_z, deformed, anchored, config.shape_matching,
                         height_samples=samples)  # fmt: skip
+    beta_std = float(est.beta_std)
+    # a surface the record reads rigid needs no dent seen: β = 0 is what it measured
+    if visible is False and not (stiffness is not None and stiffness.rigid):
+        beta_std = max(beta_std, UNINFORMED_BETA_STD)
     t3 = time.perf_counter()
-    stiffness, thickness, stiffness_error = _stiffness(obs, surface, config)
-    t4 = time.perf_counter()
     target_xy = obs.target_xy
     record = PokeRecord(
         index=index,
@@ -177,7 +250,7 @@ def measure_press(obs: PressObservation, index: int, surface: SurfaceModel,
         contact=ContactRecord.of(contact),
         force_n=float(obs.force_n),
         beta=float(est.beta),
-        beta_std=float(est.beta_std),
+        beta_std=beta_std,
         betas=tuple(float(b) for b in np.asarray(est.betas)),
         errors=tuple(float(e) for e in np.asarray(est.errors)),
         iterations=int(np.max(est.iterations)),
@@ -186,8 +259,9 @@ def measure_press(obs: PressObservation, index: int, surface: SurfaceModel,
         n_roi_points=len(roi),
         camera_noise_m=camera_noise,
         timings=PokeTimings(filter_s=t1 - t0, touch_gp_s=t2 - t1, beta_s=t3 - t2,
-                            stiffness_s=None if obs.force_travel is None else t4 - t3),
+                            stiffness_s=None if obs.force_travel is None else t_stiff),
         stiffness=stiffness, layer_thickness_m=thickness, stiffness_error=stiffness_error,
+        indentation_m=depth, depth_anchored=anchored_noise is not None, dent_visible=visible,
     )
     dent = Dent(roi_xs, roi_ys, rest_z, deformed_z, roi, tactile)
     return PokeResult(record, dent, est)

@@ -214,6 +214,14 @@ class PokeRecord:
     stiffness_error : str or None
         Why a record that came with the press gave no estimate (the poke then stands on the
         camera alone).
+    indentation_m : float or None
+        The indentation the tactile points were placed for: the force–travel record's (0 when
+        read rigid), else the tip's depth below the surface model (:mod:`deformap.explore._dent`).
+    depth_anchored : bool or None
+        Whether the tactile points' heights came from the record rather than the tip's height.
+    dent_visible : bool or None
+        Whether the camera saw the dent above its noise (``False``: β's σ was widened to that of
+        a uniform β; ``None`` when β's uncertainty is not the camera's noise).
     purpose : {"first", "variance", "boundary"} or None
         Why this place (``None`` outside the live loop: a replayed or single poke).
     planned_after : int or None
@@ -241,6 +249,9 @@ class PokeRecord:
     stiffness: StiffnessEstimate | None = None
     layer_thickness_m: float | None = None
     stiffness_error: str | None = None
+    indentation_m: float | None = None
+    depth_anchored: bool | None = None
+    dent_visible: bool | None = None
     purpose: Purpose | None = None
     planned_after: int | None = None
     max_variance_after: float | None = None
@@ -264,8 +275,8 @@ class PokeRecord:
         }  # fmt: skip
         if self.stiffness is not None:
             out["stiffness"] = _stiffness_to_dict(self.stiffness)
-        for name in ("layer_thickness_m", "stiffness_error", "purpose", "planned_after",
-                     "max_variance_after"):
+        for name in ("layer_thickness_m", "stiffness_error", "indentation_m", "depth_anchored",
+                     "dent_visible", "purpose", "planned_after", "max_variance_after"):
             if getattr(self, name) is not None:
                 out[name] = getattr(self, name)
         return out
@@ -310,6 +321,9 @@ class PokeRecord:
             stiffness=_stiffness_from_dict(data.get("stiffness"), f"{where}.stiffness"),
             layer_thickness_m=_number(data, "layer_thickness_m", where, optional=True),
             stiffness_error=_text(data, "stiffness_error", where),
+            indentation_m=_number(data, "indentation_m", where, optional=True),
+            depth_anchored=_number(data, "depth_anchored", where, kind=bool, optional=True),
+            dent_visible=_number(data, "dent_visible", where, kind=bool, optional=True),
             purpose=purpose,
             planned_after=_number(data, "planned_after", where, kind=int, optional=True),
             max_variance_after=_number(data, "max_variance_after", where, optional=True),

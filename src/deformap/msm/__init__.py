@@ -21,6 +21,20 @@ only bend, and its dent is a cone as wide as the ROI). Softer foams dent deeper 
 β̂ falls with hardness, and a rigid surface gives β̂ = 0. The README ("β separates hardness only
 under the force-driven protocol") has both protocols' βs on analytic and simulated dents.
 
+The β scale's window: β lives in [0, 1) and the body's stiffness is one number, so β reads a window
+of stiffnesses whose stiff end is set by the calibration. On analytic Hertz dents (0.6 N, 1 cm tip)
+β̂ reaches 0 once the dent is shallower than about twice the reference's pole depth, not at the
+reference itself (the β = 0 body's dent is wider than Hertz's, and E(β) compares the whole ROI):
+100 kPa reads 0.93 / 0.87 / 0.76 / 0.67 / 0.43 for 30 / 60 / 110 / 150 / 250 N (19 kPa, a 3.1 mm
+dent) and 0 at 39 kPa (a 2.0 mm dent) and stiffer. Moving the window does not widen it: a 400 kPa
+reference reads 0.98 / 0.96 / 0.91 / 0.88 / 0.79 (the soft foams a step of the β resolution apart)
+and still 0 at 77 kPa; calibrating on the reference's whole Hertz surface instead of its pole depth
+reads 0.98 / 0.96 / 0.92 / 0.88 / 0.80 and 0 at 77 kPa; scaling every β's dent to the measured
+indentation (β as pure shape) reads 0.99 / 0.90 / 0 / 0 / 0. Past the window's stiff end the
+force–travel record carries the reading (Young's modulus,
+:func:`deformap.explore.estimate_stiffness`); a fixed reference is kept so that β means the same on
+every poke and in every session.
+
 References
 ----------
 Müller, M., Heidelberger, B., Teschner, M., Gross, M. (2005). Meshless deformations based on

@@ -74,7 +74,9 @@ class ShapeMatchingConfig:
         that at β = 0 the simulated body dents, under the measured force and tip, as deep as an
         elastic half-space of this Young's modulus (Hertz). 100 kPa lies an order of magnitude
         above the stiffest polyurethane foams (about 20 kPa for a 250 N hardness) and below
-        rubbers, so β = 0 means "a stiff rubber-like body" and every foam maps inside (0, 1).
+        rubbers. β̂ reaches 0 well before the reference, by 39 kPa on analytic Hertz dents
+        (:mod:`deformap.msm`, "The β scale's window"): the stiffest polyurethane foams lie near
+        the window's stiff end, and a stiffer reference narrows the soft end instead.
     poisson_ratio : float
         Poisson ratio of that reference half-space (0.5: nearly incompressible, like solid
         rubber; the value only enters through ``E* = E / (1 − ν²)``).
