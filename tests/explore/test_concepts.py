@@ -74,7 +74,7 @@ def test_the_beta_field_is_the_exact_gp_posterior() -> None:
 
 
 def test_max_variance_after_one_poke_goes_to_the_least_known_reachable_cell() -> None:
-    config = ExplorationConfig(strategy="max-variance")
+    config = ExplorationConfig(strategy="max-variance", field="beta")  # a β-field test
     grid = MapGrid.build(WORKSPACE, config)
     field = BetaField(_pokes([(0.3, 0.2)], [0.5]), grid.xs, grid.ys, config.beta_field)
     target = choose_next(grid, field, config, np.random.default_rng(0), boundary_owed=0)

@@ -4,13 +4,14 @@ their detection bound, pokes without a record left out, the settings, and the ma
 from __future__ import annotations
 
 import dataclasses
+import re
 
 import numpy as np
 import pytest
 
 from deformap._validation import SettingError
 from deformap.environment import Workspace
-from deformap.errors import EnvironmentStateError, InvalidArgumentError
+from deformap.errors import InvalidArgumentError
 from deformap.explore import (
     ExplorationConfig,
     Mapper,
@@ -126,7 +127,7 @@ def test_settings_in_beta_units_are_the_same_fraction_of_the_modulus_prior() -> 
     assert modulus.threshold / prior_modulus == pytest.approx(beta.threshold / prior_beta)
     assert modulus.min_step / config.modulus_field.signal_std == pytest.approx(
         beta.min_step / config.beta_field.signal_std)
-    assert field_settings(ExplorationConfig()).name == "beta"
+    assert field_settings(ExplorationConfig()).name == "modulus"  # the default
 
 
 @pytest.mark.parametrize("bad", [{"signal_std": 0.0}, {"length_scale_m": -0.1},
@@ -166,9 +167,20 @@ def test_the_map_runs_on_the_modulus_field_when_asked() -> None:
     assert on_beta.regions().n_regions == 1
 
 
-def test_field_modulus_without_a_record_is_refused_at_the_first_poke() -> None:
+def test_field_modulus_without_a_record_falls_back_to_beta_and_says_so() -> None:
     mapper = _mapper("modulus")
-    with pytest.raises(EnvironmentStateError, match=r"exploration\.field.*no force–travel record"):
-        mapper.add(_poke((0.3, 0.2), None))
-    # the β-field's map takes the same poke
+    mapper.add(_poke((0.3, 0.2), None))
+    assert mapper.config.field == "beta" and mapper.map_field is mapper.field
+    assert mapper.field_fallback is not None
+    assert re.match(r"`exploration.field` 'modulus' fell back to 'beta': poke 1 gave no modulus "
+                    r"\(.*no force–travel record", mapper.field_fallback)
+    assert mapper.threshold == field_settings(mapper.config).threshold == 0.06
+    mapper.add(_poke((0.1, 0.1), None, 1))
+    assert len(mapper.field.pokes) == 2
+    # a first poke with a modulus keeps the modulus field, a later one without is left out of it
+    kept = _mapper("modulus")
+    kept.add(_poke((0.3, 0.2), _soft(10e3)))
+    kept.add(_poke((0.1, 0.1), None, 1))
+    assert kept.config.field == "modulus" and kept.field_fallback is None
+    assert len(kept.modulus_field.pokes) == 1 and len(kept.field.pokes) == 2
     assert len(_mapper("beta").add(_poke((0.3, 0.2), None)).record.contact_xy) == 2

@@ -195,6 +195,6 @@ def test_a_further_press_is_expected_as_noisy_as_the_place_has_read() -> None:
 
     pokes = PokeSet.of([synthetic_poke((0.3, 0.2), 0.5, 0.2).record,
                         synthetic_poke((0.1, 0.1), 0.5, 0.001).record], noise_floor=FLOOR)
-    config = ExplorationConfig()
+    config = ExplorationConfig(field="beta")  # β-field pokes, the β-field's floor
     noise = expected_noise(np.array([[0.3, 0.21], [0.1, 0.1], [0.5, 0.3]]), pokes, config)
     assert noise.tolist() == [0.2, FLOOR, FLOOR]  # near the noisy poke; the floor elsewhere

@@ -44,3 +44,30 @@ def test_user_text_with_brackets_is_printed_as_written(tmp_path: Path) -> None:
     result = runner.invoke(app, ["world", "show", "[bold]x[/bold].yaml", "--out",
                                  str(tmp_path / "w")])
     assert result.exit_code == 2 and "'[bold]x[/bold].yaml'" in result.output, result.output
+
+
+def test_a_camera_only_session_maps_on_beta_and_says_so(tmp_path: Path, synthetic,  # type: ignore[no-untyped-def]
+                                                        write_synthetic) -> None:
+    from dataclasses import replace
+
+    presses = [replace(p, force_travel=None) for p in synthetic.presses]
+    session = write_synthetic(tmp_path / "session", replace(synthetic, presses=presses))
+    out = tmp_path / "map"
+    result = runner.invoke(app, ["map", str(session), "--out", str(out), "--no-figures"])
+    assert result.exit_code == 0, result.output
+    report = json.loads((out / "report.json").read_text())
+    assert report["config"]["exploration"]["field"] == "modulus"  # what the run asked for
+    assert report["field"] == "beta" and report["n_pokes"] == 3
+    assert report["field_fallback"].startswith("`exploration.field` 'modulus' fell back to 'beta'")
+    assert report["field_fallback"] in report["warnings"]
+    assert "fell back to 'beta'" in result.output
+
+
+def test_a_session_with_records_maps_on_the_modulus(tmp_path: Path, synthetic,  # type: ignore[no-untyped-def]
+                                                    write_synthetic) -> None:
+    session = write_synthetic(tmp_path / "session", synthetic)
+    out = tmp_path / "map"
+    assert runner.invoke(app, ["map", str(session), "--out", str(out),
+                               "--no-figures"]).exit_code == 0
+    report = json.loads((out / "report.json").read_text())
+    assert report["field"] == "modulus" and report["field_fallback"] is None

@@ -289,8 +289,11 @@ class ExplorationConfig:
         The field the regions, the next-poke choice and the stopping rule run on: ``beta``, the
         β-field (the paper's); ``modulus``, the modulus field over ln E from the force–travel
         records (:mod:`deformap.explore._modulus`; ``threshold`` is then read as the same fraction
-        of its prior variance). With ``modulus``, a run whose pokes give no usable record is
-        refused at its first poke (:class:`deformap.errors.EnvironmentStateError`).
+        of its prior variance), the default: it counted the regions right on the simulated FEM
+        world and on the stiffening-foam physics where the β-field did not (README, "Regions on
+        the β-field or on the modulus field"), and it does not depend on the camera. When no poke
+        of a run gives a usable record (a camera-only robot or session) the run falls back to
+        ``beta`` at its first poke, and its result says so (``field_fallback``).
     modulus_field : ModulusFieldConfig
         Prior of the modulus field; it is computed whenever a poke has a modulus, whichever
         ``field`` is chosen.
@@ -315,7 +318,7 @@ class ExplorationConfig:
     region_labels: RegionLabels = "isopleth"
     boundary_pokes: int = setting(0, ge=0, le=1000)  # as for max_pokes
     beta_uncertainty: BetaUncertainty = "camera-noise"
-    field: FieldName = "beta"
+    field: FieldName = "modulus"
     surface: SurfaceGPConfig = _field(default_factory=SurfaceGPConfig)
     touch: TouchGPConfig = _field(default_factory=TouchGPConfig)
     beta_field: BetaFieldConfig = _field(default_factory=BetaFieldConfig)

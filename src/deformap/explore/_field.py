@@ -84,7 +84,8 @@ class PokeSet:
     ``xy (p, 2)`` metres, ``beta (p,)`` the values the field is fitted to (β for the β-field, ln E
     for the modulus field), ``noise (p,)`` each poke's uncertainty raised to the field's noise
     floor (what the field and the planner take as its noise), ``index (p,)`` the pokes' indices
-    in their run (default ``0 .. p-1``; the modulus field leaves out pokes without a modulus).
+    in their run (``PokeRecord.index``; default ``0 .. p-1``; a session's skipped poke and the
+    modulus field's pokes without a modulus leave gaps).
     """
 
     xy: NDArray[np.float64]
@@ -101,7 +102,8 @@ class PokeSet:
         xy = np.array([r.contact_xy for r in records], dtype=float).reshape(-1, 2)
         beta = np.array([r.beta for r in records], dtype=float)
         noise = np.maximum(np.array([r.beta_std for r in records], dtype=float), noise_floor)
-        return cls(xy, beta, np.asarray(noise, dtype=float).reshape(-1))
+        index = np.array([r.index for r in records], dtype=np.int64)
+        return cls(xy, beta, np.asarray(noise, dtype=float).reshape(-1), index)
 
     def __len__(self) -> int:
         return int(self.beta.size)

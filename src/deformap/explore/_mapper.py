@@ -14,6 +14,7 @@ Caccamo et al. (2016), Sec. III-D (the process flow this class follows).
 from __future__ import annotations
 
 import dataclasses
+import logging
 import time
 from collections.abc import Mapping
 
@@ -34,6 +35,8 @@ from deformap.explore._surface import SurfaceModel, fit_surface
 from deformap.explore._targets import choose_next
 
 __all__ = ["Mapper"]
+
+logger = logging.getLogger(__name__)
 
 
 class Mapper:
@@ -56,6 +59,8 @@ class Mapper:
         self._pokes: list[PokeResult] = []
         self._field, self._modulus = self._fit([])
         self.threshold = field_settings(config).threshold
+        #: Why the run maps on β although ``config.field`` asked for the modulus (else None).
+        self.field_fallback: str | None = None
 
     @property
     def pokes(self) -> tuple[PokeResult, ...]:
@@ -107,11 +112,13 @@ class Mapper:
         t0 = time.perf_counter()
         field, modulus = self._fit([*self._pokes, poke])
         if self.config.field == "modulus" and not len(modulus.pokes):
+            # no poke of the run has a modulus (a camera-only robot or session): map on β
             why = modulus.readings[-1].excluded
-            raise EnvironmentStateError(
-                f"`exploration.field` is 'modulus', but poke {poke.record.index + 1} gave no "
-                f"modulus ({why}); map with `exploration.field` 'beta', or give the presses "
-                "force–travel records")
+            self.field_fallback = (f"`exploration.field` 'modulus' fell back to 'beta': poke "
+                                   f"{poke.record.index + 1} gave no modulus ({why})")
+            logger.warning("%s", self.field_fallback)
+            self.config = dataclasses.replace(self.config, field="beta")
+            self.threshold = field_settings(self.config).threshold
         active = modulus if self.config.field == "modulus" else field
         record = poke.record
         if target is not None:
@@ -157,4 +164,5 @@ class Mapper:
             pokes=self.pokes, field=self._field, modulus_field=self._modulus,
             regions=self.regions() if self._pokes else None,
             max_variance=self.max_variance(), stop_reason=stop_reason, timings=dict(timings),
+            field_fallback=self.field_fallback,
         )  # fmt: skip

@@ -53,6 +53,9 @@ class ExplorationResult:
         A :data:`StopReason`.
     timings : mapping of str to float
         ``total_s``, ``observe_s``, ``surface_gp_s``, ``environment_s``.
+    field_fallback : str or None
+        Why the map is on the β-field although the run asked for the modulus field (no poke gave
+        a modulus); ``config.field`` is then ``"beta"``.
     """
 
     config: ExplorationConfig
@@ -66,6 +69,7 @@ class ExplorationResult:
     max_variance: float
     stop_reason: str
     timings: Mapping[str, float]
+    field_fallback: str | None = None
 
     @property
     def xs(self) -> NDArray[np.float64]:

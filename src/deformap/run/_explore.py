@@ -232,7 +232,7 @@ def explore_scenario(
     if figures:
         hooks.stage("drawing figures")
         title = f"{config.scenario} (seed {config.seed}): {len(result.pokes)} pokes"
-        threshold = field_settings(config.exploration).threshold
+        threshold = field_settings(result.config).threshold
         write_map_figures(folder, result, truth=world, threshold=threshold,
                           title=title, poke_figures=False)  # fmt: skip
         _redraw_resumed_pokes(folder, result, world, config.exploration)

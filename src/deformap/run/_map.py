@@ -105,6 +105,6 @@ def map_recorded_session(
     if figures:
         hooks.stage("drawing figures")
         write_map_figures(folder, replay.result, truth=recorded.ground_truth,
-                          threshold=field_settings(cfg.exploration).threshold,
+                          threshold=field_settings(replay.result.config).threshold,
                           title=f"{stem}: {len(replay.result.pokes)} pokes")  # fmt: skip
     return MapOutput(report=report, session=recorded, replay=replay, config=cfg, folder=folder)

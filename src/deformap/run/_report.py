@@ -61,6 +61,7 @@ SHARED_KEYS = (
     "n_pokes",
     "stop_reason",
     "field",
+    "field_fallback",
     "threshold",
     "max_variance",
     "max_variance_map",
@@ -83,7 +84,7 @@ def _class_values(result: ExplorationResult) -> dict[str, Any]:
     found = result.regions
     assert found is not None
     field = result.map_field
-    betas = np.array([p.record.beta for p in result.pokes])
+    betas = {p.record.index: p.record.beta for p in result.pokes}  # a skipped poke has none
     index = np.arange(len(field.pokes)) if field.pokes.index is None else field.pokes.index
     by_index = {int(i): int(k) for i, k in zip(index, found.poke_labels, strict=True)}
     class_betas = []
@@ -149,6 +150,7 @@ def shared_report(result: ExplorationResult, *, truth: Any = None) -> dict[str, 
         "n_pokes": len(pokes),
         "stop_reason": result.stop_reason,
         "field": result.config.field,
+        "field_fallback": result.field_fallback,
         "threshold": field_settings(result.config).threshold,
         "max_variance": result.max_variance,
         "max_variance_map": float(var.max()),
@@ -220,7 +222,8 @@ def session_report(
         "config": config_to_dict(config),
         **shared_report(replay.result, truth=session.ground_truth),
         "skipped": replay.skipped,
-        "warnings": replay.warnings,
+        "warnings": [*replay.warnings,
+                     *([replay.result.field_fallback] if replay.result.field_fallback else [])],
     }
 
 
