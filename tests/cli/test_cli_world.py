@@ -40,3 +40,6 @@ def test_bench_world_writes_json(tmp_path) -> None:
     data = json.loads(out.read_text())
     assert set(data) >= {"construction_s", "press_s", "observe_s", "n_dofs", "n_points_on_area"}
     assert data["n_dofs"] > 0 and data["n_points_on_area"] > 1000
+    # one poke's compute with its record, and the camera-only baseline beside it
+    assert 0.0 < data["poke_compute_s"] and 0.0 < data["poke_compute_camera_only_s"]
+    assert "poke_compute_camera_only_s" in result.output

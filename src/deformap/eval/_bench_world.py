@@ -15,7 +15,8 @@ __all__ = ["bench_world"]
 def bench_world(*, scenario: str = "heterogeneous-60-110-rigid", rng: np.random.Generator,
                 config: Any = None, n_presses: int = 3,
                 force_n: float = ExplorationConfig().force_n) -> dict[str, Any]:
-    """Time one world at its default mesh (goals: build ≤ 20 s, press ≤ 1 s, observe ≤ 0.5 s).
+    """Time one world at its default mesh (goals: build ≤ 20 s, press ≤ 1 s, observe ≤ 0.5 s)
+    and one poke's compute on its presses (goal ≤ 1 s).
 
     Parameters
     ----------
@@ -32,7 +33,9 @@ def bench_world(*, scenario: str = "heterogeneous-60-110-rigid", rng: np.random.
     Returns
     -------
     dict with ``construction_s``, ``press_s``, ``observe_s`` (medians, seconds), ``n_dofs``,
-    ``n_points`` and ``n_points_on_area`` of one observation, ``scenario``, ``element_size_m``.
+    ``n_points`` and ``n_points_on_area`` of one observation, ``scenario``, ``element_size_m``,
+    ``poke_compute_s`` (median compute of one poke with its force–travel record: goal ≤ 1 s) and
+    ``poke_compute_camera_only_s`` (the same presses without records, the baseline).
     """
     from deformap.world import SimulatedWorld, WorldConfig, load_scenario
 
@@ -48,11 +51,13 @@ def bench_world(*, scenario: str = "heterogeneous-60-110-rigid", rng: np.random.
         observe_times.append(time.perf_counter() - t0)
     (x0, y0), (x1, y1) = sc.workspace.lower, sc.workspace.upper
     press_times = []
+    presses = []
     for f in np.linspace(0.2, 0.8, n_presses):
         t0 = time.perf_counter()
-        world.press((x0 + f * (x1 - x0), y0 + 0.5 * (y1 - y0)), force_n)
+        presses.append(world.press((x0 + f * (x1 - x0), y0 + 0.5 * (y1 - y0)), force_n))
         press_times.append(time.perf_counter() - t0)
         world.release()
+    with_record, camera_only = _poke_compute(sc.workspace, cloud, presses, rng)
     return {
         "scenario": sc.name,
         "element_size_m": cfg.element_size_m,
@@ -62,4 +67,30 @@ def bench_world(*, scenario: str = "heterogeneous-60-110-rigid", rng: np.random.
         "n_dofs": world.n_dofs,
         "n_points": len(cloud),
         "n_points_on_area": int(np.count_nonzero(sc.workspace.contains(cloud.xy))),
+        "poke_compute_s": with_record,
+        "poke_compute_camera_only_s": camera_only,
     }
+
+
+def _poke_compute(workspace: Any, cloud: Any, presses: list[Any], rng: np.random.Generator
+                  ) -> tuple[float, float]:
+    """Median compute of one poke (dent, β and its uncertainty, the force–travel reading, both
+    fields updated) on the world's presses, with their records and, as the baseline, the same
+    presses without them (the camera-only estimate)."""
+    import dataclasses
+
+    from deformap.explore import Mapper
+
+    medians = []
+    for keep_record in (True, False):
+        # without records the map is on β (no fallback warning in a benchmark's output)
+        mapper = Mapper(workspace, ExplorationConfig(field="modulus" if keep_record else "beta"))
+        mapper.initialise(cloud, np.random.default_rng(rng.integers(2**32)))
+        times = []
+        for index, obs in enumerate(presses):
+            press = obs if keep_record else dataclasses.replace(obs, force_travel=None)
+            t0 = time.perf_counter()
+            mapper.add(mapper.process_press(press, index))
+            times.append(time.perf_counter() - t0)
+        medians.append(float(np.median(times)))
+    return medians[0], medians[1]
