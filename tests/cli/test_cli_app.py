@@ -35,3 +35,17 @@ def test_every_command_group_is_registered() -> None:
                          ("study", ("hardness", "cluster-size")), ("world", ("show",))):  # fmt: skip
         result = runner.invoke(app, [group, "--help"])
         assert result.exit_code == 0 and all(n in result.output for n in names), result.output
+
+
+def test_every_command_with_a_seed_refuses_a_negative_one_before_running(tmp_path: Path) -> None:
+    commands = [["explore", "-s", "heterogeneous-60-150"], ["record-sim", "-s", "homogeneous-60"],
+                ["map", str(tmp_path)], ["reproduce"], ["study", "hardness"],
+                ["study", "cluster-size"], ["world", "show", "homogeneous-60", "--out",
+                                            str(tmp_path / "w")],
+                ["bench", "world"], ["bench", "io"], ["bench", "speed"], ["bench", "memory"]]
+    for command in commands:
+        result = runner.invoke(app, [*command, "--seed", "-3"])
+        assert result.exit_code == 2, (command, result.output)
+        assert "`--seed` must be an integer >= 0; got -3" in result.output, (command, result.output)
+        assert "Traceback" not in result.output
+    assert not (tmp_path / "w").exists()  # refused before any work

@@ -24,7 +24,7 @@ from rich.console import Console
 from rich.text import Text
 
 from deformap import __version__, run
-from deformap.errors import ConfigError, DeformapError
+from deformap.errors import ConfigError, DeformapError, InvalidArgumentError
 
 __all__ = [
     "JsonOption",
@@ -93,11 +93,15 @@ F = TypeVar("F", bound=Callable[..., Any])
 
 
 def friendly_errors(func: F) -> F:
-    """Turn a DeformapError into a one-line message and exit code 2."""
+    """Turn a DeformapError into a one-line message and exit code 2; refuse a negative
+    ``--seed`` (every command that has one) before the command runs."""
 
     @wraps(func)
     def wrapper(*args: Any, **kwargs: Any) -> Any:
         try:
+            seed = kwargs.get("seed")
+            if isinstance(seed, int) and seed < 0:  # numpy's generators take seeds >= 0
+                raise InvalidArgumentError(f"`--seed` must be an integer >= 0; got {seed}")
             return func(*args, **kwargs)
         except DeformapError as exc:
             err_console.print(labelled("error:", "bold red", str(exc)), soft_wrap=True)
