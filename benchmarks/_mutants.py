@@ -28,6 +28,9 @@ KINDS: dict[str, tuple[str, ...]] = {
     "npz": ("flip", "truncate", "extend", "member-flip", "member-truncate", "member-extend",
             "member-npy-header", "member-shape"),
     "session": ("yaml", "file", "link"),
+    # the YAML a user writes: a run configuration (`deformap config dump`) and a scenario
+    "config": ("yaml", "flip", "truncate"),
+    "scenario": ("yaml", "flip", "truncate"),
 }
 
 
@@ -98,6 +101,13 @@ def make_templates(root: Path) -> dict[str, Path]:
     out["npz"] = root / "t.npz"
     write_npz(out["npz"], cloud)
     out["session-folder"] = write_session(root / "session", **_session_parts()).parent
+    from deformap.run import RunConfig, config_yaml
+    from deformap.world import load_scenario, save_scenario
+
+    out["config"] = root / "config.yaml"
+    out["config"].write_text(config_yaml(RunConfig()))
+    out["scenario"] = root / "scenario.yaml"
+    save_scenario(load_scenario("heterogeneous-60-110-rigid"), out["scenario"])
     try:
         import rosbags  # noqa: F401
     except ImportError:
@@ -281,4 +291,6 @@ def mutate_file(data: bytes, kind: str, rng: np.random.Generator) -> bytes:
     """One file mutant: a ``FILE_MUTATORS`` kind, or ``member-KIND`` inside an NPZ member."""
     if kind.startswith("member-"):
         return _npz_member(data, rng, kind.removeprefix("member-"))
+    if kind == "yaml":
+        return _yaml_edit(data.decode("utf-8"), rng).encode("utf-8")
     return FILE_MUTATORS[kind](data, rng)

@@ -9,7 +9,8 @@ installed)
 are mutated by seeded byte flips, truncations, appended bytes, header field edits and point-count
 changes (and, for NPZ, the same inside a member, plus edits of its .npy header and shape, with
 the member's zip CRC made to match; for sessions,
-edits of ``session.yaml``, of one of its files, and links out of the folder). Each mutant is read
+edits of ``session.yaml``, of one of its files, and links out of the folder; and the YAML a user
+writes, a run configuration and a scenario, by line edits, byte flips and cuts). Each mutant is read
 in a worker process under a per-case time limit, and counted as:
 
 - ``clean``: refused with a DeformapError (a session: at load, or at least one of its reads);
@@ -70,6 +71,14 @@ def read_snapshot(reader: str, path: str) -> tuple[str, Any]:
     from deformap.errors import DeformapError
 
     try:
+        if reader in ("config", "scenario"):
+            from deformap._config import config_to_dict
+            from deformap.run import load_run_config
+            from deformap.world import load_scenario
+
+            value = (config_to_dict(load_run_config(path)) if reader == "config"
+                     else load_scenario(path).to_dict())  # fmt: skip
+            return "ok", hashlib.sha256(repr(value).encode()).hexdigest()[:16]
         if not reader.startswith("session"):
             from deformap.cloud.io import read_npz, read_pcd, read_ply
 
@@ -115,6 +124,8 @@ def classify(reader: str, kind: str, status: str, got: Any, want: Any) -> str:
         return status
     if got == want:
         return "same"
+    if reader in ("config", "scenario"):  # text a user edits: another valid value is theirs
+        return "changed"
     if reader.startswith("session"):
         n_got, reads = got
         if any(value == "refused" for _, value in reads):
