@@ -18,6 +18,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+from matplotlib import patheffects
 from matplotlib.axes import Axes
 from matplotlib.colors import LogNorm
 from matplotlib.figure import Figure
@@ -38,11 +39,17 @@ def _extent(xs: NDArray, ys: NDArray) -> list[float]:
 def _contacts(ax: Axes, contacts: NDArray[np.float64]) -> None:
     if contacts.size == 0:
         return
-    ax.plot(contacts[0, 0], contacts[0, 1], "o", mfc="none", mec="k", ms=10, mew=2)
+    # black marks with a white halo: readable on the dark end of a colour map (a rigid board's
+    # β = 0) as on the light one
+    halo = [patheffects.withStroke(linewidth=3.5, foreground="w")]
+    ax.plot(contacts[0, 0], contacts[0, 1], "o", mfc="none", mec="k", ms=10, mew=2,
+            path_effects=halo)
     if len(contacts) > 1:
-        ax.plot(contacts[1:, 0], contacts[1:, 1], "^", mfc="none", mec="k", ms=9, mew=2)
+        ax.plot(contacts[1:, 0], contacts[1:, 1], "^", mfc="none", mec="k", ms=9, mew=2,
+                path_effects=halo, linestyle="none")
     for i, (x, y) in enumerate(contacts):
-        ax.annotate(str(i + 1), (x, y), xytext=(6, 6), textcoords="offset points", fontsize=8)
+        ax.annotate(str(i + 1), (x, y), xytext=(6, 6), textcoords="offset points", fontsize=8,
+                    path_effects=[patheffects.withStroke(linewidth=2.5, foreground="w")])
 
 
 def plot_map(
