@@ -60,7 +60,10 @@ robot arm's joint encoders through its forward kinematics) and ``1 % of reading 
 force (a wrist force–torque sensor's class). The Poisson ratio defaults to 0.33, the value of
 open-cell foams in Gibson & Ashby's analysis (cell edges that bend give ``G ≈ 3E/8``, so
 ``ν = E/(2G) − 1 ≈ 1/3``); it is an assumption the caller may change: ``E`` scales with
-``1 − ν²`` (about 2 % between 0.3 and 0.36) and the layer correction moves with it.
+``1 − ν²`` (about 2 % between 0.3 and 0.36) and the layer correction moves with it. A press does
+not measure ν, so σ(E) also carries the assumption's own uncertainty: ``poisson_ratio_std`` 0.07,
+the spread of ν taken as anywhere in [0.2, 0.45] (a foam's ν depends on its cell structure and
+its strain; a range about 1/3 rather than a fitted figure), which moves E by about ±5 %.
 
 References
 ----------
@@ -75,6 +78,7 @@ Birge, R. T. (1932). The calculation of errors by the method of least squares. P
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from typing import Any
 
@@ -121,6 +125,11 @@ class StiffnessConfig:
     ----------
     poisson_ratio : float
         ``ν`` of the surface's material, an assumption (open-cell foam: 0.33).
+    poisson_ratio_std : float
+        How uncertain that assumption is; σ(E) carries what it moves E by (a refit at
+        ``ν ± poisson_ratio_std``). The default 0.07 is the standard deviation of ν spread
+        uniformly over [0.2, 0.45], about Gibson & Ashby's 1/3 (module docstring); 0 claims ν is
+        known.
     travel_noise_m : float
         Standard deviation of one travel reading (encoders through kinematics).
     force_noise_rel, force_noise_abs_n : float
@@ -139,6 +148,7 @@ class StiffnessConfig:
     """
 
     poisson_ratio: float = setting(0.33, ge=0.0, le=0.5)
+    poisson_ratio_std: float = setting(0.07, ge=0.0, le=0.25)
     travel_noise_m: float = setting(5e-5, gt=0.0, lt=0.01)
     force_noise_rel: float = setting(0.01, ge=0.0, lt=1.0)
     force_noise_abs_n: float = setting(0.005, gt=0.0)
@@ -484,6 +494,12 @@ def estimate_stiffness(travel_m: Any, force_n: Any, *, tip_radius_m: float, thic
     if thickness_std > 0:  # the layer's thickness is read from the surface model: its error too
         moduli = [_fit(travel, force, radius, max(thickness + d, 1.01 * travel.max()), config)[0]
                   for d in (-thickness_std, thickness_std)]
+        modulus_var += ((moduli[1] - moduli[0]) / 2.0) ** 2
+    if config.poisson_ratio_std > 0:  # the material's ν is assumed, not measured: its spread too
+        nus = [min(max(config.poisson_ratio + d, 0.0), 0.5)
+               for d in (-config.poisson_ratio_std, config.poisson_ratio_std)]
+        moduli = [_fit(travel, force, radius, thickness,
+                       dataclasses.replace(config, poisson_ratio=nu))[0] for nu in nus]
         modulus_var += ((moduli[1] - moduli[0]) / 2.0) ** 2
     modulus_std = float(np.sqrt(modulus_var))
 
