@@ -27,6 +27,12 @@ def test_a_session_with_no_usable_poke_exits_2_after_writing_its_report(
     report = json.loads((out / "report.json").read_text())
     assert report["n_pokes"] == 0 and report["regions"] is None
     assert len(report["warnings"]) == 3
+    assert (out / "pokes.csv").read_text().count("\n") == 1  # the header, no poke
+    import numpy as np
+
+    with np.load(out / "map.npz") as grids:
+        assert np.all(grids["region_labels"] == -1)
+        assert np.all(np.isnan(grids["modulus_median_pa"]))
 
 
 def test_a_session_with_usable_pokes_exits_0(tmp_path: Path, synthetic, write_synthetic) -> None:  # type: ignore[no-untyped-def]

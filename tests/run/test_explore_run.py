@@ -68,6 +68,35 @@ def test_report_and_figures(full_run) -> None:  # type: ignore[no-untyped-def]
     assert variances[-1] <= variances[0]
 
 
+def test_the_maps_as_numbers(full_run) -> None:  # type: ignore[no-untyped-def]
+    import csv
+
+    import numpy as np
+
+    folder, result = full_run.folder, full_run.result
+    with np.load(folder / "map.npz") as grids:  # no pickle needed
+        assert str(grids["frame"]) == "world" and str(grids["field"]) == result.config.field
+        ny, nx = grids["ys_m"].size, grids["xs_m"].size
+        for name in ("beta_mean", "beta_std", "modulus_median_pa", "log_modulus_mean",
+                     "log_modulus_std", "region_labels"):
+            assert grids[name].shape == (ny, nx), name
+        np.testing.assert_array_equal(grids["beta_mean"], result.field.mean)
+        np.testing.assert_array_equal(grids["region_labels"], result.regions.labels)
+        assert np.all(np.isfinite(grids["modulus_median_pa"]))  # the world gives records
+        np.testing.assert_allclose(grids["modulus_median_pa"],
+                                   np.exp(grids["log_modulus_mean"]))
+    rows = list(csv.DictReader((folder / "pokes.csv").open()))
+    assert [int(r["index"]) for r in rows] == [p.record.index for p in result.pokes]
+    for row, poke in zip(rows, result.pokes, strict=True):
+        assert float(row["beta"]) == poke.record.beta
+        assert float(row["contact_x_m"]) == poke.record.contact_xy[0]
+        assert row["purpose"] == poke.record.purpose and row["region"] != ""
+        stiffness = poke.record.stiffness
+        assert stiffness is not None and row["rigid"] == str(stiffness.rigid)
+        if not stiffness.rigid:
+            assert float(row["modulus_pa"]) == stiffness.modulus_pa
+
+
 def _run_killed_after_two_pokes(out: Path) -> None:
     """Start the test run in ``out`` and kill it right after its second poke was journalled."""
 

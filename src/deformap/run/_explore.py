@@ -39,6 +39,7 @@ from deformap.run._config import (
     load_run_config,
     run_generators,
 )
+from deformap.run._export import write_map_npz, write_pokes_csv
 from deformap.run._figures import (
     poke_figure_path,
     write_map_figures,
@@ -229,6 +230,8 @@ def explore_scenario(
                      on_poke=on_poke)  # fmt: skip
     report = live_report(config, result, world, world_build_s=world_s)
     write_json(folder / "report.json", report)
+    write_map_npz(folder / "map.npz", result)
+    write_pokes_csv(folder / "pokes.csv", result)
     if figures:
         hooks.stage("drawing figures")
         title = f"{config.scenario} (seed {config.seed}): {len(result.pokes)} pokes"

@@ -19,6 +19,7 @@ from deformap.run._config import (
     run_generators,
     session_run_config,
 )
+from deformap.run._export import write_map_npz, write_pokes_csv
 from deformap.run._figures import write_map_figures
 from deformap.run._folder import (
     create_run_folder,
@@ -102,6 +103,8 @@ def map_recorded_session(
     write_text(folder / CONFIG_NAME, config_yaml(cfg))
     report = session_report(cfg, recorded, replay)
     write_json(folder / "report.json", report)
+    write_map_npz(folder / "map.npz", replay.result)
+    write_pokes_csv(folder / "pokes.csv", replay.result)
     if figures:
         hooks.stage("drawing figures")
         write_map_figures(folder, replay.result, truth=recorded.ground_truth,

@@ -1,0 +1,94 @@
+"""Maps a user can take away as numbers: ``map.npz`` (the grids) and ``pokes.csv`` (one row a poke).
+
+``map.npz`` (numpy's zip of arrays, read with ``numpy.load(path)``, no pickle), every array on the
+map's grid of ``(ny, nx)`` cells unless said otherwise:
+
+- ``xs_m (nx,)``, ``ys_m (ny,)``: the cells' centres in the world frame (metres, z up, the table
+  z = 0); ``frame`` and ``units`` (strings) say so.
+- ``beta_mean``, ``beta_std``: the β-field's posterior mean and standard deviation.
+- ``modulus_median_pa``, ``log_modulus_mean``, ``log_modulus_std``: the modulus field (over ln E,
+  E in Pa): the median E (``exp`` of the mean), the mean and standard deviation of ln E; NaN
+  everywhere when no poke gave a modulus.
+- ``region_labels`` (int, -1 without a region map), ``field``: the field the regions were cut from.
+
+``pokes.csv``: ``index`` (0-based, as in ``report.json``), ``purpose``, ``target_x_m``,
+``target_y_m``, ``contact_x_m``, ``contact_y_m`` (where the tip touched: the fields' input),
+``tip_center_z_m`` (the tip's centre at the commanded force), ``force_n``, ``beta``,
+``beta_std``, ``stiffness_n_per_m``, ``stiffness_std_n_per_m``, ``modulus_pa``, ``modulus_std_pa``,
+``rigid`` (the force–travel reading; empty where the poke had none), ``region`` (the class of the
+poke in the region map, empty where the map field left the poke out).
+
+Both are written atomically (:mod:`deformap._files`).
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from deformap._files import atomic_path, write_text_atomically
+from deformap.explore import ExplorationResult
+
+__all__ = ["POKES_CSV_COLUMNS", "write_map_npz", "write_pokes_csv"]
+
+POKES_CSV_COLUMNS = (
+    "index", "purpose", "target_x_m", "target_y_m", "contact_x_m", "contact_y_m", "tip_center_z_m",
+    "force_n", "beta", "beta_std", "stiffness_n_per_m", "stiffness_std_n_per_m", "modulus_pa",
+    "modulus_std_pa", "rigid", "region",
+)  # fmt: skip
+
+
+def write_map_npz(path: Path, result: ExplorationResult) -> Path:
+    """``map.npz`` of ``result`` (module docstring)."""
+    shape = (result.ys.size, result.xs.size)
+    nan = np.full(shape, np.nan)
+    modulus = result.modulus_field
+    arrays: dict[str, Any] = {
+        "xs_m": result.xs, "ys_m": result.ys,
+        "frame": np.array("world"),
+        "units": np.array("xs_m, ys_m: m; beta: 1; modulus_median_pa: Pa; log_modulus: ln Pa"),
+        "beta_mean": result.field.mean, "beta_std": np.sqrt(result.field.variance),
+        "modulus_median_pa": modulus.median_pa if result.has_modulus else nan,
+        "log_modulus_mean": modulus.mean if result.has_modulus else nan,
+        "log_modulus_std": modulus.std if result.has_modulus else nan,
+        "region_labels": (result.regions.labels if result.regions is not None
+                          else np.full(shape, -1, dtype=np.int64)),
+        "field": np.array(result.config.field),
+    }  # fmt: skip
+    with atomic_path(path) as tmp, open(tmp, "wb") as fh:
+        np.savez_compressed(fh, **arrays)
+    return path
+
+
+def _cell(value: Any) -> Any:
+    return "" if value is None else value
+
+
+def write_pokes_csv(path: Path, result: ExplorationResult) -> Path:
+    """``pokes.csv`` of ``result`` (module docstring)."""
+    region_of: dict[int, int] = {}
+    if result.regions is not None:
+        index = result.map_field.pokes.index
+        assert index is not None  # PokeSet fills it
+        region_of = {int(i): int(k) for i, k in zip(index, result.regions.poke_labels,
+                                                    strict=True)}  # fmt: skip
+    text = io.StringIO()
+    writer = csv.writer(text, lineterminator="\n")
+    writer.writerow(POKES_CSV_COLUMNS)
+    for poke in result.pokes:
+        r = poke.record
+        s = r.stiffness
+        writer.writerow([
+            r.index, _cell(r.purpose), *(float(v) for v in r.target_xy),
+            *(float(v) for v in r.contact_xy), r.contact.tip_center[2], r.force_n, r.beta,
+            r.beta_std,
+            _cell(s and s.stiffness_n_per_m), _cell(s and s.stiffness_std_n_per_m),
+            _cell(s and s.modulus_pa), _cell(s and s.modulus_std_pa),
+            "" if s is None else s.rigid, _cell(region_of.get(r.index)),
+        ])  # fmt: skip
+    write_text_atomically(path, text.getvalue())
+    return path
