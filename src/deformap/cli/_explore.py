@@ -126,12 +126,26 @@ def explore_command(
     rerun: Annotated[
         bool, typer.Option("--rerun", help="Also write run.rrd (extra `rerun`).")
     ] = False,
+    environment: Annotated[
+        str | None,
+        typer.Option(help="Explore your own Environment instead of a simulated world: "
+                     "package.module:factory (docs/robot.md)."),
+    ] = None,
+    env_arg: Annotated[
+        list[str] | None,
+        typer.Option("--env-arg", help="key=value passed to the --environment factory (repeat)."),
+    ] = None,
     json_path: JsonOption = None,
 ) -> None:
-    """Explore a simulated world: poke until the β-field is known, then cut it into regions."""
+    """Explore a simulated world (or your own Environment): poke until the map field is known,
+    then cut it into regions."""
     overrides = run.RunOverrides(scenario=scenario, seed=seed, strategy=strategy,
                                  threshold=threshold, max_pokes=max_pokes,
                                  field=field)  # fmt: skip
+    if environment is not None or env_arg:
+        _explore_environment(environment, env_arg or [], scenario, resume, rerun, config,
+                             overrides, out, json_path)
+        return
     cfg = run.explore_run_config(config, overrides, resume)
     shown = out_console(json_path)
     with progress(shown) as bar:
@@ -156,3 +170,29 @@ def config_dump(
     except OSError as exc:
         raise ConfigError(f"cannot write --out {str(out)!r}: {exc.strerror or exc}") from None
     out_console(None).print(f"wrote {out}")
+
+
+def _explore_environment(environment: str | None, env_args: list[str], scenario: str | None,
+                         resume: Path | None, rerun: bool, config: Path | None,
+                         overrides: Any, out: Path | None, json_path: Path | None) -> None:
+    """``explore --environment``: a user's Environment, no ground truth to score against."""
+    if environment is None:
+        raise ConfigError("--env-arg goes with --environment package.module:factory; got no "
+                          "--environment")
+    if scenario is not None or resume is not None or rerun:
+        given = [n for n, v in (("--scenario", scenario), ("--resume", resume),
+                                ("--rerun", rerun)) if v]  # fmt: skip
+        raise ConfigError(f"--environment runs without {', '.join(given)}: a simulated world's "
+                          "options (resume and rerun recordings are for simulated runs)")
+    cfg = run.explore_run_config(config, overrides, None)
+    args = run.parse_env_args(env_args)
+    shown = out_console(json_path)
+    with progress(shown) as bar:
+        report, folder = run.explore_environment(environment, args, cfg, out,
+                                                 hooks=run_hooks(bar, poke_row=poke_row))
+    regions = report["regions"]
+    found = "no region map" if regions is None else f"{len(regions['class_betas'])} region(s)"
+    shown.print(f"{report['n_pokes']} pokes (stopped by {report['stop_reason']}), {found}, "
+                f"map field {report['field']}; {modulus_summary(report)}; wrote {folder}",
+                highlight=False)  # fmt: skip
+    emit_json(json_path, report)

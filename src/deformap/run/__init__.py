@@ -46,8 +46,10 @@ if TYPE_CHECKING:
         run_generators,
         session_run_config,
     )
+    from deformap.run._environment import explore_environment, load_environment, parse_env_args
     from deformap.run._estimate import EstimateOutput, estimate_one_poke
     from deformap.run._explore import RunOutput, explore_scenario
+    from deformap.run._export import POKES_CSV_COLUMNS, write_map_npz, write_pokes_csv
     from deformap.run._figures import write_estimate_figures, write_map_figures, write_rerun
     from deformap.run._folder import (
         RUNS_ROOT,
@@ -82,7 +84,9 @@ _MODULES = {
     "_config": ("CONFIG_NAME", "RunConfig", "RunOverrides", "apply_overrides", "config_yaml",
                 "explore_run_config", "load_run_config",
                 "resume_run_config", "run_generators", "session_run_config"),
+    "_environment": ("explore_environment", "load_environment", "parse_env_args"),
     "_estimate": ("EstimateOutput", "estimate_one_poke"),
+    "_export": ("POKES_CSV_COLUMNS", "write_map_npz", "write_pokes_csv"),
     "_explore": ("RunOutput", "explore_scenario"),
     "_figures": ("write_estimate_figures", "write_map_figures", "write_rerun"),
     "_folder": ("RUNS_ROOT", "atomic_path", "create_run_folder", "default_run_folder", "run_stem",
@@ -101,6 +105,7 @@ _MODULES = {
 __all__ = [
     "CLUSTER_SIZE_FOAMS",
     "CONFIG_NAME",
+    "POKES_CSV_COLUMNS",
     "RUNS_ROOT",
     "SHARED_KEYS",
     "EstimateOutput",
@@ -121,11 +126,14 @@ __all__ = [
     "default_run_folder",
     "estimate_one_poke",
     "estimate_report",
+    "explore_environment",
     "explore_run_config",
     "explore_scenario",
     "live_report",
+    "load_environment",
     "load_run_config",
     "map_recorded_session",
+    "parse_env_args",
     "record_simulation",
     "reproduce",
     "resume_run_config",
@@ -142,6 +150,8 @@ __all__ = [
     "write_estimate_figures",
     "write_json",
     "write_map_figures",
+    "write_map_npz",
+    "write_pokes_csv",
     "write_rerun",
     "write_text",
 ]

@@ -1,0 +1,132 @@
+"""Explore a user's own `Environment` (a real robot, or any world) named on the command line.
+
+``deformap explore --environment package.module:factory --env-arg key=value …`` imports
+``package.module`` (from the installed packages or the current folder), calls ``factory(**args)``
+and explores what it returns exactly as the simulated world is explored: the same loop, journal,
+report (without the ground-truth metrics, which only a simulated world has), figures and maps as
+numbers. Each ``--env-arg`` value is read as a YAML scalar (``port=5`` gives the integer 5,
+``name=arm`` the string, ``rate=0.5`` the float). Importing runs the module's code: name only
+code you trust, as with any Python import.
+"""
+
+from __future__ import annotations
+
+import importlib
+import sys
+import time
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from deformap import __version__
+from deformap._config import config_to_dict
+from deformap.environment import Environment
+from deformap.errors import ConfigError
+from deformap.explore import Journal, check_exploration_budget, explore, field_settings
+from deformap.run._config import CONFIG_NAME, RunConfig, config_yaml, run_generators
+from deformap.run._export import write_map_npz, write_pokes_csv
+from deformap.run._figures import write_map_figures, write_poke_figure
+from deformap.run._folder import (
+    create_run_folder,
+    default_run_folder,
+    write_json,
+    write_text,
+)
+from deformap.run._hooks import NO_HOOKS, RunHooks, RunStart
+from deformap.run._report import shared_report
+
+__all__ = ["explore_environment", "load_environment", "parse_env_args"]
+
+
+def parse_env_args(pairs: Sequence[str]) -> dict[str, Any]:
+    """``["key=value", …]`` as keyword arguments, each value a YAML scalar."""
+    args: dict[str, Any] = {}
+    for pair in pairs:
+        key, sep, text = pair.partition("=")
+        if not sep or not key.isidentifier():
+            raise ConfigError(f"--env-arg must be key=value with a Python name as key; got {pair!r}")
+        if key in args:
+            raise ConfigError(f"--env-arg {key!r} is given twice")
+        try:
+            value = yaml.safe_load(text) if text else ""
+        except yaml.YAMLError:
+            value = text
+        args[key] = value if isinstance(value, (str, int, float, bool)) or value is None else text
+    return args
+
+
+def load_environment(spec: str, args: dict[str, Any]) -> Environment:
+    """Import ``package.module:factory`` and return ``factory(**args)``, an Environment."""
+    module_name, sep, attr = spec.partition(":")
+    if not sep or not module_name or not attr:
+        raise ConfigError(f"--environment must be package.module:factory; got {spec!r}")
+    if "" not in sys.path and str(Path.cwd()) not in sys.path:
+        sys.path.append(str(Path.cwd()))  # a module beside the user, after the installed ones
+    try:
+        module = importlib.import_module(module_name)
+    except ImportError as exc:
+        raise ConfigError(f"--environment {spec!r}: cannot import {module_name!r} ({exc})") from None
+    factory = getattr(module, attr, None)
+    if not callable(factory):
+        raise ConfigError(f"--environment {spec!r}: {module_name!r} has no callable {attr!r}")
+    try:
+        env = factory(**args)
+    except TypeError as exc:
+        raise ConfigError(f"--environment {spec!r}: the --env-arg values do not fit {attr}(): "
+                          f"{exc}") from None
+    if not isinstance(env, Environment):
+        raise ConfigError(
+            f"--environment {spec!r} must return an Environment (workspace, observe, press, "
+            f"release); got {type(env).__name__}")
+    return env
+
+
+def explore_environment(
+    spec: str,
+    env_args: dict[str, Any],
+    config: RunConfig,
+    out: Path | None = None,
+    *,
+    figures: bool = True,
+    hooks: RunHooks = NO_HOOKS,
+) -> tuple[dict[str, Any], Path]:
+    """Explore the Environment ``spec`` returns (module docstring); ``(report, folder)``.
+
+    The run folder is new or empty (default ``runs/<factory>-explore-s<seed>-<time>``); the
+    environment is built before the folder is made, so that a spec that does not load leaves
+    nothing behind. ``config.world`` and ``config.scenario`` are not used.
+    """
+    env = load_environment(spec, env_args)
+    check_exploration_budget(config.exploration, env.workspace)
+    folder = out or default_run_folder(spec.partition(":")[2], "explore", config.seed)
+    create_run_folder(folder, what="output")
+    write_text(folder / CONFIG_NAME, config_yaml(config))
+    header = {"deformap": __version__, "config": config_to_dict(config), "environment": spec,
+              "env_args": env_args}  # fmt: skip
+    journal = Journal.create(folder, header)
+    hooks.start(RunStart(kind="explore", title=f"{spec} seed {config.seed}", folder=folder,
+                         total=config.exploration.max_pokes, done=0))  # fmt: skip
+    _, explore_rng = run_generators(config.seed)
+
+    def on_poke(poke: Any) -> None:
+        if figures:
+            write_poke_figure(folder, poke)
+        hooks.poke(poke.record)
+
+    hooks.stage("exploring")
+    t0 = time.perf_counter()
+    result = explore(env, config.exploration, rng=explore_rng, journal=journal, on_poke=on_poke)
+    report = {"deformap": __version__, "environment": spec, "env_args": env_args,
+              "seed": config.seed, "config": config_to_dict(config),
+              **shared_report(result, truth=None)}  # fmt: skip
+    report["timings"]["wall_s"] = time.perf_counter() - t0
+    write_json(folder / "report.json", report)
+    write_map_npz(folder / "map.npz", result)
+    write_pokes_csv(folder / "pokes.csv", result)
+    if figures:
+        hooks.stage("drawing figures")
+        write_map_figures(folder, result, threshold=field_settings(result.config).threshold,
+                          title=f"{spec}: {len(result.pokes)} pokes", poke_figures=False)
+    return report, folder
