@@ -93,7 +93,8 @@ def test_offline_map_gives_the_live_betas(recorded: Path, live: dict[str, Any],
         assert report["regions"][key] == live["regions"][key]
     assert report["true_regions"] == live["true_regions"]
     assert report["max_variance"] == live["max_variance"]
-    assert sorted(p.name for p in out.iterdir()) == ["config.yaml", "report.json"]
+    assert sorted(p.name for p in out.iterdir()) == ["config.yaml", "map.npz", "pokes.csv",
+                                                     "report.json"]
 
 
 def test_live_and_map_reports_share_one_schema(recorded: Path, live: dict[str, Any],
@@ -180,7 +181,8 @@ def test_session_without_ground_truth_has_no_metrics(recorded: Path, tmp_path: P
     report = json.loads((tmp_path / "map" / "report.json").read_text())
     assert "accuracy" not in report["regions"] and "true_regions" not in report
     names = sorted(p.name for p in (tmp_path / "map").iterdir())
-    assert names == ["config.yaml", "map.png", "poke-01.png", "report.json"]
+    assert names == ["config.yaml", "map.npz", "map.png", "poke-01.png", "pokes.csv",
+                     "report.json"]
 
 
 def test_map_session_api_skips_every_broken_poke(recorded: Path, config_file: Path,
