@@ -19,6 +19,8 @@ definite (never expected) falls back to SuperLU.
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import scipy.sparse as sp
 from numpy.typing import NDArray
@@ -201,7 +203,13 @@ class StepMatrices:
             csr = sp.csr_matrix((np.concatenate([v, v[off]]), (rows, cols)), shape=(n, n))
             offsets = np.unique(cols - rows)
             dense = offsets.size * n  # the entries of the diagonal storage
-            self._s1_mat = csr.todia() if dense <= 2 * max(csr.nnz, 1) else csr
+            if dense <= 2 * max(csr.nnz, 1):
+                with warnings.catch_warnings():  # the storage rule above is the efficiency
+                    # check; scipy's warns on any count of diagonals over 100 whatever the fill
+                    warnings.simplefilter("ignore", sp.SparseEfficiencyWarning)
+                    self._s1_mat = csr.todia()
+            else:
+                self._s1_mat = csr
         return self._s1_mat
 
     def _factor(self, beta_fit: float, reuse: Array | None = None) -> object:
