@@ -135,7 +135,7 @@ def test_full_writes_every_condition_with_its_summary(tmp_path: Path,
                                       "--hardness", "30", "--hardness", "110",
                                       "--out", str(out)])  # fmt: skip
     assert result.exit_code == 0, (result.output, result.exception)
-    assert "per physics" in result.output and "kinect-v1" in result.output
+    assert "per physics" in result.output and "kinect-v1" in result.output, result.output
     study = json.loads((out / "hardness.json").read_text())
     assert study["matrix"]["cameras"] == ["primesense", "kinect-v1"]
     assert study["matrix"]["thicknesses_m"] == [0.03] and study["matrix"]["force_n"] == 3.0

@@ -118,9 +118,12 @@ def _yes(value: bool | None) -> str:
 def _print_summary(shown: Any, study: dict[str, Any]) -> None:
     """The full study's summary: one line per condition, then one per physics."""
     table = Table(title="E and β against hardness, per condition (force/quadratic rows)")
-    for col in ("camera", "thickness \\[m]", "physics", "median |E err|", "E within 2σ",
-                "E monotone, rigid", "β monotone", "β σ claimed / spread", "refused"):
-        table.add_column(col, justify="right" if "[" in col or "E" in col else "left")
+    table.add_column("camera", no_wrap=True)
+    table.add_column("H \\[m]", justify="right")  # the foam's thickness
+    table.add_column("physics", no_wrap=True)
+    for col in ("median |E err|", "E within 2σ", "E monotone, rigid", "β monotone",
+                "β σ claimed / spread", "refused"):
+        table.add_column(col, justify="right")
     for e in study["summary"]:
         beta = ("–" if e["beta_claimed_std"] is None or e["beta_spread"] is None
                 else f"{e['beta_claimed_std']:.3f} / {e['beta_spread']:.3f}")  # fmt: skip

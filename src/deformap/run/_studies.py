@@ -17,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+from deformap._validation import check_positive
 from deformap.eval import (
     DEFAULT_HARDNESSES,
     FoamPresses,
@@ -25,7 +26,6 @@ from deformap.eval import (
     hardness_study,
     hardness_summary,
 )
-from deformap._validation import check_positive
 from deformap.explore import ExplorationConfig
 from deformap.run._folder import create_run_folder, default_run_folder, write_json
 from deformap.run._hooks import NO_HOOKS, RunHooks, RunStart
