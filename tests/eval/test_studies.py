@@ -64,7 +64,8 @@ def _check_row(row: dict[str, object]) -> None:
 def test_hardness_study_rows_and_monotone_flags(foams: list[FoamPresses]) -> None:
     protocols = {name: PROTOCOLS[name] for name in ("force/quadratic", "pinned/linear")}
     study = hardness_study(foams, protocols=protocols)
-    assert set(study) == {"rows", "monotone", "modulus_monotone"}
+    assert set(study) == {"rows", "monotone", "modulus_monotone", "n_refused"}
+    assert study["n_refused"] == 0
     json.dumps(study)  # the CLI writes it as is
     rows = study["rows"]
     assert [(r["protocol"], r["hardness_n"]) for r in rows] == [

@@ -59,6 +59,10 @@ def study_hardness(
     physics: Annotated[
         str, typer.Option(help="World physics: linear-fem | stiffening-foam (`world.physics`).")
     ] = "linear-fem",
+    full: Annotated[
+        bool, typer.Option(help="The whole matrix: every camera preset × thickness 0.03, 0.05, "
+                           "0.10 m × both physics (replaces --camera, --thickness, --physics).")
+    ] = False,
     json_path: JsonOption = None,
 ) -> None:
     """β and Young's modulus against hardness for each contact protocol (paper Fig. 5a)."""
@@ -66,7 +70,12 @@ def study_hardness(
     with progress(shown) as bar:
         output = run.run_hardness_study(out, seed=seed, hardness=hardness, coarse=coarse,
                                         camera=camera, thickness_m=thickness, force_n=force,
-                                        physics=physics, hooks=run_hooks(bar))  # fmt: skip
+                                        physics=physics, full=full, hooks=run_hooks(bar))  # fmt: skip
+    if full:
+        _print_summary(shown, output.study)
+        shown.print(f"wrote {' and '.join(map(str, output.files))}", highlight=False)
+        emit_json(json_path, output.study)
+        return
     s = output.study
     where = ", ".join(f"{s[k]}" for k in ("camera", "physics") if k in s)
     table = Table(title=f"β and E against hardness{f' ({where})' if where else ''}")
@@ -75,18 +84,64 @@ def study_hardness(
                 "E \\[kPa]", "true E \\[kPa]"):
         table.add_column(col, justify="right")
     for r in output.study["rows"]:
+        if r.get("refused"):
+            table.add_row(r["protocol"], _hardness(r["hardness_n"]), "refused", *["–"] * 4,
+                          _kpa(r, "true_modulus_pa"))  # fmt: skip
+            continue
         table.add_row(r["protocol"], _hardness(r["hardness_n"]), f"{r['beta']:.3f}",
                       f"{r['beta_std']:.3f}", f"{r['beta_estimate_std']:.3f}",
                       f"{r['fit_error_m'] * 1e3:.3f}", _kpa(r), _kpa(r, "true_modulus_pa"))  # fmt: skip
     shown.print(table)
+    for reason in dict.fromkeys(r["refused"] for r in output.study["rows"] if r.get("refused")):
+        shown.print(f"  refused: {reason}", highlight=False)
     for name, ok in output.study["monotone"].items():
         rises = "strictly rises" if ok else "does NOT strictly rise"
         shown.print(f"  {name}: β {rises} as hardness falls", highlight=False)
     if output.study.get("modulus_monotone") is not None:
         rises = "strictly rises" if output.study["modulus_monotone"] else "does NOT strictly rise"
         shown.print(f"  force–travel: E {rises} with hardness (rigid read rigid)", highlight=False)
+    if output.study.get("n_refused"):
+        shown.print(f"  {output.study['n_refused']} foam(s) refused by the world, left out of "
+                    "these checks", highlight=False)  # fmt: skip
     shown.print(f"wrote {' and '.join(map(str, output.files))}", highlight=False)
     emit_json(json_path, output.study)
+
+
+def _pct(value: float | None) -> str:
+    return "–" if value is None else f"{value:.1%}"
+
+
+def _yes(value: bool | None) -> str:
+    return "–" if value is None else ("yes" if value else "NO")
+
+
+def _print_summary(shown: Any, study: dict[str, Any]) -> None:
+    """The full study's summary: one line per condition, then one per physics."""
+    table = Table(title="E and β against hardness, per condition (force/quadratic rows)")
+    table.add_column("camera", no_wrap=True)
+    table.add_column("H \\[m]", justify="right")  # the foam's thickness
+    table.add_column("physics", no_wrap=True)
+    for col in ("median |E err|", "E within 2σ", "E monotone, rigid", "β monotone",
+                "β σ claimed / spread", "refused"):
+        table.add_column(col, justify="right")
+    for e in study["summary"]:
+        beta = ("–" if e["beta_claimed_std"] is None or e["beta_spread"] is None
+                else f"{e['beta_claimed_std']:.3f} / {e['beta_spread']:.3f}")  # fmt: skip
+        table.add_row(e["camera"], f"{e['thickness_m']:g}", e["physics"],
+                      _pct(e["modulus_median_abs_rel_error"]), _pct(e["modulus_within_2sigma"]),
+                      _yes(e["modulus_monotone"]), _yes(e["beta_monotone"]), beta,
+                      f"{e['n_refused']}")  # fmt: skip
+    shown.print(table)
+    overall = Table(title="over every condition, per physics")
+    for col in ("physics", "presses", "unread", "median |E err|", "E within 2σ",
+                "E monotone everywhere", "β monotone everywhere", "refused"):
+        overall.add_column(col, justify="left" if col == "physics" else "right")
+    for o in study["overall"]:
+        overall.add_row(o["physics"], f"{o['n_presses']}", f"{o['n_unread']}",
+                        _pct(o["modulus_median_abs_rel_error"]), _pct(o["modulus_within_2sigma"]),
+                        _yes(o["modulus_monotone"]), _yes(o["beta_monotone"]),
+                        f"{o['n_refused']}")  # fmt: skip
+    shown.print(overall)
 
 
 @study_app.command("cluster-size")

@@ -33,6 +33,7 @@ if TYPE_CHECKING:
         cluster_size_study,
         collect_presses,
         hardness_study,
+        hardness_summary,
     )
     from deformap.eval._table_i import PAPER_TABLE_I, markdown_table, table_row
 
@@ -44,7 +45,7 @@ _MODULES = {
     "_bench_world": ("bench_world",),
     "_metrics": ("OrderingScores", "RegionScores", "ordering_scores", "region_scores"),
     "_studies": ("DEFAULT_HARDNESSES", "DEFAULT_POSITIONS", "PROTOCOLS", "FoamPresses",
-                 "cluster_size_study", "collect_presses", "hardness_study"),
+                 "cluster_size_study", "collect_presses", "hardness_study", "hardness_summary"),
     "_table_i": ("PAPER_TABLE_I", "markdown_table", "table_row"),
 }  # fmt: skip
 
@@ -65,6 +66,7 @@ __all__ = [
     "cluster_size_study",
     "collect_presses",
     "hardness_study",
+    "hardness_summary",
     "markdown_table",
     "measure_case",
     "ordering_scores",

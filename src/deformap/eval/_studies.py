@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 
 from deformap.environment import PressObservation, Workspace
+from deformap.errors import InvalidArgumentError
 from deformap.explore import ExplorationConfig, Mapper, PokeRecord, measure_press
 from deformap.msm import ShapeMatchingConfig
 from deformap.world import Block, Scenario, SimulatedWorld, WorldConfig
@@ -25,11 +26,13 @@ from deformap.world import Block, Scenario, SimulatedWorld, WorldConfig
 __all__ = [
     "DEFAULT_HARDNESSES",
     "DEFAULT_POSITIONS",
+    "DEFAULT_PROTOCOL",
     "PROTOCOLS",
     "FoamPresses",
     "cluster_size_study",
     "collect_presses",
     "hardness_study",
+    "hardness_summary",
 ]
 
 logger = logging.getLogger(__name__)
@@ -48,15 +51,25 @@ PROTOCOLS: dict[str, dict[str, Any]] = {
 }
 """The contact protocols compared (see :mod:`deformap.msm`)."""
 
+DEFAULT_PROTOCOL = "force/quadratic"
+"""The protocol of :class:`~deformap.msm.ShapeMatchingConfig`'s defaults, whose rows the summary
+reads."""
+
+CONDITION_KEYS = ("camera", "thickness_m", "physics", "force_n")
+"""The keys of a row that name its condition (one combination of a study's matrix)."""
+
 
 @dataclass
 class FoamPresses:
-    """One homogeneous foam: the mapper with its surface model and the presses made on it."""
+    """One homogeneous foam: the mapper with its surface model and the presses made on it;
+    ``refused`` the world's reason when it refused to press this foam with that force (then
+    ``presses`` is empty)."""
 
     hardness_n: float | None
     mapper: Mapper
     presses: list[PressObservation]
     true_modulus_pa: float | None = None  # the world's own, at the presses (None: rigid)
+    refused: str | None = None
 
 
 def _block_scenario(hardness_n: float | None, workspace: Workspace,
@@ -84,7 +97,11 @@ def collect_presses(
     thickness_m: float = 0.05,
 ) -> list[FoamPresses]:
     """Build one world per foam (a block ``thickness_m`` thick over the workspace), observe it,
-    and press it at ``positions`` with the configuration's ``force_n``."""
+    and press it at ``positions`` with the configuration's ``force_n``.
+
+    A foam the world refuses to press with that force (the tip would sink as deep as the block,
+    :class:`~deformap.errors.InvalidArgumentError`) is kept with no presses and the world's
+    reason in ``refused``: the study goes on with the other foams."""
     world_config = world_config or WorldConfig()
     config = config or ExplorationConfig()
     streams = rng.spawn(len(hardnesses))
@@ -97,15 +114,22 @@ def collect_presses(
         )
         mapper = Mapper(world.workspace, config)
         mapper.initialise(world.observe(), fit_rng)
-        presses = []
-        for xy in positions:
-            presses.append(world.press(np.asarray(xy), config.force_n))
-            world.release()
+        presses: list[PressObservation] = []
+        refused = None
+        try:
+            for xy in positions:
+                presses.append(world.press(np.asarray(xy), config.force_n))
+                world.release()
+        except InvalidArgumentError as error:
+            presses, refused = [], str(error)
+            logger.warning("foam %s refused: %s", hardness, refused)
         x, y = positions[0]
         true = float(world.ground_truth_modulus(np.array([x]), np.array([y]))[0, 0])
-        out.append(FoamPresses(hardness, mapper, presses, true if math.isfinite(true) else None))
+        out.append(FoamPresses(hardness, mapper, presses, true if math.isfinite(true) else None,
+                               refused))  # fmt: skip
         if progress is not None:
-            progress(f"pressed {'rigid' if hardness is None else f'{hardness:g} N'} foam")
+            name = "rigid" if hardness is None else f"{hardness:g} N"
+            progress(f"pressed {name} foam" if refused is None else f"{name} foam refused")
     return out
 
 
@@ -147,10 +171,33 @@ def _stiffness_summary(records: list[PokeRecord], true_modulus_pa: float | None
         "modulus_spread_pa": float(moduli.std(ddof=1)) if moduli.size > 1 else None,
         "true_modulus_pa": true_modulus_pa,
         "modulus_rel_error": None,
+        # per press, in the order of the places (None: no modulus read there)
+        "moduli_pa": [_read(s, "modulus_pa") for s in estimates],
+        "modulus_stds_pa": [_read(s, "modulus_std_pa") for s in estimates],
+        "modulus_rel_errors": [None] * len(estimates),
     }
     if read and true_modulus_pa:
         out["modulus_rel_error"] = float((moduli.mean() - true_modulus_pa) / true_modulus_pa)
+        out["modulus_rel_errors"] = [None if e is None else (e - true_modulus_pa) / true_modulus_pa
+                                     for e in out["moduli_pa"]]  # fmt: skip
     return out
+
+
+def _read(estimate: Any, key: str) -> float | None:
+    """One press's value of ``key`` (None when the press gave no modulus or read rigid)."""
+    if estimate is None or estimate.rigid or estimate.modulus_pa is None:
+        return None
+    value = getattr(estimate, key)
+    return None if value is None else float(value)
+
+
+def _refused_row(foam: FoamPresses) -> dict[str, Any]:
+    """The row of a foam the world refused to press: its reason and no values."""
+    keys = ("beta", "beta_std", "beta_estimate_std", "fit_error_m", "iterations", "converged",
+            "stiffness_n_per_m", "modulus_pa", "modulus_std_pa", "modulus_spread_pa",
+            "modulus_rel_error", "rigid", "n_rigid")  # fmt: skip
+    return {**dict.fromkeys(keys), "true_modulus_pa": foam.true_modulus_pa, "moduli_pa": [],
+            "modulus_stds_pa": [], "modulus_rel_errors": [], "refused": foam.refused}
 
 
 def hardness_study(
@@ -159,10 +206,12 @@ def hardness_study(
     base: ShapeMatchingConfig | None = None,
     protocols: dict[str, dict[str, Any]] = PROTOCOLS,
 ) -> dict[str, Any]:
-    """β against hardness for each protocol: ``{"rows": [...], "monotone": {protocol: bool}}``.
+    """β against hardness for each protocol: ``{"rows": [...], "monotone": {protocol: bool},
+    "modulus_monotone": bool | None, "n_refused": int}``.
 
     A protocol is *monotone* when β strictly rises as hardness falls over the foams, with the rigid
-    board (if present) below every foam.
+    board (if present) below every foam. A foam the world refused to press has a row with
+    ``refused`` (the reason) and null values, and is left out of both monotone checks.
     """
     base = base or ShapeMatchingConfig()
     rows = []
@@ -171,24 +220,38 @@ def hardness_study(
         cfg = dataclasses.replace(base, **settings)
         proto_rows = []
         for foam in foams:
+            if foam.refused is not None:
+                proto_rows.append({"protocol": name, "hardness_n": foam.hardness_n,
+                                   **_refused_row(foam)})  # fmt: skip
+                continue
             records = _betas(foam, cfg)
             row = {"protocol": name, "hardness_n": foam.hardness_n, **_summary(records),
-                   **_stiffness_summary(records, foam.true_modulus_pa)}  # fmt: skip
+                   **_stiffness_summary(records, foam.true_modulus_pa), "refused": None}  # fmt: skip
             proto_rows.append(row)
         rows.extend(proto_rows)
-        ordered = sorted(
-            proto_rows, key=lambda r: math.inf if r["hardness_n"] is None else r["hardness_n"]
-        )
-        monotone[name] = bool(np.all(np.diff([r["beta"] for r in ordered]) < 0))
-    return {"rows": rows, "monotone": monotone, "modulus_monotone": _modulus_monotone(rows)}
+        monotone[name] = _beta_monotone(proto_rows)
+    return {"rows": rows, "monotone": monotone, "modulus_monotone": _modulus_monotone(rows),
+            "n_refused": sum(f.refused is not None for f in foams)}  # fmt: skip
+
+
+def _by_hardness(rows: Any) -> list[dict[str, Any]]:
+    """The rows of the foams the world pressed, by rising hardness, the rigid board last."""
+    kept = [r for r in rows if not r.get("refused")]
+    return sorted(kept, key=lambda r: math.inf if r["hardness_n"] is None else r["hardness_n"])
+
+
+def _beta_monotone(rows: list[dict[str, Any]]) -> bool:
+    """β strictly falls as hardness rises over one protocol's rows, the rigid board lowest
+    (refused foams left out)."""
+    return bool(np.all(np.diff([r["beta"] for r in _by_hardness(rows)]) < 0))
 
 
 def _modulus_monotone(rows: list[dict[str, Any]]) -> bool | None:
     """Whether the force–travel records order the foams: E strictly rises with hardness and a
-    rigid board is read rigid (``None`` when the presses had no records)."""
+    rigid board is read rigid (``None`` when the presses had no records); refused foams are left
+    out."""
     first = rows[0]["protocol"] if rows else None
-    own = sorted((r for r in rows if r["protocol"] == first),
-                 key=lambda r: math.inf if r["hardness_n"] is None else r["hardness_n"])
+    own = _by_hardness(r for r in rows if r["protocol"] == first)
     if not own or all(r["modulus_pa"] is None and not r["rigid"] for r in own):
         return None
     foams = [r for r in own if r["hardness_n"] is not None]
@@ -215,3 +278,101 @@ def cluster_size_study(
                 {"cluster_size": k, "hardness_n": foam.hardness_n, **_summary(_betas(foam, cfg))}
             )
     return {"rows": rows}
+
+
+def hardness_summary(rows: list[dict[str, Any]]) -> dict[str, Any]:
+    """What a hardness study's rows say, per condition and per physics.
+
+    Reads the rows of :data:`DEFAULT_PROTOCOL` (the first protocol when the rows have none of
+    it), grouped by their condition (:data:`CONDITION_KEYS`, absent keys read None).
+
+    Returns
+    -------
+    dict
+        ``{"summary": [...], "overall": [...]}``. Each ``summary`` entry names its condition and
+        gives, over the foam presses (not the foam means): ``n_presses``, ``n_unread`` (foam
+        presses that gave no modulus), ``modulus_median_abs_rel_error`` (median of |E − E_true| /
+        E_true over the presses read), ``modulus_within_2sigma`` (the fraction of all foam
+        presses with |E − E_true| ≤ 2σ as claimed; an unread press counts outside),
+        ``modulus_monotone`` (E strictly rises with hardness and the rigid board reads rigid),
+        ``beta_monotone`` (β strictly falls as hardness rises, rigid lowest),
+        ``beta_claimed_std`` and ``beta_spread`` (means over the foams of β's claimed σ and of
+        its standard deviation between places) and ``n_refused`` (foams the world refused to
+        press, left out of the rest). Each ``overall`` entry does the same per physics over its
+        conditions: ``modulus_median_abs_rel_error``, ``modulus_within_2sigma``,
+        ``modulus_monotone`` and ``beta_monotone`` (in every condition), ``n_refused``.
+    """
+    protocols = list(dict.fromkeys(r["protocol"] for r in rows))
+    protocol = DEFAULT_PROTOCOL if DEFAULT_PROTOCOL in protocols else protocols[0] if rows else None
+    own = [r for r in rows if r["protocol"] == protocol]
+    groups: dict[tuple[Any, ...], list[dict[str, Any]]] = {}
+    for row in own:
+        groups.setdefault(tuple(row.get(k) for k in CONDITION_KEYS), []).append(row)
+    summary = []
+    for condition, group in groups.items():
+        errors, covered, n_presses = _press_errors(group)
+        foams = [r for r in group if r["hardness_n"] is not None and not r.get("refused")]
+        summary.append({
+            **dict(zip(CONDITION_KEYS, condition, strict=True)),
+            "n_presses": n_presses,
+            "n_unread": n_presses - len(errors),
+            "modulus_median_abs_rel_error": _median_abs(errors),
+            "modulus_within_2sigma": _fraction(covered, n_presses),
+            "modulus_monotone": _modulus_monotone(group),
+            "beta_monotone": _beta_monotone(group),
+            "beta_claimed_std": _mean([r["beta_estimate_std"] for r in foams]),
+            "beta_spread": _mean([r["beta_std"] for r in foams]),
+            "n_refused": sum(bool(r.get("refused")) for r in group),
+            "_errors": errors, "_covered": covered,
+        })  # fmt: skip
+    overall = []
+    for physics in dict.fromkeys(s["physics"] for s in summary):
+        mine = [s for s in summary if s["physics"] == physics]
+        errors = [e for s in mine for e in s["_errors"]]
+        n_presses = sum(s["n_presses"] for s in mine)
+        overall.append({
+            "physics": physics,
+            "n_conditions": len(mine),
+            "n_presses": n_presses,
+            "n_unread": sum(s["n_unread"] for s in mine),
+            "modulus_median_abs_rel_error": _median_abs(errors),
+            "modulus_within_2sigma": _fraction(sum(s["_covered"] for s in mine), n_presses),
+            "modulus_monotone": all(s["modulus_monotone"] is True for s in mine),
+            "beta_monotone": all(s["beta_monotone"] for s in mine),
+            "n_refused": sum(s["n_refused"] for s in mine),
+        })  # fmt: skip
+    for s in summary:
+        del s["_errors"], s["_covered"]
+    return {"summary": summary, "overall": overall}
+
+
+def _press_errors(rows: list[dict[str, Any]]) -> tuple[list[float], int, int]:
+    """Over the foam presses of ``rows``: the relative errors of E (presses read), how many lie
+    within twice their claimed σ of the true E, and how many presses there were."""
+    errors: list[float] = []
+    covered = n_presses = 0
+    for row in rows:
+        true = row.get("true_modulus_pa")
+        if row["hardness_n"] is None or row.get("refused") or not true:
+            continue
+        moduli, stds = row.get("moduli_pa") or [], row.get("modulus_stds_pa") or []
+        n_presses += len(moduli)
+        for modulus, std in zip(moduli, stds, strict=True):
+            if modulus is None:
+                continue
+            errors.append((modulus - true) / true)
+            covered += std is not None and abs(modulus - true) <= 2.0 * std
+    return errors, covered, n_presses
+
+
+def _median_abs(values: list[float]) -> float | None:
+    return float(np.median(np.abs(values))) if values else None
+
+
+def _fraction(part: int, whole: int) -> float | None:
+    return part / whole if whole else None
+
+
+def _mean(values: list[Any]) -> float | None:
+    kept = [v for v in values if v is not None and math.isfinite(v)]
+    return float(np.mean(kept)) if kept else None

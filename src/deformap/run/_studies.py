@@ -9,6 +9,7 @@ reports progress.
 from __future__ import annotations
 
 import dataclasses
+import itertools
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -16,22 +17,38 @@ from typing import Any
 
 import numpy as np
 
+from deformap._validation import check_positive
 from deformap.eval import (
     DEFAULT_HARDNESSES,
     FoamPresses,
     cluster_size_study,
     collect_presses,
     hardness_study,
+    hardness_summary,
 )
 from deformap.explore import ExplorationConfig
 from deformap.run._folder import create_run_folder, default_run_folder, write_json
 from deformap.run._hooks import NO_HOOKS, RunHooks, RunStart
 from deformap.world import Physics, WorldConfig, camera_preset
 
-__all__ = ["CLUSTER_SIZE_FOAMS", "StudyOutput", "run_cluster_size_study", "run_hardness_study"]
+__all__ = [
+    "CLUSTER_SIZE_FOAMS",
+    "FULL_CAMERAS",
+    "FULL_PHYSICS",
+    "FULL_THICKNESSES_M",
+    "StudyOutput",
+    "run_cluster_size_study",
+    "run_hardness_study",
+]
 
 CLUSTER_SIZE_FOAMS: tuple[float, ...] = (60.0, 110.0, 150.0)
 """Foams of the cluster-size study in newtons (the rigid board is added)."""
+
+FULL_CAMERAS: tuple[str, ...] = ("primesense", "kinect-v1", "realsense-d435")
+FULL_THICKNESSES_M: tuple[float, ...] = (0.03, 0.05, 0.10)
+FULL_PHYSICS: tuple[str, ...] = ("linear-fem", "stiffening-foam")
+"""The matrix of ``deformap study hardness --full`` (issue 13): every camera preset × three foam
+thicknesses × both physics of the world."""
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -44,13 +61,10 @@ class StudyOutput:
 
 
 def _foams(
-    name: str, foams: Sequence[float | None], folder: Path, *, seed: int, coarse: bool,
+    foams: Sequence[float | None], *, seed: int, coarse: bool,
     hooks: RunHooks, camera: str | None = None, thickness_m: float = 0.05,
     force_n: float | None = None, physics: Physics = "linear-fem",
 ) -> list[FoamPresses]:  # fmt: skip
-    hooks.start(RunStart(kind="study", title=f"{name}, seed {seed}", folder=folder,
-                         total=len(foams)))  # fmt: skip
-    hooks.stage("pressing the foams")
     world = WorldConfig.coarse(physics=physics) if coarse else WorldConfig(physics=physics)
     if camera is not None:
         world = dataclasses.replace(world, camera=camera_preset(camera))
@@ -75,10 +89,15 @@ def run_hardness_study(
     thickness_m: float = 0.05,
     force_n: float | None = None,
     physics: str = "linear-fem",
+    full: bool = False,
+    cameras: Sequence[str] | None = None,
+    thicknesses_m: Sequence[float] | None = None,
+    physics_names: Sequence[str] | None = None,
     hooks: RunHooks = NO_HOOKS,
 ) -> StudyOutput:
     """β (each contact protocol) and the force–travel reading (stiffness, Young's modulus)
-    against hardness (:func:`deformap.eval.hardness_study`).
+    against hardness (:func:`deformap.eval.hardness_study`), under one condition or, with
+    ``full``, over a matrix of them.
 
     Parameters
     ----------
@@ -86,7 +105,7 @@ def run_hardness_study(
         A new or empty folder (default: :func:`~deformap.run.default_run_folder`, stem
         ``hardness``, kind ``study``).
     seed : int
-        Seed of the worlds' noise.
+        Seed of the worlds' noise (the same for every condition).
     hardness : sequence of float, optional
         Foams in newtons (the rigid board is added); default
         :data:`~deformap.eval.DEFAULT_HARDNESSES`.
@@ -100,26 +119,64 @@ def run_hardness_study(
         The press force (default: the exploration's).
     physics : str
         The world's contact physics, a :data:`deformap.world.PHYSICS` name (``WorldConfig.physics``).
+    full : bool
+        Every condition of :data:`FULL_CAMERAS` × :data:`FULL_THICKNESSES_M` ×
+        :data:`FULL_PHYSICS` (``camera``, ``thickness_m`` and ``physics`` are then not used).
+    cameras, thicknesses_m, physics_names : sequence, optional
+        With ``full``, the matrix's cameras, thicknesses and physics in place of the full ones (a
+        smaller matrix).
     hooks : RunHooks
+
+    Notes
+    -----
+    The study's JSON has ``rows`` (each names its ``camera``, ``thickness_m``, ``physics`` and
+    ``force_n``), ``summary`` (one entry per condition) and ``overall`` (one per physics), see
+    :func:`deformap.eval.hardness_summary`; a single-condition study also has its condition and
+    the monotone flags at the top, a full one its ``matrix``.
     """
     from deformap.viz import plot_hardness_study  # matplotlib: only when a study is drawn
 
+    if full:
+        conditions = list(itertools.product(
+            cameras or FULL_CAMERAS, thicknesses_m or FULL_THICKNESSES_M,
+            physics_names or FULL_PHYSICS))  # fmt: skip
+    else:
+        conditions = [(camera or "primesense", thickness_m, physics)]
+    checked = []
+    for name, thickness, physics_name in conditions:  # bad names fail here, before any world
+        camera_preset(name)
+        check_positive("thickness_m", thickness)
+        checked.append((name, float(thickness),
+                        WorldConfig(physics=physics_name).physics))  # type: ignore[arg-type]
     folder = create_run_folder(out or default_run_folder("hardness", "study", seed), what="study")
     foams = DEFAULT_HARDNESSES if not hardness else (*hardness, None)
-    if camera is not None:
-        camera_preset(camera)  # an unknown name fails here, before any world is built
-    # so does an unknown physics (one line naming `physics`)
-    checked = WorldConfig(physics=physics).physics  # type: ignore[arg-type]
-    presses = _foams("hardness study", foams, folder, seed=seed, coarse=coarse, hooks=hooks,
-                     camera=camera, thickness_m=thickness_m, force_n=force_n, physics=checked)
-    hooks.stage("estimating β per protocol")
-    conditions = {"camera": camera or "primesense", "thickness_m": thickness_m,
-                  "force_n": presses[0].presses[0].force_n if presses else force_n,
-                  "physics": physics}
-    study = {**conditions, **hardness_study(presses)}
-    study["rows"] = [{**row, **conditions} for row in study["rows"]]
+    hooks.start(RunStart(kind="study", title=f"hardness study, seed {seed}", folder=folder,
+                         total=len(foams) * len(checked)))  # fmt: skip
+    rows: list[dict[str, Any]] = []
+    single: dict[str, Any] = {}
+    for name, thickness, physics_name in checked:
+        hooks.stage(f"pressing the foams: {name}, {thickness:g} m, {physics_name}")
+        presses = _foams(foams, seed=seed, coarse=coarse, hooks=hooks, camera=name,
+                         thickness_m=thickness, force_n=force_n, physics=physics_name)  # fmt: skip
+        hooks.stage(f"estimating β per protocol: {name}, {thickness:g} m, {physics_name}")
+        pressed = [f.presses[0].force_n for f in presses if f.presses]
+        condition = {"camera": name, "thickness_m": thickness,
+                     "force_n": pressed[0] if pressed else _force(force_n),
+                     "physics": physics_name}  # fmt: skip
+        single = {**condition, **hardness_study(presses)}
+        rows.extend({**row, **condition} for row in single["rows"])
+    study = {**(single if not full else {"matrix": {
+        "cameras": list(dict.fromkeys(c[0] for c in checked)),
+        "thicknesses_m": sorted({c[1] for c in checked}),
+        "physics": list(dict.fromkeys(c[2] for c in checked)),
+        "force_n": _force(force_n), "seed": seed, "coarse": coarse}}),
+        "rows": rows, **hardness_summary(rows)}  # fmt: skip
     return StudyOutput(study=study, folder=folder,
                        files=_write(folder, "hardness", study, plot_hardness_study))  # fmt: skip
+
+
+def _force(force_n: float | None) -> float:
+    return ExplorationConfig().force_n if force_n is None else float(force_n)
 
 
 def run_cluster_size_study(
@@ -139,7 +196,10 @@ def run_cluster_size_study(
     folder = create_run_folder(out or default_run_folder("cluster-size", "study", seed),
                                what="study")  # fmt: skip
     foams = (*CLUSTER_SIZE_FOAMS, None)
-    presses = _foams("cluster-size study", foams, folder, seed=seed, coarse=coarse, hooks=hooks)
+    hooks.start(RunStart(kind="study", title=f"cluster-size study, seed {seed}", folder=folder,
+                         total=len(foams)))  # fmt: skip
+    hooks.stage("pressing the foams")
+    presses = _foams(foams, seed=seed, coarse=coarse, hooks=hooks)
     hooks.stage("estimating β per cluster size")
     study = cluster_size_study(presses)
     return StudyOutput(study=study, folder=folder,

@@ -7,11 +7,13 @@ built without ``pyplot``, and, given ``path``, writes it there atomically at 110
 
 from __future__ import annotations
 
+import itertools
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 from matplotlib.figure import Figure
+from matplotlib.ticker import FuncFormatter, ScalarFormatter
 
 from deformap.viz._save import save_figure
 
@@ -31,11 +33,18 @@ def plot_hardness_study(study: dict[str, Any], *, path: str | Path | None = None
     ----------
     study : dict
         ``{"rows": [{"protocol", "hardness_n" (None: rigid), "beta", "beta_std"}, ...]}`` and
-        optionally ``"monotone": {protocol: bool}``, marked in the legend.
+        optionally ``"monotone": {protocol: bool}``, marked in the legend. Rows with
+        ``refused`` are not drawn. A study with a ``matrix`` (``deformap study hardness --full``)
+        is drawn by :func:`_plot_hardness_matrix` instead.
     path : str or Path, optional
         Where to write the figure; nothing is written without it.
     """
-    rows = study["rows"]
+    if "matrix" in study:
+        fig = _plot_hardness_matrix(study)
+        if path is not None:
+            save_figure(fig, path, dpi=110)
+        return fig
+    rows = [r for r in study["rows"] if not r.get("refused")]
     _, rigid_x = _hardness_axis(rows)
     fig = Figure(figsize=(7, 4.5), layout="constrained")
     ax = fig.subplots()
@@ -62,6 +71,73 @@ def plot_hardness_study(study: dict[str, Any], *, path: str | Path | None = None
     if path is not None:
         save_figure(fig, path, dpi=110)
     return fig
+
+
+def _plot_hardness_matrix(study: dict[str, Any]) -> Figure:
+    """E read against the world's true E, one panel per physics: each foam's mean over its places
+    with its claimed σ, colour per thickness, marker per camera; the diagonal is a perfect read."""
+    rows = [r for r in study["rows"] if r["protocol"] == _first_protocol(study["rows"])]
+    physics = list(dict.fromkeys(r["physics"] for r in rows))
+    thicknesses = sorted({r["thickness_m"] for r in rows})
+    cameras = list(dict.fromkeys(r["camera"] for r in rows))
+    markers, colours = "osD^v<>", [f"C{i}" for i in range(10)]
+    summary = {(s["camera"], s["thickness_m"], s["physics"]): s for s in study.get("summary", [])}
+    overall = {o["physics"]: o for o in study.get("overall", [])}
+    fig = Figure(figsize=(6.0 * len(physics), 5.2), layout="constrained")
+    axes = np.atleast_1d(fig.subplots(1, len(physics), sharey=True))
+    for ax, name in zip(axes, physics, strict=True):
+        values: list[float] = []
+        for (ci, camera), (ti, thickness) in itertools.product(enumerate(cameras),
+                                                                enumerate(thicknesses)):
+            sub = [r for r in rows if r["physics"] == name and r["camera"] == camera
+                   and r["thickness_m"] == thickness and r.get("modulus_pa") is not None
+                   and r.get("true_modulus_pa")]  # fmt: skip
+            if not sub:
+                continue
+            x = np.array([r["true_modulus_pa"] for r in sub]) / 1e3
+            y = np.array([r["modulus_pa"] for r in sub]) / 1e3
+            err = np.array([r["modulus_std_pa"] or 0.0 for r in sub]) / 1e3
+            values.extend([*x, *y])
+            entry = summary.get((camera, thickness, name), {})
+            ok = entry.get("modulus_monotone") and entry.get("beta_monotone")
+            # open markers shrinking per camera: cameras reading alike stay visible, nested
+            ax.errorbar(x, y, yerr=err, ls="none", marker=markers[ci % len(markers)],
+                        ms=9 - 2 * (ci % 3), mfc="none", mew=1.3,
+                        color=colours[ti % len(colours)], capsize=2, alpha=0.9,
+                        label=f"{camera}, {thickness * 100:g} cm" + ("" if ok else " ✗"))  # fmt: skip
+        if values:
+            lo, hi = min(values) / 1.5, max(values) * 1.5
+            ax.plot([lo, hi], [lo, hi], color="0.5", ls="--", lw=1, label="E read = true E")
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        for axis in (ax.xaxis, ax.yaxis):
+            axis.set_major_formatter(ScalarFormatter())
+            axis.set_minor_formatter(FuncFormatter(_minor_label))
+        ax.set_xlabel("true Young's modulus E [kPa] (log)")
+        info = overall.get(name, {})
+        med, cov = info.get("modulus_median_abs_rel_error"), info.get("modulus_within_2sigma")
+        ax.set_title(f"{name}: median |E error| "
+                     f"{'–' if med is None else f'{med:.1%}'}, within 2σ "
+                     f"{'–' if cov is None else f'{cov:.0%}'}\n"
+                     f"presses {info.get('n_presses', 0)}, unread {info.get('n_unread', 0)}, "
+                     f"foams refused {info.get('n_refused', 0)}",
+                     fontsize=10)  # fmt: skip
+        ax.legend(fontsize=7, loc="upper left", ncols=1)
+    axes[0].set_ylabel("E read from the force–travel record [kPa] (log; ±claimed σ)")
+    fig.suptitle("Young's modulus read against the world's, per camera × thickness "
+                 "(✗: E or β not monotone, or rigid not read rigid)", fontsize=10)  # fmt: skip
+    return fig
+
+
+def _minor_label(value: float, _: object) -> str:
+    """Log axes: label the minor ticks at 2, 3 and 5 of each decade only (the others crowd)."""
+    mantissa = value / 10 ** np.floor(np.log10(value))
+    return f"{value:g}" if any(np.isclose(mantissa, m) for m in (2.0, 3.0, 5.0)) else ""
+
+
+def _first_protocol(rows: list[dict[str, Any]]) -> str | None:
+    names = list(dict.fromkeys(r["protocol"] for r in rows))
+    return "force/quadratic" if "force/quadratic" in names else (names[0] if names else None)
 
 
 def plot_cluster_size_study(study: dict[str, Any], *, path: str | Path | None = None) -> Figure:
