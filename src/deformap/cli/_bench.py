@@ -44,13 +44,13 @@ def bench_speed(json_path: JsonOption = None, seed: SeedOption = 0, quick: Quick
         sweep = evaluation.bench_beta_sweep(n_particles_side=20 if quick else 40, rng=rng)
     shown.print(_table(
         "surface GP → mean and std on the 120×80 grid (σw 4 cm, σn 2 mm)",
-        ("points", "exact \\[s]", "grid \\[s]", "speed-up", "max |Δmean| [µm]", "max Δstd [%]"),
+        ("points", "exact [s]", "grid [s]", "speed-up", "max |Δmean| [µm]", "max Δstd [%]"),
         [(str(r["n_points"]), f"{r['exact_s']:.3f}", f"{r['grid_s']:.3f}", f"{r['speedup']:.0f}×",
           f"{r['max_mean_dev_m'] * 1e6:.2f}", f"{r['max_rel_std_dev'] * 100:.3f}") for r in gp_rows],
     ))  # fmt: skip
     shown.print(_table(
         "β estimation (converged, 3×3 clusters)",
-        ("β values", "particles", "batched \\[s]", "per-β loop \\[s]", "speed-up"),
+        ("β values", "particles", "batched [s]", "per-β loop [s]", "speed-up"),
         [(str(sweep["n_beta"]), str(sweep["n_particles"]), f"{sweep['batched_s']:.3f}",
           f"{sweep['loop_s']:.3f}", f"{sweep['speedup']:.1f}×")],
     ))  # fmt: skip
@@ -118,7 +118,7 @@ def _memory_table(title: str, rows: list[dict[str, Any]], size_label: str) -> Ta
         added = "n/a" if r["rss_added_mib"] is None else f"{r['rss_added_mib']:.1f}"
         cells.append((f"{r['size']:,}", r["case"].split("-", 1)[1], f"{r['traced_peak_mib']:.1f}",
                       added, f"{r['seconds']:.2f}", base_text, ratio))  # fmt: skip
-    return _table(title, (size_label, "path", "traced [MiB]", "RSS+ [MiB]", "time \\[s]",
+    return _table(title, (size_label, "path", "traced [MiB]", "RSS+ [MiB]", "time [s]",
                           "baseline [MiB]", "vs baseline"), cells)  # fmt: skip
 
 

@@ -80,8 +80,8 @@ def study_hardness(
     where = ", ".join(f"{s[k]}" for k in ("camera", "physics") if k in s)
     table = Table(title=f"β and E against hardness{f' ({where})' if where else ''}")
     table.add_column("protocol", no_wrap=True)  # the row's name, never cut
-    for col in ("hardness [N]", "β", "β spread", "β uncertainty", "fit error \\[mm]",
-                "E \\[kPa]", "true E \\[kPa]"):
+    for col in ("hardness [N]", "β", "β spread", "β uncertainty", "fit error [mm]",
+                "E [kPa]", "true E [kPa]"):
         table.add_column(col, justify="right")
     for r in output.study["rows"]:
         if r.get("refused"):
@@ -119,7 +119,7 @@ def _print_summary(shown: Any, study: dict[str, Any]) -> None:
     """The full study's summary: one line per condition, then one per physics."""
     table = Table(title="E and β against hardness, per condition (force/quadratic rows)")
     table.add_column("camera", no_wrap=True)
-    table.add_column("H \\[m]", justify="right")  # the foam's thickness
+    table.add_column("H [m]", justify="right")  # the foam's thickness
     table.add_column("physics", no_wrap=True)
     for col in ("median |E err|", "E within 2σ", "E monotone, rigid", "β monotone",
                 "β σ claimed / spread", "refused"):
@@ -161,7 +161,7 @@ def study_cluster_size(
     with progress(shown) as bar:
         output = run.run_cluster_size_study(out, seed=seed, coarse=coarse, hooks=run_hooks(bar))
     table = Table(title="fit error against cluster size")
-    for col in ("k×k", "hardness [N]", "β", "fit error \\[mm]"):
+    for col in ("k×k", "hardness [N]", "β", "fit error [mm]"):
         table.add_column(col, justify="right")
     for r in output.study["rows"]:
         table.add_row(f"{r['cluster_size']}", _hardness(r["hardness_n"]), f"{r['beta']:.3f}",
