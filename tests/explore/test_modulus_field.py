@@ -184,3 +184,25 @@ def test_field_modulus_without_a_record_falls_back_to_beta_and_says_so() -> None
     assert kept.config.field == "modulus" and kept.field_fallback is None
     assert len(kept.modulus_field.pokes) == 1 and len(kept.field.pokes) == 2
     assert len(_mapper("beta").add(_poke((0.3, 0.2), None)).record.contact_xy) == 2
+
+
+def test_a_first_poke_without_modulus_does_not_decide_the_run() -> None:
+    mapper = _mapper("modulus")
+    mapper.add(_poke((0.3, 0.2), None, 0, error="the record was refused"))
+    assert mapper.config.field == "beta" and mapper.field_fallback is not None
+    mapper.add(_poke((0.1, 0.1), _soft(5e3), 1))  # a modulus arrives: back on the modulus field
+    assert mapper.config.field == "modulus" and mapper.field_fallback is None
+    assert mapper.map_field is mapper.modulus_field
+
+
+def test_a_place_whose_modulus_cannot_be_read_twice_gives_the_run_to_beta() -> None:
+    mapper = _mapper("modulus")
+    mapper.add(_poke((0.1, 0.1), _soft(5e3), 0))
+    mapper.add(_poke((0.4, 0.2), None, 1, error="too deep"))
+    assert mapper.config.field == "modulus"  # once: left out, the run goes on on the modulus
+    mapper.add(_poke((0.405, 0.2), None, 2, error="too deep"))  # the same place again
+    assert mapper.config.field == "beta"
+    assert mapper.field_fallback is not None
+    assert "could not be read twice at one place (" in mapper.field_fallback
+    mapper.add(_poke((0.5, 0.3), _soft(6e3), 3))  # for good: the β-field maps the rest
+    assert mapper.config.field == "beta" and mapper.map_field is mapper.field

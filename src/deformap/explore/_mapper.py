@@ -23,7 +23,7 @@ import numpy as np
 from deformap.cloud import PointCloud
 from deformap.environment import PressObservation, Workspace
 from deformap.errors import EnvironmentStateError
-from deformap.explore._config import ExplorationConfig, check_exploration_budget
+from deformap.explore._config import ExplorationConfig, FieldName, check_exploration_budget
 from deformap.explore._dent import measure_press
 from deformap.explore._field import BetaField, field_settings
 from deformap.explore._grid import MapGrid
@@ -32,7 +32,7 @@ from deformap.explore._records import PokeResult, Target
 from deformap.explore._regions import RegionMap, map_regions
 from deformap.explore._result import ExplorationResult
 from deformap.explore._surface import SurfaceModel, fit_surface
-from deformap.explore._targets import choose_next
+from deformap.explore._targets import BOUNDARY_SPACING_ROI, choose_next
 
 __all__ = ["Mapper"]
 
@@ -61,6 +61,8 @@ class Mapper:
         self.threshold = field_settings(config).threshold
         #: Why the run maps on β although ``config.field`` asked for the modulus (else None).
         self.field_fallback: str | None = None
+        self._requested_field = config.field
+        self._given_up: str | None = None
 
     @property
     def pokes(self) -> tuple[PokeResult, ...]:
@@ -111,14 +113,8 @@ class Mapper:
         """
         t0 = time.perf_counter()
         field, modulus = self._fit([*self._pokes, poke])
-        if self.config.field == "modulus" and not len(modulus.pokes):
-            # no poke of the run has a modulus (a camera-only robot or session): map on β
-            why = modulus.readings[-1].excluded
-            self.field_fallback = (f"`exploration.field` 'modulus' fell back to 'beta': poke "
-                                   f"{poke.record.index + 1} gave no modulus ({why})")
-            logger.warning("%s", self.field_fallback)
-            self.config = dataclasses.replace(self.config, field="beta")
-            self.threshold = field_settings(self.config).threshold
+        if self._requested_field == "modulus":
+            self._choose_field(poke, modulus)
         active = modulus if self.config.field == "modulus" else field
         record = poke.record
         if target is not None:
@@ -133,6 +129,36 @@ class Mapper:
         self._pokes.append(added)
         self._field, self._modulus = field, modulus
         return added
+
+    def _choose_field(self, poke: PokeResult, modulus: ModulusField) -> None:
+        """Under ``field: modulus``, the field to map on after ``poke``: the modulus field once a
+        poke has a modulus; the β-field while none has (a camera-only robot or session), and for
+        good once the modulus could not be read twice at one place (a further press there would
+        read nothing again, and the modulus field's variance there would never fall)."""
+        reading = modulus.readings[-1]
+        if self._given_up is None and reading.excluded is not None and self._pokes:
+            here = np.asarray(poke.record.contact_xy)
+            radius = BOUNDARY_SPACING_ROI * self.config.touch.roi_size_m
+            unread = {r.index for r in modulus.readings[:-1] if r.excluded is not None}
+            if any(p.record.index in unread
+                   and np.hypot(*(np.asarray(p.record.contact_xy) - here)) <= radius
+                   for p in self._pokes):  # fmt: skip
+                self._given_up = (f"poke {poke.record.index + 1}: the modulus could not be read "
+                                  f"twice at one place ({reading.excluded})")
+        if self._given_up is not None:
+            why = self._given_up
+        elif not len(modulus.pokes):
+            why = f"poke {poke.record.index + 1} gave no modulus ({reading.excluded})"
+        else:
+            why = None
+        fallback = None if why is None else f"`exploration.field` 'modulus' fell back to 'beta': {why}"
+        if fallback is not None and fallback != self.field_fallback:
+            logger.warning("%s", fallback)
+        self.field_fallback = fallback
+        field: FieldName = "modulus" if fallback is None else "beta"
+        if field != self.config.field:
+            self.config = dataclasses.replace(self.config, field=field)
+            self.threshold = field_settings(self.config).threshold
 
     def max_variance(self) -> float:
         """The map field's largest variance where it must fall below ``threshold``
