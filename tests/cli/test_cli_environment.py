@@ -28,6 +28,9 @@ def make(scenario="heterogeneous-60-150", seed=0, scale=1.0):
 def not_an_environment():
     return 42
 
+def offline():
+    raise ConnectionError("robot offline")
+
 VALUE = 3
 '''
 
@@ -37,11 +40,13 @@ SMALL = "exploration: {max_pokes: 2, surface: {fit_hyperparameters: false}}\n"
 @pytest.fixture
 def robot_folder(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
     (tmp_path / "my_robot_env.py").write_text(ROBOT)
+    (tmp_path / "my_broken_env.py").write_text("raise RuntimeError('no driver')\n")
     (tmp_path / "small.yaml").write_text(SMALL)
     monkeypatch.chdir(tmp_path)
     monkeypatch.syspath_prepend(str(tmp_path))
     yield tmp_path
     sys.modules.pop("my_robot_env", None)
+    sys.modules.pop("my_broken_env", None)
 
 
 def test_a_users_environment_is_explored_with_every_output(robot_folder: Path) -> None:
@@ -74,6 +79,12 @@ def test_a_users_environment_is_explored_with_every_output(robot_folder: Path) -
     (["--environment", "my_robot_env:make", "--env-arg", "a=1", "--env-arg", "a=2"],
      r"--env-arg 'a' is given twice"),
     (["--env-arg", "seed=1"], r"--env-arg goes with --environment"),
+    (["--environment", ".my_robot_env:make"], r"an absolute module name"),
+    (["--environment", "my_broken_env:make"], r"cannot import 'my_broken_env' \(RuntimeError: "
+                                              r"no driver"),
+    (["--environment", "my_robot_env:offline"], r"offline\(\) failed \(ConnectionError: robot"),
+    (["--environment", "my_robot_env:make", "--env-arg", "scale=.nan"],
+     r"--env-arg 'scale' must be finite"),
     (["--environment", "my_robot_env:make", "--scenario", "homogeneous-60"],
      r"--environment runs without --scenario"),
 ])

@@ -38,7 +38,7 @@ def modulus_text(p: PokeRecord) -> str:
 @contextlib.contextmanager
 def progress(out: Console, description: str = "working") -> Iterator[Progress]:
     """A transient progress display on ``out`` with one task (spinner, bar, count, time)."""
-    columns = (SpinnerColumn(), TextColumn("{task.description}"), BarColumn(),
+    columns = (SpinnerColumn(), TextColumn("{task.description}", markup=False), BarColumn(),
                MofNCompleteColumn(), TimeElapsedColumn())  # fmt: skip
     with Progress(*columns, console=out, transient=True) as bar:
         bar.add_task(description, total=None)

@@ -500,7 +500,9 @@ def estimate_stiffness(travel_m: Any, force_n: Any, *, tip_radius_m: float, thic
                for d in (-config.poisson_ratio_std, config.poisson_ratio_std)]
         moduli = [_fit(travel, force, radius, thickness,
                        dataclasses.replace(config, poisson_ratio=nu))[0] for nu in nus]
-        modulus_var += ((moduli[1] - moduli[0]) / 2.0) ** 2
+        # the slope over the span actually taken (ν is clamped to [0, 0.5] at the ends)
+        slope = (moduli[1] - moduli[0]) / (nus[1] - nus[0])
+        modulus_var += (slope * config.poisson_ratio_std) ** 2
     modulus_std = float(np.sqrt(modulus_var))
 
     def stiffness_at(e: float) -> float:

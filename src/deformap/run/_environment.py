@@ -12,6 +12,7 @@ code you trust, as with any Python import.
 from __future__ import annotations
 
 import importlib
+import math
 import sys
 import time
 from collections.abc import Sequence
@@ -53,6 +54,8 @@ def parse_env_args(pairs: Sequence[str]) -> dict[str, Any]:
             value = yaml.safe_load(text) if text else ""
         except yaml.YAMLError:
             value = text
+        if isinstance(value, float) and not math.isfinite(value):
+            raise ConfigError(f"--env-arg {key!r} must be finite; got {text!r}")
         args[key] = value if isinstance(value, (str, int, float, bool)) or value is None else text
     return args
 
@@ -60,14 +63,16 @@ def parse_env_args(pairs: Sequence[str]) -> dict[str, Any]:
 def load_environment(spec: str, args: dict[str, Any]) -> Environment:
     """Import ``package.module:factory`` and return ``factory(**args)``, an Environment."""
     module_name, sep, attr = spec.partition(":")
-    if not sep or not module_name or not attr:
-        raise ConfigError(f"--environment must be package.module:factory; got {spec!r}")
+    if not sep or not module_name or not attr or module_name.startswith("."):
+        raise ConfigError(f"--environment must be package.module:factory (an absolute module "
+                          f"name); got {spec!r}")
     if "" not in sys.path and str(Path.cwd()) not in sys.path:
         sys.path.append(str(Path.cwd()))  # a module beside the user, after the installed ones
     try:
         module = importlib.import_module(module_name)
-    except ImportError as exc:
-        raise ConfigError(f"--environment {spec!r}: cannot import {module_name!r} ({exc})") from None
+    except Exception as exc:  # the user's module: whatever it raises is one line here
+        raise ConfigError(f"--environment {spec!r}: cannot import {module_name!r} "
+                          f"({type(exc).__name__}: {exc})") from None
     factory = getattr(module, attr, None)
     if not callable(factory):
         raise ConfigError(f"--environment {spec!r}: {module_name!r} has no callable {attr!r}")
@@ -76,6 +81,9 @@ def load_environment(spec: str, args: dict[str, Any]) -> Environment:
     except TypeError as exc:
         raise ConfigError(f"--environment {spec!r}: the --env-arg values do not fit {attr}(): "
                           f"{exc}") from None
+    except Exception as exc:  # a robot that is offline, a driver that fails to start
+        raise ConfigError(f"--environment {spec!r}: {attr}() failed "
+                          f"({type(exc).__name__}: {exc})") from None
     if not isinstance(env, Environment):
         raise ConfigError(
             f"--environment {spec!r} must return an Environment (workspace, observe, press, "

@@ -11,7 +11,7 @@ Every report of a mapped surface (a live exploration, :func:`live_report`; a rec
 - ``regions``: ``levels`` and ``class_values`` (in the map field's units: β, or ln E [ln Pa]),
   ``class_betas`` (the mean β of each class's pokes), ``class_modulus_median_pa`` (the median of
   the modulus field's E [Pa] over each found region's cells; ``None`` without a modulus),
-  ``poke_labels``, ``labels_by`` and, with a ground truth, the scores of
+  ``poke_labels`` (of the pokes ``poke_indices``), ``labels_by`` and, with a ground truth, the scores of
   :func:`deformap.eval.region_scores` (``None`` without a poke; the ordering scores read the
   modulus field as ``−ln E``, which grows with softness as β does);
 - ``modulus_field`` (``None`` while no poke has a modulus): the modulus field on the map's grid,
@@ -110,6 +110,9 @@ def _regions(result: ExplorationResult, truth: Any) -> tuple[dict[str, Any], lis
                                "class_values": found.class_betas.tolist(),
                                **_class_values(result),
                                "poke_labels": found.poke_labels.tolist(),
+                               # the pokes poke_labels speak of (the map field may leave some out)
+                               "poke_indices": [int(i) for i in (field.pokes.index if
+                                                field.pokes.index is not None else [])],
                                "labels_by": result.config.region_labels}  # fmt: skip
     if truth is None:
         return regions, None

@@ -86,7 +86,9 @@ class WorldConfig:
     stick_length_m: float = setting(0.10, gt=0.0)
     stick_radius_m: float = setting(0.006, gt=0.0)
     hand_size_m: tuple[float, float, float] = setting((0.08, 0.06, 0.10), gt=0.0)
-    force_noise_n: float = setting(0.01, ge=0.0)
+    # the protocol refuses a contact force more than 25 % + 0.05 N off the command (0.125 N at
+    # 0.3 N): a per-axis noise of at most 0.02 N stays six of its σ inside that
+    force_noise_n: float = setting(0.01, ge=0.0, le=0.02)
     # 8 levels resolve the curvature of a sphere's F ∝ δ^(3/2); each level costs one press solve
     force_travel_levels: int = setting(8, ge=2, le=1000)
     contact_threshold_n: float = setting(0.02, gt=0.0, le=0.1)
