@@ -206,3 +206,20 @@ def test_a_place_whose_modulus_cannot_be_read_twice_gives_the_run_to_beta() -> N
     assert "could not be read twice at one place (" in mapper.field_fallback
     mapper.add(_poke((0.5, 0.3), _soft(6e3), 3))  # for good: the β-field maps the rest
     assert mapper.config.field == "beta" and mapper.map_field is mapper.field
+
+
+def test_the_planner_is_told_the_pokes_made_not_the_pokes_in_the_field() -> None:
+    from deformap.explore._targets import choose_next
+
+    mapper = Mapper(Workspace(), ExplorationConfig(field="modulus", max_pokes=4))
+    mapper.add(_poke((0.3, 0.2), _soft(5e3), 0))
+    mapper.add(_poke((0.1, 0.1), None, 1, error="left out"))
+    mapper.add(_poke((0.5, 0.3), None, 2, error="left out"))
+    assert len(mapper.map_field.pokes) == 1 and mapper.config.field == "modulus"
+    target = mapper.next_target(np.random.default_rng(0))
+    assert target is not None and target.plan is not None
+    assert len(target.plan.targets) <= 1  # 4 pokes in all, 3 made: one left to plan
+    counted_from_field = choose_next(mapper.grid, mapper.map_field, mapper.config,
+                                     np.random.default_rng(0), boundary_owed=0)
+    assert counted_from_field is not None and counted_from_field.plan is not None
+    assert len(counted_from_field.plan.targets) > 1  # what it planned before

@@ -174,7 +174,8 @@ class Mapper:
         """The next target (:func:`deformap.explore._targets.choose_next`), or ``None`` when the
         map is done."""
         return choose_next(self.grid, self.map_field, self.config, rng,
-                           boundary_owed=self.boundary_owed())  # fmt: skip
+                           boundary_owed=self.boundary_owed(),
+                           n_made=len(self._pokes))  # fmt: skip
 
     def regions(self) -> RegionMap:
         """Cut the current map field into regions (:func:`map_regions`)."""

@@ -80,7 +80,8 @@ def _boundary(grid: MapGrid, field: BetaField, pokes: PokeSet,
 
 
 def choose_next(grid: MapGrid, field: BetaField, config: ExplorationConfig,
-                rng: np.random.Generator, *, boundary_owed: int) -> Target | None:
+                rng: np.random.Generator, *, boundary_owed: int,
+                n_made: int | None = None) -> Target | None:
     """The next target after the pokes ``field`` was fitted to, or ``None`` when the variance is
     under ``T_h`` and no boundary poke is owed or none has a place left.
 
@@ -96,6 +97,9 @@ def choose_next(grid: MapGrid, field: BetaField, config: ExplorationConfig,
         This choice's stream (``paper`` draws from it; ``min-max-variance`` subsamples with it).
     boundary_owed : int
         Boundary pokes still to make.
+    n_made : int, optional
+        Pokes made so far (the budget left is ``max_pokes`` less these); default: the pokes in
+        ``field``, which the modulus field may leave some out of.
     """
     pokes = field.pokes
     variance = field.variance.ravel()
@@ -114,7 +118,8 @@ def choose_next(grid: MapGrid, field: BetaField, config: ExplorationConfig,
     plans: list[PokePlan] = []
 
     def planner() -> NDArray[np.float64]:
-        plans.append(_plan(grid, pokes, config, len(pokes)))
+        made = len(pokes) if n_made is None else n_made  # the field may leave pokes out
+        plans.append(_plan(grid, pokes, config, made))
         return np.array(plans[-1].targets[0], dtype=float)
 
     if reachable.max() <= threshold:  # only the edge band is left
