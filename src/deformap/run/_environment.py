@@ -25,14 +25,12 @@ from deformap import __version__
 from deformap._config import config_to_dict
 from deformap.environment import Environment
 from deformap.errors import ConfigError
-from deformap.explore import Journal, check_exploration_budget, explore, field_settings
+from deformap.explore import Journal, check_exploration_budget, explore
 from deformap.run._config import CONFIG_NAME, RunConfig, config_yaml, run_generators
-from deformap.run._export import write_map_npz, write_pokes_csv
-from deformap.run._figures import write_map_figures, write_poke_figure
+from deformap.run._export import poke_writer, write_run_results
 from deformap.run._folder import (
     create_run_folder,
     default_run_folder,
-    write_json,
     write_text,
 )
 from deformap.run._hooks import NO_HOOKS, RunHooks, RunStart
@@ -118,11 +116,7 @@ def explore_environment(
                          total=config.exploration.max_pokes, done=0))  # fmt: skip
     _, explore_rng = run_generators(config.seed)
 
-    def on_poke(poke: Any) -> None:
-        if figures:
-            write_poke_figure(folder, poke)
-        hooks.poke(poke.record)
-
+    on_poke = poke_writer(folder, figures=figures, hooks=hooks)
     hooks.stage("exploring")
     t0 = time.perf_counter()
     result = explore(env, config.exploration, rng=explore_rng, journal=journal, on_poke=on_poke)
@@ -130,11 +124,6 @@ def explore_environment(
               "seed": config.seed, "config": config_to_dict(config),
               **shared_report(result, truth=None)}  # fmt: skip
     report["timings"]["wall_s"] = time.perf_counter() - t0
-    write_json(folder / "report.json", report)
-    write_map_npz(folder / "map.npz", result)
-    write_pokes_csv(folder / "pokes.csv", result)
-    if figures:
-        hooks.stage("drawing figures")
-        write_map_figures(folder, result, threshold=field_settings(result.config).threshold,
-                          title=f"{spec}: {len(result.pokes)} pokes", poke_figures=False)
+    write_run_results(folder, result, report, figures=figures, poke_figures=False,
+                      title=f"{spec}: {len(result.pokes)} pokes", hooks=hooks)
     return report, folder

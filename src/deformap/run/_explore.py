@@ -25,10 +25,8 @@ from deformap.explore import (
     ExplorationResult,
     Journal,
     PokeRecord,
-    PokeResult,
     check_exploration_budget,
     explore,
-    field_settings,
     measure_press,
     read_journal,
 )
@@ -39,10 +37,9 @@ from deformap.run._config import (
     load_run_config,
     run_generators,
 )
-from deformap.run._export import write_map_npz, write_pokes_csv
+from deformap.run._export import poke_writer, write_run_results
 from deformap.run._figures import (
     poke_figure_path,
-    write_map_figures,
     write_poke_figure,
     write_rerun,
 )
@@ -50,7 +47,6 @@ from deformap.run._folder import (
     create_run_folder,
     default_run_folder,
     run_stem,
-    write_json,
     write_text,
 )
 from deformap.run._hooks import NO_HOOKS, RunHooks, RunStart
@@ -221,23 +217,14 @@ def explore_scenario(
     world_s = time.perf_counter() - t0
     hooks.stage("exploring")
 
-    def on_poke(poke: PokeResult) -> None:
-        if figures:  # drawn as each poke is made, so a killed run keeps its pokes' figures
-            write_poke_figure(folder, poke)
-        hooks.poke(poke.record)
-
+    on_poke = poke_writer(folder, figures=figures, hooks=hooks)
     result = explore(world, config.exploration, rng=explore_rng, journal=journal, done=done,
                      on_poke=on_poke)  # fmt: skip
     report = live_report(config, result, world, world_build_s=world_s)
-    write_json(folder / "report.json", report)
-    write_map_npz(folder / "map.npz", result)
-    write_pokes_csv(folder / "pokes.csv", result)
+    write_run_results(folder, result, report, figures=figures, truth=world, poke_figures=False,
+                      title=f"{config.scenario} (seed {config.seed}): {len(result.pokes)} pokes",
+                      hooks=hooks)  # fmt: skip
     if figures:
-        hooks.stage("drawing figures")
-        title = f"{config.scenario} (seed {config.seed}): {len(result.pokes)} pokes"
-        threshold = field_settings(result.config).threshold
-        write_map_figures(folder, result, truth=world, threshold=threshold,
-                          title=title, poke_figures=False)  # fmt: skip
         _redraw_resumed_pokes(folder, result, world, config.exploration)
     if rerun:
         hooks.stage("writing run.rrd")

@@ -18,22 +18,29 @@ map's grid of ``(ny, nx)`` cells unless said otherwise:
 ``rigid`` (the force–travel reading; empty where the poke had none), ``region`` (the class of the
 poke in the region map, empty where the map field left the poke out).
 
-Both are written atomically (:mod:`deformap._files`).
+Both are written atomically (:mod:`deformap._files`). :func:`write_run_results` writes a run's
+results in one place for every workflow that maps (explore, a user's environment, a session):
+``report.json``, these two files and the figures.
 """
 
 from __future__ import annotations
 
 import csv
 import io
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from deformap._files import atomic_path, write_text_atomically
-from deformap.explore import ExplorationResult
+from deformap.explore import ExplorationResult, PokeResult, field_settings
+from deformap.run._figures import write_map_figures, write_poke_figure
+from deformap.run._folder import write_json
+from deformap.run._hooks import NO_HOOKS, RunHooks
 
-__all__ = ["POKES_CSV_COLUMNS", "write_map_npz", "write_pokes_csv"]
+__all__ = ["POKES_CSV_COLUMNS", "poke_writer", "write_map_npz", "write_pokes_csv",
+           "write_run_results"]
 
 POKES_CSV_COLUMNS = (
     "index", "purpose", "target_x_m", "target_y_m", "contact_x_m", "contact_y_m", "tip_center_z_m",
@@ -92,3 +99,31 @@ def write_pokes_csv(path: Path, result: ExplorationResult) -> Path:
         ])  # fmt: skip
     write_text_atomically(path, text.getvalue())
     return path
+
+
+def write_run_results(folder: Path, result: ExplorationResult, report: dict[str, Any], *,
+                      figures: bool, title: str, truth: Any = None, poke_figures: bool = True,
+                      hooks: RunHooks = NO_HOOKS) -> None:
+    """``report.json``, ``map.npz``, ``pokes.csv`` and, with ``figures``, ``map.png`` (T_h of the
+    field the map ran on) and the ``poke-NN.png`` (unless the caller drew them as the pokes came:
+    ``poke_figures=False``)."""
+    write_json(folder / "report.json", report)
+    write_map_npz(folder / "map.npz", result)
+    write_pokes_csv(folder / "pokes.csv", result)
+    if figures:
+        hooks.stage("drawing figures")
+        write_map_figures(folder, result, truth=truth,
+                          threshold=field_settings(result.config).threshold, title=title,
+                          poke_figures=poke_figures)  # fmt: skip
+
+
+def poke_writer(folder: Path, *, figures: bool, hooks: RunHooks) -> Callable[[PokeResult], None]:
+    """The live loop's ``on_poke``: ``poke-NN.png`` drawn as each poke is made (so a killed run
+    keeps its pokes' figures), then the progress hook."""
+
+    def on_poke(poke: PokeResult) -> None:
+        if figures:
+            write_poke_figure(folder, poke)
+        hooks.poke(poke.record)
+
+    return on_poke

@@ -10,7 +10,6 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from deformap.explore import field_settings
 from deformap.replay import RecordedSession, ReplayResult, load_session, map_session
 from deformap.run._config import (
     CONFIG_NAME,
@@ -19,13 +18,11 @@ from deformap.run._config import (
     run_generators,
     session_run_config,
 )
-from deformap.run._export import write_map_npz, write_pokes_csv
-from deformap.run._figures import write_map_figures
+from deformap.run._export import write_run_results
 from deformap.run._folder import (
     create_run_folder,
     default_run_folder,
     run_stem,
-    write_json,
     write_text,
 )
 from deformap.run._hooks import NO_HOOKS, RunHooks, RunStart
@@ -102,12 +99,7 @@ def map_recorded_session(
                          on_poke=lambda poke: hooks.poke(poke.record))  # fmt: skip
     write_text(folder / CONFIG_NAME, config_yaml(cfg))
     report = session_report(cfg, recorded, replay)
-    write_json(folder / "report.json", report)
-    write_map_npz(folder / "map.npz", replay.result)
-    write_pokes_csv(folder / "pokes.csv", replay.result)
-    if figures:
-        hooks.stage("drawing figures")
-        write_map_figures(folder, replay.result, truth=recorded.ground_truth,
-                          threshold=field_settings(replay.result.config).threshold,
-                          title=f"{stem}: {len(replay.result.pokes)} pokes")  # fmt: skip
+    write_run_results(folder, replay.result, report, figures=figures,
+                      truth=recorded.ground_truth,
+                      title=f"{stem}: {len(replay.result.pokes)} pokes", hooks=hooks)  # fmt: skip
     return MapOutput(report=report, session=recorded, replay=replay, config=cfg, folder=folder)
