@@ -72,7 +72,8 @@ def record_sim_command(
 @friendly_errors
 def map_command(
     session: Annotated[
-        Path, typer.Argument(metavar="SESSION", help="Session folder or its session.yaml.")
+        Path, typer.Argument(metavar="SESSION", help="Session folder or its session.yaml, or a "
+                             "bag as a robot records it (.mcap, .db3 or rosbag2 folder).")
     ],
     out: Annotated[
         Path | None,
@@ -85,14 +86,42 @@ def map_command(
         int | None, typer.Option(help="Seed of the surface fit; default: the session's.")
     ] = None,
     figures: Annotated[bool, typer.Option(help="Write map.png and poke-NN.png.")] = True,
+    layout: Annotated[str, typer.Option(
+        help="auto | session | raw: raw reads SESSION as a bag a robot recorded (camera, force "
+             "sensor, /tf); auto tells them apart.")] = "auto",
+    raw_config: Annotated[Path | None, typer.Option(
+        help="Raw bag: settings YAML (default: deformap.yaml in a rosbag2 folder, NAME.deformap"
+             ".yaml beside NAME.mcap; keys in docs/robot.md).")] = None,
+    cloud_topic: Annotated[str | None, typer.Option(
+        help="Raw bag: the organised PointCloud2 topic, default /camera/depth/color/points.")
+    ] = None,
+    wrench_topic: Annotated[str | None, typer.Option(
+        help="Raw bag: the WrenchStamped topic, default /ft_sensor/wrench.")] = None,
+    world_frame: Annotated[str | None, typer.Option(
+        help="Raw bag: the table's frame, z up, default world.")] = None,
+    tip_frame: Annotated[str | None, typer.Option(
+        help="Raw bag: the frame at the tip's centre, z along the stick, default tip.")] = None,
+    press_force: Annotated[float | None, typer.Option(
+        help="Raw bag: the commanded force, N; default the run config's exploration.force_n.")
+    ] = None,
+    stamp_tolerance: Annotated[float | None, typer.Option(
+        help="Raw bag: largest time between a press and its frame or transform, s; "
+             "default 0.05.")] = None,
     json_path: JsonOption = None,
 ) -> None:
-    """Map a recorded session: its pokes, in order, through the live loop's mapper."""
+    """Map a recorded session (or a robot's raw bag): its pokes, in order, through the live
+    loop's mapper."""
     cfg = None if config is None else run.load_run_config(config)
+    raw_settings = {"cloud_topic": cloud_topic, "wrench_topic": wrench_topic,
+                    "world_frame": world_frame, "tip_frame": tip_frame, "force_n": press_force,
+                    "stamp_tolerance_s": stamp_tolerance}  # fmt: skip
     shown = out_console(json_path)
     with progress(shown) as bar:
         output = run.map_recorded_session(session, out, config=cfg, seed=seed, figures=figures,
-                                          hooks=run_hooks(bar, poke_row=poke_row))  # fmt: skip
+                                          hooks=run_hooks(bar, poke_row=poke_row),
+                                          layout=layout,  # type: ignore[arg-type]
+                                          raw_config=raw_config,
+                                          raw_settings=raw_settings)  # fmt: skip
     report = output.report
     for line in report["warnings"]:
         err_console.print(labelled("warning:", "yellow", line), soft_wrap=True)

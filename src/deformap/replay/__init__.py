@@ -4,7 +4,9 @@ the same mapper the live loop uses.
 The format is documented in ``docs/recording-format.md``. :func:`load_session` checks a session's
 ``session.yaml`` and opens its data; each poke is read on demand as the
 :class:`~deformap.environment.PressObservation` the environment returned, so a broken poke is
-reported on its own. :func:`write_session` writes the format (``deformap record-sim`` uses it,
+reported on its own. :func:`load_raw_bag` opens a bag as a robot records it (camera, force
+sensor, ``/tf``; settings in :class:`RawBagConfig`) as a session of form ``"raw"``, its presses
+found in the force stream. :func:`write_session` writes the format (``deformap record-sim`` uses it,
 through :class:`RecordingEnvironment`).
 """
 
@@ -19,6 +21,15 @@ from deformap.replay._format import (
     SESSION_FILE,
     TOPICS,
 )
+from deformap.replay._rawconfig import (
+    DEFAULT_HULL,
+    RAW_CONFIG_NAME,
+    HullPart,
+    RawBagConfig,
+    load_raw_config,
+    raw_config_file,
+)
+from deformap.replay._rawsession import RAW_SUFFIXES, is_raw_bag, load_raw_bag
 from deformap.replay._recorder import RecordingEnvironment
 from deformap.replay._session import DEFAULT_CONTACT_GAP_M, RecordedSession, load_session
 from deformap.replay._truth import GroundTruth, read_ground_truth, write_ground_truth
@@ -30,19 +41,28 @@ _OFFLINE = ("ReplayResult", "estimate_poke", "map_session", "tip_sphere_points")
 
 __all__ = [
     "DEFAULT_CONTACT_GAP_M",
+    "DEFAULT_HULL",
     "FORMAT_NAME",
     "FORMAT_VERSION",
     "OPTIONAL_TOPICS",
+    "RAW_CONFIG_NAME",
+    "RAW_SUFFIXES",
     "SESSION_FILE",
     "SESSION_FORMATS",
     "TOPICS",
     "GroundTruth",
+    "HullPart",
+    "RawBagConfig",
     "RecordedSession",
     "RecordingEnvironment",
     "ReplayResult",
     "estimate_poke",
+    "is_raw_bag",
+    "load_raw_bag",
+    "load_raw_config",
     "load_session",
     "map_session",
+    "raw_config_file",
     "read_ground_truth",
     "tip_sphere_points",
     "write_ground_truth",

@@ -26,6 +26,7 @@ from deformap.replay._bagform import BagReader
 from deformap.replay._folder import FolderReader
 from deformap.replay._format import SESSION_FILE, SessionHeader, parse_session_yaml
 from deformap.replay._manifest import verify_digest
+from deformap.replay._rawbag import RawBagReader
 from deformap.replay._truth import GroundTruth, read_ground_truth
 
 __all__ = ["DEFAULT_CONTACT_GAP_M", "RecordedSession", "check_contact_gap", "load_session"]
@@ -60,12 +61,12 @@ class RecordedSession:
     path: Path
     header: SessionHeader
     ground_truth: GroundTruth | None
-    _reader: FolderReader | BagReader = field(repr=False)
+    _reader: FolderReader | BagReader | RawBagReader = field(repr=False)
     contact_gap_m: float = DEFAULT_CONTACT_GAP_M
 
     @property
     def form(self) -> str:
-        """``"folder"`` or ``"bag"``."""
+        """``"folder"``, ``"bag"`` or ``"raw"`` (a bag as a robot records it)."""
         return self.header.form
 
     @property

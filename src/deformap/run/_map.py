@@ -2,15 +2,27 @@
 folder as a live run does (``config.yaml``, ``report.json``, ``map.png``, ``poke-NN.png``).
 
 A poke that cannot be read or processed is skipped and listed in the report; the others count.
+``session`` is a session folder (or its ``session.yaml``), or a bag as a robot records it (the
+``raw`` layout: a ``.mcap`` / ``.db3`` file or a rosbag2 folder without ``session.yaml``), whose
+presses are found in its force stream with the settings of ``replay.RawBagConfig``.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
-from deformap.replay import RecordedSession, ReplayResult, load_session, map_session
+from deformap.errors import InvalidArgumentError
+from deformap.replay import (
+    RecordedSession,
+    ReplayResult,
+    is_raw_bag,
+    load_raw_bag,
+    load_raw_config,
+    load_session,
+    map_session,
+)
 from deformap.run._config import (
     CONFIG_NAME,
     RunConfig,
@@ -28,7 +40,10 @@ from deformap.run._folder import (
 from deformap.run._hooks import NO_HOOKS, RunHooks, RunStart
 from deformap.run._report import session_report
 
-__all__ = ["MapOutput", "map_recorded_session"]
+__all__ = ["MAP_LAYOUTS", "MapOutput", "map_recorded_session"]
+
+#: What ``map`` reads: ``auto`` tells a raw bag from a session (``replay.is_raw_bag``).
+MAP_LAYOUTS = ("auto", "session", "raw")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -61,6 +76,9 @@ def map_recorded_session(
     seed: int | None = None,
     figures: bool = True,
     hooks: RunHooks = NO_HOOKS,
+    layout: Literal["auto", "session", "raw"] = "auto",
+    raw_config: Path | None = None,
+    raw_settings: dict[str, Any] | None = None,
 ) -> MapOutput:
     """Map the session at ``session`` (its folder or its ``session.yaml``) into ``out``.
 
@@ -79,6 +97,13 @@ def map_recorded_session(
     figures : bool
         Write ``map.png`` and the ``poke-NN.png``.
     hooks : RunHooks
+    layout : {"auto", "session", "raw"}
+        ``raw`` reads ``session`` as a bag a robot recorded; ``auto`` decides by its form.
+    raw_config : Path, optional
+        The raw recording's settings YAML (default: the one beside the bag, see
+        ``replay.raw_config_file``, if it exists).
+    raw_settings : dict, optional
+        ``replay.RawBagConfig`` settings that win over the file's (command-line options).
 
     Raises
     ------
@@ -86,7 +111,7 @@ def map_recorded_session(
         The session cannot be loaded, its recorded configuration is malformed, or ``out`` is not
         empty or not creatable (before any poke is mapped).
     """
-    recorded = load_session(session)
+    recorded = _open(session, config, layout, raw_config, raw_settings or {})
     cfg = session_run_config(recorded, config, seed)
     stem = recorded.path.name or "session"
     folder = out or default_run_folder(run_stem(stem), "map", cfg.seed)
@@ -103,3 +128,19 @@ def map_recorded_session(
                       truth=recorded.ground_truth,
                       title=f"{stem}: {len(replay.result.pokes)} pokes", hooks=hooks)  # fmt: skip
     return MapOutput(report=report, session=recorded, replay=replay, config=cfg, folder=folder)
+
+
+def _open(path: Path, config: RunConfig | None, layout: str, raw_config: Path | None,
+          raw_settings: dict[str, Any]) -> RecordedSession:  # fmt: skip
+    if layout not in MAP_LAYOUTS:
+        raise InvalidArgumentError(f"`layout` must be one of {list(MAP_LAYOUTS)}; got {layout!r}")
+    raw = layout == "raw" or (layout == "auto" and is_raw_bag(path))
+    if not raw:
+        if raw_config is not None or any(v is not None for v in raw_settings.values()):
+            raise InvalidArgumentError(
+                f"raw recording settings apply to a bag as a robot records it; {str(path)!r} is "
+                "read as a deformap session (pass --layout raw to read it as a raw bag)")
+        return load_session(path)
+    settings = load_raw_config(path, raw_config, **raw_settings)
+    force = (config or RunConfig()).exploration.force_n
+    return load_raw_bag(path, settings, default_force_n=force)

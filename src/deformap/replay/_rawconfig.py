@@ -1,0 +1,207 @@
+"""Settings of a raw robot recording: which topics and frames hold what, and the thresholds that
+find the presses in it (``docs/robot.md``, "A bag as your robot records it").
+
+A raw recording is a ROS 2 bag as ``ros2 bag record`` writes it from a depth camera driver, a
+force–torque sensor and an arm: an organised ``sensor_msgs/msg/PointCloud2`` stream in the
+camera's optical frame, ``geometry_msgs/msg/WrenchStamped`` in the sensor's frame, and ``/tf`` and
+``/tf_static``. :class:`RawBagConfig` names its topics and frames, the commanded force and the
+thresholds; :class:`HullPart` is one part of the robot's model (stick, hand) in the tip's frame.
+The defaults fit a RealSense camera driver (``/camera/depth/color/points``) and a force sensor
+publishing on ``/ft_sensor/wrench``. The settings come from a YAML file beside the bag
+(:func:`raw_config_file`) and from the command line; both go through the same constructor.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any, Literal
+
+from deformap._config import config_from_dict, load_yaml
+from deformap._validation import check_settings, setting
+from deformap.errors import ConfigError
+
+__all__ = [
+    "DEFAULT_HULL",
+    "RAW_CONFIG_NAME",
+    "HullPart",
+    "RawBagConfig",
+    "load_raw_config",
+    "raw_config_file",
+]
+
+#: Name of the settings file inside a rosbag2 folder; beside a single ``NAME.mcap`` or
+#: ``NAME.db3`` file it is ``NAME.deformap.yaml``.
+RAW_CONFIG_NAME = "deformap.yaml"
+
+
+@dataclass(frozen=True, kw_only=True)
+class HullPart:
+    """One rigid part of the probe (stick, hand), in the tip's frame.
+
+    The tip's frame has its origin at the centre of the spherical tip and its ``z`` axis along the
+    stick, away from the surface. Each part's convex hull is removed from the press's cloud on its
+    own, so a wide hand high above the tip does not widen the hull down at the surface.
+
+    Parameters
+    ----------
+    shape : {"box", "cylinder", "cap"}
+        ``box``: extents ``size_m`` centred at ``center_m``, axes those of the tip's frame;
+        ``cylinder``: along ``z``, diameter ``size_m[0]``, length ``size_m[2]``, centred at
+        ``center_m``; ``cap``: the tip's upper half-sphere (radius ``size_m[0] / 2``, centre
+        ``center_m``; the lower half is in the dent and must stay out of every hull).
+    center_m : (3,) float, metres
+    size_m : (3,) float, metres
+    """
+
+    shape: Literal["box", "cylinder", "cap"] = "box"
+    center_m: tuple[float, float, float] = setting((0.0, 0.0, 0.0))
+    size_m: tuple[float, float, float] = setting((0.01, 0.01, 0.01), gt=0.0)
+
+    def __post_init__(self) -> None:
+        check_settings(self)
+
+
+#: The default probe: the paper's rigid 10 cm stick on the hand (Sec. V), as three parts: the
+#: tip's upper half (1 cm radius), the stick (12 mm thick, 10 cm long) and a hand box
+#: 8 × 6 × 10 cm on top of it. Give your own in ``hull`` (measure the parts and add a few
+#: millimetres so that depth noise on their edges goes too).
+DEFAULT_HULL = (
+    HullPart(shape="cap", center_m=(0.0, 0.0, 0.0), size_m=(0.02, 0.02, 0.02)),
+    HullPart(shape="cylinder", center_m=(0.0, 0.0, 0.05), size_m=(0.012, 0.012, 0.10)),
+    HullPart(shape="box", center_m=(0.0, 0.0, 0.15), size_m=(0.08, 0.06, 0.10)),
+)
+
+
+@dataclass(frozen=True, kw_only=True)
+class RawBagConfig:
+    """What a raw robot recording holds, and how its presses are found.
+
+    Parameters
+    ----------
+    cloud_topic, wrench_topic, tf_topic, tf_static_topic : str
+        Topics of the depth camera's organised cloud, the force sensor and the transforms.
+    world_frame : str
+        The frame whose ``z = 0`` is the table, ``z`` up (the map's frame).
+    tip_frame : str
+        The frame at the centre of the probe's spherical tip, ``z`` along the stick away from the
+        surface (the press direction is its ``-z``); a ``/tf`` frame, usually static below the
+        arm's last link.
+    camera_frame, force_frame : str or None
+        Override the clouds' and the wrenches' ``header.frame_id`` (None: use them).
+    units : {"m", "mm"}
+        Units of the cloud's coordinates.
+    force_n : float or None
+        The commanded normal force [N]; None: the run configuration's ``exploration.force_n``.
+    wrench_sign : {"reaction", "applied"}
+        ``reaction``: the sensor reports the force the surface exerts on the probe (a force sensor
+        on a tool does), negated here to give the force on the surface; ``applied``: it already
+        reports the force on the surface. The result must push into the surface or the press is
+        refused (a wrong sign is never taken silently).
+    contact_force_n : float
+        A press starts at the first force sample above this [N] (first contact) and ends when the
+        force falls below it: 0.02 N, four times the 5 mN noise floor of the probe's sensor class
+        (``docs/robot.md``, the force–travel record).
+    hold_band : float
+        The hold is the longest run of samples within ``hold_band · force_n`` of the commanded
+        force: 0.1, four times the 1 % + 5 mN noise of such sensors and tighter than the 25 %
+        the protocol allows for the final force (``FORCE_MISMATCH_REL``).
+    hold_min_s : float
+        The shortest hold accepted [s]; 0.1 s lets a 30 Hz camera give at least three frames.
+    stamp_tolerance_s : float
+        A camera frame or transform farther than this in time from the moment it is wanted is
+        not used [s]: 0.05 s is 1.5 frame periods at 30 Hz and 2.5 of ``/tf`` at 20 Hz, while a
+        dropped stream (a driver that stalls) leaves gaps of a second or more.
+    observation_time_s : float or None
+        Seconds after the bag's first camera frame of the observation frame (the surface before
+        any press, arm out of view); None: the first frame.
+    observation_frames : int
+        Frames averaged for the observation, from the one picked (all before the first contact).
+    workspace_lower, workspace_upper : (2,) float or None
+        The rectangle to map in the world frame; None: the observation's ``x``–``y`` extent.
+    tip_radius_m : float
+        Radius of the probe's spherical tip; 1 cm, the order of the paper's OptoForce tip.
+    hull : tuple of HullPart
+        The probe's parts in the tip's frame (:data:`DEFAULT_HULL`).
+    """
+
+    cloud_topic: str = "/camera/depth/color/points"
+    wrench_topic: str = "/ft_sensor/wrench"
+    tf_topic: str = "/tf"
+    tf_static_topic: str = "/tf_static"
+    world_frame: str = "world"
+    tip_frame: str = "tip"
+    camera_frame: str | None = None
+    force_frame: str | None = None
+    units: Literal["m", "mm"] = "m"
+    force_n: float | None = setting(None, gt=0.0)
+    wrench_sign: Literal["reaction", "applied"] = "reaction"
+    contact_force_n: float = setting(0.02, gt=0.0)
+    hold_band: float = setting(0.1, gt=0.0, lt=1.0)
+    hold_min_s: float = setting(0.1, gt=0.0)
+    stamp_tolerance_s: float = setting(0.05, gt=0.0)
+    observation_time_s: float | None = setting(None, ge=0.0)
+    observation_frames: int = setting(1, ge=1)
+    workspace_lower: tuple[float, float] | None = None
+    workspace_upper: tuple[float, float] | None = None
+    tip_radius_m: float = setting(0.01, gt=0.0)
+    hull: tuple[HullPart, ...] = field(default=DEFAULT_HULL)
+
+    def __post_init__(self) -> None:
+        check_settings(self)
+        for name in ("cloud_topic", "wrench_topic", "tf_topic", "tf_static_topic",
+                     "world_frame", "tip_frame"):  # fmt: skip
+            if not getattr(self, name):
+                raise ConfigError(f"`{name}` must be a non-empty string; got ''")
+        if (self.workspace_lower is None) != (self.workspace_upper is None):
+            raise ConfigError("`workspace_lower` and `workspace_upper` must be given together; "
+                              "got one of them")
+        if not self.hull:
+            raise ConfigError("`hull` must hold at least one part (the stick); got none")
+
+    def commanded_force(self, default_n: float) -> float:
+        """The commanded force: ``force_n``, else ``default_n`` (the run's)."""
+        return default_n if self.force_n is None else self.force_n
+
+
+def raw_config_file(bag: Path) -> Path:
+    """Where the settings of ``bag`` live: ``deformap.yaml`` inside a rosbag2 folder, or
+    ``NAME.deformap.yaml`` beside a ``NAME.mcap`` / ``NAME.db3`` file."""
+    if bag.is_dir():
+        return bag / RAW_CONFIG_NAME
+    return bag.with_name(f"{bag.stem}.{RAW_CONFIG_NAME}")
+
+
+def load_raw_config(bag: Path, file: Path | None = None, **overrides: Any) -> RawBagConfig:
+    """The settings of the raw recording ``bag``.
+
+    Parameters
+    ----------
+    bag : Path
+    file : Path, optional
+        The settings YAML; default :func:`raw_config_file` of the bag, used when it exists.
+    **overrides
+        Settings given on the command line; they win over the file's. ``None`` values are left
+        out (an option not given).
+
+    Raises
+    ------
+    ConfigError
+        The file is not valid YAML, has an unknown key, or a value is refused (named by its key).
+    """
+    path = raw_config_file(bag) if file is None else file
+    data: dict[str, Any] = {}
+    if file is not None or path.is_file():
+        loaded = load_yaml(path, what="the raw recording's settings")
+        if loaded is not None and not isinstance(loaded, dict):
+            raise ConfigError(f"{path}: must be a mapping of settings; got {type(loaded).__name__}")
+        data = dict(loaded or {})
+    where = str(path) if data else "raw recording settings"
+    config = config_from_dict(RawBagConfig, data, where=where)
+    given = {k: v for k, v in overrides.items() if v is not None}
+    if not given:
+        return config
+    try:
+        return replace(config, **given)
+    except TypeError as exc:
+        raise ConfigError(f"raw recording settings: {exc}") from None

@@ -1,0 +1,185 @@
+"""The transforms of a raw recording (``/tf`` and ``/tf_static``), looked up at any time.
+
+Each ``geometry_msgs/msg/TransformStamped`` gives ``child2parent`` at its stamp. A lookup walks
+from each frame up to the root of its tree and composes the edges, each interpolated at the asked
+times: translation linearly, rotation by spherical linear interpolation of its quaternion
+(scipy's ``Slerp``), as ``tf2`` does. A time is answered only if a sample of every dynamic edge on
+the way lies within the tolerance of it; a static edge holds at all times.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from deformap.errors import FileFormatError
+
+__all__ = ["TransformGap", "TransformTree"]
+
+
+class TransformGap(FileFormatError):
+    """No transform sample within the tolerance of a wanted time (names the frame and the gap)."""
+
+
+@dataclass
+class _Edge:
+    parent: str
+    static: bool
+    stamps: list[int] = field(default_factory=list)
+    translations: list[tuple[float, float, float]] = field(default_factory=list)
+    quaternions: list[tuple[float, float, float, float]] = field(default_factory=list)
+
+
+@dataclass(frozen=True)
+class _Series:
+    stamps: NDArray[np.int64]
+    translations: NDArray[np.float64]
+    rotations: Any  # scipy Rotation of len(stamps)
+
+
+class TransformTree:
+    """The frames of ``/tf`` and ``/tf_static`` and their transforms over time.
+
+    Parameters
+    ----------
+    topic : str
+        The dynamic topic's name, for messages (``"/tf"``).
+    tolerance_ns : int
+        Largest time between a wanted time and the nearest sample of a dynamic edge.
+    """
+
+    def __init__(self, topic: str, tolerance_ns: int) -> None:
+        self.topic = topic
+        self.tolerance_ns = tolerance_ns
+        self._edges: dict[str, _Edge] = {}
+        self._series: dict[str, _Series] = {}
+
+    def add(self, msg: Any, *, static: bool, where: str) -> None:
+        """Add every transform of a ``tf2_msgs/msg/TFMessage``."""
+        for tf in msg.transforms:
+            child, parent = str(tf.child_frame_id), str(tf.header.frame_id)
+            q, t = tf.transform.rotation, tf.transform.translation
+            quat = (float(q.x), float(q.y), float(q.z), float(q.w))
+            trans = (float(t.x), float(t.y), float(t.z))
+            norm = float(np.linalg.norm(quat))
+            if not (np.isfinite(quat).all() and np.isfinite(trans).all()) or abs(norm - 1) > 1e-3:
+                raise FileFormatError(
+                    f"{where}: transform {parent!r} -> {child!r} must be finite with a unit "
+                    f"quaternion; got translation {trans}, quaternion {quat}")
+            edge = self._edges.setdefault(child, _Edge(parent=parent, static=static))
+            if edge.parent != parent:
+                raise FileFormatError(
+                    f"{where}: frame {child!r} has two parents, {edge.parent!r} and {parent!r}")
+            edge.static = edge.static and static
+            stamp = int(tf.header.stamp.sec) * 10**9 + int(tf.header.stamp.nanosec)
+            edge.stamps.append(stamp)
+            edge.translations.append(trans)
+            edge.quaternions.append(quat)
+        self._series.clear()
+
+    @property
+    def frames(self) -> list[str]:
+        names = set(self._edges) | {e.parent for e in self._edges.values()}
+        return sorted(names)
+
+    def _chain(self, frame: str) -> list[str]:
+        """``frame`` and its ancestors up to the root."""
+        chain = [frame]
+        while chain[-1] in self._edges:
+            chain.append(self._edges[chain[-1]].parent)
+            if len(chain) > len(self._edges) + 1:
+                raise FileFormatError(f"{self.topic}: the frames above {frame!r} form a loop")
+        return chain
+
+    def _edge_series(self, child: str) -> _Series:
+        if child not in self._series:
+            from scipy.spatial.transform import Rotation
+
+            edge = self._edges[child]
+            order = np.argsort(np.asarray(edge.stamps, dtype=np.int64), kind="stable")
+            stamps = np.asarray(edge.stamps, dtype=np.int64)[order]
+            keep = np.concatenate([[True], np.diff(stamps) > 0])  # a repeated stamp: first kept
+            rot = Rotation.from_quat(np.asarray(edge.quaternions)[order][keep])
+            self._series[child] = _Series(stamps[keep],
+                                          np.asarray(edge.translations)[order][keep], rot)
+        return self._series[child]
+
+    def _edge_at(self, child: str, times_ns: NDArray[np.int64], what: str
+                 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:  # fmt: skip
+        """Rotations ``(n, 3, 3)`` and translations ``(n, 3)`` of ``child2parent`` at the times."""
+        from scipy.spatial.transform import Slerp
+
+        edge, series = self._edges[child], self._edge_series(child)
+        n = times_ns.size
+        if edge.static or series.stamps.size == 1:
+            if not edge.static:
+                self._check_gap(child, series.stamps, times_ns, what)
+            mat = series.rotations[-1].as_matrix()
+            return np.broadcast_to(mat, (n, 3, 3)).copy(), np.tile(series.translations[-1], (n, 1))
+        self._check_gap(child, series.stamps, times_ns, what)
+        t = np.clip(times_ns, series.stamps[0], series.stamps[-1])
+        rel = (t - series.stamps[0]).astype(np.float64)
+        knots = (series.stamps - series.stamps[0]).astype(np.float64)
+        rot = Slerp(knots, series.rotations)(rel).as_matrix()
+        trans = np.column_stack([np.interp(rel, knots, series.translations[:, i])
+                                 for i in range(3)])  # fmt: skip
+        return rot, trans
+
+    def _check_gap(self, child: str, stamps: NDArray[np.int64], times: NDArray[np.int64],
+                   what: str) -> None:  # fmt: skip
+        idx = np.clip(np.searchsorted(stamps, times), 1, max(stamps.size - 1, 1))
+        before = stamps[np.maximum(idx - 1, 0)]
+        after = stamps[np.minimum(idx, stamps.size - 1)]
+        gap = np.minimum(np.abs(times - before), np.abs(times - after))
+        worst = int(np.argmax(gap))
+        if gap[worst] > self.tolerance_ns:
+            raise TransformGap(
+                f"{what}: topic {self.topic!r} has no transform {self._edges[child].parent!r} -> "
+                f"{child!r} within {self.tolerance_ns / 1e9:g} s of t = {times[worst] / 1e9:.3f} s "
+                f"(nearest {gap[worst] / 1e9:.3f} s away)")
+
+    def lookup(self, target: str, source: str, times_ns: Any, *, what: str
+               ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:  # fmt: skip
+        """``source2target`` at each time: rotations ``(n, 3, 3)`` and translations ``(n, 3)``.
+
+        ``p_target = R @ p_source + t``. ``what`` starts every refusal (the press and stream).
+
+        Raises
+        ------
+        FileFormatError
+            A frame is unknown or the two are not connected; :class:`TransformGap` when a
+            dynamic edge has no sample within the tolerance of a time.
+        """
+        times = np.atleast_1d(np.asarray(times_ns, dtype=np.int64))
+        for frame in (target, source):
+            if frame not in self._edges and frame not in {e.parent for e in self._edges.values()}:
+                raise FileFormatError(
+                    f"{what}: no frame {frame!r} on {self.topic!r} or its static topic "
+                    f"(frames: {self.frames})")
+        up_source, up_target = self._chain(source), self._chain(target)
+        if up_source[-1] != up_target[-1]:
+            raise FileFormatError(
+                f"{what}: frames {source!r} and {target!r} are not connected by the transforms "
+                f"(roots {up_source[-1]!r} and {up_target[-1]!r})")
+        common = next(f for f in up_source if f in up_target)
+        rs, ts = self._to_ancestor(up_source, common, times, what)
+        rt, tt = self._to_ancestor(up_target, common, times, what)
+        # source2target = inverse(target2common) @ source2common
+        rt_inv = np.transpose(rt, (0, 2, 1))
+        rot = rt_inv @ rs
+        trans = np.einsum("nij,nj->ni", rt_inv, ts - tt)
+        return rot, trans
+
+    def _to_ancestor(self, chain: list[str], ancestor: str, times: NDArray[np.int64], what: str
+                     ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:  # fmt: skip
+        n = times.size
+        rot, trans = np.broadcast_to(np.eye(3), (n, 3, 3)).copy(), np.zeros((n, 3))
+        for child in chain[: chain.index(ancestor)]:
+            r_edge, t_edge = self._edge_at(child, times, what)
+            # child2grandparent = edge @ (frame2child): apply the edge after what came before
+            trans = np.einsum("nij,nj->ni", r_edge, trans) + t_edge
+            rot = r_edge @ rot
+        return rot, trans
