@@ -64,7 +64,8 @@ def hull_points(part: HullPart, rot: NDArray[np.float64], origin: NDArray[np.flo
         az = np.linspace(0.0, 2 * np.pi, _CIRCLE, endpoint=False)
         ring = np.column_stack([np.cos(az), np.sin(az), np.zeros_like(az)]) * (sx / 2)
         if part.shape == "cylinder":
-            local = np.vstack([ring + [0, 0, -sz / 2], ring + [0, 0, sz / 2]])
+            half = np.array([0.0, 0.0, sz / 2])
+            local = np.vstack([ring - half, ring + half])
         else:  # cap: the upper half-sphere, as rings at 0°, 30°, 60° and the pole
             r = sx / 2
             local = np.vstack([ring * np.cos(a) + [0, 0, r * np.sin(a)]
@@ -91,11 +92,13 @@ class RawBagReader:
         cfg = config
         self.tree = TransformTree(cfg.tf_topic, round(cfg.stamp_tolerance_s * 1e9))
         self._index()
+        self.origin_ns = self.tree.origin_ns = int(min(self.cloud_ns.min(), self.wrench_ns[0]))
         self.presses = find_presses(
             self.wrench_ns, np.linalg.norm(self.wrench_force, axis=1), commanded_n=commanded_n,
             contact_n=cfg.contact_force_n, band=cfg.hold_band,
             hold_min_ns=round(cfg.hold_min_s * 1e9),
-            merge_ns=round(cfg.stamp_tolerance_s * 1e9), topic=cfg.wrench_topic)
+            merge_ns=round(cfg.stamp_tolerance_s * 1e9), topic=cfg.wrench_topic,
+            origin_ns=self.origin_ns)
         if not self.presses:
             peak = float(np.max(np.linalg.norm(self.wrench_force, axis=1)))
             raise FileFormatError(
@@ -153,6 +156,10 @@ class RawBagReader:
                                   "infinite forces")  # fmt: skip
         self.cloud_ns = np.asarray(stamps, dtype=np.int64)
 
+    def _s(self, stamp_ns: Any) -> str:
+        """A stamp as seconds after the bag's start (its first camera or force message)."""
+        return f"{(int(stamp_ns) - self.origin_ns) / 1e9:.3f}"
+
     def _one_frame(self, frames: set[str], topic: str) -> str:
         if len(frames) != 1:
             raise FileFormatError(f"{self.path}: topic {topic!r} must use one frame_id; got "
@@ -167,15 +174,15 @@ class RawBagReader:
         times = self.cloud_ns[order]
         pick = 0
         if cfg.observation_time_s is not None:
-            wanted = times[0] + round(cfg.observation_time_s * 1e9)
+            wanted = self.origin_ns + round(cfg.observation_time_s * 1e9)
             pick = int(np.argmin(np.abs(times - wanted)))
         chosen = [int(i) for i in order[pick: pick + cfg.observation_frames]]
         last = int(self.cloud_ns[chosen[-1]])
         if last >= first_contact or len(chosen) < cfg.observation_frames:
             raise FileFormatError(
                 f"{self.path}: the observation's {cfg.observation_frames} frame(s) on "
-                f"{cfg.cloud_topic!r} from t = {times[pick] / 1e9:.3f} s must all come before the "
-                f"first contact at t = {first_contact / 1e9:.3f} s (`observation_time_s`, "
+                f"{cfg.cloud_topic!r} from t = {self._s(times[pick])} s must all come before the "
+                f"first contact at t = {self._s(first_contact)} s (`observation_time_s`, "
                 "`observation_frames`)")
         return self._still(chosen, "the observation")
 
@@ -183,7 +190,7 @@ class RawBagReader:
         cfg = self.config
         t0, t1 = int(self.wrench_ns[press.hold_start]), int(self.wrench_ns[press.hold_end - 1])
         inside = np.flatnonzero((self.cloud_ns >= t0) & (self.cloud_ns <= t1))
-        where = f"press {press.index} (hold t = {t0 / 1e9:.3f}–{t1 / 1e9:.3f} s)"
+        where = f"press {press.index} (hold t = {self._s(t0)}–{self._s(t1)} s)"
         if inside.size == 0:
             gap = np.maximum(t0 - self.cloud_ns, self.cloud_ns - t1)
             nearest = int(np.argmin(gap))
@@ -233,13 +240,13 @@ class RawBagReader:
                 raise FileFormatError(f"{where}: could not be decoded: {type(exc).__name__}: "
                                       f"{str(exc)[:120]}") from None  # fmt: skip
             shape = (int(msg.height), int(msg.width))
+            ok = np.isfinite(xyz).all(axis=1)
             for group in wanted[number]:
-                if group.total is None:
+                if group.total is None or group.count is None:
                     group.shape, group.total = shape, np.zeros_like(xyz)
                     group.count = np.zeros(xyz.shape[0], dtype=np.int64)
-                if shape != group.shape or (shape[0] == 1 and group.count.max() > 0):
+                elif shape != group.shape or shape[0] == 1:
                     continue  # another layout, or an unorganised cloud: no pixel to average
-                ok = np.isfinite(xyz).all(axis=1)
                 group.total[ok] += xyz[ok]
                 group.count[ok] += 1
 
@@ -305,8 +312,8 @@ class RawBagReader:
     def press_parts(self, spec: PokeSpec) -> PressParts:
         press, cfg = self.presses[spec.index], self.config
         where = (f"{self.path}: press {press.index} (hold t = "
-                 f"{self.wrench_ns[press.hold_start] / 1e9:.3f}–"
-                 f"{self.wrench_ns[press.hold_end - 1] / 1e9:.3f} s)")
+                 f"{self._s(self.wrench_ns[press.hold_start])}–"
+                 f"{self._s(self.wrench_ns[press.hold_end - 1])} s)")
         span = slice(press.start, press.hold_end)
         stamps = self.wrench_ns[span]
         r_force, _ = self.tree.lookup(cfg.world_frame, self.force_frame, stamps,
@@ -326,7 +333,10 @@ class RawBagReader:
                 f"{np.round(direction, 3).tolist()}); the sensor's sign is the other one "
                 f"(`wrench_sign` is {cfg.wrench_sign!r})")
         normal = forces @ direction
-        ramp = slice(0, hold.start + 1)
+        # the record runs from first contact to the first sample that reaches the force held
+        # (the hold's mean, the commanded force within the controller's error and the noise)
+        reached = np.flatnonzero(normal[: hold.stop] >= float(normal[hold].mean()))
+        ramp = slice(0, int(reached[0]) + 1 if reached.size else hold.start + 1)
         travel = (tips[ramp] - tips[0]) @ direction
         try:
             record = ForceTravel(travel_m=travel, force_n=normal[ramp])

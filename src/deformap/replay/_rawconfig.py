@@ -113,8 +113,9 @@ class RawBagConfig:
         not used [s]: 0.05 s is 1.5 frame periods at 30 Hz and 2.5 of ``/tf`` at 20 Hz, while a
         dropped stream (a driver that stalls) leaves gaps of a second or more.
     observation_time_s : float or None
-        Seconds after the bag's first camera frame of the observation frame (the surface before
-        any press, arm out of view); None: the first frame.
+        When the observation's frame was taken (the surface before any press, arm out of view),
+        in seconds after the bag's start (its first camera or force message; every time in
+        messages counts from there); the frame nearest to it is taken. None: the first frame.
     observation_frames : int
         Frames averaged for the observation, from the one picked (all before the first contact).
     workspace_lower, workspace_upper : (2,) float or None

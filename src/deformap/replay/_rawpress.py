@@ -27,8 +27,9 @@ class FoundPress:
     start, end : int
         The first sample over the contact threshold (first contact), and one past the last.
     hold_start, hold_end : int
-        The hold: the longest run of samples within the band around the commanded force (end
-        exclusive); both ``-1`` when the force never entered the band.
+        The hold (end exclusive): in the longest run of samples within the band around the
+        commanded force, from the first sample that reaches the run's mean force to the last;
+        both ``-1`` when the force never entered the band.
     error : str or None
         Why the press cannot be used (the force never reached the command, the hold was too short).
     """
@@ -58,6 +59,7 @@ def find_presses(
     hold_min_ns: int,
     merge_ns: int,
     topic: str,
+    origin_ns: int = 0,
 ) -> list[FoundPress]:
     """The presses of a force stream.
 
@@ -80,6 +82,8 @@ def find_presses(
         threshold at first contact).
     topic : str
         Names the stream in errors.
+    origin_ns : int
+        Times in errors are seconds after this one (the bag's start).
 
     Returns
     -------
@@ -100,8 +104,8 @@ def find_presses(
             continue  # a spike of sensor noise over the threshold
         index = len(presses)
         seg = force_n[start:end]
-        where = (f"press {index} (t = {times_ns[start] / 1e9:.3f}–{times_ns[end - 1] / 1e9:.3f} s "
-                 f"on {topic!r})")  # fmt: skip
+        where = (f"press {index} (t = {(times_ns[start] - origin_ns) / 1e9:.3f}–"
+                 f"{(times_ns[end - 1] - origin_ns) / 1e9:.3f} s on {topic!r})")  # fmt: skip
         holds = _runs((seg >= lo) & (seg <= hi))
         if not holds:
             presses.append(FoundPress(index=index, start=start, end=end, error=(
@@ -110,6 +114,10 @@ def find_presses(
             continue
         h0, h1 = max(holds, key=lambda r: times_ns[start + r[1] - 1] - times_ns[start + r[0]])
         h0, h1 = start + h0, start + h1
+        # held from the first sample that reaches the force held (the band's top of the ramp is
+        # still rising, the dent still forming) to the last one before the release
+        settled = np.flatnonzero(force_n[h0:h1] >= force_n[h0:h1].mean())
+        h0, h1 = h0 + int(settled[0]), h0 + int(settled[-1]) + 1
         held = int(times_ns[h1 - 1] - times_ns[h0])
         error = None
         if held < hold_min_ns:

@@ -49,11 +49,14 @@ class TransformTree:
         The dynamic topic's name, for messages (``"/tf"``).
     tolerance_ns : int
         Largest time between a wanted time and the nearest sample of a dynamic edge.
+    origin_ns : int
+        Times in messages are seconds after this one (the bag's start).
     """
 
-    def __init__(self, topic: str, tolerance_ns: int) -> None:
+    def __init__(self, topic: str, tolerance_ns: int, origin_ns: int = 0) -> None:
         self.topic = topic
         self.tolerance_ns = tolerance_ns
+        self.origin_ns = origin_ns
         self._edges: dict[str, _Edge] = {}
         self._series: dict[str, _Series] = {}
 
@@ -138,7 +141,8 @@ class TransformTree:
         if gap[worst] > self.tolerance_ns:
             raise TransformGap(
                 f"{what}: topic {self.topic!r} has no transform {self._edges[child].parent!r} -> "
-                f"{child!r} within {self.tolerance_ns / 1e9:g} s of t = {times[worst] / 1e9:.3f} s "
+                f"{child!r} within {self.tolerance_ns / 1e9:g} s of t = "
+                f"{(times[worst] - self.origin_ns) / 1e9:.3f} s "
                 f"(nearest {gap[worst] / 1e9:.3f} s away)")
 
     def lookup(self, target: str, source: str, times_ns: Any, *, what: str
