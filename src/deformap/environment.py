@@ -30,7 +30,7 @@ from deformap._validation import (
     check_positive,
     check_vector,
 )
-from deformap.cloud import PointCloud
+from deformap.cloud import PointCloud, hull_parts
 from deformap.errors import InvalidArgumentError
 from deformap.mechanics import TactileContact
 
@@ -245,9 +245,12 @@ class PressObservation:
         Tip position, measured force and tip radius at the commanded force. The force pushes
         into the surface (negative z in the world frame) and its magnitude lies within
         ``FORCE_MISMATCH_REL · force_n + FORCE_MISMATCH_ABS_N`` of ``force_n``.
-    robot_points : (m, 3) float, metres
+    robot_points : (m, 3) float, metres, or a tuple of such arrays (one per part)
         Points whose convex hull covers the stick and hand at that moment, from the robot model
-        and proprioception (at least 4 points, not all on a plane).
+        and proprioception (at least 4 points, not all on a plane); or one such array per part
+        (stick, hand), each part's hull removed on its own, so that a wide hand above a narrow
+        stick does not widen the hull down at the surface. Stored as a read-only array, or a
+        tuple of them; :attr:`robot_hulls` gives the tuple either way.
     target_xy : (2,) float, metres
         The commanded target.
     force_n : float
@@ -260,7 +263,7 @@ class PressObservation:
 
     cloud: PointCloud
     contact: TactileContact
-    robot_points: NDArray[np.float64]
+    robot_points: NDArray[np.float64] | tuple[NDArray[np.float64], ...]
     target_xy: NDArray[np.float64]
     force_n: float
     force_travel: ForceTravel | None = None
@@ -272,11 +275,15 @@ class PressObservation:
             raise InvalidArgumentError(
                 f"`contact` must be a TactileContact; got {type(self.contact)}"
             )
-        robot = check_points("robot_points", self.robot_points, min_rows=4)
+        parts = hull_parts(self.robot_points)
+        hulls = ((check_points("robot_points", self.robot_points, min_rows=4),) if parts is None
+                 else tuple(check_points(f"robot_points[{i}]", part, min_rows=4)
+                            for i, part in enumerate(parts)))  # fmt: skip
         target = check_vector("target_xy", self.target_xy, 2, what="metres")
-        robot.setflags(write=False)
+        for hull in hulls:
+            hull.setflags(write=False)
         target.setflags(write=False)
-        object.__setattr__(self, "robot_points", robot)
+        object.__setattr__(self, "robot_points", hulls[0] if parts is None else hulls)
         object.__setattr__(self, "target_xy", target)
         force_n = check_positive("force_n", self.force_n)
         object.__setattr__(self, "force_n", force_n)
@@ -296,6 +303,12 @@ class PressObservation:
                 f"{allowed:.3g} N); its last force is {final:.4g} N"
             )
 
+
+    @property
+    def robot_hulls(self) -> tuple[NDArray[np.float64], ...]:
+        """The robot's hulls' points, one ``(m_i, 3)`` array per part (one for a single hull)."""
+        robot = self.robot_points
+        return robot if isinstance(robot, tuple) else (robot,)
 
     def _check_contact_force(self, force_n: float) -> None:
         """The measured contact force must be a press (into the surface, world z up) of about the

@@ -10,6 +10,7 @@ from deformap.cloud._filters import (
     HULL_TOLERANCE_M,
     crop_box,
     height_field_mask,
+    hull_parts,
     points_in_hull,
     statistical_outlier_mask,
 )
@@ -23,6 +24,7 @@ __all__ = [
     "contact_cap",
     "crop_box",
     "height_field_mask",
+    "hull_parts",
     "points_in_hull",
     "statistical_outlier_mask",
     "tactile_points",

@@ -27,6 +27,7 @@ __all__ = [
     "HULL_TOLERANCE_M",
     "crop_box",
     "height_field_mask",
+    "hull_parts",
     "points_in_hull",
     "statistical_outlier_mask",
 ]
@@ -190,19 +191,35 @@ def height_field_mask(points: Any, k: int = 20, max_slope_deg: float = 60.0) -> 
     return np.asarray(mask)
 
 
+def hull_parts(hull_points: Any) -> tuple[Any, ...] | None:
+    """The parts of a robot given one convex hull per part, or None for a single hull.
+
+    A tuple or list whose every entry is two-dimensional (an ``(m_i, 3)`` array or nested list)
+    holds one hull per part; anything else (an ``(m, 3)`` array, a list of points) is one hull.
+    """
+    if isinstance(hull_points, (tuple, list)) and hull_points and all(
+        np.ndim(part) == 2 for part in hull_points
+    ):
+        return tuple(hull_points)
+    return None
+
+
 def points_in_hull(
     points: Any, hull_points: Any, *, tolerance_m: float = HULL_TOLERANCE_M
 ) -> NDArray[np.bool_]:
-    """Mask of the points inside the convex hull of ``hull_points`` (surface included).
+    """Mask of the points inside the convex hull of ``hull_points`` (surface included), or inside
+    any of the hulls when one hull per part is given.
 
     Used to remove the robot's stick and hand from a cloud: ``cloud.select(~points_in_hull(...))``.
+    One hull per part (stick, hand) covers each part without the space between them: a single
+    hull around a narrow stick and a wide hand above it widens down to the surface.
 
     Parameters
     ----------
     points : (n, 3) float, metres
         The points to test; an empty array gives an empty mask.
-    hull_points : (m, 3) float, metres
-        At least 4 points, not all on one plane.
+    hull_points : (m, 3) float, metres, or a tuple or list of such arrays (one per part)
+        At least 4 points per hull, not all on one plane.
     tolerance_m : float
         A point counts as inside when it lies at most this far outside every facet plane
         (default :data:`HULL_TOLERANCE_M`, 1 µm, see there why).
@@ -213,10 +230,21 @@ def points_in_hull(
         ``True`` for the points inside or on the hull.
     """
     pts = check_points("points", points, min_rows=0)
-    verts = check_points("hull_points", hull_points, min_rows=4)
     tol = check_finite_scalar("tolerance_m", tolerance_m)
     if tol < 0:
         raise InvalidArgumentError(f"`tolerance_m` must be >= 0; got {tol}")
+    parts = hull_parts(hull_points)
+    if parts is None:
+        return _in_one_hull(pts, check_points("hull_points", hull_points, min_rows=4), tol)
+    inside = np.zeros(pts.shape[0], dtype=bool)
+    for i, part in enumerate(parts):
+        verts = check_points(f"hull_points[{i}]", part, min_rows=4)
+        inside |= _in_one_hull(pts, verts, tol)
+    return inside
+
+
+def _in_one_hull(pts: NDArray[np.float64], verts: NDArray[np.float64], tol: float
+                 ) -> NDArray[np.bool_]:  # fmt: skip
     centered = verts - verts.mean(axis=0)
     singular = np.linalg.svd(centered, compute_uv=False)
     # Relative rank test: a hull flatter than 1e-9 of its size has no interior worth the name.

@@ -271,7 +271,8 @@ def write_session_bag(
                                                      stamp_ns=stamp, dtype="float64"))  # fmt: skip
             put("wrench", stamp, _wrench_message(stamp, obs.contact.force))
             put("tip", stamp, _point_message(stamp, obs.contact.tip_center))
-            put("robot", stamp, array_to_pointcloud2(obs.robot_points, frame_id="world",
-                                                     stamp_ns=stamp, dtype="float64"))  # fmt: skip
+            robot = np.vstack(obs.robot_hulls)  # one hull per poke: the parts' common one
+            put("robot", stamp, array_to_pointcloud2(robot, frame_id="world", stamp_ns=stamp,
+                                                     dtype="float64"))  # fmt: skip
             if obs.force_travel is not None:
                 put("force_travel", stamp, force_travel_message(obs.force_travel))

@@ -25,7 +25,7 @@ class PressParts:
     cloud: PointCloud
     tip_center: NDArray[np.float64]
     force: NDArray[np.float64]
-    robot_points: NDArray[np.float64]
+    robot_points: NDArray[np.float64] | tuple[NDArray[np.float64], ...]  # one hull, or per part
     force_travel: ForceTravel | None = None
 
 

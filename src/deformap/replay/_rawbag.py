@@ -346,5 +346,5 @@ class RawBagReader:
             raise FileFormatError(f"{where}: {self._errors.get(spec.index, 'no frame')}")
         cloud = self._cloud(self._groups[spec.index], where)
         tip = tips[hold].mean(axis=0)
-        robot = np.vstack([hull_points(p, r_tip[mid], tip) for p in cfg.hull])
+        robot = tuple(hull_points(p, r_tip[mid], tip) for p in cfg.hull)  # a hull per part
         return PressParts(cloud, tip, force, robot, record)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -20,6 +21,8 @@ from deformap.replay._manifest import manifest_of
 from deformap.replay._truth import GroundTruth, write_ground_truth
 
 __all__ = ["SESSION_FORMATS", "write_session"]
+
+logger = logging.getLogger(__name__)
 
 #: ``"folder"``: one cloud file per observation; ``"mcap"`` / ``"sqlite3"``: a ROS 2 bag.
 SESSION_FORMATS = ("folder", *BAG_STORAGES)
@@ -147,6 +150,11 @@ def write_session(
     -------
     Path
         The ``session.yaml`` written.
+
+    Notes
+    -----
+    The format keeps one robot hull per poke: a press given one hull per part is written with
+    the points of all its parts, whose common hull covers them (a warning says so).
     """
     out, presses, tip = _check_inputs(folder, workspace, observation, presses, tip_radius_m,
                                       format, cloud_format, ground_truth)  # fmt: skip
@@ -164,6 +172,10 @@ def write_session(
     if ground_truth is not None:
         write_ground_truth(out / "ground_truth.npz", ground_truth)
         doc["ground_truth"] = "ground_truth.npz"
+    parted = [i for i, obs in enumerate(presses) if len(obs.robot_hulls) > 1]
+    if parted:
+        logger.warning("presses %s give one robot hull per part; the session keeps one hull per "
+                       "poke, their common hull (docs/recording-format.md)", parted)
     if format == "folder":
         doc["observation"] = f"observation.{cloud_format}"
         write_cloud(out / doc["observation"], observation)
@@ -171,7 +183,7 @@ def write_session(
         for i, obs in enumerate(presses, start=1):
             cloud, robot = f"poke-{i:02d}.{cloud_format}", f"poke-{i:02d}-robot.{cloud_format}"
             write_cloud(out / cloud, obs.cloud)
-            write_cloud(out / robot, PointCloud(obs.robot_points))
+            write_cloud(out / robot, PointCloud(np.vstack(obs.robot_hulls)))
             entry: dict[str, Any] = {
                 "cloud": cloud, "tip_center": _floats(obs.contact.tip_center),
                 "force": _floats(obs.contact.force), "target_xy": _floats(obs.target_xy),
