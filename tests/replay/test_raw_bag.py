@@ -450,3 +450,27 @@ def test_transforms_interpolate_in_time_and_refuse_a_gap() -> None:
     np.testing.assert_allclose(rot_inv[0] @ trans[0] + trans_inv[0], 0.0, atol=1e-12)
     with pytest.raises(TransformGap, match=r"test: topic '/tf' .*'tool'.* \(nearest 0\.160 s"):
         tree.lookup("world", "tip", [200_000_000], what="test")
+
+
+def test_an_observation_picked_after_the_first_contact_is_refused(
+    raw_bag: Path, live: tuple[RecordedSession, list[Any]], config_file: Path, tmp_path: Path
+) -> None:
+    settings = tmp_path / "late.yaml"
+    settings.write_text(yaml.safe_dump(_settings(live[0], observation_time_s=FIRST_PRESS_S + 1)))
+    code, output, _ = _map(raw_bag, tmp_path / "map", config_file, "--raw-config", str(settings))
+    assert code == 2
+    assert "must all come before the first contact" in output and "observation_time_s" in output
+
+
+def test_the_layout_is_told_apart_and_raw_options_are_refused_on_a_session(
+    raw_bag: Path, live: tuple[RecordedSession, list[Any]], config_file: Path, tmp_path: Path
+) -> None:
+    from deformap.replay import is_raw_bag
+
+    folder = tmp_path / "rosbag2"
+    folder.mkdir()
+    (folder / "metadata.yaml").write_text("rosbag2_bagfile_information: {}\n")
+    assert is_raw_bag(raw_bag) and is_raw_bag(folder)
+    assert not is_raw_bag(live[0].path) and not is_raw_bag(live[0].path / "session.yaml")
+    code, output, _ = _map(live[0].path, tmp_path / "map", config_file, "--cloud-topic", "/c")
+    assert code == 2 and "--layout raw" in output
