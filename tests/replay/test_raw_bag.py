@@ -215,6 +215,7 @@ def _cloud_msg(t_s: float, grid: np.ndarray, shape: tuple[int, int]) -> dict[str
 
 def write_raw_bag(path: Path, session: RecordedSession, *, seed: int = 0,
                   drop: tuple[str, ...] = (), camera_gap_s: tuple[float, float] | None = None,
+                  tf_gap_s: tuple[float, float] | None = None, bias_n: float = 0.0,
                   ) -> list[Press]:  # fmt: skip
     """Write ``session``'s presses as a robot's drivers record them; return the timeline."""
     rng = np.random.default_rng(seed)
@@ -256,6 +257,8 @@ def write_raw_bag(path: Path, session: RecordedSession, *, seed: int = 0,
     # the arm, 50 Hz: base_link -> tool0 carries the tip along the press
     for t in np.arange(0.0, end_s, 1 / 50):
         stamp = t + rng.uniform(-0.002, 0.002)
+        if tf_gap_s is not None and tf_gap_s[0] <= stamp <= tf_gap_s[1]:
+            continue
         tip2world = _pose(TIP_YAW, _tip_position(presses, stamp))
         tool2base = np.linalg.inv(BASE2WORLD) @ tip2world @ np.linalg.inv(TIP2TOOL)
         put("/tf", "tf2_msgs/msg/TFMessage",
@@ -264,6 +267,7 @@ def write_raw_bag(path: Path, session: RecordedSession, *, seed: int = 0,
     times = np.arange(0.0, end_s, 1 / 500)
     times = times + rng.uniform(-4e-4, 4e-4, times.size)
     force = _force_on_surface(presses, times) + rng.normal(0.0, 0.002, (times.size, 3))
+    force[:, 2] -= bias_n  # a sensor not zeroed
     sensor2world = TIP_YAW @ SENSOR2TIP[:3, :3]
     reaction = -force @ sensor2world  # = (sensor2world.T @ -f) row by row
     for t, f in zip(times, reaction, strict=True):
@@ -373,6 +377,20 @@ def test_a_press_without_a_frame_in_tolerance_is_refused_naming_it(
     assert len(report["pokes"]) == POKES - 1
 
 
+def test_a_press_without_a_transform_in_tolerance_is_refused_naming_it(
+    live: tuple[RecordedSession, list[Any]], config_file: Path, tmp_path: Path
+) -> None:
+    bag = tmp_path / "tfgap.mcap"
+    hold = presses_hold(live[0], 2)
+    write_raw_bag(bag, live[0], tf_gap_s=(hold[0] - 0.2, hold[1] + 0.2))
+    bag.with_name("tfgap.deformap.yaml").write_text(yaml.safe_dump(_settings(live[0])))
+    code, output, report = _map(bag, tmp_path / "map", config_file)
+    assert code == 0, output
+    assert [s["index"] for s in report["skipped"]] == [2]
+    line = report["skipped"][0]["error"]
+    assert "press 2" in line and "'/tf'" in line and "'tool0'" in line and "s away" in line
+
+
 def presses_hold(session: RecordedSession, index: int) -> tuple[float, float]:
     step = APPROACH + RAMP + HOLD + RELEASE + PAUSE
     start = FIRST_PRESS_S + index * step + APPROACH + RAMP
@@ -474,3 +492,14 @@ def test_the_layout_is_told_apart_and_raw_options_are_refused_on_a_session(
     assert not is_raw_bag(live[0].path) and not is_raw_bag(live[0].path / "session.yaml")
     code, output, _ = _map(live[0].path, tmp_path / "map", config_file, "--cloud-topic", "/c")
     assert code == 2 and "--layout raw" in output
+
+
+def test_a_sensor_not_zeroed_is_refused_when_the_bag_is_opened(
+    live: tuple[RecordedSession, list[Any]], config_file: Path, tmp_path: Path
+) -> None:
+    bag = tmp_path / "bias.mcap"
+    write_raw_bag(bag, live[0], bias_n=0.3)
+    bag.with_name("bias.deformap.yaml").write_text(yaml.safe_dump(_settings(live[0])))
+    code, output, _ = _map(bag, tmp_path / "map", config_file)
+    assert code == 2
+    assert "from its first sample" in output and "not zeroed" in output

@@ -99,6 +99,12 @@ class RawBagReader:
             hold_min_ns=round(cfg.hold_min_s * 1e9),
             merge_ns=round(cfg.stamp_tolerance_s * 1e9), topic=cfg.wrench_topic,
             origin_ns=self.origin_ns)
+        if self.presses and self.presses[0].start == 0:
+            first = float(np.linalg.norm(self.wrench_force[0]))
+            raise FileFormatError(
+                f"{bag}: topic {cfg.wrench_topic!r} reads {first:.4g} N from its first sample, over "
+                f"the contact threshold {cfg.contact_force_n:g} N (`contact_force_n`): a sensor "
+                "not zeroed with the probe free, or a recording started during a press")
         if not self.presses:
             peak = float(np.max(np.linalg.norm(self.wrench_force, axis=1)))
             raise FileFormatError(
