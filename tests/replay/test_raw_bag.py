@@ -26,8 +26,6 @@ from typer.testing import CliRunner
 from deformap.cli import app
 from deformap.environment import PressObservation
 from deformap.replay import RecordedSession, load_session
-from deformap.replay._rawpress import find_presses
-from deformap.replay._rawtf import TransformGap, TransformTree
 from deformap.run import load_run_config, record_simulation
 
 mcap_ros2_writer = pytest.importorskip("mcap_ros2.writer")
@@ -422,52 +420,6 @@ def test_a_bad_yaml_key_is_named(raw_bag: Path, config_file: Path, tmp_path: Pat
     code, output, _ = _map(raw_bag, tmp_path / "map", config_file, "--raw-config", str(settings))
     assert code == 2
     assert "tip_frmae" in output and "unknown key" in output
-
-
-# -- the parts on their own -----------------------------------------------------------------------
-def test_presses_are_found_from_rise_hold_and_release_and_spikes_are_noise() -> None:
-    t = np.arange(0, 4000, dtype=np.int64) * 2_000_000  # 500 Hz, 8 s
-    f = np.zeros(t.size)
-    f[100] = 0.5  # a spike
-    f[1000:1200] = np.linspace(0.0, 1.0, 200)  # a press: ramp, hold, release
-    f[1200:1400] = 1.0
-    f[2000:2200] = np.linspace(0.0, 0.5, 200)  # one that stops at half the command
-    f[2200:2300] = 0.5
-    f[3000:3100], f[3100:3120] = np.linspace(0.0, 1.0, 100), 1.0  # a hold of 40 ms
-    found = find_presses(t, f, commanded_n=1.0, contact_n=0.02, band=0.1,
-                         hold_min_ns=100_000_000, merge_ns=50_000_000, topic="/w")  # fmt: skip
-    assert len(found) == 3
-    assert found[0].error is None and 1000 < found[0].start < 1010
-    assert found[0].hold_start < 1200 < 1399 < found[0].hold_end
-    assert "never reached" in str(found[1].error) and "0.5 N" in str(found[1].error)
-    assert "held the commanded" in str(found[2].error)
-
-
-def test_transforms_interpolate_in_time_and_refuse_a_gap() -> None:
-    from types import SimpleNamespace as NS
-
-    def msg(t_ns: int, parent: str, child: str, xyz: Any, quat: Any) -> Any:
-        stamp = NS(sec=t_ns // 10**9, nanosec=t_ns % 10**9)
-        return NS(transforms=[NS(header=NS(stamp=stamp, frame_id=parent), child_frame_id=child,
-                                 transform=NS(translation=NS(x=xyz[0], y=xyz[1], z=xyz[2]),
-                                              rotation=NS(x=quat[0], y=quat[1], z=quat[2],
-                                                          w=quat[3])))])  # fmt: skip
-
-    tree = TransformTree("/tf", tolerance_ns=50_000_000)
-    q0 = Rotation.identity().as_quat()
-    q1 = Rotation.from_euler("z", 90, degrees=True).as_quat()
-    tree.add(msg(0, "world", "tool", (0, 0, 0), q0), static=False, where="m0")
-    tree.add(msg(40_000_000, "world", "tool", (0.04, 0, 0), q1), static=False, where="m1")
-    tree.add(msg(0, "tool", "tip", (0, 0, -0.1), q0), static=True, where="s")
-    rot, trans = tree.lookup("world", "tip", [20_000_000], what="test")
-    expected = Rotation.from_euler("z", 45, degrees=True).as_matrix()
-    np.testing.assert_allclose(rot[0], expected, atol=1e-12)
-    np.testing.assert_allclose(trans[0], [0.02, 0.0, -0.1], atol=1e-12)
-    # and the inverse direction
-    rot_inv, trans_inv = tree.lookup("tip", "world", [20_000_000], what="test")
-    np.testing.assert_allclose(rot_inv[0] @ trans[0] + trans_inv[0], 0.0, atol=1e-12)
-    with pytest.raises(TransformGap, match=r"test: topic '/tf' .*'tool'.* \(nearest 0\.160 s"):
-        tree.lookup("world", "tip", [200_000_000], what="test")
 
 
 def test_an_observation_picked_after_the_first_contact_is_refused(
