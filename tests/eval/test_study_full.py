@@ -2,9 +2,10 @@
 a summary per condition and per physics, foams the world refuses to press recorded rather than
 fatal, and the summary's numbers checked on hand-made rows.
 
-The CLI test shrinks the matrix (two cameras, one thickness, one physics) through the run layer's
-module constants, and presses a 30 N foam 3 cm thick with 3 N: the world refuses it (the tip
-would sink deeper than the block), while the 110 N foam takes it.
+The CLI test shrinks the matrix to two cameras (the run layer's module constant) and pins one
+thickness and one physics on the command line, and presses a 30 N foam 3 cm thick with 3 N: the
+world refuses it (the tip would sink deeper than the block), while the 250 N foam takes it (a
+110 N one would sink past the tip's radius, where its force–travel record is not read).
 """
 
 from __future__ import annotations
@@ -128,12 +129,13 @@ def test_full_writes_every_condition_with_its_summary(tmp_path: Path,
     from deformap.run import _studies
 
     monkeypatch.setattr(_studies, "FULL_CAMERAS", ("primesense", "kinect-v1"))
-    monkeypatch.setattr(_studies, "FULL_THICKNESSES_M", (0.03,))
-    monkeypatch.setattr(_studies, "FULL_PHYSICS", ("linear-fem",))
     out = tmp_path / "full"
+    # --thickness and --physics given pin those axes of the matrix; the cameras span it
     result = CliRunner().invoke(app, ["study", "hardness", "--full", "--coarse", "--force", "3",
-                                      "--hardness", "30", "--hardness", "110",
-                                      "--out", str(out)])  # fmt: skip
+                                      "--hardness", "30", "--hardness", "250",
+                                      "--thickness", "0.03", "--physics", "linear-fem",
+                                      "--protocol", "force/quadratic", "--protocol",
+                                      "pinned/linear", "--out", str(out)])  # fmt: skip
     assert result.exit_code == 0, (result.output, result.exception)
     assert "per physics" in result.output and "kinect-v1" in result.output, result.output
     study = json.loads((out / "hardness.json").read_text())
@@ -143,7 +145,8 @@ def test_full_writes_every_condition_with_its_summary(tmp_path: Path,
                   for r in study["rows"]}  # fmt: skip
     assert conditions == {("primesense", 0.03, "linear-fem", 3.0),
                           ("kinect-v1", 0.03, "linear-fem", 3.0)}  # fmt: skip
-    assert len(study["rows"]) == 2 * 4 * 3  # conditions × protocols × foams
+    assert len(study["rows"]) == 2 * 2 * 3  # conditions × protocols × foams
+    assert {r["protocol"] for r in study["rows"]} == {"force/quadratic", "pinned/linear"}
     assert [(s["camera"], s["n_refused"]) for s in study["summary"]] == [
         ("primesense", 1), ("kinect-v1", 1)]  # fmt: skip
     for row in study["rows"]:
@@ -151,16 +154,35 @@ def test_full_writes_every_condition_with_its_summary(tmp_path: Path,
             assert "force_n" in row["refused"] and row["beta"] is None
         else:
             assert row["refused"] is None and 0.0 <= row["beta"] < 1.0
-        if row["hardness_n"] == 110.0:
+        if row["hardness_n"] == 250.0:
             errors = row["modulus_rel_errors"]
             assert len(errors) == 3 and all(math.isfinite(e) for e in errors)
             assert np.mean(errors) == pytest.approx(row["modulus_rel_error"])
     for entry in study["summary"]:
         assert entry["n_presses"] == 3 and entry["n_unread"] == 0
         assert 0.0 <= entry["modulus_median_abs_rel_error"] < 1.0
-        assert entry["modulus_monotone"] is True  # 110 N read, rigid read rigid
+        assert entry["modulus_monotone"] is True  # 250 N read, rigid read rigid
     (overall,) = study["overall"]
     assert overall["physics"] == "linear-fem" and overall["n_presses"] == 6
     assert overall["n_refused"] == 2
     with Image.open(out / "hardness.png") as image:
         assert image.format == "PNG" and image.size[0] > 600
+
+
+def test_an_unknown_protocol_is_refused_before_any_world(tmp_path: Path) -> None:
+    out = tmp_path / "study"
+    result = CliRunner().invoke(app, ["study", "hardness", "--protocol", "pinned/cubic",
+                                      "--out", str(out)])  # fmt: skip
+    assert result.exit_code == 2
+    lines = [line for line in result.output.splitlines() if line.strip()]
+    assert len(lines) == 1 and "protocols" in lines[0] and "'pinned/cubic'" in lines[0]
+    assert "force/quadratic" in lines[0] and not out.exists()
+
+
+def test_the_quick_study_fits_the_default_and_the_papers_protocol() -> None:
+    from deformap.eval import DEFAULT_PROTOCOL, PAPER_PROTOCOL, STUDY_PROTOCOLS
+    from deformap.run._studies import _protocols
+
+    assert STUDY_PROTOCOLS == (DEFAULT_PROTOCOL, PAPER_PROTOCOL)
+    assert list(_protocols(None)) == ["force/quadratic", "pinned/quadratic"]
+    assert list(_protocols(["pinned/linear", "pinned/linear"])) == ["pinned/linear"]

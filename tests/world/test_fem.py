@@ -116,3 +116,32 @@ def test_stiffer_foam_dents_less_and_default_force_dents_clearly() -> None:
     assert depths[0] > depths[1] > depths[2]
     assert depths[2] > 1.5 * sigma  # the 150 N foam still dents beyond the pixel noise
     assert depths[0] < 0.025  # less than half of the 5 cm block
+
+
+def test_homogeneous_blocks_share_the_unit_modulus_factorisation_and_solve_exactly() -> None:
+    """Two homogeneous blocks of one mesh solve on one factorisation, scaled by 1/E, and give
+    what a direct sparse solve of their own stiffness gives; a graded block factorises its own."""
+    from scipy.sparse.linalg import spsolve
+
+    grid = _box_grid(0.06, 0.03, 0.01, 0.005, 1.5)
+    load = np.zeros((grid.n_nodes, 3))
+    top = np.flatnonzero(np.isclose(grid.node_xyz()[:, 2], 0.03))
+    load[top[len(top) // 2], 2] = -0.5
+    soft = FoamBody(grid, 2.0e3, poisson_ratio=0.3)
+    hard = FoamBody(grid, 2.0e4, poisson_ratio=0.3)
+    assert hard._lu is soft._lu  # one factorisation for both
+    for body in (soft, hard):
+        k_ff = body.stiffness[body.free][:, body.free].tocsc()
+        direct = spsolve(k_ff, load.ravel()[body.free])
+        np.testing.assert_allclose(body.solve(load).ravel()[body.free], direct, rtol=1e-8,
+                                   atol=1e-15)
+    np.testing.assert_allclose(hard.solve(load), soft.solve(load) / 10.0, rtol=1e-12, atol=0)
+    graded = np.full((grid.nz, grid.ny, grid.nx), 2.0e3)
+    graded[0] = 4.0e3
+    other = FoamBody(grid, graded, poisson_ratio=0.3)
+    assert other._lu is not soft._lu
+    k_ff = other.stiffness[other.free][:, other.free].tocsc()
+    np.testing.assert_allclose(other.solve(load).ravel()[other.free],
+                               spsolve(k_ff, load.ravel()[other.free]), rtol=1e-8, atol=1e-15)
+    # another Poisson ratio is another stiffness
+    assert FoamBody(grid, 2.0e3, poisson_ratio=0.25)._lu is not soft._lu

@@ -52,25 +52,47 @@ def study_hardness(
     ] = None,
     coarse: CoarseOption = False,
     camera: Annotated[
-        str | None, typer.Option(help="Camera preset: primesense | kinect-v1 | realsense-d435.")
+        str | None, typer.Option(help="Camera preset: primesense | kinect-v1 | realsense-d435 "
+                                 "(default primesense; with --full, the matrix's only camera).")
     ] = None,
-    thickness: Annotated[float, typer.Option(help="Foam thickness in metres.")] = 0.05,
+    thickness: Annotated[
+        float | None, typer.Option(help="Foam thickness in metres (default 0.05; with --full, "
+                                   "the matrix's only thickness).")
+    ] = None,
     force: Annotated[float | None, typer.Option(help="Press force in N (default 0.6).")] = None,
     physics: Annotated[
-        str, typer.Option(help="World physics: linear-fem | stiffening-foam (`world.physics`).")
-    ] = "linear-fem",
+        str | None, typer.Option(help="World physics: linear-fem | stiffening-foam "
+                                 "(`world.physics`; default linear-fem; with --full, the "
+                                 "matrix's only physics).")
+    ] = None,
     full: Annotated[
         bool, typer.Option(help="The whole matrix: every camera preset × thickness 0.03, 0.05, "
-                           "0.10 m × both physics (replaces --camera, --thickness, --physics).")
+                           "0.10 m × both physics; --camera, --thickness or --physics given "
+                           "pins that axis.")
     ] = False,
+    protocol: Annotated[
+        list[str] | None, typer.Option(help="Contact protocol whose β is fitted (repeat): "
+                                       "force/quadratic | force/linear | pinned/quadratic | "
+                                       "pinned/linear (default force/quadratic and the "
+                                       "paper's pinned/quadratic).")
+    ] = None,
     json_path: JsonOption = None,
 ) -> None:
     """β and Young's modulus against hardness for each contact protocol (paper Fig. 5a)."""
     shown = out_console(json_path)
     with progress(shown) as bar:
-        output = run.run_hardness_study(out, seed=seed, hardness=hardness, coarse=coarse,
-                                        camera=camera, thickness_m=thickness, force_n=force,
-                                        physics=physics, full=full, hooks=run_hooks(bar))  # fmt: skip
+        if full:  # an axis given on the command line pins it; the others span the matrix
+            output = run.run_hardness_study(
+                out, seed=seed, hardness=hardness, coarse=coarse, force_n=force, full=True,
+                cameras=None if camera is None else [camera],
+                thicknesses_m=None if thickness is None else [thickness],
+                physics_names=None if physics is None else [physics], protocols=protocol,
+                hooks=run_hooks(bar))  # fmt: skip
+        else:
+            output = run.run_hardness_study(
+                out, seed=seed, hardness=hardness, coarse=coarse, camera=camera,
+                thickness_m=0.05 if thickness is None else thickness, force_n=force,
+                physics=physics or "linear-fem", protocols=protocol, hooks=run_hooks(bar))
     if full:
         _print_summary(shown, output.study)
         shown.print(f"wrote {' and '.join(map(str, output.files))}", highlight=False)

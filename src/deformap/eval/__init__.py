@@ -28,7 +28,10 @@ if TYPE_CHECKING:
     from deformap.eval._studies import (
         DEFAULT_HARDNESSES,
         DEFAULT_POSITIONS,
+        DEFAULT_PROTOCOL,
+        PAPER_PROTOCOL,
         PROTOCOLS,
+        STUDY_PROTOCOLS,
         FoamPresses,
         cluster_size_study,
         collect_presses,
@@ -44,7 +47,8 @@ _MODULES = {
     "_bench_msm": ("bench_beta_sweep",),
     "_bench_world": ("bench_world",),
     "_metrics": ("OrderingScores", "RegionScores", "ordering_scores", "region_scores"),
-    "_studies": ("DEFAULT_HARDNESSES", "DEFAULT_POSITIONS", "PROTOCOLS", "FoamPresses",
+    "_studies": ("DEFAULT_HARDNESSES", "DEFAULT_POSITIONS", "DEFAULT_PROTOCOL", "PAPER_PROTOCOL",
+                 "PROTOCOLS", "STUDY_PROTOCOLS", "FoamPresses",
                  "cluster_size_study", "collect_presses", "hardness_study", "hardness_summary"),
     "_table_i": ("PAPER_TABLE_I", "markdown_table", "table_row"),
 }  # fmt: skip
@@ -52,9 +56,12 @@ _MODULES = {
 __all__ = [
     "DEFAULT_HARDNESSES",
     "DEFAULT_POSITIONS",
+    "DEFAULT_PROTOCOL",
     "IO_GOAL_S",
+    "PAPER_PROTOCOL",
     "PAPER_TABLE_I",
     "PROTOCOLS",
+    "STUDY_PROTOCOLS",
     "FoamPresses",
     "OrderingScores",
     "RegionScores",

@@ -27,7 +27,9 @@ __all__ = [
     "DEFAULT_HARDNESSES",
     "DEFAULT_POSITIONS",
     "DEFAULT_PROTOCOL",
+    "PAPER_PROTOCOL",
     "PROTOCOLS",
+    "STUDY_PROTOCOLS",
     "FoamPresses",
     "cluster_size_study",
     "collect_presses",
@@ -54,6 +56,14 @@ PROTOCOLS: dict[str, dict[str, Any]] = {
 DEFAULT_PROTOCOL = "force/quadratic"
 """The protocol of :class:`~deformap.msm.ShapeMatchingConfig`'s defaults, whose rows the summary
 reads."""
+
+PAPER_PROTOCOL = "pinned/quadratic"
+"""The paper's protocol (Caccamo et al.: the particle under the tip pinned at the observed dent),
+reported beside the default."""
+
+STUDY_PROTOCOLS: tuple[str, ...] = (DEFAULT_PROTOCOL, PAPER_PROTOCOL)
+"""The protocols a hardness study runs unless asked for others: the default and the paper's (the
+linear-mode variants on request; each protocol is one β fit per press)."""
 
 CONDITION_KEYS = ("camera", "thickness_m", "physics", "force_n")
 """The keys of a row that name its condition (one combination of a study's matrix)."""

@@ -18,8 +18,11 @@ from typing import Any
 import numpy as np
 
 from deformap._validation import check_positive
+from deformap.errors import InvalidArgumentError
 from deformap.eval import (
     DEFAULT_HARDNESSES,
+    PROTOCOLS,
+    STUDY_PROTOCOLS,
     FoamPresses,
     cluster_size_study,
     collect_presses,
@@ -93,6 +96,7 @@ def run_hardness_study(
     cameras: Sequence[str] | None = None,
     thicknesses_m: Sequence[float] | None = None,
     physics_names: Sequence[str] | None = None,
+    protocols: Sequence[str] | None = None,
     hooks: RunHooks = NO_HOOKS,
 ) -> StudyOutput:
     """β (each contact protocol) and the force–travel reading (stiffness, Young's modulus)
@@ -125,6 +129,9 @@ def run_hardness_study(
     cameras, thicknesses_m, physics_names : sequence, optional
         With ``full``, the matrix's cameras, thicknesses and physics in place of the full ones (a
         smaller matrix).
+    protocols : sequence of str, optional
+        The contact protocols whose β is fitted, names of :data:`~deformap.eval.PROTOCOLS`
+        (default :data:`~deformap.eval.STUDY_PROTOCOLS`: the default one and the paper's).
     hooks : RunHooks
 
     Notes
@@ -142,6 +149,7 @@ def run_hardness_study(
             physics_names or FULL_PHYSICS))  # fmt: skip
     else:
         conditions = [(camera or "primesense", thickness_m, physics)]
+    chosen = _protocols(protocols)
     checked = []
     for name, thickness, physics_name in conditions:  # bad names fail here, before any world
         camera_preset(name)
@@ -163,7 +171,7 @@ def run_hardness_study(
         condition = {"camera": name, "thickness_m": thickness,
                      "force_n": pressed[0] if pressed else _force(force_n),
                      "physics": physics_name}  # fmt: skip
-        single = {**condition, **hardness_study(presses)}
+        single = {**condition, **hardness_study(presses, protocols=chosen)}
         rows.extend({**row, **condition} for row in single["rows"])
     study = {**(single if not full else {"matrix": {
         "cameras": list(dict.fromkeys(c[0] for c in checked)),
@@ -173,6 +181,17 @@ def run_hardness_study(
         "rows": rows, **hardness_summary(rows)}  # fmt: skip
     return StudyOutput(study=study, folder=folder,
                        files=_write(folder, "hardness", study, plot_hardness_study))  # fmt: skip
+
+
+def _protocols(names: Sequence[str] | None) -> dict[str, dict[str, Any]]:
+    """The protocols by name, checked before any world is built."""
+    names = list(STUDY_PROTOCOLS if names is None else names)
+    unknown = [n for n in names if n not in PROTOCOLS]
+    if not names or unknown:
+        raise InvalidArgumentError(
+            f"protocols: expected one or more of {', '.join(PROTOCOLS)}, got "
+            f"{', '.join(map(repr, unknown)) if unknown else 'none'}")
+    return {name: PROTOCOLS[name] for name in dict.fromkeys(names)}
 
 
 def _force(force_n: float | None) -> float:

@@ -10,6 +10,10 @@ Structured assembly: every hex of one layer has the same shape, so its stiffness
 matrix computed by scikit-fem for a unit modulus, scaled by each element's modulus and scattered
 with numpy. This gives the same matrix as scikit-fem's generic ``asm`` (a test checks it) at a
 fraction of the cost. The stiffness is factorised once (SuperLU); each press is then one solve.
+A block of one modulus ``E`` has the stiffness ``E K₁`` of the unit-modulus block, so its solve is
+``K₁⁻¹ f / E``: the factorisation of ``K₁`` is kept (the most recent few, by the mesh's geometry,
+``ν`` and symmetry) and shared by every homogeneous block of that mesh — a study that presses one
+block geometry in several foams factorises once.
 
 References
 ----------
@@ -20,19 +24,25 @@ Journal of Open Source Software 5(52), 2369.
 from __future__ import annotations
 
 import logging
+from collections import OrderedDict
 from dataclasses import dataclass
 from functools import lru_cache
 
 import numpy as np
 import scipy.sparse as sp
 from numpy.typing import NDArray
-from scipy.sparse.linalg import splu
+from scipy.sparse.linalg import SuperLU, splu
 
 from deformap.errors import NotPositiveDefiniteError
 
 __all__ = ["FoamBody", "HexGrid", "graded_levels", "unit_hex_stiffness"]
 
 log = logging.getLogger(__name__)
+
+# Unit-modulus factorisations kept for homogeneous blocks (each holds some tens of MB on the
+# default mesh): a few, the most recently used
+_UNIT_FACTORS: OrderedDict[bytes, SuperLU] = OrderedDict()
+_UNIT_FACTORS_KEPT = 2
 
 # Corner c = ci + 2 cj + 4 ck of a hex, as offsets (ci, cj, ck) from its lowest node.
 _CORNERS = np.array([[c & 1, (c >> 1) & 1, (c >> 2) & 1] for c in range(8)])
@@ -194,7 +204,16 @@ class FoamBody:
                                        (grid.nz, grid.ny, grid.nx))
         self.stiffness = self._assemble()
         self.free = self._free_dofs(symmetry)
-        k_ff = self.stiffness[self.free][:, self.free].tocsc()
+        used = self.modulus[:, grid.active]
+        uniform = used.size > 0 and bool(np.all(used == used.flat[0]))
+        # a homogeneous block solves on the unit-modulus factorisation, scaled (module docstring)
+        self._scale = 1.0 / float(used.flat[0]) if uniform else 1.0
+        key = self._geometry_key(symmetry) if uniform else None
+        if key is not None and key in _UNIT_FACTORS:
+            _UNIT_FACTORS.move_to_end(key)
+            self._lu = _UNIT_FACTORS[key]
+            return
+        k_ff = (self.stiffness * self._scale)[self.free][:, self.free].tocsc()
         try:
             self._lu = splu(k_ff, permc_spec="MMD_AT_PLUS_A",
                             options={"SymmetricMode": True})
@@ -202,6 +221,19 @@ class FoamBody:
             raise NotPositiveDefiniteError(
                 f"foam stiffness could not be factorised: {exc}") from None
         log.debug("factorised %d DOFs", self.free.size)
+        if key is not None:
+            _UNIT_FACTORS[key] = self._lu
+            while len(_UNIT_FACTORS) > _UNIT_FACTORS_KEPT:
+                _UNIT_FACTORS.popitem(last=False)
+
+    def _geometry_key(self, symmetry: tuple[str, ...]) -> bytes:
+        """What the unit-modulus stiffness depends on: the mesh, ``ν`` and the held planes."""
+        g = self.grid
+        head = np.array([*np.asarray(g.origin, dtype=float), g.dx, g.dy, g.nx, g.ny,
+                         self.poisson_ratio], dtype=float)
+        return b"|".join([head.tobytes(), np.asarray(g.levels, dtype=float).tobytes(),
+                          np.packbits(np.asarray(g.active, dtype=bool)).tobytes(),
+                          ",".join(sorted(symmetry)).encode()])
 
     @property
     def n_dofs(self) -> int:
@@ -249,5 +281,5 @@ class FoamBody:
     def solve(self, nodal_force: NDArray[np.float64]) -> NDArray[np.float64]:
         """``(n_nodes, 3)`` displacements in metres for ``(n_nodes, 3)`` nodal forces in newtons."""
         u = np.zeros(3 * self.grid.n_nodes)
-        u[self.free] = self._lu.solve(nodal_force.ravel()[self.free])
+        u[self.free] = self._lu.solve(nodal_force.ravel()[self.free]) * self._scale
         return u.reshape(-1, 3)
