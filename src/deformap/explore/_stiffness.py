@@ -454,8 +454,8 @@ def estimate_stiffness(travel_m: Any, force_n: Any, *, tip_radius_m: float, thic
         not start at contact, a negative force, travel or force going backwards beyond their
         noise, force not rising, a travel not below the thickness (millimetres for metres), a
         last force far from the commanded one, a bad radius or thickness, or a record that leaves
-        the contact model's range (an indentation deeper than the tip's radius, where the
-        stick meets the surface; ``χ`` above 1; an indentation deeper than half the layer; or
+        the contact model's range (an indentation deeper than the tip's diameter, where the
+        sphere is buried and the stick holding it presses too; ``χ`` above 1; an indentation deeper than half the layer; or
         a modulus on the fit's lower bound): the tip sank too deep to read the layer.
     """
     config = StiffnessConfig() if config is None else config
@@ -486,12 +486,12 @@ def estimate_stiffness(travel_m: Any, force_n: Any, *, tip_radius_m: float, thic
     depth_c = float(table.depth_at(np.array([force_c / modulus]))[0])
     chi = float(np.sqrt(radius * depth_c) / thickness)
     strain = depth_c / thickness
-    if depth_c > radius:
+    if depth_c > 2.0 * radius:
         raise InvalidArgumentError(
             f"`force_n`/`travel_m` leave the contact model's range: the tip sank "
-            f"{depth_c * 1e3:.3g} mm, deeper than its {radius * 1e3:.3g} mm radius (`tip_radius_m`), "
-            f"so the stick above the sphere meets the surface and a sphere's contact no longer "
-            f"describes the press")
+            f"{depth_c * 1e3:.3g} mm, more than its {2e3 * radius:.3g} mm diameter "
+            f"(`tip_radius_m` {radius:g} m): the sphere is buried and what holds it above "
+            f"presses the surface too")
     if chi > _MAX_CHI or strain > _MAX_STRAIN or modulus <= 1.001 * table.low_bound:
         raise InvalidArgumentError(
             f"`force_n`/`travel_m` leave the contact model's range (χ = {chi:.2f}, at most "
