@@ -130,6 +130,9 @@ def _good() -> SimpleNamespace:
         (lambda m: setattr(m.fields[2], "offset", 10), r"spans bytes 10\.\.14 of a 12-byte"),
         (lambda m: setattr(m, "data", m.data[:-1]), "holds 47 bytes but 2×2 points"),
         (lambda m: setattr(m, "row_step", 20), "row_step 20 is shorter"),
+        # the header's point count lowered (one row of two): the surplus row is not dropped
+        (lambda m: setattr(m, "height", 1), "24 bytes the header does not count"),
+        (lambda m: setattr(m, "data", m.data + b"\0" * 12), "12 bytes the header does not count"),
         (lambda m: setattr(m, "height", -1), "negative size"),
         (
             lambda m: setattr(m, "data", m.data[:12] + struct.pack("<f", np.nan) + m.data[16:]),

@@ -114,6 +114,14 @@ def pointcloud2_structured(msg: Any) -> NDArray[Any]:
             f"`msg` data holds {data.size} bytes but {height}×{width} points of {point_step} bytes "
             f"(row_step {row_step}) need {need}"
         )
+    # a message holds height·row_step bytes: more is data the header no longer counts (its
+    # height or width lowered), which reading would drop silently
+    most = max(height * row_step, need)
+    if data.size > most:
+        raise InvalidArgumentError(
+            f"`msg` data holds {data.size} bytes but {height}×{width} points of {point_step} bytes "
+            f"(row_step {row_step}) fill {most}: {data.size - most} bytes the header does not count"
+        )
     if row_step == width * point_step or height == 1:
         return np.frombuffer(data, dtype=dtype, count=n)
     rows = np.lib.stride_tricks.as_strided(
