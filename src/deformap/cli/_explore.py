@@ -19,7 +19,7 @@ from deformap.cli._app import (
     out_console,
 )
 from deformap.cli._progress import modulus_text, progress, run_hooks
-from deformap.errors import ConfigError
+from deformap.errors import ConfigError, InvalidArgumentError
 
 if TYPE_CHECKING:  # the CLI loads the estimator only when a command runs
     from deformap.explore import PokeRecord
@@ -135,22 +135,30 @@ def explore_command(
         list[str] | None,
         typer.Option("--env-arg", help="key=value passed to the --environment factory (repeat)."),
     ] = None,
+    variance_max: Annotated[
+        float | None,
+        typer.Option(help="Top of map.png's variance colour scale, the same in every run drawn "
+                     "with it so that runs compare (default: each map's own largest variance)."),
+    ] = None,
     json_path: JsonOption = None,
 ) -> None:
     """Explore a simulated world (or your own Environment): poke until the map field is known,
     then cut it into regions."""
+    if variance_max is not None and not variance_max > 0:  # NaN too
+        raise InvalidArgumentError(f"--variance-max must be a number > 0; got {variance_max}")
     overrides = run.RunOverrides(scenario=scenario, seed=seed, strategy=strategy,
                                  threshold=threshold, max_pokes=max_pokes,
                                  field=field)  # fmt: skip
     if environment is not None or env_arg:
         _explore_environment(environment, env_arg or [], scenario, resume, rerun, config,
-                             overrides, out, json_path)
+                             overrides, out, json_path, variance_max)
         return
     cfg = run.explore_run_config(config, overrides, resume)
     shown = out_console(json_path)
     with progress(shown) as bar:
         output = run.explore_scenario(cfg, resume or out, resume=resume is not None, rerun=rerun,
-                                      hooks=run_hooks(bar, poke_row=poke_row))  # fmt: skip
+                                      hooks=run_hooks(bar, poke_row=poke_row),
+                                      variance_max=variance_max)  # fmt: skip
     _summary(shown, output.report, output.folder)
     emit_json(json_path, output.report)
 
@@ -174,7 +182,8 @@ def config_dump(
 
 def _explore_environment(environment: str | None, env_args: list[str], scenario: str | None,
                          resume: Path | None, rerun: bool, config: Path | None,
-                         overrides: Any, out: Path | None, json_path: Path | None) -> None:
+                         overrides: Any, out: Path | None, json_path: Path | None,
+                         variance_max: float | None) -> None:
     """``explore --environment``: a user's Environment, no ground truth to score against."""
     if environment is None:
         raise ConfigError("--env-arg goes with --environment package.module:factory; got no "
@@ -189,7 +198,8 @@ def _explore_environment(environment: str | None, env_args: list[str], scenario:
     shown = out_console(json_path)
     with progress(shown) as bar:
         report, folder = run.explore_environment(environment, args, cfg, out,
-                                                 hooks=run_hooks(bar, poke_row=poke_row))
+                                                 hooks=run_hooks(bar, poke_row=poke_row),
+                                                 variance_max=variance_max)
     regions = report["regions"]
     found = "no region map" if regions is None else f"{len(regions['class_betas'])} region(s)"
     shown.print(f"{report['n_pokes']} pokes (stopped by {report['stop_reason']}), {found}, "

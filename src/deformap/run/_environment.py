@@ -97,8 +97,11 @@ def explore_environment(
     *,
     figures: bool = True,
     hooks: RunHooks = NO_HOOKS,
+    variance_max: float | None = None,
 ) -> tuple[dict[str, Any], Path]:
     """Explore the Environment ``spec`` returns (module docstring); ``(report, folder)``.
+
+    ``variance_max`` fixes the top of ``map.png``'s variance colour scale (so that runs compare).
 
     The run folder is new or empty (default ``runs/<factory>-explore-s<seed>-<time>``); the
     environment is built before the folder is made, so that a spec that does not load leaves
@@ -125,5 +128,6 @@ def explore_environment(
               **shared_report(result, truth=None)}  # fmt: skip
     report["timings"]["wall_s"] = time.perf_counter() - t0
     write_run_results(folder, result, report, figures=figures, poke_figures=False,
-                      title=f"{spec}: {len(result.pokes)} pokes", hooks=hooks)
+                      title=f"{spec}: {len(result.pokes)} pokes", hooks=hooks,
+                      variance_max=variance_max)
     return report, folder

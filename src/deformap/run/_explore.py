@@ -164,6 +164,7 @@ def explore_scenario(
     figures: bool = True,
     rerun: bool = False,
     hooks: RunHooks = NO_HOOKS,
+    variance_max: float | None = None,
 ) -> RunOutput:
     """Explore ``config.scenario``, score the map against ground truth, write the run folder.
 
@@ -182,6 +183,8 @@ def explore_scenario(
         Write ``run.rrd`` (extra ``rerun``).
     hooks : RunHooks
         Progress callbacks.
+    variance_max : float, optional
+        A fixed top of ``map.png``'s variance colour scale, so that runs compare.
 
     Returns
     -------
@@ -223,10 +226,10 @@ def explore_scenario(
     report = live_report(config, result, world, world_build_s=world_s)
     write_run_results(folder, result, report, figures=figures, truth=world, poke_figures=False,
                       title=f"{config.scenario} (seed {config.seed}): {len(result.pokes)} pokes",
-                      hooks=hooks)  # fmt: skip
+                      hooks=hooks, variance_max=variance_max)  # fmt: skip
     if figures:
         _redraw_resumed_pokes(folder, result, world, config.exploration)
     if rerun:
         hooks.stage("writing run.rrd")
-        write_rerun(folder / "run.rrd", result)
+        write_rerun(folder / "run.rrd", result, truth=world)
     return RunOutput(report=report, result=result, world=world, folder=folder)
