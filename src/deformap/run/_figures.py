@@ -118,13 +118,22 @@ def write_estimate_figures(folder: Path, poke: PokeResult) -> list[Path]:
 
 
 def write_rerun(path: Path, result: ExplorationResult, *, truth: Any = None) -> Path:
-    """The run as a rerun recording (extra ``rerun``), starting from the surface's points; with
-    ``truth`` (an object with ``ground_truth_hardness(xs, ys)``) its ground truth too."""
+    """The run as a rerun recording (extra ``rerun``), starting from the surface's points.
+
+    With ``truth`` (a simulated world: ``ground_truth_hardness(xs, ys)`` and its probe in
+    ``config.probe``) the recording holds the ground truth and, per poke, the robot's hull: the
+    probe's ``robot_points`` at the poke's tip centre, pressing straight down as the simulated
+    world does.
+    """
     from deformap.viz import record_run
 
     surface = result.surface
     if surface is None:  # pragma: no cover - explore() fits the surface before any poke
         raise RuntimeError("the exploration has no surface model")
     truth_hardness = None if truth is None else truth.ground_truth_hardness(result.xs, result.ys)
+    probe = getattr(getattr(truth, "config", None), "probe", None)
+    hulls = None if probe is None else [
+        probe.robot_points(np.asarray(p.record.contact.tip_center), np.array([0.0, 0.0, 1.0]))
+        for p in result.pokes]  # fmt: skip
     return Path(record_run(path, result, initial_points=surface.points,
-                           truth_hardness=truth_hardness))
+                           truth_hardness=truth_hardness, robot_points=hulls))
