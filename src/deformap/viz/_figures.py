@@ -37,12 +37,13 @@ _MARKS = {"first": ("o", "first poke"), "variance": ("^", "later pokes"),
           "boundary": ("s", "boundary pokes")}  # fmt: skip
 _HALO = [patheffects.withStroke(linewidth=3.5, foreground="w")]
 _REGION_COLOUR, _THRESHOLD_COLOUR = "c", "r"
+Extent = tuple[float, float, float, float]
 
 
-def _extent(xs: NDArray, ys: NDArray) -> list[float]:
+def _extent(xs: NDArray, ys: NDArray) -> Extent:
     dx = (xs[1] - xs[0]) / 2 if xs.size > 1 else 0.0025
     dy = (ys[1] - ys[0]) / 2 if ys.size > 1 else 0.0025
-    return [xs[0] - dx, xs[-1] + dx, ys[0] - dy, ys[-1] + dy]
+    return (float(xs[0] - dx), float(xs[-1] + dx), float(ys[0] - dy), float(ys[-1] + dy))
 
 
 def _purposes(n: int, purposes: Sequence[str | None] | None) -> list[str]:
@@ -186,7 +187,7 @@ def plot_map(
         if a.get_label() != "<colorbar>":
             a.set_xlabel("x [m]")
             a.set_ylabel("y [m]")
-    _legend(fig, kinds, regions=labels is not None and np.ptp(labels) > 0,
+    _legend(fig, kinds, regions=labels is not None and bool(np.ptp(labels) > 0),
             threshold=threshold if drawn else None)
     if title:
         fig.suptitle(title)
@@ -195,7 +196,7 @@ def plot_map(
     return fig
 
 
-def _truth_panel(fig: Figure, ax: Axes, xs: NDArray, ys: NDArray, ext: list[float],
+def _truth_panel(fig: Figure, ax: Axes, xs: NDArray, ys: NDArray, ext: Extent,
                  truth_hardness: NDArray) -> None:
     shown = np.where(np.isinf(truth_hardness), np.nan, truth_hardness)
     im = ax.imshow(shown, origin="lower", extent=ext, cmap="viridis_r")
@@ -206,7 +207,7 @@ def _truth_panel(fig: Figure, ax: Axes, xs: NDArray, ys: NDArray, ext: list[floa
     ax.set_title("ground truth")
 
 
-def _variance_panel(fig: Figure, ax: Axes, xs: NDArray, ys: NDArray, ext: list[float],
+def _variance_panel(fig: Figure, ax: Axes, xs: NDArray, ys: NDArray, ext: Extent,
                     variance: NDArray, threshold: float | None, variance_max: float | None, *,
                     modulus: bool) -> bool:
     """The variance from 0 to ``variance_max`` (or its own maximum), the T_h contour labelled;
@@ -264,7 +265,7 @@ def _regions(ax: Axes, xs: NDArray, ys: NDArray, values: NDArray, labels: NDArra
                        linestyles="solid" if main else "dashed")  # fmt: skip
 
 
-def _modulus_panel(fig: Figure, ax: Axes, ext: list[float], modulus_pa: NDArray) -> None:
+def _modulus_panel(fig: Figure, ax: Axes, ext: Extent, modulus_pa: NDArray) -> None:
     """E in kPa on a log colour scale spanning at least a factor of ten."""
     kpa = np.asarray(modulus_pa, dtype=float) / 1e3
     finite = kpa[np.isfinite(kpa) & (kpa > 0)]
@@ -272,7 +273,7 @@ def _modulus_panel(fig: Figure, ax: Axes, ext: list[float], modulus_pa: NDArray)
     mid = np.sqrt(low * high)
     if high / low < 10.0:
         low, high = mid / np.sqrt(10.0), mid * np.sqrt(10.0)
-    im = ax.imshow(kpa, origin="lower", extent=(ext[0], ext[1], ext[2], ext[3]), cmap="viridis",
+    im = ax.imshow(kpa, origin="lower", extent=ext, cmap="viridis",
                    norm=LogNorm(vmin=low, vmax=high))  # fmt: skip
     bar = fig.colorbar(im, ax=ax, label="Young's modulus E [kPa] (log scale)")
     decades = float(np.log10(high / low))

@@ -12,6 +12,7 @@ Built on :class:`matplotlib.figure.Figure` without ``pyplot``; written atomicall
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from matplotlib.axes import Axes
@@ -35,7 +36,8 @@ Khoshelham, K., Elberink, S. O. (2012). Accuracy and resolution of Kinect depth 
 mapping applications. Sensors 12(2), 1437–1454.
 """
 
-_BELOW = {"loc": "upper center", "bbox_to_anchor": (0.5, -0.2), "fontsize": 8, "frameon": False}
+_BELOW: dict[str, Any] = {"loc": "upper center", "bbox_to_anchor": (0.5, -0.2), "fontsize": 8,
+                          "frameon": False}  # fmt: skip
 
 
 def plot_beta_curve(ax: Axes, betas: NDArray, errors: NDArray, beta_hat: float, std: float) -> None:

@@ -64,8 +64,9 @@ def plot_hardness_study(study: dict[str, Any], *, path: str | Path | None = None
                        key=lambda r: -r["hardness_n"])  # fmt: skip
         mono = study.get("monotone", {}).get(protocol)
         label = protocol + ("" if mono is None else (" ✓ monotone" if mono else " ✗ not monotone"))
-        style = {"color": f"C{i % 10}", "marker": _MARKERS[i % len(_MARKERS)], "capsize": 3,
-                 "ls": _LINES[i % len(_LINES)], "mfc": "none", "mew": 1.5}  # fmt: skip
+        style: dict[str, Any] = {"color": f"C{i % 10}", "marker": _MARKERS[i % len(_MARKERS)],
+                                 "capsize": 3, "ls": _LINES[i % len(_LINES)], "mfc": "none",
+                                 "mew": 1.5}  # fmt: skip
         if foams:
             ax.errorbar([r["hardness_n"] * dodge for r in foams], [r["beta"] for r in foams],
                         yerr=np.nan_to_num([r["beta_std"] for r in foams]), label=label,
