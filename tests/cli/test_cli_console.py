@@ -142,3 +142,15 @@ def test_no_warning_filter_is_left_changed_by_configuring() -> None:
         logging.captureWarnings(False)
         logging.getLogger("deformap").setLevel(logging.NOTSET)
         logging.getLogger("py.warnings").setLevel(logging.NOTSET)
+
+
+def test_study_and_record_help_show_their_defaults() -> None:
+    from deformap.cli import _studies
+    from deformap.eval import DEFAULT_HARDNESSES
+
+    foams = ", ".join(f"{h:g}" for h in DEFAULT_HARDNESSES if h is not None)
+    assert _studies.STUDY_HARDNESSES_HELP == f"{foams} and rigid" and None in DEFAULT_HARDNESSES
+    result = runner.invoke(app, ["study", "hardness", "--help"], env={"COLUMNS": "200"})
+    assert f"[default: ({foams} and rigid)]" in result.output
+    result = runner.invoke(app, ["record-sim", "--help"], env={"COLUMNS": "200"})
+    assert "[default: (0)]" in result.output and "[default: (12)]" in result.output

@@ -18,7 +18,7 @@ from deformap.cli._app import (
     labelled,
     out_console,
 )
-from deformap.cli._explore import modulus_summary
+from deformap.cli._explore import HELP_DEFAULTS, modulus_summary
 from deformap.cli._progress import modulus_text, progress, run_hooks
 from deformap.errors import InvalidArgumentError
 
@@ -50,8 +50,12 @@ def record_sim_command(
         typer.Option(help="New session folder (default runs/<scenario>-record-s<seed>-<time>)."),
     ] = None,
     format: Annotated[str, typer.Option("--format", help="folder | mcap | sqlite3.")] = "folder",
-    seed: Annotated[int | None, typer.Option(help="Seed of world noise and poke choice.")] = None,
-    pokes: Annotated[int | None, typer.Option("--pokes", help="Most pokes to make.")] = None,
+    seed: Annotated[int | None, typer.Option(
+        help="Seed of world noise and poke choice.",
+        show_default=str(HELP_DEFAULTS["seed"]))] = None,
+    pokes: Annotated[int | None, typer.Option(
+        "--pokes", help="Most pokes to make.",
+        show_default=str(HELP_DEFAULTS["exploration.max_pokes"]))] = None,
     config: ConfigOption = None,
     json_path: JsonOption = None,
 ) -> None:
