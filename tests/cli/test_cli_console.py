@@ -154,3 +154,26 @@ def test_study_and_record_help_show_their_defaults() -> None:
     assert f"[default: ({foams} and rigid)]" in result.output
     result = runner.invoke(app, ["record-sim", "--help"], env={"COLUMNS": "200"})
     assert "[default: (0)]" in result.output and "[default: (12)]" in result.output
+
+
+def test_explore_variance_max_reaches_the_run_and_a_bad_one_is_one_line(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    from deformap import run
+
+    seen: dict[str, Any] = {}
+
+    class Stop(Exception):
+        pass
+
+    def stop(*args: Any, **kwargs: Any) -> Any:
+        seen.update(kwargs)
+        raise Stop
+
+    monkeypatch.setattr(run, "explore_scenario", stop)
+    result = runner.invoke(app, ["explore", "-s", "homogeneous-60", "--variance-max", "0.5"])
+    assert isinstance(result.exception, Stop) and seen["variance_max"] == 0.5
+    for bad in ("0", "-1", "nan"):
+        result = runner.invoke(app, ["explore", "-s", "homogeneous-60", "--variance-max", bad])
+        assert result.exit_code == 2
+        assert f"--variance-max must be a number > 0; got {float(bad)}" in result.output

@@ -98,7 +98,9 @@ def record_run(path: str | Path, result: Any, *, initial_points: NDArray[np.floa
 def hull_mesh(points: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
     """Vertices ``(v, 3)`` and triangles ``(t, 3)`` of the convex hull of ``points (m, 3)``."""
     hull = ConvexHull(points)
-    return points[hull.vertices], np.searchsorted(hull.vertices, hull.simplices)
+    index = np.full(len(points), -1, dtype=np.int64)
+    index[hull.vertices] = np.arange(hull.vertices.size)
+    return points[hull.vertices], index[hull.simplices]
 
 
 def _blueprint() -> Any:
