@@ -327,3 +327,12 @@ def test_each_poke_figure_draws_the_simulated_dent_at_its_beta(
         path = write_poke_figure(tmp_path, poke)
         assert path.exists()
         assert np.array_equal(drawn["simulated_z"], surface[..., 2])
+
+
+def test_a_bad_variance_max_is_refused_before_any_folder(tmp_path: Path) -> None:
+    from deformap.errors import InvalidArgumentError
+
+    for bad in (0.0, -1.0, float("nan")):
+        with pytest.raises(InvalidArgumentError, match="`variance_max` must be"):
+            explore_scenario(_config(), tmp_path / "run", variance_max=bad)
+    assert not (tmp_path / "run").exists()

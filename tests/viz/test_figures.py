@@ -265,7 +265,7 @@ def test_map_figure_legend_threshold_label_and_region_values() -> None:
     fig = plot_map(*args, **kwargs, modulus_pa=np.where(gx < 0.3, 6e3, 2e4))
     names = sorted(t.get_text() for t in _panels(fig)[2].texts if t.get_text().startswith("R"))
     assert names == ["R1: E = 6 kPa", "R2: E = 20 kPa"]
-    with pytest.raises(ValueError, match="purposes"):
+    with pytest.raises(InvalidArgumentError, match="purposes"):
         plot_map(*args, **kwargs, purposes=["first"])
 
 
@@ -277,7 +277,7 @@ def test_map_figure_variance_scale_can_be_fixed_so_runs_compare() -> None:
     fixed = _panels(fig)[-1].get_images()[0]
     assert fixed.get_clim() == (0.0, 0.5)
     assert _colorbar_labels(fig)[-1] == "var(β) (fixed scale)"
-    with pytest.raises(ValueError, match="variance_max"):
+    with pytest.raises(InvalidArgumentError, match="variance_max"):
         plot_map(*args, **kwargs, variance_max=0.0)
 
 

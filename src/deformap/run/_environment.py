@@ -23,6 +23,7 @@ import yaml
 
 from deformap import __version__
 from deformap._config import config_to_dict
+from deformap._validation import check_positive
 from deformap.environment import Environment
 from deformap.errors import ConfigError
 from deformap.explore import Journal, check_exploration_budget, explore
@@ -107,6 +108,8 @@ def explore_environment(
     environment is built before the folder is made, so that a spec that does not load leaves
     nothing behind. ``config.world`` and ``config.scenario`` are not used.
     """
+    if variance_max is not None:  # before any work
+        check_positive("variance_max", variance_max)
     env = load_environment(spec, env_args)
     check_exploration_budget(config.exploration, env.workspace)
     folder = out or default_run_folder(spec.partition(":")[2], "explore", config.seed)

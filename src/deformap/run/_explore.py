@@ -18,6 +18,7 @@ from typing import Any
 
 from deformap import __version__
 from deformap._config import config_from_dict, config_to_dict
+from deformap._validation import check_positive
 from deformap.errors import ConfigError, DeformapError, FileFormatError
 from deformap.explore import (
     JOURNAL_NAME,
@@ -196,6 +197,8 @@ def explore_scenario(
         Unknown scenario; ``out`` not empty, or not creatable (before any work); on resume, no
         run there or a different configuration.
     """
+    if variance_max is not None:  # before any work
+        check_positive("variance_max", variance_max)
     if resume and out is None:
         raise ConfigError("`out` must name the run folder to resume; got None")
     scenario = load_scenario(config.scenario)

@@ -28,6 +28,7 @@ from matplotlib.ticker import FuncFormatter
 from numpy.typing import NDArray
 from scipy.ndimage import distance_transform_edt
 
+from deformap.errors import InvalidArgumentError
 from deformap.viz._save import save_figure
 
 __all__ = ["plot_map"]
@@ -51,7 +52,8 @@ def _purposes(n: int, purposes: Sequence[str | None] | None) -> list[str]:
     if purposes is None:
         return ["first"] + ["variance"] * (n - 1) if n else []
     if len(purposes) != n:
-        raise ValueError(f"`purposes` must have one entry per contact ({n}); got {len(purposes)}")
+        raise InvalidArgumentError(
+            f"`purposes` must have one entry per contact ({n}); got {len(purposes)}")
     return [p if p in _MARKS else ("first" if i == 0 else "variance")
             for i, p in enumerate(purposes)]  # fmt: skip
 
@@ -147,8 +149,8 @@ def plot_map(
     """
     if region_field == "modulus" and modulus_pa is None:
         raise ValueError("`modulus_pa` is required when `region_field` is 'modulus'")
-    if variance_max is not None and not variance_max > 0:
-        raise ValueError(f"`variance_max` must be a number > 0; got {variance_max!r}")
+    if variance_max is not None and not variance_max > 0:  # NaN too
+        raise InvalidArgumentError(f"`variance_max` must be a number > 0; got {variance_max!r}")
     contacts = np.asarray(contacts, dtype=float).reshape(-1, 2)
     kinds = _purposes(len(contacts), purposes)
     panels = 2 + (truth_hardness is not None) + (modulus_pa is not None)
