@@ -120,8 +120,7 @@ def _blueprint() -> Any:
             ),
             column_shares=[3, 2],
         ),
-        collapse_panels=True,
-    )
+    )  # the side and time panels stay open: the time panel steps through the pokes
 
 
 def _log_run(rec: Any, result: Any, pts: NDArray[np.float64]) -> None:
