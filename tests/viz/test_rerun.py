@@ -43,6 +43,10 @@ def test_record_run_writes_a_recording_rerun_can_read(tmp_path) -> None:
     assert "AnnotationContext:context" in columns["/maps/regions"]
     # a blueprint the viewer opens on, stored with the recording
     assert [b.kind for b in reader.blueprints()] == ["blueprint"]
+    layout = {str(c.entity_path) for c in reader.stream(store=reader.blueprints()[0])}
+    views = {e for e in layout if e.startswith("/view/") and e.count("/") == 2}
+    # the 3D scene, four maps, the regions and the time series, in three containers
+    assert len(views) == 7 and sum(e.startswith("/container/") for e in layout) == 3
     # without a world: no ground truth, no robot hull
     assert "/maps/truth_hardness_n" not in entities and "/world/press/robot_hull" not in entities
 
