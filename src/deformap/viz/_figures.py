@@ -15,7 +15,7 @@ and GUI applications, which keep their own backend and display the returned figu
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 import numpy as np
@@ -162,25 +162,17 @@ def plot_map(
     n_regions = "" if labels is None else f", {len(np.unique(labels))} region(s)"
     ax = axes.pop(0)
     im = ax.imshow(beta, origin="lower", extent=ext, cmap="magma", vmin=0.0, vmax=1.0)
-    _regions(ax, xs, ys, beta, labels, levels if region_field == "beta" else None,
-             main=region_field == "beta")  # fmt: skip
     fig.colorbar(im, ax=ax, label="β (deformability) [–]")
     ax.set_title(f"β-field{n_regions if region_field == 'beta' else ''}")
-    _contacts(ax, contacts, kinds)
-    if labels is not None:
-        _region_names(ax, xs, ys, labels, {k: f"β = {v:.2f}" for k, v in
-                                           _region_means(labels, beta).items()})  # fmt: skip
+    _field_overlay(ax, xs, ys, beta, labels, levels, contacts, kinds,
+                   main=region_field == "beta", name=lambda v: f"β = {v:.2f}")  # fmt: skip
     if modulus_pa is not None:
         ax = axes.pop(0)
         _modulus_panel(fig, ax, ext, modulus_pa)
-        log_e = np.log(modulus_pa)
-        _regions(ax, xs, ys, log_e, labels, levels if region_field == "modulus" else None,
-                 main=region_field == "modulus")  # fmt: skip
         ax.set_title(f"modulus field{n_regions if region_field == 'modulus' else ''}")
-        _contacts(ax, contacts, kinds)
-        if labels is not None:
-            _region_names(ax, xs, ys, labels, {k: f"E = {np.exp(v) / 1e3:.3g} kPa" for k, v in
-                                               _region_means(labels, log_e).items()})  # fmt: skip
+        _field_overlay(ax, xs, ys, np.log(modulus_pa), labels, levels, contacts, kinds,
+                       main=region_field == "modulus",
+                       name=lambda v: f"E = {np.exp(v) / 1e3:.3g} kPa")  # fmt: skip
     ax = axes.pop(0)
     drawn = _variance_panel(fig, ax, xs, ys, ext, variance, threshold, variance_max,
                             modulus=region_field == "modulus")  # fmt: skip
@@ -196,6 +188,18 @@ def plot_map(
     if path is not None:
         save_figure(fig, path, dpi=110)
     return fig
+
+
+def _field_overlay(ax: Axes, xs: NDArray, ys: NDArray, values: NDArray, labels: NDArray | None,
+                   levels: NDArray | None, contacts: NDArray, kinds: list[str], *, main: bool,
+                   name: Callable[[float], str]) -> None:
+    """On one field's panel: the regions (its isopleths ``levels`` when the regions were cut from
+    it, ``main``), the pokes, and each region named with ``name`` of its mean of ``values``."""
+    _regions(ax, xs, ys, values, labels, levels if main else None, main=main)
+    _contacts(ax, contacts, kinds)
+    if labels is not None:
+        _region_names(ax, xs, ys, labels,
+                      {k: name(v) for k, v in _region_means(labels, values).items()})
 
 
 def _truth_panel(fig: Figure, ax: Axes, xs: NDArray, ys: NDArray, ext: Extent,
