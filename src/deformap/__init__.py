@@ -21,12 +21,89 @@ The packages, what each owns and may import, the data flow and the contracts are
 - :mod:`deformap.run`: the application layer (run configuration, folders, reports, workflows);
 - :mod:`deformap.cli`: the ``deformap`` command over :mod:`deformap.run`;
 - :mod:`deformap.testing`: fixtures and tolerance helpers for tests.
+
+The main entry points are names of ``deformap`` itself (``deformap.SimulatedWorld``,
+``deformap.ExplorationConfig``, ``deformap.GaussianRandomField``, …, listed in ``__all__``), and
+the packages are its attributes (``deformap.explore.explore``, the loop, whose name is its
+package's); each is imported on first use, so ``import deformap`` stays cheap (the command line's
+``--help`` loads neither the world nor the estimator).
 """
 
 from __future__ import annotations
 
+import importlib
+from typing import TYPE_CHECKING, Any
+
 __version__ = "0.1.0"
 
+from deformap._lazy import lazy_exports
 from deformap.errors import DeformapError
 
-__all__ = ["DeformapError", "__version__"]
+if TYPE_CHECKING:  # the names a user imports from deformap; loaded on first use (below)
+    from deformap.cloud import PointCloud
+    from deformap.environment import (
+        Environment,
+        ForceTravel,
+        PressObservation,
+        TactileContact,
+        Workspace,
+    )
+    from deformap.explore import ExplorationConfig, ExplorationResult, PokeRecord
+    from deformap.gp import GaussianRandomField
+    from deformap.msm import BetaEstimate, ShapeMatchingConfig, estimate_beta
+    from deformap.replay import load_session, map_session, write_session
+    from deformap.run import RunConfig, explore_scenario
+    from deformap.world import SimulatedWorld, WorldConfig, list_scenarios, load_scenario
+
+# the subpackage each main entry point lives in (its public name, imported on first use)
+_MODULES = {
+    "cloud": ("PointCloud",),
+    "environment": ("Environment", "ForceTravel", "PressObservation", "TactileContact",
+                    "Workspace"),
+    "explore": ("ExplorationConfig", "ExplorationResult", "PokeRecord"),
+    "gp": ("GaussianRandomField",),
+    "msm": ("BetaEstimate", "ShapeMatchingConfig", "estimate_beta"),
+    "replay": ("load_session", "map_session", "write_session"),
+    "run": ("RunConfig", "explore_scenario"),
+    "world": ("SimulatedWorld", "WorldConfig", "list_scenarios", "load_scenario"),
+}  # fmt: skip
+
+__all__ = [
+    "BetaEstimate",
+    "DeformapError",
+    "Environment",
+    "ExplorationConfig",
+    "ExplorationResult",
+    "ForceTravel",
+    "GaussianRandomField",
+    "PointCloud",
+    "PokeRecord",
+    "PressObservation",
+    "RunConfig",
+    "ShapeMatchingConfig",
+    "SimulatedWorld",
+    "TactileContact",
+    "Workspace",
+    "WorldConfig",
+    "__version__",
+    "estimate_beta",
+    "explore_scenario",
+    "list_scenarios",
+    "load_scenario",
+    "load_session",
+    "map_session",
+    "write_session",
+]  # fmt: skip
+
+# a subpackage as an attribute of deformap (``deformap.gp``) without importing it first; no name
+# above is a subpackage's (``explore()`` stays ``deformap.explore.explore``: as ``deformap.explore``
+# it would hide its package once that is imported)
+_PACKAGES = ("cloud", "environment", "eval", "explore", "gp", "mechanics", "msm", "replay", "run",
+             "viz", "world")  # fmt: skip
+_names_getattr, __dir__ = lazy_exports(__name__, _MODULES, [*__all__, *_PACKAGES], globals())
+
+
+def __getattr__(name: str) -> Any:
+    if name in _PACKAGES:
+        return importlib.import_module(f"{__name__}.{name}")
+    return _names_getattr(name)

@@ -296,3 +296,43 @@ def test_a_run_killed_with_sigkill_resumes_to_the_same_result(tmp_path, full_run
     assert [json.loads(line)["beta"] for line in kept] == [
         p["beta"] for p in report["pokes"][: len(kept)]
     ]
+
+
+def test_each_poke_figure_draws_the_simulated_dent_at_its_beta(
+    full_run, tmp_path: Path, monkeypatch: pytest.MonkeyPatch  # type: ignore[no-untyped-def]
+) -> None:
+    import numpy as np
+    from scipy.spatial import cKDTree
+
+    import deformap.viz
+    from deformap.run._figures import write_poke_figure
+
+    drawn: dict[str, object] = {}
+    real = deformap.viz.plot_poke
+
+    def spy(**kwargs: object) -> object:
+        drawn.update(kwargs)
+        return real(**kwargs)
+
+    monkeypatch.setattr(deformap.viz, "plot_poke", spy)
+    for poke in full_run.result.pokes:
+        dent, record = poke.dent, poke.record
+        surface = poke.estimate.surface
+        assert surface.shape == (*dent.rest_z.shape, 3)
+        # the body kept is β̂'s: its matching error is E(β̂) of the record
+        gx, gy = np.meshgrid(dent.roi_xs, dent.roi_ys)
+        observed = np.column_stack([gx.ravel(), gy.ravel(), dent.deformed_z.ravel()])
+        error = cKDTree(observed).query(surface.reshape(-1, 3))[0].mean()
+        assert error == pytest.approx(record.errors[record.betas.index(record.beta)], rel=1e-6)
+        path = write_poke_figure(tmp_path, poke)
+        assert path.exists()
+        assert np.array_equal(drawn["simulated_z"], surface[..., 2])
+
+
+def test_a_bad_variance_max_is_refused_before_any_folder(tmp_path: Path) -> None:
+    from deformap.errors import InvalidArgumentError
+
+    for bad in (0.0, -1.0, float("nan")):
+        with pytest.raises(InvalidArgumentError, match="`variance_max` must be"):
+            explore_scenario(_config(), tmp_path / "run", variance_max=bad)
+    assert not (tmp_path / "run").exists()

@@ -145,7 +145,7 @@ def test_map_figure_panels_labels_and_colour_bars() -> None:
     assert all((ax.get_xlabel(), ax.get_ylabel()) == ("x [m]", "y [m]") for ax in panels)
     assert _colorbar_labels(fig) == [
         "hardness H [N] (grey: rigid)",
-        "β (deformability)",
+        "β (deformability) [–]",
         "var(β)",
     ]
     assert fig.get_suptitle() == "two blocks"
@@ -196,23 +196,89 @@ def test_poke_figure_panels_and_labels() -> None:
     assert [ax.get_title() for ax in panels] == [
         "ROI before (surface GP)",
         "cloud while pressing (robot removed)",
-        "section through the contact",
         "shape-matching error E(β)",
+        "observed dent (touch GP)",
+        "shape matching at β̂ = 0.400",
+        "section through the contact (y = 0.000 m)",
     ]
+    # every panel names its axes with units
     assert [(ax.get_xlabel(), ax.get_ylabel()) for ax in panels] == [
-        ("x [m]", "y [m]"),
-        ("x [m]", "y [m]"),
-        ("x [cm]", "z [mm]"),
-        ("β", "E(β) [mm]"),
-    ]
-    assert _colorbar_labels(fig) == ["z [mm]", "z [mm]"]
-    section = panels[2].get_legend()
+        ("x [m]", "y [m]"), ("x [m]", "y [m]"), ("β [–]", "E(β) [mm]"),
+        ("x [m]", "y [m]"), ("x [m]", "y [m]"), ("x [m]", "z [mm]"),
+    ]  # fmt: skip
+    assert _colorbar_labels(fig) == ["z [mm] (own scale)", "z [mm]", "z [mm]", "z [mm]"]
+    section = panels[5].get_legend()
     assert [t.get_text() for t in section.get_texts()] == [
-        "before",
+        "before (surface GP)",
         "observed dent (touch GP)",
         "shape matching at β̂",
         "cloud points on the section",
     ]
+    # the legends sit below their axes, where they cover no data (the dent is mid-section)
+    for ax in (panels[1], panels[5]):
+        assert ax.get_legend()._loc == 9 and ax.get_legend().get_bbox_to_anchor().y1 < \
+            ax.get_window_extent().y0 + 1
+    # the simulated dent is drawn beside the observed one, on the same colour scale
+    observed, simulated = panels[3].get_images()[0], panels[4].get_images()[0]
+    assert observed.get_clim() == simulated.get_clim()
+    assert np.allclose(simulated.get_array(), _poke_kwargs()["simulated_z"] * 1e3)
+
+
+def test_poke_figure_shows_the_surface_before_on_its_own_scale() -> None:
+    kwargs = _poke_kwargs()
+    xs = kwargs["roi_xs"]
+    kwargs["rest_z"] = 0.05 + 0.02 * (xs[None, :] + 0.06) + 0 * kwargs["rest_z"]  # 2.4 mm slope
+    fig = plot_poke(**kwargs)
+    before = _panels(fig)[0].get_images()[0]
+    low, high = before.get_clim()
+    assert (low, high) == pytest.approx((kwargs["rest_z"].min() * 1e3,
+                                         kwargs["rest_z"].max() * 1e3))  # fmt: skip
+    # a flat surface: at least a millimetre of scale, not its round-off blown up
+    kwargs["rest_z"] = np.full_like(kwargs["rest_z"], 0.05)
+    low, high = _panels(plot_poke(**kwargs))[0].get_images()[0].get_clim()
+    assert high - low == pytest.approx(1.0)
+    # without a simulation, its panel says so
+    kwargs["simulated_z"] = None
+    texts = [t.get_text() for t in _panels(plot_poke(**kwargs))[4].texts]
+    assert texts == ["not simulated"]
+
+
+def test_map_figure_legend_threshold_label_and_region_values() -> None:
+    args, kwargs = _map_args()
+    fig = plot_map(*args, **kwargs, purposes=["first", "variance", "boundary"])
+    (legend,) = fig.legends
+    assert [t.get_text() for t in legend.get_texts()] == [
+        "first poke", "later pokes", "boundary pokes", "region boundary",
+        "variance = T_h (0.06)",
+    ]  # fmt: skip
+    panels = _panels(fig)
+    variance = panels[-1]
+    assert [t.get_text() for t in variance.texts if t.get_text() == "T_h"] == ["T_h"]
+    # each region named at a cell inside it with its mean β
+    names = sorted(t.get_text() for t in panels[1].texts if t.get_text().startswith("R"))
+    assert names == ["R1: β = 0.80", "R2: β = 0.20"]
+    # without boundary pokes, no boundary entry; marks per purpose
+    fig = plot_map(*args, **kwargs)
+    assert "boundary pokes" not in [t.get_text() for t in fig.legends[0].get_texts()]
+    # the modulus panel names each region's E
+    gx, _ = np.meshgrid(*args)
+    fig = plot_map(*args, **kwargs, modulus_pa=np.where(gx < 0.3, 6e3, 2e4))
+    names = sorted(t.get_text() for t in _panels(fig)[2].texts if t.get_text().startswith("R"))
+    assert names == ["R1: E = 6 kPa", "R2: E = 20 kPa"]
+    with pytest.raises(InvalidArgumentError, match="purposes"):
+        plot_map(*args, **kwargs, purposes=["first"])
+
+
+def test_map_figure_variance_scale_can_be_fixed_so_runs_compare() -> None:
+    args, kwargs = _map_args()
+    own = _panels(plot_map(*args, **kwargs))[-1].get_images()[0]
+    assert own.get_clim() == pytest.approx((0.0, kwargs["variance"].max()))
+    fig = plot_map(*args, **kwargs, variance_max=0.5)
+    fixed = _panels(fig)[-1].get_images()[0]
+    assert fixed.get_clim() == (0.0, 0.5)
+    assert _colorbar_labels(fig)[-1] == "var(β) (fixed scale)"
+    with pytest.raises(InvalidArgumentError, match="variance_max"):
+        plot_map(*args, **kwargs, variance_max=0.0)
 
 
 def test_error_curve_figure() -> None:
@@ -221,7 +287,7 @@ def test_error_curve_figure() -> None:
     (ax,) = fig.axes
     assert (ax.get_title(), ax.get_xlabel(), ax.get_ylabel()) == (
         "shape-matching error E(β)",
-        "β",
+        "β [–]",
         "E(β) [mm]",
     )
     curve = ax.get_lines()[0]
@@ -233,13 +299,27 @@ def test_error_curve_figure() -> None:
 def test_study_figures() -> None:
     fig = plot_hardness_study(_hardness_study())
     (ax,) = fig.axes
-    assert ax.get_ylabel() == "estimated β"
+    assert ax.get_ylabel() == "estimated β [–]"
     assert ax.get_xlabel().startswith("hardness H [N]")
     assert ax.get_xscale() == "log" and ax.xaxis_inverted()
     assert [t.get_text() for t in ax.get_legend().get_texts()] == [
+        "rigid board (filled ◆, its own tick)",
         "paper ✓ monotone",
         "force ✗ not monotone",
     ]
+    # ticks at the tested hardnesses and one for rigid, nothing else
+    fig.canvas.draw()
+    labels = [t.get_text() for t in ax.get_xticklabels()]
+    assert sorted(labels) == sorted(["60", "110", "150", "rigid"])
+    assert ax.get_xticklabels(minor=True) == [] or all(
+        t.get_text() == "" for t in ax.get_xticklabels(minor=True))
+    # every protocol visible where they read alike: a little apart in x, own marker
+    lines = [line for line in ax.get_lines()
+             if len(line.get_xdata()) == 3 and line.get_linestyle() != "None"]  # not the caps
+    assert len(lines) == 2
+    assert lines[0].get_marker() != lines[1].get_marker()
+    assert not np.allclose(np.asarray(lines[0].get_xdata(), dtype=float),
+                           np.asarray(lines[1].get_xdata(), dtype=float))
     fig = plot_cluster_size_study(_cluster_size_study())
     (ax,) = fig.axes
     assert (ax.get_xlabel(), ax.get_ylabel()) == (
@@ -248,6 +328,8 @@ def test_study_figures() -> None:
     )
     assert [t.get_text() for t in ax.get_legend().get_texts()] == ["60 N", "150 N", "rigid"]
     assert np.allclose(ax.get_lines()[0].get_ydata(), [1.0, 1.5, 2.0, 2.5, 3.0])
+    ticks = [t for t in ax.get_xticks() if 2 <= t <= 6]
+    assert ticks == [2, 3, 4, 5, 6]  # whole cluster sizes only
 
 
 def test_show_world_writes_three_pictures_and_nothing_else(tmp_path: Path) -> None:

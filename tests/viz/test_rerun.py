@@ -33,8 +33,57 @@ def test_record_run_writes_a_recording_rerun_can_read(tmp_path) -> None:
 
     reader = RrdReader(path)
     entities = {str(chunk.entity_path) for chunk in reader.stream()}
-    for entity in ("/world/observation", "/world/press/dent", "/maps/beta", "/metrics/beta"):
+    for entity in ("/world/observation", "/world/press/dent", "/maps/beta", "/metrics/beta",
+                   "/maps/variance", "/maps/regions"):  # fmt: skip
         assert entity in entities, (entity, sorted(entities))
+    columns = _columns(path)
+    # the maps as values, not colours; the regions as classes with names
+    assert "Tensor:data" in columns["/maps/beta"] and "Tensor:data" in columns["/maps/variance"]
+    assert "SegmentationImage:buffer" in columns["/maps/regions"]
+    assert "AnnotationContext:context" in columns["/maps/regions"]
+    # a blueprint the viewer opens on, stored with the recording
+    assert [b.kind for b in reader.blueprints()] == ["blueprint"]
+    layout = {str(c.entity_path) for c in reader.stream(store=reader.blueprints()[0])}
+    views = {e for e in layout if e.startswith("/view/") and e.count("/") == 2}
+    # the 3D scene, four maps, the regions and the time series, in three containers
+    assert len(views) == 7 and sum(e.startswith("/container/") for e in layout) == 3
+    # without a world: no ground truth, no robot hull
+    assert "/maps/truth_hardness_n" not in entities and "/world/press/robot_hull" not in entities
+
+
+def _columns(path: Path) -> dict[str, set[str]]:
+    from rerun.chunk import RrdReader
+
+    out: dict[str, set[str]] = {}
+    for chunk in RrdReader(path).stream():
+        out.setdefault(str(chunk.entity_path), set()).update(chunk.to_record_batch().schema.names)
+    return out
+
+
+def test_the_recording_holds_the_ground_truth_and_the_robot_hull_when_given(tmp_path) -> None:
+    pytest.importorskip("rerun")
+    from test_own_environment import TwoFoamTable  # type: ignore[import-not-found]
+
+    from deformap.explore import ExplorationConfig, SurfaceGPConfig, explore
+    from deformap.viz import hull_mesh, record_run
+
+    env = TwoFoamTable(np.random.default_rng(1))
+    config = ExplorationConfig(
+        max_pokes=1, strategy="max-variance", first_target=(0.06, 0.08),
+        surface=SurfaceGPConfig(fit_hyperparameters=False, length_scale_m=0.02),
+    )  # fmt: skip
+    result = explore(env, config, rng=np.random.default_rng(0))
+    truth = np.full((result.ys.size, result.xs.size), 60.0)
+    truth[:, : result.xs.size // 2] = np.inf  # rigid: NaN in the tensor
+    box = np.array([[x, y, z] for x in (0, 0.1) for y in (0, 0.1) for z in (0.05, 0.2)])
+    path = record_run(tmp_path / "run.rrd", result, initial_points=env.observe().points,
+                      truth_hardness=truth, robot_points=[box])  # fmt: skip
+    columns = _columns(path)
+    assert "Tensor:data" in columns["/maps/truth_hardness_n"]
+    assert "Mesh3D:vertex_positions" in columns["/world/press/robot_hull"]
+    vertices, triangles = hull_mesh(box)
+    assert len(vertices) == 8 and len(triangles) == 12  # a box: 8 corners, 2 triangles a face
+    assert triangles.max() == 7
 
 
 def test_a_failed_recording_leaves_no_file(tmp_path) -> None:

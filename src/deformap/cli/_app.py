@@ -12,6 +12,7 @@ go to stderr so that stdout is the JSON alone.
 from __future__ import annotations
 
 import logging
+import os
 import sys
 import tempfile
 from collections.abc import Callable
@@ -37,10 +38,27 @@ __all__ = [
     "out_console",
 ]
 
-# Markup off: file names, scenario names and messages are the user's text, where "[" and "]" are
-# characters, not styles; the few styled words are Text with a style (``labelled``).
-console = Console(markup=False, highlight=False)
-err_console = Console(stderr=True, markup=False, highlight=False)
+PIPE_WIDTH = 400
+"""Columns of a console writing to a file or pipe (not a terminal), where rich would otherwise
+assume 80 and wrap every longer line: wide enough for any row deformap prints (a table row, a
+poke line, a results folder's absolute path) to stay one line, which ``grep`` and ``cut`` need;
+the ``COLUMNS`` environment variable still wins when set."""
+
+
+def _console(*, stderr: bool) -> Console:
+    """A console on stdout or stderr; on a file or pipe, :data:`PIPE_WIDTH` columns wide.
+
+    Markup off: file names, scenario names and messages are the user's text, where "[" and "]"
+    are characters, not styles; the few styled words are Text with a style (``labelled``).
+    """
+    stream = sys.stderr if stderr else sys.stdout
+    piped = not (hasattr(stream, "isatty") and stream.isatty())
+    width = PIPE_WIDTH if piped and not os.environ.get("COLUMNS") else None
+    return Console(stderr=stderr, markup=False, highlight=False, width=width)
+
+
+console = _console(stderr=False)
+err_console = _console(stderr=True)
 
 
 def labelled(label: str, style: str, text: str) -> Text:
@@ -148,9 +166,19 @@ def _root(
             "--version", callback=_version_callback, is_eager=True, help="Print the version."
         ),
     ] = False,
-    verbose: Annotated[bool, typer.Option("--verbose", "-v", help="Log progress details.")] = False,
+    verbose: Annotated[
+        bool, typer.Option("--verbose", "-v", help="Log deformap's progress details.")
+    ] = False,
 ) -> None:
-    logging.basicConfig(
-        level=logging.INFO if verbose else logging.WARNING,
-        format="%(levelname)s %(name)s: %(message)s",
-    )
+    configure_logging(verbose)
+
+
+def configure_logging(verbose: bool) -> None:
+    """deformap's warnings always, its INFO lines with ``verbose``; other libraries' log lines
+    at WARNING and above only, and their Python warnings (scipy's sparse-efficiency warnings,
+    for one) not shown at all: they are advice to the library's programmer, not to the user,
+    and with ``verbose`` they come as log lines of ``py.warnings``."""
+    logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
+    logging.getLogger("deformap").setLevel(logging.INFO if verbose else logging.WARNING)
+    logging.captureWarnings(True)
+    logging.getLogger("py.warnings").setLevel(logging.WARNING if verbose else logging.CRITICAL)

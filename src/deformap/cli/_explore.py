@@ -19,7 +19,7 @@ from deformap.cli._app import (
     out_console,
 )
 from deformap.cli._progress import modulus_text, progress, run_hooks
-from deformap.errors import ConfigError
+from deformap.errors import ConfigError, InvalidArgumentError
 
 if TYPE_CHECKING:  # the CLI loads the estimator only when a command runs
     from deformap.explore import PokeRecord
@@ -27,6 +27,15 @@ if TYPE_CHECKING:  # the CLI loads the estimator only when a command runs
 __all__ = ["config_app"]
 
 config_app = typer.Typer(help="The run configuration (YAML).")
+
+HELP_DEFAULTS: dict[str, str | int | float] = {
+    "scenario": "heterogeneous-60-110-rigid", "seed": 0, "exploration.strategy": "planned",
+    "exploration.threshold": 0.06, "exploration.max_pokes": 12, "exploration.field": "modulus",
+}  # fmt: skip
+"""The defaults ``explore --help`` shows for the options that override the run configuration
+(the ``RunConfig()`` values; a test keeps them equal). Written out, not read from ``RunConfig``:
+that import loads the estimator and the world (over a second), which ``--help`` must not wait
+for. A ``--config`` file's values replace them."""
 app.add_typer(config_app, name="config")
 
 
@@ -94,9 +103,12 @@ def _summary(out: Console, report: dict[str, Any], folder: Path) -> None:
 @friendly_errors
 def explore_command(
     scenario: Annotated[
-        str | None, typer.Option("--scenario", "-s", help="Built-in scenario name or YAML file.")
+        str | None, typer.Option("--scenario", "-s", help="Built-in scenario name or YAML file.",
+                                 show_default=str(HELP_DEFAULTS["scenario"]))
     ] = None,
-    seed: Annotated[int | None, typer.Option(help="Seed of world noise and poke choice.")] = None,
+    seed: Annotated[int | None, typer.Option(
+        help="Seed of world noise and poke choice.",
+        show_default=str(HELP_DEFAULTS["seed"]))] = None,
     out: Annotated[
         Path | None,
         typer.Option(help="Run folder (default runs/<scenario>-explore-s<seed>-<time>)."),
@@ -104,18 +116,24 @@ def explore_command(
     strategy: Annotated[
         str | None,
         typer.Option(help="How the next poke is chosen: `exploration.strategy` (a name it does "
-                     "not know is refused with the list of choices)."),
+                     "not know is refused with the list of choices).",
+                     show_default=str(HELP_DEFAULTS["exploration.strategy"])),
     ] = None,
     threshold: Annotated[
         float | None,
         typer.Option(help="T_h: stop when max var(β) is below it (then any boundary pokes); "
-                     "with --field modulus, read as the same fraction of its prior variance."),
+                     "with --field modulus, read as the same fraction of its prior variance.",
+                     show_default=str(HELP_DEFAULTS["exploration.threshold"])),
     ] = None,
-    max_pokes: Annotated[int | None, typer.Option(help="Most pokes to make.")] = None,
+    max_pokes: Annotated[int | None, typer.Option(
+        help="Most pokes to make.",
+        show_default=str(HELP_DEFAULTS["exploration.max_pokes"]),
+    )] = None,
     field: Annotated[
         str | None,
         typer.Option(help="The field regions, targets and the stop rule run on: "
-                     "`exploration.field`, 'beta' or 'modulus' (from the force–travel records)."),
+                     "`exploration.field`, 'beta' or 'modulus' (from the force–travel records).",
+                     show_default=str(HELP_DEFAULTS["exploration.field"])),
     ] = None,
     config: Annotated[
         Path | None, typer.Option(help="Run configuration YAML (see `config dump`).")
@@ -135,22 +153,35 @@ def explore_command(
         list[str] | None,
         typer.Option("--env-arg", help="key=value passed to the --environment factory (repeat)."),
     ] = None,
+    variance_max: Annotated[
+        float | None,
+        typer.Option(help="Top of map.png's variance colour scale, the same in every run drawn "
+                     "with it so that runs compare (default: each map's own largest variance)."),
+    ] = None,
     json_path: JsonOption = None,
 ) -> None:
     """Explore a simulated world (or your own Environment): poke until the map field is known,
     then cut it into regions."""
+    if variance_max is not None and not variance_max > 0:  # NaN too
+        raise InvalidArgumentError(f"--variance-max must be a number > 0; got {variance_max}")
     overrides = run.RunOverrides(scenario=scenario, seed=seed, strategy=strategy,
                                  threshold=threshold, max_pokes=max_pokes,
                                  field=field)  # fmt: skip
     if environment is not None or env_arg:
         _explore_environment(environment, env_arg or [], scenario, resume, rerun, config,
-                             overrides, out, json_path)
+                             overrides, out, json_path, variance_max)
         return
     cfg = run.explore_run_config(config, overrides, resume)
     shown = out_console(json_path)
+    if scenario is None and resume is None:  # say what runs instead of running it silently
+        source = f"from --config {config}" if config is not None else "the default"
+        shown.print(f"no --scenario or --environment: exploring the simulated scenario "
+                    f"{cfg.scenario!r} ({source}; list them with `deformap scenarios`)",
+                    highlight=False)  # fmt: skip
     with progress(shown) as bar:
         output = run.explore_scenario(cfg, resume or out, resume=resume is not None, rerun=rerun,
-                                      hooks=run_hooks(bar, poke_row=poke_row))  # fmt: skip
+                                      hooks=run_hooks(bar, poke_row=poke_row),
+                                      variance_max=variance_max)  # fmt: skip
     _summary(shown, output.report, output.folder)
     emit_json(json_path, output.report)
 
@@ -174,7 +205,8 @@ def config_dump(
 
 def _explore_environment(environment: str | None, env_args: list[str], scenario: str | None,
                          resume: Path | None, rerun: bool, config: Path | None,
-                         overrides: Any, out: Path | None, json_path: Path | None) -> None:
+                         overrides: Any, out: Path | None, json_path: Path | None,
+                         variance_max: float | None) -> None:
     """``explore --environment``: a user's Environment, no ground truth to score against."""
     if environment is None:
         raise ConfigError("--env-arg goes with --environment package.module:factory; got no "
@@ -189,7 +221,8 @@ def _explore_environment(environment: str | None, env_args: list[str], scenario:
     shown = out_console(json_path)
     with progress(shown) as bar:
         report, folder = run.explore_environment(environment, args, cfg, out,
-                                                 hooks=run_hooks(bar, poke_row=poke_row))
+                                                 hooks=run_hooks(bar, poke_row=poke_row),
+                                                 variance_max=variance_max)
     regions = report["regions"]
     found = "no region map" if regions is None else f"{len(regions['class_betas'])} region(s)"
     shown.print(f"{report['n_pokes']} pokes (stopped by {report['stop_reason']}), {found}, "

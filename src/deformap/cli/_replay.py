@@ -18,8 +18,9 @@ from deformap.cli._app import (
     labelled,
     out_console,
 )
-from deformap.cli._explore import modulus_summary
+from deformap.cli._explore import HELP_DEFAULTS, modulus_summary
 from deformap.cli._progress import modulus_text, progress, run_hooks
+from deformap.errors import InvalidArgumentError
 
 if TYPE_CHECKING:  # the CLI loads the estimator only when a command runs
     from deformap.explore import PokeRecord
@@ -49,8 +50,12 @@ def record_sim_command(
         typer.Option(help="New session folder (default runs/<scenario>-record-s<seed>-<time>)."),
     ] = None,
     format: Annotated[str, typer.Option("--format", help="folder | mcap | sqlite3.")] = "folder",
-    seed: Annotated[int | None, typer.Option(help="Seed of world noise and poke choice.")] = None,
-    pokes: Annotated[int | None, typer.Option("--pokes", help="Most pokes to make.")] = None,
+    seed: Annotated[int | None, typer.Option(
+        help="Seed of world noise and poke choice.",
+        show_default=str(HELP_DEFAULTS["seed"]))] = None,
+    pokes: Annotated[int | None, typer.Option(
+        "--pokes", help="Most pokes to make.",
+        show_default=str(HELP_DEFAULTS["exploration.max_pokes"]))] = None,
     config: ConfigOption = None,
     json_path: JsonOption = None,
 ) -> None:
@@ -143,24 +148,50 @@ def map_command(
         raise typer.Exit(code=2)
 
 
-@app.command("estimate")
+def _three_numbers(option: str, values: tuple[str, str, str] | None, what: str
+                   ) -> tuple[float, float, float]:
+    """``values`` of a three-number option as floats; one line naming the option when it is
+    not given, when a value is missing (the parser took the next option's name as the third
+    value) or is not a number."""
+    if values is None:
+        raise InvalidArgumentError(f"{option} is required: three numbers, {what}; got none")
+    given = [v for v in values if not v.startswith("--")]
+    if len(given) < 3:
+        raise InvalidArgumentError(f"{option} takes three numbers, {what}; got {len(given)}"
+                                   f" ({' '.join(given) or 'none'}) before {values[len(given)]}")
+    try:
+        return (float(values[0]), float(values[1]), float(values[2]))
+    except ValueError:
+        raise InvalidArgumentError(f"{option} takes three numbers, {what}; got "
+                                   f"{' '.join(values)}") from None
+
+
+@app.command("estimate", context_settings={"ignore_unknown_options": True,
+                                           "allow_extra_args": True})  # fmt: skip
 @friendly_errors
 def estimate_command(
+    ctx: typer.Context,
     before: Annotated[
         Path, typer.Option("--before", help="Cloud of the undisturbed surface (PCD, PLY, NPZ).")
     ],
     after: Annotated[Path, typer.Option("--after", help="Cloud while pressing.")],
+    # --contact, --force and --tip-radius: optional to the parser, required here, so that a
+    # value missing from --contact or --force is named (below) instead of the parser's
+    # "Missing option '--force'" when --contact took that option's name as its third value
     contact: Annotated[
-        tuple[float, float, float],
-        typer.Option("--contact", help="Tip centre X Y Z at the press, metres."),
-    ],
+        tuple[str, str, str] | None,
+        typer.Option("--contact", metavar="X Y Z",
+                     help="Tip centre X Y Z at the press, metres. [required]"),
+    ] = None,
     force: Annotated[
-        tuple[float, float, float],
-        typer.Option("--force", help="Force FX FY FZ on the surface, newtons."),
-    ],
+        tuple[str, str, str] | None,
+        typer.Option("--force", metavar="FX FY FZ",
+                     help="Force FX FY FZ on the surface, newtons. [required]"),
+    ] = None,
     tip_radius: Annotated[
-        float, typer.Option("--tip-radius", help="Radius of the spherical tip, metres.")
-    ],
+        float | None,
+        typer.Option("--tip-radius", help="Radius of the spherical tip, metres. [required]"),
+    ] = None,
     robot_hull: Annotated[
         Path | None,
         typer.Option("--robot-hull", help="Cloud file of points whose hull covers stick and hand."),
@@ -180,10 +211,19 @@ def estimate_command(
     ] = None,
 ) -> None:
     """β of one poke from two clouds and the tactile contact (world frame, SI units)."""
+    # unknown options are let through the parser so that a value missing from --contact or
+    # --force (the parser then takes the next option's name as a value) is named here
+    tip_center = _three_numbers("--contact", contact, "the tip centre X Y Z in metres")
+    force_n = _three_numbers("--force", force, "the force FX FY FZ in newtons")
+    if tip_radius is None:
+        raise InvalidArgumentError("--tip-radius is required: the tip's radius in metres; got none")
+    if ctx.args:
+        raise InvalidArgumentError(f"estimate takes no argument {ctx.args[0]!r}; got "
+                                   f"{' '.join(ctx.args)} (see deformap estimate --help)")
     if json_path is None and out is None:  # the JSON alone on stdout, for pipes
         json_path = Path("-")
     output = run.estimate_one_poke(
-        before=before, after=after, tip_center=contact, force=force, tip_radius_m=tip_radius,
+        before=before, after=after, tip_center=tip_center, force=force_n, tip_radius_m=tip_radius,
         config=run.load_run_config(config), robot_hull=robot_hull, units=units, seed=seed, out=out,
     )  # fmt: skip
     r = output.report

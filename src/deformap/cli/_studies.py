@@ -20,6 +20,10 @@ from deformap.cli._progress import progress, run_hooks
 
 __all__ = ["study_app"]
 
+STUDY_HARDNESSES_HELP = "30, 60, 110, 150, 250 and rigid"
+"""``--hardness``'s default as ``--help`` shows it (``deformap.eval.DEFAULT_HARDNESSES``; written
+out so that ``--help`` does not import the studies, a test keeps them equal)."""
+
 study_app = typer.Typer(help="Studies on homogeneous simulated foams (the paper's Fig. 5).")
 app.add_typer(study_app, name="study")
 
@@ -48,7 +52,8 @@ def study_hardness(
     ] = None,
     seed: SeedOption = 0,
     hardness: Annotated[
-        list[float] | None, typer.Option(help="Foams in N (repeat); rigid is added.")
+        list[float] | None, typer.Option(help="Foams in N (repeat); rigid is added.",
+                                         show_default=STUDY_HARDNESSES_HELP)
     ] = None,
     coarse: CoarseOption = False,
     camera: Annotated[

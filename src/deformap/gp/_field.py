@@ -131,6 +131,36 @@ class GaussianRandomField:
             )
         self._state: ExactState | GridState | None = None
 
+    _PARAMS = ("length_scale", "signal_std", "noise_std", "method", "inducing_spacing", "jitter",
+               "max_jitter")  # fmt: skip
+    _FITTED = ("xy_", "mean_", "method_", "jitter_used_", "n_inducing_",
+               "log_marginal_likelihood_")  # fmt: skip
+
+    def get_params(self, deep: bool = True) -> dict[str, Any]:
+        """The constructor's parameters, as scikit-learn's estimator API has them (``clone``
+        builds an unfitted copy from them); ``deep`` is accepted for that API (no parameter
+        is itself an estimator)."""
+        return {name: getattr(self, name) for name in self._PARAMS}
+
+    def set_params(self, **params: Any) -> GaussianRandomField:
+        """Set constructor parameters (scikit-learn's estimator API); returns ``self``.
+
+        They are checked as the constructor checks them, all before any is set (a bad one
+        leaves the field as it was). A fitted field is unfitted: its state was computed with
+        the old hyperparameters, so ``fit`` must be called again before predicting.
+        """
+        unknown = sorted(set(params) - set(self._PARAMS))
+        if unknown:
+            raise InvalidArgumentError(
+                f"`set_params` takes parameters of {list(self._PARAMS)}; got {unknown}")
+        checked = GaussianRandomField(**{**self.get_params(), **params})
+        for name in self._PARAMS:
+            setattr(self, name, getattr(checked, name))
+        self._state = None
+        for name in self._FITTED:
+            self.__dict__.pop(name, None)
+        return self
+
     def __repr__(self) -> str:
         return (
             f"GaussianRandomField(length_scale={self.length_scale!r}, "

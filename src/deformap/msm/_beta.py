@@ -70,6 +70,9 @@ class BetaEstimate:
     mode : str
     stiffness_n_per_m : float or None
         Calibrated spring stiffness of the force protocol.
+    surface : (ny, nx, 3) float, metres, or None
+        The simulated body's surface particles at β̂ (at rest on the ROI grid): the dent shape
+        matching explains the observed one with, for figures and recordings.
     """
 
     beta: float
@@ -83,6 +86,7 @@ class BetaEstimate:
     protocol: str
     mode: str
     stiffness_n_per_m: float | None = None
+    surface: Array | None = None
 
     @property
     def all_converged(self) -> bool:
@@ -365,4 +369,11 @@ def estimate_beta(rest_xs: Any, rest_ys: Any, rest_z: Any, deformed_points: Any,
         beta_std=beta_std,
         betas=betas, errors=errors, iterations=its, residual=res, converged=conv,
         tolerances=tols, protocol=cfg.contact, mode=cfg.mode, stiffness_n_per_m=model.stiffness,
+        surface=_surface_at(sweep, float(betas[best])),
     )
+
+
+def _surface_at(sweep: _Sweep, beta: float) -> Array:
+    """The surface particles ``(ny, nx, 3)`` of the body solved at ``beta``."""
+    sim, j = sweep.sims[beta]
+    return np.array(sim.positions[j])

@@ -23,6 +23,7 @@ import yaml
 
 from deformap import __version__
 from deformap._config import config_to_dict
+from deformap._validation import check_positive
 from deformap.environment import Environment
 from deformap.errors import ConfigError
 from deformap.explore import Journal, check_exploration_budget, explore
@@ -97,13 +98,18 @@ def explore_environment(
     *,
     figures: bool = True,
     hooks: RunHooks = NO_HOOKS,
+    variance_max: float | None = None,
 ) -> tuple[dict[str, Any], Path]:
     """Explore the Environment ``spec`` returns (module docstring); ``(report, folder)``.
+
+    ``variance_max`` fixes the top of ``map.png``'s variance colour scale (so that runs compare).
 
     The run folder is new or empty (default ``runs/<factory>-explore-s<seed>-<time>``); the
     environment is built before the folder is made, so that a spec that does not load leaves
     nothing behind. ``config.world`` and ``config.scenario`` are not used.
     """
+    if variance_max is not None:  # before any work
+        check_positive("variance_max", variance_max)
     env = load_environment(spec, env_args)
     check_exploration_budget(config.exploration, env.workspace)
     folder = out or default_run_folder(spec.partition(":")[2], "explore", config.seed)
@@ -125,5 +131,6 @@ def explore_environment(
               **shared_report(result, truth=None)}  # fmt: skip
     report["timings"]["wall_s"] = time.perf_counter() - t0
     write_run_results(folder, result, report, figures=figures, poke_figures=False,
-                      title=f"{spec}: {len(result.pokes)} pokes", hooks=hooks)
+                      title=f"{spec}: {len(result.pokes)} pokes", hooks=hooks,
+                      variance_max=variance_max)
     return report, folder

@@ -18,6 +18,7 @@ from typing import Any
 
 from deformap import __version__
 from deformap._config import config_from_dict, config_to_dict
+from deformap._validation import check_positive
 from deformap.errors import ConfigError, DeformapError, FileFormatError
 from deformap.explore import (
     JOURNAL_NAME,
@@ -164,6 +165,7 @@ def explore_scenario(
     figures: bool = True,
     rerun: bool = False,
     hooks: RunHooks = NO_HOOKS,
+    variance_max: float | None = None,
 ) -> RunOutput:
     """Explore ``config.scenario``, score the map against ground truth, write the run folder.
 
@@ -182,6 +184,8 @@ def explore_scenario(
         Write ``run.rrd`` (extra ``rerun``).
     hooks : RunHooks
         Progress callbacks.
+    variance_max : float, optional
+        A fixed top of ``map.png``'s variance colour scale, so that runs compare.
 
     Returns
     -------
@@ -193,6 +197,8 @@ def explore_scenario(
         Unknown scenario; ``out`` not empty, or not creatable (before any work); on resume, no
         run there or a different configuration.
     """
+    if variance_max is not None:  # before any work
+        check_positive("variance_max", variance_max)
     if resume and out is None:
         raise ConfigError("`out` must name the run folder to resume; got None")
     scenario = load_scenario(config.scenario)
@@ -223,10 +229,10 @@ def explore_scenario(
     report = live_report(config, result, world, world_build_s=world_s)
     write_run_results(folder, result, report, figures=figures, truth=world, poke_figures=False,
                       title=f"{config.scenario} (seed {config.seed}): {len(result.pokes)} pokes",
-                      hooks=hooks)  # fmt: skip
+                      hooks=hooks, variance_max=variance_max)  # fmt: skip
     if figures:
         _redraw_resumed_pokes(folder, result, world, config.exploration)
     if rerun:
         hooks.stage("writing run.rrd")
-        write_rerun(folder / "run.rrd", result)
+        write_rerun(folder / "run.rrd", result, truth=world)
     return RunOutput(report=report, result=result, world=world, folder=folder)

@@ -103,10 +103,10 @@ def write_pokes_csv(path: Path, result: ExplorationResult) -> Path:
 
 def write_run_results(folder: Path, result: ExplorationResult, report: dict[str, Any], *,
                       figures: bool, title: str, truth: Any = None, poke_figures: bool = True,
-                      hooks: RunHooks = NO_HOOKS) -> None:
+                      hooks: RunHooks = NO_HOOKS, variance_max: float | None = None) -> None:
     """``report.json``, ``map.npz``, ``pokes.csv`` and, with ``figures``, ``map.png`` (T_h of the
-    field the map ran on) and the ``poke-NN.png`` (unless the caller drew them as the pokes came:
-    ``poke_figures=False``)."""
+    field the map ran on; its variance scale fixed at ``variance_max`` when given) and the
+    ``poke-NN.png`` (unless the caller drew them as the pokes came: ``poke_figures=False``)."""
     write_json(folder / "report.json", report)
     write_map_npz(folder / "map.npz", result)
     write_pokes_csv(folder / "pokes.csv", result)
@@ -114,7 +114,7 @@ def write_run_results(folder: Path, result: ExplorationResult, report: dict[str,
         hooks.stage("drawing figures")
         write_map_figures(folder, result, truth=truth,
                           threshold=field_settings(result.config).threshold, title=title,
-                          poke_figures=poke_figures)  # fmt: skip
+                          poke_figures=poke_figures, variance_max=variance_max)  # fmt: skip
 
 
 def poke_writer(folder: Path, *, figures: bool, hooks: RunHooks) -> Callable[[PokeResult], None]:

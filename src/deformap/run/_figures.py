@@ -27,6 +27,7 @@ def write_map_figures(
     threshold: float | None = None,
     title: str = "",
     poke_figures: bool = True,
+    variance_max: float | None = None,
 ) -> list[Path]:
     """``map.png`` (when there is a poke) and, with ``poke_figures``, one ``poke-NN.png`` per
     poke processed here (:func:`write_poke_figure`).
@@ -43,6 +44,9 @@ def write_map_figures(
     title : str
     poke_figures : bool
         False when the caller drew each poke's figure as the poke was made.
+    variance_max : float, optional
+        A fixed top of the variance colour scale, so that runs compare; without it each map's
+        own largest variance.
 
     Returns
     -------
@@ -62,7 +66,9 @@ def write_map_figures(
                  variance=result.map_field.variance, contacts=contacts, labels=regions.labels,
                  levels=levels, truth_hardness=truth_hardness, threshold=threshold, title=title,
                  path=folder / "map.png", modulus_pa=modulus,
-                 region_field=result.config.field)  # fmt: skip
+                 region_field=result.config.field,
+                 purposes=[p.record.purpose for p in result.pokes],
+                 variance_max=variance_max)  # fmt: skip
         written.append(folder / "map.png")
     if poke_figures:
         written += [write_poke_figure(folder, poke) for poke in result.pokes
@@ -89,10 +95,15 @@ def _plot_poke(path: Path, poke: PokeResult, title: str) -> None:
 
     r, dent = poke.record, poke.dent
     assert dent is not None  # the callers skip pokes without a dent
+    # the shape-matching body at β̂ that the estimate kept (its particles start on the ROI grid)
+    surface = None if poke.estimate is None else poke.estimate.surface
+    simulated = None if surface is None else np.asarray(surface)[..., 2]
+    if simulated is not None and simulated.shape != dent.rest_z.shape:
+        simulated = None
     plot_poke(roi_xs=dent.roi_xs, roi_ys=dent.roi_ys, rest_z=dent.rest_z,
               deformed_z=dent.deformed_z, roi_points=dent.roi_points, tactile=dent.tactile,
               betas=np.asarray(r.betas), errors=np.asarray(r.errors), beta=r.beta,
-              beta_std=r.beta_std, title=title, path=path)  # fmt: skip
+              beta_std=r.beta_std, simulated_z=simulated, title=title, path=path)  # fmt: skip
 
 
 def write_estimate_figures(folder: Path, poke: PokeResult) -> list[Path]:
@@ -106,11 +117,23 @@ def write_estimate_figures(folder: Path, poke: PokeResult) -> list[Path]:
     return [folder / "beta-curve.png", folder / "poke.png"]
 
 
-def write_rerun(path: Path, result: ExplorationResult) -> Path:
-    """The run as a rerun recording (extra ``rerun``), starting from the surface's points."""
+def write_rerun(path: Path, result: ExplorationResult, *, truth: Any = None) -> Path:
+    """The run as a rerun recording (extra ``rerun``), starting from the surface's points.
+
+    With ``truth`` (a simulated world: ``ground_truth_hardness(xs, ys)`` and its probe in
+    ``config.probe``) the recording holds the ground truth and, per poke, the robot's hull: the
+    probe's ``robot_points`` at the poke's tip centre, pressing straight down as the simulated
+    world does.
+    """
     from deformap.viz import record_run
 
     surface = result.surface
     if surface is None:  # pragma: no cover - explore() fits the surface before any poke
         raise RuntimeError("the exploration has no surface model")
-    return Path(record_run(path, result, initial_points=surface.points))
+    truth_hardness = None if truth is None else truth.ground_truth_hardness(result.xs, result.ys)
+    probe = getattr(getattr(truth, "config", None), "probe", None)
+    hulls = None if probe is None else [
+        probe.robot_points(np.asarray(p.record.contact.tip_center), np.array([0.0, 0.0, 1.0]))
+        for p in result.pokes]  # fmt: skip
+    return Path(record_run(path, result, initial_points=surface.points,
+                           truth_hardness=truth_hardness, robot_points=hulls))

@@ -9,13 +9,15 @@ the suffix). Importing this package and drawing with it never selects a matplotl
 
 from __future__ import annotations
 
-from deformap.viz._figures import plot_beta_curve, plot_error_curve, plot_map, plot_poke
-from deformap.viz._rerun import heightmap_mesh, record_run
+from deformap.viz._figures import plot_map
+from deformap.viz._poke import plot_beta_curve, plot_error_curve, plot_poke
+from deformap.viz._rerun import heightmap_mesh, hull_mesh, record_run
 from deformap.viz._studies import plot_cluster_size_study, plot_hardness_study
 from deformap.viz._world import show_world
 
 __all__ = [
     "heightmap_mesh",
+    "hull_mesh",
     "plot_beta_curve",
     "plot_cluster_size_study",
     "plot_error_curve",

@@ -1,11 +1,11 @@
-"""Figures of a run, each a :class:`matplotlib.figure.Figure` built without ``pyplot``.
+"""The map figure of a run, a :class:`matplotlib.figure.Figure` built without ``pyplot``.
 
 ``map.png`` follows the paper's Fig. 6: ground truth | β-field with region contours and the contacts
-| variance with the contacts (first contact a circle, later ones triangles); with a modulus field, a
-panel of E in kPa (log colour scale) comes before the variance, which is the variance of the field
-the regions ran on. ``poke-NN.png``
-follows its Fig. 4: the ROI before, after (cloud and reconstructed surface), the fitted dent, and
-the error curve E(β).
+| variance with the contacts; with a modulus field, a panel of E in kPa (log colour scale) comes
+before the variance, which is the variance of the field the regions ran on. Each region is named
+(R1, R2, …) at its inmost cell with its mean β (and E) on the map; one legend below the panels says
+which mark is the first poke, the later ones and the boundary pokes, and which line is a region
+boundary and which the T_h contour. The poke figures are :mod:`deformap.viz._poke`.
 
 Every ``plot_*`` function returns its figure and, given ``path``, also writes it there atomically
 (a temporary file in the same folder, renamed onto ``path`` once complete). No backend is selected,
@@ -15,6 +15,7 @@ and GUI applications, which keep their own backend and display the returned figu
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 import numpy as np
@@ -22,34 +23,66 @@ from matplotlib import patheffects
 from matplotlib.axes import Axes
 from matplotlib.colors import LogNorm
 from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
 from matplotlib.ticker import FuncFormatter
 from numpy.typing import NDArray
+from scipy.ndimage import distance_transform_edt
 
+from deformap.errors import InvalidArgumentError
 from deformap.viz._save import save_figure
 
-__all__ = ["plot_beta_curve", "plot_error_curve", "plot_map", "plot_poke"]
+__all__ = ["plot_map"]
+
+# marker per poke purpose: the first poke, the pokes the variance chose, the boundary pokes
+_MARKS = {"first": ("o", "first poke"), "variance": ("^", "later pokes"),
+          "boundary": ("s", "boundary pokes")}  # fmt: skip
+_HALO = [patheffects.withStroke(linewidth=3.5, foreground="w")]
+_REGION_COLOUR, _THRESHOLD_COLOUR = "c", "r"
+Extent = tuple[float, float, float, float]
 
 
-def _extent(xs: NDArray, ys: NDArray) -> list[float]:
+def _extent(xs: NDArray, ys: NDArray) -> Extent:
     dx = (xs[1] - xs[0]) / 2 if xs.size > 1 else 0.0025
     dy = (ys[1] - ys[0]) / 2 if ys.size > 1 else 0.0025
-    return [xs[0] - dx, xs[-1] + dx, ys[0] - dy, ys[-1] + dy]
+    return (float(xs[0] - dx), float(xs[-1] + dx), float(ys[0] - dy), float(ys[-1] + dy))
 
 
-def _contacts(ax: Axes, contacts: NDArray[np.float64]) -> None:
-    if contacts.size == 0:
-        return
-    # black marks with a white halo: readable on the dark end of a colour map (a rigid board's
-    # β = 0) as on the light one
-    halo = [patheffects.withStroke(linewidth=3.5, foreground="w")]
-    ax.plot(contacts[0, 0], contacts[0, 1], "o", mfc="none", mec="k", ms=10, mew=2,
-            path_effects=halo)
-    if len(contacts) > 1:
-        ax.plot(contacts[1:, 0], contacts[1:, 1], "^", mfc="none", mec="k", ms=9, mew=2,
-                path_effects=halo, linestyle="none")
+def _purposes(n: int, purposes: Sequence[str | None] | None) -> list[str]:
+    """Each contact's purpose; without them the first is ``first`` and the rest ``variance``."""
+    if purposes is None:
+        return ["first"] + ["variance"] * (n - 1) if n else []
+    if len(purposes) != n:
+        raise InvalidArgumentError(
+            f"`purposes` must have one entry per contact ({n}); got {len(purposes)}")
+    return [p if p in _MARKS else ("first" if i == 0 else "variance")
+            for i, p in enumerate(purposes)]  # fmt: skip
+
+
+def _contacts(ax: Axes, contacts: NDArray[np.float64], purposes: list[str]) -> None:
+    """The pokes, marked by purpose and numbered in order: black with a white halo, readable on
+    the dark end of a colour map (a rigid board's β = 0) as on the light one."""
+    for purpose, (marker, _) in _MARKS.items():
+        mine = [i for i, p in enumerate(purposes) if p == purpose]
+        if mine:
+            ax.plot(contacts[mine, 0], contacts[mine, 1], marker, mfc="none", mec="k",
+                    ms=10 if marker == "o" else 9, mew=2, path_effects=_HALO, linestyle="none")
     for i, (x, y) in enumerate(contacts):
         ax.annotate(str(i + 1), (x, y), xytext=(6, 6), textcoords="offset points", fontsize=8,
                     path_effects=[patheffects.withStroke(linewidth=2.5, foreground="w")])
+
+
+def _legend(fig: Figure, purposes: list[str], *, regions: bool, threshold: float | None) -> None:
+    """One legend below the panels (inside, it would cover a map)."""
+    handles = [Line2D([], [], marker=_MARKS[p][0], mfc="none", mec="k", mew=2, ms=9, ls="none",
+                      label=_MARKS[p][1]) for p in _MARKS if p in purposes]  # fmt: skip
+    if regions:
+        handles.append(Line2D([], [], color=_REGION_COLOUR, lw=2, label="region boundary"))
+    if threshold is not None:
+        handles.append(Line2D([], [], color=_THRESHOLD_COLOUR, lw=1,
+                              label=f"variance = T_h ({threshold:.3g})"))
+    if handles:
+        fig.legend(handles=handles, loc="outside lower center", ncols=len(handles), fontsize=9,
+                   frameon=False)
 
 
 def plot_map(
@@ -67,6 +100,8 @@ def plot_map(
     path: str | Path | None = None,
     modulus_pa: NDArray[np.float64] | None = None,
     region_field: str = "beta",
+    purposes: Sequence[str | None] | None = None,
+    variance_max: float | None = None,
 ) -> Figure:
     """The map figure: ground truth (when given) | β-field | modulus field (when given) |
     variance and contacts; the regions drawn on the field they were cut from.
@@ -85,10 +120,13 @@ def plot_map(
         Region label map and the isopleths drawn as contours of ``region_field``'s mean (β, or
         ln E of ``modulus_pa``); without ``levels``, the edges between the labels are drawn
         (regions labelled by nearest poke). The other field's panel shows the labels' edges.
+        Each region is named at its inmost cell with the mean of the β-field over its cells (and
+        on the modulus panel the geometric mean of E over them).
     truth_hardness : (ny, nx) float, optional
         Ground-truth hardness in newtons (``inf`` rigid, ``nan`` bare table); omitted without truth.
     threshold : float, optional
-        The variance threshold, drawn as a contour on the variance panel where the field crosses it.
+        The variance threshold T_h, drawn and labelled as a contour on the variance panel where
+        the field crosses it.
     title : str
         The figure's title.
     path : str or Path, optional
@@ -97,56 +135,54 @@ def plot_map(
         The modulus field's median E in pascals, drawn in kPa on a log colour scale.
     region_field : {"beta", "modulus"}
         The field the regions were cut from (``modulus`` needs ``modulus_pa``).
+    purposes : sequence of {"first", "variance", "boundary"} or None, optional
+        Each contact's purpose, which picks its mark (circle, triangle, square); without them the
+        first contact is the first poke and the others later pokes.
+    variance_max : float, optional
+        The top of the variance colour scale (from 0), the same for every run drawn with it so
+        that runs compare; without it the scale spans 0 to this map's largest variance.
 
     Returns
     -------
     matplotlib.figure.Figure
-        The figure, one panel per map, each with its colour bar.
+        The figure, one panel per map, each with its colour bar, and one legend below them.
     """
     if region_field == "modulus" and modulus_pa is None:
         raise ValueError("`modulus_pa` is required when `region_field` is 'modulus'")
+    if variance_max is not None and not variance_max > 0:  # NaN too
+        raise InvalidArgumentError(f"`variance_max` must be a number > 0; got {variance_max!r}")
+    contacts = np.asarray(contacts, dtype=float).reshape(-1, 2)
+    kinds = _purposes(len(contacts), purposes)
     panels = 2 + (truth_hardness is not None) + (modulus_pa is not None)
-    fig = Figure(figsize=(5.2 * panels, 4.0), layout="constrained")
-    axes = fig.subplots(1, panels)
+    fig = Figure(figsize=(5.2 * panels, 4.5), layout="constrained")
+    axes = list(np.atleast_1d(fig.subplots(1, panels)))
     ext = _extent(xs, ys)
-    axes = list(np.atleast_1d(axes))
     if truth_hardness is not None:
-        ax = axes.pop(0)
-        shown = np.where(np.isinf(truth_hardness), np.nan, truth_hardness)
-        im = ax.imshow(shown, origin="lower", extent=ext, cmap="viridis_r")
-        rigid = np.isinf(truth_hardness)
-        if rigid.any():
-            ax.contourf(xs, ys, rigid.astype(float), levels=[0.5, 1.5], colors="0.3")
-        fig.colorbar(im, ax=ax, label="hardness H [N] (grey: rigid)")
-        ax.set_title("ground truth")
+        _truth_panel(fig, axes.pop(0), xs, ys, ext, truth_hardness)
     n_regions = "" if labels is None else f", {len(np.unique(labels))} region(s)"
     ax = axes.pop(0)
     im = ax.imshow(beta, origin="lower", extent=ext, cmap="magma", vmin=0.0, vmax=1.0)
-    _regions(ax, xs, ys, beta, labels, levels if region_field == "beta" else None,
-             main=region_field == "beta")  # fmt: skip
-    fig.colorbar(im, ax=ax, label="β (deformability)")
+    fig.colorbar(im, ax=ax, label="β (deformability) [–]")
     ax.set_title(f"β-field{n_regions if region_field == 'beta' else ''}")
-    _contacts(ax, contacts)
+    _field_overlay(ax, xs, ys, beta, labels, levels, contacts, kinds,
+                   main=region_field == "beta", name=lambda v: f"β = {v:.2f}")  # fmt: skip
     if modulus_pa is not None:
         ax = axes.pop(0)
         _modulus_panel(fig, ax, ext, modulus_pa)
-        log_e = np.log(modulus_pa)
-        _regions(ax, xs, ys, log_e, labels, levels if region_field == "modulus" else None,
-                 main=region_field == "modulus")  # fmt: skip
         ax.set_title(f"modulus field{n_regions if region_field == 'modulus' else ''}")
-        _contacts(ax, contacts)
+        _field_overlay(ax, xs, ys, np.log(modulus_pa), labels, levels, contacts, kinds,
+                       main=region_field == "modulus",
+                       name=lambda v: f"E = {np.exp(v) / 1e3:.3g} kPa")  # fmt: skip
     ax = axes.pop(0)
-    im = ax.imshow(variance, origin="lower", extent=ext, cmap="Blues")
-    if threshold is not None and variance.max() > threshold > variance.min():
-        ax.contour(xs, ys, variance, levels=[threshold], colors="r", linewidths=1)
-    name = "ln E" if region_field == "modulus" else "β"
-    fig.colorbar(im, ax=ax, label=f"var({name})")
-    ax.set_title(f"{'modulus' if region_field == 'modulus' else 'β'}-field variance and contacts")
-    _contacts(ax, contacts)
+    drawn = _variance_panel(fig, ax, xs, ys, ext, variance, threshold, variance_max,
+                            modulus=region_field == "modulus")  # fmt: skip
+    _contacts(ax, contacts, kinds)
     for a in fig.axes:
         if a.get_label() != "<colorbar>":
             a.set_xlabel("x [m]")
             a.set_ylabel("y [m]")
+    _legend(fig, kinds, regions=labels is not None and bool(np.ptp(labels) > 0),
+            threshold=threshold if drawn else None)
     if title:
         fig.suptitle(title)
     if path is not None:
@@ -154,22 +190,88 @@ def plot_map(
     return fig
 
 
+def _field_overlay(ax: Axes, xs: NDArray, ys: NDArray, values: NDArray, labels: NDArray | None,
+                   levels: NDArray | None, contacts: NDArray, kinds: list[str], *, main: bool,
+                   name: Callable[[float], str]) -> None:
+    """On one field's panel: the regions (its isopleths ``levels`` when the regions were cut from
+    it, ``main``), the pokes, and each region named with ``name`` of its mean of ``values``."""
+    _regions(ax, xs, ys, values, labels, levels if main else None, main=main)
+    _contacts(ax, contacts, kinds)
+    if labels is not None:
+        _region_names(ax, xs, ys, labels,
+                      {k: name(v) for k, v in _region_means(labels, values).items()})
+
+
+def _truth_panel(fig: Figure, ax: Axes, xs: NDArray, ys: NDArray, ext: Extent,
+                 truth_hardness: NDArray) -> None:
+    shown = np.where(np.isinf(truth_hardness), np.nan, truth_hardness)
+    im = ax.imshow(shown, origin="lower", extent=ext, cmap="viridis_r")
+    rigid = np.isinf(truth_hardness)
+    if rigid.any():
+        ax.contourf(xs, ys, rigid.astype(float), levels=[0.5, 1.5], colors="0.3")
+    fig.colorbar(im, ax=ax, label="hardness H [N] (grey: rigid)")
+    ax.set_title("ground truth")
+
+
+def _variance_panel(fig: Figure, ax: Axes, xs: NDArray, ys: NDArray, ext: Extent,
+                    variance: NDArray, threshold: float | None, variance_max: float | None, *,
+                    modulus: bool) -> bool:
+    """The variance from 0 to ``variance_max`` (or its own maximum), the T_h contour labelled;
+    whether that contour was drawn."""
+    top = float(np.nanmax(variance)) if variance_max is None else variance_max
+    im = ax.imshow(variance, origin="lower", extent=ext, cmap="Blues", vmin=0.0,
+                   vmax=top if top > 0 else 1.0)  # fmt: skip
+    drawn = threshold is not None and float(variance.max()) > threshold > float(variance.min())
+    if drawn:
+        lines = ax.contour(xs, ys, variance, levels=[threshold], colors=_THRESHOLD_COLOUR,
+                           linewidths=1)  # fmt: skip
+        ax.clabel(lines, fmt=lambda _: "T_h", fontsize=8, inline=True)
+    name = "ln E" if modulus else "β"
+    over = variance_max is not None and float(np.nanmax(variance)) > variance_max
+    fig.colorbar(im, ax=ax, extend="max" if over else "neither",
+                 label=f"var({name})" + (" (fixed scale)" if variance_max is not None else ""))
+    ax.set_title(f"{'modulus' if modulus else 'β'}-field variance and contacts")
+    return drawn
+
+
+def _region_means(labels: NDArray, values: NDArray) -> dict[int, float]:
+    """The mean of ``values`` over each region's cells (finite values only)."""
+    out = {}
+    for k in np.unique(labels):
+        cells = values[(labels == k) & np.isfinite(values)]
+        if k >= 0 and cells.size:
+            out[int(k)] = float(cells.mean())
+    return out
+
+
+def _region_names(ax: Axes, xs: NDArray, ys: NDArray, labels: NDArray,
+                  texts: dict[int, str]) -> None:
+    """``R<k+1>`` and its text at each region's inmost cell (the cell farthest from the region's
+    edge: inside the region however it is shaped, where a centroid may fall outside)."""
+    for k, text in texts.items():
+        inside = np.pad(labels == k, 1)  # the map's border counts as an edge
+        depth = distance_transform_edt(inside)[1:-1, 1:-1]
+        iy, ix = np.unravel_index(int(np.argmax(depth)), depth.shape)
+        ax.text(xs[ix], ys[iy], f"R{k + 1}: {text}", ha="center", va="center", fontsize=8,
+                bbox={"boxstyle": "round,pad=0.2", "fc": "w", "ec": "0.5", "alpha": 0.8})
+
+
 def _regions(ax: Axes, xs: NDArray, ys: NDArray, values: NDArray, labels: NDArray | None,
              levels: NDArray | None, *, main: bool) -> None:
     """The regions on one field's panel: its isopleths ``levels`` when given, else the labels'
     outlines (dashed on the panel of the field they were not cut from)."""
     if levels is not None and len(levels):
-        ax.contour(xs, ys, values, levels=np.sort(levels), colors="c", linewidths=2)
+        ax.contour(xs, ys, values, levels=np.sort(levels), colors=_REGION_COLOUR, linewidths=2)
     elif labels is not None and np.ptp(labels) > 0:
         # each region's outline (contours of the label values would draw two lines where
         # regions 0 and 2 meet)
         for label in np.unique(labels):
-            ax.contour(xs, ys, (labels == label).astype(float), levels=[0.5], colors="c",
-                       linewidths=2 if main else 1,
+            ax.contour(xs, ys, (labels == label).astype(float), levels=[0.5],
+                       colors=_REGION_COLOUR, linewidths=2 if main else 1,
                        linestyles="solid" if main else "dashed")  # fmt: skip
 
 
-def _modulus_panel(fig: Figure, ax: Axes, ext: list[float], modulus_pa: NDArray) -> None:
+def _modulus_panel(fig: Figure, ax: Axes, ext: Extent, modulus_pa: NDArray) -> None:
     """E in kPa on a log colour scale spanning at least a factor of ten."""
     kpa = np.asarray(modulus_pa, dtype=float) / 1e3
     finite = kpa[np.isfinite(kpa) & (kpa > 0)]
@@ -177,7 +279,7 @@ def _modulus_panel(fig: Figure, ax: Axes, ext: list[float], modulus_pa: NDArray)
     mid = np.sqrt(low * high)
     if high / low < 10.0:
         low, high = mid / np.sqrt(10.0), mid * np.sqrt(10.0)
-    im = ax.imshow(kpa, origin="lower", extent=(ext[0], ext[1], ext[2], ext[3]), cmap="viridis",
+    im = ax.imshow(kpa, origin="lower", extent=ext, cmap="viridis",
                    norm=LogNorm(vmin=low, vmax=high))  # fmt: skip
     bar = fig.colorbar(im, ax=ax, label="Young's modulus E [kPa] (log scale)")
     decades = float(np.log10(high / low))
@@ -189,140 +291,3 @@ def _modulus_panel(fig: Figure, ax: Axes, ext: list[float], modulus_pa: NDArray)
 
     bar.ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
     bar.ax.yaxis.set_minor_formatter(FuncFormatter(minor))
-
-
-def plot_beta_curve(ax: Axes, betas: NDArray, errors: NDArray, beta_hat: float, std: float) -> None:
-    """Draw E(β) with the estimate and its uncertainty band on ``ax``."""
-    order = np.argsort(betas)
-    ax.plot(np.asarray(betas)[order], np.asarray(errors)[order] * 1e3, "-", color="k")
-    ax.axvline(beta_hat, color="r", label=f"β̂ = {beta_hat:.3f} ± {std:.3f}")
-    ax.axvspan(max(0.0, beta_hat - std), min(1.0, beta_hat + std), color="r", alpha=0.15)
-    ax.set_xlabel("β")
-    ax.set_ylabel("E(β) [mm]")
-    ax.legend(fontsize=8)
-
-
-def plot_error_curve(
-    betas: NDArray[np.float64],
-    errors: NDArray[np.float64],
-    beta: float,
-    beta_std: float,
-    *,
-    title: str = "shape-matching error E(β)",
-    path: str | Path | None = None,
-) -> Figure:
-    """A figure of its own holding :func:`plot_beta_curve`: E(β), β̂ and its uncertainty band.
-
-    Parameters
-    ----------
-    betas, errors : (m,) float
-        The βs tried and their error E(β) in metres (drawn in millimetres), in any order.
-    beta, beta_std : float
-        The estimate β̂ and its standard deviation.
-    title : str
-        The axes' title.
-    path : str or Path, optional
-        Where to write the figure (110 dpi, format from the suffix); nothing is written without it.
-    """
-    fig = Figure(figsize=(5.0, 3.6), layout="constrained")
-    ax = fig.subplots()
-    plot_beta_curve(ax, betas, errors, beta, beta_std)
-    ax.set_title(title)
-    if path is not None:
-        save_figure(fig, path, dpi=110)
-    return fig
-
-
-def plot_poke(
-    *,
-    roi_xs: NDArray[np.float64],
-    roi_ys: NDArray[np.float64],
-    rest_z: NDArray[np.float64],
-    deformed_z: NDArray[np.float64],
-    roi_points: NDArray[np.float64],
-    tactile: NDArray[np.float64],
-    betas: NDArray[np.float64],
-    errors: NDArray[np.float64],
-    beta: float,
-    beta_std: float,
-    simulated_z: NDArray[np.float64] | None = None,
-    title: str = "",
-    path: str | Path | None = None,
-) -> Figure:
-    """One poke's figure: the ROI before, the cloud while pressing, a section, E(β).
-
-    Parameters
-    ----------
-    roi_xs, roi_ys : (nx,), (ny,) float, metres
-        Grid of the region of interest around the contact.
-    rest_z, deformed_z : (ny, nx) float, metres
-        Heights before (surface GP) and while pressing (touch GP).
-    roi_points : (n, 3) float, metres
-        The cloud in the ROI while pressing, the robot removed.
-    tactile : (t, 3) float, metres
-        The tactile points added on the probe's tip.
-    betas, errors : (m,) float
-        The βs tried and their error E(β) in metres.
-    beta, beta_std : float
-        The estimate β̂ and its standard deviation.
-    simulated_z : (ny, nx) float, metres, optional
-        The shape-matching surface at β̂, drawn on the section when given.
-    title : str
-        The figure's title.
-    path : str or Path, optional
-        Where to write the figure (100 dpi, format from the suffix); nothing is written without it.
-    """
-    fig = Figure(figsize=(19, 4.0), layout="constrained")
-    axes = fig.subplots(1, 4)
-    ext = _extent(roi_xs, roi_ys)
-    lo = float(min(rest_z.min(), deformed_z.min()))
-    hi = float(max(rest_z.max(), deformed_z.max()))
-    ax = axes[0]
-    im = ax.imshow(rest_z * 1e3, origin="lower", extent=ext, vmin=lo * 1e3, vmax=hi * 1e3)
-    ax.set_title("ROI before (surface GP)")
-    ax.set(xlabel="x [m]", ylabel="y [m]")
-    fig.colorbar(im, ax=ax, label="z [mm]")
-    ax = axes[1]
-    sc = ax.scatter(
-        roi_points[:, 0],
-        roi_points[:, 1],
-        c=roi_points[:, 2] * 1e3,
-        s=4,
-        vmin=lo * 1e3,
-        vmax=hi * 1e3,
-    )
-    ax.plot(tactile[:, 0], tactile[:, 1], "r.", ms=6, label="tactile points")
-    ax.set_xlim(ext[0], ext[1])
-    ax.set_ylim(ext[2], ext[3])
-    ax.set_aspect("equal")
-    ax.legend(fontsize=8, loc="upper right")
-    ax.set_title("cloud while pressing (robot removed)")
-    ax.set(xlabel="x [m]", ylabel="y [m]")
-    fig.colorbar(sc, ax=ax, label="z [mm]")
-    ax = axes[2]
-    mid = rest_z.shape[0] // 2
-    ax.plot(roi_xs * 1e2, rest_z[mid] * 1e3, "k--", label="before")
-    ax.plot(roi_xs * 1e2, deformed_z[mid] * 1e3, "b-", lw=2, label="observed dent (touch GP)")
-    if simulated_z is not None:
-        ax.plot(roi_xs * 1e2, simulated_z[mid] * 1e3, "r-", label="shape matching at β̂")
-    near = np.abs(roi_points[:, 1] - roi_ys[mid]) < (roi_ys[1] - roi_ys[0])
-    ax.plot(
-        roi_points[near, 0] * 1e2,
-        roi_points[near, 2] * 1e3,
-        ".",
-        color="0.6",
-        ms=3,
-        label="cloud points on the section",
-    )
-    ax.set_xlabel("x [cm]")
-    ax.set_ylabel("z [mm]")
-    ax.set_title("section through the contact")
-    # below the axes: inside, it would cover the dent, which is at the section's middle
-    ax.legend(fontsize=8, ncol=2, loc="upper center", bbox_to_anchor=(0.5, -0.16))
-    plot_beta_curve(axes[3], betas, errors, beta, beta_std)
-    axes[3].set_title("shape-matching error E(β)")
-    if title:
-        fig.suptitle(title)
-    if path is not None:
-        save_figure(fig, path, dpi=100)
-    return fig

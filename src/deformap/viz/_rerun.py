@@ -1,23 +1,34 @@
 """A 3D recording of a run for the rerun viewer (extra ``rerun``): ``run.rrd``.
 
-Timeline ``poke``: step 0 holds the first observation and the surface GP's heightmap; step k holds
-the k-th press (cloud with the robot removed, tactile points, reconstructed dent), the β-field as a
-coloured surface and its variance, and the scalars (β, max variance) as they evolve.
-Open it with ``rerun run.rrd``.
+Timeline ``poke``: step 0 holds the first observation, the surface GP's heightmap and the ground
+truth (when the world has one); step k holds the k-th press (cloud with the robot removed, tactile
+points, reconstructed dent, the robot's hull), the β-field as a coloured surface, and the maps and
+scalars as they evolve; the last step holds the regions.
+
+The maps are logged as values, not colours: ``maps/beta`` (β), ``maps/variance`` (of the map
+field), ``maps/modulus_kpa`` (the modulus field's median E in kPa) and ``maps/truth_hardness_n``
+(hardness in N; NaN where rigid or bare table) are :class:`rerun.Tensor` grids of ``(ny, nx)``
+cells, and ``maps/regions`` is a :class:`rerun.SegmentationImage` of the region labels whose
+annotation context names each region with its mean β. Every grid is stored top row first (row 0
+is the largest y), so that it shows with y up as in ``map.png``. A blueprint opens on the 3D scene
+beside the maps and the scalars' time series. Open it with ``rerun run.rrd``.
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+from matplotlib import colormaps
 from numpy.typing import NDArray
+from scipy.spatial import ConvexHull
 
 from deformap._files import atomic_path
 from deformap.errors import missing_extra
 
-__all__ = ["heightmap_mesh", "record_run"]
+__all__ = ["heightmap_mesh", "hull_mesh", "record_run"]
 
 
 def heightmap_mesh(
@@ -35,13 +46,13 @@ def heightmap_mesh(
 
 
 def _colors(values: NDArray[np.float64], cmap: str, lo: float, hi: float) -> NDArray[np.uint8]:
-    from matplotlib import colormaps
-
     scaled = np.clip((np.asarray(values, float) - lo) / max(hi - lo, 1e-12), 0.0, 1.0)
     return (colormaps[cmap](np.nan_to_num(scaled))[..., :3] * 255).astype(np.uint8)
 
 
-def record_run(path: str | Path, result: Any, *, initial_points: NDArray[np.float64]) -> Path:
+def record_run(path: str | Path, result: Any, *, initial_points: NDArray[np.float64],
+               truth_hardness: NDArray[np.float64] | None = None,
+               robot_points: Sequence[NDArray[np.float64] | None] | None = None) -> Path:
     """Write ``run.rrd`` for an :class:`~deformap.explore.ExplorationResult`.
 
     Parameters
@@ -52,6 +63,11 @@ def record_run(path: str | Path, result: Any, *, initial_points: NDArray[np.floa
         A finished exploration (its surface model, every poke and the β-field after each).
     initial_points : (n, 3) float, metres
         The first observation, as the camera saw it.
+    truth_hardness : (ny, nx) float, optional
+        Ground-truth hardness in newtons on the map's grid (``inf`` rigid, ``nan`` bare table).
+    robot_points : sequence of (m, 3) float or None, optional
+        Per poke, points whose convex hull covers the robot at the press (as the environment
+        gave them), logged as a mesh ``world/press/robot_hull``; ``None`` for a poke without.
     """
     try:
         import rerun as rr
@@ -60,11 +76,51 @@ def record_run(path: str | Path, result: Any, *, initial_points: NDArray[np.floa
     out = Path(path)
     with atomic_path(out) as tmp:
         rec = rr.RecordingStream("deformap")
-        rec.save(tmp)
+        rec.save(tmp, default_blueprint=_blueprint())
         _log_run(rec, result, np.asarray(initial_points))
+        if truth_hardness is not None:
+            rec.set_time("poke", sequence=0)
+            truth = np.where(np.isinf(truth_hardness), np.nan, truth_hardness)
+            rec.log("maps/truth_hardness_n", rr.Tensor(truth[::-1], dim_names=("y", "x")))
+        for k, points in enumerate(robot_points or (), start=1):
+            if points is not None:
+                rec.set_time("poke", sequence=k)
+                vertices, triangles = hull_mesh(np.asarray(points, dtype=float))
+                rec.log("world/press/robot_hull", rr.Mesh3D(
+                    vertex_positions=vertices, triangle_indices=triangles,
+                    albedo_factor=[120, 120, 120, 110]))  # fmt: skip
+        _log_regions(rec, result)
         rec.flush()
         rec.disconnect()  # closes the file
     return out
+
+
+def hull_mesh(points: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
+    """Vertices ``(v, 3)`` and triangles ``(t, 3)`` of the convex hull of ``points (m, 3)``."""
+    hull = ConvexHull(points)
+    index = np.full(len(points), -1, dtype=np.int64)
+    index[hull.vertices] = np.arange(hull.vertices.size)
+    return points[hull.vertices], index[hull.simplices]
+
+
+def _blueprint() -> Any:
+    """The layout the viewer opens on: the 3D scene; beside it the maps above the scalars."""
+    import rerun.blueprint as rrb
+
+    maps = [rrb.TensorView(origin=f"maps/{name}", name=title) for name, title in (
+        ("beta", "β-field"), ("variance", "map field variance"),
+        ("modulus_kpa", "E [kPa]"), ("truth_hardness_n", "ground truth H [N]"))]  # fmt: skip
+    return rrb.Blueprint(
+        rrb.Horizontal(
+            rrb.Spatial3DView(origin="world", name="surface, presses and β-field"),
+            rrb.Vertical(
+                rrb.Grid(*maps, rrb.Spatial2DView(origin="maps/regions", name="regions")),
+                rrb.TimeSeriesView(origin="metrics", name="β, E and max variance per poke"),
+                row_shares=[2, 1],
+            ),
+            column_shares=[3, 2],
+        ),
+    )  # the side and time panels stay open: the time panel steps through the pokes
 
 
 def _log_run(rec: Any, result: Any, pts: NDArray[np.float64]) -> None:
@@ -104,7 +160,7 @@ def _log_run(rec: Any, result: Any, pts: NDArray[np.float64]) -> None:
                 rr.Mesh3D(vertex_positions=v, triangle_indices=t, vertex_colors=[60, 120, 230]),
             )
         field = result.field_after(k)
-        mean, var = field.mean, field.variance
+        mean = field.mean
         if surface_mesh is not None:
             v, t = surface_mesh
             rec.log(
@@ -115,25 +171,56 @@ def _log_run(rec: Any, result: Any, pts: NDArray[np.float64]) -> None:
                     vertex_colors=_colors(mean.ravel(), "magma", 0, 1),
                 ),
             )
-        rec.log("maps/beta", rr.Image(_colors(mean[::-1], "magma", 0.0, 1.0)))
-        rec.log("maps/variance", rr.Image(_colors(var[::-1], "Blues", 0.0, float(var.max()))))
+        rec.log("maps/beta", rr.Tensor(mean[::-1], dim_names=("y", "x"), value_range=(0.0, 1.0)))
         rec.log("metrics/beta", rr.Scalars(poke.record.beta))
+        var = _map_variance(result, k, field.variance)
+        rec.log("maps/variance", rr.Tensor(var[::-1], dim_names=("y", "x")))
         rec.log("metrics/max_variance", rr.Scalars(float(var.max())))
         _log_modulus(rec, result, k)
 
 
+def _map_variance(result: Any, k: int, beta_variance: NDArray) -> NDArray:
+    """The variance of the field the map runs on after ``k`` pokes (the β-field's, or the
+    modulus field's once it holds a poke when the map runs on it)."""
+    if getattr(getattr(result, "config", None), "field", "beta") == "modulus":
+        field = result.modulus_field_after(k)
+        if len(field.pokes):
+            return np.asarray(field.variance)
+    return np.asarray(beta_variance)
+
+
+def _log_regions(rec: Any, result: Any) -> None:
+    """The final regions as a segmentation image named by class (R1, R2, …: mean β over the
+    region's cells)."""
+    import rerun as rr
+
+    regions = getattr(result, "regions", None)
+    if regions is None:
+        return
+    rec.set_time("poke", sequence=len(result.pokes))
+    labels = np.asarray(regions.labels)
+    mean = np.asarray(result.field.mean)
+    infos = []
+    for k in np.unique(labels[labels >= 0]):
+        colour = (np.array(colormaps["tab10"](int(k) % 10)[:3]) * 255).astype(np.uint8)
+        infos.append(rr.AnnotationInfo(id=int(k) + 1, color=colour,
+                                       label=f"R{k + 1}: β = {mean[labels == k].mean():.2f}"))
+    rec.log("maps/regions", rr.AnnotationContext(infos), static=True)
+    # ids from 1: 0 is the "no class" of a segmentation image (cells without a region, -1)
+    rec.log("maps/regions", rr.SegmentationImage((labels + 1)[::-1].astype(np.uint16)))
+
+
 def _log_modulus(rec: Any, result: Any, k: int) -> None:
-    """The modulus field after ``k`` pokes: ``maps/modulus_kpa`` (log₁₀ E in kPa coloured over
-    0.1 kPa – 10 MPa: soft foams to stiff rubbers), ``metrics/modulus_kpa`` (the poke's E, or
-    its detection bound when rigid) and ``metrics/modulus_max_variance`` (of ln E); nothing while
-    no poke has a modulus."""
+    """The modulus field after ``k`` pokes: ``maps/modulus_kpa`` (the median E in kPa),
+    ``metrics/modulus_kpa`` (the poke's E, or its detection bound when rigid) and
+    ``metrics/modulus_max_variance`` (of ln E); nothing while no poke has a modulus."""
     import rerun as rr
 
     field = result.modulus_field_after(k)
     if not len(field.pokes):
         return
-    log_kpa = np.log10(field.median_pa / 1e3)
-    rec.log("maps/modulus_kpa", rr.Image(_colors(log_kpa[::-1], "viridis", -1.0, 4.0)))
+    kpa = np.asarray(field.median_pa) / 1e3
+    rec.log("maps/modulus_kpa", rr.Tensor(kpa[::-1], dim_names=("y", "x")))
     reading = field.readings[-1]
     if reading.log_modulus is not None:
         rec.log("metrics/modulus_kpa", rr.Scalars(float(np.exp(reading.log_modulus) / 1e3)))

@@ -13,11 +13,17 @@ from typing import Any
 
 import numpy as np
 from matplotlib.figure import Figure
-from matplotlib.ticker import FuncFormatter, ScalarFormatter
+from matplotlib.ticker import FixedLocator, FuncFormatter, MaxNLocator, NullLocator, ScalarFormatter
 
 from deformap.viz._save import save_figure
 
 __all__ = ["plot_cluster_size_study", "plot_hardness_study"]
+
+_MARKERS, _LINES = "osv^<>", ("-", "--", "-.", ":")
+_DODGE = 1.03
+"""The factor between neighbouring protocols' x on the log hardness axis: about a marker's width,
+enough to tell points apart where protocols read the same β, small beside the 1.4× or more between
+tested foams."""
 
 
 def _hardness_axis(rows: list[dict[str, Any]]) -> tuple[list[float], float]:
@@ -45,28 +51,45 @@ def plot_hardness_study(study: dict[str, Any], *, path: str | Path | None = None
             save_figure(fig, path, dpi=110)
         return fig
     rows = [r for r in study["rows"] if not r.get("refused")]
-    _, rigid_x = _hardness_axis(rows)
-    fig = Figure(figsize=(7, 4.5), layout="constrained")
+    finite, rigid_x = _hardness_axis(rows)
+    fig = Figure(figsize=(7.5, 4.8), layout="constrained")
     ax = fig.subplots()
-    for protocol in dict.fromkeys(r["protocol"] for r in rows):
+    protocols = list(dict.fromkeys(r["protocol"] for r in rows))
+    for i, protocol in enumerate(protocols):
         sub = [r for r in rows if r["protocol"] == protocol]
-        x = np.array([rigid_x if r["hardness_n"] is None else r["hardness_n"] for r in sub])
-        y = np.array([r["beta"] for r in sub])
-        err = np.nan_to_num(np.array([r["beta_std"] for r in sub]))
-        order = np.argsort(-x)
+        # each protocol a little apart in x (a factor about 1.03 per protocol, on the log axis)
+        # and with its own marker and line, so protocols reading the same β stay visible
+        dodge = _DODGE ** (i - (len(protocols) - 1) / 2)
+        foams = sorted((r for r in sub if r["hardness_n"] is not None),
+                       key=lambda r: -r["hardness_n"])  # fmt: skip
         mono = study.get("monotone", {}).get(protocol)
         label = protocol + ("" if mono is None else (" ✓ monotone" if mono else " ✗ not monotone"))
-        ax.errorbar(x[order], y[order], yerr=err[order], marker="o", capsize=3, label=label)
+        style: dict[str, Any] = {"color": f"C{i % 10}", "marker": _MARKERS[i % len(_MARKERS)],
+                                 "capsize": 3, "ls": _LINES[i % len(_LINES)], "mfc": "none",
+                                 "mew": 1.5}  # fmt: skip
+        if foams:
+            ax.errorbar([r["hardness_n"] * dodge for r in foams], [r["beta"] for r in foams],
+                        yerr=np.nan_to_num([r["beta_std"] for r in foams]), label=label,
+                        **style)  # fmt: skip
+        for r in (r for r in sub if r["hardness_n"] is None):  # the rigid board: its own tick
+            ax.errorbar([rigid_x * dodge], [r["beta"]], yerr=np.nan_to_num([r["beta_std"]]),
+                        **{**style, "ls": "none", "marker": "D", "mfc": style["color"]},
+                        label=None if foams else label)  # fmt: skip
     ax.set_xscale("log")
     ax.invert_xaxis()
-    ax.axvline(rigid_x / 1.25, color="0.7", ls=":")
-    # at the top: the rigid board's β, near 0, would sit under the word
-    ax.annotate("rigid", (rigid_x, 0.98), ha="center", va="top", fontsize=9)
+    ax.axvline(np.sqrt(rigid_x * max(finite, default=rigid_x / 1.6)), color="0.7", ls=":")
+    ticks = [*finite, rigid_x] if any(r["hardness_n"] is None for r in rows) else finite
+    ax.xaxis.set_major_locator(FixedLocator(ticks))
+    ax.xaxis.set_major_formatter(FuncFormatter(
+        lambda v, _: "rigid" if np.isclose(v, rigid_x) else f"{v:g}"))  # fmt: skip
+    ax.xaxis.set_minor_locator(NullLocator())
+    if any(r["hardness_n"] is None for r in rows):
+        ax.plot([], [], "D", color="0.3", label="rigid board (filled ◆, its own tick)")
     ax.set_xlabel("hardness H [N] (ISO 2439, log scale; softer →)")
-    ax.set_ylabel("estimated β")
-    ax.set_ylim(-0.03, 1.03)
+    ax.set_ylabel("estimated β [–]")
+    ax.set_ylim(-0.05, 1.05)
     ax.set_title("β against hardness (same force, same places)")
-    # β rises to the right (softer), so the lower right is free; upper left holds "rigid"
+    # β rises to the right (softer), so the lower right is free
     ax.legend(fontsize=8, loc="lower right")
     if path is not None:
         save_figure(fig, path, dpi=110)
@@ -164,6 +187,7 @@ def plot_cluster_size_study(study: dict[str, Any], *, path: str | Path | None = 
             marker="o",
             label=label,
         )
+    ax.xaxis.set_major_locator(MaxNLocator(integer=True))
     ax.set_xlabel("cluster size k (k×k particles)")
     ax.set_ylabel("fit error min E(β) [mm]")
     ax.set_title("shape-matching fit error against cluster size")

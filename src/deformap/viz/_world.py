@@ -48,9 +48,14 @@ def show_world(world: SimulatedWorld, out: str | Path, *, force_n: float) -> lis
     for k, b in enumerate(world.regions):
         ax.add_patch(Polygon(b.polygon, closed=True, facecolor=b.color, edgecolor="k", alpha=0.9))
         cx, cy = b.polygon.mean(axis=0)
-        text = "rigid" if b.rigid else f"{b.hardness:.0f} N\nE = {b.modulus_pa / 1e3:.1f} kPa"
-        ax.text(cx, cy, f"[{k}] {b.name}\n{text}\nt = {b.thickness_m * 100:.0f} cm",
-                ha="center", va="center", fontsize=9)
+        lines = [f"[{k}] {b.name}"]
+        if b.rigid:
+            lines += [] if b.name == "rigid" else ["rigid"]  # the name may say it already
+        else:
+            lines += [f"{b.hardness:.0f} N", f"E = {b.modulus_pa / 1e3:.1f} kPa"]
+        ax.text(cx, cy, "\n".join([*lines, f"t = {b.thickness_m * 100:.0f} cm"]), ha="center",
+                va="center", fontsize=9,
+                bbox={"boxstyle": "round,pad=0.2", "fc": "w", "ec": "none", "alpha": 0.6})
     (x0, y0), (w, d) = world.workspace.lower, world.workspace.size
     ax.add_patch(Rectangle((x0, y0), w, d, fill=False, linestyle="--", edgecolor="b"))
     cam = world.camera.origin
@@ -89,7 +94,8 @@ def _dent_figure(world: SimulatedWorld, out: Path, force: float) -> Path:
     before = world.surface_height(xs, ys)
     after = world.surface_height(xs, ys, dent.displacement)
     fig = Figure(figsize=(16, 4.5), layout="constrained")
-    axes = fig.subplots(1, 3)
+    # the section wider: drawn to scale (equal aspect), it is short and needs the width
+    axes = fig.subplots(1, 3, width_ratios=(1.0, 1.0, 1.4))
     ext = (xs[0], xs[-1], ys[0], ys[-1])
     panels = ((axes[0], before, "surface before"), (axes[1], after, "surface pressed"))
     for ax, img, title in panels:
@@ -110,9 +116,13 @@ def _dent_figure(world: SimulatedWorld, out: Path, force: float) -> Path:
     ax.plot((tip[0] + r * np.cos(theta)) * 1e3, (tip[2] + r * np.sin(theta)) * 1e3, "k",
             label="tip")
     ax.set_aspect("equal")
+    # the middle half of the section (the dent and its rim): to scale, the whole 12 cm would
+    # leave the panel a sliver
     ax.set(xlabel="x [mm]", ylabel="z [mm]", ylim=(after.min() * 1e3 - 5, before.max() * 1e3 + 25),
-           title=f"{force:.2f} N at ({target[0]:.2f}, {target[1]:.2f}): "
-                 f"dent {dent.depth_m * 1e3:.1f} mm, a = {dent.contact_radius_m * 1e3:.1f} mm")
+           xlim=((target[0] - 0.03) * 1e3, (target[0] + 0.03) * 1e3),
+           title=f"section: {force:.2f} N at ({target[0]:.2f}, {target[1]:.2f}) m\n"
+                 f"dent {dent.depth_m * 1e3:.1f} mm, contact radius a = "
+                 f"{dent.contact_radius_m * 1e3:.1f} mm")
     # beside the axes: inside, the legend would cover the tip (the equal aspect leaves the panel short)
     ax.legend(fontsize=7, loc="center left", bbox_to_anchor=(1.02, 0.5))
     return save_figure(fig, out / "dent.png", dpi=120, bbox_inches="tight")

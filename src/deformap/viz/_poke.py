@@ -1,0 +1,202 @@
+"""The figures of one poke: ``poke-NN.png`` (the paper's Fig. 4) and the error curve E(β).
+
+``poke-NN.png`` has two rows. Above: the ROI before the poke (the surface GP) on a colour scale of
+its own, so that its relief shows; the cloud while pressing with the tactile points; E(β) with β̂.
+Below, on one colour scale: the observed dent (the touch GP), the shape-matching surface at β̂
+beside it, and a section through the contact with both. Every panel names its axes and units;
+legends sit outside the axes, where they cover no data.
+
+Built on :class:`matplotlib.figure.Figure` without ``pyplot``; written atomically when given a path.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from matplotlib.axes import Axes
+from matplotlib.figure import Figure
+from numpy.typing import NDArray
+
+from deformap.viz._save import save_figure
+
+__all__ = ["plot_beta_curve", "plot_error_curve", "plot_poke"]
+
+MIN_COLOUR_SPAN_M = 1e-3
+"""The narrowest height span a colour scale of the surface before the poke covers (metres). A
+structured-light depth camera's random error is about 1.6 mm · z² at range z in metres (Kinect v1,
+Khoshelham & Elberink 2012, Fig. 9; the world's camera model uses the same), so relief under a
+millimetre at a metre is the surface GP's smoothing of noise, which a narrower scale would paint as
+structure.
+
+References
+----------
+Khoshelham, K., Elberink, S. O. (2012). Accuracy and resolution of Kinect depth data for indoor
+mapping applications. Sensors 12(2), 1437–1454.
+"""
+
+_BELOW: dict[str, Any] = {"loc": "upper center", "bbox_to_anchor": (0.5, -0.2), "fontsize": 8,
+                          "frameon": False}  # fmt: skip
+
+
+def plot_beta_curve(ax: Axes, betas: NDArray, errors: NDArray, beta_hat: float, std: float) -> None:
+    """Draw E(β) with the estimate and its uncertainty band on ``ax``."""
+    order = np.argsort(betas)
+    ax.plot(np.asarray(betas)[order], np.asarray(errors)[order] * 1e3, "-", color="k")
+    ax.axvline(beta_hat, color="r", label=f"β̂ = {beta_hat:.3f} ± {std:.3f}")
+    ax.axvspan(max(0.0, beta_hat - std), min(1.0, beta_hat + std), color="r", alpha=0.15)
+    ax.set_xlabel("β [–]")
+    ax.set_ylabel("E(β) [mm]")
+    ax.legend(fontsize=8)
+
+
+def plot_error_curve(
+    betas: NDArray[np.float64],
+    errors: NDArray[np.float64],
+    beta: float,
+    beta_std: float,
+    *,
+    title: str = "shape-matching error E(β)",
+    path: str | Path | None = None,
+) -> Figure:
+    """A figure of its own holding :func:`plot_beta_curve`: E(β), β̂ and its uncertainty band.
+
+    Parameters
+    ----------
+    betas, errors : (m,) float
+        The βs tried and their error E(β) in metres (drawn in millimetres), in any order.
+    beta, beta_std : float
+        The estimate β̂ and its standard deviation.
+    title : str
+        The axes' title.
+    path : str or Path, optional
+        Where to write the figure (110 dpi, format from the suffix); nothing is written without it.
+    """
+    fig = Figure(figsize=(5.0, 3.6), layout="constrained")
+    ax = fig.subplots()
+    plot_beta_curve(ax, betas, errors, beta, beta_std)
+    ax.set_title(title)
+    if path is not None:
+        save_figure(fig, path, dpi=110)
+    return fig
+
+
+def _extent(xs: NDArray, ys: NDArray) -> tuple[float, float, float, float]:
+    dx = (xs[1] - xs[0]) / 2 if xs.size > 1 else 0.0025
+    dy = (ys[1] - ys[0]) / 2 if ys.size > 1 else 0.0025
+    return (xs[0] - dx, xs[-1] + dx, ys[0] - dy, ys[-1] + dy)
+
+
+def _span(values: NDArray, minimum: float) -> tuple[float, float]:
+    """``(low, high)`` of the finite ``values``, widened about its middle to ``minimum``."""
+    finite = np.asarray(values, dtype=float)
+    finite = finite[np.isfinite(finite)]
+    low, high = (float(finite.min()), float(finite.max())) if finite.size else (0.0, 0.0)
+    if high - low < minimum:
+        mid = 0.5 * (low + high)
+        low, high = mid - minimum / 2, mid + minimum / 2
+    return low, high
+
+
+def plot_poke(
+    *,
+    roi_xs: NDArray[np.float64],
+    roi_ys: NDArray[np.float64],
+    rest_z: NDArray[np.float64],
+    deformed_z: NDArray[np.float64],
+    roi_points: NDArray[np.float64],
+    tactile: NDArray[np.float64],
+    betas: NDArray[np.float64],
+    errors: NDArray[np.float64],
+    beta: float,
+    beta_std: float,
+    simulated_z: NDArray[np.float64] | None = None,
+    title: str = "",
+    path: str | Path | None = None,
+) -> Figure:
+    """One poke's figure: the ROI before, the cloud while pressing, E(β); the observed dent, the
+    simulated one at β̂ and a section through both.
+
+    Parameters
+    ----------
+    roi_xs, roi_ys : (nx,), (ny,) float, metres
+        Grid of the region of interest around the contact.
+    rest_z, deformed_z : (ny, nx) float, metres
+        Heights before (surface GP) and while pressing (touch GP).
+    roi_points : (n, 3) float, metres
+        The cloud in the ROI while pressing, the robot removed.
+    tactile : (t, 3) float, metres
+        The tactile points added on the probe's tip.
+    betas, errors : (m,) float
+        The βs tried and their error E(β) in metres.
+    beta, beta_std : float
+        The estimate β̂ and its standard deviation.
+    simulated_z : (ny, nx) float, metres, optional
+        The shape-matching surface at β̂ (its particles' heights, on the ROI grid at rest); its
+        panel says "not simulated" without it.
+    title : str
+        The figure's title.
+    path : str or Path, optional
+        Where to write the figure (100 dpi, format from the suffix); nothing is written without it.
+    """
+    fig = Figure(figsize=(15, 8.6), layout="constrained")
+    (before, cloud, curve), (observed, simulated, section) = fig.subplots(2, 3)
+    ext = _extent(roi_xs, roi_ys)
+    low, high = _span(rest_z, MIN_COLOUR_SPAN_M)
+    im = before.imshow(rest_z * 1e3, origin="lower", extent=ext, vmin=low * 1e3, vmax=high * 1e3,
+                       cmap="viridis")  # fmt: skip
+    fig.colorbar(im, ax=before, label="z [mm] (own scale)")
+    before.set_title("ROI before (surface GP)")
+    # one scale for the dent's three views, from the deepest surface to the rest surface's top
+    dents = [deformed_z] + ([] if simulated_z is None else [simulated_z])
+    low = min(float(np.nanmin(d)) for d in dents)
+    high = max(float(np.nanmax(rest_z)), low + MIN_COLOUR_SPAN_M)
+    scale = {"vmin": low * 1e3, "vmax": high * 1e3, "cmap": "viridis"}
+    sc = cloud.scatter(roi_points[:, 0], roi_points[:, 1], c=roi_points[:, 2] * 1e3, s=4, **scale)
+    cloud.plot(tactile[:, 0], tactile[:, 1], "r.", ms=6, label="tactile points")
+    cloud.set(xlim=ext[:2], ylim=ext[2:], aspect="equal")
+    cloud.legend(**_BELOW)
+    cloud.set_title("cloud while pressing (robot removed)")
+    fig.colorbar(sc, ax=cloud, label="z [mm]", extend="both")
+    im = observed.imshow(deformed_z * 1e3, origin="lower", extent=ext, **scale)
+    observed.set_title("observed dent (touch GP)")
+    fig.colorbar(im, ax=observed, label="z [mm]")
+    if simulated_z is None:
+        simulated.text(0.5, 0.5, "not simulated", ha="center", va="center",
+                       transform=simulated.transAxes)  # fmt: skip
+        simulated.set(xlim=ext[:2], ylim=ext[2:])
+    else:
+        im = simulated.imshow(simulated_z * 1e3, origin="lower", extent=ext, **scale)
+        fig.colorbar(im, ax=simulated, label="z [mm]")
+    simulated.set_title(f"shape matching at β̂ = {beta:.3f}")
+    for ax in (before, cloud, observed, simulated):
+        ax.set(xlabel="x [m]", ylabel="y [m]")
+    _section(section, roi_xs, roi_ys, rest_z, deformed_z, simulated_z, roi_points)
+    plot_beta_curve(curve, betas, errors, beta, beta_std)
+    curve.set_title("shape-matching error E(β)")
+    if title:
+        fig.suptitle(title)
+    if path is not None:
+        save_figure(fig, path, dpi=100)
+    return fig
+
+
+def _section(ax: Axes, xs: NDArray, ys: NDArray, rest_z: NDArray, deformed_z: NDArray,
+             simulated_z: NDArray | None, points: NDArray) -> None:
+    """The row of the ROI through its middle (the contact): before, observed, simulated, and the
+    cloud's points within one cell of it."""
+    mid = rest_z.shape[0] // 2
+    ax.plot(xs, rest_z[mid] * 1e3, "k--", label="before (surface GP)")
+    ax.plot(xs, deformed_z[mid] * 1e3, "b-", lw=2, label="observed dent (touch GP)")
+    if simulated_z is not None:
+        ax.plot(xs, simulated_z[mid] * 1e3, "r-", label="shape matching at β̂")
+    cell = (ys[1] - ys[0]) if ys.size > 1 else np.inf
+    near = np.abs(points[:, 1] - ys[mid]) < cell
+    ax.plot(points[near, 0], points[near, 2] * 1e3, ".", color="0.6", ms=3,
+            label="cloud points on the section")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("z [mm]")
+    ax.set_title(f"section through the contact (y = {ys[mid]:.3f} m)")
+    # below the axes: inside, it would cover the dent, which is at the section's middle
+    ax.legend(ncols=2, **_BELOW)
