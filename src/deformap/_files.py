@@ -5,6 +5,12 @@ a run folder (``config.yaml``, ``report.json``, ...), figures and recordings. A 
 under a temporary name beside its destination (same folder, so the same file system), fsynced,
 renamed onto the destination with :func:`os.replace`, and the folder is fsynced so that the rename
 itself is durable (POSIX keeps it in the folder's cache until then).
+
+A destination that exists must be a regular file (or a symbolic link, which the rename replaces,
+not its target): renaming onto a FIFO, a device or a socket would replace that node with a plain
+file (``--json /dev/zero`` run as root would replace the device), and onto a folder fails late.
+Such a destination, or a path that names no file (``""``, ``.``), is refused before anything is
+written.
 """
 
 from __future__ import annotations
@@ -12,10 +18,41 @@ from __future__ import annotations
 import contextlib
 import os
 import secrets
+import stat
 from collections.abc import Iterator
 from pathlib import Path
 
-__all__ = ["atomic_path", "replace_durably", "write_text_atomically"]
+from deformap.errors import InvalidArgumentError
+
+__all__ = ["atomic_path", "check_destination", "replace_durably", "write_text_atomically"]
+
+_KINDS = ((stat.S_ISDIR, "a folder"), (stat.S_ISFIFO, "a FIFO"), (stat.S_ISCHR, "a device"),
+          (stat.S_ISBLK, "a device"), (stat.S_ISSOCK, "a socket"))
+
+
+def check_destination(path: str | Path) -> Path:
+    """``path`` as a :class:`~pathlib.Path`, if a file may be written there by renaming onto it.
+
+    Raises
+    ------
+    InvalidArgumentError
+        The path names no file (empty, ``.`` or ``..``), or it exists as something other than a
+        regular file or a symbolic link.
+    """
+    out = Path(path)
+    if str(path) == "" or out.name in ("", ".", ".."):
+        raise InvalidArgumentError(f"{str(path)!r}: expected the name of a file to write")
+    try:
+        mode = os.lstat(out).st_mode
+    except FileNotFoundError:
+        return out
+    except OSError as error:  # a name too long, a parent that is a file, no permission
+        raise InvalidArgumentError(f"{out}: cannot be written ({error.strerror})") from None
+    for test, kind in _KINDS:
+        if test(mode):
+            raise InvalidArgumentError(
+                f"{out}: expected a regular file or a new name to write, got {kind}")
+    return out
 
 
 def _fsync_folder(folder: Path) -> None:
@@ -38,9 +75,10 @@ def atomic_path(path: str | Path) -> Iterator[Path]:
     """Yield a temporary path beside ``path`` (same suffix) for a writer to create; when the
     block ends without an error it is fsynced and renamed onto ``path``.
 
-    If the block raises, the temporary file is removed and ``path`` is left as it was.
+    If the block raises, the temporary file is removed and ``path`` is left as it was. A
+    destination that is no regular file is refused first (:func:`check_destination`).
     """
-    out = Path(path)
+    out = check_destination(path)
     # a hidden name unique to this write, created by the writer: open() honours the umask, so the
     # file gets the permissions a plain write would (mkstemp's are owner-only)
     tmp = out.with_name(f".{out.stem}.{secrets.token_hex(4)}.tmp{out.suffix}")

@@ -148,3 +148,30 @@ def test_json_is_strict_nan_as_null_dates_as_iso(tmp_path: Path) -> None:
     assert json.loads((tmp_path / "r.json").read_text())["when"] == "2020-01-02"
     with pytest.raises(TypeError, match="not JSON serialisable: object"):
         to_json({"bad": object()})
+
+
+def test_a_destination_that_is_no_regular_file_is_refused_not_replaced(tmp_path: Path) -> None:
+    from deformap._files import check_destination, write_text_atomically
+    from deformap.errors import InvalidArgumentError
+
+    fifo = tmp_path / "pipe"
+    os.mkfifo(fifo)
+    folder = tmp_path / "folder"
+    folder.mkdir()
+    for path, kind in ((fifo, "a FIFO"), (folder, "a folder"), (Path("/dev/null"), "a device")):
+        with pytest.raises(InvalidArgumentError, match=f"got {kind}"):
+            write_text_atomically(path, "{}")
+    assert fifo.is_fifo() and Path("/dev/null").is_char_device()  # left as they were
+    for name in ("", ".", ".."):
+        with pytest.raises(InvalidArgumentError, match="expected the name of a file"):
+            check_destination(name)
+    # a regular file is replaced; a symbolic link is replaced itself, its target left alone
+    plain = tmp_path / "plain.json"
+    plain.write_text("old")
+    write_text_atomically(plain, "new")
+    assert plain.read_text() == "new"
+    link = tmp_path / "link.json"
+    link.symlink_to(plain)
+    write_text_atomically(link, "via link")
+    assert not link.is_symlink() and link.read_text() == "via link"
+    assert plain.read_text() == "new"

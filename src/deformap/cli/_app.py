@@ -25,6 +25,7 @@ from rich.console import Console
 from rich.text import Text
 
 from deformap import __version__, run
+from deformap._files import check_destination
 from deformap.errors import ConfigError, DeformapError, InvalidArgumentError
 
 __all__ = [
@@ -80,19 +81,18 @@ def _json_target(value: Path | None) -> Path | None:
     if value is None or str(value) == "-":
         return value
     try:
+        check_destination(value)  # a FIFO, device, socket or folder is never written over
         parent = value.parent
         while not parent.exists() and parent != parent.parent:  # the nearest folder that exists
             parent = parent.parent
-        problem = (
-            "it is a folder" if value.is_dir()
-            else f"{str(parent)!r} is not a folder" if not parent.is_dir()
-            else None
-        )  # fmt: skip
+        problem = f"{str(parent)!r} is not a folder" if not parent.is_dir() else None
         if problem is None:
             with tempfile.TemporaryFile(dir=parent):  # what the folder's file system will take
                 pass
     except OSError as exc:
         problem = exc.strerror or str(exc)
+    except InvalidArgumentError as exc:
+        problem = str(exc)
     if problem is not None:
         err_console.print(labelled("error:", "bold red", (
             f"--json must name a file that can be written; got {str(value)!r}: {problem}")),

@@ -455,8 +455,9 @@ def estimate_stiffness(travel_m: Any, force_n: Any, *, tip_radius_m: float, thic
         noise, force not rising, a travel not below the thickness (millimetres for metres), a
         last force far from the commanded one, a bad radius or thickness, or a record that leaves
         the contact model's range (an indentation deeper than the tip's diameter, where the
-        sphere is buried and the stick holding it presses too; ``χ`` above 1; an indentation deeper than half the layer; or
-        a modulus on the fit's lower bound): the tip sank too deep to read the layer.
+        sphere is buried and the stick holding it presses too; ``χ`` above 1; an indentation
+        deeper than half the layer; or a modulus on the fit's lower bound): the tip sank too
+        deep to read the layer.
     """
     config = StiffnessConfig() if config is None else config
     radius = check_positive("tip_radius_m", tip_radius_m)
