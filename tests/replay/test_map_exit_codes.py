@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import pytest
 from typer.testing import CliRunner
 
 from deformap.cli import app
@@ -77,3 +78,13 @@ def test_a_session_with_records_maps_on_the_modulus(tmp_path: Path, synthetic,  
                                "--no-figures"]).exit_code == 0
     report = json.loads((out / "report.json").read_text())
     assert report["field"] == "modulus" and report["field_fallback"] is None
+
+
+@pytest.mark.parametrize("bad", ["nan", "0", "-1"])
+def test_map_refuses_a_bad_variance_max_before_reading_the_session(tmp_path: Path,
+                                                                   bad: str) -> None:
+    out = tmp_path / "result"
+    result = CliRunner().invoke(app, ["map", str(tmp_path / "no-session"), "--variance-max", bad,
+                                      "--out", str(out)])  # fmt: skip
+    assert result.exit_code == 2
+    assert "`variance_max` must be" in result.output and not out.exists()

@@ -30,6 +30,7 @@ from deformap.errors import ConfigError, DeformapError, InvalidArgumentError
 
 __all__ = [
     "JsonOption",
+    "VarianceMaxOption",
     "app",
     "console",
     "emit_json",
@@ -99,6 +100,13 @@ def _json_target(value: Path | None) -> Path | None:
             soft_wrap=True)
         raise typer.Exit(code=2)
     return value
+
+
+VarianceMaxOption = Annotated[
+    float | None,
+    typer.Option(help="Top of map.png's variance colour scale, the same in every run drawn "
+                 "with it so that runs compare (default: each map's own largest variance)."),
+]
 
 
 JsonOption = Annotated[

@@ -13,6 +13,7 @@ from rich.table import Table
 from deformap import run
 from deformap.cli._app import (
     JsonOption,
+    VarianceMaxOption,
     app,
     emit_json,
     friendly_errors,
@@ -153,11 +154,7 @@ def explore_command(
         list[str] | None,
         typer.Option("--env-arg", help="key=value passed to the --environment factory (repeat)."),
     ] = None,
-    variance_max: Annotated[
-        float | None,
-        typer.Option(help="Top of map.png's variance colour scale, the same in every run drawn "
-                     "with it so that runs compare (default: each map's own largest variance)."),
-    ] = None,
+    variance_max: VarianceMaxOption = None,
     json_path: JsonOption = None,
 ) -> None:
     """Explore a simulated world (or your own Environment): poke until the map field is known,

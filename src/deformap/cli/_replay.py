@@ -11,6 +11,7 @@ import typer
 from deformap import run
 from deformap.cli._app import (
     JsonOption,
+    VarianceMaxOption,
     app,
     emit_json,
     err_console,
@@ -91,6 +92,7 @@ def map_command(
         int | None, typer.Option(help="Seed of the surface fit; default: the session's.")
     ] = None,
     figures: Annotated[bool, typer.Option(help="Write map.png and poke-NN.png.")] = True,
+    variance_max: VarianceMaxOption = None,
     layout: Annotated[str, typer.Option(
         help="auto | session | raw: raw reads SESSION as a bag a robot recorded (camera, force "
              "sensor, /tf); auto tells them apart.")] = "auto",
@@ -123,6 +125,7 @@ def map_command(
     shown = out_console(json_path)
     with progress(shown) as bar:
         output = run.map_recorded_session(session, out, config=cfg, seed=seed, figures=figures,
+                                          variance_max=variance_max,
                                           hooks=run_hooks(bar, poke_row=poke_row),
                                           layout=layout,  # type: ignore[arg-type]
                                           raw_config=raw_config,

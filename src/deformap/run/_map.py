@@ -13,6 +13,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Literal
 
+from deformap._validation import check_positive
 from deformap.errors import InvalidArgumentError
 from deformap.replay import (
     RecordedSession,
@@ -79,6 +80,7 @@ def map_recorded_session(
     layout: Literal["auto", "session", "raw"] = "auto",
     raw_config: Path | None = None,
     raw_settings: dict[str, Any] | None = None,
+    variance_max: float | None = None,
 ) -> MapOutput:
     """Map the session at ``session`` (its folder or its ``session.yaml``) into ``out``.
 
@@ -104,6 +106,8 @@ def map_recorded_session(
         ``replay.raw_config_file``, if it exists).
     raw_settings : dict, optional
         ``replay.RawBagConfig`` settings that win over the file's (command-line options).
+    variance_max : float, optional
+        Top of ``map.png``'s variance colour scale (default: the map's own largest variance).
 
     Raises
     ------
@@ -111,6 +115,8 @@ def map_recorded_session(
         The session cannot be loaded, its recorded configuration is malformed, or ``out`` is not
         empty or not creatable (before any poke is mapped).
     """
+    if variance_max is not None:  # before any work
+        check_positive("variance_max", variance_max)
     recorded = _open(session, config, layout, raw_config, raw_settings or {})
     cfg = session_run_config(recorded, config, seed)
     stem = recorded.path.name or "session"
@@ -126,7 +132,8 @@ def map_recorded_session(
     report = session_report(cfg, recorded, replay)
     write_run_results(folder, replay.result, report, figures=figures,
                       truth=recorded.ground_truth,
-                      title=f"{stem}: {len(replay.result.pokes)} pokes", hooks=hooks)  # fmt: skip
+                      title=f"{stem}: {len(replay.result.pokes)} pokes", hooks=hooks,
+                      variance_max=variance_max)  # fmt: skip
     return MapOutput(report=report, session=recorded, replay=replay, config=cfg, folder=folder)
 
 
