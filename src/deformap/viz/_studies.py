@@ -89,8 +89,9 @@ def plot_hardness_study(study: dict[str, Any], *, path: str | Path | None = None
     ax.set_ylabel("estimated β [–]")
     ax.set_ylim(-0.05, 1.05)
     ax.set_title("β against hardness (same force, same places)")
-    # β rises to the right (softer), so the lower right is free
-    ax.legend(fontsize=8, loc="lower right")
+    # β rises to the right (softer) and protocols that cannot tell foams apart lie along β = 0,
+    # so the upper left (high β on stiff foams) is the corner no curve reaches
+    ax.legend(fontsize=8, loc="upper left")
     if path is not None:
         save_figure(fig, path, dpi=110)
     return fig
