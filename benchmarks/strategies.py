@@ -85,26 +85,40 @@ def run_one(name: str, scenario: Any, seed: int, strategy: str, max_pokes: int) 
             "curve": curve}
 
 
+def _accuracy(run: dict[str, Any], cut: str, max_pokes: int) -> np.ndarray:
+    """Accuracy after each poke, the last one held to ``max_pokes`` (a run that stopped)."""
+    acc = [c[cut]["accuracy"] for c in run["curve"]]
+    return np.array(acc + acc[-1:] * (max_pokes - len(acc)))
+
+
 def _summary(runs: list[dict[str, Any]], max_pokes: int, goal: float) -> None:
-    print(f"pokes to region accuracy {goal} (median over runs; never: {max_pokes + 1}), "
-          f"accuracy at 5, 10, {max_pokes} pokes (median, min)")
+    """A markdown table: per strategy and cut, over the runs, the median pokes to ``goal`` (a run
+    that never reaches it counts ``max_pokes + 1``), how many reach it, and the accuracy after 5,
+    10 and ``max_pokes`` pokes (median, min)."""
+    at = sorted(k for k in {5, 10, max_pokes} if k <= max_pokes)
+    print(f"| strategy | cut | runs | median pokes to {goal} | runs reaching {goal} | "
+          + " | ".join(f"accuracy at {k}: median (min)" for k in at) + " |")
+    print("|---|---|---|---|---|" + "---|" * len(at))
     for strategy in STRATEGIES:
         mine = [r for r in runs if r["strategy"] == strategy]
         if not mine:
             continue
         for cut in CUTS:
-            acc = np.array([[c[cut]["accuracy"] for c in r["curve"]]
-                            + [r["curve"][-1][cut]["accuracy"]] * (max_pokes - len(r["curve"]))
-                            for r in mine])
+            acc = np.array([_accuracy(r, cut, max_pokes) for r in mine])
             reach = [int(np.argmax(a >= goal)) + 1 if np.any(a >= goal) else max_pokes + 1
                      for a in acc]
-            at = {k: acc[:, k - 1] for k in sorted({5, 10, max_pokes}) if k <= max_pokes}
-            print(f"{strategy:20s} {cut:18s} n={len(mine):2d} to-{goal}: "
-                  f"{np.median(reach):5.1f}  "
-                  + "  ".join(f"@{k}: {np.median(v):.3f} ({v.min():.3f})" for k, v in at.items()))
-        th = [r["t_h_poke"] or max_pokes + 1 for r in mine]
-        print(f"{strategy:20s} default-T_h reached at poke (median) {np.median(th):.1f}; "
-              f"mean run time {np.mean([r['seconds'] for r in mine]):.1f} s")
+            cells = " | ".join(f"{np.median(acc[:, k - 1]):.3f} ({acc[:, k - 1].min():.3f})"
+                               for k in at)
+            print(f"| {strategy} | {cut} | {len(mine)} | {np.median(reach):g} | "
+                  f"{sum(r <= max_pokes for r in reach)} | {cells} |")
+    print()
+    for strategy in STRATEGIES:
+        mine = [r for r in runs if r["strategy"] == strategy]
+        if mine:
+            th = [r["t_h_poke"] or max_pokes + 1 for r in mine]
+            seconds = np.median([r["seconds"] for r in mine])
+            print(f"{strategy}: the default T_h reached after {np.median(th):g} pokes (median; "
+                  f"range {min(th)}–{max(th)}); run time {seconds:.0f} s (median)")
 
 
 def main() -> None:
