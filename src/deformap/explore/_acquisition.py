@@ -18,6 +18,32 @@ Strategies
     all together (:mod:`deformap.explore._planning`) and planned again after every poke. How
     many pokes each strategy needs on the simulated scenarios is in the README ("Results", the
     paper's Table I).
+``level-set``
+    Aimed at the region boundaries from the first poke on: the reachable cell of largest
+    *straddle* score (Bryan et al. 2005), ``1.96 σ(x) − min_l |μ(x) − h_l|``, among those at least
+    a quarter ROI from every poke (the score and the spacing of the boundary pokes below). The
+    levels ``h_l`` are the map's current cut levels, the isopleths between the classes the region
+    test finds in the pokes so far (:func:`deformap.explore.poke_classes`, the midpoints of
+    neighbouring class means): those are the boundaries the map will draw, so a cell near one
+    of them whose field is still uncertain is the cell whose label a poke is most likely to
+    change. While the pokes form one class there is no level, and the score is ``σ(x)`` alone
+    (the least-known place, where a region not yet met is most likely to be found). Straddle,
+    rather than ILS-UCB (Garg et al. 2016), because it has no weight to choose: its 1.96 is the
+    95 % band within which a cell's side of ``h`` is not yet known.
+``integrated-variance``
+    The candidate that most reduces the posterior variance integrated over the workspace
+    (IMSE, Sacks et al. 1989): for a poke at ``x`` with noise ``σ_n²(x)``,
+    ``Σ_d k_post(d, x)² / (σ²(x) + σ_n²(x))`` over the cells ``d`` where the variance must fall
+    (an exact rank-one update of the posterior, which does not depend on the values). It is
+    evaluated on the planner's 2 cm lattices (:class:`deformap.explore.MapGrid`'s
+    ``plan_candidates`` and ``plan_domain``), so its cost is that of one (candidates × domain)
+    matrix however fine the map grid, and it takes the noise a poke there is expected to have
+    (:func:`deformap.explore._targets.expected_noise`). Myopic like ``min-max-variance``, but on
+    the mean of the variance rather than its maximum: it pokes where most of the map learns,
+    not where the worst cell is.
+
+Every strategy runs until the map field's variance is below ``T_h`` (the paper's stop); the
+boundary pokes, if any, follow.
 
 Boundary pokes (``boundary_pokes`` > 0, after any strategy)
     Once the variance is below ``T_h`` everywhere, the map is "known" in the paper's sense, but its
@@ -33,6 +59,10 @@ Boundary pokes (``boundary_pokes`` > 0, after any strategy)
 
 References
 ----------
+Sacks, J., Welch, W. J., Mitchell, T. J., Wynn, H. P. (1989). Design and analysis of computer
+experiments. Statistical Science 4(4), 409–423 (the integrated mean squared error criterion).
+Garg, A., Sen, S., Kapadia, R., et al. (2016). Tumor localization using automated palpation with
+Gaussian process adaptive sampling. IEEE CASE (the implicit level set UCB it is compared with).
 Bryan, B., Schneider, J., Nichol, R. C., Miller, C. J., Genovese, C. R., Wasserman, L. (2005).
 Active learning for identifying function threshold boundaries. NIPS 18.
 """
@@ -47,16 +77,22 @@ from numpy.typing import NDArray
 
 from deformap.errors import InvalidArgumentError
 
-__all__ = ["STRATEGIES", "Strategy", "boundary_score", "choose_target"]
+__all__ = ["SCORED", "STRATEGIES", "Strategy", "boundary_score", "choose_target"]
 
 #: The strategies' names: the one list, which ``ExplorationConfig.strategy`` is annotated with.
-Strategy = Literal["paper", "max-variance", "min-max-variance", "planned"]
+Strategy = Literal["paper", "max-variance", "min-max-variance", "planned", "level-set",
+                   "integrated-variance"]
 STRATEGIES: tuple[Strategy, ...] = get_args(Strategy)
 
 #: ``(candidates (c, 2)) -> (c,)`` largest posterior variance left if that candidate were poked.
 LookAhead = Callable[[NDArray[np.float64]], NDArray[np.float64]]
 #: ``() -> (2,)`` the next poke of a plan that reaches the threshold.
 Planner = Callable[[], NDArray[np.float64]]
+#: ``() -> (candidates (c, 2), scores (c,))`` a scored strategy's candidates (``level-set``,
+#: ``integrated-variance``); the largest score is poked.
+Scorer = Callable[[], tuple[NDArray[np.float64], NDArray[np.float64]]]
+#: The strategies that poke the best of their scorer's candidates.
+SCORED: tuple[Strategy, ...] = ("level-set", "integrated-variance")
 
 
 def choose_target(
@@ -68,13 +104,15 @@ def choose_target(
     *,
     look_ahead: LookAhead | None = None,
     planner: Planner | None = None,
+    scorer: Scorer | None = None,
     n_candidates: int = 256,
 ) -> NDArray[np.float64] | None:
     """Pick the next target, or ``None`` when no cell's variance exceeds ``threshold``.
 
     Parameters
     ----------
-    strategy : {"paper", "max-variance", "min-max-variance", "planned"}
+    strategy : {"paper", "max-variance", "min-max-variance", "planned", "level-set", \
+"integrated-variance"}
     cells_xy : (n, 2) float, metres
         Centres of the grid cells that may be poked.
     variance : (n,) float
@@ -87,6 +125,9 @@ def choose_target(
         Required by ``min-max-variance``.
     planner : callable, optional
         Required by ``planned``.
+    scorer : callable, optional
+        Required by ``level-set`` and ``integrated-variance``: their candidates and scores; the
+        first of the largest score is poked.
     n_candidates : int
         How many above-threshold cells ``min-max-variance`` evaluates (a seeded subsample).
     """
@@ -105,6 +146,11 @@ def choose_target(
         if planner is None:
             raise InvalidArgumentError("`planner` is required by strategy 'planned'")
         return np.array(planner(), dtype=float)
+    if strategy in SCORED:
+        if scorer is None:
+            raise InvalidArgumentError(f"`scorer` is required by strategy {strategy!r}")
+        candidates_xy, scores = scorer()
+        return np.array(candidates_xy[int(np.argmax(scores))], dtype=float)
     if look_ahead is None:
         raise InvalidArgumentError("`look_ahead` is required by strategy 'min-max-variance'")
     candidates = above

@@ -77,6 +77,7 @@ __all__ = [
     "MAX_MAP_CELLS",
     "MAX_PLAN_CELLS",
     "MAX_ROI_BAND_BYTES",
+    "PLANNER_STRATEGIES",
     "BetaFieldConfig",
     "BetaUncertainty",
     "DepthAnchor",
@@ -101,7 +102,7 @@ DepthAnchor = Literal["record", "tip"]
 #: Where the variance must fall below ``T_h`` (``ExplorationConfig.stop_region``).
 StopRegion = Literal["workspace", "targets"]
 #: How cells get their region (``ExplorationConfig.region_labels``).
-RegionLabels = Literal["isopleth", "nearest"]
+RegionLabels = Literal["isopleth", "nearest", "indicator-kriging"]
 #: Which field the regions and the next-poke choice run on (``ExplorationConfig.field``).
 FieldName = Literal["beta", "modulus"]
 #: Where a poke's β uncertainty comes from (``ExplorationConfig.beta_uncertainty``).
@@ -114,13 +115,16 @@ MAX_ROI_BAND_BYTES = 512 * 2**20
 #: Most cells of the map grid: every map is a dense grid, and the ``min-max-variance`` look-ahead
 #: holds a (256 candidates × cells) float64 matrix, 2 GB at this size.
 MAX_MAP_CELLS = 1_000_000
-#: Most cells of the planner's 2 cm grids (``planned``, ``min-max-variance``): it holds
+#: Most cells of the planner's 2 cm grids (``planned``, ``min-max-variance``,
+#: ``integrated-variance``): it holds
 #: (candidates × domain) and (candidates × candidates) float64 kernel matrices, 0.8 GB each at
 #: this size (4 m² of workspace).
 MAX_PLAN_CELLS = 10_000
 #: Spacing of the planner's grids (:class:`deformap.explore.MapGrid`'s ``plan_domain`` and
 #: ``plan_candidates``), the budget's and the grid's one value.
 PLAN_GRID_M = 0.02
+#: The strategies that hold the planner's (candidates × domain) matrices.
+PLANNER_STRATEGIES: tuple[Strategy, ...] = ("planned", "min-max-variance", "integrated-variance")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -254,7 +258,8 @@ class ExplorationConfig:
         ``T_h``: stop when the β-field's largest variance on the grid falls below it (paper: 0.06).
     max_pokes : int
         Hard limit on the number of pokes.
-    strategy : {"paper", "max-variance", "min-max-variance", "planned"}
+    strategy : {"paper", "max-variance", "min-max-variance", "planned", "level-set", \
+"integrated-variance"}
         How the next target is chosen (see :mod:`deformap.explore._acquisition`).
     first_target : (2,) float or None
         The first poke, in metres; ``None`` means the workspace centre.
@@ -274,10 +279,12 @@ class ExplorationConfig:
         How many degrees of freedom the pokes' uncertainties count for when the region test
         judges whether the βs scatter more than one material would (7: as much as the eight
         presses on one foam the noise floor was measured from; 0: ignore them, scale-free).
-    region_labels : {"isopleth", "nearest"}
+    region_labels : {"isopleth", "nearest", "indicator-kriging"}
         How cells get their region once the classes are found (:mod:`deformap.explore._regions`):
         ``isopleth``, the paper's, by the band of the β-field's mean a cell falls in;
-        ``nearest``, by the class of the poke nearest to the cell.
+        ``nearest``, by the class of the poke nearest to the cell; ``indicator-kriging``, by the
+        most probable class, each class's probability kriged from the pokes' class indicators
+        (:mod:`deformap.explore._indicator`).
     boundary_pokes : int
         Pokes made after the variance has fallen below ``T_h``, each where a region boundary is
         least certain (:mod:`deformap.explore._acquisition`, "boundary pokes"); 0, the paper's
@@ -385,8 +392,8 @@ def check_exploration_budget(config: ExplorationConfig, workspace: Workspace) ->
 
     The bounds that depend on a single settings object hold from its construction; these depend
     on the workspace too. The map grid (``Workspace.grid`` at ``surface.grid_spacing_m``) must
-    have at most :data:`MAX_MAP_CELLS` cells and, for the strategies that plan (``planned``,
-    ``min-max-variance``), the planner's 2 cm grid at most :data:`MAX_PLAN_CELLS`.
+    have at most :data:`MAX_MAP_CELLS` cells and, for the strategies that work on the planner's
+    2 cm grid (:data:`PLANNER_STRATEGIES`), that grid at most :data:`MAX_PLAN_CELLS`.
 
     Parameters
     ----------
@@ -413,7 +420,7 @@ def check_exploration_budget(config: ExplorationConfig, workspace: Workspace) ->
             f"spacing or a smaller workspace; got {spacing:g} m",
         )
     plan = (round(width / PLAN_GRID_M) + 1) * (round(depth / PLAN_GRID_M) + 1)
-    if config.strategy in ("planned", "min-max-variance") and plan > MAX_PLAN_CELLS:
+    if config.strategy in PLANNER_STRATEGIES and plan > MAX_PLAN_CELLS:
         raise SettingError(
             "strategy",
             f"{config.strategy!r} plans on {plan:,} cells of {PLAN_GRID_M * 100:g} cm over "

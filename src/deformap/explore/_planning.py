@@ -81,6 +81,13 @@ class VarianceDesign:
         excess = np.maximum(after - threshold, 0.0).sum(axis=1)
         return excess, np.asarray(after.max(axis=1))
 
+    def integrated_reduction(self) -> Array:
+        """``(c,)`` how much a poke at each candidate lowers the variance summed over the domain:
+        ``Σ_d k_post(d, x)² / (σ²(x) + σ_n²(x))``, the rank-one update of RW2006 Eq. 2.26 summed
+        (``integrated-variance``, :mod:`deformap.explore._acquisition`)."""
+        _, cov, var_c = self.gp.posterior([])
+        return np.asarray(np.sum(cov**2, axis=1) / (var_c + self.gp.new_var))
+
 
 def _best_addition(design: VarianceDesign, chosen: list[int], threshold: float
                    ) -> tuple[int, tuple[float, float]]:  # fmt: skip

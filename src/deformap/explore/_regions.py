@@ -49,6 +49,12 @@ the same pokes follow the pokes instead. The README ("Region accuracy") compares
 the default pokes and with boundary pokes; with the default pokes neither labels every map well,
 and the paper's isopleths stay the default.
 
+Labelling by indicator kriging (``region_labels = "indicator-kriging"``)
+-------------------------------------------------------------------------
+The classes are found as above; each cell takes its most probable class, each class's
+probability kriged from the pokes' class indicators with the map field's own covariance
+(:mod:`deformap.explore._indicator`). The README ("Strategies and cuts") compares the three cuts.
+
 References
 ----------
 Fisher, W. D. (1958). On grouping for maximum homogeneity. JASA 53(284), 789–798.
@@ -67,6 +73,7 @@ from numpy.typing import NDArray
 from deformap._validation import check_array, check_int, check_positive
 from deformap.explore._config import ExplorationConfig
 from deformap.explore._field import PokeSet, field_settings
+from deformap.explore._indicator import indicator_labels
 
 __all__ = ["RegionMap", "map_regions", "poke_classes", "segment_regions"]
 
@@ -295,9 +302,17 @@ def map_regions(mean: NDArray[np.float64], pokes: PokeSet, cells_xy: NDArray[np.
                 config: ExplorationConfig) -> RegionMap:
     """The regions of a β-field with mean ``mean (ny, nx)`` fitted to ``pokes``, as the
     exploration settings ask: classes by :func:`segment_regions` (``max_regions``,
-    ``region_prior_dof``, the β-field's noise floor), cells labelled by isopleth or by nearest
-    poke (``region_labels``; ``cells_xy (ny · nx, 2)`` are the grid's cells)."""
+    ``region_prior_dof``, the β-field's noise floor), cells labelled by isopleth, by nearest
+    poke or by indicator kriging (``region_labels``; ``cells_xy (ny · nx, 2)`` are the grid's
+    cells)."""
     found = poke_classes(mean, pokes, config)
     if config.region_labels == "nearest":
         return found.nearest_poke(pokes.xy, cells_xy)
+    if config.region_labels == "indicator-kriging":
+        cfg = field_settings(config)
+        labels = indicator_labels(pokes.xy, found.poke_labels, pokes.noise, cells_xy,
+                                  n_classes=found.n_regions, length_scale=cfg.length_scale_m,
+                                  signal_std=cfg.signal_std)  # fmt: skip
+        return RegionMap(labels=labels.reshape(found.labels.shape), levels=found.levels,
+                         class_betas=found.class_betas, poke_labels=found.poke_labels)
     return found

@@ -65,18 +65,45 @@ def _plan(grid: MapGrid, pokes: PokeSet, config: ExplorationConfig, n_made: int)
     )  # fmt: skip
 
 
+def _straddle(grid: MapGrid, field: BetaField, pokes: PokeSet, config: ExplorationConfig
+              ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:  # fmt: skip
+    """The reachable cells at least ``BOUNDARY_SPACING_ROI`` ROIs from every poke and their
+    straddle scores (:func:`boundary_score` against the isopleths of the pokes' classes; ``σ``
+    alone before any poke); both empty when no cell is left."""
+    allowed = grid.target_mask.copy()
+    var = field.variance.ravel()
+    if len(pokes) == 0:
+        return grid.cells_xy[allowed], np.sqrt(var[allowed])
+    spacing = BOUNDARY_SPACING_ROI * config.touch.roi_size_m
+    allowed &= cKDTree(pokes.xy).query(grid.cells_xy, k=1)[0] >= spacing
+    if not allowed.any():
+        return np.empty((0, 2)), np.empty(0)
+    mean = field.mean
+    levels = poke_classes(mean, pokes, config).levels
+    score = boundary_score(mean.ravel()[allowed], np.sqrt(var[allowed]), levels)
+    return grid.cells_xy[allowed], score
+
+
 def _boundary(grid: MapGrid, field: BetaField, pokes: PokeSet,
               config: ExplorationConfig) -> NDArray[np.float64] | None:
-    """Where a region boundary is least certain (:func:`boundary_score`) among the reachable
-    cells at least ``BOUNDARY_SPACING_ROI`` ROIs from every poke; ``None`` when none is left."""
-    spacing = BOUNDARY_SPACING_ROI * config.touch.roi_size_m
-    allowed = grid.target_mask & (cKDTree(pokes.xy).query(grid.cells_xy, k=1)[0] >= spacing)
-    if not allowed.any():
+    """Where a region boundary is least certain (:func:`_straddle`); ``None`` when no place is
+    left."""
+    cells, score = _straddle(grid, field, pokes, config)
+    if score.size == 0:
         return None
-    mean, var = field.mean, field.variance
-    levels = poke_classes(mean, pokes, config).levels
-    score = boundary_score(mean.ravel()[allowed], np.sqrt(var.ravel()[allowed]), levels)
-    return np.array(grid.cells_xy[allowed][int(np.argmax(score))], dtype=float)
+    return np.array(cells[int(np.argmax(score))], dtype=float)
+
+
+def _integrated(grid: MapGrid, pokes: PokeSet, config: ExplorationConfig
+                ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:  # fmt: skip
+    """The planner's candidates and how much a poke at each lowers the variance summed over the
+    planner's domain (``integrated-variance``), each with the noise it is expected to have."""
+    cfg = field_settings(config)
+    candidates = grid.plan_candidates
+    design = VarianceDesign(pokes.xy, pokes.noise, candidates, grid.plan_domain,
+                            cfg.signal_std, cfg.length_scale_m,
+                            expected_noise(candidates, pokes, config))  # fmt: skip
+    return candidates, design.integrated_reduction()
 
 
 def choose_next(grid: MapGrid, field: BetaField, config: ExplorationConfig,
@@ -137,8 +164,17 @@ def choose_next(grid: MapGrid, field: BetaField, config: ExplorationConfig,
                                     expected_noise(candidates, pokes, config))  # fmt: skip
             return design.after([], threshold)[1]
 
+        def scorer() -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+            if config.strategy == "integrated-variance":
+                return _integrated(grid, pokes, config)
+            found = _straddle(grid, field, pokes, config)
+            if found[1].size == 0:  # every reachable cell near a poke: the least known one
+                return cells, reachable
+            return found
+
         chosen = choose_target(config.strategy, cells, reachable, threshold, rng,
-                               look_ahead=look_ahead, planner=planner)  # fmt: skip
+                               look_ahead=look_ahead, planner=planner,
+                               scorer=scorer)  # fmt: skip
         if chosen is None:  # pragma: no cover - reachable.max() > threshold above
             return None
         xy = chosen
