@@ -311,3 +311,46 @@ def test_one_reader_yields_several_topics_in_bag_order(tmp_path: Path, storage: 
         list(iter_bag_messages(bag, {"/ft": "sensor_msgs/msg/PointCloud2"}))
     with pytest.raises(InvalidArgumentError, match="`topics` must be a non-empty mapping"):
         list(iter_bag_messages(bag, {}))
+
+
+def test_mcap_chunks_carry_their_crc_so_a_flipped_point_byte_is_refused(tmp_path: Path) -> None:
+    import struct
+    import zlib
+
+    bag = tmp_path / "bag"
+    clouds = [(i, _cloud(i)) for i in range(3)]
+    write_bag(bag, storage="mcap", clouds={"/pts": clouds})
+    (data_file,) = bag.glob("*.mcap")
+    data = bytearray(data_file.read_bytes())
+    # walk the records: every chunk has a non-zero CRC equal to the CRC-32 of its records
+    at, chunks = 8, 0
+    while at + 9 <= len(data) - 8:
+        opcode, length = data[at], struct.unpack_from("<Q", data, at + 1)[0]
+        if opcode == 0x06:
+            crc, name_len = struct.unpack_from("<II", data, at + 9 + 24)
+            records_at = at + 9 + 32 + name_len
+            (records_len,) = struct.unpack_from("<Q", data, records_at)
+            assert crc != 0 and name_len == 0
+            assert crc == zlib.crc32(data[records_at + 8:records_at + 8 + records_len])
+            chunks += 1
+        at += 9 + length
+    assert chunks >= 1
+    # a point's coordinate changed in place (the message still parses) is caught by the CRC
+    needle = np.asarray(clouds[1][1].points[7], dtype=np.float32).tobytes()
+    where = bytes(data).find(needle)
+    assert where > 0
+    data[where] ^= 0x01
+    data_file.write_bytes(bytes(data))
+    with pytest.raises(FileFormatError, match=r"bag"):
+        read_bag_clouds(bag, "/pts")
+
+
+def test_mcap_written_by_deformap_reads_with_crc_checks_in_the_mcap_library(
+        tmp_path: Path) -> None:
+    reader_module = pytest.importorskip("mcap.reader")
+    bag = tmp_path / "bag"
+    write_bag(bag, storage="mcap", clouds={"/pts": [(i, _cloud(i)) for i in range(2)]})
+    (data_file,) = bag.glob("*.mcap")
+    with open(data_file, "rb") as fh:
+        reader = reader_module.make_reader(fh, validate_crcs=True)
+        assert sum(1 for _ in reader.iter_messages()) == 2

@@ -30,7 +30,7 @@ from deformap.cloud.io._bag import (
     read_bag_static_transform,
     read_bag_wrenches,
 )
-from deformap.cloud.io._bag_writer import bag_writer, wrench_message, write_bag
+from deformap.cloud.io._bag_writer import bag_writer, fill_chunk_crcs, wrench_message, write_bag
 from deformap.cloud.io._common import MM_EXTENT_THRESHOLD, UNITS, path_kind
 from deformap.cloud.io._dispatch import CLOUD_FORMATS, read_cloud, write_cloud
 from deformap.cloud.io._npz import MAX_NPZ_BYTES, load_npz_arrays, read_npz, write_npz
@@ -59,6 +59,7 @@ __all__ = [
     "array_to_pointcloud2",
     "bag_read_errors",
     "bag_writer",
+    "fill_chunk_crcs",
     "iter_bag_messages",
     "load_npz_arrays",
     "path_kind",

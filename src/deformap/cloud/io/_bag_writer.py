@@ -1,15 +1,24 @@
 """Writing ROS 2 bags (sqlite3 or MCAP) of clouds, wrenches and static transforms.
 
 Used by the tests and by simulated recordings, so that the bag-reading path runs on real files.
+
+MCAP chunks carry a CRC-32 of their records (the format's own integrity check, which rosbags'
+reader verifies when it is not zero); rosbags writes it as zero, so once its writer has closed
+the bag each chunk's CRC is filled in (:func:`fill_chunk_crcs`): a flipped byte in a stored cloud
+is then refused when read instead of being read as other data. sqlite3 bags have no such field;
+a session's manifest of SHA-256 digests covers both.
 """
 
 from __future__ import annotations
 
+import struct
+import zlib
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
+from deformap._files import atomic_path
 from deformap._validation import check_array
 from deformap.cloud._pointcloud import PointCloud
 from deformap.cloud.io._bag import (
@@ -25,7 +34,48 @@ from deformap.cloud.io._pointcloud2 import array_to_pointcloud2
 from deformap.cloud.io._ros import typestore
 from deformap.errors import InvalidArgumentError
 
-__all__ = ["bag_writer", "wrench_message", "write_bag"]
+__all__ = ["bag_writer", "fill_chunk_crcs", "wrench_message", "write_bag"]
+
+_MCAP_MAGIC = b"\x89MCAP0\r\n"
+_CHUNK_OPCODE = 0x06
+# a chunk's fields before its CRC: message start and end time, uncompressed size (u64 each)
+_CHUNK_CRC_AT = 24
+
+
+def fill_chunk_crcs(path: str | Path) -> int:
+    """Write each uncompressed chunk's CRC-32 into the MCAP file at ``path`` (where a writer left
+    it zero); returns how many were filled. A compressed chunk, or one whose CRC is set already,
+    is left as it is. The file is rewritten atomically.
+
+    Chunk record (MCAP specification): opcode ``0x06``, content length (u64), then message start
+    and end time and uncompressed size (u64 each), the uncompressed CRC (u32), the compression
+    (u32 length + name) and the records (u64 length + bytes); all little-endian.
+    """
+    data = bytearray(Path(path).read_bytes())
+    if not data.startswith(_MCAP_MAGIC):
+        raise InvalidArgumentError(f"`path` {path} is not an MCAP file (no leading magic)")
+    filled, at = 0, len(_MCAP_MAGIC)
+    while at + 9 <= len(data) - len(_MCAP_MAGIC):
+        opcode = data[at]
+        (length,) = struct.unpack_from("<Q", data, at + 1)
+        content = at + 9
+        if content + length > len(data):
+            raise InvalidArgumentError(f"`path` {path}: a record runs past the file's end")
+        if opcode == _CHUNK_OPCODE:
+            crc_at = content + _CHUNK_CRC_AT
+            (crc,) = struct.unpack_from("<I", data, crc_at)
+            (name_len,) = struct.unpack_from("<I", data, crc_at + 4)
+            records_at = crc_at + 8 + name_len
+            (records_len,) = struct.unpack_from("<Q", data, records_at)
+            if crc == 0 and name_len == 0:  # uncompressed: the CRC is of the records as stored
+                records = data[records_at + 8:records_at + 8 + records_len]
+                struct.pack_into("<I", data, crc_at, zlib.crc32(records))
+                filled += 1
+        at = content + length
+    if filled:
+        with atomic_path(path) as tmp:
+            tmp.write_bytes(bytes(data))
+    return filled
 
 
 def _header(stamp_ns: int, frame_id: str) -> Any:
@@ -86,6 +136,8 @@ def bag_writer(path: str | Path, storage: str = "mcap") -> Iterator[Any]:
         raise InvalidArgumentError(f"`path` {p} exists already; a bag is written to a new folder")
     with rosbag2.Writer(p, version=9, storage_plugin=plugin) as writer:
         yield writer
+    for mcap in sorted(p.glob("*.mcap")) if storage == "mcap" else ():
+        fill_chunk_crcs(mcap)
 
 
 def write_bag(
