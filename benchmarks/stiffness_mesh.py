@@ -24,13 +24,18 @@ from deformap.explore import estimate_stiffness
 from deformap.world import Block, Scenario, SimulatedWorld, WorldConfig
 
 
-def block_world(hardness_n: float, element_size_m: float, thickness_m: float) -> SimulatedWorld:
+def block_scenario(hardness_n: float, thickness_m: float) -> Scenario:
+    """One foam block ``thickness_m`` thick over the default workspace."""
     ws = Workspace()
     (x0, y0), (x1, y1) = ws.lower, ws.upper
     polygon = np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]])
     block = Block(name=f"{hardness_n:g} N foam", polygon=polygon, hardness_n=hardness_n,
                   thickness_m=thickness_m)
-    scenario = Scenario(name=f"homogeneous-{hardness_n:g}", blocks=(block,), workspace=ws)
+    return Scenario(name=f"homogeneous-{hardness_n:g}", blocks=(block,), workspace=ws)
+
+
+def block_world(hardness_n: float, element_size_m: float, thickness_m: float) -> SimulatedWorld:
+    scenario = block_scenario(hardness_n, thickness_m)
     config = WorldConfig(element_size_m=element_size_m,
                          top_layer_m=min(WorldConfig().top_layer_m, element_size_m), noise=False)
     return SimulatedWorld(scenario, config=config, rng=np.random.default_rng(0))

@@ -20,23 +20,18 @@ import argparse
 import time
 
 import numpy as np
+from stiffness_mesh import block_scenario  # this folder's: the same block
 
-from deformap.environment import Workspace
 from deformap.errors import InvalidArgumentError
 from deformap.explore import estimate_stiffness
-from deformap.world import Block, Scenario, SimulatedWorld, WorldConfig
+from deformap.world import SimulatedWorld, WorldConfig
 
 CASES = (("linear-fem", 1.0), ("stiffening-foam", 0.0), ("stiffening-foam", 1.0))
 
 
 def block_world(hardness_n: float, thickness_m: float, physics: str,
                 exponent: float) -> SimulatedWorld:
-    ws = Workspace()
-    (x0, y0), (x1, y1) = ws.lower, ws.upper
-    polygon = np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]])
-    block = Block(name=f"{hardness_n:g} N foam", polygon=polygon, hardness_n=hardness_n,
-                  thickness_m=thickness_m)
-    scenario = Scenario(name=f"homogeneous-{hardness_n:g}", blocks=(block,), workspace=ws)
+    scenario = block_scenario(hardness_n, thickness_m)
     config = WorldConfig(physics=physics, stiffening_exponent=exponent,  # type: ignore[arg-type]
                          noise=False)
     return SimulatedWorld(scenario, config=config, rng=np.random.default_rng(0))
