@@ -158,7 +158,7 @@ def test_broken_poke_is_reported_and_skipped(recorded: Path, live: dict[str, Any
     (session / "poke-02.pcd").write_bytes(data[: len(data) // 2])
     result = _cli("map", str(session), "--out", str(tmp_path / "map"), "--no-figures")
     assert result.exit_code == 0, result.output
-    assert "poke 1 skipped" in result.output and "poke-02.pcd" in result.output
+    assert "poke 2 skipped" in result.output and "poke-02.pcd" in result.output
     report = json.loads((tmp_path / "map" / "report.json").read_text())
     assert len(report["warnings"]) == 1 and "poke-02.pcd" in report["warnings"][0]
     assert report["skipped"][0]["index"] == 1

@@ -56,8 +56,9 @@ class ReplayResult:
 
     @property
     def warnings(self) -> list[str]:
-        """One line per skipped poke, for ``report.json``."""
-        return [f"poke {s['index']} skipped: {s['error']}" for s in self.skipped]
+        """One line per skipped poke, for ``report.json``: numbered from 1 as the console, the
+        figures (``poke-01.png``) and a session's files are (``index`` stays 0-based)."""
+        return [f"poke {s['index'] + 1} skipped: {s['error']}" for s in self.skipped]
 
 
 def map_session(
@@ -105,7 +106,7 @@ def map_session(
             # reading the session stands in for the environment of the live loop
             poke = run.step(index, partial(session.press_observation, index))
         except DeformapError as exc:
-            logger.warning("poke %d skipped: %s", index, exc)
+            logger.warning("poke %d skipped: %s", index + 1, exc)
             skipped.append({"index": index, "error": str(exc)})
             continue
         if on_poke is not None:
