@@ -6,11 +6,11 @@ under a temporary name beside its destination (same folder, so the same file sys
 renamed onto the destination with :func:`os.replace`, and the folder is fsynced so that the rename
 itself is durable (POSIX keeps it in the folder's cache until then).
 
-A destination that exists must be a regular file (or a symbolic link, which the rename replaces,
-not its target): renaming onto a FIFO, a device or a socket would replace that node with a plain
-file (``--json /dev/zero`` run as root would replace the device), and onto a folder fails late.
-Such a destination, or a path that names no file (``""``, ``.``), is refused before anything is
-written.
+A destination that exists must be a regular file: renaming onto a FIFO, a device or a socket
+would replace that node with a plain file (``--json /dev/zero`` run as root would replace the
+device), onto a symbolic link would replace the link, not write its target (``/dev/stdout`` is a
+link to ``/proc/self/fd/1``), and onto a folder fails late. Such a destination, or a path that
+names no file (``""``, ``.``), is refused before anything is written.
 """
 
 from __future__ import annotations
@@ -27,7 +27,8 @@ from deformap.errors import InvalidArgumentError
 __all__ = ["atomic_path", "check_destination", "replace_durably", "write_text_atomically"]
 
 _KINDS = ((stat.S_ISDIR, "a folder"), (stat.S_ISFIFO, "a FIFO"), (stat.S_ISCHR, "a device"),
-          (stat.S_ISBLK, "a device"), (stat.S_ISSOCK, "a socket"))
+          (stat.S_ISBLK, "a device"), (stat.S_ISSOCK, "a socket"),
+          (stat.S_ISLNK, "a symbolic link (name its target, or a new file)"))
 
 
 def check_destination(path: str | Path) -> Path:
@@ -37,7 +38,7 @@ def check_destination(path: str | Path) -> Path:
     ------
     InvalidArgumentError
         The path names no file (empty, ``.`` or ``..``), or it exists as something other than a
-        regular file or a symbolic link.
+        regular file (a folder, FIFO, device, socket or symbolic link).
     """
     out = Path(path)
     if str(path) == "" or out.name in ("", ".", ".."):

@@ -132,6 +132,8 @@ def _good() -> SimpleNamespace:
         (lambda m: setattr(m, "row_step", 20), "row_step 20 is shorter"),
         # the header's point count lowered (one row of two): the surplus row is not dropped
         (lambda m: setattr(m, "height", 1), "24 bytes the header does not count"),
+        (lambda m: (setattr(m, "width", 0), setattr(m, "row_step", 0)),
+         "48 bytes but 2×0 points: none counted"),
         (lambda m: setattr(m, "data", m.data + b"\0" * 12), "12 bytes the header does not count"),
         (lambda m: setattr(m, "height", -1), "negative size"),
         (

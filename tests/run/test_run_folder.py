@@ -165,13 +165,14 @@ def test_a_destination_that_is_no_regular_file_is_refused_not_replaced(tmp_path:
     for name in ("", ".", ".."):
         with pytest.raises(InvalidArgumentError, match="expected the name of a file"):
             check_destination(name)
-    # a regular file is replaced; a symbolic link is replaced itself, its target left alone
+    # a regular file is replaced; a symbolic link is refused (the rename would replace the link,
+    # and /dev/stdout is one: a link to /proc/self/fd/1)
     plain = tmp_path / "plain.json"
     plain.write_text("old")
     write_text_atomically(plain, "new")
     assert plain.read_text() == "new"
-    link = tmp_path / "link.json"
-    link.symlink_to(plain)
-    write_text_atomically(link, "via link")
-    assert not link.is_symlink() and link.read_text() == "via link"
-    assert plain.read_text() == "new"
+    link = tmp_path / "stdout"
+    link.symlink_to("/proc/self/fd/1")
+    with pytest.raises(InvalidArgumentError, match="got a symbolic link"):
+        write_text_atomically(link, "{}")
+    assert link.is_symlink()

@@ -104,6 +104,9 @@ def pointcloud2_structured(msg: Any) -> NDArray[Any]:
     data = _message_bytes(msg)
     n = height * width
     if n == 0:
+        if data.size > height * row_step:  # a header lowered to no points over data
+            raise InvalidArgumentError(
+                f"`msg` data holds {data.size} bytes but {height}×{width} points: none counted")
         return np.empty(0, dtype=dtype)
     if point_step == 0:
         raise InvalidArgumentError(f"`msg` has {n} points but point_step 0")
