@@ -145,3 +145,20 @@ def test_homogeneous_blocks_share_the_unit_modulus_factorisation_and_solve_exact
                                spsolve(k_ff, load.ravel()[other.free]), rtol=1e-8, atol=1e-15)
     # another Poisson ratio is another stiffness
     assert FoamBody(grid, 2.0e3, poisson_ratio=0.25)._lu is not soft._lu
+
+
+def test_a_homogeneous_solve_does_not_depend_on_what_was_built_before() -> None:
+    """Bit for bit: the unit-modulus factorisation is of K₁ assembled at E = 1, not of the first
+    block's stiffness scaled back (which differs in the last bits from one history to another)."""
+    from deformap.world import _fem
+
+    grid = _box_grid(0.06, 0.03, 0.01, 0.005, 1.5)
+    load = np.zeros((grid.n_nodes, 3))
+    top = np.flatnonzero(np.isclose(grid.node_xyz()[:, 2], 0.03))
+    load[top[len(top) // 3], 2] = -0.3
+    _fem._UNIT_FACTORS.clear()
+    alone = FoamBody(grid, 37.0e3, poisson_ratio=0.3).solve(load)
+    _fem._UNIT_FACTORS.clear()
+    FoamBody(grid, 1.3e3, poisson_ratio=0.3)  # fills the cache first
+    after = FoamBody(grid, 37.0e3, poisson_ratio=0.3).solve(load)
+    assert np.array_equal(alone, after)

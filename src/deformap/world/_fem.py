@@ -202,18 +202,21 @@ class FoamBody:
         self.poisson_ratio = poisson_ratio
         self.modulus = np.broadcast_to(np.asarray(modulus_pa, dtype=float),
                                        (grid.nz, grid.ny, grid.nx))
-        self.stiffness = self._assemble()
         self.free = self._free_dofs(symmetry)
         used = self.modulus[:, grid.active]
         uniform = used.size > 0 and bool(np.all(used == used.flat[0]))
-        # a homogeneous block solves on the unit-modulus factorisation, scaled (module docstring)
+        # a homogeneous block solves on the unit-modulus factorisation, scaled (module docstring);
+        # K₁ is assembled at E = 1 itself, so a solve does not depend on what was built before
         self._scale = 1.0 / float(used.flat[0]) if uniform else 1.0
+        factored = self._assemble(np.ones_like(self.modulus) if uniform else self.modulus)
+        self.stiffness = factored * float(used.flat[0]) if uniform else factored
         key = self._geometry_key(symmetry) if uniform else None
-        if key is not None and key in _UNIT_FACTORS:
+        cached = None if key is None else _UNIT_FACTORS.get(key)
+        if key is not None and cached is not None:
             _UNIT_FACTORS.move_to_end(key)
-            self._lu = _UNIT_FACTORS[key]
+            self._lu = cached
             return
-        k_ff = (self.stiffness * self._scale)[self.free][:, self.free].tocsc()
+        k_ff = factored[self.free][:, self.free].tocsc()
         try:
             self._lu = splu(k_ff, permc_spec="MMD_AT_PLUS_A",
                             options={"SymmetricMode": True})
@@ -249,7 +252,7 @@ class FoamBody:
         dofs = (3 * nodes[:, :, None] + np.arange(3)).reshape(len(ii), 24)
         return dofs, jj, ii
 
-    def _assemble(self) -> sp.csr_matrix:
+    def _assemble(self, modulus: NDArray[np.float64]) -> sp.csr_matrix:
         g = self.grid
         n = 3 * g.n_nodes
         total = sp.csr_matrix((n, n))
@@ -257,7 +260,7 @@ class FoamBody:
             ke = unit_hex_stiffness(g.dx, g.dy, float(g.levels[k + 1] - g.levels[k]),
                                     self.poisson_ratio)
             dofs, jj, ii = self._element_dofs(k)
-            vals = self.modulus[k, jj, ii][:, None] * ke.ravel()[None, :]
+            vals = modulus[k, jj, ii][:, None] * ke.ravel()[None, :]
             rows = np.repeat(dofs, 24, axis=1).ravel()
             cols = np.tile(dofs, (1, 24)).ravel()
             total = total + sp.csr_matrix((vals.ravel(), (rows, cols)), shape=(n, n))
