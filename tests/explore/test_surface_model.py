@@ -10,13 +10,13 @@ import pytest
 from deformap._config import config_from_dict
 from deformap.environment import Workspace
 from deformap.errors import ConfigError
-from deformap.eval._studies import _block_scenario
+from deformap.eval._studies import block_scenario
 from deformap.explore import ExplorationConfig, Mapper
 from deformap.world import SimulatedWorld, WorldConfig
 
 
 def _surface_error(max_slope_deg: float) -> float:
-    world = SimulatedWorld(_block_scenario(150.0, Workspace()), config=WorldConfig.coarse(),
+    world = SimulatedWorld(block_scenario(150.0, Workspace()), config=WorldConfig.coarse(),
                            rng=np.random.default_rng(0))
     base = ExplorationConfig()
     cfg = dataclasses.replace(

@@ -94,7 +94,7 @@ def test_custom_yaml_reads_rect_polygon_modulus_and_rigid(tmp_path) -> None:
     [
         (("hardness_n: 60", "hardness_n: 60\n    squishiness: 3"), "unknown key"),
         (("rect: [0.6, 0.0, 0.7, 0.1]", "rect: [0.5, 0.0, 0.7, 0.1]"), "overlap"),
-        (("thickness_m: 0.03", "thickness_m: -0.03"), "thickness_m` must be > 0"),
+        (("thickness_m: 0.03", "thickness_m: -0.03"), "thickness_m` must be >= 0.001"),
         (("hardness_n: 60", "hardness_n: 0"), "hardness_n` must be >= 0.1"),
         (("youngs_modulus_pa: 20000", "youngs_modulus_pa: 20000\n    rigid: true"), "exactly one"),
         (("rect: [0.0, 0.0, 0.3, 0.4]", "rect: [0.3, 0.0, 0.0, 0.4]"), "x1 > x0"),

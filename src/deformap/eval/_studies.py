@@ -31,6 +31,7 @@ __all__ = [
     "PROTOCOLS",
     "STUDY_PROTOCOLS",
     "FoamPresses",
+    "block_scenario",
     "cluster_size_study",
     "collect_presses",
     "hardness_study",
@@ -82,8 +83,10 @@ class FoamPresses:
     refused: str | None = None
 
 
-def _block_scenario(hardness_n: float | None, workspace: Workspace,
-                    thickness_m: float = 0.05) -> Scenario:
+def block_scenario(hardness_n: float | None, workspace: Workspace,
+                   thickness_m: float = 0.05) -> Scenario:
+    """One block over ``workspace``: a foam of ``hardness_n`` newtons, or the rigid board (None);
+    the block's own checks refuse a material or thickness the world cannot press."""
     (x0, y0), (x1, y1) = workspace.lower, workspace.upper
     polygon = np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]])
     if hardness_n is None:
@@ -119,7 +122,7 @@ def collect_presses(
     for hardness, stream in zip(hardnesses, streams, strict=True):
         world_rng, fit_rng = stream.spawn(2)
         world = SimulatedWorld(
-            _block_scenario(hardness, Workspace(), thickness_m), config=world_config,
+            block_scenario(hardness, Workspace(), thickness_m), config=world_config,
             rng=world_rng,
         )
         mapper = Mapper(world.workspace, config)
@@ -252,8 +255,9 @@ def _by_hardness(rows: Any) -> list[dict[str, Any]]:
 
 def _beta_monotone(rows: list[dict[str, Any]]) -> bool:
     """β strictly falls as hardness rises over one protocol's rows, the rigid board lowest
-    (refused foams left out)."""
-    return bool(np.all(np.diff([r["beta"] for r in _by_hardness(rows)]) < 0))
+    (refused foams left out); fewer than two surfaces read is no order shown (False)."""
+    betas = [r["beta"] for r in _by_hardness(rows)]
+    return len(betas) >= 2 and bool(np.all(np.diff(betas) < 0))
 
 
 def _modulus_monotone(rows: list[dict[str, Any]]) -> bool | None:

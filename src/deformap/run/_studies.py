@@ -18,12 +18,14 @@ from typing import Any
 import numpy as np
 
 from deformap._validation import check_positive
+from deformap.environment import Workspace
 from deformap.errors import InvalidArgumentError
 from deformap.eval import (
     DEFAULT_HARDNESSES,
     PROTOCOLS,
     STUDY_PROTOCOLS,
     FoamPresses,
+    block_scenario,
     cluster_size_study,
     collect_presses,
     hardness_study,
@@ -32,7 +34,7 @@ from deformap.eval import (
 from deformap.explore import ExplorationConfig
 from deformap.run._folder import create_run_folder, default_run_folder, write_json
 from deformap.run._hooks import NO_HOOKS, RunHooks, RunStart
-from deformap.world import Physics, WorldConfig, camera_preset
+from deformap.world import MIN_RECORD_FORCE_N, Physics, WorldConfig, camera_preset
 
 __all__ = [
     "CLUSTER_SIZE_FOAMS",
@@ -150,14 +152,17 @@ def run_hardness_study(
     else:
         conditions = [(camera or "primesense", thickness_m, physics)]
     chosen = _protocols(protocols)
+    foams = DEFAULT_HARDNESSES if not hardness else (*hardness, None)
+    _check_press(foams, force_n)
     checked = []
     for name, thickness, physics_name in conditions:  # bad names fail here, before any world
         camera_preset(name)
         check_positive("thickness_m", thickness)
         checked.append((name, float(thickness),
                         WorldConfig(physics=physics_name).physics))  # type: ignore[arg-type]
+    for _, thickness, _ in checked:  # a block the world cannot build: before any folder
+        block_scenario(None, Workspace(), thickness)
     folder = create_run_folder(out or default_run_folder("hardness", "study", seed), what="study")
-    foams = DEFAULT_HARDNESSES if not hardness else (*hardness, None)
     hooks.start(RunStart(kind="study", title=f"hardness study, seed {seed}", folder=folder,
                          total=len(foams) * len(checked)))  # fmt: skip
     rows: list[dict[str, Any]] = []
@@ -181,6 +186,20 @@ def run_hardness_study(
         "rows": rows, **hardness_summary(rows)}  # fmt: skip
     return StudyOutput(study=study, folder=folder,
                        files=_write(folder, "hardness", study, plot_hardness_study))  # fmt: skip
+
+
+def _check_press(foams: Sequence[float | None], force_n: float | None) -> None:
+    """The foams and the force, checked before any folder or world: each foam a block the world
+    can build, and a force that gives a force–travel record."""
+    for value in foams:
+        if value is not None:
+            block_scenario(value, Workspace())
+    if force_n is not None:
+        force = check_positive("force_n", force_n)
+        if not force >= MIN_RECORD_FORCE_N:
+            raise InvalidArgumentError(
+                f"`force_n` must be at least {MIN_RECORD_FORCE_N:g} N, a press the world gives a "
+                f"force–travel record of; got {force:g}")
 
 
 def _protocols(names: Sequence[str] | None) -> dict[str, dict[str, Any]]:

@@ -67,7 +67,7 @@ class Block:
         Convex footprint, ``k >= 3``, at most :data:`MAX_EXTENT_M` across on each axis; stored
         counter-clockwise.
     thickness_m : float
-        Height of the block's top above the table, in ``(0, MAX_EXTENT_M]``.
+        Height of the block's top above the table, in ``[0.001, MAX_EXTENT_M]`` metres.
     hardness_n : float or None
         ISO 2439 hardness in newtons; give this or ``youngs_modulus_pa`` for foam.
     youngs_modulus_pa : float or None
@@ -80,7 +80,9 @@ class Block:
 
     name: str
     polygon: NDArray[np.float64]
-    thickness_m: float = setting(0.05, gt=0.0, le=MAX_EXTENT_M)
+    # at least the 1 mm the FEM's smallest element may be (`WorldConfig.element_size_m`): a
+    # thinner block is no layer the world can mesh (1e-320 m gave a zero Jacobian deep inside)
+    thickness_m: float = setting(0.05, ge=0.001, le=MAX_EXTENT_M)
     # Flexible foams are graded from about 20 N (super soft) to about 1 kN (ISO 2439); the bounds
     # are far outside that and only refuse what is no material the world can press: 0.1 N is
     # 7.7 Pa, far softer than any foam sold; 10 GPa is wood or stone, a block to declare rigid.
