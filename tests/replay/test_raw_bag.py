@@ -374,7 +374,9 @@ def test_a_press_without_a_frame_in_tolerance_is_refused_naming_it(
     assert code == 0, output
     assert [s["index"] for s in report["skipped"]] == [1]
     line = report["skipped"][0]["error"]
-    assert "press 1" in line and "'/camera/depth/color/points'" in line and "s away" in line
+    # press and poke numbered alike, from 1
+    assert "press 2" in line and "poke 2 skipped" in " ".join(report["warnings"])
+    assert "'/camera/depth/color/points'" in line and "s away" in line
     assert len(report["pokes"]) == POKES - 1
 
 
@@ -389,7 +391,7 @@ def test_a_press_without_a_transform_in_tolerance_is_refused_naming_it(
     assert code == 0, output
     assert [s["index"] for s in report["skipped"]] == [2]
     line = report["skipped"][0]["error"]
-    assert "press 2" in line and "'/tf'" in line and "'tool0'" in line and "s away" in line
+    assert "press 3" in line and "'/tf'" in line and "'tool0'" in line and "s away" in line
 
 
 def presses_hold(session: RecordedSession, index: int) -> tuple[float, float]:
@@ -403,7 +405,7 @@ def test_force_never_reaching_the_command_refuses_every_press_with_exit_2(
 ) -> None:
     code, output, _ = _map(raw_bag, tmp_path / "map", config_file, "--press-force", "2.0")
     assert code == 2, output
-    assert "never reached the commanded 2 N" in output and "press 0" in output
+    assert "never reached the commanded 2 N" in output and "press 1 " in output
     assert "no poke of the session" in output
 
 
@@ -415,6 +417,19 @@ def test_a_sensor_of_the_other_sign_is_refused_not_taken(
     code, output, _ = _map(raw_bag, tmp_path / "map", config_file, "--raw-config", str(settings))
     assert code == 2, output
     assert "points away from it" in output and "wrench_sign" in output
+
+
+def test_a_tip_frame_whose_z_points_into_the_surface_is_named(
+    raw_bag: Path, live: tuple[RecordedSession, list[Any]], config_file: Path, tmp_path: Path
+) -> None:
+    # tool0's z points down the stick (the flange's convention): the press would go up; the
+    # error names the frame, not the wrench's sign, which is right
+    settings = tmp_path / "tool0.yaml"
+    settings.write_text(yaml.safe_dump(_settings(live[0], tip_frame="tool0")))
+    code, output, _ = _map(raw_bag, tmp_path / "map", config_file, "--raw-config", str(settings))
+    assert code == 2, output
+    assert "'tool0'" in output and "`tip_frame` must have z along the stick" in output
+    assert "wrench_sign" not in output
 
 
 def test_a_bad_yaml_key_is_named(raw_bag: Path, config_file: Path, tmp_path: Path) -> None:

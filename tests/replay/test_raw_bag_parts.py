@@ -22,9 +22,11 @@ def test_presses_are_found_from_rise_hold_and_release_and_spikes_are_noise() -> 
     f[2000:2200] = np.linspace(0.0, 0.5, 200)  # one that stops at half the command
     f[2200:2300] = 0.5
     f[3000:3100], f[3100:3120] = np.linspace(0.0, 1.0, 100), 1.0  # a hold of 40 ms
+    f[3500:3520] = 1.0  # a tap at the commanded force, 40 ms over the threshold in all
     found = find_presses(t, f, commanded_n=1.0, contact_n=0.02, band=0.1,
                          hold_min_ns=100_000_000, merge_ns=50_000_000, topic="/w")  # fmt: skip
-    assert len(found) == 3
+    assert len(found) == 4  # the spike is noise; the tap is a press too short to read, said
+    assert "press 4 " in str(found[3].error) and "for only 0.038 s" in str(found[3].error)
     assert found[0].error is None and 1000 < found[0].start < 1010
     assert found[0].hold_start < 1200 < 1399 < found[0].hold_end
     assert "never reached" in str(found[1].error) and "0.5 N" in str(found[1].error)

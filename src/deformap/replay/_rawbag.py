@@ -196,7 +196,7 @@ class RawBagReader:
         cfg = self.config
         t0, t1 = int(self.wrench_ns[press.hold_start]), int(self.wrench_ns[press.hold_end - 1])
         inside = np.flatnonzero((self.cloud_ns >= t0) & (self.cloud_ns <= t1))
-        where = f"press {press.index} (hold t = {self._s(t0)}–{self._s(t1)} s)"
+        where = f"press {press.index + 1} (hold t = {self._s(t0)}–{self._s(t1)} s)"
         if inside.size == 0:
             gap = np.maximum(t0 - self.cloud_ns, self.cloud_ns - t1)
             nearest = int(np.argmin(gap))
@@ -305,7 +305,7 @@ class RawBagReader:
                 try:
                     _, tip = self.tree.lookup(
                         self.config.world_frame, self.config.tip_frame, stamp,
-                        what=f"press {press.index} [{self.config.tf_topic}, the tip]")
+                        what=f"press {press.index + 1} [{self.config.tf_topic}, the tip]")
                     target = tip[0, :2]
                 except DeformapError as exc:
                     error = str(exc)
@@ -317,7 +317,7 @@ class RawBagReader:
 
     def press_parts(self, spec: PokeSpec) -> PressParts:
         press, cfg = self.presses[spec.index], self.config
-        where = (f"{self.path}: press {press.index} (hold t = "
+        where = (f"{self.path}: press {press.index + 1} (hold t = "
                  f"{self._s(self.wrench_ns[press.hold_start])}–"
                  f"{self._s(self.wrench_ns[press.hold_end - 1])} s)")
         span = slice(press.start, press.hold_end)
@@ -331,6 +331,12 @@ class RawBagReader:
         hold = slice(press.hold_start - press.start, press.hold_end - press.start)
         mid = (hold.start + hold.stop) // 2
         direction = -r_tip[mid][:, 2]  # the press goes along the tip frame's -z
+        if direction[2] >= 0.0:  # the press must go down, into the table's surface
+            raise FileFormatError(
+                f"{where}: the tip frame {cfg.tip_frame!r}'s −z points "
+                f"{np.round(direction, 3).tolist()} in {cfg.world_frame!r}, not down into the "
+                f"surface; `tip_frame` must have z along the stick, away from the surface "
+                f"(docs/robot.md)")
         force = forces[hold].mean(axis=0)
         if float(force @ direction) <= 0.0:
             raise FileFormatError(

@@ -75,8 +75,9 @@ def find_presses(
         Contact threshold [N].
     band : float
     hold_min_ns : int
-        A press shorter than this over the threshold is noise (a spike), not a press; a hold
-        shorter than this is refused.
+        A run over the threshold shorter than this is noise (a spike) when it stays below the
+        commanded band, and a press too short to read (returned with its error) when it reaches
+        it; a hold shorter than this is refused.
     merge_ns : int
         Runs over the threshold closer than this in time are one press (noise around the
         threshold at first contact).
@@ -100,12 +101,20 @@ def find_presses(
     presses: list[FoundPress] = []
     lo, hi = commanded_n * (1 - band), commanded_n * (1 + band)
     for start, end in merged:
-        if times_ns[end - 1] - times_ns[start] < hold_min_ns:
-            continue  # a spike of sensor noise over the threshold
         index = len(presses)
         seg = force_n[start:end]
-        where = (f"press {index} (t = {(times_ns[start] - origin_ns) / 1e9:.3f}–"
+        # numbered from 1 in messages, as the pokes and their files are
+        where = (f"press {index + 1} (t = {(times_ns[start] - origin_ns) / 1e9:.3f}–"
                  f"{(times_ns[end - 1] - origin_ns) / 1e9:.3f} s on {topic!r})")  # fmt: skip
+        lasted = int(times_ns[end - 1] - times_ns[start])
+        if lasted < hold_min_ns:
+            if float(seg.max()) < lo:  # a spike of sensor noise over the threshold
+                continue
+            # it reached the commanded force: a press too short to read, said, not dropped
+            presses.append(FoundPress(index=index, start=start, end=end, error=(
+                f"{where}: over the contact threshold for only {lasted / 1e9:.3f} s; at least "
+                f"{hold_min_ns / 1e9:g} s expected (`hold_min_s`)")))
+            continue
         holds = _runs((seg >= lo) & (seg <= hi))
         if not holds:
             presses.append(FoundPress(index=index, start=start, end=end, error=(
