@@ -44,6 +44,16 @@ explain widens the interval instead of hiding it). The stiffness at the commande
 ``k = E g'(δ_c)`` with ``E g(δ_c) = F_c``; its standard deviation follows from ``E``'s by the
 delta method (``k`` at a fixed force depends on ``E`` only).
 
+The sphere's range
+------------------
+Hertz's contact radius ``√(Rδ)`` reaches the sphere's own radius at ``δ = R``: deeper, the
+contact is no paraboloid cap and the model does not describe the press. Samples whose fitted
+indentation exceeds ``R`` are left out and the record is fitted again on those within it (the
+first ones: the travel rises), at least three; ``n_samples`` counts the samples used, and ``k``
+at a commanded force beyond ``R`` is the model's extrapolation. A record with fewer than three
+samples within ``R`` is refused, and so is one whose indentation at the commanded force exceeds
+the tip's diameter (the sphere buried, the stick that holds it pressing the surface too).
+
 Rigid
 -----
 Before any fit, the travel gained from the first sample to the commanded force is estimated by a
@@ -186,6 +196,7 @@ class StiffnessEstimate:
     rigid : bool
         The surface is stiffer than the probe and arm can tell apart.
     n_samples : int
+        Samples the estimate used (those within the tip's radius; module docstring).
     model : str
         The contact model (:data:`LAYER_MODEL`).
     """
@@ -484,6 +495,17 @@ def estimate_stiffness(travel_m: Any, force_n: Any, *, tip_radius_m: float, thic
     thickness = _check_thickness(thickness_m, travel)
     thickness_std = check_positive("thickness_std_m", thickness_std_m, allow_zero=True)
     modulus, offset, cov, chi2_red, table = _fit(travel, force, radius, thickness, config)
+    for _ in range(2):  # keep the samples within the sphere's range (module docstring)
+        within = int(np.count_nonzero(np.cumprod(travel + offset <= radius)))
+        if within == travel.size:
+            break
+        if within < _MIN_SAMPLES:
+            raise InvalidArgumentError(
+                f"`force_n`/`travel_m` leave the contact model's range: only {within} sample(s) "
+                f"lie within the tip's {radius * 1e3:.3g} mm radius (`tip_radius_m`), "
+                f"{_MIN_SAMPLES} needed; deeper, the sphere's contact is no Hertz cap")
+        travel, force = travel[:within], force[:within]
+        modulus, offset, cov, chi2_red, table = _fit(travel, force, radius, thickness, config)
     depth_c = float(table.depth_at(np.array([force_c / modulus]))[0])
     chi = float(np.sqrt(radius * depth_c) / thickness)
     strain = depth_c / thickness
