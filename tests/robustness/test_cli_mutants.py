@@ -160,3 +160,51 @@ def test_a_bad_number_names_its_option(value: str, tmp_path: Path) -> None:
                                       str(tmp_path / "run")])  # fmt: skip
     assert result.exit_code == 2
     assert "threshold" in result.output and not (tmp_path / "run").exists()
+
+
+NON_FINITE = ("nan", "inf", "-inf", "1e400")
+
+
+def test_every_number_option_refuses_non_finite_values_itself(tmp_path: Path) -> None:
+    """Without a guard: a float option given NaN or an infinity must be refused naming that
+    option (or by the parser), before any folder; accepted, the command would go on to its work
+    and the alarm would say so. This catches what the guard above can mask (a value refused
+    only after the folder check)."""
+    runner = CliRunner()
+    failures, cases = [], 0
+    previous = signal.signal(signal.SIGALRM, _timeout)
+    try:
+        for path, command in _commands(typer.main.get_command(app)):
+            positional = [p for p in command.params if not p.opts or
+                          not p.opts[0].startswith("-")]  # fmt: skip
+            names = [p.opts[0] for p in _options(command)]
+            for param in _options(command):
+                if param.bare_type() != "float":
+                    continue
+                for value in NON_FINITE:
+                    cases += 1
+                    out = tmp_path / f"out-{cases}"
+                    argv = [*path, *[str(tmp_path / "no-session") for _ in positional],
+                            param.opts[0], *([value] + ["0"] * (int(param.nargs) - 1))]
+                    if "--out" in names:
+                        argv += ["--out", str(out)]
+                    signal.alarm(HANG_LIMIT_S)
+                    try:
+                        result = runner.invoke(app, argv, env={"COLUMNS": "200"})
+                    except TimeoutError as error:
+                        failures.append(f"{' '.join(argv)}: {error}")
+                        continue
+                    finally:
+                        signal.alarm(0)
+                    problem = _judge(result)
+                    named = param.name in result.output or param.opts[0] in result.output
+                    if problem is None and not named and "Usage:" not in result.output:
+                        problem = f"refused without naming {param.opts[0]}: {result.output!r}"
+                    if problem is None and out.exists():
+                        problem = "left a folder"
+                    if problem:
+                        failures.append(f"{' '.join(argv)}: {problem}"[:300])
+    finally:
+        signal.signal(signal.SIGALRM, previous)
+    assert cases >= 20
+    assert not failures, f"{len(failures)} of {cases}:\n" + "\n".join(failures[:20])

@@ -16,6 +16,7 @@ from typing import Any, Literal
 from deformap._validation import check_positive
 from deformap.errors import InvalidArgumentError
 from deformap.replay import (
+    RawBagConfig,
     RecordedSession,
     ReplayResult,
     is_raw_bag,
@@ -141,6 +142,9 @@ def _open(path: Path, config: RunConfig | None, layout: str, raw_config: Path | 
           raw_settings: dict[str, Any]) -> RecordedSession:  # fmt: skip
     if layout not in MAP_LAYOUTS:
         raise InvalidArgumentError(f"`layout` must be one of {list(MAP_LAYOUTS)}; got {layout!r}")
+    given = {k: v for k, v in raw_settings.items() if v is not None}
+    if given:  # each value checked itself first, whatever the recording turns out to be
+        RawBagConfig(**given)
     raw = layout == "raw" or (layout == "auto" and is_raw_bag(path))
     if not raw:
         if raw_config is not None or any(v is not None for v in raw_settings.values()):
