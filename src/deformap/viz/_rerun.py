@@ -66,8 +66,10 @@ def record_run(path: str | Path, result: Any, *, initial_points: NDArray[np.floa
     truth_hardness : (ny, nx) float, optional
         Ground-truth hardness in newtons on the map's grid (``inf`` rigid, ``nan`` bare table).
     robot_points : sequence of (m, 3) float or None, optional
-        Per poke, points whose convex hull covers the robot at the press (as the environment
-        gave them), logged as a mesh ``world/press/robot_hull``; ``None`` for a poke without.
+        Per poke, points whose convex hull covers the robot at the press, logged as a mesh
+        ``world/press/robot_hull``; ``None`` for a poke without. ``explore --rerun`` gives the
+        simulated probe's points, rebuilt from the world at each contact; runs without a
+        simulated world (``map``, ``--environment``) log no hull.
     """
     try:
         import rerun as rr
