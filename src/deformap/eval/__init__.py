@@ -36,6 +36,26 @@ if TYPE_CHECKING:
         hardness_summary,
     )
     from deformap.eval._table_i import PAPER_TABLE_I, markdown_table, table_row
+    from deformap.eval._worlds import (
+        FORCES_N,
+        HARDNESS_RANGE_N,
+        THICKNESSES_M,
+        TIME_COLUMNS,
+        WorldDraw,
+        choices,
+        draw_world,
+        row_values,
+        run_world,
+    )
+    from deformap.eval._worlds_summary import (
+        CSV_COLUMNS,
+        GOOD_ACCURACY,
+        accuracy_curves,
+        combination_name,
+        markdown_summary,
+        runs_csv,
+        summarise_worlds,
+    )
 
 _MODULES = {
     "_bench_gp": ("bench_surface_gp",),
@@ -47,30 +67,50 @@ _MODULES = {
     "_studies": ("DEFAULT_HARDNESSES", "DEFAULT_POSITIONS", "PROTOCOLS", "FoamPresses",
                  "cluster_size_study", "collect_presses", "hardness_study", "hardness_summary"),
     "_table_i": ("PAPER_TABLE_I", "markdown_table", "table_row"),
+    "_worlds": ("FORCES_N", "HARDNESS_RANGE_N", "THICKNESSES_M", "TIME_COLUMNS", "WorldDraw",
+                "choices", "draw_world", "row_values", "run_world"),
+    "_worlds_summary": ("CSV_COLUMNS", "GOOD_ACCURACY", "accuracy_curves", "combination_name",
+                        "markdown_summary", "runs_csv", "summarise_worlds"),
 }  # fmt: skip
 
 __all__ = [
+    "CSV_COLUMNS",
     "DEFAULT_HARDNESSES",
     "DEFAULT_POSITIONS",
+    "FORCES_N",
+    "GOOD_ACCURACY",
+    "HARDNESS_RANGE_N",
     "IO_GOAL_S",
     "PAPER_TABLE_I",
     "PROTOCOLS",
+    "THICKNESSES_M",
+    "TIME_COLUMNS",
     "FoamPresses",
     "OrderingScores",
     "RegionScores",
+    "WorldDraw",
+    "accuracy_curves",
     "bench_beta_sweep",
     "bench_io",
     "bench_memory",
     "bench_surface_gp",
     "bench_world",
+    "choices",
     "cluster_size_study",
     "collect_presses",
+    "combination_name",
+    "draw_world",
     "hardness_study",
     "hardness_summary",
+    "markdown_summary",
     "markdown_table",
     "measure_case",
     "ordering_scores",
     "region_scores",
+    "row_values",
+    "run_world",
+    "runs_csv",
+    "summarise_worlds",
     "table_row",
 ]
 

@@ -31,8 +31,8 @@ from deformap.mechanics import (
 from deformap.world._camera import CAMERA_PRESETS, CameraConfig, camera_preset
 from deformap.world._config import PHYSICS, Physics, WorldConfig, check_world_budget
 from deformap.world._foam import Dent
-from deformap.world._probe import ProbeGeometry
 from deformap.world._layouts import LAYOUT_FAMILIES, LayoutFamily
+from deformap.world._probe import ProbeGeometry
 from deformap.world._random import random_scenario
 from deformap.world._scenario import BARE_TABLE, Block, Scenario
 from deformap.world._scenario_io import list_scenarios, load_scenario, save_scenario

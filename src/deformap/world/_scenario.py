@@ -2,11 +2,11 @@
 
 A scenario is a list of blocks on the rigid table. Each block is a simple polygon in the table plane
 (a rectangle is the common case; non-convex footprints, an L or a U, are one piece, and a block may
-have holes, where another block is inserted), extruded to its own thickness, made of foam of a given hardness
-(or Young's modulus) or ``rigid`` (a wooden board that does not deform). What no block covers is the
-bare table at ``z = 0``, also rigid. Blocks never overlap; they may touch. Neighbouring blocks are
-separate pieces laid side by side, as in the paper's experiments: each is bonded to the table at its
-bottom but not glued to its neighbours.
+have holes, where another block is inserted), extruded to its own thickness, made of foam of a
+given hardness (or Young's modulus) or ``rigid`` (a wooden board that does not deform). What no
+block covers is the bare table at ``z = 0``, also rigid. Blocks never overlap; they may touch.
+Neighbouring blocks are separate pieces laid side by side, as in the paper's experiments: each is
+bonded to the table at its bottom but not glued to its neighbours.
 
 Built-in layouts (paper's Table I; its figure of the layouts is lost, so these are our choice), all
 over the 60 × 40 cm workspace with 5 cm thick blocks:
