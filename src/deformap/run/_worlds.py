@@ -61,8 +61,8 @@ SETTINGS_NAME = "bench.json"
 
 @dataclass(frozen=True, kw_only=True)
 class WorldsBenchConfig:
-    """What ``deformap bench worlds`` runs (the engine settings, ``workers`` and ``scheduler``,
-    do not change a result, so a run may resume on another engine).
+    """What ``deformap bench worlds`` runs (``worlds``, ``workers`` and ``scheduler`` do not
+    change a world's result, so a run may resume with more worlds or on another engine).
 
     Parameters
     ----------
@@ -112,7 +112,8 @@ class WorldsBenchConfig:
 
     def result_settings(self) -> dict[str, Any]:
         """The settings a world's result depends on (``bench.json``; resuming compares them)."""
-        return {k: v for k, v in asdict(self).items() if k not in ("workers", "scheduler")}
+        return {k: v for k, v in asdict(self).items()
+                if k not in ("worlds", "workers", "scheduler")}
 
     def combinations(self) -> list[tuple[str, str, str]]:
         cut = self.cut or str(choices("region_labels")[0])
@@ -265,7 +266,7 @@ def _write_outputs(folder: Path, config: WorldsBenchConfig, results: Sequence[di
                    ) -> tuple[dict[str, Any], list[Path]]:
     combos = config.combinations()
     summary = summarise_worlds(results, combos, config.max_pokes)
-    summary["settings"] = config.result_settings()
+    summary["settings"] = {**config.result_settings(), "worlds": config.worlds}
     files = [write_text(folder / "runs.csv", runs_csv(results, combos)),
              write_text(folder / "summary.json", to_json(summary)),
              write_text(folder / "summary.md", markdown_summary(summary))]

@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 from matplotlib.figure import Figure
+from matplotlib.ticker import MaxNLocator
 from numpy.typing import NDArray
 
 from deformap.viz._save import save_figure
@@ -58,7 +59,9 @@ def plot_world_curves(curves: dict[str, dict[str, NDArray[np.float64]]], *,
             ax.fill_between(pokes, mean - _Z95 * se, np.minimum(1.0, mean + _Z95 * se),
                             color=colours[name], alpha=0.15, lw=0)
         ax.axhline(good_accuracy, color="k", ls="--", lw=0.8)
-        ax.set_title(f"{family} ({n_worlds} worlds)", fontsize=10)
+        ax.set_title(f"{family} ({n_worlds} world{'s' if n_worlds != 1 else ''})", fontsize=10)
+        ax.set_ylim(0.0, 1.02)
+        ax.xaxis.set_major_locator(MaxNLocator(integer=True))
         ax.grid(alpha=0.3)
     for ax in axes.ravel()[len(families):]:
         ax.set_visible(False)
