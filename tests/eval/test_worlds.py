@@ -120,3 +120,19 @@ def test_one_world_is_mapped_to_max_pokes_by_every_combination() -> None:
     assert rows[-1]["modulus_error"] is not None and rows[-1]["modulus_error"] >= 0
     json.dumps(result)  # plain data crosses processes
     assert np.isfinite([r["poke_s"] for r in rows]).all()
+
+
+def test_the_command_refuses_bad_names_in_one_line_before_any_folder(tmp_path) -> None:
+    from typer.testing import CliRunner
+
+    from deformap.cli import app
+
+    out = tmp_path / "w"
+    for args, message in ((["--strategies", "paper,guess"], "`strategies` must be distinct"),
+                          (["--fields", "hardness"], "`fields` must be distinct"),
+                          (["--cut", "voronoi"], "`cut` must be one of"),
+                          (["--worlds", "0"], "`worlds` must be an integer >= 1")):
+        result = CliRunner().invoke(app, ["bench", "worlds", "--out", str(out), *args])
+        assert result.exit_code == 2, result.output
+        assert message in result.output and len(result.output.strip().splitlines()) == 1
+        assert not out.exists()

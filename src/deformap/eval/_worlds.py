@@ -40,7 +40,7 @@ import time
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from functools import partial
-from typing import Any, get_args, get_type_hints
+from typing import Any, cast, get_args, get_type_hints
 
 import numpy as np
 from numpy.typing import NDArray
@@ -52,6 +52,7 @@ from deformap.world import (
     CAMERA_PRESETS,
     LAYOUT_FAMILIES,
     PHYSICS,
+    Physics,
     Scenario,
     SimulatedWorld,
     WorldConfig,
@@ -97,7 +98,7 @@ class WorldDraw:
 
     index: int
     family: str
-    physics: str
+    physics: Physics
     camera: str
     thickness_m: float
     force_n: float
@@ -119,7 +120,7 @@ def draw_world(seed: int, index: int, families: Sequence[str] = LAYOUT_FAMILIES)
         raise InvalidArgumentError("`families` must name at least one layout family; got none")
     rng = np.random.default_rng(np.random.SeedSequence([seed, index]))
     family = families[index % len(families)]
-    physics = str(rng.choice(PHYSICS))
+    physics = cast(Physics, str(rng.choice(PHYSICS)))
     camera = str(rng.choice(sorted(CAMERA_PRESETS)))
     thickness = float(rng.choice(THICKNESSES_M))
     force = float(rng.choice(FORCES_N))

@@ -9,6 +9,8 @@ exactly from the pairwise overlaps of their triangles.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -170,8 +172,8 @@ def _triangles_overlap(ta: NDArray[np.float64], tb: NDArray[np.float64]) -> floa
 
 
 def overlap_area(a: NDArray[np.float64], b: NDArray[np.float64],
-                 holes_a: tuple[NDArray[np.float64], ...] = (),
-                 holes_b: tuple[NDArray[np.float64], ...] = ()) -> float:
+                 holes_a: Sequence[NDArray[np.float64]] = (),
+                 holes_b: Sequence[NDArray[np.float64]] = ()) -> float:
     """Area shared by two footprints, each a simple counter-clockwise polygon less its holes, m².
 
     The holes of a footprint lie inside it and apart, so by inclusion–exclusion
