@@ -167,6 +167,9 @@ def bench_worlds_command(
         help="Comma-separated (or repeated); default: paper, max-variance, planned.",
         show_default=False)] = None,
     fields: NamesOption = None,
+    physics: Annotated[list[str] | None, typer.Option(
+        help="World physics drawn from (linear-fem, stiffening-foam); default: both.",
+        show_default=False)] = None,
     cut: Annotated[str | None, typer.Option(
         help="Region labels (exploration.region_labels); default: its default.")] = None,
     max_pokes: Annotated[int, typer.Option(help="Pokes per world and combination.")] = 12,
@@ -186,7 +189,7 @@ def bench_worlds_command(
     from deformap import run
 
     given = {"families": _names(families), "strategies": _names(strategies),
-             "fields": _names(fields)}
+             "fields": _names(fields), "physics": _names(physics)}
     config = run.WorldsBenchConfig(
         worlds=worlds, seed=seed, cut=cut, max_pokes=max_pokes, coarse=coarse, workers=workers,
         scheduler=scheduler, **{k: v for k, v in given.items() if v is not None})

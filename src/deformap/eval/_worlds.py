@@ -114,19 +114,24 @@ class WorldDraw:
                 "rigid": any(b.rigid for b in self.scenario.blocks)}  # fmt: skip
 
 
-def draw_world(seed: int, index: int, families: Sequence[str] = LAYOUT_FAMILIES) -> WorldDraw:
-    """The ``index``-th world of a benchmark seeded ``seed`` (module docstring)."""
+def draw_world(seed: int, index: int, families: Sequence[str] = LAYOUT_FAMILIES,
+               physics: Sequence[str] = PHYSICS) -> WorldDraw:
+    """The ``index``-th world of a benchmark seeded ``seed`` (module docstring); ``physics``
+    the world physics to draw from (all by default)."""
     if not families:
         raise InvalidArgumentError("`families` must name at least one layout family; got none")
+    if not physics or any(p not in PHYSICS for p in physics):
+        raise InvalidArgumentError(f"`physics` must be names from {list(PHYSICS)}; got "
+                                   f"{list(physics)}")
     rng = np.random.default_rng(np.random.SeedSequence([seed, index]))
     family = families[index % len(families)]
-    physics = cast(Physics, str(rng.choice(PHYSICS)))
+    drawn = cast(Physics, str(rng.choice(list(physics))))
     camera = str(rng.choice(sorted(CAMERA_PRESETS)))
     thickness = float(rng.choice(THICKNESSES_M))
     force = float(rng.choice(FORCES_N))
     scenario = random_scenario(rng, family=family, hardness_range_n=HARDNESS_RANGE_N,
                                p_rigid=P_RIGID, thickness_m=thickness)  # fmt: skip
-    return WorldDraw(index=index, family=family, physics=physics, camera=camera,
+    return WorldDraw(index=index, family=family, physics=drawn, camera=camera,
                      thickness_m=thickness, force_n=force, scenario=scenario)
 
 
@@ -193,7 +198,8 @@ def run_world(task: dict[str, Any]) -> dict[str, Any]:
     Parameters
     ----------
     task : dict
-        ``seed``, ``index``, ``families``, ``strategies``, ``fields``, ``cut`` (a
+        ``seed``, ``index``, ``families``, ``physics`` (optional: the world physics drawn
+        from, default all), ``strategies``, ``fields``, ``cut`` (a
         ``region_labels`` value, or ``None`` for the default), ``max_pokes``, ``coarse`` (the
         test mesh and camera of :meth:`WorldConfig.coarse`, else the default world).
 
@@ -204,7 +210,7 @@ def run_world(task: dict[str, Any]) -> dict[str, Any]:
     """
     t0 = time.perf_counter()
     seed, index = int(task["seed"]), int(task["index"])
-    draw = draw_world(seed, index, tuple(task["families"]))
+    draw = draw_world(seed, index, tuple(task["families"]), tuple(task.get("physics", PHYSICS)))
     base = WorldConfig.coarse() if task["coarse"] else WorldConfig()
     config = replace(base, physics=draw.physics,
                      camera=replace(camera_preset(draw.camera), width=base.camera.width,

@@ -46,7 +46,7 @@ from deformap.eval import (
 from deformap.run._folder import create_run_folder, default_run_folder, to_json, write_text
 from deformap.run._hooks import NO_HOOKS, RunHooks, RunStart
 from deformap.viz import plot_world_curves
-from deformap.world import LAYOUT_FAMILIES
+from deformap.world import LAYOUT_FAMILIES, PHYSICS
 
 __all__ = ["BLAS_THREAD_VARIABLES", "WorldsBenchConfig", "WorldsOutput", "bench_worlds"]
 
@@ -71,6 +71,8 @@ class WorldsBenchConfig:
     seed : int
     families : tuple of str
         Layout families, taken in turn (:data:`deformap.world.LAYOUT_FAMILIES`).
+    physics : tuple of str
+        The world physics each world's is drawn from (:data:`deformap.world.PHYSICS`).
     strategies, fields : tuple of str
         ``ExplorationConfig.strategy`` and ``field`` values, every pair mapped on every world.
     cut : str or None
@@ -89,6 +91,7 @@ class WorldsBenchConfig:
     worlds: int = setting(100, ge=1, le=1_000_000)
     seed: int = setting(0, ge=0)
     families: tuple[str, ...] = LAYOUT_FAMILIES
+    physics: tuple[str, ...] = PHYSICS
     strategies: tuple[str, ...] = ("paper", "max-variance", "planned")
     fields: tuple[str, ...] = ("beta", "modulus")
     cut: str | None = None
@@ -101,6 +104,7 @@ class WorldsBenchConfig:
     def __post_init__(self) -> None:
         check_settings(self)
         for name, given, allowed in (("families", self.families, LAYOUT_FAMILIES),
+                                     ("physics", self.physics, PHYSICS),
                                      ("strategies", self.strategies, choices("strategy")),
                                      ("fields", self.fields, choices("field"))):
             if not given or any(g not in allowed for g in given) or len(set(given)) < len(given):
@@ -122,6 +126,7 @@ class WorldsBenchConfig:
     def task(self, index: int) -> dict[str, Any]:
         """The plain-data task of world ``index``."""
         return {"seed": self.seed, "index": index, "families": list(self.families),
+                "physics": list(self.physics),
                 "strategies": list(self.strategies), "fields": list(self.fields),
                 "cut": self.cut, "max_pokes": self.max_pokes, "coarse": self.coarse}
 
@@ -171,7 +176,8 @@ def _failed(task: dict[str, Any], exc: BaseException) -> dict[str, Any]:
     from deformap.eval import draw_world
 
     try:
-        world = draw_world(task["seed"], task["index"], tuple(task["families"])).summary()
+        world = draw_world(task["seed"], task["index"], tuple(task["families"]),
+                           tuple(task.get("physics", PHYSICS))).summary()
     except Exception:  # the failure to report may be the draw itself
         world = {"index": task["index"],
                  "family": task["families"][task["index"] % len(task["families"])]}
