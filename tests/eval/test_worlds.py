@@ -69,6 +69,7 @@ def _results() -> list[dict]:
     return [
         _result(0, "cuts", {"paper/beta": [0.5, 0.95, 0.97], "planned/beta": [0.92, 0.95, 0.96]}),
         _result(1, "cuts", {"paper/beta": [0.5, 0.6, 0.7], "planned/beta": [0.5, 0.91, 0.93]}),
+        _result(4, "cuts", {"paper/beta": [0.95, 0.6, 0.7], "planned/beta": [0.3, 0.5, 0.6]}),
         # paper ran out of targets after poke 1: its last map counts for pokes 2 and 3
         _result(2, "insert", {"paper/beta": [0.95], "planned/beta": [0.4, 0.5, 0.95]}),
         _result(3, "insert", {}, status="failed"),
@@ -79,28 +80,30 @@ def test_summary_counts_never_and_failed_as_max_pokes_plus_one() -> None:
     summary = summarise_worlds(_results(), COMBOS, 3)
     paper, planned = (summary["strategies"][n] for n in ("paper/beta/isopleth",
                                                           "planned/beta/isopleth"))
-    # paper: 2, never (4), 1, failed (4) → median 3; planned: 1, 2, 3, 4 → 2.5
-    assert paper["median_pokes_to_accuracy_0.9"] == 3.0
-    assert planned["median_pokes_to_accuracy_0.9"] == 2.5
-    assert paper["worlds"] == 4 and paper["failed"] == 1
-    assert paper["final_accuracy_median"] == pytest.approx(0.95)  # 0.97, 0.7, 0.95 (carried)
-    assert paper["by_family"]["cuts"]["median_pokes_to_accuracy_0.9"] == 3.0
+    # first at 0.9 — paper: 2, never (4), 1, failed (4), 1 → 2; planned: 1, 2, 3, 4, 4 → 3
+    assert paper["median_pokes_to_accuracy_0.9"] == 2.0
+    assert planned["median_pokes_to_accuracy_0.9"] == 3.0
+    # staying at 0.9 — paper's world 4 loses it after poke 1: 2, 4, 1, 4, 4 → 4
+    assert paper["median_pokes_to_stay_0.9"] == 4.0 and planned["median_pokes_to_stay_0.9"] == 3.0
+    assert paper["worlds"] == 5 and paper["failed"] == 1
+    assert paper["final_accuracy_median"] == pytest.approx(0.825)  # 0.97, 0.7, 0.95 carried, 0.7
+    assert paper["by_family"]["cuts"]["median_pokes_to_accuracy_0.9"] == 2.0
     assert paper["by_family"]["insert"]["median_pokes_to_accuracy_0.9"] == 2.5
     assert set(paper) >= {"median_pokes_to_accuracy_0.9", "final_accuracy_median",
                           "modulus_error_median", "worlds", "by_family"}
-    assert summary["best"] == "planned/beta/isopleth"
+    assert summary["best"] == "paper/beta/isopleth"
     assert summary["failed_worlds"] == [{"index": 3, "error": "Boom: no"}]
     table = markdown_summary(summary)
-    assert "| planned/beta/isopleth (best) | 4 (1 failed) | 2.5 |" in table
+    assert "| paper/beta/isopleth (best) | 5 (1 failed) | 2 | 4 |" in table
     curves = accuracy_curves(_results(), COMBOS, 3)
-    assert curves["all"]["paper/beta/isopleth"].shape == (3, 3)
+    assert curves["all"]["paper/beta/isopleth"].shape == (4, 3)
     assert curves["insert"]["paper/beta/isopleth"].tolist() == [[0.95, 0.95, 0.95]]
 
 
 def test_runs_csv_has_a_row_per_poke_and_the_failed_world_per_combination() -> None:
     rows = list(csv.DictReader(io.StringIO(runs_csv(_results(), COMBOS))))
     assert tuple(rows[0]) == CSV_COLUMNS
-    assert len(rows) == 3 + 3 + 3 + 3 + 1 + 3 + 2
+    assert len(rows) == 3 + 3 + 3 + 3 + 1 + 3 + 2 + 3 + 3
     failed = [r for r in rows if r["status"] == "failed"]
     assert [r["strategy"] for r in failed] == ["paper", "planned"]
     assert all(r["poke"] == "" and r["error"] == "Boom: no" for r in failed)

@@ -4,7 +4,9 @@ markdown table.
 A *combination* is one strategy × field × cut, named ``strategy/field/cut``. Its pokes to a good
 map in one world are the first poke after which the region accuracy is at least
 :data:`GOOD_ACCURACY`; a world where it never is (or that failed) counts ``max_pokes + 1``, so a
-median over worlds is never flattered by leaving the hard ones out. A combination whose loop had
+median over worlds is never flattered by leaving the hard ones out. A map can lose that accuracy
+with later pokes (a new poke can split a region wrongly), which a robot that stops could not
+know: ``median_pokes_to_stay_0.9`` counts from the poke after which every later one keeps it. A combination whose loop had
 nothing left to poke before ``max_pokes`` keeps its last map for the remaining pokes.
 """
 
@@ -104,11 +106,18 @@ def _per_world(results: Sequence[dict[str, Any]], combination: tuple[str, str, s
     return out
 
 
-def _pokes_to_good(entry: dict[str, Any], max_pokes: int) -> int:
+def _pokes_to_good(entry: dict[str, Any], max_pokes: int, *, stay: bool = False) -> int:
+    """The first poke with accuracy ≥ :data:`GOOD_ACCURACY` (``stay``: from which every later
+    poke keeps it); ``max_pokes + 1`` when there is none."""
     if entry["failed"]:
         return max_pokes + 1
-    good = np.flatnonzero(entry["accuracy"] >= GOOD_ACCURACY)
-    return int(good[0]) + 1 if good.size else max_pokes + 1
+    good = entry["accuracy"] >= GOOD_ACCURACY
+    if stay:
+        bad = np.flatnonzero(~good)
+        first = 0 if not bad.size else int(bad[-1]) + 1
+        return first + 1 if first < max_pokes else max_pokes + 1
+    hits = np.flatnonzero(good)
+    return int(hits[0]) + 1 if hits.size else max_pokes + 1
 
 
 def _median(values: Sequence[float]) -> float | None:
@@ -120,6 +129,8 @@ def _stats(entries: list[dict[str, Any]], max_pokes: int) -> dict[str, Any]:
     done = [e for e in entries if not e["failed"]]
     return {
         "median_pokes_to_accuracy_0.9": _median([_pokes_to_good(e, max_pokes) for e in entries]),
+        "median_pokes_to_stay_0.9": _median([_pokes_to_good(e, max_pokes, stay=True)
+                                             for e in entries]),
         "final_accuracy_median": _median([float(e["accuracy"][-1]) for e in done]),
         "modulus_error_median": _median([float(e["modulus_error"][-1]) for e in done]),
         "worlds": len(entries),
@@ -181,8 +192,8 @@ def markdown_summary(summary: dict[str, Any]) -> str:
     """The summary as a markdown table: one row per combination, overall and per family."""
     k = summary["max_pokes"]
     families = sorted({f for s in summary["strategies"].values() for f in s["by_family"]})
-    head = ["combination", "worlds", "median pokes to 0.9", "final accuracy", "E error",
-            *families]
+    head = ["combination", "worlds", "median pokes to 0.9", "to stay at 0.9", "final accuracy",
+            "E error", *families]
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for name, s in summary["strategies"].items():
         per = [_fmt(s["by_family"].get(f, {}).get("median_pokes_to_accuracy_0.9"), "g")
@@ -190,7 +201,8 @@ def markdown_summary(summary: dict[str, Any]) -> str:
         mark = " (best)" if name == summary["best"] else ""
         lines.append("| " + " | ".join([
             f"{name}{mark}", f"{s['worlds']}" + (f" ({s['failed']} failed)" if s["failed"] else ""),
-            _fmt(s["median_pokes_to_accuracy_0.9"], "g"), _fmt(s["final_accuracy_median"], ".3f"),
+            _fmt(s["median_pokes_to_accuracy_0.9"], "g"), _fmt(s.get("median_pokes_to_stay_0.9"), "g"),
+            _fmt(s["final_accuracy_median"], ".3f"),
             _fmt(s["modulus_error_median"], ".2f"), *per]) + " |")  # fmt: skip
     lines.append("")
     lines.append(f"Pokes to region accuracy {summary['good_accuracy']:g} (median over worlds; a "
