@@ -6,8 +6,9 @@ map in one world are the first poke after which the region accuracy is at least
 :data:`GOOD_ACCURACY`; a world where it never is (or that failed) counts ``max_pokes + 1``, so a
 median over worlds is never flattered by leaving the hard ones out. A map can lose that accuracy
 with later pokes (a new poke can split a region wrongly), which a robot that stops could not
-know: ``median_pokes_to_stay_0.9`` counts from the poke after which every later one keeps it. A combination whose loop had
-nothing left to poke before ``max_pokes`` keeps its last map for the remaining pokes.
+know: ``median_pokes_to_stay_0.9`` counts from the poke after which every later one keeps it.
+A combination whose loop had nothing left to poke before ``max_pokes`` keeps its last map for the
+remaining pokes.
 """
 
 from __future__ import annotations
