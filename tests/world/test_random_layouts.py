@@ -120,3 +120,15 @@ def test_world_presses_a_non_convex_piece_and_the_insert_in_its_hole() -> None:
                                                                    (outer, outside))}
     soft, hard = sorted(depth)
     assert depth[soft] > depth[hard] > 0
+
+
+def test_scenarios_with_holes_and_non_convex_blocks_round_trip_through_yaml(tmp_path) -> None:
+    from deformap.world import load_scenario, save_scenario
+
+    for family in ("insert", "non-convex", "l-shape"):
+        sc = random_scenario(np.random.default_rng(4), family=family)
+        save_scenario(sc, tmp_path / f"{family}.yaml")
+        again = load_scenario(tmp_path / f"{family}.yaml")
+        assert again.to_dict() == sc.to_dict()
+        xs, ys = np.linspace(0.01, 0.59, 60), np.linspace(0.01, 0.39, 40)
+        assert np.array_equal(again.labels(xs, ys), sc.labels(xs, ys))
