@@ -2,11 +2,12 @@
 same run, on the same small set of worlds.
 
     PYTHONPATH=src python benchmarks/worlds_dask.py [--worlds 4] [--max-pokes 3] [--seed 0]
-        [--strategies paper] [--fields beta] [--out /tmp/worlds-dask]
+        [--strategies paper] [--fields beta] [--default-world] [--out /tmp/worlds-dask]
 
 Each configuration starts its own ``LocalCluster`` on the loopback interface (processes, one
 thread each, no dashboard), runs the same worlds into a fresh folder and times the whole call
-(cluster start excluded). Prints worlds per hour for each and the speed-up against one worker,
+(cluster start excluded). The worlds are coarse (``WorldConfig.coarse()``: the engines' scaling,
+not the maps, is measured) unless ``--default-world``. Prints worlds per hour for each and the speed-up against one worker,
 and checks that both runs give the same numbers (``runs.csv`` without its time columns). On a
 machine shared with other work, the speed-up is bounded by the cores left free: say the load
 average beside the result (printed too).
@@ -38,6 +39,7 @@ def main() -> None:
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--strategies", default="paper")
     parser.add_argument("--fields", default="beta")
+    parser.add_argument("--default-world", action="store_true")
     parser.add_argument("--out", type=Path, default=Path("/tmp/worlds-dask"))
     args = parser.parse_args()
     from distributed import LocalCluster
@@ -51,7 +53,7 @@ def main() -> None:
             config = WorldsBenchConfig(
                 worlds=args.worlds, seed=args.seed, max_pokes=args.max_pokes,
                 strategies=tuple(args.strategies.split(",")), fields=tuple(args.fields.split(",")),
-                scheduler=cluster.scheduler_address)
+                coarse=not args.default_world, scheduler=cluster.scheduler_address)
             t0 = time.perf_counter()
             bench_worlds(config, folder)
             seconds = time.perf_counter() - t0

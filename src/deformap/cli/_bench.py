@@ -174,8 +174,8 @@ def bench_worlds_command(
         help="Region labels (exploration.region_labels); default: its default.")] = None,
     max_pokes: Annotated[int, typer.Option(help="Pokes per world and combination.")] = 12,
     coarse: Annotated[bool, typer.Option(
-        help="The coarse test mesh and camera (default; the default world is tens of times "
-             "slower).")] = True,
+        help="The coarse test mesh and camera: a third of the cost, a smoke run only (its 2 cm "
+             "mesh reads E far off).")] = False,
     workers: Annotated[int, typer.Option(help="Processes of the local pool.")] = 1,
     scheduler: Annotated[str | None, typer.Option(
         help="A dask.distributed scheduler's address (tcp://host:8786) instead of the pool.")
