@@ -7,10 +7,11 @@ same run, on the same small set of worlds.
 Each configuration starts its own ``LocalCluster`` on the loopback interface (processes, one
 thread each, no dashboard), runs the same worlds into a fresh folder and times the whole call
 (cluster start excluded). The worlds are coarse (``WorldConfig.coarse()``: the engines' scaling,
-not the maps, is measured) unless ``--default-world``. Prints worlds per hour for each and the speed-up against one worker,
-and checks that both runs give the same numbers (``runs.csv`` without its time columns). On a
-machine shared with other work, the speed-up is bounded by the cores left free: say the load
-average beside the result (printed too).
+not the maps, is measured) unless ``--default-world``. Prints worlds per hour for each and the
+speed-up against one worker, and checks that both runs give the same numbers (``runs.csv``
+without its time columns). On a machine shared with other work the speed-up is bounded by the
+cores left free, and two processes also take a larger share of a loaded machine than one: say
+the load average beside the result (printed too).
 """
 
 from __future__ import annotations
