@@ -190,23 +190,31 @@ def _failed(task: dict[str, Any], exc: BaseException) -> dict[str, Any]:
 def _local_results(tasks: Sequence[dict[str, Any]], workers: int) -> Iterator[dict[str, Any]]:
     """Results as they finish on a spawn-started process pool; each task retried once."""
     context = multiprocessing.get_context("spawn")
-    with _one_thread_environment(), ProcessPoolExecutor(
-            max_workers=workers, mp_context=context, initializer=_pin_worker) as pool:
-        pending: dict[Future[dict[str, Any]], tuple[dict[str, Any], int]] = {
-            pool.submit(run_world_pinned, t): (t, 0) for t in tasks}
-        while pending:
-            finished, _ = wait(pending, return_when=FIRST_COMPLETED)
-            for future in finished:
-                task, tries = pending.pop(future)
-                try:
-                    yield future.result()
-                except Exception as exc:  # reported, never dropped
-                    if tries == 0:
-                        logger.warning("world %d failed (%s); trying once more", task["index"],
-                                       exc)
-                        pending[pool.submit(run_world_pinned, task)] = (task, 1)
-                    else:
-                        yield _failed(task, exc)
+    with _one_thread_environment():
+        pool = ProcessPoolExecutor(max_workers=workers, mp_context=context,
+                                   initializer=_pin_worker)
+        try:
+            pending: dict[Future[dict[str, Any]], tuple[dict[str, Any], int]] = {
+                pool.submit(run_world_pinned, t): (t, 0) for t in tasks}
+            while pending:
+                finished, _ = wait(pending, return_when=FIRST_COMPLETED)
+                for future in finished:
+                    task, tries = pending.pop(future)
+                    try:
+                        result = future.result()
+                    except Exception as exc:  # reported, never dropped
+                        if tries == 0:
+                            logger.warning("world %d failed (%s); trying once more",
+                                           task["index"], exc)
+                            pending[pool.submit(run_world_pinned, task)] = (task, 1)
+                            continue
+                        result = _failed(task, exc)
+                    yield result
+        except BaseException:
+            # interrupted (or the caller stopped reading): start no further world
+            pool.shutdown(wait=False, cancel_futures=True)
+            raise
+        pool.shutdown()
 
 
 def _dask_results(tasks: Sequence[dict[str, Any]], address: str) -> Iterator[dict[str, Any]]:
