@@ -163,9 +163,7 @@ def bench_worlds_command(
     seed: Annotated[int, typer.Option(help="Seed of the worlds (world i is drawn from "
                                            "(seed, i) alone).")] = 0,
     families: NamesOption = None,
-    strategies: Annotated[list[str] | None, typer.Option(
-        help="Comma-separated (or repeated); default: paper, max-variance, planned.",
-        show_default=False)] = None,
+    strategies: NamesOption = None,
     fields: NamesOption = None,
     physics: Annotated[list[str] | None, typer.Option(
         help="World physics drawn from (linear-fem, stiffening-foam); default: both.",

@@ -94,8 +94,9 @@ class WorldsBenchConfig:
     seed: int = setting(0, ge=0)
     families: tuple[str, ...] = LAYOUT_FAMILIES
     physics: tuple[str, ...] = PHYSICS
-    strategies: tuple[str, ...] = ("paper", "max-variance", "planned")
-    fields: tuple[str, ...] = ("beta", "modulus")
+    # every choice ExplorationConfig has, so a strategy or field added there is benchmarked too
+    strategies: tuple[str, ...] = choices("strategy")
+    fields: tuple[str, ...] = choices("field")
     cut: str | None = None
     # every poke is a press and a β sweep per combination (issue 16 reads 20 and more)
     max_pokes: int = setting(12, ge=1, le=1000)
