@@ -86,6 +86,7 @@ def test_summary_counts_never_and_failed_as_max_pokes_plus_one() -> None:
     # staying at 0.9 — paper's world 4 loses it after poke 1: 2, 4, 1, 4, 4 → 4
     assert paper["median_pokes_to_stay_0.9"] == 4.0 and planned["median_pokes_to_stay_0.9"] == 3.0
     assert paper["worlds"] == 5 and paper["failed"] == 1
+    assert paper["share_reaching_0.9"] == pytest.approx(3 / 5)
     assert paper["final_accuracy_median"] == pytest.approx(0.825)  # 0.97, 0.7, 0.95 carried, 0.7
     assert paper["by_family"]["cuts"]["median_pokes_to_accuracy_0.9"] == 2.0
     assert paper["by_family"]["insert"]["median_pokes_to_accuracy_0.9"] == 2.5
@@ -94,7 +95,7 @@ def test_summary_counts_never_and_failed_as_max_pokes_plus_one() -> None:
     assert summary["best"] == "paper/beta/isopleth"
     assert summary["failed_worlds"] == [{"index": 3, "error": "Boom: no"}]
     table = markdown_summary(summary)
-    assert "| paper/beta/isopleth (best) | 5 (1 failed) | 2 | 4 |" in table
+    assert "| paper/beta/isopleth (best) | 5 (1 failed) | 2 | 4 | 60% |" in table
     curves = accuracy_curves(_results(), COMBOS, 3)
     assert curves["all"]["paper/beta/isopleth"].shape == (4, 3)
     assert curves["insert"]["paper/beta/isopleth"].tolist() == [[0.95, 0.95, 0.95]]

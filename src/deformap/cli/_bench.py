@@ -202,13 +202,14 @@ def bench_worlds_command(
         rows.append((name + (" (best)" if name == summary["best"] else ""), str(s["worlds"]),
                      "–" if pokes is None else f"{pokes:g}",
                      "–" if stay is None else f"{stay:g}",
+                     "–" if s["share_reaching_0.9"] is None else f"{s['share_reaching_0.9']:.0%}",
                      "–" if final is None else f"{final:.3f}",
                      "–" if error is None else f"{error:.2f}"))  # fmt: skip
     shown.print(_table(
         f"{len(rows)} combinations over {config.worlds} worlds, {config.max_pokes} pokes "
         f"(a world never at 0.9 counts {config.max_pokes + 1})",
-        ("strategy/field/cut", "worlds", "pokes to 0.9", "to stay", "final accuracy",
-         "E error"),
+        ("strategy/field/cut", "worlds", "pokes to 0.9", "to stay", "reach 0.9",
+         "final accuracy", "E error"),
         rows))  # fmt: skip
     shown.print(f"{output.computed} worlds computed in {output.seconds:.0f} s → {output.folder}",
                 highlight=False)

@@ -132,6 +132,9 @@ def _stats(entries: list[dict[str, Any]], max_pokes: int) -> dict[str, Any]:
         "median_pokes_to_accuracy_0.9": _median([_pokes_to_good(e, max_pokes) for e in entries]),
         "median_pokes_to_stay_0.9": _median([_pokes_to_good(e, max_pokes, stay=True)
                                              for e in entries]),
+        # when most worlds never get there the medians saturate at max_pokes + 1; the share does not
+        "share_reaching_0.9": (sum(_pokes_to_good(e, max_pokes) <= max_pokes for e in entries)
+                               / len(entries)) if entries else None,
         "final_accuracy_median": _median([float(e["accuracy"][-1]) for e in done]),
         "modulus_error_median": _median([float(e["modulus_error"][-1]) for e in done]),
         "worlds": len(entries),
@@ -193,8 +196,8 @@ def markdown_summary(summary: dict[str, Any]) -> str:
     """The summary as a markdown table: one row per combination, overall and per family."""
     k = summary["max_pokes"]
     families = sorted({f for s in summary["strategies"].values() for f in s["by_family"]})
-    head = ["combination", "worlds", "median pokes to 0.9", "to stay at 0.9", "final accuracy",
-            "E error", *families]
+    head = ["combination", "worlds", "median pokes to 0.9", "to stay at 0.9", "reach 0.9",
+            "final accuracy", "E error", *families]
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for name, s in summary["strategies"].items():
         per = [_fmt(s["by_family"].get(f, {}).get("median_pokes_to_accuracy_0.9"), "g")
@@ -203,11 +206,13 @@ def markdown_summary(summary: dict[str, Any]) -> str:
         lines.append("| " + " | ".join([
             f"{name}{mark}", f"{s['worlds']}" + (f" ({s['failed']} failed)" if s["failed"] else ""),
             _fmt(s["median_pokes_to_accuracy_0.9"], "g"), _fmt(s.get("median_pokes_to_stay_0.9"), "g"),
-            _fmt(s["final_accuracy_median"], ".3f"),
+            _fmt(s.get("share_reaching_0.9"), ".0%"), _fmt(s["final_accuracy_median"], ".3f"),
             _fmt(s["modulus_error_median"], ".2f"), *per]) + " |")  # fmt: skip
     lines.append("")
     lines.append(f"Pokes to region accuracy {summary['good_accuracy']:g} (median over worlds; a "
-                 f"world that never reaches it counts {k + 1}); final accuracy and the modulus "
+                 f"world that never reaches it counts {k + 1}); to stay: from the poke after which "
+                 "it stays there; reach: the share of worlds that reach it by the last poke; "
+                 "final accuracy and the modulus "
                  f"field's median relative E error after {k} pokes; the family columns are "
                  "median pokes to 0.9.")
     return "\n".join(lines) + "\n"
