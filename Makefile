@@ -4,7 +4,7 @@ PYTHON ?= python3
 VENV ?= .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.deformap-installed
-EXTRAS ?= test,ros,rerun
+EXTRAS ?= test,ros,rerun,dask
 
 .PHONY: demo test bench lint clean venv
 

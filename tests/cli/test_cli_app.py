@@ -31,7 +31,7 @@ def test_every_command_group_is_registered() -> None:
     for name in ("explore", "record-sim", "map", "estimate", "reproduce", "scenarios", "bench",
                  "config", "study", "world"):  # fmt: skip
         assert name in result.output
-    for group, names in (("bench", ("speed", "world", "io", "memory")),
+    for group, names in (("bench", ("speed", "world", "io", "memory", "worlds")),
                          ("study", ("hardness", "cluster-size")), ("world", ("show",))):  # fmt: skip
         result = runner.invoke(app, [group, "--help"])
         assert result.exit_code == 0 and all(n in result.output for n in names), result.output
@@ -42,10 +42,11 @@ def test_every_command_with_a_seed_refuses_a_negative_one_before_running(tmp_pat
                 ["map", str(tmp_path)], ["reproduce"], ["study", "hardness"],
                 ["study", "cluster-size"], ["world", "show", "homogeneous-60", "--out",
                                             str(tmp_path / "w")],
-                ["bench", "world"], ["bench", "io"], ["bench", "speed"], ["bench", "memory"]]
+                ["bench", "world"], ["bench", "io"], ["bench", "speed"], ["bench", "memory"],
+                ["bench", "worlds", "--out", str(tmp_path / "b")]]
     for command in commands:
         result = runner.invoke(app, [*command, "--seed", "-3"])
         assert result.exit_code == 2, (command, result.output)
         assert "`--seed` must be an integer >= 0; got -3" in result.output, (command, result.output)
         assert "Traceback" not in result.output
-    assert not (tmp_path / "w").exists()  # refused before any work
+    assert not (tmp_path / "w").exists() and not (tmp_path / "b").exists()  # before any work

@@ -99,7 +99,8 @@ def test_custom_yaml_reads_rect_polygon_modulus_and_rigid(tmp_path) -> None:
         (("youngs_modulus_pa: 20000", "youngs_modulus_pa: 20000\n    rigid: true"), "exactly one"),
         (("rect: [0.0, 0.0, 0.3, 0.4]", "rect: [0.3, 0.0, 0.0, 0.4]"), "x1 > x0"),
         (("name: custom", "name: custom\nwind: 3"), "unknown key"),
-        (("[0.6, 0.4], [0.3, 0.4]]", "[0.45, 0.1], [0.6, 0.4], [0.3, 0.4]]"), "convex"),
+        # a bow-tie: two edges cross (a notched, non-convex footprint is fine)
+        (("[0.6, 0.4], [0.3, 0.4]]", "[0.3, 0.4], [0.6, 0.4]]"), "simple polygon"),
     ],
 )
 def test_bad_yaml_is_refused_with_a_clear_message(tmp_path, edit, message) -> None:

@@ -1,8 +1,10 @@
-"""``deformap bench speed | world | io | memory``: tables with a baseline measured in the same run."""
+"""``deformap bench speed | world | io | memory``: tables with a baseline measured in the same run;
+``deformap bench worlds``: strategies and fields over many random worlds."""
 
 from __future__ import annotations
 
 from collections.abc import Sequence
+from pathlib import Path
 from typing import Annotated, Any
 
 import numpy as np
@@ -11,7 +13,7 @@ from rich.table import Table
 
 from deformap import eval as evaluation
 from deformap.cli._app import JsonOption, app, emit_json, friendly_errors, out_console
-from deformap.cli._progress import progress
+from deformap.cli._progress import progress, run_hooks
 
 __all__ = ["bench_app"]
 
@@ -141,3 +143,74 @@ def bench_memory_command(json_path: JsonOption = None, seed: SeedOption = 0,
     shown.print("traced: numpy + Python (tracemalloc); RSS+: resident set rise, all libraries; "
                 "one fresh process per row; baseline: the same size", style="dim")
     emit_json(json_path, result)
+
+
+def _names(values: list[str] | None) -> tuple[str, ...] | None:
+    """Names given as repeated options, each possibly a comma-separated list."""
+    if not values:
+        return None
+    return tuple(n.strip() for v in values for n in v.split(",") if n.strip())
+
+
+NamesOption = Annotated[list[str] | None, typer.Option(
+    help="Comma-separated (or repeated); default: all.", show_default=False)]
+
+
+@bench_app.command("worlds")
+@friendly_errors
+def bench_worlds_command(
+    worlds: Annotated[int, typer.Option(help="How many random worlds.")] = 100,
+    seed: Annotated[int, typer.Option(help="Seed of the worlds (world i is drawn from "
+                                           "(seed, i) alone).")] = 0,
+    families: NamesOption = None,
+    strategies: NamesOption = None,
+    fields: NamesOption = None,
+    physics: Annotated[list[str] | None, typer.Option(
+        help="World physics drawn from (linear-fem, stiffening-foam); default: both.",
+        show_default=False)] = None,
+    cut: Annotated[str | None, typer.Option(
+        help="Region labels (exploration.region_labels); default: its default.")] = None,
+    max_pokes: Annotated[int, typer.Option(help="Pokes per world and combination.")] = 12,
+    coarse: Annotated[bool, typer.Option(
+        help="The coarse test mesh and camera: a third of the cost, a smoke run only (its 2 cm "
+             "mesh reads E far off).")] = False,
+    workers: Annotated[int, typer.Option(help="Processes of the local pool.")] = 1,
+    scheduler: Annotated[str | None, typer.Option(
+        help="A dask.distributed scheduler's address (tcp://host:8786) instead of the pool.")
+    ] = None,
+    out: Annotated[Path | None, typer.Option(
+        help="The folder (new, or this benchmark's own to resume).")] = None,
+    json_path: JsonOption = None,
+) -> None:
+    """Map many seeded random worlds with every strategy × field; accuracy after every poke,
+    curves per layout family and the pokes a good map takes (resumes in its --out)."""
+    from deformap import run
+
+    given = {"families": _names(families), "strategies": _names(strategies),
+             "fields": _names(fields), "physics": _names(physics)}
+    config = run.WorldsBenchConfig(
+        worlds=worlds, seed=seed, cut=cut, max_pokes=max_pokes, coarse=coarse, workers=workers,
+        scheduler=scheduler, **{k: v for k, v in given.items() if v is not None})
+    shown = out_console(json_path)
+    with progress(shown) as bar:
+        output = run.bench_worlds(config, out, hooks=run_hooks(bar))
+    summary = output.summary
+    rows = []
+    for name, s in summary["strategies"].items():
+        pokes, stay = s["median_pokes_to_accuracy_0.9"], s["median_pokes_to_stay_0.9"]
+        final, error = s["final_accuracy_median"], s["modulus_error_median"]
+        rows.append((name + (" (best)" if name == summary["best"] else ""), str(s["worlds"]),
+                     "–" if pokes is None else f"{pokes:g}",
+                     "–" if stay is None else f"{stay:g}",
+                     "–" if s["share_reaching_0.9"] is None else f"{s['share_reaching_0.9']:.0%}",
+                     "–" if final is None else f"{final:.3f}",
+                     "–" if error is None else f"{error:.2f}"))  # fmt: skip
+    shown.print(_table(
+        f"{len(rows)} combinations over {config.worlds} worlds, {config.max_pokes} pokes "
+        f"(a world never at 0.9 counts {config.max_pokes + 1})",
+        ("strategy/field/cut", "worlds", "pokes to 0.9", "to stay", "reach 0.9",
+         "final accuracy", "E error"),
+        rows))  # fmt: skip
+    shown.print(f"{output.computed} worlds computed in {output.seconds:.0f} s → {output.folder}",
+                highlight=False)
+    emit_json(json_path, summary)

@@ -79,6 +79,12 @@ if TYPE_CHECKING:
         run_hardness_study,
     )
     from deformap.run._world import ScenarioSummary, scenario_summaries, show_scenario
+    from deformap.run._worlds import (
+        BLAS_THREAD_VARIABLES,
+        WorldsBenchConfig,
+        WorldsOutput,
+        bench_worlds,
+    )
 
 _MODULES = {
     "_config": ("CONFIG_NAME", "RunConfig", "RunOverrides", "apply_overrides", "config_yaml",
@@ -100,9 +106,11 @@ _MODULES = {
     "_studies": ("CLUSTER_SIZE_FOAMS", "StudyOutput", "run_cluster_size_study",
                  "run_hardness_study"),
     "_world": ("ScenarioSummary", "scenario_summaries", "show_scenario"),
+    "_worlds": ("BLAS_THREAD_VARIABLES", "WorldsBenchConfig", "WorldsOutput", "bench_worlds"),
 }  # fmt: skip
 
 __all__ = [
+    "BLAS_THREAD_VARIABLES",
     "CLUSTER_SIZE_FOAMS",
     "CONFIG_NAME",
     "POKES_CSV_COLUMNS",
@@ -119,8 +127,11 @@ __all__ = [
     "RunStart",
     "ScenarioSummary",
     "StudyOutput",
+    "WorldsBenchConfig",
+    "WorldsOutput",
     "apply_overrides",
     "atomic_path",
+    "bench_worlds",
     "config_yaml",
     "create_run_folder",
     "default_run_folder",

@@ -31,6 +31,7 @@ from deformap.mechanics import (
 from deformap.world._camera import CAMERA_PRESETS, CameraConfig, camera_preset
 from deformap.world._config import PHYSICS, Physics, WorldConfig, check_world_budget
 from deformap.world._foam import Dent
+from deformap.world._layouts import LAYOUT_FAMILIES, LayoutFamily
 from deformap.world._probe import ProbeGeometry
 from deformap.world._random import random_scenario
 from deformap.world._scenario import BARE_TABLE, Block, Scenario
@@ -40,11 +41,13 @@ from deformap.world._world import MIN_RECORD_FORCE_N, SimulatedWorld
 __all__ = [
     "BARE_TABLE",
     "CAMERA_PRESETS",
+    "LAYOUT_FAMILIES",
     "MIN_RECORD_FORCE_N",
     "PHYSICS",
     "Block",
     "CameraConfig",
     "Dent",
+    "LayoutFamily",
     "Physics",
     "ProbeGeometry",
     "Scenario",

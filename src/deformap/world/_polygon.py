@@ -1,10 +1,15 @@
-"""Small exact helpers for convex polygons in the table plane (no shapely needed).
+"""Small exact helpers for polygons in the table plane (no shapely needed).
 
 Polygons are ``(k, 2)`` float arrays of vertices in metres, counter-clockwise, without repeating the
-first vertex at the end.
+first vertex at the end. Most helpers take convex polygons; a footprint may be any *simple* polygon
+(no two edges cross, :func:`is_simple`), with holes: :func:`triangulate` cuts a simple polygon into
+triangles (ear clipping), and :func:`overlap_area` measures the shared area of two footprints
+exactly from the pairwise overlaps of their triangles.
 """
 
 from __future__ import annotations
+
+from collections.abc import Sequence
 
 import numpy as np
 from numpy.typing import NDArray
@@ -13,9 +18,12 @@ __all__ = [
     "clip_halfplane",
     "convex_overlap_area",
     "is_convex",
+    "is_simple",
+    "overlap_area",
     "points_in_polygon",
     "polygon_area",
     "rectangle",
+    "triangulate",
 ]
 
 _EPS = 1e-12
@@ -85,3 +93,98 @@ def convex_overlap_area(a: NDArray[np.float64], b: NDArray[np.float64]) -> float
         if len(clipped) < 3:
             return 0.0
     return max(0.0, polygon_area(clipped))
+
+
+def _cross(o: NDArray[np.float64], a: NDArray[np.float64], b: NDArray[np.float64]
+           ) -> NDArray[np.float64]:
+    """z of ``(a - o) × (b - o)``, broadcast over leading axes."""
+    return np.asarray((a[..., 0] - o[..., 0]) * (b[..., 1] - o[..., 1])
+                      - (a[..., 1] - o[..., 1]) * (b[..., 0] - o[..., 0]))
+
+
+def is_simple(poly: NDArray[np.float64]) -> bool:
+    """True when no two edges of the polygon meet except neighbours at their shared vertex.
+
+    Every pair of non-adjacent edges is tested for a crossing or a touch (orientation signs, with
+    collinear overlaps counted as touching): O(k²), fine for footprints of up to a few hundred
+    vertices.
+    """
+    k = len(poly)
+    if k < 3:
+        return False
+    a, b = poly, np.roll(poly, -1, axis=0)
+    if np.any(np.all(np.abs(b - a) <= _EPS, axis=1)):
+        return False  # a repeated vertex
+    i, j = np.triu_indices(k, k=2)
+    keep = ~((i == 0) & (j == k - 1))  # the last edge and the first share vertex 0
+    i, j = i[keep], j[keep]
+    p1, p2, q1, q2 = a[i], b[i], a[j], b[j]
+    d1, d2 = _cross(q1, q2, p1), _cross(q1, q2, p2)
+    d3, d4 = _cross(p1, p2, q1), _cross(p1, p2, q2)
+    proper = (d1 * d2 < -_EPS**2) & (d3 * d4 < -_EPS**2)
+
+    def on_segment(o: NDArray, s: NDArray, e: NDArray, d: NDArray) -> NDArray[np.bool_]:
+        lo, hi = np.minimum(s, e) - _EPS, np.maximum(s, e) + _EPS
+        return np.asarray((np.abs(d) <= _EPS) & np.all((o >= lo) & (o <= hi), axis=-1))
+
+    touch = (on_segment(p1, q1, q2, d1) | on_segment(p2, q1, q2, d2)
+             | on_segment(q1, p1, p2, d3) | on_segment(q2, p1, p2, d4))
+    return not bool(np.any(proper | touch))
+
+
+def triangulate(poly: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``(k - 2, 3, 2)`` counter-clockwise triangles that tile a simple counter-clockwise polygon.
+
+    Ear clipping (Meisters 1975: every simple polygon of more than three vertices has an ear, a
+    convex vertex whose triangle holds no other vertex), O(k³) at worst, fine for footprints.
+    """
+    idx = list(range(len(poly)))
+    out: list[NDArray[np.float64]] = []
+    while len(idx) > 3:
+        n = len(idx)
+        for m in range(n):
+            ia, ib, ic = idx[m - 1], idx[m], idx[(m + 1) % n]
+            a, b, c = poly[ia], poly[ib], poly[ic]
+            if float(_cross(a, b, c)) <= _EPS**2:
+                continue  # reflex or flat: not an ear
+            others = poly[[i for i in idx if i not in (ia, ib, ic)]]
+            inside = ((_cross(a, b, others) >= -_EPS**2) & (_cross(b, c, others) >= -_EPS**2)
+                      & (_cross(c, a, others) >= -_EPS**2))
+            if not np.any(inside):
+                out.append(np.array([a, b, c]))
+                del idx[m]
+                break
+        else:  # only for a polygon that is not simple (callers check first) or degenerate
+            raise ValueError("triangulate: no ear found; the polygon is not simple")
+    out.append(poly[idx])
+    return np.array(out, dtype=float).reshape(-1, 3, 2)
+
+
+def _triangles_overlap(ta: NDArray[np.float64], tb: NDArray[np.float64]) -> float:
+    """Total overlap of two sets of triangles (each set disjoint), m²."""
+    total = 0.0
+    lo_a, hi_a = ta.min(axis=1), ta.max(axis=1)
+    lo_b, hi_b = tb.min(axis=1), tb.max(axis=1)
+    hits = np.all((lo_a[:, None] < hi_b[None]) & (lo_b[None] < hi_a[:, None]), axis=2)
+    for i, j in zip(*np.nonzero(hits), strict=True):
+        total += convex_overlap_area(ta[i], tb[j])
+    return total
+
+
+def overlap_area(a: NDArray[np.float64], b: NDArray[np.float64],
+                 holes_a: Sequence[NDArray[np.float64]] = (),
+                 holes_b: Sequence[NDArray[np.float64]] = ()) -> float:
+    """Area shared by two footprints, each a simple counter-clockwise polygon less its holes, m².
+
+    The holes of a footprint lie inside it and apart, so by inclusion–exclusion
+    ``|A ∩ B| = |A₀ ∩ B₀| − Σ|hᵢ ∩ B₀| − Σ|A₀ ∩ gⱼ| + ΣΣ|hᵢ ∩ gⱼ|`` with ``A₀``, ``B₀`` the outer
+    polygons and ``hᵢ``, ``gⱼ`` the holes; each term sums the overlaps of the triangles of the two
+    polygons (:func:`triangulate`), which tile them.
+    """
+    tri = [triangulate(p) for p in (a, *holes_a)], [triangulate(p) for p in (b, *holes_b)]
+    total = 0.0
+    for i, ta in enumerate(tri[0]):
+        for j, tb in enumerate(tri[1]):
+            sign = (-1.0 if i else 1.0) * (-1.0 if j else 1.0)
+            total += sign * _triangles_overlap(ta, tb)
+    return max(0.0, total)

@@ -1,43 +1,42 @@
 """Seeded random heterogeneous worlds for benchmarks over many layouts.
 
-The workspace is cut into 2–4 convex regions by straight cuts at random angles through random points
-of the largest remaining piece (so regions are rarely axis-aligned), each piece keeping at least
-``min_area_fraction`` of the area. Each region gets a hardness drawn uniformly from the foam range
-(60–150 N by default, at least ``min_hardness_gap_n`` apart so that regions differ), and with
-probability ``p_rigid`` one region is a rigid board instead.
+A layout family (:mod:`deformap.world._layouts`: straight ``cuts``, an ``insert``, an ``l-shape``,
+a ``checker``, ``stripes``, a ``non-convex`` piece) cuts the workspace into pieces, each made of
+one of a few materials. Each material gets a hardness drawn uniformly from the foam range (60–150 N
+by default, at least ``min_hardness_gap_n`` apart so that materials differ), and with probability
+``p_rigid`` one material is a rigid board instead. The default family, ``cuts``, draws exactly what
+this generator drew before the other families existed.
 """
 
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import NDArray
 
 from deformap._validation import check_in_range, check_int
 from deformap.environment import Workspace
 from deformap.errors import InvalidArgumentError
-from deformap.world._polygon import clip_halfplane, polygon_area, rectangle
+from deformap.world._layouts import LAYOUT_FAMILIES, Piece, cut_pieces, layout_pieces
 from deformap.world._scenario import Block, Scenario
 
 __all__ = ["random_scenario"]
 
 _PALETTE = ("#f4d35e", "#ee964b", "#c8553d", "#7fb285", "#5b8e7d")
+_RIGID_COLOR = "#6b4f3a"
 
 
-def _cut(poly: NDArray[np.float64], rng: np.random.Generator, min_area: float
-         ) -> tuple[NDArray[np.float64], NDArray[np.float64]] | None:
-    lo, hi = poly.min(axis=0), poly.max(axis=0)
-    point = lo + rng.uniform(0.3, 0.7, size=2) * (hi - lo)
-    angle = rng.uniform(0.0, np.pi)
-    normal = np.array([np.cos(angle), np.sin(angle)])
-    a, b = clip_halfplane(poly, point, normal), clip_halfplane(poly, point, -normal)
-    if len(a) < 3 or len(b) < 3 or min(polygon_area(a), polygon_area(b)) < min_area:
-        return None
-    return a, b
+def _hardnesses(rng: np.random.Generator, n: int, low: float, high: float, gap: float
+                ) -> np.ndarray:
+    for _ in range(1000):
+        hardness = rng.uniform(low, high, size=n)
+        if n < 2 or np.min(np.diff(np.sort(hardness))) >= gap:
+            break
+    return hardness
 
 
 def random_scenario(
     rng: np.random.Generator,
     *,
+    family: str = "cuts",
     n_regions: int | None = None,
     hardness_range_n: tuple[float, float] = (60.0, 150.0),
     p_rigid: float = 0.25,
@@ -52,18 +51,29 @@ def random_scenario(
     ----------
     rng : numpy.random.Generator
         The only source of randomness: the same seed gives the same scenario.
+    family : str
+        One of :data:`deformap.world.LAYOUT_FAMILIES` (module docstring).
     n_regions : int, optional
-        2–4; drawn uniformly when not given.
+        ``cuts`` only: 2–4 pieces; drawn uniformly when not given.
     hardness_range_n : (2,) float, newtons
         Range of foam hardness.
     p_rigid : float
-        Probability that one of the regions is a rigid board.
+        Probability that one of the materials is a rigid board.
+    thickness_m : float
+        Every block's thickness.
+    min_area_fraction : float
+        ``cuts`` only: the smallest piece's share of the area.
+    min_hardness_gap_n : float
+        Least difference of two materials' hardness.
     """
     if not isinstance(rng, np.random.Generator):
         raise InvalidArgumentError(f"`rng` must be a numpy.random.Generator; got {type(rng)}")
-    n = int(rng.integers(2, 5)) if n_regions is None else check_int("n_regions", n_regions)
-    if not 2 <= n <= 4:
-        raise InvalidArgumentError(f"`n_regions` must be 2, 3 or 4; got {n}")
+    if family not in LAYOUT_FAMILIES:
+        raise InvalidArgumentError(
+            f"`family` must be one of {list(LAYOUT_FAMILIES)}; got {family!r}")
+    if n_regions is not None and family != "cuts":
+        raise InvalidArgumentError(
+            f"`n_regions` is for the 'cuts' family only; got {n_regions} with {family!r}")
     h_lo, h_hi = (float(v) for v in hardness_range_n)
     if not 0 < h_lo < h_hi:
         raise InvalidArgumentError(
@@ -71,34 +81,32 @@ def random_scenario(
         )
     check_in_range("p_rigid", p_rigid, 0.0, 1.0, closed_high=True)
     ws = workspace or Workspace()
-    pieces = [rectangle(*ws.lower, *ws.upper)]
-    min_area = min_area_fraction * polygon_area(pieces[0])
-    while len(pieces) < n:
-        pieces.sort(key=polygon_area)
-        for _ in range(200):
-            cut = _cut(pieces[-1], rng, min_area)
-            if cut is not None:
-                pieces = [*pieces[:-1], *cut]
-                break
-        else:
-            raise InvalidArgumentError(
-                f"could not cut {n} regions of at least {min_area_fraction:.0%} of the area; "
-                "lower `min_area_fraction`"
-            )
-    pieces.sort(key=lambda p: tuple(p.mean(axis=0)))
-    for _ in range(1000):
-        hardness = rng.uniform(h_lo, h_hi, size=n)
-        if n < 2 or np.min(np.diff(np.sort(hardness))) >= min_hardness_gap_n:
-            break
-    rigid_index = int(rng.integers(n)) if rng.uniform() < p_rigid else -1
+    if family == "cuts":
+        n = int(rng.integers(2, 5)) if n_regions is None else check_int("n_regions", n_regions)
+        if not 2 <= n <= 4:
+            raise InvalidArgumentError(f"`n_regions` must be 2, 3 or 4; got {n}")
+        pieces = [Piece(p, k) for k, p in enumerate(cut_pieces(ws, rng, n, min_area_fraction))]
+    else:
+        pieces = layout_pieces(family, ws, rng, min_area_fraction=min_area_fraction)
+    n_materials = 1 + max(p.material for p in pieces)
+    if n_materials > 1 and (h_hi - h_lo) < min_hardness_gap_n * (n_materials - 1):
+        raise InvalidArgumentError(
+            f"`hardness_range_n` {hardness_range_n} cannot hold {n_materials} hardnesses "
+            f"{min_hardness_gap_n:g} N apart; widen it or lower `min_hardness_gap_n`")
+    hardness = _hardnesses(rng, n_materials, h_lo, h_hi, min_hardness_gap_n)
+    rigid_material = int(rng.integers(n_materials)) if rng.uniform() < p_rigid else -1
     blocks = []
-    for k, poly in enumerate(pieces):
-        if k == rigid_index:
-            blocks.append(Block(name=f"region-{k}-rigid", polygon=poly, rigid=True,
-                                thickness_m=thickness_m, color="#6b4f3a"))
+    for k, piece in enumerate(pieces):
+        m = piece.material
+        if m == rigid_material:
+            blocks.append(Block(name=f"region-{k}-rigid", polygon=piece.polygon,
+                                holes=piece.holes, rigid=True, thickness_m=thickness_m,
+                                color=_RIGID_COLOR))
         else:
-            h = round(float(hardness[k]), 1)
-            blocks.append(Block(name=f"region-{k}-{h:g}N", polygon=poly, hardness_n=h,
-                                thickness_m=thickness_m, color=_PALETTE[k % len(_PALETTE)]))
-    return Scenario(name="random", blocks=tuple(blocks), workspace=ws,
-                    description=f"random world with {n} regions")
+            h = round(float(hardness[m]), 1)
+            blocks.append(Block(name=f"region-{k}-{h:g}N", polygon=piece.polygon,
+                                holes=piece.holes, hardness_n=h, thickness_m=thickness_m,
+                                color=_PALETTE[m % len(_PALETTE)]))
+    return Scenario(name=f"random-{family}", blocks=tuple(blocks), workspace=ws,
+                    description=f"random {family} world: {len(pieces)} pieces of "
+                                f"{n_materials} materials")

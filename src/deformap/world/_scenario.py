@@ -1,11 +1,12 @@
 """Scenarios: which foam blocks lie where on the table.
 
-A scenario is a list of blocks on the rigid table. Each block is a convex polygon in the table plane
-(a rectangle is the common case), extruded to its own thickness, made of foam of a given hardness
-(or Young's modulus) or ``rigid`` (a wooden board that does not deform). What no block covers is the
-bare table at ``z = 0``, also rigid. Blocks never overlap; they may touch. Neighbouring blocks are
-separate pieces laid side by side, as in the paper's experiments: each is bonded to the table at its
-bottom but not glued to its neighbours.
+A scenario is a list of blocks on the rigid table. Each block is a simple polygon in the table plane
+(a rectangle is the common case; non-convex footprints, an L or a U, are one piece, and a block may
+have holes, where another block is inserted), extruded to its own thickness, made of foam of a
+given hardness (or Young's modulus) or ``rigid`` (a wooden board that does not deform). What no
+block covers is the bare table at ``z = 0``, also rigid. Blocks never overlap; they may touch.
+Neighbouring blocks are separate pieces laid side by side, as in the paper's experiments: each is
+bonded to the table at its bottom but not glued to its neighbours.
 
 Built-in layouts (paper's Table I; its figure of the layouts is lost, so these are our choice), all
 over the 60 × 40 cm workspace with 5 cm thick blocks:
@@ -25,6 +26,7 @@ the bare table.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -36,8 +38,8 @@ from deformap.environment import Workspace
 from deformap.errors import InvalidArgumentError
 from deformap.mechanics import hardness_to_youngs_modulus, youngs_modulus_to_hardness
 from deformap.world._polygon import (
-    convex_overlap_area,
-    is_convex,
+    is_simple,
+    overlap_area,
     points_in_polygon,
     polygon_area,
     rectangle,
@@ -57,15 +59,19 @@ MAX_EXTENT_M = 10.0
 
 @dataclass(frozen=True, kw_only=True)
 class Block:
-    """One block on the table: a convex prism of foam (or of a rigid material).
+    """One block on the table: a prism of foam (or of a rigid material) over a simple polygon.
 
     Parameters
     ----------
     name : str
         Region name used in reports (``"soft"``, ``"60 N foam"``).
     polygon : (k, 2) float, metres
-        Convex footprint, ``k >= 3``, at most :data:`MAX_EXTENT_M` across on each axis; stored
-        counter-clockwise.
+        Footprint, ``k >= 3``, a simple polygon (convex or not; no two edges cross), at most
+        :data:`MAX_EXTENT_M` across on each axis; stored counter-clockwise.
+    holes : tuple of (m, 2) float, metres
+        Simple polygons inside the footprint, apart from each other, that the block leaves
+        empty (another block may fill them); stored counter-clockwise. Points inside a block are
+        told by the even-odd rule over the footprint and its holes.
     thickness_m : float
         Height of the block's top above the table, in ``[0.001, MAX_EXTENT_M]`` metres.
     hardness_n : float or None
@@ -80,6 +86,8 @@ class Block:
 
     name: str
     polygon: NDArray[np.float64]
+    # a sequence of arrays of their own shapes, checked by _ring below (stored as a tuple)
+    holes: Sequence[NDArray[np.float64]] = ()
     # at least the 1 mm the FEM's smallest element may be (`WorldConfig.element_size_m`): a
     # thinner block is no layer the world can mesh (1e-320 m gave a zero Jacobian deep inside)
     thickness_m: float = setting(0.05, ge=0.001, le=MAX_EXTENT_M)
@@ -99,25 +107,39 @@ class Block:
         if not self.name:
             raise InvalidArgumentError(
                 f"block `name` must be a non-empty string; got {self.name!r}")
-        poly = check_array(f"block {self.name!r} polygon", self.polygon, (None, 2),
-                           what="vertices (x, y) in metres", min_rows=3)
-        area = polygon_area(poly)
-        if area < 0:
-            poly, area = poly[::-1].copy(), -area
-        if area <= _OVERLAP_TOL_M2 or not is_convex(poly):
+        poly = _ring(f"block {self.name!r} polygon", self.polygon)
+        if isinstance(self.holes, (str, bytes, np.ndarray)) or not isinstance(self.holes,
+                                                                              Sequence):
             raise InvalidArgumentError(
-                f"block {self.name!r} polygon must be convex with a positive area; "
-                f"got area {area:.3g} m², convex={is_convex(poly)}"
-            )
+                f"block {self.name!r} `holes` must be a sequence of polygons; got "
+                f"{type(self.holes).__name__}")
+        holes = tuple(_ring(f"block {self.name!r} holes[{i}]", h)
+                      for i, h in enumerate(self.holes))
+        self._check_holes(poly, holes)
         extent = poly.max(axis=0) - poly.min(axis=0)
         if np.any(extent > MAX_EXTENT_M):
             raise SettingError(
                 "polygon", f"must span at most {MAX_EXTENT_M:g} m on each axis; got "
                 f"{extent[0]:g} × {extent[1]:g} m (block {self.name!r})"
             )
-        poly.setflags(write=False)
+        for ring in (poly, *holes):
+            ring.setflags(write=False)
         object.__setattr__(self, "polygon", poly)
+        object.__setattr__(self, "holes", holes)
         self._check_material()
+
+    def _check_holes(self, poly: NDArray[np.float64], holes: tuple[NDArray[np.float64], ...]
+                     ) -> None:
+        for i, hole in enumerate(holes):
+            inside = overlap_area(hole, poly)
+            if abs(inside - polygon_area(hole)) > _OVERLAP_TOL_M2:
+                raise InvalidArgumentError(
+                    f"block {self.name!r} holes[{i}] must lie inside the polygon; got "
+                    f"{(polygon_area(hole) - inside) * 1e4:.2f} cm² of it outside")
+            for j, other in enumerate(holes[:i]):
+                if overlap_area(hole, other) > _OVERLAP_TOL_M2:
+                    raise InvalidArgumentError(
+                        f"block {self.name!r} holes[{i}] must not overlap holes[{j}]")
 
     def _check_material(self) -> None:
         given = [self.hardness_n is not None, self.youngs_modulus_pa is not None, bool(self.rigid)]
@@ -144,13 +166,24 @@ class Block:
         """Hardness in N; ``inf`` for a rigid block."""
         return float("inf") if self.rigid else float(self.hardness_n)  # type: ignore[arg-type]
 
+    @property
+    def area_m2(self) -> float:
+        """Area of the footprint less its holes, m²."""
+        return polygon_area(self.polygon) - sum(polygon_area(h) for h in self.holes)
+
     def contains(self, xy: NDArray[np.float64]) -> NDArray[np.bool_]:
-        """Mask of the ``(n, 2)`` points inside the footprint."""
-        return points_in_polygon(np.asarray(xy, dtype=float).reshape(-1, 2), self.polygon)
+        """Mask of the ``(n, 2)`` points inside the footprint and outside its holes."""
+        pts = np.asarray(xy, dtype=float).reshape(-1, 2)
+        inside = points_in_polygon(pts, self.polygon)
+        for hole in self.holes:
+            inside &= ~points_in_polygon(pts, hole)
+        return inside
 
     def to_dict(self) -> dict[str, Any]:
         out: dict[str, Any] = {"name": self.name,
                                "polygon": [[float(x), float(y)] for x, y in self.polygon]}
+        if self.holes:
+            out["holes"] = [[[float(x), float(y)] for x, y in h] for h in self.holes]
         if self.rigid:
             out["rigid"] = True
         else:
@@ -195,7 +228,7 @@ class Scenario:
             raise InvalidArgumentError(f"scenario {self.name!r} has repeated block names: {names}")
         for i, a in enumerate(blocks):
             for b in blocks[i + 1:]:
-                area = convex_overlap_area(a.polygon, b.polygon)
+                area = overlap_area(a.polygon, b.polygon, a.holes, b.holes)
                 if area > _OVERLAP_TOL_M2:
                     raise InvalidArgumentError(
                         f"scenario {self.name!r}: blocks {a.name!r} and {b.name!r} overlap "
@@ -222,6 +255,20 @@ class Scenario:
         return {"name": self.name, "description": self.description,
                 "workspace": self.workspace.to_dict(),
                 "blocks": [b.to_dict() for b in self.blocks]}
+
+
+def _ring(what: str, vertices: Any) -> NDArray[np.float64]:
+    """A footprint's (or hole's) vertices, checked simple with a positive area, counter-clockwise."""
+    poly = check_array(what, vertices, (None, 2), what="vertices (x, y) in metres", min_rows=3)
+    area = polygon_area(poly)
+    if area < 0:
+        poly, area = poly[::-1].copy(), -area
+    simple = is_simple(poly)
+    if area <= _OVERLAP_TOL_M2 or not simple:
+        raise InvalidArgumentError(
+            f"{what} must be a simple polygon (no two edges crossing) with a positive area; "
+            f"got area {area:.3g} m², simple={simple}")
+    return poly
 
 
 _FOAM_COLORS = {60: "#f4d35e", 110: "#ee964b", 150: "#c8553d"}

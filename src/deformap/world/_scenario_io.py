@@ -12,7 +12,8 @@ Format (every key is checked; an unknown key is an error)::
         thickness_m: 0.05                # optional, default 0.05
         color: "#f4d35e"                 # optional
       - name: hard
-        polygon: [[0.3, 0], [0.6, 0], [0.6, 0.4], [0.3, 0.4]]   # or a convex polygon
+        polygon: [[0.3, 0], [0.6, 0], [0.6, 0.4], [0.3, 0.4]]   # or any simple polygon
+        holes: [[[0.4, 0.1], [0.5, 0.1], [0.45, 0.2]]]   # optional: left empty, inside it
         rigid: true
 """
 
@@ -33,7 +34,7 @@ from deformap.world._scenario import Block, Scenario, builtin_scenarios
 __all__ = ["list_scenarios", "load_scenario", "parse_scenario", "save_scenario"]
 
 _SCENARIO_KEYS = {"name", "description", "workspace", "blocks"}
-_BLOCK_KEYS = {"name", "rect", "polygon", "hardness_n", "youngs_modulus_pa", "rigid",
+_BLOCK_KEYS = {"name", "rect", "polygon", "holes", "hardness_n", "youngs_modulus_pa", "rigid",
                "thickness_m", "color"}
 _WORKSPACE_KEYS = {"lower", "upper"}
 
@@ -104,6 +105,7 @@ def _block(data: Any, where: str) -> Block:
             raise ConfigError(f"{where}: `rigid` must be true or false; got {rigid!r}")
         return Block(
             name=str(data.get("name", "")), polygon=poly,
+            holes=tuple(np.asarray(h, dtype=float) for h in data.get("holes", ())),
             thickness_m=data.get("thickness_m", 0.05),
             hardness_n=data.get("hardness_n"), youngs_modulus_pa=data.get("youngs_modulus_pa"),
             rigid=rigid, color=str(data.get("color", "#6b4f3a" if rigid else "#c8a165")),

@@ -1,0 +1,241 @@
+"""Many worlds: one seeded random world, every strategy × field mapped on it, scored after each poke.
+
+A benchmark world (:func:`draw_world`) is drawn from ``(seed, index)`` alone: its layout family is
+the ``index``-th of the families asked for, in turn (so any run of ``n`` worlds spans them
+evenly), and the rest is drawn from ``numpy.random.SeedSequence([seed, index])``: the layout and
+its materials (:func:`deformap.world.random_scenario`, hardness over 30–250 N, the hardness study's
+range, issue 13; one material rigid with probability 1/4), and the axes of the stiffness issue:
+the world's physics (either of :data:`deformap.world.PHYSICS`), camera (every preset of
+:data:`deformap.world.CAMERA_PRESETS`), block thickness (:data:`THICKNESSES_M`, the hardness
+study's matrix) and press force (:data:`FORCES_N`).
+
+:func:`run_world` builds that world once and maps it with every strategy × field (× cut) from the
+same surface model (one first observation and one fit: the same cloud and the same stream give
+every combination the same model), poking to ``max_pokes``: once the map field's variance is
+under ``T_h`` the remaining pokes go where a region boundary is least certain
+(``ExplorationConfig.boundary_pokes``), so every combination makes ``max_pokes`` pokes and the
+curves compare like with like; ``threshold`` in a row says whether the variance rule was met.
+After every poke it records (one row each):
+
+- ``accuracy``, ``mean_iou``, ``found``, ``true``, ``kendall_tau``
+  (:func:`deformap.eval.region_scores`) of the map field's regions against the world's truth by
+  *material* (blocks of one material, a checker's diagonal squares, are one true region);
+- ``modulus_error``: the median over the foam cells of ``|Ê − E| / E``, Ê the modulus field's
+  median (``None`` while no poke has a modulus);
+- ``beta_spread``: the β-field has no ground truth in the simulated world (β is the estimator's
+  shape-matching parameter, not a property of the foam), so its error against the truth is read
+  as how far it is from being constant on each material: the standard deviation of its mean over
+  each foam material's cells, averaged over the materials (0 for a field that is constant on
+  each material; the order of those constants is ``kendall_tau``'s);
+- ``poke_s``: the poke's wall time (target, press, dent and estimate, fields), ``elapsed_s`` the
+  combination's so far.
+
+Every number of a row is a function of ``(seed, index)`` and the settings, whatever process
+computes it; only the times differ between runs.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+from functools import partial
+from typing import Any, cast, get_args, get_type_hints
+
+import numpy as np
+from numpy.typing import NDArray
+
+from deformap.errors import InvalidArgumentError
+from deformap.eval._metrics import region_scores
+from deformap.explore import ExplorationConfig, Mapper, Target, poke_step
+from deformap.world import (
+    CAMERA_PRESETS,
+    LAYOUT_FAMILIES,
+    PHYSICS,
+    Physics,
+    Scenario,
+    SimulatedWorld,
+    WorldConfig,
+    camera_preset,
+    random_scenario,
+)
+
+__all__ = [
+    "FORCES_N",
+    "HARDNESS_RANGE_N",
+    "THICKNESSES_M",
+    "TIME_COLUMNS",
+    "WorldDraw",
+    "choices",
+    "draw_world",
+    "row_values",
+    "run_world",
+]
+
+#: Hardness of the benchmark's foams: the hardness study's 30–250 N (issue 13), super soft to firm.
+HARDNESS_RANGE_N = (30.0, 250.0)
+#: Block thicknesses: the hardness study's matrix (``study hardness --full``).
+THICKNESSES_M = (0.03, 0.05, 0.10)
+#: Press forces: the exploration's 0.6 N and a third below and above it. 0.4 N still dents a
+#: 250 N foam by more than the camera's noise at 5 cm; 0.8 N stays within the range the world
+#: presses a 30 N foam 3 cm thick without bottoming out (issue 13's forces).
+FORCES_N = (0.4, 0.6, 0.8)
+#: Probability that one material of a benchmark world is a rigid board (the generator's default).
+P_RIGID = 0.25
+#: Columns of a row that hold wall times (the only ones two runs of one world may differ in).
+TIME_COLUMNS = ("poke_s", "elapsed_s")
+
+
+def choices(field: str) -> tuple[str, ...]:
+    """The values ``ExplorationConfig.<field>`` accepts (its ``Literal``): ``strategy``,
+    ``field`` or ``region_labels``; new names added there are accepted here unchanged."""
+    return tuple(get_args(get_type_hints(ExplorationConfig)[field]))
+
+
+@dataclass(frozen=True, kw_only=True)
+class WorldDraw:
+    """One benchmark world: its layout and the axes it is measured under."""
+
+    index: int
+    family: str
+    physics: Physics
+    camera: str
+    thickness_m: float
+    force_n: float
+    scenario: Scenario
+
+    def summary(self) -> dict[str, Any]:
+        """Plain data naming the world (its blocks' hardness and whether any is rigid)."""
+        return {"index": self.index, "family": self.family, "physics": self.physics,
+                "camera": self.camera, "thickness_m": self.thickness_m, "force_n": self.force_n,
+                "blocks": len(self.scenario.blocks),
+                "hardness_n": sorted({b.hardness for b in self.scenario.blocks
+                                      if not b.rigid}),
+                "rigid": any(b.rigid for b in self.scenario.blocks)}  # fmt: skip
+
+
+def draw_world(seed: int, index: int, families: Sequence[str] = LAYOUT_FAMILIES,
+               physics: Sequence[str] = PHYSICS) -> WorldDraw:
+    """The ``index``-th world of a benchmark seeded ``seed`` (module docstring); ``physics``
+    the world physics to draw from (all by default)."""
+    if not families:
+        raise InvalidArgumentError("`families` must name at least one layout family; got none")
+    if not physics or any(p not in PHYSICS for p in physics):
+        raise InvalidArgumentError(f"`physics` must be names from {list(PHYSICS)}; got "
+                                   f"{list(physics)}")
+    rng = np.random.default_rng(np.random.SeedSequence([seed, index]))
+    family = families[index % len(families)]
+    drawn = cast(Physics, str(rng.choice(list(physics))))
+    camera = str(rng.choice(sorted(CAMERA_PRESETS)))
+    thickness = float(rng.choice(THICKNESSES_M))
+    force = float(rng.choice(FORCES_N))
+    scenario = random_scenario(rng, family=family, hardness_range_n=HARDNESS_RANGE_N,
+                               p_rigid=P_RIGID, thickness_m=thickness)  # fmt: skip
+    return WorldDraw(index=index, family=family, physics=drawn, camera=camera,
+                     thickness_m=thickness, force_n=force, scenario=scenario)
+
+
+def _material_truth(world: SimulatedWorld, xs: NDArray, ys: NDArray
+                    ) -> tuple[NDArray[np.int64], dict[int, float], NDArray[np.float64]]:
+    """Labels by material (blocks of one hardness are one), their hardness, and E on the grid."""
+    hardness = world.ground_truth_hardness(xs, ys)
+    values, labels = np.unique(hardness, return_inverse=True)
+    return (labels.reshape(hardness.shape).astype(np.int64),
+            {k: float(v) for k, v in enumerate(values)}, world.ground_truth_modulus(xs, ys))
+
+
+def _scores(mapper: Mapper, truth: tuple[NDArray, dict[int, float], NDArray]) -> dict[str, Any]:
+    labels, hardness, modulus = truth
+    field = mapper.map_field
+    found = mapper.regions()
+    sign = -1.0 if field.name == "modulus" else 1.0  # the metrics order by softness
+    scores = region_scores(found.labels, labels, sign * field.mean, hardness)
+    foam = np.isfinite(modulus)
+    modulus_error = None
+    if len(mapper.modulus_field.pokes) and foam.any():
+        rel = np.abs(mapper.modulus_field.median_pa[foam] / modulus[foam] - 1.0)
+        modulus_error = float(np.median(rel))
+    beta = mapper.field.mean
+    spreads = [float(np.std(beta[(labels == k) & foam])) for k in np.unique(labels[foam])]
+    return {"accuracy": scores.accuracy, "mean_iou": scores.mean_iou, "found": scores.found,
+            "true": scores.true, "kendall_tau": scores.kendall_tau,
+            "modulus_error": modulus_error,
+            "beta_spread": float(np.mean(spreads)) if spreads else None}  # fmt: skip
+
+
+def _map_one(world: SimulatedWorld, draw: WorldDraw, config: ExplorationConfig, surface: Any,
+             truth: tuple[NDArray, dict[int, float], NDArray], seed: int) -> list[dict[str, Any]]:
+    """Map the world with one configuration to ``max_pokes``; one row per poke."""
+    mapper = Mapper(world.workspace, config)
+    mapper.surface = surface  # the combinations share the first observation's model
+    streams = np.random.default_rng(np.random.SeedSequence([seed, draw.index, 1])).spawn(
+        config.max_pokes + 1)
+    rows: list[dict[str, Any]] = []
+    t_start = time.perf_counter()
+    for index in range(config.max_pokes):
+        t0 = time.perf_counter()
+        if index == 0:
+            target: Target | None = Target(np.array(world.workspace.center, float), "first")
+        else:
+            target = mapper.next_target(streams[index + 1])
+        if target is None:  # nothing left to poke: the map stays as it is
+            break
+        t_target = time.perf_counter() - t0
+        poke = poke_step(mapper, index, partial(world.press, target.xy, config.force_n),
+                         finish=world.release, target=target, target_s=t_target)  # fmt: skip
+        t1 = time.perf_counter()
+        rows.append({"poke": index + 1, "purpose": poke.record.purpose,
+                     "map_field": mapper.config.field,
+                     "threshold": bool(mapper.max_variance() <= mapper.threshold),
+                     **_scores(mapper, truth),
+                     "poke_s": t1 - t0, "elapsed_s": t1 - t_start})  # fmt: skip
+    return rows
+
+
+def run_world(task: dict[str, Any]) -> dict[str, Any]:
+    """Build one benchmark world and map it with every strategy × field; plain data in and out.
+
+    Parameters
+    ----------
+    task : dict
+        ``seed``, ``index``, ``families``, ``physics`` (optional: the world physics drawn
+        from, default all), ``strategies``, ``fields``, ``cut`` (a
+        ``region_labels`` value, or ``None`` for the default), ``max_pokes``, ``coarse`` (the
+        test mesh and camera of :meth:`WorldConfig.coarse`, else the default world).
+
+    Returns
+    -------
+    dict with ``world`` (:meth:`WorldDraw.summary`), ``rows`` (one per strategy × field × poke,
+    each naming them) and ``seconds`` (the world's wall time, building included).
+    """
+    t0 = time.perf_counter()
+    seed, index = int(task["seed"]), int(task["index"])
+    draw = draw_world(seed, index, tuple(task["families"]), tuple(task.get("physics", PHYSICS)))
+    base = WorldConfig.coarse() if task["coarse"] else WorldConfig()
+    config = replace(base, physics=draw.physics,
+                     camera=replace(camera_preset(draw.camera), width=base.camera.width,
+                                    height=base.camera.height) if task["coarse"]
+                     else camera_preset(draw.camera))  # fmt: skip
+    world_seq, explore_seq = np.random.SeedSequence([seed, index, 0]).spawn(2)
+    world = SimulatedWorld(draw.scenario, config=config, rng=np.random.default_rng(world_seq))
+    k = int(task["max_pokes"])
+    cut = task.get("cut")
+    explore = ExplorationConfig(max_pokes=k, boundary_pokes=k, force_n=draw.force_n,
+                                **({} if cut is None else {"region_labels": cut}))  # fmt: skip
+    first = Mapper(world.workspace, explore)
+    surface = first.initialise(world.observe(), np.random.default_rng(explore_seq))
+    truth = _material_truth(world, first.grid.xs, first.grid.ys)
+    rows = []
+    for strategy in task["strategies"]:
+        for field in task["fields"]:
+            cfg = replace(explore, strategy=strategy, field=field)
+            for row in _map_one(world, draw, cfg, surface, truth, seed):
+                rows.append({"world": index, "family": draw.family, "strategy": strategy,
+                             "field": field, "cut": cfg.region_labels, **row})  # fmt: skip
+    return {"world": draw.summary(), "rows": rows, "seconds": time.perf_counter() - t0,
+            "status": "ok", "error": None}
+
+
+def row_values(row: dict[str, Any]) -> dict[str, Any]:
+    """A row without its wall times (what two runs of one world must agree on)."""
+    return {k: v for k, v in row.items() if k not in TIME_COLUMNS}

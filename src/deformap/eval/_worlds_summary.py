@@ -1,0 +1,218 @@
+"""What many worlds say: ``runs.csv``, accuracy against pokes per family, ``summary.json`` and its
+markdown table.
+
+A *combination* is one strategy × field × cut, named ``strategy/field/cut``. Its pokes to a good
+map in one world are the first poke after which the region accuracy is at least
+:data:`GOOD_ACCURACY`; a world where it never is (or that failed) counts ``max_pokes + 1``, so a
+median over worlds is never flattered by leaving the hard ones out. A map can lose that accuracy
+with later pokes (a new poke can split a region wrongly), which a robot that stops could not
+know: ``median_pokes_to_stay_0.9`` counts from the poke after which every later one keeps it.
+A combination whose loop had nothing left to poke before ``max_pokes`` keeps its last map for the
+remaining pokes.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+__all__ = [
+    "CSV_COLUMNS",
+    "GOOD_ACCURACY",
+    "accuracy_curves",
+    "combination_name",
+    "markdown_summary",
+    "runs_csv",
+    "summarise_worlds",
+]
+
+#: The region accuracy a map must reach (issue 16: "how many pokes does a good map take").
+GOOD_ACCURACY = 0.9
+
+_WORLD_COLUMNS = ("physics", "camera", "thickness_m", "force_n")
+_ROW_COLUMNS = ("strategy", "field", "cut", "poke", "purpose", "map_field", "threshold",
+                "accuracy", "mean_iou", "found", "true", "kendall_tau", "modulus_error",
+                "beta_spread", "poke_s", "elapsed_s")  # fmt: skip
+#: Columns of ``runs.csv``: one row per world × strategy × field × poke (a failed world: one row
+#: per combination, ``poke`` empty, ``status`` failed with its ``error``).
+CSV_COLUMNS = ("world", "family", *_WORLD_COLUMNS, *_ROW_COLUMNS, "status", "error")
+
+
+def combination_name(strategy: str, field: str, cut: str) -> str:
+    """``strategy/field/cut``."""
+    return f"{strategy}/{field}/{cut}"
+
+
+def _cell(value: Any) -> str:
+    if value is None:
+        return ""
+    if isinstance(value, float):
+        return f"{value:.6g}" if math.isfinite(value) else ""
+    return str(value)
+
+
+def runs_csv(results: Sequence[dict[str, Any]], combinations: Sequence[tuple[str, str, str]]
+             ) -> str:
+    """``runs.csv`` of the worlds' results (in world order), as text."""
+    buffer = io.StringIO()
+    writer = csv.writer(buffer, lineterminator="\n")
+    writer.writerow(CSV_COLUMNS)
+    for result in sorted(results, key=lambda r: r["world"]["index"]):
+        world = result["world"]
+        head = [world["index"], world["family"], *(world.get(k) for k in _WORLD_COLUMNS)]
+        if result["status"] != "ok":
+            for strategy, field, cut in combinations:
+                writer.writerow([_cell(v) for v in (*head, strategy, field, cut)]
+                                + [""] * (len(_ROW_COLUMNS) - 3) + ["failed", result["error"]])
+            continue
+        for row in result["rows"]:
+            writer.writerow([_cell(v) for v in (*head, *(row[k] for k in _ROW_COLUMNS))]
+                            + ["ok", ""])
+    return buffer.getvalue()
+
+
+def _series(rows: list[dict[str, Any]], key: str, max_pokes: int) -> NDArray[np.float64]:
+    """``key`` after pokes 1..max_pokes (the last map carried on; NaN for None)."""
+    out = np.full(max_pokes, np.nan)
+    last = np.nan
+    by_poke = {int(r["poke"]): r.get(key) for r in rows}
+    for k in range(1, max_pokes + 1):
+        if k in by_poke:
+            value = by_poke[k]
+            last = np.nan if value is None else float(value)
+        out[k - 1] = last
+    return out
+
+
+def _per_world(results: Sequence[dict[str, Any]], combination: tuple[str, str, str],
+               max_pokes: int) -> list[dict[str, Any]]:
+    """One entry per world for one combination: family, accuracy and modulus-error series."""
+    out = []
+    for result in results:
+        world = result["world"]
+        if result["status"] != "ok":
+            out.append({"family": world["family"], "failed": True})
+            continue
+        rows = [r for r in result["rows"]
+                if (r["strategy"], r["field"], r["cut"]) == combination]  # fmt: skip
+        out.append({"family": world["family"], "failed": False,
+                    "accuracy": _series(rows, "accuracy", max_pokes),
+                    "modulus_error": _series(rows, "modulus_error", max_pokes)})  # fmt: skip
+    return out
+
+
+def _pokes_to_good(entry: dict[str, Any], max_pokes: int, *, stay: bool = False) -> int:
+    """The first poke with accuracy ≥ :data:`GOOD_ACCURACY` (``stay``: from which every later
+    poke keeps it); ``max_pokes + 1`` when there is none."""
+    if entry["failed"]:
+        return max_pokes + 1
+    good = entry["accuracy"] >= GOOD_ACCURACY
+    if stay:
+        bad = np.flatnonzero(~good)
+        first = 0 if not bad.size else int(bad[-1]) + 1
+        return first + 1 if first < max_pokes else max_pokes + 1
+    hits = np.flatnonzero(good)
+    return int(hits[0]) + 1 if hits.size else max_pokes + 1
+
+
+def _median(values: Sequence[float]) -> float | None:
+    finite = [v for v in values if v is not None and math.isfinite(v)]
+    return float(np.median(finite)) if finite else None
+
+
+def _stats(entries: list[dict[str, Any]], max_pokes: int) -> dict[str, Any]:
+    done = [e for e in entries if not e["failed"]]
+    return {
+        "median_pokes_to_accuracy_0.9": _median([_pokes_to_good(e, max_pokes) for e in entries]),
+        "median_pokes_to_stay_0.9": _median([_pokes_to_good(e, max_pokes, stay=True)
+                                             for e in entries]),
+        # when most worlds never get there the medians saturate at max_pokes + 1; the share does not
+        "share_reaching_0.9": (sum(_pokes_to_good(e, max_pokes) <= max_pokes for e in entries)
+                               / len(entries)) if entries else None,
+        "final_accuracy_median": _median([float(e["accuracy"][-1]) for e in done]),
+        "modulus_error_median": _median([float(e["modulus_error"][-1]) for e in done]),
+        "worlds": len(entries),
+        "failed": len(entries) - len(done),
+    }
+
+
+def summarise_worlds(results: Sequence[dict[str, Any]],
+                     combinations: Sequence[tuple[str, str, str]], max_pokes: int
+                     ) -> dict[str, Any]:
+    """``summary.json``: ``{"strategies": {NAME: {"median_pokes_to_accuracy_0.9",
+    "final_accuracy_median", "modulus_error_median", "worlds", "by_family": {FAMILY: …}}}}``
+    (NAME a :func:`combination_name`; each entry also counts its ``failed`` worlds), with
+    ``best`` (fewest median pokes, then the highest final accuracy), ``max_pokes`` and
+    ``failed_worlds`` (index and error of each world that failed twice)."""
+    strategies: dict[str, Any] = {}
+    for combination in combinations:
+        entries = _per_world(results, combination, max_pokes)
+        families = sorted({e["family"] for e in entries})
+        strategies[combination_name(*combination)] = {
+            **_stats(entries, max_pokes),
+            "by_family": {f: _stats([e for e in entries if e["family"] == f], max_pokes)
+                          for f in families},
+        }  # fmt: skip
+
+    def rank(name: str) -> tuple[float, float]:
+        s = strategies[name]
+        pokes = s["median_pokes_to_accuracy_0.9"]
+        final = s["final_accuracy_median"]
+        return (math.inf if pokes is None else pokes, -(final if final is not None else -1.0))
+
+    best = min(strategies, key=rank) if strategies else None
+    return {"strategies": strategies, "best": best, "max_pokes": max_pokes,
+            "good_accuracy": GOOD_ACCURACY,
+            "failed_worlds": [{"index": r["world"]["index"], "error": r["error"]}
+                              for r in results if r["status"] != "ok"]}  # fmt: skip
+
+
+def accuracy_curves(results: Sequence[dict[str, Any]],
+                    combinations: Sequence[tuple[str, str, str]], max_pokes: int
+                    ) -> dict[str, dict[str, NDArray[np.float64]]]:
+    """Per family (and ``"all"``), per combination: the ``(n_worlds, max_pokes)`` accuracies of
+    the worlds that ran (the figure's bands come from these)."""
+    out: dict[str, dict[str, NDArray[np.float64]]] = {}
+    for combination in combinations:
+        entries = [e for e in _per_world(results, combination, max_pokes) if not e["failed"]]
+        for family in ["all", *sorted({e["family"] for e in entries})]:
+            chosen = [e["accuracy"] for e in entries if family in ("all", e["family"])]
+            out.setdefault(family, {})[combination_name(*combination)] = (
+                np.array(chosen).reshape(-1, max_pokes))
+    return out
+
+
+def _fmt(value: Any, spec: str) -> str:
+    return "–" if value is None else format(value, spec)
+
+
+def markdown_summary(summary: dict[str, Any]) -> str:
+    """The summary as a markdown table: one row per combination, overall and per family."""
+    k = summary["max_pokes"]
+    families = sorted({f for s in summary["strategies"].values() for f in s["by_family"]})
+    head = ["combination", "worlds", "median pokes to 0.9", "to stay at 0.9", "reach 0.9",
+            "final accuracy", "E error", *families]
+    lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    for name, s in summary["strategies"].items():
+        per = [_fmt(s["by_family"].get(f, {}).get("median_pokes_to_accuracy_0.9"), "g")
+               for f in families]  # fmt: skip
+        mark = " (best)" if name == summary["best"] else ""
+        lines.append("| " + " | ".join([
+            f"{name}{mark}", f"{s['worlds']}" + (f" ({s['failed']} failed)" if s["failed"] else ""),
+            _fmt(s["median_pokes_to_accuracy_0.9"], "g"), _fmt(s.get("median_pokes_to_stay_0.9"), "g"),
+            _fmt(s.get("share_reaching_0.9"), ".0%"), _fmt(s["final_accuracy_median"], ".3f"),
+            _fmt(s["modulus_error_median"], ".2f"), *per]) + " |")  # fmt: skip
+    lines.append("")
+    lines.append(f"Pokes to region accuracy {summary['good_accuracy']:g} (median over worlds; a "
+                 f"world that never reaches it counts {k + 1}); to stay: from the poke after which "
+                 "it stays there; reach: the share of worlds that reach it by the last poke; "
+                 "final accuracy and the modulus "
+                 f"field's median relative E error after {k} pokes; the family columns are "
+                 "median pokes to 0.9.")
+    return "\n".join(lines) + "\n"

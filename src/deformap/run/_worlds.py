@@ -1,0 +1,349 @@
+"""``deformap bench worlds``: many seeded random worlds, each mapped with every strategy × field,
+on a local process pool or a Dask cluster, resumable.
+
+The folder holds ``bench.json`` (the settings, written first), ``worlds/world-NNNNN.json`` (one
+result per world, written atomically as it arrives: a killed run loses at most the worlds in
+flight) and, rewritten after every world, ``runs.csv``, ``summary.json``, ``summary.md`` and
+``curves.png`` (:mod:`deformap.eval._worlds_summary`, :func:`deformap.viz.plot_world_curves`).
+Run again on the same folder with the same settings, it reads the finished worlds and computes
+only the others (a world that failed is tried again).
+
+Engines. By default a local process pool (``concurrent.futures`` with the ``spawn`` start
+method: no state of the parent leaks into a worker); with ``scheduler``, a ``dask.distributed``
+cluster (``Client(address)``; results stream back with ``as_completed``). Either way a world
+that raises is tried once more and then reported as failed (in ``runs.csv``, ``summary.json``
+and its world file), never dropped. Tasks and results cross processes as plain data (numbers,
+strings, lists, dicts). Each world runs with its BLAS pinned to one thread (threadpoolctl in the
+task; for the local pool also the environment variables, set before a worker loads numpy): two
+OpenBLAS threads per process doubled a run's wall time on a loaded 2-core machine (issue 16).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import logging
+import multiprocessing
+import os
+import time
+from collections.abc import Iterator, Sequence
+from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Any
+
+from deformap import __version__
+from deformap._validation import SettingError, check_settings, setting
+from deformap.errors import ConfigError
+from deformap.eval import (
+    accuracy_curves,
+    choices,
+    markdown_summary,
+    run_world,
+    runs_csv,
+    summarise_worlds,
+)
+from deformap.run._folder import create_run_folder, default_run_folder, to_json, write_text
+from deformap.run._hooks import NO_HOOKS, RunHooks, RunStart
+from deformap.viz import plot_world_curves
+from deformap.world import LAYOUT_FAMILIES, PHYSICS
+
+__all__ = ["BLAS_THREAD_VARIABLES", "WorldsBenchConfig", "WorldsOutput", "bench_worlds"]
+
+logger = logging.getLogger(__name__)
+
+#: The environment variables that size the BLAS and OpenMP thread pools a worker's numpy and
+#: scipy start with; each is set to 1 for the local pool's workers.
+BLAS_THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS",
+                         "BLIS_NUM_THREADS", "VECLIB_MAXIMUM_THREADS", "NUMEXPR_NUM_THREADS")
+SETTINGS_NAME = "bench.json"
+
+
+@dataclass(frozen=True, kw_only=True)
+class WorldsBenchConfig:
+    """What ``deformap bench worlds`` runs (``worlds``, ``workers`` and ``scheduler`` do not
+    change a world's result, so a run may resume with more worlds or on another engine).
+
+    Parameters
+    ----------
+    worlds : int
+        How many worlds (indices 0 .. worlds − 1 of the seed).
+    seed : int
+    families : tuple of str
+        Layout families, taken in turn (:data:`deformap.world.LAYOUT_FAMILIES`).
+    physics : tuple of str
+        The world physics each world's is drawn from (:data:`deformap.world.PHYSICS`).
+    strategies, fields : tuple of str
+        ``ExplorationConfig.strategy`` and ``field`` values, every pair mapped on every world.
+    cut : str or None
+        ``ExplorationConfig.region_labels`` (``None``: its default).
+    max_pokes : int
+        Pokes per world and combination.
+    coarse : bool
+        The test mesh and camera (:meth:`deformap.world.WorldConfig.coarse`, about a third of a
+        default world's cost) instead of the default world. A smoke run only: on one linear-FEM
+        world, 6 pokes of ``planned`` on the modulus field read E 100 % off on the 2 cm mesh
+        and 14 % off on the default 7.5 mm mesh (region accuracy 0.86 against 0.94).
+    workers : int
+        Processes of the local pool.
+    scheduler : str or None
+        A ``dask.distributed`` scheduler's address (``tcp://host:8786``) instead of the pool.
+    """
+
+    worlds: int = setting(100, ge=1, le=1_000_000)
+    seed: int = setting(0, ge=0)
+    families: tuple[str, ...] = LAYOUT_FAMILIES
+    physics: tuple[str, ...] = PHYSICS
+    # every choice ExplorationConfig has, so a strategy or field added there is benchmarked too
+    strategies: tuple[str, ...] = choices("strategy")
+    fields: tuple[str, ...] = choices("field")
+    cut: str | None = None
+    # every poke is a press and a β sweep per combination (issue 16 reads 20 and more)
+    max_pokes: int = setting(12, ge=1, le=1000)
+    coarse: bool = False
+    workers: int = setting(1, ge=1, le=1024)
+    scheduler: str | None = None
+
+    def __post_init__(self) -> None:
+        check_settings(self)
+        for name, given, allowed in (("families", self.families, LAYOUT_FAMILIES),
+                                     ("physics", self.physics, PHYSICS),
+                                     ("strategies", self.strategies, choices("strategy")),
+                                     ("fields", self.fields, choices("field"))):
+            if not given or any(g not in allowed for g in given) or len(set(given)) < len(given):
+                raise SettingError(name, f"must be distinct names from {list(allowed)}; got "
+                                         f"{list(given)}")
+        if self.cut is not None and self.cut not in choices("region_labels"):
+            raise SettingError("cut", f"must be one of {list(choices('region_labels'))}; got "
+                                      f"{self.cut!r}")
+
+    def result_settings(self) -> dict[str, Any]:
+        """The settings a world's result depends on (``bench.json``; resuming compares them)."""
+        return {k: v for k, v in asdict(self).items()
+                if k not in ("worlds", "workers", "scheduler")}
+
+    def combinations(self) -> list[tuple[str, str, str]]:
+        cut = self.cut or str(choices("region_labels")[0])
+        return [(s, f, cut) for s in self.strategies for f in self.fields]
+
+    def task(self, index: int) -> dict[str, Any]:
+        """The plain-data task of world ``index``."""
+        return {"seed": self.seed, "index": index, "families": list(self.families),
+                "physics": list(self.physics),
+                "strategies": list(self.strategies), "fields": list(self.fields),
+                "cut": self.cut, "max_pokes": self.max_pokes, "coarse": self.coarse}
+
+
+@dataclass(frozen=True, kw_only=True)
+class WorldsOutput:
+    """What :func:`bench_worlds` wrote: ``summary`` (``summary.json``'s content), ``folder``,
+    ``files`` and the worlds ``computed`` by this call (the others were read back)."""
+
+    summary: dict[str, Any]
+    folder: Path
+    files: list[Path]
+    computed: int
+    seconds: float
+
+
+def run_world_pinned(task: dict[str, Any]) -> dict[str, Any]:
+    """:func:`deformap.eval.run_world` with BLAS and OpenMP pinned to one thread."""
+    from threadpoolctl import threadpool_limits
+
+    with threadpool_limits(limits=1):
+        return run_world(task)
+
+
+def _pin_worker() -> None:
+    from threadpoolctl import threadpool_limits
+
+    threadpool_limits(limits=1)
+
+
+@contextlib.contextmanager
+def _one_thread_environment() -> Iterator[None]:
+    """The BLAS variables at 1 while workers start (they read them when they load numpy)."""
+    saved = {k: os.environ.get(k) for k in BLAS_THREAD_VARIABLES}
+    os.environ.update(dict.fromkeys(BLAS_THREAD_VARIABLES, "1"))
+    try:
+        yield
+    finally:
+        for key, value in saved.items():
+            if value is None:
+                os.environ.pop(key, None)
+            else:
+                os.environ[key] = value
+
+
+def _failed(task: dict[str, Any], exc: BaseException) -> dict[str, Any]:
+    from deformap.eval import draw_world
+
+    try:
+        world = draw_world(task["seed"], task["index"], tuple(task["families"]),
+                           tuple(task.get("physics", PHYSICS))).summary()
+    except Exception:  # the failure to report may be the draw itself
+        world = {"index": task["index"],
+                 "family": task["families"][task["index"] % len(task["families"])]}
+    error = f"{type(exc).__name__}: {exc}".splitlines()[0]
+    return {"world": world, "rows": [], "seconds": None, "status": "failed", "error": error}
+
+
+def _local_results(tasks: Sequence[dict[str, Any]], workers: int) -> Iterator[dict[str, Any]]:
+    """Results as they finish on a spawn-started process pool; each task retried once."""
+    context = multiprocessing.get_context("spawn")
+    with _one_thread_environment():
+        pool = ProcessPoolExecutor(max_workers=workers, mp_context=context,
+                                   initializer=_pin_worker)
+        try:
+            pending: dict[Future[dict[str, Any]], tuple[dict[str, Any], int]] = {
+                pool.submit(run_world_pinned, t): (t, 0) for t in tasks}
+            while pending:
+                finished, _ = wait(pending, return_when=FIRST_COMPLETED)
+                for future in finished:
+                    task, tries = pending.pop(future)
+                    try:
+                        result = future.result()
+                    except Exception as exc:  # reported, never dropped
+                        if tries == 0:
+                            logger.warning("world %d failed (%s); trying once more",
+                                           task["index"], exc)
+                            pending[pool.submit(run_world_pinned, task)] = (task, 1)
+                            continue
+                        result = _failed(task, exc)
+                    yield result
+        except BaseException:
+            # interrupted (or the caller stopped reading): start no further world
+            pool.shutdown(wait=False, cancel_futures=True)
+            raise
+        pool.shutdown()
+
+
+def _dask_results(tasks: Sequence[dict[str, Any]], address: str) -> Iterator[dict[str, Any]]:
+    """Results as they finish on a ``dask.distributed`` cluster; each task retried once."""
+    try:
+        from dask.distributed import Client, as_completed
+    except ImportError:
+        raise ConfigError("--scheduler needs dask.distributed; install it with "
+                          "pip install 'deformap[dask]'") from None
+    try:
+        client = Client(address, timeout="20s")
+    except (OSError, TimeoutError, ValueError) as exc:
+        raise ConfigError(f"--scheduler: cannot reach a Dask scheduler at {address!r}: "
+                          f"{exc}".splitlines()[0]) from None
+    with client:
+        stamp = time.time_ns()
+        futures = {}
+        for task in tasks:
+            future = client.submit(run_world_pinned, task, retries=1, pure=False,
+                                   key=f"deformap-world-{task['seed']}-{task['index']}-{stamp}")
+            futures[future.key] = (future, task)
+        for future in as_completed([f for f, _ in futures.values()]):
+            task = futures[future.key][1]
+            try:
+                yield future.result()
+            except Exception as exc:  # reported, never dropped
+                yield _failed(task, exc)
+            future.release()
+
+
+def _world_path(folder: Path, index: int) -> Path:
+    return folder / "worlds" / f"world-{index:05d}.json"
+
+
+def _open_folder(config: WorldsBenchConfig, out: Path | None) -> tuple[Path, dict[int, Any]]:
+    """The folder (new, or the same run's to resume) and the finished worlds found there."""
+    folder = out or default_run_folder("worlds", "bench", config.seed)
+    header = {"deformap": __version__, "settings": config.result_settings()}
+    settings_file = folder / SETTINGS_NAME
+    if settings_file.is_file():
+        try:
+            stored = json.loads(settings_file.read_text(encoding="utf-8"))
+        except (OSError, ValueError) as exc:
+            raise ConfigError(f"--out: {settings_file} cannot be read: {exc}") from None
+        if stored.get("settings") != json.loads(to_json(config.result_settings())):
+            raise ConfigError(
+                f"--out {str(folder)!r} holds a worlds benchmark with other settings "
+                f"({stored.get('settings')}); choose another --out or the same settings")
+    else:
+        create_run_folder(folder, what="benchmark")
+        write_text(settings_file, to_json(header))
+    (folder / "worlds").mkdir(exist_ok=True)
+    done: dict[int, Any] = {}
+    for index in range(config.worlds):
+        path = _world_path(folder, index)
+        if path.is_file():
+            with contextlib.suppress(OSError, ValueError):
+                result = json.loads(path.read_text(encoding="utf-8"))
+                if result.get("status") == "ok":
+                    done[index] = result
+    return folder, done
+
+
+def _write_outputs(folder: Path, config: WorldsBenchConfig, results: Sequence[dict[str, Any]]
+                   ) -> tuple[dict[str, Any], list[Path]]:
+    combos = config.combinations()
+    summary = summarise_worlds(results, combos, config.max_pokes)
+    summary["settings"] = {**config.result_settings(), "worlds": config.worlds}
+    files = [write_text(folder / "runs.csv", runs_csv(results, combos)),
+             write_text(folder / "summary.json", to_json(summary)),
+             write_text(folder / "summary.md", markdown_summary(summary))]
+    curves = accuracy_curves(results, combos, config.max_pokes)
+    if curves:
+        plot_world_curves(curves, good_accuracy=summary["good_accuracy"],
+                          path=folder / "curves.png")
+        files.append(folder / "curves.png")
+    return summary, files
+
+
+def bench_worlds(config: WorldsBenchConfig, out: Path | None = None, *,
+                 hooks: RunHooks = NO_HOOKS) -> WorldsOutput:
+    """Run (or resume) the worlds benchmark ``config`` into ``out`` (module docstring).
+
+    Parameters
+    ----------
+    config : WorldsBenchConfig
+    out : Path, optional
+        The folder: new, empty, or this benchmark's own to resume (default:
+        ``runs/worlds-bench-s<seed>-<time>``).
+    hooks : RunHooks
+        ``on_start`` once; ``on_step`` per world with worlds done, worlds per hour and the
+        estimate of time left.
+
+    Raises
+    ------
+    ConfigError
+        ``out`` holds something else, or a benchmark with other settings; the scheduler cannot
+        be reached or dask is not installed.
+    """
+    if not isinstance(config, WorldsBenchConfig):
+        raise ConfigError(f"`config` must be a WorldsBenchConfig; got {type(config).__name__}")
+    folder, done = _open_folder(config, out)
+    results = dict(done)
+    engine = (f"Dask at {config.scheduler}" if config.scheduler
+              else f"{config.workers} local process{'es' if config.workers > 1 else ''}")
+    hooks.start(RunStart(kind="bench worlds", folder=folder, total=config.worlds, done=len(done),
+                         title=f"{config.worlds} worlds, seed {config.seed}, {engine}"))
+    tasks = [config.task(i) for i in range(config.worlds) if i not in done]
+    t0 = time.perf_counter()
+    stream = (_dask_results(tasks, config.scheduler) if config.scheduler
+              else _local_results(tasks, config.workers))
+    computed = 0
+    summary, files = _write_outputs(folder, config, list(results.values())) if done else ({}, [])
+    for result in stream:
+        index = int(result["world"]["index"])
+        write_text(_world_path(folder, index), to_json(result))
+        results[index] = result
+        computed += 1
+        summary, files = _write_outputs(folder, config, list(results.values()))
+        elapsed = time.perf_counter() - t0
+        rate = computed / elapsed * 3600.0
+        left = (len(tasks) - computed) / rate * 3600.0 if rate > 0 else float("nan")
+        what = (f"{result['seconds']:.0f} s" if result["status"] == "ok"
+                else f"FAILED: {result['error']}")
+        hooks.step(f"world {index} ({result['world']['family']}): {what} · "
+                   f"{len(results)}/{config.worlds} done · {rate:.1f} worlds/h · "
+                   f"{left / 60:.0f} min left")
+    if not tasks and not files:
+        summary, files = _write_outputs(folder, config, list(results.values()))
+    return WorldsOutput(summary=summary, folder=folder, files=[folder / SETTINGS_NAME, *files],
+                        computed=computed, seconds=time.perf_counter() - t0)

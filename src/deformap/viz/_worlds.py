@@ -1,0 +1,79 @@
+"""The many-worlds benchmark's figure: region accuracy against pokes, one panel per layout family.
+
+Each combination (strategy/field/cut) is a line, the mean accuracy over the family's worlds after
+each poke, with a band of its 95 % confidence interval (mean ± 1.96 standard errors, a normal
+approximation: the worlds are independent draws) and the good-map level as a dashed line.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+from matplotlib.figure import Figure
+from matplotlib.ticker import MaxNLocator
+from numpy.typing import NDArray
+
+from deformap.viz._save import save_figure
+
+__all__ = ["plot_world_curves"]
+
+_Z95 = 1.959964  # two-sided 95 % quantile of the standard normal
+
+
+def plot_world_curves(curves: dict[str, dict[str, NDArray[np.float64]]], *,
+                      good_accuracy: float = 0.9, path: str | Path | None = None) -> Figure:
+    """Accuracy against pokes with confidence bands, one panel per family (``"all"`` first).
+
+    Parameters
+    ----------
+    curves : dict
+        ``{family: {combination: (n_worlds, max_pokes) accuracies}}``
+        (:func:`deformap.eval.accuracy_curves`).
+    good_accuracy : float
+        Drawn as a dashed line.
+    path : str or Path, optional
+        Where to write the figure (110 dpi); nothing is written without it.
+    """
+    families = sorted(curves, key=lambda f: (f != "all", f))
+    cols = min(3, max(1, len(families)))
+    rows = math.ceil(len(families) / cols)
+    fig = Figure(figsize=(4.6 * cols, 3.4 * rows), layout="constrained")
+    axes = fig.subplots(rows, cols, squeeze=False, sharex=True, sharey=True)
+    names = sorted({name for family in curves.values() for name in family})
+    colours = {name: f"C{i % 10}" for i, name in enumerate(names)}
+    styles = {name: ("-", "--", ":", "-.")[(i // 10) % 4] for i, name in enumerate(names)}
+    for ax, family in zip(axes.ravel(), families, strict=False):
+        n_worlds = 0
+        for name in names:
+            acc = curves[family].get(name)
+            if acc is None or not acc.size:
+                continue
+            n_worlds = max(n_worlds, len(acc))
+            pokes = np.arange(1, acc.shape[1] + 1)
+            mean = np.nanmean(acc, axis=0)
+            counts = np.sum(np.isfinite(acc), axis=0)
+            se = np.nanstd(acc, axis=0, ddof=1) / np.sqrt(counts) if len(acc) > 1 else 0 * mean
+            ax.plot(pokes, mean, color=colours[name], ls=styles[name], lw=1.4, label=name)
+            ax.fill_between(pokes, mean - _Z95 * se, np.minimum(1.0, mean + _Z95 * se),
+                            color=colours[name], alpha=0.15, lw=0)
+        ax.axhline(good_accuracy, color="k", ls="--", lw=0.8)
+        ax.set_title(f"{family} ({n_worlds} world{'s' if n_worlds != 1 else ''})", fontsize=10)
+        ax.set_ylim(0.0, 1.02)
+        ax.xaxis.set_major_locator(MaxNLocator(integer=True))
+        ax.grid(alpha=0.3)
+    for ax in axes.ravel()[len(families):]:
+        ax.set_visible(False)
+    for ax in axes[-1]:
+        ax.set_xlabel("pokes")
+    for ax in axes[:, 0]:
+        ax.set_ylabel("region accuracy")
+    handles, labels = axes[0, 0].get_legend_handles_labels()
+    if handles:
+        fig.legend(handles, labels, loc="outside lower center", ncols=min(4, len(labels)),
+                   fontsize=8, frameon=False)
+    fig.suptitle("region accuracy against pokes: mean and 95 % band over worlds", fontsize=11)
+    if path is not None:
+        save_figure(fig, path, dpi=110)
+    return fig

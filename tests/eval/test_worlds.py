@@ -1,0 +1,144 @@
+"""The many-worlds benchmark's parts: the world draw, one world mapped, and the summary (issue 16)."""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+
+import numpy as np
+import pytest
+
+from deformap.eval import (
+    CSV_COLUMNS,
+    FORCES_N,
+    THICKNESSES_M,
+    accuracy_curves,
+    choices,
+    draw_world,
+    markdown_summary,
+    run_world,
+    runs_csv,
+    summarise_worlds,
+)
+from deformap.explore import STRATEGIES
+from deformap.world import CAMERA_PRESETS, LAYOUT_FAMILIES, PHYSICS
+
+
+def test_choices_are_the_config_literals() -> None:
+    assert choices("strategy") == STRATEGIES
+    assert choices("field") == ("beta", "modulus")
+    assert "isopleth" in choices("region_labels")
+
+
+def test_worlds_take_the_families_in_turn_and_are_drawn_from_seed_and_index() -> None:
+    draws = [draw_world(7, i) for i in range(12)]
+    assert [d.family for d in draws] == [LAYOUT_FAMILIES[i % 6] for i in range(12)]
+    assert draw_world(7, 5).scenario.to_dict() == draws[5].scenario.to_dict()
+    assert draw_world(8, 5).scenario.to_dict() != draws[5].scenario.to_dict()
+    assert {d.physics for d in draws} <= set(PHYSICS)
+    assert {d.camera for d in draws} <= set(CAMERA_PRESETS)
+    assert {d.thickness_m for d in draws} <= set(THICKNESSES_M)
+    assert {d.force_n for d in draws} <= set(FORCES_N)
+    assert all(b.thickness_m == d.thickness_m for d in draws for b in d.scenario.blocks)
+    assert draw_world(7, 3, ("stripes",)).family == "stripes"
+    assert {draw_world(7, i, physics=("stiffening-foam",)).physics for i in range(4)} == {
+        "stiffening-foam"}
+    json.dumps(draws[0].summary())  # plain data
+
+
+def _result(index: int, family: str, accuracy: dict[str, list[float]], status: str = "ok",
+            modulus_error: float | None = 0.2) -> dict:
+    rows = [{"strategy": name.split("/")[0], "field": name.split("/")[1], "cut": "isopleth",
+             "poke": k + 1, "purpose": "variance", "map_field": name.split("/")[1],
+             "threshold": False, "accuracy": a, "mean_iou": a, "found": 2, "true": 2,
+             "kendall_tau": 1.0, "modulus_error": modulus_error, "beta_spread": 0.1,
+             "poke_s": 1.0, "elapsed_s": k + 1.0}
+            for name, series in accuracy.items() for k, a in enumerate(series)]
+    world = {"index": index, "family": family, "physics": "linear-fem", "camera": "primesense",
+             "thickness_m": 0.05, "force_n": 0.6}
+    if status != "ok":
+        return {"world": world, "rows": [], "status": "failed", "error": "Boom: no"}
+    return {"world": world, "rows": rows, "status": "ok", "error": None, "seconds": 3.0}
+
+
+COMBOS = [("paper", "beta", "isopleth"), ("planned", "beta", "isopleth")]
+
+
+def _results() -> list[dict]:
+    return [
+        _result(0, "cuts", {"paper/beta": [0.5, 0.95, 0.97], "planned/beta": [0.92, 0.95, 0.96]}),
+        _result(1, "cuts", {"paper/beta": [0.5, 0.6, 0.7], "planned/beta": [0.5, 0.91, 0.93]}),
+        _result(4, "cuts", {"paper/beta": [0.95, 0.6, 0.7], "planned/beta": [0.3, 0.5, 0.6]}),
+        # paper ran out of targets after poke 1: its last map counts for pokes 2 and 3
+        _result(2, "insert", {"paper/beta": [0.95], "planned/beta": [0.4, 0.5, 0.95]}),
+        _result(3, "insert", {}, status="failed"),
+    ]
+
+
+def test_summary_counts_never_and_failed_as_max_pokes_plus_one() -> None:
+    summary = summarise_worlds(_results(), COMBOS, 3)
+    paper, planned = (summary["strategies"][n] for n in ("paper/beta/isopleth",
+                                                          "planned/beta/isopleth"))
+    # first at 0.9 — paper: 2, never (4), 1, failed (4), 1 → 2; planned: 1, 2, 3, 4, 4 → 3
+    assert paper["median_pokes_to_accuracy_0.9"] == 2.0
+    assert planned["median_pokes_to_accuracy_0.9"] == 3.0
+    # staying at 0.9 — paper's world 4 loses it after poke 1: 2, 4, 1, 4, 4 → 4
+    assert paper["median_pokes_to_stay_0.9"] == 4.0 and planned["median_pokes_to_stay_0.9"] == 3.0
+    assert paper["worlds"] == 5 and paper["failed"] == 1
+    assert paper["share_reaching_0.9"] == pytest.approx(3 / 5)
+    assert paper["final_accuracy_median"] == pytest.approx(0.825)  # 0.97, 0.7, 0.95 carried, 0.7
+    assert paper["by_family"]["cuts"]["median_pokes_to_accuracy_0.9"] == 2.0
+    assert paper["by_family"]["insert"]["median_pokes_to_accuracy_0.9"] == 2.5
+    assert set(paper) >= {"median_pokes_to_accuracy_0.9", "final_accuracy_median",
+                          "modulus_error_median", "worlds", "by_family"}
+    assert summary["best"] == "paper/beta/isopleth"
+    assert summary["failed_worlds"] == [{"index": 3, "error": "Boom: no"}]
+    table = markdown_summary(summary)
+    assert "| paper/beta/isopleth (best) | 5 (1 failed) | 2 | 4 | 60% |" in table
+    curves = accuracy_curves(_results(), COMBOS, 3)
+    assert curves["all"]["paper/beta/isopleth"].shape == (4, 3)
+    assert curves["insert"]["paper/beta/isopleth"].tolist() == [[0.95, 0.95, 0.95]]
+
+
+def test_runs_csv_has_a_row_per_poke_and_the_failed_world_per_combination() -> None:
+    rows = list(csv.DictReader(io.StringIO(runs_csv(_results(), COMBOS))))
+    assert tuple(rows[0]) == CSV_COLUMNS
+    assert len(rows) == 3 + 3 + 3 + 3 + 1 + 3 + 2 + 3 + 3
+    failed = [r for r in rows if r["status"] == "failed"]
+    assert [r["strategy"] for r in failed] == ["paper", "planned"]
+    assert all(r["poke"] == "" and r["error"] == "Boom: no" for r in failed)
+
+
+def test_one_world_is_mapped_to_max_pokes_by_every_combination() -> None:
+    task = {"seed": 5, "index": 0, "families": ["l-shape"], "physics": ["linear-fem"],
+            "strategies": ["paper"],
+            "fields": ["beta", "modulus"], "cut": None, "max_pokes": 2, "coarse": True}
+    result = run_world(task)
+    assert result["status"] == "ok" and result["world"]["family"] == "l-shape"
+    rows = result["rows"]
+    assert [(r["field"], r["poke"]) for r in rows] == [("beta", 1), ("beta", 2),
+                                                        ("modulus", 1), ("modulus", 2)]
+    for r in rows:
+        assert 0.0 <= r["accuracy"] <= 1.0 and 0.0 <= r["mean_iou"] <= 1.0
+        assert r["true"] == 2 and r["found"] >= 1
+    assert rows[0]["purpose"] == "first"
+    assert rows[-1]["modulus_error"] is not None and rows[-1]["modulus_error"] >= 0
+    json.dumps(result)  # plain data crosses processes
+    assert np.isfinite([r["poke_s"] for r in rows]).all()
+
+
+def test_the_command_refuses_bad_names_in_one_line_before_any_folder(tmp_path) -> None:
+    from typer.testing import CliRunner
+
+    from deformap.cli import app
+
+    out = tmp_path / "w"
+    for args, message in ((["--strategies", "paper,guess"], "`strategies` must be distinct"),
+                          (["--fields", "hardness"], "`fields` must be distinct"),
+                          (["--cut", "voronoi"], "`cut` must be one of"),
+                          (["--worlds", "0"], "`worlds` must be an integer >= 1")):
+        result = CliRunner().invoke(app, ["bench", "worlds", "--out", str(out), *args])
+        assert result.exit_code == 2, result.output
+        assert message in result.output and len(result.output.strip().splitlines()) == 1
+        assert not out.exists()

@@ -1,0 +1,73 @@
+"""``deformap bench worlds`` on the local process pool and on a Dask cluster: the same numbers,
+resumed without redoing a world, a failing world reported (issue 16, items 2 and 3)."""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+
+import pytest
+
+from deformap.errors import ConfigError, InvalidArgumentError
+from deformap.eval import TIME_COLUMNS
+from deformap.run import WorldsBenchConfig, bench_worlds
+from deformap.run._worlds import _local_results
+
+
+def _values(folder) -> list[dict[str, str]]:
+    rows = list(csv.DictReader(io.StringIO((folder / "runs.csv").read_text())))
+    return [{k: v for k, v in r.items() if k not in TIME_COLUMNS} for r in rows]
+
+
+def _config(**kw) -> WorldsBenchConfig:
+    # coarse worlds on the linear FEM: a poke costs an eighth of the stiffening foam's
+    settings = {"seed": 3, "families": ("cuts", "checker"), "physics": ("linear-fem",),
+                "coarse": True,
+                "strategies": ("paper",), "fields": ("beta",), "max_pokes": 2, **kw}
+    return WorldsBenchConfig(**settings)
+
+
+def test_pool_and_dask_agree_byte_for_byte_apart_from_times_and_resume(tmp_path) -> None:
+    distributed = pytest.importorskip("distributed")
+    pool = bench_worlds(_config(worlds=2), tmp_path / "pool")
+    assert pool.computed == 2
+    with distributed.LocalCluster(processes=True, n_workers=1, threads_per_worker=1,
+                                  host="127.0.0.1", dashboard_address=None) as cluster:
+        dask = bench_worlds(_config(worlds=2, scheduler=cluster.scheduler_address),
+                            tmp_path / "dask")
+    assert dask.computed == 2
+    assert _values(tmp_path / "pool") == _values(tmp_path / "dask")
+    assert len(_values(tmp_path / "pool")) == 2 * 2  # worlds × pokes
+    for name in ("worlds/world-00000.json", "worlds/world-00001.json"):
+        a, b = (json.loads((tmp_path / f / name).read_text()) for f in ("pool", "dask"))
+        assert a["world"] == b["world"]
+        assert [{k: v for k, v in r.items() if k not in TIME_COLUMNS} for r in a["rows"]] == \
+            [{k: v for k, v in r.items() if k not in TIME_COLUMNS} for r in b["rows"]]
+    summary = json.loads((tmp_path / "pool" / "summary.json").read_text())
+    assert summary["strategies"]["paper/beta/isopleth"]["worlds"] == 2
+    assert (tmp_path / "pool" / "curves.png").stat().st_size > 0
+    assert "| paper/beta/isopleth" in (tmp_path / "pool" / "summary.md").read_text()
+    again = bench_worlds(_config(worlds=2), tmp_path / "pool")  # resumed: nothing redone
+    assert again.computed == 0 and again.summary == pool.summary
+    with pytest.raises(ConfigError, match="other settings"):
+        bench_worlds(_config(worlds=2, max_pokes=3), tmp_path / "pool")
+
+
+def test_a_failing_world_is_tried_twice_then_reported_not_dropped(caplog) -> None:
+    bad = {**_config(worlds=1).task(0), "families": ["spiral"]}  # fails as it is drawn
+    with caplog.at_level("WARNING"):
+        results = list(_local_results([bad], workers=1))
+    assert [r["status"] for r in results] == ["failed"]
+    assert "spiral" in results[0]["error"] and results[0]["rows"] == []
+    assert results[0]["world"] == {"index": 0, "family": "spiral"}
+    assert "trying once more" in caplog.text
+
+
+def test_settings_are_checked_against_the_config_literals() -> None:
+    with pytest.raises(InvalidArgumentError, match="`strategies` must be distinct names"):
+        WorldsBenchConfig(strategies=("paper", "guess"))
+    with pytest.raises(InvalidArgumentError, match="`cut` must be one of"):
+        WorldsBenchConfig(cut="voronoi")
+    with pytest.raises(InvalidArgumentError, match="`families` must be"):
+        WorldsBenchConfig(families=())
