@@ -58,20 +58,26 @@ def plot_world_curves(curves: dict[str, dict[str, NDArray[np.float64]]], *,
             ax.plot(pokes, mean, color=colours[name], ls=styles[name], lw=1.4, label=name)
             ax.fill_between(pokes, mean - _Z95 * se, np.minimum(1.0, mean + _Z95 * se),
                             color=colours[name], alpha=0.15, lw=0)
-        ax.axhline(good_accuracy, color="k", ls="--", lw=0.8)
+        ax.axhline(good_accuracy, color="k", ls="--", lw=0.8,
+                   label=f"accuracy {good_accuracy:g} (a good map)")
         ax.set_title(f"{family} ({n_worlds} world{'s' if n_worlds != 1 else ''})", fontsize=10)
         ax.set_ylim(0.0, 1.02)
         ax.xaxis.set_major_locator(MaxNLocator(integer=True))
         ax.grid(alpha=0.3)
     for ax in axes.ravel()[len(families):]:
         ax.set_visible(False)
-    for ax in axes[-1]:
-        ax.set_xlabel("pokes")
+    # the lowest panel drawn in each column carries the poke axis (shared x hides the others')
+    for col in range(cols):
+        shown = [r for r in range(rows) if r * cols + col < len(families)]
+        if shown:
+            ax = axes[shown[-1], col]
+            ax.xaxis.set_tick_params(labelbottom=True)
+            ax.set_xlabel("pokes")
     for ax in axes[:, 0]:
         ax.set_ylabel("region accuracy")
     handles, labels = axes[0, 0].get_legend_handles_labels()
     if handles:
-        fig.legend(handles, labels, loc="outside lower center", ncols=min(4, len(labels)),
+        fig.legend(handles, labels, loc="outside lower center", ncols=min(5, len(labels)),
                    fontsize=8, frameon=False)
     fig.suptitle("region accuracy against pokes: mean and 95 % band over worlds", fontsize=11)
     if path is not None:
