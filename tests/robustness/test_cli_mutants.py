@@ -97,6 +97,17 @@ def _timeout(signum: int, frame: Any) -> None:
     raise TimeoutError(f"no answer within {HANG_LIMIT_S} s")
 
 
+def _invoke(runner: CliRunner, argv: list[str]) -> Any:
+    """The command's result, or the TimeoutError of the alarm (the SIGALRM handler installed)."""
+    signal.alarm(HANG_LIMIT_S)
+    try:
+        return runner.invoke(app, argv, env={"COLUMNS": "200"})
+    except TimeoutError as error:
+        return error
+    finally:
+        signal.alarm(0)
+
+
 def test_every_option_of_every_command_refuses_hostile_values(tmp_path: Path) -> None:
     paths = _paths(tmp_path)
     cases = _cases(paths)
@@ -112,14 +123,10 @@ def test_every_option_of_every_command_refuses_hostile_values(tmp_path: Path) ->
             positional = [p for p in command.params if not p.opts or
                           not p.opts[0].startswith("-")]  # fmt: skip
             argv = _argv(path, option, nargs, value, names, positional, paths)
-            signal.alarm(HANG_LIMIT_S)
-            try:
-                result = runner.invoke(app, argv, env={"COLUMNS": "200"})
-            except TimeoutError as error:
-                failures.append(f"{' '.join(argv)[:160]}: {error}")
+            result = _invoke(runner, argv)
+            if isinstance(result, TimeoutError):
+                failures.append(f"{' '.join(argv)[:160]}: {result}")
                 continue
-            finally:
-                signal.alarm(0)
             problem = _judge(result)
             if problem:
                 failures.append(f"{' '.join(argv)[:160]}: {problem}")
@@ -188,14 +195,10 @@ def test_every_number_option_refuses_non_finite_values_itself(tmp_path: Path) ->
                             param.opts[0], *([value] + ["0"] * (int(param.nargs) - 1))]
                     if "--out" in names:
                         argv += ["--out", str(out)]
-                    signal.alarm(HANG_LIMIT_S)
-                    try:
-                        result = runner.invoke(app, argv, env={"COLUMNS": "200"})
-                    except TimeoutError as error:
-                        failures.append(f"{' '.join(argv)}: {error}")
+                    result = _invoke(runner, argv)
+                    if isinstance(result, TimeoutError):
+                        failures.append(f"{' '.join(argv)}: {result}")
                         continue
-                    finally:
-                        signal.alarm(0)
                     problem = _judge(result)
                     named = param.name in result.output or param.opts[0] in result.output
                     if problem is None and not named and "Usage:" not in result.output:
