@@ -176,4 +176,4 @@ def test_explore_variance_max_reaches_the_run_and_a_bad_one_is_one_line(
     for bad in ("0", "-1", "nan"):
         result = runner.invoke(app, ["explore", "-s", "homogeneous-60", "--variance-max", bad])
         assert result.exit_code == 2
-        assert f"--variance-max must be a number > 0; got {float(bad)}" in result.output
+        assert f"--variance-max must be a finite number > 0; got {float(bad)}" in result.output

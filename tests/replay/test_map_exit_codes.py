@@ -87,4 +87,4 @@ def test_map_refuses_a_bad_variance_max_before_reading_the_session(tmp_path: Pat
     result = CliRunner().invoke(app, ["map", str(tmp_path / "no-session"), "--variance-max", bad,
                                       "--out", str(out)])  # fmt: skip
     assert result.exit_code == 2
-    assert "`variance_max` must be" in result.output and not out.exists()
+    assert "--variance-max must be a finite number > 0" in result.output and not out.exists()

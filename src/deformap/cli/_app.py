@@ -32,6 +32,7 @@ __all__ = [
     "JsonOption",
     "VarianceMaxOption",
     "app",
+    "check_positive_options",
     "console",
     "emit_json",
     "err_console",
@@ -100,6 +101,15 @@ def _json_target(value: Path | None) -> Path | None:
             soft_wrap=True)
         raise typer.Exit(code=2)
     return value
+
+
+def check_positive_options(**numbers: float | None) -> None:
+    """Refuse, naming its option (``press_force`` → ``--press-force``), a number given that is not
+    finite and > 0 (NaN too), before the command does anything."""
+    for name, value in numbers.items():
+        if value is not None and not 0.0 < value < float("inf"):
+            option = "--" + name.replace("_", "-")
+            raise InvalidArgumentError(f"{option} must be a finite number > 0; got {value}")
 
 
 VarianceMaxOption = Annotated[

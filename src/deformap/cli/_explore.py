@@ -15,12 +15,13 @@ from deformap.cli._app import (
     JsonOption,
     VarianceMaxOption,
     app,
+    check_positive_options,
     emit_json,
     friendly_errors,
     out_console,
 )
 from deformap.cli._progress import modulus_text, progress, run_hooks
-from deformap.errors import ConfigError, InvalidArgumentError
+from deformap.errors import ConfigError
 
 if TYPE_CHECKING:  # the CLI loads the estimator only when a command runs
     from deformap.explore import PokeRecord
@@ -159,8 +160,7 @@ def explore_command(
 ) -> None:
     """Explore a simulated world (or your own Environment): poke until the map field is known,
     then cut it into regions."""
-    if variance_max is not None and not variance_max > 0:  # NaN too
-        raise InvalidArgumentError(f"--variance-max must be a number > 0; got {variance_max}")
+    check_positive_options(variance_max=variance_max)
     overrides = run.RunOverrides(scenario=scenario, seed=seed, strategy=strategy,
                                  threshold=threshold, max_pokes=max_pokes,
                                  field=field)  # fmt: skip

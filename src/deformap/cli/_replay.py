@@ -13,6 +13,7 @@ from deformap.cli._app import (
     JsonOption,
     VarianceMaxOption,
     app,
+    check_positive_options,
     emit_json,
     err_console,
     friendly_errors,
@@ -118,9 +119,8 @@ def map_command(
 ) -> None:
     """Map a recorded session (or a robot's raw bag): its pokes, in order, through the live
     loop's mapper."""
-    for option, number in (("--press-force", press_force), ("--stamp-tolerance", stamp_tolerance)):
-        if number is not None and not 0.0 < number < float("inf"):  # NaN too
-            raise InvalidArgumentError(f"{option} must be a finite number > 0; got {number}")
+    check_positive_options(press_force=press_force, stamp_tolerance=stamp_tolerance,
+                           variance_max=variance_max)
     cfg = None if config is None else run.load_run_config(config)
     raw_settings = {"cloud_topic": cloud_topic, "wrench_topic": wrench_topic,
                     "world_frame": world_frame, "tip_frame": tip_frame, "force_n": press_force,
