@@ -17,6 +17,7 @@ from deformap.eval import (
     choices,
     draw_world,
     markdown_summary,
+    row_values,
     run_world,
     runs_csv,
     summarise_worlds,
@@ -113,12 +114,13 @@ def test_runs_csv_has_a_row_per_poke_and_the_failed_world_per_combination() -> N
 def test_one_world_is_mapped_to_max_pokes_by_every_combination() -> None:
     task = {"seed": 5, "index": 0, "families": ["l-shape"], "physics": ["linear-fem"],
             "strategies": ["paper"],
-            "fields": ["beta", "modulus"], "cut": None, "max_pokes": 2, "coarse": True}
+            "fields": ["beta", "modulus"], "cuts": ["isopleth", "nearest"], "max_pokes": 2,
+            "coarse": True}
     result = run_world(task)
     assert result["status"] == "ok" and result["world"]["family"] == "l-shape"
     rows = result["rows"]
-    assert [(r["field"], r["poke"]) for r in rows] == [("beta", 1), ("beta", 2),
-                                                        ("modulus", 1), ("modulus", 2)]
+    assert [(r["field"], r["poke"], r["cut"]) for r in rows] == [
+        (f, k, c) for f in ("beta", "modulus") for k in (1, 2) for c in ("isopleth", "nearest")]
     for r in rows:
         assert 0.0 <= r["accuracy"] <= 1.0 and 0.0 <= r["mean_iou"] <= 1.0
         assert r["true"] == 2 and r["found"] >= 1
@@ -136,9 +138,23 @@ def test_the_command_refuses_bad_names_in_one_line_before_any_folder(tmp_path) -
     out = tmp_path / "w"
     for args, message in ((["--strategies", "paper,guess"], "`strategies` must be distinct"),
                           (["--fields", "hardness"], "`fields` must be distinct"),
-                          (["--cut", "voronoi"], "`cut` must be one of"),
+                          (["--cut", "voronoi"], "`cuts` must be distinct"),
+                          (["--cuts", "nearest,nearest"], "`cuts` must be distinct"),
                           (["--worlds", "0"], "`worlds` must be an integer >= 1")):
         result = CliRunner().invoke(app, ["bench", "worlds", "--out", str(out), *args])
         assert result.exit_code == 2, result.output
         assert message in result.output and len(result.output.strip().splitlines()) == 1
         assert not out.exists()
+
+
+def test_the_cuts_are_scored_on_the_same_pokes_as_a_run_per_cut() -> None:
+    """One mapping scored under every cut equals one mapping per cut: where a poke goes does not
+    depend on the cut (the level-set strategy and the boundary pokes read cut-free classes)."""
+    task = {"seed": 2, "index": 1, "families": ["insert"], "physics": ["linear-fem"],
+            "strategies": ["level-set"], "fields": ["beta"], "max_pokes": 4, "coarse": True}
+    cuts = ["isopleth", "nearest", "indicator-kriging"]
+    together = [row_values(r) for r in run_world({**task, "cuts": cuts})["rows"]]
+    apart = [row_values(r) for cut in cuts for r in run_world({**task, "cuts": [cut]})["rows"]]
+    key = lambda r: (r["cut"], r["poke"])  # noqa: E731
+    assert sorted(together, key=key) == sorted(apart, key=key)
+    assert {r["cut"] for r in together} == set(cuts)

@@ -168,8 +168,10 @@ def bench_worlds_command(
     physics: Annotated[list[str] | None, typer.Option(
         help="World physics drawn from (linear-fem, stiffening-foam); default: both.",
         show_default=False)] = None,
-    cut: Annotated[str | None, typer.Option(
-        help="Region labels (exploration.region_labels); default: its default.")] = None,
+    cuts: Annotated[list[str] | None, typer.Option(
+        "--cuts", "--cut",
+        help="Region labels (exploration.region_labels), each scored on the same pokes; "
+             "comma-separated (or repeated); default: all.", show_default=False)] = None,
     max_pokes: Annotated[int, typer.Option(help="Pokes per world and combination.")] = 12,
     coarse: Annotated[bool, typer.Option(
         help="The coarse test mesh and camera: a third of the cost, a smoke run only (its 2 cm "
@@ -187,9 +189,9 @@ def bench_worlds_command(
     from deformap import run
 
     given = {"families": _names(families), "strategies": _names(strategies),
-             "fields": _names(fields), "physics": _names(physics)}
+             "fields": _names(fields), "physics": _names(physics), "cuts": _names(cuts)}
     config = run.WorldsBenchConfig(
-        worlds=worlds, seed=seed, cut=cut, max_pokes=max_pokes, coarse=coarse, workers=workers,
+        worlds=worlds, seed=seed, max_pokes=max_pokes, coarse=coarse, workers=workers,
         scheduler=scheduler, **{k: v for k, v in given.items() if v is not None})
     shown = out_console(json_path)
     with progress(shown) as bar:

@@ -9,13 +9,16 @@ the world's physics (either of :data:`deformap.world.PHYSICS`), camera (every pr
 :data:`deformap.world.CAMERA_PRESETS`), block thickness (:data:`THICKNESSES_M`, the hardness
 study's matrix) and press force (:data:`FORCES_N`).
 
-:func:`run_world` builds that world once and maps it with every strategy × field (× cut) from the
-same surface model (one first observation and one fit: the same cloud and the same stream give
-every combination the same model), poking to ``max_pokes``: once the map field's variance is
-under ``T_h`` the remaining pokes go where a region boundary is least certain
+:func:`run_world` builds that world once and maps it with every strategy × field from the same
+surface model (one first observation and one fit: the same cloud and the same stream give every
+combination the same model), poking to ``max_pokes``: once the map field's variance is under
+``T_h`` the remaining pokes go where a region boundary is least certain
 (``ExplorationConfig.boundary_pokes``), so every combination makes ``max_pokes`` pokes and the
 curves compare like with like; ``threshold`` in a row says whether the variance rule was met.
-After every poke it records (one row each):
+Every cut (``region_labels``) asked for is scored on the same pokes: where the next poke goes
+does not depend on the cut (the targets read the classes of
+:func:`deformap.explore.poke_classes`, before any cut), so mapping once per cut would repeat the
+same pokes. After every poke it records (one row each per cut):
 
 - ``accuracy``, ``mean_iou``, ``found``, ``true``, ``kendall_tau``
   (:func:`deformap.eval.region_scores`) of the map field's regions against the world's truth by
@@ -47,7 +50,7 @@ from numpy.typing import NDArray
 
 from deformap.errors import InvalidArgumentError
 from deformap.eval._metrics import region_scores
-from deformap.explore import ExplorationConfig, Mapper, Target, poke_step
+from deformap.explore import ExplorationConfig, Mapper, Target, map_regions, poke_step
 from deformap.world import (
     CAMERA_PRESETS,
     LAYOUT_FAMILIES,
@@ -144,12 +147,13 @@ def _material_truth(world: SimulatedWorld, xs: NDArray, ys: NDArray
             {k: float(v) for k, v in enumerate(values)}, world.ground_truth_modulus(xs, ys))
 
 
-def _scores(mapper: Mapper, truth: tuple[NDArray, dict[int, float], NDArray]) -> dict[str, Any]:
+def _scores(mapper: Mapper, truth: tuple[NDArray, dict[int, float], NDArray],
+            cuts: Sequence[str]) -> dict[str, dict[str, Any]]:
+    """Each cut's scores of the mapper's current map (the pokes do not depend on the cut: the
+    targets read the cut-free classes of :func:`deformap.explore.poke_classes`)."""
     labels, hardness, modulus = truth
     field = mapper.map_field
-    found = mapper.regions()
     sign = -1.0 if field.name == "modulus" else 1.0  # the metrics order by softness
-    scores = region_scores(found.labels, labels, sign * field.mean, hardness)
     foam = np.isfinite(modulus)
     modulus_error = None
     if len(mapper.modulus_field.pokes) and foam.any():
@@ -157,15 +161,23 @@ def _scores(mapper: Mapper, truth: tuple[NDArray, dict[int, float], NDArray]) ->
         modulus_error = float(np.median(rel))
     beta = mapper.field.mean
     spreads = [float(np.std(beta[(labels == k) & foam])) for k in np.unique(labels[foam])]
-    return {"accuracy": scores.accuracy, "mean_iou": scores.mean_iou, "found": scores.found,
-            "true": scores.true, "kendall_tau": scores.kendall_tau,
-            "modulus_error": modulus_error,
-            "beta_spread": float(np.mean(spreads)) if spreads else None}  # fmt: skip
+    shared = {"modulus_error": modulus_error,
+              "beta_spread": float(np.mean(spreads)) if spreads else None}
+    out = {}
+    for cut in cuts:
+        found = map_regions(field.mean, field.pokes, mapper.grid.cells_xy,
+                            replace(mapper.config, region_labels=cut))  # fmt: skip
+        scores = region_scores(found.labels, labels, sign * field.mean, hardness)
+        out[cut] = {"accuracy": scores.accuracy, "mean_iou": scores.mean_iou,
+                    "found": scores.found, "true": scores.true,
+                    "kendall_tau": scores.kendall_tau, **shared}  # fmt: skip
+    return out
 
 
 def _map_one(world: SimulatedWorld, draw: WorldDraw, config: ExplorationConfig, surface: Any,
-             truth: tuple[NDArray, dict[int, float], NDArray], seed: int) -> list[dict[str, Any]]:
-    """Map the world with one configuration to ``max_pokes``; one row per poke."""
+             truth: tuple[NDArray, dict[int, float], NDArray], seed: int,
+             cuts: Sequence[str]) -> list[dict[str, Any]]:
+    """Map the world with one configuration to ``max_pokes``; one row per poke and cut."""
     mapper = Mapper(world.workspace, config)
     mapper.surface = surface  # the combinations share the first observation's model
     streams = np.random.default_rng(np.random.SeedSequence([seed, draw.index, 1])).spawn(
@@ -184,11 +196,12 @@ def _map_one(world: SimulatedWorld, draw: WorldDraw, config: ExplorationConfig, 
         poke = poke_step(mapper, index, partial(world.press, target.xy, config.force_n),
                          finish=world.release, target=target, target_s=t_target)  # fmt: skip
         t1 = time.perf_counter()
-        rows.append({"poke": index + 1, "purpose": poke.record.purpose,
-                     "map_field": mapper.config.field,
-                     "threshold": bool(mapper.max_variance() <= mapper.threshold),
-                     **_scores(mapper, truth),
-                     "poke_s": t1 - t0, "elapsed_s": t1 - t_start})  # fmt: skip
+        head = {"poke": index + 1, "purpose": poke.record.purpose,
+                "map_field": mapper.config.field,
+                "threshold": bool(mapper.max_variance() <= mapper.threshold)}
+        for cut, scores in _scores(mapper, truth, cuts).items():
+            rows.append({"cut": cut, **head, **scores,
+                         "poke_s": t1 - t0, "elapsed_s": t1 - t_start})  # fmt: skip
     return rows
 
 
@@ -205,8 +218,8 @@ def run_world(task: dict[str, Any]) -> dict[str, Any]:
 
     Returns
     -------
-    dict with ``world`` (:meth:`WorldDraw.summary`), ``rows`` (one per strategy × field × poke,
-    each naming them) and ``seconds`` (the world's wall time, building included).
+    dict with ``world`` (:meth:`WorldDraw.summary`), ``rows`` (one per strategy × field × cut ×
+    poke, each naming them) and ``seconds`` (the world's wall time, building included).
     """
     t0 = time.perf_counter()
     seed, index = int(task["seed"]), int(task["index"])
@@ -219,9 +232,8 @@ def run_world(task: dict[str, Any]) -> dict[str, Any]:
     world_seq, explore_seq = np.random.SeedSequence([seed, index, 0]).spawn(2)
     world = SimulatedWorld(draw.scenario, config=config, rng=np.random.default_rng(world_seq))
     k = int(task["max_pokes"])
-    cut = task.get("cut")
-    explore = ExplorationConfig(max_pokes=k, boundary_pokes=k, force_n=draw.force_n,
-                                **({} if cut is None else {"region_labels": cut}))  # fmt: skip
+    cuts = tuple(task["cuts"])
+    explore = ExplorationConfig(max_pokes=k, boundary_pokes=k, force_n=draw.force_n)
     first = Mapper(world.workspace, explore)
     surface = first.initialise(world.observe(), np.random.default_rng(explore_seq))
     truth = _material_truth(world, first.grid.xs, first.grid.ys)
@@ -229,9 +241,9 @@ def run_world(task: dict[str, Any]) -> dict[str, Any]:
     for strategy in task["strategies"]:
         for field in task["fields"]:
             cfg = replace(explore, strategy=strategy, field=field)
-            for row in _map_one(world, draw, cfg, surface, truth, seed):
+            for row in _map_one(world, draw, cfg, surface, truth, seed, cuts):
                 rows.append({"world": index, "family": draw.family, "strategy": strategy,
-                             "field": field, "cut": cfg.region_labels, **row})  # fmt: skip
+                             "field": field, **row})  # fmt: skip
     return {"world": draw.summary(), "rows": rows, "seconds": time.perf_counter() - t0,
             "status": "ok", "error": None}
 

@@ -75,8 +75,9 @@ class WorldsBenchConfig:
         The world physics each world's is drawn from (:data:`deformap.world.PHYSICS`).
     strategies, fields : tuple of str
         ``ExplorationConfig.strategy`` and ``field`` values, every pair mapped on every world.
-    cut : str or None
-        ``ExplorationConfig.region_labels`` (``None``: its default).
+    cuts : tuple of str
+        ``ExplorationConfig.region_labels`` values, each scored on the same pokes (the pokes
+        do not depend on the cut).
     max_pokes : int
         Pokes per world and combination.
     coarse : bool
@@ -97,7 +98,7 @@ class WorldsBenchConfig:
     # every choice ExplorationConfig has, so a strategy or field added there is benchmarked too
     strategies: tuple[str, ...] = choices("strategy")
     fields: tuple[str, ...] = choices("field")
-    cut: str | None = None
+    cuts: tuple[str, ...] = choices("region_labels")
     # every poke is a press and a β sweep per combination (issue 16 reads 20 and more)
     max_pokes: int = setting(12, ge=1, le=1000)
     coarse: bool = False
@@ -109,13 +110,11 @@ class WorldsBenchConfig:
         for name, given, allowed in (("families", self.families, LAYOUT_FAMILIES),
                                      ("physics", self.physics, PHYSICS),
                                      ("strategies", self.strategies, choices("strategy")),
-                                     ("fields", self.fields, choices("field"))):
+                                     ("fields", self.fields, choices("field")),
+                                     ("cuts", self.cuts, choices("region_labels"))):
             if not given or any(g not in allowed for g in given) or len(set(given)) < len(given):
                 raise SettingError(name, f"must be distinct names from {list(allowed)}; got "
                                          f"{list(given)}")
-        if self.cut is not None and self.cut not in choices("region_labels"):
-            raise SettingError("cut", f"must be one of {list(choices('region_labels'))}; got "
-                                      f"{self.cut!r}")
 
     def result_settings(self) -> dict[str, Any]:
         """The settings a world's result depends on (``bench.json``; resuming compares them)."""
@@ -123,15 +122,14 @@ class WorldsBenchConfig:
                 if k not in ("worlds", "workers", "scheduler")}
 
     def combinations(self) -> list[tuple[str, str, str]]:
-        cut = self.cut or str(choices("region_labels")[0])
-        return [(s, f, cut) for s in self.strategies for f in self.fields]
+        return [(s, f, c) for s in self.strategies for f in self.fields for c in self.cuts]
 
     def task(self, index: int) -> dict[str, Any]:
         """The plain-data task of world ``index``."""
         return {"seed": self.seed, "index": index, "families": list(self.families),
                 "physics": list(self.physics),
                 "strategies": list(self.strategies), "fields": list(self.fields),
-                "cut": self.cut, "max_pokes": self.max_pokes, "coarse": self.coarse}
+                "cuts": list(self.cuts), "max_pokes": self.max_pokes, "coarse": self.coarse}
 
 
 @dataclass(frozen=True, kw_only=True)
