@@ -20,7 +20,18 @@ Patch radius: Hertz's ``a`` assumes a half-space, but the foam is a layer bonded
 responds stiffer, so the tip sinks less than Hertz says and touches a smaller disc. The press
 therefore iterates ``a ← sqrt(a · sqrt(R δ_FEM))`` (a damped fixed point of the sphere's geometric
 relation ``a² = R δ``) from the Hertz value until ``a`` changes by less than 2 %, and never lets
-``a`` exceed the tip radius ``R``.
+``a`` exceed the tip radius ``R``. The iteration is safeguarded: each solve tells on which side of
+the fixed point ``a`` lies (``sqrt(R δ(a)) > a``: the patch must grow), so the radii tried keep a
+bracket around it, and a step that would leave the bracket bisects it instead. Near a seam
+between blocks ``δ(a)`` jumps as the patch crosses into the next block, and the plain iteration
+can oscillate there without converging (1 world of 100 in ``deformap bench worlds``, seed 0,
+whose force–travel record then went backwards by 0.9 mm); the bracket converges anyway.
+
+Loading: the indentation of a rigid sphere pressed into a linear elastic body grows with the
+force and so does its contact disc. ``δ(a; F)`` grows with ``F`` at every ``a``, so the fixed
+point at a smaller force lies within the radius at a larger one: a press solved at several loads
+(the force–travel record, :meth:`deformap.world.SimulatedWorld.force_travel`) passes the radius
+of the load above as ``max_radius_m``, the upper end of the bracket.
 """
 
 from __future__ import annotations
@@ -155,12 +166,14 @@ class FoamModel(FoamMesh):
         return sum(b.n_dofs for b in self.bodies.values())
 
     def dent(self, target_xy: NDArray[np.float64], force_n: float, *, tip_radius_m: float,
-             max_iterations: int = 6, tolerance: float = 0.02,
-             initial_radius_m: float | None = None) -> Dent:
+             max_iterations: int = 40, tolerance: float = 0.02,
+             initial_radius_m: float | None = None, max_radius_m: float | None = None) -> Dent:
         """Solve the press of ``force_n`` newtons at ``target_xy`` (see the module docstring).
 
         ``initial_radius_m`` starts the patch iteration there instead of at Hertz's radius (a
         nearby press's converged patch, scaled): the same fixed point in fewer solves.
+        ``max_radius_m`` bounds the patch (the radius of the same press at a larger force);
+        default the tip's radius.
         """
         target = np.asarray(target_xy, dtype=float).reshape(1, 2)
         labels = self.scenario.labels(target[:, 0], target[:, 1])
@@ -168,22 +181,32 @@ class FoamModel(FoamMesh):
         if index not in self.bodies:
             return Dent(displacement=self.zero_displacement(), depth_m=0.0,
                         contact_radius_m=0.0, iterations=0)
+        top = tip_radius_m if not max_radius_m or max_radius_m <= 0.0 else min(
+            float(max_radius_m), tip_radius_m)
         if initial_radius_m is not None and initial_radius_m > 0.0:
-            a = min(float(initial_radius_m), tip_radius_m)
+            a = min(float(initial_radius_m), top)
         else:
             modulus = self.scenario.blocks[index].modulus_pa
             a = min(hertz_contact_radius(force_n, tip_radius_m, modulus, self.poisson_ratio),
-                    tip_radius_m)
+                    top)
+        low, high = 0.0, top  # the fixed point lies in [low, high]
         for iteration in range(1, max_iterations + 1):
             u, points, forces = self._solve_patch(target[0], a, force_n)
             mean_u = -float(forces @ self.top_displacement(points, u)[:, 2]) / force_n
             depth = max(0.0, mean_u + 0.2 * a * a / tip_radius_m)
-            a_new = min(np.sqrt(a * np.sqrt(tip_radius_m * depth)), tip_radius_m)
-            converged = abs(a_new - a) <= tolerance * a
+            consistent = float(np.sqrt(tip_radius_m * depth))  # the radius this sink touches
+            if consistent > a:
+                low = a
+            else:
+                high = a
+            a_new = min(float(np.sqrt(a * consistent)), top)
+            if not low < a_new < high:  # would leave the bracket: bisect it
+                a_new = 0.5 * (low + high)
+            converged = abs(a_new - a) <= tolerance * a or high - low <= tolerance * a
             log.debug("press iteration %d: a=%.4f m, depth=%.4f m", iteration, a, depth)
             if converged or iteration == max_iterations:
                 break
-            a = float(a_new)
+            a = a_new
         self._conform_to_tip(u, target[0], a, depth, tip_radius_m)
         return Dent(displacement=u, depth_m=depth, contact_radius_m=float(a),
                     iterations=iteration)

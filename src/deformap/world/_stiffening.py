@@ -151,13 +151,16 @@ class StiffeningFoam(FoamMesh):
         return sum((self.grids[i].nx + 1) * (self.grids[i].ny + 1) for i in self.layers)
 
     def dent(self, target_xy: NDArray[np.float64], force_n: float, *, tip_radius_m: float,
-             initial_radius_m: float | None = None) -> Dent:
+             initial_radius_m: float | None = None, max_radius_m: float | None = None) -> Dent:
         """Solve the press of ``force_n`` newtons at ``target_xy`` (see the module docstring).
 
         ``initial_radius_m`` is the contact radius expected (a nearby level's, scaled), which
         sets the first grid and mode shape; default ``sqrt(R δ)`` from a first guess of the
         sink (:func:`_depth_guess`). Logs a warning when Newton's method did not converge.
+        ``max_radius_m`` (the FEM's bracket, :class:`deformap.world._foam.FoamModel`) is not
+        needed here: the contact set is the active set's own solution, not a fixed point.
         """
+        del max_radius_m
         target = np.asarray(target_xy, dtype=float).reshape(2)
         index = self.block_at(target)
         if index is None:

@@ -242,16 +242,22 @@ class SimulatedWorld:
         Solved from the top level down, each patch iteration started from the level above's patch
         scaled as Hertz's ``a ∝ F^(1/3)``: close to its fixed point, so one or two solves a level
         on the stiffness factorised when the world was built (the FEM), or a grid and mode shape
-        near the level's own (the stiffening foam).
+        near the level's own (the stiffening foam). Each level's patch is bounded by the radius
+        of the level above (a press's contact grows with its force). The indentation grows with
+        the force too, so a level that comes out deeper than the one above it (the discrete
+        patch crossing a seam between blocks, a few per cent of the depth) reads that level's.
         """
         depths = np.empty(levels.size)
         depths[-1], patch = final.depth_m, final
         for k in range(levels.size - 2, -1, -1):
             start = patch.contact_radius_m * (levels[k] / levels[k + 1]) ** (1.0 / 3.0)
             patch = self.foam.dent(target, float(levels[k]), tip_radius_m=self.config.tip_radius_m,
-                                   initial_radius_m=start)
+                                   initial_radius_m=start,
+                                   max_radius_m=patch.contact_radius_m)
             depths[k] = patch.depth_m
-        return depths
+        # a press sinks deeper under more force; a level solved a few per cent shallow where the
+        # patch crosses a seam (FoamModel's "Patch radius") must not make the record go back
+        return np.minimum.accumulate(depths[::-1])[::-1]
 
     def ground_truth_labels(self, xs: Any, ys: Any) -> NDArray[np.int64]:
         """``(ny, nx)`` block index at ``(xs[j], ys[i])``; ``-1`` on the bare table."""
