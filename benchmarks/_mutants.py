@@ -10,6 +10,7 @@ import io
 import os
 import re
 import shutil
+import struct
 import zipfile
 from collections.abc import Callable
 from pathlib import Path
@@ -17,7 +18,8 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["FILE_MUTATORS", "KINDS", "make_templates", "mutate_file", "mutate_session"]
+__all__ = ["FILE_MUTATORS", "KINDS", "make_templates", "mutate_file", "mutate_raw",
+           "mutate_session"]
 
 Mutator = Callable[[bytes, np.random.Generator], bytes]
 
@@ -31,7 +33,16 @@ KINDS: dict[str, tuple[str, ...]] = {
     # the YAML a user writes: a run configuration (`deformap config dump`) and a scenario
     "config": ("yaml", "flip", "truncate"),
     "scenario": ("yaml", "flip", "truncate"),
+    # a bag as a robot records it (``deformap map BAG``): the MCAP's bytes, one of its records,
+    # one message's bytes in a bag rewritten so that every CRC matches, and the YAML beside it
+    "raw": ("flip", "truncate", "extend", "record", "message-flip", "message-truncate",
+            "message-extend", "yaml"),
 }
+
+#: The raw template's rates [Hz] (camera, /tf, force sensor) and chunk size: a few compressed
+#: chunks of a bag small enough to read in a few hundredths of a second.
+RAW_RATES_HZ = (15.0, 25.0, 100.0)
+RAW_CHUNK_BYTES = 16 * 1024
 
 
 # ----------------------------------------------------------------------------- templates
@@ -115,7 +126,31 @@ def make_templates(root: Path) -> dict[str, Path]:
     for storage in ("mcap", "sqlite3"):
         out[f"session-{storage}"] = write_session(root / f"session-{storage}", format=storage,
                                                   **_session_parts()).parent  # fmt: skip
+    try:
+        import mcap_ros2.writer  # noqa: F401
+    except ImportError:
+        return out
+    out["raw-mcap"] = _raw_template(root / "raw", out["session-folder"])
     return out
+
+
+def _raw_template(folder: Path, session_folder: Path) -> Path:
+    """The synthetic session's presses written as a robot records them, with its settings YAML
+    beside the bag (``NAME.deformap.yaml``); returns the bag."""
+    import yaml
+
+    from deformap.replay import load_session
+    from deformap.testing.robotbag import raw_settings, write_raw_bag
+
+    folder.mkdir()
+    session = load_session(session_folder)
+    camera_hz, tf_hz, wrench_hz = RAW_RATES_HZ
+    bag = folder / "lab.mcap"
+    write_raw_bag(bag, session, camera_hz=camera_hz, tf_hz=tf_hz, wrench_hz=wrench_hz,
+                  chunk_size=RAW_CHUNK_BYTES)  # fmt: skip
+    settings = raw_settings(session, force_n=1.0)
+    (folder / "lab.deformap.yaml").write_text(yaml.safe_dump(settings, sort_keys=False))
+    return bag
 
 
 # ----------------------------------------------------------------------------- mutators
@@ -285,6 +320,86 @@ def mutate_session(template: Path, out: Path, kind: str, rng: np.random.Generato
         victim = data_files[int(rng.integers(len(data_files)))]
         name = ("flip", "truncate", "extend", "header", "count")[int(rng.integers(5))]
         victim.write_bytes(FILE_MUTATORS[name](victim.read_bytes(), rng))
+
+
+# ----------------------------------------------------------------------------- raw bags
+
+_MCAP_MAGIC = b"\x89MCAP0\r\n"
+
+
+def _mcap_record(data: bytes, rng: np.random.Generator) -> bytes:
+    """Damage one record of an MCAP file (opcode, u64 length, content): a byte of its content
+    flipped, its length field changed, the record left out or repeated."""
+    spans, at = [], len(_MCAP_MAGIC)
+    while at + 9 <= len(data) - len(_MCAP_MAGIC):
+        (length,) = struct.unpack_from("<Q", data, at + 1)
+        spans.append((at, at + 9 + length))
+        at += 9 + length
+    start, end = spans[int(rng.integers(len(spans)))]
+    choice = rng.random()
+    if choice < 0.4 and end > start + 9:
+        return _flip_at(data, int(rng.integers(start + 9, end)), rng)
+    if choice < 0.6:
+        length = end - start - 9
+        new = [length - 1, length + 1, 0, length // 2, 2**63, 2**64 - 1][int(rng.integers(6))]
+        return data[: start + 1] + struct.pack("<Q", max(new, 0)) + data[start + 9:]
+    if choice < 0.8:
+        return data[:start] + data[end:]
+    return data[:end] + data[start:]
+
+
+def _flip_at(data: bytes, at: int, rng: np.random.Generator) -> bytes:
+    out = bytearray(data)
+    out[at] ^= 1 << int(rng.integers(8))
+    return bytes(out)
+
+
+def _mcap_message(data: bytes, rng: np.random.Generator, kind: str) -> bytes:
+    """Rewrite the MCAP with one message's bytes damaged (``kind``: flip, truncate, extend) and
+    every CRC computed anew: what only deformap's own checks can refuse. The topic is drawn
+    first, then one of its messages."""
+    from mcap.reader import make_reader
+    from mcap.writer import Writer
+
+    records = list(make_reader(io.BytesIO(data)).iter_messages(log_time_order=False))
+    topics = sorted({channel.topic for _, channel, _ in records})
+    topic = topics[int(rng.integers(len(topics)))]
+    mine = [i for i, (_, channel, _) in enumerate(records) if channel.topic == topic]
+    victim = mine[int(rng.integers(len(mine)))]
+    out = io.BytesIO()
+    writer = Writer(out, chunk_size=RAW_CHUNK_BYTES)
+    writer.start(profile="ros2", library="deformap robustness")
+    schemas: dict[int, int] = {}
+    channels: dict[int, int] = {}
+    for i, (schema, channel, message) in enumerate(records):
+        if schema is not None and schema.id not in schemas:
+            schemas[schema.id] = writer.register_schema(schema.name, schema.encoding, schema.data)
+        if channel.id not in channels:
+            channels[channel.id] = writer.register_channel(
+                channel.topic, channel.message_encoding,
+                schemas[schema.id] if schema is not None else 0, channel.metadata)
+        payload = FILE_MUTATORS[kind](message.data, rng) if i == victim else message.data
+        writer.add_message(channels[channel.id], message.log_time, payload, message.publish_time,
+                           message.sequence)  # fmt: skip
+    writer.finish()
+    return out.getvalue()
+
+
+def mutate_raw(template: Path, out: Path, kind: str, rng: np.random.Generator) -> Path:
+    """Copy the folder of the raw bag ``template`` (the bag and its settings YAML) to ``out``
+    and damage the bag or, for ``yaml``, the settings; returns the damaged bag's path."""
+    shutil.copytree(template.parent, out)
+    bag = out / template.name
+    if kind == "yaml":
+        settings = bag.with_name(f"{bag.stem}.deformap.yaml")
+        settings.write_text(_yaml_edit(settings.read_text(), rng))
+    elif kind == "record":
+        bag.write_bytes(_mcap_record(bag.read_bytes(), rng))
+    elif kind.startswith("message-"):
+        bag.write_bytes(_mcap_message(bag.read_bytes(), rng, kind.removeprefix("message-")))
+    else:
+        bag.write_bytes(FILE_MUTATORS[kind](bag.read_bytes(), rng))
+    return bag
 
 
 def mutate_file(data: bytes, kind: str, rng: np.random.Generator) -> bytes:

@@ -2,29 +2,44 @@
 
     python benchmarks/robustness.py --mutants 3000          # the table in the README
     python benchmarks/robustness.py --mutants 300 --seed 1  # a quick run
+    python benchmarks/robustness.py --mutants 0 --cli-mutants 3000  # the command line's only
 
 Templates (a small cloud as PCD ascii/binary/binary_compressed, PLY ascii/binary, NPZ, and a
 folder session written by ``write_session``, plus MCAP and sqlite3 sessions when ``rosbags`` is
-installed)
+installed, and a raw robot bag when ``mcap-ros2-support`` is too: the folder session's three
+presses written as a robot's drivers record them by ``deformap.testing.robotbag`` — organised
+PointCloud2 with NaN holes at 15 Hz, WrenchStamped at 100 Hz, /tf at 25 Hz, /tf_static, in
+zstd chunks of 16 kB with their CRCs — read as ``deformap map BAG`` reads it, with its
+``NAME.deformap.yaml`` beside it)
 are mutated by seeded byte flips, truncations, appended bytes, header field edits and point-count
 changes (and, for NPZ, the same inside a member, plus edits of its .npy header and shape, with
 the member's zip CRC made to match; for sessions,
-edits of ``session.yaml``, of one of its files, and links out of the folder; and the YAML a user
+edits of ``session.yaml``, of one of its files, and links out of the folder; for the raw bag, the
+same byte mutants, one MCAP record's content or length damaged or the record left out or
+repeated, one message's bytes damaged in a bag rewritten with every CRC made to match, and line
+edits of its settings YAML; and the YAML a user
 writes, a run configuration and a scenario, by line edits, byte flips and cuts). Each mutant is read
 in a worker process under a per-case time limit, and counted as:
 
 - ``clean``: refused with a DeformapError (a session: at load, or at least one of its reads);
 - ``same``: accepted, and the data read equal the template's (the mutant touched nothing read);
 - ``changed``: accepted with other data, where no check could know (a flipped bit in a coordinate
-  of a format without checksum, a number edited in ``session.yaml``);
+  of a format without checksum, a number edited in ``session.yaml`` or a raw bag's settings, a
+  raw bag's message damaged with the CRCs made to match);
 - ``silent``: accepted with other data where a check could have caught it: a different number of
-  points or pokes, a structural mutant (truncation, count change, appended bytes) accepted as
-  different data, or any change to a file covered by a checksum (NPZ members, a session's
-  ``sha256`` manifest);
+  points or pokes, a structural mutant (truncation, count change, appended bytes, a message's
+  length changed) accepted as different data, or any change to a file covered by a checksum (NPZ
+  members, a session's ``sha256`` manifest, a raw bag's chunk and summary CRCs);
 - ``traceback``: any other exception; ``hang``: over the time limit.
 
-From a source checkout the ``src/`` beside this folder is imported, installed or not. The test
-``tests/robustness/test_reader_mutants.py`` runs the same machinery on a few hundred mutants.
+``--cli-mutants N`` also runs at least N command-line mutants (``benchmarks/_cli_mutants.py``:
+every option of every command given seeded hostile values under a guard that stops a run before
+its work) and prints, per value kind, how many ended in one clean ``error:`` line, in the parser's
+usage box, in a traceback, a hang, or otherwise (another exit code, several error lines).
+
+From a source checkout the ``src/`` beside this folder is imported, installed or not. The tests
+``tests/robustness/test_reader_mutants.py`` and ``test_cli_mutants.py`` run the same machinery on
+a few hundred mutants each.
 """
 
 from __future__ import annotations
@@ -50,10 +65,11 @@ for _path in (_SRC, Path(__file__).resolve().parent):
     if _path.is_dir() and str(_path) not in sys.path:
         sys.path.insert(0, str(_path))
 
-from _mutants import KINDS, make_templates, mutate_file, mutate_session  # noqa: E402
+from _mutants import KINDS, make_templates, mutate_file, mutate_raw, mutate_session  # noqa: E402
 
 OUTCOMES = ("clean", "same", "changed", "silent", "traceback", "hang")
-STRUCTURAL = {"truncate", "count", "extend", "member-truncate", "member-extend", "member-shape"}
+STRUCTURAL = {"truncate", "count", "extend", "member-truncate", "member-extend", "member-shape",
+              "message-truncate", "message-extend"}  # fmt: skip
 
 # ----------------------------------------------------------------------------- reading
 
@@ -61,7 +77,10 @@ STRUCTURAL = {"truncate", "count", "extend", "member-truncate", "member-extend",
 def _digest(*arrays: Any) -> str:
     h = hashlib.sha256()
     for a in arrays:
-        h.update(b"-" if a is None else np.ascontiguousarray(a).tobytes())
+        if isinstance(a, tuple):  # a raw bag's robot points: one hull per part
+            h.update(_digest(*a).encode())
+        else:
+            h.update(b"-" if a is None else np.ascontiguousarray(a).tobytes())
     return h.hexdigest()[:16]
 
 
@@ -79,16 +98,21 @@ def read_snapshot(reader: str, path: str) -> tuple[str, Any]:
             value = (config_to_dict(load_run_config(path)) if reader == "config"
                      else load_scenario(path).to_dict())  # fmt: skip
             return "ok", hashlib.sha256(repr(value).encode()).hexdigest()[:16]
-        if not reader.startswith("session"):
+        if not reader.startswith(("session", "raw")):
             from deformap.cloud.io import read_npz, read_pcd, read_ply
 
             read = {"pcd": read_pcd, "ply": read_ply, "npz": read_npz}[reader.split("-")[0]]
             cloud, extras = read(path)
             return "ok", (len(cloud), _digest(cloud.points, cloud.colors,
                                               *[extras[k] for k in sorted(extras)]))  # fmt: skip
-        from deformap.replay import load_session
+        from deformap.replay import load_raw_bag, load_raw_config, load_session
+        from deformap.run import RunConfig
 
-        session = load_session(path)
+        if reader.startswith("raw"):  # as `deformap map BAG` opens it, settings from beside it
+            session = load_raw_bag(path, load_raw_config(Path(path)),
+                                   default_force_n=RunConfig().exploration.force_n)
+        else:
+            session = load_session(path)
         reads: list[Any] = [("obs", _safe(lambda: _digest(session.observation().points)))]
         for i in range(len(session)):
             reads.append((i, _safe(lambda i=i: _press_digest(session.press_observation(i)))))
@@ -126,12 +150,15 @@ def classify(reader: str, kind: str, status: str, got: Any, want: Any) -> str:
         return "same"
     if reader in ("config", "scenario"):  # text a user edits: another valid value is theirs
         return "changed"
-    if reader.startswith("session"):
+    if reader.startswith(("session", "raw")):
         n_got, reads = got
         if any(value == "refused" for _, value in reads):
             changed = [k for (k, v), (_, w) in zip(reads, want[1], strict=False)
                        if v not in ("refused", w)]  # fmt: skip
-            return "clean" if not changed and n_got == want[0] else _session_change(kind, got, want)
+            if not changed and n_got == want[0]:
+                return "clean"
+        if reader.startswith("raw"):
+            return _raw_change(kind)
         return _session_change(kind, got, want)
     # A zip holds a CRC-32 of each member; the member-* mutants forge it to match.
     checksummed = reader == "npz" and not kind.startswith("member-")
@@ -144,6 +171,16 @@ def _session_change(kind: str, got: Any, want: Any) -> str:
     # Files are covered by the manifest; session.yaml is text a user may edit: only a lost poke
     # (a count that disagrees) is then something a check could see.
     if kind != "yaml" or got[0] < want[0]:
+        return "silent"
+    return "changed"
+
+
+def _raw_change(kind: str) -> str:
+    # The bag's chunks and summary carry CRCs and its records lengths: a change from a byte or
+    # record mutant is one they could have caught. A message rewritten with its CRCs made to
+    # match, or a settings YAML a user edits, is other valid data, unless the message's
+    # length changed (the decoder could tell).
+    if kind in STRUCTURAL or not (kind == "yaml" or kind.startswith("message-")):
         return "silent"
     return "changed"
 
@@ -217,6 +254,8 @@ def run(n_mutants: int, seed: int, limit_s: float, work: Path,
             target = work / f"m{index}"
             if reader.startswith("session"):
                 mutate_session(templates[reader], target, kind, rng)
+            elif reader.startswith("raw"):
+                target = mutate_raw(templates[reader], target, kind, rng)
             else:
                 target = target.with_suffix(templates[reader].suffix)
                 data = templates[reader].read_bytes()
@@ -225,7 +264,9 @@ def run(n_mutants: int, seed: int, limit_s: float, work: Path,
             status, got = worker.read(reader, target)
             outcome = classify(reader, kind, status, got, want[reader][1])
             cases.append(Case(reader, kind, outcome, str(got)[:300]))
-            if target.is_dir():
+            if reader.startswith("raw"):
+                shutil.rmtree(target.parent)
+            elif target.is_dir():
                 shutil.rmtree(target)
                 for link in work.glob(f"{target.name}-outside-*"):
                     link.unlink()
@@ -236,42 +277,85 @@ def run(n_mutants: int, seed: int, limit_s: float, work: Path,
     return cases
 
 
+def _count_table(header: list[str], cases: list[Any], group: str, outcome: str,
+                 outcomes: tuple[str, ...], lead: Callable[[list[Any]], list[str]]) -> str:
+    """A markdown table: a row per value of the cases' attribute ``group`` (its name, ``lead``'s
+    cells, the count of each of ``outcomes`` in their attribute ``outcome``), then the row of all
+    (``lead`` of all of them; a "kinds tried" column left empty there)."""
+    rows = ["| " + " | ".join(header) + " |",
+            "|---|" + "|".join("---" if h == "kinds tried" else "---:" for h in header[1:]) + "|"]
+    groups: dict[str, list[Any]] = {}
+    for case in cases:
+        groups.setdefault(getattr(case, group), []).append(case)
+    for name, mine in [*groups.items(), ("**all**", cases)]:
+        n = Counter(getattr(c, outcome) for c in mine)
+        cells = [name, *lead(mine), *(str(n[o]) for o in outcomes)]
+        if name == "**all**" and "kinds tried" in header:
+            cells[header.index("kinds tried")] = ""
+        rows.append("| " + " | ".join(cells) + " |")
+    return "\n".join(rows)
+
+
 def table(cases: list[Case]) -> str:
     """A markdown table: one row per reader, the kinds tried and the count of each outcome."""
-    rows = ["| reader | kinds tried | mutants | clean errors | accepted, same | accepted, changed "
-            "(undetectable) | silently accepted corruptions | tracebacks | hangs |",
-            "|---|---|---:|---:|---:|---:|---:|---:|---:|"]  # fmt: skip
-    for reader in dict.fromkeys(c.reader for c in cases):
-        mine = [c for c in cases if c.reader == reader]
-        n = Counter(c.outcome for c in mine)
-        kinds = ", ".join(dict.fromkeys(c.kind for c in mine))
-        rows.append(f"| {reader} | {kinds} | {len(mine)} | {n['clean']} | {n['same']} | "
-                    f"{n['changed']} | {n['silent']} | {n['traceback']} | {n['hang']} |")  # fmt: skip
-    n = Counter(c.outcome for c in cases)
-    rows.append(f"| **all** | | {len(cases)} | {n['clean']} | {n['same']} | {n['changed']} | "
-                f"{n['silent']} | {n['traceback']} | {n['hang']} |")  # fmt: skip
-    return "\n".join(rows)
+    return _count_table(
+        ["reader", "kinds tried", "mutants", "clean errors", "accepted, same",
+         "accepted, changed (undetectable)", "silently accepted corruptions", "tracebacks",
+         "hangs"], cases, "reader", "outcome",
+        ("clean", "same", "changed", "silent", "traceback", "hang"),
+        lambda mine: [", ".join(dict.fromkeys(c.kind for c in mine)), str(len(mine))])
+
+
+def cli_table(cases: list[Any]) -> str:
+    """A markdown table of command-line mutants: one row per value kind, the options given it
+    and the count of each ending."""
+    return _count_table(
+        ["value kind", "mutants", "options", "clean errors (one line)", "usage errors (parser)",
+         "tracebacks", "hangs", "other endings"],
+        sorted(cases, key=lambda c: c.kind), "kind", "ending",
+        ("clean", "usage", "traceback", "hang", "other"),
+        lambda mine: [str(len(mine)), str(len({c.option for c in mine}))])
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--mutants", type=int, default=3000, help="how many mutants (default 3000)")
+    parser.add_argument("--mutants", type=int, default=3000,
+                        help="how many reader mutants (default 3000; 0: none)")
+    parser.add_argument("--cli-mutants", type=int, default=0,
+                        help="how many command-line mutants, at least (default 0: none; "
+                             "benchmarks/_cli_mutants.py)")
     parser.add_argument("--seed", type=int, default=0, help="seed of the mutants (default 0)")
     parser.add_argument("--limit", type=float, default=10.0,
                         help="seconds a case may take before it counts as a hang (default 10)")
     args = parser.parse_args(argv)
-    if args.mutants < 1 or args.seed < 0 or not args.limit > 0:
-        parser.error("--mutants must be >= 1, --seed >= 0 and --limit > 0")
+    if (args.mutants < 0 or args.cli_mutants < 0 or args.mutants + args.cli_mutants < 1
+            or args.seed < 0 or not args.limit > 0):  # fmt: skip
+        parser.error("--mutants and --cli-mutants must be >= 0 and not both 0, --seed >= 0 and "
+                     "--limit > 0")
     logging.disable(logging.WARNING)  # refused pokes are counted, not logged
-    start = time.perf_counter()
-    with tempfile.TemporaryDirectory(prefix="deformap-robustness-") as tmp:
-        cases = run(args.mutants, args.seed, args.limit, Path(tmp))
-    print(table(cases))
-    print(f"\n{len(cases)} mutants (seed {args.seed}) in {time.perf_counter() - start:.0f} s, "
-          f"per-case limit {args.limit:g} s")
-    bad = [c for c in cases if c.outcome in ("traceback", "hang", "silent")]
-    for case in bad[:20]:
-        print(f"{case.outcome}: {case.reader} {case.kind}: {case.detail}")
+    bad: list[str] = []
+    if args.mutants:
+        start = time.perf_counter()
+        with tempfile.TemporaryDirectory(prefix="deformap-robustness-") as tmp:
+            cases = run(args.mutants, args.seed, args.limit, Path(tmp))
+        print(table(cases))
+        print(f"\n{len(cases)} mutants (seed {args.seed}) in {time.perf_counter() - start:.0f} s, "
+              f"per-case limit {args.limit:g} s")
+        bad += [f"{c.outcome}: {c.reader} {c.kind}: {c.detail}" for c in cases
+                if c.outcome in ("traceback", "hang", "silent")]  # fmt: skip
+    if args.cli_mutants:
+        from _cli_mutants import HANG_LIMIT_S, run_cli
+
+        start = time.perf_counter()
+        with tempfile.TemporaryDirectory(prefix="deformap-cli-mutants-") as tmp:
+            cli_cases = run_cli(args.cli_mutants, args.seed, Path(tmp))
+        print(("\n" if args.mutants else "") + cli_table(cli_cases))
+        print(f"\n{len(cli_cases)} command-line mutants (seed {args.seed}) in "
+              f"{time.perf_counter() - start:.0f} s, hang limit {HANG_LIMIT_S} s")
+        bad += [f"{c.ending}: {c.option} ({c.kind}): {c.detail}" for c in cli_cases
+                if c.ending in ("traceback", "hang", "other")]  # fmt: skip
+    for line in bad[:20]:
+        print(line)
     return 1 if bad else 0
 
 

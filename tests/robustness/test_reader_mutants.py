@@ -1,33 +1,22 @@
 """Seeded mutants of every reader's input (PCD ascii/binary/compressed, PLY ascii/binary, NPZ, and
-folder and MCAP sessions, the YAML of a run configuration and of a scenario) load to a valid
-result or raise a DeformapError: never another
-exception, never a hang, never a corruption a check could have caught accepted (issue 14).
+folder and MCAP sessions, the YAML of a run configuration and of a scenario, and a raw robot bag
+as ``deformap map BAG`` reads it, with the YAML beside it) load to a valid result or raise a
+DeformapError: never another exception, never a hang, never a corruption a check could have
+caught accepted (issue 14).
 
 The mutants, the per-case time limit and the classification are ``benchmarks/robustness.py``'s,
-which runs thousands of them for the README's table; here a few hundred, each kind ten times.
+which runs thousands of them for the README's table; here a few hundred, every kind of every
+reader in turn (about seven of each).
 """
 
 from __future__ import annotations
 
 import importlib.util
-import sys
 import time
 from pathlib import Path
 from types import ModuleType
 
 import pytest
-
-_BENCH = Path(__file__).resolve().parents[2] / "benchmarks" / "robustness.py"
-
-
-@pytest.fixture(scope="module")
-def bench() -> ModuleType:
-    spec = importlib.util.spec_from_file_location("deformap_bench_robustness", _BENCH)
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module  # dataclasses look their module up
-    spec.loader.exec_module(module)
-    return module
 
 
 def test_every_mutant_is_read_or_cleanly_refused(bench: ModuleType, tmp_path: Path) -> None:
@@ -41,6 +30,9 @@ def test_every_mutant_is_read_or_cleanly_refused(bench: ModuleType, tmp_path: Pa
     readers = {c.reader for c in cases}
     assert {"pcd-ascii", "pcd-binary", "pcd-binary_compressed", "ply-ascii", "ply-binary", "npz",
             "session-folder", "config", "scenario"} <= readers  # fmt: skip
+    if importlib.util.find_spec("mcap_ros2") is not None:
+        raw = [c for c in cases if c.reader == "raw-mcap"]
+        assert {c.kind for c in raw} == set(bench.KINDS["raw"]) and len(raw) >= 40
 
 
 def test_the_classifier_flags_what_it_must(bench: ModuleType) -> None:
@@ -56,6 +48,14 @@ def test_the_classifier_flags_what_it_must(bench: ModuleType) -> None:
     assert bench.classify("session-folder", "file", "ok", changed, full) == "silent"
     refused = (3, (("obs", "o"), (0, "p0"), (1, "refused"), (2, "p2"), ("truth", "t")))
     assert bench.classify("session-folder", "file", "ok", refused, full) == "clean"
+    # a raw bag: its chunks and summary carry CRCs; a message rewritten with its CRCs made to
+    # match is other data, unless its length changed; the settings YAML is the user's
+    assert bench.classify("raw-mcap", "record", "ok", changed, full) == "silent"
+    assert bench.classify("raw-mcap", "flip", "ok", changed, full) == "silent"
+    assert bench.classify("raw-mcap", "message-flip", "ok", changed, full) == "changed"
+    assert bench.classify("raw-mcap", "message-truncate", "ok", changed, full) == "silent"
+    assert bench.classify("raw-mcap", "yaml", "ok", lost, full) == "changed"
+    assert bench.classify("raw-mcap", "flip", "ok", refused, full) == "clean"
     assert bench.read_snapshot("no-such-reader", "x")[0] == "traceback"
 
 

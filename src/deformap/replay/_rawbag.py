@@ -45,6 +45,11 @@ _TF = "tf2_msgs/msg/TFMessage"
 #: noise of the cameras deformap is used with); a frame farther off is left out of the average.
 STILL_M, STILL_RAD = 5e-4, 1e-3
 
+#: The largest force component a wrench message may hold [N]: beyond the range of any
+#: force–torque sensor (the largest read tens of kN), so a larger or non-finite value is a damaged
+#: message, refused before it is squared (a norm of 1e200 N overflows).
+MAX_FORCE_N = 1e6
+
 #: Points of a hull part's circle (cylinder, cap): 16 give a polygon within 2 % of the circle.
 _CIRCLE = 16
 
@@ -157,9 +162,13 @@ class RawBagReader:
         order = np.argsort(np.asarray(w_ns, dtype=np.int64), kind="stable")
         self.wrench_ns = np.asarray(w_ns, dtype=np.int64)[order]
         self.wrench_force = np.asarray(w_force, dtype=np.float64)[order]
-        if not np.isfinite(self.wrench_force).all():
-            raise FileFormatError(f"{self.path}: topic {cfg.wrench_topic!r} holds NaN or "
-                                  "infinite forces")  # fmt: skip
+        bad = ~(np.abs(self.wrench_force) <= MAX_FORCE_N).all(axis=1)  # NaN fails too
+        if bad.any():
+            first = int(order[np.flatnonzero(bad)[0]])
+            raise FileFormatError(
+                f"{self.path} [{cfg.wrench_topic} message {first} of the topic]: force "
+                f"{w_force[first]} N: expected finite components within ±{MAX_FORCE_N:g} N "
+                "(no force sensor reads more: a damaged message)")
         self.cloud_ns = np.asarray(stamps, dtype=np.int64)
 
     def _s(self, stamp_ns: Any) -> str:

@@ -17,7 +17,11 @@ from numpy.typing import NDArray
 
 from deformap.errors import FileFormatError
 
-__all__ = ["TransformGap", "TransformTree"]
+__all__ = ["MAX_TRANSLATION_M", "TransformGap", "TransformTree"]
+
+#: The farthest a transform may move a frame [m]: beyond any robot's frame tree (a map frame in
+#: UTM coordinates holds a few 10⁶ m), so a larger or non-finite translation is a damaged message.
+MAX_TRANSLATION_M = 1e9
 
 
 class TransformGap(FileFormatError):
@@ -67,11 +71,14 @@ class TransformTree:
             q, t = tf.transform.rotation, tf.transform.translation
             quat = (float(q.x), float(q.y), float(q.z), float(q.w))
             trans = (float(t.x), float(t.y), float(t.z))
-            norm = float(np.linalg.norm(quat))
-            if not (np.isfinite(quat).all() and np.isfinite(trans).all()) or abs(norm - 1) > 1e-3:
+            # ranges first (NaN fails them), so that the norm cannot overflow
+            in_range = (all(abs(v) <= 1.0 + 1e-3 for v in quat)
+                        and all(abs(v) <= MAX_TRANSLATION_M for v in trans))  # fmt: skip
+            if not in_range or abs(float(np.linalg.norm(quat)) - 1) > 1e-3:
                 raise FileFormatError(
-                    f"{where}: transform {parent!r} -> {child!r} must be finite with a unit "
-                    f"quaternion; got translation {trans}, quaternion {quat}")
+                    f"{where}: transform {parent!r} -> {child!r} must have a finite translation "
+                    f"within {MAX_TRANSLATION_M:g} m and a unit quaternion; got translation "
+                    f"{trans}, quaternion {quat}")
             edge = self._edges.setdefault(child, _Edge(parent=parent, static=static))
             if edge.parent != parent:
                 raise FileFormatError(

@@ -109,7 +109,9 @@ class RecordedSession:
             raise spec.error
         parts = self._reader.press_parts(spec)
         assert spec.target_xy is not None and spec.force_n is not None  # set when no error
-        where = f"{self.path / SESSION_FILE}: poke {i}"
+        # a raw bag's presses are named from 1, in the bag itself (it has no session.yaml)
+        where = (f"{self.path}: press {i + 1}" if self.form == "raw"
+                 else f"{self.path / SESSION_FILE}: poke {i}")  # fmt: skip
         try:
             contact = TactileContact(tip_center=parts.tip_center, force=parts.force,
                                      tip_radius_m=self.tip_radius_m)  # fmt: skip

@@ -8,9 +8,11 @@ ROS is not needed: rosbags reads and writes the files in pure Python.
 
 from __future__ import annotations
 
+import importlib
 import logging
 import sqlite3
 import struct
+import zlib
 from collections import deque
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
@@ -115,19 +117,33 @@ def bag_read_errors() -> tuple[type[BaseException], ...]:
 
     Recent rosbags read sqlite3 bags through ``apsw`` (its ``CorruptError`` is not a
     ``sqlite3.Error``); a corrupted length field can ask for an absurd allocation (MemoryError).
+    An MCAP chunk's compressed bytes are decompressed before its CRC is checked: damaged, they
+    raise the decompressor's own error (zstd's ``ZstdError``; lz4's is a ``RuntimeError``).
     """
     from rosbags.serde import SerdeError
 
     errors: tuple[type[BaseException], ...] = (
         _rosbag2().ReaderError, SerdeError, sqlite3.Error, OSError, ValueError, KeyError,
         IndexError, TypeError, AssertionError, EOFError, struct.error, MemoryError,
-        OverflowError, UnicodeDecodeError,
+        OverflowError, UnicodeDecodeError, RuntimeError, *_zstd_errors(),
     )  # fmt: skip
     try:
         import apsw
     except ImportError:
         return errors
     return (*errors, apsw.Error)
+
+
+def _zstd_errors() -> tuple[type[BaseException], ...]:
+    """The ``ZstdError`` of the zstd module rosbags decompresses MCAP chunks with (the standard
+    library's from Python 3.14, else ``backports.zstd``), if it is there."""
+    for name in ("compression.zstd", "backports.zstd"):
+        try:
+            module = importlib.import_module(name)
+        except ImportError:
+            continue
+        return (module.ZstdError,)
+    return ()
 
 
 @dataclass(frozen=True)
@@ -183,6 +199,8 @@ def iter_bag_messages(path: Any, topics: Mapping[str, str],
     for topic, msgtype in (optional or {}).items():
         wanted.setdefault(topic, msgtype)
     errors = bag_read_errors()
+    for file in sorted(p.glob("*.mcap")) if p.is_dir() else [p]:
+        check_mcap_crcs(file)
     try:
         with rosbag2.Reader(p) as reader:
             found = sorted({c.topic for c in reader.connections})
@@ -209,6 +227,76 @@ def iter_bag_messages(path: Any, topics: Mapping[str, str],
         raise FileFormatError(
             f"{p}: could not read {what}: {type(exc).__name__}: {str(exc)[:200]}"
         ) from exc
+
+
+_MCAP_MAGIC = b"\x89MCAP0\r\n"
+_FOOTER = struct.Struct("<BQQQI")  # opcode 0x02, length 20, summary start, offsets start, CRC
+_DATA_END = struct.Struct("<BQI")  # opcode 0x0F, length 4, the data section's CRC
+_BLOCK = 1 << 20
+#: MCAP files whose CRCs were verified: (path, size, mtime) → None; a bag is read in passes.
+_VERIFIED: dict[tuple[str, int, int], None] = {}
+
+
+def _crc32(fh: Any, start: int, end: int) -> int:
+    fh.seek(start)
+    crc, left = 0, end - start
+    while left > 0:
+        block = fh.read(min(_BLOCK, left))
+        if not block:
+            break
+        crc, left = zlib.crc32(block, crc), left - len(block)
+    return crc
+
+
+def check_mcap_crcs(path: Path) -> None:
+    """Verify the CRC-32s an MCAP file's writer left in its footer (of the summary section: the
+    schemas, channels, chunk indexes and statistics a reader trusts) and in its ``DataEnd``
+    record (of the whole data section); rosbags checks only each chunk's. A CRC of zero (not
+    written) is not checked, nor is a file that is no MCAP or whose footer is damaged (the
+    reader refuses those itself).
+
+    Raises
+    ------
+    FileFormatError
+        A CRC does not match: one line naming the file, the section and both values.
+    """
+    try:
+        stat = path.stat()
+    except OSError:
+        return
+    key = (str(path.resolve()), stat.st_size, stat.st_mtime_ns)
+    if key in _VERIFIED or stat.st_size < 2 * len(_MCAP_MAGIC) + _FOOTER.size:
+        return
+    footer_at = stat.st_size - len(_MCAP_MAGIC) - _FOOTER.size
+    with path.open("rb") as fh:
+        if fh.read(len(_MCAP_MAGIC)) != _MCAP_MAGIC:
+            return
+        fh.seek(footer_at)
+        tail = fh.read()
+        if tail[-len(_MCAP_MAGIC):] != _MCAP_MAGIC:
+            return
+        opcode, length, summary_at, _, summary_crc = _FOOTER.unpack_from(tail)
+        if opcode != 0x02 or length != 20 or summary_at > footer_at:
+            return
+        summary_start = summary_at or footer_at
+        if summary_crc:
+            # the summary section and the footer up to its CRC field
+            got = zlib.crc32(tail[: _FOOTER.size - 4], _crc32(fh, summary_start, footer_at))
+            if got != summary_crc:
+                raise FileFormatError(
+                    f"{path}: the MCAP summary section (schemas, channels, chunk indexes) fails "
+                    f"its CRC-32: expected {summary_crc:#010x} (the footer's), got {got:#010x}")
+        data_end_at = summary_start - _DATA_END.size
+        if data_end_at >= len(_MCAP_MAGIC):
+            fh.seek(data_end_at)
+            opcode, length, data_crc = _DATA_END.unpack(fh.read(_DATA_END.size))
+            if opcode == 0x0F and length == 4 and data_crc:
+                got = _crc32(fh, 0, data_end_at)
+                if got != data_crc:
+                    raise FileFormatError(
+                        f"{path}: the MCAP data section fails its CRC-32: expected "
+                        f"{data_crc:#010x} (the DataEnd record's), got {got:#010x}")
+    _VERIFIED[key] = None
 
 
 def _messages(path: Any, topic: str, msgtype: str) -> Iterator[tuple[int, Any]]:
