@@ -237,9 +237,13 @@ def measure_press(obs: PressObservation, index: int, surface: SurfaceModel,
         visible = dent_visible(depth, camera_noise, int(near.sum()), cfg.dent_visible_sigmas)
     est = estimate_beta(roi_xs, roi_ys, rest_z, deformed, anchored, config.shape_matching,
                         height_samples=samples)  # fmt: skip
-    beta_std = float(est.beta_std)
-    # a surface the record reads rigid needs no dent seen: β = 0 is what it measured
-    if visible is False and not (stiffness is not None and stiffness.rigid):
+    beta, beta_std = float(est.beta), float(est.beta_std)
+    rigid = stiffness is not None and stiffness.rigid
+    # a surface the record reads rigid needs no dent seen: β = 0 is what it measured (on the odds
+    # scale, β = 0 is the rigid body itself)
+    if rigid and config.shape_matching.rigid_at_zero:
+        beta = 0.0
+    if visible is False and not rigid:
         beta_std = max(beta_std, UNINFORMED_BETA_STD)
     t3 = time.perf_counter()
     target_xy = obs.target_xy
@@ -249,7 +253,7 @@ def measure_press(obs: PressObservation, index: int, surface: SurfaceModel,
         contact_xy=(float(center[0]), float(center[1])),
         contact=ContactRecord.of(contact),
         force_n=float(obs.force_n),
-        beta=float(est.beta),
+        beta=beta,
         beta_std=beta_std,
         betas=tuple(float(b) for b in np.asarray(est.betas)),
         errors=tuple(float(e) for e in np.asarray(est.errors)),

@@ -15,6 +15,8 @@ DeformationMode = Literal["quadratic", "linear", "rigid"]
 ContactProtocol = Literal["force", "pinned"]
 #: How ``beta_std`` is obtained (see ``ShapeMatchingConfig.uncertainty``).
 UncertaintyMethod = Literal["bootstrap", "tolerance"]
+#: What β = 0 is and where the reference sits (see ``ShapeMatchingConfig.beta_scale``).
+BetaScale = Literal["odds", "reference"]
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -122,6 +124,7 @@ class ShapeMatchingConfig:
     max_iter: int = setting(500, ge=1, le=100_000)
     regularization: float = setting(1e-3, ge=0.0, lt=1.0)
     reference_modulus_pa: float = setting(100e3, gt=0.0)
+    beta_scale: BetaScale = "odds"
     poisson_ratio: float = setting(0.5, ge=-1.0, le=0.5)  # the range of an isotropic solid
     uncertainty: UncertaintyMethod = "bootstrap"
     bootstrap_tile_m: float = setting(0.02, gt=0.0)
@@ -141,6 +144,12 @@ class ShapeMatchingConfig:
     def refines(self) -> bool:
         """Whether the coarse sweep is refined: ``refine`` and ``beta_resolution < 1 / n_beta``."""
         return self.refine and self.beta_resolution < 1.0 / self.n_beta
+
+    @property
+    def rigid_at_zero(self) -> bool:
+        """Whether β = 0 is the rigid body: the force protocol on the ``"odds"`` scale (the
+        pinned protocol has no load to share, and its β keeps the paper's meaning)."""
+        return self.contact == "force" and self.beta_scale == "odds"
 
     @property
     def body_layers(self) -> int:
