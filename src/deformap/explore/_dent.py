@@ -240,9 +240,12 @@ def measure_press(obs: PressObservation, index: int, surface: SurfaceModel,
     beta, beta_std = float(est.beta), float(est.beta_std)
     rigid = stiffness is not None and stiffness.rigid
     # a surface the record reads rigid needs no dent seen: β = 0 is what it measured (on the odds
-    # scale, β = 0 is the rigid body itself)
+    # scale β = 0 is the rigid body itself, and the camera's noise alone, a dent of a few tenths
+    # of a millimetre, would read a small β > 0 with the σ of that noise): β = 0 to the β grid's
+    # resolution, the floor of every β's σ
     if rigid and config.shape_matching.rigid_at_zero:
         beta = 0.0
+        beta_std = config.shape_matching.beta_resolution / np.sqrt(12.0)
     if visible is False and not rigid:
         beta_std = max(beta_std, UNINFORMED_BETA_STD)
     t3 = time.perf_counter()
