@@ -27,7 +27,9 @@
    camera's mean height over the points within two tip radii of the contact, the claimed σ is
    that of a uniform over [0, 1), 1/√12 (:func:`dent_visible`), and the poke says so
    (``PokeRecord.dent_visible``); unless the record read the surface rigid, which is β = 0
-   measured without the camera.
+   measured without the camera: on the ``"odds"`` β scale (``shape_matching.beta_scale``, β = 0
+   the rigid body) such a press reports β = 0 with the β grid's resolution as its σ, whatever
+   the camera's noise makes of the flat dent.
 
 References
 ----------
