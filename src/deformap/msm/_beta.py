@@ -168,9 +168,11 @@ class _Sweep:
 
     def _start(self, beta: float) -> Array | None:
         """Starting positions for ``beta``: its own loosely solved equilibrium, else linear in
-        ``v = 1 / (1 − β)`` through the two nearest solved β (the scale on which the dent
-        deepens, see :func:`_vertex`), or the only one's displacements scaled by the ratio of
-        ``v``; ``None`` (the model's own start) when no β is solved yet."""
+        the dent's amplitude ``v`` (``1 / (1 − β)``, or the odds ``β / (1 − β)`` on the odds
+        scale, :meth:`PokeModel.amplitude`) through the two nearest solved β (the scale on which
+        the dent deepens, see :func:`_vertex`), or the nearest deformed one's displacements
+        scaled by the ratio of ``v`` (the calibration's dent, of amplitude 1, when only the
+        rigid β = 0 is solved); ``None`` (the model's own start) when no β is solved yet."""
         if beta in self._body:
             return self._body[beta]
         if not self._body:
@@ -254,7 +256,8 @@ def _vertex(betas: Array, errors: Array, *, odds: bool = False) -> float:
     The parabola is fitted in ``v = 1 / (1 − β)``: the β-dependent part of the goals stiffens
     the body in proportion to ``1 − β`` (``K_β``'s smallest eigenvalues, see
     :mod:`deformap.msm._linsys`), so the simulated dent deepens, and E changes, about linearly
-    in ``v``; a parabola in β puts the vertex systematically on the rigid side.
+    in ``v``; a parabola in β puts the vertex systematically on the rigid side. With ``odds``
+    (the odds scale, springs ``k / β``) the dent goes as ``v = β / (1 − β)`` instead.
     """
     c = int(np.flatnonzero(errors <= errors.min() + _TIE_M)[0])
     left, right = betas < betas[c], betas > betas[c]

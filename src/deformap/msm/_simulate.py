@@ -153,8 +153,10 @@ def simulate_poke(rest: Any, masses: Any, fixed: Any, contact: TactileContact, b
     at its rest position moved by the observed indentation (contact point minus the rest surface
     under it); no force acts. ``contact="force"``: the force ``contact.force`` is shared by the
     free particles under the tip (:func:`force_weights`) and each particle's spring to its goal
-    has the stiffness ``k`` calibrated so that the β = 0 body dents like an elastic half-space of
-    ``config.reference_modulus_pa`` (:func:`calibrate_stiffness`); softer surfaces need larger β.
+    has the stiffness ``k`` calibrated so that the body of rigid goals dents like an elastic
+    half-space of ``config.reference_modulus_pa`` (:func:`calibrate_stiffness`), divided by β on
+    the ``"odds"`` scale (``config.beta_scale``: β = 0 is rigid, at rest); softer surfaces need
+    larger β.
     Both solve the PBD steady state directly (see :mod:`deformap.msm._poke`).
     """
     cfg = _check_config(config)
