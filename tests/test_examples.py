@@ -36,9 +36,12 @@ DEPTHS_MM = [11.363, 7.158, 4.779, 3.886, 2.764, 0.0]
 TABLE_BETAS = {
     ("pinned", 0, "linear"): [0.00, 0.00, 0.00, 0.00, 0.00, 0.00],
     ("pinned", 0, "quadratic"): [0.00, 0.00, 0.00, 0.00, 0.00, 0.00],
-    ("force", 0, "quadratic"): [0.75, 0.43, 0.00, 0.00, 0.00, 0.00],
-    ("force", 3, "linear"): [0.99, 0.97, 0.93, 0.87, 0.68, 0.00],
-    ("force", 3, "quadratic"): [0.93, 0.86, 0.75, 0.65, 0.38, 0.00],  # the default
+    # the odds β scale (the default since issue 13): the reference scale read 0.75 / 0.43 / 0 /
+    # 0 / 0 (sheet), 0.99 / 0.97 / 0.93 / 0.87 / 0.68 (linear) and 0.93 / 0.86 / 0.75 / 0.65 /
+    # 0.38 (the default) on the foams
+    ("force", 0, "quadratic"): [0.80, 0.64, 0.48, 0.40, 0.29, 0.00],
+    ("force", 3, "linear"): [0.99, 0.97, 0.93, 0.89, 0.77, 0.00],
+    ("force", 3, "quadratic"): [0.94, 0.88, 0.80, 0.75, 0.63, 0.00],  # the default
 }
 
 
@@ -71,8 +74,10 @@ def test_hardness_table_main_prints_every_protocol(
     assert out.count("| 60 | 7.16 |") == 8
 
 
-# hardness 30, 60, 110, 150, 250 N, rigid: tilted, curved surface, off-grid contact, 0.1 mm noise
-ROBUST_BETAS = [0.92, 0.84, 0.69, 0.58, 0.28, 0.00]
+# hardness 30, 60, 110, 150, 250 N, rigid: tilted, curved surface, off-grid contact, 0.1 mm noise;
+# on the odds β scale (the reference scale read 0.92 / 0.84 / 0.69 / 0.58 / 0.28 / 0.00): the
+# rigid board's 0.1 mm of noise now reads as a dent of β 0.01
+ROBUST_BETAS = [0.92, 0.86, 0.77, 0.71, 0.58, 0.01]
 
 
 def test_robustness_runs_as_a_script_and_prints_the_reference_values(
@@ -85,8 +90,10 @@ def test_robustness_runs_as_a_script_and_prints_the_reference_values(
     betas = [float(c[1]) for c in cells]
     np.testing.assert_allclose(betas, ROBUST_BETAS, atol=BETA_TOL)
     assert all(a > b for a, b in itertools.pairwise(betas))
-    # the claimed uncertainty grows as the dent gets shallower (the rigid board: resolution only)
+    # the claimed uncertainty grows as the dent gets shallower; the rigid board's, on the odds
+    # scale where β = 0 is rigid and the noise reads as a dent of a few hundredths, is of that
+    # order (it was the resolution only on the reference scale, where β̂ = 0 under any noise)
     stds = [float(c[2]) for c in cells]
-    assert all(a < b for a, b in itertools.pairwise(stds[:-1])) and stds[-1] < 0.01
+    assert all(a <= b for a, b in itertools.pairwise(stds[:-1])) and stds[-1] < 0.05
     # every foam but the softest converges (30 N: β = 0.99 stops at the iteration limit here)
     assert cells[0][3] in ("True", "False") and all(c[3] == "True" for c in cells[1:])

@@ -25,21 +25,23 @@ def _grid(xs, ys, z):
     return ParticleGrid.from_heightmap(xs, ys, z)
 
 
+@pytest.mark.parametrize("scale", ["odds", "reference"])
 @pytest.mark.parametrize("mode", ["linear", "quadratic"])
-def test_force_equilibrium_satisfies_the_pbd_steady_state(mode):
-    # sheet body: the solver's matrix form must agree with the goals computed independently
+def test_force_equilibrium_satisfies_the_pbd_steady_state(mode, scale):
+    # sheet body: the solver's matrix form must agree with the goals computed independently;
+    # on the odds scale the springs of β are k / β (the body carries β times the force)
     xs, ys, z, _, contact = dent_case(60, n=11)
     g = _grid(xs, ys, z)
     betas = np.array([0.0, 0.5, 0.98])
-    cfg = ShapeMatchingConfig(mode=mode, layers=0, tol=1e-10)
+    cfg = ShapeMatchingConfig(mode=mode, layers=0, tol=1e-10, beta_scale=scale)
     sim = simulate_poke(g.rest, g.masses, g.fixed, contact, betas, cfg)
     assert sim.converged.all()
     goals = shape_matching_goals(g.rest, sim.positions, betas, cfg)
     w = force_weights(g.rest, g.fixed, contact, g.spacing_m)
-    want = w[..., None] * contact.force / sim.stiffness_n_per_m
+    share = betas if scale == "odds" else np.ones_like(betas)
+    want = share[:, None, None, None] * (w[..., None] * contact.force / sim.stiffness_n_per_m)
     free = ~g.fixed
-    np.testing.assert_allclose((sim.positions - goals)[:, free], np.broadcast_to(
-        want[free], (3, *want[free].shape)), rtol=0, atol=1e-9)
+    np.testing.assert_allclose((sim.positions - goals)[:, free], want[:, free], rtol=0, atol=1e-9)
     np.testing.assert_array_equal(sim.positions[:, g.fixed], np.broadcast_to(
         g.rest[g.fixed], (3, *g.rest[g.fixed].shape)))
 
@@ -51,7 +53,8 @@ def test_layered_body_equilibrium_satisfies_the_pbd_steady_state():
     xs, ys, z, _, contact = dent_case(60, n=11)
     g = _grid(xs, ys, z)
     betas = np.array([0.0, 0.6, 0.98])
-    cfg = ShapeMatchingConfig(tol=1e-10)  # force, quadratic, 3 layers
+    # force, quadratic, 3 layers; the reference scale (every β carries the whole force)
+    cfg = ShapeMatchingConfig(tol=1e-10, beta_scale="reference")
     sim = simulate_poke(g.rest, g.masses, g.fixed, contact, betas, cfg)
     body, body_m, body_fixed, window = _body(g.rest, g.masses, g.fixed, g.spacing_m, cfg)
     assert body.shape[0] == 4 and np.all(body_fixed[-1]) and window == (2, 3, 3)
@@ -88,15 +91,38 @@ def test_pinned_equilibrium_holds_the_contact_particle_and_relaxes_the_rest():
 
 @pytest.mark.parametrize("mode", ["linear", "quadratic"])
 def test_force_calibration_makes_beta_zero_dent_like_the_reference_half_space(mode):
+    # the reference scale's β = 0 body is the calibrated one
     xs, ys, z, _, contact = dent_case(60, n=13)
     g = _grid(xs, ys, z)
-    cfg = ShapeMatchingConfig(mode=mode)
+    cfg = ShapeMatchingConfig(mode=mode, beta_scale="reference")
     sim = simulate_poke(g.rest, g.masses, g.fixed, contact, np.array([0.0]), cfg)
     w = force_weights(g.rest, g.fixed, contact, g.spacing_m)
     depth = float(np.sum(w * (g.rest[..., 2] - sim.positions[0, ..., 2])))
     want = hertz_indentation(contact.force_n, contact.tip_radius_m, cfg.reference_modulus_pa,
                              cfg.poisson_ratio)
     assert depth == pytest.approx(want, rel=2e-3)
+
+
+def test_odds_scale_is_rigid_at_zero_and_the_reference_body_times_beta():
+    # springs k / β with the reference scale's calibrated k: β = 0 is the rest shape exactly (a
+    # rigid body), and each β's dent is β times the reference body's at that β (a linear body
+    # carrying β times the force; the geometric non-linearity of a 1–4 mm dent is small), so the
+    # dent's depth runs from 0 to the reference's at the odds β / (1 − β) = 1 and beyond
+    xs, ys, z, _, contact = dent_case(60, n=13)
+    g = _grid(xs, ys, z)
+    betas = np.array([0.0, 0.1, 0.5, 0.9])
+    odds = simulate_poke(g.rest, g.masses, g.fixed, contact, betas,
+                         ShapeMatchingConfig(beta_scale="odds"))
+    ref = simulate_poke(g.rest, g.masses, g.fixed, contact, betas,
+                        ShapeMatchingConfig(beta_scale="reference"))
+    assert odds.stiffness_n_per_m == ref.stiffness_n_per_m
+    assert odds.converged.all() and odds.iterations[0] == 0
+    np.testing.assert_array_equal(odds.positions[0], g.rest)
+    w = force_weights(g.rest, g.fixed, contact, g.spacing_m)
+    d_odds = np.sum(w * (g.rest[..., 2] - odds.positions[..., 2]), axis=(1, 2))
+    d_ref = np.sum(w * (g.rest[..., 2] - ref.positions[..., 2]), axis=(1, 2))
+    np.testing.assert_allclose(d_odds[1:], betas[1:] * d_ref[1:], rtol=0.02)
+    assert np.all(np.diff(d_odds) > 0)
 
 
 def test_force_dent_deepens_with_beta_and_converges_fast_near_one():

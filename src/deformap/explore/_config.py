@@ -34,12 +34,17 @@ Its length scale (1 cm) is the tip's radius: the dent cannot vary faster than th
 β-field ("GPR β-field"): prior standard deviation 0.3 (variance 0.09, above the paper's threshold
 0.06 so that the unexplored map asks for a poke); length scale 0.2 m, a third of the table's width:
 the size of the foam pieces a robot is asked to tell apart; each poke's β uncertainty is its noise,
-with a floor of 0.03. That uncertainty is the camera's noise (measured in each poke's ROI)
+with a floor of 0.015. That uncertainty is the camera's noise (measured in each poke's ROI)
 carried through the estimate (``TouchGPConfig.noise_samples`` draws of the touch GP's smoother
 applied to noise, β̂ re-read on each, :mod:`deformap.explore._dent_noise`): a repeatability, which
 the README ("β separates hardness only under the force-driven protocol") compares with the spread
 of β̂ between places on one block. The floor stands for what the camera's noise does not explain
-(the rest of that spread, largest on the hard foams).
+(the rest of that spread, largest on the hard foams): the spread between places on the 150 N
+foam, 0.015 on the default odds β scale (``ShapeMatchingConfig.beta_scale``; 0.015 / 0.017 with
+the PrimeSense / Kinect-v1 presets, three places) and 0.03 on the former reference scale (0.031
+over eight places), which squeezed the foams less (30–250 N at 0.91–0.37 there, 0.91–0.63 on the
+odds scale, which also spans the stiffer surfaces to rigid); with ``beta_scale: reference`` set
+``beta_field.noise_floor: 0.03`` to reproduce the former maps.
 Modulus field (``ExplorationConfig.field = "modulus"``, :mod:`deformap.explore._modulus`): a
 Gaussian random field over ln E [ln Pa] from the pokes' force–travel records. Its prior standard
 deviation 1.73 is a quarter of ln(10⁶ Pa / 10³ Pa) = 6.9: the soft foams to rubbers a table-top
@@ -216,7 +221,7 @@ class BetaFieldConfig:
 
     signal_std: float = setting(0.3, gt=0.0)
     length_scale_m: float = setting(0.2, gt=0.0)
-    noise_floor: float = setting(0.03, gt=0.0)
+    noise_floor: float = setting(0.015, gt=0.0)
 
     def __post_init__(self) -> None:
         check_settings(self)

@@ -27,7 +27,9 @@
    camera's mean height over the points within two tip radii of the contact, the claimed σ is
    that of a uniform over [0, 1), 1/√12 (:func:`dent_visible`), and the poke says so
    (``PokeRecord.dent_visible``); unless the record read the surface rigid, which is β = 0
-   measured without the camera.
+   measured without the camera: on the ``"odds"`` β scale (``shape_matching.beta_scale``, β = 0
+   the rigid body) such a press reports β = 0 with the β grid's resolution as its σ, whatever
+   the camera's noise makes of the flat dent.
 
 References
 ----------
@@ -237,9 +239,16 @@ def measure_press(obs: PressObservation, index: int, surface: SurfaceModel,
         visible = dent_visible(depth, camera_noise, int(near.sum()), cfg.dent_visible_sigmas)
     est = estimate_beta(roi_xs, roi_ys, rest_z, deformed, anchored, config.shape_matching,
                         height_samples=samples)  # fmt: skip
-    beta_std = float(est.beta_std)
-    # a surface the record reads rigid needs no dent seen: β = 0 is what it measured
-    if visible is False and not (stiffness is not None and stiffness.rigid):
+    beta, beta_std = float(est.beta), float(est.beta_std)
+    rigid = stiffness is not None and stiffness.rigid
+    # a surface the record reads rigid needs no dent seen: β = 0 is what it measured (on the odds
+    # scale β = 0 is the rigid body itself, and the camera's noise alone, a dent of a few tenths
+    # of a millimetre, would read a small β > 0 with the σ of that noise): β = 0 to the β grid's
+    # resolution, the floor of every β's σ
+    if rigid and config.shape_matching.rigid_at_zero:
+        beta = 0.0
+        beta_std = config.shape_matching.beta_resolution / np.sqrt(12.0)
+    if visible is False and not rigid:
         beta_std = max(beta_std, UNINFORMED_BETA_STD)
     t3 = time.perf_counter()
     target_xy = obs.target_xy
@@ -249,7 +258,7 @@ def measure_press(obs: PressObservation, index: int, surface: SurfaceModel,
         contact_xy=(float(center[0]), float(center[1])),
         contact=ContactRecord.of(contact),
         force_n=float(obs.force_n),
-        beta=float(est.beta),
+        beta=beta,
         beta_std=beta_std,
         betas=tuple(float(b) for b in np.asarray(est.betas)),
         errors=tuple(float(e) for e in np.asarray(est.errors)),

@@ -168,24 +168,28 @@ class _Sweep:
 
     def _start(self, beta: float) -> Array | None:
         """Starting positions for ``beta``: its own loosely solved equilibrium, else linear in
-        ``v = 1 / (1 − β)`` through the two nearest solved β (the scale on which the dent
-        deepens, see :func:`_vertex`), or the only one's displacements scaled by the ratio of
-        ``v``; ``None`` (the model's own start) when no β is solved yet."""
+        the dent's amplitude ``v`` (``1 / (1 − β)``, or the odds ``β / (1 − β)`` on the odds
+        scale, :meth:`PokeModel.amplitude`) through the two nearest solved β (the scale on which
+        the dent deepens, see :func:`_vertex`), or the nearest deformed one's displacements
+        scaled by the ratio of ``v`` (the calibration's dent, of amplitude 1, when only the
+        rigid β = 0 is solved); ``None`` (the model's own start) when no β is solved yet."""
         if beta in self._body:
             return self._body[beta]
         if not self._body:
             return None
         known = np.fromiter(self._body, dtype=float)
         near = known[np.argsort(np.abs(known - beta), kind="stable")[:2]]
-        v = 1.0 / (1.0 - beta)
-        if near.size == 1:
-            b0 = float(near[0])
-            rest = self.model.clusters.rest
-            return rest + (self._body[b0] - rest) * (v * (1.0 - b0))
-        b0, b1 = float(near[0]), float(near[1])
-        v0, v1 = 1.0 / (1.0 - b0), 1.0 / (1.0 - b1)
-        t = (v - v0) / (v1 - v0)
-        return (1.0 - t) * self._body[b0] + t * self._body[b1]
+        amp = self.model.amplitude
+        rest = self.model.clusters.rest
+        if near.size == 2 and amp(float(near[0])) != amp(float(near[1])):
+            b0, b1 = float(near[0]), float(near[1])
+            t = (amp(beta) - amp(b0)) / (amp(b1) - amp(b0))
+            return (1.0 - t) * self._body[b0] + t * self._body[b1]
+        b0 = float(near[0]) if amp(float(near[0])) > 0.0 else float(known.max())
+        if amp(b0) <= 0.0:  # only the rigid end solved: the calibration's dent, of amplitude 1
+            start = self.model.start
+            return None if start is None else rest + (start[0] - rest) * amp(beta)
+        return rest + (self._body[b0] - rest) * (amp(beta) / amp(b0))
 
     def curve(self) -> tuple[Array, Array, NDArray[np.int64], Array, NDArray[np.bool_], Array]:
         """Sorted β, E(β), iterations, residuals, converged flags and tolerances of every β
@@ -200,7 +204,8 @@ class _Sweep:
         return betas, errors, its, res, conv, tols
 
 
-def _refine(sweep: _Sweep, step: float, resolution: float, tol: float) -> None:
+def _refine(sweep: _Sweep, step: float, resolution: float, tol: float, *,
+            odds: bool = False) -> None:
     """Find the minimum of E on the ``resolution`` grid within one ``step`` of the best swept β.
 
     E(β) is smooth, so there it is unimodal, and a grid point whose two grid neighbours are both
@@ -236,14 +241,14 @@ def _refine(sweep: _Sweep, step: float, resolution: float, tol: float) -> None:
                 return
         known = np.fromiter(sweep.errors, dtype=float)
         errs = np.fromiter(sweep.errors.values(), dtype=float)
-        target = (_vertex(known, errs) - best) / resolution
+        target = (_vertex(known, errs, odds=odds) - best) / resolution
         guess = int(np.clip(round(target), a, b))
         if sweep.solved(key(guess), tol):
             guess = min(missing, key=lambda i: abs(i - target))
         sweep.run(np.array([key(guess)]), tol)
 
 
-def _vertex(betas: Array, errors: Array) -> float:
+def _vertex(betas: Array, errors: Array, *, odds: bool = False) -> float:
     """β of the vertex of the parabola through the lowest of ``errors`` and its nearest
     neighbours in ``betas`` on either side (the three nearest β when one side has none); the
     lowest β itself when that parabola has no minimum.
@@ -251,7 +256,8 @@ def _vertex(betas: Array, errors: Array) -> float:
     The parabola is fitted in ``v = 1 / (1 − β)``: the β-dependent part of the goals stiffens
     the body in proportion to ``1 − β`` (``K_β``'s smallest eigenvalues, see
     :mod:`deformap.msm._linsys`), so the simulated dent deepens, and E changes, about linearly
-    in ``v``; a parabola in β puts the vertex systematically on the rigid side.
+    in ``v``; a parabola in β puts the vertex systematically on the rigid side. With ``odds``
+    (the odds scale, springs ``k / β``) the dent goes as ``v = β / (1 − β)`` instead.
     """
     c = int(np.flatnonzero(errors <= errors.min() + _TIE_M)[0])
     left, right = betas < betas[c], betas > betas[c]
@@ -263,12 +269,15 @@ def _vertex(betas: Array, errors: Array) -> float:
     if len(pick) < 3:
         return float(betas[c])
     order = np.argsort(betas[pick])
-    x = 1.0 / (1.0 - betas[pick][order])
+    b = betas[pick][order]
+    x = (b if odds else 1.0) / (1.0 - b)
     e = errors[pick][order]
     vertex, ok = parabola_vertex(x, e)
     if not ok:
         return float(betas[c])
     v = float(vertex)
+    if odds:
+        return v / (1.0 + v) if v > 0.0 else 0.0
     return float(1.0 - 1.0 / v) if v >= 1.0 else 0.0
 
 
@@ -350,7 +359,7 @@ def estimate_beta(rest_xs: Any, rest_ys: Any, rest_z: Any, deformed_points: Any,
     sweep = _Sweep(model, cKDTree(observed, balanced_tree=False))  # faster queries, same distances
     sweep.run(np.arange(cfg.n_beta) / cfg.n_beta, cfg.coarse_tol)
     if cfg.refines:
-        _refine(sweep, 1.0 / cfg.n_beta, cfg.beta_resolution, cfg.tol)
+        _refine(sweep, 1.0 / cfg.n_beta, cfg.beta_resolution, cfg.tol, odds=model.odds)
     betas, errors, its, res, conv, tols = sweep.curve()
     best = _best_index(errors, tols <= cfg.tol, conv)
     if height_samples is not None:

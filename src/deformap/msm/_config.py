@@ -7,7 +7,7 @@ from typing import Literal
 
 from deformap._validation import SettingError, check_settings, setting
 
-__all__ = ["ContactProtocol", "DeformationMode", "ShapeMatchingConfig", "UncertaintyMethod"]
+__all__ = ["BetaScale", "ContactProtocol", "DeformationMode", "ShapeMatchingConfig", "UncertaintyMethod"]
 
 #: Müller et al.'s deformation modes of a cluster.
 DeformationMode = Literal["quadratic", "linear", "rigid"]
@@ -15,6 +15,8 @@ DeformationMode = Literal["quadratic", "linear", "rigid"]
 ContactProtocol = Literal["force", "pinned"]
 #: How ``beta_std`` is obtained (see ``ShapeMatchingConfig.uncertainty``).
 UncertaintyMethod = Literal["bootstrap", "tolerance"]
+#: What β = 0 is and where the reference sits (see ``ShapeMatchingConfig.beta_scale``).
+BetaScale = Literal["odds", "reference"]
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -71,12 +73,21 @@ class ShapeMatchingConfig:
         deformations exactly reproduced at β = 1.
     reference_modulus_pa : float, pascals
         Force protocol only: the particle spring stiffness ``k`` (N/m) is calibrated per ROI so
-        that at β = 0 the simulated body dents, under the measured force and tip, as deep as an
-        elastic half-space of this Young's modulus (Hertz). 100 kPa lies an order of magnitude
-        above the stiffest polyurethane foams (about 20 kPa for a 250 N hardness) and below
-        rubbers. β̂ reaches 0 well before the reference, by 39 kPa on analytic Hertz dents
-        (:mod:`deformap.msm`, "The β scale's window"): the stiffest polyurethane foams lie near
-        the window's stiff end, and a stiffer reference narrows the soft end instead.
+        that the body of rigid goals (β = 0's goals) with springs ``k`` dents, under the
+        measured force and tip, as deep as an elastic half-space of this Young's modulus
+        (Hertz). 100 kPa lies an order of magnitude above the stiffest polyurethane foams (about
+        20 kPa for a 250 N hardness) and below rubbers. On the ``"reference"`` scale that body is
+        β = 0's; on the ``"odds"`` scale each β's body carries β times the force, and dents β
+        times as deep as the reference scale's body of the same β.
+    beta_scale : {"odds", "reference"}
+        Force protocol only: what β = 0 is. ``"odds"`` (default): each β's springs are ``k /
+        β``, so β = 0 is rigid (the paper's "β close to 0, the object behaves like a rigid
+        body") and the odds β / (1 − β) is the body's compliance against the reference: β reads
+        every stiffness from the softest foam to rigid, with no stiff end short of rigid.
+        ``"reference"``: every β's springs are ``k``, β = 0 is the reference body, and β̂ is 0
+        for every surface whose dent is shallower than about twice the reference's (39 kPa
+        on analytic Hertz dents at 0.6 N; the scale used before issue 13). See
+        :mod:`deformap.msm`, "The β scale".
     poisson_ratio : float
         Poisson ratio of that reference half-space (0.5: nearly incompressible, like solid
         rubber; the value only enters through ``E* = E / (1 − ν²)``).
@@ -122,6 +133,7 @@ class ShapeMatchingConfig:
     max_iter: int = setting(500, ge=1, le=100_000)
     regularization: float = setting(1e-3, ge=0.0, lt=1.0)
     reference_modulus_pa: float = setting(100e3, gt=0.0)
+    beta_scale: BetaScale = "odds"
     poisson_ratio: float = setting(0.5, ge=-1.0, le=0.5)  # the range of an isotropic solid
     uncertainty: UncertaintyMethod = "bootstrap"
     bootstrap_tile_m: float = setting(0.02, gt=0.0)
@@ -141,6 +153,12 @@ class ShapeMatchingConfig:
     def refines(self) -> bool:
         """Whether the coarse sweep is refined: ``refine`` and ``beta_resolution < 1 / n_beta``."""
         return self.refine and self.beta_resolution < 1.0 / self.n_beta
+
+    @property
+    def rigid_at_zero(self) -> bool:
+        """Whether β = 0 is the rigid body: the force protocol on the ``"odds"`` scale (the
+        pinned protocol has no load to share, and its β keeps the paper's meaning)."""
+        return self.contact == "force" and self.beta_scale == "odds"
 
     @property
     def body_layers(self) -> int:

@@ -113,8 +113,12 @@ class Equilibrium:
     """
 
     def __init__(self, clusters: Clusters, fixed: NDArray[np.bool_], betas: Array, *,
-                 system: StepMatrices | None = None, max_split: float = 0.0):
+                 system: StepMatrices | None = None, max_split: float = 0.0,
+                 load_scale: Array | None = None):
         self.cl, self.betas = clusters, np.asarray(betas, dtype=float)
+        # the share of the force each β's body carries (``ShapeMatchingConfig.beta_scale``)
+        self.load_scale = (np.ones_like(self.betas) if load_scale is None
+                           else np.asarray(load_scale, dtype=float))
         self.system = StepMatrices(clusters, fixed) if system is None else system
         self.free, self.fix = self.system.free, self.system.fix
         if self.system.rigid:
@@ -178,7 +182,7 @@ class Equilibrium:
         load = np.take(force, self.free, axis=0) / stiffness
         for j in range(nb):
             self.const[j] = (self.fit_weight[j] * (self.system.fit_const + pull_p)
-                             + pull_w + load)
+                             + pull_w + self.load_scale[j] * load)
         # flat indices: np.take / put on the flattened rows are several times faster than
         # fancy indexing of (n, 3) rows
         flat_free, flat_fix = self.system.flat_free, self.system.flat_fix

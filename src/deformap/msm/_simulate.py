@@ -153,8 +153,10 @@ def simulate_poke(rest: Any, masses: Any, fixed: Any, contact: TactileContact, b
     at its rest position moved by the observed indentation (contact point minus the rest surface
     under it); no force acts. ``contact="force"``: the force ``contact.force`` is shared by the
     free particles under the tip (:func:`force_weights`) and each particle's spring to its goal
-    has the stiffness ``k`` calibrated so that the β = 0 body dents like an elastic half-space of
-    ``config.reference_modulus_pa`` (:func:`calibrate_stiffness`); softer surfaces need larger β.
+    has the stiffness ``k`` calibrated so that the body of rigid goals dents like an elastic
+    half-space of ``config.reference_modulus_pa`` (:func:`calibrate_stiffness`), divided by β on
+    the ``"odds"`` scale (``config.beta_scale``: β = 0 is rigid, at rest); softer surfaces need
+    larger β.
     Both solve the PBD steady state directly (see :mod:`deformap.msm._poke`).
     """
     cfg = _check_config(config)
@@ -188,6 +190,7 @@ class PokeModel:
         if stiffness_n_per_m is not None:
             check_positive("stiffness_n_per_m", stiffness_n_per_m)
         self.cfg = cfg
+        self.odds = cfg.rigid_at_zero
         self.spacing = float(np.mean(np.linalg.norm(np.diff(p0[..., :2], axis=1), axis=-1)))
         near = _check_contact(contact, p0, fx, self.spacing)
         body, body_m, body_fixed, window = _body(p0, m, fx, self.spacing, cfg)
@@ -222,11 +225,22 @@ class PokeModel:
                 self.start = self._calibrated[0]
         self.stiffness = float(stiffness_n_per_m)
 
+    def load_scale(self, betas: Array) -> Array:
+        """The share of the measured force that the body of each β carries: 1, or β under the
+        ``"odds"`` scale (springs of stiffness ``k / β``: β = 0 is rigid)."""
+        b = np.asarray(betas, dtype=float)
+        return b.copy() if self.odds else np.ones_like(b)
+
+    def amplitude(self, beta: float) -> float:
+        """How the dent deepens with β, about: ``1 / (1 − β)``, or the odds ``β / (1 − β)``."""
+        return (beta if self.odds else 1.0) / (1.0 - beta)
+
     def calibrated(self, tol: float) -> tuple[PokeSimulation, Array] | None:
         """The β = 0 equilibrium that the stiffness calibration solved (to ``coarse_tol``), as
         :meth:`solve` would return it, if that is ``tol`` or looser and it converged; else
         ``None``."""
-        if self._calibrated is None or tol < self.cfg.coarse_tol:
+        if (self._calibrated is None or tol < self.cfg.coarse_tol
+                or self.odds):
             return None
         x, it, res, conv = self._calibrated
         if not conv.all():
@@ -248,13 +262,32 @@ class PokeModel:
         ``(B, *body, 3)`` (to warm-start a later solve).
         """
         cfg = self.cfg
-        eq = Equilibrium(self.clusters, self.fixed, betas, system=self.system,
-                         max_split=max_split)
-        k = 1.0 if self.stiffness is None else self.stiffness
-        if x0 is None and self.start is not None:
-            x0 = np.broadcast_to(self.start, (len(betas), *self.start.shape[1:]))
-        x, it, res, conv = eq.solve(self.x_fixed, self.force, k, cfg.tol if tol is None else tol,
-                                    cfg.max_iter, self.spacing, x0=x0)
+        betas = np.asarray(betas, dtype=float)
+        rest = self.clusters.rest
+        x = np.broadcast_to(rest, (len(betas), *rest.shape)).copy()
+        it = np.zeros(len(betas), dtype=np.int64)
+        res = np.zeros(len(betas))
+        conv = np.ones(len(betas), dtype=bool)
+        # on the odds scale β = 0 carries no load: the rigid body at rest, exactly (rest is the
+        # fixed point of rigid goals), which the relative stopping test could not confirm below
+        # round-off
+        moving = self.load_scale(betas) > 0.0 if self.odds else np.ones(len(betas), dtype=bool)
+        if moving.any():
+            sub = betas[moving]
+            if x0 is not None:
+                x0 = np.asarray(x0)[moving]
+            elif self.start is not None and self.odds:
+                # the calibration's dent has amplitude 1 on the odds scale
+                amp = np.array([self.amplitude(float(b)) for b in sub])
+                x0 = rest + (self.start - rest) * amp.reshape(-1, *([1] * rest.ndim))
+            elif self.start is not None:
+                x0 = np.broadcast_to(self.start, (len(sub), *self.start.shape[1:]))
+            eq = Equilibrium(self.clusters, self.fixed, sub, system=self.system,
+                             max_split=max_split, load_scale=self.load_scale(sub))
+            k = 1.0 if self.stiffness is None else self.stiffness
+            x[moving], it[moving], res[moving], conv[moving] = eq.solve(
+                self.x_fixed, self.force, k, cfg.tol if tol is None else tol, cfg.max_iter,
+                self.spacing, x0=x0)
         sim = PokeSimulation(betas=betas, positions=x[:, 0], iterations=it, residual=res,
                              converged=conv, protocol=cfg.contact,
                              stiffness_n_per_m=self.stiffness)
