@@ -39,7 +39,7 @@ _WORLD_COLUMNS = ("physics", "camera", "thickness_m", "force_n")
 _ROW_COLUMNS = ("strategy", "field", "cut", "poke", "purpose", "map_field", "threshold",
                 "accuracy", "mean_iou", "found", "true", "kendall_tau", "modulus_error",
                 "beta_spread", "poke_s", "elapsed_s")  # fmt: skip
-#: Columns of ``runs.csv``: one row per world × strategy × field × poke (a failed world: one row
+#: Columns of ``runs.csv``: one row per world × strategy × field × cut × poke (a failed world: one row
 #: per combination, ``poke`` empty, ``status`` failed with its ``error``).
 CSV_COLUMNS = ("world", "family", *_WORLD_COLUMNS, *_ROW_COLUMNS, "status", "error")
 
