@@ -17,7 +17,8 @@ def test_an_unknown_physics_is_refused_in_one_line_before_any_world(tmp_path: Pa
                                       "--out", str(out)])
     assert result.exit_code != 0
     message = [line for line in result.output.splitlines() if "physics" in line]
-    assert message and "must be one of ['linear-fem', 'stiffening-foam']" in " ".join(message)
+    assert message and ("must be one of ['linear-fem', 'stiffening-foam', 'stiffening-fem']"
+                        in " ".join(message))
     assert "'rubber'" in result.output
     assert not (out / "hardness.json").exists()
 

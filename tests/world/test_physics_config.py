@@ -20,7 +20,8 @@ SQUARE = np.array([[0.0, 0.0], [0.6, 0.0], [0.6, 0.4], [0.0, 0.4]])
 
 
 def test_the_default_physics_is_the_fem_and_older_files_load(tmp_path: Path) -> None:
-    assert WorldConfig().physics == "linear-fem" and PHYSICS == ("linear-fem", "stiffening-foam")
+    assert WorldConfig().physics == "linear-fem"
+    assert PHYSICS == ("linear-fem", "stiffening-foam", "stiffening-fem")
     old = tmp_path / "old.yaml"
     old.write_text("world:\n  element_size_m: 0.01\n")  # written before `physics` existed
     assert load_run_config(old).world.physics == "linear-fem"
@@ -31,8 +32,8 @@ def test_the_default_physics_is_the_fem_and_older_files_load(tmp_path: Path) -> 
 
 
 @pytest.mark.parametrize(("settings", "message"), [
-    ({"physics": "hyperelastic"}, r"`physics` must be one of \['linear-fem', 'stiffening-foam'\]; "
-                                  r"got 'hyperelastic'"),
+    ({"physics": "hyperelastic"}, r"`physics` must be one of \['linear-fem', 'stiffening-foam', "
+                                  r"'stiffening-fem'\]; got 'hyperelastic'"),
     ({"densification_strain": 1.5}, r"`densification_strain` must be <= 1"),
     ({"densification_strain": 0.0}, r"`densification_strain` must be > 0"),
     ({"stiffening_exponent": -1.0}, r"`stiffening_exponent` must be >= 0"),
