@@ -204,7 +204,7 @@ class FoamModel(FoamMesh):
         points, forces = hertz_pressure_samples(center, radius, force_n)
         u = self.zero_displacement()
         claimed = np.zeros(len(points), dtype=bool)
-        for index, body in self.bodies.items():
+        for index in self.bodies:
             grid, off = self.grids[index], self.offsets[index]
             inside, nodes, weights = grid.locate(points)
             inside &= ~claimed

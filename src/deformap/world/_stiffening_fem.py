@@ -279,9 +279,11 @@ class StiffeningFem(FoamModel):
         far, eps = near.predict(force, f.size)
         history: list[tuple[NDArray[np.float64], NDArray[np.float64]]] = []
         steps, residual, rounds, converged = 0, np.inf, 0, False
-        for rounds in range(1, _MAX_ROUNDS + 1):
+        while rounds < _MAX_ROUNDS:
+            rounds += 1
             response = body.solve_free(f - far)
-            eps, taken = self._newton(near.columns.T @ response, near, op, eps)
+            solved, taken = self._newton(near.columns.T @ response, near, op, eps)
+            eps = solved
             steps += taken
             u = response - near.z @ self._law(eps, op, near.elements)
             strain = op.matrix.T @ u
@@ -303,7 +305,7 @@ class StiffeningFem(FoamModel):
         if not converged:
             log.warning("stiffening FEM: the press did not converge in %d rounds (residual "
                         "%.3g N at %.3g N)", _MAX_ROUNDS, residual, force)
-        near.remember(force, far, eps)
+        near.remember(force, far, solved)
         self.last = NewtonSolve(residual_n=residual, rounds=rounds, newton_steps=steps,
                                 near_elements=int(near.elements.size),
                                 max_strain=float(strain.max()), converged=converged)
