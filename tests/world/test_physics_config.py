@@ -1,5 +1,6 @@
 """Choosing the world's physics: settings, configuration files, the budget, and a whole
-exploration and study under the stiffening foam (:mod:`deformap.world._stiffening`)."""
+exploration under each stiffening physics (:mod:`deformap.world._stiffening`,
+:mod:`deformap.world._stiffening_fem`)."""
 
 from __future__ import annotations
 
@@ -62,8 +63,9 @@ def test_the_budget_bounds_the_foundation_grid() -> None:
     check_world_budget(WorldConfig(tip_radius_m=1e-200), scenario)  # the FEM has no such grid
 
 
-def test_a_coarse_world_under_the_stiffening_foam_is_explored_end_to_end() -> None:
-    world = coarse_world("heterogeneous-60-110-rigid", seed=3, physics="stiffening-foam")
+@pytest.mark.parametrize("physics", ["stiffening-foam", "stiffening-fem"])
+def test_a_coarse_world_under_a_stiffening_physics_is_explored_end_to_end(physics) -> None:
+    world = coarse_world("heterogeneous-60-110-rigid", seed=3, physics=physics)
     config = ExplorationConfig(
         max_pokes=2, first_target=(0.1, 0.2),
         surface=SurfaceGPConfig(fit_hyperparameters=False, length_scale_m=0.05),
@@ -71,8 +73,8 @@ def test_a_coarse_world_under_the_stiffening_foam_is_explored_end_to_end() -> No
     result = explore(world, config, rng=np.random.default_rng(0))
     assert len(result.pokes) == 2 and not world.is_pressing
     # the 60 N foam at the first target: a finite modulus of its order (the estimator's contact
-    # model is not this physics', so not its value: see the README for the bias), the rigid
-    # board (x > 0.4) read rigid
+    # model is not these physics', and the coarse mesh's E is far off: see the README), the
+    # rigid board (x > 0.4) read rigid
     first = result.pokes[0].record.stiffness
     assert first is not None and not first.rigid and first.modulus_pa is not None
     true = float(world.ground_truth_modulus(np.array([0.1]), np.array([0.2]))[0, 0])

@@ -1,15 +1,12 @@
 """The world's third contact physics: the FEM of a continuum foam that stiffens as it is compressed,
-solved by Newton's method (:mod:`deformap.world._stiffening_fem`), on the coarse test mesh."""
+solved by Newton's method (:mod:`deformap.world._stiffening_fem`), on the coarse test mesh (its
+exploration through the normal loop: ``tests/world/test_physics_config.py``)."""
 
 from __future__ import annotations
-
-import math
 
 import numpy as np
 import pytest
 
-from deformap.explore import BetaFieldConfig, ExplorationConfig, SurfaceGPConfig, explore
-from deformap.testing import coarse_world
 from deformap.world import Block, Scenario, SimulatedWorld, WorldConfig, hertz_pressure_samples
 from deformap.world._fem import FoamBody, HexGrid, graded_levels
 from deformap.world._foam import FoamModel
@@ -151,21 +148,3 @@ def test_the_record_is_monotone_deterministic_and_stiffer_than_the_fems() -> Non
     b = _world(seed=4, noise=True).force_travel(CENTER, 0.6)
     assert a is not None and b is not None
     assert np.array_equal(a.travel_m, b.travel_m) and np.array_equal(a.force_n, b.force_n)
-
-
-def test_a_coarse_world_under_the_stiffening_fem_is_explored_end_to_end() -> None:
-    world = coarse_world("heterogeneous-60-110-rigid", seed=3, physics="stiffening-fem")
-    config = ExplorationConfig(
-        max_pokes=2, first_target=(0.1, 0.2),
-        surface=SurfaceGPConfig(fit_hyperparameters=False, length_scale_m=0.05),
-        beta_field=BetaFieldConfig(length_scale_m=0.1))
-    result = explore(world, config, rng=np.random.default_rng(0))
-    assert len(result.pokes) == 2 and not world.is_pressing
-    first = result.pokes[0].record.stiffness
-    assert first is not None and not first.rigid and first.modulus_pa is not None
-    true = float(world.ground_truth_modulus(np.array([0.1]), np.array([0.2]))[0, 0])
-    assert 0.5 * true < first.modulus_pa < 3.0 * true  # of its order: the coarse mesh's E
-    for poke in result.pokes[1:]:
-        assert poke.record.stiffness is not None
-        assert poke.record.stiffness.rigid == bool(poke.xy[0] > 0.4)
-    assert all(math.isfinite(p.record.beta) for p in result.pokes)
