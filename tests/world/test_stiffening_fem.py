@@ -143,6 +143,9 @@ def test_the_record_is_monotone_deterministic_and_stiffer_than_the_fems() -> Non
                          rng=np.random.default_rng(0)).force_travel(CENTER, 0.6)
     assert fem is not None
     assert np.all(record.travel_m[1:] < fem.travel_m[1:])
+    # and without stiffening the world's record is the FEM's, to the bit
+    flat = _world(stiffening_exponent=0.0).force_travel(CENTER, 0.6)
+    assert flat is not None and np.array_equal(flat.travel_m, fem.travel_m)
     # seeded: the same seed gives the same noisy record, bit for bit
     a = _world(seed=4, noise=True).force_travel(CENTER, 0.6)
     b = _world(seed=4, noise=True).force_travel(CENTER, 0.6)

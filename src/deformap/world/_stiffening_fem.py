@@ -51,9 +51,11 @@ the surface conformed to the tip); each patch's equilibrium ``K₀ u + C s(Cᵀu
   1e-8 solve, about 1/400 of the encoders' noise; ``benchmarks/stiffness_physics.py`` cases).
 
 Each target's first solve (the commanded force, the record's top level) sets the near set; the
-record's lower levels warm-start from the level above. The elements are the FEM's own (7.5 mm in
-plane): a strain is an element's mean, so the stiffening a patch smaller than an element feels
-is averaged over it.
+record's lower levels warm-start from the level above. The near sets of the last two targets are
+kept, each ``n`` vectors of the block's unknowns (at most 96 in all: 40 MB on the default
+mesh). The elements are the FEM's own (7.5 mm in plane): a strain is an element's mean, so the
+stiffening a patch smaller than an element feels is averaged over it, and it grows as the mesh
+is refined (README, the third physics).
 
 Range: the law holds while every element's ``ε < ε_d`` (the solve keeps it there: the stress is
 unbounded at ``ε_d``); small strain (no geometric nonlinearity), like the linear FEM, so a dent
