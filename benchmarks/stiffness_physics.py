@@ -4,11 +4,13 @@ misreads because a foam stiffens from what it misreads because the physics is no
 continuum at all.
 
     OMP_NUM_THREADS=1 PYTHONPATH=src python benchmarks/stiffness_physics.py \
-        [--hardness 30 60 110 150 250] [--thickness 0.05] [--force 0.6]
+        [--hardness 30 60 110 150 250] [--thickness 0.05] [--force 0.6] [--physics NAME ...]
 
 Rows: ``linear-fem`` (3-D linear elasticity, the baseline measured in the same run),
 ``stiffening-foam`` with ``stiffening_exponent`` 0 (the Vlasov layer, linear: only its restricted
-kinematics differ from elasticity) and 1 (the default: it also stiffens toward densification).
+kinematics differ from elasticity) and 1 (the default: it also stiffens toward densification), and
+``stiffening-fem`` (the same FEM as ``linear-fem``, of a foam that stiffens toward densification;
+with exponent 0 it is ``linear-fem`` exactly, so its row is the stiffening's effect alone).
 Each foam is a block over the default workspace, pressed once at its centre with every noise
 source off; the record is read by ``deformap.explore.estimate_stiffness`` against the world's own
 small-strain modulus.
@@ -26,7 +28,8 @@ from deformap.errors import InvalidArgumentError
 from deformap.explore import estimate_stiffness
 from deformap.world import SimulatedWorld, WorldConfig
 
-CASES = (("linear-fem", 1.0), ("stiffening-foam", 0.0), ("stiffening-foam", 1.0))
+CASES = (("linear-fem", 1.0), ("stiffening-foam", 0.0), ("stiffening-foam", 1.0),
+         ("stiffening-fem", 1.0))
 
 
 def block_world(hardness_n: float, thickness_m: float, physics: str,
@@ -43,10 +46,14 @@ def main() -> None:
                         default=[30.0, 60.0, 110.0, 150.0, 250.0])
     parser.add_argument("--thickness", type=float, default=0.05)
     parser.add_argument("--force", type=float, default=0.6)
+    parser.add_argument("--physics", nargs="+", default=sorted({p for p, _ in CASES}),
+                        help="Only the rows of these physics.")
     args = parser.parse_args()
     print(f"{'physics':>16} {'exponent':>8} {'foam [N]':>8} {'depth [mm]':>10} "
           f"{'E read [kPa]':>12} {'world E [kPa]':>13} {'error':>7} {'build+press [s]':>15}")
     for physics, exponent in CASES:
+        if physics not in args.physics:
+            continue
         for hardness in args.hardness:
             start = time.perf_counter()
             world = block_world(hardness, args.thickness, physics, exponent)

@@ -1,4 +1,4 @@
-"""`deformap study hardness --physics`: the study under the world's second contact physics."""
+"""`deformap study hardness --physics`: the study under the world's stiffening physics."""
 
 from __future__ import annotations
 
@@ -17,22 +17,24 @@ def test_an_unknown_physics_is_refused_in_one_line_before_any_world(tmp_path: Pa
                                       "--out", str(out)])
     assert result.exit_code != 0
     message = [line for line in result.output.splitlines() if "physics" in line]
-    assert message and "must be one of ['linear-fem', 'stiffening-foam']" in " ".join(message)
+    assert message and ("must be one of ['linear-fem', 'stiffening-foam', 'stiffening-fem']"
+                        in " ".join(message))
     assert "'rubber'" in result.output
     assert not (out / "hardness.json").exists()
 
 
 @pytest.mark.slow
-def test_the_study_runs_under_the_stiffening_foam(tmp_path: Path) -> None:
+@pytest.mark.parametrize("physics", ["stiffening-foam", "stiffening-fem"])
+def test_the_study_runs_under_a_stiffening_physics(tmp_path: Path, physics: str) -> None:
     out = tmp_path / "study"
-    result = CliRunner().invoke(app, ["study", "hardness", "--coarse", "--physics",
-                                      "stiffening-foam", "--hardness", "60", "--out", str(out)])
+    result = CliRunner().invoke(app, ["study", "hardness", "--coarse", "--physics", physics,
+                                      "--hardness", "60", "--out", str(out)])
     assert result.exit_code == 0, (result.output, result.exception)
-    assert "stiffening-foam" in result.output
+    assert physics in result.output
     study = json.loads((out / "hardness.json").read_text())
-    assert study["physics"] == "stiffening-foam"
+    assert study["physics"] == physics
     rows = [r for r in study["rows"] if r["protocol"] == "force/quadratic"]
-    assert all(r["physics"] == "stiffening-foam" for r in study["rows"])
+    assert all(r["physics"] == physics for r in study["rows"])
     soft, rigid = rows
     assert soft["modulus_pa"] > 0 and not soft["rigid"] and rigid["rigid"]
     assert soft["true_modulus_pa"] > 0 and rigid["true_modulus_pa"] is None

@@ -45,6 +45,8 @@ def test_worlds_take_the_families_in_turn_and_are_drawn_from_seed_and_index() ->
     assert draw_world(7, 3, ("stripes",)).family == "stripes"
     assert {draw_world(7, i, physics=("stiffening-foam",)).physics for i in range(4)} == {
         "stiffening-foam"}
+    assert {draw_world(7, i, physics=("stiffening-fem",)).physics for i in range(4)} == {
+        "stiffening-fem"}
     json.dumps(draws[0].summary())  # plain data
 
 

@@ -1,5 +1,6 @@
 """Choosing the world's physics: settings, configuration files, the budget, and a whole
-exploration and study under the stiffening foam (:mod:`deformap.world._stiffening`)."""
+exploration under each stiffening physics (:mod:`deformap.world._stiffening`,
+:mod:`deformap.world._stiffening_fem`)."""
 
 from __future__ import annotations
 
@@ -20,7 +21,8 @@ SQUARE = np.array([[0.0, 0.0], [0.6, 0.0], [0.6, 0.4], [0.0, 0.4]])
 
 
 def test_the_default_physics_is_the_fem_and_older_files_load(tmp_path: Path) -> None:
-    assert WorldConfig().physics == "linear-fem" and PHYSICS == ("linear-fem", "stiffening-foam")
+    assert WorldConfig().physics == "linear-fem"
+    assert PHYSICS == ("linear-fem", "stiffening-foam", "stiffening-fem")
     old = tmp_path / "old.yaml"
     old.write_text("world:\n  element_size_m: 0.01\n")  # written before `physics` existed
     assert load_run_config(old).world.physics == "linear-fem"
@@ -31,8 +33,8 @@ def test_the_default_physics_is_the_fem_and_older_files_load(tmp_path: Path) -> 
 
 
 @pytest.mark.parametrize(("settings", "message"), [
-    ({"physics": "hyperelastic"}, r"`physics` must be one of \['linear-fem', 'stiffening-foam'\]; "
-                                  r"got 'hyperelastic'"),
+    ({"physics": "hyperelastic"}, r"`physics` must be one of \['linear-fem', 'stiffening-foam', "
+                                  r"'stiffening-fem'\]; got 'hyperelastic'"),
     ({"densification_strain": 1.5}, r"`densification_strain` must be <= 1"),
     ({"densification_strain": 0.0}, r"`densification_strain` must be > 0"),
     ({"stiffening_exponent": -1.0}, r"`stiffening_exponent` must be >= 0"),
@@ -61,8 +63,9 @@ def test_the_budget_bounds_the_foundation_grid() -> None:
     check_world_budget(WorldConfig(tip_radius_m=1e-200), scenario)  # the FEM has no such grid
 
 
-def test_a_coarse_world_under_the_stiffening_foam_is_explored_end_to_end() -> None:
-    world = coarse_world("heterogeneous-60-110-rigid", seed=3, physics="stiffening-foam")
+@pytest.mark.parametrize("physics", ["stiffening-foam", "stiffening-fem"])
+def test_a_coarse_world_under_a_stiffening_physics_is_explored_end_to_end(physics) -> None:
+    world = coarse_world("heterogeneous-60-110-rigid", seed=3, physics=physics)
     config = ExplorationConfig(
         max_pokes=2, first_target=(0.1, 0.2),
         surface=SurfaceGPConfig(fit_hyperparameters=False, length_scale_m=0.05),
@@ -70,8 +73,8 @@ def test_a_coarse_world_under_the_stiffening_foam_is_explored_end_to_end() -> No
     result = explore(world, config, rng=np.random.default_rng(0))
     assert len(result.pokes) == 2 and not world.is_pressing
     # the 60 N foam at the first target: a finite modulus of its order (the estimator's contact
-    # model is not this physics', so not its value: see the README for the bias), the rigid
-    # board (x > 0.4) read rigid
+    # model is not these physics', and the coarse mesh's E is far off: see the README), the
+    # rigid board (x > 0.4) read rigid
     first = result.pokes[0].record.stiffness
     assert first is not None and not first.rigid and first.modulus_pa is not None
     true = float(world.ground_truth_modulus(np.array([0.1]), np.array([0.2]))[0, 0])

@@ -166,7 +166,8 @@ def bench_worlds_command(
     strategies: NamesOption = None,
     fields: NamesOption = None,
     physics: Annotated[list[str] | None, typer.Option(
-        help="World physics drawn from (linear-fem, stiffening-foam); default: both.",
+        help="World physics drawn from (linear-fem, stiffening-foam, stiffening-fem); "
+             "default: all.",
         show_default=False)] = None,
     cuts: Annotated[list[str] | None, typer.Option(
         "--cuts", "--cut",

@@ -66,13 +66,13 @@ def study_hardness(
     ] = None,
     force: Annotated[float | None, typer.Option(help="Press force in N (default 0.6).")] = None,
     physics: Annotated[
-        str | None, typer.Option(help="World physics: linear-fem | stiffening-foam "
-                                 "(`world.physics`; default linear-fem; with --full, the "
-                                 "matrix's only physics).")
+        str | None, typer.Option(help="World physics: linear-fem | stiffening-foam | "
+                                 "stiffening-fem (`world.physics`; default linear-fem; with "
+                                 "--full, the matrix's only physics).")
     ] = None,
     full: Annotated[
         bool, typer.Option(help="The whole matrix: every camera preset × thickness 0.03, 0.05, "
-                           "0.10 m × both physics; --camera, --thickness or --physics given "
+                           "0.10 m × every physics; --camera, --thickness or --physics given "
                            "pins that axis.")
     ] = False,
     protocol: Annotated[

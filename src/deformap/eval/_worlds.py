@@ -5,7 +5,7 @@ the ``index``-th of the families asked for, in turn (so any run of ``n`` worlds 
 evenly), and the rest is drawn from ``numpy.random.SeedSequence([seed, index])``: the layout and
 its materials (:func:`deformap.world.random_scenario`, hardness over 30–250 N, the hardness study's
 range, issue 13; one material rigid with probability 1/4), and the axes of the stiffness issue:
-the world's physics (either of :data:`deformap.world.PHYSICS`), camera (every preset of
+the world's physics (any of :data:`deformap.world.PHYSICS`), camera (every preset of
 :data:`deformap.world.CAMERA_PRESETS`), block thickness (:data:`THICKNESSES_M`, the hardness
 study's matrix) and press force (:data:`FORCES_N`).
 

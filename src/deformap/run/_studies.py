@@ -34,7 +34,7 @@ from deformap.eval import (
 from deformap.explore import ExplorationConfig
 from deformap.run._folder import create_run_folder, default_run_folder, write_json
 from deformap.run._hooks import NO_HOOKS, RunHooks, RunStart
-from deformap.world import MIN_RECORD_FORCE_N, Physics, WorldConfig, camera_preset
+from deformap.world import MIN_RECORD_FORCE_N, PHYSICS, Physics, WorldConfig, camera_preset
 
 __all__ = [
     "CLUSTER_SIZE_FOAMS",
@@ -51,9 +51,9 @@ CLUSTER_SIZE_FOAMS: tuple[float, ...] = (60.0, 110.0, 150.0)
 
 FULL_CAMERAS: tuple[str, ...] = ("primesense", "kinect-v1", "realsense-d435")
 FULL_THICKNESSES_M: tuple[float, ...] = (0.03, 0.05, 0.10)
-FULL_PHYSICS: tuple[str, ...] = ("linear-fem", "stiffening-foam")
+FULL_PHYSICS: tuple[str, ...] = PHYSICS
 """The matrix of ``deformap study hardness --full`` (issue 13): every camera preset × three foam
-thicknesses × both physics of the world."""
+thicknesses × every physics of the world (:data:`deformap.world.PHYSICS`)."""
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -3,7 +3,8 @@
 It implements :class:`deformap.environment.Environment` and never imports the estimator
 (``msm``, ``gp``, ``explore``): its ground truth is linear elasticity solved by finite elements,
 or (``WorldConfig(physics="stiffening-foam")``) a foam layer that stiffens as it is compressed,
-a two-parameter foundation solved by Newton's method.
+a two-parameter foundation solved by Newton's method, or (``physics="stiffening-fem"``) the
+finite elements of a continuum foam that stiffens as it is compressed, solved by Newton's method.
 Hertz contact and the hardness–modulus conversion live in :mod:`deformap.mechanics` (shared with
 the estimator, part of neither) and are re-exported here.
 

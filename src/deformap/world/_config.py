@@ -16,10 +16,11 @@ from deformap.world._stiffening import max_grid_nodes
 
 __all__ = ["MAX_FEM_UNKNOWNS", "PHYSICS", "Physics", "WorldConfig", "check_world_budget"]
 
-#: The world's contact physics: 3-D linear elasticity by FEM (:mod:`deformap.world._foam`), or a
+#: The world's contact physics: 3-D linear elasticity by FEM (:mod:`deformap.world._foam`), a
 #: stiffening two-parameter foundation solved by Newton's method
-#: (:mod:`deformap.world._stiffening`).
-Physics = Literal["linear-fem", "stiffening-foam"]
+#: (:mod:`deformap.world._stiffening`), or the FEM of a continuum foam that stiffens as it is
+#: compressed, solved by Newton's method (:mod:`deformap.world._stiffening_fem`).
+Physics = Literal["linear-fem", "stiffening-foam", "stiffening-fem"]
 PHYSICS: tuple[str, ...] = get_args(Physics)
 
 
@@ -29,15 +30,18 @@ class WorldConfig:
 
     Parameters
     ----------
-    physics : {"linear-fem", "stiffening-foam"}
-        How the foam answers a press: linear elasticity of each block by finite elements, or each
+    physics : {"linear-fem", "stiffening-foam", "stiffening-fem"}
+        How the foam answers a press: linear elasticity of each block by finite elements; each
         block as a foam layer that stiffens toward densification, a two-parameter foundation
-        whose contact with the tip is solved by Newton's method (:mod:`deformap.world._stiffening`).
-        Either way a block's ``modulus_pa`` is its small-strain Young's modulus.
+        whose contact with the tip is solved by Newton's method (:mod:`deformap.world._stiffening`);
+        or the same finite elements of a continuum foam whose volumetric response stiffens
+        toward densification, solved by Newton's method (:mod:`deformap.world._stiffening_fem`).
+        Every way a block's ``modulus_pa`` is its small-strain Young's modulus.
     densification_strain, stiffening_exponent : float
-        The stiffening foam's column law ``σ = M ε / (1 − ε / ε_d)^m`` (``stiffening-foam`` only):
-        ``ε_d`` from Gibson & Ashby's ``1 − 1.4 ρ*/ρ_s`` at a relative density of 0.035 (a
-        flexible polyurethane foam), ``m = 1`` their densification fit; ``m = 0`` is linear.
+        The stiffening column law ``σ = M ε / (1 − ε / ε_d)^m`` (the stiffening physics only:
+        the layer's compression, the continuum foam's under confined compression): ``ε_d`` from
+        Gibson & Ashby's ``1 − 1.4 ρ*/ρ_s`` at a relative density of 0.035 (a flexible
+        polyurethane foam), ``m = 1`` their densification fit; ``m = 0`` is linear.
     element_size_m : float
         In-plane size of the foam's hexahedra. 7.5 mm resolves the dent of the 1 cm tip (the
         press's compliance converges at second order under refinement,
@@ -55,7 +59,7 @@ class WorldConfig:
     force_travel_levels : int
         Load levels of the press's force–travel record above contact: it has this many plus one
         samples, evenly spaced in force from ``contact_threshold_n`` to the commanded force, each
-        solved by the FEM (see :mod:`deformap.world._force_travel`).
+        solved by the world's physics (see :mod:`deformap.world._force_travel`).
     contact_threshold_n : float
         The force at which the probe detects contact: the record's first sample, where its
         travel starts. Presses at less than :data:`MIN_RECORD_FORCE_N` give no record.

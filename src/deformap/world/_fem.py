@@ -243,8 +243,10 @@ class FoamBody:
         """Number of free displacement unknowns."""
         return int(self.free.size)
 
-    def _element_dofs(self, k: int
-                      ) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64]]:
+    def element_dofs(self, k: int
+                     ) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64]]:
+        """The hexes of layer ``k`` (active columns): ``(m, 24)`` DOF ids (``3 node + component``,
+        corners in the order of :func:`unit_hex_stiffness`) and their column indices ``jj, ii``."""
         g = self.grid
         jj, ii = np.nonzero(g.active)
         nodes = np.column_stack([g.node_id(ii + c[0], jj + c[1], np.full_like(ii, k + c[2]))
@@ -259,7 +261,7 @@ class FoamBody:
         for k in range(g.nz):
             ke = unit_hex_stiffness(g.dx, g.dy, float(g.levels[k + 1] - g.levels[k]),
                                     self.poisson_ratio)
-            dofs, jj, ii = self._element_dofs(k)
+            dofs, jj, ii = self.element_dofs(k)
             vals = modulus[k, jj, ii][:, None] * ke.ravel()[None, :]
             rows = np.repeat(dofs, 24, axis=1).ravel()
             cols = np.tile(dofs, (1, 24)).ravel()
@@ -270,7 +272,7 @@ class FoamBody:
         g = self.grid
         used = np.zeros(g.n_nodes, dtype=bool)
         for k in range(g.nz):
-            used[self._element_dofs(k)[0][:, ::3] // 3] = True
+            used[self.element_dofs(k)[0][:, ::3] // 3] = True
         xyz = g.node_xyz()
         fixed = np.zeros((g.n_nodes, 3), dtype=bool)
         fixed[~used] = True
@@ -281,8 +283,13 @@ class FoamBody:
             fixed[np.isclose(xyz[:, 1], g.origin[1]), 1] = True
         return np.flatnonzero(~fixed.ravel())
 
+    def solve_free(self, rhs: NDArray[np.float64]) -> NDArray[np.float64]:
+        """``K⁻¹ rhs`` on the free unknowns: ``rhs`` is ``(n_dofs,)`` or ``(n_dofs, k)`` (``k``
+        right-hand sides in one call) in the order of :attr:`free`."""
+        return np.asarray(self._lu.solve(np.ascontiguousarray(rhs, dtype=float))) * self._scale
+
     def solve(self, nodal_force: NDArray[np.float64]) -> NDArray[np.float64]:
         """``(n_nodes, 3)`` displacements in metres for ``(n_nodes, 3)`` nodal forces in newtons."""
         u = np.zeros(3 * self.grid.n_nodes)
-        u[self.free] = self._lu.solve(nodal_force.ravel()[self.free]) * self._scale
+        u[self.free] = self.solve_free(nodal_force.ravel()[self.free])
         return u.reshape(-1, 3)

@@ -227,7 +227,7 @@ class FoamModel(FoamMesh):
         points, forces = hertz_pressure_samples(center, radius, force_n)
         u = self.zero_displacement()
         claimed = np.zeros(len(points), dtype=bool)
-        for index, body in self.bodies.items():
+        for index in self.bodies:
             grid, off = self.grids[index], self.offsets[index]
             inside, nodes, weights = grid.locate(points)
             inside &= ~claimed
@@ -237,5 +237,11 @@ class FoamModel(FoamMesh):
             load = np.zeros((grid.n_nodes, 3))
             np.add.at(load[:, 2], nodes[inside].ravel(),
                       -(weights[inside] * forces[inside, None]).ravel())
-            u[off:off + grid.n_nodes] = body.solve(load)
+            u[off:off + grid.n_nodes] = self._respond(index, load, center)
         return u, points, forces
+
+    def _respond(self, index: int, load: NDArray[np.float64], center: NDArray[np.float64]
+                 ) -> NDArray[np.float64]:
+        """``(n_nodes, 3)`` displacement of block ``index`` under ``(n_nodes, 3)`` nodal forces
+        centred at ``center`` (linear: one solve; a nonlinear material overrides it)."""
+        return self.bodies[index].solve(load)

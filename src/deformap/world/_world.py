@@ -3,9 +3,11 @@
 Physics
 -------
 ``WorldConfig.physics`` picks how the foam answers a press: 3-D linear elasticity by FEM
-(:mod:`deformap.world._foam`, the default) or a stiffening two-parameter foundation solved by
-Newton's method (:mod:`deformap.world._stiffening`). Both displace the same hexahedral mesh, which
-is what the camera sees, and both give the press's depth for the force–travel record.
+(:mod:`deformap.world._foam`, the default), a stiffening two-parameter foundation solved by
+Newton's method (:mod:`deformap.world._stiffening`), or the FEM of a continuum foam that stiffens
+as it is compressed, solved by Newton's method (:mod:`deformap.world._stiffening_fem`). All
+displace the same hexahedral mesh, which is what the camera sees, and all give the press's depth
+for the force–travel record.
 
 Press force
 -----------
@@ -59,6 +61,7 @@ from deformap.world._foam import Dent, FoamModel
 from deformap.world._force_travel import force_levels, simulated_force_travel
 from deformap.world._scenario import BARE_TABLE, Block, Scenario
 from deformap.world._stiffening import StiffeningFoam
+from deformap.world._stiffening_fem import StiffeningFem
 
 __all__ = ["MIN_RECORD_FORCE_N", "SimulatedWorld"]
 
@@ -104,11 +107,17 @@ class SimulatedWorld:
         self._noise_key = int(rng.integers(2**62))
         self._n_observed = 0
         c = self.config
-        self.foam: FoamModel | StiffeningFoam
+        self.foam: FoamModel | StiffeningFoam  # StiffeningFem is a FoamModel
         if c.physics == "linear-fem":
             self.foam = FoamModel(scenario, element_size_m=c.element_size_m,
                                   top_layer_m=c.top_layer_m, layer_growth=c.layer_growth,
                                   poisson_ratio=c.poisson_ratio)
+        elif c.physics == "stiffening-fem":
+            self.foam = StiffeningFem(
+                scenario, element_size_m=c.element_size_m, top_layer_m=c.top_layer_m,
+                layer_growth=c.layer_growth, poisson_ratio=c.poisson_ratio,
+                densification_strain=c.densification_strain,
+                stiffening_exponent=c.stiffening_exponent)
         else:
             self.foam = StiffeningFoam(
                 scenario, element_size_m=c.element_size_m, top_layer_m=c.top_layer_m,
@@ -164,7 +173,7 @@ class SimulatedWorld:
         return self._pressed
 
     def release(self) -> None:
-        """Lift the probe; the foam springs back (linear elasticity has no memory)."""
+        """Lift the probe; the foam springs back (no physics of the world has memory)."""
         self._pressed = None
         self._displacement = self.foam.zero_displacement()
 
@@ -187,14 +196,15 @@ class SimulatedWorld:
         return self._pressed is not None
 
     def dent(self, target_xy: Any, force_n: float) -> Dent:
-        """The foam's response to a press (FEM or foundation, ``config.physics``), without
+        """The foam's response to a press (``config.physics``: FEM, foundation or stiffening
+        FEM), without
         touching the world's state (no noise).
 
         Raises
         ------
         InvalidArgumentError
             When the tip would sink as deep as the block is thick (a force far too large for
-            the foam, which neither physics models: it would be crushed onto the table).
+            the foam, which no physics of the world models: it would be crushed onto the table).
         """
         target = check_vector("target_xy", target_xy, 2, what="metres")
         force = check_positive("force_n", force_n)

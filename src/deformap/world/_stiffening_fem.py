@@ -1,0 +1,392 @@
+"""A third contact physics: the FEM's foam blocks made of a continuum foam that stiffens as it is
+compressed toward densification, solved by Newton's method
+(``WorldConfig(physics="stiffening-fem")``).
+
+Material
+--------
+A small-strain elastic solid whose volumetric response stiffens toward densification. Each hex
+``e`` of the FEM's mesh (:mod:`deformap.world._fem`) has the strain energy
+
+    W_e(u) = ½ uₑᵀ Kₑ(E₀) uₑ + V_e Φ(ε_e),     Φ'(ε) = M₀ ε [(1 − ε/ε_d)^(−m) − 1]  (ε > 0),
+
+``Kₑ(E₀)`` the linear FEM's element stiffness at the block's small-strain modulus ``E₀``
+(``modulus_pa``, the world's ground truth), ``ε_e = −(1/V_e) ∫ div u dV`` the element's mean
+compressive volumetric strain (linear in its 24 displacements: ``ε_e = cₑ · uₑ``),
+``M₀ = E₀ (1 − ν) / ((1 + ν)(1 − 2ν))`` the constrained modulus, ``ε_d`` the world's
+``densification_strain`` and ``m`` its ``stiffening_exponent``; ``Φ = 0`` in dilatation
+(``ε ≤ 0``). Under confined (uniaxial-strain) compression ``ε`` is the axial strain and the
+stress is the column law ``σ = M₀ ε / (1 − ε/ε_d)^m`` of the ``stiffening-foam`` layer, whose
+tangent is ``M₀ / (1 − ε/ε_d)²`` for ``m = 1``: the stress rises without bound as the cells close
+(Gibson & Ashby 1997, ch. 5: densification at ``ε_d ≈ 1 − 1.4 ρ*/ρ_s``; their ``m = 1`` fit).
+``m = 0`` is the linear FEM exactly.
+
+Why the volumetric strain: densification is the foam's volume falling to its solid's (``ε_d``
+is a volume fraction), so it is the volume change that stiffens, not the shape change; in a
+foam's uniaxial test (lateral expansion about nil past the linear range) the axial strain is the
+volumetric one, and a volumetric term is how hyperelastic foam laws stiffen (Storåkers 1986). It
+is frame-free (no press direction in the law), shear stays at ``G₀ = E₀ / (2 (1 + ν))``, and at
+small strain the material is the linear FEM's (``Φ'' → 0`` as ``ε → 0``). The energy's Hessian,
+the tangent, is ``K₀ + Σ_e V_e Φ''(ε_e) cₑ cₑᵀ``: the linear stiffness plus one rank-one term per
+compressed element, symmetric positive definite and never softer than ``K₀``.
+
+Solve
+-----
+Force control with the FEM's sphere contact (:class:`~deformap.world._foam.FoamModel`: the Hertz
+pressure of the force on a patch of radius ``a``, ``a ← sqrt(a sqrt(R δ))`` until it settles,
+the surface conformed to the tip); each patch's equilibrium ``K₀ u + C s(Cᵀu) = f``
+(``s = V Φ'``) is solved by Newton's method, never refactorising:
+
+- ``K₀`` is factorised once when the world is built (shared by homogeneous blocks of one mesh, as
+  in the FEM).
+- The near set's tangent is exact: the elements the linear press would stiffen by more than 5 %
+  (``Φ'' > 0.05 M₀``), the most compressed first, at most ``near_elements`` (48) and at least 8,
+  as a rank-``n`` update of ``K₀`` (Woodbury): ``Z = K₀⁻¹ C_N`` (``n`` right-hand sides in one
+  solve call, once per press target, kept for every load level and patch of that target)
+  reduces each Newton step to a dense ``n × n`` system.
+- The other elements stiffen by a few per cent at most; their forces enter every residual and
+  are carried by an outer fixed point (Anderson-accelerated), one solve with ``K₀`` a round,
+  each round's Newton solve warm-started from the last. An element outside the near set
+  compressed past ``ε_d / 5`` joins it. A press is converged when the residual over every free
+  unknown is below ``tolerance · F`` (1e-4: the record then moves by at most 1.3e-7 m from a
+  1e-8 solve, about 1/400 of the encoders' noise; ``benchmarks/stiffness_physics.py`` cases).
+
+Each target's first solve (the commanded force, the record's top level) sets the near set; the
+record's lower levels warm-start from the level above. The near sets of the last two targets are
+kept, each ``n`` vectors of the block's unknowns (at most 96 in all: 40 MB on the default
+mesh). The elements are the FEM's own (7.5 mm in plane): a strain is an element's mean, so the
+stiffening a patch smaller than an element feels is averaged over it, and it grows as the mesh
+is refined (README, the third physics).
+
+Range: the law holds while every element's ``ε < ε_d`` (the solve keeps it there: the stress is
+unbounded at ``ε_d``); small strain (no geometric nonlinearity), like the linear FEM, so a dent
+deeper than a fraction of the layer is outside what either models well. The world refuses a
+press that sinks the tip as deep as the block is thick.
+
+References
+----------
+Gibson, L. J., Ashby, M. F. (1997). Cellular Solids: Structure and Properties, 2nd ed., ch. 5.
+Cambridge University Press.
+Storåkers, B. (1986). On material representation and constitutive branching in finite
+compressible elasticity. Journal of the Mechanics and Physics of Solids 34(2), 125–145.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections import OrderedDict
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.sparse as sp
+from numpy.typing import NDArray
+
+from deformap.world._fem import _CORNERS, FoamBody
+from deformap.world._foam import FoamModel
+from deformap.world._scenario import Scenario
+
+__all__ = ["NewtonSolve", "StiffeningFem", "volumetric_stress", "volumetric_tangent"]
+
+log = logging.getLogger(__name__)
+
+_MAX_ROUNDS = 60  # outer rounds (one K₀ solve each) a patch may take
+_MAX_NEWTON = 60  # Newton steps of one round's near-field solve
+_JOIN_STRAIN = 0.2  # a far element past this fraction of ε_d joins the near set
+_TARGETS_KEPT = 2  # near sets (with their K₀⁻¹ C_N) kept, the most recent
+# an element the linear press would stiffen by less than this (Φ'' / M₀) is left to the outer
+# rounds, which then shrink the residual by about as much each; the near set has at least a few
+_NEAR_STIFFENING = 0.05
+_NEAR_LEAST = 8
+
+
+def volumetric_stress(strain: NDArray[np.float64], constrained_pa: NDArray[np.float64], *,
+                      densification: float, exponent: float) -> NDArray[np.float64]:
+    """``Φ'(ε) = M₀ ε [(1 − ε/ε_d)^(−m) − 1]`` for ``ε > 0`` (0 otherwise), in Pa: the stress the
+    stiffening adds to the linear solid's (module docstring); ``inf`` at and past ``ε_d``."""
+    eps = np.maximum(np.asarray(strain, dtype=float), 0.0)
+    x = eps / densification
+    with np.errstate(divide="ignore", invalid="ignore"):
+        out = constrained_pa * eps * (np.power(1.0 - x, -exponent) - 1.0)
+    return np.where(x < 1.0, out, np.inf)
+
+
+def volumetric_tangent(strain: NDArray[np.float64], constrained_pa: NDArray[np.float64], *,
+                       densification: float, exponent: float) -> NDArray[np.float64]:
+    """``Φ''(ε) = M₀ [(1 − x)^(−m) + m x (1 − x)^(−m−1) − 1]``, ``x = ε/ε_d`` (0 for ``ε ≤ 0``):
+    the derivative of :func:`volumetric_stress`, continuous at 0 (where it is 0)."""
+    eps = np.maximum(np.asarray(strain, dtype=float), 0.0)
+    x = eps / densification
+    with np.errstate(divide="ignore", invalid="ignore"):
+        out = constrained_pa * (np.power(1.0 - x, -exponent)
+                                + exponent * x * np.power(1.0 - x, -exponent - 1.0) - 1.0)
+    return np.where(x < 1.0, out, np.inf)
+
+
+@dataclass(frozen=True)
+class _StrainOperator:
+    """One block's elements: ``matrix`` ``(n_free, n_el)`` with column ``e`` the ``cₑ`` of
+    ``ε_e = cₑ · u`` (free unknowns only), volumes [m³] and constrained moduli [Pa]."""
+
+    matrix: sp.csc_matrix
+    volume: NDArray[np.float64]
+    constrained_pa: NDArray[np.float64]
+
+
+def strain_operator(body: FoamBody) -> _StrainOperator:
+    """The element-mean compressive volumetric strain of every hex of ``body``: for a corner
+    ``(ci, cj, ck)`` of a ``dx × dy × dz`` hex, ``∫ ∂N/∂x dV / V = (2 ci − 1) / (4 dx)`` (the
+    divergence theorem on the box), so ``ε = −Σ_c Σ_d (2 c_d − 1) u_{c,d} / (4 Δ_d)``."""
+    g = body.grid
+    nu = body.poisson_ratio
+    rows, cols, vals, volume, modulus = [], [], [], [], []
+    count = 0
+    for k in range(g.nz):
+        dz = float(g.levels[k + 1] - g.levels[k])
+        dofs, jj, ii = body.element_dofs(k)
+        row = -((2 * _CORNERS - 1) / (4 * np.array([g.dx, g.dy, dz]))).ravel()  # (24,)
+        rows.append(dofs.ravel())
+        cols.append(np.repeat(np.arange(count, count + len(ii)), 24))
+        vals.append(np.tile(row, len(ii)))
+        volume.append(np.full(len(ii), g.dx * g.dy * dz))
+        modulus.append(body.modulus[k, jj, ii])
+        count += len(ii)
+    full = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                         shape=(3 * g.n_nodes, count))
+    e = np.concatenate(modulus)
+    return _StrainOperator(matrix=full[body.free].tocsc(), volume=np.concatenate(volume),
+                           constrained_pa=e * (1 - nu) / ((1 + nu) * (1 - 2 * nu)))
+
+
+@dataclass
+class _NearSet:
+    """The elements whose tangent a target's Newton steps take exactly, with ``Z = K₀⁻¹ C_N``
+    and ``G = C_Nᵀ Z``; the target's last solve, to warm-start the next."""
+
+    elements: NDArray[np.int64]
+    columns: sp.csc_matrix  # C_N
+    z: NDArray[np.float64]
+    g: NDArray[np.float64]
+    #: the target's last two solves: (force, far elements' forces, near elements' strains)
+    solved: list[tuple[float, NDArray[np.float64], NDArray[np.float64]]] = field(
+        default_factory=list)
+
+    def predict(self, force: float, size: int
+                ) -> tuple[NDArray[np.float64], NDArray[np.float64] | None]:
+        """A first guess at ``force``: the last solve's far forces and near strains scaled as
+        powers of the force, the powers those of the last two solves (the far forces about as
+        ``F²`` and the strains as ``F`` when there is one: strain ``∝ F``, stress ``∝ ε²``)."""
+        if not self.solved:
+            return np.zeros(size), None
+        f1, far1, eps1 = self.solved[-1]
+        powers = [2.0, 1.0]
+        if len(self.solved) == 2 and not np.isclose(self.solved[0][0], f1):
+            f0, far0, eps0 = self.solved[0]
+            for i, (a, b) in enumerate(((far0, far1), (eps0, eps1))):
+                na, nb = float(np.linalg.norm(a)), float(np.linalg.norm(b))
+                if na > 0.0 and nb > 0.0:
+                    powers[i] = float(np.clip(np.log(nb / na) / np.log(f1 / f0), 0.5, 4.0))
+        return far1 * (force / f1) ** powers[0], eps1 * (force / f1) ** powers[1]
+
+    def remember(self, force: float, far: NDArray[np.float64], eps: NDArray[np.float64]) -> None:
+        if self.solved and np.isclose(self.solved[-1][0], force):
+            self.solved.pop()  # a patch iteration of the same level: keep its settled solve
+        self.solved = [*self.solved[-1:], (force, far, eps)]
+
+
+@dataclass(frozen=True)
+class NewtonSolve:
+    """How one patch's equilibrium was solved: the residual over every free unknown [N], the
+    outer rounds (K₀ solves), the Newton steps over all rounds, the near set's size, and the
+    largest element strain."""
+
+    residual_n: float
+    rounds: int
+    newton_steps: int
+    near_elements: int
+    max_strain: float
+    converged: bool
+
+
+class StiffeningFem(FoamModel):
+    """All foam blocks of a scenario as FEM bodies of the stiffening foam (module docstring).
+
+    Parameters
+    ----------
+    scenario : Scenario
+    element_size_m, top_layer_m, layer_growth, poisson_ratio : float
+        The FEM's mesh and ``ν`` (:class:`~deformap.world._foam.FoamModel`).
+    densification_strain, stiffening_exponent : float
+        ``ε_d`` and ``m`` of the law.
+    near_elements : int
+        Elements whose tangent the Newton steps take exactly.
+    tolerance : float
+        Converged when the residual's norm is below ``tolerance`` times the patch's force.
+    """
+
+    def __init__(self, scenario: Scenario, *, element_size_m: float, top_layer_m: float,
+                 layer_growth: float, poisson_ratio: float, densification_strain: float,
+                 stiffening_exponent: float, near_elements: int = 48,
+                 tolerance: float = 1e-4) -> None:
+        super().__init__(scenario, element_size_m=element_size_m, top_layer_m=top_layer_m,
+                         layer_growth=layer_growth, poisson_ratio=poisson_ratio)
+        self.densification_strain = densification_strain
+        self.stiffening_exponent = stiffening_exponent
+        self.near_elements = near_elements
+        self.tolerance = tolerance
+        self.operators = {index: strain_operator(body) for index, body in self.bodies.items()}
+        self._near: OrderedDict[tuple[int, bytes], _NearSet] = OrderedDict()
+        #: the last patch solve's convergence, for checks
+        self.last: NewtonSolve | None = None
+
+    def _law(self, strain: NDArray[np.float64], op: _StrainOperator, elements: NDArray[np.int64],
+             tangent: bool = False) -> NDArray[np.float64]:
+        """``V Φ'`` (or ``V Φ''``) of ``elements`` at their ``strain``: element forces [N]."""
+        f = volumetric_tangent if tangent else volumetric_stress
+        return op.volume[elements] * f(strain, op.constrained_pa[elements],
+                                       densification=self.densification_strain,
+                                       exponent=self.stiffening_exponent)
+
+    def _respond(self, index: int, load: NDArray[np.float64], center: NDArray[np.float64]
+                 ) -> NDArray[np.float64]:
+        body = self.bodies[index]
+        f = load.ravel()[body.free]
+        force = float(-f.sum())
+        u = np.zeros(3 * body.grid.n_nodes)
+        if self.stiffening_exponent == 0.0 or force <= 0.0:  # the linear FEM's one solve
+            u[body.free] = body.solve_free(f)
+            self.last = NewtonSolve(residual_n=0.0, rounds=1, newton_steps=0, near_elements=0,
+                                    max_strain=float((self.operators[index].matrix.T
+                                                      @ u[body.free]).max()), converged=True)
+        else:
+            u[body.free] = self._solve(index, f, force, center)
+        return u.reshape(-1, 3)
+
+    def _with_columns(self, index: int, near: _NearSet, extra: NDArray[np.int64]) -> _NearSet:
+        """``near`` with the elements ``extra`` added: their ``K₀⁻¹ cₑ`` in one solve call."""
+        op, body = self.operators[index], self.bodies[index]
+        elements = np.concatenate([near.elements, extra])
+        columns = op.matrix[:, elements]
+        z = np.hstack([near.z, body.solve_free(op.matrix[:, extra].toarray())])
+        g = columns.T @ z
+        log.debug("stiffening FEM: near set of %d elements", elements.size)
+        return _NearSet(elements, columns, z, 0.5 * (g + g.T))
+
+    def _solve(self, index: int, f: NDArray[np.float64], force: float,
+               center: NDArray[np.float64]) -> NDArray[np.float64]:
+        """The free displacements of block ``index`` in equilibrium with the free nodal forces
+        ``f`` (module docstring: Newton on the near set, a fixed point on the far elements'
+        forces, Anderson-accelerated)."""
+        op, body = self.operators[index], self.bodies[index]
+        key = (index, np.asarray(center, dtype=float).tobytes())
+        near = self._near.get(key)
+        linear = None
+        if near is None:  # the target's first press: the linear response picks the near set
+            linear = body.solve_free(f)
+            near = self._near_set(index, linear)
+            self._near[key] = near
+            while len(self._near) > _TARGETS_KEPT:
+                self._near.popitem(last=False)
+        self._near.move_to_end(key)
+        far, eps = near.predict(force, f.size)
+        history: list[tuple[NDArray[np.float64], NDArray[np.float64]]] = []
+        steps, residual, rounds, converged = 0, np.inf, 0, False
+        while rounds < _MAX_ROUNDS:
+            rounds += 1
+            # the first round of a new target has no far forces yet: its linear response
+            response = linear if linear is not None and rounds == 1 else body.solve_free(f - far)
+            solved, taken = self._newton(near.columns.T @ response, near, op, eps)
+            eps = solved
+            steps += taken
+            u = response - near.z @ self._law(eps, op, near.elements)
+            strain = op.matrix.T @ u
+            stress = self._law(strain, op, np.arange(strain.size))
+            stress[near.elements] = 0.0
+            hard = np.flatnonzero(strain > _JOIN_STRAIN * self.densification_strain)
+            joining = hard[stress[hard] != 0.0]
+            if joining.size:  # a far element compressed hard: its tangent is taken exactly too
+                near = self._with_columns(index, near, joining)
+                self._near[key] = near
+                eps, history = None, []
+                continue
+            new_far = op.matrix @ stress
+            residual = float(np.linalg.norm(new_far - far))
+            if residual <= self.tolerance * force:
+                converged = True
+                break
+            far = _anderson(far, new_far, history)
+        if not converged:
+            log.warning("stiffening FEM: the press did not converge in %d rounds (residual "
+                        "%.3g N at %.3g N)", _MAX_ROUNDS, residual, force)
+        near.remember(force, far, solved)
+        self.last = NewtonSolve(residual_n=residual, rounds=rounds, newton_steps=steps,
+                                near_elements=int(near.elements.size),
+                                max_strain=float(strain.max()), converged=converged)
+        return u
+
+    def _near_set(self, index: int, linear: NDArray[np.float64]) -> _NearSet:
+        """The elements the linear response ``linear`` compresses most: at most
+        ``near_elements`` of them, and of those only the ones it would stiffen by more than
+        :data:`_NEAR_STIFFENING` (at least :data:`_NEAR_LEAST`)."""
+        op = self.operators[index]
+        strain = op.matrix.T @ linear
+        order = np.argsort(strain)[::-1][:min(self.near_elements, strain.size)]
+        stiffening = volumetric_tangent(strain[order], np.ones(order.size),
+                                        densification=self.densification_strain,
+                                        exponent=self.stiffening_exponent)
+        count = max(int(np.count_nonzero(stiffening > _NEAR_STIFFENING)),
+                    min(_NEAR_LEAST, order.size))
+        chosen = np.sort(order[:count])
+        empty = _NearSet(np.zeros(0, dtype=np.int64), op.matrix[:, :0],
+                         np.zeros((linear.size, 0)), np.zeros((0, 0)))
+        return self._with_columns(index, empty, chosen)
+
+    def _newton(self, b: NDArray[np.float64], near: _NearSet, op: _StrainOperator,
+                start: NDArray[np.float64] | None) -> tuple[NDArray[np.float64], int]:
+        """The near elements' strains ``ε`` with ``ε − b + G s(ε) = 0`` (``s = V Φ'``), by Newton's
+        method on the Jacobian ``I + G diag(V Φ'')``, steps halved to keep every ``ε < ε_d`` and
+        the residual falling."""
+        cap, g, elements = self.densification_strain, near.g, near.elements
+        eps = np.minimum(b, 0.5 * cap) if start is None or start.size != b.size else start
+        eps = np.minimum(eps, 0.999 * cap)
+
+        def residual(e: NDArray[np.float64]) -> NDArray[np.float64]:
+            return e - b + g @ self._law(e, op, elements)
+
+        r = residual(eps)
+        norm = float(np.linalg.norm(r))
+        scale = max(float(np.abs(b).max()), 1e-12)
+        for step in range(1, _MAX_NEWTON + 1):
+            if norm <= 1e-13 * scale:
+                return eps, step - 1
+            jac = np.eye(b.size) + g * self._law(eps, op, elements, tangent=True)[None, :]
+            delta = np.linalg.solve(jac, -r)
+            alpha = 1.0
+            while True:
+                trial = eps + alpha * delta
+                if np.all(trial < cap):
+                    r_trial = residual(trial)
+                    n_trial = float(np.linalg.norm(r_trial))
+                    if n_trial < norm or alpha < 1e-6:
+                        break
+                alpha *= 0.5
+            eps, r, norm = trial, r_trial, n_trial
+        log.warning("stiffening FEM: the near-field Newton solve stopped at %.3g", norm)
+        return eps, _MAX_NEWTON
+
+
+_ANDERSON_DEPTH = 3
+
+
+def _anderson(x: NDArray[np.float64], fx: NDArray[np.float64],
+              history: list[tuple[NDArray[np.float64], NDArray[np.float64]]]
+              ) -> NDArray[np.float64]:
+    """The next iterate of the fixed point ``x = T(x)`` from ``x`` and ``fx = T(x)``, by Anderson
+    mixing over the last few (Walker & Ni 2011); ``history`` (``(x, T(x))`` pairs) is updated."""
+    history.append((x, fx))
+    del history[:-(_ANDERSON_DEPTH + 1)]
+    if len(history) < 2:
+        return fx
+    gaps = [t - y for y, t in history]
+    d_gap = np.column_stack([gaps[i + 1] - gaps[i] for i in range(len(gaps) - 1)])
+    d_t = np.column_stack([history[i + 1][1] - history[i][1] for i in range(len(gaps) - 1)])
+    gamma = np.linalg.lstsq(d_gap, gaps[-1], rcond=None)[0]
+    return np.asarray(fx - d_t @ gamma)
