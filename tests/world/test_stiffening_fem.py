@@ -151,3 +151,15 @@ def test_the_record_is_monotone_deterministic_and_stiffer_than_the_fems() -> Non
     b = _world(seed=4, noise=True).force_travel(CENTER, 0.6)
     assert a is not None and b is not None
     assert np.array_equal(a.travel_m, b.travel_m) and np.array_equal(a.force_n, b.force_n)
+
+
+def test_a_press_is_solved_the_same_whatever_was_pressed_before() -> None:
+    """The near sets and warm starts a press leaves are not carried to the next press: a run
+    resumed without its earlier pokes presses a place again to the bit (issue 14's resume)."""
+    fresh = _world().dent(CENTER, 0.6)
+    world = _world()
+    world.dent(CENTER, 0.3)  # the same place, lighter, first
+    world.dent(CENTER + 0.03, 0.6)  # and another place
+    again = world.dent(CENTER, 0.6)
+    assert again.depth_m == fresh.depth_m
+    assert np.array_equal(again.displacement, fresh.displacement)

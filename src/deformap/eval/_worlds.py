@@ -17,8 +17,8 @@ combination the same model), poking to ``max_pokes``: once the map field's varia
 curves compare like with like; ``threshold`` in a row says whether the variance rule was met.
 Every cut (``region_labels``) asked for is scored on the same pokes: where the next poke goes
 does not depend on the cut (the targets read the classes of
-:func:`deformap.explore.poke_classes`, before any cut), so mapping once per cut would repeat the
-same pokes. After every poke it records (one row each per cut):
+:func:`deformap.explore._regions.poke_classes`, before any cut), so mapping once per cut would
+repeat the same pokes. After every poke it records (one row each per cut):
 
 - ``accuracy``, ``mean_iou``, ``found``, ``true``, ``kendall_tau``
   (:func:`deformap.eval.region_scores`) of the map field's regions against the world's truth by
@@ -50,7 +50,14 @@ from numpy.typing import NDArray
 
 from deformap.errors import InvalidArgumentError
 from deformap.eval._metrics import region_scores
-from deformap.explore import ExplorationConfig, Mapper, Target, map_regions, poke_step
+from deformap.explore import (
+    ExplorationConfig,
+    Mapper,
+    RegionLabels,
+    Target,
+    map_regions,
+    poke_step,
+)
 from deformap.world import (
     CAMERA_PRESETS,
     LAYOUT_FAMILIES,
@@ -150,7 +157,7 @@ def _material_truth(world: SimulatedWorld, xs: NDArray, ys: NDArray
 def _scores(mapper: Mapper, truth: tuple[NDArray, dict[int, float], NDArray],
             cuts: Sequence[str]) -> dict[str, dict[str, Any]]:
     """Each cut's scores of the mapper's current map (the pokes do not depend on the cut: the
-    targets read the cut-free classes of :func:`deformap.explore.poke_classes`)."""
+    targets read the cut-free classes of :func:`deformap.explore._regions.poke_classes`)."""
     labels, hardness, modulus = truth
     field = mapper.map_field
     sign = -1.0 if field.name == "modulus" else 1.0  # the metrics order by softness
@@ -166,7 +173,8 @@ def _scores(mapper: Mapper, truth: tuple[NDArray, dict[int, float], NDArray],
     out = {}
     for cut in cuts:
         found = map_regions(field.mean, field.pokes, mapper.grid.cells_xy,
-                            replace(mapper.config, region_labels=cut))  # fmt: skip
+                            replace(mapper.config,
+                                    region_labels=cast(RegionLabels, cut)))  # fmt: skip
         scores = region_scores(found.labels, labels, sign * field.mean, hardness)
         out[cut] = {"accuracy": scores.accuracy, "mean_iou": scores.mean_iou,
                     "found": scores.found, "true": scores.true,
@@ -212,8 +220,8 @@ def run_world(task: dict[str, Any]) -> dict[str, Any]:
     ----------
     task : dict
         ``seed``, ``index``, ``families``, ``physics`` (optional: the world physics drawn
-        from, default all), ``strategies``, ``fields``, ``cut`` (a
-        ``region_labels`` value, or ``None`` for the default), ``max_pokes``, ``coarse`` (the
+        from, default all), ``strategies``, ``fields``, ``cuts`` (the
+        ``region_labels`` scored, each on the same pokes), ``max_pokes``, ``coarse`` (the
         test mesh and camera of :meth:`WorldConfig.coarse`, else the default world).
 
     Returns

@@ -47,9 +47,9 @@ of the band of the β-field it falls in (:meth:`RegionMap.nearest_poke`). The is
 with a decimetre length scale are smooth curves that revert towards the field's mean away from
 the pokes, and pokes placed to pin a boundary do not move them much; the nearest-poke labels of
 the same pokes follow the pokes instead. It is the default: over 100 random worlds
-(``deformap bench worlds``, README "Many worlds") it gave the highest region accuracy with every
-strategy from 7 pokes on and was level with the isopleths before; the paper's isopleths stay
-available (``region_labels: isopleth``).
+(``deformap bench worlds``, README "Many worlds") it beat the isopleths with every strategy from
+7 pokes on (level before) and was the best of the three cuts at 20 pokes; the paper's isopleths
+stay available (``region_labels: isopleth``).
 
 Labelling by indicator kriging (``region_labels = "indicator-kriging"``)
 -------------------------------------------------------------------------
@@ -242,7 +242,9 @@ def segment_regions(
     poke_beta, poke_std : (k,) float
         The pokes' β estimates and their uncertainties.
     floor : float
-        Smallest uncertainty a poke is credited with.
+        Smallest uncertainty a poke is credited with (the map field's noise floor:
+        :func:`poke_classes` passes the field's own; this function's default, 0.03, is the
+        β-field's on the former reference β scale, kept for direct callers).
     min_step : float
         Smallest difference of two class means that can separate them.
     z : float

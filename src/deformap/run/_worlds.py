@@ -112,9 +112,13 @@ class WorldsBenchConfig:
                                      ("strategies", self.strategies, choices("strategy")),
                                      ("fields", self.fields, choices("field")),
                                      ("cuts", self.cuts, choices("region_labels"))):
-            if not given or any(g not in allowed for g in given) or len(set(given)) < len(given):
+            unknown = [g for g in given if g not in allowed]
+            repeated = sorted({g for g in given if given.count(g) > 1})
+            if not given or unknown or repeated:
+                why = ("none" if not given else f"{unknown} (unknown)" if unknown
+                       else f"{repeated} more than once")
                 raise SettingError(name, f"must be distinct names from {list(allowed)}; got "
-                                         f"{list(given)}")
+                                         f"{why}")
 
     def result_settings(self) -> dict[str, Any]:
         """The settings a world's result depends on (``bench.json``; resuming compares them)."""

@@ -22,16 +22,18 @@ therefore iterates ``a ← sqrt(a · sqrt(R δ_FEM))`` (a damped fixed point of 
 relation ``a² = R δ``) from the Hertz value until ``a`` changes by less than 2 %, and never lets
 ``a`` exceed the tip radius ``R``. The iteration is safeguarded: each solve tells on which side of
 the fixed point ``a`` lies (``sqrt(R δ(a)) > a``: the patch must grow), so the radii tried keep a
-bracket around it, and a step that would leave the bracket bisects it instead. Near a seam
-between blocks ``δ(a)`` jumps as the patch crosses into the next block, and the plain iteration
-can oscillate there without converging (1 world of 100 in ``deformap bench worlds``, seed 0,
-whose force–travel record then went backwards by 0.9 mm); the bracket converges anyway.
+bracket around it, and a step that would leave the bracket bisects it instead; where ``δ(a)``
+jumps (near a seam between blocks the load samples cross into the next block as the patch grows)
+the plain iteration can oscillate, and the bracket still ends within the tolerance. It does not
+make ``δ`` continuous there: a press by a seam can still solve shallower at a larger force (by
+0.3–0.9 mm on the default mesh), and past the encoder's tolerance
+:meth:`deformap.world.SimulatedWorld.force_travel` gives no record.
 
 Loading: the indentation of a rigid sphere pressed into a linear elastic body grows with the
-force and so does its contact disc. ``δ(a; F)`` grows with ``F`` at every ``a``, so the fixed
-point at a smaller force lies within the radius at a larger one: a press solved at several loads
-(the force–travel record, :meth:`deformap.world.SimulatedWorld.force_travel`) passes the radius
-of the load above as ``max_radius_m``, the upper end of the bracket.
+force, and so does its contact disc. ``δ(a; F)`` grows with ``F`` at every ``a``, so the largest
+fixed point at a smaller force lies within it at a larger one: a press solved at several loads
+(the force–travel record) passes the radius of the load above as ``max_radius_m``, the upper end
+of the bracket.
 """
 
 from __future__ import annotations
@@ -164,6 +166,10 @@ class FoamModel(FoamMesh):
     def n_dofs(self) -> int:
         """Free displacement unknowns over all foam bodies."""
         return sum(b.n_dofs for b in self.bodies.values())
+
+    def forget(self) -> None:
+        """Drop whatever earlier presses left to warm-start the next (the linear FEM keeps
+        nothing: its factorisation is the body's, not a press's)."""
 
     def dent(self, target_xy: NDArray[np.float64], force_n: float, *, tip_radius_m: float,
              max_iterations: int = 40, tolerance: float = 0.02,

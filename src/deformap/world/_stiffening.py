@@ -150,6 +150,9 @@ class StiffeningFoam(FoamMesh):
         solves on a grid of its own, graded around the tip."""
         return sum((self.grids[i].nx + 1) * (self.grids[i].ny + 1) for i in self.layers)
 
+    def forget(self) -> None:
+        """Nothing to drop: each press is solved from its own first guess."""
+
     def dent(self, target_xy: NDArray[np.float64], force_n: float, *, tip_radius_m: float,
              initial_radius_m: float | None = None, max_radius_m: float | None = None) -> Dent:
         """Solve the press of ``force_n`` newtons at ``target_xy`` (see the module docstring).

@@ -270,6 +270,11 @@ class StiffeningFem(FoamModel):
         log.debug("stiffening FEM: near set of %d elements", elements.size)
         return _NearSet(elements, columns, z, 0.5 * (g + g.T))
 
+    def forget(self) -> None:
+        """Drop the near sets and warm starts earlier presses left: a press is then solved
+        the same whatever was pressed before (the world calls it at each press)."""
+        self._near.clear()
+
     def _solve(self, index: int, f: NDArray[np.float64], force: float,
                center: NDArray[np.float64]) -> NDArray[np.float64]:
         """The free displacements of block ``index`` in equilibrium with the free nodal forces
@@ -367,6 +372,11 @@ class StiffeningFem(FoamModel):
                     n_trial = float(np.linalg.norm(r_trial))
                     if n_trial < norm or alpha < 1e-6:
                         break
+                elif alpha < 1e-6 or not np.all(np.isfinite(delta)):
+                    # no step keeps the strains below densification, or the step is not a number
+                    log.warning("stiffening FEM: the near-field Newton step is not usable "
+                                "(residual %.3g); the last strains are kept", norm)
+                    return eps, step
                 alpha *= 0.5
             eps, r, norm = trial, r_trial, n_trial
         log.warning("stiffening FEM: the near-field Newton solve stopped at %.3g", norm)
