@@ -18,12 +18,13 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["FILE_MUTATORS", "KINDS", "make_templates", "mutate_file", "mutate_raw",
+__all__ = ["FILE_MUTATORS", "KINDS", "kinds_of", "make_templates", "mutate_file", "mutate_raw",
            "mutate_session"]
 
 Mutator = Callable[[bytes, np.random.Generator], bytes]
 
-#: Reader family → the kinds of mutation tried on it.
+#: Reader (``raw-mcap``) or reader family (``pcd`` for ``pcd-ascii``) → the kinds of mutation
+#: tried on it (:func:`kinds_of`).
 KINDS: dict[str, tuple[str, ...]] = {
     "pcd": ("flip", "truncate", "extend", "header", "count"),
     "ply": ("flip", "truncate", "extend", "header", "count"),
@@ -35,9 +36,21 @@ KINDS: dict[str, tuple[str, ...]] = {
     "scenario": ("yaml", "flip", "truncate"),
     # a bag as a robot records it (``deformap map BAG``): the MCAP's bytes, one of its records,
     # one message's bytes in a bag rewritten so that every CRC matches, and the YAML beside it
-    "raw": ("flip", "truncate", "extend", "record", "message-flip", "message-truncate",
-            "message-extend", "yaml"),
+    "raw-mcap": ("flip", "truncate", "extend", "record", "message-flip", "message-truncate",
+                 "message-extend", "yaml"),
+    # the same bag as sqlite3 (``.db3``, rosbag2's default before Iron) written by rosbags: the
+    # file's bytes, one message row's data (sqlite3 has no CRC to make match), a message row
+    # deleted or repeated or its data or time given another SQL type, one field of a ``topics``
+    # row, and the YAML beside it
+    "raw-db3": ("flip", "truncate", "extend", "message-flip", "message-truncate",
+                "message-extend", "row-delete", "row-repeat", "row-type", "topic", "yaml"),
 }
+
+
+def kinds_of(reader: str) -> tuple[str, ...]:
+    """The kinds of mutation tried on ``reader`` (its own entry in :data:`KINDS`, else its
+    family's)."""
+    return KINDS.get(reader) or KINDS[reader.split("-")[0]]
 
 #: The raw template's rates [Hz] (camera, /tf, force sensor) and chunk size: a few compressed
 #: chunks of a bag small enough to read in a few hundredths of a second.
@@ -131,6 +144,7 @@ def make_templates(root: Path) -> dict[str, Path]:
     except ImportError:
         return out
     out["raw-mcap"] = _raw_template(root / "raw", out["session-folder"])
+    out["raw-db3"] = _raw_db3_template(root / "raw-db3", out["raw-mcap"])
     return out
 
 
@@ -151,6 +165,16 @@ def _raw_template(folder: Path, session_folder: Path) -> Path:
     settings = raw_settings(session, force_n=1.0)
     (folder / "lab.deformap.yaml").write_text(yaml.safe_dump(settings, sort_keys=False))
     return bag
+
+
+def _raw_db3_template(folder: Path, mcap_bag: Path) -> Path:
+    """The raw MCAP bag's messages as a lone sqlite3 ``.db3``, written by rosbags' rosbag2
+    writer (not deformap's), with the same settings YAML beside it; returns the ``.db3``."""
+    from deformap.testing.robotbag import copy_to_db3
+
+    folder.mkdir()
+    shutil.copy(mcap_bag.with_name(f"{mcap_bag.stem}.deformap.yaml"), folder)
+    return copy_to_db3(mcap_bag, folder / "lab.db3")
 
 
 # ----------------------------------------------------------------------------- mutators
@@ -385,6 +409,55 @@ def _mcap_message(data: bytes, rng: np.random.Generator, kind: str) -> bytes:
     return out.getvalue()
 
 
+def _db3_edit(bag: Path, kind: str, rng: np.random.Generator) -> None:
+    """Edit the sqlite3 bag in place through SQL: one message row's data damaged (``kind``:
+    message-flip, message-truncate, message-extend), the row deleted (row-delete) or inserted
+    again (row-repeat), its data or time given a value of another SQL type (row-type), or one
+    field of a ``topics`` row given another value (topic). The topic is drawn first, then one of
+    its messages."""
+    import sqlite3
+
+    conn = sqlite3.connect(bag)
+    try:
+        topics = conn.execute("SELECT id, name, type FROM topics ORDER BY id").fetchall()
+        tid, name, msgtype = topics[int(rng.integers(len(topics)))]
+        if kind == "topic":
+            others = [t for t in topics if t[0] != tid] or topics
+            other = others[int(rng.integers(len(others)))]
+            column, values = [
+                ("name", [other[1], name + "x", "", "/", name.upper()]),
+                ("type", [other[2], "std_msgs/msg/String", msgtype + "x", ""]),
+                ("serialization_format", ["", "json", "ros1", "cdr\x00"]),
+                ("offered_qos_profiles", ["", "- x", "[", "- history: 99", "{a: [}"]),
+                ("type_description_hash", ["", "RIHS01_00", "x"]),
+                ("id", [tid + 100, -1, 0]),
+            ][int(rng.integers(6))]  # fmt: skip
+            value = values[int(rng.integers(len(values)))]
+            conn.execute(f"UPDATE topics SET {column} = ? WHERE id = ?", (value, tid))
+        else:
+            ids = [r[0] for r in conn.execute(
+                "SELECT id FROM messages WHERE topic_id = ? ORDER BY id", (tid,))]
+            victim = ids[int(rng.integers(len(ids)))]
+            if kind == "row-delete":
+                conn.execute("DELETE FROM messages WHERE id = ?", (victim,))
+            elif kind == "row-type":  # sqlite3 stores any type in any column
+                column = ("data", "timestamp")[int(rng.integers(2))]
+                value = [7, 10**12, -1, 2.5, 1e300, "x", "1700000000000000000",
+                         b"\x00\x01"][int(rng.integers(8))]
+                conn.execute(f"UPDATE messages SET {column} = ? WHERE id = ?", (value, victim))
+            elif kind == "row-repeat":
+                conn.execute("INSERT INTO messages (topic_id, timestamp, data) SELECT topic_id, "
+                             "timestamp, data FROM messages WHERE id = ?", (victim,))
+            else:
+                (data,) = conn.execute("SELECT data FROM messages WHERE id = ?",
+                                       (victim,)).fetchone()  # fmt: skip
+                payload = FILE_MUTATORS[kind.removeprefix("message-")](bytes(data), rng)
+                conn.execute("UPDATE messages SET data = ? WHERE id = ?", (payload, victim))
+        conn.commit()
+    finally:
+        conn.close()
+
+
 def mutate_raw(template: Path, out: Path, kind: str, rng: np.random.Generator) -> Path:
     """Copy the folder of the raw bag ``template`` (the bag and its settings YAML) to ``out``
     and damage the bag or, for ``yaml``, the settings; returns the damaged bag's path."""
@@ -393,6 +466,8 @@ def mutate_raw(template: Path, out: Path, kind: str, rng: np.random.Generator) -
     if kind == "yaml":
         settings = bag.with_name(f"{bag.stem}.deformap.yaml")
         settings.write_text(_yaml_edit(settings.read_text(), rng))
+    elif bag.suffix == ".db3" and kind not in FILE_MUTATORS:
+        _db3_edit(bag, kind, rng)
     elif kind == "record":
         bag.write_bytes(_mcap_record(bag.read_bytes(), rng))
     elif kind.startswith("message-"):

@@ -9,15 +9,18 @@ folder session written by ``write_session``, plus MCAP and sqlite3 sessions when
 installed, and a raw robot bag when ``mcap-ros2-support`` is too: the folder session's three
 presses written as a robot's drivers record them by ``deformap.testing.robotbag`` — organised
 PointCloud2 with NaN holes at 15 Hz, WrenchStamped at 100 Hz, /tf at 25 Hz, /tf_static, in
-zstd chunks of 16 kB with their CRCs — read as ``deformap map BAG`` reads it, with its
-``NAME.deformap.yaml`` beside it)
+zstd chunks of 16 kB with their CRCs (``raw-mcap``), and the same messages as a lone sqlite3
+``.db3`` written by rosbags' rosbag2 writer (``raw-db3``) — read as ``deformap map BAG`` reads
+it, with its ``NAME.deformap.yaml`` beside it)
 are mutated by seeded byte flips, truncations, appended bytes, header field edits and point-count
 changes (and, for NPZ, the same inside a member, plus edits of its .npy header and shape, with
 the member's zip CRC made to match; for sessions,
 edits of ``session.yaml``, of one of its files, and links out of the folder; for the raw bag, the
 same byte mutants, one MCAP record's content or length damaged or the record left out or
 repeated, one message's bytes damaged in a bag rewritten with every CRC made to match, and line
-edits of its settings YAML; and the YAML a user
+edits of its settings YAML; for the ``.db3``, the byte mutants, and through SQL one message
+row's data flipped, cut or extended, the row deleted or inserted again, or one field of a
+``topics`` row changed; and the YAML a user
 writes, a run configuration and a scenario, by line edits, byte flips and cuts). Each mutant is read
 in a worker process under a per-case time limit, and counted as:
 
@@ -25,12 +28,14 @@ in a worker process under a per-case time limit, and counted as:
 - ``same``: accepted, and the data read equal the template's (the mutant touched nothing read);
 - ``changed``: accepted with other data, where no check could know (a flipped bit in a coordinate
   of a format without checksum, a number edited in ``session.yaml`` or a raw bag's settings, a
-  raw bag's message damaged with the CRCs made to match);
+  raw bag's message damaged with the CRCs made to match; in a ``.db3``, which has no checksum, a
+  flipped byte, a message's bytes edited in place, a row deleted or repeated, a topic's field);
 - ``silent``: accepted with other data where a check could have caught it: a different number of
   points or pokes, a structural mutant (truncation, count change, appended bytes, a message's
   length changed) accepted as different data, or any change to a file covered by a checksum (NPZ
   members, a session's ``sha256`` manifest, a raw bag's chunk and summary CRCs);
-- ``traceback``: any other exception; ``hang``: over the time limit.
+- ``traceback``: any other exception, or an error of several lines; ``hang``: over the time
+  limit.
 
 ``--cli-mutants N`` also runs at least N command-line mutants (``benchmarks/_cli_mutants.py``:
 every option of every command given seeded hostile values under a guard that stops a run before
@@ -65,7 +70,14 @@ for _path in (_SRC, Path(__file__).resolve().parent):
     if _path.is_dir() and str(_path) not in sys.path:
         sys.path.insert(0, str(_path))
 
-from _mutants import KINDS, make_templates, mutate_file, mutate_raw, mutate_session  # noqa: E402
+from _mutants import (  # noqa: E402
+    KINDS,  # noqa: F401  (the tests read it from here)
+    kinds_of,
+    make_templates,
+    mutate_file,
+    mutate_raw,
+    mutate_session,
+)
 
 OUTCOMES = ("clean", "same", "changed", "silent", "traceback", "hang")
 STRUCTURAL = {"truncate", "count", "extend", "member-truncate", "member-extend", "member-shape",
@@ -120,6 +132,8 @@ def read_snapshot(reader: str, path: str) -> tuple[str, Any]:
         reads.append(("truth", None if truth is None else _digest(truth.labels, truth.hardness)))
         return "ok", (len(session), tuple(reads))
     except DeformapError as exc:
+        if "\n" in str(exc):  # an error is one line (a refused read's too: _safe)
+            return "traceback", f"an error of several lines: {str(exc)[:300]!r}"
         return "clean", str(exc)[:300]
     except Exception as exc:  # counting what escapes is the point
         return "traceback", f"{type(exc).__name__}: {str(exc)[:300]}"
@@ -138,7 +152,9 @@ def _safe(read: Callable[[], str]) -> str:
 
     try:
         return read()
-    except DeformapError:
+    except DeformapError as exc:
+        if "\n" in str(exc):
+            raise RuntimeError(f"an error of several lines: {str(exc)[:300]!r}") from None
         return "refused"
 
 
@@ -158,7 +174,7 @@ def classify(reader: str, kind: str, status: str, got: Any, want: Any) -> str:
             if not changed and n_got == want[0]:
                 return "clean"
         if reader.startswith("raw"):
-            return _raw_change(kind)
+            return _raw_change(reader, kind)
         return _session_change(kind, got, want)
     # A zip holds a CRC-32 of each member; the member-* mutants forge it to match.
     checksummed = reader == "npz" and not kind.startswith("member-")
@@ -175,14 +191,18 @@ def _session_change(kind: str, got: Any, want: Any) -> str:
     return "changed"
 
 
-def _raw_change(kind: str) -> str:
-    # The bag's chunks and summary carry CRCs and its records lengths: a change from a byte or
-    # record mutant is one they could have caught. A message rewritten with its CRCs made to
-    # match, or a settings YAML a user edits, is other valid data, unless the message's
-    # length changed (the decoder could tell).
-    if kind in STRUCTURAL or not (kind == "yaml" or kind.startswith("message-")):
+def _raw_change(reader: str, kind: str) -> str:
+    # An MCAP bag's chunks and summary carry CRCs and its records lengths: a change from a byte
+    # or record mutant is one they could have caught. A message rewritten with its CRCs made to
+    # match, or a settings YAML a user edits, is other valid data, unless the message's length
+    # changed (the decoder could tell). A sqlite3 bag carries no CRC: a flipped byte, a
+    # message's data edited, a row deleted or repeated or a topic's field changed is other data
+    # nothing could tell, unless bytes or a message were cut or added.
+    if kind in STRUCTURAL:
         return "silent"
-    return "changed"
+    if reader == "raw-db3" or kind == "yaml" or kind.startswith("message-"):
+        return "changed"
+    return "silent"
 
 
 def _worker(conn: Any) -> None:
@@ -245,7 +265,7 @@ def run(n_mutants: int, seed: int, limit_s: float, work: Path,
     for r, (status, snap) in want.items():
         if status != "ok":
             raise RuntimeError(f"template {r} does not read: {snap}")
-    plan = [(r, k) for r in names for k in KINDS[r.split("-")[0]]]
+    plan = [(r, k) for r in names for k in kinds_of(r)]
     cases = []
     try:
         for index in range(n_mutants):

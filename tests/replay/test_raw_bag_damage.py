@@ -10,11 +10,21 @@ bag's seeded mutants in ``benchmarks/robustness.py`` found (issue 14).
   RuntimeWarning, then a force of inf); both are damaged messages, refused at once.
 - A raw press refused by the contact check named ``BAG/session.yaml: poke 0``, a file that does
   not exist, instead of the bag and the press numbered from 1.
+
+The sqlite3 form (``.db3``, written from the MCAP by rosbags' writer) found, before the fixes:
+- a ``topics`` row whose QoS profiles are not YAML refused with the YAML parser's message of
+  four lines (every damaged bag's message is now one line);
+- a message row whose data is a number (sqlite3 stores any type in any column) taken as that
+  many zero bytes, ``bytes(10**12)`` asking for a terabyte (a MemoryError), and text or a real
+  refused with Python's words for a conversion (``string argument without an encoding``);
+- an observation whose camera frame has no transform (``/tf_static`` lost) refused without
+  naming the bag.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import re
 import struct
 import warnings
 from pathlib import Path
@@ -152,3 +162,67 @@ def test_a_raw_press_refused_by_the_contact_check_names_the_bag(session: Any,
         raw.press_observation(0)
     message = str(info.value)
     assert message.startswith(f"{bag}: press 1") and "session.yaml" not in message
+
+
+def _db3(folder: Path, session: Any) -> Path:
+    """The raw bag as a lone ``.db3`` beside its settings, written by rosbags' writer."""
+    pytest.importorskip("rosbags")
+    from deformap.testing.robotbag import copy_to_db3
+
+    bag = _bag(folder, session)
+    return copy_to_db3(bag, bag.with_suffix(".db3"))
+
+
+def _sql(bag: Path, statement: str, *args: Any) -> None:
+    import sqlite3
+
+    conn = sqlite3.connect(bag)
+    try:
+        conn.execute(statement, args)
+        conn.commit()
+    finally:
+        conn.close()
+
+
+def test_a_db3_bag_reads_as_its_mcap(session: Any, tmp_path: Path) -> None:
+    db3 = _db3(tmp_path, session)
+    raw, mcap = _open(db3), _open(db3.with_suffix(".mcap"))
+    assert len(raw) == len(mcap) == 3
+    np.testing.assert_array_equal(raw.observation().points, mcap.observation().points)
+
+
+def test_a_db3_topic_whose_qos_is_not_yaml_is_refused_on_one_line(session: Any,
+                                                                  tmp_path: Path) -> None:  # fmt: skip
+    bag = _db3(tmp_path, session)
+    _sql(bag, "UPDATE topics SET offered_qos_profiles = '[' WHERE name = '/tf'")
+    with pytest.raises(FileFormatError) as info:
+        _open(bag)
+    message = str(info.value)
+    assert message.startswith(f"{bag}: could not read the bag: ReaderError: ")
+    assert "offered_qos_profiles" in message and "\n" not in message
+
+
+@pytest.mark.parametrize(("column", "value", "expected"), [
+    ("data", 10**12, r"expected its data as bytes; got int '1000000000000'"),
+    ("data", "text", r"expected its data as bytes; got str 'text'"),
+    ("data", 2.5, r"expected its data as bytes; got float '2.5'"),
+    ("timestamp", "x", r"expected an integer log time \[ns\]; got str 'x'"),
+])  # fmt: skip
+def test_a_db3_message_of_another_sql_type_is_refused_naming_it(
+        session: Any, tmp_path: Path, column: str, value: Any, expected: str) -> None:  # fmt: skip
+    bag = _db3(tmp_path, session)
+    _sql(bag, f"UPDATE messages SET {column} = ? WHERE id = (SELECT max(messages.id) FROM "
+              "messages JOIN topics ON topic_id = topics.id WHERE name = '/ft_sensor/wrench')",
+         value)  # fmt: skip
+    with pytest.raises(FileFormatError, match=rf"^{re.escape(str(bag))} \[/ft_sensor/wrench "
+                                              rf"message \d+ of the topic\]: {expected}$"):
+        _open(bag)
+
+
+def test_an_observation_without_its_camera_transform_names_the_bag(session: Any,
+                                                                   tmp_path: Path) -> None:  # fmt: skip
+    bag = _bag(tmp_path, session, drop=("/tf_static",))
+    with pytest.raises(FileFormatError) as info:
+        _open(bag)
+    assert str(info.value).startswith(f"{bag}: the observation [/camera/depth/color/points]: "
+                                      "no frame 'world'")

@@ -1,6 +1,7 @@
 """Seeded mutants of every reader's input (PCD ascii/binary/compressed, PLY ascii/binary, NPZ, and
 folder and MCAP sessions, the YAML of a run configuration and of a scenario, and a raw robot bag
-as ``deformap map BAG`` reads it, with the YAML beside it) load to a valid result or raise a
+as ``deformap map BAG`` reads it, MCAP and sqlite3, with the YAML beside it) load to a valid
+result or raise a
 DeformapError: never another exception, never a hang, never a corruption a check could have
 caught accepted (issue 14).
 
@@ -31,8 +32,9 @@ def test_every_mutant_is_read_or_cleanly_refused(bench: ModuleType, tmp_path: Pa
     assert {"pcd-ascii", "pcd-binary", "pcd-binary_compressed", "ply-ascii", "ply-binary", "npz",
             "session-folder", "config", "scenario"} <= readers  # fmt: skip
     if importlib.util.find_spec("mcap_ros2") is not None:
-        raw = [c for c in cases if c.reader == "raw-mcap"]
-        assert {c.kind for c in raw} == set(bench.KINDS["raw"]) and len(raw) >= 40
+        for reader in ("raw-mcap", "raw-db3"):
+            raw = [c for c in cases if c.reader == reader]
+            assert {c.kind for c in raw} == set(bench.KINDS[reader]) and len(raw) >= 40
 
 
 def test_the_classifier_flags_what_it_must(bench: ModuleType) -> None:
@@ -56,7 +58,27 @@ def test_the_classifier_flags_what_it_must(bench: ModuleType) -> None:
     assert bench.classify("raw-mcap", "message-truncate", "ok", changed, full) == "silent"
     assert bench.classify("raw-mcap", "yaml", "ok", lost, full) == "changed"
     assert bench.classify("raw-mcap", "flip", "ok", refused, full) == "clean"
+    # a sqlite3 bag has no CRC: bytes or a row edited in place are other data nothing could tell,
+    # bytes or a message's data cut or extended are not
+    for kind in ("flip", "message-flip", "row-delete", "row-repeat", "row-type", "topic", "yaml"):
+        assert bench.classify("raw-db3", kind, "ok", changed, full) == "changed"
+    for kind in ("truncate", "extend", "message-truncate", "message-extend"):
+        assert bench.classify("raw-db3", kind, "ok", changed, full) == "silent"
+    assert bench.classify("raw-db3", "row-delete", "ok", refused, full) == "clean"
     assert bench.read_snapshot("no-such-reader", "x")[0] == "traceback"
+
+
+def test_an_error_of_several_lines_counts_as_a_defect(
+        bench: ModuleType, monkeypatch: pytest.MonkeyPatch) -> None:  # fmt: skip
+    import deformap.cloud.io
+    from deformap.errors import FileFormatError
+
+    def read(path: str) -> None:
+        raise FileFormatError(f"{path}: could not read: while parsing\n  in line 1")
+
+    monkeypatch.setattr(deformap.cloud.io, "read_pcd", read)
+    status, detail = bench.read_snapshot("pcd-ascii", "x.pcd")
+    assert status == "traceback" and "several lines" in detail
 
 
 def test_a_hanging_reader_is_cut_at_the_limit(bench: ModuleType, monkeypatch: pytest.MonkeyPatch,

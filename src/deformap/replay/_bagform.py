@@ -23,6 +23,7 @@ from numpy.typing import NDArray
 from deformap.cloud import PointCloud
 from deformap.cloud.io import (
     array_to_pointcloud2,
+    bag_error_text,
     bag_read_errors,
     bag_writer,
     iter_bag_messages,
@@ -96,7 +97,7 @@ class BagReader:
             msg = typestore().deserialize_cdr(raws[0].data, msgtype)
         except bag_read_errors() as exc:
             raise FileFormatError(
-                f"{where}: could not be decoded: {type(exc).__name__}: {str(exc)[:120]}"
+                f"{where}: could not be decoded: {bag_error_text(exc, 120)}"
             ) from None
         dims = [(str(d.label), int(d.size)) for d in msg.layout.dim]
         data = np.asarray(msg.data, dtype=float)
@@ -130,7 +131,7 @@ class BagReader:
                     by_stamp.setdefault(stamp, msg)
                 except errors as exc:
                     self._undecodable.setdefault(topic, []).append(
-                        f"message {number}: {type(exc).__name__}: {str(exc)[:120]}"
+                        f"message {number}: {bag_error_text(exc, 120)}"
                     )
             decoded[key] = by_stamp
         self._decoded = decoded

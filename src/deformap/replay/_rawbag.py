@@ -23,7 +23,13 @@ import numpy as np
 from numpy.typing import NDArray
 
 from deformap.cloud import PointCloud
-from deformap.cloud.io import bag_read_errors, iter_bag_messages, pointcloud2_structured, typestore
+from deformap.cloud.io import (
+    bag_error_text,
+    bag_read_errors,
+    iter_bag_messages,
+    pointcloud2_structured,
+    typestore,
+)
 from deformap.environment import ForceTravel, Workspace
 from deformap.errors import DeformapError, FileFormatError
 from deformap.replay._folder import PressParts
@@ -141,8 +147,8 @@ class RawBagReader:
             try:
                 msg = store.deserialize_cdr(bytes(raw.data), types[raw.topic])
             except errors as exc:
-                raise FileFormatError(f"{where}: could not be decoded: {type(exc).__name__}: "
-                                      f"{str(exc)[:120]}") from None  # fmt: skip
+                raise FileFormatError(f"{where}: could not be decoded: "
+                                      f"{bag_error_text(exc, 120)}") from None  # fmt: skip
             if raw.topic == cfg.cloud_topic:
                 stamps.append(_stamp(msg.header))
                 frames.add(str(msg.header.frame_id))
@@ -199,7 +205,7 @@ class RawBagReader:
                 f"{cfg.cloud_topic!r} from t = {self._s(times[pick])} s must all come before the "
                 f"first contact at t = {self._s(first_contact)} s (`observation_time_s`, "
                 "`observation_frames`)")
-        return self._still(chosen, "the observation")
+        return self._still(chosen, f"{self.path}: the observation")
 
     def _plan_press(self, press: FoundPress) -> None:
         cfg = self.config
@@ -252,8 +258,8 @@ class RawBagReader:
                 msg = store.deserialize_cdr(bytes(raw.data), _CLOUD)
                 xyz = self._xyz(msg, where)
             except errors as exc:
-                raise FileFormatError(f"{where}: could not be decoded: {type(exc).__name__}: "
-                                      f"{str(exc)[:120]}") from None  # fmt: skip
+                raise FileFormatError(f"{where}: could not be decoded: "
+                                      f"{bag_error_text(exc, 120)}") from None  # fmt: skip
             shape = (int(msg.height), int(msg.width))
             ok = np.isfinite(xyz).all(axis=1)
             for group in wanted[number]:

@@ -7,6 +7,8 @@ reader (``tests/replay/test_raw_bag.py``, ``benchmarks/robustness.py``).
 frames), a ``WrenchStamped`` in a rotated sensor frame with the reaction force's sign, ``/tf``
 with the arm moving the tip along the press, and ``/tf_static`` for the camera mount; every stamp
 jittered. :func:`raw_settings` is the YAML beside it (this rig's frames and probe).
+:func:`copy_to_db3` writes such a bag's messages as a lone sqlite3 ``.db3`` with rosbags' rosbag2
+writer (the ``ros`` extra), the storage rosbag2 recorded by default before Iron.
 """
 
 from __future__ import annotations
@@ -22,7 +24,7 @@ from deformap.environment import PressObservation
 from deformap.replay import RecordedSession
 
 __all__ = ["APPROACH", "FIRST_PRESS_S", "HOLD", "MSGDEFS", "PAUSE", "RAMP", "RELEASE", "T0_NS",
-           "Press", "raw_settings", "write_raw_bag"]
+           "Press", "copy_to_db3", "raw_settings", "write_raw_bag"]
 
 T0_NS = 1_700_000_000 * 10**9  # a realistic epoch stamp
 #: Timeline of one press [s]: approach, ramp from contact to the force, hold, release, pause.
@@ -267,6 +269,31 @@ def write_raw_bag(path: Path, session: RecordedSession, *, seed: int = 0,
                        "torque": {"x": 0.0, "y": 0.0, "z": 0.0}}}, t)  # fmt: skip
     writer.finish()
     return presses
+
+
+def copy_to_db3(bag: Path, db3: Path) -> Path:
+    """Write every message of ``bag`` (an MCAP written by :func:`write_raw_bag`), in its order,
+    as the lone sqlite3 file ``db3`` (``NAME.db3``) with rosbags' rosbag2 writer, not
+    deformap's: its topics, types, definitions (rosbags' Humble typestore) and log times.
+    Returns ``db3``."""
+    import shutil
+    import tempfile
+
+    from rosbags.rosbag2 import Reader, Writer
+    from rosbags.rosbag2.enums import StoragePlugin
+    from rosbags.typesys import Stores, get_typestore
+
+    store = get_typestore(Stores.ROS2_HUMBLE)
+    with tempfile.TemporaryDirectory(dir=db3.parent) as tmp:
+        staging = Path(tmp) / "rosbag2"  # the writer makes a rosbag2 folder around the .db3
+        with Reader(bag) as reader, Writer(staging, version=8,
+                                           storage_plugin=StoragePlugin.SQLITE3) as writer:
+            conns = {c.id: writer.add_connection(c.topic, c.msgtype, typestore=store)
+                     for c in reader.connections}  # fmt: skip
+            for conn, log_time, data in reader.messages():
+                writer.write(conns[conn.id], log_time, data)
+        shutil.move(staging / "rosbag2.db3", db3)
+    return db3
 
 
 def raw_settings(session: RecordedSession, **extra: Any) -> dict[str, Any]:

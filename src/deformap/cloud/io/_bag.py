@@ -39,6 +39,7 @@ __all__ = [
     "RawBagMessage",
     "StampedCloud",
     "WrenchSeries",
+    "bag_error_text",
     "bag_read_errors",
     "iter_bag_messages",
     "read_bag_clouds",
@@ -134,6 +135,14 @@ def bag_read_errors() -> tuple[type[BaseException], ...]:
     return (*errors, apsw.Error)
 
 
+def bag_error_text(exc: BaseException, limit: int = 200) -> str:
+    """``exc`` as ``"TypeName: message"`` on one line, the message cut at ``limit`` characters:
+    what a damaged bag's error says after the bag's name. rosbags passes on its drivers' and
+    parsers' messages as they come, some of several lines (a YAML parser's, pointing at the
+    column) that would break an error's one line."""
+    return f"{type(exc).__name__}: {' '.join(str(exc).split())[:limit]}"
+
+
 def _zstd_errors() -> tuple[type[BaseException], ...]:
     """The ``ZstdError`` of the zstd module rosbags decompresses MCAP chunks with (the standard
     library's from Python 3.14, else ``backports.zstd``), if it is there."""
@@ -216,17 +225,35 @@ def iter_bag_messages(path: Any, topics: Mapping[str, str],
                 wrong = [c.msgtype for c in conns if c.msgtype != msgtype]
                 if wrong:
                     raise FileFormatError(
-                        f"{p}: topic {topic!r} carries {wrong[0]}, expected {msgtype}"
+                        f"{p}: topic {topic!r} carries {wrong[0] or repr(wrong[0])}, expected "
+                        f"{msgtype}"
                     )
             conns = [c for c in reader.connections if c.topic in wanted]
+            counts: dict[str, int] = {}
             for conn, log_time, raw in reader.messages(connections=conns):
-                yield RawBagMessage(conn.topic, int(log_time), raw)
+                number = counts[conn.topic] = counts.get(conn.topic, -1) + 1
+                _check_row(p, conn.topic, number, log_time, raw)
+                yield RawBagMessage(conn.topic, log_time, raw)
     except DeformapError:
         raise
     except errors as exc:
         raise FileFormatError(
-            f"{p}: could not read {what}: {type(exc).__name__}: {str(exc)[:200]}"
+            f"{p}: could not read {what}: {bag_error_text(exc)}"
         ) from exc
+
+
+def _check_row(path: Path, topic: str, number: int, log_time: Any, data: Any) -> None:
+    """A message's log time must be an integer and its data bytes. An sqlite3 bag stores any
+    type in any column: a number in ``data`` would otherwise be taken as that many zero bytes
+    (``bytes(10**12)`` allocates a terabyte), text as a string to encode."""
+    if not isinstance(data, (bytes, bytearray, memoryview)):
+        what, value = "its data as bytes", data
+    elif not isinstance(log_time, int) or isinstance(log_time, bool):
+        what, value = "an integer log time [ns]", log_time
+    else:
+        return
+    raise FileFormatError(f"{path} [{topic} message {number} of the topic]: expected {what}; got "
+                          f"{type(value).__name__} {str(value)[:40]!r}")
 
 
 _MCAP_MAGIC = b"\x89MCAP0\r\n"
@@ -310,8 +337,7 @@ def _messages(path: Any, topic: str, msgtype: str) -> Iterator[tuple[int, Any]]:
             msg = store.deserialize_cdr(raw.data, msgtype)
         except errors as exc:
             raise FileFormatError(
-                f"{Path(path)}: could not read topic {topic!r}: {type(exc).__name__}: "
-                f"{str(exc)[:200]}"
+                f"{Path(path)}: could not read topic {topic!r}: {bag_error_text(exc)}"
             ) from exc
         yield raw.log_time_ns, msg
 
