@@ -219,7 +219,11 @@ def judge(result: Any) -> str | None:
 
 # ----------------------------------------------------------------------------- the benchmark
 
-ENDINGS = ("clean", "usage", "traceback", "hang", "other")
+#: How a mutant ended: one ``error:`` line that names the mutated option or its value
+#: (``named``), one that names the guard's destination instead (``guard``: the run stopped at the
+#: guard, which does not show that the value itself would have been refused), one that names
+#: neither (``clean``); the parser's usage box (``usage``); a traceback, a hang, anything else.
+ENDINGS = ("named", "guard", "clean", "usage", "traceback", "hang", "other")
 
 
 @dataclass
@@ -230,9 +234,26 @@ class CliCase:
     detail: str
 
 
-def _ending(result: Any, problem: str | None) -> str:
+def _names(option: str) -> tuple[str, ...]:
+    """How an error line may name ``option`` (``--max-pokes``): as given, bare, or as the
+    setting it fills (``max_pokes``)."""
+    bare = option.lstrip("-")
+    return (option, f"`{bare}`", f"`{bare.replace('-', '_')}`", bare.replace("-", "_"))
+
+
+def _ending(result: Any, problem: str | None, mutant: CliMutant | None = None,
+            paths: dict[str, str] | None = None) -> str:
     if problem is None:
-        return "usage" if "Usage:" in result.output else "clean"
+        if "Usage:" in result.output:
+            return "usage"
+        if mutant is None or paths is None:
+            return "clean"
+        line = next(x for x in result.output.splitlines() if x.startswith("error:"))
+        guard = (paths["file"], paths["dir"])
+        value = mutant.value if mutant.value.strip() and mutant.value not in guard else None
+        if any(name in line for name in _names(mutant.option)) or (value and value in line):
+            return "named"
+        return "guard" if any(g in line for g in guard) else "clean"
     if problem.startswith("hang"):
         return "hang"
     if problem.startswith(("raised", "printed a traceback")):
@@ -254,6 +275,6 @@ def run_cli(count: int, seed: int, work: Path) -> list[CliCase]:
             result = invoke(runner, args)
             problem = judge(result)
             cases.append(CliCase(mutant.kind, " ".join((*mutant.path, mutant.option)),
-                                 _ending(result, problem),
+                                 _ending(result, problem, mutant, paths),
                                  f"{' '.join(args)[:160]}: {problem}"))  # fmt: skip
     return cases

@@ -29,11 +29,12 @@ in a worker process under a per-case time limit, and counted as:
 - ``changed``: accepted with other data, where no check could know (a flipped bit in a coordinate
   of a format without checksum, a number edited in ``session.yaml`` or a raw bag's settings, a
   raw bag's message damaged with the CRCs made to match; in a ``.db3``, which has no checksum, a
-  flipped byte, a message's bytes edited in place, a row deleted or repeated, a topic's field);
+  flipped byte, a message's bytes edited in place, a topic's field);
 - ``silent``: accepted with other data where a check could have caught it: a different number of
   points or pokes, a structural mutant (truncation, count change, appended bytes, a message's
   length changed) accepted as different data, or any change to a file covered by a checksum (NPZ
-  members, a session's ``sha256`` manifest, a raw bag's chunk and summary CRCs);
+  members, a session's ``sha256`` manifest, a raw bag's chunk and summary CRCs), and a ``.db3``
+  row deleted or repeated (the bag's metadata table counts its messages);
 - ``traceback``: any other exception, or an error of several lines; ``hang``: over the time
   limit.
 
@@ -196,9 +197,10 @@ def _raw_change(reader: str, kind: str) -> str:
     # or record mutant is one they could have caught. A message rewritten with its CRCs made to
     # match, or a settings YAML a user edits, is other valid data, unless the message's length
     # changed (the decoder could tell). A sqlite3 bag carries no CRC: a flipped byte, a
-    # message's data edited, a row deleted or repeated or a topic's field changed is other data
-    # nothing could tell, unless bytes or a message were cut or added.
-    if kind in STRUCTURAL:
+    # message's data edited or a topic's field changed is other data nothing could tell, unless
+    # bytes or a message were cut or added; a row deleted or repeated disagrees with the message
+    # counts in the bag's metadata table, which the reader compares.
+    if kind in STRUCTURAL or (reader == "raw-db3" and kind in ("row-delete", "row-repeat")):
         return "silent"
     if reader == "raw-db3" or kind == "yaml" or kind.startswith("message-"):
         return "changed"
@@ -330,10 +332,11 @@ def cli_table(cases: list[Any]) -> str:
     """A markdown table of command-line mutants: one row per value kind, the options given it
     and the count of each ending."""
     return _count_table(
-        ["value kind", "mutants", "options", "clean errors (one line)", "usage errors (parser)",
+        ["value kind", "mutants", "options", "one line naming the option or value",
+         "one line naming the guard", "one line naming neither", "usage errors (parser)",
          "tracebacks", "hangs", "other endings"],
         sorted(cases, key=lambda c: c.kind), "kind", "ending",
-        ("clean", "usage", "traceback", "hang", "other"),
+        ("named", "guard", "clean", "usage", "traceback", "hang", "other"),
         lambda mine: [str(len(mine)), str(len({c.option for c in mine}))])
 
 

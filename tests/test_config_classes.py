@@ -189,3 +189,14 @@ def test_rules_between_fields_name_a_field_too(
     section = SECTIONS[cls]
     with pytest.raises(ConfigError, match=rf"^`config\.{section}\.{name}` "):
         config_from_dict(RunConfig, _nested(section, kwargs))
+
+
+def test_a_file_that_is_no_run_config_is_named_without_its_whole_text(tmp_path) -> None:
+    """`--config /etc/passwd` read as one long string: the error says what came in one short
+    line, not the file's whole text."""
+    text = "root:x:0:0:root:/root:/bin/bash " * 40
+    with pytest.raises(ConfigError) as info:
+        config_from_dict(RunConfig, text, where="passwd")
+    message = str(info.value)
+    assert message.startswith("`passwd` must be a mapping of settings; got str of 1280 characters")
+    assert len(message) < 200

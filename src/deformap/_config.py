@@ -88,7 +88,10 @@ def config_from_dict(cls: type[T], data: Any, *, where: str = "config") -> T:
     if data is None:
         data = {}
     if not isinstance(data, dict):
-        raise ConfigError(f"`{where}` must be a mapping of settings; got {data!r}")
+        shown = repr(data)
+        if len(shown) > 80:  # a whole file read as one string (a file that is no run config)
+            shown = f"{type(data).__name__} of {len(str(data))} characters, {shown[:60]}…"
+        raise ConfigError(f"`{where}` must be a mapping of settings; got {shown}")
     fields = {f.name: f for f in dataclasses.fields(cls) if f.init}  # type: ignore[arg-type]
     # files written by an older version: the class reads them as they were meant
     upgrade = getattr(cls, "upgrade_settings", None)

@@ -354,3 +354,13 @@ def test_mcap_written_by_deformap_reads_with_crc_checks_in_the_mcap_library(
     with open(data_file, "rb") as fh:
         reader = reader_module.make_reader(fh, validate_crcs=True)
         assert sum(1 for _ in reader.iter_messages()) == 2
+
+
+def test_a_programs_fault_is_not_read_as_a_damaged_bag() -> None:
+    from deformap.cloud.io import bag_error_text
+
+    assert bag_error_text(RuntimeError("LZ4F_decompress failed:\n  ERROR_frameType")) == \
+        "RuntimeError: LZ4F_decompress failed: ERROR_frameType"  # lz4's, on one line
+    for fault in (NotImplementedError("no such codec path"), RecursionError("deep")):
+        with pytest.raises(type(fault)):
+            bag_error_text(fault)

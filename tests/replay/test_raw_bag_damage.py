@@ -226,3 +226,34 @@ def test_an_observation_without_its_camera_transform_names_the_bag(session: Any,
         _open(bag)
     assert str(info.value).startswith(f"{bag}: the observation [/camera/depth/color/points]: "
                                       "no frame 'world'")
+
+
+@pytest.mark.parametrize("edit", [
+    "DELETE FROM messages WHERE id = (SELECT max(id) FROM messages WHERE topic_id = "
+    "(SELECT id FROM topics WHERE name = '/tf'))",
+    "INSERT INTO messages(topic_id, timestamp, data) SELECT topic_id, timestamp, data "
+    "FROM messages WHERE id = (SELECT min(id) FROM messages WHERE topic_id = "
+    "(SELECT id FROM topics WHERE name = '/tf'))",
+])
+def test_a_db3_row_lost_or_repeated_is_told_by_the_bags_own_counts(
+        session: Any, tmp_path: Path, edit: str) -> None:
+    """sqlite3 keeps no checksum; the message counts rosbag2 leaves in the bag's metadata table
+    tell a lost or repeated row (it reads as other data otherwise)."""
+    bag = _db3(tmp_path, session)
+    _open(bag)  # as written: the counts agree
+    _sql(bag, edit)
+    with pytest.raises(FileFormatError) as info:
+        _open(bag)
+    message = str(info.value)
+    assert message.startswith(f"{bag}: topic '/tf' holds") and "metadata says" in message
+    assert len(message.splitlines()) == 1
+
+
+def test_a_db3_whose_metadata_is_not_rosbag2_yaml_is_refused_on_one_line(
+        session: Any, tmp_path: Path) -> None:
+    bag = _db3(tmp_path, session)
+    _sql(bag, "UPDATE metadata SET metadata = ?", "rosbag2_bagfile_information: [\n  1")
+    with pytest.raises(FileFormatError) as info:
+        _open(bag)
+    assert "metadata table's YAML" in str(info.value)
+    assert len(str(info.value).splitlines()) == 1

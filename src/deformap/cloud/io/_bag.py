@@ -41,6 +41,7 @@ __all__ = [
     "WrenchSeries",
     "bag_error_text",
     "bag_read_errors",
+    "check_db3_counts",
     "iter_bag_messages",
     "read_bag_clouds",
     "read_bag_static_transform",
@@ -139,7 +140,13 @@ def bag_error_text(exc: BaseException, limit: int = 200) -> str:
     """``exc`` as ``"TypeName: message"`` on one line, the message cut at ``limit`` characters:
     what a damaged bag's error says after the bag's name. rosbags passes on its drivers' and
     parsers' messages as they come, some of several lines (a YAML parser's, pointing at the
-    column) that would break an error's one line."""
+    column) that would break an error's one line.
+
+    :func:`bag_read_errors` takes ``RuntimeError`` for lz4's damaged-chunk error; its
+    subclasses ``NotImplementedError`` and ``RecursionError`` are a program's faults, not a bag's,
+    and are raised again here instead of being read as a damaged bag."""
+    if isinstance(exc, (NotImplementedError, RecursionError)):
+        raise exc
     return f"{type(exc).__name__}: {' '.join(str(exc).split())[:limit]}"
 
 
@@ -210,6 +217,8 @@ def iter_bag_messages(path: Any, topics: Mapping[str, str],
     errors = bag_read_errors()
     for file in sorted(p.glob("*.mcap")) if p.is_dir() else [p]:
         check_mcap_crcs(file)
+    for file in sorted(p.glob("*.db3")) if p.is_dir() else [p]:
+        check_db3_counts(file)
     try:
         with rosbag2.Reader(p) as reader:
             found = sorted({c.topic for c in reader.connections})
@@ -260,8 +269,11 @@ _MCAP_MAGIC = b"\x89MCAP0\r\n"
 _FOOTER = struct.Struct("<BQQQI")  # opcode 0x02, length 20, summary start, offsets start, CRC
 _DATA_END = struct.Struct("<BQI")  # opcode 0x0F, length 4, the data section's CRC
 _BLOCK = 1 << 20
-#: MCAP files whose CRCs were verified: (path, size, mtime) → None; a bag is read in passes.
-_VERIFIED: dict[tuple[str, int, int], None] = {}
+#: MCAP files whose CRCs were verified, a bag being read in passes: (path, inode, size, mtime,
+#: ctime) → None (a file rewritten in place changes its ctime too), the last
+#: :data:`_VERIFIED_KEPT` of them.
+_VERIFIED: dict[tuple[str, int, int, int, int], None] = {}
+_VERIFIED_KEPT = 256
 
 
 def _crc32(fh: Any, start: int, end: int) -> int:
@@ -273,6 +285,67 @@ def _crc32(fh: Any, start: int, end: int) -> int:
             break
         crc, left = zlib.crc32(block, crc), left - len(block)
     return crc
+
+
+#: The most bytes of a sqlite3 bag's metadata YAML read (rosbag2 writes a few kilobytes).
+_DB3_METADATA_BYTES = 16 * 2**20
+
+
+def check_db3_counts(path: Path) -> None:
+    """Compare each topic's messages in a sqlite3 bag with the count its writer left in the
+    bag's own ``metadata`` table (rosbag2 since Iron, and rosbags' writer, store the bag's
+    ``metadata.yaml`` there; rosbags counts the rows and does not read it). sqlite3 keeps no
+    checksum, so this is what tells a message row lost or repeated. A file that is no sqlite3
+    database, or one without that table (older bags), is not checked here.
+
+    Raises
+    ------
+    FileFormatError
+        A topic holds another number of messages than the metadata says, or the metadata is not
+        a rosbag2 metadata YAML: one line naming the file and what differs.
+    """
+    import yaml
+
+    if path.suffix != ".db3" or path_kind(path) != "file":
+        return
+    try:
+        conn = sqlite3.connect(f"{path.resolve().as_uri()}?mode=ro", uri=True)
+    except sqlite3.Error:
+        return
+    try:
+        tables = {r[0] for r in conn.execute("SELECT name FROM sqlite_master WHERE type='table'")}
+        if not {"metadata", "topics", "messages"} <= tables:
+            return
+        row = conn.execute("SELECT metadata FROM metadata ORDER BY id DESC LIMIT 1").fetchone()
+        rows = conn.execute("SELECT topics.name, count(messages.id) FROM topics LEFT JOIN "
+                            "messages ON topics.id == messages.topic_id GROUP BY topics.id")
+        found: dict[str, int] = {}
+        for name, count in rows:
+            found[str(name)] = found.get(str(name), 0) + int(count)
+    except sqlite3.Error:
+        return  # the reader refuses a damaged database itself, naming it
+    finally:
+        conn.close()
+    if row is None:
+        return
+    text = row[0]
+    if not isinstance(text, str) or len(text) > _DB3_METADATA_BYTES:
+        raise FileFormatError(f"{path}: the metadata table must hold rosbag2's metadata YAML; "
+                              f"got {type(text).__name__} of {len(text or '')} characters")
+    try:
+        doc = yaml.safe_load(text)
+        # the table holds the bag information itself (metadata.yaml wraps it in this key)
+        info = doc.get("rosbag2_bagfile_information", doc)
+        declared = {str(t["topic_metadata"]["name"]): int(t["message_count"])
+                    for t in info["topics_with_message_count"]}
+    except (yaml.YAMLError, AttributeError, KeyError, TypeError, ValueError) as exc:
+        raise FileFormatError(f"{path}: the metadata table's YAML is not rosbag2's bag "
+                              f"information: {bag_error_text(exc, 120)}") from None
+    for name, count in declared.items():
+        if name in found and found[name] != count:
+            raise FileFormatError(
+                f"{path}: topic {name!r} holds {found[name]} messages where the bag's metadata "
+                f"says {count}: messages were lost or repeated after it was written")
 
 
 def check_mcap_crcs(path: Path) -> None:
@@ -291,7 +364,7 @@ def check_mcap_crcs(path: Path) -> None:
         stat = path.stat()
     except OSError:
         return
-    key = (str(path.resolve()), stat.st_size, stat.st_mtime_ns)
+    key = (str(path.resolve()), stat.st_ino, stat.st_size, stat.st_mtime_ns, stat.st_ctime_ns)
     if key in _VERIFIED or stat.st_size < 2 * len(_MCAP_MAGIC) + _FOOTER.size:
         return
     footer_at = stat.st_size - len(_MCAP_MAGIC) - _FOOTER.size
@@ -324,6 +397,8 @@ def check_mcap_crcs(path: Path) -> None:
                         f"{path}: the MCAP data section fails its CRC-32: expected "
                         f"{data_crc:#010x} (the DataEnd record's), got {got:#010x}")
     _VERIFIED[key] = None
+    while len(_VERIFIED) > _VERIFIED_KEPT:
+        del _VERIFIED[next(iter(_VERIFIED))]
 
 
 def _messages(path: Any, topic: str, msgtype: str) -> Iterator[tuple[int, Any]]:
