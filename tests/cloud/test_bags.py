@@ -175,14 +175,14 @@ def test_millimetre_and_all_nan_messages_are_refused(tmp_path: Path) -> None:
     bag = tmp_path / "mm"
     write_bag(bag, clouds={"/pts": [(1, PointCloud(_cloud(1).points * 1000, frame="cam"))]})
     with pytest.raises(
-        FileFormatError, match=r"\[/pts message 0\]: coordinates reach .* units='mm'"
+        FileFormatError, match=r"\[/pts message 1\]: coordinates reach .* units='mm'"
     ):
         read_bag_clouds(bag, "/pts")
     got = read_bag_clouds(bag, "/pts", units="mm")[0].cloud
     np.testing.assert_allclose(got.points, _cloud(1).points, rtol=1e-6)
     bag = tmp_path / "nan"
     _write_raw_cloud_bag(bag, "mcap", [_organised_big_endian(np.full((4, 3), np.nan), 2)])
-    with pytest.raises(FileFormatError, match=r"\[/pts message 0\]: the cloud is empty"):
+    with pytest.raises(FileFormatError, match=r"\[/pts message 1\]: the cloud is empty"):
         read_bag_clouds(bag, "/pts")
 
 

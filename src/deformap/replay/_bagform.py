@@ -131,7 +131,7 @@ class BagReader:
                     by_stamp.setdefault(stamp, msg)
                 except errors as exc:
                     self._undecodable.setdefault(topic, []).append(
-                        f"message {number}: {bag_error_text(exc, 120)}"
+                        f"message {number + 1}: {bag_error_text(exc, 120)}"
                     )
             decoded[key] = by_stamp
         self._decoded = decoded

@@ -142,8 +142,10 @@ class RawBagReader:
         w_force: list[list[float]] = []
         w_frames: set[str] = set()
         types = {**topics, **optional}
-        for number, raw in enumerate(iter_bag_messages(self.path, topics, optional=optional)):
-            where = f"{self.path} [{raw.topic} message {number}]"
+        seen: dict[str, int] = {}  # messages of each topic so far: errors number them from 1
+        for raw in iter_bag_messages(self.path, topics, optional=optional):
+            seen[raw.topic] = seen.get(raw.topic, 0) + 1
+            where = f"{self.path} [{raw.topic} message {seen[raw.topic]}]"
             try:
                 msg = store.deserialize_cdr(bytes(raw.data), types[raw.topic])
             except errors as exc:
@@ -172,7 +174,7 @@ class RawBagReader:
         if bad.any():
             first = int(order[np.flatnonzero(bad)[0]])
             raise FileFormatError(
-                f"{self.path} [{cfg.wrench_topic} message {first} of the topic]: force "
+                f"{self.path} [{cfg.wrench_topic} message {first + 1}]: force "
                 f"{w_force[first]} N: expected finite components within ±{MAX_FORCE_N:g} N "
                 "(no force sensor reads more: a damaged message)")
         self.cloud_ns = np.asarray(stamps, dtype=np.int64)
@@ -253,7 +255,7 @@ class RawBagReader:
             number += 1
             if number not in wanted:
                 continue
-            where = f"{self.path} [{cfg.cloud_topic} message {number}]"
+            where = f"{self.path} [{cfg.cloud_topic} message {number + 1}]"
             try:
                 msg = store.deserialize_cdr(bytes(raw.data), _CLOUD)
                 xyz = self._xyz(msg, where)

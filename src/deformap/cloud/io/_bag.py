@@ -261,7 +261,7 @@ def _check_row(path: Path, topic: str, number: int, log_time: Any, data: Any) ->
         what, value = "an integer log time [ns]", log_time
     else:
         return
-    raise FileFormatError(f"{path} [{topic} message {number} of the topic]: expected {what}; got "
+    raise FileFormatError(f"{path} [{topic} message {number + 1}]: expected {what}; got "
                           f"{type(value).__name__} {str(value)[:40]!r}")
 
 
@@ -519,7 +519,7 @@ def read_bag_clouds(
     transforms: dict[str, NDArray[np.float64]] = {}
     out = []
     for index, (log_time, msg) in enumerate(_messages(path, topic, CLOUD_TYPE)):
-        where = f"{path} [{topic} message {index}]"
+        where = f"{path} [{topic} message {index + 1}]"
         cloud, dropped = _to_cloud(msg, where, scale, msg.header.frame_id or "sensor", True)
         if cam2world is not None:
             if fixed is None:
