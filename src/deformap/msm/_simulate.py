@@ -271,7 +271,7 @@ class PokeModel:
         # on the odds scale β = 0 carries no load: the rigid body at rest, exactly (rest is the
         # fixed point of rigid goals), which the relative stopping test could not confirm below
         # round-off
-        moving = self.load_scale(betas) > 0.0 if self.odds else np.ones(len(betas), dtype=bool)
+        moving = self.load_scale(betas) > 0.0
         if moving.any():
             sub = betas[moving]
             if x0 is not None:

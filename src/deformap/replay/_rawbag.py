@@ -142,10 +142,8 @@ class RawBagReader:
         w_force: list[list[float]] = []
         w_frames: set[str] = set()
         types = {**topics, **optional}
-        seen: dict[str, int] = {}  # messages of each topic so far: errors number them from 1
         for raw in iter_bag_messages(self.path, topics, optional=optional):
-            seen[raw.topic] = seen.get(raw.topic, 0) + 1
-            where = f"{self.path} [{raw.topic} message {seen[raw.topic]}]"
+            where = f"{self.path} [{raw.topic} message {raw.number}]"
             try:
                 msg = store.deserialize_cdr(bytes(raw.data), types[raw.topic])
             except errors as exc:
@@ -250,12 +248,11 @@ class RawBagReader:
             for frame in group.frames:
                 wanted.setdefault(frame, []).append(group)
         cfg, store, errors = self.config, typestore(), bag_read_errors()
-        number = -1
         for raw in iter_bag_messages(self.path, {cfg.cloud_topic: _CLOUD}):
-            number += 1
+            number = raw.number - 1  # the frame index the groups name
             if number not in wanted:
                 continue
-            where = f"{self.path} [{cfg.cloud_topic} message {number + 1}]"
+            where = f"{self.path} [{cfg.cloud_topic} message {raw.number}]"
             try:
                 msg = store.deserialize_cdr(bytes(raw.data), _CLOUD)
                 xyz = self._xyz(msg, where)

@@ -174,11 +174,14 @@ class RawBagMessage:
     data : bytes or memoryview
         The CDR bytes (``typestore().deserialize_cdr(data, msgtype)`` decodes them); a view may
         be valid only until the next message is read, so keep ``bytes(data)``.
+    number : int
+        Its place among its topic's messages in the bag's order, from 1 (as errors name it).
     """
 
     topic: str
     log_time_ns: int
     data: bytes | memoryview
+    number: int = 0
 
 
 def iter_bag_messages(path: Any, topics: Mapping[str, str],
@@ -240,9 +243,9 @@ def iter_bag_messages(path: Any, topics: Mapping[str, str],
             conns = [c for c in reader.connections if c.topic in wanted]
             counts: dict[str, int] = {}
             for conn, log_time, raw in reader.messages(connections=conns):
-                number = counts[conn.topic] = counts.get(conn.topic, -1) + 1
+                number = counts[conn.topic] = counts.get(conn.topic, 0) + 1
                 _check_row(p, conn.topic, number, log_time, raw)
-                yield RawBagMessage(conn.topic, log_time, raw)
+                yield RawBagMessage(conn.topic, log_time, raw, number)
     except DeformapError:
         raise
     except errors as exc:
@@ -261,7 +264,7 @@ def _check_row(path: Path, topic: str, number: int, log_time: Any, data: Any) ->
         what, value = "an integer log time [ns]", log_time
     else:
         return
-    raise FileFormatError(f"{path} [{topic} message {number + 1}]: expected {what}; got "
+    raise FileFormatError(f"{path} [{topic} message {number}]: expected {what}; got "
                           f"{type(value).__name__} {str(value)[:40]!r}")
 
 
