@@ -31,7 +31,7 @@ def test_every_command_group_is_registered() -> None:
     for name in ("explore", "record-sim", "map", "estimate", "reproduce", "scenarios", "bench",
                  "config", "study", "world"):  # fmt: skip
         assert name in result.output
-    for group, names in (("bench", ("speed", "world", "io", "memory", "worlds")),
+    for group, names in (("bench", ("speed", "world", "io", "memory", "worlds", "rescore")),
                          ("study", ("hardness", "cluster-size")), ("world", ("show",))):  # fmt: skip
         result = runner.invoke(app, [group, "--help"])
         assert result.exit_code == 0 and all(n in result.output for n in names), result.output

@@ -9,6 +9,7 @@ import json
 import numpy as np
 import pytest
 
+from deformap.errors import InvalidArgumentError
 from deformap.eval import (
     CSV_COLUMNS,
     FORCES_N,
@@ -17,6 +18,7 @@ from deformap.eval import (
     choices,
     draw_world,
     markdown_summary,
+    rescore_world,
     row_values,
     run_world,
     runs_csv,
@@ -130,6 +132,24 @@ def test_one_world_is_mapped_to_max_pokes_by_every_combination() -> None:
     assert rows[-1]["modulus_error"] is not None and rows[-1]["modulus_error"] >= 0
     json.dumps(result)  # plain data crosses processes
     assert np.isfinite([r["poke_s"] for r in rows]).all()
+    for field in ("beta", "modulus"):
+        stored = result["pokes"][f"paper/{field}"]
+        assert sorted(stored) == ["index", "noise", "value", "x", "y"]
+        assert 1 <= len(stored["value"]) <= 2 and stored["index"] == sorted(stored["index"])
+    # the stored pokes score the run's cuts again to the bit, through JSON, in another order
+    again = rescore_world(task, json.loads(json.dumps(result)), ["nearest", "isopleth"])
+    key = lambda r: (r["field"], r["poke"], r["cut"])  # noqa: E731
+    assert sorted(again["rows"], key=key) == sorted(rows, key=key)
+
+
+def test_a_world_without_stored_pokes_cannot_be_rescored() -> None:
+    task = {"seed": 5, "index": 0, "families": ["l-shape"], "physics": ["linear-fem"],
+            "strategies": ["paper"], "fields": ["beta"], "cuts": ["nearest"], "max_pokes": 2,
+            "coarse": True}
+    with pytest.raises(InvalidArgumentError, match="pokes stored; got status 'ok' and no pokes"):
+        rescore_world(task, {"status": "ok", "rows": []}, ["nearest"])
+    with pytest.raises(InvalidArgumentError, match="status 'failed'"):
+        rescore_world(task, {"status": "failed", "rows": [], "pokes": {}}, ["nearest"])
 
 
 def test_the_command_refuses_bad_names_in_one_line_before_any_folder(tmp_path) -> None:

@@ -72,3 +72,40 @@ def test_settings_are_checked_against_the_config_literals() -> None:
         WorldsBenchConfig(cuts=("voronoi",))
     with pytest.raises(InvalidArgumentError, match="`families` must be"):
         WorldsBenchConfig(families=())
+
+
+def test_rescore_scores_other_cuts_on_the_stored_pokes_and_names_what_it_cannot(tmp_path) -> None:
+    from typer.testing import CliRunner
+
+    from deformap.cli import app
+
+    runner = CliRunner()
+    bench_worlds(_config(worlds=2), tmp_path / "src")
+    result = runner.invoke(app, ["bench", "rescore", str(tmp_path / "src"), "--out",
+                                 str(tmp_path / "again"), "--cuts", "isopleth,nearest",
+                                 "--no-merge-seams"])
+    assert result.exit_code == 0, result.output
+    again = _values(tmp_path / "again")
+    assert [r for r in again if r["cut"] == "isopleth"] == _values(tmp_path / "src")
+    assert {r["cut"] for r in again} == {"isopleth", "nearest"} and len(again) == 2 * 2 * 2
+    settings = json.loads((tmp_path / "again" / "bench.json").read_text())
+    assert settings["rescored_from"] == str(tmp_path / "src")
+    assert settings["settings"]["cuts"] == ["isopleth", "nearest"]
+    assert "paper/beta/nearest" in json.loads((tmp_path / "again" / "summary.json").read_text())[
+        "strategies"]
+    # the folder must be new; a world from before the pokes were stored is named
+    result = runner.invoke(app, ["bench", "rescore", str(tmp_path / "src"), "--out",
+                                 str(tmp_path / "again")])
+    assert result.exit_code == 2 and "--out" in result.output
+    world = tmp_path / "src" / "worlds" / "world-00001.json"
+    stored = json.loads(world.read_text())
+    del stored["pokes"]
+    world.write_text(json.dumps(stored))
+    result = runner.invoke(app, ["bench", "rescore", str(tmp_path / "src"), "--out",
+                                 str(tmp_path / "third")])
+    assert result.exit_code == 2
+    assert "1 without (worlds [1]: run before pokes were stored)" in result.output
+    assert "Traceback" not in result.output and not (tmp_path / "third").exists()
+    result = runner.invoke(app, ["bench", "rescore", str(tmp_path), "--out",
+                                 str(tmp_path / "fourth")])
+    assert result.exit_code == 2 and "is not a worlds benchmark" in result.output

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from deformap.errors import InvalidArgumentError
-from deformap.explore._regions import segment_regions
+from deformap.explore._regions import merge_seam_classes, segment_regions
 
 
 def test_three_separated_classes_give_three_bands() -> None:
@@ -112,3 +112,44 @@ def test_nearest_poke_labels_give_each_cell_its_nearest_pokes_class() -> None:
         found.nearest_poke(pokes[:3], cells)
     with pytest.raises(InvalidArgumentError, match="`cells_xy`"):
         found.nearest_poke(pokes, cells[:-1])
+
+
+def _grid_pokes(value_at) -> tuple[np.ndarray, np.ndarray]:
+    xs = np.linspace(0.0, 0.2, 5)
+    xy = np.array([(x, y) for y in xs for x in xs])
+    return xy, np.array([value_at(x, y) for x, y in xy])
+
+
+def test_a_class_of_seam_pokes_joins_the_classes_it_lies_between() -> None:
+    """Soft on the left, hard on the right, the middle column pressed on the seam reads between;
+    taken for a material by the values alone, it is merged once its pokes border both sides."""
+    xy, value = _grid_pokes(lambda x, y: 0.0 if x < 0.09 else 2.0 if x > 0.11 else
+                            (0.9 if y < 0.1 else 1.1))
+    std = np.full(value.size, 0.05)
+    found = segment_regions(np.zeros((2, 2)), value, std)
+    assert found.n_regions == 4  # the seam's 0.9s and 1.1s are two classes of their own
+    merged = merge_seam_classes(found, np.zeros((2, 2)), xy, value)
+    assert merged.n_regions == 2
+    middle = np.isclose(xy[:, 0], 0.1)
+    # each seam poke ends on the side nearer its value: 0.9 soft, 1.1 hard
+    assert merged.poke_labels[middle & (value < 1.0)].tolist() == [0, 0]
+    assert merged.poke_labels[middle & (value > 1.0)].tolist() == [1, 1, 1]
+    np.testing.assert_allclose(merged.class_betas, [
+        value[merged.poke_labels == 0].mean(), value[merged.poke_labels == 1].mean()])
+
+
+def test_a_material_with_pokes_inside_it_is_not_a_seam() -> None:
+    """A middle value whose block has pokes bordering only its own class stays a region."""
+    xy, value = _grid_pokes(lambda x, y: 0.0 if x < 0.09 else 1.0 if y > 0.09 else 2.0)
+    found = segment_regions(np.zeros((2, 2)), value, np.full(value.size, 0.05))
+    merged = merge_seam_classes(found, np.zeros((2, 2)), xy, value)
+    assert merged.n_regions == found.n_regions == 3
+    np.testing.assert_array_equal(merged.poke_labels, found.poke_labels)
+
+
+def test_seams_are_not_judged_without_a_triangulation() -> None:
+    xy = np.column_stack([np.linspace(0, 0.2, 7), np.zeros(7)])  # one line of pokes
+    value = np.array([0.0, 0.0, 0.0, 1.0, 2.0, 2.0, 2.0])
+    found = segment_regions(np.zeros((2, 2)), value, np.full(7, 0.05))
+    merged = merge_seam_classes(found, np.zeros((2, 2)), xy, value)
+    np.testing.assert_array_equal(merged.poke_labels, found.poke_labels)

@@ -174,6 +174,10 @@ def bench_worlds_command(
         help="Region labels (exploration.region_labels), each scored on the same pokes; "
              "comma-separated (or repeated); default: all.", show_default=False)] = None,
     max_pokes: Annotated[int, typer.Option(help="Pokes per world and combination.")] = 12,
+    merge_seams: Annotated[bool | None, typer.Option(
+        "--merge-seams/--no-merge-seams",
+        help="Merge the classes of seam pokes before cutting (exploration.merge_seams); "
+             "default: the exploration's.", show_default=False)] = None,
     coarse: Annotated[bool, typer.Option(
         help="The coarse test mesh and camera: a third of the cost, a smoke run only (its 2 cm "
              "mesh reads E far off).")] = False,
@@ -189,14 +193,20 @@ def bench_worlds_command(
     curves per layout family and the pokes a good map takes (resumes in its --out)."""
     from deformap import run
 
-    given = {"families": _names(families), "strategies": _names(strategies),
-             "fields": _names(fields), "physics": _names(physics), "cuts": _names(cuts)}
+    given: dict[str, Any] = {"families": _names(families), "strategies": _names(strategies),
+                             "fields": _names(fields), "physics": _names(physics),
+                             "cuts": _names(cuts), "merge_seams": merge_seams}
     config = run.WorldsBenchConfig(
         worlds=worlds, seed=seed, max_pokes=max_pokes, coarse=coarse, workers=workers,
         scheduler=scheduler, **{k: v for k, v in given.items() if v is not None})
     shown = out_console(json_path)
     with progress(shown) as bar:
         output = run.bench_worlds(config, out, hooks=run_hooks(bar))
+    _show_worlds_summary(shown, output, config.worlds, config.max_pokes, json_path)
+
+
+def _show_worlds_summary(shown: Any, output: Any, worlds: int, max_pokes: int,
+                         json_path: Path | None) -> None:
     summary = output.summary
     rows = []
     for name, s in summary["strategies"].items():
@@ -209,11 +219,39 @@ def bench_worlds_command(
                      "–" if final is None else f"{final:.3f}",
                      "–" if error is None else f"{error:.2f}"))  # fmt: skip
     shown.print(_table(
-        f"{len(rows)} combinations over {config.worlds} worlds, {config.max_pokes} pokes "
-        f"(a world never at 0.9 counts {config.max_pokes + 1})",
+        f"{len(rows)} combinations over {worlds} worlds, {max_pokes} pokes "
+        f"(a world never at 0.9 counts {max_pokes + 1})",
         ("strategy/field/cut", "worlds", "pokes to 0.9", "to stay", "reach 0.9",
          "final accuracy", "E error"),
         rows))  # fmt: skip
     shown.print(f"{output.computed} worlds computed in {output.seconds:.0f} s → {output.folder}",
                 highlight=False)
     emit_json(json_path, summary)
+
+
+@bench_app.command("rescore")
+@friendly_errors
+def bench_rescore_command(
+    source: Annotated[Path, typer.Argument(help="A `bench worlds` folder whose worlds stored "
+                                                "their pokes.", show_default=False)],
+    out: Annotated[Path, typer.Option(help="The new folder for the rescored benchmark.",
+                                      show_default=False)],
+    cuts: Annotated[list[str] | None, typer.Option(
+        "--cuts", "--cut", help="Region labels to score; comma-separated (or repeated); "
+                                "default: the source's.", show_default=False)] = None,
+    merge_seams: Annotated[bool | None, typer.Option(
+        "--merge-seams/--no-merge-seams",
+        help="Merge the classes of seam pokes before cutting; default: the source's.",
+        show_default=False)] = None,
+    json_path: JsonOption = None,
+) -> None:
+    """Score a worlds benchmark's pokes again under other cuts or seam rule, without pressing
+    again (seconds a world)."""
+    from deformap import run
+
+    shown = out_console(json_path)
+    with progress(shown) as bar:
+        output = run.rescore_worlds(source, out, cuts=_names(cuts), merge_seams=merge_seams,
+                                    hooks=run_hooks(bar))  # fmt: skip
+    settings = output.summary["settings"]
+    _show_worlds_summary(shown, output, settings["worlds"], settings["max_pokes"], json_path)

@@ -48,6 +48,7 @@ if TYPE_CHECKING:
         WorldDraw,
         choices,
         draw_world,
+        rescore_world,
         row_values,
         run_world,
     )
@@ -73,7 +74,8 @@ _MODULES = {
                  "cluster_size_study", "collect_presses", "hardness_study", "hardness_summary"),
     "_table_i": ("PAPER_TABLE_I", "markdown_table", "table_row"),
     "_worlds": ("FORCES_N", "HARDNESS_RANGE_N", "THICKNESSES_M", "TIME_COLUMNS", "WorldDraw",
-                "choices", "draw_world", "row_values", "run_world"),
+                "choices", "draw_world", "rescore_world", "row_values",
+                "run_world"),
     "_worlds_summary": ("CSV_COLUMNS", "GOOD_ACCURACY", "accuracy_curves", "combination_name",
                         "markdown_summary", "runs_csv", "summarise_worlds"),
 }  # fmt: skip
@@ -116,6 +118,7 @@ __all__ = [
     "measure_case",
     "ordering_scores",
     "region_scores",
+    "rescore_world",
     "row_values",
     "run_world",
     "runs_csv",

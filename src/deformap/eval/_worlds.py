@@ -51,8 +51,10 @@ from numpy.typing import NDArray
 from deformap.errors import InvalidArgumentError
 from deformap.eval._metrics import region_scores
 from deformap.explore import (
+    BetaField,
     ExplorationConfig,
     Mapper,
+    PokeSet,
     RegionLabels,
     Target,
     map_regions,
@@ -78,6 +80,7 @@ __all__ = [
     "WorldDraw",
     "choices",
     "draw_world",
+    "rescore_world",
     "row_values",
     "run_world",
 ]
@@ -184,8 +187,9 @@ def _scores(mapper: Mapper, truth: tuple[NDArray, dict[int, float], NDArray],
 
 def _map_one(world: SimulatedWorld, draw: WorldDraw, config: ExplorationConfig, surface: Any,
              truth: tuple[NDArray, dict[int, float], NDArray], seed: int,
-             cuts: Sequence[str]) -> list[dict[str, Any]]:
-    """Map the world with one configuration to ``max_pokes``; one row per poke and cut."""
+             cuts: Sequence[str]) -> tuple[list[dict[str, Any]], dict[str, list[Any]]]:
+    """Map the world with one configuration to ``max_pokes``; one row per poke and cut, and the
+    map field's pokes at the end (:func:`poke_data`)."""
     mapper = Mapper(world.workspace, config)
     mapper.surface = surface  # the combinations share the first observation's model
     streams = np.random.default_rng(np.random.SeedSequence([seed, draw.index, 1])).spawn(
@@ -210,7 +214,34 @@ def _map_one(world: SimulatedWorld, draw: WorldDraw, config: ExplorationConfig, 
         for cut, scores in _scores(mapper, truth, cuts).items():
             rows.append({"cut": cut, **head, **scores,
                          "poke_s": t1 - t0, "elapsed_s": t1 - t_start})  # fmt: skip
-    return rows
+    return rows, poke_data(mapper.map_field.pokes)
+
+
+def poke_data(pokes: PokeSet) -> dict[str, list[Any]]:
+    """A map field's pokes as plain data: ``x``, ``y`` [m], ``value`` (β, or ln E [ln Pa]),
+    ``noise`` (its uncertainty with the field's floor) and ``index`` (the poke's number in its
+    run, from 0), in the field's order. Floats keep every bit through JSON (``repr``)."""
+    return {"x": [float(v) for v in pokes.xy[:, 0]], "y": [float(v) for v in pokes.xy[:, 1]],
+            "value": [float(v) for v in pokes.beta], "noise": [float(v) for v in pokes.noise],
+            "index": [int(v) for v in np.asarray(pokes.index)]}
+
+
+def _build_world(task: dict[str, Any]) -> tuple[WorldDraw, SimulatedWorld, ExplorationConfig]:
+    """The world of ``task`` (:func:`run_world`) and the exploration settings it is mapped with."""
+    seed, index = int(task["seed"]), int(task["index"])
+    draw = draw_world(seed, index, tuple(task["families"]), tuple(task.get("physics", PHYSICS)))
+    base = WorldConfig.coarse() if task["coarse"] else WorldConfig()
+    config = replace(base, physics=draw.physics,
+                     camera=replace(camera_preset(draw.camera), width=base.camera.width,
+                                    height=base.camera.height) if task["coarse"]
+                     else camera_preset(draw.camera))  # fmt: skip
+    world_seq = np.random.SeedSequence([seed, index, 0]).spawn(2)[0]
+    world = SimulatedWorld(draw.scenario, config=config, rng=np.random.default_rng(world_seq))
+    k = int(task["max_pokes"])
+    explore = ExplorationConfig(max_pokes=k, boundary_pokes=k, force_n=draw.force_n)
+    if "merge_seams" in task:
+        explore = replace(explore, merge_seams=bool(task["merge_seams"]))
+    return draw, world, explore
 
 
 def run_world(task: dict[str, Any]) -> dict[str, Any]:
@@ -222,40 +253,97 @@ def run_world(task: dict[str, Any]) -> dict[str, Any]:
         ``seed``, ``index``, ``families``, ``physics`` (optional: the world physics drawn
         from, default all), ``strategies``, ``fields``, ``cuts`` (the
         ``region_labels`` scored, each on the same pokes), ``max_pokes``, ``coarse`` (the
-        test mesh and camera of :meth:`WorldConfig.coarse`, else the default world).
+        test mesh and camera of :meth:`WorldConfig.coarse`, else the default world),
+        ``merge_seams`` (optional: ``ExplorationConfig.merge_seams``, default the
+        exploration's).
 
     Returns
     -------
     dict with ``world`` (:meth:`WorldDraw.summary`), ``rows`` (one per strategy × field × cut ×
-    poke, each naming them) and ``seconds`` (the world's wall time, building included).
+    poke, each naming them), ``pokes`` (each ``"strategy/field"``'s map-field pokes,
+    :func:`poke_data`: what :func:`rescore_world` scores other cuts on) and ``seconds`` (the
+    world's wall time, building included).
     """
     t0 = time.perf_counter()
+    draw, world, explore = _build_world(task)
     seed, index = int(task["seed"]), int(task["index"])
-    draw = draw_world(seed, index, tuple(task["families"]), tuple(task.get("physics", PHYSICS)))
-    base = WorldConfig.coarse() if task["coarse"] else WorldConfig()
-    config = replace(base, physics=draw.physics,
-                     camera=replace(camera_preset(draw.camera), width=base.camera.width,
-                                    height=base.camera.height) if task["coarse"]
-                     else camera_preset(draw.camera))  # fmt: skip
-    world_seq, explore_seq = np.random.SeedSequence([seed, index, 0]).spawn(2)
-    world = SimulatedWorld(draw.scenario, config=config, rng=np.random.default_rng(world_seq))
-    k = int(task["max_pokes"])
     cuts = tuple(task["cuts"])
-    explore = ExplorationConfig(max_pokes=k, boundary_pokes=k, force_n=draw.force_n)
+    explore_seq = np.random.SeedSequence([seed, index, 0]).spawn(2)[1]
     first = Mapper(world.workspace, explore)
     surface = first.initialise(world.observe(), np.random.default_rng(explore_seq))
     truth = _material_truth(world, first.grid.xs, first.grid.ys)
     rows = []
+    pokes = {}
     for strategy in task["strategies"]:
         for field in task["fields"]:
             cfg = replace(explore, strategy=strategy, field=field)
-            for row in _map_one(world, draw, cfg, surface, truth, seed, cuts):
+            mapped, pokes[f"{strategy}/{field}"] = _map_one(world, draw, cfg, surface, truth,
+                                                            seed, cuts)
+            for row in mapped:
                 rows.append({"world": index, "family": draw.family, "strategy": strategy,
                              "field": field, **row})  # fmt: skip
-    return {"world": draw.summary(), "rows": rows, "seconds": time.perf_counter() - t0,
-            "status": "ok", "error": None}
+    return {"world": draw.summary(), "rows": rows, "pokes": pokes,
+            "seconds": time.perf_counter() - t0, "status": "ok", "error": None}
 
 
 def row_values(row: dict[str, Any]) -> dict[str, Any]:
     """A row without its wall times (what two runs of one world must agree on)."""
     return {k: v for k, v in row.items() if k not in TIME_COLUMNS}
+
+
+def rescore_world(task: dict[str, Any], result: dict[str, Any], cuts: Sequence[str],
+                  **settings: Any) -> dict[str, Any]:
+    """``result`` of :func:`run_world` for ``task`` with its rows scored under ``cuts`` instead,
+    on the pokes it stored (no press is made again: the pokes do not depend on the cut).
+    ``settings`` are :class:`ExplorationConfig` fields the cuts are scored with (e.g.
+    ``merge_seams=True``): only those that act after the pokes, on the regions, are meaningful.
+
+    After ``k`` pokes the map field is the one of the stored pokes numbered below ``k`` (a poke
+    without a value, a modulus field's poke whose record gave none, leaves a gap, as it did in the
+    run), so scoring the run's own cuts again gives its rows to the bit (a test checks it). The
+    columns that do not depend on the cut (``purpose``, ``threshold``, ``modulus_error``, times,
+    ...) are the run's.
+
+    Raises
+    ------
+    InvalidArgumentError
+        ``result`` did not finish, or holds no pokes (a run before they were stored).
+    """
+    if result.get("status") != "ok" or not isinstance(result.get("pokes"), dict):
+        raise InvalidArgumentError(
+            f"`result` of world {task.get('index')} must be a finished world with its pokes "
+            f"stored; got status {result.get('status')!r} and "
+            f"{'pokes' if 'pokes' in result else 'no pokes'}")
+    _, world, explore = _build_world(task)
+    grid = Mapper(world.workspace, explore).grid
+    labels, hardness, _ = _material_truth(world, grid.xs, grid.ys)
+    head: dict[tuple[str, str, int], dict[str, Any]] = {}
+    for row in result["rows"]:
+        head.setdefault((row["strategy"], row["field"], int(row["poke"])), row)
+    rows = []
+    for (strategy, field_name, poke), old in sorted(head.items(), key=lambda kv: (
+            task["strategies"].index(kv[0][0]), task["fields"].index(kv[0][1]), kv[0][2])):
+        data = result["pokes"][f"{strategy}/{field_name}"]
+        index = np.asarray(data["index"], dtype=np.int64)
+        keep = index < poke
+        pokes = PokeSet(np.column_stack([data["x"], data["y"]])[keep],
+                        np.asarray(data["value"], float)[keep],
+                        np.asarray(data["noise"], float)[keep], index[keep])  # fmt: skip
+        config = replace(explore, strategy=cast(Any, strategy),
+                         field=cast(Any, field_name), **settings)
+        field_config = config.modulus_field if field_name == "modulus" else config.beta_field
+        mean = BetaField(pokes, grid.xs, grid.ys, field_config).mean
+        sign = -1.0 if field_name == "modulus" else 1.0
+        for cut in cuts:
+            if len(pokes):
+                found = map_regions(mean, pokes, grid.cells_xy,
+                                    replace(config, region_labels=cast(RegionLabels, cut)))
+                scores = region_scores(found.labels, labels, sign * mean, hardness)
+                region = {"accuracy": scores.accuracy, "mean_iou": scores.mean_iou,
+                          "found": scores.found, "true": scores.true,
+                          "kendall_tau": scores.kendall_tau}  # fmt: skip
+            else:  # no poke has a value yet: the run's rows say what an empty map scores
+                region = {k: old[k] for k in ("accuracy", "mean_iou", "found", "true",
+                                              "kendall_tau")}  # fmt: skip
+            rows.append({**old, "cut": cut, **region})
+    return {**result, "rows": rows}

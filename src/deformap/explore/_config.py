@@ -293,6 +293,10 @@ class ExplorationConfig:
         worlds (``deformap bench worlds``, README "Many worlds") the nearest-poke cut beat the
         isopleths with every strategy from 7 pokes on (level before) and was the best of the
         three at 20 pokes (indicator kriging was a little better at 5–10).
+    merge_seams : bool
+        Before the cells are labelled, merge the classes whose every poke lies on a seam between
+        a lower and a higher class (:func:`deformap.explore.merge_seam_classes`): a press
+        across two materials reads between them and is otherwise a region of its own.
     boundary_pokes : int
         Pokes made after the variance has fallen below ``T_h``, each where a region boundary is
         least certain (:mod:`deformap.explore._acquisition`, "boundary pokes"); 0, the paper's
@@ -331,6 +335,7 @@ class ExplorationConfig:
     max_regions: int = setting(6, ge=1)
     region_prior_dof: float = setting(7.0, ge=0.0)
     region_labels: RegionLabels = "nearest"
+    merge_seams: bool = False
     boundary_pokes: int = setting(0, ge=0, le=1000)  # as for max_pokes
     beta_uncertainty: BetaUncertainty = "camera-noise"
     field: FieldName = "modulus"

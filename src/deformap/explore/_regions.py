@@ -71,13 +71,14 @@ from itertools import pairwise
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy.spatial import Delaunay, QhullError
 
 from deformap._validation import check_array, check_int, check_positive
 from deformap.explore._config import ExplorationConfig
 from deformap.explore._field import PokeSet, field_settings
 from deformap.explore._indicator import indicator_labels
 
-__all__ = ["RegionMap", "map_regions", "poke_classes", "segment_regions"]
+__all__ = ["RegionMap", "map_regions", "merge_seam_classes", "poke_classes", "segment_regions"]
 
 _NULL_SAMPLES = 4000
 _NULL_SEED = 20161115
@@ -290,6 +291,77 @@ def segment_regions(
                      poke_labels=poke_labels)
 
 
+def _neighbours(xy: NDArray[np.float64]) -> list[set[int]]:
+    """Each poke's natural neighbours: the pokes whose Voronoi cells share an edge with its own
+    (Delaunay triangulation; pokes at one place share their neighbours). Empty sets when the
+    places do not span the plane (fewer than three, or all on a line)."""
+    places, which = np.unique(np.round(xy, 9), axis=0, return_inverse=True)
+    which = np.asarray(which).reshape(-1)
+    empty: list[set[int]] = [set() for _ in range(xy.shape[0])]
+    if places.shape[0] < 3:
+        return empty
+    try:
+        tri = Delaunay(places)
+    except QhullError:  # collinear places: no triangle
+        return empty
+    near: list[set[int]] = [set() for _ in range(places.shape[0])]
+    for simplex in tri.simplices:
+        for a in simplex:
+            near[a].update(int(b) for b in simplex if b != a)
+    members = [np.flatnonzero(which == k) for k in range(places.shape[0])]
+    return [{int(j) for k in near[which[i]] | {int(which[i])} for j in members[k] if j != i}
+            for i in range(xy.shape[0])]
+
+
+def merge_seam_classes(found: RegionMap, mean: NDArray[np.float64],
+                       poke_xy: NDArray[np.float64],
+                       poke_value: NDArray[np.float64]) -> RegionMap:
+    """``found`` with its seam classes merged into their neighbours.
+
+    A press on the seam between two materials dents both and reads a value between theirs, which
+    the classes, found from the values alone, can take for a material of its own. A class is
+    taken for a seam when its value lies between two other classes' and *every* one of its pokes
+    has natural neighbours (:func:`_neighbours`) on both sides: one in a class below it and one
+    in a class above it. Each of its pokes then joins the neighbouring class (the one just below
+    or just above) whose mean is nearer to its value; the classes' means and isopleths are
+    recomputed, and the test is repeated until no class is a seam. A material that lies between
+    two others in value *and* in space (a middle stripe met by a single row of pokes) passes the
+    same test: the rule trades it for the seams; ``deformap bench worlds --cuts`` measures what
+    it gains.
+    """
+    labels = found.poke_labels.copy()
+    values = check_array("poke_value", poke_value, (labels.size,))
+    near = _neighbours(check_array("poke_xy", poke_xy, (labels.size, 2), what="metres"))
+    while True:
+        classes = np.unique(labels)
+        means = np.array([values[labels == c].mean() for c in classes])
+        rank = {int(c): k for k, c in enumerate(classes[np.argsort(means, kind="stable")])}
+        order = np.array([rank[int(c)] for c in labels])  # 0 .. K-1 by mean
+        k_total = classes.size
+        seam = None
+        for k in range(1, k_total - 1):
+            members = np.flatnonzero(order == k)
+            if all(any(order[j] < k for j in near[i]) and any(order[j] > k for j in near[i])
+                   for i in members):
+                seam = k
+                break
+        if seam is None:
+            break
+        by_rank = np.array([values[order == k].mean() for k in range(k_total)])
+        for i in np.flatnonzero(order == seam):
+            lower, upper = by_rank[seam - 1], by_rank[seam + 1]
+            order[i] = seam - 1 if abs(values[i] - lower) <= abs(values[i] - upper) else seam + 1
+        labels = np.unique(order, return_inverse=True)[1].reshape(-1)
+    class_values = np.array([values[labels == c].mean() for c in range(labels.max() + 1)])
+    rank_of = np.argsort(np.argsort(class_values, kind="stable"), kind="stable")
+    poke_labels = rank_of[labels].astype(np.int64)
+    class_betas = np.sort(class_values)
+    levels = (class_betas[:-1] + class_betas[1:]) / 2
+    cells = np.searchsorted(levels, mean, side="right").astype(np.int64)
+    return RegionMap(labels=cells, levels=levels, class_betas=class_betas,
+                     poke_labels=poke_labels)
+
+
 def poke_classes(mean: NDArray[np.float64], pokes: PokeSet,
                  config: ExplorationConfig) -> RegionMap:
     """The pokes' classes and the isopleth labels of the map field's mean ``mean (ny, nx)``, by
@@ -310,6 +382,8 @@ def map_regions(mean: NDArray[np.float64], pokes: PokeSet, cells_xy: NDArray[np.
     poke or by indicator kriging (``region_labels``; ``cells_xy (ny · nx, 2)`` are the grid's
     cells)."""
     found = poke_classes(mean, pokes, config)
+    if config.merge_seams and found.n_regions >= 3:
+        found = merge_seam_classes(found, mean, pokes.xy, pokes.beta)
     if config.region_labels == "nearest":
         return found.nearest_poke(pokes.xy, cells_xy)
     if config.region_labels == "indicator-kriging":

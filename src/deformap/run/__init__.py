@@ -84,6 +84,7 @@ if TYPE_CHECKING:
         WorldsBenchConfig,
         WorldsOutput,
         bench_worlds,
+        rescore_worlds,
     )
 
 _MODULES = {
@@ -106,7 +107,8 @@ _MODULES = {
     "_studies": ("CLUSTER_SIZE_FOAMS", "StudyOutput", "run_cluster_size_study",
                  "run_hardness_study"),
     "_world": ("ScenarioSummary", "scenario_summaries", "show_scenario"),
-    "_worlds": ("BLAS_THREAD_VARIABLES", "WorldsBenchConfig", "WorldsOutput", "bench_worlds"),
+    "_worlds": ("BLAS_THREAD_VARIABLES", "WorldsBenchConfig", "WorldsOutput", "bench_worlds",
+                "rescore_worlds"),
 }  # fmt: skip
 
 __all__ = [
@@ -147,6 +149,7 @@ __all__ = [
     "parse_env_args",
     "record_simulation",
     "reproduce",
+    "rescore_worlds",
     "resume_run_config",
     "run_cluster_size_study",
     "run_generators",

@@ -39,16 +39,19 @@ from deformap.eval import (
     accuracy_curves,
     choices,
     markdown_summary,
+    rescore_world,
     run_world,
     runs_csv,
     summarise_worlds,
 )
+from deformap.explore import ExplorationConfig
 from deformap.run._folder import create_run_folder, default_run_folder, to_json, write_text
 from deformap.run._hooks import NO_HOOKS, RunHooks, RunStart
 from deformap.viz import plot_world_curves
 from deformap.world import LAYOUT_FAMILIES, PHYSICS
 
-__all__ = ["BLAS_THREAD_VARIABLES", "WorldsBenchConfig", "WorldsOutput", "bench_worlds"]
+__all__ = ["BLAS_THREAD_VARIABLES", "WorldsBenchConfig", "WorldsOutput", "bench_worlds",
+           "rescore_worlds"]
 
 logger = logging.getLogger(__name__)
 
@@ -80,6 +83,9 @@ class WorldsBenchConfig:
         do not depend on the cut).
     max_pokes : int
         Pokes per world and combination.
+    merge_seams : bool
+        ``ExplorationConfig.merge_seams`` for every cut scored (it acts after the pokes, on the
+        regions, like the cut; its default is the exploration's).
     coarse : bool
         The test mesh and camera (:meth:`deformap.world.WorldConfig.coarse`, about a third of a
         default world's cost) instead of the default world. A smoke run only: on one linear-FEM
@@ -101,6 +107,7 @@ class WorldsBenchConfig:
     cuts: tuple[str, ...] = choices("region_labels")
     # every poke is a press and a β sweep per combination (issue 16 reads 20 and more)
     max_pokes: int = setting(12, ge=1, le=1000)
+    merge_seams: bool = ExplorationConfig().merge_seams
     coarse: bool = False
     workers: int = setting(1, ge=1, le=1024)
     scheduler: str | None = None
@@ -133,7 +140,8 @@ class WorldsBenchConfig:
         return {"seed": self.seed, "index": index, "families": list(self.families),
                 "physics": list(self.physics),
                 "strategies": list(self.strategies), "fields": list(self.fields),
-                "cuts": list(self.cuts), "max_pokes": self.max_pokes, "coarse": self.coarse}
+                "cuts": list(self.cuts), "max_pokes": self.max_pokes, "coarse": self.coarse,
+                "merge_seams": self.merge_seams}
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -349,3 +357,74 @@ def bench_worlds(config: WorldsBenchConfig, out: Path | None = None, *,
         summary, files = _write_outputs(folder, config, list(results.values()))
     return WorldsOutput(summary=summary, folder=folder, files=[folder / SETTINGS_NAME, *files],
                         computed=computed, seconds=time.perf_counter() - t0)
+
+
+def rescore_worlds(source: Path, out: Path, *, cuts: Sequence[str] | None = None,
+                   merge_seams: bool | None = None, hooks: RunHooks = NO_HOOKS) -> WorldsOutput:
+    """Score the finished worlds of the benchmark folder ``source`` again under ``cuts`` and
+    ``merge_seams`` (default: the source's), from the pokes each world stored, into the new
+    folder ``out`` (``bench.json`` naming the source, ``worlds/``, ``runs.csv``, the summary and
+    curves, as :func:`bench_worlds` writes them). No press is made again: the pokes do not depend
+    on the cut, so a cut or seam rule added later is measured on the same pokes in seconds a
+    world (:func:`deformap.eval.rescore_world`).
+
+    Raises
+    ------
+    ConfigError
+        ``source`` is not a worlds benchmark, holds no finished world, or a world from before
+        the pokes were stored; ``out`` is not new or empty; a cut is unknown.
+    """
+    settings_file = Path(source) / SETTINGS_NAME
+    try:
+        stored = json.loads(settings_file.read_text(encoding="utf-8"))["settings"]
+    except (OSError, ValueError, KeyError, TypeError) as exc:
+        raise ConfigError(f"source: {settings_file} is not a worlds benchmark's settings: "
+                          f"{exc}") from None
+    known = {f for f in WorldsBenchConfig.__dataclass_fields__} - {"worlds", "workers",
+                                                                     "scheduler"}
+    if not isinstance(stored, dict) or not set(stored) <= known:
+        raise ConfigError(f"source: {settings_file} holds settings this version does not know: "
+                          f"{sorted(set(stored) - known) if isinstance(stored, dict) else stored}")
+    finished = sorted(Path(source, "worlds").glob("world-*.json"))
+    results = []
+    for path in finished:
+        try:
+            result = json.loads(path.read_text(encoding="utf-8"))
+        except (OSError, ValueError) as exc:
+            raise ConfigError(f"source: {path} cannot be read: {exc}") from None
+        if result.get("status") == "ok":
+            results.append(result)
+    without = [r["world"]["index"] for r in results if "pokes" not in r]
+    if not results or without:
+        raise ConfigError(
+            f"source: {source} must hold finished worlds with their pokes stored; got "
+            + ("none" if not results else f"{len(without)} without (worlds {without[:5]}"
+               f"{' …' if len(without) > 5 else ''}: run before pokes were stored)"))
+    given: dict[str, Any] = {k: tuple(v) if isinstance(v, list) else v
+                             for k, v in stored.items()}
+    if cuts is not None:
+        given["cuts"] = tuple(cuts)
+    if merge_seams is not None:
+        given["merge_seams"] = merge_seams
+    config = WorldsBenchConfig(worlds=1 + max(r["world"]["index"] for r in results), **given)
+    folder = Path(out)
+    create_run_folder(folder, what="benchmark")
+    write_text(folder / SETTINGS_NAME, to_json({"deformap": __version__,
+                                                "settings": config.result_settings(),
+                                                "rescored_from": str(source)}))
+    (folder / "worlds").mkdir(exist_ok=True)
+    hooks.start(RunStart(kind="bench rescore", folder=folder, total=len(results), done=0,
+                         title=f"{len(results)} worlds of {source} rescored"))
+    t0 = time.perf_counter()
+    rescored = []
+    for result in results:
+        index = int(result["world"]["index"])
+        task = config.task(index)
+        again = rescore_world(task, result, config.cuts, merge_seams=config.merge_seams)
+        write_text(_world_path(folder, index), to_json(again))
+        rescored.append(again)
+        hooks.step(f"world {index} ({result['world']['family']}) · {len(rescored)}/"
+                   f"{len(results)} done")
+    summary, files = _write_outputs(folder, config, rescored)
+    return WorldsOutput(summary=summary, folder=folder, files=[folder / SETTINGS_NAME, *files],
+                        computed=len(rescored), seconds=time.perf_counter() - t0)
