@@ -56,7 +56,7 @@ def main() -> None:
           f"{'s':>5}   (b = {args.bias_mm:g} mm)")
     worst_e = worst_beta = 0.0
     for physics in args.physics:
-        world = dataclasses.replace(WorldConfig(physics=physics),  # type: ignore[arg-type]
+        world = dataclasses.replace(WorldConfig(physics=physics),
                                     camera=camera_preset(args.camera))
         for hardness in args.hardness:
             start = time.perf_counter()
