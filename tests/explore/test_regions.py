@@ -147,6 +147,30 @@ def test_a_material_with_pokes_inside_it_is_not_a_seam() -> None:
     np.testing.assert_array_equal(merged.poke_labels, found.poke_labels)
 
 
+def test_a_press_by_a_free_face_reading_softer_than_both_joins_a_neighbour() -> None:
+    """Two pieces laid side by side: one press beside the joint reads softer than either; it
+    borders both, so it is no third material."""
+    xy, value = _grid_pokes(lambda x, y: 1.0 if x < 0.09 else 2.0)
+    joint = np.flatnonzero(np.isclose(xy[:, 0], 0.05) & np.isclose(xy[:, 1], 0.1))
+    value[joint] = 0.2
+    found = segment_regions(np.zeros((2, 2)), value, np.full(value.size, 0.05))
+    assert found.n_regions == 3 and found.poke_labels[joint] == [0]
+    merged = merge_seam_classes(found, np.zeros((2, 2)), xy, value)
+    assert merged.n_regions == 2 and merged.poke_labels[joint] == [0]
+    np.testing.assert_array_equal(merged.poke_labels[value != 0.2], found.poke_labels[value != 0.2] - 1)
+
+
+def test_an_insert_met_by_one_poke_stays_a_region() -> None:
+    """One poke inside a piece borders pokes of one other class only: kept."""
+    xy, value = _grid_pokes(lambda x, y: 0.0 if x < 0.09 else 2.0)
+    centre = np.flatnonzero(np.isclose(xy[:, 0], 0.15) & np.isclose(xy[:, 1], 0.1))
+    value[centre] = 1.0
+    found = segment_regions(np.zeros((2, 2)), value, np.full(value.size, 0.05))
+    assert found.n_regions == 3
+    merged = merge_seam_classes(found, np.zeros((2, 2)), xy, value)
+    np.testing.assert_array_equal(merged.poke_labels, found.poke_labels)
+
+
 def test_seams_are_not_judged_without_a_triangulation() -> None:
     xy = np.column_stack([np.linspace(0, 0.2, 7), np.zeros(7)])  # one line of pokes
     value = np.array([0.0, 0.0, 0.0, 1.0, 2.0, 2.0, 2.0])

@@ -294,9 +294,13 @@ class ExplorationConfig:
         isopleths with every strategy from 7 pokes on (level before) and was the best of the
         three at 20 pokes (indicator kriging was a little better at 5–10).
     merge_seams : bool
-        Before the cells are labelled, merge the classes whose every poke lies on a seam between
-        a lower and a higher class (:func:`deformap.explore.merge_seam_classes`): a press
-        across two materials reads between them and is otherwise a region of its own.
+        Before the cells are labelled, merge the classes whose every poke borders pokes of two
+        other classes (:func:`deformap.explore.merge_seam_classes`): a press where two pieces
+        meet reads between them, or softer than both by a free face, and is otherwise a region of
+        its own. On by default: over the first 26 worlds of ``deformap bench worlds --seed 0``
+        (rescored on the same pokes) it took the worlds with more regions found than true after
+        20 pokes from 35–54 % to 0–4 % and raised the share reaching accuracy 0.9 with both
+        strategies measured (README, "Many worlds"); ``false`` gives the classes as found.
     boundary_pokes : int
         Pokes made after the variance has fallen below ``T_h``, each where a region boundary is
         least certain (:mod:`deformap.explore._acquisition`, "boundary pokes"); 0, the paper's
@@ -335,7 +339,7 @@ class ExplorationConfig:
     max_regions: int = setting(6, ge=1)
     region_prior_dof: float = setting(7.0, ge=0.0)
     region_labels: RegionLabels = "nearest"
-    merge_seams: bool = False
+    merge_seams: bool = True
     boundary_pokes: int = setting(0, ge=0, le=1000)  # as for max_pokes
     beta_uncertainty: BetaUncertainty = "camera-noise"
     field: FieldName = "modulus"

@@ -316,18 +316,20 @@ def _neighbours(xy: NDArray[np.float64]) -> list[set[int]]:
 def merge_seam_classes(found: RegionMap, mean: NDArray[np.float64],
                        poke_xy: NDArray[np.float64],
                        poke_value: NDArray[np.float64]) -> RegionMap:
-    """``found`` with its seam classes merged into their neighbours.
+    """``found`` with its junction classes merged into their neighbours.
 
-    A press on the seam between two materials dents both and reads a value between theirs, which
-    the classes, found from the values alone, can take for a material of its own. A class is
-    taken for a seam when its value lies between two other classes' and *every* one of its pokes
-    has natural neighbours (:func:`_neighbours`) on both sides: one in a class below it and one
-    in a class above it. Each of its pokes then joins the neighbouring class (the one just below
-    or just above) whose mean is nearer to its value; the classes' means and isopleths are
-    recomputed, and the test is repeated until no class is a seam. A material that lies between
-    two others in value *and* in space (a middle stripe met by a single row of pokes) passes the
-    same test: the rule trades it for the seams; ``deformap bench worlds --cuts`` measures what
-    it gains.
+    A press where two pieces meet reads neither piece: across a bonded seam it dents both and
+    reads between them; beside a free face (pieces laid side by side) the foam gives way sideways
+    and it reads softer than both. The classes, found from the values alone, take such a reading
+    for a material of its own. A class is taken for a junction when *every* one of its pokes is a
+    natural neighbour (:func:`_neighbours`) of pokes of at least two other classes: each such poke
+    then joins, of its neighbours' classes, the one whose mean is nearest to its value; the
+    classes' means and isopleths are recomputed and the test repeated until no class is a
+    junction. A class with one poke inside it (its neighbours of one other class only) is kept,
+    so an insert met by a single poke stays a region. What it gives up: a material seen only by
+    pokes lying where two others meet (a stripe one poke wide between two others) is merged until
+    a poke lands inside it; ``deformap bench rescore --merge-seams`` measures the trade (README,
+    "Many worlds").
     """
     labels = found.poke_labels.copy()
     values = check_array("poke_value", poke_value, (labels.size,))
@@ -335,31 +337,24 @@ def merge_seam_classes(found: RegionMap, mean: NDArray[np.float64],
     while True:
         classes = np.unique(labels)
         means = np.array([values[labels == c].mean() for c in classes])
-        rank = {int(c): k for k, c in enumerate(classes[np.argsort(means, kind="stable")])}
-        order = np.array([rank[int(c)] for c in labels])  # 0 .. K-1 by mean
-        k_total = classes.size
-        seam = None
-        for k in range(1, k_total - 1):
-            members = np.flatnonzero(order == k)
-            if all(any(order[j] < k for j in near[i]) and any(order[j] > k for j in near[i])
-                   for i in members):
-                seam = k
-                break
-        if seam is None:
+        others = [{int(labels[j]) for j in near[i]} - {int(labels[i])}
+                  for i in range(labels.size)]
+        junction = next((int(c) for c in classes[np.argsort(means, kind="stable")]
+                         if all(len(others[i]) >= 2 for i in np.flatnonzero(labels == c))), None)
+        if junction is None:
             break
-        by_rank = np.array([values[order == k].mean() for k in range(k_total)])
-        for i in np.flatnonzero(order == seam):
-            lower, upper = by_rank[seam - 1], by_rank[seam + 1]
-            order[i] = seam - 1 if abs(values[i] - lower) <= abs(values[i] - upper) else seam + 1
-        labels = np.unique(order, return_inverse=True)[1].reshape(-1)
+        mean_of = dict(zip(classes.tolist(), means.tolist(), strict=True))
+        moved = labels.copy()
+        for i in np.flatnonzero(labels == junction):
+            moved[i] = min(sorted(others[i]), key=lambda c: abs(values[i] - mean_of[c]))
+        labels = np.unique(moved, return_inverse=True)[1].reshape(-1)
     class_values = np.array([values[labels == c].mean() for c in range(labels.max() + 1)])
     rank_of = np.argsort(np.argsort(class_values, kind="stable"), kind="stable")
-    poke_labels = rank_of[labels].astype(np.int64)
     class_betas = np.sort(class_values)
     levels = (class_betas[:-1] + class_betas[1:]) / 2
-    cells = np.searchsorted(levels, mean, side="right").astype(np.int64)
-    return RegionMap(labels=cells, levels=levels, class_betas=class_betas,
-                     poke_labels=poke_labels)
+    return RegionMap(labels=np.searchsorted(levels, mean, side="right").astype(np.int64),
+                     levels=levels, class_betas=class_betas,
+                     poke_labels=rank_of[labels].astype(np.int64))
 
 
 def poke_classes(mean: NDArray[np.float64], pokes: PokeSet,
