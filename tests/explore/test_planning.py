@@ -5,7 +5,7 @@ import pytest
 
 from deformap.environment import Workspace
 from deformap.errors import InvalidArgumentError
-from deformap.explore import ExplorationConfig, Mapper
+from deformap.explore import ExplorationConfig, Mapper, beta_noise_floor
 from deformap.explore._acquisition import choose_target
 from deformap.explore._planning import plan_pokes
 from deformap.gp import GaussianRandomField
@@ -127,7 +127,7 @@ def _pokes_until_known(config: ExplorationConfig, size: tuple[float, float] = (0
     rng = np.random.default_rng(0)
     xy: np.ndarray | None = np.array(size) / 2
     while xy is not None and len(mapper.pokes) < config.max_pokes:
-        std = 0.06 if len(mapper.pokes) < noisy else config.beta_field.noise_floor
+        std = 0.06 if len(mapper.pokes) < noisy else beta_noise_floor(config)
         mapper.add(synthetic_poke(xy, 0.5, std))
         target = mapper.next_target(rng)
         xy = None if target is None else target.xy
@@ -194,7 +194,7 @@ def test_a_further_press_is_expected_as_noisy_as_the_place_has_read() -> None:
     from deformap.explore._targets import expected_noise
 
     config = ExplorationConfig(field="beta")  # β-field pokes, the β-field's floor
-    floor = config.beta_field.noise_floor
+    floor = beta_noise_floor(config)
     pokes = PokeSet.of([synthetic_poke((0.3, 0.2), 0.5, 0.2).record,
                         synthetic_poke((0.1, 0.1), 0.5, 0.001).record], noise_floor=floor)
     noise = expected_noise(np.array([[0.3, 0.21], [0.1, 0.1], [0.5, 0.3]]), pokes, config)

@@ -89,6 +89,7 @@ __all__ = [
     "ExplorationConfig",
     "FieldName",
     "ModulusFieldConfig",
+    "NuggetEstimate",
     "RegionLabels",
     "StopRegion",
     "SurfaceGPConfig",
@@ -110,6 +111,8 @@ StopRegion = Literal["workspace", "targets"]
 RegionLabels = Literal["isopleth", "nearest", "indicator-kriging"]
 #: Which field the regions and the next-poke choice run on (``ExplorationConfig.field``).
 FieldName = Literal["beta", "modulus"]
+#: How the β-field's nugget is estimated (``BetaFieldConfig.nugget``).
+NuggetEstimate = Literal["within-class", "off"]
 #: Where a poke's β uncertainty comes from (``ExplorationConfig.beta_uncertainty``).
 BetaUncertainty = Literal["camera-noise", "shape-matching"]
 
@@ -217,11 +220,30 @@ class TouchGPConfig:
 
 @dataclass(frozen=True, kw_only=True)
 class BetaFieldConfig:
-    """Prior of the β-field Gaussian random field (the paper's σe, σw, σn)."""
+    """Prior of the β-field Gaussian random field (the paper's σe, σw, σn; module docstring,
+    "β-field", argues the defaults).
+
+    Parameters
+    ----------
+    signal_std : float
+        σe, the prior standard deviation of β about the pokes' weighted mean.
+    length_scale_m : float
+        σw, metres.
+    noise_floor : float or None
+        Smallest claimed σ of a poke's β, an explicit lower bound; ``None`` (default): the β
+        grid's quantisation, ``shape_matching.beta_resolution / √12``, which every β̂'s σ
+        already is at least (:func:`deformap.explore.beta_noise_floor`).
+    nugget : {"within-class", "off"}
+        ``within-class`` (default): each poke's noise is its σ (at least the floor) plus, in
+        variance, the map's nugget τ², the scatter between places on one material that the
+        claimed σ does not explain, estimated from the pokes of the map's own region classes
+        (:mod:`deformap.explore._nugget`); ``off``: the σ at least the floor alone.
+    """
 
     signal_std: float = setting(0.3, gt=0.0)
     length_scale_m: float = setting(0.2, gt=0.0)
-    noise_floor: float = setting(0.015, gt=0.0)
+    noise_floor: float | None = setting(None, gt=0.0)
+    nugget: NuggetEstimate = "within-class"
 
     def __post_init__(self) -> None:
         check_settings(self)

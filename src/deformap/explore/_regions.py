@@ -66,7 +66,8 @@ expression in microarray experiments. Stat. Appl. Genet. Mol. Biol. 3(1), Articl
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
 from itertools import pairwise
 
 import numpy as np
@@ -74,10 +75,13 @@ from numpy.typing import NDArray
 
 from deformap._validation import check_array, check_int, check_positive
 from deformap.explore._config import ExplorationConfig
-from deformap.explore._field import PokeSet, field_settings
+from deformap.explore._field import REGION_MIN_STEP_BETA, PokeSet, beta_noise_floor, field_settings
 from deformap.explore._indicator import indicator_labels
+from deformap.explore._nugget import MAX_ROUNDS, estimate_nugget
+from deformap.explore._records import PokeRecord
 
-__all__ = ["RegionMap", "map_regions", "poke_classes", "segment_regions"]
+__all__ = ["RegionMap", "beta_pokes", "map_regions", "poke_classes", "segment_regions",
+           "with_nugget"]
 
 _NULL_SAMPLES = 4000
 _NULL_SEED = 20161115
@@ -320,3 +324,35 @@ def map_regions(mean: NDArray[np.float64], pokes: PokeSet, cells_xy: NDArray[np.
         return RegionMap(labels=labels.reshape(found.labels.shape), levels=found.levels,
                          class_betas=found.class_betas, poke_labels=found.poke_labels)
     return found
+
+
+def with_nugget(pokes: PokeSet, config: ExplorationConfig) -> PokeSet:
+    """``pokes`` (β, each noise its claimed σ at least the floor) with the map's nugget τ̂ added to
+    every poke's noise in variance, ``√(σᵢ² + τ̂²)`` (:mod:`deformap.explore._nugget`).
+
+    The classes are the region test's on the β values (:func:`segment_regions` with the
+    exploration's ``max_regions``, ``region_prior_dof`` and the β-field's smallest step and floor):
+    found first with the claimed σ, τ̂ estimated within them, found again with the noise that τ̂
+    gives, until they no longer change (at most :data:`deformap.explore._nugget.MAX_ROUNDS`
+    rounds). ``pokes`` unchanged under ``beta_field.nugget: off``.
+    """
+    if config.beta_field.nugget == "off" or len(pokes) < 2:
+        return pokes
+    floor = beta_noise_floor(config)
+    flat = np.zeros((1, 1))
+    tau, labels = 0.0, None
+    for _ in range(MAX_ROUNDS):
+        found = segment_regions(flat, pokes.beta, np.hypot(pokes.noise, tau), floor=floor,
+                                min_step=REGION_MIN_STEP_BETA, max_regions=config.max_regions,
+                                prior_dof=config.region_prior_dof).poke_labels  # fmt: skip
+        if labels is not None and np.array_equal(found, labels):
+            break
+        labels = found
+        tau = estimate_nugget(pokes.beta, pokes.noise, labels)
+    return replace(pokes, noise=np.hypot(pokes.noise, tau), nugget=tau)
+
+
+def beta_pokes(records: Sequence[PokeRecord], config: ExplorationConfig) -> PokeSet:
+    """The pokes of the β-field as the mapper fits it: each poke's claimed σ raised to the floor
+    (:func:`deformap.explore.beta_noise_floor`), plus the map's nugget (:func:`with_nugget`)."""
+    return with_nugget(PokeSet.of(records, beta_noise_floor(config)), config)
