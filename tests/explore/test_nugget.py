@@ -16,6 +16,7 @@ from deformap.explore import (
     beta_pokes,
     estimate_nugget,
     field_settings,
+    segment_regions,
     with_nugget,
 )
 from deformap.explore._config import BetaFieldConfig
@@ -164,3 +165,22 @@ def _posterior_var_at_first(pokes: PokeSet) -> float:
     k = 0.3**2 * np.exp(-d2 / 0.2**2)
     gram = k + np.diag(pokes.noise**2)
     return float(k[0, 0] - k[0] @ np.linalg.solve(gram, k[:, 0]))
+
+
+def test_a_class_the_region_test_could_not_examine_gives_no_scatter() -> None:
+    # the stiffening-foam world's heterogeneous-110-150 map (seed 0): its first four pokes, two
+    # on each foam. A pair is never split, so read as one material it would put the step between
+    # the foams (0.74 against 0.64) into the nugget after the second poke, and the pairs the
+    # four pokes split into would give 0.02, enough to merge the foams again
+    betas = np.array([0.74, 0.64, 0.61, 0.68])
+    stds = np.array([0.0149, 0.0236, 0.0348, 0.0153])
+    pairs = np.array([1, 0, 0, 1])
+    assert estimate_nugget(betas[:2], stds[:2], np.zeros(2, dtype=np.int64)) > 0.03
+    assert estimate_nugget(betas, stds, pairs) > 0.015
+    assert estimate_nugget(betas, stds, pairs, min_class_size=3) == 0.0
+    assert with_nugget(_pokes(betas[:2], stds[:2]), CONFIG).nugget == 0.0
+    four = with_nugget(_pokes(betas, stds), CONFIG)
+    assert four.nugget == 0.0
+    classes = segment_regions(np.zeros((1, 1)), betas, four.noise,
+                              floor=beta_noise_floor(CONFIG)).poke_labels  # fmt: skip
+    assert classes.tolist() == pairs.tolist()

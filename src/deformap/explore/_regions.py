@@ -19,7 +19,9 @@ splitting with a calibrated test:
    (W): a moderated test (the claimed noise as a scaled-χ² prior on the scatter, as in Smyth
    2004). ``ν₀ = 0`` is the scale-free test that trusts only the βs; a large ``ν₀`` is Cochran's
    χ² test with known noise. The default 7 weighs the claimed noise like the eight presses on
-   one foam that the β-field's noise floor was measured from.
+   one foam that the β-field's former noise floor was measured from. The β-field's pokes carry
+   the map's nugget in their uncertainty (:mod:`deformap.explore._nugget`), itself estimated
+   within the classes this test finds (:func:`with_nugget`).
 3. The same is done for the best split into three parts (two materials cannot always be told
    from one by a binary split when a third sits between them); the more significant of the two
    tests is used, at 5 % with a Bonferroni correction for testing both.
@@ -332,14 +334,18 @@ def with_nugget(pokes: PokeSet, config: ExplorationConfig) -> PokeSet:
 
     The classes are the region test's on the β values (:func:`segment_regions` with the
     exploration's ``max_regions``, ``region_prior_dof`` and the β-field's smallest step and floor):
-    found first with the claimed σ, τ̂ estimated within them, found again with the noise that τ̂
-    gives, until they no longer change (at most :data:`deformap.explore._nugget.MAX_ROUNDS`
-    rounds). ``pokes`` unchanged under ``beta_field.nugget: off``.
+    found first with the claimed σ, τ̂ estimated within those the test examined (as many pokes as
+    it tests a group of: a smaller class, a pair above all, is no evidence of one material), found
+    again with the noise that τ̂ gives, until they no longer change (at most
+    :data:`deformap.explore._nugget.MAX_ROUNDS` rounds). ``pokes`` unchanged under
+    ``beta_field.nugget: off``.
     """
     if config.beta_field.nugget == "off" or len(pokes) < 2:
         return pokes
     floor = beta_noise_floor(config)
     flat = np.zeros((1, 1))
+    # the smallest class the region test examines (segment_regions: n ≥ 3 and ν₀ + n − 2 ≥ 2)
+    examined = max(3, int(np.ceil(4 - config.region_prior_dof)))
     tau, labels = 0.0, None
     for _ in range(MAX_ROUNDS):
         found = segment_regions(flat, pokes.beta, np.hypot(pokes.noise, tau), floor=floor,
@@ -347,8 +353,10 @@ def with_nugget(pokes: PokeSet, config: ExplorationConfig) -> PokeSet:
                                 prior_dof=config.region_prior_dof).poke_labels  # fmt: skip
         if labels is not None and np.array_equal(found, labels):
             break
-        labels = found
-        tau = estimate_nugget(pokes.beta, pokes.noise, labels)
+        labels, before = found, tau
+        tau = estimate_nugget(pokes.beta, pokes.noise, labels, min_class_size=examined)
+        if tau == before:  # the same noise finds the same classes again
+            break
     return replace(pokes, noise=np.hypot(pokes.noise, tau), nugget=tau)
 
 
