@@ -57,8 +57,10 @@ from deformap.explore import (
     PokeSet,
     RegionLabels,
     Target,
+    beta_noise_floor,
     map_regions,
     poke_step,
+    with_nugget,
 )
 from deformap.world import (
     CAMERA_PRESETS,
@@ -214,13 +216,17 @@ def _map_one(world: SimulatedWorld, draw: WorldDraw, config: ExplorationConfig, 
         for cut, scores in _scores(mapper, truth, cuts).items():
             rows.append({"cut": cut, **head, **scores,
                          "poke_s": t1 - t0, "elapsed_s": t1 - t_start})  # fmt: skip
-    return rows, poke_data(mapper.map_field.pokes)
+    stored = (mapper.map_field.pokes if config.field == "modulus"
+              else PokeSet.of([p.record for p in mapper.pokes], beta_noise_floor(config)))
+    return rows, poke_data(stored)
 
 
 def poke_data(pokes: PokeSet) -> dict[str, list[Any]]:
     """A map field's pokes as plain data: ``x``, ``y`` [m], ``value`` (β, or ln E [ln Pa]),
-    ``noise`` (its uncertainty with the field's floor) and ``index`` (the poke's number in its
-    run, from 0), in the field's order. Floats keep every bit through JSON (``repr``)."""
+    ``noise`` (its uncertainty with the field's floor; the β-field's before the map's nugget,
+    which depends on the pokes so far and is estimated again when they are rescored) and
+    ``index`` (the poke's number in its run, from 0), in the field's order. Floats keep every
+    bit through JSON (``repr``)."""
     return {"x": [float(v) for v in pokes.xy[:, 0]], "y": [float(v) for v in pokes.xy[:, 1]],
             "value": [float(v) for v in pokes.beta], "noise": [float(v) for v in pokes.noise],
             "index": [int(v) for v in np.asarray(pokes.index)]}
@@ -331,8 +337,11 @@ def rescore_world(task: dict[str, Any], result: dict[str, Any], cuts: Sequence[s
                         np.asarray(data["noise"], float)[keep], index[keep])  # fmt: skip
         config = replace(explore, strategy=cast(Any, strategy),
                          field=cast(Any, field_name), **settings)
-        field_config = config.modulus_field if field_name == "modulus" else config.beta_field
-        mean = BetaField(pokes, grid.xs, grid.ys, field_config).mean
+        if field_name == "modulus":
+            mean = BetaField(pokes, grid.xs, grid.ys, config.modulus_field).mean
+        else:  # the map's nugget after k pokes, as the run's β-field had it
+            pokes = with_nugget(pokes, config)
+            mean = BetaField(pokes, grid.xs, grid.ys, config.beta_field).mean
         sign = -1.0 if field_name == "modulus" else 1.0
         for cut in cuts:
             if len(pokes):

@@ -16,7 +16,13 @@ from deformap.explore._config import (
     check_exploration_budget,
 )
 from deformap.explore._dent import measure_press, roi_grid
-from deformap.explore._field import BetaField, FieldSettings, PokeSet, field_settings
+from deformap.explore._field import (
+    BetaField,
+    FieldSettings,
+    PokeSet,
+    beta_noise_floor,
+    field_settings,
+)
 from deformap.explore._grid import MapGrid
 from deformap.explore._journal import (
     JOURNAL_NAME,
@@ -32,6 +38,7 @@ from deformap.explore._modulus import (
     modulus_reading,
     rigid_modulus_bound,
 )
+from deformap.explore._nugget import estimate_nugget
 from deformap.explore._records import (
     PURPOSES,
     ContactRecord,
@@ -42,7 +49,13 @@ from deformap.explore._records import (
     Purpose,
     Target,
 )
-from deformap.explore._regions import RegionMap, map_regions, segment_regions
+from deformap.explore._regions import (
+    RegionMap,
+    beta_pokes,
+    map_regions,
+    segment_regions,
+    with_nugget,
+)
 from deformap.explore._result import ExplorationResult, StopReason
 from deformap.explore._stiffness import (
     LAYER_MODEL,
@@ -87,8 +100,11 @@ __all__ = [
     "SurfaceModel",
     "Target",
     "TouchGPConfig",
+    "beta_noise_floor",
+    "beta_pokes",
     "check_exploration_budget",
     "choose_target",
+    "estimate_nugget",
     "estimate_stiffness",
     "explore",
     "field_settings",
@@ -101,4 +117,5 @@ __all__ = [
     "rigid_modulus_bound",
     "roi_grid",
     "segment_regions",
+    "with_nugget",
 ]

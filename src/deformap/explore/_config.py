@@ -33,18 +33,28 @@ Its length scale (1 cm) is the tip's radius: the dent cannot vary faster than th
 
 β-field ("GPR β-field"): prior standard deviation 0.3 (variance 0.09, above the paper's threshold
 0.06 so that the unexplored map asks for a poke); length scale 0.2 m, a third of the table's width:
-the size of the foam pieces a robot is asked to tell apart; each poke's β uncertainty is its noise,
-with a floor of 0.015. That uncertainty is the camera's noise (measured in each poke's ROI)
-carried through the estimate (``TouchGPConfig.noise_samples`` draws of the touch GP's smoother
-applied to noise, β̂ re-read on each, :mod:`deformap.explore._dent_noise`): a repeatability, which
-the README ("β separates hardness only under the force-driven protocol") compares with the spread
-of β̂ between places on one block. The floor stands for what the camera's noise does not explain
-(the rest of that spread, largest on the hard foams): the spread between places on the 150 N
-foam, 0.015 on the default odds β scale (``ShapeMatchingConfig.beta_scale``; 0.015 / 0.017 with
-the PrimeSense / Kinect-v1 presets, three places) and 0.03 on the former reference scale (0.031
-over eight places), which squeezed the foams less (30–250 N at 0.91–0.37 there, 0.91–0.63 on the
-odds scale, which also spans the stiffer surfaces to rigid); with ``beta_scale: reference`` set
-``beta_field.noise_floor: 0.03`` to reproduce the former maps.
+the size of the foam pieces a robot is asked to tell apart. Each poke's noise is its claimed β
+uncertainty plus, in variance, the map's nugget: ``√(σᵢ² + τ̂²)``. σᵢ is the camera's noise
+(measured in each poke's ROI) carried through the estimate (``TouchGPConfig.noise_samples`` draws
+of the touch GP's smoother applied to noise, β̂ re-read on each,
+:mod:`deformap.explore._dent_noise`): a repeatability at one place. τ̂ is the scatter of β̂ between
+places on one material that σᵢ does not explain (the README, "β separates hardness only under the
+force-driven protocol", compares the two), estimated for each map from its own pokes
+(``BetaFieldConfig.nugget``, :mod:`deformap.explore._nugget`): the maximum a posteriori of the
+restricted likelihood of the pokes within the region test's classes (each class's mean removed,
+so the steps between materials are not read as scatter), with a half-Cauchy prior on τ whose scale
+is the pokes' median claimed σ (the estimator's own scale, no number of a world). σᵢ is at least
+``BetaFieldConfig.noise_floor``, by default the β grid's quantisation,
+``shape_matching.beta_resolution / √12`` (0.0029: what every β̂'s σ already is at least, and
+what a press read rigid claims), an explicit lower bound a robot may raise. Until this change the
+floor was 0.015 and there was no nugget: the spread between places on the simulated world's 150 N
+foam, a number fitted to the simulator's output (0.03 on the former reference β scale); ``nugget:
+off`` with ``noise_floor: 0.015`` (``0.03`` under ``beta_scale: reference``) reproduces those maps.
+On the simulated Table I scenarios (β-field; FEM seeds 0–3, the stiffening foam, kinect-v1) the
+nugget came out 0–0.022; on the same pokes the region test found the same classes as with the
+former floor in every map, while the planner, given other noises, placed other pokes (27 of 32
+maps counted right against 30 of 32: README, Table I on the β-field under "β separates hardness
+only under the force-driven protocol").
 Modulus field (``ExplorationConfig.field = "modulus"``, :mod:`deformap.explore._modulus`): a
 Gaussian random field over ln E [ln Pa] from the pokes' force–travel records. Its prior standard
 deviation 1.73 is a quarter of ln(10⁶ Pa / 10³ Pa) = 6.9: the soft foams to rubbers a table-top
@@ -89,6 +99,7 @@ __all__ = [
     "ExplorationConfig",
     "FieldName",
     "ModulusFieldConfig",
+    "NuggetEstimate",
     "RegionLabels",
     "StopRegion",
     "SurfaceGPConfig",
@@ -110,6 +121,8 @@ StopRegion = Literal["workspace", "targets"]
 RegionLabels = Literal["isopleth", "nearest", "indicator-kriging"]
 #: Which field the regions and the next-poke choice run on (``ExplorationConfig.field``).
 FieldName = Literal["beta", "modulus"]
+#: How the β-field's nugget is estimated (``BetaFieldConfig.nugget``).
+NuggetEstimate = Literal["within-class", "off"]
 #: Where a poke's β uncertainty comes from (``ExplorationConfig.beta_uncertainty``).
 BetaUncertainty = Literal["camera-noise", "shape-matching"]
 
@@ -217,11 +230,30 @@ class TouchGPConfig:
 
 @dataclass(frozen=True, kw_only=True)
 class BetaFieldConfig:
-    """Prior of the β-field Gaussian random field (the paper's σe, σw, σn)."""
+    """Prior of the β-field Gaussian random field (the paper's σe, σw, σn; module docstring,
+    "β-field", argues the defaults).
+
+    Parameters
+    ----------
+    signal_std : float
+        σe, the prior standard deviation of β about the pokes' weighted mean.
+    length_scale_m : float
+        σw, metres.
+    noise_floor : float or None
+        Smallest claimed σ of a poke's β, an explicit lower bound; ``None`` (default): the β
+        grid's quantisation, ``shape_matching.beta_resolution / √12``, which every β̂'s σ
+        already is at least (:func:`deformap.explore.beta_noise_floor`).
+    nugget : {"within-class", "off"}
+        ``within-class`` (default): each poke's noise is its σ (at least the floor) plus, in
+        variance, the map's nugget τ², the scatter between places on one material that the
+        claimed σ does not explain, estimated from the pokes of the map's own region classes
+        (:mod:`deformap.explore._nugget`); ``off``: the σ at least the floor alone.
+    """
 
     signal_std: float = setting(0.3, gt=0.0)
     length_scale_m: float = setting(0.2, gt=0.0)
-    noise_floor: float = setting(0.015, gt=0.0)
+    noise_floor: float | None = setting(None, gt=0.0)
+    nugget: NuggetEstimate = "within-class"
 
     def __post_init__(self) -> None:
         check_settings(self)
@@ -283,7 +315,7 @@ class ExplorationConfig:
     region_prior_dof : float
         How many degrees of freedom the pokes' uncertainties count for when the region test
         judges whether the βs scatter more than one material would (7: as much as the eight
-        presses on one foam the noise floor was measured from; 0: ignore them, scale-free).
+        presses on one foam the former noise floor was measured from; 0: ignore them, scale-free).
     region_labels : {"isopleth", "nearest", "indicator-kriging"}
         How cells get their region once the classes are found (:mod:`deformap.explore._regions`):
         ``isopleth``, the paper's, by the band of the β-field's mean a cell falls in;

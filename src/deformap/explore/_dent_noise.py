@@ -8,7 +8,8 @@ noise ``ε ~ N(0, Σ)`` leaves in it is ``W ε``: drawn here without the data's 
 sampling spread of the reconstruction, not the GP's posterior: the posterior adds what the prior
 does not know about the surface, which is not noise that another press would draw afresh (taken
 as the poke's noise, it made β̂ look far less repeatable than repeated presses on one foam are);
-what the reconstruction gets systematically wrong is left to the β-field's noise floor.
+what the reconstruction gets systematically wrong from place to place is left to the β-field's
+nugget (:mod:`deformap.explore._nugget`).
 
 The touch GP sees thousands of points in the ROI; here they are binned onto the ROI's own grid
 (a cell's points become one observation at its node, with noise σₙ/√count), which keeps the

@@ -1,7 +1,8 @@
 """The β-field ("GPR β-field"): a Gaussian random field over the pokes' βs, each poke's
-uncertainty its noise (with a floor), read on the map's grid; and the settings any field the map
-runs on takes (:func:`field_settings`: the β-field's, or the modulus field's of
-:mod:`deformap.explore._modulus`, which is built on the same class).
+uncertainty its noise (with a floor, plus the map's nugget: :mod:`deformap.explore._nugget`), read
+on the map's grid; and the settings any field the map runs on takes (:func:`field_settings`: the
+β-field's, or the modulus field's of :mod:`deformap.explore._modulus`, which is built on the same
+class).
 
 References
 ----------
@@ -27,7 +28,8 @@ from deformap.explore._config import (
 from deformap.explore._records import PokeRecord
 from deformap.gp import GaussianRandomField
 
-__all__ = ["REGION_MIN_STEP_BETA", "BetaField", "FieldSettings", "PokeSet", "field_settings"]
+__all__ = ["REGION_MIN_STEP_BETA", "BetaField", "FieldSettings", "PokeSet", "beta_noise_floor",
+           "field_settings"]
 
 #: Smallest difference of two region classes' mean β that separates them
 #: (:func:`deformap.explore.segment_regions`'s ``min_step`` under the β-field).
@@ -43,7 +45,8 @@ class FieldSettings:
     ----------
     name : {"beta", "modulus"}
     signal_std, length_scale_m, noise_floor : float
-        The field's prior (σe, σw) and its noise floor.
+        The field's prior (σe, σw) and its noise floor (the β-field's resolved by
+        :func:`beta_noise_floor`).
     threshold : float
         ``T_h`` on the field's variance.
     min_step : float
@@ -58,6 +61,17 @@ class FieldSettings:
     min_step: float
 
 
+def beta_noise_floor(config: ExplorationConfig) -> float:
+    """The smallest σ a poke's β is credited with: ``beta_field.noise_floor`` when set, else the
+    β grid's quantisation, ``shape_matching.beta_resolution / √12`` (the σ of a value known to
+    one step of the grid, what :func:`deformap.msm.estimate_beta` claims at least and a press read
+    rigid claims: :mod:`deformap.explore._dent`)."""
+    floor = config.beta_field.noise_floor
+    if floor is None:
+        return float(config.shape_matching.beta_resolution / np.sqrt(12.0))
+    return float(floor)
+
+
 def field_settings(config: ExplorationConfig, name: FieldName | None = None) -> FieldSettings:
     """The settings of the field ``name`` (default: the one ``config.field`` chooses).
 
@@ -68,7 +82,7 @@ def field_settings(config: ExplorationConfig, name: FieldName | None = None) -> 
     """
     beta = config.beta_field
     if (name or config.field) == "beta":
-        return FieldSettings("beta", beta.signal_std, beta.length_scale_m, beta.noise_floor,
+        return FieldSettings("beta", beta.signal_std, beta.length_scale_m, beta_noise_floor(config),
                              config.threshold, REGION_MIN_STEP_BETA)  # fmt: skip
     modulus = config.modulus_field
     ratio = modulus.signal_std / beta.signal_std
@@ -83,15 +97,18 @@ class PokeSet:
 
     ``xy (p, 2)`` metres, ``beta (p,)`` the values the field is fitted to (β for the β-field, ln E
     for the modulus field), ``noise (p,)`` each poke's uncertainty raised to the field's noise
-    floor (what the field and the planner take as its noise), ``index (p,)`` the pokes' indices
-    in their run (``PokeRecord.index``; default ``0 .. p-1``; a session's skipped poke and the
-    modulus field's pokes without a modulus leave gaps).
+    floor and, with a nugget, ``√(σ² + nugget²)`` (what the field and the planner take as its
+    noise), ``index (p,)`` the pokes' indices in their run (``PokeRecord.index``; default
+    ``0 .. p-1``; a session's skipped poke and the modulus field's pokes without a modulus leave
+    gaps), ``nugget`` the scatter between places of one material added to every poke's noise
+    (0: none; :func:`deformap.explore._regions.with_nugget`).
     """
 
     xy: NDArray[np.float64]
     beta: NDArray[np.float64]
     noise: NDArray[np.float64]
     index: NDArray[np.int64] | None = None
+    nugget: float = 0.0
 
     def __post_init__(self) -> None:
         if self.index is None:
@@ -121,20 +138,15 @@ class BetaField:
     pokes : PokeSet
     xs : (nx,) float, ys : (ny,) float, metres
     config : BetaFieldConfig
-        Prior standard deviation σe, length scale σw and the noise floor (any object with
-        ``signal_std``, ``length_scale_m`` and ``noise_floor``: the modulus field passes its own).
+        Prior standard deviation σe and length scale σw (any object with ``signal_std`` and
+        ``length_scale_m``: the modulus field passes its own). The pokes' noise is theirs, floor
+        and nugget included (the mapper's β-field: :func:`deformap.explore._regions.beta_pokes`).
 
     Attributes
     ----------
     mean, variance : (ny, nx) float
         Posterior mean (NaN without pokes) and variance, computed once on first use.
     """
-
-    @classmethod
-    def of(cls, records: Sequence[PokeRecord], xs: NDArray[np.float64], ys: NDArray[np.float64],
-           config: BetaFieldConfig) -> BetaField:
-        """The β-field of the pokes ``records`` (each one's uncertainty raised to the floor)."""
-        return cls(PokeSet.of(records, config.noise_floor), xs, ys, config)
 
     name: FieldName = "beta"
 
@@ -147,7 +159,7 @@ class BetaField:
         if len(pokes):
             self.gp = GaussianRandomField(
                 length_scale=config.length_scale_m, signal_std=config.signal_std,
-                noise_std=config.noise_floor, method="exact",
+                noise_std=float(pokes.noise.min()), method="exact",
             ).fit(pokes.xy, pokes.beta, noise_std=pokes.noise)  # fmt: skip
 
     @cached_property

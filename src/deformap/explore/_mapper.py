@@ -29,7 +29,7 @@ from deformap.explore._field import BetaField, field_settings
 from deformap.explore._grid import MapGrid
 from deformap.explore._modulus import ModulusField
 from deformap.explore._records import PokeResult, Target
-from deformap.explore._regions import RegionMap, map_regions
+from deformap.explore._regions import RegionMap, beta_pokes, map_regions
 from deformap.explore._result import ExplorationResult
 from deformap.explore._surface import SurfaceModel, fit_surface
 from deformap.explore._targets import BOUNDARY_SPACING_ROI, choose_next
@@ -87,7 +87,8 @@ class Mapper:
 
     def _fit(self, pokes: list[PokeResult]) -> tuple[BetaField, ModulusField]:
         records = [p.record for p in pokes]
-        return (BetaField.of(records, self.grid.xs, self.grid.ys, self.config.beta_field),
+        return (BetaField(beta_pokes(records, self.config), self.grid.xs, self.grid.ys,
+                          self.config.beta_field),
                 ModulusField.of_records(records, self.grid.xs, self.grid.ys,
                                         self.config.modulus_field,
                                         self.config.stiffness.poisson_ratio))  # fmt: skip

@@ -13,11 +13,13 @@ candidate that best complements the others (exchange passes, as in Fedorov's exc
 for optimal designs), until a pass moves none or after ``max_passes`` passes. The first ``m``
 whose plan reaches ``T_h`` is the plan.
 
-Every planned poke is assumed to come with the β-field's noise floor; a real poke often reports
-more, so the loop plans again after every poke with the uncertainties actually measured. Greedy
-one-step look-ahead (``min-max-variance``) and largest-variance-first (``max-variance``) are
-myopic: each poke serves the worst cell now, not the set of pokes that covers the domain; the
-README ("Results", the paper's Table I) gives the pokes each strategy needs.
+Every planned poke is assumed to come with the noise ``expected_noise`` gives
+(:mod:`deformap.explore._targets`: the β-field's floor with the map's nugget, or the noise of the
+pokes already near it); a real poke often reports more, so the loop plans again after every
+poke with the uncertainties actually measured. Greedy one-step look-ahead (``min-max-variance``)
+and largest-variance-first (``max-variance``) are myopic: each poke serves the worst cell now, not
+the set of pokes that covers the domain; the README ("Results", the paper's Table I) gives the
+pokes each strategy needs.
 
 References
 ----------

@@ -19,7 +19,9 @@ splitting with a calibrated test:
    (W): a moderated test (the claimed noise as a scaled-χ² prior on the scatter, as in Smyth
    2004). ``ν₀ = 0`` is the scale-free test that trusts only the βs; a large ``ν₀`` is Cochran's
    χ² test with known noise. The default 7 weighs the claimed noise like the eight presses on
-   one foam that the β-field's noise floor was measured from.
+   one foam that the β-field's former noise floor was measured from. The β-field's pokes carry
+   the map's nugget in their uncertainty (:mod:`deformap.explore._nugget`), itself estimated
+   within the classes this test finds (:func:`with_nugget`).
 3. The same is done for the best split into three parts (two materials cannot always be told
    from one by a binary split when a third sits between them); the more significant of the two
    tests is used, at 5 % with a Bonferroni correction for testing both.
@@ -66,7 +68,8 @@ expression in microarray experiments. Stat. Appl. Genet. Mol. Biol. 3(1), Articl
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
 from itertools import pairwise
 
 import numpy as np
@@ -75,10 +78,13 @@ from scipy.spatial import Delaunay, QhullError
 
 from deformap._validation import check_array, check_int, check_positive
 from deformap.explore._config import ExplorationConfig
-from deformap.explore._field import PokeSet, field_settings
+from deformap.explore._field import REGION_MIN_STEP_BETA, PokeSet, beta_noise_floor, field_settings
 from deformap.explore._indicator import indicator_labels
+from deformap.explore._nugget import MAX_ROUNDS, estimate_nugget
+from deformap.explore._records import PokeRecord
 
-__all__ = ["RegionMap", "map_regions", "merge_seam_classes", "poke_classes", "segment_regions"]
+__all__ = ["RegionMap", "beta_pokes", "map_regions", "merge_seam_classes", "poke_classes",
+           "segment_regions", "with_nugget"]
 
 _NULL_SAMPLES = 4000
 _NULL_SEED = 20161115
@@ -389,3 +395,41 @@ def map_regions(mean: NDArray[np.float64], pokes: PokeSet, cells_xy: NDArray[np.
         return RegionMap(labels=labels.reshape(found.labels.shape), levels=found.levels,
                          class_betas=found.class_betas, poke_labels=found.poke_labels)
     return found
+
+
+def with_nugget(pokes: PokeSet, config: ExplorationConfig) -> PokeSet:
+    """``pokes`` (β, each noise its claimed σ at least the floor) with the map's nugget τ̂ added to
+    every poke's noise in variance, ``√(σᵢ² + τ̂²)`` (:mod:`deformap.explore._nugget`).
+
+    The classes are the region test's on the β values (:func:`segment_regions` with the
+    exploration's ``max_regions``, ``region_prior_dof`` and the β-field's smallest step and floor):
+    found first with the claimed σ, τ̂ estimated within those the test examined (as many pokes as
+    it tests a group of: a smaller class, a pair above all, is no evidence of one material), found
+    again with the noise that τ̂ gives, until they no longer change (at most
+    :data:`deformap.explore._nugget.MAX_ROUNDS` rounds). ``pokes`` unchanged under
+    ``beta_field.nugget: off``.
+    """
+    if config.beta_field.nugget == "off" or len(pokes) < 2:
+        return pokes
+    floor = beta_noise_floor(config)
+    flat = np.zeros((1, 1))
+    # the smallest class the region test examines (segment_regions: n ≥ 3 and ν₀ + n − 2 ≥ 2)
+    examined = max(3, int(np.ceil(4 - config.region_prior_dof)))
+    tau, labels = 0.0, None
+    for _ in range(MAX_ROUNDS):
+        found = segment_regions(flat, pokes.beta, np.hypot(pokes.noise, tau), floor=floor,
+                                min_step=REGION_MIN_STEP_BETA, max_regions=config.max_regions,
+                                prior_dof=config.region_prior_dof).poke_labels  # fmt: skip
+        if labels is not None and np.array_equal(found, labels):
+            break
+        labels, before = found, tau
+        tau = estimate_nugget(pokes.beta, pokes.noise, labels, min_class_size=examined)
+        if tau == before:  # the same noise finds the same classes again
+            break
+    return replace(pokes, noise=np.hypot(pokes.noise, tau), nugget=tau)
+
+
+def beta_pokes(records: Sequence[PokeRecord], config: ExplorationConfig) -> PokeSet:
+    """The pokes of the β-field as the mapper fits it: each poke's claimed σ raised to the floor
+    (:func:`deformap.explore.beta_noise_floor`), plus the map's nugget (:func:`with_nugget`)."""
+    return with_nugget(PokeSet.of(records, beta_noise_floor(config)), config)

@@ -16,7 +16,7 @@ from deformap.explore._field import BetaField
 from deformap.explore._grid import MapGrid
 from deformap.explore._modulus import ModulusField
 from deformap.explore._records import PokeResult
-from deformap.explore._regions import RegionMap
+from deformap.explore._regions import RegionMap, beta_pokes
 from deformap.explore._surface import SurfaceModel
 
 __all__ = ["ExplorationResult", "StopReason"]
@@ -93,8 +93,8 @@ class ExplorationResult:
         """The β-field as it was after the first ``n_pokes`` pokes (recordings, figures)."""
         if n_pokes == len(self.pokes):
             return self.field
-        return BetaField.of([p.record for p in self.pokes[:n_pokes]], self.grid.xs, self.grid.ys,
-                            self.config.beta_field)  # fmt: skip
+        return BetaField(beta_pokes([p.record for p in self.pokes[:n_pokes]], self.config),
+                         self.grid.xs, self.grid.ys, self.config.beta_field)
 
     def modulus_field_after(self, n_pokes: int) -> ModulusField:
         """The modulus field as it was after the first ``n_pokes`` pokes."""

@@ -39,10 +39,11 @@ def expected_noise(candidates: NDArray[np.float64], pokes: PokeSet,
     """The β uncertainty a poke at each of ``candidates (c, 2)`` is expected to have: the largest
     of the pokes already made within ``BOUNDARY_SPACING_ROI`` ROIs of it (a dent spreads a few
     centimetres, so a press there measures that foam again, no better), else the map field's
-    noise floor (:func:`deformap.explore.field_settings`). So the target choice knows what a
-    further press at a place can still reduce, and does not return to a place whose readings are
-    noisy expecting a reading at the floor."""
-    floor = field_settings(config).noise_floor
+    noise floor (:func:`deformap.explore.field_settings`) with the map's nugget added in variance
+    (``pokes.nugget``: any press carries the scatter between places of one material). So the
+    target choice knows what a further press at a place can still reduce, and does not return to
+    a place whose readings are noisy expecting a reading at the floor."""
+    floor = float(np.hypot(field_settings(config).noise_floor, pokes.nugget))
     noise = np.full(len(candidates), floor)
     if len(pokes) == 0:
         return noise

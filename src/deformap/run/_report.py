@@ -6,6 +6,9 @@ Every report of a mapped surface (a live exploration, :func:`live_report`; a rec
 - ``pokes`` (one record per poke, as the mapper wrote it), ``n_pokes``, ``stop_reason``;
 - ``max_variance`` (what the stopping rule compared with T_h, over ``stop_region``) and
   ``max_variance_map`` (over the whole map), both of the map field (``field``), in its units;
+- ``beta_nugget``: the β-field's nugget, the scatter of β between places of one material that
+  the pokes' claimed σ does not explain, estimated from this map's pokes
+  (:mod:`deformap.explore._nugget`; 0 under ``beta_field.nugget: off``);
 - ``field`` (the field the regions, the targets and the stop rule ran on: ``beta`` or
   ``modulus``) and ``threshold`` (its ``T_h``, in its units: :func:`deformap.explore.field_settings`);
 - ``regions``: ``levels`` and ``class_values`` (in the map field's units: β, or ln E [ln Pa]),
@@ -65,6 +68,7 @@ SHARED_KEYS = (
     "threshold",
     "max_variance",
     "max_variance_map",
+    "beta_nugget",
     "regions",
     "modulus_field",
     "timings",
@@ -157,6 +161,7 @@ def shared_report(result: ExplorationResult, *, truth: Any = None) -> dict[str, 
         "threshold": field_settings(result.config).threshold,
         "max_variance": result.max_variance,
         "max_variance_map": float(var.max()),
+        "beta_nugget": float(result.field.pokes.nugget),
         "regions": regions,
         "modulus_field": modulus_report(result),
     }
