@@ -134,7 +134,8 @@ def test_one_world_is_mapped_to_max_pokes_by_every_combination() -> None:
     assert np.isfinite([r["poke_s"] for r in rows]).all()
     for field in ("beta", "modulus"):
         stored = result["pokes"][f"paper/{field}"]
-        assert sorted(stored) == ["index", "noise", "value", "x", "y"]
+        assert sorted(stored) == ["index", "noise", "thickness", "value", "x", "y"]
+        assert stored["thickness"] is not None and len(stored["thickness"]) == len(stored["x"])
         assert 1 <= len(stored["value"]) <= 2 and stored["index"] == sorted(stored["index"])
     # the stored pokes score the run's cuts again to the bit, through JSON, in another order
     again = rescore_world(task, json.loads(json.dumps(result)), ["nearest", "isopleth"])

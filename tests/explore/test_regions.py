@@ -114,6 +114,9 @@ def test_nearest_poke_labels_give_each_cell_its_nearest_pokes_class() -> None:
         found.nearest_poke(pokes, cells[:-1])
 
 
+_THICK = np.full(25, 0.05)  # 5 cm foam: a joint within 10 cm of a press reaches it
+
+
 def _grid_pokes(value_at) -> tuple[np.ndarray, np.ndarray]:
     xs = np.linspace(0.0, 0.2, 5)
     xy = np.array([(x, y) for y in xs for x in xs])
@@ -128,7 +131,7 @@ def test_a_class_of_seam_pokes_joins_the_classes_it_lies_between() -> None:
     std = np.full(value.size, 0.05)
     found = segment_regions(np.zeros((2, 2)), value, std)
     assert found.n_regions == 4  # the seam's 0.9s and 1.1s are two classes of their own
-    merged = merge_seam_classes(found, np.zeros((2, 2)), xy, value)
+    merged = merge_seam_classes(found, np.zeros((2, 2)), xy, value, _THICK)
     assert merged.n_regions == 2
     middle = np.isclose(xy[:, 0], 0.1)
     # each seam poke ends on the side nearer its value: 0.9 soft, 1.1 hard
@@ -142,7 +145,7 @@ def test_a_material_with_pokes_inside_it_is_not_a_seam() -> None:
     """A middle value whose block has pokes bordering only its own class stays a region."""
     xy, value = _grid_pokes(lambda x, y: 0.0 if x < 0.09 else 1.0 if y > 0.09 else 2.0)
     found = segment_regions(np.zeros((2, 2)), value, np.full(value.size, 0.05))
-    merged = merge_seam_classes(found, np.zeros((2, 2)), xy, value)
+    merged = merge_seam_classes(found, np.zeros((2, 2)), xy, value, _THICK)
     assert merged.n_regions == found.n_regions == 3
     np.testing.assert_array_equal(merged.poke_labels, found.poke_labels)
 
@@ -155,7 +158,7 @@ def test_a_press_by_a_free_face_reading_softer_than_both_joins_a_neighbour() -> 
     value[joint] = 0.2
     found = segment_regions(np.zeros((2, 2)), value, np.full(value.size, 0.05))
     assert found.n_regions == 3 and found.poke_labels[joint] == [0]
-    merged = merge_seam_classes(found, np.zeros((2, 2)), xy, value)
+    merged = merge_seam_classes(found, np.zeros((2, 2)), xy, value, _THICK)
     assert merged.n_regions == 2 and merged.poke_labels[joint] == [0]
     np.testing.assert_array_equal(merged.poke_labels[value != 0.2], found.poke_labels[value != 0.2] - 1)
 
@@ -167,7 +170,7 @@ def test_an_insert_met_by_one_poke_stays_a_region() -> None:
     value[centre] = 1.0
     found = segment_regions(np.zeros((2, 2)), value, np.full(value.size, 0.05))
     assert found.n_regions == 3
-    merged = merge_seam_classes(found, np.zeros((2, 2)), xy, value)
+    merged = merge_seam_classes(found, np.zeros((2, 2)), xy, value, _THICK)
     np.testing.assert_array_equal(merged.poke_labels, found.poke_labels)
 
 
@@ -175,5 +178,18 @@ def test_seams_are_not_judged_without_a_triangulation() -> None:
     xy = np.column_stack([np.linspace(0, 0.2, 7), np.zeros(7)])  # one line of pokes
     value = np.array([0.0, 0.0, 0.0, 1.0, 2.0, 2.0, 2.0])
     found = segment_regions(np.zeros((2, 2)), value, np.full(7, 0.05))
-    merged = merge_seam_classes(found, np.zeros((2, 2)), xy, value)
+    merged = merge_seam_classes(found, np.zeros((2, 2)), xy, value, np.full(7, 0.05))
     np.testing.assert_array_equal(merged.poke_labels, found.poke_labels)
+
+
+def test_a_joint_farther_than_the_layer_reaches_is_no_junction() -> None:
+    """The seam column of the first test, read with 1 cm foam: its neighbours 5 cm away lie
+    beyond twice the thickness, so nothing merges; without the thickness nothing merges either."""
+    xy, value = _grid_pokes(lambda x, y: 0.0 if x < 0.09 else 2.0 if x > 0.11 else
+                            (0.9 if y < 0.1 else 1.1))
+    found = segment_regions(np.zeros((2, 2)), value, np.full(value.size, 0.05))
+    for thickness in (np.full(25, 0.01), None):
+        merged = merge_seam_classes(found, np.zeros((2, 2)), xy, value, thickness)
+        np.testing.assert_array_equal(merged.poke_labels, found.poke_labels)
+    with pytest.raises(InvalidArgumentError, match="thickness_m"):
+        merge_seam_classes(found, np.zeros((2, 2)), xy, value, np.full(3, 0.05))

@@ -189,7 +189,7 @@ def _scores(mapper: Mapper, truth: tuple[NDArray, dict[int, float], NDArray],
 
 def _map_one(world: SimulatedWorld, draw: WorldDraw, config: ExplorationConfig, surface: Any,
              truth: tuple[NDArray, dict[int, float], NDArray], seed: int,
-             cuts: Sequence[str]) -> tuple[list[dict[str, Any]], dict[str, list[Any]]]:
+             cuts: Sequence[str]) -> tuple[list[dict[str, Any]], dict[str, list[Any] | None]]:
     """Map the world with one configuration to ``max_pokes``; one row per poke and cut, and the
     map field's pokes at the end (:func:`poke_data`)."""
     mapper = Mapper(world.workspace, config)
@@ -221,15 +221,17 @@ def _map_one(world: SimulatedWorld, draw: WorldDraw, config: ExplorationConfig, 
     return rows, poke_data(stored)
 
 
-def poke_data(pokes: PokeSet) -> dict[str, list[Any]]:
+def poke_data(pokes: PokeSet) -> dict[str, list[Any] | None]:
     """A map field's pokes as plain data: ``x``, ``y`` [m], ``value`` (β, or ln E [ln Pa]),
     ``noise`` (its uncertainty with the field's floor; the β-field's before the map's nugget,
     which depends on the pokes so far and is estimated again when they are rescored) and
-    ``index`` (the poke's number in its run, from 0), in the field's order. Floats keep every
-    bit through JSON (``repr``)."""
+    ``index`` (the poke's number in its run, from 0) and ``thickness`` (the layer's at each poke
+    [m], or ``None``), in the field's order. Floats keep every bit through JSON (``repr``)."""
     return {"x": [float(v) for v in pokes.xy[:, 0]], "y": [float(v) for v in pokes.xy[:, 1]],
             "value": [float(v) for v in pokes.beta], "noise": [float(v) for v in pokes.noise],
-            "index": [int(v) for v in np.asarray(pokes.index)]}
+            "index": [int(v) for v in np.asarray(pokes.index)],
+            "thickness": None if pokes.thickness is None
+            else [float(v) for v in pokes.thickness]}
 
 
 def _build_world(task: dict[str, Any]) -> tuple[WorldDraw, SimulatedWorld, ExplorationConfig]:
@@ -332,9 +334,12 @@ def rescore_world(task: dict[str, Any], result: dict[str, Any], cuts: Sequence[s
         data = result["pokes"][f"{strategy}/{field_name}"]
         index = np.asarray(data["index"], dtype=np.int64)
         keep = index < poke
+        thickness = data.get("thickness")
         pokes = PokeSet(np.column_stack([data["x"], data["y"]])[keep],
                         np.asarray(data["value"], float)[keep],
-                        np.asarray(data["noise"], float)[keep], index[keep])  # fmt: skip
+                        np.asarray(data["noise"], float)[keep], index[keep],
+                        thickness=None if thickness is None
+                        else np.asarray(thickness, float)[keep])  # fmt: skip
         config = replace(explore, strategy=cast(Any, strategy),
                          field=cast(Any, field_name), **settings)
         if field_name == "modulus":

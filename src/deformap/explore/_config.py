@@ -327,12 +327,12 @@ class ExplorationConfig:
         three at 20 pokes (indicator kriging was a little better at 5–10).
     merge_seams : bool
         Before the cells are labelled, merge the classes whose every poke borders pokes of two
-        other classes (:func:`deformap.explore.merge_seam_classes`): a press where two pieces
-        meet reads between them, or softer than both by a free face, and is otherwise a region of
-        its own. On by default: over the first 26 worlds of ``deformap bench worlds --seed 0``
-        (rescored on the same pokes) it took the worlds with more regions found than true after
-        20 pokes from 35–54 % to 0–4 % and raised the share reaching accuracy 0.9 with both
-        strategies measured (README, "Many worlds"); ``false`` gives the classes as found.
+        other classes within twice the layer's thickness (:func:`deformap.explore.merge_seam_classes`):
+        a press where two pieces meet reads between them, or softer than both by a free face, and
+        is otherwise a region of its own. On by default: on the first 30 worlds of ``deformap
+        bench worlds --seed 0`` (rescored on the same pokes, README "Many worlds") it took the
+        worlds with more regions found than true after 20 pokes from 53 % to 30 % (``paper``) and
+        33 % to 20 % (``planned``) and left Table I as it was; ``false`` gives the classes as found.
     boundary_pokes : int
         Pokes made after the variance has fallen below ``T_h``, each where a region boundary is
         least certain (:mod:`deformap.explore._acquisition`, "boundary pokes"); 0, the paper's

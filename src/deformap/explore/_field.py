@@ -101,7 +101,10 @@ class PokeSet:
     noise), ``index (p,)`` the pokes' indices in their run (``PokeRecord.index``; default
     ``0 .. p-1``; a session's skipped poke and the modulus field's pokes without a modulus leave
     gaps), ``nugget`` the scatter between places of one material added to every poke's noise
-    (0: none; :func:`deformap.explore._regions.with_nugget`).
+    (0: none; :func:`deformap.explore._regions.with_nugget`), ``thickness (p,)`` the layer's
+    thickness at each poke in metres (:func:`layer_thickness`; ``None`` when not every poke has
+    one), which bounds how far a junction can reach a press
+    (:func:`deformap.explore.merge_seam_classes`).
     """
 
     xy: NDArray[np.float64]
@@ -109,6 +112,7 @@ class PokeSet:
     noise: NDArray[np.float64]
     index: NDArray[np.int64] | None = None
     nugget: float = 0.0
+    thickness: NDArray[np.float64] | None = None
 
     def __post_init__(self) -> None:
         if self.index is None:
@@ -120,10 +124,20 @@ class PokeSet:
         beta = np.array([r.beta for r in records], dtype=float)
         noise = np.maximum(np.array([r.beta_std for r in records], dtype=float), noise_floor)
         index = np.array([r.index for r in records], dtype=np.int64)
-        return cls(xy, beta, np.asarray(noise, dtype=float).reshape(-1), index)
+        return cls(xy, beta, np.asarray(noise, dtype=float).reshape(-1), index,
+                   thickness=layer_thickness(records))
 
     def __len__(self) -> int:
         return int(self.beta.size)
+
+
+def layer_thickness(records: Sequence[PokeRecord]) -> NDArray[np.float64] | None:
+    """Each poke's layer thickness [m] (``PokeRecord.layer_thickness_m``, the surface model's
+    height at the contact), or ``None`` unless every poke has one."""
+    values = [r.layer_thickness_m for r in records]
+    if not values or any(v is None for v in values):
+        return None
+    return np.array(values, dtype=float)
 
 
 class BetaField:

@@ -33,7 +33,7 @@ from numpy.typing import NDArray
 
 from deformap.errors import InvalidArgumentError
 from deformap.explore._config import ModulusFieldConfig
-from deformap.explore._field import BetaField, PokeSet
+from deformap.explore._field import BetaField, PokeSet, layer_thickness
 from deformap.explore._records import PokeRecord
 from deformap.mechanics import layer_indentation_force
 
@@ -138,7 +138,9 @@ class ModulusField(BetaField):
         noise = np.maximum(np.array([m.log_std for _, m in used], dtype=float),
                            config.noise_floor)  # fmt: skip
         index = np.array([m.index for _, m in used], dtype=np.int64)
-        return cls(PokeSet(xy, values, noise.reshape(-1), index), xs, ys, config, readings)
+        thickness = layer_thickness([r for r, _ in used])
+        return cls(PokeSet(xy, values, noise.reshape(-1), index, thickness=thickness), xs, ys,
+                   config, readings)
 
     @property
     def std(self) -> NDArray[np.float64]:

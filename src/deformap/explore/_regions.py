@@ -320,8 +320,8 @@ def _neighbours(xy: NDArray[np.float64]) -> list[set[int]]:
 
 
 def merge_seam_classes(found: RegionMap, mean: NDArray[np.float64],
-                       poke_xy: NDArray[np.float64],
-                       poke_value: NDArray[np.float64]) -> RegionMap:
+                       poke_xy: NDArray[np.float64], poke_value: NDArray[np.float64],
+                       thickness_m: NDArray[np.float64] | None) -> RegionMap:
     """``found`` with its junction classes merged into their neighbours.
 
     A press where two pieces meet reads neither piece: across a bonded seam it dents both and
@@ -335,11 +335,17 @@ def merge_seam_classes(found: RegionMap, mean: NDArray[np.float64],
     so an insert met by a single poke stays a region. What it gives up: a material seen only by
     pokes lying where two others meet (a stripe one poke wide between two others) is merged until
     a poke lands inside it; ``deformap bench rescore --merge-seams`` measures the trade (README,
-    "Many worlds").
+    "Many worlds"). Without every poke's thickness (``None``: a poke without a force–travel
+    record) no class is merged.
     """
     labels = found.poke_labels.copy()
+    if thickness_m is None:
+        return found
     values = check_array("poke_value", poke_value, (labels.size,))
-    near = _neighbours(check_array("poke_xy", poke_xy, (labels.size, 2), what="metres"))
+    xy = check_array("poke_xy", poke_xy, (labels.size, 2), what="metres")
+    reach = 2.0 * check_array("thickness_m", thickness_m, (labels.size,), what="metres")
+    near = [{j for j in neighbours if np.hypot(*(xy[j] - xy[i])) <= reach[i]}
+            for i, neighbours in enumerate(_neighbours(xy))]
     while True:
         classes = np.unique(labels)
         means = np.array([values[labels == c].mean() for c in classes])
@@ -384,7 +390,7 @@ def map_regions(mean: NDArray[np.float64], pokes: PokeSet, cells_xy: NDArray[np.
     cells)."""
     found = poke_classes(mean, pokes, config)
     if config.merge_seams and found.n_regions >= 3:
-        found = merge_seam_classes(found, mean, pokes.xy, pokes.beta)
+        found = merge_seam_classes(found, mean, pokes.xy, pokes.beta, pokes.thickness)
     if config.region_labels == "nearest":
         return found.nearest_poke(pokes.xy, cells_xy)
     if config.region_labels == "indicator-kriging":
