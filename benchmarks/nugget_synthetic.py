@@ -18,10 +18,16 @@ import argparse
 
 import numpy as np
 
-from deformap.explore import ExplorationConfig, PokeSet, segment_regions, with_nugget
+from deformap.explore import (
+    ExplorationConfig,
+    PokeSet,
+    beta_noise_floor,
+    segment_regions,
+    with_nugget,
+)
 
 CONFIG = ExplorationConfig(field="beta")
-FLOOR = 0.01 / np.sqrt(12.0)
+FLOOR = beta_noise_floor(CONFIG)  # the β grid's resolution / √12
 FLAT = np.zeros((1, 1))
 
 

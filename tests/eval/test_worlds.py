@@ -221,3 +221,33 @@ def test_the_cuts_are_scored_on_the_same_pokes_as_a_run_per_cut() -> None:
     key = lambda r: (r["cut"], r["poke"])  # noqa: E731
     assert sorted(together, key=key) == sorted(apart, key=key)
     assert {r["cut"] for r in together} == set(cuts)
+
+
+def test_rescoring_merges_a_junction_class_within_the_stored_thickness_only() -> None:
+    """Stored pokes: a soft left, a stiff right and a column between them on the joint; the
+    junction rule merges that column when the stored layer is thick enough to reach it, and
+    a poke without a thickness turns the rule off from that poke on."""
+    task = {"seed": 5, "index": 0, "families": ["l-shape"], "physics": ["linear-fem"],
+            "strategies": ["paper"], "fields": ["modulus"], "cuts": ["nearest"],
+            "max_pokes": 25, "coarse": True}
+    xs, ys = np.linspace(0.1, 0.5, 5), np.linspace(0.05, 0.35, 5)
+    xy = np.array([(x, y) for y in ys for x in xs])
+    value = np.log(np.where(xy[:, 0] < 0.25, 10e3, np.where(xy[:, 0] > 0.35, 40e3, 20e3)))
+    rows = [{"world": 0, "family": "l-shape", "strategy": "paper", "field": "modulus",
+             "cut": "nearest", "poke": k} for k in range(1, 26)]
+
+    def found(thickness, merge: bool) -> list[int]:
+        pokes = {"x": xy[:, 0].tolist(), "y": xy[:, 1].tolist(), "value": value.tolist(),
+                 "noise": [0.1] * 25, "index": list(range(25)), "thickness": thickness}
+        result = {"status": "ok", "world": {"index": 0}, "rows": rows,
+                  "pokes": {"paper/modulus": pokes}}
+        again = rescore_world(task, result, ["nearest"], merge_seams=merge)["rows"]
+        return [r["found"] for r in again]
+
+    assert found([0.06] * 25, merge=False)[-1] == 3  # the joint column is a class
+    assert found([0.06] * 25, merge=True)[-1] == 2  # within 2 × 6 cm: merged
+    assert found([0.01] * 25, merge=True)[-1] == 3  # 1 cm foam: the joint cannot reach
+    late = found([0.06] * 24 + [None], merge=True)  # the last poke has no thickness
+    assert late[-2] == 2 and late[-1] == 3
+    with pytest.raises(InvalidArgumentError, match="merge_seams only"):
+        rescore_world(task, {"status": "ok", "rows": [], "pokes": {}}, ["nearest"], max_regions=2)

@@ -104,8 +104,20 @@ def test_rescore_scores_other_cuts_on_the_stored_pokes_and_names_what_it_cannot(
     result = runner.invoke(app, ["bench", "rescore", str(tmp_path / "src"), "--out",
                                  str(tmp_path / "third")])
     assert result.exit_code == 2
-    assert "1 without (worlds [1]: run before pokes were stored)" in result.output
+    assert "world-00001.json is not a rescorable world: no `pokes`" in result.output
     assert "Traceback" not in result.output and not (tmp_path / "third").exists()
+    # damaged stored worlds: one line naming the file and what is wrong, before any folder
+    stored["pokes"] = {"paper/beta": {"x": [0.1], "y": [0.1, 0.2], "value": [1.0],
+                                      "noise": [0.1], "index": [0]}}
+    for damaged, why in (([1, 2], "expected an object"),
+                         ({**stored, "world": {"index": "a"}}, "`world.index` must be"),
+                         (stored, "columns of different lengths"),
+                         ({**stored, "pokes": {}}, "no stored pokes for 'paper/beta'")):
+        world.write_text(json.dumps(damaged))
+        result = runner.invoke(app, ["bench", "rescore", str(tmp_path / "src"), "--out",
+                                     str(tmp_path / "third")])
+        assert result.exit_code == 2 and why in result.output, result.output
+        assert "Traceback" not in result.output and not (tmp_path / "third").exists()
     result = runner.invoke(app, ["bench", "rescore", str(tmp_path), "--out",
                                  str(tmp_path / "fourth")])
     assert result.exit_code == 2 and "is not a worlds benchmark" in result.output

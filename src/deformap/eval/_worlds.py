@@ -189,7 +189,7 @@ def _scores(mapper: Mapper, truth: tuple[NDArray, dict[int, float], NDArray],
 
 def _map_one(world: SimulatedWorld, draw: WorldDraw, config: ExplorationConfig, surface: Any,
              truth: tuple[NDArray, dict[int, float], NDArray], seed: int,
-             cuts: Sequence[str]) -> tuple[list[dict[str, Any]], dict[str, list[Any] | None]]:
+             cuts: Sequence[str]) -> tuple[list[dict[str, Any]], dict[str, list[Any]]]:
     """Map the world with one configuration to ``max_pokes``; one row per poke and cut, and the
     map field's pokes at the end (:func:`poke_data`)."""
     mapper = Mapper(world.workspace, config)
@@ -216,22 +216,24 @@ def _map_one(world: SimulatedWorld, draw: WorldDraw, config: ExplorationConfig, 
         for cut, scores in _scores(mapper, truth, cuts).items():
             rows.append({"cut": cut, **head, **scores,
                          "poke_s": t1 - t0, "elapsed_s": t1 - t_start})  # fmt: skip
+    records = {p.record.index: p.record for p in mapper.pokes}
     stored = (mapper.map_field.pokes if config.field == "modulus"
-              else PokeSet.of([p.record for p in mapper.pokes], beta_noise_floor(config)))
-    return rows, poke_data(stored)
+              else PokeSet.of(list(records.values()), beta_noise_floor(config)))
+    thickness = [records[int(i)].layer_thickness_m for i in np.asarray(stored.index)]
+    return rows, poke_data(stored, thickness)
 
 
-def poke_data(pokes: PokeSet) -> dict[str, list[Any] | None]:
+def poke_data(pokes: PokeSet, thickness: Sequence[float | None]) -> dict[str, list[Any]]:
     """A map field's pokes as plain data: ``x``, ``y`` [m], ``value`` (β, or ln E [ln Pa]),
     ``noise`` (its uncertainty with the field's floor; the β-field's before the map's nugget,
     which depends on the pokes so far and is estimated again when they are rescored) and
     ``index`` (the poke's number in its run, from 0) and ``thickness`` (the layer's at each poke
-    [m], or ``None``), in the field's order. Floats keep every bit through JSON (``repr``)."""
+    [m], ``None`` where a poke had none: ``PokeRecord.layer_thickness_m``), in the field's order.
+    Floats keep every bit through JSON (``repr``)."""
     return {"x": [float(v) for v in pokes.xy[:, 0]], "y": [float(v) for v in pokes.xy[:, 1]],
             "value": [float(v) for v in pokes.beta], "noise": [float(v) for v in pokes.noise],
             "index": [int(v) for v in np.asarray(pokes.index)],
-            "thickness": None if pokes.thickness is None
-            else [float(v) for v in pokes.thickness]}
+            "thickness": [None if t is None else float(t) for t in thickness]}
 
 
 def _build_world(task: dict[str, Any]) -> tuple[WorldDraw, SimulatedWorld, ExplorationConfig]:
@@ -303,25 +305,30 @@ def rescore_world(task: dict[str, Any], result: dict[str, Any], cuts: Sequence[s
                   **settings: Any) -> dict[str, Any]:
     """``result`` of :func:`run_world` for ``task`` with its rows scored under ``cuts`` instead,
     on the pokes it stored (no press is made again: the pokes do not depend on the cut).
-    ``settings`` are :class:`ExplorationConfig` fields the cuts are scored with (e.g.
-    ``merge_seams=True``): only those that act after the pokes, on the regions, are meaningful.
+    ``settings`` are the rules that act after the pokes, on the regions: ``merge_seams`` only.
 
     After ``k`` pokes the map field is the one of the stored pokes numbered below ``k`` (a poke
     without a value, a modulus field's poke whose record gave none, leaves a gap, as it did in the
-    run), so scoring the run's own cuts again gives its rows to the bit (a test checks it). The
-    columns that do not depend on the cut (``purpose``, ``threshold``, ``modulus_error``, times,
-    ...) are the run's.
+    run), so scoring the run's own cuts again, on a world written by the same version, gives its
+    rows to the bit (a test checks it). The columns that do not depend on the cut (``purpose``,
+    ``threshold``, ``modulus_error``, times, ...) are the run's. A world stored before the pokes'
+    layer thickness was (no ``thickness`` key) has the world's own rest height at each poke stand
+    in for the surface model's (:func:`deformap.explore.merge_seam_classes` needs it).
 
     Raises
     ------
     InvalidArgumentError
-        ``result`` did not finish, or holds no pokes (a run before they were stored).
+        ``result`` did not finish, or holds no pokes (a run before they were stored); a setting
+        other than ``merge_seams``.
     """
     if result.get("status") != "ok" or not isinstance(result.get("pokes"), dict):
         raise InvalidArgumentError(
             f"`result` of world {task.get('index')} must be a finished world with its pokes "
             f"stored; got status {result.get('status')!r} and "
             f"{'pokes' if 'pokes' in result else 'no pokes'}")
+    if set(settings) - {"merge_seams"}:
+        raise InvalidArgumentError(f"`settings` may set merge_seams only (the rules that act "
+                                   f"after the pokes); got {sorted(settings)}")
     _, world, explore = _build_world(task)
     grid = Mapper(world.workspace, explore).grid
     labels, hardness, _ = _material_truth(world, grid.xs, grid.ys)
@@ -334,12 +341,17 @@ def rescore_world(task: dict[str, Any], result: dict[str, Any], cuts: Sequence[s
         data = result["pokes"][f"{strategy}/{field_name}"]
         index = np.asarray(data["index"], dtype=np.int64)
         keep = index < poke
-        thickness = data.get("thickness")
+        if "thickness" in data:
+            kept = [h for h, k in zip(data["thickness"], keep, strict=True) if k]
+            thickness = None if any(h is None for h in kept) else np.asarray(kept, float)
+        else:  # stored before the thickness was: the world's rest height stands in
+            thickness = np.array([world.surface_height(np.array([x]), np.array([y]))[0, 0]
+                                  for x, y, k in zip(data["x"], data["y"], keep, strict=True)
+                                  if k])  # fmt: skip
         pokes = PokeSet(np.column_stack([data["x"], data["y"]])[keep],
                         np.asarray(data["value"], float)[keep],
                         np.asarray(data["noise"], float)[keep], index[keep],
-                        thickness=None if thickness is None
-                        else np.asarray(thickness, float)[keep])  # fmt: skip
+                        thickness=thickness)  # fmt: skip
         config = replace(explore, strategy=cast(Any, strategy),
                          field=cast(Any, field_name), **settings)
         if field_name == "modulus":
@@ -348,16 +360,11 @@ def rescore_world(task: dict[str, Any], result: dict[str, Any], cuts: Sequence[s
             pokes = with_nugget(pokes, config)
             mean = BetaField(pokes, grid.xs, grid.ys, config.beta_field).mean
         sign = -1.0 if field_name == "modulus" else 1.0
-        for cut in cuts:
-            if len(pokes):
-                found = map_regions(mean, pokes, grid.cells_xy,
-                                    replace(config, region_labels=cast(RegionLabels, cut)))
-                scores = region_scores(found.labels, labels, sign * mean, hardness)
-                region = {"accuracy": scores.accuracy, "mean_iou": scores.mean_iou,
-                          "found": scores.found, "true": scores.true,
-                          "kendall_tau": scores.kendall_tau}  # fmt: skip
-            else:  # no poke has a value yet: the run's rows say what an empty map scores
-                region = {k: old[k] for k in ("accuracy", "mean_iou", "found", "true",
-                                              "kendall_tau")}  # fmt: skip
-            rows.append({**old, "cut": cut, **region})
+        for cut in cuts:  # a finished world has a poke with a value at every k (else it failed)
+            found = map_regions(mean, pokes, grid.cells_xy,
+                                replace(config, region_labels=cast(RegionLabels, cut)))
+            scores = region_scores(found.labels, labels, sign * mean, hardness)
+            rows.append({**old, "cut": cut, "accuracy": scores.accuracy,
+                         "mean_iou": scores.mean_iou, "found": scores.found,
+                         "true": scores.true, "kendall_tau": scores.kendall_tau})  # fmt: skip
     return {**result, "rows": rows}

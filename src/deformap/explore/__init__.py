@@ -53,6 +53,7 @@ from deformap.explore._regions import (
     RegionMap,
     beta_pokes,
     map_regions,
+    merge_seam_classes,
     segment_regions,
     with_nugget,
 )
@@ -111,6 +112,7 @@ __all__ = [
     "fit_surface",
     "map_regions",
     "measure_press",
+    "merge_seam_classes",
     "modulus_reading",
     "poke_step",
     "read_journal",

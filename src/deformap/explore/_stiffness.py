@@ -57,7 +57,9 @@ between-part variance is ``τ² = max(0, D² − σ_D²) / 2`` (DerSimonian & La
 for two parts) and ``E``, their pooled value, carries ``τ² / 2``:
 ``σ_model = E √max(0, D² − σ_D²) / 2`` (``model_error_pa``), added to ``E``'s variance in
 quadrature. Nothing in it is fitted to any world; ``E`` itself is the joint fit's, unchanged.
-With fewer than four samples (three parameters) it is not computed.
+With fewer than four samples (three parameters) it is not computed. Where the halves' disagreement
+has already widened the joint fit's Birge-scaled covariance, adding it again counts part of it
+twice: the term errs on the side of a wider σ.
 
 What it sees: a modulus that changes along the record faster than ``δ₀`` can follow, such as a
 soft skin over a stiffer core (``tests/explore/test_stiffness.py``: the share of records whose

@@ -28,7 +28,7 @@ import os
 import time
 from collections.abc import Iterator, Sequence
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -359,6 +359,47 @@ def bench_worlds(config: WorldsBenchConfig, out: Path | None = None, *,
                         computed=computed, seconds=time.perf_counter() - t0)
 
 
+def _check_stored(path: Path, result: Any, config: WorldsBenchConfig) -> dict[str, Any]:
+    """``result`` read from ``path`` if it is a world of the benchmark ``config`` that can be
+    rescored (a failed one is carried as it is); else one :class:`ConfigError` line naming the
+    file and what is wrong."""
+    def bad(what: str) -> ConfigError:
+        return ConfigError(f"source: {path} is not a rescorable world: {what}")
+
+    if not isinstance(result, dict) or not isinstance(result.get("world"), dict):
+        raise bad("expected an object with a `world` object")
+    index = result["world"].get("index")
+    if isinstance(index, bool) or not isinstance(index, int) or index < 0:
+        raise bad(f"`world.index` must be an integer >= 0; got {index!r}")
+    if result.get("status") != "ok":
+        return result
+    rows, pokes = result.get("rows"), result.get("pokes")
+    if not isinstance(rows, list) or not all(isinstance(r, dict) for r in rows):
+        raise bad("`rows` must be a list of objects")
+    if not isinstance(pokes, dict):
+        raise bad("no `pokes` (a world run before pokes were stored)")
+    for row in rows:
+        combo = f"{row.get('strategy')}/{row.get('field')}"
+        if row.get("strategy") not in config.strategies or \
+                row.get("field") not in config.fields or not isinstance(row.get("poke"), int):
+            raise bad(f"a row of {combo!r} at poke {row.get('poke')!r} is not of this benchmark")
+        data = pokes.get(combo)
+        if not isinstance(data, dict):
+            raise bad(f"no stored pokes for {combo!r}")
+        columns = ("x", "y", "value", "noise", "index")
+        if not all(isinstance(data.get(k), list) for k in columns):
+            raise bad(f"the pokes of {combo!r} must have lists {list(columns)}")
+        sizes = {len(data[k]) for k in (*columns, *(("thickness",) if "thickness" in data
+                                                    else ()))}
+        if len(sizes) != 1 or not isinstance(data.get("thickness", []), list):
+            raise bad(f"the pokes of {combo!r} have columns of different lengths")
+        numbers = [v for k in columns for v in data[k]]
+        numbers += [v for v in data.get("thickness", []) if v is not None]
+        if not all(isinstance(v, int | float) and not isinstance(v, bool) for v in numbers):
+            raise bad(f"the pokes of {combo!r} must be numbers")
+    return result
+
+
 def rescore_worlds(source: Path, out: Path, *, cuts: Sequence[str] | None = None,
                    merge_seams: bool | None = None, hooks: RunHooks = NO_HOOKS) -> WorldsOutput:
     """Score the finished worlds of the benchmark folder ``source`` again under ``cuts`` and
@@ -371,8 +412,10 @@ def rescore_worlds(source: Path, out: Path, *, cuts: Sequence[str] | None = None
     Raises
     ------
     ConfigError
-        ``source`` is not a worlds benchmark, holds no finished world, or a world from before
-        the pokes were stored; ``out`` is not new or empty; a cut is unknown.
+        ``source`` is not a worlds benchmark, holds no finished world, or a world that cannot be
+        rescored (from before the pokes were stored, or damaged: the file and what is wrong are
+        named); ``out`` is not new or empty; a cut is unknown. Every world is checked before
+        ``out`` is created. A failed world is carried into ``out`` as it was.
     """
     settings_file = Path(source) / SETTINGS_NAME
     try:
@@ -385,28 +428,25 @@ def rescore_worlds(source: Path, out: Path, *, cuts: Sequence[str] | None = None
     if not isinstance(stored, dict) or not set(stored) <= known:
         raise ConfigError(f"source: {settings_file} holds settings this version does not know: "
                           f"{sorted(set(stored) - known) if isinstance(stored, dict) else stored}")
-    finished = sorted(Path(source, "worlds").glob("world-*.json"))
-    results = []
-    for path in finished:
-        try:
-            result = json.loads(path.read_text(encoding="utf-8"))
-        except (OSError, ValueError) as exc:
-            raise ConfigError(f"source: {path} cannot be read: {exc}") from None
-        if result.get("status") == "ok":
-            results.append(result)
-    without = [r["world"]["index"] for r in results if "pokes" not in r]
-    if not results or without:
-        raise ConfigError(
-            f"source: {source} must hold finished worlds with their pokes stored; got "
-            + ("none" if not results else f"{len(without)} without (worlds {without[:5]}"
-               f"{' …' if len(without) > 5 else ''}: run before pokes were stored)"))
     given: dict[str, Any] = {k: tuple(v) if isinstance(v, list) else v
                              for k, v in stored.items()}
     if cuts is not None:
         given["cuts"] = tuple(cuts)
     if merge_seams is not None:
         given["merge_seams"] = merge_seams
-    config = WorldsBenchConfig(worlds=1 + max(r["world"]["index"] for r in results), **given)
+    config = WorldsBenchConfig(worlds=1, **given)  # the settings checked before any world
+    results = []
+    for path in sorted(Path(source, "worlds").glob("world-*.json")):
+        try:
+            result = json.loads(path.read_text(encoding="utf-8"))
+        except (OSError, ValueError) as exc:
+            raise ConfigError(f"source: {path} cannot be read: {exc}") from None
+        results.append(_check_stored(path, result, config))
+    finished = [r for r in results if r.get("status") == "ok"]
+    if not finished:
+        raise ConfigError(f"source: {source} must hold finished worlds with their pokes stored; "
+                          f"got none")
+    config = replace(config, worlds=1 + max(r["world"]["index"] for r in results))
     folder = Path(out)
     create_run_folder(folder, what="benchmark")
     write_text(folder / SETTINGS_NAME, to_json({"deformap": __version__,
@@ -419,11 +459,11 @@ def rescore_worlds(source: Path, out: Path, *, cuts: Sequence[str] | None = None
     rescored = []
     for result in results:
         index = int(result["world"]["index"])
-        task = config.task(index)
-        again = rescore_world(task, result, config.cuts, merge_seams=config.merge_seams)
+        again = result if result.get("status") != "ok" else rescore_world(
+            config.task(index), result, config.cuts, merge_seams=config.merge_seams)
         write_text(_world_path(folder, index), to_json(again))
         rescored.append(again)
-        hooks.step(f"world {index} ({result['world']['family']}) · {len(rescored)}/"
+        hooks.step(f"world {index} ({result['world'].get('family')}) · {len(rescored)}/"
                    f"{len(results)} done")
     summary, files = _write_outputs(folder, config, rescored)
     return WorldsOutput(summary=summary, folder=folder, files=[folder / SETTINGS_NAME, *files],
