@@ -107,7 +107,10 @@ def test_raw_bag_maps_to_the_live_betas_and_moduli(
         np.testing.assert_allclose(poke["contact_xy"], rec.contact_xy, atol=1e-4)
         # the same clouds to float32 precision, the force's mean over the hold within its noise
         assert poke["beta"] == pytest.approx(rec.beta, abs=0.02)
-        assert poke["beta_std"] == pytest.approx(rec.beta_std, rel=0.05, abs=0.005)
+        # β's σ carries σ(E) through the depth anchoring, and σ(E) its model-error term, read
+        # from the record itself: 8 levels live, a 500 Hz ramp here (seed 0: σ(E) 16 % apart,
+        # β's σ 12 %); before that term the two agreed within 5 %
+        assert poke["beta_std"] == pytest.approx(rec.beta_std, rel=0.15, abs=0.005)
         live_e = rec.stiffness
         raw_e = poke.get("stiffness")
         assert (live_e is None) == (raw_e is None)
