@@ -174,12 +174,18 @@ def test_an_insert_met_by_one_poke_stays_a_region() -> None:
     np.testing.assert_array_equal(merged.poke_labels, found.poke_labels)
 
 
-def test_seams_are_not_judged_without_a_triangulation() -> None:
-    xy = np.column_stack([np.linspace(0, 0.2, 7), np.zeros(7)])  # one line of pokes
+def test_pokes_on_one_line_are_neighbours_along_it() -> None:
+    """A line of pokes has no triangle: the joint's poke borders the pokes either side of it
+    along the line, exactly on it or a hair off it alike."""
     value = np.array([0.0, 0.0, 0.0, 1.0, 2.0, 2.0, 2.0])
     found = segment_regions(np.zeros((2, 2)), value, np.full(7, 0.05))
-    merged = merge_seam_classes(found, np.zeros((2, 2)), xy, value, np.full(7, 0.05))
-    np.testing.assert_array_equal(merged.poke_labels, found.poke_labels)
+    assert found.n_regions == 3
+    for off in (0.0, 1e-7):
+        xy = np.column_stack([np.linspace(0, 0.18, 7), np.zeros(7)])
+        xy[3, 1] += off
+        merged = merge_seam_classes(found, np.zeros((2, 2)), xy, value, np.full(7, 0.05))
+        assert merged.n_regions == 2, off
+        assert merged.poke_labels.tolist() == [0, 0, 0, 0, 1, 1, 1]
 
 
 def test_a_joint_farther_than_the_layer_reaches_is_no_junction() -> None:

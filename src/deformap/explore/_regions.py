@@ -299,21 +299,25 @@ def segment_regions(
 
 def _neighbours(xy: NDArray[np.float64]) -> list[set[int]]:
     """Each poke's natural neighbours: the pokes whose Voronoi cells share an edge with its own
-    (Delaunay triangulation; pokes at one place share their neighbours). Empty sets when the
-    places do not span the plane (fewer than three, or all on a line)."""
+    (Delaunay triangulation; pokes at one place share their neighbours). Places on one line
+    (no triangle) have their Voronoi cells side by side along it: each place's neighbours are
+    the places just before and after it along the line."""
     places, which = np.unique(np.round(xy, 9), axis=0, return_inverse=True)
     which = np.asarray(which).reshape(-1)
-    empty: list[set[int]] = [set() for _ in range(xy.shape[0])]
-    if places.shape[0] < 3:
-        return empty
-    try:
-        tri = Delaunay(places)
-    except QhullError:  # collinear places: no triangle
-        return empty
     near: list[set[int]] = [set() for _ in range(places.shape[0])]
-    for simplex in tri.simplices:
-        for a in simplex:
-            near[a].update(int(b) for b in simplex if b != a)
+    try:
+        if places.shape[0] < 3:
+            raise QhullError("fewer than three places")
+        for simplex in Delaunay(places).simplices:
+            for a in simplex:
+                near[a].update(int(b) for b in simplex if b != a)
+    except QhullError:  # on one line: neighbours along it
+        centred = places - places.mean(axis=0)
+        axis = np.linalg.svd(centred, full_matrices=False)[2][0]
+        order = np.argsort(centred @ axis, kind="stable")
+        for a, b in pairwise(order.tolist()):
+            near[a].add(b)
+            near[b].add(a)
     members = [np.flatnonzero(which == k) for k in range(places.shape[0])]
     return [{int(j) for k in near[which[i]] | {int(which[i])} for j in members[k] if j != i}
             for i in range(xy.shape[0])]
