@@ -179,3 +179,15 @@ def test_random_scenarios_are_seeded_valid_and_tile_the_area() -> None:
         random_scenario(np.random.default_rng(0), n_regions=7)
     with pytest.raises(InvalidArgumentError, match="`rng`"):
         random_scenario(0)  # type: ignore[arg-type]
+
+
+def test_per_block_gives_each_point_its_blocks_value_and_the_table_elsewhere() -> None:
+    scenario = load_scenario("heterogeneous-60-150")
+    xs, ys = np.linspace(-0.05, 0.65, 15), np.linspace(0.0, 0.4, 5)
+    labels = scenario.labels(xs, ys)
+    values = [10.0 * (k + 1) for k in range(len(scenario.blocks))]
+    got = scenario.per_block(xs, ys, values, table=-1.0)
+    np.testing.assert_array_equal(got, np.where(labels < 0, -1.0, 10.0 * (labels + 1)))
+    assert (labels < 0).any() and (labels >= 0).any()
+    with pytest.raises(InvalidArgumentError, match="one value per block"):
+        scenario.per_block(xs, ys, values[:1])

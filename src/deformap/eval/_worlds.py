@@ -53,6 +53,7 @@ from deformap.eval._metrics import region_scores
 from deformap.explore import (
     BetaField,
     ExplorationConfig,
+    MapGrid,
     Mapper,
     PokeSet,
     RegionLabels,
@@ -150,13 +151,15 @@ def draw_world(seed: int, index: int, families: Sequence[str] = LAYOUT_FAMILIES,
                      thickness_m=thickness, force_n=force, scenario=scenario)
 
 
-def _material_truth(world: SimulatedWorld, xs: NDArray, ys: NDArray
+def _material_truth(scenario: Scenario, xs: NDArray, ys: NDArray
                     ) -> tuple[NDArray[np.int64], dict[int, float], NDArray[np.float64]]:
-    """Labels by material (blocks of one hardness are one), their hardness, and E on the grid."""
-    hardness = world.ground_truth_hardness(xs, ys)
+    """Labels by material (blocks of one hardness are one), their hardness, and E on the grid
+    (the world's ground truth, read from its layout: no FEM needed)."""
+    hardness = scenario.per_block(xs, ys, [b.hardness for b in scenario.blocks])
     values, labels = np.unique(hardness, return_inverse=True)
     return (labels.reshape(hardness.shape).astype(np.int64),
-            {k: float(v) for k, v in enumerate(values)}, world.ground_truth_modulus(xs, ys))
+            {k: float(v) for k, v in enumerate(values)},
+            scenario.per_block(xs, ys, [b.modulus_pa for b in scenario.blocks]))
 
 
 def _scores(mapper: Mapper, truth: tuple[NDArray, dict[int, float], NDArray],
@@ -236,10 +239,23 @@ def poke_data(pokes: PokeSet, thickness: Sequence[float | None]) -> dict[str, li
             "thickness": [None if t is None else float(t) for t in thickness]}
 
 
+def _draw(task: dict[str, Any]) -> tuple[WorldDraw, ExplorationConfig]:
+    """The world ``task`` draws (:func:`run_world`) and the exploration settings it is mapped
+    with."""
+    draw = draw_world(int(task["seed"]), int(task["index"]), tuple(task["families"]),
+                      tuple(task.get("physics", PHYSICS)))
+    k = int(task["max_pokes"])
+    explore = ExplorationConfig(max_pokes=k, boundary_pokes=k, force_n=draw.force_n)
+    if "merge_seams" in task:
+        explore = replace(explore, merge_seams=bool(task["merge_seams"]))
+    return draw, explore
+
+
 def _build_world(task: dict[str, Any]) -> tuple[WorldDraw, SimulatedWorld, ExplorationConfig]:
-    """The world of ``task`` (:func:`run_world`) and the exploration settings it is mapped with."""
+    """The world of ``task`` (:func:`run_world`), built, and the exploration settings it is
+    mapped with."""
     seed, index = int(task["seed"]), int(task["index"])
-    draw = draw_world(seed, index, tuple(task["families"]), tuple(task.get("physics", PHYSICS)))
+    draw, explore = _draw(task)
     base = WorldConfig.coarse() if task["coarse"] else WorldConfig()
     config = replace(base, physics=draw.physics,
                      camera=replace(camera_preset(draw.camera), width=base.camera.width,
@@ -247,10 +263,6 @@ def _build_world(task: dict[str, Any]) -> tuple[WorldDraw, SimulatedWorld, Explo
                      else camera_preset(draw.camera))  # fmt: skip
     world_seq = np.random.SeedSequence([seed, index, 0]).spawn(2)[0]
     world = SimulatedWorld(draw.scenario, config=config, rng=np.random.default_rng(world_seq))
-    k = int(task["max_pokes"])
-    explore = ExplorationConfig(max_pokes=k, boundary_pokes=k, force_n=draw.force_n)
-    if "merge_seams" in task:
-        explore = replace(explore, merge_seams=bool(task["merge_seams"]))
     return draw, world, explore
 
 
@@ -281,7 +293,7 @@ def run_world(task: dict[str, Any]) -> dict[str, Any]:
     explore_seq = np.random.SeedSequence([seed, index, 0]).spawn(2)[1]
     first = Mapper(world.workspace, explore)
     surface = first.initialise(world.observe(), np.random.default_rng(explore_seq))
-    truth = _material_truth(world, first.grid.xs, first.grid.ys)
+    truth = _material_truth(world.scenario, first.grid.xs, first.grid.ys)
     rows = []
     pokes = {}
     for strategy in task["strategies"]:
@@ -329,9 +341,11 @@ def rescore_world(task: dict[str, Any], result: dict[str, Any], cuts: Sequence[s
     if set(settings) - {"merge_seams"}:
         raise InvalidArgumentError(f"`settings` may set merge_seams only (the rules that act "
                                    f"after the pokes); got {sorted(settings)}")
-    _, world, explore = _build_world(task)
-    grid = Mapper(world.workspace, explore).grid
-    labels, hardness, _ = _material_truth(world, grid.xs, grid.ys)
+    draw, explore = _draw(task)  # the truth is the layout's: no world is built, nothing pressed
+    scenario = draw.scenario
+    grid = MapGrid.build(scenario.workspace, explore)
+    labels, hardness, _ = _material_truth(scenario, grid.xs, grid.ys)
+    rest_height = [b.thickness_m for b in scenario.blocks]
     head: dict[tuple[str, str, int], dict[str, Any]] = {}
     for row in result["rows"]:
         head.setdefault((row["strategy"], row["field"], int(row["poke"])), row)
@@ -345,7 +359,7 @@ def rescore_world(task: dict[str, Any], result: dict[str, Any], cuts: Sequence[s
             kept = [h for h, k in zip(data["thickness"], keep, strict=True) if k]
             thickness = None if any(h is None for h in kept) else np.asarray(kept, float)
         else:  # stored before the thickness was: the world's rest height stands in
-            thickness = np.array([world.surface_height(np.array([x]), np.array([y]))[0, 0]
+            thickness = np.array([scenario.per_block([x], [y], rest_height, table=0.0)[0, 0]
                                   for x, y, k in zip(data["x"], data["y"], keep, strict=True)
                                   if k])  # fmt: skip
         pokes = PokeSet(np.column_stack([data["x"], data["y"]])[keep],

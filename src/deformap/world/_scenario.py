@@ -251,6 +251,15 @@ class Scenario:
             out[free] = np.where(block.contains(pts[free]), k, BARE_TABLE)
         return out.reshape(len(y), len(x))
 
+    def per_block(self, xs: Any, ys: Any, values: Sequence[float],
+                  table: float = np.inf) -> NDArray[np.float64]:
+        """``(ny, nx)`` the value of the block at each grid point (``values[k]`` of block ``k``),
+        ``table`` on the bare table."""
+        if len(values) != len(self.blocks):
+            raise InvalidArgumentError(f"`values` must have one value per block "
+                                       f"({len(self.blocks)}); got {len(values)}")
+        return np.asarray(np.array([*values, table], dtype=float)[self.labels(xs, ys)])
+
     def to_dict(self) -> dict[str, Any]:
         return {"name": self.name, "description": self.description,
                 "workspace": self.workspace.to_dict(),

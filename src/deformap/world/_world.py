@@ -284,12 +284,11 @@ class SimulatedWorld:
 
     def ground_truth_hardness(self, xs: Any, ys: Any) -> NDArray[np.float64]:
         """``(ny, nx)`` hardness in N; ``inf`` on rigid blocks and the bare table."""
-        return self._per_label(self.ground_truth_labels(xs, ys), [b.hardness for b in self.regions])
+        return self.scenario.per_block(xs, ys, [b.hardness for b in self.regions])
 
     def ground_truth_modulus(self, xs: Any, ys: Any) -> NDArray[np.float64]:
         """``(ny, nx)`` Young's modulus in Pa; ``inf`` on rigid blocks and the bare table."""
-        return self._per_label(self.ground_truth_labels(xs, ys),
-                               [b.modulus_pa for b in self.regions])
+        return self.scenario.per_block(xs, ys, [b.modulus_pa for b in self.regions])
 
     def surface_height(self, xs: Any, ys: Any, displacement: Any = None) -> NDArray[np.float64]:
         """``(ny, nx)`` height of the top surface in metres, deformed by ``displacement``.
@@ -308,11 +307,6 @@ class SimulatedWorld:
         return np.asarray(height)
 
     # ---- internals ----
-    @staticmethod
-    def _per_label(labels: NDArray[np.int64], values: list[float]) -> NDArray[np.float64]:
-        table = np.array([*values, np.inf])
-        return np.asarray(table[labels])
-
     def _tip_center(self, target: NDArray[np.float64], dent: Dent) -> NDArray[np.float64]:
         index = int(self.scenario.labels(target[:1], target[1:])[0, 0])
         top = 0.0 if index == BARE_TABLE else self.regions[index].thickness_m
