@@ -285,12 +285,20 @@ def segment_regions(
             done.append(group)
         else:
             pending += parts
-    means = np.array([b[g].mean() for g in done])
+    return _ranked(grid, b, done, order)
+
+
+def _ranked(grid: NDArray[np.float64], values: NDArray[np.float64],
+            groups: list[NDArray[np.int64]], order: NDArray[np.int64]) -> RegionMap:
+    """The regions of the classes ``groups`` (indices into ``values``), numbered by their mean
+    value upwards, with the isopleths midway between neighbouring means; ``order`` maps an index
+    into ``values`` to the poke's place in the order the pokes were given."""
+    means = np.array([values[g].mean() for g in groups])
     rank = np.argsort(means, kind="stable")
     class_betas = means[rank]
-    poke_labels = np.empty(b.size, dtype=np.int64)
+    poke_labels = np.empty(values.size, dtype=np.int64)
     for k, g in enumerate(rank):
-        poke_labels[order[done[g]]] = k
+        poke_labels[order[groups[g]]] = k
     levels = (class_betas[:-1] + class_betas[1:]) / 2
     labels = np.searchsorted(levels, grid, side="right").astype(np.int64)
     return RegionMap(labels=labels, levels=levels, class_betas=class_betas,
@@ -342,9 +350,9 @@ def merge_seam_classes(found: RegionMap, mean: NDArray[np.float64],
     "Many worlds"). Without every poke's thickness (``None``: a poke without a force–travel
     record) no class is merged.
     """
-    labels = found.poke_labels.copy()
     if thickness_m is None:
         return found
+    labels = found.poke_labels.copy()
     values = check_array("poke_value", poke_value, (labels.size,))
     xy = check_array("poke_xy", poke_xy, (labels.size, 2), what="metres")
     reach = 2.0 * check_array("thickness_m", thickness_m, (labels.size,), what="metres")
@@ -364,13 +372,8 @@ def merge_seam_classes(found: RegionMap, mean: NDArray[np.float64],
         for i in np.flatnonzero(labels == junction):
             moved[i] = min(sorted(others[i]), key=lambda c: abs(values[i] - mean_of[c]))
         labels = np.unique(moved, return_inverse=True)[1].reshape(-1)
-    class_values = np.array([values[labels == c].mean() for c in range(labels.max() + 1)])
-    rank_of = np.argsort(np.argsort(class_values, kind="stable"), kind="stable")
-    class_betas = np.sort(class_values)
-    levels = (class_betas[:-1] + class_betas[1:]) / 2
-    return RegionMap(labels=np.searchsorted(levels, mean, side="right").astype(np.int64),
-                     levels=levels, class_betas=class_betas,
-                     poke_labels=rank_of[labels].astype(np.int64))
+    return _ranked(mean, values, [np.flatnonzero(labels == c) for c in range(labels.max() + 1)],
+                   np.arange(labels.size))
 
 
 def poke_classes(mean: NDArray[np.float64], pokes: PokeSet,
