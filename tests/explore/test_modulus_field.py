@@ -223,3 +223,27 @@ def test_the_planner_is_told_the_pokes_made_not_the_pokes_in_the_field() -> None
                                      np.random.default_rng(0), boundary_owed=0)
     assert counted_from_field is not None and counted_from_field.plan is not None
     assert len(counted_from_field.plan.targets) > 1  # what it planned before
+
+
+def test_under_the_modulus_field_the_beta_field_is_fitted_on_first_use_and_is_the_same(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    from deformap.explore import _mapper as mapper_module
+
+    fits = []
+    real = mapper_module.beta_pokes
+    monkeypatch.setattr(mapper_module, "beta_pokes", lambda *a: fits.append(1) or real(*a))
+    mapper = _mapper("modulus")
+    xys = [(0.1, 0.1), (0.15, 0.3), (0.5, 0.1), (0.45, 0.3), (0.3, 0.2)]
+    for i, xy in enumerate(xys):
+        mapper.add(_poke(xy, _soft(5e3 * (1 + 2 * (xy[0] > 0.3))), i))
+    assert fits == []  # five pokes on the modulus field, no β-field fitted
+    lazy = mapper.field
+    assert len(fits) == 1 and mapper.field is lazy  # fitted once, then kept
+    on_beta = _mapper("beta")  # fitted eagerly at every poke, as the β map needs it
+    for i, xy in enumerate(xys):
+        on_beta.add(_poke(xy, _soft(5e3 * (1 + 2 * (xy[0] > 0.3))), i))
+    assert len(fits) == 1 + len(xys)
+    np.testing.assert_array_equal(lazy.mean, on_beta.field.mean)
+    np.testing.assert_array_equal(lazy.pokes.noise, on_beta.field.pokes.noise)
+    mapper.add(_poke((0.2, 0.25), _soft(5e3), 5))  # a new poke: the next use fits it again
+    assert len(mapper.field.pokes) == 6 and len(fits) == 2 + len(xys)

@@ -74,9 +74,10 @@ def bench_world(*, scenario: str = "heterogeneous-60-110-rigid", rng: np.random.
 
 def _poke_compute(workspace: Any, cloud: Any, presses: list[Any], rng: np.random.Generator
                   ) -> tuple[float, float]:
-    """Median compute of one poke (dent, β and its uncertainty, the force–travel reading, both
-    fields updated) on the world's presses, with their records and, as the baseline, the same
-    presses without them (the camera-only estimate)."""
+    """Median compute of one poke (dent, β and its uncertainty, the force–travel reading, the
+    map field updated; under the modulus field the β-field waits for its first use) on the
+    world's presses, with their records and, as the baseline, the same presses without them
+    (the camera-only estimate, mapped on the β-field)."""
     import dataclasses
 
     from deformap.explore import Mapper

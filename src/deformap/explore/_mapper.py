@@ -57,7 +57,8 @@ class Mapper:
         self.grid = MapGrid.build(workspace, config)
         self.surface: SurfaceModel | None = None
         self._pokes: list[PokeResult] = []
-        self._field, self._modulus = self._fit([])
+        self._field: BetaField | None = None  # fitted when first asked for (`field`)
+        self._modulus = self._fit_modulus([])
         self.threshold = field_settings(config).threshold
         #: Why the run maps on β although ``config.field`` asked for the modulus (else None).
         self.field_fallback: str | None = None
@@ -71,7 +72,10 @@ class Mapper:
 
     @property
     def field(self) -> BetaField:
-        """The current β-field."""
+        """The current β-field, fitted on first use after a poke: under ``field: modulus`` the
+        loop does not need it, and its nugget costs a region test per poke."""
+        if self._field is None:
+            self._field = self._fit_beta(self._pokes)
         return self._field
 
     @property
@@ -83,15 +87,16 @@ class Mapper:
     def map_field(self) -> BetaField:
         """The field the regions, the next target and the stopping rule run on
         (``config.field``); ``threshold`` is its ``T_h``."""
-        return self._modulus if self.config.field == "modulus" else self._field
+        return self._modulus if self.config.field == "modulus" else self.field
 
-    def _fit(self, pokes: list[PokeResult]) -> tuple[BetaField, ModulusField]:
-        records = [p.record for p in pokes]
-        return (BetaField(beta_pokes(records, self.config), self.grid.xs, self.grid.ys,
-                          self.config.beta_field),
-                ModulusField.of_records(records, self.grid.xs, self.grid.ys,
-                                        self.config.modulus_field,
-                                        self.config.stiffness.poisson_ratio))  # fmt: skip
+    def _fit_beta(self, pokes: list[PokeResult]) -> BetaField:
+        return BetaField(beta_pokes([p.record for p in pokes], self.config), self.grid.xs,
+                         self.grid.ys, self.config.beta_field)
+
+    def _fit_modulus(self, pokes: list[PokeResult]) -> ModulusField:
+        return ModulusField.of_records([p.record for p in pokes], self.grid.xs, self.grid.ys,
+                                       self.config.modulus_field,
+                                       self.config.stiffness.poisson_ratio)  # fmt: skip
 
     def initialise(self, cloud: PointCloud, rng: np.random.Generator) -> SurfaceModel:
         """Fit the surface model to the first observation (:func:`fit_surface`)."""
@@ -113,10 +118,13 @@ class Mapper:
         stage times measured outside the mapper (``target_s``, ``environment_s``).
         """
         t0 = time.perf_counter()
-        field, modulus = self._fit([*self._pokes, poke])
+        pokes = [*self._pokes, poke]
+        modulus = self._fit_modulus(pokes)
         if self._requested_field == "modulus":
             self._choose_field(poke, modulus)
-        active = modulus if self.config.field == "modulus" else field
+        # the β-field is fitted now only when it is the map field; otherwise on first use
+        field = None if self.config.field == "modulus" else self._fit_beta(pokes)
+        active = modulus if field is None else field
         record = poke.record
         if target is not None:
             record = dataclasses.replace(record, purpose=target.purpose,
@@ -128,6 +136,8 @@ class Mapper:
         )  # fmt: skip
         added = dataclasses.replace(poke, record=record)
         self._pokes.append(added)
+        # a lazily fitted β-field holds the pokes' records, and ``added`` differs from ``poke``
+        # only in what the field does not read (purpose, plan, variance after, timings)
         self._field, self._modulus = field, modulus
         return added
 
@@ -189,7 +199,7 @@ class Mapper:
         """What the exploration produced, with the β-field and regions read once."""
         return ExplorationResult(
             config=self.config, workspace=self.workspace, grid=self.grid, surface=self.surface,
-            pokes=self.pokes, field=self._field, modulus_field=self._modulus,
+            pokes=self.pokes, field=self.field, modulus_field=self._modulus,
             regions=self.regions() if self._pokes else None,
             max_variance=self.max_variance(), stop_reason=stop_reason, timings=dict(timings),
             field_fallback=self.field_fallback,
