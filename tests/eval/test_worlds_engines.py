@@ -10,7 +10,7 @@ import json
 import pytest
 
 from deformap.errors import ConfigError, InvalidArgumentError
-from deformap.eval import TIME_COLUMNS
+from deformap.eval import POKES_FORMAT, TIME_COLUMNS
 from deformap.run import WorldsBenchConfig, bench_worlds
 from deformap.run._worlds import _local_results
 
@@ -99,6 +99,7 @@ def test_rescore_scores_other_cuts_on_the_stored_pokes_and_names_what_it_cannot(
     assert result.exit_code == 2 and "--out" in result.output
     world = tmp_path / "src" / "worlds" / "world-00001.json"
     stored = json.loads(world.read_text())
+    original = json.loads(world.read_text())
     del stored["pokes"]
     world.write_text(json.dumps(stored))
     result = runner.invoke(app, ["bench", "rescore", str(tmp_path / "src"), "--out",
@@ -107,12 +108,21 @@ def test_rescore_scores_other_cuts_on_the_stored_pokes_and_names_what_it_cannot(
     assert "world-00001.json is not a rescorable world: no `pokes`" in result.output
     assert "Traceback" not in result.output and not (tmp_path / "third").exists()
     # damaged stored worlds: one line naming the file and what is wrong, before any folder
+    assert stored["pokes_format"] == POKES_FORMAT == 2
     stored["pokes"] = {"paper/beta": {"x": [0.1], "y": [0.1, 0.2], "value": [1.0],
-                                      "noise": [0.1], "index": [0]}}
+                                      "noise": [0.1], "index": [0], "thickness": [0.05]}}
+    unthick = {"paper/beta": {k: v for k, v in stored["pokes"]["paper/beta"].items()
+                              if k != "thickness"}}
     for damaged, why in (([1, 2], "expected an object"),
                          ({**stored, "world": {"index": "a"}}, "`world.index` must be"),
                          (stored, "columns of different lengths"),
-                         ({**stored, "pokes": {}}, "no stored pokes for 'paper/beta'")):
+                         ({**stored, "pokes": {}}, "no stored pokes for 'paper/beta'"),
+                         ({**stored, "pokes_format": 3},
+                          "`pokes_format` must be an integer from 1 to 2 (the formats this "
+                          "deformap reads); got 3 (written by a newer version?)"),
+                         ({**stored, "pokes_format": True}, "`pokes_format` must be"),
+                         ({**stored, "pokes": unthick},
+                          "the pokes of 'paper/beta' have no `thickness` (pokes_format 2)")):
         world.write_text(json.dumps(damaged))
         result = runner.invoke(app, ["bench", "rescore", str(tmp_path / "src"), "--out",
                                      str(tmp_path / "third")])
@@ -121,3 +131,13 @@ def test_rescore_scores_other_cuts_on_the_stored_pokes_and_names_what_it_cannot(
     result = runner.invoke(app, ["bench", "rescore", str(tmp_path), "--out",
                                  str(tmp_path / "fourth")])
     assert result.exit_code == 2 and "is not a worlds benchmark" in result.output
+    # a world stored before the format key and the thickness were is read as the first format
+    legacy = {k: v for k, v in original.items() if k != "pokes_format"}
+    legacy["pokes"] = {combo: {k: v for k, v in data.items() if k != "thickness"}
+                       for combo, data in original["pokes"].items()}
+    world.write_text(json.dumps(legacy))
+    result = runner.invoke(app, ["bench", "rescore", str(tmp_path / "src"), "--out",
+                                 str(tmp_path / "fifth"), "--no-merge-seams"])
+    assert result.exit_code == 0, result.output
+    assert "pokes_format" not in json.loads(
+        (tmp_path / "fifth" / "worlds" / "world-00001.json").read_text())

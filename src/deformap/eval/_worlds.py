@@ -78,6 +78,7 @@ from deformap.world import (
 __all__ = [
     "FORCES_N",
     "HARDNESS_RANGE_N",
+    "POKES_FORMAT",
     "THICKNESSES_M",
     "TIME_COLUMNS",
     "WorldDraw",
@@ -98,6 +99,11 @@ THICKNESSES_M = (0.03, 0.05, 0.10)
 FORCES_N = (0.4, 0.6, 0.8)
 #: Probability that one material of a benchmark world is a rigid board (the generator's default).
 P_RIGID = 0.25
+#: Version of the stored pokes (a world's ``pokes`` and ``pokes_format``): 1, the columns ``x``,
+#: ``y``, ``value``, ``noise``, ``index`` (worlds stored before the key was, without
+#: ``thickness``, read as 1); 2, with ``thickness`` too. A reader refuses a version it does not
+#: know rather than guess what a newer one's columns mean.
+POKES_FORMAT = 2
 #: Columns of a row that hold wall times (the only ones two runs of one world may differ in).
 TIME_COLUMNS = ("poke_s", "elapsed_s")
 
@@ -283,8 +289,8 @@ def run_world(task: dict[str, Any]) -> dict[str, Any]:
     -------
     dict with ``world`` (:meth:`WorldDraw.summary`), ``rows`` (one per strategy × field × cut ×
     poke, each naming them), ``pokes`` (each ``"strategy/field"``'s map-field pokes,
-    :func:`poke_data`: what :func:`rescore_world` scores other cuts on) and ``seconds`` (the
-    world's wall time, building included).
+    :func:`poke_data`: what :func:`rescore_world` scores other cuts on), ``pokes_format``
+    (:data:`POKES_FORMAT`) and ``seconds`` (the world's wall time, building included).
     """
     t0 = time.perf_counter()
     draw, world, explore = _build_world(task)
@@ -304,7 +310,7 @@ def run_world(task: dict[str, Any]) -> dict[str, Any]:
             for row in mapped:
                 rows.append({"world": index, "family": draw.family, "strategy": strategy,
                              "field": field, **row})  # fmt: skip
-    return {"world": draw.summary(), "rows": rows, "pokes": pokes,
+    return {"world": draw.summary(), "rows": rows, "pokes": pokes, "pokes_format": POKES_FORMAT,
             "seconds": time.perf_counter() - t0, "status": "ok", "error": None}
 
 

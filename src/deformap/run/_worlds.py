@@ -36,6 +36,7 @@ from deformap import __version__
 from deformap._validation import SettingError, check_settings, setting
 from deformap.errors import ConfigError
 from deformap.eval import (
+    POKES_FORMAT,
     accuracy_curves,
     choices,
     markdown_summary,
@@ -378,6 +379,10 @@ def _check_stored(path: Path, result: Any, config: WorldsBenchConfig) -> dict[st
         raise bad("`rows` must be a list of objects")
     if not isinstance(pokes, dict):
         raise bad("no `pokes` (a world run before pokes were stored)")
+    version = result.get("pokes_format", 1)  # stored before the key was: the first format
+    if isinstance(version, bool) or version not in range(1, POKES_FORMAT + 1):
+        raise bad(f"`pokes_format` must be an integer from 1 to {POKES_FORMAT} (the formats this "
+                  f"deformap reads); got {version!r} (written by a newer version?)")
     for row in rows:
         combo = f"{row.get('strategy')}/{row.get('field')}"
         if row.get("strategy") not in config.strategies or \
@@ -389,6 +394,8 @@ def _check_stored(path: Path, result: Any, config: WorldsBenchConfig) -> dict[st
         columns = ("x", "y", "value", "noise", "index")
         if not all(isinstance(data.get(k), list) for k in columns):
             raise bad(f"the pokes of {combo!r} must have lists {list(columns)}")
+        if version >= 2 and "thickness" not in data:
+            raise bad(f"the pokes of {combo!r} have no `thickness` (pokes_format {version})")
         sizes = {len(data[k]) for k in (*columns, *(("thickness",) if "thickness" in data
                                                     else ()))}
         if len(sizes) != 1 or not isinstance(data.get("thickness", []), list):
