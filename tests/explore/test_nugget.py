@@ -184,3 +184,18 @@ def test_a_class_the_region_test_could_not_examine_gives_no_scatter() -> None:
     classes = segment_regions(np.zeros((1, 1)), betas, four.noise,
                               floor=beta_noise_floor(CONFIG)).poke_labels  # fmt: skip
     assert classes.tolist() == pairs.tolist()
+
+
+def test_the_former_betafield_of_still_works_and_says_it_is_deprecated() -> None:
+    from deformap.explore import BetaField
+
+    records = [synthetic_poke((0.1 + 0.1 * i, 0.2), 0.5 + 0.05 * i, index=i).record
+               for i in range(4)]
+    xs, ys = np.linspace(0.0, 0.6, 13), np.linspace(0.0, 0.4, 9)
+    for config, floor in ((BetaFieldConfig(), beta_noise_floor(ExplorationConfig())),
+                          (BetaFieldConfig(noise_floor=0.02), 0.02)):
+        with pytest.warns(DeprecationWarning, match="BetaField.of is deprecated"):
+            old = BetaField.of(records, xs, ys, config)
+        new = BetaField(PokeSet.of(records, floor), xs, ys, config)
+        np.testing.assert_array_equal(old.mean, new.mean)
+        assert old.pokes.nugget == 0.0 and float(old.pokes.noise.min()) >= floor

@@ -12,6 +12,7 @@ for Machine Learning, Eq. 2.24 (posterior mean and variance with per-point noise
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cached_property
@@ -163,6 +164,22 @@ class BetaField:
     """
 
     name: FieldName = "beta"
+
+    @classmethod
+    def of(cls, records: Sequence[PokeRecord], xs: NDArray[np.float64], ys: NDArray[np.float64],
+           config: BetaFieldConfig) -> BetaField:
+        """Deprecated (0.1.0): the β-field of ``records``, each σ raised to the floor, no nugget.
+
+        The mapper's β-field is ``BetaField(beta_pokes(records, exploration_config), xs, ys,
+        exploration_config.beta_field)`` (:func:`deformap.explore.beta_pokes`: the floor and the
+        map's nugget). This keeps the former call's meaning: ``config.noise_floor``, or when it
+        is ``None`` the default β grid's quantisation (:func:`beta_noise_floor`), and no nugget.
+        """
+        warnings.warn("BetaField.of is deprecated and will be removed: use BetaField(beta_pokes("
+                      "records, exploration_config), xs, ys, exploration_config.beta_field), "
+                      "which adds the map's nugget", DeprecationWarning, stacklevel=2)
+        floor = beta_noise_floor(ExplorationConfig(beta_field=config))
+        return cls(PokeSet.of(records, floor), xs, ys, config)
 
     def __init__(self, pokes: PokeSet, xs: NDArray[np.float64], ys: NDArray[np.float64],
                  config: BetaFieldConfig | ModulusFieldConfig) -> None:
