@@ -194,6 +194,9 @@ def test_the_quick_study_fits_the_default_and_the_papers_protocol() -> None:
     (["--hardness", "1e400"], "hardness_n"),
     (["--force", "1e-320"], "force_n"),
     (["--force", "0.05"], "force_n"),
+    (["--element-size", "0.0005"], "--element-size"),
+    (["--element-size", "nan"], "--element-size"),
+    (["--element-size", "0.01", "--coarse"], "--element-size"),
 ])
 def test_a_study_nothing_can_press_is_refused_before_any_folder(tmp_path: Path, args: list[str],
                                                                 names: str) -> None:
@@ -202,3 +205,29 @@ def test_a_study_nothing_can_press_is_refused_before_any_folder(tmp_path: Path, 
     assert result.exit_code == 2, result.output
     lines = [line for line in result.output.splitlines() if line.strip()]
     assert len(lines) == 1 and names in lines[0] and not out.exists()
+
+
+def test_the_element_size_reaches_the_world_and_the_study_records_it(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    from deformap.run import _studies
+
+    seen = []
+    real = _studies.collect_presses
+
+    def spy(foams: Any, **kwargs: Any) -> Any:
+        seen.append((kwargs["world_config"].element_size_m, kwargs["world_config"].top_layer_m))
+        return real(foams, **kwargs)
+
+    monkeypatch.setattr(_studies, "collect_presses", spy)
+    out = tmp_path / "mesh"
+    result = CliRunner().invoke(app, ["study", "hardness", "--element-size", "0.02",
+                                      "--hardness", "110", "--thickness", "0.03",
+                                      "--protocol", "force/quadratic", "--out", str(out)])
+    assert result.exit_code == 0, (result.output, result.exception)
+    assert seen == [(0.02, WorldConfig().top_layer_m)]  # the top layer already finer: kept
+    study = json.loads((out / "hardness.json").read_text())
+    assert study["element_size_m"] == 0.02
+    assert [r["hardness_n"] for r in study["rows"]] == [110.0, None]
+    fine = _studies._foams((), seed=0, coarse=False, hooks=_studies.NO_HOOKS,
+                           element_size_m=0.003)
+    assert fine == [] and seen[-1] == (0.003, 0.003)  # finer than the top layer: it follows

@@ -12,11 +12,13 @@ from deformap import run
 from deformap.cli._app import (
     JsonOption,
     app,
+    check_positive_options,
     emit_json,
     friendly_errors,
     out_console,
 )
 from deformap.cli._progress import progress, run_hooks
+from deformap.errors import InvalidArgumentError
 
 __all__ = ["study_app"]
 
@@ -81,9 +83,22 @@ def study_hardness(
                                        "pinned/linear (default force/quadratic and the "
                                        "paper's pinned/quadratic).")
     ] = None,
+    element_size: Annotated[
+        float | None, typer.Option(help="The world's in-plane FEM element size in metres "
+                                   "(default 0.0075; 0.00375 has about 5 times the unknowns): "
+                                   "how much of E's error is the world's mesh. Not with "
+                                   "--coarse.")
+    ] = None,
     json_path: JsonOption = None,
 ) -> None:
     """β and Young's modulus against hardness for each contact protocol (paper Fig. 5a)."""
+    check_positive_options(element_size=element_size)
+    if element_size is not None and element_size < 0.001:  # WorldConfig.element_size_m's range
+        raise InvalidArgumentError(f"--element-size must be at least 0.001 (metres); got "
+                                   f"{element_size}")
+    if element_size is not None and coarse:
+        raise InvalidArgumentError(f"--element-size sets the mesh, as --coarse does: give one "
+                                   f"of them; got --element-size {element_size} and --coarse")
     shown = out_console(json_path)
     with progress(shown) as bar:
         if full:  # an axis given on the command line pins it; the others span the matrix
@@ -92,12 +107,13 @@ def study_hardness(
                 cameras=None if camera is None else [camera],
                 thicknesses_m=None if thickness is None else [thickness],
                 physics_names=None if physics is None else [physics], protocols=protocol,
-                hooks=run_hooks(bar))  # fmt: skip
+                element_size_m=element_size, hooks=run_hooks(bar))  # fmt: skip
         else:
             output = run.run_hardness_study(
                 out, seed=seed, hardness=hardness, coarse=coarse, camera=camera,
                 thickness_m=0.05 if thickness is None else thickness, force_n=force,
-                physics=physics or "linear-fem", protocols=protocol, hooks=run_hooks(bar))
+                physics=physics or "linear-fem", protocols=protocol,
+                element_size_m=element_size, hooks=run_hooks(bar))
     if full:
         _print_summary(shown, output.study)
         shown.print(f"wrote {' and '.join(map(str, output.files))}", highlight=False)

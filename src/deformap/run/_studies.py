@@ -69,8 +69,12 @@ def _foams(
     foams: Sequence[float | None], *, seed: int, coarse: bool,
     hooks: RunHooks, camera: str | None = None, thickness_m: float = 0.05,
     force_n: float | None = None, physics: Physics = "linear-fem",
+    element_size_m: float | None = None,
 ) -> list[FoamPresses]:  # fmt: skip
     world = WorldConfig.coarse(physics=physics) if coarse else WorldConfig(physics=physics)
+    if element_size_m is not None:  # finer in-plane elements, and top layers no thicker
+        world = dataclasses.replace(world, element_size_m=element_size_m,
+                                    top_layer_m=min(world.top_layer_m, element_size_m))
     if camera is not None:
         world = dataclasses.replace(world, camera=camera_preset(camera))
     explore = ExplorationConfig() if force_n is None else ExplorationConfig(force_n=force_n)
@@ -99,6 +103,7 @@ def run_hardness_study(
     thicknesses_m: Sequence[float] | None = None,
     physics_names: Sequence[str] | None = None,
     protocols: Sequence[str] | None = None,
+    element_size_m: float | None = None,
     hooks: RunHooks = NO_HOOKS,
 ) -> StudyOutput:
     """β (each contact protocol) and the force–travel reading (stiffness, Young's modulus)
@@ -134,6 +139,11 @@ def run_hardness_study(
     protocols : sequence of str, optional
         The contact protocols whose β is fitted, names of :data:`~deformap.eval.PROTOCOLS`
         (default :data:`~deformap.eval.STUDY_PROTOCOLS`: the default one and the paper's).
+    element_size_m : float, optional
+        The world's in-plane FEM element size (``WorldConfig.element_size_m``; its top layer no
+        thicker) in place of the default 7.5 mm: how much of E's error is the world's
+        discretisation (a small contact patch on coarse elements presses too stiff). Not with
+        ``coarse``.
     hooks : RunHooks
 
     Notes
@@ -152,6 +162,11 @@ def run_hardness_study(
     else:
         conditions = [(camera or "primesense", thickness_m, physics)]
     chosen = _protocols(protocols)
+    if element_size_m is not None:
+        if coarse:
+            raise InvalidArgumentError("`element_size_m` sets the mesh the coarse world has its "
+                                       "own of: give one or the other, not both")
+        WorldConfig(element_size_m=element_size_m)  # the world's own check, before any folder
     foams = DEFAULT_HARDNESSES if not hardness else (*hardness, None)
     _check_press(foams, force_n)
     checked = []
@@ -170,19 +185,22 @@ def run_hardness_study(
     for name, thickness, physics_name in checked:
         hooks.stage(f"pressing the foams: {name}, {thickness:g} m, {physics_name}")
         presses = _foams(foams, seed=seed, coarse=coarse, hooks=hooks, camera=name,
-                         thickness_m=thickness, force_n=force_n, physics=physics_name)  # fmt: skip
+                         thickness_m=thickness, force_n=force_n, physics=physics_name,
+                         element_size_m=element_size_m)  # fmt: skip
         hooks.stage(f"estimating β per protocol: {name}, {thickness:g} m, {physics_name}")
         pressed = [f.presses[0].force_n for f in presses if f.presses]
         condition = {"camera": name, "thickness_m": thickness,
                      "force_n": pressed[0] if pressed else _force(force_n),
                      "physics": physics_name}  # fmt: skip
-        single = {**condition, **hardness_study(presses, protocols=chosen)}
+        single = {**condition, "element_size_m": element_size_m,
+                  **hardness_study(presses, protocols=chosen)}
         rows.extend({**row, **condition} for row in single["rows"])
     study = {**(single if not full else {"matrix": {
         "cameras": list(dict.fromkeys(c[0] for c in checked)),
         "thicknesses_m": sorted({c[1] for c in checked}),
         "physics": list(dict.fromkeys(c[2] for c in checked)),
-        "force_n": _force(force_n), "seed": seed, "coarse": coarse}}),
+        "force_n": _force(force_n), "seed": seed, "coarse": coarse,
+        "element_size_m": element_size_m}}),
         "rows": rows, **hardness_summary(rows)}  # fmt: skip
     return StudyOutput(study=study, folder=folder,
                        files=_write(folder, "hardness", study, plot_hardness_study))  # fmt: skip
