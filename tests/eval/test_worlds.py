@@ -249,5 +249,15 @@ def test_rescoring_merges_a_junction_class_within_the_stored_thickness_only() ->
     assert found([0.01] * 25, merge=True)[-1] == 3  # 1 cm foam: the joint cannot reach
     late = found([0.06] * 24 + [None], merge=True)  # the last poke has no thickness
     assert late[-2] == 2 and late[-1] == 3
-    with pytest.raises(InvalidArgumentError, match="merge_seams only"):
+    # two foams 20 % apart in E, left and right: one class by value, two by place
+    close = np.log(np.where(xy[:, 0] < 0.3, 10e3, 12.2e3))
+    pokes = {"x": xy[:, 0].tolist(), "y": xy[:, 1].tolist(), "value": close.tolist(),
+             "noise": [0.1] * 25, "index": list(range(25)), "thickness": [0.03] * 25}
+    result = {"status": "ok", "world": {"index": 0}, "rows": rows,
+              "pokes": {"paper/modulus": pokes}}
+    by_value, by_place = (rescore_world(task, result, ["nearest"], split_by_place=split)["rows"]
+                          for split in (False, True))
+    assert by_value[-1]["found"] == 1 and by_place[-1]["found"] == 2
+    assert by_place[-1]["accuracy"] > by_value[-1]["accuracy"]
+    with pytest.raises(InvalidArgumentError, match="merge_seams and split_by_place only"):
         rescore_world(task, {"status": "ok", "rows": [], "pokes": {}}, ["nearest"], max_regions=2)

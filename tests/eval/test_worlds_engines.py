@@ -93,6 +93,17 @@ def test_rescore_scores_other_cuts_on_the_stored_pokes_and_names_what_it_cannot(
     assert settings["settings"]["cuts"] == ["isopleth", "nearest"]
     assert "paper/beta/nearest" in json.loads((tmp_path / "again" / "summary.json").read_text())[
         "strategies"]
+    # the split by place is a rule after the pokes too; a source from before it had it off
+    source_settings = tmp_path / "src" / "bench.json"
+    stored = json.loads(source_settings.read_text())
+    del stored["settings"]["split_by_place"]
+    source_settings.write_text(json.dumps(stored))
+    for flag, expected, folder in (([], False, "before"), (["--split-by-place"], True, "split")):
+        result = runner.invoke(app, ["bench", "rescore", str(tmp_path / "src"), "--out",
+                                     str(tmp_path / folder), "--cuts", "nearest", *flag])
+        assert result.exit_code == 0, result.output
+        written = json.loads((tmp_path / folder / "bench.json").read_text())["settings"]
+        assert written["split_by_place"] is expected
     # the folder must be new; a world from before the pokes were stored is named
     result = runner.invoke(app, ["bench", "rescore", str(tmp_path / "src"), "--out",
                                  str(tmp_path / "again")])

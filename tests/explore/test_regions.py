@@ -4,7 +4,14 @@ import numpy as np
 import pytest
 
 from deformap.errors import InvalidArgumentError
-from deformap.explore._regions import merge_seam_classes, segment_regions
+from deformap.explore._regions import (
+    RegionMap,
+    _ranked,
+    merge_seam_classes,
+    place_split,
+    segment_regions,
+    split_by_place,
+)
 
 
 def test_three_separated_classes_give_three_bands() -> None:
@@ -199,3 +206,64 @@ def test_a_joint_farther_than_the_layer_reaches_is_no_junction() -> None:
         np.testing.assert_array_equal(merged.poke_labels, found.poke_labels)
     with pytest.raises(InvalidArgumentError, match="thickness_m"):
         merge_seam_classes(found, np.zeros((2, 2)), xy, value, np.full(3, 0.05))
+
+
+def _halves(rng: np.random.Generator, contrast: float, scatter: float = 0.05
+            ) -> tuple[np.ndarray, np.ndarray]:
+    """Twenty pokes on a 60 × 40 cm table: ln E one value on the left half and ``contrast``
+    more on the right, each read with ``scatter``."""
+    xy = np.column_stack([rng.uniform(0.02, 0.58, 20), rng.uniform(0.02, 0.38, 20)])
+    value = np.log(10e3) + contrast * (xy[:, 0] > 0.3) + scatter * rng.standard_normal(20)
+    return xy, value
+
+
+def _one_class(value: np.ndarray) -> RegionMap:
+    return _ranked(np.zeros((2, 2)), value, [np.arange(value.size)], np.arange(value.size))
+
+
+def test_two_close_materials_side_by_side_split_by_their_places() -> None:
+    rng = np.random.default_rng(3)
+    xy, value = _halves(rng, contrast=0.2)  # ln 1.22: under the modulus field's smallest step
+    found = segment_regions(np.zeros((2, 2)), value, np.full(20, 0.05), floor=0.05,
+                            min_step=0.285)
+    assert found.n_regions == 1  # the values alone cannot tell them
+    split = split_by_place(found, np.zeros((2, 2)), xy, value, np.full(20, 0.05),
+                           np.full(20, 0.03), max_regions=6)
+    assert split.n_regions == 2
+    right = xy[:, 0] > 0.3  # the split is by value: a poke read across the other's may follow it
+    assert np.count_nonzero(split.poke_labels == right) >= 18
+    # the same split again from the same pokes (a fixed seed for the shuffles)
+    again = split_by_place(found, np.zeros((2, 2)), xy, value, np.full(20, 0.05),
+                           np.full(20, 0.03), max_regions=6)
+    np.testing.assert_array_equal(again.poke_labels, split.poke_labels)
+
+
+def test_one_material_is_not_split_by_place_beyond_the_test_level() -> None:
+    rng = np.random.default_rng(4)
+    splits = 0
+    for _ in range(40):
+        xy, value = _halves(rng, contrast=0.0, scatter=0.1)
+        if place_split(value, np.full(20, 0.1), xy) is not None:
+            splits += 1
+    assert splits <= 5  # 5 % of 40 is 2; a binomial tail above 5 has probability under 2 %
+
+
+def test_a_split_by_place_needs_the_values_apart_and_six_pokes_away_from_other_classes() -> None:
+    rng = np.random.default_rng(5)
+    xy, value = _halves(rng, contrast=0.2)
+    # claimed σ so large that the parts' means are not 2 standard errors apart
+    assert place_split(value, np.full(20, 1.0), xy) is None
+    assert place_split(value[:5], np.full(5, 0.05), xy[:5]) is None  # fewer than six pokes
+    # every poke within reach of another class's (thickness 0.5 m): none tested, none split
+    others = np.vstack([xy, [[0.3, 0.2]]])
+    found = _ranked(np.zeros((2, 2)), np.append(value, 12.0),
+                    [np.arange(20), np.array([20])], np.arange(21))
+    kept = split_by_place(found, np.zeros((2, 2)), others, np.append(value, 12.0),
+                          np.full(21, 0.05), np.full(21, 0.5), max_regions=6)
+    assert kept is found
+    # without every poke's thickness nothing is split
+    assert split_by_place(_one_class(value), np.zeros((2, 2)), xy, value, np.full(20, 0.05),
+                          None, max_regions=6).n_regions == 1
+    # nor beyond max_regions
+    assert split_by_place(_one_class(value), np.zeros((2, 2)), xy, value, np.full(20, 0.05),
+                          np.full(20, 0.03), max_regions=1).n_regions == 1

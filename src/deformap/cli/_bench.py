@@ -178,6 +178,11 @@ def bench_worlds_command(
         "--merge-seams/--no-merge-seams",
         help="Merge the classes of seam pokes before cutting (exploration.merge_seams); "
              "default: the exploration's.", show_default=False)] = None,
+    split_by_place: Annotated[bool | None, typer.Option(
+        "--split-by-place/--no-split-by-place",
+        help="Split a class whose pokes form two places of different values before cutting "
+             "(exploration.split_by_place); default: the exploration's.",
+        show_default=False)] = None,
     coarse: Annotated[bool, typer.Option(
         help="The coarse test mesh and camera: a third of the cost, a smoke run only (its 2 cm "
              "mesh reads E far off).")] = False,
@@ -195,7 +200,8 @@ def bench_worlds_command(
 
     given: dict[str, Any] = {"families": _names(families), "strategies": _names(strategies),
                              "fields": _names(fields), "physics": _names(physics),
-                             "cuts": _names(cuts), "merge_seams": merge_seams}
+                             "cuts": _names(cuts), "merge_seams": merge_seams,
+                             "split_by_place": split_by_place}
     config = run.WorldsBenchConfig(
         worlds=worlds, seed=seed, max_pokes=max_pokes, coarse=coarse, workers=workers,
         scheduler=scheduler, **{k: v for k, v in given.items() if v is not None})
@@ -243,15 +249,21 @@ def bench_rescore_command(
         "--merge-seams/--no-merge-seams",
         help="Merge the classes of seam pokes before cutting; default: the source's.",
         show_default=False)] = None,
+    split_by_place: Annotated[bool | None, typer.Option(
+        "--split-by-place/--no-split-by-place",
+        help="Split a class whose pokes form two places of different values before cutting; "
+             "default: the source's (off for a source from before the rule).",
+        show_default=False)] = None,
     json_path: JsonOption = None,
 ) -> None:
-    """Score a worlds benchmark's pokes again under other cuts or seam rule, without pressing
+    """Score a worlds benchmark's pokes again under other cuts or region rules, without pressing
     again (seconds a world)."""
     from deformap import run
 
     shown = out_console(json_path)
     with progress(shown) as bar:
         output = run.rescore_worlds(source, out, cuts=_names(cuts), merge_seams=merge_seams,
+                                    split_by_place=split_by_place,
                                     hooks=run_hooks(bar))  # fmt: skip
     settings = output.summary["settings"]
     _show_worlds_summary(shown, output, settings["worlds"], settings["max_pokes"], json_path)

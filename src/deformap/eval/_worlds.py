@@ -252,8 +252,9 @@ def _draw(task: dict[str, Any]) -> tuple[WorldDraw, ExplorationConfig]:
                       tuple(task.get("physics", PHYSICS)))
     k = int(task["max_pokes"])
     explore = ExplorationConfig(max_pokes=k, boundary_pokes=k, force_n=draw.force_n)
-    if "merge_seams" in task:
-        explore = replace(explore, merge_seams=bool(task["merge_seams"]))
+    rules: dict[str, Any] = {r: bool(task[r]) for r in ("merge_seams", "split_by_place")
+                             if r in task}  # the rules on the regions, when given
+    explore = replace(explore, **rules)
     return draw, explore
 
 
@@ -282,7 +283,7 @@ def run_world(task: dict[str, Any]) -> dict[str, Any]:
         from, default all), ``strategies``, ``fields``, ``cuts`` (the
         ``region_labels`` scored, each on the same pokes), ``max_pokes``, ``coarse`` (the
         test mesh and camera of :meth:`WorldConfig.coarse`, else the default world),
-        ``merge_seams`` (optional: ``ExplorationConfig.merge_seams``, default the
+        ``merge_seams`` and ``split_by_place`` (optional: ``ExplorationConfig``'s, default the
         exploration's).
 
     Returns
@@ -323,7 +324,8 @@ def rescore_world(task: dict[str, Any], result: dict[str, Any], cuts: Sequence[s
                   **settings: Any) -> dict[str, Any]:
     """``result`` of :func:`run_world` for ``task`` with its rows scored under ``cuts`` instead,
     on the pokes it stored (no press is made again: the pokes do not depend on the cut).
-    ``settings`` are the rules that act after the pokes, on the regions: ``merge_seams`` only.
+    ``settings`` are the rules that act after the pokes, on the regions: ``merge_seams`` and
+    ``split_by_place`` only.
 
     After ``k`` pokes the map field is the one of the stored pokes numbered below ``k`` (a poke
     without a value, a modulus field's poke whose record gave none, leaves a gap, as it did in the
@@ -337,16 +339,17 @@ def rescore_world(task: dict[str, Any], result: dict[str, Any], cuts: Sequence[s
     ------
     InvalidArgumentError
         ``result`` did not finish, or holds no pokes (a run before they were stored); a setting
-        other than ``merge_seams``.
+        other than those two.
     """
     if result.get("status") != "ok" or not isinstance(result.get("pokes"), dict):
         raise InvalidArgumentError(
             f"`result` of world {task.get('index')} must be a finished world with its pokes "
             f"stored; got status {result.get('status')!r} and "
             f"{'pokes' if 'pokes' in result else 'no pokes'}")
-    if set(settings) - {"merge_seams"}:
-        raise InvalidArgumentError(f"`settings` may set merge_seams only (the rules that act "
-                                   f"after the pokes); got {sorted(settings)}")
+    if set(settings) - {"merge_seams", "split_by_place"}:
+        raise InvalidArgumentError(f"`settings` may set merge_seams and split_by_place only "
+                                   f"(the rules that act after the pokes); got "
+                                   f"{sorted(settings)}")
     draw, explore = _draw(task)  # the truth is the layout's: no world is built, nothing pressed
     scenario = draw.scenario
     grid = MapGrid.build(scenario.workspace, explore)

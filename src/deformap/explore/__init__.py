@@ -55,6 +55,7 @@ from deformap.explore._regions import (
     map_regions,
     merge_seam_classes,
     segment_regions,
+    split_by_place,
     with_nugget,
 )
 from deformap.explore._result import ExplorationResult, StopReason
@@ -119,5 +120,6 @@ __all__ = [
     "rigid_modulus_bound",
     "roi_grid",
     "segment_regions",
+    "split_by_place",
     "with_nugget",
 ]

@@ -42,6 +42,25 @@ neighbouring classes is the midpoint of their means; cells are labelled by the b
 mean they fall in, so a region is a level set of the map, and ``n_regions`` is the number of classes
 found.
 
+Two materials whose values lie close (``ExplorationConfig.split_by_place``)
+---------------------------------------------------------------------------
+The test above sees the values only: two materials closer than ``min_step`` (or whose pokes'
+values overlap) stay one class wherever their pokes lie. Where they lie is evidence too: pokes of
+two materials side by side form two *places*, while the scatter of one material is spread over
+its area at random. So a class is also tested for a split by place (:func:`split_by_place`):
+its best split by value into a lower and an upper part (at least three pokes each, Fisher's
+split as in 1.) is scored by how many edges of the pokes' Delaunay graph it cuts (the join
+count: Cliff & Ord 1981), against the same split's join count after each of
+:data:`PLACE_PERMUTATIONS` shuffles of the values over the places (fixed seed: the same pokes
+give the same classes). A split that cuts fewer edges than shuffled values do (one-sided, 5 %)
+and whose parts' means differ by more than ``z`` standard errors is kept, with no smallest step:
+the places, not the size of the difference, are the evidence. Only the class's pokes farther
+than twice the layer's thickness from every poke of another class take part (what a press reads
+near a joint is the joint's, and pokes along a boundary would make one material look like two
+places: the junction rule's reach, :func:`merge_seam_classes`), at least six of them; each poke
+of the class then joins the part of its nearest such poke. Repeated until no class splits or
+``max_regions`` are found. Measured on 30 default worlds (README, "Many worlds").
+
 Labelling by nearest poke (``ExplorationConfig.region_labels = "nearest"``)
 -----------------------------------------------------------------------------
 The classes are found as above; each cell then takes the class of the poke nearest to it instead
@@ -61,6 +80,8 @@ probability kriged from the pokes' class indicators with the map field's own cov
 
 References
 ----------
+Cliff, A. D., Ord, J. K. (1981). Spatial Processes: Models & Applications, ch. 1–2 (join count
+statistics). Pion, London.
 Fisher, W. D. (1958). On grouping for maximum homogeneity. JASA 53(284), 789–798.
 Smyth, G. K. (2004). Linear models and empirical Bayes methods for assessing differential
 expression in microarray experiments. Stat. Appl. Genet. Mol. Biol. 3(1), Article 3.
@@ -83,11 +104,19 @@ from deformap.explore._indicator import indicator_labels
 from deformap.explore._nugget import MAX_ROUNDS, estimate_nugget
 from deformap.explore._records import PokeRecord
 
-__all__ = ["RegionMap", "beta_pokes", "map_regions", "merge_seam_classes", "poke_classes",
-           "segment_regions", "with_nugget"]
+__all__ = ["PLACE_PERMUTATIONS", "RegionMap", "beta_pokes", "map_regions", "merge_seam_classes",
+           "place_split", "poke_classes", "segment_regions", "split_by_place", "with_nugget"]
 
 _NULL_SAMPLES = 4000
 _NULL_SEED = 20161115
+#: Shuffles of the values over the places in the split-by-place test (module docstring): a Monte
+#: Carlo p-value in steps of 1/200, a tenth of the test's 5 %.
+PLACE_PERMUTATIONS = 199
+_PLACE_SEED = 20161116
+# pokes on each side of a split by place: the value test's smallest group (segment_regions)
+_PLACE_MIN_PART = 3
+# the value test's z (segment_regions): standard errors between two parts' means
+_REGION_Z = 2.0
 
 
 @dataclass(frozen=True)
@@ -376,6 +405,85 @@ def merge_seam_classes(found: RegionMap, mean: NDArray[np.float64],
                    np.arange(labels.size))
 
 
+def _value_splits(values: NDArray[np.float64]) -> NDArray[np.bool_]:
+    """For each row of ``values (m, n)``, the upper part of its best split by value (Fisher's:
+    the largest between-part sum of squares, at least ``_PLACE_MIN_PART`` values each side), as a
+    mask over the row's own places (ties broken by place, stably)."""
+    m, n = values.shape
+    order = np.argsort(values, axis=1, kind="stable")
+    csum = np.cumsum(np.take_along_axis(values, order, axis=1), axis=1)
+    size = np.arange(_PLACE_MIN_PART, n - _PLACE_MIN_PART + 1)  # of the lower part
+    lower = csum[:, size - 1] / size
+    upper = (csum[:, -1:] - csum[:, size - 1]) / (n - size)
+    best = size[np.argmax(size * (n - size) * (upper - lower) ** 2, axis=1)]
+    rank = np.empty_like(order)
+    np.put_along_axis(rank, order, np.broadcast_to(np.arange(n), (m, n)), axis=1)
+    return np.asarray(rank >= best[:, None])
+
+
+def place_split(values: NDArray[np.float64], stds: NDArray[np.float64],
+                xy: NDArray[np.float64]) -> NDArray[np.bool_] | None:
+    """The upper part of the best split by value of one class's pokes when that split follows
+    their places (module docstring, "Two materials whose values lie close"), else ``None``.
+
+    ``values (n,)`` and ``stds (n,)`` (each at least the field's floor) at ``xy (n, 2)``; at least
+    ``2 · 3`` pokes, else ``None``."""
+    n = values.size
+    if n < 2 * _PLACE_MIN_PART:
+        return None
+    edges = np.array([(i, j) for i, near in enumerate(_neighbours(xy)) for j in near if i < j],
+                     dtype=np.int64).reshape(-1, 2)
+    if not edges.size:
+        return None
+    rng = np.random.default_rng(_PLACE_SEED)
+    rows = np.vstack([values[None, :], [rng.permutation(values) for _ in
+                                        range(PLACE_PERMUTATIONS)]])
+    splits = _value_splits(rows)
+    joins = np.count_nonzero(splits[:, edges[:, 0]] != splits[:, edges[:, 1]], axis=1)
+    p_value = (1 + np.count_nonzero(joins[1:] <= joins[0])) / (PLACE_PERMUTATIONS + 1)
+    upper = splits[0]
+    parts = [np.flatnonzero(~upper), np.flatnonzero(upper)]
+    if p_value > 0.05 or not _separated(values, stds, parts, 0.0, _REGION_Z):
+        return None
+    return upper
+
+
+def split_by_place(found: RegionMap, mean: NDArray[np.float64], poke_xy: NDArray[np.float64],
+                   poke_value: NDArray[np.float64], poke_std: NDArray[np.float64],
+                   thickness_m: NDArray[np.float64] | None, *, max_regions: int) -> RegionMap:
+    """``found`` with each class split in two while its pokes away from the other classes form
+    two places of different values (:func:`place_split`; module docstring), up to
+    ``max_regions`` classes. Only a class's pokes farther than twice the layer's thickness from
+    every poke of another class are tested (at least six); every poke of the class then joins the
+    part of its nearest tested poke. Without every poke's thickness (``None``) nothing is split,
+    as :func:`merge_seam_classes` merges nothing."""
+    if thickness_m is None:
+        return found
+    labels = found.poke_labels.copy()
+    values = check_array("poke_value", poke_value, (labels.size,))
+    stds = check_array("poke_std", poke_std, (labels.size,), what="standard deviations")
+    xy = check_array("poke_xy", poke_xy, (labels.size, 2), what="metres")
+    reach = 2.0 * check_array("thickness_m", thickness_m, (labels.size,), what="metres")
+    distance = np.hypot(*(xy[:, None, :] - xy[None, :, :]).transpose(2, 0, 1))
+    while np.unique(labels).size < max_regions:
+        for c in np.unique(labels):
+            members = np.flatnonzero(labels == c)
+            others = labels != c
+            tested = members[np.all(distance[np.ix_(members, np.flatnonzero(others))]
+                                    > reach[members, None], axis=1)]
+            upper = place_split(values[tested], stds[tested], xy[tested])
+            if upper is not None:
+                nearest = np.argmin(distance[np.ix_(members, tested)], axis=1)
+                labels[members[upper[nearest]]] = labels.max() + 1
+                break
+        else:
+            break
+    if np.array_equal(labels, found.poke_labels):
+        return found
+    return _ranked(mean, values, [np.flatnonzero(labels == c) for c in np.unique(labels)],
+                   np.arange(labels.size))
+
+
 def poke_classes(mean: NDArray[np.float64], pokes: PokeSet,
                  config: ExplorationConfig) -> RegionMap:
     """The pokes' classes and the isopleth labels of the map field's mean ``mean (ny, nx)``, by
@@ -392,10 +500,15 @@ def map_regions(mean: NDArray[np.float64], pokes: PokeSet, cells_xy: NDArray[np.
                 config: ExplorationConfig) -> RegionMap:
     """The regions of a β-field with mean ``mean (ny, nx)`` fitted to ``pokes``, as the
     exploration settings ask: classes by :func:`segment_regions` (``max_regions``,
-    ``region_prior_dof``, the β-field's noise floor), cells labelled by isopleth, by nearest
+    ``region_prior_dof``, the β-field's noise floor), split by place (``split_by_place``) and
+    junctions merged (``merge_seams``), cells labelled by isopleth, by nearest
     poke or by indicator kriging (``region_labels``; ``cells_xy (ny · nx, 2)`` are the grid's
     cells)."""
     found = poke_classes(mean, pokes, config)
+    if config.split_by_place:
+        found = split_by_place(found, mean, pokes.xy, pokes.beta,
+                               np.maximum(pokes.noise, field_settings(config).noise_floor),
+                               pokes.thickness, max_regions=config.max_regions)  # fmt: skip
     if config.merge_seams and found.n_regions >= 3:
         found = merge_seam_classes(found, mean, pokes.xy, pokes.beta, pokes.thickness)
     if config.region_labels == "nearest":

@@ -87,6 +87,8 @@ class WorldsBenchConfig:
     merge_seams : bool
         ``ExplorationConfig.merge_seams`` for every cut scored (it acts after the pokes, on the
         regions, like the cut; its default is the exploration's).
+    split_by_place : bool
+        ``ExplorationConfig.split_by_place`` likewise.
     coarse : bool
         The test mesh and camera (:meth:`deformap.world.WorldConfig.coarse`, about a third of a
         default world's cost) instead of the default world. A smoke run only: on one linear-FEM
@@ -109,6 +111,7 @@ class WorldsBenchConfig:
     # every poke is a press and a β sweep per combination (issue 16 reads 20 and more)
     max_pokes: int = setting(12, ge=1, le=1000)
     merge_seams: bool = ExplorationConfig().merge_seams
+    split_by_place: bool = ExplorationConfig().split_by_place
     coarse: bool = False
     workers: int = setting(1, ge=1, le=1024)
     scheduler: str | None = None
@@ -142,7 +145,7 @@ class WorldsBenchConfig:
                 "physics": list(self.physics),
                 "strategies": list(self.strategies), "fields": list(self.fields),
                 "cuts": list(self.cuts), "max_pokes": self.max_pokes, "coarse": self.coarse,
-                "merge_seams": self.merge_seams}
+                "merge_seams": self.merge_seams, "split_by_place": self.split_by_place}
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -408,7 +411,8 @@ def _check_stored(path: Path, result: Any, config: WorldsBenchConfig) -> dict[st
 
 
 def rescore_worlds(source: Path, out: Path, *, cuts: Sequence[str] | None = None,
-                   merge_seams: bool | None = None, hooks: RunHooks = NO_HOOKS) -> WorldsOutput:
+                   merge_seams: bool | None = None, split_by_place: bool | None = None,
+                   hooks: RunHooks = NO_HOOKS) -> WorldsOutput:
     """Score the finished worlds of the benchmark folder ``source`` again under ``cuts`` and
     ``merge_seams`` (default: the source's), from the pokes each world stored, into the new
     folder ``out`` (``bench.json`` naming the source, ``worlds/``, ``runs.csv``, the summary and
@@ -441,6 +445,10 @@ def rescore_worlds(source: Path, out: Path, *, cuts: Sequence[str] | None = None
         given["cuts"] = tuple(cuts)
     if merge_seams is not None:
         given["merge_seams"] = merge_seams
+    # a source from before the split by place was scored without it
+    given.setdefault("split_by_place", False)
+    if split_by_place is not None:
+        given["split_by_place"] = split_by_place
     config = WorldsBenchConfig(worlds=1, **given)  # the settings checked before any world
     results = []
     for path in sorted(Path(source, "worlds").glob("world-*.json")):
@@ -467,7 +475,8 @@ def rescore_worlds(source: Path, out: Path, *, cuts: Sequence[str] | None = None
     for result in results:
         index = int(result["world"]["index"])
         again = result if result.get("status") != "ok" else rescore_world(
-            config.task(index), result, config.cuts, merge_seams=config.merge_seams)
+            config.task(index), result, config.cuts, merge_seams=config.merge_seams,
+            split_by_place=config.split_by_place)
         write_text(_world_path(folder, index), to_json(again))
         rescored.append(again)
         hooks.step(f"world {index} ({result['world'].get('family')}) · {len(rescored)}/"
