@@ -197,6 +197,7 @@ def test_the_quick_study_fits_the_default_and_the_papers_protocol() -> None:
     (["--element-size", "0.0005"], "--element-size"),
     (["--element-size", "nan"], "--element-size"),
     (["--element-size", "0.01", "--coarse"], "--element-size"),
+    (["--element-size", "0.002"], "--element-size"),  # over the world's mesh budget at 5 cm
 ])
 def test_a_study_nothing_can_press_is_refused_before_any_folder(tmp_path: Path, args: list[str],
                                                                 names: str) -> None:

@@ -51,8 +51,16 @@ def test_pool_and_dask_agree_byte_for_byte_apart_from_times_and_resume(tmp_path)
     assert "| paper/beta/isopleth" in (tmp_path / "pool" / "summary.md").read_text()
     again = bench_worlds(_config(worlds=2), tmp_path / "pool")  # resumed: nothing redone
     assert again.computed == 0 and again.summary == pool.summary
-    with pytest.raises(ConfigError, match="other settings"):
+    with pytest.raises(ConfigError, match=r"other settings \(max_pokes: 2 there, 3 here\)"):
         bench_worlds(_config(worlds=2, max_pokes=3), tmp_path / "pool")
+    # a folder from before the split by place ran without it: resumed as such, refused with it
+    settings_file = tmp_path / "pool" / "bench.json"
+    header = json.loads(settings_file.read_text())
+    del header["settings"]["split_by_place"]
+    settings_file.write_text(json.dumps(header))
+    assert bench_worlds(_config(worlds=2, split_by_place=False), tmp_path / "pool").computed == 0
+    with pytest.raises(ConfigError, match="split_by_place: False there, True here"):
+        bench_worlds(_config(worlds=2, split_by_place=True), tmp_path / "pool")
 
 
 def test_a_failing_world_is_tried_twice_then_reported_not_dropped(caplog) -> None:

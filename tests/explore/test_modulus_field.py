@@ -190,9 +190,12 @@ def test_a_first_poke_without_modulus_does_not_decide_the_run() -> None:
     mapper = _mapper("modulus")
     mapper.add(_poke((0.3, 0.2), None, 0, error="the record was refused"))
     assert mapper.config.field == "beta" and mapper.field_fallback is not None
+    on_beta = mapper.field  # fitted at the poke, as the map field then
+    assert len(on_beta.pokes) == 1 and mapper.map_field is on_beta
     mapper.add(_poke((0.1, 0.1), _soft(5e3), 1))  # a modulus arrives: back on the modulus field
     assert mapper.config.field == "modulus" and mapper.field_fallback is None
     assert mapper.map_field is mapper.modulus_field
+    assert len(mapper.field.pokes) == 2 and mapper.field is not on_beta  # fitted again, lazily
 
 
 def test_a_place_whose_modulus_cannot_be_read_twice_gives_the_run_to_beta() -> None:

@@ -267,3 +267,35 @@ def test_a_split_by_place_needs_the_values_apart_and_six_pokes_away_from_other_c
     # nor beyond max_regions
     assert split_by_place(_one_class(value), np.zeros((2, 2)), xy, value, np.full(20, 0.05),
                           np.full(20, 0.03), max_regions=1).n_regions == 1
+
+
+def test_pokes_repeated_at_one_place_end_the_split_by_place() -> None:
+    """Places pressed once low and then three times high at the same spot (the review's case that
+    looped forever): a tested poke keeps its own part, so the split ends within max_regions."""
+    rng = np.random.default_rng(0)
+    single = np.column_stack([rng.uniform(0.02, 0.58, 36), rng.uniform(0.02, 0.38, 36)])
+    spots = np.column_stack([np.linspace(0.05, 0.55, 8), np.full(8, 0.2)])
+    xy = np.vstack([single, spots, np.repeat(spots, 3, axis=0)])
+    value = np.concatenate([np.log(10e3) + 0.05 * rng.standard_normal(36),
+                            np.full(8, np.log(9e3)), np.full(24, np.log(13e3))])
+    n = value.size
+    split = split_by_place(_one_class(value), np.zeros((2, 2)), xy, value, np.full(n, 0.05),
+                           np.full(n, 0.01), max_regions=6)
+    assert 1 <= split.n_regions <= 6 and split.poke_labels.size == n
+
+
+def test_the_junction_rule_runs_before_the_split_by_place() -> None:
+    """A joint column between two foams is merged first; the split by place then acts on the
+    merged classes (its parts are never taken for junctions)."""
+    from deformap.explore import ExplorationConfig, PokeSet, map_regions
+
+    xs, ys = np.linspace(0.05, 0.55, 7), np.linspace(0.05, 0.35, 5)
+    xy = np.array([(x, y) for y in ys for x in xs])
+    value = np.log(np.where(xy[:, 0] < 0.28, 10e3, np.where(xy[:, 0] > 0.32, 40e3, 20e3)))
+    pokes = PokeSet(xy, value, np.full(len(xy), 0.1), thickness=np.full(len(xy), 0.06))
+    cells = np.array([(x, y) for y in np.linspace(0, 0.4, 9) for x in np.linspace(0, 0.6, 13)])
+    mean = np.zeros((9, 13))
+    on = map_regions(mean, pokes, cells, ExplorationConfig(field="modulus"))
+    off = map_regions(mean, pokes, cells, ExplorationConfig(field="modulus", split_by_place=False))
+    assert on.n_regions == off.n_regions == 2  # the joint merged; the two foams not split again
+    np.testing.assert_array_equal(on.poke_labels, off.poke_labels)

@@ -9,6 +9,7 @@ import typer
 from rich.table import Table
 
 from deformap import run
+from deformap._validation import SettingError
 from deformap.cli._app import (
     JsonOption,
     app,
@@ -85,7 +86,7 @@ def study_hardness(
     ] = None,
     element_size: Annotated[
         float | None, typer.Option(help="The world's in-plane FEM element size in metres "
-                                   "(default 0.0075; 0.00375 has about 5 times the unknowns): "
+                                   "(default 0.0075; 0.00375 has about 4 times the unknowns): "
                                    "how much of E's error is the world's mesh. Not with "
                                    "--coarse.")
     ] = None,
@@ -100,20 +101,25 @@ def study_hardness(
         raise InvalidArgumentError(f"--element-size sets the mesh, as --coarse does: give one "
                                    f"of them; got --element-size {element_size} and --coarse")
     shown = out_console(json_path)
-    with progress(shown) as bar:
-        if full:  # an axis given on the command line pins it; the others span the matrix
-            output = run.run_hardness_study(
-                out, seed=seed, hardness=hardness, coarse=coarse, force_n=force, full=True,
-                cameras=None if camera is None else [camera],
-                thicknesses_m=None if thickness is None else [thickness],
-                physics_names=None if physics is None else [physics], protocols=protocol,
-                element_size_m=element_size, hooks=run_hooks(bar))  # fmt: skip
-        else:
-            output = run.run_hardness_study(
-                out, seed=seed, hardness=hardness, coarse=coarse, camera=camera,
-                thickness_m=0.05 if thickness is None else thickness, force_n=force,
-                physics=physics or "linear-fem", protocols=protocol,
-                element_size_m=element_size, hooks=run_hooks(bar))
+    try:
+        with progress(shown) as bar:
+            if full:  # an axis given on the command line pins it; the others span the matrix
+                output = run.run_hardness_study(
+                    out, seed=seed, hardness=hardness, coarse=coarse, force_n=force, full=True,
+                    cameras=None if camera is None else [camera],
+                    thicknesses_m=None if thickness is None else [thickness],
+                    physics_names=None if physics is None else [physics], protocols=protocol,
+                    element_size_m=element_size, hooks=run_hooks(bar))  # fmt: skip
+            else:
+                output = run.run_hardness_study(
+                    out, seed=seed, hardness=hardness, coarse=coarse, camera=camera,
+                    thickness_m=0.05 if thickness is None else thickness, force_n=force,
+                    physics=physics or "linear-fem", protocols=protocol,
+                    element_size_m=element_size, hooks=run_hooks(bar))
+    except SettingError as exc:  # the mesh the option asked for: named as the option
+        if exc.field != "element_size_m":
+            raise
+        raise InvalidArgumentError(f"--element-size {exc.detail}") from None
     if full:
         _print_summary(shown, output.study)
         shown.print(f"wrote {' and '.join(map(str, output.files))}", highlight=False)

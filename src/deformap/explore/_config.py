@@ -341,7 +341,8 @@ class ExplorationConfig:
         class, so it acts in longer runs (Table I is as without it). On by default: on 12
         held-out worlds of ``deformap bench worlds --seed 1`` (``planned``, 20 pokes) it took the
         median pokes to accuracy 0.9 from 14.5 to 12.5 and mended 3 maps, breaking none; on the 30
-        worlds it was shaped on it mended 2 maps and broke 2 (README "Many worlds").
+        worlds it was shaped on it mended 2 maps and broke 1 for three pokes (README "Many
+        worlds").
     boundary_pokes : int
         Pokes made after the variance has fallen below ``T_h``, each where a region boundary is
         least certain (:mod:`deformap.explore._acquisition`, "boundary pokes"); 0, the paper's

@@ -52,14 +52,18 @@ its best split by value into a lower and an upper part (at least three pokes eac
 split as in 1.) is scored by how many edges of the pokes' Delaunay graph it cuts (the join
 count: Cliff & Ord 1981), against the same split's join count after each of
 :data:`PLACE_PERMUTATIONS` shuffles of the values over the places (fixed seed: the same pokes
-give the same classes). A split that cuts fewer edges than shuffled values do (one-sided, 5 %)
-and whose parts' means differ by more than ``z`` standard errors is kept, with no smallest step:
-the places, not the size of the difference, are the evidence. Only the class's pokes farther
-than twice the layer's thickness from every poke of another class take part (what a press reads
-near a joint is the joint's, and pokes along a boundary would make one material look like two
-places: the junction rule's reach, :func:`merge_seam_classes`), at least six of them; each poke
-of the class then joins the part of its nearest such poke. Repeated until no class splits or
-``max_regions`` are found. Measured on 30 default worlds (README, "Many worlds").
+give the same classes). A split that cuts fewer edges than shuffled values do (one-sided, 5 %
+shared by the classes tested in one round, Bonferroni) is kept, with no smallest step: the
+places, not the size of the difference, are the evidence (the parts' means must also lie ``z``
+standard errors apart, but Fisher's best split of one material already separates them by about
+that much: the join count is the test). Only the class's pokes farther than twice the layer's
+thickness from every poke of another class take part (what a press reads near a joint is the
+joint's, and pokes along a boundary would make one material look like two places: the junction
+rule's reach, :func:`merge_seam_classes`); with six of them the test cannot reject (a 3 / 3 split
+and its mirror cut as many edges), so it acts from about eight. A tested poke keeps its part and
+each other poke of the class joins the part of its nearest tested poke. Run after the junction
+rule (its parts are not junctions) and repeated until no class splits or ``max_regions`` are
+found. Measured on 42 default worlds (README, "Many worlds").
 
 Labelling by nearest poke (``ExplorationConfig.region_labels = "nearest"``)
 -----------------------------------------------------------------------------
@@ -384,7 +388,7 @@ def merge_seam_classes(found: RegionMap, mean: NDArray[np.float64],
     labels = found.poke_labels.copy()
     values = check_array("poke_value", poke_value, (labels.size,))
     xy = check_array("poke_xy", poke_xy, (labels.size, 2), what="metres")
-    reach = 2.0 * check_array("thickness_m", thickness_m, (labels.size,), what="metres")
+    reach = _joint_reach(thickness_m, labels.size)
     near = [{j for j in neighbours if np.hypot(*(xy[j] - xy[i])) <= reach[i]}
             for i, neighbours in enumerate(_neighbours(xy))]
     while True:
@@ -422,12 +426,14 @@ def _value_splits(values: NDArray[np.float64]) -> NDArray[np.bool_]:
 
 
 def place_split(values: NDArray[np.float64], stds: NDArray[np.float64],
-                xy: NDArray[np.float64]) -> NDArray[np.bool_] | None:
+                xy: NDArray[np.float64], *, level: float = 0.05) -> NDArray[np.bool_] | None:
     """The upper part of the best split by value of one class's pokes when that split follows
-    their places (module docstring, "Two materials whose values lie close"), else ``None``.
+    their places at ``level`` (module docstring, "Two materials whose values lie close"), else
+    ``None``.
 
     ``values (n,)`` and ``stds (n,)`` (each at least the field's floor) at ``xy (n, 2)``; at least
-    ``2 · 3`` pokes, else ``None``."""
+    ``2 · 3`` pokes, else ``None`` (with six the test cannot reject: a 3 / 3 split and its mirror
+    image cut as many edges, so about one shuffle in ten ties it; it rejects from about eight)."""
     n = values.size
     if n < 2 * _PLACE_MIN_PART:
         return None
@@ -443,9 +449,16 @@ def place_split(values: NDArray[np.float64], stds: NDArray[np.float64],
     p_value = (1 + np.count_nonzero(joins[1:] <= joins[0])) / (PLACE_PERMUTATIONS + 1)
     upper = splits[0]
     parts = [np.flatnonzero(~upper), np.flatnonzero(upper)]
-    if p_value > 0.05 or not _separated(values, stds, parts, 0.0, _REGION_Z):
+    if p_value > level or not _separated(values, stds, parts, 0.0, _REGION_Z):
         return None
     return upper
+
+
+def _joint_reach(thickness_m: NDArray[np.float64], n: int) -> NDArray[np.float64]:
+    """How far from a press a joint changes what it reads: twice the layer's thickness there
+    (a bonded layer carries the load sideways over about its own thickness; the joint, expected
+    midway between two presses, within one thickness of each), per poke [m]."""
+    return 2.0 * check_array("thickness_m", thickness_m, (n,), what="metres")
 
 
 def split_by_place(found: RegionMap, mean: NDArray[np.float64], poke_xy: NDArray[np.float64],
@@ -453,30 +466,42 @@ def split_by_place(found: RegionMap, mean: NDArray[np.float64], poke_xy: NDArray
                    thickness_m: NDArray[np.float64] | None, *, max_regions: int) -> RegionMap:
     """``found`` with each class split in two while its pokes away from the other classes form
     two places of different values (:func:`place_split`; module docstring), up to
-    ``max_regions`` classes. Only a class's pokes farther than twice the layer's thickness from
-    every poke of another class are tested (at least six); every poke of the class then joins the
-    part of its nearest tested poke. Without every poke's thickness (``None``) nothing is split,
-    as :func:`merge_seam_classes` merges nothing."""
+    ``max_regions`` classes. Only a class's pokes farther than the joint's reach
+    (:func:`_joint_reach`) from every poke of another class are tested; the classes tested in one
+    round share the 5 % (Bonferroni); a tested poke keeps its part and every other poke of the
+    class joins the part of its nearest tested poke (a split that would leave a part empty is
+    none). Without every poke's thickness (``None``) nothing is split, as
+    :func:`merge_seam_classes` merges nothing."""
     if thickness_m is None:
         return found
     labels = found.poke_labels.copy()
     values = check_array("poke_value", poke_value, (labels.size,))
     stds = check_array("poke_std", poke_std, (labels.size,), what="standard deviations")
     xy = check_array("poke_xy", poke_xy, (labels.size, 2), what="metres")
-    reach = 2.0 * check_array("thickness_m", thickness_m, (labels.size,), what="metres")
+    reach = _joint_reach(thickness_m, labels.size)
     distance = np.hypot(*(xy[:, None, :] - xy[None, :, :]).transpose(2, 0, 1))
     while np.unique(labels).size < max_regions:
+        candidates = []
         for c in np.unique(labels):
             members = np.flatnonzero(labels == c)
-            others = labels != c
-            tested = members[np.all(distance[np.ix_(members, np.flatnonzero(others))]
-                                    > reach[members, None], axis=1)]
-            upper = place_split(values[tested], stds[tested], xy[tested])
-            if upper is not None:
-                nearest = np.argmin(distance[np.ix_(members, tested)], axis=1)
-                labels[members[upper[nearest]]] = labels.max() + 1
-                break
-        else:
+            away = np.all(distance[np.ix_(members, np.flatnonzero(labels != c))]
+                          > reach[members, None], axis=1)
+            if np.count_nonzero(away) >= 2 * _PLACE_MIN_PART:
+                candidates.append((members, members[away]))
+        split = False
+        for members, tested in candidates:
+            upper = place_split(values[tested], stds[tested], xy[tested],
+                                level=0.05 / len(candidates))
+            if upper is None:
+                continue
+            side = upper[np.argmin(distance[np.ix_(members, tested)], axis=1)]
+            side[np.searchsorted(members, tested)] = upper  # a tested poke keeps its own part
+            if side.all() or not side.any():
+                continue
+            labels[members[side]] = labels.max() + 1
+            split = True
+            break
+        if not split:
             break
     if np.array_equal(labels, found.poke_labels):
         return found
@@ -500,17 +525,17 @@ def map_regions(mean: NDArray[np.float64], pokes: PokeSet, cells_xy: NDArray[np.
                 config: ExplorationConfig) -> RegionMap:
     """The regions of a β-field with mean ``mean (ny, nx)`` fitted to ``pokes``, as the
     exploration settings ask: classes by :func:`segment_regions` (``max_regions``,
-    ``region_prior_dof``, the β-field's noise floor), split by place (``split_by_place``) and
-    junctions merged (``merge_seams``), cells labelled by isopleth, by nearest
+    ``region_prior_dof``, the β-field's noise floor), junctions merged (``merge_seams``) and
+    classes split by place (``split_by_place``), cells labelled by isopleth, by nearest
     poke or by indicator kriging (``region_labels``; ``cells_xy (ny · nx, 2)`` are the grid's
     cells)."""
     found = poke_classes(mean, pokes, config)
-    if config.split_by_place:
+    if config.merge_seams and found.n_regions >= 3:
+        found = merge_seam_classes(found, mean, pokes.xy, pokes.beta, pokes.thickness)
+    if config.split_by_place:  # after the junctions: the parts it makes are not junctions
         found = split_by_place(found, mean, pokes.xy, pokes.beta,
                                np.maximum(pokes.noise, field_settings(config).noise_floor),
                                pokes.thickness, max_regions=config.max_regions)  # fmt: skip
-    if config.merge_seams and found.n_regions >= 3:
-        found = merge_seam_classes(found, mean, pokes.xy, pokes.beta, pokes.thickness)
     if config.region_labels == "nearest":
         return found.nearest_poke(pokes.xy, cells_xy)
     if config.region_labels == "indicator-kriging":

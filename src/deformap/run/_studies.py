@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from deformap._validation import check_positive
+from deformap._validation import SettingError, check_positive
 from deformap.environment import Workspace
 from deformap.errors import InvalidArgumentError
 from deformap.eval import (
@@ -34,7 +34,14 @@ from deformap.eval import (
 from deformap.explore import ExplorationConfig
 from deformap.run._folder import create_run_folder, default_run_folder, write_json
 from deformap.run._hooks import NO_HOOKS, RunHooks, RunStart
-from deformap.world import MIN_RECORD_FORCE_N, PHYSICS, Physics, WorldConfig, camera_preset
+from deformap.world import (
+    MIN_RECORD_FORCE_N,
+    PHYSICS,
+    Physics,
+    WorldConfig,
+    camera_preset,
+    check_world_budget,
+)
 
 __all__ = [
     "CLUSTER_SIZE_FOAMS",
@@ -71,15 +78,40 @@ def _foams(
     force_n: float | None = None, physics: Physics = "linear-fem",
     element_size_m: float | None = None,
 ) -> list[FoamPresses]:  # fmt: skip
-    world = WorldConfig.coarse(physics=physics) if coarse else WorldConfig(physics=physics)
-    if element_size_m is not None:  # finer in-plane elements, and top layers no thicker
-        world = dataclasses.replace(world, element_size_m=element_size_m,
-                                    top_layer_m=min(world.top_layer_m, element_size_m))
+    world = _study_world(physics, coarse=coarse, element_size_m=element_size_m)
     if camera is not None:
         world = dataclasses.replace(world, camera=camera_preset(camera))
     explore = ExplorationConfig() if force_n is None else ExplorationConfig(force_n=force_n)
     return collect_presses(foams, world_config=world, config=explore, thickness_m=thickness_m,
                            rng=np.random.default_rng(seed), progress=hooks.step)  # fmt: skip
+
+
+def _study_world(physics: Physics, *, coarse: bool, element_size_m: float | None) -> WorldConfig:
+    """The world a study presses: the default (or coarse) one, with ``element_size_m`` in-plane
+    elements and top layers no thicker when given."""
+    world = WorldConfig.coarse(physics=physics) if coarse else WorldConfig(physics=physics)
+    if element_size_m is None:
+        return world
+    return dataclasses.replace(world, element_size_m=element_size_m,
+                               top_layer_m=min(world.top_layer_m, element_size_m))
+
+
+def _check_study_mesh(element_size_m: float, thicknesses_m: Sequence[float],
+                     physics_names: Sequence[str]) -> None:
+    """Refuse, before any folder or world, an element size whose study blocks (one per thickness
+    and physics) would exceed the world's mesh budget
+    (:func:`deformap.world.check_world_budget`): a :class:`SettingError` naming
+    ``element_size_m``, the block and the limit."""
+    for physics_name in physics_names:
+        world = _study_world(WorldConfig(physics=physics_name).physics,  # type: ignore[arg-type]
+                             coarse=False, element_size_m=element_size_m)
+        for thickness in thicknesses_m:
+            try:
+                check_world_budget(world, block_scenario(None, Workspace(), thickness))
+            except SettingError as exc:
+                raise SettingError("element_size_m", f"{element_size_m} m is too fine for the "
+                                   f"{thickness:g} m study block ({physics_name}): "
+                                   f"{exc.detail}") from None
 
 
 def _write(folder: Path, stem: str, study: dict[str, Any], plot: Any) -> list[Path]:
@@ -162,11 +194,9 @@ def run_hardness_study(
     else:
         conditions = [(camera or "primesense", thickness_m, physics)]
     chosen = _protocols(protocols)
-    if element_size_m is not None:
-        if coarse:
-            raise InvalidArgumentError("`element_size_m` sets the mesh the coarse world has its "
-                                       "own of: give one or the other, not both")
-        WorldConfig(element_size_m=element_size_m)  # the world's own check, before any folder
+    if element_size_m is not None and coarse:
+        raise InvalidArgumentError("`element_size_m` sets the mesh the coarse world has its "
+                                   "own of: give one or the other, not both")
     foams = DEFAULT_HARDNESSES if not hardness else (*hardness, None)
     _check_press(foams, force_n)
     checked = []
@@ -177,6 +207,9 @@ def run_hardness_study(
                         WorldConfig(physics=physics_name).physics))  # type: ignore[arg-type]
     for _, thickness, _ in checked:  # a block the world cannot build: before any folder
         block_scenario(None, Workspace(), thickness)
+    if element_size_m is not None:  # nor a mesh it would refuse
+        _check_study_mesh(element_size_m, sorted({c[1] for c in checked}),
+                         list(dict.fromkeys(c[2] for c in checked)))
     folder = create_run_folder(out or default_run_folder("hardness", "study", seed), what="study")
     hooks.start(RunStart(kind="study", title=f"hardness study, seed {seed}", folder=folder,
                          total=len(foams) * len(checked)))  # fmt: skip
@@ -192,7 +225,8 @@ def run_hardness_study(
         condition = {"camera": name, "thickness_m": thickness,
                      "force_n": pressed[0] if pressed else _force(force_n),
                      "physics": physics_name}  # fmt: skip
-        single = {**condition, "element_size_m": element_size_m,
+        used = _study_world(physics_name, coarse=coarse, element_size_m=element_size_m)
+        single = {**condition, "element_size_m": used.element_size_m,
                   **hardness_study(presses, protocols=chosen)}
         rows.extend({**row, **condition} for row in single["rows"])
     study = {**(single if not full else {"matrix": {
@@ -200,7 +234,8 @@ def run_hardness_study(
         "thicknesses_m": sorted({c[1] for c in checked}),
         "physics": list(dict.fromkeys(c[2] for c in checked)),
         "force_n": _force(force_n), "seed": seed, "coarse": coarse,
-        "element_size_m": element_size_m}}),
+        "element_size_m": _study_world("linear-fem", coarse=coarse,
+                                       element_size_m=element_size_m).element_size_m}}),
         "rows": rows, **hardness_summary(rows)}  # fmt: skip
     return StudyOutput(study=study, folder=folder,
                        files=_write(folder, "hardness", study, plot_hardness_study))  # fmt: skip

@@ -274,10 +274,18 @@ def _open_folder(config: WorldsBenchConfig, out: Path | None) -> tuple[Path, dic
             stored = json.loads(settings_file.read_text(encoding="utf-8"))
         except (OSError, ValueError) as exc:
             raise ConfigError(f"--out: {settings_file} cannot be read: {exc}") from None
-        if stored.get("settings") != json.loads(to_json(config.result_settings())):
+        ours = json.loads(to_json(config.result_settings()))
+        theirs = stored.get("settings") if isinstance(stored, dict) else None
+        if isinstance(theirs, dict):  # a run from before the split by place ran without it
+            theirs = {"split_by_place": False, **theirs}
+        if theirs != ours:
+            there = theirs if isinstance(theirs, dict) else {}
+            differ = ", ".join(f"{k}: {there.get(k)!r} there, {ours.get(k)!r} here"
+                               for k in sorted(set(ours) | set(there))
+                               if there.get(k) != ours.get(k))
             raise ConfigError(
                 f"--out {str(folder)!r} holds a worlds benchmark with other settings "
-                f"({stored.get('settings')}); choose another --out or the same settings")
+                f"({differ}); choose another --out or the same settings")
     else:
         create_run_folder(folder, what="benchmark")
         write_text(settings_file, to_json(header))
@@ -384,8 +392,11 @@ def _check_stored(path: Path, result: Any, config: WorldsBenchConfig) -> dict[st
         raise bad("no `pokes` (a world run before pokes were stored)")
     version = result.get("pokes_format", 1)  # stored before the key was: the first format
     if isinstance(version, bool) or version not in range(1, POKES_FORMAT + 1):
+        newer = isinstance(version, int) and not isinstance(version, bool) \
+            and version > POKES_FORMAT
         raise bad(f"`pokes_format` must be an integer from 1 to {POKES_FORMAT} (the formats this "
-                  f"deformap reads); got {version!r} (written by a newer version?)")
+                  f"deformap reads); got {version!r}"
+                  + (" (written by a newer version?)" if newer else ""))
     for row in rows:
         combo = f"{row.get('strategy')}/{row.get('field')}"
         if row.get("strategy") not in config.strategies or \
@@ -413,8 +424,9 @@ def _check_stored(path: Path, result: Any, config: WorldsBenchConfig) -> dict[st
 def rescore_worlds(source: Path, out: Path, *, cuts: Sequence[str] | None = None,
                    merge_seams: bool | None = None, split_by_place: bool | None = None,
                    hooks: RunHooks = NO_HOOKS) -> WorldsOutput:
-    """Score the finished worlds of the benchmark folder ``source`` again under ``cuts`` and
-    ``merge_seams`` (default: the source's), from the pokes each world stored, into the new
+    """Score the finished worlds of the benchmark folder ``source`` again under ``cuts``,
+    ``merge_seams`` and ``split_by_place`` (default: the source's; a source from before the split
+    by place was scored without it), from the pokes each world stored, into the new
     folder ``out`` (``bench.json`` naming the source, ``worlds/``, ``runs.csv``, the summary and
     curves, as :func:`bench_worlds` writes them). No press is made again: the pokes do not depend
     on the cut, so a cut or seam rule added later is measured on the same pokes in seconds a
