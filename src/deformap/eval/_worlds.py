@@ -226,7 +226,9 @@ def _map_one(world: SimulatedWorld, draw: WorldDraw, config: ExplorationConfig, 
             rows.append({"cut": cut, **head, **scores,
                          "poke_s": t1 - t0, "elapsed_s": t1 - t_start})  # fmt: skip
     records = {p.record.index: p.record for p in mapper.pokes}
-    stored = (mapper.map_field.pokes if config.field == "modulus"
+    # the field's own pokes (after a fall back to β the map field is the β-field: rescoring
+    # carries such a run's rows, :func:`rescore_world`)
+    stored = (mapper.modulus_field.pokes if config.field == "modulus"
               else PokeSet.of(list(records.values()), beta_noise_floor(config)))
     thickness = [records[int(i)].layer_thickness_m for i in np.asarray(stored.index)]
     return rows, poke_data(stored, thickness)
@@ -330,7 +332,10 @@ def rescore_world(task: dict[str, Any], result: dict[str, Any], cuts: Sequence[s
     After ``k`` pokes the map field is the one of the stored pokes numbered below ``k`` (a poke
     without a value, a modulus field's poke whose record gave none, leaves a gap, as it did in the
     run), so scoring the run's own cuts again, on a world written by the same version, gives its
-    rows to the bit (a test checks it). The columns that do not depend on the cut (``purpose``,
+    rows to the bit (a test checks it). A combination whose run fell back from the modulus
+    field to β (a row's ``map_field`` is not its ``field``) is carried as it was, for the cuts it
+    was scored under (none for another cut): its map changed field on the way, which its stored
+    pokes do not retrace. The columns that do not depend on the cut (``purpose``,
     ``threshold``, ``modulus_error``, times, ...) are the run's. A world stored before the pokes'
     layer thickness was (no ``thickness`` key) has the world's own rest height at each poke stand
     in for the surface model's (:func:`deformap.explore.merge_seam_classes` needs it).
@@ -358,9 +363,17 @@ def rescore_world(task: dict[str, Any], result: dict[str, Any], cuts: Sequence[s
     head: dict[tuple[str, str, int], dict[str, Any]] = {}
     for row in result["rows"]:
         head.setdefault((row["strategy"], row["field"], int(row["poke"])), row)
-    rows = []
+    # a run that fell back from the modulus field to β mapped on two fields in turn, which one
+    # field's stored pokes do not retrace: its rows are carried as they were
+    fell_back = {(r["strategy"], r["field"]) for r in result["rows"]
+                 if r.get("map_field", r["field"]) != r["field"]}
+    rows: list[dict[str, Any]] = []
     for (strategy, field_name, poke), old in sorted(head.items(), key=lambda kv: (
             task["strategies"].index(kv[0][0]), task["fields"].index(kv[0][1]), kv[0][2])):
+        if (strategy, field_name) in fell_back:
+            rows.extend(r for r in result["rows"] if (r["strategy"], r["field"], r["poke"])
+                        == (strategy, field_name, poke) and r["cut"] in cuts)
+            continue
         data = result["pokes"][f"{strategy}/{field_name}"]
         index = np.asarray(data["index"], dtype=np.int64)
         keep = index < poke
