@@ -12,9 +12,11 @@ with these pokes and this cut; the gap to the run's is what the class test loses
 merged, seam presses split off), and what the oracle itself misses is where the pokes went (a
 boundary between pokes placed no closer than their spacing allows).
 
-The table gives, per combination and per layout family, the median pokes to region accuracy 0.9
-(a world that never gets there counts ``max_pokes + 1``, as in ``summary.json``) and the share of
-worlds reaching it.
+The stored pokes are the field's own: for a run that fell back from the modulus field to β on
+the way (``runs.csv``'s ``map_field``), the oracle sees the pokes that gave a modulus, not every
+poke its map used. The table gives, per combination and per layout family, the median pokes to
+region accuracy 0.9 (a world that never gets there counts ``max_pokes + 1``, as in
+``summary.json``) and the share of worlds reaching it.
 """
 
 from __future__ import annotations

@@ -262,7 +262,10 @@ def test_rescoring_merges_a_junction_class_within_the_stored_thickness_only() ->
     # a run that fell back to β from its third poke on: its rows are carried, not rescored
     fell = [{**r, "accuracy": 0.123, "found": 7, "true": 2, "mean_iou": 0.1, "kendall_tau": None,
              "map_field": "modulus" if r["poke"] < 3 else "beta"} for r in rows]
-    again = rescore_world(task, {**result, "rows": fell}, ["nearest", "isopleth"])["rows"]
-    assert again == fell  # the run's own cut only: no row is made for a cut it was not scored on
+    again = rescore_world(task, {**result, "rows": fell}, ["nearest"], split_by_place=True)
+    assert again["rows"] == fell  # the same rows whatever the rules asked
+    with pytest.raises(InvalidArgumentError, match=r"`cuts` must be among those paper/modulus "
+                                                   r"of world 0 was scored under \(\['nearest'\]\)"):
+        rescore_world(task, {**result, "rows": fell}, ["nearest", "isopleth"])
     with pytest.raises(InvalidArgumentError, match="merge_seams and split_by_place only"):
         rescore_world(task, {"status": "ok", "rows": [], "pokes": {}}, ["nearest"], max_regions=2)

@@ -160,3 +160,11 @@ def test_rescore_scores_other_cuts_on_the_stored_pokes_and_names_what_it_cannot(
     assert result.exit_code == 0, result.output
     assert "pokes_format" not in json.loads(
         (tmp_path / "fifth" / "worlds" / "world-00001.json").read_text())
+    # a run whose map changed field on the way is carried, and so only under its own cuts
+    fell = {**original, "rows": [{**r, "map_field": "modulus"} for r in original["rows"]]}
+    world.write_text(json.dumps(fell))
+    result = runner.invoke(app, ["bench", "rescore", str(tmp_path / "src"), "--out",
+                                 str(tmp_path / "sixth"), "--cuts", "isopleth,nearest"])
+    assert result.exit_code == 2 and "world-00001.json" in result.output, result.output
+    assert "fell back from the modulus field to β" in result.output
+    assert not (tmp_path / "sixth").exists()

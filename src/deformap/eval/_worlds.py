@@ -322,6 +322,16 @@ def row_values(row: dict[str, Any]) -> dict[str, Any]:
     return {k: v for k, v in row.items() if k not in TIME_COLUMNS}
 
 
+def fell_back_cuts(result: dict[str, Any]) -> dict[tuple[str, str], set[str]]:
+    """The combinations ``(strategy, field)`` of a :func:`run_world` result whose run fell back
+    from the modulus field to β on the way (a row's ``map_field`` is not its ``field``), each with
+    the cuts its rows were scored under."""
+    fell = {(r["strategy"], r["field"]) for r in result.get("rows", [])
+            if r.get("map_field", r["field"]) != r["field"]}
+    return {combo: {r["cut"] for r in result["rows"] if (r["strategy"], r["field"]) == combo}
+            for combo in fell}
+
+
 def rescore_world(task: dict[str, Any], result: dict[str, Any], cuts: Sequence[str],
                   **settings: Any) -> dict[str, Any]:
     """``result`` of :func:`run_world` for ``task`` with its rows scored under ``cuts`` instead,
@@ -334,17 +344,17 @@ def rescore_world(task: dict[str, Any], result: dict[str, Any], cuts: Sequence[s
     run), so scoring the run's own cuts again, on a world written by the same version, gives its
     rows to the bit (a test checks it). A combination whose run fell back from the modulus
     field to β (a row's ``map_field`` is not its ``field``) is carried as it was, for the cuts it
-    was scored under (none for another cut): its map changed field on the way, which its stored
-    pokes do not retrace. The columns that do not depend on the cut (``purpose``,
-    ``threshold``, ``modulus_error``, times, ...) are the run's. A world stored before the pokes'
-    layer thickness was (no ``thickness`` key) has the world's own rest height at each poke stand
-    in for the surface model's (:func:`deformap.explore.merge_seam_classes` needs it).
+    was scored under (another cut is refused): its map changed field on the way, which its stored
+    pokes do not retrace (:func:`fell_back_cuts`). The columns that do not depend on the cut
+    (``purpose``, ``threshold``, ``modulus_error``, times, ...) are the run's. A world stored
+    before the pokes' layer thickness was (no ``thickness`` key) has the world's own rest height at
+    each poke stand in for the surface model's (:func:`deformap.explore.merge_seam_classes` needs it).
 
     Raises
     ------
     InvalidArgumentError
         ``result`` did not finish, or holds no pokes (a run before they were stored); a setting
-        other than those two.
+        other than those two; a cut a fallen-back combination was not scored under.
     """
     if result.get("status") != "ok" or not isinstance(result.get("pokes"), dict):
         raise InvalidArgumentError(
@@ -365,8 +375,14 @@ def rescore_world(task: dict[str, Any], result: dict[str, Any], cuts: Sequence[s
         head.setdefault((row["strategy"], row["field"], int(row["poke"])), row)
     # a run that fell back from the modulus field to β mapped on two fields in turn, which one
     # field's stored pokes do not retrace: its rows are carried as they were
-    fell_back = {(r["strategy"], r["field"]) for r in result["rows"]
-                 if r.get("map_field", r["field"]) != r["field"]}
+    fell_back = fell_back_cuts(result)
+    for (strategy, field_name), ran in fell_back.items():
+        if set(cuts) - ran:
+            raise InvalidArgumentError(
+                f"`cuts` must be among those {strategy}/{field_name} of world "
+                f"{task.get('index')} was scored under ({sorted(ran)}): its run fell back from "
+                f"the modulus field to β, and its rows are carried, not rescored; got "
+                f"{sorted(set(cuts) - ran)}")
     rows: list[dict[str, Any]] = []
     for (strategy, field_name, poke), old in sorted(head.items(), key=lambda kv: (
             task["strategies"].index(kv[0][0]), task["fields"].index(kv[0][1]), kv[0][2])):

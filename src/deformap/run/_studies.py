@@ -109,6 +109,8 @@ def _check_study_mesh(element_size_m: float, thicknesses_m: Sequence[float],
             try:
                 check_world_budget(world, block_scenario(None, Workspace(), thickness))
             except SettingError as exc:
+                if exc.field != "element_size_m":
+                    raise
                 raise SettingError("element_size_m", f"{element_size_m} m is too fine for the "
                                    f"{thickness:g} m study block ({physics_name}): "
                                    f"{exc.detail}") from None

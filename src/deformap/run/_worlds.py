@@ -39,6 +39,7 @@ from deformap.eval import (
     POKES_FORMAT,
     accuracy_curves,
     choices,
+    fell_back_cuts,
     markdown_summary,
     rescore_world,
     run_world,
@@ -418,6 +419,11 @@ def _check_stored(path: Path, result: Any, config: WorldsBenchConfig) -> dict[st
         numbers += [v for v in data.get("thickness", []) if v is not None]
         if not all(isinstance(v, int | float) and not isinstance(v, bool) for v in numbers):
             raise bad(f"the pokes of {combo!r} must be numbers")
+    for (strategy, field), ran in fell_back_cuts(result).items():
+        if set(config.cuts) - ran:
+            raise bad(f"the run of {strategy}/{field} fell back from the modulus field to β, so "
+                      f"its rows are carried, under the cuts it was scored on only "
+                      f"({sorted(ran)}); got --cuts {sorted(config.cuts)}")
     return result
 
 
