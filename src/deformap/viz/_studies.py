@@ -148,8 +148,13 @@ def _plot_hardness_matrix(study: dict[str, Any]) -> Figure:
                      fontsize=10)  # fmt: skip
         ax.legend(fontsize=7, loc="upper left", ncols=1)
     axes[0].set_ylabel("E read from the force–travel record [kPa] (log; ±claimed σ)")
-    fig.suptitle("Young's modulus read against the world's, per camera × thickness "
-                 "(✗: E or β not monotone, or rigid not read rigid)", fontsize=10)  # fmt: skip
+    # one line over several panels; on one panel (a single physics) it would be cut: two lines
+    gap = " " if len(physics) > 1 else "\n"
+    fig.suptitle("Young's modulus read against the world's, per camera × thickness"
+                 f"{gap}(✗: E or β not monotone, or rigid not read rigid)", fontsize=10)
+    if study.get("matrix", {}).get("element_size_m") not in (None, 0.0075):
+        fig.supxlabel(f"world mesh: {study['matrix']['element_size_m'] * 1e3:g} mm elements "
+                      f"(default 7.5 mm)", fontsize=8)
     return fig
 
 
