@@ -9,7 +9,6 @@ import typer
 from rich.table import Table
 
 from deformap import run
-from deformap._validation import SettingError
 from deformap.cli._app import (
     JsonOption,
     app,
@@ -116,10 +115,10 @@ def study_hardness(
                     thickness_m=0.05 if thickness is None else thickness, force_n=force,
                     physics=physics or "linear-fem", protocols=protocol,
                     element_size_m=element_size, hooks=run_hooks(bar))
-    except SettingError as exc:  # the mesh the option asked for: named as the option
-        if exc.field != "element_size_m":
+    except InvalidArgumentError as exc:  # the mesh the option asked for: named as the option
+        if getattr(exc, "field", None) != "element_size_m":
             raise
-        raise InvalidArgumentError(f"--element-size {exc.detail}") from None
+        raise InvalidArgumentError(f"--element-size {getattr(exc, 'detail', exc)}") from None
     if full:
         _print_summary(shown, output.study)
         shown.print(f"wrote {' and '.join(map(str, output.files))}", highlight=False)
