@@ -140,6 +140,7 @@ def test_rescore_scores_other_cuts_on_the_stored_pokes_and_names_what_it_cannot(
                           "`pokes_format` must be an integer from 1 to 2 (the formats this "
                           "deformap reads); got 3 (written by a newer version?)"),
                          ({**stored, "pokes_format": True}, "`pokes_format` must be"),
+                         ({**stored, "pokes_format": 2.0}, "`pokes_format` must be an integer"),
                          ({**stored, "pokes": unthick},
                           "the pokes of 'paper/beta' have no `thickness` (pokes_format 2)")):
         world.write_text(json.dumps(damaged))

@@ -473,7 +473,9 @@ def split_by_place(found: RegionMap, mean: NDArray[np.float64], poke_xy: NDArray
     round share the 5 % (Bonferroni); a tested poke keeps its part and every other poke of the
     class joins the part of its nearest tested poke (a split that would leave a part empty is
     none). Without every poke's thickness (``None``) nothing is split, as
-    :func:`merge_seam_classes` merges nothing."""
+    :func:`merge_seam_classes` merges nothing. With eleven classes or more tested at once the
+    shared level falls below the shuffles' resolution (1/200) and none can split: the default
+    ``max_regions`` (6) stays clear of it."""
     if thickness_m is None:
         return found
     labels = found.poke_labels.copy()

@@ -392,7 +392,8 @@ def _check_stored(path: Path, result: Any, config: WorldsBenchConfig) -> dict[st
     if not isinstance(pokes, dict):
         raise bad("no `pokes` (a world run before pokes were stored)")
     version = result.get("pokes_format", 1)  # stored before the key was: the first format
-    if isinstance(version, bool) or version not in range(1, POKES_FORMAT + 1):
+    if not isinstance(version, int) or isinstance(version, bool) \
+            or version not in range(1, POKES_FORMAT + 1):
         newer = isinstance(version, int) and not isinstance(version, bool) \
             and version > POKES_FORMAT
         raise bad(f"`pokes_format` must be an integer from 1 to {POKES_FORMAT} (the formats this "
