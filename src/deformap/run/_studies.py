@@ -197,8 +197,8 @@ def run_hardness_study(
         conditions = [(camera or "primesense", thickness_m, physics)]
     chosen = _protocols(protocols)
     if element_size_m is not None and coarse:
-        raise InvalidArgumentError("`element_size_m` sets the mesh the coarse world has its "
-                                   "own of: give one or the other, not both")
+        raise SettingError("element_size_m", f"sets the mesh, as the coarse world does: give one "
+                           f"of them; got {element_size_m} and coarse")
     foams = DEFAULT_HARDNESSES if not hardness else (*hardness, None)
     _check_press(foams, force_n)
     checked = []
@@ -217,6 +217,9 @@ def run_hardness_study(
                          total=len(foams) * len(checked)))  # fmt: skip
     rows: list[dict[str, Any]] = []
     single: dict[str, Any] = {}
+    # the element size the worlds have (the same under every physics)
+    mesh_m = _study_world("linear-fem", coarse=coarse, element_size_m=element_size_m
+                          ).element_size_m
     for name, thickness, physics_name in checked:
         hooks.stage(f"pressing the foams: {name}, {thickness:g} m, {physics_name}")
         presses = _foams(foams, seed=seed, coarse=coarse, hooks=hooks, camera=name,
@@ -227,8 +230,7 @@ def run_hardness_study(
         condition = {"camera": name, "thickness_m": thickness,
                      "force_n": pressed[0] if pressed else _force(force_n),
                      "physics": physics_name}  # fmt: skip
-        used = _study_world(physics_name, coarse=coarse, element_size_m=element_size_m)
-        single = {**condition, "element_size_m": used.element_size_m,
+        single = {**condition, "element_size_m": mesh_m,
                   **hardness_study(presses, protocols=chosen)}
         rows.extend({**row, **condition} for row in single["rows"])
     study = {**(single if not full else {"matrix": {
@@ -236,8 +238,7 @@ def run_hardness_study(
         "thicknesses_m": sorted({c[1] for c in checked}),
         "physics": list(dict.fromkeys(c[2] for c in checked)),
         "force_n": _force(force_n), "seed": seed, "coarse": coarse,
-        "element_size_m": _study_world("linear-fem", coarse=coarse,
-                                       element_size_m=element_size_m).element_size_m}}),
+        "element_size_m": mesh_m}}),
         "rows": rows, **hardness_summary(rows)}  # fmt: skip
     return StudyOutput(study=study, folder=folder,
                        files=_write(folder, "hardness", study, plot_hardness_study))  # fmt: skip

@@ -392,13 +392,11 @@ def _check_stored(path: Path, result: Any, config: WorldsBenchConfig) -> dict[st
     if not isinstance(pokes, dict):
         raise bad("no `pokes` (a world run before pokes were stored)")
     version = result.get("pokes_format", 1)  # stored before the key was: the first format
-    if not isinstance(version, int) or isinstance(version, bool) \
-            or version not in range(1, POKES_FORMAT + 1):
-        newer = isinstance(version, int) and not isinstance(version, bool) \
-            and version > POKES_FORMAT
+    whole = isinstance(version, int) and not isinstance(version, bool)
+    if not (whole and 1 <= version <= POKES_FORMAT):
         raise bad(f"`pokes_format` must be an integer from 1 to {POKES_FORMAT} (the formats this "
                   f"deformap reads); got {version!r}"
-                  + (" (written by a newer version?)" if newer else ""))
+                  + (" (written by a newer version?)" if whole and version > POKES_FORMAT else ""))
     for row in rows:
         combo = f"{row.get('strategy')}/{row.get('field')}"
         if row.get("strategy") not in config.strategies or \
