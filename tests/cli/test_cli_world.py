@@ -42,4 +42,7 @@ def test_bench_world_writes_json(tmp_path) -> None:
     assert data["n_dofs"] > 0 and data["n_points_on_area"] > 1000
     # one poke's compute with its record, and the camera-only baseline beside it
     assert 0.0 < data["poke_compute_s"] and 0.0 < data["poke_compute_camera_only_s"]
+    # the press with the FEM's unit responses, and solved load by load beside it
+    assert 0.0 < data["press_s"] and 0.0 < data["press_load_by_load_s"]
+    assert "baseline of press_s" in result.output
     assert "poke_compute_camera_only_s" in result.output

@@ -162,3 +162,60 @@ def test_a_homogeneous_solve_does_not_depend_on_what_was_built_before() -> None:
     FoamBody(grid, 1.3e3, poisson_ratio=0.3)  # fills the cache first
     after = FoamBody(grid, 37.0e3, poisson_ratio=0.3).solve(load)
     assert np.array_equal(alone, after)
+
+
+def _two_blocks() -> FoamModel:
+    blocks = (Block(name="soft", polygon=rectangle(0.0, 0.0, 0.08, 0.12), hardness_n=40.0),
+              Block(name="hard", polygon=rectangle(0.08, 0.0, 0.16, 0.12), hardness_n=150.0,
+                    thickness_m=0.03))
+    return FoamModel(Scenario(name="s", blocks=blocks), element_size_m=0.0075,
+                     top_layer_m=0.005, layer_growth=1.5, poisson_ratio=0.3)
+
+
+@pytest.mark.parametrize("target", [(0.04, 0.06), (0.081, 0.05), (0.12, 0.03)])
+def test_a_press_from_unit_responses_is_the_press_solved_load_by_load(
+        target: tuple[float, float]) -> None:
+    """The press's unit responses under the tip, summed, give the displacements of one solve per
+    load to rounding (inside a block, by the seam where the patch loads both, on a thinner
+    block), with the same patch iterations; the press takes one solve call per body."""
+    direct, columns = _two_blocks(), _two_blocks()
+    direct.max_unit_columns = 0
+    calls: list[int] = []
+    for body in columns.bodies.values():
+        solve = body.solve_free
+
+        def counted(rhs: np.ndarray, solve=solve) -> np.ndarray:  # type: ignore[no-untyped-def]
+            calls.append(1 if rhs.ndim == 1 else rhs.shape[1])
+            return solve(rhs)
+
+        body.solve_free = counted  # type: ignore[method-assign]
+    xy = np.array(target)
+    iterations = []
+    for force in (0.8, 0.4, 0.2):  # as a record's levels: the largest first, one press
+        a = direct.dent(xy, force, tip_radius_m=0.01)
+        b = columns.dent(xy, force, tip_radius_m=0.01)
+        assert b.iterations == a.iterations
+        iterations.append(a.iterations)
+        assert b.depth_m == pytest.approx(a.depth_m, rel=1e-12)
+        assert b.contact_radius_m == pytest.approx(a.contact_radius_m, rel=1e-12)
+        np.testing.assert_allclose(b.displacement, a.displacement, rtol=0,
+                                   atol=1e-12 * float(np.abs(a.displacement).max()))
+    assert sum(iterations) > 3  # the patch iterated
+    loaded_bodies = len(columns._columns)
+    assert 1 <= loaded_bodies <= 2 and len(calls) == loaded_bodies  # one call a body
+    assert all(1 < n <= columns.max_unit_columns for n in calls)
+    # a press elsewhere is solved the same whatever was pressed before
+    columns.forget()
+    again = columns.dent(xy, 0.8, tip_radius_m=0.01)
+    fresh = _two_blocks().dent(xy, 0.8, tip_radius_m=0.01)
+    assert np.array_equal(again.displacement, fresh.displacement)
+
+
+def test_a_press_needing_more_unit_responses_than_allowed_is_solved_load_by_load() -> None:
+    capped, direct = _two_blocks(), _two_blocks()
+    capped.max_unit_columns, direct.max_unit_columns = 3, 0
+    xy = np.array([0.04, 0.06])
+    a = direct.dent(xy, 1.0, tip_radius_m=0.01)
+    b = capped.dent(xy, 1.0, tip_radius_m=0.01)
+    assert not capped._columns  # nothing solved as columns
+    assert np.array_equal(a.displacement, b.displacement) and a.depth_m == b.depth_m

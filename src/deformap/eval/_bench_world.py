@@ -34,6 +34,9 @@ def bench_world(*, scenario: str = "heterogeneous-60-110-rigid", rng: np.random.
     -------
     dict with ``construction_s``, ``press_s``, ``observe_s`` (medians, seconds), ``n_dofs``,
     ``n_points`` and ``n_points_on_area`` of one observation, ``scenario``, ``element_size_m``,
+    ``press_load_by_load_s`` (the same presses with the linear FEM solving each load as it comes
+    instead of the unit responses under the tip: the baseline of ``press_s``; None for a physics
+    without them),
     ``poke_compute_s`` (median compute of one poke with its force–travel record: goal ≤ 1 s) and
     ``poke_compute_camera_only_s`` (the same presses without records, the baseline).
     """
@@ -57,12 +60,14 @@ def bench_world(*, scenario: str = "heterogeneous-60-110-rigid", rng: np.random.
         presses.append(world.press((x0 + f * (x1 - x0), y0 + 0.5 * (y1 - y0)), force_n))
         press_times.append(time.perf_counter() - t0)
         world.release()
+    load_by_load = _press_load_by_load(world, sc, n_presses, force_n)
     with_record, camera_only = _poke_compute(sc.workspace, cloud, presses, rng)
     return {
         "scenario": sc.name,
         "element_size_m": cfg.element_size_m,
         "construction_s": construction,
         "press_s": float(np.median(press_times)),
+        "press_load_by_load_s": load_by_load,
         "observe_s": float(np.median(observe_times)),
         "n_dofs": world.n_dofs,
         "n_points": len(cloud),
@@ -70,6 +75,26 @@ def bench_world(*, scenario: str = "heterogeneous-60-110-rigid", rng: np.random.
         "poke_compute_s": with_record,
         "poke_compute_camera_only_s": camera_only,
     }
+
+
+def _press_load_by_load(world: Any, scenario: Any, n_presses: int, force_n: float
+                        ) -> float | None:
+    """Median press of the same presses with the FEM's unit responses off (the baseline)."""
+    foam = world.foam
+    if not hasattr(foam, "max_unit_columns"):
+        return None
+    (x0, y0), (x1, y1) = scenario.workspace.lower, scenario.workspace.upper
+    kept, foam.max_unit_columns = foam.max_unit_columns, 0
+    times = []
+    try:
+        for f in np.linspace(0.2, 0.8, n_presses):
+            t0 = time.perf_counter()
+            world.press((x0 + f * (x1 - x0), y0 + 0.5 * (y1 - y0)), force_n)
+            times.append(time.perf_counter() - t0)
+            world.release()
+    finally:
+        foam.max_unit_columns = kept
+    return float(np.median(times))
 
 
 def _poke_compute(workspace: Any, cloud: Any, presses: list[Any], rng: np.random.Generator

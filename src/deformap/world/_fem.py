@@ -9,7 +9,8 @@ the footprint, so slanted edges are resolved to the element size. Elements are t
 Structured assembly: every hex of one layer has the same shape, so its stiffness is one 24×24
 matrix computed by scikit-fem for a unit modulus, scaled by each element's modulus and scattered
 with numpy. This gives the same matrix as scikit-fem's generic ``asm`` (a test checks it) at a
-fraction of the cost. The stiffness is factorised once (SuperLU); each press is then one solve.
+fraction of the cost. The stiffness is factorised once (SuperLU); a press then solves the unit
+responses of the few top nodes under the tip in one call (:class:`~deformap.world._foam.FoamModel`).
 A block of one modulus ``E`` has the stiffness ``E K₁`` of the unit-modulus block, so its solve is
 ``K₁⁻¹ f / E``: the factorisation of ``K₁`` is kept (the most recent few, by the mesh's geometry,
 ``ν`` and symmetry) and shared by every homogeneous block of that mesh — a study that presses one

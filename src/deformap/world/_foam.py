@@ -29,6 +29,14 @@ make ``δ`` continuous there: a press by a seam can still solve shallower at a l
 0.3–0.9 mm on the default mesh), and past the encoder's tolerance
 :meth:`deformap.world.SimulatedWorld.force_travel` gives no record.
 
+Solves: the linear FEM's press loads only the vertical unknowns of the top nodes under the tip, so
+at a press's first solve it solves their unit responses ``K⁻¹ e_z`` for every top node of a cell
+the tip's disc reaches (some 15–25 on the default mesh) in one call with several right-hand sides,
+and every patch iteration and load level of that press is a sum of them (equal to a solve per load
+to rounding: ``tests/world/test_fem.py``); :meth:`FoamModel.forget` drops them at the next press.
+On the default world this took a press with its force–travel record from about 0.75 s to 0.2 s of
+solves (:data:`MAX_UNIT_COLUMNS`).
+
 Loading: the indentation of a rigid sphere pressed into a linear elastic body grows with the
 force, and so does its contact disc. ``δ(a; F)`` grows with ``F`` at every ``a``, so the largest
 fixed point at a smaller force lies within it at a larger one: a press solved at several loads
@@ -51,6 +59,14 @@ from deformap.world._scenario import Block, Scenario
 __all__ = ["Dent", "FoamMesh", "FoamModel", "block_grid"]
 
 log = logging.getLogger(__name__)
+
+# A press loads only the top nodes under the tip, and only vertically: the linear FEM solves their
+# unit responses ``K⁻¹ e_z`` in one call with several right-hand sides (SuperLU passes its factors
+# once for all of them: about 7 ms a column at 20 columns against 25 ms for a single solve, on the
+# default mesh's 22 k unknowns, one thread), and each patch iteration and load level of the press
+# is then a product with them. Where more nodes than this lie under the tip (a fine mesh) the
+# columns would cost more than the solves they replace, and each load is solved as it comes.
+MAX_UNIT_COLUMNS = 48
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -161,6 +177,12 @@ class FoamModel(FoamMesh):
             index: FoamBody(self.grids[index], scenario.blocks[index].modulus_pa,
                             poisson_ratio=poisson_ratio)
             for index in self.foam_blocks}
+        #: the most unit responses a press solves per body (:data:`MAX_UNIT_COLUMNS`; 0: none,
+        #: every load solved as it comes)
+        self.max_unit_columns = MAX_UNIT_COLUMNS
+        # the press's unit responses per body: (K⁻¹ columns, column of each free unknown or -1)
+        self._columns: dict[int, tuple[NDArray[np.float64], NDArray[np.int64]]] = {}
+        self._reach: tuple[NDArray[np.float64], float] | None = None  # the tip's disc
 
     @property
     def n_dofs(self) -> int:
@@ -168,8 +190,10 @@ class FoamModel(FoamMesh):
         return sum(b.n_dofs for b in self.bodies.values())
 
     def forget(self) -> None:
-        """Drop whatever earlier presses left to warm-start the next (the linear FEM keeps
-        nothing: its factorisation is the body's, not a press's)."""
+        """Drop whatever earlier presses left to warm-start the next (the linear FEM: the unit
+        responses under the last tip; its factorisation is the body's, not a press's)."""
+        self._columns.clear()
+        self._reach = None
 
     def dent(self, target_xy: NDArray[np.float64], force_n: float, *, tip_radius_m: float,
              max_iterations: int = 40, tolerance: float = 0.02,
@@ -195,6 +219,7 @@ class FoamModel(FoamMesh):
             modulus = self.scenario.blocks[index].modulus_pa
             a = min(hertz_contact_radius(force_n, tip_radius_m, modulus, self.poisson_ratio),
                     top)
+        self._reach = (target[0].copy(), float(top))
         low, high = 0.0, top  # the fixed point lies in [low, high]
         for iteration in range(1, max_iterations + 1):
             u, points, forces = self._solve_patch(target[0], a, force_n)
@@ -249,5 +274,55 @@ class FoamModel(FoamMesh):
     def _respond(self, index: int, load: NDArray[np.float64], center: NDArray[np.float64]
                  ) -> NDArray[np.float64]:
         """``(n_nodes, 3)`` displacement of block ``index`` under ``(n_nodes, 3)`` nodal forces
-        centred at ``center`` (linear: one solve; a nonlinear material overrides it)."""
-        return self.bodies[index].solve(load)
+        centred at ``center`` (linear: a sum of the loaded unknowns' unit responses, or one
+        solve; a nonlinear material overrides it)."""
+        body = self.bodies[index]
+        f = load.ravel()[body.free]
+        loaded = np.flatnonzero(f)
+        columns = self._unit_columns(index, loaded)
+        if columns is None:
+            return body.solve(load)
+        z, where = columns
+        u = np.zeros(3 * body.grid.n_nodes)
+        u[body.free] = z[:, where[loaded]] @ f[loaded]
+        return u.reshape(-1, 3)
+
+    def _unit_columns(self, index: int, loaded: NDArray[np.int64]
+                      ) -> tuple[NDArray[np.float64], NDArray[np.int64]] | None:
+        """Body ``index``'s unit responses to its free unknowns ``loaded`` (and, at a press's
+        first solve, to the vertical unknowns of every top node of a cell the tip's disc
+        reaches), solved in one call for those not yet solved; None past
+        :attr:`max_unit_columns`."""
+        body = self.bodies[index]
+        z, where = self._columns.get(index, (np.zeros((body.n_dofs, 0)),
+                                             np.full(body.n_dofs, -1, dtype=np.int64)))
+        wanted = loaded if z.shape[1] else np.union1d(loaded, self._under_tip(index))
+        missing = wanted[where[wanted] < 0]
+        if z.shape[1] + missing.size > self.max_unit_columns:
+            return None
+        if missing.size:
+            unit = np.zeros((body.n_dofs, missing.size))
+            unit[missing, np.arange(missing.size)] = 1.0
+            where[missing] = z.shape[1] + np.arange(missing.size)
+            z = np.hstack([z, body.solve_free(unit)])
+            self._columns[index] = (z, where)
+        return z, where
+
+    def _under_tip(self, index: int) -> NDArray[np.int64]:
+        """The free vertical unknowns (positions in the body's ``free``) of the top nodes of
+        block ``index``'s active cells that the tip's disc of the press reaches."""
+        if self._reach is None:
+            return np.zeros(0, dtype=np.int64)
+        (cx, cy), radius = self._reach
+        grid, body = self.grids[index], self.bodies[index]
+        x0 = grid.origin[0] + np.arange(grid.nx) * grid.dx
+        y0 = grid.origin[1] + np.arange(grid.ny) * grid.dy
+        gap_x = np.maximum.reduce([x0 - cx, np.zeros_like(x0), cx - (x0 + grid.dx)])
+        gap_y = np.maximum.reduce([y0 - cy, np.zeros_like(y0), cy - (y0 + grid.dy)])
+        near = (gap_y[:, None] ** 2 + gap_x[None, :] ** 2 < radius**2) & grid.active
+        jj, ii = np.nonzero(near)
+        nodes = np.concatenate([grid.node_id(ii + c0, jj + c1, grid.nz)
+                                for c0 in (0, 1) for c1 in (0, 1)])
+        dofs = np.unique(3 * nodes + 2)
+        at = np.clip(np.searchsorted(body.free, dofs), 0, body.free.size - 1)
+        return at[body.free[at] == dofs]

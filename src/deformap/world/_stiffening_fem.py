@@ -250,14 +250,15 @@ class StiffeningFem(FoamModel):
         body = self.bodies[index]
         f = load.ravel()[body.free]
         force = float(-f.sum())
-        u = np.zeros(3 * body.grid.n_nodes)
-        if self.stiffening_exponent == 0.0 or force <= 0.0:  # the linear FEM's one solve
-            u[body.free] = body.solve_free(f)
+        if self.stiffening_exponent == 0.0 or force <= 0.0:  # the linear FEM's response
+            linear = super()._respond(index, load, center)
             self.last = NewtonSolve(residual_n=0.0, rounds=1, newton_steps=0, near_elements=0,
                                     max_strain=float((self.operators[index].matrix.T
-                                                      @ u[body.free]).max()), converged=True)
-        else:
-            u[body.free] = self._solve(index, f, force, center)
+                                                      @ linear.ravel()[body.free]).max()),
+                                    converged=True)
+            return linear
+        u = np.zeros(3 * body.grid.n_nodes)
+        u[body.free] = self._solve(index, f, force, center)
         return u.reshape(-1, 3)
 
     def _with_columns(self, index: int, near: _NearSet, extra: NDArray[np.int64]) -> _NearSet:
@@ -273,6 +274,7 @@ class StiffeningFem(FoamModel):
     def forget(self) -> None:
         """Drop the near sets and warm starts earlier presses left: a press is then solved
         the same whatever was pressed before (the world calls it at each press)."""
+        super().forget()
         self._near.clear()
 
     def _solve(self, index: int, f: NDArray[np.float64], force: float,
