@@ -133,3 +133,39 @@ def test_a_press_whose_levels_do_not_make_a_record_gives_none_and_says_so(
     assert "no force–travel record" in caplog.text and "backwards" in caplog.text
     monkeypatch.undo()
     assert _press(exact, HARD).travel_m.size == exact.config.force_travel_levels + 1
+
+
+def test_levels_spaced_evenly_in_travel_for_a_hertz_contact() -> None:
+    from deformap.world._force_travel import force_levels
+
+    levels = force_levels(0.02, 0.8, 8, "travel")
+    assert levels[0] == 0.02 and levels[-1] == 0.8
+    assert np.all(np.diff(levels) > 0)
+    # Hertz: δ ∝ F^(2/3), so the travel grows evenly when F^(2/3) does
+    np.testing.assert_allclose(np.diff(levels ** (2.0 / 3.0)),
+                               (0.8 ** (2.0 / 3.0) - 0.02 ** (2.0 / 3.0)) / 8, rtol=1e-12)
+    np.testing.assert_array_equal(force_levels(0.02, 0.8, 8), np.linspace(0.02, 0.8, 9))
+    with pytest.raises(ValueError, match="`spacing` must be 'force' or 'travel'; got 'time'"):
+        force_levels(0.02, 0.8, 8, "time")
+
+
+def test_a_record_spaced_in_travel_samples_the_start_of_the_press_more_densely() -> None:
+    """The same press, recorded at forces even in travel: the first sample past contact comes at
+    a smaller force and travel, and the ends are the same."""
+    worlds = {s: SimulatedWorld(load_scenario(SCENARIO),
+                                config=WorldConfig.coarse(noise=False, force_travel_spacing=s),
+                                rng=np.random.default_rng(7)) for s in ("force", "travel")}
+    force, travel = (_press(worlds[s], SOFT) for s in ("force", "travel"))
+    assert travel.force_n[-1] == pytest.approx(force.force_n[-1], rel=1e-12)
+    # the contact sample's depth is solved from another level above it (to the patch's tolerance)
+    assert travel.travel_m[-1] == pytest.approx(force.travel_m[-1], rel=1e-3)
+    assert travel.force_n[1] < force.force_n[1] and travel.travel_m[1] < force.travel_m[1]
+    assert np.all(np.diff(travel.travel_m) > 0) and np.all(np.diff(travel.force_n) > 0)
+
+
+def test_the_record_spacing_is_a_checked_setting() -> None:
+    from deformap.errors import InvalidArgumentError
+
+    with pytest.raises(InvalidArgumentError,
+                       match="`force_travel_spacing` must be one of \\['force', 'travel'\\]"):
+        WorldConfig(force_travel_spacing="time")  # type: ignore[arg-type]

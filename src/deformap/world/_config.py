@@ -22,6 +22,11 @@ __all__ = ["MAX_FEM_UNKNOWNS", "PHYSICS", "Physics", "WorldConfig", "check_world
 #: compressed, solved by Newton's method (:mod:`deformap.world._stiffening_fem`).
 Physics = Literal["linear-fem", "stiffening-foam", "stiffening-fem"]
 PHYSICS: tuple[str, ...] = get_args(Physics)
+#: How the samples of a press's force–travel record are spaced (``WorldConfig``'s
+#: ``force_travel_spacing``): evenly in force, as a press whose force ramps at a constant rate
+#: records; or evenly in travel, as an arm that advances at a constant speed and samples at a fixed
+#: rate records (exactly even for a Hertz contact, :func:`deformap.world._force_travel.force_levels`).
+RecordSpacing = Literal["force", "travel"]
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -58,8 +63,12 @@ class WorldConfig:
         Standard deviation per axis of the force sensor's noise (Optoforce-class resolution).
     force_travel_levels : int
         Load levels of the press's force–travel record above contact: it has this many plus one
-        samples, evenly spaced in force from ``contact_threshold_n`` to the commanded force, each
-        solved by the world's physics (see :mod:`deformap.world._force_travel`).
+        samples from ``contact_threshold_n`` to the commanded force, each solved by the world's
+        physics (see :mod:`deformap.world._force_travel`).
+    force_travel_spacing : {"force", "travel"}
+        How those samples are spaced (:data:`RecordSpacing`): evenly in force (default), or
+        evenly in travel (more samples at small forces, where a soft foam's record stays within
+        the sphere's range).
     contact_threshold_n : float
         The force at which the probe detects contact: the record's first sample, where its
         travel starts. Presses at less than :data:`MIN_RECORD_FORCE_N` give no record.
@@ -95,6 +104,7 @@ class WorldConfig:
     force_noise_n: float = setting(0.01, ge=0.0, le=0.02)
     # 8 levels resolve the curvature of a sphere's F ∝ δ^(3/2); each level costs one press solve
     force_travel_levels: int = setting(8, ge=2, le=1000)
+    force_travel_spacing: RecordSpacing = "force"
     contact_threshold_n: float = setting(0.02, gt=0.0, le=0.1)
     encoder_noise_m: float = setting(5e-5, ge=0.0, le=1e-3)  # arm encoders: about 0.05 mm
     force_travel_noise_rel: float = setting(0.01, ge=0.0, le=0.1)  # force sensors: 1 % + 5 mN

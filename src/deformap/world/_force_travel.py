@@ -5,8 +5,9 @@ direction (joint encoders through forward kinematics) and the normal force (the 
 ``docs/robot.md`` says how. The simulated world gives the same record from its physics
 (``WorldConfig.physics``; said here for the FEM, the foundation's press is alike):
 
-- Load levels: ``n_levels + 1`` forces evenly spaced from the contact threshold ``F_c`` (the force
-  at which a robot detects contact, its first sample) to the commanded force ``F``.
+- Load levels: ``n_levels + 1`` forces from the contact threshold ``F_c`` (the force at which a
+  robot detects contact, its first sample) to the commanded force ``F``, evenly spaced in force
+  (a force ramp) or in travel (an arm at constant speed: :func:`force_levels`).
 - Travel: the foam's contact patch grows with the force (a sphere on an elastic layer), so each
   level is its own press solve (:meth:`~deformap.world._foam.FoamModel.dent`), on the stiffness
   factorised when the world was built, each started from the patch of the level above it (so
@@ -33,9 +34,22 @@ from deformap.environment import ForceTravel
 __all__ = ["force_levels", "simulated_force_travel"]
 
 
-def force_levels(contact_n: float, force_n: float, n_levels: int) -> NDArray[np.float64]:
-    """``(n_levels + 1,)`` forces evenly spaced from ``contact_n`` to ``force_n`` (both kept)."""
-    return np.linspace(contact_n, force_n, n_levels + 1)
+def force_levels(contact_n: float, force_n: float, n_levels: int, spacing: str = "force"
+                 ) -> NDArray[np.float64]:
+    """``(n_levels + 1,)`` forces from ``contact_n`` to ``force_n`` (both kept).
+
+    ``spacing`` ``"force"``: evenly spaced. ``"travel"``: evenly spaced in travel for a Hertz
+    contact (``δ ∝ F^{2/3}``: ``F_k^{2/3}`` evenly spaced from ``F_c^{2/3}`` to ``F^{2/3}``), as an
+    arm advancing at constant speed samples a press; on the world's layers, whose indentation
+    departs from Hertz's, the steps in travel are uneven by as much as that departure.
+    """
+    if spacing == "force":
+        return np.linspace(contact_n, force_n, n_levels + 1)
+    if spacing != "travel":
+        raise ValueError(f"`spacing` must be 'force' or 'travel'; got {spacing!r}")
+    levels = np.linspace(contact_n ** (2.0 / 3.0), force_n ** (2.0 / 3.0), n_levels + 1) ** 1.5
+    levels[[0, -1]] = contact_n, force_n  # the ends exactly
+    return levels
 
 
 def simulated_force_travel(

@@ -239,7 +239,8 @@ class SimulatedWorld:
             return None
         c = self.config
         final = dent if dent is not None else self.dent(target, force)
-        levels = force_levels(c.contact_threshold_n, force, c.force_travel_levels)
+        levels = force_levels(c.contact_threshold_n, force, c.force_travel_levels,
+                              c.force_travel_spacing)
 
         depths = self._level_depths(target, levels, final)
         noisy = c.noise
