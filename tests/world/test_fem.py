@@ -204,11 +204,58 @@ def test_a_press_from_unit_responses_is_the_press_solved_load_by_load(
     loaded_bodies = len(columns._columns)
     assert 1 <= loaded_bodies <= 2 and len(calls) == loaded_bodies  # one call a body
     assert all(1 < n <= columns.max_unit_columns for n in calls)
-    # a press elsewhere is solved the same whatever was pressed before
-    columns.forget()
-    again = columns.dent(xy, 0.8, tip_radius_m=0.01)
-    fresh = _two_blocks().dent(xy, 0.8, tip_radius_m=0.01)
+    # a press elsewhere starts afresh, forget() or not: bit for bit a fresh model's press there
+    elsewhere = xy + np.array([0.013, 0.021])
+    again = columns.dent(elsewhere, 0.8, tip_radius_m=0.01)
+    fresh = _two_blocks().dent(elsewhere, 0.8, tip_radius_m=0.01)
     assert np.array_equal(again.displacement, fresh.displacement)
+    columns.forget()
+    assert not columns._columns and columns._reach is None
+
+
+def _top_load(model: FoamModel, index: int, xy: tuple[float, float], force: float) -> np.ndarray:
+    """A vertical point load on the top node of block ``index`` nearest ``xy``."""
+    grid, body = model.grids[index], model.bodies[index]
+    nodes = grid.node_xyz()
+    top = np.flatnonzero(np.isclose(nodes[:, 2], grid.levels[-1]))
+    node = top[np.argmin(np.hypot(*(nodes[top, :2] - np.asarray(xy)).T))]
+    load = np.zeros((grid.n_nodes, 3))
+    load[node, 2] = -force
+    assert 3 * node + 2 in body.free
+    return load
+
+
+def test_a_load_beyond_the_solved_unit_responses_solves_the_missing_ones_or_falls_back() -> None:
+    """Within a press, a load on a node outside the tip's disc adds its unit response (one more
+    call of one column); past the cap the load is solved as it comes; both to rounding."""
+    model = _two_blocks()
+    xy = np.array([0.04, 0.06])
+    model.dent(xy, 0.4, tip_radius_m=0.01)
+    z, _ = model._columns[0]
+    far = _top_load(model, 0, (0.015, 0.02), 0.3)  # 5 cm from the tip
+    body = model.bodies[0]
+    expected = body.solve(far)
+    got = model._respond(0, far, xy)
+    np.testing.assert_allclose(got, expected, rtol=0, atol=1e-12 * np.abs(expected).max())
+    assert model._columns[0][0].shape[1] == z.shape[1] + 1
+    other = _top_load(model, 0, (0.07, 0.11), 0.2)
+    model.max_unit_columns = model._columns[0][0].shape[1]  # no room for one more
+    got = model._respond(0, other, xy)
+    np.testing.assert_array_equal(got, body.solve(other))  # the load solved as it came
+    assert model._columns[0][0].shape[1] == model.max_unit_columns
+
+
+def test_long_columns_past_the_byte_bound_are_not_kept(monkeypatch) -> None:
+    from deformap.world import _foam
+
+    model = _two_blocks()
+    monkeypatch.setattr(_foam, "MAX_UNIT_BYTES", 8 * model.bodies[0].n_dofs * 3)
+    xy = np.array([0.04, 0.06])
+    direct = _two_blocks()
+    direct.max_unit_columns = 0
+    a, b = direct.dent(xy, 0.4, tip_radius_m=0.01), model.dent(xy, 0.4, tip_radius_m=0.01)
+    assert not model._columns
+    assert np.array_equal(a.displacement, b.displacement)
 
 
 def test_a_press_needing_more_unit_responses_than_allowed_is_solved_load_by_load() -> None:

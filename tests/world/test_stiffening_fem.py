@@ -108,6 +108,14 @@ def test_newton_converges_to_equilibrium_whatever_the_near_set(near) -> None:
     assert u == pytest.approx(reference, rel=1e-7, abs=1e-12)
 
 
+def test_forgetting_drops_the_linear_unit_responses_too() -> None:
+    foam = _foam(0.0)
+    foam.dent(CENTER, 0.6, tip_radius_m=R)
+    assert foam._columns  # the exponent-0 press solved by the linear FEM's unit responses
+    foam.forget()
+    assert not foam._columns and not foam._near
+
+
 def test_without_stiffening_it_is_the_linear_fem() -> None:
     linear = FoamModel(_scenario(), **MESH)
     for force in (0.3, 0.6, 2.0):

@@ -80,7 +80,8 @@ def bench_world_command(
                                         config=config)  # fmt: skip
     goals = {"construction_s": 20.0, "press_s": 1.0, "observe_s": 0.5, "poke_compute_s": 1.0,
              "poke_compute_camera_only_s": 1.0}
-    rows = [(key, f"{value:.4g}" if isinstance(value, float) else str(value),
+    rows = [(key, f"{value:.4g}" if isinstance(value, float)
+             else "n/a (not the linear FEM)" if value is None else str(value),
              f"≤ {goals[key]:g} s" if key in goals
              else "baseline of press_s" if key == "press_load_by_load_s" else "")
             for key, value in result.items() if key != "scenario"]  # fmt: skip

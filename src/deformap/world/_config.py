@@ -14,7 +14,8 @@ from deformap.world._probe import ProbeGeometry
 from deformap.world._scenario import Scenario
 from deformap.world._stiffening import max_grid_nodes
 
-__all__ = ["MAX_FEM_UNKNOWNS", "PHYSICS", "Physics", "WorldConfig", "check_world_budget"]
+__all__ = ["MAX_FEM_UNKNOWNS", "PHYSICS", "Physics", "RecordSpacing", "WorldConfig",
+           "check_world_budget"]
 
 #: The world's contact physics: 3-D linear elasticity by FEM (:mod:`deformap.world._foam`), a
 #: stiffening two-parameter foundation solved by Newton's method

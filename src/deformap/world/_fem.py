@@ -287,7 +287,10 @@ class FoamBody:
     def solve_free(self, rhs: NDArray[np.float64]) -> NDArray[np.float64]:
         """``K⁻¹ rhs`` on the free unknowns: ``rhs`` is ``(n_dofs,)`` or ``(n_dofs, k)`` (``k``
         right-hand sides in one call) in the order of :attr:`free`."""
-        return np.asarray(self._lu.solve(np.ascontiguousarray(rhs, dtype=float))) * self._scale
+        # SuperLU takes its right-hand sides in Fortran order (a C-order block would be copied)
+        out = np.asarray(self._lu.solve(np.asfortranarray(rhs, dtype=float)))
+        out *= self._scale
+        return out
 
     def solve(self, nodal_force: NDArray[np.float64]) -> NDArray[np.float64]:
         """``(n_nodes, 3)`` displacements in metres for ``(n_nodes, 3)`` nodal forces in newtons."""

@@ -65,8 +65,10 @@ log = logging.getLogger(__name__)
 # once for all of them: about 7 ms a column at 20 columns against 25 ms for a single solve, on the
 # default mesh's 22 k unknowns, one thread), and each patch iteration and load level of the press
 # is then a product with them. Where more nodes than this lie under the tip (a fine mesh) the
-# columns would cost more than the solves they replace, and each load is solved as it comes.
+# columns would cost more than the solves they replace, and each load is solved as it comes; so
+# too past MAX_UNIT_BYTES of columns a body (a fine mesh's long columns).
 MAX_UNIT_COLUMNS = 48
+MAX_UNIT_BYTES = 64 * 2**20
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -206,6 +208,8 @@ class FoamModel(FoamMesh):
         default the tip's radius.
         """
         target = np.asarray(target_xy, dtype=float).reshape(1, 2)
+        if self._reach is None or not np.array_equal(self._reach[0], target[0]):
+            self._columns.clear()  # another target's unit responses: a press starts afresh
         labels = self.scenario.labels(target[:, 0], target[:, 1])
         index = int(labels[0, 0])
         if index not in self.bodies:
@@ -283,8 +287,10 @@ class FoamModel(FoamMesh):
         if columns is None:
             return body.solve(load)
         z, where = columns
+        coefficients = np.zeros(z.shape[1])
+        coefficients[where[loaded]] = f[loaded]
         u = np.zeros(3 * body.grid.n_nodes)
-        u[body.free] = z[:, where[loaded]] @ f[loaded]
+        u[body.free] = z @ coefficients
         return u.reshape(-1, 3)
 
     def _unit_columns(self, index: int, loaded: NDArray[np.int64]
@@ -292,16 +298,17 @@ class FoamModel(FoamMesh):
         """Body ``index``'s unit responses to its free unknowns ``loaded`` (and, at a press's
         first solve, to the vertical unknowns of every top node of a cell the tip's disc
         reaches), solved in one call for those not yet solved; None past
-        :attr:`max_unit_columns`."""
+        :attr:`max_unit_columns` or :data:`MAX_UNIT_BYTES`."""
         body = self.bodies[index]
         z, where = self._columns.get(index, (np.zeros((body.n_dofs, 0)),
                                              np.full(body.n_dofs, -1, dtype=np.int64)))
         wanted = loaded if z.shape[1] else np.union1d(loaded, self._under_tip(index))
         missing = wanted[where[wanted] < 0]
-        if z.shape[1] + missing.size > self.max_unit_columns:
+        n_columns = z.shape[1] + missing.size
+        if n_columns > self.max_unit_columns or 8 * n_columns * body.n_dofs > MAX_UNIT_BYTES:
             return None
         if missing.size:
-            unit = np.zeros((body.n_dofs, missing.size))
+            unit = np.zeros((body.n_dofs, missing.size), order="F")
             unit[missing, np.arange(missing.size)] = 1.0
             where[missing] = z.shape[1] + np.arange(missing.size)
             z = np.hstack([z, body.solve_free(unit)])

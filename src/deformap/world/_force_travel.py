@@ -30,12 +30,13 @@ import numpy as np
 from numpy.typing import NDArray
 
 from deformap.environment import ForceTravel
+from deformap.world._config import RecordSpacing
 
 __all__ = ["force_levels", "simulated_force_travel"]
 
 
-def force_levels(contact_n: float, force_n: float, n_levels: int, spacing: str = "force"
-                 ) -> NDArray[np.float64]:
+def force_levels(contact_n: float, force_n: float, n_levels: int,
+                 spacing: RecordSpacing = "force") -> NDArray[np.float64]:
     """``(n_levels + 1,)`` forces from ``contact_n`` to ``force_n`` (both kept).
 
     ``spacing`` ``"force"``: evenly spaced. ``"travel"``: evenly spaced in travel for a Hertz
