@@ -169,3 +169,40 @@ def test_rescore_scores_other_cuts_on_the_stored_pokes_and_names_what_it_cannot(
     assert result.exit_code == 2 and "world-00001.json" in result.output, result.output
     assert "fell back from the modulus field to β" in result.output
     assert not (tmp_path / "sixth").exists()
+
+
+def _alive(pid: int) -> bool:
+    """Whether ``pid`` runs (a zombie, dead but not yet reaped by its new parent, does not)."""
+    try:
+        with open(f"/proc/{pid}/stat") as stat:
+            return stat.read().rsplit(")", 1)[1].split()[0] != "Z"
+    except FileNotFoundError:
+        return False
+
+
+@pytest.mark.skipif(not __import__("os").path.isdir("/proc"), reason="reads /proc")
+def test_pool_workers_end_when_the_run_is_killed() -> None:
+    """A run killed without time to stop its pool (SIGKILL; SIGTERM's default) leaves no worker
+    computing a world for nobody: each ends within a few of its parent checks."""
+    import subprocess
+    import sys
+    import time
+
+    from deformap.run._worlds import PARENT_CHECK_S
+
+    script = (
+        "import os, signal, sys, time\n"
+        "from deformap.run._worlds import worker_pool\n"
+        "pool = worker_pool(1)\n"
+        "print(pool.submit(os.getpid).result(), flush=True)\n"
+        "pool.submit(time.sleep, 600)\n"
+        "time.sleep(0.5)\n"
+        "os.kill(os.getpid(), signal.SIGKILL)\n")
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                          timeout=120)
+    assert done.returncode == -9, done.stderr
+    worker = int(done.stdout.split()[0])
+    deadline = time.monotonic() + 20 * PARENT_CHECK_S
+    while _alive(worker) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert not _alive(worker)

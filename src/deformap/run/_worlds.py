@@ -25,6 +25,7 @@ import json
 import logging
 import multiprocessing
 import os
+import threading
 import time
 from collections.abc import Iterator, Sequence
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
@@ -169,10 +170,34 @@ def run_world_pinned(task: dict[str, Any]) -> dict[str, Any]:
         return run_world(task)
 
 
-def _pin_worker() -> None:
+#: How often a pool worker checks that the process that started it is still there [s].
+PARENT_CHECK_S = 1.0
+
+
+def _pin_worker(parent: int) -> None:
+    """A pool worker's start: BLAS pinned to one thread, and a watch that ends the worker when
+    the process that started it is gone (killed by a signal that left it no time to stop its
+    pool: the worker would compute its world to the end for nobody)."""
     from threadpoolctl import threadpool_limits
 
     threadpool_limits(limits=1)
+    threading.Thread(target=_exit_with_parent, args=(parent,), daemon=True,
+                     name="deformap-parent-watch").start()
+
+
+def _exit_with_parent(parent: int) -> None:
+    while os.getppid() == parent:
+        time.sleep(PARENT_CHECK_S)
+    os._exit(1)
+
+
+def worker_pool(workers: int) -> ProcessPoolExecutor:
+    """The local pool of ``bench worlds``: spawn-started processes with BLAS pinned to one thread
+    that end with the process that started them. They start at the first ``submit``: submit
+    within :func:`_one_thread_environment` (their numpy reads the thread variables as it
+    loads)."""
+    return ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn"),
+                               initializer=_pin_worker, initargs=(os.getpid(),))
 
 
 @contextlib.contextmanager
@@ -205,10 +230,8 @@ def _failed(task: dict[str, Any], exc: BaseException) -> dict[str, Any]:
 
 def _local_results(tasks: Sequence[dict[str, Any]], workers: int) -> Iterator[dict[str, Any]]:
     """Results as they finish on a spawn-started process pool; each task retried once."""
-    context = multiprocessing.get_context("spawn")
     with _one_thread_environment():
-        pool = ProcessPoolExecutor(max_workers=workers, mp_context=context,
-                                   initializer=_pin_worker)
+        pool = worker_pool(workers)
         try:
             pending: dict[Future[dict[str, Any]], tuple[dict[str, Any], int]] = {
                 pool.submit(run_world_pinned, t): (t, 0) for t in tasks}
