@@ -170,34 +170,33 @@ def run_world_pinned(task: dict[str, Any]) -> dict[str, Any]:
         return run_world(task)
 
 
-#: How often a pool worker checks that the process that started it is still there [s].
-PARENT_CHECK_S = 1.0
-
-
-def _pin_worker(parent: int) -> None:
+def _pin_worker() -> None:
     """A pool worker's start: BLAS pinned to one thread, and a watch that ends the worker when
     the process that started it is gone (killed by a signal that left it no time to stop its
     pool: the worker would compute its world to the end for nobody)."""
     from threadpoolctl import threadpool_limits
 
     threadpool_limits(limits=1)
-    threading.Thread(target=_exit_with_parent, args=(parent,), daemon=True,
-                     name="deformap-parent-watch").start()
+    parent = multiprocessing.parent_process()
+    if parent is not None:
+        threading.Thread(target=_exit_with_parent, args=(parent,), daemon=True,
+                         name="deformap-parent-watch").start()
 
 
-def _exit_with_parent(parent: int) -> None:
-    while os.getppid() == parent:
-        time.sleep(PARENT_CHECK_S)
+def _exit_with_parent(parent: Any) -> None:
+    """Wait on the parent's sentinel (its end of the start pipe on POSIX, its process handle
+    on Windows: ready the moment it is gone) and end this worker then."""
+    parent.join()
     os._exit(1)
 
 
 def worker_pool(workers: int) -> ProcessPoolExecutor:
     """The local pool of ``bench worlds``: spawn-started processes with BLAS pinned to one thread
-    that end with the process that started them. They start at the first ``submit``: submit
-    within :func:`_one_thread_environment` (their numpy reads the thread variables as it
-    loads)."""
+    that end with the process that started them. A worker starts at a ``submit`` that finds
+    none idle (up to ``workers``): submit within :func:`_one_thread_environment` (their numpy
+    reads the thread variables as it loads)."""
     return ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn"),
-                               initializer=_pin_worker, initargs=(os.getpid(),))
+                               initializer=_pin_worker)
 
 
 @contextlib.contextmanager

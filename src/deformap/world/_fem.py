@@ -287,7 +287,7 @@ class FoamBody:
     def solve_free(self, rhs: NDArray[np.float64]) -> NDArray[np.float64]:
         """``K⁻¹ rhs`` on the free unknowns: ``rhs`` is ``(n_dofs,)`` or ``(n_dofs, k)`` (``k``
         right-hand sides in one call) in the order of :attr:`free`."""
-        # SuperLU takes its right-hand sides in Fortran order (a C-order block would be copied)
+        # SuperLU copies its right-hand sides into Fortran order (a C-order block twice over)
         out = np.asarray(self._lu.solve(np.asfortranarray(rhs, dtype=float)))
         out *= self._scale
         return out

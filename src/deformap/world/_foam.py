@@ -310,8 +310,9 @@ class FoamModel(FoamMesh):
         if missing.size:
             unit = np.zeros((body.n_dofs, missing.size), order="F")
             unit[missing, np.arange(missing.size)] = 1.0
+            solved = body.solve_free(unit)  # before `where` changes: a failed solve leaves it
             where[missing] = z.shape[1] + np.arange(missing.size)
-            z = np.hstack([z, body.solve_free(unit)])
+            z = np.hstack([z, solved])  # the old and new columns both, for a moment
             self._columns[index] = (z, where)
         return z, where
 
