@@ -425,3 +425,20 @@ def test_importing_and_drawing_leave_matplotlib_global_state_alone(tmp_path: Pat
     assert done.stdout.strip() == "ok"
     assert len(list(tmp_path.glob("*.png"))) == len(CALLS)
     assert len(list((tmp_path / "world").glob("*.png"))) == 3
+
+
+def _matrix_study(element_size_m: float) -> dict[str, Any]:
+    rows = [{"protocol": "force/quadratic", "physics": "linear-fem", "camera": "primesense",
+             "thickness_m": 0.05, "modulus_pa": e * 1.05, "modulus_std_pa": 0.1 * e,
+             "true_modulus_pa": e} for e in (1.0e4, 3.0e4)]
+    return {"matrix": {"element_size_m": element_size_m}, "rows": rows, "summary": [],
+            "overall": []}
+
+
+def test_the_hardness_matrix_names_a_world_mesh_other_than_the_default() -> None:
+    fig = plot_hardness_study(_matrix_study(0.00375))
+    assert fig._supxlabel is not None  # type: ignore[attr-defined]
+    assert fig._supxlabel.get_text() == (  # type: ignore[attr-defined]
+        "world mesh: 3.75 mm elements (default 7.5 mm)")
+    assert "\n" in fig._suptitle.get_text()  # type: ignore[attr-defined]  # one panel: two lines
+    assert plot_hardness_study(_matrix_study(0.0075))._supxlabel is None  # type: ignore[attr-defined]

@@ -52,15 +52,8 @@ def bench_world(*, scenario: str = "heterogeneous-60-110-rigid", rng: np.random.
         t0 = time.perf_counter()
         cloud = world.observe()
         observe_times.append(time.perf_counter() - t0)
-    (x0, y0), (x1, y1) = sc.workspace.lower, sc.workspace.upper
-    press_times = []
-    presses = []
-    for f in np.linspace(0.2, 0.8, n_presses):
-        t0 = time.perf_counter()
-        presses.append(world.press((x0 + f * (x1 - x0), y0 + 0.5 * (y1 - y0)), force_n))
-        press_times.append(time.perf_counter() - t0)
-        world.release()
-    load_by_load = _press_load_by_load(world, sc, n_presses, force_n)
+    presses, press_times = _timed_presses(world, n_presses, force_n)
+    load_by_load = _press_load_by_load(world, n_presses, force_n)
     with_record, camera_only = _poke_compute(sc.workspace, cloud, presses, rng)
     return {
         "scenario": sc.name,
@@ -77,25 +70,31 @@ def bench_world(*, scenario: str = "heterogeneous-60-110-rigid", rng: np.random.
     }
 
 
-def _press_load_by_load(world: Any, scenario: Any, n_presses: int, force_n: float
-                        ) -> float | None:
+def _timed_presses(world: Any, n_presses: int, force_n: float
+                   ) -> tuple[list[Any], list[float]]:
+    """The bench's presses (spread along the workspace's middle, each released) and their
+    times."""
+    (x0, y0), (x1, y1) = world.workspace.lower, world.workspace.upper
+    presses, times = [], []
+    for f in np.linspace(0.2, 0.8, n_presses):
+        t0 = time.perf_counter()
+        presses.append(world.press((x0 + f * (x1 - x0), y0 + 0.5 * (y1 - y0)), force_n))
+        times.append(time.perf_counter() - t0)
+        world.release()
+    return presses, times
+
+
+def _press_load_by_load(world: Any, n_presses: int, force_n: float) -> float | None:
     """Median press of the same presses with the FEM's unit responses off (the baseline); None
     where the physics does not solve by them (the stiffening physics)."""
     foam = world.foam
     if world.config.physics != "linear-fem":
         return None
-    (x0, y0), (x1, y1) = scenario.workspace.lower, scenario.workspace.upper
     kept, foam.max_unit_columns = foam.max_unit_columns, 0
-    times = []
     try:
-        for f in np.linspace(0.2, 0.8, n_presses):
-            t0 = time.perf_counter()
-            world.press((x0 + f * (x1 - x0), y0 + 0.5 * (y1 - y0)), force_n)
-            times.append(time.perf_counter() - t0)
-            world.release()
+        return float(np.median(_timed_presses(world, n_presses, force_n)[1]))
     finally:
         foam.max_unit_columns = kept
-    return float(np.median(times))
 
 
 def _poke_compute(workspace: Any, cloud: Any, presses: list[Any], rng: np.random.Generator

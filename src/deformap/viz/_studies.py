@@ -152,9 +152,12 @@ def _plot_hardness_matrix(study: dict[str, Any]) -> Figure:
     gap = " " if len(physics) > 1 else "\n"
     fig.suptitle("Young's modulus read against the world's, per camera × thickness"
                  f"{gap}(✗: E or β not monotone, or rigid not read rigid)", fontsize=10)
-    if study.get("matrix", {}).get("element_size_m") not in (None, 0.0075):
+    from deformap.world import WorldConfig  # the default mesh, named under a finer one
+
+    default_m = WorldConfig().element_size_m
+    if study.get("matrix", {}).get("element_size_m") not in (None, default_m):
         fig.supxlabel(f"world mesh: {study['matrix']['element_size_m'] * 1e3:g} mm elements "
-                      f"(default 7.5 mm)", fontsize=8)
+                      f"(default {default_m * 1e3:g} mm)", fontsize=8)
     return fig
 
 
