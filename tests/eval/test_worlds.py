@@ -269,3 +269,35 @@ def test_rescoring_merges_a_junction_class_within_the_stored_thickness_only() ->
         rescore_world(task, {**result, "rows": fell}, ["nearest", "isopleth"])
     with pytest.raises(InvalidArgumentError, match="merge_seams and split_by_place only"):
         rescore_world(task, {"status": "ok", "rows": [], "pokes": {}}, ["nearest"], max_regions=2)
+
+
+def test_a_run_that_fell_back_to_beta_is_rescored_on_its_stored_beta_pokes(monkeypatch) -> None:
+    from deformap.world import SimulatedWorld
+
+    recorded = SimulatedWorld.force_travel
+    calls = []
+
+    def first_unrecorded(self, *args, **kwargs):  # a robot whose first press logs no record
+        calls.append(1)
+        return None if len(calls) == 1 else recorded(self, *args, **kwargs)
+
+    monkeypatch.setattr(SimulatedWorld, "force_travel", first_unrecorded)
+    task = {"seed": 5, "index": 0, "families": ["l-shape"], "physics": ["linear-fem"],
+            "strategies": ["paper"], "fields": ["modulus"], "cuts": ["nearest"], "max_pokes": 3,
+            "coarse": True}
+    result = json.loads(json.dumps(run_world(task)))
+    # the first poke had no modulus: the map field was β there, the modulus field after it
+    assert [r["map_field"] for r in result["rows"]] == ["beta", "modulus", "modulus"]
+    beta, modulus = result["fallback_pokes"]["paper/modulus"], result["pokes"]["paper/modulus"]
+    assert beta["index"] == [0, 1, 2] and modulus["index"] == [1, 2]
+    again = rescore_world(task, result, ["nearest"])
+    assert again["rows"] == result["rows"]  # to the bit, the β row included
+    # another cut is scored too (not carried): on the β pokes at the first poke
+    other = rescore_world(task, result, ["isopleth"])["rows"]
+    assert [r["cut"] for r in other] == ["isopleth"] * 3
+    assert [r["map_field"] for r in other] == ["beta", "modulus", "modulus"]
+    # the same run with its β pokes lost (a world stored before they were) is carried instead
+    del result["fallback_pokes"]
+    assert rescore_world(task, result, ["nearest"])["rows"] == result["rows"]
+    with pytest.raises(InvalidArgumentError, match="its run fell back"):
+        rescore_world(task, result, ["isopleth"])

@@ -128,7 +128,7 @@ def test_rescore_scores_other_cuts_on_the_stored_pokes_and_names_what_it_cannot(
     assert "world-00001.json is not a rescorable world: no `pokes`" in result.output
     assert "Traceback" not in result.output and not (tmp_path / "third").exists()
     # damaged stored worlds: one line naming the file and what is wrong, before any folder
-    assert stored["pokes_format"] == POKES_FORMAT == 2
+    assert stored["pokes_format"] == POKES_FORMAT == 3
     stored["pokes"] = {"paper/beta": {"x": [0.1], "y": [0.1, 0.2], "value": [1.0],
                                       "noise": [0.1], "index": [0], "thickness": [0.05]}}
     unthick = {"paper/beta": {k: v for k, v in stored["pokes"]["paper/beta"].items()
@@ -136,14 +136,18 @@ def test_rescore_scores_other_cuts_on_the_stored_pokes_and_names_what_it_cannot(
     for damaged, why in (([1, 2], "expected an object"),
                          ({**stored, "world": {"index": "a"}}, "`world.index` must be"),
                          (stored, "columns of different lengths"),
-                         ({**stored, "pokes": {}}, "no stored pokes for 'paper/beta'"),
-                         ({**stored, "pokes_format": 3},
-                          "`pokes_format` must be an integer from 1 to 2 (the formats this "
-                          "deformap reads); got 3 (written by a newer version?)"),
+                         ({**stored, "pokes": {}}, "no stored pokes of 'paper/beta'"),
+                         ({**stored, "pokes_format": 4},
+                          "`pokes_format` must be an integer from 1 to 3 (the formats this "
+                          "deformap reads); got 4 (written by a newer version?)"),
+                         ({**original, "fallback_pokes": []},
+                          "`fallback_pokes` must be an object; got list"),
+                         ({**original, "fallback_pokes": {"paper/beta": {"x": [0.1]}}},
+                          "the fallback pokes of 'paper/beta' must have lists"),
                          ({**stored, "pokes_format": True}, "`pokes_format` must be"),
                          ({**stored, "pokes_format": 2.0}, "`pokes_format` must be an integer"),
                          ({**stored, "pokes": unthick},
-                          "the pokes of 'paper/beta' have no `thickness` (pokes_format 2)")):
+                          "the pokes of 'paper/beta' have no `thickness` (pokes_format 3)")):
         world.write_text(json.dumps(damaged))
         result = runner.invoke(app, ["bench", "rescore", str(tmp_path / "src"), "--out",
                                      str(tmp_path / "third")])
@@ -162,8 +166,10 @@ def test_rescore_scores_other_cuts_on_the_stored_pokes_and_names_what_it_cannot(
     assert result.exit_code == 0, result.output
     assert "pokes_format" not in json.loads(
         (tmp_path / "fifth" / "worlds" / "world-00001.json").read_text())
-    # a run whose map changed field on the way is carried, and so only under its own cuts
+    # a run whose map changed field on the way, stored without its β pokes (before the third
+    # format), is carried, and so only under its own cuts
     fell = {**original, "rows": [{**r, "map_field": "modulus"} for r in original["rows"]]}
+    del fell["fallback_pokes"]
     world.write_text(json.dumps(fell))
     result = runner.invoke(app, ["bench", "rescore", str(tmp_path / "src"), "--out",
                                  str(tmp_path / "sixth"), "--cuts", "isopleth,nearest"])

@@ -101,9 +101,10 @@ FORCES_N = (0.4, 0.6, 0.8)
 P_RIGID = 0.25
 #: Version of the stored pokes (a world's ``pokes`` and ``pokes_format``): 1, the columns ``x``,
 #: ``y``, ``value``, ``noise``, ``index`` (worlds stored before the key was, without
-#: ``thickness``, read as 1); 2, with ``thickness`` too. A reader refuses a version it does not
-#: know rather than guess what a newer one's columns mean.
-POKES_FORMAT = 2
+#: ``thickness``, read as 1); 2, with ``thickness`` too; 3, with ``fallback_pokes`` too (the β
+#: pokes of a modulus run that fell back, so that its rows are rescored, not carried). A reader
+#: refuses a version it does not know rather than guess what a newer one's columns mean.
+POKES_FORMAT = 3
 #: Columns of a row that hold wall times (the only ones two runs of one world may differ in).
 TIME_COLUMNS = ("poke_s", "elapsed_s")
 
@@ -198,9 +199,11 @@ def _scores(mapper: Mapper, truth: tuple[NDArray, dict[int, float], NDArray],
 
 def _map_one(world: SimulatedWorld, draw: WorldDraw, config: ExplorationConfig, surface: Any,
              truth: tuple[NDArray, dict[int, float], NDArray], seed: int,
-             cuts: Sequence[str]) -> tuple[list[dict[str, Any]], dict[str, list[Any]]]:
-    """Map the world with one configuration to ``max_pokes``; one row per poke and cut, and the
-    map field's pokes at the end (:func:`poke_data`)."""
+             cuts: Sequence[str]
+             ) -> tuple[list[dict[str, Any]], dict[str, list[Any]], dict[str, list[Any]] | None]:
+    """Map the world with one configuration to ``max_pokes``; one row per poke and cut, the
+    field's pokes at the end (:func:`poke_data`), and the β pokes of a run whose map field fell
+    back to β at some poke (else ``None``)."""
     mapper = Mapper(world.workspace, config)
     mapper.surface = surface  # the combinations share the first observation's model
     streams = np.random.default_rng(np.random.SeedSequence([seed, draw.index, 1])).spawn(
@@ -226,12 +229,18 @@ def _map_one(world: SimulatedWorld, draw: WorldDraw, config: ExplorationConfig, 
             rows.append({"cut": cut, **head, **scores,
                          "poke_s": t1 - t0, "elapsed_s": t1 - t_start})  # fmt: skip
     records = {p.record.index: p.record for p in mapper.pokes}
-    # the field's own pokes (after a fall back to β the map field is the β-field: rescoring
-    # carries such a run's rows, :func:`rescore_world`)
-    stored = (mapper.modulus_field.pokes if config.field == "modulus"
-              else PokeSet.of(list(records.values()), beta_noise_floor(config)))
-    thickness = [records[int(i)].layer_thickness_m for i in np.asarray(stored.index)]
-    return rows, poke_data(stored, thickness)
+    beta = PokeSet.of(list(records.values()), beta_noise_floor(config))
+
+    def data(pokes: PokeSet) -> dict[str, list[Any]]:
+        thickness = [records[int(i)].layer_thickness_m for i in np.asarray(pokes.index)]
+        return poke_data(pokes, thickness)
+
+    # the field's own pokes; a modulus run whose map field was β at some poke (it fell back, for
+    # good or until a poke had a modulus) stores the β pokes too, which :func:`rescore_world`
+    # scores those pokes' rows on
+    stored = mapper.modulus_field.pokes if config.field == "modulus" else beta
+    fell_back = any(r["map_field"] != config.field for r in rows)
+    return rows, data(stored), (data(beta) if fell_back else None)
 
 
 def poke_data(pokes: PokeSet, thickness: Sequence[float | None]) -> dict[str, list[Any]]:
@@ -291,9 +300,11 @@ def run_world(task: dict[str, Any]) -> dict[str, Any]:
     Returns
     -------
     dict with ``world`` (:meth:`WorldDraw.summary`), ``rows`` (one per strategy × field × cut ×
-    poke, each naming them), ``pokes`` (each ``"strategy/field"``'s map-field pokes,
-    :func:`poke_data`: what :func:`rescore_world` scores other cuts on), ``pokes_format``
-    (:data:`POKES_FORMAT`) and ``seconds`` (the world's wall time, building included).
+    poke, each naming them), ``pokes`` (each ``"strategy/field"``'s field's pokes,
+    :func:`poke_data`: what :func:`rescore_world` scores other cuts on), ``fallback_pokes`` (the
+    β pokes of each modulus ``"strategy/field"`` whose map field was β at some poke: a row's
+    ``map_field`` says which), ``pokes_format`` (:data:`POKES_FORMAT`) and ``seconds`` (the
+    world's wall time, building included).
     """
     t0 = time.perf_counter()
     draw, world, explore = _build_world(task)
@@ -304,17 +315,20 @@ def run_world(task: dict[str, Any]) -> dict[str, Any]:
     surface = first.initialise(world.observe(), np.random.default_rng(explore_seq))
     truth = _material_truth(world.scenario, first.grid.xs, first.grid.ys)
     rows = []
-    pokes = {}
+    pokes, fallback = {}, {}
     for strategy in task["strategies"]:
         for field in task["fields"]:
             cfg = replace(explore, strategy=strategy, field=field)
-            mapped, pokes[f"{strategy}/{field}"] = _map_one(world, draw, cfg, surface, truth,
-                                                            seed, cuts)
+            combo = f"{strategy}/{field}"
+            mapped, pokes[combo], beta = _map_one(world, draw, cfg, surface, truth, seed, cuts)
+            if beta is not None:
+                fallback[combo] = beta
             for row in mapped:
                 rows.append({"world": index, "family": draw.family, "strategy": strategy,
                              "field": field, **row})  # fmt: skip
-    return {"world": draw.summary(), "rows": rows, "pokes": pokes, "pokes_format": POKES_FORMAT,
-            "seconds": time.perf_counter() - t0, "status": "ok", "error": None}
+    return {"world": draw.summary(), "rows": rows, "pokes": pokes, "fallback_pokes": fallback,
+            "pokes_format": POKES_FORMAT, "seconds": time.perf_counter() - t0, "status": "ok",
+            "error": None}
 
 
 def row_values(row: dict[str, Any]) -> dict[str, Any]:
@@ -323,11 +337,14 @@ def row_values(row: dict[str, Any]) -> dict[str, Any]:
 
 
 def fell_back_cuts(result: dict[str, Any]) -> dict[tuple[str, str], set[str]]:
-    """The combinations ``(strategy, field)`` of a :func:`run_world` result whose run fell back
-    from the modulus field to β on the way (a row's ``map_field`` is not its ``field``), each with
-    the cuts its rows were scored under."""
+    """The combinations ``(strategy, field)`` of a :func:`run_world` result that cannot be
+    rescored: their run fell back from the modulus field to β on the way (a row's ``map_field`` is
+    not its ``field``) and the result holds no β pokes of theirs (``fallback_pokes``: a world
+    stored before :data:`POKES_FORMAT` 3), each with the cuts its rows were scored under."""
+    stored = result.get("fallback_pokes") or {}
     fell = {(r["strategy"], r["field"]) for r in result.get("rows", [])
-            if r.get("map_field", r["field"]) != r["field"]}
+            if r.get("map_field", r["field"]) != r["field"]
+            and f"{r['strategy']}/{r['field']}" not in stored}
     return {combo: {r["cut"] for r in result["rows"] if (r["strategy"], r["field"]) == combo}
             for combo in fell}
 
@@ -342,10 +359,11 @@ def rescore_world(task: dict[str, Any], result: dict[str, Any], cuts: Sequence[s
     After ``k`` pokes the map field is the one of the stored pokes numbered below ``k`` (a poke
     without a value, a modulus field's poke whose record gave none, leaves a gap, as it did in the
     run), so scoring the run's own cuts again, on a world written by the same version, gives its
-    rows to the bit (a test checks it). A combination whose run fell back from the modulus
-    field to β (a row's ``map_field`` is not its ``field``) is carried as it was, for the cuts it
-    was scored under (another cut is refused): its map changed field on the way, which its stored
-    pokes do not retrace (:func:`fell_back_cuts`). The columns that do not depend on the cut
+    rows to the bit (a test checks it). Where a modulus run's map field was β after ``k`` pokes
+    (it fell back: the row's ``map_field``), that row is scored on the β pokes it stored
+    (``fallback_pokes``). A world stored before those were (:data:`POKES_FORMAT` 1 and 2) carries
+    such a combination's rows as they were, for the cuts it was scored under (another cut is
+    refused: :func:`fell_back_cuts`). The columns that do not depend on the cut
     (``purpose``, ``threshold``, ``modulus_error``, times, ...) are the run's. A world stored
     before the pokes' layer thickness was (no ``thickness`` key) has the world's own rest height at
     each poke stand in for the surface model's (:func:`deformap.explore.merge_seam_classes` needs it).
@@ -373,8 +391,8 @@ def rescore_world(task: dict[str, Any], result: dict[str, Any], cuts: Sequence[s
     head: dict[tuple[str, str, int], dict[str, Any]] = {}
     for row in result["rows"]:
         head.setdefault((row["strategy"], row["field"], int(row["poke"])), row)
-    # a run that fell back from the modulus field to β mapped on two fields in turn, which one
-    # field's stored pokes do not retrace: its rows are carried as they were
+    # a run that fell back from the modulus field to β mapped on two fields in turn: stored before
+    # its β pokes were, its rows are carried as they were
     fell_back = fell_back_cuts(result)
     for (strategy, field_name), ran in fell_back.items():
         if set(cuts) - ran:
@@ -390,7 +408,9 @@ def rescore_world(task: dict[str, Any], result: dict[str, Any], cuts: Sequence[s
             rows.extend(r for r in result["rows"] if (r["strategy"], r["field"], r["poke"])
                         == (strategy, field_name, poke) and r["cut"] in cuts)
             continue
-        data = result["pokes"][f"{strategy}/{field_name}"]
+        mapped = old.get("map_field", field_name)  # the field the run mapped on at this poke
+        data = (result["pokes"] if mapped == field_name
+                else result["fallback_pokes"])[f"{strategy}/{field_name}"]
         index = np.asarray(data["index"], dtype=np.int64)
         keep = index < poke
         if "thickness" in data:
@@ -405,13 +425,13 @@ def rescore_world(task: dict[str, Any], result: dict[str, Any], cuts: Sequence[s
                         np.asarray(data["noise"], float)[keep], index[keep],
                         thickness=thickness)  # fmt: skip
         config = replace(explore, strategy=cast(Any, strategy),
-                         field=cast(Any, field_name), **settings)
-        if field_name == "modulus":
+                         field=cast(Any, mapped), **settings)
+        if mapped == "modulus":
             mean = BetaField(pokes, grid.xs, grid.ys, config.modulus_field).mean
         else:  # the map's nugget after k pokes, as the run's β-field had it
             pokes = with_nugget(pokes, config)
             mean = BetaField(pokes, grid.xs, grid.ys, config.beta_field).mean
-        sign = -1.0 if field_name == "modulus" else 1.0
+        sign = -1.0 if mapped == "modulus" else 1.0
         for cut in cuts:  # a finished world has a poke with a value at every k (else it failed)
             found = map_regions(mean, pokes, grid.cells_xy,
                                 replace(config, region_labels=cast(RegionLabels, cut)))

@@ -419,27 +419,35 @@ def _check_stored(path: Path, result: Any, config: WorldsBenchConfig) -> dict[st
         raise bad(f"`pokes_format` must be an integer from 1 to {POKES_FORMAT} (the formats this "
                   f"deformap reads); got {version!r}"
                   + (" (written by a newer version?)" if whole and version > POKES_FORMAT else ""))
+    fallback = result.get("fallback_pokes", {})
+    if not isinstance(fallback, dict):
+        raise bad(f"`fallback_pokes` must be an object; got {type(fallback).__name__}")
+
+    def check_pokes(data: Any, what: str) -> None:
+        if not isinstance(data, dict):
+            raise bad(f"no stored {what}")
+        columns = ("x", "y", "value", "noise", "index")
+        if not all(isinstance(data.get(k), list) for k in columns):
+            raise bad(f"the {what} must have lists {list(columns)}")
+        if version >= 2 and "thickness" not in data:
+            raise bad(f"the {what} have no `thickness` (pokes_format {version})")
+        sizes = {len(data[k]) for k in (*columns, *(("thickness",) if "thickness" in data
+                                                    else ()))}
+        if len(sizes) != 1 or not isinstance(data.get("thickness", []), list):
+            raise bad(f"the {what} have columns of different lengths")
+        numbers = [v for k in columns for v in data[k]]
+        numbers += [v for v in data.get("thickness", []) if v is not None]
+        if not all(isinstance(v, int | float) and not isinstance(v, bool) for v in numbers):
+            raise bad(f"the {what} must be numbers")
+
     for row in rows:
         combo = f"{row.get('strategy')}/{row.get('field')}"
         if row.get("strategy") not in config.strategies or \
                 row.get("field") not in config.fields or not isinstance(row.get("poke"), int):
             raise bad(f"a row of {combo!r} at poke {row.get('poke')!r} is not of this benchmark")
-        data = pokes.get(combo)
-        if not isinstance(data, dict):
-            raise bad(f"no stored pokes for {combo!r}")
-        columns = ("x", "y", "value", "noise", "index")
-        if not all(isinstance(data.get(k), list) for k in columns):
-            raise bad(f"the pokes of {combo!r} must have lists {list(columns)}")
-        if version >= 2 and "thickness" not in data:
-            raise bad(f"the pokes of {combo!r} have no `thickness` (pokes_format {version})")
-        sizes = {len(data[k]) for k in (*columns, *(("thickness",) if "thickness" in data
-                                                    else ()))}
-        if len(sizes) != 1 or not isinstance(data.get("thickness", []), list):
-            raise bad(f"the pokes of {combo!r} have columns of different lengths")
-        numbers = [v for k in columns for v in data[k]]
-        numbers += [v for v in data.get("thickness", []) if v is not None]
-        if not all(isinstance(v, int | float) and not isinstance(v, bool) for v in numbers):
-            raise bad(f"the pokes of {combo!r} must be numbers")
+        check_pokes(pokes.get(combo), f"pokes of {combo!r}")
+        if combo in fallback:
+            check_pokes(fallback[combo], f"fallback pokes of {combo!r}")
     for (strategy, field), ran in fell_back_cuts(result).items():
         if set(config.cuts) - ran:
             raise bad(f"the run of {strategy}/{field} fell back from the modulus field to β, so "
