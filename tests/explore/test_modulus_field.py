@@ -14,6 +14,7 @@ from deformap.environment import Workspace
 from deformap.errors import InvalidArgumentError
 from deformap.explore import (
     ExplorationConfig,
+    MapGrid,
     Mapper,
     ModulusField,
     ModulusFieldConfig,
@@ -23,6 +24,7 @@ from deformap.explore import (
     modulus_reading,
     rigid_modulus_bound,
 )
+from deformap.explore._targets import BOUNDARY_SPACING_ROI
 from deformap.testing import synthetic_poke
 
 CONFIG = ModulusFieldConfig()
@@ -209,6 +211,57 @@ def test_a_place_whose_modulus_cannot_be_read_twice_gives_the_run_to_beta() -> N
     assert "could not be read twice at one place (" in mapper.field_fallback
     mapper.add(_poke((0.5, 0.3), _soft(6e3), 3))  # for good: the β-field maps the rest
     assert mapper.config.field == "beta" and mapper.map_field is mapper.field
+
+
+def test_under_unread_place_avoid_the_place_leaves_the_targets_and_the_stopping_rule() -> None:
+    config = ExplorationConfig(field="modulus", unread_place="avoid", max_pokes=12)
+    mapper = Mapper(Workspace(), config)
+    mapper.add(_poke((0.1, 0.1), _soft(5e3), 0))
+    mapper.add(_poke((0.4, 0.2), None, 1, error="too deep"))
+    before = mapper.max_variance()
+    mapper.add(_poke((0.405, 0.2), None, 2, error="too deep"))  # the same place again
+    # the modulus field maps on; the place is out of the targets and the stopping rule
+    assert mapper.config.field == "modulus" and mapper.field_fallback is None
+    assert mapper.unread_places == [(0.405, 0.2)]
+    radius = BOUNDARY_SPACING_ROI * config.touch.roi_size_m
+    grid = mapper.grid  # the map itself still covers every cell
+    gone = np.hypot(*(grid.cells_xy - (0.405, 0.2)).T) <= radius
+    choice = mapper._choice_grid
+    assert gone.any() and not (choice.target_mask & gone).any()
+    assert not (choice.stop_mask & gone).any()
+    assert (choice.stop_mask == grid.stop_mask & ~gone).all()
+    assert mapper.max_variance() == mapper.modulus_field.max_variance(choice.stop_mask)
+    assert mapper.max_variance() <= before  # the unread disc no longer holds the rule up
+    for seed in range(5):
+        target = mapper.next_target(np.random.default_rng(seed))
+        assert target is not None and np.hypot(*(target.xy - (0.405, 0.2))) > radius
+    mapper.add(_poke((0.5, 0.3), _soft(6e3), 3))
+    assert mapper.config.field == "modulus"
+    result = mapper.result("max_pokes", {})
+    assert result.unread_places == ((0.405, 0.2),) and result.field_fallback is None
+    # the default, `beta`, gives the same run to β at that poke
+    assert _mapper("modulus").config.unread_place == "beta"
+
+
+def test_a_grid_without_every_target_is_none_and_the_run_goes_to_beta() -> None:
+    grid = MapGrid.build(Workspace(), ExplorationConfig())
+    assert grid.without(np.array([[0.3, 0.2]]), 10.0) is None  # the whole workspace gone
+    kept = grid.without(np.zeros((0, 2)), 0.05)
+    assert kept is not None and (kept.target_mask == grid.target_mask).all()
+    assert len(kept.plan_candidates) == len(grid.plan_candidates)
+    part = grid.without(np.array([[0.3, 0.2]]), 0.05)
+    assert part is not None and len(part.plan_candidates) < len(grid.plan_candidates)
+    assert (np.hypot(*(part.plan_candidates - (0.3, 0.2)).T) > 0.05).all()
+    # a tiny workspace whose only place cannot be read: nothing left, so β for good
+    small = Workspace(lower=(0.0, 0.0), upper=(0.06, 0.06))  # every target within the disc
+    mapper = Mapper(small, ExplorationConfig(field="modulus", unread_place="avoid",
+                                             max_pokes=4))
+    mapper.add(_poke((0.03, 0.03), _soft(5e3), 0))
+    mapper.add(_poke((0.03, 0.03), None, 1, error="too deep"))
+    mapper.add(_poke((0.031, 0.03), None, 2, error="too deep"))
+    assert mapper.config.field == "beta" and mapper.unread_places == []
+    assert mapper.field_fallback is not None
+    assert "no target would be left without it" in mapper.field_fallback
 
 
 def test_the_planner_is_told_the_pokes_made_not_the_pokes_in_the_field() -> None:

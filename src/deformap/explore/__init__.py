@@ -13,6 +13,7 @@ from deformap.explore._config import (
     RegionLabels,
     SurfaceGPConfig,
     TouchGPConfig,
+    UnreadPlace,
     check_exploration_budget,
 )
 from deformap.explore._dent import measure_press, roi_grid
@@ -102,6 +103,7 @@ __all__ = [
     "SurfaceModel",
     "Target",
     "TouchGPConfig",
+    "UnreadPlace",
     "beta_noise_floor",
     "beta_pokes",
     "check_exploration_budget",

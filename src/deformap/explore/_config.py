@@ -106,6 +106,7 @@ __all__ = [
     "TactileCap",
     "TouchGPConfig",
     "TouchModel",
+    "UnreadPlace",
     "check_exploration_budget",
 ]
 
@@ -125,6 +126,9 @@ FieldName = Literal["beta", "modulus"]
 NuggetEstimate = Literal["within-class", "off"]
 #: Where a poke's β uncertainty comes from (``ExplorationConfig.beta_uncertainty``).
 BetaUncertainty = Literal["camera-noise", "shape-matching"]
+#: What the modulus field does with a place whose modulus could not be read twice
+#: (``ExplorationConfig.unread_place``).
+UnreadPlace = Literal["beta", "avoid"]
 
 #: Most bytes of one band of the ROI's shape-matching system (:mod:`deformap.msm._linsys`): the
 #: β sweep holds its two assembled bands and a few factorisations of that size at once, so 512 MiB
@@ -357,6 +361,15 @@ class ExplorationConfig:
         the β-field or on the modulus field"), and it does not depend on the camera. When no poke
         of a run gives a usable record (a camera-only robot or session) the run falls back to
         ``beta`` at its first poke, and its result says so (``field_fallback``).
+    unread_place : {"beta", "avoid"}
+        Under ``field: modulus``, what a place whose modulus could not be read twice does (two
+        presses within ``BOUNDARY_SPACING_ROI`` ROIs of each other whose records were not read:
+        a further press there would read nothing again, so the modulus field's variance there
+        would never fall): ``beta``, the run maps on the β-field from then on, for good;
+        ``avoid``, the run keeps the modulus field and takes that disc out of the targets and of
+        the cells whose variance must fall below ``T_h`` (the map still covers it, from the
+        pokes around it; ``ExplorationResult.unread_places`` lists them), and falls back to β
+        only when no target would be left.
     modulus_field : ModulusFieldConfig
         Prior of the modulus field; it is computed whenever a poke has a modulus, whichever
         ``field`` is chosen.
@@ -384,6 +397,7 @@ class ExplorationConfig:
     boundary_pokes: int = setting(0, ge=0, le=1000)  # as for max_pokes
     beta_uncertainty: BetaUncertainty = "camera-noise"
     field: FieldName = "modulus"
+    unread_place: UnreadPlace = "beta"
     surface: SurfaceGPConfig = _field(default_factory=SurfaceGPConfig)
     touch: TouchGPConfig = _field(default_factory=TouchGPConfig)
     beta_field: BetaFieldConfig = _field(default_factory=BetaFieldConfig)

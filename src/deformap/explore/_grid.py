@@ -80,6 +80,30 @@ class MapGrid:
         candidates = cells[_strided(xs.size, ys.size, PLAN_GRID_M, spacing, within=target)]
         return cls(xs, ys, cells, target, stop, domain, candidates)
 
+    def without(self, centres: NDArray[np.float64], radius_m: float) -> MapGrid | None:
+        """This grid with the discs of ``radius_m`` around the ``(n, 2)`` ``centres`` taken out of
+        its targets and of the cells whose variance must fall (places the map cannot read, which
+        no further press would make known); ``None`` when no target or no such cell is left."""
+        centres = np.asarray(centres, dtype=float).reshape(-1, 2)
+        near = np.zeros(len(self.cells_xy), dtype=bool)
+        for centre in centres:
+            near |= np.hypot(*(self.cells_xy - centre).T) <= radius_m
+        target, stop = self.target_mask & ~near, self.stop_mask & ~near
+        if not target.any() or not stop.any():
+            return None
+
+        def lattice(points: NDArray[np.float64]) -> NDArray[np.float64]:
+            if not len(centres):
+                return points
+            gone = (np.hypot(points[:, None, 0] - centres[None, :, 0],
+                             points[:, None, 1] - centres[None, :, 1]) <= radius_m).any(axis=1)
+            return points[~gone]
+
+        domain, candidates = lattice(self.plan_domain), lattice(self.plan_candidates)
+        if not len(domain) or not len(candidates):
+            return None
+        return MapGrid(self.xs, self.ys, self.cells_xy, target, stop, domain, candidates)
+
     @property
     def shape(self) -> tuple[int, int]:
         """``(ny, nx)``."""

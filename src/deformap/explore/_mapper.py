@@ -64,6 +64,10 @@ class Mapper:
         self.field_fallback: str | None = None
         self._requested_field = config.field
         self._given_up: str | None = None
+        #: places the modulus could not be read twice at (``unread_place: avoid``), and the grid
+        #: the targets and the stopping rule use: ``grid`` without them
+        self.unread_places: list[tuple[float, float]] = []
+        self._choice_grid = self.grid
 
     @property
     def pokes(self) -> tuple[PokeResult, ...]:
@@ -130,7 +134,7 @@ class Mapper:
             record = dataclasses.replace(record, purpose=target.purpose,
                                          planned_after=target.planned_after)  # fmt: skip
         record = dataclasses.replace(
-            record, max_variance_after=active.max_variance(self.grid.stop_mask),
+            record, max_variance_after=active.max_variance(self._choice_grid.stop_mask),
             timings=dataclasses.replace(record.timings, field_s=time.perf_counter() - t0,
                                         **dict(timings or {})),
         )  # fmt: skip
@@ -143,19 +147,34 @@ class Mapper:
 
     def _choose_field(self, poke: PokeResult, modulus: ModulusField) -> None:
         """Under ``field: modulus``, the field to map on after ``poke``: the modulus field once a
-        poke has a modulus; the β-field while none has (a camera-only robot or session), and for
-        good once the modulus could not be read twice at one place (a further press there would
-        read nothing again, and the modulus field's variance there would never fall)."""
+        poke has a modulus; the β-field while none has (a camera-only robot or session). Once the
+        modulus could not be read twice at one place (a further press there would read nothing
+        again, and the modulus field's variance there would never fall): under ``unread_place:
+        beta`` the β-field for good; under ``avoid`` the modulus field still, with that place
+        taken out of the targets and the stopping rule (the β-field for good only when nothing
+        would be left)."""
         reading = modulus.readings[-1]
         if self._given_up is None and reading.excluded is not None and self._pokes:
-            here = np.asarray(poke.record.contact_xy)
+            here = np.asarray(poke.record.contact_xy, dtype=float)
             radius = BOUNDARY_SPACING_ROI * self.config.touch.roi_size_m
             unread = {r.index for r in modulus.readings[:-1] if r.excluded is not None}
             if any(p.record.index in unread
                    and np.hypot(*(np.asarray(p.record.contact_xy) - here)) <= radius
                    for p in self._pokes):  # fmt: skip
-                self._given_up = (f"poke {poke.record.index + 1}: the modulus could not be read "
-                                  f"twice at one place ({reading.excluded})")
+                places = [*self.unread_places, (float(here[0]), float(here[1]))]
+                left = (self.grid.without(np.array(places), radius)
+                        if self.config.unread_place == "avoid" else None)  # fmt: skip
+                if left is not None:
+                    self.unread_places, self._choice_grid = places, left
+                    logger.warning("poke %d: the modulus could not be read twice at (%.3f, %.3f) "
+                                   "m (%s); that place is left out of the targets and the "
+                                   "stopping rule", poke.record.index + 1, here[0], here[1],
+                                   reading.excluded)  # fmt: skip
+                else:
+                    self._given_up = (f"poke {poke.record.index + 1}: the modulus could not be "
+                                      f"read twice at one place ({reading.excluded})"
+                                      + ("; no target would be left without it"
+                                         if self.config.unread_place == "avoid" else ""))
         if self._given_up is not None:
             why = self._given_up
         elif not len(modulus.pokes):
@@ -174,7 +193,7 @@ class Mapper:
     def max_variance(self) -> float:
         """The map field's largest variance where it must fall below ``threshold``
         (``stop_region``)."""
-        return self.map_field.max_variance(self.grid.stop_mask)
+        return self.map_field.max_variance(self._choice_grid.stop_mask)
 
     def boundary_owed(self) -> int:
         """Boundary pokes still to make (``boundary_pokes`` less those made)."""
@@ -184,7 +203,7 @@ class Mapper:
     def next_target(self, rng: np.random.Generator) -> Target | None:
         """The next target (:func:`deformap.explore._targets.choose_next`), or ``None`` when the
         map is done."""
-        return choose_next(self.grid, self.map_field, self.config, rng,
+        return choose_next(self._choice_grid, self.map_field, self.config, rng,
                            boundary_owed=self.boundary_owed(),
                            n_made=len(self._pokes))  # fmt: skip
 
@@ -202,5 +221,5 @@ class Mapper:
             pokes=self.pokes, field=self.field, modulus_field=self._modulus,
             regions=self.regions() if self._pokes else None,
             max_variance=self.max_variance(), stop_reason=stop_reason, timings=dict(timings),
-            field_fallback=self.field_fallback,
+            field_fallback=self.field_fallback, unread_places=tuple(self.unread_places),
         )  # fmt: skip

@@ -56,6 +56,9 @@ class ExplorationResult:
     field_fallback : str or None
         Why the map is on the β-field although the run asked for the modulus field (no poke gave
         a modulus); ``config.field`` is then ``"beta"``.
+    unread_places : tuple of (x, y)
+        Places the modulus could not be read twice at, taken out of the targets and the stopping
+        rule (``exploration.unread_place: avoid``), in the order found [m].
     """
 
     config: ExplorationConfig
@@ -70,6 +73,7 @@ class ExplorationResult:
     stop_reason: str
     timings: Mapping[str, float]
     field_fallback: str | None = None
+    unread_places: tuple[tuple[float, float], ...] = ()
 
     @property
     def xs(self) -> NDArray[np.float64]:

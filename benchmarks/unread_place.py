@@ -1,0 +1,167 @@
+"""What a place whose modulus cannot be read should do to a run: β for good, or be avoided (issue 16).
+
+    OMP_NUM_THREADS=1 PYTHONPATH=src python benchmarks/unread_place.py RUN [--workers 2] [--out F]
+
+``RUN`` is a folder written by ``deformap bench worlds`` with the modulus field among its fields
+and the default ``exploration.unread_place: beta``: a run that presses a place twice without a
+usable force–travel record maps on the β-field from then on. This maps every world of ``RUN``
+where a combination did so again, with the same settings and ``unread_place: avoid`` (the run
+keeps the modulus field and leaves that place out of its targets and its stopping rule). The
+baseline is ``RUN``'s own rows of those worlds: a world's presses are a function of its seed and
+the settings, so everything before the fallback is the same press for press, and the rows of the
+combinations that never fell back must come out the same to the bit apart from times (the script
+checks it, and says so where they do not: then the worlds are not paired).
+
+It prints, for each combination that fell back (``world``, ``strategy``) and over them, the
+pokes to region accuracy 0.9 (``max_pokes + 1`` when never), the accuracy and the modulus error
+after the last poke under each rule, and the medians of the whole run with those worlds mapped
+under ``avoid``. ``--out`` writes the new worlds' results as JSON.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import multiprocessing
+import os
+import time
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+from typing import Any
+
+for _name in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_name, "1")  # the workers are spawned: they read these as numpy loads
+
+import numpy as np  # noqa: E402
+
+from deformap.eval import row_values, run_world, summarise_worlds  # noqa: E402
+
+GOOD = 0.9
+
+
+def _pin() -> None:
+    from threadpoolctl import threadpool_limits
+
+    threadpool_limits(limits=1)
+
+
+def _given_up(result: dict[str, Any]) -> set[tuple[str, str]]:
+    """Combinations whose map field was β at their last poke although they asked for the modulus:
+    gone to β for good (a run that read no modulus at all is among them, which ``avoid`` does
+    not change)."""
+    last: dict[tuple[str, str], dict[str, Any]] = {}
+    for row in result["rows"]:
+        key = (row["strategy"], row["field"])
+        if key not in last or row["poke"] >= last[key]["poke"]:
+            last[key] = row
+    return {k for k, r in last.items() if r["field"] == "modulus" and r["map_field"] == "beta"}
+
+
+def _curve(rows: list[dict[str, Any]], strategy: str, cut: str) -> list[dict[str, Any]]:
+    return sorted((r for r in rows if r["strategy"] == strategy and r["field"] == "modulus"
+                   and r["cut"] == cut), key=lambda r: r["poke"])
+
+
+def _to_good(curve: list[dict[str, Any]], max_pokes: int) -> int:
+    return next((r["poke"] for r in curve if r["accuracy"] >= GOOD), max_pokes + 1)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("run", type=Path, help="a bench worlds folder mapped on the modulus field")
+    parser.add_argument("--workers", type=int, default=2, help="local processes (default 2)")
+    parser.add_argument("--out", type=Path, help="a JSON file for the worlds mapped again")
+    args = parser.parse_args()
+    if args.workers < 1:
+        raise SystemExit(f"--workers: expected an integer >= 1; got {args.workers}")
+    settings = json.loads((args.run / "bench.json").read_text(encoding="utf-8"))["settings"]
+    if "modulus" not in settings["fields"]:
+        raise SystemExit(f"RUN: expected a run with the modulus field among its fields; got "
+                         f"{settings['fields']}")
+    source = {}
+    for path in sorted((args.run / "worlds").glob("world-*.json")):
+        result = json.loads(path.read_text(encoding="utf-8"))
+        if result.get("status") == "ok":
+            source[result["world"]["index"]] = result
+    affected = {i: _given_up(r) for i, r in source.items() if _given_up(r)}
+    if not affected:
+        raise SystemExit(f"RUN: no combination of {args.run} went to β for good; nothing to do")
+    k = settings["max_pokes"]
+    cut = settings["cuts"][0]
+    print(f"{len(affected)} of {len(source)} worlds of {args.run} had a combination go to β for "
+          f"good; mapping them again with unread_place: avoid ({args.workers} processes)")
+    tasks = {i: {**{key: settings[key] for key in ("seed", "families", "physics", "strategies",
+                                                   "fields", "cuts", "max_pokes", "coarse",
+                                                   "merge_seams", "split_by_place")},
+                 "index": i, "unread_place": "avoid"} for i in affected}
+    t0 = time.perf_counter()
+    ctx = multiprocessing.get_context("spawn")
+    with ProcessPoolExecutor(args.workers, mp_context=ctx, initializer=_pin) as pool:
+        again = dict(zip(tasks, pool.map(run_world, tasks.values()), strict=True))
+    print(f"mapped in {time.perf_counter() - t0:.0f} s\n")
+    if args.out:
+        args.out.write_text(json.dumps(list(again.values())), encoding="utf-8")
+
+    paired = True
+    for i, result in again.items():
+        for strategy in settings["strategies"]:
+            for field in settings["fields"]:
+                if (strategy, field) in affected[i]:
+                    continue
+                old = [row_values(r) for r in source[i]["rows"]
+                       if (r["strategy"], r["field"]) == (strategy, field)]
+                new = [row_values(r) for r in result["rows"]
+                       if (r["strategy"], r["field"]) == (strategy, field)]
+                if old != new:
+                    paired = False
+                    print(f"world {i}: {strategy}/{field} did not fall back but its rows differ "
+                          f"from the run's")
+    print("the combinations that did not fall back gave the run's rows to the bit"
+          if paired else "NOT PAIRED: the rows above differ")
+    print()
+    print(f"| world | family | strategy | fell back at | pokes to {GOOD} (beta / avoid) | "
+          f"accuracy after {k} (beta / avoid) | E error after {k} (beta / avoid) | "
+          f"unread places |")
+    print("|---|---|---|---|---|---|---|---|")
+    pairs = []
+    for i in sorted(affected):
+        for strategy, _ in sorted(affected[i]):
+            old, new = _curve(source[i]["rows"], strategy, cut), _curve(again[i]["rows"],
+                                                                        strategy, cut)
+            fell = next(r["poke"] for r in old if r["map_field"] == "beta"
+                        and all(q["map_field"] == "beta" for q in old if q["poke"] >= r["poke"]))
+            unread = sum(r["map_field"] == "beta" for r in new)
+            pairs.append((_to_good(old, k), _to_good(new, k), old[-1]["accuracy"],
+                          new[-1]["accuracy"]))
+            err = [c[-1]["modulus_error"] for c in (old, new)]
+            print(f"| {i} | {source[i]['world']['family']} | {strategy} | {fell} | "
+                  f"{pairs[-1][0]} / {pairs[-1][1]} | {old[-1]['accuracy']:.3f} / "
+                  f"{new[-1]['accuracy']:.3f} | "
+                  + " / ".join("–" if e is None else f"{e:.2f}" for e in err)
+                  + f" | {'on β at ' + str(unread) + ' pokes' if unread else ''} |")
+    arr = np.array(pairs, dtype=float)
+    better = int(np.sum(arr[:, 1] < arr[:, 0]))
+    worse = int(np.sum(arr[:, 1] > arr[:, 0]))
+    print(f"\n{len(pairs)} combinations: median pokes to {GOOD} {np.median(arr[:, 0]):g} (beta) "
+          f"/ {np.median(arr[:, 1]):g} (avoid); fewer under avoid in {better}, more in {worse}; "
+          f"mean final accuracy {arr[:, 2].mean():.3f} / {arr[:, 3].mean():.3f}")
+    whole = [{**r, "rows": [x for x in r["rows"] if x["cut"] == cut]} for r in source.values()]
+    replaced = [{**(again.get(i) or r), "rows": [x for x in (again.get(i) or r)["rows"]
+                                                 if x["cut"] == cut]}
+                for i, r in source.items()]
+    combos = [(s, "modulus", cut) for s in settings["strategies"]]
+    before = summarise_worlds(whole, combos, k)["strategies"]
+    after = summarise_worlds(replaced, combos, k)["strategies"]
+    print(f"\nThe whole run ({len(source)} worlds), median pokes to {GOOD} / reach:")
+    print("| combination | unread_place: beta | unread_place: avoid |")
+    print("|---|---|---|")
+    for s, f, c in combos:
+        name = f"{s}/{f}/{c}"
+        b, a = before[name], after[name]
+        print(f"| {name} | {b['median_pokes_to_accuracy_0.9']:g} / "
+              f"{b['share_reaching_0.9']:.0%} | {a['median_pokes_to_accuracy_0.9']:g} / "
+              f"{a['share_reaching_0.9']:.0%} |")
+
+
+if __name__ == "__main__":
+    main()
