@@ -163,7 +163,9 @@ def test_the_command_refuses_bad_names_in_one_line_before_any_folder(tmp_path) -
                           (["--fields", "hardness"], "`fields` must be distinct"),
                           (["--cut", "voronoi"], "got ['voronoi'] (unknown)"),
                           (["--cuts", "nearest,nearest"], "got ['nearest'] more than once"),
-                          (["--worlds", "0"], "`worlds` must be an integer >= 1")):
+                          (["--worlds", "0"], "`worlds` must be an integer >= 1"),
+                          (["--unread-place", "skip"],
+                           "`unread_place` must be one of ['beta', 'avoid']; got 'skip'")):
         result = CliRunner().invoke(app, ["bench", "worlds", "--out", str(out), *args])
         assert result.exit_code == 2, result.output
         assert message in result.output and len(result.output.strip().splitlines()) == 1

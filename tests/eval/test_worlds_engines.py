@@ -7,6 +7,7 @@ import csv
 import io
 import json
 import os
+from dataclasses import replace
 
 import pytest
 
@@ -62,6 +63,13 @@ def test_pool_and_dask_agree_byte_for_byte_apart_from_times_and_resume(tmp_path)
     assert bench_worlds(_config(worlds=2, split_by_place=False), tmp_path / "pool").computed == 0
     with pytest.raises(ConfigError, match="split_by_place: False there, True here"):
         bench_worlds(_config(worlds=2, split_by_place=True), tmp_path / "pool")
+    # and one from before unread_place gave a run to β at an unread place
+    del header["settings"]["unread_place"]
+    settings_file.write_text(json.dumps(header))
+    resumed = _config(worlds=2, split_by_place=False, unread_place="beta")
+    assert bench_worlds(resumed, tmp_path / "pool").computed == 0
+    with pytest.raises(ConfigError, match="unread_place: 'beta' there, 'avoid' here"):
+        bench_worlds(replace(resumed, unread_place="avoid"), tmp_path / "pool")
 
 
 def test_a_failing_world_is_tried_twice_then_reported_not_dropped(caplog) -> None:
@@ -107,12 +115,15 @@ def test_rescore_scores_other_cuts_on_the_stored_pokes_and_names_what_it_cannot(
     stored = json.loads(source_settings.read_text())
     del stored["settings"]["split_by_place"]
     source_settings.write_text(json.dumps(stored))
+    del stored["settings"]["unread_place"]  # and from before unread_place
+    source_settings.write_text(json.dumps(stored))
     for flag, expected, folder in (([], False, "before"), (["--split-by-place"], True, "split")):
         result = runner.invoke(app, ["bench", "rescore", str(tmp_path / "src"), "--out",
                                      str(tmp_path / folder), "--cuts", "nearest", *flag])
         assert result.exit_code == 0, result.output
         written = json.loads((tmp_path / folder / "bench.json").read_text())["settings"]
         assert written["split_by_place"] is expected
+        assert written["unread_place"] == "beta"  # what such a run did
     # the folder must be new; a world from before the pokes were stored is named
     result = runner.invoke(app, ["bench", "rescore", str(tmp_path / "src"), "--out",
                                  str(tmp_path / "again")])

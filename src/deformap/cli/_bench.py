@@ -185,6 +185,9 @@ def bench_worlds_command(
         help="Split a class whose pokes form two places of different values before cutting "
              "(exploration.split_by_place); default: the exploration's.",
         show_default=False)] = None,
+    unread_place: Annotated[str | None, typer.Option(
+        help="What a place whose modulus cannot be read twice does (exploration.unread_place: "
+             "beta or avoid); default: the exploration's.", show_default=False)] = None,
     coarse: Annotated[bool, typer.Option(
         help="The coarse test mesh and camera: a third of the cost, a smoke run only (its 2 cm "
              "mesh reads E far off).")] = False,
@@ -203,7 +206,7 @@ def bench_worlds_command(
     given: dict[str, Any] = {"families": _names(families), "strategies": _names(strategies),
                              "fields": _names(fields), "physics": _names(physics),
                              "cuts": _names(cuts), "merge_seams": merge_seams,
-                             "split_by_place": split_by_place}
+                             "split_by_place": split_by_place, "unread_place": unread_place}
     config = run.WorldsBenchConfig(
         worlds=worlds, seed=seed, max_pokes=max_pokes, coarse=coarse, workers=workers,
         scheduler=scheduler, **{k: v for k, v in given.items() if v is not None})

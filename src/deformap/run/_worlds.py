@@ -47,7 +47,7 @@ from deformap.eval import (
     runs_csv,
     summarise_worlds,
 )
-from deformap.explore import ExplorationConfig
+from deformap.explore import ExplorationConfig, UnreadPlace
 from deformap.run._folder import create_run_folder, default_run_folder, to_json, write_text
 from deformap.run._hooks import NO_HOOKS, RunHooks, RunStart
 from deformap.viz import plot_world_curves
@@ -91,6 +91,9 @@ class WorldsBenchConfig:
         regions, like the cut; its default is the exploration's).
     split_by_place : bool
         ``ExplorationConfig.split_by_place`` likewise.
+    unread_place : {"beta", "avoid"}
+        ``ExplorationConfig.unread_place`` (it changes where the pokes go after a place could
+        not be read, so a rescore keeps the source's; default the exploration's).
     coarse : bool
         The test mesh and camera (:meth:`deformap.world.WorldConfig.coarse`, about a third of a
         default world's cost) instead of the default world. A smoke run only: on one linear-FEM
@@ -114,6 +117,7 @@ class WorldsBenchConfig:
     max_pokes: int = setting(12, ge=1, le=1000)
     merge_seams: bool = ExplorationConfig().merge_seams
     split_by_place: bool = ExplorationConfig().split_by_place
+    unread_place: UnreadPlace = ExplorationConfig().unread_place
     coarse: bool = False
     workers: int = setting(1, ge=1, le=1024)
     scheduler: str | None = None
@@ -147,7 +151,8 @@ class WorldsBenchConfig:
                 "physics": list(self.physics),
                 "strategies": list(self.strategies), "fields": list(self.fields),
                 "cuts": list(self.cuts), "max_pokes": self.max_pokes, "coarse": self.coarse,
-                "merge_seams": self.merge_seams, "split_by_place": self.split_by_place}
+                "merge_seams": self.merge_seams, "split_by_place": self.split_by_place,
+                "unread_place": self.unread_place}
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -299,8 +304,9 @@ def _open_folder(config: WorldsBenchConfig, out: Path | None) -> tuple[Path, dic
             raise ConfigError(f"--out: {settings_file} cannot be read: {exc}") from None
         ours = json.loads(to_json(config.result_settings()))
         theirs = stored.get("settings") if isinstance(stored, dict) else None
-        if isinstance(theirs, dict):  # a run from before the split by place ran without it
-            theirs = {"split_by_place": False, **theirs}
+        if isinstance(theirs, dict):  # a run from before the split by place ran without it,
+            # and one from before unread_place gave a run to β at an unread place
+            theirs = {"split_by_place": False, "unread_place": "beta", **theirs}
         if theirs != ours:
             there = theirs if isinstance(theirs, dict) else {}
             differ = ", ".join(f"{k}: {there.get(k)!r} there, {ours.get(k)!r} here"
@@ -492,8 +498,10 @@ def rescore_worlds(source: Path, out: Path, *, cuts: Sequence[str] | None = None
         given["cuts"] = tuple(cuts)
     if merge_seams is not None:
         given["merge_seams"] = merge_seams
-    # a source from before the split by place was scored without it
+    # a source from before the split by place was scored without it, and from before
+    # unread_place mapped with β at an unread place
     given.setdefault("split_by_place", False)
+    given.setdefault("unread_place", "beta")
     if split_by_place is not None:
         given["split_by_place"] = split_by_place
     config = WorldsBenchConfig(worlds=1, **given)  # the settings checked before any world
