@@ -15,7 +15,8 @@ checks it, and says so where they do not: then the worlds are not paired).
 It prints, for each combination that fell back (``world``, ``strategy``) and over them, the
 pokes to region accuracy 0.9 (``max_pokes + 1`` when never), the accuracy and the modulus error
 after the last poke under each rule, and the medians of the whole run with those worlds mapped
-under ``avoid``. ``--out`` writes the new worlds' results as JSON.
+under ``avoid``. ``--out`` writes the new worlds' results as JSON; ``--again FILE`` reads such
+a file instead of mapping again (the tables only).
 """
 
 from __future__ import annotations
@@ -62,8 +63,18 @@ def _curve(rows: list[dict[str, Any]], strategy: str, cut: str) -> list[dict[str
                    and r["cut"] == cut), key=lambda r: r["poke"])
 
 
+def _fell(curve: list[dict[str, Any]]) -> int:
+    """The poke from which every later row of ``curve`` mapped on β."""
+    return next(r["poke"] for r in curve if r["map_field"] == "beta"
+                and all(q["map_field"] == "beta" for q in curve if q["poke"] >= r["poke"]))
+
+
 def _to_good(curve: list[dict[str, Any]], max_pokes: int) -> int:
     return next((r["poke"] for r in curve if r["accuracy"] >= GOOD), max_pokes + 1)
+
+
+#: bench.json keys a run from before them did not have, and what such a run did
+_BEFORE = {"split_by_place": False, "unread_place": "beta"}
 
 
 def main() -> None:
@@ -71,13 +82,20 @@ def main() -> None:
     parser.add_argument("run", type=Path, help="a bench worlds folder mapped on the modulus field")
     parser.add_argument("--workers", type=int, default=2, help="local processes (default 2)")
     parser.add_argument("--out", type=Path, help="a JSON file for the worlds mapped again")
+    parser.add_argument("--again", type=Path, help="a JSON file --out wrote: no mapping")
     args = parser.parse_args()
     if args.workers < 1:
         raise SystemExit(f"--workers: expected an integer >= 1; got {args.workers}")
-    settings = json.loads((args.run / "bench.json").read_text(encoding="utf-8"))["settings"]
-    if "modulus" not in settings["fields"]:
-        raise SystemExit(f"RUN: expected a run with the modulus field among its fields; got "
-                         f"{settings['fields']}")
+    try:
+        settings = {**_BEFORE, **json.loads((args.run / "bench.json").read_text(
+            encoding="utf-8"))["settings"]}
+    except (OSError, ValueError, KeyError, TypeError) as exc:
+        raise SystemExit(f"RUN: expected a bench worlds folder with its bench.json; got "
+                         f"{args.run} ({exc})") from None
+    if "modulus" not in settings["fields"] or settings["unread_place"] != "beta":
+        raise SystemExit(f"RUN: expected a run on the modulus field with unread_place beta; got "
+                         f"fields {settings['fields']}, unread_place "
+                         f"{settings['unread_place']!r}")
     source = {}
     for path in sorted((args.run / "worlds").glob("world-*.json")):
         result = json.loads(path.read_text(encoding="utf-8"))
@@ -88,48 +106,60 @@ def main() -> None:
         raise SystemExit(f"RUN: no combination of {args.run} went to β for good; nothing to do")
     k = settings["max_pokes"]
     cut = settings["cuts"][0]
-    print(f"{len(affected)} of {len(source)} worlds of {args.run} had a combination go to β for "
-          f"good; mapping them again with unread_place: avoid ({args.workers} processes)")
-    tasks = {i: {**{key: settings[key] for key in ("seed", "families", "physics", "strategies",
-                                                   "fields", "cuts", "max_pokes", "coarse",
-                                                   "merge_seams", "split_by_place")},
-                 "index": i, "unread_place": "avoid"} for i in affected}
-    t0 = time.perf_counter()
-    ctx = multiprocessing.get_context("spawn")
-    with ProcessPoolExecutor(args.workers, mp_context=ctx, initializer=_pin) as pool:
-        again = dict(zip(tasks, pool.map(run_world, tasks.values()), strict=True))
-    print(f"mapped in {time.perf_counter() - t0:.0f} s\n")
-    if args.out:
-        args.out.write_text(json.dumps(list(again.values())), encoding="utf-8")
+    if args.again:
+        again = {r["world"]["index"]: r for r in json.loads(args.again.read_text("utf-8"))}
+        if set(again) != set(affected):
+            raise SystemExit(f"--again: expected the worlds {sorted(affected)}; got "
+                             f"{sorted(again)}")
+        print(f"{len(affected)} of {len(source)} worlds of {args.run} had a combination go to β "
+              f"for good; read again from {args.again}")
+    else:
+        print(f"{len(affected)} of {len(source)} worlds of {args.run} had a combination go to β "
+              f"for good; mapping them again with unread_place: avoid ({args.workers} "
+              f"processes)")
+        keys = ("seed", "families", "physics", "strategies", "fields", "cuts", "max_pokes",
+                "coarse", "merge_seams", "split_by_place")
+        tasks = {i: {**{key: settings[key] for key in keys}, "index": i,
+                     "unread_place": "avoid"} for i in affected}
+        t0 = time.perf_counter()
+        ctx = multiprocessing.get_context("spawn")
+        with ProcessPoolExecutor(args.workers, mp_context=ctx, initializer=_pin) as pool:
+            again = dict(zip(tasks, pool.map(run_world, tasks.values()), strict=True))
+        print(f"mapped in {time.perf_counter() - t0:.0f} s\n")
+        if args.out:
+            args.out.write_text(json.dumps(list(again.values())), encoding="utf-8")
 
     paired = True
     for i, result in again.items():
         for strategy in settings["strategies"]:
             for field in settings["fields"]:
-                if (strategy, field) in affected[i]:
-                    continue
                 old = [row_values(r) for r in source[i]["rows"]
                        if (r["strategy"], r["field"]) == (strategy, field)]
                 new = [row_values(r) for r in result["rows"]
                        if (r["strategy"], r["field"]) == (strategy, field)]
+                if (strategy, field) in affected[i]:  # the same until the poke that fell back
+                    until = _fell(_curve(source[i]["rows"], strategy, cut))
+                    old = [r for r in old if r["poke"] < until]
+                    new = [r for r in new if r["poke"] < until]
                 if old != new:
                     paired = False
-                    print(f"world {i}: {strategy}/{field} did not fall back but its rows differ "
+                    print(f"world {i}: {strategy}/{field} differs from the run's before it "
+                          f"fell back" if (strategy, field) in affected[i] else
+                          f"world {i}: {strategy}/{field} did not fall back but its rows differ "
                           f"from the run's")
-    print("the combinations that did not fall back gave the run's rows to the bit"
-          if paired else "NOT PAIRED: the rows above differ")
+    print("the combinations that did not fall back gave the run's rows to the bit, and those "
+          "that did gave them up to that poke" if paired else "NOT PAIRED: the rows above differ")
     print()
     print(f"| world | family | strategy | fell back at | pokes to {GOOD} (beta / avoid) | "
-          f"accuracy after {k} (beta / avoid) | E error after {k} (beta / avoid) | "
-          f"unread places |")
+          f"accuracy after the last poke (beta / avoid) | E error after the last poke (beta / "
+          f"avoid) | pokes on β under avoid |")
     print("|---|---|---|---|---|---|---|---|")
     pairs = []
     for i in sorted(affected):
         for strategy, _ in sorted(affected[i]):
             old, new = _curve(source[i]["rows"], strategy, cut), _curve(again[i]["rows"],
                                                                         strategy, cut)
-            fell = next(r["poke"] for r in old if r["map_field"] == "beta"
-                        and all(q["map_field"] == "beta" for q in old if q["poke"] >= r["poke"]))
+            fell = _fell(old)
             unread = sum(r["map_field"] == "beta" for r in new)
             pairs.append((_to_good(old, k), _to_good(new, k), old[-1]["accuracy"],
                           new[-1]["accuracy"]))
@@ -138,7 +168,7 @@ def main() -> None:
                   f"{pairs[-1][0]} / {pairs[-1][1]} | {old[-1]['accuracy']:.3f} / "
                   f"{new[-1]['accuracy']:.3f} | "
                   + " / ".join("–" if e is None else f"{e:.2f}" for e in err)
-                  + f" | {'on β at ' + str(unread) + ' pokes' if unread else ''} |")
+                  + f" | {unread} |")
     arr = np.array(pairs, dtype=float)
     better = int(np.sum(arr[:, 1] < arr[:, 0]))
     worse = int(np.sum(arr[:, 1] > arr[:, 0]))

@@ -155,6 +155,13 @@ def test_rescore_scores_other_cuts_on_the_stored_pokes_and_names_what_it_cannot(
                           "`fallback_pokes` must be an object; got list"),
                          ({**original, "fallback_pokes": {"paper/beta": {"x": [0.1]}}},
                           "the fallback pokes of 'paper/beta' must have lists"),
+                         ({**original, "rows": [{**r, "map_field": "hardness"}
+                                                for r in original["rows"]]},
+                          "has `map_field` 'hardness', expected one of ['beta', 'modulus']"),
+                         ({**original, "rows": [{**r, "map_field": "modulus"}
+                                                for r in original["rows"]]},
+                          "no stored fallback pokes of 'paper/beta', whose map field was "
+                          "'modulus' at poke 1 (pokes_format 3)"),
                          ({**stored, "pokes_format": True}, "`pokes_format` must be"),
                          ({**stored, "pokes_format": 2.0}, "`pokes_format` must be an integer"),
                          ({**stored, "pokes": unthick},
@@ -179,7 +186,8 @@ def test_rescore_scores_other_cuts_on_the_stored_pokes_and_names_what_it_cannot(
         (tmp_path / "fifth" / "worlds" / "world-00001.json").read_text())
     # a run whose map changed field on the way, stored without its β pokes (before the third
     # format), is carried, and so only under its own cuts
-    fell = {**original, "rows": [{**r, "map_field": "modulus"} for r in original["rows"]]}
+    fell = {**original, "rows": [{**r, "map_field": "modulus"} for r in original["rows"]],
+            "pokes_format": 2}
     del fell["fallback_pokes"]
     world.write_text(json.dumps(fell))
     result = runner.invoke(app, ["bench", "rescore", str(tmp_path / "src"), "--out",

@@ -24,6 +24,7 @@ from deformap.explore import (
     modulus_reading,
     rigid_modulus_bound,
 )
+from deformap.explore._mapper import unread_radius_m
 from deformap.explore._targets import BOUNDARY_SPACING_ROI
 from deformap.testing import synthetic_poke
 
@@ -217,34 +218,83 @@ def test_under_unread_place_avoid_the_place_leaves_the_targets_and_the_stopping_
     config = ExplorationConfig(field="modulus", unread_place="avoid", max_pokes=12)
     mapper = Mapper(Workspace(), config)
     mapper.add(_poke((0.1, 0.1), _soft(5e3), 0))
-    mapper.add(_poke((0.4, 0.2), None, 1, error="too deep"))
+    n = 1
+    mapper.add(_poke((0.4, 0.2), None, n, error="too deep"))
     before = mapper.max_variance()
-    mapper.add(_poke((0.405, 0.2), None, 2, error="too deep"))  # the same place again
+    mapper.add(_poke((0.42, 0.2), None, n + 1, error="too deep"))  # the same place again
     # the modulus field maps on; the place is out of the targets and the stopping rule
     assert mapper.config.field == "modulus" and mapper.field_fallback is None
-    assert mapper.unread_places == [(0.405, 0.2)]
-    radius = BOUNDARY_SPACING_ROI * config.touch.roi_size_m
+    assert mapper.unread_places == [(0.4, 0.2), (0.42, 0.2)]  # about both presses
+    radius = unread_radius_m(config)
+    assert radius == BOUNDARY_SPACING_ROI * config.touch.roi_size_m
     grid = mapper.grid  # the map itself still covers every cell
-    gone = np.hypot(*(grid.cells_xy - (0.405, 0.2)).T) <= radius
+    gone = ((np.hypot(*(grid.cells_xy - (0.4, 0.2)).T) <= radius)
+            | (np.hypot(*(grid.cells_xy - (0.42, 0.2)).T) <= radius))
     choice = mapper._choice_grid
     assert gone.any() and not (choice.target_mask & gone).any()
-    assert not (choice.stop_mask & gone).any()
+    assert (choice.target_mask == grid.target_mask & ~gone).all()
     assert (choice.stop_mask == grid.stop_mask & ~gone).all()
     assert mapper.max_variance() == mapper.modulus_field.max_variance(choice.stop_mask)
-    assert mapper.max_variance() <= before  # the unread disc no longer holds the rule up
+    # (the field's length scale, 0.2 m, spreads the pokes around over the disc: here it is not
+    # where the variance is largest, and the rule's value stays)
+    assert mapper.max_variance() <= before == mapper.modulus_field.max_variance(grid.stop_mask)
     for seed in range(5):
         target = mapper.next_target(np.random.default_rng(seed))
-        assert target is not None and np.hypot(*(target.xy - (0.405, 0.2))) > radius
-    mapper.add(_poke((0.5, 0.3), _soft(6e3), 3))
+        assert target is not None
+        assert min(np.hypot(*(target.xy - xy)) for xy in [(0.4, 0.2), (0.42, 0.2)]) > radius
+    mapper.add(_poke((0.5, 0.3), _soft(6e3), n + 2))
     assert mapper.config.field == "modulus"
     result = mapper.result("max_pokes", {})
-    assert result.unread_places == ((0.405, 0.2),) and result.field_fallback is None
-    # the default, `beta`, gives the same run to β at that poke
-    assert _mapper("modulus").config.unread_place == "beta"
+    assert result.unread_places == ((0.4, 0.2), (0.42, 0.2)) and result.field_fallback is None
+    assert (result.stop_cells == choice.stop_mask).all()
+    assert result.max_variance == mapper.modulus_field.max_variance(choice.stop_mask)
+    # the default, `beta`, gives the same presses' run to β for good, on the whole grid
+    default = _mapper("modulus")
+    assert default.config.unread_place == "beta"
+    for poke in (_poke((0.1, 0.1), _soft(5e3), 0), _poke((0.4, 0.2), None, 1, error="too deep"),
+                 _poke((0.42, 0.2), None, 2, error="too deep")):
+        default.add(poke)
+    assert default.config.field == "beta" and default.unread_places == []
+    assert default.result("max_pokes", {}).stop_mask is not None
+    assert (default.result("max_pokes", {}).stop_cells == default.grid.stop_mask).all()
+
+
+def test_avoid_leaves_a_run_without_any_modulus_on_beta_with_every_place() -> None:
+    """A camera-only run maps on β, which reads the place: nothing is avoided."""
+    mapper = Mapper(Workspace(), ExplorationConfig(field="modulus", unread_place="avoid"))
+    mapper.add(_poke((0.3, 0.2), None, 0, error="too deep"))
+    mapper.add(_poke((0.305, 0.2), None, 1, error="too deep"))
+    assert mapper.config.field == "beta" and mapper.unread_places == []
+    assert (mapper._choice_grid.target_mask == mapper.grid.target_mask).all()
+    mapper.add(_poke((0.1, 0.1), _soft(5e3), 2))  # a modulus: back on the modulus field
+    assert mapper.config.field == "modulus" and mapper.field_fallback is None
+    mapper.add(_poke((0.31, 0.2), None, 3, error="too deep"))  # the place again: now avoided
+    assert mapper.config.field == "modulus" and len(mapper.unread_places) == 3
+
+
+def test_going_to_beta_after_avoided_places_gives_the_targets_back() -> None:
+    small = Workspace(lower=(0.0, 0.0), upper=(0.12, 0.06))
+    mapper = Mapper(small, ExplorationConfig(field="modulus", unread_place="avoid",
+                                             max_pokes=8))
+    mapper.add(_poke((0.03, 0.03), _soft(5e3), 0))
+    mapper.add(_poke((0.09, 0.03), None, 1, error="too deep"))
+    mapper.add(_poke((0.09, 0.03), None, 2, error="too deep"))
+    assert mapper.config.field == "modulus" and len(mapper.unread_places) == 2
+    assert mapper._choice_grid.target_mask.sum() < mapper.grid.target_mask.sum()
+    mapper.add(_poke((0.04, 0.03), None, 3, error="too deep"))
+    mapper.add(_poke((0.04, 0.03), None, 4, error="too deep"))  # no target would be left
+    assert mapper.config.field == "beta"
+    assert "no target would be left without it" in (mapper.field_fallback or "")
+    assert (mapper._choice_grid.target_mask == mapper.grid.target_mask).all()
+    assert (mapper._choice_grid.stop_mask == mapper.grid.stop_mask).all()
 
 
 def test_a_grid_without_every_target_is_none_and_the_run_goes_to_beta() -> None:
     grid = MapGrid.build(Workspace(), ExplorationConfig())
+    with pytest.raises(InvalidArgumentError, match=r"`centres` must be an \(n, 2\) array"):
+        grid.without(np.array([0.3, 0.2, 0.1]), 0.05)
+    with pytest.raises(InvalidArgumentError, match="`radius_m` must be a positive number"):
+        grid.without(np.array([[0.3, 0.2]]), -0.05)
     assert grid.without(np.array([[0.3, 0.2]]), 10.0) is None  # the whole workspace gone
     kept = grid.without(np.zeros((0, 2)), 0.05)
     assert kept is not None and (kept.target_mask == grid.target_mask).all()

@@ -5,7 +5,9 @@ over its edge, where shape matching would have to explain a cliff). The planner 
 :mod:`deformap.explore._planning` works on two coarser lattices of the same grid: the cells where
 the variance must fall (``plan_domain``) and the cells a poke may be planned on
 (``plan_candidates``), every 2 cm with the edges included; a plan short by the difference between
-the lattice and the full grid is planned again after the next poke.
+the lattice and the full grid is planned again after the next poke. A grid without the places a
+run could not read (:meth:`MapGrid.without`, ``exploration.unread_place: avoid``) keeps the
+lattices' points outside those discs.
 """
 
 from __future__ import annotations
@@ -16,6 +18,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from deformap.environment import Workspace
+from deformap.errors import InvalidArgumentError
 from deformap.explore._config import PLAN_GRID_M, ExplorationConfig
 
 __all__ = ["MapGrid"]
@@ -83,8 +86,21 @@ class MapGrid:
     def without(self, centres: NDArray[np.float64], radius_m: float) -> MapGrid | None:
         """This grid with the discs of ``radius_m`` around the ``(n, 2)`` ``centres`` taken out of
         its targets and of the cells whose variance must fall (places the map cannot read, which
-        no further press would make known); ``None`` when no target or no such cell is left."""
-        centres = np.asarray(centres, dtype=float).reshape(-1, 2)
+        no further press would make known); ``None`` when no target or no such cell is left.
+
+        Raises
+        ------
+        InvalidArgumentError
+            ``centres`` is not ``(n, 2)`` finite metres, or ``radius_m`` is not a positive
+            finite number.
+        """
+        centres = np.asarray(centres, dtype=float)
+        if centres.ndim != 2 or centres.shape[1] != 2 or not np.isfinite(centres).all():
+            raise InvalidArgumentError(f"`centres` must be an (n, 2) array of finite metres; got "
+                                       f"shape {centres.shape}")
+        if not (np.isfinite(radius_m) and radius_m > 0):
+            raise InvalidArgumentError(f"`radius_m` must be a positive number of metres; got "
+                                       f"{radius_m!r}")
         near = np.zeros(len(self.cells_xy), dtype=bool)
         for centre in centres:
             near |= np.hypot(*(self.cells_xy - centre).T) <= radius_m

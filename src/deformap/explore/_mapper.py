@@ -34,9 +34,16 @@ from deformap.explore._result import ExplorationResult
 from deformap.explore._surface import SurfaceModel, fit_surface
 from deformap.explore._targets import BOUNDARY_SPACING_ROI, choose_next
 
-__all__ = ["Mapper"]
+__all__ = ["Mapper", "unread_radius_m"]
 
 logger = logging.getLogger(__name__)
+
+
+def unread_radius_m(config: ExplorationConfig) -> float:
+    """Radius [m] of one place: two presses this close are at one place, and an unread place's
+    disc of it leaves the targets and the stopping rule under ``unread_place: avoid``
+    (``BOUNDARY_SPACING_ROI`` ROIs: a dent spreads a few centimetres)."""
+    return float(BOUNDARY_SPACING_ROI * config.touch.roi_size_m)
 
 
 class Mapper:
@@ -156,25 +163,31 @@ class Mapper:
         reading = modulus.readings[-1]
         if self._given_up is None and reading.excluded is not None and self._pokes:
             here = np.asarray(poke.record.contact_xy, dtype=float)
-            radius = BOUNDARY_SPACING_ROI * self.config.touch.roi_size_m
+            radius = unread_radius_m(self.config)
             unread = {r.index for r in modulus.readings[:-1] if r.excluded is not None}
-            if any(p.record.index in unread
-                   and np.hypot(*(np.asarray(p.record.contact_xy) - here)) <= radius
-                   for p in self._pokes):  # fmt: skip
-                places = [*self.unread_places, (float(here[0]), float(here[1]))]
-                left = (self.grid.without(np.array(places), radius)
-                        if self.config.unread_place == "avoid" else None)  # fmt: skip
+            before = [np.asarray(p.record.contact_xy, dtype=float) for p in self._pokes
+                      if p.record.index in unread
+                      and np.hypot(*(np.asarray(p.record.contact_xy) - here)) <= radius]
+            # while no poke has a modulus the run maps on β, which reads the place: nothing to
+            # avoid yet (a later unread press there, once a modulus is read, is caught again)
+            avoid = self.config.unread_place == "avoid"
+            if before and not (avoid and not len(modulus.pokes)):
+                # the disc about every unread press of the place, not only the last
+                places = [*self.unread_places,
+                          *((float(x), float(y)) for x, y in (*before, here))]
+                left = self.grid.without(np.array(places), radius) if avoid else None
                 if left is not None:
                     self.unread_places, self._choice_grid = places, left
                     logger.warning("poke %d: the modulus could not be read twice at (%.3f, %.3f) "
                                    "m (%s); that place is left out of the targets and the "
                                    "stopping rule", poke.record.index + 1, here[0], here[1],
                                    reading.excluded)  # fmt: skip
-                else:
+                else:  # β reads every place: its targets and stopping rule are the whole grid's
+                    self._choice_grid = self.grid
                     self._given_up = (f"poke {poke.record.index + 1}: the modulus could not be "
                                       f"read twice at one place ({reading.excluded})"
-                                      + ("; no target would be left without it"
-                                         if self.config.unread_place == "avoid" else ""))
+                                      + ("; no target would be left without it" if avoid
+                                         else ""))
         if self._given_up is not None:
             why = self._given_up
         elif not len(modulus.pokes):
@@ -222,4 +235,5 @@ class Mapper:
             regions=self.regions() if self._pokes else None,
             max_variance=self.max_variance(), stop_reason=stop_reason, timings=dict(timings),
             field_fallback=self.field_fallback, unread_places=tuple(self.unread_places),
+            stop_mask=self._choice_grid.stop_mask,
         )  # fmt: skip

@@ -57,8 +57,12 @@ class ExplorationResult:
         Why the map is on the β-field although the run asked for the modulus field (no poke gave
         a modulus); ``config.field`` is then ``"beta"``.
     unread_places : tuple of (x, y)
-        Places the modulus could not be read twice at, taken out of the targets and the stopping
-        rule (``exploration.unread_place: avoid``), in the order found [m].
+        The presses whose modulus could not be read at a place read twice in vain, whose discs
+        were taken out of the targets and the stopping rule (``exploration.unread_place:
+        avoid``), in the order found [m].
+    stop_mask : (ny * nx,) bool or None
+        The cells whose variance the stopping rule read: ``grid.stop_mask`` without those discs
+        (``None``: ``grid.stop_mask``).
     """
 
     config: ExplorationConfig
@@ -74,6 +78,12 @@ class ExplorationResult:
     timings: Mapping[str, float]
     field_fallback: str | None = None
     unread_places: tuple[tuple[float, float], ...] = ()
+    stop_mask: NDArray[np.bool_] | None = None
+
+    @property
+    def stop_cells(self) -> NDArray[np.bool_]:
+        """The cells whose variance the stopping rule read (``stop_mask``, else the grid's)."""
+        return self.grid.stop_mask if self.stop_mask is None else self.stop_mask
 
     @property
     def xs(self) -> NDArray[np.float64]:

@@ -198,7 +198,7 @@ def modulus_report(result: ExplorationResult) -> dict[str, Any] | None:
         "ys_m": result.ys.tolist(),
         "log_mean_ln_pa": _rounded(field.mean),
         "log_std": _rounded(field.std),
-        "max_variance": field.max_variance(result.grid.stop_mask),
+        "max_variance": field.max_variance(result.stop_cells),
         "n_used": len(field.pokes),
         "pokes": [r.to_dict() for r in field.readings],
     }  # fmt: skip

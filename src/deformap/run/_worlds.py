@@ -451,9 +451,16 @@ def _check_stored(path: Path, result: Any, config: WorldsBenchConfig) -> dict[st
         if row.get("strategy") not in config.strategies or \
                 row.get("field") not in config.fields or not isinstance(row.get("poke"), int):
             raise bad(f"a row of {combo!r} at poke {row.get('poke')!r} is not of this benchmark")
+        mapped = row.get("map_field", row["field"])
+        if mapped not in choices("field"):
+            raise bad(f"a row of {combo!r} at poke {row['poke']} has `map_field` {mapped!r}, "
+                      f"expected one of {list(choices('field'))}")
         check_pokes(pokes.get(combo), f"pokes of {combo!r}")
         if combo in fallback:
             check_pokes(fallback[combo], f"fallback pokes of {combo!r}")
+        elif mapped != row["field"] and version >= 3:  # the third format stores them
+            raise bad(f"no stored fallback pokes of {combo!r}, whose map field was {mapped!r} "
+                      f"at poke {row['poke']} (pokes_format {version})")
     for (strategy, field), ran in fell_back_cuts(result).items():
         if set(config.cuts) - ran:
             raise bad(f"the run of {strategy}/{field} fell back from the modulus field to β, so "
