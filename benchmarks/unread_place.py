@@ -23,10 +23,8 @@ from __future__ import annotations
 
 import argparse
 import json
-import multiprocessing
 import os
 import time
-from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 from typing import Any
 
@@ -36,14 +34,9 @@ for _name in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
 import numpy as np  # noqa: E402
 
 from deformap.eval import row_values, run_world, summarise_worlds  # noqa: E402
+from deformap.run._worlds import worker_pool  # noqa: E402
 
 GOOD = 0.9
-
-
-def _pin() -> None:
-    from threadpoolctl import threadpool_limits
-
-    threadpool_limits(limits=1)
 
 
 def _given_up(result: dict[str, Any]) -> set[tuple[str, str]]:
@@ -122,8 +115,8 @@ def main() -> None:
         tasks = {i: {**{key: settings[key] for key in keys}, "index": i,
                      "unread_place": "avoid"} for i in affected}
         t0 = time.perf_counter()
-        ctx = multiprocessing.get_context("spawn")
-        with ProcessPoolExecutor(args.workers, mp_context=ctx, initializer=_pin) as pool:
+        # bench worlds' own pool: BLAS on one thread, and workers that end with this process
+        with worker_pool(args.workers) as pool:
             again = dict(zip(tasks, pool.map(run_world, tasks.values()), strict=True))
         print(f"mapped in {time.perf_counter() - t0:.0f} s\n")
         if args.out:

@@ -11,6 +11,10 @@ Every report of a mapped surface (a live exploration, :func:`live_report`; a rec
   (:mod:`deformap.explore._nugget`; 0 under ``beta_field.nugget: off``);
 - ``field`` (the field the regions, the targets and the stop rule ran on: ``beta`` or
   ``modulus``) and ``threshold`` (its ``T_h``, in its units: :func:`deformap.explore.field_settings`);
+  ``field_fallback`` (why a run asked for the modulus field maps on β, else ``None``) and
+  ``unread_places`` (``[x, y]`` [m] of the presses of places whose modulus could not be read
+  twice, left out of the targets and the stopping rule under ``exploration.unread_place: avoid``;
+  ``max_variance`` and ``modulus_field.max_variance`` are over the rule's cells without them);
 - ``regions``: ``levels`` and ``class_values`` (in the map field's units: β, or ln E [ln Pa]),
   ``class_betas`` (the mean β of each class's pokes), ``class_modulus_median_pa`` (the median of
   the modulus field's E [Pa] over each found region's cells; ``None`` without a modulus),
