@@ -34,7 +34,7 @@ for _name in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
 import numpy as np  # noqa: E402
 
 from deformap.eval import row_values, run_world, summarise_worlds  # noqa: E402
-from deformap.run._worlds import worker_pool  # noqa: E402
+from deformap.run._worlds import SETTINGS_BEFORE, worker_pool  # noqa: E402
 
 GOOD = 0.9
 
@@ -66,8 +66,6 @@ def _to_good(curve: list[dict[str, Any]], max_pokes: int) -> int:
     return next((r["poke"] for r in curve if r["accuracy"] >= GOOD), max_pokes + 1)
 
 
-#: bench.json keys a run from before them did not have, and what such a run did
-_BEFORE = {"split_by_place": False, "unread_place": "beta"}
 
 
 def main() -> None:
@@ -80,7 +78,7 @@ def main() -> None:
     if args.workers < 1:
         raise SystemExit(f"--workers: expected an integer >= 1; got {args.workers}")
     try:
-        settings = {**_BEFORE, **json.loads((args.run / "bench.json").read_text(
+        settings = {**SETTINGS_BEFORE, **json.loads((args.run / "bench.json").read_text(
             encoding="utf-8"))["settings"]}
     except (OSError, ValueError, KeyError, TypeError) as exc:
         raise SystemExit(f"RUN: expected a bench worlds folder with its bench.json; got "
@@ -111,7 +109,7 @@ def main() -> None:
               f"for good; mapping them again with unread_place: avoid ({args.workers} "
               f"processes)")
         keys = ("seed", "families", "physics", "strategies", "fields", "cuts", "max_pokes",
-                "coarse", "merge_seams", "split_by_place")
+                "coarse", "merge_seams", "split_by_place", "boundary_score")
         tasks = {i: {**{key: settings[key] for key in keys}, "index": i,
                      "unread_place": "avoid"} for i in affected}
         t0 = time.perf_counter()

@@ -165,7 +165,10 @@ def test_the_command_refuses_bad_names_in_one_line_before_any_folder(tmp_path) -
                           (["--cuts", "nearest,nearest"], "got ['nearest'] more than once"),
                           (["--worlds", "0"], "`worlds` must be an integer >= 1"),
                           (["--unread-place", "skip"],
-                           "`unread_place` must be one of ['beta', 'avoid']; got 'skip'")):
+                           "`unread_place` must be one of ['beta', 'avoid']; got 'skip'"),
+                          (["--boundary-score", "voronoi"],
+                           "`boundary_score` must be one of ['straddle', 'nearest-poke']; got "
+                           "'voronoi'")):
         result = CliRunner().invoke(app, ["bench", "worlds", "--out", str(out), *args])
         assert result.exit_code == 2, result.output
         assert message in result.output and len(result.output.strip().splitlines()) == 1

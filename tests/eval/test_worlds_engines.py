@@ -63,13 +63,17 @@ def test_pool_and_dask_agree_byte_for_byte_apart_from_times_and_resume(tmp_path)
     assert bench_worlds(_config(worlds=2, split_by_place=False), tmp_path / "pool").computed == 0
     with pytest.raises(ConfigError, match="split_by_place: False there, True here"):
         bench_worlds(_config(worlds=2, split_by_place=True), tmp_path / "pool")
-    # and one from before unread_place gave a run to β at an unread place
-    del header["settings"]["unread_place"]
+    # and one from before unread_place gave a run to β at an unread place, and scored its
+    # boundary pokes by straddle
+    del header["settings"]["unread_place"], header["settings"]["boundary_score"]
     settings_file.write_text(json.dumps(header))
-    resumed = _config(worlds=2, split_by_place=False, unread_place="beta")
+    resumed = _config(worlds=2, split_by_place=False, unread_place="beta",
+                      boundary_score="straddle")
     assert bench_worlds(resumed, tmp_path / "pool").computed == 0
     with pytest.raises(ConfigError, match="unread_place: 'beta' there, 'avoid' here"):
         bench_worlds(replace(resumed, unread_place="avoid"), tmp_path / "pool")
+    with pytest.raises(ConfigError, match="boundary_score: 'straddle' there, 'nearest-poke'"):
+        bench_worlds(replace(resumed, boundary_score="nearest-poke"), tmp_path / "pool")
 
 
 def test_a_failing_world_is_tried_twice_then_reported_not_dropped(caplog) -> None:
@@ -115,7 +119,7 @@ def test_rescore_scores_other_cuts_on_the_stored_pokes_and_names_what_it_cannot(
     stored = json.loads(source_settings.read_text())
     del stored["settings"]["split_by_place"]
     source_settings.write_text(json.dumps(stored))
-    del stored["settings"]["unread_place"]  # and from before unread_place
+    del stored["settings"]["unread_place"], stored["settings"]["boundary_score"]  # and before
     source_settings.write_text(json.dumps(stored))
     for flag, expected, folder in (([], False, "before"), (["--split-by-place"], True, "split")):
         result = runner.invoke(app, ["bench", "rescore", str(tmp_path / "src"), "--out",
@@ -124,6 +128,7 @@ def test_rescore_scores_other_cuts_on_the_stored_pokes_and_names_what_it_cannot(
         written = json.loads((tmp_path / folder / "bench.json").read_text())["settings"]
         assert written["split_by_place"] is expected
         assert written["unread_place"] == "beta"  # what such a run did
+        assert written["boundary_score"] == "straddle"
     # the folder must be new; a world from before the pokes were stored is named
     result = runner.invoke(app, ["bench", "rescore", str(tmp_path / "src"), "--out",
                                  str(tmp_path / "again")])

@@ -114,3 +114,47 @@ def test_boundary_pokes_go_onto_the_isopleth_not_to_the_least_known_place() -> N
         target = mapper.next_target(rng)
     assert len(boundary) == 2 and mapper.boundary_owed() == 0
     assert all(abs(t[0] - 0.3) < 0.08 for t in boundary)  # near the true edge
+
+
+def test_the_nearest_poke_boundary_score_is_highest_on_the_bisector_far_from_the_pokes() -> None:
+    from deformap.explore._targets import nearest_poke_boundary_score
+
+    xy = np.array([[0.1, 0.2], [0.5, 0.2]])
+    cells = np.array([[0.3, 0.2], [0.3, 0.39], [0.2, 0.2], [0.45, 0.2]])
+    one = nearest_poke_boundary_score(cells, xy, np.array([0, 0]))
+    np.testing.assert_allclose(one, np.hypot(*(cells[:, None, :] - xy[None]).transpose(2, 0, 1))
+                               .min(axis=1))  # one class: the distance to the pokes alone
+    two = nearest_poke_boundary_score(cells, xy, np.array([0, 1]))
+    # on the bisector x = 0.3 the score is the distance to the pokes; off it, less by half the
+    # difference of the two distances
+    np.testing.assert_allclose(two[0], 0.2)
+    np.testing.assert_allclose(two[1], np.hypot(0.2, 0.19))
+    np.testing.assert_allclose(two[2], 0.1 - 0.5 * (0.3 - 0.1))
+    assert two[1] > two[0] > two[2] and two[3] < 0
+
+
+def test_nearest_poke_boundary_pokes_go_onto_the_pokes_bisector_between_two_materials() -> None:
+    # two materials split at x = 0.30 m (β 0.8 left, 0.5 right), as the straddle test above
+    config = ExplorationConfig(boundary_pokes=2, boundary_score="nearest-poke",
+                               beta_field=BetaFieldConfig(noise_floor=0.015))
+    mapper = Mapper(Workspace(lower=(0.0, 0.0), upper=(0.6, 0.4)), config)
+    rng = np.random.default_rng(0)
+    target: Target | None = Target(np.array([0.3, 0.2]), "first")
+    boundary = []
+    while target is not None:
+        xy_t = target.xy
+        if target.purpose == "boundary":
+            xy = np.array([p.xy for p in mapper.pokes])
+            labels = mapper.regions().poke_labels
+            d = np.linalg.norm(xy - xy_t, axis=1)
+            # about as far from the nearest poke of each class: on the map's boundary
+            near = [d[labels == k].min() for k in np.unique(labels)]
+            assert len(near) == 2 and abs(near[0] - near[1]) < 0.03
+            assert d.min() >= 0.25 * config.touch.roi_size_m
+            boundary.append(xy_t)
+        beta = 0.8 if xy_t[0] < 0.3 else 0.5
+        mapper.add(synthetic_poke(xy_t, beta, 0.03, index=len(mapper.pokes)), target=target)
+        target = mapper.next_target(rng)
+    assert len(boundary) == 2 and mapper.boundary_owed() == 0
+    with pytest.raises(InvalidArgumentError, match="`boundary_score` must be one of"):
+        ExplorationConfig(boundary_score="voronoi")  # type: ignore[arg-type]

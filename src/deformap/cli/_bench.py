@@ -188,6 +188,9 @@ def bench_worlds_command(
     unread_place: Annotated[str | None, typer.Option(
         help="What a place whose modulus cannot be read twice does (exploration.unread_place: "
              "beta or avoid); default: the exploration's.", show_default=False)] = None,
+    boundary_score: Annotated[str | None, typer.Option(
+        help="How a boundary poke scores a cell (exploration.boundary_score: straddle or "
+             "nearest-poke); default: the exploration's.", show_default=False)] = None,
     coarse: Annotated[bool, typer.Option(
         help="The coarse test mesh and camera: a third of the cost, a smoke run only (its 2 cm "
              "mesh reads E far off).")] = False,
@@ -206,7 +209,8 @@ def bench_worlds_command(
     given: dict[str, Any] = {"families": _names(families), "strategies": _names(strategies),
                              "fields": _names(fields), "physics": _names(physics),
                              "cuts": _names(cuts), "merge_seams": merge_seams,
-                             "split_by_place": split_by_place, "unread_place": unread_place}
+                             "split_by_place": split_by_place, "unread_place": unread_place,
+                             "boundary_score": boundary_score}
     config = run.WorldsBenchConfig(
         worlds=worlds, seed=seed, max_pokes=max_pokes, coarse=coarse, workers=workers,
         scheduler=scheduler, **{k: v for k, v in given.items() if v is not None})

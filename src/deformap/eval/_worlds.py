@@ -265,8 +265,8 @@ def _draw(task: dict[str, Any]) -> tuple[WorldDraw, ExplorationConfig]:
     explore = ExplorationConfig(max_pokes=k, boundary_pokes=k, force_n=draw.force_n)
     rules: dict[str, Any] = {r: bool(task[r]) for r in ("merge_seams", "split_by_place")
                              if r in task}  # the rules on the regions, when given
-    if "unread_place" in task:  # what an unreadable place does, when given
-        rules["unread_place"] = task["unread_place"]
+    # where the pokes go after an unread place, and where a boundary poke goes, when given
+    rules.update({k: task[k] for k in ("unread_place", "boundary_score") if k in task})
     explore = replace(explore, **rules)
     return draw, explore
 
@@ -296,8 +296,8 @@ def run_world(task: dict[str, Any]) -> dict[str, Any]:
         from, default all), ``strategies``, ``fields``, ``cuts`` (the
         ``region_labels`` scored, each on the same pokes), ``max_pokes``, ``coarse`` (the
         test mesh and camera of :meth:`WorldConfig.coarse`, else the default world),
-        ``merge_seams``, ``split_by_place`` and ``unread_place`` (optional:
-        ``ExplorationConfig``'s, default the exploration's).
+        ``merge_seams``, ``split_by_place``, ``unread_place`` and ``boundary_score``
+        (optional: ``ExplorationConfig``'s, default the exploration's).
 
     Returns
     -------

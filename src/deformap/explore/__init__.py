@@ -7,6 +7,7 @@ from __future__ import annotations
 from deformap.explore._acquisition import STRATEGIES, choose_target
 from deformap.explore._config import (
     BetaFieldConfig,
+    BoundaryScore,
     ExplorationConfig,
     FieldName,
     ModulusFieldConfig,
@@ -75,6 +76,7 @@ __all__ = [
     "STRATEGIES",
     "BetaField",
     "BetaFieldConfig",
+    "BoundaryScore",
     "ContactRecord",
     "Dent",
     "ExplorationConfig",

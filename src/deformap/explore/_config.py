@@ -95,6 +95,7 @@ __all__ = [
     "PLANNER_STRATEGIES",
     "BetaFieldConfig",
     "BetaUncertainty",
+    "BoundaryScore",
     "DepthAnchor",
     "ExplorationConfig",
     "FieldName",
@@ -126,6 +127,8 @@ FieldName = Literal["beta", "modulus"]
 NuggetEstimate = Literal["within-class", "off"]
 #: Where a poke's β uncertainty comes from (``ExplorationConfig.beta_uncertainty``).
 BetaUncertainty = Literal["camera-noise", "shape-matching"]
+#: How a boundary poke (and ``level-set``) scores a cell (``ExplorationConfig.boundary_score``).
+BoundaryScore = Literal["straddle", "nearest-poke"]
 #: What the modulus field does with a place whose modulus could not be read twice
 #: (``ExplorationConfig.unread_place``).
 UnreadPlace = Literal["beta", "avoid"]
@@ -349,6 +352,14 @@ class ExplorationConfig:
         Pokes made after the variance has fallen below ``T_h``, each where a region boundary is
         least certain (:mod:`deformap.explore._acquisition`, "boundary pokes"); 0, the paper's
         rule, stops there.
+    boundary_score : {"straddle", "nearest-poke"}
+        How a boundary poke, and every poke of ``level-set``, scores the reachable cells:
+        ``straddle``, the field's (Bryan et al. 2005: ``1.96 σ − min |μ − h|`` against the
+        isopleths between the classes); ``nearest-poke``, the nearest-poke map's
+        (:func:`deformap.explore._targets.nearest_poke_boundary_score`: how far a cell is from
+        any poke, less half its distance to where the nearest-poke map's boundary passes), the
+        boundaries the default cut draws. Either reads the pokes' classes before any cut, so
+        where the pokes go does not depend on ``region_labels``.
     stiffness : StiffnessConfig
         Reading stiffness and Young's modulus from a press's force–travel record, when the
         environment gives one (:func:`deformap.explore.estimate_stiffness`).
@@ -395,6 +406,7 @@ class ExplorationConfig:
     merge_seams: bool = True
     split_by_place: bool = True
     boundary_pokes: int = setting(0, ge=0, le=1000)  # as for max_pokes
+    boundary_score: BoundaryScore = "straddle"
     beta_uncertainty: BetaUncertainty = "camera-noise"
     field: FieldName = "modulus"
     unread_place: UnreadPlace = "beta"

@@ -47,7 +47,7 @@ from deformap.eval import (
     runs_csv,
     summarise_worlds,
 )
-from deformap.explore import ExplorationConfig, UnreadPlace
+from deformap.explore import BoundaryScore, ExplorationConfig, UnreadPlace
 from deformap.run._folder import create_run_folder, default_run_folder, to_json, write_text
 from deformap.run._hooks import NO_HOOKS, RunHooks, RunStart
 from deformap.viz import plot_world_curves
@@ -63,6 +63,10 @@ logger = logging.getLogger(__name__)
 BLAS_THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS",
                          "BLIS_NUM_THREADS", "VECLIB_MAXIMUM_THREADS", "NUMEXPR_NUM_THREADS")
 SETTINGS_NAME = "bench.json"
+#: What a run did before each of these settings was in ``bench.json``: scored without the split by
+#: place, gave a run to β at an unread place, scored boundary pokes by straddle.
+SETTINGS_BEFORE: dict[str, Any] = {"split_by_place": False, "unread_place": "beta",
+                                   "boundary_score": "straddle"}
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -94,6 +98,8 @@ class WorldsBenchConfig:
     unread_place : {"beta", "avoid"}
         ``ExplorationConfig.unread_place`` (it changes where the pokes go after a place could
         not be read, so a rescore keeps the source's; default the exploration's).
+    boundary_score : {"straddle", "nearest-poke"}
+        ``ExplorationConfig.boundary_score`` (where the boundary pokes go; likewise kept).
     coarse : bool
         The test mesh and camera (:meth:`deformap.world.WorldConfig.coarse`, about a third of a
         default world's cost) instead of the default world. A smoke run only: on one linear-FEM
@@ -118,6 +124,7 @@ class WorldsBenchConfig:
     merge_seams: bool = ExplorationConfig().merge_seams
     split_by_place: bool = ExplorationConfig().split_by_place
     unread_place: UnreadPlace = ExplorationConfig().unread_place
+    boundary_score: BoundaryScore = ExplorationConfig().boundary_score
     coarse: bool = False
     workers: int = setting(1, ge=1, le=1024)
     scheduler: str | None = None
@@ -152,7 +159,7 @@ class WorldsBenchConfig:
                 "strategies": list(self.strategies), "fields": list(self.fields),
                 "cuts": list(self.cuts), "max_pokes": self.max_pokes, "coarse": self.coarse,
                 "merge_seams": self.merge_seams, "split_by_place": self.split_by_place,
-                "unread_place": self.unread_place}
+                "unread_place": self.unread_place, "boundary_score": self.boundary_score}
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -304,9 +311,8 @@ def _open_folder(config: WorldsBenchConfig, out: Path | None) -> tuple[Path, dic
             raise ConfigError(f"--out: {settings_file} cannot be read: {exc}") from None
         ours = json.loads(to_json(config.result_settings()))
         theirs = stored.get("settings") if isinstance(stored, dict) else None
-        if isinstance(theirs, dict):  # a run from before the split by place ran without it,
-            # and one from before unread_place gave a run to β at an unread place
-            theirs = {"split_by_place": False, "unread_place": "beta", **theirs}
+        if isinstance(theirs, dict):  # a run from before a setting did what it did then
+            theirs = {**SETTINGS_BEFORE, **theirs}
         if theirs != ours:
             there = theirs if isinstance(theirs, dict) else {}
             differ = ", ".join(f"{k}: {there.get(k)!r} there, {ours.get(k)!r} here"
@@ -505,10 +511,7 @@ def rescore_worlds(source: Path, out: Path, *, cuts: Sequence[str] | None = None
         given["cuts"] = tuple(cuts)
     if merge_seams is not None:
         given["merge_seams"] = merge_seams
-    # a source from before the split by place was scored without it, and from before
-    # unread_place mapped with β at an unread place
-    given.setdefault("split_by_place", False)
-    given.setdefault("unread_place", "beta")
+    given = {**SETTINGS_BEFORE, **given}  # a source from before a setting did what it did then
     if split_by_place is not None:
         given["split_by_place"] = split_by_place
     config = WorldsBenchConfig(worlds=1, **given)  # the settings checked before any world
