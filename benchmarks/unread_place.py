@@ -32,8 +32,9 @@ for _name in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_name, "1")  # the workers are spawned: they read these as numpy loads
 
 import numpy as np  # noqa: E402
+from numpy.typing import NDArray  # noqa: E402
 
-from deformap.eval import row_values, run_world, summarise_worlds  # noqa: E402
+from deformap.eval import run_world, summarise_worlds  # noqa: E402
 from deformap.run._worlds import SETTINGS_BEFORE, worker_pool  # noqa: E402
 
 GOOD = 0.9
@@ -54,6 +55,18 @@ def _given_up(result: dict[str, Any]) -> set[tuple[str, str]]:
 def _curve(rows: list[dict[str, Any]], strategy: str, cut: str) -> list[dict[str, Any]]:
     return sorted((r for r in rows if r["strategy"] == strategy and r["field"] == "modulus"
                    and r["cut"] == cut), key=lambda r: r["poke"])
+
+
+def _same_pokes(a: dict[str, list[Any]], b: dict[str, list[Any]], until: int) -> bool:
+    """The stored pokes numbered below ``until`` (from 1) at the same places with the same values,
+    to 1e-9 relative: the same presses (a score may still differ in its last bits, or a τ of one
+    poke be 1.0 or undefined, as the BLAS sums in another order)."""
+    def kept(d: dict[str, list[Any]]) -> NDArray[np.float64]:
+        keep = np.asarray(d["index"]) < until - 1
+        return np.column_stack([np.asarray(d[c], float)[keep] for c in ("x", "y", "value")])
+
+    x, y = kept(a), kept(b)
+    return x.shape == y.shape and bool(np.allclose(x, y, rtol=1e-9, atol=1e-12))
 
 
 def _fell(curve: list[dict[str, Any]]) -> int:
@@ -124,22 +137,17 @@ def main() -> None:
     for i, result in again.items():
         for strategy in settings["strategies"]:
             for field in settings["fields"]:
-                old = [row_values(r) for r in source[i]["rows"]
-                       if (r["strategy"], r["field"]) == (strategy, field)]
-                new = [row_values(r) for r in result["rows"]
-                       if (r["strategy"], r["field"]) == (strategy, field)]
-                if (strategy, field) in affected[i]:  # the same until the poke that fell back
-                    until = _fell(_curve(source[i]["rows"], strategy, cut))
-                    old = [r for r in old if r["poke"] < until]
-                    new = [r for r in new if r["poke"] < until]
-                if old != new:
+                combo = f"{strategy}/{field}"
+                until = (_fell(_curve(source[i]["rows"], strategy, cut))
+                         if (strategy, field) in affected[i] else k + 1)
+                if not _same_pokes(source[i]["pokes"][combo], result["pokes"][combo], until):
                     paired = False
-                    print(f"world {i}: {strategy}/{field} differs from the run's before it "
-                          f"fell back" if (strategy, field) in affected[i] else
-                          f"world {i}: {strategy}/{field} did not fall back but its rows differ "
-                          f"from the run's")
-    print("the combinations that did not fall back gave the run's rows to the bit, and those "
-          "that did gave them up to that poke" if paired else "NOT PAIRED: the rows above differ")
+                    print(f"world {i}: {combo} pressed elsewhere than the run"
+                          + (f" before poke {until}, where it fell back"
+                             if until <= k else ""))
+    print("the combinations that did not fall back pressed where the run did, with the same "
+          "readings (to 1e-9), and those that did up to that poke" if paired else
+          "NOT PAIRED: the combinations above pressed elsewhere")
     print()
     print(f"| world | family | strategy | fell back at | pokes to {GOOD} (beta / avoid) | "
           f"accuracy after the last poke (beta / avoid) | E error after the last poke (beta / "

@@ -201,8 +201,9 @@ def test_a_first_poke_without_modulus_does_not_decide_the_run() -> None:
     assert len(mapper.field.pokes) == 2 and mapper.field is not on_beta  # fitted again, lazily
 
 
-def test_a_place_whose_modulus_cannot_be_read_twice_gives_the_run_to_beta() -> None:
-    mapper = _mapper("modulus")
+def test_under_unread_place_beta_a_place_read_twice_in_vain_gives_the_run_to_beta() -> None:
+    mapper = Mapper(Workspace(), ExplorationConfig(field="modulus", unread_place="beta",
+                                                   max_pokes=6))
     mapper.add(_poke((0.1, 0.1), _soft(5e3), 0))
     mapper.add(_poke((0.4, 0.2), None, 1, error="too deep"))
     assert mapper.config.field == "modulus"  # once: left out, the run goes on on the modulus
@@ -248,9 +249,9 @@ def test_under_unread_place_avoid_the_place_leaves_the_targets_and_the_stopping_
     assert result.unread_places == ((0.4, 0.2), (0.42, 0.2)) and result.field_fallback is None
     assert (result.stop_cells == choice.stop_mask).all()
     assert result.max_variance == mapper.modulus_field.max_variance(choice.stop_mask)
-    # the default, `beta`, gives the same presses' run to β for good, on the whole grid
-    default = _mapper("modulus")
-    assert default.config.unread_place == "beta"
+    # the former rule, `beta`, gives the same presses' run to β for good, on the whole grid
+    assert _mapper("modulus").config.unread_place == "avoid"  # the default
+    default = Mapper(Workspace(), ExplorationConfig(field="modulus", unread_place="beta"))
     for poke in (_poke((0.1, 0.1), _soft(5e3), 0), _poke((0.4, 0.2), None, 1, error="too deep"),
                  _poke((0.42, 0.2), None, 2, error="too deep")):
         default.add(poke)

@@ -380,7 +380,11 @@ class ExplorationConfig:
         ``avoid``, the run keeps the modulus field and takes that disc out of the targets and of
         the cells whose variance must fall below ``T_h`` (the map still covers it, from the
         pokes around it; ``ExplorationResult.unread_places`` lists them), and falls back to β
-        only when no target would be left.
+        only when no target would be left. ``avoid`` is the default: over the 100 default worlds
+        of ``deformap bench worlds --seed 0`` (README, "Many worlds") it changed the 23 of 600
+        runs that had gone to β, median pokes to accuracy 0.9 as they were (16 of those runs
+        ended more accurate, 7 less; mean final accuracy 0.845 → 0.872), and it keeps the map in
+        physical units.
     modulus_field : ModulusFieldConfig
         Prior of the modulus field; it is computed whenever a poke has a modulus, whichever
         ``field`` is chosen.
@@ -409,7 +413,7 @@ class ExplorationConfig:
     boundary_score: BoundaryScore = "straddle"
     beta_uncertainty: BetaUncertainty = "camera-noise"
     field: FieldName = "modulus"
-    unread_place: UnreadPlace = "beta"
+    unread_place: UnreadPlace = "avoid"
     surface: SurfaceGPConfig = _field(default_factory=SurfaceGPConfig)
     touch: TouchGPConfig = _field(default_factory=TouchGPConfig)
     beta_field: BetaFieldConfig = _field(default_factory=BetaFieldConfig)
