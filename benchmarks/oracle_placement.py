@@ -5,7 +5,8 @@
 
 For each world of a ``deformap bench worlds`` seed (drawn from ``(seed, index)`` alone, as the
 benchmark draws it; nothing is pressed) this places pokes as an oracle would: the first at the
-workspace's centre, as every strategy's, then each where it raises the region accuracy most, each
+workspace's centre, as every strategy's, then each where it raises the share of cells labelled as
+their material most (the region accuracy before its label matching, which can only raise it), each
 poke given the class of the material under it and every cell the class of its nearest poke (the
 default cut). Candidates are the planner's 2 cm lattice of the cells a poke may be centred on.
 A greedy placement is not the best placement, so its count is one that *can* be reached, not
@@ -79,9 +80,15 @@ def main() -> None:
                          f"{args.max_pokes}")
     families, physics, run_rows = list(LAYOUT_FAMILIES), ["linear-fem"], None
     if args.run is not None:
-        settings = json.loads((args.run / "bench.json").read_text(encoding="utf-8"))["settings"]
-        if settings["seed"] != args.seed:
-            raise SystemExit(f"--run: expected a run of seed {args.seed}; got {settings['seed']}")
+        try:
+            settings = json.loads((args.run / "bench.json").read_text(encoding="utf-8"))[
+                "settings"]
+        except (OSError, ValueError, KeyError, TypeError) as exc:
+            raise SystemExit(f"--run: expected a bench worlds folder with its bench.json; got "
+                             f"{args.run} ({exc})") from None
+        if settings["seed"] != args.seed or "nearest" not in settings["cuts"]:
+            raise SystemExit(f"--run: expected a run of seed {args.seed} scored under the nearest "
+                             f"cut; got seed {settings['seed']}, cuts {settings['cuts']}")
         families, physics = settings["families"], settings["physics"]
         run_rows = settings
     results = []
@@ -97,7 +104,10 @@ def main() -> None:
     if run_rows is not None:
         stored = {}
         for path in sorted((args.run / "worlds").glob("world-*.json")):
-            r = json.loads(path.read_text(encoding="utf-8"))
+            try:
+                r = json.loads(path.read_text(encoding="utf-8"))
+            except (OSError, ValueError) as exc:
+                raise SystemExit(f"--run: {path} cannot be read ({exc})") from None
             if r.get("status") == "ok" and r["world"]["index"] < args.worlds:
                 stored[r["world"]["index"]] = [x for x in r["rows"] if x["cut"] == "nearest"
                                                and x["poke"] <= args.max_pokes]

@@ -3,14 +3,14 @@
     OMP_NUM_THREADS=1 PYTHONPATH=src python benchmarks/unread_place.py RUN [--workers 2] [--out F]
 
 ``RUN`` is a folder written by ``deformap bench worlds`` with the modulus field among its fields
-and the default ``exploration.unread_place: beta``: a run that presses a place twice without a
-usable force–travel record maps on the β-field from then on. This maps every world of ``RUN``
-where a combination did so again, with the same settings and ``unread_place: avoid`` (the run
-keeps the modulus field and leaves that place out of its targets and its stopping rule). The
-baseline is ``RUN``'s own rows of those worlds: a world's presses are a function of its seed and
-the settings, so everything before the fallback is the same press for press, and the rows of the
-combinations that never fell back must come out the same to the bit apart from times (the script
-checks it, and says so where they do not: then the worlds are not paired).
+and ``--unread-place beta`` (the default before ``avoid``): a run that presses a place twice
+without a usable force–travel record maps on the β-field from then on. This maps every world of
+``RUN`` where a combination did so again, with the same settings and ``unread_place: avoid``
+(the run keeps the modulus field and leaves that place out of its targets and its stopping
+rule). The baseline is ``RUN``'s own rows of those worlds: a world's presses are a function of
+its seed and the settings, so every press before the fallback is the same, and every press of
+the combinations that never fell back (the script checks it on the stored pokes, places and
+readings to 1e-9, and says so where they differ: then the worlds are not paired).
 
 It prints, for each combination that fell back (``world``, ``strategy``) and over them, the
 pokes to region accuracy 0.9 (``max_pokes + 1`` when never), the accuracy and the modulus error
@@ -102,16 +102,23 @@ def main() -> None:
                          f"{settings['unread_place']!r}")
     source = {}
     for path in sorted((args.run / "worlds").glob("world-*.json")):
-        result = json.loads(path.read_text(encoding="utf-8"))
-        if result.get("status") == "ok":
-            source[result["world"]["index"]] = result
+        try:
+            result = json.loads(path.read_text(encoding="utf-8"))
+            if result.get("status") == "ok":
+                source[result["world"]["index"]] = result
+        except (OSError, ValueError, KeyError, TypeError, AttributeError) as exc:
+            raise SystemExit(f"RUN: {path} is not a world's result ({exc})") from None
     affected = {i: _given_up(r) for i, r in source.items() if _given_up(r)}
     if not affected:
         raise SystemExit(f"RUN: no combination of {args.run} went to β for good; nothing to do")
     k = settings["max_pokes"]
     cut = settings["cuts"][0]
     if args.again:
-        again = {r["world"]["index"]: r for r in json.loads(args.again.read_text("utf-8"))}
+        try:
+            again = {r["world"]["index"]: r for r in json.loads(args.again.read_text("utf-8"))}
+        except (OSError, ValueError, KeyError, TypeError) as exc:
+            raise SystemExit(f"--again: expected a JSON file written by --out; got "
+                             f"{args.again} ({exc})") from None
         if set(again) != set(affected):
             raise SystemExit(f"--again: expected the worlds {sorted(affected)}; got "
                              f"{sorted(again)}")

@@ -149,7 +149,7 @@ def test_nearest_poke_boundary_pokes_go_onto_the_pokes_bisector_between_two_mate
             d = np.linalg.norm(xy - xy_t, axis=1)
             # about as far from the nearest poke of each class: on the map's boundary
             near = [d[labels == k].min() for k in np.unique(labels)]
-            assert len(near) == 2 and abs(near[0] - near[1]) < 0.03
+            assert len(near) == 2 and abs(near[0] - near[1]) < 0.01  # straddle's: 0.03
             assert d.min() >= 0.25 * config.touch.roi_size_m
             boundary.append(xy_t)
         beta = 0.8 if xy_t[0] < 0.3 else 0.5

@@ -59,7 +59,7 @@ Boundary pokes (``boundary_pokes`` > 0, after any strategy)
     score is the nearest-poke map's instead (:func:`deformap.explore._targets.
     nearest_poke_boundary_score`): the boundaries that cut draws are the bisectors between pokes
     of different classes, not the field's isopleths, so a cell scores by how far it is from any
-    poke less half its distance to such a bisector.
+    poke less its distance to such a bisector (about ``(d₂ − d₁) / 2``).
 
 References
 ----------

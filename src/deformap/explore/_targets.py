@@ -70,8 +70,9 @@ def _plan(grid: MapGrid, pokes: PokeSet, config: ExplorationConfig, n_made: int)
 def _straddle(grid: MapGrid, field: BetaField, pokes: PokeSet, config: ExplorationConfig
               ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:  # fmt: skip
     """The reachable cells at least ``BOUNDARY_SPACING_ROI`` ROIs from every poke and their
-    straddle scores (:func:`boundary_score` against the isopleths of the pokes' classes; ``σ``
-    alone before any poke); both empty when no cell is left."""
+    boundary scores: straddle (:func:`boundary_score` against the isopleths of the pokes'
+    classes), or under ``boundary_score: nearest-poke`` :func:`nearest_poke_boundary_score`
+    against the pokes' classes; ``σ`` alone before any poke; both empty when no cell is left."""
     allowed = grid.target_mask.copy()
     var = field.variance.ravel()
     if len(pokes) == 0:
