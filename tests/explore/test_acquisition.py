@@ -1,5 +1,7 @@
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 import pytest
 
@@ -83,12 +85,10 @@ def test_boundary_settings_are_checked() -> None:
         ExplorationConfig(boundary_pokes=-1)
 
 
-def test_boundary_pokes_go_onto_the_isopleth_not_to_the_least_known_place() -> None:
-    # fake pokes on two materials split at x = 0.30 m (β 0.8 left, 0.5 right), from the centre
-    # at the former floor 0.015: the planner's pokes before the boundary pokes depend on the
-    # noise it expects of a new poke (the floor far from the pokes), and at the default floor,
-    # the β grid's 0.0029, its design leaves a boundary poke 8 cm or more off the edge
-    config = ExplorationConfig(boundary_pokes=2, beta_field=BetaFieldConfig(noise_floor=0.015))
+def _two_materials(config: ExplorationConfig,
+                   check: Callable[[Mapper, np.ndarray], None]) -> list[np.ndarray]:
+    """Map fake pokes on two materials split at x = 0.30 m (β 0.8 left, 0.5 right) from the
+    centre; ``check(mapper, xy)`` before each boundary poke; the boundary pokes' places."""
     mapper = Mapper(Workspace(lower=(0.0, 0.0), upper=(0.6, 0.4)), config)
     rng = np.random.default_rng(0)
     target: Target | None = Target(np.array([0.3, 0.2]), "first")
@@ -96,23 +96,37 @@ def test_boundary_pokes_go_onto_the_isopleth_not_to_the_least_known_place() -> N
     while target is not None:
         xy_t = target.xy
         if target.purpose == "boundary":
-            mean, var = mapper.field.mean, mapper.field.variance
-            level = mapper.regions().levels
-            assert level.size == 1
-            at = int(np.argmin(np.sum((mapper.grid.cells_xy - xy_t) ** 2, axis=1)))
-            # on the isopleth, where the least known reachable cell is not
-            assert abs(mean.ravel()[at] - level[0]) < 0.02
-            least_known = int(np.argmax(np.where(mapper.grid.target_mask, var.ravel(), -1.0)))
-            assert abs(mean.ravel()[least_known] - level[0]) > 0.05
             xy = np.array([p.xy for p in mapper.pokes])
             assert np.min(np.linalg.norm(xy - xy_t, axis=1)) >= 0.25 * config.touch.roi_size_m
+            check(mapper, xy_t)
             boundary.append(xy_t)
         beta = 0.8 if xy_t[0] < 0.3 else 0.5
         poke = synthetic_poke(xy_t, beta, 0.03, index=len(mapper.pokes))
         added = mapper.add(poke, target=target)
         assert added.record.purpose == target.purpose
         target = mapper.next_target(rng)
-    assert len(boundary) == 2 and mapper.boundary_owed() == 0
+    assert mapper.boundary_owed() == 0
+    return boundary
+
+
+def test_boundary_pokes_go_onto_the_isopleth_not_to_the_least_known_place() -> None:
+    # at the former floor 0.015: the planner's pokes before the boundary pokes depend on the
+    # noise it expects of a new poke (the floor far from the pokes), and at the default floor,
+    # the β grid's 0.0029, its design leaves a boundary poke 8 cm or more off the edge
+    config = ExplorationConfig(boundary_pokes=2, beta_field=BetaFieldConfig(noise_floor=0.015))
+
+    def on_the_isopleth(mapper: Mapper, xy_t: np.ndarray) -> None:
+        mean, var = mapper.field.mean, mapper.field.variance
+        level = mapper.regions().levels
+        assert level.size == 1
+        at = int(np.argmin(np.sum((mapper.grid.cells_xy - xy_t) ** 2, axis=1)))
+        # on the isopleth, where the least known reachable cell is not
+        assert abs(mean.ravel()[at] - level[0]) < 0.02
+        least_known = int(np.argmax(np.where(mapper.grid.target_mask, var.ravel(), -1.0)))
+        assert abs(mean.ravel()[least_known] - level[0]) > 0.05
+
+    boundary = _two_materials(config, on_the_isopleth)
+    assert len(boundary) == 2
     assert all(abs(t[0] - 0.3) < 0.08 for t in boundary)  # near the true edge
 
 
@@ -134,27 +148,17 @@ def test_the_nearest_poke_boundary_score_is_highest_on_the_bisector_far_from_the
 
 
 def test_nearest_poke_boundary_pokes_go_onto_the_pokes_bisector_between_two_materials() -> None:
-    # two materials split at x = 0.30 m (β 0.8 left, 0.5 right), as the straddle test above
     config = ExplorationConfig(boundary_pokes=2, boundary_score="nearest-poke",
                                beta_field=BetaFieldConfig(noise_floor=0.015))
-    mapper = Mapper(Workspace(lower=(0.0, 0.0), upper=(0.6, 0.4)), config)
-    rng = np.random.default_rng(0)
-    target: Target | None = Target(np.array([0.3, 0.2]), "first")
-    boundary = []
-    while target is not None:
-        xy_t = target.xy
-        if target.purpose == "boundary":
-            xy = np.array([p.xy for p in mapper.pokes])
-            labels = mapper.regions().poke_labels
-            d = np.linalg.norm(xy - xy_t, axis=1)
-            # about as far from the nearest poke of each class: on the map's boundary
-            near = [d[labels == k].min() for k in np.unique(labels)]
-            assert len(near) == 2 and abs(near[0] - near[1]) < 0.01  # straddle's: 0.03
-            assert d.min() >= 0.25 * config.touch.roi_size_m
-            boundary.append(xy_t)
-        beta = 0.8 if xy_t[0] < 0.3 else 0.5
-        mapper.add(synthetic_poke(xy_t, beta, 0.03, index=len(mapper.pokes)), target=target)
-        target = mapper.next_target(rng)
-    assert len(boundary) == 2 and mapper.boundary_owed() == 0
+
+    def on_the_bisector(mapper: Mapper, xy_t: np.ndarray) -> None:
+        xy = np.array([p.xy for p in mapper.pokes])
+        labels = mapper.regions().poke_labels
+        d = np.linalg.norm(xy - xy_t, axis=1)
+        # about as far from the nearest poke of each class: on the map's boundary
+        near = [d[labels == k].min() for k in np.unique(labels)]
+        assert len(near) == 2 and abs(near[0] - near[1]) < 0.01  # straddle's: 0.03
+
+    assert len(_two_materials(config, on_the_bisector)) == 2
     with pytest.raises(InvalidArgumentError, match="`boundary_score` must be one of"):
         ExplorationConfig(boundary_score="voronoi")  # type: ignore[arg-type]
