@@ -354,3 +354,26 @@ def test_under_the_modulus_field_the_beta_field_is_fitted_on_first_use_and_is_th
     np.testing.assert_array_equal(lazy.pokes.noise, on_beta.field.pokes.noise)
     mapper.add(_poke((0.2, 0.25), _soft(5e3), 5))  # a new poke: the next use fits it again
     assert len(mapper.field.pokes) == 6 and len(fits) == 2 + len(xys)
+
+
+def test_a_resumed_run_finds_the_same_unread_places_from_its_journalled_records() -> None:
+    """What ``explore(done=…)`` does with a killed run's journal: each record read back from its
+    JSON line is added again in order, and the unread places follow from them alone."""
+    import json
+
+    from deformap.explore import PokeRecord
+
+    config = ExplorationConfig(field="modulus", unread_place="avoid", max_pokes=12)
+    first = Mapper(Workspace(), config)
+    for poke in (_poke((0.1, 0.1), _soft(5e3), 0), _poke((0.4, 0.2), None, 1, error="too deep"),
+                 _poke((0.42, 0.2), None, 2, error="too deep"), _poke((0.5, 0.3), _soft(6e3), 3)):
+        first.add(poke)
+    assert len(first.unread_places) == 2
+    resumed = Mapper(Workspace(), config)
+    for added in first.pokes:
+        line = json.loads(json.dumps(added.record.to_dict()))
+        resumed.add(PokeResult(PokeRecord.from_dict(line)))
+    assert resumed.unread_places == first.unread_places
+    assert (resumed._choice_grid.target_mask == first._choice_grid.target_mask).all()
+    assert resumed.max_variance() == first.max_variance()
+    assert resumed.config.field == "modulus"
