@@ -442,3 +442,23 @@ def test_the_hardness_matrix_names_a_world_mesh_other_than_the_default() -> None
         "world mesh: 3.75 mm elements (default 7.5 mm)")
     assert "\n" in fig._suptitle.get_text()  # type: ignore[attr-defined]  # one panel: two lines
     assert plot_hardness_study(_matrix_study(0.0075))._supxlabel is None  # type: ignore[attr-defined]
+
+
+def test_world_curves_colour_a_strategy_and_dash_a_field_and_cut() -> None:
+    from deformap.viz._worlds import _line_styles, plot_world_curves
+
+    names = [f"{s}/{f}/{c}" for s in ("paper", "planned") for f in ("beta", "modulus")
+             for c in ("nearest", "isopleth")] + ["oracle"]
+    colours, styles = _line_styles(names)
+    assert colours["paper/beta/nearest"] == colours["paper/modulus/isopleth"] == "C0"
+    assert colours["planned/beta/nearest"] == "C1" and colours["oracle"] == "C2"
+    assert styles["paper/beta/nearest"] == styles["planned/beta/nearest"]
+    assert len({str(styles[n]) for n in names if n.startswith("paper/")}) == 4
+    rng = np.random.default_rng(0)
+    curves = {"all": {n: rng.uniform(0.5, 1.0, (3, 5)) for n in names}}
+    fig = plot_world_curves(curves)  # the figure takes the names in sorted order
+    drawn = {ln.get_label(): ln.get_color() for ln in fig.axes[0].get_lines()
+             if ln.get_label() in names}
+    assert drawn == _line_styles(sorted(names))[0] and len(drawn) == len(names)
+    assert len({drawn[n] for n in names if n.startswith("planned/")}) == 1
+    assert len(set(drawn.values())) == 3  # paper, planned, oracle

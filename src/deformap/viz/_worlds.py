@@ -22,6 +22,27 @@ __all__ = ["plot_world_curves"]
 _Z95 = 1.959964  # two-sided 95 % quantile of the standard normal
 
 
+#: Line styles of the fields and cuts, in the order first met (solid, dashed, dotted, ...).
+_STYLES: tuple[str | tuple[int, tuple[int, ...]], ...] = (
+    "-", "--", ":", "-.", (0, (5, 1)), (0, (3, 1, 1, 1, 1, 1)), (0, (1, 3)), (0, (8, 3, 2, 3)))
+
+
+def _line_styles(names: list[str]) -> tuple[dict[str, str], dict[str, object]]:
+    """A colour per strategy and a line style per field and cut of each ``strategy/field/cut``
+    name (a name of another shape is a strategy of its own), so that a reader finds a strategy by
+    its colour and a cut by its line whatever the number of combinations; past ten strategies
+    or eight field/cut pairs the colours or styles repeat."""
+    strategies: dict[str, int] = {}
+    ways: dict[str, int] = {}
+    colours: dict[str, str] = {}
+    styles: dict[str, object] = {}
+    for name in names:
+        strategy, _, way = name.partition("/")
+        colours[name] = f"C{strategies.setdefault(strategy, len(strategies)) % 10}"
+        styles[name] = _STYLES[ways.setdefault(way, len(ways)) % len(_STYLES)]
+    return colours, styles
+
+
 def plot_world_curves(curves: dict[str, dict[str, NDArray[np.float64]]], *,
                       good_accuracy: float = 0.9, path: str | Path | None = None) -> Figure:
     """Accuracy against pokes with confidence bands, one panel per family (``"all"`` first).
@@ -42,8 +63,8 @@ def plot_world_curves(curves: dict[str, dict[str, NDArray[np.float64]]], *,
     fig = Figure(figsize=(4.6 * cols, 3.4 * rows), layout="constrained")
     axes = fig.subplots(rows, cols, squeeze=False, sharex=True, sharey=True)
     names = sorted({name for family in curves.values() for name in family})
-    colours = {name: f"C{i % 10}" for i, name in enumerate(names)}
-    styles = {name: ("-", "--", ":", "-.")[(i // 10) % 4] for i, name in enumerate(names)}
+    colours, styles = _line_styles(names)
+    band_alpha = 0.15 if len(names) <= 6 else 0.06  # many bands over each other read as one
     for ax, family in zip(axes.ravel(), families, strict=False):
         n_worlds = 0
         for name in names:
@@ -57,7 +78,7 @@ def plot_world_curves(curves: dict[str, dict[str, NDArray[np.float64]]], *,
             se = np.nanstd(acc, axis=0, ddof=1) / np.sqrt(counts) if len(acc) > 1 else 0 * mean
             ax.plot(pokes, mean, color=colours[name], ls=styles[name], lw=1.4, label=name)
             ax.fill_between(pokes, mean - _Z95 * se, np.minimum(1.0, mean + _Z95 * se),
-                            color=colours[name], alpha=0.15, lw=0)
+                            color=colours[name], alpha=band_alpha, lw=0)
         ax.axhline(good_accuracy, color="k", ls="--", lw=0.8,
                    label=f"accuracy {good_accuracy:g} (a good map)")
         ax.set_title(f"{family} ({n_worlds} world{'s' if n_worlds != 1 else ''})", fontsize=10)
