@@ -34,10 +34,9 @@ for _name in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
 import numpy as np  # noqa: E402
 from numpy.typing import NDArray  # noqa: E402
 
-from deformap.eval import run_world, summarise_worlds  # noqa: E402
+from deformap.eval import GOOD_ACCURACY as GOOD  # noqa: E402
+from deformap.eval import pokes_to_good, run_world, summarise_worlds  # noqa: E402
 from deformap.run._worlds import SETTINGS_BEFORE, worker_pool  # noqa: E402
-
-GOOD = 0.9
 
 
 def _given_up(result: dict[str, Any]) -> set[tuple[str, str]]:
@@ -73,10 +72,6 @@ def _fell(curve: list[dict[str, Any]]) -> int:
     """The poke from which every later row of ``curve`` mapped on β."""
     return next(r["poke"] for r in curve if r["map_field"] == "beta"
                 and all(q["map_field"] == "beta" for q in curve if q["poke"] >= r["poke"]))
-
-
-def _to_good(curve: list[dict[str, Any]], max_pokes: int) -> int:
-    return next((r["poke"] for r in curve if r["accuracy"] >= GOOD), max_pokes + 1)
 
 
 
@@ -167,7 +162,9 @@ def main() -> None:
                                                                         strategy, cut)
             fell = _fell(old)
             unread = sum(r["map_field"] == "beta" for r in new)
-            pairs.append((_to_good(old, k), _to_good(new, k), old[-1]["accuracy"],
+            combo = (strategy, "modulus", cut)
+            pairs.append((pokes_to_good([source[i]], combo, k)[i],
+                          pokes_to_good([again[i]], combo, k)[i], old[-1]["accuracy"],
                           new[-1]["accuracy"]))
             err = [c[-1]["modulus_error"] for c in (old, new)]
             print(f"| {i} | {source[i]['world']['family']} | {strategy} | {fell} | "
@@ -181,13 +178,10 @@ def main() -> None:
     print(f"\n{len(pairs)} combinations: median pokes to {GOOD} {np.median(arr[:, 0]):g} (beta) "
           f"/ {np.median(arr[:, 1]):g} (avoid); fewer under avoid in {better}, more in {worse}; "
           f"mean final accuracy {arr[:, 2].mean():.3f} / {arr[:, 3].mean():.3f}")
-    whole = [{**r, "rows": [x for x in r["rows"] if x["cut"] == cut]} for r in source.values()]
-    replaced = [{**(again.get(i) or r), "rows": [x for x in (again.get(i) or r)["rows"]
-                                                 if x["cut"] == cut]}
-                for i, r in source.items()]
     combos = [(s, "modulus", cut) for s in settings["strategies"]]
-    before = summarise_worlds(whole, combos, k)["strategies"]
-    after = summarise_worlds(replaced, combos, k)["strategies"]
+    before = summarise_worlds(list(source.values()), combos, k)["strategies"]
+    after = summarise_worlds([again.get(i, r) for i, r in source.items()], combos,
+                             k)["strategies"]
     print(f"\nThe whole run ({len(source)} worlds), median pokes to {GOOD} / reach:")
     print("| combination | unread_place: beta | unread_place: avoid |")
     print("|---|---|---|")

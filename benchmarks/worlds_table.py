@@ -2,60 +2,64 @@
 
     PYTHONPATH=src python benchmarks/worlds_table.py RUN [RUN ...] [--worlds N]
 
-Reads each run's ``runs.csv`` (a ``bench worlds`` or ``bench rescore`` folder) and prints, per
+Reads each run's worlds (a ``bench worlds`` or ``bench rescore`` folder) and prints, per
 strategy/field/cut over the worlds below ``--worlds`` (default: all), what the README's "Many
-worlds" tables show beyond ``summary.md``: the median pokes to region accuracy 0.9 (a world never
-there counts ``max_pokes + 1``, as ``summary.json``), the share reaching it, the median final
-accuracy, the mean accuracy after 5 / 10 / 20 pokes (a run that stopped early keeping its last
-map), the median pokes until the map field's variance was under ``T_h`` (``max_pokes + 1`` when
-never), how many runs ended mapped on another field than asked (a modulus run gone to β), the
-share of worlds with fewer / more regions than true after the last poke, and the failed worlds
-(each counted ``max_pokes + 1`` in the pokes, as ``summary.json``). Two runs of the same worlds
-may be put side by side (say, the modulus field of one and the β-field of another); a combination
-found in two runs is refused.
+worlds" tables show beyond ``summary.md``: the median pokes to region accuracy 0.9, the share
+reaching it and the median final accuracy (``summary.json``'s, :func:`deformap.eval.
+summarise_worlds`: a world never there, or failed, counts ``max_pokes + 1``), the mean accuracy
+after 5 / 10 / 20 pokes (:func:`deformap.eval.accuracy_curves`: a run that stopped early keeps
+its last map), the median pokes until the map field's variance was under ``T_h``
+(``max_pokes + 1`` when never), how many runs ended mapped on another field than asked (a modulus
+run gone to β), the share of worlds with fewer / more regions than true after the last poke, and
+the failed worlds. Two runs of the same worlds may be put side by side (say, the modulus field of
+one and the β-field of another); a combination found in two runs is refused.
 """
 
 from __future__ import annotations
 
 import argparse
-import csv
 import json
 import statistics
-from collections import defaultdict
 from pathlib import Path
+from typing import Any
 
-GOOD = 0.9
+import numpy as np
+
+from deformap.eval import GOOD_ACCURACY, accuracy_curves, combination_name, summarise_worlds
 
 
-def _read(run: Path, below: int | None) -> tuple[int, dict[tuple[str, str, str],
-                                                           dict[int, list[dict[str, str]]]],
-                                                  dict[tuple[str, str, str], int]]:
-    """``run``'s ``max_pokes``, its finished rows by combination and world, and its failed worlds
-    by combination."""
+def _read(run: Path, below: int | None) -> tuple[dict[str, Any], list[dict[str, Any]]]:
+    """``run``'s settings and its worlds' results (those numbered below ``below``)."""
     try:
-        max_pokes = int(json.loads((run / "bench.json").read_text(encoding="utf-8"))[
-            "settings"]["max_pokes"])
-        with (run / "runs.csv").open(encoding="utf-8", newline="") as handle:
-            rows = list(csv.DictReader(handle))
-        columns = {"world", "status", "strategy", "field", "cut", "poke", "accuracy", "found",
-                   "true", "threshold", "map_field"}
-        if rows and not columns <= set(rows[0]):
-            raise KeyError(f"columns {sorted(columns - set(rows[0]))}")
+        settings = json.loads((run / "bench.json").read_text(encoding="utf-8"))["settings"]
+        results = [json.loads(path.read_text(encoding="utf-8"))
+                   for path in sorted((run / "worlds").glob("world-*.json"))]
+        results = [r for r in results if below is None or r["world"]["index"] < below]
     except (OSError, ValueError, KeyError, TypeError) as exc:
-        raise SystemExit(f"RUN: expected a bench worlds folder with bench.json and runs.csv; got "
+        raise SystemExit(f"RUN: expected a bench worlds folder with bench.json and worlds/; got "
                          f"{run} ({exc})") from None
-    found: dict[tuple[str, str, str], dict[int, list[dict[str, str]]]] = defaultdict(
-        lambda: defaultdict(list))
-    failed: dict[tuple[str, str, str], int] = defaultdict(int)
-    for row in rows:
-        world, key = int(row["world"]), (row["strategy"], row["field"], row["cut"])
-        if below is not None and world >= below:
+    if not results:
+        raise SystemExit(f"RUN: expected finished worlds in {run}; got none")
+    return settings, results
+
+
+def _ends(results: list[dict[str, Any]], combination: tuple[str, str, str], max_pokes: int
+          ) -> tuple[list[int], int, int, int]:
+    """Per finished world, the pokes to ``T_h``; and how many ended on another field, with fewer
+    regions than true, with more."""
+    to_th, other, under, over = [], 0, 0, 0
+    for result in results:
+        if result.get("status") != "ok":
             continue
-        if row["status"] != "ok":
-            failed[key] += 1
-        else:
-            found[key][world].append(row)
-    return max_pokes, found, failed
+        rows = sorted((r for r in result["rows"]
+                       if (r["strategy"], r["field"], r["cut"]) == combination),
+                      key=lambda r: r["poke"])
+        to_th.append(next((r["poke"] for r in rows if r["threshold"]), max_pokes + 1))
+        last = rows[-1]
+        other += last["map_field"] != combination[1]
+        under += last["found"] < last["true"]
+        over += last["found"] > last["true"]
+    return to_th, other, under, over
 
 
 def main() -> None:
@@ -63,46 +67,37 @@ def main() -> None:
     parser.add_argument("runs", type=Path, nargs="+", help="bench worlds folders")
     parser.add_argument("--worlds", type=int, help="only the worlds numbered below this")
     args = parser.parse_args()
-    by: dict[tuple[str, str, str], tuple[int, dict[int, list[dict[str, str]]], int]] = {}
+    seen: set[tuple[str, str, str]] = set()
+    lines = []
     for run in args.runs:
-        max_pokes, found, failed = _read(run, args.worlds)
-        for key in {*found, *failed}:
-            if key in by:
-                raise SystemExit(f"RUN: {'/'.join(key)} is in more than one run")
-            by[key] = (max_pokes, found.get(key, {}), failed.get(key, 0))
-    print(f"| combination | worlds | median pokes to {GOOD} | reach {GOOD} | final accuracy | "
-          f"mean accuracy after 5 / 10 / 20 | median pokes to T_h | ended on another field | "
-          f"fewer / more regions than true at the end | failed |")
+        settings, results = _read(run, args.worlds)
+        k = int(settings["max_pokes"])
+        combos = [(s, f, c) for s in settings["strategies"] for f in settings["fields"]
+                  for c in settings["cuts"]]
+        if seen & set(combos):
+            raise SystemExit(f"RUN: {'/'.join(sorted(seen & set(combos))[0])} is in more than "
+                             f"one run")
+        seen |= set(combos)
+        summary = summarise_worlds(results, combos, k)["strategies"]
+        curves = accuracy_curves(results, combos, k)["all"]
+        for combo in combos:
+            name = combination_name(*combo)
+            s, acc = summary[name], curves[name]
+            means = " / ".join(f"{np.mean(acc[:, p - 1]):.3f}" if p <= k and len(acc) else "–"
+                               for p in (5, 10, 20))
+            to_th, other, under, over = _ends(results, combo, k)
+            n = s["worlds"]
+            lines.append((name, f"| {name} | {n} | {s['median_pokes_to_accuracy_0.9']:g} | "
+                                f"{s['share_reaching_0.9']:.0%} | "
+                                f"{s['final_accuracy_median'] or float('nan'):.3f} | {means} | "
+                                f"{statistics.median(to_th) if to_th else float('nan'):g} | "
+                                f"{other} | {under / n:.0%} / {over / n:.0%} | {s['failed']} |"))
+    print(f"| combination | worlds | median pokes to {GOOD_ACCURACY} | reach {GOOD_ACCURACY} | "
+          f"final accuracy | mean accuracy after 5 / 10 / 20 | median pokes to T_h | ended on "
+          f"another field | fewer / more regions than true at the end | failed |")
     print("|---|---|---|---|---|---|---|---|---|---|")
-    for key in sorted(by):
-        max_pokes, worlds, n_failed = by[key]
-        never = max_pokes + 1  # as summary.json: a world never there, or failed
-        pokes, final, to_th = [never] * n_failed, [], []
-        acc: dict[int, list[float]] = {5: [], 10: [], 20: []}
-        other = under = over = 0
-        for rows in worlds.values():
-            rows.sort(key=lambda r: int(r["poke"]))
-            pokes.append(next((int(r["poke"]) for r in rows if float(r["accuracy"]) >= GOOD),
-                              never))
-            to_th.append(next((int(r["poke"]) for r in rows if r["threshold"] == "True"), never))
-            final.append(float(rows[-1]["accuracy"]))
-            for k in acc:  # a run that stopped early keeps its last map
-                upto = [r for r in rows if int(r["poke"]) <= k]
-                if upto and k <= max_pokes:
-                    acc[k].append(float(upto[-1]["accuracy"]))
-            other += rows[-1]["map_field"] != key[1]
-            under += int(rows[-1]["found"]) < int(rows[-1]["true"])
-            over += int(rows[-1]["found"]) > int(rows[-1]["true"])
-        n = len(worlds) + n_failed
-        if not n:
-            continue
-        reach = sum(p <= max_pokes for p in pokes)
-        means = " / ".join(f"{statistics.mean(v):.3f}" if v else "–" for v in acc.values())
-        fin = f"{statistics.median(final):.3f}" if final else "–"
-        th = f"{statistics.median(to_th):g}" if to_th else "–"
-        print(f"| {'/'.join(key)} | {n} | {statistics.median(pokes):g} | {reach / n:.0%} | "
-              f"{fin} | {means} | {th} | {other} | {under / n:.0%} / {over / n:.0%} | "
-              f"{n_failed} |")
+    for _, line in sorted(lines):
+        print(line)
 
 
 if __name__ == "__main__":

@@ -18,6 +18,7 @@ from deformap.eval import (
     choices,
     draw_world,
     markdown_summary,
+    pokes_to_good,
     rescore_world,
     row_values,
     run_world,
@@ -99,6 +100,9 @@ def test_summary_counts_never_and_failed_as_max_pokes_plus_one() -> None:
                           "modulus_error_median", "worlds", "by_family"}
     assert summary["best"] == "paper/beta/isopleth"
     assert summary["failed_worlds"] == [{"index": 3, "error": "Boom: no"}]
+    # the same counts world by world, for paired comparisons
+    by_world = pokes_to_good(_results(), ("paper", "beta", "isopleth"), 3)
+    assert by_world == {0: 2, 1: 4, 2: 1, 3: 4, 4: 1}
     table = markdown_summary(summary)
     assert "| paper/beta/isopleth (best) | 5 (1 failed) | 2 | 4 | 60% |" in table
     curves = accuracy_curves(_results(), COMBOS, 3)

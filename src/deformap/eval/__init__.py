@@ -60,6 +60,7 @@ if TYPE_CHECKING:
         accuracy_curves,
         combination_name,
         markdown_summary,
+        pokes_to_good,
         runs_csv,
         summarise_worlds,
     )
@@ -80,7 +81,7 @@ _MODULES = {
                 "row_values",
                 "run_world"),
     "_worlds_summary": ("CSV_COLUMNS", "GOOD_ACCURACY", "accuracy_curves", "combination_name",
-                        "markdown_summary", "runs_csv", "summarise_worlds"),
+                        "markdown_summary", "pokes_to_good", "runs_csv", "summarise_worlds"),
 }  # fmt: skip
 
 __all__ = [
@@ -122,6 +123,7 @@ __all__ = [
     "markdown_table",
     "measure_case",
     "ordering_scores",
+    "pokes_to_good",
     "region_scores",
     "rescore_world",
     "row_values",

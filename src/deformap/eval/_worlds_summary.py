@@ -28,6 +28,7 @@ __all__ = [
     "accuracy_curves",
     "combination_name",
     "markdown_summary",
+    "pokes_to_good",
     "runs_csv",
     "summarise_worlds",
 ]
@@ -119,6 +120,16 @@ def _pokes_to_good(entry: dict[str, Any], max_pokes: int, *, stay: bool = False)
         return first + 1 if first < max_pokes else max_pokes + 1
     hits = np.flatnonzero(good)
     return int(hits[0]) + 1 if hits.size else max_pokes + 1
+
+
+def pokes_to_good(results: Sequence[dict[str, Any]], combination: tuple[str, str, str],
+                  max_pokes: int) -> dict[int, int]:
+    """Each world's pokes to :data:`GOOD_ACCURACY` under one combination, by world index
+    (``max_pokes + 1`` where never, or where the world failed): what ``summary.json``'s medians
+    are taken over, for comparing two combinations world by world."""
+    entries = _per_world(results, combination, max_pokes)
+    return {int(r["world"]["index"]): _pokes_to_good(e, max_pokes)
+            for r, e in zip(results, entries, strict=True)}
 
 
 def _median(values: Sequence[float]) -> float | None:

@@ -452,6 +452,7 @@ def _check_stored(path: Path, result: Any, config: WorldsBenchConfig) -> dict[st
         if not all(isinstance(v, int | float) and not isinstance(v, bool) for v in numbers):
             raise bad(f"the {what} must be numbers")
 
+    combos: dict[str, tuple[str, int] | None] = {}  # each one's first poke on another field
     for row in rows:
         combo = f"{row.get('strategy')}/{row.get('field')}"
         if row.get("strategy") not in config.strategies or \
@@ -461,12 +462,15 @@ def _check_stored(path: Path, result: Any, config: WorldsBenchConfig) -> dict[st
         if mapped not in choices("field"):
             raise bad(f"a row of {combo!r} at poke {row['poke']} has `map_field` {mapped!r}, "
                       f"expected one of {list(choices('field'))}")
+        if combos.get(combo) is None:
+            combos[combo] = (mapped, row["poke"]) if mapped != row["field"] else None
+    for combo, fell in combos.items():  # each combination's stored pokes, once
         check_pokes(pokes.get(combo), f"pokes of {combo!r}")
         if combo in fallback:
             check_pokes(fallback[combo], f"fallback pokes of {combo!r}")
-        elif mapped != row["field"] and version >= 3:  # the third format stores them
-            raise bad(f"no stored fallback pokes of {combo!r}, whose map field was {mapped!r} "
-                      f"at poke {row['poke']} (pokes_format {version})")
+        elif fell is not None and version >= 3:  # the third format stores them
+            raise bad(f"no stored fallback pokes of {combo!r}, whose map field was {fell[0]!r} "
+                      f"at poke {fell[1]} (pokes_format {version})")
     for (strategy, field), ran in fell_back_cuts(result).items():
         if set(config.cuts) - ran:
             raise bad(f"the run of {strategy}/{field} fell back from the modulus field to β, so "
