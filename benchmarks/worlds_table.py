@@ -4,9 +4,10 @@
 
 Reads each run's worlds (a ``bench worlds`` or ``bench rescore`` folder) and prints, per
 strategy/field/cut over the worlds below ``--worlds`` (default: all), what the README's "Many
-worlds" tables show beyond ``summary.md``: the median pokes to region accuracy 0.9, the share
-reaching it and the median final accuracy (``summary.json``'s, :func:`deformap.eval.
-summarise_worlds`: a world never there, or failed, counts ``max_pokes + 1``), the mean accuracy
+worlds" tables show beyond ``summary.md``: the median pokes to region accuracy 0.9 (with its
+95 % bootstrap interval) and their mean, the share reaching it and the median final accuracy
+(``summary.json``'s, :func:`deformap.eval.summarise_worlds`: a world never there, or failed,
+counts ``max_pokes + 1``), the mean accuracy
 after 5 / 10 / 20 pokes (:func:`deformap.eval.accuracy_curves`: a run that stopped early keeps
 its last map), the median pokes until the map field's variance was under ``T_h``
 (``max_pokes + 1`` when never), how many runs ended mapped on another field than asked (a modulus
@@ -87,15 +88,18 @@ def main() -> None:
                                for p in (5, 10, 20))
             to_th, other, under, over = _ends(results, combo, k)
             n = s["worlds"]
-            lines.append((name, f"| {name} | {n} | {s['median_pokes_to_accuracy_0.9']:g} | "
+            low, high = s["median_pokes_ci95"]
+            lines.append((name, f"| {name} | {n} | {s['median_pokes_to_accuracy_0.9']:g} "
+                                f"({low:g}–{high:g}) | {s['mean_pokes_to_accuracy_0.9']:.1f} | "
                                 f"{s['share_reaching_0.9']:.0%} | "
                                 f"{s['final_accuracy_median'] or float('nan'):.3f} | {means} | "
                                 f"{statistics.median(to_th) if to_th else float('nan'):g} | "
                                 f"{other} | {under / n:.0%} / {over / n:.0%} | {s['failed']} |"))
-    print(f"| combination | worlds | median pokes to {GOOD_ACCURACY} | reach {GOOD_ACCURACY} | "
-          f"final accuracy | mean accuracy after 5 / 10 / 20 | median pokes to T_h | ended on "
-          f"another field | fewer / more regions than true at the end | failed |")
-    print("|---|---|---|---|---|---|---|---|---|---|")
+    print(f"| combination | worlds | median pokes to {GOOD_ACCURACY} (95 % interval) | mean "
+          f"pokes to {GOOD_ACCURACY} | reach {GOOD_ACCURACY} | final accuracy | mean accuracy "
+          f"after 5 / 10 / 20 | median pokes to T_h | ended on another field | fewer / more "
+          f"regions than true at the end | failed |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
     for _, line in sorted(lines):
         print(line)
 

@@ -98,16 +98,46 @@ def test_summary_counts_never_and_failed_as_max_pokes_plus_one() -> None:
     assert paper["by_family"]["insert"]["median_pokes_to_accuracy_0.9"] == 2.5
     assert set(paper) >= {"median_pokes_to_accuracy_0.9", "final_accuracy_median",
                           "modulus_error_median", "worlds", "by_family"}
+    # every world's count on average: paper 2.4, planned 2.8
+    assert paper["mean_pokes_to_accuracy_0.9"] == pytest.approx(2.4)
+    assert planned["mean_pokes_to_accuracy_0.9"] == pytest.approx(2.8)
+    low, high = paper["median_pokes_ci95"]
+    assert 1.0 <= low <= 2.0 <= high <= 4.0 and low < high
+    assert summarise_worlds(_results(), COMBOS, 3) == summary  # the bootstrap is seeded
     assert summary["best"] == "paper/beta/isopleth"
     assert summary["failed_worlds"] == [{"index": 3, "error": "Boom: no"}]
     # the same counts world by world, for paired comparisons
     by_world = pokes_to_good(_results(), ("paper", "beta", "isopleth"), 3)
     assert by_world == {0: 2, 1: 4, 2: 1, 3: 4, 4: 1}
     table = markdown_summary(summary)
-    assert "| paper/beta/isopleth (best) | 5 (1 failed) | 2 | 4 | 60% |" in table
+    assert (f"| paper/beta/isopleth (best) | 5 (1 failed) | 2 ({low:g}–{high:g}) | 2.4 | 4 | "
+            "60% |") in table
     curves = accuracy_curves(_results(), COMBOS, 3)
     assert curves["all"]["paper/beta/isopleth"].shape == (4, 3)
     assert curves["insert"]["paper/beta/isopleth"].tolist() == [[0.95, 0.95, 0.95]]
+
+
+def test_best_is_the_fewest_pokes_on_average_not_the_capped_median() -> None:
+    """Steady reaches 0.9 at poke 4 in every world; lucky at poke 3 in three of five and never in
+    two (counted 7 at 6 pokes): the median (3 against 4) would pick lucky, the mean (4.6 against
+    4) picks steady. With equal means the median decides."""
+    def series(first: int | None) -> list[float]:
+        return [0.95 if first is not None and k + 1 >= first else 0.5 for k in range(6)]
+
+    results = [_result(i, "cuts", {"lucky/beta": series(3 if i < 3 else None),
+                                   "steady/beta": series(4)}) for i in range(5)]
+    combos = [("lucky", "beta", "isopleth"), ("steady", "beta", "isopleth")]
+    summary = summarise_worlds(results, combos, 6)
+    lucky, steady = (summary["strategies"][f"{n}/beta/isopleth"] for n in ("lucky", "steady"))
+    assert lucky["median_pokes_to_accuracy_0.9"] == 3 and steady["median_pokes_to_accuracy_0.9"] == 4
+    assert lucky["mean_pokes_to_accuracy_0.9"] == pytest.approx(4.6)
+    assert steady["mean_pokes_to_accuracy_0.9"] == pytest.approx(4.0)
+    assert steady["median_pokes_ci95"] == [4.0, 4.0]
+    assert summary["best"] == "steady/beta/isopleth"
+    # equal means (4 and 4): the smaller median wins
+    results = [_result(i, "cuts", {"lucky/beta": series((3, 3, 3, 5, 6)[i]),
+                                   "steady/beta": series(4)}) for i in range(5)]
+    assert summarise_worlds(results, combos, 6)["best"] == "lucky/beta/isopleth"
 
 
 def test_runs_csv_has_a_row_per_poke_and_the_failed_world_per_combination() -> None:

@@ -227,16 +227,18 @@ def _show_worlds_summary(shown: Any, output: Any, worlds: int, max_pokes: int,
     for name, s in summary["strategies"].items():
         pokes, stay = s["median_pokes_to_accuracy_0.9"], s["median_pokes_to_stay_0.9"]
         final, error = s["final_accuracy_median"], s["modulus_error_median"]
+        mean = s.get("mean_pokes_to_accuracy_0.9")
         rows.append((name + (" (best)" if name == summary["best"] else ""), str(s["worlds"]),
                      "–" if pokes is None else f"{pokes:g}",
+                     "–" if mean is None else f"{mean:.1f}",
                      "–" if stay is None else f"{stay:g}",
                      "–" if s["share_reaching_0.9"] is None else f"{s['share_reaching_0.9']:.0%}",
                      "–" if final is None else f"{final:.3f}",
                      "–" if error is None else f"{error:.2f}"))  # fmt: skip
     shown.print(_table(
         f"{len(rows)} combinations over {worlds} worlds, {max_pokes} pokes "
-        f"(a world never at 0.9 counts {max_pokes + 1})",
-        ("strategy/field/cut", "worlds", "pokes to 0.9", "to stay", "reach 0.9",
+        f"(a world never at 0.9 counts {max_pokes + 1}; best: fewest mean pokes)",
+        ("strategy/field/cut", "worlds", "median pokes to 0.9", "mean", "to stay", "reach 0.9",
          "final accuracy", "E error"),
         rows))  # fmt: skip
     shown.print(f"{output.computed} worlds computed in {output.seconds:.0f} s → {output.folder}",
