@@ -232,3 +232,44 @@ def test_the_element_size_reaches_the_world_and_the_study_records_it(
     fine = _studies._foams((), seed=0, coarse=False, hooks=_studies.NO_HOOKS,
                            element_size_m=0.003)
     assert fine == [] and seen[-1] == (0.003, 0.003)  # finer than the top layer: it follows
+
+
+@pytest.mark.slow
+def test_full_presses_on_a_contact_resolving_mesh_thickness_first(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """`--full` without `--element-size` or `--coarse` is the measurement: its worlds have
+    FULL_ELEMENT_SIZE_M elements (the quick look keeps the default). It presses the thicknesses
+    one after the other (one FEM factorisation each) and writes the rows in the matrix's own
+    order, camera first."""
+    from deformap.run import _studies
+
+    assert _studies.FULL_ELEMENT_SIZE_M < WorldConfig().element_size_m
+    monkeypatch.setattr(_studies, "FULL_CAMERAS", ("primesense", "kinect-v1"))
+    monkeypatch.setattr(_studies, "FULL_THICKNESSES_M", (0.05, 0.03))
+    seen: list[tuple[float, float]] = []
+    real = _studies.collect_presses
+
+    def spy(foams: Any, **kwargs: Any) -> Any:  # records the mesh, presses on a coarse one
+        seen.append((kwargs["thickness_m"], kwargs["world_config"].element_size_m))
+        coarse = WorldConfig.coarse(camera=kwargs["world_config"].camera)
+        return real(foams, **{**kwargs, "world_config": coarse})
+
+    monkeypatch.setattr(_studies, "collect_presses", spy)
+    out = tmp_path / "full"
+    result = CliRunner().invoke(app, ["study", "hardness", "--full", "--hardness", "110",
+                                      "--physics", "linear-fem", "--protocol",
+                                      "force/quadratic", "--out", str(out)])  # fmt: skip
+    assert result.exit_code == 0, (result.output, result.exception)
+    full_mesh = _studies.FULL_ELEMENT_SIZE_M
+    assert seen == [(0.03, full_mesh), (0.03, full_mesh), (0.05, full_mesh), (0.05, full_mesh)]
+    study = json.loads((out / "hardness.json").read_text())
+    assert study["matrix"]["element_size_m"] == full_mesh
+    assert [(r["camera"], r["thickness_m"]) for r in study["rows"]][::2] == [
+        ("primesense", 0.05), ("primesense", 0.03), ("kinect-v1", 0.05), ("kinect-v1", 0.03)]
+    assert [(s["camera"], s["thickness_m"]) for s in study["summary"]] == [
+        ("primesense", 0.05), ("primesense", 0.03), ("kinect-v1", 0.05), ("kinect-v1", 0.03)]
+    seen.clear()  # the quick look (one condition) stays on the default mesh
+    quick = CliRunner().invoke(app, ["study", "hardness", "--hardness", "110", "--protocol",
+                                     "force/quadratic", "--out", str(tmp_path / "quick")])
+    assert quick.exit_code == 0, (quick.output, quick.exception)
+    assert seen == [(0.05, WorldConfig().element_size_m)]

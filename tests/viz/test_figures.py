@@ -435,13 +435,16 @@ def _matrix_study(element_size_m: float) -> dict[str, Any]:
             "overall": []}
 
 
-def test_the_hardness_matrix_names_a_world_mesh_other_than_the_default() -> None:
-    fig = plot_hardness_study(_matrix_study(0.00375))
-    assert fig._supxlabel is not None  # type: ignore[attr-defined]
-    assert fig._supxlabel.get_text() == (  # type: ignore[attr-defined]
-        "world mesh: 3.75 mm elements (default 7.5 mm)")
+def test_the_hardness_matrix_names_its_world_mesh() -> None:
+    for size, text in ((0.00375, "3.75"), (0.0075, "7.5")):
+        fig = plot_hardness_study(_matrix_study(size))
+        assert fig._supxlabel is not None  # type: ignore[attr-defined]
+        assert fig._supxlabel.get_text() == (  # type: ignore[attr-defined]
+            f"world mesh: {text} mm elements in plane")
     assert "\n" in fig._suptitle.get_text()  # type: ignore[attr-defined]  # one panel: two lines
-    assert plot_hardness_study(_matrix_study(0.0075))._supxlabel is None  # type: ignore[attr-defined]
+    study = _matrix_study(0.0075)
+    del study["matrix"]["element_size_m"]  # a study written before the mesh was recorded
+    assert plot_hardness_study(study)._supxlabel is None  # type: ignore[attr-defined]
 
 
 def test_world_curves_colour_a_strategy_and_dash_a_field_and_cut() -> None:

@@ -85,9 +85,10 @@ def study_hardness(
     ] = None,
     element_size: Annotated[
         float | None, typer.Option(help="The world's in-plane FEM element size in metres "
-                                   "(default 0.0075; 0.00375 has about 4 times the unknowns): "
-                                   "how much of E's error is the world's mesh. Not with "
-                                   "--coarse.")
+                                   "(default 0.0075, a quick look; with --full 0.00375, a mesh "
+                                   "that resolves a stiff foam's contact, about 5 times the "
+                                   "time of a press): how much of E's error is the world's "
+                                   "mesh. Not with --coarse.")
     ] = None,
     json_path: JsonOption = None,
 ) -> None:

@@ -46,6 +46,7 @@ from deformap.world import (
 __all__ = [
     "CLUSTER_SIZE_FOAMS",
     "FULL_CAMERAS",
+    "FULL_ELEMENT_SIZE_M",
     "FULL_PHYSICS",
     "FULL_THICKNESSES_M",
     "StudyOutput",
@@ -61,6 +62,15 @@ FULL_THICKNESSES_M: tuple[float, ...] = (0.03, 0.05, 0.10)
 FULL_PHYSICS: tuple[str, ...] = PHYSICS
 """The matrix of ``deformap study hardness --full`` (issue 13): every camera preset × three foam
 thicknesses × every physics of the world (:data:`deformap.world.PHYSICS`)."""
+
+FULL_ELEMENT_SIZE_M = 0.00375
+"""The world's in-plane element size for ``--full`` (the measurement), in place of the default
+7.5 mm (a quick look): a contact-resolving mesh. The matrix's stiffest press (250 N foam, 0.6 N,
+10 mm tip) touches a patch of about 6 mm radius (Hertz); on 7.5 mm elements such a patch is
+pressed 11–13 % too stiff, on 3.75 mm ones 1–3 % (the mesh's convergence, measured against a
+4× finer mesh by ``benchmarks/stiffness_mesh.py``): the world's own discretisation error then
+stays well under the estimator's claimed σ of E, so the study measures the estimator, not the
+mesh. It costs about five times the time and memory of a press (README, the hardness study)."""
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -199,6 +209,8 @@ def run_hardness_study(
     if element_size_m is not None and coarse:
         raise SettingError("element_size_m", f"sets the mesh, as the coarse world does: give one "
                            f"of them; got {element_size_m} and coarse")
+    if full and not coarse and element_size_m is None:
+        element_size_m = FULL_ELEMENT_SIZE_M
     foams = DEFAULT_HARDNESSES if not hardness else (*hardness, None)
     _check_press(foams, force_n)
     checked = []
@@ -215,12 +227,15 @@ def run_hardness_study(
     folder = create_run_folder(out or default_run_folder("hardness", "study", seed), what="study")
     hooks.start(RunStart(kind="study", title=f"hardness study, seed {seed}", folder=folder,
                          total=len(foams) * len(checked)))  # fmt: skip
-    rows: list[dict[str, Any]] = []
+    by_condition: dict[tuple[str, float, str], list[dict[str, Any]]] = {}
     single: dict[str, Any] = {}
     # the element size the worlds have (the same under every physics)
     mesh_m = _study_world("linear-fem", coarse=coarse, element_size_m=element_size_m
                           ).element_size_m
-    for name, thickness, physics_name in checked:
+    # thickness first: the FEM's factorisation depends on the block's mesh only (one per
+    # thickness, shared by the cameras and the two FEM physics, deformap.world._fem); the rows
+    # are written in the matrix's own order below, whatever order they were pressed in
+    for name, thickness, physics_name in sorted(checked, key=lambda c: c[1]):
         hooks.stage(f"pressing the foams: {name}, {thickness:g} m, {physics_name}")
         presses = _foams(foams, seed=seed, coarse=coarse, hooks=hooks, camera=name,
                          thickness_m=thickness, force_n=force_n, physics=physics_name,
@@ -232,7 +247,9 @@ def run_hardness_study(
                      "physics": physics_name}  # fmt: skip
         single = {**condition, "element_size_m": mesh_m,
                   **hardness_study(presses, protocols=chosen)}
-        rows.extend({**row, **condition} for row in single["rows"])
+        by_condition[(name, thickness, physics_name)] = [{**row, **condition}
+                                                         for row in single["rows"]]
+    rows = [row for condition in checked for row in by_condition[condition]]
     study = {**(single if not full else {"matrix": {
         "cameras": list(dict.fromkeys(c[0] for c in checked)),
         "thicknesses_m": sorted({c[1] for c in checked}),

@@ -152,12 +152,9 @@ def _plot_hardness_matrix(study: dict[str, Any]) -> Figure:
     gap = " " if len(physics) > 1 else "\n"
     fig.suptitle("Young's modulus read against the world's, per camera × thickness"
                  f"{gap}(✗: E or β not monotone, or rigid not read rigid)", fontsize=10)
-    from deformap.world import WorldConfig  # the default mesh, named under a finer one
-
-    default_m = WorldConfig().element_size_m
-    if study.get("matrix", {}).get("element_size_m") not in (None, default_m):
-        fig.supxlabel(f"world mesh: {study['matrix']['element_size_m'] * 1e3:g} mm elements "
-                      f"(default {default_m * 1e3:g} mm)", fontsize=8)
+    mesh_m = study.get("matrix", {}).get("element_size_m")
+    if mesh_m is not None:  # the world's mesh is part of what E's error measures
+        fig.supxlabel(f"world mesh: {mesh_m * 1e3:g} mm elements in plane", fontsize=8)
     return fig
 
 
