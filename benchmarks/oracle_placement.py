@@ -130,7 +130,7 @@ def main() -> None:
     if args.worlds < 1 or args.max_pokes < 1:
         raise SystemExit(f"--worlds, --max-pokes: expected integers >= 1; got {args.worlds}, "
                          f"{args.max_pokes}")
-    placements = [p for p in args.placements.split(",") if p]
+    placements = list(dict.fromkeys(p for p in args.placements.split(",") if p))
     if not placements or not set(placements) <= set(PLACEMENTS):
         raise SystemExit(f"--placements: expected some of {', '.join(PLACEMENTS)}; got "
                          f"{args.placements!r}")

@@ -140,6 +140,49 @@ def test_best_is_the_fewest_pokes_on_average_not_the_capped_median() -> None:
     assert summarise_worlds(results, combos, 6)["best"] == "lucky/beta/isopleth"
 
 
+def test_the_summary_does_not_depend_on_the_order_the_worlds_finished_in() -> None:
+    """Worlds come back in the order they finish (a pool, a cluster, a resumed run): the
+    summary, its bootstrap intervals included, is that of the worlds, not of their order."""
+    rng = np.random.default_rng(3)
+
+    def reaching(first: int) -> list[float]:  # 0.9 from poke `first` on (11: never in 10)
+        return [0.95 if k + 1 >= first else 0.5 for k in range(10)]
+
+    results = [_result(i, ("cuts", "insert")[i % 2],
+                       {"paper/beta": reaching(int(rng.integers(1, 12))),
+                        "planned/beta": reaching(int(rng.integers(1, 12)))},
+                       status="ok" if i != 7 else "failed") for i in range(30)]
+    reference = summarise_worlds(results, COMBOS, 10)
+    assert reference["failed_worlds"] == [{"index": 7, "error": "Boom: no"}]
+    for seed in range(3):
+        shuffled = [results[i] for i in np.random.default_rng(seed).permutation(len(results))]
+        assert summarise_worlds(shuffled, COMBOS, 10) == reference
+
+
+def test_the_command_shows_the_mean_beside_the_median_and_marks_the_best() -> None:
+    from types import SimpleNamespace
+
+    from rich.console import Console
+
+    from deformap.cli._bench import _show_worlds_summary
+
+    results = [_result(i, "cuts", {"lucky/beta": [0.95 if i < 3 and k >= 2 else 0.5
+                                                  for k in range(6)],
+                                   "steady/beta": [0.95 if k >= 3 else 0.5 for k in range(6)]})
+               for i in range(5)]
+    summary = summarise_worlds(results, [("lucky", "beta", "isopleth"),
+                                         ("steady", "beta", "isopleth")], 6)
+    console = Console(record=True, width=200)
+    _show_worlds_summary(console, SimpleNamespace(summary=summary, computed=5, seconds=1.0,
+                                                  folder="F"), 5, 6, None)  # fmt: skip
+    text = console.export_text()
+    assert "best: fewest mean pokes" in text and "mean" in text
+    lines = {line.split("│")[1].strip(): [c.strip() for c in line.split("│")[2:]]
+             for line in text.splitlines() if "/beta/" in line}
+    assert lines["steady/beta/isopleth (best)"][:3] == ["5", "4", "4.0"]
+    assert lines["lucky/beta/isopleth"][:3] == ["5", "3", "4.6"]
+
+
 def test_runs_csv_has_a_row_per_poke_and_the_failed_world_per_combination() -> None:
     rows = list(csv.DictReader(io.StringIO(runs_csv(_results(), COMBOS))))
     assert tuple(rows[0]) == CSV_COLUMNS

@@ -48,6 +48,7 @@ def test_pool_and_dask_agree_byte_for_byte_apart_from_times_and_resume(tmp_path)
         assert [{k: v for k, v in r.items() if k not in TIME_COLUMNS} for r in a["rows"]] == \
             [{k: v for k, v in r.items() if k not in TIME_COLUMNS} for r in b["rows"]]
     summary = json.loads((tmp_path / "pool" / "summary.json").read_text())
+    assert summary == json.loads((tmp_path / "dask" / "summary.json").read_text())
     assert summary["strategies"]["paper/beta/isopleth"]["worlds"] == 2
     assert (tmp_path / "pool" / "curves.png").stat().st_size > 0
     assert "| paper/beta/isopleth" in (tmp_path / "pool" / "summary.md").read_text()

@@ -162,7 +162,8 @@ def _median_interval(counts: Sequence[int]) -> list[float] | None:
     """The 95 % percentile-bootstrap interval of the median of ``counts`` (None without any)."""
     if not counts:
         return None
-    values = np.asarray(counts, dtype=float)
+    # sorted: the same interval whatever order the worlds finished in
+    values = np.sort(np.asarray(counts, dtype=float))
     draws = np.random.default_rng(_BOOTSTRAP_SEED).integers(0, values.size,
                                                             (_BOOTSTRAP, values.size))
     medians = np.median(values[draws], axis=1)
@@ -201,6 +202,7 @@ def summarise_worlds(results: Sequence[dict[str, Any]],
     ``failed`` worlds), with ``best`` (the fewest mean pokes, then the fewest median pokes, then
     the highest final accuracy: module docstring), ``max_pokes`` and ``failed_worlds`` (index and
     error of each world that failed twice)."""
+    results = sorted(results, key=lambda r: int(r["world"]["index"]))  # as they finished
     strategies: dict[str, Any] = {}
     for combination in combinations:
         entries = _per_world(results, combination, max_pokes)

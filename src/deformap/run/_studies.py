@@ -187,7 +187,8 @@ def run_hardness_study(
         (default :data:`~deformap.eval.STUDY_PROTOCOLS`: the default one and the paper's).
     element_size_m : float, optional
         The world's in-plane FEM element size (``WorldConfig.element_size_m``; its top layer no
-        thicker) in place of the default 7.5 mm: how much of E's error is the world's
+        thicker) in place of the default: the world's 7.5 mm for one condition,
+        :data:`FULL_ELEMENT_SIZE_M` with ``full``. How much of E's error is the world's
         discretisation (a small contact patch on coarse elements presses too stiff). Not with
         ``coarse``.
     hooks : RunHooks
@@ -221,6 +222,7 @@ def run_hardness_study(
         check_positive("thickness_m", thickness)
         checked.append((name, float(thickness),
                         WorldConfig(physics=physics_name).physics))  # type: ignore[arg-type]
+    checked = list(dict.fromkeys(checked))  # a condition named twice is pressed once
     for _, thickness, _ in checked:  # a block the world cannot build: before any folder
         block_scenario(None, Workspace(), thickness)
     if element_size_m is not None:  # nor a mesh it would refuse
