@@ -183,8 +183,8 @@ def _stats(entries: list[dict[str, Any]], max_pokes: int) -> dict[str, Any]:
         "median_pokes_to_stay_0.9": _median([_pokes_to_good(e, max_pokes, stay=True)
                                              for e in entries]),
         # when most worlds never get there the medians saturate at max_pokes + 1; the share does not
-        "share_reaching_0.9": (sum(_pokes_to_good(e, max_pokes) <= max_pokes for e in entries)
-                               / len(entries)) if entries else None,
+        "share_reaching_0.9": (sum(c <= max_pokes for c in counts) / len(counts)
+                               if counts else None),
         "final_accuracy_median": _median([float(e["accuracy"][-1]) for e in done]),
         "modulus_error_median": _median([float(e["modulus_error"][-1]) for e in done]),
         "worlds": len(entries),
