@@ -66,7 +66,9 @@ def test_a_relative_link_resolves(page: Path, target: str) -> None:
 
 def test_the_anchor_rule_matches_githubs() -> None:
     assert _anchor("The run folder") == "the-run-folder"
-    assert _anchor("β's scale: rigid at β = 0, no stiff end") == "βs-scale-rigid-at-β--0-no-stiff-end"
+    assert (
+        _anchor("β's scale: rigid at β = 0, no stiff end") == "βs-scale-rigid-at-β--0-no-stiff-end"
+    )
     assert _anchor("Throughput of `bench worlds`, local and on Dask") == (
         "throughput-of-bench-worlds-local-and-on-dask"
     )
