@@ -1,16 +1,11 @@
 """Settings of the mapper and the exploration loop, one frozen, keyword-only dataclass per component.
 
-Every field is described in its class's Parameters section: a one-line description with its unit
-first, then the reason for its default. Lengths are in metres, forces in newtons; β is the
-dimensionless shape-matching stiffness in [0, 1) and the modulus field works on ln E, E in pascals.
-
-Two reasons are shared by several classes. The β-field's and the modulus field's length scale,
-0.2 m or a third of a table's width, is the size of the pieces a robot is asked to tell apart (a
-property of the layout, not of what is measured). Settings given in β units take their
-modulus-field counterpart as the same fraction of the prior: ``T_h`` scales with the prior
-variance (0.06 of 0.09 is 2.0 of 3.0 in (ln E)²) and the regions' smallest step with the prior
-standard deviation (:func:`deformap.explore.field_settings`). The ``MAX_*`` bounds refuse, before
-any work, settings whose matrices would not fit in memory.
+Each class's Parameters section describes every field: first a one-line description with its unit
+(lengths in metres, forces in newtons, β dimensionless in [0, 1), the modulus field in ln E with E
+in pascals), then the reason for its default. A setting given in β units holds for the modulus
+field as the same fraction of its prior: ``T_h`` of the prior variance, the regions' smallest step
+of the prior standard deviation (:func:`deformap.explore.field_settings`).
+The ``MAX_*`` bounds refuse, before any work, settings whose matrices would not fit in memory.
 
 References
 ----------
@@ -77,20 +72,16 @@ BoundaryScore = Literal["straddle", "nearest-poke"]
 #: (``ExplorationConfig.unread_place``).
 UnreadPlace = Literal["beta", "avoid"]
 
-#: Most bytes of one band of the ROI's shape-matching system (:mod:`deformap.msm._linsys`): the
-#: β sweep holds its two assembled bands and a few factorisations of that size at once, so 512 MiB
-#: keeps the sweep within a few GiB.
+#: Most bytes of one band of the ROI's shape-matching system (:mod:`deformap.msm._linsys`); the
+#: β sweep holds a few arrays of that size at once, so 512 MiB keeps it within a few GiB.
 MAX_ROI_BAND_BYTES = 512 * 2**20
 #: Most cells of the map grid: every map is a dense grid, and the ``min-max-variance`` look-ahead
 #: holds a (256 candidates × cells) float64 matrix, 2 GB at this size.
 MAX_MAP_CELLS = 1_000_000
-#: Most cells of the planner's 2 cm grids (``planned``, ``min-max-variance``,
-#: ``integrated-variance``): it holds
-#: (candidates × domain) and (candidates × candidates) float64 kernel matrices, 0.8 GB each at
-#: this size (4 m² of workspace).
+#: Most cells of the planner's 2 cm grids (:data:`PLANNER_STRATEGIES`): its (candidates × domain)
+#: and (candidates × candidates) float64 matrices are 0.8 GB each at this size (4 m² of workspace).
 MAX_PLAN_CELLS = 10_000
-#: Spacing of the planner's grids (:class:`deformap.explore.MapGrid`'s ``plan_domain`` and
-#: ``plan_candidates``), the budget's and the grid's one value.
+#: Spacing of the planner's grids (``MapGrid.plan_domain``, ``plan_candidates``), metres.
 PLAN_GRID_M = 0.02
 #: The strategies that hold the planner's (candidates × domain) matrices.
 PLANNER_STRATEGIES: tuple[Strategy, ...] = ("planned", "min-max-variance", "integrated-variance")
@@ -196,11 +187,10 @@ class TouchGPConfig:
         cap.
     depth_anchor : {"record", "tip"}
         Where the tactile points' depth comes from, the record or the tip.
-        ``record`` (default), for a press whose force–travel record the stiffness estimate reads:
-        the surface model's height at the contact minus the record's indentation, with that
-        indentation's uncertainty as their noise, so an error in the tip's absolute height does not
-        move the dent; ``tip``, and every other press: the tip where proprioception puts it, with
-        ``tactile_noise_std_m``.
+        ``record`` (default; a press with a readable force–travel record): the surface model's
+        height minus the record's indentation, with its uncertainty as noise, so an error in the
+        tip's absolute height does not move the dent; ``tip`` and every other press: the tip as
+        proprioception places it, with ``tactile_noise_std_m``.
     dent_visible_sigmas : float
         Smallest visible dent, in standard deviations of the camera's mean height near the tip.
         A dent shallower at the contact's edge (δ/2, Hertz) claims the σ of knowing nothing
@@ -271,7 +261,8 @@ class BetaFieldConfig:
         0.3: its variance 0.09 lies above the paper's ``T_h`` = 0.06, so an unexplored map asks for
         a poke.
     length_scale_m : float
-        Length scale σw of the β-field, metres (module docstring: the pieces' size).
+        Length scale σw of the β-field, metres.
+        0.2 m, a third of a table, is the size of the pieces a robot is asked to tell apart.
     noise_floor : float or None
         Smallest claimed σ of a poke's β, dimensionless; ``None``: the β grid's quantisation.
         The quantisation, ``shape_matching.beta_resolution / √12`` (the default), is what
@@ -308,7 +299,8 @@ class ModulusFieldConfig:
         1.73, a quarter of ln(10⁶ / 10³): ±2σ spans the 1 kPa to 1 MPa of the soft foams to rubbers
         a table-top robot presses (Gibson & Ashby 1997, ch. 5).
     length_scale_m : float
-        Length scale σ_w of the modulus field, metres (module docstring: the pieces' size).
+        Length scale σ_w of the modulus field, metres.
+        The β-field's, for its reason: the pieces' size is a property of the layout.
     noise_floor : float
         Smallest standard deviation of a poke's ln E, ln Pa (its σ_E / E is raised to it).
         0.1: a foam's modulus goes as its density squared (Gibson & Ashby 1997, Eq. 5.6), and a
@@ -372,16 +364,14 @@ class ExplorationConfig:
         (:mod:`deformap.explore._indicator`).
     merge_seams : bool
         Whether to merge the classes that lie on a seam between two others before labelling.
-        Such a class's every poke borders pokes of two other classes within twice the layer's
-        thickness (:func:`deformap.explore.merge_seam_classes`); on, because a press where two
-        pieces meet reads between them, or softer than both, and would otherwise be a region
-        of its own.
+        Every poke of such a class borders pokes of two others within twice the layer's thickness
+        (:func:`deformap.explore.merge_seam_classes`); on, because a press where two pieces meet
+        reads between or below both and would otherwise be a region of its own.
     split_by_place : bool
         Whether to split a class whose pokes form two places of different values, before merging.
-        Only pokes away from the other classes count (:func:`deformap.explore.split_by_place`,
-        a join-count test against shuffles); on, because two materials closer than the region
-        test's smallest step, side by side, are otherwise one region. It needs six such pokes in
-        a class.
+        It needs six pokes away from the other classes (:func:`deformap.explore.split_by_place`);
+        on, because two materials closer than the region test's smallest step, side by side, are
+        otherwise one region.
     boundary_pokes : int
         Pokes made after the variance has fallen below ``T_h``, a count.
         Each goes where a region boundary is least certain (straddle score, Bryan et al. 2005;
@@ -394,12 +384,11 @@ class ExplorationConfig:
         ``touch.noise_samples`` must then be 0, so no setting is silently ignored).
     field : {"beta", "modulus"}
         The field the regions, the next-poke choice and the stop run on, β or ln E.
-        ``beta``, the β-field (the paper's); ``modulus`` (default), the modulus field over ln E,
-        which is in physical units and does not depend on the camera. With ``modulus`` a place
-        whose modulus could not be read twice is taken out of the targets and the stop cells
-        (``ExplorationResult.unread_places``; ``beta`` if no target is left), and a run none of
-        whose pokes gives a usable force–travel record maps on ``beta`` from its first poke and
-        says so (``field_fallback``).
+        ``beta``, the paper's; ``modulus`` (default), in physical units and independent of the
+        camera. Under ``modulus`` a place whose modulus could not be read twice leaves the targets
+        and stop cells (``ExplorationResult.unread_places``); the run maps on ``beta`` while no
+        poke has a modulus, and for good once no target would be left, and says why
+        (``field_fallback``).
     surface : SurfaceGPConfig
         The crop, filters and surface GP of the first observation.
     touch : TouchGPConfig
