@@ -1,19 +1,16 @@
 """Non-myopic poke planning: the fewest further pokes that bring the map field under ``T_h``.
 
-A GP's posterior variance depends on where the observations are and on their noise, never on the
-values observed (RW2006 Eq. 2.26), so the set of further pokes after which the largest variance
-over the domain falls below ``T_h`` can be planned before any is made. Finding the smallest such
-set is a covering (minimax) design problem, solved approximately over a grid of candidates for
-``m = 1, 2, …`` further pokes in turn. A design is scored by the variance above ``T_h`` summed
-over the domain, ties broken by the largest variance: the sum is smooth where the maximum is not,
-so it still falls when a move helps one corner and leaves the worst one as it was. The plan for
-``m`` is the plan for ``m − 1`` plus the best candidate (a greedy step), then improved by exchange
-passes (Fedorov 1972) that move each planned poke in turn to the candidate that best complements
-the others, until a pass moves none or after ``max_passes``. The first ``m`` whose plan reaches
-``T_h`` is the plan.
-
-Each planned poke is assumed to come with the noise ``_targets.expected_noise`` gives; a real poke
-often reports more, so the loop plans again after every poke.
+A GP's posterior variance depends on where the data are and on their noise, never on the values
+(RW2006 Eq. 2.26), so the pokes after which the largest variance over the domain falls below
+``T_h`` can be planned before any is made: a covering design, solved approximately over a grid of
+candidates for ``m = 1, 2, …`` pokes in turn. A design scores the variance above ``T_h`` summed
+over the domain, ties broken by the largest variance (the sum still falls when a move helps one
+corner and leaves the worst as it was). The plan for ``m`` is that for ``m − 1`` plus the best
+candidate, improved by exchange passes (Fedorov 1972) that move each planned poke to the
+candidate that best complements the others, until a pass moves none or after ``max_passes``;
+the first ``m`` whose plan reaches ``T_h`` is the plan. Planned pokes are assumed to have the
+noise ``_targets.expected_noise`` gives; a real poke often reports more, so the loop plans again
+after every poke.
 
 References
 ----------
