@@ -1,28 +1,23 @@
 """One press: the dent reconstructed from the cloud seen while pressing, and its β.
 
-1. The ROI, a square of ``roi_size_m`` centred on the contact, is cropped from the cloud; the
-   robot's points are removed (its convex hull plus ``robot_margin_m``, a ball of the tip's radius
-   plus ``tip_margin_m``), then steep faces, then every point more than ``above_surface_m`` above
-   the surface model (a dent goes down).
-2. The touch GP ("GPR-touch") is fitted to those points and the tactile points, by default as the
-   change of height against the surface model, and read on the ROI's grid: the deformed heightmap
-   X̄. The tactile points cover the cap that touches at the indentation δ
-   (:func:`deformap.cloud.contact_cap`): δ is the force–travel record's model indentation at the
-   commanded force when the stiffness estimate read one (0 if it read the surface rigid), else the
-   tip's depth below the surface model. With a record and ``depth_anchor="record"`` the pole sits
-   at the surface model's height minus δ, with δ's uncertainty as the points' noise, so an error
-   in the tip's absolute height does not move the dent; else the points lie on the tip as
-   proprioception places it.
+1. The ROI (``roi_size_m`` square on the contact) is cropped from the cloud; the robot's points
+   (its hull plus ``robot_margin_m``, the tip's ball plus ``tip_margin_m``), steep faces, and every
+   point more than ``above_surface_m`` above the surface model (a dent goes down) are removed.
+2. The touch GP is fitted to those points and the tactile points (by default as the change of
+   height against the surface model) and read on the ROI's grid: the deformed heightmap X̄. The
+   tactile points cover the cap touching at the indentation δ (:func:`deformap.cloud.contact_cap`):
+   the force–travel record's model indentation when the stiffness estimate read one (0 if rigid),
+   else the tip's depth below the surface model; with a record and ``depth_anchor="record"`` they
+   hang from the surface model's height minus δ, with δ's uncertainty as noise.
 3. Shape matching from the ROI's heightmap before the press gives β̂
-   (:func:`deformap.msm.estimate_beta`). Under ``beta_uncertainty="camera-noise"`` its σ is the
-   camera's noise (the points' median absolute deviation about X̄) carried through the estimate
-   (:func:`deformap.explore._dent_noise.dent_error_samples`), else the shape matcher's own. Noise
-   draws cannot show a dent the camera does not see (β̂ sits at β = 0 under every draw), so a dent
-   shallower at the contact's edge (δ/2, Hertz) than ``dent_visible_sigmas`` standard deviations
-   of the camera's mean height within two tip radii claims σ = 1/√12, a uniform β
-   (:func:`dent_visible`, ``PokeRecord.dent_visible``). A press the record reads rigid reports
-   β = 0 with the β grid's resolution as σ on the ``odds`` scale (where β = 0 is the rigid body),
-   whatever the camera makes of the flat dent.
+   (:func:`deformap.msm.estimate_beta`); under ``camera-noise`` its σ is the camera's noise (the
+   points' median absolute deviation about X̄) carried through the estimate
+   (:func:`deformap.explore._dent_noise.dent_error_samples`). Noise draws cannot show a dent the
+   camera does not see, so a dent shallower at the contact's edge (δ/2, Hertz) than
+   ``dent_visible_sigmas`` standard deviations of the camera's mean height within two tip radii
+   claims σ = 1/√12, a uniform β (:func:`dent_visible`). Where β = 0 is the rigid body
+   (``ShapeMatchingConfig.rigid_at_zero``) a press the record reads rigid reports β = 0 with the
+   β grid's quantisation σ, whatever the camera makes of the flat dent.
 
 References
 ----------
