@@ -29,8 +29,8 @@ Strategies
 Every strategy runs until the map field's variance is below ``T_h`` (the paper's stop). Then come
 the ``boundary_pokes``, if any: the variance criterion leaves the isopleths where the field's length
 scale smoothed them, so each boundary poke goes to the largest straddle score, as for ``level-set``,
-among the reachable cells at least ``_targets.BOUNDARY_SPACING_ROI`` ROIs from every poke (where a
-new dent would not overlap an old one). The score reads the pokes' classes before any cut, so where
+among the reachable cells at least ``_targets.BOUNDARY_SPACING_ROI`` ROIs from every poke (a
+closer dent would overlap an old one). The score reads the pokes' classes before any cut, so where
 the pokes go does not depend on ``region_labels``.
 
 References
