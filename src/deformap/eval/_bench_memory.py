@@ -1,25 +1,20 @@
 """Memory benchmark: the peak memory of the surface GP (grid against exact) and of a β estimation.
 
-Each case runs in a fresh Python process (``python -m deformap.eval._bench_memory CASE SIZE SEED``)
-so that one case's heap never inflates another's numbers. The child imports everything and builds
-its inputs first, then measures two peaks over the case alone:
+Each case runs in a fresh process (``python -m deformap.eval._bench_memory CASE SIZE SEED``), so
+no case's heap inflates another's; the child builds its inputs first, then measures the case alone:
 
-- ``traced_peak_mib``: the largest total of live Python and numpy allocations (:mod:`tracemalloc`;
-  numpy reports its array buffers to it). It misses memory that C libraries allocate by
-  themselves (BLAS/LAPACK workspaces, SuperLU), and it is the same on every platform.
-- ``rss_peak_mib`` and ``rss_added_mib``: the process's peak resident set during the case and how
-  far it rose above the resident set just before (Linux: ``VmHWM``, reset before the case through
-  ``/proc/self/clear_refs``, after the set-up's freed heap went back to the OS through glibc's
-  ``malloc_trim``, so that the case cannot reuse it unseen). Everything counts here, C libraries
-  included; ``None`` where the platform cannot reset the peak (it would then include the set-up).
+- ``traced_peak_mib``: the largest total of live Python and numpy allocations (:mod:`tracemalloc`),
+  the same on every platform, but blind to what C libraries allocate themselves (BLAS, SuperLU).
+- ``rss_peak_mib`` and ``rss_added_mib``: the peak resident set during the case and its rise above
+  the set just before (Linux ``VmHWM``, reset through ``/proc/self/clear_refs`` after glibc's
+  ``malloc_trim`` returned the set-up's freed heap), everything included; ``None`` where the
+  platform cannot reset the peak.
 
-Cases (the same problems as the speed benchmarks, whose code they call):
-
-- ``gp-exact`` / ``gp-grid``: fit the surface GP to ``size`` noisy points over the 60 × 40 cm
-  workspace and predict mean and std on the 120 × 80 grid (:mod:`deformap.eval._bench_gp`).
-- ``beta-batched``: one converged β estimation (:func:`deformap.msm.estimate_beta`) on
-  ``size × size`` particles; ``beta-loop``: its baseline, the same β simulated one at a time
-  (:mod:`deformap.eval._bench_msm`).
+Cases, the speed benchmarks' problems: ``gp-exact`` / ``gp-grid`` fit the surface GP to ``size``
+noisy points over 60 × 40 cm and predict on the 120 × 80 grid (:mod:`deformap.eval._bench_gp`);
+``beta-batched`` is one converged :func:`deformap.msm.estimate_beta` on ``size × size``
+particles, ``beta-loop`` its baseline, the same β simulated one at a time
+(:mod:`deformap.eval._bench_msm`).
 """
 
 from __future__ import annotations

@@ -1,13 +1,12 @@
 """Benchmark of the β estimation: the estimate against a naive per-β loop, same run.
 
-Both sides compute the same thing: the converged poke equilibrium of every β that
-:func:`deformap.msm.estimate_beta` visits (the coarse uniform sweep plus the refinement to 0.01)
-and E(β) for each, on a Hertz dent of a 60 N foam (an elastic half-space, not shape matching) with
-0.1 mm of seeded observation noise. The estimate sets the ROI up once, starts each β from the
-β already solved and shares banded factorisations between nearby β; the naive loop simulates
-each of the same β on its own, to the same tolerance (its own set-up and factorisation, started
-from rest), reusing only the calibrated stiffness. "n_beta" is the number of β values simulated
-("batched_s" is the estimate's time, a name kept from when the sweep was one batch).
+Both sides compute the converged poke equilibrium and E(β) of every β that
+:func:`deformap.msm.estimate_beta` visits (the coarse sweep plus the refinement to 0.01), on a
+Hertz dent of a 60 N foam (an elastic half-space, not shape matching) with 0.1 mm of seeded
+observation noise. The estimate sets the ROI up once, starts each β from the one already solved
+and shares banded factorisations between nearby β; the loop simulates each β from rest with its
+own set-up, to the same tolerance, sharing only the calibrated stiffness. ``n_beta`` counts the
+β simulated and ``batched_s`` is the estimate's time.
 """
 
 from __future__ import annotations
@@ -73,9 +72,8 @@ def bench_beta_sweep(*, n_particles_side: int = 40, cluster_size: int = 3,
     t0 = time.perf_counter()
     loop_errors = per_beta_loop(grid, tree, contact, est, cfg)
     loop = time.perf_counter() - t0
-    # a β solved only to the loose sweep tolerance is good to about a micrometre of E (both sides
-    # stop within ``sweep_tol`` of the fixed point, from different starts); tight ones agree far
-    # better
+    # both sides stop within ``sweep_tol`` of the fixed point from different starts, so loosely
+    # solved β agree to about a micrometre of E and tightly solved ones far better
     atol = np.where(est.tolerances > cfg.tol, _LOOSE_ATOL_M, _TIGHT_ATOL_M)
     if np.any(np.abs(np.asarray(loop_errors) - est.errors) > atol):
         raise RuntimeError("the per-β loop disagrees with the estimate by more than "

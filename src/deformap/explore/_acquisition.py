@@ -1,72 +1,44 @@
-"""Where to poke next, from the β-field's variance on a grid.
+"""Where to poke next, from the map field's posterior variance on a grid.
 
 Strategies
 ----------
 ``paper``
-    Caccamo et al. 2016, Sec. III-D: a random cell among those whose variance exceeds the threshold
-    ``T_h`` (drawn with the explicit generator, so a seed fixes the run).
+    Caccamo et al. 2016, Sec. III-D: a random cell among those whose variance exceeds ``T_h``,
+    drawn with the explicit generator.
 ``max-variance``
-    The cell of largest variance (ties broken by the first in row-major order).
+    The cell of largest variance (ties: the first in row-major order).
 ``min-max-variance``
-    A one-step look-ahead: the candidate whose addition leaves the smallest *largest* posterior
-    variance over the grid. A GP's posterior variance does not depend on the observed values, only
-    on where they are (RW2006 Eq. 2.26), so the look-ahead is exact before the poke is made. It is
-    myopic, though: the poke that lowers the worst cell most now is not the first of the fewest
-    pokes that bring every cell under ``T_h``.
-``planned`` (the default)
+    One-step look-ahead: the candidate whose poke leaves the smallest largest posterior variance.
+    A GP's posterior variance depends only on where the data are (RW2006 Eq. 2.26), so the
+    look-ahead is exact before the poke; it is myopic.
+``planned`` (default)
     The first of the fewest further pokes that bring the largest variance under ``T_h``, planned
-    all together (:mod:`deformap.explore._planning`) and planned again after every poke. How
-    many pokes each strategy needs on the simulated scenarios is in the README ("Results", the
-    paper's Table I).
+    together and again after every poke (:mod:`deformap.explore._planning`).
 ``level-set``
-    Aimed at the region boundaries from the first poke on: the reachable cell of largest
-    *straddle* score (Bryan et al. 2005), ``1.96 σ(x) − min_l |μ(x) − h_l|``, among those at least
-    a quarter ROI from every poke (the score and the spacing of the boundary pokes below). The
-    levels ``h_l`` are the map's current cut levels, the isopleths between the classes the region
-    test finds in the pokes so far (:func:`deformap.explore.poke_classes`, the midpoints of
-    neighbouring class means): those are the boundaries the map will draw, so a cell near one
-    of them whose field is still uncertain is the cell whose label a poke is most likely to
-    change. While the pokes form one class there is no level, and the score is ``σ(x)`` alone
-    (the least-known place, where a region not yet met is most likely to be found). Straddle,
-    rather than ILS-UCB (Garg et al. 2016), because it has no weight to choose: its 1.96 is the
-    95 % band within which a cell's side of ``h`` is not yet known.
+    The reachable cell of largest straddle score (Bryan et al. 2005), ``1.96 σ(x) − min_l
+    |μ(x) − h_l|``, at least a quarter ROI from every poke; ``h_l`` are the isopleths between the
+    classes the region test finds in the pokes so far, and with one class the score is ``σ(x)``
+    (a region not yet met is likeliest where the field is least known). Straddle rather than
+    ILS-UCB (Garg et al. 2016) because it has no weight to choose: 1.96 is the 95 % band.
 ``integrated-variance``
-    The candidate that most reduces the posterior variance integrated over the workspace
-    (IMSE, Sacks et al. 1989): for a poke at ``x`` with noise ``σ_n²(x)``,
-    ``Σ_d k_post(d, x)² / (σ²(x) + σ_n²(x))`` over the cells ``d`` where the variance must fall
-    (an exact rank-one update of the posterior, which does not depend on the values). It is
-    evaluated on the planner's 2 cm lattices (:class:`deformap.explore.MapGrid`'s
-    ``plan_candidates`` and ``plan_domain``), so its cost is that of one (candidates × domain)
-    matrix however fine the map grid, and it takes the noise a poke there is expected to have
-    (:func:`deformap.explore._targets.expected_noise`). Myopic like ``min-max-variance``, but on
-    the mean of the variance rather than its maximum: it pokes where most of the map learns,
-    not where the worst cell is.
+    The candidate that most reduces the posterior variance integrated over the stop cells (IMSE,
+    Sacks et al. 1989): ``Σ_d k_post(d, x)² / (σ²(x) + σ_n²(x))``, an exact rank-one update with
+    the noise a poke at ``x`` is expected to have (:func:`deformap.explore._targets.expected_noise`),
+    on the planner's 2 cm lattices so its cost does not grow with the map grid.
 
-Every strategy runs until the map field's variance is below ``T_h`` (the paper's stop); the
-boundary pokes, if any, follow.
-
-Boundary pokes (``boundary_pokes`` > 0, after any strategy)
-    Once the variance is below ``T_h`` everywhere, the map is "known" in the paper's sense, but its
-    region boundaries are not: the β-field's length scale (``BetaFieldConfig.length_scale_m``)
-    smooths a block edge over as much, and more pokes placed for variance alone leave the isopleths
-    where they were (README, "Region accuracy": a lower ``T_h`` against boundary pokes). Each
-    boundary poke goes where a region boundary is least certain, by the *straddle* score of
-    level-set estimation (Bryan et al. 2005), ``1.96 σ(x) − min_l |μ(x) − h_l|`` over the isopleths
-    ``h_l`` between the classes found so far (``σ(x)`` alone while one class is found: a region not
-    yet met is looked for where the field is least known), among the reachable cells at least a
-    quarter ROI (``_targets.BOUNDARY_SPACING_ROI``) from every poke, where a new dent would
-    overlap an old one. Under ``boundary_score: nearest-poke`` (and so for ``level-set`` too) the
-    score is the nearest-poke map's instead (:func:`deformap.explore._targets.
-    nearest_poke_boundary_score`): the boundaries that cut draws are the bisectors between pokes
-    of different classes, not the field's isopleths, so a cell scores by how far it is from any
-    poke less its distance to such a bisector (about ``(d₂ − d₁) / 2``).
+Every strategy runs until the map field's variance is below ``T_h`` (the paper's stop). Then come
+the ``boundary_pokes``, if any: the variance criterion leaves the isopleths where the field's length
+scale smoothed them, so each boundary poke goes to the largest straddle score, as for ``level-set``,
+among the reachable cells at least ``_targets.BOUNDARY_SPACING_ROI`` ROIs from every poke (a
+closer dent would overlap an old one). The score reads the pokes' classes before any cut, so where
+the pokes go does not depend on ``region_labels``.
 
 References
 ----------
 Sacks, J., Welch, W. J., Mitchell, T. J., Wynn, H. P. (1989). Design and analysis of computer
-experiments. Statistical Science 4(4), 409–423 (the integrated mean squared error criterion).
+experiments. Statistical Science 4(4), 409–423.
 Garg, A., Sen, S., Kapadia, R., et al. (2016). Tumor localization using automated palpation with
-Gaussian process adaptive sampling. IEEE CASE (the implicit level set UCB it is compared with).
+Gaussian process adaptive sampling. IEEE CASE.
 Bryan, B., Schneider, J., Nichol, R. C., Miller, C. J., Genovese, C. R., Wasserman, L. (2005).
 Active learning for identifying function threshold boundaries. NIPS 18.
 """
@@ -120,7 +92,7 @@ def choose_target(
     cells_xy : (n, 2) float, metres
         Centres of the grid cells that may be poked.
     variance : (n,) float
-        β-field posterior variance at those cells.
+        The map field's posterior variance at those cells.
     threshold : float
         ``T_h``: exploration stops when every cell's variance is at or below it.
     rng : numpy.random.Generator
@@ -169,9 +141,11 @@ def choose_target(
 
 def boundary_score(mean: NDArray[np.float64], std: NDArray[np.float64],
                    levels: NDArray[np.float64]) -> NDArray[np.float64]:
-    """Straddle score ``1.96 σ − min_l |μ − h_l|`` of cells with β-field mean ``mean (n,)`` and
-    standard deviation ``std (n,)`` against the isopleths ``levels (m,)``; ``std`` itself when
-    there is no isopleth (one class). The next boundary poke goes to the largest score."""
+    """Straddle score ``1.96 σ − min_l |μ − h_l|`` (Bryan et al. 2005) of cells.
+
+    ``mean`` and ``std`` ``(n,)`` are the map field's posterior at the cells, ``levels`` ``(m,)``
+    the isopleths; with no isopleth (one class) the score is ``std``. Returns ``(n,)``.
+    """
     if levels.size == 0:
         return np.asarray(std, dtype=float)
     gap = np.min(np.abs(mean[:, None] - levels[None, :]), axis=1)

@@ -1,79 +1,18 @@
-"""Settings of the mapper and the exploration loop (one frozen dataclass per component).
+"""Settings of the mapper and the exploration loop, one frozen, keyword-only dataclass per component.
 
-Defaults and why
-----------------
-Surface GP ("GPR world"): hyperparameters are fitted by maximum marginal likelihood on the first
-observation, on a seeded subset of 800 points (their mean spacing, about 2 cm over 60×40 cm, is
-well below any length scale a table-top surface has, and each likelihood evaluation costs n³), from
-the values below and one random restart; the map is read on the paper's 0.5 cm grid. Before the
-fit, points on surfaces steeper than 60° are dropped (``max_slope_deg``,
-:func:`deformap.cloud.height_field_mask`): a camera at 45° sees the front faces of the blocks, and
-fitted as heights those walls make the GP ring over the whole map (README, "β separates hardness
-only under the force-driven protocol", says by how much). The fitted length scale is kept at or
-above 3 cm (``min_length_scale_m``): a flat surface leaves it undetermined (the fitted signal is
-then micrometres and any length scale fits) and the camera's disparity steps pull it to
-millimetres, while the grid GP's cost grows steeply below it (its compressed inducing features
-number about (extent / σ_w)², and its fit costs their cube, :mod:`deformap.gp`). The dents
-themselves are the touch GP's (1 cm).
+Each class's Parameters section describes every field: first a one-line description with its unit
+(lengths in metres, forces in newtons, β dimensionless in [0, 1), the modulus field in ln E with E
+in pascals), then the reason for its default. A setting given in β units holds for the modulus
+field as the same fraction of its prior: ``T_h`` of the prior variance, the regions' smallest step
+of the prior standard deviation (:func:`deformap.explore.field_settings`).
+The ``MAX_*`` bounds refuse, before any work, settings whose matrices would not fit in memory.
 
-Robot removal: the convex hull of the robot's points (plus 2 mm: proprioception and camera do not
-agree to the millimetre), a ball of the tip's radius plus 3 mm around the tip (the tactile points
-stand for what it hides), and every point more than 1 cm above the surface as it was before the
-poke — a dent goes down, so anything that high is the stick, the hand or a flying pixel between
-them and the surface (1 cm is five times the camera's depth noise at the table). The same 60° slope
-filter as for the surface removes the flying-pixel veils that hang lower than that behind the stick.
-
-Touch GP ("GPR-touch"): fitted on a square ROI of the cloud seen while pressing plus the 10 tactile
-points. ROI 12 cm: the dent of a 1 cm tip under about a newton spreads over a few centimetres on
-foam 5 cm thick, and the edges of the ROI must be undisturbed because shape matching fixes them.
-By default the touch GP models the *change* of height against the surface GP's mean before the poke
-(``model="residual"``): far from the dent it reverts to "no change" instead of to a constant, which
-the occlusion by stick and hand would otherwise bias. ``model="height"`` is the paper's literal form.
-Its length scale (1 cm) is the tip's radius: the dent cannot vary faster than the body pressing it.
-
-β-field ("GPR β-field"): prior standard deviation 0.3 (variance 0.09, above the paper's threshold
-0.06 so that the unexplored map asks for a poke); length scale 0.2 m, a third of the table's width:
-the size of the foam pieces a robot is asked to tell apart. Each poke's noise is its claimed β
-uncertainty plus, in variance, the map's nugget: ``√(σᵢ² + τ̂²)``. σᵢ is the camera's noise
-(measured in each poke's ROI) carried through the estimate (``TouchGPConfig.noise_samples`` draws
-of the touch GP's smoother applied to noise, β̂ re-read on each,
-:mod:`deformap.explore._dent_noise`): a repeatability at one place. τ̂ is the scatter of β̂ between
-places on one material that σᵢ does not explain (the README, "β separates hardness only under the
-force-driven protocol", compares the two), estimated for each map from its own pokes
-(``BetaFieldConfig.nugget``, :mod:`deformap.explore._nugget`): the maximum a posteriori of the
-restricted likelihood of the pokes within the region test's classes (each class's mean removed,
-so the steps between materials are not read as scatter), with a half-Cauchy prior on τ whose scale
-is the pokes' median claimed σ (the estimator's own scale, no number of a world). σᵢ is at least
-``BetaFieldConfig.noise_floor``, by default the β grid's quantisation,
-``shape_matching.beta_resolution / √12`` (0.0029: what every β̂'s σ already is at least, and
-what a press read rigid claims), an explicit lower bound a robot may raise. Until this change the
-floor was 0.015 and there was no nugget: the spread between places on the simulated world's 150 N
-foam, a number fitted to the simulator's output (0.03 on the former reference β scale); ``nugget:
-off`` with ``noise_floor: 0.015`` (``0.03`` under ``beta_scale: reference``) reproduces those maps.
-On the simulated Table I scenarios (β-field; FEM seeds 0–3, the stiffening foam, kinect-v1) the
-nugget came out 0–0.022; on the same pokes the region test found the same classes as with the
-former floor in every map, while the planner, given other noises, placed other pokes (27 of 32
-maps counted right against 30 of 32: README, Table I on the β-field under "β separates hardness
-only under the force-driven protocol").
-Modulus field (``ExplorationConfig.field = "modulus"``, :mod:`deformap.explore._modulus`): a
-Gaussian random field over ln E [ln Pa] from the pokes' force–travel records. Its prior standard
-deviation 1.73 is a quarter of ln(10⁶ Pa / 10³ Pa) = 6.9: the soft foams to rubbers a table-top
-robot presses span about 1 kPa to 1 MPa (Gibson & Ashby 1997, ch. 5, flexible foams; rubbers at
-0.5–5 MPa), so ±2σ about the data's mean spans that range. Its length scale is the β-field's
-0.2 m, for the β-field's reason (the size of the pieces to tell apart, a property of the layout,
-not of what is measured). Noise floor 0.1 (10 % in E): an open-cell foam's modulus goes as its
-density squared (Gibson & Ashby, Eq. 5.6), and a foam sheet's density varies by a few per cent
-from place to place (±5 % in density is ±10 % in E); the contact model's own error is of that
-order too (issue 13 asks ≤ 10 % on linear-elastic foams). A rigid poke sits on the ln E axis at
-its detection bound with ``rigid_log_std`` (0.75): the bound is the record's travel span plus two
-of its standard deviations, so its relative error is about 1/2, and E goes as travel^(−3/2)
-(Hertz): 1.5 × 1/2 = 0.75. Settings given in β units take their modulus-field counterpart as
-the same fraction of the prior: ``T_h`` scales with the prior variance (0.06 of 0.09, two thirds,
-is 2.0 of 3.0 in (ln E)²) and the regions' smallest step with the prior standard deviation
-(:func:`deformap.explore.field_settings`).
-Next pokes by ``planned`` (:mod:`deformap.explore._planning`): the fewest pokes, the centre
-included, that bring every cell below ``T_h``; the README ("Results", the paper's Table I) gives
-the pokes each strategy needs on the simulated scenarios.
+References
+----------
+Caccamo, S., Güler, P., Kjellström, H., Kragic, D. (2016). Active Perception and Modeling of
+Deformable Surfaces using Gaussian Processes and Position-based Dynamics. Humanoids.
+Gibson, L. J., Ashby, M. F. (1997). Cellular Solids, 2nd ed., ch. 5.
+Rasmussen, C. E., Williams, C. K. I. (2006). Gaussian Processes for Machine Learning, Sec. 5.4.
 """
 
 from __future__ import annotations
@@ -133,20 +72,16 @@ BoundaryScore = Literal["straddle", "nearest-poke"]
 #: (``ExplorationConfig.unread_place``).
 UnreadPlace = Literal["beta", "avoid"]
 
-#: Most bytes of one band of the ROI's shape-matching system (:mod:`deformap.msm._linsys`): the
-#: β sweep holds its two assembled bands and a few factorisations of that size at once, so 512 MiB
-#: keeps the sweep within a few GiB.
+#: Most bytes of one band of the ROI's shape-matching system (:mod:`deformap.msm._linsys`); the
+#: β sweep holds a few arrays of that size at once, so 512 MiB keeps it within a few GiB.
 MAX_ROI_BAND_BYTES = 512 * 2**20
 #: Most cells of the map grid: every map is a dense grid, and the ``min-max-variance`` look-ahead
 #: holds a (256 candidates × cells) float64 matrix, 2 GB at this size.
 MAX_MAP_CELLS = 1_000_000
-#: Most cells of the planner's 2 cm grids (``planned``, ``min-max-variance``,
-#: ``integrated-variance``): it holds
-#: (candidates × domain) and (candidates × candidates) float64 kernel matrices, 0.8 GB each at
-#: this size (4 m² of workspace).
+#: Most cells of the planner's 2 cm grids (:data:`PLANNER_STRATEGIES`): its (candidates × domain)
+#: and (candidates × candidates) float64 matrices are 0.8 GB each at this size (4 m² of workspace).
 MAX_PLAN_CELLS = 10_000
-#: Spacing of the planner's grids (:class:`deformap.explore.MapGrid`'s ``plan_domain`` and
-#: ``plan_candidates``), the budget's and the grid's one value.
+#: Spacing of the planner's grids (``MapGrid.plan_domain``, ``plan_candidates``), metres.
 PLAN_GRID_M = 0.02
 #: The strategies that hold the planner's (candidates × domain) matrices.
 PLANNER_STRATEGIES: tuple[Strategy, ...] = ("planned", "min-max-variance", "integrated-variance")
@@ -154,7 +89,47 @@ PLANNER_STRATEGIES: tuple[Strategy, ...] = ("planned", "min-max-variance", "inte
 
 @dataclass(frozen=True, kw_only=True)
 class SurfaceGPConfig:
-    """Crop, outlier filter and the surface Gaussian random field."""
+    """Crop, outlier filter and the surface Gaussian random field ("GPR world").
+
+    The hyperparameters start from the values below and are fitted by maximum marginal
+    likelihood (RW2006 Sec. 5.4) on a seeded subset of the first observation.
+
+    Parameters
+    ----------
+    z_min_m : float
+        Lowest height the crop keeps, metres in the world frame.
+    z_max_m : float
+        Highest height the crop keeps, metres in the world frame; must exceed ``z_min_m``.
+    outlier_k : int
+        Neighbours per point of the statistical outlier and slope filters, a count.
+    outlier_std_ratio : float
+        Outlier cut, in standard deviations of the points' mean neighbour distances.
+    max_slope_deg : float
+        Steepest surface kept, degrees from the horizontal.
+        60°: a camera at 45° sees the blocks' front faces, and those walls fitted as heights make
+        the GP ring over the map (:func:`deformap.cloud.height_field_mask`).
+    min_length_scale_m : float
+        Smallest length scale the fit may reach, metres.
+        3 cm: a flat surface leaves the length scale undetermined and the camera's disparity steps
+        pull it to millimetres, while the grid GP's cost grows steeply below it
+        (:mod:`deformap.gp`).
+    fit_hyperparameters : bool
+        Whether to fit the hyperparameters; ``False`` keeps the values below.
+    max_fit_points : int
+        Points of the seeded subset the likelihood is evaluated on, a count.
+        800: their spacing (about 2 cm over 60 × 40 cm) is well below any table-top surface's length
+        scale, and each evaluation costs n³.
+    fit_restarts : int
+        Random restarts of the fit besides the start below, a count.
+    length_scale_m : float
+        Length scale σ_w the fit starts from, metres.
+    signal_std_m : float
+        Prior standard deviation of the heights the fit starts from, metres.
+    noise_std_m : float
+        Standard deviation of the camera's height noise the fit starts from, metres.
+    grid_spacing_m : float
+        Spacing of the map grid, metres; 5 mm is the paper's grid.
+    """
 
     z_min_m: float = -0.02
     z_max_m: float = 0.30
@@ -184,30 +159,67 @@ class SurfaceGPConfig:
 
 @dataclass(frozen=True, kw_only=True)
 class TouchGPConfig:
-    """The ROI around a poke and the Gaussian random field that reconstructs its dent.
+    """The ROI around a poke, the robot's removal from it, and the touch GP ("GPR-touch").
 
-    ``noise_samples``: how many draws of the camera's noise are carried through the touch GP when
-    β's uncertainty is the camera's noise (``ExplorationConfig.beta_uncertainty``, the one
-    switch; :mod:`deformap.explore._dent_noise`); 0 when it is not.
+    The touch GP is fitted, with the hyperparameters below, to the ROI of the cloud seen while
+    pressing plus the tactile points (:func:`deformap.explore.measure_press`).
 
-    ``tactile_cap``: ``"contact"`` (default) puts the tactile points only on the cap of the tip
-    that touches at the poke's indentation (Hertz contact radius ``√(R δ)``, at the paper's
-    density of ``n_tactile`` points per 30° cap, at least the pole;
-    :func:`deformap.cloud.contact_cap`); ``"fixed"``, the paper's ``n_tactile`` points on a
-    fixed 30° cap.
-
-    ``depth_anchor``: ``"record"`` (default) places the tactile points, when the press has a
-    force–travel record the stiffness estimate could read, at the surface model's height at the
-    contact minus the record's indentation (so that an error in the tip's absolute height does
-    not move the dent), with the record's uncertainty of that indentation as their noise;
-    ``"tip"``, and every press without such a record, places them on the tip where
-    proprioception says it is, with ``tactile_noise_std_m``.
-
-    ``dent_visible_sigmas``: with β's uncertainty from the camera's noise, a dent whose depth at
-    the contact's edge (half the indentation, Hertz) is below this many standard deviations of
-    the camera's mean height over the points seen around the tip is within the camera's noise:
-    β's claimed σ is then that of knowing nothing about β, a uniform over [0, 1) (1/√12).
-    2: a one-sided test at about 98 %.
+    Parameters
+    ----------
+    roi_size_m : float
+        Side of the square ROI centred on the poke, metres.
+        12 cm: a 1 cm tip under about a newton dents 5 cm of foam over a few centimetres, and shape
+        matching fixes the ROI's edges, so they must be undisturbed.
+    model : {"residual", "height"}
+        What the touch GP models, heights or their change, metres.
+        ``residual`` (default), the change of height against the surface GP's mean before the poke:
+        far from the dent it reverts to "no change" rather than to a constant that the occlusion by
+        stick and hand would bias; ``height``, the paper's literal form.
+    n_tactile : int
+        Tactile points per 30° cap of the tip, a count (the paper's 10).
+    tactile_noise_std_m : float
+        Noise standard deviation of tactile points on the tip's proprioceptive pose, metres.
+    tactile_cap : {"contact", "fixed"}
+        Which cap of the tip carries the tactile points.
+        ``contact`` (default), the cap that touches at the poke's indentation δ (Hertz contact
+        radius √(Rδ)) at ``n_tactile`` points per 30°, at least the pole
+        (:func:`deformap.cloud.contact_cap`); ``fixed``, the paper's ``n_tactile`` points on a 30°
+        cap.
+    depth_anchor : {"record", "tip"}
+        Where the tactile points' depth comes from, the record or the tip.
+        ``record`` (default; a press with a readable force–travel record): the surface model's
+        height minus the record's indentation, with its uncertainty as noise, so an error in the
+        tip's absolute height does not move the dent; ``tip`` and every other press: the tip as
+        proprioception places it, with ``tactile_noise_std_m``.
+    dent_visible_sigmas : float
+        Smallest visible dent, in standard deviations of the camera's mean height near the tip.
+        A dent shallower at the contact's edge (δ/2, Hertz) claims the σ of knowing nothing
+        about β, 1/√12; 2 is a one-sided test at about 98 %.
+    robot_margin_m : float
+        Margin of the robot's convex hull whose points are removed, metres.
+        2 mm: proprioception and camera do not agree to the millimetre.
+    tip_margin_m : float
+        Margin beyond the tip's radius of the ball whose points are removed, metres.
+        The tactile points stand for what it hides.
+    above_surface_m : float
+        Height above the pre-poke surface above which points are removed, metres.
+        A dent goes down, so anything 1 cm higher (five times the camera's depth noise at the table)
+        is the stick, the hand or a flying pixel.
+    max_slope_deg : float
+        Steepest surface kept in the ROI, degrees from the horizontal.
+        It removes the flying-pixel veils behind the stick that hang lower than
+        ``above_surface_m``.
+    length_scale_m : float
+        Length scale σ_w of the touch GP, metres.
+        1 cm, the tip's radius: the dent cannot vary faster than the body pressing it.
+    signal_std_m : float
+        Prior standard deviation of the touch GP's heights, metres.
+    noise_std_m : float
+        Standard deviation of the camera's height noise in the ROI, metres.
+    noise_samples : int
+        Draws of the camera's noise carried through the touch GP for β's uncertainty, a count.
+        See :mod:`deformap.explore._dent_noise`; 0 when ``ExplorationConfig.beta_uncertainty`` is
+        ``shape-matching``, else at least 2.
     """
 
     roi_size_m: float = setting(0.12, gt=0.0)
@@ -237,24 +249,31 @@ class TouchGPConfig:
 
 @dataclass(frozen=True, kw_only=True)
 class BetaFieldConfig:
-    """Prior of the β-field Gaussian random field (the paper's σe, σw, σn; module docstring,
-    "β-field", argues the defaults).
+    """Prior of the β-field, the Gaussian random field over the pokes' β (the paper's σe, σw, σn).
+
+    Each poke's noise standard deviation is ``√(σᵢ² + τ̂²)``: σᵢ its claimed β uncertainty, at
+    least ``noise_floor``, and τ̂ the map's nugget.
 
     Parameters
     ----------
     signal_std : float
-        σe, the prior standard deviation of β about the pokes' weighted mean.
+        Prior standard deviation σe of β about the pokes' weighted mean, dimensionless.
+        0.3: its variance 0.09 lies above the paper's ``T_h`` = 0.06, so an unexplored map asks for
+        a poke.
     length_scale_m : float
-        σw, metres.
+        Length scale σw of the β-field, metres.
+        0.2 m, a third of a table, is the size of the pieces a robot is asked to tell apart.
     noise_floor : float or None
-        Smallest claimed σ of a poke's β, an explicit lower bound; ``None`` (default): the β
-        grid's quantisation, ``shape_matching.beta_resolution / √12``, which every β̂'s σ
-        already is at least (:func:`deformap.explore.beta_noise_floor`).
+        Smallest claimed σ of a poke's β, dimensionless; ``None``: the β grid's quantisation.
+        The quantisation, ``shape_matching.beta_resolution / √12`` (the default), is what
+        every β̂'s σ already is at least (:func:`deformap.explore.beta_noise_floor`), so only
+        a robot that knows better need raise it.
     nugget : {"within-class", "off"}
-        ``within-class`` (default): each poke's noise is its σ (at least the floor) plus, in
-        variance, the map's nugget τ², the scatter between places on one material that the
-        claimed σ does not explain, estimated from the pokes of the map's own region classes
-        (:mod:`deformap.explore._nugget`); ``off``: the σ at least the floor alone.
+        How the nugget τ̂, in β units, is estimated.
+        ``within-class`` (default): τ̂ is the scatter of β̂ between places on one material that σᵢ
+        does not explain, the maximum a posteriori of the restricted likelihood of the pokes within
+        the region test's classes (each class's mean removed) under a half-Cauchy prior scaled by
+        the pokes' median σᵢ (:mod:`deformap.explore._nugget`); ``off``: τ̂ = 0.
     """
 
     signal_std: float = setting(0.3, gt=0.0)
@@ -268,19 +287,28 @@ class BetaFieldConfig:
 
 @dataclass(frozen=True, kw_only=True)
 class ModulusFieldConfig:
-    """Prior of the modulus field, a Gaussian random field over ln E (E in Pa; module docstring,
-    "Modulus field", argues the defaults).
+    """Prior of the modulus field, the Gaussian random field over the pokes' ln E (E in Pa).
+
+    It is fitted to the pokes whose force–travel record gave a modulus or read rigid
+    (:mod:`deformap.explore._modulus`).
 
     Parameters
     ----------
     signal_std : float
-        Prior standard deviation of ln E about the pokes' weighted mean.
+        Prior standard deviation of ln E about the pokes' weighted mean, ln Pa.
+        1.73, a quarter of ln(10⁶ / 10³): ±2σ spans the 1 kPa to 1 MPa of the soft foams to rubbers
+        a table-top robot presses (Gibson & Ashby 1997, ch. 5).
     length_scale_m : float
-        σ_w, metres.
+        Length scale σ_w of the modulus field, metres.
+        The β-field's, for its reason: the pieces' size is a property of the layout.
     noise_floor : float
-        Smallest standard deviation of a poke's ln E (σ_E / E raised to it).
+        Smallest standard deviation of a poke's ln E, ln Pa (its σ_E / E is raised to it).
+        0.1: a foam's modulus goes as its density squared (Gibson & Ashby 1997, Eq. 5.6), and a
+        sheet's density varies by a few per cent from place to place.
     rigid_log_std : float
-        Standard deviation of ln E given to a rigid poke at its detection bound.
+        Standard deviation of ln E given to a rigid poke at its detection bound, ln Pa.
+        0.75: the bound (travel span plus two standard deviations) has a relative error of about
+        1/2, and E goes as travel^(−3/2) (Hertz).
     """
 
     signal_std: float = setting(1.73, gt=0.0)
@@ -299,101 +327,82 @@ class ExplorationConfig:
     Parameters
     ----------
     threshold : float
-        ``T_h``: stop when the β-field's largest variance on the grid falls below it (paper: 0.06).
+        ``T_h``, the largest map-field variance the stop cells may keep, in β².
+        The modulus field reads it as the same fraction of its prior variance; 0.06 is the
+        paper's.
     max_pokes : int
-        Hard limit on the number of pokes.
+        Most pokes of a run, boundary pokes included, a count.
     strategy : {"paper", "max-variance", "min-max-variance", "planned", "level-set", \
 "integrated-variance"}
-        How the next target is chosen (see :mod:`deformap.explore._acquisition`).
+        How the next poke is chosen (:mod:`deformap.explore._acquisition`).
+        ``planned`` (default) takes the first of the fewest pokes, the centre included, that
+        bring every cell below ``T_h``.
     first_target : (2,) float or None
-        The first poke, in metres; ``None`` means the workspace centre.
+        The first poke's x, y, metres in the world frame; ``None``: the workspace's centre.
     stop_region : {"workspace", "targets"}
-        Where the variance must fall below ``T_h``: ``workspace``, every cell of the map;
-        ``targets``, only the cells a poke can be centred on (half a ROI inside the edges), the
-        paper's literal rule ("until the ROI detector block does not find a new candidate point"),
-        which stops sooner and leaves the edge band to extrapolation.
+        Where the variance must fall below ``T_h``, the whole map or the targets.
+        ``workspace`` (default), every cell of the map; ``targets``, the cells a poke can be centred
+        on (half a ROI inside the edges), the paper's literal rule, which stops sooner and leaves
+        the edge band to extrapolation.
     force_n : float
-        The commanded normal force of every press. 0.6 N keeps the Hertz contact of a 1 cm tip
-        on the tip itself for foams down to 60 N (``F <= 4 E* R² / 3`` = 0.68 N) while denting
-        them by millimetres, well above the camera's noise (:mod:`deformap.world._world`,
-        "Default press force").
+        Commanded normal force of every press, newtons.
+        0.6 N keeps the Hertz contact of a 1 cm tip on the tip for foams down to 60 N
+        (``F <= 4 E* R² / 3`` = 0.68 N) while denting them by millimetres, well above the
+        camera's noise.
     max_regions : int
-        Most regions the β-field is cut into (see :mod:`deformap.explore._regions`).
+        Most regions the map field is cut into, a count (:mod:`deformap.explore._regions`).
     region_prior_dof : float
-        How many degrees of freedom the pokes' uncertainties count for when the region test
-        judges whether the βs scatter more than one material would (7: as much as the eight
-        presses on one foam the former noise floor was measured from; 0: ignore them, scale-free).
+        Degrees of freedom the pokes' claimed uncertainties count for in the region test.
+        The test judges whether the values scatter more than one material's would; 7 is as
+        much as eight presses on one foam; 0 ignores the claims (scale-free).
     region_labels : {"isopleth", "nearest", "indicator-kriging"}
-        How cells get their region once the classes are found (:mod:`deformap.explore._regions`):
-        ``isopleth``, the paper's, by the band of the β-field's mean a cell falls in;
-        ``nearest``, the default, by the class of the poke nearest to the cell;
-        ``indicator-kriging``, by the most probable class, each class's probability kriged from
-        the pokes' class indicators (:mod:`deformap.explore._indicator`). Over 100 random
-        worlds (``deformap bench worlds``, README "Many worlds") the nearest-poke cut beat the
-        isopleths with every strategy from 7 pokes on (level before) and was the best of the
-        three at 20 pokes (indicator kriging was a little better at 5–10).
+        How cells get their region once the classes are found.
+        See :mod:`deformap.explore._regions`: ``isopleth``, the paper's, by the band of the map
+        field's mean a cell falls in; ``nearest`` (default, the cut that counted the regions of
+        random worlds best), by the class of the nearest poke; ``indicator-kriging``, by the most
+        probable class, each class's probability kriged from the pokes' class indicators
+        (:mod:`deformap.explore._indicator`).
     merge_seams : bool
-        Before the cells are labelled, merge the classes whose every poke borders pokes of two
-        other classes within twice the layer's thickness (:func:`deformap.explore.merge_seam_classes`):
-        a press where two pieces meet reads between them, or softer than both by a free face, and
-        is otherwise a region of its own. On by default: on the first 30 worlds of ``deformap
-        bench worlds --seed 0`` (rescored on the same pokes, README "Many worlds") it took the
-        worlds with more regions found than true after 20 pokes from 53 % to 30 % (``paper``) and
-        33 % to 20 % (``planned``) and left Table I as it was; ``false`` gives the classes as found.
+        Whether to merge the classes that lie on a seam between two others before labelling.
+        Every poke of such a class borders pokes of two others within twice the layer's thickness
+        (:func:`deformap.explore.merge_seam_classes`); on, because a press where two pieces meet
+        reads between or below both and would otherwise be a region of its own.
     split_by_place : bool
-        Before that, split a class whose pokes away from the other classes form two places of
-        different values (:func:`deformap.explore.split_by_place`: a join-count test of its best
-        split by value against shuffles, no smallest step): two materials closer than the region
-        test's smallest step, side by side, are otherwise one region. Needs six such pokes in a
-        class, so it acts in longer runs (Table I is as without it). On by default: over 42
-        random worlds (README "Many worlds") it mended 3 maps and broke 1 for three pokes, and
-        left the median pokes to accuracy 0.9 as they were.
+        Whether to split a class whose pokes form two places of different values, before merging.
+        It needs six pokes away from the other classes (:func:`deformap.explore.split_by_place`);
+        on, because two materials closer than the region test's smallest step, side by side, are
+        otherwise one region.
     boundary_pokes : int
-        Pokes made after the variance has fallen below ``T_h``, each where a region boundary is
-        least certain (:mod:`deformap.explore._acquisition`, "boundary pokes"); 0, the paper's
-        rule, stops there.
-    boundary_score : {"straddle", "nearest-poke"}
-        How a boundary poke, and every poke of ``level-set``, scores the reachable cells:
-        ``straddle``, the field's (Bryan et al. 2005: ``1.96 σ − min |μ − h|`` against the
-        isopleths between the classes); ``nearest-poke``, the nearest-poke map's
-        (:func:`deformap.explore._targets.nearest_poke_boundary_score`: how far a cell is from
-        any poke, less its distance to where the nearest-poke map's boundary passes, about
-        ``(d₂ − d₁) / 2``), the boundaries the default cut draws. Either reads the pokes'
-        classes before any cut, so where the pokes go does not depend on ``region_labels``.
-    stiffness : StiffnessConfig
-        Reading stiffness and Young's modulus from a press's force–travel record, when the
-        environment gives one (:func:`deformap.explore.estimate_stiffness`).
-    field : {"beta", "modulus"}
-        The field the regions, the next-poke choice and the stopping rule run on: ``beta``, the
-        β-field (the paper's); ``modulus``, the modulus field over ln E from the force–travel
-        records (:mod:`deformap.explore._modulus`; ``threshold`` is then read as the same fraction
-        of its prior variance), the default: it counted the regions right on the simulated FEM
-        world and on the stiffening-foam physics where the β-field did not (README, "Regions on
-        the β-field or on the modulus field"), and it does not depend on the camera. When no poke
-        of a run gives a usable record (a camera-only robot or session) the run falls back to
-        ``beta`` at its first poke, and its result says so (``field_fallback``).
-    unread_place : {"beta", "avoid"}
-        Under ``field: modulus``, what a place whose modulus could not be read twice does (two
-        presses within ``BOUNDARY_SPACING_ROI`` ROIs of each other whose records were not read:
-        a further press there would read nothing again, so the modulus field's variance there
-        would never fall): ``beta``, the run maps on the β-field from then on, for good;
-        ``avoid``, the run keeps the modulus field and takes that disc out of the targets and of
-        the cells whose variance must fall below ``T_h`` (the map still covers it, from the
-        pokes around it; ``ExplorationResult.unread_places`` lists them), and falls back to β
-        only when no target would be left. ``avoid`` is the default: over the 100 default worlds
-        of ``deformap bench worlds --seed 0`` (README, "Many worlds") it changed the 23 of 600
-        runs that had gone to β, every strategy's median pokes to accuracy 0.9 over the worlds
-        as it was (those 23 runs' own: 17 → 19), 17 of the 23 ended more accurate and 6 less
-        (mean final accuracy 0.845 → 0.872), and it keeps the map in physical units.
-    modulus_field : ModulusFieldConfig
-        Prior of the modulus field; it is computed whenever a poke has a modulus, whichever
-        ``field`` is chosen.
+        Pokes made after the variance has fallen below ``T_h``, a count.
+        Each goes where a region boundary is least certain (straddle score, Bryan et al. 2005;
+        :mod:`deformap.explore._acquisition`); 0, the paper's rule, stops there.
     beta_uncertainty : {"camera-noise", "shape-matching"}
-        The one switch for where each poke's β uncertainty (its noise in the β-field) comes from:
-        ``camera-noise``, the camera's noise measured in the ROI carried through the touch GP and
-        the estimate (``touch.noise_samples`` draws, at least 2); ``shape-matching``, the shape
-        matcher's own (``shape_matching.uncertainty``: the tile bootstrap or the E(β) tolerance;
-        ``touch.noise_samples`` must then be 0, so that no setting is silently ignored).
+        Where each poke's β uncertainty, its noise in the β-field, comes from.
+        ``camera-noise`` (default), the camera's noise measured in the ROI carried through the
+        touch GP and the estimate (``touch.noise_samples`` >= 2 draws), a repeatability at one
+        place; ``shape-matching``, the shape matcher's own (``shape_matching.uncertainty``;
+        ``touch.noise_samples`` must then be 0, so no setting is silently ignored).
+    field : {"beta", "modulus"}
+        The field the regions, the next-poke choice and the stop run on, β or ln E.
+        ``beta``, the paper's; ``modulus`` (default), in physical units and independent of the
+        camera. Under ``modulus`` a place whose modulus could not be read twice leaves the targets
+        and stop cells (``ExplorationResult.unread_places``); the run maps on ``beta`` while no
+        poke has a modulus, and for good once no target would be left, and says why
+        (``field_fallback``).
+    surface : SurfaceGPConfig
+        The crop, filters and surface GP of the first observation.
+    touch : TouchGPConfig
+        The ROI, robot removal and touch GP of each press.
+    beta_field : BetaFieldConfig
+        Prior and noise of the β-field.
+    modulus_field : ModulusFieldConfig
+        Prior of the modulus field.
+        It is computed whenever a poke has a modulus, whichever ``field`` is chosen.
+    shape_matching : ShapeMatchingConfig
+        The shape-matching β estimate of each dent (:mod:`deformap.msm`).
+    stiffness : StiffnessConfig
+        Reading stiffness and Young's modulus from a press's force–travel record.
+        Used when the environment gives a record (:func:`deformap.explore.estimate_stiffness`).
     """
 
     threshold: float = setting(0.06, gt=0.0)

@@ -1,35 +1,23 @@
 """One press: the dent reconstructed from the cloud seen while pressing, and its β.
 
-1. The ROI, a square of ``roi_size_m`` centred on the contact, is cropped from the cloud; the
-   robot's points are removed (the convex hull of its stick and hand plus ``robot_margin_m``, a
-   ball of the tip's radius plus ``tip_margin_m``), then steep faces, then every point more than
-   ``above_surface_m`` above the surface model (a dent goes down).
-2. The touch GP ("GPR-touch") is fitted to those points and the tactile points on the tip's cap,
-   by default as the change of height against the surface model (``model="residual"``), and read
-   on the ROI's grid: the deformed heightmap X̄. The tactile points cover only the cap that
-   touches at the poke's indentation δ (``touch.tactile_cap``; :func:`deformap.cloud.contact_cap`):
-   δ is the force–travel record's when the stiffness estimate read one (its model indentation at
-   the commanded force; 0 when it read the surface rigid), else the tip's depth below the
-   surface model at the contact. With a record (``touch.depth_anchor="record"``) the points'
-   heights are anchored to it: the pole at the surface model's height at the contact minus δ,
-   with δ's uncertainty as their noise (the travel's noise and what E's σ moves δ by), so that an
-   error in the tip's absolute height, which a real arm's calibration makes by a millimetre, no
-   longer moves the dent. Without a record the points lie on the tip as proprioception places
-   it.
+1. The ROI (``roi_size_m`` square on the contact) is cropped from the cloud; the robot's points
+   (its hull plus ``robot_margin_m``, the tip's ball plus ``tip_margin_m``), steep faces, and every
+   point more than ``above_surface_m`` above the surface model (a dent goes down) are removed.
+2. The touch GP is fitted to those points and the tactile points (by default as the change of
+   height against the surface model) and read on the ROI's grid: the deformed heightmap X̄. The
+   tactile points cover the cap touching at the indentation δ (:func:`deformap.cloud.contact_cap`):
+   the force–travel record's model indentation when the stiffness estimate read one (0 if rigid),
+   else the tip's depth below the surface model; with a record and ``depth_anchor="record"`` they
+   hang from the surface model's height minus δ, with δ's uncertainty as noise.
 3. Shape matching from the ROI's heightmap before the press gives β̂
-   (:func:`deformap.msm.estimate_beta`). Its uncertainty is the camera's noise, measured in the
-   ROI by the points' median absolute deviation about X̄, carried through the estimate
-   (:func:`deformap.explore._dent_noise.dent_error_samples`) when ``beta_uncertainty`` is
-   ``camera-noise``; else the shape matcher's own (``shape_matching.uncertainty``). Draws of the
-   camera's noise cannot show a dent that the camera does not see at all (β̂ then sits at the
-   β = 0 end under every draw, and the draws claim a small σ): when the dent's depth at the
-   contact's edge, δ/2 (Hertz), is below ``touch.dent_visible_sigmas`` standard deviations of the
-   camera's mean height over the points within two tip radii of the contact, the claimed σ is
-   that of a uniform over [0, 1), 1/√12 (:func:`dent_visible`), and the poke says so
-   (``PokeRecord.dent_visible``); unless the record read the surface rigid, which is β = 0
-   measured without the camera: on the ``"odds"`` β scale (``shape_matching.beta_scale``, β = 0
-   the rigid body) such a press reports β = 0 with the β grid's resolution as its σ, whatever
-   the camera's noise makes of the flat dent.
+   (:func:`deformap.msm.estimate_beta`); under ``camera-noise`` its σ is the camera's noise (the
+   points' median absolute deviation about X̄) carried through the estimate
+   (:func:`deformap.explore._dent_noise.dent_error_samples`). Noise draws cannot show a dent the
+   camera does not see, so a dent shallower at the contact's edge (δ/2, Hertz) than
+   ``dent_visible_sigmas`` standard deviations of the camera's mean height within two tip radii
+   claims σ = 1/√12, a uniform β (:func:`dent_visible`). Where β = 0 is the rigid body
+   (``ShapeMatchingConfig.rigid_at_zero``) a press the record reads rigid reports β = 0 with the
+   β grid's quantisation σ, whatever the camera makes of the flat dent.
 
 References
 ----------
@@ -241,10 +229,8 @@ def measure_press(obs: PressObservation, index: int, surface: SurfaceModel,
                         height_samples=samples)  # fmt: skip
     beta, beta_std = float(est.beta), float(est.beta_std)
     rigid = stiffness is not None and stiffness.rigid
-    # a surface the record reads rigid needs no dent seen: β = 0 is what it measured (on the odds
-    # scale β = 0 is the rigid body itself, and the camera's noise alone, a dent of a few tenths
-    # of a millimetre, would read a small β > 0 with the σ of that noise): β = 0 to the β grid's
-    # resolution, the floor of every β's σ
+    # a surface the record reads rigid needs no dent seen: the camera's noise alone would read a
+    # small β > 0, so β = 0 to the β grid's resolution, the floor of every β's σ
     if rigid and config.shape_matching.rigid_at_zero:
         beta = 0.0
         beta_std = config.shape_matching.beta_resolution / np.sqrt(12.0)

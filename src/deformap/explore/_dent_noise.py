@@ -1,21 +1,17 @@
-"""How much the camera's noise moves the reconstructed dent: the touch GP's smoother applied to
-noise.
+"""How much the camera's noise moves the reconstructed dent: the touch GP's smoother on noise.
 
-The β of a poke is read from the touch GP's mean; how far that β would move if the camera had seen
-another draw of its noise is what the β-field should take as the poke's noise (its repeatability).
-The GP's mean is linear in the data, ``m = W y`` with ``W = K*ₓ (K + Σ)⁻¹``, so the error that the
-noise ``ε ~ N(0, Σ)`` leaves in it is ``W ε``: drawn here without the data's values. This is the
-sampling spread of the reconstruction, not the GP's posterior: the posterior adds what the prior
-does not know about the surface, which is not noise that another press would draw afresh (taken
-as the poke's noise, it made β̂ look far less repeatable than repeated presses on one foam are);
-what the reconstruction gets systematically wrong from place to place is left to the β-field's
-nugget (:mod:`deformap.explore._nugget`).
+A poke's β is read from the touch GP's mean, and the β-field takes as the poke's noise how far β
+would move under another draw of the camera's noise (its repeatability). The mean is linear in
+the data, ``m = W y`` with ``W = K*ₓ (K + Σ)⁻¹``, so the noise ``ε ~ N(0, Σ)`` leaves the error
+``W ε`` in it, drawn here without the data's values. This is the reconstruction's sampling
+spread, not the GP's posterior: the posterior adds what the prior does not know about the
+surface, which another press would not draw afresh; what the reconstruction gets systematically
+wrong from place to place is left to the β-field's nugget (:mod:`deformap.explore._nugget`).
 
-The touch GP sees thousands of points in the ROI; here they are binned onto the ROI's own grid
-(a cell's points become one observation at its node, with noise σₙ/√count), which keeps the
-smoother exact on a few hundred pseudo-observations (one small Cholesky factorisation) and
-changes it little: the cells are half the kernel's length scale or less. The tactile points enter
-as they are.
+The camera's points are binned onto the ROI's grid (a cell's points become one observation at its
+node, noise σₙ/√count), which keeps the smoother exact on a few hundred pseudo-observations and
+changes it little, the cells being half the kernel's length scale or less; the tactile points
+enter as they are.
 
 References
 ----------

@@ -1,13 +1,11 @@
 """The map's grid: every cell of the workspace, where a poke may go, where the variance must fall.
 
-Targets keep half a ROI inside the workspace, so that each ROI lies on the surveyed surface (not
-over its edge, where shape matching would have to explain a cliff). The planner of
-:mod:`deformap.explore._planning` works on two coarser lattices of the same grid: the cells where
-the variance must fall (``plan_domain``) and the cells a poke may be planned on
-(``plan_candidates``), every 2 cm with the edges included; a plan short by the difference between
-the lattice and the full grid is planned again after the next poke. A grid without the places a
-run could not read (:meth:`MapGrid.without`, ``exploration.unread_place: avoid``) keeps the
-lattices' points outside those discs.
+Targets keep half a ROI inside the workspace, so each ROI lies on the surveyed surface rather than
+over its edge, where shape matching would have to explain a cliff. The planner
+(:mod:`deformap.explore._planning`) works on two 2 cm lattices of the same grid, edges included:
+the cells where the variance must fall (``plan_domain``) and those a poke may be planned on
+(``plan_candidates``); a plan short by the lattice's coarseness is planned again after the next
+poke. :meth:`MapGrid.without` takes the places a run could not read out of both.
 """
 
 from __future__ import annotations

@@ -1,8 +1,8 @@
-"""The exploration loop: drive any ``Environment`` with the mapper until the β-field is known.
+"""The exploration loop: drive any ``Environment`` with the mapper until the map field is known.
 
 The loop speaks only to the :class:`~deformap.environment.Environment` protocol; it never knows
 whether a simulated world or a robot answers. One poke, live or replayed, is one
-:func:`poke_step`: acquire the press, reconstruct and estimate, add to the β-field.
+:func:`poke_step`: acquire the press, reconstruct and estimate, add to the fields.
 """
 
 from __future__ import annotations
@@ -30,7 +30,7 @@ def poke_step(mapper: Mapper, index: int, acquire: Callable[[], PressObservation
               finish: Callable[[], None] | None = None, target: Target | None = None,
               target_s: float | None = None) -> PokeResult:
     """One poke: ``acquire()`` the press, reconstruct its dent and β, ``finish()`` (the live
-    loop's release; called even when the estimate fails), add it to the β-field.
+    loop's release; called even when the estimate fails), add it to the fields.
 
     ``environment_s`` of the record is the time spent in ``acquire`` and ``finish``.
     """
@@ -121,7 +121,7 @@ def explore(
     done: Sequence[PokeRecord] = (),
     on_poke: Callable[[PokeResult], None] | None = None,
 ) -> ExplorationResult:
-    """Observe, then poke where the β-field is least known until its variance is below ``T_h``,
+    """Observe, then poke where the map field is least known until its variance is below ``T_h``,
     then make the ``boundary_pokes`` (if any) where a region boundary is least certain.
 
     Parameters
@@ -137,7 +137,7 @@ def explore(
         Each completed poke is appended (and fsynced) before the next one starts.
     done : sequence of PokeRecord
         The pokes of a killed run, read from its journal (:meth:`PokeRecord.from_dict`): they
-        enter the β-field without being pressed or estimated again.
+        enter the fields without being pressed or estimated again.
     on_poke : callable, optional
         Called after each new poke (progress display).
     """

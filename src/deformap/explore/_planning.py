@@ -1,25 +1,16 @@
-"""Non-myopic poke planning: the fewest further pokes that bring the β-field under ``T_h``.
+"""Non-myopic poke planning: the fewest further pokes that bring the map field under ``T_h``.
 
-A Gaussian process's posterior variance depends on where the observations are and on their noise,
-never on the values observed (RW2006 Eq. 2.26). So the set of further pokes after which the
-β-field's largest variance over the workspace falls below ``T_h`` can be planned before any of
-them is made. Finding the smallest such set is a minimax (covering) design problem. It is solved
-here approximately, for ``m = 1, 2, …`` further pokes in turn, over a grid of candidate places.
-A design is scored by the variance above ``T_h`` summed over the domain (smooth where the largest
-variance is not: it still falls when a move helps one corner and leaves the worst one as it was),
-ties broken by the largest variance. The plan for ``m`` starts from the plan for ``m − 1`` plus
-the candidate that scores best (a greedy step); then each planned poke in turn is moved to the
-candidate that best complements the others (exchange passes, as in Fedorov's exchange algorithm
-for optimal designs), until a pass moves none or after ``max_passes`` passes. The first ``m``
-whose plan reaches ``T_h`` is the plan.
-
-Every planned poke is assumed to come with the noise ``expected_noise`` gives
-(:mod:`deformap.explore._targets`: the β-field's floor with the map's nugget, or the noise of the
-pokes already near it); a real poke often reports more, so the loop plans again after every
-poke with the uncertainties actually measured. Greedy one-step look-ahead (``min-max-variance``)
-and largest-variance-first (``max-variance``) are myopic: each poke serves the worst cell now, not
-the set of pokes that covers the domain; the README ("Results", the paper's Table I) gives the
-pokes each strategy needs.
+A GP's posterior variance depends on where the data are and on their noise, never on the values
+(RW2006 Eq. 2.26), so the pokes after which the largest variance over the domain falls below
+``T_h`` can be planned before any is made: a covering design, solved approximately over a grid of
+candidates for ``m = 1, 2, …`` pokes in turn. A design scores the variance above ``T_h`` summed
+over the domain, ties broken by the largest variance (the sum still falls when a move helps one
+corner and leaves the worst as it was). The plan for ``m`` is that for ``m − 1`` plus the best
+candidate, improved by exchange passes (Fedorov 1972) that move each planned poke to the
+candidate that best complements the others, until a pass moves none or after ``max_passes``;
+the first ``m`` whose plan reaches ``T_h`` is the plan. Planned pokes are assumed to have the
+noise ``_targets.expected_noise`` gives; a real poke often reports more, so the loop plans again
+after every poke.
 
 References
 ----------
@@ -51,10 +42,9 @@ class PokePlan:
     Attributes
     ----------
     targets : (m, 2) float, metres
-        The planned pokes, ordered by the β-field's variance there now (largest first).
+        The planned pokes, ordered by the field's variance there now (largest first).
     max_variance : float
-        The largest β-field variance over the domain once they are all made (with the noise
-        floor as their noise).
+        The largest variance over the domain once they are all made with their assumed noise.
     reaches : bool
         Whether ``max_variance`` is at or below the threshold (``False`` when ``max_new``
         pokes were not enough; ``targets`` then holds the best ``max_new`` found).
@@ -66,7 +56,7 @@ class PokePlan:
 
 
 class VarianceDesign:
-    """The planner's view of the β-field's posterior (:class:`deformap.gp.PosteriorDesign`): the
+    """The planner's view of the field's posterior (:class:`deformap.gp.PosteriorDesign`): the
     pokes made, the candidates, the domain, and the score of each candidate added."""
 
     def __init__(self, poked_xy: Array, poked_noise: Array, candidates: Array, domain: Array,
@@ -104,24 +94,24 @@ def _best_addition(design: VarianceDesign, chosen: list[int], threshold: float
 def plan_pokes(poked_xy: Array, poked_noise: Array, candidates: Array, domain: Array, *,
                signal_std: float, length_scale: float, new_noise: float | Array, threshold: float,
                max_new: int, max_passes: int = 4) -> PokePlan:
-    """The fewest further pokes among ``candidates`` that bring the β-field's largest variance
-    over ``domain`` to ``threshold`` or below (see the module docstring for the method).
+    """The fewest further pokes among ``candidates`` that bring the field's largest variance
+    over ``domain`` to ``threshold`` or below (method: module docstring).
 
     Parameters
     ----------
     poked_xy : (p, 2) float, metres
         Where the pokes made so far were (``p`` may be 0).
     poked_noise : (p,) float
-        Their β standard deviations, as the β-field uses them.
+        Their standard deviations, as the field uses them.
     candidates : (c, 2) float, metres
         Where a poke may be planned.
     domain : (d, 2) float, metres
         Where the variance must fall below ``threshold``.
     signal_std, length_scale : float
-        The β-field's prior (σe, σw).
+        The field's prior standard deviation and length scale (metres).
     new_noise : float or (c,) float
-        The β standard deviation assumed for a poke planned at each candidate (the same for
-        all, or one each).
+        The standard deviation assumed for a poke planned at each candidate (one for all, or
+        one each).
     threshold : float
         ``T_h``.
     max_new : int

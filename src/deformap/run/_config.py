@@ -41,7 +41,20 @@ CONFIG_NAME = "config.yaml"
 
 @dataclass(frozen=True, kw_only=True)
 class RunConfig:
-    """The whole configuration of a run: which world, which seed, and every component's settings."""
+    """The whole configuration of a run: which world, which seed, and every component's settings.
+
+    Parameters
+    ----------
+    scenario : str
+        The simulated scenario explored, a built-in name or a scenario YAML file.
+        ``deformap scenarios`` lists the built-in names.
+    seed : int
+        Seed of the run's generators (:func:`run_generators`); a run is reproduced by its seed.
+    world : WorldConfig
+        The simulated world's physics, camera and layout settings.
+    exploration : ExplorationConfig
+        The mapper's and the exploration loop's settings.
+    """
 
     scenario: str = "heterogeneous-60-110-rigid"
     seed: int = setting(0, ge=0)
@@ -56,8 +69,20 @@ class RunConfig:
 class RunOverrides:
     """Settings given on the command line; ``None`` keeps the configuration's own.
 
-    ``strategy``, ``threshold``, ``max_pokes`` and ``field`` are fields of
-    :class:`~deformap.explore.ExplorationConfig`, which validates them.
+    Parameters
+    ----------
+    scenario : str or None
+        Replaces ``RunConfig.scenario``.
+    seed : int or None
+        Replaces ``RunConfig.seed``.
+    strategy : str or None
+        Replaces ``ExplorationConfig.strategy``, which validates it (as the three below).
+    threshold : float or None
+        Replaces ``ExplorationConfig.threshold`` (``T_h``).
+    max_pokes : int or None
+        Replaces ``ExplorationConfig.max_pokes``.
+    field : str or None
+        Replaces ``ExplorationConfig.field``.
     """
 
     scenario: str | None = None

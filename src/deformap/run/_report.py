@@ -1,40 +1,31 @@
 """The one ``report.json`` schema, with one builder per kind of run.
 
-Every report of a mapped surface (a live exploration, :func:`live_report`; a recorded session,
-:func:`session_report`) holds the same core, built once by :func:`shared_report`:
+Every report of a mapped surface (:func:`live_report`, :func:`session_report`) holds the core
+that :func:`shared_report` builds; values of the map field (``field``) are in its units, β or
+ln E [ln Pa]:
 
-- ``pokes`` (one record per poke, as the mapper wrote it), ``n_pokes``, ``stop_reason``;
-- ``max_variance`` (what the stopping rule compared with T_h, over ``stop_region``) and
-  ``max_variance_map`` (over the whole map), both of the map field (``field``), in its units;
-- ``beta_nugget``: the β-field's nugget, the scatter of β between places of one material that
-  the pokes' claimed σ does not explain, estimated from this map's pokes
-  (:mod:`deformap.explore._nugget`; 0 under ``beta_field.nugget: off``);
-- ``field`` (the field the regions, the targets and the stop rule ran on: ``beta`` or
-  ``modulus``) and ``threshold`` (its ``T_h``, in its units: :func:`deformap.explore.field_settings`);
-  ``field_fallback`` (why a run asked for the modulus field maps on β, else ``None``) and
-  ``unread_places`` (``[x, y]`` [m] of the presses of places whose modulus could not be read
-  twice, left out of the targets and the stopping rule under ``exploration.unread_place: avoid``;
-  ``max_variance`` and ``modulus_field.max_variance`` are over the rule's cells without them);
-- ``regions``: ``levels`` and ``class_values`` (in the map field's units: β, or ln E [ln Pa]),
-  ``class_betas`` (the mean β of each class's pokes), ``class_modulus_median_pa`` (the median of
-  the modulus field's E [Pa] over each found region's cells; ``None`` without a modulus),
-  ``poke_labels`` (of the pokes ``poke_indices``), ``labels_by`` and, with a ground truth, the scores of
-  :func:`deformap.eval.region_scores` (``None`` without a poke; the ordering scores read the
-  modulus field as ``−ln E``, which grows with softness as β does);
-- ``modulus_field`` (``None`` while no poke has a modulus): the modulus field on the map's grid,
-  ``xs_m``, ``ys_m``, ``log_mean_ln_pa`` (posterior mean of ln E, rows along y) and
-  ``log_std`` (standard deviation of ln E, ≈ the relative error of E), ``max_variance``, the
-  per-poke ``pokes`` (``log_modulus_ln_pa``, ``rigid``, ``used``, ``excluded_because``) and
-  ``n_used``;
-- ``true_regions`` (only with a ground truth) and ``timings`` (the loop's, plus per poke).
+- ``pokes`` (one :meth:`deformap.explore.PokeRecord.to_dict` each), ``n_pokes``, ``stop_reason``;
+- ``max_variance`` (what the stop compared with ``T_h``, over the stop cells) and
+  ``max_variance_map`` (over the whole map);
+- ``beta_nugget``, the β-field's nugget τ̂ (:mod:`deformap.explore._nugget`; 0 when off);
+- ``field`` (``beta`` or ``modulus``), ``threshold`` (its ``T_h``,
+  :func:`deformap.explore.field_settings`), ``field_fallback`` (why a run that asked for the
+  modulus field maps on β, else ``None``) and ``unread_places`` (``[x, y]`` [m] of places whose
+  modulus could not be read twice, left out of the targets and the stop cells);
+- ``regions``: ``levels``, ``class_values``, ``class_betas`` (each class's mean poke β),
+  ``class_modulus_median_pa`` (median E [Pa] over each region's cells, ``None`` without a
+  modulus), ``poke_labels`` of the pokes ``poke_indices``, ``labels_by``, and with a ground truth
+  the scores of :func:`deformap.eval.region_scores` (the ordering scores read the modulus field
+  as ``−ln E``, which grows with softness as β does);
+- ``modulus_field`` (``None`` while no poke has a modulus): ``xs_m``, ``ys_m``,
+  ``log_mean_ln_pa`` and ``log_std`` (posterior mean and standard deviation of ln E, rows along
+  y), ``max_variance``, ``pokes`` (``log_modulus_ln_pa``, ``rigid``, ``used``,
+  ``excluded_because``) and ``n_used``;
+- ``true_regions`` (with a ground truth) and ``timings`` (the loop's, and per poke).
 
-Around it, every report names the version (``deformap``), the ``seed`` and the effective
-``config``; a live run adds its ``scenario`` and ``timings.world_build_s``, a session its path,
-``form``, ``source``, ``skipped`` and ``warnings``. One poke estimated alone
-(:func:`estimate_report`) has no map and its own small schema.
-
-Poke records become plain data here (:meth:`deformap.explore.PokeRecord.to_dict`), at the report
-boundary.
+Every report also names ``deformap`` (the version), ``seed`` and the effective ``config``; a live
+run adds ``scenario`` and ``timings.world_build_s``, a session its path, ``form``, ``source``,
+``skipped`` and ``warnings``. :func:`estimate_report` (one poke, no map) has its own schema.
 """
 
 from __future__ import annotations

@@ -60,19 +60,16 @@ CLUSTER_SIZE_FOAMS: tuple[float, ...] = (60.0, 110.0, 150.0)
 FULL_CAMERAS: tuple[str, ...] = ("primesense", "kinect-v1", "realsense-d435")
 FULL_THICKNESSES_M: tuple[float, ...] = (0.03, 0.05, 0.10)
 FULL_PHYSICS: tuple[str, ...] = PHYSICS
-"""The matrix of ``deformap study hardness --full`` (issue 13): every camera preset × three foam
-thicknesses × every physics of the world (:data:`deformap.world.PHYSICS`)."""
+"""The matrix of ``deformap study hardness --full``: every camera preset × three foam thicknesses
+(metres) × every physics of the world (:data:`deformap.world.PHYSICS`)."""
 
 FULL_ELEMENT_SIZE_M = 0.00375
-"""The world's in-plane element size for ``--full`` (the measurement), in place of the default
-7.5 mm (a quick look): a contact-resolving mesh. The matrix's stiffest press (250 N foam, 0.6 N,
-10 mm tip) touches a patch of 5–6 mm radius (Hertz, and √(Rδ) of the solved press), smaller than
-a 7.5 mm element: on noise-free records E then reads +11.5 % (150 N) and +12.6 % (250 N) high
-on 7.5 mm elements, +0.9 % and +2.6 % on 3.75 mm ones (``benchmarks/stiffness_mesh.py``, README),
-the coarse mesh pressing too stiff. On the finer mesh the world's own discretisation error stays
-well under the estimator's claimed σ of E, so the study measures the estimator, not the mesh. A
-condition costs about five times the time and memory (one condition, linear FEM, 5 cm: 51 s and
-1.1 GB against 267 s and 5.6 GB; README, the hardness study)."""
+"""The world's in-plane element size for ``--full``, metres, in place of the default 7.5 mm.
+
+The matrix's stiffest press (250 N foam, 0.6 N, 10 mm tip) touches a patch of 5–6 mm radius,
+smaller than a 7.5 mm element, which then presses too stiff; a contact-resolving mesh keeps the
+world's discretisation error well under the estimator's claimed σ of E, so the study measures the
+estimator, not the mesh. It costs about five times the time and memory per condition."""
 
 
 @dataclass(frozen=True, kw_only=True)
