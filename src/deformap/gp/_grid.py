@@ -51,24 +51,19 @@ __all__ = ["GRID_BLAS_THREADS", "GRID_MARGIN_FRACTION", "GRID_SPACING_FRACTION",
 
 _LOG = logging.getLogger(__name__)
 
-#: Default inducing spacing = σ_w × this. The SE spectrum exp(−σ_w²ω²/4) at the grid's Nyquist
-#: frequency π/h is exp(−π²·9/4) ≈ 2e-10 for h = σ_w/3; the measured 1-D Nyström residual inside the
-#: grid is 2e-10 (relative to σₑ²), i.e. the grid loses nothing a float64 Cholesky would keep.
+#: Default inducing spacing = σ_w × this: the SE spectrum exp(−σ_w²ω²/4) at the grid's Nyquist
+#: frequency π/h is exp(−π²·9/4) ≈ 2e-10, so the grid loses nothing a float64 Cholesky would keep.
 GRID_SPACING_FRACTION = 1.0 / 3.0
-#: Inducing nodes extend this many σ_w beyond the data's bounding box. At spacing σ_w/3, the 1-D
-#: Nyström residual at the box edge is 7e-9 σₑ² with a 1 σ_w margin (1.5e-7 with 0.5 σ_w, 8e-10
-#: with 2 σ_w). The compression to the data's modes makes extra nodes nearly free (only the 1-D
-#: factors grow), the residual at the edge is what counts.
+#: Inducing nodes extend this many σ_w beyond the data's bounding box, which keeps the Nyström
+#: residual at the box's edge near round-off; the compression to the data's modes makes the extra
+#: nodes nearly free.
 GRID_MARGIN_FRACTION = 1.0
 #: Largest number of grid nodes accepted (their 1-D factors are cheap; B is at most this size,
 #: 8·M² bytes = 1.2 GB).
 MAX_INDUCING = 12_000
-#: BLAS threads while the grid path runs (None: leave the process's setting). Its BLAS calls are
-#: mid-sized (M of the order of a thousand; per-cell products of a few hundred) and many, and every
-#: threaded call waits for all its threads: on a machine shared with other jobs one descheduled
-#: thread stalls each call, which costs far more than a second thread gains on calls this small.
-#: Applied with threadpoolctl where it is installed (it comes with scikit-learn); without it the
-#: process's setting stays.
+#: BLAS threads while the grid path runs (None: leave the process's setting), applied with
+#: threadpoolctl where installed: its many mid-sized BLAS calls each wait for all their threads, so
+#: one descheduled thread on a shared machine costs more than a second thread gains.
 GRID_BLAS_THREADS: int | None = 1
 _BLOCK_BYTES = 32 * 2**20  # bound on the intermediate of one block of cells in the data term
 #: Candidate cell widths (× σ_w) for the interpolated data term; the cheapest by the flop model in
@@ -246,8 +241,7 @@ def _data_terms(
         for i, c in enumerate(block):
             seg = slice(bounds[c], bounds[c + 1])
             rows = (lag[seg, :, None] * root_hb[seg, None, :]).reshape(-1, degree * rb)
-            # A full GEMM, not SYRK: the next step reads all of E_c, and OpenBLAS's GEMM runs
-            # faster than its SYRK, which would then need a symmetrisation too.
+            # a full GEMM, not SYRK: the next step reads all of E_c, which SYRK leaves half empty
             np.matmul(rows.T, rows, out=gram[i])
             rhs += h_nodes[c].T @ (lag[seg].T @ resid_hb[seg])
         _spread_cells(system, gram, h_nodes[c0 : block.stop])
