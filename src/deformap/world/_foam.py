@@ -41,13 +41,10 @@ __all__ = ["Dent", "FoamMesh", "FoamModel", "block_grid"]
 
 log = logging.getLogger(__name__)
 
-# A press loads only the top nodes under the tip, and only vertically: the linear FEM solves their
-# unit responses ``K⁻¹ e_z`` in one call with several right-hand sides (SuperLU passes its factors
-# once for all of them: about 7 ms a column at 20 columns against 25 ms for a single solve, on the
-# default mesh's 22 k unknowns, one thread), and each patch iteration and load level of the press
-# is then a product with them. Where more nodes than this lie under the tip (a fine mesh) the
-# columns would cost more than the solves they replace, and each load is solved as it comes; so
-# too past MAX_UNIT_BYTES of columns a body (a fine mesh's long columns).
+# A press's unit responses ``K⁻¹ e_z`` are solved in one multi-right-hand-side call (SuperLU passes
+# its factors once for all of them); where more nodes than this lie under the tip, or past
+# MAX_UNIT_BYTES of columns a body (a fine mesh), the columns would cost more than the solves they
+# replace, and each load is solved as it comes.
 MAX_UNIT_COLUMNS = 48
 MAX_UNIT_BYTES = 64 * 2**20
 
