@@ -189,7 +189,9 @@ _UNIT_SUFFIXES = (("_n_per_m", "N/m"), ("_kpa", "kPa"), ("_deg", "degrees"), ("_
 #: Unit words a numpydoc type line may end with (``reference_modulus_pa : float, pascals``).
 _UNIT_WORDS = {"metres": "m", "meters": "m", "newtons": "N", "pascals": "Pa", "seconds": "s",
                "degrees": "degrees", "radians": "rad", "n/m": "N/m"}
-_SENTENCE_END = re.compile(r"(?<=[.!?])\s+(?=[A-Z(`\"])")
+#: A sentence's end: a full stop and a capital, digit or quote next, not after an abbreviation.
+_SENTENCE_END = re.compile(r"(?<![ .]al\.)(?<!e\.g\.)(?<!i\.e\.)(?<!Eq\.)(?<!Fig\.)(?<=[.!?])\s+"
+                           r"(?=[A-Z0-9(`\"])")
 _ROLE = re.compile(r":[a-z]+:`~?([^`]+)`")  # :mod:`deformap.world` -> deformap.world
 
 

@@ -39,26 +39,26 @@ class ShapeMatchingConfig:
         Number of β of the coarse sweep ``β_j = j / n_beta`` over ``[0, 1)``, each solved from the
         β already solved. E(β) is smooth, so 10 values bracket its minimum.
     refine : bool
-        Refine around the sweep's minimum on the ``beta_resolution`` grid within one sweep step: a
-        parabolic search (in ``1 / (1 − β)``) that solves one grid point at a time until the lowest
+        Refine β̂ around the sweep's minimum on the ``beta_resolution`` grid. A parabolic search
+        (in ``1 / (1 − β)``) within one sweep step solves one grid point at a time until the lowest
         has both grid neighbours solved.
     beta_resolution : float
         Step of the local refinement (dimensionless).
     tol : float
-        Relative fixed-point tolerance: iteration stops when the largest particle update is below
-        ``tol`` times the largest displacement from rest (or the particle spacing when nothing
-        moved). Every β the refinement compares is solved to it.
+        Relative fixed-point tolerance of every β the refinement compares. Iteration stops when the
+        largest particle update is below ``tol`` times the largest displacement from rest (or the
+        particle spacing when nothing moved).
     sweep_tol : float
         Tolerance of the coarse sweep and of the stiffness calibration when ``refine`` is on (at
-        least ``tol``); the sweep only brackets the minimum, and a swept β the refinement compares
-        is solved again to ``tol``.
+        least ``tol``). The sweep only brackets the minimum; a swept β the refinement compares is
+        solved again to ``tol``.
     max_iter : int
         Iteration cap; a β that hits it is reported as not converged, never silently accepted.
     regularization : float
-        Relative eigenvalue cut-off of each cluster's moment matrix (on features scaled by the
-        cluster's RMS radius): directions below ``regularization × largest moment`` are left out of
-        the fit (spectral truncation), so the rest shape stays an exact fixed point and affine /
-        quadratic deformations are reproduced exactly at β = 1.
+        Relative eigenvalue cut-off of each cluster's moment matrix. Directions below
+        ``regularization × largest moment`` (features scaled by the cluster's RMS radius) are left
+        out of the fit, so the rest shape stays an exact fixed point and affine / quadratic
+        deformations are reproduced exactly at β = 1.
     reference_modulus_pa : float, pascals
         Young's modulus of the elastic half-space whose Hertz dent calibrates the spring stiffness
         ``k`` (force protocol only). 100 kPa lies above the stiffest polyurethane foams and below
@@ -71,18 +71,18 @@ class ShapeMatchingConfig:
     poisson_ratio : float
         Poisson's ratio of the reference half-space; it enters only through ``E / (1 − ν²)``.
     layers : int or None
-        Layers of particles under the surface sheet (sides and bottom fixed; spacings grow by
-        ``layer_growth`` and sum to half the ROI's smaller side; clusters span two layers). ``0``
-        is the paper's sheet, which fixed at its edges can only bend; ``None`` picks 0 for
-        ``"pinned"`` and 3 for ``"force"``.
+        Layers of particles under the surface sheet; ``None`` picks 0 for ``"pinned"`` and 3 for
+        ``"force"``. Sides and bottom are fixed, spacings grow by ``layer_growth`` and sum to half
+        the ROI's smaller side, and clusters span two layers; ``0`` is the paper's sheet, which,
+        fixed at its edges, can only bend.
     layer_growth : float
         Ratio of successive layer spacings: fine under the surface where strains are large.
     uncertainty : {"bootstrap", "tolerance"}
-        How ``beta_std`` is obtained: ``"bootstrap"`` resamples blocks of particles, paired across
+        How ``beta_std`` is obtained. ``"bootstrap"`` resamples blocks of particles, paired across
         β (:mod:`deformap.msm._uncertainty`); ``"tolerance"`` takes the β interval where E(β) stays
         within ``error_tolerance_m`` of its minimum (width / √12).
     bootstrap_tile_m : float, metres
-        Side of the resampled blocks; 2 cm, twice the tip radius and the touch GP's length scale,
+        Side of the resampled blocks. 2 cm, twice the tip radius and the touch GP's length scale,
         resamples correlated neighbours together.
     error_tolerance_m : float, metres
         Tolerance on E(β) of the ``"tolerance"`` uncertainty, of the order of the touch GP's error.

@@ -51,7 +51,7 @@ class CameraConfig:
     Parameters
     ----------
     width, height : int
-        Pixels per row and per column; one ray each.
+        Pixels per row and per column of the image, one ray each.
     fov_deg : (2,) float, degrees
         Horizontal and vertical field of view, each in ``(0, 180)``.
     height_m : float, metres
@@ -62,7 +62,7 @@ class CameraConfig:
     noise : bool
         False turns off flying pixels, axial noise and quantisation.
     sigma_base_m, sigma_quadratic_m, sigma_reference_m : float, metres
-        Axial noise ``σ_z = sigma_base + sigma_quadratic·(z − sigma_reference)²``.
+        The terms of the axial noise ``σ_z = sigma_base + sigma_quadratic·(z − sigma_reference)²``.
     baseline_m : float, metres
         Projector–sensor baseline ``b`` of the disparity.
     subpixel : float

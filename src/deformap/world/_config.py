@@ -37,7 +37,7 @@ class WorldConfig:
     Parameters
     ----------
     physics : {"linear-fem", "stiffening-foam", "stiffening-fem"}
-        How the foam answers a press: linear elasticity by finite elements, a stiffening
+        How the foam answers a press. Linear elasticity by finite elements, a stiffening
         two-parameter foundation (:mod:`deformap.world._stiffening`), or finite elements of a foam
         that stiffens toward densification (:mod:`deformap.world._stiffening_fem`); a block's
         ``modulus_pa`` is its small-strain Young's modulus in each.
