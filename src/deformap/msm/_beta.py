@@ -164,12 +164,11 @@ class _Sweep:
             self._body[key] = body[0]
 
     def _start(self, beta: float) -> Array | None:
-        """Starting positions for ``beta``: its own loosely solved equilibrium, else linear in
-        the dent's amplitude ``v`` (``1 / (1 − β)``, or the odds ``β / (1 − β)`` on the odds
-        scale, :meth:`PokeModel.amplitude`) through the two nearest solved β (the scale on which
-        the dent deepens, see :func:`_vertex`), or the nearest deformed one's displacements
-        scaled by the ratio of ``v`` (the calibration's dent, of amplitude 1, when only the
-        rigid β = 0 is solved); ``None`` (the model's own start) when no β is solved yet."""
+        """Starting positions for ``beta``: its own loosely solved equilibrium; else linear in the dent's
+        amplitude ``v`` (:meth:`PokeModel.amplitude`) through the two nearest solved β; else the
+        nearest deformed one's displacements (or, with only β = 0 solved, the calibration's dent of
+        amplitude 1) scaled by the ratio of ``v``; ``None`` (the model's own start) when none is solved.
+        """
         if beta in self._body:
             return self._body[beta]
         if not self._body:
