@@ -1,14 +1,12 @@
-"""``check_*`` validators used at the public boundary.
+"""``check_*`` validators used at the public boundary, and the one validator of settings.
 
-The array and scalar validators each return a clean value (arrays: float64, C-contiguous, a copy
-when they had to convert) or raise :class:`~deformap.errors.InvalidArgumentError` with a message
-that names the argument, what was expected and what came. Internal code calls them once at the
-entry of a public function and then trusts its arrays.
+The array and scalar validators return a clean value (arrays: float64, C-contiguous, a copy when
+they had to convert) or raise :class:`~deformap.errors.InvalidArgumentError` naming the argument,
+what was expected and what came; internal code calls them once at the entry of a public function.
 
-Settings dataclasses have one validator, :func:`check_settings`, which every one of them calls
-first in its ``__post_init__``: it checks each field against its type annotation and against the
-bounds declared beside the field with :func:`setting`, and raises :class:`SettingError` naming the
-field. The YAML loader adds no rule of its own, so Python and YAML are checked alike.
+Every settings dataclass calls :func:`check_settings` first in its ``__post_init__``: each field is
+checked against its annotation and the bounds declared beside it with :func:`setting`, and a bad
+one raises :class:`SettingError` naming it. The YAML loader adds no rule of its own.
 """
 
 from __future__ import annotations
