@@ -1,14 +1,13 @@
 """Settings of a raw robot recording: which topics and frames hold what, and the thresholds that
-find the presses in it (``docs/robot.md``, "A bag as your robot records it").
+find the presses in it (``docs/robot.md``).
 
-A raw recording is a ROS 2 bag as ``ros2 bag record`` writes it from a depth camera driver, a
-force–torque sensor and an arm: an organised ``sensor_msgs/msg/PointCloud2`` stream in the
-camera's optical frame, ``geometry_msgs/msg/WrenchStamped`` in the sensor's frame, and ``/tf`` and
-``/tf_static``. :class:`RawBagConfig` names its topics and frames, the commanded force and the
-thresholds; :class:`HullPart` is one part of the robot's model (stick, hand) in the tip's frame.
-The defaults fit a RealSense camera driver (``/camera/depth/color/points``) and a force sensor
-publishing on ``/ft_sensor/wrench``. The settings come from a YAML file beside the bag
-(:func:`raw_config_file`) and from the command line; both go through the same constructor.
+A raw recording is a ROS 2 bag as ``ros2 bag record`` writes it: an organised
+``sensor_msgs/msg/PointCloud2`` stream in the camera's optical frame,
+``geometry_msgs/msg/WrenchStamped`` in the force sensor's frame, and ``/tf`` and ``/tf_static``.
+:class:`RawBagConfig` names them, the commanded force and the thresholds (defaults: a RealSense
+driver and a force sensor on ``/ft_sensor/wrench``); :class:`HullPart` is one part of the robot's
+model in the tip's frame. The settings come from a YAML file beside the bag
+(:func:`raw_config_file`) and the command line, through the same constructor.
 """
 
 from __future__ import annotations
@@ -37,11 +36,8 @@ RAW_CONFIG_NAME = "deformap.yaml"
 
 @dataclass(frozen=True, kw_only=True)
 class HullPart:
-    """One rigid part of the probe (stick, hand), in the tip's frame.
-
-    The tip's frame has its origin at the centre of the spherical tip and its ``z`` axis along the
-    stick, away from the surface. Each part's convex hull is removed from the press's cloud on its
-    own, so a wide hand high above the tip does not widen the hull down at the surface.
+    """One rigid part of the probe (stick, hand) in the tip's frame (origin at the tip's centre, ``z``
+    along the stick away from the surface), its convex hull removed from the press's cloud on its own.
 
     Parameters
     ----------
