@@ -57,6 +57,12 @@ def test_config_dump_is_described_and_loads_back_as_the_defaults(tmp_path) -> No
     assert "one of: paper, max-variance" in text
     assert yaml.safe_load(text) == yaml.safe_load(dump_yaml(RunConfig()))
     assert load_run_config(tmp_path / "c.yaml") == RunConfig()  # what `explore --config` reads
+    # explore reads the file, then refuses only the override (before any work is done)
+    refused = runner.invoke(app, ["explore", "--config", str(tmp_path / "c.yaml"),
+                                  "--out", str(tmp_path / "run"), "--max-pokes", "0"])
+    assert refused.exit_code == 2
+    assert "`max_pokes` must be an integer >= 1" in refused.output
+    assert "c.yaml" not in refused.output
     printed = runner.invoke(app, ["config", "dump"])
     assert printed.exit_code == 0 and printed.output == text
 
