@@ -14,8 +14,9 @@ with compression at the constrained modulus ``M = E (1 − ν) / ((1 + ν)(1 −
 Pa/m), and shear ``G_p = G ∫ φ² dz`` (N/m, ``G = E / (2 (1 + ν))``). ``E`` is the block's
 ``modulus_pa``. The mode shape is the modified Vlasov model's ``φ = sinh(γ z / H) / sinh γ``, with
 ``(γ / H)² = (G / M) ∫ |∇w|² dA / ∫ w² dA`` iterated on the solved surface to 1 %, so that a
-thick layer under a small tip tends to a depth-independent limit as an elastic layer does. A
-restricted displacement field is stiffer than the elastic solid (Ritz): at small strain the tip
+thick layer under a small tip tends to a depth-independent limit as an elastic layer does. The
+influence length ``ℓ = sqrt(G_p / k)`` is how far a dent spreads beyond the tip. A restricted
+displacement field is stiffer than the elastic solid (Ritz): at small strain the tip
 sinks less than in a half-space of the same ``E``.
 
 Stiffening (Gibson & Ashby 1997, ch. 5): ``σ(ε) = M ε / (1 − ε / ε_d)^m`` for ``ε ≥ 0`` (linear in
