@@ -1,25 +1,22 @@
 """Sparse GP with inducing points on a regular grid: DTC/SGPR predictions in Kronecker form.
 
-With inducing inputs u on a grid ``ua × ub`` and the separable kernel, the prior covariance of the
-inducing values is K_uu = σₑ² (K_a ⊗ K_b), and the cross-covariance of a point p with them is the
-Kronecker (for many points: Khatri–Rao) product k_u(p) = σₑ² k_a(p_a) ⊗ k_b(p_b). DTC needs only
-M×M algebra (RW2006 §8.3.3; Quiñonero-Candela & Rasmussen 2005):
+With inducing inputs on a grid ``ua × ub`` and the separable kernel, K_uu = σₑ² (K_a ⊗ K_b) and
+k_u(p) = σₑ² k_a(p_a) ⊗ k_b(p_b) (Khatri–Rao for many points). DTC needs only M×M algebra (RW2006
+§8.3.3; Quiñonero-Candela & Rasmussen 2005; the predictions of Titsias' 2009 SGPR):
 
     mean(p) = k_u(p)ᵀ Σ⁻¹ K_uf Λ⁻¹ (z − z̄),          Σ = K_uu + K_uf Λ⁻¹ K_fu
     var(p)  = k(p, p) − k_u(p)ᵀ K_uu⁻¹ k_u(p) + k_u(p)ᵀ Σ⁻¹ k_u(p)
 
-which are also the predictions of Titsias' (2009) SGPR. K_uu of a fine grid is numerically
-singular (condition ~1e18), so everything is *whitened* by its Kronecker Cholesky factor
-L = L_a ⊗ L_b, as in SGPR implementations, and then compressed per axis to the modes the data
-excite (``_grid_basis``): h(p) = h_a(p_a) ⊗ h_b(p_b) with h = Qᵀ L⁻¹ k keeps the Khatri–Rao
-structure and the N(0, I) prior, B = I + σₑ² Hᵀ Λ⁻¹ H (eigenvalues >= 1), and
+K_uu of a fine grid is numerically singular, so everything is whitened by its Kronecker Cholesky
+factor L = L_a ⊗ L_b and compressed per axis to the modes the data excite (``_grid_basis``):
+h(p) = h_a(p_a) ⊗ h_b(p_b) with h = Qᵀ L⁻¹ k, B = I + σₑ² Hᵀ Λ⁻¹ H (eigenvalues >= 1), and
 
     mean(p) = h(p)ᵀ B⁻¹ σₑ² Hᵀ Λ⁻¹ (z − z̄)
     var(p)  = σₑ² (1 − ‖h(p)‖² + h(p)ᵀ B⁻¹ h(p)).
 
-With the grid finer than the kernel's resolution the Nyström residual 1 − ‖g‖² is at round-off
-level and DTC equals the exact GP to that accuracy; the defaults below follow from that residual.
-Axis ``a`` is the axis with more inducing nodes; the flattened feature index is ``ia * rb + ib``.
+With the grid finer than the kernel's resolution the Nyström residual 1 − ‖g‖² is at round-off and
+DTC equals the exact GP. Axis ``a`` has more inducing nodes; the flattened feature index is
+``ia * rb + ib``.
 """
 
 from __future__ import annotations

@@ -1,16 +1,12 @@
 """One-dimensional feature maps of the grid GP: whitening, compression and Chebyshev interpolation.
 
-Along one axis with inducing nodes ``u`` (m,) and K = k₁(u, u) = L Lᵀ, the whitened features of a
-coordinate t are g(t) = L⁻¹ k₁(u, t) (m,). The prior of the whitened inducing values is N(0, I), so
-any orthonormal Q (m, r) gives the inducing *features* h(t) = Qᵀ g(t) with prior N(0, I) as well:
-DTC with them is exact up to what the data's features lose, ‖g(tᵢ)‖² − ‖h(tᵢ)‖². Q is taken from
-the eigenvectors of Σᵢ g(tᵢ) g(tᵢ)ᵀ over the data, keeping the fewest that leave every data point a
-residual below ``FEATURE_TOLERANCE``: a fine grid (spacing ≤ σ_w/3) has more nodes than the data
-box has modes, and the inducing dimension M enters the fit as M² and M³.
-
-The data term needs the features of every data point; along the longer axis they are interpolated
-within short cells from R Chebyshev nodes (:func:`chebyshev_degree` gives R from a rigorous error
-bound), so that the n per-point outer products are replaced by products of size R.
+Along one axis with inducing nodes ``u`` (m,) and K = k₁(u, u) = L Lᵀ, the whitened features of t
+are g(t) = L⁻¹ k₁(u, t) with prior N(0, I), so any orthonormal Q (m, r) gives features
+h(t) = Qᵀ g(t) with prior N(0, I) too, and DTC with them is exact up to ‖g(tᵢ)‖² − ‖h(tᵢ)‖². Q is
+taken from the eigenvectors of Σᵢ g(tᵢ) g(tᵢ)ᵀ, keeping the fewest that leave every data point a
+residual below ``FEATURE_TOLERANCE``. Along the longer axis the data's features are interpolated
+within short cells from R Chebyshev nodes (:func:`chebyshev_degree`), so that the n per-point outer
+products become products of size R.
 
 References
 ----------
