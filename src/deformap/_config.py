@@ -11,24 +11,28 @@ refusal is a :class:`~deformap.errors.ConfigError` that names the field by its d
 from __future__ import annotations
 
 import dataclasses
+import inspect
 import logging
 import os
+import re
 import stat
+import textwrap
 import types
 import typing
 from pathlib import Path
-from typing import Any, TypeVar, get_args, get_origin
+from typing import Any, Literal, TypeVar, get_args, get_origin
 
 import yaml
 
-from deformap._validation import SettingError
+from deformap._validation import SettingError, setting_metadata
 from deformap.errors import ConfigError, DeformapError
 
 #: Largest YAML file read (config, scenario, session): a session lists its pokes and files, never
 #: their data, so even thousands of pokes stay far below this.
 MAX_YAML_BYTES = 16 * 2**20
 
-__all__ = ["config_from_dict", "config_to_dict", "dump_yaml", "load_yaml"]
+__all__ = ["config_from_dict", "config_to_dict", "described_yaml", "dump_yaml", "load_yaml",
+           "setting_docs"]
 
 logger = logging.getLogger(__name__)
 
@@ -174,3 +178,156 @@ def dump_yaml(data: Any, path: str | Path | None = None) -> str:
     if path is not None:
         Path(path).write_text(text, encoding="utf-8")
     return text
+
+
+# -- the configuration reference: YAML with each setting's description, unit and bounds --------
+
+#: Unit of a setting by the suffix of its name, longest first.
+_UNIT_SUFFIXES = (("_n_per_m", "N/m"), ("_kpa", "kPa"), ("_deg", "degrees"), ("_rel", "fraction"),
+                  ("_pa", "Pa"), ("_mm", "mm"), ("_hz", "Hz"), ("_px", "pixels"), ("_m", "m"),
+                  ("_n", "N"), ("_s", "s"))
+#: Unit words a numpydoc type line may end with (``reference_modulus_pa : float, pascals``).
+_UNIT_WORDS = {"metres": "m", "meters": "m", "newtons": "N", "pascals": "Pa", "seconds": "s",
+               "degrees": "degrees", "radians": "rad", "n/m": "N/m"}
+#: A sentence's end: a full stop and a capital, digit or quote next, not after an abbreviation.
+_SENTENCE_END = re.compile(r"(?<![ .]al\.)(?<!e\.g\.)(?<!i\.e\.)(?<!Eq\.)(?<!Fig\.)(?<=[.!?])\s+"
+                           r"(?=[A-Z0-9(`\"])")
+_ROLE = re.compile(r":[a-z]+:`~?([^`]+)`")  # :mod:`deformap.world` -> deformap.world
+
+
+def _parameters_section(cls: type) -> dict[str, tuple[str, str]]:
+    """``name -> (type text, first sentence)`` from the numpydoc "Parameters" section of
+    ``cls``'s docstring; a line ``a, b : float`` documents both names."""
+    lines = inspect.cleandoc(cls.__doc__ or "").splitlines()
+    try:
+        start = next(i for i in range(len(lines) - 1)
+                     if lines[i].strip() == "Parameters" and set(lines[i + 1].strip()) == {"-"})
+    except StopIteration:
+        return {}
+    entries: dict[str, tuple[str, str]] = {}
+    names: list[str] = []
+    text: list[str] = []
+    kind = ""
+
+    def flush() -> None:
+        sentence = _SENTENCE_END.split(" ".join(text).strip(), maxsplit=1)[0]
+        sentence = _ROLE.sub(r"\1", sentence).replace("``", "")
+        entries.update({name: (kind, sentence) for name in names})
+
+    for i in range(start + 2, len(lines)):
+        line = lines[i]
+        if i + 1 < len(lines) and line.strip() and set(lines[i + 1].strip()) == {"-"}:
+            break  # the next section
+        if line and not line[0].isspace():
+            flush()
+            head, _, kind = line.partition(" : ")
+            names, text = [n.strip() for n in head.split(",")], []
+        elif line.strip():
+            text.append(line.strip())
+    flush()
+    return entries
+
+
+def _unit(name: str, kind: str) -> str | None:
+    for suffix, unit in _UNIT_SUFFIXES:
+        if name.endswith(suffix):
+            return unit
+    if not kind.startswith("{") and "," in kind:
+        return _UNIT_WORDS.get(kind.rsplit(",", 1)[1].strip().lower())
+    return None
+
+
+def _range(bounds: dict[str, Any]) -> str | None:
+    """The bounds of :func:`~deformap._validation.setting` as one interval, the tighter bound of
+    each side kept (``gt=0, ge=0.001`` is ``>= 0.001``)."""
+    low = max(((bounds[k], k == "gt") for k in ("gt", "ge") if k in bounds), default=None)
+    high = min(((bounds[k], k == "le") for k in ("lt", "le") if k in bounds), default=None)
+    if low is not None and high is not None:
+        return f"{'(' if low[1] else '['}{low[0]:g}, {high[0]:g}{']' if high[1] else ')'}"
+    if low is not None:
+        return f"{'>' if low[1] else '>='} {low[0]:g}"
+    if high is not None:
+        return f"{'<=' if high[1] else '<'} {high[0]:g}"
+    return None
+
+
+def _facts(name: str, hint: Any, kind: str, bounds: dict[str, Any]) -> list[str]:
+    """Unit, range, choices and ``null`` of one setting, as ``key: value`` phrases."""
+    facts = []
+    options = get_args(hint) if get_origin(hint) in (typing.Union, types.UnionType) else (hint,)
+    unit = _unit(name, kind)
+    if unit is not None:
+        facts.append(f"unit: {unit}")
+    if any(o in (int, float) or get_origin(o) is tuple for o in options):
+        interval = _range(bounds)
+        if interval is not None:
+            facts.append(f"range: {interval}")
+    for option in options:
+        if get_origin(option) is Literal:
+            facts.append("one of: " + ", ".join(str(c) for c in get_args(option)))
+    if type(None) in options:
+        facts.append("null allowed")
+    return facts
+
+
+def setting_docs(cls: type, prefix: str = "") -> list[tuple[str, str | None, list[str]]]:
+    """Every setting of the settings dataclass ``cls``, nested ones included, in definition order:
+    ``(dotted name, one-line description or None, facts)``.
+
+    The description is the field's ``setting(doc=...)``, else the first sentence of its entry in
+    the class docstring's "Parameters" section, else (for a nested settings dataclass) the first
+    line of that class's docstring. The facts are its unit (from the name's suffix, or the unit
+    word that ends its numpydoc type), its bounds as an interval, its ``Literal`` choices, and
+    whether it may be ``None``.
+    """
+    params = _parameters_section(cls)
+    hints = typing.get_type_hints(cls)
+    out: list[tuple[str, str | None, list[str]]] = []
+    for f in dataclasses.fields(cls):
+        bounds, doc = setting_metadata(f)
+        kind, sentence = params.get(f.name, ("", ""))
+        hint = hints[f.name]
+        nested = isinstance(hint, type) and dataclasses.is_dataclass(hint)
+        if doc is None and sentence:
+            doc = sentence
+        if doc is None and nested and hint.__doc__:
+            doc = inspect.cleandoc(hint.__doc__).splitlines()[0]
+        out.append((prefix + f.name, doc, [] if nested else _facts(f.name, hint, kind, bounds)))
+        if nested:
+            out.extend(setting_docs(hint, prefix + f.name + "."))
+    return out
+
+
+def described_yaml(config: Any, *, width: int = 99) -> str:
+    """``config`` (a settings dataclass) as YAML with, above each setting, a comment: its
+    description, then its unit, range and choices (:func:`setting_docs`).
+
+    The comments are YAML comments, so the text loads back as :func:`dump_yaml`'s does.
+    """
+    docs = {name: (doc, facts) for name, doc, facts in setting_docs(type(config))}
+    lines = [f"# {type(config).__name__}: every setting, with its description, unit and bounds."]
+    _describe(config, "", docs, lines, width)
+    return "\n".join(lines) + "\n"
+
+
+def _describe(obj: Any, prefix: str, docs: dict[str, tuple[str | None, list[str]]],
+              lines: list[str], width: int) -> None:
+    indent = "  " * prefix.count(".")
+    for f in dataclasses.fields(obj):
+        name = prefix + f.name
+        value = getattr(obj, f.name)
+        doc, facts = docs[name]
+        nested = dataclasses.is_dataclass(value) and dataclasses.fields(value)
+        if nested and not prefix:
+            lines.append("")
+        comment = textwrap.wrap(doc or "", width - len(indent) - 2)
+        if facts:
+            comment.append("; ".join(facts))
+        lines.extend(f"{indent}# {text}" for text in comment)
+        if nested:
+            lines.append(f"{indent}{f.name}:")
+            _describe(value, name + ".", docs, lines, width)
+            continue
+        text = yaml.safe_dump({f.name: config_to_dict(value)}, sort_keys=False,
+                              default_flow_style=False)
+        lines.extend(indent + line for line in text.splitlines())

@@ -1,15 +1,13 @@
 """Writing files so that a kill or a power cut leaves the old file or the new one, never half.
 
-One home for every durable write of the package: the journal's header and rewrites, the files of
-a run folder (``config.yaml``, ``report.json``, ...), figures and recordings. A file is written
-under a temporary name beside its destination (same folder, so the same file system), fsynced,
-renamed onto the destination with :func:`os.replace`, and the folder is fsynced so that the rename
-itself is durable (POSIX keeps it in the folder's cache until then).
+Every durable write of the package (the journal's header and rewrites, the files of a run folder,
+figures, recordings) goes through here: a temporary file beside the destination (same file
+system), fsynced, renamed onto it with :func:`os.replace`, and the folder fsynced so that the rename
+itself is durable.
 
-A destination that exists must be a regular file: renaming onto a FIFO, a device or a socket
-would replace that node with a plain file (``--json /dev/zero`` run as root would replace the
-device), onto a symbolic link would replace the link, not write its target (``/dev/stdout`` is a
-link to ``/proc/self/fd/1``), and onto a folder fails late. Such a destination, or a path that
+A destination that exists must be a regular file: renaming onto a FIFO, device or socket would
+replace that node with a plain file, onto a symbolic link would replace the link rather than write
+its target (``/dev/stdout``), and onto a folder fails late. Such a destination, or a path that
 names no file (``""``, ``.``), is refused before anything is written.
 """
 

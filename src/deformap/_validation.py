@@ -1,14 +1,12 @@
-"""``check_*`` validators used at the public boundary.
+"""``check_*`` validators used at the public boundary, and the one validator of settings.
 
-The array and scalar validators each return a clean value (arrays: float64, C-contiguous, a copy
-when they had to convert) or raise :class:`~deformap.errors.InvalidArgumentError` with a message
-that names the argument, what was expected and what came. Internal code calls them once at the
-entry of a public function and then trusts its arrays.
+The array and scalar validators return a clean value (arrays: float64, C-contiguous, a copy when
+they had to convert) or raise :class:`~deformap.errors.InvalidArgumentError` naming the argument,
+what was expected and what came; internal code calls them once at the entry of a public function.
 
-Settings dataclasses have one validator, :func:`check_settings`, which every one of them calls
-first in its ``__post_init__``: it checks each field against its type annotation and against the
-bounds declared beside the field with :func:`setting`, and raises :class:`SettingError` naming the
-field. The YAML loader adds no rule of its own, so Python and YAML are checked alike.
+Every settings dataclass calls :func:`check_settings` first in its ``__post_init__``: each field is
+checked against its annotation and the bounds declared beside it with :func:`setting`, and a bad
+one raises :class:`SettingError` naming it. The YAML loader adds no rule of its own.
 """
 
 from __future__ import annotations
@@ -17,7 +15,7 @@ import math
 import operator
 import sys
 from collections.abc import Sequence
-from dataclasses import field, fields, is_dataclass
+from dataclasses import Field, field, fields, is_dataclass
 from functools import cache
 from types import UnionType
 from typing import Any, Literal, Union, get_args, get_origin, get_type_hints
@@ -41,6 +39,7 @@ __all__ = [
     "check_vector",
     "describe",
     "setting",
+    "setting_metadata",
 ]
 
 
@@ -197,6 +196,7 @@ def check_int(name: str, value: Any, *, minimum: int | None = None) -> int:
 # -- settings dataclasses -------------------------------------------------------------------------
 
 _BOUNDS = "deformap.bounds"
+_DOC = "deformap.doc"
 _BOUND_TEXT = {"gt": ">", "ge": ">=", "lt": "<", "le": "<="}
 
 
@@ -225,8 +225,9 @@ def setting(
     lt: float | None = None,
     le: float | None = None,
     finite: bool = True,
+    doc: str | None = None,
 ) -> Any:
-    """A dataclass field whose bounds are declared beside it, for :func:`check_settings`.
+    """A dataclass field whose bounds (and description) are declared beside it.
 
     Parameters
     ----------
@@ -238,10 +239,23 @@ def setting(
         every entry; on an optional field, for a value that is not ``None``.
     finite : bool
         Refuse NaN and infinite values of a float field (the default).
+    doc : str, optional
+        One-line description of the setting, shown by ``deformap config dump``
+        (:func:`deformap._config.described_yaml`); without it the class docstring's "Parameters"
+        entry is used.
     """
     bounds = {key: bound for key, bound in (("gt", gt), ("ge", ge), ("lt", lt), ("le", le))
               if bound is not None}
-    return field(default=default, metadata={_BOUNDS: {"finite": finite, **bounds}})
+    metadata: dict[str, Any] = {_BOUNDS: {"finite": finite, **bounds}}
+    if doc is not None:
+        metadata[_DOC] = doc
+    return field(default=default, metadata=metadata)
+
+
+def setting_metadata(f: Field[Any]) -> tuple[dict[str, Any], str | None]:
+    """The bounds (``gt``, ``ge``, ``lt``, ``le``, ``finite``) and description that
+    :func:`setting` declared for the dataclass field ``f`` (no bounds and ``None`` without it)."""
+    return dict(f.metadata.get(_BOUNDS, {"finite": True})), f.metadata.get(_DOC)
 
 
 @cache

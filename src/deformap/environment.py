@@ -1,14 +1,11 @@
 """The ``Environment`` protocol: all the exploration loop needs from a world or a robot.
 
-The simulated world (:mod:`deformap.world`) and a real robot adapter both implement it, and the loop
-in :mod:`deformap.explore` never knows which one it drives. :class:`TactileContact` is contact
-mechanics, defined in :mod:`deformap.mechanics` (so that the estimator can take it without this
-protocol) and re-exported here: ``deformap.environment.TactileContact`` is the same class.
+The simulated world (:mod:`deformap.world`) and a real robot adapter both implement it; the loop in
+:mod:`deformap.explore` never knows which one it drives. :class:`TactileContact` is defined in
+:mod:`deformap.mechanics` and re-exported here.
 
-Frames and units
-----------------
-Everything is SI and in the world frame: the table plane is ``z = 0``, ``z`` points up, and clouds
-leave an environment already transformed by the camera's known extrinsics (``cam2world``).
+Everything is SI and in the world frame: the table plane is ``z = 0``, ``z`` up, and clouds leave an
+environment already transformed by the camera's extrinsics (``cam2world``).
 
 References
 ----------
@@ -49,9 +46,8 @@ __all__ = [
 ]
 
 
-#: Most cells of a :meth:`Workspace.grid`: 25 million float cells are 200 MB per map layer, far
-#: more than a table-top map needs (the exploration's own, smaller budget is in
-#: ``deformap.explore``); a spacing that asks for more is refused before any array exists.
+#: Most cells of a :meth:`Workspace.grid` (200 MB per float map layer), refused before any array
+#: exists; the exploration's own budget is smaller.
 MAX_GRID_CELLS = 25_000_000
 
 
@@ -117,29 +113,21 @@ class Workspace:
 
 
 #: A travel sample may lie this far below the largest travel before it (encoder noise, not a
-#: retraction). Arm encoders read the tip's position to about 0.05 mm (one standard deviation);
-#: 0.5 mm is ten of them, so the noise of a rigid press, whose travel is only that noise around
-#: zero, stays inside it even over thousands of samples (the range of 10⁴ normal draws is about
-#: eight standard deviations), while a slip or a retraction of half a millimetre is refused.
+#: retraction): ten standard deviations of arm encoders (about 0.05 mm), so a rigid press's noise
+#: stays inside it over thousands of samples while a half-millimetre slip is refused.
 TRAVEL_BACKWARDS_TOLERANCE_M = 5e-4
 
-#: Largest travel accepted [m]. The probe presses a few newtons into foams at most 10 cm thick;
-#: a dent of 5 cm would put a 1 cm tip's stick into the foam, so larger numbers are millimetres
-#: (a 0.05–50 mm dent read in millimetres is 0.05–50 "metres"). A record in millimetres of a dent
-#: shallower than 0.05 mm cannot be told from metres; it reads as a rigid press.
+#: Largest travel accepted [m]: a 5 cm dent would put a 1 cm tip's stick into the foam, so larger
+#: numbers are millimetres (a record in millimetres of a dent under 0.05 mm reads as rigid).
 MAX_TRAVEL_M = 0.05
 
 #: The force must rise by more than this from the first sample to the last [N]: four times the
-#: 5 mN noise floor of the force sensors a probe carries, so that a flat record with noise is not
-#: taken for a press, while a press from contact to the smallest useful force (0.3 N) rises by far
-#: more.
+#: 5 mN noise floor of a probe's force sensor, so that a flat noisy record is not a press.
 MIN_FORCE_RISE_N = 0.02
 
 #: A record's final force may differ from the commanded force by at most
-#: ``FORCE_MISMATCH_REL · force_n + FORCE_MISMATCH_ABS_N``. The record ends when the force
-#: controller reaches the command, so its last sample lies within the controller's overshoot and
-#: the sensor's noise (about 1 % + 5 mN) of it; a quarter of the command is far beyond both, and a
-#: record that misses it by more belongs to another press or is scaled wrong (grams, a wrong axis).
+#: ``FORCE_MISMATCH_REL · force_n + FORCE_MISMATCH_ABS_N``: far beyond the controller's overshoot
+#: and the sensor's noise, so a record that misses it belongs to another press or is scaled wrong.
 FORCE_MISMATCH_REL = 0.25
 FORCE_MISMATCH_ABS_N = 0.05
 
@@ -148,27 +136,24 @@ FORCE_MISMATCH_ABS_N = 0.05
 class ForceTravel:
     """The press's force–travel record, from first contact to the commanded force.
 
-    Samples in time order of the probe's travel along the press direction since first contact and
-    of the normal force it exerts on the surface. A robot reads the travel from its joints through
-    forward kinematics and the force from its force sensor (``docs/robot.md``); the simulated
-    world from its own physics with the noise of such sensors.
+    Samples, in time order, of the probe's travel along the press direction since first contact and
+    of the normal force on the surface (a robot reads them from forward kinematics and its force
+    sensor, ``docs/robot.md``).
 
     Parameters
     ----------
     travel_m : (n,) float, metres
-        How far the tip has moved along the press direction (into the surface) since first
-        contact; about 0 at the first sample. It may fall back by sensor noise, at most
-        :data:`TRAVEL_BACKWARDS_TOLERANCE_M` below the largest travel before it, and never
-        exceeds :data:`MAX_TRAVEL_M` in magnitude (larger numbers are millimetres).
+        Travel into the surface since first contact, about 0 at the first sample. It may fall back by
+        at most :data:`TRAVEL_BACKWARDS_TOLERANCE_M` below the largest travel before it and never
+        exceeds :data:`MAX_TRAVEL_M` in magnitude.
     force_n : (n,) float, newtons
-        The normal component of the force on the surface (positive pushing into it). The last
-        sample must exceed the first by more than :data:`MIN_FORCE_RISE_N` and be positive.
+        The normal force on the surface (positive into it); the last sample is positive and exceeds
+        the first by more than :data:`MIN_FORCE_RISE_N`.
 
     Notes
     -----
-    ``n >= 3``. The arrays are stored as read-only float64 copies. The record holds no times: its
-    samples are in time order by contract (a reader with time stamps sorts or refuses them).
-    Every refusal is an :class:`~deformap.errors.InvalidArgumentError` naming the field.
+    ``n >= 3``; the arrays are stored as read-only float64 copies. Every refusal is an
+    :class:`~deformap.errors.InvalidArgumentError` naming the field.
     """
 
     travel_m: NDArray[np.float64]
@@ -239,26 +224,22 @@ class PressObservation:
     Parameters
     ----------
     cloud : PointCloud
-        The cloud seen while pressing, world frame. It contains the robot's stick and hand and
-        misses what they occlude.
+        The cloud seen while pressing, world frame, with the robot's stick and hand in it.
     contact : TactileContact
-        Tip position, measured force and tip radius at the commanded force. The force pushes
-        into the surface (negative z in the world frame) and its magnitude lies within
+        Tip position, measured force and tip radius at the commanded force; the force pushes into
+        the surface (negative z) and its magnitude lies within
         ``FORCE_MISMATCH_REL · force_n + FORCE_MISMATCH_ABS_N`` of ``force_n``.
     robot_points : (m, 3) float, metres, or a tuple of such arrays (one per part)
-        Points whose convex hull covers the stick and hand at that moment, from the robot model
-        and proprioception (at least 4 points, not all on a plane); or one such array per part
-        (stick, hand), each part's hull removed on its own, so that a wide hand above a narrow
-        stick does not widen the hull down at the surface. Stored as a read-only array, or a
-        tuple of them; :attr:`robot_hulls` gives the tuple either way.
+        Points whose convex hull covers the stick and hand (at least 4, not coplanar), or one array
+        per part, each hull removed on its own so that a wide hand does not widen the hull down at
+        the surface; :attr:`robot_hulls` gives the tuple either way.
     target_xy : (2,) float, metres
         The commanded target.
     force_n : float
         The commanded normal force.
     force_travel : ForceTravel or None
-        The press's force–travel record from first contact to ``force_n``; None where the
-        environment cannot provide it. Its last force must lie within
-        ``FORCE_MISMATCH_REL · force_n + FORCE_MISMATCH_ABS_N`` of ``force_n``.
+        The press's force–travel record (None where the environment cannot provide it); its last
+        force lies within the same tolerance of ``force_n``.
     """
 
     cloud: PointCloud

@@ -188,8 +188,9 @@ def explore_command(
 def config_dump(
     out: Annotated[Path | None, typer.Option(help="Write to this file instead of stdout.")] = None,
 ) -> None:
-    """Write the full default run configuration as YAML."""
-    text = run.config_yaml(run.RunConfig())
+    """Write the full default run configuration as YAML, each setting under a comment giving its
+    description, unit and bounds (a file that ``explore --config`` reads back)."""
+    text = run.config_yaml(run.RunConfig(), described=True)
     if out is None:
         sys.stdout.write(text)
         return

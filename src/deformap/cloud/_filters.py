@@ -79,19 +79,18 @@ def _mean_neighbour_distances(pts: NDArray[np.float64], k: int) -> NDArray[np.fl
 def statistical_outlier_mask(points: Any, k: int, std_ratio: float) -> NDArray[np.bool_]:
     """Mask of the points kept by Open3D's statistical outlier rule.
 
-    For each point, average the distances to its ``k`` nearest neighbours, the point itself
-    included (so one of them is 0). Let ``m`` be the mean of those averages and ``s`` their sample
-    standard deviation (ddof = 1). A point is kept when its average is strictly below
-    ``m + std_ratio · s``.
+    For each point, average the distances to its ``k`` nearest neighbours, the point itself included.
+    With ``m`` the mean of those averages and ``s`` their sample standard deviation (ddof = 1), a point
+    is kept when its average is strictly below ``m + std_ratio · s``.
 
     Parameters
     ----------
     points : (n, 3) float, metres
-        The cloud, with at least ``k`` points (and at least 2, for a sample deviation).
+        The cloud, with at least ``k`` points (and at least 2).
     k : int
         Number of neighbours, the point itself included (Open3D's ``nb_neighbors``), ``>= 1``.
     std_ratio : float
-        Threshold in standard deviations, ``> 0`` (Open3D refuses others too).
+        Threshold in standard deviations, ``> 0``.
 
     Returns
     -------
@@ -100,11 +99,10 @@ def statistical_outlier_mask(points: Any, k: int, std_ratio: float) -> NDArray[n
 
     Notes
     -----
-    Two details follow Open3D's code rather than the textbook rule, so that results agree point
-    for point. A point whose average is exactly 0 (it has ``k - 1`` exact duplicates, or ``k = 1``)
-    counts in ``n`` and in ``m`` but adds nothing to the squared deviations of ``s``, and is
-    never kept. With every average equal and non-zero, ``s = 0`` and the strict inequality removes
-    every point, as in Open3D.
+    As in Open3D's code, so that results agree point for point: a point whose average is exactly 0
+    (``k - 1`` exact duplicates, or ``k = 1``) counts in ``m`` but adds nothing to the squared
+    deviations of ``s``, and is never kept; with every average equal and non-zero, ``s = 0`` and every
+    point is removed.
 
     References
     ----------
@@ -135,15 +133,11 @@ def statistical_outlier_mask(points: Any, k: int, std_ratio: float) -> NDArray[n
 def height_field_mask(points: Any, k: int = 20, max_slope_deg: float = 60.0) -> NDArray[np.bool_]:
     """Mask of the points whose local surface is flat enough to belong to a height field.
 
-    A Gaussian random field over ``(x, y)`` models the surface as a height field ``z = f(x, y)``.
-    A depth camera that looks at the scene from the side also sees what is not a height field:
-    the vertical faces of objects (the front of a foam block, the step between two blocks), and
-    the "flying pixels" at depth edges, which form veils along the camera's rays behind a
-    foreground object (the robot's stick). Fitted as heights, such points pull the surface
-    down or up by centimetres at the edge and make a smooth GP ring across the whole map. This
-    filter keeps a point when the normal of the plane fitted to its ``k`` nearest neighbours (the
-    point included; the eigenvector of their covariance with the smallest eigenvalue) is within
-    ``max_slope_deg`` of the vertical.
+    A surface GP models ``z = f(x, y)``; a camera looking from the side also sees what is not a height
+    field (the vertical faces of blocks, flying pixels along the rays behind the robot's stick), which,
+    fitted as heights, make the GP ring across the map. A point is kept when the normal of the plane
+    fitted to its ``k`` nearest neighbours (the point included; PCA) is within ``max_slope_deg`` of
+    the vertical.
 
     Parameters
     ----------
@@ -153,8 +147,8 @@ def height_field_mask(points: Any, k: int = 20, max_slope_deg: float = 60.0) -> 
         Neighbours of the local plane fit, the point included, ``>= 3``.
     max_slope_deg : float
         Steepest surface kept, in degrees from horizontal, in ``(0, 90]`` (90 keeps everything).
-        60° keeps the walls of a probe's dent (about 40° for a 7 mm dent under a 1 cm tip) with
-        margin for the normals' noise, and removes vertical faces and veils.
+        60° keeps the walls of a probe's dent, with margin for the normals' noise, and removes
+        vertical faces and veils.
 
     Returns
     -------
@@ -207,12 +201,11 @@ def hull_parts(hull_points: Any) -> tuple[Any, ...] | None:
 def points_in_hull(
     points: Any, hull_points: Any, *, tolerance_m: float = HULL_TOLERANCE_M
 ) -> NDArray[np.bool_]:
-    """Mask of the points inside the convex hull of ``hull_points`` (surface included), or inside
-    any of the hulls when one hull per part is given.
+    """Mask of the points inside the convex hull of ``hull_points`` (surface included), or inside any of
+    the hulls when one hull per part is given.
 
-    Used to remove the robot's stick and hand from a cloud: ``cloud.select(~points_in_hull(...))``.
-    One hull per part (stick, hand) covers each part without the space between them: a single
-    hull around a narrow stick and a wide hand above it widens down to the surface.
+    Removes the robot from a cloud: ``cloud.select(~points_in_hull(...))``. One hull per part (stick,
+    hand) covers each part without the space between them.
 
     Parameters
     ----------
@@ -222,7 +215,7 @@ def points_in_hull(
         At least 4 points per hull, not all on one plane.
     tolerance_m : float
         A point counts as inside when it lies at most this far outside every facet plane
-        (default :data:`HULL_TOLERANCE_M`, 1 µm, see there why).
+        (:data:`HULL_TOLERANCE_M`).
 
     Returns
     -------

@@ -1,24 +1,20 @@
 """Tactile points: where the probe's spherical tip touches the surface while it presses.
 
 The paper adds ten points from the touch sensor to the cloud seen while pressing, because the tip
-and stick hide the very dent being measured; they are "virtually generated considering the position
-and shape of the spherical surface of the sensor along with the contact force direction". Here they
-are points on the spherical cap of the tip that faces along the contact force.
+and stick hide the dent being measured; they are "virtually generated considering the position and
+shape of the spherical surface of the sensor along with the contact force direction". Here they are
+points on the spherical cap of the tip that faces along the contact force.
 
-Which cap touches depends on how deep the tip sinks: a sphere of radius ``R`` pressed ``δ`` into
-an elastic surface touches it within the Hertz contact radius ``a = √(R δ)`` (Johnson 1985,
-§4.2; Dimitriadis et al. 2002 expand the bonded layer's force in ``χ = a / h`` with the same
-``a``), beyond which the surface falls away from the tip. :func:`contact_cap` gives that cap's
-half-angle ``asin(a / R)`` and how many points keep the paper's density on it (ten on a 30° cap),
-at least the pole: points farther up the tip would lie above the real surface and make the dent
-look shallower (a 1–2 mm dent on a 1 cm tip touches a cap of 18–27°, not a fixed 30°).
+A sphere of radius ``R`` pressed ``δ`` into an elastic surface touches it within the Hertz contact
+radius ``a = √(R δ)`` (Johnson 1985, §4.2). :func:`contact_cap` gives that cap's half-angle
+``asin(a / R)`` and how many points keep the paper's density on it (ten on a 30° cap): points
+farther up the tip would lie above the real surface and make the dent look shallower.
 
 References
 ----------
 Caccamo et al., "Active Perception and Modeling of Deformable Surfaces using Gaussian Processes
 and Position-based Dynamics", HUMANOIDS 2016, Sec. III ("The algorithm process flow").
 Johnson, K. L. (1985). Contact Mechanics, §4.2. Cambridge University Press.
-Dimitriadis, E. K., et al. (2002). Biophysical Journal 82(5), 2798–2810.
 """
 
 from __future__ import annotations

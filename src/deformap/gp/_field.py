@@ -24,13 +24,9 @@ __all__ = ["AUTO_EXACT_MAX_POINTS", "GaussianRandomField"]
 
 _LOG = logging.getLogger(__name__)
 
-#: ``method="auto"`` uses the exact GP up to this many points and the grid GP above. The grid
-#: path costs about the same at any n (its size follows the extent over σ_w); the exact path's
-#: fit grows as n³ and its std as n² × the number of predicted points, so it is the cheaper one
-#: only for small n. The crossover depends on the problem (the surface's 120×80 grid, a ROI's
-#: 25×25) and on the machine; 1,000 keeps the small problems exact and moves the large ones to
-#: the grid, which ``deformap bench speed`` compares with the exact path in time and accuracy
-#: (``benchmarks/README.md``).
+#: ``method="auto"`` uses the exact GP up to this many points and the grid GP above: the grid's
+#: cost follows the extent over σ_w while the exact fit grows as n³, so exact is cheaper only for
+#: small n (``deformap bench speed`` compares the two).
 AUTO_EXACT_MAX_POINTS = 1000
 _METHODS = ("auto", "exact", "grid")
 
@@ -51,26 +47,23 @@ def _hyperparameter(name: str, value: Any) -> float:
 class GaussianRandomField:
     """GP regression of a scalar field z(x, y) with the paper's squared-exponential kernel.
 
-    The prior is f ~ GP(m, k) with k(p, p') = σₑ² exp(−‖p − p'‖² / σ_w²) and a *constant mean*
-    m = the data mean (the inverse-noise-variance weighted mean when per-point noise is given),
-    which is subtracted before the fit and added back to every prediction. Observations are
-    z = f + ε, ε ~ N(0, σₙ²) (or per-point σₙ,ᵢ²).
+    The prior is f ~ GP(m, k) with k(p, p') = σₑ² exp(−‖p − p'‖² / σ_w²) and a constant mean m, the
+    data mean (inverse-noise-variance weighted with per-point noise), subtracted before the fit and
+    added back to every prediction. Observations are z = f + ε, ε ~ N(0, σₙ²) (or per-point σₙ,ᵢ²).
 
     Parameters
     ----------
     length_scale : float, metres
-        σ_w (no factor 2: equals √2 × scikit-learn's RBF ℓ).
+        σ_w (no factor 2: √2 × scikit-learn's RBF ℓ).
     signal_std : float, units of z
         σₑ, the prior standard deviation around the mean.
     noise_std : float, units of z
         σₙ, the observation noise (used when ``fit`` gets no per-point noise).
     method : {"auto", "exact", "grid"}
-        ``"exact"``: Cholesky of the n×n covariance (RW2006 Alg. 2.1), O(n³).
-        ``"grid"``: DTC/SGPR with inducing points on a regular grid and Kronecker algebra,
-        near-exact for the SE kernel at the default spacing (see ``deformap.gp._grid``); each
-        axis's whitened inducing features are compressed to the modes the data's extent
-        excites, so its cost follows the extent over σ_w, hardly n (``deformap.gp._grid_basis``).
-        ``"auto"``: exact for n ≤ ``AUTO_EXACT_MAX_POINTS`` (1,000), grid above.
+        ``"exact"``: Cholesky of the n×n covariance (RW2006 Alg. 2.1), O(n³). ``"grid"``: DTC/SGPR
+        with inducing points on a regular grid and Kronecker algebra, near-exact for the SE kernel at
+        the default spacing, its cost following the extent over σ_w rather than n
+        (:mod:`deformap.gp._grid`). ``"auto"``: exact up to ``AUTO_EXACT_MAX_POINTS`` points.
     inducing_spacing : float, metres, optional
         Grid method's node spacing; default σ_w / 3.
     jitter, max_jitter : float
@@ -88,8 +81,7 @@ class GaussianRandomField:
     jitter_used_ : float
         The relative jitter the factorisation needed.
     n_inducing_ : int
-        Number of inducing grid points (0 for the exact method); the linear algebra runs on
-        fewer compressed features, see ``deformap.gp._grid_basis``.
+        Number of inducing grid points (0 for the exact method).
     log_marginal_likelihood_ : float or None
         log p(z | hyperparameters) of the exact method (RW2006 Eq. 2.30); None for the grid method.
 

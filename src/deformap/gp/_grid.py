@@ -1,25 +1,22 @@
 """Sparse GP with inducing points on a regular grid: DTC/SGPR predictions in Kronecker form.
 
-With inducing inputs u on a grid ``ua × ub`` and the separable kernel, the prior covariance of the
-inducing values is K_uu = σₑ² (K_a ⊗ K_b), and the cross-covariance of a point p with them is the
-Kronecker (for many points: Khatri–Rao) product k_u(p) = σₑ² k_a(p_a) ⊗ k_b(p_b). DTC needs only
-M×M algebra (RW2006 §8.3.3; Quiñonero-Candela & Rasmussen 2005):
+With inducing inputs on a grid ``ua × ub`` and the separable kernel, K_uu = σₑ² (K_a ⊗ K_b) and
+k_u(p) = σₑ² k_a(p_a) ⊗ k_b(p_b) (Khatri–Rao for many points). DTC needs only M×M algebra (RW2006
+§8.3.3; Quiñonero-Candela & Rasmussen 2005; the predictions of Titsias' 2009 SGPR):
 
     mean(p) = k_u(p)ᵀ Σ⁻¹ K_uf Λ⁻¹ (z − z̄),          Σ = K_uu + K_uf Λ⁻¹ K_fu
     var(p)  = k(p, p) − k_u(p)ᵀ K_uu⁻¹ k_u(p) + k_u(p)ᵀ Σ⁻¹ k_u(p)
 
-which are also the predictions of Titsias' (2009) SGPR. K_uu of a fine grid is numerically
-singular (condition ~1e18), so everything is *whitened* by its Kronecker Cholesky factor
-L = L_a ⊗ L_b, as in SGPR implementations, and then compressed per axis to the modes the data
-excite (``_grid_basis``): h(p) = h_a(p_a) ⊗ h_b(p_b) with h = Qᵀ L⁻¹ k keeps the Khatri–Rao
-structure and the N(0, I) prior, B = I + σₑ² Hᵀ Λ⁻¹ H (eigenvalues >= 1), and
+K_uu of a fine grid is numerically singular, so everything is whitened by its Kronecker Cholesky
+factor L = L_a ⊗ L_b and compressed per axis to the modes the data excite (``_grid_basis``):
+h(p) = h_a(p_a) ⊗ h_b(p_b) with h = Qᵀ L⁻¹ k, B = I + σₑ² Hᵀ Λ⁻¹ H (eigenvalues >= 1), and
 
     mean(p) = h(p)ᵀ B⁻¹ σₑ² Hᵀ Λ⁻¹ (z − z̄)
     var(p)  = σₑ² (1 − ‖h(p)‖² + h(p)ᵀ B⁻¹ h(p)).
 
-With the grid finer than the kernel's resolution the Nyström residual 1 − ‖g‖² is at round-off
-level and DTC equals the exact GP to that accuracy; the defaults below follow from that residual.
-Axis ``a`` is the axis with more inducing nodes; the flattened feature index is ``ia * rb + ib``.
+With the grid finer than the kernel's resolution the Nyström residual 1 − ‖g‖² is at round-off and
+DTC equals the exact GP. Axis ``a`` has more inducing nodes; the flattened feature index is
+``ia * rb + ib``.
 """
 
 from __future__ import annotations
@@ -51,24 +48,19 @@ __all__ = ["GRID_BLAS_THREADS", "GRID_MARGIN_FRACTION", "GRID_SPACING_FRACTION",
 
 _LOG = logging.getLogger(__name__)
 
-#: Default inducing spacing = σ_w × this. The SE spectrum exp(−σ_w²ω²/4) at the grid's Nyquist
-#: frequency π/h is exp(−π²·9/4) ≈ 2e-10 for h = σ_w/3; the measured 1-D Nyström residual inside the
-#: grid is 2e-10 (relative to σₑ²), i.e. the grid loses nothing a float64 Cholesky would keep.
+#: Default inducing spacing = σ_w × this: the SE spectrum exp(−σ_w²ω²/4) at the grid's Nyquist
+#: frequency π/h is exp(−π²·9/4) ≈ 2e-10, so the grid loses nothing a float64 Cholesky would keep.
 GRID_SPACING_FRACTION = 1.0 / 3.0
-#: Inducing nodes extend this many σ_w beyond the data's bounding box. At spacing σ_w/3, the 1-D
-#: Nyström residual at the box edge is 7e-9 σₑ² with a 1 σ_w margin (1.5e-7 with 0.5 σ_w, 8e-10
-#: with 2 σ_w). The compression to the data's modes makes extra nodes nearly free (only the 1-D
-#: factors grow), the residual at the edge is what counts.
+#: Inducing nodes extend this many σ_w beyond the data's bounding box, which keeps the Nyström
+#: residual at the box's edge near round-off; the compression to the data's modes makes the extra
+#: nodes nearly free.
 GRID_MARGIN_FRACTION = 1.0
 #: Largest number of grid nodes accepted (their 1-D factors are cheap; B is at most this size,
 #: 8·M² bytes = 1.2 GB).
 MAX_INDUCING = 12_000
-#: BLAS threads while the grid path runs (None: leave the process's setting). Its BLAS calls are
-#: mid-sized (M of the order of a thousand; per-cell products of a few hundred) and many, and every
-#: threaded call waits for all its threads: on a machine shared with other jobs one descheduled
-#: thread stalls each call, which costs far more than a second thread gains on calls this small.
-#: Applied with threadpoolctl where it is installed (it comes with scikit-learn); without it the
-#: process's setting stays.
+#: BLAS threads while the grid path runs (None: leave the process's setting), applied with
+#: threadpoolctl where installed: its many mid-sized BLAS calls each wait for all their threads, so
+#: one descheduled thread on a shared machine costs more than a second thread gains.
 GRID_BLAS_THREADS: int | None = 1
 _BLOCK_BYTES = 32 * 2**20  # bound on the intermediate of one block of cells in the data term
 #: Candidate cell widths (× σ_w) for the interpolated data term; the cheapest by the flop model in
@@ -246,8 +238,7 @@ def _data_terms(
         for i, c in enumerate(block):
             seg = slice(bounds[c], bounds[c + 1])
             rows = (lag[seg, :, None] * root_hb[seg, None, :]).reshape(-1, degree * rb)
-            # A full GEMM, not SYRK: the next step reads all of E_c, and OpenBLAS's GEMM runs
-            # faster than its SYRK, which would then need a symmetrisation too.
+            # a full GEMM, not SYRK: the next step reads all of E_c, which SYRK leaves half empty
             np.matmul(rows.T, rows, out=gram[i])
             rhs += h_nodes[c].T @ (lag[seg].T @ resid_hb[seg])
         _spread_cells(system, gram, h_nodes[c0 : block.stop])

@@ -1,16 +1,12 @@
 """One-dimensional feature maps of the grid GP: whitening, compression and Chebyshev interpolation.
 
-Along one axis with inducing nodes ``u`` (m,) and K = k₁(u, u) = L Lᵀ, the whitened features of a
-coordinate t are g(t) = L⁻¹ k₁(u, t) (m,). The prior of the whitened inducing values is N(0, I), so
-any orthonormal Q (m, r) gives the inducing *features* h(t) = Qᵀ g(t) with prior N(0, I) as well:
-DTC with them is exact up to what the data's features lose, ‖g(tᵢ)‖² − ‖h(tᵢ)‖². Q is taken from
-the eigenvectors of Σᵢ g(tᵢ) g(tᵢ)ᵀ over the data, keeping the fewest that leave every data point a
-residual below ``FEATURE_TOLERANCE``: a fine grid (spacing ≤ σ_w/3) has more nodes than the data
-box has modes, and the inducing dimension M enters the fit as M² and M³.
-
-The data term needs the features of every data point; along the longer axis they are interpolated
-within short cells from R Chebyshev nodes (:func:`chebyshev_degree` gives R from a rigorous error
-bound), so that the n per-point outer products are replaced by products of size R.
+Along one axis with inducing nodes ``u`` (m,) and K = k₁(u, u) = L Lᵀ, the whitened features of t
+are g(t) = L⁻¹ k₁(u, t) with prior N(0, I), so any orthonormal Q (m, r) gives features
+h(t) = Qᵀ g(t) with prior N(0, I) too, and DTC with them is exact up to ‖g(tᵢ)‖² − ‖h(tᵢ)‖². Q is
+taken from the eigenvectors of Σᵢ g(tᵢ) g(tᵢ)ᵀ, keeping the fewest that leave every data point a
+residual below ``FEATURE_TOLERANCE``. Along the longer axis the data's features are interpolated
+within short cells from R Chebyshev nodes (:func:`chebyshev_degree`), so that the n per-point outer
+products become products of size R.
 
 References
 ----------
@@ -36,7 +32,7 @@ __all__: list[str] = []
 #: Largest relative prior variance (fraction of σₑ²) the compressed features may miss at a data
 #: point, and twice the largest interpolation error of a data point's features. Both perturb the
 #: data's covariance by at most this much, the order of the grid's own Nyström residual at its edge
-#: (7e-9 σₑ² at spacing σ_w/3 and a 1 σ_w margin, see ``_grid.GRID_MARGIN_FRACTION``).
+#: (``_grid.GRID_MARGIN_FRACTION``).
 FEATURE_TOLERANCE = 1e-8
 _SAMPLES_PER_LENGTH = 24
 
@@ -104,8 +100,7 @@ def chebyshev_degree(half_width: float, length_scale: float, tolerance: float) -
     For nodes at the roots of T_R on [c − δ, c + δ], ‖h(t) − p(t)‖ ≤ 2 (δ/2)^R / R! · max ‖h⁽ᴿ⁾‖
     (the Hermite–Genocchi form holds for vector-valued h), and ‖h⁽ᴿ⁾(t)‖² is a Nyström
     approximation of the kernel's R-th derivative variance, so it is at most
-    ∂ᴿ∂'ᴿ k₁(t, t) = (2R)! / (R! σ_w^{2R}). At δ = σ_w/6 the bound is 2.6e-9 for R = 8, and the
-    measured error is 2.6e-9.
+    ∂ᴿ∂'ᴿ k₁(t, t) = (2R)! / (R! σ_w^{2R}).
     """
     if half_width <= 0.0:
         return 1

@@ -1,12 +1,8 @@
-"""Contact mechanics: the tactile contact, Hertz contact of the probe's sphere, a sphere on an elastic
-layer bonded to the table, foam hardness.
+"""Contact mechanics: the tactile contact, Hertz contact of the probe's sphere, a sphere on a bonded
+elastic layer, foam hardness.
 
-The one home of the physics that both the simulated world (:mod:`deformap.world`) and the estimator
-(:mod:`deformap.msm`) use. It sits at the bottom of the package graph: it imports numpy and the
-validators only, so that ``world`` can use it without importing the estimator and ``msm`` without
-importing the robot protocol (:mod:`deformap.environment` re-exports :class:`TactileContact`).
-
-Units are SI: metres, newtons, pascals.
+The physics both the simulated world and the estimator use; it imports numpy and the validators
+only, so that ``world`` can use it without the estimator. Units are SI.
 
 References
 ----------

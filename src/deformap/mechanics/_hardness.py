@@ -7,9 +7,8 @@ indenter gives a secant modulus
 
     E = (H / A) / ε,    A = 0.0323 m²,  ε = 0.4,
 
-so 60, 110 and 150 N foams get 4.6, 8.5 and 11.6 kPa. This ignores the foam around the indenter and
-the non-linearity of foam at 40 % strain; it is the conversion the project takes as its reference
-(issue 3), and every world that uses it states the moduli it produced.
+so 60, 110 and 150 N foams get 4.6, 8.5 and 11.6 kPa. It ignores the foam around the indenter and
+the non-linearity of foam at 40 % strain; it is the project's reference conversion.
 
 References
 ----------

@@ -1,55 +1,33 @@
 """A rigid sphere indenting an elastic layer bonded to a rigid base (Hertz with the finite-thickness
 correction of Dimitriadis et al. 2002).
 
-A rigid sphere of radius ``R`` that sinks by ``δ`` into an elastic half-space of Young's modulus
-``E`` and Poisson's ratio ``ν`` pushes back with Hertz's force (Johnson 1985, §4.2)
+A rigid sphere of radius ``R`` sunk by ``δ`` into a half-space of Young's modulus ``E`` and
+Poisson's ratio ``ν`` pushes back with Hertz's force (Johnson 1985, §4.2)
 
     F_H(δ) = (4/3) E* √R δ^(3/2),    E* = E / (1 − ν²).
 
-On a layer of thickness ``h`` bonded to a rigid table the base stiffens the contact as the contact
-radius ``a ≈ √(Rδ)`` grows against ``h``. Dimitriadis et al. (2002) solve the bonded (no slip at the
-base) and the non-bonded layer as a series in ``χ = √(Rδ) / h``; their force for a spherical
-(paraboloidal) indenter is
+On a layer of thickness ``h`` bonded to the table, Dimitriadis et al. (2002) correct it by a
+series in ``χ = √(Rδ) / h``:
 
     F(δ) = F_H(δ) · P(χ),
     P(χ) = 1 − (2α₀/π) χ + (4α₀²/π²) χ² − (8/π³)(α₀³ + (4π²/15) β₀) χ³
              + (16α₀/π⁴)(α₀³ + (3π²/5) β₀) χ⁴,
-
-with, for the bonded layer,
-
     α₀(ν) = −(1.2876 − 1.4678 ν + 1.3442 ν²) / (1 − ν),
-    β₀(ν) = (0.6387 − 1.0277 ν + 1.5164 ν²) / (1 − ν).
+    β₀(ν) = (0.6387 − 1.0277 ν + 1.5164 ν²) / (1 − ν)    (bonded layer).
 
-At ``ν = 0.5`` the first three coefficients are their printed 1.133, 1.283 and 0.769 (their bonded
-equation for incompressible samples); the non-bonded ``α₀ = −0.347 (3 − 2ν)/(1 − ν)``,
-``β₀ = 0.056 (5 − 2ν)/(1 − ν)`` put into the same series give their non-bonded coefficients
-(0.884, 0.781, 0.386, 0.0048) to the printed digits. For the bonded case the series gives the
-χ⁴ coefficient −0.0975 where the printed incompressible form reads +0.0975 (the same magnitude,
-the opposite sign); this module evaluates the series, which its own non-bonded case confirms (the
-two bonded readings differ by less than 5 % of ``F`` for ``χ ≤ 1``).
+The series is evaluated as written; its χ⁴ coefficient at ``ν = 0.5`` is −0.0975 where the paper's
+printed incompressible form reads +0.0975 (its non-bonded case, put into the same series,
+reproduces the printed coefficients).
 
-Range of validity
------------------
-- ``χ ≲ 1``: the series is an expansion in the contact radius over the thickness, meant for
-  contact radii up to about the layer's thickness. Beyond it the
-  polynomial is an extrapolation, and its negative χ⁴ term makes the force stop rising at
-  :func:`layer_chi_limit` (``χ ≈ 2.2`` at ``ν = 0.33``, 1.7 at ``ν = 0``): past that it means
-  nothing. :func:`deformap.explore.estimate_stiffness` stays below it and reports the ``χ`` it
-  reached.
-- small strain: Hertz's paraboloidal sphere and linear elasticity need ``a ≪ R`` (``δ ≪ R``),
-  ``δ ≪ h`` and strains in the material's linear range; a foam pressed to a sizeable fraction of
-  its thickness is outside all three. With a tip smaller than the layer (``R < h``) the depth
-  reaches ``h`` before ``χ`` reaches 1 (``χ = √(R/h)`` at ``δ = h``), so there the strain, not
-  ``χ``, bounds the model.
-- frictionless contact at the tip, a flat and homogeneous, isotropic layer.
+Valid for ``χ ≲ 1`` (beyond it the polynomial extrapolates and the force stops rising at
+:func:`layer_chi_limit`), small strain (``δ ≪ R``, ``δ ≪ h``; with ``R < h`` the strain, not
+``χ``, bounds the model), and a frictionless tip on a flat, homogeneous, isotropic layer.
 
 References
 ----------
 Dimitriadis, E. K., Horkay, F., Maresca, J., Kachar, B., Chadwick, R. S. (2002). Determination of
 elastic moduli of thin layers of soft material using the atomic force microscope. Biophysical
-Journal 82(5), 2798–2810 (the spherical indenter on bonded and non-bonded layers: the series in χ,
-α₀ and β₀ of the bonded and non-bonded cases, and their incompressible numerical forms, the bonded
-one being their Eq. 12).
+Journal 82(5), 2798–2810 (Eq. 12 and the bonded / non-bonded α₀, β₀).
 Johnson, K. L. (1985). Contact Mechanics, §4.2. Cambridge University Press.
 """
 

@@ -44,15 +44,12 @@ class BetaEstimate:
     Parameters
     ----------
     beta : float
-        β̂, the minimiser of E(β) over the β solved to ``config.tol`` (those the refinement
-        compared, or every sampled β without refinement) that converged (over all of them if
-        none did, which ``all_converged`` reports); E values within 1 nm of the minimum
-        are round-off ties and the smallest (most rigid) of them is taken, so a flat E(β) gives
-        the rigid end β̂ = 0.
+        β̂, the minimiser of E(β) over the converged β solved to ``config.tol`` (over all of
+        them if none converged); E values within 1 nm are ties and the most rigid is taken, so a
+        flat E(β) gives β̂ = 0.
     beta_std : float
-        Uncertainty of β̂ from the curve's shape: the standard deviation (width / √12) of the β
-        interval around β̂ where E(β) ≤ min E + ``config.error_tolerance_m`` (its ends linearly
-        interpolated between the sampled β), at least ``beta_resolution / √12``.
+        Standard deviation of β̂ (``config.uncertainty``, or the spread over ``height_samples``),
+        at least ``beta_resolution / √12``.
     betas : (n,) float
         Every β simulated, sorted (the uniform sweep plus the refinement).
     errors : (n,) float, metres
@@ -167,12 +164,11 @@ class _Sweep:
             self._body[key] = body[0]
 
     def _start(self, beta: float) -> Array | None:
-        """Starting positions for ``beta``: its own loosely solved equilibrium, else linear in
-        the dent's amplitude ``v`` (``1 / (1 − β)``, or the odds ``β / (1 − β)`` on the odds
-        scale, :meth:`PokeModel.amplitude`) through the two nearest solved β (the scale on which
-        the dent deepens, see :func:`_vertex`), or the nearest deformed one's displacements
-        scaled by the ratio of ``v`` (the calibration's dent, of amplitude 1, when only the
-        rigid β = 0 is solved); ``None`` (the model's own start) when no β is solved yet."""
+        """Starting positions for ``beta``: its own loosely solved equilibrium; else linear in the dent's
+        amplitude ``v`` (:meth:`PokeModel.amplitude`) through the two nearest solved β; else the
+        nearest deformed one's displacements (or, with only β = 0 solved, the calibration's dent of
+        amplitude 1) scaled by the ratio of ``v``; ``None`` (the model's own start) when none is solved.
+        """
         if beta in self._body:
             return self._body[beta]
         if not self._body:
@@ -213,10 +209,9 @@ def _refine(sweep: _Sweep, step: float, resolution: float, tol: float, *,
     parabola (:func:`_vertex`) through the lowest β solved so far and its nearest solved
     neighbours, rounded to the grid, or, when that point is already solved to ``tol``, the
     unsolved grid neighbour of the lowest point solved to ``tol`` nearest that vertex; it stops
-    when that lowest point has both grid neighbours solved to ``tol``. That is a few solves
-    (README, "Speed and memory", counts them) instead of the ``2 step / resolution`` of an
-    exhaustive grid, and the same grid minimum. Every β compared is solved to ``tol``; the loosely
-    swept β only guide the parabola.
+    when that lowest point has both grid neighbours solved to ``tol``: a few solves instead of the
+    ``2 step / resolution`` of an exhaustive grid, with the same grid minimum. Every β compared is
+    solved to ``tol``; the loosely swept β only guide the parabola.
     """
     known = np.fromiter(sweep.errors, dtype=float)
     errs = np.fromiter(sweep.errors.values(), dtype=float)

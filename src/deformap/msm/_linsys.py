@@ -1,20 +1,15 @@
 """The sparse linear part ``K_β`` of the local–global step: assembled once per ROI, one banded
 Cholesky factorisation per β.
 
-``K_β = I − M⁻¹ (Σ_c W_c + β Σ_c Π_c)`` restricted to the free particles (see
-:mod:`deformap.msm._poke`). ``W_c`` (centre of mass) and ``Π_c`` (the mass-weighted least-squares
-fit) are orthogonal projections in the inner product of the particle masses ``m``, so
-``S_β = diag(m M) K_β = diag(m M) − diag(m) Σ_c (W_c + β Π_c)`` is symmetric, and positive
-definite for β < 1 once a boundary is held fixed (``W_c + β Π_c ≤ I`` with equality only for a
-common translation, which the fixed particles forbid). Ordered row by row with the layer index
-innermost, the clusters only couple particles ``(k − 1)`` rows apart, so ``S_β`` is a band matrix
-of half-width ``(k − 1)(n_x n_z + n_z) + n_z − 1``, and a dense banded Cholesky (LAPACK
-``pbtrf``) factorises it several times faster than a general sparse LU, with no pivoting.
-``S_β = S₀ − β S₁`` is affine in β, so both bands are assembled once and each β costs one
-factorisation only, or none: a β may step with the factorisation of a smaller β′ through the
-convergent splitting ``S_β = S_β′ − (β − β′) S₁`` (:meth:`StepMatrices.solve`), one sparse
-product with ``S₁`` per step instead of a factorisation per β. A matrix that is not positive
-definite (never expected) falls back to SuperLU.
+``K_β = I − M⁻¹ (Σ_c W_c + β Σ_c Π_c)`` on the free particles (:mod:`deformap.msm._poke`). ``W_c``
+and ``Π_c`` are orthogonal projections in the particle masses' inner product, so
+``S_β = diag(m M) K_β`` is symmetric, and positive definite for β < 1 once a boundary is fixed.
+Ordered row by row with the layer index innermost, ``S_β`` is a band matrix of half-width
+``(k − 1)(n_x n_z + n_z) + n_z − 1``, factorised by LAPACK ``pbtrf`` with no pivoting.
+``S_β = S₀ − β S₁`` is affine in β, so both bands are assembled once; a β may also step with the
+factorisation of a smaller β′ through the convergent splitting ``S_β = S_β′ − (β − β′) S₁``
+(:meth:`StepMatrices.solve`). A matrix that is not positive definite (never expected) falls back
+to SuperLU.
 """
 
 from __future__ import annotations

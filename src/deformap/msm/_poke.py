@@ -1,27 +1,23 @@
 """Static equilibrium of a shape-matching body under a poke, for many β at once.
 
 Position-based dynamics moves each free particle toward its goal,
-``x ← x + α (g(x) − x) + h² f / m``; its steady state is the fixed point
-``x_i − g_i(x) = f_i / k`` with ``k = α m / h²`` (N/m) the stiffness of the spring that pulls a
-particle to its goal. Time stepping reaches that state like a diffusion (~n² steps on an n×n
-grid) and stops wherever the step budget ends, so we solve for the steady state directly.
+``x ← x + α (g(x) − x) + h² f / m``; its steady state is the fixed point ``x_i − g_i(x) = f_i / k``
+with ``k = α m / h²`` (N/m). Time stepping reaches that state like a diffusion (~n² steps on an n×n
+grid), so the steady state is solved for directly.
 
 The goal of particle ``i`` in cluster ``c`` is
-``g_i^c = t_c + (1 − β) R_c s_i + β (s_i + Π_c (x − p⁰))``, where ``t_c`` (centre of mass) and
-``Π_c (x − p⁰)`` (the linear or quadratic least-squares fit) are *linear* in ``x``; only the
-rotation ``R_c = polar(A_pq)`` is not. Moving the linear part to the left gives, for the free
-particles,
+``g_i^c = t_c + (1 − β) R_c s_i + β (s_i + Π_c (x − p⁰))``, linear in ``x`` except for the rotation
+``R_c = polar(A_pq)``. Moving the linear part to the left gives, for the free particles,
 
     K_β x = (1 − β) M⁻¹ Σ_c R_c s^c + b_β,    K_β = I − M⁻¹ (Σ_c W_c + β Σ_c Π_c),
 
-with ``M`` the number of clusters holding each particle (the paper's averaged goal), ``W_c`` the
-centre-of-mass rows and ``b_β`` the fixed particles' and the force's terms. ``K_β`` is sparse, the
-same for x, y and z, and constant over the iterations: it is factorised once per β (a banded
-Cholesky of its symmetric scaling, :mod:`deformap.msm._linsys`) and
-each iteration only recomputes the rotations and back-substitutes (a local–global scheme like
-projective dynamics, Bouaziz et al. 2014, but with the β-dependent linear part solved exactly, so
-that the iteration count does not grow as β → 1), accelerated by Anderson mixing (Walker & Ni
-2011). The fixed point is exactly the PBD steady state; nothing is changed about the model.
+with ``M`` the number of clusters holding each particle, ``W_c`` the centre-of-mass rows and
+``b_β`` the fixed particles' and the force's terms. ``K_β`` is sparse, the same for x, y and z and
+constant over the iterations: it is factorised once per β (banded Cholesky,
+:mod:`deformap.msm._linsys`) and each iteration recomputes the rotations and back-substitutes (a
+local–global scheme like projective dynamics, Bouaziz et al. 2014, with the β-dependent part
+solved exactly so that the iteration count does not grow as β → 1), accelerated by Anderson mixing
+(Walker & Ni 2011). The fixed point is exactly the PBD steady state.
 
 References
 ----------
@@ -155,25 +151,19 @@ class Equilibrium:
               ) -> tuple[Array, NDArray[np.int64], Array, NDArray[np.bool_]]:
         """Iterate ``x ← G(x)`` to its fixed point for every β, with Anderson acceleration.
 
-        ``x_fixed (n_fix, 3)``: positions of the fixed particles; ``force (n, 3)`` newtons.
-        Returns positions ``(B, ny, nx, 3)``, iterations, residuals ``max‖G(x) − x‖ / max‖G(x) −
-        p⁰‖`` and converged flags. Anderson acceleration (type II, ``memory`` past steps, Walker &
-        Ni 2011) replaces the plain step, safeguarded: an extrapolated point whose residual exceeds
-        that of the point it was extrapolated from is rejected, and the plain step from that point
-        (already computed) taken instead, with a fresh history; after ``n`` consecutive rejections
-        ``2^min(n, 6) − 1`` plain steps follow before mixing again. A plain step that increases
-        the residual restarts the history. Near large rotations (clusters under a deep dent
-        turning inside out at high β) the step map is strongly non-linear: the residual of plain
-        steps first grows, then contracts, and unguarded extrapolations kept throwing the iterate
-        back into the growing phase, in a cycle that lasted until ``max_iter``.
-        ``x0 (B, *grid, 3)``, optional: starting positions (only the free particles' are used, e.g.
-        the equilibrium of a nearby β); the rest shape by default. The fixed point does not
-        depend on it.
+        ``x_fixed (n_fix, 3)``: positions of the fixed particles; ``force (n, 3)`` newtons; ``x0 (B,
+        *grid, 3)``, optional: starting positions (only the free particles' are used; the rest shape by
+        default; the fixed point does not depend on it). Returns positions ``(B, ny, nx, 3)``,
+        iterations, residuals ``max‖G(x) − x‖ / max‖G(x) − p⁰‖`` and converged flags.
 
-        A β that steps with a smaller β's factorisation (contraction bound ``ρ`` of the splitting,
-        see :meth:`StepMatrices.solve`) stops at ``tol (1 − ρ)`` instead of ``tol``: its steps
-        contract more slowly, and the distance to the fixed point, about ``step / (1 −
-        contraction)``, is then bounded as with its own factorisation.
+        Anderson acceleration (type II, ``memory`` past steps, Walker & Ni 2011) is safeguarded, because
+        near large rotations (clusters turning inside out under a deep dent at high β) the step map is
+        strongly non-linear: an extrapolated point whose residual exceeds that of its origin is rejected
+        for the plain step from that origin, with a fresh history; after ``n`` consecutive rejections
+        ``2^min(n, 6) − 1`` plain steps follow; a plain step that increases the residual restarts the
+        history. A β that steps with a smaller β's factorisation (contraction bound ``ρ``,
+        :meth:`StepMatrices.solve`) stops at ``tol (1 − ρ)``, so that its distance to the fixed point is
+        bounded as with its own factorisation.
         """
         cl, nb = self.cl, len(self.betas)
         rest = cl.rest.reshape(-1, 3)
@@ -283,16 +273,13 @@ def calibrate_stiffness(eq0: Equilibrium, x_fixed: Array, weights: Array, contac
                         ) -> tuple[float, Solution | None]:
     """Spring stiffness ``k`` (N/m) such that the β = 0 body dents like the reference half-space.
 
-    ``eq0`` must hold the single β = 0. ``k`` is found by fixed-point (secant) iteration on
-    ``k ← k δ(k) / δ_Hertz(E_ref, F, tip)`` until the force-weighted depth of the loaded
-    particles at the measured force matches the Hertz depth to 0.1 % (depth ∝ 1/k for a linear
-    body, so this converges in a few steps; the body's geometric non-linearity is included).
-    Each equilibrium is solved to ``config.coarse_tol`` (a relative tolerance far below the
-    0.1 % asked of the depth).
+    ``eq0`` must hold the single β = 0. Secant iteration on ``k ← k δ(k) / δ_Hertz(E_ref, F, tip)``
+    until the force-weighted depth of the loaded particles matches the Hertz depth to 0.1 % (depth ∝
+    1/k for a linear body, so a few steps), each equilibrium solved to ``config.coarse_tol``.
 
     Returns ``k`` and the β = 0 solve at that ``k`` (:meth:`Equilibrium.solve`'s positions
-    ``(1, *body, 3)``, iterations, residual and converged flag; ``None`` if the depth did not
-    match within 8 steps, when ``k`` is the last secant estimate).
+    ``(1, *body, 3)``, iterations, residual, converged flag), or ``None`` for the solve if the depth
+    did not match within 8 steps (``k`` is then the last secant estimate).
     """
     f_mag = contact.force_n
     force = weights.reshape(-1, 1) * contact.force[None, :]

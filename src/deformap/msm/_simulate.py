@@ -130,7 +130,7 @@ def simulate_poke(rest: Any, masses: Any, fixed: Any, contact: TactileContact, b
     Parameters
     ----------
     rest : (ny, nx, 3) float, metres
-        Rest positions (see :meth:`ParticleGrid.from_heightmap`); a regular grid in x and y.
+        Rest positions (:meth:`ParticleGrid.from_heightmap`); a regular grid in x and y.
     masses : (ny, nx) float
         Particle masses (only ratios within a cluster matter).
     fixed : (ny, nx) bool
@@ -140,8 +140,8 @@ def simulate_poke(rest: Any, masses: Any, fixed: Any, contact: TactileContact, b
     betas : (B,) float in [0, 1)
     config : ShapeMatchingConfig
     stiffness_n_per_m : float, optional
-        Force protocol: use this spring stiffness (e.g. the one a previous call calibrated for
-        the same ROI and contact) instead of calibrating it again.
+        Force protocol: use this spring stiffness (one calibrated before for the same ROI and
+        contact) instead of calibrating it again.
 
     Returns
     -------
@@ -149,15 +149,11 @@ def simulate_poke(rest: Any, masses: Any, fixed: Any, contact: TactileContact, b
 
     Notes
     -----
-    ``contact="pinned"`` (Caccamo et al. 2016): the free particle nearest the contact point is held
-    at its rest position moved by the observed indentation (contact point minus the rest surface
-    under it); no force acts. ``contact="force"``: the force ``contact.force`` is shared by the
-    free particles under the tip (:func:`force_weights`) and each particle's spring to its goal
-    has the stiffness ``k`` calibrated so that the body of rigid goals dents like an elastic
-    half-space of ``config.reference_modulus_pa`` (:func:`calibrate_stiffness`), divided by β on
-    the ``"odds"`` scale (``config.beta_scale``: β = 0 is rigid, at rest); softer surfaces need
-    larger β.
-    Both solve the PBD steady state directly (see :mod:`deformap.msm._poke`).
+    ``contact="pinned"`` (Caccamo et al. 2016): the free particle nearest the contact is held at its
+    rest position moved by the observed indentation; no force acts. ``contact="force"``: the force is
+    shared by the free particles under the tip (:func:`force_weights`), and each particle's spring
+    has the stiffness ``k`` of :func:`calibrate_stiffness`, divided by β on the ``"odds"`` scale.
+    Both solve the PBD steady state directly (:mod:`deformap.msm._poke`).
     """
     cfg = _check_config(config)
     p0 = _check_rest(rest, cfg.cluster_size)

@@ -1,15 +1,11 @@
 """How well one poke pins down β: a paired block bootstrap of E(β) over the ROI.
 
-E(β) is a mean over the ROI's particles of the distance from each simulated particle to the observed
-surface. Most of the ROI is undisturbed and adds nearly the same distance at every β, so the *level*
-of E says little about which β fits; what matters is how consistently the particles prefer one β.
-Resampling whole tiles of particles (blocks of about the touch GP's correlation length, so that
-neighbouring, correlated particles move together) and taking the argmin of each resampled curve
-gives the spread of β̂ that the observation supports: tight for a deep, clear dent, wide for a
-shallow one whose E(β) is flat (Künsch 1989; Efron & Tibshirani 1993, §8.6).
-
-The resampling uses a fixed internal seed, so the uncertainty is a deterministic function of the
-poke (the same poke always gets the same β-field noise).
+E(β) is a mean over the ROI's particles; most of the ROI is undisturbed and adds nearly the same
+distance at every β, so what matters is how consistently the particles prefer one β. Resampling
+whole tiles of particles (about the touch GP's correlation length, so correlated neighbours move
+together) and taking the argmin of each resampled curve gives the spread of β̂ the observation
+supports (Künsch 1989; Efron & Tibshirani 1993, §8.6). The resampling uses a fixed internal seed,
+so the uncertainty is a deterministic function of the poke.
 
 References
 ----------
@@ -101,13 +97,11 @@ def sample_beta_std(
 ) -> float:
     """Standard deviation of β̂ over plausible observed surfaces (observation noise propagated).
 
-    Each sample moves the observed surface's points vertically by one draw of the error of its
-    reconstruction (for example the touch GP's posterior); E(β) is re-evaluated for every
-    simulated β against the moved points, and the spread of the argmins is returned. The
-    simulations are not repeated: only the observation changes. Each particle's nearest moved
-    point is sought among its ``8`` nearest unmoved ones, which holds while the samples move
-    the points by less than the grid spacing's order; that is the case for millimetre errors on
-    a 5 mm grid.
+    Each sample moves the observed points vertically by one draw of their reconstruction error (the
+    touch GP's posterior, for instance); E(β) is re-evaluated for every simulated β against the moved
+    points (the simulations are not repeated) and the spread of the argmins returned. Each
+    particle's nearest moved point is sought among its 8 nearest unmoved ones, which holds while the
+    samples move points by less than about the grid spacing.
 
     Parameters
     ----------
@@ -143,14 +137,10 @@ def sample_beta_std(
 
 
 def _argmins(betas: NDArray[np.float64], curves: NDArray[np.float64]) -> NDArray[np.float64]:
-    """Minimiser of each row of ``curves (S, B)`` between the sampled ``betas``.
-
-    The sampled β are uneven (a coarse sweep and a fine refinement around β̂), so a sample's
-    minimum that falls beyond the refined few would snap to a coarse β a whole sweep step away;
-    instead each row's minimum is the vertex of the parabola through its lowest sample and the
-    two beside it, in ``u = −log(1 − β)`` (like the refinement's ``1 / (1 − β)`` in
-    :func:`deformap.msm._beta._vertex`, a scale that stretches the soft end, where the simulated
-    dent changes fastest), kept between those two.
+    """Minimiser of each row of ``curves (S, B)`` between the sampled ``betas``: the vertex of the
+    parabola through its lowest sample and the two beside it, in ``u = −log(1 − β)`` (a scale that
+    stretches the soft end, where the dent changes fastest), kept between those two, so that a
+    minimum beyond the refined few β does not snap to a coarse β a sweep step away.
     """
     s_idx = np.arange(curves.shape[0])
     lowest = np.argmin(curves, axis=1)

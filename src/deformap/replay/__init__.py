@@ -1,13 +1,11 @@
 """Recorded sessions (a folder of cloud files, or a ROS 2 bag) read back and fed, poke by poke, to
-the same mapper the live loop uses.
+the mapper the live loop uses.
 
-The format is documented in ``docs/recording-format.md``. :func:`load_session` checks a session's
-``session.yaml`` and opens its data; each poke is read on demand as the
-:class:`~deformap.environment.PressObservation` the environment returned, so a broken poke is
-reported on its own. :func:`load_raw_bag` opens a bag as a robot records it (camera, force
-sensor, ``/tf``; settings in :class:`RawBagConfig`) as a session of form ``"raw"``, its presses
-found in the force stream. :func:`write_session` writes the format (``deformap record-sim`` uses it,
-through :class:`RecordingEnvironment`).
+:func:`load_session` checks a session's ``session.yaml`` (``docs/recording-format.md``) and opens
+its data; each poke is read on demand, so a broken poke is reported on its own.
+:func:`load_raw_bag` opens a bag as a robot records it (:class:`RawBagConfig`) as a session of form
+``"raw"``. :func:`write_session` writes the format (``deformap record-sim``, through
+:class:`RecordingEnvironment`).
 """
 
 from __future__ import annotations

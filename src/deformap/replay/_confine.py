@@ -2,10 +2,8 @@
 
 Every file a session names (in ``session.yaml``, and in a rosbag2 folder's ``metadata.yaml``) must
 be a relative name without ``..`` that, once symbolic links are resolved, lies inside the session
-folder. There is no opt-in to leave it: a session is moved, shared and archived as one folder, so
-a name outside it points at a different file (or none) on the next machine, and a session that may
-name any path would let whoever wrote it make ``deformap map`` read, and put into its report and
-figures, any file the user can read. Data kept elsewhere is copied (or hard-linked) into the folder.
+folder, with no opt-out: a session is moved and shared as one folder, and a session that could name
+any path would let whoever wrote it make ``deformap map`` read any file the user can read.
 """
 
 from __future__ import annotations

@@ -2,14 +2,12 @@
 
 The bag holds an organised ``sensor_msgs/msg/PointCloud2`` stream in the camera's frame, a
 ``geometry_msgs/msg/WrenchStamped`` stream in the force sensor's frame and ``/tf`` with
-``/tf_static``; :class:`~deformap.replay.RawBagConfig` names them. Reading takes two passes. The
-first decodes the wrenches, the transforms and the clouds' stamps, and finds the presses in the
-force stream (:func:`find_presses`). The second averages, pixel by pixel (``nanmean``), the camera
-frames each press was held for and the frames of the observation, so that no more than one frame
-per press is kept in memory. A press is read into a
-:class:`~deformap.environment.PressObservation` when asked for; one that cannot be (no frame or
-transform within the stamp tolerance, a force that never reached the command or points away from
-the surface) is refused with one line naming the press, the topic and the gap.
+``/tf_static`` (:class:`~deformap.replay.RawBagConfig` names them). A first pass decodes the
+wrenches, the transforms and the clouds' stamps and finds the presses in the force stream
+(:func:`find_presses`); a second averages, pixel by pixel, the camera frames each press was held
+for and those of the observation, keeping at most one frame per press in memory. A press that
+cannot be read (no frame or transform within the stamp tolerance, a force that never reached the
+command or points away from the surface) is refused with one line naming it, the topic and the gap.
 """
 
 from __future__ import annotations

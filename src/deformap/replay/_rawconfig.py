@@ -1,14 +1,13 @@
 """Settings of a raw robot recording: which topics and frames hold what, and the thresholds that
-find the presses in it (``docs/robot.md``, "A bag as your robot records it").
+find the presses in it (``docs/robot.md``).
 
-A raw recording is a ROS 2 bag as ``ros2 bag record`` writes it from a depth camera driver, a
-force–torque sensor and an arm: an organised ``sensor_msgs/msg/PointCloud2`` stream in the
-camera's optical frame, ``geometry_msgs/msg/WrenchStamped`` in the sensor's frame, and ``/tf`` and
-``/tf_static``. :class:`RawBagConfig` names its topics and frames, the commanded force and the
-thresholds; :class:`HullPart` is one part of the robot's model (stick, hand) in the tip's frame.
-The defaults fit a RealSense camera driver (``/camera/depth/color/points``) and a force sensor
-publishing on ``/ft_sensor/wrench``. The settings come from a YAML file beside the bag
-(:func:`raw_config_file`) and from the command line; both go through the same constructor.
+A raw recording is a ROS 2 bag as ``ros2 bag record`` writes it: an organised
+``sensor_msgs/msg/PointCloud2`` stream in the camera's optical frame,
+``geometry_msgs/msg/WrenchStamped`` in the force sensor's frame, and ``/tf`` and ``/tf_static``.
+:class:`RawBagConfig` names them, the commanded force and the thresholds (defaults: a RealSense
+driver and a force sensor on ``/ft_sensor/wrench``); :class:`HullPart` is one part of the robot's
+model in the tip's frame. The settings come from a YAML file beside the bag
+(:func:`raw_config_file`) and the command line, through the same constructor.
 """
 
 from __future__ import annotations
@@ -37,11 +36,8 @@ RAW_CONFIG_NAME = "deformap.yaml"
 
 @dataclass(frozen=True, kw_only=True)
 class HullPart:
-    """One rigid part of the probe (stick, hand), in the tip's frame.
-
-    The tip's frame has its origin at the centre of the spherical tip and its ``z`` axis along the
-    stick, away from the surface. Each part's convex hull is removed from the press's cloud on its
-    own, so a wide hand high above the tip does not widen the hull down at the surface.
+    """One rigid part of the probe (stick, hand) in the tip's frame (origin at the tip's centre, ``z``
+    along the stick away from the surface), its convex hull removed from the press's cloud on its own.
 
     Parameters
     ----------
@@ -84,9 +80,8 @@ class RawBagConfig:
     world_frame : str
         The frame whose ``z = 0`` is the table, ``z`` up (the map's frame).
     tip_frame : str
-        The frame at the centre of the probe's spherical tip, ``z`` along the stick away from the
-        surface (the press direction is its ``-z``); a ``/tf`` frame, usually static below the
-        arm's last link.
+        The ``/tf`` frame at the centre of the probe's spherical tip, ``z`` along the stick away from
+        the surface (the press direction is its ``-z``).
     camera_frame, force_frame : str or None
         Override the clouds' and the wrenches' ``header.frame_id`` (None: use them).
     units : {"m", "mm"}
@@ -94,28 +89,22 @@ class RawBagConfig:
     force_n : float or None
         The commanded normal force [N]; None: the run configuration's ``exploration.force_n``.
     wrench_sign : {"reaction", "applied"}
-        ``reaction``: the sensor reports the force the surface exerts on the probe (a force sensor
-        on a tool does), negated here to give the force on the surface; ``applied``: it already
-        reports the force on the surface. The result must push into the surface or the press is
-        refused (a wrong sign is never taken silently).
+        ``"reaction"``: the sensor reports the force on the probe (negated here); ``"applied"``: the
+        force on the surface. A result that does not push into the surface is refused.
     contact_force_n : float
-        A press starts at the first force sample above this [N] (first contact) and ends when the
-        force falls below it: 0.02 N, four times the 5 mN noise floor of the probe's sensor class
-        (``docs/robot.md``, the force–travel record).
+        A press starts at the first force sample above this [N] and ends when the force falls below
+        it; 0.02 N is four times the noise floor of the probe's sensor class.
     hold_band : float
-        The hold is the longest run of samples within ``hold_band · force_n`` of the commanded
-        force: 0.1, four times the 1 % + 5 mN noise of such sensors and tighter than the 25 %
-        the protocol allows for the final force (``FORCE_MISMATCH_REL``).
+        The hold is the longest run of samples within ``hold_band · force_n`` of the commanded force;
+        0.1 is four times such sensors' noise and tighter than the protocol's ``FORCE_MISMATCH_REL``.
     hold_min_s : float
-        The shortest hold accepted [s]; 0.1 s lets a 30 Hz camera give at least three frames.
+        The shortest hold accepted [s]; 0.1 s gives a 30 Hz camera at least three frames.
     stamp_tolerance_s : float
-        A camera frame or transform farther than this in time from the moment it is wanted is
-        not used [s]: 0.05 s is 1.5 frame periods at 30 Hz and 2.5 of ``/tf`` at 20 Hz, while a
-        dropped stream (a driver that stalls) leaves gaps of a second or more.
+        A camera frame or transform farther than this in time from the moment wanted is not used [s];
+        0.05 s is 1.5 frame periods at 30 Hz, while a stalled stream leaves gaps of a second or more.
     observation_time_s : float or None
-        When the observation's frame was taken (the surface before any press, arm out of view),
-        in seconds after the bag's start (its first camera or force message; every time in
-        messages counts from there); the frame nearest to it is taken. None: the first frame.
+        When the observation's frame was taken, in seconds after the bag's start (its first camera or
+        force message); the nearest frame is taken. None: the first frame.
     observation_frames : int
         Frames averaged for the observation, from the one picked (all before the first contact).
     workspace_lower, workspace_upper : (2,) float or None

@@ -122,7 +122,7 @@ def write_session(
     """Write a session that :func:`load_session` reads back exactly.
 
     ``session.yaml`` is written last, with ``n_pokes`` and the ``sha256`` manifest of every file
-    written before it (see ``docs/recording-format.md``).
+    written before it (``docs/recording-format.md``).
 
     Parameters
     ----------
@@ -132,9 +132,8 @@ def write_session(
     observation : PointCloud
         The initial observation, world frame, metres.
     presses : sequence of PressObservation
-        In order. Clouds and robot points are written in float64, so they read back bit for bit;
-        so is a press's force–travel record (in ``session.yaml``, or on the bag's
-        ``/deformap/press/force_travel``).
+        In order; clouds, robot points and force–travel records are written in float64 and read
+        back bit for bit.
     tip_radius_m : float, optional
         Defaults to the presses' (which must agree).
     ground_truth : GroundTruth, optional
@@ -153,8 +152,8 @@ def write_session(
 
     Notes
     -----
-    The format keeps one robot hull per poke: a press given one hull per part is written with
-    the points of all its parts, whose common hull covers them (a warning says so).
+    The format keeps one robot hull per poke: a press given one hull per part is written with the
+    points of all its parts (a warning says so).
     """
     out, presses, tip = _check_inputs(folder, workspace, observation, presses, tip_radius_m,
                                       format, cloud_format, ground_truth)  # fmt: skip

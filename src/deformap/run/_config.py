@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from deformap._config import config_from_dict, dump_yaml, load_yaml
+from deformap._config import config_from_dict, described_yaml, dump_yaml, load_yaml
 from deformap._validation import check_int, check_settings, setting
 from deformap.cloud.io import path_kind
 from deformap.errors import ConfigError
@@ -110,9 +110,10 @@ def load_run_config(path: str | Path | None) -> RunConfig:
     return config_from_dict(RunConfig, load_yaml(path), where=Path(path).name)
 
 
-def config_yaml(config: RunConfig) -> str:
-    """``config`` as the YAML of ``config.yaml`` (every field, in definition order)."""
-    return dump_yaml(config)
+def config_yaml(config: RunConfig, *, described: bool = False) -> str:
+    """``config`` as the YAML of ``config.yaml`` (every field, in definition order); with
+    ``described``, each setting under a comment giving its description, unit and bounds."""
+    return described_yaml(config) if described else dump_yaml(config)
 
 
 def apply_overrides(config: RunConfig, overrides: RunOverrides) -> RunConfig:

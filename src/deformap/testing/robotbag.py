@@ -1,14 +1,12 @@
-"""A bag as a robot's drivers record it, written with the ``mcap`` and ``mcap-ros2-support``
-packages (the ``test`` extra), not deformap's writer: for tests of ``deformap map BAG`` and of its
-reader (``tests/replay/test_raw_bag.py``, ``benchmarks/robustness.py``).
+"""A bag as a robot's drivers record it, written with the ``mcap`` and ``mcap-ros2-support`` packages
+(the ``test`` extra), not deformap's writer: for tests of ``deformap map BAG`` and of its reader.
 
 :func:`write_raw_bag` writes a recorded session's presses as a rig publishes them: an organised
-``PointCloud2`` in the camera's optical frame (NaN holes, packed rgb, each pixel blanked in some
+``PointCloud2`` in the camera's optical frame (NaN holes, packed rgb, pixels blanked in some
 frames), a ``WrenchStamped`` in a rotated sensor frame with the reaction force's sign, ``/tf``
-with the arm moving the tip along the press, and ``/tf_static`` for the camera mount; every stamp
-jittered. :func:`raw_settings` is the YAML beside it (this rig's frames and probe).
-:func:`copy_to_db3` writes such a bag's messages as a lone sqlite3 ``.db3`` with rosbags' rosbag2
-writer (the ``ros`` extra), the storage rosbag2 recorded by default before Iron.
+with the arm moving the tip along the press and ``/tf_static`` for the camera mount, every stamp
+jittered. :func:`raw_settings` is the YAML beside it. :func:`copy_to_db3` writes such a bag's
+messages as a lone sqlite3 ``.db3`` with rosbags' writer (the ``ros`` extra).
 """
 
 from __future__ import annotations

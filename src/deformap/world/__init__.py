@@ -1,12 +1,9 @@
-"""The simulated world: foam scenarios, finite-element ground truth, a depth camera and a probe.
+"""The simulated world: foam scenarios, physics ground truth, a depth camera and a probe.
 
-It implements :class:`deformap.environment.Environment` and never imports the estimator
-(``msm``, ``gp``, ``explore``): its ground truth is linear elasticity solved by finite elements,
-or (``WorldConfig(physics="stiffening-foam")``) a foam layer that stiffens as it is compressed,
-a two-parameter foundation solved by Newton's method, or (``physics="stiffening-fem"``) the
-finite elements of a continuum foam that stiffens as it is compressed, solved by Newton's method.
-Hertz contact and the hardness–modulus conversion live in :mod:`deformap.mechanics` (shared with
-the estimator, part of neither) and are re-exported here.
+It implements :class:`deformap.environment.Environment` and never imports the estimator (``msm``,
+``gp``, ``explore``), so accuracy figures are never circular; its physics is chosen by
+``WorldConfig.physics``. Hertz contact and the hardness–modulus conversion live in
+:mod:`deformap.mechanics` and are re-exported here.
 
 Quick start::
 

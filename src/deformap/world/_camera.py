@@ -1,19 +1,16 @@
 """A PrimeSense-like depth camera: ray casting plus the sensor's error model.
 
-The camera sits ``height_m`` above the table in front of the workspace (on its ``-y`` side) and
-looks at the workspace centre ``pitch_deg`` below the horizontal. Each of the ``width × height``
-pixels casts one ray (trimesh's Embree backend when ``embreex`` is installed, else the
-pure-numpy caster) into the scene: table, blocks' deformed surfaces and,
-while pressing, the probe. Then, per pixel, in this order:
+The camera sits ``height_m`` above the table on the workspace's ``-y`` side and looks at the
+workspace centre ``pitch_deg`` below the horizontal. Each pixel casts one ray (trimesh's Embree
+backend when ``embreex`` is installed, else the pure-numpy caster) into the table, the blocks'
+deformed surfaces and, while pressing, the probe. Then, per pixel, in this order:
 
 1. no return when the ray meets the surface at more than ``grazing_deg`` from its normal;
 2. flying pixels: where the depth jumps by more than ``edge_jump_m`` to the right or lower
    neighbour, with probability ``flying_probability`` the pixel takes a depth drawn uniformly
-   between
-   the two (the mixed returns of structured-light sensors at depth edges);
-3. axial noise ``σ_z = 1.2 mm + 1.9 mm·(z − 0.4 m)²`` (z in metres along the optical axis);
-4. disparity quantisation to ``1 / subpixel`` pixel:
-   ``z = f b / (round(f b / z · subpixel) / subpixel)``.
+   between the two (structured-light mixed returns);
+3. axial noise ``σ_z = sigma_base + sigma_quadratic·(z − sigma_reference)²`` (z along the axis);
+4. disparity quantisation: ``z = f b / (round(f b / z · subpixel) / subpixel)``.
 
 Points are returned in the world frame, one per valid pixel in row-major pixel order.
 
@@ -24,10 +21,8 @@ mapping applications. Sensors 12(2), 1437–1454.
 Nguyen, C. V., Izadi, S., Lovell, D. (2012). Modeling Kinect sensor noise for improved 3D
 reconstruction and tracking. 3DIMPVT.
 Grunnet-Jepsen, A., Sweetser, J. N., Woodfill, J. (2018). Best-known-methods for tuning Intel
-RealSense D400 depth cameras for best performance. Intel white paper, rev. 1.9 (depth RMS error
-``z² · subpixel / (f · b)`` with a subpixel RMS of about 0.08 pixel).
-Intel RealSense D400 series product family datasheet (2019): D435 depth field of view 87° × 58°,
-baseline 50 mm, 848 × 480 at 90 fps.
+RealSense D400 depth cameras for best performance. Intel white paper, rev. 1.9.
+Intel RealSense D400 series product family datasheet (2019).
 """
 
 from __future__ import annotations
@@ -56,7 +51,7 @@ class CameraConfig:
     Parameters
     ----------
     width, height : int
-        Pixels per row and per column; one ray each.
+        Pixels per row and per column of the image, one ray each.
     fov_deg : (2,) float, degrees
         Horizontal and vertical field of view, each in ``(0, 180)``.
     height_m : float, metres
@@ -67,7 +62,7 @@ class CameraConfig:
     noise : bool
         False turns off flying pixels, axial noise and quantisation.
     sigma_base_m, sigma_quadratic_m, sigma_reference_m : float, metres
-        Axial noise ``σ_z = sigma_base + sigma_quadratic·(z − sigma_reference)²``.
+        The terms of the axial noise ``σ_z = sigma_base + sigma_quadratic·(z − sigma_reference)²``.
     baseline_m : float, metres
         Projector–sensor baseline ``b`` of the disparity.
     subpixel : float

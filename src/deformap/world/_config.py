@@ -37,50 +37,53 @@ class WorldConfig:
     Parameters
     ----------
     physics : {"linear-fem", "stiffening-foam", "stiffening-fem"}
-        How the foam answers a press: linear elasticity of each block by finite elements; each
-        block as a foam layer that stiffens toward densification, a two-parameter foundation
-        whose contact with the tip is solved by Newton's method (:mod:`deformap.world._stiffening`);
-        or the same finite elements of a continuum foam whose volumetric response stiffens
-        toward densification, solved by Newton's method (:mod:`deformap.world._stiffening_fem`).
-        Every way a block's ``modulus_pa`` is its small-strain Young's modulus.
-    densification_strain, stiffening_exponent : float
-        The stiffening column law ``σ = M ε / (1 − ε / ε_d)^m`` (the stiffening physics only:
-        the layer's compression, the continuum foam's under confined compression): ``ε_d`` from
-        Gibson & Ashby's ``1 − 1.4 ρ*/ρ_s`` at a relative density of 0.035 (a flexible
-        polyurethane foam), ``m = 1`` their densification fit; ``m = 0`` is linear.
+        How the foam answers a press. Linear elasticity by finite elements, a stiffening
+        two-parameter foundation (:mod:`deformap.world._stiffening`), or finite elements of a foam
+        that stiffens toward densification (:mod:`deformap.world._stiffening_fem`); a block's
+        ``modulus_pa`` is its small-strain Young's modulus in each.
+    densification_strain : float
+        Densification strain ``ε_d`` of the stiffening law ``σ = M ε / (1 − ε / ε_d)^m`` (stiffening
+        physics only). 0.95 is Gibson & Ashby's ``1 − 1.4 ρ*/ρ_s`` for a flexible polyurethane foam
+        of relative density 0.035.
+    stiffening_exponent : float
+        Exponent ``m`` of that law; 1 is Gibson & Ashby's densification fit, 0 is linear.
     element_size_m : float
-        In-plane size of the foam's hexahedra. 7.5 mm resolves the dent of the 1 cm tip (the
-        press's compliance converges at second order under refinement,
-        ``tests/world/test_fem.py``) while a world stays quick to build (``deformap bench world``,
-        ``benchmarks/README.md``).
-    top_layer_m, layer_growth : float
-        Thickness of the top element layer and growth factor of the layers below it.
+        In-plane size of the foam's hexahedra. 7.5 mm resolves the dent of the 1 cm tip while a world
+        stays quick to build.
+    top_layer_m : float
+        Thickness of the top element layer.
+    layer_growth : float
+        Growth factor of the element layers' thickness below the top one.
     poisson_ratio : float
-    tip_radius_m, stick_length_m, stick_radius_m : float
-        The probe: spherical tip (1 cm, Optoforce-like), stick (10 cm long).
+        Poisson's ratio of every foam block.
+    tip_radius_m : float
+        Radius of the probe's spherical tip (1 cm, Optoforce-like).
+    stick_length_m : float
+        Length of the stick that holds the tip.
+    stick_radius_m : float
+        Radius of that stick.
     hand_size_m : (3,) float
         The box standing for the hand that holds the stick.
     force_noise_n : float
         Standard deviation per axis of the force sensor's noise (Optoforce-class resolution).
     force_travel_levels : int
-        Load levels of the press's force–travel record above contact: it has this many plus one
-        samples from ``contact_threshold_n`` to the commanded force, each solved by the world's
-        physics (see :mod:`deformap.world._force_travel`).
+        Load levels of the press's force–travel record above contact (the record has one more
+        sample), each solved by the world's physics (:mod:`deformap.world._force_travel`).
     force_travel_spacing : {"force", "travel"}
-        How those samples are spaced (:data:`RecordSpacing`): evenly in force (default), or
-        evenly in travel (more samples at small forces, where a soft foam's record stays within
-        the sphere's range).
+        How the record's samples are spaced (:data:`RecordSpacing`): evenly in force, or evenly in
+        travel.
     contact_threshold_n : float
-        The force at which the probe detects contact: the record's first sample, where its
-        travel starts. Presses at less than :data:`MIN_RECORD_FORCE_N` give no record.
+        The force at which the probe detects contact: the record's first sample, where travel starts.
     encoder_noise_m : float
-        Standard deviation of the arm's reading of the tip's position along the press direction
-        (joint encoders through forward kinematics), for the record's travel.
-    force_travel_noise_rel, force_travel_noise_n : float
-        Standard deviation of the record's force samples: ``rel · F + n`` at force ``F``.
+        Standard deviation of the arm's reading of the tip's position along the press direction.
+    force_travel_noise_rel : float
+        Relative part ``rel`` of the record's force noise ``rel · F + n`` at force ``F``.
+    force_travel_noise_n : float
+        Absolute part ``n`` of the record's force noise ``rel · F + n``.
     noise : bool
         False turns off every noise source (camera, force sensor, force–travel record) at once.
     camera : CameraConfig
+        The simulated depth camera.
     table_margin_m : float
         How far the table extends beyond the workspace on every side.
     """

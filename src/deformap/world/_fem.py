@@ -1,20 +1,15 @@
 """Linear elasticity of a foam block bonded to a rigid table, on a structured hexahedral mesh.
 
 A block is meshed as a tensor grid: uniform ``dx``, ``dy`` over the bounding box of its footprint
-and layers that grow geometrically from the top (where the probe presses) to the bottom (bonded to
-the table: all displacements zero). A column of hexes belongs to the block when its centre lies in
-the footprint, so slanted edges are resolved to the element size. Elements are trilinear
-(scikit-fem ``ElementHex1``, 8 nodes, 2×2×2 Gauss points) with a per-element Young's modulus.
+and layers that grow geometrically from the top to the bottom (bonded to the table: displacements
+zero). A column of hexes belongs to the block when its centre lies in the footprint. Elements are
+trilinear (scikit-fem ``ElementHex1``, 2×2×2 Gauss points) with a per-element Young's modulus.
 
-Structured assembly: every hex of one layer has the same shape, so its stiffness is one 24×24
-matrix computed by scikit-fem for a unit modulus, scaled by each element's modulus and scattered
-with numpy. This gives the same matrix as scikit-fem's generic ``asm`` (a test checks it) at a
-fraction of the cost. The stiffness is factorised once (SuperLU); a press then solves the unit
-responses of the few top nodes under the tip in one call (:class:`~deformap.world._foam.FoamModel`).
-A block of one modulus ``E`` has the stiffness ``E K₁`` of the unit-modulus block, so its solve is
-``K₁⁻¹ f / E``: the factorisation of ``K₁`` is kept (the most recent few, by the mesh's geometry,
-``ν`` and symmetry) and shared by every homogeneous block of that mesh — a study that presses one
-block geometry in several foams factorises once.
+Every hex of one layer has the same shape, so its stiffness is one 24×24 matrix computed by
+scikit-fem for a unit modulus, scaled per element and scattered with numpy (the same matrix as
+scikit-fem's ``asm``, which a test checks). The stiffness is factorised once (SuperLU). A block of
+one modulus ``E`` solves ``K₁⁻¹ f / E`` on the unit-modulus factorisation, kept (the most recent
+few, by geometry, ``ν`` and symmetry) and shared by every homogeneous block of that mesh.
 
 References
 ----------

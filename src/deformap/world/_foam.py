@@ -2,46 +2,27 @@
 
 Each foam block is its own :class:`~deformap.world._fem.FoamBody` (neighbouring blocks are separate
 pieces, not glued), factorised once when the world is built. A press puts the Hertz pressure of the
-commanded force on the top surface under the tip; the part of the patch that falls on rigid ground
-(a rigid board or the bare table) is carried by it and loads no foam.
+commanded force on the top surface under the tip; the part of the patch on rigid ground (a rigid
+board or the bare table) is carried by it and loads no foam.
 
-Indentation: inside the contact the surface follows the rigid sphere, ``u(r) = δ − r² / (2R)``, so
-averaging with the Hertz pressure as weight gives ``δ = ū_p + <r²>_p / (2R) = ū_p + 0.2 a² / R``,
-where ``ū_p`` is the pressure-weighted mean FEM displacement (the load's work-conjugate, which
-converges at second order under mesh refinement and does not depend on where the target falls
-between nodes, unlike the displacement interpolated at the target).
+Indentation: inside the contact the surface follows the sphere, ``u(r) = δ − r² / (2R)``, so
+weighting by the Hertz pressure gives ``δ = ū_p + 0.2 a² / R``, ``ū_p`` the pressure-weighted mean
+FEM displacement (the load's work-conjugate, which converges at second order under refinement and
+does not depend on where the target falls between nodes). After the solve the top nodes inside the
+contact disc are put on the tip's cap, so the surface the camera sees agrees with the tip.
 
-Contact: after the solve, the top nodes inside the contact disc are put on the tip's lower cap
-(``u_z = −δ + R − sqrt(R² − r²)``), since there the foam touches the rigid tip. On a mesh coarser
-than the patch the nodal solution overshoots or undershoots the cap; this projection keeps the
-surface the camera sees consistent with the tip it sees.
+Patch radius: the foam is a layer bonded to the table, stiffer than Hertz's half-space, so the
+press iterates ``a ← sqrt(a · sqrt(R δ_FEM))`` (a damped fixed point of ``a² = R δ``) from the Hertz
+value until ``a`` changes by less than 2 %, never beyond the tip radius; each solve tells on which
+side of the fixed point ``a`` lies, and a step that would leave that bracket bisects it, so the
+iteration ends within the tolerance even where ``δ(a)`` jumps at a seam between blocks. Since
+``δ(a; F)`` grows with ``F``, a press solved at several loads (the force–travel record) passes the
+radius of the load above as ``max_radius_m``, the upper end of the bracket.
 
-Patch radius: Hertz's ``a`` assumes a half-space, but the foam is a layer bonded to the table and
-responds stiffer, so the tip sinks less than Hertz says and touches a smaller disc. The press
-therefore iterates ``a ← sqrt(a · sqrt(R δ_FEM))`` (a damped fixed point of the sphere's geometric
-relation ``a² = R δ``) from the Hertz value until ``a`` changes by less than 2 %, and never lets
-``a`` exceed the tip radius ``R``. The iteration is safeguarded: each solve tells on which side of
-the fixed point ``a`` lies (``sqrt(R δ(a)) > a``: the patch must grow), so the radii tried keep a
-bracket around it, and a step that would leave the bracket bisects it instead; where ``δ(a)``
-jumps (near a seam between blocks the load samples cross into the next block as the patch grows)
-the plain iteration can oscillate, and the bracket still ends within the tolerance. It does not
-make ``δ`` continuous there: a press by a seam can still solve shallower at a larger force (by
-0.3–0.9 mm on the default mesh), and past the encoder's tolerance
-:meth:`deformap.world.SimulatedWorld.force_travel` gives no record.
-
-Solves: the linear FEM's press loads only the vertical unknowns of the top nodes under the tip, so
-at a press's first solve it solves their unit responses ``K⁻¹ e_z`` for every top node of a cell
-the tip's disc reaches (some 15–25 on the default mesh) in one call with several right-hand sides,
-and every patch iteration and load level of that press is a sum of them (equal to a solve per load
-to rounding: ``tests/world/test_fem.py``); :meth:`FoamModel.forget` drops them at the next press.
-On the default world this took a press with its force–travel record from about 0.75 s to 0.2 s of
-solves (:data:`MAX_UNIT_COLUMNS`).
-
-Loading: the indentation of a rigid sphere pressed into a linear elastic body grows with the
-force, and so does its contact disc. ``δ(a; F)`` grows with ``F`` at every ``a``, so the largest
-fixed point at a smaller force lies within it at a larger one: a press solved at several loads
-(the force–travel record) passes the radius of the load above as ``max_radius_m``, the upper end
-of the bracket.
+Solves: a press loads only the vertical unknowns of the top nodes under the tip, so its first
+solve computes their unit responses ``K⁻¹ e_z`` in one multi-right-hand-side call, and every patch
+iteration and load level of that press is a sum of them (:data:`MAX_UNIT_COLUMNS`);
+:meth:`FoamModel.forget` drops them at the next press.
 """
 
 from __future__ import annotations
@@ -60,13 +41,10 @@ __all__ = ["Dent", "FoamMesh", "FoamModel", "block_grid"]
 
 log = logging.getLogger(__name__)
 
-# A press loads only the top nodes under the tip, and only vertically: the linear FEM solves their
-# unit responses ``K⁻¹ e_z`` in one call with several right-hand sides (SuperLU passes its factors
-# once for all of them: about 7 ms a column at 20 columns against 25 ms for a single solve, on the
-# default mesh's 22 k unknowns, one thread), and each patch iteration and load level of the press
-# is then a product with them. Where more nodes than this lie under the tip (a fine mesh) the
-# columns would cost more than the solves they replace, and each load is solved as it comes; so
-# too past MAX_UNIT_BYTES of columns a body (a fine mesh's long columns).
+# A press's unit responses ``K⁻¹ e_z`` are solved in one multi-right-hand-side call (SuperLU passes
+# its factors once for all of them); where more nodes than this lie under the tip, or past
+# MAX_UNIT_BYTES of columns a body (a fine mesh), the columns would cost more than the solves they
+# replace, and each load is solved as it comes.
 MAX_UNIT_COLUMNS = 48
 MAX_UNIT_BYTES = 64 * 2**20
 

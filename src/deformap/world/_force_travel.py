@@ -1,27 +1,20 @@
 """The force–travel record of a simulated press, from the world's own physics.
 
 A real arm records, from first contact to the commanded force, the tip's travel along the press
-direction (joint encoders through forward kinematics) and the normal force (the force sensor);
-``docs/robot.md`` says how. The simulated world gives the same record from its physics
-(``WorldConfig.physics``; said here for the FEM, the foundation's press is alike):
+direction (encoders through forward kinematics) and the normal force (``docs/robot.md``). The
+simulated world gives the same record from its physics (``WorldConfig.physics``):
 
-- Load levels: ``n_levels + 1`` forces from the contact threshold ``F_c`` (the force at which a
-  robot detects contact, its first sample) to the commanded force ``F``, evenly spaced in force
-  (a force ramp) or in travel (an arm at constant speed: :func:`force_levels`).
-- Travel: the foam's contact patch grows with the force (a sphere on an elastic layer), so each
-  level is its own press solve (:meth:`~deformap.world._foam.FoamModel.dent`), on the stiffness
-  factorised when the world was built, each started from the patch of the level above it (so
-  one or two solves a level); the commanded level is the press's own dent. The tip's
-  true descent at level ``k`` is the dent depth ``δ(F_k)``; on rigid ground it is 0.
-- Sensor noise, as a real arm's: the encoders read the tip's position with an error of
-  ``encoder_noise_m`` at every sample, and the travel is the position minus the position at first
-  contact (so the first travel is exactly 0, and every later one carries the difference of two
-  errors); the force sensor reads ``F_k`` with an error of ``rel · F_k + abs`` (one standard
-  deviation). A rigid board therefore gives a travel of encoder noise around zero.
+- Load levels: ``n_levels + 1`` forces from the contact threshold ``F_c`` (the first sample) to
+  the commanded force ``F``, evenly spaced in force or in travel (:func:`force_levels`).
+- Travel: each level is its own press solve (:meth:`~deformap.world._foam.FoamModel.dent`), on the
+  stiffness factorised when the world was built, started from the patch of the level above; the
+  true descent at level ``k`` is the dent depth ``δ(F_k)``, 0 on rigid ground.
+- Noise: the encoders read the tip's position with an error of ``encoder_noise_m`` at every
+  sample and the travel is the position minus the position at first contact (so the first travel
+  is exactly 0); the force sensor reads ``F_k`` with an error of ``rel · F_k + abs`` (one standard
+  deviation). A rigid board gives a travel of encoder noise around zero.
 
-The noise comes from a generator of its own (the world keys it by the press, apart from the
-camera's and the contact's), so the record adds draws without moving any draw the press made
-before it existed.
+The noise comes from a generator of its own, so the record moves no draw the press made.
 """
 
 from __future__ import annotations

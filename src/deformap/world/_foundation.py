@@ -2,60 +2,34 @@
 force-controlled contact with it solved by Newton's method (the physics of
 :mod:`deformap.world._stiffening`).
 
-Layer theory (Vlasov & Leontiev 1966; Vallabhan & Das 1988)
------------------------------------------------------------
-Each foam block of thickness ``H`` bonded to the rigid table deforms as
-``u(x, y, z) = (0, 0, −w(x, y) φ(z))``: vertical displacement only, the surface deflection ``w``
-(positive down) times a mode shape ``φ`` from 0 at the table (``z = 0``) to 1 at the top.
-Integrating the strain energy of that field through the thickness gives a two-parameter
-(Pasternak) foundation,
+Layer theory (Vlasov & Leontiev 1966; Vallabhan & Das 1988). A block of thickness ``H`` bonded to
+the table deforms as ``u = (0, 0, −w(x, y) φ(z))``, the surface deflection ``w`` (positive down)
+times a mode shape ``φ`` from 0 at the table to 1 at the top. Integrating the strain energy
+through the thickness gives a Pasternak foundation
 
     Π[w] = ∫ Φ(w) dA + ½ G_p ∫ |∇w|² dA,
 
-whose compression is carried at the constrained (oedometric) modulus
-``M = E (1 − ν) / ((1 + ν)(1 − 2ν))`` (lateral strain suppressed by the kinematics), with the
-strain ``ε(z) = w φ'(z)``, so ``Φ'(w) = p(w) = ∫ σ(w φ') φ' dz`` and the small-strain spring
-modulus ``k = M ∫ φ'² dz`` [Pa/m], and whose shear layer (shear modulus
-``G = E / (2 (1 + ν))``) gives ``G_p = G ∫ φ² dz`` [N/m]. ``E`` is the block's ``modulus_pa``: the
-small-strain Young's modulus stays the world's ground truth.
+with compression at the constrained modulus ``M = E (1 − ν) / ((1 + ν)(1 − 2ν))`` and strain
+``ε = w φ'``, so ``Φ'(w) = p(w) = ∫ σ(w φ') φ' dz`` (small-strain spring ``k = M ∫ φ'² dz``,
+Pa/m), and shear ``G_p = G ∫ φ² dz`` (N/m, ``G = E / (2 (1 + ν))``). ``E`` is the block's
+``modulus_pa``. The mode shape is the modified Vlasov model's ``φ = sinh(γ z / H) / sinh γ``, with
+``(γ / H)² = (G / M) ∫ |∇w|² dA / ∫ w² dA`` iterated on the solved surface to 1 %, so that a
+thick layer under a small tip tends to a depth-independent limit as an elastic layer does. The
+influence length ``ℓ = sqrt(G_p / k)`` is how far a dent spreads beyond the tip. A restricted
+displacement field is stiffer than the elastic solid (Ritz): at small strain the tip
+sinks less than in a half-space of the same ``E``.
 
-The mode shape is the modified Vlasov model's, ``φ = sinh(γ z / H) / sinh γ``, with ``γ`` fixed by
-the solved surface itself, ``(γ / H)² = (G / M) ∫ |∇w|² dA / ∫ w² dA`` (the condition that makes
-the small-strain energy stationary in ``φ`` as well; Vallabhan & Das 1988): the press iterates it to 1 %.
-A dent much narrower than the layer (the 1 cm tip on 3–10 cm of foam) then decays within about
-its own width below the surface, so a thicker layer is softer and tends to a depth-independent
-limit, as an elastic layer does; the linear ``φ = z / H`` of Vlasov's first model would instead
-make a thick layer stiffer in shear under a small tip (``G_p = G H / 3``). The influence length
-``ℓ = sqrt(G_p / k)`` is how far a dent spreads beyond the tip (about the contact radius here).
-A restricted displacement field is stiffer than the elastic solid (Ritz): at small strain the
-tip sinks less than in a half-space of the same ``E`` (Hertz).
+Stiffening (Gibson & Ashby 1997, ch. 5): ``σ(ε) = M ε / (1 − ε / ε_d)^m`` for ``ε ≥ 0`` (linear in
+extension), ``ε_d`` the world's ``densification_strain`` and ``m`` its ``stiffening_exponent``;
+``p(w)`` is integrated through the thickness by 32-point Gauss–Legendre. The plateau of
+elastomeric foams is left out: this physics lies on the stiff side of linear elasticity.
 
-Stiffening (Gibson & Ashby 1997, ch. 5)
----------------------------------------
-Compressing a foam toward densification brings its cell walls into contact and the stress rises
-without bound as the strain nears the densification strain ``ε_d``. The law is
-
-    σ(ε) = M ε / (1 − ε / ε_d)^m      (ε ≥ 0; linear ``M ε`` in extension),
-
-with ``ε_d`` the world's ``densification_strain`` (Gibson & Ashby: ``ε_D ≈ 1 − 1.4 ρ*/ρ_s``;
-0.95 for a flexible polyurethane foam of relative density 0.035) and ``m`` its
-``stiffening_exponent`` (their densification fit has ``m ≈ 1``; ``m = 0`` is linear). The strain
-is largest at the top, ``w φ'(H)``; ``p(w)`` is integrated through the thickness by 32-point
-Gauss–Legendre, and the deflection is held below the quadrature's densification limit. The
-plateau of elastomeric foams (elastic buckling of the cell walls) is left out: this physics lies
-on the stiff side of linear elasticity.
-
-Contact, force control, Newton
-------------------------------
-The rigid sphere of radius ``R`` sinks ``δ`` below the rest surface; a surface point at distance
-``r`` from the target may not pass the tip's lower cap: ``w ≥ δ − c(r)``, ``c = R − sqrt(R² − r²)``
-(Signorini conditions, with a non-negative contact force where equality holds). The press
-commands the force ``F``, so ``δ`` is an unknown and ``Π[w] − F δ`` is minimised. Discretised on a
-tensor grid of bilinear elements (lumped spring term, consistent shear term), the active set of
-nodes in contact ties ``w = δ − c`` there and Newton's method solves for ``δ`` and the free
-deflections; after each step, nodes that penetrate the tip join the active set and nodes whose
-contact force pulls leave it (a primal–dual active-set method, Hintermüller, Ito & Kunisch 2002).
-Steps are shortened so that no strain reaches ``ε_d``.
+Contact: the rigid sphere of radius ``R`` sinks ``δ`` below the rest surface and a surface point
+at distance ``r`` may not pass its cap, ``w ≥ δ − (R − sqrt(R² − r²))`` (Signorini). The press
+commands the force ``F``, so ``δ`` is an unknown and ``Π[w] − F δ`` is minimised on a tensor grid
+of bilinear elements (lumped spring, consistent shear) by Newton's method with a primal–dual
+active set (Hintermüller, Ito & Kunisch 2002); steps are shortened so that no strain reaches
+``ε_d``.
 
 References
 ----------

@@ -1,21 +1,16 @@
 """Seeded layout families: how a rectangular workspace is cut into the footprints of pieces.
 
-Each family draws from the generator it is given and returns :class:`Piece` footprints that tile
-the workspace, each with the index of the *material* it is made of (pieces of one material are
-separate blocks laid side by side, as a checker's diagonal squares are):
+Each family draws from the generator it is given and returns :class:`Piece` footprints (``(k, 2)``
+vertices in metres) that tile the workspace, each with the index of its material (pieces of one
+material are separate blocks side by side):
 
-* ``cuts``: 2–4 convex pieces by straight cuts at random angles through random points of the
-  largest remaining piece, each keeping at least ``min_area_fraction`` of the area.
-* ``insert``: a disc or an ellipse (random semi-axes and angle) of one material inside another:
-  the outer piece is the workspace with the ellipse as its hole.
-* ``l-shape``: an L-shaped piece along two sides meeting at a random corner, one piece although
-  not convex; the rest is a rectangle.
+* ``cuts``: 2–4 convex pieces by straight cuts at random angles through the largest remaining
+  piece, each keeping at least ``min_area_fraction`` of the area.
+* ``insert``: a disc or an ellipse of one material inside another (the outer piece has it as a hole).
+* ``l-shape``: an L-shaped piece along two sides meeting at a random corner; the rest a rectangle.
 * ``checker``: four blocks about a random point near the centre, two materials alternating.
 * ``stripes``: 3–5 parallel stripes at a random angle, two or three materials in turn.
-* ``non-convex``: a U open toward the far side, or a star-shaped blob inside the workspace; the
-  non-convex piece is one piece, and so is the rest around it.
-
-Polygons are ``(k, 2)`` float vertices in metres (:mod:`deformap.world._polygon`).
+* ``non-convex``: a U open toward the far side, or a star-shaped blob, and the rest around it.
 """
 
 from __future__ import annotations

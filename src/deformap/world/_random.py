@@ -1,11 +1,9 @@
 """Seeded random heterogeneous worlds for benchmarks over many layouts.
 
-A layout family (:mod:`deformap.world._layouts`: straight ``cuts``, an ``insert``, an ``l-shape``,
-a ``checker``, ``stripes``, a ``non-convex`` piece) cuts the workspace into pieces, each made of
-one of a few materials. Each material gets a hardness drawn uniformly from the foam range (60–150 N
-by default, at least ``min_hardness_gap_n`` apart so that materials differ), and with probability
-``p_rigid`` one material is a rigid board instead. The default family, ``cuts``, draws exactly what
-this generator drew before the other families existed.
+A layout family (:mod:`deformap.world._layouts`) cuts the workspace into pieces, each made of one
+of a few materials. Each material gets a hardness drawn uniformly from the foam range, at least
+``min_hardness_gap_n`` apart, and with probability ``p_rigid`` one material is a rigid board
+instead.
 """
 
 from __future__ import annotations

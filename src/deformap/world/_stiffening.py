@@ -1,26 +1,19 @@
 """A second contact physics: each foam block a layer that stiffens as it is compressed, a
 two-parameter foundation whose contact with the tip is solved by Newton's method
 (:mod:`deformap.world._foundation`), behind the interface the world uses from the FEM
-(:class:`~deformap.world._foam.FoamModel`).
+(:class:`~deformap.world._foam.FoamModel`). It is of another kind than the estimator's Hertz
+half-space with a bonded-layer correction, so the estimator is checked on a physics it was not
+derived on.
 
-The world's first physics is 3-D linear elasticity. This one is of another kind, so that the
-estimator (derived from a Hertz half-space with a bonded-layer correction) is checked on a
-physics it was not derived on.
+Grid: spacing ``a / 6`` over a core of ±2 ``a`` around the target (``a`` the expected contact
+radius; re-gridded when the solved disc spans fewer than 4 or more than 9 cells), cells growing by
+1.2 outside it out to 8 ``ℓ`` beyond the core, cut at the block's free edge. Only the block under
+the target is loaded. Valid while the tip sinks less than its radius (beyond it the stick would
+touch the foam; the press still solves, with the sphere alone).
 
-Grid: uniform spacing ``s = a / 6`` over a core of ±2 ``a`` around the target (``a`` the contact
-radius expected; the press re-grids when the solved disc spans fewer than 4 or more than 9 cells),
-cells growing by 1.2 outside it out to 8 ``ℓ`` beyond the core, cut at the block's edge (a free
-edge: neighbouring blocks are separate, not glued). Only the block under the target is loaded; a
-tip overhanging a neighbour is not stopped by it.
-
-Range: the tip sinks less than its radius (beyond it, the stick would touch the foam; the press
-still solves, with the sphere alone). Under the 1 cm tip on the default world the presses of 0.3
-to 3 N on the 250 N foam, and of 0.3 to 0.6 N on the 30 N foam, lie in it; 3 N on the 30 N foam
-does not (the tip sinks 14–19 mm).
-
-The press settles three things together, a few Newton steps a round, then solves in full: the
-grid (re-graded while the contact disc is off its core), the mode shape's ``γ`` (to 1 %) and the
-contact. The camera's mesh (the FEM's hexahedra, not solved) is displaced by ``u_z = −w φ(z)``.
+The press settles the grid, the mode shape's ``γ`` (to 1 %) and the contact together, a few
+Newton steps a round, then solves in full. The camera's mesh (the FEM's hexahedra, not solved) is
+displaced by ``u_z = −w φ(z)``.
 """
 
 from __future__ import annotations

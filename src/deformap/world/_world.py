@@ -1,34 +1,16 @@
 """The simulated world: scenario + foam physics + depth camera + probe, as an ``Environment``.
 
-Physics
--------
-``WorldConfig.physics`` picks how the foam answers a press: 3-D linear elasticity by FEM
-(:mod:`deformap.world._foam`, the default), a stiffening two-parameter foundation solved by
-Newton's method (:mod:`deformap.world._stiffening`), or the FEM of a continuum foam that stiffens
-as it is compressed, solved by Newton's method (:mod:`deformap.world._stiffening_fem`). All
-displace the same hexahedral mesh, which is what the camera sees, and all give the press's depth
-for the force–travel record.
+``WorldConfig.physics`` picks how the foam answers a press (:mod:`deformap.world._foam`,
+:mod:`deformap.world._stiffening`, :mod:`deformap.world._stiffening_fem`); each displaces the same
+hexahedral mesh, which the camera sees, and gives the press's depth for the force–travel record.
+The world owns no press force: it is pressed with the force its caller commands.
 
-Press force
------------
-The world is pressed with whatever force its caller commands (``press(target_xy, force_n)``); it
-owns no press force of its own. The exploration's (``ExplorationConfig.force_n``, 0.6 N) keeps a
-spherical-tip contact on every foam of the paper's range; the world's tests check that it dents
-every foam by more than the camera's noise and by less than half of the block
-(``tests/world/test_fem.py``).
-
-Force–travel record
--------------------
-Each press also returns its force–travel record (``PressObservation.force_travel``): the physics
-solved at ``force_travel_levels`` loads from the contact threshold to the commanded force, with the
-noise of arm encoders and a force sensor, drawn from a stream of its own so that the press's other
-draws (contact force, clouds) are those of a world without the record
+Each press also returns its force–travel record (``PressObservation.force_travel``), drawn from a
+noise stream of its own so that the press's other draws are those of a world without the record
 (:mod:`deformap.world._force_travel`).
 
-Ground truth
-------------
-Labels are block indices (``-1`` = bare table). Hardness and modulus are ``inf`` on rigid blocks and
-on the bare table (neither deforms).
+Ground truth labels are block indices (``-1`` = bare table); hardness and modulus are ``inf`` on
+rigid blocks and the bare table.
 """
 
 from __future__ import annotations
@@ -83,16 +65,15 @@ class SimulatedWorld:
     scenario : Scenario
     config : WorldConfig
     rng : numpy.random.Generator
-        Source of the camera and force-sensor noise; the same seed gives the same clouds. One
-        number is drawn from it at construction; each event then draws its noise from a stream
-        keyed by that number and the event itself (the n-th observation at rest; a press by its
-        target and force). So the noise of a press does not depend on what happened before it,
-        and a killed run that is resumed sees exactly the noise the uninterrupted run saw.
+        Source of the camera and force-sensor noise. One number is drawn from it at construction;
+        each event then draws from a stream keyed by that number and the event (the n-th observation
+        at rest; a press by its target and force), so a resumed run sees the noise the uninterrupted
+        run saw.
 
     Notes
     -----
-    Building the world meshes and factorises every foam block (the slow part); each press is then
-    one to a few solves. ``observe`` during a press shows the pressed scene, probe included.
+    Building the world meshes and factorises every foam block; each press is then one to a few
+    solves. ``observe`` during a press shows the pressed scene, probe included.
     """
 
     def __init__(self, scenario: Scenario, *, config: WorldConfig | None = None,

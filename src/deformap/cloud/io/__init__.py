@@ -1,20 +1,16 @@
 """Point-cloud files and ROS 2 bags in and out.
 
-Readers return clouds in metres and refuse what they cannot read faithfully: truncated or corrupted
-files, missing x/y/z, NaN points (unless ``drop_nan=True``), empty clouds, and clouds that look like
-millimetres (unless ``units="mm"``). Every refusal is a :class:`~deformap.errors.FileFormatError`
-that names the file and what was wrong. No file is ever read with pickle.
+Readers return clouds in metres and refuse what they cannot read faithfully (truncated or corrupt
+files, missing x/y/z, NaN points unless ``drop_nan=True``, empty clouds, clouds that look like
+millimetres unless ``units="mm"``) with a :class:`~deformap.errors.FileFormatError` naming the file.
+Every size a header declares is checked against the bytes present before anything is allocated,
+and a body larger than its header declares is refused, not cut. No file is read with pickle.
 
-Every size a header declares (a point count, a record size, a compressed length, an array's
-shape) is checked against the bytes present before anything is allocated, and a binary body that
-holds more data than its header declares is refused, not cut (``_common.check_body_size``).
-
-Formats: PCD (ascii, binary, binary_compressed; through pypcd4), PLY (ascii, binary either byte
-order; numpy), NPZ (``points``, ``colors``; at most :data:`MAX_NPZ_BYTES` once decompressed), and
-ROS 2 bags (sqlite3 and MCAP; through the optional ``rosbags``, extra ``ros``) with
-``sensor_msgs/msg/PointCloud2`` and ``geometry_msgs/msg/WrenchStamped``. :func:`iter_bag_messages`
-is the one place a bag is opened and read, :func:`bag_writer` the one place one is written;
-:func:`pointcloud2_to_cloud` turns a message into a cloud under the file readers' rules.
+Formats: PCD (pypcd4), PLY (ascii and binary; numpy), NPZ (``points``, ``colors``; at most
+:data:`MAX_NPZ_BYTES` decompressed), and ROS 2 bags (sqlite3 and MCAP, through the optional
+``rosbags``, extra ``ros``) of ``sensor_msgs/msg/PointCloud2`` and
+``geometry_msgs/msg/WrenchStamped``. :func:`iter_bag_messages` is the one place a bag is read,
+:func:`bag_writer` the one place one is written.
 """
 
 from __future__ import annotations

@@ -92,11 +92,9 @@ def check_body_size(
 ) -> None:
     """Refuse a data section whose size disagrees with what its header declares.
 
-    Every reader calls this with the byte count its header implies (a count times a record size,
-    both plain Python integers) *before* it allocates anything for the data, so that a forged
-    count cannot ask for gigabytes, a truncated file is refused, and (``exact``) a count lowered
-    by a corruption does not silently drop the surplus. Surplus bytes that are all ASCII
-    whitespace are tolerated (some writers end the file with a newline).
+    Called with the byte count the header implies *before* anything is allocated for the data, so
+    that a forged count cannot ask for gigabytes, a truncated file is refused and (``exact``) a count
+    lowered by corruption does not silently drop the surplus. Surplus ASCII whitespace is tolerated.
 
     Parameters
     ----------
@@ -108,13 +106,12 @@ def check_body_size(
     need : int
         Bytes the header declares.
     body : bytes or int
-        The bytes present for that section (to the end of the file), or only their number
-        (then any surplus is refused).
+        The bytes present for that section, or only their number (then any surplus is refused).
     exact : bool
         Refuse surplus bytes too (else only a shortfall).
     text : bool
-        The section is text (an ascii body). A binary section made only of the bytes of ascii
-        numbers is refused as an ascii body under a binary header.
+        The section is text; a binary section made only of ascii numbers is refused as an ascii
+        body under a binary header.
     """
     have = body if isinstance(body, int) else len(body)
     if (not text and not isinstance(body, int) and have >= _TEXT_MIN_BYTES
