@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 
 from deformap.world import Block, Scenario, SimulatedWorld, WorldConfig, hertz_pressure_samples
+from deformap.world._densification import strain_operator, volumetric_stress, volumetric_tangent
 from deformap.world._fem import FoamBody, HexGrid, graded_levels
 from deformap.world._foam import FoamModel
-from deformap.world._densification import strain_operator, volumetric_stress, volumetric_tangent
 from deformap.world._stiffening_fem import StiffeningFem
 
 R = 0.01  # the tip's radius
