@@ -136,7 +136,7 @@ def test_layered_rotation_term_matches_the_per_cluster_sum(rng):
 
 
 def test_fast_polar_rotation_matches_the_svd_polar(rng):
-    from deformap.msm._clusters import fast_polar_rotation
+    from deformap.msm._polar import fast_polar_rotation
 
     a = rng.normal(size=(300, 3, 3))
     a[:100] = np.eye(3) + 0.05 * a[:100]  # near rotations, as in a converging solve
@@ -150,7 +150,7 @@ def test_fast_polar_rotation_matches_the_svd_polar(rng):
 def test_fast_polar_rotation_falls_back_to_svd_when_newton_stops_early(rng, max_iter):
     # every matrix is safe for Newton, but the iteration budget ends before convergence: the
     # unconverged ones must get the SVD answer of the *input*, not of a half-updated iterate
-    from deformap.msm._clusters import fast_polar_rotation
+    from deformap.msm._polar import fast_polar_rotation
 
     a = np.eye(3) + 0.5 * rng.normal(size=(200, 3, 3))
     a = a[np.linalg.det(a) > 0.1]

@@ -14,7 +14,7 @@ file, an over-long name). A command with neither is left out. This suite found `
 /dev/zero`` replacing the device node with a JSON file (run as root) and ``config dump --out ""``
 ending in a traceback.
 
-The generator, the guard and the judge are ``benchmarks/_cli_mutants.py``'s, which
+The generator, the guard and the judge are :mod:`deformap.testing.cli_mutants`'s, which
 ``benchmarks/robustness.py --cli-mutants N`` runs at a larger count (values generated beyond the
 fixed pools); here five of the pools' values per option.
 """
@@ -22,19 +22,18 @@ fixed pools); here five of the pools' values per option.
 from __future__ import annotations
 
 from pathlib import Path
-from types import ModuleType
 
 import pytest
 import typer
 from typer.testing import CliRunner
 
 from deformap.cli import app
+from deformap.testing import cli_mutants as cm
 
 PER_OPTION = 5  # values drawn per option (seeded); every value class appears over the options
 
 
-def test_every_option_of_every_command_refuses_hostile_values(cm: ModuleType,
-                                                              tmp_path: Path) -> None:
+def test_every_option_of_every_command_refuses_hostile_values(tmp_path: Path) -> None:
     paths = cm.hostile_paths(tmp_path)
     mutants = cm.cli_mutants(paths, PER_OPTION, seed=20261125)
     assert len(mutants) >= 300  # every command with a guard, every option (about 75 options)
@@ -51,7 +50,7 @@ def test_every_option_of_every_command_refuses_hostile_values(cm: ModuleType,
     assert not failures, f"{len(failures)} of {len(mutants)} mutants:\n" + "\n".join(failures[:20])
 
 
-def test_generated_values_are_seeded_and_of_every_class(cm: ModuleType, tmp_path: Path) -> None:
+def test_generated_values_are_seeded_and_of_every_class(tmp_path: Path) -> None:
     paths = cm.hostile_paths(tmp_path)
     first = cm.cli_mutants(paths, 30, seed=1)
     assert first == cm.cli_mutants(paths, 30, seed=1) != cm.cli_mutants(paths, 30, seed=2)
@@ -60,7 +59,7 @@ def test_generated_values_are_seeded_and_of_every_class(cm: ModuleType, tmp_path
     assert sole and all(m.kind.startswith("path") for m in sole)  # a sole guard: destinations
 
 
-def test_the_guards_alone_refuse_before_any_work(cm: ModuleType, tmp_path: Path) -> None:
+def test_the_guards_alone_refuse_before_any_work(tmp_path: Path) -> None:
     # the guard must be what stops a mutant whose value happened to be valid
     paths = cm.hostile_paths(tmp_path)
     result = CliRunner().invoke(app, ["explore", "--out", paths["file"]])
@@ -80,8 +79,7 @@ def test_a_bad_number_names_its_option(value: str, tmp_path: Path) -> None:
 NON_FINITE = ("nan", "inf", "-inf", "1e400")
 
 
-def test_every_number_option_refuses_non_finite_values_itself(cm: ModuleType,
-                                                               tmp_path: Path) -> None:
+def test_every_number_option_refuses_non_finite_values_itself(tmp_path: Path) -> None:
     """Without a guard: a float option given NaN or an infinity must be refused naming that
     option (or by the parser), before any folder; accepted, the command would go on to its work
     and the alarm would say so. This catches what the guard above can mask (a value refused

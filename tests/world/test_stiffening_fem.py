@@ -8,14 +8,10 @@ import numpy as np
 import pytest
 
 from deformap.world import Block, Scenario, SimulatedWorld, WorldConfig, hertz_pressure_samples
+from deformap.world._densification import strain_operator, volumetric_stress, volumetric_tangent
 from deformap.world._fem import FoamBody, HexGrid, graded_levels
 from deformap.world._foam import FoamModel
-from deformap.world._stiffening_fem import (
-    StiffeningFem,
-    strain_operator,
-    volumetric_stress,
-    volumetric_tangent,
-)
+from deformap.world._stiffening_fem import StiffeningFem
 
 R = 0.01  # the tip's radius
 CENTER = np.array([0.15, 0.1])

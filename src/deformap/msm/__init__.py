@@ -33,10 +33,10 @@ Deformable Surfaces using Gaussian Processes and Position-based Dynamics. IEEE-R
 from __future__ import annotations
 
 from deformap.msm._beta import BetaEstimate, estimate_beta, matching_error
-from deformap.msm._clusters import polar_rotation
 from deformap.msm._config import ShapeMatchingConfig
 from deformap.msm._grid import ParticleGrid
 from deformap.msm._poke import PokeSimulation
+from deformap.msm._polar import polar_rotation
 from deformap.msm._simulate import shape_matching_goals, simulate_poke
 
 __all__ = [

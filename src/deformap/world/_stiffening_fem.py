@@ -1,36 +1,7 @@
-"""A third contact physics: the FEM's foam blocks made of a continuum foam that stiffens as it is
-compressed toward densification, solved by Newton's method
-(``WorldConfig(physics="stiffening-fem")``).
+"""The stiffening-FEM physics solved: the FEM's foam blocks made of the foam that stiffens toward
+densification (``WorldConfig(physics="stiffening-fem")``; its law and strain operator are
+:mod:`deformap.world._densification`), each press's equilibrium found by Newton's method.
 
-Material
---------
-A small-strain elastic solid whose volumetric response stiffens toward densification. Each hex
-``e`` of the FEM's mesh (:mod:`deformap.world._fem`) has the strain energy
-
-    W_e(u) = ½ uₑᵀ Kₑ(E₀) uₑ + V_e Φ(ε_e),     Φ'(ε) = M₀ ε [(1 − ε/ε_d)^(−m) − 1]  (ε > 0),
-
-``Kₑ(E₀)`` the linear FEM's element stiffness at the block's small-strain modulus ``E₀``
-(``modulus_pa``, the world's ground truth), ``ε_e = −(1/V_e) ∫ div u dV`` the element's mean
-compressive volumetric strain (linear in its 24 displacements: ``ε_e = cₑ · uₑ``),
-``M₀ = E₀ (1 − ν) / ((1 + ν)(1 − 2ν))`` the constrained modulus, ``ε_d`` the world's
-``densification_strain`` and ``m`` its ``stiffening_exponent``; ``Φ = 0`` in dilatation
-(``ε ≤ 0``). Under confined (uniaxial-strain) compression ``ε`` is the axial strain and the
-stress is the column law ``σ = M₀ ε / (1 − ε/ε_d)^m`` of the ``stiffening-foam`` layer, whose
-tangent is ``M₀ / (1 − ε/ε_d)²`` for ``m = 1``: the stress rises without bound as the cells close
-(Gibson & Ashby 1997, ch. 5: densification at ``ε_d ≈ 1 − 1.4 ρ*/ρ_s``; their ``m = 1`` fit).
-``m = 0`` is the linear FEM exactly.
-
-Why the volumetric strain: densification is the foam's volume falling to its solid's (``ε_d``
-is a volume fraction), so it is the volume change that stiffens, not the shape change; in a
-foam's uniaxial test (lateral expansion about nil past the linear range) the axial strain is the
-volumetric one, and a volumetric term is how hyperelastic foam laws stiffen (Storåkers 1986). It
-is frame-free (no press direction in the law), shear stays at ``G₀ = E₀ / (2 (1 + ν))``, and at
-small strain the material is the linear FEM's (``Φ'' → 0`` as ``ε → 0``). The energy's Hessian,
-the tangent, is ``K₀ + Σ_e V_e Φ''(ε_e) cₑ cₑᵀ``: the linear stiffness plus one rank-one term per
-compressed element, symmetric positive definite and never softer than ``K₀``.
-
-Solve
------
 Force control with the FEM's sphere contact (:class:`~deformap.world._foam.FoamModel`: the Hertz
 pressure of the force on a patch of radius ``a``, ``a ← sqrt(a sqrt(R δ))`` until it settles,
 the surface conformed to the tip); each patch's equilibrium ``K₀ u + C s(Cᵀu) = f``
@@ -39,35 +10,25 @@ the surface conformed to the tip); each patch's equilibrium ``K₀ u + C s(Cᵀu
 - ``K₀`` is factorised once when the world is built (shared by homogeneous blocks of one mesh, as
   in the FEM).
 - The near set's tangent is exact: the elements the linear press would stiffen by more than 5 %
-  (``Φ'' > 0.05 M₀``), the most compressed first, at most ``near_elements`` (48) and at least 8,
+  (``Φ'' > 0.05 M₀``), the most compressed first, at most ``near_elements`` and at least 8,
   as a rank-``n`` update of ``K₀`` (Woodbury): ``Z = K₀⁻¹ C_N`` (``n`` right-hand sides in one
   solve call, once per press target, kept for every load level and patch of that target)
   reduces each Newton step to a dense ``n × n`` system.
 - The other elements stiffen by a few per cent at most; their forces enter every residual and
-  are carried by an outer fixed point (Anderson-accelerated), one solve with ``K₀`` a round,
-  each round's Newton solve warm-started from the last. An element outside the near set
-  compressed past ``ε_d / 5`` joins it. A press is converged when the residual over every free
-  unknown is below ``tolerance · F`` (1e-4: the record then moves by at most 1.3e-7 m from a
-  1e-8 solve, about 1/400 of the encoders' noise; ``benchmarks/stiffness_physics.py`` cases).
+  are carried by an outer fixed point (Anderson-accelerated, Walker & Ni 2011), one solve with
+  ``K₀`` a round, each round's Newton solve warm-started from the last. An element outside the
+  near set compressed past ``ε_d / 5`` joins it. A press is converged when the residual over
+  every free unknown is below ``tolerance · F``.
 
 Each target's first solve (the commanded force, the record's top level) sets the near set; the
 record's lower levels warm-start from the level above. The near sets of the last two targets are
-kept, each ``n`` vectors of the block's unknowns (at most 96 in all: 40 MB on the default
-mesh). The elements are the FEM's own (7.5 mm in plane): a strain is an element's mean, so the
-stiffening a patch smaller than an element feels is averaged over it, and it grows as the mesh
-is refined (README, the third physics).
-
-Range: the law holds while every element's ``ε < ε_d`` (the solve keeps it there: the stress is
-unbounded at ``ε_d``); small strain (no geometric nonlinearity), like the linear FEM, so a dent
-deeper than a fraction of the layer is outside what either models well. The world refuses a
-press that sinks the tip as deep as the block is thick.
+kept, each ``n`` vectors of the block's unknowns. The Newton steps keep every element's strain
+below ``ε_d``; the world refuses a press that sinks the tip as deep as the block is thick.
 
 References
 ----------
-Gibson, L. J., Ashby, M. F. (1997). Cellular Solids: Structure and Properties, 2nd ed., ch. 5.
-Cambridge University Press.
-Storåkers, B. (1986). On material representation and constitutive branching in finite
-compressible elasticity. Journal of the Mechanics and Physics of Solids 34(2), 125–145.
+Walker, H. F., Ni, P. (2011). Anderson acceleration for fixed-point iterations. SIAM Journal on
+Numerical Analysis 49(4), 1715–1735.
 """
 
 from __future__ import annotations
@@ -80,11 +41,16 @@ import numpy as np
 import scipy.sparse as sp
 from numpy.typing import NDArray
 
-from deformap.world._fem import _CORNERS, FoamBody
+from deformap.world._densification import (
+    StrainOperator,
+    strain_operator,
+    volumetric_stress,
+    volumetric_tangent,
+)
 from deformap.world._foam import FoamModel
 from deformap.world._scenario import Scenario
 
-__all__ = ["NewtonSolve", "StiffeningFem", "volumetric_stress", "volumetric_tangent"]
+__all__ = ["NewtonSolve", "StiffeningFem"]
 
 log = logging.getLogger(__name__)
 
@@ -96,64 +62,6 @@ _TARGETS_KEPT = 2  # near sets (with their K₀⁻¹ C_N) kept, the most recent
 # rounds, which then shrink the residual by about as much each; the near set has at least a few
 _NEAR_STIFFENING = 0.05
 _NEAR_LEAST = 8
-
-
-def volumetric_stress(strain: NDArray[np.float64], constrained_pa: NDArray[np.float64], *,
-                      densification: float, exponent: float) -> NDArray[np.float64]:
-    """``Φ'(ε) = M₀ ε [(1 − ε/ε_d)^(−m) − 1]`` for ``ε > 0`` (0 otherwise), in Pa: the stress the
-    stiffening adds to the linear solid's (module docstring); ``inf`` at and past ``ε_d``."""
-    eps = np.maximum(np.asarray(strain, dtype=float), 0.0)
-    x = eps / densification
-    with np.errstate(divide="ignore", invalid="ignore"):
-        out = constrained_pa * eps * (np.power(1.0 - x, -exponent) - 1.0)
-    return np.where(x < 1.0, out, np.inf)
-
-
-def volumetric_tangent(strain: NDArray[np.float64], constrained_pa: NDArray[np.float64], *,
-                       densification: float, exponent: float) -> NDArray[np.float64]:
-    """``Φ''(ε) = M₀ [(1 − x)^(−m) + m x (1 − x)^(−m−1) − 1]``, ``x = ε/ε_d`` (0 for ``ε ≤ 0``):
-    the derivative of :func:`volumetric_stress`, continuous at 0 (where it is 0)."""
-    eps = np.maximum(np.asarray(strain, dtype=float), 0.0)
-    x = eps / densification
-    with np.errstate(divide="ignore", invalid="ignore"):
-        out = constrained_pa * (np.power(1.0 - x, -exponent)
-                                + exponent * x * np.power(1.0 - x, -exponent - 1.0) - 1.0)
-    return np.where(x < 1.0, out, np.inf)
-
-
-@dataclass(frozen=True)
-class _StrainOperator:
-    """One block's elements: ``matrix`` ``(n_free, n_el)`` with column ``e`` the ``cₑ`` of
-    ``ε_e = cₑ · u`` (free unknowns only), volumes [m³] and constrained moduli [Pa]."""
-
-    matrix: sp.csc_matrix
-    volume: NDArray[np.float64]
-    constrained_pa: NDArray[np.float64]
-
-
-def strain_operator(body: FoamBody) -> _StrainOperator:
-    """The element-mean compressive volumetric strain of every hex of ``body``: for a corner
-    ``(ci, cj, ck)`` of a ``dx × dy × dz`` hex, ``∫ ∂N/∂x dV / V = (2 ci − 1) / (4 dx)`` (the
-    divergence theorem on the box), so ``ε = −Σ_c Σ_d (2 c_d − 1) u_{c,d} / (4 Δ_d)``."""
-    g = body.grid
-    nu = body.poisson_ratio
-    rows, cols, vals, volume, modulus = [], [], [], [], []
-    count = 0
-    for k in range(g.nz):
-        dz = float(g.levels[k + 1] - g.levels[k])
-        dofs, jj, ii = body.element_dofs(k)
-        row = -((2 * _CORNERS - 1) / (4 * np.array([g.dx, g.dy, dz]))).ravel()  # (24,)
-        rows.append(dofs.ravel())
-        cols.append(np.repeat(np.arange(count, count + len(ii)), 24))
-        vals.append(np.tile(row, len(ii)))
-        volume.append(np.full(len(ii), g.dx * g.dy * dz))
-        modulus.append(body.modulus[k, jj, ii])
-        count += len(ii)
-    full = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-                         shape=(3 * g.n_nodes, count))
-    e = np.concatenate(modulus)
-    return _StrainOperator(matrix=full[body.free].tocsc(), volume=np.concatenate(volume),
-                           constrained_pa=e * (1 - nu) / ((1 + nu) * (1 - 2 * nu)))
 
 
 @dataclass
@@ -217,9 +125,11 @@ class StiffeningFem(FoamModel):
     densification_strain, stiffening_exponent : float
         ``ε_d`` and ``m`` of the law.
     near_elements : int
-        Elements whose tangent the Newton steps take exactly.
+        The most elements whose tangent the Newton steps take exactly; 48 bounds each Newton
+        step's dense system to 48 × 48 while the outer rounds carry the rest.
     tolerance : float
-        Converged when the residual's norm is below ``tolerance`` times the patch's force.
+        Converged when the residual's norm is below ``tolerance`` times the patch's force; 1e-4
+        keeps the force–travel record's error far below the encoders' noise.
     """
 
     def __init__(self, scenario: Scenario, *, element_size_m: float, top_layer_m: float,
@@ -237,7 +147,7 @@ class StiffeningFem(FoamModel):
         #: the last patch solve's convergence, for checks
         self.last: NewtonSolve | None = None
 
-    def _law(self, strain: NDArray[np.float64], op: _StrainOperator, elements: NDArray[np.int64],
+    def _law(self, strain: NDArray[np.float64], op: StrainOperator, elements: NDArray[np.int64],
              tangent: bool = False) -> NDArray[np.float64]:
         """``V Φ'`` (or ``V Φ''``) of ``elements`` at their ``strain``: element forces [N]."""
         f = volumetric_tangent if tangent else volumetric_stress
@@ -346,7 +256,7 @@ class StiffeningFem(FoamModel):
                          np.zeros((linear.size, 0)), np.zeros((0, 0)))
         return self._with_columns(index, empty, chosen)
 
-    def _newton(self, b: NDArray[np.float64], near: _NearSet, op: _StrainOperator,
+    def _newton(self, b: NDArray[np.float64], near: _NearSet, op: StrainOperator,
                 start: NDArray[np.float64] | None) -> tuple[NDArray[np.float64], int]:
         """The near elements' strains ``ε`` with ``ε − b + G s(ε) = 0`` (``s = V Φ'``), by Newton's
         method on the Jacobian ``I + G diag(V Φ'')``, steps halved to keep every ``ε < ε_d`` and

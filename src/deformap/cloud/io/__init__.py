@@ -16,16 +16,18 @@ Formats: PCD (pypcd4), PLY (ascii and binary; numpy), NPZ (``points``, ``colors`
 from __future__ import annotations
 
 from deformap.cloud.io._bag import (
-    BAG_STORAGES,
-    RawBagMessage,
     StampedCloud,
     WrenchSeries,
-    bag_error_text,
-    bag_read_errors,
-    iter_bag_messages,
     read_bag_clouds,
     read_bag_static_transform,
     read_bag_wrenches,
+)
+from deformap.cloud.io._bag_reader import (
+    BAG_STORAGES,
+    RawBagMessage,
+    bag_error_text,
+    bag_read_errors,
+    iter_bag_messages,
 )
 from deformap.cloud.io._bag_writer import bag_writer, fill_chunk_crcs, wrench_message, write_bag
 from deformap.cloud.io._common import MM_EXTENT_THRESHOLD, UNITS, path_kind

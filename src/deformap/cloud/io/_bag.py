@@ -1,20 +1,15 @@
-"""ROS 2 bags (sqlite3 and MCAP) through the optional ``rosbags`` package (extra ``ros``).
+"""Typed messages of a ROS 2 bag: ``sensor_msgs/msg/PointCloud2`` topics read into
+:class:`~deformap.cloud.PointCloud`\\ s (in the world frame given a 4×4 ``cam2world``, or one
+composed from the bag's ``/tf_static``), ``geometry_msgs/msg/WrenchStamped`` topics into arrays.
 
-Reads ``sensor_msgs/msg/PointCloud2`` topics into :class:`~deformap.cloud.PointCloud`\\ s (in the
-world frame given a 4×4 ``cam2world``, or one composed from the bag's ``/tf_static``),
-and ``geometry_msgs/msg/WrenchStamped`` topics into arrays (writing is in ``_bag_writer``).
-ROS is not needed: rosbags reads and writes the files in pure Python.
+The bag is opened and read by :func:`~deformap.cloud.io._bag_reader.iter_bag_messages` (through
+the optional ``rosbags``, extra ``ros``; ROS itself is not needed); writing is in ``_bag_writer``.
 """
 
 from __future__ import annotations
 
-import importlib
-import logging
-import sqlite3
-import struct
-import zlib
 from collections import deque
-from collections.abc import Iterator, Mapping
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -24,33 +19,29 @@ from numpy.typing import NDArray
 
 from deformap._validation import check_array
 from deformap.cloud._pointcloud import PointCloud
-from deformap.cloud.io._common import check_units, path_kind
+from deformap.cloud.io._bag_reader import (
+    _rosbag2,
+    bag_error_text,
+    bag_read_errors,
+    iter_bag_messages,
+)
+from deformap.cloud.io._common import check_units
 from deformap.cloud.io._pointcloud2 import _to_cloud
 from deformap.cloud.io._ros import typestore
-from deformap.errors import (
-    DeformapError,
-    FileFormatError,
-    InvalidArgumentError,
-    missing_extra,
-)
+from deformap.errors import FileFormatError, InvalidArgumentError
 
 __all__ = [
-    "BAG_STORAGES",
-    "RawBagMessage",
+    "CLOUD_TYPE",
+    "TF_STATIC_TOPIC",
+    "TF_TYPE",
+    "WRENCH_TYPE",
     "StampedCloud",
     "WrenchSeries",
-    "bag_error_text",
-    "bag_read_errors",
-    "check_db3_counts",
-    "iter_bag_messages",
     "read_bag_clouds",
     "read_bag_static_transform",
     "read_bag_wrenches",
 ]
 
-logger = logging.getLogger(__name__)
-
-BAG_STORAGES = ("mcap", "sqlite3")
 CLOUD_TYPE = "sensor_msgs/msg/PointCloud2"
 WRENCH_TYPE = "geometry_msgs/msg/WrenchStamped"
 TF_TYPE = "tf2_msgs/msg/TFMessage"
@@ -102,306 +93,8 @@ class WrenchSeries:
     frame_id: str
 
 
-def _rosbag2() -> Any:
-    try:
-        import rosbags.rosbag2 as rosbag2
-    except ImportError:
-        raise missing_extra("rosbags", "ros", "reading ROS 2 bags") from None
-    return rosbag2
-
-
 def _stamp_ns(header: Any) -> int:
     return int(header.stamp.sec) * 10**9 + int(header.stamp.nanosec)
-
-
-def bag_read_errors() -> tuple[type[BaseException], ...]:
-    """What rosbags, its SQLite driver and the CDR decoder raise on a damaged bag.
-
-    Recent rosbags read sqlite3 bags through ``apsw`` (its ``CorruptError`` is not a
-    ``sqlite3.Error``); a corrupted length field can ask for an absurd allocation (MemoryError).
-    An MCAP chunk's compressed bytes are decompressed before its CRC is checked: damaged, they
-    raise the decompressor's own error (zstd's ``ZstdError``; lz4's is a ``RuntimeError``).
-    """
-    from rosbags.serde import SerdeError
-
-    errors: tuple[type[BaseException], ...] = (
-        _rosbag2().ReaderError, SerdeError, sqlite3.Error, OSError, ValueError, KeyError,
-        IndexError, TypeError, AssertionError, EOFError, struct.error, MemoryError,
-        OverflowError, UnicodeDecodeError, RuntimeError, *_zstd_errors(),
-    )  # fmt: skip
-    try:
-        import apsw
-    except ImportError:
-        return errors
-    return (*errors, apsw.Error)
-
-
-def bag_error_text(exc: BaseException, limit: int = 200) -> str:
-    """``exc`` as ``"TypeName: message"`` on one line, the message cut at ``limit`` characters:
-    what a damaged bag's error says after the bag's name. rosbags passes on its drivers' and
-    parsers' messages as they come, some of several lines (a YAML parser's, pointing at the
-    column) that would break an error's one line.
-
-    :func:`bag_read_errors` takes ``RuntimeError`` for lz4's damaged-chunk error; its
-    subclasses ``NotImplementedError`` and ``RecursionError`` are a program's faults, not a bag's,
-    and are raised again here instead of being read as a damaged bag."""
-    if isinstance(exc, (NotImplementedError, RecursionError)):
-        raise exc
-    return f"{type(exc).__name__}: {' '.join(str(exc).split())[:limit]}"
-
-
-def _zstd_errors() -> tuple[type[BaseException], ...]:
-    """The ``ZstdError`` of the zstd module rosbags decompresses MCAP chunks with (the standard
-    library's from Python 3.14, else ``backports.zstd``), if it is there."""
-    for name in ("compression.zstd", "backports.zstd"):
-        try:
-            module = importlib.import_module(name)
-        except ImportError:
-            continue
-        return (module.ZstdError,)
-    return ()
-
-
-@dataclass(frozen=True)
-class RawBagMessage:
-    """One message of a bag, not yet deserialised.
-
-    Attributes
-    ----------
-    topic : str
-    log_time_ns : int
-        When the bag recorded it, nanoseconds.
-    data : bytes or memoryview
-        The CDR bytes (``typestore().deserialize_cdr(data, msgtype)`` decodes them); a view may
-        be valid only until the next message is read, so keep ``bytes(data)``.
-    number : int
-        Its place among its topic's messages in the bag's order, from 1 (as errors name it).
-    """
-
-    topic: str
-    log_time_ns: int
-    data: bytes | memoryview
-    number: int = 0
-
-
-def iter_bag_messages(path: Any, topics: Mapping[str, str],
-                      optional: Mapping[str, str] | None = None) -> Iterator[RawBagMessage]:
-    """The messages of ``topics`` in a ROS 2 bag, in the bag's order: the one bag reader.
-
-    Opens the bag (a rosbag2 folder, ``.mcap`` or ``.db3``) through rosbags, checks that each
-    topic is there and carries only its message type, and yields the raw messages. Whatever
-    rosbags or its storage drivers raise on a damaged bag (:func:`bag_read_errors`) becomes a
-    :class:`~deformap.errors.FileFormatError` that names the file.
-
-    Parameters
-    ----------
-    path : str or Path
-    topics : mapping of str to str
-        Topic name → message type (``"sensor_msgs/msg/PointCloud2"``); at least one.
-    optional : mapping of str to str, optional
-        Topics the bag may lack; when present, they must carry only their type, and their
-        messages are yielded with the others'.
-    """
-    if not isinstance(path, (str, Path)):
-        raise InvalidArgumentError(
-            f"`path` must be a str or pathlib.Path; got {type(path).__name__}"
-        )
-    if not isinstance(topics, Mapping) or not topics:
-        raise InvalidArgumentError(f"`topics` must be a non-empty mapping; got {topics!r}")
-    rosbag2, p = _rosbag2(), Path(path)
-    if path_kind(p) == "missing":
-        raise FileFormatError(f"{p}: no such bag")
-    if optional is not None and not isinstance(optional, Mapping):
-        raise InvalidArgumentError(f"`optional` must be a mapping or None; got {optional!r}")
-    what = f"topic {next(iter(topics))!r}" if len(topics) == 1 and not optional else "the bag"
-    wanted = dict(topics)
-    for topic, msgtype in (optional or {}).items():
-        wanted.setdefault(topic, msgtype)
-    errors = bag_read_errors()
-    for file in sorted(p.glob("*.mcap")) if p.is_dir() else [p]:
-        check_mcap_crcs(file)
-    for file in sorted(p.glob("*.db3")) if p.is_dir() else [p]:
-        check_db3_counts(file)
-    try:
-        with rosbag2.Reader(p) as reader:
-            found = sorted({c.topic for c in reader.connections})
-            for topic, msgtype in wanted.items():
-                conns = [c for c in reader.connections if c.topic == topic]
-                if not conns and topic not in topics:
-                    continue
-                if not conns:
-                    raise FileFormatError(
-                        f"{p}: bag has no topic {topic!r} (topics: {found}); expected one "
-                        f"carrying {msgtype}"
-                    )
-                wrong = [c.msgtype for c in conns if c.msgtype != msgtype]
-                if wrong:
-                    raise FileFormatError(
-                        f"{p}: topic {topic!r} carries {wrong[0] or repr(wrong[0])}, expected "
-                        f"{msgtype}"
-                    )
-            conns = [c for c in reader.connections if c.topic in wanted]
-            counts: dict[str, int] = {}
-            for conn, log_time, raw in reader.messages(connections=conns):
-                number = counts[conn.topic] = counts.get(conn.topic, 0) + 1
-                _check_row(p, conn.topic, number, log_time, raw)
-                yield RawBagMessage(conn.topic, log_time, raw, number)
-    except DeformapError:
-        raise
-    except errors as exc:
-        raise FileFormatError(
-            f"{p}: could not read {what}: {bag_error_text(exc)}"
-        ) from exc
-
-
-def _check_row(path: Path, topic: str, number: int, log_time: Any, data: Any) -> None:
-    """A message's log time must be an integer and its data bytes. An sqlite3 bag stores any
-    type in any column: a number in ``data`` would otherwise be taken as that many zero bytes
-    (``bytes(10**12)`` allocates a terabyte), text as a string to encode."""
-    if not isinstance(data, (bytes, bytearray, memoryview)):
-        what, value = "its data as bytes", data
-    elif not isinstance(log_time, int) or isinstance(log_time, bool):
-        what, value = "an integer log time [ns]", log_time
-    else:
-        return
-    raise FileFormatError(f"{path} [{topic} message {number}]: expected {what}; got "
-                          f"{type(value).__name__} {str(value)[:40]!r}")
-
-
-_MCAP_MAGIC = b"\x89MCAP0\r\n"
-_FOOTER = struct.Struct("<BQQQI")  # opcode 0x02, length 20, summary start, offsets start, CRC
-_DATA_END = struct.Struct("<BQI")  # opcode 0x0F, length 4, the data section's CRC
-_BLOCK = 1 << 20
-#: MCAP files whose CRCs were verified, a bag being read in passes: (path, inode, size, mtime,
-#: ctime) → None (a file rewritten in place changes its ctime too), the last
-#: :data:`_VERIFIED_KEPT` of them.
-_VERIFIED: dict[tuple[str, int, int, int, int], None] = {}
-_VERIFIED_KEPT = 256
-
-
-def _crc32(fh: Any, start: int, end: int) -> int:
-    fh.seek(start)
-    crc, left = 0, end - start
-    while left > 0:
-        block = fh.read(min(_BLOCK, left))
-        if not block:
-            break
-        crc, left = zlib.crc32(block, crc), left - len(block)
-    return crc
-
-
-#: The most bytes of a sqlite3 bag's metadata YAML read (rosbag2 writes a few kilobytes).
-_DB3_METADATA_BYTES = 16 * 2**20
-
-
-def check_db3_counts(path: Path) -> None:
-    """Compare each topic's messages in a sqlite3 bag with the count its writer left in the
-    bag's own ``metadata`` table (rosbag2 since Iron, and rosbags' writer, store the bag's
-    ``metadata.yaml`` there; rosbags counts the rows and does not read it). sqlite3 keeps no
-    checksum, so this is what tells a message row lost or repeated. A file that is no sqlite3
-    database, or one without that table (older bags), is not checked here.
-
-    Raises
-    ------
-    FileFormatError
-        A topic holds another number of messages than the metadata says, or the metadata is not
-        a rosbag2 metadata YAML: one line naming the file and what differs.
-    """
-    import yaml
-
-    if path.suffix != ".db3" or path_kind(path) != "file":
-        return
-    try:
-        conn = sqlite3.connect(f"{path.resolve().as_uri()}?mode=ro", uri=True)
-    except sqlite3.Error:
-        return
-    try:
-        tables = {r[0] for r in conn.execute("SELECT name FROM sqlite_master WHERE type='table'")}
-        if not {"metadata", "topics", "messages"} <= tables:
-            return
-        row = conn.execute("SELECT metadata FROM metadata ORDER BY id DESC LIMIT 1").fetchone()
-        rows = conn.execute("SELECT topics.name, count(messages.id) FROM topics LEFT JOIN "
-                            "messages ON topics.id == messages.topic_id GROUP BY topics.id")
-        found: dict[str, int] = {}
-        for name, count in rows:
-            found[str(name)] = found.get(str(name), 0) + int(count)
-    except sqlite3.Error:
-        return  # the reader refuses a damaged database itself, naming it
-    finally:
-        conn.close()
-    if row is None:
-        return
-    text = row[0]
-    if not isinstance(text, str) or len(text) > _DB3_METADATA_BYTES:
-        raise FileFormatError(f"{path}: the metadata table must hold rosbag2's metadata YAML; "
-                              f"got {type(text).__name__} of {len(text or '')} characters")
-    try:
-        doc = yaml.safe_load(text)
-        # the table holds the bag information itself (metadata.yaml wraps it in this key)
-        info = doc.get("rosbag2_bagfile_information", doc)
-        declared = {str(t["topic_metadata"]["name"]): int(t["message_count"])
-                    for t in info["topics_with_message_count"]}
-    except (yaml.YAMLError, AttributeError, KeyError, TypeError, ValueError) as exc:
-        raise FileFormatError(f"{path}: the metadata table's YAML is not rosbag2's bag "
-                              f"information: {bag_error_text(exc, 120)}") from None
-    for name, count in declared.items():
-        if name in found and found[name] != count:
-            raise FileFormatError(
-                f"{path}: topic {name!r} holds {found[name]} messages where the bag's metadata "
-                f"says {count}: messages were lost or repeated after it was written")
-
-
-def check_mcap_crcs(path: Path) -> None:
-    """Verify the CRC-32s an MCAP file's writer left in its footer (of the summary section: the
-    schemas, channels, chunk indexes and statistics a reader trusts) and in its ``DataEnd``
-    record (of the whole data section); rosbags checks only each chunk's. A CRC of zero (not
-    written) is not checked, nor is a file that is no MCAP or whose footer is damaged (the
-    reader refuses those itself).
-
-    Raises
-    ------
-    FileFormatError
-        A CRC does not match: one line naming the file, the section and both values.
-    """
-    try:
-        stat = path.stat()
-    except OSError:
-        return
-    key = (str(path.resolve()), stat.st_ino, stat.st_size, stat.st_mtime_ns, stat.st_ctime_ns)
-    if key in _VERIFIED or stat.st_size < 2 * len(_MCAP_MAGIC) + _FOOTER.size:
-        return
-    footer_at = stat.st_size - len(_MCAP_MAGIC) - _FOOTER.size
-    with path.open("rb") as fh:
-        if fh.read(len(_MCAP_MAGIC)) != _MCAP_MAGIC:
-            return
-        fh.seek(footer_at)
-        tail = fh.read()
-        if tail[-len(_MCAP_MAGIC):] != _MCAP_MAGIC:
-            return
-        opcode, length, summary_at, _, summary_crc = _FOOTER.unpack_from(tail)
-        if opcode != 0x02 or length != 20 or summary_at > footer_at:
-            return
-        summary_start = summary_at or footer_at
-        if summary_crc:
-            # the summary section and the footer up to its CRC field
-            got = zlib.crc32(tail[: _FOOTER.size - 4], _crc32(fh, summary_start, footer_at))
-            if got != summary_crc:
-                raise FileFormatError(
-                    f"{path}: the MCAP summary section (schemas, channels, chunk indexes) fails "
-                    f"its CRC-32: expected {summary_crc:#010x} (the footer's), got {got:#010x}")
-        data_end_at = summary_start - _DATA_END.size
-        if data_end_at >= len(_MCAP_MAGIC):
-            fh.seek(data_end_at)
-            opcode, length, data_crc = _DATA_END.unpack(fh.read(_DATA_END.size))
-            if opcode == 0x0F and length == 4 and data_crc:
-                got = _crc32(fh, 0, data_end_at)
-                if got != data_crc:
-                    raise FileFormatError(
-                        f"{path}: the MCAP data section fails its CRC-32: expected "
-                        f"{data_crc:#010x} (the DataEnd record's), got {got:#010x}")
-    _VERIFIED[key] = None
-    while len(_VERIFIED) > _VERIFIED_KEPT:
-        del _VERIFIED[next(iter(_VERIFIED))]
 
 
 def _messages(path: Any, topic: str, msgtype: str) -> Iterator[tuple[int, Any]]:

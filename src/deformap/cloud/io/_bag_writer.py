@@ -21,15 +21,8 @@ from typing import Any
 from deformap._files import atomic_path
 from deformap._validation import check_array
 from deformap.cloud._pointcloud import PointCloud
-from deformap.cloud.io._bag import (
-    BAG_STORAGES,
-    CLOUD_TYPE,
-    TF_STATIC_TOPIC,
-    TF_TYPE,
-    WRENCH_TYPE,
-    WrenchSeries,
-    _rosbag2,
-)
+from deformap.cloud.io._bag import CLOUD_TYPE, TF_STATIC_TOPIC, TF_TYPE, WRENCH_TYPE, WrenchSeries
+from deformap.cloud.io._bag_reader import BAG_STORAGES, _rosbag2
 from deformap.cloud.io._pointcloud2 import array_to_pointcloud2
 from deformap.cloud.io._ros import typestore
 from deformap.errors import InvalidArgumentError

@@ -1,5 +1,5 @@
 """Seeded hostile arguments for every option of every command, found from the Typer app itself,
-each run under a guard that stops it before its work; shared by
+each run under a guard that stops it before its work: a test helper, run by
 ``tests/robustness/test_cli_mutants.py`` (five per option) and ``benchmarks/robustness.py
 --cli-mutants N`` (N in all).
 
@@ -35,9 +35,10 @@ import typer
 from typer.testing import CliRunner
 
 from deformap.cli import app
+from deformap.testing.mutants import count_table
 
 __all__ = ["ENDINGS", "HANG_LIMIT_S", "CliCase", "CliMutant", "alarm_handler", "argv",
-           "cli_mutants", "commands", "hostile_paths", "invoke", "judge", "options",
+           "cli_mutants", "cli_table", "commands", "hostile_paths", "invoke", "judge", "options",
            "positional", "run_cli"]
 
 NUMBERS = ("-1", "0", "nan", "inf", "-inf", "1e400", "9" * 400, "1e-320", "abc", "3.5", "")
@@ -142,7 +143,7 @@ def cli_mutants(paths: dict[str, str], per_option: int, seed: int) -> list[CliMu
     pool = ([("number", v) for v in NUMBERS] + [("string", v) for v in STRINGS]
             + [("path", v) for v in paths.values()])  # fmt: skip
     unwritable = [("path", paths[k]) for k in UNWRITABLE]
-    cases = []
+    cases: list[CliMutant] = []
     for path, command in commands(typer.main.get_command(app)):
         names = [p.opts[0] for p in options(command)]
         guards = {"--out", "--json"} & set(names)
@@ -217,7 +218,7 @@ def judge(result: Any) -> str | None:
     return None
 
 
-# ----------------------------------------------------------------------------- the benchmark
+# ----------------------------------------------------------------------------- the run
 
 #: How a mutant ended: one ``error:`` line that names the mutated option or its value
 #: (``named``), one that names the guard's destination instead (``guard``: the run stopped at the
@@ -228,6 +229,9 @@ ENDINGS = ("named", "guard", "clean", "usage", "traceback", "hang", "other")
 
 @dataclass
 class CliCase:
+    """One mutant run: its value's kind, the command and option given it, its ending
+    (:data:`ENDINGS`) and what it printed."""
+
     kind: str
     option: str
     ending: str
@@ -278,3 +282,14 @@ def run_cli(count: int, seed: int, work: Path) -> list[CliCase]:
                                  _ending(result, problem, mutant, paths),
                                  f"{' '.join(args)[:160]}: {problem}"))  # fmt: skip
     return cases
+
+
+def cli_table(cases: list[CliCase]) -> str:
+    """A markdown table of command-line mutants: one row per value kind, the options given it
+    and the count of each ending."""
+    return count_table(
+        ["value kind", "mutants", "options", "one line naming the option or value",
+         "one line naming the guard", "one line naming neither", "usage errors (parser)",
+         "tracebacks", "hangs", "other endings"],
+        sorted(cases, key=lambda c: c.kind), "kind", "ending",
+        ENDINGS, lambda mine: [str(len(mine)), str(len({c.option for c in mine}))])
