@@ -37,7 +37,7 @@ def test_every_table_has_its_run_line() -> None:
     assert missing == [], f"tables without a **Run:** line (command and commit) at lines {missing}"
 
 
-def test_the_lead_has_a_place_for_the_measurements_from_the_code() -> None:
+def test_the_measurements_from_the_code_are_here() -> None:
     assert "\n## Measurements formerly in the code\n" in RESULTS
 
 
