@@ -76,7 +76,7 @@ def test_a_map_grid_too_fine_for_the_workspace_is_refused() -> None:
 
 def test_planning_over_a_workspace_too_large_for_its_matrices_is_refused() -> None:
     big = Workspace(upper=(3.0, 3.0))
-    for strategy in ("planned", "min-max-variance"):
+    for strategy in ("planned",):
         with pytest.raises(SettingError, match="22,801 cells") as info:
             check_exploration_budget(ExplorationConfig(strategy=strategy), big)
         assert info.value.field == "strategy"

@@ -45,26 +45,17 @@ def test_max_variance_picks_the_peak_and_paper_stays_above_threshold() -> None:
     np.testing.assert_array_equal(again[0], picks[0])
 
 
-def test_min_max_variance_uses_the_look_ahead() -> None:
+def test_planned_pokes_its_planners_first_target_and_retired_names_are_refused() -> None:
     cells, variance = _cells()
-    target = np.array([0.2, 0.9])
-
-    def look_ahead(candidates: np.ndarray) -> np.ndarray:
-        return np.linalg.norm(candidates - target, axis=1)
-
-    pick = choose_target(
-        "min-max-variance",
-        cells,
-        np.ones(len(cells)),
-        0.5,
-        np.random.default_rng(0),
-        look_ahead=look_ahead,
-    )
-    np.testing.assert_allclose(pick, target)
-    with pytest.raises(InvalidArgumentError, match="`look_ahead` is required"):
-        choose_target("min-max-variance", cells, variance, 0.1, np.random.default_rng(0))
-    with pytest.raises(InvalidArgumentError, match="`strategy` must be one of"):
-        choose_target("greedy", cells, variance, 0.1, np.random.default_rng(0))
+    first = np.array([0.2, 0.9])
+    pick = choose_target("planned", cells, variance, 0.1, np.random.default_rng(0),
+                         planner=lambda: first)
+    np.testing.assert_allclose(pick, first)
+    with pytest.raises(InvalidArgumentError, match="`planner` is required"):
+        choose_target("planned", cells, variance, 0.1, np.random.default_rng(0))
+    for name in ("greedy", "min-max-variance", "integrated-variance"):
+        with pytest.raises(InvalidArgumentError, match="`strategy` must be one of"):
+            choose_target(name, cells, variance, 0.1, np.random.default_rng(0))
 
 
 def test_the_boundary_score_prefers_uncertain_cells_on_an_isopleth() -> None:

@@ -1,17 +1,20 @@
-"""The strategies of issue 16, item 4: ``level-set`` (straddle on the cut levels) and
-``integrated-variance`` (integrated posterior variance reduction), on hand-built β-fields."""
+"""The strategies on hand-built β-fields: ``level-set`` (straddle on the cut levels) where it
+pokes, every strategy's stop, the planner's budget, and the names a config may give."""
 
 from __future__ import annotations
+
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 from deformap._validation import SettingError
 from deformap.environment import Workspace
-from deformap.errors import InvalidArgumentError
-from deformap.explore import ExplorationConfig, Mapper, check_exploration_budget
+from deformap.errors import ConfigError, InvalidArgumentError
+from deformap.explore import STRATEGIES, ExplorationConfig, Mapper, check_exploration_budget
 from deformap.explore._acquisition import boundary_score, choose_target
-from deformap.explore._targets import BOUNDARY_SPACING_ROI, expected_noise
+from deformap.explore._targets import BOUNDARY_SPACING_ROI
+from deformap.run import load_run_config
 from deformap.testing import synthetic_poke
 
 WORKSPACE = Workspace(lower=(0.0, 0.0), upper=(0.6, 0.4))
@@ -67,53 +70,19 @@ def test_level_set_with_one_class_looks_where_the_field_is_least_known() -> None
     assert var[_cell(mapper, target.xy)] == pytest.approx(reachable.max())
 
 
-def _brute_force_reduction(mapper: Mapper) -> np.ndarray:
-    """Variance summed over the planner's domain before less after a poke at each planner
-    candidate, each posterior solved afresh with the candidate among the data (RW2006 Eq. 2.26)."""
-    cfg = mapper.config.beta_field
-    pokes = mapper.field.pokes
-    cand, dom = mapper.grid.plan_candidates, mapper.grid.plan_domain
-    noise_new = expected_noise(cand, pokes, mapper.config)
-
-    def k(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-        d2 = np.sum((a[:, None] - b[None]) ** 2, axis=2)
-        return cfg.signal_std**2 * np.exp(-d2 / cfg.length_scale_m**2)
-
-    def total_variance(xy: np.ndarray, noise: np.ndarray) -> float:
-        gram = k(xy, xy) + np.diag(noise**2)
-        kd = k(xy, dom)
-        return float(np.sum(cfg.signal_std**2 - np.sum(kd * np.linalg.solve(gram, kd), axis=0)))
-
-    before = total_variance(pokes.xy, pokes.noise)
-    return np.array([before - total_variance(np.vstack([pokes.xy, c]),
-                                             np.append(pokes.noise, n))
-                     for c, n in zip(cand, noise_new, strict=True)])  # fmt: skip
-
-
-def test_integrated_variance_pokes_where_the_summed_variance_falls_most() -> None:
-    mapper = _mapper("integrated-variance", [((0.3, 0.2), 0.6), ((0.12, 0.1), 0.6)])
-    target = mapper.next_target(np.random.default_rng(0))
-    assert target is not None
-    reduction = _brute_force_reduction(mapper)
-    np.testing.assert_allclose(target.xy, mapper.grid.plan_candidates[np.argmax(reduction)])
-
-
-def test_integrated_variance_does_not_chase_the_corner_max_variance_pokes() -> None:
-    # after the centre, the least-known reachable cells are the target area's corners; a poke
-    # there informs the fewest cells, so the summed variance falls more from further in
-    iv = _mapper("integrated-variance", [((0.3, 0.2), 0.6)]).next_target(np.random.default_rng(0))
+def test_max_variance_pokes_a_corner_of_the_target_area_after_the_centre() -> None:
+    # after the centre, the least-known reachable cells are the target area's corners
     mv = _mapper("max-variance", [((0.3, 0.2), 0.6)]).next_target(np.random.default_rng(0))
-    assert iv is not None and mv is not None
+    assert mv is not None and mv.purpose == "variance"
     margin = 0.06  # half the ROI
     corners = np.array([[margin, margin], [0.6 - margin, margin], [margin, 0.4 - margin],
                         [0.6 - margin, 0.4 - margin]])  # fmt: skip
     assert np.min(np.linalg.norm(corners - mv.xy, axis=1)) < 0.01
-    assert np.min(np.linalg.norm(corners - iv.xy, axis=1)) > 0.03
 
 
 def test_every_strategy_stops_under_the_threshold() -> None:
-    for strategy in ("level-set", "integrated-variance"):
-        config = ExplorationConfig(strategy=strategy, field="beta", threshold=0.2)  # type: ignore[arg-type]
+    for strategy in STRATEGIES:
+        config = ExplorationConfig(strategy=strategy, field="beta", threshold=0.2)
         mapper = Mapper(WORKSPACE, config)
         mapper.add(synthetic_poke(np.array([0.3, 0.2]), 0.6, 0.03))
         rng = np.random.default_rng(0)
@@ -122,22 +91,37 @@ def test_every_strategy_stops_under_the_threshold() -> None:
             if target is None:
                 break
             mapper.add(synthetic_poke(target.xy, 0.6, 0.03, index=i), target=target)
-        assert target is None and mapper.max_variance() <= 0.2
+        assert target is None and mapper.max_variance() <= 0.2, strategy
 
 
-def test_the_new_names_are_settings_and_a_scored_strategy_needs_its_scorer() -> None:
-    for strategy in ("level-set", "integrated-variance"):
-        assert ExplorationConfig(strategy=strategy).strategy == strategy  # type: ignore[arg-type]
-        with pytest.raises(InvalidArgumentError, match=f"`scorer` is required by strategy "
-                                                       f"'{strategy}'"):
-            choose_target(strategy, np.zeros((3, 2)), np.ones(3), 0.5, np.random.default_rng(0))
+def test_level_set_is_a_setting_and_needs_its_scorer() -> None:
+    assert ExplorationConfig(strategy="level-set").strategy == "level-set"
+    with pytest.raises(InvalidArgumentError, match="`scorer` is required by strategy 'level-set'"):
+        choose_target("level-set", np.zeros((3, 2)), np.ones(3), 0.5, np.random.default_rng(0))
     with pytest.raises(InvalidArgumentError, match="`strategy` must be one of"):
         ExplorationConfig(strategy="level_set")  # type: ignore[arg-type]
 
 
-def test_integrated_variance_is_held_to_the_planners_budget() -> None:
+def test_only_the_planned_strategy_is_held_to_the_planners_budget() -> None:
     big = Workspace(upper=(3.0, 3.0))
     with pytest.raises(SettingError, match="22,801 cells") as info:
-        check_exploration_budget(ExplorationConfig(strategy="integrated-variance"), big)
+        check_exploration_budget(ExplorationConfig(strategy="planned"), big)
     assert info.value.field == "strategy"
-    check_exploration_budget(ExplorationConfig(strategy="level-set"), big)  # the map grid only
+    for strategy in set(STRATEGIES) - {"planned"}:
+        check_exploration_budget(ExplorationConfig(strategy=strategy), big)  # the map grid only
+
+
+@pytest.mark.parametrize("retired", ["min-max-variance", "integrated-variance"])
+def test_a_config_file_naming_a_retired_strategy_is_refused_in_one_line(
+    tmp_path: Path, retired: str
+) -> None:
+    path = tmp_path / "old.yaml"
+    path.write_text(f"exploration:\n  strategy: {retired}\n")
+    with pytest.raises(ConfigError) as info:
+        load_run_config(path)
+    message = str(info.value)
+    assert "\n" not in message
+    assert message == (f"`old.yaml.exploration.strategy` must be one of {list(STRATEGIES)}; "
+                       f"got {retired!r}")
+    assert retired not in STRATEGIES
+    assert set(STRATEGIES) == {"paper", "max-variance", "planned", "level-set"}

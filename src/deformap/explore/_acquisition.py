@@ -7,10 +7,6 @@ Strategies
     drawn with the explicit generator.
 ``max-variance``
     The cell of largest variance (ties: the first in row-major order).
-``min-max-variance``
-    One-step look-ahead: the candidate whose poke leaves the smallest largest posterior variance.
-    A GP's posterior variance depends only on where the data are (RW2006 Eq. 2.26), so the
-    look-ahead is exact before the poke; it is myopic.
 ``planned`` (default)
     The first of the fewest further pokes that bring the largest variance under ``T_h``, planned
     together and again after every poke (:mod:`deformap.explore._planning`).
@@ -20,11 +16,6 @@ Strategies
     classes the region test finds in the pokes so far, and with one class the score is ``σ(x)``
     (a region not yet met is likeliest where the field is least known). Straddle rather than
     ILS-UCB (Garg et al. 2016) because it has no weight to choose: 1.96 is the 95 % band.
-``integrated-variance``
-    The candidate that most reduces the posterior variance integrated over the stop cells (IMSE,
-    Sacks et al. 1989): ``Σ_d k_post(d, x)² / (σ²(x) + σ_n²(x))``, an exact rank-one update with
-    the noise a poke at ``x`` is expected to have (:func:`deformap.explore._targets.expected_noise`),
-    on the planner's 2 cm lattices so its cost does not grow with the map grid.
 
 Every strategy runs until the map field's variance is below ``T_h`` (the paper's stop). Then come
 the ``boundary_pokes``, if any: the variance criterion leaves the isopleths where the field's length
@@ -35,8 +26,6 @@ the pokes go does not depend on ``region_labels``.
 
 References
 ----------
-Sacks, J., Welch, W. J., Mitchell, T. J., Wynn, H. P. (1989). Design and analysis of computer
-experiments. Statistical Science 4(4), 409–423.
 Garg, A., Sen, S., Kapadia, R., et al. (2016). Tumor localization using automated palpation with
 Gaussian process adaptive sampling. IEEE CASE.
 Bryan, B., Schneider, J., Nichol, R. C., Miller, C. J., Genovese, C. R., Wasserman, L. (2005).
@@ -53,22 +42,17 @@ from numpy.typing import NDArray
 
 from deformap.errors import InvalidArgumentError
 
-__all__ = ["SCORED", "STRATEGIES", "Strategy", "boundary_score", "choose_target"]
+__all__ = ["STRATEGIES", "Strategy", "boundary_score", "choose_target"]
 
 #: The strategies' names: the one list, which ``ExplorationConfig.strategy`` is annotated with.
-Strategy = Literal["paper", "max-variance", "min-max-variance", "planned", "level-set",
-                   "integrated-variance"]
+Strategy = Literal["paper", "max-variance", "planned", "level-set"]
 STRATEGIES: tuple[Strategy, ...] = get_args(Strategy)
 
-#: ``(candidates (c, 2)) -> (c,)`` largest posterior variance left if that candidate were poked.
-LookAhead = Callable[[NDArray[np.float64]], NDArray[np.float64]]
 #: ``() -> (2,)`` the next poke of a plan that reaches the threshold.
 Planner = Callable[[], NDArray[np.float64]]
-#: ``() -> (candidates (c, 2), scores (c,))`` a scored strategy's candidates (``level-set``,
-#: ``integrated-variance``); the largest score is poked.
+#: ``() -> (candidates (c, 2), scores (c,))`` the ``level-set`` candidates and their straddle
+#: scores; the largest score is poked.
 Scorer = Callable[[], tuple[NDArray[np.float64], NDArray[np.float64]]]
-#: The strategies that poke the best of their scorer's candidates.
-SCORED: tuple[Strategy, ...] = ("level-set", "integrated-variance")
 
 
 def choose_target(
@@ -78,17 +62,14 @@ def choose_target(
     threshold: float,
     rng: np.random.Generator,
     *,
-    look_ahead: LookAhead | None = None,
     planner: Planner | None = None,
     scorer: Scorer | None = None,
-    n_candidates: int = 256,
 ) -> NDArray[np.float64] | None:
     """Pick the next target, or ``None`` when no cell's variance exceeds ``threshold``.
 
     Parameters
     ----------
-    strategy : {"paper", "max-variance", "min-max-variance", "planned", "level-set", \
-"integrated-variance"}
+    strategy : {"paper", "max-variance", "planned", "level-set"}
     cells_xy : (n, 2) float, metres
         Centres of the grid cells that may be poked.
     variance : (n,) float
@@ -96,16 +77,12 @@ def choose_target(
     threshold : float
         ``T_h``: exploration stops when every cell's variance is at or below it.
     rng : numpy.random.Generator
-        Used by ``paper`` (and to subsample candidates of ``min-max-variance``).
-    look_ahead : callable, optional
-        Required by ``min-max-variance``.
+        Used by ``paper``.
     planner : callable, optional
         Required by ``planned``.
     scorer : callable, optional
-        Required by ``level-set`` and ``integrated-variance``: their candidates and scores; the
-        first of the largest score is poked.
-    n_candidates : int
-        How many above-threshold cells ``min-max-variance`` evaluates (a seeded subsample).
+        Required by ``level-set``: its candidates and scores; the first of the largest score is
+        poked.
     """
     if strategy not in STRATEGIES:
         raise InvalidArgumentError(
@@ -122,21 +99,10 @@ def choose_target(
         if planner is None:
             raise InvalidArgumentError("`planner` is required by strategy 'planned'")
         return np.array(planner(), dtype=float)
-    if strategy in SCORED:
-        if scorer is None:
-            raise InvalidArgumentError(f"`scorer` is required by strategy {strategy!r}")
-        candidates_xy, scores = scorer()
-        return np.array(candidates_xy[int(np.argmax(scores))], dtype=float)
-    if look_ahead is None:
-        raise InvalidArgumentError("`look_ahead` is required by strategy 'min-max-variance'")
-    candidates = above
-    if candidates.size > n_candidates:
-        candidates = np.sort(rng.choice(candidates, size=n_candidates, replace=False))
-    left = look_ahead(cells_xy[candidates])
-    # Among near-ties prefer the higher current variance: it is the less-known place.
-    best = np.flatnonzero(left <= left.min() + 1e-9)
-    pick = best[np.argmax(variance[candidates[best]])]
-    return np.array(cells_xy[candidates[pick]], dtype=float)
+    if scorer is None:  # level-set
+        raise InvalidArgumentError(f"`scorer` is required by strategy {strategy!r}")
+    candidates_xy, scores = scorer()
+    return np.array(candidates_xy[int(np.argmax(scores))], dtype=float)
 
 
 def boundary_score(mean: NDArray[np.float64], std: NDArray[np.float64],

@@ -31,7 +31,6 @@ __all__ = [
     "MAX_MAP_CELLS",
     "MAX_PLAN_CELLS",
     "MAX_ROI_BAND_BYTES",
-    "PLANNER_STRATEGIES",
     "BetaFieldConfig",
     "BetaUncertainty",
     "BoundaryScore",
@@ -75,16 +74,15 @@ UnreadPlace = Literal["beta", "avoid"]
 #: Most bytes of one band of the ROI's shape-matching system (:mod:`deformap.msm._linsys`); the
 #: β sweep holds a few arrays of that size at once, so 512 MiB keeps it within a few GiB.
 MAX_ROI_BAND_BYTES = 512 * 2**20
-#: Most cells of the map grid: every map is a dense grid, and the ``min-max-variance`` look-ahead
-#: holds a (256 candidates × cells) float64 matrix, 2 GB at this size.
+#: Most cells of the map grid: every map (the surface, the field's mean and variance, the labels,
+#: each figure) is a dense grid of these cells, and a million (25 m² at the default 5 mm) is far
+#: more than a table top needs while each float64 map stays at 8 MB.
 MAX_MAP_CELLS = 1_000_000
-#: Most cells of the planner's 2 cm grids (:data:`PLANNER_STRATEGIES`): its (candidates × domain)
-#: and (candidates × candidates) float64 matrices are 0.8 GB each at this size (4 m² of workspace).
+#: Most cells of the ``planned`` strategy's 2 cm grids: its (candidates × domain) and
+#: (candidates × candidates) float64 matrices are 0.8 GB each at this size (4 m² of workspace).
 MAX_PLAN_CELLS = 10_000
 #: Spacing of the planner's grids (``MapGrid.plan_domain``, ``plan_candidates``), metres.
 PLAN_GRID_M = 0.02
-#: The strategies that hold the planner's (candidates × domain) matrices.
-PLANNER_STRATEGIES: tuple[Strategy, ...] = ("planned", "min-max-variance", "integrated-variance")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -332,8 +330,7 @@ class ExplorationConfig:
         paper's.
     max_pokes : int
         Most pokes of a run, boundary pokes included, a count.
-    strategy : {"paper", "max-variance", "min-max-variance", "planned", "level-set", \
-"integrated-variance"}
+    strategy : {"paper", "max-variance", "planned", "level-set"}
         How the next poke is chosen (:mod:`deformap.explore._acquisition`).
         ``planned`` (default) takes the first of the fewest pokes, the centre included, that
         bring every cell below ``T_h``.
@@ -489,8 +486,8 @@ def check_exploration_budget(config: ExplorationConfig, workspace: Workspace) ->
 
     The bounds that depend on a single settings object hold from its construction; these depend
     on the workspace too. The map grid (``Workspace.grid`` at ``surface.grid_spacing_m``) must
-    have at most :data:`MAX_MAP_CELLS` cells and, for the strategies that work on the planner's
-    2 cm grid (:data:`PLANNER_STRATEGIES`), that grid at most :data:`MAX_PLAN_CELLS`.
+    have at most :data:`MAX_MAP_CELLS` cells and, for ``planned``, the planner's 2 cm grid at
+    most :data:`MAX_PLAN_CELLS`.
 
     Parameters
     ----------
@@ -517,7 +514,7 @@ def check_exploration_budget(config: ExplorationConfig, workspace: Workspace) ->
             f"spacing or a smaller workspace; got {spacing:g} m",
         )
     plan = (round(width / PLAN_GRID_M) + 1) * (round(depth / PLAN_GRID_M) + 1)
-    if config.strategy in PLANNER_STRATEGIES and plan > MAX_PLAN_CELLS:
+    if config.strategy == "planned" and plan > MAX_PLAN_CELLS:
         raise SettingError(
             "strategy",
             f"{config.strategy!r} plans on {plan:,} cells of {PLAN_GRID_M * 100:g} cm over "

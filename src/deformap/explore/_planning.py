@@ -30,7 +30,7 @@ from deformap._validation import check_array, check_int, check_positive
 from deformap.errors import InvalidArgumentError
 from deformap.gp import PosteriorDesign
 
-__all__ = ["PokePlan", "VarianceDesign", "plan_pokes"]
+__all__ = ["PokePlan", "plan_pokes"]
 
 Array = NDArray[np.float64]
 
@@ -55,37 +55,14 @@ class PokePlan:
     reaches: bool
 
 
-class VarianceDesign:
-    """The planner's view of the field's posterior (:class:`deformap.gp.PosteriorDesign`): the
-    pokes made, the candidates, the domain, and the score of each candidate added."""
-
-    def __init__(self, poked_xy: Array, poked_noise: Array, candidates: Array, domain: Array,
-                 signal_std: float, length_scale: float, new_noise: float | Array):
-        self.gp = PosteriorDesign(poked_xy, poked_noise, candidates, domain,
-                                  length_scale=length_scale, signal_std=signal_std,
-                                  candidate_noise_std=new_noise)  # fmt: skip
-
-    def after(self, chosen: list[int], threshold: float) -> tuple[Array, Array]:
-        """For each candidate added to ``chosen`` (an exact rank-one update of the posterior):
-        the variance above ``threshold`` summed over the domain, and the largest variance
-        ``(c,)`` each."""
-        after = self.gp.variance_after_adding(chosen)
-        excess = np.maximum(after - threshold, 0.0).sum(axis=1)
-        return excess, np.asarray(after.max(axis=1))
-
-    def integrated_reduction(self) -> Array:
-        """``(c,)`` how much a poke at each candidate lowers the variance summed over the domain:
-        ``Σ_d k_post(d, x)² / (σ²(x) + σ_n²(x))``, the rank-one update of RW2006 Eq. 2.26 summed
-        (``integrated-variance``, :mod:`deformap.explore._acquisition`)."""
-        _, cov, var_c = self.gp.posterior([])
-        return np.asarray(np.sum(cov**2, axis=1) / (var_c + self.gp.new_var))
-
-
-def _best_addition(design: VarianceDesign, chosen: list[int], threshold: float
+def _best_addition(gp: PosteriorDesign, chosen: list[int], threshold: float
                    ) -> tuple[int, tuple[float, float]]:  # fmt: skip
-    """The candidate not in ``chosen`` whose addition leaves the least variance above
-    ``threshold`` (then the smallest largest variance), and that score."""
-    excess, worst = design.after(chosen, threshold)
+    """The candidate not in ``chosen`` whose addition (an exact rank-one update of the posterior)
+    leaves the least variance above ``threshold`` summed over the domain (then the smallest
+    largest variance), and that score."""
+    after = gp.variance_after_adding(chosen)
+    excess = np.maximum(after - threshold, 0.0).sum(axis=1)
+    worst = np.asarray(after.max(axis=1))
     excess[chosen] = np.inf  # a second poke on the same place is never the better plan
     pick = int(np.lexsort((worst, excess))[0])
     return pick, (float(excess[pick]), float(worst[pick]))
@@ -138,18 +115,18 @@ def plan_pokes(poked_xy: Array, poked_noise: Array, candidates: Array, domain: A
             f"`poked_noise` must be positive standard deviations; got {poked_noise.min()!r}")
     max_new = check_int("max_new", max_new, minimum=1)
     max_passes = check_int("max_passes", max_passes, minimum=0)
-    design = VarianceDesign(poked_xy, poked_noise, candidates, domain, signal_std, length_scale,
-                     new_noise)
+    gp = PosteriorDesign(poked_xy, poked_noise, candidates, domain, length_scale=length_scale,
+                         signal_std=signal_std, candidate_noise_std=new_noise)
     chosen: list[int] = []
     best = (np.inf, np.inf)
     for _ in range(min(max_new, candidates.shape[0])):
-        pick, best = _best_addition(design, chosen, threshold)
+        pick, best = _best_addition(gp, chosen, threshold)
         chosen = [*chosen, pick]
         for _ in range(max_passes):
             moved = False
             for i in range(len(chosen)):
                 others = chosen[:i] + chosen[i + 1:]
-                pick, score = _best_addition(design, others, threshold)
+                pick, score = _best_addition(gp, others, threshold)
                 if score < best and pick != chosen[i]:
                     chosen, best, moved = [*others[:i], pick, *others[i:]], score, True
             if not moved:
@@ -157,7 +134,7 @@ def plan_pokes(poked_xy: Array, poked_noise: Array, candidates: Array, domain: A
         if best[1] <= threshold:
             break
     # poke first where the field is least known now
-    _, _, var_now = design.gp.posterior([])
+    _, _, var_now = gp.posterior([])
     order = sorted(range(len(chosen)), key=lambda i: (-var_now[chosen[i]], i))
     targets = candidates[np.array([chosen[i] for i in order])]
     return PokePlan(targets=np.array(targets, dtype=float), max_variance=best[1],

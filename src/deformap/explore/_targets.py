@@ -21,7 +21,7 @@ from deformap.explore._acquisition import boundary_score, choose_target
 from deformap.explore._config import ExplorationConfig
 from deformap.explore._field import BetaField, PokeSet, field_settings
 from deformap.explore._grid import MapGrid
-from deformap.explore._planning import PokePlan, VarianceDesign, plan_pokes
+from deformap.explore._planning import PokePlan, plan_pokes
 from deformap.explore._records import Target
 from deformap.explore._regions import poke_classes
 
@@ -127,18 +127,6 @@ def _boundary(grid: MapGrid, field: BetaField, pokes: PokeSet,
     return np.array(cells[int(np.argmax(score))], dtype=float)
 
 
-def _integrated(grid: MapGrid, pokes: PokeSet, config: ExplorationConfig
-                ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:  # fmt: skip
-    """The planner's candidates and how much a poke at each lowers the variance summed over the
-    planner's domain (``integrated-variance``), each with the noise it is expected to have."""
-    cfg = field_settings(config)
-    candidates = grid.plan_candidates
-    design = VarianceDesign(pokes.xy, pokes.noise, candidates, grid.plan_domain,
-                            cfg.signal_std, cfg.length_scale_m,
-                            expected_noise(candidates, pokes, config))  # fmt: skip
-    return candidates, design.integrated_reduction()
-
-
 def choose_next(grid: MapGrid, field: BetaField, config: ExplorationConfig,
                 rng: np.random.Generator, *, boundary_owed: int,
                 n_made: int | None = None) -> Target | None:
@@ -154,7 +142,7 @@ def choose_next(grid: MapGrid, field: BetaField, config: ExplorationConfig,
         :func:`deformap.explore.field_settings`.
     config : ExplorationConfig
     rng : numpy.random.Generator
-        This choice's stream (``paper`` draws from it; ``min-max-variance`` subsamples with it).
+        This choice's stream (``paper`` draws from it).
     boundary_owed : int
         Boundary pokes still to make.
     n_made : int, optional
@@ -188,26 +176,14 @@ def choose_next(grid: MapGrid, field: BetaField, config: ExplorationConfig,
         else:
             xy = np.array(cells[int(np.argmax(reachable))], dtype=float)
     else:
-        def look_ahead(candidates: NDArray[np.float64]) -> NDArray[np.float64]:
-            # exact rank-one updates of the posterior: the variance does not depend on the βs
-            cfg = field_settings(config)
-            design = VarianceDesign(pokes.xy, pokes.noise, candidates,
-                                    grid.cells_xy[grid.stop_mask], cfg.signal_std,
-                                    cfg.length_scale_m,
-                                    expected_noise(candidates, pokes, config))  # fmt: skip
-            return design.after([], threshold)[1]
-
         def scorer() -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-            if config.strategy == "integrated-variance":
-                return _integrated(grid, pokes, config)
             found = _straddle(grid, field, pokes, config)
             if found[1].size == 0:  # every reachable cell near a poke: the least known one
                 return cells, reachable
             return found
 
         chosen = choose_target(config.strategy, cells, reachable, threshold, rng,
-                               look_ahead=look_ahead, planner=planner,
-                               scorer=scorer)  # fmt: skip
+                               planner=planner, scorer=scorer)  # fmt: skip
         if chosen is None:  # pragma: no cover - reachable.max() > threshold above
             return None
         xy = chosen
