@@ -10,7 +10,8 @@ import pytest
 from deformap._config import config_from_dict
 from deformap.errors import ConfigError
 from deformap.explore import ExplorationConfig
-from deformap.run import exploration_changes, exploration_with, parse_assignments
+from deformap.run import exploration_with, parse_assignments
+from deformap.run._worlds_config import exploration_changes
 from deformap.run._worlds_engines import _task, task_data
 
 

@@ -88,7 +88,6 @@ if TYPE_CHECKING:
     )
     from deformap.run._worlds_config import (
         WorldsBenchConfig,
-        exploration_changes,
         exploration_with,
         parse_assignments,
     )
@@ -115,8 +114,7 @@ _MODULES = {
                  "run_hardness_study"),
     "_world": ("ScenarioSummary", "scenario_summaries", "show_scenario"),
     "_worlds": ("RESCORABLE", "WorldsOutput", "bench_worlds", "load_worlds", "rescore_worlds"),
-    "_worlds_config": ("WorldsBenchConfig", "exploration_changes", "exploration_with",
-                       "parse_assignments"),
+    "_worlds_config": ("WorldsBenchConfig", "exploration_with", "parse_assignments"),
     "_worlds_engines": ("BLAS_THREAD_VARIABLES",),
 }  # fmt: skip
 
@@ -149,7 +147,6 @@ __all__ = [
     "default_run_folder",
     "estimate_one_poke",
     "estimate_report",
-    "exploration_changes",
     "exploration_with",
     "explore_environment",
     "explore_run_config",
