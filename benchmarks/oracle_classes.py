@@ -1,4 +1,4 @@
-"""What limits a worlds benchmark's maps: the classes found, or where the pokes went (issue 16).
+"""What limits a worlds benchmark's maps: the classes found, or where the pokes went.
 
     OMP_NUM_THREADS=1 PYTHONPATH=src python benchmarks/oracle_classes.py RUN [--cut nearest]
 
@@ -22,32 +22,33 @@ region accuracy 0.9 (a world that never gets there counts ``max_pokes + 1``, as 
 from __future__ import annotations
 
 import argparse
-import json
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 from scipy.spatial import cKDTree
 
-from deformap.eval import region_scores, summarise_worlds
-from deformap.eval._worlds import _draw, _material_truth
+from deformap.errors import ConfigError
+from deformap.eval import WorldResult, WorldTask, material_truth, region_scores, summarise_worlds
 from deformap.explore import MapGrid
+from deformap.run import load_worlds
 
 
-def _oracle_rows(task: dict[str, Any], result: dict[str, Any]) -> list[dict[str, Any]]:
+def _oracle_rows(task: WorldTask, result: WorldResult) -> list[dict[str, Any]]:
     """Rows of the oracle cut (``cut`` "oracle") after every poke of every stored combination."""
-    draw, explore = _draw(task)
-    grid = MapGrid.build(draw.scenario.workspace, explore)
-    labels, hardness, _ = _material_truth(draw.scenario, grid.xs, grid.ys)
+    draw = task.draw()
+    grid = MapGrid.build(draw.scenario.workspace, task.exploration_for(draw))
+    labels, hardness, _ = material_truth(draw.scenario, grid.xs, grid.ys)
     cells = grid.cells_xy
     under = cKDTree(cells)
     rows = []
-    for combo, data in result["pokes"].items():
+    for combo, data in result.pokes.items():
         strategy, field = combo.split("/")
         xy = np.column_stack([data["x"], data["y"]])
         index = np.asarray(data["index"], dtype=np.int64)
         truth_at_poke = labels.reshape(-1)[under.query(xy)[1]] if len(xy) else index
-        for poke in range(1, task["max_pokes"] + 1):
+        for poke in range(1, task.max_pokes + 1):
             keep = index < poke
             if not keep.any():
                 continue
@@ -65,25 +66,25 @@ def main() -> None:
     parser.add_argument("run", type=Path, help="a bench worlds folder with stored pokes")
     parser.add_argument("--cut", default="nearest", help="the run's cut shown beside the oracle")
     args = parser.parse_args()
-    settings = json.loads((args.run / "bench.json").read_text(encoding="utf-8"))["settings"]
-    if args.cut not in settings["cuts"]:
-        raise SystemExit(f"--cut: expected one of the run's cuts {settings['cuts']}; "
+    try:
+        config, stored = load_worlds(args.run)
+    except ConfigError as exc:
+        raise SystemExit(f"RUN: {exc}") from None
+    if args.cut not in config.cuts:
+        raise SystemExit(f"--cut: expected one of the run's cuts {list(config.cuts)}; "
                          f"got {args.cut!r}")
     results = []
-    for path in sorted((args.run / "worlds").glob("world-*.json")):
-        result = json.loads(path.read_text(encoding="utf-8"))
-        if result.get("status") != "ok" or not isinstance(result.get("pokes"), dict):
+    for result in stored:
+        if result.status != "ok":
             continue
-        task = {"seed": settings["seed"], "index": result["world"]["index"],
-                "families": settings["families"], "physics": settings["physics"],
-                "max_pokes": settings["max_pokes"]}
-        own = [r for r in result["rows"] if r["cut"] == args.cut]
-        results.append({**result, "rows": own + _oracle_rows(task, result)})
+        own = [r for r in result.rows if r["cut"] == args.cut]
+        oracle = _oracle_rows(config.task(result.index), result)
+        results.append(replace(result, rows=(*own, *oracle)))
     if not results:
         raise SystemExit(f"RUN: expected finished worlds with stored pokes in {args.run}; "
                          f"got none")
-    k = settings["max_pokes"]
-    combos = [(s, f, c) for s in settings["strategies"] for f in settings["fields"]
+    k = config.max_pokes
+    combos = [(s, f, c) for s in config.strategies for f in config.fields
               for c in (args.cut, "oracle")]
     summary = summarise_worlds(results, combos, k)["strategies"]
     families = sorted({f for s in summary.values() for f in s["by_family"]})

@@ -1,4 +1,4 @@
-"""How few pokes a good map could take: pokes placed knowing the layout, cut by nearest poke (issue 16).
+"""How few pokes a good map could take: pokes placed knowing the layout, cut by nearest poke.
 
     OMP_NUM_THREADS=1 PYTHONPATH=src python benchmarks/oracle_placement.py [--worlds 100]
         [--seed 0] [--max-pokes 20] [--run RUN] [--placements layout,maximin,boundary]
@@ -33,8 +33,8 @@ the run's own medians per combination (its ``nearest`` cut), as the baseline on 
 from __future__ import annotations
 
 import argparse
-import json
 import os
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -44,9 +44,16 @@ for _name in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
 import numpy as np  # noqa: E402
 from numpy.typing import NDArray  # noqa: E402
 
-from deformap.eval import region_scores, summarise_worlds  # noqa: E402
-from deformap.eval._worlds import _draw, _material_truth  # noqa: E402
+from deformap.errors import ConfigError  # noqa: E402
+from deformap.eval import (  # noqa: E402
+    WorldResult,
+    WorldTask,
+    material_truth,
+    region_scores,
+    summarise_worlds,
+)
 from deformap.explore import MapGrid  # noqa: E402
+from deformap.run import load_worlds  # noqa: E402
 from deformap.world import LAYOUT_FAMILIES  # noqa: E402
 
 GOOD = 0.9
@@ -57,15 +64,15 @@ BOUNDARY_FIRST = 4  # maximin pokes before the boundary score
 BOUNDARY_WEIGHT = 2.0
 
 
-def _world(task: dict[str, Any]) -> tuple[Any, NDArray[np.int64], Any, Any, NDArray[np.float64],
+def _world(task: WorldTask) -> tuple[Any, NDArray[np.int64], Any, Any, NDArray[np.float64],
                                           NDArray[np.float64], NDArray[np.float64],
                                           NDArray[np.int64]]:
     """The world's draw, its true labels on the grid (and as the grid's shape), its hardness, the
     grid's cells, the planner's candidates, their distances ``(c, n)`` to the cells and the
     material under each candidate."""
-    draw, explore = _draw(task)
-    grid = MapGrid.build(draw.scenario.workspace, explore)
-    labels, hardness, _ = _material_truth(draw.scenario, grid.xs, grid.ys)
+    draw = task.draw()
+    grid = MapGrid.build(draw.scenario.workspace, task.exploration_for(draw))
+    labels, hardness, _ = material_truth(draw.scenario, grid.xs, grid.ys)
     truth = labels.reshape(-1)
     cells = grid.cells_xy
     candidates = grid.plan_candidates
@@ -73,14 +80,14 @@ def _world(task: dict[str, Any]) -> tuple[Any, NDArray[np.int64], Any, Any, NDAr
     return draw, truth, labels, hardness, cells, candidates, dist, truth[np.argmin(dist, axis=1)]
 
 
-def blind_curve(task: dict[str, Any], placement: str) -> tuple[str, list[float]]:
+def blind_curve(task: WorldTask, placement: str) -> tuple[str, list[float]]:
     """The world's family and the region accuracy after each of ``max_pokes`` pokes placed by
     ``maximin`` or ``boundary`` (module docstring), each read as the material under it."""
     draw, _, labels, hardness, _, candidates, dist, cand_label = _world(task)
     centre = np.asarray(draw.scenario.workspace.center, float)
     pokes = [int(np.argmin(np.hypot(*(candidates - centre).T)))]
     curve = []
-    for _ in range(int(task["max_pokes"])):
+    for _ in range(task.max_pokes):
         found = cand_label[pokes][np.argmin(dist[pokes], axis=0)].reshape(labels.shape)
         curve.append(region_scores(found, labels, found.astype(float), hardness).accuracy)
         apart = np.hypot(*(candidates[:, None, :] - candidates[None, pokes, :]).transpose(2, 0, 1))
@@ -97,7 +104,7 @@ def blind_curve(task: dict[str, Any], placement: str) -> tuple[str, list[float]]
     return draw.family, curve
 
 
-def greedy_curve(task: dict[str, Any]) -> tuple[str, list[float]]:
+def greedy_curve(task: WorldTask) -> tuple[str, list[float]]:
     """The world's family and the region accuracy after each of ``max_pokes`` oracle pokes."""
     draw, truth, labels, hardness, cells, _, dist, cand_label = _world(task)
 
@@ -107,7 +114,7 @@ def greedy_curve(task: dict[str, Any]) -> tuple[str, list[float]]:
 
     near, label = place(np.asarray(draw.scenario.workspace.center, float))
     curve = []
-    for _ in range(int(task["max_pokes"])):
+    for _ in range(task.max_pokes):
         found = label.reshape(labels.shape)
         curve.append(region_scores(found, labels, found.astype(float), hardness).accuracy)
         closer = dist < near[None, :]
@@ -134,48 +141,37 @@ def main() -> None:
     if not placements or not set(placements) <= set(PLACEMENTS):
         raise SystemExit(f"--placements: expected some of {', '.join(PLACEMENTS)}; got "
                          f"{args.placements!r}")
-    families, physics, run_rows = list(LAYOUT_FAMILIES), ["linear-fem"], None
+    base = WorldTask(seed=args.seed, families=LAYOUT_FAMILIES, physics=("linear-fem",),
+                     max_pokes=args.max_pokes)
+    run = None
     if args.run is not None:
         try:
-            settings = json.loads((args.run / "bench.json").read_text(encoding="utf-8"))[
-                "settings"]
-        except (OSError, ValueError, KeyError, TypeError) as exc:
-            raise SystemExit(f"--run: expected a bench worlds folder with its bench.json; got "
-                             f"{args.run} ({exc})") from None
-        if settings["seed"] != args.seed or "nearest" not in settings["cuts"]:
+            run, stored = load_worlds(args.run)
+        except ConfigError as exc:
+            raise SystemExit(f"--run: {exc}") from None
+        if run.seed != args.seed or "nearest" not in run.cuts:
             raise SystemExit(f"--run: expected a run of seed {args.seed} scored under the nearest "
-                             f"cut; got seed {settings['seed']}, cuts {settings['cuts']}")
-        families, physics = settings["families"], settings["physics"]
-        run_rows = settings
+                             f"cut; got seed {run.seed}, cuts {list(run.cuts)}")
+        base = replace(base, families=run.families, physics=run.physics)
     results = []
     for index in range(args.worlds):
-        task = {"seed": args.seed, "index": index, "families": families, "physics": physics,
-                "max_pokes": args.max_pokes}
-        rows = []
+        task = replace(base, index=index)
+        rows: list[dict[str, Any]] = []
         for placement in placements:
             family, curve = (greedy_curve(task) if placement == "layout"
                              else blind_curve(task, placement))
             rows += [{"strategy": "oracle", "field": placement, "cut": "nearest", "poke": k + 1,
                       "accuracy": a, "modulus_error": None} for k, a in enumerate(curve)]
-        results.append({"world": {"index": index, "family": family}, "rows": rows,
-                        "status": "ok"})
+        results.append(WorldResult(world={"index": index, "family": family}, rows=tuple(rows)))
     combos = [("oracle", placement, "nearest") for placement in placements]
-    if run_rows is not None:
-        stored = {}
-        for path in sorted((args.run / "worlds").glob("world-*.json")):
-            try:
-                r = json.loads(path.read_text(encoding="utf-8"))
-            except (OSError, ValueError) as exc:
-                raise SystemExit(f"--run: {path} cannot be read ({exc})") from None
-            if r.get("status") == "ok" and r["world"]["index"] < args.worlds:
-                stored[r["world"]["index"]] = [x for x in r["rows"] if x["cut"] == "nearest"
-                                               and x["poke"] <= args.max_pokes]
-        if set(stored) != set(range(args.worlds)):
+    if run is not None:
+        own = {r.index: [x for x in r.rows if x["cut"] == "nearest" and x["poke"] <= args.max_pokes]
+               for r in stored if r.status == "ok" and r.index < args.worlds}
+        if set(own) != set(range(args.worlds)):
             raise SystemExit(f"--run: expected worlds 0..{args.worlds - 1} finished; got "
-                             f"{len(stored)}")
-        for r in results:
-            r["rows"] += stored[r["world"]["index"]]
-        combos += [(s, f, "nearest") for s in run_rows["strategies"] for f in run_rows["fields"]]
+                             f"{len(own)}")
+        results = [replace(r, rows=(*r.rows, *own[r.index])) for r in results]
+        combos += [(s, f, "nearest") for s in run.strategies for f in run.fields]
     summary = summarise_worlds(results, combos, args.max_pokes)["strategies"]
     names = sorted({f for s in summary.values() for f in s["by_family"]})
     print(f"{args.worlds} worlds of seed {args.seed}, {args.max_pokes} pokes; median pokes to "
@@ -191,7 +187,7 @@ def main() -> None:
         entry = summary[f"{s}/{f}/{c}"]
         means = []
         for k in (5, 10, 20):
-            acc = [x["accuracy"] for r in results for x in r["rows"]
+            acc = [x["accuracy"] for r in results for x in r.rows
                    if (x["strategy"], x["field"], x["cut"], x["poke"]) == (s, f, c, k)]
             means.append(f"{np.mean(acc):.3f}" if acc else "–")
         label = labels[f] if s == "oracle" else f"{s}/{f}"

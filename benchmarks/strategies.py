@@ -1,4 +1,4 @@
-"""Strategies and cuts compared: region accuracy after every poke (issue 16, item 4).
+"""Strategies and cuts compared: region accuracy after every poke.
 
 Each run explores one world to ``--max-pokes`` pokes with one strategy, then replays its pokes
 one at a time into a fresh :class:`deformap.explore.Mapper` and scores every cut

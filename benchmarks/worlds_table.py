@@ -1,10 +1,10 @@
-"""One table over the combinations of one or more ``deformap bench worlds`` runs (issue 16).
+"""One table over the combinations of one or more ``deformap bench worlds`` runs.
 
     PYTHONPATH=src python benchmarks/worlds_table.py RUN [RUN ...] [--worlds N]
 
 Reads each run's worlds (a ``bench worlds`` or ``bench rescore`` folder) and prints, per
-strategy/field/cut over the worlds below ``--worlds`` (default: all), what the README's "Many
-worlds" tables show beyond ``summary.md``: the median pokes to region accuracy 0.9 (with its
+strategy/field/cut over the worlds below ``--worlds`` (default: all), what the results' tables
+show beyond ``summary.md``: the median pokes to region accuracy 0.9 (with its
 95 % bootstrap interval) and their mean, the share reaching it and the median final accuracy
 (``summary.json``'s, :func:`deformap.eval.summarise_worlds`: a world never there, or failed,
 counts ``max_pokes + 1``), the mean accuracy
@@ -19,40 +19,43 @@ one and the β-field of another); a combination found in two runs is refused.
 from __future__ import annotations
 
 import argparse
-import json
 import statistics
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
-from deformap.eval import GOOD_ACCURACY, accuracy_curves, combination_name, summarise_worlds
+from deformap.errors import ConfigError
+from deformap.eval import (
+    GOOD_ACCURACY,
+    WorldResult,
+    accuracy_curves,
+    combination_name,
+    summarise_worlds,
+)
+from deformap.run import WorldsBenchConfig, load_worlds
 
 
-def _read(run: Path, below: int | None) -> tuple[dict[str, Any], list[dict[str, Any]]]:
+def _read(run: Path, below: int | None) -> tuple[WorldsBenchConfig, list[WorldResult]]:
     """``run``'s settings and its worlds' results (those numbered below ``below``)."""
     try:
-        settings = json.loads((run / "bench.json").read_text(encoding="utf-8"))["settings"]
-        results = [json.loads(path.read_text(encoding="utf-8"))
-                   for path in sorted((run / "worlds").glob("world-*.json"))]
-        results = [r for r in results if below is None or r["world"]["index"] < below]
-    except (OSError, ValueError, KeyError, TypeError) as exc:
-        raise SystemExit(f"RUN: expected a bench worlds folder with bench.json and worlds/; got "
-                         f"{run} ({exc})") from None
+        config, results = load_worlds(run)
+    except ConfigError as exc:
+        raise SystemExit(f"RUN: {exc}") from None
+    results = [r for r in results if below is None or r.index < below]
     if not results:
         raise SystemExit(f"RUN: expected finished worlds in {run}; got none")
-    return settings, results
+    return config, results
 
 
-def _ends(results: list[dict[str, Any]], combination: tuple[str, str, str], max_pokes: int
+def _ends(results: list[WorldResult], combination: tuple[str, str, str], max_pokes: int
           ) -> tuple[list[int], int, int, int]:
     """Per finished world, the pokes to ``T_h``; and how many ended on another field, with fewer
     regions than true, with more."""
     to_th, other, under, over = [], 0, 0, 0
     for result in results:
-        if result.get("status") != "ok":
+        if result.status != "ok":
             continue
-        rows = sorted((r for r in result["rows"]
+        rows = sorted((r for r in result.rows
                        if (r["strategy"], r["field"], r["cut"]) == combination),
                       key=lambda r: r["poke"])
         to_th.append(next((r["poke"] for r in rows if r["threshold"]), max_pokes + 1))
@@ -71,10 +74,9 @@ def main() -> None:
     seen: set[tuple[str, str, str]] = set()
     lines = []
     for run in args.runs:
-        settings, results = _read(run, args.worlds)
-        k = int(settings["max_pokes"])
-        combos = [(s, f, c) for s in settings["strategies"] for f in settings["fields"]
-                  for c in settings["cuts"]]
+        config, results = _read(run, args.worlds)
+        k = config.max_pokes
+        combos = config.combinations()
         if seen & set(combos):
             raise SystemExit(f"RUN: {'/'.join(sorted(seen & set(combos))[0])} is in more than "
                              f"one run")

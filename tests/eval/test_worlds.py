@@ -1,10 +1,11 @@
-"""The many-worlds benchmark's parts: the world draw, one world mapped, and the summary (issue 16)."""
+"""The many-worlds benchmark's parts: the world draw, one world mapped, and the summary."""
 
 from __future__ import annotations
 
 import csv
 import io
 import json
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -14,6 +15,8 @@ from deformap.eval import (
     CSV_COLUMNS,
     FORCES_N,
     THICKNESSES_M,
+    WorldResult,
+    WorldTask,
     accuracy_curves,
     choices,
     draw_world,
@@ -25,7 +28,7 @@ from deformap.eval import (
     runs_csv,
     summarise_worlds,
 )
-from deformap.explore import STRATEGIES
+from deformap.explore import STRATEGIES, ExplorationConfig
 from deformap.world import CAMERA_PRESETS, LAYOUT_FAMILIES, PHYSICS
 
 
@@ -54,7 +57,7 @@ def test_worlds_take_the_families_in_turn_and_are_drawn_from_seed_and_index() ->
 
 
 def _result(index: int, family: str, accuracy: dict[str, list[float]], status: str = "ok",
-            modulus_error: float | None = 0.2) -> dict:
+            modulus_error: float | None = 0.2) -> WorldResult:
     rows = [{"strategy": name.split("/")[0], "field": name.split("/")[1], "cut": "isopleth",
              "poke": k + 1, "purpose": "variance", "map_field": name.split("/")[1],
              "threshold": False, "accuracy": a, "mean_iou": a, "found": 2, "true": 2,
@@ -64,14 +67,14 @@ def _result(index: int, family: str, accuracy: dict[str, list[float]], status: s
     world = {"index": index, "family": family, "physics": "linear-fem", "camera": "primesense",
              "thickness_m": 0.05, "force_n": 0.6}
     if status != "ok":
-        return {"world": world, "rows": [], "status": "failed", "error": "Boom: no"}
-    return {"world": world, "rows": rows, "status": "ok", "error": None, "seconds": 3.0}
+        return WorldResult(world=world, status="failed", error="Boom: no")
+    return WorldResult(world=world, rows=tuple(rows), seconds=3.0)
 
 
 COMBOS = [("paper", "beta", "isopleth"), ("planned", "beta", "isopleth")]
 
 
-def _results() -> list[dict]:
+def _results() -> list[WorldResult]:
     return [
         _result(0, "cuts", {"paper/beta": [0.5, 0.95, 0.97], "planned/beta": [0.92, 0.95, 0.96]}),
         _result(1, "cuts", {"paper/beta": [0.5, 0.6, 0.7], "planned/beta": [0.5, 0.91, 0.93]}),
@@ -192,14 +195,23 @@ def test_runs_csv_has_a_row_per_poke_and_the_failed_world_per_combination() -> N
     assert all(r["poke"] == "" and r["error"] == "Boom: no" for r in failed)
 
 
+def _task(**given) -> WorldTask:
+    return WorldTask(**{"seed": 5, "index": 0, "families": ("l-shape",),
+                        "physics": ("linear-fem",), "strategies": ("paper",),
+                        "fields": ("modulus",), "cuts": ("nearest",), "coarse": True, **given})
+
+
+def _through_json(result: WorldResult) -> WorldResult:
+    """``result`` as a world file holds it and as it crosses processes."""
+    return WorldResult.from_dict(json.loads(json.dumps(result.to_dict())))
+
+
 def test_one_world_is_mapped_to_max_pokes_by_every_combination() -> None:
-    task = {"seed": 5, "index": 0, "families": ["l-shape"], "physics": ["linear-fem"],
-            "strategies": ["paper"],
-            "fields": ["beta", "modulus"], "cuts": ["isopleth", "nearest"], "max_pokes": 2,
-            "coarse": True}
+    task = _task(fields=("beta", "modulus"), cuts=("isopleth", "nearest"), max_pokes=2)
     result = run_world(task)
-    assert result["status"] == "ok" and result["world"]["family"] == "l-shape"
-    rows = result["rows"]
+    assert result.status == "ok" and result.world["family"] == "l-shape"
+    assert _through_json(result) == result  # plain data, every bit kept
+    rows = result.rows
     assert [(r["field"], r["poke"], r["cut"]) for r in rows] == [
         (f, k, c) for f in ("beta", "modulus") for k in (1, 2) for c in ("isopleth", "nearest")]
     for r in rows:
@@ -207,27 +219,37 @@ def test_one_world_is_mapped_to_max_pokes_by_every_combination() -> None:
         assert r["true"] == 2 and r["found"] >= 1
     assert rows[0]["purpose"] == "first"
     assert rows[-1]["modulus_error"] is not None and rows[-1]["modulus_error"] >= 0
-    json.dumps(result)  # plain data crosses processes
     assert np.isfinite([r["poke_s"] for r in rows]).all()
     for field in ("beta", "modulus"):
-        stored = result["pokes"][f"paper/{field}"]
+        stored = result.pokes[f"paper/{field}"]
         assert sorted(stored) == ["index", "noise", "thickness", "value", "x", "y"]
         assert stored["thickness"] is not None and len(stored["thickness"]) == len(stored["x"])
         assert 1 <= len(stored["value"]) <= 2 and stored["index"] == sorted(stored["index"])
     # the stored pokes score the run's cuts again to the bit, through JSON, in another order
-    again = rescore_world(task, json.loads(json.dumps(result)), ["nearest", "isopleth"])
+    again = rescore_world(replace(task, cuts=("nearest", "isopleth")), _through_json(result))
     key = lambda r: (r["field"], r["poke"], r["cut"])  # noqa: E731
-    assert sorted(again["rows"], key=key) == sorted(rows, key=key)
+    assert sorted(again.rows, key=key) == sorted(rows, key=key)
 
 
-def test_a_world_without_stored_pokes_cannot_be_rescored() -> None:
-    task = {"seed": 5, "index": 0, "families": ["l-shape"], "physics": ["linear-fem"],
-            "strategies": ["paper"], "fields": ["beta"], "cuts": ["nearest"], "max_pokes": 2,
-            "coarse": True}
-    with pytest.raises(InvalidArgumentError, match="pokes stored; got status 'ok' and no pokes"):
-        rescore_world(task, {"status": "ok", "rows": []}, ["nearest"])
+def test_a_stored_world_of_another_format_or_without_pokes_is_refused_in_one_line() -> None:
+    stored = {"world": {"index": 0}, "rows": [], "pokes": {}, "fallback_pokes": {},
+              "pokes_format": 3, "seconds": 1.0, "status": "ok", "error": None}
+    assert WorldResult.from_dict(stored).status == "ok"
+    for data, message in (({**stored, "pokes_format": 2}, "`pokes_format` is 2; this version "
+                                                          "of deformap reads 3 only"),
+                          ({k: v for k, v in stored.items() if k != "pokes_format"},
+                           "`pokes_format` is None"),
+                          ({**stored, "pokes": None}, "`pokes` must be an object"),
+                          ({**stored, "pokes": {"paper/beta": {"x": [0.1]}}},
+                           "the pokes of 'paper/beta' must have lists"),
+                          ({**stored, "world": {"index": -1}}, "`world.index` must be")):
+        with pytest.raises(InvalidArgumentError, match=message) as caught:
+            WorldResult.from_dict(data)
+        assert len(str(caught.value).splitlines()) == 1
+    failed = WorldResult(world={"index": 0, "family": "cuts"}, status="failed", error="Boom")
+    assert WorldResult.from_dict(failed.to_dict()) == failed
     with pytest.raises(InvalidArgumentError, match="status 'failed'"):
-        rescore_world(task, {"status": "failed", "rows": [], "pokes": {}}, ["nearest"])
+        rescore_world(_task(), failed)
 
 
 def test_the_command_refuses_bad_names_in_one_line_before_any_folder(tmp_path) -> None:
@@ -241,11 +263,13 @@ def test_the_command_refuses_bad_names_in_one_line_before_any_folder(tmp_path) -
                           (["--cut", "voronoi"], "got ['voronoi'] (unknown)"),
                           (["--cuts", "nearest,nearest"], "got ['nearest'] more than once"),
                           (["--worlds", "0"], "`worlds` must be an integer >= 1"),
-                          (["--unread-place", "skip"],
-                           "`unread_place` must be one of ['beta', 'avoid']; got 'skip'"),
-                          (["--boundary-score", "voronoi"],
-                           "`boundary_score` must be one of ['straddle', 'nearest-poke']; got "
-                           "'voronoi'")):
+                          (["--set", "merge_seams=maybe"], "`exploration.merge_seams` must be"),
+                          (["--set", "merge_seam=false"], "`exploration.merge_seam` is no "
+                                                          "setting"),
+                          (["--set", "beta_field.signal_std=-1"],
+                           "`exploration.beta_field.signal_std` must be"),
+                          (["--set", "merge_seams"], "--set must be key=value"),
+                          (["--set", "strategy=paper"], "(option: --strategies)")):
         result = CliRunner().invoke(app, ["bench", "worlds", "--out", str(out), *args])
         assert result.exit_code == 2, result.output
         assert message in result.output and len(result.output.strip().splitlines()) == 1
@@ -291,15 +315,16 @@ def test_where_the_pokes_go_does_not_depend_on_the_cut() -> None:
 def test_the_cuts_are_scored_on_the_same_pokes_as_a_run_per_cut() -> None:
     """Each cut's rows from one run scoring every cut equal those of a run scoring that cut
     alone (scoring one cut leaves the others' scores alone)."""
-    task = {"seed": 2, "index": 1, "families": ["insert"], "physics": ["linear-fem"],
-            "strategies": ["level-set"], "fields": ["beta"], "max_pokes": 4, "coarse": True}
-    cuts = ["isopleth", "nearest", "indicator-kriging"]
-    result = run_world({**task, "cuts": cuts})
-    together = [row_values(r) for r in result["rows"]]
+    cuts = ("isopleth", "nearest", "indicator-kriging")
+    task = _task(seed=2, index=1, families=("insert",), strategies=("level-set",),
+                 fields=("beta",), max_pokes=4, cuts=cuts)
+    result = run_world(task)
+    together = [row_values(r) for r in result.rows]
     # the β-field's stored pokes, rescored with the map's nugget estimated again after each poke
-    rescored = rescore_world({**task, "cuts": cuts}, json.loads(json.dumps(result)), cuts)
-    assert [row_values(r) for r in rescored["rows"]] == together
-    apart = [row_values(r) for cut in cuts for r in run_world({**task, "cuts": [cut]})["rows"]]
+    rescored = rescore_world(task, _through_json(result))
+    assert [row_values(r) for r in rescored.rows] == together
+    apart = [row_values(r) for cut in cuts
+             for r in run_world(replace(task, cuts=(cut,))).rows]
     key = lambda r: (r["cut"], r["poke"])  # noqa: E731
     assert sorted(together, key=key) == sorted(apart, key=key)
     assert {r["cut"] for r in together} == set(cuts)
@@ -309,9 +334,7 @@ def test_rescoring_merges_a_junction_class_within_the_stored_thickness_only() ->
     """Stored pokes: a soft left, a stiff right and a column between them on the joint; the
     junction rule merges that column when the stored layer is thick enough to reach it, and
     a poke without a thickness turns the rule off from that poke on."""
-    task = {"seed": 5, "index": 0, "families": ["l-shape"], "physics": ["linear-fem"],
-            "strategies": ["paper"], "fields": ["modulus"], "cuts": ["nearest"],
-            "max_pokes": 25, "coarse": True}
+    task = _task(max_pokes=25)
     xs, ys = np.linspace(0.1, 0.5, 5), np.linspace(0.05, 0.35, 5)
     xy = np.array([(x, y) for y in ys for x in xs])
     value = np.log(np.where(xy[:, 0] < 0.25, 10e3, np.where(xy[:, 0] > 0.35, 40e3, 20e3)))
@@ -321,9 +344,9 @@ def test_rescoring_merges_a_junction_class_within_the_stored_thickness_only() ->
     def found(thickness, merge: bool) -> list[int]:
         pokes = {"x": xy[:, 0].tolist(), "y": xy[:, 1].tolist(), "value": value.tolist(),
                  "noise": [0.1] * 25, "index": list(range(25)), "thickness": thickness}
-        result = {"status": "ok", "world": {"index": 0}, "rows": rows,
-                  "pokes": {"paper/modulus": pokes}}
-        again = rescore_world(task, result, ["nearest"], merge_seams=merge)["rows"]
+        result = WorldResult(world={"index": 0}, rows=tuple(rows),
+                             pokes={"paper/modulus": pokes})
+        again = rescore_world(_rules(task, merge_seams=merge), result).rows
         return [r["found"] for r in again]
 
     assert found([0.06] * 25, merge=False)[-1] == 3  # the joint column is a class
@@ -335,22 +358,20 @@ def test_rescoring_merges_a_junction_class_within_the_stored_thickness_only() ->
     close = np.log(np.where(xy[:, 0] < 0.3, 10e3, 12.2e3))
     pokes = {"x": xy[:, 0].tolist(), "y": xy[:, 1].tolist(), "value": close.tolist(),
              "noise": [0.1] * 25, "index": list(range(25)), "thickness": [0.03] * 25}
-    result = {"status": "ok", "world": {"index": 0}, "rows": rows,
-              "pokes": {"paper/modulus": pokes}}
-    by_value, by_place = (rescore_world(task, result, ["nearest"], split_by_place=split)["rows"]
+    result = WorldResult(world={"index": 0}, rows=tuple(rows), pokes={"paper/modulus": pokes})
+    by_value, by_place = (rescore_world(_rules(task, split_by_place=split), result).rows
                           for split in (False, True))
     assert by_value[-1]["found"] == 1 and by_place[-1]["found"] == 2
     assert by_place[-1]["accuracy"] > by_value[-1]["accuracy"]
-    # a run that fell back to β from its third poke on: its rows are carried, not rescored
-    fell = [{**r, "accuracy": 0.123, "found": 7, "true": 2, "mean_iou": 0.1, "kendall_tau": None,
-             "map_field": "modulus" if r["poke"] < 3 else "beta"} for r in rows]
-    again = rescore_world(task, {**result, "rows": fell}, ["nearest"], split_by_place=True)
-    assert again["rows"] == fell  # the same rows whatever the rules asked
-    with pytest.raises(InvalidArgumentError, match=r"`cuts` must be among those paper/modulus "
-                                                   r"of world 0 was scored under \(\['nearest'\]\)"):
-        rescore_world(task, {**result, "rows": fell}, ["nearest", "isopleth"])
-    with pytest.raises(InvalidArgumentError, match="merge_seams and split_by_place only"):
-        rescore_world(task, {"status": "ok", "rows": [], "pokes": {}}, ["nearest"], max_regions=2)
+    # a run that fell back to β from its third poke on needs its β pokes to be rescored
+    fell = tuple({**r, "map_field": "modulus" if r["poke"] < 3 else "beta"} for r in rows)
+    with pytest.raises(InvalidArgumentError, match="stores no beta pokes of 'paper/modulus', "
+                                                   "whose map field was 'beta' at poke 3"):
+        rescore_world(task, replace(result, rows=fell))
+
+
+def _rules(task: WorldTask, **rules) -> WorldTask:
+    return replace(task, exploration=replace(task.exploration, **rules))
 
 
 def test_a_run_that_fell_back_to_beta_is_rescored_on_its_stored_beta_pokes(monkeypatch) -> None:
@@ -364,33 +385,24 @@ def test_a_run_that_fell_back_to_beta_is_rescored_on_its_stored_beta_pokes(monke
         return None if len(calls) == 1 else recorded(self, *args, **kwargs)
 
     monkeypatch.setattr(SimulatedWorld, "force_travel", first_unrecorded)
-    task = {"seed": 5, "index": 0, "families": ["l-shape"], "physics": ["linear-fem"],
-            "strategies": ["paper"], "fields": ["modulus"], "cuts": ["nearest"], "max_pokes": 3,
-            "coarse": True}
-    result = json.loads(json.dumps(run_world(task)))
+    task = _task(max_pokes=3)
+    result = _through_json(run_world(task))
     # the first poke had no modulus: the map field was β there, the modulus field after it
-    assert [r["map_field"] for r in result["rows"]] == ["beta", "modulus", "modulus"]
-    beta, modulus = result["fallback_pokes"]["paper/modulus"], result["pokes"]["paper/modulus"]
+    assert [r["map_field"] for r in result.rows] == ["beta", "modulus", "modulus"]
+    beta, modulus = result.fallback_pokes["paper/modulus"], result.pokes["paper/modulus"]
     assert beta["index"] == [0, 1, 2] and modulus["index"] == [1, 2]
-    again = rescore_world(task, result, ["nearest"])
-    assert again["rows"] == result["rows"]  # to the bit, the β row included
-    # another cut is scored too (not carried): on the β pokes at the first poke
-    other = rescore_world(task, result, ["isopleth"])["rows"]
+    again = rescore_world(task, result)
+    assert again.rows == result.rows  # to the bit, the β row included
+    # another cut is scored too: on the β pokes at the first poke
+    other = rescore_world(replace(task, cuts=("isopleth",)), result).rows
     assert [r["cut"] for r in other] == ["isopleth"] * 3
     assert [r["map_field"] for r in other] == ["beta", "modulus", "modulus"]
-    # the same run with its β pokes lost (a world stored before they were) is carried instead
-    del result["fallback_pokes"]
-    assert rescore_world(task, result, ["nearest"])["rows"] == result["rows"]
-    with pytest.raises(InvalidArgumentError, match="its run fell back"):
-        rescore_world(task, result, ["isopleth"])
 
 
-def test_a_task_sets_where_the_pokes_go_after_an_unread_place_and_on_a_boundary() -> None:
-    from deformap.eval._worlds import _draw
-
-    task = {"seed": 5, "index": 0, "families": ["l-shape"], "physics": ["linear-fem"],
-            "max_pokes": 3}
-    _, default = _draw(task)
-    assert (default.unread_place, default.boundary_score) == ("avoid", "straddle")
-    _, given = _draw({**task, "unread_place": "beta", "boundary_score": "nearest-poke"})
-    assert (given.unread_place, given.boundary_score) == ("beta", "nearest-poke")
+def test_a_task_maps_with_its_exploration_settings_and_its_own_axes() -> None:
+    task = _task(max_pokes=3, exploration=ExplorationConfig(merge_seams=False))
+    draw = task.draw()
+    explore = task.exploration_for(draw)
+    assert explore == replace(ExplorationConfig(merge_seams=False), max_pokes=3,
+                              boundary_pokes=3, force_n=draw.force_n)
+    assert draw.summary() == draw_world(5, 0, ("l-shape",), ("linear-fem",)).summary()

@@ -1,5 +1,5 @@
 """``deformap bench worlds`` on the local process pool and on a Dask cluster: the same numbers,
-resumed without redoing a world, a failing world reported (issue 16, items 2 and 3)."""
+resumed without redoing a world, a failing world reported, a stored benchmark rescored."""
 
 from __future__ import annotations
 
@@ -13,8 +13,9 @@ import pytest
 
 from deformap.errors import ConfigError, InvalidArgumentError
 from deformap.eval import POKES_FORMAT, TIME_COLUMNS
+from deformap.explore import ExplorationConfig
 from deformap.run import WorldsBenchConfig, bench_worlds
-from deformap.run._worlds import _local_results
+from deformap.run._worlds_engines import world_results
 
 
 def _values(folder) -> list[dict[str, str]]:
@@ -56,34 +57,29 @@ def test_pool_and_dask_agree_byte_for_byte_apart_from_times_and_resume(tmp_path)
     assert again.computed == 0 and again.summary == pool.summary
     with pytest.raises(ConfigError, match=r"other settings \(max_pokes: 2 there, 3 here\)"):
         bench_worlds(_config(worlds=2, max_pokes=3), tmp_path / "pool")
-    # a folder from before the split by place ran without it: resumed as such, refused with it
+    # the exploration settings are the benchmark's: another is refused, naming it
+    with pytest.raises(ConfigError, match=r"other settings \(exploration: \{\} there, "
+                                          r"\{'split_by_place': False\} here\)"):
+        bench_worlds(_config(worlds=2, exploration=ExplorationConfig(split_by_place=False)),
+                     tmp_path / "pool")
+    # a folder of the format before: refused in one line naming both versions
     settings_file = tmp_path / "pool" / "bench.json"
     header = json.loads(settings_file.read_text())
-    del header["settings"]["split_by_place"]
+    assert header["format"] == 2 and header["settings"]["exploration"] == {}
+    del header["format"]
     settings_file.write_text(json.dumps(header))
-    assert bench_worlds(_config(worlds=2, split_by_place=False), tmp_path / "pool").computed == 0
-    with pytest.raises(ConfigError, match="split_by_place: False there, True here"):
-        bench_worlds(_config(worlds=2, split_by_place=True), tmp_path / "pool")
-    # and one from before unread_place gave a run to β at an unread place, and scored its
-    # boundary pokes by straddle
-    del header["settings"]["unread_place"], header["settings"]["boundary_score"]
-    settings_file.write_text(json.dumps(header))
-    resumed = _config(worlds=2, split_by_place=False, unread_place="beta",
-                      boundary_score="straddle")
-    assert bench_worlds(resumed, tmp_path / "pool").computed == 0
-    with pytest.raises(ConfigError, match="unread_place: 'beta' there, 'avoid' here"):
-        bench_worlds(replace(resumed, unread_place="avoid"), tmp_path / "pool")
-    with pytest.raises(ConfigError, match="boundary_score: 'straddle' there, 'nearest-poke'"):
-        bench_worlds(replace(resumed, boundary_score="nearest-poke"), tmp_path / "pool")
+    with pytest.raises(ConfigError, match="is a worlds benchmark of format 1; this version of "
+                                          "deformap reads format 2 only"):
+        bench_worlds(_config(worlds=2), tmp_path / "pool")
 
 
 def test_a_failing_world_is_tried_twice_then_reported_not_dropped(caplog) -> None:
-    bad = {**_config(worlds=1).task(0), "families": ["spiral"]}  # fails as it is drawn
+    bad = replace(_config(worlds=1).task(0), families=("spiral",))  # fails as it is drawn
     with caplog.at_level("WARNING"):
-        results = list(_local_results([bad], workers=1))
-    assert [r["status"] for r in results] == ["failed"]
-    assert "spiral" in results[0]["error"] and results[0]["rows"] == []
-    assert results[0]["world"] == {"index": 0, "family": "spiral"}
+        results = list(world_results([bad], workers=1))
+    assert [r.status for r in results] == ["failed"]
+    assert "spiral" in results[0].error and results[0].rows == ()
+    assert results[0].world == {"index": 0, "family": "spiral"}
     assert "trying once more" in caplog.text
 
 
@@ -94,6 +90,14 @@ def test_settings_are_checked_against_the_config_literals() -> None:
         WorldsBenchConfig(cuts=("voronoi",))
     with pytest.raises(InvalidArgumentError, match="`families` must be"):
         WorldsBenchConfig(families=())
+    # the exploration settings the benchmark's axes set are its own
+    for given, option in (({"strategy": "paper"}, "--strategies"),
+                          ({"max_pokes": 3}, "--max-pokes"),
+                          ({"region_labels": "isopleth"}, "--cuts"),
+                          ({"force_n": 0.4}, "none: each world")):
+        with pytest.raises(InvalidArgumentError, match=f"`exploration.{next(iter(given))}` is "
+                                                       f"the benchmark's to set .option: {option}"):
+            WorldsBenchConfig(exploration=ExplorationConfig(**given))
 
 
 def test_rescore_scores_other_cuts_on_the_stored_pokes_and_names_what_it_cannot(tmp_path) -> None:
@@ -105,7 +109,7 @@ def test_rescore_scores_other_cuts_on_the_stored_pokes_and_names_what_it_cannot(
     bench_worlds(_config(worlds=2), tmp_path / "src")
     result = runner.invoke(app, ["bench", "rescore", str(tmp_path / "src"), "--out",
                                  str(tmp_path / "again"), "--cuts", "isopleth,nearest",
-                                 "--no-merge-seams"])
+                                 "--set", "merge_seams=false"])
     assert result.exit_code == 0, result.output
     again = _values(tmp_path / "again")
     assert [r for r in again if r["cut"] == "isopleth"] == _values(tmp_path / "src")
@@ -115,21 +119,23 @@ def test_rescore_scores_other_cuts_on_the_stored_pokes_and_names_what_it_cannot(
     assert settings["settings"]["cuts"] == ["isopleth", "nearest"]
     assert "paper/beta/nearest" in json.loads((tmp_path / "again" / "summary.json").read_text())[
         "strategies"]
-    # the split by place is a rule after the pokes too; a source from before it had it off
-    source_settings = tmp_path / "src" / "bench.json"
-    stored = json.loads(source_settings.read_text())
-    del stored["settings"]["split_by_place"]
-    source_settings.write_text(json.dumps(stored))
-    del stored["settings"]["unread_place"], stored["settings"]["boundary_score"]  # and before
-    source_settings.write_text(json.dumps(stored))
-    for flag, expected, folder in (([], False, "before"), (["--split-by-place"], True, "split")):
+    assert settings["settings"]["exploration"] == {"merge_seams": False}
+    # the region rules after the pokes are rescored on top of the source's; any other setting
+    # would move the pokes, and is refused before any folder
+    result = runner.invoke(app, ["bench", "rescore", str(tmp_path / "again"), "--out",
+                                 str(tmp_path / "split"), "--set", "split_by_place=false"])
+    assert result.exit_code == 0, result.output
+    written = json.loads((tmp_path / "split" / "bench.json").read_text())["settings"]
+    assert written["exploration"] == {"merge_seams": False, "split_by_place": False}
+    for args, why in ((["--set", "threshold=0.1"], "--set threshold: a rescore scores the stored "
+                                                   "pokes again, so it may change only "
+                                                   "merge_seams, split_by_place"),
+                      (["--set", "merge_seams=2"], "`exploration.merge_seams` must be"),
+                      (["--cuts", "voronoi"], "`cuts` must be distinct names")):
         result = runner.invoke(app, ["bench", "rescore", str(tmp_path / "src"), "--out",
-                                     str(tmp_path / folder), "--cuts", "nearest", *flag])
-        assert result.exit_code == 0, result.output
-        written = json.loads((tmp_path / folder / "bench.json").read_text())["settings"]
-        assert written["split_by_place"] is expected
-        assert written["unread_place"] == "beta"  # what such a run did
-        assert written["boundary_score"] == "straddle"
+                                     str(tmp_path / "moved"), *args])
+        assert result.exit_code == 2 and why in result.output, result.output
+        assert len(result.output.strip().splitlines()) == 1 and not (tmp_path / "moved").exists()
     # the folder must be new; a world from before the pokes were stored is named
     result = runner.invoke(app, ["bench", "rescore", str(tmp_path / "src"), "--out",
                                  str(tmp_path / "again")])
@@ -142,7 +148,7 @@ def test_rescore_scores_other_cuts_on_the_stored_pokes_and_names_what_it_cannot(
     result = runner.invoke(app, ["bench", "rescore", str(tmp_path / "src"), "--out",
                                  str(tmp_path / "third")])
     assert result.exit_code == 2
-    assert "world-00001.json is not a rescorable world: no `pokes`" in result.output
+    assert "world-00001.json is not a stored world: `pokes` must be an object" in result.output
     assert "Traceback" not in result.output and not (tmp_path / "third").exists()
     # damaged stored worlds: one line naming the file and what is wrong, before any folder
     assert stored["pokes_format"] == POKES_FORMAT == 3
@@ -155,23 +161,24 @@ def test_rescore_scores_other_cuts_on_the_stored_pokes_and_names_what_it_cannot(
                          (stored, "columns of different lengths"),
                          ({**stored, "pokes": {}}, "no stored pokes of 'paper/beta'"),
                          ({**stored, "pokes_format": 4},
-                          "`pokes_format` must be an integer from 1 to 3 (the formats this "
-                          "deformap reads); got 4 (written by a newer version?)"),
+                          "`pokes_format` is 4; this version of deformap reads 3 only"),
+                         ({**stored, "pokes_format": 2},
+                          "`pokes_format` is 2; this version of deformap reads 3 only"),
                          ({**original, "fallback_pokes": []},
                           "`fallback_pokes` must be an object; got list"),
                          ({**original, "fallback_pokes": {"paper/beta": {"x": [0.1]}}},
-                          "the fallback pokes of 'paper/beta' must have lists"),
+                          "the fallback_pokes of 'paper/beta' must have lists"),
                          ({**original, "rows": [{**r, "map_field": "hardness"}
                                                 for r in original["rows"]]},
                           "has `map_field` 'hardness', expected one of ['beta', 'modulus']"),
                          ({**original, "rows": [{**r, "map_field": "modulus"}
                                                 for r in original["rows"]]},
                           "no stored fallback pokes of 'paper/beta', whose map field was "
-                          "'modulus' at poke 1 (pokes_format 3)"),
-                         ({**stored, "pokes_format": True}, "`pokes_format` must be"),
-                         ({**stored, "pokes_format": 2.0}, "`pokes_format` must be an integer"),
+                          "'modulus' at poke 1"),
+                         ({**stored, "pokes_format": True}, "`pokes_format` is True"),
+                         ({**stored, "pokes_format": 3.0}, "`pokes_format` is 3.0"),
                          ({**stored, "pokes": unthick},
-                          "the pokes of 'paper/beta' have no `thickness` (pokes_format 3)")):
+                          "the pokes of 'paper/beta' must have lists")):
         world.write_text(json.dumps(damaged))
         result = runner.invoke(app, ["bench", "rescore", str(tmp_path / "src"), "--out",
                                      str(tmp_path / "third")])
@@ -179,28 +186,16 @@ def test_rescore_scores_other_cuts_on_the_stored_pokes_and_names_what_it_cannot(
         assert "Traceback" not in result.output and not (tmp_path / "third").exists()
     result = runner.invoke(app, ["bench", "rescore", str(tmp_path), "--out",
                                  str(tmp_path / "fourth")])
-    assert result.exit_code == 2 and "is not a worlds benchmark" in result.output
-    # a world stored before the format key and the thickness were is read as the first format
-    legacy = {k: v for k, v in original.items() if k != "pokes_format"}
-    legacy["pokes"] = {combo: {k: v for k, v in data.items() if k != "thickness"}
-                       for combo, data in original["pokes"].items()}
-    world.write_text(json.dumps(legacy))
+    assert result.exit_code == 2 and "bench.json cannot be read" in result.output
+    # a benchmark of the format before is refused in one line naming both versions
+    world.write_text(json.dumps(original))
+    header = json.loads((tmp_path / "src" / "bench.json").read_text())
+    (tmp_path / "src" / "bench.json").write_text(json.dumps({**header, "format": 1}))
     result = runner.invoke(app, ["bench", "rescore", str(tmp_path / "src"), "--out",
-                                 str(tmp_path / "fifth"), "--no-merge-seams"])
-    assert result.exit_code == 0, result.output
-    assert "pokes_format" not in json.loads(
-        (tmp_path / "fifth" / "worlds" / "world-00001.json").read_text())
-    # a run whose map changed field on the way, stored without its β pokes (before the third
-    # format), is carried, and so only under its own cuts
-    fell = {**original, "rows": [{**r, "map_field": "modulus"} for r in original["rows"]],
-            "pokes_format": 2}
-    del fell["fallback_pokes"]
-    world.write_text(json.dumps(fell))
-    result = runner.invoke(app, ["bench", "rescore", str(tmp_path / "src"), "--out",
-                                 str(tmp_path / "sixth"), "--cuts", "isopleth,nearest"])
-    assert result.exit_code == 2 and "world-00001.json" in result.output, result.output
-    assert "fell back from the modulus field to β" in result.output
-    assert not (tmp_path / "sixth").exists()
+                                 str(tmp_path / "fifth")])
+    assert result.exit_code == 2 and len(result.output.strip().splitlines()) == 1
+    assert "is a worlds benchmark of format 1; this version of deformap reads format 2 only" \
+        in result.output
 
 
 def _alive(pid: int) -> bool:
@@ -227,7 +222,7 @@ def test_pool_workers_end_when_the_run_is_killed(tmp_path) -> None:
     pid_file = tmp_path / "worker.pid"
     script = (
         "import os, signal, sys, time\n"
-        "from deformap.run._worlds import worker_pool\n"
+        "from deformap.run._worlds_engines import worker_pool\n"
         "pool = worker_pool(1)\n"
         f"open({str(pid_file)!r}, 'w').write(str(pool.submit(os.getpid).result()))\n"
         "pool.submit(time.sleep, 600)\n"

@@ -156,6 +156,11 @@ def _names(values: list[str] | None) -> tuple[str, ...] | None:
 
 NamesOption = Annotated[list[str] | None, typer.Option(
     help="Comma-separated (or repeated); default: all.", show_default=False)]
+SetOption = Annotated[list[str] | None, typer.Option(
+    "--set", metavar="KEY=VALUE",
+    help="An exploration setting for every world, as in a config file's exploration section "
+         "(dotted key, YAML value: --set merge_seams=false --set beta_field.signal_std=0.25); "
+         "repeatable.", show_default=False)]
 
 
 @bench_app.command("worlds")
@@ -176,21 +181,7 @@ def bench_worlds_command(
         help="Region labels (exploration.region_labels), each scored on the same pokes; "
              "comma-separated (or repeated); default: all.", show_default=False)] = None,
     max_pokes: Annotated[int, typer.Option(help="Pokes per world and combination.")] = 12,
-    merge_seams: Annotated[bool | None, typer.Option(
-        "--merge-seams/--no-merge-seams",
-        help="Merge the classes of seam pokes before cutting (exploration.merge_seams); "
-             "default: the exploration's.", show_default=False)] = None,
-    split_by_place: Annotated[bool | None, typer.Option(
-        "--split-by-place/--no-split-by-place",
-        help="Split a class whose pokes form two places of different values before cutting "
-             "(exploration.split_by_place); default: the exploration's.",
-        show_default=False)] = None,
-    unread_place: Annotated[str | None, typer.Option(
-        help="What a place whose modulus cannot be read twice does (exploration.unread_place: "
-             "beta or avoid); default: the exploration's.", show_default=False)] = None,
-    boundary_score: Annotated[str | None, typer.Option(
-        help="How a boundary poke scores a cell (exploration.boundary_score: straddle or "
-             "nearest-poke); default: the exploration's.", show_default=False)] = None,
+    assignments: SetOption = None,
     coarse: Annotated[bool, typer.Option(
         help="The coarse test mesh and camera: a third of the cost, a smoke run only (its 2 cm "
              "mesh reads E far off).")] = False,
@@ -208,12 +199,11 @@ def bench_worlds_command(
 
     given: dict[str, Any] = {"families": _names(families), "strategies": _names(strategies),
                              "fields": _names(fields), "physics": _names(physics),
-                             "cuts": _names(cuts), "merge_seams": merge_seams,
-                             "split_by_place": split_by_place, "unread_place": unread_place,
-                             "boundary_score": boundary_score}
+                             "cuts": _names(cuts)}
+    exploration = run.exploration_with(run.parse_assignments(assignments or ()))
     config = run.WorldsBenchConfig(
-        worlds=worlds, seed=seed, max_pokes=max_pokes, coarse=coarse, workers=workers,
-        scheduler=scheduler, **{k: v for k, v in given.items() if v is not None})
+        worlds=worlds, seed=seed, max_pokes=max_pokes, exploration=exploration, coarse=coarse,
+        workers=workers, scheduler=scheduler, **{k: v for k, v in given.items() if v is not None})
     shown = out_console(json_path)
     with progress(shown) as bar:
         output = run.bench_worlds(config, out, hooks=run_hooks(bar))
@@ -256,14 +246,10 @@ def bench_rescore_command(
     cuts: Annotated[list[str] | None, typer.Option(
         "--cuts", "--cut", help="Region labels to score; comma-separated (or repeated); "
                                 "default: the source's.", show_default=False)] = None,
-    merge_seams: Annotated[bool | None, typer.Option(
-        "--merge-seams/--no-merge-seams",
-        help="Merge the classes of seam pokes before cutting; default: the source's.",
-        show_default=False)] = None,
-    split_by_place: Annotated[bool | None, typer.Option(
-        "--split-by-place/--no-split-by-place",
-        help="Split a class whose pokes form two places of different values before cutting; "
-             "default: the source's (off for a source from before the rule).",
+    assignments: Annotated[list[str] | None, typer.Option(
+        "--set", metavar="KEY=VALUE",
+        help="A region rule to score under instead of the source's (merge_seams or "
+             "split_by_place, e.g. --set merge_seams=false); repeatable.",
         show_default=False)] = None,
     json_path: JsonOption = None,
 ) -> None:
@@ -273,8 +259,8 @@ def bench_rescore_command(
 
     shown = out_console(json_path)
     with progress(shown) as bar:
-        output = run.rescore_worlds(source, out, cuts=_names(cuts), merge_seams=merge_seams,
-                                    split_by_place=split_by_place,
+        output = run.rescore_worlds(source, out, cuts=_names(cuts),
+                                    changes=run.parse_assignments(assignments or ()),
                                     hooks=run_hooks(bar))  # fmt: skip
     settings = output.summary["settings"]
     _show_worlds_summary(shown, output, settings["worlds"], settings["max_pokes"], json_path)

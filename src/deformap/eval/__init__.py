@@ -25,6 +25,7 @@ if TYPE_CHECKING:
         ordering_scores,
         region_scores,
     )
+    from deformap.eval._rescore import rescore_world
     from deformap.eval._studies import (
         DEFAULT_HARDNESSES,
         DEFAULT_POSITIONS,
@@ -40,20 +41,23 @@ if TYPE_CHECKING:
         hardness_summary,
     )
     from deformap.eval._table_i import PAPER_TABLE_I, markdown_table, table_row
-    from deformap.eval._worlds import (
+    from deformap.eval._world_draw import (
         FORCES_N,
         HARDNESS_RANGE_N,
-        POKES_FORMAT,
         THICKNESSES_M,
-        TIME_COLUMNS,
         WorldDraw,
+        WorldTask,
         choices,
         draw_world,
-        fell_back_cuts,
-        rescore_world,
-        row_values,
-        run_world,
+        material_truth,
     )
+    from deformap.eval._world_result import (
+        POKES_FORMAT,
+        TIME_COLUMNS,
+        WorldResult,
+        row_values,
+    )
+    from deformap.eval._worlds import run_world
     from deformap.eval._worlds_summary import (
         CSV_COLUMNS,
         GOOD_ACCURACY,
@@ -76,10 +80,11 @@ _MODULES = {
                  "PROTOCOLS", "STUDY_PROTOCOLS", "FoamPresses", "block_scenario",
                  "cluster_size_study", "collect_presses", "hardness_study", "hardness_summary"),
     "_table_i": ("PAPER_TABLE_I", "markdown_table", "table_row"),
-    "_worlds": ("FORCES_N", "HARDNESS_RANGE_N", "POKES_FORMAT", "THICKNESSES_M", "TIME_COLUMNS",
-                "WorldDraw", "choices", "draw_world", "fell_back_cuts", "rescore_world",
-                "row_values",
-                "run_world"),
+    "_rescore": ("rescore_world",),
+    "_world_draw": ("FORCES_N", "HARDNESS_RANGE_N", "THICKNESSES_M", "WorldDraw", "WorldTask",
+                    "choices", "draw_world", "material_truth"),
+    "_world_result": ("POKES_FORMAT", "TIME_COLUMNS", "WorldResult", "row_values"),
+    "_worlds": ("run_world",),
     "_worlds_summary": ("CSV_COLUMNS", "GOOD_ACCURACY", "accuracy_curves", "combination_name",
                         "markdown_summary", "pokes_to_good", "runs_csv", "summarise_worlds"),
 }  # fmt: skip
@@ -104,6 +109,8 @@ __all__ = [
     "OrderingScores",
     "RegionScores",
     "WorldDraw",
+    "WorldResult",
+    "WorldTask",
     "accuracy_curves",
     "bench_beta_sweep",
     "bench_io",
@@ -116,11 +123,11 @@ __all__ = [
     "collect_presses",
     "combination_name",
     "draw_world",
-    "fell_back_cuts",
     "hardness_study",
     "hardness_summary",
     "markdown_summary",
     "markdown_table",
+    "material_truth",
     "measure_case",
     "ordering_scores",
     "pokes_to_good",

@@ -11,8 +11,7 @@ A combination whose loop had nothing left to poke before ``max_pokes`` keeps its
 remaining pokes.
 
 Which combination is best. With many worlds at ``max_pokes + 1`` the median sits on a cap and
-moves by a poke or two with a few worlds (over 100 default worlds at 20 pokes its 95 %
-bootstrap interval spans 6–9 pokes for most combinations). ``best`` is therefore the combination
+moves by a poke or two with a few worlds. ``best`` is therefore the combination
 with the fewest pokes on average, ``mean_pokes_to_accuracy_0.9``: the restricted mean of the same
 counts (survival analysis' restricted mean time to an event, here bounded at ``max_pokes + 1``),
 which every world moves by its own count; ties go to the smaller median, then the higher median
@@ -38,6 +37,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from deformap.eval._world_result import WorldResult
+
 __all__ = [
     "CSV_COLUMNS",
     "GOOD_ACCURACY",
@@ -49,7 +50,7 @@ __all__ = [
     "summarise_worlds",
 ]
 
-#: The region accuracy a map must reach (issue 16: "how many pokes does a good map take").
+#: The region accuracy a map must reach: the benchmark counts the pokes a good map takes.
 GOOD_ACCURACY = 0.9
 
 _WORLD_COLUMNS = ("physics", "camera", "thickness_m", "force_n")
@@ -74,21 +75,21 @@ def _cell(value: Any) -> str:
     return str(value)
 
 
-def runs_csv(results: Sequence[dict[str, Any]], combinations: Sequence[tuple[str, str, str]]
+def runs_csv(results: Sequence[WorldResult], combinations: Sequence[tuple[str, str, str]]
              ) -> str:
     """``runs.csv`` of the worlds' results (in world order), as text."""
     buffer = io.StringIO()
     writer = csv.writer(buffer, lineterminator="\n")
     writer.writerow(CSV_COLUMNS)
-    for result in sorted(results, key=lambda r: r["world"]["index"]):
-        world = result["world"]
+    for result in sorted(results, key=lambda r: r.world["index"]):
+        world = result.world
         head = [world["index"], world["family"], *(world.get(k) for k in _WORLD_COLUMNS)]
-        if result["status"] != "ok":
+        if result.status != "ok":
             for strategy, field, cut in combinations:
                 writer.writerow([_cell(v) for v in (*head, strategy, field, cut)]
-                                + [""] * (len(_ROW_COLUMNS) - 3) + ["failed", result["error"]])
+                                + [""] * (len(_ROW_COLUMNS) - 3) + ["failed", result.error])
             continue
-        for row in result["rows"]:
+        for row in result.rows:
             writer.writerow([_cell(v) for v in (*head, *(row[k] for k in _ROW_COLUMNS))]
                             + ["ok", ""])
     return buffer.getvalue()
@@ -107,16 +108,16 @@ def _series(rows: list[dict[str, Any]], key: str, max_pokes: int) -> NDArray[np.
     return out
 
 
-def _per_world(results: Sequence[dict[str, Any]], combination: tuple[str, str, str],
+def _per_world(results: Sequence[WorldResult], combination: tuple[str, str, str],
                max_pokes: int) -> list[dict[str, Any]]:
     """One entry per world for one combination: family, accuracy and modulus-error series."""
     out = []
     for result in results:
-        world = result["world"]
-        if result["status"] != "ok":
+        world = result.world
+        if result.status != "ok":
             out.append({"family": world["family"], "failed": True})
             continue
-        rows = [r for r in result["rows"]
+        rows = [r for r in result.rows
                 if (r["strategy"], r["field"], r["cut"]) == combination]  # fmt: skip
         out.append({"family": world["family"], "failed": False,
                     "accuracy": _series(rows, "accuracy", max_pokes),
@@ -138,13 +139,13 @@ def _pokes_to_good(entry: dict[str, Any], max_pokes: int, *, stay: bool = False)
     return int(hits[0]) + 1 if hits.size else max_pokes + 1
 
 
-def pokes_to_good(results: Sequence[dict[str, Any]], combination: tuple[str, str, str],
+def pokes_to_good(results: Sequence[WorldResult], combination: tuple[str, str, str],
                   max_pokes: int) -> dict[int, int]:
     """Each world's pokes to :data:`GOOD_ACCURACY` under one combination, by world index
     (``max_pokes + 1`` where never, or where the world failed): what ``summary.json``'s medians
     are taken over, for comparing two combinations world by world."""
     entries = _per_world(results, combination, max_pokes)
-    return {int(r["world"]["index"]): _pokes_to_good(e, max_pokes)
+    return {int(r.world["index"]): _pokes_to_good(e, max_pokes)
             for r, e in zip(results, entries, strict=True)}
 
 
@@ -192,7 +193,7 @@ def _stats(entries: list[dict[str, Any]], max_pokes: int) -> dict[str, Any]:
     }
 
 
-def summarise_worlds(results: Sequence[dict[str, Any]],
+def summarise_worlds(results: Sequence[WorldResult],
                      combinations: Sequence[tuple[str, str, str]], max_pokes: int
                      ) -> dict[str, Any]:
     """``summary.json``: ``{"strategies": {NAME: {"median_pokes_to_accuracy_0.9",
@@ -203,7 +204,7 @@ def summarise_worlds(results: Sequence[dict[str, Any]],
     the highest final accuracy: module docstring), ``max_pokes`` and ``failed_worlds`` (index and
     error of each world that failed twice)."""
     # by index, whatever order the worlds finished in
-    results = sorted(results, key=lambda r: int(r["world"]["index"]))
+    results = sorted(results, key=lambda r: int(r.world["index"]))
     strategies: dict[str, Any] = {}
     for combination in combinations:
         entries = _per_world(results, combination, max_pokes)
@@ -224,11 +225,11 @@ def summarise_worlds(results: Sequence[dict[str, Any]],
     best = min(strategies, key=rank) if strategies else None
     return {"strategies": strategies, "best": best, "max_pokes": max_pokes,
             "good_accuracy": GOOD_ACCURACY,
-            "failed_worlds": [{"index": r["world"]["index"], "error": r["error"]}
-                              for r in results if r["status"] != "ok"]}  # fmt: skip
+            "failed_worlds": [{"index": r.world["index"], "error": r.error}
+                              for r in results if r.status != "ok"]}  # fmt: skip
 
 
-def accuracy_curves(results: Sequence[dict[str, Any]],
+def accuracy_curves(results: Sequence[WorldResult],
                     combinations: Sequence[tuple[str, str, str]], max_pokes: int
                     ) -> dict[str, dict[str, NDArray[np.float64]]]:
     """Per family (and ``"all"``), per combination: the ``(n_worlds, max_pokes)`` accuracies of

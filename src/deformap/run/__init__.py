@@ -80,12 +80,18 @@ if TYPE_CHECKING:
     )
     from deformap.run._world import ScenarioSummary, scenario_summaries, show_scenario
     from deformap.run._worlds import (
-        BLAS_THREAD_VARIABLES,
-        WorldsBenchConfig,
+        RESCORABLE,
         WorldsOutput,
         bench_worlds,
+        load_worlds,
         rescore_worlds,
     )
+    from deformap.run._worlds_config import (
+        WorldsBenchConfig,
+        exploration_with,
+        parse_assignments,
+    )
+    from deformap.run._worlds_engines import BLAS_THREAD_VARIABLES
 
 _MODULES = {
     "_config": ("CONFIG_NAME", "RunConfig", "RunOverrides", "apply_overrides", "config_yaml",
@@ -107,8 +113,9 @@ _MODULES = {
     "_studies": ("CLUSTER_SIZE_FOAMS", "StudyOutput", "run_cluster_size_study",
                  "run_hardness_study"),
     "_world": ("ScenarioSummary", "scenario_summaries", "show_scenario"),
-    "_worlds": ("BLAS_THREAD_VARIABLES", "WorldsBenchConfig", "WorldsOutput", "bench_worlds",
-                "rescore_worlds"),
+    "_worlds": ("RESCORABLE", "WorldsOutput", "bench_worlds", "load_worlds", "rescore_worlds"),
+    "_worlds_config": ("WorldsBenchConfig", "exploration_with", "parse_assignments"),
+    "_worlds_engines": ("BLAS_THREAD_VARIABLES",),
 }  # fmt: skip
 
 __all__ = [
@@ -116,6 +123,7 @@ __all__ = [
     "CLUSTER_SIZE_FOAMS",
     "CONFIG_NAME",
     "POKES_CSV_COLUMNS",
+    "RESCORABLE",
     "RUNS_ROOT",
     "SHARED_KEYS",
     "EstimateOutput",
@@ -139,13 +147,16 @@ __all__ = [
     "default_run_folder",
     "estimate_one_poke",
     "estimate_report",
+    "exploration_with",
     "explore_environment",
     "explore_run_config",
     "explore_scenario",
     "live_report",
     "load_environment",
     "load_run_config",
+    "load_worlds",
     "map_recorded_session",
+    "parse_assignments",
     "parse_env_args",
     "record_simulation",
     "reproduce",
