@@ -33,7 +33,7 @@ from deformap.run import run_generators
 from deformap.world import SimulatedWorld, WorldConfig, load_scenario, random_scenario
 
 CUTS = ("isopleth", "nearest", "indicator-kriging")
-STRATEGIES = ("paper", "planned", "level-set", "integrated-variance", "planned+boundary")
+STRATEGIES = ("paper", "planned", "level-set", "planned+boundary")
 TABLE_I = ("heterogeneous-60-150", "heterogeneous-110-150", "heterogeneous-150-rigid",
            "heterogeneous-60-110-rigid")
 
