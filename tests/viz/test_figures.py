@@ -144,8 +144,8 @@ def test_map_figure_panels_labels_and_colour_bars() -> None:
     ]
     assert all((ax.get_xlabel(), ax.get_ylabel()) == ("x [m]", "y [m]") for ax in panels)
     assert _colorbar_labels(fig) == [
-        "hardness H [N] (grey: rigid)",
-        "β (deformability) [–]",
+        "true E [kPa] (log scale; grey: rigid)",
+        "β (deformability) [–]; 1 soft, 0 stiff",
         "var(β)",
     ]
     assert fig.get_suptitle() == "two blocks"
@@ -267,6 +267,62 @@ def test_map_figure_legend_threshold_label_and_region_values() -> None:
     assert names == ["R1: E = 6 kPa", "R2: E = 20 kPa"]
     with pytest.raises(InvalidArgumentError, match="purposes"):
         plot_map(*args, **kwargs, purposes=["first"])
+
+
+def test_map_figure_draws_stiffness_one_way_and_the_truth_on_the_maps_scale() -> None:
+    from matplotlib.colors import LogNorm
+
+    args, kwargs = _map_args()
+    gx, _ = np.meshgrid(*args)
+    fig = plot_map(*args, **kwargs, modulus_pa=np.where(gx < 0.3, 6e3, 2e4))
+    truth, beta, modulus = (ax.get_images()[0] for ax in _panels(fig)[:3])
+    # the truth is E in kPa (60 N is 4.64 kPa), on the modulus panel's scale and colour map
+    assert np.nanmax(truth.get_array()) == pytest.approx(60.0 / 0.0323 / 0.4 / 1e3)
+    assert isinstance(truth.norm, LogNorm)
+    assert (truth.norm.vmin, truth.norm.vmax) == (modulus.norm.vmin, modulus.norm.vmax)
+    assert truth.norm.vmin <= 4.64 and modulus.norm.vmax >= 20.0
+    # soft is the dark end everywhere: low E, and high β (the reversed map)
+    dark = np.mean(modulus.cmap(0.0)[:3])
+    assert np.mean(modulus.cmap(1.0)[:3]) > dark
+    assert np.allclose(beta.cmap(1.0), modulus.cmap(0.0)) and truth.cmap.name == modulus.cmap.name
+    assert "rigid" in [t.get_text() for t in _panels(fig)[0].texts]
+
+
+def test_map_figure_names_regions_with_the_reports_values_and_rigid_as_rigid() -> None:
+    args, kwargs = _map_args()
+    gx, _ = np.meshgrid(*args)
+    fig = plot_map(*args, **kwargs, modulus_pa=np.where(gx < 0.3, 6e3, 6e5),
+                   class_betas=[0.83, 0.01], class_modulus_pa=[5.1e3, 6.3e5],
+                   rigid_classes={1})  # fmt: skip
+    names = [sorted(t.get_text() for t in ax.texts if t.get_text().startswith("R"))
+             for ax in _panels(fig)[1:3]]  # fmt: skip
+    assert names == [["R1: β = 0.83", "R2: rigid"], ["R1: E = 5.1 kPa", "R2: rigid"]]
+
+
+def test_map_figure_says_when_the_variance_never_crosses_t_h() -> None:
+    args, kwargs = _map_args()
+    for threshold, side in ((0.5, "below"), (0.01, "above")):
+        fig = plot_map(*args, **{**kwargs, "threshold": threshold})
+        texts = [t.get_text() for t in fig.legends[0].get_texts()]
+        assert f"variance {side} T_h ({threshold:g}) everywhere: no T_h contour" in texts
+        assert not any(t.startswith("variance = T_h") for t in texts)
+        assert "T_h" not in [t.get_text() for t in _panels(fig)[-1].texts]
+
+
+def test_map_figure_keeps_region_labels_clear_of_the_pokes() -> None:
+    args, kwargs = _map_args()
+    # a poke at each region's deepest cell, where the label went before
+    contacts = np.array([[0.15, 0.2], [0.45, 0.2], [0.1, 0.1]])
+    fig = plot_map(*args, **{**kwargs, "contacts": contacts})
+    fig.canvas.draw()
+    ax = _panels(fig)[1]
+    boxes = [t.get_window_extent() for t in ax.texts if t.get_text().startswith("R")]
+    marks = ax.transData.transform(contacts)
+    assert len(boxes) == 2
+    for box in boxes:
+        for mx, my in marks:
+            inside = box.x0 - 8 < mx < box.x1 + 8 and box.y0 - 8 < my < box.y1 + 8
+            assert not inside, (box, (mx, my))
 
 
 def test_map_figure_variance_scale_can_be_fixed_so_runs_compare() -> None:

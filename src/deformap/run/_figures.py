@@ -14,9 +14,10 @@ from typing import Any
 import numpy as np
 
 from deformap.explore import ExplorationResult, PokeResult
+from deformap.run._report import _class_values
 
-__all__ = ["poke_figure_path", "write_estimate_figures", "write_map_figures", "write_poke_figure",
-           "write_rerun"]
+__all__ = ["poke_figure_path", "rigid_regions", "write_estimate_figures", "write_map_figures",
+           "write_poke_figure", "write_rerun"]
 
 
 def write_map_figures(
@@ -62,18 +63,36 @@ def write_map_figures(
         truth_hardness = None if truth is None else truth.ground_truth_hardness(result.xs, result.ys)
         levels = regions.levels if result.config.region_labels == "isopleth" else None
         modulus = result.modulus_field.median_pa if result.has_modulus else None
+        values = _class_values(result)  # what report.json says of each region
         plot_map(result.xs, result.ys, beta=result.field.mean,
                  variance=result.map_field.variance, contacts=contacts, labels=regions.labels,
                  levels=levels, truth_hardness=truth_hardness, threshold=threshold, title=title,
                  path=folder / "map.png", modulus_pa=modulus,
                  region_field=result.config.field,
                  purposes=[p.record.purpose for p in result.pokes],
-                 variance_max=variance_max)  # fmt: skip
+                 variance_max=variance_max, class_betas=values["class_betas"],
+                 class_modulus_pa=values["class_modulus_median_pa"],
+                 rigid_classes=rigid_regions(result))  # fmt: skip
         written.append(folder / "map.png")
     if poke_figures:
         written += [write_poke_figure(folder, poke) for poke in result.pokes
                     if poke.dent is not None]  # a poke resumed from a journal has no arrays
     return written
+
+
+def rigid_regions(result: ExplorationResult) -> set[int]:
+    """The regions (labels) whose pokes all read rigid from their force–travel records."""
+    regions = result.regions
+    if regions is None:
+        return set()
+    index = result.map_field.pokes.index
+    indices = range(len(regions.poke_labels)) if index is None else index
+    rigid = {p.record.index: p.record.stiffness is not None and p.record.stiffness.rigid
+             for p in result.pokes}  # fmt: skip
+    by_label: dict[int, list[bool]] = {}
+    for i, k in zip(indices, regions.poke_labels, strict=True):
+        by_label.setdefault(int(k), []).append(rigid.get(int(i), False))
+    return {k for k, flags in by_label.items() if flags and all(flags)}
 
 
 def poke_figure_path(folder: Path, index: int) -> Path:
