@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 from matplotlib.figure import Figure
 from matplotlib.image import imread
+from matplotlib.text import Text
 
 from deformap.errors import InvalidArgumentError
 from deformap.viz import (
@@ -195,19 +196,21 @@ def test_poke_figure_panels_and_labels() -> None:
     panels = _panels(fig)
     assert [ax.get_title() for ax in panels] == [
         "ROI before (surface GP)",
-        "cloud while pressing (robot removed)",
-        "shape-matching error E(β)",
+        "cloud pressed, robot removed",
         "observed dent (touch GP)",
         "shape matching at β̂ = 0.400",
-        "section through the contact (y = 0.000 m)",
+        "section through the contact (y = 0 mm)",
+        "shape-matching error ε(β)",
+        "force–travel record",
     ]
-    # every panel names its axes with units
+    # every panel names its axes with units, every length in millimetres
     assert [(ax.get_xlabel(), ax.get_ylabel()) for ax in panels] == [
-        ("x [m]", "y [m]"), ("x [m]", "y [m]"), ("β [–]", "E(β) [mm]"),
-        ("x [m]", "y [m]"), ("x [m]", "y [m]"), ("x [m]", "z [mm]"),
+        *[("x [mm]", "y [mm]")] * 4, ("x [mm]", "z [mm]"),
+        ("β [–]", "shape-matching error ε(β) [mm]"),
+        ("travel since first contact [mm]", "force [N]"),
     ]  # fmt: skip
     assert _colorbar_labels(fig) == ["z [mm] (own scale)", "z [mm]", "z [mm]", "z [mm]"]
-    section = panels[5].get_legend()
+    section = panels[4].get_legend()
     assert [t.get_text() for t in section.get_texts()] == [
         "before (surface GP)",
         "observed dent (touch GP)",
@@ -215,13 +218,35 @@ def test_poke_figure_panels_and_labels() -> None:
         "cloud points on the section",
     ]
     # the legends sit below their axes, where they cover no data (the dent is mid-section)
-    for ax in (panels[1], panels[5]):
+    for ax in (panels[1], panels[4]):
         assert ax.get_legend()._loc == 9 and ax.get_legend().get_bbox_to_anchor().y1 < \
             ax.get_window_extent().y0 + 1
     # the simulated dent is drawn beside the observed one, on the same colour scale
-    observed, simulated = panels[3].get_images()[0], panels[4].get_images()[0]
+    observed, simulated = panels[2].get_images()[0], panels[3].get_images()[0]
     assert observed.get_clim() == simulated.get_clim()
     assert np.allclose(simulated.get_array(), _poke_kwargs()["simulated_z"] * 1e3)
+    # the suptitle sits above every panel's title
+    fig.canvas.draw()
+    (top,) = [t.get_window_extent() for t in fig.findobj(Text) if t.get_text() == "poke 1"]
+    assert all(ax.title.get_window_extent().y1 < top.y0 for ax in panels)
+    # without a record, the force panel says so
+    assert "no force–travel record" in [t.get_text() for t in panels[6].texts]
+
+
+def test_poke_figure_draws_the_force_travel_record_and_its_fit() -> None:
+    travel = np.linspace(0.0, 0.004, 8)
+    fit = np.vstack([np.linspace(0.0, 0.004, 30), 40.0 * np.linspace(0.0, 0.004, 30) ** 1.5])
+    fig = plot_poke(**_poke_kwargs(), force_travel=(travel, 40.0 * travel**1.5), force_fit=fit,
+                    reading="E = 9.7 ± 0.7 kPa")  # fmt: skip
+    press = _panels(fig)[6]
+    record, curve = press.get_lines()
+    assert np.allclose(record.get_xdata(), travel * 1e3)  # millimetres
+    assert np.allclose(curve.get_ydata(), fit[1])
+    assert [t.get_text() for t in press.get_legend().get_texts()] == [
+        "record", "contact model fitted: E = 9.7 ± 0.7 kPa"]
+    # a rigid reading has no fit: the record and the reading
+    fig = plot_poke(**_poke_kwargs(), force_travel=(travel * 0, travel * 100), reading="rigid")
+    assert [t.get_text() for t in _panels(fig)[6].get_legend().get_texts()] == ["record", "rigid"]
 
 
 def test_poke_figure_shows_the_surface_before_on_its_own_scale() -> None:
@@ -239,7 +264,7 @@ def test_poke_figure_shows_the_surface_before_on_its_own_scale() -> None:
     assert high - low == pytest.approx(1.0)
     # without a simulation, its panel says so
     kwargs["simulated_z"] = None
-    texts = [t.get_text() for t in _panels(plot_poke(**kwargs))[4].texts]
+    texts = [t.get_text() for t in _panels(plot_poke(**kwargs))[3].texts]
     assert texts == ["not simulated"]
 
 
@@ -342,9 +367,9 @@ def test_error_curve_figure() -> None:
     fig = plot_error_curve(betas, np.array([3e-3, 2e-3, 1e-3]), 0.5, 0.1)
     (ax,) = fig.axes
     assert (ax.get_title(), ax.get_xlabel(), ax.get_ylabel()) == (
-        "shape-matching error E(β)",
+        "shape-matching error ε(β)",
         "β [–]",
-        "E(β) [mm]",
+        "shape-matching error ε(β) [mm]",
     )
     curve = ax.get_lines()[0]
     assert np.array_equal(curve.get_xdata(), [0.0, 0.5, 0.9])

@@ -119,14 +119,31 @@ def _plot_poke(path: Path, poke: PokeResult, title: str) -> None:
     simulated = None if surface is None else np.asarray(surface)[..., 2]
     if simulated is not None and simulated.shape != dent.rest_z.shape:
         simulated = None
+    record = dent.force_travel
     plot_poke(roi_xs=dent.roi_xs, roi_ys=dent.roi_ys, rest_z=dent.rest_z,
               deformed_z=dent.deformed_z, roi_points=dent.roi_points, tactile=dent.tactile,
               betas=np.asarray(r.betas), errors=np.asarray(r.errors), beta=r.beta,
-              beta_std=r.beta_std, simulated_z=simulated, title=title, path=path)  # fmt: skip
+              beta_std=r.beta_std, simulated_z=simulated, title=title, path=path,
+              force_travel=None if record is None else (record.travel_m, record.force_n),
+              force_fit=dent.force_fit, reading=_reading(poke))  # fmt: skip
+
+
+def _reading(poke: PokeResult) -> str:
+    """What the poke's force–travel record read, as the console prints it."""
+    r = poke.record
+    s = r.stiffness
+    if s is None:
+        return "" if r.stiffness_error is None else "not read (see report.json)"
+    if s.rigid:
+        bound = s.stiffness_lower_n_per_m
+        return "rigid" + ("" if bound is None else f" (k ≥ {bound:.0f} N/m)")
+    if s.modulus_pa is None or s.modulus_std_pa is None:
+        return ""
+    return f"E = {s.modulus_pa / 1e3:.1f} ± {s.modulus_std_pa / 1e3:.1f} kPa"
 
 
 def write_estimate_figures(folder: Path, poke: PokeResult) -> list[Path]:
-    """``beta-curve.png`` (the shape-matching error E(β)) and ``poke.png`` of one poke."""
+    """``beta-curve.png`` (the shape-matching error ε(β)) and ``poke.png`` of one poke."""
     from deformap.viz import plot_error_curve
 
     r = poke.record
