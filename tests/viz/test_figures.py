@@ -405,12 +405,38 @@ def test_study_figures() -> None:
     (ax,) = fig.axes
     assert (ax.get_xlabel(), ax.get_ylabel()) == (
         "cluster size k (k×k particles)",
-        "fit error min E(β) [mm]",
+        "fit error min ε(β) [mm]",
     )
     assert [t.get_text() for t in ax.get_legend().get_texts()] == ["60 N", "150 N", "rigid"]
     assert np.allclose(ax.get_lines()[0].get_ydata(), [1.0, 1.5, 2.0, 2.5, 3.0])
     ticks = [t for t in ax.get_xticks() if 2 <= t <= 6]
     assert ticks == [2, 3, 4, 5, 6]  # whole cluster sizes only
+
+
+def test_hardness_figure_puts_e_beside_beta_and_its_conditions_in_the_title() -> None:
+    study = _hardness_study()
+    for r in study["rows"]:
+        h = r["hardness_n"]
+        r.update(rigid=h is None, modulus_pa=None if h is None else h / 0.0323 / 0.4 * 1.2,
+                 modulus_std_pa=None if h is None else 100.0,
+                 true_modulus_pa=None if h is None else h / 0.0323 / 0.4)  # fmt: skip
+    study.update(force_n=0.6, thickness_m=0.05, camera="primesense", physics="linear-fem")
+    fig = plot_hardness_study(study)
+    beta, modulus = fig.axes
+    assert fig.get_suptitle() == ("β and E against hardness (force 0.6 N, foam 5 cm thick, "
+                                  "camera primesense, physics linear-fem)")
+    assert (beta.get_ylabel(), modulus.get_ylabel()) == (
+        "estimated β [–]", "Young's modulus E [kPa] (log scale)")
+    assert modulus.get_yscale() == "log" and modulus.get_xlim() == beta.get_xlim()
+    assert [t.get_text() for t in modulus.get_legend().get_texts()] == [
+        "true E (from H, ISO 2439)", "E read from the force–travel record (± claimed σ)"]
+    read, true = (line for line in modulus.get_lines()
+                  if len(line.get_xdata()) == 3 and line.get_linestyle() != "None")  # no caps
+    assert np.allclose(np.asarray(true.get_ydata(), dtype=float),
+                       np.array([150, 110, 60]) / 0.0323 / 0.4 / 1e3)
+    assert np.allclose(np.asarray(read.get_ydata(), dtype=float),
+                       np.asarray(true.get_ydata(), dtype=float) * 1.2)  # fmt: skip
+    assert "read rigid" in [t.get_text() for t in modulus.texts]
 
 
 def test_show_world_writes_three_pictures_and_nothing_else(tmp_path: Path) -> None:
