@@ -554,21 +554,47 @@ def test_the_hardness_matrix_names_its_world_mesh() -> None:
     assert plot_hardness_study(study)._supxlabel is None  # type: ignore[attr-defined]
 
 
-def test_world_curves_colour_a_strategy_and_dash_a_field_and_cut() -> None:
-    from deformap.viz._worlds import _line_styles, plot_world_curves
-
-    names = [f"{s}/{f}/{c}" for s in ("paper", "planned") for f in ("beta", "modulus")
-             for c in ("nearest", "isopleth")] + ["oracle"]
-    colours, styles = _line_styles(names)
-    assert colours["paper/beta/nearest"] == colours["paper/modulus/isopleth"] == "C0"
-    assert colours["planned/beta/nearest"] == "C1" and colours["oracle"] == "C2"
-    assert styles["paper/beta/nearest"] == styles["planned/beta/nearest"]
-    assert len({str(styles[n]) for n in names if n.startswith("paper/")}) == 4
+def _world_curves(n_worlds: int, families: tuple[str, ...]) -> dict[str, dict[str, Any]]:
+    names = [f"{s}/{f}/{c}" for s in ("paper", "planned", "max-variance")
+             for f in ("beta", "modulus") for c in ("nearest", "isopleth")]  # fmt: skip
     rng = np.random.default_rng(0)
-    curves = {"all": {n: rng.uniform(0.5, 1.0, (3, 5)) for n in names}}
-    fig = plot_world_curves(curves)  # the figure takes the names in sorted order
-    drawn = {ln.get_label(): ln.get_color() for ln in fig.axes[0].get_lines()
-             if ln.get_label() in names}
-    assert drawn == _line_styles(sorted(names))[0] and len(drawn) == len(names)
-    assert len({drawn[n] for n in names if n.startswith("planned/")}) == 1
-    assert len(set(drawn.values())) == 3  # paper, planned, oracle
+    # planned/modulus/* best, then planned/beta/*; the paper's own combination among the worst
+    level = {n: 0.9 if n.startswith("planned/modulus") else 0.7 if n.startswith("planned") else
+             0.5 for n in names}  # fmt: skip
+    level["planned/modulus/nearest"], level["planned/beta/isopleth"] = 0.95, 0.75
+    return {family: {n: np.clip(level[n] + rng.normal(0, 0.02, (n_worlds, 5)), 0, 1)
+                     for n in names} for family in ("all", *families)}  # fmt: skip
+
+
+def test_world_curves_draw_the_best_few_and_the_papers() -> None:
+    from deformap.viz._worlds import plot_world_curves
+
+    fig = plot_world_curves(_world_curves(3, ("cuts", "insert")))
+    panels = [ax for ax in fig.axes if ax.axison]
+    assert [ax.get_title() for ax in panels] == [
+        "all (3 worlds, too few for a band)", "cuts (3 worlds, too few for a band)",
+        "insert (3 worlds, too few for a band)"]  # fmt: skip
+    labels = [ln.get_label() for ln in panels[0].get_lines()]
+    assert labels == ["1. planned/modulus/nearest", "2. planned/modulus/isopleth",
+                      "3. planned/beta/isopleth", "paper/beta/isopleth (the paper's)",
+                      "accuracy 0.9 (a good map)"]  # fmt: skip
+    assert all(not ax.collections for ax in panels)  # no band over three worlds
+    # twelve worlds: bands; without the paper's combination, its strategy's best stands in
+    curves = _world_curves(12, ())
+    del curves["all"]["paper/beta/isopleth"]
+    fig = plot_world_curves(curves, best=2)
+    (ax,) = fig.axes
+    assert len(ax.collections) == 3
+    assert [ln.get_label() for ln in ax.get_lines()][2].endswith("(the paper's strategy)")
+
+
+def test_world_curves_leave_no_panel_empty() -> None:
+    from deformap.viz._worlds import plot_world_curves
+
+    for families, spare in ((("a", "b", "c"), 0), (("a", "b", "c", "d"), 1), (("a",), 0)):
+        fig = plot_world_curves(_world_curves(2, families))
+        off = [ax for ax in fig.axes if not ax.axison]
+        assert len(off) == spare
+        # a slot the families leave holds the legend; else it is below the panels
+        assert [ax.get_legend() is not None for ax in off] == [True] * spare
+        assert len(fig.legends) == (0 if spare else 1)
