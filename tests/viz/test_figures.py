@@ -450,6 +450,32 @@ def test_show_world_writes_three_pictures_and_nothing_else(tmp_path: Path) -> No
         assert path.read_bytes()[:8] == PNG_MAGIC
 
 
+def test_world_pictures_have_a_stiffness_colour_bar_and_one_unit_per_figure() -> None:
+    from matplotlib.colors import to_rgba
+
+    from deformap.testing import coarse_world
+    from deformap.viz._world import _dent_figure, _layout_figure
+
+    world = coarse_world("heterogeneous-60-110-rigid")
+    fig = _layout_figure(world)
+    ax = _panels(fig)[0]
+    assert _colorbar_labels(fig) == ["Young's modulus E [kPa] (log scale)"]
+    (bar,) = [a for a in fig.axes if a.get_label() == "<colorbar>"]
+    fig.canvas.draw()
+    assert [t.get_text() for t in bar.get_yticklabels()] == ["4.6", "8.5"]
+    (side,) = bar.child_axes  # hardness beside E, at the blocks' values
+    assert side.get_ylabel() == "hardness H [N]"
+    assert [t.get_text() for t in side.get_yticklabels()] == ["60", "110"]
+    # soft darker than stiff, rigid grey; names without an index
+    soft, stiff, rigid = (p.get_facecolor() for p in ax.patches[:3])
+    assert np.mean(soft[:3]) < np.mean(stiff[:3]) and rigid == to_rgba("0.55")
+    assert [t.get_text().split("\n")[0] for t in ax.texts[:3]] == ["foam-60", "foam-110", "rigid"]
+    fig = _dent_figure(world, 0.6)
+    assert [(a.get_xlabel(), a.get_ylabel()) for a in _panels(fig)] == [
+        ("x [mm]", "y [mm]"), ("x [mm]", "y [mm]"), ("x [mm]", "z [mm]")]
+    assert _colorbar_labels(fig) == ["z [mm]", "z [mm]"]
+
+
 def test_a_failed_write_keeps_the_previous_file(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
