@@ -624,3 +624,22 @@ def test_world_curves_leave_no_panel_empty() -> None:
         # a slot the families leave holds the legend; else it is below the panels
         assert [ax.get_legend() is not None for ax in off] == [True] * spare
         assert len(fig.legends) == (0 if spare else 1)
+
+
+def test_a_runs_poke_figure_draws_its_force_travel_record_and_the_fit(tmp_path: Path) -> None:
+    from deformap.explore import ExplorationConfig, SurfaceGPConfig, explore
+    from deformap.run._figures import write_poke_figure
+    from deformap.testing import coarse_world
+
+    config = ExplorationConfig(max_pokes=1, surface=SurfaceGPConfig(fit_hyperparameters=False))
+    result = explore(coarse_world("homogeneous-60"), config, rng=np.random.default_rng(0))
+    (poke,) = result.pokes
+    dent = poke.dent
+    assert dent is not None and dent.force_travel is not None and dent.force_fit is not None
+    # the fitted model runs through the record: within 15 % of each sample's force above 0.1 N
+    travel, force = dent.force_travel.travel_m, dent.force_travel.force_n
+    model = np.interp(travel, dent.force_fit[0], dent.force_fit[1])
+    strong = force > 0.1
+    assert np.all(np.abs(model[strong] - force[strong]) < 0.15 * force[strong])
+    path = write_poke_figure(tmp_path, poke)
+    assert path == tmp_path / "poke-01.png" and path.read_bytes()[:8] == PNG_MAGIC
