@@ -71,10 +71,43 @@ a(["loud"], standalone_mode=False)
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "ran"
     assert "SparseEfficiencyWarning" not in out.stderr and "sparsity" not in out.stderr
-    # with -v it is a log line of py.warnings, not a raw warning
+    # with -v it is a log line naming where it came from, not a raw warning
     out = subprocess.run([sys.executable, "-c", code.replace('["loud"]', '["-v", "loud"]')],
                          capture_output=True, text=True, check=True)  # fmt: skip
-    assert "WARNING py.warnings" in out.stderr
+    assert "warning (python):" in out.stderr and "SparseEfficiencyWarning" in out.stderr
+
+
+def test_a_warning_is_printed_once_without_a_module_path() -> None:
+    # a command logs a warning as it happens, then lists it again at the end (as `map` does
+    # with a skipped poke): stderr holds it once, labelled, with no internal module name
+    code = f"""
+import logging, sys
+sys.path.insert(0, {SRC!r})
+from deformap.cli._app import app as a, warn
+@a.command("twice")
+def _twice():
+    logging.getLogger("deformap.replay._offline").warning("poke %d skipped: %s", 2, "no dent")
+    warn("poke 2 skipped: no dent")
+    warn("poke 3 skipped: no dent")
+a(["twice"], standalone_mode=False)
+"""
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    lines = out.stderr.splitlines()
+    assert lines == ["warning: poke 2 skipped: no dent", "warning: poke 3 skipped: no dent"]
+    assert "deformap.replay" not in out.stderr and "WARNING" not in out.stderr
+
+
+def test_help_text_reflows_and_keeps_its_brackets() -> None:
+    # a docstring's hard line break is not kept (rich rewraps to the terminal), and "[required]"
+    # in an option's help is text, not a style
+    wide = runner.invoke(app, ["--help"], env={"COLUMNS": "200"})
+    assert ("poke until the map field is known, then cut it into regions."
+            in wide.output)  # fmt: skip
+    narrow = runner.invoke(app, ["--help"], env={"COLUMNS": "70"})
+    for line in narrow.output.splitlines():
+        assert len(line) <= 70
+    result = runner.invoke(app, ["estimate", "--help"], env={"COLUMNS": "200"})
+    assert "Tip centre X Y Z at the press, metres. [required]" in result.output
 
 
 def test_explore_without_a_scenario_says_what_it_runs(monkeypatch: pytest.MonkeyPatch) -> None:

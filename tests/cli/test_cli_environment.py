@@ -66,6 +66,13 @@ def test_a_users_environment_is_explored_with_every_output(robot_folder: Path) -
                  "poke-01.png", "poke-02.png"):
         assert (out / name).is_file(), name
     assert "2 pokes" in result.output
+    # pokes and regions numbered from 1, as poke-01.png and the map's R1, R2, … are
+    import csv
+
+    rows = list(csv.DictReader((out / "pokes.csv").open()))
+    assert [r["poke"] for r in rows] == ["1", "2"]
+    assert [p["index"] for p in report["pokes"]] == [0, 1]  # report.json keeps its index
+    assert all(int(r["region"]) >= 1 for r in rows if r["region"])
 
 
 @pytest.mark.parametrize(("args", "message"), [

@@ -86,7 +86,7 @@ def test_the_maps_as_numbers(full_run) -> None:  # type: ignore[no-untyped-def]
         np.testing.assert_allclose(grids["modulus_median_pa"],
                                    np.exp(grids["log_modulus_mean"]))
     rows = list(csv.DictReader((folder / "pokes.csv").open()))
-    assert [int(r["index"]) for r in rows] == [p.record.index for p in result.pokes]
+    assert [int(r["poke"]) for r in rows] == [p.record.index + 1 for p in result.pokes]
     for row, poke in zip(rows, result.pokes, strict=True):
         assert float(row["beta"]) == poke.record.beta
         assert float(row["contact_x_m"]) == poke.record.contact_xy[0]

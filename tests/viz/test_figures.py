@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 from matplotlib.figure import Figure
 from matplotlib.image import imread
+from matplotlib.text import Text
 
 from deformap.errors import InvalidArgumentError
 from deformap.viz import (
@@ -144,8 +145,8 @@ def test_map_figure_panels_labels_and_colour_bars() -> None:
     ]
     assert all((ax.get_xlabel(), ax.get_ylabel()) == ("x [m]", "y [m]") for ax in panels)
     assert _colorbar_labels(fig) == [
-        "hardness H [N] (grey: rigid)",
-        "β (deformability) [–]",
+        "true E [kPa] (log scale; grey: rigid)",
+        "β (deformability) [–]; 1 soft, 0 stiff",
         "var(β)",
     ]
     assert fig.get_suptitle() == "two blocks"
@@ -195,19 +196,21 @@ def test_poke_figure_panels_and_labels() -> None:
     panels = _panels(fig)
     assert [ax.get_title() for ax in panels] == [
         "ROI before (surface GP)",
-        "cloud while pressing (robot removed)",
-        "shape-matching error E(β)",
+        "cloud pressed, robot removed",
         "observed dent (touch GP)",
         "shape matching at β̂ = 0.400",
-        "section through the contact (y = 0.000 m)",
+        "section through the contact (y = 0 mm)",
+        "shape-matching error ε(β)",
+        "force–travel record",
     ]
-    # every panel names its axes with units
+    # every panel names its axes with units, every length in millimetres
     assert [(ax.get_xlabel(), ax.get_ylabel()) for ax in panels] == [
-        ("x [m]", "y [m]"), ("x [m]", "y [m]"), ("β [–]", "E(β) [mm]"),
-        ("x [m]", "y [m]"), ("x [m]", "y [m]"), ("x [m]", "z [mm]"),
+        *[("x [mm]", "y [mm]")] * 4, ("x [mm]", "z [mm]"),
+        ("β [–]", "shape-matching error ε(β) [mm]"),
+        ("travel since first contact [mm]", "force [N]"),
     ]  # fmt: skip
     assert _colorbar_labels(fig) == ["z [mm] (own scale)", "z [mm]", "z [mm]", "z [mm]"]
-    section = panels[5].get_legend()
+    section = panels[4].get_legend()
     assert [t.get_text() for t in section.get_texts()] == [
         "before (surface GP)",
         "observed dent (touch GP)",
@@ -215,13 +218,35 @@ def test_poke_figure_panels_and_labels() -> None:
         "cloud points on the section",
     ]
     # the legends sit below their axes, where they cover no data (the dent is mid-section)
-    for ax in (panels[1], panels[5]):
+    for ax in (panels[1], panels[4]):
         assert ax.get_legend()._loc == 9 and ax.get_legend().get_bbox_to_anchor().y1 < \
             ax.get_window_extent().y0 + 1
     # the simulated dent is drawn beside the observed one, on the same colour scale
-    observed, simulated = panels[3].get_images()[0], panels[4].get_images()[0]
+    observed, simulated = panels[2].get_images()[0], panels[3].get_images()[0]
     assert observed.get_clim() == simulated.get_clim()
     assert np.allclose(simulated.get_array(), _poke_kwargs()["simulated_z"] * 1e3)
+    # the suptitle sits above every panel's title
+    fig.canvas.draw()
+    (top,) = [t.get_window_extent() for t in fig.findobj(Text) if t.get_text() == "poke 1"]
+    assert all(ax.title.get_window_extent().y1 < top.y0 for ax in panels)
+    # without a record, the force panel says so
+    assert "no force–travel record" in [t.get_text() for t in panels[6].texts]
+
+
+def test_poke_figure_draws_the_force_travel_record_and_its_fit() -> None:
+    travel = np.linspace(0.0, 0.004, 8)
+    fit = np.vstack([np.linspace(0.0, 0.004, 30), 40.0 * np.linspace(0.0, 0.004, 30) ** 1.5])
+    fig = plot_poke(**_poke_kwargs(), force_travel=(travel, 40.0 * travel**1.5), force_fit=fit,
+                    reading="E = 9.7 ± 0.7 kPa")  # fmt: skip
+    press = _panels(fig)[6]
+    record, curve = press.get_lines()
+    assert np.allclose(record.get_xdata(), travel * 1e3)  # millimetres
+    assert np.allclose(curve.get_ydata(), fit[1])
+    assert [t.get_text() for t in press.get_legend().get_texts()] == [
+        "record", "contact model fitted: E = 9.7 ± 0.7 kPa"]
+    # a rigid reading has no fit: the record and the reading
+    fig = plot_poke(**_poke_kwargs(), force_travel=(travel * 0, travel * 100), reading="rigid")
+    assert [t.get_text() for t in _panels(fig)[6].get_legend().get_texts()] == ["record", "rigid"]
 
 
 def test_poke_figure_shows_the_surface_before_on_its_own_scale() -> None:
@@ -239,7 +264,7 @@ def test_poke_figure_shows_the_surface_before_on_its_own_scale() -> None:
     assert high - low == pytest.approx(1.0)
     # without a simulation, its panel says so
     kwargs["simulated_z"] = None
-    texts = [t.get_text() for t in _panels(plot_poke(**kwargs))[4].texts]
+    texts = [t.get_text() for t in _panels(plot_poke(**kwargs))[3].texts]
     assert texts == ["not simulated"]
 
 
@@ -269,6 +294,62 @@ def test_map_figure_legend_threshold_label_and_region_values() -> None:
         plot_map(*args, **kwargs, purposes=["first"])
 
 
+def test_map_figure_draws_stiffness_one_way_and_the_truth_on_the_maps_scale() -> None:
+    from matplotlib.colors import LogNorm
+
+    args, kwargs = _map_args()
+    gx, _ = np.meshgrid(*args)
+    fig = plot_map(*args, **kwargs, modulus_pa=np.where(gx < 0.3, 6e3, 2e4))
+    truth, beta, modulus = (ax.get_images()[0] for ax in _panels(fig)[:3])
+    # the truth is E in kPa (60 N is 4.64 kPa), on the modulus panel's scale and colour map
+    assert np.nanmax(truth.get_array()) == pytest.approx(60.0 / 0.0323 / 0.4 / 1e3)
+    assert isinstance(truth.norm, LogNorm)
+    assert (truth.norm.vmin, truth.norm.vmax) == (modulus.norm.vmin, modulus.norm.vmax)
+    assert truth.norm.vmin <= 4.64 and modulus.norm.vmax >= 20.0
+    # soft is the dark end everywhere: low E, and high β (the reversed map)
+    dark = np.mean(modulus.cmap(0.0)[:3])
+    assert np.mean(modulus.cmap(1.0)[:3]) > dark
+    assert np.allclose(beta.cmap(1.0), modulus.cmap(0.0)) and truth.cmap.name == modulus.cmap.name
+    assert "rigid" in [t.get_text() for t in _panels(fig)[0].texts]
+
+
+def test_map_figure_names_regions_with_the_reports_values_and_rigid_as_rigid() -> None:
+    args, kwargs = _map_args()
+    gx, _ = np.meshgrid(*args)
+    fig = plot_map(*args, **kwargs, modulus_pa=np.where(gx < 0.3, 6e3, 6e5),
+                   class_betas=[0.83, 0.01], class_modulus_pa=[5.1e3, 6.3e5],
+                   rigid_classes={1})  # fmt: skip
+    names = [sorted(t.get_text() for t in ax.texts if t.get_text().startswith("R"))
+             for ax in _panels(fig)[1:3]]  # fmt: skip
+    assert names == [["R1: β = 0.83", "R2: rigid"], ["R1: E = 5.1 kPa", "R2: rigid"]]
+
+
+def test_map_figure_says_when_the_variance_never_crosses_t_h() -> None:
+    args, kwargs = _map_args()
+    for threshold, side in ((0.5, "below"), (0.01, "above")):
+        fig = plot_map(*args, **{**kwargs, "threshold": threshold})
+        texts = [t.get_text() for t in fig.legends[0].get_texts()]
+        assert f"variance {side} T_h ({threshold:g}) everywhere: no T_h contour" in texts
+        assert not any(t.startswith("variance = T_h") for t in texts)
+        assert "T_h" not in [t.get_text() for t in _panels(fig)[-1].texts]
+
+
+def test_map_figure_keeps_region_labels_clear_of_the_pokes() -> None:
+    args, kwargs = _map_args()
+    # a poke at each region's deepest cell, where the label went before
+    contacts = np.array([[0.15, 0.2], [0.45, 0.2], [0.1, 0.1]])
+    fig = plot_map(*args, **{**kwargs, "contacts": contacts})
+    fig.canvas.draw()
+    ax = _panels(fig)[1]
+    boxes = [t.get_window_extent() for t in ax.texts if t.get_text().startswith("R")]
+    marks = ax.transData.transform(contacts)
+    assert len(boxes) == 2
+    for box in boxes:
+        for mx, my in marks:
+            inside = box.x0 - 8 < mx < box.x1 + 8 and box.y0 - 8 < my < box.y1 + 8
+            assert not inside, (box, (mx, my))
+
+
 def test_map_figure_variance_scale_can_be_fixed_so_runs_compare() -> None:
     args, kwargs = _map_args()
     own = _panels(plot_map(*args, **kwargs))[-1].get_images()[0]
@@ -286,9 +367,9 @@ def test_error_curve_figure() -> None:
     fig = plot_error_curve(betas, np.array([3e-3, 2e-3, 1e-3]), 0.5, 0.1)
     (ax,) = fig.axes
     assert (ax.get_title(), ax.get_xlabel(), ax.get_ylabel()) == (
-        "shape-matching error E(β)",
+        "shape-matching error ε(β)",
         "β [–]",
-        "E(β) [mm]",
+        "shape-matching error ε(β) [mm]",
     )
     curve = ax.get_lines()[0]
     assert np.array_equal(curve.get_xdata(), [0.0, 0.5, 0.9])
@@ -324,12 +405,38 @@ def test_study_figures() -> None:
     (ax,) = fig.axes
     assert (ax.get_xlabel(), ax.get_ylabel()) == (
         "cluster size k (k×k particles)",
-        "fit error min E(β) [mm]",
+        "fit error min ε(β) [mm]",
     )
     assert [t.get_text() for t in ax.get_legend().get_texts()] == ["60 N", "150 N", "rigid"]
     assert np.allclose(ax.get_lines()[0].get_ydata(), [1.0, 1.5, 2.0, 2.5, 3.0])
     ticks = [t for t in ax.get_xticks() if 2 <= t <= 6]
     assert ticks == [2, 3, 4, 5, 6]  # whole cluster sizes only
+
+
+def test_hardness_figure_puts_e_beside_beta_and_its_conditions_in_the_title() -> None:
+    study = _hardness_study()
+    for r in study["rows"]:
+        h = r["hardness_n"]
+        r.update(rigid=h is None, modulus_pa=None if h is None else h / 0.0323 / 0.4 * 1.2,
+                 modulus_std_pa=None if h is None else 100.0,
+                 true_modulus_pa=None if h is None else h / 0.0323 / 0.4)  # fmt: skip
+    study.update(force_n=0.6, thickness_m=0.05, camera="primesense", physics="linear-fem")
+    fig = plot_hardness_study(study)
+    beta, modulus = fig.axes
+    assert fig.get_suptitle() == ("β and E against hardness (force 0.6 N, foam 5 cm thick, "
+                                  "camera primesense, physics linear-fem)")
+    assert (beta.get_ylabel(), modulus.get_ylabel()) == (
+        "estimated β [–]", "Young's modulus E [kPa] (log scale)")
+    assert modulus.get_yscale() == "log" and modulus.get_xlim() == beta.get_xlim()
+    assert [t.get_text() for t in modulus.get_legend().get_texts()] == [
+        "true E (from H, ISO 2439)", "E read from the force–travel record (± claimed σ)"]
+    read, true = (line for line in modulus.get_lines()
+                  if len(line.get_xdata()) == 3 and line.get_linestyle() != "None")  # no caps
+    assert np.allclose(np.asarray(true.get_ydata(), dtype=float),
+                       np.array([150, 110, 60]) / 0.0323 / 0.4 / 1e3)
+    assert np.allclose(np.asarray(read.get_ydata(), dtype=float),
+                       np.asarray(true.get_ydata(), dtype=float) * 1.2)  # fmt: skip
+    assert "read rigid" in [t.get_text() for t in modulus.texts]
 
 
 def test_show_world_writes_three_pictures_and_nothing_else(tmp_path: Path) -> None:
@@ -341,6 +448,32 @@ def test_show_world_writes_three_pictures_and_nothing_else(tmp_path: Path) -> No
     assert sorted(out.iterdir()) == sorted(paths)
     for path in paths:
         assert path.read_bytes()[:8] == PNG_MAGIC
+
+
+def test_world_pictures_have_a_stiffness_colour_bar_and_one_unit_per_figure() -> None:
+    from matplotlib.colors import to_rgba
+
+    from deformap.testing import coarse_world
+    from deformap.viz._world import _dent_figure, _layout_figure
+
+    world = coarse_world("heterogeneous-60-110-rigid")
+    fig = _layout_figure(world)
+    ax = _panels(fig)[0]
+    assert _colorbar_labels(fig) == ["Young's modulus E [kPa] (log scale)"]
+    (bar,) = [a for a in fig.axes if a.get_label() == "<colorbar>"]
+    fig.canvas.draw()
+    assert [t.get_text() for t in bar.get_yticklabels()] == ["4.6", "8.5"]
+    (side,) = bar.child_axes  # hardness beside E, at the blocks' values
+    assert side.get_ylabel() == "hardness H [N]"
+    assert [t.get_text() for t in side.get_yticklabels()] == ["60", "110"]
+    # soft darker than stiff, rigid grey; names without an index
+    soft, stiff, rigid = (p.get_facecolor() for p in ax.patches[:3])
+    assert np.mean(soft[:3]) < np.mean(stiff[:3]) and rigid == to_rgba("0.55")
+    assert [t.get_text().split("\n")[0] for t in ax.texts[:3]] == ["foam-60", "foam-110", "rigid"]
+    fig = _dent_figure(world, 0.6)
+    assert [(a.get_xlabel(), a.get_ylabel()) for a in _panels(fig)] == [
+        ("x [mm]", "y [mm]"), ("x [mm]", "y [mm]"), ("x [mm]", "z [mm]")]
+    assert _colorbar_labels(fig) == ["z [mm]", "z [mm]"]
 
 
 def test_a_failed_write_keeps_the_previous_file(
@@ -447,21 +580,66 @@ def test_the_hardness_matrix_names_its_world_mesh() -> None:
     assert plot_hardness_study(study)._supxlabel is None  # type: ignore[attr-defined]
 
 
-def test_world_curves_colour_a_strategy_and_dash_a_field_and_cut() -> None:
-    from deformap.viz._worlds import _line_styles, plot_world_curves
-
-    names = [f"{s}/{f}/{c}" for s in ("paper", "planned") for f in ("beta", "modulus")
-             for c in ("nearest", "isopleth")] + ["oracle"]
-    colours, styles = _line_styles(names)
-    assert colours["paper/beta/nearest"] == colours["paper/modulus/isopleth"] == "C0"
-    assert colours["planned/beta/nearest"] == "C1" and colours["oracle"] == "C2"
-    assert styles["paper/beta/nearest"] == styles["planned/beta/nearest"]
-    assert len({str(styles[n]) for n in names if n.startswith("paper/")}) == 4
+def _world_curves(n_worlds: int, families: tuple[str, ...]) -> dict[str, dict[str, Any]]:
+    names = [f"{s}/{f}/{c}" for s in ("paper", "planned", "max-variance")
+             for f in ("beta", "modulus") for c in ("nearest", "isopleth")]  # fmt: skip
     rng = np.random.default_rng(0)
-    curves = {"all": {n: rng.uniform(0.5, 1.0, (3, 5)) for n in names}}
-    fig = plot_world_curves(curves)  # the figure takes the names in sorted order
-    drawn = {ln.get_label(): ln.get_color() for ln in fig.axes[0].get_lines()
-             if ln.get_label() in names}
-    assert drawn == _line_styles(sorted(names))[0] and len(drawn) == len(names)
-    assert len({drawn[n] for n in names if n.startswith("planned/")}) == 1
-    assert len(set(drawn.values())) == 3  # paper, planned, oracle
+    # planned/modulus/* best, then planned/beta/*; the paper's own combination among the worst
+    level = {n: 0.9 if n.startswith("planned/modulus") else 0.7 if n.startswith("planned") else
+             0.5 for n in names}  # fmt: skip
+    level["planned/modulus/nearest"], level["planned/beta/isopleth"] = 0.95, 0.75
+    return {family: {n: np.clip(level[n] + rng.normal(0, 0.02, (n_worlds, 5)), 0, 1)
+                     for n in names} for family in ("all", *families)}  # fmt: skip
+
+
+def test_world_curves_draw_the_best_few_and_the_papers() -> None:
+    from deformap.viz._worlds import plot_world_curves
+
+    fig = plot_world_curves(_world_curves(3, ("cuts", "insert")))
+    panels = [ax for ax in fig.axes if ax.axison]
+    assert [ax.get_title() for ax in panels] == [
+        "all (3 worlds, too few for a band)", "cuts (3 worlds, too few for a band)",
+        "insert (3 worlds, too few for a band)"]  # fmt: skip
+    labels = [ln.get_label() for ln in panels[0].get_lines()]
+    assert labels == ["1. planned/modulus/nearest", "2. planned/modulus/isopleth",
+                      "3. planned/beta/isopleth", "paper/beta/isopleth (the paper's)",
+                      "accuracy 0.9 (a good map)"]  # fmt: skip
+    assert all(not ax.collections for ax in panels)  # no band over three worlds
+    # twelve worlds: bands; without the paper's combination, its strategy's best stands in
+    curves = _world_curves(12, ())
+    del curves["all"]["paper/beta/isopleth"]
+    fig = plot_world_curves(curves, best=2)
+    (ax,) = fig.axes
+    assert len(ax.collections) == 3
+    assert [ln.get_label() for ln in ax.get_lines()][2].endswith("(the paper's strategy)")
+
+
+def test_world_curves_leave_no_panel_empty() -> None:
+    from deformap.viz._worlds import plot_world_curves
+
+    for families, spare in ((("a", "b", "c"), 0), (("a", "b", "c", "d"), 1), (("a",), 0)):
+        fig = plot_world_curves(_world_curves(2, families))
+        off = [ax for ax in fig.axes if not ax.axison]
+        assert len(off) == spare
+        # a slot the families leave holds the legend; else it is below the panels
+        assert [ax.get_legend() is not None for ax in off] == [True] * spare
+        assert len(fig.legends) == (0 if spare else 1)
+
+
+def test_a_runs_poke_figure_draws_its_force_travel_record_and_the_fit(tmp_path: Path) -> None:
+    from deformap.explore import ExplorationConfig, SurfaceGPConfig, explore
+    from deformap.run._figures import write_poke_figure
+    from deformap.testing import coarse_world
+
+    config = ExplorationConfig(max_pokes=1, surface=SurfaceGPConfig(fit_hyperparameters=False))
+    result = explore(coarse_world("homogeneous-60"), config, rng=np.random.default_rng(0))
+    (poke,) = result.pokes
+    dent = poke.dent
+    assert dent is not None and dent.force_travel is not None and dent.force_fit is not None
+    # the fitted model runs through the record: within 15 % of each sample's force above 0.1 N
+    travel, force = dent.force_travel.travel_m, dent.force_travel.force_n
+    model = np.interp(travel, dent.force_fit[0], dent.force_fit[1])
+    strong = force > 0.1
+    assert np.all(np.abs(model[strong] - force[strong]) < 0.15 * force[strong])
+    path = write_poke_figure(tmp_path, poke)
+    assert path == tmp_path / "poke-01.png" and path.read_bytes()[:8] == PNG_MAGIC

@@ -11,6 +11,7 @@ go to stderr so that stdout is the JSON alone.
 
 from __future__ import annotations
 
+import inspect
 import logging
 import os
 import sys
@@ -22,7 +23,9 @@ from typing import Annotated, Any, TypeVar
 
 import typer
 from rich.console import Console
+from rich.markup import escape
 from rich.text import Text
+from typer.core import TyperGroup
 
 from deformap import __version__, run
 from deformap._files import check_destination
@@ -39,6 +42,7 @@ __all__ = [
     "friendly_errors",
     "labelled",
     "out_console",
+    "warn",
 ]
 
 PIPE_WIDTH = 400
@@ -68,8 +72,39 @@ def labelled(label: str, style: str, text: str) -> Text:
     """``label`` in ``style``, a space, then ``text`` as it is (no markup)."""
     return Text.assemble((label, style), " ", text)
 
+def _reflowed(text: str | None) -> str | None:
+    """``text`` with each paragraph's line breaks made spaces (rich then wraps it to the
+    terminal) and its square brackets literal ("[required]", "x [m]" are words, not styles)."""
+    if not text:
+        return text
+    paragraphs = inspect.cleandoc(text).split("\n\n")
+    return escape("\n\n".join(p if p.startswith("\b") else " ".join(p.split("\n"))
+                                for p in paragraphs))  # fmt: skip
+
+
+def _reflow_help(command: Any) -> None:
+    """Reflow the help of a click ``command``, its parameters and every subcommand
+    (:func:`_reflowed`)."""
+    command.help = _reflowed(command.help)
+    for param in command.params:
+        if hasattr(param, "help"):  # options and typer's arguments; click's arguments have none
+            param.help = _reflowed(param.help)
+    for sub in getattr(command, "commands", {}).values():
+        _reflow_help(sub)
+
+
+class _ReflowingGroup(TyperGroup):
+    """The root group: once built with every subcommand, their help texts are reflowed, since
+    rich keeps a docstring's hard line breaks and reads its brackets as styles."""
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        _reflow_help(self)
+
+
 app = typer.Typer(
     name="deformap",
+    cls=_ReflowingGroup,
     help="Map how deformable a surface is, region by region, from a few robot pokes.",
     no_args_is_help=True,
     add_completion=False,
@@ -195,8 +230,46 @@ def configure_logging(verbose: bool) -> None:
     """deformap's warnings always, its INFO lines with ``verbose``; other libraries' log lines
     at WARNING and above only, and their Python warnings (scipy's sparse-efficiency warnings,
     for one) not shown at all: they are advice to the library's programmer, not to the user,
-    and with ``verbose`` they come as log lines of ``py.warnings``."""
-    logging.basicConfig(level=logging.WARNING, format="%(levelname)s %(name)s: %(message)s")
+    and with ``verbose`` they come as log lines of ``py.warnings``. Every line goes through one
+    handler on the root logger (:class:`_ConsoleHandler`), so each is printed once."""
+    root = logging.getLogger()
+    for handler in [h for h in root.handlers if isinstance(h, _ConsoleHandler)]:
+        root.removeHandler(handler)
+    root.addHandler(_ConsoleHandler())
+    if root.level == logging.NOTSET or root.level > logging.WARNING:
+        root.setLevel(logging.WARNING)
     logging.getLogger("deformap").setLevel(logging.INFO if verbose else logging.WARNING)
     logging.captureWarnings(True)
     logging.getLogger("py.warnings").setLevel(logging.WARNING if verbose else logging.CRITICAL)
+
+
+_SHOWN: set[str] = set()
+"""The warning lines printed in this process, so that :func:`warn` does not print one that a log
+line already did (a skipped poke is logged as it happens and listed again in the report)."""
+
+_LEVEL_STYLES = {"error": "bold red", "warning": "yellow", "info": "dim", "debug": "dim"}
+
+
+class _ConsoleHandler(logging.Handler):
+    """Log lines on stderr as ``warning: message``: a user reads what happened, not which
+    internal module said it; another library's lines name it (``warning (scipy): …``)."""
+
+    def emit(self, record: logging.LogRecord) -> None:
+        try:
+            message = record.getMessage()
+            level = record.levelname.lower()
+            top = "python" if record.name == "py.warnings" else record.name.split(".")[0]
+            label = f"{level}:" if top in ("deformap", "root") else f"{level} ({top}):"
+            if record.levelno >= logging.WARNING:
+                _SHOWN.add(message)
+            err_console.print(labelled(label, _LEVEL_STYLES.get(level, ""), message),
+                              soft_wrap=True)
+        except Exception:  # logging's own contract: a handler never raises
+            self.handleError(record)
+
+
+def warn(message: str) -> None:
+    """Print ``warning: message`` on stderr, unless a log line printed it already."""
+    if message not in _SHOWN:
+        _SHOWN.add(message)
+        err_console.print(labelled("warning:", "yellow", message), soft_wrap=True)

@@ -19,6 +19,7 @@ from deformap.cli._app import (
     friendly_errors,
     labelled,
     out_console,
+    warn,
 )
 from deformap.cli._explore import HELP_DEFAULTS, modulus_summary
 from deformap.cli._progress import modulus_text, progress, run_hooks
@@ -135,7 +136,7 @@ def map_command(
                                           raw_settings=raw_settings)  # fmt: skip
     report = output.report
     for line in report["warnings"]:
-        err_console.print(labelled("warning:", "yellow", line), soft_wrap=True)
+        warn(line)  # once: the log line of a skipped poke printed it as it happened
     regions = report["regions"]
     found = (
         "no poke usable" if regions is None else f"{len(regions['class_betas'])} region class(es)"

@@ -41,6 +41,7 @@ from deformap.explore._records import ContactRecord, Dent, PokeRecord, PokeResul
 from deformap.explore._stiffness import StiffnessEstimate, estimate_stiffness
 from deformap.explore._surface import SurfaceModel, crop_to
 from deformap.gp import GaussianRandomField
+from deformap.mechanics import layer_indentation_force
 from deformap.msm import estimate_beta
 
 __all__ = ["dent_visible", "measure_press", "roi_grid"]
@@ -58,6 +59,21 @@ _FLANK_TIP_RADII = 2.0
 """The dent's flank, where the camera must see it: within two tip radii of the contact (a Hertz
 dent's surface has fallen to under a third of δ there; the tip and stick hide the part inside one
 radius from most views)."""
+
+
+def _force_fit(obs: PressObservation, stiffness: StiffnessEstimate | None,
+               thickness: float | None, config: ExplorationConfig) -> NDArray[np.float64] | None:
+    """``(2, 60)``: travel [m] over the record and the force [N] of the fitted contact model,
+    ``E g(t + δ₀)`` (:mod:`deformap.explore._stiffness`), for the poke's figure; ``None``
+    without a modulus."""
+    record = obs.force_travel
+    if record is None or stiffness is None or stiffness.modulus_pa is None or thickness is None:
+        return None
+    travel = np.linspace(0.0, float(np.max(record.travel_m)), 60)
+    depth = np.maximum(travel + (stiffness.contact_offset_m or 0.0), 0.0)
+    force = layer_indentation_force(depth, obs.contact.tip_radius_m, thickness,
+                                    stiffness.modulus_pa, config.stiffness.poisson_ratio)
+    return np.vstack([travel, force])
 
 
 def _robust_std(residuals: NDArray[np.float64], floor: float = 1e-6) -> float:
@@ -258,5 +274,6 @@ def measure_press(obs: PressObservation, index: int, surface: SurfaceModel,
         stiffness=stiffness, layer_thickness_m=thickness, stiffness_error=stiffness_error,
         indentation_m=depth, depth_anchored=anchored_noise is not None, dent_visible=visible,
     )
-    dent = Dent(roi_xs, roi_ys, rest_z, deformed_z, roi, tactile)
+    dent = Dent(roi_xs, roi_ys, rest_z, deformed_z, roi, tactile, obs.force_travel,
+                _force_fit(obs, stiffness, thickness, config))
     return PokeResult(record, dent, est)

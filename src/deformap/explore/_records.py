@@ -15,7 +15,7 @@ from typing import Any, Literal, get_args
 import numpy as np
 from numpy.typing import NDArray
 
-from deformap.environment import TactileContact
+from deformap.environment import ForceTravel, TactileContact
 from deformap.errors import FileFormatError, InvalidArgumentError
 from deformap.explore._planning import PokePlan
 from deformap.explore._stiffness import LAYER_MODEL, StiffnessEstimate
@@ -336,7 +336,9 @@ class Dent:
 
     ``roi_xs (nx,)``, ``roi_ys (ny,)`` the ROI grid; ``rest_z``, ``deformed_z (ny, nx)`` the
     surface before and while pressing (metres); ``roi_points (m, 3)`` the cloud points kept;
-    ``tactile (k, 3)`` the tactile points on the tip.
+    ``tactile (k, 3)`` the tactile points on the tip; ``force_travel`` the press's force–travel
+    record (``None`` without one) and ``force_fit (2, m)`` the curve its modulus was fitted with,
+    travel [m] and force [N] (``None`` without a modulus).
     """
 
     roi_xs: NDArray[np.float64]
@@ -345,6 +347,8 @@ class Dent:
     deformed_z: NDArray[np.float64]
     roi_points: NDArray[np.float64]
     tactile: NDArray[np.float64]
+    force_travel: ForceTravel | None = None
+    force_fit: NDArray[np.float64] | None = None
 
 
 @dataclass(frozen=True, eq=False)

@@ -9,14 +9,17 @@ map's grid of ``(ny, nx)`` cells unless said otherwise:
 - ``modulus_median_pa``, ``log_modulus_mean``, ``log_modulus_std``: the modulus field (over ln E,
   E in Pa): the median E (``exp`` of the mean), the mean and standard deviation of ln E; NaN
   everywhere when no poke gave a modulus.
-- ``region_labels`` (int, -1 without a region map), ``field``: the field the regions were cut from.
+- ``region_labels`` (int, -1 without a region map; label ``k`` is region ``R(k+1)`` of
+  ``map.png``), ``field``: the field the regions were cut from.
 
-``pokes.csv``: ``index`` (0-based, as in ``report.json``), ``purpose``, ``target_x_m``,
+``pokes.csv``: ``poke`` (numbered from 1, as in ``poke-NN.png``, the figures and the console;
+``report.json``'s ``index`` is this number minus one), ``purpose``, ``target_x_m``,
 ``target_y_m``, ``contact_x_m``, ``contact_y_m`` (where the tip touched: the fields' input),
 ``tip_center_z_m`` (the tip's centre at the commanded force), ``force_n``, ``beta``,
 ``beta_std``, ``stiffness_n_per_m``, ``stiffness_std_n_per_m``, ``modulus_pa``, ``modulus_std_pa``,
-``rigid`` (the force–travel reading; empty where the poke had none), ``region`` (the class of the
-poke in the region map, empty where the map field left the poke out).
+``rigid`` (the force–travel reading; empty where the poke had none), ``region`` (the region the
+poke is in, numbered from 1 as ``R1, R2, …`` on ``map.png``: ``region_labels`` + 1; empty where
+the map field left the poke out).
 
 Both are written atomically (:mod:`deformap._files`). :func:`write_run_results` writes a run's
 results in one place for every workflow that maps (explore, a user's environment, a session):
@@ -43,7 +46,7 @@ __all__ = ["POKES_CSV_COLUMNS", "poke_writer", "write_map_npz", "write_pokes_csv
            "write_run_results"]
 
 POKES_CSV_COLUMNS = (
-    "index", "purpose", "target_x_m", "target_y_m", "contact_x_m", "contact_y_m", "tip_center_z_m",
+    "poke", "purpose", "target_x_m", "target_y_m", "contact_x_m", "contact_y_m", "tip_center_z_m",
     "force_n", "beta", "beta_std", "stiffness_n_per_m", "stiffness_std_n_per_m", "modulus_pa",
     "modulus_std_pa", "rigid", "region",
 )  # fmt: skip
@@ -90,12 +93,13 @@ def write_pokes_csv(path: Path, result: ExplorationResult) -> Path:
         r = poke.record
         s = r.stiffness
         writer.writerow([
-            r.index, _cell(r.purpose), *(float(v) for v in r.target_xy),
+            r.index + 1, _cell(r.purpose), *(float(v) for v in r.target_xy),
             *(float(v) for v in r.contact_xy), r.contact.tip_center[2], r.force_n, r.beta,
             r.beta_std,
             _cell(s and s.stiffness_n_per_m), _cell(s and s.stiffness_std_n_per_m),
             _cell(s and s.modulus_pa), _cell(s and s.modulus_std_pa),
-            "" if s is None else s.rigid, _cell(region_of.get(r.index)),
+            "" if s is None else s.rigid,
+            "" if r.index not in region_of else region_of[r.index] + 1,
         ])  # fmt: skip
     write_text_atomically(path, text.getvalue())
     return path

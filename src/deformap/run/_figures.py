@@ -14,9 +14,10 @@ from typing import Any
 import numpy as np
 
 from deformap.explore import ExplorationResult, PokeResult
+from deformap.run._report import _class_values
 
-__all__ = ["poke_figure_path", "write_estimate_figures", "write_map_figures", "write_poke_figure",
-           "write_rerun"]
+__all__ = ["poke_figure_path", "rigid_regions", "write_estimate_figures", "write_map_figures",
+           "write_poke_figure", "write_rerun"]
 
 
 def write_map_figures(
@@ -62,18 +63,36 @@ def write_map_figures(
         truth_hardness = None if truth is None else truth.ground_truth_hardness(result.xs, result.ys)
         levels = regions.levels if result.config.region_labels == "isopleth" else None
         modulus = result.modulus_field.median_pa if result.has_modulus else None
+        values = _class_values(result)  # what report.json says of each region
         plot_map(result.xs, result.ys, beta=result.field.mean,
                  variance=result.map_field.variance, contacts=contacts, labels=regions.labels,
                  levels=levels, truth_hardness=truth_hardness, threshold=threshold, title=title,
                  path=folder / "map.png", modulus_pa=modulus,
                  region_field=result.config.field,
                  purposes=[p.record.purpose for p in result.pokes],
-                 variance_max=variance_max)  # fmt: skip
+                 variance_max=variance_max, class_betas=values["class_betas"],
+                 class_modulus_pa=values["class_modulus_median_pa"],
+                 rigid_classes=rigid_regions(result))  # fmt: skip
         written.append(folder / "map.png")
     if poke_figures:
         written += [write_poke_figure(folder, poke) for poke in result.pokes
                     if poke.dent is not None]  # a poke resumed from a journal has no arrays
     return written
+
+
+def rigid_regions(result: ExplorationResult) -> set[int]:
+    """The regions (labels) whose pokes all read rigid from their force–travel records."""
+    regions = result.regions
+    if regions is None:
+        return set()
+    index = result.map_field.pokes.index
+    indices = range(len(regions.poke_labels)) if index is None else index
+    rigid = {p.record.index: p.record.stiffness is not None and p.record.stiffness.rigid
+             for p in result.pokes}  # fmt: skip
+    by_label: dict[int, list[bool]] = {}
+    for i, k in zip(indices, regions.poke_labels, strict=True):
+        by_label.setdefault(int(k), []).append(rigid.get(int(i), False))
+    return {k for k, flags in by_label.items() if flags and all(flags)}
 
 
 def poke_figure_path(folder: Path, index: int) -> Path:
@@ -100,14 +119,31 @@ def _plot_poke(path: Path, poke: PokeResult, title: str) -> None:
     simulated = None if surface is None else np.asarray(surface)[..., 2]
     if simulated is not None and simulated.shape != dent.rest_z.shape:
         simulated = None
+    record = dent.force_travel
     plot_poke(roi_xs=dent.roi_xs, roi_ys=dent.roi_ys, rest_z=dent.rest_z,
               deformed_z=dent.deformed_z, roi_points=dent.roi_points, tactile=dent.tactile,
               betas=np.asarray(r.betas), errors=np.asarray(r.errors), beta=r.beta,
-              beta_std=r.beta_std, simulated_z=simulated, title=title, path=path)  # fmt: skip
+              beta_std=r.beta_std, simulated_z=simulated, title=title, path=path,
+              force_travel=None if record is None else (record.travel_m, record.force_n),
+              force_fit=dent.force_fit, reading=_reading(poke))  # fmt: skip
+
+
+def _reading(poke: PokeResult) -> str:
+    """What the poke's force–travel record read, as the console prints it."""
+    r = poke.record
+    s = r.stiffness
+    if s is None:
+        return "" if r.stiffness_error is None else "not read (see report.json)"
+    if s.rigid:
+        bound = s.stiffness_lower_n_per_m
+        return "rigid" + ("" if bound is None else f" (k ≥ {bound:.0f} N/m)")
+    if s.modulus_pa is None or s.modulus_std_pa is None:
+        return ""
+    return f"E = {s.modulus_pa / 1e3:.1f} ± {s.modulus_std_pa / 1e3:.1f} kPa"
 
 
 def write_estimate_figures(folder: Path, poke: PokeResult) -> list[Path]:
-    """``beta-curve.png`` (the shape-matching error E(β)) and ``poke.png`` of one poke."""
+    """``beta-curve.png`` (the shape-matching error ε(β)) and ``poke.png`` of one poke."""
     from deformap.viz import plot_error_curve
 
     r = poke.record

@@ -1,11 +1,15 @@
 """The map figure of a run, a :class:`matplotlib.figure.Figure` built without ``pyplot``.
 
 ``map.png`` follows the paper's Fig. 6: ground truth | β-field with region contours and the contacts
-| variance with the contacts; with a modulus field, a panel of E in kPa (log colour scale) comes
-before the variance, which is the variance of the field the regions ran on. Each region is named
-(R1, R2, …) at its inmost cell with its mean β (and E) on the map; one legend below the panels says
-which mark is the first poke, the later ones and the boundary pokes, and which line is a region
-boundary and which the T_h contour. The poke figures are :mod:`deformap.viz._poke`.
+| variance with the contacts; with a modulus field, a panel of E in kPa comes before the variance,
+which is the variance of the field the regions ran on. Stiffness has one colour direction in every
+panel (:mod:`deformap.viz._style`: dark soft, light stiff): the ground truth is drawn as Young's
+modulus on the modulus panel's log scale, rigid in grey. Each region is named R1, R2, … (as
+``pokes.csv`` numbers them) with the statistic ``report.json`` gives for it, or "rigid", at the
+cell deepest inside it that keeps the label clear of the pokes' marks; the pokes are numbered from
+1. One legend below the panels says which mark is the first poke, the later ones and the boundary
+pokes, which line is a region boundary and which the T_h contour, or that the variance is below
+(above) T_h everywhere when there is no contour. The poke figures are :mod:`deformap.viz._poke`.
 
 Every ``plot_*`` function returns its figure and, given ``path``, also writes it there atomically
 (a temporary file in the same folder, renamed onto ``path`` once complete). No backend is selected,
@@ -15,13 +19,13 @@ and GUI applications, which keep their own backend and display the returned figu
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Collection, Sequence
 from pathlib import Path
 
 import numpy as np
 from matplotlib import patheffects
 from matplotlib.axes import Axes
-from matplotlib.colors import LogNorm
+from matplotlib.colors import ListedColormap, LogNorm
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.ticker import FuncFormatter
@@ -30,6 +34,8 @@ from scipy.ndimage import distance_transform_edt
 
 from deformap.errors import InvalidArgumentError
 from deformap.viz._save import save_figure
+from deformap.viz._style import BETA_CMAP, RIGID_COLOUR, STIFFNESS_CMAP, modulus_norm
+from deformap.world import hardness_to_youngs_modulus
 
 __all__ = ["plot_map"]
 
@@ -37,7 +43,10 @@ __all__ = ["plot_map"]
 _MARKS = {"first": ("o", "first poke"), "variance": ("^", "later pokes"),
           "boundary": ("s", "boundary pokes")}  # fmt: skip
 _HALO = [patheffects.withStroke(linewidth=3.5, foreground="w")]
-_REGION_COLOUR, _THRESHOLD_COLOUR = "c", "r"
+_REGION_COLOUR, _THRESHOLD_COLOUR = "r", "tab:orange"
+_PANEL_PX = 400.0
+"""About how many pixels a map panel's axes span across (5.2 in at 110 dpi, less its colour bar):
+the scale by which a region's label is kept clear of the pokes' marks."""
 Extent = tuple[float, float, float, float]
 
 
@@ -59,8 +68,8 @@ def _purposes(n: int, purposes: Sequence[str | None] | None) -> list[str]:
 
 
 def _contacts(ax: Axes, contacts: NDArray[np.float64], purposes: list[str]) -> None:
-    """The pokes, marked by purpose and numbered in order: black with a white halo, readable on
-    the dark end of a colour map (a rigid board's β = 0) as on the light one."""
+    """The pokes, marked by purpose and numbered from 1: black with a white halo, readable on
+    the dark end of a colour map as on the light one."""
     for purpose, (marker, _) in _MARKS.items():
         mine = [i for i, p in enumerate(purposes) if p == purpose]
         if mine:
@@ -71,15 +80,19 @@ def _contacts(ax: Axes, contacts: NDArray[np.float64], purposes: list[str]) -> N
                     path_effects=[patheffects.withStroke(linewidth=2.5, foreground="w")])
 
 
-def _legend(fig: Figure, purposes: list[str], *, regions: bool, threshold: float | None) -> None:
-    """One legend below the panels (inside, it would cover a map)."""
+def _legend(fig: Figure, purposes: list[str], *, regions: bool, threshold: float | None,
+            note: str | None) -> None:
+    """One legend below the panels (inside, it would cover a map); ``note`` (no T_h contour) as
+    an entry without a mark."""
     handles = [Line2D([], [], marker=_MARKS[p][0], mfc="none", mec="k", mew=2, ms=9, ls="none",
                       label=_MARKS[p][1]) for p in _MARKS if p in purposes]  # fmt: skip
     if regions:
         handles.append(Line2D([], [], color=_REGION_COLOUR, lw=2, label="region boundary"))
     if threshold is not None:
-        handles.append(Line2D([], [], color=_THRESHOLD_COLOUR, lw=1,
-                              label=f"variance = T_h ({threshold:.3g})"))
+        handles.append(Line2D([], [], color=_THRESHOLD_COLOUR, lw=1.5,
+                              label=f"variance = T_h ({threshold:.4g})"))
+    if note is not None:
+        handles.append(Line2D([], [], ls="none", label=note))
     if handles:
         fig.legend(handles=handles, loc="outside lower center", ncols=len(handles), fontsize=9,
                    frameon=False)
@@ -102,6 +115,9 @@ def plot_map(
     region_field: str = "beta",
     purposes: Sequence[str | None] | None = None,
     variance_max: float | None = None,
+    class_betas: Sequence[float | None] | None = None,
+    class_modulus_pa: Sequence[float | None] | None = None,
+    rigid_classes: Collection[int] = (),
 ) -> Figure:
     """The map figure: ground truth (when given) | β-field | modulus field (when given) |
     variance and contacts; the regions drawn on the field they were cut from.
@@ -115,18 +131,20 @@ def plot_map(
     variance : (ny, nx) float
         Variance of the field the regions ran on (``region_field``'s: β², or (ln E)²).
     contacts : (k, 2) float, metres
-        Poked places in order.
+        Poked places in order; numbered from 1 on the map.
     labels, levels : optional
-        Region label map and the isopleths drawn as contours of ``region_field``'s mean (β, or
-        ln E of ``modulus_pa``); without ``levels``, the edges between the labels are drawn
-        (regions labelled by nearest poke). The other field's panel shows the labels' edges.
-        Each region is named at its inmost cell with the mean of the β-field over its cells (and
-        on the modulus panel the geometric mean of E over them).
+        Region label map (label ``k`` is region R(k+1)) and the isopleths drawn as contours of
+        ``region_field``'s mean (β, or ln E of ``modulus_pa``); without ``levels``, the edges
+        between the labels are drawn (regions labelled by nearest poke). The other field's panel
+        shows the labels' edges.
     truth_hardness : (ny, nx) float, optional
-        Ground-truth hardness in newtons (``inf`` rigid, ``nan`` bare table); omitted without truth.
+        Ground-truth hardness in newtons (``inf`` rigid, ``nan`` bare table), drawn as Young's
+        modulus (:func:`deformap.world.hardness_to_youngs_modulus`) on the modulus panel's
+        colour scale; omitted without truth.
     threshold : float, optional
         The variance threshold T_h, drawn and labelled as a contour on the variance panel where
-        the field crosses it.
+        the field crosses it; where it does not, the legend says the variance is below (or
+        above) it everywhere.
     title : str
         The figure's title.
     path : str or Path, optional
@@ -141,6 +159,12 @@ def plot_map(
     variance_max : float, optional
         The top of the variance colour scale (from 0), the same for every run drawn with it so
         that runs compare; without it the scale spans 0 to this map's largest variance.
+    class_betas, class_modulus_pa : sequence of float or None, optional
+        Each region's β and E [Pa] as ``report.json`` gives them (``class_betas``, the mean β of
+        its pokes; ``class_modulus_median_pa``, the median E over its cells), written on the β and
+        modulus panels; without them, the median over the region's cells of the panel's field.
+    rigid_classes : collection of int
+        Regions whose pokes all read rigid: labelled "rigid", not with a number.
 
     Returns
     -------
@@ -154,35 +178,40 @@ def plot_map(
     contacts = np.asarray(contacts, dtype=float).reshape(-1, 2)
     kinds = _purposes(len(contacts), purposes)
     panels = 2 + (truth_hardness is not None) + (modulus_pa is not None)
-    fig = Figure(figsize=(5.2 * panels, 4.5), layout="constrained")
+    fig = Figure(figsize=(5.2 * panels, 4.6), layout="constrained")
     axes = list(np.atleast_1d(fig.subplots(1, panels)))
     ext = _extent(xs, ys)
-    if truth_hardness is not None:
-        _truth_panel(fig, axes.pop(0), xs, ys, ext, truth_hardness)
+    truth_kpa = None if truth_hardness is None else _truth_modulus_kpa(truth_hardness)
+    kpa = None if modulus_pa is None else np.asarray(modulus_pa, dtype=float) / 1e3
+    norm = modulus_norm(*(m for m in (kpa, truth_kpa) if m is not None))
+    if truth_kpa is not None:
+        _truth_panel(fig, axes.pop(0), xs, ys, ext, truth_kpa, norm)
     n_regions = "" if labels is None else f", {len(np.unique(labels))} region(s)"
+    overlay = _Overlay(xs, ys, labels, levels, contacts, kinds, set(rigid_classes))
     ax = axes.pop(0)
-    im = ax.imshow(beta, origin="lower", extent=ext, cmap="magma", vmin=0.0, vmax=1.0)
-    fig.colorbar(im, ax=ax, label="β (deformability) [–]")
+    im = ax.imshow(beta, origin="lower", extent=ext, cmap=BETA_CMAP, vmin=0.0, vmax=1.0)
+    fig.colorbar(im, ax=ax, label="β (deformability) [–]; 1 soft, 0 stiff")
     ax.set_title(f"β-field{n_regions if region_field == 'beta' else ''}")
-    _field_overlay(ax, xs, ys, beta, labels, levels, contacts, kinds,
-                   main=region_field == "beta", name=lambda v: f"β = {v:.2f}")  # fmt: skip
-    if modulus_pa is not None:
+    overlay.draw(ax, beta, class_betas, main=region_field == "beta",
+                 name=lambda v: f"β = {v:.2f}")  # fmt: skip
+    if kpa is not None:
         ax = axes.pop(0)
-        _modulus_panel(fig, ax, ext, modulus_pa)
+        _modulus_image(fig, ax, ext, kpa, norm, "Young's modulus E [kPa] (log scale)")
         ax.set_title(f"modulus field{n_regions if region_field == 'modulus' else ''}")
-        _field_overlay(ax, xs, ys, np.log(modulus_pa), labels, levels, contacts, kinds,
-                       main=region_field == "modulus",
-                       name=lambda v: f"E = {np.exp(v) / 1e3:.3g} kPa")  # fmt: skip
+        moduli = None if class_modulus_pa is None else [
+            None if v is None else float(np.log(v)) for v in class_modulus_pa]  # fmt: skip
+        overlay.draw(ax, np.log(kpa * 1e3), moduli, main=region_field == "modulus",
+                     name=lambda v: f"E = {np.exp(v) / 1e3:.3g} kPa")  # fmt: skip
     ax = axes.pop(0)
-    drawn = _variance_panel(fig, ax, xs, ys, ext, variance, threshold, variance_max,
-                            modulus=region_field == "modulus")  # fmt: skip
+    note = _variance_panel(fig, ax, xs, ys, ext, variance, threshold, variance_max,
+                           modulus=region_field == "modulus")  # fmt: skip
     _contacts(ax, contacts, kinds)
     for a in fig.axes:
         if a.get_label() != "<colorbar>":
             a.set_xlabel("x [m]")
             a.set_ylabel("y [m]")
     _legend(fig, kinds, regions=labels is not None and bool(np.ptp(labels) > 0),
-            threshold=threshold if drawn else None)
+            threshold=threshold if note is None else None, note=note)
     if title:
         fig.suptitle(title)
     if path is not None:
@@ -190,70 +219,130 @@ def plot_map(
     return fig
 
 
-def _field_overlay(ax: Axes, xs: NDArray, ys: NDArray, values: NDArray, labels: NDArray | None,
-                   levels: NDArray | None, contacts: NDArray, kinds: list[str], *, main: bool,
-                   name: Callable[[float], str]) -> None:
-    """On one field's panel: the regions (its isopleths ``levels`` when the regions were cut from
-    it, ``main``), the pokes, and each region named with ``name`` of its mean of ``values``."""
-    _regions(ax, xs, ys, values, labels, levels if main else None, main=main)
-    _contacts(ax, contacts, kinds)
-    if labels is not None:
-        _region_names(ax, xs, ys, labels,
-                      {k: name(v) for k, v in _region_means(labels, values).items()})
+def _truth_modulus_kpa(truth_hardness: NDArray) -> NDArray[np.float64]:
+    """Young's modulus [kPa] of each cell's ground-truth hardness; ``inf`` (rigid) and ``nan``
+    (bare table) kept."""
+    hardness = np.asarray(truth_hardness, dtype=float)
+    out = hardness.copy()
+    foam = np.isfinite(hardness) & (hardness > 0)
+    out[foam] = [hardness_to_youngs_modulus(float(h)) / 1e3 for h in hardness[foam]]
+    return out
+
+
+def _modulus_image(fig: Figure, ax: Axes, ext: Extent, kpa: NDArray, norm: LogNorm,
+                   label: str) -> None:
+    """E in kPa on the shared log scale, its colour bar's ticks as plain numbers (the 2s and 5s
+    between the powers of ten labelled too when the scale spans under two decades)."""
+    im = ax.imshow(np.where(np.isfinite(kpa), kpa, np.nan), origin="lower", extent=ext,
+                   cmap=STIFFNESS_CMAP, norm=norm)  # fmt: skip
+    bar = fig.colorbar(im, ax=ax, label=label)
+    decades = float(np.log10(float(norm.vmax or 10.0) / float(norm.vmin or 1.0)))
+
+    def minor(value: float, _: object) -> str:
+        lead = round(value / 10 ** np.floor(np.log10(value)))
+        return f"{value:g}" if decades < 2.0 and lead in (2, 5) else ""
+
+    bar.ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+    bar.ax.yaxis.set_minor_formatter(FuncFormatter(minor))
 
 
 def _truth_panel(fig: Figure, ax: Axes, xs: NDArray, ys: NDArray, ext: Extent,
-                 truth_hardness: NDArray) -> None:
-    shown = np.where(np.isinf(truth_hardness), np.nan, truth_hardness)
-    im = ax.imshow(shown, origin="lower", extent=ext, cmap="viridis_r")
-    rigid = np.isinf(truth_hardness)
+                 truth_kpa: NDArray, norm: LogNorm) -> None:
+    """The ground truth as E on the map's scale; rigid cells grey and named."""
+    _modulus_image(fig, ax, ext, truth_kpa, norm,
+                   "true E [kPa] (log scale; grey: rigid)")  # fmt: skip
+    rigid = np.isinf(truth_kpa)
     if rigid.any():
-        ax.contourf(xs, ys, rigid.astype(float), levels=[0.5, 1.5], colors="0.3")
-    fig.colorbar(im, ax=ax, label="hardness H [N] (grey: rigid)")
+        ax.contourf(xs, ys, rigid.astype(float), levels=[0.5, 1.5],
+                    cmap=ListedColormap([RIGID_COLOUR]))  # fmt: skip
+        depth = distance_transform_edt(np.pad(rigid, 1))[1:-1, 1:-1]
+        iy, ix = np.unravel_index(int(np.argmax(depth)), depth.shape)
+        ax.text(xs[ix], ys[iy], "rigid", ha="center", va="center", fontsize=9, color="w")
     ax.set_title("ground truth")
 
 
 def _variance_panel(fig: Figure, ax: Axes, xs: NDArray, ys: NDArray, ext: Extent,
                     variance: NDArray, threshold: float | None, variance_max: float | None, *,
-                    modulus: bool) -> bool:
+                    modulus: bool) -> str | None:
     """The variance from 0 to ``variance_max`` (or its own maximum), the T_h contour labelled;
-    whether that contour was drawn."""
+    without a contour, the note that says why (``None`` when drawn or without T_h)."""
     top = float(np.nanmax(variance)) if variance_max is None else variance_max
     im = ax.imshow(variance, origin="lower", extent=ext, cmap="Blues", vmin=0.0,
                    vmax=top if top > 0 else 1.0)  # fmt: skip
-    drawn = threshold is not None and float(variance.max()) > threshold > float(variance.min())
-    if drawn:
-        lines = ax.contour(xs, ys, variance, levels=[threshold], colors=_THRESHOLD_COLOUR,
-                           linewidths=1)  # fmt: skip
-        ax.clabel(lines, fmt=lambda _: "T_h", fontsize=8, inline=True)
+    note = None
+    if threshold is not None:
+        high, low = float(np.nanmax(variance)), float(np.nanmin(variance))
+        if high > threshold > low:
+            lines = ax.contour(xs, ys, variance, levels=[threshold], colors=_THRESHOLD_COLOUR,
+                               linewidths=1.5)  # fmt: skip
+            ax.clabel(lines, fmt=lambda _: "T_h", fontsize=8, inline=True)
+        else:
+            side = "below" if high <= threshold else "above"
+            note = f"variance {side} T_h ({threshold:.4g}) everywhere: no T_h contour"
     name = "ln E" if modulus else "β"
     over = variance_max is not None and float(np.nanmax(variance)) > variance_max
     fig.colorbar(im, ax=ax, extend="max" if over else "neither",
                  label=f"var({name})" + (" (fixed scale)" if variance_max is not None else ""))
     ax.set_title(f"{'modulus' if modulus else 'β'}-field variance and contacts")
-    return drawn
+    return note
 
 
-def _region_means(labels: NDArray, values: NDArray) -> dict[int, float]:
-    """The mean of ``values`` over each region's cells (finite values only)."""
-    out = {}
-    for k in np.unique(labels):
-        cells = values[(labels == k) & np.isfinite(values)]
-        if k >= 0 and cells.size:
-            out[int(k)] = float(cells.mean())
-    return out
+class _Overlay:
+    """What every field panel draws over its image: the regions, the pokes and the regions'
+    names with their values."""
+
+    def __init__(self, xs: NDArray, ys: NDArray, labels: NDArray | None, levels: NDArray | None,
+                 contacts: NDArray, kinds: list[str], rigid: set[int]) -> None:
+        self.xs, self.ys, self.labels, self.levels = xs, ys, labels, levels
+        self.contacts, self.kinds, self.rigid = contacts, kinds, rigid
+
+    def draw(self, ax: Axes, values: NDArray, given: Sequence[float | None] | None, *,
+             main: bool, name: Callable[[float], str]) -> None:
+        """The regions (the isopleths of ``values`` when cut from this field, ``main``), the
+        pokes, and each region's name with ``given[k]`` (else the median of ``values`` over its
+        cells) or "rigid"."""
+        _regions(ax, self.xs, self.ys, values, self.labels, self.levels if main else None,
+                 main=main)  # fmt: skip
+        _contacts(ax, self.contacts, self.kinds)
+        if self.labels is None:
+            return
+        texts = {}
+        for k in (int(k) for k in np.unique(self.labels) if k >= 0):
+            value = given[k] if given is not None and k < len(given) else None
+            if value is None:
+                cells = values[(self.labels == k) & np.isfinite(values)]
+                value = float(np.median(cells)) if cells.size else None
+            if k in self.rigid:
+                texts[k] = f"R{k + 1}: rigid"
+            elif value is not None:
+                texts[k] = f"R{k + 1}: {name(value)}"
+        for k, text in texts.items():
+            x, y = _label_place(self.xs, self.ys, self.labels == k, self.contacts, len(text))
+            ax.text(x, y, text, ha="center", va="center", fontsize=8,
+                    bbox={"boxstyle": "round,pad=0.2", "fc": "w", "ec": "0.5", "alpha": 0.85})
 
 
-def _region_names(ax: Axes, xs: NDArray, ys: NDArray, labels: NDArray,
-                  texts: dict[int, str]) -> None:
-    """``R<k+1>`` and its text at each region's inmost cell (the cell farthest from the region's
-    edge: inside the region however it is shaped, where a centroid may fall outside)."""
-    for k, text in texts.items():
-        inside = np.pad(labels == k, 1)  # the map's border counts as an edge
-        depth = distance_transform_edt(inside)[1:-1, 1:-1]
-        iy, ix = np.unravel_index(int(np.argmax(depth)), depth.shape)
-        ax.text(xs[ix], ys[iy], f"R{k + 1}: {text}", ha="center", va="center", fontsize=8,
-                bbox={"boxstyle": "round,pad=0.2", "fc": "w", "ec": "0.5", "alpha": 0.8})
+def _label_place(xs: NDArray, ys: NDArray, region: NDArray, contacts: NDArray,
+                 n_chars: int) -> tuple[float, float]:
+    """Where a region's label of ``n_chars`` characters goes: the cell deepest inside the region
+    (farthest from its edge, the map's border counting as one: inside however the region is
+    shaped, where a centroid may fall outside) among those where the label's box clears every
+    poke's mark and number; the deepest cell when none does."""
+    depth = distance_transform_edt(np.pad(region, 1))[1:-1, 1:-1]
+    px = (xs[-1] - xs[0]) / _PANEL_PX if xs.size > 1 else 1e-3  # metres per pixel
+    # at 110 dpi a poke takes its mark (10 px about it) and its number (up to 20 px right of it
+    # and 23 px above); the label's box is 8-point characters about 6.5 px wide, 20 px high;
+    # 4 px apart
+    half_w, half_h = n_chars * 3.25 + 4.0 + 4.0, 10.0 + 4.0
+    gx, gy = np.meshgrid(xs, ys)
+    clear = region.copy()
+    for cx, cy in contacts:
+        dx, dy = (gx - cx) / px, (gy - cy) / px
+        clear &= ~((dx > -10.0 - half_w) & (dx < 20.0 + half_w)
+                   & (dy > -10.0 - half_h) & (dy < 23.0 + half_h))
+    score = np.where(clear, depth, -1.0) if clear.any() else depth
+    iy, ix = np.unravel_index(int(np.argmax(score)), score.shape)
+    return float(xs[ix]), float(ys[iy])
 
 
 def _regions(ax: Axes, xs: NDArray, ys: NDArray, values: NDArray, labels: NDArray | None,
@@ -269,25 +358,3 @@ def _regions(ax: Axes, xs: NDArray, ys: NDArray, values: NDArray, labels: NDArra
             ax.contour(xs, ys, (labels == label).astype(float), levels=[0.5],
                        colors=_REGION_COLOUR, linewidths=2 if main else 1,
                        linestyles="solid" if main else "dashed")  # fmt: skip
-
-
-def _modulus_panel(fig: Figure, ax: Axes, ext: Extent, modulus_pa: NDArray) -> None:
-    """E in kPa on a log colour scale spanning at least a factor of ten."""
-    kpa = np.asarray(modulus_pa, dtype=float) / 1e3
-    finite = kpa[np.isfinite(kpa) & (kpa > 0)]
-    low, high = (float(finite.min()), float(finite.max())) if finite.size else (1.0, 10.0)
-    mid = np.sqrt(low * high)
-    if high / low < 10.0:
-        low, high = mid / np.sqrt(10.0), mid * np.sqrt(10.0)
-    im = ax.imshow(kpa, origin="lower", extent=ext, cmap="viridis",
-                   norm=LogNorm(vmin=low, vmax=high))  # fmt: skip
-    bar = fig.colorbar(im, ax=ax, label="Young's modulus E [kPa] (log scale)")
-    decades = float(np.log10(high / low))
-
-    def minor(value: float, _: object) -> str:
-        # over less than two decades, label the 2s and 5s between the powers of ten
-        lead = round(value / 10 ** np.floor(np.log10(value)))
-        return f"{value:g}" if decades < 2.0 and lead in (2, 5) else ""
-
-    bar.ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
-    bar.ax.yaxis.set_minor_formatter(FuncFormatter(minor))

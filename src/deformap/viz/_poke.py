@@ -1,10 +1,12 @@
-"""The figures of one poke: ``poke-NN.png`` (the paper's Fig. 4) and the error curve E(β).
+"""The figures of one poke: ``poke-NN.png`` (the paper's Fig. 4) and the error curve ε(β).
 
-``poke-NN.png`` has two rows. Above: the ROI before the poke (the surface GP) on a colour scale of
-its own, so that its relief shows; the cloud while pressing with the tactile points; E(β) with β̂.
-Below, on one colour scale: the observed dent (the touch GP), the shape-matching surface at β̂
-beside it, and a section through the contact with both. Every panel names its axes and units;
-legends sit outside the axes, where they cover no data.
+``poke-NN.png`` has two rows. Above, the maps: the ROI before the poke (the surface GP) on a colour
+scale of its own, so that its relief shows; then, on one colour scale, the cloud while pressing
+with the tactile points, the observed dent (the touch GP) and the shape-matching surface at β̂.
+Below, the curves: a section through the contact with all three; the shape-matching error ε(β)
+with β̂ (ε, not E: E is Young's modulus); the press's force against the tip's travel with the
+contact model fitted to it and the modulus it gives. Every length is in millimetres; every panel
+names its axes and units; legends sit outside the axes, where they cover no data.
 
 Built on :class:`matplotlib.figure.Figure` without ``pyplot``; written atomically when given a path.
 """
@@ -41,13 +43,14 @@ _BELOW: dict[str, Any] = {"loc": "upper center", "bbox_to_anchor": (0.5, -0.2), 
 
 
 def plot_beta_curve(ax: Axes, betas: NDArray, errors: NDArray, beta_hat: float, std: float) -> None:
-    """Draw E(β) with the estimate and its uncertainty band on ``ax``."""
+    """Draw the shape-matching error ε(β) [mm] with the estimate and its uncertainty band on
+    ``ax``."""
     order = np.argsort(betas)
     ax.plot(np.asarray(betas)[order], np.asarray(errors)[order] * 1e3, "-", color="k")
     ax.axvline(beta_hat, color="r", label=f"β̂ = {beta_hat:.3f} ± {std:.3f}")
     ax.axvspan(max(0.0, beta_hat - std), min(1.0, beta_hat + std), color="r", alpha=0.15)
     ax.set_xlabel("β [–]")
-    ax.set_ylabel("E(β) [mm]")
+    ax.set_ylabel("shape-matching error ε(β) [mm]")
     ax.legend(fontsize=8)
 
 
@@ -57,15 +60,16 @@ def plot_error_curve(
     beta: float,
     beta_std: float,
     *,
-    title: str = "shape-matching error E(β)",
+    title: str = "shape-matching error ε(β)",
     path: str | Path | None = None,
 ) -> Figure:
-    """A figure of its own holding :func:`plot_beta_curve`: E(β), β̂ and its uncertainty band.
+    """A figure of its own holding :func:`plot_beta_curve`: ε(β), β̂ and its uncertainty band.
 
     Parameters
     ----------
     betas, errors : (m,) float
-        The βs tried and their error E(β) in metres (drawn in millimetres), in any order.
+        The βs tried and their shape-matching error ε(β) in metres (drawn in millimetres), in any
+        order.
     beta, beta_std : float
         The estimate β̂ and its standard deviation.
     title : str
@@ -114,9 +118,12 @@ def plot_poke(
     simulated_z: NDArray[np.float64] | None = None,
     title: str = "",
     path: str | Path | None = None,
+    force_travel: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None,
+    force_fit: NDArray[np.float64] | None = None,
+    reading: str = "",
 ) -> Figure:
-    """One poke's figure: the ROI before, the cloud while pressing, E(β); the observed dent, the
-    simulated one at β̂ and a section through both.
+    """One poke's figure: the ROI before, the cloud while pressing, the observed dent and the
+    simulated one at β̂; a section through them, ε(β), and force against travel.
 
     Parameters
     ----------
@@ -129,7 +136,7 @@ def plot_poke(
     tactile : (t, 3) float, metres
         The tactile points added on the probe's tip.
     betas, errors : (m,) float
-        The βs tried and their error E(β) in metres.
+        The βs tried and their shape-matching error ε(β) in metres.
     beta, beta_std : float
         The estimate β̂ and its standard deviation.
     simulated_z : (ny, nx) float, metres, optional
@@ -139,44 +146,56 @@ def plot_poke(
         The figure's title.
     path : str or Path, optional
         Where to write the figure (100 dpi, format from the suffix); nothing is written without it.
+    force_travel : ((n,), (n,)) float, metres and newtons, optional
+        The press's record: the tip's travel since first contact and the force; the panel says
+        "no force–travel record" without it.
+    force_fit : (2, m) float, metres and newtons, optional
+        The contact model fitted to the record, travel and force, drawn over it.
+    reading : str
+        What the record read ("E = 9.7 ± 0.7 kPa", "rigid", or why none), in the panel's legend.
     """
-    fig = Figure(figsize=(15, 8.6), layout="constrained")
-    (before, cloud, curve), (observed, simulated, section) = fig.subplots(2, 3)
-    ext = _extent(roi_xs, roi_ys)
+    fig = Figure(figsize=(17, 8.8), layout="constrained")
+    top, bottom = fig.subfigures(2, 1, height_ratios=(1.0, 0.95))  # type: ignore[misc]
+    before, cloud, observed, simulated = top.subplots(1, 4)
+    section, curve, press = bottom.subplots(1, 3)
+    mm = 1e3
+    ext = tuple(v * mm for v in _extent(roi_xs, roi_ys))
     low, high = _span(rest_z, MIN_COLOUR_SPAN_M)
-    im = before.imshow(rest_z * 1e3, origin="lower", extent=ext, vmin=low * 1e3, vmax=high * 1e3,
+    im = before.imshow(rest_z * mm, origin="lower", extent=ext, vmin=low * mm, vmax=high * mm,
                        cmap="viridis")  # fmt: skip
-    fig.colorbar(im, ax=before, label="z [mm] (own scale)")
+    top.colorbar(im, ax=before, label="z [mm] (own scale)")
     before.set_title("ROI before (surface GP)")
     # one scale for the dent's three views, from the deepest surface to the rest surface's top
     dents = [deformed_z] + ([] if simulated_z is None else [simulated_z])
     low = min(float(np.nanmin(d)) for d in dents)
     high = max(float(np.nanmax(rest_z)), low + MIN_COLOUR_SPAN_M)
-    scale = {"vmin": low * 1e3, "vmax": high * 1e3, "cmap": "viridis"}
-    sc = cloud.scatter(roi_points[:, 0], roi_points[:, 1], c=roi_points[:, 2] * 1e3, s=4, **scale)
-    cloud.plot(tactile[:, 0], tactile[:, 1], "r.", ms=6, label="tactile points")
+    scale = {"vmin": low * mm, "vmax": high * mm, "cmap": "viridis"}
+    sc = cloud.scatter(roi_points[:, 0] * mm, roi_points[:, 1] * mm, c=roi_points[:, 2] * mm,
+                       s=4, **scale)  # fmt: skip
+    cloud.plot(tactile[:, 0] * mm, tactile[:, 1] * mm, "r.", ms=6, label="tactile points")
     cloud.set(xlim=ext[:2], ylim=ext[2:], aspect="equal")
     cloud.legend(**_BELOW)
-    cloud.set_title("cloud while pressing (robot removed)")
-    fig.colorbar(sc, ax=cloud, label="z [mm]", extend="both")
-    im = observed.imshow(deformed_z * 1e3, origin="lower", extent=ext, **scale)
+    cloud.set_title("cloud pressed, robot removed")
+    top.colorbar(sc, ax=cloud, label="z [mm]", extend="both")
+    im = observed.imshow(deformed_z * mm, origin="lower", extent=ext, **scale)
     observed.set_title("observed dent (touch GP)")
-    fig.colorbar(im, ax=observed, label="z [mm]")
+    top.colorbar(im, ax=observed, label="z [mm]")
     if simulated_z is None:
         simulated.text(0.5, 0.5, "not simulated", ha="center", va="center",
                        transform=simulated.transAxes)  # fmt: skip
         simulated.set(xlim=ext[:2], ylim=ext[2:])
     else:
-        im = simulated.imshow(simulated_z * 1e3, origin="lower", extent=ext, **scale)
-        fig.colorbar(im, ax=simulated, label="z [mm]")
+        im = simulated.imshow(simulated_z * mm, origin="lower", extent=ext, **scale)
+        top.colorbar(im, ax=simulated, label="z [mm]")
     simulated.set_title(f"shape matching at β̂ = {beta:.3f}")
     for ax in (before, cloud, observed, simulated):
-        ax.set(xlabel="x [m]", ylabel="y [m]")
+        ax.set(xlabel="x [mm]", ylabel="y [mm]")
     _section(section, roi_xs, roi_ys, rest_z, deformed_z, simulated_z, roi_points)
     plot_beta_curve(curve, betas, errors, beta, beta_std)
-    curve.set_title("shape-matching error E(β)")
-    if title:
-        fig.suptitle(title)
+    curve.set_title("shape-matching error ε(β)")
+    _force_travel(press, force_travel, force_fit, reading)
+    if title:  # on the upper subfigure, whose layout keeps it clear of the panels' titles
+        top.suptitle(title, fontsize=13)
     if path is not None:
         save_figure(fig, path, dpi=100)
     return fig
@@ -185,18 +204,41 @@ def plot_poke(
 def _section(ax: Axes, xs: NDArray, ys: NDArray, rest_z: NDArray, deformed_z: NDArray,
              simulated_z: NDArray | None, points: NDArray) -> None:
     """The row of the ROI through its middle (the contact): before, observed, simulated, and the
-    cloud's points within one cell of it."""
+    cloud's points within one cell of it; millimetres on both axes."""
     mid = rest_z.shape[0] // 2
-    ax.plot(xs, rest_z[mid] * 1e3, "k--", label="before (surface GP)")
-    ax.plot(xs, deformed_z[mid] * 1e3, "b-", lw=2, label="observed dent (touch GP)")
+    mm = 1e3
+    ax.plot(xs * mm, rest_z[mid] * mm, "k--", label="before (surface GP)")
+    ax.plot(xs * mm, deformed_z[mid] * mm, "b-", lw=2, label="observed dent (touch GP)")
     if simulated_z is not None:
-        ax.plot(xs, simulated_z[mid] * 1e3, "r-", label="shape matching at β̂")
+        ax.plot(xs * mm, simulated_z[mid] * mm, "r-", label="shape matching at β̂")
     cell = (ys[1] - ys[0]) if ys.size > 1 else np.inf
     near = np.abs(points[:, 1] - ys[mid]) < cell
-    ax.plot(points[near, 0], points[near, 2] * 1e3, ".", color="0.6", ms=3,
+    ax.plot(points[near, 0] * mm, points[near, 2] * mm, ".", color="0.6", ms=3,
             label="cloud points on the section")
-    ax.set_xlabel("x [m]")
+    ax.set_xlabel("x [mm]")
     ax.set_ylabel("z [mm]")
-    ax.set_title(f"section through the contact (y = {ys[mid]:.3f} m)")
+    ax.set_title(f"section through the contact (y = {ys[mid] * mm:.0f} mm)")
     # below the axes: inside, it would cover the dent, which is at the section's middle
     ax.legend(ncols=2, **_BELOW)
+
+
+def _force_travel(ax: Axes, record: tuple[NDArray, NDArray] | None, fit: NDArray | None,
+                  reading: str) -> None:
+    """The press's force against the tip's travel, the fitted contact model over it, and what
+    it read in the legend."""
+    ax.set_title("force–travel record")
+    ax.set_xlabel("travel since first contact [mm]")
+    ax.set_ylabel("force [N]")
+    if record is None:
+        ax.text(0.5, 0.5, "no force–travel record" + (f"\n{reading}" if reading else ""),
+                ha="center", va="center", transform=ax.transAxes)  # fmt: skip
+        return
+    travel, force = (np.asarray(v, dtype=float) for v in record)
+    ax.plot(travel * 1e3, force, "o", ms=4, mfc="none", color="k", label="record")
+    if fit is not None:
+        ax.plot(np.asarray(fit[0]) * 1e3, fit[1], "r-", lw=1.5,
+                label="contact model fitted" + (f": {reading}" if reading else ""))
+    elif reading:
+        ax.plot([], [], ls="none", label=reading)
+    ax.grid(alpha=0.3)
+    ax.legend(**_BELOW)

@@ -12,6 +12,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 from matplotlib.ticker import FixedLocator, FuncFormatter, MaxNLocator, NullLocator, ScalarFormatter
 
@@ -33,17 +34,27 @@ def _hardness_axis(rows: list[dict[str, Any]]) -> tuple[list[float], float]:
 
 
 def plot_hardness_study(study: dict[str, Any], *, path: str | Path | None = None) -> Figure:
-    """β per foam and protocol, hardness decreasing to the right as in the paper; rigid at left.
+    """β and Young's modulus per foam, hardness decreasing to the right as in the paper; rigid at
+    left; the study's conditions (force, thickness, camera, physics) in the title.
 
     Parameters
     ----------
     study : dict
-        ``{"rows": [{"protocol", "hardness_n" (None: rigid), "beta", "beta_std"}, ...]}`` and
-        optionally ``"monotone": {protocol: bool}``, marked in the legend. Rows with
+        ``{"rows": [{"protocol", "hardness_n" (None: rigid), "beta", "beta_std"}, ...]}``, each
+        row optionally with ``modulus_pa``, ``modulus_std_pa``, ``true_modulus_pa`` and
+        ``rigid``; optionally ``"monotone": {protocol: bool}``, marked in the legend, and the
+        conditions ``force_n``, ``thickness_m``, ``camera`` and ``physics``. Rows with
         ``refused`` are not drawn. A study with a ``matrix`` (``deformap study hardness --full``)
         is drawn by :func:`_plot_hardness_matrix` instead.
     path : str or Path, optional
         Where to write the figure; nothing is written without it.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        β against hardness (one line per protocol) beside E against hardness (the force–travel
+        record's E, which no protocol changes, and the true E), or β alone when no row has a
+        modulus.
     """
     if "matrix" in study:
         fig = _plot_hardness_matrix(study)
@@ -52,8 +63,56 @@ def plot_hardness_study(study: dict[str, Any], *, path: str | Path | None = None
         return fig
     rows = [r for r in study["rows"] if not r.get("refused")]
     finite, rigid_x = _hardness_axis(rows)
-    fig = Figure(figsize=(7.5, 4.8), layout="constrained")
-    ax = fig.subplots()
+    with_modulus = any(r.get("modulus_pa") is not None or r.get("rigid") for r in rows)
+    fig = Figure(figsize=(13.0 if with_modulus else 7.5, 4.8), layout="constrained")
+    axes = fig.subplots(1, 2 if with_modulus else 1, squeeze=False)[0]
+    _beta_panel(axes[0], study, rows, rigid_x)
+    if with_modulus:
+        _modulus_panel(axes[1], [r for r in rows if r["protocol"] == _first_protocol(rows)],
+                       rigid_x)  # fmt: skip
+    for ax in axes:
+        _hardness_ticks(ax, rows, finite, rigid_x)
+    axes[-1].set_xlim(axes[0].get_xlim())  # one hardness axis: rigid's tick on both panels
+    conditions = _conditions(study)
+    name = "β and E against hardness" if with_modulus else "β against hardness"
+    fig.suptitle(name + (f" ({conditions})" if conditions else ""), fontsize=11)
+    if path is not None:
+        save_figure(fig, path, dpi=110)
+    return fig
+
+
+def _conditions(study: dict[str, Any]) -> str:
+    """The press force, foam thickness, camera and world physics the study ran under."""
+    parts = []
+    if study.get("force_n") is not None:
+        parts.append(f"force {study['force_n']:g} N")
+    if study.get("thickness_m") is not None:
+        parts.append(f"foam {study['thickness_m'] * 100:g} cm thick")
+    if study.get("camera"):
+        parts.append(f"camera {study['camera']}")
+    if study.get("physics"):
+        parts.append(f"physics {study['physics']}")
+    return ", ".join(parts)
+
+
+def _hardness_ticks(ax: Axes, rows: list[dict[str, Any]], finite: list[float],
+                    rigid_x: float) -> None:
+    """The log hardness axis, softer to the right, a tick per tested foam and one for rigid
+    beyond a dotted line."""
+    ax.set_xscale("log")
+    ax.invert_xaxis()
+    ax.axvline(np.sqrt(rigid_x * max(finite, default=rigid_x / 1.6)), color="0.7", ls=":")
+    ticks = [*finite, rigid_x] if any(r["hardness_n"] is None for r in rows) else finite
+    ax.xaxis.set_major_locator(FixedLocator(ticks))
+    ax.xaxis.set_major_formatter(FuncFormatter(
+        lambda v, _: "rigid" if np.isclose(v, rigid_x) else f"{v:g}"))  # fmt: skip
+    ax.xaxis.set_minor_locator(NullLocator())
+    ax.set_xlabel("hardness H [N] (ISO 2439, log scale; softer →)")
+
+
+def _beta_panel(ax: Axes, study: dict[str, Any], rows: list[dict[str, Any]],
+                rigid_x: float) -> None:
+    """β per foam and protocol, each protocol a little apart in x and with its own marker."""
     protocols = list(dict.fromkeys(r["protocol"] for r in rows))
     for i, protocol in enumerate(protocols):
         sub = [r for r in rows if r["protocol"] == protocol]
@@ -75,26 +134,40 @@ def plot_hardness_study(study: dict[str, Any], *, path: str | Path | None = None
             ax.errorbar([rigid_x * dodge], [r["beta"]], yerr=np.nan_to_num([r["beta_std"]]),
                         **{**style, "ls": "none", "marker": "D", "mfc": style["color"]},
                         label=None if foams else label)  # fmt: skip
-    ax.set_xscale("log")
-    ax.invert_xaxis()
-    ax.axvline(np.sqrt(rigid_x * max(finite, default=rigid_x / 1.6)), color="0.7", ls=":")
-    ticks = [*finite, rigid_x] if any(r["hardness_n"] is None for r in rows) else finite
-    ax.xaxis.set_major_locator(FixedLocator(ticks))
-    ax.xaxis.set_major_formatter(FuncFormatter(
-        lambda v, _: "rigid" if np.isclose(v, rigid_x) else f"{v:g}"))  # fmt: skip
-    ax.xaxis.set_minor_locator(NullLocator())
     if any(r["hardness_n"] is None for r in rows):
         ax.plot([], [], "D", color="0.3", label="rigid board (filled ◆, its own tick)")
-    ax.set_xlabel("hardness H [N] (ISO 2439, log scale; softer →)")
     ax.set_ylabel("estimated β [–]")
     ax.set_ylim(-0.05, 1.05)
-    ax.set_title("β against hardness (same force, same places)")
+    ax.set_title("β from shape matching, per contact protocol", fontsize=10)
     # β rises to the right (softer) and protocols that cannot tell foams apart lie along β = 0,
     # so the upper left (high β on stiff foams) is the corner no curve reaches
     ax.legend(fontsize=8, loc="upper left")
-    if path is not None:
-        save_figure(fig, path, dpi=110)
-    return fig
+
+
+def _modulus_panel(ax: Axes, rows: list[dict[str, Any]], rigid_x: float) -> None:
+    """E read from the force–travel record per foam (± its claimed σ) beside the true E; the
+    rigid board at its tick, marked when read rigid."""
+    foams = sorted((r for r in rows if r["hardness_n"] is not None and r.get("modulus_pa")),
+                   key=lambda r: -r["hardness_n"])  # fmt: skip
+    if foams:
+        ax.errorbar([r["hardness_n"] for r in foams], [r["modulus_pa"] / 1e3 for r in foams],
+                    yerr=[(r.get("modulus_std_pa") or 0.0) / 1e3 for r in foams], color="C0",
+                    marker="o", mfc="none", mew=1.5, capsize=3,
+                    label="E read from the force–travel record (± claimed σ)")  # fmt: skip
+    truth = [r for r in foams if r.get("true_modulus_pa")]
+    if truth:
+        ax.plot([r["hardness_n"] for r in truth], [r["true_modulus_pa"] / 1e3 for r in truth],
+                color="0.4", ls="--", marker="x", label="true E (from H, ISO 2439)")  # fmt: skip
+    ax.set_yscale("log")
+    ax.yaxis.set_major_formatter(ScalarFormatter())
+    ax.yaxis.set_minor_formatter(FuncFormatter(_minor_label))
+    for r in (r for r in rows if r["hardness_n"] is None):
+        read = "read rigid" if r.get("rigid") else "not read rigid"
+        ax.annotate(read, (rigid_x, 0.5), xycoords=("data", "axes fraction"), ha="center",
+                    rotation=90, fontsize=9, color="C0" if r.get("rigid") else "C3")  # fmt: skip
+    ax.set_ylabel("Young's modulus E [kPa] (log scale)")
+    ax.set_title("E from the force–travel record", fontsize=10)
+    ax.legend(fontsize=8, loc="upper right")
 
 
 def _plot_hardness_matrix(study: dict[str, Any]) -> Figure:
@@ -170,7 +243,7 @@ def _first_protocol(rows: list[dict[str, Any]]) -> str | None:
 
 
 def plot_cluster_size_study(study: dict[str, Any], *, path: str | Path | None = None) -> Figure:
-    """Fit error min E(β) against cluster size, one line per foam.
+    """Shape-matching fit error min ε(β) against cluster size, one line per foam.
 
     Parameters
     ----------
@@ -195,7 +268,7 @@ def plot_cluster_size_study(study: dict[str, Any], *, path: str | Path | None = 
         )
     ax.xaxis.set_major_locator(MaxNLocator(integer=True))
     ax.set_xlabel("cluster size k (k×k particles)")
-    ax.set_ylabel("fit error min E(β) [mm]")
+    ax.set_ylabel("fit error min ε(β) [mm]")
     ax.set_title("shape-matching fit error against cluster size")
     ax.legend(fontsize=8)
     if path is not None:

@@ -1,8 +1,11 @@
 """The many-worlds benchmark's figure: region accuracy against pokes, one panel per layout family.
 
-Each combination (strategy/field/cut) is a line, the mean accuracy over the family's worlds after
-each poke, with a band of its 95 % confidence interval (mean ± 1.96 standard errors, a normal
-approximation: the worlds are independent draws) and the good-map level as a dashed line.
+Each panel draws the few combinations (strategy/field/cut) with the highest mean accuracy over all
+worlds and pokes, and the paper's combination beside them, as the mean accuracy over the family's
+worlds after each poke; the same combinations in every panel, in one legend. A band of the mean's
+95 % confidence interval (mean ± 1.96 standard errors, a normal approximation: the worlds are
+independent draws) is drawn only over enough worlds for that approximation to mean something
+(``min_band_worlds``). The good-map level is a dashed line.
 """
 
 from __future__ import annotations
@@ -11,6 +14,7 @@ import math
 from pathlib import Path
 
 import numpy as np
+from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 from matplotlib.ticker import MaxNLocator
 from numpy.typing import NDArray
@@ -20,32 +24,33 @@ from deformap.viz._save import save_figure
 __all__ = ["plot_world_curves"]
 
 _Z95 = 1.959964  # two-sided 95 % quantile of the standard normal
+PAPER_COMBINATION = "paper/beta/isopleth"
+"""The paper's way: its variance-led poke choice, the β-field, regions cut at isopleths."""
+
+Curves = dict[str, dict[str, NDArray[np.float64]]]
 
 
-#: Line styles of the fields and cuts, in the order first met (solid, dashed, dotted, ...).
-_STYLES: tuple[str | tuple[int, tuple[int, ...]], ...] = (
-    "-", "--", ":", "-.", (0, (5, 1)), (0, (3, 1, 1, 1, 1, 1)), (0, (1, 3)), (0, (8, 3, 2, 3)))
+def _chosen(curves: Curves, best: int, paper: str) -> tuple[list[str], str | None]:
+    """The ``best`` combinations by mean accuracy over every world and poke (of ``"all"`` when
+    present, else of every family), and the paper's: ``paper`` when run, else the best of its
+    strategy's combinations, ``None`` when none ran."""
+    pooled = curves.get("all") or {
+        name: np.concatenate([f[name] for f in curves.values() if name in f])
+        for name in {n for f in curves.values() for n in f}}  # fmt: skip
+    scores = {name: float(np.nanmean(acc)) if np.isfinite(acc).any() else -np.inf
+              for name, acc in pooled.items() if acc.size}  # fmt: skip
+    ranked = sorted(scores, key=lambda n: (-scores[n], n))
+    strategy = paper.partition("/")[0]
+    theirs = paper if paper in scores else next(
+        (n for n in ranked if n.partition("/")[0] == strategy), None)  # fmt: skip
+    return ranked[:best], theirs
 
 
-def _line_styles(names: list[str]) -> tuple[dict[str, str], dict[str, object]]:
-    """A colour per strategy and a line style per field and cut of each ``strategy/field/cut``
-    name (a name of another shape is a strategy of its own), so that a reader finds a strategy by
-    its colour and a cut by its line whatever the number of combinations; past ten strategies
-    or eight field/cut pairs the colours or styles repeat."""
-    strategies: dict[str, int] = {}
-    ways: dict[str, int] = {}
-    colours: dict[str, str] = {}
-    styles: dict[str, object] = {}
-    for name in names:
-        strategy, _, way = name.partition("/")
-        colours[name] = f"C{strategies.setdefault(strategy, len(strategies)) % 10}"
-        styles[name] = _STYLES[ways.setdefault(way, len(ways)) % len(_STYLES)]
-    return colours, styles
-
-
-def plot_world_curves(curves: dict[str, dict[str, NDArray[np.float64]]], *,
-                      good_accuracy: float = 0.9, path: str | Path | None = None) -> Figure:
-    """Accuracy against pokes with confidence bands, one panel per family (``"all"`` first).
+def plot_world_curves(curves: Curves, *, good_accuracy: float = 0.9,
+                      path: str | Path | None = None, best: int = 3, min_band_worlds: int = 10,
+                      paper: str = PAPER_COMBINATION) -> Figure:
+    """Accuracy against pokes of the best few combinations and the paper's, one panel per family
+    (``"all"`` first).
 
     Parameters
     ----------
@@ -56,51 +61,71 @@ def plot_world_curves(curves: dict[str, dict[str, NDArray[np.float64]]], *,
         Drawn as a dashed line.
     path : str or Path, optional
         Where to write the figure (110 dpi); nothing is written without it.
+    best : int
+        How many combinations to draw besides the paper's: a handful keeps the lines apart.
+    min_band_worlds : int
+        The fewest worlds behind a mean for its 95 % band to be drawn: over fewer, the normal
+        approximation of the mean's spread is too rough to draw.
+    paper : str
+        The paper's combination, drawn black; without it in ``curves``, the best of its
+        strategy's combinations.
     """
     families = sorted(curves, key=lambda f: (f != "all", f))
-    cols = min(3, max(1, len(families)))
-    rows = math.ceil(len(families) / cols)
-    fig = Figure(figsize=(4.6 * cols, 3.4 * rows), layout="constrained")
-    axes = fig.subplots(rows, cols, squeeze=False, sharex=True, sharey=True)
-    names = sorted({name for family in curves.values() for name in family})
-    colours, styles = _line_styles(names)
-    band_alpha = 0.15 if len(names) <= 6 else 0.06  # many bands over each other read as one
-    for ax, family in zip(axes.ravel(), families, strict=False):
-        n_worlds = 0
-        for name in names:
+    top, theirs = _chosen(curves, best, paper)
+    shown = top + ([theirs] if theirs is not None and theirs not in top else [])
+    n = max(1, len(families))
+    cols = 2 if n == 4 else min(3, n)
+    rows = math.ceil(n / cols)
+    fig = Figure(figsize=(4.6 * cols, 3.4 * rows + 0.6), layout="constrained")
+    axes = fig.subplots(rows, cols, squeeze=False, sharey=True).ravel()
+    for ax, family in zip(axes, families, strict=False):
+        worlds = 0
+        for i, name in enumerate(shown):
             acc = curves[family].get(name)
-            if acc is None or not acc.size:
-                continue
-            n_worlds = max(n_worlds, len(acc))
-            pokes = np.arange(1, acc.shape[1] + 1)
-            mean = np.nanmean(acc, axis=0)
-            counts = np.sum(np.isfinite(acc), axis=0)
-            se = np.nanstd(acc, axis=0, ddof=1) / np.sqrt(counts) if len(acc) > 1 else 0 * mean
-            ax.plot(pokes, mean, color=colours[name], ls=styles[name], lw=1.4, label=name)
-            ax.fill_between(pokes, mean - _Z95 * se, np.minimum(1.0, mean + _Z95 * se),
-                            color=colours[name], alpha=band_alpha, lw=0)
-        ax.axhline(good_accuracy, color="k", ls="--", lw=0.8,
-                   label=f"accuracy {good_accuracy:g} (a good map)")
-        ax.set_title(f"{family} ({n_worlds} world{'s' if n_worlds != 1 else ''})", fontsize=10)
-        ax.set_ylim(0.0, 1.02)
+            if acc is not None and acc.size:
+                worlds = max(worlds, len(acc))
+                _curve(ax, acc, name, i, paper=None if name != theirs else name == paper,
+                       band=min_band_worlds)  # fmt: skip
+        ax.axhline(good_accuracy, color="0.3", ls="--", lw=0.8,
+                   label=f"accuracy {good_accuracy:g} (a good map)")  # fmt: skip
+        note = "" if worlds >= min_band_worlds else ", too few for a band"
+        ax.set_title(f"{family} ({worlds} world{'s' if worlds != 1 else ''}{note})", fontsize=10)
+        ax.set(ylim=(0.0, 1.02), xlabel="pokes")
         ax.xaxis.set_major_locator(MaxNLocator(integer=True))
         ax.grid(alpha=0.3)
-    for ax in axes.ravel()[len(families):]:
-        ax.set_visible(False)
-    # the lowest panel drawn in each column carries the poke axis (shared x hides the others')
-    for col in range(cols):
-        shown = [r for r in range(rows) if r * cols + col < len(families)]
-        if shown:
-            ax = axes[shown[-1], col]
-            ax.xaxis.set_tick_params(labelbottom=True)
-            ax.set_xlabel("pokes")
-    for ax in axes[:, 0]:
+    for ax in axes[0::cols]:
         ax.set_ylabel("region accuracy")
-    handles, labels = axes[0, 0].get_legend_handles_labels()
-    if handles:
-        fig.legend(handles, labels, loc="outside lower center", ncols=min(5, len(labels)),
+    handles, labels = axes[0].get_legend_handles_labels()
+    spare = axes[len(families):]
+    for ax in spare:  # a slot the families leave: the legend goes there, not below
+        ax.set_axis_off()
+    if handles and len(spare):
+        spare[0].legend(handles, labels, loc="center", fontsize=8, frameon=False)
+    elif handles:
+        fig.legend(handles, labels, loc="outside lower center", ncols=min(3, len(labels)),
                    fontsize=8, frameon=False)
-    fig.suptitle("region accuracy against pokes: mean and 95 % band over worlds", fontsize=11)
+    n_all = len({name for family in curves.values() for name in family})
+    fig.suptitle(f"region accuracy against pokes, mean over worlds: the best {len(top)} of "
+                 f"{n_all} combinations by mean accuracy, and the paper's\n(95 % band where "
+                 f"{min_band_worlds} worlds or more)", fontsize=10)  # fmt: skip
     if path is not None:
         save_figure(fig, path, dpi=110)
     return fig
+
+
+def _curve(ax: Axes, acc: NDArray[np.float64], name: str, rank: int, *, paper: bool | None,
+           band: int) -> None:
+    """One combination's mean accuracy after each poke, its 95 % band where at least ``band``
+    worlds count; the paper's (``paper`` True: its combination, False: its strategy's best)
+    black and dash-dotted, the others in the colour of their rank."""
+    pokes = np.arange(1, acc.shape[1] + 1)
+    mean = np.nanmean(acc, axis=0)
+    colour, style = ("k", "-.") if paper is not None else (f"C{rank % 10}", "-")
+    label = {None: f"{rank + 1}. {name}", True: f"{name} (the paper's)",
+             False: f"{name} (the paper's strategy)"}[paper]  # fmt: skip
+    ax.plot(pokes, mean, color=colour, ls=style, lw=1.6, label=label)
+    counts = np.sum(np.isfinite(acc), axis=0)
+    if counts.min() >= max(band, 2):
+        se = np.nanstd(acc, axis=0, ddof=1) / np.sqrt(counts)
+        ax.fill_between(pokes, mean - _Z95 * se, np.minimum(1.0, mean + _Z95 * se),
+                        color=colour, alpha=0.15, lw=0)  # fmt: skip
