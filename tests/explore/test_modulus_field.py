@@ -201,22 +201,8 @@ def test_a_first_poke_without_modulus_does_not_decide_the_run() -> None:
     assert len(mapper.field.pokes) == 2 and mapper.field is not on_beta  # fitted again, lazily
 
 
-def test_under_unread_place_beta_a_place_read_twice_in_vain_gives_the_run_to_beta() -> None:
-    mapper = Mapper(Workspace(), ExplorationConfig(field="modulus", unread_place="beta",
-                                                   max_pokes=6))
-    mapper.add(_poke((0.1, 0.1), _soft(5e3), 0))
-    mapper.add(_poke((0.4, 0.2), None, 1, error="too deep"))
-    assert mapper.config.field == "modulus"  # once: left out, the run goes on on the modulus
-    mapper.add(_poke((0.405, 0.2), None, 2, error="too deep"))  # the same place again
-    assert mapper.config.field == "beta"
-    assert mapper.field_fallback is not None
-    assert "could not be read twice at one place (" in mapper.field_fallback
-    mapper.add(_poke((0.5, 0.3), _soft(6e3), 3))  # for good: the β-field maps the rest
-    assert mapper.config.field == "beta" and mapper.map_field is mapper.field
-
-
-def test_under_unread_place_avoid_the_place_leaves_the_targets_and_the_stopping_rule() -> None:
-    config = ExplorationConfig(field="modulus", unread_place="avoid", max_pokes=12)
+def test_a_place_read_twice_in_vain_leaves_the_targets_and_the_stopping_rule() -> None:
+    config = ExplorationConfig(field="modulus", max_pokes=12)
     mapper = Mapper(Workspace(), config)
     mapper.add(_poke((0.1, 0.1), _soft(5e3), 0))
     n = 1
@@ -249,20 +235,11 @@ def test_under_unread_place_avoid_the_place_leaves_the_targets_and_the_stopping_
     assert result.unread_places == ((0.4, 0.2), (0.42, 0.2)) and result.field_fallback is None
     assert (result.stop_cells == choice.stop_mask).all()
     assert result.max_variance == mapper.modulus_field.max_variance(choice.stop_mask)
-    # the former rule, `beta`, gives the same presses' run to β for good, on the whole grid
-    assert _mapper("modulus").config.unread_place == "avoid"  # the default
-    default = Mapper(Workspace(), ExplorationConfig(field="modulus", unread_place="beta"))
-    for poke in (_poke((0.1, 0.1), _soft(5e3), 0), _poke((0.4, 0.2), None, 1, error="too deep"),
-                 _poke((0.42, 0.2), None, 2, error="too deep")):
-        default.add(poke)
-    assert default.config.field == "beta" and default.unread_places == []
-    assert default.result("max_pokes", {}).stop_mask is not None
-    assert (default.result("max_pokes", {}).stop_cells == default.grid.stop_mask).all()
 
 
-def test_avoid_leaves_a_run_without_any_modulus_on_beta_with_every_place() -> None:
+def test_a_run_without_any_modulus_maps_on_beta_with_every_place() -> None:
     """A camera-only run maps on β, which reads the place: nothing is avoided."""
-    mapper = Mapper(Workspace(), ExplorationConfig(field="modulus", unread_place="avoid"))
+    mapper = Mapper(Workspace(), ExplorationConfig(field="modulus"))
     mapper.add(_poke((0.3, 0.2), None, 0, error="too deep"))
     mapper.add(_poke((0.305, 0.2), None, 1, error="too deep"))
     assert mapper.config.field == "beta" and mapper.unread_places == []
@@ -275,8 +252,7 @@ def test_avoid_leaves_a_run_without_any_modulus_on_beta_with_every_place() -> No
 
 def test_going_to_beta_after_avoided_places_gives_the_targets_back() -> None:
     small = Workspace(lower=(0.0, 0.0), upper=(0.12, 0.06))
-    mapper = Mapper(small, ExplorationConfig(field="modulus", unread_place="avoid",
-                                             max_pokes=8))
+    mapper = Mapper(small, ExplorationConfig(field="modulus", max_pokes=8))
     mapper.add(_poke((0.03, 0.03), _soft(5e3), 0))
     mapper.add(_poke((0.09, 0.03), None, 1, error="too deep"))
     mapper.add(_poke((0.09, 0.03), None, 2, error="too deep"))
@@ -305,8 +281,7 @@ def test_a_grid_without_every_target_is_none_and_the_run_goes_to_beta() -> None:
     assert (np.hypot(*(part.plan_candidates - (0.3, 0.2)).T) > 0.05).all()
     # a tiny workspace whose only place cannot be read: nothing left, so β for good
     small = Workspace(lower=(0.0, 0.0), upper=(0.06, 0.06))  # every target within the disc
-    mapper = Mapper(small, ExplorationConfig(field="modulus", unread_place="avoid",
-                                             max_pokes=4))
+    mapper = Mapper(small, ExplorationConfig(field="modulus", max_pokes=4))
     mapper.add(_poke((0.03, 0.03), _soft(5e3), 0))
     mapper.add(_poke((0.03, 0.03), None, 1, error="too deep"))
     mapper.add(_poke((0.031, 0.03), None, 2, error="too deep"))
@@ -363,7 +338,7 @@ def test_a_resumed_run_finds_the_same_unread_places_from_its_journalled_records(
 
     from deformap.explore import PokeRecord
 
-    config = ExplorationConfig(field="modulus", unread_place="avoid", max_pokes=12)
+    config = ExplorationConfig(field="modulus", max_pokes=12)
     first = Mapper(Workspace(), config)
     for poke in (_poke((0.1, 0.1), _soft(5e3), 0), _poke((0.4, 0.2), None, 1, error="too deep"),
                  _poke((0.42, 0.2), None, 2, error="too deep"), _poke((0.5, 0.3), _soft(6e3), 3)):

@@ -265,8 +265,6 @@ def _draw(task: dict[str, Any]) -> tuple[WorldDraw, ExplorationConfig]:
     explore = ExplorationConfig(max_pokes=k, boundary_pokes=k, force_n=draw.force_n)
     rules: dict[str, Any] = {r: bool(task[r]) for r in ("merge_seams", "split_by_place")
                              if r in task}  # the rules on the regions, when given
-    # where the pokes go after an unread place, and where a boundary poke goes, when given
-    rules.update({k: task[k] for k in ("unread_place", "boundary_score") if k in task})
     explore = replace(explore, **rules)
     return draw, explore
 

@@ -7,14 +7,12 @@ from __future__ import annotations
 from deformap.explore._acquisition import STRATEGIES, choose_target
 from deformap.explore._config import (
     BetaFieldConfig,
-    BoundaryScore,
     ExplorationConfig,
     FieldName,
     ModulusFieldConfig,
     RegionLabels,
     SurfaceGPConfig,
     TouchGPConfig,
-    UnreadPlace,
     check_exploration_budget,
 )
 from deformap.explore._dent import measure_press, roi_grid
@@ -76,7 +74,6 @@ __all__ = [
     "STRATEGIES",
     "BetaField",
     "BetaFieldConfig",
-    "BoundaryScore",
     "ContactRecord",
     "Dent",
     "ExplorationConfig",
@@ -105,7 +102,6 @@ __all__ = [
     "SurfaceModel",
     "Target",
     "TouchGPConfig",
-    "UnreadPlace",
     "beta_noise_floor",
     "beta_pokes",
     "check_exploration_budget",

@@ -55,11 +55,7 @@ Boundary pokes (``boundary_pokes`` > 0, after any strategy)
     ``h_l`` between the classes found so far (``σ(x)`` alone while one class is found: a region not
     yet met is looked for where the field is least known), among the reachable cells at least a
     quarter ROI (``_targets.BOUNDARY_SPACING_ROI``) from every poke, where a new dent would
-    overlap an old one. Under ``boundary_score: nearest-poke`` (and so for ``level-set`` too) the
-    score is the nearest-poke map's instead (:func:`deformap.explore._targets.
-    nearest_poke_boundary_score`): the boundaries that cut draws are the bisectors between pokes
-    of different classes, not the field's isopleths, so a cell scores by how far it is from any
-    poke less its distance to such a bisector (about ``(d₂ − d₁) / 2``).
+    overlap an old one.
 
 References
 ----------

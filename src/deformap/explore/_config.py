@@ -80,7 +80,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from dataclasses import field as _field
-from typing import Any, Literal
+from typing import Literal
 
 from deformap._validation import SettingError, check_settings, setting
 from deformap.environment import Workspace
@@ -95,7 +95,6 @@ __all__ = [
     "PLANNER_STRATEGIES",
     "BetaFieldConfig",
     "BetaUncertainty",
-    "BoundaryScore",
     "DepthAnchor",
     "ExplorationConfig",
     "FieldName",
@@ -107,7 +106,6 @@ __all__ = [
     "TactileCap",
     "TouchGPConfig",
     "TouchModel",
-    "UnreadPlace",
     "check_exploration_budget",
 ]
 
@@ -127,11 +125,6 @@ FieldName = Literal["beta", "modulus"]
 NuggetEstimate = Literal["within-class", "off"]
 #: Where a poke's β uncertainty comes from (``ExplorationConfig.beta_uncertainty``).
 BetaUncertainty = Literal["camera-noise", "shape-matching"]
-#: How a boundary poke (and ``level-set``) scores a cell (``ExplorationConfig.boundary_score``).
-BoundaryScore = Literal["straddle", "nearest-poke"]
-#: What the modulus field does with a place whose modulus could not be read twice
-#: (``ExplorationConfig.unread_place``).
-UnreadPlace = Literal["beta", "avoid"]
 
 #: Most bytes of one band of the ROI's shape-matching system (:mod:`deformap.msm._linsys`): the
 #: β sweep holds its two assembled bands and a few factorisations of that size at once, so 512 MiB
@@ -352,14 +345,6 @@ class ExplorationConfig:
         Pokes made after the variance has fallen below ``T_h``, each where a region boundary is
         least certain (:mod:`deformap.explore._acquisition`, "boundary pokes"); 0, the paper's
         rule, stops there.
-    boundary_score : {"straddle", "nearest-poke"}
-        How a boundary poke, and every poke of ``level-set``, scores the reachable cells:
-        ``straddle``, the field's (Bryan et al. 2005: ``1.96 σ − min |μ − h|`` against the
-        isopleths between the classes); ``nearest-poke``, the nearest-poke map's
-        (:func:`deformap.explore._targets.nearest_poke_boundary_score`: how far a cell is from
-        any poke, less its distance to where the nearest-poke map's boundary passes, about
-        ``(d₂ − d₁) / 2``), the boundaries the default cut draws. Either reads the pokes'
-        classes before any cut, so where the pokes go does not depend on ``region_labels``.
     stiffness : StiffnessConfig
         Reading stiffness and Young's modulus from a press's force–travel record, when the
         environment gives one (:func:`deformap.explore.estimate_stiffness`).
@@ -372,19 +357,6 @@ class ExplorationConfig:
         the β-field or on the modulus field"), and it does not depend on the camera. When no poke
         of a run gives a usable record (a camera-only robot or session) the run falls back to
         ``beta`` at its first poke, and its result says so (``field_fallback``).
-    unread_place : {"beta", "avoid"}
-        Under ``field: modulus``, what a place whose modulus could not be read twice does (two
-        presses within ``BOUNDARY_SPACING_ROI`` ROIs of each other whose records were not read:
-        a further press there would read nothing again, so the modulus field's variance there
-        would never fall): ``beta``, the run maps on the β-field from then on, for good;
-        ``avoid``, the run keeps the modulus field and takes that disc out of the targets and of
-        the cells whose variance must fall below ``T_h`` (the map still covers it, from the
-        pokes around it; ``ExplorationResult.unread_places`` lists them), and falls back to β
-        only when no target would be left. ``avoid`` is the default: over the 100 default worlds
-        of ``deformap bench worlds --seed 0`` (README, "Many worlds") it changed the 23 of 600
-        runs that had gone to β, every strategy's median pokes to accuracy 0.9 over the worlds
-        as it was (those 23 runs' own: 17 → 19), 17 of the 23 ended more accurate and 6 less
-        (mean final accuracy 0.845 → 0.872), and it keeps the map in physical units.
     modulus_field : ModulusFieldConfig
         Prior of the modulus field; it is computed whenever a poke has a modulus, whichever
         ``field`` is chosen.
@@ -410,26 +382,14 @@ class ExplorationConfig:
     merge_seams: bool = True
     split_by_place: bool = True
     boundary_pokes: int = setting(0, ge=0, le=1000)  # as for max_pokes
-    boundary_score: BoundaryScore = "straddle"
     beta_uncertainty: BetaUncertainty = "camera-noise"
     field: FieldName = "modulus"
-    unread_place: UnreadPlace = "avoid"
     surface: SurfaceGPConfig = _field(default_factory=SurfaceGPConfig)
     touch: TouchGPConfig = _field(default_factory=TouchGPConfig)
     beta_field: BetaFieldConfig = _field(default_factory=BetaFieldConfig)
     modulus_field: ModulusFieldConfig = _field(default_factory=ModulusFieldConfig)
     shape_matching: ShapeMatchingConfig = _field(default_factory=ShapeMatchingConfig)
     stiffness: StiffnessConfig = _field(default_factory=StiffnessConfig)
-
-    @staticmethod
-    def upgrade_settings(data: dict[str, Any]) -> dict[str, Any]:
-        """Files written before ``beta_uncertainty`` existed chose β's uncertainty with
-        ``touch.noise_samples`` alone (0: the shape matcher's own): read them as they meant."""
-        touch = data.get("touch")
-        if ("beta_uncertainty" not in data and isinstance(touch, dict)
-                and touch.get("noise_samples") == 0):
-            return {**data, "beta_uncertainty": "shape-matching"}
-        return data
 
     def __post_init__(self) -> None:
         check_settings(self)

@@ -6,7 +6,7 @@ over its edge, where shape matching would have to explain a cliff). The planner 
 the variance must fall (``plan_domain``) and the cells a poke may be planned on
 (``plan_candidates``), every 2 cm with the edges included; a plan short by the difference between
 the lattice and the full grid is planned again after the next poke. A grid without the places a
-run could not read (:meth:`MapGrid.without`, ``exploration.unread_place: avoid``) keeps the
+run could not read (:meth:`MapGrid.without`) keeps the
 lattices' points outside those discs.
 """
 

@@ -41,8 +41,8 @@ logger = logging.getLogger(__name__)
 
 def unread_radius_m(config: ExplorationConfig) -> float:
     """Radius [m] of one place: two presses this close are at one place, and an unread place's
-    disc of it leaves the targets and the stopping rule under ``unread_place: avoid``
-    (``BOUNDARY_SPACING_ROI`` ROIs: a dent spreads a few centimetres)."""
+    disc of it leaves the targets and the stopping rule (``BOUNDARY_SPACING_ROI`` ROIs: a dent
+    spreads a few centimetres)."""
     return float(BOUNDARY_SPACING_ROI * config.touch.roi_size_m)
 
 
@@ -71,7 +71,7 @@ class Mapper:
         self.field_fallback: str | None = None
         self._requested_field = config.field
         self._given_up: str | None = None
-        #: places the modulus could not be read twice at (``unread_place: avoid``), and the grid
+        #: places the modulus could not be read twice at, and the grid
         #: the targets and the stopping rule use: ``grid`` without them
         self.unread_places: list[tuple[float, float]] = []
         self._choice_grid = self.grid
@@ -156,10 +156,9 @@ class Mapper:
         """Under ``field: modulus``, the field to map on after ``poke``: the modulus field once a
         poke has a modulus; the β-field while none has (a camera-only robot or session). Once the
         modulus could not be read twice at one place (a further press there would read nothing
-        again, and the modulus field's variance there would never fall): under ``unread_place:
-        beta`` the β-field for good; under ``avoid`` the modulus field still, with that place
-        taken out of the targets and the stopping rule (the β-field for good only when nothing
-        would be left)."""
+        again, and the modulus field's variance there would never fall): the modulus field still,
+        with that place taken out of the targets and the stopping rule (the β-field for good only
+        when nothing would be left)."""
         reading = modulus.readings[-1]
         if self._given_up is None and reading.excluded is not None and self._pokes:
             here = np.asarray(poke.record.contact_xy, dtype=float)
@@ -170,12 +169,11 @@ class Mapper:
                       and np.hypot(*(np.asarray(p.record.contact_xy) - here)) <= radius]
             # while no poke has a modulus the run maps on β, which reads the place: nothing to
             # avoid yet (a later unread press there, once a modulus is read, is caught again)
-            avoid = self.config.unread_place == "avoid"
-            if before and not (avoid and not len(modulus.pokes)):
+            if before and len(modulus.pokes):
                 # the disc about every unread press of the place, not only the last
                 places = [*self.unread_places,
                           *((float(x), float(y)) for x, y in (*before, here))]
-                left = self.grid.without(np.array(places), radius) if avoid else None
+                left = self.grid.without(np.array(places), radius)
                 if left is not None:
                     self.unread_places, self._choice_grid = places, left
                     logger.warning("poke %d: the modulus could not be read twice at (%.3f, %.3f) "
@@ -185,9 +183,8 @@ class Mapper:
                 else:  # β reads every place: its targets and stopping rule are the whole grid's
                     self._choice_grid = self.grid
                     self._given_up = (f"poke {poke.record.index + 1}: the modulus could not be "
-                                      f"read twice at one place ({reading.excluded})"
-                                      + ("; no target would be left without it" if avoid
-                                         else ""))
+                                      f"read twice at one place ({reading.excluded}); no target "
+                                      "would be left without it")
         if self._given_up is not None:
             why = self._given_up
         elif not len(modulus.pokes):

@@ -58,8 +58,7 @@ class ExplorationResult:
         a modulus); ``config.field`` is then ``"beta"``.
     unread_places : tuple of (x, y)
         The presses whose modulus could not be read at a place read twice in vain, whose discs
-        were taken out of the targets and the stopping rule (``exploration.unread_place:
-        avoid``), in the order found [m].
+        were taken out of the targets and the stopping rule, in the order found [m].
     stop_mask : (ny * nx,) bool or None
         The cells whose variance the stopping rule read: ``grid.stop_mask`` without those discs
         (``None``: ``grid.stop_mask``).

@@ -25,8 +25,7 @@ from deformap.explore._planning import PokePlan, VarianceDesign, plan_pokes
 from deformap.explore._records import Target
 from deformap.explore._regions import poke_classes
 
-__all__ = ["BOUNDARY_SPACING_ROI", "choose_next", "expected_noise",
-           "nearest_poke_boundary_score"]
+__all__ = ["BOUNDARY_SPACING_ROI", "choose_next", "expected_noise"]
 
 logger = logging.getLogger(__name__)
 
@@ -70,9 +69,8 @@ def _plan(grid: MapGrid, pokes: PokeSet, config: ExplorationConfig, n_made: int)
 def _straddle(grid: MapGrid, field: BetaField, pokes: PokeSet, config: ExplorationConfig
               ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:  # fmt: skip
     """The reachable cells at least ``BOUNDARY_SPACING_ROI`` ROIs from every poke and their
-    boundary scores: straddle (:func:`boundary_score` against the isopleths of the pokes'
-    classes), or under ``boundary_score: nearest-poke`` :func:`nearest_poke_boundary_score`
-    against the pokes' classes; ``σ`` alone before any poke; both empty when no cell is left."""
+    straddle scores (:func:`boundary_score` against the isopleths of the pokes' classes); ``σ``
+    alone before any poke; both empty when no cell is left."""
     allowed = grid.target_mask.copy()
     var = field.variance.ravel()
     if len(pokes) == 0:
@@ -83,38 +81,8 @@ def _straddle(grid: MapGrid, field: BetaField, pokes: PokeSet, config: Explorati
         return np.empty((0, 2)), np.empty(0)
     mean = field.mean
     classes = poke_classes(mean, pokes, config)
-    if config.boundary_score == "nearest-poke":
-        score = nearest_poke_boundary_score(grid.cells_xy[allowed], pokes.xy,
-                                            classes.poke_labels)
-    else:
-        score = boundary_score(mean.ravel()[allowed], np.sqrt(var[allowed]), classes.levels)
+    score = boundary_score(mean.ravel()[allowed], np.sqrt(var[allowed]), classes.levels)
     return grid.cells_xy[allowed], score
-
-
-def nearest_poke_boundary_score(cells: NDArray[np.float64], xy: NDArray[np.float64],
-                                labels: NDArray[np.integer]) -> NDArray[np.float64]:
-    """How uncertain the nearest-poke map's label of each of ``cells (n, 2)`` is, from the pokes
-    at ``xy (m, 2)`` of classes ``labels (m,)``: ``d₁ − (d₂ − d₁) / 2`` [m], ``d₁`` the distance
-    to the nearest poke and ``d₂`` to the nearest poke of another class than that one's. The
-    map's boundary is where ``d₂ = d₁`` (half of ``d₂ − d₁`` is about a cell's distance to it),
-    and where it truly lies is known only to within the distance to the pokes that place it; so a
-    cell scores high where the boundary may pass through it, and highest where that is farthest
-    from any poke. The straddle score's counterpart (:func:`boundary_score`: ``1.96 σ − |μ −
-    h|``) for the nearest-poke cut, whose boundaries are the pokes' and not the field's
-    isopleths. With one class, ``d₁`` alone (the least-known place, where a region not yet met
-    is most likely)."""
-    tree = cKDTree(xy)
-    d1, nearest = tree.query(cells, k=1)
-    labels = np.asarray(labels)
-    if np.unique(labels).size < 2:
-        return np.asarray(d1, dtype=float)
-    d2 = np.full(len(cells), np.inf)
-    for k in np.unique(labels):
-        others = xy[labels != k]
-        mine = labels[nearest] == k
-        if mine.any():
-            d2[mine] = cKDTree(others).query(cells[mine], k=1)[0]
-    return np.asarray(d1 - 0.5 * (d2 - d1), dtype=float)
 
 
 def _boundary(grid: MapGrid, field: BetaField, pokes: PokeSet,

@@ -31,7 +31,7 @@ from collections.abc import Iterator, Sequence
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 from deformap import __version__
 from deformap._validation import SettingError, check_settings, setting
@@ -47,7 +47,7 @@ from deformap.eval import (
     runs_csv,
     summarise_worlds,
 )
-from deformap.explore import BoundaryScore, ExplorationConfig, UnreadPlace
+from deformap.explore import ExplorationConfig
 from deformap.run._folder import create_run_folder, default_run_folder, to_json, write_text
 from deformap.run._hooks import NO_HOOKS, RunHooks, RunStart
 from deformap.viz import plot_world_curves
@@ -63,6 +63,9 @@ logger = logging.getLogger(__name__)
 BLAS_THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS",
                          "BLIS_NUM_THREADS", "VECLIB_MAXIMUM_THREADS", "NUMEXPR_NUM_THREADS")
 SETTINGS_NAME = "bench.json"
+# removed from ExplorationConfig (wt-explore); the bench's own options go with SETTINGS_BEFORE
+UnreadPlace = Literal["beta", "avoid"]
+BoundaryScore = Literal["straddle", "nearest-poke"]
 #: What a run did before each of these settings was in ``bench.json``: scored without the split by
 #: place, gave a run to β at an unread place, scored boundary pokes by straddle.
 SETTINGS_BEFORE: dict[str, Any] = {"split_by_place": False, "unread_place": "beta",
@@ -123,8 +126,8 @@ class WorldsBenchConfig:
     max_pokes: int = setting(12, ge=1, le=1000)
     merge_seams: bool = ExplorationConfig().merge_seams
     split_by_place: bool = ExplorationConfig().split_by_place
-    unread_place: UnreadPlace = ExplorationConfig().unread_place
-    boundary_score: BoundaryScore = ExplorationConfig().boundary_score
+    unread_place: UnreadPlace = "avoid"
+    boundary_score: BoundaryScore = "straddle"
     coarse: bool = False
     workers: int = setting(1, ge=1, le=1024)
     scheduler: str | None = None
