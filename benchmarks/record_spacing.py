@@ -8,7 +8,7 @@ read: evenly in force (``WorldConfig.force_travel_spacing = "force"``) against e
 Each world is ``deformap.eval.draw_world(seed, i)`` (its layout, camera, thickness and force, the
 default mesh; its own noise seed, not the benchmark's), built once; ``--presses`` places drawn
 uniformly over its foam blocks are pressed with the world's force, and each press's record, solved
-once per spacing (the same noise stream), is read by ``deformap.explore.estimate_stiffness`` with
+once per spacing (the same noise stream), is read by ``deformap.stiffness.estimate_stiffness`` with
 the block's true thickness (the record alone: the surface model's thickness error is left out).
 A row per spacing: records read, refused (by reason), the median relative error of E against the
 block's modulus and the share within its claimed 2σ, over the records it read and over the
@@ -29,7 +29,7 @@ import numpy as np
 
 from deformap.errors import DeformapError
 from deformap.eval import draw_world
-from deformap.explore import estimate_stiffness
+from deformap.stiffness import estimate_stiffness
 from deformap.world import SimulatedWorld, WorldConfig, camera_preset
 
 SPACINGS = ("force", "travel")

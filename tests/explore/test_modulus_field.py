@@ -19,13 +19,13 @@ from deformap.explore import (
     ModulusField,
     ModulusFieldConfig,
     PokeResult,
-    StiffnessEstimate,
     field_settings,
     modulus_reading,
     rigid_modulus_bound,
 )
 from deformap.explore._mapper import unread_radius_m
 from deformap.explore._targets import BOUNDARY_SPACING_ROI
+from deformap.stiffness import StiffnessEstimate
 from deformap.testing import synthetic_poke
 
 CONFIG = ModulusFieldConfig()

@@ -1,5 +1,5 @@
 """Active exploration: the mapper and its concepts (surface model, dent and β, β-field, target
-choice, regions, stiffness and modulus from a force–travel record, the modulus field), the loop
+choice, regions, the modulus field over the stiffness a force–travel record gives), the loop
 that drives an ``Environment`` with it, the typed poke records and the session journal."""
 
 from __future__ import annotations
@@ -59,17 +59,10 @@ from deformap.explore._regions import (
     with_nugget,
 )
 from deformap.explore._result import ExplorationResult, StopReason
-from deformap.explore._stiffness import (
-    LAYER_MODEL,
-    StiffnessConfig,
-    StiffnessEstimate,
-    estimate_stiffness,
-)
 from deformap.explore._surface import SurfaceModel, fit_surface
 
 __all__ = [
     "JOURNAL_NAME",
-    "LAYER_MODEL",
     "PURPOSES",
     "STRATEGIES",
     "BetaField",
@@ -95,8 +88,6 @@ __all__ = [
     "Purpose",
     "RegionLabels",
     "RegionMap",
-    "StiffnessConfig",
-    "StiffnessEstimate",
     "StopReason",
     "SurfaceGPConfig",
     "SurfaceModel",
@@ -107,7 +98,6 @@ __all__ = [
     "check_exploration_budget",
     "choose_target",
     "estimate_nugget",
-    "estimate_stiffness",
     "explore",
     "field_settings",
     "fit_surface",

@@ -85,8 +85,8 @@ from typing import Literal
 from deformap._validation import SettingError, check_settings, setting
 from deformap.environment import Workspace
 from deformap.explore._acquisition import Strategy
-from deformap.explore._stiffness import StiffnessConfig
 from deformap.msm import ShapeMatchingConfig
+from deformap.stiffness import StiffnessConfig
 
 __all__ = [
     "MAX_MAP_CELLS",
@@ -347,7 +347,7 @@ class ExplorationConfig:
         rule, stops there.
     stiffness : StiffnessConfig
         Reading stiffness and Young's modulus from a press's force–travel record, when the
-        environment gives one (:func:`deformap.explore.estimate_stiffness`).
+        environment gives one (:func:`deformap.stiffness.estimate_stiffness`).
     field : {"beta", "modulus"}
         The field the regions, the next-poke choice and the stopping rule run on: ``beta``, the
         β-field (the paper's); ``modulus``, the modulus field over ln E from the force–travel

@@ -50,10 +50,10 @@ from deformap.errors import DeformapError
 from deformap.explore._config import ExplorationConfig
 from deformap.explore._dent_noise import dent_error_samples
 from deformap.explore._records import ContactRecord, Dent, PokeRecord, PokeResult, PokeTimings
-from deformap.explore._stiffness import StiffnessEstimate, estimate_stiffness
 from deformap.explore._surface import SurfaceModel, crop_to
 from deformap.gp import GaussianRandomField
 from deformap.msm import estimate_beta
+from deformap.stiffness import StiffnessEstimate, estimate_stiffness
 
 __all__ = ["dent_visible", "measure_press", "roi_grid"]
 

@@ -3,7 +3,7 @@ records, beside the β-field and built on the same class (:class:`deformap.explo
 
 Each poke's value and noise
 ---------------------------
-A poke whose record gave a modulus (:class:`deformap.explore.StiffnessEstimate`) enters as
+A poke whose record gave a modulus (:class:`deformap.stiffness.StiffnessEstimate`) enters as
 ``ln E`` with the standard deviation ``σ_E / E`` (the delta method's σ of ln E), raised to the
 field's noise floor. A *rigid* poke has no modulus: it enters at its detection bound, the
 smallest modulus whose press would have travelled as far as the record's travel bound
@@ -73,7 +73,7 @@ def rigid_modulus_bound(record: PokeRecord, poisson_ratio: float) -> float:
 
     The record's lower bound on the stiffness bounds the travel from zero force to the commanded
     force ``F`` from above, ``δ_b = F / k_lower`` (at least the rigid test's travel bound: the
-    travel span plus two of its standard deviations, :func:`deformap.explore.estimate_stiffness`);
+    travel span plus two of its standard deviations, :func:`deformap.stiffness.estimate_stiffness`);
     a surface of modulus ``E_b = F / g(δ_b)`` (``g`` the bonded-layer force at unit modulus on the
     poke's layer, Hertz's half-space force without a layer thickness) would have travelled that
     far. A stiffer one travels less and reads rigid too, so ``E_b`` is where the record's

@@ -34,7 +34,7 @@ Range of validity
   contact radii up to about the layer's thickness. Beyond it the
   polynomial is an extrapolation, and its negative χ⁴ term makes the force stop rising at
   :func:`layer_chi_limit` (``χ ≈ 2.2`` at ``ν = 0.33``, 1.7 at ``ν = 0``): past that it means
-  nothing. :func:`deformap.explore.estimate_stiffness` stays below it and reports the ``χ`` it
+  nothing. :func:`deformap.stiffness.estimate_stiffness` stays below it and reports the ``χ`` it
   reached.
 - small strain: Hertz's paraboloidal sphere and linear elasticity need ``a ≪ R`` (``δ ≪ R``),
   ``δ ≪ h`` and strains in the material's linear range; a foam pressed to a sizeable fraction of

@@ -63,7 +63,7 @@ surface, strictly monotone, about linear in ``log E`` on the logit axis (``logit
 33 kPa)``); at 0.3 N 0.97 (1 kPa) … 0.02 / 0.01 (1 / 3 MPa), at 3 N 0.98 … 0.05 / 0.02, both
 monotone. The stiff end is compressed (a step of the β resolution, 0.01, is about a seventh of a
 decade of E near 1 MPa), not cut off. The force–travel record reads Young's modulus in physical
-units (:func:`deformap.explore.estimate_stiffness`); a press it reads rigid is given β = 0 (the
+units (:func:`deformap.stiffness.estimate_stiffness`); a press it reads rigid is given β = 0 (the
 rigid body, measured) by :func:`deformap.explore.measure_press`.
 
 References
