@@ -117,3 +117,12 @@ def test_imports_follow_the_table(path: Path) -> None:
         if any(n.startswith("_") and not n.endswith("__") for n in names):
             problems.append(f"{where}: private name of another package ({module}: {names})")
     assert not problems, "\n".join(problems)
+
+
+def test_fitting_the_field_does_not_go_through_the_region_labelling() -> None:
+    """The β-field's pokes (their nugget) need the region test's classes only: the field's modules
+    import neither the cell labelling nor the place and seam rules."""
+    explore = SRC / "explore"
+    for name in ("_field.py", "_nugget.py", "_modulus.py", "_classes.py"):
+        imported = {module for _, module, _ in _imports(explore / name)}
+        assert not imported & {"deformap.explore._labels", "deformap.explore._places"}, name

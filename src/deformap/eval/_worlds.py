@@ -17,7 +17,7 @@ combination the same model), poking to ``max_pokes``: once the map field's varia
 curves compare like with like; ``threshold`` in a row says whether the variance rule was met.
 Every cut (``region_labels``) asked for is scored on the same pokes: where the next poke goes
 does not depend on the cut (the targets read the classes of
-:func:`deformap.explore._regions.poke_classes`, before any cut), so mapping once per cut would
+:func:`deformap.explore._classes.poke_classes`, before any cut), so mapping once per cut would
 repeat the same pokes. After every poke it records (one row each per cut):
 
 - ``accuracy``, ``mean_iou``, ``found``, ``true``, ``kendall_tau``
@@ -172,7 +172,7 @@ def _material_truth(scenario: Scenario, xs: NDArray, ys: NDArray
 def _scores(mapper: Mapper, truth: tuple[NDArray, dict[int, float], NDArray],
             cuts: Sequence[str]) -> dict[str, dict[str, Any]]:
     """Each cut's scores of the mapper's current map (the pokes do not depend on the cut: the
-    targets read the cut-free classes of :func:`deformap.explore._regions.poke_classes`)."""
+    targets read the cut-free classes of :func:`deformap.explore._classes.poke_classes`)."""
     labels, hardness, modulus = truth
     field = mapper.map_field
     sign = -1.0 if field.name == "modulus" else 1.0  # the metrics order by softness

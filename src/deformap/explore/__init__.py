@@ -5,6 +5,7 @@ that drives an ``Environment`` with it, the typed poke records and the session j
 from __future__ import annotations
 
 from deformap.explore._acquisition import STRATEGIES, choose_target
+from deformap.explore._classes import RegionMap, segment_regions
 from deformap.explore._config import (
     BetaFieldConfig,
     ExplorationConfig,
@@ -30,6 +31,7 @@ from deformap.explore._journal import (
     JournalContents,
     read_journal,
 )
+from deformap.explore._labels import map_regions
 from deformap.explore._loop import MappingRun, explore, poke_step
 from deformap.explore._mapper import Mapper
 from deformap.explore._modulus import (
@@ -38,7 +40,8 @@ from deformap.explore._modulus import (
     modulus_reading,
     rigid_modulus_bound,
 )
-from deformap.explore._nugget import estimate_nugget
+from deformap.explore._nugget import beta_pokes, estimate_nugget, with_nugget
+from deformap.explore._places import merge_seam_classes, split_by_place
 from deformap.explore._records import (
     PURPOSES,
     ContactRecord,
@@ -48,15 +51,6 @@ from deformap.explore._records import (
     PokeTimings,
     Purpose,
     Target,
-)
-from deformap.explore._regions import (
-    RegionMap,
-    beta_pokes,
-    map_regions,
-    merge_seam_classes,
-    segment_regions,
-    split_by_place,
-    with_nugget,
 )
 from deformap.explore._result import ExplorationResult, StopReason
 from deformap.explore._surface import SurfaceModel, fit_surface

@@ -102,7 +102,7 @@ class PokeSet:
     noise), ``index (p,)`` the pokes' indices in their run (``PokeRecord.index``; default
     ``0 .. p-1``; a session's skipped poke and the modulus field's pokes without a modulus leave
     gaps), ``nugget`` the scatter between places of one material added to every poke's noise
-    (0: none; :func:`deformap.explore._regions.with_nugget`), ``thickness (p,)`` the layer's
+    (0: none; :func:`deformap.explore._nugget.with_nugget`), ``thickness (p,)`` the layer's
     thickness at each poke in metres (:func:`layer_thickness`; ``None`` when not every poke has
     one), which bounds how far a junction can reach a press
     (:func:`deformap.explore.merge_seam_classes`).
@@ -155,7 +155,7 @@ class BetaField:
     config : BetaFieldConfig
         Prior standard deviation σe and length scale σw (any object with ``signal_std`` and
         ``length_scale_m``: the modulus field passes its own). The pokes' noise is theirs, floor
-        and nugget included (the mapper's β-field: :func:`deformap.explore._regions.beta_pokes`).
+        and nugget included (the mapper's β-field: :func:`deformap.explore._nugget.beta_pokes`).
 
     Attributes
     ----------

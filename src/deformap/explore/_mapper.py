@@ -23,13 +23,15 @@ import numpy as np
 from deformap.cloud import PointCloud
 from deformap.environment import PressObservation, Workspace
 from deformap.errors import EnvironmentStateError
+from deformap.explore._classes import RegionMap
 from deformap.explore._config import ExplorationConfig, FieldName, check_exploration_budget
 from deformap.explore._dent import measure_press
 from deformap.explore._field import BetaField, field_settings
 from deformap.explore._grid import MapGrid
+from deformap.explore._labels import map_regions
 from deformap.explore._modulus import ModulusField
+from deformap.explore._nugget import beta_pokes
 from deformap.explore._records import PokeResult, Target
-from deformap.explore._regions import RegionMap, beta_pokes, map_regions
 from deformap.explore._result import ExplorationResult
 from deformap.explore._surface import SurfaceModel, fit_surface
 from deformap.explore._targets import BOUNDARY_SPACING_ROI, choose_next

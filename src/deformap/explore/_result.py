@@ -11,12 +11,13 @@ import numpy as np
 from numpy.typing import NDArray
 
 from deformap.environment import Workspace
+from deformap.explore._classes import RegionMap
 from deformap.explore._config import ExplorationConfig
 from deformap.explore._field import BetaField
 from deformap.explore._grid import MapGrid
 from deformap.explore._modulus import ModulusField
+from deformap.explore._nugget import beta_pokes
 from deformap.explore._records import PokeResult
-from deformap.explore._regions import RegionMap, beta_pokes
 from deformap.explore._surface import SurfaceModel
 
 __all__ = ["ExplorationResult", "StopReason"]

@@ -18,12 +18,12 @@ from numpy.typing import NDArray
 from scipy.spatial import cKDTree
 
 from deformap.explore._acquisition import boundary_score, choose_target
+from deformap.explore._classes import poke_classes
 from deformap.explore._config import ExplorationConfig
 from deformap.explore._field import BetaField, PokeSet, field_settings
 from deformap.explore._grid import MapGrid
 from deformap.explore._planning import PokePlan, VarianceDesign, plan_pokes
 from deformap.explore._records import Target
-from deformap.explore._regions import poke_classes
 
 __all__ = ["BOUNDARY_SPACING_ROI", "choose_next", "expected_noise"]
 
