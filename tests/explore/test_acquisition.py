@@ -116,7 +116,7 @@ def test_boundary_pokes_go_onto_the_isopleth_not_to_the_least_known_place() -> N
     config = ExplorationConfig(boundary_pokes=2, beta_field=BetaFieldConfig(noise_floor=0.015))
 
     def on_the_isopleth(mapper: Mapper, xy_t: np.ndarray) -> None:
-        mean, var = mapper.field.mean, mapper.field.variance
+        mean, var = mapper.beta_field.mean, mapper.beta_field.variance
         level = mapper.regions().levels
         assert level.size == 1
         at = int(np.argmin(np.sum((mapper.grid.cells_xy - xy_t) ** 2, axis=1)))

@@ -65,7 +65,7 @@ def test_the_field_is_over_ln_e_and_interpolates_the_pokes_within_their_noise() 
     places = [(0.1, 0.1), (0.3, 0.3), (0.5, 0.1)]
     pairs = enumerate(zip(places, moduli, strict=True))
     field = _field([_poke(xy, _soft(e), i) for i, (xy, e) in pairs])
-    assert np.allclose(field.pokes.beta, np.log(moduli))
+    assert np.allclose(field.pokes.values, np.log(moduli))
     for (x, y), e in zip(places, moduli, strict=True):
         col, row = int(np.argmin(abs(XS - x))), int(np.argmin(abs(YS - y)))
         # within two of the poke's noise on the ln E axis (its 3 % raised to the 10 % floor)
@@ -173,19 +173,19 @@ def test_the_map_runs_on_the_modulus_field_when_asked() -> None:
 def test_field_modulus_without_a_record_falls_back_to_beta_and_says_so() -> None:
     mapper = _mapper("modulus")
     mapper.add(_poke((0.3, 0.2), None))
-    assert mapper.config.field == "beta" and mapper.map_field is mapper.field
+    assert mapper.config.field == "beta" and mapper.map_field is mapper.beta_field
     assert mapper.field_fallback is not None
     assert re.match(r"`exploration.field` 'modulus' fell back to 'beta': poke 1 gave no modulus "
                     r"\(.*no force–travel record", mapper.field_fallback)
     assert mapper.threshold == field_settings(mapper.config).threshold == 0.06
     mapper.add(_poke((0.1, 0.1), None, 1))
-    assert len(mapper.field.pokes) == 2
+    assert len(mapper.beta_field.pokes) == 2
     # a first poke with a modulus keeps the modulus field, a later one without is left out of it
     kept = _mapper("modulus")
     kept.add(_poke((0.3, 0.2), _soft(10e3)))
     kept.add(_poke((0.1, 0.1), None, 1))
     assert kept.config.field == "modulus" and kept.field_fallback is None
-    assert len(kept.modulus_field.pokes) == 1 and len(kept.field.pokes) == 2
+    assert len(kept.modulus_field.pokes) == 1 and len(kept.beta_field.pokes) == 2
     assert len(_mapper("beta").add(_poke((0.3, 0.2), None)).record.contact_xy) == 2
 
 
@@ -193,12 +193,13 @@ def test_a_first_poke_without_modulus_does_not_decide_the_run() -> None:
     mapper = _mapper("modulus")
     mapper.add(_poke((0.3, 0.2), None, 0, error="the record was refused"))
     assert mapper.config.field == "beta" and mapper.field_fallback is not None
-    on_beta = mapper.field  # fitted at the poke, as the map field then
+    on_beta = mapper.beta_field  # fitted at the poke, as the map field then
     assert len(on_beta.pokes) == 1 and mapper.map_field is on_beta
     mapper.add(_poke((0.1, 0.1), _soft(5e3), 1))  # a modulus arrives: back on the modulus field
     assert mapper.config.field == "modulus" and mapper.field_fallback is None
     assert mapper.map_field is mapper.modulus_field
-    assert len(mapper.field.pokes) == 2 and mapper.field is not on_beta  # fitted again, lazily
+    # fitted again, lazily
+    assert len(mapper.beta_field.pokes) == 2 and mapper.beta_field is not on_beta
 
 
 def test_a_place_read_twice_in_vain_leaves_the_targets_and_the_stopping_rule() -> None:
@@ -319,16 +320,16 @@ def test_under_the_modulus_field_the_beta_field_is_fitted_on_first_use_and_is_th
     for i, xy in enumerate(xys):
         mapper.add(_poke(xy, _soft(5e3 * (1 + 2 * (xy[0] > 0.3))), i))
     assert fits == []  # five pokes on the modulus field, no β-field fitted
-    lazy = mapper.field
-    assert len(fits) == 1 and mapper.field is lazy  # fitted once, then kept
+    lazy = mapper.beta_field
+    assert len(fits) == 1 and mapper.beta_field is lazy  # fitted once, then kept
     on_beta = _mapper("beta")  # fitted eagerly at every poke, as the β map needs it
     for i, xy in enumerate(xys):
         on_beta.add(_poke(xy, _soft(5e3 * (1 + 2 * (xy[0] > 0.3))), i))
     assert len(fits) == 1 + len(xys)
-    np.testing.assert_array_equal(lazy.mean, on_beta.field.mean)
-    np.testing.assert_array_equal(lazy.pokes.noise, on_beta.field.pokes.noise)
+    np.testing.assert_array_equal(lazy.mean, on_beta.beta_field.mean)
+    np.testing.assert_array_equal(lazy.pokes.noise, on_beta.beta_field.pokes.noise)
     mapper.add(_poke((0.2, 0.25), _soft(5e3), 5))  # a new poke: the next use fits it again
-    assert len(mapper.field.pokes) == 6 and len(fits) == 2 + len(xys)
+    assert len(mapper.beta_field.pokes) == 6 and len(fits) == 2 + len(xys)
 
 
 def test_a_resumed_run_finds_the_same_unread_places_from_its_journalled_records() -> None:

@@ -37,7 +37,7 @@ def test_level_set_pokes_where_the_cut_is_least_certain() -> None:
     mapper = _mapper("level-set", TWO_SIDES)
     target = mapper.next_target(np.random.default_rng(0))
     assert target is not None and target.purpose == "variance"
-    field, cells = mapper.field, mapper.grid.cells_xy
+    field, cells = mapper.beta_field, mapper.grid.cells_xy
     mean, std = field.mean.ravel(), np.sqrt(field.variance.ravel())
     levels = mapper.regions().levels
     assert levels.size == 1  # two classes, one isopleth
@@ -62,7 +62,7 @@ def test_level_set_with_one_class_looks_where_the_field_is_least_known() -> None
     assert mapper.regions().n_regions == 1
     target = mapper.next_target(np.random.default_rng(0))
     assert target is not None
-    var = mapper.field.variance.ravel()
+    var = mapper.beta_field.variance.ravel()
     reachable = np.where(mapper.grid.target_mask, var, -1.0)
     assert var[_cell(mapper, target.xy)] == pytest.approx(reachable.max())
 
@@ -71,7 +71,7 @@ def _brute_force_reduction(mapper: Mapper) -> np.ndarray:
     """Variance summed over the planner's domain before less after a poke at each planner
     candidate, each posterior solved afresh with the candidate among the data (RW2006 Eq. 2.26)."""
     cfg = mapper.config.beta_field
-    pokes = mapper.field.pokes
+    pokes = mapper.beta_field.pokes
     cand, dom = mapper.grid.plan_candidates, mapper.grid.plan_domain
     noise_new = expected_noise(cand, pokes, mapper.config)
 

@@ -80,7 +80,7 @@ def test_the_maps_as_numbers(full_run) -> None:  # type: ignore[no-untyped-def]
         for name in ("beta_mean", "beta_std", "modulus_median_pa", "log_modulus_mean",
                      "log_modulus_std", "region_labels"):
             assert grids[name].shape == (ny, nx), name
-        np.testing.assert_array_equal(grids["beta_mean"], result.field.mean)
+        np.testing.assert_array_equal(grids["beta_mean"], result.beta_field.mean)
         np.testing.assert_array_equal(grids["region_labels"], result.regions.labels)
         assert np.all(np.isfinite(grids["modulus_median_pa"]))  # the world gives records
         np.testing.assert_allclose(grids["modulus_median_pa"],

@@ -55,6 +55,7 @@ from deformap.explore import (
     ExplorationConfig,
     MapGrid,
     Mapper,
+    ModulusField,
     PokeSet,
     RegionLabels,
     Target,
@@ -181,7 +182,7 @@ def _scores(mapper: Mapper, truth: tuple[NDArray, dict[int, float], NDArray],
     if len(mapper.modulus_field.pokes) and foam.any():
         rel = np.abs(mapper.modulus_field.median_pa[foam] / modulus[foam] - 1.0)
         modulus_error = float(np.median(rel))
-    beta = mapper.field.mean
+    beta = mapper.beta_field.mean
     spreads = [float(np.std(beta[(labels == k) & foam])) for k in np.unique(labels[foam])]
     shared = {"modulus_error": modulus_error,
               "beta_spread": float(np.mean(spreads)) if spreads else None}
@@ -251,7 +252,7 @@ def poke_data(pokes: PokeSet, thickness: Sequence[float | None]) -> dict[str, li
     [m], ``None`` where a poke had none: ``PokeRecord.layer_thickness_m``), in the field's order.
     Floats keep every bit through JSON (``repr``)."""
     return {"x": [float(v) for v in pokes.xy[:, 0]], "y": [float(v) for v in pokes.xy[:, 1]],
-            "value": [float(v) for v in pokes.beta], "noise": [float(v) for v in pokes.noise],
+            "value": [float(v) for v in pokes.values], "noise": [float(v) for v in pokes.noise],
             "index": [int(v) for v in np.asarray(pokes.index)],
             "thickness": [None if t is None else float(t) for t in thickness]}
 
@@ -427,7 +428,7 @@ def rescore_world(task: dict[str, Any], result: dict[str, Any], cuts: Sequence[s
         config = replace(explore, strategy=cast(Any, strategy),
                          field=cast(Any, mapped), **settings)
         if mapped == "modulus":
-            mean = BetaField(pokes, grid.xs, grid.ys, config.modulus_field).mean
+            mean = ModulusField(pokes, grid.xs, grid.ys, config.modulus_field).mean
         else:  # the map's nugget after k pokes, as the run's β-field had it
             pokes = with_nugget(pokes, config)
             mean = BetaField(pokes, grid.xs, grid.ys, config.beta_field).mean

@@ -20,6 +20,7 @@ from deformap.explore._dent import measure_press, roi_grid
 from deformap.explore._field import (
     BetaField,
     FieldSettings,
+    PokeField,
     PokeSet,
     beta_noise_floor,
     field_settings,
@@ -75,6 +76,7 @@ __all__ = [
     "ModulusField",
     "ModulusFieldConfig",
     "ModulusReading",
+    "PokeField",
     "PokeRecord",
     "PokeResult",
     "PokeSet",

@@ -291,6 +291,6 @@ def poke_classes(mean: NDArray[np.float64], pokes: PokeSet,
     ``region_prior_dof``) and the map field's noise floor and smallest step
     (:func:`deformap.explore.field_settings`: β, or ln E under ``field = "modulus"``)."""
     cfg = field_settings(config)
-    return segment_regions(mean, pokes.beta, pokes.noise, floor=cfg.noise_floor,
+    return segment_regions(mean, pokes.values, pokes.noise, floor=cfg.noise_floor,
                            min_step=cfg.min_step, max_regions=config.max_regions,
                            prior_dof=config.region_prior_dof)  # fmt: skip

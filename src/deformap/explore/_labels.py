@@ -37,9 +37,9 @@ def map_regions(mean: NDArray[np.float64], pokes: PokeSet, cells_xy: NDArray[np.
     cells)."""
     found = poke_classes(mean, pokes, config)
     if config.merge_seams and found.n_regions >= 3:
-        found = merge_seam_classes(found, mean, pokes.xy, pokes.beta, pokes.thickness)
+        found = merge_seam_classes(found, mean, pokes.xy, pokes.values, pokes.thickness)
     if config.split_by_place:  # after the junctions: the parts it makes are not junctions
-        found = split_by_place(found, mean, pokes.xy, pokes.beta,
+        found = split_by_place(found, mean, pokes.xy, pokes.values,
                                np.maximum(pokes.noise, field_settings(config).noise_floor),
                                pokes.thickness, max_regions=config.max_regions)  # fmt: skip
     if config.region_labels == "nearest":

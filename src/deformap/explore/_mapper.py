@@ -26,7 +26,7 @@ from deformap.errors import EnvironmentStateError
 from deformap.explore._classes import RegionMap
 from deformap.explore._config import ExplorationConfig, FieldName, check_exploration_budget
 from deformap.explore._dent import measure_press
-from deformap.explore._field import BetaField, field_settings
+from deformap.explore._field import BetaField, PokeField, field_settings
 from deformap.explore._grid import MapGrid
 from deformap.explore._labels import map_regions
 from deformap.explore._modulus import ModulusField
@@ -66,7 +66,7 @@ class Mapper:
         self.grid = MapGrid.build(workspace, config)
         self.surface: SurfaceModel | None = None
         self._pokes: list[PokeResult] = []
-        self._field: BetaField | None = None  # fitted when first asked for (`field`)
+        self._beta_field: BetaField | None = None  # fitted when first asked for (`beta_field`)
         self._modulus = self._fit_modulus([])
         self.threshold = field_settings(config).threshold
         #: Why the run maps on β although ``config.field`` asked for the modulus (else None).
@@ -84,12 +84,12 @@ class Mapper:
         return tuple(self._pokes)
 
     @property
-    def field(self) -> BetaField:
+    def beta_field(self) -> BetaField:
         """The current β-field, fitted on first use after a poke: under ``field: modulus`` the
         loop does not need it, and its nugget costs a region test per poke."""
-        if self._field is None:
-            self._field = self._fit_beta(self._pokes)
-        return self._field
+        if self._beta_field is None:
+            self._beta_field = self._fit_beta(self._pokes)
+        return self._beta_field
 
     @property
     def modulus_field(self) -> ModulusField:
@@ -97,10 +97,10 @@ class Mapper:
         return self._modulus
 
     @property
-    def map_field(self) -> BetaField:
+    def map_field(self) -> PokeField:
         """The field the regions, the next target and the stopping rule run on
         (``config.field``); ``threshold`` is its ``T_h``."""
-        return self._modulus if self.config.field == "modulus" else self.field
+        return self._modulus if self.config.field == "modulus" else self.beta_field
 
     def _fit_beta(self, pokes: list[PokeResult]) -> BetaField:
         return BetaField(beta_pokes([p.record for p in pokes], self.config), self.grid.xs,
@@ -151,7 +151,7 @@ class Mapper:
         self._pokes.append(added)
         # a lazily fitted β-field holds the pokes' records, and ``added`` differs from ``poke``
         # only in what the field does not read (purpose, plan, variance after, timings)
-        self._field, self._modulus = field, modulus
+        self._beta_field, self._modulus = field, modulus
         return added
 
     def _choose_field(self, poke: PokeResult, modulus: ModulusField) -> None:
@@ -230,7 +230,7 @@ class Mapper:
         """What the exploration produced, with the β-field and regions read once."""
         return ExplorationResult(
             config=self.config, workspace=self.workspace, grid=self.grid, surface=self.surface,
-            pokes=self.pokes, field=self.field, modulus_field=self._modulus,
+            pokes=self.pokes, beta_field=self.beta_field, modulus_field=self._modulus,
             regions=self.regions() if self._pokes else None,
             max_variance=self.max_variance(), stop_reason=stop_reason, timings=dict(timings),
             field_fallback=self.field_fallback, unread_places=tuple(self.unread_places),

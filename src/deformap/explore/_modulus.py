@@ -1,5 +1,5 @@
 """The modulus field: a Gaussian random field over ln E (E in Pa) from the pokes' force–travel
-records, beside the β-field and built on the same class (:class:`deformap.explore.BetaField`).
+records, beside the β-field, both a :class:`deformap.explore.PokeField`.
 
 Each poke's value and noise
 ---------------------------
@@ -27,13 +27,14 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cached_property
+from typing import ClassVar
 
 import numpy as np
 from numpy.typing import NDArray
 
 from deformap.errors import InvalidArgumentError
-from deformap.explore._config import ModulusFieldConfig
-from deformap.explore._field import BetaField, PokeSet, layer_thickness
+from deformap.explore._config import FieldName, ModulusFieldConfig
+from deformap.explore._field import PokeField, PokeSet, layer_thickness
 from deformap.explore._records import PokeRecord
 from deformap.mechanics import layer_indentation_force
 
@@ -111,14 +112,14 @@ def modulus_reading(record: PokeRecord, config: ModulusFieldConfig,
                           float(estimate.modulus_std_pa / estimate.modulus_pa), False, None)
 
 
-class ModulusField(BetaField):
+class ModulusField(PokeField):
     """The modulus field over ln E of the pokes that have a modulus (no such poke: the prior).
 
     ``mean`` and ``variance`` are of ln E [ln Pa] on the grid; :attr:`median_pa` is ``exp(mean)``
     (the median of the log-normal posterior of E), :attr:`std` the standard deviation of ln E.
     """
 
-    name = "modulus"
+    name: ClassVar[FieldName] = "modulus"
 
     def __init__(self, pokes: PokeSet, xs: NDArray[np.float64], ys: NDArray[np.float64],
                  config: ModulusFieldConfig,

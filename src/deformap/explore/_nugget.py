@@ -159,13 +159,13 @@ def with_nugget(pokes: PokeSet, config: ExplorationConfig) -> PokeSet:
     examined = max(3, int(np.ceil(4 - config.region_prior_dof)))
     tau, labels = 0.0, None
     for _ in range(MAX_ROUNDS):
-        found = segment_regions(flat, pokes.beta, np.hypot(pokes.noise, tau), floor=floor,
+        found = segment_regions(flat, pokes.values, np.hypot(pokes.noise, tau), floor=floor,
                                 min_step=REGION_MIN_STEP_BETA, max_regions=config.max_regions,
                                 prior_dof=config.region_prior_dof).poke_labels  # fmt: skip
         if labels is not None and np.array_equal(found, labels):
             break
         labels, before = found, tau
-        tau = estimate_nugget(pokes.beta, pokes.noise, labels, min_class_size=examined)
+        tau = estimate_nugget(pokes.values, pokes.noise, labels, min_class_size=examined)
         if tau == before:  # the same noise finds the same classes again
             break
     return replace(pokes, noise=np.hypot(pokes.noise, tau), nugget=tau)

@@ -13,7 +13,7 @@ from numpy.typing import NDArray
 from deformap.environment import Workspace
 from deformap.explore._classes import RegionMap
 from deformap.explore._config import ExplorationConfig
-from deformap.explore._field import BetaField
+from deformap.explore._field import BetaField, PokeField
 from deformap.explore._grid import MapGrid
 from deformap.explore._modulus import ModulusField
 from deformap.explore._nugget import beta_pokes
@@ -40,8 +40,9 @@ class ExplorationResult:
     surface : SurfaceModel or None
     pokes : tuple of PokeResult
         In order.
-    field : BetaField
-        The β-field after the last poke (``field.mean``, ``field.variance``: ``(ny, nx)``).
+    beta_field : BetaField
+        The β-field after the last poke (``beta_field.mean``, ``beta_field.variance``:
+        ``(ny, nx)``).
     modulus_field : ModulusField
         The modulus field over ln E after the last poke (the prior when no poke has a modulus;
         ``modulus_field.readings`` says which pokes it holds and why the others are left out).
@@ -70,7 +71,7 @@ class ExplorationResult:
     grid: MapGrid
     surface: SurfaceModel | None
     pokes: tuple[PokeResult, ...]
-    field: BetaField
+    beta_field: BetaField
     modulus_field: ModulusField
     regions: RegionMap | None
     max_variance: float
@@ -94,19 +95,19 @@ class ExplorationResult:
         return self.grid.ys
 
     @property
-    def map_field(self) -> BetaField:
+    def map_field(self) -> PokeField:
         """The field the regions and the stopping rule ran on (``config.field``)."""
-        return self.modulus_field if self.config.field == "modulus" else self.field
+        return self.modulus_field if self.config.field == "modulus" else self.beta_field
 
     @property
     def has_modulus(self) -> bool:
         """Whether at least one poke has a modulus (the modulus field is more than its prior)."""
         return len(self.modulus_field.pokes) > 0
 
-    def field_after(self, n_pokes: int) -> BetaField:
+    def beta_field_after(self, n_pokes: int) -> BetaField:
         """The β-field as it was after the first ``n_pokes`` pokes (recordings, figures)."""
         if n_pokes == len(self.pokes):
-            return self.field
+            return self.beta_field
         return BetaField(beta_pokes([p.record for p in self.pokes[:n_pokes]], self.config),
                          self.grid.xs, self.grid.ys, self.config.beta_field)
 

@@ -20,7 +20,7 @@ from scipy.spatial import cKDTree
 from deformap.explore._acquisition import boundary_score, choose_target
 from deformap.explore._classes import poke_classes
 from deformap.explore._config import ExplorationConfig
-from deformap.explore._field import BetaField, PokeSet, field_settings
+from deformap.explore._field import PokeField, PokeSet, field_settings
 from deformap.explore._grid import MapGrid
 from deformap.explore._planning import PokePlan, VarianceDesign, plan_pokes
 from deformap.explore._records import Target
@@ -66,7 +66,7 @@ def _plan(grid: MapGrid, pokes: PokeSet, config: ExplorationConfig, n_made: int)
     )  # fmt: skip
 
 
-def _straddle(grid: MapGrid, field: BetaField, pokes: PokeSet, config: ExplorationConfig
+def _straddle(grid: MapGrid, field: PokeField, pokes: PokeSet, config: ExplorationConfig
               ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:  # fmt: skip
     """The reachable cells at least ``BOUNDARY_SPACING_ROI`` ROIs from every poke and their
     straddle scores (:func:`boundary_score` against the isopleths of the pokes' classes); ``σ``
@@ -85,7 +85,7 @@ def _straddle(grid: MapGrid, field: BetaField, pokes: PokeSet, config: Explorati
     return grid.cells_xy[allowed], score
 
 
-def _boundary(grid: MapGrid, field: BetaField, pokes: PokeSet,
+def _boundary(grid: MapGrid, field: PokeField, pokes: PokeSet,
               config: ExplorationConfig) -> NDArray[np.float64] | None:
     """Where a region boundary is least certain (:func:`_straddle`); ``None`` when no place is
     left."""
@@ -107,7 +107,7 @@ def _integrated(grid: MapGrid, pokes: PokeSet, config: ExplorationConfig
     return candidates, design.integrated_reduction()
 
 
-def choose_next(grid: MapGrid, field: BetaField, config: ExplorationConfig,
+def choose_next(grid: MapGrid, field: PokeField, config: ExplorationConfig,
                 rng: np.random.Generator, *, boundary_owed: int,
                 n_made: int | None = None) -> Target | None:
     """The next target after the pokes ``field`` was fitted to, or ``None`` when the variance is
@@ -116,7 +116,7 @@ def choose_next(grid: MapGrid, field: BetaField, config: ExplorationConfig,
     Parameters
     ----------
     grid : MapGrid
-    field : BetaField
+    field : PokeField
         The current map field (the β-field, or the modulus field under ``config.field =
         "modulus"``; its ``pokes`` are the pokes it holds), read with
         :func:`deformap.explore.field_settings`.

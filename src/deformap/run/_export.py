@@ -58,7 +58,7 @@ def write_map_npz(path: Path, result: ExplorationResult) -> Path:
         "xs_m": result.xs, "ys_m": result.ys,
         "frame": np.array("world"),
         "units": np.array("xs_m, ys_m: m; beta: 1; modulus_median_pa: Pa; log_modulus: ln Pa"),
-        "beta_mean": result.field.mean, "beta_std": np.sqrt(result.field.variance),
+        "beta_mean": result.beta_field.mean, "beta_std": np.sqrt(result.beta_field.variance),
         "modulus_median_pa": modulus.median_pa if result.has_modulus else nan,
         "log_modulus_mean": modulus.mean if result.has_modulus else nan,
         "log_modulus_std": modulus.std if result.has_modulus else nan,

@@ -62,7 +62,7 @@ def write_map_figures(
         truth_hardness = None if truth is None else truth.ground_truth_hardness(result.xs, result.ys)
         levels = regions.levels if result.config.region_labels == "isopleth" else None
         modulus = result.modulus_field.median_pa if result.has_modulus else None
-        plot_map(result.xs, result.ys, beta=result.field.mean,
+        plot_map(result.xs, result.ys, beta=result.beta_field.mean,
                  variance=result.map_field.variance, contacts=contacts, labels=regions.labels,
                  levels=levels, truth_hardness=truth_hardness, threshold=threshold, title=title,
                  path=folder / "map.png", modulus_pa=modulus,

@@ -136,7 +136,7 @@ def _regions(result: ExplorationResult, truth: Any) -> tuple[dict[str, Any], lis
     col = np.abs(result.xs[None, :] - xy[:, :1]).argmin(axis=1)
     row = np.abs(result.ys[None, :] - xy[:, 1:]).argmin(axis=1)
     order = ordering_scores(found.labels, sign * found.class_betas, labels, hardness,
-                            sign * field.pokes.beta, labels[row, col])
+                            sign * field.pokes.values, labels[row, col])
     true_regions = [
         {"label": label, "hardness_n": _finite(h)} for label, h in sorted(hardness.items())
     ]
@@ -167,7 +167,7 @@ def shared_report(result: ExplorationResult, *, truth: Any = None) -> dict[str, 
         "threshold": field_settings(result.config).threshold,
         "max_variance": result.max_variance,
         "max_variance_map": float(var.max()),
-        "beta_nugget": float(result.field.pokes.nugget),
+        "beta_nugget": float(result.beta_field.pokes.nugget),
         "regions": regions,
         "modulus_field": modulus_report(result),
     }
