@@ -23,7 +23,7 @@ from deformap.explore import (
     modulus_reading,
     rigid_modulus_bound,
 )
-from deformap.explore._mapper import unread_radius_m
+from deformap.explore._choice import unread_radius_m
 from deformap.explore._targets import BOUNDARY_SPACING_ROI
 from deformap.stiffness import StiffnessEstimate
 from deformap.testing import synthetic_poke
@@ -173,18 +173,19 @@ def test_the_map_runs_on_the_modulus_field_when_asked() -> None:
 def test_field_modulus_without_a_record_falls_back_to_beta_and_says_so() -> None:
     mapper = _mapper("modulus")
     mapper.add(_poke((0.3, 0.2), None))
-    assert mapper.config.field == "beta" and mapper.map_field is mapper.beta_field
+    assert mapper.map_field_name == "beta" and mapper.map_field is mapper.beta_field
     assert mapper.field_fallback is not None
     assert re.match(r"`exploration.field` 'modulus' fell back to 'beta': poke 1 gave no modulus "
                     r"\(.*no force–travel record", mapper.field_fallback)
-    assert mapper.threshold == field_settings(mapper.config).threshold == 0.06
+    assert mapper.threshold == field_settings(mapper.config, "beta").threshold == 0.06
+    assert mapper.config.field == "modulus"  # the settings say what was asked for
     mapper.add(_poke((0.1, 0.1), None, 1))
     assert len(mapper.beta_field.pokes) == 2
     # a first poke with a modulus keeps the modulus field, a later one without is left out of it
     kept = _mapper("modulus")
     kept.add(_poke((0.3, 0.2), _soft(10e3)))
     kept.add(_poke((0.1, 0.1), None, 1))
-    assert kept.config.field == "modulus" and kept.field_fallback is None
+    assert kept.map_field_name == "modulus" and kept.field_fallback is None
     assert len(kept.modulus_field.pokes) == 1 and len(kept.beta_field.pokes) == 2
     assert len(_mapper("beta").add(_poke((0.3, 0.2), None)).record.contact_xy) == 2
 
@@ -192,11 +193,15 @@ def test_field_modulus_without_a_record_falls_back_to_beta_and_says_so() -> None
 def test_a_first_poke_without_modulus_does_not_decide_the_run() -> None:
     mapper = _mapper("modulus")
     mapper.add(_poke((0.3, 0.2), None, 0, error="the record was refused"))
-    assert mapper.config.field == "beta" and mapper.field_fallback is not None
+    assert mapper.map_field_name == "beta" and mapper.field_fallback is not None
+    assert mapper.config.field == "modulus"  # what was asked for, never rewritten
+    result = mapper.result("max_pokes", {})
+    assert result.config.field == "modulus" and result.map_field_name == "beta"
+    assert result.map_field is result.beta_field
     on_beta = mapper.beta_field  # fitted at the poke, as the map field then
     assert len(on_beta.pokes) == 1 and mapper.map_field is on_beta
     mapper.add(_poke((0.1, 0.1), _soft(5e3), 1))  # a modulus arrives: back on the modulus field
-    assert mapper.config.field == "modulus" and mapper.field_fallback is None
+    assert mapper.map_field_name == "modulus" and mapper.field_fallback is None
     assert mapper.map_field is mapper.modulus_field
     # fitted again, lazily
     assert len(mapper.beta_field.pokes) == 2 and mapper.beta_field is not on_beta
@@ -211,14 +216,14 @@ def test_a_place_read_twice_in_vain_leaves_the_targets_and_the_stopping_rule() -
     before = mapper.max_variance()
     mapper.add(_poke((0.42, 0.2), None, n + 1, error="too deep"))  # the same place again
     # the modulus field maps on; the place is out of the targets and the stopping rule
-    assert mapper.config.field == "modulus" and mapper.field_fallback is None
+    assert mapper.map_field_name == "modulus" and mapper.field_fallback is None
     assert mapper.unread_places == [(0.4, 0.2), (0.42, 0.2)]  # about both presses
     radius = unread_radius_m(config)
     assert radius == BOUNDARY_SPACING_ROI * config.touch.roi_size_m
     grid = mapper.grid  # the map itself still covers every cell
     gone = ((np.hypot(*(grid.cells_xy - (0.4, 0.2)).T) <= radius)
             | (np.hypot(*(grid.cells_xy - (0.42, 0.2)).T) <= radius))
-    choice = mapper._choice_grid
+    choice = mapper.choice_grid
     assert gone.any() and not (choice.target_mask & gone).any()
     assert (choice.target_mask == grid.target_mask & ~gone).all()
     assert (choice.stop_mask == grid.stop_mask & ~gone).all()
@@ -231,7 +236,7 @@ def test_a_place_read_twice_in_vain_leaves_the_targets_and_the_stopping_rule() -
         assert target is not None
         assert min(np.hypot(*(target.xy - xy)) for xy in [(0.4, 0.2), (0.42, 0.2)]) > radius
     mapper.add(_poke((0.5, 0.3), _soft(6e3), n + 2))
-    assert mapper.config.field == "modulus"
+    assert mapper.map_field_name == "modulus"
     result = mapper.result("max_pokes", {})
     assert result.unread_places == ((0.4, 0.2), (0.42, 0.2)) and result.field_fallback is None
     assert (result.stop_cells == choice.stop_mask).all()
@@ -243,12 +248,12 @@ def test_a_run_without_any_modulus_maps_on_beta_with_every_place() -> None:
     mapper = Mapper(Workspace(), ExplorationConfig(field="modulus"))
     mapper.add(_poke((0.3, 0.2), None, 0, error="too deep"))
     mapper.add(_poke((0.305, 0.2), None, 1, error="too deep"))
-    assert mapper.config.field == "beta" and mapper.unread_places == []
-    assert (mapper._choice_grid.target_mask == mapper.grid.target_mask).all()
+    assert mapper.map_field_name == "beta" and mapper.unread_places == []
+    assert (mapper.choice_grid.target_mask == mapper.grid.target_mask).all()
     mapper.add(_poke((0.1, 0.1), _soft(5e3), 2))  # a modulus: back on the modulus field
-    assert mapper.config.field == "modulus" and mapper.field_fallback is None
+    assert mapper.map_field_name == "modulus" and mapper.field_fallback is None
     mapper.add(_poke((0.31, 0.2), None, 3, error="too deep"))  # the place again: now avoided
-    assert mapper.config.field == "modulus" and len(mapper.unread_places) == 3
+    assert mapper.map_field_name == "modulus" and len(mapper.unread_places) == 3
 
 
 def test_going_to_beta_after_avoided_places_gives_the_targets_back() -> None:
@@ -257,14 +262,14 @@ def test_going_to_beta_after_avoided_places_gives_the_targets_back() -> None:
     mapper.add(_poke((0.03, 0.03), _soft(5e3), 0))
     mapper.add(_poke((0.09, 0.03), None, 1, error="too deep"))
     mapper.add(_poke((0.09, 0.03), None, 2, error="too deep"))
-    assert mapper.config.field == "modulus" and len(mapper.unread_places) == 2
-    assert mapper._choice_grid.target_mask.sum() < mapper.grid.target_mask.sum()
+    assert mapper.map_field_name == "modulus" and len(mapper.unread_places) == 2
+    assert mapper.choice_grid.target_mask.sum() < mapper.grid.target_mask.sum()
     mapper.add(_poke((0.04, 0.03), None, 3, error="too deep"))
     mapper.add(_poke((0.04, 0.03), None, 4, error="too deep"))  # no target would be left
-    assert mapper.config.field == "beta"
+    assert mapper.map_field_name == "beta"
     assert "no target would be left without it" in (mapper.field_fallback or "")
-    assert (mapper._choice_grid.target_mask == mapper.grid.target_mask).all()
-    assert (mapper._choice_grid.stop_mask == mapper.grid.stop_mask).all()
+    assert (mapper.choice_grid.target_mask == mapper.grid.target_mask).all()
+    assert (mapper.choice_grid.stop_mask == mapper.grid.stop_mask).all()
 
 
 def test_a_grid_without_every_target_is_none_and_the_run_goes_to_beta() -> None:
@@ -286,7 +291,7 @@ def test_a_grid_without_every_target_is_none_and_the_run_goes_to_beta() -> None:
     mapper.add(_poke((0.03, 0.03), _soft(5e3), 0))
     mapper.add(_poke((0.03, 0.03), None, 1, error="too deep"))
     mapper.add(_poke((0.031, 0.03), None, 2, error="too deep"))
-    assert mapper.config.field == "beta" and mapper.unread_places == []
+    assert mapper.map_field_name == "beta" and mapper.unread_places == []
     assert mapper.field_fallback is not None
     assert "no target would be left without it" in mapper.field_fallback
 
@@ -298,7 +303,7 @@ def test_the_planner_is_told_the_pokes_made_not_the_pokes_in_the_field() -> None
     mapper.add(_poke((0.3, 0.2), _soft(5e3), 0))
     mapper.add(_poke((0.1, 0.1), None, 1, error="left out"))
     mapper.add(_poke((0.5, 0.3), None, 2, error="left out"))
-    assert len(mapper.map_field.pokes) == 1 and mapper.config.field == "modulus"
+    assert len(mapper.map_field.pokes) == 1 and mapper.map_field_name == "modulus"
     target = mapper.next_target(np.random.default_rng(0))
     assert target is not None and target.plan is not None
     assert len(target.plan.targets) <= 1  # 4 pokes in all, 3 made: one left to plan
@@ -350,6 +355,33 @@ def test_a_resumed_run_finds_the_same_unread_places_from_its_journalled_records(
         line = json.loads(json.dumps(added.record.to_dict()))
         resumed.add(PokeResult(PokeRecord.from_dict(line)))
     assert resumed.unread_places == first.unread_places
-    assert (resumed._choice_grid.target_mask == first._choice_grid.target_mask).all()
+    assert (resumed.choice_grid.target_mask == first.choice_grid.target_mask).all()
     assert resumed.max_variance() == first.max_variance()
-    assert resumed.config.field == "modulus"
+    assert resumed.map_field_name == "modulus"
+
+
+def test_the_field_choice_is_a_pure_function_of_the_pokes_and_the_choice_before() -> None:
+    from deformap.explore._choice import FieldChoice, choose_map_field
+
+    config = ExplorationConfig(field="modulus", max_pokes=12)
+    grid = MapGrid.build(Workspace(), config)
+    radius = unread_radius_m(config)
+    records = [_poke((0.1, 0.1), _soft(5e3), 0).record,
+               _poke((0.4, 0.2), None, 1, error="too deep").record,
+               _poke((0.42, 0.2), None, 2, error="too deep").record]
+    choice = FieldChoice(name="modulus", grid=grid)
+    for n in range(1, len(records) + 1):
+        modulus = ModulusField.of_records(records[:n], grid.xs, grid.ys, config.modulus_field,
+                                          config.stiffness.poisson_ratio)
+        before = choice
+        choice = choose_map_field(before, "modulus", records[:n], modulus, grid, radius)
+        again = choose_map_field(before, "modulus", records[:n], modulus, grid, radius)
+        assert (again.name, again.fallback, again.unread_places) == (
+            choice.name, choice.fallback, choice.unread_places)
+    assert choice.name == "modulus" and choice.fallback is None
+    assert choice.unread_places == ((0.4, 0.2), (0.42, 0.2))
+    assert choice.grid.target_mask.sum() < grid.target_mask.sum()
+    # under field: beta the choice is the β-field on the whole grid, whatever the pokes
+    beta = choose_map_field(choice, "beta", records, modulus, grid, radius)
+    assert beta.name == "beta" and beta.grid is grid and beta.unread_places == ()
+    assert config.field == "modulus"

@@ -189,8 +189,8 @@ def _scores(mapper: Mapper, truth: tuple[NDArray, dict[int, float], NDArray],
     out = {}
     for cut in cuts:
         found = map_regions(field.mean, field.pokes, mapper.grid.cells_xy,
-                            replace(mapper.config,
-                                    region_labels=cast(RegionLabels, cut)))  # fmt: skip
+                            replace(mapper.config, region_labels=cast(RegionLabels, cut)),
+                            field.name)  # fmt: skip
         scores = region_scores(found.labels, labels, sign * field.mean, hardness)
         out[cut] = {"accuracy": scores.accuracy, "mean_iou": scores.mean_iou,
                     "found": scores.found, "true": scores.true,
@@ -224,7 +224,7 @@ def _map_one(world: SimulatedWorld, draw: WorldDraw, config: ExplorationConfig, 
                          finish=world.release, target=target, target_s=t_target)  # fmt: skip
         t1 = time.perf_counter()
         head = {"poke": index + 1, "purpose": poke.record.purpose,
-                "map_field": mapper.config.field,
+                "map_field": mapper.map_field_name,
                 "threshold": bool(mapper.max_variance() <= mapper.threshold)}
         for cut, scores in _scores(mapper, truth, cuts).items():
             rows.append({"cut": cut, **head, **scores,

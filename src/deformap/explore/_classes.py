@@ -58,7 +58,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from deformap._validation import check_array, check_int, check_positive
-from deformap.explore._config import ExplorationConfig
+from deformap.explore._config import ExplorationConfig, FieldName
 from deformap.explore._field import PokeSet, field_settings
 
 __all__ = ["REGION_Z", "RegionMap", "poke_classes", "ranked", "segment_regions", "separated"]
@@ -284,13 +284,13 @@ def ranked(grid: NDArray[np.float64], values: NDArray[np.float64],
                      poke_labels=poke_labels)
 
 
-def poke_classes(mean: NDArray[np.float64], pokes: PokeSet,
-                 config: ExplorationConfig) -> RegionMap:
+def poke_classes(mean: NDArray[np.float64], pokes: PokeSet, config: ExplorationConfig,
+                 field: FieldName | None = None) -> RegionMap:
     """The pokes' classes and the isopleth labels of the map field's mean ``mean (ny, nx)``, by
     :func:`segment_regions` with the exploration's settings (``max_regions``,
-    ``region_prior_dof``) and the map field's noise floor and smallest step
-    (:func:`deformap.explore.field_settings`: β, or ln E under ``field = "modulus"``)."""
-    cfg = field_settings(config)
+    ``region_prior_dof``) and the noise floor and smallest step of the field ``field`` (default:
+    ``config.field``; :func:`deformap.explore.field_settings`: β, or ln E for ``"modulus"``)."""
+    cfg = field_settings(config, field)
     return segment_regions(mean, pokes.values, pokes.noise, floor=cfg.noise_floor,
                            min_step=cfg.min_step, max_regions=config.max_regions,
                            prior_dof=config.region_prior_dof)  # fmt: skip

@@ -19,7 +19,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from deformap.explore._classes import RegionMap, poke_classes
-from deformap.explore._config import ExplorationConfig
+from deformap.explore._config import ExplorationConfig, FieldName
 from deformap.explore._field import PokeSet, field_settings
 from deformap.explore._indicator import indicator_labels
 from deformap.explore._places import merge_seam_classes, split_by_place
@@ -28,27 +28,27 @@ __all__ = ["map_regions"]
 
 
 def map_regions(mean: NDArray[np.float64], pokes: PokeSet, cells_xy: NDArray[np.float64],
-                config: ExplorationConfig) -> RegionMap:
-    """The regions of a β-field with mean ``mean (ny, nx)`` fitted to ``pokes``, as the
-    exploration settings ask: classes by :func:`deformap.explore.segment_regions` (``max_regions``,
-    ``region_prior_dof``, the β-field's noise floor), junctions merged (``merge_seams``) and
-    classes split by place (``split_by_place``), cells labelled by isopleth, by nearest
-    poke or by indicator kriging (``region_labels``; ``cells_xy (ny · nx, 2)`` are the grid's
-    cells)."""
-    found = poke_classes(mean, pokes, config)
+                config: ExplorationConfig, field: FieldName | None = None) -> RegionMap:
+    """The regions of the field ``field`` (default: ``config.field``) with mean ``mean (ny, nx)``
+    fitted to ``pokes``, as the exploration settings ask: classes by
+    :func:`deformap.explore.segment_regions` (``max_regions``, ``region_prior_dof``, the field's
+    noise floor and smallest step), junctions merged (``merge_seams``) and classes split by place
+    (``split_by_place``), cells labelled by isopleth, by nearest poke or by indicator kriging
+    (``region_labels``; ``cells_xy (ny · nx, 2)`` are the grid's cells)."""
+    settings = field_settings(config, field)
+    found = poke_classes(mean, pokes, config, field)
     if config.merge_seams and found.n_regions >= 3:
         found = merge_seam_classes(found, mean, pokes.xy, pokes.values, pokes.thickness)
     if config.split_by_place:  # after the junctions: the parts it makes are not junctions
         found = split_by_place(found, mean, pokes.xy, pokes.values,
-                               np.maximum(pokes.noise, field_settings(config).noise_floor),
+                               np.maximum(pokes.noise, settings.noise_floor),
                                pokes.thickness, max_regions=config.max_regions)  # fmt: skip
     if config.region_labels == "nearest":
         return found.nearest_poke(pokes.xy, cells_xy)
     if config.region_labels == "indicator-kriging":
-        cfg = field_settings(config)
         labels = indicator_labels(pokes.xy, found.poke_labels, pokes.noise, cells_xy,
-                                  n_classes=found.n_regions, length_scale=cfg.length_scale_m,
-                                  signal_std=cfg.signal_std)  # fmt: skip
+                                  n_classes=found.n_regions, length_scale=settings.length_scale_m,
+                                  signal_std=settings.signal_std)  # fmt: skip
         return RegionMap(labels=labels.reshape(found.labels.shape), levels=found.levels,
                          class_betas=found.class_betas, poke_labels=found.poke_labels)
     return found

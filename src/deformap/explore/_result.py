@@ -12,7 +12,7 @@ from numpy.typing import NDArray
 
 from deformap.environment import Workspace
 from deformap.explore._classes import RegionMap
-from deformap.explore._config import ExplorationConfig
+from deformap.explore._config import ExplorationConfig, FieldName
 from deformap.explore._field import BetaField, PokeField
 from deformap.explore._grid import MapGrid
 from deformap.explore._modulus import ModulusField
@@ -47,7 +47,7 @@ class ExplorationResult:
         The modulus field over ln E after the last poke (the prior when no poke has a modulus;
         ``modulus_field.readings`` says which pokes it holds and why the others are left out).
     regions : RegionMap or None
-        The regions of the map field (``map_field``: ``config.field``'s; ``None`` without pokes).
+        The regions of the map field (``map_field``; ``None`` without pokes).
     max_variance : float
         What the stopping rule compared with ``T_h`` (over ``stop_region``, in the map field's
         units: :func:`deformap.explore.field_settings`).
@@ -55,9 +55,12 @@ class ExplorationResult:
         A :data:`StopReason`.
     timings : mapping of str to float
         ``total_s``, ``observe_s``, ``surface_gp_s``, ``environment_s``.
+    map_field_name : {"beta", "modulus"}
+        The field the regions, the targets and the stopping rule ran on at the end: ``config.field``
+        (what was asked for), or ``"beta"`` where the run fell back (``field_fallback``).
     field_fallback : str or None
         Why the map is on the β-field although the run asked for the modulus field (no poke gave
-        a modulus); ``config.field`` is then ``"beta"``.
+        a modulus, or no target would be left without the unread places).
     unread_places : tuple of (x, y)
         The presses whose modulus could not be read at a place read twice in vain, whose discs
         were taken out of the targets and the stopping rule, in the order found [m].
@@ -77,6 +80,7 @@ class ExplorationResult:
     max_variance: float
     stop_reason: str
     timings: Mapping[str, float]
+    map_field_name: FieldName
     field_fallback: str | None = None
     unread_places: tuple[tuple[float, float], ...] = ()
     stop_mask: NDArray[np.bool_] | None = None
@@ -96,8 +100,8 @@ class ExplorationResult:
 
     @property
     def map_field(self) -> PokeField:
-        """The field the regions and the stopping rule ran on (``config.field``)."""
-        return self.modulus_field if self.config.field == "modulus" else self.beta_field
+        """The field the regions and the stopping rule ran on (:attr:`map_field_name`)."""
+        return self.modulus_field if self.map_field_name == "modulus" else self.beta_field
 
     @property
     def has_modulus(self) -> bool:

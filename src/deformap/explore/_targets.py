@@ -19,7 +19,7 @@ from scipy.spatial import cKDTree
 
 from deformap.explore._acquisition import boundary_score, choose_target
 from deformap.explore._classes import poke_classes
-from deformap.explore._config import ExplorationConfig
+from deformap.explore._config import ExplorationConfig, FieldName
 from deformap.explore._field import PokeField, PokeSet, field_settings
 from deformap.explore._grid import MapGrid
 from deformap.explore._planning import PokePlan, VarianceDesign, plan_pokes
@@ -34,16 +34,17 @@ BOUNDARY_SPACING_ROI = 0.25
 closer pokes would measure much the same foam again."""
 
 
-def expected_noise(candidates: NDArray[np.float64], pokes: PokeSet,
-                   config: ExplorationConfig) -> NDArray[np.float64]:
+def expected_noise(candidates: NDArray[np.float64], pokes: PokeSet, config: ExplorationConfig,
+                   field: FieldName | None = None) -> NDArray[np.float64]:
     """The β uncertainty a poke at each of ``candidates (c, 2)`` is expected to have: the largest
     of the pokes already made within ``BOUNDARY_SPACING_ROI`` ROIs of it (a dent spreads a few
     centimetres, so a press there measures that foam again, no better), else the map field's
-    noise floor (:func:`deformap.explore.field_settings`) with the map's nugget added in variance
+    noise floor (:func:`deformap.explore.field_settings` of ``field``, default ``config.field``)
+    with the map's nugget added in variance
     (``pokes.nugget``: any press carries the scatter between places of one material). So the
     target choice knows what a further press at a place can still reduce, and does not return to
     a place whose readings are noisy expecting a reading at the floor."""
-    floor = float(np.hypot(field_settings(config).noise_floor, pokes.nugget))
+    floor = float(np.hypot(field_settings(config, field).noise_floor, pokes.nugget))
     noise = np.full(len(candidates), floor)
     if len(pokes) == 0:
         return noise
@@ -55,13 +56,14 @@ def expected_noise(candidates: NDArray[np.float64], pokes: PokeSet,
     return noise
 
 
-def _plan(grid: MapGrid, pokes: PokeSet, config: ExplorationConfig, n_made: int) -> PokePlan:
+def _plan(grid: MapGrid, pokes: PokeSet, config: ExplorationConfig, n_made: int,
+          field: FieldName) -> PokePlan:
     """The plan with the fewest further pokes that brings the variance under ``T_h``."""
-    cfg = field_settings(config)
+    cfg = field_settings(config, field)
     return plan_pokes(
         pokes.xy, pokes.noise, grid.plan_candidates, grid.plan_domain,
         signal_std=cfg.signal_std, length_scale=cfg.length_scale_m,
-        new_noise=expected_noise(grid.plan_candidates, pokes, config),
+        new_noise=expected_noise(grid.plan_candidates, pokes, config, field),
         threshold=cfg.threshold, max_new=max(1, config.max_pokes - n_made),
     )  # fmt: skip
 
@@ -80,7 +82,7 @@ def _straddle(grid: MapGrid, field: PokeField, pokes: PokeSet, config: Explorati
     if not allowed.any():
         return np.empty((0, 2)), np.empty(0)
     mean = field.mean
-    classes = poke_classes(mean, pokes, config)
+    classes = poke_classes(mean, pokes, config, field.name)
     score = boundary_score(mean.ravel()[allowed], np.sqrt(var[allowed]), classes.levels)
     return grid.cells_xy[allowed], score
 
@@ -95,15 +97,15 @@ def _boundary(grid: MapGrid, field: PokeField, pokes: PokeSet,
     return np.array(cells[int(np.argmax(score))], dtype=float)
 
 
-def _integrated(grid: MapGrid, pokes: PokeSet, config: ExplorationConfig
+def _integrated(grid: MapGrid, pokes: PokeSet, config: ExplorationConfig, field: FieldName
                 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:  # fmt: skip
     """The planner's candidates and how much a poke at each lowers the variance summed over the
     planner's domain (``integrated-variance``), each with the noise it is expected to have."""
-    cfg = field_settings(config)
+    cfg = field_settings(config, field)
     candidates = grid.plan_candidates
     design = VarianceDesign(pokes.xy, pokes.noise, candidates, grid.plan_domain,
                             cfg.signal_std, cfg.length_scale_m,
-                            expected_noise(candidates, pokes, config))  # fmt: skip
+                            expected_noise(candidates, pokes, config, field))  # fmt: skip
     return candidates, design.integrated_reduction()
 
 
@@ -117,9 +119,9 @@ def choose_next(grid: MapGrid, field: PokeField, config: ExplorationConfig,
     ----------
     grid : MapGrid
     field : PokeField
-        The current map field (the β-field, or the modulus field under ``config.field =
-        "modulus"``; its ``pokes`` are the pokes it holds), read with
-        :func:`deformap.explore.field_settings`.
+        The current map field (the β-field or the modulus field; its ``pokes`` are the pokes it
+        holds), read with its own settings (:func:`deformap.explore.field_settings` of
+        ``field.name``).
     config : ExplorationConfig
     rng : numpy.random.Generator
         This choice's stream (``paper`` draws from it; ``min-max-variance`` subsamples with it).
@@ -131,7 +133,7 @@ def choose_next(grid: MapGrid, field: PokeField, config: ExplorationConfig,
     """
     pokes = field.pokes
     variance = field.variance.ravel()
-    threshold = field_settings(config).threshold
+    threshold = field_settings(config, field.name).threshold
     if variance[grid.stop_mask].max() <= threshold:
         if boundary_owed == 0:
             return None
@@ -147,7 +149,7 @@ def choose_next(grid: MapGrid, field: PokeField, config: ExplorationConfig,
 
     def planner() -> NDArray[np.float64]:
         made = len(pokes) if n_made is None else n_made  # the field may leave pokes out
-        plans.append(_plan(grid, pokes, config, made))
+        plans.append(_plan(grid, pokes, config, made, field.name))
         return np.array(plans[-1].targets[0], dtype=float)
 
     if reachable.max() <= threshold:  # only the edge band is left
@@ -158,16 +160,17 @@ def choose_next(grid: MapGrid, field: PokeField, config: ExplorationConfig,
     else:
         def look_ahead(candidates: NDArray[np.float64]) -> NDArray[np.float64]:
             # exact rank-one updates of the posterior: the variance does not depend on the βs
-            cfg = field_settings(config)
+            cfg = field_settings(config, field.name)
             design = VarianceDesign(pokes.xy, pokes.noise, candidates,
                                     grid.cells_xy[grid.stop_mask], cfg.signal_std,
                                     cfg.length_scale_m,
-                                    expected_noise(candidates, pokes, config))  # fmt: skip
+                                    expected_noise(candidates, pokes, config,
+                                                   field.name))  # fmt: skip
             return design.after([], threshold)[1]
 
         def scorer() -> tuple[NDArray[np.float64], NDArray[np.float64]]:
             if config.strategy == "integrated-variance":
-                return _integrated(grid, pokes, config)
+                return _integrated(grid, pokes, config, field.name)
             found = _straddle(grid, field, pokes, config)
             if found[1].size == 0:  # every reachable cell near a poke: the least known one
                 return cells, reachable

@@ -66,7 +66,7 @@ def write_map_figures(
                  variance=result.map_field.variance, contacts=contacts, labels=regions.labels,
                  levels=levels, truth_hardness=truth_hardness, threshold=threshold, title=title,
                  path=folder / "map.png", modulus_pa=modulus,
-                 region_field=result.config.field,
+                 region_field=result.map_field_name,
                  purposes=[p.record.purpose for p in result.pokes],
                  variance_max=variance_max)  # fmt: skip
         written.append(folder / "map.png")
