@@ -18,13 +18,8 @@ import argparse
 
 import numpy as np
 
-from deformap.explore import (
-    ExplorationConfig,
-    PokeSet,
-    beta_noise_floor,
-    segment_regions,
-    with_nugget,
-)
+from deformap.explore import ExplorationConfig, PokeSet, beta_noise_floor, segment_regions
+from deformap.explore._nugget import with_nugget
 
 CONFIG = ExplorationConfig(field="beta")
 FLOOR = beta_noise_floor(CONFIG)  # the β grid's resolution / √12

@@ -19,8 +19,8 @@ from deformap.explore import (
     map_regions,
     measure_press,
     poke_step,
-    roi_grid,
 )
+from deformap.explore._dent import roi_grid
 from deformap.explore._targets import choose_next
 from deformap.testing import coarse_world, synthetic_poke
 

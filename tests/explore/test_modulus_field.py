@@ -20,10 +20,10 @@ from deformap.explore import (
     ModulusFieldConfig,
     PokeResult,
     field_settings,
-    modulus_reading,
     rigid_modulus_bound,
 )
 from deformap.explore._choice import unread_radius_m
+from deformap.explore._modulus import modulus_reading
 from deformap.explore._targets import BOUNDARY_SPACING_ROI
 from deformap.stiffness import StiffnessEstimate
 from deformap.testing import synthetic_poke

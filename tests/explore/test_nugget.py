@@ -13,13 +13,11 @@ from deformap.explore import (
     Mapper,
     PokeSet,
     beta_noise_floor,
-    beta_pokes,
-    estimate_nugget,
     field_settings,
     segment_regions,
-    with_nugget,
 )
 from deformap.explore._config import BetaFieldConfig
+from deformap.explore._nugget import beta_pokes, estimate_nugget, with_nugget
 from deformap.explore._targets import expected_noise
 from deformap.msm import ShapeMatchingConfig
 from deformap.testing import synthetic_poke

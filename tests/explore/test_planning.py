@@ -9,7 +9,7 @@ from deformap.explore import BetaFieldConfig, ExplorationConfig, Mapper, beta_no
 from deformap.explore._acquisition import choose_target
 from deformap.explore._planning import plan_pokes
 from deformap.gp import GaussianRandomField
-from deformap.run import shared_report
+from deformap.run._report import shared_report
 from deformap.testing import synthetic_poke
 
 PRIOR = {"signal_std": 0.3, "length_scale": 0.2}

@@ -62,8 +62,8 @@ from deformap.explore import (
     beta_noise_floor,
     map_regions,
     poke_step,
-    with_nugget,
 )
+from deformap.explore._nugget import with_nugget
 from deformap.world import (
     CAMERA_PRESETS,
     LAYOUT_FAMILIES,

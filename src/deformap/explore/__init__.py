@@ -4,7 +4,7 @@ that drives an ``Environment`` with it, the typed poke records and the session j
 
 from __future__ import annotations
 
-from deformap.explore._acquisition import STRATEGIES, choose_target
+from deformap.explore._acquisition import STRATEGIES
 from deformap.explore._classes import RegionMap, segment_regions
 from deformap.explore._config import (
     BetaFieldConfig,
@@ -16,7 +16,7 @@ from deformap.explore._config import (
     TouchGPConfig,
     check_exploration_budget,
 )
-from deformap.explore._dent import measure_press, roi_grid
+from deformap.explore._dent import measure_press
 from deformap.explore._field import (
     BetaField,
     FieldSettings,
@@ -35,14 +35,7 @@ from deformap.explore._journal import (
 from deformap.explore._labels import map_regions
 from deformap.explore._loop import MappingRun, explore, poke_step
 from deformap.explore._mapper import Mapper
-from deformap.explore._modulus import (
-    ModulusField,
-    ModulusReading,
-    modulus_reading,
-    rigid_modulus_bound,
-)
-from deformap.explore._nugget import beta_pokes, estimate_nugget, with_nugget
-from deformap.explore._places import merge_seam_classes, split_by_place
+from deformap.explore._modulus import ModulusField, ModulusReading, rigid_modulus_bound
 from deformap.explore._records import (
     PURPOSES,
     ContactRecord,
@@ -90,22 +83,14 @@ __all__ = [
     "Target",
     "TouchGPConfig",
     "beta_noise_floor",
-    "beta_pokes",
     "check_exploration_budget",
-    "choose_target",
-    "estimate_nugget",
     "explore",
     "field_settings",
     "fit_surface",
     "map_regions",
     "measure_press",
-    "merge_seam_classes",
-    "modulus_reading",
     "poke_step",
     "read_journal",
     "rigid_modulus_bound",
-    "roi_grid",
     "segment_regions",
-    "split_by_place",
-    "with_nugget",
 ]
