@@ -367,7 +367,8 @@ def rescore_world(task: dict[str, Any], result: dict[str, Any], cuts: Sequence[s
     refused: :func:`fell_back_cuts`). The columns that do not depend on the cut
     (``purpose``, ``threshold``, ``modulus_error``, times, ...) are the run's. A world stored
     before the pokes' layer thickness was (no ``thickness`` key) has the world's own rest height at
-    each poke stand in for the surface model's (:func:`deformap.explore.merge_seam_classes` needs it).
+    each poke stand in for the surface model's
+    (:func:`deformap.explore._places.merge_seam_classes` needs it).
 
     Raises
     ------

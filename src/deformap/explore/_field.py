@@ -106,7 +106,7 @@ class PokeSet:
     noise (0: none; :func:`deformap.explore._nugget.with_nugget`), ``thickness (p,)`` the layer's
     thickness at each poke in metres (:func:`layer_thickness`; ``None`` when not every poke has
     one), which bounds how far a junction can reach a press
-    (:func:`deformap.explore.merge_seam_classes`).
+    (:func:`deformap.explore._places.merge_seam_classes`).
     """
 
     xy: NDArray[np.float64]
@@ -205,7 +205,7 @@ class PokeField:
 
 class BetaField(PokeField):
     """The β-field ("GPR β-field"): the field over the pokes' βs. The mapper's pokes are
-    :func:`deformap.explore.beta_pokes` (each σ raised to the floor, plus the map's nugget)."""
+    :func:`deformap.explore._nugget.beta_pokes` (each σ raised to the floor, plus the map's nugget)."""
 
     name: ClassVar[FieldName] = "beta"
 

@@ -2,9 +2,10 @@
 
 It orchestrates the concepts of the paper's process flow, each in its own module: the surface
 model (:mod:`._surface`), the dent and its β (:mod:`._dent`), the β-field (:mod:`._field`), the
-choice of the next target (:mod:`._targets`) and the regions (:mod:`._regions`). The live loop
-(:func:`deformap.explore.explore`) and a recorded session (:mod:`deformap.replay`) both feed it
-through :func:`deformap.explore.poke_step`, so a poke gives the same β whichever way it arrives.
+choice of the next target (:mod:`._targets`), the field it maps on (:mod:`._choice`) and the
+regions (:mod:`._labels`). The live loop (:func:`deformap.explore.explore`) and a recorded
+session (:mod:`deformap.replay`) both feed it through :func:`deformap.explore.poke_step`, so a
+poke gives the same β whichever way it arrives.
 
 References
 ----------
