@@ -18,8 +18,8 @@ splitting with a calibrated test:
    many degrees of freedom the claimed uncertainties are worth beside the scatter the βs show
    (W): a moderated test (the claimed noise as a scaled-χ² prior on the scatter, as in Smyth
    2004). ``ν₀ = 0`` is the scale-free test that trusts only the βs; a large ``ν₀`` is Cochran's
-   χ² test with known noise. The default 7 weighs the claimed noise like the eight presses on
-   one foam that the β-field's former noise floor was measured from. The β-field's pokes carry
+   χ² test with known noise. The default 7 weighs the claimed noise like eight repeated presses
+   on one foam. The β-field's pokes carry
    the map's nugget in their uncertainty (:mod:`deformap.explore._nugget`), itself estimated
    within the classes this test finds (:func:`deformap.explore._nugget.with_nugget`).
 3. The same is done for the best split into three parts (two materials cannot always be told
@@ -229,8 +229,8 @@ def segment_regions(
         The pokes' β estimates and their uncertainties.
     floor : float
         Smallest uncertainty a poke is credited with (the map field's noise floor:
-        :func:`poke_classes` passes the field's own; this function's default, 0.03, is the
-        β-field's on the former reference β scale, kept for direct callers).
+        :func:`poke_classes` passes the field's own; this function's default, 0.03, is for
+        direct callers).
     min_step : float
         Smallest difference of two class means that can separate them.
     z : float

@@ -7,9 +7,8 @@ A poke's claimed σ is the camera's noise carried through the estimate
 (:mod:`deformap.explore._dent_noise`): a repeatability at that place. Pressed at another place of
 the same material β̂ also moves with what the camera's noise does not model (the foam's own
 variation, the dent's reconstruction at another spot, the contact's placement), so the spread of β̂
-between places on one material exceeds the claimed σ (README, "β separates hardness only under the
-force-driven protocol", 0.7–2.2 times it on the simulated foams). That excess was a constant floor
-of 0.015, measured on the simulated world's 150 N foam; it is now estimated from each map's pokes.
+between places on one material exceeds the claimed σ. That excess is estimated from each map's
+pokes.
 
 Model
 -----
@@ -40,8 +39,7 @@ say which pokes are one material whatever their distance, and removing each clas
 steps between materials. Only the classes the region test examined and kept whole count: a class
 of fewer pokes than the test examines (3 with the default ``region_prior_dof``) is no evidence of
 one material (two pokes are never split, so a pair straddling two foams would read their step as
-scatter; on the stiffening-foam world's heterogeneous-110-150 map that pair, 0.74 and 0.64, gave
-τ̂ = 0.036 after the second poke and merged the two foams' classes at the fourth before this rule).
+scatter, and that scatter could merge the two foams' classes).
 The classes depend on the noise and the noise on τ:
 :func:`with_nugget` starts from the claimed σ, estimates τ from the classes
 found, finds the classes again with σᵢ² + τ² and repeats until the classes no longer change (at

@@ -96,8 +96,7 @@ def merge_seam_classes(found: RegionMap, mean: NDArray[np.float64],
     junction. A class with one poke inside it (its neighbours of one other class only) is kept,
     so an insert met by a single poke stays a region. What it gives up: a material seen only by
     pokes lying where two others meet (a stripe one poke wide between two others) is merged until
-    a poke lands inside it; ``deformap bench rescore --merge-seams`` measures the trade (README,
-    "Many worlds"). Without every poke's thickness (``None``: a poke without a force–travel
+    a poke lands inside it. Without every poke's thickness (``None``: a poke without a force–travel
     record) no class is merged.
     """
     if thickness_m is None:

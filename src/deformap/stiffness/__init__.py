@@ -64,17 +64,11 @@ has already widened the joint fit's Birge-scaled covariance, adding it again cou
 twice: the term errs on the side of a wider σ.
 
 What it sees: a modulus that changes along the record faster than ``δ₀`` can follow, such as a
-soft skin over a stiffer core (``tests/stiffness/test_estimate.py``: the share of records whose
-``E ± 2σ`` reaches the range of moduli the press crossed rises from 71 to 82 %). What it cannot
-see: a modulus that rises *smoothly* with the indentation is absorbed by the contact offset (a
-Hertz curve of a higher ``E`` and a smaller ``δ₀`` fits it within the noise), and then neither
-the two halves, nor a jackknife over the load levels, nor the local secant modulus
-``Fᵢ / g(tᵢ + δ₀)`` shows it: on the simulated foam that stiffens (``stiffening-fem``) the
-halves agree within ±1.6 ``σ_D`` and the secant modulus is flat from the first sample, so the
-term adds at most 5 % of ``E`` there and the claimed σ does not cover that world's bias (README,
-the hardness study). On records of the model itself it is zero in about two records of three
-(``D² < σ_D²``, as noise alone gives in 68 %), and widens σ by 9 % on average (noise-only σ; 5 %
-with the Poisson ratio's term).
+soft skin over a stiffer core. What it cannot see: a modulus that rises *smoothly* with the
+indentation is absorbed by the contact offset (a Hertz curve of a higher ``E`` and a smaller
+``δ₀`` fits it within the noise), and then neither the two halves, nor a jackknife over the load
+levels, nor the local secant modulus ``Fᵢ / g(tᵢ + δ₀)`` shows it, so the claimed σ does not
+cover that bias. On records of the model itself it is zero whenever ``D² < σ_D²``.
 
 The sphere's range
 ------------------
