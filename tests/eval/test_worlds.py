@@ -383,14 +383,3 @@ def test_a_run_that_fell_back_to_beta_is_rescored_on_its_stored_beta_pokes(monke
     assert rescore_world(task, result, ["nearest"])["rows"] == result["rows"]
     with pytest.raises(InvalidArgumentError, match="its run fell back"):
         rescore_world(task, result, ["isopleth"])
-
-
-def test_a_task_sets_where_the_pokes_go_after_an_unread_place_and_on_a_boundary() -> None:
-    from deformap.eval._worlds import _draw
-
-    task = {"seed": 5, "index": 0, "families": ["l-shape"], "physics": ["linear-fem"],
-            "max_pokes": 3}
-    _, default = _draw(task)
-    assert (default.unread_place, default.boundary_score) == ("avoid", "straddle")
-    _, given = _draw({**task, "unread_place": "beta", "boundary_score": "nearest-poke"})
-    assert (given.unread_place, given.boundary_score) == ("beta", "nearest-poke")
