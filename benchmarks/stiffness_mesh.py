@@ -6,7 +6,7 @@ world's FEM mesh size: separates the estimator's error from the world's discreti
 
 For each foam (a 5 cm block over the default workspace) and each in-plane element size, the world
 is built with every noise source off, pressed once at the workspace's centre, and its force–travel
-record read by ``deformap.explore.estimate_stiffness``. The baseline in each row is the world's own
+record read by ``deformap.stiffness.estimate_stiffness``. The baseline in each row is the world's own
 material modulus; the dent depth shows how far the FEM's press has converged (a finer mesh lets
 the tip sink deeper: a coarse mesh is too stiff on a contact patch smaller than its elements).
 A finer mesh costs much more: 3.75 mm elements have about 5 times the unknowns of 7.5 mm ones.
@@ -20,7 +20,7 @@ import time
 import numpy as np
 
 from deformap.environment import Workspace
-from deformap.explore import estimate_stiffness
+from deformap.stiffness import estimate_stiffness
 from deformap.world import Block, Scenario, SimulatedWorld, WorldConfig
 
 

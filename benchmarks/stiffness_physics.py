@@ -12,7 +12,7 @@ kinematics differ from elasticity) and 1 (the default: it also stiffens toward d
 ``stiffening-fem`` (the same FEM as ``linear-fem``, of a foam that stiffens toward densification;
 with exponent 0 it is ``linear-fem`` exactly, so its row is the stiffening's effect alone).
 Each foam is a block over the default workspace, pressed once at its centre with every noise
-source off; the record is read by ``deformap.explore.estimate_stiffness`` against the world's own
+source off; the record is read by ``deformap.stiffness.estimate_stiffness`` against the world's own
 small-strain modulus.
 """
 
@@ -25,7 +25,7 @@ import numpy as np
 from stiffness_mesh import block_scenario  # this folder's: the same block
 
 from deformap.errors import InvalidArgumentError
-from deformap.explore import estimate_stiffness
+from deformap.stiffness import estimate_stiffness
 from deformap.world import SimulatedWorld, WorldConfig
 
 CASES = (("linear-fem", 1.0), ("stiffening-foam", 0.0), ("stiffening-foam", 1.0),

@@ -34,6 +34,15 @@ def _table() -> dict[str, set[str] | None]:
 
 TABLE = _table()
 
+#: The internals one package shares with another (``(importer, private module)``: why), the only
+#: private modules a package may import from another; each must be in use.
+ALLOWED_INTERNALS: dict[tuple[str, str], str] = {
+    ("deformap.cli", "deformap.run._folder"): "a command's --json and --out files are written with "
+    "the run folder's atomic writes (to_json, write_json, write_text)",
+    ("deformap.eval", "deformap.explore._nugget"): "rescoring a stored run refits its β-field with "
+    "the map's nugget as the mapper did (with_nugget)",
+}
+
 
 def _package(module: str) -> str:
     """The table row a module belongs to: the longest row name that is a prefix of it."""
@@ -112,8 +121,28 @@ def test_imports_follow_the_table(path: Path) -> None:
         if allowed is not None and target not in allowed:
             problems.append(f"{where}: {mine} may not import {target} ({module})")
         rest = module[len(target):].split(".")
-        if any(part.startswith("_") for part in rest if part):
+        private = any(part.startswith("_") for part in rest if part)
+        if private and (mine, module) not in ALLOWED_INTERNALS:
             problems.append(f"{where}: private module of another package ({module})")
         if any(n.startswith("_") and not n.endswith("__") for n in names):
             problems.append(f"{where}: private name of another package ({module}: {names})")
     assert not problems, "\n".join(problems)
+
+
+def test_fitting_the_field_does_not_go_through_the_region_labelling() -> None:
+    """The β-field's pokes (their nugget) need the region test's classes only: the field's modules
+    import neither the cell labelling nor the place and seam rules."""
+    explore = SRC / "explore"
+    for name in ("_field.py", "_nugget.py", "_modulus.py", "_classes.py"):
+        imported = {module for _, module, _ in _imports(explore / name)}
+        assert not imported & {"deformap.explore._labels", "deformap.explore._places"}, name
+
+
+def test_every_shared_internal_is_in_use_and_allowed_by_the_table() -> None:
+    used = {(_package(_module_name(path)), module)
+            for path in MODULES for _, module, _ in _imports(path)}
+    for (importer, module), why in ALLOWED_INTERNALS.items():
+        assert why, (importer, module)
+        assert (importer, module) in used, f"{importer} no longer imports {module}: drop it"
+        allowed = TABLE[importer]
+        assert allowed is None or _package(module) in allowed, (importer, module)

@@ -219,13 +219,21 @@ def test_a_retired_setting_in_an_older_file_is_ignored_with_a_warning(caplog) ->
         config_from_dict(RunConfig, {"world": {"default_force": 0.6}})
 
 
-def test_an_older_file_that_turned_the_camera_noise_off_keeps_its_meaning() -> None:
+def test_a_file_that_sets_a_removed_exploration_switch_is_refused_in_one_line() -> None:
     from deformap.run import RunConfig
 
-    # before `beta_uncertainty` existed, noise_samples 0 meant the shape matcher's own uncertainty
-    older = config_from_dict(RunConfig, {"exploration": {"touch": {"noise_samples": 0}}})
-    assert older.exploration.beta_uncertainty == "shape-matching"
-    # a file that names the switch is read as written, and refused when it contradicts itself
+    for key, value in (("unread_place", "avoid"), ("boundary_score", "straddle")):
+        with pytest.raises(ConfigError) as caught:
+            config_from_dict(RunConfig, {"exploration": {key: value}})
+        message = str(caught.value)
+        assert "\n" not in message
+        assert message.startswith(f"`config.exploration` has unknown key(s) ['{key}']")
+    # noise_samples 0 no longer implies the shape matcher's uncertainty: the file must say so
+    with pytest.raises(ConfigError, match=r"touch\.noise_samples.*beta_uncertainty"):
+        config_from_dict(RunConfig, {"exploration": {"touch": {"noise_samples": 0}}})
+    shape = config_from_dict(RunConfig, {"exploration": {"beta_uncertainty": "shape-matching",
+                                                         "touch": {"noise_samples": 0}}})
+    assert shape.exploration.beta_uncertainty == "shape-matching"
     with pytest.raises(ConfigError, match=r"touch\.noise_samples"):
         config_from_dict(RunConfig, {"exploration": {"beta_uncertainty": "camera-noise",
                                                      "touch": {"noise_samples": 0}}})

@@ -22,12 +22,12 @@ from deformap.explore import (
     BetaFieldConfig,
     ExplorationConfig,
     ModulusFieldConfig,
-    StiffnessConfig,
     SurfaceGPConfig,
     TouchGPConfig,
 )
 from deformap.msm import ShapeMatchingConfig
 from deformap.run import RunConfig
+from deformap.stiffness import StiffnessConfig
 from deformap.world import CameraConfig, WorldConfig
 
 _BOUNDS = "deformap.bounds"

@@ -11,6 +11,7 @@ The packages, what each owns and may import, the data flow and the contracts are
 - :mod:`deformap.cloud`: point clouds, filters, tactile points, file and ROS 2 bag I/O;
 - :mod:`deformap.gp`: the paper's kernel, exact and grid Gaussian random fields, hyperparameters;
 - :mod:`deformap.msm`: meshless shape matching and the β estimation;
+- :mod:`deformap.stiffness`: stiffness and Young's modulus from a press's force–travel record;
 - :mod:`deformap.mechanics`: contact mechanics (tactile contact, Hertz, hardness ↔ modulus);
 - :mod:`deformap.environment`: the ``Environment`` protocol a world or a robot implements;
 - :mod:`deformap.explore`: the mapper and its concepts, the loop, poke records, the journal;
@@ -99,7 +100,7 @@ __all__ = [
 # above is a subpackage's (``explore()`` stays ``deformap.explore.explore``: as ``deformap.explore``
 # it would hide its package once that is imported)
 _PACKAGES = ("cloud", "environment", "eval", "explore", "gp", "mechanics", "msm", "replay", "run",
-             "viz", "world")  # fmt: skip
+             "stiffness", "viz", "world")  # fmt: skip
 _names_getattr, __dir__ = lazy_exports(__name__, _MODULES, [*__all__, *_PACKAGES], globals())
 
 

@@ -107,7 +107,7 @@ def test_boundary_pokes_go_onto_the_isopleth_not_to_the_least_known_place() -> N
     config = ExplorationConfig(boundary_pokes=2, beta_field=BetaFieldConfig(noise_floor=0.015))
 
     def on_the_isopleth(mapper: Mapper, xy_t: np.ndarray) -> None:
-        mean, var = mapper.field.mean, mapper.field.variance
+        mean, var = mapper.beta_field.mean, mapper.beta_field.variance
         level = mapper.regions().levels
         assert level.size == 1
         at = int(np.argmin(np.sum((mapper.grid.cells_xy - xy_t) ** 2, axis=1)))
@@ -119,37 +119,3 @@ def test_boundary_pokes_go_onto_the_isopleth_not_to_the_least_known_place() -> N
     boundary = _two_materials(config, on_the_isopleth)
     assert len(boundary) == 2
     assert all(abs(t[0] - 0.3) < 0.08 for t in boundary)  # near the true edge
-
-
-def test_the_nearest_poke_boundary_score_is_highest_on_the_bisector_far_from_the_pokes() -> None:
-    from deformap.explore._targets import nearest_poke_boundary_score
-
-    xy = np.array([[0.1, 0.2], [0.5, 0.2]])
-    cells = np.array([[0.3, 0.2], [0.3, 0.39], [0.2, 0.2], [0.45, 0.2]])
-    one = nearest_poke_boundary_score(cells, xy, np.array([0, 0]))
-    np.testing.assert_allclose(one, np.hypot(*(cells[:, None, :] - xy[None]).transpose(2, 0, 1))
-                               .min(axis=1))  # one class: the distance to the pokes alone
-    two = nearest_poke_boundary_score(cells, xy, np.array([0, 1]))
-    # on the bisector x = 0.3 the score is the distance to the pokes; off it, less by half the
-    # difference of the two distances
-    np.testing.assert_allclose(two[0], 0.2)
-    np.testing.assert_allclose(two[1], np.hypot(0.2, 0.19))
-    np.testing.assert_allclose(two[2], 0.1 - 0.5 * (0.3 - 0.1))
-    assert two[1] > two[0] > two[2] and two[3] < 0
-
-
-def test_nearest_poke_boundary_pokes_go_onto_the_pokes_bisector_between_two_materials() -> None:
-    config = ExplorationConfig(boundary_pokes=2, boundary_score="nearest-poke",
-                               beta_field=BetaFieldConfig(noise_floor=0.015))
-
-    def on_the_bisector(mapper: Mapper, xy_t: np.ndarray) -> None:
-        xy = np.array([p.xy for p in mapper.pokes])
-        labels = mapper.regions().poke_labels
-        d = np.linalg.norm(xy - xy_t, axis=1)
-        # about as far from the nearest poke of each class: on the map's boundary
-        near = [d[labels == k].min() for k in np.unique(labels)]
-        assert len(near) == 2 and abs(near[0] - near[1]) < 0.01  # straddle's: 0.03
-
-    assert len(_two_materials(config, on_the_bisector)) == 2
-    with pytest.raises(InvalidArgumentError, match="`boundary_score` must be one of"):
-        ExplorationConfig(boundary_score="voronoi")  # type: ignore[arg-type]

@@ -19,8 +19,8 @@ from deformap.explore import (
     map_regions,
     measure_press,
     poke_step,
-    roi_grid,
 )
+from deformap.explore._dent import roi_grid
 from deformap.explore._targets import choose_next
 from deformap.testing import coarse_world, synthetic_poke
 
@@ -65,8 +65,8 @@ def test_the_beta_field_is_the_exact_gp_posterior() -> None:
     gram = k(pokes.xy, pokes.xy) + np.diag(pokes.noise**2)
     cross = k(cells, pokes.xy)
     w = 1 / pokes.noise**2
-    m = np.sum(w * pokes.beta) / np.sum(w)
-    mean = m + cross @ np.linalg.solve(gram, pokes.beta - m)
+    m = np.sum(w * pokes.values) / np.sum(w)
+    mean = m + cross @ np.linalg.solve(gram, pokes.values - m)
     var = cfg.signal_std**2 - np.sum(cross * np.linalg.solve(gram, cross.T).T, axis=1)
     np.testing.assert_allclose(field.mean.ravel(), mean, atol=1e-9)
     np.testing.assert_allclose(field.variance.ravel(), var, atol=1e-9)

@@ -19,13 +19,13 @@ from deformap.explore import (
     ModulusField,
     ModulusFieldConfig,
     PokeResult,
-    StiffnessEstimate,
     field_settings,
-    modulus_reading,
     rigid_modulus_bound,
 )
-from deformap.explore._mapper import unread_radius_m
+from deformap.explore._choice import unread_radius_m
+from deformap.explore._modulus import modulus_reading
 from deformap.explore._targets import BOUNDARY_SPACING_ROI
+from deformap.stiffness import StiffnessEstimate
 from deformap.testing import synthetic_poke
 
 CONFIG = ModulusFieldConfig()
@@ -65,7 +65,7 @@ def test_the_field_is_over_ln_e_and_interpolates_the_pokes_within_their_noise() 
     places = [(0.1, 0.1), (0.3, 0.3), (0.5, 0.1)]
     pairs = enumerate(zip(places, moduli, strict=True))
     field = _field([_poke(xy, _soft(e), i) for i, (xy, e) in pairs])
-    assert np.allclose(field.pokes.beta, np.log(moduli))
+    assert np.allclose(field.pokes.values, np.log(moduli))
     for (x, y), e in zip(places, moduli, strict=True):
         col, row = int(np.argmin(abs(XS - x))), int(np.argmin(abs(YS - y)))
         # within two of the poke's noise on the ln E axis (its 3 % raised to the 10 % floor)
@@ -173,50 +173,42 @@ def test_the_map_runs_on_the_modulus_field_when_asked() -> None:
 def test_field_modulus_without_a_record_falls_back_to_beta_and_says_so() -> None:
     mapper = _mapper("modulus")
     mapper.add(_poke((0.3, 0.2), None))
-    assert mapper.config.field == "beta" and mapper.map_field is mapper.field
+    assert mapper.map_field_name == "beta" and mapper.map_field is mapper.beta_field
     assert mapper.field_fallback is not None
     assert re.match(r"`exploration.field` 'modulus' fell back to 'beta': poke 1 gave no modulus "
                     r"\(.*no force–travel record", mapper.field_fallback)
-    assert mapper.threshold == field_settings(mapper.config).threshold == 0.06
+    assert mapper.threshold == field_settings(mapper.config, "beta").threshold == 0.06
+    assert mapper.config.field == "modulus"  # the settings say what was asked for
     mapper.add(_poke((0.1, 0.1), None, 1))
-    assert len(mapper.field.pokes) == 2
+    assert len(mapper.beta_field.pokes) == 2
     # a first poke with a modulus keeps the modulus field, a later one without is left out of it
     kept = _mapper("modulus")
     kept.add(_poke((0.3, 0.2), _soft(10e3)))
     kept.add(_poke((0.1, 0.1), None, 1))
-    assert kept.config.field == "modulus" and kept.field_fallback is None
-    assert len(kept.modulus_field.pokes) == 1 and len(kept.field.pokes) == 2
+    assert kept.map_field_name == "modulus" and kept.field_fallback is None
+    assert len(kept.modulus_field.pokes) == 1 and len(kept.beta_field.pokes) == 2
     assert len(_mapper("beta").add(_poke((0.3, 0.2), None)).record.contact_xy) == 2
 
 
 def test_a_first_poke_without_modulus_does_not_decide_the_run() -> None:
     mapper = _mapper("modulus")
     mapper.add(_poke((0.3, 0.2), None, 0, error="the record was refused"))
-    assert mapper.config.field == "beta" and mapper.field_fallback is not None
-    on_beta = mapper.field  # fitted at the poke, as the map field then
+    assert mapper.map_field_name == "beta" and mapper.field_fallback is not None
+    assert mapper.config.field == "modulus"  # what was asked for, never rewritten
+    result = mapper.result("max_pokes", {})
+    assert result.config.field == "modulus" and result.map_field_name == "beta"
+    assert result.map_field is result.beta_field
+    on_beta = mapper.beta_field  # fitted at the poke, as the map field then
     assert len(on_beta.pokes) == 1 and mapper.map_field is on_beta
     mapper.add(_poke((0.1, 0.1), _soft(5e3), 1))  # a modulus arrives: back on the modulus field
-    assert mapper.config.field == "modulus" and mapper.field_fallback is None
+    assert mapper.map_field_name == "modulus" and mapper.field_fallback is None
     assert mapper.map_field is mapper.modulus_field
-    assert len(mapper.field.pokes) == 2 and mapper.field is not on_beta  # fitted again, lazily
+    # fitted again, lazily
+    assert len(mapper.beta_field.pokes) == 2 and mapper.beta_field is not on_beta
 
 
-def test_under_unread_place_beta_a_place_read_twice_in_vain_gives_the_run_to_beta() -> None:
-    mapper = Mapper(Workspace(), ExplorationConfig(field="modulus", unread_place="beta",
-                                                   max_pokes=6))
-    mapper.add(_poke((0.1, 0.1), _soft(5e3), 0))
-    mapper.add(_poke((0.4, 0.2), None, 1, error="too deep"))
-    assert mapper.config.field == "modulus"  # once: left out, the run goes on on the modulus
-    mapper.add(_poke((0.405, 0.2), None, 2, error="too deep"))  # the same place again
-    assert mapper.config.field == "beta"
-    assert mapper.field_fallback is not None
-    assert "could not be read twice at one place (" in mapper.field_fallback
-    mapper.add(_poke((0.5, 0.3), _soft(6e3), 3))  # for good: the β-field maps the rest
-    assert mapper.config.field == "beta" and mapper.map_field is mapper.field
-
-
-def test_under_unread_place_avoid_the_place_leaves_the_targets_and_the_stopping_rule() -> None:
-    config = ExplorationConfig(field="modulus", unread_place="avoid", max_pokes=12)
+def test_a_place_read_twice_in_vain_leaves_the_targets_and_the_stopping_rule() -> None:
+    config = ExplorationConfig(field="modulus", max_pokes=12)
     mapper = Mapper(Workspace(), config)
     mapper.add(_poke((0.1, 0.1), _soft(5e3), 0))
     n = 1
@@ -224,14 +216,14 @@ def test_under_unread_place_avoid_the_place_leaves_the_targets_and_the_stopping_
     before = mapper.max_variance()
     mapper.add(_poke((0.42, 0.2), None, n + 1, error="too deep"))  # the same place again
     # the modulus field maps on; the place is out of the targets and the stopping rule
-    assert mapper.config.field == "modulus" and mapper.field_fallback is None
+    assert mapper.map_field_name == "modulus" and mapper.field_fallback is None
     assert mapper.unread_places == [(0.4, 0.2), (0.42, 0.2)]  # about both presses
     radius = unread_radius_m(config)
     assert radius == BOUNDARY_SPACING_ROI * config.touch.roi_size_m
     grid = mapper.grid  # the map itself still covers every cell
     gone = ((np.hypot(*(grid.cells_xy - (0.4, 0.2)).T) <= radius)
             | (np.hypot(*(grid.cells_xy - (0.42, 0.2)).T) <= radius))
-    choice = mapper._choice_grid
+    choice = mapper.choice_grid
     assert gone.any() and not (choice.target_mask & gone).any()
     assert (choice.target_mask == grid.target_mask & ~gone).all()
     assert (choice.stop_mask == grid.stop_mask & ~gone).all()
@@ -244,50 +236,40 @@ def test_under_unread_place_avoid_the_place_leaves_the_targets_and_the_stopping_
         assert target is not None
         assert min(np.hypot(*(target.xy - xy)) for xy in [(0.4, 0.2), (0.42, 0.2)]) > radius
     mapper.add(_poke((0.5, 0.3), _soft(6e3), n + 2))
-    assert mapper.config.field == "modulus"
+    assert mapper.map_field_name == "modulus"
     result = mapper.result("max_pokes", {})
     assert result.unread_places == ((0.4, 0.2), (0.42, 0.2)) and result.field_fallback is None
     assert (result.stop_cells == choice.stop_mask).all()
     assert result.max_variance == mapper.modulus_field.max_variance(choice.stop_mask)
-    # the former rule, `beta`, gives the same presses' run to β for good, on the whole grid
-    assert _mapper("modulus").config.unread_place == "avoid"  # the default
-    default = Mapper(Workspace(), ExplorationConfig(field="modulus", unread_place="beta"))
-    for poke in (_poke((0.1, 0.1), _soft(5e3), 0), _poke((0.4, 0.2), None, 1, error="too deep"),
-                 _poke((0.42, 0.2), None, 2, error="too deep")):
-        default.add(poke)
-    assert default.config.field == "beta" and default.unread_places == []
-    assert default.result("max_pokes", {}).stop_mask is not None
-    assert (default.result("max_pokes", {}).stop_cells == default.grid.stop_mask).all()
 
 
-def test_avoid_leaves_a_run_without_any_modulus_on_beta_with_every_place() -> None:
+def test_a_run_without_any_modulus_maps_on_beta_with_every_place() -> None:
     """A camera-only run maps on β, which reads the place: nothing is avoided."""
-    mapper = Mapper(Workspace(), ExplorationConfig(field="modulus", unread_place="avoid"))
+    mapper = Mapper(Workspace(), ExplorationConfig(field="modulus"))
     mapper.add(_poke((0.3, 0.2), None, 0, error="too deep"))
     mapper.add(_poke((0.305, 0.2), None, 1, error="too deep"))
-    assert mapper.config.field == "beta" and mapper.unread_places == []
-    assert (mapper._choice_grid.target_mask == mapper.grid.target_mask).all()
+    assert mapper.map_field_name == "beta" and mapper.unread_places == []
+    assert (mapper.choice_grid.target_mask == mapper.grid.target_mask).all()
     mapper.add(_poke((0.1, 0.1), _soft(5e3), 2))  # a modulus: back on the modulus field
-    assert mapper.config.field == "modulus" and mapper.field_fallback is None
+    assert mapper.map_field_name == "modulus" and mapper.field_fallback is None
     mapper.add(_poke((0.31, 0.2), None, 3, error="too deep"))  # the place again: now avoided
-    assert mapper.config.field == "modulus" and len(mapper.unread_places) == 3
+    assert mapper.map_field_name == "modulus" and len(mapper.unread_places) == 3
 
 
 def test_going_to_beta_after_avoided_places_gives_the_targets_back() -> None:
     small = Workspace(lower=(0.0, 0.0), upper=(0.12, 0.06))
-    mapper = Mapper(small, ExplorationConfig(field="modulus", unread_place="avoid",
-                                             max_pokes=8))
+    mapper = Mapper(small, ExplorationConfig(field="modulus", max_pokes=8))
     mapper.add(_poke((0.03, 0.03), _soft(5e3), 0))
     mapper.add(_poke((0.09, 0.03), None, 1, error="too deep"))
     mapper.add(_poke((0.09, 0.03), None, 2, error="too deep"))
-    assert mapper.config.field == "modulus" and len(mapper.unread_places) == 2
-    assert mapper._choice_grid.target_mask.sum() < mapper.grid.target_mask.sum()
+    assert mapper.map_field_name == "modulus" and len(mapper.unread_places) == 2
+    assert mapper.choice_grid.target_mask.sum() < mapper.grid.target_mask.sum()
     mapper.add(_poke((0.04, 0.03), None, 3, error="too deep"))
     mapper.add(_poke((0.04, 0.03), None, 4, error="too deep"))  # no target would be left
-    assert mapper.config.field == "beta"
+    assert mapper.map_field_name == "beta"
     assert "no target would be left without it" in (mapper.field_fallback or "")
-    assert (mapper._choice_grid.target_mask == mapper.grid.target_mask).all()
-    assert (mapper._choice_grid.stop_mask == mapper.grid.stop_mask).all()
+    assert (mapper.choice_grid.target_mask == mapper.grid.target_mask).all()
+    assert (mapper.choice_grid.stop_mask == mapper.grid.stop_mask).all()
 
 
 def test_a_grid_without_every_target_is_none_and_the_run_goes_to_beta() -> None:
@@ -305,12 +287,11 @@ def test_a_grid_without_every_target_is_none_and_the_run_goes_to_beta() -> None:
     assert (np.hypot(*(part.plan_candidates - (0.3, 0.2)).T) > 0.05).all()
     # a tiny workspace whose only place cannot be read: nothing left, so β for good
     small = Workspace(lower=(0.0, 0.0), upper=(0.06, 0.06))  # every target within the disc
-    mapper = Mapper(small, ExplorationConfig(field="modulus", unread_place="avoid",
-                                             max_pokes=4))
+    mapper = Mapper(small, ExplorationConfig(field="modulus", max_pokes=4))
     mapper.add(_poke((0.03, 0.03), _soft(5e3), 0))
     mapper.add(_poke((0.03, 0.03), None, 1, error="too deep"))
     mapper.add(_poke((0.031, 0.03), None, 2, error="too deep"))
-    assert mapper.config.field == "beta" and mapper.unread_places == []
+    assert mapper.map_field_name == "beta" and mapper.unread_places == []
     assert mapper.field_fallback is not None
     assert "no target would be left without it" in mapper.field_fallback
 
@@ -322,7 +303,7 @@ def test_the_planner_is_told_the_pokes_made_not_the_pokes_in_the_field() -> None
     mapper.add(_poke((0.3, 0.2), _soft(5e3), 0))
     mapper.add(_poke((0.1, 0.1), None, 1, error="left out"))
     mapper.add(_poke((0.5, 0.3), None, 2, error="left out"))
-    assert len(mapper.map_field.pokes) == 1 and mapper.config.field == "modulus"
+    assert len(mapper.map_field.pokes) == 1 and mapper.map_field_name == "modulus"
     target = mapper.next_target(np.random.default_rng(0))
     assert target is not None and target.plan is not None
     assert len(target.plan.targets) <= 1  # 4 pokes in all, 3 made: one left to plan
@@ -344,16 +325,16 @@ def test_under_the_modulus_field_the_beta_field_is_fitted_on_first_use_and_is_th
     for i, xy in enumerate(xys):
         mapper.add(_poke(xy, _soft(5e3 * (1 + 2 * (xy[0] > 0.3))), i))
     assert fits == []  # five pokes on the modulus field, no β-field fitted
-    lazy = mapper.field
-    assert len(fits) == 1 and mapper.field is lazy  # fitted once, then kept
+    lazy = mapper.beta_field
+    assert len(fits) == 1 and mapper.beta_field is lazy  # fitted once, then kept
     on_beta = _mapper("beta")  # fitted eagerly at every poke, as the β map needs it
     for i, xy in enumerate(xys):
         on_beta.add(_poke(xy, _soft(5e3 * (1 + 2 * (xy[0] > 0.3))), i))
     assert len(fits) == 1 + len(xys)
-    np.testing.assert_array_equal(lazy.mean, on_beta.field.mean)
-    np.testing.assert_array_equal(lazy.pokes.noise, on_beta.field.pokes.noise)
+    np.testing.assert_array_equal(lazy.mean, on_beta.beta_field.mean)
+    np.testing.assert_array_equal(lazy.pokes.noise, on_beta.beta_field.pokes.noise)
     mapper.add(_poke((0.2, 0.25), _soft(5e3), 5))  # a new poke: the next use fits it again
-    assert len(mapper.field.pokes) == 6 and len(fits) == 2 + len(xys)
+    assert len(mapper.beta_field.pokes) == 6 and len(fits) == 2 + len(xys)
 
 
 def test_a_resumed_run_finds_the_same_unread_places_from_its_journalled_records() -> None:
@@ -363,7 +344,7 @@ def test_a_resumed_run_finds_the_same_unread_places_from_its_journalled_records(
 
     from deformap.explore import PokeRecord
 
-    config = ExplorationConfig(field="modulus", unread_place="avoid", max_pokes=12)
+    config = ExplorationConfig(field="modulus", max_pokes=12)
     first = Mapper(Workspace(), config)
     for poke in (_poke((0.1, 0.1), _soft(5e3), 0), _poke((0.4, 0.2), None, 1, error="too deep"),
                  _poke((0.42, 0.2), None, 2, error="too deep"), _poke((0.5, 0.3), _soft(6e3), 3)):
@@ -374,6 +355,33 @@ def test_a_resumed_run_finds_the_same_unread_places_from_its_journalled_records(
         line = json.loads(json.dumps(added.record.to_dict()))
         resumed.add(PokeResult(PokeRecord.from_dict(line)))
     assert resumed.unread_places == first.unread_places
-    assert (resumed._choice_grid.target_mask == first._choice_grid.target_mask).all()
+    assert (resumed.choice_grid.target_mask == first.choice_grid.target_mask).all()
     assert resumed.max_variance() == first.max_variance()
-    assert resumed.config.field == "modulus"
+    assert resumed.map_field_name == "modulus"
+
+
+def test_the_field_choice_is_a_pure_function_of_the_pokes_and_the_choice_before() -> None:
+    from deformap.explore._choice import FieldChoice, choose_map_field
+
+    config = ExplorationConfig(field="modulus", max_pokes=12)
+    grid = MapGrid.build(Workspace(), config)
+    radius = unread_radius_m(config)
+    records = [_poke((0.1, 0.1), _soft(5e3), 0).record,
+               _poke((0.4, 0.2), None, 1, error="too deep").record,
+               _poke((0.42, 0.2), None, 2, error="too deep").record]
+    choice = FieldChoice(name="modulus", grid=grid)
+    for n in range(1, len(records) + 1):
+        modulus = ModulusField.of_records(records[:n], grid.xs, grid.ys, config.modulus_field,
+                                          config.stiffness.poisson_ratio)
+        before = choice
+        choice = choose_map_field(before, "modulus", records[:n], modulus, grid, radius)
+        again = choose_map_field(before, "modulus", records[:n], modulus, grid, radius)
+        assert (again.name, again.fallback, again.unread_places) == (
+            choice.name, choice.fallback, choice.unread_places)
+    assert choice.name == "modulus" and choice.fallback is None
+    assert choice.unread_places == ((0.4, 0.2), (0.42, 0.2))
+    assert choice.grid.target_mask.sum() < grid.target_mask.sum()
+    # under field: beta the choice is the β-field on the whole grid, whatever the pokes
+    beta = choose_map_field(choice, "beta", records, modulus, grid, radius)
+    assert beta.name == "beta" and beta.grid is grid and beta.unread_places == ()
+    assert config.field == "modulus"

@@ -13,13 +13,11 @@ from deformap.explore import (
     Mapper,
     PokeSet,
     beta_noise_floor,
-    beta_pokes,
-    estimate_nugget,
     field_settings,
     segment_regions,
-    with_nugget,
 )
 from deformap.explore._config import BetaFieldConfig
+from deformap.explore._nugget import beta_pokes, estimate_nugget, with_nugget
 from deformap.explore._targets import expected_noise
 from deformap.msm import ShapeMatchingConfig
 from deformap.testing import synthetic_poke
@@ -149,10 +147,10 @@ def test_the_mapper_fits_the_beta_field_with_the_nugget_and_plans_with_it() -> N
     places = [(0.15, 0.1), (0.45, 0.1), (0.15, 0.3), (0.45, 0.3), (0.3, 0.2)]
     for i, (xy, b) in enumerate(zip(places, ONE_FOAM, strict=True)):
         mapper.add(synthetic_poke(xy, b, 0.005, index=i))
-    pokes = mapper.field.pokes
+    pokes = mapper.beta_field.pokes
     assert pokes.nugget == beta_pokes([p.record for p in mapper.pokes], CONFIG).nugget > 0.015
-    assert mapper.field.gp is not None
-    assert np.allclose(mapper.field.gp.predict(pokes.xy[:1], return_std=True)[1] ** 2,
+    assert mapper.beta_field.gp is not None
+    assert np.allclose(mapper.beta_field.gp.predict(pokes.xy[:1], return_std=True)[1] ** 2,
                        _posterior_var_at_first(pokes), rtol=1e-6)
     # a press far from every poke is expected to carry the nugget too
     far = expected_noise(np.array([[0.55, 0.38]]), pokes, CONFIG)
@@ -184,18 +182,3 @@ def test_a_class_the_region_test_could_not_examine_gives_no_scatter() -> None:
     classes = segment_regions(np.zeros((1, 1)), betas, four.noise,
                               floor=beta_noise_floor(CONFIG)).poke_labels  # fmt: skip
     assert classes.tolist() == pairs.tolist()
-
-
-def test_the_former_betafield_of_still_works_and_says_it_is_deprecated() -> None:
-    from deformap.explore import BetaField
-
-    records = [synthetic_poke((0.1 + 0.1 * i, 0.2), 0.5 + 0.05 * i, index=i).record
-               for i in range(4)]
-    xs, ys = np.linspace(0.0, 0.6, 13), np.linspace(0.0, 0.4, 9)
-    for config, floor in ((BetaFieldConfig(), beta_noise_floor(ExplorationConfig())),
-                          (BetaFieldConfig(noise_floor=0.02), 0.02)):
-        with pytest.warns(DeprecationWarning, match="BetaField.of is deprecated"):
-            old = BetaField.of(records, xs, ys, config)
-        new = BetaField(PokeSet.of(records, floor), xs, ys, config)
-        np.testing.assert_array_equal(old.mean, new.mean)
-        assert old.pokes.nugget == 0.0 and float(old.pokes.noise.min()) >= floor

@@ -115,7 +115,7 @@ def test_the_loop_maps_an_environment_written_by_a_user(strategy: str) -> None:
     assert min(soft) > max(hard), (soft, hard)
     regions = result.regions
     assert regions is not None and regions.n_regions == 2
-    mean, var = result.field.mean, result.field.variance
+    mean, var = result.beta_field.mean, result.beta_field.variance
     assert mean[:, :10].mean() > mean[:, -10:].mean()
     assert var.shape == (32, 48)
 

@@ -9,7 +9,7 @@ from deformap.explore import BetaFieldConfig, ExplorationConfig, Mapper, beta_no
 from deformap.explore._acquisition import choose_target
 from deformap.explore._planning import plan_pokes
 from deformap.gp import GaussianRandomField
-from deformap.run import shared_report
+from deformap.run._report import shared_report
 from deformap.testing import synthetic_poke
 
 PRIOR = {"signal_std": 0.3, "length_scale": 0.2}
@@ -152,13 +152,13 @@ def test_the_paper_stop_rule_on_targets_only_stops_sooner() -> None:
     targets, n_targets = _pokes_until_known(ExplorationConfig(stop_region="targets",
                                                               beta_field=floor))
     assert n_whole == 5 and n_targets < n_whole
-    var = targets.field.variance
+    var = targets.beta_field.variance
     assert targets.max_variance() <= T_H < var.max()  # the edge band is left above T_h
     # the report's max variance is the one the stopping rule compared with T_h
     report = shared_report(targets.result("threshold", {}))
     assert report["max_variance"] == targets.max_variance() <= T_H
     assert report["max_variance_map"] == var.max()
-    assert whole.max_variance() == pytest.approx(whole.field.variance.max())
+    assert whole.max_variance() == pytest.approx(whole.beta_field.variance.max())
     assert whole.max_variance() <= T_H
     with pytest.raises(InvalidArgumentError, match="`stop_region` must be one of"):
         ExplorationConfig(stop_region="edges")  # type: ignore[arg-type]

@@ -130,7 +130,7 @@ def test_journal_lines_of_earlier_versions_are_read_as_written() -> None:
 
 
 def test_a_record_with_its_stiffness_survives_the_round_trip() -> None:
-    from deformap.explore import StiffnessEstimate
+    from deformap.stiffness import StiffnessEstimate
 
     soft = StiffnessEstimate(stiffness_n_per_m=120.0, stiffness_std_n_per_m=4.0,
                              stiffness_lower_n_per_m=None, modulus_pa=5000.0, modulus_std_pa=150.0,

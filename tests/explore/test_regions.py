@@ -4,14 +4,8 @@ import numpy as np
 import pytest
 
 from deformap.errors import InvalidArgumentError
-from deformap.explore._regions import (
-    RegionMap,
-    _ranked,
-    merge_seam_classes,
-    place_split,
-    segment_regions,
-    split_by_place,
-)
+from deformap.explore._classes import RegionMap, ranked, segment_regions
+from deformap.explore._places import merge_seam_classes, place_split, split_by_place
 
 
 def test_three_separated_classes_give_three_bands() -> None:
@@ -218,7 +212,7 @@ def _halves(rng: np.random.Generator, contrast: float, scatter: float = 0.05
 
 
 def _one_class(value: np.ndarray) -> RegionMap:
-    return _ranked(np.zeros((2, 2)), value, [np.arange(value.size)], np.arange(value.size))
+    return ranked(np.zeros((2, 2)), value, [np.arange(value.size)], np.arange(value.size))
 
 
 def test_two_close_materials_side_by_side_split_by_their_places() -> None:
@@ -256,7 +250,7 @@ def test_a_split_by_place_needs_the_values_apart_and_six_pokes_away_from_other_c
     assert place_split(value[:5], np.full(5, 0.05), xy[:5]) is None  # fewer than six pokes
     # every poke within reach of another class's (thickness 0.5 m): none tested, none split
     others = np.vstack([xy, [[0.3, 0.2]]])
-    found = _ranked(np.zeros((2, 2)), np.append(value, 12.0),
+    found = ranked(np.zeros((2, 2)), np.append(value, 12.0),
                     [np.arange(20), np.array([20])], np.arange(21))
     kept = split_by_place(found, np.zeros((2, 2)), others, np.append(value, 12.0),
                           np.full(21, 0.05), np.full(21, 0.5), max_regions=6)

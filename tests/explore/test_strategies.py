@@ -40,7 +40,7 @@ def test_level_set_pokes_where_the_cut_is_least_certain() -> None:
     mapper = _mapper("level-set", TWO_SIDES)
     target = mapper.next_target(np.random.default_rng(0))
     assert target is not None and target.purpose == "variance"
-    field, cells = mapper.field, mapper.grid.cells_xy
+    field, cells = mapper.beta_field, mapper.grid.cells_xy
     mean, std = field.mean.ravel(), np.sqrt(field.variance.ravel())
     levels = mapper.regions().levels
     assert levels.size == 1  # two classes, one isopleth
@@ -65,7 +65,7 @@ def test_level_set_with_one_class_looks_where_the_field_is_least_known() -> None
     assert mapper.regions().n_regions == 1
     target = mapper.next_target(np.random.default_rng(0))
     assert target is not None
-    var = mapper.field.variance.ravel()
+    var = mapper.beta_field.variance.ravel()
     reachable = np.where(mapper.grid.target_mask, var, -1.0)
     assert var[_cell(mapper, target.xy)] == pytest.approx(reachable.max())
 

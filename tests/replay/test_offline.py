@@ -22,7 +22,8 @@ from deformap.cloud import PointCloud
 from deformap.cloud.io import write_cloud
 from deformap.explore import Mapper, measure_press
 from deformap.replay import load_session, map_session, write_session
-from deformap.run import SHARED_KEYS, explore_scenario, load_run_config
+from deformap.run import explore_scenario, load_run_config
+from deformap.run._report import SHARED_KEYS
 
 SCENARIO = "heterogeneous-150-rigid"
 SEED = 3

@@ -75,12 +75,12 @@ def test_the_maps_as_numbers(full_run) -> None:  # type: ignore[no-untyped-def]
 
     folder, result = full_run.folder, full_run.result
     with np.load(folder / "map.npz") as grids:  # no pickle needed
-        assert str(grids["frame"]) == "world" and str(grids["field"]) == result.config.field
+        assert str(grids["frame"]) == "world" and str(grids["field"]) == result.map_field_name
         ny, nx = grids["ys_m"].size, grids["xs_m"].size
         for name in ("beta_mean", "beta_std", "modulus_median_pa", "log_modulus_mean",
                      "log_modulus_std", "region_labels"):
             assert grids[name].shape == (ny, nx), name
-        np.testing.assert_array_equal(grids["beta_mean"], result.field.mean)
+        np.testing.assert_array_equal(grids["beta_mean"], result.beta_field.mean)
         np.testing.assert_array_equal(grids["region_labels"], result.regions.labels)
         assert np.all(np.isfinite(grids["modulus_median_pa"]))  # the world gives records
         np.testing.assert_allclose(grids["modulus_median_pa"],

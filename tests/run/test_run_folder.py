@@ -12,17 +12,8 @@ import pytest
 from deformap import _files as files_module
 from deformap._validation import SettingError
 from deformap.errors import ConfigError
-from deformap.run import (
-    RunConfig,
-    atomic_path,
-    create_run_folder,
-    default_run_folder,
-    explore_scenario,
-    record_simulation,
-    run_stem,
-    write_json,
-    write_text,
-)
+from deformap.run import RunConfig, default_run_folder, explore_scenario, record_simulation
+from deformap.run._folder import atomic_path, create_run_folder, run_stem, write_json, write_text
 
 
 def test_one_naming_scheme_for_every_kind_of_run() -> None:
@@ -135,7 +126,7 @@ def test_json_is_strict_nan_as_null_dates_as_iso(tmp_path: Path) -> None:
 
     import numpy as np
 
-    from deformap.run import to_json
+    from deformap.run._folder import to_json
 
     data = {"nan": float("nan"), "inf": np.float64("inf"), "arr": np.array([1.0, np.nan]),
             "when": datetime.date(2020, 1, 2), "where": tmp_path, "ok": (1, True, None, "x")}

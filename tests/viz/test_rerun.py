@@ -107,10 +107,10 @@ def test_the_recording_logs_the_modulus_field_when_a_poke_has_a_modulus(tmp_path
         ExplorationConfig,
         ModulusField,
         PokeResult,
-        StiffnessEstimate,
         SurfaceGPConfig,
         explore,
     )
+    from deformap.stiffness import StiffnessEstimate
     from deformap.viz import record_run
 
     env = TwoFoamTable(np.random.default_rng(1))

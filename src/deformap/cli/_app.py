@@ -27,7 +27,7 @@ from rich.markup import escape
 from rich.text import Text
 from typer.core import TyperGroup
 
-from deformap import __version__, run
+from deformap import __version__
 from deformap._files import check_destination
 from deformap.errors import ConfigError, DeformapError, InvalidArgumentError
 
@@ -194,12 +194,14 @@ def emit_json(json_path: Path | None, data: Any) -> None:
     """Write ``data`` as JSON where ``--json`` says (nothing when it was not given)."""
     if json_path is None:
         return
+    from deformap.run._folder import to_json, write_json
+
     if _to_stdout(json_path):
-        sys.stdout.write(run.to_json(data, indent=None) + "\n")  # one line, for pipes
+        sys.stdout.write(to_json(data, indent=None) + "\n")  # one line, for pipes
         return
     try:
         json_path.parent.mkdir(parents=True, exist_ok=True)
-        run.write_json(json_path, data)
+        write_json(json_path, data)
     except OSError as exc:
         raise ConfigError(f"cannot write --json {str(json_path)!r}: {exc.strerror or exc}") from None
     out_console(json_path).print(f"wrote {json_path}", highlight=False)

@@ -194,8 +194,10 @@ def config_dump(
     if out is None:
         sys.stdout.write(text)
         return
+    from deformap.run._folder import write_text
+
     try:
-        run.write_text(out, text)
+        write_text(out, text)
     except OSError as exc:
         raise ConfigError(f"cannot write --out {str(out)!r}: {exc.strerror or exc}") from None
     out_console(None).print(f"wrote {out}")

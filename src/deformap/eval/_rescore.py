@@ -15,11 +15,12 @@ from deformap.explore import (
     BetaField,
     ExplorationConfig,
     MapGrid,
+    ModulusField,
     PokeSet,
     RegionLabels,
     map_regions,
-    with_nugget,
 )
+from deformap.explore._nugget import with_nugget
 
 __all__ = ["rescore_world"]
 
@@ -90,6 +91,6 @@ def _map_field(data: dict[str, list[Any]], poke: int, config: ExplorationConfig,
                     np.asarray(data["noise"], float)[keep], index[keep],
                     thickness=thickness)  # fmt: skip
     if config.field == "modulus":
-        return BetaField(pokes, grid.xs, grid.ys, config.modulus_field).mean, pokes
+        return ModulusField(pokes, grid.xs, grid.ys, config.modulus_field).mean, pokes
     pokes = with_nugget(pokes, config)
     return BetaField(pokes, grid.xs, grid.ys, config.beta_field).mean, pokes

@@ -38,7 +38,7 @@ def poke_data(pokes: PokeSet, thickness: Sequence[float | None]) -> PokeData:
     [m], ``None`` where a poke had none: ``PokeRecord.layer_thickness_m``), in the field's order.
     Floats keep every bit through JSON (``repr``)."""
     return {"x": [float(v) for v in pokes.xy[:, 0]], "y": [float(v) for v in pokes.xy[:, 1]],
-            "value": [float(v) for v in pokes.beta], "noise": [float(v) for v in pokes.noise],
+            "value": [float(v) for v in pokes.values], "noise": [float(v) for v in pokes.noise],
             "index": [int(v) for v in np.asarray(pokes.index)],
             "thickness": [None if t is None else float(t) for t in thickness]}
 

@@ -71,15 +71,15 @@ def _scores(mapper: Mapper, truth: _Truth,
     if len(mapper.modulus_field.pokes) and foam.any():
         rel = np.abs(mapper.modulus_field.median_pa[foam] / modulus[foam] - 1.0)
         modulus_error = float(np.median(rel))
-    beta = mapper.field.mean
+    beta = mapper.beta_field.mean
     spreads = [float(np.std(beta[(labels == k) & foam])) for k in np.unique(labels[foam])]
     shared = {"modulus_error": modulus_error,
               "beta_spread": float(np.mean(spreads)) if spreads else None}
     out = {}
     for cut in cuts:
         found = map_regions(field.mean, field.pokes, mapper.grid.cells_xy,
-                            replace(mapper.config,
-                                    region_labels=cast(RegionLabels, cut)))  # fmt: skip
+                            replace(mapper.config, region_labels=cast(RegionLabels, cut)),
+                            field.name)  # fmt: skip
         scores = region_scores(found.labels, labels, sign * field.mean, hardness)
         out[cut] = {"accuracy": scores.accuracy, "mean_iou": scores.mean_iou,
                     "found": scores.found, "true": scores.true,
@@ -113,7 +113,7 @@ def _map_one(world: SimulatedWorld, draw: WorldDraw, config: ExplorationConfig, 
                          finish=world.release, target=target, target_s=t_target)  # fmt: skip
         t1 = time.perf_counter()
         head = {"poke": index + 1, "purpose": poke.record.purpose,
-                "map_field": mapper.config.field,
+                "map_field": mapper.map_field_name,
                 "threshold": bool(mapper.max_variance() <= mapper.threshold)}
         for cut, scores in _scores(mapper, truth, cuts).items():
             rows.append({"cut": cut, **head, **scores,

@@ -1,26 +1,26 @@
 """Active exploration: the mapper and its concepts (surface model, dent and β, β-field, target
-choice, regions, stiffness and modulus from a force–travel record, the modulus field), the loop
+choice, regions, the modulus field over the stiffness a force–travel record gives), the loop
 that drives an ``Environment`` with it, the typed poke records and the session journal."""
 
 from __future__ import annotations
 
-from deformap.explore._acquisition import STRATEGIES, choose_target
+from deformap.explore._acquisition import STRATEGIES
+from deformap.explore._classes import RegionMap, segment_regions
 from deformap.explore._config import (
     BetaFieldConfig,
-    BoundaryScore,
     ExplorationConfig,
     FieldName,
     ModulusFieldConfig,
     RegionLabels,
     SurfaceGPConfig,
     TouchGPConfig,
-    UnreadPlace,
     check_exploration_budget,
 )
-from deformap.explore._dent import measure_press, roi_grid
+from deformap.explore._dent import measure_press
 from deformap.explore._field import (
     BetaField,
     FieldSettings,
+    PokeField,
     PokeSet,
     beta_noise_floor,
     field_settings,
@@ -32,15 +32,10 @@ from deformap.explore._journal import (
     JournalContents,
     read_journal,
 )
+from deformap.explore._labels import map_regions
 from deformap.explore._loop import MappingRun, explore, poke_step
 from deformap.explore._mapper import Mapper
-from deformap.explore._modulus import (
-    ModulusField,
-    ModulusReading,
-    modulus_reading,
-    rigid_modulus_bound,
-)
-from deformap.explore._nugget import estimate_nugget
+from deformap.explore._modulus import ModulusField, ModulusReading, rigid_modulus_bound
 from deformap.explore._records import (
     PURPOSES,
     ContactRecord,
@@ -51,32 +46,15 @@ from deformap.explore._records import (
     Purpose,
     Target,
 )
-from deformap.explore._regions import (
-    RegionMap,
-    beta_pokes,
-    map_regions,
-    merge_seam_classes,
-    segment_regions,
-    split_by_place,
-    with_nugget,
-)
 from deformap.explore._result import ExplorationResult, StopReason
-from deformap.explore._stiffness import (
-    LAYER_MODEL,
-    StiffnessConfig,
-    StiffnessEstimate,
-    estimate_stiffness,
-)
 from deformap.explore._surface import SurfaceModel, fit_surface
 
 __all__ = [
     "JOURNAL_NAME",
-    "LAYER_MODEL",
     "PURPOSES",
     "STRATEGIES",
     "BetaField",
     "BetaFieldConfig",
-    "BoundaryScore",
     "ContactRecord",
     "Dent",
     "ExplorationConfig",
@@ -91,6 +69,7 @@ __all__ = [
     "ModulusField",
     "ModulusFieldConfig",
     "ModulusReading",
+    "PokeField",
     "PokeRecord",
     "PokeResult",
     "PokeSet",
@@ -98,32 +77,20 @@ __all__ = [
     "Purpose",
     "RegionLabels",
     "RegionMap",
-    "StiffnessConfig",
-    "StiffnessEstimate",
     "StopReason",
     "SurfaceGPConfig",
     "SurfaceModel",
     "Target",
     "TouchGPConfig",
-    "UnreadPlace",
     "beta_noise_floor",
-    "beta_pokes",
     "check_exploration_budget",
-    "choose_target",
-    "estimate_nugget",
-    "estimate_stiffness",
     "explore",
     "field_settings",
     "fit_surface",
     "map_regions",
     "measure_press",
-    "merge_seam_classes",
-    "modulus_reading",
     "poke_step",
     "read_journal",
     "rigid_modulus_bound",
-    "roi_grid",
     "segment_regions",
-    "split_by_place",
-    "with_nugget",
 ]

@@ -19,13 +19,13 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from dataclasses import field as _field
-from typing import Any, Literal
+from typing import Literal
 
 from deformap._validation import SettingError, check_settings, setting
 from deformap.environment import Workspace
 from deformap.explore._acquisition import Strategy
-from deformap.explore._stiffness import StiffnessConfig
 from deformap.msm import ShapeMatchingConfig
+from deformap.stiffness import StiffnessConfig
 
 __all__ = [
     "MAX_MAP_CELLS",
@@ -33,7 +33,6 @@ __all__ = [
     "MAX_ROI_BAND_BYTES",
     "BetaFieldConfig",
     "BetaUncertainty",
-    "BoundaryScore",
     "DepthAnchor",
     "ExplorationConfig",
     "FieldName",
@@ -45,7 +44,6 @@ __all__ = [
     "TactileCap",
     "TouchGPConfig",
     "TouchModel",
-    "UnreadPlace",
     "check_exploration_budget",
 ]
 
@@ -65,11 +63,6 @@ FieldName = Literal["beta", "modulus"]
 NuggetEstimate = Literal["within-class", "off"]
 #: Where a poke's β uncertainty comes from (``ExplorationConfig.beta_uncertainty``).
 BetaUncertainty = Literal["camera-noise", "shape-matching"]
-#: How a boundary poke (and ``level-set``) scores a cell (``ExplorationConfig.boundary_score``).
-BoundaryScore = Literal["straddle", "nearest-poke"]
-#: What the modulus field does with a place whose modulus could not be read twice
-#: (``ExplorationConfig.unread_place``).
-UnreadPlace = Literal["beta", "avoid"]
 
 #: Most bytes of one band of the ROI's shape-matching system (:mod:`deformap.msm._linsys`); the
 #: β sweep holds a few arrays of that size at once, so 512 MiB keeps it within a few GiB.
@@ -347,14 +340,14 @@ class ExplorationConfig:
         (``F <= 4 E* R² / 3`` = 0.68 N) while denting them by millimetres, well above the
         camera's noise.
     max_regions : int
-        Most regions the map field is cut into, a count (:mod:`deformap.explore._regions`).
+        Most regions the map field is cut into, a count (:mod:`deformap.explore._classes`).
     region_prior_dof : float
         Degrees of freedom the pokes' claimed uncertainties count for in the region test.
         The test judges whether the values scatter more than one material's would; 7 is as
         much as eight presses on one foam; 0 ignores the claims (scale-free).
     region_labels : {"isopleth", "nearest", "indicator-kriging"}
         How cells get their region once the classes are found.
-        See :mod:`deformap.explore._regions`: ``isopleth``, the paper's, by the band of the map
+        See :mod:`deformap.explore._labels`: ``isopleth``, the paper's, by the band of the map
         field's mean a cell falls in; ``nearest`` (default, the cut that counted the regions of
         random worlds best), by the class of the nearest poke; ``indicator-kriging``, by the most
         probable class, each class's probability kriged from the pokes' class indicators
@@ -362,11 +355,11 @@ class ExplorationConfig:
     merge_seams : bool
         Whether to merge the classes that lie on a seam between two others before labelling.
         Every poke of such a class borders pokes of two others within twice the layer's thickness
-        (:func:`deformap.explore.merge_seam_classes`); on, because a press where two pieces meet
-        reads between or below both and would otherwise be a region of its own.
+        (:mod:`deformap.explore._places`); on, because a press where two pieces meet reads
+        between or below both and would otherwise be a region of its own.
     split_by_place : bool
         Whether to split a class whose pokes form two places of different values, before merging.
-        It needs six pokes away from the other classes (:func:`deformap.explore.split_by_place`);
+        It needs six pokes away from the other classes (:mod:`deformap.explore._places`);
         on, because two materials closer than the region test's smallest step, side by side, are
         otherwise one region.
     boundary_pokes : int
@@ -399,7 +392,7 @@ class ExplorationConfig:
         The shape-matching β estimate of each dent (:mod:`deformap.msm`).
     stiffness : StiffnessConfig
         Reading stiffness and Young's modulus from a press's force–travel record.
-        Used when the environment gives a record (:func:`deformap.explore.estimate_stiffness`).
+        Used when the environment gives a record (:func:`deformap.stiffness.estimate_stiffness`).
     """
 
     threshold: float = setting(0.06, gt=0.0)
@@ -416,26 +409,14 @@ class ExplorationConfig:
     merge_seams: bool = True
     split_by_place: bool = True
     boundary_pokes: int = setting(0, ge=0, le=1000)  # as for max_pokes
-    boundary_score: BoundaryScore = "straddle"
     beta_uncertainty: BetaUncertainty = "camera-noise"
     field: FieldName = "modulus"
-    unread_place: UnreadPlace = "avoid"
     surface: SurfaceGPConfig = _field(default_factory=SurfaceGPConfig)
     touch: TouchGPConfig = _field(default_factory=TouchGPConfig)
     beta_field: BetaFieldConfig = _field(default_factory=BetaFieldConfig)
     modulus_field: ModulusFieldConfig = _field(default_factory=ModulusFieldConfig)
     shape_matching: ShapeMatchingConfig = _field(default_factory=ShapeMatchingConfig)
     stiffness: StiffnessConfig = _field(default_factory=StiffnessConfig)
-
-    @staticmethod
-    def upgrade_settings(data: dict[str, Any]) -> dict[str, Any]:
-        """Files written before ``beta_uncertainty`` existed chose β's uncertainty with
-        ``touch.noise_samples`` alone (0: the shape matcher's own): read them as they meant."""
-        touch = data.get("touch")
-        if ("beta_uncertainty" not in data and isinstance(touch, dict)
-                and touch.get("noise_samples") == 0):
-            return {**data, "beta_uncertainty": "shape-matching"}
-        return data
 
     def __post_init__(self) -> None:
         check_settings(self)

@@ -38,11 +38,11 @@ from deformap.errors import DeformapError
 from deformap.explore._config import ExplorationConfig
 from deformap.explore._dent_noise import dent_error_samples
 from deformap.explore._records import ContactRecord, Dent, PokeRecord, PokeResult, PokeTimings
-from deformap.explore._stiffness import StiffnessEstimate, estimate_stiffness
 from deformap.explore._surface import SurfaceModel, crop_to
 from deformap.gp import GaussianRandomField
 from deformap.mechanics import layer_indentation_force
 from deformap.msm import estimate_beta
+from deformap.stiffness import StiffnessEstimate, estimate_stiffness
 
 __all__ = ["dent_visible", "measure_press", "roi_grid"]
 
@@ -64,7 +64,7 @@ radius from most views)."""
 def _force_fit(obs: PressObservation, stiffness: StiffnessEstimate | None,
                thickness: float | None, config: ExplorationConfig) -> NDArray[np.float64] | None:
     """``(2, 60)``: travel [m] over the record and the force [N] of the fitted contact model,
-    ``E g(t + δ₀)`` (:mod:`deformap.explore._stiffness`), for the poke's figure; ``None``
+    ``E g(t + δ₀)`` (:mod:`deformap.stiffness`), for the poke's figure; ``None``
     without a modulus."""
     record = obs.force_travel
     if record is None or stiffness is None or stiffness.modulus_pa is None or thickness is None:

@@ -1,8 +1,9 @@
-"""The β-field ("GPR β-field"): a Gaussian random field over the pokes' βs, each poke's
-uncertainty its noise (with a floor, plus the map's nugget: :mod:`deformap.explore._nugget`), read
-on the map's grid; and the settings any field the map runs on takes (:func:`field_settings`: the
-β-field's, or the modulus field's of :mod:`deformap.explore._modulus`, which is built on the same
-class).
+"""The fields over the pokes: :class:`PokeField`, a Gaussian random field over the pokes' values,
+each poke's uncertainty its noise, read on the map's grid; its two kinds, the β-field ("GPR
+β-field", :class:`BetaField`: each σ with a floor, plus the map's nugget,
+:mod:`deformap.explore._nugget`) and the modulus field over ln E
+(:class:`deformap.explore.ModulusField`, :mod:`deformap.explore._modulus`); and the settings
+either takes when the map runs on it (:func:`field_settings`).
 
 References
 ----------
@@ -12,10 +13,10 @@ for Machine Learning, Eq. 2.24 (posterior mean and variance with per-point noise
 
 from __future__ import annotations
 
-import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cached_property
+from typing import ClassVar
 
 import numpy as np
 from numpy.typing import NDArray
@@ -29,8 +30,8 @@ from deformap.explore._config import (
 from deformap.explore._records import PokeRecord
 from deformap.gp import GaussianRandomField
 
-__all__ = ["REGION_MIN_STEP_BETA", "BetaField", "FieldSettings", "PokeSet", "beta_noise_floor",
-           "field_settings"]
+__all__ = ["REGION_MIN_STEP_BETA", "BetaField", "FieldSettings", "PokeField", "PokeSet",
+           "beta_noise_floor", "field_settings"]
 
 #: Smallest difference of two region classes' mean β that separates them
 #: (:func:`deformap.explore.segment_regions`'s ``min_step`` under the β-field).
@@ -96,20 +97,20 @@ def field_settings(config: ExplorationConfig, name: FieldName | None = None) -> 
 class PokeSet:
     """Where the pokes were and what they gave, as arrays.
 
-    ``xy (p, 2)`` metres, ``beta (p,)`` the values the field is fitted to (β for the β-field, ln E
-    for the modulus field), ``noise (p,)`` each poke's uncertainty raised to the field's noise
-    floor and, with a nugget, ``√(σ² + nugget²)`` (what the field and the planner take as its
-    noise), ``index (p,)`` the pokes' indices in their run (``PokeRecord.index``; default
-    ``0 .. p-1``; a session's skipped poke and the modulus field's pokes without a modulus leave
-    gaps), ``nugget`` the scatter between places of one material added to every poke's noise
-    (0: none; :func:`deformap.explore._regions.with_nugget`), ``thickness (p,)`` the layer's
+    ``xy (p, 2)`` metres, ``values (p,)`` the values the field is fitted to (β for the β-field,
+    ln E [ln Pa] for the modulus field), ``noise (p,)`` each poke's uncertainty raised to the
+    field's noise floor and, with a nugget, ``√(σ² + nugget²)`` (what the field and the planner
+    take as its noise), ``index (p,)`` the pokes' indices in their run (``PokeRecord.index``;
+    default ``0 .. p-1``; a session's skipped poke and the modulus field's pokes without a modulus
+    leave gaps), ``nugget`` the scatter between places of one material added to every poke's
+    noise (0: none; :func:`deformap.explore._nugget.with_nugget`), ``thickness (p,)`` the layer's
     thickness at each poke in metres (:func:`layer_thickness`; ``None`` when not every poke has
     one), which bounds how far a junction can reach a press
-    (:func:`deformap.explore.merge_seam_classes`).
+    (:func:`deformap.explore._places.merge_seam_classes`).
     """
 
     xy: NDArray[np.float64]
-    beta: NDArray[np.float64]
+    values: NDArray[np.float64]
     noise: NDArray[np.float64]
     index: NDArray[np.int64] | None = None
     nugget: float = 0.0
@@ -117,10 +118,11 @@ class PokeSet:
 
     def __post_init__(self) -> None:
         if self.index is None:
-            object.__setattr__(self, "index", np.arange(self.beta.size, dtype=np.int64))
+            object.__setattr__(self, "index", np.arange(self.values.size, dtype=np.int64))
 
     @classmethod
     def of(cls, records: Sequence[PokeRecord], noise_floor: float) -> PokeSet:
+        """The pokes' βs, each σ raised to ``noise_floor``, no nugget."""
         xy = np.array([r.contact_xy for r in records], dtype=float).reshape(-1, 2)
         beta = np.array([r.beta for r in records], dtype=float)
         noise = np.maximum(np.array([r.beta_std for r in records], dtype=float), noise_floor)
@@ -129,7 +131,7 @@ class PokeSet:
                    thickness=layer_thickness(records))
 
     def __len__(self) -> int:
-        return int(self.beta.size)
+        return int(self.values.size)
 
 
 def layer_thickness(records: Sequence[PokeRecord]) -> NDArray[np.float64] | None:
@@ -141,45 +143,31 @@ def layer_thickness(records: Sequence[PokeRecord]) -> NDArray[np.float64] | None
     return np.array(values, dtype=float)
 
 
-class BetaField:
-    """The β-field of a set of pokes on the grid ``xs``, ``ys`` (no poke: the prior).
+class PokeField:
+    """A Gaussian random field over the values of a set of pokes, read on the grid ``xs``, ``ys``
+    (no poke: the prior).
 
     The prior mean is a constant, the pokes' inverse-noise-variance weighted mean
     (:class:`deformap.gp.GaussianRandomField`), so far from every poke the field reverts to what
-    the pokes say on average, not to an arbitrary zero.
+    the pokes say on average, not to an arbitrary zero. Each poke's noise is ``pokes.noise``,
+    floor and nugget included.
 
     Parameters
     ----------
     pokes : PokeSet
     xs : (nx,) float, ys : (ny,) float, metres
-    config : BetaFieldConfig
-        Prior standard deviation σe and length scale σw (any object with ``signal_std`` and
-        ``length_scale_m``: the modulus field passes its own). The pokes' noise is theirs, floor
-        and nugget included (the mapper's β-field: :func:`deformap.explore._regions.beta_pokes`).
+    config : BetaFieldConfig or ModulusFieldConfig
+        Prior standard deviation σe and length scale σw, in the field's units.
 
     Attributes
     ----------
+    name : {"beta", "modulus"}
+        Which field it is (:func:`field_settings` of that name gives its settings).
     mean, variance : (ny, nx) float
         Posterior mean (NaN without pokes) and variance, computed once on first use.
     """
 
-    name: FieldName = "beta"
-
-    @classmethod
-    def of(cls, records: Sequence[PokeRecord], xs: NDArray[np.float64], ys: NDArray[np.float64],
-           config: BetaFieldConfig) -> BetaField:
-        """Deprecated (0.1.0): the β-field of ``records``, each σ raised to the floor, no nugget.
-
-        The mapper's β-field is ``BetaField(beta_pokes(records, exploration_config), xs, ys,
-        exploration_config.beta_field)`` (:func:`deformap.explore.beta_pokes`: the floor and the
-        map's nugget). This keeps the former call's meaning: ``config.noise_floor``, or when it
-        is ``None`` the default β grid's quantisation (:func:`beta_noise_floor`), and no nugget.
-        """
-        warnings.warn("BetaField.of is deprecated and will be removed: use BetaField(beta_pokes("
-                      "records, exploration_config), xs, ys, exploration_config.beta_field), "
-                      "which adds the map's nugget", DeprecationWarning, stacklevel=2)
-        floor = beta_noise_floor(ExplorationConfig(beta_field=config))
-        return cls(PokeSet.of(records, floor), xs, ys, config)
+    name: ClassVar[FieldName]
 
     def __init__(self, pokes: PokeSet, xs: NDArray[np.float64], ys: NDArray[np.float64],
                  config: BetaFieldConfig | ModulusFieldConfig) -> None:
@@ -191,7 +179,7 @@ class BetaField:
             self.gp = GaussianRandomField(
                 length_scale=config.length_scale_m, signal_std=config.signal_std,
                 noise_std=float(pokes.noise.min()), method="exact",
-            ).fit(pokes.xy, pokes.beta, noise_std=pokes.noise)  # fmt: skip
+            ).fit(pokes.xy, pokes.values, noise_std=pokes.noise)  # fmt: skip
 
     @cached_property
     def _grid(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -213,3 +201,14 @@ class BetaField:
         """The largest variance over the flat cells ``mask`` (all cells by default)."""
         var = self.variance.ravel()
         return float(var.max() if mask is None else var[mask].max())
+
+
+class BetaField(PokeField):
+    """The β-field ("GPR β-field"): the field over the pokes' βs. The mapper's pokes are
+    :func:`deformap.explore._nugget.beta_pokes` (each σ raised to the floor, plus the map's nugget)."""
+
+    name: ClassVar[FieldName] = "beta"
+
+    def __init__(self, pokes: PokeSet, xs: NDArray[np.float64], ys: NDArray[np.float64],
+                 config: BetaFieldConfig) -> None:
+        super().__init__(pokes, xs, ys, config)

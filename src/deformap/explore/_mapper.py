@@ -2,9 +2,10 @@
 
 It orchestrates the concepts of the paper's process flow, each in its own module: the surface
 model (:mod:`._surface`), the dent and its β (:mod:`._dent`), the β-field (:mod:`._field`), the
-choice of the next target (:mod:`._targets`) and the regions (:mod:`._regions`). The live loop
-(:func:`deformap.explore.explore`) and a recorded session (:mod:`deformap.replay`) both feed it
-through :func:`deformap.explore.poke_step`, so a poke gives the same β whichever way it arrives.
+choice of the next target (:mod:`._targets`), the field it maps on (:mod:`._choice`) and the
+regions (:mod:`._labels`). The live loop (:func:`deformap.explore.explore`) and a recorded
+session (:mod:`deformap.replay`) both feed it through :func:`deformap.explore.poke_step`, so a
+poke gives the same β whichever way it arrives.
 
 References
 ----------
@@ -23,27 +24,23 @@ import numpy as np
 from deformap.cloud import PointCloud
 from deformap.environment import PressObservation, Workspace
 from deformap.errors import EnvironmentStateError
+from deformap.explore._choice import FieldChoice, choose_map_field, unread_radius_m
+from deformap.explore._classes import RegionMap
 from deformap.explore._config import ExplorationConfig, FieldName, check_exploration_budget
 from deformap.explore._dent import measure_press
-from deformap.explore._field import BetaField, field_settings
+from deformap.explore._field import BetaField, PokeField, field_settings
 from deformap.explore._grid import MapGrid
+from deformap.explore._labels import map_regions
 from deformap.explore._modulus import ModulusField
-from deformap.explore._records import PokeResult, Target
-from deformap.explore._regions import RegionMap, beta_pokes, map_regions
+from deformap.explore._nugget import beta_pokes
+from deformap.explore._records import PokeRecord, PokeResult, Target
 from deformap.explore._result import ExplorationResult
 from deformap.explore._surface import SurfaceModel, fit_surface
-from deformap.explore._targets import BOUNDARY_SPACING_ROI, choose_next
+from deformap.explore._targets import choose_next
 
-__all__ = ["Mapper", "unread_radius_m"]
+__all__ = ["Mapper"]
 
 logger = logging.getLogger(__name__)
-
-
-def unread_radius_m(config: ExplorationConfig) -> float:
-    """Radius [m] of one place: two presses this close are at one place, and an unread place's
-    disc of it leaves the targets and the stopping rule under ``unread_place: avoid``
-    (``BOUNDARY_SPACING_ROI`` ROIs: a dent spreads a few centimetres)."""
-    return float(BOUNDARY_SPACING_ROI * config.touch.roi_size_m)
 
 
 class Mapper:
@@ -64,17 +61,9 @@ class Mapper:
         self.grid = MapGrid.build(workspace, config)
         self.surface: SurfaceModel | None = None
         self._pokes: list[PokeResult] = []
-        self._field: BetaField | None = None  # fitted when first asked for (`field`)
+        self._beta_field: BetaField | None = None  # fitted when first asked for (`beta_field`)
         self._modulus = self._fit_modulus([])
-        self.threshold = field_settings(config).threshold
-        #: Why the run maps on β although ``config.field`` asked for the modulus (else None).
-        self.field_fallback: str | None = None
-        self._requested_field = config.field
-        self._given_up: str | None = None
-        #: places the modulus could not be read twice at (``unread_place: avoid``), and the grid
-        #: the targets and the stopping rule use: ``grid`` without them
-        self.unread_places: list[tuple[float, float]] = []
-        self._choice_grid = self.grid
+        self._choice = FieldChoice(name=config.field, grid=self.grid)
 
     @property
     def pokes(self) -> tuple[PokeResult, ...]:
@@ -82,12 +71,39 @@ class Mapper:
         return tuple(self._pokes)
 
     @property
-    def field(self) -> BetaField:
+    def map_field_name(self) -> FieldName:
+        """The field the run maps on now (:func:`deformap.explore._choice.choose_map_field`):
+        ``config.field``, or ``"beta"`` where a run that asked for the modulus field falls back."""
+        return self._choice.name
+
+    @property
+    def field_fallback(self) -> str | None:
+        """Why the run maps on β although ``config.field`` asked for the modulus (else None)."""
+        return self._choice.fallback
+
+    @property
+    def unread_places(self) -> list[tuple[float, float]]:
+        """The presses [m] of the places the modulus could not be read twice at, left out of
+        the targets and the stopping rule."""
+        return list(self._choice.unread_places)
+
+    @property
+    def choice_grid(self) -> MapGrid:
+        """The grid the targets and the stopping rule use: ``grid`` without the unread places."""
+        return self._choice.grid
+
+    @property
+    def threshold(self) -> float:
+        """``T_h`` of the map field (:func:`deformap.explore.field_settings`)."""
+        return field_settings(self.config, self.map_field_name).threshold
+
+    @property
+    def beta_field(self) -> BetaField:
         """The current β-field, fitted on first use after a poke: under ``field: modulus`` the
         loop does not need it, and its nugget costs a region test per poke."""
-        if self._field is None:
-            self._field = self._fit_beta(self._pokes)
-        return self._field
+        if self._beta_field is None:
+            self._beta_field = self._fit_beta(self._pokes)
+        return self._beta_field
 
     @property
     def modulus_field(self) -> ModulusField:
@@ -95,10 +111,10 @@ class Mapper:
         return self._modulus
 
     @property
-    def map_field(self) -> BetaField:
+    def map_field(self) -> PokeField:
         """The field the regions, the next target and the stopping rule run on
-        (``config.field``); ``threshold`` is its ``T_h``."""
-        return self._modulus if self.config.field == "modulus" else self.field
+        (:attr:`map_field_name`); ``threshold`` is its ``T_h``."""
+        return self._modulus if self.map_field_name == "modulus" else self.beta_field
 
     def _fit_beta(self, pokes: list[PokeResult]) -> BetaField:
         return BetaField(beta_pokes([p.record for p in pokes], self.config), self.grid.xs,
@@ -131,17 +147,16 @@ class Mapper:
         t0 = time.perf_counter()
         pokes = [*self._pokes, poke]
         modulus = self._fit_modulus(pokes)
-        if self._requested_field == "modulus":
-            self._choose_field(poke, modulus)
+        self._update_choice([p.record for p in pokes], modulus)
         # the β-field is fitted now only when it is the map field; otherwise on first use
-        field = None if self.config.field == "modulus" else self._fit_beta(pokes)
+        field = None if self.map_field_name == "modulus" else self._fit_beta(pokes)
         active = modulus if field is None else field
         record = poke.record
         if target is not None:
             record = dataclasses.replace(record, purpose=target.purpose,
                                          planned_after=target.planned_after)  # fmt: skip
         record = dataclasses.replace(
-            record, max_variance_after=active.max_variance(self._choice_grid.stop_mask),
+            record, max_variance_after=active.max_variance(self.choice_grid.stop_mask),
             timings=dataclasses.replace(record.timings, field_s=time.perf_counter() - t0,
                                         **dict(timings or {})),
         )  # fmt: skip
@@ -149,64 +164,28 @@ class Mapper:
         self._pokes.append(added)
         # a lazily fitted β-field holds the pokes' records, and ``added`` differs from ``poke``
         # only in what the field does not read (purpose, plan, variance after, timings)
-        self._field, self._modulus = field, modulus
+        self._beta_field, self._modulus = field, modulus
         return added
 
-    def _choose_field(self, poke: PokeResult, modulus: ModulusField) -> None:
-        """Under ``field: modulus``, the field to map on after ``poke``: the modulus field once a
-        poke has a modulus; the β-field while none has (a camera-only robot or session). Once the
-        modulus could not be read twice at one place (a further press there would read nothing
-        again, and the modulus field's variance there would never fall): under ``unread_place:
-        beta`` the β-field for good; under ``avoid`` the modulus field still, with that place
-        taken out of the targets and the stopping rule (the β-field for good only when nothing
-        would be left)."""
-        reading = modulus.readings[-1]
-        if self._given_up is None and reading.excluded is not None and self._pokes:
-            here = np.asarray(poke.record.contact_xy, dtype=float)
-            radius = unread_radius_m(self.config)
-            unread = {r.index for r in modulus.readings[:-1] if r.excluded is not None}
-            before = [np.asarray(p.record.contact_xy, dtype=float) for p in self._pokes
-                      if p.record.index in unread
-                      and np.hypot(*(np.asarray(p.record.contact_xy) - here)) <= radius]
-            # while no poke has a modulus the run maps on β, which reads the place: nothing to
-            # avoid yet (a later unread press there, once a modulus is read, is caught again)
-            avoid = self.config.unread_place == "avoid"
-            if before and not (avoid and not len(modulus.pokes)):
-                # the disc about every unread press of the place, not only the last
-                places = [*self.unread_places,
-                          *((float(x), float(y)) for x, y in (*before, here))]
-                left = self.grid.without(np.array(places), radius) if avoid else None
-                if left is not None:
-                    self.unread_places, self._choice_grid = places, left
-                    logger.warning("poke %d: the modulus could not be read twice at (%.3f, %.3f) "
-                                   "m (%s); that place is left out of the targets and the "
-                                   "stopping rule", poke.record.index + 1, here[0], here[1],
-                                   reading.excluded)  # fmt: skip
-                else:  # β reads every place: its targets and stopping rule are the whole grid's
-                    self._choice_grid = self.grid
-                    self._given_up = (f"poke {poke.record.index + 1}: the modulus could not be "
-                                      f"read twice at one place ({reading.excluded})"
-                                      + ("; no target would be left without it" if avoid
-                                         else ""))
-        if self._given_up is not None:
-            why = self._given_up
-        elif not len(modulus.pokes):
-            why = f"poke {poke.record.index + 1} gave no modulus ({reading.excluded})"
-        else:
-            why = None
-        fallback = None if why is None else f"`exploration.field` 'modulus' fell back to 'beta': {why}"
-        if fallback is not None and fallback != self.field_fallback:
+    def _update_choice(self, records: list[PokeRecord], modulus: ModulusField) -> None:
+        """The field to map on after the latest of ``records`` (:func:`choose_map_field`), with
+        a warning for each place it leaves out and each new reason to fall back to β."""
+        before = self._choice
+        self._choice = choose_map_field(before, self.config.field, records, modulus, self.grid,
+                                        unread_radius_m(self.config))  # fmt: skip
+        if len(self._choice.unread_places) > len(before.unread_places):
+            x, y = records[-1].contact_xy
+            logger.warning("poke %d: the modulus could not be read twice at (%.3f, %.3f) m (%s); "
+                           "that place is left out of the targets and the stopping rule",
+                           records[-1].index + 1, x, y, modulus.readings[-1].excluded)
+        fallback = self._choice.fallback
+        if fallback is not None and fallback != before.fallback:
             logger.warning("%s", fallback)
-        self.field_fallback = fallback
-        field: FieldName = "modulus" if fallback is None else "beta"
-        if field != self.config.field:
-            self.config = dataclasses.replace(self.config, field=field)
-            self.threshold = field_settings(self.config).threshold
 
     def max_variance(self) -> float:
         """The map field's largest variance where it must fall below ``threshold``
         (``stop_region``)."""
-        return self.map_field.max_variance(self._choice_grid.stop_mask)
+        return self.map_field.max_variance(self.choice_grid.stop_mask)
 
     def boundary_owed(self) -> int:
         """Boundary pokes still to make (``boundary_pokes`` less those made)."""
@@ -216,7 +195,7 @@ class Mapper:
     def next_target(self, rng: np.random.Generator) -> Target | None:
         """The next target (:func:`deformap.explore._targets.choose_next`), or ``None`` when the
         map is done."""
-        return choose_next(self._choice_grid, self.map_field, self.config, rng,
+        return choose_next(self.choice_grid, self.map_field, self.config, rng,
                            boundary_owed=self.boundary_owed(),
                            n_made=len(self._pokes))  # fmt: skip
 
@@ -225,15 +204,16 @@ class Mapper:
         if not self._pokes:
             raise EnvironmentStateError("no poke yet: the field has no regions")
         field = self.map_field
-        return map_regions(field.mean, field.pokes, self.grid.cells_xy, self.config)
+        return map_regions(field.mean, field.pokes, self.grid.cells_xy, self.config,
+                           self.map_field_name)
 
     def result(self, stop_reason: str, timings: Mapping[str, float]) -> ExplorationResult:
         """What the exploration produced, with the β-field and regions read once."""
         return ExplorationResult(
             config=self.config, workspace=self.workspace, grid=self.grid, surface=self.surface,
-            pokes=self.pokes, field=self.field, modulus_field=self._modulus,
+            pokes=self.pokes, beta_field=self.beta_field, modulus_field=self._modulus,
             regions=self.regions() if self._pokes else None,
             max_variance=self.max_variance(), stop_reason=stop_reason, timings=dict(timings),
-            field_fallback=self.field_fallback, unread_places=tuple(self.unread_places),
-            stop_mask=self._choice_grid.stop_mask,
+            map_field_name=self.map_field_name, field_fallback=self.field_fallback,
+            unread_places=self._choice.unread_places, stop_mask=self.choice_grid.stop_mask,
         )  # fmt: skip

@@ -1,9 +1,9 @@
 """The modulus field: a Gaussian random field over ln E (E in Pa) from the pokes' force–travel
-records, beside the β-field and built on the same class (:class:`deformap.explore.BetaField`).
+records, beside the β-field, both a :class:`deformap.explore.PokeField`.
 
 Each poke's value and noise
 ---------------------------
-A poke whose record gave a modulus (:class:`deformap.explore.StiffnessEstimate`) enters as
+A poke whose record gave a modulus (:class:`deformap.stiffness.StiffnessEstimate`) enters as
 ``ln E`` with the standard deviation ``σ_E / E`` (the delta method's σ of ln E), raised to the
 field's noise floor. A *rigid* poke has no modulus: it enters at its detection bound, the
 smallest modulus whose press would have travelled as far as the record's travel bound
@@ -27,13 +27,14 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cached_property
+from typing import ClassVar
 
 import numpy as np
 from numpy.typing import NDArray
 
 from deformap.errors import InvalidArgumentError
-from deformap.explore._config import ModulusFieldConfig
-from deformap.explore._field import BetaField, PokeSet, layer_thickness
+from deformap.explore._config import FieldName, ModulusFieldConfig
+from deformap.explore._field import PokeField, PokeSet, layer_thickness
 from deformap.explore._records import PokeRecord
 from deformap.mechanics import layer_indentation_force
 
@@ -73,7 +74,7 @@ def rigid_modulus_bound(record: PokeRecord, poisson_ratio: float) -> float:
 
     The record's lower bound on the stiffness bounds the travel from zero force to the commanded
     force ``F`` from above, ``δ_b = F / k_lower`` (at least the rigid test's travel bound: the
-    travel span plus two of its standard deviations, :func:`deformap.explore.estimate_stiffness`);
+    travel span plus two of its standard deviations, :func:`deformap.stiffness.estimate_stiffness`);
     a surface of modulus ``E_b = F / g(δ_b)`` (``g`` the bonded-layer force at unit modulus on the
     poke's layer, Hertz's half-space force without a layer thickness) would have travelled that
     far. A stiffer one travels less and reads rigid too, so ``E_b`` is where the record's
@@ -111,14 +112,14 @@ def modulus_reading(record: PokeRecord, config: ModulusFieldConfig,
                           float(estimate.modulus_std_pa / estimate.modulus_pa), False, None)
 
 
-class ModulusField(BetaField):
+class ModulusField(PokeField):
     """The modulus field over ln E of the pokes that have a modulus (no such poke: the prior).
 
     ``mean`` and ``variance`` are of ln E [ln Pa] on the grid; :attr:`median_pa` is ``exp(mean)``
     (the median of the log-normal posterior of E), :attr:`std` the standard deviation of ln E.
     """
 
-    name = "modulus"
+    name: ClassVar[FieldName] = "modulus"
 
     def __init__(self, pokes: PokeSet, xs: NDArray[np.float64], ys: NDArray[np.float64],
                  config: ModulusFieldConfig,

@@ -7,9 +7,8 @@ A poke's claimed σ is the camera's noise carried through the estimate
 (:mod:`deformap.explore._dent_noise`): a repeatability at that place. Pressed at another place of
 the same material β̂ also moves with what the camera's noise does not model (the foam's own
 variation, the dent's reconstruction at another spot, the contact's placement), so the spread of β̂
-between places on one material exceeds the claimed σ (README, "β separates hardness only under the
-force-driven protocol", 0.7–2.2 times it on the simulated foams). That excess was a constant floor
-of 0.015, measured on the simulated world's 150 N foam; it is now estimated from each map's pokes.
+between places on one material exceeds the claimed σ. That excess is estimated from each map's
+pokes.
 
 Model
 -----
@@ -40,10 +39,9 @@ say which pokes are one material whatever their distance, and removing each clas
 steps between materials. Only the classes the region test examined and kept whole count: a class
 of fewer pokes than the test examines (3 with the default ``region_prior_dof``) is no evidence of
 one material (two pokes are never split, so a pair straddling two foams would read their step as
-scatter; on the stiffening-foam world's heterogeneous-110-150 map that pair, 0.74 and 0.64, gave
-τ̂ = 0.036 after the second poke and merged the two foams' classes at the fourth before this rule).
+scatter, and that scatter could merge the two foams' classes).
 The classes depend on the noise and the noise on τ:
-:func:`deformap.explore._regions.with_nugget` starts from the claimed σ, estimates τ from the classes
+:func:`with_nugget` starts from the claimed σ, estimates τ from the classes
 found, finds the classes again with σᵢ² + τ² and repeats until the classes no longer change (at
 most :data:`MAX_ROUNDS` rounds). The region test's smallest step (``min_step``, 0.05 in β) keeps
 one material whose scatter the first round underrates from being cut in two.
@@ -58,16 +56,24 @@ variance parameters in hierarchical models. Bayesian Analysis 1(3), 515–534.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+from dataclasses import replace
+
 import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import minimize_scalar
 
 from deformap._validation import check_array
 from deformap.errors import InvalidArgumentError
+from deformap.explore._classes import segment_regions
+from deformap.explore._config import ExplorationConfig
+from deformap.explore._field import REGION_MIN_STEP_BETA, PokeSet, beta_noise_floor
+from deformap.explore._records import PokeRecord
 
-__all__ = ["MAX_ROUNDS", "estimate_nugget", "restricted_log_posterior"]
+__all__ = ["MAX_ROUNDS", "beta_pokes", "estimate_nugget", "restricted_log_posterior",
+           "with_nugget"]
 
-#: Most rounds of classes and nugget (:func:`deformap.explore._regions.with_nugget`).
+#: Most rounds of classes and nugget (:func:`with_nugget`).
 MAX_ROUNDS = 5
 
 _GRID = 241  # τ values of the coarse search, geometric between the scale / 1000 and the upper end
@@ -129,3 +135,41 @@ def estimate_nugget(beta: NDArray[np.float64], std: NDArray[np.float64],
                             options={"xatol": scale * 1e-4})
     tau = float(found.x) if found.success and -found.fun >= values[best] else float(taus[best])
     return tau
+
+
+def with_nugget(pokes: PokeSet, config: ExplorationConfig) -> PokeSet:
+    """``pokes`` (β, each noise its claimed σ at least the floor) with the map's nugget τ̂ added to
+    every poke's noise in variance, ``√(σᵢ² + τ̂²)`` (module docstring).
+
+    The classes are the region test's on the β values (:func:`deformap.explore.segment_regions` with the
+    exploration's ``max_regions``, ``region_prior_dof`` and the β-field's smallest step and floor):
+    found first with the claimed σ, τ̂ estimated within those the test examined (as many pokes as
+    it tests a group of: a smaller class, a pair above all, is no evidence of one material), found
+    again with the noise that τ̂ gives, until they no longer change (at most
+    :data:`MAX_ROUNDS` rounds). ``pokes`` unchanged under
+    ``beta_field.nugget: off``.
+    """
+    if config.beta_field.nugget == "off" or len(pokes) < 2:
+        return pokes
+    floor = beta_noise_floor(config)
+    flat = np.zeros((1, 1))
+    # the smallest class the region test examines (segment_regions: n ≥ 3 and ν₀ + n − 2 ≥ 2)
+    examined = max(3, int(np.ceil(4 - config.region_prior_dof)))
+    tau, labels = 0.0, None
+    for _ in range(MAX_ROUNDS):
+        found = segment_regions(flat, pokes.values, np.hypot(pokes.noise, tau), floor=floor,
+                                min_step=REGION_MIN_STEP_BETA, max_regions=config.max_regions,
+                                prior_dof=config.region_prior_dof).poke_labels  # fmt: skip
+        if labels is not None and np.array_equal(found, labels):
+            break
+        labels, before = found, tau
+        tau = estimate_nugget(pokes.values, pokes.noise, labels, min_class_size=examined)
+        if tau == before:  # the same noise finds the same classes again
+            break
+    return replace(pokes, noise=np.hypot(pokes.noise, tau), nugget=tau)
+
+
+def beta_pokes(records: Sequence[PokeRecord], config: ExplorationConfig) -> PokeSet:
+    """The pokes of the β-field as the mapper fits it: each poke's claimed σ raised to the floor
+    (:func:`deformap.explore.beta_noise_floor`), plus the map's nugget (:func:`with_nugget`)."""
+    return with_nugget(PokeSet.of(records, beta_noise_floor(config)), config)

@@ -18,8 +18,8 @@ from numpy.typing import NDArray
 from deformap.environment import ForceTravel, TactileContact
 from deformap.errors import FileFormatError, InvalidArgumentError
 from deformap.explore._planning import PokePlan
-from deformap.explore._stiffness import LAYER_MODEL, StiffnessEstimate
 from deformap.msm import BetaEstimate
+from deformap.stiffness import LAYER_MODEL, StiffnessEstimate
 
 __all__ = [
     "PURPOSES",
@@ -208,7 +208,7 @@ class PokeRecord:
         The camera's noise measured in the ROI (``None`` when β's uncertainty is not sampled).
     stiffness : StiffnessEstimate or None
         Stiffness and Young's modulus from the press's force–travel record
-        (:func:`deformap.explore.estimate_stiffness`); ``None`` without a record.
+        (:func:`deformap.stiffness.estimate_stiffness`); ``None`` without a record.
     layer_thickness_m : float or None
         The layer thickness the modulus was read with (the surface's height at the contact).
     stiffness_error : str or None

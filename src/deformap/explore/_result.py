@@ -11,12 +11,13 @@ import numpy as np
 from numpy.typing import NDArray
 
 from deformap.environment import Workspace
-from deformap.explore._config import ExplorationConfig
-from deformap.explore._field import BetaField
+from deformap.explore._classes import RegionMap
+from deformap.explore._config import ExplorationConfig, FieldName
+from deformap.explore._field import BetaField, PokeField
 from deformap.explore._grid import MapGrid
 from deformap.explore._modulus import ModulusField
+from deformap.explore._nugget import beta_pokes
 from deformap.explore._records import PokeResult
-from deformap.explore._regions import RegionMap, beta_pokes
 from deformap.explore._surface import SurfaceModel
 
 __all__ = ["ExplorationResult", "StopReason"]
@@ -39,13 +40,14 @@ class ExplorationResult:
     surface : SurfaceModel or None
     pokes : tuple of PokeResult
         In order.
-    field : BetaField
-        The β-field after the last poke (``field.mean``, ``field.variance``: ``(ny, nx)``).
+    beta_field : BetaField
+        The β-field after the last poke (``beta_field.mean``, ``beta_field.variance``:
+        ``(ny, nx)``).
     modulus_field : ModulusField
         The modulus field over ln E after the last poke (the prior when no poke has a modulus;
         ``modulus_field.readings`` says which pokes it holds and why the others are left out).
     regions : RegionMap or None
-        The regions of the map field (``map_field``: ``config.field``'s; ``None`` without pokes).
+        The regions of the map field (``map_field``; ``None`` without pokes).
     max_variance : float
         What the stopping rule compared with ``T_h`` (over ``stop_region``, in the map field's
         units: :func:`deformap.explore.field_settings`).
@@ -53,13 +55,15 @@ class ExplorationResult:
         A :data:`StopReason`.
     timings : mapping of str to float
         ``total_s``, ``observe_s``, ``surface_gp_s``, ``environment_s``.
+    map_field_name : {"beta", "modulus"}
+        The field the regions, the targets and the stopping rule ran on at the end: ``config.field``
+        (what was asked for), or ``"beta"`` where the run fell back (``field_fallback``).
     field_fallback : str or None
         Why the map is on the β-field although the run asked for the modulus field (no poke gave
-        a modulus); ``config.field`` is then ``"beta"``.
+        a modulus, or no target would be left without the unread places).
     unread_places : tuple of (x, y)
         The presses whose modulus could not be read at a place read twice in vain, whose discs
-        were taken out of the targets and the stopping rule (``exploration.unread_place:
-        avoid``), in the order found [m].
+        were taken out of the targets and the stopping rule, in the order found [m].
     stop_mask : (ny * nx,) bool or None
         The cells whose variance the stopping rule read: ``grid.stop_mask`` without those discs
         (``None``: ``grid.stop_mask``).
@@ -70,12 +74,13 @@ class ExplorationResult:
     grid: MapGrid
     surface: SurfaceModel | None
     pokes: tuple[PokeResult, ...]
-    field: BetaField
+    beta_field: BetaField
     modulus_field: ModulusField
     regions: RegionMap | None
     max_variance: float
     stop_reason: str
     timings: Mapping[str, float]
+    map_field_name: FieldName
     field_fallback: str | None = None
     unread_places: tuple[tuple[float, float], ...] = ()
     stop_mask: NDArray[np.bool_] | None = None
@@ -94,19 +99,19 @@ class ExplorationResult:
         return self.grid.ys
 
     @property
-    def map_field(self) -> BetaField:
-        """The field the regions and the stopping rule ran on (``config.field``)."""
-        return self.modulus_field if self.config.field == "modulus" else self.field
+    def map_field(self) -> PokeField:
+        """The field the regions and the stopping rule ran on (:attr:`map_field_name`)."""
+        return self.modulus_field if self.map_field_name == "modulus" else self.beta_field
 
     @property
     def has_modulus(self) -> bool:
         """Whether at least one poke has a modulus (the modulus field is more than its prior)."""
         return len(self.modulus_field.pokes) > 0
 
-    def field_after(self, n_pokes: int) -> BetaField:
+    def beta_field_after(self, n_pokes: int) -> BetaField:
         """The β-field as it was after the first ``n_pokes`` pokes (recordings, figures)."""
         if n_pokes == len(self.pokes):
-            return self.field
+            return self.beta_field
         return BetaField(beta_pokes([p.record for p in self.pokes[:n_pokes]], self.config),
                          self.grid.xs, self.grid.ys, self.config.beta_field)
 

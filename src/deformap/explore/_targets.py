@@ -18,15 +18,14 @@ from numpy.typing import NDArray
 from scipy.spatial import cKDTree
 
 from deformap.explore._acquisition import boundary_score, choose_target
-from deformap.explore._config import ExplorationConfig
-from deformap.explore._field import BetaField, PokeSet, field_settings
+from deformap.explore._classes import poke_classes
+from deformap.explore._config import ExplorationConfig, FieldName
+from deformap.explore._field import PokeField, PokeSet, field_settings
 from deformap.explore._grid import MapGrid
 from deformap.explore._planning import PokePlan, plan_pokes
 from deformap.explore._records import Target
-from deformap.explore._regions import poke_classes
 
-__all__ = ["BOUNDARY_SPACING_ROI", "choose_next", "expected_noise",
-           "nearest_poke_boundary_score"]
+__all__ = ["BOUNDARY_SPACING_ROI", "choose_next", "expected_noise"]
 
 logger = logging.getLogger(__name__)
 
@@ -35,16 +34,17 @@ BOUNDARY_SPACING_ROI = 0.25
 closer pokes would measure much the same foam again."""
 
 
-def expected_noise(candidates: NDArray[np.float64], pokes: PokeSet,
-                   config: ExplorationConfig) -> NDArray[np.float64]:
+def expected_noise(candidates: NDArray[np.float64], pokes: PokeSet, config: ExplorationConfig,
+                   field: FieldName | None = None) -> NDArray[np.float64]:
     """The β uncertainty a poke at each of ``candidates (c, 2)`` is expected to have: the largest
     of the pokes already made within ``BOUNDARY_SPACING_ROI`` ROIs of it (a dent spreads a few
     centimetres, so a press there measures that foam again, no better), else the map field's
-    noise floor (:func:`deformap.explore.field_settings`) with the map's nugget added in variance
+    noise floor (:func:`deformap.explore.field_settings` of ``field``, default ``config.field``)
+    with the map's nugget added in variance
     (``pokes.nugget``: any press carries the scatter between places of one material). So the
     target choice knows what a further press at a place can still reduce, and does not return to
     a place whose readings are noisy expecting a reading at the floor."""
-    floor = float(np.hypot(field_settings(config).noise_floor, pokes.nugget))
+    floor = float(np.hypot(field_settings(config, field).noise_floor, pokes.nugget))
     noise = np.full(len(candidates), floor)
     if len(pokes) == 0:
         return noise
@@ -56,23 +56,23 @@ def expected_noise(candidates: NDArray[np.float64], pokes: PokeSet,
     return noise
 
 
-def _plan(grid: MapGrid, pokes: PokeSet, config: ExplorationConfig, n_made: int) -> PokePlan:
+def _plan(grid: MapGrid, pokes: PokeSet, config: ExplorationConfig, n_made: int,
+          field: FieldName) -> PokePlan:
     """The plan with the fewest further pokes that brings the variance under ``T_h``."""
-    cfg = field_settings(config)
+    cfg = field_settings(config, field)
     return plan_pokes(
         pokes.xy, pokes.noise, grid.plan_candidates, grid.plan_domain,
         signal_std=cfg.signal_std, length_scale=cfg.length_scale_m,
-        new_noise=expected_noise(grid.plan_candidates, pokes, config),
+        new_noise=expected_noise(grid.plan_candidates, pokes, config, field),
         threshold=cfg.threshold, max_new=max(1, config.max_pokes - n_made),
     )  # fmt: skip
 
 
-def _straddle(grid: MapGrid, field: BetaField, pokes: PokeSet, config: ExplorationConfig
+def _straddle(grid: MapGrid, field: PokeField, pokes: PokeSet, config: ExplorationConfig
               ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:  # fmt: skip
     """The reachable cells at least ``BOUNDARY_SPACING_ROI`` ROIs from every poke and their
-    boundary scores: straddle (:func:`boundary_score` against the isopleths of the pokes'
-    classes), or under ``boundary_score: nearest-poke`` :func:`nearest_poke_boundary_score`
-    against the pokes' classes; ``σ`` alone before any poke; both empty when no cell is left."""
+    straddle scores (:func:`boundary_score` against the isopleths of the pokes' classes); ``σ``
+    alone before any poke; both empty when no cell is left."""
     allowed = grid.target_mask.copy()
     var = field.variance.ravel()
     if len(pokes) == 0:
@@ -82,42 +82,12 @@ def _straddle(grid: MapGrid, field: BetaField, pokes: PokeSet, config: Explorati
     if not allowed.any():
         return np.empty((0, 2)), np.empty(0)
     mean = field.mean
-    classes = poke_classes(mean, pokes, config)
-    if config.boundary_score == "nearest-poke":
-        score = nearest_poke_boundary_score(grid.cells_xy[allowed], pokes.xy,
-                                            classes.poke_labels)
-    else:
-        score = boundary_score(mean.ravel()[allowed], np.sqrt(var[allowed]), classes.levels)
+    classes = poke_classes(mean, pokes, config, field.name)
+    score = boundary_score(mean.ravel()[allowed], np.sqrt(var[allowed]), classes.levels)
     return grid.cells_xy[allowed], score
 
 
-def nearest_poke_boundary_score(cells: NDArray[np.float64], xy: NDArray[np.float64],
-                                labels: NDArray[np.integer]) -> NDArray[np.float64]:
-    """How uncertain the nearest-poke map's label of each of ``cells (n, 2)`` is, from the pokes
-    at ``xy (m, 2)`` of classes ``labels (m,)``: ``d₁ − (d₂ − d₁) / 2`` [m], ``d₁`` the distance
-    to the nearest poke and ``d₂`` to the nearest poke of another class than that one's. The
-    map's boundary is where ``d₂ = d₁`` (half of ``d₂ − d₁`` is about a cell's distance to it),
-    and where it truly lies is known only to within the distance to the pokes that place it; so a
-    cell scores high where the boundary may pass through it, and highest where that is farthest
-    from any poke. The straddle score's counterpart (:func:`boundary_score`: ``1.96 σ − |μ −
-    h|``) for the nearest-poke cut, whose boundaries are the pokes' and not the field's
-    isopleths. With one class, ``d₁`` alone (the least-known place, where a region not yet met
-    is most likely)."""
-    tree = cKDTree(xy)
-    d1, nearest = tree.query(cells, k=1)
-    labels = np.asarray(labels)
-    if np.unique(labels).size < 2:
-        return np.asarray(d1, dtype=float)
-    d2 = np.full(len(cells), np.inf)
-    for k in np.unique(labels):
-        others = xy[labels != k]
-        mine = labels[nearest] == k
-        if mine.any():
-            d2[mine] = cKDTree(others).query(cells[mine], k=1)[0]
-    return np.asarray(d1 - 0.5 * (d2 - d1), dtype=float)
-
-
-def _boundary(grid: MapGrid, field: BetaField, pokes: PokeSet,
+def _boundary(grid: MapGrid, field: PokeField, pokes: PokeSet,
               config: ExplorationConfig) -> NDArray[np.float64] | None:
     """Where a region boundary is least certain (:func:`_straddle`); ``None`` when no place is
     left."""
@@ -127,7 +97,7 @@ def _boundary(grid: MapGrid, field: BetaField, pokes: PokeSet,
     return np.array(cells[int(np.argmax(score))], dtype=float)
 
 
-def choose_next(grid: MapGrid, field: BetaField, config: ExplorationConfig,
+def choose_next(grid: MapGrid, field: PokeField, config: ExplorationConfig,
                 rng: np.random.Generator, *, boundary_owed: int,
                 n_made: int | None = None) -> Target | None:
     """The next target after the pokes ``field`` was fitted to, or ``None`` when the variance is
@@ -136,10 +106,10 @@ def choose_next(grid: MapGrid, field: BetaField, config: ExplorationConfig,
     Parameters
     ----------
     grid : MapGrid
-    field : BetaField
-        The current map field (the β-field, or the modulus field under ``config.field =
-        "modulus"``; its ``pokes`` are the pokes it holds), read with
-        :func:`deformap.explore.field_settings`.
+    field : PokeField
+        The current map field (the β-field or the modulus field; its ``pokes`` are the pokes it
+        holds), read with its own settings (:func:`deformap.explore.field_settings` of
+        ``field.name``).
     config : ExplorationConfig
     rng : numpy.random.Generator
         This choice's stream (``paper`` draws from it).
@@ -151,7 +121,7 @@ def choose_next(grid: MapGrid, field: BetaField, config: ExplorationConfig,
     """
     pokes = field.pokes
     variance = field.variance.ravel()
-    threshold = field_settings(config).threshold
+    threshold = field_settings(config, field.name).threshold
     if variance[grid.stop_mask].max() <= threshold:
         if boundary_owed == 0:
             return None
@@ -167,7 +137,7 @@ def choose_next(grid: MapGrid, field: BetaField, config: ExplorationConfig,
 
     def planner() -> NDArray[np.float64]:
         made = len(pokes) if n_made is None else n_made  # the field may leave pokes out
-        plans.append(_plan(grid, pokes, config, made))
+        plans.append(_plan(grid, pokes, config, made, field.name))
         return np.array(plans[-1].targets[0], dtype=float)
 
     if reachable.max() <= threshold:  # only the edge band is left

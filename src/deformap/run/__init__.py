@@ -7,11 +7,10 @@ One concept per module:
   resumed (:func:`resume_run_config`) or taken from a recorded session
   (:func:`session_run_config`); the run's random streams (:func:`run_generators`).
 - ``_folder``: the one run-folder policy: one naming scheme (:func:`default_run_folder`), new
-  folders only (:func:`create_run_folder`), every file written atomically (:func:`write_json`,
-  :func:`write_text`, :func:`atomic_path`).
-- ``_report``: the one ``report.json`` schema, one builder per kind of run
-  (:func:`live_report`, :func:`session_report`, :func:`estimate_report`) around the shared part
-  (:func:`shared_report`).
+  folders only, every file written atomically.
+- ``_report``: the one ``report.json`` schema, one builder per kind of run around the shared
+  part.
+- ``_export``: the maps as numbers (``map.npz``, ``pokes.csv``: :data:`POKES_CSV_COLUMNS`).
 - ``_figures``: the figures of a run folder.
 - ``_hooks``: :class:`RunHooks`, the progress callbacks every workflow takes.
 - the workflows, each a function with typed arguments returning a typed result:
@@ -49,28 +48,11 @@ if TYPE_CHECKING:
     from deformap.run._environment import explore_environment, load_environment, parse_env_args
     from deformap.run._estimate import EstimateOutput, estimate_one_poke
     from deformap.run._explore import RunOutput, explore_scenario
-    from deformap.run._export import POKES_CSV_COLUMNS, write_map_npz, write_pokes_csv
-    from deformap.run._figures import write_estimate_figures, write_map_figures, write_rerun
-    from deformap.run._folder import (
-        RUNS_ROOT,
-        atomic_path,
-        create_run_folder,
-        default_run_folder,
-        run_stem,
-        to_json,
-        write_json,
-        write_text,
-    )
+    from deformap.run._export import POKES_CSV_COLUMNS
+    from deformap.run._folder import RUNS_ROOT, default_run_folder
     from deformap.run._hooks import RunHooks, RunStart
     from deformap.run._map import MapOutput, map_recorded_session
     from deformap.run._record import RecordOutput, record_simulation
-    from deformap.run._report import (
-        SHARED_KEYS,
-        estimate_report,
-        live_report,
-        session_report,
-        shared_report,
-    )
     from deformap.run._reproduce import ReproduceOutput, reproduce
     from deformap.run._studies import (
         CLUSTER_SIZE_FOAMS,
@@ -93,25 +75,21 @@ if TYPE_CHECKING:
     )
     from deformap.run._worlds_engines import BLAS_THREAD_VARIABLES
 
-_MODULES = {
+_MODULES: dict[str, tuple[str, ...]] = {
     "_config": ("CONFIG_NAME", "RunConfig", "RunOverrides", "apply_overrides", "config_yaml",
-                "explore_run_config", "load_run_config",
-                "resume_run_config", "run_generators", "session_run_config"),
+               "explore_run_config", "load_run_config", "resume_run_config", "run_generators",
+               "session_run_config"),
     "_environment": ("explore_environment", "load_environment", "parse_env_args"),
     "_estimate": ("EstimateOutput", "estimate_one_poke"),
-    "_export": ("POKES_CSV_COLUMNS", "write_map_npz", "write_pokes_csv"),
     "_explore": ("RunOutput", "explore_scenario"),
-    "_figures": ("write_estimate_figures", "write_map_figures", "write_rerun"),
-    "_folder": ("RUNS_ROOT", "atomic_path", "create_run_folder", "default_run_folder", "run_stem",
-                "to_json", "write_json", "write_text"),
+    "_export": ("POKES_CSV_COLUMNS",),
+    "_folder": ("RUNS_ROOT", "default_run_folder"),
     "_hooks": ("RunHooks", "RunStart"),
     "_map": ("MapOutput", "map_recorded_session"),
     "_record": ("RecordOutput", "record_simulation"),
-    "_report": ("SHARED_KEYS", "estimate_report", "live_report",
-                "session_report", "shared_report"),
     "_reproduce": ("ReproduceOutput", "reproduce"),
     "_studies": ("CLUSTER_SIZE_FOAMS", "StudyOutput", "run_cluster_size_study",
-                 "run_hardness_study"),
+                "run_hardness_study"),
     "_world": ("ScenarioSummary", "scenario_summaries", "show_scenario"),
     "_worlds": ("RESCORABLE", "WorldsOutput", "bench_worlds", "load_worlds", "rescore_worlds"),
     "_worlds_config": ("WorldsBenchConfig", "exploration_with", "parse_assignments"),
@@ -125,7 +103,6 @@ __all__ = [
     "POKES_CSV_COLUMNS",
     "RESCORABLE",
     "RUNS_ROOT",
-    "SHARED_KEYS",
     "EstimateOutput",
     "MapOutput",
     "RecordOutput",
@@ -140,18 +117,14 @@ __all__ = [
     "WorldsBenchConfig",
     "WorldsOutput",
     "apply_overrides",
-    "atomic_path",
     "bench_worlds",
     "config_yaml",
-    "create_run_folder",
     "default_run_folder",
     "estimate_one_poke",
-    "estimate_report",
     "exploration_with",
     "explore_environment",
     "explore_run_config",
     "explore_scenario",
-    "live_report",
     "load_environment",
     "load_run_config",
     "load_worlds",
@@ -165,20 +138,9 @@ __all__ = [
     "run_cluster_size_study",
     "run_generators",
     "run_hardness_study",
-    "run_stem",
     "scenario_summaries",
-    "session_report",
     "session_run_config",
-    "shared_report",
     "show_scenario",
-    "to_json",
-    "write_estimate_figures",
-    "write_json",
-    "write_map_figures",
-    "write_map_npz",
-    "write_pokes_csv",
-    "write_rerun",
-    "write_text",
 ]
 
 

@@ -61,13 +61,13 @@ def write_map_npz(path: Path, result: ExplorationResult) -> Path:
         "xs_m": result.xs, "ys_m": result.ys,
         "frame": np.array("world"),
         "units": np.array("xs_m, ys_m: m; beta: 1; modulus_median_pa: Pa; log_modulus: ln Pa"),
-        "beta_mean": result.field.mean, "beta_std": np.sqrt(result.field.variance),
+        "beta_mean": result.beta_field.mean, "beta_std": np.sqrt(result.beta_field.variance),
         "modulus_median_pa": modulus.median_pa if result.has_modulus else nan,
         "log_modulus_mean": modulus.mean if result.has_modulus else nan,
         "log_modulus_std": modulus.std if result.has_modulus else nan,
         "region_labels": (result.regions.labels if result.regions is not None
                           else np.full(shape, -1, dtype=np.int64)),
-        "field": np.array(result.config.field),
+        "field": np.array(result.map_field_name),
     }  # fmt: skip
     with atomic_path(path) as tmp, open(tmp, "wb") as fh:
         np.savez_compressed(fh, **arrays)
@@ -117,7 +117,8 @@ def write_run_results(folder: Path, result: ExplorationResult, report: dict[str,
     if figures:
         hooks.stage("drawing figures")
         write_map_figures(folder, result, truth=truth,
-                          threshold=field_settings(result.config).threshold, title=title,
+                          threshold=field_settings(result.config,
+                                                   result.map_field_name).threshold, title=title,
                           poke_figures=poke_figures, variance_max=variance_max)  # fmt: skip
 
 

@@ -64,11 +64,11 @@ def write_map_figures(
         levels = regions.levels if result.config.region_labels == "isopleth" else None
         modulus = result.modulus_field.median_pa if result.has_modulus else None
         values = _class_values(result)  # what report.json says of each region
-        plot_map(result.xs, result.ys, beta=result.field.mean,
+        plot_map(result.xs, result.ys, beta=result.beta_field.mean,
                  variance=result.map_field.variance, contacts=contacts, labels=regions.labels,
                  levels=levels, truth_hardness=truth_hardness, threshold=threshold, title=title,
                  path=folder / "map.png", modulus_pa=modulus,
-                 region_field=result.config.field,
+                 region_field=result.map_field_name,
                  purposes=[p.record.purpose for p in result.pokes],
                  variance_max=variance_max, class_betas=values["class_betas"],
                  class_modulus_pa=values["class_modulus_median_pa"],

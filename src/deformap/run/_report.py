@@ -127,7 +127,7 @@ def _regions(result: ExplorationResult, truth: Any) -> tuple[dict[str, Any], lis
     col = np.abs(result.xs[None, :] - xy[:, :1]).argmin(axis=1)
     row = np.abs(result.ys[None, :] - xy[:, 1:]).argmin(axis=1)
     order = ordering_scores(found.labels, sign * found.class_betas, labels, hardness,
-                            sign * field.pokes.beta, labels[row, col])
+                            sign * field.pokes.values, labels[row, col])
     true_regions = [
         {"label": label, "hardness_n": _finite(h)} for label, h in sorted(hardness.items())
     ]
@@ -152,13 +152,13 @@ def shared_report(result: ExplorationResult, *, truth: Any = None) -> dict[str, 
         "pokes": pokes,
         "n_pokes": len(pokes),
         "stop_reason": result.stop_reason,
-        "field": result.config.field,
+        "field": result.map_field_name,
         "field_fallback": result.field_fallback,
         "unread_places": [list(xy) for xy in result.unread_places],
-        "threshold": field_settings(result.config).threshold,
+        "threshold": field_settings(result.config, result.map_field_name).threshold,
         "max_variance": result.max_variance,
         "max_variance_map": float(var.max()),
-        "beta_nugget": float(result.field.pokes.nugget),
+        "beta_nugget": float(result.beta_field.pokes.nugget),
         "regions": regions,
         "modulus_field": modulus_report(result),
     }

@@ -161,7 +161,7 @@ def _log_run(rec: Any, result: Any, pts: NDArray[np.float64]) -> None:
                 "world/press/dent",
                 rr.Mesh3D(vertex_positions=v, triangle_indices=t, vertex_colors=[60, 120, 230]),
             )
-        field = result.field_after(k)
+        field = result.beta_field_after(k)
         mean = field.mean
         if surface_mesh is not None:
             v, t = surface_mesh
@@ -201,7 +201,7 @@ def _log_regions(rec: Any, result: Any) -> None:
         return
     rec.set_time("poke", sequence=len(result.pokes))
     labels = np.asarray(regions.labels)
-    mean = np.asarray(result.field.mean)
+    mean = np.asarray(result.beta_field.mean)
     infos = []
     for k in np.unique(labels[labels >= 0]):
         colour = (np.array(colormaps["tab10"](int(k) % 10)[:3]) * 255).astype(np.uint8)

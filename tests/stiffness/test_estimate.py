@@ -13,13 +13,8 @@ from scipy.optimize import brentq
 
 from deformap._validation import SettingError
 from deformap.errors import InvalidArgumentError
-from deformap.explore import (
-    LAYER_MODEL,
-    StiffnessConfig,
-    StiffnessEstimate,
-    estimate_stiffness,
-)
 from deformap.mechanics import hertz_indentation, layer_correction, layer_indentation_force
+from deformap.stiffness import LAYER_MODEL, StiffnessConfig, StiffnessEstimate, estimate_stiffness
 
 R = 0.01  # the probe's tip radius, 1 cm
 NU = 0.33  # the estimator's default Poisson ratio: these records are made with the same one

@@ -1,0 +1,296 @@
+"""The region test: classes of the pokes' values on the map field (β, or ln E), and the
+isopleths between them.
+
+How the contour levels are chosen
+---------------------------------
+The paper draws "the best isopleth" of the β-field without saying how. We choose the levels from
+the data the field is trained on, the pokes' own estimates (the field's posterior at a poke is
+smoothed toward its neighbours, which fills the very gaps that separate classes), by divisive
+splitting with a calibrated test:
+
+1. Sort the βs; the best split of a group into a lower and an upper part is the one that explains
+   the largest share of its spread (Fisher's optimal split of ordered data): between-part sum of
+   squares B, within-part W.
+2. Splitting a sorted sample at its best point *always* separates the two means, so the split's
+   statistic ``T = B / (ν₀ s̄² + W)`` is compared with its own null distribution, simulated for
+   the group under one material: each poke's β its mean plus a normal error of the poke's own
+   uncertainty. ``s̄²`` is the group's mean squared uncertainty and ``ν₀`` (``prior_dof``) how
+   many degrees of freedom the claimed uncertainties are worth beside the scatter the βs show
+   (W): a moderated test (the claimed noise as a scaled-χ² prior on the scatter, as in Smyth
+   2004). ``ν₀ = 0`` is the scale-free test that trusts only the βs; a large ``ν₀`` is Cochran's
+   χ² test with known noise. The default 7 weighs the claimed noise like eight repeated presses
+   on one foam. The β-field's pokes carry
+   the map's nugget in their uncertainty (:mod:`deformap.explore._nugget`), itself estimated
+   within the classes this test finds (:func:`deformap.explore._nugget.with_nugget`).
+3. The same is done for the best split into three parts (two materials cannot always be told
+   from one by a binary split when a third sits between them); the more significant of the two
+   tests is used, at 5 % with a Bonferroni correction for testing both.
+4. A split is kept only if neighbouring parts' means differ by at least ``min_step`` and by more
+   than ``z`` standard errors (from the pokes' own uncertainties, at least ``floor``); each part
+   is then split in turn. A group is tested while the test has two degrees of freedom for the
+   scatter, ``ν₀ + n − 2 ≥ 2`` for ``n ≥ 3`` pokes: down to groups of 4 for the scale-free test,
+   which learns the scatter from the βs alone, and of 3 when the claimed noise counts
+   (``ν₀ ≥ 1``), so that a material met by a single poke beside two of another is still told
+   apart.
+
+Why not the scale-free test alone (``prior_dof=0``): with the few pokes a map needs, it must learn
+the scatter from the same few βs it splits (``n − 2`` degrees of freedom), so its null distribution
+is wide and two neighbouring foams go untold; the pokes' measured noise
+(:mod:`deformap.explore._dent_noise`) is the information it lacks. The isopleth between two
+neighbouring classes is the midpoint of their means; cells are labelled by the band of the β-field's
+mean they fall in, so a region is a level set of the map, and ``n_regions`` is the number of classes
+found.
+
+
+References
+----------
+Fisher, W. D. (1958). On grouping for maximum homogeneity. JASA 53(284), 789–798.
+Smyth, G. K. (2004). Linear models and empirical Bayes methods for assessing differential
+expression in microarray experiments. Stat. Appl. Genet. Mol. Biol. 3(1), Article 3.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from itertools import pairwise
+
+import numpy as np
+from numpy.typing import NDArray
+
+from deformap._validation import check_array, check_int, check_positive
+from deformap.explore._config import ExplorationConfig, FieldName
+from deformap.explore._field import PokeSet, field_settings
+
+__all__ = ["REGION_Z", "RegionMap", "poke_classes", "ranked", "segment_regions", "separated"]
+
+_NULL_SAMPLES = 4000
+_NULL_SEED = 20161115
+#: The value test's z (:func:`segment_regions`): standard errors between two parts' means.
+REGION_Z = 2.0
+
+
+@dataclass(frozen=True)
+class RegionMap:
+    """Regions of a β-field on a grid.
+
+    Attributes
+    ----------
+    labels : (ny, nx) int
+        Region of each cell, 0 for the lowest band of the field upwards (β-field: the stiffest
+        class first; modulus field, ln E: the softest first).
+    levels : (n_regions - 1,) float
+        The isopleths between bands, increasing.
+    class_betas : (n_regions,) float
+        Mean value of the pokes in each class (β, or ln E [ln Pa] for the modulus field).
+    poke_labels : (k,) int
+        The class of each poke, in the order the pokes were given (a class is a run of the sorted
+        βs, so a poke's class is not always the band its β falls in).
+    """
+
+    labels: NDArray[np.int64]
+    levels: NDArray[np.float64]
+    class_betas: NDArray[np.float64]
+    poke_labels: NDArray[np.int64]
+
+    @property
+    def n_regions(self) -> int:
+        return int(self.class_betas.size)
+
+    def nearest_poke(self, poke_xy: NDArray[np.float64],
+                     cells_xy: NDArray[np.float64]) -> RegionMap:
+        """The same classes, each cell labelled by the class of the poke nearest to it (ties: the
+        earliest poke) instead of by the band of the β-field it falls in.
+
+        Parameters
+        ----------
+        poke_xy : (k, 2) float, metres
+            Where the pokes were, in the order of ``poke_labels``.
+        cells_xy : (ny · nx, 2) float, metres
+            The cells of ``labels``, row-major.
+        """
+        pokes = check_array("poke_xy", poke_xy, (self.poke_labels.size, 2), what="metres")
+        cells = check_array("cells_xy", cells_xy, (self.labels.size, 2), what="metres")
+        # squared distances of every cell to every poke (a few dozen pokes): argmin keeps the
+        # earliest poke of a tie, which a k-d tree does not promise
+        d2 = np.sum((cells[:, None, :] - pokes[None, :, :]) ** 2, axis=-1)
+        nearest = np.argmin(d2, axis=1)
+        labels = self.poke_labels[nearest].reshape(self.labels.shape)
+        return RegionMap(labels=labels, levels=self.levels, class_betas=self.class_betas,
+                         poke_labels=self.poke_labels)
+
+
+def _best_splits(values: NDArray[np.float64]) -> tuple[NDArray, NDArray, NDArray, NDArray,
+                                                       NDArray]:  # fmt: skip
+    """Best 2- and 3-part splits of each sorted row of ``values (m, n)``.
+
+    Returns the between-part sums of squares of the best splits, ``b2 (m,)`` and ``b3 (m,)``, the
+    rows' total sums of squares ``spread (m,)``, and the cut indices, ``cut2 (m,)`` and ``cuts3
+    (m, 2)``.
+    """
+    m, n = values.shape
+    csum = np.concatenate([np.zeros((m, 1)), np.cumsum(values, axis=1)], axis=1)
+    spread = np.sum((values - values.mean(axis=1, keepdims=True)) ** 2, axis=1)
+
+    def part(i: NDArray, j: NDArray) -> NDArray:  # Σ² / size of the part [i, j)
+        return (csum[:, j] - csum[:, i]) ** 2 / (j - i)
+
+    base = csum[:, n] ** 2 / n
+    cut2 = np.arange(1, n)
+    between2 = part(np.zeros_like(cut2), cut2) + part(cut2, np.full_like(cut2, n)) - base[:, None]
+    i3, j3 = np.triu_indices(n, k=1)
+    keep = i3 >= 1
+    i3, j3 = i3[keep], j3[keep]
+    if i3.size:
+        zeros, ends = np.zeros_like(i3), np.full_like(i3, n)
+        between3 = part(zeros, i3) + part(i3, j3) + part(j3, ends) - base[:, None]
+    else:
+        between3 = np.zeros((m, 1))
+        i3 = j3 = np.array([1])
+    # round-off can leave a tiny between-sum on a row without spread
+    b2 = np.where(spread > 0, between2.max(axis=1), 0.0)
+    b3 = np.where(spread > 0, between3.max(axis=1), 0.0)
+    best3 = np.argmax(between3, axis=1)
+    return b2, b3, spread, cut2[np.argmax(between2, axis=1)], np.column_stack([i3[best3], j3[best3]])
+
+
+def _statistics(values: NDArray[np.float64], prior: float) -> tuple[NDArray, NDArray, NDArray,
+                                                                     NDArray]:  # fmt: skip
+    """Split statistics ``T = between / (prior + within)`` of the best 2- and 3-part splits of
+    each sorted row of ``values (m, n)``, with their cuts (see :func:`_best_splits`)."""
+    b2, b3, spread, cut2, cuts3 = _best_splits(values)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        t2 = np.nan_to_num(b2 / (prior + (spread - b2)))
+        t3 = np.nan_to_num(b3 / (prior + (spread - b3)))
+    return t2, t3, cut2, cuts3
+
+
+def _null(stds: NDArray[np.float64], prior_dof: float) -> tuple[NDArray, NDArray]:
+    """Sorted statistics t2, t3 of ``_NULL_SAMPLES`` draws of one material: each poke's β its
+    mean plus its own noise (``stds``, in the group's sorted order, which under one material is
+    unrelated to the noise)."""
+    rng = np.random.default_rng(_NULL_SEED)
+    draws = rng.standard_normal((_NULL_SAMPLES, stds.size)) * stds[None, :]
+    t2, t3, _, _ = _statistics(np.sort(draws, axis=1), prior_dof * float(np.mean(stds**2)))
+    return np.sort(t2), np.sort(t3)
+
+
+def _p_value(null_sorted: NDArray, observed: float) -> float:
+    above = null_sorted.size - np.searchsorted(null_sorted, observed, side="left")
+    return float((above + 1) / (null_sorted.size + 1))
+
+
+def separated(b: NDArray, s: NDArray, parts: list[NDArray], min_step: float, z: float) -> bool:
+    """Whether neighbouring parts' means differ by ``min_step`` and ``z`` standard errors."""
+    for lower, upper in pairwise(parts):
+        gap = b[upper].mean() - b[lower].mean()
+        error = np.hypot(np.sqrt(np.mean(s[lower] ** 2) / lower.size),
+                         np.sqrt(np.mean(s[upper] ** 2) / upper.size))  # fmt: skip
+        if gap <= max(min_step, z * error):
+            return False
+    return True
+
+
+def _split(b: NDArray, s: NDArray, group: NDArray, room: int, *, min_step: float, z: float,
+           prior_dof: float) -> list[NDArray] | None:  # fmt: skip
+    """The significant split of ``group`` into 2 or 3 parts, or None (5 %, Bonferroni over 2)."""
+    prior = prior_dof * float(np.mean(s[group] ** 2))
+    t2, t3, cut2, cuts3 = _statistics(b[group][None, :], prior)
+    null2, null3 = _null(s[group], prior_dof)
+    tests = [(_p_value(null2, float(t2[0])), [int(cut2[0])])]
+    if room >= 3 and group.size >= 6:
+        tests.append((_p_value(null3, float(t3[0])), [int(c) for c in cuts3[0]]))
+    for p_value, cuts in sorted(tests, key=lambda t: t[0]):
+        if p_value * len(tests) > 0.05:
+            break
+        parts = np.split(group, cuts)
+        if separated(b, s, parts, min_step, z):
+            return parts
+    return None
+
+
+def segment_regions(
+    beta_grid: NDArray[np.float64],
+    poke_beta: NDArray[np.float64],
+    poke_std: NDArray[np.float64],
+    *,
+    floor: float = 0.03,
+    min_step: float = 0.05,
+    z: float = 2.0,
+    max_regions: int = 6,
+    prior_dof: float = 7.0,
+) -> RegionMap:
+    """Label the cells of ``beta_grid`` by isopleths chosen from the pokes' β estimates.
+
+    Parameters
+    ----------
+    beta_grid : (ny, nx) float
+        Posterior mean of the β-field on the grid.
+    poke_beta, poke_std : (k,) float
+        The pokes' β estimates and their uncertainties.
+    floor : float
+        Smallest uncertainty a poke is credited with (the map field's noise floor:
+        :func:`poke_classes` passes the field's own; this function's default, 0.03, is for
+        direct callers).
+    min_step : float
+        Smallest difference of two class means that can separate them.
+    z : float
+        Standard errors of the difference of two class means needed to separate them.
+    max_regions : int
+        Most classes returned.
+    prior_dof : float
+        Degrees of freedom the pokes' uncertainties count for in the scatter the split test
+        expects (0: the scatter is estimated from the βs alone, a scale-free test).
+    """
+    grid = check_array("beta_grid", beta_grid, (None, None))
+    betas = check_array("poke_beta", poke_beta, (None,), min_rows=1)
+    stds = check_array("poke_std", poke_std, (betas.size,), what="standard deviations")
+    check_positive("floor", floor)
+    check_positive("min_step", min_step, allow_zero=True)
+    check_positive("z", z, allow_zero=True)
+    check_int("max_regions", max_regions, minimum=1)
+    check_positive("prior_dof", prior_dof, allow_zero=True)
+    order = np.argsort(betas, kind="stable")
+    b, s = betas[order], np.maximum(stds[order], floor)
+    pending: list[NDArray[np.int64]] = [np.arange(b.size)]
+    done: list[NDArray[np.int64]] = []
+    while pending:
+        group = pending.pop()
+        room = max_regions - len(done) - len(pending)
+        if group.size < 3 or prior_dof + group.size - 2 < 2 or room < 2:
+            done.append(group)
+            continue
+        parts = _split(b, s, group, room, min_step=min_step, z=z, prior_dof=prior_dof)
+        if parts is None:
+            done.append(group)
+        else:
+            pending += parts
+    return ranked(grid, b, done, order)
+
+
+def ranked(grid: NDArray[np.float64], values: NDArray[np.float64],
+            groups: list[NDArray[np.int64]], order: NDArray[np.int64]) -> RegionMap:
+    """The regions of the classes ``groups`` (indices into ``values``), numbered by their mean
+    value upwards, with the isopleths midway between neighbouring means; ``order`` maps an index
+    into ``values`` to the poke's place in the order the pokes were given."""
+    means = np.array([values[g].mean() for g in groups])
+    rank = np.argsort(means, kind="stable")
+    class_betas = means[rank]
+    poke_labels = np.empty(values.size, dtype=np.int64)
+    for k, g in enumerate(rank):
+        poke_labels[order[groups[g]]] = k
+    levels = (class_betas[:-1] + class_betas[1:]) / 2
+    labels = np.searchsorted(levels, grid, side="right").astype(np.int64)
+    return RegionMap(labels=labels, levels=levels, class_betas=class_betas,
+                     poke_labels=poke_labels)
+
+
+def poke_classes(mean: NDArray[np.float64], pokes: PokeSet, config: ExplorationConfig,
+                 field: FieldName | None = None) -> RegionMap:
+    """The pokes' classes and the isopleth labels of the map field's mean ``mean (ny, nx)``, by
+    :func:`segment_regions` with the exploration's settings (``max_regions``,
+    ``region_prior_dof``) and the noise floor and smallest step of the field ``field`` (default:
+    ``config.field``; :func:`deformap.explore.field_settings`: β, or ln E for ``"modulus"``)."""
+    cfg = field_settings(config, field)
+    return segment_regions(mean, pokes.values, pokes.noise, floor=cfg.noise_floor,
+                           min_step=cfg.min_step, max_regions=config.max_regions,
+                           prior_dof=config.region_prior_dof)  # fmt: skip

@@ -1,0 +1,54 @@
+"""The regions of the map field: the pokes' classes (:mod:`deformap.explore._classes`), junctions
+merged and classes split by place (:mod:`deformap.explore._places`), then each cell labelled
+(``ExplorationConfig.region_labels``).
+
+- ``isopleth``, the paper's: a cell takes the band of the field's mean it falls in between the
+  isopleths midway between neighbouring classes' means, so a region is a level set of the map.
+- ``nearest``, the default: a cell takes the class of the poke nearest to it
+  (:meth:`RegionMap.nearest_poke`). The isopleths of a field with a decimetre length scale are
+  smooth curves that revert towards the field's mean away from the pokes, and pokes placed to pin
+  a boundary do not move them much; the nearest-poke labels of the same pokes follow the pokes.
+- ``indicator-kriging``: a cell takes its most probable class, each class's probability kriged
+  from the pokes' class indicators with the map field's own covariance
+  (:mod:`deformap.explore._indicator`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from deformap.explore._classes import RegionMap, poke_classes
+from deformap.explore._config import ExplorationConfig, FieldName
+from deformap.explore._field import PokeSet, field_settings
+from deformap.explore._indicator import indicator_labels
+from deformap.explore._places import merge_seam_classes, split_by_place
+
+__all__ = ["map_regions"]
+
+
+def map_regions(mean: NDArray[np.float64], pokes: PokeSet, cells_xy: NDArray[np.float64],
+                config: ExplorationConfig, field: FieldName | None = None) -> RegionMap:
+    """The regions of the field ``field`` (default: ``config.field``) with mean ``mean (ny, nx)``
+    fitted to ``pokes``, as the exploration settings ask: classes by
+    :func:`deformap.explore.segment_regions` (``max_regions``, ``region_prior_dof``, the field's
+    noise floor and smallest step), junctions merged (``merge_seams``) and classes split by place
+    (``split_by_place``), cells labelled by isopleth, by nearest poke or by indicator kriging
+    (``region_labels``; ``cells_xy (ny · nx, 2)`` are the grid's cells)."""
+    settings = field_settings(config, field)
+    found = poke_classes(mean, pokes, config, field)
+    if config.merge_seams and found.n_regions >= 3:
+        found = merge_seam_classes(found, mean, pokes.xy, pokes.values, pokes.thickness)
+    if config.split_by_place:  # after the junctions: the parts it makes are not junctions
+        found = split_by_place(found, mean, pokes.xy, pokes.values,
+                               np.maximum(pokes.noise, settings.noise_floor),
+                               pokes.thickness, max_regions=config.max_regions)  # fmt: skip
+    if config.region_labels == "nearest":
+        return found.nearest_poke(pokes.xy, cells_xy)
+    if config.region_labels == "indicator-kriging":
+        labels = indicator_labels(pokes.xy, found.poke_labels, pokes.noise, cells_xy,
+                                  n_classes=found.n_regions, length_scale=settings.length_scale_m,
+                                  signal_std=settings.signal_std)  # fmt: skip
+        return RegionMap(labels=labels.reshape(found.labels.shape), levels=found.levels,
+                         class_betas=found.class_betas, poke_labels=found.poke_labels)
+    return found

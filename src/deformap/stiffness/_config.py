@@ -1,0 +1,142 @@
+"""The force–travel estimator's settings and what it returns (:mod:`deformap.stiffness`)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from deformap._validation import check_settings, setting
+from deformap.errors import InvalidArgumentError
+
+__all__ = ["LAYER_MODEL", "MIN_SAMPLES", "StiffnessConfig", "StiffnessEstimate", "force_std"]
+
+#: The contact model's name in :attr:`StiffnessEstimate.model`.
+LAYER_MODEL = "sphere-on-bonded-layer (Hertz + Dimitriadis 2002)"
+#: Fewest samples a record needs: the fit has two parameters, E and δ₀.
+MIN_SAMPLES = 3
+
+
+@dataclass(frozen=True, kw_only=True)
+class StiffnessConfig:
+    """How a force–travel record is read (:mod:`deformap.stiffness`: model, fit, rigid test,
+    defaults).
+
+    Parameters
+    ----------
+    poisson_ratio : float
+        ``ν`` of the surface's material, an assumption (open-cell foam: 0.33).
+    poisson_ratio_std : float
+        How uncertain that assumption is; σ(E) carries what it moves E by (a refit at
+        ``ν ± poisson_ratio_std``). The default 0.07 is the standard deviation of ν spread
+        uniformly over [0.2, 0.45], about Gibson & Ashby's 1/3 (:mod:`deformap.stiffness`); 0
+        claims ν is known.
+    travel_noise_m : float
+        Standard deviation of one travel reading (encoders through kinematics).
+    force_noise_rel, force_noise_abs_n : float
+        Standard deviation of one force reading: ``rel · |F| + abs``.
+    rigid_travel_sigmas : float
+        A record whose travel span at the commanded force is below this many ``travel_noise_m``
+        is rigid.
+    backwards_sigmas : float
+        How far, in standard deviations of the difference of two readings, travel or force may
+        step back between samples before the record is refused (noise moves them a little).
+    force_tolerance_rel, force_tolerance_abs_n : float
+        When the commanded force is given, the record's last force may differ from it by
+        ``rel · F + abs`` (or three force standard deviations, if larger) before it is refused:
+        the same rule as :class:`deformap.environment.PressObservation`'s, so that a record the
+        protocol accepts is read.
+    """
+
+    poisson_ratio: float = setting(0.33, ge=0.0, le=0.5)
+    poisson_ratio_std: float = setting(0.07, ge=0.0, le=0.25)
+    travel_noise_m: float = setting(5e-5, gt=0.0, lt=0.01)
+    force_noise_rel: float = setting(0.01, ge=0.0, lt=1.0)
+    force_noise_abs_n: float = setting(0.005, gt=0.0)
+    rigid_travel_sigmas: float = setting(3.0, gt=0.0)
+    backwards_sigmas: float = setting(4.0, gt=0.0)
+    force_tolerance_rel: float = setting(0.25, ge=0.0, le=1.0)
+    force_tolerance_abs_n: float = setting(0.05, ge=0.0)
+
+    def __post_init__(self) -> None:
+        check_settings(self)
+
+
+@dataclass(frozen=True, kw_only=True)
+class StiffnessEstimate:
+    """What one force–travel record says about the surface, in SI units.
+
+    Parameters
+    ----------
+    stiffness_n_per_m, stiffness_std_n_per_m : float or None
+        ``k = dF/dδ`` at the commanded force and its standard deviation; ``None`` when rigid.
+    stiffness_lower_n_per_m : float or None
+        When rigid, a lower bound on ``k`` (:mod:`deformap.stiffness`); otherwise ``None``.
+    modulus_pa, modulus_std_pa : float or None
+        Young's modulus from the contact model and its standard deviation; ``None`` when rigid.
+    contact_offset_m : float or None
+        The fitted indentation ``δ₀`` at zero travel; ``None`` when rigid.
+    depth_m : float
+        Indentation at the commanded force (the model's ``δ_c``); when rigid, the travel span
+        estimated by the rigid test.
+    max_chi : float or None
+        ``√(R δ_c) / h`` at the commanded force: the contact model holds for ``χ ≲ 1``.
+    reduced_chi2 : float or None
+        The fit's χ² per degree of freedom: about 1 when the model and the noise settings explain
+        the record, well above it when they do not; ``None`` when rigid.
+    rigid : bool
+        The surface is stiffer than the probe and arm can tell apart.
+    n_samples : int
+        Samples the estimate used (those within the tip's radius: :mod:`deformap.stiffness`).
+    model : str
+        The contact model (:data:`LAYER_MODEL`).
+    model_error_pa : float or None
+        The model-error part of ``modulus_std_pa`` (in quadrature with the rest): half the
+        difference between the moduli the record's lower and upper halves read, beyond what
+        their own noise explains (:mod:`deformap.stiffness`, Model error); 0 when they agree, ``None``
+        when rigid or the record has fewer than four samples (then not tested).
+    """
+
+    stiffness_n_per_m: float | None
+    stiffness_std_n_per_m: float | None
+    stiffness_lower_n_per_m: float | None
+    modulus_pa: float | None
+    modulus_std_pa: float | None
+    contact_offset_m: float | None
+    depth_m: float
+    max_chi: float | None
+    reduced_chi2: float | None
+    rigid: bool
+    n_samples: int
+    model: str = LAYER_MODEL
+    model_error_pa: float | None = None
+
+    def __post_init__(self) -> None:
+        if self.model != LAYER_MODEL:
+            raise InvalidArgumentError(f"`model` must be {LAYER_MODEL!r}; got {self.model!r}")
+        if isinstance(self.n_samples, bool) or not isinstance(self.n_samples, int) \
+                or self.n_samples < MIN_SAMPLES:
+            raise InvalidArgumentError(
+                f"`n_samples` must be an integer >= {MIN_SAMPLES}; got {self.n_samples!r}")
+        read = ("stiffness_n_per_m", "stiffness_std_n_per_m", "modulus_pa", "modulus_std_pa")
+        if self.rigid:
+            if any(getattr(self, n) is not None for n in (*read, "model_error_pa")) or not (
+                    self.stiffness_lower_n_per_m is not None and self.stiffness_lower_n_per_m > 0):
+                raise InvalidArgumentError(
+                    "a rigid estimate has no stiffness, modulus or model error, and a positive "
+                    "`stiffness_lower_n_per_m`")
+        elif any(getattr(self, n) is None or not np.isfinite(getattr(self, n))
+                 or getattr(self, n) < 0 or (getattr(self, n) == 0 and "std" not in n)
+                 for n in read):
+            raise InvalidArgumentError(
+                f"an estimate that is not rigid has finite {', '.join(read)}, the values "
+                "positive and their standard deviations not negative")
+        elif self.model_error_pa is not None and not (
+                np.isfinite(self.model_error_pa) and self.model_error_pa >= 0):
+            raise InvalidArgumentError(
+                f"`model_error_pa` must be None or finite and >= 0; got {self.model_error_pa!r}")
+
+def force_std(force: NDArray[np.float64], config: StiffnessConfig) -> NDArray[np.float64]:
+    """Standard deviation [N] of each force reading: ``force_noise_rel · |F| + force_noise_abs_n``."""
+    return np.asarray(config.force_noise_rel * np.abs(force) + config.force_noise_abs_n)

@@ -1,0 +1,213 @@
+"""Stiffness and Young's modulus from one force–travel record (:mod:`deformap.stiffness`)."""
+
+from __future__ import annotations
+
+import dataclasses
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from deformap._validation import check_array, check_positive
+from deformap.errors import InvalidArgumentError
+from deformap.stiffness._config import MIN_SAMPLES, StiffnessConfig, StiffnessEstimate, force_std
+from deformap.stiffness._fit import fit_record, model_error
+
+__all__ = ["estimate_stiffness"]
+
+# thicker than any foam a table-top probe presses: a larger value is a unit slip (millimetres)
+_MAX_THICKNESS_M = 2.0
+# the range the contact model is read in: the finite-thickness series holds for χ ≲ 1 (Dimitriadis
+# et al. 2002); past half the layer the tip nears the table and the foam under it nears its
+# collapse plateau (Gibson & Ashby, ch. 5), far outside the small-strain expansion the series is
+_MAX_CHI = 1.0
+_MAX_STRAIN = 0.5
+
+
+def _check_record(travel_m: Any, force_n: Any, config: StiffnessConfig,
+                  ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    travel = check_array("travel_m", travel_m, (None,), what="travels in metres",
+                         min_rows=MIN_SAMPLES)
+    force = check_array("force_n", force_n, (None,), what="forces in newtons",
+                        min_rows=MIN_SAMPLES)
+    if force.shape != travel.shape:
+        raise InvalidArgumentError(f"`force_n` must have one value per travel sample "
+                                   f"({travel.size}); got {force.size}")
+    if abs(travel[0]) > config.backwards_sigmas * config.travel_noise_m:
+        raise InvalidArgumentError(
+            f"`travel_m` must start at first contact (0 within its noise, "
+            f"{config.backwards_sigmas * config.travel_noise_m:.3g} m); got {travel[0]:.4g} m "
+            "(an absolute position rather than the travel since contact?)")
+    if force.min() < -3.0 * config.force_noise_abs_n:
+        raise InvalidArgumentError(
+            f"`force_n` must be the force pressing the surface, >= 0 within its noise; got "
+            f"{force.min():.4g} N (a sensor not zeroed, or its reaction force not negated?)")
+    step_t = config.backwards_sigmas * np.sqrt(2.0) * config.travel_noise_m
+    if np.any(np.diff(travel) < -step_t):
+        at = int(np.argmax(np.diff(travel) < -step_t)) + 1
+        raise InvalidArgumentError(
+            f"`travel_m` must not go backwards by more than its noise ({step_t:.3g} m); sample "
+            f"{at} goes back by {travel[at - 1] - travel[at]:.3g} m")
+    sigma = force_std(force, config)
+    step_f = config.backwards_sigmas * np.hypot(sigma[:-1], sigma[1:])
+    rise = force[-1] - force[0]
+    if rise <= config.backwards_sigmas * np.hypot(sigma[0], sigma[-1]) or np.any(
+            np.diff(force) < -step_f):
+        raise InvalidArgumentError(
+            f"`force_n` must rise from contact to the commanded force (no step back beyond its "
+            f"noise); got {force[0]:.4g} N to {force[-1]:.4g} N, smallest step "
+            f"{np.diff(force).min():.4g} N")
+    return travel, force
+
+
+def _travel_span(travel: NDArray[np.float64], force: NDArray[np.float64], force_c: float,
+                 sigma_t: float) -> tuple[float, float]:
+    """Travel gained from the first force to ``force_c`` by a straight line of travel against
+    force, and its standard deviation from the travel noise."""
+    centred = force - force.mean()
+    sxx = float(centred @ centred)
+    slope = float(centred @ travel) / sxx
+    span = slope * (force_c - force[0])
+    return span, sigma_t * abs(force_c - force[0]) / np.sqrt(sxx)
+
+
+def _check_thickness(thickness_m: float, travel: NDArray[np.float64]) -> float:
+    thickness = check_positive("thickness_m", thickness_m)
+    if thickness > _MAX_THICKNESS_M:
+        raise InvalidArgumentError(
+            f"`thickness_m` must be in metres, at most {_MAX_THICKNESS_M}; got {thickness} "
+            f"(millimetres?)")
+    if travel.max() >= thickness:
+        raise InvalidArgumentError(
+            f"`travel_m` must be in metres and below the layer's thickness ({thickness} m); got "
+            f"a travel of {travel.max()} (millimetres?)")
+    return thickness
+
+
+def estimate_stiffness(travel_m: Any, force_n: Any, *, tip_radius_m: float, thickness_m: float,
+                       commanded_force_n: float | None = None, thickness_std_m: float = 0.0,
+                       config: StiffnessConfig | None = None) -> StiffnessEstimate:
+    """Stiffness and Young's modulus with their uncertainties from one force–travel record.
+
+    Parameters
+    ----------
+    travel_m : (n,) float, metres
+        The probe's travel along the press direction since first contact, in time order,
+        ``n >= 3``; it may step back by no more than its noise.
+    force_n : (n,) float, newtons
+        The normal force at each sample; it rises from the contact threshold to the commanded
+        force.
+    tip_radius_m : float
+        Radius of the probe's spherical tip.
+    thickness_m : float
+        The elastic layer's thickness at the contact (the surface's height above the table), in
+        ``(0, 2]`` m; the travel must stay below it.
+    commanded_force_n : float, optional
+        The force the press was commanded to; the record's last force must be near it
+        (``config.force_tolerance_rel`` and ``force_tolerance_abs_n``). Default: the record's
+        largest force.
+    thickness_std_m : float
+        Standard deviation of ``thickness_m`` (the surface model's at the contact); E's
+        standard deviation includes what it moves E by (a refit at ``h ± σ_h``).
+    config : StiffnessConfig, optional
+
+    Returns
+    -------
+    StiffnessEstimate
+        ``k`` at the commanded force and ``E`` with their standard deviations
+        (:mod:`deformap.stiffness`), or ``rigid=True`` with ``None`` for both.
+
+    Raises
+    ------
+    InvalidArgumentError
+        Naming the argument: NaN or infinite values, fewer than three samples, a travel that does
+        not start at contact, a negative force, travel or force going backwards beyond their
+        noise, force not rising, a travel not below the thickness (millimetres for metres), a
+        last force far from the commanded one, a bad radius or thickness, or a record that leaves
+        the contact model's range (an indentation deeper than the tip's diameter, where the
+        sphere is buried and the stick holding it presses too; ``χ`` above 1; an indentation
+        deeper than half the layer; or a modulus on the fit's lower bound): the tip sank too
+        deep to read the layer.
+    """
+    config = StiffnessConfig() if config is None else config
+    radius = check_positive("tip_radius_m", tip_radius_m)
+    travel, force = _check_record(travel_m, force_n, config)
+    if commanded_force_n is None:
+        force_c = float(force.max())
+    else:
+        force_c = check_positive("commanded_force_n", commanded_force_n)
+        allowed = max(config.force_tolerance_rel * force_c + config.force_tolerance_abs_n,
+                      3.0 * float(force_std(np.array([force_c]), config)[0]))
+        if abs(force[-1] - force_c) > allowed:
+            raise InvalidArgumentError(
+                f"`force_n` must end near the commanded force {force_c} N (within {allowed:.3g} "
+                f"N); its last value is {force[-1]:.4g} N")
+    # rigid needs no layer: a board or the bare table, which a surface model may read as thin
+    span, span_std = _travel_span(travel, force, force_c, config.travel_noise_m)
+    if span < config.rigid_travel_sigmas * config.travel_noise_m:
+        bound = max(span, 0.0) + 2.0 * span_std
+        return StiffnessEstimate(
+            stiffness_n_per_m=None, stiffness_std_n_per_m=None,
+            stiffness_lower_n_per_m=float((force_c - force[0]) / bound), modulus_pa=None,
+            modulus_std_pa=None, contact_offset_m=None, depth_m=float(span), max_chi=None,
+            reduced_chi2=None, rigid=True, n_samples=int(travel.size))
+    thickness = _check_thickness(thickness_m, travel)
+    thickness_std = check_positive("thickness_std_m", thickness_std_m, allow_zero=True)
+    modulus, offset, cov, chi2_red, fit = fit_record(travel, force, radius, thickness, config)
+    for _ in range(2):  # keep the samples within the sphere's range (:mod:`deformap.stiffness`)
+        within = int(np.count_nonzero(np.cumprod(travel + offset <= radius)))
+        if within == travel.size:
+            break
+        if within < MIN_SAMPLES:
+            raise InvalidArgumentError(
+                f"`force_n`/`travel_m` leave the contact model's range: only {within} sample(s) "
+                f"lie within the tip's {radius * 1e3:.3g} mm radius (`tip_radius_m`), "
+                f"{MIN_SAMPLES} needed; deeper, the sphere's contact is no Hertz cap")
+        travel, force = travel[:within], force[:within]
+        modulus, offset, cov, chi2_red, fit = fit_record(travel, force, radius, thickness, config)
+    table = fit.table
+    depth_c = float(table.depth_at(np.array([force_c / modulus]))[0])
+    chi = float(np.sqrt(radius * depth_c) / thickness)
+    strain = depth_c / thickness
+    if depth_c > 2.0 * radius:
+        raise InvalidArgumentError(
+            f"`force_n`/`travel_m` leave the contact model's range: the tip sank "
+            f"{depth_c * 1e3:.3g} mm, more than its {2e3 * radius:.3g} mm diameter "
+            f"(`tip_radius_m` {radius:g} m): the sphere is buried and what holds it above "
+            f"presses the surface too")
+    if chi > _MAX_CHI or strain > _MAX_STRAIN or modulus <= 1.001 * table.low_bound:
+        raise InvalidArgumentError(
+            f"`force_n`/`travel_m` leave the contact model's range (χ = {chi:.2f}, at most "
+            f"{_MAX_CHI}; indentation {strain:.0%} of the {thickness:.3g} m layer, at most "
+            f"{_MAX_STRAIN:.0%}): the tip presses too deep into this layer to read its modulus")
+    modulus_var = max(cov[0, 0], 0.0)
+    error_pa = model_error(fit, modulus)  # what the record shows the model misses
+    if error_pa is not None:
+        modulus_var += error_pa**2
+    if thickness_std > 0:  # the layer's thickness is read from the surface model: its error too
+        moduli = [fit_record(travel, force, radius, max(thickness + d, 1.01 * travel.max()),
+                             config)[0] for d in (-thickness_std, thickness_std)]
+        modulus_var += ((moduli[1] - moduli[0]) / 2.0) ** 2
+    if config.poisson_ratio_std > 0:  # the material's ν is assumed, not measured: its spread too
+        nus = [min(max(config.poisson_ratio + d, 0.0), 0.5)
+               for d in (-config.poisson_ratio_std, config.poisson_ratio_std)]
+        moduli = [fit_record(travel, force, radius, thickness,
+                       dataclasses.replace(config, poisson_ratio=nu))[0] for nu in nus]
+        # the slope over the span actually taken (ν is clamped to [0, 0.5] at the ends)
+        slope = (moduli[1] - moduli[0]) / (nus[1] - nus[0])
+        modulus_var += (slope * config.poisson_ratio_std) ** 2
+    modulus_std = float(np.sqrt(modulus_var))
+
+    def stiffness_at(e: float) -> float:
+        return float(e * table.slope(table.depth_at(np.array([force_c / e])))[0])
+
+    step = 1e-4 * modulus
+    dk_de = (stiffness_at(modulus + step) - stiffness_at(modulus - step)) / (2.0 * step)
+    return StiffnessEstimate(
+        stiffness_n_per_m=stiffness_at(modulus),
+        stiffness_std_n_per_m=float(abs(dk_de) * modulus_std), stiffness_lower_n_per_m=None,
+        modulus_pa=modulus, modulus_std_pa=modulus_std, model_error_pa=error_pa,
+        contact_offset_m=offset,
+        depth_m=depth_c, max_chi=chi,
+        reduced_chi2=None if np.isnan(chi2_red) else float(chi2_red), rigid=False,
+        n_samples=int(travel.size))

@@ -1,0 +1,215 @@
+"""The force–travel record's fit: effective-variance weighted least squares of the travel on the
+bonded-layer model, its covariance, and the two-part model-error test (:mod:`deformap.stiffness`:
+Fit, Model error)."""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.optimize import minimize_scalar
+
+from deformap.mechanics import (
+    layer_chi_limit,
+    layer_indentation_force,
+    layer_indentation_stiffness,
+)
+from deformap.stiffness._config import StiffnessConfig, force_std
+
+__all__ = ["LayerTable", "RecordFit", "fit_record", "model_error"]
+
+_EFFECTIVE_VARIANCE_ROUNDS = 4
+_MODULUS_GRID = 61
+_TABLE_SIZE = 800
+# the fit stays below the depth where the series' force turns down (and at most χ = 3, far past
+# the series' range), where the inverse's slope still means something
+_CHI_FRACTION = 0.95
+_CHI_CAP = 3.0
+# the model-error test fits one modulus to each half of the record with one shared δ₀: three
+# parameters, at least one degree of freedom left (:mod:`deformap.stiffness`, Model error)
+_MIN_PART_SAMPLES = 4
+_PART_ROUNDS = 8
+
+
+class LayerTable:
+    """The bonded-layer force at unit modulus, ``g(δ)``, tabulated on ``[0, δ_lim]`` for its
+    inverse; ``δ_lim`` stays below the depth where the series' force stops rising and at most the
+    layer's thickness."""
+
+    def __init__(self, radius: float, thickness: float, nu: float) -> None:
+        self.radius, self.thickness, self.nu = radius, thickness, nu
+        self.low_bound = 0.0  # the softest modulus the fit may return (set by the fit)
+        chi_lim = min(_CHI_FRACTION * layer_chi_limit(nu), _CHI_CAP)
+        # nor deeper than the layer: with R < h that comes first (χ = √(R/h) < 1 at δ = h)
+        self.depth_limit = min((chi_lim * thickness) ** 2 / radius, thickness)
+        self.depth = self.depth_limit * np.geomspace(1e-9, 1.0, _TABLE_SIZE)
+        self.log_depth = np.log(self.depth)
+        self.log_force = np.log(layer_indentation_force(self.depth, radius, thickness, 1.0, nu))
+
+    @property
+    def force_limit(self) -> float:
+        """``g(δ_lim)``: the largest force per pascal the table holds."""
+        return float(np.exp(self.log_force[-1]))
+
+    def depth_at(self, force_per_pa: NDArray[np.float64]) -> NDArray[np.float64]:
+        """``g⁻¹``: log–log interpolation, Hertz's ``δ ∝ F^(2/3)`` below the table, ``δ_lim``
+        above it."""
+        u = np.log(np.maximum(force_per_pa, 1e-300))
+        below = self.log_depth[0] + (u - self.log_force[0]) / 1.5
+        inside = np.interp(u, self.log_force, self.log_depth)
+        return np.asarray(np.exp(np.where(u < self.log_force[0], below, inside)))
+
+    def slope(self, depth: NDArray[np.float64]) -> NDArray[np.float64]:
+        """``g'(δ)`` at unit modulus, N/m per Pa."""
+        return layer_indentation_stiffness(np.maximum(depth, self.depth[0]), self.radius,
+                                           self.thickness, 1.0, self.nu)
+
+
+class RecordFit:
+    """Effective-variance weighted least squares of ``t = g⁻¹(F / E) − δ₀``
+    (:mod:`deformap.stiffness`, Fit)."""
+
+    def __init__(self, travel: NDArray[np.float64], force: NDArray[np.float64],
+                 table: LayerTable, config: StiffnessConfig) -> None:
+        self.travel, self.force, self.table, self.config = travel, force, table, config
+        self.force_std = force_std(force, config)
+        self.weights = np.full(travel.size, 1.0 / config.travel_noise_m**2)
+        self.low_bound = 0.0
+
+    def depths(self, modulus: float) -> NDArray[np.float64]:
+        return self.table.depth_at(self.force / modulus)
+
+    def offset(self, modulus: float) -> float:
+        """The weighted least-squares ``δ₀`` at ``modulus`` (closed form), kept at or above
+        ``−3 σ_t``."""
+        gap = self.depths(modulus) - self.travel
+        return max(float(self.weights @ gap / self.weights.sum()),
+                   -3.0 * self.config.travel_noise_m)
+
+    def chi2(self, log_modulus: float) -> float:
+        modulus = float(np.exp(log_modulus))
+        r = self.travel + self.offset(modulus) - self.depths(modulus)
+        return float(self.weights @ (r * r))
+
+    def reweight(self, modulus: float) -> None:
+        """Each sample's variance: the travel's plus the force's carried through ``g⁻¹``."""
+        ddepth_dforce = 1.0 / (modulus * self.table.slope(self.depths(modulus)))
+        self.weights = 1.0 / (self.config.travel_noise_m**2
+                              + (self.force_std * ddepth_dforce) ** 2)
+
+    def solve(self) -> float:
+        f_max = float(self.force.max())
+        # the softest modulus keeps the largest force inside the table; the stiffest sinks the
+        # tip by a thousandth of the travel noise
+        low = np.log(f_max / self.table.force_limit)
+        high = np.log(f_max / float(layer_indentation_force(
+            1e-3 * self.config.travel_noise_m, self.table.radius, self.table.thickness, 1.0,
+            self.table.nu)))
+        self.low_bound = float(np.exp(low))
+        log_modulus = low
+        for _ in range(_EFFECTIVE_VARIANCE_ROUNDS):
+            grid = np.linspace(low, high, _MODULUS_GRID)
+            values = [self.chi2(x) for x in grid]
+            best = int(np.argmin(values))
+            lo, hi = grid[max(best - 1, 0)], grid[min(best + 1, grid.size - 1)]
+            found = minimize_scalar(self.chi2, bounds=(lo, hi), method="bounded",
+                                    options={"xatol": 1e-6})
+            log_modulus = float(found.x) if found.fun <= values[best] else float(grid[best])
+            self.reweight(float(np.exp(log_modulus)))
+        return float(np.exp(log_modulus))
+
+    def covariance(self, modulus: float) -> tuple[NDArray[np.float64], float]:
+        """Covariance of ``(E, δ₀)`` from the weighted residuals' Jacobian, Birge-scaled, and
+        the reduced χ²."""
+        sw = np.sqrt(self.weights)
+        depth = self.depths(modulus)
+        # ∂δᵢ/∂E = −(Fᵢ / E²) / g'(δᵢ); the residual is t + δ₀ − δ
+        d_depth = -(self.force / modulus**2) / self.table.slope(depth)
+        # columns in relative units (E's fraction, δ₀ in travel-noise units): the raw ones differ
+        # by ten orders of magnitude
+        scale = np.array([modulus, self.config.travel_noise_m])
+        jac = np.column_stack([-d_depth * sw, sw]) * scale
+        if self.offset_clamped(modulus):  # δ₀ sits on its bound: not a free parameter there
+            scale, jac = scale[:1], jac[:, :1]
+        dof = self.force.size - jac.shape[1]
+        chi2_red = self.chi2(float(np.log(modulus))) / dof if dof > 0 else float("nan")
+        cov = np.linalg.pinv(jac.T @ jac) * np.outer(scale, scale)
+        if dof > 0 and chi2_red > 1.0:
+            cov = cov * chi2_red
+        return cov, chi2_red
+
+    def offset_clamped(self, modulus: float) -> bool:
+        """Whether the best ``δ₀`` at ``modulus`` lies on its ``−3 σ_t`` bound."""
+        gap = self.depths(modulus) - self.travel
+        return float(self.weights @ gap / self.weights.sum()) < -3.0 * self.config.travel_noise_m
+
+    def part_difference(self, modulus: float) -> tuple[float, float] | None:
+        """The two-part model's ``log E_hi − log E_lo`` and its standard deviation (module
+        docstring, Model error), or ``None`` when the record has too few samples to tell.
+
+        The lower samples (the first ``n // 2``) read ``E_lo``, the others ``E_hi``, all one
+        ``δ₀`` (held at the joint fit's when that sits on its bound); Gauss–Newton from the joint
+        fit with its effective-variance weights, the covariance Birge-scaled like the joint
+        fit's."""
+        n = self.force.size
+        if n < _MIN_PART_SAMPLES:
+            return None
+        upper = np.arange(n) >= n // 2
+        free_offset = not self.offset_clamped(modulus)
+        sigma_t = self.config.travel_noise_m
+        # (log E_lo, log E_hi, δ₀ / σ_t): columns of one order of magnitude
+        params = np.array([np.log(modulus), np.log(modulus), self.offset(modulus) / sigma_t])
+        sw = np.sqrt(self.weights)
+
+        def linearise(p: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+            per_sample = np.exp(np.where(upper, p[1], p[0]))
+            depth = self.table.depth_at(self.force / per_sample)
+            # the residual t + δ₀ − δ; ∂δ/∂log E = −(F / E) / g'(δ)
+            d_log = (self.force / per_sample) / self.table.slope(depth)
+            columns = [np.where(upper, 0.0, d_log), np.where(upper, d_log, 0.0)]
+            if free_offset:
+                columns.append(np.full(n, sigma_t))
+            residual = (self.travel + p[2] * sigma_t - depth) * sw
+            return residual, np.column_stack(columns) * sw[:, None]
+
+        k = 3 if free_offset else 2
+        for _ in range(_PART_ROUNDS):
+            residual, jac = linearise(params)
+            step = np.linalg.lstsq(jac, -residual, rcond=None)[0]
+            params[:k] += step
+            if not np.all(np.isfinite(params)):
+                return None
+            if np.max(np.abs(step[:2])) < 1e-8:
+                break
+        residual, jac = linearise(params)
+        dof = n - k
+        cov = np.linalg.pinv(jac.T @ jac)
+        chi2_red = float(residual @ residual) / dof
+        if chi2_red > 1.0:
+            cov = cov * chi2_red
+        var = float(cov[0, 0] + cov[1, 1] - 2.0 * cov[0, 1])
+        if not (np.isfinite(var) and var >= 0.0):
+            return None
+        return float(params[1] - params[0]), float(np.sqrt(var))
+
+
+def fit_record(travel: NDArray[np.float64], force: NDArray[np.float64], radius: float,
+         thickness: float, config: StiffnessConfig
+         ) -> tuple[float, float, NDArray[np.float64], float, RecordFit]:
+    """``(E, δ₀, cov(E, δ₀), reduced χ², fit)`` of the record on a layer of ``thickness``."""
+    table = LayerTable(radius, thickness, config.poisson_ratio)
+    fit = RecordFit(travel, force, table, config)
+    modulus = fit.solve()
+    table.low_bound = fit.low_bound
+    cov, chi2_red = fit.covariance(modulus)
+    return modulus, fit.offset(modulus), cov, chi2_red, fit
+
+
+def model_error(fit: RecordFit, modulus: float) -> float | None:
+    """The model-error standard deviation of ``E`` [Pa] from the two-part test
+    (:mod:`deformap.stiffness`, Model error): half the parts' difference beyond its own noise;
+    ``None`` when the record has too few samples to tell."""
+    part = fit.part_difference(modulus)
+    if part is None:
+        return None
+    difference, std = part
+    return float(modulus * np.sqrt(max(difference**2 - std**2, 0.0)) / 2.0)
