@@ -35,6 +35,7 @@ from deformap.cloud.io._pcd import PCD_ENCODINGS, read_pcd, write_pcd
 from deformap.cloud.io._ply import PLY_FORMATS, read_ply, write_ply
 from deformap.cloud.io._pointcloud2 import (
     array_to_pointcloud2,
+    pointcloud2_colors,
     pointcloud2_structured,
     pointcloud2_to_array,
     pointcloud2_to_cloud,
@@ -61,6 +62,7 @@ __all__ = [
     "iter_bag_messages",
     "load_npz_arrays",
     "path_kind",
+    "pointcloud2_colors",
     "pointcloud2_structured",
     "pointcloud2_to_array",
     "pointcloud2_to_cloud",
