@@ -15,6 +15,7 @@ import yaml
 
 from deformap.cloud import PointCloud
 from deformap.environment import ForceTravel
+from deformap.errors import FileFormatError
 from deformap.replay import load_raw_bag, load_raw_config, load_session
 
 FORMS = [("folder", "pcd"), ("folder", "ply"), ("folder", "npz"), ("mcap", "pcd"),
@@ -48,6 +49,22 @@ def test_every_session_form_gives_the_colours_back(tmp_path: Path, coloured: Any
         got = session.press_observation(i)
         np.testing.assert_array_equal(got.cloud.points, want.cloud.points)
         np.testing.assert_array_equal(got.cloud.colors, want.cloud.colors)
+
+
+def test_a_poke_file_with_nan_colours_is_refused_naming_file_and_field(
+        tmp_path: Path, coloured: Any, write_synthetic: Any) -> None:  # fmt: skip
+    file = write_synthetic(tmp_path / "s", coloured, cloud_format="npz", sealed=False)
+    cloud = coloured.presses[0].cloud
+    colors = np.array(cloud.colors)
+    colors[7, 2] = np.nan
+    np.savez(file.parent / "poke-01.npz", points=cloud.points, colors=colors)
+    session = load_session(file.parent)
+    with pytest.raises(FileFormatError) as info:
+        session.press_observation(0)
+    text = str(info.value)
+    assert "poke-01.npz" in text and "colour field 'colors' of point 7" in text
+    assert "\n" not in text
+    assert session.press_observation(1).cloud.colors is not None  # the other pokes still read
 
 
 @pytest.mark.parametrize(("form", "cloud_format"), FORMS)
