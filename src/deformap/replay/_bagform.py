@@ -154,15 +154,15 @@ class BagReader:
             )
         return msg
 
-    def _cloud(self, msg: Any, where: str, frame: str) -> PointCloud:
+    def _cloud(self, msg: Any, where: str, frame: str, colors: bool = True) -> PointCloud:
         if msg.header.frame_id != frame:
             raise FileFormatError(
                 f"{where}: header.frame_id is {msg.header.frame_id!r} but the session's frame is "
                 f"{frame!r} (session.yaml `frame`)"
             )
-        # holes of an organised cloud (is_dense false) are dropped; colours are not read
+        # holes of an organised cloud (is_dense false) are dropped with their colours
         cloud, _ = pointcloud2_to_cloud(msg, where=where, units=self.header.units, frame=frame,
-                                        colors=False)  # fmt: skip
+                                        colors=colors)  # fmt: skip
         return cloud
 
     def _to_world(self, cloud: PointCloud) -> PointCloud:
@@ -197,7 +197,7 @@ class BagReader:
 
         cloud = self._to_world(self._cloud(self._message("cloud", stamp), where("cloud"),
                                            self.header.frame))  # fmt: skip
-        robot = self._cloud(self._message("robot", stamp), where("robot"), "world")
+        robot = self._cloud(self._message("robot", stamp), where("robot"), "world", colors=False)
         wrench, tip = self._message("wrench", stamp), self._message("tip", stamp)
         for key, msg in (("wrench", wrench), ("tip", tip)):
             if msg.header.frame_id != "world":
@@ -252,7 +252,11 @@ def write_session_bag(
     presses: Sequence[PressObservation],
     stamps_ns: Sequence[int],
 ) -> None:
-    """Write the observation and the presses (world frame, float64) to a new bag at ``path``."""
+    """Write the observation and the presses (world frame, float64) to a new bag at ``path``.
+
+    A cloud with colours gets a packed FLOAT32 ``rgb`` field (8 bits a channel); the robot's
+    points have none.
+    """
     store = typestore()
     # the record's topic only where a press has one: a bag of presses without stays as before
     topics = dict(TOPICS)
@@ -265,11 +269,13 @@ def write_session_bag(
         def put(key: str, stamp: int, msg: Any) -> None:
             writer.write(conns[key], stamp, store.serialize_cdr(msg, topics[key][1]))
 
-        put("observation", 0, array_to_pointcloud2(observation.points, frame_id="world",
-                                                   stamp_ns=0, dtype="float64"))  # fmt: skip
+        put("observation", 0, array_to_pointcloud2(observation.points, colors=observation.colors,
+                                                   frame_id="world", stamp_ns=0,
+                                                   dtype="float64"))  # fmt: skip
         for stamp, obs in zip(stamps_ns, presses, strict=True):
-            put("cloud", stamp, array_to_pointcloud2(obs.cloud.points, frame_id="world",
-                                                     stamp_ns=stamp, dtype="float64"))  # fmt: skip
+            put("cloud", stamp, array_to_pointcloud2(obs.cloud.points, colors=obs.cloud.colors,
+                                                     frame_id="world", stamp_ns=stamp,
+                                                     dtype="float64"))  # fmt: skip
             put("wrench", stamp, _wrench_message(stamp, obs.contact.force))
             put("tip", stamp, _point_message(stamp, obs.contact.tip_center))
             robot = np.vstack(obs.robot_hulls)  # one hull per poke: the parts' common one

@@ -5,7 +5,8 @@ The bag holds an organised ``sensor_msgs/msg/PointCloud2`` stream in the camera'
 ``/tf_static`` (:class:`~deformap.replay.RawBagConfig` names them). A first pass decodes the
 wrenches, the transforms and the clouds' stamps and finds the presses in the force stream
 (:func:`find_presses`); a second averages, pixel by pixel, the camera frames each press was held
-for and those of the observation, keeping at most one frame per press in memory. A press that
+for and those of the observation (their colours too, over the same frames, when every frame has
+them), keeping at most one frame per press in memory. A press that
 cannot be read (no frame or transform within the stamp tolerance, a force that never reached the
 command or points away from the surface) is refused with one line naming it, the topic and the gap.
 """
@@ -25,6 +26,7 @@ from deformap.cloud.io import (
     bag_error_text,
     bag_read_errors,
     iter_bag_messages,
+    pointcloud2_colors,
     pointcloud2_structured,
     typestore,
 )
@@ -84,13 +86,17 @@ def hull_points(part: HullPart, rot: NDArray[np.float64], origin: NDArray[np.flo
 
 @dataclass
 class _Group:
-    """Frames averaged into one cloud: their indices, and the sum and count per pixel."""
+    """Frames averaged into one cloud: their indices, and the sums and count per pixel.
+
+    ``rgb`` sums the colours over the same frames as ``total``; it is None once a frame has none.
+    """
 
     frames: list[int]
     cam_stamp: int
     shape: tuple[int, int] | None = None
     total: NDArray[np.float64] | None = None
     count: NDArray[np.int64] | None = None
+    rgb: NDArray[np.float64] | None = None
 
 
 class RawBagReader:
@@ -253,7 +259,7 @@ class RawBagReader:
             where = f"{self.path} [{cfg.cloud_topic} message {raw.number}]"
             try:
                 msg = store.deserialize_cdr(bytes(raw.data), _CLOUD)
-                xyz = self._xyz(msg, where)
+                xyz, rgb = self._xyz(msg, where)
             except errors as exc:
                 raise FileFormatError(f"{where}: could not be decoded: "
                                       f"{bag_error_text(exc, 120)}") from None  # fmt: skip
@@ -263,12 +269,18 @@ class RawBagReader:
                 if group.total is None or group.count is None:
                     group.shape, group.total = shape, np.zeros_like(xyz)
                     group.count = np.zeros(xyz.shape[0], dtype=np.int64)
+                    group.rgb = None if rgb is None else np.zeros_like(xyz)
                 elif shape != group.shape or shape[0] == 1:
                     continue  # another layout, or an unorganised cloud: no pixel to average
                 group.total[ok] += xyz[ok]
                 group.count[ok] += 1
+                if group.rgb is not None and rgb is not None:
+                    group.rgb[ok] += rgb[ok]
+                else:
+                    group.rgb = None
 
-    def _xyz(self, msg: Any, where: str) -> NDArray[np.float64]:
+    def _xyz(self, msg: Any, where: str) -> tuple[NDArray[np.float64], NDArray[np.float64] | None]:
+        """The frame's points, NaN holes kept, and their colours (NaN at the holes) or None."""
         try:
             table = pointcloud2_structured(msg)
         except DeformapError as exc:
@@ -280,7 +292,8 @@ class RawBagReader:
             xyz = np.column_stack([table[a].astype(np.float64) for a in "xyz"])
         if bool(msg.is_dense) and not np.isfinite(xyz).all():
             raise FileFormatError(f"{where}: says is_dense but holds NaN or infinite points")
-        return xyz * (1e-3 if self.config.units == "mm" else 1.0)
+        rgb = pointcloud2_colors(msg, where=where, table=table, valid=np.isfinite(xyz).all(axis=1))
+        return xyz * (1e-3 if self.config.units == "mm" else 1.0), rgb
 
     def _cloud(self, group: _Group, where: str) -> PointCloud:
         if group.total is None or group.count is None or not group.count.any():
@@ -288,9 +301,10 @@ class RawBagReader:
                                   "no finite point")  # fmt: skip
         seen = group.count > 0
         cam = group.total[seen] / group.count[seen, None]
+        rgb = None if group.rgb is None else np.clip(group.rgb[seen] / group.count[seen, None], 0, 1)
         rot, trans = self.tree.lookup(self.config.world_frame, self.camera_frame, group.cam_stamp,
                                       what=f"{where} [{self.config.cloud_topic}]")  # fmt: skip
-        return PointCloud(cam @ rot[0].T + trans[0])
+        return PointCloud(cam @ rot[0].T + trans[0], rgb)
 
     # -- what the session asks for -----------------------------------------------------------
 

@@ -133,7 +133,8 @@ def write_session(
         The initial observation, world frame, metres.
     presses : sequence of PressObservation
         In order; clouds, robot points and force–travel records are written in float64 and read
-        back bit for bit.
+        back bit for bit. Cloud colours are written when a cloud has them: exactly in NPZ, to 8
+        bits a channel in PCD, PLY and bags (exact for multiples of 1/255).
     tip_radius_m : float, optional
         Defaults to the presses' (which must agree).
     ground_truth : GroundTruth, optional

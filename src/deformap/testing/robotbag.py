@@ -177,12 +177,22 @@ def _organised(points_world: np.ndarray, optical2world: np.ndarray, pixels: np.n
     return grid
 
 
-def _cloud_msg(t_s: float, grid: np.ndarray, shape: tuple[int, int]) -> dict[str, Any]:
+def _packed(colors: np.ndarray | None, pixels: np.ndarray, n: int) -> np.ndarray:
+    """``(n,)`` uint32 ``0x00RRGGBB`` words: ``colors`` on ``pixels``, grey without colours."""
+    words = np.full(n, 0x808080, dtype=np.uint32)
+    if colors is not None:
+        rgb = np.round(colors * 255).astype(np.uint32)
+        words[pixels] = (rgb[:, 0] << 16) | (rgb[:, 1] << 8) | rgb[:, 2]
+    return words
+
+
+def _cloud_msg(t_s: float, grid: np.ndarray, shape: tuple[int, int],
+               words: np.ndarray) -> dict[str, Any]:  # fmt: skip
     table = np.zeros(grid.shape[0], dtype=[("x", "<f4"), ("y", "<f4"), ("z", "<f4"),
                                            ("rgb", "<f4")])  # fmt: skip
     for i, a in enumerate("xyz"):
         table[a] = grid[:, i]
-    table["rgb"] = np.full(grid.shape[0], 0x808080, dtype=np.uint32).view(np.float32)
+    table["rgb"] = words.view(np.float32)  # the bits, as the drivers publish them
     fields = [{"name": a, "offset": 4 * i, "datatype": 7, "count": 1}
               for i, a in enumerate(["x", "y", "z", "rgb"])]  # fmt: skip
     return {"header": _header(t_s, "camera_depth_optical_frame"), "height": shape[0],
@@ -195,14 +205,15 @@ def write_raw_bag(path: Path, session: RecordedSession, *, seed: int = 0,
                   tf_gap_s: tuple[float, float] | None = None, bias_n: float = 0.0,
                   camera_hz: float = 30.0, tf_hz: float = 50.0, wrench_hz: float = 500.0,
                   chunk_size: int = 1024 * 1024, compression: str = "zstd",
-                  ) -> list[Press]:  # fmt: skip
+                  colors: bool = False) -> list[Press]:  # fmt: skip
     """Write ``session``'s presses as a robot's drivers record them; return the timeline.
 
     ``drop`` leaves topics out; ``camera_gap_s`` and ``tf_gap_s`` leave out the camera's frames
     or the arm's transforms stamped within a span [s]; ``bias_n`` offsets the sensor's z (a
     sensor not zeroed); the rates are the camera's, the arm's ``/tf`` and the force sensor's
     [Hz]; ``chunk_size`` and ``compression`` (``"zstd"``, ``"lz4"`` or ``"none"``) the writer's
-    chunks', each with its CRC-32.
+    chunks', each with its CRC-32. The packed ``rgb`` field is grey, or with ``colors`` the
+    session clouds' own colours (which they must have), rounded to 8 bits a channel.
     """
     import mcap_ros2.writer as mcap_ros2_writer
     from mcap.writer import CompressionType
@@ -211,13 +222,17 @@ def write_raw_bag(path: Path, session: RecordedSession, *, seed: int = 0,
     presses = _timeline(session)
     end_s = presses[-1].hold_s[1] + RELEASE + PAUSE
     optical2world = _camera_optical2world()
-    observation = session.observation().points
-    clouds = [observation] + [p.obs.cloud.points for p in presses]
+    colored = [session.observation()] + [p.obs.cloud for p in presses]
+    clouds = [c.points for c in colored]
     width = 128
     height = -(-max(len(c) for c in clouds) * 5 // 4 // width)  # a quarter more pixels: holes
     shape = (height, width)
     layouts = [np.sort(rng.choice(height * width, len(c), replace=False)) for c in clouds]
     grids = [_organised(c, optical2world, px, shape) for c, px in zip(clouds, layouts, strict=True)]
+    if colors and any(c.colors is None for c in colored):
+        raise ValueError("`colors=True` needs a session whose clouds have colours")
+    words = [_packed(c.colors if colors else None, px, height * width)
+             for c, px in zip(colored, layouts, strict=True)]  # fmt: skip
     writer = mcap_ros2_writer.Writer(str(path), chunk_size=chunk_size,
                                      compression=CompressionType[compression.upper()])
     schemas = {name: writer.register_msgdef(name, text) for name, text in MSGDEFS.items()}
@@ -239,11 +254,12 @@ def write_raw_bag(path: Path, session: RecordedSession, *, seed: int = 0,
         if camera_gap_s is not None and camera_gap_s[0] <= stamp <= camera_gap_s[1]:
             continue
         held = [k for k, p in enumerate(presses) if p.contact_s <= stamp <= p.hold_s[1] + RELEASE]
-        grid = grids[held[0] + 1].copy() if held else grids[0].copy()
-        blank = layouts[held[0] + 1 if held else 0]
+        which = held[0] + 1 if held else 0
+        grid = grids[which].copy()
+        blank = layouts[which]
         grid[blank[(np.arange(blank.size) * 7 + n) % 9 == 0][::3]] = np.nan
         put("/camera/depth/color/points", "sensor_msgs/msg/PointCloud2",
-            _cloud_msg(stamp, grid, shape), stamp)
+            _cloud_msg(stamp, grid, shape, words[which]), stamp)
     # the arm (50 Hz): base_link -> tool0 carries the tip along the press
     for t in np.arange(0.0, end_s, 1 / tf_hz):
         stamp = t + rng.uniform(-0.002, 0.002)

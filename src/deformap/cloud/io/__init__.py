@@ -10,7 +10,8 @@ Formats: PCD (pypcd4), PLY (ascii and binary; numpy), NPZ (``points``, ``colors`
 :data:`MAX_NPZ_BYTES` decompressed), and ROS 2 bags (sqlite3 and MCAP, through the optional
 ``rosbags``, extra ``ros``) of ``sensor_msgs/msg/PointCloud2`` and
 ``geometry_msgs/msg/WrenchStamped``. :func:`iter_bag_messages` is the one place a bag is read,
-:func:`bag_writer` the one place one is written.
+:func:`bag_writer` the one place one is written. Colours (RGB in [0, 1]) are read from every
+format's usual fields and written whenever a cloud has them (``docs/recording-format.md``).
 """
 
 from __future__ import annotations
@@ -37,6 +38,7 @@ from deformap.cloud.io._pcd import PCD_ENCODINGS, read_pcd, write_pcd
 from deformap.cloud.io._ply import PLY_FORMATS, read_ply, write_ply
 from deformap.cloud.io._pointcloud2 import (
     array_to_pointcloud2,
+    pointcloud2_colors,
     pointcloud2_structured,
     pointcloud2_to_array,
     pointcloud2_to_cloud,
@@ -63,6 +65,7 @@ __all__ = [
     "iter_bag_messages",
     "load_npz_arrays",
     "path_kind",
+    "pointcloud2_colors",
     "pointcloud2_structured",
     "pointcloud2_to_array",
     "pointcloud2_to_cloud",

@@ -27,6 +27,7 @@ __all__ = [
     "MM_EXTENT_THRESHOLD",
     "UNITS",
     "check_body_size",
+    "check_colors",
     "check_units",
     "finish_cloud",
     "parse_errors",
@@ -179,6 +180,33 @@ def parse_errors(path: Path, what: str) -> Iterator[None]:
         ) from exc
 
 
+def check_colors(where: Path | str, colors: NDArray[Any], field: str) -> NDArray[np.float64]:
+    """``(n, 3)`` float64 colours in [0, 1] from a file's colour values, or a FileFormatError.
+
+    Integers are 8-bit channels, taken in [0, 255] and divided by 255; floats must already lie in
+    [0, 1]. A NaN, infinite or out-of-range value is refused with one line naming ``where``, the
+    colour ``field`` as the file names it (``"rgb"``, ``"red/green/blue"``) and the first bad point.
+    A constant, black or saturated colour is valid data.
+    """
+    raw = np.asarray(colors).reshape(-1, 3)
+    kind = raw.dtype.kind
+    if kind not in "iuf":
+        raise FileFormatError(f"{where}: colour field {field!r} has dtype {raw.dtype}, not numbers")
+    with np.errstate(invalid="ignore"):
+        values = raw.astype(np.float64)
+    low, high, what = (0.0, 255.0, "integers") if kind in "iu" else (0.0, 1.0, "floats")
+    bad = ~((values >= low) & (values <= high)).all(axis=1)  # NaN fails too
+    if bad.any():
+        row = int(np.argmax(bad))
+        shown = ", ".join(f"{v:g}" for v in values[row])
+        raise FileFormatError(
+            f"{where}: colour field {field!r} of point {row} is ({shown}); {what} must lie in "
+            f"[{low:g}, {high:g}] ({int(bad.sum())} of {len(values)} points are out of range "
+            "or NaN)"
+        )
+    return values / 255.0 if kind in "iu" else values
+
+
 def finish_cloud(
     path: Path | str,
     xyz: NDArray[Any],
@@ -188,12 +216,14 @@ def finish_cloud(
     scale: float,
     drop_nan: bool,
     frame: str = "world",
+    color_field: str = "colors",
 ) -> tuple[PointCloud, dict[str, NDArray[Any]]]:
     """Apply the NaN policy and the units rule, and build the cloud.
 
     ``path`` names the source in messages (a file, or a bag with its topic and message index).
     Rows with a NaN or infinite coordinate are refused, or dropped (with a warning in the log, and
-    from ``colors`` and ``extras`` alike) when ``drop_nan``. Empty results are refused.
+    from ``colors`` and ``extras`` alike) when ``drop_nan``. Empty results are refused. The colours
+    of the points kept are then checked by :func:`check_colors`, naming ``color_field``.
     """
     # Widening a signalling NaN (a corrupted float32) raises "invalid"; NaN is handled just below.
     with np.errstate(invalid="ignore"):
@@ -216,6 +246,8 @@ def finish_cloud(
         extras = {k: v[finite] for k, v in extras.items()}
         if xyz.shape[0] == 0:
             raise FileFormatError(f"{path}: every point has a NaN or infinite x/y/z")
+    if colors is not None:
+        colors = check_colors(path, colors, color_field)
     largest = float(np.abs(xyz).max())
     if scale == 1.0 and largest > MM_EXTENT_THRESHOLD:
         raise FileFormatError(

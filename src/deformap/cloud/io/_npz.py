@@ -127,6 +127,9 @@ def read_npz(
 ) -> tuple[PointCloud, dict[str, NDArray[Any]]]:
     """Read an NPZ archive with ``points`` and optional ``colors``; other arrays become extras.
 
+    ``colors`` is (n, 3): integers in [0, 255] or floats in [0, 1]; NaN or out-of-range values
+    are refused (a point dropped for a NaN coordinate drops its colour too).
+
     The archive is opened with ``allow_pickle=False``: object arrays are refused.
 
     Parameters
@@ -165,7 +168,8 @@ def read_npz(
     extras = {
         k: v for k, v in arrays.items() if v.shape == (len(points),) and v.dtype.kind in "iufb"
     }
-    return finish_cloud(p, points, colors, extras, scale=scale, drop_nan=drop_nan)
+    return finish_cloud(p, points, colors, extras, scale=scale, drop_nan=drop_nan,
+                        color_field="colors")  # fmt: skip
 
 
 def write_npz(

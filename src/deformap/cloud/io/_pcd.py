@@ -103,17 +103,59 @@ def _check_header_against_body(path: Path, meta: Any, body: bytes) -> None:
                     compressed + 8, body)  # fmt: skip
 
 
-def _decode_rgb(values: NDArray[Any], ascii: bool) -> NDArray[np.uint8]:
-    # Binary files hold a float rgb as the bits of 0x00RRGGBB. PCL's ascii writer prints those bits
-    # as an unsigned integer even under TYPE F, so integer-valued floats in an ascii file are the
-    # packed value itself (a float whose bits are 0x00RRGGBB is < 1e-38, never integer but 0).
-    integral = values.dtype.kind != "f" or (ascii and bool(np.all(values == np.round(values))))
-    if integral:
-        packed = values.astype(np.uint32)
-    else:
-        packed = values.astype(np.float32).view(np.uint32)
+#: Colour fields a PCD may carry, in the order they are looked for.
+_PACKED, _SEPARATE = ("rgb", "rgba"), ("r", "g", "b")
+
+
+def _unpack(packed: NDArray[np.uint32]) -> NDArray[np.uint8]:
+    """(n, 3) uint8 R, G, B of ``0xAARRGGBB`` words (alpha ignored)."""
     shifts = np.array([16, 8, 0], dtype=np.uint32)
     return ((packed[:, None] >> shifts) & 0xFF).astype(np.uint8)
+
+
+def _pcd_colors(path: Path, pc_data: NDArray[Any], meta: Any, body: bytes
+                ) -> tuple[NDArray[Any] | None, str, tuple[str, ...]]:  # fmt: skip
+    """The file's colours (not yet checked), the name of their field(s) and the fields taken.
+
+    ``rgb`` (SIZE 4, TYPE F) holds the bits of ``0x00RRGGBB`` in a float, PCL's convention; as TYPE
+    U or I, or ``rgba`` (``0xAARRGGBB``), the word itself. PCL's ascii writer prints a float rgb's
+    bits as an unsigned integer even under TYPE F, so integer-valued floats in an ascii file are the
+    packed word (a float whose bits are ``0x00RRGGBB`` is < 1e-38, never an integer but 0); that
+    column is read again from ``body`` as float64, as float32 would round a word with an alpha
+    byte. Separate ``r``, ``g``, ``b`` fields are 8-bit integers or floats in [0, 1].
+    """
+    names = pc_data.dtype.names or ()
+    field = next((c for c in _PACKED if c in names), None)
+    if field is None:
+        if all(c in names for c in _SEPARATE):
+            return np.column_stack([pc_data[c] for c in _SEPARATE]), "r/g/b", _SEPARATE
+        return None, "", ()
+    values = np.asarray(pc_data[field])
+    if values.ndim != 1 or values.dtype.itemsize != 4:
+        raise FileFormatError(
+            f"{path}: colour field {field!r} must be one 4-byte word per point (packed "
+            f"0x00RRGGBB); got {values.dtype.itemsize}-byte values, count "
+            f"{1 if values.ndim == 1 else values.shape[1]}"
+        )
+    if values.dtype.kind == "f" and meta.data.value == "ascii":
+        column = sum(meta.count[: meta.fields.index(field)])
+        values = np.loadtxt(io.BytesIO(body), dtype=np.float64, usecols=column, ndmin=1,
+                            comments=None)  # fmt: skip
+        if not np.isfinite(values).all():
+            row = int(np.argmax(~np.isfinite(values)))
+            raise FileFormatError(
+                f"{path}: colour field {field!r} of point {row} is {values[row]}: an ascii file "
+                "holds the packed word as an integer"
+            )
+        if np.all(values == np.round(values)):
+            if values.min() < 0 or values.max() > 0xFFFFFFFF:
+                raise FileFormatError(
+                    f"{path}: colour field {field!r} holds {values.min():.0f} to "
+                    f"{values.max():.0f}; a packed word lies in [0, 2^32)"
+                )
+            return _unpack(values.astype(np.uint32)), field, (field,)
+    word = values.dtype.str[0] + "u4"  # the same bytes as an unsigned word, NaN bits included
+    return _unpack(np.ascontiguousarray(values).view(word).astype(np.uint32)), field, (field,)
 
 
 def read_pcd(
@@ -134,7 +176,9 @@ def read_pcd(
     Returns
     -------
     cloud : PointCloud
-        ``x, y, z`` in metres, and colours from an ``rgb`` or ``rgba`` field when present.
+        ``x, y, z`` in metres, and colours from a packed ``rgb`` or ``rgba`` field, or from
+        ``r``, ``g``, ``b`` fields, when present (see ``_pcd_colors``); NaN or out-of-range
+        colours are refused, naming the field.
     extras : dict of str to (n,) array
         Every other per-point field, in the file's dtype (fields with COUNT > 1 as
         ``name__0000``, ``name__0001``, ... as pypcd4 names them; padding fields left out).
@@ -161,16 +205,15 @@ def read_pcd(
     if missing:
         raise FileFormatError(f"{p}: PCD has no field {missing[0]!r} (fields: {list(names)})")
     xyz = np.column_stack([pc_data[a] for a in "xyz"])
-    color_field = next((c for c in ("rgb", "rgba") if c in names), None)
-    colors = None
-    if color_field is not None:
-        colors = _decode_rgb(np.asarray(pc_data[color_field]), meta.data.value == "ascii")
+    with parse_errors(p, "the PCD file's colours"):
+        colors, color_field, taken = _pcd_colors(p, pc_data, meta, data[offset:])
     extras = {
         name: np.array(pc_data[name])
         for name in names
-        if name not in ("x", "y", "z", color_field) and not name.startswith(_PYPCD4_PADDING_PREFIX)
+        if name not in ("x", "y", "z", *taken) and not name.startswith(_PYPCD4_PADDING_PREFIX)
     }
-    return finish_cloud(p, xyz, colors, extras, scale=scale, drop_nan=drop_nan)
+    return finish_cloud(p, xyz, colors, extras, scale=scale, drop_nan=drop_nan,
+                        color_field=color_field)  # fmt: skip
 
 
 def write_pcd(

@@ -238,8 +238,9 @@ def read_ply(
     Returns
     -------
     cloud : PointCloud
-        ``x, y, z`` in metres; colours from ``red``, ``green``, ``blue`` when all three are present
-        (integers taken in [0, 255], floats in [0, 1]).
+        ``x, y, z`` in metres; colours from ``red``, ``green``, ``blue`` (integers taken in
+        [0, 255], floats in [0, 1]; one or two of the three, a NaN or an out-of-range value is
+        refused, naming the properties).
     extras : dict of str to (n,) array
         Every other vertex property, in native byte order.
     """
@@ -254,6 +255,12 @@ def read_ply(
             f"{p}: PLY 'vertex' element has no property {missing[0]!r} (has: {list(names)})"
         )
     has_color = all(c in names for c in _COLOR_NAMES)
+    partial = [c for c in _COLOR_NAMES if c in names]
+    if partial and not has_color:
+        raise FileFormatError(
+            f"{p}: PLY 'vertex' element has colour properties {partial} but not "
+            f"{[c for c in _COLOR_NAMES if c not in names]}; a colour needs all three"
+        )
     taken = {"x", "y", "z", *(_COLOR_NAMES if has_color else ())}
     # Widening a signalling NaN (a corrupted float) raises "invalid"; finish_cloud handles NaN.
     with np.errstate(invalid="ignore"):
@@ -261,7 +268,8 @@ def read_ply(
         colors = np.column_stack([vertices[c] for c in _COLOR_NAMES]) if has_color else None
         extras = {n: vertices[n].astype(vertices[n].dtype.newbyteorder("=")) for n in names
                   if n not in taken}  # fmt: skip
-    return finish_cloud(p, xyz, colors, extras, scale=scale, drop_nan=drop_nan)
+    return finish_cloud(p, xyz, colors, extras, scale=scale, drop_nan=drop_nan,
+                        color_field="red/green/blue")  # fmt: skip
 
 
 def write_ply(

@@ -21,12 +21,13 @@ from numpy.typing import NDArray
 
 from deformap._validation import check_array, check_int, check_points
 from deformap.cloud._pointcloud import PointCloud
-from deformap.cloud.io._common import check_units, finish_cloud
+from deformap.cloud.io._common import check_colors, check_units, finish_cloud
 from deformap.cloud.io._ros import typestore
 from deformap.errors import FileFormatError, InvalidArgumentError
 
 __all__ = [
     "array_to_pointcloud2",
+    "pointcloud2_colors",
     "pointcloud2_structured",
     "pointcloud2_to_array",
     "pointcloud2_to_cloud",
@@ -254,15 +255,71 @@ def array_to_pointcloud2(
     )  # fmt: skip
 
 
-def _decode_colors(table: NDArray[Any]) -> NDArray[np.uint8] | None:
-    names = table.dtype.names or ()
-    field = next((c for c in ("rgb", "rgba") if c in names), None)
-    if field is None or table[field].ndim != 1 or table[field].dtype.itemsize != 4:
-        return None
-    packed = np.ascontiguousarray(table[field]).view(table[field].dtype.newbyteorder("="))
-    packed = packed.view(np.uint32) if packed.dtype.kind == "f" else packed.astype(np.uint32)
+def _packed_colors(where: str, table: NDArray[Any], field: str) -> NDArray[np.uint8]:
+    column = table[field]
+    if column.ndim != 1 or column.dtype.itemsize != 4 or column.dtype.kind not in "fiu":
+        raise FileFormatError(
+            f"{where}: colour field {field!r} must be one FLOAT32 or UINT32 word per point "
+            f"(packed 0x00RRGGBB); got {column.dtype.itemsize}-byte {column.dtype.kind!r} values, "
+            f"count {1 if column.ndim == 1 else column.shape[1]}"
+        )
+    # the word's bits in the message's byte order; as a float they may be NaN (an alpha byte)
+    word = np.ascontiguousarray(column).view(column.dtype.str[0] + "u4").astype(np.uint32)
     shifts = np.array([16, 8, 0], dtype=np.uint32)
-    return ((packed[:, None] >> shifts) & 0xFF).astype(np.uint8)
+    return ((word[:, None] >> shifts) & 0xFF).astype(np.uint8)
+
+
+def _separate_colors(where: str, table: NDArray[Any], present: list[str]) -> NDArray[Any]:
+    kinds = {table[c].dtype.str[1:] for c in present}
+    if len(present) != 3 or any(table[c].ndim != 1 for c in present) or len(kinds) != 1 or not (
+            kinds <= {"u1", "f4", "f8"}):  # fmt: skip
+        raise FileFormatError(
+            f"{where}: colour fields r, g, b must be all three, one UINT8 or FLOAT32 each, of "
+            f"one type; got {[(c, table[c].dtype.str[1:], table[c].shape[1:]) for c in present]}"
+        )
+    return np.column_stack([table[c] for c in present])
+
+
+def pointcloud2_colors(msg: Any, *, where: str = "PointCloud2", table: Any = None,
+                       valid: Any = None) -> NDArray[np.float64] | None:  # fmt: skip
+    """``(height·width, 3)`` float64 colours in [0, 1] of a PointCloud2, or None without any.
+
+    The layouts ROS drivers publish are read: ``rgb`` as a FLOAT32 (realsense, Azure Kinect,
+    OpenNI, PCL's ``PointXYZRGB``) or UINT32 whose bits are ``0x00RRGGBB``, ``rgba`` as a UINT32
+    or FLOAT32 ``0xAARRGGBB`` (alpha ignored), or separate ``r``, ``g``, ``b`` fields, UINT8 (in
+    [0, 255]) or FLOAT32 (in [0, 1]). A packed word is read for its bits, never its float value.
+
+    Parameters
+    ----------
+    msg : sensor_msgs/msg/PointCloud2
+    where : str
+        Names the message in errors.
+    table : structured array, optional
+        ``pointcloud2_structured(msg)``, when the caller already has it.
+    valid : (height·width,) bool, optional
+        The points whose colours count (the finite ones); the others' rows are NaN and their
+        colour is not checked (a NaN hole drops its colour too). Default every point.
+
+    Raises
+    ------
+    FileFormatError
+        Naming ``where`` and the field: a colour field of another type or count, only some of
+        ``r``, ``g``, ``b``, or a NaN or out-of-range colour on a valid point.
+    """
+    table = pointcloud2_structured(msg) if table is None else table
+    names = table.dtype.names or ()
+    packed = next((c for c in ("rgb", "rgba") if c in names), None)
+    present = [c for c in "rgb" if c in names]
+    if packed is not None:
+        raw, field = _packed_colors(where, table, packed), packed
+    elif present:
+        raw, field = _separate_colors(where, table, present), "r/g/b"
+    else:
+        return None
+    keep = np.ones(len(table), dtype=bool) if valid is None else np.asarray(valid, dtype=bool)
+    out = np.full((len(table), 3), np.nan)
+    out[keep] = check_colors(where, raw[keep], field)
+    return out
 
 
 def _to_cloud(msg: Any, where: str, scale: float, frame: str, colors: bool
@@ -272,8 +329,8 @@ def _to_cloud(msg: Any, where: str, scale: float, frame: str, colors: bool
         xyz = xyz_with_holes(msg, table)
     except InvalidArgumentError as exc:
         raise FileFormatError(f"{where}: {str(exc).replace('`msg` ', '')}") from None
-    rgb = _decode_colors(table) if colors else None
     finite = np.isfinite(xyz).all(axis=1)
+    rgb = pointcloud2_colors(msg, where=where, table=table, valid=finite) if colors else None
     dropped = int(finite.size - finite.sum())
     xyz, rgb = xyz[finite], None if rgb is None else rgb[finite]
     cloud, _ = finish_cloud(where, xyz, rgb, {}, scale=scale, drop_nan=False, frame=frame)
@@ -298,12 +355,12 @@ def pointcloud2_to_cloud(msg: Any, *, where: str, units: str = "m", frame: str |
     frame : str, optional
         The cloud's frame name; default the header's ``frame_id`` (``"sensor"`` when empty).
     colors : bool
-        Decode a packed ``rgb``/``rgba`` field when there is one.
+        Read the message's colours when it has them (:func:`pointcloud2_colors`).
 
     Returns
     -------
     cloud : PointCloud
-        Points in metres.
+        Points in metres, with colours when the message has them and ``colors``.
     n_dropped : int
         Points dropped for a non-finite coordinate.
     """
