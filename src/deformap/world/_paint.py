@@ -73,9 +73,12 @@ def _textured(rng: np.random.Generator, n: int) -> list[Appearance]:
 
 
 def _inside_point(piece: Piece, rng: np.random.Generator) -> tuple[float, float]:
-    """A point of ``piece`` near the middle of its bounding box (its vertices' mean if none)."""
+    """A point of ``piece``, near the middle of its bounding box where it can (the first of
+    64 draws there, then of 256 over the box but its edges); its vertices' mean if none falls in."""
     lo, hi = piece.polygon.min(axis=0), piece.polygon.max(axis=0)
-    tries = lo + rng.uniform(0.3, 0.7, size=(64, 2)) * (hi - lo)
+    share = np.concatenate([rng.uniform(0.3, 0.7, size=(64, 2)),
+                            rng.uniform(0.05, 0.95, size=(256, 2))])
+    tries = lo + share * (hi - lo)
     inside = points_in_polygon(tries, piece.polygon)
     for hole in piece.holes:
         inside &= ~points_in_polygon(tries, hole)
