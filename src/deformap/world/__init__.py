@@ -15,6 +15,10 @@ Quick start::
     obs = world.press((0.1, 0.2), 0.6)   # target (m), force (N)
     obs.force_travel.travel_m, obs.force_travel.force_n   # contact → 0.6 N, 9 samples
     world.release()
+
+Every frame carries colour (``cloud.colors``, sRGB): each block has an :class:`Appearance` (a
+colour and a texture), lit by one light and seen through the camera's colour sensor;
+``world.rgb_image()`` is the camera's colour image of the scene as it is now.
 """
 
 from __future__ import annotations
@@ -26,10 +30,12 @@ from deformap.mechanics import (
     hertz_pressure_samples,
     youngs_modulus_to_hardness,
 )
+from deformap.world._appearance import Appearance, Split
 from deformap.world._camera import CAMERA_PRESETS, CameraConfig, camera_preset
 from deformap.world._config import PHYSICS, Physics, WorldConfig, check_world_budget
 from deformap.world._foam import Dent
 from deformap.world._layouts import LAYOUT_FAMILIES, LayoutFamily
+from deformap.world._paint import APPEARANCE_FAMILIES, AppearanceFamily
 from deformap.world._probe import ProbeGeometry
 from deformap.world._random import random_scenario
 from deformap.world._scenario import BARE_TABLE, Block, Scenario
@@ -37,11 +43,14 @@ from deformap.world._scenario_io import list_scenarios, load_scenario, save_scen
 from deformap.world._world import MIN_RECORD_FORCE_N, SimulatedWorld
 
 __all__ = [
+    "APPEARANCE_FAMILIES",
     "BARE_TABLE",
     "CAMERA_PRESETS",
     "LAYOUT_FAMILIES",
     "MIN_RECORD_FORCE_N",
     "PHYSICS",
+    "Appearance",
+    "AppearanceFamily",
     "Block",
     "CameraConfig",
     "Dent",
@@ -50,6 +59,7 @@ __all__ = [
     "ProbeGeometry",
     "Scenario",
     "SimulatedWorld",
+    "Split",
     "WorldConfig",
     "camera_preset",
     "check_world_budget",

@@ -12,7 +12,13 @@ deformed surfaces and, while pressing, the probe. Then, per pixel, in this order
 3. axial noise ``σ_z = sigma_base + sigma_quadratic·(z − sigma_reference)²`` (z along the axis);
 4. disparity quantisation: ``z = f b / (round(f b / z · subpixel) / subpixel)``.
 
-Points are returned in the world frame, one per valid pixel in row-major pixel order.
+Points are returned in the world frame, one per valid pixel in row-major pixel order, with the
+pixel, the triangle and the noise-free point each ray hit, which the world colours. The colour
+sensor (:meth:`DepthCamera.sensor_colors`) takes the light reaching each pixel (linear RGB) and
+applies, in this order, vignetting (``1 − vignetting · r²``, ``r`` the pixel's distance from the
+image centre over the half-diagonal; Goldman 2010), per-channel white-balance gains, the sRGB
+encoding, Gaussian noise of standard deviation ``color_noise`` per channel (from its own random
+stream: the depth's draws are those of a camera without colour) and clipping to ``[0, 1]``.
 
 References
 ----------
@@ -23,6 +29,8 @@ reconstruction and tracking. 3DIMPVT.
 Grunnet-Jepsen, A., Sweetser, J. N., Woodfill, J. (2018). Best-known-methods for tuning Intel
 RealSense D400 depth cameras for best performance. Intel white paper, rev. 1.9.
 Intel RealSense D400 series product family datasheet (2019).
+Goldman, D. B. (2010). Vignette and exposure calibration and compensation. IEEE Transactions on
+Pattern Analysis and Machine Intelligence 32(12), 2276–2288.
 """
 
 from __future__ import annotations
@@ -30,6 +38,7 @@ from __future__ import annotations
 import logging
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 import trimesh
@@ -37,9 +46,10 @@ from numpy.typing import NDArray
 
 from deformap._validation import check_settings, setting
 from deformap.errors import InvalidArgumentError
+from deformap.world._appearance import linear_to_srgb
 from deformap.world._raycast import cast_rays
 
-__all__ = ["CAMERA_PRESETS", "CameraConfig", "DepthCamera", "camera_preset"]
+__all__ = ["CAMERA_PRESETS", "CameraConfig", "DepthCamera", "Frame", "camera_preset"]
 
 log = logging.getLogger(__name__)
 
@@ -75,6 +85,12 @@ class CameraConfig:
         Probability in ``[0, 1]`` that a candidate pixel flies.
     use_embree : bool
         Use trimesh's Embree ray caster when ``embreex`` is installed.
+    color_noise : float
+        Standard deviation of the colour sensor's noise per channel, in sRGB units of ``[0, 1]``.
+    white_balance : (3,) float
+        Gains on the red, green and blue light (1, 1, 1: balanced).
+    vignetting : float
+        Relative loss of light at the image's corners, in ``[0, 1)``.
     """
 
     # a ray per pixel, with a few float64 arrays each: 4096 × 4096 rays is gigabytes per frame
@@ -93,6 +109,14 @@ class CameraConfig:
     edge_jump_m: float = setting(0.02, gt=0.0)
     flying_probability: float = setting(0.3, ge=0.0, le=1.0)
     use_embree: bool = True
+    # about 1 % of full scale: an 8-bit webcam-class colour sensor in good light
+    color_noise: float = setting(0.01, ge=0.0, le=0.5,
+                                 doc="colour noise, standard deviation per channel (sRGB units)")
+    # a gain beyond 4 is no white balance but a colour filter
+    white_balance: tuple[float, float, float] = setting(
+        (1.0, 1.0, 1.0), gt=0.0, le=4.0, doc="white-balance gains on red, green, blue")
+    vignetting: float = setting(0.0, ge=0.0, lt=1.0,
+                                doc="relative loss of light at the image's corners")
 
     def __post_init__(self) -> None:
         check_settings(self)
@@ -101,25 +125,28 @@ class CameraConfig:
 def _kinect_v1() -> CameraConfig:
     # Kinect v1 in its 320 × 240 depth mode, 1 m above the table: field of view 57° × 43°,
     # baseline 7.5 cm, disparity in 1/8 pixel (at half the resolution, twice the quantisation
-    # step in depth), random error about 1.6 mm · z² (Khoshelham & Elberink 2012, Fig. 9)
+    # step in depth), random error about 1.6 mm · z² (Khoshelham & Elberink 2012, Fig. 9); its
+    # VGA Bayer colour sensor is noisier than the later ones: twice the default colour noise
     return CameraConfig(width=320, height=240, fov_deg=(57.0, 43.0), height_m=1.0,
                         sigma_base_m=0.0, sigma_quadratic_m=0.0016, sigma_reference_m=0.0,
-                        baseline_m=0.075, subpixel=8.0)
+                        baseline_m=0.075, subpixel=8.0, color_noise=0.02)
 
 
 def _realsense_d435() -> CameraConfig:
     # RealSense D435 at 848 × 480, 0.6 m above the table (its minimum range is about 0.2 m):
     # field of view 87° × 58°, baseline 5 cm; depth RMS z² · 0.08 px / (f b) with
     # f = 424 px / tan(43.5°) ≈ 447 px, i.e. 3.6 mm · z² (Grunnet-Jepsen et al. 2018); its
-    # disparity is finer than that noise (1/32 pixel)
+    # disparity is finer than that noise (1/32 pixel); its global-shutter colour sensor a little
+    # less noisy than the default
     return CameraConfig(width=848, height=480, fov_deg=(87.0, 58.0), height_m=0.6,
                         sigma_base_m=0.0, sigma_quadratic_m=0.0036, sigma_reference_m=0.0,
-                        baseline_m=0.05, subpixel=32.0)
+                        baseline_m=0.05, subpixel=32.0, color_noise=0.008)
 
 
 #: Named depth cameras of the kind a robot carries, each a :class:`CameraConfig` built from the
 #: maker's or the literature's figures (see the references): ``primesense`` (the default, a
-#: PrimeSense Carmine 1.08 at 0.8 m and 45°), ``kinect-v1`` and ``realsense-d435``.
+#: PrimeSense Carmine 1.08 at 0.8 m and 45°), ``kinect-v1`` and ``realsense-d435``. Their colour
+#: noise is 0.01, 0.02 and 0.008 (sRGB units), our choice by sensor class, not a maker's figure.
 CAMERA_PRESETS: dict[str, Callable[[], CameraConfig]] = {
     "primesense": CameraConfig,
     "kinect-v1": _kinect_v1,
@@ -133,6 +160,18 @@ def camera_preset(name: str) -> CameraConfig:
         raise InvalidArgumentError(
             f"`camera` must be one of {sorted(CAMERA_PRESETS)}; got {name!r}")
     return CAMERA_PRESETS[name]()
+
+
+class Frame(NamedTuple):
+    """One frame: ``points`` ``(n, 3)`` world metres (noisy), and for each the flat ``pixel``
+    index ``(n,)``, the ``triangle`` its ray hit ``(n,)``, the noise-free ``hit`` ``(n, 3)`` and
+    that triangle's unit ``normal`` ``(n, 3)`` (as the mesh orients it)."""
+
+    points: NDArray[np.float64]
+    pixel: NDArray[np.int64]
+    triangle: NDArray[np.int64]
+    hit: NDArray[np.float64]
+    normal: NDArray[np.float64]
 
 
 class DepthCamera:
@@ -170,6 +209,11 @@ class DepthCamera:
 
     def depth_image(self, mesh: trimesh.Trimesh) -> NDArray[np.float64]:
         """``(height, width)`` noise-free depth along the optical axis, NaN where no return."""
+        return self._cast(mesh)[0]
+
+    def _cast(self, mesh: trimesh.Trimesh
+              ) -> tuple[NDArray[np.float64], NDArray[np.int64], NDArray[np.float64]]:
+        """Noise-free depth image, and per pixel the triangle hit (-1: none) and the hit point."""
         c = self.config
         origins = np.broadcast_to(self.origin, self.directions.shape)
         ray, tri, loc = cast_rays(mesh, np.ascontiguousarray(origins), self.directions,
@@ -178,12 +222,16 @@ class DepthCamera:
         cos_incidence = np.abs(np.einsum("ij,ij->i", mesh.face_normals[tri], self.directions[ray]))
         ok = cos_incidence >= np.cos(np.radians(c.grazing_deg))
         depth[ray[ok]] = (loc[ok] - self.origin) @ self._forward
-        return depth.reshape(c.height, c.width)
+        triangle = np.full(c.width * c.height, -1, dtype=np.int64)
+        triangle[ray[ok]] = tri[ok]
+        hit = np.full((c.width * c.height, 3), np.nan)
+        hit[ray[ok]] = loc[ok]
+        return depth.reshape(c.height, c.width), triangle, hit
 
-    def capture(self, mesh: trimesh.Trimesh, rng: np.random.Generator) -> NDArray[np.float64]:
-        """``(n, 3)`` world points of one frame of ``mesh`` (see the module docstring)."""
+    def capture(self, mesh: trimesh.Trimesh, rng: np.random.Generator) -> Frame:
+        """One frame of ``mesh``: world points and what each one's ray hit (module docstring)."""
         c = self.config
-        depth = self.depth_image(mesh)
+        depth, triangle, hit = self._cast(mesh)
         # draw every random number for every pixel so the stream never depends on the scene
         mix = rng.uniform(size=(2, c.height, c.width))
         gauss = rng.standard_normal(size=(c.height, c.width))
@@ -196,7 +244,25 @@ class DepthCamera:
         flat = depth.ravel()
         valid = np.isfinite(flat) & (flat > 0)
         rng_along = flat[valid] / self._cos_axis[valid]
-        return np.asarray(self.origin + self.directions[valid] * rng_along[:, None])
+        points = np.asarray(self.origin + self.directions[valid] * rng_along[:, None])
+        return Frame(points=points, pixel=np.flatnonzero(valid), triangle=triangle[valid],
+                     hit=hit[valid], normal=np.asarray(mesh.face_normals)[triangle[valid]])
+
+    def sensor_colors(self, light: NDArray[np.float64], pixel: NDArray[np.int64],
+                      rng: np.random.Generator) -> NDArray[np.float64]:
+        """``(n, 3)`` sRGB in ``[0, 1]`` of the ``(n, 3)`` linear ``light`` reaching the flat
+        ``pixel`` indices: vignetting, white balance, sRGB encoding, noise from ``rng`` (drawn for
+        every pixel of the image), clipping (module docstring)."""
+        c = self.config
+        u = pixel % c.width + 0.5 - c.width / 2
+        v = pixel // c.width + 0.5 - c.height / 2
+        r2 = (u * u + v * v) / ((c.width / 2) ** 2 + (c.height / 2) ** 2)
+        linear = light * (1.0 - c.vignetting * r2)[:, None] * np.array(c.white_balance)
+        out = linear_to_srgb(linear)
+        noise = rng.standard_normal(size=(c.height * c.width, 3))
+        if c.noise:
+            out = out + c.color_noise * noise[pixel]
+        return np.asarray(np.clip(out, 0.0, 1.0))
 
     def _flying_pixels(self, depth: NDArray[np.float64], mix: NDArray[np.float64]
                        ) -> NDArray[np.float64]:

@@ -8,7 +8,10 @@ import math
 from dataclasses import dataclass, field
 from typing import Any, ClassVar, Literal, get_args
 
+import numpy as np
+
 from deformap._validation import SettingError, check_settings, setting
+from deformap.world._appearance import parse_color
 from deformap.world._camera import CameraConfig
 from deformap.world._probe import ProbeGeometry
 from deformap.world._scenario import Scenario
@@ -86,6 +89,12 @@ class WorldConfig:
         The simulated depth camera.
     table_margin_m : float
         How far the table extends beyond the workspace on every side.
+    light_direction : (3,) float
+        Direction toward the scene's one distant light (any length; pointing up, ``z > 0``).
+    ambient : float
+        Share of the light that comes from everywhere (ambient), in ``[0, 1]``.
+    tip_color, stick_color, hand_color : (3,) float in [0, 1], or "#rrggbb"
+        Colours (sRGB) of the probe's tip, its stick and the hand that holds it.
     """
 
     physics: Physics = "linear-fem"
@@ -116,6 +125,17 @@ class WorldConfig:
     noise: bool = True
     camera: CameraConfig = field(default_factory=CameraConfig)
     table_margin_m: float = setting(0.2, gt=0.0)
+    # a light up and to the front left, as over a lab bench: side faces show three shades
+    light_direction: tuple[float, float, float] = setting(
+        (-0.3, -0.4, 1.0), ge=-1e3, le=1e3, doc="direction toward the light (z > 0)")
+    # a lit room: a third of the light on a face comes from everywhere
+    ambient: float = setting(0.3, ge=0.0, le=1.0, doc="share of ambient light")
+    tip_color: tuple[float, float, float] = setting(
+        (0.15, 0.15, 0.15), ge=0.0, le=1.0, doc="probe tip colour, sRGB")  # black rubber
+    stick_color: tuple[float, float, float] = setting(
+        (0.75, 0.75, 0.78), ge=0.0, le=1.0, doc="probe stick colour, sRGB")  # aluminium
+    hand_color: tuple[float, float, float] = setting(
+        (0.2, 0.35, 0.6), ge=0.0, le=1.0, doc="hand colour, sRGB")  # a blue gripper
 
     #: Settings that were removed, accepted (and ignored) in configuration files written before.
     RETIRED_SETTINGS: ClassVar[dict[str, str]] = {
@@ -123,7 +143,12 @@ class WorldConfig:
     }
 
     def __post_init__(self) -> None:
+        for name in ("tip_color", "stick_color", "hand_color"):
+            object.__setattr__(self, name, parse_color(getattr(self, name), name))
         check_settings(self)
+        light = np.asarray(self.light_direction)
+        if not light[2] > 1e-6 * np.linalg.norm(light):
+            raise SettingError("light_direction", f"must point up (z > 0); got {light.tolist()}")
 
     @property
     def probe(self) -> ProbeGeometry:

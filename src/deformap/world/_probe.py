@@ -33,18 +33,27 @@ class ProbeGeometry:
         x /= np.linalg.norm(x)
         return np.column_stack([x, np.cross(z, x), z])
 
-    def mesh(self, tip_center: NDArray[np.float64], normal: NDArray[np.float64]) -> trimesh.Trimesh:
-        """Triangle mesh of tip, stick and hand (for the camera)."""
-        rot = self._frame(normal)
-        pose = np.eye(4)
-        pose[:3, :3] = rot
+    def _parts(self) -> list[trimesh.Trimesh]:
+        """Tip, stick and hand in the probe's frame (tip centre at the origin, stick along z)."""
         tip = trimesh.creation.icosphere(subdivisions=2, radius=self.tip_radius_m)
         stick = trimesh.creation.cylinder(radius=self.stick_radius_m, height=self.stick_length_m,
                                           sections=16)
         stick.apply_translation([0.0, 0.0, self.stick_length_m / 2])
         hand = trimesh.creation.box(extents=self.hand_size_m)
         hand.apply_translation([0.0, 0.0, self.stick_length_m + self.hand_size_m[2] / 2])
-        parts: trimesh.Trimesh = trimesh.util.concatenate([tip, stick, hand])  # type: ignore[assignment]
+        return [tip, stick, hand]
+
+    def part_faces(self) -> tuple[int, int, int]:
+        """Triangles of the tip, the stick and the hand, in the order :meth:`mesh` stacks them."""
+        tip, stick, hand = (len(p.faces) for p in self._parts())
+        return tip, stick, hand
+
+    def mesh(self, tip_center: NDArray[np.float64], normal: NDArray[np.float64]) -> trimesh.Trimesh:
+        """Triangle mesh of tip, stick and hand (for the camera)."""
+        rot = self._frame(normal)
+        pose = np.eye(4)
+        pose[:3, :3] = rot
+        parts: trimesh.Trimesh = trimesh.util.concatenate(self._parts())  # type: ignore[assignment]
         pose[:3, 3] = tip_center
         parts.apply_transform(pose)
         return parts

@@ -3,7 +3,8 @@
 A layout family (:mod:`deformap.world._layouts`) cuts the workspace into pieces, each made of one
 of a few materials. Each material gets a hardness drawn uniformly from the foam range, at least
 ``min_hardness_gap_n`` apart, and with probability ``p_rigid`` one material is a rigid board
-instead.
+instead. An appearance family (:mod:`deformap.world._paint`) paints the pieces, from a generator
+spawned from the one given, so that the layout and the materials are the same whatever the family.
 """
 
 from __future__ import annotations
@@ -14,6 +15,7 @@ from deformap._validation import check_in_range, check_int
 from deformap.environment import Workspace
 from deformap.errors import InvalidArgumentError
 from deformap.world._layouts import LAYOUT_FAMILIES, Piece, cut_pieces, layout_pieces
+from deformap.world._paint import APPEARANCE_FAMILIES, paint_pieces
 from deformap.world._scenario import Block, Scenario
 
 __all__ = ["random_scenario"]
@@ -42,6 +44,7 @@ def random_scenario(
     workspace: Workspace | None = None,
     min_area_fraction: float = 0.15,
     min_hardness_gap_n: float = 20.0,
+    appearance: str = "plain",
 ) -> Scenario:
     """A random heterogeneous scenario.
 
@@ -63,6 +66,9 @@ def random_scenario(
         ``cuts`` only: the smallest piece's share of the area.
     min_hardness_gap_n : float
         Least difference of two materials' hardness.
+    appearance : str
+        One of :data:`deformap.world.APPEARANCE_FAMILIES` (:mod:`deformap.world._paint`); the
+        default, ``plain``, paints every block the default grey and draws nothing.
     """
     if not isinstance(rng, np.random.Generator):
         raise InvalidArgumentError(f"`rng` must be a numpy.random.Generator; got {type(rng)}")
@@ -78,6 +84,9 @@ def random_scenario(
             f"`hardness_range_n` must be (low, high) with 0 < low < high; got {hardness_range_n}"
         )
     check_in_range("p_rigid", p_rigid, 0.0, 1.0, closed_high=True)
+    if appearance not in APPEARANCE_FAMILIES:
+        raise InvalidArgumentError(
+            f"`appearance` must be one of {list(APPEARANCE_FAMILIES)}; got {appearance!r}")
     ws = workspace or Workspace()
     if family == "cuts":
         n = int(rng.integers(2, 5)) if n_regions is None else check_int("n_regions", n_regions)
@@ -93,18 +102,20 @@ def random_scenario(
             f"{min_hardness_gap_n:g} N apart; widen it or lower `min_hardness_gap_n`")
     hardness = _hardnesses(rng, n_materials, h_lo, h_hi, min_hardness_gap_n)
     rigid_material = int(rng.integers(n_materials)) if rng.uniform() < p_rigid else -1
+    looks = paint_pieces(appearance, pieces, ws, rng.spawn(1)[0] if appearance != "plain" else rng)
     blocks = []
-    for k, piece in enumerate(pieces):
+    for k, (piece, look) in enumerate(zip(pieces, looks, strict=True)):
         m = piece.material
         if m == rigid_material:
             blocks.append(Block(name=f"region-{k}-rigid", polygon=piece.polygon,
                                 holes=piece.holes, rigid=True, thickness_m=thickness_m,
-                                color=_RIGID_COLOR))
+                                color=_RIGID_COLOR, appearance=look))
         else:
             h = round(float(hardness[m]), 1)
             blocks.append(Block(name=f"region-{k}-{h:g}N", polygon=piece.polygon,
                                 holes=piece.holes, hardness_n=h, thickness_m=thickness_m,
-                                color=_PALETTE[m % len(_PALETTE)]))
+                                color=_PALETTE[m % len(_PALETTE)], appearance=look))
+    painted = "" if appearance == "plain" else f", painted {appearance}"
     return Scenario(name=f"random-{family}", blocks=tuple(blocks), workspace=ws,
                     description=f"random {family} world: {len(pieces)} pieces of "
-                                f"{n_materials} materials")
+                                f"{n_materials} materials{painted}")

@@ -37,6 +37,7 @@ from deformap._validation import SettingError, check_array, check_settings, sett
 from deformap.environment import Workspace
 from deformap.errors import InvalidArgumentError
 from deformap.mechanics import hardness_to_youngs_modulus, youngs_modulus_to_hardness
+from deformap.world._appearance import Appearance, parse_color
 from deformap.world._polygon import (
     is_simple,
     overlap_area,
@@ -82,6 +83,9 @@ class Block:
         A block that does not deform (then neither hardness nor modulus is given).
     color : str
         Matplotlib colour for figures.
+    appearance : Appearance or None
+        How the camera sees the block (:mod:`deformap.world._appearance`); None:
+        :data:`~deformap.world._appearance.DEFAULT_APPEARANCE`, neutral grey and plain.
     """
 
     name: str
@@ -98,6 +102,7 @@ class Block:
     youngs_modulus_pa: float | None = setting(None, ge=10.0, le=1e10)
     rigid: bool = False
     color: str = "#c8a165"
+    appearance: Appearance | None = None
 
     def __post_init__(self) -> None:
         try:
@@ -190,6 +195,8 @@ class Block:
             out["hardness_n"] = float(self.hardness_n)  # type: ignore[arg-type]
         out["thickness_m"] = self.thickness_m
         out["color"] = self.color
+        if self.appearance is not None:
+            out["appearance"] = self.appearance.to_dict()
         return out
 
 
@@ -205,12 +212,16 @@ class Scenario:
     workspace : Workspace
         The rectangle to map (60 × 40 cm by default), at most :data:`MAX_EXTENT_M` on each side.
     description : str
+    table_appearance : Appearance or None
+        How the camera sees the table; None:
+        :data:`~deformap.world._appearance.DEFAULT_TABLE_APPEARANCE`.
     """
 
     name: str
     blocks: tuple[Block, ...]
     workspace: Workspace = field(default_factory=Workspace)
     description: str = ""
+    table_appearance: Appearance | None = None
 
     def __post_init__(self) -> None:
         check_settings(self)
@@ -261,9 +272,12 @@ class Scenario:
         return np.asarray(np.array([*values, table], dtype=float)[self.labels(xs, ys)])
 
     def to_dict(self) -> dict[str, Any]:
-        return {"name": self.name, "description": self.description,
-                "workspace": self.workspace.to_dict(),
-                "blocks": [b.to_dict() for b in self.blocks]}
+        out = {"name": self.name, "description": self.description,
+               "workspace": self.workspace.to_dict(),
+               "blocks": [b.to_dict() for b in self.blocks]}
+        if self.table_appearance is not None:
+            out["table_appearance"] = self.table_appearance.to_dict()
+        return out
 
 
 def _ring(what: str, vertices: Any) -> NDArray[np.float64]:
@@ -282,14 +296,21 @@ def _ring(what: str, vertices: Any) -> NDArray[np.float64]:
 
 _FOAM_COLORS = {60: "#f4d35e", 110: "#ee964b", 150: "#c8553d"}
 _RIGID_COLOR = "#6b4f3a"
+# open-cell foam: a fine mottle of pores, finer in the denser (harder) foams; a wooden board: grain
+_FOAM_PORES_M = {60: 0.005, 110: 0.004, 150: 0.003}
 
 
 def _foam(name: str, poly: NDArray[np.float64], hardness: int) -> Block:
-    return Block(name=name, polygon=poly, hardness_n=float(hardness), color=_FOAM_COLORS[hardness])
+    look = Appearance(color=parse_color(_FOAM_COLORS[hardness]), texture="noise",
+                      scale_m=_FOAM_PORES_M[hardness], amplitude=0.15, seed=hardness)
+    return Block(name=name, polygon=poly, hardness_n=float(hardness), color=_FOAM_COLORS[hardness],
+                 appearance=look)
 
 
 def _rigid(name: str, poly: NDArray[np.float64]) -> Block:
-    return Block(name=name, polygon=poly, rigid=True, color=_RIGID_COLOR)
+    look = Appearance(color=parse_color(_RIGID_COLOR), texture="stripes", scale_m=0.006, amplitude=0.1,
+                      angle_deg=90.0)
+    return Block(name=name, polygon=poly, rigid=True, color=_RIGID_COLOR, appearance=look)
 
 
 def builtin_scenarios() -> dict[str, Scenario]:

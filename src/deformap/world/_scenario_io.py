@@ -10,11 +10,22 @@ Format (every key is checked; an unknown key is an error)::
         rect: [0.0, 0.0, 0.3, 0.4]       # x0, y0, x1, y1 in metres ...
         hardness_n: 60                   # ... one of hardness_n, youngs_modulus_pa, rigid: true
         thickness_m: 0.05                # optional, default 0.05
-        color: "#f4d35e"                 # optional
+        color: "#f4d35e"                 # optional, for figures
+        appearance:                      # optional: how the camera sees it (default grey, plain)
+          color: "#f4d35e"               # sRGB, or [r, g, b] in [0, 1]
+          texture: noise                 # plain | noise | stripes | photo
+          scale_m: 0.005                 # pitch, period or photograph side in metres
+          amplitude: 0.15                # largest relative change of brightness
       - name: hard
         polygon: [[0.3, 0], [0.6, 0], [0.6, 0.4], [0.3, 0.4]]   # or any simple polygon
         holes: [[[0.4, 0.1], [0.5, 0.1], [0.45, 0.2]]]   # optional: left empty, inside it
         rigid: true
+        appearance: {color: [0.4, 0.3, 0.2], texture: photo, photo: gravel, scale_m: 0.2,
+                     split: {through: [0.45, 0.2], normal_deg: 0, color: "#3050a0"}}
+    table_appearance: {color: "#5a5550"}   # optional: the table's look
+
+Every appearance key and its default is listed in ``docs/scenarios.md``
+(:class:`~deformap.world._appearance.Appearance`).
 """
 
 from __future__ import annotations
@@ -28,14 +39,15 @@ import yaml
 from deformap._config import load_yaml
 from deformap.environment import Workspace
 from deformap.errors import ConfigError, DeformapError
+from deformap.world._appearance import Appearance, appearance_from_dict
 from deformap.world._polygon import rectangle
 from deformap.world._scenario import Block, Scenario, builtin_scenarios
 
 __all__ = ["list_scenarios", "load_scenario", "parse_scenario", "save_scenario"]
 
-_SCENARIO_KEYS = {"name", "description", "workspace", "blocks"}
+_SCENARIO_KEYS = {"name", "description", "workspace", "blocks", "table_appearance"}
 _BLOCK_KEYS = {"name", "rect", "polygon", "holes", "hardness_n", "youngs_modulus_pa", "rigid",
-               "thickness_m", "color"}
+               "thickness_m", "color", "appearance"}
 _WORKSPACE_KEYS = {"lower", "upper"}
 
 
@@ -103,17 +115,26 @@ def _block(data: Any, where: str) -> Block:
         rigid = data.get("rigid", False)
         if not isinstance(rigid, bool):
             raise ConfigError(f"{where}: `rigid` must be true or false; got {rigid!r}")
+        look = data.get("appearance")
         return Block(
             name=str(data.get("name", "")), polygon=poly,
             holes=tuple(np.asarray(h, dtype=float) for h in data.get("holes", ())),
             thickness_m=data.get("thickness_m", 0.05),
             hardness_n=data.get("hardness_n"), youngs_modulus_pa=data.get("youngs_modulus_pa"),
             rigid=rigid, color=str(data.get("color", "#6b4f3a" if rigid else "#c8a165")),
+            appearance=None if look is None else _appearance(look, f"{where}.appearance"),
         )
     except (TypeError, ValueError, DeformapError) as exc:
         if isinstance(exc, ConfigError):
             raise
         raise ConfigError(f"{where}: {exc}") from None
+
+
+def _appearance(data: Any, where: str) -> Appearance:
+    try:
+        return appearance_from_dict(data, where)
+    except ValueError as exc:
+        raise ConfigError(str(exc)) from None
 
 
 def parse_scenario(data: Any, *, source: str = "<scenario>") -> Scenario:
@@ -131,11 +152,13 @@ def parse_scenario(data: Any, *, source: str = "<scenario>") -> Scenario:
     if not isinstance(ws, dict):
         raise ConfigError(f"{source}: `workspace` must be a mapping with `lower` and `upper`")
     _unknown(f"{source}: workspace", ws, _WORKSPACE_KEYS)
+    table = data.get("table_appearance")
+    table_look = None if table is None else _appearance(table, f"{source}: table_appearance")
     try:
         workspace = Workspace(lower=tuple(ws.get("lower", (0.0, 0.0))),
                               upper=tuple(ws.get("upper", (0.6, 0.4))))
         return Scenario(name=str(data["name"]), blocks=blocks, workspace=workspace,
-                        description=str(data.get("description", "")))
+                        description=str(data.get("description", "")), table_appearance=table_look)
     except DeformapError as exc:
         if isinstance(exc, ConfigError):
             raise

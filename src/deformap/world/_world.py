@@ -9,6 +9,11 @@ Each press also returns its force–travel record (``PressObservation.force_trav
 noise stream of its own so that the press's other draws are those of a world without the record
 (:mod:`deformap.world._force_travel`).
 
+Each frame carries the colour the camera sees at every point (:mod:`deformap.world._looks`,
+:meth:`DepthCamera.sensor_colors <deformap.world._camera.DepthCamera.sensor_colors>`); the colour
+noise comes from a stream of its own per event, so the depth's draws are those of a world without
+colour.
+
 Ground truth labels are block indices (``-1`` = bare table); hardness and modulus are ``inf`` on
 rigid blocks and the bare table.
 """
@@ -37,10 +42,11 @@ from deformap.environment import (
     Workspace,
 )
 from deformap.errors import EnvironmentStateError, InvalidArgumentError
-from deformap.world._camera import DepthCamera
+from deformap.world._camera import DepthCamera, Frame
 from deformap.world._config import WorldConfig, check_world_budget
 from deformap.world._foam import Dent, FoamModel
 from deformap.world._force_travel import force_levels, simulated_force_travel
+from deformap.world._looks import HAND, STICK, TABLE, TIP, SceneLooks
 from deformap.world._scenario import BARE_TABLE, Block, Scenario
 from deformap.world._stiffening import StiffeningFoam
 from deformap.world._stiffening_fem import StiffeningFem
@@ -68,7 +74,7 @@ class SimulatedWorld:
         Source of the camera and force-sensor noise. One number is drawn from it at construction;
         each event then draws from a stream keyed by that number and the event (the n-th observation
         at rest; a press by its target and force), so a resumed run sees the noise the uninterrupted
-        run saw.
+        run saw. The colour noise of an event has a stream of its own, keyed the same way.
 
     Notes
     -----
@@ -108,8 +114,9 @@ class SimulatedWorld:
         camera = c.camera if c.noise else replace(c.camera, noise=False)
         self.camera = DepthCamera(camera, scenario.workspace.center)
         self._force_noise_n = c.force_noise_n if c.noise else 0.0
-        self._faces = self._surface_triangles()
+        self._faces, self._owner = self._surface_triangles()
         self._table = self._table_mesh()
+        self.looks = SceneLooks(scenario, self.config)
         self._pressed: PressObservation | None = None
         self._displacement = self.foam.zero_displacement()
 
@@ -121,11 +128,24 @@ class SimulatedWorld:
     def observe(self) -> PointCloud:
         """One depth frame of the scene as it is now, world frame."""
         if self._pressed is None:
-            rng = self._event_rng(0, self._n_observed)
+            key: tuple[int, ...] = (0, self._n_observed)
             self._n_observed += 1
-            return self._capture(self._displacement, None, rng)
+            return self._capture(self._displacement, None, self._event_rng(*key), key)
         p = self._pressed
-        return self._capture(self._displacement, p.contact, self._press_rng(p.target_xy, p.force_n, 1))
+        key = self._press_key(p.target_xy, p.force_n, 1)
+        return self._capture(self._displacement, p.contact, self._event_rng(*key), key)
+
+    def rgb_image(self) -> NDArray[np.float64]:
+        """``(height, width, 3)`` sRGB in ``[0, 1]`` of the scene as it is now, as the camera sees
+        it (colour noise included, from a stream of its own: no event's draws change); NaN where a
+        pixel has no return."""
+        contact = None if self._pressed is None else self._pressed.contact
+        frame = self.camera.capture(self.scene_mesh(self._displacement, contact),
+                                    self._event_rng(5))
+        c = self.camera.config
+        image = np.full((c.height * c.width, 3), np.nan)
+        image[frame.pixel] = self._colors(frame, contact is not None, self._event_rng(6))
+        return image.reshape(c.height, c.width, 3)
 
     def press(self, target_xy: Any, force_n: float) -> PressObservation:
         """Press at ``target_xy`` with ``force_n`` newtons along the surface normal and hold."""
@@ -141,11 +161,12 @@ class SimulatedWorld:
                 f"{tuple(np.round(self._pressed.target_xy, 4))}; call release() first")
         dent = self.dent(target, force)
         tip_center = self._tip_center(target, dent)
-        rng = self._press_rng(target, force, 0)
+        key = self._press_key(target, force, 0)
+        rng = self._event_rng(*key)
         noise = rng.normal(0.0, 1.0, size=3) * self._force_noise_n
         contact = TactileContact(tip_center=tip_center, force=-_UP * force + noise,
                                  tip_radius_m=self.config.tip_radius_m)
-        cloud = self._capture(dent.displacement, contact, rng)
+        cloud = self._capture(dent.displacement, contact, rng, key)
         self._displacement = dent.displacement
         self._pressed = PressObservation(
             cloud=cloud, contact=contact, target_xy=target, force_n=force,
@@ -227,7 +248,7 @@ class SimulatedWorld:
         noisy = c.noise
         try:
             return simulated_force_travel(
-                depths, levels, self._press_rng(target, force, 2),
+                depths, levels, self._event_rng(*self._press_key(target, force, 2)),
                 encoder_noise_m=c.encoder_noise_m if noisy else 0.0,
                 force_noise_rel=c.force_travel_noise_rel if noisy else 0.0,
                 force_noise_n=c.force_travel_noise_n if noisy else 0.0)
@@ -294,12 +315,14 @@ class SimulatedWorld:
         top = 0.0 if index == BARE_TABLE else self.regions[index].thickness_m
         return np.array([target[0], target[1], top - dent.depth_m + self.config.tip_radius_m])
 
-    def _surface_triangles(self) -> NDArray[np.int64]:
-        tris = []
-        for grid, off in zip(self.foam.grids, self.foam.offsets, strict=True):
+    def _surface_triangles(self) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+        """The blocks' surface triangles and the block that owns each."""
+        tris, owner = [], []
+        for k, (grid, off) in enumerate(zip(self.foam.grids, self.foam.offsets, strict=True)):
             q = grid.surface_quads() + off
             tris.append(np.concatenate([q[:, [0, 1, 2]], q[:, [0, 2, 3]]]))
-        return np.concatenate(tris)
+            owner.append(np.full(2 * len(q), k, dtype=np.int64))
+        return np.concatenate(tris), np.concatenate(owner)
 
     def _table_mesh(self) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
         m = self.config.table_margin_m
@@ -323,13 +346,25 @@ class SimulatedWorld:
     def _event_rng(self, *key: int) -> np.random.Generator:
         return np.random.default_rng([self._noise_key, *key])
 
-    def _press_rng(self, target: NDArray[np.float64], force: float, view: int
-                   ) -> np.random.Generator:
+    def _press_key(self, target: NDArray[np.float64], force: float, view: int
+                   ) -> tuple[int, ...]:
         # Micrometres and micronewtons, shifted to be non-negative: SeedSequence takes naturals.
         x, y = (round(v * 1e6) + 2**40 for v in target)
-        return self._event_rng(1, x, y, round(force * 1e6), view)
+        return 1, x, y, round(force * 1e6), view
 
     def _capture(self, displacement: NDArray[np.float64], contact: TactileContact | None,
-                 rng: np.random.Generator) -> PointCloud:
-        points = self.camera.capture(self.scene_mesh(displacement, contact), rng)
-        return PointCloud(points=points, frame="world")
+                 rng: np.random.Generator, key: tuple[int, ...]) -> PointCloud:
+        frame = self.camera.capture(self.scene_mesh(displacement, contact), rng)
+        # the colour's own stream: a key no depth or force stream has (those start with 0 or 1)
+        colors = self._colors(frame, contact is not None, self._event_rng(3, *key))
+        return PointCloud(points=frame.points, colors=colors, frame="world")
+
+    def _colors(self, frame: Frame, probe: bool, rng: np.random.Generator
+                ) -> NDArray[np.float64]:
+        owner = [self._owner, np.full(len(self._table[1]), TABLE)]
+        if probe:
+            owner += [np.full(n, part) for n, part in
+                      zip(self.config.probe.part_faces(), (TIP, STICK, HAND), strict=True)]
+        hit_owner = np.concatenate(owner)[frame.triangle]
+        light = self.looks.radiance(hit_owner, frame.hit, frame.normal, self.camera.origin)
+        return self.camera.sensor_colors(light, frame.pixel, rng)
