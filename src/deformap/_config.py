@@ -75,8 +75,7 @@ def _shape(value: Any, hint: Any, where: str) -> Any:
 def config_from_dict(cls: type[T], data: Any, *, where: str = "config") -> T:
     """Build the settings dataclass ``cls`` from plain data; missing keys keep their defaults.
 
-    A class may read files written by an older version through a static ``upgrade_settings(data)
-    -> data`` (called first, on its own level of the data). A key the class lists in its
+    A key the class lists in its
     ``RETIRED_SETTINGS`` (a setting that was removed, with why) is
     accepted with a logged warning and dropped, so configuration files written before still load.
     The data is only shaped (mappings into nested dataclasses, lists into tuples) and handed to
@@ -97,10 +96,6 @@ def config_from_dict(cls: type[T], data: Any, *, where: str = "config") -> T:
             shown = f"{type(data).__name__} of {len(str(data))} characters, {shown[:60]}…"
         raise ConfigError(f"`{where}` must be a mapping of settings; got {shown}")
     fields = {f.name: f for f in dataclasses.fields(cls) if f.init}  # type: ignore[arg-type]
-    # files written by an older version: the class reads them as they were meant
-    upgrade = getattr(cls, "upgrade_settings", None)
-    if upgrade is not None:
-        data = upgrade(dict(data))
     # settings that were removed: accepted in files written before, said once, and dropped
     retired: dict[str, str] = getattr(cls, "RETIRED_SETTINGS", {})
     for key in sorted(set(data) & set(retired)):
