@@ -56,7 +56,7 @@ def _scores(world: SimulatedWorld, mapper: Mapper) -> dict[str, Any]:
     out: dict[str, Any] = {"max_variance": mapper.max_variance(), "field": field.name}
     for cut in CUTS:
         config = dataclasses.replace(mapper.config, region_labels=cut)
-        found = map_regions(field.mean, field.pokes, mapper.grid.cells_xy, config)
+        found = map_regions(field.mean, field.pokes, mapper.grid.cells_xy, config, field.name)
         score = region_scores(found.labels, truth, sign * field.mean, hardness)
         out[cut] = {"accuracy": score.accuracy, "mean_iou": score.mean_iou,
                     "found": score.found, "true": score.true}

@@ -205,18 +205,12 @@ def test_yaml_that_the_parser_cannot_take_is_a_config_error(
         load_yaml(bad)
 
 
-def test_a_retired_setting_in_an_older_file_is_ignored_with_a_warning(caplog) -> None:  # type: ignore[no-untyped-def]
+def test_a_setting_of_a_pre_release_file_is_refused_in_one_line() -> None:
     from deformap.run import RunConfig
-    from deformap.world import WorldConfig
 
     older = {"world": {"default_force_n": 0.6, "element_size_m": 0.02}}
-    with caplog.at_level("WARNING", logger="deformap._config"):
-        config = config_from_dict(RunConfig, older)
-    assert config.world == WorldConfig(element_size_m=0.02)
-    assert "`config.world.default_force_n` is no longer a setting" in caplog.text
-    # a key that never was a setting is still refused
-    with pytest.raises(ConfigError, match="unknown key"):
-        config_from_dict(RunConfig, {"world": {"default_force": 0.6}})
+    with pytest.raises(ConfigError, match=r"`config.world` has unknown key\(s\) \['default_force_n'\]"):
+        config_from_dict(RunConfig, older)
 
 
 def test_a_file_that_sets_a_removed_exploration_switch_is_refused_in_one_line() -> None:

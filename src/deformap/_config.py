@@ -75,9 +75,6 @@ def _shape(value: Any, hint: Any, where: str) -> Any:
 def config_from_dict(cls: type[T], data: Any, *, where: str = "config") -> T:
     """Build the settings dataclass ``cls`` from plain data; missing keys keep their defaults.
 
-    A key the class lists in its
-    ``RETIRED_SETTINGS`` (a setting that was removed, with why) is
-    accepted with a logged warning and dropped, so configuration files written before still load.
     The data is only shaped (mappings into nested dataclasses, lists into tuples) and handed to
     the constructor, whose ``__post_init__`` checks every field (:func:`check_settings`): a value
     is refused or accepted exactly as it would be from Python.
@@ -96,11 +93,6 @@ def config_from_dict(cls: type[T], data: Any, *, where: str = "config") -> T:
             shown = f"{type(data).__name__} of {len(str(data))} characters, {shown[:60]}…"
         raise ConfigError(f"`{where}` must be a mapping of settings; got {shown}")
     fields = {f.name: f for f in dataclasses.fields(cls) if f.init}  # type: ignore[arg-type]
-    # settings that were removed: accepted in files written before, said once, and dropped
-    retired: dict[str, str] = getattr(cls, "RETIRED_SETTINGS", {})
-    for key in sorted(set(data) & set(retired)):
-        logger.warning("`%s.%s` is no longer a setting (%s); ignored", where, key, retired[key])
-    data = {k: v for k, v in data.items() if k not in retired}
     unknown = sorted(set(data) - set(fields))
     if unknown:
         raise ConfigError(

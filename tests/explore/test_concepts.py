@@ -102,10 +102,10 @@ def test_regions_by_isopleth_and_by_nearest_poke() -> None:
     config = ExplorationConfig()
     grid = MapGrid.build(WORKSPACE, config)
     field = BetaField(pokes, grid.xs, grid.ys, config.beta_field)
-    by_level = map_regions(field.mean, pokes, grid.cells_xy, config)
+    by_level = map_regions(field.mean, pokes, grid.cells_xy, config, field.name)
     assert by_level.n_regions == 2 and by_level.poke_labels.tolist() == [1, 1, 1, 0, 0, 0]
     nearest = map_regions(field.mean, pokes, grid.cells_xy,
-                          ExplorationConfig(region_labels="nearest"))
+                          ExplorationConfig(region_labels="nearest"), field.name)
     # a cell right by each poke takes that poke's class
     for p, label in zip(xy, nearest.poke_labels, strict=True):
         at = np.argmin(np.sum((grid.cells_xy - p) ** 2, axis=1))

@@ -153,7 +153,7 @@ def test_the_mapper_fits_the_beta_field_with_the_nugget_and_plans_with_it() -> N
     assert np.allclose(mapper.beta_field.gp.predict(pokes.xy[:1], return_std=True)[1] ** 2,
                        _posterior_var_at_first(pokes), rtol=1e-6)
     # a press far from every poke is expected to carry the nugget too
-    far = expected_noise(np.array([[0.55, 0.38]]), pokes, CONFIG)
+    far = expected_noise(np.array([[0.55, 0.38]]), pokes, CONFIG, CONFIG.field)
     assert far[0] == pytest.approx(np.hypot(beta_noise_floor(CONFIG), pokes.nugget))
 
 

@@ -203,5 +203,6 @@ def test_a_further_press_is_expected_as_noisy_as_the_place_has_read() -> None:
     floor = beta_noise_floor(config)
     pokes = PokeSet.of([synthetic_poke((0.3, 0.2), 0.5, 0.2).record,
                         synthetic_poke((0.1, 0.1), 0.5, 0.001).record], noise_floor=floor)
-    noise = expected_noise(np.array([[0.3, 0.21], [0.1, 0.1], [0.5, 0.3]]), pokes, config)
+    noise = expected_noise(np.array([[0.3, 0.21], [0.1, 0.1], [0.5, 0.3]]), pokes, config,
+                           config.field)
     assert noise.tolist() == [0.2, floor, floor]  # near the noisy poke; the floor elsewhere

@@ -295,7 +295,8 @@ def test_with_the_split_by_place_on_the_junction_rule_still_merges_a_joint_colum
     pokes = PokeSet(xy, value, np.full(len(xy), 0.1), thickness=np.full(len(xy), 0.06))
     cells = np.array([(x, y) for y in np.linspace(0, 0.4, 9) for x in np.linspace(0, 0.6, 13)])
     mean = np.zeros((9, 13))
-    on = map_regions(mean, pokes, cells, ExplorationConfig(field="modulus"))
-    off = map_regions(mean, pokes, cells, ExplorationConfig(field="modulus", split_by_place=False))
+    on = map_regions(mean, pokes, cells, ExplorationConfig(field="modulus"), "modulus")
+    off = map_regions(mean, pokes, cells,
+                      ExplorationConfig(field="modulus", split_by_place=False), "modulus")
     assert on.n_regions == off.n_regions == 2  # the joint merged; the two foams not split again
     np.testing.assert_array_equal(on.poke_labels, off.poke_labels)

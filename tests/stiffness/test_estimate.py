@@ -335,7 +335,8 @@ def test_bad_input_is_refused_naming_the_argument(change, name):
 def test_travel_may_step_back_by_its_noise():
     args = _good()
     args["travel_m"][5] = args["travel_m"][4] - 2 * TRAVEL_SIGMA
-    estimate_stiffness(**args)
+    est = estimate_stiffness(**args)
+    assert not est.rigid and np.isfinite(est.modulus_pa) and est.modulus_pa > 0
 
 
 @pytest.mark.parametrize(("field", "value"), [

@@ -109,6 +109,7 @@ app = typer.Typer(
     no_args_is_help=True,
     add_completion=False,
     pretty_exceptions_enable=False,
+    rich_markup_mode="rich",  # _ReflowingGroup escapes square brackets for rich markup
 )
 
 def _json_target(value: Path | None) -> Path | None:

@@ -70,7 +70,8 @@ def rescore_world(task: WorldTask, result: WorldResult) -> WorldResult:
         sign = -1.0 if mapped == "modulus" else 1.0
         for cut in task.cuts:  # a finished world has a poke with a value at every k
             found = map_regions(mean, pokes, grid.cells_xy,
-                                replace(config, region_labels=cast(RegionLabels, cut)))
+                                replace(config, region_labels=cast(RegionLabels, cut)),
+                                mapped)
             scores = region_scores(found.labels, labels, sign * mean, hardness)
             rows.append({**old, "cut": cut, "accuracy": scores.accuracy,
                          "mean_iou": scores.mean_iou, "found": scores.found,

@@ -285,11 +285,11 @@ def ranked(grid: NDArray[np.float64], values: NDArray[np.float64],
 
 
 def poke_classes(mean: NDArray[np.float64], pokes: PokeSet, config: ExplorationConfig,
-                 field: FieldName | None = None) -> RegionMap:
+                 field: FieldName) -> RegionMap:
     """The pokes' classes and the isopleth labels of the map field's mean ``mean (ny, nx)``, by
     :func:`segment_regions` with the exploration's settings (``max_regions``,
-    ``region_prior_dof``) and the noise floor and smallest step of the field ``field`` (default:
-    ``config.field``; :func:`deformap.explore.field_settings`: β, or ln E for ``"modulus"``)."""
+    ``region_prior_dof``) and the noise floor and smallest step of the field ``field`` (the one
+    mapped on; :func:`deformap.explore.field_settings`: β, or ln E for ``"modulus"``)."""
     cfg = field_settings(config, field)
     return segment_regions(mean, pokes.values, pokes.noise, floor=cfg.noise_floor,
                            min_step=cfg.min_step, max_regions=config.max_regions,

@@ -28,9 +28,10 @@ __all__ = ["map_regions"]
 
 
 def map_regions(mean: NDArray[np.float64], pokes: PokeSet, cells_xy: NDArray[np.float64],
-                config: ExplorationConfig, field: FieldName | None = None) -> RegionMap:
-    """The regions of the field ``field`` (default: ``config.field``) with mean ``mean (ny, nx)``
-    fitted to ``pokes``, as the exploration settings ask: classes by
+                config: ExplorationConfig, field: FieldName) -> RegionMap:
+    """The regions of the field ``field`` (the one mapped on, which after a fallback is not
+    ``config.field``) with mean ``mean (ny, nx)`` fitted to ``pokes``, as the exploration
+    settings ask: classes by
     :func:`deformap.explore.segment_regions` (``max_regions``, ``region_prior_dof``, the field's
     noise floor and smallest step), junctions merged (``merge_seams``) and classes split by place
     (``split_by_place``), cells labelled by isopleth, by nearest poke or by indicator kriging

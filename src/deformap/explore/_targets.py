@@ -35,11 +35,11 @@ closer pokes would measure much the same foam again."""
 
 
 def expected_noise(candidates: NDArray[np.float64], pokes: PokeSet, config: ExplorationConfig,
-                   field: FieldName | None = None) -> NDArray[np.float64]:
+                   field: FieldName) -> NDArray[np.float64]:
     """The β uncertainty a poke at each of ``candidates (c, 2)`` is expected to have: the largest
     of the pokes already made within ``BOUNDARY_SPACING_ROI`` ROIs of it (a dent spreads a few
     centimetres, so a press there measures that foam again, no better), else the map field's
-    noise floor (:func:`deformap.explore.field_settings` of ``field``, default ``config.field``)
+    noise floor (:func:`deformap.explore.field_settings` of ``field``)
     with the map's nugget added in variance
     (``pokes.nugget``: any press carries the scatter between places of one material). So the
     target choice knows what a further press at a place can still reduce, and does not return to

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any, ClassVar, Literal, get_args
+from typing import Any, Literal, get_args
 
 import numpy as np
 
@@ -136,11 +136,6 @@ class WorldConfig:
         (0.75, 0.75, 0.78), ge=0.0, le=1.0, doc="probe stick colour, sRGB")  # aluminium
     hand_color: tuple[float, float, float] = setting(
         (0.2, 0.35, 0.6), ge=0.0, le=1.0, doc="hand colour, sRGB")  # a blue gripper
-
-    #: Settings that were removed, accepted (and ignored) in configuration files written before.
-    RETIRED_SETTINGS: ClassVar[dict[str, str]] = {
-        "default_force_n": "the press force is the exploration's `force_n`",
-    }
 
     def __post_init__(self) -> None:
         for name in ("tip_color", "stick_color", "hand_color"):
