@@ -40,7 +40,8 @@ def write_map_figures(
     truth : object with ``ground_truth_hardness(xs, ys)``, optional
         As in :func:`~deformap.run.shared_report`; without it the map has no ground-truth panel.
     threshold : float, optional
-        T_h of the map field (``field_settings(config).threshold``), drawn on the variance
+        T_h of the map field actually used (``field_settings(result.config,
+        result.map_field_name).threshold``), drawn on the variance
         panel.
     title : str
     poke_figures : bool
