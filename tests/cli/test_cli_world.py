@@ -18,11 +18,11 @@ def test_scenarios_lists_table_i() -> None:
         assert name in result.output
 
 
-def test_world_show_writes_three_pictures(tmp_path) -> None:
+def test_world_show_writes_four_pictures(tmp_path) -> None:
     result = runner.invoke(app, ["world", "show", "heterogeneous-150-rigid", "--out",
                                  str(tmp_path), "--coarse"])
     assert result.exit_code == 0, result.output
-    for name in ("layout.png", "cloud.png", "dent.png"):
+    for name in ("layout.png", "rgb.png", "cloud.png", "dent.png"):
         data = (tmp_path / name).read_bytes()
         assert data[:8] == b"\x89PNG\r\n\x1a\n" and len(data) > 10_000
 

@@ -439,15 +439,34 @@ def test_hardness_figure_puts_e_beside_beta_and_its_conditions_in_the_title() ->
     assert "read rigid" in [t.get_text() for t in modulus.texts]
 
 
-def test_show_world_writes_three_pictures_and_nothing_else(tmp_path: Path) -> None:
+def test_show_world_writes_four_pictures_and_nothing_else(tmp_path: Path) -> None:
     from deformap.testing import coarse_world
 
     out = tmp_path / "new" / "folder"
     paths = show_world(coarse_world("heterogeneous-150-rigid"), str(out), force_n=0.6)
-    assert paths == [out / "layout.png", out / "cloud.png", out / "dent.png"]
+    assert paths == [out / "layout.png", out / "rgb.png", out / "cloud.png", out / "dent.png"]
     assert sorted(out.iterdir()) == sorted(paths)
     for path in paths:
         assert path.read_bytes()[:8] == PNG_MAGIC
+
+
+def test_rgb_figure_shows_the_camera_image_and_the_cloud_in_its_own_colours() -> None:
+    from deformap.testing import coarse_world
+    from deformap.viz._world import _rgb_figure
+
+    image = coarse_world("heterogeneous-60-110-rigid").rgb_image()
+    fig = _rgb_figure(coarse_world("heterogeneous-60-110-rigid"))  # the same seed, a fresh world
+    view, top = fig.axes
+    shown = np.asarray(view.images[0].get_array())
+    assert shown.shape == image.shape
+    assert np.array_equal(shown, np.nan_to_num(image, nan=1.0))  # no return: white
+    assert np.ptp(shown[~np.isnan(image).any(axis=2)], axis=0).max() > 0.2  # blocks and table differ
+    assert "heterogeneous-60-110-rigid" in view.get_title()
+    assert (view.get_xlabel(), view.get_ylabel()) == ("image column [px]", "image row [px]")
+    assert (top.get_xlabel(), top.get_ylabel()) == ("x [m]", "y [m]")
+    assert top.get_aspect() == 1.0
+    colours = top.collections[0].get_facecolors()[:, :3]
+    assert len(np.unique(colours.round(2), axis=0)) > 10  # each point its own colour
 
 
 def test_world_pictures_have_a_stiffness_colour_bar_and_one_unit_per_figure() -> None:
@@ -557,7 +576,7 @@ def test_importing_and_drawing_leave_matplotlib_global_state_alone(tmp_path: Pat
     assert done.returncode == 0, done.stderr
     assert done.stdout.strip() == "ok"
     assert len(list(tmp_path.glob("*.png"))) == len(CALLS)
-    assert len(list((tmp_path / "world").glob("*.png"))) == 3
+    assert len(list((tmp_path / "world").glob("*.png"))) == 4
 
 
 def _matrix_study(element_size_m: float) -> dict[str, Any]:

@@ -38,7 +38,8 @@ def world_show_command(
     seed: Annotated[int, typer.Option(help="Seed of the camera and sensor noise.")] = 0,
     coarse: Annotated[bool, typer.Option(help="Use the coarse test mesh (fast).")] = False,
 ) -> None:
-    """Write layout.png, cloud.png and dent.png of a scenario into OUT."""
+    """Write layout.png, rgb.png (the camera's colour view), cloud.png and dent.png of a scenario
+    into OUT."""
     with progress(console) as bar:
         paths = run.show_scenario(name, out, seed=seed, coarse=coarse, hooks=run_hooks(bar))
     for path in paths:

@@ -42,7 +42,8 @@ def show_scenario(
     name: str, out: Path, *, seed: int = 0, coarse: bool = False,
     force_n: float = ExplorationConfig().force_n, hooks: RunHooks = NO_HOOKS,
 ) -> list[Path]:
-    """Write ``layout.png``, ``cloud.png`` and ``dent.png`` of scenario ``name`` into ``out``.
+    """Write ``layout.png``, ``rgb.png``, ``cloud.png`` and ``dent.png`` of scenario ``name`` into
+    ``out``.
 
     Parameters
     ----------

@@ -1,4 +1,5 @@
-"""Pictures of a world for a person to check it: layout, one observed cloud, one dent.
+"""Pictures of a world for a person to check it: layout, the camera's colour view, one observed
+cloud, one dent.
 
 Figures live in :mod:`deformap.viz`, a leaf: the world itself never imports matplotlib. They are
 built on :class:`matplotlib.figure.Figure` without ``pyplot`` and written atomically, so no backend
@@ -20,7 +21,7 @@ from matplotlib.ticker import NullLocator
 
 from deformap.viz._save import save_figure
 from deformap.viz._style import RIGID_COLOUR, STIFFNESS_CMAP, modulus_norm
-from deformap.world import youngs_modulus_to_hardness
+from deformap.world import CAMERA_PRESETS, youngs_modulus_to_hardness
 
 if TYPE_CHECKING:
     from deformap.world import SimulatedWorld
@@ -38,17 +39,20 @@ def _press_target(world: SimulatedWorld) -> np.ndarray:
 
 
 def show_world(world: SimulatedWorld, out: str | Path, *, force_n: float) -> list[Path]:
-    """Write ``layout.png``, ``cloud.png`` and ``dent.png`` into ``out``; returns their paths.
+    """Write ``layout.png``, ``rgb.png``, ``cloud.png`` and ``dent.png`` into ``out``; returns their
+    paths.
 
     The folder is created if needed; each file is written atomically. ``layout.png`` colours each
     foam block by its stiffness (:mod:`deformap.viz._style`: dark soft, light stiff) with a
-    colour bar in Young's modulus and hardness, rigid blocks grey; ``cloud.png`` observes the
+    colour bar in Young's modulus and hardness, rigid blocks grey; ``rgb.png`` shows the camera's
+    colour image and the coloured cloud of one observation from above; ``cloud.png`` observes the
     world once (lengths in metres); ``dent.png`` presses the centroid of its softest foam block
     once with ``force_n`` newtons and releases it (lengths in millimetres).
     """
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     return [save_figure(_layout_figure(world), out / "layout.png", dpi=120, bbox_inches="tight"),
+            save_figure(_rgb_figure(world), out / "rgb.png", dpi=120, bbox_inches="tight"),
             save_figure(_cloud_figure(world), out / "cloud.png", dpi=120, bbox_inches="tight"),
             save_figure(_dent_figure(world, force_n), out / "dent.png", dpi=120,
                         bbox_inches="tight")]  # fmt: skip
@@ -95,6 +99,34 @@ def _layout_figure(world: SimulatedWorld) -> Figure:
                 arrowprops={"arrowstyle": "->"})
     ax.set(xlim=(x0 - 0.05, x0 + w + 0.05), ylim=(y0 - 0.08, y0 + d + 0.05), aspect="equal",
            xlabel="x [m]", ylabel="y [m]", title=f"{world.scenario.name}: layout and stiffness")
+    return fig
+
+
+def _camera_name(world: SimulatedWorld) -> str:
+    """The preset whose configuration the world's camera has, else its resolution."""
+    config = world.camera.config
+    for name, make in CAMERA_PRESETS.items():
+        if make() == config:
+            return name
+    return f"custom camera {config.width}×{config.height}"
+
+
+def _rgb_figure(world: SimulatedWorld) -> Figure:
+    """The camera's colour image as it sees the scene (no-return pixels white), and one observed
+    cloud from above in world metres, each point drawn in its own colour."""
+    image = world.rgb_image()
+    cloud = world.observe()
+    fig = Figure(figsize=(13, 4.8), layout="constrained")
+    a1, a2 = fig.subplots(1, 2)
+    a1.imshow(np.nan_to_num(image, nan=1.0), interpolation="nearest")
+    a1.set(xlabel="image column [px]", ylabel="image row [px]",
+           title=f"{world.scenario.name}: {_camera_name(world)} colour view")
+    step = max(1, len(cloud) // 60000)
+    colours = cloud.colors if cloud.colors is not None else np.full((len(cloud), 3), 0.5)
+    a2.scatter(cloud.xy[::step, 0], cloud.xy[::step, 1], c=np.clip(colours[::step], 0, 1),
+               s=2.0, linewidths=0)  # points large enough that their colour reads
+    a2.set(aspect="equal", xlabel="x [m]", ylabel="y [m]",
+           title=f"coloured cloud from above, {len(cloud)} points")
     return fig
 
 
