@@ -43,6 +43,7 @@ __all__ = [
     "MAX_MAP_CELLS",
     "MAX_PLAN_CELLS",
     "MAX_ROI_BAND_BYTES",
+    "AppearanceUse",
     "BetaFieldConfig",
     "BetaUncertainty",
     "DepthAnchor",
@@ -67,6 +68,8 @@ RegionLabels = Literal["isopleth", "nearest", "indicator-kriging"]
 FieldName = Literal["beta", "modulus"]
 #: Where a poke's β uncertainty comes from (``ExplorationConfig.beta_uncertainty``).
 BetaUncertainty = Literal["camera-noise", "shape-matching"]
+#: Whether the map uses the camera's view of the layout (``ExplorationConfig.appearance``).
+AppearanceUse = Literal["auto", "off"]
 
 #: Most bytes of one band of the ROI's shape-matching system (:mod:`deformap.msm._linsys`); the
 #: β sweep holds a few arrays of that size at once, so 512 MiB keeps it within a few GiB.
@@ -150,6 +153,10 @@ class ExplorationConfig:
         and stop cells (``ExplorationResult.unread_places``); the run maps on ``beta`` while no
         poke has a modulus, and for good once no target would be left, and says why
         (``field_fallback``).
+    appearance : {"auto", "off"}
+        Whether the map field uses the first observation's colours as a prior on the layout.
+        ``auto`` (default) uses them when the cloud has colour, its weight learned from the
+        pokes; ``off``, the blind map.
     surface : SurfaceGPConfig
         The crop, filters and surface GP of the first observation.
     touch : TouchGPConfig
@@ -182,6 +189,7 @@ class ExplorationConfig:
     boundary_pokes: int = setting(0, ge=0, le=1000)  # as for max_pokes
     beta_uncertainty: BetaUncertainty = "camera-noise"
     field: FieldName = "modulus"
+    appearance: AppearanceUse = "auto"
     surface: SurfaceGPConfig = _field(default_factory=SurfaceGPConfig)
     touch: TouchGPConfig = _field(default_factory=TouchGPConfig)
     beta_field: BetaFieldConfig = _field(default_factory=BetaFieldConfig)
