@@ -39,20 +39,9 @@ from deformap.mechanics._layer import (
 )
 
 __all__ = [
-    "INDENTATION_STRAIN",
-    "INDENTER_AREA_M2",
-    "TactileContact",
-    "elastic_dent",
-    "hardness_to_youngs_modulus",
-    "hertz_contact_radius",
-    "hertz_indentation",
-    "hertz_pressure_samples",
-    "hertz_surface_deflection",
-    "layer_chi_limit",
-    "layer_correction",
-    "layer_correction_coefficients",
-    "layer_indentation_force",
-    "layer_indentation_stiffness",
-    "reduced_modulus",
-    "youngs_modulus_to_hardness",
+    "INDENTATION_STRAIN", "INDENTER_AREA_M2", "TactileContact", "elastic_dent",
+    "hardness_to_youngs_modulus", "hertz_contact_radius", "hertz_indentation",
+    "hertz_pressure_samples", "hertz_surface_deflection", "layer_chi_limit", "layer_correction",
+    "layer_correction_coefficients", "layer_indentation_force", "layer_indentation_stiffness",
+    "reduced_modulus", "youngs_modulus_to_hardness",
 ]

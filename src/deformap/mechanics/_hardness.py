@@ -7,8 +7,7 @@ indenter gives a secant modulus
 
     E = (H / A) / ε,    A = 0.0323 m²,  ε = 0.4,
 
-so 60, 110 and 150 N foams get 4.6, 8.5 and 11.6 kPa. It ignores the foam around the indenter and
-the non-linearity of foam at 40 % strain; it is the project's reference conversion.
+ignoring the foam around the indenter and the non-linearity of foam at 40 % strain.
 
 References
 ----------
@@ -22,12 +21,8 @@ import numpy as np
 
 from deformap._validation import check_positive
 
-__all__ = [
-    "INDENTATION_STRAIN",
-    "INDENTER_AREA_M2",
-    "hardness_to_youngs_modulus",
-    "youngs_modulus_to_hardness",
-]
+__all__ = ["INDENTATION_STRAIN", "INDENTER_AREA_M2", "hardness_to_youngs_modulus",
+           "youngs_modulus_to_hardness"]
 
 INDENTER_AREA_M2 = 0.0323
 """Area of the ISO 2439 indenter foot (203 mm diameter), m²."""
@@ -37,18 +32,8 @@ INDENTATION_STRAIN = 0.4
 
 
 def hardness_to_youngs_modulus(hardness_n: float) -> float:
-    """Young's modulus in pascals of a foam of indentation hardness ``hardness_n`` newtons.
-
-    Parameters
-    ----------
-    hardness_n : float, newtons
-        Force to compress the foam to 40 % under a 323 cm² indenter; must be > 0.
-
-    Returns
-    -------
-    float, pascals
-        ``(hardness_n / 0.0323) / 0.4``; 60 N gives about 4644 Pa.
-    """
+    """Young's modulus ``(hardness_n / 0.0323) / 0.4`` in pascals of a foam of indentation
+    hardness ``hardness_n > 0`` newtons."""
     h = check_positive("hardness_n", hardness_n)
     return float(h / INDENTER_AREA_M2 / INDENTATION_STRAIN)
 
