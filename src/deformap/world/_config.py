@@ -20,16 +20,10 @@ from deformap.world._stiffening import max_grid_nodes
 __all__ = ["MAX_FEM_UNKNOWNS", "PHYSICS", "Physics", "RecordSpacing", "WorldConfig",
            "check_world_budget"]
 
-#: The world's contact physics: 3-D linear elasticity by FEM (:mod:`deformap.world._foam`), a
-#: stiffening two-parameter foundation solved by Newton's method
-#: (:mod:`deformap.world._stiffening`), or the FEM of a continuum foam that stiffens as it is
-#: compressed, solved by Newton's method (:mod:`deformap.world._stiffening_fem`).
+#: The world's contact physics (``WorldConfig.physics``).
 Physics = Literal["linear-fem", "stiffening-foam", "stiffening-fem"]
 PHYSICS: tuple[str, ...] = get_args(Physics)
-#: How the samples of a press's force–travel record are spaced (``WorldConfig``'s
-#: ``force_travel_spacing``): evenly in force, as a press whose force ramps at a constant rate
-#: records; or evenly in travel, as an arm that advances at a constant speed and samples at a fixed
-#: rate records (exactly even for a Hertz contact, :func:`deformap.world._force_travel.force_levels`).
+#: How a force–travel record's samples are spaced (:func:`~deformap.world._force_travel.force_levels`).
 RecordSpacing = Literal["force", "travel"]
 
 
@@ -40,19 +34,16 @@ class WorldConfig:
     Parameters
     ----------
     physics : {"linear-fem", "stiffening-foam", "stiffening-fem"}
-        How the foam answers a press. Linear elasticity by finite elements, a stiffening
-        two-parameter foundation (:mod:`deformap.world._stiffening`), or finite elements of a foam
-        that stiffens toward densification (:mod:`deformap.world._stiffening_fem`); a block's
-        ``modulus_pa`` is its small-strain Young's modulus in each.
+        How the foam answers a press. Linear FEM (:mod:`deformap.world._foam`), a stiffening
+        foundation (:mod:`deformap.world._stiffening`) or a stiffening FEM
+        (:mod:`deformap.world._stiffening_fem`); ``modulus_pa`` is the small-strain modulus in each.
     densification_strain : float
         Densification strain ``ε_d`` of the stiffening law ``σ = M ε / (1 − ε / ε_d)^m`` (stiffening
-        physics only). 0.95 is Gibson & Ashby's ``1 − 1.4 ρ*/ρ_s`` for a flexible polyurethane foam
-        of relative density 0.035.
+        physics only). 0.95 is Gibson & Ashby's ``1 − 1.4 ρ*/ρ_s`` at relative density 0.035.
     stiffening_exponent : float
         Exponent ``m`` of that law; 1 is Gibson & Ashby's densification fit, 0 is linear.
     element_size_m : float
-        In-plane size of the foam's hexahedra. 7.5 mm resolves the dent of the 1 cm tip while a world
-        stays quick to build.
+        In-plane size of the foam's hexahedra. 7.5 mm resolves the 1 cm tip's dent and builds fast.
     top_layer_m : float
         Thickness of the top element layer.
     layer_growth : float
@@ -70,11 +61,9 @@ class WorldConfig:
     force_noise_n : float
         Standard deviation per axis of the force sensor's noise (Optoforce-class resolution).
     force_travel_levels : int
-        Load levels of the press's force–travel record above contact (the record has one more
-        sample), each solved by the world's physics (:mod:`deformap.world._force_travel`).
+        Load levels of the press's force–travel record above contact, each one press solve.
     force_travel_spacing : {"force", "travel"}
-        How the record's samples are spaced (:data:`RecordSpacing`): evenly in force, or evenly in
-        travel.
+        How the record's samples are spaced: evenly in force, or evenly in travel.
     contact_threshold_n : float
         The force at which the probe detects contact: the record's first sample, where travel starts.
     encoder_noise_m : float
@@ -161,16 +150,13 @@ class WorldConfig:
         return cls(**settings)
 
 
-#: Most displacement unknowns (3 per mesh node, all blocks) of the foam FEM: each foam block's
-#: stiffness matrix is factorised once by a sparse direct solver and kept, and on a 3-D mesh its
-#: fill-in grows faster than the unknowns (as N^(4/3) for a 3-D mesh under a nested-dissection
-#: ordering), into gigabytes at a million.
+#: Most displacement unknowns (3 per mesh node, all blocks) of the foam FEM: each block's
+#: factorisation is kept, and its fill-in (about N^(4/3) on a 3-D mesh) reaches gigabytes at a million.
 MAX_FEM_UNKNOWNS = 1_000_000
 
 
 def _layer_count(thickness_m: float, top_m: float, growth: float) -> int:
-    """Upper bound on the layers of :func:`~deformap.world._fem.graded_levels` (no loop, so that
-    an absurd request is refused at once): layers ``top·gⁱ`` until they sum to the thickness."""
+    """Upper bound, in closed form, on the layers of :func:`~deformap.world._fem.graded_levels`."""
     top = min(top_m, thickness_m)
     if growth <= 1.0 + 1e-12:
         return math.ceil(thickness_m / top) + 1
@@ -178,21 +164,14 @@ def _layer_count(thickness_m: float, top_m: float, growth: float) -> int:
 
 
 def check_world_budget(config: WorldConfig, scenario: Scenario) -> None:
-    """Refuse, before any work, a world whose foam mesh would be absurdly large.
-
-    Counts the nodes of every block's structured mesh (``element_size_m`` in plane over the
-    block's bounding box, the graded layers of ``top_layer_m`` and ``layer_growth`` through its
-    thickness) and refuses more than :data:`MAX_FEM_UNKNOWNS` unknowns: the FEM's, and under the
-    ``stiffening-foam`` physics the camera's mesh of the same nodes. That physics solves each press
-    on a grid of its own, graded from the tip outward, whose nodes are bounded by
-    :func:`~deformap.world._stiffening.max_grid_nodes` (they grow with the logarithm of the block's
-    size over the tip's radius) and refused over the same limit. :class:`SimulatedWorld` calls it
-    first; a run can call it before it starts anything else.
+    """Refuse, before any work, a world of more than :data:`MAX_FEM_UNKNOWNS` unknowns in its
+    blocks' meshes, or (``stiffening-foam``) in a press grid
+    (:func:`~deformap.world._stiffening.max_grid_nodes`).
 
     Raises
     ------
     SettingError
-        Naming ``element_size_m``, the unknowns asked for and the limit.
+        Naming ``element_size_m`` (or ``tip_radius_m``), the unknowns asked for and the limit.
     """
     if not isinstance(config, WorldConfig):
         raise SettingError("config", f"must be a WorldConfig; got {type(config).__name__}")
