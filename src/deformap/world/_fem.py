@@ -6,10 +6,9 @@ zero). A column of hexes belongs to the block when its centre lies in the footpr
 trilinear (scikit-fem ``ElementHex1``, 2×2×2 Gauss points) with a per-element Young's modulus.
 
 Every hex of one layer has the same shape, so its stiffness is one 24×24 matrix computed by
-scikit-fem for a unit modulus, scaled per element and scattered with numpy (the same matrix as
-scikit-fem's ``asm``, which a test checks). The stiffness is factorised once (SuperLU). A block of
-one modulus ``E`` solves ``K₁⁻¹ f / E`` on the unit-modulus factorisation, kept (the most recent
-few, by geometry, ``ν`` and symmetry) and shared by every homogeneous block of that mesh.
+scikit-fem for a unit modulus, scaled per element and scattered with numpy. The stiffness is
+factorised once (SuperLU); a block of one modulus ``E`` solves ``K₁⁻¹ f / E`` on a unit-modulus
+factorisation shared by the homogeneous blocks of that mesh.
 
 References
 ----------
@@ -35,8 +34,7 @@ __all__ = ["FoamBody", "HexGrid", "graded_levels", "unit_hex_stiffness"]
 
 log = logging.getLogger(__name__)
 
-# Unit-modulus factorisations kept for homogeneous blocks (each holds some tens of MB on the
-# default mesh): a few, the most recently used
+# the most recent unit-modulus factorisations (tens of MB each on the default mesh)
 _UNIT_FACTORS: OrderedDict[bytes, SuperLU] = OrderedDict()
 _UNIT_FACTORS_KEPT = 2
 
@@ -45,10 +43,8 @@ _CORNERS = np.array([[c & 1, (c >> 1) & 1, (c >> 2) & 1] for c in range(8)])
 
 
 def graded_levels(thickness_m: float, top_m: float, growth: float) -> NDArray[np.float64]:
-    """``(nz + 1,)`` z levels from 0 to ``thickness_m``; layers grow by ``growth`` going down.
-
-    The top layer is about ``top_m`` thick; the stack is scaled to end exactly at the thickness.
-    """
+    """``(nz + 1,)`` z levels from 0 to ``thickness_m``, the top layer about ``top_m`` thick and
+    the layers growing by ``growth`` going down."""
     sizes = [top_m]
     while (sum(sizes) < thickness_m * (1 - 1e-9)
            and sum(sizes) + sizes[-1] * growth < thickness_m * 1.2):
@@ -59,10 +55,8 @@ def graded_levels(thickness_m: float, top_m: float, growth: float) -> NDArray[np
 
 @lru_cache(maxsize=256)
 def unit_hex_stiffness(dx: float, dy: float, dz: float, nu: float) -> NDArray[np.float64]:
-    """``(24, 24)`` stiffness of a ``dx × dy × dz`` trilinear hex with E = 1 Pa, by scikit-fem.
-
-    Rows and columns are ordered ``3 c + component`` with corner ``c = ci + 2 cj + 4 ck``.
-    """
+    """``(24, 24)`` stiffness of a ``dx × dy × dz`` trilinear hex with E = 1 Pa, by scikit-fem,
+    ordered ``3 c + component`` with corner ``c = ci + 2 cj + 4 ck``."""
     from skfem import Basis, BilinearForm, ElementHex1, ElementVectorH1, MeshHex, asm
     from skfem.models.elasticity import lame_parameters, linear_elasticity
 
@@ -70,7 +64,6 @@ def unit_hex_stiffness(dx: float, dy: float, dz: float, nu: float) -> NDArray[np
     basis = Basis(mesh, ElementVectorH1(ElementHex1()))
     form: BilinearForm = linear_elasticity(*lame_parameters(1.0, nu))
     k = asm(form, basis).toarray()
-    # map scikit-fem's DOF numbering to ours: find which corner each mesh node is
     corner_of_node = np.rint(mesh.p.T / np.array([dx, dy, dz])).astype(int)
     ours = corner_of_node[:, 0] + 2 * corner_of_node[:, 1] + 4 * corner_of_node[:, 2]
     perm = np.empty(24, dtype=int)
@@ -84,21 +77,9 @@ def unit_hex_stiffness(dx: float, dy: float, dz: float, nu: float) -> NDArray[np
 
 @dataclass(frozen=True, kw_only=True)
 class HexGrid:
-    """Geometry of one block's structured mesh.
-
-    Parameters
-    ----------
-    origin : (2,) float, metres
-        ``(x0, y0)`` of the bounding box.
-    dx, dy : float, metres
-        Element sizes in the plane.
-    nx, ny : int
-        Elements along x and y.
-    levels : (nz + 1,) float, metres
-        Node heights, 0 at the table.
-    active : (ny, nx) bool
-        Columns that belong to the block.
-    """
+    """One block's structured mesh: ``nx × ny`` columns of ``dx × dy`` (metres) from ``origin``
+    ``(x0, y0)``, node heights ``levels`` ``(nz + 1,)`` from 0 at the table, and the ``(ny, nx)``
+    ``active`` columns that belong to the block."""
 
     origin: NDArray[np.float64]
     dx: float
@@ -139,31 +120,19 @@ class HexGrid:
             si, sj = ii[open_side], jj[open_side]
             # the two nodes of the column's edge on that side, then extruded over every layer
             if di:
-                a = (si + (di > 0), sj)
-                b = (si + (di > 0), sj + 1)
+                a, b = (si + (di > 0), sj), (si + (di > 0), sj + 1)
             else:
-                a = (si, sj + (dj > 0))
-                b = (si + 1, sj + (dj > 0))
+                a, b = (si, sj + (dj > 0)), (si + 1, sj + (dj > 0))
             for k in range(self.nz):
-                quads.append(np.column_stack([self.node_id(a[0], a[1], k),
-                                              self.node_id(b[0], b[1], k),
-                                              self.node_id(b[0], b[1], k + 1),
-                                              self.node_id(a[0], a[1], k + 1)]))
+                quads.append(np.column_stack([self.node_id(*a, k), self.node_id(*b, k),
+                                              self.node_id(*b, k + 1), self.node_id(*a, k + 1)]))
         return np.concatenate(quads, axis=0)
 
     def locate(self, xy: NDArray[np.float64]
                ) -> tuple[NDArray[np.bool_], NDArray[np.int64], NDArray[np.float64]]:
-        """Top-face bilinear weights of ``(n, 2)`` points.
-
-        Returns
-        -------
-        inside : (n,) bool
-            The point lies on an active column.
-        nodes : (n, 4) int
-            Top node ids (corners 00, 10, 01, 11) of its column (0 where not inside).
-        weights : (n, 4) float
-            Bilinear shape-function values at the point.
-        """
+        """Top-face bilinear interpolation at ``(n, 2)`` points: ``inside`` ``(n,)`` (on an active
+        column), the column's top node ids ``(n, 4)`` (corners 00, 10, 01, 11; 0 where not
+        inside) and the bilinear weights ``(n, 4)``."""
         u = (xy[:, 0] - self.origin[0]) / self.dx
         v = (xy[:, 1] - self.origin[1]) / self.dy
         i = np.clip(np.floor(u).astype(np.int64), 0, self.nx - 1)
@@ -181,15 +150,9 @@ class HexGrid:
 class FoamBody:
     """One elastic block: its mesh, stiffness factorised once, and solves for nodal loads.
 
-    Parameters
-    ----------
-    grid : HexGrid
-    modulus_pa : (nz, ny, nx) float or float
-        Young's modulus per element (only active columns are used).
-    poisson_ratio : float
-    symmetry : tuple of str
-        Planes ``"x_min"``/``"y_min"`` of the box on which the normal displacement is zero, to
-        model a quarter of a symmetric problem (used by the analytic checks).
+    ``modulus_pa`` is Young's modulus, one or ``(nz, ny, nx)`` per element; ``symmetry`` names
+    the planes ``"x_min"``/``"y_min"`` of the box held in their normal direction (a quarter of a
+    symmetric problem).
     """
 
     def __init__(self, grid: HexGrid, modulus_pa: float | NDArray[np.float64], *,
@@ -201,7 +164,6 @@ class FoamBody:
         self.free = self._free_dofs(symmetry)
         used = self.modulus[:, grid.active]
         uniform = used.size > 0 and bool(np.all(used == used.flat[0]))
-        # a homogeneous block solves on the unit-modulus factorisation, scaled (module docstring);
         # K₁ is assembled at E = 1 itself, so a solve does not depend on what was built before
         self._scale = 1.0 / float(used.flat[0]) if uniform else 1.0
         factored = self._assemble(np.ones_like(self.modulus) if uniform else self.modulus)
@@ -241,8 +203,8 @@ class FoamBody:
 
     def element_dofs(self, k: int
                      ) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64]]:
-        """The hexes of layer ``k`` (active columns): ``(m, 24)`` DOF ids (``3 node + component``,
-        corners in the order of :func:`unit_hex_stiffness`) and their column indices ``jj, ii``."""
+        """``(m, 24)`` DOF ids of the hexes of layer ``k`` (order of :func:`unit_hex_stiffness`)
+        and their column indices ``jj, ii``."""
         g = self.grid
         jj, ii = np.nonzero(g.active)
         nodes = np.column_stack([g.node_id(ii + c[0], jj + c[1], np.full_like(ii, k + c[2]))
@@ -280,8 +242,7 @@ class FoamBody:
         return np.flatnonzero(~fixed.ravel())
 
     def solve_free(self, rhs: NDArray[np.float64]) -> NDArray[np.float64]:
-        """``K⁻¹ rhs`` on the free unknowns: ``rhs`` is ``(n_dofs,)`` or ``(n_dofs, k)`` (``k``
-        right-hand sides in one call) in the order of :attr:`free`."""
+        """``K⁻¹ rhs`` on the free unknowns, ``rhs`` ``(n_dofs,)`` or ``(n_dofs, k)``."""
         # SuperLU copies its right-hand sides into Fortran order (a C-order block twice over)
         out = np.asarray(self._lu.solve(np.asfortranarray(rhs, dtype=float)))
         out *= self._scale
