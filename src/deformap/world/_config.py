@@ -23,7 +23,8 @@ __all__ = ["MAX_FEM_UNKNOWNS", "PHYSICS", "Physics", "RecordSpacing", "WorldConf
 #: The world's contact physics (``WorldConfig.physics``).
 Physics = Literal["linear-fem", "stiffening-foam", "stiffening-fem"]
 PHYSICS: tuple[str, ...] = get_args(Physics)
-#: How a force–travel record's samples are spaced (:func:`~deformap.world._force_travel.force_levels`).
+#: How a force–travel record's samples are spaced
+#: (:func:`~deformap.world._force_travel.force_levels`).
 RecordSpacing = Literal["force", "travel"]
 
 
@@ -43,7 +44,7 @@ class WorldConfig:
     stiffening_exponent : float
         Exponent ``m`` of that law; 1 is Gibson & Ashby's densification fit, 0 is linear.
     element_size_m : float
-        In-plane size of the foam's hexahedra. 7.5 mm resolves the 1 cm tip's dent and builds fast.
+        In-plane size of the foam's hexahedra. 7.5 mm resolves the 1 cm tip's dent.
     top_layer_m : float
         Thickness of the top element layer.
     layer_growth : float
@@ -151,7 +152,7 @@ class WorldConfig:
 
 
 #: Most displacement unknowns (3 per mesh node, all blocks) of the foam FEM: each block's
-#: factorisation is kept, and its fill-in (about N^(4/3) on a 3-D mesh) reaches gigabytes at a million.
+#: factorisation is kept, and its fill-in (about N^(4/3) in 3-D) reaches gigabytes at a million.
 MAX_FEM_UNKNOWNS = 1_000_000
 
 

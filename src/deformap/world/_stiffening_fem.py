@@ -1,29 +1,15 @@
-"""The stiffening-FEM physics solved: the FEM's foam blocks made of the foam that stiffens toward
-densification (``WorldConfig(physics="stiffening-fem")``; its law and strain operator are
-:mod:`deformap.world._densification`), each press's equilibrium found by Newton's method.
+"""The ``stiffening-fem`` physics: the FEM's foam blocks made of the foam that stiffens toward
+densification (:mod:`deformap.world._densification`), each press's equilibrium found by Newton's
+method, never refactorising.
 
-Force control with the FEM's sphere contact (:class:`~deformap.world._foam.FoamModel`: the Hertz
-pressure of the force on a patch of radius ``a``, ``a ← sqrt(a sqrt(R δ))`` until it settles,
-the surface conformed to the tip); each patch's equilibrium ``K₀ u + C s(Cᵀu) = f``
-(``s = V Φ'``) is solved by Newton's method, never refactorising:
-
-- ``K₀`` is factorised once when the world is built (shared by homogeneous blocks of one mesh, as
-  in the FEM).
-- The near set's tangent is exact: the elements the linear press would stiffen by more than 5 %
-  (``Φ'' > 0.05 M₀``), the most compressed first, at most ``near_elements`` and at least 8,
-  as a rank-``n`` update of ``K₀`` (Woodbury): ``Z = K₀⁻¹ C_N`` (``n`` right-hand sides in one
-  solve call, once per press target, kept for every load level and patch of that target)
-  reduces each Newton step to a dense ``n × n`` system.
-- The other elements stiffen by a few per cent at most; their forces enter every residual and
-  are carried by an outer fixed point (Anderson-accelerated, Walker & Ni 2011), one solve with
-  ``K₀`` a round, each round's Newton solve warm-started from the last. An element outside the
-  near set compressed past ``ε_d / 5`` joins it. A press is converged when the residual over
-  every free unknown is below ``tolerance · F``.
-
-Each target's first solve (the commanded force, the record's top level) sets the near set; the
-record's lower levels warm-start from the level above. The near sets of the last two targets are
-kept, each ``n`` vectors of the block's unknowns. The Newton steps keep every element's strain
-below ``ε_d``; the world refuses a press that sinks the tip as deep as the block is thick.
+Force control and the patch iteration are the FEM's (:class:`~deformap.world._foam.FoamModel`);
+each patch's equilibrium ``K₀ u + C s(Cᵀu) = f`` (``s = V Φ'``) is solved with ``K₀`` factorised
+once. The near set (the elements the linear press would stiffen by more than 5 %, the most
+compressed first, between 8 and ``near_elements``) takes its tangent exactly, as a Woodbury update
+``Z = K₀⁻¹ C_N`` solved once per press target, which reduces each Newton step to a dense ``n × n``
+system. The other elements' forces are carried by an outer fixed point (Anderson-accelerated,
+Walker & Ni 2011), one ``K₀`` solve a round; an element compressed past ``ε_d / 5`` joins the near
+set. A patch is converged when the residual over every free unknown is below ``tolerance · F``.
 
 References
 ----------
@@ -66,8 +52,7 @@ _NEAR_LEAST = 8
 
 @dataclass
 class _NearSet:
-    """The elements whose tangent a target's Newton steps take exactly, with ``Z = K₀⁻¹ C_N``
-    and ``G = C_Nᵀ Z``; the target's last solve, to warm-start the next."""
+    """A target's near set with ``Z = K₀⁻¹ C_N``, ``G = C_Nᵀ Z`` and its last solves."""
 
     elements: NDArray[np.int64]
     columns: sp.csc_matrix  # C_N
@@ -80,8 +65,7 @@ class _NearSet:
     def predict(self, force: float, size: int
                 ) -> tuple[NDArray[np.float64], NDArray[np.float64] | None]:
         """A first guess at ``force``: the last solve's far forces and near strains scaled as
-        powers of the force, the powers those of the last two solves (the far forces about as
-        ``F²`` and the strains as ``F`` when there is one: strain ``∝ F``, stress ``∝ ε²``)."""
+        powers of the force, fitted to the last two solves (``F²`` and ``F`` after one)."""
         if not self.solved:
             return np.zeros(size), None
         f1, far1, eps1 = self.solved[-1]
@@ -102,9 +86,7 @@ class _NearSet:
 
 @dataclass(frozen=True)
 class NewtonSolve:
-    """How one patch's equilibrium was solved: the residual over every free unknown [N], the
-    outer rounds (K₀ solves), the Newton steps over all rounds, the near set's size, and the
-    largest element strain."""
+    """How one patch's equilibrium was solved (residual in newtons)."""
 
     residual_n: float
     rounds: int
@@ -117,19 +99,8 @@ class NewtonSolve:
 class StiffeningFem(FoamModel):
     """All foam blocks of a scenario as FEM bodies of the stiffening foam (module docstring).
 
-    Parameters
-    ----------
-    scenario : Scenario
-    element_size_m, top_layer_m, layer_growth, poisson_ratio : float
-        The FEM's mesh and ``ν`` (:class:`~deformap.world._foam.FoamModel`).
-    densification_strain, stiffening_exponent : float
-        ``ε_d`` and ``m`` of the law.
-    near_elements : int
-        The most elements whose tangent the Newton steps take exactly; 48 bounds each Newton
-        step's dense system to 48 × 48 while the outer rounds carry the rest.
-    tolerance : float
-        Converged when the residual's norm is below ``tolerance`` times the patch's force; 1e-4
-        keeps the force–travel record's error far below the encoders' noise.
+    ``near_elements``: 48 bounds each Newton step's dense system to 48 × 48. ``tolerance``: 1e-4
+    of the force keeps the force–travel record's error far below the encoders' noise.
     """
 
     def __init__(self, scenario: Scenario, *, element_size_m: float, top_layer_m: float,
@@ -144,7 +115,6 @@ class StiffeningFem(FoamModel):
         self.tolerance = tolerance
         self.operators = {index: strain_operator(body) for index, body in self.bodies.items()}
         self._near: OrderedDict[tuple[int, bytes], _NearSet] = OrderedDict()
-        #: the last patch solve's convergence, for checks
         self.last: NewtonSolve | None = None
 
     def _law(self, strain: NDArray[np.float64], op: StrainOperator, elements: NDArray[np.int64],
@@ -182,16 +152,14 @@ class StiffeningFem(FoamModel):
         return _NearSet(elements, columns, z, 0.5 * (g + g.T))
 
     def forget(self) -> None:
-        """Drop the near sets and warm starts earlier presses left: a press is then solved
-        the same whatever was pressed before (the world calls it at each press)."""
+        """Drop the unit responses, near sets and warm starts earlier presses left."""
         super().forget()
         self._near.clear()
 
     def _solve(self, index: int, f: NDArray[np.float64], force: float,
                center: NDArray[np.float64]) -> NDArray[np.float64]:
         """The free displacements of block ``index`` in equilibrium with the free nodal forces
-        ``f`` (module docstring: Newton on the near set, a fixed point on the far elements'
-        forces, Anderson-accelerated)."""
+        ``f`` (module docstring)."""
         op, body = self.operators[index], self.bodies[index]
         key = (index, np.asarray(center, dtype=float).tobytes())
         near = self._near.get(key)
@@ -240,9 +208,7 @@ class StiffeningFem(FoamModel):
         return u
 
     def _near_set(self, index: int, linear: NDArray[np.float64]) -> _NearSet:
-        """The elements the linear response ``linear`` compresses most: at most
-        ``near_elements`` of them, and of those only the ones it would stiffen by more than
-        :data:`_NEAR_STIFFENING` (at least :data:`_NEAR_LEAST`)."""
+        """The near set of the linear response ``linear`` (module docstring)."""
         op = self.operators[index]
         strain = op.matrix.T @ linear
         order = np.argsort(strain)[::-1][:min(self.near_elements, strain.size)]
@@ -258,9 +224,8 @@ class StiffeningFem(FoamModel):
 
     def _newton(self, b: NDArray[np.float64], near: _NearSet, op: StrainOperator,
                 start: NDArray[np.float64] | None) -> tuple[NDArray[np.float64], int]:
-        """The near elements' strains ``ε`` with ``ε − b + G s(ε) = 0`` (``s = V Φ'``), by Newton's
-        method on the Jacobian ``I + G diag(V Φ'')``, steps halved to keep every ``ε < ε_d`` and
-        the residual falling."""
+        """The near elements' strains ``ε`` with ``ε − b + G s(ε) = 0`` by Newton's method, steps
+        halved to keep every ``ε < ε_d`` and the residual falling."""
         cap, g, elements = self.densification_strain, near.g, near.elements
         eps = np.minimum(b, 0.5 * cap) if start is None or start.size != b.size else start
         eps = np.minimum(eps, 0.999 * cap)
@@ -301,8 +266,8 @@ _ANDERSON_DEPTH = 3
 def _anderson(x: NDArray[np.float64], fx: NDArray[np.float64],
               history: list[tuple[NDArray[np.float64], NDArray[np.float64]]]
               ) -> NDArray[np.float64]:
-    """The next iterate of the fixed point ``x = T(x)`` from ``x`` and ``fx = T(x)``, by Anderson
-    mixing over the last few (Walker & Ni 2011); ``history`` (``(x, T(x))`` pairs) is updated."""
+    """The next iterate of ``x = T(x)`` from ``x`` and ``fx = T(x)`` by Anderson mixing over
+    ``history`` (``(x, T(x))`` pairs, updated)."""
     history.append((x, fx))
     del history[:-(_ANDERSON_DEPTH + 1)]
     if len(history) < 2:
