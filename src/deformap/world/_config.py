@@ -196,5 +196,4 @@ def check_world_budget(config: WorldConfig, scenario: Scenario) -> None:
         raise SettingError(
             "element_size_m",
             f"meshes scenario {scenario.name!r} with about {unknowns:,} FEM unknowns; at most "
-            f"{MAX_FEM_UNKNOWNS:,}: use larger elements or a thicker `top_layer_m`; got {size:g} m",
-        )
+            f"{MAX_FEM_UNKNOWNS:,}: use larger elements or a thicker `top_layer_m`; got {size:g} m")

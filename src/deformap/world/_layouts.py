@@ -73,8 +73,7 @@ def cut_pieces(ws: Workspace, rng: np.random.Generator, n: int, min_area_fractio
         else:
             raise InvalidArgumentError(
                 f"could not cut {n} regions of at least {min_area_fraction:.0%} of the area; "
-                "lower `min_area_fraction`"
-            )
+                "lower `min_area_fraction`")
     pieces.sort(key=lambda p: tuple(p.mean(axis=0)))
     return pieces
 

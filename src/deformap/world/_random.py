@@ -81,8 +81,7 @@ def random_scenario(
     h_lo, h_hi = (float(v) for v in hardness_range_n)
     if not 0 < h_lo < h_hi:
         raise InvalidArgumentError(
-            f"`hardness_range_n` must be (low, high) with 0 < low < high; got {hardness_range_n}"
-        )
+            f"`hardness_range_n` must be (low, high) with 0 < low < high; got {hardness_range_n}")
     check_in_range("p_rigid", p_rigid, 0.0, 1.0, closed_high=True)
     if appearance not in APPEARANCE_FAMILIES:
         raise InvalidArgumentError(

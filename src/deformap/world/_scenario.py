@@ -1,27 +1,24 @@
 """Scenarios: which foam blocks lie where on the table.
 
 A scenario is a list of blocks on the rigid table. Each block is a simple polygon in the table plane
-(a rectangle is the common case; non-convex footprints, an L or a U, are one piece, and a block may
-have holes, where another block is inserted), extruded to its own thickness, made of foam of a
-given hardness (or Young's modulus) or ``rigid`` (a wooden board that does not deform). What no
-block covers is the bare table at ``z = 0``, also rigid. Blocks never overlap; they may touch.
-Neighbouring blocks are separate pieces laid side by side, as in the paper's experiments: each is
-bonded to the table at its bottom but not glued to its neighbours.
+(convex or not, with holes where another block is inserted), extruded to its own thickness, made of
+foam of a given hardness (or Young's modulus) or ``rigid`` (a board). What no block covers is the
+bare table at ``z = 0``. Blocks may touch but never overlap; each is bonded to the table, not glued
+to its neighbours, as in the paper's experiments.
 
-Built-in layouts (paper's Table I; its figure of the layouts is lost, so these are our choice), all
-over the 60 × 40 cm workspace with 5 cm thick blocks:
+Built-in layouts (the paper's Table I, our choice of layout), over the 60 × 40 cm workspace with
+5 cm thick blocks:
 
 * ``homogeneous-60``, ``homogeneous-110``: one block covering the whole area.
-* ``heterogeneous-60-150``: two blocks side by side, 60 N on ``x < 0.30 m``, 150 N on the rest.
-* ``heterogeneous-110-150``: two blocks, 110 N on ``y < 0.20 m`` (front), 150 N at the back.
-* ``heterogeneous-150-rigid``: 150 N foam on ``x < 0.32 m``, a rigid board of the same thickness on
-  the rest (so the surface is level and the rigid region must be told apart by pressing).
-* ``heterogeneous-60-110-rigid``: three blocks, the first cut not aligned with the axes: 60 N left
-  of the slanted line from (0.18, 0) to (0.30, 0.40), 110 N between it and ``x = 0.44``, rigid
-  beyond.
+* ``heterogeneous-60-150``: 60 N on ``x < 0.30 m``, 150 N on the rest.
+* ``heterogeneous-110-150``: 110 N on ``y < 0.20 m`` (front), 150 N at the back.
+* ``heterogeneous-150-rigid``: 150 N foam on ``x < 0.32 m``, a rigid board of the same thickness
+  on the rest.
+* ``heterogeneous-60-110-rigid``: 60 N left of the slanted line from (0.18, 0) to (0.30, 0.40),
+  110 N between it and ``x = 0.44``, rigid beyond.
 
-Ground-truth labels are block indices ``0 .. n-1`` in the order of ``Scenario.blocks``; ``-1`` marks
-the bare table.
+Ground-truth labels are block indices in the order of ``Scenario.blocks``; ``-1`` marks the bare
+table.
 """
 
 from __future__ import annotations
@@ -52,9 +49,8 @@ BARE_TABLE = -1
 """Ground-truth label of table area that no block covers."""
 
 _OVERLAP_TOL_M2 = 1e-8  # 1 mm² of shared area is a real overlap, less is rounding of touching edges
-#: Largest side of a workspace and of a block's footprint, and largest block thickness, in metres:
-#: a table-top scene, ten metres beyond what any arm over a table reaches, while every map and
-#: every mesh grows with the area.
+#: Largest side of a workspace or footprint and largest block thickness, in metres: far beyond
+#: what an arm over a table reaches, while every map and mesh grows with the area.
 MAX_EXTENT_M = 10.0
 
 
@@ -67,12 +63,11 @@ class Block:
     name : str
         Region name used in reports (``"soft"``, ``"60 N foam"``).
     polygon : (k, 2) float, metres
-        Footprint, ``k >= 3``, a simple polygon (convex or not; no two edges cross), at most
-        :data:`MAX_EXTENT_M` across on each axis; stored counter-clockwise.
+        Footprint, a simple polygon of ``k >= 3`` vertices, at most :data:`MAX_EXTENT_M` across;
+        stored counter-clockwise.
     holes : tuple of (m, 2) float, metres
         Simple polygons inside the footprint, apart from each other, that the block leaves
-        empty (another block may fill them); stored counter-clockwise. Points inside a block are
-        told by the even-odd rule over the footprint and its holes.
+        empty; stored counter-clockwise.
     thickness_m : float
         Height of the block's top above the table, in ``[0.001, MAX_EXTENT_M]`` metres.
     hardness_n : float or None
@@ -84,20 +79,17 @@ class Block:
     color : str
         Matplotlib colour for figures.
     appearance : Appearance or None
-        How the camera sees the block (:mod:`deformap.world._appearance`); None:
-        :data:`~deformap.world._appearance.DEFAULT_APPEARANCE`, neutral grey and plain.
+        How the camera sees the block; None: neutral grey and plain.
     """
 
     name: str
     polygon: NDArray[np.float64]
     # a sequence of arrays of their own shapes, checked by _ring below (stored as a tuple)
     holes: Sequence[NDArray[np.float64]] = ()
-    # at least the 1 mm the FEM's smallest element may be (`WorldConfig.element_size_m`): a
-    # thinner block is no layer the world can mesh (1e-320 m gave a zero Jacobian deep inside)
+    # at least the FEM's smallest element (1 mm): a thinner block is no layer the world can mesh
     thickness_m: float = setting(0.05, ge=0.001, le=MAX_EXTENT_M)
-    # Flexible foams are graded from about 20 N (super soft) to about 1 kN (ISO 2439); the bounds
-    # are far outside that and only refuse what is no material the world can press: 0.1 N is
-    # 7.7 Pa, far softer than any foam sold; 10 GPa is wood or stone, a block to declare rigid.
+    # flexible foams run from about 20 N to 1 kN (ISO 2439); the bounds refuse only what is no
+    # material to press: 0.1 N is 7.7 Pa, and 10 GPa is wood or stone, a block to declare rigid
     hardness_n: float | None = setting(None, ge=0.1, le=1.3e8)
     youngs_modulus_pa: float | None = setting(None, ge=10.0, le=1e10)
     rigid: bool = False
@@ -125,8 +117,7 @@ class Block:
         if np.any(extent > MAX_EXTENT_M):
             raise SettingError(
                 "polygon", f"must span at most {MAX_EXTENT_M:g} m on each axis; got "
-                f"{extent[0]:g} × {extent[1]:g} m (block {self.name!r})"
-            )
+                f"{extent[0]:g} × {extent[1]:g} m (block {self.name!r})")
         for ring in (poly, *holes):
             ring.setflags(write=False)
         object.__setattr__(self, "polygon", poly)
@@ -152,8 +143,7 @@ class Block:
             raise InvalidArgumentError(
                 f"block {self.name!r} needs exactly one of `hardness_n`, `youngs_modulus_pa` or "
                 f"`rigid=True`; got hardness_n={self.hardness_n!r}, "
-                f"youngs_modulus_pa={self.youngs_modulus_pa!r}, rigid={self.rigid!r}"
-            )
+                f"youngs_modulus_pa={self.youngs_modulus_pa!r}, rigid={self.rigid!r}")
         if self.hardness_n is not None:
             object.__setattr__(self, "youngs_modulus_pa",
                                hardness_to_youngs_modulus(float(self.hardness_n)))
@@ -213,8 +203,7 @@ class Scenario:
         The rectangle to map (60 × 40 cm by default), at most :data:`MAX_EXTENT_M` on each side.
     description : str
     table_appearance : Appearance or None
-        How the camera sees the table; None:
-        :data:`~deformap.world._appearance.DEFAULT_TABLE_APPEARANCE`.
+        How the camera sees the table; None: a darker warm grey.
     """
 
     name: str
@@ -232,8 +221,7 @@ class Scenario:
         if max(size) > MAX_EXTENT_M:
             raise SettingError(
                 "workspace", f"must span at most {MAX_EXTENT_M:g} m on each axis; got "
-                f"{size[0]:g} × {size[1]:g} m (scenario {self.name!r})"
-            )
+                f"{size[0]:g} × {size[1]:g} m (scenario {self.name!r})")
         names = [b.name for b in blocks]
         if len(set(names)) != len(names):
             raise InvalidArgumentError(f"scenario {self.name!r} has repeated block names: {names}")
@@ -243,8 +231,7 @@ class Scenario:
                 if area > _OVERLAP_TOL_M2:
                     raise InvalidArgumentError(
                         f"scenario {self.name!r}: blocks {a.name!r} and {b.name!r} overlap "
-                        f"by {area * 1e4:.2f} cm²; blocks may touch but not overlap"
-                    )
+                        f"by {area * 1e4:.2f} cm²; blocks may touch but not overlap")
 
     @property
     def region_names(self) -> list[str]:
@@ -281,7 +268,7 @@ class Scenario:
 
 
 def _ring(what: str, vertices: Any) -> NDArray[np.float64]:
-    """A footprint's (or hole's) vertices, checked simple with a positive area, counter-clockwise."""
+    """A footprint's or hole's vertices, checked simple with a positive area, counter-clockwise."""
     poly = check_array(what, vertices, (None, 2), what="vertices (x, y) in metres", min_rows=3)
     area = polygon_area(poly)
     if area < 0:
