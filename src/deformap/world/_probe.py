@@ -1,9 +1,5 @@
-"""The probe: a spherical tip (Optoforce-like) on a 10 cm stick held by a box-shaped hand.
-
-The probe approaches along the surface normal ``n`` at the target; at the commanded force the tip's
-centre is ``R`` above the dented surface along ``n``, the stick runs from the tip centre along ``n``
-and the hand is a box on top of the stick.
-"""
+"""The probe: a spherical tip (Optoforce-like) on a stick along the press normal, held by a
+box-shaped hand on top of it."""
 
 from __future__ import annotations
 
@@ -50,21 +46,16 @@ class ProbeGeometry:
 
     def mesh(self, tip_center: NDArray[np.float64], normal: NDArray[np.float64]) -> trimesh.Trimesh:
         """Triangle mesh of tip, stick and hand (for the camera)."""
-        rot = self._frame(normal)
         pose = np.eye(4)
-        pose[:3, :3] = rot
+        pose[:3, :3], pose[:3, 3] = self._frame(normal), tip_center
         parts: trimesh.Trimesh = trimesh.util.concatenate(self._parts())  # type: ignore[assignment]
-        pose[:3, 3] = tip_center
         parts.apply_transform(pose)
         return parts
 
     def robot_points(self, tip_center: NDArray[np.float64], normal: NDArray[np.float64]
                      ) -> NDArray[np.float64]:
-        """``(m, 3)`` points whose convex hull covers the tip's upper half, the stick and the hand.
-
-        The tip's lower half is in the dent, so it is left out: a hull around it would swallow the
-        dented surface the estimator needs.
-        """
+        """``(m, 3)`` points whose convex hull covers the tip's upper half (the lower is in the
+        dent), the stick and the hand."""
         rot = self._frame(normal)
         r = self.tip_radius_m
         az = np.linspace(0.0, 2 * np.pi, 16, endpoint=False)

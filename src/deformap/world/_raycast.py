@@ -1,9 +1,6 @@
-"""Ray casting: Embree through trimesh when ``embreex`` is installed, else a pure-numpy caster.
-
-The numpy caster serves rays that share one origin (a pinhole camera): it projects every triangle
-onto the plane ``z = 1`` of a frame looking along the rays' mean direction, bins the rays on a
-uniform grid of that plane, pairs each triangle with the rays of the cells its projected box
-covers, and runs the Möller–Trumbore test on those pairs only.
+"""Ray casting: Embree through trimesh when ``embreex`` is installed, else a pure-numpy caster for
+rays of one origin, which bins the rays on a grid of the image plane, pairs each projected
+triangle with the rays of the cells its box covers, and runs the Möller–Trumbore test on them.
 
 References
 ----------
@@ -24,20 +21,9 @@ Hits = tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.float64]]
 
 def cast_rays(mesh: trimesh.Trimesh, origins: NDArray[np.float64], directions: NDArray[np.float64],
               *, use_embree: bool = True) -> Hits:
-    """First hits of rays on a mesh: ``(ray index, triangle index, (k, 3) location)``.
-
-    Parameters
-    ----------
-    mesh : trimesh.Trimesh
-    origins, directions : (n, 3) float
-        Ray origins (metres) and unit directions. The numpy fallback needs one shared origin.
-    use_embree : bool
-        Use Embree when it is installed (the numpy caster otherwise, same hits up to round-off).
-
-    Returns
-    -------
-    ray : (k,) int, sorted; triangle : (k,) int; location : (k, 3) float
-    """
+    """First hits of ``(n, 3)`` rays (origins in metres, unit directions; one shared origin
+    without Embree) on a mesh: ray index ``(k,)`` sorted, triangle index ``(k,)``, location
+    ``(k, 3)``."""
     if use_embree:
         try:
             from trimesh.ray.ray_pyembree import RayMeshIntersector
