@@ -90,7 +90,6 @@ class NewtonSolve:
 
     residual_n: float
     rounds: int
-    newton_steps: int
     near_elements: int
     max_strain: float
     converged: bool
@@ -132,10 +131,9 @@ class StiffeningFem(FoamModel):
         force = float(-f.sum())
         if self.stiffening_exponent == 0.0 or force <= 0.0:  # the linear FEM's response
             linear = super()._respond(index, load, center)
-            self.last = NewtonSolve(residual_n=0.0, rounds=1, newton_steps=0, near_elements=0,
-                                    max_strain=float((self.operators[index].matrix.T
-                                                      @ linear.ravel()[body.free]).max()),
-                                    converged=True)
+            strain = self.operators[index].matrix.T @ linear.ravel()[body.free]
+            self.last = NewtonSolve(residual_n=0.0, rounds=1, near_elements=0,
+                                    max_strain=float(strain.max()), converged=True)
             return linear
         u = np.zeros(3 * body.grid.n_nodes)
         u[body.free] = self._solve(index, f, force, center)
@@ -173,14 +171,12 @@ class StiffeningFem(FoamModel):
         self._near.move_to_end(key)
         far, eps = near.predict(force, f.size)
         history: list[tuple[NDArray[np.float64], NDArray[np.float64]]] = []
-        steps, residual, rounds, converged = 0, np.inf, 0, False
+        residual, rounds, converged = np.inf, 0, False
         while rounds < _MAX_ROUNDS:
             rounds += 1
             # the first round of a new target has no far forces yet: its linear response
             response = linear if linear is not None and rounds == 1 else body.solve_free(f - far)
-            solved, taken = self._newton(near.columns.T @ response, near, op, eps)
-            eps = solved
-            steps += taken
+            eps = solved = self._newton(near.columns.T @ response, near, op, eps)
             u = response - near.z @ self._law(eps, op, near.elements)
             strain = op.matrix.T @ u
             stress = self._law(strain, op, np.arange(strain.size))
@@ -202,7 +198,7 @@ class StiffeningFem(FoamModel):
             log.warning("stiffening FEM: the press did not converge in %d rounds (residual "
                         "%.3g N at %.3g N)", _MAX_ROUNDS, residual, force)
         near.remember(force, far, solved)
-        self.last = NewtonSolve(residual_n=residual, rounds=rounds, newton_steps=steps,
+        self.last = NewtonSolve(residual_n=residual, rounds=rounds,
                                 near_elements=int(near.elements.size),
                                 max_strain=float(strain.max()), converged=converged)
         return u
@@ -223,7 +219,7 @@ class StiffeningFem(FoamModel):
         return self._with_columns(index, empty, chosen)
 
     def _newton(self, b: NDArray[np.float64], near: _NearSet, op: StrainOperator,
-                start: NDArray[np.float64] | None) -> tuple[NDArray[np.float64], int]:
+                start: NDArray[np.float64] | None) -> NDArray[np.float64]:
         """The near elements' strains ``ε`` with ``ε − b + G s(ε) = 0`` by Newton's method, steps
         halved to keep every ``ε < ε_d`` and the residual falling."""
         cap, g, elements = self.densification_strain, near.g, near.elements
@@ -236,9 +232,9 @@ class StiffeningFem(FoamModel):
         r = residual(eps)
         norm = float(np.linalg.norm(r))
         scale = max(float(np.abs(b).max()), 1e-12)
-        for step in range(1, _MAX_NEWTON + 1):
+        for _ in range(_MAX_NEWTON):
             if norm <= 1e-13 * scale:
-                return eps, step - 1
+                return eps
             jac = np.eye(b.size) + g * self._law(eps, op, elements, tangent=True)[None, :]
             delta = np.linalg.solve(jac, -r)
             alpha = 1.0
@@ -253,11 +249,11 @@ class StiffeningFem(FoamModel):
                     # no step keeps the strains below densification, or the step is not a number
                     log.warning("stiffening FEM: the near-field Newton step is not usable "
                                 "(residual %.3g); the last strains are kept", norm)
-                    return eps, step
+                    return eps
                 alpha *= 0.5
             eps, r, norm = trial, r_trial, n_trial
         log.warning("stiffening FEM: the near-field Newton solve stopped at %.3g", norm)
-        return eps, _MAX_NEWTON
+        return eps
 
 
 _ANDERSON_DEPTH = 3
