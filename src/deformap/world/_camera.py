@@ -65,7 +65,8 @@ class CameraConfig:
     height_m : float, metres
         Height of the optical centre above the table.
     pitch_deg : float, degrees
-        Angle of the optical axis below the horizontal, in ``(0, 90]`` (90: straight down).
+        Angle of the optical axis below the horizontal, in ``(0, 90]`` (90: straight down); the
+        axis passes through the workspace centre.
     noise : bool
         False turns off flying pixels, axial noise and quantisation.
     sigma_base_m, sigma_quadratic_m, sigma_reference_m : float, metres
@@ -82,12 +83,6 @@ class CameraConfig:
         Probability in ``[0, 1]`` that a candidate pixel flies.
     use_embree : bool
         Use trimesh's Embree ray caster when ``embreex`` is installed.
-    color_noise : float
-        Standard deviation of the colour sensor's noise per channel, in sRGB units of ``[0, 1]``.
-    white_balance : (3,) float
-        Gains on the red, green and blue light (1, 1, 1: balanced).
-    vignetting : float
-        Relative loss of light at the image's corners, in ``[0, 1)``.
     """
 
     # a ray per pixel, with a few float64 arrays each: 4096 × 4096 rays is gigabytes per frame

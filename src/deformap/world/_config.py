@@ -35,9 +35,7 @@ class WorldConfig:
     Parameters
     ----------
     physics : {"linear-fem", "stiffening-foam", "stiffening-fem"}
-        How the foam answers a press. Linear FEM (:mod:`deformap.world._foam`), a stiffening
-        foundation (:mod:`deformap.world._stiffening`) or a stiffening FEM
-        (:mod:`deformap.world._stiffening_fem`); ``modulus_pa`` is the small-strain modulus in each.
+        How the foam answers a press. ``modulus_pa`` is the small-strain modulus in each.
     densification_strain : float
         Densification strain ``ε_d`` of the stiffening law ``σ = M ε / (1 − ε / ε_d)^m`` (stiffening
         physics only). 0.95 is Gibson & Ashby's ``1 − 1.4 ρ*/ρ_s`` at relative density 0.035.
@@ -62,9 +60,11 @@ class WorldConfig:
     force_noise_n : float
         Standard deviation per axis of the force sensor's noise (Optoforce-class resolution).
     force_travel_levels : int
-        Load levels of the press's force–travel record above contact, each one press solve.
+        Load levels of the press's force–travel record above contact (the record has one more
+        sample), each solved by the world's physics (:mod:`deformap.world._force_travel`).
     force_travel_spacing : {"force", "travel"}
-        How the record's samples are spaced: evenly in force, or evenly in travel.
+        How the record's samples are spaced (:data:`RecordSpacing`): evenly in force, or evenly in
+        travel.
     contact_threshold_n : float
         The force at which the probe detects contact: the record's first sample, where travel starts.
     encoder_noise_m : float
@@ -79,12 +79,6 @@ class WorldConfig:
         The simulated depth camera.
     table_margin_m : float
         How far the table extends beyond the workspace on every side.
-    light_direction : (3,) float
-        Direction toward the scene's one distant light (any length; pointing up, ``z > 0``).
-    ambient : float
-        Share of the light that comes from everywhere (ambient), in ``[0, 1]``.
-    tip_color, stick_color, hand_color : (3,) float in [0, 1], or "#rrggbb"
-        Colours (sRGB) of the probe's tip, its stick and the hand that holds it.
     """
 
     physics: Physics = "linear-fem"
