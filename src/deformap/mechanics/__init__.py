@@ -1,16 +1,9 @@
 """Contact mechanics: the tactile contact, Hertz contact of the probe's sphere, a sphere on a bonded
 elastic layer, foam hardness.
 
-The physics both the simulated world and the estimator use; it imports numpy and the validators
-only, so that ``world`` can use it without the estimator. Units are SI.
-
-References
-----------
-Dimitriadis, E. K., et al. (2002). Determination of elastic moduli of thin layers of soft material
-using the atomic force microscope. Biophysical Journal 82(5), 2798–2810.
-Johnson, K. L. (1985). Contact Mechanics, §3.4 and §4.2. Cambridge University Press.
-ISO 2439 (2008). Flexible cellular polymeric materials — Determination of hardness (indentation
-technique).
+The physics both the simulated world and the estimator use (SI units); it imports numpy and the
+validators only, so that ``world`` can use it without the estimator. Each module gives its
+references.
 """
 
 from __future__ import annotations

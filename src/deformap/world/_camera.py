@@ -1,9 +1,8 @@
 """A PrimeSense-like depth camera: ray casting plus the sensor's error model.
 
 The camera sits ``height_m`` above the table on the workspace's ``-y`` side and looks at the
-workspace centre ``pitch_deg`` below the horizontal. Each pixel casts one ray (trimesh's Embree
-backend when ``embreex`` is installed, else the pure-numpy caster) into the table, the blocks'
-deformed surfaces and, while pressing, the probe. Then, per pixel, in this order:
+workspace centre ``pitch_deg`` below the horizontal. Each pixel casts one ray
+(:mod:`deformap.world._raycast`) into the scene. Then, per pixel, in this order:
 
 1. no return when the ray meets the surface at more than ``grazing_deg`` from its normal;
 2. flying pixels: where the depth jumps by more than ``edge_jump_m`` to the right or lower
@@ -26,9 +25,7 @@ Nguyen, C. V., Izadi, S., Lovell, D. (2012). Modeling Kinect sensor noise for im
 reconstruction and tracking. 3DIMPVT.
 Grunnet-Jepsen, A., Sweetser, J. N., Woodfill, J. (2018). Best-known-methods for tuning Intel
 RealSense D400 depth cameras for best performance. Intel white paper, rev. 1.9.
-Intel RealSense D400 series product family datasheet (2019).
-Goldman, D. B. (2010). Vignette and exposure calibration and compensation. IEEE Transactions on
-Pattern Analysis and Machine Intelligence 32(12), 2276–2288.
+Goldman, D. B. (2010). Vignette and exposure calibration and compensation. IEEE TPAMI 32(12).
 """
 
 from __future__ import annotations
@@ -159,15 +156,8 @@ class Frame(NamedTuple):
 
 
 class DepthCamera:
-    """The camera at its pose over a workspace centre ``(cx, cy)``.
-
-    Attributes
-    ----------
-    origin : (3,) float, metres
-        Optical centre in the world frame.
-    cam2world : (4, 4) float
-        Camera pose (x right, y down, z forward, OpenCV convention).
-    """
+    """The camera at its pose over a workspace centre: optical centre ``origin`` ``(3,)`` (world,
+    metres) and pose ``cam2world`` ``(4, 4)`` (x right, y down, z forward, OpenCV convention)."""
 
     def __init__(self, config: CameraConfig, center_xy: tuple[float, float]) -> None:
         self.config = config

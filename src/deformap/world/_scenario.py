@@ -60,22 +60,13 @@ class Block:
 
     Parameters
     ----------
-    name : str
-        Region name used in reports (``"soft"``, ``"60 N foam"``).
     polygon : (k, 2) float, metres
-        Footprint, a simple polygon of ``k >= 3`` vertices, at most :data:`MAX_EXTENT_M` across;
-        stored counter-clockwise.
+        Footprint, a simple polygon of ``k >= 3`` vertices, at most :data:`MAX_EXTENT_M` across.
     holes : tuple of (m, 2) float, metres
-        Simple polygons inside the footprint, apart from each other, that the block leaves
-        empty; stored counter-clockwise.
-    thickness_m : float
-        Height of the block's top above the table, in ``[0.001, MAX_EXTENT_M]`` metres.
-    hardness_n : float or None
-        ISO 2439 hardness in newtons; give this or ``youngs_modulus_pa`` for foam.
-    youngs_modulus_pa : float or None
-        Young's modulus; derived from ``hardness_n`` when that is given instead.
-    rigid : bool
-        A block that does not deform (then neither hardness nor modulus is given).
+        Simple polygons inside the footprint, apart from each other, that the block leaves empty.
+    hardness_n, youngs_modulus_pa, rigid
+        Exactly one is given (ISO 2439 hardness in newtons, Young's modulus in pascals, or a
+        board that does not deform); the modulus and hardness derive from each other.
     color : str
         Matplotlib colour for figures.
     appearance : Appearance or None
@@ -194,16 +185,8 @@ class Block:
 class Scenario:
     """A named layout of blocks over a workspace.
 
-    Parameters
-    ----------
-    name : str
-    blocks : tuple of Block
-        At least one; no two may overlap (touching is fine).
-    workspace : Workspace
-        The rectangle to map (60 × 40 cm by default), at most :data:`MAX_EXTENT_M` on each side.
-    description : str
-    table_appearance : Appearance or None
-        How the camera sees the table; None: a darker warm grey.
+    ``blocks``: at least one, no two overlapping; ``workspace``: the rectangle to map, at most
+    :data:`MAX_EXTENT_M` on each side; ``table_appearance`` None: a darker warm grey.
     """
 
     name: str

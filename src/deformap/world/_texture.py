@@ -14,8 +14,7 @@ Each texture maps ``(n, 2)`` surface coordinates ``uv`` in metres to ``(n,)`` va
 References
 ----------
 Perlin, K. (1985). An image synthesizer. SIGGRAPH '85, 287–296.
-Ebert, D. S., Musgrave, F. K., Peachey, D., Perlin, K., Worley, S. (2003). Texturing and
-Modeling: A Procedural Approach, 3rd ed. Morgan Kaufmann.
+Ebert, D. S., et al. (2003). Texturing and Modeling: A Procedural Approach, 3rd ed.
 """
 
 from __future__ import annotations
