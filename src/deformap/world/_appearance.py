@@ -144,8 +144,7 @@ class Split:
         return np.asarray((xy - np.array(self.through)) @ np.array([np.cos(a), np.sin(a)]) > 0)
 
     def to_dict(self) -> dict[str, Any]:
-        return {"through": list(self.through), "normal_deg": self.normal_deg,
-                **self.look.to_dict()}
+        return {"through": list(self.through), "normal_deg": self.normal_deg, **self.look.to_dict()}
 
 
 #: A block without an appearance: neutral grey, plain.

@@ -176,8 +176,7 @@ class FoamBody:
             return
         k_ff = factored[self.free][:, self.free].tocsc()
         try:
-            self._lu = splu(k_ff, permc_spec="MMD_AT_PLUS_A",
-                            options={"SymmetricMode": True})
+            self._lu = splu(k_ff, permc_spec="MMD_AT_PLUS_A", options={"SymmetricMode": True})
         except RuntimeError as exc:  # singular: a block that is not held by the table
             raise NotPositiveDefiniteError(
                 f"foam stiffness could not be factorised: {exc}") from None

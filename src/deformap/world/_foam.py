@@ -157,8 +157,7 @@ class FoamModel(FoamMesh):
             a = min(float(initial_radius_m), top)
         else:
             modulus = self.scenario.blocks[index].modulus_pa
-            a = min(hertz_contact_radius(force_n, tip_radius_m, modulus, self.poisson_ratio),
-                    top)
+            a = min(hertz_contact_radius(force_n, tip_radius_m, modulus, self.poisson_ratio), top)
         self._reach = (target[0].copy(), float(top))
         low, high = 0.0, top  # the fixed point lies in [low, high]
         for iteration in range(1, _MAX_ITERATIONS + 1):
@@ -179,8 +178,7 @@ class FoamModel(FoamMesh):
                 break
             a = a_new
         self._conform_to_tip(u, target[0], a, depth, tip_radius_m)
-        return Dent(displacement=u, depth_m=depth, contact_radius_m=float(a),
-                    iterations=iteration)
+        return Dent(displacement=u, depth_m=depth, contact_radius_m=float(a), iterations=iteration)
 
     def _conform_to_tip(self, u: NDArray[np.float64], center: NDArray[np.float64], radius: float,
                         depth: float, tip_radius_m: float) -> None:

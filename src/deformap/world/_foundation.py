@@ -130,8 +130,7 @@ class FoundationLayer:
         big_m = self.constrained_modulus_pa
         squeeze = np.where(eps > 0.0, 1.0 - eps / ed, 1.0)
         sigma = big_m * eps * squeeze**-m
-        dsigma = big_m * (squeeze**-m + np.where(eps > 0.0, eps * m / ed * squeeze**(-m - 1),
-                                                 0.0))
+        dsigma = big_m * (squeeze**-m + np.where(eps > 0.0, eps * m / ed * squeeze**(-m - 1), 0.0))
         return (sigma * slope) @ weight, (dsigma * slope**2) @ weight
 
 
@@ -240,8 +239,7 @@ def solve_press(layer: FoundationLayer, grid: FoundationGrid, center: NDArray[np
         grad = t.T @ f - np.r_[np.zeros(free.size), force_n]
         jac = (t.T @ (sp.diags(spring) + gp * grid.laplacian) @ t).tocsc()
         # symmetric positive definite: a symmetric fill-reducing ordering, diagonal pivots
-        step = -splu(jac, permc_spec="MMD_AT_PLUS_A",
-                     options={"SymmetricMode": True}).solve(grad)
+        step = -splu(jac, permc_spec="MMD_AT_PLUS_A", options={"SymmetricMode": True}).solve(grad)
         dw = t @ step
         rising = dw > 0  # shorten the step so that no column reaches densification
         alpha = 1.0

@@ -183,8 +183,6 @@ def layout_pieces(family: str, ws: Workspace, rng: np.random.Generator) -> list[
     """The pieces of one layout of ``family`` over ``ws``: any of :data:`LAYOUT_FAMILIES` but
     ``cuts`` (:func:`cut_pieces`)."""
     if family not in _FAMILIES:
-        raise InvalidArgumentError(
-            f"`family` must be one of {list(_FAMILIES)}; got {family!r}")
+        raise InvalidArgumentError(f"`family` must be one of {list(_FAMILIES)}; got {family!r}")
     pieces = _FAMILIES[family](ws, rng)
-    return [Piece(_clean(p.polygon), p.material, tuple(_clean(h) for h in p.holes))
-            for p in pieces]
+    return [Piece(_clean(p.polygon), p.material, tuple(_clean(h) for h in p.holes)) for p in pieces]

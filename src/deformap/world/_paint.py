@@ -31,8 +31,7 @@ AppearanceFamily = Literal["plain", "informative", "textured", "shared", "split"
 APPEARANCE_FAMILIES: tuple[str, ...] = get_args(AppearanceFamily)
 
 # eight colours far apart in hue and lightness, so that no two looks of a world are mistaken
-_COLOURS = ("#e6c229", "#d1495b", "#2e86ab", "#66a182", "#8d6a9f", "#f18f01", "#3b3b58",
-            "#c5d86d")
+_COLOURS = ("#e6c229", "#d1495b", "#2e86ab", "#66a182", "#8d6a9f", "#f18f01", "#3b3b58", "#c5d86d")
 # six textures that tell apart at a camera's millimetre pixels
 _TEXTURES = (
     Appearance(texture="plain"),

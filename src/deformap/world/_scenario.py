@@ -96,13 +96,11 @@ class Block:
             raise InvalidArgumentError(
                 f"block `name` must be a non-empty string; got {self.name!r}")
         poly = _ring(f"block {self.name!r} polygon", self.polygon)
-        if isinstance(self.holes, (str, bytes, np.ndarray)) or not isinstance(self.holes,
-                                                                              Sequence):
+        if isinstance(self.holes, (str, bytes, np.ndarray)) or not isinstance(self.holes, Sequence):
             raise InvalidArgumentError(
                 f"block {self.name!r} `holes` must be a sequence of polygons; got "
                 f"{type(self.holes).__name__}")
-        holes = tuple(_ring(f"block {self.name!r} holes[{i}]", h)
-                      for i, h in enumerate(self.holes))
+        holes = tuple(_ring(f"block {self.name!r} holes[{i}]", h) for i, h in enumerate(self.holes))
         self._check_holes(poly, holes)
         extent = poly.max(axis=0) - poly.min(axis=0)
         if np.any(extent > MAX_EXTENT_M):
