@@ -33,6 +33,7 @@ from __future__ import annotations
 import logging
 from collections.abc import Callable
 from dataclasses import dataclass
+from functools import partial
 from typing import NamedTuple
 
 import numpy as np
@@ -111,28 +112,21 @@ class CameraConfig:
         check_settings(self)
 
 
-def _kinect_v1() -> CameraConfig:
-    # its 320 × 240 depth mode, 1 m above the table; random error 1.6 mm · z² (Khoshelham &
-    # Elberink 2012, Fig. 9); a VGA Bayer colour sensor, twice the default colour noise
-    return CameraConfig(width=320, height=240, fov_deg=(57.0, 43.0), height_m=1.0,
-                        sigma_base_m=0.0, sigma_quadratic_m=0.0016, sigma_reference_m=0.0,
-                        baseline_m=0.075, subpixel=8.0, color_noise=0.02)
-
-
-def _realsense_d435() -> CameraConfig:
-    # 0.6 m above the table; depth RMS z² · 0.08 px / (f b), f ≈ 447 px: 3.6 mm · z²
-    # (Grunnet-Jepsen et al. 2018); a global-shutter colour sensor, a little less noisy
-    return CameraConfig(width=848, height=480, fov_deg=(87.0, 58.0), height_m=0.6,
-                        sigma_base_m=0.0, sigma_quadratic_m=0.0036, sigma_reference_m=0.0,
-                        baseline_m=0.05, subpixel=32.0, color_noise=0.008)
-
-
 #: Named depth cameras, from the maker's or the literature's figures (the references); the colour
 #: noise is our choice by sensor class.
 CAMERA_PRESETS: dict[str, Callable[[], CameraConfig]] = {
     "primesense": CameraConfig,
-    "kinect-v1": _kinect_v1,
-    "realsense-d435": _realsense_d435,
+    # its 320 × 240 depth mode, 1 m above the table; random error 1.6 mm · z² (Khoshelham &
+    # Elberink 2012, Fig. 9); a VGA Bayer colour sensor, twice the default colour noise
+    "kinect-v1": partial(CameraConfig, width=320, height=240, fov_deg=(57.0, 43.0), height_m=1.0,
+                         sigma_base_m=0.0, sigma_quadratic_m=0.0016, sigma_reference_m=0.0,
+                         baseline_m=0.075, subpixel=8.0, color_noise=0.02),
+    # 0.6 m above the table; depth RMS z² · 0.08 px / (f b), f ≈ 447 px: 3.6 mm · z²
+    # (Grunnet-Jepsen et al. 2018); a global-shutter colour sensor, a little less noisy
+    "realsense-d435": partial(CameraConfig, width=848, height=480, fov_deg=(87.0, 58.0),
+                              height_m=0.6, sigma_base_m=0.0, sigma_quadratic_m=0.0036,
+                              sigma_reference_m=0.0, baseline_m=0.05, subpixel=32.0,
+                              color_noise=0.008),
 }
 
 
