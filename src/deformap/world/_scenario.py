@@ -6,17 +6,8 @@ foam of a given hardness (or Young's modulus) or ``rigid`` (a board). What no bl
 bare table at ``z = 0``. Blocks may touch but never overlap; each is bonded to the table, not glued
 to its neighbours, as in the paper's experiments.
 
-Built-in layouts (the paper's Table I, our choice of layout), over the 60 × 40 cm workspace with
-5 cm thick blocks:
-
-* ``homogeneous-60``, ``homogeneous-110``: one block covering the whole area.
-* ``heterogeneous-60-150``: 60 N on ``x < 0.30 m``, 150 N on the rest.
-* ``heterogeneous-110-150``: 110 N on ``y < 0.20 m`` (front), 150 N at the back.
-* ``heterogeneous-150-rigid``: 150 N foam on ``x < 0.32 m``, a rigid board of the same thickness
-  on the rest.
-* ``heterogeneous-60-110-rigid``: 60 N left of the slanted line from (0.18, 0) to (0.30, 0.40),
-  110 N between it and ``x = 0.44``, rigid beyond.
-
+The built-in scenarios (:func:`builtin_scenarios`) are the paper's Table I, over the 60 × 40 cm
+workspace with 5 cm thick blocks, each layout our choice and described in its ``description``.
 Ground-truth labels are block indices in the order of ``Scenario.blocks``; ``-1`` marks the bare
 table.
 """
@@ -282,7 +273,7 @@ def _rigid(name: str, poly: NDArray[np.float64]) -> Block:
 
 
 def builtin_scenarios() -> dict[str, Scenario]:
-    """The six scenarios of the paper's Table I (layouts in the module docstring)."""
+    """The six scenarios of the paper's Table I."""
     full = rectangle(0.0, 0.0, 0.60, 0.40)
     out = [
         Scenario(name="homogeneous-60", blocks=(_foam("foam-60", full, 60),),
