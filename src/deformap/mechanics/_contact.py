@@ -15,17 +15,9 @@ __all__ = ["TactileContact"]
 
 @dataclass(frozen=True, kw_only=True)
 class TactileContact:
-    """What the force sensor and proprioception say at the moment of the press.
-
-    Parameters
-    ----------
-    tip_center : (3,) float, metres
-        Centre of the probe's spherical tip in the world frame.
-    force : (3,) float, newtons
-        Force the probe exerts on the surface, pointing into it (``(0, 0, -F)`` straight down).
-    tip_radius_m : float
-        Radius of the spherical tip.
-    """
+    """What the force sensor and proprioception say at the moment of the press: the ``(3,)``
+    ``tip_center`` (world frame, metres) of the spherical tip of radius ``tip_radius_m`` and the
+    ``(3,)`` ``force`` in newtons it exerts on the surface (``(0, 0, -F)`` pressing down)."""
 
     tip_center: NDArray[np.float64]
     force: NDArray[np.float64]

@@ -70,17 +70,8 @@ def linear_to_srgb(c: NDArray[np.float64]) -> NDArray[np.float64]:
 
 @dataclass(frozen=True, kw_only=True)
 class Appearance:
-    """The look of a surface (module docstring).
-
-    Parameters
-    ----------
-    texture : {"plain", "noise", "stripes", "photo"}
-        The brightness pattern (:mod:`deformap.world._texture`).
-    photo : {"brick", "grass", "gravel"}
-        The photograph of the ``photo`` texture (scikit-image's bundled samples).
-    split : Split or None
-        Another look painted over part of the surface.
-    """
+    """The look of a surface (module docstring): a ``texture`` of :mod:`deformap.world._texture`
+    (``photo`` names scikit-image's sample photograph) and an optional ``split``."""
 
     color: tuple[float, float, float] = setting((0.6, 0.6, 0.6), ge=0.0, le=1.0,
                                                 doc="base colour, sRGB in [0, 1]")

@@ -202,8 +202,7 @@ class FoamBody:
 
     def element_dofs(self, k: int
                      ) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64]]:
-        """``(m, 24)`` DOF ids of the hexes of layer ``k`` (order of :func:`unit_hex_stiffness`)
-        and their column indices ``jj, ii``."""
+        """``(m, 24)`` DOF ids of the hexes of layer ``k`` and their columns ``jj, ii``."""
         g = self.grid
         jj, ii = np.nonzero(g.active)
         nodes = np.column_stack([g.node_id(ii + c[0], jj + c[1], np.full_like(ii, k + c[2]))

@@ -211,8 +211,7 @@ class FoamModel(FoamMesh):
 
     def _respond(self, index: int, load: NDArray[np.float64], center: NDArray[np.float64]
                  ) -> NDArray[np.float64]:
-        """``(n_nodes, 3)`` displacement of block ``index`` under ``(n_nodes, 3)`` nodal forces
-        centred at ``center`` (a nonlinear material overrides it)."""
+        """Block ``index``'s displacement under nodal forces ``load`` centred at ``center``."""
         body = self.bodies[index]
         f = load.ravel()[body.free]
         loaded = np.flatnonzero(f)
@@ -228,9 +227,7 @@ class FoamModel(FoamMesh):
 
     def _unit_columns(self, index: int, loaded: NDArray[np.int64]
                       ) -> tuple[NDArray[np.float64], NDArray[np.int64]] | None:
-        """Body ``index``'s unit responses to its free unknowns ``loaded`` (at a press's first
-        solve, also to those :meth:`_under_tip`), the missing ones solved in one call; None past
-        :attr:`max_unit_columns` or :data:`MAX_UNIT_BYTES`."""
+        """Body ``index``'s unit responses to ``loaded`` (and :meth:`_under_tip`), or None."""
         body = self.bodies[index]
         z, where = self._columns.get(index, (np.zeros((body.n_dofs, 0)),
                                              np.full(body.n_dofs, -1, dtype=np.int64)))
@@ -249,8 +246,7 @@ class FoamModel(FoamMesh):
         return z, where
 
     def _under_tip(self, index: int) -> NDArray[np.int64]:
-        """The free vertical unknowns (positions in ``free``) of the top nodes of block ``index``'s
-        active cells that the press's tip disc reaches."""
+        """Positions in ``free`` of the top nodes' vertical unknowns the tip's disc reaches."""
         if self._reach is None:
             return np.zeros(0, dtype=np.int64)
         (cx, cy), radius = self._reach

@@ -64,8 +64,7 @@ def _textured(rng: np.random.Generator, n: int) -> list[Appearance]:
 
 
 def _inside_point(piece: Piece, rng: np.random.Generator) -> tuple[float, float]:
-    """A point of ``piece``: the first of 64 draws near the middle of its bounding box, then of
-    256 over the box, that falls in it; its vertices' mean if none does."""
+    """A point of ``piece``, drawn near the middle of its bounding box where it can."""
     lo, hi = piece.polygon.min(axis=0), piece.polygon.max(axis=0)
     share = np.concatenate([rng.uniform(0.3, 0.7, size=(64, 2)),
                             rng.uniform(0.05, 0.95, size=(256, 2))])

@@ -46,8 +46,7 @@ _SETTLING_STEPS = 3
 
 def graded_axis(center: float, lo: float, hi: float, *, step: float, core: float,
                 reach: float) -> NDArray[np.float64]:
-    """Node coordinates of one axis: spacing ``step`` within ``core`` of ``center`` (a node), then
-    cells growing by 1.2 out to ``core + reach``, cut to ``[lo, hi]``."""
+    """One axis's nodes: ``step`` apart near ``center``, then growing, cut to ``[lo, hi]``."""
     offsets = list(np.arange(0.0, core + 0.5 * step, step))
     cell = step
     while offsets[-1] < core + reach:
@@ -80,9 +79,7 @@ def max_grid_nodes(extent_m: NDArray[np.float64], tip_radius_m: float) -> int:
 
 
 def _depth_guess(layer: FoundationLayer, force_n: float, tip_radius_m: float) -> float:
-    """A first sink of the tip: the sphere as a flat punch of radius ``a = sqrt(2 R δ)`` carrying
-    ``F = K(a) δ / 2``, the linear Pasternak punch's ``K(a) = π a² k + 2π a sqrt(k G_p) K₁ / K₀``
-    (of ``a / ℓ``)."""
+    """A first sink: a flat punch of radius ``sqrt(2 R δ)`` on the linear Pasternak layer."""
     k, gp, ell = layer.spring_pa_per_m, layer.shear_n_per_m, layer.influence_length_m
     depth = math.sqrt(force_n / (math.pi * k * tip_radius_m))
     for _ in range(30):  # a damped fixed point: K rises with δ

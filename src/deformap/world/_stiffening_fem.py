@@ -64,8 +64,7 @@ class _NearSet:
 
     def predict(self, force: float, size: int
                 ) -> tuple[NDArray[np.float64], NDArray[np.float64] | None]:
-        """A first guess at ``force``: the last solve's far forces and near strains scaled as
-        powers of the force, fitted to the last two solves (``F²`` and ``F`` after one)."""
+        """Far forces and near strains at ``force``, scaled from the last solves as its powers."""
         if not self.solved:
             return np.zeros(size), None
         f1, far1, eps1 = self.solved[-1]
@@ -156,8 +155,7 @@ class StiffeningFem(FoamModel):
 
     def _solve(self, index: int, f: NDArray[np.float64], force: float,
                center: NDArray[np.float64]) -> NDArray[np.float64]:
-        """The free displacements of block ``index`` in equilibrium with the free nodal forces
-        ``f`` (module docstring)."""
+        """Block ``index``'s free displacements in equilibrium with the free nodal forces ``f``."""
         op, body = self.operators[index], self.bodies[index]
         key = (index, np.asarray(center, dtype=float).tobytes())
         near = self._near.get(key)
@@ -220,8 +218,7 @@ class StiffeningFem(FoamModel):
 
     def _newton(self, b: NDArray[np.float64], near: _NearSet, op: StrainOperator,
                 start: NDArray[np.float64] | None) -> NDArray[np.float64]:
-        """The near elements' strains ``ε`` with ``ε − b + G s(ε) = 0`` by Newton's method, steps
-        halved to keep every ``ε < ε_d`` and the residual falling."""
+        """The near strains with ``ε − b + G s(ε) = 0``, by Newton's method with halved steps."""
         cap, g, elements = self.densification_strain, near.g, near.elements
         eps = np.minimum(b, 0.5 * cap) if start is None or start.size != b.size else start
         eps = np.minimum(eps, 0.999 * cap)
@@ -262,8 +259,7 @@ _ANDERSON_DEPTH = 3
 def _anderson(x: NDArray[np.float64], fx: NDArray[np.float64],
               history: list[tuple[NDArray[np.float64], NDArray[np.float64]]]
               ) -> NDArray[np.float64]:
-    """The next iterate of ``x = T(x)`` from ``x`` and ``fx = T(x)`` by Anderson mixing over
-    ``history`` (``(x, T(x))`` pairs, updated)."""
+    """The next iterate of ``x = T(x)`` by Anderson mixing over ``history`` (updated)."""
     history.append((x, fx))
     del history[:-(_ANDERSON_DEPTH + 1)]
     if len(history) < 2:

@@ -53,14 +53,9 @@ MIN_RECORD_FORCE_N = 0.1 + 5 * MIN_FORCE_RISE_N
 class SimulatedWorld:
     """A scenario on a table, seen by a depth camera and pressed by a force-controlled probe.
 
-    Parameters
-    ----------
-    scenario : Scenario
-    config : WorldConfig
-    rng : numpy.random.Generator
-        One number is drawn from it at construction; each event (the n-th observation at rest; a
-        press by its target and force) then draws its noise from a stream keyed by that number and
-        the event, so a resumed run sees the noise the uninterrupted run saw.
+    One number is drawn from ``rng`` at construction; each event (the n-th observation at rest; a
+    press by its target and force) then draws its noise from a stream keyed by that number and the
+    event, so a resumed run sees the noise the uninterrupted run saw.
     """
 
     def __init__(self, scenario: Scenario, *, config: WorldConfig | None = None,
