@@ -85,8 +85,7 @@ class WorldConfig:
     densification_strain: float = setting(0.95, gt=0.0, le=1.0)  # a strain: at most full collapse
     # m > 10 is a wall, not a foam; each unit of m steepens σ near ε_d by another 1 / (1 − ε/ε_d)
     stiffening_exponent: float = setting(1.0, ge=0.0, le=10.0)
-    # finer than 1 mm resolves nothing the 1 cm tip or the camera can tell, and the element count
-    # grows as 1 / size² (see check_world_budget for the mesh as a whole)
+    # finer than 1 mm resolves nothing the tip or the camera can tell (elements grow as 1 / size²)
     element_size_m: float = setting(0.0075, gt=0.0, ge=0.001)
     # the layer count grows as thickness / top layer when the layers do not grow (growth 1)
     top_layer_m: float = setting(0.005, gt=0.0, ge=0.001)
@@ -96,8 +95,7 @@ class WorldConfig:
     stick_length_m: float = setting(0.10, gt=0.0)
     stick_radius_m: float = setting(0.006, gt=0.0)
     hand_size_m: tuple[float, float, float] = setting((0.08, 0.06, 0.10), gt=0.0)
-    # the protocol refuses a contact force more than 25 % + 0.05 N off the command (0.125 N at
-    # 0.3 N): a per-axis noise of at most 0.02 N stays six of its σ inside that
+    # the protocol refuses a force 0.125 N off a 0.3 N command: 0.02 N per axis stays 6 σ inside
     force_noise_n: float = setting(0.01, ge=0.0, le=0.02)
     # 8 levels resolve the curvature of a sphere's F ∝ δ^(3/2); each level costs one press solve
     force_travel_levels: int = setting(8, ge=2, le=1000)

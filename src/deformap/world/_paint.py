@@ -10,7 +10,6 @@ Each family gives every piece of a layout (:class:`~deformap.world._layouts.Piec
 * ``split``: as ``informative``, but the largest piece is painted in two looks, split by a line
   through it: a look boundary that is no material boundary.
 * ``misleading``: two looks split by one line across the workspace, whatever the materials.
-
 """
 
 from __future__ import annotations
