@@ -79,9 +79,10 @@ def layer_correction(chi: Any, poisson_ratio: float) -> NDArray[np.float64]:
     return np.asarray(np.polynomial.polynomial.polyval(chi, coeffs))
 
 
-def _checked(depth_m: Any, tip_radius_m: float, thickness_m: float, youngs_modulus_pa: float,
-             poisson_ratio: float) -> tuple[NDArray[np.float64], float, float, float,
-                                            NDArray[np.float64]]:
+def _terms(depth_m: Any, tip_radius_m: float, thickness_m: float, youngs_modulus_pa: float,
+           poisson_ratio: float) -> tuple[NDArray[np.float64], NDArray[np.float64], float,
+                                          NDArray[np.float64]]:
+    """The checked depths ``δ``, ``χ = √(Rδ) / h``, ``(4/3) E* √R`` and ``P``'s coefficients."""
     check_array("depth_m", np.ravel(depth_m), (None,), what="depths in metres")
     depth = np.asarray(depth_m, dtype=float)
     if np.any(depth < 0):
@@ -89,9 +90,9 @@ def _checked(depth_m: Any, tip_radius_m: float, thickness_m: float, youngs_modul
             f"`depth_m` must hold depths >= 0 in metres; got {float(depth.min())}")
     r = check_positive("tip_radius_m", tip_radius_m)
     h = check_positive("thickness_m", thickness_m)
-    e_star = reduced_modulus(youngs_modulus_pa, poisson_ratio)
+    scale = 4.0 / 3.0 * reduced_modulus(youngs_modulus_pa, poisson_ratio) * np.sqrt(r)
     coeffs = layer_correction_coefficients(poisson_ratio)
-    return depth, r, h, e_star, coeffs
+    return depth, np.sqrt(r * depth) / h, scale, coeffs
 
 
 def layer_indentation_force(depth_m: Any, tip_radius_m: float, thickness_m: float,
@@ -99,11 +100,9 @@ def layer_indentation_force(depth_m: Any, tip_radius_m: float, thickness_m: floa
     """Force ``F = (4/3) E* √R δ^(3/2) · P(√(Rδ)/h)`` in newtons (the shape of ``depth_m``) of a
     rigid sphere of radius ``R`` sunk ``δ = depth_m ≥ 0`` into a layer of thickness ``h`` bonded
     to a rigid base; Hertz's half-space force as ``h → ∞``."""
-    depth, r, h, e_star, coeffs = _checked(depth_m, tip_radius_m, thickness_m,
-                                           youngs_modulus_pa, poisson_ratio)
-    chi = np.sqrt(r * depth) / h
-    hertz = 4.0 / 3.0 * e_star * np.sqrt(r) * depth**1.5
-    return np.asarray(hertz * np.polynomial.polynomial.polyval(chi, coeffs))
+    depth, chi, scale, coeffs = _terms(depth_m, tip_radius_m, thickness_m, youngs_modulus_pa,
+                                       poisson_ratio)
+    return np.asarray(scale * depth**1.5 * np.polynomial.polynomial.polyval(chi, coeffs))
 
 
 def layer_indentation_stiffness(depth_m: Any, tip_radius_m: float, thickness_m: float,
@@ -111,9 +110,8 @@ def layer_indentation_stiffness(depth_m: Any, tip_radius_m: float, thickness_m: 
                                 ) -> NDArray[np.float64]:
     """Contact stiffness ``dF/dδ = (4/3) E* √R √δ · (1.5 P(χ) + 0.5 χ P'(χ))`` in N/m of
     :func:`layer_indentation_force` (same arguments); 0 at ``δ = 0``."""
-    depth, r, h, e_star, coeffs = _checked(depth_m, tip_radius_m, thickness_m,
-                                           youngs_modulus_pa, poisson_ratio)
-    chi = np.sqrt(r * depth) / h
+    depth, chi, scale, coeffs = _terms(depth_m, tip_radius_m, thickness_m, youngs_modulus_pa,
+                                       poisson_ratio)
     poly = np.polynomial.polynomial
     shape = 1.5 * poly.polyval(chi, coeffs) + 0.5 * chi * poly.polyval(chi, poly.polyder(coeffs))
-    return np.asarray(4.0 / 3.0 * e_star * np.sqrt(r) * np.sqrt(depth) * shape)
+    return np.asarray(scale * np.sqrt(depth) * shape)

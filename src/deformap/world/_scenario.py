@@ -155,16 +155,11 @@ class Block:
         return inside
 
     def to_dict(self) -> dict[str, Any]:
-        out: dict[str, Any] = {"name": self.name,
-                               "polygon": [[float(x), float(y)] for x, y in self.polygon]}
+        out: dict[str, Any] = {"name": self.name, "polygon": self.polygon.tolist()}
         if self.holes:
-            out["holes"] = [[[float(x), float(y)] for x, y in h] for h in self.holes]
-        if self.rigid:
-            out["rigid"] = True
-        else:
-            out["hardness_n"] = float(self.hardness_n)  # type: ignore[arg-type]
-        out["thickness_m"] = self.thickness_m
-        out["color"] = self.color
+            out["holes"] = [h.tolist() for h in self.holes]
+        out.update({"rigid": True} if self.rigid else {"hardness_n": self.hardness})
+        out.update(thickness_m=self.thickness_m, color=self.color)
         if self.appearance is not None:
             out["appearance"] = self.appearance.to_dict()
         return out

@@ -36,7 +36,7 @@ from deformap.world._densification import (
 from deformap.world._foam import FoamModel
 from deformap.world._scenario import Scenario
 
-__all__ = ["NewtonSolve", "StiffeningFem"]
+__all__ = ["StiffeningFem"]
 
 log = logging.getLogger(__name__)
 
@@ -83,17 +83,6 @@ class _NearSet:
         self.solved = [*self.solved[-1:], (force, far, eps)]
 
 
-@dataclass(frozen=True)
-class NewtonSolve:
-    """How one patch's equilibrium was solved (residual in newtons)."""
-
-    residual_n: float
-    rounds: int
-    near_elements: int
-    max_strain: float
-    converged: bool
-
-
 class StiffeningFem(FoamModel):
     """All foam blocks of a scenario as FEM bodies of the stiffening foam (module docstring).
 
@@ -113,7 +102,6 @@ class StiffeningFem(FoamModel):
         self.tolerance = tolerance
         self.operators = {index: strain_operator(body) for index, body in self.bodies.items()}
         self._near: OrderedDict[tuple[int, bytes], _NearSet] = OrderedDict()
-        self.last: NewtonSolve | None = None
 
     def _law(self, strain: NDArray[np.float64], op: StrainOperator, elements: NDArray[np.int64],
              tangent: bool = False) -> NDArray[np.float64]:
@@ -129,11 +117,7 @@ class StiffeningFem(FoamModel):
         f = load.ravel()[body.free]
         force = float(-f.sum())
         if self.stiffening_exponent == 0.0 or force <= 0.0:  # the linear FEM's response
-            linear = super()._respond(index, load, center)
-            strain = self.operators[index].matrix.T @ linear.ravel()[body.free]
-            self.last = NewtonSolve(residual_n=0.0, rounds=1, near_elements=0,
-                                    max_strain=float(strain.max()), converged=True)
-            return linear
+            return super()._respond(index, load, center)
         u = np.zeros(3 * body.grid.n_nodes)
         u[body.free] = self._solve(index, f, force, center)
         return u.reshape(-1, 3)
@@ -169,9 +153,8 @@ class StiffeningFem(FoamModel):
         self._near.move_to_end(key)
         far, eps = near.predict(force, f.size)
         history: list[tuple[NDArray[np.float64], NDArray[np.float64]]] = []
-        residual, rounds, converged = np.inf, 0, False
-        while rounds < _MAX_ROUNDS:
-            rounds += 1
+        residual = np.inf
+        for rounds in range(1, _MAX_ROUNDS + 1):
             # the first round of a new target has no far forces yet: its linear response
             response = linear if linear is not None and rounds == 1 else body.solve_free(f - far)
             eps = solved = self._newton(near.columns.T @ response, near, op, eps)
@@ -189,16 +172,12 @@ class StiffeningFem(FoamModel):
             new_far = op.matrix @ stress
             residual = float(np.linalg.norm(new_far - far))
             if residual <= self.tolerance * force:
-                converged = True
                 break
             far = _anderson(far, new_far, history)
-        if not converged:
+        else:
             log.warning("stiffening FEM: the press did not converge in %d rounds (residual "
                         "%.3g N at %.3g N)", _MAX_ROUNDS, residual, force)
         near.remember(force, far, solved)
-        self.last = NewtonSolve(residual_n=residual, rounds=rounds,
-                                near_elements=int(near.elements.size),
-                                max_strain=float(strain.max()), converged=converged)
         return u
 
     def _near_set(self, index: int, linear: NDArray[np.float64]) -> _NearSet:
