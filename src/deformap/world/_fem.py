@@ -67,9 +67,7 @@ def unit_hex_stiffness(dx: float, dy: float, dz: float, nu: float) -> NDArray[np
     corner_of_node = np.rint(mesh.p.T / np.array([dx, dy, dz])).astype(int)
     ours = corner_of_node[:, 0] + 2 * corner_of_node[:, 1] + 4 * corner_of_node[:, 2]
     perm = np.empty(24, dtype=int)
-    for node in range(8):
-        for comp in range(3):
-            perm[3 * ours[node] + comp] = basis.nodal_dofs[comp, node]
+    perm[(3 * ours[:, None] + np.arange(3)).ravel()] = np.asarray(basis.nodal_dofs).T.ravel()
     out = k[np.ix_(perm, perm)]
     out.setflags(write=False)
     return out

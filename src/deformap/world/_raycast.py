@@ -14,7 +14,7 @@ import numpy as np
 import trimesh
 from numpy.typing import NDArray
 
-__all__ = ["cast_rays"]
+__all__ = ["cast_rays", "frame_along"]
 
 Hits = tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.float64]]
 
@@ -39,18 +39,18 @@ def cast_rays(mesh: trimesh.Trimesh, origins: NDArray[np.float64], directions: N
     return _pinhole_hits(np.asarray(mesh.triangles), origins[0], directions)
 
 
-def _frame(directions: NDArray[np.float64]) -> NDArray[np.float64]:
-    axis = directions.mean(axis=0)
-    axis /= np.linalg.norm(axis)
-    helper = np.array([1.0, 0.0, 0.0]) if abs(axis[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
-    e1 = np.cross(helper, axis)
-    e1 /= np.linalg.norm(e1)
-    return np.stack([e1, np.cross(axis, e1), axis])
+def frame_along(axis: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``(3, 3)`` rows of a right-handed orthonormal frame whose third axis is along ``axis``."""
+    z = axis / np.linalg.norm(axis)
+    helper = np.array([1.0, 0.0, 0.0]) if abs(z[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+    x = np.cross(helper, z)
+    x /= np.linalg.norm(x)
+    return np.stack([x, np.cross(z, x), z])
 
 
 def _pinhole_hits(triangles: NDArray[np.float64], origin: NDArray[np.float64],
                   directions: NDArray[np.float64]) -> Hits:
-    basis = _frame(directions)
+    basis = frame_along(directions.mean(axis=0))
     d = directions @ basis.T
     uv = d[:, :2] / d[:, 2:3]
     lo, hi = uv.min(axis=0), uv.max(axis=0)
