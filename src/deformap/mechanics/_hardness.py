@@ -7,8 +7,7 @@ around it and the non-linearity at 40 % strain) it gives the secant modulus
 
 References
 ----------
-ISO 2439 (2008). Flexible cellular polymeric materials — Determination of hardness (indentation
-technique). ASTM D3574, test B1 (indentation force deflection).
+ISO 2439 (2008). Flexible cellular polymeric materials — Determination of hardness.
 """
 
 from __future__ import annotations

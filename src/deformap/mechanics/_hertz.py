@@ -13,8 +13,7 @@ continuous at ``r = a`` with ``u(0) = δ``.
 
 References
 ----------
-Johnson, K. L. (1985). Contact Mechanics, §3.4 (pressure on a circular region) and §4.2 (Hertz
-contact of solids of revolution). Cambridge University Press.
+Johnson, K. L. (1985). Contact Mechanics, §3.4 and §4.2. Cambridge University Press.
 """
 
 from __future__ import annotations

@@ -22,9 +22,8 @@ homogeneous, isotropic layer.
 
 References
 ----------
-Dimitriadis, E. K., Horkay, F., Maresca, J., Kachar, B., Chadwick, R. S. (2002). Determination of
-elastic moduli of thin layers of soft material using the atomic force microscope. Biophysical
-Journal 82(5), 2798–2810 (Eq. 12 and the bonded / non-bonded α₀, β₀).
+Dimitriadis, E. K., et al. (2002). Elastic moduli of thin layers of soft material by AFM.
+Biophysical Journal 82(5), 2798–2810 (Eq. 12, the bonded α₀, β₀).
 Johnson, K. L. (1985). Contact Mechanics, §4.2. Cambridge University Press.
 """
 

@@ -10,10 +10,8 @@ one distant light (Foley et al. 1996, §16.1), 1 on a face that looks straight u
 
 References
 ----------
-IEC 61966-2-1:1999. Multimedia systems and equipment — Colour measurement and management —
-Part 2-1: Default RGB colour space — sRGB.
-Foley, J. D., van Dam, A., Feiner, S. K., Hughes, J. F. (1996). Computer Graphics: Principles
-and Practice, 2nd ed.
+IEC 61966-2-1:1999. Default RGB colour space — sRGB.
+Foley, J. D., et al. (1996). Computer Graphics: Principles and Practice, 2nd ed.
 """
 
 from __future__ import annotations

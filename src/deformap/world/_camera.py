@@ -19,12 +19,9 @@ clipping to ``[0, 1]``.
 
 References
 ----------
-Khoshelham, K., Elberink, S. O. (2012). Accuracy and resolution of Kinect depth data for indoor
-mapping applications. Sensors 12(2), 1437–1454.
-Nguyen, C. V., Izadi, S., Lovell, D. (2012). Modeling Kinect sensor noise for improved 3D
-reconstruction and tracking. 3DIMPVT.
-Grunnet-Jepsen, A., Sweetser, J. N., Woodfill, J. (2018). Best-known-methods for tuning Intel
-RealSense D400 depth cameras for best performance. Intel white paper, rev. 1.9.
+Khoshelham, K., Elberink, S. O. (2012). Accuracy and resolution of Kinect depth data. Sensors 12(2).
+Nguyen, C. V., Izadi, S., Lovell, D. (2012). Modeling Kinect sensor noise. 3DIMPVT.
+Grunnet-Jepsen, A., et al. (2018). Tuning Intel RealSense D400 depth cameras. Intel white paper.
 Goldman, D. B. (2010). Vignette and exposure calibration and compensation. IEEE TPAMI 32(12).
 """
 

@@ -15,10 +15,8 @@ law holds while every element's ``ε < ε_d``, at small strain.
 
 References
 ----------
-Gibson, L. J., Ashby, M. F. (1997). Cellular Solids: Structure and Properties, 2nd ed., ch. 5.
-Cambridge University Press.
-Storåkers, B. (1986). On material representation and constitutive branching in finite
-compressible elasticity. Journal of the Mechanics and Physics of Solids 34(2), 125–145.
+Gibson, L. J., Ashby, M. F. (1997). Cellular Solids, 2nd ed., ch. 5. Cambridge University Press.
+Storåkers, B. (1986). Finite compressible elasticity. J. Mech. Phys. Solids 34(2), 125–145.
 """
 
 from __future__ import annotations

@@ -12,8 +12,7 @@ factorisation shared by the homogeneous blocks of that mesh.
 
 References
 ----------
-Gustafsson, T., McBain, G. D. (2020). scikit-fem: A Python package for finite element assembly.
-Journal of Open Source Software 5(52), 2369.
+Gustafsson, T., McBain, G. D. (2020). scikit-fem. Journal of Open Source Software 5(52), 2369.
 """
 
 from __future__ import annotations

@@ -21,13 +21,10 @@ strain reaches ``ε_d``.
 
 References
 ----------
-Vlasov, V. Z., Leontiev, N. N. (1966). Beams, Plates and Shells on Elastic Foundations. Israel
-Program for Scientific Translations.
+Vlasov, V. Z., Leontiev, N. N. (1966). Beams, Plates and Shells on Elastic Foundations.
 Gibson, L. J., Ashby, M. F. (1997). Cellular Solids, 2nd ed., Cambridge University Press, ch. 5.
-Vallabhan, C. V. G., Das, Y. C. (1988). Parametric study of beams on elastic foundations. J. Eng.
-Mech. 114(12), 2072–2082.
-Hintermüller, M., Ito, K., Kunisch, K. (2002). The primal-dual active set strategy as a semismooth
-Newton method. SIAM J. Optim. 13(3), 865–888.
+Vallabhan, C. V. G., Das, Y. C. (1988). Beams on elastic foundations. J. Eng. Mech. 114(12).
+Hintermüller, M., Ito, K., Kunisch, K. (2002). Primal-dual active set. SIAM J. Optim. 13(3).
 """
 
 from __future__ import annotations

@@ -4,8 +4,7 @@ triangle with the rays of the cells its box covers, and runs the Möller–Trumb
 
 References
 ----------
-Möller, T., Trumbore, B. (1997). Fast, minimum storage ray-triangle intersection. Journal of
-Graphics Tools 2(1), 21–28.
+Möller, T., Trumbore, B. (1997). Fast, minimum storage ray-triangle intersection. JGT 2(1).
 """
 
 from __future__ import annotations

@@ -13,8 +13,7 @@ set. A patch is converged when the residual over every free unknown is below ``t
 
 References
 ----------
-Walker, H. F., Ni, P. (2011). Anderson acceleration for fixed-point iterations. SIAM Journal on
-Numerical Analysis 49(4), 1715–1735.
+Walker, H. F., Ni, P. (2011). Anderson acceleration for fixed-point iterations. SINUM 49(4).
 """
 
 from __future__ import annotations
