@@ -4,14 +4,11 @@ stiffens toward densification. Each hex ``e`` of the FEM's mesh has the strain e
 
     W_e(u) = ½ uₑᵀ Kₑ(E₀) uₑ + V_e Φ(ε_e),     Φ'(ε) = M₀ ε [(1 − ε/ε_d)^(−m) − 1]  (ε > 0),
 
-``Kₑ(E₀)`` the linear FEM's element stiffness at the block's ``modulus_pa``,
-``ε_e = −(1/V_e) ∫ div u dV = cₑ · uₑ`` the element's mean compressive volumetric strain,
-``M₀ = E₀ (1 − ν) / ((1 + ν)(1 − 2ν))``, and ``Φ = 0`` in dilatation. Under confined compression
-the stress is the column law ``σ = M₀ ε / (1 − ε/ε_d)^m`` of the ``stiffening-foam`` layer (Gibson
-& Ashby 1997, ch. 5); ``m = 0`` is the linear FEM exactly. Volumetric stiffening is how
-hyperelastic foam laws stiffen (Storåkers 1986); shear stays at ``G₀``. The tangent
-``K₀ + Σ_e V_e Φ''(ε_e) cₑ cₑᵀ`` is symmetric positive definite and never softer than ``K₀``. The
-law holds while every element's ``ε < ε_d``, at small strain.
+``Kₑ(E₀)`` the linear FEM's element stiffness at the block's ``modulus_pa``, ``ε_e = cₑ · uₑ`` the
+element's mean compressive volumetric strain, ``M₀`` the constrained modulus and ``Φ = 0`` in
+dilatation: under confined compression the column law ``σ = M₀ ε / (1 − ε/ε_d)^m`` (Gibson & Ashby
+1997, ch. 5; volumetric, as hyperelastic foam laws stiffen, Storåkers 1986), ``m = 0`` the linear
+FEM. The tangent ``K₀ + Σ_e V_e Φ''(ε_e) cₑ cₑᵀ`` is never softer than ``K₀``.
 
 References
 ----------

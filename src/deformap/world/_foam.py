@@ -1,22 +1,16 @@
 """The foam of a whole scenario: one elastic body per foam block, pressed by the probe.
 
 Each foam block is its own :class:`~deformap.world._fem.FoamBody` (neighbouring blocks are not
-glued). A press puts the Hertz pressure of the commanded force on the top surface under the tip;
-the part of the patch on rigid ground loads no foam.
+glued). A press puts the Hertz pressure of the commanded force on the top surface under the tip
+(on rigid ground it loads no foam). Inside the contact the surface follows the sphere, so the
+pressure-weighted mean FEM displacement ``ū_p`` gives the indentation ``δ = ū_p + 0.2 a² / R``;
+after the solve the top nodes inside the contact disc are put on the tip's cap.
 
-Indentation: inside the contact the surface follows the sphere, ``u(r) = δ − r² / (2R)``, so
-weighting by the Hertz pressure gives ``δ = ū_p + 0.2 a² / R``, ``ū_p`` the pressure-weighted mean
-FEM displacement (the load's work-conjugate, second-order convergent). After the solve the top
-nodes inside the contact disc are put on the tip's cap.
-
-Patch radius: the press iterates ``a ← sqrt(a · sqrt(R δ_FEM))`` (a damped fixed point of
-``a² = R δ``) from the Hertz value until ``a`` changes by less than 2 %, never beyond the tip
-radius (or ``max_radius_m``); a step that would leave the bracket the solves have set around the
-fixed point bisects it, so the iteration ends even where ``δ(a)`` jumps at a seam between blocks.
-
-Solves: a press's first solve computes the unit responses ``K⁻¹ e_z`` of the top nodes under the
-tip in one multi-right-hand-side call; every patch iteration and load level of that press is a sum
-of them (:data:`MAX_UNIT_COLUMNS`).
+The patch radius iterates ``a ← sqrt(a · sqrt(R δ_FEM))`` (a damped fixed point of ``a² = R δ``)
+from the Hertz value until it changes by less than 2 %, at most the tip radius (or
+``max_radius_m``), bisecting the bracket the solves set where a step would leave it (``δ(a)`` jumps
+at a seam). A press's first solve computes the unit responses ``K⁻¹ e_z`` of the top nodes under
+the tip in one call; its patch iterations and load levels are sums of them.
 """
 
 from __future__ import annotations

@@ -4,14 +4,12 @@ force-controlled contact with it solved by Newton's method (the physics of
 
 Layer (Vlasov & Leontiev 1966; Vallabhan & Das 1988): a block of thickness ``H`` deforms as
 ``u = (0, 0, −w(x, y) φ(z))``, ``φ`` from 0 at the table to 1 at the top, which gives the Pasternak
-energy ``Π[w] = ∫ Φ(w) dA + ½ G_p ∫ |∇w|² dA`` with ``Φ'(w) = p(w) = ∫ σ(w φ') φ' dz`` (small-strain
-spring ``k = M ∫ φ'² dz``, ``M = E (1 − ν) / ((1 + ν)(1 − 2ν))``) and ``G_p = G ∫ φ² dz``
-(``G = E / (2 (1 + ν))``). The mode shape is ``φ = sinh(γ z / H) / sinh γ`` with
-``(γ / H)² = (G / M) ∫ |∇w|² dA / ∫ w² dA`` iterated on the solved surface; ``ℓ = sqrt(G_p / k)``
-is how far a dent spreads beyond the tip.
-
-Stiffening (Gibson & Ashby 1997, ch. 5): ``σ(ε) = M ε / (1 − ε / ε_d)^m`` for ``ε ≥ 0`` (linear in
-extension), integrated through the thickness by 32-point Gauss–Legendre.
+energy ``Π[w] = ∫ Φ(w) dA + ½ G_p ∫ |∇w|² dA`` with ``Φ'(w) = p(w) = ∫ σ(w φ') φ' dz`` (32-point
+Gauss–Legendre; small-strain spring ``k = M ∫ φ'² dz``, ``M`` the constrained modulus) and
+``G_p = G ∫ φ² dz``. The mode shape is ``φ = sinh(γ z / H) / sinh γ`` with
+``(γ / H)² = (G / M) ∫ |∇w|² dA / ∫ w² dA`` on the solved surface; ``ℓ = sqrt(G_p / k)`` is how far
+a dent spreads. Stiffening (Gibson & Ashby 1997, ch. 5): ``σ(ε) = M ε / (1 − ε / ε_d)^m`` for
+``ε ≥ 0``, linear in extension.
 
 Contact: a surface point at distance ``r`` may not pass the sphere's cap,
 ``w ≥ δ − (R − sqrt(R² − r²))``; the press commands ``F``, so ``Π[w] − F δ`` is minimised over

@@ -2,14 +2,13 @@
 densification (:mod:`deformap.world._densification`), each press's equilibrium found by Newton's
 method, never refactorising.
 
-Force control and the patch iteration are the FEM's (:class:`~deformap.world._foam.FoamModel`);
-each patch's equilibrium ``K₀ u + C s(Cᵀu) = f`` (``s = V Φ'``) is solved with ``K₀`` factorised
-once. The near set (the elements the linear press would stiffen by more than 5 %, the most
-compressed first, between 8 and ``near_elements``) takes its tangent exactly, as a Woodbury update
-``Z = K₀⁻¹ C_N`` solved once per press target, which reduces each Newton step to a dense ``n × n``
-system. The other elements' forces are carried by an outer fixed point (Anderson-accelerated,
-Walker & Ni 2011), one ``K₀`` solve a round; an element compressed past ``ε_d / 5`` joins the near
-set. A patch is converged when the residual over every free unknown is below ``tolerance · F``.
+Force control and the patch iteration are the FEM's (:class:`~deformap.world._foam.FoamModel`).
+Each patch's equilibrium ``K₀ u + C s(Cᵀu) = f`` (``s = V Φ'``): the near set (the elements the
+linear press would stiffen by more than 5 %, 8 to ``near_elements`` of them) takes its tangent
+exactly by a Woodbury update ``Z = K₀⁻¹ C_N`` (a dense ``n × n`` Newton system); the other
+elements' forces are an outer fixed point (Anderson-accelerated, Walker & Ni 2011), one ``K₀``
+solve a round, and an element compressed past ``ε_d / 5`` joins the near set. Converged when the
+residual over every free unknown is below ``tolerance · F``.
 
 References
 ----------

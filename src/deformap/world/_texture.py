@@ -1,12 +1,11 @@
 """Textures of the simulated world: brightness patterns in metres on a surface.
 
 Each texture maps ``(n, 2)`` surface coordinates ``uv`` in metres to ``(n,)`` values in
-``[-1, 1]`` with a mean near 0:
+``[-1, 1]`` with a mean near 0 (``plain``: 0 everywhere):
 
-* ``plain``: 0 everywhere.
-* ``noise``: fractal value noise (Perlin 1985; Ebert et al. 2003, ch. 2): random values on a
-  square lattice of pitch ``scale_m``, interpolated with Hermite's smoothstep, summed over three
-  octaves of half the pitch and half the weight each.
+* ``noise``: fractal value noise (Perlin 1985; Ebert et al. 2003, ch. 2), random values on a
+  lattice of pitch ``scale_m`` interpolated by smoothstep, over three octaves of half the pitch
+  and half the weight each.
 * ``stripes``: a square wave of period ``scale_m`` across the direction ``angle_deg``.
 * ``photo``: a grey photograph bundled with scikit-image (``brick``, ``grass``, ``gravel``), one
   per ``scale_m`` square, repeated, sampled bilinearly, centred and scaled into ``[-1, 1]``.

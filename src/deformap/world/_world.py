@@ -1,12 +1,9 @@
 """The simulated world: scenario + foam physics + depth camera + probe, as an ``Environment``.
 
-``WorldConfig.physics`` picks how the foam answers a press (:mod:`deformap.world._foam`,
-:mod:`deformap.world._stiffening`, :mod:`deformap.world._stiffening_fem`); each displaces the same
-hexahedral mesh, which the camera sees. The force–travel record
-(:mod:`deformap.world._force_travel`) and each frame's colour (:mod:`deformap.world._looks`) draw
-their noise from streams of their own, so the depth's and the press's draws are those of a world
-without them. Ground truth labels are block indices (``-1`` = bare table); hardness and modulus are
-``inf`` on rigid blocks and the bare table.
+``WorldConfig.physics`` picks how the foam answers a press; each physics displaces the same
+hexahedral mesh, which the camera sees. The force–travel record and each frame's colour draw their
+noise from streams of their own, so the depth's and the press's draws are those of a world without
+them. Ground truth is ``-1`` (labels) or ``inf`` (hardness, modulus) on the bare table.
 """
 
 from __future__ import annotations
