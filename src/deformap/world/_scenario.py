@@ -254,45 +254,43 @@ _RIGID_COLOR = "#6b4f3a"
 _FOAM_PORES_M = {60: 0.005, 110: 0.004, 150: 0.003}
 
 
-def _foam(name: str, poly: NDArray[np.float64], hardness: int) -> Block:
+def _foam(poly: NDArray[np.float64], hardness: int) -> Block:
     look = Appearance(color=parse_color(_FOAM_COLORS[hardness]), texture="noise",
                       scale_m=_FOAM_PORES_M[hardness], amplitude=0.15, seed=hardness)
-    return Block(name=name, polygon=poly, hardness_n=float(hardness), color=_FOAM_COLORS[hardness],
-                 appearance=look)
+    return Block(name=f"foam-{hardness}", polygon=poly, hardness_n=float(hardness),
+                 color=_FOAM_COLORS[hardness], appearance=look)
 
 
-def _rigid(name: str, poly: NDArray[np.float64]) -> Block:
-    look = Appearance(color=parse_color(_RIGID_COLOR), texture="stripes", scale_m=0.006, amplitude=0.1,
-                      angle_deg=90.0)
-    return Block(name=name, polygon=poly, rigid=True, color=_RIGID_COLOR, appearance=look)
+def _rigid(poly: NDArray[np.float64]) -> Block:
+    look = Appearance(color=parse_color(_RIGID_COLOR), texture="stripes", scale_m=0.006,
+                      amplitude=0.1, angle_deg=90.0)
+    return Block(name="rigid", polygon=poly, rigid=True, color=_RIGID_COLOR, appearance=look)
 
 
 def builtin_scenarios() -> dict[str, Scenario]:
     """The six scenarios of the paper's Table I."""
     full = rectangle(0.0, 0.0, 0.60, 0.40)
     out = [
-        Scenario(name="homogeneous-60", blocks=(_foam("foam-60", full, 60),),
+        Scenario(name="homogeneous-60", blocks=(_foam(full, 60),),
                  description="one 60 N foam block over the whole 60x40 cm area"),
-        Scenario(name="homogeneous-110", blocks=(_foam("foam-110", full, 110),),
+        Scenario(name="homogeneous-110", blocks=(_foam(full, 110),),
                  description="one 110 N foam block over the whole 60x40 cm area"),
         Scenario(name="heterogeneous-60-150",
-                 blocks=(_foam("foam-60", rectangle(0.0, 0.0, 0.30, 0.40), 60),
-                         _foam("foam-150", rectangle(0.30, 0.0, 0.60, 0.40), 150)),
+                 blocks=(_foam(rectangle(0.0, 0.0, 0.30, 0.40), 60),
+                         _foam(rectangle(0.30, 0.0, 0.60, 0.40), 150)),
                  description="60 N foam on the left half, 150 N on the right half"),
         Scenario(name="heterogeneous-110-150",
-                 blocks=(_foam("foam-110", rectangle(0.0, 0.0, 0.60, 0.20), 110),
-                         _foam("foam-150", rectangle(0.0, 0.20, 0.60, 0.40), 150)),
+                 blocks=(_foam(rectangle(0.0, 0.0, 0.60, 0.20), 110),
+                         _foam(rectangle(0.0, 0.20, 0.60, 0.40), 150)),
                  description="110 N foam at the front (y < 20 cm), 150 N at the back"),
         Scenario(name="heterogeneous-150-rigid",
-                 blocks=(_foam("foam-150", rectangle(0.0, 0.0, 0.32, 0.40), 150),
-                         _rigid("rigid", rectangle(0.32, 0.0, 0.60, 0.40))),
+                 blocks=(_foam(rectangle(0.0, 0.0, 0.32, 0.40), 150),
+                         _rigid(rectangle(0.32, 0.0, 0.60, 0.40))),
                  description="150 N foam on x < 32 cm, a rigid board of the same height beyond"),
         Scenario(name="heterogeneous-60-110-rigid",
-                 blocks=(_foam("foam-60", np.array([[0.0, 0.0], [0.18, 0.0], [0.30, 0.40],
-                                                    [0.0, 0.40]]), 60),
-                         _foam("foam-110", np.array([[0.18, 0.0], [0.44, 0.0], [0.44, 0.40],
-                                                     [0.30, 0.40]]), 110),
-                         _rigid("rigid", rectangle(0.44, 0.0, 0.60, 0.40))),
+                 blocks=(_foam(np.array([[0.0, 0.0], [0.18, 0.0], [0.30, 0.40], [0.0, 0.40]]), 60),
+                         _foam(np.array([[0.18, 0.0], [0.44, 0.0], [0.44, 0.4], [0.30, 0.4]]), 110),
+                         _rigid(rectangle(0.44, 0.0, 0.60, 0.40))),
                  description="60 N | 110 N split by a slanted cut, rigid board on x > 44 cm"),
     ]
     return {s.name: s for s in out}
