@@ -5,10 +5,10 @@ stiffens toward densification. Each hex ``e`` of the FEM's mesh has the strain e
     W_e(u) = ½ uₑᵀ Kₑ(E₀) uₑ + V_e Φ(ε_e),     Φ'(ε) = M₀ ε [(1 − ε/ε_d)^(−m) − 1]  (ε > 0),
 
 ``Kₑ(E₀)`` the linear FEM's element stiffness at the block's ``modulus_pa``, ``ε_e = cₑ · uₑ`` the
-element's mean compressive volumetric strain, ``M₀`` the constrained modulus and ``Φ = 0`` in
-dilatation: under confined compression the column law ``σ = M₀ ε / (1 − ε/ε_d)^m`` (Gibson & Ashby
-1997, ch. 5; volumetric, as hyperelastic foam laws stiffen, Storåkers 1986), ``m = 0`` the linear
-FEM. The tangent ``K₀ + Σ_e V_e Φ''(ε_e) cₑ cₑᵀ`` is never softer than ``K₀``.
+element's mean compressive volumetric strain, ``M₀`` the constrained modulus; ``Φ = 0`` in
+dilatation. Under confined compression it is the column law ``σ = M₀ ε / (1 − ε/ε_d)^m`` (Gibson &
+Ashby 1997, ch. 5), stiffening in volume as hyperelastic foam laws do (Storåkers 1986); ``m = 0``
+is the linear FEM. The tangent ``K₀ + Σ_e V_e Φ''(ε_e) cₑ cₑᵀ`` is never softer than ``K₀``.
 
 References
 ----------
