@@ -14,16 +14,15 @@ from deformap.world import (
     WorldConfig,
     random_scenario,
 )
-from deformap.world._polygon import (
-    is_convex,
-    is_simple,
-    overlap_area,
-    polygon_area,
-    rectangle,
-    triangulate,
-)
+from deformap.world._polygon import is_simple, overlap_area, polygon_area, rectangle, triangulate
 
 L_SHAPE = np.array([[0, 0], [0.4, 0], [0.4, 0.1], [0.1, 0.1], [0.1, 0.4], [0, 0.4]], float)
+
+
+def is_convex(poly: np.ndarray) -> bool:
+    """True when the counter-clockwise polygon turns left (or goes straight) at every vertex."""
+    e = np.roll(poly, -1, axis=0) - poly
+    return bool(np.all(e[:, 0] * np.roll(e[:, 1], -1) - e[:, 1] * np.roll(e[:, 0], -1) >= -1e-12))
 
 
 def test_every_family_is_seeded_and_tiles_the_workspace() -> None:

@@ -95,9 +95,8 @@ def test_newton_converges_to_equilibrium_whatever_the_near_set(near) -> None:
     stress = op.volume * volumetric_stress(strain, op.constrained_pa, densification=0.95,
                                            exponent=1.0)
     residual = body.stiffness[free][:, free] @ u[free] + op.matrix @ stress - load.ravel()[free]
-    assert foam.last is not None and foam.last.converged
     assert np.linalg.norm(residual) <= 1e-9 * 2.0
-    assert foam.last.max_strain > 0.05  # it was pressed into the nonlinear range
+    assert strain.max() > 0.05  # it was pressed into the nonlinear range
     # the answer is the equilibrium's, not the near set's: 2 elements (the rest joining or
     # carried by the outer rounds) give the 48 elements' displacements
     reference = _foam(tolerance=1e-10)._respond(0, load, CENTER).ravel()

@@ -1,16 +1,9 @@
 """Contact mechanics: the tactile contact, Hertz contact of the probe's sphere, a sphere on a bonded
 elastic layer, foam hardness.
 
-The physics both the simulated world and the estimator use; it imports numpy and the validators
-only, so that ``world`` can use it without the estimator. Units are SI.
-
-References
-----------
-Dimitriadis, E. K., et al. (2002). Determination of elastic moduli of thin layers of soft material
-using the atomic force microscope. Biophysical Journal 82(5), 2798–2810.
-Johnson, K. L. (1985). Contact Mechanics, §3.4 and §4.2. Cambridge University Press.
-ISO 2439 (2008). Flexible cellular polymeric materials — Determination of hardness (indentation
-technique).
+The physics both the simulated world and the estimator use (SI units); it imports numpy and the
+validators only, so that ``world`` can use it without the estimator. Each module gives its
+references.
 """
 
 from __future__ import annotations
@@ -39,20 +32,9 @@ from deformap.mechanics._layer import (
 )
 
 __all__ = [
-    "INDENTATION_STRAIN",
-    "INDENTER_AREA_M2",
-    "TactileContact",
-    "elastic_dent",
-    "hardness_to_youngs_modulus",
-    "hertz_contact_radius",
-    "hertz_indentation",
-    "hertz_pressure_samples",
-    "hertz_surface_deflection",
-    "layer_chi_limit",
-    "layer_correction",
-    "layer_correction_coefficients",
-    "layer_indentation_force",
-    "layer_indentation_stiffness",
-    "reduced_modulus",
-    "youngs_modulus_to_hardness",
+    "INDENTATION_STRAIN", "INDENTER_AREA_M2", "TactileContact", "elastic_dent",
+    "hardness_to_youngs_modulus", "hertz_contact_radius", "hertz_indentation",
+    "hertz_pressure_samples", "hertz_surface_deflection", "layer_chi_limit", "layer_correction",
+    "layer_correction_coefficients", "layer_indentation_force", "layer_indentation_stiffness",
+    "reduced_modulus", "youngs_modulus_to_hardness",
 ]

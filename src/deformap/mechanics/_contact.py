@@ -15,18 +15,9 @@ __all__ = ["TactileContact"]
 
 @dataclass(frozen=True, kw_only=True)
 class TactileContact:
-    """What the force sensor and proprioception say at the moment of the press.
-
-    Parameters
-    ----------
-    tip_center : (3,) float, metres
-        Centre of the probe's spherical tip in the world frame.
-    force : (3,) float, newtons
-        Force the probe exerts on the surface (it points into the surface: about ``(0, 0, -F)``
-        for a press straight down). The tactile points lie on the tip's cap that faces along it.
-    tip_radius_m : float
-        Radius of the spherical tip.
-    """
+    """What the force sensor and proprioception say at the moment of the press: the ``(3,)``
+    ``tip_center`` (world frame, metres) of the spherical tip of radius ``tip_radius_m`` and the
+    ``(3,)`` ``force`` in newtons it exerts on the surface (``(0, 0, -F)`` pressing down)."""
 
     tip_center: NDArray[np.float64]
     force: NDArray[np.float64]
@@ -37,10 +28,9 @@ class TactileContact:
         force = check_vector("force", self.force, 3, what="newtons")
         if not np.any(force):
             raise InvalidArgumentError("`force` must be a non-zero force vector; got (0, 0, 0)")
-        center.setflags(write=False)
-        force.setflags(write=False)
-        object.__setattr__(self, "tip_center", center)
-        object.__setattr__(self, "force", force)
+        for name, value in (("tip_center", center), ("force", force)):
+            value.setflags(write=False)
+            object.__setattr__(self, name, value)
         object.__setattr__(self, "tip_radius_m", check_positive("tip_radius_m", self.tip_radius_m))
 
     @property

@@ -1,19 +1,13 @@
 """Foam hardness (ISO 2439 indentation force) to Young's modulus and back.
 
-Foam makers grade polyurethane foam by its indentation hardness: the force ``H`` in newtons that a
-flat circular indenter of 323 cm² (203 mm diameter, ISO 2439 / ASTM D3574) needs to compress a
-sample to 40 % of its thickness. Reading that test as uniaxial compression of the material under the
-indenter gives a secant modulus
-
-    E = (H / A) / ε,    A = 0.0323 m²,  ε = 0.4,
-
-so 60, 110 and 150 N foams get 4.6, 8.5 and 11.6 kPa. It ignores the foam around the indenter and
-the non-linearity of foam at 40 % strain; it is the project's reference conversion.
+The hardness ``H`` is the force in newtons that a flat indenter of 323 cm² needs to compress a
+sample to 40 % of its thickness; read as uniaxial compression under the indenter (ignoring the foam
+around it and the non-linearity at 40 % strain) it gives the secant modulus
+``E = (H / A) / ε``, ``A = 0.0323 m²``, ``ε = 0.4``.
 
 References
 ----------
-ISO 2439 (2008). Flexible cellular polymeric materials — Determination of hardness (indentation
-technique). ASTM D3574, test B1 (indentation force deflection).
+ISO 2439 (2008). Flexible cellular polymeric materials — Determination of hardness.
 """
 
 from __future__ import annotations
@@ -22,33 +16,16 @@ import numpy as np
 
 from deformap._validation import check_positive
 
-__all__ = [
-    "INDENTATION_STRAIN",
-    "INDENTER_AREA_M2",
-    "hardness_to_youngs_modulus",
-    "youngs_modulus_to_hardness",
-]
+__all__ = ["INDENTATION_STRAIN", "INDENTER_AREA_M2", "hardness_to_youngs_modulus",
+           "youngs_modulus_to_hardness"]
 
-INDENTER_AREA_M2 = 0.0323
-"""Area of the ISO 2439 indenter foot (203 mm diameter), m²."""
-
-INDENTATION_STRAIN = 0.4
-"""Compression at which the hardness force is read (40 % of the thickness)."""
+INDENTER_AREA_M2 = 0.0323  # the ISO 2439 indenter foot (203 mm diameter), m²
+INDENTATION_STRAIN = 0.4  # the compression at which the hardness force is read
 
 
 def hardness_to_youngs_modulus(hardness_n: float) -> float:
-    """Young's modulus in pascals of a foam of indentation hardness ``hardness_n`` newtons.
-
-    Parameters
-    ----------
-    hardness_n : float, newtons
-        Force to compress the foam to 40 % under a 323 cm² indenter; must be > 0.
-
-    Returns
-    -------
-    float, pascals
-        ``(hardness_n / 0.0323) / 0.4``; 60 N gives about 4644 Pa.
-    """
+    """Young's modulus ``(hardness_n / 0.0323) / 0.4`` in pascals of a foam of indentation
+    hardness ``hardness_n > 0`` newtons."""
     h = check_positive("hardness_n", hardness_n)
     return float(h / INDENTER_AREA_M2 / INDENTATION_STRAIN)
 

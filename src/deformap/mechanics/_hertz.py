@@ -13,8 +13,7 @@ continuous at ``r = a`` with ``u(0) = δ``.
 
 References
 ----------
-Johnson, K. L. (1985). Contact Mechanics, §3.4 (pressure on a circular region) and §4.2 (Hertz
-contact of solids of revolution). Cambridge University Press.
+Johnson, K. L. (1985). Contact Mechanics, §3.4 and §4.2. Cambridge University Press.
 """
 
 from __future__ import annotations
@@ -28,26 +27,13 @@ from deformap._validation import check_array, check_finite_scalar, check_int, ch
 from deformap.errors import InvalidArgumentError
 from deformap.mechanics._contact import TactileContact
 
-__all__ = [
-    "elastic_dent",
-    "hertz_contact_radius",
-    "hertz_indentation",
-    "hertz_pressure_samples",
-    "hertz_surface_deflection",
-    "reduced_modulus",
-]
+__all__ = ["elastic_dent", "hertz_contact_radius", "hertz_indentation", "hertz_pressure_samples",
+           "hertz_surface_deflection", "reduced_modulus"]
 
 
 def reduced_modulus(youngs_modulus_pa: float, poisson_ratio: float) -> float:
-    """``E* = E / (1 − ν²)`` in pascals: a half-space's modulus against a rigid indenter.
-
-    Parameters
-    ----------
-    youngs_modulus_pa : float, pascals
-        ``E > 0``.
-    poisson_ratio : float
-        ``ν`` in ``(−1, 0.5]``.
-    """
+    """``E* = E / (1 − ν²)`` in pascals of a half-space (``E > 0``, ``ν`` in ``(−1, 0.5]``)
+    against a rigid indenter."""
     e = check_positive("youngs_modulus_pa", youngs_modulus_pa)
     nu = check_finite_scalar("poisson_ratio", poisson_ratio)
     if not -1.0 < nu <= 0.5:
@@ -76,20 +62,8 @@ def hertz_indentation(force_n: float, tip_radius_m: float, youngs_modulus_pa: fl
 
 def hertz_surface_deflection(r: Any, force_n: float, tip_radius_m: float, modulus_pa: float,
                              poisson_ratio: float = 0.5) -> NDArray[np.float64]:
-    """Downward surface deflection ``u(r)`` (metres) of a half-space under a Hertz sphere.
-
-    Parameters
-    ----------
-    r : array of float, metres
-        Horizontal distances from the contact centre (any shape).
-    force_n, tip_radius_m, modulus_pa, poisson_ratio : float
-        Normal force, sphere radius, Young's modulus and Poisson ratio of the half-space.
-
-    Returns
-    -------
-    array of float, metres
-        ``u(r)`` of the module docstring, the shape of ``r``; ``u(0) = δ``.
-    """
+    """Downward surface deflection ``u(r)`` in metres (module docstring, ``u(0) = δ``) at
+    horizontal distances ``r`` (any shape, metres) from the centre of a Hertz sphere's contact."""
     r = np.asarray(r, dtype=float)
     e_star = reduced_modulus(modulus_pa, poisson_ratio)
     a = hertz_contact_radius(force_n, tip_radius_m, modulus_pa, poisson_ratio)
@@ -103,24 +77,9 @@ def hertz_surface_deflection(r: Any, force_n: float, tip_radius_m: float, modulu
 
 def hertz_pressure_samples(center_xy: NDArray[np.float64], radius_m: float, force_n: float,
                            n_across: int = 24) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Point forces that sample the Hertz pressure on a disc and sum to ``force_n`` exactly.
-
-    Parameters
-    ----------
-    center_xy : (2,) float, metres
-    radius_m : float
-        Contact radius ``a``.
-    force_n : float
-        Total normal force.
-    n_across : int
-        Samples across the diameter (midpoint rule on a square lattice).
-
-    Returns
-    -------
-    points : (s, 2) float, metres
-    forces : (s,) float, newtons, summing to ``force_n``
-        Proportional to ``√(1 − r² / a²)`` at each sample.
-    """
+    """``(s, 2)`` points (metres) and ``(s,)`` forces (newtons, ``∝ √(1 − r² / a²)``, summing
+    to ``force_n`` exactly) that sample the Hertz pressure on the disc of radius ``radius_m``
+    about ``center_xy``: the midpoint rule on a square lattice of ``n_across`` cells across."""
     center = check_array("center_xy", center_xy, (2,), what="metres")
     radius_m = check_positive("radius_m", radius_m)
     n_across = check_int("n_across", n_across, minimum=1)
@@ -137,42 +96,21 @@ def hertz_pressure_samples(center_xy: NDArray[np.float64], radius_m: float, forc
 def elastic_dent(xs: Any, ys: Any, z_rest: Any, contact_xy: Any, *, force_n: float,
                  tip_radius_m: float, modulus_pa: float | None, poisson_ratio: float = 0.5,
                  ) -> tuple[NDArray[np.float64], TactileContact]:
-    """Deformed heightmap and tactile contact of a vertical Hertz poke on a (locally flat) foam.
-
-    An analytic dent (:func:`hertz_surface_deflection` subtracted from the rest heights), not
-    shape matching: a reference the β estimation is checked against.
-
-    Parameters
-    ----------
-    xs : (nx,) float, ys : (ny,) float, z_rest : (ny, nx) float, metres
-        The rest heightmap.
-    contact_xy : (2,) float, metres
-    force_n, tip_radius_m : float
-    modulus_pa : float or None
-        ``None`` means a rigid surface (no dent).
-    poisson_ratio : float
-
-    Returns
-    -------
-    z_deformed : (ny, nx) float, metres
-    contact : TactileContact
-        Tip resting in the dent (its lowest point at the dent's bottom below the grid node nearest
-        ``contact_xy``), force ``(0, 0, −F)``.
-    """
+    """Deformed ``(ny, nx)`` heightmap and tactile contact of a vertical Hertz poke on the rest
+    heightmap ``z_rest`` over ``xs``, ``ys`` (metres): :func:`hertz_surface_deflection`
+    subtracted, an analytic reference for the β estimation. ``modulus_pa`` None is a rigid
+    surface. The tip rests in the dent below the grid node nearest ``contact_xy``, force
+    ``(0, 0, −F)``."""
     xs, ys, z_rest = np.asarray(xs, float), np.asarray(ys, float), np.asarray(z_rest, float)
     gx, gy = np.meshgrid(xs, ys)
     cx, cy = float(contact_xy[0]), float(contact_xy[1])
-    if modulus_pa is None:
-        u = np.zeros_like(z_rest)
-        depth = 0.0
-    else:
+    u, depth = np.zeros_like(z_rest), 0.0
+    if modulus_pa is not None:
         u = hertz_surface_deflection(np.hypot(gx - cx, gy - cy), force_n, tip_radius_m,
                                      modulus_pa, poisson_ratio)
         depth = float(hertz_surface_deflection(0.0, force_n, tip_radius_m, modulus_pa,
                                                poisson_ratio))
-    j = int(np.argmin(np.abs(xs - cx)))
-    i = int(np.argmin(np.abs(ys - cy)))
-    z_top = float(z_rest[i, j]) - depth
+    z_top = float(z_rest[np.argmin(np.abs(ys - cy)), np.argmin(np.abs(xs - cx))]) - depth
     contact = TactileContact(tip_center=np.array([cx, cy, z_top + tip_radius_m]),
                              force=np.array([0.0, 0.0, -force_n]), tip_radius_m=tip_radius_m)
     return z_rest - u, contact

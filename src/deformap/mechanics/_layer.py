@@ -15,19 +15,15 @@ series in ``χ = √(Rδ) / h``:
     α₀(ν) = −(1.2876 − 1.4678 ν + 1.3442 ν²) / (1 − ν),
     β₀(ν) = (0.6387 − 1.0277 ν + 1.5164 ν²) / (1 − ν)    (bonded layer).
 
-The series is evaluated as written; its χ⁴ coefficient at ``ν = 0.5`` is −0.0975 where the paper's
-printed incompressible form reads +0.0975 (its non-bonded case, put into the same series,
-reproduces the printed coefficients).
-
-Valid for ``χ ≲ 1`` (beyond it the polynomial extrapolates and the force stops rising at
-:func:`layer_chi_limit`), small strain (``δ ≪ R``, ``δ ≪ h``; with ``R < h`` the strain, not
-``χ``, bounds the model), and a frictionless tip on a flat, homogeneous, isotropic layer.
+The series is evaluated as written (its χ⁴ coefficient at ``ν = 0.5`` is −0.0975; the paper's
+printed incompressible form reads +0.0975). Valid for ``χ ≲ 1`` (the force stops rising at
+:func:`layer_chi_limit`), small strain (``δ ≪ R``, ``δ ≪ h``) and a frictionless tip on a flat,
+homogeneous, isotropic layer.
 
 References
 ----------
-Dimitriadis, E. K., Horkay, F., Maresca, J., Kachar, B., Chadwick, R. S. (2002). Determination of
-elastic moduli of thin layers of soft material using the atomic force microscope. Biophysical
-Journal 82(5), 2798–2810 (Eq. 12 and the bonded / non-bonded α₀, β₀).
+Dimitriadis, E. K., et al. (2002). Elastic moduli of thin layers of soft material by AFM.
+Biophysical Journal 82(5), 2798–2810 (Eq. 12, the bonded α₀, β₀).
 Johnson, K. L. (1985). Contact Mechanics, §4.2. Cambridge University Press.
 """
 
@@ -42,41 +38,22 @@ from deformap._validation import check_array, check_positive
 from deformap.errors import InvalidArgumentError
 from deformap.mechanics._hertz import reduced_modulus
 
-__all__ = [
-    "layer_chi_limit",
-    "layer_correction",
-    "layer_correction_coefficients",
-    "layer_indentation_force",
-    "layer_indentation_stiffness",
-]
+__all__ = ["layer_chi_limit", "layer_correction", "layer_correction_coefficients",
+           "layer_indentation_force", "layer_indentation_stiffness"]
 
 
 def layer_correction_coefficients(poisson_ratio: float) -> NDArray[np.float64]:
-    """Coefficients ``c₀ … c₄`` of ``P(χ) = Σ cₖ χᵏ`` for a bonded layer (module docstring).
-
-    Parameters
-    ----------
-    poisson_ratio : float
-        ``ν`` in ``[0, 0.5]`` (the bonded ``α₀``, ``β₀`` were fitted over that range).
-
-    Returns
-    -------
-    (5,) float
-        ``c₀ = 1``; at ``ν = 0.5`` about ``(1, 1.133, 1.283, 0.769, −0.095)``.
-    """
+    """``(5,)`` coefficients ``c₀ = 1 … c₄`` of ``P(χ) = Σ cₖ χᵏ`` for a bonded layer (module
+    docstring); ``ν`` in ``[0, 0.5]``, the range the bonded ``α₀``, ``β₀`` were fitted over."""
     nu = check_positive("poisson_ratio", poisson_ratio, allow_zero=True)
     if nu > 0.5:
         raise InvalidArgumentError(f"`poisson_ratio` must lie in [0, 0.5]; got {nu}")
     alpha = -(1.2876 - 1.4678 * nu + 1.3442 * nu**2) / (1.0 - nu)
     beta = (0.6387 - 1.0277 * nu + 1.5164 * nu**2) / (1.0 - nu)
     pi = np.pi
-    return np.array([
-        1.0,
-        -2.0 * alpha / pi,
-        4.0 * alpha**2 / pi**2,
-        -8.0 / pi**3 * (alpha**3 + 4.0 * pi**2 / 15.0 * beta),
-        16.0 * alpha / pi**4 * (alpha**3 + 3.0 * pi**2 / 5.0 * beta),
-    ])
+    return np.array([1.0, -2.0 * alpha / pi, 4.0 * alpha**2 / pi**2,
+                     -8.0 / pi**3 * (alpha**3 + 4.0 * pi**2 / 15.0 * beta),
+                     16.0 * alpha / pi**4 * (alpha**3 + 3.0 * pi**2 / 5.0 * beta)])
 
 
 def layer_chi_limit(poisson_ratio: float) -> float:
@@ -92,20 +69,8 @@ def layer_chi_limit(poisson_ratio: float) -> float:
 
 
 def layer_correction(chi: Any, poisson_ratio: float) -> NDArray[np.float64]:
-    """``P(χ)``, the bonded layer's force over Hertz's at the same depth (module docstring).
-
-    Parameters
-    ----------
-    chi : array of float
-        ``χ = √(Rδ) / h ≥ 0`` (any shape).
-    poisson_ratio : float
-        As in :func:`layer_correction_coefficients`.
-
-    Returns
-    -------
-    array of float
-        The shape of ``chi``; 1 at ``χ = 0``.
-    """
+    """``P(χ)`` (the shape of ``chi``, 1 at ``χ = 0``), the bonded layer's force over Hertz's at
+    the same depth, for ``χ = √(Rδ) / h ≥ 0``."""
     chi = np.asarray(chi, dtype=float)
     if not np.all(np.isfinite(chi)) or np.any(chi < 0):
         raise InvalidArgumentError("`chi` must hold finite values >= 0")
@@ -113,9 +78,10 @@ def layer_correction(chi: Any, poisson_ratio: float) -> NDArray[np.float64]:
     return np.asarray(np.polynomial.polynomial.polyval(chi, coeffs))
 
 
-def _checked(depth_m: Any, tip_radius_m: float, thickness_m: float, youngs_modulus_pa: float,
-             poisson_ratio: float) -> tuple[NDArray[np.float64], float, float, float,
-                                            NDArray[np.float64]]:
+def _terms(depth_m: Any, tip_radius_m: float, thickness_m: float, youngs_modulus_pa: float,
+           poisson_ratio: float) -> tuple[NDArray[np.float64], NDArray[np.float64], float,
+                                          NDArray[np.float64]]:
+    """The checked depths ``δ``, ``χ = √(Rδ) / h``, ``(4/3) E* √R`` and ``P``'s coefficients."""
     check_array("depth_m", np.ravel(depth_m), (None,), what="depths in metres")
     depth = np.asarray(depth_m, dtype=float)
     if np.any(depth < 0):
@@ -123,55 +89,28 @@ def _checked(depth_m: Any, tip_radius_m: float, thickness_m: float, youngs_modul
             f"`depth_m` must hold depths >= 0 in metres; got {float(depth.min())}")
     r = check_positive("tip_radius_m", tip_radius_m)
     h = check_positive("thickness_m", thickness_m)
-    e_star = reduced_modulus(youngs_modulus_pa, poisson_ratio)
+    scale = 4.0 / 3.0 * reduced_modulus(youngs_modulus_pa, poisson_ratio) * np.sqrt(r)
     coeffs = layer_correction_coefficients(poisson_ratio)
-    return depth, r, h, e_star, coeffs
+    return depth, np.sqrt(r * depth) / h, scale, coeffs
 
 
 def layer_indentation_force(depth_m: Any, tip_radius_m: float, thickness_m: float,
                             youngs_modulus_pa: float, poisson_ratio: float) -> NDArray[np.float64]:
-    """Force in newtons of a rigid sphere sunk ``depth_m`` into a bonded elastic layer.
-
-    ``F = (4/3) E* √R δ^(3/2) · P(√(Rδ)/h)`` (module docstring), vectorised over ``δ``; it tends to
-    Hertz's half-space force (:func:`deformap.mechanics.hertz_indentation`'s inverse) as
-    ``h → ∞`` and grows faster than it on thinner layers.
-
-    Parameters
-    ----------
-    depth_m : array of float, metres
-        Indentation depths ``δ ≥ 0`` (any shape).
-    tip_radius_m : float
-        Sphere radius ``R > 0``.
-    thickness_m : float
-        Layer thickness ``h > 0`` above the rigid base.
-    youngs_modulus_pa : float
-        ``E > 0``.
-    poisson_ratio : float
-        ``ν`` in ``[0, 0.5]``.
-
-    Returns
-    -------
-    array of float, newtons
-        The shape of ``depth_m``.
-    """
-    depth, r, h, e_star, coeffs = _checked(depth_m, tip_radius_m, thickness_m,
-                                           youngs_modulus_pa, poisson_ratio)
-    chi = np.sqrt(r * depth) / h
-    hertz = 4.0 / 3.0 * e_star * np.sqrt(r) * depth**1.5
-    return np.asarray(hertz * np.polynomial.polynomial.polyval(chi, coeffs))
+    """Force ``F = (4/3) E* √R δ^(3/2) · P(√(Rδ)/h)`` in newtons (the shape of ``depth_m``) of a
+    rigid sphere of radius ``R`` sunk ``δ = depth_m ≥ 0`` into a layer of thickness ``h`` bonded
+    to a rigid base; Hertz's half-space force as ``h → ∞``."""
+    depth, chi, scale, coeffs = _terms(depth_m, tip_radius_m, thickness_m, youngs_modulus_pa,
+                                       poisson_ratio)
+    return np.asarray(scale * depth**1.5 * np.polynomial.polynomial.polyval(chi, coeffs))
 
 
 def layer_indentation_stiffness(depth_m: Any, tip_radius_m: float, thickness_m: float,
                                 youngs_modulus_pa: float, poisson_ratio: float,
                                 ) -> NDArray[np.float64]:
-    """Contact stiffness ``dF/dδ`` in N/m of :func:`layer_indentation_force` at ``depth_m``.
-
-    With ``dχ/dδ = χ / (2δ)``: ``dF/dδ = (4/3) E* √R √δ · (1.5 P(χ) + 0.5 χ P'(χ))``. Arguments as
-    in :func:`layer_indentation_force`; 0 at ``δ = 0``.
-    """
-    depth, r, h, e_star, coeffs = _checked(depth_m, tip_radius_m, thickness_m,
-                                           youngs_modulus_pa, poisson_ratio)
-    chi = np.sqrt(r * depth) / h
+    """Contact stiffness ``dF/dδ = (4/3) E* √R √δ · (1.5 P(χ) + 0.5 χ P'(χ))`` in N/m of
+    :func:`layer_indentation_force` (same arguments); 0 at ``δ = 0``."""
+    depth, chi, scale, coeffs = _terms(depth_m, tip_radius_m, thickness_m, youngs_modulus_pa,
+                                       poisson_ratio)
     poly = np.polynomial.polynomial
     shape = 1.5 * poly.polyval(chi, coeffs) + 0.5 * chi * poly.polyval(chi, poly.polyder(coeffs))
-    return np.asarray(4.0 / 3.0 * e_star * np.sqrt(r) * np.sqrt(depth) * shape)
+    return np.asarray(scale * np.sqrt(depth) * shape)

@@ -1,24 +1,11 @@
 """The simulated world: foam scenarios, physics ground truth, a depth camera and a probe.
 
-It implements :class:`deformap.environment.Environment` and never imports the estimator (``msm``,
-``gp``, ``explore``), so accuracy figures are never circular; its physics is chosen by
-``WorldConfig.physics``. Hertz contact and the hardness–modulus conversion live in
-:mod:`deformap.mechanics` and are re-exported here.
-
-Quick start::
-
-    import numpy as np
-    from deformap.world import SimulatedWorld, load_scenario
-    scenario = load_scenario("heterogeneous-60-110-rigid")
-    world = SimulatedWorld(scenario, rng=np.random.default_rng(0))
-    cloud = world.observe()
-    obs = world.press((0.1, 0.2), 0.6)   # target (m), force (N)
-    obs.force_travel.travel_m, obs.force_travel.force_n   # contact → 0.6 N, 9 samples
-    world.release()
-
-Every frame carries colour (``cloud.colors``, sRGB): each block has an :class:`Appearance` (a
-colour and a texture), lit by one light and seen through the camera's colour sensor;
-``world.rgb_image()`` is the camera's colour image of the scene as it is now.
+:class:`SimulatedWorld` implements :class:`deformap.environment.Environment` and never imports the
+estimator (``msm``, ``gp``, ``explore``), so accuracy figures are never circular; its physics is
+chosen by ``WorldConfig.physics``. Every frame carries colour (``cloud.colors``, sRGB): each block
+has an :class:`Appearance`, lit by one light and seen through the camera's colour sensor;
+``world.rgb_image()`` is the camera's colour image of the scene. Hertz contact and the
+hardness–modulus conversion of :mod:`deformap.mechanics` are re-exported here.
 """
 
 from __future__ import annotations
@@ -43,33 +30,10 @@ from deformap.world._scenario_io import list_scenarios, load_scenario, save_scen
 from deformap.world._world import MIN_RECORD_FORCE_N, SimulatedWorld
 
 __all__ = [
-    "APPEARANCE_FAMILIES",
-    "BARE_TABLE",
-    "CAMERA_PRESETS",
-    "LAYOUT_FAMILIES",
-    "MIN_RECORD_FORCE_N",
-    "PHYSICS",
-    "Appearance",
-    "AppearanceFamily",
-    "Block",
-    "CameraConfig",
-    "Dent",
-    "LayoutFamily",
-    "Physics",
-    "ProbeGeometry",
-    "Scenario",
-    "SimulatedWorld",
-    "Split",
-    "WorldConfig",
-    "camera_preset",
-    "check_world_budget",
-    "hardness_to_youngs_modulus",
-    "hertz_contact_radius",
-    "hertz_indentation",
-    "hertz_pressure_samples",
-    "list_scenarios",
-    "load_scenario",
-    "random_scenario",
-    "save_scenario",
-    "youngs_modulus_to_hardness",
+    "APPEARANCE_FAMILIES", "BARE_TABLE", "CAMERA_PRESETS", "LAYOUT_FAMILIES", "MIN_RECORD_FORCE_N",
+    "PHYSICS", "Appearance", "AppearanceFamily", "Block", "CameraConfig", "Dent", "LayoutFamily",
+    "Physics", "ProbeGeometry", "Scenario", "SimulatedWorld", "Split", "WorldConfig",
+    "camera_preset", "check_world_budget", "hardness_to_youngs_modulus", "hertz_contact_radius",
+    "hertz_indentation", "hertz_pressure_samples", "list_scenarios", "load_scenario",
+    "random_scenario", "save_scenario", "youngs_modulus_to_hardness",
 ]

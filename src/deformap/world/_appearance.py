@@ -1,24 +1,17 @@
 """How a surface of the simulated world looks: a colour, a texture and, optionally, a second look
 painted over part of it.
 
-An :class:`Appearance` gives the albedo at a surface point: its sRGB ``color`` turned linear
-(IEC 61966-2-1), times ``1 + amplitude · t`` where ``t`` in ``[-1, 1]`` is its texture
-(:mod:`deformap.world._texture`) at the point's surface coordinates in metres: ``(x, y)`` on a
-face that looks up, ``(s, z)`` on a side face (``s`` along the face, horizontal). A :class:`Split`
-paints another look over the half-plane on one side of a line in the table plane: one material
-in two colours, a look boundary that is no material boundary.
-
-:func:`lambert` shades an albedo: ambient plus Lambert's cosine law for one distant light,
-normalised so that a face that looks straight up shows its albedo (the exposure is set on the
-table), so that side faces are darker than top faces whenever the light is nearer the vertical
-than the face's normal is.
+An :class:`Appearance`'s albedo at a point is its sRGB ``color`` turned linear (IEC 61966-2-1)
+times ``1 + amplitude · t``, ``t`` in ``[-1, 1]`` its texture (:mod:`deformap.world._texture`) at
+the point's surface coordinates in metres (``(x, y)`` on a face that looks up, ``(s, z)`` on a side
+face). A :class:`Split` paints another look over a half-plane of the table: a look boundary that
+is no material boundary. :func:`lambert` shades an albedo: ambient plus Lambert's cosine law for
+one distant light (Foley et al. 1996, §16.1), 1 on a face that looks straight up.
 
 References
 ----------
-IEC 61966-2-1:1999. Multimedia systems and equipment — Colour measurement and management —
-Part 2-1: Default RGB colour space — sRGB.
-Foley, J. D., van Dam, A., Feiner, S. K., Hughes, J. F. (1996). Computer Graphics: Principles
-and Practice, 2nd ed., §16.1 (ambient and diffuse reflection).
+IEC 61966-2-1:1999. Default RGB colour space — sRGB.
+Foley, J. D., et al. (1996). Computer Graphics: Principles and Practice, 2nd ed.
 """
 
 from __future__ import annotations
@@ -39,8 +32,7 @@ RGB = tuple[float, float, float]
 
 
 def parse_color(value: Any, name: str = "color") -> Any:
-    """An sRGB colour ``"#rrggbb"`` as ``(r, g, b)`` in ``[0, 1]``; anything else unchanged (the
-    settings check then refuses what is no triple in ``[0, 1]``)."""
+    """An sRGB colour ``"#rrggbb"`` as ``(r, g, b)`` in ``[0, 1]``; anything else unchanged."""
     if not isinstance(value, str):
         return value
     text = value.strip()
@@ -76,27 +68,8 @@ def linear_to_srgb(c: NDArray[np.float64]) -> NDArray[np.float64]:
 
 @dataclass(frozen=True, kw_only=True)
 class Appearance:
-    """The look of a surface.
-
-    Parameters
-    ----------
-    color : (3,) float in [0, 1], or "#rrggbb"
-        Base colour, sRGB.
-    texture : {"plain", "noise", "stripes", "photo"}
-        The brightness pattern (:mod:`deformap.world._texture`).
-    scale_m : float, metres
-        The noise's lattice pitch, the stripes' period or the side of one photograph.
-    amplitude : float
-        The texture's largest relative change of brightness, in ``[0, 1]``.
-    angle_deg : float, degrees
-        Direction of the stripes' normal from the x axis.
-    photo : {"brick", "grass", "gravel"}
-        The photograph of the ``photo`` texture (scikit-image's bundled samples).
-    seed : int
-        Draws the noise lattice: two looks with one seed have one pattern.
-    split : Split or None
-        Another look painted over part of the surface.
-    """
+    """The look of a surface (module docstring): a ``texture`` of :mod:`deformap.world._texture`
+    (``photo`` names scikit-image's sample photograph) and an optional ``split``."""
 
     color: tuple[float, float, float] = setting((0.6, 0.6, 0.6), ge=0.0, le=1.0,
                                                 doc="base colour, sRGB in [0, 1]")
@@ -116,8 +89,8 @@ class Appearance:
             raise SettingError("split", "must paint a look without a split of its own")
 
     def albedo(self, xy: NDArray[np.float64], uv: NDArray[np.float64]) -> NDArray[np.float64]:
-        """``(n, 3)`` linear albedo at points of table-plane position ``xy`` and surface
-        coordinates ``uv`` (both ``(n, 2)``, metres); the split decides by ``xy``."""
+        """``(n, 3)`` linear albedo at table-plane positions ``xy`` (which the split reads) and
+        surface coordinates ``uv`` (both ``(n, 2)``, metres)."""
         t = texture_values(self.texture, uv, scale_m=self.scale_m, angle_deg=self.angle_deg,
                            photo=self.photo, seed=self.seed)
         out = srgb_to_linear(np.array(self.color))[None, :] * (1.0 + self.amplitude * t)[:, None]
@@ -145,17 +118,8 @@ class Appearance:
 
 @dataclass(frozen=True, kw_only=True)
 class Split:
-    """A second look over the half-plane ``(p − through) · (cos a, sin a) > 0``, ``a = normal_deg``.
-
-    Parameters
-    ----------
-    through : (2,) float, metres
-        A point of the dividing line.
-    normal_deg : float, degrees
-        Direction, from the x axis, of the side that shows ``look``.
-    look : Appearance
-        The look painted there (without a split of its own).
-    """
+    """A second ``look`` (without a split of its own) over the half-plane
+    ``(p − through) · (cos a, sin a) > 0``, ``a = normal_deg``."""
 
     through: tuple[float, float] = setting((0.0, 0.0), ge=-10.0, le=10.0, doc="a point [m]")
     normal_deg: float = setting(0.0, ge=-360.0, le=360.0, doc="the painted side's direction")
@@ -169,11 +133,10 @@ class Split:
         return np.asarray((xy - np.array(self.through)) @ np.array([np.cos(a), np.sin(a)]) > 0)
 
     def to_dict(self) -> dict[str, Any]:
-        return {"through": list(self.through), "normal_deg": self.normal_deg,
-                **self.look.to_dict()}
+        return {"through": list(self.through), "normal_deg": self.normal_deg, **self.look.to_dict()}
 
 
-#: A block without an appearance: neutral grey, plain (a look that tells no block from another).
+#: A block without an appearance: neutral grey, plain.
 DEFAULT_APPEARANCE = Appearance()
 #: The table without an appearance: a darker warm grey, plain, so that blocks stand out on it.
 DEFAULT_TABLE_APPEARANCE = Appearance(color=parse_color("#5a5550"))
@@ -183,14 +146,8 @@ _SPLIT_KEYS = {"through", "normal_deg"}
 
 
 def appearance_from_dict(data: Any, where: str) -> Appearance:
-    """An :class:`Appearance` from its YAML mapping (keys of its fields; ``split`` holds
-    ``through``, ``normal_deg`` and the painted look's own keys).
-
-    Raises
-    ------
-    ValueError
-        One line naming ``where`` and the bad key or value.
-    """
+    """An :class:`Appearance` from its YAML mapping (``split`` holds ``through``, ``normal_deg``
+    and the painted look's own keys); a ValueError names ``where`` and the bad key or value."""
     if not isinstance(data, dict):
         raise ValueError(f"{where}: must be a mapping; got {type(data).__name__}")
     extra = sorted(set(data) - _KEYS)
@@ -216,8 +173,7 @@ def appearance_from_dict(data: Any, where: str) -> Appearance:
 
 def lambert(normals: NDArray[np.float64], light: NDArray[np.float64], ambient: float
             ) -> NDArray[np.float64]:
-    """``(n,)`` shading of faces of unit ``normals`` ``(n, 3)`` under a distant light from the
-    unit direction ``light`` (toward the light) and the ``ambient`` share, 1 on a face that looks
-    straight up."""
+    """``(n,)`` shading of faces of unit ``normals`` ``(n, 3)`` lit from the unit direction
+    ``light`` with the ``ambient`` share (module docstring)."""
     diffuse = np.clip(normals @ light, 0.0, None)
     return np.asarray((ambient + (1.0 - ambient) * diffuse) / (ambient + (1.0 - ambient) * light[2]))

@@ -1,9 +1,8 @@
 """A PrimeSense-like depth camera: ray casting plus the sensor's error model.
 
 The camera sits ``height_m`` above the table on the workspace's ``-y`` side and looks at the
-workspace centre ``pitch_deg`` below the horizontal. Each pixel casts one ray (trimesh's Embree
-backend when ``embreex`` is installed, else the pure-numpy caster) into the table, the blocks'
-deformed surfaces and, while pressing, the probe. Then, per pixel, in this order:
+workspace centre ``pitch_deg`` below the horizontal. Each pixel casts one ray
+(:mod:`deformap.world._raycast`) into the scene. Then, per pixel, in this order:
 
 1. no return when the ray meets the surface at more than ``grazing_deg`` from its normal;
 2. flying pixels: where the depth jumps by more than ``edge_jump_m`` to the right or lower
@@ -12,25 +11,18 @@ deformed surfaces and, while pressing, the probe. Then, per pixel, in this order
 3. axial noise ``σ_z = sigma_base + sigma_quadratic·(z − sigma_reference)²`` (z along the axis);
 4. disparity quantisation: ``z = f b / (round(f b / z · subpixel) / subpixel)``.
 
-Points are returned in the world frame, one per valid pixel in row-major pixel order, with the
-pixel, the triangle and the noise-free point each ray hit, which the world colours. The colour
-sensor (:meth:`DepthCamera.sensor_colors`) takes the light reaching each pixel (linear RGB) and
-applies, in this order, vignetting (``1 − vignetting · r²``, ``r`` the pixel's distance from the
-image centre over the half-diagonal; Goldman 2010), per-channel white-balance gains, the sRGB
-encoding, Gaussian noise of standard deviation ``color_noise`` per channel (from its own random
-stream: the depth's draws are those of a camera without colour) and clipping to ``[0, 1]``.
+Points are returned in the world frame, one per valid pixel in row-major order. The colour sensor
+(:meth:`DepthCamera.sensor_colors`) applies to the linear light reaching each pixel vignetting
+(``1 − vignetting · r²``, ``r`` the distance from the image centre over the half-diagonal; Goldman
+2010), white-balance gains, the sRGB encoding, Gaussian noise ``color_noise`` per channel and
+clipping to ``[0, 1]``.
 
 References
 ----------
-Khoshelham, K., Elberink, S. O. (2012). Accuracy and resolution of Kinect depth data for indoor
-mapping applications. Sensors 12(2), 1437–1454.
-Nguyen, C. V., Izadi, S., Lovell, D. (2012). Modeling Kinect sensor noise for improved 3D
-reconstruction and tracking. 3DIMPVT.
-Grunnet-Jepsen, A., Sweetser, J. N., Woodfill, J. (2018). Best-known-methods for tuning Intel
-RealSense D400 depth cameras for best performance. Intel white paper, rev. 1.9.
-Intel RealSense D400 series product family datasheet (2019).
-Goldman, D. B. (2010). Vignette and exposure calibration and compensation. IEEE Transactions on
-Pattern Analysis and Machine Intelligence 32(12), 2276–2288.
+Khoshelham, K., Elberink, S. O. (2012). Accuracy and resolution of Kinect depth data. Sensors 12(2).
+Nguyen, C. V., Izadi, S., Lovell, D. (2012). Modeling Kinect sensor noise. 3DIMPVT.
+Grunnet-Jepsen, A., et al. (2018). Tuning Intel RealSense D400 depth cameras. Intel white paper.
+Goldman, D. B. (2010). Vignette and exposure calibration and compensation. IEEE TPAMI 32(12).
 """
 
 from __future__ import annotations
@@ -38,6 +30,7 @@ from __future__ import annotations
 import logging
 from collections.abc import Callable
 from dataclasses import dataclass
+from functools import partial
 from typing import NamedTuple
 
 import numpy as np
@@ -85,12 +78,6 @@ class CameraConfig:
         Probability in ``[0, 1]`` that a candidate pixel flies.
     use_embree : bool
         Use trimesh's Embree ray caster when ``embreex`` is installed.
-    color_noise : float
-        Standard deviation of the colour sensor's noise per channel, in sRGB units of ``[0, 1]``.
-    white_balance : (3,) float
-        Gains on the red, green and blue light (1, 1, 1: balanced).
-    vignetting : float
-        Relative loss of light at the image's corners, in ``[0, 1)``.
     """
 
     # a ray per pixel, with a few float64 arrays each: 4096 × 4096 rays is gigabytes per frame
@@ -122,35 +109,21 @@ class CameraConfig:
         check_settings(self)
 
 
-def _kinect_v1() -> CameraConfig:
-    # Kinect v1 in its 320 × 240 depth mode, 1 m above the table: field of view 57° × 43°,
-    # baseline 7.5 cm, disparity in 1/8 pixel (at half the resolution, twice the quantisation
-    # step in depth), random error about 1.6 mm · z² (Khoshelham & Elberink 2012, Fig. 9); its
-    # VGA Bayer colour sensor is noisier than the later ones: twice the default colour noise
-    return CameraConfig(width=320, height=240, fov_deg=(57.0, 43.0), height_m=1.0,
-                        sigma_base_m=0.0, sigma_quadratic_m=0.0016, sigma_reference_m=0.0,
-                        baseline_m=0.075, subpixel=8.0, color_noise=0.02)
-
-
-def _realsense_d435() -> CameraConfig:
-    # RealSense D435 at 848 × 480, 0.6 m above the table (its minimum range is about 0.2 m):
-    # field of view 87° × 58°, baseline 5 cm; depth RMS z² · 0.08 px / (f b) with
-    # f = 424 px / tan(43.5°) ≈ 447 px, i.e. 3.6 mm · z² (Grunnet-Jepsen et al. 2018); its
-    # disparity is finer than that noise (1/32 pixel); its global-shutter colour sensor a little
-    # less noisy than the default
-    return CameraConfig(width=848, height=480, fov_deg=(87.0, 58.0), height_m=0.6,
-                        sigma_base_m=0.0, sigma_quadratic_m=0.0036, sigma_reference_m=0.0,
-                        baseline_m=0.05, subpixel=32.0, color_noise=0.008)
-
-
-#: Named depth cameras of the kind a robot carries, each a :class:`CameraConfig` built from the
-#: maker's or the literature's figures (see the references): ``primesense`` (the default, a
-#: PrimeSense Carmine 1.08 at 0.8 m and 45°), ``kinect-v1`` and ``realsense-d435``. Their colour
-#: noise is 0.01, 0.02 and 0.008 (sRGB units), our choice by sensor class, not a maker's figure.
+#: Named depth cameras, from the maker's or the literature's figures (the references); the colour
+#: noise is our choice by sensor class.
 CAMERA_PRESETS: dict[str, Callable[[], CameraConfig]] = {
     "primesense": CameraConfig,
-    "kinect-v1": _kinect_v1,
-    "realsense-d435": _realsense_d435,
+    # its 320 × 240 depth mode, 1 m above the table; random error 1.6 mm · z² (Khoshelham &
+    # Elberink 2012, Fig. 9); a VGA Bayer colour sensor, twice the default colour noise
+    "kinect-v1": partial(CameraConfig, width=320, height=240, fov_deg=(57.0, 43.0), height_m=1.0,
+                         sigma_base_m=0.0, sigma_quadratic_m=0.0016, sigma_reference_m=0.0,
+                         baseline_m=0.075, subpixel=8.0, color_noise=0.02),
+    # 0.6 m above the table; depth RMS z² · 0.08 px / (f b), f ≈ 447 px: 3.6 mm · z²
+    # (Grunnet-Jepsen et al. 2018); a global-shutter colour sensor, a little less noisy
+    "realsense-d435": partial(CameraConfig, width=848, height=480, fov_deg=(87.0, 58.0),
+                              height_m=0.6, sigma_base_m=0.0, sigma_quadratic_m=0.0036,
+                              sigma_reference_m=0.0, baseline_m=0.05, subpixel=32.0,
+                              color_noise=0.008),
 }
 
 
@@ -163,9 +136,8 @@ def camera_preset(name: str) -> CameraConfig:
 
 
 class Frame(NamedTuple):
-    """One frame: ``points`` ``(n, 3)`` world metres (noisy), and for each the flat ``pixel``
-    index ``(n,)``, the ``triangle`` its ray hit ``(n,)``, the noise-free ``hit`` ``(n, 3)`` and
-    that triangle's unit ``normal`` ``(n, 3)`` (as the mesh orients it)."""
+    """Noisy ``points`` ``(n, 3)`` (world, metres) and each one's flat ``pixel``, ``triangle``
+    hit, noise-free ``hit`` ``(n, 3)`` and the triangle's unit ``normal`` ``(n, 3)``."""
 
     points: NDArray[np.float64]
     pixel: NDArray[np.int64]
@@ -175,15 +147,8 @@ class Frame(NamedTuple):
 
 
 class DepthCamera:
-    """The camera at its pose over a workspace centre ``(cx, cy)``.
-
-    Attributes
-    ----------
-    origin : (3,) float, metres
-        Optical centre in the world frame.
-    cam2world : (4, 4) float
-        Camera pose (x right, y down, z forward, OpenCV convention).
-    """
+    """The camera at its pose over a workspace centre: optical centre ``origin`` ``(3,)`` (world,
+    metres) and pose ``cam2world`` ``(4, 4)`` (x right, y down, z forward, OpenCV convention)."""
 
     def __init__(self, config: CameraConfig, center_xy: tuple[float, float]) -> None:
         self.config = config
@@ -206,10 +171,6 @@ class DepthCamera:
         self._cos_axis = 1.0 / np.linalg.norm(cam, axis=1)
         self.directions = (cam * self._cos_axis[:, None]) @ self.cam2world[:3, :3].T
         self._forward = forward
-
-    def depth_image(self, mesh: trimesh.Trimesh) -> NDArray[np.float64]:
-        """``(height, width)`` noise-free depth along the optical axis, NaN where no return."""
-        return self._cast(mesh)[0]
 
     def _cast(self, mesh: trimesh.Trimesh
               ) -> tuple[NDArray[np.float64], NDArray[np.int64], NDArray[np.float64]]:
@@ -251,8 +212,7 @@ class DepthCamera:
     def sensor_colors(self, light: NDArray[np.float64], pixel: NDArray[np.int64],
                       rng: np.random.Generator) -> NDArray[np.float64]:
         """``(n, 3)`` sRGB in ``[0, 1]`` of the ``(n, 3)`` linear ``light`` reaching the flat
-        ``pixel`` indices: vignetting, white balance, sRGB encoding, noise from ``rng`` (drawn for
-        every pixel of the image), clipping (module docstring)."""
+        ``pixel`` indices (module docstring); noise drawn for every pixel of the image."""
         c = self.config
         u = pixel % c.width + 0.5 - c.width / 2
         v = pixel // c.width + 0.5 - c.height / 2
@@ -268,12 +228,9 @@ class DepthCamera:
                        ) -> NDArray[np.float64]:
         c = self.config
         out = depth.copy()
-        for axis in (1, 0):
+        for here, right_or_below in ((np.s_[:, :-1], np.s_[:, 1:]), (np.s_[:-1, :], np.s_[1:, :])):
             nxt = np.full_like(depth, np.nan)
-            if axis == 1:
-                nxt[:, :-1] = depth[:, 1:]
-            else:
-                nxt[:-1, :] = depth[1:, :]
+            nxt[here] = depth[right_or_below]
             with np.errstate(invalid="ignore"):
                 edge = np.abs(nxt - depth) > c.edge_jump_m
             fly = edge & (mix[0] < c.flying_probability) & np.isfinite(out)

@@ -20,16 +20,11 @@ from deformap.world._stiffening import max_grid_nodes
 __all__ = ["MAX_FEM_UNKNOWNS", "PHYSICS", "Physics", "RecordSpacing", "WorldConfig",
            "check_world_budget"]
 
-#: The world's contact physics: 3-D linear elasticity by FEM (:mod:`deformap.world._foam`), a
-#: stiffening two-parameter foundation solved by Newton's method
-#: (:mod:`deformap.world._stiffening`), or the FEM of a continuum foam that stiffens as it is
-#: compressed, solved by Newton's method (:mod:`deformap.world._stiffening_fem`).
+#: The world's contact physics (``WorldConfig.physics``).
 Physics = Literal["linear-fem", "stiffening-foam", "stiffening-fem"]
 PHYSICS: tuple[str, ...] = get_args(Physics)
-#: How the samples of a press's force–travel record are spaced (``WorldConfig``'s
-#: ``force_travel_spacing``): evenly in force, as a press whose force ramps at a constant rate
-#: records; or evenly in travel, as an arm that advances at a constant speed and samples at a fixed
-#: rate records (exactly even for a Hertz contact, :func:`deformap.world._force_travel.force_levels`).
+#: How a force–travel record's samples are spaced
+#: (:func:`~deformap.world._force_travel.force_levels`).
 RecordSpacing = Literal["force", "travel"]
 
 
@@ -40,19 +35,14 @@ class WorldConfig:
     Parameters
     ----------
     physics : {"linear-fem", "stiffening-foam", "stiffening-fem"}
-        How the foam answers a press. Linear elasticity by finite elements, a stiffening
-        two-parameter foundation (:mod:`deformap.world._stiffening`), or finite elements of a foam
-        that stiffens toward densification (:mod:`deformap.world._stiffening_fem`); a block's
-        ``modulus_pa`` is its small-strain Young's modulus in each.
+        How the foam answers a press. ``modulus_pa`` is the small-strain modulus in each.
     densification_strain : float
         Densification strain ``ε_d`` of the stiffening law ``σ = M ε / (1 − ε / ε_d)^m`` (stiffening
-        physics only). 0.95 is Gibson & Ashby's ``1 − 1.4 ρ*/ρ_s`` for a flexible polyurethane foam
-        of relative density 0.035.
+        physics only). 0.95 is Gibson & Ashby's ``1 − 1.4 ρ*/ρ_s`` at relative density 0.035.
     stiffening_exponent : float
         Exponent ``m`` of that law; 1 is Gibson & Ashby's densification fit, 0 is linear.
     element_size_m : float
-        In-plane size of the foam's hexahedra. 7.5 mm resolves the dent of the 1 cm tip while a world
-        stays quick to build.
+        In-plane size of the foam's hexahedra. 7.5 mm resolves the 1 cm tip's dent.
     top_layer_m : float
         Thickness of the top element layer.
     layer_growth : float
@@ -89,20 +79,13 @@ class WorldConfig:
         The simulated depth camera.
     table_margin_m : float
         How far the table extends beyond the workspace on every side.
-    light_direction : (3,) float
-        Direction toward the scene's one distant light (any length; pointing up, ``z > 0``).
-    ambient : float
-        Share of the light that comes from everywhere (ambient), in ``[0, 1]``.
-    tip_color, stick_color, hand_color : (3,) float in [0, 1], or "#rrggbb"
-        Colours (sRGB) of the probe's tip, its stick and the hand that holds it.
     """
 
     physics: Physics = "linear-fem"
     densification_strain: float = setting(0.95, gt=0.0, le=1.0)  # a strain: at most full collapse
     # m > 10 is a wall, not a foam; each unit of m steepens σ near ε_d by another 1 / (1 − ε/ε_d)
     stiffening_exponent: float = setting(1.0, ge=0.0, le=10.0)
-    # finer than 1 mm resolves nothing the 1 cm tip or the camera can tell, and the element count
-    # grows as 1 / size² (see check_world_budget for the mesh as a whole)
+    # finer than 1 mm resolves nothing the tip or the camera can tell (elements grow as 1 / size²)
     element_size_m: float = setting(0.0075, gt=0.0, ge=0.001)
     # the layer count grows as thickness / top layer when the layers do not grow (growth 1)
     top_layer_m: float = setting(0.005, gt=0.0, ge=0.001)
@@ -112,8 +95,7 @@ class WorldConfig:
     stick_length_m: float = setting(0.10, gt=0.0)
     stick_radius_m: float = setting(0.006, gt=0.0)
     hand_size_m: tuple[float, float, float] = setting((0.08, 0.06, 0.10), gt=0.0)
-    # the protocol refuses a contact force more than 25 % + 0.05 N off the command (0.125 N at
-    # 0.3 N): a per-axis noise of at most 0.02 N stays six of its σ inside that
+    # the protocol refuses a force 0.125 N off a 0.3 N command: 0.02 N per axis stays 6 σ inside
     force_noise_n: float = setting(0.01, ge=0.0, le=0.02)
     # 8 levels resolve the curvature of a sphere's F ∝ δ^(3/2); each level costs one press solve
     force_travel_levels: int = setting(8, ge=2, le=1000)
@@ -161,16 +143,13 @@ class WorldConfig:
         return cls(**settings)
 
 
-#: Most displacement unknowns (3 per mesh node, all blocks) of the foam FEM: each foam block's
-#: stiffness matrix is factorised once by a sparse direct solver and kept, and on a 3-D mesh its
-#: fill-in grows faster than the unknowns (as N^(4/3) for a 3-D mesh under a nested-dissection
-#: ordering), into gigabytes at a million.
+#: Most displacement unknowns (3 per mesh node, all blocks) of the foam FEM: each block's
+#: factorisation is kept, and its fill-in (about N^(4/3) in 3-D) reaches gigabytes at a million.
 MAX_FEM_UNKNOWNS = 1_000_000
 
 
 def _layer_count(thickness_m: float, top_m: float, growth: float) -> int:
-    """Upper bound on the layers of :func:`~deformap.world._fem.graded_levels` (no loop, so that
-    an absurd request is refused at once): layers ``top·gⁱ`` until they sum to the thickness."""
+    """Upper bound, in closed form, on the layers of :func:`~deformap.world._fem.graded_levels`."""
     top = min(top_m, thickness_m)
     if growth <= 1.0 + 1e-12:
         return math.ceil(thickness_m / top) + 1
@@ -178,21 +157,14 @@ def _layer_count(thickness_m: float, top_m: float, growth: float) -> int:
 
 
 def check_world_budget(config: WorldConfig, scenario: Scenario) -> None:
-    """Refuse, before any work, a world whose foam mesh would be absurdly large.
-
-    Counts the nodes of every block's structured mesh (``element_size_m`` in plane over the
-    block's bounding box, the graded layers of ``top_layer_m`` and ``layer_growth`` through its
-    thickness) and refuses more than :data:`MAX_FEM_UNKNOWNS` unknowns: the FEM's, and under the
-    ``stiffening-foam`` physics the camera's mesh of the same nodes. That physics solves each press
-    on a grid of its own, graded from the tip outward, whose nodes are bounded by
-    :func:`~deformap.world._stiffening.max_grid_nodes` (they grow with the logarithm of the block's
-    size over the tip's radius) and refused over the same limit. :class:`SimulatedWorld` calls it
-    first; a run can call it before it starts anything else.
+    """Refuse, before any work, a world of more than :data:`MAX_FEM_UNKNOWNS` unknowns in its
+    blocks' meshes, or (``stiffening-foam``) in a press grid
+    (:func:`~deformap.world._stiffening.max_grid_nodes`).
 
     Raises
     ------
     SettingError
-        Naming ``element_size_m``, the unknowns asked for and the limit.
+        Naming ``element_size_m`` (or ``tip_radius_m``), the unknowns asked for and the limit.
     """
     if not isinstance(config, WorldConfig):
         raise SettingError("config", f"must be a WorldConfig; got {type(config).__name__}")
@@ -216,5 +188,4 @@ def check_world_budget(config: WorldConfig, scenario: Scenario) -> None:
         raise SettingError(
             "element_size_m",
             f"meshes scenario {scenario.name!r} with about {unknowns:,} FEM unknowns; at most "
-            f"{MAX_FEM_UNKNOWNS:,}: use larger elements or a thicker `top_layer_m`; got {size:g} m",
-        )
+            f"{MAX_FEM_UNKNOWNS:,}: use larger elements or a thicker `top_layer_m`; got {size:g} m")

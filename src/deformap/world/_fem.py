@@ -6,15 +6,13 @@ zero). A column of hexes belongs to the block when its centre lies in the footpr
 trilinear (scikit-fem ``ElementHex1``, 2×2×2 Gauss points) with a per-element Young's modulus.
 
 Every hex of one layer has the same shape, so its stiffness is one 24×24 matrix computed by
-scikit-fem for a unit modulus, scaled per element and scattered with numpy (the same matrix as
-scikit-fem's ``asm``, which a test checks). The stiffness is factorised once (SuperLU). A block of
-one modulus ``E`` solves ``K₁⁻¹ f / E`` on the unit-modulus factorisation, kept (the most recent
-few, by geometry, ``ν`` and symmetry) and shared by every homogeneous block of that mesh.
+scikit-fem for a unit modulus, scaled per element and scattered with numpy. The stiffness is
+factorised once (SuperLU); a block of one modulus ``E`` solves ``K₁⁻¹ f / E`` on a unit-modulus
+factorisation shared by the homogeneous blocks of that mesh.
 
 References
 ----------
-Gustafsson, T., McBain, G. D. (2020). scikit-fem: A Python package for finite element assembly.
-Journal of Open Source Software 5(52), 2369.
+Gustafsson, T., McBain, G. D. (2020). scikit-fem. Journal of Open Source Software 5(52), 2369.
 """
 
 from __future__ import annotations
@@ -35,8 +33,7 @@ __all__ = ["FoamBody", "HexGrid", "graded_levels", "unit_hex_stiffness"]
 
 log = logging.getLogger(__name__)
 
-# Unit-modulus factorisations kept for homogeneous blocks (each holds some tens of MB on the
-# default mesh): a few, the most recently used
+# the most recent unit-modulus factorisations (tens of MB each on the default mesh)
 _UNIT_FACTORS: OrderedDict[bytes, SuperLU] = OrderedDict()
 _UNIT_FACTORS_KEPT = 2
 
@@ -45,10 +42,8 @@ _CORNERS = np.array([[c & 1, (c >> 1) & 1, (c >> 2) & 1] for c in range(8)])
 
 
 def graded_levels(thickness_m: float, top_m: float, growth: float) -> NDArray[np.float64]:
-    """``(nz + 1,)`` z levels from 0 to ``thickness_m``; layers grow by ``growth`` going down.
-
-    The top layer is about ``top_m`` thick; the stack is scaled to end exactly at the thickness.
-    """
+    """``(nz + 1,)`` z levels from 0 to ``thickness_m``, the top layer about ``top_m`` thick and
+    the layers growing by ``growth`` going down."""
     sizes = [top_m]
     while (sum(sizes) < thickness_m * (1 - 1e-9)
            and sum(sizes) + sizes[-1] * growth < thickness_m * 1.2):
@@ -59,10 +54,8 @@ def graded_levels(thickness_m: float, top_m: float, growth: float) -> NDArray[np
 
 @lru_cache(maxsize=256)
 def unit_hex_stiffness(dx: float, dy: float, dz: float, nu: float) -> NDArray[np.float64]:
-    """``(24, 24)`` stiffness of a ``dx × dy × dz`` trilinear hex with E = 1 Pa, by scikit-fem.
-
-    Rows and columns are ordered ``3 c + component`` with corner ``c = ci + 2 cj + 4 ck``.
-    """
+    """``(24, 24)`` stiffness of a ``dx × dy × dz`` trilinear hex with E = 1 Pa, by scikit-fem,
+    ordered ``3 c + component`` with corner ``c = ci + 2 cj + 4 ck``."""
     from skfem import Basis, BilinearForm, ElementHex1, ElementVectorH1, MeshHex, asm
     from skfem.models.elasticity import lame_parameters, linear_elasticity
 
@@ -70,13 +63,10 @@ def unit_hex_stiffness(dx: float, dy: float, dz: float, nu: float) -> NDArray[np
     basis = Basis(mesh, ElementVectorH1(ElementHex1()))
     form: BilinearForm = linear_elasticity(*lame_parameters(1.0, nu))
     k = asm(form, basis).toarray()
-    # map scikit-fem's DOF numbering to ours: find which corner each mesh node is
     corner_of_node = np.rint(mesh.p.T / np.array([dx, dy, dz])).astype(int)
     ours = corner_of_node[:, 0] + 2 * corner_of_node[:, 1] + 4 * corner_of_node[:, 2]
     perm = np.empty(24, dtype=int)
-    for node in range(8):
-        for comp in range(3):
-            perm[3 * ours[node] + comp] = basis.nodal_dofs[comp, node]
+    perm[(3 * ours[:, None] + np.arange(3)).ravel()] = np.asarray(basis.nodal_dofs).T.ravel()
     out = k[np.ix_(perm, perm)]
     out.setflags(write=False)
     return out
@@ -84,21 +74,9 @@ def unit_hex_stiffness(dx: float, dy: float, dz: float, nu: float) -> NDArray[np
 
 @dataclass(frozen=True, kw_only=True)
 class HexGrid:
-    """Geometry of one block's structured mesh.
-
-    Parameters
-    ----------
-    origin : (2,) float, metres
-        ``(x0, y0)`` of the bounding box.
-    dx, dy : float, metres
-        Element sizes in the plane.
-    nx, ny : int
-        Elements along x and y.
-    levels : (nz + 1,) float, metres
-        Node heights, 0 at the table.
-    active : (ny, nx) bool
-        Columns that belong to the block.
-    """
+    """One block's structured mesh: ``nx × ny`` columns of ``dx × dy`` (metres) from ``origin``
+    ``(x0, y0)``, node heights ``levels`` ``(nz + 1,)`` from 0 at the table, and the ``(ny, nx)``
+    ``active`` columns that belong to the block."""
 
     origin: NDArray[np.float64]
     dx: float
@@ -139,31 +117,19 @@ class HexGrid:
             si, sj = ii[open_side], jj[open_side]
             # the two nodes of the column's edge on that side, then extruded over every layer
             if di:
-                a = (si + (di > 0), sj)
-                b = (si + (di > 0), sj + 1)
+                a, b = (si + (di > 0), sj), (si + (di > 0), sj + 1)
             else:
-                a = (si, sj + (dj > 0))
-                b = (si + 1, sj + (dj > 0))
+                a, b = (si, sj + (dj > 0)), (si + 1, sj + (dj > 0))
             for k in range(self.nz):
-                quads.append(np.column_stack([self.node_id(a[0], a[1], k),
-                                              self.node_id(b[0], b[1], k),
-                                              self.node_id(b[0], b[1], k + 1),
-                                              self.node_id(a[0], a[1], k + 1)]))
+                quads.append(np.column_stack([self.node_id(*a, k), self.node_id(*b, k),
+                                              self.node_id(*b, k + 1), self.node_id(*a, k + 1)]))
         return np.concatenate(quads, axis=0)
 
     def locate(self, xy: NDArray[np.float64]
                ) -> tuple[NDArray[np.bool_], NDArray[np.int64], NDArray[np.float64]]:
-        """Top-face bilinear weights of ``(n, 2)`` points.
-
-        Returns
-        -------
-        inside : (n,) bool
-            The point lies on an active column.
-        nodes : (n, 4) int
-            Top node ids (corners 00, 10, 01, 11) of its column (0 where not inside).
-        weights : (n, 4) float
-            Bilinear shape-function values at the point.
-        """
+        """Top-face bilinear interpolation at ``(n, 2)`` points: ``inside`` ``(n,)`` (on an active
+        column), the column's top node ids ``(n, 4)`` (corners 00, 10, 01, 11; 0 where not
+        inside) and the bilinear weights ``(n, 4)``."""
         u = (xy[:, 0] - self.origin[0]) / self.dx
         v = (xy[:, 1] - self.origin[1]) / self.dy
         i = np.clip(np.floor(u).astype(np.int64), 0, self.nx - 1)
@@ -181,15 +147,9 @@ class HexGrid:
 class FoamBody:
     """One elastic block: its mesh, stiffness factorised once, and solves for nodal loads.
 
-    Parameters
-    ----------
-    grid : HexGrid
-    modulus_pa : (nz, ny, nx) float or float
-        Young's modulus per element (only active columns are used).
-    poisson_ratio : float
-    symmetry : tuple of str
-        Planes ``"x_min"``/``"y_min"`` of the box on which the normal displacement is zero, to
-        model a quarter of a symmetric problem (used by the analytic checks).
+    ``modulus_pa`` is Young's modulus, one or ``(nz, ny, nx)`` per element; ``symmetry`` names
+    the planes ``"x_min"``/``"y_min"`` of the box held in their normal direction (a quarter of a
+    symmetric problem).
     """
 
     def __init__(self, grid: HexGrid, modulus_pa: float | NDArray[np.float64], *,
@@ -201,7 +161,6 @@ class FoamBody:
         self.free = self._free_dofs(symmetry)
         used = self.modulus[:, grid.active]
         uniform = used.size > 0 and bool(np.all(used == used.flat[0]))
-        # a homogeneous block solves on the unit-modulus factorisation, scaled (module docstring);
         # K₁ is assembled at E = 1 itself, so a solve does not depend on what was built before
         self._scale = 1.0 / float(used.flat[0]) if uniform else 1.0
         factored = self._assemble(np.ones_like(self.modulus) if uniform else self.modulus)
@@ -214,8 +173,7 @@ class FoamBody:
             return
         k_ff = factored[self.free][:, self.free].tocsc()
         try:
-            self._lu = splu(k_ff, permc_spec="MMD_AT_PLUS_A",
-                            options={"SymmetricMode": True})
+            self._lu = splu(k_ff, permc_spec="MMD_AT_PLUS_A", options={"SymmetricMode": True})
         except RuntimeError as exc:  # singular: a block that is not held by the table
             raise NotPositiveDefiniteError(
                 f"foam stiffness could not be factorised: {exc}") from None
@@ -241,8 +199,7 @@ class FoamBody:
 
     def element_dofs(self, k: int
                      ) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64]]:
-        """The hexes of layer ``k`` (active columns): ``(m, 24)`` DOF ids (``3 node + component``,
-        corners in the order of :func:`unit_hex_stiffness`) and their column indices ``jj, ii``."""
+        """``(m, 24)`` DOF ids of the hexes of layer ``k`` and their columns ``jj, ii``."""
         g = self.grid
         jj, ii = np.nonzero(g.active)
         nodes = np.column_stack([g.node_id(ii + c[0], jj + c[1], np.full_like(ii, k + c[2]))
@@ -280,8 +237,7 @@ class FoamBody:
         return np.flatnonzero(~fixed.ravel())
 
     def solve_free(self, rhs: NDArray[np.float64]) -> NDArray[np.float64]:
-        """``K⁻¹ rhs`` on the free unknowns: ``rhs`` is ``(n_dofs,)`` or ``(n_dofs, k)`` (``k``
-        right-hand sides in one call) in the order of :attr:`free`."""
+        """``K⁻¹ rhs`` on the free unknowns, ``rhs`` ``(n_dofs,)`` or ``(n_dofs, k)``."""
         # SuperLU copies its right-hand sides into Fortran order (a C-order block twice over)
         out = np.asarray(self._lu.solve(np.asfortranarray(rhs, dtype=float)))
         out *= self._scale

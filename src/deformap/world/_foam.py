@@ -1,28 +1,16 @@
 """The foam of a whole scenario: one elastic body per foam block, pressed by the probe.
 
-Each foam block is its own :class:`~deformap.world._fem.FoamBody` (neighbouring blocks are separate
-pieces, not glued), factorised once when the world is built. A press puts the Hertz pressure of the
-commanded force on the top surface under the tip; the part of the patch on rigid ground (a rigid
-board or the bare table) is carried by it and loads no foam.
+Each foam block is its own :class:`~deformap.world._fem.FoamBody` (neighbouring blocks are not
+glued). A press puts the Hertz pressure of the commanded force on the top surface under the tip
+(on rigid ground it loads no foam). Inside the contact the surface follows the sphere, so the
+pressure-weighted mean FEM displacement ``ū_p`` gives the indentation ``δ = ū_p + 0.2 a² / R``;
+after the solve the top nodes inside the contact disc are put on the tip's cap.
 
-Indentation: inside the contact the surface follows the sphere, ``u(r) = δ − r² / (2R)``, so
-weighting by the Hertz pressure gives ``δ = ū_p + 0.2 a² / R``, ``ū_p`` the pressure-weighted mean
-FEM displacement (the load's work-conjugate, which converges at second order under refinement and
-does not depend on where the target falls between nodes). After the solve the top nodes inside the
-contact disc are put on the tip's cap, so the surface the camera sees agrees with the tip.
-
-Patch radius: the foam is a layer bonded to the table, stiffer than Hertz's half-space, so the
-press iterates ``a ← sqrt(a · sqrt(R δ_FEM))`` (a damped fixed point of ``a² = R δ``) from the Hertz
-value until ``a`` changes by less than 2 %, never beyond the tip radius; each solve tells on which
-side of the fixed point ``a`` lies, and a step that would leave that bracket bisects it, so the
-iteration ends within the tolerance even where ``δ(a)`` jumps at a seam between blocks. Since
-``δ(a; F)`` grows with ``F``, a press solved at several loads (the force–travel record) passes the
-radius of the load above as ``max_radius_m``, the upper end of the bracket.
-
-Solves: a press loads only the vertical unknowns of the top nodes under the tip, so its first
-solve computes their unit responses ``K⁻¹ e_z`` in one multi-right-hand-side call, and every patch
-iteration and load level of that press is a sum of them (:data:`MAX_UNIT_COLUMNS`);
-:meth:`FoamModel.forget` drops them at the next press.
+The patch radius iterates ``a ← sqrt(a · sqrt(R δ_FEM))`` (a damped fixed point of ``a² = R δ``)
+from the Hertz value until it changes by less than 2 %, at most the tip radius (or
+``max_radius_m``), bisecting the bracket the solves set where a step would leave it (``δ(a)`` jumps
+at a seam). A press's first solve computes the unit responses ``K⁻¹ e_z`` of the top nodes under
+the tip in one call; its patch iterations and load levels are sums of them.
 """
 
 from __future__ import annotations
@@ -41,30 +29,19 @@ __all__ = ["Dent", "FoamMesh", "FoamModel", "block_grid"]
 
 log = logging.getLogger(__name__)
 
-# A press's unit responses ``K⁻¹ e_z`` are solved in one multi-right-hand-side call (SuperLU passes
-# its factors once for all of them); where more nodes than this lie under the tip, or past
-# MAX_UNIT_BYTES of columns a body (a fine mesh), the columns would cost more than the solves they
-# replace, and each load is solved as it comes.
+# past this many unit responses under the tip, or MAX_UNIT_BYTES of them a body, they would cost
+# more than the solves they replace, and each load is solved as it comes
 MAX_UNIT_COLUMNS = 48
 MAX_UNIT_BYTES = 64 * 2**20
+_MAX_ITERATIONS = 40  # patch iterations a press may take
+_TOLERANCE = 0.02  # relative change of the patch radius that ends them
 
 
 @dataclass(frozen=True, kw_only=True)
 class Dent:
-    """The foam's response to one press.
-
-    Parameters
-    ----------
-    displacement : (n_nodes, 3) float, metres
-        Displacement of every mesh node of the world (all bodies stacked).
-    depth_m : float
-        Indentation of the tip: how far its lowest point sinks below the rest surface (0 on
-        rigid ground); see the module docstring.
-    contact_radius_m : float
-        Radius of the loaded patch after the consistency iteration (0 on rigid ground).
-    iterations : int
-        Solves the press took.
-    """
+    """The foam's response to one press: the ``(n_nodes, 3)`` ``displacement`` (metres) of every
+    mesh node (all bodies stacked), the tip's indentation ``depth_m`` below the rest surface, the
+    loaded patch's ``contact_radius_m`` (both 0 on rigid ground) and the solves it took."""
 
     displacement: NDArray[np.float64]
     depth_m: float
@@ -74,7 +51,7 @@ class Dent:
 
 def block_grid(block: Block, *, element_size_m: float, top_layer_m: float,
                layer_growth: float) -> HexGrid:
-    """The structured mesh of one block (see :mod:`deformap.world._fem`)."""
+    """The structured mesh of one block (:mod:`deformap.world._fem`)."""
     lo, hi = block.polygon.min(axis=0), block.polygon.max(axis=0)
     nx, ny = (max(1, int(np.ceil((hi[d] - lo[d]) / element_size_m - 1e-9))) for d in (0, 1))
     dx, dy = (hi[0] - lo[0]) / nx, (hi[1] - lo[1]) / ny
@@ -85,17 +62,9 @@ def block_grid(block: Block, *, element_size_m: float, top_layer_m: float,
 
 
 class FoamMesh:
-    """The structured hexahedral meshes of a scenario's blocks, stacked: what the camera sees.
-
-    Every contact physics of the world displaces these nodes; the press solve is the physics'
-    own (:class:`FoamModel` here, :class:`~deformap.world._stiffening.StiffeningFoam`).
-
-    Parameters
-    ----------
-    scenario : Scenario
-    element_size_m, top_layer_m, layer_growth : float
-        Mesh: in-plane element size, thickness of the top layer, growth of layers downwards.
-    """
+    """The structured hexahedral meshes of a scenario's blocks, stacked: what the camera sees
+    and every contact physics displaces (in-plane ``element_size_m``, top layer ``top_layer_m``,
+    layers growing by ``layer_growth`` downwards)."""
 
     def __init__(self, scenario: Scenario, *, element_size_m: float, top_layer_m: float,
                  layer_growth: float) -> None:
@@ -111,7 +80,6 @@ class FoamMesh:
             n += grid.n_nodes
         self.n_nodes = n
         self.rest_nodes = np.concatenate([g.node_xyz() for g in self.grids])
-        #: indices of the blocks that deform (not rigid)
         self.foam_blocks = tuple(i for i, b in enumerate(scenario.blocks) if not b.rigid)
 
     def zero_displacement(self) -> NDArray[np.float64]:
@@ -138,15 +106,8 @@ class FoamMesh:
 
 
 class FoamModel(FoamMesh):
-    """All foam bodies of a scenario as linear-elastic FEM, with the press solve.
-
-    Parameters
-    ----------
-    scenario : Scenario
-    element_size_m, top_layer_m, layer_growth : float
-        Mesh: in-plane element size, thickness of the top layer, growth of layers downwards.
-    poisson_ratio : float
-    """
+    """All foam bodies of a scenario as linear-elastic FEM, with the press solve (module
+    docstring); the mesh as in :class:`FoamMesh`."""
 
     def __init__(self, scenario: Scenario, *, element_size_m: float, top_layer_m: float,
                  layer_growth: float, poisson_ratio: float) -> None:
@@ -157,8 +118,6 @@ class FoamModel(FoamMesh):
             index: FoamBody(self.grids[index], scenario.blocks[index].modulus_pa,
                             poisson_ratio=poisson_ratio)
             for index in self.foam_blocks}
-        #: the most unit responses a press solves per body (:data:`MAX_UNIT_COLUMNS`; 0: none,
-        #: every load solved as it comes)
         self.max_unit_columns = MAX_UNIT_COLUMNS
         # the press's unit responses per body: (K⁻¹ columns, column of each free unknown or -1)
         self._columns: dict[int, tuple[NDArray[np.float64], NDArray[np.int64]]] = {}
@@ -170,26 +129,19 @@ class FoamModel(FoamMesh):
         return sum(b.n_dofs for b in self.bodies.values())
 
     def forget(self) -> None:
-        """Drop whatever earlier presses left to warm-start the next (the linear FEM: the unit
-        responses under the last tip; its factorisation is the body's, not a press's)."""
+        """Drop what earlier presses left to warm-start the next (the unit responses)."""
         self._columns.clear()
         self._reach = None
 
     def dent(self, target_xy: NDArray[np.float64], force_n: float, *, tip_radius_m: float,
-             max_iterations: int = 40, tolerance: float = 0.02,
              initial_radius_m: float | None = None, max_radius_m: float | None = None) -> Dent:
-        """Solve the press of ``force_n`` newtons at ``target_xy`` (see the module docstring).
-
-        ``initial_radius_m`` starts the patch iteration there instead of at Hertz's radius (a
-        nearby press's converged patch, scaled): the same fixed point in fewer solves.
-        ``max_radius_m`` bounds the patch (the radius of the same press at a larger force);
-        default the tip's radius.
-        """
+        """Solve the press of ``force_n`` newtons at ``target_xy`` (module docstring), the patch
+        iteration started at ``initial_radius_m`` (default Hertz's) and bounded by
+        ``max_radius_m`` (default the tip's radius)."""
         target = np.asarray(target_xy, dtype=float).reshape(1, 2)
         if self._reach is None or not np.array_equal(self._reach[0], target[0]):
             self._columns.clear()  # another target's unit responses: a press starts afresh
-        labels = self.scenario.labels(target[:, 0], target[:, 1])
-        index = int(labels[0, 0])
+        index = int(self.scenario.labels(target[:, 0], target[:, 1])[0, 0])
         if index not in self.bodies:
             return Dent(displacement=self.zero_displacement(), depth_m=0.0,
                         contact_radius_m=0.0, iterations=0)
@@ -199,11 +151,10 @@ class FoamModel(FoamMesh):
             a = min(float(initial_radius_m), top)
         else:
             modulus = self.scenario.blocks[index].modulus_pa
-            a = min(hertz_contact_radius(force_n, tip_radius_m, modulus, self.poisson_ratio),
-                    top)
+            a = min(hertz_contact_radius(force_n, tip_radius_m, modulus, self.poisson_ratio), top)
         self._reach = (target[0].copy(), float(top))
         low, high = 0.0, top  # the fixed point lies in [low, high]
-        for iteration in range(1, max_iterations + 1):
+        for iteration in range(1, _MAX_ITERATIONS + 1):
             u, points, forces = self._solve_patch(target[0], a, force_n)
             mean_u = -float(forces @ self.top_displacement(points, u)[:, 2]) / force_n
             depth = max(0.0, mean_u + 0.2 * a * a / tip_radius_m)
@@ -215,14 +166,13 @@ class FoamModel(FoamMesh):
             a_new = min(float(np.sqrt(a * consistent)), top)
             if not low < a_new < high:  # would leave the bracket: bisect it
                 a_new = 0.5 * (low + high)
-            converged = abs(a_new - a) <= tolerance * a or high - low <= tolerance * a
+            converged = abs(a_new - a) <= _TOLERANCE * a or high - low <= _TOLERANCE * a
             log.debug("press iteration %d: a=%.4f m, depth=%.4f m", iteration, a, depth)
-            if converged or iteration == max_iterations:
+            if converged or iteration == _MAX_ITERATIONS:
                 break
             a = a_new
         self._conform_to_tip(u, target[0], a, depth, tip_radius_m)
-        return Dent(displacement=u, depth_m=depth, contact_radius_m=float(a),
-                    iterations=iteration)
+        return Dent(displacement=u, depth_m=depth, contact_radius_m=float(a), iterations=iteration)
 
     def _conform_to_tip(self, u: NDArray[np.float64], center: NDArray[np.float64], radius: float,
                         depth: float, tip_radius_m: float) -> None:
@@ -255,9 +205,7 @@ class FoamModel(FoamMesh):
 
     def _respond(self, index: int, load: NDArray[np.float64], center: NDArray[np.float64]
                  ) -> NDArray[np.float64]:
-        """``(n_nodes, 3)`` displacement of block ``index`` under ``(n_nodes, 3)`` nodal forces
-        centred at ``center`` (linear: a sum of the loaded unknowns' unit responses, or one
-        solve; a nonlinear material overrides it)."""
+        """Block ``index``'s displacement under nodal forces ``load`` centred at ``center``."""
         body = self.bodies[index]
         f = load.ravel()[body.free]
         loaded = np.flatnonzero(f)
@@ -273,10 +221,7 @@ class FoamModel(FoamMesh):
 
     def _unit_columns(self, index: int, loaded: NDArray[np.int64]
                       ) -> tuple[NDArray[np.float64], NDArray[np.int64]] | None:
-        """Body ``index``'s unit responses to its free unknowns ``loaded`` (and, at a press's
-        first solve, to the vertical unknowns of every top node of a cell the tip's disc
-        reaches), solved in one call for those not yet solved; None past
-        :attr:`max_unit_columns` or :data:`MAX_UNIT_BYTES`."""
+        """Body ``index``'s unit responses to ``loaded`` (and :meth:`_under_tip`), or None."""
         body = self.bodies[index]
         z, where = self._columns.get(index, (np.zeros((body.n_dofs, 0)),
                                              np.full(body.n_dofs, -1, dtype=np.int64)))
@@ -295,8 +240,7 @@ class FoamModel(FoamMesh):
         return z, where
 
     def _under_tip(self, index: int) -> NDArray[np.int64]:
-        """The free vertical unknowns (positions in the body's ``free``) of the top nodes of
-        block ``index``'s active cells that the tip's disc of the press reaches."""
+        """Positions in ``free`` of the top nodes' vertical unknowns the tip's disc reaches."""
         if self._reach is None:
             return np.zeros(0, dtype=np.int64)
         (cx, cy), radius = self._reach

@@ -2,45 +2,27 @@
 force-controlled contact with it solved by Newton's method (the physics of
 :mod:`deformap.world._stiffening`).
 
-Layer theory (Vlasov & Leontiev 1966; Vallabhan & Das 1988). A block of thickness ``H`` bonded to
-the table deforms as ``u = (0, 0, −w(x, y) φ(z))``, the surface deflection ``w`` (positive down)
-times a mode shape ``φ`` from 0 at the table to 1 at the top. Integrating the strain energy
-through the thickness gives a Pasternak foundation
+Layer (Vlasov & Leontiev 1966; Vallabhan & Das 1988): a block of thickness ``H`` deforms as
+``u = (0, 0, −w(x, y) φ(z))``, ``φ`` from 0 at the table to 1 at the top, which gives the Pasternak
+energy ``Π[w] = ∫ Φ(w) dA + ½ G_p ∫ |∇w|² dA`` with ``Φ'(w) = p(w) = ∫ σ(w φ') φ' dz`` (32-point
+Gauss–Legendre; small-strain spring ``k = M ∫ φ'² dz``, ``M`` the constrained modulus) and
+``G_p = G ∫ φ² dz``. The mode shape is ``φ = sinh(γ z / H) / sinh γ`` with
+``(γ / H)² = (G / M) ∫ |∇w|² dA / ∫ w² dA`` on the solved surface; ``ℓ = sqrt(G_p / k)`` is how far
+a dent spreads. Stiffening (Gibson & Ashby 1997, ch. 5): ``σ(ε) = M ε / (1 − ε / ε_d)^m`` for
+``ε ≥ 0``, linear in extension.
 
-    Π[w] = ∫ Φ(w) dA + ½ G_p ∫ |∇w|² dA,
-
-with compression at the constrained modulus ``M = E (1 − ν) / ((1 + ν)(1 − 2ν))`` and strain
-``ε = w φ'``, so ``Φ'(w) = p(w) = ∫ σ(w φ') φ' dz`` (small-strain spring ``k = M ∫ φ'² dz``,
-Pa/m), and shear ``G_p = G ∫ φ² dz`` (N/m, ``G = E / (2 (1 + ν))``). ``E`` is the block's
-``modulus_pa``. The mode shape is the modified Vlasov model's ``φ = sinh(γ z / H) / sinh γ``, with
-``(γ / H)² = (G / M) ∫ |∇w|² dA / ∫ w² dA`` iterated on the solved surface to 1 %, so that a
-thick layer under a small tip tends to a depth-independent limit as an elastic layer does. The
-influence length ``ℓ = sqrt(G_p / k)`` is how far a dent spreads beyond the tip. A restricted
-displacement field is stiffer than the elastic solid (Ritz): at small strain the tip
-sinks less than in a half-space of the same ``E``.
-
-Stiffening (Gibson & Ashby 1997, ch. 5): ``σ(ε) = M ε / (1 − ε / ε_d)^m`` for ``ε ≥ 0`` (linear in
-extension), ``ε_d`` the world's ``densification_strain`` and ``m`` its ``stiffening_exponent``;
-``p(w)`` is integrated through the thickness by 32-point Gauss–Legendre. The plateau of
-elastomeric foams is left out: this physics lies on the stiff side of linear elasticity.
-
-Contact: the rigid sphere of radius ``R`` sinks ``δ`` below the rest surface and a surface point
-at distance ``r`` may not pass its cap, ``w ≥ δ − (R − sqrt(R² − r²))`` (Signorini). The press
-commands the force ``F``, so ``δ`` is an unknown and ``Π[w] − F δ`` is minimised on a tensor grid
-of bilinear elements (lumped spring, consistent shear) by Newton's method with a primal–dual
-active set (Hintermüller, Ito & Kunisch 2002); steps are shortened so that no strain reaches
-``ε_d``.
+Contact: a surface point at distance ``r`` may not pass the sphere's cap,
+``w ≥ δ − (R − sqrt(R² − r²))``; the press commands ``F``, so ``Π[w] − F δ`` is minimised over
+``w`` and ``δ`` on a tensor grid of bilinear elements (lumped spring, consistent shear) by Newton's
+method with a primal–dual active set (Hintermüller, Ito & Kunisch 2002), steps shortened so that no
+strain reaches ``ε_d``.
 
 References
 ----------
-Vlasov, V. Z., Leontiev, N. N. (1966). Beams, Plates and Shells on Elastic Foundations. Israel
-Program for Scientific Translations (ch. 1: the two-parameter model from the layer's mode shape).
-Kerr, A. D. (1964). Elastic and viscoelastic foundation models. J. Appl. Mech. 31(3), 491–498.
+Vlasov, V. Z., Leontiev, N. N. (1966). Beams, Plates and Shells on Elastic Foundations.
 Gibson, L. J., Ashby, M. F. (1997). Cellular Solids, 2nd ed., Cambridge University Press, ch. 5.
-Vallabhan, C. V. G., Das, Y. C. (1988). Parametric study of beams on elastic foundations. J. Eng.
-Mech. 114(12), 2072–2082 (the modified Vlasov model and its γ).
-Hintermüller, M., Ito, K., Kunisch, K. (2002). The primal-dual active set strategy as a semismooth
-Newton method. SIAM J. Optim. 13(3), 865–888.
+Vallabhan, C. V. G., Das, Y. C. (1988). Beams on elastic foundations. J. Eng. Mech. 114(12).
+Hintermüller, M., Ito, K., Kunisch, K. (2002). Primal-dual active set. SIAM J. Optim. 13(3).
 """
 
 from __future__ import annotations
@@ -65,21 +47,9 @@ MAX_NEWTON_STEPS = 80  # a press that needs more is reported (logged) as not con
 
 @dataclass(frozen=True, kw_only=True)
 class FoundationLayer:
-    """The foundation parameters of one foam block (see the module docstring).
-
-    Parameters
-    ----------
-    modulus_pa, poisson_ratio, thickness_m : float
-        The block's small-strain Young's modulus, Poisson ratio and thickness.
-    densification_strain : float
-        ``ε_d``: the strain at which the stress becomes unbounded.
-    stiffening_exponent : float
-        ``m``; 0 is a linear spring.
-    decay : float
-        ``γ`` of the mode shape ``φ(z) = sinh(γ z / H) / sinh γ`` (0: linear, ``z / H``).
-    shear : bool
-        False drops the shear layer (``G_p = 0``: a Winkler foundation).
-    """
+    """The foundation of one foam block (module docstring): its small-strain modulus, Poisson
+    ratio and thickness, ``ε_d``, ``m`` (0: linear), the mode shape's ``γ`` (``decay``; 0:
+    ``φ = z / H``) and ``shear`` (False: ``G_p = 0``, a Winkler foundation)."""
 
     modulus_pa: float
     poisson_ratio: float
@@ -106,7 +76,7 @@ class FoundationLayer:
         return np.sinh(g * z / h) / np.sinh(g), g / h * np.cosh(g * z / h) / np.sinh(g)
 
     def _moments(self) -> tuple[float, float]:
-        """``∫ φ'² dz`` [1/m] and ``∫ φ² dz`` [m] over the thickness, in closed form."""
+        """``∫ φ'² dz`` [1/m] and ``∫ φ² dz`` [m] over the thickness."""
         h, g = self.thickness_m, self.decay
         if g < 1e-6:
             return 1.0 / h, h / 3.0
@@ -116,13 +86,12 @@ class FoundationLayer:
 
     @property
     def spring_pa_per_m(self) -> float:
-        """Small-strain spring modulus ``k = M ∫ φ'² dz`` [Pa/m] (``M / H`` when linear)."""
+        """Small-strain spring modulus ``k = M ∫ φ'² dz`` [Pa/m]."""
         return self.constrained_modulus_pa * self._moments()[0]
 
     @property
     def shear_n_per_m(self) -> float:
-        """Pasternak shear parameter ``G_p = G ∫ φ² dz`` [N/m] (``G H / 3`` when linear; 0
-        without shear)."""
+        """Pasternak shear parameter ``G_p = G ∫ φ² dz`` [N/m] (0 without shear)."""
         return self.shear_modulus_pa * self._moments()[1] if self.shear else 0.0
 
     @property
@@ -132,41 +101,36 @@ class FoundationLayer:
 
     @property
     def max_deflection_m(self) -> float:
-        """The deflection at which the largest strain (at the top) reaches ``ε_d``, as the
-        quadrature through the thickness sees it (its highest point): where its pressure is
-        unbounded (inf when linear)."""
+        """The deflection at which the quadrature's highest strain reaches ``ε_d`` (inf when
+        linear)."""
         if self.stiffening_exponent == 0.0:
             return math.inf
         slope = self.mode(_through_thickness(self.thickness_m)[0])[1]
         return self.densification_strain / float(np.max(slope))
 
     def decay_for(self, w: NDArray[np.float64], grid: FoundationGrid) -> float:
-        """Vallabhan & Das's ``γ`` for the surface deflection ``w`` on ``grid``:
-        ``(γ / H)² = (G / M) ∫ |∇w|² dA / ∫ w² dA``."""
+        """Vallabhan & Das's ``γ`` for the surface deflection ``w`` on ``grid``."""
         ratio = float(w @ (grid.laplacian @ w)) / float(np.sum(grid.area * w * w))
         return self.thickness_m * math.sqrt(self.shear_modulus_pa
                                             / self.constrained_modulus_pa * ratio)
 
     def pressure(self, w: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """Spring pressure ``p(w) = ∫ σ(w φ') φ' dz`` [Pa] and ``dp/dw`` [Pa/m], elementwise
-        (Gauss–Legendre through the thickness; closed form when linear)."""
+        """Spring pressure ``p(w)`` [Pa] and ``dp/dw`` [Pa/m], elementwise."""
         if self.stiffening_exponent == 0.0:
             return self.spring_pa_per_m * w, np.full_like(w, self.spring_pa_per_m)
         z, weight = _through_thickness(self.thickness_m)
         slope = self.mode(z)[1]  # (q,)
         eps = w[:, None] * slope  # (n, q) strains
-        m, ed, big_m = self.stiffening_exponent, self.densification_strain, \
-            self.constrained_modulus_pa
+        m, ed = self.stiffening_exponent, self.densification_strain
+        big_m = self.constrained_modulus_pa
         squeeze = np.where(eps > 0.0, 1.0 - eps / ed, 1.0)
         sigma = big_m * eps * squeeze**-m
-        dsigma = big_m * (squeeze**-m + np.where(eps > 0.0, eps * m / ed * squeeze**(-m - 1),
-                                                 0.0))
+        dsigma = big_m * (squeeze**-m + np.where(eps > 0.0, eps * m / ed * squeeze**(-m - 1), 0.0))
         return (sigma * slope) @ weight, (dsigma * slope**2) @ weight
 
 
 def _through_thickness(thickness_m: float) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """32 Gauss–Legendre heights and weights over ``[0, H]`` (exact for ``φ'²`` polynomials of
-    degree 63; ``cosh²(γ z / H)`` to machine precision for the decays met here)."""
+    """32 Gauss–Legendre heights and weights over ``[0, H]``."""
     x, wt = np.polynomial.legendre.leggauss(32)
     return 0.5 * thickness_m * (x + 1.0), 0.5 * thickness_m * wt
 
@@ -231,12 +195,9 @@ def solve_press(layer: FoundationLayer, grid: FoundationGrid, center: NDArray[np
     """Force-controlled sphere contact on the foundation by Newton's method with active sets.
 
     Unknowns: the deflections off the contact and the tip's sink ``δ`` (on the contact
-    ``w = δ − c``). Their residual is the gradient of ``Π − F δ``: the nodal forces off the
-    contact and the contact's total force minus ``F``; its Jacobian is the tangent stiffness
-    reduced the same way (symmetric positive definite while ``ε < ε_d``). ``start`` is a first
-    ``(w, active)`` (a coarser grid's solution); default: the nodes under the tip sunk
-    ``depth_guess_m`` in contact. ``max_steps`` caps the Newton steps (an inexact solve, for
-    a press still settling its grid and mode shape).
+    ``w = δ − c``); the residual is the gradient of ``Π − F δ``, the Jacobian the reduced tangent
+    stiffness (symmetric positive definite while ``ε < ε_d``). ``start`` is a first
+    ``(w, active)``; default: the nodes under the tip sunk ``depth_guess_m`` in contact.
     """
     r2 = np.sum((grid.xy - center) ** 2, axis=1)
     cap = np.full(r2.size, np.inf)
@@ -273,8 +234,7 @@ def solve_press(layer: FoundationLayer, grid: FoundationGrid, center: NDArray[np
         grad = t.T @ f - np.r_[np.zeros(free.size), force_n]
         jac = (t.T @ (sp.diags(spring) + gp * grid.laplacian) @ t).tocsc()
         # symmetric positive definite: a symmetric fill-reducing ordering, diagonal pivots
-        step = -splu(jac, permc_spec="MMD_AT_PLUS_A",
-                     options={"SymmetricMode": True}).solve(grad)
+        step = -splu(jac, permc_spec="MMD_AT_PLUS_A", options={"SymmetricMode": True}).solve(grad)
         dw = t @ step
         rising = dw > 0  # shorten the step so that no column reaches densification
         alpha = 1.0

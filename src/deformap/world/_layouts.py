@@ -1,8 +1,7 @@
 """Seeded layout families: how a rectangular workspace is cut into the footprints of pieces.
 
-Each family draws from the generator it is given and returns :class:`Piece` footprints (``(k, 2)``
-vertices in metres) that tile the workspace, each with the index of its material (pieces of one
-material are separate blocks side by side):
+Each family draws from the generator it is given :class:`Piece` footprints that tile the
+workspace, each with the index of its material:
 
 * ``cuts``: 2–4 convex pieces by straight cuts at random angles through the largest remaining
   piece, each keeping at least ``min_area_fraction`` of the area.
@@ -31,15 +30,14 @@ __all__ = ["LAYOUT_FAMILIES", "LayoutFamily", "Piece", "layout_pieces"]
 LayoutFamily = Literal["cuts", "insert", "l-shape", "checker", "stripes", "non-convex"]
 LAYOUT_FAMILIES: tuple[str, ...] = get_args(LayoutFamily)
 
-#: Vertices of an ellipse's or a blob's outline: its polygon's area is within 0.7 % of the
-#: curve's (1 − sin(2π/n)/(2π/n) at n = 48), far below a 2 cm mesh's own rounding of the outline.
+#: Vertices of an ellipse's or a blob's outline: its area is within 0.7 % of the curve's.
 _OUTLINE_VERTICES = 48
 
 
 @dataclass(frozen=True)
 class Piece:
-    """One footprint of a layout: ``polygon`` less its ``holes``, made of material ``material``
-    (0, 1, …; pieces sharing an index are of one material)."""
+    """One footprint of a layout: ``polygon`` less its ``holes`` (``(k, 2)``, metres), made of
+    material ``material`` (0, 1, …)."""
 
     polygon: NDArray[np.float64]
     material: int
@@ -73,8 +71,7 @@ def cut_pieces(ws: Workspace, rng: np.random.Generator, n: int, min_area_fractio
         else:
             raise InvalidArgumentError(
                 f"could not cut {n} regions of at least {min_area_fraction:.0%} of the area; "
-                "lower `min_area_fraction`"
-            )
+                "lower `min_area_fraction`")
     pieces.sort(key=lambda p: tuple(p.mean(axis=0)))
     return pieces
 
@@ -90,7 +87,7 @@ def _flip(u: NDArray[np.float64], flips: NDArray[np.bool_]) -> NDArray[np.float6
     return np.where(flips, 1.0 - u, u)
 
 
-def _insert(ws: Workspace, rng: np.random.Generator, *, min_area_fraction: float) -> list[Piece]:
+def _insert(ws: Workspace, rng: np.random.Generator) -> list[Piece]:
     size = np.asarray(ws.size, float)
     short = float(size.min())
     a, b = rng.uniform(0.18, 0.34) * short, rng.uniform(0.18, 0.34) * short
@@ -106,7 +103,7 @@ def _insert(ws: Workspace, rng: np.random.Generator, *, min_area_fraction: float
     return [Piece(rectangle(*ws.lower, *ws.upper), 0, holes=(ellipse,)), Piece(ellipse, 1)]
 
 
-def _l_shape(ws: Workspace, rng: np.random.Generator, *, min_area_fraction: float) -> list[Piece]:
+def _l_shape(ws: Workspace, rng: np.random.Generator) -> list[Piece]:
     wx, wy = rng.uniform(0.25, 0.45, size=2)  # the L's arms' widths, share of each side
     flips = rng.uniform(size=2) < 0.5
     ell = np.array([[0, 0], [1, 0], [1, wy], [wx, wy], [wx, 1], [0, 1]], float)
@@ -114,7 +111,7 @@ def _l_shape(ws: Workspace, rng: np.random.Generator, *, min_area_fraction: floa
     return [Piece(_unit(ws, _flip(ell, flips)), 0), Piece(_unit(ws, _flip(rest, flips)), 1)]
 
 
-def _checker(ws: Workspace, rng: np.random.Generator, *, min_area_fraction: float) -> list[Piece]:
+def _checker(ws: Workspace, rng: np.random.Generator) -> list[Piece]:
     cx, cy = rng.uniform(0.35, 0.65, size=2)
     out = []
     for i, (x0, x1) in enumerate(((0.0, cx), (cx, 1.0))):
@@ -123,7 +120,7 @@ def _checker(ws: Workspace, rng: np.random.Generator, *, min_area_fraction: floa
     return out
 
 
-def _stripes(ws: Workspace, rng: np.random.Generator, *, min_area_fraction: float) -> list[Piece]:
+def _stripes(ws: Workspace, rng: np.random.Generator) -> list[Piece]:
     n, n_materials = int(rng.integers(3, 6)), int(rng.integers(2, 4))
     angle = rng.uniform(0.0, np.pi)
     normal = np.array([np.cos(angle), np.sin(angle)])
@@ -166,20 +163,13 @@ def _blob(ws: Workspace, rng: np.random.Generator) -> list[Piece]:
     return [Piece(rectangle(*ws.lower, *ws.upper), 0, holes=(star,)), Piece(star, 1)]
 
 
-def _non_convex(ws: Workspace, rng: np.random.Generator, *, min_area_fraction: float
-                ) -> list[Piece]:
+def _non_convex(ws: Workspace, rng: np.random.Generator) -> list[Piece]:
     return _u_shape(ws, rng) if rng.uniform() < 0.5 else _blob(ws, rng)
 
 
-def _cuts(ws: Workspace, rng: np.random.Generator, *, min_area_fraction: float,
-          n_regions: int | None = None) -> list[Piece]:
-    n = int(rng.integers(2, 5)) if n_regions is None else n_regions
-    return [Piece(p, k) for k, p in enumerate(cut_pieces(ws, rng, n, min_area_fraction))]
-
-
-_FAMILIES: dict[str, Callable[..., list[Piece]]] = {
-    "cuts": _cuts, "insert": _insert, "l-shape": _l_shape, "checker": _checker,
-    "stripes": _stripes, "non-convex": _non_convex,
+_FAMILIES: dict[str, Callable[[Workspace, np.random.Generator], list[Piece]]] = {
+    "insert": _insert, "l-shape": _l_shape, "checker": _checker, "stripes": _stripes,
+    "non-convex": _non_convex,
 }
 
 
@@ -189,12 +179,10 @@ def _clean(poly: NDArray[np.float64]) -> NDArray[np.float64]:
     return poly[step > 1e-9]
 
 
-def layout_pieces(family: str, ws: Workspace, rng: np.random.Generator, *,
-                  min_area_fraction: float = 0.15) -> list[Piece]:
-    """The pieces of one layout of ``family`` (one of :data:`LAYOUT_FAMILIES`) over ``ws``."""
+def layout_pieces(family: str, ws: Workspace, rng: np.random.Generator) -> list[Piece]:
+    """The pieces of one layout of ``family`` over ``ws``: any of :data:`LAYOUT_FAMILIES` but
+    ``cuts`` (:func:`cut_pieces`)."""
     if family not in _FAMILIES:
-        raise InvalidArgumentError(
-            f"`family` must be one of {list(LAYOUT_FAMILIES)}; got {family!r}")
-    pieces = _FAMILIES[family](ws, rng, min_area_fraction=min_area_fraction)
-    return [Piece(_clean(p.polygon), p.material, tuple(_clean(h) for h in p.holes))
-            for p in pieces]
+        raise InvalidArgumentError(f"`family` must be one of {list(_FAMILIES)}; got {family!r}")
+    pieces = _FAMILIES[family](ws, rng)
+    return [Piece(_clean(p.polygon), p.material, tuple(_clean(h) for h in p.holes)) for p in pieces]

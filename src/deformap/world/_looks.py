@@ -1,11 +1,10 @@
 """The light that reaches the colour sensor from each surface the camera's rays hit.
 
-Every triangle of the scene has an owner: a block (its index), the table, or a part of the probe
-(tip, stick, hand). The albedo at a hit is the owner's: a block's or the table's
-:class:`~deformap.world._appearance.Appearance` at the hit's surface coordinates (``(x, y)`` on a
-face that looks up, ``(s, z)`` on a side face, ``s`` the horizontal position along the face), or the
-probe part's plain colour. It is shaded by :func:`~deformap.world._appearance.lambert` with the
-face's normal turned toward the camera; there are no shadows and no inter-reflections.
+Every triangle of the scene has an owner: a block (its index), the table, or a part of the probe.
+The albedo at a hit is the owner's :class:`~deformap.world._appearance.Appearance` at the hit's
+surface coordinates, or the probe part's plain colour, shaded by
+:func:`~deformap.world._appearance.lambert` with the face's normal turned toward the camera (no
+shadows, no inter-reflections).
 """
 
 from __future__ import annotations
@@ -55,8 +54,8 @@ class SceneLooks:
 
     def radiance(self, owner: NDArray[np.int64], hit: NDArray[np.float64],
                  normal: NDArray[np.float64], eye: NDArray[np.float64]) -> NDArray[np.float64]:
-        """``(n, 3)`` linear light from hits ``(n, 3)`` of owners ``(n,)`` on faces of unit
-        ``normal`` ``(n, 3)`` (either orientation), seen from ``eye`` ``(3,)``."""
+        """``(n, 3)`` linear light from hits ``(n, 3)`` of ``owner`` on faces of unit ``normal``
+        (either orientation), seen from ``eye``."""
         toward = np.where((np.einsum("ij,ij->i", normal, hit - eye) > 0)[:, None], -normal, normal)
         uv = surface_uv(hit, toward)
         albedo = np.zeros((len(owner), 3))

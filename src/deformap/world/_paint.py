@@ -1,8 +1,7 @@
 """Seeded appearance families: how the pieces of a random layout are painted.
 
 Each family gives every piece of a layout (:class:`~deformap.world._layouts.Piece`) an
-:class:`~deformap.world._appearance.Appearance`, from the material indices alone or, for ``split``
-and ``misleading``, with lines that have nothing to do with the materials' boundaries:
+:class:`~deformap.world._appearance.Appearance`:
 
 * ``plain``: one look everywhere (the default grey; nothing drawn).
 * ``informative``: each material its own look (its own colour, a texture drawn for it).
@@ -11,9 +10,6 @@ and ``misleading``, with lines that have nothing to do with the materials' bound
 * ``split``: as ``informative``, but the largest piece is painted in two looks, split by a line
   through it: a look boundary that is no material boundary.
 * ``misleading``: two looks split by one line across the workspace, whatever the materials.
-
-The appearance of a layout is drawn from a generator of its own (spawned from the layout's), so a
-family changes no draw of the layout or its materials.
 """
 
 from __future__ import annotations
@@ -24,7 +20,7 @@ from typing import Literal, get_args
 import numpy as np
 
 from deformap.environment import Workspace
-from deformap.world._appearance import Appearance, Split
+from deformap.world._appearance import Appearance, Split, parse_color
 from deformap.world._layouts import Piece
 from deformap.world._polygon import points_in_polygon, polygon_area
 
@@ -34,8 +30,7 @@ AppearanceFamily = Literal["plain", "informative", "textured", "shared", "split"
 APPEARANCE_FAMILIES: tuple[str, ...] = get_args(AppearanceFamily)
 
 # eight colours far apart in hue and lightness, so that no two looks of a world are mistaken
-_COLOURS = ("#e6c229", "#d1495b", "#2e86ab", "#66a182", "#8d6a9f", "#f18f01", "#3b3b58",
-            "#c5d86d")
+_COLOURS = ("#e6c229", "#d1495b", "#2e86ab", "#66a182", "#8d6a9f", "#f18f01", "#3b3b58", "#c5d86d")
 # six textures that tell apart at a camera's millimetre pixels
 _TEXTURES = (
     Appearance(texture="plain"),
@@ -47,22 +42,17 @@ _TEXTURES = (
 )
 
 
-def _hex(colour: str) -> tuple[float, float, float]:
-    r, g, b = (int(colour[i:i + 2], 16) / 255.0 for i in (1, 3, 5))
-    return r, g, b
-
-
 def _looks(rng: np.random.Generator, n: int) -> list[Appearance]:
     """``n`` looks with distinct colours, each with a texture drawn for it."""
     colours = rng.permutation(len(_COLOURS))[:n]
     textures = rng.integers(len(_TEXTURES), size=n)
-    return [replace(_TEXTURES[t], color=_hex(_COLOURS[c]), seed=int(rng.integers(2**31)),
+    return [replace(_TEXTURES[t], color=parse_color(_COLOURS[c]), seed=int(rng.integers(2**31)),
                     angle_deg=float(rng.uniform(0.0, 180.0)))
             for c, t in zip(colours, textures, strict=True)]
 
 
 def _textured(rng: np.random.Generator, n: int) -> list[Appearance]:
-    base = np.array(_hex(_COLOURS[int(rng.integers(len(_COLOURS)))]))
+    base = np.array(parse_color(_COLOURS[int(rng.integers(len(_COLOURS)))]))
     textures = rng.permutation(len(_TEXTURES))[:n]
     out = []
     for t in textures:
@@ -73,8 +63,7 @@ def _textured(rng: np.random.Generator, n: int) -> list[Appearance]:
 
 
 def _inside_point(piece: Piece, rng: np.random.Generator) -> tuple[float, float]:
-    """A point of ``piece``, near the middle of its bounding box where it can (the first of
-    64 draws there, then of 256 over the box but its edges); its vertices' mean if none falls in."""
+    """A point of ``piece``, drawn near the middle of its bounding box where it can."""
     lo, hi = piece.polygon.min(axis=0), piece.polygon.max(axis=0)
     share = np.concatenate([rng.uniform(0.3, 0.7, size=(64, 2)),
                             rng.uniform(0.05, 0.95, size=(256, 2))])

@@ -1,10 +1,5 @@
-"""Small exact helpers for polygons in the table plane (no shapely needed).
-
-Polygons are ``(k, 2)`` float arrays of vertices in metres, counter-clockwise, without repeating the
-first vertex at the end. Most helpers take convex polygons; a footprint may be any *simple* polygon
-(no two edges cross, :func:`is_simple`), with holes: :func:`triangulate` cuts a simple polygon into
-triangles (ear clipping), and :func:`overlap_area` measures the shared area of two footprints
-exactly from the pairwise overlaps of their triangles.
+"""Small exact helpers for polygons in the table plane: ``(k, 2)`` float arrays of vertices in
+metres, counter-clockwise, the first vertex not repeated at the end.
 """
 
 from __future__ import annotations
@@ -14,17 +9,8 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = [
-    "clip_halfplane",
-    "convex_overlap_area",
-    "is_convex",
-    "is_simple",
-    "overlap_area",
-    "points_in_polygon",
-    "polygon_area",
-    "rectangle",
-    "triangulate",
-]
+__all__ = ["clip_halfplane", "convex_overlap_area", "is_simple", "overlap_area",
+           "points_in_polygon", "polygon_area", "rectangle", "triangulate"]
 
 _EPS = 1e-12
 
@@ -40,19 +26,9 @@ def polygon_area(poly: NDArray[np.float64]) -> float:
     return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y))
 
 
-def is_convex(poly: NDArray[np.float64]) -> bool:
-    """True when the counter-clockwise polygon turns left (or goes straight) at every vertex."""
-    e = np.roll(poly, -1, axis=0) - poly
-    cross = e[:, 0] * np.roll(e[:, 1], -1) - e[:, 1] * np.roll(e[:, 0], -1)
-    return bool(np.all(cross >= -_EPS))
-
-
 def points_in_polygon(points: NDArray[np.float64], poly: NDArray[np.float64]) -> NDArray[np.bool_]:
-    """Mask of ``(n, 2)`` points inside the polygon (even-odd rule; works for non-convex ones).
-
-    A point on an edge may fall either way; callers that need a unique owner (ground-truth labels)
-    take the first block that claims a point.
-    """
+    """Mask of ``(n, 2)`` points inside the polygon (even-odd rule); a point on an edge may fall
+    either way."""
     px, py = points[:, 0][:, None], points[:, 1][:, None]
     x0, y0 = poly[:, 0][None, :], poly[:, 1][None, :]
     x1, y1 = np.roll(poly[:, 0], -1)[None, :], np.roll(poly[:, 1], -1)[None, :]
@@ -63,13 +39,10 @@ def points_in_polygon(points: NDArray[np.float64], poly: NDArray[np.float64]) ->
     return np.asarray(np.count_nonzero(crossings, axis=1) % 2 == 1)
 
 
-def clip_halfplane(
-    poly: NDArray[np.float64], point: NDArray[np.float64], normal: NDArray[np.float64]
-) -> NDArray[np.float64]:
-    """Part of a convex polygon where ``(p - point) · normal <= 0`` (Sutherland–Hodgman step).
-
-    Returns a ``(k, 2)`` array, possibly with ``k < 3`` when nothing of area is left.
-    """
+def clip_halfplane(poly: NDArray[np.float64], point: NDArray[np.float64],
+                   normal: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``(k, 2)`` part of a convex polygon where ``(p - point) · normal <= 0`` (Sutherland–Hodgman
+    step); ``k < 3`` when nothing of area is left."""
     d = (poly - point) @ normal
     out: list[NDArray[np.float64]] = []
     n = len(poly)
@@ -103,12 +76,8 @@ def _cross(o: NDArray[np.float64], a: NDArray[np.float64], b: NDArray[np.float64
 
 
 def is_simple(poly: NDArray[np.float64]) -> bool:
-    """True when no two edges of the polygon meet except neighbours at their shared vertex.
-
-    Every pair of non-adjacent edges is tested for a crossing or a touch (orientation signs, with
-    collinear overlaps counted as touching): O(k²), fine for footprints of up to a few hundred
-    vertices.
-    """
+    """True when no two edges of the polygon meet except neighbours at their shared vertex
+    (every pair of non-adjacent edges tested by orientation signs, collinear overlaps touching)."""
     k = len(poly)
     if k < 3:
         return False
@@ -133,11 +102,8 @@ def is_simple(poly: NDArray[np.float64]) -> bool:
 
 
 def triangulate(poly: NDArray[np.float64]) -> NDArray[np.float64]:
-    """``(k - 2, 3, 2)`` counter-clockwise triangles that tile a simple counter-clockwise polygon.
-
-    Ear clipping (Meisters 1975: every simple polygon of more than three vertices has an ear, a
-    convex vertex whose triangle holds no other vertex), O(k³) at worst, fine for footprints.
-    """
+    """``(k - 2, 3, 2)`` counter-clockwise triangles that tile a simple counter-clockwise polygon,
+    by ear clipping (Meisters 1975)."""
     idx = list(range(len(poly)))
     out: list[NDArray[np.float64]] = []
     while len(idx) > 3:
@@ -174,13 +140,9 @@ def _triangles_overlap(ta: NDArray[np.float64], tb: NDArray[np.float64]) -> floa
 def overlap_area(a: NDArray[np.float64], b: NDArray[np.float64],
                  holes_a: Sequence[NDArray[np.float64]] = (),
                  holes_b: Sequence[NDArray[np.float64]] = ()) -> float:
-    """Area shared by two footprints, each a simple counter-clockwise polygon less its holes, m².
-
-    The holes of a footprint lie inside it and apart, so by inclusion–exclusion
-    ``|A ∩ B| = |A₀ ∩ B₀| − Σ|hᵢ ∩ B₀| − Σ|A₀ ∩ gⱼ| + ΣΣ|hᵢ ∩ gⱼ|`` with ``A₀``, ``B₀`` the outer
-    polygons and ``hᵢ``, ``gⱼ`` the holes; each term sums the overlaps of the triangles of the two
-    polygons (:func:`triangulate`), which tile them.
-    """
+    """Area shared by two footprints, each a simple counter-clockwise polygon less its holes, m²:
+    ``|A₀ ∩ B₀| − Σ|hᵢ ∩ B₀| − Σ|A₀ ∩ gⱼ| + ΣΣ|hᵢ ∩ gⱼ|`` over the outer polygons and their holes
+    (inside them and apart), each term from the overlaps of their triangles."""
     tri = [triangulate(p) for p in (a, *holes_a)], [triangulate(p) for p in (b, *holes_b)]
     total = 0.0
     for i, ta in enumerate(tri[0]):

@@ -1,9 +1,5 @@
-"""The probe: a spherical tip (Optoforce-like) on a 10 cm stick held by a box-shaped hand.
-
-The probe approaches along the surface normal ``n`` at the target; at the commanded force the tip's
-centre is ``R`` above the dented surface along ``n``, the stick runs from the tip centre along ``n``
-and the hand is a box on top of the stick.
-"""
+"""The probe: a spherical tip (Optoforce-like) on a stick along the press normal, held by a
+box-shaped hand on top of it."""
 
 from __future__ import annotations
 
@@ -12,6 +8,8 @@ from dataclasses import dataclass
 import numpy as np
 import trimesh
 from numpy.typing import NDArray
+
+from deformap.world._raycast import frame_along
 
 __all__ = ["ProbeGeometry"]
 
@@ -24,14 +22,6 @@ class ProbeGeometry:
     stick_length_m: float = 0.10
     stick_radius_m: float = 0.006
     hand_size_m: tuple[float, float, float] = (0.08, 0.06, 0.10)
-
-    def _frame(self, normal: NDArray[np.float64]) -> NDArray[np.float64]:
-        """Rotation whose z axis is ``normal``."""
-        z = normal / np.linalg.norm(normal)
-        helper = np.array([1.0, 0.0, 0.0]) if abs(z[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
-        x = np.cross(helper, z)
-        x /= np.linalg.norm(x)
-        return np.column_stack([x, np.cross(z, x), z])
 
     def _parts(self) -> list[trimesh.Trimesh]:
         """Tip, stick and hand in the probe's frame (tip centre at the origin, stick along z)."""
@@ -50,22 +40,17 @@ class ProbeGeometry:
 
     def mesh(self, tip_center: NDArray[np.float64], normal: NDArray[np.float64]) -> trimesh.Trimesh:
         """Triangle mesh of tip, stick and hand (for the camera)."""
-        rot = self._frame(normal)
         pose = np.eye(4)
-        pose[:3, :3] = rot
+        pose[:3, :3], pose[:3, 3] = frame_along(normal).T, tip_center
         parts: trimesh.Trimesh = trimesh.util.concatenate(self._parts())  # type: ignore[assignment]
-        pose[:3, 3] = tip_center
         parts.apply_transform(pose)
         return parts
 
     def robot_points(self, tip_center: NDArray[np.float64], normal: NDArray[np.float64]
                      ) -> NDArray[np.float64]:
-        """``(m, 3)`` points whose convex hull covers the tip's upper half, the stick and the hand.
-
-        The tip's lower half is in the dent, so it is left out: a hull around it would swallow the
-        dented surface the estimator needs.
-        """
-        rot = self._frame(normal)
+        """``(m, 3)`` points whose convex hull covers the tip's upper half (the lower is in the
+        dent), the stick and the hand."""
+        rot = frame_along(normal).T
         r = self.tip_radius_m
         az = np.linspace(0.0, 2 * np.pi, 16, endpoint=False)
         circles = [np.column_stack([rad * np.cos(az), rad * np.sin(az), np.full_like(az, z)])

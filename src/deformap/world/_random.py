@@ -33,42 +33,17 @@ def _hardnesses(rng: np.random.Generator, n: int, low: float, high: float, gap: 
     return hardness
 
 
-def random_scenario(
-    rng: np.random.Generator,
-    *,
-    family: str = "cuts",
-    n_regions: int | None = None,
-    hardness_range_n: tuple[float, float] = (60.0, 150.0),
-    p_rigid: float = 0.25,
-    thickness_m: float = 0.05,
-    workspace: Workspace | None = None,
-    min_area_fraction: float = 0.15,
-    min_hardness_gap_n: float = 20.0,
-    appearance: str = "plain",
-) -> Scenario:
-    """A random heterogeneous scenario.
+def random_scenario(rng: np.random.Generator, *, family: str = "cuts", n_regions: int | None = None,
+                    hardness_range_n: tuple[float, float] = (60.0, 150.0), p_rigid: float = 0.25,
+                    thickness_m: float = 0.05, workspace: Workspace | None = None,
+                    min_area_fraction: float = 0.15, min_hardness_gap_n: float = 20.0,
+                    appearance: str = "plain") -> Scenario:
+    """A random heterogeneous scenario (module docstring), the same for the same ``rng`` state.
 
-    Parameters
-    ----------
-    rng : numpy.random.Generator
-        The only source of randomness: the same seed gives the same scenario.
-    family : str
-        One of :data:`deformap.world.LAYOUT_FAMILIES` (module docstring).
-    n_regions : int, optional
-        ``cuts`` only: 2–4 pieces; drawn uniformly when not given.
-    hardness_range_n : (2,) float, newtons
-        Range of foam hardness.
-    p_rigid : float
-        Probability that one of the materials is a rigid board.
-    thickness_m : float
-        Every block's thickness.
-    min_area_fraction : float
-        ``cuts`` only: the smallest piece's share of the area.
-    min_hardness_gap_n : float
-        Least difference of two materials' hardness.
-    appearance : str
-        One of :data:`deformap.world.APPEARANCE_FAMILIES` (:mod:`deformap.world._paint`); the
-        default, ``plain``, paints every block the default grey and draws nothing.
+    ``family`` is one of :data:`deformap.world.LAYOUT_FAMILIES`; ``n_regions`` (2–4, drawn when
+    not given) and ``min_area_fraction`` (the smallest piece's share of the area) are for
+    ``cuts`` only. ``appearance`` is one of :data:`deformap.world.APPEARANCE_FAMILIES`; the
+    default, ``plain``, draws nothing.
     """
     if not isinstance(rng, np.random.Generator):
         raise InvalidArgumentError(f"`rng` must be a numpy.random.Generator; got {type(rng)}")
@@ -81,8 +56,7 @@ def random_scenario(
     h_lo, h_hi = (float(v) for v in hardness_range_n)
     if not 0 < h_lo < h_hi:
         raise InvalidArgumentError(
-            f"`hardness_range_n` must be (low, high) with 0 < low < high; got {hardness_range_n}"
-        )
+            f"`hardness_range_n` must be (low, high) with 0 < low < high; got {hardness_range_n}")
     check_in_range("p_rigid", p_rigid, 0.0, 1.0, closed_high=True)
     if appearance not in APPEARANCE_FAMILIES:
         raise InvalidArgumentError(
@@ -94,7 +68,7 @@ def random_scenario(
             raise InvalidArgumentError(f"`n_regions` must be 2, 3 or 4; got {n}")
         pieces = [Piece(p, k) for k, p in enumerate(cut_pieces(ws, rng, n, min_area_fraction))]
     else:
-        pieces = layout_pieces(family, ws, rng, min_area_fraction=min_area_fraction)
+        pieces = layout_pieces(family, ws, rng)
     n_materials = 1 + max(p.material for p in pieces)
     if n_materials > 1 and (h_hi - h_lo) < min_hardness_gap_n * (n_materials - 1):
         raise InvalidArgumentError(

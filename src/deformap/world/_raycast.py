@@ -1,14 +1,10 @@
-"""Ray casting: Embree through trimesh when ``embreex`` is installed, else a pure-numpy caster.
-
-The numpy caster serves rays that share one origin (a pinhole camera): it projects every triangle
-onto the plane ``z = 1`` of a frame looking along the rays' mean direction, bins the rays on a
-uniform grid of that plane, pairs each triangle with the rays of the cells its projected box
-covers, and runs the Möller–Trumbore test on those pairs only.
+"""Ray casting: Embree through trimesh when ``embreex`` is installed, else a pure-numpy caster for
+rays of one origin, which bins the rays on a grid of the image plane, pairs each projected
+triangle with the rays of the cells its box covers, and runs the Möller–Trumbore test on them.
 
 References
 ----------
-Möller, T., Trumbore, B. (1997). Fast, minimum storage ray-triangle intersection. Journal of
-Graphics Tools 2(1), 21–28.
+Möller, T., Trumbore, B. (1997). Fast, minimum storage ray-triangle intersection. JGT 2(1).
 """
 
 from __future__ import annotations
@@ -17,27 +13,16 @@ import numpy as np
 import trimesh
 from numpy.typing import NDArray
 
-__all__ = ["cast_rays"]
+__all__ = ["cast_rays", "frame_along"]
 
 Hits = tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.float64]]
 
 
 def cast_rays(mesh: trimesh.Trimesh, origins: NDArray[np.float64], directions: NDArray[np.float64],
               *, use_embree: bool = True) -> Hits:
-    """First hits of rays on a mesh: ``(ray index, triangle index, (k, 3) location)``.
-
-    Parameters
-    ----------
-    mesh : trimesh.Trimesh
-    origins, directions : (n, 3) float
-        Ray origins (metres) and unit directions. The numpy fallback needs one shared origin.
-    use_embree : bool
-        Use Embree when it is installed (the numpy caster otherwise, same hits up to round-off).
-
-    Returns
-    -------
-    ray : (k,) int, sorted; triangle : (k,) int; location : (k, 3) float
-    """
+    """First hits of ``(n, 3)`` rays (origins in metres, unit directions; one shared origin
+    without Embree) on a mesh: ray index ``(k,)`` sorted, triangle index ``(k,)``, location
+    ``(k, 3)``."""
     if use_embree:
         try:
             from trimesh.ray.ray_pyembree import RayMeshIntersector
@@ -53,18 +38,18 @@ def cast_rays(mesh: trimesh.Trimesh, origins: NDArray[np.float64], directions: N
     return _pinhole_hits(np.asarray(mesh.triangles), origins[0], directions)
 
 
-def _frame(directions: NDArray[np.float64]) -> NDArray[np.float64]:
-    axis = directions.mean(axis=0)
-    axis /= np.linalg.norm(axis)
-    helper = np.array([1.0, 0.0, 0.0]) if abs(axis[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
-    e1 = np.cross(helper, axis)
-    e1 /= np.linalg.norm(e1)
-    return np.stack([e1, np.cross(axis, e1), axis])
+def frame_along(axis: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``(3, 3)`` rows of a right-handed orthonormal frame whose third axis is along ``axis``."""
+    z = axis / np.linalg.norm(axis)
+    helper = np.array([1.0, 0.0, 0.0]) if abs(z[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+    x = np.cross(helper, z)
+    x /= np.linalg.norm(x)
+    return np.stack([x, np.cross(z, x), z])
 
 
 def _pinhole_hits(triangles: NDArray[np.float64], origin: NDArray[np.float64],
                   directions: NDArray[np.float64]) -> Hits:
-    basis = _frame(directions)
+    basis = frame_along(directions.mean(axis=0))
     d = directions @ basis.T
     uv = d[:, :2] / d[:, 2:3]
     lo, hi = uv.min(axis=0), uv.max(axis=0)

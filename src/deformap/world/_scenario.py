@@ -1,27 +1,15 @@
 """Scenarios: which foam blocks lie where on the table.
 
 A scenario is a list of blocks on the rigid table. Each block is a simple polygon in the table plane
-(a rectangle is the common case; non-convex footprints, an L or a U, are one piece, and a block may
-have holes, where another block is inserted), extruded to its own thickness, made of foam of a
-given hardness (or Young's modulus) or ``rigid`` (a wooden board that does not deform). What no
-block covers is the bare table at ``z = 0``, also rigid. Blocks never overlap; they may touch.
-Neighbouring blocks are separate pieces laid side by side, as in the paper's experiments: each is
-bonded to the table at its bottom but not glued to its neighbours.
+(convex or not, with holes where another block is inserted), extruded to its own thickness, made of
+foam of a given hardness (or Young's modulus) or ``rigid`` (a board). What no block covers is the
+bare table at ``z = 0``. Blocks may touch but never overlap; each is bonded to the table, not glued
+to its neighbours, as in the paper's experiments.
 
-Built-in layouts (paper's Table I; its figure of the layouts is lost, so these are our choice), all
-over the 60 × 40 cm workspace with 5 cm thick blocks:
-
-* ``homogeneous-60``, ``homogeneous-110``: one block covering the whole area.
-* ``heterogeneous-60-150``: two blocks side by side, 60 N on ``x < 0.30 m``, 150 N on the rest.
-* ``heterogeneous-110-150``: two blocks, 110 N on ``y < 0.20 m`` (front), 150 N at the back.
-* ``heterogeneous-150-rigid``: 150 N foam on ``x < 0.32 m``, a rigid board of the same thickness on
-  the rest (so the surface is level and the rigid region must be told apart by pressing).
-* ``heterogeneous-60-110-rigid``: three blocks, the first cut not aligned with the axes: 60 N left
-  of the slanted line from (0.18, 0) to (0.30, 0.40), 110 N between it and ``x = 0.44``, rigid
-  beyond.
-
-Ground-truth labels are block indices ``0 .. n-1`` in the order of ``Scenario.blocks``; ``-1`` marks
-the bare table.
+The built-in scenarios (:func:`builtin_scenarios`) are the paper's Table I, over the 60 × 40 cm
+workspace with 5 cm thick blocks, each layout our choice and described in its ``description``.
+Ground-truth labels are block indices in the order of ``Scenario.blocks``; ``-1`` marks the bare
+table.
 """
 
 from __future__ import annotations
@@ -52,9 +40,8 @@ BARE_TABLE = -1
 """Ground-truth label of table area that no block covers."""
 
 _OVERLAP_TOL_M2 = 1e-8  # 1 mm² of shared area is a real overlap, less is rounding of touching edges
-#: Largest side of a workspace and of a block's footprint, and largest block thickness, in metres:
-#: a table-top scene, ten metres beyond what any arm over a table reaches, while every map and
-#: every mesh grows with the area.
+#: Largest side of a workspace or footprint and largest block thickness, in metres: far beyond
+#: what an arm over a table reaches, while every map and mesh grows with the area.
 MAX_EXTENT_M = 10.0
 
 
@@ -64,40 +51,27 @@ class Block:
 
     Parameters
     ----------
-    name : str
-        Region name used in reports (``"soft"``, ``"60 N foam"``).
     polygon : (k, 2) float, metres
-        Footprint, ``k >= 3``, a simple polygon (convex or not; no two edges cross), at most
-        :data:`MAX_EXTENT_M` across on each axis; stored counter-clockwise.
+        Footprint, a simple polygon of ``k >= 3`` vertices, at most :data:`MAX_EXTENT_M` across.
     holes : tuple of (m, 2) float, metres
-        Simple polygons inside the footprint, apart from each other, that the block leaves
-        empty (another block may fill them); stored counter-clockwise. Points inside a block are
-        told by the even-odd rule over the footprint and its holes.
-    thickness_m : float
-        Height of the block's top above the table, in ``[0.001, MAX_EXTENT_M]`` metres.
-    hardness_n : float or None
-        ISO 2439 hardness in newtons; give this or ``youngs_modulus_pa`` for foam.
-    youngs_modulus_pa : float or None
-        Young's modulus; derived from ``hardness_n`` when that is given instead.
-    rigid : bool
-        A block that does not deform (then neither hardness nor modulus is given).
+        Simple polygons inside the footprint, apart from each other, that the block leaves empty.
+    hardness_n, youngs_modulus_pa, rigid
+        Exactly one is given (ISO 2439 hardness in newtons, Young's modulus in pascals, or a
+        board that does not deform); the modulus and hardness derive from each other.
     color : str
         Matplotlib colour for figures.
     appearance : Appearance or None
-        How the camera sees the block (:mod:`deformap.world._appearance`); None:
-        :data:`~deformap.world._appearance.DEFAULT_APPEARANCE`, neutral grey and plain.
+        How the camera sees the block; None: neutral grey and plain.
     """
 
     name: str
     polygon: NDArray[np.float64]
     # a sequence of arrays of their own shapes, checked by _ring below (stored as a tuple)
     holes: Sequence[NDArray[np.float64]] = ()
-    # at least the 1 mm the FEM's smallest element may be (`WorldConfig.element_size_m`): a
-    # thinner block is no layer the world can mesh (1e-320 m gave a zero Jacobian deep inside)
+    # at least the FEM's smallest element (1 mm): a thinner block is no layer the world can mesh
     thickness_m: float = setting(0.05, ge=0.001, le=MAX_EXTENT_M)
-    # Flexible foams are graded from about 20 N (super soft) to about 1 kN (ISO 2439); the bounds
-    # are far outside that and only refuse what is no material the world can press: 0.1 N is
-    # 7.7 Pa, far softer than any foam sold; 10 GPa is wood or stone, a block to declare rigid.
+    # flexible foams run from about 20 N to 1 kN (ISO 2439); the bounds refuse only what is no
+    # material to press: 0.1 N is 7.7 Pa, and 10 GPa is wood or stone, a block to declare rigid
     hardness_n: float | None = setting(None, ge=0.1, le=1.3e8)
     youngs_modulus_pa: float | None = setting(None, ge=10.0, le=1e10)
     rigid: bool = False
@@ -113,20 +87,17 @@ class Block:
             raise InvalidArgumentError(
                 f"block `name` must be a non-empty string; got {self.name!r}")
         poly = _ring(f"block {self.name!r} polygon", self.polygon)
-        if isinstance(self.holes, (str, bytes, np.ndarray)) or not isinstance(self.holes,
-                                                                              Sequence):
+        if isinstance(self.holes, (str, bytes, np.ndarray)) or not isinstance(self.holes, Sequence):
             raise InvalidArgumentError(
                 f"block {self.name!r} `holes` must be a sequence of polygons; got "
                 f"{type(self.holes).__name__}")
-        holes = tuple(_ring(f"block {self.name!r} holes[{i}]", h)
-                      for i, h in enumerate(self.holes))
+        holes = tuple(_ring(f"block {self.name!r} holes[{i}]", h) for i, h in enumerate(self.holes))
         self._check_holes(poly, holes)
         extent = poly.max(axis=0) - poly.min(axis=0)
         if np.any(extent > MAX_EXTENT_M):
             raise SettingError(
                 "polygon", f"must span at most {MAX_EXTENT_M:g} m on each axis; got "
-                f"{extent[0]:g} × {extent[1]:g} m (block {self.name!r})"
-            )
+                f"{extent[0]:g} × {extent[1]:g} m (block {self.name!r})")
         for ring in (poly, *holes):
             ring.setflags(write=False)
         object.__setattr__(self, "polygon", poly)
@@ -152,8 +123,7 @@ class Block:
             raise InvalidArgumentError(
                 f"block {self.name!r} needs exactly one of `hardness_n`, `youngs_modulus_pa` or "
                 f"`rigid=True`; got hardness_n={self.hardness_n!r}, "
-                f"youngs_modulus_pa={self.youngs_modulus_pa!r}, rigid={self.rigid!r}"
-            )
+                f"youngs_modulus_pa={self.youngs_modulus_pa!r}, rigid={self.rigid!r}")
         if self.hardness_n is not None:
             object.__setattr__(self, "youngs_modulus_pa",
                                hardness_to_youngs_modulus(float(self.hardness_n)))
@@ -185,16 +155,11 @@ class Block:
         return inside
 
     def to_dict(self) -> dict[str, Any]:
-        out: dict[str, Any] = {"name": self.name,
-                               "polygon": [[float(x), float(y)] for x, y in self.polygon]}
+        out: dict[str, Any] = {"name": self.name, "polygon": self.polygon.tolist()}
         if self.holes:
-            out["holes"] = [[[float(x), float(y)] for x, y in h] for h in self.holes]
-        if self.rigid:
-            out["rigid"] = True
-        else:
-            out["hardness_n"] = float(self.hardness_n)  # type: ignore[arg-type]
-        out["thickness_m"] = self.thickness_m
-        out["color"] = self.color
+            out["holes"] = [h.tolist() for h in self.holes]
+        out.update({"rigid": True} if self.rigid else {"hardness_n": self.hardness})
+        out.update(thickness_m=self.thickness_m, color=self.color)
         if self.appearance is not None:
             out["appearance"] = self.appearance.to_dict()
         return out
@@ -204,17 +169,8 @@ class Block:
 class Scenario:
     """A named layout of blocks over a workspace.
 
-    Parameters
-    ----------
-    name : str
-    blocks : tuple of Block
-        At least one; no two may overlap (touching is fine).
-    workspace : Workspace
-        The rectangle to map (60 × 40 cm by default), at most :data:`MAX_EXTENT_M` on each side.
-    description : str
-    table_appearance : Appearance or None
-        How the camera sees the table; None:
-        :data:`~deformap.world._appearance.DEFAULT_TABLE_APPEARANCE`.
+    ``blocks``: at least one, no two overlapping; ``workspace``: the rectangle to map, at most
+    :data:`MAX_EXTENT_M` on each side; ``table_appearance`` None: a darker warm grey.
     """
 
     name: str
@@ -232,8 +188,7 @@ class Scenario:
         if max(size) > MAX_EXTENT_M:
             raise SettingError(
                 "workspace", f"must span at most {MAX_EXTENT_M:g} m on each axis; got "
-                f"{size[0]:g} × {size[1]:g} m (scenario {self.name!r})"
-            )
+                f"{size[0]:g} × {size[1]:g} m (scenario {self.name!r})")
         names = [b.name for b in blocks]
         if len(set(names)) != len(names):
             raise InvalidArgumentError(f"scenario {self.name!r} has repeated block names: {names}")
@@ -243,8 +198,7 @@ class Scenario:
                 if area > _OVERLAP_TOL_M2:
                     raise InvalidArgumentError(
                         f"scenario {self.name!r}: blocks {a.name!r} and {b.name!r} overlap "
-                        f"by {area * 1e4:.2f} cm²; blocks may touch but not overlap"
-                    )
+                        f"by {area * 1e4:.2f} cm²; blocks may touch but not overlap")
 
     @property
     def region_names(self) -> list[str]:
@@ -281,7 +235,7 @@ class Scenario:
 
 
 def _ring(what: str, vertices: Any) -> NDArray[np.float64]:
-    """A footprint's (or hole's) vertices, checked simple with a positive area, counter-clockwise."""
+    """A footprint's or hole's vertices, checked simple with a positive area, counter-clockwise."""
     poly = check_array(what, vertices, (None, 2), what="vertices (x, y) in metres", min_rows=3)
     area = polygon_area(poly)
     if area < 0:
@@ -300,45 +254,43 @@ _RIGID_COLOR = "#6b4f3a"
 _FOAM_PORES_M = {60: 0.005, 110: 0.004, 150: 0.003}
 
 
-def _foam(name: str, poly: NDArray[np.float64], hardness: int) -> Block:
+def _foam(poly: NDArray[np.float64], hardness: int) -> Block:
     look = Appearance(color=parse_color(_FOAM_COLORS[hardness]), texture="noise",
                       scale_m=_FOAM_PORES_M[hardness], amplitude=0.15, seed=hardness)
-    return Block(name=name, polygon=poly, hardness_n=float(hardness), color=_FOAM_COLORS[hardness],
-                 appearance=look)
+    return Block(name=f"foam-{hardness}", polygon=poly, hardness_n=float(hardness),
+                 color=_FOAM_COLORS[hardness], appearance=look)
 
 
-def _rigid(name: str, poly: NDArray[np.float64]) -> Block:
-    look = Appearance(color=parse_color(_RIGID_COLOR), texture="stripes", scale_m=0.006, amplitude=0.1,
-                      angle_deg=90.0)
-    return Block(name=name, polygon=poly, rigid=True, color=_RIGID_COLOR, appearance=look)
+def _rigid(poly: NDArray[np.float64]) -> Block:
+    look = Appearance(color=parse_color(_RIGID_COLOR), texture="stripes", scale_m=0.006,
+                      amplitude=0.1, angle_deg=90.0)
+    return Block(name="rigid", polygon=poly, rigid=True, color=_RIGID_COLOR, appearance=look)
 
 
 def builtin_scenarios() -> dict[str, Scenario]:
-    """The six scenarios of the paper's Table I (layouts in the module docstring)."""
+    """The six scenarios of the paper's Table I."""
     full = rectangle(0.0, 0.0, 0.60, 0.40)
     out = [
-        Scenario(name="homogeneous-60", blocks=(_foam("foam-60", full, 60),),
+        Scenario(name="homogeneous-60", blocks=(_foam(full, 60),),
                  description="one 60 N foam block over the whole 60x40 cm area"),
-        Scenario(name="homogeneous-110", blocks=(_foam("foam-110", full, 110),),
+        Scenario(name="homogeneous-110", blocks=(_foam(full, 110),),
                  description="one 110 N foam block over the whole 60x40 cm area"),
         Scenario(name="heterogeneous-60-150",
-                 blocks=(_foam("foam-60", rectangle(0.0, 0.0, 0.30, 0.40), 60),
-                         _foam("foam-150", rectangle(0.30, 0.0, 0.60, 0.40), 150)),
+                 blocks=(_foam(rectangle(0.0, 0.0, 0.30, 0.40), 60),
+                         _foam(rectangle(0.30, 0.0, 0.60, 0.40), 150)),
                  description="60 N foam on the left half, 150 N on the right half"),
         Scenario(name="heterogeneous-110-150",
-                 blocks=(_foam("foam-110", rectangle(0.0, 0.0, 0.60, 0.20), 110),
-                         _foam("foam-150", rectangle(0.0, 0.20, 0.60, 0.40), 150)),
+                 blocks=(_foam(rectangle(0.0, 0.0, 0.60, 0.20), 110),
+                         _foam(rectangle(0.0, 0.20, 0.60, 0.40), 150)),
                  description="110 N foam at the front (y < 20 cm), 150 N at the back"),
         Scenario(name="heterogeneous-150-rigid",
-                 blocks=(_foam("foam-150", rectangle(0.0, 0.0, 0.32, 0.40), 150),
-                         _rigid("rigid", rectangle(0.32, 0.0, 0.60, 0.40))),
+                 blocks=(_foam(rectangle(0.0, 0.0, 0.32, 0.40), 150),
+                         _rigid(rectangle(0.32, 0.0, 0.60, 0.40))),
                  description="150 N foam on x < 32 cm, a rigid board of the same height beyond"),
         Scenario(name="heterogeneous-60-110-rigid",
-                 blocks=(_foam("foam-60", np.array([[0.0, 0.0], [0.18, 0.0], [0.30, 0.40],
-                                                    [0.0, 0.40]]), 60),
-                         _foam("foam-110", np.array([[0.18, 0.0], [0.44, 0.0], [0.44, 0.40],
-                                                     [0.30, 0.40]]), 110),
-                         _rigid("rigid", rectangle(0.44, 0.0, 0.60, 0.40))),
+                 blocks=(_foam(np.array([[0.0, 0.0], [0.18, 0.0], [0.30, 0.40], [0.0, 0.40]]), 60),
+                         _foam(np.array([[0.18, 0.0], [0.44, 0.0], [0.44, 0.4], [0.30, 0.4]]), 110),
+                         _rigid(rectangle(0.44, 0.0, 0.60, 0.40))),
                  description="60 N | 110 N split by a slanted cut, rigid board on x > 44 cm"),
     ]
     return {s.name: s for s in out}

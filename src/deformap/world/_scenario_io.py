@@ -1,31 +1,10 @@
 """Scenario files (YAML) and the catalogue of built-in scenarios.
 
-Format (every key is checked; an unknown key is an error)::
-
-    name: two-foams                      # required
-    description: soft left, hard right   # optional
-    workspace: {lower: [0, 0], upper: [0.6, 0.4]}   # optional, this is the default
-    blocks:                              # required, at least one
-      - name: soft                       # required, unique
-        rect: [0.0, 0.0, 0.3, 0.4]       # x0, y0, x1, y1 in metres ...
-        hardness_n: 60                   # ... one of hardness_n, youngs_modulus_pa, rigid: true
-        thickness_m: 0.05                # optional, default 0.05
-        color: "#f4d35e"                 # optional, for figures
-        appearance:                      # optional: how the camera sees it (default grey, plain)
-          color: "#f4d35e"               # sRGB, or [r, g, b] in [0, 1]
-          texture: noise                 # plain | noise | stripes | photo
-          scale_m: 0.005                 # pitch, period or photograph side in metres
-          amplitude: 0.15                # largest relative change of brightness
-      - name: hard
-        polygon: [[0.3, 0], [0.6, 0], [0.6, 0.4], [0.3, 0.4]]   # or any simple polygon
-        holes: [[[0.4, 0.1], [0.5, 0.1], [0.45, 0.2]]]   # optional: left empty, inside it
-        rigid: true
-        appearance: {color: [0.4, 0.3, 0.2], texture: photo, photo: gravel, scale_m: 0.2,
-                     split: {through: [0.45, 0.2], normal_deg: 0, color: "#3050a0"}}
-    table_appearance: {color: "#5a5550"}   # optional: the table's look
-
-Every appearance key and its default is listed in ``docs/scenarios.md``
-(:class:`~deformap.world._appearance.Appearance`).
+A file holds ``name``, ``blocks`` (each with ``name``, one of ``rect`` or ``polygon``, optional
+``holes``, one of ``hardness_n``, ``youngs_modulus_pa`` or ``rigid: true``, optional
+``thickness_m``, ``color`` and ``appearance``) and optionally ``description``, ``workspace``
+(``lower``, ``upper``) and ``table_appearance``; every key is checked, and ``docs/scenarios.md``
+lists them all with their defaults.
 """
 
 from __future__ import annotations
@@ -62,12 +41,9 @@ def load_scenario(name_or_path: str | Path) -> Scenario:
     Raises
     ------
     ConfigError
-        Unknown name, or a file with an unknown key or a bad value.
-    FileFormatError
-        Not raised: a path that does not exist is reported as an unknown name (ConfigError).
+        Unknown name (or missing file), or a file with an unknown key or a bad value.
     """
-    catalogue = builtin_scenarios()
-    key = str(name_or_path)
+    catalogue, key = builtin_scenarios(), str(name_or_path)
     if key in catalogue:
         return catalogue[key]
     path = Path(key)
@@ -78,10 +54,8 @@ def load_scenario(name_or_path: str | Path) -> Scenario:
     if not is_file:
         raise ConfigError(
             f"unknown scenario {key!r}: not a built-in name ({', '.join(catalogue)}) "
-            "and not an existing YAML file"
-        )
-    data = load_yaml(path, what="the scenario file")
-    return parse_scenario(data, source=str(path))
+            "and not an existing YAML file")
+    return parse_scenario(load_yaml(path, what="the scenario file"), source=str(path))
 
 
 def save_scenario(scenario: Scenario, path: str | Path) -> None:
@@ -107,8 +81,7 @@ def _block(data: Any, where: str) -> Block:
             if r.shape != (4,) or not (r[2] > r[0] and r[3] > r[1]):
                 raise ConfigError(
                     f"{where}: `rect` must be [x0, y0, x1, y1] with x1 > x0 and y1 > y0; "
-                    f"got {data['rect']!r}"
-                )
+                    f"got {data['rect']!r}")
             poly = rectangle(*r)
         else:
             poly = np.asarray(data["polygon"], dtype=float)
@@ -122,8 +95,7 @@ def _block(data: Any, where: str) -> Block:
             thickness_m=data.get("thickness_m", 0.05),
             hardness_n=data.get("hardness_n"), youngs_modulus_pa=data.get("youngs_modulus_pa"),
             rigid=rigid, color=str(data.get("color", "#6b4f3a" if rigid else "#c8a165")),
-            appearance=None if look is None else _appearance(look, f"{where}.appearance"),
-        )
+            appearance=None if look is None else _appearance(look, f"{where}.appearance"))
     except (TypeError, ValueError, DeformapError) as exc:
         if isinstance(exc, ConfigError):
             raise

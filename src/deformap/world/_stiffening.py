@@ -1,19 +1,13 @@
-"""A second contact physics: each foam block a layer that stiffens as it is compressed, a
-two-parameter foundation whose contact with the tip is solved by Newton's method
-(:mod:`deformap.world._foundation`), behind the interface the world uses from the FEM
-(:class:`~deformap.world._foam.FoamModel`). It is of another kind than the estimator's Hertz
-half-space with a bonded-layer correction, so the estimator is checked on a physics it was not
-derived on.
+"""The ``stiffening-foam`` physics: each foam block a stiffening two-parameter foundation
+(:mod:`deformap.world._foundation`) behind the FEM's interface
+(:class:`~deformap.world._foam.FoamModel`), a physics of another kind than the estimator's.
 
 Grid: spacing ``a / 6`` over a core of ±2 ``a`` around the target (``a`` the expected contact
 radius; re-gridded when the solved disc spans fewer than 4 or more than 9 cells), cells growing by
-1.2 outside it out to 8 ``ℓ`` beyond the core, cut at the block's free edge. Only the block under
-the target is loaded. Valid while the tip sinks less than its radius (beyond it the stick would
-touch the foam; the press still solves, with the sphere alone).
-
-The press settles the grid, the mode shape's ``γ`` (to 1 %) and the contact together, a few
-Newton steps a round, then solves in full. The camera's mesh (the FEM's hexahedra, not solved) is
-displaced by ``u_z = −w φ(z)``.
+1.2 outside it out to 8 ``ℓ`` beyond the core, cut at the block's edge; only the block under the
+target is loaded. The press settles the grid, the mode shape's ``γ`` (to 1 %) and the contact
+together, a few Newton steps a round, then solves in full. The camera's mesh is displaced by
+``u_z = −w φ(z)``.
 """
 
 from __future__ import annotations
@@ -52,9 +46,7 @@ _SETTLING_STEPS = 3
 
 def graded_axis(center: float, lo: float, hi: float, *, step: float, core: float,
                 reach: float) -> NDArray[np.float64]:
-    """Node coordinates of one axis: spacing ``step`` within ``core`` of ``center``, then cells
-    growing by 1.2 out to ``core + reach``, cut to ``[lo, hi]`` (whose ends become nodes when
-    the grid reaches them). ``center`` (inside ``[lo, hi]``) is always a node."""
+    """One axis's nodes: ``step`` apart near ``center``, then growing, cut to ``[lo, hi]``."""
     offsets = list(np.arange(0.0, core + 0.5 * step, step))
     cell = step
     while offsets[-1] < core + reach:
@@ -75,9 +67,8 @@ def graded_axis(center: float, lo: float, hi: float, *, step: float, core: float
 
 def max_grid_nodes(extent_m: NDArray[np.float64], tip_radius_m: float) -> int:
     """Most nodes of a press grid over a block of ``(2,)`` in-plane ``extent_m``: per axis the
-    core (``±2 a`` at spacing ``a / 6``, or coarser when clamped to ``R / 200``; ``a`` at most
-    ``sqrt(2) R``, so at most 17 cells a side) and the graded cells out to the block's extent
-    on either side, from the finest spacing ``R / 200``."""
+    core (``a ≤ sqrt(2) R``) and the graded cells from the finest spacing ``R / 200`` out to the
+    block's extent."""
     finest = tip_radius_m / 200
     core = math.ceil(_CORE_RADII * math.sqrt(2.0) * _CORE_CELLS_PER_RADIUS)
     count = 1
@@ -88,10 +79,7 @@ def max_grid_nodes(extent_m: NDArray[np.float64], tip_radius_m: float) -> int:
 
 
 def _depth_guess(layer: FoundationLayer, force_n: float, tip_radius_m: float) -> float:
-    """A first sink of the tip, to start Newton near the answer: the sphere as a flat punch of
-    radius ``a = sqrt(2 R δ)`` carrying ``F = K(a) δ / 2`` (exact for the linear Winkler layer,
-    ``F = π k R δ²``), with the linear Pasternak punch's stiffness
-    ``K(a) = π a² k + 2π a sqrt(k G_p) K₁(a/ℓ) / K₀(a/ℓ)``."""
+    """A first sink: a flat punch of radius ``sqrt(2 R δ)`` on the linear Pasternak layer."""
     k, gp, ell = layer.spring_pa_per_m, layer.shear_n_per_m, layer.influence_length_m
     depth = math.sqrt(force_n / (math.pi * k * tip_radius_m))
     for _ in range(30):  # a damped fixed point: K rises with δ
@@ -104,21 +92,8 @@ def _depth_guess(layer: FoundationLayer, force_n: float, tip_radius_m: float) ->
 
 
 class StiffeningFoam(FoamMesh):
-    """All foam blocks of a scenario as stiffening foundations (see the module docstring).
-
-    The interface the world uses from :class:`~deformap.world._foam.FoamModel`: ``dent``,
-    ``zero_displacement``, ``top_displacement``, ``n_dofs`` and the display mesh
-    (``grids``, ``offsets``, ``rest_nodes``, ``n_nodes``).
-
-    Parameters
-    ----------
-    scenario : Scenario
-    element_size_m, top_layer_m, layer_growth : float
-        The display mesh (the camera's view of the deformed blocks).
-    poisson_ratio, densification_strain, stiffening_exponent : float
-    shear : bool
-        False drops the shear layer (a Winkler foundation, for checks).
-    """
+    """All foam blocks of a scenario as stiffening foundations (module docstring) on the display
+    mesh of :class:`~deformap.world._foam.FoamMesh`; ``shear`` False: Winkler foundations."""
 
     def __init__(self, scenario: Scenario, *, element_size_m: float, top_layer_m: float,
                  layer_growth: float, poisson_ratio: float, densification_strain: float,
@@ -132,15 +107,14 @@ class StiffeningFoam(FoamMesh):
             densification_strain=densification_strain,
             stiffening_exponent=stiffening_exponent, shear=shear) for index in self.foam_blocks}
         self.shear = shear
-        # the last press's Newton solve and its layer (mode shape), for checks
+        # the last press's solve, layer and grid, for checks
         self.last: NewtonResult | None = None
         self.last_layer: FoundationLayer | None = None
         self.last_grid: FoundationGrid | None = None
 
     @property
     def n_dofs(self) -> int:
-        """Top nodes of the foam blocks' display meshes (one deflection each); each press
-        solves on a grid of its own, graded around the tip."""
+        """Top nodes of the foam blocks' display meshes (one deflection each)."""
         return sum((self.grids[i].nx + 1) * (self.grids[i].ny + 1) for i in self.layers)
 
     def forget(self) -> None:
@@ -148,14 +122,9 @@ class StiffeningFoam(FoamMesh):
 
     def dent(self, target_xy: NDArray[np.float64], force_n: float, *, tip_radius_m: float,
              initial_radius_m: float | None = None, max_radius_m: float | None = None) -> Dent:
-        """Solve the press of ``force_n`` newtons at ``target_xy`` (see the module docstring).
-
-        ``initial_radius_m`` is the contact radius expected (a nearby level's, scaled), which
-        sets the first grid and mode shape; default ``sqrt(R δ)`` from a first guess of the
-        sink (:func:`_depth_guess`). Logs a warning when Newton's method did not converge.
-        ``max_radius_m`` (the FEM's bracket, :class:`deformap.world._foam.FoamModel`) is not
-        needed here: the contact set is the active set's own solution, not a fixed point.
-        """
+        """Solve the press of ``force_n`` newtons at ``target_xy`` (module docstring), the first
+        grid and mode shape set by ``initial_radius_m`` (default ``sqrt(R δ)`` of
+        :func:`_depth_guess`); ``max_radius_m``, the FEM's bracket, is not needed here."""
         del max_radius_m
         target = np.asarray(target_xy, dtype=float).reshape(2)
         index = self.block_at(target)

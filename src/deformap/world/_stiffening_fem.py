@@ -1,34 +1,18 @@
-"""The stiffening-FEM physics solved: the FEM's foam blocks made of the foam that stiffens toward
-densification (``WorldConfig(physics="stiffening-fem")``; its law and strain operator are
-:mod:`deformap.world._densification`), each press's equilibrium found by Newton's method.
+"""The ``stiffening-fem`` physics: the FEM's foam blocks made of the foam that stiffens toward
+densification (:mod:`deformap.world._densification`), each press's equilibrium found by Newton's
+method, never refactorising.
 
-Force control with the FEM's sphere contact (:class:`~deformap.world._foam.FoamModel`: the Hertz
-pressure of the force on a patch of radius ``a``, ``a ← sqrt(a sqrt(R δ))`` until it settles,
-the surface conformed to the tip); each patch's equilibrium ``K₀ u + C s(Cᵀu) = f``
-(``s = V Φ'``) is solved by Newton's method, never refactorising:
-
-- ``K₀`` is factorised once when the world is built (shared by homogeneous blocks of one mesh, as
-  in the FEM).
-- The near set's tangent is exact: the elements the linear press would stiffen by more than 5 %
-  (``Φ'' > 0.05 M₀``), the most compressed first, at most ``near_elements`` and at least 8,
-  as a rank-``n`` update of ``K₀`` (Woodbury): ``Z = K₀⁻¹ C_N`` (``n`` right-hand sides in one
-  solve call, once per press target, kept for every load level and patch of that target)
-  reduces each Newton step to a dense ``n × n`` system.
-- The other elements stiffen by a few per cent at most; their forces enter every residual and
-  are carried by an outer fixed point (Anderson-accelerated, Walker & Ni 2011), one solve with
-  ``K₀`` a round, each round's Newton solve warm-started from the last. An element outside the
-  near set compressed past ``ε_d / 5`` joins it. A press is converged when the residual over
-  every free unknown is below ``tolerance · F``.
-
-Each target's first solve (the commanded force, the record's top level) sets the near set; the
-record's lower levels warm-start from the level above. The near sets of the last two targets are
-kept, each ``n`` vectors of the block's unknowns. The Newton steps keep every element's strain
-below ``ε_d``; the world refuses a press that sinks the tip as deep as the block is thick.
+Force control and the patch iteration are the FEM's (:class:`~deformap.world._foam.FoamModel`).
+Each patch's equilibrium ``K₀ u + C s(Cᵀu) = f`` (``s = V Φ'``): the near set (the elements the
+linear press would stiffen by more than 5 %, 8 to ``near_elements`` of them) takes its tangent
+exactly by a Woodbury update ``Z = K₀⁻¹ C_N`` (a dense ``n × n`` Newton system); the other
+elements' forces are an outer fixed point (Anderson-accelerated, Walker & Ni 2011), one ``K₀``
+solve a round, and an element compressed past ``ε_d / 5`` joins the near set. Converged when the
+residual over every free unknown is below ``tolerance · F``.
 
 References
 ----------
-Walker, H. F., Ni, P. (2011). Anderson acceleration for fixed-point iterations. SIAM Journal on
-Numerical Analysis 49(4), 1715–1735.
+Walker, H. F., Ni, P. (2011). Anderson acceleration for fixed-point iterations. SINUM 49(4).
 """
 
 from __future__ import annotations
@@ -50,7 +34,7 @@ from deformap.world._densification import (
 from deformap.world._foam import FoamModel
 from deformap.world._scenario import Scenario
 
-__all__ = ["NewtonSolve", "StiffeningFem"]
+__all__ = ["StiffeningFem"]
 
 log = logging.getLogger(__name__)
 
@@ -66,8 +50,7 @@ _NEAR_LEAST = 8
 
 @dataclass
 class _NearSet:
-    """The elements whose tangent a target's Newton steps take exactly, with ``Z = K₀⁻¹ C_N``
-    and ``G = C_Nᵀ Z``; the target's last solve, to warm-start the next."""
+    """A target's near set with ``Z = K₀⁻¹ C_N``, ``G = C_Nᵀ Z`` and its last solves."""
 
     elements: NDArray[np.int64]
     columns: sp.csc_matrix  # C_N
@@ -79,9 +62,7 @@ class _NearSet:
 
     def predict(self, force: float, size: int
                 ) -> tuple[NDArray[np.float64], NDArray[np.float64] | None]:
-        """A first guess at ``force``: the last solve's far forces and near strains scaled as
-        powers of the force, the powers those of the last two solves (the far forces about as
-        ``F²`` and the strains as ``F`` when there is one: strain ``∝ F``, stress ``∝ ε²``)."""
+        """Far forces and near strains at ``force``, scaled from the last solves as its powers."""
         if not self.solved:
             return np.zeros(size), None
         f1, far1, eps1 = self.solved[-1]
@@ -100,36 +81,11 @@ class _NearSet:
         self.solved = [*self.solved[-1:], (force, far, eps)]
 
 
-@dataclass(frozen=True)
-class NewtonSolve:
-    """How one patch's equilibrium was solved: the residual over every free unknown [N], the
-    outer rounds (K₀ solves), the Newton steps over all rounds, the near set's size, and the
-    largest element strain."""
-
-    residual_n: float
-    rounds: int
-    newton_steps: int
-    near_elements: int
-    max_strain: float
-    converged: bool
-
-
 class StiffeningFem(FoamModel):
     """All foam blocks of a scenario as FEM bodies of the stiffening foam (module docstring).
 
-    Parameters
-    ----------
-    scenario : Scenario
-    element_size_m, top_layer_m, layer_growth, poisson_ratio : float
-        The FEM's mesh and ``ν`` (:class:`~deformap.world._foam.FoamModel`).
-    densification_strain, stiffening_exponent : float
-        ``ε_d`` and ``m`` of the law.
-    near_elements : int
-        The most elements whose tangent the Newton steps take exactly; 48 bounds each Newton
-        step's dense system to 48 × 48 while the outer rounds carry the rest.
-    tolerance : float
-        Converged when the residual's norm is below ``tolerance`` times the patch's force; 1e-4
-        keeps the force–travel record's error far below the encoders' noise.
+    ``near_elements``: 48 bounds each Newton step's dense system to 48 × 48. ``tolerance``: 1e-4
+    of the force keeps the force–travel record's error far below the encoders' noise.
     """
 
     def __init__(self, scenario: Scenario, *, element_size_m: float, top_layer_m: float,
@@ -144,8 +100,6 @@ class StiffeningFem(FoamModel):
         self.tolerance = tolerance
         self.operators = {index: strain_operator(body) for index, body in self.bodies.items()}
         self._near: OrderedDict[tuple[int, bytes], _NearSet] = OrderedDict()
-        #: the last patch solve's convergence, for checks
-        self.last: NewtonSolve | None = None
 
     def _law(self, strain: NDArray[np.float64], op: StrainOperator, elements: NDArray[np.int64],
              tangent: bool = False) -> NDArray[np.float64]:
@@ -161,12 +115,7 @@ class StiffeningFem(FoamModel):
         f = load.ravel()[body.free]
         force = float(-f.sum())
         if self.stiffening_exponent == 0.0 or force <= 0.0:  # the linear FEM's response
-            linear = super()._respond(index, load, center)
-            self.last = NewtonSolve(residual_n=0.0, rounds=1, newton_steps=0, near_elements=0,
-                                    max_strain=float((self.operators[index].matrix.T
-                                                      @ linear.ravel()[body.free]).max()),
-                                    converged=True)
-            return linear
+            return super()._respond(index, load, center)
         u = np.zeros(3 * body.grid.n_nodes)
         u[body.free] = self._solve(index, f, force, center)
         return u.reshape(-1, 3)
@@ -182,16 +131,13 @@ class StiffeningFem(FoamModel):
         return _NearSet(elements, columns, z, 0.5 * (g + g.T))
 
     def forget(self) -> None:
-        """Drop the near sets and warm starts earlier presses left: a press is then solved
-        the same whatever was pressed before (the world calls it at each press)."""
+        """Drop the unit responses, near sets and warm starts earlier presses left."""
         super().forget()
         self._near.clear()
 
     def _solve(self, index: int, f: NDArray[np.float64], force: float,
                center: NDArray[np.float64]) -> NDArray[np.float64]:
-        """The free displacements of block ``index`` in equilibrium with the free nodal forces
-        ``f`` (module docstring: Newton on the near set, a fixed point on the far elements'
-        forces, Anderson-accelerated)."""
+        """Block ``index``'s free displacements in equilibrium with the free nodal forces ``f``."""
         op, body = self.operators[index], self.bodies[index]
         key = (index, np.asarray(center, dtype=float).tobytes())
         near = self._near.get(key)
@@ -205,14 +151,11 @@ class StiffeningFem(FoamModel):
         self._near.move_to_end(key)
         far, eps = near.predict(force, f.size)
         history: list[tuple[NDArray[np.float64], NDArray[np.float64]]] = []
-        steps, residual, rounds, converged = 0, np.inf, 0, False
-        while rounds < _MAX_ROUNDS:
-            rounds += 1
+        residual = np.inf
+        for rounds in range(1, _MAX_ROUNDS + 1):
             # the first round of a new target has no far forces yet: its linear response
             response = linear if linear is not None and rounds == 1 else body.solve_free(f - far)
-            solved, taken = self._newton(near.columns.T @ response, near, op, eps)
-            eps = solved
-            steps += taken
+            eps = solved = self._newton(near.columns.T @ response, near, op, eps)
             u = response - near.z @ self._law(eps, op, near.elements)
             strain = op.matrix.T @ u
             stress = self._law(strain, op, np.arange(strain.size))
@@ -227,22 +170,16 @@ class StiffeningFem(FoamModel):
             new_far = op.matrix @ stress
             residual = float(np.linalg.norm(new_far - far))
             if residual <= self.tolerance * force:
-                converged = True
                 break
             far = _anderson(far, new_far, history)
-        if not converged:
+        else:
             log.warning("stiffening FEM: the press did not converge in %d rounds (residual "
                         "%.3g N at %.3g N)", _MAX_ROUNDS, residual, force)
         near.remember(force, far, solved)
-        self.last = NewtonSolve(residual_n=residual, rounds=rounds, newton_steps=steps,
-                                near_elements=int(near.elements.size),
-                                max_strain=float(strain.max()), converged=converged)
         return u
 
     def _near_set(self, index: int, linear: NDArray[np.float64]) -> _NearSet:
-        """The elements the linear response ``linear`` compresses most: at most
-        ``near_elements`` of them, and of those only the ones it would stiffen by more than
-        :data:`_NEAR_STIFFENING` (at least :data:`_NEAR_LEAST`)."""
+        """The near set of the linear response ``linear`` (module docstring)."""
         op = self.operators[index]
         strain = op.matrix.T @ linear
         order = np.argsort(strain)[::-1][:min(self.near_elements, strain.size)]
@@ -257,10 +194,8 @@ class StiffeningFem(FoamModel):
         return self._with_columns(index, empty, chosen)
 
     def _newton(self, b: NDArray[np.float64], near: _NearSet, op: StrainOperator,
-                start: NDArray[np.float64] | None) -> tuple[NDArray[np.float64], int]:
-        """The near elements' strains ``ε`` with ``ε − b + G s(ε) = 0`` (``s = V Φ'``), by Newton's
-        method on the Jacobian ``I + G diag(V Φ'')``, steps halved to keep every ``ε < ε_d`` and
-        the residual falling."""
+                start: NDArray[np.float64] | None) -> NDArray[np.float64]:
+        """The near strains with ``ε − b + G s(ε) = 0``, by Newton's method with halved steps."""
         cap, g, elements = self.densification_strain, near.g, near.elements
         eps = np.minimum(b, 0.5 * cap) if start is None or start.size != b.size else start
         eps = np.minimum(eps, 0.999 * cap)
@@ -271,9 +206,9 @@ class StiffeningFem(FoamModel):
         r = residual(eps)
         norm = float(np.linalg.norm(r))
         scale = max(float(np.abs(b).max()), 1e-12)
-        for step in range(1, _MAX_NEWTON + 1):
+        for _ in range(_MAX_NEWTON):
             if norm <= 1e-13 * scale:
-                return eps, step - 1
+                return eps
             jac = np.eye(b.size) + g * self._law(eps, op, elements, tangent=True)[None, :]
             delta = np.linalg.solve(jac, -r)
             alpha = 1.0
@@ -288,11 +223,11 @@ class StiffeningFem(FoamModel):
                     # no step keeps the strains below densification, or the step is not a number
                     log.warning("stiffening FEM: the near-field Newton step is not usable "
                                 "(residual %.3g); the last strains are kept", norm)
-                    return eps, step
+                    return eps
                 alpha *= 0.5
             eps, r, norm = trial, r_trial, n_trial
         log.warning("stiffening FEM: the near-field Newton solve stopped at %.3g", norm)
-        return eps, _MAX_NEWTON
+        return eps
 
 
 _ANDERSON_DEPTH = 3
@@ -301,8 +236,7 @@ _ANDERSON_DEPTH = 3
 def _anderson(x: NDArray[np.float64], fx: NDArray[np.float64],
               history: list[tuple[NDArray[np.float64], NDArray[np.float64]]]
               ) -> NDArray[np.float64]:
-    """The next iterate of the fixed point ``x = T(x)`` from ``x`` and ``fx = T(x)``, by Anderson
-    mixing over the last few (Walker & Ni 2011); ``history`` (``(x, T(x))`` pairs) is updated."""
+    """The next iterate of ``x = T(x)`` by Anderson mixing over ``history`` (updated)."""
     history.append((x, fx))
     del history[:-(_ANDERSON_DEPTH + 1)]
     if len(history) < 2:

@@ -1,23 +1,19 @@
 """Textures of the simulated world: brightness patterns in metres on a surface.
 
 Each texture maps ``(n, 2)`` surface coordinates ``uv`` in metres to ``(n,)`` values in
-``[-1, 1]`` with a mean near 0; an appearance multiplies its colour by ``1 + amplitude · t``.
+``[-1, 1]`` with a mean near 0 (``plain``: 0 everywhere):
 
-* ``plain``: 0 everywhere.
-* ``noise``: fractal value noise (Perlin 1985; Ebert et al. 2003, ch. 2): random values on a
-  square lattice of pitch ``scale_m``, interpolated with Hermite's smoothstep, summed over three
-  octaves of half the pitch and half the weight each.
+* ``noise``: fractal value noise (Perlin 1985; Ebert et al. 2003, ch. 2), random values on a
+  lattice of pitch ``scale_m`` interpolated by smoothstep, over three octaves of half the pitch
+  and half the weight each.
 * ``stripes``: a square wave of period ``scale_m`` across the direction ``angle_deg``.
-* ``photo``: a photographed texture bundled with scikit-image (``brick``, ``grass``, ``gravel``;
-  512 × 512 grey images, read from the installed package, nothing downloaded), one image per
-  ``scale_m`` square, repeated, sampled bilinearly, its grey levels centred and scaled into
-  ``[-1, 1]``.
+* ``photo``: a grey photograph bundled with scikit-image (``brick``, ``grass``, ``gravel``), one
+  per ``scale_m`` square, repeated, sampled bilinearly, centred and scaled into ``[-1, 1]``.
 
 References
 ----------
 Perlin, K. (1985). An image synthesizer. SIGGRAPH '85, 287–296.
-Ebert, D. S., Musgrave, F. K., Peachey, D., Perlin, K., Worley, S. (2003). Texturing and
-Modeling: A Procedural Approach, 3rd ed. Morgan Kaufmann.
+Ebert, D. S., et al. (2003). Texturing and Modeling: A Procedural Approach, 3rd ed.
 """
 
 from __future__ import annotations
@@ -28,12 +24,11 @@ from typing import Literal, get_args
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["PHOTOS", "TEXTURES", "Photo", "Texture", "texture_values"]
+__all__ = ["TEXTURES", "Photo", "Texture", "texture_values"]
 
 Texture = Literal["plain", "noise", "stripes", "photo"]
 TEXTURES: tuple[str, ...] = get_args(Texture)
 Photo = Literal["brick", "grass", "gravel"]
-PHOTOS: tuple[str, ...] = get_args(Photo)
 
 _LATTICE = 256  # lattice values per side; the noise repeats every 256 pitches
 _OCTAVES = 3
@@ -91,12 +86,8 @@ def _noise(uv: NDArray[np.float64], scale_m: float, seed: int) -> NDArray[np.flo
 def texture_values(texture: str, uv: NDArray[np.float64], *, scale_m: float,
                    angle_deg: float = 0.0, photo: str = "brick", seed: int = 0
                    ) -> NDArray[np.float64]:
-    """``(n,)`` values in ``[-1, 1]`` of ``texture`` at the ``(n, 2)`` coordinates ``uv`` (metres).
-
-    ``scale_m`` is the lattice pitch (``noise``), the period (``stripes``) or the side of one
-    photograph (``photo``); ``angle_deg`` turns the stripes' normal from the ``u`` axis; ``photo``
-    names the photograph; ``seed`` draws the noise lattice.
-    """
+    """``(n,)`` values in ``[-1, 1]`` of ``texture`` at the ``(n, 2)`` coordinates ``uv`` (metres;
+    the parameters as in the module docstring, ``seed`` drawing the noise lattice)."""
     uv = np.asarray(uv, dtype=float).reshape(-1, 2)
     if texture == "plain":
         return np.zeros(len(uv))

@@ -1,21 +1,9 @@
 """The simulated world: scenario + foam physics + depth camera + probe, as an ``Environment``.
 
-``WorldConfig.physics`` picks how the foam answers a press (:mod:`deformap.world._foam`,
-:mod:`deformap.world._stiffening`, :mod:`deformap.world._stiffening_fem`); each displaces the same
-hexahedral mesh, which the camera sees, and gives the press's depth for the force–travel record.
-The world owns no press force: it is pressed with the force its caller commands.
-
-Each press also returns its force–travel record (``PressObservation.force_travel``), drawn from a
-noise stream of its own so that the press's other draws are those of a world without the record
-(:mod:`deformap.world._force_travel`).
-
-Each frame carries the colour the camera sees at every point (:mod:`deformap.world._looks`,
-:meth:`DepthCamera.sensor_colors <deformap.world._camera.DepthCamera.sensor_colors>`); the colour
-noise comes from a stream of its own per event, so the depth's draws are those of a world without
-colour.
-
-Ground truth labels are block indices (``-1`` = bare table); hardness and modulus are ``inf`` on
-rigid blocks and the bare table.
+``WorldConfig.physics`` picks how the foam answers a press; each physics displaces the same
+hexahedral mesh, which the camera sees. The force–travel record and each frame's colour draw their
+noise from streams of their own, so the depth's and the press's draws are those of a world without
+them. Ground truth is ``-1`` (labels) or ``inf`` (hardness, modulus) on the bare table.
 """
 
 from __future__ import annotations
@@ -28,11 +16,7 @@ import numpy as np
 import trimesh
 from numpy.typing import NDArray
 
-from deformap._validation import (
-    check_array,
-    check_positive,
-    check_vector,
-)
+from deformap._validation import check_array, check_positive, check_vector
 from deformap.cloud import PointCloud
 from deformap.environment import (
     MIN_FORCE_RISE_N,
@@ -66,20 +50,9 @@ MIN_RECORD_FORCE_N = 0.1 + 5 * MIN_FORCE_RISE_N
 class SimulatedWorld:
     """A scenario on a table, seen by a depth camera and pressed by a force-controlled probe.
 
-    Parameters
-    ----------
-    scenario : Scenario
-    config : WorldConfig
-    rng : numpy.random.Generator
-        Source of the camera and force-sensor noise. One number is drawn from it at construction;
-        each event then draws from a stream keyed by that number and the event (the n-th observation
-        at rest; a press by its target and force), so a resumed run sees the noise the uninterrupted
-        run saw. The colour noise of an event has a stream of its own, keyed the same way.
-
-    Notes
-    -----
-    Building the world meshes and factorises every foam block; each press is then one to a few
-    solves. ``observe`` during a press shows the pressed scene, probe included.
+    One number is drawn from ``rng`` at construction; each event (the n-th observation at rest; a
+    press by its target and force) then draws its noise from a stream keyed by that number and the
+    event, so a resumed run sees the noise the uninterrupted run saw.
     """
 
     def __init__(self, scenario: Scenario, *, config: WorldConfig | None = None,
@@ -94,23 +67,15 @@ class SimulatedWorld:
         self._noise_key = int(rng.integers(2**62))
         self._n_observed = 0
         c = self.config
+        mesh: dict[str, Any] = dict(element_size_m=c.element_size_m, top_layer_m=c.top_layer_m,
+                                    layer_growth=c.layer_growth, poisson_ratio=c.poisson_ratio)
         self.foam: FoamModel | StiffeningFoam  # StiffeningFem is a FoamModel
         if c.physics == "linear-fem":
-            self.foam = FoamModel(scenario, element_size_m=c.element_size_m,
-                                  top_layer_m=c.top_layer_m, layer_growth=c.layer_growth,
-                                  poisson_ratio=c.poisson_ratio)
-        elif c.physics == "stiffening-fem":
-            self.foam = StiffeningFem(
-                scenario, element_size_m=c.element_size_m, top_layer_m=c.top_layer_m,
-                layer_growth=c.layer_growth, poisson_ratio=c.poisson_ratio,
-                densification_strain=c.densification_strain,
-                stiffening_exponent=c.stiffening_exponent)
+            self.foam = FoamModel(scenario, **mesh)
         else:
-            self.foam = StiffeningFoam(
-                scenario, element_size_m=c.element_size_m, top_layer_m=c.top_layer_m,
-                layer_growth=c.layer_growth, poisson_ratio=c.poisson_ratio,
-                densification_strain=c.densification_strain,
-                stiffening_exponent=c.stiffening_exponent)
+            physics = StiffeningFem if c.physics == "stiffening-fem" else StiffeningFoam
+            self.foam = physics(scenario, **mesh, densification_strain=c.densification_strain,
+                                stiffening_exponent=c.stiffening_exponent)
         camera = c.camera if c.noise else replace(c.camera, noise=False)
         self.camera = DepthCamera(camera, scenario.workspace.center)
         self._force_noise_n = c.force_noise_n if c.noise else 0.0
@@ -136,9 +101,8 @@ class SimulatedWorld:
         return self._capture(self._displacement, p.contact, self._event_rng(*key), key)
 
     def rgb_image(self) -> NDArray[np.float64]:
-        """``(height, width, 3)`` sRGB in ``[0, 1]`` of the scene as it is now, as the camera sees
-        it (colour noise included, from a stream of its own: no event's draws change); NaN where a
-        pixel has no return."""
+        """``(height, width, 3)`` sRGB in ``[0, 1]`` of the scene as the camera sees it now (noise
+        from a stream of its own); NaN where a pixel has no return."""
         contact = None if self._pressed is None else self._pressed.contact
         frame = self.camera.capture(self.scene_mesh(self._displacement, contact),
                                     self._event_rng(5))
@@ -198,15 +162,12 @@ class SimulatedWorld:
         return self._pressed is not None
 
     def dent(self, target_xy: Any, force_n: float) -> Dent:
-        """The foam's response to a press (``config.physics``: FEM, foundation or stiffening
-        FEM), without touching the world's state (no noise), the same whatever was pressed
-        before.
+        """The foam's response to a press, without noise or touching the world's state.
 
         Raises
         ------
         InvalidArgumentError
-            When the tip would sink as deep as the block is thick (a force far too large for
-            the foam, which no physics of the world models: it would be crushed onto the table).
+            When the tip would sink as deep as the block is thick (crushed onto the table).
         """
         target = check_vector("target_xy", target_xy, 2, what="metres")
         force = check_positive("force_n", force_n)
@@ -226,14 +187,10 @@ class SimulatedWorld:
                      ) -> ForceTravel | None:
         """The force–travel record of the press at ``target_xy`` with ``force_n`` newtons.
 
-        One press solve of the world's physics per load level
-        (:mod:`deformap.world._force_travel`); ``dent``, the press's own solve at ``force_n``,
-        is the last level. The noise comes from the press's own stream for the record (the
-        same for the same press, whatever came before), none with ``noise=False``. None for a
-        press under :data:`MIN_RECORD_FORCE_N`, and for a press whose solved indentations do not
-        make a record (:class:`~deformap.environment.ForceTravel` refuses them: by a seam the
-        FEM's indentation can fall from one level to the next as the load crosses into the next
-        block), with a warning: that press is read by the camera alone.
+        One press solve per load level (:mod:`deformap.world._force_travel`), ``dent`` (the
+        press's own solve) the last. None under :data:`MIN_RECORD_FORCE_N`, and, with a warning,
+        where the solved indentations make no record (by a seam the FEM's indentation can fall
+        from one level to the next): that press is read by the camera alone.
         """
         target = check_vector("target_xy", target_xy, 2, what="metres")
         force = check_positive("force_n", force_n)
@@ -243,19 +200,15 @@ class SimulatedWorld:
         final = dent if dent is not None else self.dent(target, force)
         levels = force_levels(c.contact_threshold_n, force, c.force_travel_levels,
                               c.force_travel_spacing)
-
         depths = self._level_depths(target, levels, final)
-        noisy = c.noise
+        on = 1.0 if c.noise else 0.0
         try:
             return simulated_force_travel(
                 depths, levels, self._event_rng(*self._press_key(target, force, 2)),
-                encoder_noise_m=c.encoder_noise_m if noisy else 0.0,
-                force_noise_rel=c.force_travel_noise_rel if noisy else 0.0,
-                force_noise_n=c.force_travel_noise_n if noisy else 0.0)
+                encoder_noise_m=c.encoder_noise_m * on,
+                force_noise_rel=c.force_travel_noise_rel * on,
+                force_noise_n=c.force_travel_noise_n * on)
         except InvalidArgumentError as err:
-            # by a seam between two blocks the load samples cross into the next body as the patch
-            # grows, and the solved indentation can fall between levels; such a record is not
-            # the press's, and a robot without a record is read by its camera alone
             log.warning("no force–travel record for the press at %s with %g N: the solved "
                         "indentations %s mm are not a press's (%s)", tuple(np.round(target, 4)),
                         force, np.round(depths * 1e3, 2).tolist(), err)
@@ -263,21 +216,15 @@ class SimulatedWorld:
 
     def _level_depths(self, target: NDArray[np.float64], levels: NDArray[np.float64],
                       final: Dent) -> NDArray[np.float64]:
-        """The tip's indentation at each force of ``levels`` (increasing, ending at ``final``'s).
-
-        Solved from the top level down, each patch iteration started from the level above's patch
-        scaled as Hertz's ``a ∝ F^(1/3)``: close to its fixed point, so one or two solves a level
-        on the stiffness factorised when the world was built (the FEM), or a grid and mode shape
-        near the level's own (the stiffening foam). Each level's patch is bounded by the radius
-        of the level above (a press's contact grows with its force).
-        """
+        """The tip's indentation at each force of ``levels`` (increasing, ending at ``final``'s),
+        solved from the top down, each level's patch started from the level above's scaled as
+        Hertz's ``a ∝ F^(1/3)`` and bounded by its radius."""
         depths = np.empty(levels.size)
         depths[-1], patch = final.depth_m, final
         for k in range(levels.size - 2, -1, -1):
             start = patch.contact_radius_m * (levels[k] / levels[k + 1]) ** (1.0 / 3.0)
             patch = self.foam.dent(target, float(levels[k]), tip_radius_m=self.config.tip_radius_m,
-                                   initial_radius_m=start,
-                                   max_radius_m=patch.contact_radius_m)
+                                   initial_radius_m=start, max_radius_m=patch.contact_radius_m)
             depths[k] = patch.depth_m
         return depths
 
@@ -294,11 +241,8 @@ class SimulatedWorld:
         return self.scenario.per_block(xs, ys, [b.modulus_pa for b in self.regions])
 
     def surface_height(self, xs: Any, ys: Any, displacement: Any = None) -> NDArray[np.float64]:
-        """``(ny, nx)`` height of the top surface in metres, deformed by ``displacement``.
-
-        ``displacement`` is ``Dent.displacement`` (``(n_nodes, 3)``) or None for the rest shape.
-        Lateral displacement of the surface is neglected (it is a fraction of the vertical one).
-        """
+        """``(ny, nx)`` height of the top surface in metres, deformed vertically by
+        ``displacement`` (``Dent.displacement``, ``(n_nodes, 3)``; None: the rest shape)."""
         labels = self.ground_truth_labels(xs, ys)
         thickness = np.array([b.thickness_m for b in self.regions] + [0.0])
         height = thickness[labels]  # label -1 picks the table's 0
