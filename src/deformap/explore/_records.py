@@ -1,8 +1,7 @@
 """Typed records of an exploration: what one poke gave, and why a place was chosen.
 
-A poke's record is a frozen value built once, when the poke has entered the β-field; it becomes
-plain data only at the journal and report boundary (:meth:`PokeRecord.to_dict`) and comes back
-from a journal through :meth:`PokeRecord.from_dict`, which refuses a line that is not a poke.
+A record becomes plain data only at the journal and report boundary (:meth:`PokeRecord.to_dict`)
+and comes back through :meth:`PokeRecord.from_dict`, which refuses a line that is not a poke.
 """
 
 from __future__ import annotations
@@ -21,20 +20,12 @@ from deformap.explore._planning import PokePlan
 from deformap.msm import BetaEstimate
 from deformap.stiffness import LAYER_MODEL, StiffnessEstimate
 
-__all__ = [
-    "PURPOSES",
-    "ContactRecord",
-    "Dent",
-    "PokeRecord",
-    "PokeResult",
-    "PokeTimings",
-    "Purpose",
-    "Target",
-]
+__all__ = ["PURPOSES", "ContactRecord", "Dent", "PokeRecord", "PokeResult", "PokeTimings", "Purpose",
+           "Target"]
 
+#: Why a place was poked: the first poke, the strategy's (until the variance is under ``T_h``), or
+#: a boundary poke after it.
 Purpose = Literal["first", "variance", "boundary"]
-"""Why a place was poked: the configured first poke, the strategy's (until the β-field's variance
-is under ``T_h``), or a boundary poke after it."""
 PURPOSES: tuple[str, ...] = get_args(Purpose)
 
 
@@ -98,19 +89,13 @@ def _stiffness_from_dict(data: Any, where: str) -> StiffnessEstimate | None:
                for n in names - {"rigid", "n_samples", "model", "depth_m"}}  # fmt: skip
     model = _text(data, "model", where)
     try:
-        return _stiffness_estimate(data, numbers, model, where)
+        return StiffnessEstimate(
+            **numbers, depth_m=_number(data, "depth_m", where),
+            rigid=_number(data, "rigid", where, kind=bool),
+            n_samples=_number(data, "n_samples", where, kind=int),
+            model=LAYER_MODEL if model is None else model)
     except InvalidArgumentError as exc:
         raise FileFormatError(f"`{where}`: {exc}") from None
-
-
-def _stiffness_estimate(data: Mapping[str, Any], numbers: dict[str, Any], model: str | None,
-                        where: str) -> StiffnessEstimate:
-    return StiffnessEstimate(
-        **numbers, depth_m=_number(data, "depth_m", where),
-        rigid=_number(data, "rigid", where, kind=bool),
-        n_samples=_number(data, "n_samples", where, kind=int),
-        model=LAYER_MODEL if model is None else model,
-    )  # fmt: skip
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -145,13 +130,9 @@ class ContactRecord:
 
 @dataclass(frozen=True, kw_only=True)
 class PokeTimings:
-    """Seconds spent on one poke, by stage; a stage a poke did not pass through is ``None``.
-
-    ``filter_s`` crop and robot removal, ``touch_gp_s`` the dent's reconstruction, ``beta_s`` the
-    β estimate and its uncertainty, ``stiffness_s`` the force–travel fit, ``field_s`` the β-field
-    update, ``target_s`` choosing the place, ``environment_s`` the world or robot (or reading the
-    recording).
-    """
+    """Seconds spent on one poke, by stage (``None``: not passed through): crop and filter, the
+    dent's reconstruction, β, the force–travel fit, the field update, choosing the place, and the
+    world, robot or recording."""
 
     filter_s: float
     touch_gp_s: float
@@ -192,43 +173,37 @@ class PokeRecord:
     index : int
         The poke's place in its run, from 0.
     target_xy, contact_xy : (2,) float, metres
-        Where the poke was aimed, and where the tip touched (the β-field's input location).
+        Where the poke was aimed, and where the tip touched.
     force_n : float
         The commanded normal force.
     beta, beta_std : float
-        β̂ and its uncertainty (the β-field's noise for this poke, before the floor).
+        β̂ and its uncertainty (before the field's floor).
     betas, errors : tuple of float
-        The compared β and their shape-matching errors E(β) in metres.
+        The compared β and their errors E(β) in metres.
     iterations, residual, converged
-        The shape-matching solver's largest iteration count and residual, and whether every
-        compared β converged.
+        The solver's largest iteration count and residual, and whether every β converged.
     n_roi_points : int
         Cloud points of the ROI the dent was reconstructed from.
     camera_noise_m : float or None
         The camera's noise measured in the ROI (``None`` when β's uncertainty is not sampled).
     stiffness : StiffnessEstimate or None
-        Stiffness and Young's modulus from the press's force–travel record
-        (:func:`deformap.stiffness.estimate_stiffness`); ``None`` without a record.
+        The force–travel record's estimate; ``None`` without one.
     layer_thickness_m : float or None
-        The layer thickness the modulus was read with (the surface's height at the contact).
+        The layer thickness the modulus was read with.
     stiffness_error : str or None
-        Why a record that came with the press gave no estimate (the poke then stands on the
-        camera alone).
+        Why a record that came with the press gave no estimate.
     indentation_m : float or None
-        The indentation the tactile points were placed for: the force–travel record's (0 when
-        read rigid), else the tip's depth below the surface model (:mod:`deformap.explore._dent`).
+        The indentation the tactile points were placed for (:mod:`deformap.explore._dent`).
     depth_anchored : bool or None
-        Whether the tactile points' heights came from the record rather than the tip's height.
+        Whether the tactile points' heights came from the record.
     dent_visible : bool or None
-        Whether the camera saw the dent above its noise (``False``: β's σ was widened to that of
-        a uniform β; ``None`` when β's uncertainty is not the camera's noise).
+        Whether the camera saw the dent above its noise (``False``: σ widened to a uniform β's).
     purpose : {"first", "variance", "boundary"} or None
-        Why this place (``None`` outside the live loop: a replayed or single poke).
+        Why this place (``None`` outside the live loop).
     planned_after : int or None
-        Under ``planned``, how many more pokes the plan this target came from foresaw.
+        Under ``planned``, how many more pokes the plan foresaw.
     max_variance_after : float or None
-        The largest β-field variance where it must fall under ``T_h``, this poke included
-        (``None`` until the poke has entered a β-field).
+        The largest field variance where it must fall under ``T_h``, this poke included.
     """
 
     index: int
@@ -262,8 +237,7 @@ class PokeRecord:
         return np.asarray(self.contact_xy, dtype=float)
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain data for the journal and ``report.json`` (optional fields left out when unset,
-        ``camera_noise_m`` always written)."""
+        """Plain data for the journal and ``report.json`` (unset optional fields left out)."""
         out: dict[str, Any] = {
             "index": self.index, "target_xy": list(self.target_xy),
             "contact_xy": list(self.contact_xy), "contact": self.contact.to_dict(),
@@ -283,13 +257,8 @@ class PokeRecord:
 
     @classmethod
     def from_dict(cls, data: Any, *, where: str = "poke") -> PokeRecord:
-        """The record a journal line holds (:meth:`to_dict`'s form).
-
-        Raises
-        ------
-        FileFormatError
-            If a field is missing, of the wrong type or unknown; the message names it.
-        """
+        """The record a journal line holds; :class:`FileFormatError` naming a field that is
+        missing, of the wrong type or unknown."""
         if not isinstance(data, Mapping):
             raise FileFormatError(f"`{where}` must be a mapping; got {data!r}")
         names = {f.name for f in fields(cls)}
@@ -332,14 +301,10 @@ class PokeRecord:
 
 @dataclass(frozen=True, eq=False)
 class Dent:
-    """A poke's reconstructed dent on its ROI grid, for figures and recordings.
-
-    ``roi_xs (nx,)``, ``roi_ys (ny,)`` the ROI grid; ``rest_z``, ``deformed_z (ny, nx)`` the
-    surface before and while pressing (metres); ``roi_points (m, 3)`` the cloud points kept;
-    ``tactile (k, 3)`` the tactile points on the tip; ``force_travel`` the press's force–travel
-    record (``None`` without one) and ``force_fit (2, m)`` the curve its modulus was fitted with,
-    travel [m] and force [N] (``None`` without a modulus).
-    """
+    """A poke's reconstructed dent for figures and recordings: the ROI grid ``roi_xs (nx,)``,
+    ``roi_ys (ny,)``; heights ``rest_z``, ``deformed_z (ny, nx)`` before and while pressing;
+    ``roi_points (m, 3)`` and ``tactile (k, 3)``, metres; the press's ``force_travel`` record and
+    ``force_fit (2, m)``, travel [m] and force [N] of the fitted model (``None`` without)."""
 
     roi_xs: NDArray[np.float64]
     roi_ys: NDArray[np.float64]
@@ -353,8 +318,7 @@ class Dent:
 
 @dataclass(frozen=True, eq=False)
 class PokeResult:
-    """One processed poke: its record, and (when processed in this session, not resumed from a
-    journal) the dent it was estimated from and the full β estimate."""
+    """One processed poke: its record, and (unless resumed from a journal) its dent and estimate."""
 
     record: PokeRecord
     dent: Dent | None = None
@@ -368,11 +332,7 @@ class PokeResult:
 
 @dataclass(frozen=True, eq=False)
 class Target:
-    """The next place to poke and why.
-
-    ``xy (2,)`` metres; ``purpose`` as in :class:`PokeRecord`; ``plan`` the plan it came from
-    (strategy ``planned``), else ``None``.
-    """
+    """The next place to poke, ``xy (2,)`` metres, why, and the plan it came from (or ``None``)."""
 
     xy: NDArray[np.float64]
     purpose: Purpose
@@ -380,8 +340,7 @@ class Target:
 
     @property
     def planned_after(self) -> int | None:
-        """How many more pokes the plan foresees after this one (only a plan that reaches
-        ``T_h`` foresees any)."""
+        """How many more pokes a plan that reaches ``T_h`` foresees after this one."""
         if self.plan is None or not self.plan.reaches:
             return None
         return len(self.plan.targets) - 1
