@@ -30,8 +30,9 @@ class ShapeMatchingConfig:
     cluster_size : int
         Side ``k`` of the overlapping ``k × k`` particle clusters; 3 is the paper's best value.
     contact : {"force", "pinned"}
-        How the poke enters the simulation (:mod:`deformap.msm`).
-        ``"force"`` simulates the dent's depth per newton instead of copying it.
+        How the poke enters the simulation.
+        ``"pinned"`` is the paper's (:mod:`deformap.msm`); ``"force"`` simulates the dent's depth
+        per newton instead of copying it.
     n_beta : int
         Number of β of the coarse sweep ``β_j = j / n_beta`` over ``[0, 1)``.
         E(β) is smooth, so 10 values bracket its minimum.
