@@ -102,24 +102,20 @@ class TouchGPConfig:
     ----------
     roi_size_m : float
         Side of the square ROI centred on the poke, metres.
-        12 cm: a 1 cm tip dents foam over a few centimetres, and the ROI's fixed edges must be
-        undisturbed.
+        12 cm: a 1 cm tip dents foam over a few centimetres, inside the ROI's fixed edges.
     model : {"residual", "height"}
         What the touch GP models, heights or their change, metres.
-        ``residual`` (against the surface model) reverts far from the dent to "no change", not to
-        a constant the occlusion would bias; ``height`` is the paper's form.
+        ``residual`` reverts far from the dent to "no change"; ``height`` is the paper's form.
     n_tactile : int
         Tactile points per 30° cap of the tip, a count (the paper's 10).
     tactile_noise_std_m : float
         Noise standard deviation of tactile points on the tip's proprioceptive pose, metres.
     tactile_cap : {"contact", "fixed"}
         Which cap of the tip carries the tactile points.
-        ``contact``, the cap touching at δ (Hertz radius √(Rδ), :func:`deformap.cloud.contact_cap`),
-        or ``fixed``, the paper's 30° cap.
+        ``contact`` touches at δ (:func:`deformap.cloud.contact_cap`); ``fixed`` is the paper's.
     depth_anchor : {"record", "tip"}
         Where the tactile points' depth comes from, the record or the tip.
-        ``record`` hangs them from the surface model minus the record's indentation, so an error in
-        the tip's absolute height does not move the dent.
+        ``record``: the surface minus the record's indentation, blind to the tip's height error.
     dent_visible_sigmas : float
         Smallest visible dent, in standard deviations of the camera's mean height near the tip.
         2 is a one-sided test at about 98 %.
@@ -134,8 +130,7 @@ class TouchGPConfig:
         A dent goes down, so 1 cm higher is the stick, the hand or a flying pixel.
     max_slope_deg : float
         Steepest surface kept in the ROI, degrees from the horizontal.
-        It removes the flying-pixel veils behind the stick that hang lower than
-        ``above_surface_m``.
+        It removes the flying-pixel veils behind the stick below ``above_surface_m``.
     length_scale_m : float
         Length scale σ_w of the touch GP, metres.
         1 cm, the tip's radius: the dent cannot vary faster than the body pressing it.
@@ -181,8 +176,7 @@ class BetaFieldConfig:
     ----------
     signal_std : float
         Prior standard deviation σe of β about the pokes' weighted mean, dimensionless.
-        0.3: its variance 0.09 lies above the paper's ``T_h`` = 0.06, so an unexplored map asks for
-        a poke.
+        0.3: its variance 0.09 exceeds the paper's ``T_h`` = 0.06, so an unexplored map asks for a poke.
     length_scale_m : float
         Length scale σw of the β-field, metres.
         0.2 m, a third of a table, is the size of the pieces a robot is asked to tell apart.
@@ -191,8 +185,7 @@ class BetaFieldConfig:
         The quantisation ``beta_resolution / √12`` is what every β̂'s σ already is at least.
     nugget : {"within-class", "off"}
         How the nugget τ̂, in β units, is estimated.
-        ``within-class``: the REML scatter within the region test's classes
-        (:mod:`deformap.explore._nugget`); ``off``: τ̂ = 0.
+        ``within-class`` (:mod:`deformap.explore._nugget`) or ``off`` (τ̂ = 0).
     """
 
     signal_std: float = setting(0.3, gt=0.0)
@@ -212,8 +205,7 @@ class ModulusFieldConfig:
     ----------
     signal_std : float
         Prior standard deviation of ln E about the pokes' weighted mean, ln Pa.
-        1.73, a quarter of ln(10⁶ / 10³): ±2σ spans the 1 kPa to 1 MPa of soft foams to rubbers
-        (Gibson & Ashby 1997, ch. 5).
+        1.73: ±2σ spans the 1 kPa to 1 MPa of soft foams to rubbers (Gibson & Ashby 1997, ch. 5).
     length_scale_m : float
         Length scale σ_w of the modulus field, metres.
         The β-field's, for its reason: the pieces' size is a property of the layout.

@@ -238,21 +238,17 @@ class PokeRecord:
 
     def to_dict(self) -> dict[str, Any]:
         """Plain data for the journal and ``report.json`` (unset optional fields left out)."""
-        out: dict[str, Any] = {
-            "index": self.index, "target_xy": list(self.target_xy),
-            "contact_xy": list(self.contact_xy), "contact": self.contact.to_dict(),
-            "force_n": self.force_n, "beta": self.beta, "beta_std": self.beta_std,
-            "betas": list(self.betas), "errors": list(self.errors),
-            "iterations": self.iterations, "residual": self.residual,
-            "converged": self.converged, "n_roi_points": self.n_roi_points,
-            "camera_noise_m": self.camera_noise_m, "timings": self.timings.to_dict(),
-        }  # fmt: skip
-        if self.stiffness is not None:
-            out["stiffness"] = _stiffness_to_dict(self.stiffness)
-        for name in ("layer_thickness_m", "stiffness_error", "indentation_m", "depth_anchored",
-                     "dent_visible", "purpose", "planned_after", "max_variance_after"):
-            if getattr(self, name) is not None:
-                out[name] = getattr(self, name)
+        out: dict[str, Any] = {}
+        for f in fields(self):
+            value = getattr(self, f.name)
+            if isinstance(value, tuple):
+                value = list(value)
+            elif isinstance(value, (ContactRecord, PokeTimings)):
+                value = value.to_dict()
+            elif isinstance(value, StiffnessEstimate):
+                value = _stiffness_to_dict(value)
+            if value is not None or f.name == "camera_noise_m":
+                out[f.name] = value
         return out
 
     @classmethod

@@ -31,8 +31,7 @@ class ShapeMatchingConfig:
         Side ``k`` of the overlapping ``k × k`` particle clusters; 3 is the paper's best value.
     contact : {"force", "pinned"}
         How the poke enters the simulation.
-        ``"pinned"`` is the paper's (:mod:`deformap.msm`); ``"force"`` simulates the dent's depth
-        per newton instead of copying it.
+        ``"force"`` simulates the dent's depth per newton instead of copying it (:mod:`deformap.msm`).
     n_beta : int
         Number of β of the coarse sweep ``β_j = j / n_beta`` over ``[0, 1)``.
         E(β) is smooth, so 10 values bracket its minimum.
@@ -42,8 +41,7 @@ class ShapeMatchingConfig:
         Step of the local refinement (dimensionless).
     tol : float
         Relative fixed-point tolerance of every β the refinement compares.
-        Iteration stops when the largest particle update is below ``tol`` times the largest
-        displacement from rest (or the particle spacing when nothing moved).
+        The largest particle update is compared with the largest displacement from rest.
     sweep_tol : float
         Tolerance of the coarse sweep and the stiffness calibration under ``refine`` (≥ ``tol``).
         The sweep only brackets the minimum; a swept β the refinement compares is solved again.
@@ -51,8 +49,7 @@ class ShapeMatchingConfig:
         Iteration cap; a β that hits it is reported as not converged.
     regularization : float
         Relative eigenvalue cut-off of each cluster's moment matrix.
-        It keeps the rest shape an exact fixed point and affine / quadratic deformations exact at
-        β = 1.
+        It keeps the rest shape a fixed point and affine / quadratic deformations exact at β = 1.
     reference_modulus_pa : float, pascals
         Young's modulus of the half-space whose Hertz dent calibrates the spring stiffness ``k``.
         100 kPa lies above the stiffest polyurethane foams and below rubbers.
@@ -71,8 +68,7 @@ class ShapeMatchingConfig:
         See :mod:`deformap.msm._uncertainty`.
     bootstrap_tile_m : float, metres
         Side of the resampled blocks.
-        2 cm, twice the tip radius and the touch GP's length scale, keeps correlated neighbours
-        together.
+        2 cm, twice the tip radius and the touch GP's length scale, keeps neighbours together.
     error_tolerance_m : float, metres
         Tolerance on E(β) of the ``"tolerance"`` uncertainty, of the order of the touch GP's error.
     """
