@@ -168,17 +168,9 @@ def _split(b: NDArray, s: NDArray, group: NDArray, room: int, *, min_step: float
     return None
 
 
-def segment_regions(
-    beta_grid: NDArray[np.float64],
-    poke_beta: NDArray[np.float64],
-    poke_std: NDArray[np.float64],
-    *,
-    floor: float = 0.03,
-    min_step: float = 0.05,
-    z: float = 2.0,
-    max_regions: int = 6,
-    prior_dof: float = 7.0,
-) -> RegionMap:
+def segment_regions(beta_grid: NDArray[np.float64], poke_beta: NDArray[np.float64],
+                    poke_std: NDArray[np.float64], *, floor: float = 0.03, min_step: float = 0.05,
+                    z: float = 2.0, max_regions: int = 6, prior_dof: float = 7.0) -> RegionMap:
     """Label the cells of ``beta_grid (ny, nx)`` (the field's mean) by isopleths chosen from the
     pokes' estimates ``poke_beta (k,)`` and uncertainties ``poke_std (k,)`` (module docstring:
     ``floor``, ``min_step``, ``z``, ``prior_dof``; at most ``max_regions`` classes)."""

@@ -180,10 +180,9 @@ def measure_press(obs: PressObservation, index: int, surface: SurfaceModel,
     target = data[:, 2]
     if cfg.model == "residual":
         target = target - np.concatenate([rest_at, surface.gp.predict(tactile[:, :2])])
-    touch = GaussianRandomField(
-        length_scale=cfg.length_scale_m, signal_std=cfg.signal_std_m,
-        noise_std=cfg.noise_std_m, method="auto",
-    ).fit(data[:, :2], target, noise_std=noise)  # fmt: skip
+    touch = GaussianRandomField(length_scale=cfg.length_scale_m, signal_std=cfg.signal_std_m,
+                                noise_std=cfg.noise_std_m, method="auto",
+                                ).fit(data[:, :2], target, noise_std=noise)  # fmt: skip
     deformed_z = np.asarray(touch.predict_grid(roi_xs, roi_ys))
     if cfg.model == "residual":
         deformed_z = deformed_z + rest_z

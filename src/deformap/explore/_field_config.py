@@ -88,9 +88,7 @@ class SurfaceGPConfig:
     def __post_init__(self) -> None:
         check_settings(self)
         if self.z_max_m <= self.z_min_m:
-            raise SettingError(
-                "z_max_m", f"must exceed `z_min_m` ({self.z_min_m}); got {self.z_max_m}"
-            )
+            raise SettingError("z_max_m", f"must exceed `z_min_m` ({self.z_min_m}); got {self.z_max_m}")
 
 
 @dataclass(frozen=True, kw_only=True)

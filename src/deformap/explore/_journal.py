@@ -91,9 +91,8 @@ class Journal:
         stored = {k: v for k, v in contents.header.items() if k != "kind"}
         if stored != json.loads(json.dumps(header)):
             differing = sorted(k for k in set(stored) | set(header) if stored.get(k) != header.get(k))
-            raise ConfigError(
-                f"cannot resume {str(Path(folder))!r}: its run differs from this one in {differing}"
-            )
+            raise ConfigError(f"cannot resume {str(Path(folder))!r}: its run differs from this one "
+                              f"in {differing}")
         journal = cls(path)
         if contents.broken_line is not None:
             journal._rewrite(contents)

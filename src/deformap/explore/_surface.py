@@ -58,10 +58,9 @@ def fit_surface(cloud: PointCloud, workspace: Workspace, xs: NDArray[np.float64]
     """
     pts = crop_to(cloud.points, workspace.lower, workspace.upper, config)
     if pts.shape[0] <= config.outlier_k:
-        raise InvalidArgumentError(
-            f"`cloud` must have more than {config.outlier_k} points on the workspace; "
-            f"got {pts.shape[0]} (is it in the world frame, in metres?)"
-        )
+        raise InvalidArgumentError(f"`cloud` must have more than {config.outlier_k} points on the "
+                                   f"workspace; got {pts.shape[0]} (is it in the world frame, in "
+                                   "metres?)")
     kept = pts[statistical_outlier_mask(pts, config.outlier_k, config.outlier_std_ratio)]
     if kept.shape[0] >= config.outlier_k:
         kept = kept[height_field_mask(kept, config.outlier_k, config.max_slope_deg)]
@@ -71,12 +70,10 @@ def fit_surface(cloud: PointCloud, workspace: Workspace, xs: NDArray[np.float64]
     if config.fit_hyperparameters:
         bounds = default_bounds(kept[:, :2], kept[:, 2])
         bounds[0] = np.maximum(bounds[0], config.min_length_scale_m)
-        hyper = fit_hyperparameters(kept[:, :2], kept[:, 2], rng=rng, init=init,
-                                    max_points=config.max_fit_points,
-                                    n_restarts=config.fit_restarts, bounds=bounds)  # fmt: skip
-    gp = GaussianRandomField(
-        length_scale=hyper.length_scale, signal_std=hyper.signal_std, noise_std=hyper.noise_std
-    ).fit(kept[:, :2], kept[:, 2])
+        hyper = fit_hyperparameters(kept[:, :2], kept[:, 2], rng=rng, init=init, bounds=bounds,
+                                    max_points=config.max_fit_points, n_restarts=config.fit_restarts)
+    gp = GaussianRandomField(length_scale=hyper.length_scale, signal_std=hyper.signal_std,
+                             noise_std=hyper.noise_std).fit(kept[:, :2], kept[:, 2])
     height, std = gp.predict_grid(xs, ys, return_std=True)
     logger.info("surface GP: %d of %d points kept, %s", kept.shape[0], len(cloud), hyper)
     return SurfaceModel(gp, hyper, height, std, cloud.points.shape[0], kept)

@@ -62,9 +62,8 @@ class Clusters:
         nd = len(self.shape)
         v = sliding_window_view(x, self.window, axis=tuple(range(1, nd + 1)))
         b, d = x.shape[0], x.shape[-1]
-        return np.ascontiguousarray(
-            v.reshape(b, self.n_clusters, d, self.n_members).transpose(0, 1, 3, 2)
-        )
+        v = v.reshape(b, self.n_clusters, d, self.n_members)
+        return np.ascontiguousarray(v.transpose(0, 1, 3, 2))
 
     def scatter(self, vals: Array) -> Array:
         """Sum ``(B, C, km, d)`` per-(cluster, member) values onto particles ``(B, *grid, d)``."""

@@ -120,6 +120,4 @@ class ShapeMatchingConfig:
     def __post_init__(self) -> None:
         check_settings(self)
         if self.sweep_tol < self.tol:
-            raise SettingError(
-                "sweep_tol", f"must be >= `tol` ({self.tol:g}); got {self.sweep_tol:g}"
-            )
+            raise SettingError("sweep_tol", f"must be >= `tol` ({self.tol:g}); got {self.sweep_tol:g}")

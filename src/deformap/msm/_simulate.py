@@ -46,10 +46,8 @@ def _check_config(config: Any) -> ShapeMatchingConfig:
 def _check_rest(rest: Any, k: int) -> Array:
     arr = check_array("rest", rest, (None, None, 3), what="particle positions in metres")
     if arr.shape[0] < k or arr.shape[1] < k:
-        raise InvalidArgumentError(
-            f"`rest` must hold at least cluster_size × cluster_size = {k}×{k} particles; "
-            f"got a {arr.shape[0]}×{arr.shape[1]} grid"
-        )
+        raise InvalidArgumentError(f"`rest` must hold at least cluster_size × cluster_size = {k}×{k} "
+                                   f"particles; got a {arr.shape[0]}×{arr.shape[1]} grid")
     return arr
 
 
@@ -81,14 +79,12 @@ def _check_contact(contact: Any, rest: Array, fixed: NDArray[np.bool_], spacing:
         raise InvalidArgumentError(
             f"`contact` must press inside the ROI [{lo[0] + spacing:.4f}, {hi[0] - spacing:.4f}] × "
             f"[{lo[1] + spacing:.4f}, {hi[1] - spacing:.4f}] m; got contact point xy "
-            f"({cp[0]:.4f}, {cp[1]:.4f})"
-        )
+            f"({cp[0]:.4f}, {cp[1]:.4f})")
     near = int(np.argmin(np.sum((rest[..., :2] - cp[:2]) ** 2, axis=-1)))
     if fixed.ravel()[near]:
         raise InvalidArgumentError(
             "`contact` presses on the ROI's fixed edge (its nearest particle is held at rest); "
-            "centre the ROI on the contact"
-        )
+            "centre the ROI on the contact")
     return near
 
 
@@ -135,10 +131,8 @@ class PokeModel:
             raise InvalidArgumentError(f"`masses` must be > 0; got minimum {m.min()}")
         fx = np.asarray(fixed)
         if fx.shape != p0.shape[:2] or fx.dtype != np.bool_:
-            raise InvalidArgumentError(
-                f"`fixed` must be a {p0.shape[:2]} bool array; got {np.asarray(fixed).dtype} "
-                f"array of shape {fx.shape}"
-            )
+            raise InvalidArgumentError(f"`fixed` must be a {p0.shape[:2]} bool array; got "
+                                       f"{np.asarray(fixed).dtype} array of shape {fx.shape}")
         if stiffness_n_per_m is not None:
             check_positive("stiffness_n_per_m", stiffness_n_per_m)
         self.cfg = cfg
