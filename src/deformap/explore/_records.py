@@ -72,19 +72,22 @@ def _text(data: Mapping[str, Any], key: str, where: str) -> str | None:
     return value
 
 
-def _stiffness_to_dict(estimate: StiffnessEstimate) -> dict[str, Any]:
-    return {f.name: getattr(estimate, f.name) for f in fields(estimate)}
+def _mapping(data: Any, where: str, cls: type | None = None, *, also: frozenset[str] = frozenset()
+             ) -> Mapping[str, Any]:
+    """``data`` if it is a mapping holding no key but ``cls``'s fields (and ``also``)."""
+    if not isinstance(data, Mapping):
+        raise FileFormatError(f"`{where}` must be a mapping; got {data!r}")
+    unknown = [] if cls is None else sorted(set(data) - {f.name for f in fields(cls)} - also)
+    if unknown:
+        raise FileFormatError(f"`{where}` has unknown key(s) {unknown}")
+    return data
 
 
 def _stiffness_from_dict(data: Any, where: str) -> StiffnessEstimate | None:
     if data is None:
         return None
-    if not isinstance(data, Mapping):
-        raise FileFormatError(f"`{where}` must be a mapping; got {data!r}")
+    data = _mapping(data, where, StiffnessEstimate)
     names = {f.name for f in fields(StiffnessEstimate)}
-    unknown = sorted(set(data) - names)
-    if unknown:
-        raise FileFormatError(f"`{where}` has unknown key(s) {unknown}")
     numbers = {n: _number(data, n, where, optional=True)
                for n in names - {"rigid", "n_samples", "model", "depth_m"}}  # fmt: skip
     model = _text(data, "model", where)
@@ -119,8 +122,7 @@ class ContactRecord:
 
     @classmethod
     def from_dict(cls, data: Any, where: str) -> ContactRecord:
-        if not isinstance(data, Mapping):
-            raise FileFormatError(f"`{where}` must be a mapping; got {data!r}")
+        data = _mapping(data, where)
         center = _floats(data.get("tip_center"), 3, f"{where}.tip_center")
         force = _floats(data.get("force"), 3, f"{where}.force")
         return cls(tip_center=(center[0], center[1], center[2]),
@@ -154,12 +156,8 @@ class PokeTimings:
 
     @classmethod
     def from_dict(cls, data: Any, where: str) -> PokeTimings:
-        if not isinstance(data, Mapping):
-            raise FileFormatError(f"`{where}` must be a mapping; got {data!r}")
+        data = _mapping(data, where, cls)
         names = [f.name for f in fields(cls)]
-        unknown = sorted(set(data) - set(names))
-        if unknown:
-            raise FileFormatError(f"`{where}` has unknown key(s) {unknown}")
         required = ("filter_s", "touch_gp_s", "beta_s")
         return cls(**{n: _number(data, n, where, optional=n not in required) for n in names})
 
@@ -246,7 +244,7 @@ class PokeRecord:
             elif isinstance(value, (ContactRecord, PokeTimings)):
                 value = value.to_dict()
             elif isinstance(value, StiffnessEstimate):
-                value = _stiffness_to_dict(value)
+                value = {g.name: getattr(value, g.name) for g in fields(value)}
             if value is not None or f.name == "camera_noise_m":
                 out[f.name] = value
         return out
@@ -255,12 +253,7 @@ class PokeRecord:
     def from_dict(cls, data: Any, *, where: str = "poke") -> PokeRecord:
         """The record a journal line holds; :class:`FileFormatError` naming a field that is
         missing, of the wrong type or unknown."""
-        if not isinstance(data, Mapping):
-            raise FileFormatError(f"`{where}` must be a mapping; got {data!r}")
-        names = {f.name for f in fields(cls)}
-        unknown = sorted(set(data) - names - {"kind"})
-        if unknown:
-            raise FileFormatError(f"`{where}` has unknown key(s) {unknown}")
+        data = _mapping(data, where, cls, also=frozenset({"kind"}))
         purpose = data.get("purpose")
         if purpose is not None and purpose not in PURPOSES:
             raise FileFormatError(f"`{where}.purpose` must be one of {list(PURPOSES)}; "
