@@ -96,14 +96,13 @@ class Equilibrium:
                  system: StepMatrices | None = None, max_split: float = 0.0,
                  load_scale: Array | None = None):
         self.cl, self.betas = clusters, np.asarray(betas, dtype=float)
-        # the share of the force each β's body carries (``ShapeMatchingConfig.beta_scale``)
+        # the share of the force each β's body carries
         self.load_scale = (np.ones_like(self.betas) if load_scale is None
                            else np.asarray(load_scale, dtype=float))
         self.system = StepMatrices(clusters, fixed) if system is None else system
         self.free, self.fix = self.system.free, self.system.fix
         if self.system.rigid:
-            self.rot_weight = np.ones_like(self.betas)
-            self.fit_weight = np.zeros_like(self.betas)
+            self.rot_weight, self.fit_weight = np.ones_like(self.betas), np.zeros_like(self.betas)
         else:
             self.rot_weight, self.fit_weight = 1.0 - self.betas, self.betas.copy()
         # the factorisation each β steps with (:meth:`StepMatrices.prepare`); the splitting's
@@ -161,20 +160,13 @@ class Equilibrium:
         x_free = np.take(x, self.free, axis=1)
         rest_free = np.take(rest, self.free, axis=0)
         nf = len(self.free) * 3
-        iters = np.zeros(nb, dtype=np.int64)
-        resid = np.full(nb, np.inf)
-        hist_f = np.zeros((nb, memory, nf))
-        hist_g = np.zeros((nb, memory, nf))
-        n_hist = np.zeros(nb, dtype=np.int64)
-        prev_f = np.zeros((nb, nf))
-        prev_g = np.zeros((nb, nf))
-        # residual at the last accepted point, and whether the current point is an Anderson
-        # extrapolation (and not a plain step) from it
-        accepted_r = np.full(nb, np.inf)
-        mixed = np.zeros(nb, dtype=bool)
-        # plain steps still to take before mixing again, and consecutive rejections
-        wait = np.zeros(nb, dtype=np.int64)
-        rejected = np.zeros(nb, dtype=np.int64)
+        iters, resid = np.zeros(nb, dtype=np.int64), np.full(nb, np.inf)
+        hist_f, hist_g = np.zeros((nb, memory, nf)), np.zeros((nb, memory, nf))
+        prev_f, prev_g = np.zeros((nb, nf)), np.zeros((nb, nf))
+        # residual at the last accepted point; whether the current point is an extrapolation
+        accepted_r, mixed = np.full(nb, np.inf), np.zeros(nb, dtype=bool)
+        # history length, plain steps still to take before mixing again, consecutive rejections
+        n_hist, wait, rejected = (np.zeros(nb, dtype=np.int64) for _ in range(3))
         active = np.arange(nb)
         floor = 1e-6 * spacing
         stop = tol * (1.0 - self.split)
