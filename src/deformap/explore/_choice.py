@@ -32,17 +32,9 @@ def unread_radius_m(config: ExplorationConfig) -> float:
 class FieldChoice:
     """The field a run maps on after its latest poke, and why.
 
-    Attributes
-    ----------
-    name : {"beta", "modulus"}
-    grid : MapGrid
-        The map's grid without the unread places' discs.
-    fallback : str or None
-        Why the run maps on β although it asked for the modulus field.
-    unread_places : tuple of (x, y)
-        The presses [m] of the places whose modulus could not be read twice.
-    given_up : str or None
-        Why the run maps on β for good.
+    ``name`` is ``"beta"`` or ``"modulus"``; ``grid`` the map's grid without the discs of the
+    ``unread_places``, the presses [m] where the modulus could not be read twice; ``fallback`` why
+    the run maps on β although it asked for the modulus field; ``given_up`` why it does for good.
     """
 
     name: FieldName

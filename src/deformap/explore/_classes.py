@@ -51,16 +51,10 @@ REGION_Z = 2.0
 class RegionMap:
     """Regions of a field on a grid.
 
-    Attributes
-    ----------
-    labels : (ny, nx) int
-        Region of each cell, 0 for the lowest band of the field upwards.
-    levels : (n_regions - 1,) float
-        The isopleths between bands, increasing.
-    class_betas : (n_regions,) float
-        Mean value of the pokes in each class (β, or ln E [ln Pa]).
-    poke_labels : (k,) int
-        The class of each poke, in the order given (not always the band its value falls in).
+    ``labels (ny, nx)``: each cell's region, from the field's lowest band up; ``levels
+    (n_regions - 1,)``: the isopleths, increasing; ``class_betas (n_regions,)``: each class's mean
+    value (β, or ln E [ln Pa]); ``poke_labels (k,)``: each poke's class, in the order given (not
+    always the band its value falls in).
     """
 
     labels: NDArray[np.int64]

@@ -38,16 +38,10 @@ def _strided(nx: int, ny: int, step_m: float, spacing_m: float,
 class MapGrid:
     """Cells of the workspace at the surface grid's spacing, and the masks over them.
 
-    Attributes
-    ----------
-    xs : (nx,) float, ys : (ny,) float, metres
-        Cell centres; every map of the run is ``(ny, nx)``.
-    cells_xy : (ny * nx, 2) float
-        The cells in row-major order.
-    target_mask, stop_mask : (ny * nx,) bool
-        Cells a poke may be centred on, and whose variance must fall under ``T_h``.
-    plan_domain, plan_candidates : (d, 2), (c, 2) float
-        The planner's lattices of ``stop_mask`` and ``target_mask`` cells.
+    ``xs (nx,)``, ``ys (ny,)`` [m] the cell centres (every map is ``(ny, nx)``); ``cells_xy
+    (ny * nx, 2)`` row-major; ``target_mask``, ``stop_mask`` the cells a poke may be centred on and
+    whose variance must fall under ``T_h``; ``plan_domain (d, 2)``, ``plan_candidates (c, 2)`` the
+    planner's lattices of them.
     """
 
     xs: NDArray[np.float64]

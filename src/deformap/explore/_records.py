@@ -166,42 +166,17 @@ class PokeTimings:
 class PokeRecord:
     """What one poke gave: where, the contact, β with its uncertainty and E(β), and timings.
 
-    Attributes
-    ----------
-    index : int
-        The poke's place in its run, from 0.
-    target_xy, contact_xy : (2,) float, metres
-        Where the poke was aimed, and where the tip touched.
-    force_n : float
-        The commanded normal force.
-    beta, beta_std : float
-        β̂ and its uncertainty (before the field's floor).
-    betas, errors : tuple of float
-        The compared β and their errors E(β) in metres.
-    iterations, residual, converged
-        The solver's largest iteration count and residual, and whether every β converged.
-    n_roi_points : int
-        Cloud points of the ROI the dent was reconstructed from.
-    camera_noise_m : float or None
-        The camera's noise measured in the ROI (``None`` when β's uncertainty is not sampled).
-    stiffness : StiffnessEstimate or None
-        The force–travel record's estimate; ``None`` without one.
-    layer_thickness_m : float or None
-        The layer thickness the modulus was read with.
-    stiffness_error : str or None
-        Why a record that came with the press gave no estimate.
-    indentation_m : float or None
-        The indentation the tactile points were placed for (:mod:`deformap.explore._dent`).
-    depth_anchored : bool or None
-        Whether the tactile points' heights came from the record.
-    dent_visible : bool or None
-        Whether the camera saw the dent above its noise (``False``: σ widened to a uniform β's).
-    purpose : {"first", "variance", "boundary"} or None
-        Why this place (``None`` outside the live loop).
-    planned_after : int or None
-        Under ``planned``, how many more pokes the plan foresaw.
-    max_variance_after : float or None
-        The largest field variance where it must fall under ``T_h``, this poke included.
+    ``index`` from 0 in its run; ``target_xy`` and ``contact_xy`` [m] where the poke was aimed
+    and touched; ``force_n`` the commanded force; ``beta``, ``beta_std`` β̂ and its σ (before the
+    field's floor); ``betas``, ``errors`` the compared β and E(β) [m]; ``iterations``,
+    ``residual``, ``converged`` the solver's worst; ``n_roi_points`` the ROI's cloud points;
+    ``camera_noise_m`` the camera's measured noise. Optional (``None`` when not applicable): the
+    record's ``stiffness`` estimate, the ``layer_thickness_m`` it was read with, or why it gave
+    none (``stiffness_error``); the ``indentation_m`` the tactile points were placed for, whether
+    their depth came from the record (``depth_anchored``); whether the camera saw the dent
+    (``dent_visible``; ``False`` widens σ to a uniform β's); the ``purpose``; how many more pokes
+    a plan foresaw (``planned_after``); the largest field variance where it must fall under
+    ``T_h`` after this poke (``max_variance_after``).
     """
 
     index: int

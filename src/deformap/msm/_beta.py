@@ -35,22 +35,11 @@ _TIE_M = 1e-9  # E values within a nanometre are ties (round-off): β̂ is the m
 class BetaEstimate:
     """Result of :func:`estimate_beta`.
 
-    Parameters
-    ----------
-    beta : float
-        β̂, the minimiser of E(β) over the converged β solved to ``config.tol`` (over all of
-        them if none converged); ties within 1 nm go to the most rigid β.
-    beta_std : float
-        Standard deviation of β̂, at least ``beta_resolution / √12``.
-    betas, errors : (n,) float
-        Every β simulated, sorted, and E(β) in metres.
-    iterations, residual, converged, tolerances : (n,)
-        Each β's last solve (:class:`PokeSimulation`) and the relative tolerance it was solved to.
-    protocol, mode : str
-    stiffness_n_per_m : float or None
-        Calibrated spring stiffness of the force protocol.
-    surface : (ny, nx, 3) float, metres, or None
-        The simulated surface particles at β̂.
+    ``beta`` minimises E(β) over the converged β solved to ``config.tol`` (over all of them if
+    none converged; ties within 1 nm go to the most rigid); ``beta_std`` is at least
+    ``beta_resolution / √12``. ``betas (n,)``, sorted, and ``errors`` E(β) [m], with each β's last
+    solve (:class:`PokeSimulation`) and its ``tolerances``; ``stiffness_n_per_m`` the force
+    protocol's; ``surface (ny, nx, 3)`` [m] the simulated surface particles at β̂.
     """
 
     beta: float

@@ -8,11 +8,6 @@ exactly: the fit is written ``A q = s + Π (x − p⁰)``, ``Π`` the cluster's 
 onto its feature span (Müller's ``A_pq A_qq⁻¹`` with an exact inverse; with the truncated one the
 rest shape stays a fixed point), and the quadratic features are centred on the cluster like ``s``
 (the goal ``T q̃ + t`` has no intercept, so β = 1 reproduces a quadratic deformation).
-
-References
-----------
-Müller, M., Heidelberger, B., Teschner, M., Gross, M. (2005). Meshless deformations based on
-shape matching. ACM Transactions on Graphics 24(3), 471–478.
 """
 
 from __future__ import annotations

@@ -24,19 +24,9 @@ def _check_axis(name: str, value: Any) -> NDArray[np.float64]:
 
 @dataclass(frozen=True, kw_only=True)
 class ParticleGrid:
-    """Particles on a regular ``(ny, nx)`` grid: one per heightmap cell.
-
-    Parameters
-    ----------
-    rest : (ny, nx, 3) float, metres
-        Rest positions ``p⁰`` (row ``i`` is ``ys[i]``, column ``j`` is ``xs[j]``).
-    masses : (ny, nx) float
-        Equal masses ``Δx·Δy``: only their ratios within a cluster matter.
-    fixed : (ny, nx) bool
-        Particles held at rest: the ROI's outer ring.
-    spacing_m : float
-        Mean particle spacing ``h``.
-    """
+    """Particles on a regular ``(ny, nx)`` grid, one per heightmap cell: rest positions
+    ``rest (ny, nx, 3)`` metres (row ``i`` at ``ys[i]``), equal ``masses`` ``Δx·Δy`` (only their
+    ratios matter), the ``fixed`` outer ring and the mean spacing ``spacing_m``."""
 
     rest: NDArray[np.float64]
     masses: NDArray[np.float64]

@@ -18,7 +18,6 @@ solved exactly), accelerated by Anderson mixing (Walker & Ni 2011).
 
 References
 ----------
-Müller, M. et al. (2005). Meshless deformations based on shape matching. ACM TOG 24(3).
 Bouaziz, S. et al. (2014). Projective dynamics: fusing constraint projections for fast simulation.
 ACM TOG 33(4).
 Walker, H. F., Ni, P. (2011). Anderson acceleration for fixed-point iterations. SIAM J. Numer.
@@ -54,14 +53,11 @@ class PokeSimulation:
 
     Parameters
     ----------
-    betas : (B,) float
+    betas, iterations, residual, converged : (B,)
+        Each β's iterations, last relative update (largest move over largest displacement) and
+        whether it fell below the tolerance within ``config.max_iter`` (:meth:`Equilibrium.solve`).
     positions : (B, ny, nx, 3) float, metres
         Particle positions at equilibrium.
-    iterations : (B,) int
-    residual : (B,) float
-        Last relative fixed-point update (largest particle move over the largest displacement).
-    converged : (B,) bool
-        ``residual`` below the tolerance before ``config.max_iter`` (:meth:`Equilibrium.solve`).
     protocol : str
     stiffness_n_per_m : float or None
         Calibrated particle spring stiffness ``k`` (force protocol).

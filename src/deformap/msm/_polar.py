@@ -6,8 +6,6 @@ References
 ----------
 Higham, N. J. (1986). Computing the polar decomposition — with applications. SIAM J. Sci.
 Stat. Comput. 7(4), 1160–1174.
-Müller, M., Heidelberger, B., Teschner, M., Gross, M. (2005). Meshless deformations based on
-shape matching. ACM Transactions on Graphics 24(3), 471–478.
 """
 
 from __future__ import annotations

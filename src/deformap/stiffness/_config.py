@@ -59,33 +59,15 @@ class StiffnessConfig:
 @dataclass(frozen=True, kw_only=True)
 class StiffnessEstimate:
     """What one force–travel record says about the surface, in SI units; the read fields are
-    ``None`` when rigid.
+    ``None`` when ``rigid`` (stiffer than the probe and arm can tell apart).
 
-    Parameters
-    ----------
-    stiffness_n_per_m, stiffness_std_n_per_m : float or None
-        ``k = dF/dδ`` at the commanded force and its standard deviation.
-    stiffness_lower_n_per_m : float or None
-        When rigid, a lower bound on ``k``; otherwise ``None``.
-    modulus_pa, modulus_std_pa : float or None
-        Young's modulus from the contact model and its standard deviation.
-    contact_offset_m : float or None
-        The fitted indentation ``δ₀`` at zero travel.
-    depth_m : float
-        Indentation ``δ_c`` at the commanded force; when rigid, the travel span.
-    max_chi : float or None
-        ``√(R δ_c) / h``: the contact model holds for ``χ ≲ 1``.
-    reduced_chi2 : float or None
-        The fit's χ² per degree of freedom (about 1 when model and noise explain the record).
-    rigid : bool
-        The surface is stiffer than the probe and arm can tell apart.
-    n_samples : int
-        Samples the estimate used (those within the tip's radius).
-    model : str
-        The contact model (:data:`LAYER_MODEL`).
-    model_error_pa : float or None
-        The model-error part of ``modulus_std_pa`` (:mod:`deformap.stiffness`, Model error);
-        ``None`` when rigid or under four samples.
+    ``stiffness_n_per_m`` ``k = dF/dδ`` at the commanded force, ``modulus_pa`` E, and their
+    standard deviations; ``stiffness_lower_n_per_m`` a lower bound on ``k`` when rigid;
+    ``contact_offset_m`` the fitted ``δ₀``; ``depth_m`` the indentation ``δ_c`` at the commanded
+    force (when rigid, the travel span); ``max_chi`` ``√(R δ_c) / h`` (the model holds for
+    ``χ ≲ 1``); ``reduced_chi2`` the fit's χ² per degree of freedom; ``n_samples`` the samples
+    used; ``model`` :data:`LAYER_MODEL`; ``model_error_pa`` the model-error part of
+    ``modulus_std_pa`` (``None`` when rigid or under four samples).
     """
 
     stiffness_n_per_m: float | None
