@@ -1,8 +1,8 @@
 """The region test: classes of the pokes' values on the map field (β, or ln E), and the
 isopleths between them.
 
-The levels are chosen from the pokes' own estimates (the field's posterior is smoothed toward
-neighbours, which fills the gaps between classes) by divisive splitting with a calibrated test:
+The levels are chosen from the pokes' own estimates (the posterior's smoothing fills the gaps
+between classes) by divisive splitting with a calibrated test:
 
 1. The best split of a sorted group into a lower and an upper part explains the largest share of
    its spread (Fisher 1958): between-part sum of squares B, within-part W.

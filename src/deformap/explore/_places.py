@@ -167,7 +167,6 @@ def split_by_place(found: RegionMap, mean: NDArray[np.float64], poke_xy: NDArray
                           > reach[members, None], axis=1)
             if np.count_nonzero(away) >= 2 * _PLACE_MIN_PART:
                 candidates.append((members, members[away]))
-        split = False
         for members, tested in candidates:
             upper = place_split(values[tested], stds[tested], xy[tested],
                                 level=0.05 / len(candidates))
@@ -178,9 +177,8 @@ def split_by_place(found: RegionMap, mean: NDArray[np.float64], poke_xy: NDArray
             if side.all() or not side.any():
                 continue
             labels[members[side]] = labels.max() + 1
-            split = True
             break
-        if not split:
+        else:  # no class split
             break
     if np.array_equal(labels, found.poke_labels):
         return found

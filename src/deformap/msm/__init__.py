@@ -2,8 +2,7 @@
 
 A poke is simulated for each β as the steady state of position-based shape matching
 (:func:`simulate_poke`); β̂ minimises the paper's E(β), the mean distance from the simulated
-surface to the observed deformed one (:func:`estimate_beta`: a coarse sweep, then a search on the
-``beta_resolution`` grid around its minimum).
+surface to the observed deformed one (:func:`estimate_beta`).
 
 ``ShapeMatchingConfig.contact``: ``"pinned"``, the paper's protocol, is the surface sheet with
 fixed edges and the particle nearest the contact pinned at its observed depth; ``"force"``

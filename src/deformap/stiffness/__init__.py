@@ -11,14 +11,12 @@ finite-thickness series of Dimitriadis et al. 2002). The indentation is ``δ = t
 starts at a contact threshold, so the offset ``δ₀`` is fitted with ``E``, kept at or above
 ``−3 σ_t``.
 
-Fit: weighted least squares of the travel, ``tᵢ = g⁻¹(Fᵢ / E) − δ₀``, with errors in both
-variables by the effective variance ``σ_t² + (σ_F(Fᵢ) dδ/dF)²`` (Orear 1982), re-evaluated a few
-times; the travel is the response because it is the noisier variable relative to its span.
-``g⁻¹`` is read from a log–log table of ``g`` that stops short of where the series' force turns
-down and at ``h``. For a given ``E`` the best ``δ₀`` is a weighted mean; ``log E`` is found on a
-grid refined by Brent's bounded method. The covariance of ``(E, δ₀)`` is ``(JᵀJ)⁻¹`` scaled by the
-reduced χ² when above 1 (Birge 1932); ``k = E g'(δ_c)`` with ``E g(δ_c) = F_c``, its σ by the
-delta method.
+Fit: weighted least squares of the travel (the noisier variable relative to its span),
+``tᵢ = g⁻¹(Fᵢ / E) − δ₀``, with the effective variance ``σ_t² + (σ_F(Fᵢ) dδ/dF)²`` (Orear 1982)
+re-evaluated a few times; ``g⁻¹`` from a log–log table of ``g``; for a given ``E`` the best ``δ₀``
+is a weighted mean, and ``log E`` is found on a grid refined by Brent's method. The covariance of
+``(E, δ₀)`` is ``(JᵀJ)⁻¹``, scaled by the reduced χ² when above 1 (Birge 1932); ``k = E g'(δ_c)``
+with ``E g(δ_c) = F_c``, its σ by the delta method.
 
 Model error: the record is fitted again with one modulus for its lower half (the first ``n // 2``
 samples) and one for its upper half, sharing ``δ₀`` (Gauss–Newton from the joint fit). With ``D``
@@ -34,9 +32,7 @@ Rigid: before any fit, the travel gained up to ``F_c`` is estimated by a straigh
 against force; below ``rigid_travel_sigmas`` travel noises the surface is rigid, with a lower
 bound on ``k``: the force gained over the span plus two of its standard deviations.
 
-The noise defaults are sensor specifications (encoders through kinematics; a wrist force–torque
-sensor's class), and ν = 0.33 is Gibson & Ashby's open-cell foam, an assumption whose spread
-``poisson_ratio_std`` enters σ(E).
+The noise defaults are sensor specifications; ν = 0.33 is Gibson & Ashby's open-cell foam.
 
 References
 ----------
