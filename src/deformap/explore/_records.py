@@ -235,32 +235,29 @@ class PokeRecord:
                                   f"got {purpose!r}")  # fmt: skip
         target = _floats(data.get("target_xy"), 2, f"{where}.target_xy")
         contact_xy = _floats(data.get("contact_xy"), 2, f"{where}.contact_xy")
+
+        def num(key: str, kind: type = float, optional: bool = False) -> Any:
+            return _number(data, key, where, kind=kind, optional=optional)
+
         return cls(
-            index=_number(data, "index", where, kind=int),
-            target_xy=(target[0], target[1]),
+            index=num("index", int), target_xy=(target[0], target[1]),
             contact_xy=(contact_xy[0], contact_xy[1]),
             contact=ContactRecord.from_dict(data.get("contact"), f"{where}.contact"),
-            force_n=_number(data, "force_n", where),
-            beta=_number(data, "beta", where),
-            beta_std=_number(data, "beta_std", where),
+            force_n=num("force_n"), beta=num("beta"), beta_std=num("beta_std"),
             betas=_floats(data.get("betas"), None, f"{where}.betas"),
             errors=_floats(data.get("errors"), None, f"{where}.errors"),
-            iterations=_number(data, "iterations", where, kind=int),
-            residual=_number(data, "residual", where),
-            converged=_number(data, "converged", where, kind=bool),
-            n_roi_points=_number(data, "n_roi_points", where, kind=int),
-            camera_noise_m=_number(data, "camera_noise_m", where, optional=True),
+            iterations=num("iterations", int), residual=num("residual"),
+            converged=num("converged", bool), n_roi_points=num("n_roi_points", int),
+            camera_noise_m=num("camera_noise_m", optional=True),
             timings=PokeTimings.from_dict(data.get("timings"), f"{where}.timings"),
             stiffness=_stiffness_from_dict(data.get("stiffness"), f"{where}.stiffness"),
-            layer_thickness_m=_number(data, "layer_thickness_m", where, optional=True),
+            layer_thickness_m=num("layer_thickness_m", optional=True),
             stiffness_error=_text(data, "stiffness_error", where),
-            indentation_m=_number(data, "indentation_m", where, optional=True),
-            depth_anchored=_number(data, "depth_anchored", where, kind=bool, optional=True),
-            dent_visible=_number(data, "dent_visible", where, kind=bool, optional=True),
-            purpose=purpose,
-            planned_after=_number(data, "planned_after", where, kind=int, optional=True),
-            max_variance_after=_number(data, "max_variance_after", where, optional=True),
-        )
+            indentation_m=num("indentation_m", optional=True),
+            depth_anchored=num("depth_anchored", bool, True),
+            dent_visible=num("dent_visible", bool, True), purpose=purpose,
+            planned_after=num("planned_after", int, True),
+            max_variance_after=num("max_variance_after", optional=True))
 
 
 @dataclass(frozen=True, eq=False)
