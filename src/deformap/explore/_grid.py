@@ -85,8 +85,6 @@ class MapGrid:
             return None
 
         def lattice(points: NDArray[np.float64]) -> NDArray[np.float64]:
-            if not len(centres):
-                return points
             gone = (np.hypot(points[:, None, 0] - centres[None, :, 0],
                              points[:, None, 1] - centres[None, :, 1]) <= radius_m).any(axis=1)
             return points[~gone]

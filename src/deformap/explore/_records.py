@@ -43,13 +43,11 @@ def _floats(value: Any, n: int | None, where: str) -> tuple[float, ...]:
 
 def _number(data: Mapping[str, Any], key: str, where: str, *, kind: type = float,
             optional: bool = False) -> Any:
-    if key not in data:
-        if optional:
-            return None
-        raise FileFormatError(f"`{where}` has no `{key}`")
-    value = data[key]
+    value = data.get(key)
     if value is None and optional:
         return None
+    if key not in data:
+        raise FileFormatError(f"`{where}` has no `{key}`")
     if kind is bool:
         if not isinstance(value, bool):
             raise FileFormatError(f"`{where}.{key}` must be true or false; got {value!r}")
