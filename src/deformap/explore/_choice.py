@@ -77,12 +77,9 @@ def choose_map_field(previous: FieldChoice, requested: FieldName, records: Seque
     if requested == "beta" or not records:
         return FieldChoice(name="beta" if requested == "beta" else previous.name, grid=grid)
     choice = _unread_here(previous, records, modulus, grid, radius)
-    if choice.given_up is not None:
-        why: str | None = choice.given_up
-    elif not len(modulus.pokes):
+    why = choice.given_up
+    if why is None and not len(modulus.pokes):
         why = f"poke {records[-1].index + 1} gave no modulus ({modulus.readings[-1].excluded})"
-    else:
-        why = None
     fallback = None if why is None else f"`exploration.field` 'modulus' fell back to 'beta': {why}"
     return FieldChoice(name="modulus" if fallback is None else "beta", grid=choice.grid,
                        fallback=fallback, unread_places=choice.unread_places,

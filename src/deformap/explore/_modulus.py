@@ -52,10 +52,8 @@ def rigid_modulus_bound(record: PokeRecord, poisson_ratio: float) -> float:
     estimate = record.stiffness
     if estimate is None or not estimate.rigid or estimate.stiffness_lower_n_per_m is None:
         raise InvalidArgumentError("`record` must be a poke whose force–travel record read rigid")
-    force = record.force_n
-    radius = record.contact.tip_radius_m
+    force, radius, thickness = record.force_n, record.contact.tip_radius_m, record.layer_thickness_m
     depth = force / estimate.stiffness_lower_n_per_m
-    thickness = record.layer_thickness_m
     if thickness is not None and np.isfinite(thickness) and thickness > depth:
         unit = float(layer_indentation_force(np.array([depth]), radius, thickness, 1.0,
                                              poisson_ratio)[0])  # fmt: skip
@@ -87,8 +85,7 @@ class ModulusField(PokeField):
     name: ClassVar[FieldName] = "modulus"
 
     def __init__(self, pokes: PokeSet, xs: NDArray[np.float64], ys: NDArray[np.float64],
-                 config: ModulusFieldConfig,
-                 readings: Sequence[ModulusReading] = ()) -> None:
+                 config: ModulusFieldConfig, readings: Sequence[ModulusReading] = ()) -> None:
         super().__init__(pokes, xs, ys, config)
         self.readings = tuple(readings)
 
@@ -101,8 +98,7 @@ class ModulusField(PokeField):
         used = [(r, m) for r, m in zip(records, readings, strict=True) if m.excluded is None]
         xy = np.array([r.contact_xy for r, _ in used], dtype=float).reshape(-1, 2)
         values = np.array([m.log_modulus for _, m in used], dtype=float)
-        noise = np.maximum(np.array([m.log_std for _, m in used], dtype=float),
-                           config.noise_floor)  # fmt: skip
+        noise = np.maximum(np.array([m.log_std for _, m in used], dtype=float), config.noise_floor)
         index = np.array([m.index for _, m in used], dtype=np.int64)
         thickness = layer_thickness([r for r, _ in used])
         return cls(PokeSet(xy, values, noise.reshape(-1), index, thickness=thickness), xs, ys,
