@@ -81,14 +81,11 @@ def roi_grid(center_xy: NDArray[np.float64], roi_size_m: float,
 def _roi_points(obs: PressObservation, surface: SurfaceModel, config: ExplorationConfig
                 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """The ROI's surface points while pressing, ``(m, 3)``, and the surface model under them."""
-    cfg = config.touch
-    contact = obs.contact
-    center = contact.contact_point[:2]
-    half = cfg.roi_size_m / 2
+    cfg, contact = config.touch, obs.contact
+    center, half = contact.contact_point[:2], cfg.roi_size_m / 2
     pts = crop_to(obs.cloud.points, center - half, center + half, config.surface)
     robot = points_in_hull(pts, obs.robot_points, tolerance_m=cfg.robot_margin_m)
-    tip = contact.tip_radius_m + cfg.tip_margin_m
-    robot |= np.linalg.norm(pts - contact.tip_center, axis=1) < tip
+    robot |= np.linalg.norm(pts - contact.tip_center, axis=1) < contact.tip_radius_m + cfg.tip_margin_m
     pts = pts[~robot]
     k = config.surface.outlier_k
     if pts.shape[0] >= k:
@@ -120,8 +117,7 @@ def _stiffness(obs: PressObservation, surface: SurfaceModel, config: Exploration
     return estimate, thickness, None
 
 
-def dent_visible(indentation_m: float, camera_noise_m: float, n_points: int,
-                 sigmas: float) -> bool:
+def dent_visible(indentation_m: float, camera_noise_m: float, n_points: int, sigmas: float) -> bool:
     """Whether the dent's depth at the contact's edge, half of ``indentation_m`` (Hertz), reaches
     ``sigmas`` times ``camera_noise_m / √n_points``; ``False`` without points."""
     if n_points <= 0:
@@ -134,8 +130,7 @@ def _indentation(obs: PressObservation, surface: SurfaceModel, config: Explorati
                  ) -> tuple[float, float | None, TactileContact]:
     """The indentation δ, the noise of tactile points anchored to it (``None`` when not anchored),
     and the contact with the tip moved to that anchor."""
-    contact = obs.contact
-    point = contact.contact_point
+    contact, point = obs.contact, obs.contact.contact_point
     rest = float(np.asarray(surface.gp.predict(point[None, :2])).reshape(-1)[0])
     if stiffness is None:
         return max(rest - float(point[2]), 0.0), None, contact
@@ -205,14 +200,12 @@ def measure_press(obs: PressObservation, index: int, surface: SurfaceModel,
     rigid = stiffness is not None and stiffness.rigid
     # a surface the record reads rigid needs no dent seen: β = 0 to the β grid's resolution
     if rigid and config.shape_matching.rigid_at_zero:
-        beta = 0.0
-        beta_std = config.shape_matching.beta_resolution / np.sqrt(12.0)
+        beta, beta_std = 0.0, config.shape_matching.beta_resolution / np.sqrt(12.0)
     if visible is False and not rigid:
         beta_std = max(beta_std, UNINFORMED_BETA_STD)
     t3 = time.perf_counter()
-    target_xy = obs.target_xy
     record = PokeRecord(
-        index=index, target_xy=(float(target_xy[0]), float(target_xy[1])),
+        index=index, target_xy=(float(obs.target_xy[0]), float(obs.target_xy[1])),
         contact_xy=(float(center[0]), float(center[1])), contact=ContactRecord.of(contact),
         force_n=float(obs.force_n), beta=beta, beta_std=beta_std,
         betas=tuple(float(b) for b in np.asarray(est.betas)),
