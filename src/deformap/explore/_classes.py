@@ -29,7 +29,7 @@ expression in microarray experiments. Stat. Appl. Genet. Mol. Biol. 3(1), Articl
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from itertools import pairwise
 
 import numpy as np
@@ -66,18 +66,14 @@ class RegionMap:
     def n_regions(self) -> int:
         return int(self.class_betas.size)
 
-    def nearest_poke(self, poke_xy: NDArray[np.float64],
-                     cells_xy: NDArray[np.float64]) -> RegionMap:
+    def nearest_poke(self, poke_xy: NDArray[np.float64], cells_xy: NDArray[np.float64]) -> RegionMap:
         """The same classes, each cell of ``cells_xy (ny · nx, 2)`` labelled by the class of the
         nearest of the pokes at ``poke_xy (k, 2)`` (ties: the earliest), metres."""
         pokes = check_array("poke_xy", poke_xy, (self.poke_labels.size, 2), what="metres")
         cells = check_array("cells_xy", cells_xy, (self.labels.size, 2), what="metres")
         # argmin keeps the earliest poke of a tie, which a k-d tree does not promise
-        d2 = np.sum((cells[:, None, :] - pokes[None, :, :]) ** 2, axis=-1)
-        nearest = np.argmin(d2, axis=1)
-        labels = self.poke_labels[nearest].reshape(self.labels.shape)
-        return RegionMap(labels=labels, levels=self.levels, class_betas=self.class_betas,
-                         poke_labels=self.poke_labels)
+        nearest = np.argmin(np.sum((cells[:, None, :] - pokes[None, :, :]) ** 2, axis=-1), axis=1)
+        return replace(self, labels=self.poke_labels[nearest].reshape(self.labels.shape))
 
 
 def _best_splits(values: NDArray[np.float64]) -> tuple[NDArray, NDArray, NDArray, NDArray,

@@ -86,25 +86,12 @@ def estimate_stiffness(travel_m: Any, force_n: Any, *, tip_radius_m: float, thic
                        config: StiffnessConfig | None = None) -> StiffnessEstimate:
     """Stiffness and Young's modulus with their uncertainties from one force–travel record.
 
-    Parameters
-    ----------
-    travel_m : (n,) float, metres
-        The probe's travel since first contact, in time order, ``n >= 3``.
-    force_n : (n,) float, newtons
-        The normal force, rising from the contact threshold to the commanded force.
-    tip_radius_m : float
-        Radius of the probe's spherical tip.
-    thickness_m : float
-        The layer's thickness at the contact, in ``(0, 2]`` m; the travel must stay below it.
-    commanded_force_n : float, optional
-        The commanded force, which the last force must be near (default: the largest force).
-    thickness_std_m : float
-        Standard deviation of ``thickness_m``; σ(E) includes a refit at ``h ± σ_h``.
-    config : StiffnessConfig, optional
-
-    Returns
-    -------
-    StiffnessEstimate
+    ``travel_m (n,)`` [m], the probe's travel since first contact in time order, ``n >= 3``, and
+    ``force_n (n,)`` [N], rising from the contact threshold to the commanded force
+    ``commanded_force_n`` (default: the largest), which the last force must be near;
+    ``tip_radius_m`` the spherical tip's radius; ``thickness_m`` the layer's thickness at the
+    contact, in ``(0, 2]`` m, above the travel, with standard deviation ``thickness_std_m``
+    (σ(E) includes a refit at ``h ± σ_h``).
 
     Raises
     ------
