@@ -124,7 +124,7 @@ class PokeModel:
 
     def __init__(self, rest: Any, masses: Any, fixed: Any, contact: TactileContact,
                  config: ShapeMatchingConfig, *, stiffness_n_per_m: float | None = None):
-        cfg = config
+        self.cfg = cfg = config
         p0 = _check_rest(rest, cfg.cluster_size)
         m = check_array("masses", masses, p0.shape[:2], what="particle masses")
         if np.any(m <= 0):
@@ -135,7 +135,6 @@ class PokeModel:
                                        f"{np.asarray(fixed).dtype} array of shape {fx.shape}")
         if stiffness_n_per_m is not None:
             check_positive("stiffness_n_per_m", stiffness_n_per_m)
-        self.cfg = cfg
         self.odds = cfg.rigid_at_zero
         self.spacing = float(np.mean(np.linalg.norm(np.diff(p0[..., :2], axis=1), axis=-1)))
         near = _check_contact(contact, p0, fx, self.spacing)
@@ -201,8 +200,7 @@ class PokeModel:
         betas = np.asarray(betas, dtype=float)
         rest = self.clusters.rest
         x = np.broadcast_to(rest, (len(betas), *rest.shape)).copy()
-        it = np.zeros(len(betas), dtype=np.int64)
-        res = np.zeros(len(betas))
+        it, res = np.zeros(len(betas), dtype=np.int64), np.zeros(len(betas))
         conv = np.ones(len(betas), dtype=bool)
         # on the odds scale β = 0 carries no load: the body at rest, exactly
         moving = self.load_scale(betas) > 0.0
@@ -231,8 +229,7 @@ class PokeModel:
 def _body(p0: Array, masses: Array, fixed: NDArray[np.bool_], spacing: float,
           cfg: ShapeMatchingConfig) -> tuple[Array, Array, NDArray[np.bool_], tuple[int, ...]]:
     """The simulated body: the surface sheet, or the surface over layers down to a fixed floor."""
-    k = cfg.cluster_size
-    layers = cfg.body_layers
+    k, layers = cfg.cluster_size, cfg.body_layers
     if layers == 0:
         return p0[None], masses[None], fixed[None], (1, k, k)
     floor = 0.5 * min(float(np.ptp(p0[..., 0])), float(np.ptp(p0[..., 1])))
