@@ -1,46 +1,24 @@
 """The region test: classes of the pokes' values on the map field (β, or ln E), and the
 isopleths between them.
 
-How the contour levels are chosen
----------------------------------
-The paper draws "the best isopleth" of the β-field without saying how. We choose the levels from
-the data the field is trained on, the pokes' own estimates (the field's posterior at a poke is
-smoothed toward its neighbours, which fills the very gaps that separate classes), by divisive
-splitting with a calibrated test:
+The levels are chosen from the pokes' own estimates (the posterior's smoothing fills the gaps
+between classes) by divisive splitting with a calibrated test:
 
-1. Sort the βs; the best split of a group into a lower and an upper part is the one that explains
-   the largest share of its spread (Fisher's optimal split of ordered data): between-part sum of
-   squares B, within-part W.
-2. Splitting a sorted sample at its best point *always* separates the two means, so the split's
-   statistic ``T = B / (ν₀ s̄² + W)`` is compared with its own null distribution, simulated for
-   the group under one material: each poke's β its mean plus a normal error of the poke's own
-   uncertainty. ``s̄²`` is the group's mean squared uncertainty and ``ν₀`` (``prior_dof``) how
-   many degrees of freedom the claimed uncertainties are worth beside the scatter the βs show
-   (W): a moderated test (the claimed noise as a scaled-χ² prior on the scatter, as in Smyth
-   2004). ``ν₀ = 0`` is the scale-free test that trusts only the βs; a large ``ν₀`` is Cochran's
-   χ² test with known noise. The default 7 weighs the claimed noise like eight repeated presses
-   on one foam. The β-field's pokes carry
-   the map's nugget in their uncertainty (:mod:`deformap.explore._nugget`), itself estimated
-   within the classes this test finds (:func:`deformap.explore._nugget.with_nugget`).
-3. The same is done for the best split into three parts (two materials cannot always be told
-   from one by a binary split when a third sits between them); the more significant of the two
-   tests is used, at 5 % with a Bonferroni correction for testing both.
+1. The best split of a sorted group into a lower and an upper part explains the largest share of
+   its spread (Fisher 1958): between-part sum of squares B, within-part W.
+2. Its statistic ``T = B / (ν₀ s̄² + W)`` is compared with its null distribution, simulated for
+   the group under one material (each poke its mean plus a normal error of its own uncertainty);
+   ``s̄²`` is the mean squared uncertainty and ``ν₀`` (``prior_dof``) the degrees of freedom the
+   claimed uncertainties count for beside W: a moderated test (Smyth 2004); ``ν₀ = 0`` is the
+   scale-free test, a large ``ν₀`` Cochran's χ² test with known noise.
+3. The same for the best split into three parts (a third material between two); the more
+   significant of the two is used, at 5 % with Bonferroni over both.
 4. A split is kept only if neighbouring parts' means differ by at least ``min_step`` and by more
-   than ``z`` standard errors (from the pokes' own uncertainties, at least ``floor``); each part
-   is then split in turn. A group is tested while the test has two degrees of freedom for the
-   scatter, ``ν₀ + n − 2 ≥ 2`` for ``n ≥ 3`` pokes: down to groups of 4 for the scale-free test,
-   which learns the scatter from the βs alone, and of 3 when the claimed noise counts
-   (``ν₀ ≥ 1``), so that a material met by a single poke beside two of another is still told
-   apart.
+   than ``z`` standard errors (uncertainties at least ``floor``); each part is split in turn while
+   ``n ≥ 3`` and ``ν₀ + n − 2 ≥ 2``.
 
-Why not the scale-free test alone (``prior_dof=0``): with the few pokes a map needs, it must learn
-the scatter from the same few βs it splits (``n − 2`` degrees of freedom), so its null distribution
-is wide and two neighbouring foams go untold; the pokes' measured noise
-(:mod:`deformap.explore._dent_noise`) is the information it lacks. The isopleth between two
-neighbouring classes is the midpoint of their means; cells are labelled by the band of the β-field's
-mean they fall in, so a region is a level set of the map, and ``n_regions`` is the number of classes
-found.
-
+The isopleth between two neighbouring classes is the midpoint of their means; cells are labelled
+by the band of the field's mean they fall in.
 
 References
 ----------
@@ -51,7 +29,7 @@ expression in microarray experiments. Stat. Appl. Genet. Mol. Biol. 3(1), Articl
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from itertools import pairwise
 
 import numpy as np
@@ -71,20 +49,12 @@ REGION_Z = 2.0
 
 @dataclass(frozen=True)
 class RegionMap:
-    """Regions of a β-field on a grid.
+    """Regions of a field on a grid.
 
-    Attributes
-    ----------
-    labels : (ny, nx) int
-        Region of each cell, 0 for the lowest band of the field upwards (β-field: the stiffest
-        class first; modulus field, ln E: the softest first).
-    levels : (n_regions - 1,) float
-        The isopleths between bands, increasing.
-    class_betas : (n_regions,) float
-        Mean value of the pokes in each class (β, or ln E [ln Pa] for the modulus field).
-    poke_labels : (k,) int
-        The class of each poke, in the order the pokes were given (a class is a run of the sorted
-        βs, so a poke's class is not always the band its β falls in).
+    ``labels (ny, nx)``: each cell's region, from the field's lowest band up; ``levels
+    (n_regions - 1,)``: the isopleths, increasing; ``class_betas (n_regions,)``: each class's mean
+    value (β, or ln E [ln Pa]); ``poke_labels (k,)``: each poke's class, in the order given (not
+    always the band its value falls in).
     """
 
     labels: NDArray[np.int64]
@@ -96,37 +66,20 @@ class RegionMap:
     def n_regions(self) -> int:
         return int(self.class_betas.size)
 
-    def nearest_poke(self, poke_xy: NDArray[np.float64],
-                     cells_xy: NDArray[np.float64]) -> RegionMap:
-        """The same classes, each cell labelled by the class of the poke nearest to it (ties: the
-        earliest poke) instead of by the band of the β-field it falls in.
-
-        Parameters
-        ----------
-        poke_xy : (k, 2) float, metres
-            Where the pokes were, in the order of ``poke_labels``.
-        cells_xy : (ny · nx, 2) float, metres
-            The cells of ``labels``, row-major.
-        """
+    def nearest_poke(self, poke_xy: NDArray[np.float64], cells_xy: NDArray[np.float64]) -> RegionMap:
+        """The same classes, each cell of ``cells_xy (ny · nx, 2)`` labelled by the class of the
+        nearest of the pokes at ``poke_xy (k, 2)`` (ties: the earliest), metres."""
         pokes = check_array("poke_xy", poke_xy, (self.poke_labels.size, 2), what="metres")
         cells = check_array("cells_xy", cells_xy, (self.labels.size, 2), what="metres")
-        # squared distances of every cell to every poke (a few dozen pokes): argmin keeps the
-        # earliest poke of a tie, which a k-d tree does not promise
-        d2 = np.sum((cells[:, None, :] - pokes[None, :, :]) ** 2, axis=-1)
-        nearest = np.argmin(d2, axis=1)
-        labels = self.poke_labels[nearest].reshape(self.labels.shape)
-        return RegionMap(labels=labels, levels=self.levels, class_betas=self.class_betas,
-                         poke_labels=self.poke_labels)
+        # argmin keeps the earliest poke of a tie, which a k-d tree does not promise
+        nearest = np.argmin(np.sum((cells[:, None, :] - pokes[None, :, :]) ** 2, axis=-1), axis=1)
+        return replace(self, labels=self.poke_labels[nearest].reshape(self.labels.shape))
 
 
 def _best_splits(values: NDArray[np.float64]) -> tuple[NDArray, NDArray, NDArray, NDArray,
                                                        NDArray]:  # fmt: skip
-    """Best 2- and 3-part splits of each sorted row of ``values (m, n)``.
-
-    Returns the between-part sums of squares of the best splits, ``b2 (m,)`` and ``b3 (m,)``, the
-    rows' total sums of squares ``spread (m,)``, and the cut indices, ``cut2 (m,)`` and ``cuts3
-    (m, 2)``.
-    """
+    """Best 2- and 3-part splits of each sorted row of ``values (m, n)``: between-part sums of
+    squares ``b2``, ``b3``, total ``spread`` and cuts ``cut2 (m,)``, ``cuts3 (m, 2)``."""
     m, n = values.shape
     csum = np.concatenate([np.zeros((m, 1)), np.cumsum(values, axis=1)], axis=1)
     spread = np.sum((values - values.mean(axis=1, keepdims=True)) ** 2, axis=1)
@@ -155,8 +108,7 @@ def _best_splits(values: NDArray[np.float64]) -> tuple[NDArray, NDArray, NDArray
 
 def _statistics(values: NDArray[np.float64], prior: float) -> tuple[NDArray, NDArray, NDArray,
                                                                      NDArray]:  # fmt: skip
-    """Split statistics ``T = between / (prior + within)`` of the best 2- and 3-part splits of
-    each sorted row of ``values (m, n)``, with their cuts (see :func:`_best_splits`)."""
+    """``T = between / (prior + within)`` of the best 2- and 3-part splits, with their cuts."""
     b2, b3, spread, cut2, cuts3 = _best_splits(values)
     with np.errstate(invalid="ignore", divide="ignore"):
         t2 = np.nan_to_num(b2 / (prior + (spread - b2)))
@@ -165,9 +117,7 @@ def _statistics(values: NDArray[np.float64], prior: float) -> tuple[NDArray, NDA
 
 
 def _null(stds: NDArray[np.float64], prior_dof: float) -> tuple[NDArray, NDArray]:
-    """Sorted statistics t2, t3 of ``_NULL_SAMPLES`` draws of one material: each poke's β its
-    mean plus its own noise (``stds``, in the group's sorted order, which under one material is
-    unrelated to the noise)."""
+    """Sorted statistics t2, t3 of ``_NULL_SAMPLES`` draws of one material with noise ``stds``."""
     rng = np.random.default_rng(_NULL_SEED)
     draws = rng.standard_normal((_NULL_SAMPLES, stds.size)) * stds[None, :]
     t2, t3, _, _ = _statistics(np.sort(draws, axis=1), prior_dof * float(np.mean(stds**2)))
@@ -208,39 +158,12 @@ def _split(b: NDArray, s: NDArray, group: NDArray, room: int, *, min_step: float
     return None
 
 
-def segment_regions(
-    beta_grid: NDArray[np.float64],
-    poke_beta: NDArray[np.float64],
-    poke_std: NDArray[np.float64],
-    *,
-    floor: float = 0.03,
-    min_step: float = 0.05,
-    z: float = 2.0,
-    max_regions: int = 6,
-    prior_dof: float = 7.0,
-) -> RegionMap:
-    """Label the cells of ``beta_grid`` by isopleths chosen from the pokes' β estimates.
-
-    Parameters
-    ----------
-    beta_grid : (ny, nx) float
-        Posterior mean of the β-field on the grid.
-    poke_beta, poke_std : (k,) float
-        The pokes' β estimates and their uncertainties.
-    floor : float
-        Smallest uncertainty a poke is credited with (the map field's noise floor:
-        :func:`poke_classes` passes the field's own; this function's default, 0.03, is for
-        direct callers).
-    min_step : float
-        Smallest difference of two class means that can separate them.
-    z : float
-        Standard errors of the difference of two class means needed to separate them.
-    max_regions : int
-        Most classes returned.
-    prior_dof : float
-        Degrees of freedom the pokes' uncertainties count for in the scatter the split test
-        expects (0: the scatter is estimated from the βs alone, a scale-free test).
-    """
+def segment_regions(beta_grid: NDArray[np.float64], poke_beta: NDArray[np.float64],
+                    poke_std: NDArray[np.float64], *, floor: float = 0.03, min_step: float = 0.05,
+                    z: float = 2.0, max_regions: int = 6, prior_dof: float = 7.0) -> RegionMap:
+    """Label the cells of ``beta_grid (ny, nx)`` (the field's mean) by isopleths chosen from the
+    pokes' estimates ``poke_beta (k,)`` and uncertainties ``poke_std (k,)`` (module docstring:
+    ``floor``, ``min_step``, ``z``, ``prior_dof``; at most ``max_regions`` classes)."""
     grid = check_array("beta_grid", beta_grid, (None, None))
     betas = check_array("poke_beta", poke_beta, (None,), min_rows=1)
     stds = check_array("poke_std", poke_std, (betas.size,), what="standard deviations")
@@ -269,9 +192,8 @@ def segment_regions(
 
 def ranked(grid: NDArray[np.float64], values: NDArray[np.float64],
             groups: list[NDArray[np.int64]], order: NDArray[np.int64]) -> RegionMap:
-    """The regions of the classes ``groups`` (indices into ``values``), numbered by their mean
-    value upwards, with the isopleths midway between neighbouring means; ``order`` maps an index
-    into ``values`` to the poke's place in the order the pokes were given."""
+    """The regions of the classes ``groups`` (indices into ``values``), numbered by mean upwards,
+    isopleths midway; ``order`` maps an index into ``values`` to the poke's given place."""
     means = np.array([values[g].mean() for g in groups])
     rank = np.argsort(means, kind="stable")
     class_betas = means[rank]
@@ -286,10 +208,8 @@ def ranked(grid: NDArray[np.float64], values: NDArray[np.float64],
 
 def poke_classes(mean: NDArray[np.float64], pokes: PokeSet, config: ExplorationConfig,
                  field: FieldName) -> RegionMap:
-    """The pokes' classes and the isopleth labels of the map field's mean ``mean (ny, nx)``, by
-    :func:`segment_regions` with the exploration's settings (``max_regions``,
-    ``region_prior_dof``) and the noise floor and smallest step of the field ``field`` (the one
-    mapped on; :func:`deformap.explore.field_settings`: β, or ln E for ``"modulus"``)."""
+    """:func:`segment_regions` of the map field ``field``'s mean ``mean (ny, nx)`` with the
+    exploration's settings and that field's noise floor and smallest step."""
     cfg = field_settings(config, field)
     return segment_regions(mean, pokes.values, pokes.noise, floor=cfg.noise_floor,
                            min_step=cfg.min_step, max_regions=config.max_regions,

@@ -1,23 +1,16 @@
 """One press: the dent reconstructed from the cloud seen while pressing, and its β.
 
-1. The ROI (``roi_size_m`` square on the contact) is cropped from the cloud; the robot's points
-   (its hull plus ``robot_margin_m``, the tip's ball plus ``tip_margin_m``), steep faces, and every
-   point more than ``above_surface_m`` above the surface model (a dent goes down) are removed.
-2. The touch GP is fitted to those points and the tactile points (by default as the change of
-   height against the surface model) and read on the ROI's grid: the deformed heightmap X̄. The
-   tactile points cover the cap touching at the indentation δ (:func:`deformap.cloud.contact_cap`):
-   the force–travel record's model indentation when the stiffness estimate read one (0 if rigid),
-   else the tip's depth below the surface model; with a record and ``depth_anchor="record"`` they
-   hang from the surface model's height minus δ, with δ's uncertainty as noise.
-3. Shape matching from the ROI's heightmap before the press gives β̂
-   (:func:`deformap.msm.estimate_beta`); under ``camera-noise`` its σ is the camera's noise (the
-   points' median absolute deviation about X̄) carried through the estimate
-   (:func:`deformap.explore._dent_noise.dent_error_samples`). Noise draws cannot show a dent the
-   camera does not see, so a dent shallower at the contact's edge (δ/2, Hertz) than
-   ``dent_visible_sigmas`` standard deviations of the camera's mean height within two tip radii
-   claims σ = 1/√12, a uniform β (:func:`dent_visible`). Where β = 0 is the rigid body
-   (``ShapeMatchingConfig.rigid_at_zero``) a press the record reads rigid reports β = 0 with the
-   β grid's quantisation σ, whatever the camera makes of the flat dent.
+1. The ROI is cropped from the cloud; the robot's points (hull and tip ball with margins), steep
+   faces and points more than ``above_surface_m`` above the surface model are removed.
+2. The touch GP is fitted to those points and the tactile points on the cap touching at the
+   indentation δ (the force–travel record's, 0 if rigid, else the tip's depth below the surface
+   model; with ``depth_anchor="record"`` they hang from the surface minus δ) and read on the ROI's
+   grid: the deformed heightmap X̄.
+3. Shape matching gives β̂ (:func:`deformap.msm.estimate_beta`); under ``camera-noise`` its σ is
+   the camera's noise (the points' MAD about X̄) carried through the estimate
+   (:mod:`deformap.explore._dent_noise`). A dent the camera cannot see (:func:`dent_visible`)
+   claims a uniform β's σ = 1/√12; a press the record reads rigid reports β = 0 with the β grid's
+   quantisation σ where β = 0 is rigid.
 
 References
 ----------
@@ -48,24 +41,17 @@ __all__ = ["dent_visible", "measure_press", "roi_grid"]
 
 logger = logging.getLogger(__name__)
 
-_MAD_TO_STD = 1.4826
-"""Standard deviation per median absolute deviation of a normal distribution."""
-
+_MAD_TO_STD = 1.4826  # standard deviation per median absolute deviation of a normal
+#: Standard deviation of a uniform β over [0, 1): a poke whose dent the camera cannot see.
 UNINFORMED_BETA_STD = 1.0 / np.sqrt(12.0)
-"""Standard deviation of a uniform β over [0, 1): the claim of a poke whose dent the camera
-cannot see."""
-
+# the dent's flank, where the camera must see it: within two tip radii of the contact (the tip
+# and stick hide the part inside one radius from most views)
 _FLANK_TIP_RADII = 2.0
-"""The dent's flank, where the camera must see it: within two tip radii of the contact (a Hertz
-dent's surface has fallen to under a third of δ there; the tip and stick hide the part inside one
-radius from most views)."""
 
 
 def _force_fit(obs: PressObservation, stiffness: StiffnessEstimate | None,
                thickness: float | None, config: ExplorationConfig) -> NDArray[np.float64] | None:
-    """``(2, 60)``: travel [m] over the record and the force [N] of the fitted contact model,
-    ``E g(t + δ₀)`` (:mod:`deformap.stiffness`), for the poke's figure; ``None``
-    without a modulus."""
+    """``(2, 60)`` travel [m] and force ``E g(t + δ₀)`` [N] of the fitted model, or ``None``."""
     record = obs.force_travel
     if record is None or stiffness is None or stiffness.modulus_pa is None or thickness is None:
         return None
@@ -77,8 +63,7 @@ def _force_fit(obs: PressObservation, stiffness: StiffnessEstimate | None,
 
 
 def _robust_std(residuals: NDArray[np.float64], floor: float = 1e-6) -> float:
-    """Scatter of ``residuals`` as a normal standard deviation, from their median absolute
-    deviation (so flying pixels and the dent's rim do not inflate it); at least ``floor``."""
+    """Scatter of ``residuals`` as a normal σ from their MAD (robust to flying pixels), ≥ ``floor``."""
     if residuals.size == 0:
         return floor
     mad = float(np.median(np.abs(residuals - np.median(residuals))))
@@ -96,14 +81,11 @@ def roi_grid(center_xy: NDArray[np.float64], roi_size_m: float,
 def _roi_points(obs: PressObservation, surface: SurfaceModel, config: ExplorationConfig
                 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """The ROI's surface points while pressing, ``(m, 3)``, and the surface model under them."""
-    cfg = config.touch
-    contact = obs.contact
-    center = contact.contact_point[:2]
-    half = cfg.roi_size_m / 2
+    cfg, contact = config.touch, obs.contact
+    center, half = contact.contact_point[:2], cfg.roi_size_m / 2
     pts = crop_to(obs.cloud.points, center - half, center + half, config.surface)
     robot = points_in_hull(pts, obs.robot_points, tolerance_m=cfg.robot_margin_m)
-    tip = contact.tip_radius_m + cfg.tip_margin_m
-    robot |= np.linalg.norm(pts - contact.tip_center, axis=1) < tip
+    robot |= np.linalg.norm(pts - contact.tip_center, axis=1) < contact.tip_radius_m + cfg.tip_margin_m
     pts = pts[~robot]
     k = config.surface.outlier_k
     if pts.shape[0] >= k:
@@ -115,9 +97,8 @@ def _roi_points(obs: PressObservation, surface: SurfaceModel, config: Exploratio
 
 def _stiffness(obs: PressObservation, surface: SurfaceModel, config: ExplorationConfig
                ) -> tuple[StiffnessEstimate | None, float | None, str | None]:
-    """Stiffness and modulus from the press's force–travel record, the layer thickness they were
-    read with (the surface model's height above the table, z = 0, at the contact), and why a
-    record gave none (the poke then stands on the camera alone); all ``None`` without a record."""
+    """The force–travel record's estimate, the layer thickness it was read with (the surface's
+    height above z = 0 at the contact), and why a record gave none; all ``None`` without one."""
     record = obs.force_travel
     if record is None:
         return None, None, None
@@ -136,12 +117,9 @@ def _stiffness(obs: PressObservation, surface: SurfaceModel, config: Exploration
     return estimate, thickness, None
 
 
-def dent_visible(indentation_m: float, camera_noise_m: float, n_points: int,
-                 sigmas: float) -> bool:
-    """Whether the camera sees a dent of ``indentation_m`` at all: its depth at the contact's
-    edge, half the indentation (Hertz), against the standard deviation of the mean height of the
-    ``n_points`` camera points around the tip, ``camera_noise_m / √n``; ``False`` without
-    points."""
+def dent_visible(indentation_m: float, camera_noise_m: float, n_points: int, sigmas: float) -> bool:
+    """Whether the dent's depth at the contact's edge, half of ``indentation_m`` (Hertz), reaches
+    ``sigmas`` times ``camera_noise_m / √n_points``; ``False`` without points."""
     if n_points <= 0:
         return False
     return bool(indentation_m / 2.0 >= sigmas * camera_noise_m / np.sqrt(n_points))
@@ -150,11 +128,9 @@ def dent_visible(indentation_m: float, camera_noise_m: float, n_points: int,
 def _indentation(obs: PressObservation, surface: SurfaceModel, config: ExplorationConfig,
                  stiffness: StiffnessEstimate | None
                  ) -> tuple[float, float | None, TactileContact]:
-    """The poke's indentation δ at the tip, the noise of tactile points anchored to it (``None``
-    when they are not: no record read, or ``depth_anchor="tip"``), and the contact with the tip
-    moved to that anchor (the measured one when not anchored)."""
-    contact = obs.contact
-    point = contact.contact_point
+    """The indentation δ, the noise of tactile points anchored to it (``None`` when not anchored),
+    and the contact with the tip moved to that anchor."""
+    contact, point = obs.contact, obs.contact.contact_point
     rest = float(np.asarray(surface.gp.predict(point[None, :2])).reshape(-1)[0])
     if stiffness is None:
         return max(rest - float(point[2]), 0.0), None, contact
@@ -175,25 +151,8 @@ def _indentation(obs: PressObservation, surface: SurfaceModel, config: Explorati
 
 def measure_press(obs: PressObservation, index: int, surface: SurfaceModel,
                   config: ExplorationConfig) -> PokeResult:
-    """Reconstruct the dent of one press and estimate its β.
-
-    Parameters
-    ----------
-    obs : PressObservation
-        What the environment returned for the press (world frame, SI units).
-    index : int
-        The poke's place in its run.
-    surface : SurfaceModel
-        The surface before any poke.
-    config : ExplorationConfig
-        Its ``touch``, ``surface`` and ``shape_matching`` settings are used.
-
-    Returns
-    -------
-    PokeResult
-        The record (not yet in a β-field: no ``purpose``, ``max_variance_after`` or field time),
-        the dent and the full estimate.
-    """
+    """Reconstruct the dent of press ``obs`` (the ``index``-th of its run) on ``surface`` and
+    estimate its β; the record is not yet in a field (no ``purpose``, variance or field time)."""
     t0 = time.perf_counter()
     cfg = config.touch
     contact = obs.contact
@@ -212,16 +171,13 @@ def measure_press(obs: PressObservation, index: int, surface: SurfaceModel,
     t1 = time.perf_counter()
     rest_z = np.asarray(surface.gp.predict_grid(roi_xs, roi_ys))
     data = np.vstack([roi, tactile])
-    noise = np.concatenate(
-        [np.full(len(roi), cfg.noise_std_m), np.full(len(tactile), tactile_noise)]
-    )
+    noise = np.concatenate([np.full(len(roi), cfg.noise_std_m), np.full(len(tactile), tactile_noise)])
     target = data[:, 2]
     if cfg.model == "residual":
         target = target - np.concatenate([rest_at, surface.gp.predict(tactile[:, :2])])
-    touch = GaussianRandomField(
-        length_scale=cfg.length_scale_m, signal_std=cfg.signal_std_m,
-        noise_std=cfg.noise_std_m, method="auto",
-    ).fit(data[:, :2], target, noise_std=noise)  # fmt: skip
+    touch = GaussianRandomField(length_scale=cfg.length_scale_m, signal_std=cfg.signal_std_m,
+                                noise_std=cfg.noise_std_m, method="auto",
+                                ).fit(data[:, :2], target, noise_std=noise)  # fmt: skip
     deformed_z = np.asarray(touch.predict_grid(roi_xs, roi_ys))
     if cfg.model == "residual":
         deformed_z = deformed_z + rest_z
@@ -230,45 +186,32 @@ def measure_press(obs: PressObservation, index: int, surface: SurfaceModel,
     t2 = time.perf_counter()
     samples, camera_noise, visible = None, None, None
     if config.beta_uncertainty == "camera-noise":
-        # The camera's noise here, from the points' scatter about the reconstruction; the touch
-        # GP's σₙ is a prior setting, not a measurement.
+        # the camera's noise here, measured (the touch GP's σₙ is a prior setting)
         fitted = np.asarray(touch.predict(roi[:, :2])) if len(roi) else np.zeros(0)
         camera_noise = _robust_std(np.asarray(target[: len(roi)]) - fitted)
-        samples = dent_error_samples(
-            roi_xs, roi_ys, roi[:, :2], camera_noise, tactile[:, :2],
-            tactile_noise, length_scale_m=cfg.length_scale_m,
-            signal_std_m=cfg.signal_std_m, n_samples=cfg.noise_samples,
-        )  # fmt: skip
+        samples = dent_error_samples(roi_xs, roi_ys, roi[:, :2], camera_noise, tactile[:, :2],
+                                     tactile_noise, length_scale_m=cfg.length_scale_m,
+                                     signal_std_m=cfg.signal_std_m, n_samples=cfg.noise_samples)
         near = np.linalg.norm(roi[:, :2] - center, axis=1) <= _FLANK_TIP_RADII * contact.tip_radius_m
         visible = dent_visible(depth, camera_noise, int(near.sum()), cfg.dent_visible_sigmas)
     est = estimate_beta(roi_xs, roi_ys, rest_z, deformed, anchored, config.shape_matching,
                         height_samples=samples)  # fmt: skip
     beta, beta_std = float(est.beta), float(est.beta_std)
     rigid = stiffness is not None and stiffness.rigid
-    # a surface the record reads rigid needs no dent seen: the camera's noise alone would read a
-    # small β > 0, so β = 0 to the β grid's resolution, the floor of every β's σ
+    # a surface the record reads rigid needs no dent seen: β = 0 to the β grid's resolution
     if rigid and config.shape_matching.rigid_at_zero:
-        beta = 0.0
-        beta_std = config.shape_matching.beta_resolution / np.sqrt(12.0)
+        beta, beta_std = 0.0, config.shape_matching.beta_resolution / np.sqrt(12.0)
     if visible is False and not rigid:
         beta_std = max(beta_std, UNINFORMED_BETA_STD)
     t3 = time.perf_counter()
-    target_xy = obs.target_xy
     record = PokeRecord(
-        index=index,
-        target_xy=(float(target_xy[0]), float(target_xy[1])),
-        contact_xy=(float(center[0]), float(center[1])),
-        contact=ContactRecord.of(contact),
-        force_n=float(obs.force_n),
-        beta=beta,
-        beta_std=beta_std,
+        index=index, target_xy=(float(obs.target_xy[0]), float(obs.target_xy[1])),
+        contact_xy=(float(center[0]), float(center[1])), contact=ContactRecord.of(contact),
+        force_n=float(obs.force_n), beta=beta, beta_std=beta_std,
         betas=tuple(float(b) for b in np.asarray(est.betas)),
         errors=tuple(float(e) for e in np.asarray(est.errors)),
-        iterations=int(np.max(est.iterations)),
-        residual=float(np.max(est.residual)),
-        converged=bool(np.all(est.converged)),
-        n_roi_points=len(roi),
-        camera_noise_m=camera_noise,
+        iterations=int(np.max(est.iterations)), residual=float(np.max(est.residual)),
+        converged=bool(np.all(est.converged)), n_roi_points=len(roi), camera_noise_m=camera_noise,
         timings=PokeTimings(filter_s=t1 - t0, touch_gp_s=t2 - t1, beta_s=t3 - t2,
                             stiffness_s=None if obs.force_travel is None else t_stiff),
         stiffness=stiffness, layer_thickness_m=thickness, stiffness_error=stiffness_error,

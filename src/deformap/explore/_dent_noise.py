@@ -1,17 +1,11 @@
 """How much the camera's noise moves the reconstructed dent: the touch GP's smoother on noise.
 
-A poke's β is read from the touch GP's mean, and the β-field takes as the poke's noise how far β
-would move under another draw of the camera's noise (its repeatability). The mean is linear in
-the data, ``m = W y`` with ``W = K*ₓ (K + Σ)⁻¹``, so the noise ``ε ~ N(0, Σ)`` leaves the error
-``W ε`` in it, drawn here without the data's values. This is the reconstruction's sampling
-spread, not the GP's posterior: the posterior adds what the prior does not know about the
-surface, which another press would not draw afresh; what the reconstruction gets systematically
-wrong from place to place is left to the β-field's nugget (:mod:`deformap.explore._nugget`).
-
-The camera's points are binned onto the ROI's grid (a cell's points become one observation at its
-node, noise σₙ/√count), which keeps the smoother exact on a few hundred pseudo-observations and
-changes it little, the cells being half the kernel's length scale or less; the tactile points
-enter as they are.
+A poke's noise is how far β would move under another draw of the camera's noise. The GP's mean is
+linear in the data, ``m = W y`` with ``W = K*ₓ (K + Σ)⁻¹``, so the noise ``ε ~ N(0, Σ)`` leaves
+the error ``W ε``, drawn here without the data's values: the reconstruction's sampling spread, not
+the posterior (systematic errors are left to the nugget, :mod:`deformap.explore._nugget`). The
+camera's points are binned onto the ROI's grid (one observation per node, noise σₙ/√count); the
+tactile points enter as they are.
 
 References
 ----------
@@ -30,45 +24,20 @@ from deformap.gp import apply_smoother
 
 __all__ = ["DENT_NOISE_SEED", "dent_error_samples"]
 
-DENT_NOISE_SEED = 20161116
-"""Fixed seed of the draws: a poke's uncertainty is a deterministic function of the poke."""
+DENT_NOISE_SEED = 20161116  # a poke's uncertainty is a deterministic function of the poke
 
 
-def dent_error_samples(
-    xs: NDArray[np.float64],
-    ys: NDArray[np.float64],
-    points_xy: NDArray[np.float64],
-    points_noise_m: float,
-    extra_xy: NDArray[np.float64],
-    extra_noise_m: float,
-    *,
-    length_scale_m: float,
-    signal_std_m: float,
-    n_samples: int,
-) -> NDArray[np.float64]:
-    """Draws of the error that data noise leaves in a GP's mean on the grid ``xs × ys``.
+def dent_error_samples(xs: NDArray[np.float64], ys: NDArray[np.float64],
+                       points_xy: NDArray[np.float64], points_noise_m: float,
+                       extra_xy: NDArray[np.float64], extra_noise_m: float, *,
+                       length_scale_m: float, signal_std_m: float,
+                       n_samples: int) -> NDArray[np.float64]:
+    """``(n_samples, ny * nx)`` draws [m] of the error data noise leaves in the touch GP's mean on
+    the evenly spaced grid ``xs (nx,) × ys (ny,)``, row-major.
 
-    Parameters
-    ----------
-    xs : (nx,) float, ys : (ny,) float, metres
-        The ROI grid, evenly spaced.
-    points_xy : (n, 2) float, metres
-        Where the camera's points lie; binned onto the nearest node.
-    points_noise_m : float
-        Their noise standard deviation.
-    extra_xy : (t, 2) float, metres
-        Points entered as they are (the tactile points).
-    extra_noise_m : float
-        Their noise standard deviation.
-    length_scale_m, signal_std_m : float
-        The touch GP's kernel.
-    n_samples : int
-        Number of draws (≥ 2).
-
-    Returns
-    -------
-    (n_samples, ny * nx) float, metres
-        Draws of the noise's part of the reconstruction at the nodes, row-major like the grid.
+    ``points_xy (n, 2)`` (the camera's, binned onto the nearest node) and ``extra_xy (t, 2)`` (the
+    tactile points, as they are) in metres with noise ``points_noise_m`` and ``extra_noise_m``;
+    the GP's kernel ``length_scale_m``, ``signal_std_m``; ``n_samples ≥ 2``.
     """
     gx_, gy_ = check_array("xs", xs, (None,), min_rows=2), check_array("ys", ys, (None,), min_rows=2)
     pts = check_array("points_xy", points_xy, (None, 2), what="positions in metres")

@@ -1,10 +1,6 @@
 """Settings of the map's Gaussian random fields: the surface, the touch (dent), the β-field and the
 modulus field, one frozen, keyword-only dataclass each (gathered in
-:class:`deformap.explore.ExplorationConfig`).
-
-Each class's Parameters section describes every field: first a one-line description with its unit
-(lengths in metres, β dimensionless in [0, 1), the modulus field in ln E with E in pascals), then
-the reason for its default.
+:class:`deformap.explore.ExplorationConfig`); lengths in metres, β dimensionless, ln E in ln Pa.
 
 References
 ----------
@@ -21,16 +17,8 @@ from typing import Literal
 
 from deformap._validation import SettingError, check_settings, setting
 
-__all__ = [
-    "BetaFieldConfig",
-    "DepthAnchor",
-    "ModulusFieldConfig",
-    "NuggetEstimate",
-    "SurfaceGPConfig",
-    "TactileCap",
-    "TouchGPConfig",
-    "TouchModel",
-]
+__all__ = ["BetaFieldConfig", "DepthAnchor", "ModulusFieldConfig", "NuggetEstimate", "SurfaceGPConfig",
+           "TactileCap", "TouchGPConfig", "TouchModel"]
 
 #: How the touch GP models the dent (``TouchGPConfig.model``).
 TouchModel = Literal["residual", "height"]
@@ -43,10 +31,9 @@ NuggetEstimate = Literal["within-class", "off"]
 
 @dataclass(frozen=True, kw_only=True)
 class SurfaceGPConfig:
-    """Crop, outlier filter and the surface Gaussian random field ("GPR world").
-
-    The hyperparameters start from the values below and are fitted by maximum marginal
-    likelihood (RW2006 Sec. 5.4) on a seeded subset of the first observation.
+    """Crop, outlier filter and the surface Gaussian random field ("GPR world"), whose
+    hyperparameters are fitted by maximum marginal likelihood (RW2006 Sec. 5.4) from the values
+    below.
 
     Parameters
     ----------
@@ -60,19 +47,15 @@ class SurfaceGPConfig:
         Outlier cut, in standard deviations of the points' mean neighbour distances.
     max_slope_deg : float
         Steepest surface kept, degrees from the horizontal.
-        60°: a camera at 45° sees the blocks' front faces, and those walls fitted as heights make
-        the GP ring over the map (:func:`deformap.cloud.height_field_mask`).
+        60°: the blocks' front faces a camera at 45° sees, fitted as heights, make the GP ring.
     min_length_scale_m : float
         Smallest length scale the fit may reach, metres.
-        3 cm: a flat surface leaves the length scale undetermined and the camera's disparity steps
-        pull it to millimetres, while the grid GP's cost grows steeply below it
-        (:mod:`deformap.gp`).
+        3 cm: on a flat surface disparity steps pull it to millimetres, where the grid GP is slow.
     fit_hyperparameters : bool
         Whether to fit the hyperparameters; ``False`` keeps the values below.
     max_fit_points : int
         Points of the seeded subset the likelihood is evaluated on, a count.
-        800: their spacing (about 2 cm over 60 × 40 cm) is well below any table-top surface's length
-        scale, and each evaluation costs n³.
+        800: about 2 cm apart, well below a table-top surface's length scale, at n³ per evaluation.
     fit_restarts : int
         Random restarts of the fit besides the start below, a count.
     length_scale_m : float
@@ -99,56 +82,41 @@ class SurfaceGPConfig:
     length_scale_m: float = setting(0.04, gt=0.0)
     signal_std_m: float = setting(0.03, gt=0.0)
     noise_std_m: float = setting(0.002, gt=0.0)
-    # below 1 mm is finer than a depth camera resolves on a table (a pixel spans millimetres at
-    # a metre), while every map's cell count grows as 1 / spacing²
+    # below 1 mm is finer than a depth camera resolves, and cell counts grow as 1 / spacing²
     grid_spacing_m: float = setting(0.005, gt=0.0, ge=0.001)
 
     def __post_init__(self) -> None:
         check_settings(self)
         if self.z_max_m <= self.z_min_m:
-            raise SettingError(
-                "z_max_m", f"must exceed `z_min_m` ({self.z_min_m}); got {self.z_max_m}"
-            )
+            raise SettingError("z_max_m", f"must exceed `z_min_m` ({self.z_min_m}); got {self.z_max_m}")
 
 
 @dataclass(frozen=True, kw_only=True)
 class TouchGPConfig:
-    """The ROI around a poke, the robot's removal from it, and the touch GP ("GPR-touch").
-
-    The touch GP is fitted, with the hyperparameters below, to the ROI of the cloud seen while
-    pressing plus the tactile points (:func:`deformap.explore.measure_press`).
+    """The ROI around a poke, the robot's removal from it, and the touch GP ("GPR-touch") fitted
+    to the ROI of the cloud seen while pressing plus the tactile points.
 
     Parameters
     ----------
     roi_size_m : float
         Side of the square ROI centred on the poke, metres.
-        12 cm: a 1 cm tip under about a newton dents 5 cm of foam over a few centimetres, and shape
-        matching fixes the ROI's edges, so they must be undisturbed.
+        12 cm: a 1 cm tip dents foam over a few centimetres, inside the ROI's fixed edges.
     model : {"residual", "height"}
         What the touch GP models, heights or their change, metres.
-        ``residual`` (default), the change of height against the surface GP's mean before the poke:
-        far from the dent it reverts to "no change" rather than to a constant that the occlusion by
-        stick and hand would bias; ``height``, the paper's literal form.
+        ``residual`` reverts far from the dent to "no change"; ``height`` is the paper's form.
     n_tactile : int
         Tactile points per 30° cap of the tip, a count (the paper's 10).
     tactile_noise_std_m : float
         Noise standard deviation of tactile points on the tip's proprioceptive pose, metres.
     tactile_cap : {"contact", "fixed"}
         Which cap of the tip carries the tactile points.
-        ``contact`` (default), the cap that touches at the poke's indentation δ (Hertz contact
-        radius √(Rδ)) at ``n_tactile`` points per 30°, at least the pole
-        (:func:`deformap.cloud.contact_cap`); ``fixed``, the paper's ``n_tactile`` points on a 30°
-        cap.
+        ``contact`` touches at δ (:func:`deformap.cloud.contact_cap`); ``fixed`` is the paper's.
     depth_anchor : {"record", "tip"}
         Where the tactile points' depth comes from, the record or the tip.
-        ``record`` (default; a press with a readable force–travel record): the surface model's
-        height minus the record's indentation, with its uncertainty as noise, so an error in the
-        tip's absolute height does not move the dent; ``tip`` and every other press: the tip as
-        proprioception places it, with ``tactile_noise_std_m``.
+        ``record``: the surface minus the record's indentation, blind to the tip's height error.
     dent_visible_sigmas : float
         Smallest visible dent, in standard deviations of the camera's mean height near the tip.
-        A dent shallower at the contact's edge (δ/2, Hertz) claims the σ of knowing nothing
-        about β, 1/√12; 2 is a one-sided test at about 98 %.
+        2 is a one-sided test at about 98 %.
     robot_margin_m : float
         Margin of the robot's convex hull whose points are removed, metres.
         2 mm: proprioception and camera do not agree to the millimetre.
@@ -157,12 +125,10 @@ class TouchGPConfig:
         The tactile points stand for what it hides.
     above_surface_m : float
         Height above the pre-poke surface above which points are removed, metres.
-        A dent goes down, so anything 1 cm higher (five times the camera's depth noise at the table)
-        is the stick, the hand or a flying pixel.
+        A dent goes down, so 1 cm higher is the stick, the hand or a flying pixel.
     max_slope_deg : float
         Steepest surface kept in the ROI, degrees from the horizontal.
-        It removes the flying-pixel veils behind the stick that hang lower than
-        ``above_surface_m``.
+        It removes the flying-pixel veils behind the stick below ``above_surface_m``.
     length_scale_m : float
         Length scale σ_w of the touch GP, metres.
         1 cm, the tip's radius: the dent cannot vary faster than the body pressing it.
@@ -172,14 +138,12 @@ class TouchGPConfig:
         Standard deviation of the camera's height noise in the ROI, metres.
     noise_samples : int
         Draws of the camera's noise carried through the touch GP for β's uncertainty, a count.
-        See :mod:`deformap.explore._dent_noise`; 0 when ``ExplorationConfig.beta_uncertainty`` is
-        ``shape-matching``, else at least 2.
+        0 when ``ExplorationConfig.beta_uncertainty`` is ``shape-matching``, else at least 2.
     """
 
     roi_size_m: float = setting(0.12, gt=0.0)
     model: TouchModel = "residual"
-    # the tactile points join the touch GP's data; a thousand on a fingertip's cap are already
-    # closer together than the camera's own points
+    # a thousand on a fingertip's cap are already closer together than the camera's points
     n_tactile: int = setting(10, ge=1, le=1000)
     tactile_noise_std_m: float = setting(0.0005, gt=0.0)
     tactile_cap: TactileCap = "contact"
@@ -203,31 +167,23 @@ class TouchGPConfig:
 
 @dataclass(frozen=True, kw_only=True)
 class BetaFieldConfig:
-    """Prior of the β-field, the Gaussian random field over the pokes' β (the paper's σe, σw, σn).
-
-    Each poke's noise standard deviation is ``√(σᵢ² + τ̂²)``: σᵢ its claimed β uncertainty, at
-    least ``noise_floor``, and τ̂ the map's nugget.
+    """Prior of the β-field, the Gaussian random field over the pokes' β (the paper's σe, σw, σn);
+    each poke's noise is ``√(σᵢ² + τ̂²)``, σᵢ its claimed σ at least ``noise_floor``.
 
     Parameters
     ----------
     signal_std : float
         Prior standard deviation σe of β about the pokes' weighted mean, dimensionless.
-        0.3: its variance 0.09 lies above the paper's ``T_h`` = 0.06, so an unexplored map asks for
-        a poke.
+        0.3: its variance 0.09 exceeds the paper's ``T_h`` = 0.06, so an unexplored map asks for a poke.
     length_scale_m : float
         Length scale σw of the β-field, metres.
         0.2 m, a third of a table, is the size of the pieces a robot is asked to tell apart.
     noise_floor : float or None
         Smallest claimed σ of a poke's β, dimensionless; ``None``: the β grid's quantisation.
-        The quantisation, ``shape_matching.beta_resolution / √12`` (the default), is what
-        every β̂'s σ already is at least (:func:`deformap.explore.beta_noise_floor`), so only
-        a robot that knows better need raise it.
+        The quantisation ``beta_resolution / √12`` is what every β̂'s σ already is at least.
     nugget : {"within-class", "off"}
         How the nugget τ̂, in β units, is estimated.
-        ``within-class`` (default): τ̂ is the scatter of β̂ between places on one material that σᵢ
-        does not explain, the maximum a posteriori of the restricted likelihood of the pokes within
-        the region test's classes (each class's mean removed) under a half-Cauchy prior scaled by
-        the pokes' median σᵢ (:mod:`deformap.explore._nugget`); ``off``: τ̂ = 0.
+        ``within-class`` (:mod:`deformap.explore._nugget`) or ``off`` (τ̂ = 0).
     """
 
     signal_std: float = setting(0.3, gt=0.0)
@@ -243,26 +199,20 @@ class BetaFieldConfig:
 class ModulusFieldConfig:
     """Prior of the modulus field, the Gaussian random field over the pokes' ln E (E in Pa).
 
-    It is fitted to the pokes whose force–travel record gave a modulus or read rigid
-    (:mod:`deformap.explore._modulus`).
-
     Parameters
     ----------
     signal_std : float
         Prior standard deviation of ln E about the pokes' weighted mean, ln Pa.
-        1.73, a quarter of ln(10⁶ / 10³): ±2σ spans the 1 kPa to 1 MPa of the soft foams to rubbers
-        a table-top robot presses (Gibson & Ashby 1997, ch. 5).
+        1.73: ±2σ spans the 1 kPa to 1 MPa of soft foams to rubbers (Gibson & Ashby 1997, ch. 5).
     length_scale_m : float
         Length scale σ_w of the modulus field, metres.
         The β-field's, for its reason: the pieces' size is a property of the layout.
     noise_floor : float
         Smallest standard deviation of a poke's ln E, ln Pa (its σ_E / E is raised to it).
-        0.1: a foam's modulus goes as its density squared (Gibson & Ashby 1997, Eq. 5.6), and a
-        sheet's density varies by a few per cent from place to place.
+        0.1: a foam's modulus goes as its density squared, which varies by a few per cent.
     rigid_log_std : float
         Standard deviation of ln E given to a rigid poke at its detection bound, ln Pa.
-        0.75: the bound (travel span plus two standard deviations) has a relative error of about
-        1/2, and E goes as travel^(−3/2) (Hertz).
+        0.75: the bound has a relative error of about 1/2, and E goes as travel^(−3/2).
     """
 
     signal_std: float = setting(1.73, gt=0.0)

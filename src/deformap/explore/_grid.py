@@ -1,11 +1,7 @@
 """The map's grid: every cell of the workspace, where a poke may go, where the variance must fall.
 
-Targets keep half a ROI inside the workspace, so each ROI lies on the surveyed surface rather than
-over its edge, where shape matching would have to explain a cliff. The planner
-(:mod:`deformap.explore._planning`) works on two 2 cm lattices of the same grid, edges included:
-the cells where the variance must fall (``plan_domain``) and those a poke may be planned on
-(``plan_candidates``); a plan short by the lattice's coarseness is planned again after the next
-poke. :meth:`MapGrid.without` takes the places a run could not read out of both.
+Targets keep half a ROI inside the workspace, so each ROI lies on the surveyed surface, not over
+its edge. The planner (:mod:`deformap.explore._planning`) works on two coarser lattices of it.
 """
 
 from __future__ import annotations
@@ -24,9 +20,8 @@ __all__ = ["MapGrid"]
 
 def _strided(nx: int, ny: int, step_m: float, spacing_m: float,
              within: NDArray[np.bool_] | None = None) -> NDArray[np.int64]:
-    """Flat indices of the ``(ny, nx)`` grid's cells about ``step_m`` apart, its first and last
-    rows and columns included (of the cells in ``within`` only, which must be a non-empty
-    rectangle of cells, as the workspace and its targets are; the lattice then spans it)."""
+    """Flat indices of the ``(ny, nx)`` grid's cells about ``step_m`` apart, first and last rows
+    and columns included, within the non-empty rectangle ``within``."""
     inside = np.ones(ny * nx, dtype=bool) if within is None else within
     rows, cols = np.nonzero(inside.reshape(ny, nx))
     stride = max(1, round(step_m / spacing_m))
@@ -43,19 +38,10 @@ def _strided(nx: int, ny: int, step_m: float, spacing_m: float,
 class MapGrid:
     """Cells of the workspace at the surface grid's spacing, and the masks over them.
 
-    Attributes
-    ----------
-    xs : (nx,) float, ys : (ny,) float, metres
-        Cell centres; every map of the run is ``(ny, nx)``.
-    cells_xy : (ny * nx, 2) float
-        The cells in row-major order.
-    target_mask : (ny * nx,) bool
-        Cells a poke may be centred on (half a ROI, at most a quarter of the workspace, inside
-        the edges).
-    stop_mask : (ny * nx,) bool
-        Cells whose variance must fall under ``T_h`` (``stop_region``).
-    plan_domain, plan_candidates : (d, 2), (c, 2) float
-        The planner's lattices of ``stop_mask`` and ``target_mask`` cells.
+    ``xs (nx,)``, ``ys (ny,)`` [m] the cell centres (every map is ``(ny, nx)``); ``cells_xy
+    (ny * nx, 2)`` row-major; ``target_mask``, ``stop_mask`` the cells a poke may be centred on and
+    whose variance must fall under ``T_h``; ``plan_domain (d, 2)``, ``plan_candidates (c, 2)`` the
+    planner's lattices of them.
     """
 
     xs: NDArray[np.float64]
@@ -82,16 +68,8 @@ class MapGrid:
         return cls(xs, ys, cells, target, stop, domain, candidates)
 
     def without(self, centres: NDArray[np.float64], radius_m: float) -> MapGrid | None:
-        """This grid with the discs of ``radius_m`` around the ``(n, 2)`` ``centres`` taken out of
-        its targets and of the cells whose variance must fall (places the map cannot read, which
-        no further press would make known); ``None`` when no target or no such cell is left.
-
-        Raises
-        ------
-        InvalidArgumentError
-            ``centres`` is not ``(n, 2)`` finite metres, or ``radius_m`` is not a positive
-            finite number.
-        """
+        """This grid with discs of ``radius_m`` around ``centres (n, 2)`` taken out of its targets
+        and stop cells; ``None`` when none is left. Raises :class:`InvalidArgumentError`."""
         centres = np.asarray(centres, dtype=float)
         if centres.ndim != 2 or centres.shape[1] != 2 or not np.isfinite(centres).all():
             raise InvalidArgumentError(f"`centres` must be an (n, 2) array of finite metres; got "
@@ -107,8 +85,6 @@ class MapGrid:
             return None
 
         def lattice(points: NDArray[np.float64]) -> NDArray[np.float64]:
-            if not len(centres):
-                return points
             gone = (np.hypot(points[:, None, 0] - centres[None, :, 0],
                              points[:, None, 1] - centres[None, :, 1]) <= radius_m).any(axis=1)
             return points[~gone]

@@ -1,9 +1,8 @@
 """A durable, append-only journal of a run: one JSON line per completed poke.
 
-The first line is a header holding the run's identity (its effective configuration); each later line
-is one poke, written with ``flush`` and ``os.fsync`` before the loop moves on, so a run killed at any
-moment loses at most the poke in progress. Reading tolerates a last line cut mid-write (the broken
-line is reported and dropped; every complete poke is kept).
+The first line is a header holding the run's identity; each later line is one poke, synced to disk
+before the loop moves on, so a killed run loses at most the poke in progress. Reading drops a last
+line cut mid-write.
 """
 
 from __future__ import annotations
@@ -36,12 +35,7 @@ class JournalContents:
 
 def read_journal(path: str | Path) -> JournalContents:
     """Read a journal; a last line cut mid-write is reported in ``broken_line`` and dropped.
-
-    Raises
-    ------
-    FileFormatError
-        If the file is missing, empty, has no valid header, or a line other than the last is broken.
-    """
+    :class:`FileFormatError` if the file is missing, has no header, or another line is broken."""
     p = Path(path)
     try:
         raw = p.read_bytes()
@@ -71,22 +65,15 @@ def read_journal(path: str | Path) -> JournalContents:
 
 
 class Journal:
-    """Append-only JSON-lines journal in ``folder/journal.jsonl``.
-
-    Use :meth:`create` for a new run and :meth:`resume` to continue one; both return a journal ready
-    for :meth:`append`.
-    """
+    """Append-only JSON-lines journal in ``folder/journal.jsonl`` (:meth:`create`, :meth:`resume`)."""
 
     def __init__(self, path: Path) -> None:
         self.path = path
 
     @classmethod
     def create(cls, folder: str | Path, header: dict[str, Any]) -> Journal:
-        """Start a journal holding ``header``; :class:`FileExistsError` if the folder has one.
-
-        The header goes to a temporary file that is renamed into place, so a run killed here
-        leaves either no journal or one with its whole header, never an empty one.
-        """
+        """Start a journal holding ``header`` (written atomically); :class:`FileExistsError` if
+        the folder has one."""
         path = Path(folder) / JOURNAL_NAME
         path.parent.mkdir(parents=True, exist_ok=True)
         if path.exists():
@@ -103,12 +90,9 @@ class Journal:
         contents = read_journal(path)
         stored = {k: v for k, v in contents.header.items() if k != "kind"}
         if stored != json.loads(json.dumps(header)):
-            differing = sorted(
-                k for k in set(stored) | set(header) if stored.get(k) != header.get(k)
-            )
-            raise ConfigError(
-                f"cannot resume {str(Path(folder))!r}: its run differs from this one in {differing}"
-            )
+            differing = sorted(k for k in set(stored) | set(header) if stored.get(k) != header.get(k))
+            raise ConfigError(f"cannot resume {str(Path(folder))!r}: its run differs from this one "
+                              f"in {differing}")
         journal = cls(path)
         if contents.broken_line is not None:
             journal._rewrite(contents)

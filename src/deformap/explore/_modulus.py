@@ -1,25 +1,11 @@
 """The modulus field: a Gaussian random field over ln E (E in Pa) from the pokes' force–travel
 records, beside the β-field, both a :class:`deformap.explore.PokeField`.
 
-Each poke's value and noise
----------------------------
-A poke whose record gave a modulus (:class:`deformap.stiffness.StiffnessEstimate`) enters as
-``ln E`` with the standard deviation ``σ_E / E`` (the delta method's σ of ln E), raised to the
-field's noise floor. A *rigid* poke has no modulus: it enters at its detection bound, the
-smallest modulus whose press would have travelled as far as the record's travel bound
-(:func:`rigid_modulus_bound`), with ``rigid_log_std``; never a huge number, which would drag the
-field's prior mean (the pokes' weighted mean) and every region threshold with it. A poke without
-a usable record (none came with the press, or the estimator refused it) is left out of the
-modulus field; :attr:`ModulusField.readings` says which and why, per poke.
-
-Prior mean
-----------
-:class:`deformap.gp.GaussianRandomField` subtracts a constant prior mean, the pokes'
-inverse-noise-variance weighted mean. For ln E a zero mean would be 1 Pa, nine orders below any
-foam, and a fixed physical mean (say the geometric centre of 1 kPa–1 MPa) would pull every
-unexplored place to a material that may not be on the table; the pokes' own mean is the
-empirical-Bayes choice the β-field makes too, and the prior variance (``signal_std²``) still says
-how little is known there.
+A poke with a modulus enters as ``ln E`` with σ ``σ_E / E`` (delta method), at least the field's
+floor. A *rigid* poke enters at its detection bound (:func:`rigid_modulus_bound`) with
+``rigid_log_std``, never a huge number that would drag the prior mean and every threshold. A poke
+without a usable record is left out; :attr:`ModulusField.readings` says which and why. The prior
+mean is the pokes' weighted mean, as for the β-field (empirical Bayes).
 """
 
 from __future__ import annotations
@@ -43,19 +29,9 @@ __all__ = ["ModulusField", "ModulusReading", "modulus_reading", "rigid_modulus_b
 
 @dataclass(frozen=True)
 class ModulusReading:
-    """One poke on the modulus field's axis.
-
-    Attributes
-    ----------
-    index : int
-        The poke's index in its run.
-    log_modulus, log_std : float or None
-        ln E [ln Pa] and its standard deviation before the floor; ``None`` when left out.
-    rigid : bool
-        The record read rigid: ``log_modulus`` is the detection bound.
-    excluded : str or None
-        Why the poke is not in the modulus field (``None`` when it is).
-    """
+    """One poke on the modulus field's axis: its ``index``, ln E [ln Pa] and σ before the floor
+    (``None`` when left out), whether it read ``rigid`` (ln E is then the detection bound), and why
+    it is ``excluded`` (``None`` when it is in)."""
 
     index: int
     log_modulus: float | None
@@ -70,23 +46,14 @@ class ModulusReading:
 
 
 def rigid_modulus_bound(record: PokeRecord, poisson_ratio: float) -> float:
-    """The smallest Young's modulus [Pa] a rigid poke's record could not tell from rigid.
-
-    The record's lower bound on the stiffness bounds the travel from zero force to the commanded
-    force ``F`` from above, ``δ_b = F / k_lower`` (at least the rigid test's travel bound: the
-    travel span plus two of its standard deviations, :func:`deformap.stiffness.estimate_stiffness`);
-    a surface of modulus ``E_b = F / g(δ_b)`` (``g`` the bonded-layer force at unit modulus on the
-    poke's layer, Hertz's half-space force without a layer thickness) would have travelled that
-    far. A stiffer one travels less and reads rigid too, so ``E_b`` is where the record's
-    knowledge ends.
-    """
+    """The smallest Young's modulus [Pa] a rigid poke's record could not tell from rigid:
+    ``E_b = F / g(δ_b)`` with ``δ_b = F / k_lower`` the travel bound and ``g`` the bonded-layer
+    force at unit modulus (Hertz's half-space without a layer thickness)."""
     estimate = record.stiffness
     if estimate is None or not estimate.rigid or estimate.stiffness_lower_n_per_m is None:
         raise InvalidArgumentError("`record` must be a poke whose force–travel record read rigid")
-    force = record.force_n
-    radius = record.contact.tip_radius_m
+    force, radius, thickness = record.force_n, record.contact.tip_radius_m, record.layer_thickness_m
     depth = force / estimate.stiffness_lower_n_per_m
-    thickness = record.layer_thickness_m
     if thickness is not None and np.isfinite(thickness) and thickness > depth:
         unit = float(layer_indentation_force(np.array([depth]), radius, thickness, 1.0,
                                              poisson_ratio)[0])  # fmt: skip
@@ -113,17 +80,12 @@ def modulus_reading(record: PokeRecord, config: ModulusFieldConfig,
 
 
 class ModulusField(PokeField):
-    """The modulus field over ln E of the pokes that have a modulus (no such poke: the prior).
-
-    ``mean`` and ``variance`` are of ln E [ln Pa] on the grid; :attr:`median_pa` is ``exp(mean)``
-    (the median of the log-normal posterior of E), :attr:`std` the standard deviation of ln E.
-    """
+    """The modulus field over ln E [ln Pa] of the pokes that have a modulus (none: the prior)."""
 
     name: ClassVar[FieldName] = "modulus"
 
     def __init__(self, pokes: PokeSet, xs: NDArray[np.float64], ys: NDArray[np.float64],
-                 config: ModulusFieldConfig,
-                 readings: Sequence[ModulusReading] = ()) -> None:
+                 config: ModulusFieldConfig, readings: Sequence[ModulusReading] = ()) -> None:
         super().__init__(pokes, xs, ys, config)
         self.readings = tuple(readings)
 
@@ -136,8 +98,7 @@ class ModulusField(PokeField):
         used = [(r, m) for r, m in zip(records, readings, strict=True) if m.excluded is None]
         xy = np.array([r.contact_xy for r, _ in used], dtype=float).reshape(-1, 2)
         values = np.array([m.log_modulus for _, m in used], dtype=float)
-        noise = np.maximum(np.array([m.log_std for _, m in used], dtype=float),
-                           config.noise_floor)  # fmt: skip
+        noise = np.maximum(np.array([m.log_std for _, m in used], dtype=float), config.noise_floor)
         index = np.array([m.index for _, m in used], dtype=np.int64)
         thickness = layer_thickness([r for r, _ in used])
         return cls(PokeSet(xy, values, noise.reshape(-1), index, thickness=thickness), xs, ys,

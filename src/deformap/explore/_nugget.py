@@ -1,50 +1,22 @@
-"""The β-field's nugget: the scatter of β̂ between places on one material that the pokes' own
-uncertainties do not explain, estimated for each map from its pokes.
+"""The β-field's nugget τ: the scatter of β̂ between places on one material that the pokes' own
+uncertainties (the camera's noise, :mod:`deformap.explore._dent_noise`) do not explain, estimated
+for each map from its pokes.
 
-Why
----
-A poke's claimed σ is the camera's noise carried through the estimate
-(:mod:`deformap.explore._dent_noise`): a repeatability at that place. Pressed at another place of
-the same material β̂ also moves with what the camera's noise does not model (the foam's own
-variation, the dent's reconstruction at another spot, the contact's placement), so the spread of β̂
-between places on one material exceeds the claimed σ. That excess is estimated from each map's
-pokes.
-
-Model
------
-Within one class of the region test (:func:`deformap.explore.segment_regions`: the pokes it finds
-to be one material), ``β̂ᵢ = μ_c + ηᵢ + εᵢ``: ``μ_c`` the class's β (a fixed effect, one per class),
-``ηᵢ ~ N(0, τ²)`` the place-to-place scatter (the nugget, the same for every poke of the map) and
-``εᵢ ~ N(0, σᵢ²)`` the poke's claimed uncertainty. τ is the maximum a posteriori of the restricted
-(REML) likelihood of that one-way random-effects model (Patterson & Thompson 1971; Harville 1977),
-the likelihood of the within-class contrasts, which the class means do not enter:
+Within one class of the region test, ``β̂ᵢ = μ_c + ηᵢ + εᵢ`` with ``ηᵢ ~ N(0, τ²)`` and
+``εᵢ ~ N(0, σᵢ²)``. τ̂ is the maximum a posteriori of the restricted (REML) likelihood of that
+one-way random-effects model (Patterson & Thompson 1971; Harville 1977),
 
     ℓ_R(τ) = −½ Σ_c [ Σ_{i∈c} ln vᵢ + ln Σ_{i∈c} 1/vᵢ + Σ_{i∈c} (β̂ᵢ − μ̂_c)² / vᵢ ],  vᵢ = σᵢ² + τ²
 
-(μ̂_c the class's inverse-variance weighted mean; a class of one poke contributes nothing), with a
-half-Cauchy prior on τ (Gelman 2006, the weakly-informative prior for a variance component met by
-few groups) whose scale is the pokes' median claimed σ: before any data, the scatter the camera
-does not explain is expected of the order of the scatter it does, and the Cauchy's tail lets the
-data say it is many times more. The scale is the estimator's own (a camera with more noise claims
-more), no number of the simulated world. The prior's mode is τ = 0, so pokes that scatter no more
-than they claim give τ̂ = 0 (the field then takes their own σ, at least the floor).
+(μ̂_c the class's inverse-variance weighted mean), under a half-Cauchy prior on τ (Gelman 2006)
+scaled by the pokes' median σᵢ: the unexplained scatter is expected of the order of the explained,
+and the prior's mode τ = 0 gives τ̂ = 0 to pokes that scatter no more than they claim.
 
-Why within the classes, not from the β-field's marginal likelihood
-------------------------------------------------------------------
-The β-field's prior (σₑ 0.3 over σ_w 0.2 m) explains a difference of a few tenths between pokes a
-decimetre or more apart as signal, so a nugget from its marginal likelihood is only identified by
-pokes closer together than σ_w; the few pokes of a map (five or six, a decimetre or two apart) leave
-it unidentified, while a step between two foams at close pokes is soaked up as noise. The classes
-say which pokes are one material whatever their distance, and removing each class's mean removes the
-steps between materials. Only the classes the region test examined and kept whole count: a class
-of fewer pokes than the test examines (3 with the default ``region_prior_dof``) is no evidence of
-one material (two pokes are never split, so a pair straddling two foams would read their step as
-scatter, and that scatter could merge the two foams' classes).
-The classes depend on the noise and the noise on τ:
-:func:`with_nugget` starts from the claimed σ, estimates τ from the classes
-found, finds the classes again with σᵢ² + τ² and repeats until the classes no longer change (at
-most :data:`MAX_ROUNDS` rounds). The region test's smallest step (``min_step``, 0.05 in β) keeps
-one material whose scatter the first round underrates from being cut in two.
+The classes say which pokes are one material whatever their distance (the field's marginal
+likelihood identifies a nugget only from pokes closer than σ_w). Only classes of as many pokes as
+the region test examines count (a pair straddling two foams would read their step as scatter).
+Classes and τ depend on each other: :func:`with_nugget` alternates until the classes no longer
+change, at most :data:`MAX_ROUNDS` rounds.
 
 References
 ----------
@@ -70,11 +42,9 @@ from deformap.explore._config import ExplorationConfig
 from deformap.explore._field import REGION_MIN_STEP_BETA, PokeSet, beta_noise_floor
 from deformap.explore._records import PokeRecord
 
-__all__ = ["MAX_ROUNDS", "beta_pokes", "estimate_nugget", "restricted_log_posterior",
-           "with_nugget"]
+__all__ = ["MAX_ROUNDS", "beta_pokes", "estimate_nugget", "restricted_log_posterior", "with_nugget"]
 
-#: Most rounds of classes and nugget (:func:`with_nugget`).
-MAX_ROUNDS = 5
+MAX_ROUNDS = 5  #: Most rounds of classes and nugget (:func:`with_nugget`).
 
 _GRID = 241  # τ values of the coarse search, geometric between the scale / 1000 and the upper end
 
@@ -99,12 +69,8 @@ def restricted_log_posterior(tau: float, beta: NDArray[np.float64], std: NDArray
 
 def estimate_nugget(beta: NDArray[np.float64], std: NDArray[np.float64],
                     labels: NDArray[np.int64], *, min_class_size: int = 2) -> float:
-    """τ̂, the MAP nugget of pokes ``beta (k,)`` with claimed ``std (k,)`` in classes ``labels (k,)``.
-
-    Only the classes of at least ``min_class_size`` pokes (and 2) count. 0 when none is left
-    (nothing is known of the scatter within a material) or the pokes scatter no more than they
-    claim. The prior's scale is the median ``std`` of all the pokes (module docstring).
-    """
+    """τ̂, the MAP nugget of pokes ``beta (k,)`` with claimed ``std (k,)`` in classes ``labels (k,)``
+    of at least ``min_class_size`` (and 2) pokes; 0 when no such class is left."""
     b = check_array("beta", beta, (None,), min_rows=1)
     s = check_array("std", std, (b.size,), what="standard deviations")
     lab = np.asarray(labels).reshape(-1)
@@ -133,22 +99,13 @@ def estimate_nugget(beta: NDArray[np.float64], std: NDArray[np.float64],
     lo, hi = taus[best - 1], taus[min(best + 1, taus.size - 1)]
     found = minimize_scalar(lambda t: -posterior(t), bounds=(lo, hi), method="bounded",
                             options={"xatol": scale * 1e-4})
-    tau = float(found.x) if found.success and -found.fun >= values[best] else float(taus[best])
-    return tau
+    return float(found.x) if found.success and -found.fun >= values[best] else float(taus[best])
 
 
 def with_nugget(pokes: PokeSet, config: ExplorationConfig) -> PokeSet:
-    """``pokes`` (β, each noise its claimed σ at least the floor) with the map's nugget τ̂ added to
-    every poke's noise in variance, ``√(σᵢ² + τ̂²)`` (module docstring).
-
-    The classes are the region test's on the β values (:func:`deformap.explore.segment_regions` with the
-    exploration's ``max_regions``, ``region_prior_dof`` and the β-field's smallest step and floor):
-    found first with the claimed σ, τ̂ estimated within those the test examined (as many pokes as
-    it tests a group of: a smaller class, a pair above all, is no evidence of one material), found
-    again with the noise that τ̂ gives, until they no longer change (at most
-    :data:`MAX_ROUNDS` rounds). ``pokes`` unchanged under
-    ``beta_field.nugget: off``.
-    """
+    """``pokes`` (β, noise at least the floor) with the map's nugget τ̂ added to every poke's noise,
+    ``√(σᵢ² + τ̂²)``, the classes those of :func:`deformap.explore.segment_regions` with the
+    β-field's settings (module docstring); unchanged under ``beta_field.nugget: off``."""
     if config.beta_field.nugget == "off" or len(pokes) < 2:
         return pokes
     floor = beta_noise_floor(config)

@@ -1,31 +1,17 @@
-"""Where the pokes lie as evidence: junction classes merged into their neighbours
-(:func:`merge_seam_classes`, ``ExplorationConfig.merge_seams``) and a class split where its
-pokes form two places (:func:`split_by_place`, ``ExplorationConfig.split_by_place``), both after
-the region test of :mod:`deformap.explore._classes`.
+"""Where the pokes lie as evidence, after the region test of :mod:`deformap.explore._classes`:
+junction classes merged into their neighbours (:func:`merge_seam_classes`) and a class split
+where its pokes form two places (:func:`split_by_place`).
 
-Two materials whose values lie close (``ExplorationConfig.split_by_place``)
----------------------------------------------------------------------------
-The test above sees the values only: two materials closer than ``min_step`` (or whose pokes'
-values overlap) stay one class wherever their pokes lie. Where they lie is evidence too: pokes of
-two materials side by side form two *places*, while the scatter of one material is spread over
-its area at random. So a class is also tested for a split by place (:func:`split_by_place`):
-its best split by value into a lower and an upper part (at least three pokes each, Fisher's
-split as in 1.) is scored by how many edges of the pokes' Delaunay graph it cuts (the join
-count: Cliff & Ord 1981), against the same split's join count after each of
-:data:`PLACE_PERMUTATIONS` shuffles of the values over the places (fixed seed: the same pokes
-give the same classes). A split that cuts fewer edges than shuffled values do (one-sided, 5 %
-shared by the classes tested in one round, Bonferroni) is kept, with no smallest step: the
-places, not the size of the difference, are the evidence (the parts' means must also lie ``z``
-standard errors apart, but Fisher's best split of one material already separates them by about
-that much: the join count is the test). Only the class's pokes farther than twice the layer's
-thickness from every poke of another class take part (what a press reads near a joint is the
-joint's, and pokes along a boundary would make one material look like two places: the junction
-rule's reach, :func:`merge_seam_classes`); with six of them the test cannot reject (a 3 / 3 split
-and its mirror cut as many edges), and it finds two materials cleanly left and right of random
-places about half the time with nine. A tested poke keeps its part and
-each other poke of the class joins the part of its nearest tested poke. Run after the junction
-rule (its parts are not junctions) and repeated until no class splits or ``max_regions`` are
-found.
+Split by place: two materials closer than ``min_step`` stay one class by value, but their pokes
+form two *places*, while one material's scatter is spread at random. A class's best split by value
+into two parts (at least three pokes each, Fisher's split) is scored by the edges of the pokes'
+Delaunay graph it cuts (the join count, Cliff & Ord 1981) against :data:`PLACE_PERMUTATIONS`
+shuffles of the values over the places (fixed seed); fewer cut edges than shuffled values give
+(one-sided, 5 % shared by the classes tested in a round, Bonferroni) keeps the split, with no
+smallest step. Only the class's pokes farther than twice the layer's thickness from every other
+class's pokes take part (a press near a joint reads the joint); with six the test cannot reject.
+The other pokes join the part of their nearest tested poke; repeated until no class splits or
+``max_regions`` are found.
 
 References
 ----------
@@ -47,19 +33,15 @@ from deformap.explore._classes import REGION_Z, RegionMap, ranked, separated
 
 __all__ = ["PLACE_PERMUTATIONS", "merge_seam_classes", "place_split", "split_by_place"]
 
-#: Shuffles of the values over the places in the split-by-place test (module docstring): a Monte
-#: Carlo p-value in steps of 1/200, a tenth of the test's 5 %.
+#: Shuffles of the split-by-place test: a p-value in steps of 1/200, a tenth of the test's 5 %.
 PLACE_PERMUTATIONS = 199
 _PLACE_SEED = 20161116
-# pokes on each side of a split by place: the value test's smallest group (segment_regions)
-_PLACE_MIN_PART = 3
+_PLACE_MIN_PART = 3  # pokes on each side of a split by place: the value test's smallest group
 
 
 def _neighbours(xy: NDArray[np.float64]) -> list[set[int]]:
-    """Each poke's natural neighbours: the pokes whose Voronoi cells share an edge with its own
-    (Delaunay triangulation; pokes at one place share their neighbours). Places on one line
-    (no triangle) have their Voronoi cells side by side along it: each place's neighbours are
-    the places just before and after it along the line."""
+    """Each poke's natural neighbours (Delaunay; pokes at one place share them; places on one
+    line neighbour those just before and after)."""
     places, which = np.unique(np.round(xy, 9), axis=0, return_inverse=True)
     which = np.asarray(which).reshape(-1)
     near: list[set[int]] = [set() for _ in range(places.shape[0])]
@@ -86,18 +68,11 @@ def merge_seam_classes(found: RegionMap, mean: NDArray[np.float64],
                        thickness_m: NDArray[np.float64] | None) -> RegionMap:
     """``found`` with its junction classes merged into their neighbours.
 
-    A press where two pieces meet reads neither piece: across a bonded seam it dents both and
-    reads between them; beside a free face (pieces laid side by side) the foam gives way sideways
-    and it reads softer than both. The classes, found from the values alone, take such a reading
-    for a material of its own. A class is taken for a junction when *every* one of its pokes is a
-    natural neighbour (:func:`_neighbours`) of pokes of at least two other classes: each such poke
-    then joins, of its neighbours' classes, the one whose mean is nearest to its value; the
-    classes' means and isopleths are recomputed and the test repeated until no class is a
-    junction. A class with one poke inside it (its neighbours of one other class only) is kept,
-    so an insert met by a single poke stays a region. What it gives up: a material seen only by
-    pokes lying where two others meet (a stripe one poke wide between two others) is merged until
-    a poke lands inside it. Without every poke's thickness (``None``: a poke without a force–travel
-    record) no class is merged.
+    A press where two pieces meet reads neither (between them across a bonded seam, softer than
+    both beside a free face). A class is a junction when *every* one of its pokes is a natural
+    neighbour, within the joint's reach, of pokes of at least two other classes: each such poke
+    joins the neighbouring class whose mean is nearest its value, and the test repeats until no
+    class is a junction. Without every poke's thickness (``None``) nothing is merged.
     """
     if thickness_m is None:
         return found
@@ -126,9 +101,8 @@ def merge_seam_classes(found: RegionMap, mean: NDArray[np.float64],
 
 
 def _value_splits(values: NDArray[np.float64]) -> NDArray[np.bool_]:
-    """For each row of ``values (m, n)``, the upper part of its best split by value (Fisher's:
-    the largest between-part sum of squares, at least ``_PLACE_MIN_PART`` values each side), as a
-    mask over the row's own places (ties broken by place, stably)."""
+    """The upper part of each row's best split by value (Fisher's, at least ``_PLACE_MIN_PART``
+    each side) as a mask over ``values (m, n)``."""
     m, n = values.shape
     order = np.argsort(values, axis=1, kind="stable")
     csum = np.cumsum(np.take_along_axis(values, order, axis=1), axis=1)
@@ -143,14 +117,9 @@ def _value_splits(values: NDArray[np.float64]) -> NDArray[np.bool_]:
 
 def place_split(values: NDArray[np.float64], stds: NDArray[np.float64],
                 xy: NDArray[np.float64], *, level: float = 0.05) -> NDArray[np.bool_] | None:
-    """The upper part of the best split by value of one class's pokes when that split follows
-    their places at ``level`` (module docstring, "Two materials whose values lie close"), else
-    ``None``.
-
-    ``values (n,)`` and ``stds (n,)`` (each at least the field's floor) at ``xy (n, 2)``; at least
-    ``2 · 3`` pokes, else ``None`` (with six the test cannot reject: a 3 / 3 split and its mirror
-    image cut as many edges, so about one shuffle in ten ties it; two materials cleanly left and
-    right of random places are found in about half of the draws with nine pokes at 5 %)."""
+    """The upper part of the best split by value of one class's pokes ``values (n,)``, ``stds
+    (n,)`` at ``xy (n, 2)`` when it follows their places at ``level`` (module docstring), else
+    ``None`` (also under six pokes)."""
     n = values.size
     if n < 2 * _PLACE_MIN_PART:
         return None
@@ -159,8 +128,7 @@ def place_split(values: NDArray[np.float64], stds: NDArray[np.float64],
     if not edges.size:
         return None
     rng = np.random.default_rng(_PLACE_SEED)
-    rows = np.vstack([values[None, :], [rng.permutation(values) for _ in
-                                        range(PLACE_PERMUTATIONS)]])
+    rows = np.vstack([values[None, :], [rng.permutation(values) for _ in range(PLACE_PERMUTATIONS)]])
     splits = _value_splits(rows)
     joins = np.count_nonzero(splits[:, edges[:, 0]] != splits[:, edges[:, 1]], axis=1)
     p_value = (1 + np.count_nonzero(joins[1:] <= joins[0])) / (PLACE_PERMUTATIONS + 1)
@@ -172,9 +140,8 @@ def place_split(values: NDArray[np.float64], stds: NDArray[np.float64],
 
 
 def _joint_reach(thickness_m: NDArray[np.float64], n: int) -> NDArray[np.float64]:
-    """How far from a press a joint changes what it reads: twice the layer's thickness there
-    (a bonded layer carries the load sideways over about its own thickness; the joint, expected
-    midway between two presses, within one thickness of each), per poke [m]."""
+    """How far from each press a joint changes what it reads [m]: twice the layer's thickness (a
+    bonded layer carries the load sideways over about its thickness)."""
     return 2.0 * check_array("thickness_m", thickness_m, (n,), what="metres")
 
 
@@ -182,15 +149,8 @@ def split_by_place(found: RegionMap, mean: NDArray[np.float64], poke_xy: NDArray
                    poke_value: NDArray[np.float64], poke_std: NDArray[np.float64],
                    thickness_m: NDArray[np.float64] | None, *, max_regions: int) -> RegionMap:
     """``found`` with each class split in two while its pokes away from the other classes form
-    two places of different values (:func:`place_split`; module docstring), up to
-    ``max_regions`` classes. Only a class's pokes farther than the joint's reach
-    (:func:`_joint_reach`) from every poke of another class are tested; the classes tested in one
-    round share the 5 % (Bonferroni); a tested poke keeps its part and every other poke of the
-    class joins the part of its nearest tested poke (a split that would leave a part empty is
-    none). Without every poke's thickness (``None``) nothing is split, as
-    :func:`merge_seam_classes` merges nothing. With eleven classes or more tested at once the
-    shared level falls below the shuffles' resolution (1/200) and none can split: the default
-    ``max_regions`` (6) stays clear of it."""
+    two places of different values (module docstring), up to ``max_regions`` classes; nothing is
+    split without every poke's thickness (``None``)."""
     if thickness_m is None:
         return found
     labels = found.poke_labels.copy()
@@ -207,7 +167,6 @@ def split_by_place(found: RegionMap, mean: NDArray[np.float64], poke_xy: NDArray
                           > reach[members, None], axis=1)
             if np.count_nonzero(away) >= 2 * _PLACE_MIN_PART:
                 candidates.append((members, members[away]))
-        split = False
         for members, tested in candidates:
             upper = place_split(values[tested], stds[tested], xy[tested],
                                 level=0.05 / len(candidates))
@@ -218,9 +177,8 @@ def split_by_place(found: RegionMap, mean: NDArray[np.float64], poke_xy: NDArray
             if side.all() or not side.any():
                 continue
             labels[members[side]] = labels.max() + 1
-            split = True
             break
-        if not split:
+        else:  # no class split
             break
     if np.array_equal(labels, found.poke_labels):
         return found

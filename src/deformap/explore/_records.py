@@ -1,8 +1,7 @@
 """Typed records of an exploration: what one poke gave, and why a place was chosen.
 
-A poke's record is a frozen value built once, when the poke has entered the β-field; it becomes
-plain data only at the journal and report boundary (:meth:`PokeRecord.to_dict`) and comes back
-from a journal through :meth:`PokeRecord.from_dict`, which refuses a line that is not a poke.
+A record becomes plain data only at the journal and report boundary (:meth:`PokeRecord.to_dict`)
+and comes back through :meth:`PokeRecord.from_dict`, which refuses a line that is not a poke.
 """
 
 from __future__ import annotations
@@ -21,20 +20,12 @@ from deformap.explore._planning import PokePlan
 from deformap.msm import BetaEstimate
 from deformap.stiffness import LAYER_MODEL, StiffnessEstimate
 
-__all__ = [
-    "PURPOSES",
-    "ContactRecord",
-    "Dent",
-    "PokeRecord",
-    "PokeResult",
-    "PokeTimings",
-    "Purpose",
-    "Target",
-]
+__all__ = ["PURPOSES", "ContactRecord", "Dent", "PokeRecord", "PokeResult", "PokeTimings", "Purpose",
+           "Target"]
 
+#: Why a place was poked: the first poke, the strategy's (until the variance is under ``T_h``), or
+#: a boundary poke after it.
 Purpose = Literal["first", "variance", "boundary"]
-"""Why a place was poked: the configured first poke, the strategy's (until the β-field's variance
-is under ``T_h``), or a boundary poke after it."""
 PURPOSES: tuple[str, ...] = get_args(Purpose)
 
 
@@ -52,13 +43,11 @@ def _floats(value: Any, n: int | None, where: str) -> tuple[float, ...]:
 
 def _number(data: Mapping[str, Any], key: str, where: str, *, kind: type = float,
             optional: bool = False) -> Any:
-    if key not in data:
-        if optional:
-            return None
-        raise FileFormatError(f"`{where}` has no `{key}`")
-    value = data[key]
+    value = data.get(key)
     if value is None and optional:
         return None
+    if key not in data:
+        raise FileFormatError(f"`{where}` has no `{key}`")
     if kind is bool:
         if not isinstance(value, bool):
             raise FileFormatError(f"`{where}.{key}` must be true or false; got {value!r}")
@@ -81,36 +70,33 @@ def _text(data: Mapping[str, Any], key: str, where: str) -> str | None:
     return value
 
 
-def _stiffness_to_dict(estimate: StiffnessEstimate) -> dict[str, Any]:
-    return {f.name: getattr(estimate, f.name) for f in fields(estimate)}
+def _mapping(data: Any, where: str, cls: type | None = None, *, also: frozenset[str] = frozenset()
+             ) -> Mapping[str, Any]:
+    """``data`` if it is a mapping holding no key but ``cls``'s fields (and ``also``)."""
+    if not isinstance(data, Mapping):
+        raise FileFormatError(f"`{where}` must be a mapping; got {data!r}")
+    unknown = [] if cls is None else sorted(set(data) - {f.name for f in fields(cls)} - also)
+    if unknown:
+        raise FileFormatError(f"`{where}` has unknown key(s) {unknown}")
+    return data
 
 
 def _stiffness_from_dict(data: Any, where: str) -> StiffnessEstimate | None:
     if data is None:
         return None
-    if not isinstance(data, Mapping):
-        raise FileFormatError(f"`{where}` must be a mapping; got {data!r}")
+    data = _mapping(data, where, StiffnessEstimate)
     names = {f.name for f in fields(StiffnessEstimate)}
-    unknown = sorted(set(data) - names)
-    if unknown:
-        raise FileFormatError(f"`{where}` has unknown key(s) {unknown}")
     numbers = {n: _number(data, n, where, optional=True)
                for n in names - {"rigid", "n_samples", "model", "depth_m"}}  # fmt: skip
     model = _text(data, "model", where)
     try:
-        return _stiffness_estimate(data, numbers, model, where)
+        return StiffnessEstimate(
+            **numbers, depth_m=_number(data, "depth_m", where),
+            rigid=_number(data, "rigid", where, kind=bool),
+            n_samples=_number(data, "n_samples", where, kind=int),
+            model=LAYER_MODEL if model is None else model)
     except InvalidArgumentError as exc:
         raise FileFormatError(f"`{where}`: {exc}") from None
-
-
-def _stiffness_estimate(data: Mapping[str, Any], numbers: dict[str, Any], model: str | None,
-                        where: str) -> StiffnessEstimate:
-    return StiffnessEstimate(
-        **numbers, depth_m=_number(data, "depth_m", where),
-        rigid=_number(data, "rigid", where, kind=bool),
-        n_samples=_number(data, "n_samples", where, kind=int),
-        model=LAYER_MODEL if model is None else model,
-    )  # fmt: skip
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -134,8 +120,7 @@ class ContactRecord:
 
     @classmethod
     def from_dict(cls, data: Any, where: str) -> ContactRecord:
-        if not isinstance(data, Mapping):
-            raise FileFormatError(f"`{where}` must be a mapping; got {data!r}")
+        data = _mapping(data, where)
         center = _floats(data.get("tip_center"), 3, f"{where}.tip_center")
         force = _floats(data.get("force"), 3, f"{where}.force")
         return cls(tip_center=(center[0], center[1], center[2]),
@@ -145,13 +130,9 @@ class ContactRecord:
 
 @dataclass(frozen=True, kw_only=True)
 class PokeTimings:
-    """Seconds spent on one poke, by stage; a stage a poke did not pass through is ``None``.
-
-    ``filter_s`` crop and robot removal, ``touch_gp_s`` the dent's reconstruction, ``beta_s`` the
-    β estimate and its uncertainty, ``stiffness_s`` the force–travel fit, ``field_s`` the β-field
-    update, ``target_s`` choosing the place, ``environment_s`` the world or robot (or reading the
-    recording).
-    """
+    """Seconds spent on one poke, by stage (``None``: not passed through): crop and filter, the
+    dent's reconstruction, β, the force–travel fit, the field update, choosing the place, and the
+    world, robot or recording."""
 
     filter_s: float
     touch_gp_s: float
@@ -173,12 +154,8 @@ class PokeTimings:
 
     @classmethod
     def from_dict(cls, data: Any, where: str) -> PokeTimings:
-        if not isinstance(data, Mapping):
-            raise FileFormatError(f"`{where}` must be a mapping; got {data!r}")
+        data = _mapping(data, where, cls)
         names = [f.name for f in fields(cls)]
-        unknown = sorted(set(data) - set(names))
-        if unknown:
-            raise FileFormatError(f"`{where}` has unknown key(s) {unknown}")
         required = ("filter_s", "touch_gp_s", "beta_s")
         return cls(**{n: _number(data, n, where, optional=n not in required) for n in names})
 
@@ -187,48 +164,17 @@ class PokeTimings:
 class PokeRecord:
     """What one poke gave: where, the contact, β with its uncertainty and E(β), and timings.
 
-    Attributes
-    ----------
-    index : int
-        The poke's place in its run, from 0.
-    target_xy, contact_xy : (2,) float, metres
-        Where the poke was aimed, and where the tip touched (the β-field's input location).
-    force_n : float
-        The commanded normal force.
-    beta, beta_std : float
-        β̂ and its uncertainty (the β-field's noise for this poke, before the floor).
-    betas, errors : tuple of float
-        The compared β and their shape-matching errors E(β) in metres.
-    iterations, residual, converged
-        The shape-matching solver's largest iteration count and residual, and whether every
-        compared β converged.
-    n_roi_points : int
-        Cloud points of the ROI the dent was reconstructed from.
-    camera_noise_m : float or None
-        The camera's noise measured in the ROI (``None`` when β's uncertainty is not sampled).
-    stiffness : StiffnessEstimate or None
-        Stiffness and Young's modulus from the press's force–travel record
-        (:func:`deformap.stiffness.estimate_stiffness`); ``None`` without a record.
-    layer_thickness_m : float or None
-        The layer thickness the modulus was read with (the surface's height at the contact).
-    stiffness_error : str or None
-        Why a record that came with the press gave no estimate (the poke then stands on the
-        camera alone).
-    indentation_m : float or None
-        The indentation the tactile points were placed for: the force–travel record's (0 when
-        read rigid), else the tip's depth below the surface model (:mod:`deformap.explore._dent`).
-    depth_anchored : bool or None
-        Whether the tactile points' heights came from the record rather than the tip's height.
-    dent_visible : bool or None
-        Whether the camera saw the dent above its noise (``False``: β's σ was widened to that of
-        a uniform β; ``None`` when β's uncertainty is not the camera's noise).
-    purpose : {"first", "variance", "boundary"} or None
-        Why this place (``None`` outside the live loop: a replayed or single poke).
-    planned_after : int or None
-        Under ``planned``, how many more pokes the plan this target came from foresaw.
-    max_variance_after : float or None
-        The largest β-field variance where it must fall under ``T_h``, this poke included
-        (``None`` until the poke has entered a β-field).
+    ``index`` from 0 in its run; ``target_xy`` and ``contact_xy`` [m] where the poke was aimed
+    and touched; ``force_n`` the commanded force; ``beta``, ``beta_std`` β̂ and its σ (before the
+    field's floor); ``betas``, ``errors`` the compared β and E(β) [m]; ``iterations``,
+    ``residual``, ``converged`` the solver's worst; ``n_roi_points`` the ROI's cloud points;
+    ``camera_noise_m`` the camera's measured noise. Optional (``None`` when not applicable): the
+    record's ``stiffness`` estimate, the ``layer_thickness_m`` it was read with, or why it gave
+    none (``stiffness_error``); the ``indentation_m`` the tactile points were placed for, whether
+    their depth came from the record (``depth_anchored``); whether the camera saw the dent
+    (``dent_visible``; ``False`` widens σ to a uniform β's); the ``purpose``; how many more pokes
+    a plan foresaw (``planned_after``); the largest field variance where it must fall under
+    ``T_h`` after this poke (``max_variance_after``).
     """
 
     index: int
@@ -262,84 +208,62 @@ class PokeRecord:
         return np.asarray(self.contact_xy, dtype=float)
 
     def to_dict(self) -> dict[str, Any]:
-        """Plain data for the journal and ``report.json`` (optional fields left out when unset,
-        ``camera_noise_m`` always written)."""
-        out: dict[str, Any] = {
-            "index": self.index, "target_xy": list(self.target_xy),
-            "contact_xy": list(self.contact_xy), "contact": self.contact.to_dict(),
-            "force_n": self.force_n, "beta": self.beta, "beta_std": self.beta_std,
-            "betas": list(self.betas), "errors": list(self.errors),
-            "iterations": self.iterations, "residual": self.residual,
-            "converged": self.converged, "n_roi_points": self.n_roi_points,
-            "camera_noise_m": self.camera_noise_m, "timings": self.timings.to_dict(),
-        }  # fmt: skip
-        if self.stiffness is not None:
-            out["stiffness"] = _stiffness_to_dict(self.stiffness)
-        for name in ("layer_thickness_m", "stiffness_error", "indentation_m", "depth_anchored",
-                     "dent_visible", "purpose", "planned_after", "max_variance_after"):
-            if getattr(self, name) is not None:
-                out[name] = getattr(self, name)
+        """Plain data for the journal and ``report.json`` (unset optional fields left out)."""
+        out: dict[str, Any] = {}
+        for f in fields(self):
+            value = getattr(self, f.name)
+            if isinstance(value, tuple):
+                value = list(value)
+            elif isinstance(value, (ContactRecord, PokeTimings)):
+                value = value.to_dict()
+            elif isinstance(value, StiffnessEstimate):
+                value = {g.name: getattr(value, g.name) for g in fields(value)}
+            if value is not None or f.name == "camera_noise_m":
+                out[f.name] = value
         return out
 
     @classmethod
     def from_dict(cls, data: Any, *, where: str = "poke") -> PokeRecord:
-        """The record a journal line holds (:meth:`to_dict`'s form).
-
-        Raises
-        ------
-        FileFormatError
-            If a field is missing, of the wrong type or unknown; the message names it.
-        """
-        if not isinstance(data, Mapping):
-            raise FileFormatError(f"`{where}` must be a mapping; got {data!r}")
-        names = {f.name for f in fields(cls)}
-        unknown = sorted(set(data) - names - {"kind"})
-        if unknown:
-            raise FileFormatError(f"`{where}` has unknown key(s) {unknown}")
+        """The record a journal line holds; :class:`FileFormatError` naming a field that is
+        missing, of the wrong type or unknown."""
+        data = _mapping(data, where, cls, also=frozenset({"kind"}))
         purpose = data.get("purpose")
         if purpose is not None and purpose not in PURPOSES:
             raise FileFormatError(f"`{where}.purpose` must be one of {list(PURPOSES)}; "
                                   f"got {purpose!r}")  # fmt: skip
         target = _floats(data.get("target_xy"), 2, f"{where}.target_xy")
         contact_xy = _floats(data.get("contact_xy"), 2, f"{where}.contact_xy")
+
+        def num(key: str, kind: type = float, optional: bool = False) -> Any:
+            return _number(data, key, where, kind=kind, optional=optional)
+
         return cls(
-            index=_number(data, "index", where, kind=int),
-            target_xy=(target[0], target[1]),
+            index=num("index", int), target_xy=(target[0], target[1]),
             contact_xy=(contact_xy[0], contact_xy[1]),
             contact=ContactRecord.from_dict(data.get("contact"), f"{where}.contact"),
-            force_n=_number(data, "force_n", where),
-            beta=_number(data, "beta", where),
-            beta_std=_number(data, "beta_std", where),
+            force_n=num("force_n"), beta=num("beta"), beta_std=num("beta_std"),
             betas=_floats(data.get("betas"), None, f"{where}.betas"),
             errors=_floats(data.get("errors"), None, f"{where}.errors"),
-            iterations=_number(data, "iterations", where, kind=int),
-            residual=_number(data, "residual", where),
-            converged=_number(data, "converged", where, kind=bool),
-            n_roi_points=_number(data, "n_roi_points", where, kind=int),
-            camera_noise_m=_number(data, "camera_noise_m", where, optional=True),
+            iterations=num("iterations", int), residual=num("residual"),
+            converged=num("converged", bool), n_roi_points=num("n_roi_points", int),
+            camera_noise_m=num("camera_noise_m", optional=True),
             timings=PokeTimings.from_dict(data.get("timings"), f"{where}.timings"),
             stiffness=_stiffness_from_dict(data.get("stiffness"), f"{where}.stiffness"),
-            layer_thickness_m=_number(data, "layer_thickness_m", where, optional=True),
+            layer_thickness_m=num("layer_thickness_m", optional=True),
             stiffness_error=_text(data, "stiffness_error", where),
-            indentation_m=_number(data, "indentation_m", where, optional=True),
-            depth_anchored=_number(data, "depth_anchored", where, kind=bool, optional=True),
-            dent_visible=_number(data, "dent_visible", where, kind=bool, optional=True),
-            purpose=purpose,
-            planned_after=_number(data, "planned_after", where, kind=int, optional=True),
-            max_variance_after=_number(data, "max_variance_after", where, optional=True),
-        )
+            indentation_m=num("indentation_m", optional=True),
+            depth_anchored=num("depth_anchored", bool, True),
+            dent_visible=num("dent_visible", bool, True), purpose=purpose,
+            planned_after=num("planned_after", int, True),
+            max_variance_after=num("max_variance_after", optional=True))
 
 
 @dataclass(frozen=True, eq=False)
 class Dent:
-    """A poke's reconstructed dent on its ROI grid, for figures and recordings.
-
-    ``roi_xs (nx,)``, ``roi_ys (ny,)`` the ROI grid; ``rest_z``, ``deformed_z (ny, nx)`` the
-    surface before and while pressing (metres); ``roi_points (m, 3)`` the cloud points kept;
-    ``tactile (k, 3)`` the tactile points on the tip; ``force_travel`` the press's force–travel
-    record (``None`` without one) and ``force_fit (2, m)`` the curve its modulus was fitted with,
-    travel [m] and force [N] (``None`` without a modulus).
-    """
+    """A poke's reconstructed dent for figures and recordings: the ROI grid ``roi_xs (nx,)``,
+    ``roi_ys (ny,)``; heights ``rest_z``, ``deformed_z (ny, nx)`` before and while pressing;
+    ``roi_points (m, 3)`` and ``tactile (k, 3)``, metres; the press's ``force_travel`` record and
+    ``force_fit (2, m)``, travel [m] and force [N] of the fitted model (``None`` without)."""
 
     roi_xs: NDArray[np.float64]
     roi_ys: NDArray[np.float64]
@@ -353,8 +277,7 @@ class Dent:
 
 @dataclass(frozen=True, eq=False)
 class PokeResult:
-    """One processed poke: its record, and (when processed in this session, not resumed from a
-    journal) the dent it was estimated from and the full β estimate."""
+    """One processed poke: its record, and (unless resumed from a journal) its dent and estimate."""
 
     record: PokeRecord
     dent: Dent | None = None
@@ -368,11 +291,7 @@ class PokeResult:
 
 @dataclass(frozen=True, eq=False)
 class Target:
-    """The next place to poke and why.
-
-    ``xy (2,)`` metres; ``purpose`` as in :class:`PokeRecord`; ``plan`` the plan it came from
-    (strategy ``planned``), else ``None``.
-    """
+    """The next place to poke, ``xy (2,)`` metres, why, and the plan it came from (or ``None``)."""
 
     xy: NDArray[np.float64]
     purpose: Purpose
@@ -380,8 +299,7 @@ class Target:
 
     @property
     def planned_after(self) -> int | None:
-        """How many more pokes the plan foresees after this one (only a plan that reaches
-        ``T_h`` foresees any)."""
+        """How many more pokes a plan that reaches ``T_h`` foresees after this one."""
         if self.plan is None or not self.plan.reaches:
             return None
         return len(self.plan.targets) - 1

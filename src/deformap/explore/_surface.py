@@ -1,10 +1,6 @@
-"""The surface model ("GPR world"): the first observation, cropped and filtered, as a Gaussian
-random field and its heightmap on the map's grid.
-
-The cloud is cropped to the workspace and to ``[z_min_m, z_max_m]``, cleaned of statistical
-outliers and of steep faces no height field has (:func:`deformap.cloud.height_field_mask`), and the
-field's hyperparameters are fitted by maximum marginal likelihood (RW2006 Sec. 5.4) from the
-configured values, the length scale held at or above ``min_length_scale_m``.
+"""The surface model ("GPR world"): the first observation, cropped to the workspace and
+``[z_min_m, z_max_m]``, cleaned of outliers and steep faces, as a Gaussian random field whose
+hyperparameters are fitted by maximum marginal likelihood (RW2006 Sec. 5.4), and its heightmap.
 
 References
 ----------
@@ -55,50 +51,29 @@ def crop_to(points: NDArray[np.float64], lower_xy: NDArray[np.float64] | tuple[f
 def fit_surface(cloud: PointCloud, workspace: Workspace, xs: NDArray[np.float64],
                 ys: NDArray[np.float64], config: SurfaceGPConfig,
                 rng: np.random.Generator) -> SurfaceModel:
-    """Crop and filter ``cloud`` (world frame, metres) and fit the surface GP to it.
+    """Crop and filter ``cloud`` (world frame, metres) to ``workspace``, fit the surface GP to it
+    (``rng`` for the fit's subset and restarts) and read it on ``xs (nx,) × ys (ny,)``.
 
-    Parameters
-    ----------
-    cloud : PointCloud
-        The first observation.
-    workspace : Workspace
-        The rectangle mapped; points outside it are dropped.
-    xs : (nx,) float, ys : (ny,) float
-        The grid the heightmap is read on.
-    config : SurfaceGPConfig
-    rng : numpy.random.Generator
-        For the hyperparameter fit's subset and restarts.
-
-    Raises
-    ------
-    InvalidArgumentError
-        If no more than ``outlier_k`` points lie on the workspace.
+    Raises :class:`InvalidArgumentError` if no more than ``outlier_k`` points lie on the workspace.
     """
     pts = crop_to(cloud.points, workspace.lower, workspace.upper, config)
     if pts.shape[0] <= config.outlier_k:
-        raise InvalidArgumentError(
-            f"`cloud` must have more than {config.outlier_k} points on the workspace; "
-            f"got {pts.shape[0]} (is it in the world frame, in metres?)"
-        )
+        raise InvalidArgumentError(f"`cloud` must have more than {config.outlier_k} points on the "
+                                   f"workspace; got {pts.shape[0]} (is it in the world frame, in "
+                                   "metres?)")
     kept = pts[statistical_outlier_mask(pts, config.outlier_k, config.outlier_std_ratio)]
     if kept.shape[0] >= config.outlier_k:
         kept = kept[height_field_mask(kept, config.outlier_k, config.max_slope_deg)]
-    init = GPHyperparameters(
-        length_scale=config.length_scale_m,
-        signal_std=config.signal_std_m,
-        noise_std=config.noise_std_m,
-        log_marginal_likelihood=float("nan"),
-    )
-    hyper = init
+    hyper = init = GPHyperparameters(length_scale=config.length_scale_m,
+                                     signal_std=config.signal_std_m, noise_std=config.noise_std_m,
+                                     log_marginal_likelihood=float("nan"))
     if config.fit_hyperparameters:
         bounds = default_bounds(kept[:, :2], kept[:, 2])
         bounds[0] = np.maximum(bounds[0], config.min_length_scale_m)
-        hyper = fit_hyperparameters(kept[:, :2], kept[:, 2], rng=rng, init=init,
-                                    max_points=config.max_fit_points,
-                                    n_restarts=config.fit_restarts, bounds=bounds)  # fmt: skip
-    gp = GaussianRandomField(
-        length_scale=hyper.length_scale, signal_std=hyper.signal_std, noise_std=hyper.noise_std
-    ).fit(kept[:, :2], kept[:, 2])
+        hyper = fit_hyperparameters(kept[:, :2], kept[:, 2], rng=rng, init=init, bounds=bounds,
+                                    max_points=config.max_fit_points, n_restarts=config.fit_restarts)
+    gp = GaussianRandomField(length_scale=hyper.length_scale, signal_std=hyper.signal_std,
+                             noise_std=hyper.noise_std).fit(kept[:, :2], kept[:, 2])
     height, std = gp.predict_grid(xs, ys, return_std=True)
     logger.info("surface GP: %d of %d points kept, %s", kept.shape[0], len(cloud), hyper)
     return SurfaceModel(gp, hyper, height, std, cloud.points.shape[0], kept)

@@ -1,26 +1,13 @@
 """Overlapping k×k clusters of a particle grid and Müller's shape-matching goals, batched over β.
 
-Every ``k × k`` window of the ``(ny, nx)`` particle grid is a cluster, so there are
-``(ny − k + 1) × (nx − k + 1)`` of them. Cluster sums are taken on strided window views of the
-grid (a box filter), and the sum of a per-(cluster, member) quantity back onto the particles is
-``k²`` shifted slice additions (the box filter's transpose), all batched over a leading β axis.
+Every window of the particle grid is a cluster. Cluster sums are box filters on strided window
+views, and their transposes ``k²`` shifted slice additions, batched over a leading β axis.
 
-Two details differ from a literal reading of Müller et al. (2005), both so that the invariants
-the method promises hold exactly:
-
-* The linear/quadratic fit is written incrementally, ``A q = s + Π (x − p⁰)`` where ``Π`` is the
-  cluster's (mass-weighted, least-squares) projection onto its feature span. With an exact inverse
-  this *is* Müller's ``A = A_pq A_qq⁻¹``; with the regularised (truncated) inverse it keeps the rest
-  shape an exact fixed point for every β.
-* The quadratic features ``sx², sy², …`` are centred on the cluster (mass-weighted mean removed),
-  as the linear ones ``s`` already are; with ``t`` the centre of mass, an uncentred quadratic term
-  would need an intercept that the goal ``T q̃ + t`` does not have, and β = 1 would then not
-  reproduce a quadratic deformation.
-
-References
-----------
-Müller, M., Heidelberger, B., Teschner, M., Gross, M. (2005). Meshless deformations based on
-shape matching. ACM Transactions on Graphics 24(3), 471–478.
+Two details differ from a literal reading of Müller et al. (2005), so that its invariants hold
+exactly: the fit is written ``A q = s + Π (x − p⁰)``, ``Π`` the cluster's mass-weighted projection
+onto its feature span (Müller's ``A_pq A_qq⁻¹`` with an exact inverse; with the truncated one the
+rest shape stays a fixed point), and the quadratic features are centred on the cluster like ``s``
+(the goal ``T q̃ + t`` has no intercept, so β = 1 reproduces a quadratic deformation).
 """
 
 from __future__ import annotations
@@ -41,21 +28,9 @@ def _cut(axis: int, start: int, stop: int) -> tuple[slice, ...]:
 
 
 class Clusters:
-    """Rest-shape data of all clusters, computed once per ROI.
-
-    The particles lie on an index grid of shape ``grid`` (``(ny, nx)`` for a surface sheet or
-    ``(nz, ny, nx)`` for a layered body); a cluster is every window of shape ``window`` of it.
-
-    Parameters
-    ----------
-    rest : (*grid, 3) float, metres
-    masses : grid-shaped float
-    window : tuple of int
-        Cluster window, e.g. ``(k, k)`` or ``(2, k, k)``.
-    mode : {"rigid", "linear", "quadratic"}
-    regularization : float
-        Relative eigenvalue cut-off of the moment matrix (see ``ShapeMatchingConfig``).
-    """
+    """Rest-shape data of all clusters of particles ``rest (*grid, 3)`` with ``masses (*grid)``
+    (``grid`` is ``(ny, nx)`` or ``(nz, ny, nx)``), one per ``window`` (e.g. ``(2, k, k)``);
+    ``mode`` and ``regularization`` as in :class:`ShapeMatchingConfig`."""
 
     def __init__(self, rest: Array, masses: Array, window: tuple[int, ...], mode: str,
                  regularization: float):
@@ -63,12 +38,10 @@ class Clusters:
         self.cshape = tuple(n - w + 1 for n, w in zip(self.shape, self.window, strict=True))
         self.n_clusters = int(np.prod(self.cshape))
         self.n_members = int(np.prod(self.window))
-        self.rest = rest
-        self.masses = masses
-        mw = self._windows(masses[None, ..., None])[0, ..., 0]  # (C, km)
+        self.rest, self.masses = rest, masses
+        mw = self.gather(masses[None, ..., None])[0, ..., 0]  # (C, km)
         self.w = mw / mw.sum(axis=1, keepdims=True)
-        p0 = self._windows(rest[None])[0]  # (C, km, 3)
-        self.p0 = p0
+        self.p0 = p0 = self.gather(rest[None])[0]  # (C, km, 3)
         self.t0 = np.einsum("cj,cjd->cd", self.w, p0)
         self.s = p0 - self.t0[:, None, :]
         self.ws = self.w[..., None] * self.s
@@ -79,19 +52,13 @@ class Clusters:
         self.hat = None if mode == "rigid" else self._hat_matrices(regularization)
         self._planar_frames()
 
-    # -- window gather / scatter -------------------------------------------------------------
-    def _windows(self, x: Array) -> Array:
-        """``(B, *grid, d)`` → ``(B, C, km, d)`` copies of every window."""
+    def gather(self, x: Array) -> Array:
+        """Particle values ``(B, *grid, d)`` → copies of every window ``(B, C, km, d)``."""
         nd = len(self.shape)
         v = sliding_window_view(x, self.window, axis=tuple(range(1, nd + 1)))
         b, d = x.shape[0], x.shape[-1]
-        return np.ascontiguousarray(
-            v.reshape(b, self.n_clusters, d, self.n_members).transpose(0, 1, 3, 2)
-        )
-
-    def gather(self, x: Array) -> Array:
-        """Particle positions ``(B, *grid, 3)`` → cluster members ``(B, C, km, 3)``."""
-        return self._windows(x)
+        v = v.reshape(b, self.n_clusters, d, self.n_members)
+        return np.ascontiguousarray(v.transpose(0, 1, 3, 2))
 
     def scatter(self, vals: Array) -> Array:
         """Sum ``(B, C, km, d)`` per-(cluster, member) values onto particles ``(B, *grid, d)``."""
@@ -106,7 +73,6 @@ class Clusters:
             out[dst] += v[src]
         return out
 
-    # -- shape matching ----------------------------------------------------------------------
     def features(self) -> tuple[Array, Array | None]:
         """Centred features ``(C, km, 3)`` ``s / L`` and, in quadratic mode, ``(C, km, 6)`` the
         quadratic terms ``sx², sy², sz², sx sy, sy sz, sz sx`` of ``s / L`` (centred)."""
@@ -134,17 +100,13 @@ class Clusters:
         return np.asarray(q @ aqq_pinv @ np.swapaxes(wq, 1, 2))
 
     def _hat_matrices(self, regularization: float) -> Array:
-        """``(C, km, km)`` weighted least-squares projections onto the feature span.
-
-        The linear features are fitted first and the quadratic ones only on what the linear fit
-        leaves (Gram–Schmidt by blocks), so that truncating an ill-determined quadratic direction
-        never spoils the exact fit of rigid and affine motions. Both blocks drop eigenvalues below
-        ``regularization`` times the largest linear moment.
-        """
+        """``(C, km, km)`` weighted least-squares projections onto the feature span: the linear
+        features, then the quadratic ones on what the linear fit leaves (block Gram–Schmidt, so a
+        truncated quadratic direction never spoils rigid and affine fits), each dropping
+        eigenvalues below ``regularization`` times the largest linear moment."""
         _, quad = self.features()
         lam = self._moment[0]
-        # the linear fit on s itself: the projection and the relative cut-off do not depend on
-        # the scale of the features, and the rest moment is already decomposed
+        # the linear fit on s itself: scale-free, and the rest moment is already decomposed
         hat = self._projection(self.s, regularization * lam[:, -1], self._moment)
         if quad is not None:
             # the quadratic features are built from s / L: their cut-off in the same units
@@ -153,7 +115,6 @@ class Clusters:
             hat = hat + self._projection(quad - hat @ quad, cutoff)
         return hat
 
-    # -- separable box filters: the fast path of the solver -------------------------------------
     def box_sum(self, field: Array) -> Array:
         """Window sums ``(B, *cshape, d)`` of a particle field ``(B, *grid, d)`` (separable)."""
         out = field
@@ -190,12 +151,8 @@ class Clusters:
         self._t0c_t = np.ascontiguousarray(np.moveaxis(self._t0c, -1, 0))
 
     def rotation_term(self, x: Array) -> Array:
-        """``(1/M_i) Σ_{c∋i} R_c s_i^c`` ``(B, *grid, 3)`` for positions ``x (B, *grid, 3)``.
-
-        The same quantity as gathering every cluster's members, without the ``(B, C, km, 3)``
-        arrays: ``A_pq = Σ m x p⁰ᵀ / M − t t⁰ᵀ`` from box sums of ``m x ⊗ p⁰`` and ``m x``, and
-        ``Σ_c R_c (p⁰_i − t⁰_c) = (Σ_c R_c) p⁰_i − Σ_c R_c t⁰_c`` from box spreads.
-        """
+        """``(1/M_i) Σ_{c∋i} R_c s_i^c`` ``(B, *grid, 3)`` for positions ``x (B, *grid, 3)``, by box
+        sums (``A_pq = Σ m x p⁰ᵀ / M − t t⁰ᵀ``) and spreads (``(Σ_c R_c) p⁰_i − Σ_c R_c t⁰_c``)."""
         if not hasattr(self, "_p0c"):
             self._prepare_box()
         if not np.any(self.planar):
@@ -220,8 +177,7 @@ class Clusters:
         return np.asarray(out / self.count[None, ..., None])
 
     def _rotation_term_components(self, x: Array) -> Array:
-        """:meth:`rotation_term` with every field component-major, ``(12, B, *grid)``: the
-        polar decomposition then works on contiguous component arrays with no transposes."""
+        """:meth:`rotation_term` with every field component-major, ``(12, B, *grid)``."""
         b, shape, cshape = x.shape[0], self.shape, self.cshape
         p0 = self._p0c_t  # (3, *grid)
         xm = np.moveaxis(x - self._origin, -1, 0) * self.masses  # (3, B, *grid)
@@ -251,12 +207,8 @@ class Clusters:
         self.v_axis = np.cross(self.normal, self.u_axis)
 
     def _polar(self, apq: Array) -> Array:
-        """Polar rotations of ``(B, C, 3, 3)`` cluster matrices.
-
-        A planar cluster (normal ``n``) has ``A n = 0``; adding ``ĉ nᵀ ‖A‖`` with
-        ``c = (A u) × (A v)`` (= σ₁σ₂ R n) gives a full-rank matrix with the same polar rotation,
-        which the fast Newton iteration can take instead of an SVD.
-        """
+        """Polar rotations of ``(B, C, 3, 3)`` cluster matrices; a planar cluster's ``A`` (``A n =
+        0``) gets ``ĉ nᵀ ‖A‖``, ``c = (A u) × (A v)``: full rank with the same rotation."""
         if np.any(self.planar):
             p = self.planar
             a = apq[:, p]

@@ -1,15 +1,12 @@
 """The sparse linear part ``K_β`` of the local–global step: assembled once per ROI, one banded
 Cholesky factorisation per β.
 
-``K_β = I − M⁻¹ (Σ_c W_c + β Σ_c Π_c)`` on the free particles (:mod:`deformap.msm._poke`). ``W_c``
-and ``Π_c`` are orthogonal projections in the particle masses' inner product, so
-``S_β = diag(m M) K_β`` is symmetric, and positive definite for β < 1 once a boundary is fixed.
-Ordered row by row with the layer index innermost, ``S_β`` is a band matrix of half-width
-``(k − 1)(n_x n_z + n_z) + n_z − 1``, factorised by LAPACK ``pbtrf`` with no pivoting.
-``S_β = S₀ − β S₁`` is affine in β, so both bands are assembled once; a β may also step with the
-factorisation of a smaller β′ through the convergent splitting ``S_β = S_β′ − (β − β′) S₁``
-(:meth:`StepMatrices.solve`). A matrix that is not positive definite (never expected) falls back
-to SuperLU.
+``K_β = I − M⁻¹ (Σ_c W_c + β Σ_c Π_c)`` on the free particles (:mod:`deformap.msm._poke`); ``W_c``
+and ``Π_c`` are mass-orthogonal projections, so ``S_β = diag(m M) K_β = S₀ − β S₁`` is symmetric,
+positive definite for β < 1, and banded when ordered row by row with the layer innermost. Both
+bands are assembled once; a β may also step with a smaller β′'s factorisation through the
+splitting ``S_β = S_β′ − (β − β′) S₁`` (:meth:`StepMatrices.solve`). A matrix that is not positive
+definite (never expected) falls back to SuperLU.
 """
 
 from __future__ import annotations
@@ -31,14 +28,7 @@ Array = NDArray[np.float64]
 
 
 class StepMatrices:
-    """``K_β`` of one ROI's body for any β: coupling to the fixed particles and factorisations.
-
-    Parameters
-    ----------
-    clusters : Clusters
-    fixed : grid-shaped bool
-        Particles held at their given positions.
-    """
+    """``K_β`` of one ROI's body for any β: coupling to the ``fixed`` particles, factorisations."""
 
     def __init__(self, clusters: Clusters, fixed: NDArray[np.bool_]):
         n = fixed.size
@@ -83,9 +73,8 @@ class StepMatrices:
         up = br <= bc
         br, bc = br[up], bc[up]
         self._bw = int(np.max(bc - br)) if bc.size else 0
-        # the nonzeros of both bands, as flat indices into a column-major (LAPACK) band array:
-        # entry S[i, j], i ≤ j, is band[bw + i − j, j]; a factorisation fills a band from them
-        # (in a recycled array when the number of factorisations kept is bounded)
+        # the nonzeros of both bands as flat indices into a column-major (LAPACK) band array:
+        # entry S[i, j], i ≤ j, is band[bw + i − j, j]
         self._band_shape = (self._bw + 1, nf)
         diag = self._bw + (self._bw + 1) * np.arange(nf)
         at = np.concatenate([(self._bw + br - bc) + (self._bw + 1) * bc, diag])
@@ -97,17 +86,15 @@ class StepMatrices:
                                     minlength=self._band_at.size)
         self._factors: dict[float, object] = {}
         # at most this many factorisations are kept (None: all), the least recently used
-        # dropped first and its array reused: for a β search that moves on through β (a batch
-        # of β needing more factorisations than this at once would refactorise every step)
+        # dropped first and its array reused
         self.max_factors: int | None = None
         self._s1_mat: sp.csr_matrix | sp.dia_matrix | None = None
         self._pull: tuple[Array, Array, Array] | None = None
         self._pbtrs = get_lapack_funcs("pbtrs", (np.empty((1, 1)),))
 
     def pull(self, x_fixed: Array) -> tuple[Array, Array]:
-        """``(couple_w @ x_fixed, couple_p @ x_fixed)``, each ``(n_free, 3)``: the term that
-        carries the fixed particles into the free rows is ``w + β p`` for any β (kept for the
-        last ``x_fixed``, which a β search passes unchanged to every solve)."""
+        """``(couple_w @ x_fixed, couple_p @ x_fixed)``, each ``(n_free, 3)`` (the fixed particles'
+        term is ``w + β p``), kept for the last ``x_fixed``."""
         last = self._pull
         if last is None or not np.array_equal(last[0], x_fixed):
             x = np.array(x_fixed, dtype=float)
@@ -115,9 +102,8 @@ class StepMatrices:
         return last[1], last[2]
 
     def prepare(self, beta_fit: float, max_split: float = 0.0) -> float:
-        """Factorise what solving ``beta_fit`` needs and return the β′ whose factorisation it
-        steps with: the largest β′ ≤ ``beta_fit`` already factorised with ``(beta_fit − β′) /
-        (1 − β′) ≤ max_split`` (the splitting of :meth:`solve`), else ``beta_fit`` itself."""
+        """The β′ whose factorisation ``beta_fit`` steps with: the largest factorised β′ ≤
+        ``beta_fit`` with ``(beta_fit − β′) / (1 − β′) ≤ max_split``, else ``beta_fit`` (factorised)."""
         key = float(beta_fit)
         below = [b for b in self._factors if b <= key and (key - b) / (1.0 - b) <= max_split]
         if key in self._factors or not below:
@@ -127,13 +113,11 @@ class StepMatrices:
 
     def solve(self, beta_fit: float, rhs: Array, *, factor_beta: float | None = None,
               x: Array | None = None) -> Array:
-        """``K_β⁻¹ rhs`` for ``rhs (n_free, 3)``; factorises ``K_β`` on first use and keeps it.
+        """``K_β⁻¹ rhs`` for ``rhs (n_free, 3)``, factorising ``K_β`` on first use.
 
-        With ``factor_beta = β′ < beta_fit`` and the current free positions ``x (n_free, 3)``,
-        returns instead ``K_β′⁻¹ (rhs + (β − β′) M⁻¹ Σ_c Π_c x)``, the step of the splitting
-        ``S_β = S_β′ − (β − β′) S₁`` that reuses β′'s factorisation: the same fixed point, and,
-        since ``S₁ ≥ 0`` and ``S_β > 0``, a convergent splitting whose contraction is at most
-        ``(β − β′) / (1 − β′)`` (the generalised eigenvalues of ``(S₁, S₀)`` lie in [0, 1]).
+        With ``factor_beta = β′ < beta_fit`` and the free positions ``x (n_free, 3)``, the step
+        ``K_β′⁻¹ (rhs + (β − β′) M⁻¹ Σ_c Π_c x)`` of the splitting ``S_β = S_β′ − (β − β′) S₁``:
+        the same fixed point, contraction at most ``(β − β′) / (1 − β′)`` (``S₁ ≥ 0``, ``S_β > 0``).
         """
         beta = float(beta_fit)
         key = beta if factor_beta is None else float(factor_beta)
@@ -159,8 +143,8 @@ class StepMatrices:
         return np.take(sol, self._unperm, axis=0)
 
     def band(self, beta_fit: float, out: Array | None = None) -> Array:
-        """``S_β = S₀ − β S₁`` in LAPACK's upper band storage ``(bw + 1, n_free)``, column-major,
-        in band order (into ``out``, a column-major array of that shape, if given)."""
+        """``S_β = S₀ − β S₁`` in LAPACK's column-major upper band storage ``(bw + 1, n_free)``,
+        in band order (into ``out`` if given)."""
         if out is None:
             out = np.zeros(self._band_shape, order="F")
         else:
@@ -183,9 +167,7 @@ class StepMatrices:
 
     def _s1(self) -> sp.csr_matrix | sp.dia_matrix:
         """``S₁`` in band order as a full symmetric sparse matrix (built on first use): by
-        diagonals when its nonzeros lie on few of them (the free particles of a body with fixed
-        sides and floor form a box, and a cluster couples a fixed set of index offsets), which
-        multiplies faster; else in CSR."""
+        diagonals when its nonzeros lie on few of them, which multiplies faster; else CSR."""
         if self._s1_mat is None:
             bw, n = self._bw, self._band_shape[1]
             nz = self._band_v1 != 0.0
@@ -232,12 +214,8 @@ class _SparseFallback:
 
 def _pair_sums(clusters: Clusters) -> tuple[NDArray[np.int64], NDArray[np.int64], Array, Array]:
     """Particle pairs ``(i, j)`` sharing a cluster and their sums ``Σ_c m_i W_c[i, j]``,
-    ``Σ_c m_i Π_c[i, j]`` (zeros in rigid mode), each pair once.
-
-    The members ``a`` and ``b`` of every cluster are a fixed grid offset ``δ = b − a`` apart,
-    so the sums are accumulated per offset on particle-shaped arrays (one slice addition per
-    member pair, over all clusters at once) instead of per (cluster, member, member) entry.
-    """
+    ``Σ_c m_i Π_c[i, j]`` (zeros in rigid mode), each pair once; accumulated per grid offset of
+    the member pair on particle-shaped arrays."""
     shape, window, cshape = clusters.shape, clusters.window, clusters.cshape
     members = np.array(list(np.ndindex(*window)))  # (km, nd) offsets in the window
     n_m, nd = members.shape

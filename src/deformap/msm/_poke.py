@@ -2,8 +2,7 @@
 
 Position-based dynamics moves each free particle toward its goal,
 ``x ← x + α (g(x) − x) + h² f / m``; its steady state is the fixed point ``x_i − g_i(x) = f_i / k``
-with ``k = α m / h²`` (N/m). Time stepping reaches that state like a diffusion (~n² steps on an n×n
-grid), so the steady state is solved for directly.
+with ``k = α m / h²`` (N/m); time stepping reaches it like a diffusion, so it is solved directly.
 
 The goal of particle ``i`` in cluster ``c`` is
 ``g_i^c = t_c + (1 − β) R_c s_i + β (s_i + Π_c (x − p⁰))``, linear in ``x`` except for the rotation
@@ -12,16 +11,13 @@ The goal of particle ``i`` in cluster ``c`` is
     K_β x = (1 − β) M⁻¹ Σ_c R_c s^c + b_β,    K_β = I − M⁻¹ (Σ_c W_c + β Σ_c Π_c),
 
 with ``M`` the number of clusters holding each particle, ``W_c`` the centre-of-mass rows and
-``b_β`` the fixed particles' and the force's terms. ``K_β`` is sparse, the same for x, y and z and
-constant over the iterations: it is factorised once per β (banded Cholesky,
-:mod:`deformap.msm._linsys`) and each iteration recomputes the rotations and back-substitutes (a
+``b_β`` the fixed particles' and the force's terms. ``K_β`` is factorised once per β
+(:mod:`deformap.msm._linsys`) and each iteration recomputes the rotations and back-substitutes (a
 local–global scheme like projective dynamics, Bouaziz et al. 2014, with the β-dependent part
-solved exactly so that the iteration count does not grow as β → 1), accelerated by Anderson mixing
-(Walker & Ni 2011). The fixed point is exactly the PBD steady state.
+solved exactly), accelerated by Anderson mixing (Walker & Ni 2011).
 
 References
 ----------
-Müller, M. et al. (2005). Meshless deformations based on shape matching. ACM TOG 24(3).
 Bouaziz, S. et al. (2014). Projective dynamics: fusing constraint projections for fast simulation.
 ACM TOG 33(4).
 Walker, H. F., Ni, P. (2011). Anderson acceleration for fixed-point iterations. SIAM J. Numer.
@@ -47,11 +43,8 @@ __all__ = ["Equilibrium", "PokeSimulation", "force_weights"]
 logger = logging.getLogger(__name__)
 Array = NDArray[np.float64]
 
-_ROT_BATCH = 4
-
-_MAX_WAIT_LOG2 = 6
-"""After the ``n``-th consecutive rejected Anderson step a β takes ``2^min(n, 6) − 1`` plain
-steps before mixing again (see :meth:`Equilibrium.solve`)."""
+_ROT_BATCH = 4  # β per rotation batch: larger batches' temporaries fall out of cache
+_MAX_WAIT_LOG2 = 6  # after n rejected Anderson steps, 2^min(n, 6) − 1 plain steps follow
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -60,20 +53,14 @@ class PokeSimulation:
 
     Parameters
     ----------
-    betas : (B,) float
+    betas, iterations, residual, converged : (B,)
+        Each β's iterations, last relative update (largest move over largest displacement) and
+        whether it fell below the tolerance within ``config.max_iter`` (:meth:`Equilibrium.solve`).
     positions : (B, ny, nx, 3) float, metres
         Particle positions at equilibrium.
-    iterations : (B,) int
-        Local–global iterations each β needed.
-    residual : (B,) float
-        Last relative fixed-point update (largest particle move over the largest displacement).
-    converged : (B,) bool
-        ``residual < config.tol`` before ``config.max_iter`` (``tol (1 − ρ)`` for a β that
-        stepped with a smaller β's factorisation, see :meth:`Equilibrium.solve`).
     protocol : str
-        ``"force"`` or ``"pinned"``.
     stiffness_n_per_m : float or None
-        Calibrated particle spring stiffness ``k`` (force protocol), else ``None``.
+        Calibrated particle spring stiffness ``k`` (force protocol).
     """
 
     betas: Array
@@ -87,13 +74,9 @@ class PokeSimulation:
 
 def force_weights(rest: Array, fixed: NDArray[np.bool_], contact: TactileContact,
                   spacing: float) -> Array:
-    """``(ny, nx)`` shares of the tactile force, summing to 1, on the free particles under the tip.
-
-    Weights follow the Hertz pressure profile ``√(1 − d²/ρ²)`` of the horizontal distance ``d`` to
-    the contact point, with ``ρ = max(tip radius, particle spacing)``: the contact radius of a
-    sphere pressed less than its own radius is below the tip radius, and ``ρ ≥ h`` makes sure the
-    nearest particles always carry the load (never only a sub-grid point).
-    """
+    """``(ny, nx)`` shares of the tactile force, summing to 1, on the free particles under the tip:
+    the Hertz profile ``√(1 − d²/ρ²)``, ``ρ = max(tip radius, spacing)`` so that particles always
+    carry the load."""
     rho = max(contact.tip_radius_m, spacing)
     d2 = np.sum((rest[..., :2] - contact.contact_point[:2]) ** 2, axis=-1)
     w = np.sqrt(np.clip(1.0 - d2 / rho**2, 0.0, None))
@@ -102,40 +85,33 @@ def force_weights(rest: Array, fixed: NDArray[np.bool_], contact: TactileContact
 
 
 class Equilibrium:
-    """``K_β`` for a set of β on one ROI, and the local–global fixed-point iteration.
-
-    ``system`` (a :class:`StepMatrices` of the same clusters and fixed set) may be shared between
-    equilibria of the same ROI, so that the assembly and each β's factorisation happen once.
-    """
+    """``K_β`` for a set of β on one ROI, and the local–global fixed-point iteration; ``system``
+    may be shared between equilibria of one ROI."""
 
     def __init__(self, clusters: Clusters, fixed: NDArray[np.bool_], betas: Array, *,
                  system: StepMatrices | None = None, max_split: float = 0.0,
                  load_scale: Array | None = None):
         self.cl, self.betas = clusters, np.asarray(betas, dtype=float)
-        # the share of the force each β's body carries (``ShapeMatchingConfig.beta_scale``)
+        # the share of the force each β's body carries
         self.load_scale = (np.ones_like(self.betas) if load_scale is None
                            else np.asarray(load_scale, dtype=float))
         self.system = StepMatrices(clusters, fixed) if system is None else system
         self.free, self.fix = self.system.free, self.system.fix
         if self.system.rigid:
-            self.rot_weight = np.ones_like(self.betas)
-            self.fit_weight = np.zeros_like(self.betas)
+            self.rot_weight, self.fit_weight = np.ones_like(self.betas), np.zeros_like(self.betas)
         else:
             self.rot_weight, self.fit_weight = 1.0 - self.betas, self.betas.copy()
-        # the factorisation each β steps with: its own, or (``max_split`` > 0) a smaller β's
-        # already factorised, through the splitting of :meth:`StepMatrices.solve`, whose
-        # contraction bound ``split`` tightens that β's stopping test (see :meth:`solve`)
+        # the factorisation each β steps with (:meth:`StepMatrices.prepare`); the splitting's
+        # contraction bound ``split`` tightens the stopping test
         self.factor_beta = np.empty_like(self.fit_weight)
         for j in np.argsort(self.fit_weight, kind="stable"):
             self.factor_beta[j] = self.system.prepare(self.fit_weight[j], max_split)
         self.split = (self.fit_weight - self.factor_beta) / (1.0 - self.factor_beta)
 
     def _map(self, x: Array, x_free: Array, active: NDArray[np.int64]) -> Array:
-        """One local–global step ``G(x)`` for the free particles of the ``active`` β
-        (``x (B, n, 3)`` all positions, ``x_free (B, n_free, 3)`` the free ones)."""
+        """One local–global step ``G(x)`` for the free particles of the ``active`` β."""
         cl = self.cl
         out = np.empty((len(active), len(self.free), 3))
-        # a few β per batch: the per-cluster temporaries of larger batches fall out of cache
         for lo in range(0, len(active), _ROT_BATCH):
             part = active[lo : lo + _ROT_BATCH]
             xa = x[part].reshape(len(part), *cl.shape, 3)
@@ -151,19 +127,15 @@ class Equilibrium:
               ) -> tuple[Array, NDArray[np.int64], Array, NDArray[np.bool_]]:
         """Iterate ``x ← G(x)`` to its fixed point for every β, with Anderson acceleration.
 
-        ``x_fixed (n_fix, 3)``: positions of the fixed particles; ``force (n, 3)`` newtons; ``x0 (B,
-        *grid, 3)``, optional: starting positions (only the free particles' are used; the rest shape by
-        default; the fixed point does not depend on it). Returns positions ``(B, ny, nx, 3)``,
-        iterations, residuals ``max‖G(x) − x‖ / max‖G(x) − p⁰‖`` and converged flags.
+        ``x_fixed (n_fix, 3)`` the fixed particles; ``force (n, 3)`` newtons; ``x0 (B, *grid, 3)``
+        optional starting positions. Returns positions ``(B, ny, nx, 3)``, iterations, residuals
+        ``max‖G(x) − x‖ / max‖G(x) − p⁰‖`` and converged flags.
 
-        Anderson acceleration (type II, ``memory`` past steps, Walker & Ni 2011) is safeguarded, because
-        near large rotations (clusters turning inside out under a deep dent at high β) the step map is
-        strongly non-linear: an extrapolated point whose residual exceeds that of its origin is rejected
-        for the plain step from that origin, with a fresh history; after ``n`` consecutive rejections
-        ``2^min(n, 6) − 1`` plain steps follow; a plain step that increases the residual restarts the
-        history. A β that steps with a smaller β's factorisation (contraction bound ``ρ``,
-        :meth:`StepMatrices.solve`) stops at ``tol (1 − ρ)``, so that its distance to the fixed point is
-        bounded as with its own factorisation.
+        Anderson type II (``memory`` steps, Walker & Ni 2011) is safeguarded against the strongly
+        non-linear step map of clusters turning over: an extrapolation whose residual exceeds its
+        origin's is replaced by the plain step from there with a fresh history, and after ``n``
+        rejections in a row ``2^min(n, 6) − 1`` plain steps follow. A β stepping with a smaller
+        β's factorisation (contraction ``ρ``) stops at ``tol (1 − ρ)``.
         """
         cl, nb = self.cl, len(self.betas)
         rest = cl.rest.reshape(-1, 3)
@@ -173,8 +145,7 @@ class Equilibrium:
         for j in range(nb):
             self.const[j] = (self.fit_weight[j] * (self.system.fit_const + pull_p)
                              + pull_w + self.load_scale[j] * load)
-        # flat indices: np.take / put on the flattened rows are several times faster than
-        # fancy indexing of (n, 3) rows
+        # flat indices: np.take on flattened rows is several times faster than fancy indexing
         flat_free, flat_fix = self.system.flat_free, self.system.flat_fix
         x = np.broadcast_to(rest, (nb, *rest.shape)).copy()
         x_rows = x.reshape(nb, -1)  # a view: x is contiguous
@@ -185,20 +156,13 @@ class Equilibrium:
         x_free = np.take(x, self.free, axis=1)
         rest_free = np.take(rest, self.free, axis=0)
         nf = len(self.free) * 3
-        iters = np.zeros(nb, dtype=np.int64)
-        resid = np.full(nb, np.inf)
-        hist_f = np.zeros((nb, memory, nf))
-        hist_g = np.zeros((nb, memory, nf))
-        n_hist = np.zeros(nb, dtype=np.int64)
-        prev_f = np.zeros((nb, nf))
-        prev_g = np.zeros((nb, nf))
-        # residual at the last accepted point, and whether the current point is an Anderson
-        # extrapolation (and not a plain step) from it
-        accepted_r = np.full(nb, np.inf)
-        mixed = np.zeros(nb, dtype=bool)
-        # plain steps still to take before mixing again, and consecutive rejections
-        wait = np.zeros(nb, dtype=np.int64)
-        rejected = np.zeros(nb, dtype=np.int64)
+        iters, resid = np.zeros(nb, dtype=np.int64), np.full(nb, np.inf)
+        hist_f, hist_g = np.zeros((nb, memory, nf)), np.zeros((nb, memory, nf))
+        prev_f, prev_g = np.zeros((nb, nf)), np.zeros((nb, nf))
+        # residual at the last accepted point; whether the current point is an extrapolation
+        accepted_r, mixed = np.full(nb, np.inf), np.zeros(nb, dtype=bool)
+        # history length, plain steps still to take before mixing again, consecutive rejections
+        n_hist, wait, rejected = (np.zeros(nb, dtype=np.int64) for _ in range(3))
         active = np.arange(nb)
         floor = 1e-6 * spacing
         stop = tol * (1.0 - self.split)
@@ -216,10 +180,7 @@ class Equilibrium:
                 if done[a]:
                     continue
                 if mixed[j] and grew[a]:
-                    # safeguard: an extrapolation that increased the residual is rejected and
-                    # the plain step from the last accepted point taken instead (its image
-                    # ``prev_g``), with a fresh history; repeated rejections wait longer
-                    # (plain steps) before mixing again
+                    # safeguard: take the plain step from the last accepted point instead
                     x_new[a] = prev_g[j]
                     n_hist[j], mixed[j] = 1, False
                     rejected[j] += 1
@@ -263,23 +224,18 @@ def _row_norm2(v: Array) -> Array:
     return np.asarray(np.einsum("...i,...i->...", v, v))
 
 
+# positions (B, *body, 3), iterations, residuals and converged flags of Equilibrium.solve
 Solution = tuple[Array, NDArray[np.int64], Array, NDArray[np.bool_]]
-"""Positions ``(B, *body, 3)``, iterations, residuals and converged flags of
-:meth:`Equilibrium.solve`."""
 
 
 def calibrate_stiffness(eq0: Equilibrium, x_fixed: Array, weights: Array, contact: TactileContact,
                         config: ShapeMatchingConfig, spacing: float,
                         ) -> tuple[float, Solution | None]:
-    """Spring stiffness ``k`` (N/m) such that the β = 0 body dents like the reference half-space.
+    """Spring stiffness ``k`` (N/m) such that the β = 0 body (``eq0``) dents like the reference
+    half-space, and the β = 0 solve at that ``k`` (``None`` if 8 steps did not match).
 
-    ``eq0`` must hold the single β = 0. Secant iteration on ``k ← k δ(k) / δ_Hertz(E_ref, F, tip)``
-    until the force-weighted depth of the loaded particles matches the Hertz depth to 0.1 % (depth ∝
-    1/k for a linear body, so a few steps), each equilibrium solved to ``config.coarse_tol``.
-
-    Returns ``k`` and the β = 0 solve at that ``k`` (:meth:`Equilibrium.solve`'s positions
-    ``(1, *body, 3)``, iterations, residual, converged flag), or ``None`` for the solve if the depth
-    did not match within 8 steps (``k`` is then the last secant estimate).
+    Secant iteration ``k ← k δ(k) / δ_Hertz(E_ref, F, tip)`` until the force-weighted depth of the
+    loaded particles matches the Hertz depth to 0.1 %, each solve to ``config.coarse_tol``.
     """
     f_mag = contact.force_n
     force = weights.reshape(-1, 1) * contact.force[None, :]

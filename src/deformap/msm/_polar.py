@@ -6,8 +6,6 @@ References
 ----------
 Higham, N. J. (1986). Computing the polar decomposition — with applications. SIAM J. Sci.
 Stat. Comput. 7(4), 1160–1174.
-Müller, M., Heidelberger, B., Teschner, M., Gross, M. (2005). Meshless deformations based on
-shape matching. ACM Transactions on Graphics 24(3), 471–478.
 """
 
 from __future__ import annotations
@@ -21,13 +19,9 @@ Array = NDArray[np.float64]
 
 
 def polar_rotation(a: Array) -> Array:
-    """Rotation factor ``R`` of the polar decomposition ``A = R S`` of ``(..., 3, 3)`` matrices.
-
-    Batched SVD ``A = U Σ Vᵀ``, ``R = U diag(1, 1, det(U Vᵀ)) Vᵀ``: always a proper rotation
-    (det R = +1), also for the rank-2 ``A_pq`` of a flat cluster, where the missing direction is
-    completed as the cross product of the other two, and for ``det A < 0`` (the rotation closest
-    to ``A``, Kabsch).
-    """
+    """Rotation factor ``R`` of the polar decomposition ``A = R S`` of ``(..., 3, 3)`` matrices:
+    ``R = U diag(1, 1, det(U Vᵀ)) Vᵀ`` from the SVD, a proper rotation also for rank-2 ``A`` or
+    ``det A < 0`` (Kabsch)."""
     u, _, vt = np.linalg.svd(a)
     det = np.linalg.det(u @ vt)
     u[..., :, 2] *= np.where(det < 0.0, -1.0, 1.0)[..., None]
@@ -37,15 +31,9 @@ def polar_rotation(a: Array) -> Array:
 def fast_polar_rotation(a: Array, *, tol: float = 1e-14, max_iter: int = 30) -> Array:
     """``polar_rotation(a)`` by Higham's scaled Newton iteration where it is safe, SVD elsewhere.
 
-    ``X ← (γ X + X⁻ᵀ / γ) / 2`` with ``X⁻ᵀ = cof(X) / det X`` in closed form and determinant
-    scaling ``γ = |det X|^(−1/3)``; it converges quadratically to the polar factor when
-    ``det A > 0``. Matrices with a small or negative determinant (relative to ``‖A‖³``: flat,
-    nearly singular or inverted clusters) and any that are not converged get the SVD answer.
-
-    References
-    ----------
-    Higham, N. J. (1986). Computing the polar decomposition — with applications. SIAM J. Sci.
-    Stat. Comput. 7(4), 1160–1174.
+    ``X ← (γ X + X⁻ᵀ / γ) / 2`` with closed-form cofactors and ``γ = |det X|^(−1/3)``, quadratic
+    for ``det A > 0``; matrices with a small or negative relative determinant, or not converged,
+    get the SVD answer.
     """
     shape = a.shape
     m = np.ascontiguousarray(a.reshape(-1, 9).T)
@@ -53,18 +41,13 @@ def fast_polar_rotation(a: Array, *, tol: float = 1e-14, max_iter: int = 30) -> 
 
 
 def polar_components(m: Array, *, tol: float = 1e-14, max_iter: int = 30) -> Array:
-    """:func:`fast_polar_rotation` of ``(9, n)`` component-major (row-major 3×3) matrices.
-
-    Nine contiguous 1-D arrays make the closed-form cofactors fast; returns ``(9, n)``.
-    """
+    """:func:`fast_polar_rotation` of ``(9, n)`` component-major (row-major 3×3) matrices."""
     norm = np.sqrt(np.sum(m * m, axis=0))
     x = m / np.maximum(norm, np.finfo(float).tiny)
     cof0, det0 = _cofactors(x)
     safe = det0 > 1e-9  # scaled Newton copes with any positive det; flat ones go to SVD
     all_safe = bool(np.all(safe))
-    # Newton converges to the polar factor of its start: started from R h(U), the closed-form
-    # estimate below (h ≈ 1, symmetric positive definite), it lands on the R of x = R U in one
-    # or two steps instead of the several it takes from x itself
+    # started from the closed-form estimate R h(U) (h ≈ 1, SPD) Newton lands on R in a step or two
     if all_safe:
         cur = _polar_start(x, cof0, det0)
     else:
@@ -73,8 +56,7 @@ def polar_components(m: Array, *, tol: float = 1e-14, max_iter: int = 30) -> Arr
     step = np.inf
     for _ in range(max_iter):
         cof, det = _cofactors(cur)
-        # determinant scaling γ = |det X|^(-1/3) (Higham 1986, §3): no extra norms to compute;
-        # X ← (X / c + c X⁻ᵀ) / 2 with c = ∛det, the halving folded into the n-long factors
+        # X ← (X / c + c X⁻ᵀ) / 2 with c = ∛det (Higham 1986, §3), halving folded into factors
         gamma = np.cbrt(det)
         new = cur * (0.5 / gamma)
         cof *= 0.5 * gamma / det
@@ -99,18 +81,10 @@ def polar_components(m: Array, *, tol: float = 1e-14, max_iter: int = 30) -> Arr
 
 
 def _polar_start(x: Array, cof: Array, det: Array) -> Array:
-    """``R h(U)`` for ``(9, n)`` row-major matrices ``x = R U`` of unit Frobenius norm and
-    positive determinant (``cof``, ``det``: their :func:`_cofactors`, overwritten), with
-    ``h(U) ≈ I`` symmetric positive definite: the closed-form polar
-    factor ``R = x U⁻¹``, ``U = √(xᵀx)``, as
-    ``R = [(I_U² − II_U) x + I_U cof(x) − x xᵀx] / (I_U II_U − det x)`` (``I_U``, ``II_U`` the
-    invariants of ``U``, from the eigenvalues of ``xᵀx``; ``cof(x) = det(x) x⁻ᵀ``; the
-    interpolation of ``σ⁻¹`` on the singular values by ``α + β σ⁻² + γ σ²``).
-
-    The combination is exact for the right invariants; with inexact ones (a nearly repeated
-    eigenvalue) it is still ``R`` times a symmetric positive definite function of ``U``, whose
-    polar factor is exactly ``R``: the Newton iteration that follows removes it.
-    """
+    """``R h(U)``, ``h(U) ≈ I`` SPD, for ``(9, n)`` row-major ``x = R U`` of unit norm and positive
+    determinant (``cof``, ``det`` from :func:`_cofactors`, overwritten): the closed form
+    ``R = [(I_U² − II_U) x + I_U cof(x) − x xᵀx] / (I_U II_U − det x)`` with the invariants of
+    ``U = √(xᵀx)``; inexact invariants leave an SPD factor that Newton removes."""
     a, b, c, d, e, f, g, h, i = x
     # invariants of C = xᵀx from sums of squares: tr C = ‖x‖² = 1, II_C = ‖cof x‖², det C = det²
     ii = np.sum(cof * cof, axis=0)

@@ -46,46 +46,26 @@ def _check_config(config: Any) -> ShapeMatchingConfig:
 def _check_rest(rest: Any, k: int) -> Array:
     arr = check_array("rest", rest, (None, None, 3), what="particle positions in metres")
     if arr.shape[0] < k or arr.shape[1] < k:
-        raise InvalidArgumentError(
-            f"`rest` must hold at least cluster_size × cluster_size = {k}×{k} particles; "
-            f"got a {arr.shape[0]}×{arr.shape[1]} grid"
-        )
+        raise InvalidArgumentError(f"`rest` must hold at least cluster_size × cluster_size = {k}×{k} "
+                                   f"particles; got a {arr.shape[0]}×{arr.shape[1]} grid")
     return arr
 
 
 def shape_matching_goals(rest: Any, current: Any, betas: Any,
                          config: ShapeMatchingConfig | None = None) -> Array:
-    """Müller's goal positions of every particle, batched over β.
+    """Müller's goals ``(B, ny, nx, 3)`` of particles at ``current (B, ny, nx, 3)`` for
+    ``betas (B,)`` in [0, 1), rest positions ``rest (ny, nx, 3)`` (equal masses), metres.
 
-    Parameters
-    ----------
-    rest : (ny, nx, 3) float, metres
-        Rest positions ``p⁰`` on a grid (equal masses).
-    current : (B, ny, nx, 3) float, metres
-        Current positions, one configuration per β.
-    betas : (B,) float in [0, 1)
-    config : ShapeMatchingConfig
-        ``mode``, ``cluster_size`` and ``regularization`` are used.
-
-    Returns
-    -------
-    goals : (B, ny, nx, 3) float, metres
-        ``g_i = (1/M_i) Σ_{c∋i} [((1 − β) R_c + β A_c) s_i + t_c]`` over the ``M_i`` k×k clusters
-        holding particle ``i`` (``A_c`` the linear 3×3 or quadratic 3×9 fit, ``R_c`` its proper
-        rotation; ``R_c`` alone in rigid mode).
-
-    References
-    ----------
-    Müller et al. (2005), Eqs. 7–9 and §4.3; Caccamo et al. (2016), Eq. for ``g_i``.
+    ``g_i = (1/M_i) Σ_{c∋i} [((1 − β) R_c + β A_c) s_i + t_c]`` over the ``M_i`` clusters holding
+    ``i`` (``A_c`` the linear or quadratic fit, ``R_c`` its rotation, alone in rigid mode);
+    Müller et al. (2005), Eqs. 7–9 and §4.3.
     """
     cfg = _check_config(config)
     p0 = _check_rest(rest, cfg.cluster_size)
     b = check_betas(betas)
     x = check_array("current", current, (b.size, *p0.shape), what="particle positions in metres")
-    masses = np.ones(p0.shape[:2])
     k = cfg.cluster_size
-    cl = Clusters(p0, masses, (k, k), cfg.mode, cfg.regularization)
-    return cl.goals(x, b)
+    return Clusters(p0, np.ones(p0.shape[:2]), (k, k), cfg.mode, cfg.regularization).goals(x, b)
 
 
 def _check_contact(contact: Any, rest: Array, fixed: NDArray[np.bool_], spacing: float) -> int:
@@ -99,14 +79,12 @@ def _check_contact(contact: Any, rest: Array, fixed: NDArray[np.bool_], spacing:
         raise InvalidArgumentError(
             f"`contact` must press inside the ROI [{lo[0] + spacing:.4f}, {hi[0] - spacing:.4f}] × "
             f"[{lo[1] + spacing:.4f}, {hi[1] - spacing:.4f}] m; got contact point xy "
-            f"({cp[0]:.4f}, {cp[1]:.4f})"
-        )
+            f"({cp[0]:.4f}, {cp[1]:.4f})")
     near = int(np.argmin(np.sum((rest[..., :2] - cp[:2]) ** 2, axis=-1)))
     if fixed.ravel()[near]:
         raise InvalidArgumentError(
             "`contact` presses on the ROI's fixed edge (its nearest particle is held at rest); "
-            "centre the ROI on the contact"
-        )
+            "centre the ROI on the contact")
     return near
 
 
@@ -127,33 +105,11 @@ def simulate_poke(rest: Any, masses: Any, fixed: Any, contact: TactileContact, b
                   stiffness_n_per_m: float | None = None) -> PokeSimulation:
     """Converged static equilibrium of the shape-matching body under one poke, for every β.
 
-    Parameters
-    ----------
-    rest : (ny, nx, 3) float, metres
-        Rest positions (:meth:`ParticleGrid.from_heightmap`); a regular grid in x and y.
-    masses : (ny, nx) float
-        Particle masses (only ratios within a cluster matter).
-    fixed : (ny, nx) bool
-        Particles held at rest (the ROI's edges).
-    contact : TactileContact
-        The measured tip position, force and tip radius.
-    betas : (B,) float in [0, 1)
-    config : ShapeMatchingConfig
-    stiffness_n_per_m : float, optional
-        Force protocol: use this spring stiffness (one calibrated before for the same ROI and
-        contact) instead of calibrating it again.
-
-    Returns
-    -------
-    PokeSimulation
-
-    Notes
-    -----
-    ``contact="pinned"`` (Caccamo et al. 2016): the free particle nearest the contact is held at its
-    rest position moved by the observed indentation; no force acts. ``contact="force"``: the force is
-    shared by the free particles under the tip (:func:`force_weights`), and each particle's spring
-    has the stiffness ``k`` of :func:`calibrate_stiffness`, divided by β on the ``"odds"`` scale.
-    Both solve the PBD steady state directly (:mod:`deformap.msm._poke`).
+    ``rest (ny, nx, 3)`` metres, ``masses (ny, nx)`` and ``fixed (ny, nx)`` as in
+    :class:`ParticleGrid`; ``betas (B,)`` in [0, 1). ``"pinned"``: the free particle nearest the
+    contact is held at the observed indentation; ``"force"``: the force is shared by the particles
+    under the tip (:func:`force_weights`) on springs of :func:`calibrate_stiffness`'s ``k`` (or
+    ``stiffness_n_per_m``), divided by β on the ``"odds"`` scale.
     """
     cfg = _check_config(config)
     p0 = _check_rest(rest, cfg.cluster_size)
@@ -163,29 +119,22 @@ def simulate_poke(rest: Any, masses: Any, fixed: Any, contact: TactileContact, b
 
 
 class PokeModel:
-    """One poke on one ROI, ready to be solved for any β (see :func:`simulate_poke`).
-
-    The body, its clusters, ``K_β``'s assembly and factorisations, and the force protocol's
-    calibrated stiffness are computed once and shared by every :meth:`solve`, so that a β search
-    can solve one β at a time, each started from the equilibrium of a nearby β.
-    """
+    """One poke on one ROI, ready to be solved for any β (:func:`simulate_poke`): the body, its
+    clusters, ``K_β`` and the calibrated stiffness are shared by every :meth:`solve`."""
 
     def __init__(self, rest: Any, masses: Any, fixed: Any, contact: TactileContact,
                  config: ShapeMatchingConfig, *, stiffness_n_per_m: float | None = None):
-        cfg = config
+        self.cfg = cfg = config
         p0 = _check_rest(rest, cfg.cluster_size)
         m = check_array("masses", masses, p0.shape[:2], what="particle masses")
         if np.any(m <= 0):
             raise InvalidArgumentError(f"`masses` must be > 0; got minimum {m.min()}")
         fx = np.asarray(fixed)
         if fx.shape != p0.shape[:2] or fx.dtype != np.bool_:
-            raise InvalidArgumentError(
-                f"`fixed` must be a {p0.shape[:2]} bool array; got {np.asarray(fixed).dtype} "
-                f"array of shape {fx.shape}"
-            )
+            raise InvalidArgumentError(f"`fixed` must be a {p0.shape[:2]} bool array; got "
+                                       f"{np.asarray(fixed).dtype} array of shape {fx.shape}")
         if stiffness_n_per_m is not None:
             check_positive("stiffness_n_per_m", stiffness_n_per_m)
-        self.cfg = cfg
         self.odds = cfg.rigid_at_zero
         self.spacing = float(np.mean(np.linalg.norm(np.diff(p0[..., :2], axis=1), axis=-1)))
         near = _check_contact(contact, p0, fx, self.spacing)
@@ -193,8 +142,7 @@ class PokeModel:
         self.clusters = Clusters(body, body_m, window, cfg.mode, cfg.regularization)
         flat = body.reshape(-1, 3)
         self.stiffness: float | None = None
-        # the β = 0 equilibrium found by the calibration (to ``coarse_tol``), or None: a start
-        # for solves that have none closer
+        # the calibration's β = 0 equilibrium, a start for solves that have none closer
         self.start: Array | None = None
         self._calibrated: Solution | None = None
         if cfg.contact == "pinned":
@@ -222,8 +170,7 @@ class PokeModel:
         self.stiffness = float(stiffness_n_per_m)
 
     def load_scale(self, betas: Array) -> Array:
-        """The share of the measured force that the body of each β carries: 1, or β under the
-        ``"odds"`` scale (springs of stiffness ``k / β``: β = 0 is rigid)."""
+        """The share of the force each β's body carries: 1, or β on the ``"odds"`` scale."""
         b = np.asarray(betas, dtype=float)
         return b.copy() if self.odds else np.ones_like(b)
 
@@ -232,11 +179,9 @@ class PokeModel:
         return (beta if self.odds else 1.0) / (1.0 - beta)
 
     def calibrated(self, tol: float) -> tuple[PokeSimulation, Array] | None:
-        """The β = 0 equilibrium that the stiffness calibration solved (to ``coarse_tol``), as
-        :meth:`solve` would return it, if that is ``tol`` or looser and it converged; else
-        ``None``."""
-        if (self._calibrated is None or tol < self.cfg.coarse_tol
-                or self.odds):
+        """The calibration's converged β = 0 equilibrium as :meth:`solve` returns it, if ``tol`` is
+        no tighter than ``coarse_tol``; else ``None``."""
+        if self._calibrated is None or tol < self.cfg.coarse_tol or self.odds:
             return None
         x, it, res, conv = self._calibrated
         if not conv.all():
@@ -248,25 +193,16 @@ class PokeModel:
 
     def solve(self, betas: Array, x0: Array | None = None, tol: float | None = None, *,
               max_split: float = 0.0) -> tuple[PokeSimulation, Array]:
-        """Equilibria for ``betas (B,)``, optionally started from positions ``x0 (B, *body, 3)``
-        (default: :attr:`start` if there is one, else the rest shape), to the relative tolerance
-        ``tol`` (default ``config.tol``). ``max_split > 0`` lets a β step with the factorisation
-        of a smaller β already factorised (see :meth:`StepMatrices.prepare`) instead of its own;
-        the equilibrium is the same.
-
-        Returns the simulation (the surface layer's positions) and the whole body's positions
-        ``(B, *body, 3)`` (to warm-start a later solve).
-        """
+        """Equilibria for ``betas (B,)`` from ``x0 (B, *body, 3)`` (default: :attr:`start`, else
+        rest) to ``tol`` (default ``config.tol``; ``max_split``: :meth:`StepMatrices.prepare`):
+        the simulation of the surface layer, and the whole body's positions."""
         cfg = self.cfg
         betas = np.asarray(betas, dtype=float)
         rest = self.clusters.rest
         x = np.broadcast_to(rest, (len(betas), *rest.shape)).copy()
-        it = np.zeros(len(betas), dtype=np.int64)
-        res = np.zeros(len(betas))
+        it, res = np.zeros(len(betas), dtype=np.int64), np.zeros(len(betas))
         conv = np.ones(len(betas), dtype=bool)
-        # on the odds scale β = 0 carries no load: the rigid body at rest, exactly (rest is the
-        # fixed point of rigid goals), which the relative stopping test could not confirm below
-        # round-off
+        # on the odds scale β = 0 carries no load: the body at rest, exactly
         moving = self.load_scale(betas) > 0.0
         if moving.any():
             sub = betas[moving]
@@ -293,8 +229,7 @@ class PokeModel:
 def _body(p0: Array, masses: Array, fixed: NDArray[np.bool_], spacing: float,
           cfg: ShapeMatchingConfig) -> tuple[Array, Array, NDArray[np.bool_], tuple[int, ...]]:
     """The simulated body: the surface sheet, or the surface over layers down to a fixed floor."""
-    k = cfg.cluster_size
-    layers = cfg.body_layers
+    k, layers = cfg.cluster_size, cfg.body_layers
     if layers == 0:
         return p0[None], masses[None], fixed[None], (1, k, k)
     floor = 0.5 * min(float(np.ptp(p0[..., 0])), float(np.ptp(p0[..., 1])))

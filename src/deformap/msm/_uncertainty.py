@@ -1,11 +1,9 @@
-"""How well one poke pins down β: a paired block bootstrap of E(β) over the ROI.
+"""How well one poke pins down β: a paired block bootstrap of E(β) over the ROI, or E(β) against
+perturbed observations.
 
-E(β) is a mean over the ROI's particles; most of the ROI is undisturbed and adds nearly the same
-distance at every β, so what matters is how consistently the particles prefer one β. Resampling
-whole tiles of particles (about the touch GP's correlation length, so correlated neighbours move
-together) and taking the argmin of each resampled curve gives the spread of β̂ the observation
-supports (Künsch 1989; Efron & Tibshirani 1993, §8.6). The resampling uses a fixed internal seed,
-so the uncertainty is a deterministic function of the poke.
+E(β) is a mean over the ROI's particles; resampling whole tiles of particles (so correlated
+neighbours move together) and taking each resampled curve's argmin gives the spread of β̂ the
+observation supports (Künsch 1989; Efron & Tibshirani 1993, §8.6), with a fixed seed.
 
 References
 ----------
@@ -22,12 +20,24 @@ from scipy.spatial import cKDTree
 
 from deformap._validation import check_array, check_int, check_positive
 from deformap.errors import InvalidArgumentError
-from deformap.msm._parabola import parabola_vertex
 
-__all__ = ["BOOTSTRAP_SEED", "bootstrap_beta_std", "sample_beta_std"]
+__all__ = ["BOOTSTRAP_SEED", "bootstrap_beta_std", "parabola_vertex", "sample_beta_std"]
 
-BOOTSTRAP_SEED = 20161115
-"""The fixed seed of the resampling (a deterministic statistic, not a source of randomness)."""
+BOOTSTRAP_SEED = 20161115  # a deterministic statistic, not a source of randomness
+
+
+def parabola_vertex(x: NDArray[np.float64], e: NDArray[np.float64]
+                    ) -> tuple[NDArray[np.float64], NDArray[np.bool_]]:  # fmt: skip
+    """Vertex abscissae of the parabolas through ``(x[..., k], e[..., k])``, k = 0, 1, 2 (``x``
+    increasing), and whether each has a minimum (else the vertex is NaN)."""
+    x0, x1, x2 = x[..., 0], x[..., 1], x[..., 2]
+    e0, e1, e2 = e[..., 0], e[..., 1], e[..., 2]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        curv = ((e2 - e1) / (x2 - x1) - (e1 - e0) / (x1 - x0)) / (x2 - x0)
+        slope = (e1 - e0) / (x1 - x0) - curv * (x0 + x1)
+        ok = curv > 0.0
+        vertex = np.where(ok, -slope / (2.0 * curv), np.nan)
+    return np.asarray(vertex, dtype=float), np.asarray(ok, dtype=bool)
 
 
 def _tile_sums(distances: NDArray[np.float64], tile: int) -> NDArray[np.float64]:
@@ -44,28 +54,12 @@ def _tile_sums(distances: NDArray[np.float64], tile: int) -> NDArray[np.float64]
     return sums
 
 
-def bootstrap_beta_std(
-    betas: NDArray[np.float64],
-    distances: NDArray[np.float64],
-    *,
-    tile: int,
-    resolution: float,
-    n_boot: int = 256,
-) -> float:
-    """Standard deviation of β̂ under a block bootstrap of the ROI's particles.
+def bootstrap_beta_std(betas: NDArray[np.float64], distances: NDArray[np.float64], *, tile: int,
+                       resolution: float, n_boot: int = 256) -> float:
+    """Standard deviation of β̂ under ``n_boot`` resamples of ``tile × tile`` particle blocks.
 
-    Parameters
-    ----------
-    betas : (B,) float
-        The β values simulated, increasing.
-    distances : (B, ny, nx) float, metres
-        For each β, each surface particle's distance to the observed surface (E(β) is their mean).
-    tile : int
-        Side of a resampled block, in particles.
-    resolution : float
-        The β resolution of the estimate; the result is never below ``resolution / sqrt(12)``.
-    n_boot : int
-        Number of resamples.
+    ``betas (B,)`` increasing; ``distances (B, ny, nx)`` metres, each surface particle's distance
+    to the observed surface at each β; the result is at least ``resolution / √12``.
     """
     b = check_array("betas", betas, (None,), min_rows=2)
     d = check_array("distances", distances, (b.size, None, None), what="distances in metres")
@@ -83,38 +77,18 @@ def bootstrap_beta_std(
     return float(max(picks.std(ddof=1), floor))
 
 
-_CANDIDATES = 8
-"""Nearest observed points per particle among which a perturbed surface's nearest is sought."""
+_CANDIDATES = 8  # nearest observed points per particle searched for a moved one's nearest
 
 
-def sample_beta_std(
-    betas: NDArray[np.float64],
-    positions: NDArray[np.float64],
-    observed: NDArray[np.float64],
-    height_samples: NDArray[np.float64],
-    *,
-    resolution: float,
-) -> float:
+def sample_beta_std(betas: NDArray[np.float64], positions: NDArray[np.float64],
+                    observed: NDArray[np.float64], height_samples: NDArray[np.float64], *,
+                    resolution: float) -> float:
     """Standard deviation of β̂ over plausible observed surfaces (observation noise propagated).
 
-    Each sample moves the observed points vertically by one draw of their reconstruction error (the
-    touch GP's posterior, for instance); E(β) is re-evaluated for every simulated β against the moved
-    points (the simulations are not repeated) and the spread of the argmins returned. Each
-    particle's nearest moved point is sought among its 8 nearest unmoved ones, which holds while the
-    samples move points by less than about the grid spacing.
-
-    Parameters
-    ----------
-    betas : (B,) float
-        The β values simulated, increasing.
-    positions : (B, ny, nx, 3) float, metres
-        The simulated particle positions at each β.
-    observed : (m, 3) float, metres
-        The observed deformed surface X̄ the estimate was made against.
-    height_samples : (S, m) float, metres
-        Vertical errors of ``observed``, one row per sample (S ≥ 2).
-    resolution : float
-        The β resolution of the estimate; the result is never below ``resolution / sqrt(12)``.
+    Each row of ``height_samples (S, m)`` moves ``observed (m, 3)`` vertically; E(β) of the
+    simulated ``positions (B, ny, nx, 3)`` at ``betas (B,)`` (increasing) is re-evaluated against
+    the moved points, each particle's nearest sought among its 8 nearest unmoved ones, and the
+    spread of the argmins returned (at least ``resolution / √12``).
     """
     b = check_array("betas", betas, (None,), min_rows=2)
     if np.any(np.diff(b) <= 0):
@@ -137,11 +111,9 @@ def sample_beta_std(
 
 
 def _argmins(betas: NDArray[np.float64], curves: NDArray[np.float64]) -> NDArray[np.float64]:
-    """Minimiser of each row of ``curves (S, B)`` between the sampled ``betas``: the vertex of the
-    parabola through its lowest sample and the two beside it, in ``u = −log(1 − β)`` (a scale that
-    stretches the soft end, where the dent changes fastest), kept between those two, so that a
-    minimum beyond the refined few β does not snap to a coarse β a sweep step away.
-    """
+    """Minimiser of each row of ``curves (S, B)``: the vertex of the parabola through its lowest
+    sample and the two beside it, in ``u = −log(1 − β)`` (stretching the soft end), kept between
+    those two."""
     s_idx = np.arange(curves.shape[0])
     lowest = np.argmin(curves, axis=1)
     i = np.clip(lowest, 1, betas.size - 2)

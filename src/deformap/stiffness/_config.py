@@ -20,33 +20,26 @@ MIN_SAMPLES = 3
 
 @dataclass(frozen=True, kw_only=True)
 class StiffnessConfig:
-    """How a force–travel record is read (:mod:`deformap.stiffness`: model, fit, rigid test,
-    defaults).
+    """How a force–travel record is read (:mod:`deformap.stiffness`).
 
     Parameters
     ----------
     poisson_ratio : float
         ``ν`` of the surface's material, an assumption (open-cell foam: 0.33).
     poisson_ratio_std : float
-        How uncertain that assumption is; σ(E) carries what it moves E by (a refit at
-        ``ν ± poisson_ratio_std``). The default 0.07 is the standard deviation of ν spread
-        uniformly over [0.2, 0.45], about Gibson & Ashby's 1/3 (:mod:`deformap.stiffness`); 0
-        claims ν is known.
+        Uncertainty of that assumption, carried into σ(E) by a refit at ``ν ± poisson_ratio_std``.
+        0.07 is the standard deviation of ν uniform over [0.2, 0.45]; 0 claims ν is known.
     travel_noise_m : float
         Standard deviation of one travel reading (encoders through kinematics).
     force_noise_rel, force_noise_abs_n : float
         Standard deviation of one force reading: ``rel · |F| + abs``.
     rigid_travel_sigmas : float
-        A record whose travel span at the commanded force is below this many ``travel_noise_m``
-        is rigid.
+        A travel span at the commanded force below this many ``travel_noise_m`` reads rigid.
     backwards_sigmas : float
-        How far, in standard deviations of the difference of two readings, travel or force may
-        step back between samples before the record is refused (noise moves them a little).
+        How far, in standard deviations of a two-reading difference, travel or force may step back.
     force_tolerance_rel, force_tolerance_abs_n : float
-        When the commanded force is given, the record's last force may differ from it by
-        ``rel · F + abs`` (or three force standard deviations, if larger) before it is refused:
-        the same rule as :class:`deformap.environment.PressObservation`'s, so that a record the
-        protocol accepts is read.
+        Allowed gap ``rel · F + abs`` (or three force σ) between the last and commanded force.
+        The rule of :class:`deformap.environment.PressObservation`, so a record it accepts is read.
     """
 
     poisson_ratio: float = setting(0.33, ge=0.0, le=0.5)
@@ -65,37 +58,16 @@ class StiffnessConfig:
 
 @dataclass(frozen=True, kw_only=True)
 class StiffnessEstimate:
-    """What one force–travel record says about the surface, in SI units.
+    """What one force–travel record says about the surface, in SI units; the read fields are
+    ``None`` when ``rigid`` (stiffer than the probe and arm can tell apart).
 
-    Parameters
-    ----------
-    stiffness_n_per_m, stiffness_std_n_per_m : float or None
-        ``k = dF/dδ`` at the commanded force and its standard deviation; ``None`` when rigid.
-    stiffness_lower_n_per_m : float or None
-        When rigid, a lower bound on ``k`` (:mod:`deformap.stiffness`); otherwise ``None``.
-    modulus_pa, modulus_std_pa : float or None
-        Young's modulus from the contact model and its standard deviation; ``None`` when rigid.
-    contact_offset_m : float or None
-        The fitted indentation ``δ₀`` at zero travel; ``None`` when rigid.
-    depth_m : float
-        Indentation at the commanded force (the model's ``δ_c``); when rigid, the travel span
-        estimated by the rigid test.
-    max_chi : float or None
-        ``√(R δ_c) / h`` at the commanded force: the contact model holds for ``χ ≲ 1``.
-    reduced_chi2 : float or None
-        The fit's χ² per degree of freedom: about 1 when the model and the noise settings explain
-        the record, well above it when they do not; ``None`` when rigid.
-    rigid : bool
-        The surface is stiffer than the probe and arm can tell apart.
-    n_samples : int
-        Samples the estimate used (those within the tip's radius: :mod:`deformap.stiffness`).
-    model : str
-        The contact model (:data:`LAYER_MODEL`).
-    model_error_pa : float or None
-        The model-error part of ``modulus_std_pa`` (in quadrature with the rest): half the
-        difference between the moduli the record's lower and upper halves read, beyond what
-        their own noise explains (:mod:`deformap.stiffness`, Model error); 0 when they agree, ``None``
-        when rigid or the record has fewer than four samples (then not tested).
+    ``stiffness_n_per_m`` ``k = dF/dδ`` at the commanded force, ``modulus_pa`` E, and their
+    standard deviations; ``stiffness_lower_n_per_m`` a lower bound on ``k`` when rigid;
+    ``contact_offset_m`` the fitted ``δ₀``; ``depth_m`` the indentation ``δ_c`` at the commanded
+    force (when rigid, the travel span); ``max_chi`` ``√(R δ_c) / h`` (the model holds for
+    ``χ ≲ 1``); ``reduced_chi2`` the fit's χ² per degree of freedom; ``n_samples`` the samples
+    used; ``model`` :data:`LAYER_MODEL`; ``model_error_pa`` the model-error part of
+    ``modulus_std_pa`` (``None`` when rigid or under four samples).
     """
 
     stiffness_n_per_m: float | None

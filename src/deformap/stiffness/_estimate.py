@@ -17,19 +17,16 @@ __all__ = ["estimate_stiffness"]
 
 # thicker than any foam a table-top probe presses: a larger value is a unit slip (millimetres)
 _MAX_THICKNESS_M = 2.0
-# the range the contact model is read in: the finite-thickness series holds for χ ≲ 1 (Dimitriadis
-# et al. 2002); past half the layer the tip nears the table and the foam under it nears its
-# collapse plateau (Gibson & Ashby, ch. 5), far outside the small-strain expansion the series is
+# the series holds for χ ≲ 1 (Dimitriadis et al. 2002); past half the layer the foam nears its
+# collapse plateau (Gibson & Ashby, ch. 5)
 _MAX_CHI = 1.0
 _MAX_STRAIN = 0.5
 
 
 def _check_record(travel_m: Any, force_n: Any, config: StiffnessConfig,
                   ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    travel = check_array("travel_m", travel_m, (None,), what="travels in metres",
-                         min_rows=MIN_SAMPLES)
-    force = check_array("force_n", force_n, (None,), what="forces in newtons",
-                        min_rows=MIN_SAMPLES)
+    travel = check_array("travel_m", travel_m, (None,), what="travels in metres", min_rows=MIN_SAMPLES)
+    force = check_array("force_n", force_n, (None,), what="forces in newtons", min_rows=MIN_SAMPLES)
     if force.shape != travel.shape:
         raise InvalidArgumentError(f"`force_n` must have one value per travel sample "
                                    f"({travel.size}); got {force.size}")
@@ -89,45 +86,20 @@ def estimate_stiffness(travel_m: Any, force_n: Any, *, tip_radius_m: float, thic
                        config: StiffnessConfig | None = None) -> StiffnessEstimate:
     """Stiffness and Young's modulus with their uncertainties from one force–travel record.
 
-    Parameters
-    ----------
-    travel_m : (n,) float, metres
-        The probe's travel along the press direction since first contact, in time order,
-        ``n >= 3``; it may step back by no more than its noise.
-    force_n : (n,) float, newtons
-        The normal force at each sample; it rises from the contact threshold to the commanded
-        force.
-    tip_radius_m : float
-        Radius of the probe's spherical tip.
-    thickness_m : float
-        The elastic layer's thickness at the contact (the surface's height above the table), in
-        ``(0, 2]`` m; the travel must stay below it.
-    commanded_force_n : float, optional
-        The force the press was commanded to; the record's last force must be near it
-        (``config.force_tolerance_rel`` and ``force_tolerance_abs_n``). Default: the record's
-        largest force.
-    thickness_std_m : float
-        Standard deviation of ``thickness_m`` (the surface model's at the contact); E's
-        standard deviation includes what it moves E by (a refit at ``h ± σ_h``).
-    config : StiffnessConfig, optional
-
-    Returns
-    -------
-    StiffnessEstimate
-        ``k`` at the commanded force and ``E`` with their standard deviations
-        (:mod:`deformap.stiffness`), or ``rigid=True`` with ``None`` for both.
+    ``travel_m (n,)`` [m], the probe's travel since first contact in time order, ``n >= 3``, and
+    ``force_n (n,)`` [N], rising from the contact threshold to the commanded force
+    ``commanded_force_n`` (default: the largest), which the last force must be near;
+    ``tip_radius_m`` the spherical tip's radius; ``thickness_m`` the layer's thickness at the
+    contact, in ``(0, 2]`` m, above the travel, with standard deviation ``thickness_std_m``
+    (σ(E) includes a refit at ``h ± σ_h``).
 
     Raises
     ------
     InvalidArgumentError
-        Naming the argument: NaN or infinite values, fewer than three samples, a travel that does
-        not start at contact, a negative force, travel or force going backwards beyond their
-        noise, force not rising, a travel not below the thickness (millimetres for metres), a
-        last force far from the commanded one, a bad radius or thickness, or a record that leaves
-        the contact model's range (an indentation deeper than the tip's diameter, where the
-        sphere is buried and the stick holding it presses too; ``χ`` above 1; an indentation
-        deeper than half the layer; or a modulus on the fit's lower bound): the tip sank too
-        deep to read the layer.
+        Naming the argument: non-finite values, under three samples, a travel not starting at
+        contact, a negative force, travel or force stepping back beyond their noise, force not
+        rising, travel not below the thickness, a last force far from the commanded one, or a
+        record outside the contact model's range (:mod:`deformap.stiffness`, Range).
     """
     config = StiffnessConfig() if config is None else config
     radius = check_positive("tip_radius_m", tip_radius_m)
@@ -207,7 +179,6 @@ def estimate_stiffness(travel_m: Any, force_n: Any, *, tip_radius_m: float, thic
         stiffness_n_per_m=stiffness_at(modulus),
         stiffness_std_n_per_m=float(abs(dk_de) * modulus_std), stiffness_lower_n_per_m=None,
         modulus_pa=modulus, modulus_std_pa=modulus_std, model_error_pa=error_pa,
-        contact_offset_m=offset,
-        depth_m=depth_c, max_chi=chi,
+        contact_offset_m=offset, depth_m=depth_c, max_chi=chi,
         reduced_chi2=None if np.isnan(chi2_red) else float(chi2_red), rigid=False,
         n_samples=int(travel.size))

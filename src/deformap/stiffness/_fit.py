@@ -1,6 +1,4 @@
-"""The force–travel record's fit: effective-variance weighted least squares of the travel on the
-bonded-layer model, its covariance, and the two-part model-error test (:mod:`deformap.stiffness`:
-Fit, Model error)."""
+"""The force–travel record's fit and its two-part model-error test (:mod:`deformap.stiffness`)."""
 
 from __future__ import annotations
 
@@ -8,11 +6,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import minimize_scalar
 
-from deformap.mechanics import (
-    layer_chi_limit,
-    layer_indentation_force,
-    layer_indentation_stiffness,
-)
+from deformap.mechanics import layer_chi_limit, layer_indentation_force, layer_indentation_stiffness
 from deformap.stiffness._config import StiffnessConfig, force_std
 
 __all__ = ["LayerTable", "RecordFit", "fit_record", "model_error"]
@@ -31,9 +25,8 @@ _PART_ROUNDS = 8
 
 
 class LayerTable:
-    """The bonded-layer force at unit modulus, ``g(δ)``, tabulated on ``[0, δ_lim]`` for its
-    inverse; ``δ_lim`` stays below the depth where the series' force stops rising and at most the
-    layer's thickness."""
+    """``g(δ)``, the bonded-layer force at unit modulus, tabulated on ``[0, δ_lim]`` for its
+    inverse (``δ_lim`` short of where the series' force stops rising, at most the thickness)."""
 
     def __init__(self, radius: float, thickness: float, nu: float) -> None:
         self.radius, self.thickness, self.nu = radius, thickness, nu
@@ -51,8 +44,7 @@ class LayerTable:
         return float(np.exp(self.log_force[-1]))
 
     def depth_at(self, force_per_pa: NDArray[np.float64]) -> NDArray[np.float64]:
-        """``g⁻¹``: log–log interpolation, Hertz's ``δ ∝ F^(2/3)`` below the table, ``δ_lim``
-        above it."""
+        """``g⁻¹``: log–log interpolation, Hertz's ``δ ∝ F^(2/3)`` below the table."""
         u = np.log(np.maximum(force_per_pa, 1e-300))
         below = self.log_depth[0] + (u - self.log_force[0]) / 1.5
         inside = np.interp(u, self.log_force, self.log_depth)
@@ -65,8 +57,7 @@ class LayerTable:
 
 
 class RecordFit:
-    """Effective-variance weighted least squares of ``t = g⁻¹(F / E) − δ₀``
-    (:mod:`deformap.stiffness`, Fit)."""
+    """Effective-variance weighted least squares of ``t = g⁻¹(F / E) − δ₀``."""
 
     def __init__(self, travel: NDArray[np.float64], force: NDArray[np.float64],
                  table: LayerTable, config: StiffnessConfig) -> None:
@@ -79,8 +70,7 @@ class RecordFit:
         return self.table.depth_at(self.force / modulus)
 
     def offset(self, modulus: float) -> float:
-        """The weighted least-squares ``δ₀`` at ``modulus`` (closed form), kept at or above
-        ``−3 σ_t``."""
+        """The weighted least-squares ``δ₀`` at ``modulus``, at least ``−3 σ_t``."""
         gap = self.depths(modulus) - self.travel
         return max(float(self.weights @ gap / self.weights.sum()),
                    -3.0 * self.config.travel_noise_m)
@@ -143,13 +133,8 @@ class RecordFit:
         return float(self.weights @ gap / self.weights.sum()) < -3.0 * self.config.travel_noise_m
 
     def part_difference(self, modulus: float) -> tuple[float, float] | None:
-        """The two-part model's ``log E_hi − log E_lo`` and its standard deviation (module
-        docstring, Model error), or ``None`` when the record has too few samples to tell.
-
-        The lower samples (the first ``n // 2``) read ``E_lo``, the others ``E_hi``, all one
-        ``δ₀`` (held at the joint fit's when that sits on its bound); Gauss–Newton from the joint
-        fit with its effective-variance weights, the covariance Birge-scaled like the joint
-        fit's."""
+        """``log E_hi − log E_lo`` of the two-part model and its standard deviation, or ``None``
+        with too few samples (``δ₀`` held at the joint fit's when that sits on its bound)."""
         n = self.force.size
         if n < _MIN_PART_SAMPLES:
             return None
@@ -193,8 +178,8 @@ class RecordFit:
 
 
 def fit_record(travel: NDArray[np.float64], force: NDArray[np.float64], radius: float,
-         thickness: float, config: StiffnessConfig
-         ) -> tuple[float, float, NDArray[np.float64], float, RecordFit]:
+               thickness: float, config: StiffnessConfig
+               ) -> tuple[float, float, NDArray[np.float64], float, RecordFit]:
     """``(E, δ₀, cov(E, δ₀), reduced χ², fit)`` of the record on a layer of ``thickness``."""
     table = LayerTable(radius, thickness, config.poisson_ratio)
     fit = RecordFit(travel, force, table, config)
@@ -205,9 +190,7 @@ def fit_record(travel: NDArray[np.float64], force: NDArray[np.float64], radius: 
 
 
 def model_error(fit: RecordFit, modulus: float) -> float | None:
-    """The model-error standard deviation of ``E`` [Pa] from the two-part test
-    (:mod:`deformap.stiffness`, Model error): half the parts' difference beyond its own noise;
-    ``None`` when the record has too few samples to tell."""
+    """σ_model of ``E`` [Pa] (:mod:`deformap.stiffness`, Model error), or ``None``."""
     part = fit.part_difference(modulus)
     if part is None:
         return None
