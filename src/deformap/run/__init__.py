@@ -1,29 +1,17 @@
 """The application layer: a run's configuration, its folder, its report, and the workflows.
 
-One concept per module:
+One concept per module: ``_config`` (:class:`RunConfig`, YAML, overrides, resume, a session's
+own, the run's random streams), ``_folder`` (the one run-folder policy: naming, new folders only,
+atomic writes), ``_report`` (the one ``report.json`` schema), ``_export`` (``map.npz``,
+``pokes.csv``), ``_figures``, ``_hooks`` (:class:`RunHooks`, the progress callbacks every workflow
+takes), and one module per workflow, each a function with typed arguments returning a typed
+result: :func:`explore_scenario`, :func:`record_simulation`, :func:`map_recorded_session`,
+:func:`estimate_one_poke`, :func:`reproduce`, the studies, :func:`show_scenario` and the
+many-worlds benchmark.
 
-- ``_config``: :class:`RunConfig` (the world, the seed, every component's settings), read from
-  YAML (:func:`load_run_config`), changed by :class:`RunOverrides`, checked against a run that is
-  resumed (:func:`resume_run_config`) or taken from a recorded session
-  (:func:`session_run_config`); the run's random streams (:func:`run_generators`).
-- ``_folder``: the one run-folder policy: one naming scheme (:func:`default_run_folder`), new
-  folders only, every file written atomically.
-- ``_report``: the one ``report.json`` schema, one builder per kind of run around the shared
-  part.
-- ``_export``: the maps as numbers (``map.npz``, ``pokes.csv``: :data:`POKES_CSV_COLUMNS`).
-- ``_figures``: the figures of a run folder.
-- ``_hooks``: :class:`RunHooks`, the progress callbacks every workflow takes.
-- the workflows, each a function with typed arguments returning a typed result:
-  :func:`explore_scenario` (``_explore``), :func:`record_simulation` (``_record``),
-  :func:`map_recorded_session` (``_map``), :func:`estimate_one_poke` (``_estimate``),
-  :func:`reproduce` (``_reproduce``), :func:`run_hardness_study` and
-  :func:`run_cluster_size_study` (``_studies``), :func:`show_scenario` and
-  :func:`scenario_summaries` (``_world``).
-
-This package may import every library package (``eval`` included); none of them imports it.
-
-The names are imported on first use: a run needs the simulated world and the whole estimator
-(slow to import), which ``deformap --help`` never needs.
+This package may import every library package (``eval`` included); none of them imports it. The
+names are imported on first use: a run needs the simulated world and the whole estimator (slow to
+import), which ``deformap --help`` never needs.
 """
 
 from __future__ import annotations
@@ -68,11 +56,7 @@ if TYPE_CHECKING:
         load_worlds,
         rescore_worlds,
     )
-    from deformap.run._worlds_config import (
-        WorldsBenchConfig,
-        exploration_with,
-        parse_assignments,
-    )
+    from deformap.run._worlds_config import WorldsBenchConfig, exploration_with, parse_assignments
     from deformap.run._worlds_engines import BLAS_THREAD_VARIABLES
 
 _MODULES: dict[str, tuple[str, ...]] = {
@@ -97,51 +81,15 @@ _MODULES: dict[str, tuple[str, ...]] = {
 }  # fmt: skip
 
 __all__ = [
-    "BLAS_THREAD_VARIABLES",
-    "CLUSTER_SIZE_FOAMS",
-    "CONFIG_NAME",
-    "POKES_CSV_COLUMNS",
-    "RESCORABLE",
-    "RUNS_ROOT",
-    "EstimateOutput",
-    "MapOutput",
-    "RecordOutput",
-    "ReproduceOutput",
-    "RunConfig",
-    "RunHooks",
-    "RunOutput",
-    "RunOverrides",
-    "RunStart",
-    "ScenarioSummary",
-    "StudyOutput",
-    "WorldsBenchConfig",
-    "WorldsOutput",
-    "apply_overrides",
-    "bench_worlds",
-    "config_yaml",
-    "default_run_folder",
-    "estimate_one_poke",
-    "exploration_with",
-    "explore_environment",
-    "explore_run_config",
-    "explore_scenario",
-    "load_environment",
-    "load_run_config",
-    "load_worlds",
-    "map_recorded_session",
-    "parse_assignments",
-    "parse_env_args",
-    "record_simulation",
-    "reproduce",
-    "rescore_worlds",
-    "resume_run_config",
-    "run_cluster_size_study",
-    "run_generators",
-    "run_hardness_study",
-    "scenario_summaries",
-    "session_run_config",
-    "show_scenario",
+    "BLAS_THREAD_VARIABLES", "CLUSTER_SIZE_FOAMS", "CONFIG_NAME", "POKES_CSV_COLUMNS", "RESCORABLE",
+    "RUNS_ROOT", "EstimateOutput", "MapOutput", "RecordOutput", "ReproduceOutput", "RunConfig",
+    "RunHooks", "RunOutput", "RunOverrides", "RunStart", "ScenarioSummary", "StudyOutput",
+    "WorldsBenchConfig", "WorldsOutput", "apply_overrides", "bench_worlds", "config_yaml",
+    "default_run_folder", "estimate_one_poke", "exploration_with", "explore_environment",
+    "explore_run_config", "explore_scenario", "load_environment", "load_run_config", "load_worlds",
+    "map_recorded_session", "parse_assignments", "parse_env_args", "record_simulation", "reproduce",
+    "rescore_worlds", "resume_run_config", "run_cluster_size_study", "run_generators",
+    "run_hardness_study", "scenario_summaries", "session_run_config", "show_scenario",
 ]
-
 
 __getattr__, __dir__ = lazy_exports(__name__, _MODULES, __all__, globals())
