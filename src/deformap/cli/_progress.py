@@ -45,12 +45,8 @@ def progress(out: Console, description: str = "working") -> Iterator[Progress]:
         yield bar
 
 
-def run_hooks(
-    bar: Progress,
-    *,
-    poke_row: Callable[[PokeRecord], str] | None = None,
-    step_rows: bool = True,
-) -> run.RunHooks:
+def run_hooks(bar: Progress, *, poke_row: Callable[[PokeRecord], str] | None = None,
+              step_rows: bool = True) -> run.RunHooks:
     """Hooks that drive ``bar``'s task and print, above it, a header line, one row per poke
     (with ``poke_row``) and one per step (with ``step_rows``)."""
     task = bar.task_ids[0]
