@@ -35,44 +35,29 @@ GRID_REPEATS = 3
 def _relief(xy: NDArray[np.float64]) -> NDArray[np.float64]:
     """A smooth height field (metres) with features a few centimetres wide."""
     x, y = xy[:, 0], xy[:, 1]
-    return (
-        0.05
-        + 0.008 * np.sin(x / 0.04) * np.cos(y / 0.05)
-        + 0.006 * np.exp(-((x - 0.35) ** 2 + (y - 0.2) ** 2) / 0.06**2)
-    )
+    return (0.05 + 0.008 * np.sin(x / 0.04) * np.cos(y / 0.05)
+            + 0.006 * np.exp(-((x - 0.35) ** 2 + (y - 0.2) ** 2) / 0.06**2))
 
 
-def _timed_fit_predict(
-    method: str, xy: NDArray[np.float64], z: NDArray[np.float64], xs: Any, ys: Any
-) -> tuple[float, NDArray[np.float64], NDArray[np.float64]]:
-    field = GaussianRandomField(
-        length_scale=LENGTH_SCALE_M, signal_std=SIGNAL_STD_M, noise_std=NOISE_STD_M, method=method
-    )
+def _timed_fit_predict(method: str, xy: NDArray[np.float64], z: NDArray[np.float64], xs: Any,
+                       ys: Any) -> tuple[float, NDArray[np.float64], NDArray[np.float64]]:
+    field = GaussianRandomField(length_scale=LENGTH_SCALE_M, signal_std=SIGNAL_STD_M,
+                                noise_std=NOISE_STD_M, method=method)
     start = time.perf_counter()
     field.fit(xy, z)
     mean, std = field.predict_grid(xs, ys, return_std=True)
     return time.perf_counter() - start, mean, std
 
 
-def bench_surface_gp(
-    n_points_list: Sequence[int] = (3000, 6000, 12000), *, rng: np.random.Generator
-) -> list[dict[str, float | int]]:
-    """Time exact and grid GP regression of a noisy surface cloud and compare their outputs.
+def bench_surface_gp(n_points_list: Sequence[int] = (3000, 6000, 12000), *,
+                     rng: np.random.Generator) -> list[dict[str, float | int]]:
+    """Time exact and grid GP regression of a noisy surface cloud of each size N in
+    ``n_points_list`` (``rng`` draws the points and the noise) and compare their outputs.
 
-    Parameters
-    ----------
-    n_points_list : sequence of int
-        Cloud sizes N.
-    rng : numpy.random.Generator
-        Draws the point positions and the noise.
-
-    Returns
-    -------
-    list of dict
-        One row per N with keys ``"n_points"``, ``"exact_s"`` (fit + mean and std on the grid,
-        one run), ``"grid_s"`` (the same, best of 3 runs), ``"speedup"`` (exact_s / grid_s),
-        ``"max_mean_dev_m"`` (largest |mean_grid − mean_exact|, metres) and
-        ``"max_rel_std_dev"`` (largest |std_grid − std_exact| / std_exact).
+    One row per N: ``"n_points"``, ``"exact_s"`` (fit + mean and std on the grid, one run),
+    ``"grid_s"`` (the same, best of 3), ``"speedup"`` (exact_s / grid_s), ``"max_mean_dev_m"``
+    (largest |mean_grid − mean_exact|, metres) and ``"max_rel_std_dev"`` (largest
+    |std_grid − std_exact| / std_exact).
     """
     if not isinstance(rng, np.random.Generator):
         raise InvalidArgumentError(f"`rng` must be a numpy.random.Generator; got {type(rng)}")
@@ -88,13 +73,10 @@ def bench_surface_gp(
         grid_s = min(run[0] for run in grid_runs)
         _, m_grid, s_grid = grid_runs[0]
         row: dict[str, float | int] = {
-            "n_points": n,
-            "exact_s": exact_s,
-            "grid_s": grid_s,
-            "speedup": exact_s / grid_s,
+            "n_points": n, "exact_s": exact_s, "grid_s": grid_s, "speedup": exact_s / grid_s,
             "max_mean_dev_m": float(np.max(np.abs(m_grid - m_exact))),
             "max_rel_std_dev": float(np.max(np.abs(s_grid - s_exact) / s_exact)),
-        }
+        }  # fmt: skip
         _LOG.info("surface GP bench: %s", row)
         rows.append(row)
     return rows
