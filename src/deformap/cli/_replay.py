@@ -123,7 +123,8 @@ def map_command(
     for line in report["warnings"]:
         warn(line)  # once: the log line of a skipped poke printed it as it happened
     regions = report["regions"]
-    found = "no poke usable" if regions is None else f"{len(regions['class_betas'])} region class(es)"
+    found = ("no poke usable" if regions is None
+             else f"{len(regions['class_betas'])} region class(es)")
     scored = ""
     if regions is not None and "accuracy" in regions:
         scored = f", accuracy {regions['accuracy']:.3f} against the ground truth"

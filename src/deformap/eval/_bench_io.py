@@ -54,7 +54,8 @@ def bench_io(*, n_points: int = 300_000, rng: np.random.Generator, repeats: int 
     n = check_int("n_points", n_points, minimum=1)
     reps = check_int("repeats", repeats, minimum=1)
     if not isinstance(rng, np.random.Generator):
-        raise InvalidArgumentError(f"`rng` must be a numpy.random.Generator; got {type(rng).__name__}")
+        raise InvalidArgumentError(
+            f"`rng` must be a numpy.random.Generator; got {type(rng).__name__}")
     cloud = _scene(n, rng)
     result: dict[str, Any] = {"n_points": n, "goal_s": IO_GOAL_S}
     with tempfile.TemporaryDirectory(prefix="deformap-bench-io-") as tmp:

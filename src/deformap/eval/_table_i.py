@@ -34,8 +34,8 @@ def table_row(scenario: str, report: dict[str, Any], *, threshold: float) -> dic
 
 def markdown_table(result: dict[str, Any]) -> str:
     """The reproduction table in markdown (``result``: ``{"seed", "strategy", "rows"}``)."""
-    head = ("| scenario | paper: pokes | paper: T_h | paper: regions | pokes | regions found / true "
-            "| region accuracy | mean IoU | Kendall τ | time [s] |\n"
+    head = ("| scenario | paper: pokes | paper: T_h | paper: regions | pokes "
+            "| regions found / true | region accuracy | mean IoU | Kendall τ | time [s] |\n"
             "|---|---|---|---|---|---|---|---|---|---|\n")
     lines = []
     for r in result["rows"]:

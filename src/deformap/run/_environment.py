@@ -29,11 +29,7 @@ from deformap.errors import ConfigError
 from deformap.explore import Journal, check_exploration_budget, explore
 from deformap.run._config import CONFIG_NAME, RunConfig, config_yaml, run_generators
 from deformap.run._export import poke_writer, write_run_results
-from deformap.run._folder import (
-    create_run_folder,
-    default_run_folder,
-    write_text,
-)
+from deformap.run._folder import create_run_folder, default_run_folder, write_text
 from deformap.run._hooks import NO_HOOKS, RunHooks, RunStart
 from deformap.run._report import shared_report
 
@@ -84,29 +80,21 @@ def load_environment(spec: str, args: dict[str, Any]) -> Environment:
         raise ConfigError(f"--environment {spec!r}: {attr}() failed "
                           f"({type(exc).__name__}: {exc})") from None
     if not isinstance(env, Environment):
-        raise ConfigError(
-            f"--environment {spec!r} must return an Environment (workspace, observe, press, "
-            f"release); got {type(env).__name__}")
+        raise ConfigError(f"--environment {spec!r} must return an Environment (workspace, "
+                          f"observe, press, release); got {type(env).__name__}")
     return env
 
 
-def explore_environment(
-    spec: str,
-    env_args: dict[str, Any],
-    config: RunConfig,
-    out: Path | None = None,
-    *,
-    figures: bool = True,
-    hooks: RunHooks = NO_HOOKS,
-    variance_max: float | None = None,
-) -> tuple[dict[str, Any], Path]:
+def explore_environment(spec: str, env_args: dict[str, Any], config: RunConfig,
+                        out: Path | None = None, *, figures: bool = True,
+                        hooks: RunHooks = NO_HOOKS, variance_max: float | None = None,
+                        ) -> tuple[dict[str, Any], Path]:
     """Explore the Environment ``spec`` returns (module docstring); ``(report, folder)``.
 
-    ``variance_max`` fixes the top of ``map.png``'s variance colour scale (so that runs compare).
-
-    The run folder is new or empty (default ``runs/<factory>-explore-s<seed>-<time>``); the
-    environment is built before the folder is made, so that a spec that does not load leaves
-    nothing behind. ``config.world`` and ``config.scenario`` are not used.
+    The run folder is new or empty (default ``runs/<factory>-explore-s<seed>-<time>``), made
+    after the environment is built, so that a spec that does not load leaves nothing behind;
+    ``variance_max`` fixes the top of ``map.png``'s variance scale. ``config.world`` and
+    ``config.scenario`` are not used.
     """
     if variance_max is not None:  # before any work
         check_positive("variance_max", variance_max)

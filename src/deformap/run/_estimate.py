@@ -25,52 +25,36 @@ __all__ = ["EstimateOutput", "estimate_one_poke"]
 
 @dataclass(frozen=True, kw_only=True)
 class EstimateOutput:
-    """What :func:`estimate_one_poke` found, and the folder it wrote (``None`` when none).
-
-    ``report`` is the content of ``estimate.json``: ``before``, ``after``, ``beta``, ``beta_std``,
-    ``contact_point``, ``contact``, ``force_n``, ``betas``, ``errors``, ``converged``,
-    ``iterations``, ``n_roi_points``, ``timings``.
-    """
+    """What :func:`estimate_one_poke` found (``report``: the content of ``estimate.json``) and the
+    folder it wrote (``None`` when none)."""
 
     report: dict[str, Any]
     folder: Path | None
 
 
 def estimate_one_poke(
-    *,
-    before: Path,
-    after: Path,
-    tip_center: Sequence[float],
-    force: Sequence[float],
-    tip_radius_m: float,
-    config: RunConfig,
-    robot_hull: Path | None = None,
-    units: str = "m",
-    seed: int = 0,
-    out: Path | None = None,
-) -> EstimateOutput:
+    *, before: Path, after: Path, tip_center: Sequence[float], force: Sequence[float],
+    tip_radius_m: float, config: RunConfig, robot_hull: Path | None = None, units: str = "m",
+    seed: int = 0, out: Path | None = None,
+) -> EstimateOutput:  # fmt: skip
     """β of one poke (see :func:`deformap.replay.estimate_poke`).
 
     Parameters
     ----------
     before, after : Path
-        Clouds of the undisturbed surface and while pressing (PCD, PLY, NPZ).
+        Clouds of the undisturbed surface and while pressing (PCD, PLY, NPZ; ``units`` m or mm).
     tip_center : (3,) float, metres
-        Centre of the tip's sphere at the press.
+        Centre of the tip's sphere (radius ``tip_radius_m``) at the press.
     force : (3,) float, newtons
         Force on the surface.
-    tip_radius_m : float, metres
     config : RunConfig
         Its exploration part (surface GP, touch GP, shape matching) is used.
     robot_hull : Path, optional
         Cloud of points whose hull covers stick and hand; default: the tip's sphere.
-    units : {"m", "mm"}
-        Units of the cloud files.
     seed : int
         Seed of the surface fit.
     out : Path, optional
-        A new or empty folder for ``estimate.json`` and the figures, created before the work;
-        ``None`` writes nothing.
+        A new or empty folder for ``estimate.json`` and the figures, created before the work.
 
     Raises
     ------

@@ -21,8 +21,7 @@ map's grid of ``(ny, nx)`` cells unless said otherwise:
 poke is in, numbered from 1 as ``R1, R2, …`` on ``map.png``: ``region_labels`` + 1; empty where
 the map field left the poke out).
 
-Both are written atomically (:mod:`deformap._files`). :func:`write_run_results` writes a run's
-results in one place for every workflow that maps (explore, a user's environment, a session):
+Both are written atomically. :func:`write_run_results` writes every mapping workflow's results:
 ``report.json``, these two files and the figures.
 """
 
@@ -42,8 +41,7 @@ from deformap.run._figures import write_map_figures, write_poke_figure
 from deformap.run._folder import write_json
 from deformap.run._hooks import NO_HOOKS, RunHooks
 
-__all__ = ["POKES_CSV_COLUMNS", "poke_writer", "write_map_npz", "write_pokes_csv",
-           "write_run_results"]
+__all__ = ["POKES_CSV_COLUMNS", "poke_writer", "write_run_results"]
 
 POKES_CSV_COLUMNS = (
     "poke", "purpose", "target_x_m", "target_y_m", "contact_x_m", "contact_y_m", "tip_center_z_m",
@@ -52,7 +50,7 @@ POKES_CSV_COLUMNS = (
 )  # fmt: skip
 
 
-def write_map_npz(path: Path, result: ExplorationResult) -> Path:
+def _write_map_npz(path: Path, result: ExplorationResult) -> None:
     """``map.npz`` of ``result`` (module docstring)."""
     shape = (result.ys.size, result.xs.size)
     nan = np.full(shape, np.nan)
@@ -71,21 +69,20 @@ def write_map_npz(path: Path, result: ExplorationResult) -> Path:
     }  # fmt: skip
     with atomic_path(path) as tmp, open(tmp, "wb") as fh:
         np.savez_compressed(fh, **arrays)
-    return path
 
 
 def _cell(value: Any) -> Any:
     return "" if value is None else value
 
 
-def write_pokes_csv(path: Path, result: ExplorationResult) -> Path:
+def _write_pokes_csv(path: Path, result: ExplorationResult) -> None:
     """``pokes.csv`` of ``result`` (module docstring)."""
     region_of: dict[int, int] = {}
     if result.regions is not None:
         index = result.map_field.pokes.index
         assert index is not None  # PokeSet fills it
-        region_of = {int(i): int(k) for i, k in zip(index, result.regions.poke_labels,
-                                                    strict=True)}  # fmt: skip
+        region_of = {int(i): int(k)
+                     for i, k in zip(index, result.regions.poke_labels, strict=True)}
     text = io.StringIO()
     writer = csv.writer(text, lineterminator="\n")
     writer.writerow(POKES_CSV_COLUMNS)
@@ -95,14 +92,12 @@ def write_pokes_csv(path: Path, result: ExplorationResult) -> Path:
         writer.writerow([
             r.index + 1, _cell(r.purpose), *(float(v) for v in r.target_xy),
             *(float(v) for v in r.contact_xy), r.contact.tip_center[2], r.force_n, r.beta,
-            r.beta_std,
-            _cell(s and s.stiffness_n_per_m), _cell(s and s.stiffness_std_n_per_m),
+            r.beta_std, _cell(s and s.stiffness_n_per_m), _cell(s and s.stiffness_std_n_per_m),
             _cell(s and s.modulus_pa), _cell(s and s.modulus_std_pa),
             "" if s is None else s.rigid,
             "" if r.index not in region_of else region_of[r.index] + 1,
         ])  # fmt: skip
     write_text_atomically(path, text.getvalue())
-    return path
 
 
 def write_run_results(folder: Path, result: ExplorationResult, report: dict[str, Any], *,
@@ -112,8 +107,8 @@ def write_run_results(folder: Path, result: ExplorationResult, report: dict[str,
     field the map ran on; its variance scale fixed at ``variance_max`` when given) and the
     ``poke-NN.png`` (unless the caller drew them as the pokes came: ``poke_figures=False``)."""
     write_json(folder / "report.json", report)
-    write_map_npz(folder / "map.npz", result)
-    write_pokes_csv(folder / "pokes.csv", result)
+    _write_map_npz(folder / "map.npz", result)
+    _write_pokes_csv(folder / "pokes.csv", result)
     if figures:
         hooks.stage("drawing figures")
         write_map_figures(folder, result, truth=truth,
