@@ -44,16 +44,13 @@ ConfigOption = Annotated[Path | None, typer.Option(
 
 def poke_row(p: PokeRecord) -> str:
     """One progress line of a live poke."""
-    return (
-        f"  poke {p.index + 1:>2}  target ({p.target_xy[0]:.3f}, {p.target_xy[1]:.3f}) m"
-        f"  force {p.force_n:.2f} N  β = {p.beta:.3f} ± {p.beta_std:.3f}"
-        + modulus_text(p)
-        + f"  max var {p.max_variance_after:.4f}"
-        + (f"  plan: {p.planned_after} more" if p.planned_after is not None else "")
-        + ("  boundary poke" if p.purpose == "boundary" else "")
-        + f"  (compute {p.timings.compute_s:.2f} s,"
-        f" world {p.timings.environment_s or 0.0:.2f} s)"
-    )
+    return (f"  poke {p.index + 1:>2}  target ({p.target_xy[0]:.3f}, {p.target_xy[1]:.3f}) m"
+            f"  force {p.force_n:.2f} N  β = {p.beta:.3f} ± {p.beta_std:.3f}" + modulus_text(p)
+            + f"  max var {p.max_variance_after:.4f}"
+            + (f"  plan: {p.planned_after} more" if p.planned_after is not None else "")
+            + ("  boundary poke" if p.purpose == "boundary" else "")
+            + f"  (compute {p.timings.compute_s:.2f} s,"
+            f" world {p.timings.environment_s or 0.0:.2f} s)")
 
 
 def modulus_summary(report: dict[str, Any]) -> str:
@@ -111,28 +108,28 @@ def explore_command(
     out: Annotated[Path | None, typer.Option(
         help="Run folder (default runs/<scenario>-explore-s<seed>-<time>).")] = None,
     strategy: Annotated[str | None, typer.Option(
-        help="How the next poke is chosen: `exploration.strategy` (a name it does "
-        "not know is refused with the list of choices).",
+        help="How the next poke is chosen: `exploration.strategy` (a name it does not know is "
+        "refused with the list of choices).",
         show_default=str(HELP_DEFAULTS["exploration.strategy"]))] = None,
     threshold: Annotated[float | None, typer.Option(
         help="T_h: stop when max var(β) is below it (then any boundary pokes); "
         "with --field modulus, read as the same fraction of its prior variance.",
         show_default=str(HELP_DEFAULTS["exploration.threshold"]))] = None,
     max_pokes: Annotated[int | None, typer.Option(
-        help="Most pokes to make.",
-        show_default=str(HELP_DEFAULTS["exploration.max_pokes"]))] = None,
+        help="Most pokes to make.", show_default=str(HELP_DEFAULTS["exploration.max_pokes"]))
+    ] = None,
     field: Annotated[str | None, typer.Option(
-        help="The field regions, targets and the stop rule run on: "
-        "`exploration.field`, 'beta' or 'modulus' (from the force–travel records).",
+        help="The field regions, targets and the stop rule run on: `exploration.field`, 'beta' "
+        "or 'modulus' (from the force–travel records).",
         show_default=str(HELP_DEFAULTS["exploration.field"]))] = None,
     config: ConfigOption = None,
-    resume: Annotated[Path | None, typer.Option(
-        help="Continue the killed run in this folder.")] = None,
-    rerun: Annotated[bool, typer.Option(
-        "--rerun", help="Also write run.rrd (extra `rerun`).")] = False,
+    resume: Annotated[Path | None, typer.Option(help="Continue the killed run in this folder.")
+                      ] = None,
+    rerun: Annotated[bool, typer.Option("--rerun", help="Also write run.rrd (extra `rerun`).")
+                     ] = False,
     environment: Annotated[str | None, typer.Option(
-        help="Explore your own Environment instead of a simulated world: "
-        "package.module:factory (docs/robot.md).")] = None,
+        help="Explore your own Environment instead of a simulated world: package.module:factory "
+        "(docs/robot.md).")] = None,
     env_arg: Annotated[list[str] | None, typer.Option(
         "--env-arg", help="key=value passed to the --environment factory (repeat).")] = None,
     variance_max: VarianceMaxOption = None,

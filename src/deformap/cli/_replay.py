@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import sys
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
@@ -63,9 +64,7 @@ def record_sim_command(
                                        hooks=run_hooks(bar, poke_row=poke_row))  # fmt: skip
     shown.print(f"wrote {output.session_file} ({output.n_pokes} pokes, {output.format} form)",
                 highlight=False)  # fmt: skip
-    emit_json(json_path, {"session_file": str(output.session_file), "folder": str(output.folder),
-                          "n_pokes": output.n_pokes, "format": output.format,
-                          "live_betas": output.live_betas})  # fmt: skip
+    emit_json(json_path, dataclasses.asdict(output))  # the paths as strings
 
 
 @app.command("map")

@@ -47,39 +47,35 @@ def _hardness(value: float | None) -> str:
 @study_app.command("hardness")
 @friendly_errors
 def study_hardness(
-    out: Annotated[Path | None, typer.Option(
-        help="New folder for hardness.png and hardness.json "
-        "(default runs/hardness-study-s<seed>-<time>).")] = None,
+    out: Annotated[Path | None, typer.Option(help="New folder for hardness.png and hardness.json "
+                                             "(default runs/hardness-study-s<seed>-<time>).")
+                   ] = None,
     seed: SeedOption = 0,
     hardness: Annotated[list[float] | None, typer.Option(
         help="Foams in N (repeat); rigid is added.", show_default=STUDY_HARDNESSES_HELP)] = None,
     coarse: CoarseOption = False,
     camera: Annotated[str | None, typer.Option(
-        help="Camera preset: primesense | kinect-v1 | realsense-d435 "
-        "(default primesense; with --full, the matrix's only camera).")] = None,
+        help="Camera preset: primesense | kinect-v1 | realsense-d435 (default primesense; with "
+        "--full, the matrix's only camera).")] = None,
     thickness: Annotated[float | None, typer.Option(
-        help="Foam thickness in metres (default 0.05; with --full, "
-        "the matrix's only thickness).")] = None,
+        help="Foam thickness in metres (default 0.05; with --full, the matrix's only thickness).")
+    ] = None,
     force: Annotated[float | None, typer.Option(help="Press force in N (default 0.6).")] = None,
     physics: Annotated[str | None, typer.Option(
-        help="World physics: linear-fem | stiffening-foam | "
-        "stiffening-fem (`world.physics`; default linear-fem; with "
-        "--full, the matrix's only physics).")] = None,
+        help="World physics: linear-fem | stiffening-foam | stiffening-fem (`world.physics`; "
+        "default linear-fem; with --full, the matrix's only physics).")] = None,
     full: Annotated[bool, typer.Option(
-        help="The whole matrix: every camera preset × thickness 0.03, 0.05, "
-        "0.10 m × every physics; --camera, --thickness or --physics given "
-        "pins that axis.")] = False,
+        help="The whole matrix: every camera preset × thickness 0.03, 0.05, 0.10 m × every "
+        "physics; --camera, --thickness or --physics given pins that axis.")] = False,
     protocol: Annotated[list[str] | None, typer.Option(
-        help="Contact protocol whose β is fitted (repeat): "
-        "force/quadratic | force/linear | pinned/quadratic | "
-        "pinned/linear (default force/quadratic and the "
-        "paper's pinned/quadratic).")] = None,
+        help="Contact protocol whose β is fitted (repeat): force/quadratic | force/linear | "
+        "pinned/quadratic | pinned/linear (default force/quadratic and the paper's "
+        "pinned/quadratic).")] = None,
     element_size: Annotated[float | None, typer.Option(
-        help="The world's in-plane FEM element size in metres "
-        "(default 0.0075, a quick look; with --full 0.00375, a mesh "
-        "that resolves a stiff foam's contact, about 5 times the "
-        "time of a press): how much of E's error is the world's "
-        "mesh. Not with --coarse.")] = None,
+        help="The world's in-plane FEM element size in metres (default 0.0075, a quick look; "
+        "with --full 0.00375, a mesh that resolves a stiff foam's contact, about 5 times the "
+        "time of a press): how much of E's error is the world's mesh. Not with --coarse.")
+    ] = None,
     json_path: JsonOption = None,
 ) -> None:
     """β and Young's modulus against hardness for each contact protocol (paper Fig. 5a)."""
@@ -207,8 +203,8 @@ def reproduce_command(
         "(default runs/table-i-reproduce-s<seed>-<time>).")] = None,
     seed: Annotated[int, typer.Option(help="Seed of every run.")] = 0,
     strategy: Annotated[str | None, typer.Option(
-        help="`exploration.strategy` of every run (default: the config's; a name it "
-        "does not know is refused with the list of choices).")] = None,
+        help="`exploration.strategy` of every run (default: the config's; a name it does not "
+        "know is refused with the list of choices).")] = None,
     config: Annotated[Path | None, typer.Option(help="Run configuration YAML.")] = None,
     scenario: Annotated[list[str] | None, typer.Option(
         "--scenario", help="Only this scenario (repeat).")] = None,
