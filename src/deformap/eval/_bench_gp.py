@@ -39,8 +39,19 @@ def _relief(xy: NDArray[np.float64]) -> NDArray[np.float64]:
             + 0.006 * np.exp(-((x - 0.35) ** 2 + (y - 0.2) ** 2) / 0.06**2))
 
 
-def _timed_fit_predict(method: str, xy: NDArray[np.float64], z: NDArray[np.float64], xs: Any,
-                       ys: Any) -> tuple[float, NDArray[np.float64], NDArray[np.float64]]:
+def surface_problem(n: int, rng: np.random.Generator) -> tuple[NDArray[np.float64], ...]:
+    """``xy, z, xs, ys``: ``n`` noisy points of the relief and the grid's cell centres."""
+    xy = rng.uniform((0.0, 0.0), WORKSPACE_M, size=(n, 2))
+    z = _relief(xy) + NOISE_STD_M * rng.standard_normal(n)
+    xs = np.arange(CELL_M / 2, WORKSPACE_M[0], CELL_M)
+    ys = np.arange(CELL_M / 2, WORKSPACE_M[1], CELL_M)
+    return xy, z, xs, ys
+
+
+def timed_fit_predict(method: str, xy: NDArray[np.float64], z: NDArray[np.float64], xs: Any,
+                      ys: Any) -> tuple[float, NDArray[np.float64], NDArray[np.float64]]:
+    """Seconds to fit the surface GP by ``method`` and predict mean and std on the grid, and
+    those."""
     field = GaussianRandomField(length_scale=LENGTH_SCALE_M, signal_std=SIGNAL_STD_M,
                                 noise_std=NOISE_STD_M, method=method)
     start = time.perf_counter()
@@ -62,14 +73,11 @@ def bench_surface_gp(n_points_list: Sequence[int] = (3000, 6000, 12000), *,
     if not isinstance(rng, np.random.Generator):
         raise InvalidArgumentError(f"`rng` must be a numpy.random.Generator; got {type(rng)}")
     sizes = [check_int("n_points_list[i]", n, minimum=2) for n in n_points_list]
-    xs = np.arange(CELL_M / 2, WORKSPACE_M[0], CELL_M)
-    ys = np.arange(CELL_M / 2, WORKSPACE_M[1], CELL_M)
     rows: list[dict[str, float | int]] = []
     for n in sizes:
-        xy = rng.uniform((0.0, 0.0), WORKSPACE_M, size=(n, 2))
-        z = _relief(xy) + NOISE_STD_M * rng.standard_normal(n)
-        exact_s, m_exact, s_exact = _timed_fit_predict("exact", xy, z, xs, ys)
-        grid_runs = [_timed_fit_predict("grid", xy, z, xs, ys) for _ in range(GRID_REPEATS)]
+        xy, z, xs, ys = surface_problem(n, rng)
+        exact_s, m_exact, s_exact = timed_fit_predict("exact", xy, z, xs, ys)
+        grid_runs = [timed_fit_predict("grid", xy, z, xs, ys) for _ in range(GRID_REPEATS)]
         grid_s = min(run[0] for run in grid_runs)
         _, m_grid, s_grid = grid_runs[0]
         row: dict[str, float | int] = {

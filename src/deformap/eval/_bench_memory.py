@@ -45,14 +45,10 @@ def _prepare(case: str, size: int, seed: int) -> Callable[[], Any]:
     """Build the case's inputs (outside the measurement) and return the call to measure."""
     rng = np.random.default_rng(seed)
     if case.startswith("gp-"):
-        from deformap.eval import _bench_gp as gp
+        from deformap.eval._bench_gp import surface_problem, timed_fit_predict
 
-        xs = np.arange(gp.CELL_M / 2, gp.WORKSPACE_M[0], gp.CELL_M)
-        ys = np.arange(gp.CELL_M / 2, gp.WORKSPACE_M[1], gp.CELL_M)
-        xy = rng.uniform((0.0, 0.0), gp.WORKSPACE_M, size=(size, 2))
-        z = gp._relief(xy) + gp.NOISE_STD_M * rng.standard_normal(size)
-        method = case.removeprefix("gp-")
-        return lambda: gp._timed_fit_predict(method, xy, z, xs, ys)
+        xy, z, xs, ys = surface_problem(size, rng)
+        return lambda: timed_fit_predict(case.removeprefix("gp-"), xy, z, xs, ys)
     from scipy.spatial import cKDTree
 
     from deformap.eval._bench_msm import dent_problem, per_beta_loop

@@ -1,12 +1,9 @@
 """Explore a user's own `Environment` (a real robot, or any world) named on the command line.
 
 ``deformap explore --environment package.module:factory --env-arg key=value …`` imports
-``package.module`` (from the installed packages or the current folder), calls ``factory(**args)``
-and explores what it returns exactly as the simulated world is explored: the same loop, journal,
-report (without the ground-truth metrics, which only a simulated world has), figures and maps as
-numbers. Each ``--env-arg`` value is read as a YAML scalar (``port=5`` gives the integer 5,
-``name=arm`` the string, ``rate=0.5`` the float). Importing runs the module's code: name only
-code you trust, as with any Python import.
+``package.module`` (installed, or in the current folder), calls ``factory(**args)`` with each
+value read as a YAML scalar, and explores what it returns as the simulated world is explored
+(the report without the ground-truth metrics). Importing runs the module's code, as any import.
 """
 
 from __future__ import annotations

@@ -1,28 +1,16 @@
 """Maps a user can take away as numbers: ``map.npz`` (the grids) and ``pokes.csv`` (one row a poke).
 
-``map.npz`` (numpy's zip of arrays, read with ``numpy.load(path)``, no pickle), every array on the
-map's grid of ``(ny, nx)`` cells unless said otherwise:
+``map.npz`` (``numpy.load(path)``, no pickle), each array ``(ny, nx)`` on the map's grid: ``xs_m
+(nx,)`` and ``ys_m (ny,)``, the cells' centres in the world frame (``frame``, ``units``);
+``beta_mean``, ``beta_std``; the modulus field's ``modulus_median_pa`` (exp of the mean of ln E),
+``log_modulus_mean``, ``log_modulus_std`` (NaN when no poke gave a modulus); ``region_labels``
+(label ``k`` is region ``R(k+1)``, -1 without a region map) and the ``field`` they were cut from.
 
-- ``xs_m (nx,)``, ``ys_m (ny,)``: the cells' centres in the world frame (metres, z up, the table
-  z = 0); ``frame`` and ``units`` (strings) say so.
-- ``beta_mean``, ``beta_std``: the β-field's posterior mean and standard deviation.
-- ``modulus_median_pa``, ``log_modulus_mean``, ``log_modulus_std``: the modulus field (over ln E,
-  E in Pa): the median E (``exp`` of the mean), the mean and standard deviation of ln E; NaN
-  everywhere when no poke gave a modulus.
-- ``region_labels`` (int, -1 without a region map; label ``k`` is region ``R(k+1)`` of
-  ``map.png``), ``field``: the field the regions were cut from.
-
-``pokes.csv``: ``poke`` (numbered from 1, as in ``poke-NN.png``, the figures and the console;
-``report.json``'s ``index`` is this number minus one), ``purpose``, ``target_x_m``,
-``target_y_m``, ``contact_x_m``, ``contact_y_m`` (where the tip touched: the fields' input),
-``tip_center_z_m`` (the tip's centre at the commanded force), ``force_n``, ``beta``,
-``beta_std``, ``stiffness_n_per_m``, ``stiffness_std_n_per_m``, ``modulus_pa``, ``modulus_std_pa``,
-``rigid`` (the force–travel reading; empty where the poke had none), ``region`` (the region the
-poke is in, numbered from 1 as ``R1, R2, …`` on ``map.png``: ``region_labels`` + 1; empty where
-the map field left the poke out).
-
-Both are written atomically. :func:`write_run_results` writes every mapping workflow's results:
-``report.json``, these two files and the figures.
+``pokes.csv``: the columns :data:`POKES_CSV_COLUMNS`, ``poke`` numbered from 1 (``report.json``'s
+``index`` + 1), the contact where the tip touched, ``tip_center_z_m`` at the commanded force, the
+force–travel reading (empty without one) and ``region`` (``region_labels`` + 1; empty where the
+map field left the poke out). :func:`write_run_results` writes every mapping workflow's results:
+``report.json``, these two files and the figures, each atomically.
 """
 
 from __future__ import annotations
