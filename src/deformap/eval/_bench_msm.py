@@ -34,17 +34,15 @@ _TIGHT_ATOL_M = 1e-6
 _LOOSE_ATOL_M = 3e-6
 
 
-def bench_beta_sweep(*, n_particles_side: int = 40, cluster_size: int = 3,
-                     rng: np.random.Generator, config: ShapeMatchingConfig | None = None,
-                     ) -> dict[str, Any]:
+def bench_beta_sweep(*, n_particles_side: int = 40, rng: np.random.Generator,
+                     config: ShapeMatchingConfig | None = None) -> dict[str, Any]:
     """Time a converged β estimation on ``n_particles_side``² particles (0.5 cm apart), batched
-    and per-β, with ``config`` (default: the library's with ``cluster_size``); ``rng`` draws the
+    and per-β, with ``config`` (default: the library's with 3×3 clusters); ``rng`` draws the
     noise. Returns ``{"n_beta", "n_particles", "batched_s", "loop_s", "speedup"}``."""
     n = check_int("n_particles_side", n_particles_side, minimum=5)
-    k = check_int("cluster_size", cluster_size, minimum=2)
     if not isinstance(rng, np.random.Generator):
         raise InvalidArgumentError(f"`rng` must be a numpy.random.Generator; got {type(rng)}")
-    cfg = config or ShapeMatchingConfig(cluster_size=k)
+    cfg = config or ShapeMatchingConfig(cluster_size=3)
     xs, ys, z, pts, contact = dent_problem(n, rng)
     t0 = time.perf_counter()
     est = estimate_beta(xs, ys, z, pts, contact, cfg)

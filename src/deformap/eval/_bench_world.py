@@ -12,11 +12,15 @@ from deformap.explore import ExplorationConfig
 __all__ = ["bench_world"]
 
 
+N_PRESSES = 3
+"""Presses timed (the median reported)."""
+
+
 def bench_world(*, scenario: str = "heterogeneous-60-110-rigid", rng: np.random.Generator,
-                config: Any = None, n_presses: int = 3,
-                force_n: float = ExplorationConfig().force_n) -> dict[str, Any]:
+                config: Any = None) -> dict[str, Any]:
     """Time one world of ``scenario`` (``config``, default ``WorldConfig()``) and one poke's
-    compute on ``n_presses`` of its presses with ``force_n``, spread over the workspace.
+    compute on :data:`N_PRESSES` of its presses, spread over the workspace, with the
+    exploration's force.
 
     Returns ``construction_s``, ``press_s``, ``observe_s`` (medians, seconds), ``n_dofs``,
     ``n_points`` and ``n_points_on_area`` of one observation, ``scenario``, ``element_size_m``,
@@ -37,8 +41,9 @@ def bench_world(*, scenario: str = "heterogeneous-60-110-rigid", rng: np.random.
         t0 = time.perf_counter()
         cloud = world.observe()
         observe_times.append(time.perf_counter() - t0)
-    presses, press_times = _timed_presses(world, n_presses, force_n)
-    load_by_load = _press_load_by_load(world, n_presses, force_n)
+    force_n = ExplorationConfig().force_n
+    presses, press_times = _timed_presses(world, N_PRESSES, force_n)
+    load_by_load = _press_load_by_load(world, N_PRESSES, force_n)
     with_record, camera_only = _poke_compute(sc.workspace, cloud, presses, rng)
     return {
         "scenario": sc.name, "element_size_m": cfg.element_size_m, "construction_s": construction,

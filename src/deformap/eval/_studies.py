@@ -192,7 +192,7 @@ def _foam_row(foam: FoamPresses, shape_matching: ShapeMatchingConfig) -> dict[st
             "modulus_stds_pa": [], "modulus_rel_errors": [], "refused": foam.refused}
 
 
-def hardness_study(foams: list[FoamPresses], *, base: ShapeMatchingConfig | None = None,
+def hardness_study(foams: list[FoamPresses], *,
                    protocols: dict[str, dict[str, Any]] = PROTOCOLS) -> dict[str, Any]:
     """β against hardness for each protocol: ``{"rows": [...], "monotone": {protocol: bool},
     "modulus_monotone": bool | None, "n_refused": int}``.
@@ -201,11 +201,10 @@ def hardness_study(foams: list[FoamPresses], *, base: ShapeMatchingConfig | None
     board (if present) below every foam. A foam the world refused to press has a row with
     ``refused`` (the reason) and null values, and is left out of both monotone checks.
     """
-    base = base or ShapeMatchingConfig()
     rows = []
     monotone = {}
     for name, settings in protocols.items():
-        cfg = dataclasses.replace(base, **settings)
+        cfg = ShapeMatchingConfig(**settings)
         proto_rows = [{"protocol": name, "hardness_n": foam.hardness_n, **_foam_row(foam, cfg)}
                       for foam in foams]
         rows.extend(proto_rows)
@@ -243,13 +242,12 @@ def _modulus_monotone(rows: list[dict[str, Any]]) -> bool | None:
     return bool(np.all(np.diff(moduli) > 0) and rigid_ok)
 
 
-def cluster_size_study(foams: list[FoamPresses], *, sizes: Sequence[int] = (2, 3, 4, 5, 6),
-                       base: ShapeMatchingConfig | None = None) -> dict[str, Any]:
+def cluster_size_study(foams: list[FoamPresses], *, sizes: Sequence[int] = (2, 3, 4, 5, 6)
+                       ) -> dict[str, Any]:
     """Fit error min E(β) and β against the cluster size k×k (default protocol), per foam."""
-    base = base or ShapeMatchingConfig()
     rows = []
     for k in sizes:
-        cfg = dataclasses.replace(base, cluster_size=k)
+        cfg = ShapeMatchingConfig(cluster_size=k)
         rows += [{"cluster_size": k, "hardness_n": foam.hardness_n, **_summary(_betas(foam, cfg))}
                  for foam in foams]
     return {"rows": rows}
