@@ -1,17 +1,9 @@
-"""The application layer: a run's configuration, its folder, its report, and the workflows.
+"""The application layer: a run's configuration (:class:`RunConfig`), its folder, its report,
+the progress callbacks (:class:`RunHooks`), and the workflows, each a function with typed
+arguments returning a typed result, in a module of its own.
 
-One concept per module: ``_config`` (:class:`RunConfig`, YAML, overrides, resume, a session's
-own, the run's random streams), ``_folder`` (the one run-folder policy: naming, new folders only,
-atomic writes), ``_report`` (the one ``report.json`` schema), ``_export`` (``map.npz``,
-``pokes.csv``), ``_figures``, ``_hooks`` (:class:`RunHooks`, the progress callbacks every workflow
-takes), and one module per workflow, each a function with typed arguments returning a typed
-result: :func:`explore_scenario`, :func:`record_simulation`, :func:`map_recorded_session`,
-:func:`estimate_one_poke`, :func:`reproduce`, the studies, :func:`show_scenario` and the
-many-worlds benchmark.
-
-This package may import every library package (``eval`` included); none of them imports it. The
-names are imported on first use: a run needs the simulated world and the whole estimator (slow to
-import), which ``deformap --help`` never needs.
+This package may import every library package; none of them imports it. The names are imported
+on first use: a run needs the world and the estimator (slow to import), ``deformap --help`` not.
 """
 
 from __future__ import annotations
@@ -31,9 +23,8 @@ if TYPE_CHECKING:
         load_run_config,
         resume_run_config,
         run_generators,
-        session_run_config,
     )
-    from deformap.run._environment import explore_environment, load_environment, parse_env_args
+    from deformap.run._environment import explore_environment, parse_env_args
     from deformap.run._estimate import EstimateOutput, estimate_one_poke
     from deformap.run._explore import RunOutput, explore_scenario
     from deformap.run._export import POKES_CSV_COLUMNS
@@ -61,9 +52,8 @@ if TYPE_CHECKING:
 
 _MODULES: dict[str, tuple[str, ...]] = {
     "_config": ("CONFIG_NAME", "RunConfig", "RunOverrides", "apply_overrides", "config_yaml",
-               "explore_run_config", "load_run_config", "resume_run_config", "run_generators",
-               "session_run_config"),
-    "_environment": ("explore_environment", "load_environment", "parse_env_args"),
+               "explore_run_config", "load_run_config", "resume_run_config", "run_generators"),
+    "_environment": ("explore_environment", "parse_env_args"),
     "_estimate": ("EstimateOutput", "estimate_one_poke"),
     "_explore": ("RunOutput", "explore_scenario"),
     "_export": ("POKES_CSV_COLUMNS",),
@@ -86,10 +76,10 @@ __all__ = [
     "RunHooks", "RunOutput", "RunOverrides", "RunStart", "ScenarioSummary", "StudyOutput",
     "WorldsBenchConfig", "WorldsOutput", "apply_overrides", "bench_worlds", "config_yaml",
     "default_run_folder", "estimate_one_poke", "exploration_with", "explore_environment",
-    "explore_run_config", "explore_scenario", "load_environment", "load_run_config", "load_worlds",
+    "explore_run_config", "explore_scenario", "load_run_config", "load_worlds",
     "map_recorded_session", "parse_assignments", "parse_env_args", "record_simulation", "reproduce",
     "rescore_worlds", "resume_run_config", "run_cluster_size_study", "run_generators",
-    "run_hardness_study", "scenario_summaries", "session_run_config", "show_scenario",
+    "run_hardness_study", "scenario_summaries", "show_scenario",
 ]
 
 __getattr__, __dir__ = lazy_exports(__name__, _MODULES, __all__, globals())

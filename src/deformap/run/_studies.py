@@ -230,17 +230,16 @@ def _checked(conditions: Sequence[tuple[str, float, str]]) -> list[tuple[str, fl
 
 
 def _check_press(foams: Sequence[float | None], force_n: float | None) -> None:
-    """The foams and the force, checked before any folder or world: each foam a block the world
-    can build, and a force that gives a force–travel record."""
+    """Each foam a block the world can build, a force that gives a force–travel record."""
     for value in foams:
         if value is not None:
             block_scenario(value, Workspace())
     if force_n is not None:
         force = check_positive("force_n", force_n)
         if not force >= MIN_RECORD_FORCE_N:
-            raise InvalidArgumentError(
-                f"`force_n` must be at least {MIN_RECORD_FORCE_N:g} N, a press the world gives a "
-                f"force–travel record of; got {force:g}")
+            raise InvalidArgumentError(f"`force_n` must be at least {MIN_RECORD_FORCE_N:g} N, a "
+                                       f"press the world gives a force–travel record of; got "
+                                       f"{force:g}")
 
 
 def _protocols(names: Sequence[str] | None) -> dict[str, dict[str, Any]]:
@@ -258,13 +257,8 @@ def _force(force_n: float | None) -> float:
     return ExplorationConfig().force_n if force_n is None else float(force_n)
 
 
-def run_cluster_size_study(
-    out: Path | None = None,
-    *,
-    seed: int = 0,
-    coarse: bool = False,
-    hooks: RunHooks = NO_HOOKS,
-) -> StudyOutput:
+def run_cluster_size_study(out: Path | None = None, *, seed: int = 0, coarse: bool = False,
+                           hooks: RunHooks = NO_HOOKS) -> StudyOutput:
     """Fit error and β against cluster size 2×2 … 6×6 (:func:`deformap.eval.cluster_size_study`)
     on the foams :data:`CLUSTER_SIZE_FOAMS` and the rigid board.
 
