@@ -131,8 +131,8 @@ def check_positive_options(**numbers: float | None) -> None:
 
 
 VarianceMaxOption = Annotated[float | None, typer.Option(
-    help="Top of map.png's variance colour scale, the same in every run drawn "
-    "with it so that runs compare (default: each map's own largest variance).")]
+    help="Top of map.png's variance colour scale, the same in every run drawn with it so that "
+    "runs compare (default: each map's own largest variance).")]
 JsonOption = Annotated[Path | None, typer.Option(
     "--json", help="Also write the result as JSON to this file (- for stdout).",
     callback=_json_target)]
@@ -214,9 +214,7 @@ def configure_logging(verbose: bool) -> None:
     logging.getLogger("py.warnings").setLevel(logging.WARNING if verbose else logging.CRITICAL)
 
 
-_SHOWN: set[str] = set()
-"""The warning lines printed so far, so that :func:`warn` does not repeat a log line."""
-
+_SHOWN: set[str] = set()  # the warning lines printed so far, which warn() does not repeat
 _LEVEL_STYLES = {"error": "bold red", "warning": "yellow", "info": "dim", "debug": "dim"}
 
 

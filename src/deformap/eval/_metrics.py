@@ -53,19 +53,9 @@ class RegionScores:
 def region_scores(predicted: NDArray[np.integer], truth: NDArray[np.integer],
                   beta_grid: NDArray[np.float64], true_hardness: dict[int, float], *,
                   valid: NDArray[np.bool_] | None = None) -> RegionScores:
-    """Score a predicted region map against the truth.
-
-    Parameters
-    ----------
-    predicted, truth : (ny, nx) int
-        Label maps on the same grid.
-    beta_grid : (ny, nx) float
-        The estimated β-field's mean on that grid.
-    true_hardness : dict
-        Hardness in newtons of each true label; ``math.inf`` for a rigid region.
-    valid : (ny, nx) bool, optional
-        Cells to score (default: all).
-    """
+    """Score a predicted region map against the truth: ``predicted`` and ``truth`` (ny, nx) int
+    label maps, ``beta_grid`` (ny, nx) the β-field's mean, ``true_hardness`` each true label's
+    hardness in newtons (``math.inf``: rigid), ``valid`` (ny, nx) bool the cells scored (all)."""
     pred = np.asarray(predicted)
     true = np.asarray(truth)
     beta = check_array("beta_grid", beta_grid, pred.shape)
@@ -125,23 +115,10 @@ def ordering_scores(found: NDArray[np.integer], class_values: NDArray[np.float64
                     truth: NDArray[np.integer], true_hardness: dict[int, float],
                     poke_values: NDArray[np.float64], poke_truth: NDArray[np.integer],
                     ) -> OrderingScores:
-    """Score the order of what a map reports against the materials' softness.
-
-    Parameters
-    ----------
-    found : (ny, nx) int
-        The map's region labels, each an index into ``class_values``.
-    class_values : (k,) float
-        The value the map reports for each region (the class β).
-    truth : (ny, nx) int
-        The true labels on the same grid.
-    true_hardness : dict
-        Hardness in newtons of each true label; ``math.inf`` for a rigid region.
-    poke_values : (p,) float
-        Each poke's reading.
-    poke_truth : (p,) int
-        The true label under each poke.
-    """
+    """Score the order of what a map reports against the materials' softness: ``found`` (ny, nx)
+    int region labels indexing ``class_values`` (k,) (each region's reported value), ``truth``
+    (ny, nx) int and ``true_hardness`` as for :func:`region_scores`, ``poke_values`` (p,) each
+    poke's reading and ``poke_truth`` (p,) int the true label under it."""
     labels = np.asarray(found)
     true = np.asarray(truth)
     values = check_array("class_values", class_values, (None,))

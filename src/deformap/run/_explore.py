@@ -129,24 +129,12 @@ def explore_scenario(config: RunConfig, out: Path | None = None, *, resume: bool
                      variance_max: float | None = None) -> RunOutput:
     """Explore ``config.scenario``, score the map against ground truth, write the run folder.
 
-    Parameters
-    ----------
-    out : Path, optional
-        The run folder; new or empty unless ``resume`` (default:
-        :func:`~deformap.run.default_run_folder` of the scenario, kind ``explore``).
-    resume : bool
-        Continue the run killed in ``out``: its journal's pokes are not made again, and a
-        configuration other than the run's is refused.
-    figures, rerun : bool
-        Write ``map.png`` and the ``poke-NN.png``; write ``run.rrd`` (extra ``rerun``).
-    variance_max : float, optional
-        A fixed top of ``map.png``'s variance colour scale, so that runs compare.
-
-    Raises
-    ------
-    ConfigError
-        Unknown scenario; ``out`` not empty, or not creatable (before any work); on resume, no
-        run there or a different configuration.
+    ``out`` is new or empty (default: :func:`~deformap.run.default_run_folder` of the scenario),
+    or with ``resume`` the run killed there, whose journalled pokes are not made again;
+    ``figures`` draws ``map.png`` and the ``poke-NN.png``, ``rerun`` writes ``run.rrd``, and
+    ``variance_max`` fixes the top of the map's variance scale. An unknown scenario, a bad ``out``
+    (before any work), or on resume no run there or another configuration raise
+    :class:`ConfigError`.
     """
     if variance_max is not None:  # before any work
         check_positive("variance_max", variance_max)

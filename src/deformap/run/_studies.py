@@ -123,36 +123,17 @@ def run_hardness_study(
     element_size_m: float | None = None, hooks: RunHooks = NO_HOOKS,
 ) -> StudyOutput:  # fmt: skip
     """β (each contact protocol) and the force–travel reading (stiffness, Young's modulus)
-    against hardness (:func:`deformap.eval.hardness_study`), under one condition or, with
-    ``full``, over a matrix of them.
+    against hardness (:func:`deformap.eval.hardness_study`) into ``out`` (new or empty; default
+    stem ``hardness``), on the foams ``hardness`` in newtons and the rigid board (default
+    :data:`~deformap.eval.DEFAULT_HARDNESSES`), each world's noise from ``seed``.
 
-    Parameters
-    ----------
-    out : Path, optional
-        A new or empty folder (default :func:`~deformap.run.default_run_folder`, stem ``hardness``).
-    seed : int
-        Seed of the worlds' noise (the same for every condition).
-    hardness : sequence of float, optional
-        Foams in newtons, the rigid board added (default :data:`~deformap.eval.DEFAULT_HARDNESSES`).
-    coarse : bool
-        The coarse FEM mesh (a quick look).
-    camera, thickness_m, physics
-        The condition: a :data:`deformap.world.CAMERA_PRESETS` name (default primesense), the
-        blocks' thickness in metres and a :data:`deformap.world.PHYSICS` name.
-    force_n : float, optional
-        The press force (default: the exploration's).
-    full : bool
-        Every condition of :data:`FULL_CAMERAS` × :data:`FULL_THICKNESSES_M` ×
-        :data:`FULL_PHYSICS`, or of ``cameras``, ``thicknesses_m`` and ``physics_names`` given.
-    protocols : sequence of str, optional
-        Names of :data:`~deformap.eval.PROTOCOLS` (default :data:`~deformap.eval.STUDY_PROTOCOLS`).
-    element_size_m : float, optional
-        The world's in-plane FEM element size, its top layer no thicker (default the world's,
-        :data:`FULL_ELEMENT_SIZE_M` with ``full``); not with ``coarse``.
-    hooks : RunHooks
+    One condition is a ``camera`` preset (default primesense), a block ``thickness_m`` in metres
+    and a world ``physics``; ``full`` presses every condition of :data:`FULL_CAMERAS` ×
+    :data:`FULL_THICKNESSES_M` × :data:`FULL_PHYSICS`, or of ``cameras``, ``thicknesses_m`` and
+    ``physics_names`` where given. ``force_n`` defaults to the exploration's, ``protocols`` to
+    :data:`~deformap.eval.STUDY_PROTOCOLS`; ``element_size_m`` (not with ``coarse``) sets the
+    world's in-plane FEM elements, :data:`FULL_ELEMENT_SIZE_M` by default with ``full``.
 
-    Notes
-    -----
     The study's JSON has ``rows`` (each naming its ``camera``, ``thickness_m``, ``physics`` and
     ``force_n``) and :func:`deformap.eval.hardness_summary`'s ``summary`` and ``overall``; a
     single-condition study also its condition and monotone flags, a full one its ``matrix``.
