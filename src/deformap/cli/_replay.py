@@ -161,9 +161,8 @@ def estimate_command(
     before: Annotated[Path, typer.Option(
         "--before", help="Cloud of the undisturbed surface (PCD, PLY, NPZ).")],
     after: Annotated[Path, typer.Option("--after", help="Cloud while pressing.")],
-    # --contact, --force and --tip-radius: optional to the parser, required here, so that a
-    # value missing from --contact or --force is named (below) instead of the parser's
-    # "Missing option '--force'" when --contact took that option's name as its third value
+    # --contact, --force, --tip-radius: required here, not by the parser, so that a value missing
+    # from --contact (which then takes the next option's name as its third) is named below
     contact: Annotated[tuple[str, str, str] | None, typer.Option(
         "--contact", metavar="X Y Z", help="Tip centre X Y Z at the press, metres. [required]")
     ] = None,

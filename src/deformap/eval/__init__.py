@@ -17,12 +17,7 @@ if TYPE_CHECKING:
     from deformap.eval._bench_memory import bench_memory, measure_case
     from deformap.eval._bench_msm import bench_beta_sweep
     from deformap.eval._bench_world import bench_world
-    from deformap.eval._metrics import (
-        OrderingScores,
-        RegionScores,
-        ordering_scores,
-        region_scores,
-    )
+    from deformap.eval._metrics import OrderingScores, RegionScores, ordering_scores, region_scores
     from deformap.eval._rescore import rescore_world
     from deformap.eval._studies import (
         DEFAULT_HARDNESSES,
@@ -49,12 +44,7 @@ if TYPE_CHECKING:
         draw_world,
         material_truth,
     )
-    from deformap.eval._world_result import (
-        POKES_FORMAT,
-        TIME_COLUMNS,
-        WorldResult,
-        row_values,
-    )
+    from deformap.eval._world_result import POKES_FORMAT, TIME_COLUMNS, WorldResult, row_values
     from deformap.eval._worlds import run_world
     from deformap.eval._worlds_summary import (
         CSV_COLUMNS,

@@ -60,9 +60,8 @@ CONDITION_KEYS = ("camera", "thickness_m", "physics", "force_n")
 
 @dataclass
 class FoamPresses:
-    """One homogeneous foam: the mapper with its surface model and the presses made on it;
-    ``refused`` the world's reason when it refused to press this foam with that force (then
-    ``presses`` is empty)."""
+    """One homogeneous foam: the mapper with its surface model and the presses made on it, or
+    none and the world's reason it ``refused`` to press the foam."""
 
     hardness_n: float | None
     mapper: Mapper
@@ -221,15 +220,14 @@ def _by_hardness(rows: Any) -> list[dict[str, Any]]:
 
 def _beta_monotone(rows: list[dict[str, Any]]) -> bool:
     """β strictly falls as hardness rises over one protocol's rows, the rigid board lowest
-    (refused foams left out); fewer than two surfaces read is no order shown (False)."""
+    (refused foams left out; fewer than two is False)."""
     betas = [r["beta"] for r in _by_hardness(rows)]
     return len(betas) >= 2 and bool(np.all(np.diff(betas) < 0))
 
 
 def _modulus_monotone(rows: list[dict[str, Any]]) -> bool | None:
-    """Whether the force–travel records order the foams: E strictly rises with hardness and a
-    rigid board is read rigid (``None`` when the presses had no records); refused foams are left
-    out."""
+    """E strictly rises with hardness and a rigid board reads rigid (refused foams left out);
+    ``None`` when the presses had no records."""
     first = rows[0]["protocol"] if rows else None
     own = _by_hardness(r for r in rows if r["protocol"] == first)
     if not own or all(r["modulus_pa"] is None and not r["rigid"] for r in own):
@@ -245,12 +243,9 @@ def _modulus_monotone(rows: list[dict[str, Any]]) -> bool | None:
 def cluster_size_study(foams: list[FoamPresses], *, sizes: Sequence[int] = (2, 3, 4, 5, 6)
                        ) -> dict[str, Any]:
     """Fit error min E(β) and β against the cluster size k×k (default protocol), per foam."""
-    rows = []
-    for k in sizes:
-        cfg = ShapeMatchingConfig(cluster_size=k)
-        rows += [{"cluster_size": k, "hardness_n": foam.hardness_n, **_summary(_betas(foam, cfg))}
-                 for foam in foams]
-    return {"rows": rows}
+    return {"rows": [{"cluster_size": k, "hardness_n": foam.hardness_n,
+                      **_summary(_betas(foam, ShapeMatchingConfig(cluster_size=k)))}
+                     for k in sizes for foam in foams]}
 
 
 def hardness_summary(rows: list[dict[str, Any]]) -> dict[str, Any]:
