@@ -35,8 +35,7 @@ HELP_DEFAULTS: dict[str, str | int | float] = {
     "scenario": "heterogeneous-60-110-rigid", "seed": 0, "exploration.strategy": "planned",
     "exploration.threshold": 0.06, "exploration.max_pokes": 12, "exploration.field": "modulus",
 }  # fmt: skip
-"""The ``RunConfig()`` defaults ``--help`` shows (a test keeps them equal), written out because
-importing ``RunConfig`` loads the estimator, which ``--help`` must not wait for."""
+"""The ``RunConfig()`` defaults ``--help`` shows, written out so as not to import the estimator."""
 
 ConfigOption = Annotated[Path | None, typer.Option(
     help="Run configuration YAML (see `config dump`).")]

@@ -23,8 +23,7 @@ from deformap.errors import InvalidArgumentError
 __all__ = ["study_app"]
 
 STUDY_HARDNESSES_HELP = "30, 60, 110, 150, 250 and rigid"
-"""``deformap.eval.DEFAULT_HARDNESSES`` as ``--help`` shows it, written out so that ``--help``
-does not import the studies (a test keeps them equal)."""
+"""``deformap.eval.DEFAULT_HARDNESSES`` as ``--help`` shows it, written out (a test compares)."""
 
 study_app = typer.Typer(help="Studies on homogeneous simulated foams (the paper's Fig. 5).")
 app.add_typer(study_app, name="study")

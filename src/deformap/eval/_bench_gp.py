@@ -63,13 +63,10 @@ def timed_fit_predict(method: str, xy: NDArray[np.float64], z: NDArray[np.float6
 def bench_surface_gp(n_points_list: Sequence[int] = (3000, 6000, 12000), *,
                      rng: np.random.Generator) -> list[dict[str, float | int]]:
     """Time exact and grid GP regression of a noisy surface cloud of each size N in
-    ``n_points_list`` (``rng`` draws the points and the noise) and compare their outputs.
-
-    One row per N: ``"n_points"``, ``"exact_s"`` (fit + mean and std on the grid, one run),
-    ``"grid_s"`` (the same, best of 3), ``"speedup"`` (exact_s / grid_s), ``"max_mean_dev_m"``
-    (largest |mean_grid − mean_exact|, metres) and ``"max_rel_std_dev"`` (largest
-    |std_grid − std_exact| / std_exact).
-    """
+    ``n_points_list`` (drawn with ``rng``) and compare their outputs. One row per N:
+    ``"n_points"``, ``"exact_s"`` (fit + mean and std on the grid, one run), ``"grid_s"`` (best of
+    3), ``"speedup"``, ``"max_mean_dev_m"`` (largest |mean_grid − mean_exact|, metres) and
+    ``"max_rel_std_dev"`` (largest |std_grid − std_exact| / std_exact)."""
     if not isinstance(rng, np.random.Generator):
         raise InvalidArgumentError(f"`rng` must be a numpy.random.Generator; got {type(rng)}")
     sizes = [check_int("n_points_list[i]", n, minimum=2) for n in n_points_list]

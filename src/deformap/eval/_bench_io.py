@@ -41,14 +41,10 @@ def _scene(n_points: int, rng: np.random.Generator) -> PointCloud:
 def bench_io(*, n_points: int = 300_000, rng: np.random.Generator, repeats: int = 3
              ) -> dict[str, Any]:
     """Time reading a binary PCD file and decoding one PointCloud2 message of ``n_points`` drawn
-    with ``rng``, each read ``repeats`` times (best and median).
-
-    Returns ``pcd_read_s`` / ``pcd_read_median_s`` (:func:`deformap.cloud.io.read_cloud` of a
-    binary PCD as PCL writes it), ``pointcloud2_read_s`` / ``pointcloud2_read_median_s`` (CDR
-    deserialisation, :func:`~deformap.cloud.io.pointcloud2_to_array` and the PointCloud),
-    ``bag_read_s`` (:func:`~deformap.cloud.io.read_bag_clouds` of a one-message MCAP bag; these
-    three ``None`` without the ``ros`` extra), ``goal_s`` and ``n_points``.
-    """
+    with ``rng``, each read ``repeats`` times: ``pcd_read_s`` / ``pcd_read_median_s`` (best and
+    median), ``pointcloud2_read_s`` / ``pointcloud2_read_median_s`` (CDR to PointCloud),
+    ``bag_read_s`` (a one-message MCAP bag; these three ``None`` without the ``ros`` extra),
+    ``goal_s`` and ``n_points``."""
     from deformap.cloud.io import read_cloud, write_pcd
 
     n = check_int("n_points", n_points, minimum=1)

@@ -1,15 +1,10 @@
 """Memory benchmark: the peak memory of the surface GP (grid against exact) and of a β estimation.
 
 Each case runs in a fresh process (``python -m deformap.eval._bench_memory CASE SIZE SEED``) that
-builds its inputs, then measures the case alone: ``traced_peak_mib``, the peak of live Python and
-numpy allocations (:mod:`tracemalloc`, blind to what C libraries allocate), and ``rss_peak_mib`` /
-``rss_added_mib``, the peak resident set and its rise above the set before (Linux ``VmHWM``,
-reset through ``/proc/self/clear_refs`` after ``malloc_trim``; ``None`` where it cannot be reset).
-
-Cases, the speed benchmarks' problems: ``gp-exact`` / ``gp-grid`` (:mod:`._bench_gp`) fit the
-surface GP to ``size`` points; ``beta-batched`` is one converged
-:func:`deformap.msm.estimate_beta` on ``size × size`` particles, ``beta-loop`` its baseline, the
-same β simulated one at a time (:mod:`._bench_msm`).
+builds its inputs, then measures the case alone: the peak of live Python and numpy allocations
+(:mod:`tracemalloc`, blind to C libraries' own) and of the resident set (Linux ``VmHWM``, reset
+through ``/proc/self/clear_refs`` after ``malloc_trim``). The cases are the speed benchmarks'
+problems: the surface GP, exact or grid, and one β estimation, batched or its per-β loop.
 """
 
 from __future__ import annotations
@@ -133,14 +128,10 @@ def _child_env() -> dict[str, str]:
 
 def measure_case(case: str, size: int, *, seed: int = 0, isolate: bool = True) -> dict[str, Any]:
     """Peak memory of one ``case`` of :data:`CASES` on ``size`` points of the cloud (``gp-*``)
-    or particles per ROI side (``beta-*``), with synthetic data of ``seed``.
-
-    ``isolate=False`` measures in this process: the traced peak is still the case's own, but the
-    RSS fields are ``None`` (this process's history would count). Returns ``case``, ``size``,
-    ``traced_peak_mib``, ``rss_before_mib``, ``rss_peak_mib``, ``rss_added_mib`` (MiB, ``None``
-    where unmeasured), ``seconds`` (wall time while traced) and ``baseline`` (the case it is
-    compared with, ``None`` for a baseline).
-    """
+    or particles per ROI side (``beta-*``), with synthetic data of ``seed``: ``case``, ``size``,
+    ``traced_peak_mib``, ``rss_before_mib``, ``rss_peak_mib``, ``rss_added_mib`` (MiB; ``None``
+    unmeasured, as with ``isolate=False``, measured in this process), ``seconds`` (while traced)
+    and ``baseline`` (the case it is compared with, ``None`` for a baseline)."""
     if case not in CASES:
         raise InvalidArgumentError(f"`case` must be one of {list(CASES)}; got {case!r}")
     size = check_int("size", size, minimum=5 if case.startswith("beta-") else 2)
@@ -159,13 +150,10 @@ def bench_memory(*, gp_sizes: Sequence[int] = (3000, 12000), exact_max_points: i
                  beta_side: int = 40, seed: int = 0, isolate: bool = True,
                  ) -> dict[str, list[dict[str, Any]]]:
     """Peak memory of the surface GP and of one β estimation, each beside its baseline:
-    ``{"surface_gp": [rows], "beta_estimation": [rows]}``, rows of :func:`measure_case`,
-    baselines first.
-
-    The grid GP runs at each of ``gp_sizes``, the exact one (its baseline) at those up to
-    ``exact_max_points`` (its N × N covariance needs N² × 8 bytes several times over); the β
-    estimation and its per-β loop on ``beta_side`` particles per ROI side.
-    """
+    ``{"surface_gp": [rows], "beta_estimation": [rows]}``, rows of :func:`measure_case`, baselines
+    first. The grid GP runs at each of ``gp_sizes``, the exact one at those up to
+    ``exact_max_points`` (its N × N covariance is N² × 8 bytes several times over); the β
+    estimation and its per-β loop on ``beta_side`` particles per ROI side."""
     sizes = [check_int("gp_sizes[i]", n, minimum=2) for n in gp_sizes]
     exact_max = check_int("exact_max_points", exact_max_points, minimum=2)
 

@@ -64,8 +64,8 @@ def bench_beta_sweep(*, n_particles_side: int = 40, rng: np.random.Generator,
 
 
 def dent_problem(n: int, rng: np.random.Generator) -> tuple[Any, Any, Any, Any, Any]:
-    """The benchmark's ROI: ``xs, ys`` (n,), rest heights ``z`` (n, n), noisy observed ``points``
-    (n², 3) of the Hertz dent of a 60 N foam under 0.5 N, and the ``contact``; metres."""
+    """``xs, ys`` (n,), rest heights ``z`` (n, n), noisy ``points`` (n², 3) of the Hertz dent of a
+    60 N foam under 0.5 N, and the ``contact``; metres."""
     xs = 0.30 + (np.arange(n) - (n - 1) / 2) * _SPACING_M
     ys = 0.20 + (np.arange(n) - (n - 1) / 2) * _SPACING_M
     z = np.full((n, n), 0.05)

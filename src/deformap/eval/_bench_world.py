@@ -19,15 +19,11 @@ N_PRESSES = 3
 def bench_world(*, scenario: str = "heterogeneous-60-110-rigid", rng: np.random.Generator,
                 config: Any = None) -> dict[str, Any]:
     """Time one world of ``scenario`` (``config``, default ``WorldConfig()``) and one poke's
-    compute on :data:`N_PRESSES` of its presses, spread over the workspace, with the
-    exploration's force.
-
-    Returns ``construction_s``, ``press_s``, ``observe_s`` (medians, seconds), ``n_dofs``,
-    ``n_points`` and ``n_points_on_area`` of one observation, ``scenario``, ``element_size_m``,
-    ``press_load_by_load_s`` (the baseline of ``press_s``: the linear FEM solving each load as it
-    comes instead of by its unit responses under the tip; None for another physics),
-    ``poke_compute_s`` (median compute of one poke with its force–travel record) and
-    ``poke_compute_camera_only_s`` (the same presses without records, the baseline).
+    compute on :data:`N_PRESSES` of its presses with the exploration's force: ``construction_s``,
+    ``press_s``, ``observe_s`` (medians, seconds), ``n_dofs``, ``n_points`` and
+    ``n_points_on_area`` of one observation, ``scenario``, ``element_size_m``,
+    ``press_load_by_load_s`` (the linear FEM solving each load as it comes, the baseline; None
+    for another physics), ``poke_compute_s`` and ``poke_compute_camera_only_s`` (its baseline).
     """
     from deformap.world import SimulatedWorld, WorldConfig, load_scenario
 

@@ -1,9 +1,6 @@
-"""Studies on homogeneous simulated foams: β against hardness (the paper's Fig. 5a) and the fit error
-against cluster size (its Fig. 5b).
-
-Each foam is a homogeneous block over the whole workspace, pressed at a few fixed places with the
-same force; every protocol and cluster size is evaluated on the *same* presses, so differences come
-from the estimator alone.
+"""Studies on homogeneous simulated foams: β against hardness (the paper's Fig. 5a) and the fit
+error against cluster size (its Fig. 5b). Each foam, a block over the whole workspace, is pressed
+at a few fixed places; every protocol and cluster size reads the *same* presses.
 """
 
 from __future__ import annotations
@@ -249,16 +246,13 @@ def cluster_size_study(foams: list[FoamPresses], *, sizes: Sequence[int] = (2, 3
 
 
 def hardness_summary(rows: list[dict[str, Any]]) -> dict[str, Any]:
-    """What a hardness study's rows say, per condition and per physics.
-
-    Reads the rows of :data:`DEFAULT_PROTOCOL` (else the first protocol), grouped by condition
-    (:data:`CONDITION_KEYS`, absent keys read None). Returns ``{"summary": [...], "overall":
-    [...]}``: per condition, over the foam presses, ``n_presses``, ``n_unread`` (no modulus),
+    """What a hardness study's rows of :data:`DEFAULT_PROTOCOL` (else the first) say, grouped by
+    condition (:data:`CONDITION_KEYS`): ``{"summary": [...], "overall": [...]}``, per condition,
+    over the foam presses, ``n_presses``, ``n_unread`` (no modulus),
     ``modulus_median_abs_rel_error`` (median |E − E_true| / E_true of the presses read),
     ``modulus_within_2sigma`` (fraction of all presses within 2 claimed σ; unread counts out),
     ``modulus_monotone``, ``beta_monotone``, ``beta_claimed_std`` and ``beta_spread`` (means over
-    the foams) and ``n_refused``; per physics the same over its conditions (monotone: in all).
-    """
+    the foams) and ``n_refused``; per physics the same over its conditions (monotone: in all)."""
     protocols = list(dict.fromkeys(r["protocol"] for r in rows))
     protocol = DEFAULT_PROTOCOL if DEFAULT_PROTOCOL in protocols else protocols[0] if rows else None
     groups: dict[tuple[Any, ...], list[dict[str, Any]]] = {}

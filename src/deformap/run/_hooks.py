@@ -19,13 +19,9 @@ __all__ = ["RunHooks", "RunStart"]
 
 @dataclass(frozen=True, kw_only=True)
 class RunStart:
-    """What a workflow is about to do, told once its folder exists and before the work.
-
-    ``kind``: ``"explore"``, ``"record"``, ``"map"``, ``"study"``, ``"reproduce"`` or ``"world"``;
-    ``title``: one line on what runs; ``folder``: where the results go (``None``: nowhere);
-    ``total``: the steps to come (pokes at most, foams, scenarios; ``None``: unknown); ``done``:
-    the steps already done (pokes a resumed run takes from its journal).
-    """
+    """What a workflow is about to do (its ``kind``, a one-line ``title``, the results'
+    ``folder``), told once the folder exists; ``total`` steps to come (``None``: unknown), of
+    which ``done`` are done already (the pokes a resumed run takes from its journal)."""
 
     kind: str
     title: str

@@ -52,8 +52,7 @@ CLUSTER_SIZE_FOAMS: tuple[float, ...] = (60.0, 110.0, 150.0)
 FULL_CAMERAS: tuple[str, ...] = ("primesense", "kinect-v1", "realsense-d435")
 FULL_THICKNESSES_M: tuple[float, ...] = (0.03, 0.05, 0.10)
 FULL_PHYSICS: tuple[str, ...] = PHYSICS
-"""The matrix of ``deformap study hardness --full``: every camera preset × three foam thicknesses
-(metres) × every physics of the world (:data:`deformap.world.PHYSICS`)."""
+"""The matrix of ``study hardness --full``: camera presets × thicknesses (metres) × physics."""
 
 FULL_ELEMENT_SIZE_M = 0.00375
 """The world's in-plane element size for ``--full``, metres: the stiffest press's contact patch
