@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from typing import Any
 
 import numpy as np
 
-from deformap.explore import ExplorationConfig
+from deformap.explore import ExplorationConfig, Mapper
+from deformap.world import SimulatedWorld, WorldConfig, load_scenario
 
 __all__ = ["bench_world"]
 
@@ -25,8 +27,6 @@ def bench_world(*, scenario: str = "heterogeneous-60-110-rigid", rng: np.random.
     ``press_load_by_load_s`` (the linear FEM solving each load as it comes, the baseline; None
     for another physics), ``poke_compute_s`` and ``poke_compute_camera_only_s`` (its baseline).
     """
-    from deformap.world import SimulatedWorld, WorldConfig, load_scenario
-
     cfg = config or WorldConfig()
     sc = load_scenario(scenario)
     t0 = time.perf_counter()
@@ -37,9 +37,8 @@ def bench_world(*, scenario: str = "heterogeneous-60-110-rigid", rng: np.random.
         t0 = time.perf_counter()
         cloud = world.observe()
         observe_times.append(time.perf_counter() - t0)
-    force_n = ExplorationConfig().force_n
-    presses, press_times = _timed_presses(world, N_PRESSES, force_n)
-    load_by_load = _press_load_by_load(world, N_PRESSES, force_n)
+    presses, press_times = _timed_presses(world)
+    load_by_load = _press_load_by_load(world)
     with_record, camera_only = _poke_compute(sc.workspace, cloud, presses, rng)
     return {
         "scenario": sc.name, "element_size_m": cfg.element_size_m, "construction_s": construction,
@@ -51,12 +50,12 @@ def bench_world(*, scenario: str = "heterogeneous-60-110-rigid", rng: np.random.
     }  # fmt: skip
 
 
-def _timed_presses(world: Any, n_presses: int, force_n: float
-                   ) -> tuple[list[Any], list[float]]:
+def _timed_presses(world: Any) -> tuple[list[Any], list[float]]:
     """The presses (along the workspace's middle, each released) and their times."""
     (x0, y0), (x1, y1) = world.workspace.lower, world.workspace.upper
+    force_n = ExplorationConfig().force_n
     presses, times = [], []
-    for f in np.linspace(0.2, 0.8, n_presses):
+    for f in np.linspace(0.2, 0.8, N_PRESSES):
         t0 = time.perf_counter()
         presses.append(world.press((x0 + f * (x1 - x0), y0 + 0.5 * (y1 - y0)), force_n))
         times.append(time.perf_counter() - t0)
@@ -64,14 +63,14 @@ def _timed_presses(world: Any, n_presses: int, force_n: float
     return presses, times
 
 
-def _press_load_by_load(world: Any, n_presses: int, force_n: float) -> float | None:
+def _press_load_by_load(world: Any) -> float | None:
     """Median press with the FEM's unit responses off; None for a physics without them."""
     foam = world.foam
     if world.config.physics != "linear-fem":
         return None
     kept, foam.max_unit_columns = foam.max_unit_columns, 0
     try:
-        return float(np.median(_timed_presses(world, n_presses, force_n)[1]))
+        return float(np.median(_timed_presses(world)[1]))
     finally:
         foam.max_unit_columns = kept
 
@@ -80,10 +79,6 @@ def _poke_compute(workspace: Any, cloud: Any, presses: list[Any], rng: np.random
                   ) -> tuple[float, float]:
     """Median compute of one poke (dent, β, the force–travel reading, the map field updated) on
     the presses, with their records and, the baseline, without them (mapped on the β-field)."""
-    import dataclasses
-
-    from deformap.explore import Mapper
-
     medians = []
     for keep_record in (True, False):
         # without records the map is on β (no fallback warning in a benchmark's output)
