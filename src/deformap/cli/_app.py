@@ -83,7 +83,8 @@ def _reflow_help(command: Any) -> None:
 
 
 class _ReflowingGroup(TyperGroup):
-    """The root group, whose commands' help is reflowed once they are all registered."""
+    """The root group, whose commands' help is reflowed once all are registered: rich keeps a
+    docstring's hard line breaks and reads its brackets as styles."""
 
     def __init__(self, *args: Any, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)

@@ -107,10 +107,10 @@ def explore_environment(spec: str, env_args: dict[str, Any], config: RunConfig,
                          total=config.exploration.max_pokes, done=0))  # fmt: skip
     _, explore_rng = run_generators(config.seed)
 
-    on_poke = poke_writer(folder, figures=figures, hooks=hooks)
     hooks.stage("exploring")
     t0 = time.perf_counter()
-    result = explore(env, config.exploration, rng=explore_rng, journal=journal, on_poke=on_poke)
+    result = explore(env, config.exploration, rng=explore_rng, journal=journal,
+                     on_poke=poke_writer(folder, figures=figures, hooks=hooks))
     report = {"deformap": __version__, "environment": spec, "env_args": env_args,
               "seed": config.seed, "config": config_to_dict(config),
               **shared_report(result, truth=None)}  # fmt: skip

@@ -161,10 +161,8 @@ def explore_scenario(config: RunConfig, out: Path | None = None, *, resume: bool
     world = SimulatedWorld(scenario, config=config.world, rng=world_rng)
     world_s = time.perf_counter() - t0
     hooks.stage("exploring")
-
-    on_poke = poke_writer(folder, figures=figures, hooks=hooks)
     result = explore(world, config.exploration, rng=explore_rng, journal=journal, done=done,
-                     on_poke=on_poke)  # fmt: skip
+                     on_poke=poke_writer(folder, figures=figures, hooks=hooks))
     report = live_report(config, result, world, world_build_s=world_s)
     write_run_results(folder, result, report, figures=figures, truth=world, poke_figures=False,
                       title=f"{config.scenario} (seed {config.seed}): {len(result.pokes)} pokes",
