@@ -124,9 +124,8 @@ def map_command(
     regions = report["regions"]
     found = ("no poke usable" if regions is None
              else f"{len(regions['class_betas'])} region class(es)")
-    scored = ""
-    if regions is not None and "accuracy" in regions:
-        scored = f", accuracy {regions['accuracy']:.3f} against the ground truth"
+    scored = (f", accuracy {regions['accuracy']:.3f} against the ground truth"
+              if regions is not None and "accuracy" in regions else "")
     shown.print(f"{report['n_pokes']} of {len(output.session)} pokes used, {found}{scored}; "
                 f"wrote {output.folder / 'report.json'}", highlight=False)  # fmt: skip
     shown.print(f"modulus: {modulus_summary(report)}", highlight=False)

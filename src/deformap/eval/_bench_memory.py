@@ -9,6 +9,8 @@ problems: the surface GP, exact or grid, and one β estimation, batched or its p
 
 from __future__ import annotations
 
+import contextlib
+import ctypes
 import gc
 import json
 import os
@@ -60,24 +62,18 @@ def _prepare(case: str, size: int, seed: int) -> Callable[[], Any]:
 
 
 def _status_kib(key: str) -> float | None:
-    try:
+    with contextlib.suppress(OSError):
         for line in _STATUS.read_text().splitlines():
             if line.startswith(key + ":"):
                 return float(line.split()[1])
-    except OSError:
-        pass
     return None
 
 
 def _trim_heap() -> None:
     """Hand freed heap pages back to the OS (glibc), so the set-up's garbage is not reused unseen."""
     gc.collect()
-    try:
-        import ctypes
-
+    with contextlib.suppress(OSError, AttributeError):  # not glibc: the RSS may then read low
         ctypes.CDLL("libc.so.6").malloc_trim(0)
-    except (OSError, AttributeError):  # not glibc: the RSS fields may then read low
-        pass
 
 
 def _reset_peak_rss() -> bool:
