@@ -1,9 +1,7 @@
-"""Explore a simulated scenario: poke until the β-field is known, score the map against the
-world's ground truth, and write the run folder.
-
-A run folder receives, in this order, ``config.yaml`` (the effective configuration, before
-anything else), ``journal.jsonl`` (each poke as it completes, for resuming), ``report.json``,
-``map.png``, one ``poke-NN.png`` per poke, and with ``rerun`` the recording ``run.rrd``. A run
+"""Explore a simulated scenario: poke until the map field is known, score the map against the
+world's ground truth, and write the run folder: ``config.yaml`` before anything else,
+``journal.jsonl`` (each poke as it completes) and ``poke-NN.png`` as the pokes come, then
+``report.json``, ``map.npz``, ``pokes.csv``, ``map.png`` and with ``rerun`` ``run.rrd``. A run
 killed at any moment resumes from its folder to the uninterrupted run's result.
 """
 
