@@ -45,9 +45,9 @@ def _stubs(tmp_path: Path) -> dict[str, Any]:
     out = SimpleNamespace(report=REPORT, folder=tmp_path, session=[1], files=[tmp_path / "a"],
                           study=STUDY, table=TABLE, markdown="| table |")  # fmt: skip
     estimate = SimpleNamespace(report=ESTIMATE, folder=None)
-    recorded = SimpleNamespace(session_file=Path(RECORD["session_file"]),
-                               folder=Path(RECORD["folder"]), n_pokes=2, format="folder",
-                               live_betas=RECORD["live_betas"])  # fmt: skip
+    recorded = run.RecordOutput(session_file=Path(RECORD["session_file"]),
+                                folder=Path(RECORD["folder"]), n_pokes=2, format="folder",
+                                live_betas=RECORD["live_betas"])  # fmt: skip
     return {
         "explore_scenario": (run, lambda *a, **k: out),
         "map_recorded_session": (run, lambda *a, **k: out),

@@ -1,11 +1,8 @@
-"""The ``deformap`` command: one module per command group, each command parsing its options,
-calling one function of :mod:`deformap.run` (or :mod:`deformap.eval` for the benchmarks) and
-rendering the result.
+"""The ``deformap`` command: each command parses its options, calls one function of
+:mod:`deformap.run` (or :mod:`deformap.eval` for the benchmarks) and renders the result.
 
-``_app`` holds what they share (the app, consoles, one-line errors, ``--json``, progress);
-``_explore`` (explore, config), ``_replay`` (record-sim, map, estimate), ``_world`` (scenarios,
-world show), ``_studies`` (study, reproduce) and ``_bench`` (bench) register their commands on
-import.
+``_app`` holds what they share; ``_explore``, ``_replay``, ``_world``, ``_studies`` and ``_bench``
+register their command groups on import.
 """
 
 from __future__ import annotations

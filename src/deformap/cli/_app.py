@@ -1,12 +1,9 @@
-"""What every command shares: the ``deformap`` app, its consoles, one-line errors and ``--json``
-(the progress display of a run is :mod:`deformap.cli._progress`).
+"""What every command shares: the ``deformap`` app, its consoles, one-line errors and ``--json``.
 
 Every command turns a :class:`~deformap.errors.DeformapError` into one line on stderr and exit
-code 2: a user sees what to fix, never a traceback.
-
-``--json FILE`` means the same in every command that has it: also write the command's result as
-JSON to ``FILE`` (written atomically); ``-`` writes it to stdout, and the tables and progress then
-go to stderr so that stdout is the JSON alone.
+code 2: a user sees what to fix, never a traceback. ``--json FILE`` means the same in every
+command that has it: also write the command's result as JSON to ``FILE`` (atomically); ``-``
+writes it to stdout, and the tables and progress then go to stderr.
 """
 
 from __future__ import annotations
@@ -19,7 +16,7 @@ import tempfile
 from collections.abc import Callable
 from functools import wraps
 from pathlib import Path
-from typing import Annotated, Any, TypeVar
+from typing import Annotated, Any, NoReturn, TypeVar
 
 import typer
 from rich.console import Console
@@ -32,32 +29,18 @@ from deformap._files import check_destination
 from deformap.errors import ConfigError, DeformapError, InvalidArgumentError
 
 __all__ = [
-    "JsonOption",
-    "VarianceMaxOption",
-    "app",
-    "check_positive_options",
-    "console",
-    "emit_json",
-    "err_console",
-    "friendly_errors",
-    "labelled",
-    "out_console",
-    "warn",
+    "JsonOption", "VarianceMaxOption", "app", "check_positive_options", "console", "emit_json",
+    "err_console", "fail", "friendly_errors", "labelled", "out_console", "warn",
 ]
 
 PIPE_WIDTH = 400
-"""Columns of a console writing to a file or pipe (not a terminal), where rich would otherwise
-assume 80 and wrap every longer line: wide enough for any row deformap prints (a table row, a
-poke line, a results folder's absolute path) to stay one line, which ``grep`` and ``cut`` need;
-the ``COLUMNS`` environment variable still wins when set."""
+"""Columns of a console on a file or pipe, where rich would assume 80 and wrap: wide enough that
+every row deformap prints stays one line for ``grep`` and ``cut`` (``COLUMNS`` still wins)."""
 
 
 def _console(*, stderr: bool) -> Console:
-    """A console on stdout or stderr; on a file or pipe, :data:`PIPE_WIDTH` columns wide.
-
-    Markup off: file names, scenario names and messages are the user's text, where "[" and "]"
-    are characters, not styles; the few styled words are Text with a style (``labelled``).
-    """
+    """A console on stdout or stderr, :data:`PIPE_WIDTH` wide on a file or pipe; markup off, as
+    file and scenario names are the user's text, where brackets are characters."""
     stream = sys.stderr if stderr else sys.stdout
     piped = not (hasattr(stream, "isatty") and stream.isatty())
     width = PIPE_WIDTH if piped and not os.environ.get("COLUMNS") else None
@@ -72,6 +55,13 @@ def labelled(label: str, style: str, text: str) -> Text:
     """``label`` in ``style``, a space, then ``text`` as it is (no markup)."""
     return Text.assemble((label, style), " ", text)
 
+
+def fail(message: str) -> NoReturn:
+    """Print ``error: message`` on stderr and exit with code 2."""
+    err_console.print(labelled("error:", "bold red", message), soft_wrap=True)
+    raise typer.Exit(code=2)
+
+
 def _reflowed(text: str | None) -> str | None:
     """``text`` with each paragraph's line breaks made spaces (rich then wraps it to the
     terminal) and its square brackets literal ("[required]", "x [m]" are words, not styles)."""
@@ -83,8 +73,7 @@ def _reflowed(text: str | None) -> str | None:
 
 
 def _reflow_help(command: Any) -> None:
-    """Reflow the help of a click ``command``, its parameters and every subcommand
-    (:func:`_reflowed`)."""
+    """Reflow the help of a click ``command``, its parameters and every subcommand."""
     command.help = _reflowed(command.help)
     for param in command.params:
         if hasattr(param, "help"):  # options and typer's arguments; click's arguments have none
@@ -94,8 +83,8 @@ def _reflow_help(command: Any) -> None:
 
 
 class _ReflowingGroup(TyperGroup):
-    """The root group: once built with every subcommand, their help texts are reflowed, since
-    rich keeps a docstring's hard line breaks and reads its brackets as styles."""
+    """The root group, whose commands' help is reflowed once all are registered: rich keeps a
+    docstring's hard line breaks and reads its brackets as styles."""
 
     def __init__(self, *args: Any, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
@@ -103,19 +92,16 @@ class _ReflowingGroup(TyperGroup):
 
 
 app = typer.Typer(
-    name="deformap",
-    cls=_ReflowingGroup,
+    name="deformap", cls=_ReflowingGroup, no_args_is_help=True, add_completion=False,
     help="Map how deformable a surface is, region by region, from a few robot pokes.",
-    no_args_is_help=True,
-    add_completion=False,
     pretty_exceptions_enable=False,
     rich_markup_mode="rich",  # _ReflowingGroup escapes square brackets for rich markup
-)
+)  # fmt: skip
+
 
 def _json_target(value: Path | None) -> Path | None:
-    """``--json``'s check at parse time, before the command's work: the file must be creatable
-    (its folder exists or can be made, and it is not a folder), so that a long run or benchmark
-    does not fail only when it is done."""
+    """``--json`` checked at parse time: a file that can be created (its folder exists or can be
+    made, and it is no folder), so that a long run does not fail only when it is done."""
     if value is None or str(value) == "-":
         return value
     try:
@@ -132,10 +118,7 @@ def _json_target(value: Path | None) -> Path | None:
     except InvalidArgumentError as exc:
         problem = str(exc)
     if problem is not None:
-        err_console.print(labelled("error:", "bold red", (
-            f"--json must name a file that can be written; got {str(value)!r}: {problem}")),
-            soft_wrap=True)
-        raise typer.Exit(code=2)
+        fail(f"--json must name a file that can be written; got {str(value)!r}: {problem}")
     return value
 
 
@@ -148,18 +131,12 @@ def check_positive_options(**numbers: float | None) -> None:
             raise InvalidArgumentError(f"{option} must be a finite number > 0; got {value}")
 
 
-VarianceMaxOption = Annotated[
-    float | None,
-    typer.Option(help="Top of map.png's variance colour scale, the same in every run drawn "
-                 "with it so that runs compare (default: each map's own largest variance)."),
-]
-
-
-JsonOption = Annotated[
-    Path | None,
-    typer.Option("--json", help="Also write the result as JSON to this file (- for stdout).",
-                 callback=_json_target),
-]
+VarianceMaxOption = Annotated[float | None, typer.Option(
+    help="Top of map.png's variance colour scale, the same in every run drawn with it so that "
+    "runs compare (default: each map's own largest variance).")]
+JsonOption = Annotated[Path | None, typer.Option(
+    "--json", help="Also write the result as JSON to this file (- for stdout).",
+    callback=_json_target)]
 
 F = TypeVar("F", bound=Callable[..., Any])
 
@@ -176,8 +153,7 @@ def friendly_errors(func: F) -> F:
                 raise InvalidArgumentError(f"`--seed` must be an integer >= 0; got {seed}")
             return func(*args, **kwargs)
         except DeformapError as exc:
-            err_console.print(labelled("error:", "bold red", str(exc)), soft_wrap=True)
-            raise typer.Exit(code=2) from None
+            fail(str(exc))
 
     return wrapper  # type: ignore[return-value]
 
@@ -216,25 +192,18 @@ def _version_callback(value: bool) -> None:
 
 @app.callback()
 def _root(
-    version: Annotated[
-        bool,
-        typer.Option(
-            "--version", callback=_version_callback, is_eager=True, help="Print the version."
-        ),
-    ] = False,
-    verbose: Annotated[
-        bool, typer.Option("--verbose", "-v", help="Log deformap's progress details.")
-    ] = False,
+    version: Annotated[bool, typer.Option("--version", callback=_version_callback, is_eager=True,
+                                          help="Print the version.")] = False,
+    verbose: Annotated[bool, typer.Option("--verbose", "-v",
+                                          help="Log deformap's progress details.")] = False,
 ) -> None:
     configure_logging(verbose)
 
 
 def configure_logging(verbose: bool) -> None:
-    """deformap's warnings always, its INFO lines with ``verbose``; other libraries' log lines
-    at WARNING and above only, and their Python warnings (scipy's sparse-efficiency warnings,
-    for one) not shown at all: they are advice to the library's programmer, not to the user,
-    and with ``verbose`` they come as log lines of ``py.warnings``. Every line goes through one
-    handler on the root logger (:class:`_ConsoleHandler`), so each is printed once."""
+    """deformap's warnings always, its INFO lines with ``verbose``; other libraries' log lines at
+    WARNING and above, their Python warnings only with ``verbose`` (advice to their programmer,
+    not to the user). One handler on the root logger prints each line once."""
     root = logging.getLogger()
     for handler in [h for h in root.handlers if isinstance(h, _ConsoleHandler)]:
         root.removeHandler(handler)
@@ -246,16 +215,13 @@ def configure_logging(verbose: bool) -> None:
     logging.getLogger("py.warnings").setLevel(logging.WARNING if verbose else logging.CRITICAL)
 
 
-_SHOWN: set[str] = set()
-"""The warning lines printed in this process, so that :func:`warn` does not print one that a log
-line already did (a skipped poke is logged as it happens and listed again in the report)."""
-
+_SHOWN: set[str] = set()  # the warning lines printed so far, which warn() does not repeat
 _LEVEL_STYLES = {"error": "bold red", "warning": "yellow", "info": "dim", "debug": "dim"}
 
 
 class _ConsoleHandler(logging.Handler):
-    """Log lines on stderr as ``warning: message``: a user reads what happened, not which
-    internal module said it; another library's lines name it (``warning (scipy): …``)."""
+    """Log lines on stderr as ``warning: message``, without deformap's module names; another
+    library's lines name it (``warning (scipy): …``)."""
 
     def emit(self, record: logging.LogRecord) -> None:
         try:

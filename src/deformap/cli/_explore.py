@@ -26,33 +26,30 @@ from deformap.errors import ConfigError
 if TYPE_CHECKING:  # the CLI loads the estimator only when a command runs
     from deformap.explore import PokeRecord
 
-__all__ = ["config_app"]
+__all__ = ["ConfigOption", "config_app"]
 
 config_app = typer.Typer(help="The run configuration (YAML).")
+app.add_typer(config_app, name="config")
 
 HELP_DEFAULTS: dict[str, str | int | float] = {
     "scenario": "heterogeneous-60-110-rigid", "seed": 0, "exploration.strategy": "planned",
     "exploration.threshold": 0.06, "exploration.max_pokes": 12, "exploration.field": "modulus",
 }  # fmt: skip
-"""The defaults ``explore --help`` shows for the options that override the run configuration
-(the ``RunConfig()`` values; a test keeps them equal). Written out, not read from ``RunConfig``:
-that import loads the estimator and the world (over a second), which ``--help`` must not wait
-for. A ``--config`` file's values replace them."""
-app.add_typer(config_app, name="config")
+"""The ``RunConfig()`` defaults ``--help`` shows, written out so as not to import the estimator."""
+
+ConfigOption = Annotated[Path | None, typer.Option(
+    help="Run configuration YAML (see `config dump`).")]
 
 
 def poke_row(p: PokeRecord) -> str:
     """One progress line of a live poke."""
-    return (
-        f"  poke {p.index + 1:>2}  target ({p.target_xy[0]:.3f}, {p.target_xy[1]:.3f}) m"
-        f"  force {p.force_n:.2f} N  β = {p.beta:.3f} ± {p.beta_std:.3f}"
-        + modulus_text(p)
-        + f"  max var {p.max_variance_after:.4f}"
-        + (f"  plan: {p.planned_after} more" if p.planned_after is not None else "")
-        + ("  boundary poke" if p.purpose == "boundary" else "")
-        + f"  (compute {p.timings.compute_s:.2f} s,"
-        f" world {p.timings.environment_s or 0.0:.2f} s)"
-    )
+    return (f"  poke {p.index + 1:>2}  target ({p.target_xy[0]:.3f}, {p.target_xy[1]:.3f}) m"
+            f"  force {p.force_n:.2f} N  β = {p.beta:.3f} ± {p.beta_std:.3f}" + modulus_text(p)
+            + f"  max var {p.max_variance_after:.4f}"
+            + (f"  plan: {p.planned_after} more" if p.planned_after is not None else "")
+            + ("  boundary poke" if p.purpose == "boundary" else "")
+            + f"  (compute {p.timings.compute_s:.2f} s,"
+            f" world {p.timings.environment_s or 0.0:.2f} s)")
 
 
 def modulus_summary(report: dict[str, Any]) -> str:
@@ -91,12 +88,9 @@ def _summary(out: Console, report: dict[str, Any], folder: Path) -> None:
         table.add_row(f"order of the {what} (1: right)", "n/a" if value is None else f"{value:.2f}")
     table.add_row("modulus", modulus_summary(report))
     t = report["timings"]
-    table.add_row(
-        "time",
-        f"{t['total_s'] + t['world_build_s']:.1f} s in all, world build "
-        f"{t['world_build_s']:.1f} s, compute per poke "
-        f"{max(t['per_poke_compute_s'], default=0):.2f} s at most",
-    )
+    table.add_row("time", f"{t['total_s'] + t['world_build_s']:.1f} s in all, world build "
+                  f"{t['world_build_s']:.1f} s, compute per poke "
+                  f"{max(t['per_poke_compute_s'], default=0):.2f} s at most")
     table.add_row("results", str(folder))
     out.print(table)
 
@@ -104,57 +98,39 @@ def _summary(out: Console, report: dict[str, Any], folder: Path) -> None:
 @app.command("explore")
 @friendly_errors
 def explore_command(
-    scenario: Annotated[
-        str | None, typer.Option("--scenario", "-s", help="Built-in scenario name or YAML file.",
-                                 show_default=str(HELP_DEFAULTS["scenario"]))
-    ] = None,
+    scenario: Annotated[str | None, typer.Option(
+        "--scenario", "-s", help="Built-in scenario name or YAML file.",
+        show_default=str(HELP_DEFAULTS["scenario"]))] = None,
     seed: Annotated[int | None, typer.Option(
         help="Seed of world noise and poke choice.",
         show_default=str(HELP_DEFAULTS["seed"]))] = None,
-    out: Annotated[
-        Path | None,
-        typer.Option(help="Run folder (default runs/<scenario>-explore-s<seed>-<time>)."),
-    ] = None,
-    strategy: Annotated[
-        str | None,
-        typer.Option(help="How the next poke is chosen: `exploration.strategy` (a name it does "
-                     "not know is refused with the list of choices).",
-                     show_default=str(HELP_DEFAULTS["exploration.strategy"])),
-    ] = None,
-    threshold: Annotated[
-        float | None,
-        typer.Option(help="T_h: stop when max var(β) is below it (then any boundary pokes); "
-                     "with --field modulus, read as the same fraction of its prior variance.",
-                     show_default=str(HELP_DEFAULTS["exploration.threshold"])),
-    ] = None,
+    out: Annotated[Path | None, typer.Option(
+        help="Run folder (default runs/<scenario>-explore-s<seed>-<time>).")] = None,
+    strategy: Annotated[str | None, typer.Option(
+        help="How the next poke is chosen: `exploration.strategy` (a name it does not know is "
+        "refused with the list of choices).",
+        show_default=str(HELP_DEFAULTS["exploration.strategy"]))] = None,
+    threshold: Annotated[float | None, typer.Option(
+        help="T_h: stop when max var(β) is below it (then any boundary pokes); "
+        "with --field modulus, read as the same fraction of its prior variance.",
+        show_default=str(HELP_DEFAULTS["exploration.threshold"]))] = None,
     max_pokes: Annotated[int | None, typer.Option(
-        help="Most pokes to make.",
-        show_default=str(HELP_DEFAULTS["exploration.max_pokes"]),
-    )] = None,
-    field: Annotated[
-        str | None,
-        typer.Option(help="The field regions, targets and the stop rule run on: "
-                     "`exploration.field`, 'beta' or 'modulus' (from the force–travel records).",
-                     show_default=str(HELP_DEFAULTS["exploration.field"])),
+        help="Most pokes to make.", show_default=str(HELP_DEFAULTS["exploration.max_pokes"]))
     ] = None,
-    config: Annotated[
-        Path | None, typer.Option(help="Run configuration YAML (see `config dump`).")
-    ] = None,
-    resume: Annotated[
-        Path | None, typer.Option(help="Continue the killed run in this folder.")
-    ] = None,
-    rerun: Annotated[
-        bool, typer.Option("--rerun", help="Also write run.rrd (extra `rerun`).")
-    ] = False,
-    environment: Annotated[
-        str | None,
-        typer.Option(help="Explore your own Environment instead of a simulated world: "
-                     "package.module:factory (docs/robot.md)."),
-    ] = None,
-    env_arg: Annotated[
-        list[str] | None,
-        typer.Option("--env-arg", help="key=value passed to the --environment factory (repeat)."),
-    ] = None,
+    field: Annotated[str | None, typer.Option(
+        help="The field regions, targets and the stop rule run on: `exploration.field`, 'beta' "
+        "or 'modulus' (from the force–travel records).",
+        show_default=str(HELP_DEFAULTS["exploration.field"]))] = None,
+    config: ConfigOption = None,
+    resume: Annotated[Path | None, typer.Option(help="Continue the killed run in this folder.")
+                      ] = None,
+    rerun: Annotated[bool, typer.Option("--rerun", help="Also write run.rrd (extra `rerun`).")
+                     ] = False,
+    environment: Annotated[str | None, typer.Option(
+        help="Explore your own Environment instead of a simulated world: package.module:factory "
+        "(docs/robot.md).")] = None,
+    env_arg: Annotated[list[str] | None, typer.Option(
+        "--env-arg", help="key=value passed to the --environment factory (repeat).")] = None,
     variance_max: VarianceMaxOption = None,
     json_path: JsonOption = None,
 ) -> None:
@@ -162,8 +138,7 @@ def explore_command(
     then cut it into regions."""
     check_positive_options(variance_max=variance_max)
     overrides = run.RunOverrides(scenario=scenario, seed=seed, strategy=strategy,
-                                 threshold=threshold, max_pokes=max_pokes,
-                                 field=field)  # fmt: skip
+                                 threshold=threshold, max_pokes=max_pokes, field=field)
     if environment is not None or env_arg:
         _explore_environment(environment, env_arg or [], scenario, resume, rerun, config,
                              overrides, out, json_path, variance_max)
@@ -185,9 +160,8 @@ def explore_command(
 
 @config_app.command("dump")
 @friendly_errors
-def config_dump(
-    out: Annotated[Path | None, typer.Option(help="Write to this file instead of stdout.")] = None,
-) -> None:
+def config_dump(out: Annotated[Path | None, typer.Option(
+        help="Write to this file instead of stdout.")] = None) -> None:
     """Write the full default run configuration as YAML, each setting under a comment giving its
     description, unit and bounds (a file that ``explore --config`` reads back)."""
     text = run.config_yaml(run.RunConfig(), described=True)

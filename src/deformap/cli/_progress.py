@@ -6,15 +6,8 @@ import contextlib
 from collections.abc import Callable, Iterator
 from typing import TYPE_CHECKING
 
+from rich import progress as bars
 from rich.console import Console
-from rich.progress import (
-    BarColumn,
-    MofNCompleteColumn,
-    Progress,
-    SpinnerColumn,
-    TextColumn,
-    TimeElapsedColumn,
-)
 
 from deformap import run
 from deformap.cli._app import labelled
@@ -36,21 +29,17 @@ def modulus_text(p: PokeRecord) -> str:
 
 
 @contextlib.contextmanager
-def progress(out: Console, description: str = "working") -> Iterator[Progress]:
+def progress(out: Console, description: str = "working") -> Iterator[bars.Progress]:
     """A transient progress display on ``out`` with one task (spinner, bar, count, time)."""
-    columns = (SpinnerColumn(), TextColumn("{task.description}", markup=False), BarColumn(),
-               MofNCompleteColumn(), TimeElapsedColumn())  # fmt: skip
-    with Progress(*columns, console=out, transient=True) as bar:
+    columns = (bars.SpinnerColumn(), bars.TextColumn("{task.description}", markup=False),
+               bars.BarColumn(), bars.MofNCompleteColumn(), bars.TimeElapsedColumn())
+    with bars.Progress(*columns, console=out, transient=True) as bar:
         bar.add_task(description, total=None)
         yield bar
 
 
-def run_hooks(
-    bar: Progress,
-    *,
-    poke_row: Callable[[PokeRecord], str] | None = None,
-    step_rows: bool = True,
-) -> run.RunHooks:
+def run_hooks(bar: bars.Progress, *, poke_row: Callable[[PokeRecord], str] | None = None,
+              step_rows: bool = True) -> run.RunHooks:
     """Hooks that drive ``bar``'s task and print, above it, a header line, one row per poke
     (with ``poke_row``) and one per step (with ``step_rows``)."""
     task = bar.task_ids[0]

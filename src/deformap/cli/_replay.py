@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import sys
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
@@ -15,13 +16,12 @@ from deformap.cli._app import (
     app,
     check_positive_options,
     emit_json,
-    err_console,
+    fail,
     friendly_errors,
-    labelled,
     out_console,
     warn,
 )
-from deformap.cli._explore import HELP_DEFAULTS, modulus_summary
+from deformap.cli._explore import HELP_DEFAULTS, ConfigOption, modulus_summary
 from deformap.cli._progress import modulus_text, progress, run_hooks
 from deformap.errors import InvalidArgumentError
 
@@ -29,10 +29,6 @@ if TYPE_CHECKING:  # the CLI loads the estimator only when a command runs
     from deformap.explore import PokeRecord
 
 __all__ = ["poke_row"]
-
-ConfigOption = Annotated[
-    Path | None, typer.Option(help="Run configuration YAML (see `config dump`).")
-]
 
 
 def poke_row(p: PokeRecord) -> str:
@@ -45,13 +41,10 @@ def poke_row(p: PokeRecord) -> str:
 @app.command("record-sim")
 @friendly_errors
 def record_sim_command(
-    scenario: Annotated[
-        str, typer.Option("--scenario", "-s", help="Built-in scenario name or YAML file.")
-    ],
-    out: Annotated[
-        Path | None,
-        typer.Option(help="New session folder (default runs/<scenario>-record-s<seed>-<time>)."),
-    ] = None,
+    scenario: Annotated[str, typer.Option(
+        "--scenario", "-s", help="Built-in scenario name or YAML file.")],
+    out: Annotated[Path | None, typer.Option(
+        help="New session folder (default runs/<scenario>-record-s<seed>-<time>).")] = None,
     format: Annotated[str, typer.Option("--format", help="folder | mcap | sqlite3.")] = "folder",
     seed: Annotated[int | None, typer.Option(
         help="Seed of world noise and poke choice.",
@@ -71,28 +64,21 @@ def record_sim_command(
                                        hooks=run_hooks(bar, poke_row=poke_row))  # fmt: skip
     shown.print(f"wrote {output.session_file} ({output.n_pokes} pokes, {output.format} form)",
                 highlight=False)  # fmt: skip
-    emit_json(json_path, {"session_file": str(output.session_file), "folder": str(output.folder),
-                          "n_pokes": output.n_pokes, "format": output.format,
-                          "live_betas": output.live_betas})  # fmt: skip
+    emit_json(json_path, dataclasses.asdict(output))  # the paths as strings
 
 
 @app.command("map")
 @friendly_errors
 def map_command(
-    session: Annotated[
-        Path, typer.Argument(metavar="SESSION", help="Session folder or its session.yaml, or a "
-                             "bag as a robot records it (.mcap, .db3 or rosbag2 folder).")
-    ],
-    out: Annotated[
-        Path | None,
-        typer.Option(help="Result folder (default runs/<session>-map-s<seed>-<time>)."),
-    ] = None,
-    config: Annotated[
-        Path | None, typer.Option(help="Run configuration YAML; default: the session's own.")
-    ] = None,
-    seed: Annotated[
-        int | None, typer.Option(help="Seed of the surface fit; default: the session's.")
-    ] = None,
+    session: Annotated[Path, typer.Argument(
+        metavar="SESSION", help="Session folder or its session.yaml, or a "
+        "bag as a robot records it (.mcap, .db3 or rosbag2 folder).")],
+    out: Annotated[Path | None, typer.Option(
+        help="Result folder (default runs/<session>-map-s<seed>-<time>).")] = None,
+    config: Annotated[Path | None, typer.Option(
+        help="Run configuration YAML; default: the session's own.")] = None,
+    seed: Annotated[int | None, typer.Option(
+        help="Seed of the surface fit; default: the session's.")] = None,
     figures: Annotated[bool, typer.Option(help="Write map.png and poke-NN.png.")] = True,
     variance_max: VarianceMaxOption = None,
     layout: Annotated[str, typer.Option(
@@ -128,38 +114,31 @@ def map_command(
                     "stamp_tolerance_s": stamp_tolerance}  # fmt: skip
     shown = out_console(json_path)
     with progress(shown) as bar:
-        output = run.map_recorded_session(session, out, config=cfg, seed=seed, figures=figures,
-                                          variance_max=variance_max,
-                                          hooks=run_hooks(bar, poke_row=poke_row),
-                                          layout=layout,  # type: ignore[arg-type]
-                                          raw_config=raw_config,
-                                          raw_settings=raw_settings)  # fmt: skip
+        output = run.map_recorded_session(
+            session, out, config=cfg, seed=seed, figures=figures, variance_max=variance_max,
+            hooks=run_hooks(bar, poke_row=poke_row), layout=layout,  # type: ignore[arg-type]
+            raw_config=raw_config, raw_settings=raw_settings)
     report = output.report
     for line in report["warnings"]:
         warn(line)  # once: the log line of a skipped poke printed it as it happened
     regions = report["regions"]
-    found = (
-        "no poke usable" if regions is None else f"{len(regions['class_betas'])} region class(es)"
-    )
-    scored = ""
-    if regions is not None and "accuracy" in regions:
-        scored = f", accuracy {regions['accuracy']:.3f} against the ground truth"
+    found = ("no poke usable" if regions is None
+             else f"{len(regions['class_betas'])} region class(es)")
+    scored = (f", accuracy {regions['accuracy']:.3f} against the ground truth"
+              if regions is not None and "accuracy" in regions else "")
     shown.print(f"{report['n_pokes']} of {len(output.session)} pokes used, {found}{scored}; "
                 f"wrote {output.folder / 'report.json'}", highlight=False)  # fmt: skip
     shown.print(f"modulus: {modulus_summary(report)}", highlight=False)
     emit_json(json_path, report)
     if regions is None:  # the report is written (nothing lost), but there is no map
-        err_console.print(labelled("error:", "bold red", (
-            f"no poke of the session {str(session)!r} was usable: expected at least one, got 0 "
-            f"of {len(output.session)} (the warnings and report.json say why)")), soft_wrap=True)
-        raise typer.Exit(code=2)
+        fail(f"no poke of the session {str(session)!r} was usable: expected at least one, got 0 "
+             f"of {len(output.session)} (the warnings and report.json say why)")
 
 
 def _three_numbers(option: str, values: tuple[str, str, str] | None, what: str
                    ) -> tuple[float, float, float]:
-    """``values`` of a three-number option as floats; one line naming the option when it is
-    not given, when a value is missing (the parser took the next option's name as the third
-    value) or is not a number."""
+    """``values`` of a three-number option as floats; refused, naming the option, when absent,
+    short (the parser took the next option's name as a value) or not numbers."""
     if values is None:
         raise InvalidArgumentError(f"{option} is required: three numbers, {what}; got none")
     given = [v for v in values if not v.startswith("--")]
@@ -178,48 +157,32 @@ def _three_numbers(option: str, values: tuple[str, str, str] | None, what: str
 @friendly_errors
 def estimate_command(
     ctx: typer.Context,
-    before: Annotated[
-        Path, typer.Option("--before", help="Cloud of the undisturbed surface (PCD, PLY, NPZ).")
-    ],
+    before: Annotated[Path, typer.Option(
+        "--before", help="Cloud of the undisturbed surface (PCD, PLY, NPZ).")],
     after: Annotated[Path, typer.Option("--after", help="Cloud while pressing.")],
-    # --contact, --force and --tip-radius: optional to the parser, required here, so that a
-    # value missing from --contact or --force is named (below) instead of the parser's
-    # "Missing option '--force'" when --contact took that option's name as its third value
-    contact: Annotated[
-        tuple[str, str, str] | None,
-        typer.Option("--contact", metavar="X Y Z",
-                     help="Tip centre X Y Z at the press, metres. [required]"),
+    # --contact, --force, --tip-radius: required here, not by the parser, so that a value missing
+    # from --contact (which then takes the next option's name as its third) is named below
+    contact: Annotated[tuple[str, str, str] | None, typer.Option(
+        "--contact", metavar="X Y Z", help="Tip centre X Y Z at the press, metres. [required]")
     ] = None,
-    force: Annotated[
-        tuple[str, str, str] | None,
-        typer.Option("--force", metavar="FX FY FZ",
-                     help="Force FX FY FZ on the surface, newtons. [required]"),
+    force: Annotated[tuple[str, str, str] | None, typer.Option(
+        "--force", metavar="FX FY FZ", help="Force FX FY FZ on the surface, newtons. [required]")
     ] = None,
-    tip_radius: Annotated[
-        float | None,
-        typer.Option("--tip-radius", help="Radius of the spherical tip, metres. [required]"),
-    ] = None,
-    robot_hull: Annotated[
-        Path | None,
-        typer.Option("--robot-hull", help="Cloud file of points whose hull covers stick and hand."),
-    ] = None,
-    out: Annotated[
-        Path | None, typer.Option(help="New folder for estimate.json, beta-curve.png, poke.png.")
-    ] = None,
+    tip_radius: Annotated[float | None, typer.Option(
+        "--tip-radius", help="Radius of the spherical tip, metres. [required]")] = None,
+    robot_hull: Annotated[Path | None, typer.Option(
+        "--robot-hull", help="Cloud file of points whose hull covers stick and hand.")] = None,
+    out: Annotated[Path | None, typer.Option(
+        help="New folder for estimate.json, beta-curve.png, poke.png.")] = None,
     units: Annotated[str, typer.Option(help="Units of the cloud files: m | mm.")] = "m",
-    config: Annotated[
-        Path | None, typer.Option(help="Run configuration YAML (its exploration part).")
-    ] = None,
+    config: Annotated[Path | None, typer.Option(
+        help="Run configuration YAML (its exploration part).")] = None,
     seed: Annotated[int, typer.Option(help="Seed of the surface fit.")] = 0,
-    json_path: Annotated[
-        Path | None,
-        typer.Option("--json", help="Also write the result as JSON to this file (- for stdout; "
-                     "the default without --out)."),
-    ] = None,
+    json_path: Annotated[Path | None, typer.Option(
+        "--json", help="Also write the result as JSON to this file (- for stdout; "
+        "the default without --out).")] = None,
 ) -> None:
     """β of one poke from two clouds and the tactile contact (world frame, SI units)."""
-    # unknown options are let through the parser so that a value missing from --contact or
-    # --force (the parser then takes the next option's name as a value) is named here
     tip_center = _three_numbers("--contact", contact, "the tip centre X Y Z in metres")
     force_n = _three_numbers("--force", force, "the force FX FY FZ in newtons")
     if tip_radius is None:
@@ -231,8 +194,7 @@ def estimate_command(
         json_path = Path("-")
     output = run.estimate_one_poke(
         before=before, after=after, tip_center=tip_center, force=force_n, tip_radius_m=tip_radius,
-        config=run.load_run_config(config), robot_hull=robot_hull, units=units, seed=seed, out=out,
-    )  # fmt: skip
+        config=run.load_run_config(config), robot_hull=robot_hull, units=units, seed=seed, out=out)
     r = output.report
     shown = out_console(json_path)
     shown.print(f"β = {r['beta']:.3f} ± {r['beta_std']:.3f} ({r['n_roi_points']} ROI points)")

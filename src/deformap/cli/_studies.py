@@ -23,8 +23,7 @@ from deformap.errors import InvalidArgumentError
 __all__ = ["study_app"]
 
 STUDY_HARDNESSES_HELP = "30, 60, 110, 150, 250 and rigid"
-"""``--hardness``'s default as ``--help`` shows it (``deformap.eval.DEFAULT_HARDNESSES``; written
-out so that ``--help`` does not import the studies, a test keeps them equal)."""
+"""``deformap.eval.DEFAULT_HARDNESSES`` as ``--help`` shows it, written out (a test compares)."""
 
 study_app = typer.Typer(help="Studies on homogeneous simulated foams (the paper's Fig. 5).")
 app.add_typer(study_app, name="study")
@@ -47,86 +46,71 @@ def _hardness(value: float | None) -> str:
 @study_app.command("hardness")
 @friendly_errors
 def study_hardness(
-    out: Annotated[
-        Path | None,
-        typer.Option(help="New folder for hardness.png and hardness.json "
-                     "(default runs/hardness-study-s<seed>-<time>)."),
-    ] = None,
+    out: Annotated[Path | None, typer.Option(help="New folder for hardness.png and hardness.json "
+                                             "(default runs/hardness-study-s<seed>-<time>).")
+                   ] = None,
     seed: SeedOption = 0,
-    hardness: Annotated[
-        list[float] | None, typer.Option(help="Foams in N (repeat); rigid is added.",
-                                         show_default=STUDY_HARDNESSES_HELP)
-    ] = None,
+    hardness: Annotated[list[float] | None, typer.Option(
+        help="Foams in N (repeat); rigid is added.", show_default=STUDY_HARDNESSES_HELP)] = None,
     coarse: CoarseOption = False,
-    camera: Annotated[
-        str | None, typer.Option(help="Camera preset: primesense | kinect-v1 | realsense-d435 "
-                                 "(default primesense; with --full, the matrix's only camera).")
-    ] = None,
-    thickness: Annotated[
-        float | None, typer.Option(help="Foam thickness in metres (default 0.05; with --full, "
-                                   "the matrix's only thickness).")
+    camera: Annotated[str | None, typer.Option(
+        help="Camera preset: primesense | kinect-v1 | realsense-d435 (default primesense; with "
+        "--full, the matrix's only camera).")] = None,
+    thickness: Annotated[float | None, typer.Option(
+        help="Foam thickness in metres (default 0.05; with --full, the matrix's only thickness).")
     ] = None,
     force: Annotated[float | None, typer.Option(help="Press force in N (default 0.6).")] = None,
-    physics: Annotated[
-        str | None, typer.Option(help="World physics: linear-fem | stiffening-foam | "
-                                 "stiffening-fem (`world.physics`; default linear-fem; with "
-                                 "--full, the matrix's only physics).")
-    ] = None,
-    full: Annotated[
-        bool, typer.Option(help="The whole matrix: every camera preset × thickness 0.03, 0.05, "
-                           "0.10 m × every physics; --camera, --thickness or --physics given "
-                           "pins that axis.")
-    ] = False,
-    protocol: Annotated[
-        list[str] | None, typer.Option(help="Contact protocol whose β is fitted (repeat): "
-                                       "force/quadratic | force/linear | pinned/quadratic | "
-                                       "pinned/linear (default force/quadratic and the "
-                                       "paper's pinned/quadratic).")
-    ] = None,
-    element_size: Annotated[
-        float | None, typer.Option(help="The world's in-plane FEM element size in metres "
-                                   "(default 0.0075, a quick look; with --full 0.00375, a mesh "
-                                   "that resolves a stiff foam's contact, about 5 times the "
-                                   "time of a press): how much of E's error is the world's "
-                                   "mesh. Not with --coarse.")
+    physics: Annotated[str | None, typer.Option(
+        help="World physics: linear-fem | stiffening-foam | stiffening-fem (`world.physics`; "
+        "default linear-fem; with --full, the matrix's only physics).")] = None,
+    full: Annotated[bool, typer.Option(
+        help="The whole matrix: every camera preset × thickness 0.03, 0.05, 0.10 m × every "
+        "physics; --camera, --thickness or --physics given pins that axis.")] = False,
+    protocol: Annotated[list[str] | None, typer.Option(
+        help="Contact protocol whose β is fitted (repeat): force/quadratic | force/linear | "
+        "pinned/quadratic | pinned/linear (default force/quadratic and the paper's "
+        "pinned/quadratic).")] = None,
+    element_size: Annotated[float | None, typer.Option(
+        help="The world's in-plane FEM element size in metres (default 0.0075, a quick look; "
+        "with --full 0.00375, a mesh that resolves a stiff foam's contact, about 5 times the "
+        "time of a press): how much of E's error is the world's mesh. Not with --coarse.")
     ] = None,
     json_path: JsonOption = None,
 ) -> None:
     """β and Young's modulus against hardness for each contact protocol (paper Fig. 5a)."""
     check_positive_options(element_size=element_size)
     shown = out_console(json_path)
+    if full:  # an axis given on the command line pins it; the others span the matrix
+        condition: dict[str, Any] = {
+            "full": True, "cameras": None if camera is None else [camera],
+            "thicknesses_m": None if thickness is None else [thickness],
+            "physics_names": None if physics is None else [physics]}
+    else:
+        condition = {"camera": camera, "thickness_m": 0.05 if thickness is None else thickness,
+                     "physics": physics or "linear-fem"}
     try:
         with progress(shown) as bar:
-            if full:  # an axis given on the command line pins it; the others span the matrix
-                output = run.run_hardness_study(
-                    out, seed=seed, hardness=hardness, coarse=coarse, force_n=force, full=True,
-                    cameras=None if camera is None else [camera],
-                    thicknesses_m=None if thickness is None else [thickness],
-                    physics_names=None if physics is None else [physics], protocols=protocol,
-                    element_size_m=element_size, hooks=run_hooks(bar))  # fmt: skip
-            else:
-                output = run.run_hardness_study(
-                    out, seed=seed, hardness=hardness, coarse=coarse, camera=camera,
-                    thickness_m=0.05 if thickness is None else thickness, force_n=force,
-                    physics=physics or "linear-fem", protocols=protocol,
-                    element_size_m=element_size, hooks=run_hooks(bar))
+            output = run.run_hardness_study(
+                out, seed=seed, hardness=hardness, coarse=coarse, force_n=force,
+                protocols=protocol, element_size_m=element_size, hooks=run_hooks(bar), **condition)
     except InvalidArgumentError as exc:  # the run's refusal of the mesh, named as the option
         if getattr(exc, "field", None) != "element_size_m":
             raise
         raise InvalidArgumentError(f"--element-size {getattr(exc, 'detail', exc)}") from None
-    if full:
-        _print_summary(shown, output.study)
-        shown.print(f"wrote {' and '.join(map(str, output.files))}", highlight=False)
-        emit_json(json_path, output.study)
-        return
-    s = output.study
-    where = ", ".join(f"{s[k]}" for k in ("camera", "physics") if k in s)
+    (_print_summary if full else _print_single)(shown, output.study)
+    shown.print(f"wrote {' and '.join(map(str, output.files))}", highlight=False)
+    emit_json(json_path, output.study)
+
+
+def _print_single(shown: Any, study: dict[str, Any]) -> None:
+    """One condition's study: a row per protocol and foam, then what the checks found."""
+    where = ", ".join(f"{study[k]}" for k in ("camera", "physics") if k in study)
     table = Table(title=f"β and E against hardness{f' ({where})' if where else ''}")
     table.add_column("protocol", no_wrap=True)  # the row's name, never cut
     for col in ("hardness [N]", "β", "β spread", "β uncertainty", "fit error [mm]",
                 "E [kPa]", "true E [kPa]"):
         table.add_column(col, justify="right")
-    for r in output.study["rows"]:
+    for r in study["rows"]:
         if r.get("refused"):
             table.add_row(r["protocol"], _hardness(r["hardness_n"]), "refused", *["–"] * 4,
                           _kpa(r, "true_modulus_pa"))  # fmt: skip
@@ -135,19 +119,17 @@ def study_hardness(
                       f"{r['beta_std']:.3f}", f"{r['beta_estimate_std']:.3f}",
                       f"{r['fit_error_m'] * 1e3:.3f}", _kpa(r), _kpa(r, "true_modulus_pa"))  # fmt: skip
     shown.print(table)
-    for reason in dict.fromkeys(r["refused"] for r in output.study["rows"] if r.get("refused")):
+    for reason in dict.fromkeys(r["refused"] for r in study["rows"] if r.get("refused")):
         shown.print(f"  refused: {reason}", highlight=False)
-    for name, ok in output.study["monotone"].items():
+    for name, ok in study["monotone"].items():
         rises = "strictly rises" if ok else "does NOT strictly rise"
         shown.print(f"  {name}: β {rises} as hardness falls", highlight=False)
-    if output.study.get("modulus_monotone") is not None:
-        rises = "strictly rises" if output.study["modulus_monotone"] else "does NOT strictly rise"
+    if study.get("modulus_monotone") is not None:
+        rises = "strictly rises" if study["modulus_monotone"] else "does NOT strictly rise"
         shown.print(f"  force–travel: E {rises} with hardness (rigid read rigid)", highlight=False)
-    if output.study.get("n_refused"):
-        shown.print(f"  {output.study['n_refused']} foam(s) refused by the world, left out of "
+    if study.get("n_refused"):
+        shown.print(f"  {study['n_refused']} foam(s) refused by the world, left out of "
                     "these checks", highlight=False)  # fmt: skip
-    shown.print(f"wrote {' and '.join(map(str, output.files))}", highlight=False)
-    emit_json(json_path, output.study)
 
 
 def _pct(value: float | None) -> str:
@@ -190,11 +172,9 @@ def _print_summary(shown: Any, study: dict[str, Any]) -> None:
 @study_app.command("cluster-size")
 @friendly_errors
 def study_cluster_size(
-    out: Annotated[
-        Path | None,
-        typer.Option(help="New folder for cluster-size.png and .json "
-                     "(default runs/cluster-size-study-s<seed>-<time>)."),
-    ] = None,
+    out: Annotated[Path | None, typer.Option(
+        help="New folder for cluster-size.png and .json "
+        "(default runs/cluster-size-study-s<seed>-<time>).")] = None,
     seed: SeedOption = 0,
     coarse: CoarseOption = False,
     json_path: JsonOption = None,
@@ -217,21 +197,16 @@ def study_cluster_size(
 @app.command("reproduce")
 @friendly_errors
 def reproduce_command(
-    out: Annotated[
-        Path | None,
-        typer.Option(help="New folder: one run per scenario, table.md, table.json "
-                     "(default runs/table-i-reproduce-s<seed>-<time>)."),
-    ] = None,
+    out: Annotated[Path | None, typer.Option(
+        help="New folder: one run per scenario, table.md, table.json "
+        "(default runs/table-i-reproduce-s<seed>-<time>).")] = None,
     seed: Annotated[int, typer.Option(help="Seed of every run.")] = 0,
-    strategy: Annotated[
-        str | None,
-        typer.Option(help="`exploration.strategy` of every run (default: the config's; a name it "
-                     "does not know is refused with the list of choices)."),
-    ] = None,
+    strategy: Annotated[str | None, typer.Option(
+        help="`exploration.strategy` of every run (default: the config's; a name it does not "
+        "know is refused with the list of choices).")] = None,
     config: Annotated[Path | None, typer.Option(help="Run configuration YAML.")] = None,
-    scenario: Annotated[
-        list[str] | None, typer.Option("--scenario", help="Only this scenario (repeat).")
-    ] = None,
+    scenario: Annotated[list[str] | None, typer.Option(
+        "--scenario", help="Only this scenario (repeat).")] = None,
     json_path: JsonOption = None,
 ) -> None:
     """All six scenarios of the paper's Table I, beside the paper's numbers."""
@@ -241,11 +216,9 @@ def reproduce_command(
 
     def show(row: dict[str, Any]) -> None:
         tau = "–" if row["kendall_tau"] is None else f"{row['kendall_tau']:.2f}"
-        shown.print(
-            f"  {row['scenario']:<28} pokes {row['pokes']:>2}  regions {row['regions_found']}/"
-            f"{row['regions_true']}  accuracy {row['accuracy']:.3f}  τ {tau}  {row['time_s']:.1f} s",
-            highlight=False,
-        )
+        shown.print(f"  {row['scenario']:<28} pokes {row['pokes']:>2}  regions "
+                    f"{row['regions_found']}/{row['regions_true']}  accuracy {row['accuracy']:.3f}"
+                    f"  τ {tau}  {row['time_s']:.1f} s", highlight=False)
 
     with progress(shown) as bar:
         output = run.reproduce(out, base=base, scenarios=scenario, on_run=show,

@@ -22,9 +22,7 @@ app.add_typer(world_app, name="world")
 @friendly_errors
 def scenarios_command() -> None:
     """List the built-in scenarios (the paper's Table I) with their regions."""
-    table = Table(title="built-in scenarios")
-    for col in ("name", "regions", "description"):
-        table.add_column(col)
+    table = Table("name", "regions", "description", title="built-in scenarios")
     for sc in run.scenario_summaries():
         table.add_row(sc.name, ", ".join(sc.regions), sc.description)
     console.print(table)

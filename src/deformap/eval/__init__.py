@@ -1,10 +1,8 @@
 """Evaluation: metrics against ground truth, studies, the paper's Table I, and benchmarks.
 
-The runs that write folders (an exploration, the reproduction of Table I) belong to
-:mod:`deformap.run`, which uses this package; this package never imports it.
-
-The names are imported on first use: the studies and benchmarks pull in the simulated world and the
-whole estimator (slow to import), which ``deformap --help`` and a metric alone never need.
+The runs that write folders belong to :mod:`deformap.run`, which uses this package; this package
+never imports it. The names are imported on first use: the studies and benchmarks pull in the
+simulated world and the whole estimator (slow to import), which a metric alone never needs.
 """
 
 from __future__ import annotations
@@ -19,12 +17,7 @@ if TYPE_CHECKING:
     from deformap.eval._bench_memory import bench_memory, measure_case
     from deformap.eval._bench_msm import bench_beta_sweep
     from deformap.eval._bench_world import bench_world
-    from deformap.eval._metrics import (
-        OrderingScores,
-        RegionScores,
-        ordering_scores,
-        region_scores,
-    )
+    from deformap.eval._metrics import OrderingScores, RegionScores, ordering_scores, region_scores
     from deformap.eval._rescore import rescore_world
     from deformap.eval._studies import (
         DEFAULT_HARDNESSES,
@@ -51,12 +44,7 @@ if TYPE_CHECKING:
         draw_world,
         material_truth,
     )
-    from deformap.eval._world_result import (
-        POKES_FORMAT,
-        TIME_COLUMNS,
-        WorldResult,
-        row_values,
-    )
+    from deformap.eval._world_result import POKES_FORMAT, TIME_COLUMNS, WorldResult, row_values
     from deformap.eval._worlds import run_world
     from deformap.eval._worlds_summary import (
         CSV_COLUMNS,
@@ -90,54 +78,15 @@ _MODULES = {
 }  # fmt: skip
 
 __all__ = [
-    "CSV_COLUMNS",
-    "DEFAULT_HARDNESSES",
-    "DEFAULT_POSITIONS",
-    "DEFAULT_PROTOCOL",
-    "FORCES_N",
-    "GOOD_ACCURACY",
-    "HARDNESS_RANGE_N",
-    "IO_GOAL_S",
-    "PAPER_PROTOCOL",
-    "PAPER_TABLE_I",
-    "POKES_FORMAT",
-    "PROTOCOLS",
-    "STUDY_PROTOCOLS",
-    "THICKNESSES_M",
-    "TIME_COLUMNS",
-    "FoamPresses",
-    "OrderingScores",
-    "RegionScores",
-    "WorldDraw",
-    "WorldResult",
-    "WorldTask",
-    "accuracy_curves",
-    "bench_beta_sweep",
-    "bench_io",
-    "bench_memory",
-    "bench_surface_gp",
-    "bench_world",
-    "block_scenario",
-    "choices",
-    "cluster_size_study",
-    "collect_presses",
-    "combination_name",
-    "draw_world",
-    "hardness_study",
-    "hardness_summary",
-    "markdown_summary",
-    "markdown_table",
-    "material_truth",
-    "measure_case",
-    "ordering_scores",
-    "pokes_to_good",
-    "region_scores",
-    "rescore_world",
-    "row_values",
-    "run_world",
-    "runs_csv",
-    "summarise_worlds",
-    "table_row",
+    "CSV_COLUMNS", "DEFAULT_HARDNESSES", "DEFAULT_POSITIONS", "DEFAULT_PROTOCOL", "FORCES_N",
+    "GOOD_ACCURACY", "HARDNESS_RANGE_N", "IO_GOAL_S", "PAPER_PROTOCOL", "PAPER_TABLE_I",
+    "POKES_FORMAT", "PROTOCOLS", "STUDY_PROTOCOLS", "THICKNESSES_M", "TIME_COLUMNS", "FoamPresses",
+    "OrderingScores", "RegionScores", "WorldDraw", "WorldResult", "WorldTask", "accuracy_curves",
+    "bench_beta_sweep", "bench_io", "bench_memory", "bench_surface_gp", "bench_world",
+    "block_scenario", "choices", "cluster_size_study", "collect_presses", "combination_name",
+    "draw_world", "hardness_study", "hardness_summary", "markdown_summary", "markdown_table",
+    "material_truth", "measure_case", "ordering_scores", "pokes_to_good", "region_scores",
+    "rescore_world", "row_values", "run_world", "runs_csv", "summarise_worlds", "table_row",
 ]
 
 

@@ -1,8 +1,5 @@
-"""Benchmark of the recorded-data path: reading a large PCD file and a large PointCloud2 message.
-
-The goal: a 300,000-point binary PCD file, or one PointCloud2 message of that size, is read in
-under :data:`IO_GOAL_S`. The timings include everything a user waits for: parsing, the checks, and
-building the :class:`~deformap.cloud.PointCloud`.
+"""Benchmark of the recorded-data path: reading a large PCD file and a large PointCloud2 message,
+everything a user waits for included (parsing, the checks, the :class:`~deformap.cloud.PointCloud`).
 """
 
 from __future__ import annotations
@@ -21,8 +18,8 @@ from deformap.errors import InvalidArgumentError
 
 __all__ = ["IO_GOAL_S", "bench_io"]
 
-#: The budget for reading one 300,000-point cloud, seconds.
 IO_GOAL_S = 0.5
+"""The budget for reading one 300,000-point cloud, seconds."""
 
 
 def _best_of(repeats: int, run: Callable[[], Any]) -> tuple[float, float]:
@@ -35,44 +32,26 @@ def _best_of(repeats: int, run: Callable[[], Any]) -> tuple[float, float]:
 
 
 def _scene(n_points: int, rng: np.random.Generator) -> PointCloud:
-    # A depth-camera-like cloud over the 0.6 × 0.4 m workspace with colours.
+    """A depth-camera-like cloud with colours over the 0.6 × 0.4 m workspace."""
     xy = rng.uniform((0.0, 0.0), (0.6, 0.4), (n_points, 2))
     z = 0.05 + 0.01 * np.sin(20 * xy[:, 0]) + rng.normal(0, 5e-4, n_points)
     return PointCloud(np.column_stack([xy, z]), rng.integers(0, 256, (n_points, 3)) / 255.0)
 
 
-def bench_io(
-    *, n_points: int = 300_000, rng: np.random.Generator, repeats: int = 3
-) -> dict[str, Any]:
-    """Time reading a binary PCD file and decoding one PointCloud2 message of ``n_points``.
-
-    Parameters
-    ----------
-    n_points : int
-        Points in the cloud; 300,000 is the size the goal names.
-    rng : numpy.random.Generator
-        Source of the synthetic cloud.
-    repeats : int
-        Each read runs this many times; the best and the median are reported.
-
-    Returns
-    -------
-    dict
-        ``pcd_read_s`` / ``pcd_read_median_s``: :func:`deformap.cloud.io.read_cloud` of a binary
-        PCD (float32 x, y, z and packed rgb, as PCL writes it); ``pointcloud2_read_s`` /
-        ``pointcloud2_read_median_s``: CDR deserialisation of one message plus
-        :func:`~deformap.cloud.io.pointcloud2_to_array` and the PointCloud it becomes;
-        ``bag_read_s``: :func:`~deformap.cloud.io.read_bag_clouds` of a one-message MCAP bag, or
-        ``None`` without the ``ros`` extra; ``goal_s`` and ``n_points``.
-    """
+def bench_io(*, n_points: int = 300_000, rng: np.random.Generator, repeats: int = 3
+             ) -> dict[str, Any]:
+    """Time reading a binary PCD file and decoding one PointCloud2 message of ``n_points`` drawn
+    with ``rng``, each read ``repeats`` times: ``pcd_read_s`` / ``pcd_read_median_s`` (best and
+    median), ``pointcloud2_read_s`` / ``pointcloud2_read_median_s`` (CDR to PointCloud),
+    ``bag_read_s`` (a one-message MCAP bag; these three ``None`` without the ``ros`` extra),
+    ``goal_s`` and ``n_points``."""
     from deformap.cloud.io import read_cloud, write_pcd
 
     n = check_int("n_points", n_points, minimum=1)
     reps = check_int("repeats", repeats, minimum=1)
     if not isinstance(rng, np.random.Generator):
         raise InvalidArgumentError(
-            f"`rng` must be a numpy.random.Generator; got {type(rng).__name__}"
-        )
+            f"`rng` must be a numpy.random.Generator; got {type(rng).__name__}")
     cloud = _scene(n, rng)
     result: dict[str, Any] = {"n_points": n, "goal_s": IO_GOAL_S}
     with tempfile.TemporaryDirectory(prefix="deformap-bench-io-") as tmp:

@@ -1,24 +1,16 @@
 """Memory benchmark: the peak memory of the surface GP (grid against exact) and of a β estimation.
 
-Each case runs in a fresh process (``python -m deformap.eval._bench_memory CASE SIZE SEED``), so
-no case's heap inflates another's; the child builds its inputs first, then measures the case alone:
-
-- ``traced_peak_mib``: the largest total of live Python and numpy allocations (:mod:`tracemalloc`),
-  the same on every platform, but blind to what C libraries allocate themselves (BLAS, SuperLU).
-- ``rss_peak_mib`` and ``rss_added_mib``: the peak resident set during the case and its rise above
-  the set just before (Linux ``VmHWM``, reset through ``/proc/self/clear_refs`` after glibc's
-  ``malloc_trim`` returned the set-up's freed heap), everything included; ``None`` where the
-  platform cannot reset the peak.
-
-Cases, the speed benchmarks' problems: ``gp-exact`` / ``gp-grid`` fit the surface GP to ``size``
-noisy points over 60 × 40 cm and predict on the 120 × 80 grid (:mod:`deformap.eval._bench_gp`);
-``beta-batched`` is one converged :func:`deformap.msm.estimate_beta` on ``size × size``
-particles, ``beta-loop`` its baseline, the same β simulated one at a time
-(:mod:`deformap.eval._bench_msm`).
+Each case runs in a fresh process (``python -m deformap.eval._bench_memory CASE SIZE SEED``) that
+builds its inputs, then measures the case alone: the peak of live Python and numpy allocations
+(:mod:`tracemalloc`, blind to C libraries' own) and of the resident set (Linux ``VmHWM``, reset
+through ``/proc/self/clear_refs`` after ``malloc_trim``). The cases are the speed benchmarks'
+problems: the surface GP, exact or grid, and one β estimation, batched or its per-β loop.
 """
 
 from __future__ import annotations
 
+import contextlib
+import ctypes
 import gc
 import json
 import os
@@ -50,14 +42,10 @@ def _prepare(case: str, size: int, seed: int) -> Callable[[], Any]:
     """Build the case's inputs (outside the measurement) and return the call to measure."""
     rng = np.random.default_rng(seed)
     if case.startswith("gp-"):
-        from deformap.eval import _bench_gp as gp
+        from deformap.eval._bench_gp import surface_problem, timed_fit_predict
 
-        xs = np.arange(gp.CELL_M / 2, gp.WORKSPACE_M[0], gp.CELL_M)
-        ys = np.arange(gp.CELL_M / 2, gp.WORKSPACE_M[1], gp.CELL_M)
-        xy = rng.uniform((0.0, 0.0), gp.WORKSPACE_M, size=(size, 2))
-        z = gp._relief(xy) + gp.NOISE_STD_M * rng.standard_normal(size)
-        method = case.removeprefix("gp-")
-        return lambda: gp._timed_fit_predict(method, xy, z, xs, ys)
+        xy, z, xs, ys = surface_problem(size, rng)
+        return lambda: timed_fit_predict(case.removeprefix("gp-"), xy, z, xs, ys)
     from scipy.spatial import cKDTree
 
     from deformap.eval._bench_msm import dent_problem, per_beta_loop
@@ -74,24 +62,18 @@ def _prepare(case: str, size: int, seed: int) -> Callable[[], Any]:
 
 
 def _status_kib(key: str) -> float | None:
-    try:
+    with contextlib.suppress(OSError):
         for line in _STATUS.read_text().splitlines():
             if line.startswith(key + ":"):
                 return float(line.split()[1])
-    except OSError:
-        pass
     return None
 
 
 def _trim_heap() -> None:
     """Hand freed heap pages back to the OS (glibc), so the set-up's garbage is not reused unseen."""
     gc.collect()
-    try:
-        import ctypes
-
+    with contextlib.suppress(OSError, AttributeError):  # not glibc: the RSS may then read low
         ctypes.CDLL("libc.so.6").malloc_trim(0)
-    except (OSError, AttributeError):  # not glibc: the RSS fields may then read low
-        pass
 
 
 def _reset_peak_rss() -> bool:
@@ -104,7 +86,7 @@ def _reset_peak_rss() -> bool:
 
 
 def _run_case(case: str, size: int, seed: int) -> dict[str, Any]:
-    """Measure ``case`` in this process (the child's side; see the module docstring)."""
+    """Measure ``case`` in this process (the child's side)."""
     run = _prepare(case, size, seed)
     _trim_heap()
     rss_before = _status_kib("VmRSS")
@@ -122,15 +104,11 @@ def _run_case(case: str, size: int, seed: int) -> dict[str, Any]:
         tracemalloc.stop()
     rss_peak = _status_kib("VmHWM") if peak_reset else None
     row: dict[str, Any] = {
-        "case": case,
-        "size": size,
-        "traced_peak_mib": traced_peak / _MIB,
+        "case": case, "size": size, "traced_peak_mib": traced_peak / _MIB,
         "rss_before_mib": None if rss_before is None else rss_before / 1024,
-        "rss_peak_mib": None,
-        "rss_added_mib": None,
-        "seconds": seconds,
+        "rss_peak_mib": None, "rss_added_mib": None, "seconds": seconds,
         "baseline": BASELINE.get(case),
-    }
+    }  # fmt: skip
     if rss_peak is not None and rss_before is not None:
         row["rss_peak_mib"] = rss_peak / 1024
         row["rss_added_mib"] = (rss_peak - rss_before) / 1024
@@ -138,35 +116,18 @@ def _run_case(case: str, size: int, seed: int) -> dict[str, Any]:
 
 
 def _child_env() -> dict[str, str]:
-    # The child must import this very deformap, also when it runs from a source tree.
+    """This process's environment, with this very deformap first on the path (a source tree)."""
     src = str(Path(__file__).resolve().parents[2])
     path = os.pathsep.join(p for p in (src, os.environ.get("PYTHONPATH")) if p)
     return {**os.environ, "PYTHONPATH": path}
 
 
 def measure_case(case: str, size: int, *, seed: int = 0, isolate: bool = True) -> dict[str, Any]:
-    """Peak memory of one case.
-
-    Parameters
-    ----------
-    case : {"gp-exact", "gp-grid", "beta-batched", "beta-loop"}
-    size : int
-        Points of the cloud (``gp-*``) or particles per ROI side (``beta-*``).
-    seed : int
-        Seed of the synthetic data.
-    isolate : bool
-        Run in a fresh Python process (the default). ``False`` measures in this process: the
-        traced peak is still the case's own, but the RSS fields are ``None`` (this process's
-        history would count).
-
-    Returns
-    -------
-    dict
-        ``case``, ``size``, ``traced_peak_mib``, ``rss_before_mib``, ``rss_peak_mib``,
-        ``rss_added_mib`` (MiB, ``None`` where unmeasured), ``seconds`` (the case's wall time
-        while traced; tracing slows Python-heavy code) and ``baseline`` (the case it is compared
-        with, or ``None`` for a baseline).
-    """
+    """Peak memory of one ``case`` of :data:`CASES` on ``size`` points of the cloud (``gp-*``)
+    or particles per ROI side (``beta-*``), with synthetic data of ``seed``: ``case``, ``size``,
+    ``traced_peak_mib``, ``rss_before_mib``, ``rss_peak_mib``, ``rss_added_mib`` (MiB; ``None``
+    unmeasured, as with ``isolate=False``, measured in this process), ``seconds`` (while traced)
+    and ``baseline`` (the case it is compared with, ``None`` for a baseline)."""
     if case not in CASES:
         raise InvalidArgumentError(f"`case` must be one of {list(CASES)}; got {case!r}")
     size = check_int("size", size, minimum=5 if case.startswith("beta-") else 2)
@@ -174,46 +135,21 @@ def measure_case(case: str, size: int, *, seed: int = 0, isolate: bool = True) -
     if not isolate:
         row = _run_case(case, size, seed)
         return {**row, "rss_before_mib": None, "rss_peak_mib": None, "rss_added_mib": None}
-    done = subprocess.run(
-        [sys.executable, "-m", __name__, case, str(size), str(seed)],
-        env=_child_env(),
-        capture_output=True,
-        text=True,
-        check=False,
-    )
+    done = subprocess.run([sys.executable, "-m", __name__, case, str(size), str(seed)],
+                          env=_child_env(), capture_output=True, text=True, check=False)
     if done.returncode != 0:
         raise RuntimeError(f"memory case {case} {size} failed:\n{done.stderr[-2000:]}")
     return dict(json.loads(done.stdout.strip().splitlines()[-1]))
 
 
-def bench_memory(
-    *,
-    gp_sizes: Sequence[int] = (3000, 12000),
-    exact_max_points: int = 3000,
-    beta_side: int = 40,
-    seed: int = 0,
-    isolate: bool = True,
-) -> dict[str, list[dict[str, Any]]]:
-    """Peak memory of the surface GP and of one β estimation, each beside its baseline.
-
-    Parameters
-    ----------
-    gp_sizes : sequence of int
-        Cloud sizes; the grid path runs at each, the exact path (its baseline) at those up to
-        ``exact_max_points`` (its N × N covariance needs N² × 8 bytes several times over).
-    exact_max_points : int
-    beta_side : int
-        Particles per ROI side of the β estimation (and of its per-β-loop baseline).
-    seed : int
-    isolate : bool
-        See :func:`measure_case`.
-
-    Returns
-    -------
-    dict
-        ``{"surface_gp": [rows], "beta_estimation": [rows]}``, rows as :func:`measure_case`
-        returns them, baselines first.
-    """
+def bench_memory(*, gp_sizes: Sequence[int] = (3000, 12000), exact_max_points: int = 3000,
+                 beta_side: int = 40, seed: int = 0, isolate: bool = True,
+                 ) -> dict[str, list[dict[str, Any]]]:
+    """Peak memory of the surface GP and of one β estimation, each beside its baseline:
+    ``{"surface_gp": [rows], "beta_estimation": [rows]}``, rows of :func:`measure_case`, baselines
+    first. The grid GP runs at each of ``gp_sizes``, the exact one at those up to
+    ``exact_max_points`` (its N × N covariance is N² × 8 bytes several times over); the β
+    estimation and its per-β loop on ``beta_side`` particles per ROI side."""
     sizes = [check_int("gp_sizes[i]", n, minimum=2) for n in gp_sizes]
     exact_max = check_int("exact_max_points", exact_max_points, minimum=2)
 

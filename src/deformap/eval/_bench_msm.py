@@ -1,12 +1,9 @@
 """Benchmark of the β estimation: the estimate against a naive per-β loop, same run.
 
-Both sides compute the converged poke equilibrium and E(β) of every β that
-:func:`deformap.msm.estimate_beta` visits (the coarse sweep plus the refinement to 0.01), on a
-Hertz dent of a 60 N foam (an elastic half-space, not shape matching) with 0.1 mm of seeded
-observation noise. The estimate sets the ROI up once, starts each β from the one already solved
-and shares banded factorisations between nearby β; the loop simulates each β from rest with its
-own set-up, to the same tolerance, sharing only the calibrated stiffness. ``n_beta`` counts the
-β simulated and ``batched_s`` is the estimate's time.
+Both compute the converged poke and E(β) of every β :func:`deformap.msm.estimate_beta` visits, on
+a Hertz dent of a 60 N foam with 0.1 mm of seeded noise: the estimate sets the ROI up once, starts
+each β from the last and shares factorisations; the loop simulates each β from rest with its own
+set-up, to the same tolerance, sharing only the calibrated stiffness.
 """
 
 from __future__ import annotations
@@ -37,32 +34,15 @@ _TIGHT_ATOL_M = 1e-6
 _LOOSE_ATOL_M = 3e-6
 
 
-def bench_beta_sweep(*, n_particles_side: int = 40, cluster_size: int = 3,
-                     rng: np.random.Generator, config: ShapeMatchingConfig | None = None,
-                     ) -> dict[str, Any]:
-    """Time a converged β estimation on ``n × n`` particles, batched and per-β.
-
-    Parameters
-    ----------
-    n_particles_side : int
-        Particles per side of the ROI (0.5 cm apart).
-    cluster_size : int
-        Cluster side ``k``.
-    rng : numpy.random.Generator
-        Draws the observation noise.
-    config : ShapeMatchingConfig, optional
-        Protocol settings (default: the library default with ``cluster_size``).
-
-    Returns
-    -------
-    dict
-        ``{"n_beta", "n_particles", "batched_s", "loop_s", "speedup"}`` (plus nothing else).
-    """
+def bench_beta_sweep(*, n_particles_side: int = 40, rng: np.random.Generator,
+                     config: ShapeMatchingConfig | None = None) -> dict[str, Any]:
+    """Time a converged β estimation on ``n_particles_side``² particles (0.5 cm apart), batched
+    and per-β, with ``config`` (default: the library's with 3×3 clusters); ``rng`` draws the
+    noise. Returns ``{"n_beta", "n_particles", "batched_s", "loop_s", "speedup"}``."""
     n = check_int("n_particles_side", n_particles_side, minimum=5)
-    k = check_int("cluster_size", cluster_size, minimum=2)
     if not isinstance(rng, np.random.Generator):
         raise InvalidArgumentError(f"`rng` must be a numpy.random.Generator; got {type(rng)}")
-    cfg = config or ShapeMatchingConfig(cluster_size=k)
+    cfg = config or ShapeMatchingConfig(cluster_size=3)
     xs, ys, z, pts, contact = dent_problem(n, rng)
     t0 = time.perf_counter()
     est = estimate_beta(xs, ys, z, pts, contact, cfg)
@@ -84,8 +64,8 @@ def bench_beta_sweep(*, n_particles_side: int = 40, cluster_size: int = 3,
 
 
 def dent_problem(n: int, rng: np.random.Generator) -> tuple[Any, Any, Any, Any, Any]:
-    """The benchmark's ROI: ``xs, ys`` (n,), rest heights ``z`` (n, n), noisy observed ``points``
-    (n², 3) of the Hertz dent of a 60 N foam under 0.5 N, and the ``contact``; metres."""
+    """``xs, ys`` (n,), rest heights ``z`` (n, n), noisy ``points`` (n², 3) of the Hertz dent of a
+    60 N foam under 0.5 N, and the ``contact``; metres."""
     xs = 0.30 + (np.arange(n) - (n - 1) / 2) * _SPACING_M
     ys = 0.20 + (np.arange(n) - (n - 1) / 2) * _SPACING_M
     z = np.full((n, n), 0.05)

@@ -2,46 +2,31 @@
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from typing import Any
 
 import numpy as np
 
-from deformap.explore import ExplorationConfig
+from deformap.explore import ExplorationConfig, Mapper
+from deformap.world import SimulatedWorld, WorldConfig, load_scenario
 
 __all__ = ["bench_world"]
 
 
+N_PRESSES = 3
+"""Presses timed (the median reported)."""
+
+
 def bench_world(*, scenario: str = "heterogeneous-60-110-rigid", rng: np.random.Generator,
-                config: Any = None, n_presses: int = 3,
-                force_n: float = ExplorationConfig().force_n) -> dict[str, Any]:
-    """Time one world at its default mesh (goals: build ≤ 20 s, press ≤ 1 s, observe ≤ 0.5 s)
-    and one poke's compute on its presses (goal ≤ 1 s).
-
-    Parameters
-    ----------
-    scenario : str
-        Built-in name or YAML path.
-    rng : numpy.random.Generator
-    config : WorldConfig, optional
-        Defaults to ``WorldConfig()`` (the default mesh).
-    n_presses : int
-        Presses timed (median reported) at points spread over the workspace.
-    force_n : float
-        Their force (default: the exploration's).
-
-    Returns
-    -------
-    dict with ``construction_s``, ``press_s``, ``observe_s`` (medians, seconds), ``n_dofs``,
-    ``n_points`` and ``n_points_on_area`` of one observation, ``scenario``, ``element_size_m``,
-    ``press_load_by_load_s`` (the same presses with the linear FEM solving each load as it comes
-    instead of the unit responses under the tip: the baseline of ``press_s``; None for a physics
-    without them),
-    ``poke_compute_s`` (median compute of one poke with its force–travel record: goal ≤ 1 s) and
-    ``poke_compute_camera_only_s`` (the same presses without records, the baseline).
+                config: Any = None) -> dict[str, Any]:
+    """Time one world of ``scenario`` (``config``, default ``WorldConfig()``) and one poke's
+    compute on :data:`N_PRESSES` of its presses with the exploration's force: ``construction_s``,
+    ``press_s``, ``observe_s`` (medians, seconds), ``n_dofs``, ``n_points`` and
+    ``n_points_on_area`` of one observation, ``scenario``, ``element_size_m``,
+    ``press_load_by_load_s`` (the linear FEM solving each load as it comes, the baseline; None
+    for another physics), ``poke_compute_s`` and ``poke_compute_camera_only_s`` (its baseline).
     """
-    from deformap.world import SimulatedWorld, WorldConfig, load_scenario
-
     cfg = config or WorldConfig()
     sc = load_scenario(scenario)
     t0 = time.perf_counter()
@@ -52,31 +37,25 @@ def bench_world(*, scenario: str = "heterogeneous-60-110-rigid", rng: np.random.
         t0 = time.perf_counter()
         cloud = world.observe()
         observe_times.append(time.perf_counter() - t0)
-    presses, press_times = _timed_presses(world, n_presses, force_n)
-    load_by_load = _press_load_by_load(world, n_presses, force_n)
+    presses, press_times = _timed_presses(world)
+    load_by_load = _press_load_by_load(world)
     with_record, camera_only = _poke_compute(sc.workspace, cloud, presses, rng)
     return {
-        "scenario": sc.name,
-        "element_size_m": cfg.element_size_m,
-        "construction_s": construction,
-        "press_s": float(np.median(press_times)),
-        "press_load_by_load_s": load_by_load,
-        "observe_s": float(np.median(observe_times)),
-        "n_dofs": world.n_dofs,
+        "scenario": sc.name, "element_size_m": cfg.element_size_m, "construction_s": construction,
+        "press_s": float(np.median(press_times)), "press_load_by_load_s": load_by_load,
+        "observe_s": float(np.median(observe_times)), "n_dofs": world.n_dofs,
         "n_points": len(cloud),
         "n_points_on_area": int(np.count_nonzero(sc.workspace.contains(cloud.xy))),
-        "poke_compute_s": with_record,
-        "poke_compute_camera_only_s": camera_only,
-    }
+        "poke_compute_s": with_record, "poke_compute_camera_only_s": camera_only,
+    }  # fmt: skip
 
 
-def _timed_presses(world: Any, n_presses: int, force_n: float
-                   ) -> tuple[list[Any], list[float]]:
-    """The bench's presses (spread along the workspace's middle, each released) and their
-    times."""
+def _timed_presses(world: Any) -> tuple[list[Any], list[float]]:
+    """The presses (along the workspace's middle, each released) and their times."""
     (x0, y0), (x1, y1) = world.workspace.lower, world.workspace.upper
+    force_n = ExplorationConfig().force_n
     presses, times = [], []
-    for f in np.linspace(0.2, 0.8, n_presses):
+    for f in np.linspace(0.2, 0.8, N_PRESSES):
         t0 = time.perf_counter()
         presses.append(world.press((x0 + f * (x1 - x0), y0 + 0.5 * (y1 - y0)), force_n))
         times.append(time.perf_counter() - t0)
@@ -84,29 +63,22 @@ def _timed_presses(world: Any, n_presses: int, force_n: float
     return presses, times
 
 
-def _press_load_by_load(world: Any, n_presses: int, force_n: float) -> float | None:
-    """Median press of the same presses with the FEM's unit responses off (the baseline); None
-    where the physics does not solve by them (the stiffening physics)."""
+def _press_load_by_load(world: Any) -> float | None:
+    """Median press with the FEM's unit responses off; None for a physics without them."""
     foam = world.foam
     if world.config.physics != "linear-fem":
         return None
     kept, foam.max_unit_columns = foam.max_unit_columns, 0
     try:
-        return float(np.median(_timed_presses(world, n_presses, force_n)[1]))
+        return float(np.median(_timed_presses(world)[1]))
     finally:
         foam.max_unit_columns = kept
 
 
 def _poke_compute(workspace: Any, cloud: Any, presses: list[Any], rng: np.random.Generator
                   ) -> tuple[float, float]:
-    """Median compute of one poke (dent, β and its uncertainty, the force–travel reading, the
-    map field updated; under the modulus field the β-field waits for its first use) on the
-    world's presses, with their records and, as the baseline, the same presses without them
-    (the camera-only estimate, mapped on the β-field)."""
-    import dataclasses
-
-    from deformap.explore import Mapper
-
+    """Median compute of one poke (dent, β, the force–travel reading, the map field updated) on
+    the presses, with their records and, the baseline, without them (mapped on the β-field)."""
     medians = []
     for keep_record in (True, False):
         # without records the map is on β (no fallback warning in a benchmark's output)

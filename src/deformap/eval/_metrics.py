@@ -1,30 +1,23 @@
 """How good a β-field is, against a world's ground truth.
 
-Region metrics compare a predicted label map with the true one after the best one-to-one matching
-of labels (the Hungarian algorithm on the overlap counts), so label numbering does not matter:
+:func:`region_scores` compares a predicted label map with the true one after the best one-to-one
+matching of labels (the Hungarian algorithm on the overlap counts):
 
-- ``accuracy``: share of cells whose predicted label, once matched, equals the true one (cells of an
-  unmatched label count as wrong);
-- ``mean_iou``: intersection over union of each true region with its matched prediction, averaged
-  over the true regions (an unmatched true region scores 0);
-- ``kendall_tau``: rank agreement between the mean estimated β over each true region and that
-  region's softness (1 / hardness; a rigid region has softness 0): softer must mean higher β. It is
-  undefined (``None``) for fewer than two regions. It judges the field, not the regions the map
-  reports: a map whose two regions merged into one can still order the field's means right.
+- ``accuracy``: share of cells whose matched predicted label is the true one (an unmatched label's
+  cells count as wrong);
+- ``mean_iou``: intersection over union of each true region with its match, averaged over the true
+  regions (an unmatched one scores 0);
+- ``kendall_tau``: rank agreement between the field's mean β over each true region and its
+  softness (1 / hardness; rigid: 0), ``None`` for fewer than two regions; it judges the field,
+  not the regions the map reports.
 
-What the map reports is judged by :func:`ordering_scores`:
+:func:`ordering_scores` judges what the map reports, as concordances (Harrell's C; Kendall's τ-b
+would count two pokes on one material as a tie and read below 1 for a perfect order):
 
-- ``order_regions``: over the pairs of *found* regions that lie on materials of different
-  softness (the material under most of a region's cells), the share whose values (class βs) are
-  ordered as the softness is (a tie in value counts half): 1 when the map orders what it found,
-  0.5 as by chance, 0 reversed; ``None`` without such a pair (a merged map is credited with no
-  order);
-- ``order_pokes``: the same over the pairs of pokes on materials of different softness, each
-  poke's own reading against the material under it.
-
-These are concordances (Harrell's C) rather than Kendall's τ: τ-b counts pairs on one material
-as ties and so reads below 1 for a perfectly ordered set of pokes whenever two pokes share a
-material.
+- ``order_regions``: over the pairs of found regions on materials of different softness (the
+  material under most of a region), the share whose values are ordered as the softness (a tie
+  counts half): 1 ordered, 0.5 as by chance, 0 reversed; ``None`` without such a pair;
+- ``order_pokes``: the same over the pairs of pokes, each reading against the material under it.
 """
 
 from __future__ import annotations
@@ -57,34 +50,18 @@ class RegionScores:
         return asdict(self)
 
 
-def region_scores(
-    predicted: NDArray[np.integer],
-    truth: NDArray[np.integer],
-    beta_grid: NDArray[np.float64],
-    true_hardness: dict[int, float],
-    *,
-    valid: NDArray[np.bool_] | None = None,
-) -> RegionScores:
-    """Score a predicted region map against the truth.
-
-    Parameters
-    ----------
-    predicted, truth : (ny, nx) int
-        Label maps on the same grid.
-    beta_grid : (ny, nx) float
-        The estimated β-field's mean on that grid.
-    true_hardness : dict
-        Hardness in newtons of each true label; ``math.inf`` for a rigid region.
-    valid : (ny, nx) bool, optional
-        Cells to score (default: all).
-    """
+def region_scores(predicted: NDArray[np.integer], truth: NDArray[np.integer],
+                  beta_grid: NDArray[np.float64], true_hardness: dict[int, float], *,
+                  valid: NDArray[np.bool_] | None = None) -> RegionScores:
+    """Score a predicted region map against the truth: ``predicted`` and ``truth`` (ny, nx) int
+    label maps, ``beta_grid`` (ny, nx) the β-field's mean, ``true_hardness`` each true label's
+    hardness in newtons (``math.inf``: rigid), ``valid`` (ny, nx) bool the cells scored (all)."""
     pred = np.asarray(predicted)
     true = np.asarray(truth)
     beta = check_array("beta_grid", beta_grid, pred.shape)
     if true.shape != pred.shape:
         raise InvalidArgumentError(
-            f"`truth` must have the shape of `predicted` {pred.shape}; got {true.shape}"
-        )
+            f"`truth` must have the shape of `predicted` {pred.shape}; got {true.shape}")
     mask = np.ones(pred.shape, bool) if valid is None else np.asarray(valid, bool)
     p, t, b = pred[mask], true[mask], beta[mask]
     if p.size == 0:
@@ -107,13 +84,8 @@ def region_scores(
         softness = np.array([1.0 / true_hardness[int(label)] for label in t_labels])
         value = kendalltau(mean_beta, softness).statistic
         tau = None if np.isnan(value) else float(value)
-    return RegionScores(
-        found=int(p_labels.size),
-        true=int(t_labels.size),
-        accuracy=accuracy,
-        mean_iou=float(ious.mean()),
-        kendall_tau=tau,
-    )
+    return RegionScores(found=int(p_labels.size), true=int(t_labels.size), accuracy=accuracy,
+                        mean_iou=float(ious.mean()), kendall_tau=tau)
 
 
 @dataclass(frozen=True)
@@ -139,31 +111,14 @@ def _concordance(values: NDArray[np.float64], softness: NDArray[np.float64]) -> 
     return float(np.mean(np.where(agree > 0, 1.0, np.where(agree == 0, 0.5, 0.0))))
 
 
-def ordering_scores(
-    found: NDArray[np.integer],
-    class_values: NDArray[np.float64],
-    truth: NDArray[np.integer],
-    true_hardness: dict[int, float],
-    poke_values: NDArray[np.float64],
-    poke_truth: NDArray[np.integer],
-) -> OrderingScores:
-    """Score the order of what a map reports against the materials' softness.
-
-    Parameters
-    ----------
-    found : (ny, nx) int
-        The map's region labels, each an index into ``class_values``.
-    class_values : (k,) float
-        The value the map reports for each region (the class β).
-    truth : (ny, nx) int
-        The true labels on the same grid.
-    true_hardness : dict
-        Hardness in newtons of each true label; ``math.inf`` for a rigid region.
-    poke_values : (p,) float
-        Each poke's reading.
-    poke_truth : (p,) int
-        The true label under each poke.
-    """
+def ordering_scores(found: NDArray[np.integer], class_values: NDArray[np.float64],
+                    truth: NDArray[np.integer], true_hardness: dict[int, float],
+                    poke_values: NDArray[np.float64], poke_truth: NDArray[np.integer],
+                    ) -> OrderingScores:
+    """Score the order of what a map reports against the materials' softness: ``found`` (ny, nx)
+    int region labels indexing ``class_values`` (k,) (each region's reported value), ``truth``
+    (ny, nx) int and ``true_hardness`` as for :func:`region_scores`, ``poke_values`` (p,) each
+    poke's reading and ``poke_truth`` (p,) int the true label under it."""
     labels = np.asarray(found)
     true = np.asarray(truth)
     values = check_array("class_values", class_values, (None,))
@@ -171,17 +126,14 @@ def ordering_scores(
     under = np.asarray(poke_truth).reshape(-1)
     if true.shape != labels.shape:
         raise InvalidArgumentError(
-            f"`truth` must have the shape of `found` {labels.shape}; got {true.shape}"
-        )
+            f"`truth` must have the shape of `found` {labels.shape}; got {true.shape}")
     if under.size != readings.size:
         raise InvalidArgumentError(
-            f"`poke_truth` must have one label per poke ({readings.size}); got {under.size}"
-        )
+            f"`poke_truth` must have one label per poke ({readings.size}); got {under.size}")
     if labels.size and (labels.min() < 0 or labels.max() >= values.size):
         raise InvalidArgumentError(
             f"`found` must hold indices into `class_values` (0 to {values.size - 1}); got "
-            f"{int(labels.min())} to {int(labels.max())}"
-        )
+            f"{int(labels.min())} to {int(labels.max())}")
     missing = sorted((set(np.unique(true).tolist()) | set(under.tolist())) - set(true_hardness))
     if missing:
         raise InvalidArgumentError(f"`true_hardness` lacks the true label(s) {missing}")

@@ -1,9 +1,6 @@
-"""Studies on homogeneous simulated foams: β against hardness (the paper's Fig. 5a) and the fit error
-against cluster size (its Fig. 5b).
-
-Each foam is a homogeneous block over the whole workspace, pressed at a few fixed places with the
-same force; every protocol and cluster size is evaluated on the *same* presses, so differences come
-from the estimator alone.
+"""Studies on homogeneous simulated foams: β against hardness (the paper's Fig. 5a) and the fit
+error against cluster size (its Fig. 5b). Each foam, a block over the whole workspace, is pressed
+at a few fixed places; every protocol and cluster size reads the *same* presses.
 """
 
 from __future__ import annotations
@@ -24,18 +21,9 @@ from deformap.msm import ShapeMatchingConfig
 from deformap.world import Block, Scenario, SimulatedWorld, WorldConfig
 
 __all__ = [
-    "DEFAULT_HARDNESSES",
-    "DEFAULT_POSITIONS",
-    "DEFAULT_PROTOCOL",
-    "PAPER_PROTOCOL",
-    "PROTOCOLS",
-    "STUDY_PROTOCOLS",
-    "FoamPresses",
-    "block_scenario",
-    "cluster_size_study",
-    "collect_presses",
-    "hardness_study",
-    "hardness_summary",
+    "DEFAULT_HARDNESSES", "DEFAULT_POSITIONS", "DEFAULT_PROTOCOL", "PAPER_PROTOCOL", "PROTOCOLS",
+    "STUDY_PROTOCOLS", "FoamPresses", "block_scenario", "cluster_size_study", "collect_presses",
+    "hardness_study", "hardness_summary",
 ]
 
 logger = logging.getLogger(__name__)
@@ -55,16 +43,13 @@ PROTOCOLS: dict[str, dict[str, Any]] = {
 """The contact protocols compared (see :mod:`deformap.msm`)."""
 
 DEFAULT_PROTOCOL = "force/quadratic"
-"""The protocol of :class:`~deformap.msm.ShapeMatchingConfig`'s defaults, whose rows the summary
-reads."""
+"""The protocol of :class:`~deformap.msm.ShapeMatchingConfig`'s defaults (the summary's rows)."""
 
 PAPER_PROTOCOL = "pinned/quadratic"
-"""The paper's protocol (Caccamo et al.: the particle under the tip pinned at the observed dent),
-reported beside the default."""
+"""The paper's protocol (Caccamo et al.: the particle under the tip pinned at the observed dent)."""
 
 STUDY_PROTOCOLS: tuple[str, ...] = (DEFAULT_PROTOCOL, PAPER_PROTOCOL)
-"""The protocols a hardness study runs unless asked for others: the default and the paper's (the
-linear-mode variants on request; each protocol is one β fit per press)."""
+"""The protocols a hardness study runs unless asked for others (each is one β fit per press)."""
 
 CONDITION_KEYS = ("camera", "thickness_m", "physics", "force_n")
 """The keys of a row that name its condition (one combination of a study's matrix)."""
@@ -72,9 +57,8 @@ CONDITION_KEYS = ("camera", "thickness_m", "physics", "force_n")
 
 @dataclass
 class FoamPresses:
-    """One homogeneous foam: the mapper with its surface model and the presses made on it;
-    ``refused`` the world's reason when it refused to press this foam with that force (then
-    ``presses`` is empty)."""
+    """One homogeneous foam: the mapper with its surface model and the presses made on it, or
+    none and the world's reason it ``refused`` to press the foam."""
 
     hardness_n: float | None
     mapper: Mapper
@@ -100,31 +84,22 @@ def block_scenario(hardness_n: float | None, workspace: Workspace,
 
 
 def collect_presses(
-    hardnesses: Sequence[float | None] = DEFAULT_HARDNESSES,
-    *,
-    world_config: WorldConfig | None = None,
-    config: ExplorationConfig | None = None,
-    positions: Sequence[tuple[float, float]] = DEFAULT_POSITIONS,
-    rng: np.random.Generator,
-    progress: Callable[[str], None] | None = None,
-    thickness_m: float = 0.05,
-) -> list[FoamPresses]:
+    hardnesses: Sequence[float | None] = DEFAULT_HARDNESSES, *,
+    world_config: WorldConfig | None = None, config: ExplorationConfig | None = None,
+    positions: Sequence[tuple[float, float]] = DEFAULT_POSITIONS, rng: np.random.Generator,
+    progress: Callable[[str], None] | None = None, thickness_m: float = 0.05,
+) -> list[FoamPresses]:  # fmt: skip
     """Build one world per foam (a block ``thickness_m`` thick over the workspace), observe it,
-    and press it at ``positions`` with the configuration's ``force_n``.
-
-    A foam the world refuses to press with that force (the tip would sink as deep as the block,
-    :class:`~deformap.errors.InvalidArgumentError`) is kept with no presses and the world's
-    reason in ``refused``: the study goes on with the other foams."""
+    and press it at ``positions`` with the configuration's ``force_n``. A foam the world refuses
+    to press with that force is kept with no presses and the world's reason in ``refused``."""
     world_config = world_config or WorldConfig()
     config = config or ExplorationConfig()
     streams = rng.spawn(len(hardnesses))
     out = []
     for hardness, stream in zip(hardnesses, streams, strict=True):
         world_rng, fit_rng = stream.spawn(2)
-        world = SimulatedWorld(
-            block_scenario(hardness, Workspace(), thickness_m), config=world_config,
-            rng=world_rng,
-        )
+        world = SimulatedWorld(block_scenario(hardness, Workspace(), thickness_m),
+                               config=world_config, rng=world_rng)
         mapper = Mapper(world.workspace, config)
         mapper.initialise(world.observe(), fit_rng)
         presses: list[PressObservation] = []
@@ -156,22 +131,19 @@ def _betas(foam: FoamPresses, shape_matching: ShapeMatchingConfig) -> list[PokeR
 
 def _summary(records: list[PokeRecord]) -> dict[str, float]:
     betas = np.array([r.beta for r in records])
-    return {
-        "beta": float(betas.mean()),
-        "beta_std": float(betas.std(ddof=1)) if betas.size > 1 else float("nan"),
-        "beta_estimate_std": float(np.mean([r.beta_std for r in records])),
-        "fit_error_m": float(np.mean([min(r.errors) for r in records])),
-        "iterations": int(max(r.iterations for r in records)),
-        "converged": bool(all(r.converged for r in records)),
-    }
+    return {"beta": float(betas.mean()),
+            "beta_std": float(betas.std(ddof=1)) if betas.size > 1 else float("nan"),
+            "beta_estimate_std": float(np.mean([r.beta_std for r in records])),
+            "fit_error_m": float(np.mean([min(r.errors) for r in records])),
+            "iterations": int(max(r.iterations for r in records)),
+            "converged": bool(all(r.converged for r in records))}
 
 
 def _stiffness_summary(records: list[PokeRecord], true_modulus_pa: float | None
                        ) -> dict[str, Any]:
-    """What the presses' force–travel records read: the mean stiffness and Young's modulus over
-    the presses that gave one, the mean claimed σ of E, its spread between places, the world's
-    true modulus and E's relative error; ``rigid`` when every press was read rigid, ``n_rigid``
-    how many were (a foam some of whose presses read rigid is not averaged over silently)."""
+    """The force–travel readings: means over the presses that gave a modulus, their spread, the
+    true E and the relative errors; ``rigid`` when every press read rigid, ``n_rigid`` how many
+    did; ``moduli_pa``, ``modulus_stds_pa`` and ``modulus_rel_errors`` per press (None: none)."""
     estimates = [r.stiffness for r in records]
     read = [s for s in estimates if s is not None and not s.rigid and s.modulus_pa is not None]
     moduli = np.array([s.modulus_pa for s in read], dtype=float)
@@ -184,7 +156,6 @@ def _stiffness_summary(records: list[PokeRecord], true_modulus_pa: float | None
         "modulus_spread_pa": float(moduli.std(ddof=1)) if moduli.size > 1 else None,
         "true_modulus_pa": true_modulus_pa,
         "modulus_rel_error": None,
-        # per press, in the order of the places (None: no modulus read there)
         "moduli_pa": [_read(s, "modulus_pa") for s in estimates],
         "modulus_stds_pa": [_read(s, "modulus_std_pa") for s in estimates],
         "modulus_rel_errors": [None] * len(estimates),
@@ -204,8 +175,12 @@ def _read(estimate: Any, key: str) -> float | None:
     return None if value is None else float(value)
 
 
-def _refused_row(foam: FoamPresses) -> dict[str, Any]:
-    """The row of a foam the world refused to press: its reason and no values."""
+def _foam_row(foam: FoamPresses, shape_matching: ShapeMatchingConfig) -> dict[str, Any]:
+    """One foam's values under one protocol; a refused foam's row has its reason and none."""
+    if foam.refused is None:
+        records = _betas(foam, shape_matching)
+        return {**_summary(records), **_stiffness_summary(records, foam.true_modulus_pa),
+                "refused": None}
     keys = ("beta", "beta_std", "beta_estimate_std", "fit_error_m", "iterations", "converged",
             "stiffness_n_per_m", "modulus_pa", "modulus_std_pa", "modulus_spread_pa",
             "modulus_rel_error", "rigid", "n_rigid")  # fmt: skip
@@ -213,12 +188,8 @@ def _refused_row(foam: FoamPresses) -> dict[str, Any]:
             "modulus_stds_pa": [], "modulus_rel_errors": [], "refused": foam.refused}
 
 
-def hardness_study(
-    foams: list[FoamPresses],
-    *,
-    base: ShapeMatchingConfig | None = None,
-    protocols: dict[str, dict[str, Any]] = PROTOCOLS,
-) -> dict[str, Any]:
+def hardness_study(foams: list[FoamPresses], *,
+                   protocols: dict[str, dict[str, Any]] = PROTOCOLS) -> dict[str, Any]:
     """β against hardness for each protocol: ``{"rows": [...], "monotone": {protocol: bool},
     "modulus_monotone": bool | None, "n_refused": int}``.
 
@@ -226,21 +197,12 @@ def hardness_study(
     board (if present) below every foam. A foam the world refused to press has a row with
     ``refused`` (the reason) and null values, and is left out of both monotone checks.
     """
-    base = base or ShapeMatchingConfig()
     rows = []
     monotone = {}
     for name, settings in protocols.items():
-        cfg = dataclasses.replace(base, **settings)
-        proto_rows = []
-        for foam in foams:
-            if foam.refused is not None:
-                proto_rows.append({"protocol": name, "hardness_n": foam.hardness_n,
-                                   **_refused_row(foam)})  # fmt: skip
-                continue
-            records = _betas(foam, cfg)
-            row = {"protocol": name, "hardness_n": foam.hardness_n, **_summary(records),
-                   **_stiffness_summary(records, foam.true_modulus_pa), "refused": None}  # fmt: skip
-            proto_rows.append(row)
+        cfg = ShapeMatchingConfig(**settings)
+        proto_rows = [{"protocol": name, "hardness_n": foam.hardness_n, **_foam_row(foam, cfg)}
+                      for foam in foams]
         rows.extend(proto_rows)
         monotone[name] = _beta_monotone(proto_rows)
     return {"rows": rows, "monotone": monotone, "modulus_monotone": _modulus_monotone(rows),
@@ -255,15 +217,14 @@ def _by_hardness(rows: Any) -> list[dict[str, Any]]:
 
 def _beta_monotone(rows: list[dict[str, Any]]) -> bool:
     """β strictly falls as hardness rises over one protocol's rows, the rigid board lowest
-    (refused foams left out); fewer than two surfaces read is no order shown (False)."""
+    (refused foams left out; fewer than two is False)."""
     betas = [r["beta"] for r in _by_hardness(rows)]
     return len(betas) >= 2 and bool(np.all(np.diff(betas) < 0))
 
 
 def _modulus_monotone(rows: list[dict[str, Any]]) -> bool | None:
-    """Whether the force–travel records order the foams: E strictly rises with hardness and a
-    rigid board is read rigid (``None`` when the presses had no records); refused foams are left
-    out."""
+    """E strictly rises with hardness and a rigid board reads rigid (refused foams left out);
+    ``None`` when the presses had no records."""
     first = rows[0]["protocol"] if rows else None
     own = _by_hardness(r for r in rows if r["protocol"] == first)
     if not own or all(r["modulus_pa"] is None and not r["rigid"] for r in own):
@@ -276,88 +237,63 @@ def _modulus_monotone(rows: list[dict[str, Any]]) -> bool | None:
     return bool(np.all(np.diff(moduli) > 0) and rigid_ok)
 
 
-def cluster_size_study(
-    foams: list[FoamPresses],
-    *,
-    sizes: Sequence[int] = (2, 3, 4, 5, 6),
-    base: ShapeMatchingConfig | None = None,
-) -> dict[str, Any]:
+def cluster_size_study(foams: list[FoamPresses], *, sizes: Sequence[int] = (2, 3, 4, 5, 6)
+                       ) -> dict[str, Any]:
     """Fit error min E(β) and β against the cluster size k×k (default protocol), per foam."""
-    base = base or ShapeMatchingConfig()
-    rows = []
-    for k in sizes:
-        cfg = dataclasses.replace(base, cluster_size=k)
-        for foam in foams:
-            rows.append(
-                {"cluster_size": k, "hardness_n": foam.hardness_n, **_summary(_betas(foam, cfg))}
-            )
-    return {"rows": rows}
+    return {"rows": [{"cluster_size": k, "hardness_n": foam.hardness_n,
+                      **_summary(_betas(foam, ShapeMatchingConfig(cluster_size=k)))}
+                     for k in sizes for foam in foams]}
 
 
 def hardness_summary(rows: list[dict[str, Any]]) -> dict[str, Any]:
-    """What a hardness study's rows say, per condition and per physics.
-
-    Reads the rows of :data:`DEFAULT_PROTOCOL` (the first protocol when the rows have none of
-    it), grouped by their condition (:data:`CONDITION_KEYS`, absent keys read None).
-
-    Returns
-    -------
-    dict
-        ``{"summary": [...], "overall": [...]}``. Each ``summary`` entry names its condition and
-        gives, over the foam presses (not the foam means): ``n_presses``, ``n_unread`` (foam
-        presses that gave no modulus), ``modulus_median_abs_rel_error`` (median of |E − E_true| /
-        E_true over the presses read), ``modulus_within_2sigma`` (the fraction of all foam
-        presses with |E − E_true| ≤ 2σ as claimed; an unread press counts outside),
-        ``modulus_monotone`` (E strictly rises with hardness and the rigid board reads rigid),
-        ``beta_monotone`` (β strictly falls as hardness rises, rigid lowest),
-        ``beta_claimed_std`` and ``beta_spread`` (means over the foams of β's claimed σ and of
-        its standard deviation between places) and ``n_refused`` (foams the world refused to
-        press, left out of the rest). Each ``overall`` entry does the same per physics over its
-        conditions: ``modulus_median_abs_rel_error``, ``modulus_within_2sigma``,
-        ``modulus_monotone`` and ``beta_monotone`` (in every condition), ``n_refused``.
-    """
+    """What a hardness study's rows of :data:`DEFAULT_PROTOCOL` (else the first) say, grouped by
+    condition (:data:`CONDITION_KEYS`): ``{"summary": [...], "overall": [...]}``, per condition,
+    over the foam presses, ``n_presses``, ``n_unread`` (no modulus),
+    ``modulus_median_abs_rel_error`` (median |E − E_true| / E_true of the presses read),
+    ``modulus_within_2sigma`` (fraction of all presses within 2 claimed σ; unread counts out),
+    ``modulus_monotone``, ``beta_monotone``, ``beta_claimed_std`` and ``beta_spread`` (means over
+    the foams) and ``n_refused``; per physics the same over its conditions (monotone: in all)."""
     protocols = list(dict.fromkeys(r["protocol"] for r in rows))
     protocol = DEFAULT_PROTOCOL if DEFAULT_PROTOCOL in protocols else protocols[0] if rows else None
-    own = [r for r in rows if r["protocol"] == protocol]
     groups: dict[tuple[Any, ...], list[dict[str, Any]]] = {}
-    for row in own:
-        groups.setdefault(tuple(row.get(k) for k in CONDITION_KEYS), []).append(row)
-    summary = []
-    for condition, group in groups.items():
-        errors, covered, n_presses = _press_errors(group)
-        foams = [r for r in group if r["hardness_n"] is not None and not r.get("refused")]
-        summary.append({
-            **dict(zip(CONDITION_KEYS, condition, strict=True)),
-            "n_presses": n_presses,
-            "n_unread": n_presses - len(errors),
-            "modulus_median_abs_rel_error": _median_abs(errors),
-            "modulus_within_2sigma": _fraction(covered, n_presses),
-            "modulus_monotone": _modulus_monotone(group),
-            "beta_monotone": _beta_monotone(group),
-            "beta_claimed_std": _mean([r["beta_estimate_std"] for r in foams]),
-            "beta_spread": _mean([r["beta_std"] for r in foams]),
-            "n_refused": sum(bool(r.get("refused")) for r in group),
-            "_errors": errors, "_covered": covered,
-        })  # fmt: skip
-    overall = []
-    for physics in dict.fromkeys(s["physics"] for s in summary):
-        mine = [s for s in summary if s["physics"] == physics]
-        errors = [e for s in mine for e in s["_errors"]]
-        n_presses = sum(s["n_presses"] for s in mine)
-        overall.append({
-            "physics": physics,
-            "n_conditions": len(mine),
-            "n_presses": n_presses,
-            "n_unread": sum(s["n_unread"] for s in mine),
-            "modulus_median_abs_rel_error": _median_abs(errors),
-            "modulus_within_2sigma": _fraction(sum(s["_covered"] for s in mine), n_presses),
-            "modulus_monotone": all(s["modulus_monotone"] is True for s in mine),
-            "beta_monotone": all(s["beta_monotone"] for s in mine),
-            "n_refused": sum(s["n_refused"] for s in mine),
-        })  # fmt: skip
+    for row in rows:
+        if row["protocol"] == protocol:
+            groups.setdefault(tuple(row.get(k) for k in CONDITION_KEYS), []).append(row)
+    summary = [_condition_summary(condition, group) for condition, group in groups.items()]
+    overall = [_physics_summary(physics, [s for s in summary if s["physics"] == physics])
+               for physics in dict.fromkeys(s["physics"] for s in summary)]
     for s in summary:
         del s["_errors"], s["_covered"]
     return {"summary": summary, "overall": overall}
+
+
+def _condition_summary(condition: tuple[Any, ...], group: list[dict[str, Any]]) -> dict[str, Any]:
+    errors, covered, n_presses = _press_errors(group)
+    foams = [r for r in group if r["hardness_n"] is not None and not r.get("refused")]
+    return {
+        **dict(zip(CONDITION_KEYS, condition, strict=True)),
+        "n_presses": n_presses, "n_unread": n_presses - len(errors),
+        "modulus_median_abs_rel_error": _median_abs(errors),
+        "modulus_within_2sigma": _fraction(covered, n_presses),
+        "modulus_monotone": _modulus_monotone(group), "beta_monotone": _beta_monotone(group),
+        "beta_claimed_std": _mean([r["beta_estimate_std"] for r in foams]),
+        "beta_spread": _mean([r["beta_std"] for r in foams]),
+        "n_refused": sum(bool(r.get("refused")) for r in group),
+        "_errors": errors, "_covered": covered,
+    }  # fmt: skip
+
+
+def _physics_summary(physics: Any, mine: list[dict[str, Any]]) -> dict[str, Any]:
+    n_presses = sum(s["n_presses"] for s in mine)
+    return {
+        "physics": physics, "n_conditions": len(mine), "n_presses": n_presses,
+        "n_unread": sum(s["n_unread"] for s in mine),
+        "modulus_median_abs_rel_error": _median_abs([e for s in mine for e in s["_errors"]]),
+        "modulus_within_2sigma": _fraction(sum(s["_covered"] for s in mine), n_presses),
+        "modulus_monotone": all(s["modulus_monotone"] is True for s in mine),
+        "beta_monotone": all(s["beta_monotone"] for s in mine),
+        "n_refused": sum(s["n_refused"] for s in mine),
+    }  # fmt: skip
 
 
 def _press_errors(rows: list[dict[str, Any]]) -> tuple[list[float], int, int]:

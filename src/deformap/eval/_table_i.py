@@ -1,9 +1,5 @@
-"""The paper's Table I and the reproduction table beside it.
-
-The table puts the paper's columns (interactions, T_h, β-regions) beside what a run measured
-(pokes, regions found, region accuracy, mean IoU, Kendall τ, wall time with the world's simulation).
-The runs themselves are made by :func:`deformap.run.reproduce`; this module holds the paper's
-numbers, one row from one run's report, and the markdown.
+"""The paper's Table I (interactions, T_h, β-regions) and the reproduction table beside it: one
+row from one run's report, and the markdown (the runs are :func:`deformap.run.reproduce`'s).
 """
 
 from __future__ import annotations
@@ -24,51 +20,31 @@ PAPER_TABLE_I: dict[str, dict[str, Any]] = {
 
 
 def table_row(scenario: str, report: dict[str, Any], *, threshold: float) -> dict[str, Any]:
-    """One row of the reproduction table from a live run's ``report.json`` content.
-
-    Parameters
-    ----------
-    scenario : str
-    report : dict
-        A live run's report (ground-truth scores present).
-    threshold : float
-        The run's T_h.
-    """
+    """One row of the reproduction table from a live run's ``report`` (its T_h ``threshold``)."""
     reg, t = report["regions"], report["timings"]
     return {
-        "scenario": scenario,
-        "paper": PAPER_TABLE_I.get(scenario),
-        "pokes": report["n_pokes"],
-        "threshold": threshold,
-        "stop_reason": report["stop_reason"],
-        "regions_found": reg["found"],
-        "regions_true": reg["true"],
-        "accuracy": reg["accuracy"],
-        "mean_iou": reg["mean_iou"],
-        "kendall_tau": reg["kendall_tau"],
+        "scenario": scenario, "paper": PAPER_TABLE_I.get(scenario), "pokes": report["n_pokes"],
+        "threshold": threshold, "stop_reason": report["stop_reason"],
+        "regions_found": reg["found"], "regions_true": reg["true"], "accuracy": reg["accuracy"],
+        "mean_iou": reg["mean_iou"], "kendall_tau": reg["kendall_tau"],
         "time_s": t["total_s"] + t["world_build_s"],
         "max_compute_per_poke_s": max(t["per_poke_compute_s"], default=0.0),
-    }
+    }  # fmt: skip
 
 
 def markdown_table(result: dict[str, Any]) -> str:
     """The reproduction table in markdown (``result``: ``{"seed", "strategy", "rows"}``)."""
-    head = (
-        "| scenario | paper: pokes | paper: T_h | paper: regions | pokes | regions found / true "
-        "| region accuracy | mean IoU | Kendall τ | time [s] |\n"
-        "|---|---|---|---|---|---|---|---|---|---|\n"
-    )
+    head = ("| scenario | paper: pokes | paper: T_h | paper: regions | pokes "
+            "| regions found / true | region accuracy | mean IoU | Kendall τ | time [s] |\n"
+            "|---|---|---|---|---|---|---|---|---|---|\n")
     lines = []
     for r in result["rows"]:
         paper = r["paper"] or {"interactions": "–", "threshold": "–", "regions": "–"}
         tau = "–" if r["kendall_tau"] is None else f"{r['kendall_tau']:.2f}"
-        lines.append(
-            f"| {r['scenario']} | {paper['interactions']} | {paper['threshold']} "
-            f"| {paper['regions']} | {r['pokes']} | {r['regions_found']} / {r['regions_true']} "
-            f"| {r['accuracy']:.3f} | {r['mean_iou']:.3f} | {tau} | {r['time_s']:.1f} |"
-        )
-    note = (
-        f"\nSeed {result['seed']}, strategy `{result['strategy']}`; time includes building "
-        "the simulated world (FEM factorisation) and its presses.\n"
-    )
+        lines.append(f"| {r['scenario']} | {paper['interactions']} | {paper['threshold']} "
+                     f"| {paper['regions']} | {r['pokes']} | {r['regions_found']} / "
+                     f"{r['regions_true']} | {r['accuracy']:.3f} | {r['mean_iou']:.3f} | {tau} "
+                     f"| {r['time_s']:.1f} |")
+    note = (f"\nSeed {result['seed']}, strategy `{result['strategy']}`; time includes building "
+            "the simulated world (FEM factorisation) and its presses.\n")
     return head + "\n".join(lines) + "\n" + note

@@ -1,29 +1,9 @@
-"""The application layer: a run's configuration, its folder, its report, and the workflows.
+"""The application layer: a run's configuration (:class:`RunConfig`), its folder, its report,
+the progress callbacks (:class:`RunHooks`), and the workflows, each a function with typed
+arguments returning a typed result, in a module of its own.
 
-One concept per module:
-
-- ``_config``: :class:`RunConfig` (the world, the seed, every component's settings), read from
-  YAML (:func:`load_run_config`), changed by :class:`RunOverrides`, checked against a run that is
-  resumed (:func:`resume_run_config`) or taken from a recorded session
-  (:func:`session_run_config`); the run's random streams (:func:`run_generators`).
-- ``_folder``: the one run-folder policy: one naming scheme (:func:`default_run_folder`), new
-  folders only, every file written atomically.
-- ``_report``: the one ``report.json`` schema, one builder per kind of run around the shared
-  part.
-- ``_export``: the maps as numbers (``map.npz``, ``pokes.csv``: :data:`POKES_CSV_COLUMNS`).
-- ``_figures``: the figures of a run folder.
-- ``_hooks``: :class:`RunHooks`, the progress callbacks every workflow takes.
-- the workflows, each a function with typed arguments returning a typed result:
-  :func:`explore_scenario` (``_explore``), :func:`record_simulation` (``_record``),
-  :func:`map_recorded_session` (``_map``), :func:`estimate_one_poke` (``_estimate``),
-  :func:`reproduce` (``_reproduce``), :func:`run_hardness_study` and
-  :func:`run_cluster_size_study` (``_studies``), :func:`show_scenario` and
-  :func:`scenario_summaries` (``_world``).
-
-This package may import every library package (``eval`` included); none of them imports it.
-
-The names are imported on first use: a run needs the simulated world and the whole estimator
-(slow to import), which ``deformap --help`` never needs.
+This package may import every library package; none of them imports it. The names are imported
+on first use: a run needs the world and the estimator (slow to import), ``deformap --help`` not.
 """
 
 from __future__ import annotations
@@ -43,9 +23,8 @@ if TYPE_CHECKING:
         load_run_config,
         resume_run_config,
         run_generators,
-        session_run_config,
     )
-    from deformap.run._environment import explore_environment, load_environment, parse_env_args
+    from deformap.run._environment import explore_environment, parse_env_args
     from deformap.run._estimate import EstimateOutput, estimate_one_poke
     from deformap.run._explore import RunOutput, explore_scenario
     from deformap.run._export import POKES_CSV_COLUMNS
@@ -68,18 +47,13 @@ if TYPE_CHECKING:
         load_worlds,
         rescore_worlds,
     )
-    from deformap.run._worlds_config import (
-        WorldsBenchConfig,
-        exploration_with,
-        parse_assignments,
-    )
+    from deformap.run._worlds_config import WorldsBenchConfig, exploration_with, parse_assignments
     from deformap.run._worlds_engines import BLAS_THREAD_VARIABLES
 
 _MODULES: dict[str, tuple[str, ...]] = {
     "_config": ("CONFIG_NAME", "RunConfig", "RunOverrides", "apply_overrides", "config_yaml",
-               "explore_run_config", "load_run_config", "resume_run_config", "run_generators",
-               "session_run_config"),
-    "_environment": ("explore_environment", "load_environment", "parse_env_args"),
+               "explore_run_config", "load_run_config", "resume_run_config", "run_generators"),
+    "_environment": ("explore_environment", "parse_env_args"),
     "_estimate": ("EstimateOutput", "estimate_one_poke"),
     "_explore": ("RunOutput", "explore_scenario"),
     "_export": ("POKES_CSV_COLUMNS",),
@@ -97,51 +71,15 @@ _MODULES: dict[str, tuple[str, ...]] = {
 }  # fmt: skip
 
 __all__ = [
-    "BLAS_THREAD_VARIABLES",
-    "CLUSTER_SIZE_FOAMS",
-    "CONFIG_NAME",
-    "POKES_CSV_COLUMNS",
-    "RESCORABLE",
-    "RUNS_ROOT",
-    "EstimateOutput",
-    "MapOutput",
-    "RecordOutput",
-    "ReproduceOutput",
-    "RunConfig",
-    "RunHooks",
-    "RunOutput",
-    "RunOverrides",
-    "RunStart",
-    "ScenarioSummary",
-    "StudyOutput",
-    "WorldsBenchConfig",
-    "WorldsOutput",
-    "apply_overrides",
-    "bench_worlds",
-    "config_yaml",
-    "default_run_folder",
-    "estimate_one_poke",
-    "exploration_with",
-    "explore_environment",
-    "explore_run_config",
-    "explore_scenario",
-    "load_environment",
-    "load_run_config",
-    "load_worlds",
-    "map_recorded_session",
-    "parse_assignments",
-    "parse_env_args",
-    "record_simulation",
-    "reproduce",
-    "rescore_worlds",
-    "resume_run_config",
-    "run_cluster_size_study",
-    "run_generators",
-    "run_hardness_study",
-    "scenario_summaries",
-    "session_run_config",
-    "show_scenario",
+    "BLAS_THREAD_VARIABLES", "CLUSTER_SIZE_FOAMS", "CONFIG_NAME", "POKES_CSV_COLUMNS", "RESCORABLE",
+    "RUNS_ROOT", "EstimateOutput", "MapOutput", "RecordOutput", "ReproduceOutput", "RunConfig",
+    "RunHooks", "RunOutput", "RunOverrides", "RunStart", "ScenarioSummary", "StudyOutput",
+    "WorldsBenchConfig", "WorldsOutput", "apply_overrides", "bench_worlds", "config_yaml",
+    "default_run_folder", "estimate_one_poke", "exploration_with", "explore_environment",
+    "explore_run_config", "explore_scenario", "load_run_config", "load_worlds",
+    "map_recorded_session", "parse_assignments", "parse_env_args", "record_simulation", "reproduce",
+    "rescore_worlds", "resume_run_config", "run_cluster_size_study", "run_generators",
+    "run_hardness_study", "scenario_summaries", "show_scenario",
 ]
-
 
 __getattr__, __dir__ = lazy_exports(__name__, _MODULES, __all__, globals())

@@ -1,8 +1,6 @@
 """The run's configuration: one :class:`RunConfig`, read from YAML, changed by overrides, checked
-against the folder of a run that is resumed, or taken from the session a recording holds.
-
-A run's randomness derives from its seed alone (:func:`run_generators`), so the live run, a resumed
-run and a recorded session mapped offline draw the same numbers.
+against the folder of a run that is resumed, or taken from the session a recording holds. A run's
+randomness derives from its seed alone (:func:`run_generators`).
 """
 
 from __future__ import annotations
@@ -23,15 +21,8 @@ from deformap.replay import RecordedSession
 from deformap.world import WorldConfig
 
 __all__ = [
-    "CONFIG_NAME",
-    "RunConfig",
-    "RunOverrides",
-    "apply_overrides",
-    "config_yaml",
-    "explore_run_config",
-    "load_run_config",
-    "resume_run_config",
-    "run_generators",
+    "CONFIG_NAME", "RunConfig", "RunOverrides", "apply_overrides", "config_yaml",
+    "explore_run_config", "load_run_config", "resume_run_config", "run_generators",
     "session_run_config",
 ]
 
@@ -67,23 +58,9 @@ class RunConfig:
 
 @dataclass(frozen=True, kw_only=True)
 class RunOverrides:
-    """Settings given on the command line; ``None`` keeps the configuration's own.
-
-    Parameters
-    ----------
-    scenario : str or None
-        Replaces ``RunConfig.scenario``.
-    seed : int or None
-        Replaces ``RunConfig.seed``.
-    strategy : str or None
-        Replaces ``ExplorationConfig.strategy``, which validates it (as the three below).
-    threshold : float or None
-        Replaces ``ExplorationConfig.threshold`` (``T_h``).
-    max_pokes : int or None
-        Replaces ``ExplorationConfig.max_pokes``.
-    field : str or None
-        Replaces ``ExplorationConfig.field``.
-    """
+    """Settings given on the command line, each replacing ``RunConfig``'s field of its name (the
+    last four ``ExplorationConfig``'s, which validates them); ``None`` keeps the configuration's
+    own."""
 
     scenario: str | None = None
     seed: int | None = None
@@ -99,12 +76,8 @@ class RunOverrides:
 
 def load_run_config(path: str | Path | None) -> RunConfig:
     """Read a run configuration from YAML (missing keys keep their defaults); ``None``: defaults.
-
-    Raises
-    ------
-    ConfigError
-        The file cannot be read, or a key is unknown or has a bad value (named by its dotted path).
-    """
+    A file that cannot be read, or an unknown key or bad value (named by its dotted path), raises
+    :class:`ConfigError`."""
     if path is None:
         return RunConfig()
     return config_from_dict(RunConfig, load_yaml(path), where=Path(path).name)
@@ -126,43 +99,26 @@ def apply_overrides(config: RunConfig, overrides: RunOverrides) -> RunConfig:
 
 
 def resume_run_config(folder: Path, overrides: RunOverrides | None = None) -> RunConfig:
-    """The configuration of the run in ``folder``, read from its ``config.yaml``.
-
-    Overrides are accepted only when they repeat the run's own settings: a resumed run is the run
-    that was killed, or it would not give the uninterrupted run's result.
-
-    Raises
-    ------
-    ConfigError
-        ``folder`` holds no ``config.yaml`` (no run started there), or an override differs.
-    """
+    """The configuration of the run in ``folder``, read from its ``config.yaml``; overrides only
+    when they repeat the run's own settings, since a resumed run is the run that was killed
+    (:class:`ConfigError` otherwise, or without ``config.yaml``)."""
     if path_kind(folder / CONFIG_NAME) != "file":  # a run writes it before anything else
-        raise ConfigError(
-            f"cannot resume {str(folder)!r}: it holds no {CONFIG_NAME}, so no run started "
-            "there; start one without --resume"
-        )
+        raise ConfigError(f"cannot resume {str(folder)!r}: it holds no {CONFIG_NAME}, so no run "
+                          "started there; start one without --resume")
     config = load_run_config(folder / CONFIG_NAME)
     overrides = overrides or RunOverrides()
     changed = apply_overrides(config, overrides)
     if changed != config:
         names = ", ".join(sorted(overrides.given()))
         raise ConfigError(
-            f"cannot resume {str(folder)!r} with different settings ({names}); drop those options"
-        )
+            f"cannot resume {str(folder)!r} with different settings ({names}); drop those options")
     return config
 
 
 def explore_run_config(config: Path | None, overrides: RunOverrides,
                        resume: Path | None = None) -> RunConfig:
-    """The configuration of ``deformap explore``: the resumed run's own (``resume``), else the file
-    ``config`` (or the defaults) with ``overrides`` applied.
-
-    Raises
-    ------
-    ConfigError
-        Both ``config`` and ``resume`` given, or as :func:`resume_run_config` and
-        :func:`load_run_config`.
-    """
+    """The configuration of ``deformap explore``: the resumed run's own (``resume``; not with
+    ``config``), else the file ``config`` (or the defaults) with ``overrides`` applied."""
     if resume is None:
         return apply_overrides(load_run_config(config), overrides)
     if config is not None:
@@ -170,20 +126,11 @@ def explore_run_config(config: Path | None, overrides: RunOverrides,
     return resume_run_config(resume, overrides)
 
 
-def session_run_config(
-    session: RecordedSession, config: RunConfig | None = None, seed: int | None = None
-) -> RunConfig:
-    """The configuration to map ``session`` with.
-
-    ``config`` if given, else the one the session was recorded with (``source.config``), else the
-    defaults; the seed is ``seed`` if given, else the session's ``source.seed``, else the
-    configuration's.
-
-    Raises
-    ------
-    ConfigError
-        The recorded configuration or seed is malformed (named by its place in ``session.yaml``).
-    """
+def session_run_config(session: RecordedSession, config: RunConfig | None = None,
+                       seed: int | None = None) -> RunConfig:
+    """The configuration to map ``session`` with: ``config``, else the one it was recorded with
+    (``source.config``), else the defaults; the seed ``seed``, else ``source.seed``, else the
+    configuration's. A malformed recorded one raises :class:`ConfigError` naming its place."""
     if config is None:
         recorded = session.source.get("config")
         where = f"{session.path}/session.yaml source.config"
@@ -191,18 +138,13 @@ def session_run_config(
     if seed is None:
         seed = session.source.get("seed", config.seed)
         if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
-            raise ConfigError(
-                f"{session.path}/session.yaml: `source.seed` must be an integer >= 0; got "
-                f"{seed!r} (or pass --seed)"
-            )
+            raise ConfigError(f"{session.path}/session.yaml: `source.seed` must be an integer "
+                              f">= 0; got {seed!r} (or pass --seed)")
     return dataclasses.replace(config, seed=seed)
 
 
 def run_generators(seed: int) -> tuple[np.random.Generator, np.random.Generator]:
-    """The world's and the exploration's generators of a run with ``seed``.
-
-    Live runs, recorded simulations and mapped sessions derive theirs the same way, so that a
-    recorded session mapped offline with its seed fits the surface exactly as the live run did.
-    """
+    """The world's and the exploration's generators of a run with ``seed``, derived alike by
+    every workflow, so that a session mapped offline fits the surface as the live run did."""
     world_seq, explore_seq = np.random.SeedSequence(check_int("seed", seed, minimum=0)).spawn(2)
     return np.random.default_rng(world_seq), np.random.default_rng(explore_seq)

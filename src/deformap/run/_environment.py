@@ -1,12 +1,9 @@
 """Explore a user's own `Environment` (a real robot, or any world) named on the command line.
 
 ``deformap explore --environment package.module:factory --env-arg key=value …`` imports
-``package.module`` (from the installed packages or the current folder), calls ``factory(**args)``
-and explores what it returns exactly as the simulated world is explored: the same loop, journal,
-report (without the ground-truth metrics, which only a simulated world has), figures and maps as
-numbers. Each ``--env-arg`` value is read as a YAML scalar (``port=5`` gives the integer 5,
-``name=arm`` the string, ``rate=0.5`` the float). Importing runs the module's code: name only
-code you trust, as with any Python import.
+``package.module`` (installed, or in the current folder), calls ``factory(**args)`` with each
+value read as a YAML scalar, and explores what it returns as the simulated world is explored
+(the report without the ground-truth metrics). Importing runs the module's code, as any import.
 """
 
 from __future__ import annotations
@@ -29,11 +26,7 @@ from deformap.errors import ConfigError
 from deformap.explore import Journal, check_exploration_budget, explore
 from deformap.run._config import CONFIG_NAME, RunConfig, config_yaml, run_generators
 from deformap.run._export import poke_writer, write_run_results
-from deformap.run._folder import (
-    create_run_folder,
-    default_run_folder,
-    write_text,
-)
+from deformap.run._folder import create_run_folder, default_run_folder, write_text
 from deformap.run._hooks import NO_HOOKS, RunHooks, RunStart
 from deformap.run._report import shared_report
 
@@ -84,29 +77,21 @@ def load_environment(spec: str, args: dict[str, Any]) -> Environment:
         raise ConfigError(f"--environment {spec!r}: {attr}() failed "
                           f"({type(exc).__name__}: {exc})") from None
     if not isinstance(env, Environment):
-        raise ConfigError(
-            f"--environment {spec!r} must return an Environment (workspace, observe, press, "
-            f"release); got {type(env).__name__}")
+        raise ConfigError(f"--environment {spec!r} must return an Environment (workspace, "
+                          f"observe, press, release); got {type(env).__name__}")
     return env
 
 
-def explore_environment(
-    spec: str,
-    env_args: dict[str, Any],
-    config: RunConfig,
-    out: Path | None = None,
-    *,
-    figures: bool = True,
-    hooks: RunHooks = NO_HOOKS,
-    variance_max: float | None = None,
-) -> tuple[dict[str, Any], Path]:
+def explore_environment(spec: str, env_args: dict[str, Any], config: RunConfig,
+                        out: Path | None = None, *, figures: bool = True,
+                        hooks: RunHooks = NO_HOOKS, variance_max: float | None = None,
+                        ) -> tuple[dict[str, Any], Path]:
     """Explore the Environment ``spec`` returns (module docstring); ``(report, folder)``.
 
-    ``variance_max`` fixes the top of ``map.png``'s variance colour scale (so that runs compare).
-
-    The run folder is new or empty (default ``runs/<factory>-explore-s<seed>-<time>``); the
-    environment is built before the folder is made, so that a spec that does not load leaves
-    nothing behind. ``config.world`` and ``config.scenario`` are not used.
+    The run folder is new or empty (default ``runs/<factory>-explore-s<seed>-<time>``), made
+    after the environment is built, so that a spec that does not load leaves nothing behind;
+    ``variance_max`` fixes the top of ``map.png``'s variance scale. ``config.world`` and
+    ``config.scenario`` are not used.
     """
     if variance_max is not None:  # before any work
         check_positive("variance_max", variance_max)
@@ -122,10 +107,10 @@ def explore_environment(
                          total=config.exploration.max_pokes, done=0))  # fmt: skip
     _, explore_rng = run_generators(config.seed)
 
-    on_poke = poke_writer(folder, figures=figures, hooks=hooks)
     hooks.stage("exploring")
     t0 = time.perf_counter()
-    result = explore(env, config.exploration, rng=explore_rng, journal=journal, on_poke=on_poke)
+    result = explore(env, config.exploration, rng=explore_rng, journal=journal,
+                     on_poke=poke_writer(folder, figures=figures, hooks=hooks))
     report = {"deformap": __version__, "environment": spec, "env_args": env_args,
               "seed": config.seed, "config": config_to_dict(config),
               **shared_report(result, truth=None)}  # fmt: skip

@@ -25,58 +25,26 @@ __all__ = ["EstimateOutput", "estimate_one_poke"]
 
 @dataclass(frozen=True, kw_only=True)
 class EstimateOutput:
-    """What :func:`estimate_one_poke` found, and the folder it wrote (``None`` when none).
-
-    ``report`` is the content of ``estimate.json``: ``before``, ``after``, ``beta``, ``beta_std``,
-    ``contact_point``, ``contact``, ``force_n``, ``betas``, ``errors``, ``converged``,
-    ``iterations``, ``n_roi_points``, ``timings``.
-    """
+    """What :func:`estimate_one_poke` found (``report``: the content of ``estimate.json``) and the
+    folder it wrote (``None`` when none)."""
 
     report: dict[str, Any]
     folder: Path | None
 
 
 def estimate_one_poke(
-    *,
-    before: Path,
-    after: Path,
-    tip_center: Sequence[float],
-    force: Sequence[float],
-    tip_radius_m: float,
-    config: RunConfig,
-    robot_hull: Path | None = None,
-    units: str = "m",
-    seed: int = 0,
-    out: Path | None = None,
-) -> EstimateOutput:
-    """β of one poke (see :func:`deformap.replay.estimate_poke`).
+    *, before: Path, after: Path, tip_center: Sequence[float], force: Sequence[float],
+    tip_radius_m: float, config: RunConfig, robot_hull: Path | None = None, units: str = "m",
+    seed: int = 0, out: Path | None = None,
+) -> EstimateOutput:  # fmt: skip
+    """β of one poke (:func:`deformap.replay.estimate_poke`) from the clouds ``before`` and
+    ``after`` (PCD, PLY, NPZ in ``units`` m or mm), the tip's centre ``tip_center`` (3,) [m] and
+    ``force`` (3,) [N] at the press, with ``config.exploration`` and the surface fit's ``seed``.
 
-    Parameters
-    ----------
-    before, after : Path
-        Clouds of the undisturbed surface and while pressing (PCD, PLY, NPZ).
-    tip_center : (3,) float, metres
-        Centre of the tip's sphere at the press.
-    force : (3,) float, newtons
-        Force on the surface.
-    tip_radius_m : float, metres
-    config : RunConfig
-        Its exploration part (surface GP, touch GP, shape matching) is used.
-    robot_hull : Path, optional
-        Cloud of points whose hull covers stick and hand; default: the tip's sphere.
-    units : {"m", "mm"}
-        Units of the cloud files.
-    seed : int
-        Seed of the surface fit.
-    out : Path, optional
-        A new or empty folder for ``estimate.json`` and the figures, created before the work;
-        ``None`` writes nothing.
-
-    Raises
-    ------
-    InvalidArgumentError, FileFormatError, ConfigError
-        A bad contact (named ``--contact/--force/--tip-radius``), an unreadable cloud, a contact
-        far from the surface, or an ``out`` that is not empty or cannot be created.
+    ``robot_hull`` is a cloud whose hull covers stick and hand (default: the tip's sphere); ``out``
+    a new or empty folder for ``estimate.json`` and the figures, created before the work. A bad
+    contact (named ``--contact/--force/--tip-radius``), an unreadable cloud, a contact far from
+    the surface or a bad ``out`` raise a :class:`~deformap.errors.DeformapError`.
     """
     try:
         contact = TactileContact(tip_center=np.array(tip_center), force=np.array(force),

@@ -1,9 +1,7 @@
-"""Explore a simulated scenario: poke until the β-field is known, score the map against the
-world's ground truth, and write the run folder.
-
-A run folder receives, in this order, ``config.yaml`` (the effective configuration, before
-anything else), ``journal.jsonl`` (each poke as it completes, for resuming), ``report.json``,
-``map.png``, one ``poke-NN.png`` per poke, and with ``rerun`` the recording ``run.rrd``. A run
+"""Explore a simulated scenario: poke until the map field is known, score the map against the
+world's ground truth, and write the run folder: ``config.yaml`` before anything else,
+``journal.jsonl`` (each poke as it completes) and ``poke-NN.png`` as the pokes come, then
+``report.json``, ``map.npz``, ``pokes.csv``, ``map.png`` and with ``rerun`` ``run.rrd``. A run
 killed at any moment resumes from its folder to the uninterrupted run's result.
 """
 
@@ -39,17 +37,8 @@ from deformap.run._config import (
     run_generators,
 )
 from deformap.run._export import poke_writer, write_run_results
-from deformap.run._figures import (
-    poke_figure_path,
-    write_poke_figure,
-    write_rerun,
-)
-from deformap.run._folder import (
-    create_run_folder,
-    default_run_folder,
-    run_stem,
-    write_text,
-)
+from deformap.run._figures import poke_figure_path, write_poke_figure, write_rerun
+from deformap.run._folder import create_run_folder, default_run_folder, run_stem, write_text
 from deformap.run._hooks import NO_HOOKS, RunHooks, RunStart
 from deformap.run._report import live_report
 from deformap.world import SimulatedWorld, load_scenario
@@ -61,16 +50,8 @@ logger = logging.getLogger(__name__)
 
 @dataclass(frozen=True, kw_only=True)
 class RunOutput:
-    """What :func:`explore_scenario` wrote and the objects it made.
-
-    Attributes
-    ----------
-    report : dict
-        The content of ``report.json`` (see :mod:`deformap.run._report`).
-    result : ExplorationResult
-    world : SimulatedWorld
-    folder : Path
-    """
+    """What :func:`explore_scenario` wrote (``report``: the content of ``report.json``) and the
+    objects it made."""
 
     report: dict[str, Any]
     result: ExplorationResult
@@ -79,13 +60,8 @@ class RunOutput:
 
 
 def _stored_if_same(out: Path, config: RunConfig, header: dict[str, Any]) -> dict[str, Any]:
-    """The journal's own header if it names this run in an older form, else ``header``.
-
-    A configuration field added since the run began is missing from its journal header; read
-    with that field at its default (new fields default to the behaviour before them), the stored
-    configuration may equal this run's, which then resumes. Anything else is left for
-    :meth:`Journal.resume` to compare (and refuse, naming what differs).
-    """
+    """The journal's own header if it names this run in an older form (a configuration field
+    added since, read at its default), else ``header`` for :meth:`Journal.resume` to compare."""
     try:
         stored = read_journal(out / JOURNAL_NAME).header
         same = (
@@ -101,12 +77,9 @@ def _stored_if_same(out: Path, config: RunConfig, header: dict[str, Any]) -> dic
 def _resume_journal(
     out: Path, config: RunConfig, header: dict[str, Any]
 ) -> tuple[Journal, list[PokeRecord]]:
-    """Open the journal of the run in ``out`` and the pokes it holds (read as records here,
-    before any work, so that a broken line is refused naming it).
-
-    A folder with ``config.yaml`` but no journal (killed before its journal was created) resumes
-    from poke 1 when its configuration is this run's.
-    """
+    """The journal of the run in ``out`` and its pokes as records (a broken line refused before
+    any work); a folder killed before its journal was created starts over if its
+    ``config.yaml`` is this run's."""
     if not (out / JOURNAL_NAME).exists():
         if not (out / CONFIG_NAME).exists():
             raise ConfigError(f"cannot resume {str(out)!r}: it holds no {JOURNAL_NAME}")
@@ -124,24 +97,16 @@ def _resume_journal(
                 f"journal {str(where)!r}: poke line {k + 1} must hold poke index {k}; got "
                 f"{record.index} (a line repeated, missing or out of order)")
     if contents.broken_line is not None:
-        logger.warning(
-            "%s: the last journal line was cut mid-write and is dropped (%d complete pokes kept)",
-            out / JOURNAL_NAME,
-            len(contents.pokes),
-        )
+        logger.warning("%s: the last journal line was cut mid-write and is dropped (%d complete "
+                       "pokes kept)", where, len(contents.pokes))
     return journal, done
 
 
 def _redraw_resumed_pokes(folder: Path, result: ExplorationResult, world: SimulatedWorld,
                           config: ExplorationConfig) -> None:
-    """Draw ``poke-NN.png`` of the journalled pokes that have none (the run was killed between a
-    poke's journal line and its figure, or before figures were drawn as pokes were made).
-
-    The journal holds no arrays, so the poke is pressed again: the simulated world's noise is
-    keyed by the press and the dent's estimate is a function of the press and the surface model,
-    so it is the same poke. Its β is compared with the journalled one before anything is drawn;
-    a poke that does not come out the same gets no figure and a warning.
-    """
+    """Draw ``poke-NN.png`` of the journalled pokes that have none, pressing each again (the
+    world's noise is keyed by the press, so it is the same poke); one whose β differs from its
+    journal's gets a warning and no figure."""
     for poke in result.pokes:
         index = poke.record.index
         if poke.dent is not None or poke_figure_path(folder, index).exists():
@@ -157,45 +122,17 @@ def _redraw_resumed_pokes(folder: Path, result: ExplorationResult, world: Simula
         write_poke_figure(folder, again)
 
 
-def explore_scenario(
-    config: RunConfig,
-    out: Path | None = None,
-    *,
-    resume: bool = False,
-    figures: bool = True,
-    rerun: bool = False,
-    hooks: RunHooks = NO_HOOKS,
-    variance_max: float | None = None,
-) -> RunOutput:
+def explore_scenario(config: RunConfig, out: Path | None = None, *, resume: bool = False,
+                     figures: bool = True, rerun: bool = False, hooks: RunHooks = NO_HOOKS,
+                     variance_max: float | None = None) -> RunOutput:
     """Explore ``config.scenario``, score the map against ground truth, write the run folder.
 
-    Parameters
-    ----------
-    config : RunConfig
-    out : Path, optional
-        The run folder; new or empty unless ``resume`` (default:
-        :func:`~deformap.run.default_run_folder` of the scenario, kind ``explore``).
-    resume : bool
-        Continue the run killed in ``out``: the pokes in its journal are not made again, and a
-        configuration other than the run's is refused.
-    figures : bool
-        Write ``map.png`` and the ``poke-NN.png``.
-    rerun : bool
-        Write ``run.rrd`` (extra ``rerun``).
-    hooks : RunHooks
-        Progress callbacks.
-    variance_max : float, optional
-        A fixed top of ``map.png``'s variance colour scale, so that runs compare.
-
-    Returns
-    -------
-    RunOutput
-
-    Raises
-    ------
-    ConfigError
-        Unknown scenario; ``out`` not empty, or not creatable (before any work); on resume, no
-        run there or a different configuration.
+    ``out`` is new or empty (default: :func:`~deformap.run.default_run_folder` of the scenario),
+    or with ``resume`` the run killed there, whose journalled pokes are not made again;
+    ``figures`` draws ``map.png`` and the ``poke-NN.png``, ``rerun`` writes ``run.rrd``, and
+    ``variance_max`` fixes the top of the map's variance scale. An unknown scenario, a bad ``out``
+    (before any work), or on resume no run there or another configuration raise
+    :class:`ConfigError`.
     """
     if variance_max is not None:  # before any work
         check_positive("variance_max", variance_max)
@@ -222,10 +159,8 @@ def explore_scenario(
     world = SimulatedWorld(scenario, config=config.world, rng=world_rng)
     world_s = time.perf_counter() - t0
     hooks.stage("exploring")
-
-    on_poke = poke_writer(folder, figures=figures, hooks=hooks)
     result = explore(world, config.exploration, rng=explore_rng, journal=journal, done=done,
-                     on_poke=on_poke)  # fmt: skip
+                     on_poke=poke_writer(folder, figures=figures, hooks=hooks))
     report = live_report(config, result, world, world_build_s=world_s)
     write_run_results(folder, result, report, figures=figures, truth=world, poke_figures=False,
                       title=f"{config.scenario} (seed {config.seed}): {len(result.pokes)} pokes",

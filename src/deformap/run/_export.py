@@ -1,29 +1,16 @@
 """Maps a user can take away as numbers: ``map.npz`` (the grids) and ``pokes.csv`` (one row a poke).
 
-``map.npz`` (numpy's zip of arrays, read with ``numpy.load(path)``, no pickle), every array on the
-map's grid of ``(ny, nx)`` cells unless said otherwise:
+``map.npz`` (``numpy.load(path)``, no pickle), each array ``(ny, nx)`` on the map's grid: ``xs_m
+(nx,)`` and ``ys_m (ny,)``, the cells' centres in the world frame (``frame``, ``units``);
+``beta_mean``, ``beta_std``; the modulus field's ``modulus_median_pa`` (exp of the mean of ln E),
+``log_modulus_mean``, ``log_modulus_std`` (NaN when no poke gave a modulus); ``region_labels``
+(label ``k`` is region ``R(k+1)``, -1 without a region map) and the ``field`` they were cut from.
 
-- ``xs_m (nx,)``, ``ys_m (ny,)``: the cells' centres in the world frame (metres, z up, the table
-  z = 0); ``frame`` and ``units`` (strings) say so.
-- ``beta_mean``, ``beta_std``: the β-field's posterior mean and standard deviation.
-- ``modulus_median_pa``, ``log_modulus_mean``, ``log_modulus_std``: the modulus field (over ln E,
-  E in Pa): the median E (``exp`` of the mean), the mean and standard deviation of ln E; NaN
-  everywhere when no poke gave a modulus.
-- ``region_labels`` (int, -1 without a region map; label ``k`` is region ``R(k+1)`` of
-  ``map.png``), ``field``: the field the regions were cut from.
-
-``pokes.csv``: ``poke`` (numbered from 1, as in ``poke-NN.png``, the figures and the console;
-``report.json``'s ``index`` is this number minus one), ``purpose``, ``target_x_m``,
-``target_y_m``, ``contact_x_m``, ``contact_y_m`` (where the tip touched: the fields' input),
-``tip_center_z_m`` (the tip's centre at the commanded force), ``force_n``, ``beta``,
-``beta_std``, ``stiffness_n_per_m``, ``stiffness_std_n_per_m``, ``modulus_pa``, ``modulus_std_pa``,
-``rigid`` (the force–travel reading; empty where the poke had none), ``region`` (the region the
-poke is in, numbered from 1 as ``R1, R2, …`` on ``map.png``: ``region_labels`` + 1; empty where
-the map field left the poke out).
-
-Both are written atomically (:mod:`deformap._files`). :func:`write_run_results` writes a run's
-results in one place for every workflow that maps (explore, a user's environment, a session):
-``report.json``, these two files and the figures.
+``pokes.csv``: the columns :data:`POKES_CSV_COLUMNS`, ``poke`` numbered from 1 (``report.json``'s
+``index`` + 1), the contact where the tip touched, ``tip_center_z_m`` at the commanded force, the
+force–travel reading (empty without one) and ``region`` (``region_labels`` + 1; empty where the
+map field left the poke out). :func:`write_run_results` writes every mapping workflow's results:
+``report.json``, these two files and the figures, each atomically.
 """
 
 from __future__ import annotations
@@ -42,8 +29,7 @@ from deformap.run._figures import write_map_figures, write_poke_figure
 from deformap.run._folder import write_json
 from deformap.run._hooks import NO_HOOKS, RunHooks
 
-__all__ = ["POKES_CSV_COLUMNS", "poke_writer", "write_map_npz", "write_pokes_csv",
-           "write_run_results"]
+__all__ = ["POKES_CSV_COLUMNS", "poke_writer", "write_run_results"]
 
 POKES_CSV_COLUMNS = (
     "poke", "purpose", "target_x_m", "target_y_m", "contact_x_m", "contact_y_m", "tip_center_z_m",
@@ -52,7 +38,7 @@ POKES_CSV_COLUMNS = (
 )  # fmt: skip
 
 
-def write_map_npz(path: Path, result: ExplorationResult) -> Path:
+def _write_map_npz(path: Path, result: ExplorationResult) -> None:
     """``map.npz`` of ``result`` (module docstring)."""
     shape = (result.ys.size, result.xs.size)
     nan = np.full(shape, np.nan)
@@ -71,21 +57,20 @@ def write_map_npz(path: Path, result: ExplorationResult) -> Path:
     }  # fmt: skip
     with atomic_path(path) as tmp, open(tmp, "wb") as fh:
         np.savez_compressed(fh, **arrays)
-    return path
 
 
 def _cell(value: Any) -> Any:
     return "" if value is None else value
 
 
-def write_pokes_csv(path: Path, result: ExplorationResult) -> Path:
+def _write_pokes_csv(path: Path, result: ExplorationResult) -> None:
     """``pokes.csv`` of ``result`` (module docstring)."""
     region_of: dict[int, int] = {}
     if result.regions is not None:
         index = result.map_field.pokes.index
         assert index is not None  # PokeSet fills it
-        region_of = {int(i): int(k) for i, k in zip(index, result.regions.poke_labels,
-                                                    strict=True)}  # fmt: skip
+        region_of = {int(i): int(k)
+                     for i, k in zip(index, result.regions.poke_labels, strict=True)}
     text = io.StringIO()
     writer = csv.writer(text, lineterminator="\n")
     writer.writerow(POKES_CSV_COLUMNS)
@@ -95,14 +80,12 @@ def write_pokes_csv(path: Path, result: ExplorationResult) -> Path:
         writer.writerow([
             r.index + 1, _cell(r.purpose), *(float(v) for v in r.target_xy),
             *(float(v) for v in r.contact_xy), r.contact.tip_center[2], r.force_n, r.beta,
-            r.beta_std,
-            _cell(s and s.stiffness_n_per_m), _cell(s and s.stiffness_std_n_per_m),
+            r.beta_std, _cell(s and s.stiffness_n_per_m), _cell(s and s.stiffness_std_n_per_m),
             _cell(s and s.modulus_pa), _cell(s and s.modulus_std_pa),
             "" if s is None else s.rigid,
             "" if r.index not in region_of else region_of[r.index] + 1,
         ])  # fmt: skip
     write_text_atomically(path, text.getvalue())
-    return path
 
 
 def write_run_results(folder: Path, result: ExplorationResult, report: dict[str, Any], *,
@@ -112,8 +95,8 @@ def write_run_results(folder: Path, result: ExplorationResult, report: dict[str,
     field the map ran on; its variance scale fixed at ``variance_max`` when given) and the
     ``poke-NN.png`` (unless the caller drew them as the pokes came: ``poke_figures=False``)."""
     write_json(folder / "report.json", report)
-    write_map_npz(folder / "map.npz", result)
-    write_pokes_csv(folder / "pokes.csv", result)
+    _write_map_npz(folder / "map.npz", result)
+    _write_pokes_csv(folder / "pokes.csv", result)
     if figures:
         hooks.stage("drawing figures")
         write_map_figures(folder, result, truth=truth,

@@ -1,14 +1,11 @@
 """The one policy for the folders runs write into, and for the files written there.
 
 - **Naming**: a run without ``--out`` goes to ``runs/<stem>-<kind>-s<seed>-<YYYYmmdd-HHMMSS>``
-  (:func:`default_run_folder`), whatever its kind (explore, record, map, study, reproduce).
-- **Creating**: :func:`create_run_folder` makes the folder before any work, so that one that
-  cannot be made fails at once (naming ``--out``); an existing folder must be empty, so that no
-  result of an earlier run is ever overwritten. A run that is resumed reuses its own folder.
-- **Writing**: every file goes to a temporary file in the same folder, is flushed and fsynced,
-  renamed onto its name (``os.replace``) and the folder fsynced (:func:`write_text`,
-  :func:`write_json`, :func:`atomic_path`): a run killed at any moment leaves the old file or the
-  new one, never half of one.
+  (:func:`default_run_folder`), whatever its kind.
+- **Creating**: :func:`create_run_folder` makes the folder before any work; an existing one must
+  be empty, so that no earlier result is overwritten (a resumed run reuses its own).
+- **Writing**: every file is written atomically (:mod:`deformap._files`): a run killed at any
+  moment leaves the old file or the new one, never half of one.
 """
 
 from __future__ import annotations
@@ -27,14 +24,8 @@ from deformap.cloud.io import path_kind
 from deformap.errors import ConfigError
 
 __all__ = [
-    "RUNS_ROOT",
-    "atomic_path",
-    "create_run_folder",
-    "default_run_folder",
-    "run_stem",
-    "to_json",
-    "write_json",
-    "write_text",
+    "RUNS_ROOT", "atomic_path", "create_run_folder", "default_run_folder", "run_stem", "to_json",
+    "write_json", "write_text",
 ]
 
 RUNS_ROOT = Path("runs")
@@ -49,9 +40,8 @@ def run_stem(name: str | Path) -> str:
     return Path(text).name or text.strip("/") or "run"
 
 
-def default_run_folder(
-    stem: str, kind: str, seed: int, *, root: Path = RUNS_ROOT, when: float | None = None
-) -> Path:
+def default_run_folder(stem: str, kind: str, seed: int, *, root: Path = RUNS_ROOT,
+                       when: float | None = None) -> Path:
     """``root/<stem>-<kind>-s<seed>-<YYYYmmdd-HHMMSS>``, local time ``when`` (default: now)."""
     stamp = time.strftime("%Y%m%d-%H%M%S", time.localtime(when))
     return root / f"{stem}-{kind}-s{seed}-{stamp}"
@@ -60,49 +50,32 @@ def default_run_folder(
 def create_run_folder(folder: Path, *, what: str = "run", resume_hint: bool = False) -> Path:
     """Create ``folder`` (and its parents) for a new run; it may exist only as an empty folder.
 
-    Parameters
-    ----------
-    folder : Path
-    what : str
-        What the folder holds, for the messages ("run", "session", "result").
-    resume_hint : bool
-        Say that ``--resume`` continues the run already there.
-
-    Raises
-    ------
-    ConfigError
-        ``folder`` is a folder that is not empty, or a file, or cannot be created; the message
-        names ``--out``.
+    ``what`` names what it holds in the messages ("run", "session", "result"); ``resume_hint``
+    says that ``--resume`` continues the run already there. A folder that is not empty, a file,
+    or one that cannot be created raises :class:`ConfigError` naming ``--out``.
     """
     kind = path_kind(folder)
     if kind == "dir" and any(folder.iterdir()):
         hint = " or pass --resume" if resume_hint else ""
         raise ConfigError(
-            f"{what} folder {str(folder)!r} exists and is not empty; choose another --out{hint}"
-        )
+            f"{what} folder {str(folder)!r} exists and is not empty; choose another --out{hint}")
     if kind in ("file", "other"):
-        raise ConfigError(
-            f"cannot create {what} folder {str(folder)!r} (--out): something that is not a "
-            "folder has that name"
-        )
+        raise ConfigError(f"cannot create {what} folder {str(folder)!r} (--out): something that "
+                          "is not a folder has that name")
     try:
         folder.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
-        raise ConfigError(
-            f"cannot create {what} folder {str(folder)!r} (--out): {exc.strerror or exc}"
-        ) from None
+        raise ConfigError(f"cannot create {what} folder {str(folder)!r} (--out): "
+                          f"{exc.strerror or exc}") from None
     return folder
 
 
-def write_text(path: Path, text: str) -> Path:
-    """Write ``text`` (UTF-8) to ``path`` atomically; returns ``path``."""
-    return write_text_atomically(path, text)
+write_text = write_text_atomically  # ``text`` (UTF-8) to ``path`` atomically; returns ``path``
 
 
 def _plain(value: Any) -> Any:
-    """``value`` as strict JSON data: numpy arrays and scalars as lists and numbers, a non-finite
-    number as ``null`` (JSON has no NaN or infinity), dates and times in ISO 8601 (a YAML date a
-    user wrote in a session's ``source``), tuples as lists."""
+    """``value`` as strict JSON data: numpy values as lists and numbers, a non-finite number as
+    ``null``, dates and times in ISO 8601 (a YAML date in a session's ``source``)."""
     if isinstance(value, dict):
         return {str(k): _plain(v) for k, v in value.items()}
     if isinstance(value, (list, tuple)):
@@ -123,8 +96,7 @@ def _plain(value: Any) -> Any:
 
 
 def to_json(data: Any, *, indent: int | None = 2) -> str:
-    """``data`` as strict JSON (indented, or on one line with ``indent=None``), see
-    :func:`_plain`: never a bare ``NaN``."""
+    """``data`` as strict JSON (:func:`_plain`; indented, or one line with ``indent=None``)."""
     return json.dumps(_plain(data), indent=indent, allow_nan=False)
 
 

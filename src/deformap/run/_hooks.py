@@ -9,7 +9,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
     from deformap.explore import PokeRecord
@@ -19,21 +19,9 @@ __all__ = ["RunHooks", "RunStart"]
 
 @dataclass(frozen=True, kw_only=True)
 class RunStart:
-    """What a workflow is about to do, told once its folder exists and before the work.
-
-    Attributes
-    ----------
-    kind : str
-        ``"explore"``, ``"record"``, ``"map"``, ``"study"``, ``"reproduce"`` or ``"world"``.
-    title : str
-        One line on what runs (scenario and seed, or session and form).
-    folder : Path or None
-        Where the results go (``None`` when nothing is written).
-    total : int or None
-        Steps to come (pokes at most, foams, scenarios), ``None`` when unknown.
-    done : int
-        Steps already done (pokes a resumed run takes from its journal).
-    """
+    """What a workflow is about to do (its ``kind``, a one-line ``title``, the results'
+    ``folder``), told once the folder exists; ``total`` steps to come (``None``: unknown), of
+    which ``done`` are done already (the pokes a resumed run takes from its journal)."""
 
     kind: str
     title: str
@@ -42,10 +30,15 @@ class RunStart:
     done: int = 0
 
 
+def _call(hook: Callable[[Any], None] | None, value: Any) -> None:
+    if hook is not None:
+        hook(value)
+
+
 @dataclass(frozen=True, kw_only=True)
 class RunHooks:
     """Optional callbacks: ``on_start`` once, ``on_stage`` per stage, ``on_step`` per step
-    (a foam pressed, a scenario run), ``on_poke`` per poke."""
+    (a foam pressed, a scenario run), ``on_poke`` per poke; each method calls its own if given."""
 
     on_start: Callable[[RunStart], None] | None = None
     on_stage: Callable[[str], None] | None = None
@@ -53,24 +46,16 @@ class RunHooks:
     on_poke: Callable[[PokeRecord], None] | None = None
 
     def start(self, start: RunStart) -> None:
-        """Call ``on_start`` if given."""
-        if self.on_start is not None:
-            self.on_start(start)
+        _call(self.on_start, start)
 
     def stage(self, text: str) -> None:
-        """Call ``on_stage`` if given."""
-        if self.on_stage is not None:
-            self.on_stage(text)
+        _call(self.on_stage, text)
 
     def step(self, text: str) -> None:
-        """Call ``on_step`` if given."""
-        if self.on_step is not None:
-            self.on_step(text)
+        _call(self.on_step, text)
 
     def poke(self, poke: PokeRecord) -> None:
-        """Call ``on_poke`` if given."""
-        if self.on_poke is not None:
-            self.on_poke(poke)
+        _call(self.on_poke, poke)
 
 
 NO_HOOKS = RunHooks()

@@ -27,19 +27,8 @@ __all__ = ["RecordOutput", "record_simulation"]
 
 @dataclass(frozen=True, kw_only=True)
 class RecordOutput:
-    """What :func:`record_simulation` wrote.
-
-    Attributes
-    ----------
-    session_file : Path
-        The ``session.yaml`` written.
-    folder : Path
-    n_pokes : int
-    format : str
-        ``"folder"``, ``"mcap"`` or ``"sqlite3"``.
-    live_betas : list of float
-        β of each poke as estimated live.
-    """
+    """What :func:`record_simulation` wrote: the ``session.yaml`` (``session_file``) in its
+    ``folder``, ``n_pokes``, the ``format`` and the β of each poke as estimated live."""
 
     session_file: Path
     folder: Path
@@ -48,30 +37,12 @@ class RecordOutput:
     live_betas: list[float]
 
 
-def record_simulation(
-    config: RunConfig,
-    out: Path | None = None,
-    *,
-    format: str = "folder",
-    hooks: RunHooks = NO_HOOKS,
-) -> RecordOutput:
-    """Explore ``config.scenario`` live and write what the world returned as a session.
-
-    Parameters
-    ----------
-    config : RunConfig
-        The world, seed and exploration settings (``exploration.max_pokes`` bounds the pokes).
-    out : Path, optional
-        A new or empty folder (default: :func:`~deformap.run.default_run_folder`, kind
-        ``record``).
-    format : {"folder", "mcap", "sqlite3"}
-        Cloud files, or a ROS 2 bag (extra ``ros``).
-    hooks : RunHooks
-
-    Raises
-    ------
-    ConfigError
-        Unknown format or scenario, or ``out`` not empty or not creatable (before any work).
+def record_simulation(config: RunConfig, out: Path | None = None, *, format: str = "folder",
+                      hooks: RunHooks = NO_HOOKS) -> RecordOutput:
+    """Explore ``config.scenario`` live and write what the world returned as a session in
+    ``out`` (new or empty; default kind ``record``): cloud files (``format="folder"``) or a ROS 2
+    bag (``"mcap"``, ``"sqlite3"``; extra ``ros``). An unknown format or scenario, or an ``out``
+    not empty or not creatable raises :class:`ConfigError` before any work.
     """
     if format not in SESSION_FORMATS:
         raise ConfigError(f"--format must be one of {list(SESSION_FORMATS)}; got {format!r}")
@@ -89,17 +60,11 @@ def record_simulation(
     result = explore(env, config.exploration, rng=explore_rng,
                      on_poke=lambda poke: hooks.poke(poke.record))  # fmt: skip
     xs, ys = world.workspace.grid(config.exploration.surface.grid_spacing_m)
-    truth = GroundTruth(
-        xs, ys, world.ground_truth_labels(xs, ys), world.ground_truth_hardness(xs, ys)
-    )
+    truth = GroundTruth(xs, ys, world.ground_truth_labels(xs, ys),
+                        world.ground_truth_hardness(xs, ys))
     live_betas = [p.record.beta for p in result.pokes]
-    source = {
-        "recorded_by": f"deformap {__version__} record-sim",
-        "scenario": config.scenario,
-        "seed": config.seed,
-        "live_betas": live_betas,
-        "config": config_to_dict(config),
-    }
+    source = {"recorded_by": f"deformap {__version__} record-sim", "scenario": config.scenario,
+              "seed": config.seed, "live_betas": live_betas, "config": config_to_dict(config)}
     hooks.stage("writing the session")
     file = write_session(folder, workspace=world.workspace, observation=env.observation,
                          presses=env.presses, ground_truth=truth, source=source,

@@ -43,33 +43,14 @@ def _scenario_stage(hooks: RunHooks, scenario: str, text: str) -> None:
     hooks.stage(f"{scenario}: {text}")
 
 
-def reproduce(
-    out: Path | None = None,
-    *,
-    base: RunConfig | None = None,
-    scenarios: Sequence[str] | None = None,
-    figures: bool = True,
-    on_run: Callable[[dict[str, Any]], None] | None = None,
-    hooks: RunHooks = NO_HOOKS,
-) -> ReproduceOutput:
-    """Run every scenario of Table I (or ``scenarios``) with ``base``'s settings.
-
-    Parameters
-    ----------
-    out : Path, optional
-        A new or empty folder (default: :func:`~deformap.run.default_run_folder`, stem
-        ``table-i``, kind ``reproduce``).
-    base : RunConfig, optional
-        Settings of every run; its ``scenario`` is replaced by each scenario's.
-    scenarios : sequence of str, optional
-        A subset (built-in names or YAML files); default: the six of Table I.
-    figures : bool
-        Write each run's figures.
-    on_run : callable, optional
-        Called with each table row as its run ends.
-    hooks : RunHooks
-        ``on_start`` once (total: the scenarios), ``on_stage`` per scenario and per stage of its
-        run, ``on_step`` per run.
+def reproduce(out: Path | None = None, *, base: RunConfig | None = None,
+              scenarios: Sequence[str] | None = None, figures: bool = True,
+              on_run: Callable[[dict[str, Any]], None] | None = None,
+              hooks: RunHooks = NO_HOOKS) -> ReproduceOutput:
+    """Run every scenario of Table I (or ``scenarios``: built-in names or YAML files) with
+    ``base``'s settings, each in ``out/<scenario>/`` (``out`` new or empty, default stem
+    ``table-i``), with its figures when ``figures``; ``on_run`` is called with each table row as
+    its run ends, ``hooks.step`` once per run and ``hooks.stage`` per stage of each.
     """
     base = base or RunConfig()
     names = list(scenarios) if scenarios else list(PAPER_TABLE_I)

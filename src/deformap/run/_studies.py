@@ -1,9 +1,7 @@
 """The studies on homogeneous simulated foams (the paper's Fig. 5), each into its own folder:
-``hardness.json`` and ``hardness.png`` (β against hardness per contact protocol), or
-``cluster-size.json`` and ``cluster-size.png`` (fit error against cluster size).
-
-The numbers come from :mod:`deformap.eval`; this module builds the worlds, writes the files and
-reports progress.
+``hardness.json`` and ``.png`` (β against hardness per contact protocol), or
+``cluster-size.json`` and ``.png`` (fit error against cluster size). The numbers come from
+:mod:`deformap.eval`; this module builds the worlds, writes the files and reports progress.
 """
 
 from __future__ import annotations
@@ -44,14 +42,8 @@ from deformap.world import (
 )
 
 __all__ = [
-    "CLUSTER_SIZE_FOAMS",
-    "FULL_CAMERAS",
-    "FULL_ELEMENT_SIZE_M",
-    "FULL_PHYSICS",
-    "FULL_THICKNESSES_M",
-    "StudyOutput",
-    "run_cluster_size_study",
-    "run_hardness_study",
+    "CLUSTER_SIZE_FOAMS", "FULL_CAMERAS", "FULL_ELEMENT_SIZE_M", "FULL_PHYSICS",
+    "FULL_THICKNESSES_M", "StudyOutput", "run_cluster_size_study", "run_hardness_study",
 ]
 
 CLUSTER_SIZE_FOAMS: tuple[float, ...] = (60.0, 110.0, 150.0)
@@ -60,16 +52,11 @@ CLUSTER_SIZE_FOAMS: tuple[float, ...] = (60.0, 110.0, 150.0)
 FULL_CAMERAS: tuple[str, ...] = ("primesense", "kinect-v1", "realsense-d435")
 FULL_THICKNESSES_M: tuple[float, ...] = (0.03, 0.05, 0.10)
 FULL_PHYSICS: tuple[str, ...] = PHYSICS
-"""The matrix of ``deformap study hardness --full``: every camera preset × three foam thicknesses
-(metres) × every physics of the world (:data:`deformap.world.PHYSICS`)."""
+"""The matrix of ``study hardness --full``: camera presets × thicknesses (metres) × physics."""
 
 FULL_ELEMENT_SIZE_M = 0.00375
-"""The world's in-plane element size for ``--full``, metres, in place of the default 7.5 mm.
-
-The matrix's stiffest press (250 N foam, 0.6 N, 10 mm tip) touches a patch of 5–6 mm radius,
-smaller than a 7.5 mm element, which then presses too stiff; a contact-resolving mesh keeps the
-world's discretisation error well under the estimator's claimed σ of E, so the study measures the
-estimator, not the mesh. It costs about five times the time and memory per condition."""
+"""The world's in-plane element size for ``--full``, metres: the stiffest press's contact patch
+(5–6 mm radius) is smaller than the default 7.5 mm element, which would then press too stiff."""
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -81,12 +68,10 @@ class StudyOutput:
     files: list[Path]
 
 
-def _foams(
-    foams: Sequence[float | None], *, seed: int, coarse: bool,
-    hooks: RunHooks, camera: str | None = None, thickness_m: float = 0.05,
-    force_n: float | None = None, physics: Physics = "linear-fem",
-    element_size_m: float | None = None,
-) -> list[FoamPresses]:  # fmt: skip
+def _foams(foams: Sequence[float | None], *, seed: int, coarse: bool, hooks: RunHooks,
+           camera: str | None = None, thickness_m: float = 0.05, force_n: float | None = None,
+           physics: Physics = "linear-fem", element_size_m: float | None = None,
+           ) -> list[FoamPresses]:
     world = _study_world(physics, coarse=coarse, element_size_m=element_size_m)
     if camera is not None:
         world = dataclasses.replace(world, camera=camera_preset(camera))
@@ -96,8 +81,7 @@ def _foams(
 
 
 def _study_world(physics: Physics, *, coarse: bool, element_size_m: float | None) -> WorldConfig:
-    """The world a study presses: the default (or coarse) one, with ``element_size_m`` in-plane
-    elements and top layers no thicker when given."""
+    """The default (or coarse) world, with ``element_size_m`` elements and top layers no thicker."""
     world = WorldConfig.coarse(physics=physics) if coarse else WorldConfig(physics=physics)
     if element_size_m is None:
         return world
@@ -107,10 +91,8 @@ def _study_world(physics: Physics, *, coarse: bool, element_size_m: float | None
 
 def _check_study_mesh(element_size_m: float, thicknesses_m: Sequence[float],
                      physics_names: Sequence[str]) -> None:
-    """Refuse, before any folder or world, an element size whose study blocks (one per thickness
-    and physics) would exceed the world's mesh budget
-    (:func:`deformap.world.check_world_budget`): a :class:`SettingError` naming
-    ``element_size_m``, the block and the limit."""
+    """Refuse (:class:`SettingError` naming ``element_size_m``, the block and the limit) an element
+    size whose study blocks would exceed :func:`deformap.world.check_world_budget`."""
     for physics_name in physics_names:
         world = _study_world(WorldConfig(physics=physics_name).physics,  # type: ignore[arg-type]
                              coarse=False, element_size_m=element_size_m)
@@ -132,70 +114,28 @@ def _write(folder: Path, stem: str, study: dict[str, Any], plot: Any) -> list[Pa
 
 
 def run_hardness_study(
-    out: Path | None = None,
-    *,
-    seed: int = 0,
-    hardness: Sequence[float] | None = None,
-    coarse: bool = False,
-    camera: str | None = None,
-    thickness_m: float = 0.05,
-    force_n: float | None = None,
-    physics: str = "linear-fem",
-    full: bool = False,
-    cameras: Sequence[str] | None = None,
-    thicknesses_m: Sequence[float] | None = None,
-    physics_names: Sequence[str] | None = None,
-    protocols: Sequence[str] | None = None,
-    element_size_m: float | None = None,
-    hooks: RunHooks = NO_HOOKS,
-) -> StudyOutput:
+    out: Path | None = None, *, seed: int = 0, hardness: Sequence[float] | None = None,
+    coarse: bool = False, camera: str | None = None, thickness_m: float = 0.05,
+    force_n: float | None = None, physics: str = "linear-fem", full: bool = False,
+    cameras: Sequence[str] | None = None, thicknesses_m: Sequence[float] | None = None,
+    physics_names: Sequence[str] | None = None, protocols: Sequence[str] | None = None,
+    element_size_m: float | None = None, hooks: RunHooks = NO_HOOKS,
+) -> StudyOutput:  # fmt: skip
     """β (each contact protocol) and the force–travel reading (stiffness, Young's modulus)
-    against hardness (:func:`deformap.eval.hardness_study`), under one condition or, with
-    ``full``, over a matrix of them.
+    against hardness (:func:`deformap.eval.hardness_study`) into ``out`` (new or empty; default
+    stem ``hardness``), on the foams ``hardness`` in newtons and the rigid board (default
+    :data:`~deformap.eval.DEFAULT_HARDNESSES`), each world's noise from ``seed``.
 
-    Parameters
-    ----------
-    out : Path, optional
-        A new or empty folder (default: :func:`~deformap.run.default_run_folder`, stem
-        ``hardness``, kind ``study``).
-    seed : int
-        Seed of the worlds' noise (the same for every condition).
-    hardness : sequence of float, optional
-        Foams in newtons (the rigid board is added); default
-        :data:`~deformap.eval.DEFAULT_HARDNESSES`.
-    coarse : bool
-        The coarse FEM mesh (a quick look).
-    camera : str, optional
-        A :data:`deformap.world.CAMERA_PRESETS` name (default: the world's own camera).
-    thickness_m : float
-        The foam blocks' thickness.
-    force_n : float, optional
-        The press force (default: the exploration's).
-    physics : str
-        The world's contact physics, a :data:`deformap.world.PHYSICS` name (``WorldConfig.physics``).
-    full : bool
-        Every condition of :data:`FULL_CAMERAS` × :data:`FULL_THICKNESSES_M` ×
-        :data:`FULL_PHYSICS` (``camera``, ``thickness_m`` and ``physics`` are then not used).
-    cameras, thicknesses_m, physics_names : sequence, optional
-        With ``full``, the matrix's cameras, thicknesses and physics in place of the full ones (a
-        smaller matrix).
-    protocols : sequence of str, optional
-        The contact protocols whose β is fitted, names of :data:`~deformap.eval.PROTOCOLS`
-        (default :data:`~deformap.eval.STUDY_PROTOCOLS`: the default one and the paper's).
-    element_size_m : float, optional
-        The world's in-plane FEM element size (``WorldConfig.element_size_m``; its top layer no
-        thicker) in place of the default: the world's 7.5 mm for one condition,
-        :data:`FULL_ELEMENT_SIZE_M` with ``full``. How much of E's error is the world's
-        discretisation (a small contact patch on coarse elements presses too stiff). Not with
-        ``coarse``.
-    hooks : RunHooks
+    One condition is a ``camera`` preset (default primesense), a block ``thickness_m`` in metres
+    and a world ``physics``; ``full`` presses every condition of :data:`FULL_CAMERAS` ×
+    :data:`FULL_THICKNESSES_M` × :data:`FULL_PHYSICS`, or of ``cameras``, ``thicknesses_m`` and
+    ``physics_names`` where given. ``force_n`` defaults to the exploration's, ``protocols`` to
+    :data:`~deformap.eval.STUDY_PROTOCOLS`; ``element_size_m`` (not with ``coarse``) sets the
+    world's in-plane FEM elements, :data:`FULL_ELEMENT_SIZE_M` by default with ``full``.
 
-    Notes
-    -----
-    The study's JSON has ``rows`` (each names its ``camera``, ``thickness_m``, ``physics`` and
-    ``force_n``), ``summary`` (one entry per condition) and ``overall`` (one per physics), see
-    :func:`deformap.eval.hardness_summary`; a single-condition study also has its condition and
-    the monotone flags at the top, a full one its ``matrix``.
+    The study's JSON has ``rows`` (each naming its ``camera``, ``thickness_m``, ``physics`` and
+    ``force_n``) and :func:`deformap.eval.hardness_summary`'s ``summary`` and ``overall``; a
+    single-condition study also its condition and monotone flags, a full one its ``matrix``.
     """
     from deformap.viz import plot_hardness_study  # matplotlib: only when a study is drawn
 
@@ -213,15 +153,7 @@ def run_hardness_study(
         element_size_m = FULL_ELEMENT_SIZE_M
     foams = DEFAULT_HARDNESSES if not hardness else (*hardness, None)
     _check_press(foams, force_n)
-    checked = []
-    for name, thickness, physics_name in conditions:  # bad names fail here, before any world
-        camera_preset(name)
-        check_positive("thickness_m", thickness)
-        checked.append((name, float(thickness),
-                        WorldConfig(physics=physics_name).physics))  # type: ignore[arg-type]
-    checked = list(dict.fromkeys(checked))  # a condition named twice is pressed once
-    for _, thickness, _ in checked:  # a block the world cannot build: before any folder
-        block_scenario(None, Workspace(), thickness)
+    checked = _checked(conditions)
     if element_size_m is not None:  # nor a mesh it would refuse
         _check_study_mesh(element_size_m, sorted({c[1] for c in checked}),
                          list(dict.fromkeys(c[2] for c in checked)))
@@ -262,18 +194,32 @@ def run_hardness_study(
                        files=_write(folder, "hardness", study, plot_hardness_study))  # fmt: skip
 
 
+def _checked(conditions: Sequence[tuple[str, float, str]]) -> list[tuple[str, float, Physics]]:
+    """The conditions checked before any folder or world (names, thickness, the block), each
+    once."""
+    checked = []
+    for name, thickness, physics_name in conditions:
+        camera_preset(name)
+        check_positive("thickness_m", thickness)
+        checked.append((name, float(thickness),
+                        WorldConfig(physics=physics_name).physics))  # type: ignore[arg-type]
+    checked = list(dict.fromkeys(checked))
+    for _, thickness, _ in checked:
+        block_scenario(None, Workspace(), thickness)
+    return checked
+
+
 def _check_press(foams: Sequence[float | None], force_n: float | None) -> None:
-    """The foams and the force, checked before any folder or world: each foam a block the world
-    can build, and a force that gives a force–travel record."""
+    """Each foam a block the world can build, a force that gives a force–travel record."""
     for value in foams:
         if value is not None:
             block_scenario(value, Workspace())
     if force_n is not None:
         force = check_positive("force_n", force_n)
         if not force >= MIN_RECORD_FORCE_N:
-            raise InvalidArgumentError(
-                f"`force_n` must be at least {MIN_RECORD_FORCE_N:g} N, a press the world gives a "
-                f"force–travel record of; got {force:g}")
+            raise InvalidArgumentError(f"`force_n` must be at least {MIN_RECORD_FORCE_N:g} N, a "
+                                       f"press the world gives a force–travel record of; got "
+                                       f"{force:g}")
 
 
 def _protocols(names: Sequence[str] | None) -> dict[str, dict[str, Any]]:
@@ -291,13 +237,8 @@ def _force(force_n: float | None) -> float:
     return ExplorationConfig().force_n if force_n is None else float(force_n)
 
 
-def run_cluster_size_study(
-    out: Path | None = None,
-    *,
-    seed: int = 0,
-    coarse: bool = False,
-    hooks: RunHooks = NO_HOOKS,
-) -> StudyOutput:
+def run_cluster_size_study(out: Path | None = None, *, seed: int = 0, coarse: bool = False,
+                           hooks: RunHooks = NO_HOOKS) -> StudyOutput:
     """Fit error and β against cluster size 2×2 … 6×6 (:func:`deformap.eval.cluster_size_study`)
     on the foams :data:`CLUSTER_SIZE_FOAMS` and the rigid board.
 

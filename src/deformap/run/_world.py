@@ -28,8 +28,7 @@ class ScenarioSummary:
 
 
 def scenario_summaries() -> list[ScenarioSummary]:
-    """Every built-in scenario (the paper's Table I), in :func:`deformap.world.list_scenarios`
-    order."""
+    """Every built-in scenario, in :func:`deformap.world.list_scenarios` order."""
     out = []
     for name in list_scenarios():
         sc = load_scenario(name)
@@ -38,31 +37,14 @@ def scenario_summaries() -> list[ScenarioSummary]:
     return out
 
 
-def show_scenario(
-    name: str, out: Path, *, seed: int = 0, coarse: bool = False,
-    force_n: float = ExplorationConfig().force_n, hooks: RunHooks = NO_HOOKS,
-) -> list[Path]:
-    """Write ``layout.png``, ``rgb.png``, ``cloud.png`` and ``dent.png`` of scenario ``name`` into
-    ``out``.
+def show_scenario(name: str, out: Path, *, seed: int = 0, coarse: bool = False,
+                  force_n: float = ExplorationConfig().force_n, hooks: RunHooks = NO_HOOKS,
+                  ) -> list[Path]:
+    """Write ``layout.png``, ``rgb.png``, ``cloud.png`` and ``dent.png`` of scenario ``name`` (a
+    built-in name or YAML file) into ``out``, a new or empty folder, and return their paths.
 
-    Parameters
-    ----------
-    name : str
-        Built-in scenario name or YAML file.
-    out : Path
-        A new or empty folder, created before the world is built.
-    seed : int
-        Seed of the camera and sensor noise.
-    coarse : bool
-        The coarse test mesh (fast).
-    force_n : float
-        The press of ``dent.png`` (default: the exploration's).
-    hooks : RunHooks
-
-    Returns
-    -------
-    list of Path
-        The pictures written.
+    ``seed`` seeds the camera and sensor noise, ``coarse`` takes the coarse test mesh, ``force_n``
+    is the press of ``dent.png`` (default: the exploration's).
     """
     from deformap.viz import show_world  # matplotlib: only when pictures are drawn
 
