@@ -69,32 +69,12 @@ _MODULES = {
     "world": ("SimulatedWorld", "WorldConfig", "list_scenarios", "load_scenario"),
 }  # fmt: skip
 
-__all__ = [
-    "BetaEstimate",
-    "DeformapError",
-    "Environment",
-    "ExplorationConfig",
-    "ExplorationResult",
-    "ForceTravel",
-    "GaussianRandomField",
-    "PointCloud",
-    "PokeRecord",
-    "PressObservation",
-    "RunConfig",
-    "ShapeMatchingConfig",
-    "SimulatedWorld",
-    "TactileContact",
-    "Workspace",
-    "WorldConfig",
-    "__version__",
-    "estimate_beta",
-    "explore_scenario",
-    "list_scenarios",
-    "load_scenario",
-    "load_session",
-    "map_session",
-    "write_session",
-]  # fmt: skip
+__all__ = ["BetaEstimate", "DeformapError", "Environment", "ExplorationConfig",
+           "ExplorationResult", "ForceTravel", "GaussianRandomField", "PointCloud", "PokeRecord",
+           "PressObservation", "RunConfig", "ShapeMatchingConfig", "SimulatedWorld",
+           "TactileContact", "Workspace", "WorldConfig", "__version__", "estimate_beta",
+           "explore_scenario", "list_scenarios", "load_scenario", "load_session", "map_session",
+           "write_session"]  # fmt: skip
 
 # a subpackage as an attribute of deformap (``deformap.gp``) without importing it first; no name
 # above is a subpackage's (``explore()`` stays ``deformap.explore.explore``: as ``deformap.explore``

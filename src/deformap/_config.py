@@ -96,8 +96,7 @@ def config_from_dict(cls: type[T], data: Any, *, where: str = "config") -> T:
     unknown = sorted(set(data) - set(fields))
     if unknown:
         raise ConfigError(
-            f"`{where}` has unknown key(s) {unknown}; known keys are {sorted(fields)}"
-        )
+            f"`{where}` has unknown key(s) {unknown}; known keys are {sorted(fields)}")
     hints = typing.get_type_hints(cls)
     kwargs = {name: _shape(value, hints[name], f"{where}.{name}") for name, value in data.items()}
     try:

@@ -17,6 +17,7 @@ import sys
 from collections.abc import Sequence
 from dataclasses import Field, field, fields, is_dataclass
 from functools import cache
+from pathlib import Path
 from types import UnionType
 from typing import Any, Literal, Union, get_args, get_origin, get_type_hints
 
@@ -25,22 +26,10 @@ from numpy.typing import NDArray
 
 from deformap.errors import InvalidArgumentError
 
-__all__ = [
-    "SettingError",
-    "check_array",
-    "check_finite_scalar",
-    "check_in_range",
-    "check_int",
-    "check_points",
-    "check_positive",
-    "check_rigid_transform",
-    "check_settings",
-    "check_slope_deg",
-    "check_vector",
-    "describe",
-    "setting",
-    "setting_metadata",
-]
+__all__ = ["SettingError", "check_array", "check_finite_scalar", "check_in_range", "check_int",
+           "check_path", "check_points", "check_positive", "check_rigid_transform",
+           "check_settings", "check_slope_deg", "check_vector", "describe", "setting",
+           "setting_metadata"]
 
 
 def describe(value: Any) -> str:
@@ -60,15 +49,8 @@ def _shape_text(shape: Sequence[int | None]) -> str:
     return "(" + ", ".join(dims) + ("," if len(dims) == 1 else "") + ")"
 
 
-def check_array(
-    name: str,
-    value: Any,
-    shape: Sequence[int | None],
-    *,
-    what: str = "floats",
-    min_rows: int = 0,
-    finite: bool = True,
-) -> NDArray[np.float64]:
+def check_array(name: str, value: Any, shape: Sequence[int | None], *, what: str = "floats",
+                min_rows: int = 0, finite: bool = True) -> NDArray[np.float64]:
     """Validate a float array of a given shape; ``None`` in ``shape`` means any size.
 
     Parameters
@@ -105,15 +87,21 @@ def check_array(
         raise InvalidArgumentError(f"`{name}` must be {expected}; got shape {arr.shape}")
     if arr.ndim and arr.shape[0] < min_rows:
         raise InvalidArgumentError(
-            f"`{name}` must have at least {min_rows} rows; got {arr.shape[0]}"
-        )
+            f"`{name}` must have at least {min_rows} rows; got {arr.shape[0]}")
     arr = np.ascontiguousarray(arr, dtype=np.float64)
     if finite and not np.all(np.isfinite(arr)):
         bad = int(np.count_nonzero(~np.isfinite(arr)))
         raise InvalidArgumentError(
-            f"`{name}` must be {expected}; got {bad} NaN or infinite value(s)"
-        )
+            f"`{name}` must be {expected}; got {bad} NaN or infinite value(s)")
     return arr
+
+
+def check_path(name: str, value: Any) -> Path:
+    """Validate a file-system path given as a ``str`` or :class:`~pathlib.Path`."""
+    if not isinstance(value, (str, Path)):
+        raise InvalidArgumentError(
+            f"`{name}` must be a str or pathlib.Path; got {type(value).__name__}")
+    return Path(value)
 
 
 def check_points(name: str, value: Any, *, min_rows: int = 1) -> NDArray[np.float64]:
@@ -158,14 +146,8 @@ def check_positive(name: str, value: Any, *, allow_zero: bool = False) -> float:
     return out
 
 
-def check_in_range(
-    name: str,
-    value: Any,
-    low: float,
-    high: float,
-    *,
-    closed_high: bool = False,
-) -> float:
+def check_in_range(name: str, value: Any, low: float, high: float, *,
+                   closed_high: bool = False) -> float:
     """Validate ``low <= value < high`` (``<= high`` with ``closed_high``)."""
     out = check_finite_scalar(name, value)
     ok = low <= out <= high if closed_high else low <= out < high
@@ -217,16 +199,9 @@ class SettingError(InvalidArgumentError):
         return (type(self), (self.field, self.detail))
 
 
-def setting(
-    default: Any,
-    *,
-    gt: float | None = None,
-    ge: float | None = None,
-    lt: float | None = None,
-    le: float | None = None,
-    finite: bool = True,
-    doc: str | None = None,
-) -> Any:
+def setting(default: Any, *, gt: float | None = None, ge: float | None = None,
+            lt: float | None = None, le: float | None = None, finite: bool = True,
+            doc: str | None = None) -> Any:
     """A dataclass field whose bounds (and description) are declared beside it.
 
     Parameters

@@ -31,19 +31,9 @@ from deformap.cloud import PointCloud, hull_parts
 from deformap.errors import InvalidArgumentError
 from deformap.mechanics import TactileContact
 
-__all__ = [
-    "FORCE_MISMATCH_ABS_N",
-    "FORCE_MISMATCH_REL",
-    "MAX_GRID_CELLS",
-    "MAX_TRAVEL_M",
-    "MIN_FORCE_RISE_N",
-    "TRAVEL_BACKWARDS_TOLERANCE_M",
-    "Environment",
-    "ForceTravel",
-    "PressObservation",
-    "TactileContact",
-    "Workspace",
-]
+__all__ = ["FORCE_MISMATCH_ABS_N", "FORCE_MISMATCH_REL", "MAX_GRID_CELLS", "MAX_TRAVEL_M",
+           "MIN_FORCE_RISE_N", "TRAVEL_BACKWARDS_TOLERANCE_M", "Environment", "ForceTravel",
+           "PressObservation", "TactileContact", "Workspace"]
 
 
 #: Most cells of a :meth:`Workspace.grid` (200 MB per float map layer), refused before any array
@@ -167,41 +157,35 @@ class ForceTravel:
         if travel.shape != force.shape:
             raise InvalidArgumentError(
                 f"`force_n` must have one sample per `travel_m` sample ({travel.size}); "
-                f"got {force.size}"
-            )
+                f"got {force.size}")
         largest = float(np.max(np.abs(travel)))
         if largest > MAX_TRAVEL_M:
             raise InvalidArgumentError(
                 f"`travel_m` must be metres, at most {MAX_TRAVEL_M} m in magnitude (a press does "
-                f"not sink the tip that far; millimetres?); got {largest:.4g}"
-            )
+                f"not sink the tip that far; millimetres?); got {largest:.4g}")
         if abs(travel[0]) > TRAVEL_BACKWARDS_TOLERANCE_M:
             raise InvalidArgumentError(
                 f"`travel_m` must be the travel since first contact, its first sample 0 within "
                 f"{TRAVEL_BACKWARDS_TOLERANCE_M} m (encoder noise); got {travel[0]:.4g} m (an "
-                "absolute position?)"
-            )
+                "absolute position?)")
         if float(force.min()) < -MIN_FORCE_RISE_N:
             raise InvalidArgumentError(
                 f"`force_n` must be the force pressing the surface, >= 0 within "
                 f"{MIN_FORCE_RISE_N} N (sensor noise); got {float(force.min()):.4g} N (a sensor "
-                "not zeroed, or its reaction force not negated?)"
-            )
+                "not zeroed, or its reaction force not negated?)")
         behind = np.maximum.accumulate(travel) - travel
         worst = int(np.argmax(behind))
         if behind[worst] > TRAVEL_BACKWARDS_TOLERANCE_M:
             raise InvalidArgumentError(
                 f"`travel_m` must not go backwards by more than {TRAVEL_BACKWARDS_TOLERANCE_M} m "
                 f"(encoder noise); sample {worst} lies {behind[worst]:.4g} m below the largest "
-                "travel before it"
-            )
+                "travel before it")
         rise = float(force[-1] - force[0])
         if force[-1] <= 0.0 or rise <= MIN_FORCE_RISE_N:
             raise InvalidArgumentError(
                 f"`force_n` must rise from contact to the commanded force: the last sample "
                 f"positive and more than {MIN_FORCE_RISE_N} N above the first; got first "
-                f"{force[0]:.4g} N, last {force[-1]:.4g} N"
-            )
+                f"{force[0]:.4g} N, last {force[-1]:.4g} N")
         travel.setflags(write=False)
         force.setflags(write=False)
         object.__setattr__(self, "travel_m", travel)
@@ -254,8 +238,7 @@ class PressObservation:
             raise InvalidArgumentError(f"`cloud` must be a PointCloud; got {type(self.cloud)}")
         if not isinstance(self.contact, TactileContact):
             raise InvalidArgumentError(
-                f"`contact` must be a TactileContact; got {type(self.contact)}"
-            )
+                f"`contact` must be a TactileContact; got {type(self.contact)}")
         parts = hull_parts(self.robot_points)
         hulls = ((check_points("robot_points", self.robot_points, min_rows=4),) if parts is None
                  else tuple(check_points(f"robot_points[{i}]", part, min_rows=4)
@@ -274,15 +257,13 @@ class PressObservation:
             return
         if not isinstance(record, ForceTravel):
             raise InvalidArgumentError(
-                f"`force_travel` must be a ForceTravel or None; got {type(record).__name__}"
-            )
+                f"`force_travel` must be a ForceTravel or None; got {type(record).__name__}")
         final = float(record.force_n[-1])
         allowed = FORCE_MISMATCH_REL * force_n + FORCE_MISMATCH_ABS_N
         if abs(final - force_n) > allowed:
             raise InvalidArgumentError(
                 f"`force_travel` must end at the commanded force {force_n:.4g} N (within "
-                f"{allowed:.3g} N); its last force is {final:.4g} N"
-            )
+                f"{allowed:.3g} N); its last force is {final:.4g} N")
 
 
     @property

@@ -7,15 +7,8 @@ user can fix the call without reading our source. Each class also derives from t
 
 from __future__ import annotations
 
-__all__ = [
-    "ConfigError",
-    "DeformapError",
-    "EnvironmentStateError",
-    "FileFormatError",
-    "InvalidArgumentError",
-    "MissingDependencyError",
-    "NotPositiveDefiniteError",
-]
+__all__ = ["ConfigError", "DeformapError", "EnvironmentStateError", "FileFormatError",
+           "InvalidArgumentError", "MissingDependencyError", "NotPositiveDefiniteError"]
 
 
 class DeformapError(Exception):
@@ -60,5 +53,4 @@ def missing_extra(module: str, extra: str, purpose: str) -> MissingDependencyErr
     """
     return MissingDependencyError(
         f"{purpose} needs the optional package {module!r}, which is not installed; "
-        f"install it with: pip install 'deformap[{extra}]'"
-    )
+        f"install it with: pip install 'deformap[{extra}]'")

@@ -23,14 +23,8 @@ from deformap._validation import (
 )
 from deformap.errors import InvalidArgumentError
 
-__all__ = [
-    "HULL_TOLERANCE_M",
-    "crop_box",
-    "height_field_mask",
-    "hull_parts",
-    "points_in_hull",
-    "statistical_outlier_mask",
-]
+__all__ = ["HULL_TOLERANCE_M", "crop_box", "height_field_mask", "hull_parts", "points_in_hull",
+           "statistical_outlier_mask"]
 
 logger = logging.getLogger(__name__)
 
@@ -62,8 +56,7 @@ def crop_box(points: Any, lower: Any, upper: Any) -> NDArray[np.bool_]:
     if np.any(lo > hi):
         raise InvalidArgumentError(
             f"`lower` must be <= `upper` on every axis; got lower={lo.tolist()}, "
-            f"upper={hi.tolist()}"
-        )
+            f"upper={hi.tolist()}")
     return np.all((pts >= lo) & (pts <= hi), axis=1)
 
 
@@ -118,8 +111,7 @@ def statistical_outlier_mask(points: Any, k: int, std_ratio: float) -> NDArray[n
     if n < max(k, 2):
         raise InvalidArgumentError(
             f"`points` must hold at least k={k} points (and at least 2) for the statistical "
-            f"outlier rule; got {n}"
-        )
+            f"outlier rule; got {n}")
     avg = _mean_neighbour_distances(pts, k)
     positive = avg > 0
     mean = avg.sum() / n
@@ -168,8 +160,7 @@ def height_field_mask(points: Any, k: int = 20, max_slope_deg: float = 60.0) -> 
     n = pts.shape[0]
     if n < k:
         raise InvalidArgumentError(
-            f"`points` must hold at least k={k} points for the local plane fits; got {n}"
-        )
+            f"`points` must hold at least k={k} points for the local plane fits; got {n}")
     if slope == 90.0:
         return np.ones(n, dtype=bool)
     _, idx = cKDTree(pts).query(pts, k=k)
@@ -244,8 +235,7 @@ def _in_one_hull(pts: NDArray[np.float64], verts: NDArray[np.float64], tol: floa
     if singular[2] <= 1e-9 * max(singular[0], np.finfo(float).tiny):
         raise InvalidArgumentError(
             "`hull_points` must span a volume (at least 4 points, not all on one plane or line); "
-            f"got {verts.shape[0]} points whose spread is {singular.tolist()} along its axes"
-        )
+            f"got {verts.shape[0]} points whose spread is {singular.tolist()} along its axes")
     from scipy.spatial import ConvexHull, QhullError
 
     try:

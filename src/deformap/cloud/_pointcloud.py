@@ -48,15 +48,13 @@ class PointCloud:
                 if raw.size and (raw.min() < 0 or raw.max() > 255):
                     raise InvalidArgumentError(
                         "`colors` given as integers must lie in [0, 255]; "
-                        f"got values from {raw.min()} to {raw.max()}"
-                    )
+                        f"got values from {raw.min()} to {raw.max()}")
                 raw = raw / 255.0
             cols = check_array("colors", raw, (pts.shape[0], 3), what="RGB values in [0, 1]")
             if cols.size and (cols.min() < 0.0 or cols.max() > 1.0):
                 raise InvalidArgumentError(
                     "`colors` must lie in [0, 1] (floats) or [0, 255] (integers); "
-                    f"got values from {cols.min():g} to {cols.max():g}"
-                )
+                    f"got values from {cols.min():g} to {cols.max():g}")
             cols.setflags(write=False)
             object.__setattr__(self, "colors", cols)
         if not isinstance(self.frame, str) or not self.frame:
@@ -80,12 +78,10 @@ class PointCloud:
         index = np.asarray(mask)
         if index.dtype == np.bool_ and index.shape != (len(self),):
             raise InvalidArgumentError(
-                f"`mask` must be a ({len(self)},) boolean array; got shape {index.shape}"
-            )
+                f"`mask` must be a ({len(self)},) boolean array; got shape {index.shape}")
         if index.dtype != np.bool_ and not np.issubdtype(index.dtype, np.integer):
             raise InvalidArgumentError(
-                f"`mask` must be booleans or integer indices; got dtype {index.dtype}"
-            )
+                f"`mask` must be booleans or integer indices; got dtype {index.dtype}")
         if index.dtype != np.bool_ and index.size and (
                 index.min() < -len(self) or index.max() >= len(self)):
             raise InvalidArgumentError(
@@ -108,8 +104,7 @@ class PointCloud:
         frames = {c.frame for c in clouds}
         if len(frames) != 1:
             raise InvalidArgumentError(
-                f"`clouds` must share one frame; got frames {sorted(frames)}"
-            )
+                f"`clouds` must share one frame; got frames {sorted(frames)}")
         pts = np.concatenate([c.points for c in clouds])
         have_colors = all(c.colors is not None for c in clouds)
         cols = np.concatenate([c.colors for c in clouds]) if have_colors else None

@@ -81,14 +81,8 @@ def contact_cap(tip_radius_m: float, indentation_m: float,
     return half_angle, int(np.clip(round(most * area), 1, most))
 
 
-def tactile_points(
-    tip_center: Any,
-    force_vector: Any,
-    tip_radius_m: float,
-    n: int = 10,
-    *,
-    cap_half_angle_deg: float = DEFAULT_CAP_HALF_ANGLE_DEG,
-) -> NDArray[np.float64]:
+def tactile_points(tip_center: Any, force_vector: Any, tip_radius_m: float, n: int = 10, *,
+                   cap_half_angle_deg: float = DEFAULT_CAP_HALF_ANGLE_DEG) -> NDArray[np.float64]:
     """Deterministic points on the spherical cap of the probe tip that touches the surface.
 
     Parameters
@@ -133,6 +127,5 @@ def tactile_points(
     directions = (
         cos_theta[:, None] * axis
         + (sin_theta * np.cos(phi))[:, None] * e1
-        + (sin_theta * np.sin(phi))[:, None] * e2
-    )
+        + (sin_theta * np.sin(phi))[:, None] * e2)
     return np.asarray(center + radius * directions)

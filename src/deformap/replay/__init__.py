@@ -37,35 +37,12 @@ from deformap.replay._write import SESSION_FORMATS, write_session
 # that reading a session stays light.
 _OFFLINE = ("ReplayResult", "estimate_poke", "map_session", "tip_sphere_points")
 
-__all__ = [
-    "DEFAULT_CONTACT_GAP_M",
-    "DEFAULT_HULL",
-    "FORMAT_NAME",
-    "FORMAT_VERSION",
-    "OPTIONAL_TOPICS",
-    "RAW_CONFIG_NAME",
-    "RAW_SUFFIXES",
-    "SESSION_FILE",
-    "SESSION_FORMATS",
-    "TOPICS",
-    "GroundTruth",
-    "HullPart",
-    "RawBagConfig",
-    "RecordedSession",
-    "RecordingEnvironment",
-    "ReplayResult",
-    "estimate_poke",
-    "is_raw_bag",
-    "load_raw_bag",
-    "load_raw_config",
-    "load_session",
-    "map_session",
-    "raw_config_file",
-    "read_ground_truth",
-    "tip_sphere_points",
-    "write_ground_truth",
-    "write_session",
-]
+__all__ = ["DEFAULT_CONTACT_GAP_M", "DEFAULT_HULL", "FORMAT_NAME", "FORMAT_VERSION",
+           "OPTIONAL_TOPICS", "RAW_CONFIG_NAME", "RAW_SUFFIXES", "SESSION_FILE", "SESSION_FORMATS",
+           "TOPICS", "GroundTruth", "HullPart", "RawBagConfig", "RecordedSession",
+           "RecordingEnvironment", "ReplayResult", "estimate_poke", "is_raw_bag", "load_raw_bag",
+           "load_raw_config", "load_session", "map_session", "raw_config_file",
+           "read_ground_truth", "tip_sphere_points", "write_ground_truth", "write_session"]
 
 
 def __getattr__(name: str) -> Any:

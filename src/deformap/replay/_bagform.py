@@ -91,8 +91,7 @@ class BagReader:
             return None
         if len(raws) > 1:
             raise FileFormatError(
-                f"{where}: {len(raws)} messages; a poke needs at most one force–travel record"
-            )
+                f"{where}: {len(raws)} messages; a poke needs at most one force–travel record")
         try:
             msg = typestore().deserialize_cdr(raws[0].data, msgtype)
         except bag_read_errors() as exc:
@@ -106,8 +105,7 @@ class BagReader:
             raise FileFormatError(
                 f"{where}: layout must be {FORCE_TRAVEL_DIMS[0]!r} (n) × "
                 f"{FORCE_TRAVEL_DIMS[1]!r} (2) with 2n values from offset 0; got dims {dims}, "
-                f"offset {msg.layout.data_offset}, {data.size} values"
-            )
+                f"offset {msg.layout.data_offset}, {data.size} values")
         rows = data.reshape(-1, 2)
         try:
             return ForceTravel(travel_m=rows[:, 0], force_n=rows[:, 1])
@@ -131,8 +129,7 @@ class BagReader:
                     by_stamp.setdefault(stamp, msg)
                 except errors as exc:
                     self._undecodable.setdefault(topic, []).append(
-                        f"message {number + 1}: {bag_error_text(exc, 120)}"
-                    )
+                        f"message {number + 1}: {bag_error_text(exc, 120)}")
             decoded[key] = by_stamp
         self._decoded = decoded
         return decoded
@@ -144,22 +141,19 @@ class BagReader:
         if repeated:
             raise FileFormatError(
                 f"{self.path}: topic {topic!r} has {repeated} messages stamped {stamp}; "
-                "a poke needs exactly one on each topic"
-            )
+                "a poke needs exactly one on each topic")
         if msg is None:
             bad = self._undecodable.get(topic, [])
             note = f"; {len(bad)} message(s) there could not be decoded ({bad[0]})" if bad else ""
             raise FileFormatError(
-                f"{self.path}: topic {topic!r} has no message stamped {stamp}{note}"
-            )
+                f"{self.path}: topic {topic!r} has no message stamped {stamp}{note}")
         return msg
 
     def _cloud(self, msg: Any, where: str, frame: str, colors: bool = True) -> PointCloud:
         if msg.header.frame_id != frame:
             raise FileFormatError(
                 f"{where}: header.frame_id is {msg.header.frame_id!r} but the session's frame is "
-                f"{frame!r} (session.yaml `frame`)"
-            )
+                f"{frame!r} (session.yaml `frame`)")
         # holes of an organised cloud (is_dense false) are dropped with their colours
         cloud, _ = pointcloud2_to_cloud(msg, where=where, units=self.header.units, frame=frame,
                                         colors=colors)  # fmt: skip
@@ -183,8 +177,7 @@ class BagReader:
             bad = self._undecodable.get(topic, [])
             raise FileFormatError(
                 f"{self.path}: topic {topic!r} must hold exactly one message; got {count}"
-                + (f" ({len(bad)} could not be decoded: {bad[0]})" if bad else "")
-            )
+                + (f" ({len(bad)} could not be decoded: {bad[0]})" if bad else ""))
         where = f"{self.path} [{topic}]"
         return self._to_world(self._cloud(msgs[0], where, self.header.frame))
 
@@ -203,16 +196,14 @@ class BagReader:
             if msg.header.frame_id != "world":
                 raise FileFormatError(
                     f"{where(key)}: header.frame_id is {msg.header.frame_id!r}; the bag form "
-                    "stores contacts in the 'world' frame"
-                )
+                    "stores contacts in the 'world' frame")
         f, p = wrench.wrench.force, tip.point
         force = np.array([f.x, f.y, f.z], dtype=float)
         center = np.array([p.x, p.y, p.z], dtype=float)
         for key, value in (("wrench", force), ("tip", center)):
             if not np.isfinite(value).all():
                 raise FileFormatError(
-                    f"{where(key)}: holds NaN or infinite values {value.tolist()}"
-                )
+                    f"{where(key)}: holds NaN or infinite values {value.tolist()}")
         return PressParts(cloud, center, force, np.asarray(robot.points),
                           self._force_travel(stamp))
 
@@ -223,8 +214,7 @@ def _point_message(stamp_ns: int, point: Any) -> Any:
     header = types["std_msgs/msg/Header"](stamp=time, frame_id="world")
     x, y, z = (float(v) for v in point)
     return types["geometry_msgs/msg/PointStamped"](
-        header=header, point=types["geometry_msgs/msg/Point"](x=x, y=y, z=z)
-    )
+        header=header, point=types["geometry_msgs/msg/Point"](x=x, y=y, z=z))
 
 
 def _wrench_message(stamp_ns: int, force: Any) -> Any:
@@ -244,14 +234,8 @@ def force_travel_message(record: ForceTravel) -> Any:
     return types["std_msgs/msg/Float64MultiArray"](layout=layout, data=data)
 
 
-def write_session_bag(
-    path: Path,
-    *,
-    storage: str,
-    observation: PointCloud,
-    presses: Sequence[PressObservation],
-    stamps_ns: Sequence[int],
-) -> None:
+def write_session_bag(path: Path, *, storage: str, observation: PointCloud,
+                      presses: Sequence[PressObservation], stamps_ns: Sequence[int]) -> None:
     """Write the observation and the presses (world frame, float64) to a new bag at ``path``.
 
     A cloud with colours gets a packed FLOAT32 ``rgb`` field (8 bits a channel); the robot's

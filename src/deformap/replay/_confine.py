@@ -49,8 +49,7 @@ def confined_path(where: str, value: Any, root: Path) -> Path:
         raise ConfigError(f"{where} is {value!r:.120}, which cannot be resolved: {exc}") from None
     if not real.is_relative_to(base):
         raise ConfigError(
-            f"{where} is {value!r}, a link to {str(real)!r}, outside the session folder; {_RULE}"
-        )
+            f"{where} is {value!r}, a link to {str(real)!r}, outside the session folder; {_RULE}")
     return path
 
 

@@ -33,16 +33,8 @@ from deformap.environment import ForceTravel, Workspace
 from deformap.errors import ConfigError, DeformapError
 from deformap.replay._confine import confined_path
 
-__all__ = [
-    "FORMAT_NAME",
-    "FORMAT_VERSION",
-    "OPTIONAL_TOPICS",
-    "SESSION_FILE",
-    "TOPICS",
-    "PokeSpec",
-    "SessionHeader",
-    "parse_session_yaml",
-]
+__all__ = ["FORMAT_NAME", "FORMAT_VERSION", "OPTIONAL_TOPICS", "SESSION_FILE", "TOPICS",
+           "PokeSpec", "SessionHeader", "parse_session_yaml"]
 
 logger = logging.getLogger(__name__)
 
@@ -51,13 +43,11 @@ FORMAT_VERSION = 1
 SESSION_FILE = "session.yaml"
 
 #: Topic names of the bag form and their message types.
-TOPICS = {
-    "observation": ("/deformap/observation", "sensor_msgs/msg/PointCloud2"),
-    "cloud": ("/deformap/press/cloud", "sensor_msgs/msg/PointCloud2"),
-    "wrench": ("/deformap/press/wrench", "geometry_msgs/msg/WrenchStamped"),
-    "tip": ("/deformap/press/tip", "geometry_msgs/msg/PointStamped"),
-    "robot": ("/deformap/press/robot", "sensor_msgs/msg/PointCloud2"),
-}
+TOPICS = {"observation": ("/deformap/observation", "sensor_msgs/msg/PointCloud2"),
+          "cloud": ("/deformap/press/cloud", "sensor_msgs/msg/PointCloud2"),
+          "wrench": ("/deformap/press/wrench", "geometry_msgs/msg/WrenchStamped"),
+          "tip": ("/deformap/press/tip", "geometry_msgs/msg/PointStamped"),
+          "robot": ("/deformap/press/robot", "sensor_msgs/msg/PointCloud2")}
 
 #: Topics of the bag form that a bag may lack (then no poke has what they carry). The force–travel
 #: record is a ``Float64MultiArray`` of ``n × 2`` rows ``(travel_m, force_n)``; the message has no
@@ -170,8 +160,7 @@ def _check_keys(file: Path, key: str, data: Any, required: set[str], optional: s
     if unknown:
         raise ConfigError(
             f"{_where(file, key)} has unknown key(s) {unknown}; "
-            f"allowed: {sorted(required | optional)}"
-        )
+            f"allowed: {sorted(required | optional)}")
     missing = sorted(required - keys)
     if missing:
         raise ConfigError(f"{_where(file, key)} lacks required key(s) {missing}")
@@ -195,14 +184,12 @@ def _cam2world(file: Path, data: dict[str, Any], frame: str, form: str) -> Any:
         if raw is not None:
             raise ConfigError(
                 f"{_where(file, 'cam2world')} is given but `frame` is 'world': the clouds are "
-                "already in the world frame; remove one of the two"
-            )
+                "already in the world frame; remove one of the two")
         return None
     if raw is None:
         raise ConfigError(
             f"{_where(file, 'frame')} is {frame!r}, not 'world', so `cam2world` (a 4×4 "
-            "camera-to-world matrix) is required" + (" or 'tf_static'" if form == "bag" else "")
-        )
+            "camera-to-world matrix) is required" + (" or 'tf_static'" if form == "bag" else ""))
     if raw == "tf_static":
         if form != "bag":
             raise ConfigError(f"{_where(file, 'cam2world')}: 'tf_static' needs the bag form")
@@ -287,19 +274,16 @@ def parse_session_yaml(data: Any, file: Path) -> SessionHeader:
     _check_keys(file, "(top level)", data, _TOP_REQUIRED, _TOP_OPTIONAL)
     if data["format"] != FORMAT_NAME:
         raise ConfigError(
-            f"{_where(file, 'format')} must be {FORMAT_NAME!r}; got {data['format']!r}"
-        )
+            f"{_where(file, 'format')} must be {FORMAT_NAME!r}; got {data['format']!r}")
     if data["version"] != FORMAT_VERSION or isinstance(data["version"], bool):
         raise ConfigError(
             f"{_where(file, 'version')} must be {FORMAT_VERSION} (this deformap reads format "
-            f"version {FORMAT_VERSION}); got {data['version']!r}"
-        )
+            f"version {FORMAT_VERSION}); got {data['version']!r}")
     has_bag, has_obs = "bag" in data, "observation" in data
     if has_bag == has_obs:
         raise ConfigError(
             f"{file}: give exactly one of `observation` (folder form) and `bag` (bag form); "
-            f"got {'both' if has_bag else 'neither'}"
-        )
+            f"got {'both' if has_bag else 'neither'}")
     form = "bag" if has_bag else "folder"
     units = data.get("units", "m")
     if not isinstance(units, str) or units not in UNITS:
@@ -314,8 +298,7 @@ def parse_session_yaml(data: Any, file: Path) -> SessionHeader:
     source = data.get("source") or {}
     if not isinstance(source, dict):
         raise ConfigError(
-            f"{_where(file, 'source')} must be a mapping; got {type(source).__name__}"
-        )
+            f"{_where(file, 'source')} must be a mapping; got {type(source).__name__}")
     pokes = data["pokes"]
     if not isinstance(pokes, list):
         raise ConfigError(f"{_where(file, 'pokes')} must be a list; got {type(pokes).__name__}")
@@ -330,8 +313,7 @@ def parse_session_yaml(data: Any, file: Path) -> SessionHeader:
         bag=_file_name(file, "bag", data["bag"], root) if has_bag else None,
         ground_truth=None if truth is None else _file_name(file, "ground_truth", truth, root),
         source={str(k): v for k, v in source.items()},
-        pokes=tuple(_unique_stamps(file, specs)), sha256=digests,
-    )  # fmt: skip
+        pokes=tuple(_unique_stamps(file, specs)), sha256=digests)
 
 
 def _check_poke_count(file: Path, data: dict[str, Any], pokes: list[Any]) -> None:
@@ -342,14 +324,11 @@ def _check_poke_count(file: Path, data: dict[str, Any], pokes: list[Any]) -> Non
         return
     count = data["n_pokes"]
     if not isinstance(count, int) or isinstance(count, bool) or count < 0:
-        raise ConfigError(
-            f"{_where(file, 'n_pokes')} must be a whole number >= 0; got {count!r}"
-        )
+        raise ConfigError(f"{_where(file, 'n_pokes')} must be a whole number >= 0; got {count!r}")
     if count != len(pokes):
         raise ConfigError(
             f"{_where(file, 'n_pokes')} is {count} but `pokes` lists {len(pokes)} entries; "
-            "the file was cut or edited"
-        )
+            "the file was cut or edited")
 
 
 _HEX64 = re.compile(r"[0-9a-f]{64}")
@@ -362,16 +341,14 @@ def _manifest(file: Path, raw: Any, root: Path) -> dict[Path, str]:
     if not isinstance(raw, dict) or not raw:
         raise ConfigError(
             f"{_where(file, 'sha256')} must be a non-empty mapping of file name to SHA-256; "
-            f"got {raw!r:.80}"
-        )
+            f"got {raw!r:.80}")
     out = {}
     for name, digest in raw.items():
         key = f"sha256[{name!r}]"
         path = confined_path(_where(file, key), name, root)
         if not isinstance(digest, str) or not _HEX64.fullmatch(digest):
             raise ConfigError(
-                f"{_where(file, key)} must be 64 lowercase hex digits; got {digest!r:.80}"
-            )
+                f"{_where(file, key)} must be 64 lowercase hex digits; got {digest!r:.80}")
         out[path] = digest
     return out
 
@@ -385,8 +362,7 @@ def _unique_stamps(file: Path, specs: list[PokeSpec]) -> list[PokeSpec]:
             key = f"pokes[{spec.index}].stamp_ns"
             error = ConfigError(
                 f"{_where(file, key)} is {spec.stamp_ns}, already the stamp of "
-                f"`pokes[{first[spec.stamp_ns]}]`; each poke needs its own messages"
-            )
+                f"`pokes[{first[spec.stamp_ns]}]`; each poke needs its own messages")
             spec = PokeSpec(index=spec.index, error=error)
         elif spec.stamp_ns is not None:
             first[spec.stamp_ns] = spec.index

@@ -48,11 +48,9 @@ def verify_digest(header: SessionHeader, path: Path) -> None:
     if want is None:
         raise FileFormatError(
             f"{path}: not in the session's `sha256` manifest ({len(header.sha256)} files); "
-            "every file a session with a manifest reads must be listed"
-        )
+            "every file a session with a manifest reads must be listed")
     got = sha256_file(path)
     if got != want:
         raise FileFormatError(
             f"{path}: SHA-256 is {got[:16]}…, the session's manifest says {want[:16]}…; the "
-            "file changed after it was recorded"
-        )
+            "file changed after it was recorded")

@@ -61,13 +61,8 @@ class ReplayResult:
         return [f"poke {s['index'] + 1} skipped: {s['error']}" for s in self.skipped]
 
 
-def map_session(
-    session: RecordedSession,
-    config: ExplorationConfig,
-    *,
-    rng: np.random.Generator,
-    on_poke: Callable[[PokeResult], None] | None = None,
-) -> ReplayResult:
+def map_session(session: RecordedSession, config: ExplorationConfig, *, rng: np.random.Generator,
+                on_poke: Callable[[PokeResult], None] | None = None) -> ReplayResult:
     """Feed a session's pokes, in order, to a fresh mapper.
 
     Parameters
@@ -91,12 +86,10 @@ def map_session(
     """
     if not isinstance(session, RecordedSession):
         raise InvalidArgumentError(
-            f"`session` must be a RecordedSession; got {type(session).__name__}"
-        )
+            f"`session` must be a RecordedSession; got {type(session).__name__}")
     if not isinstance(config, ExplorationConfig):
         raise InvalidArgumentError(
-            f"`config` must be an ExplorationConfig; got {type(config).__name__}"
-        )
+            f"`config` must be an ExplorationConfig; got {type(config).__name__}")
     # explore() spawns max_pokes + 1 streams and fits the surface with the first; a spawned
     # child depends only on its position, so spawning one gives that same stream.
     run = MappingRun(session.workspace, config, session.observation, rng.spawn(1)[0])
@@ -125,16 +118,9 @@ def tip_sphere_points(tip_center: Any, tip_radius_m: float) -> NDArray[np.float6
     return center + radius * np.vstack([np.eye(3), -np.eye(3)])
 
 
-def estimate_poke(
-    before: PointCloud,
-    after: PointCloud,
-    contact: TactileContact,
-    config: ExplorationConfig,
-    *,
-    rng: np.random.Generator,
-    robot_points: Any = None,
-    contact_gap_m: float = DEFAULT_CONTACT_GAP_M,
-) -> PokeResult:
+def estimate_poke(before: PointCloud, after: PointCloud, contact: TactileContact,
+                  config: ExplorationConfig, *, rng: np.random.Generator, robot_points: Any = None,
+                  contact_gap_m: float = DEFAULT_CONTACT_GAP_M) -> PokeResult:
     """β of one poke from the clouds before and while pressing.
 
     Parameters
@@ -169,8 +155,7 @@ def estimate_poke(
             raise InvalidArgumentError(f"`{name}` must be a PointCloud; got {type(cloud).__name__}")
     if not isinstance(contact, TactileContact):
         raise InvalidArgumentError(
-            f"`contact` must be a TactileContact; got {type(contact).__name__}"
-        )
+            f"`contact` must be a TactileContact; got {type(contact).__name__}")
     robot = (tip_sphere_points(contact.tip_center, contact.tip_radius_m) if robot_points is None
              else check_points("robot_points", robot_points, min_rows=4))  # fmt: skip
     xy = contact.contact_point[:2]

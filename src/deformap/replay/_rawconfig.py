@@ -20,14 +20,8 @@ from deformap._config import config_from_dict, load_yaml
 from deformap._validation import check_settings, setting
 from deformap.errors import ConfigError
 
-__all__ = [
-    "DEFAULT_HULL",
-    "RAW_CONFIG_NAME",
-    "HullPart",
-    "RawBagConfig",
-    "load_raw_config",
-    "raw_config_file",
-]
+__all__ = ["DEFAULT_HULL", "RAW_CONFIG_NAME", "HullPart", "RawBagConfig", "load_raw_config",
+           "raw_config_file"]
 
 #: Name of the settings file inside a rosbag2 folder; beside a single ``NAME.mcap`` or
 #: ``NAME.db3`` file it is ``NAME.deformap.yaml``.
@@ -62,11 +56,9 @@ class HullPart:
 #: tip's upper half (1 cm radius), the stick (12 mm thick, 10 cm long) and a hand box
 #: 8 × 6 × 10 cm on top of it. Give your own in ``hull`` (measure the parts and add a few
 #: millimetres so that depth noise on their edges goes too).
-DEFAULT_HULL = (
-    HullPart(shape="cap", center_m=(0.0, 0.0, 0.0), size_m=(0.02, 0.02, 0.02)),
-    HullPart(shape="cylinder", center_m=(0.0, 0.0, 0.05), size_m=(0.012, 0.012, 0.10)),
-    HullPart(shape="box", center_m=(0.0, 0.0, 0.15), size_m=(0.08, 0.06, 0.10)),
-)
+DEFAULT_HULL = (HullPart(shape="cap", center_m=(0.0, 0.0, 0.0), size_m=(0.02, 0.02, 0.02)),
+                HullPart(shape="cylinder", center_m=(0.0, 0.0, 0.05), size_m=(0.012, 0.012, 0.10)),
+                HullPart(shape="box", center_m=(0.0, 0.0, 0.15), size_m=(0.08, 0.06, 0.10)))
 
 
 @dataclass(frozen=True, kw_only=True)

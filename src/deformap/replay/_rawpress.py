@@ -49,18 +49,9 @@ def _runs(mask: NDArray[np.bool_]) -> list[tuple[int, int]]:
                     strict=True))  # fmt: skip
 
 
-def find_presses(
-    times_ns: NDArray[np.int64],
-    force_n: NDArray[np.float64],
-    *,
-    commanded_n: float,
-    contact_n: float,
-    band: float,
-    hold_min_ns: int,
-    merge_ns: int,
-    topic: str,
-    origin_ns: int = 0,
-) -> list[FoundPress]:
+def find_presses(times_ns: NDArray[np.int64], force_n: NDArray[np.float64], *, commanded_n: float,
+                 contact_n: float, band: float, hold_min_ns: int, merge_ns: int, topic: str,
+                 origin_ns: int = 0) -> list[FoundPress]:
     """The presses of a force stream.
 
     Parameters

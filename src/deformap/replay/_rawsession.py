@@ -41,13 +41,8 @@ def is_raw_bag(path: str | Path) -> bool:
     return False
 
 
-def load_raw_bag(
-    path: str | Path,
-    config: RawBagConfig | None = None,
-    *,
-    default_force_n: float,
-    contact_gap_m: float = DEFAULT_CONTACT_GAP_M,
-) -> RecordedSession:
+def load_raw_bag(path: str | Path, config: RawBagConfig | None = None, *, default_force_n: float,
+                 contact_gap_m: float = DEFAULT_CONTACT_GAP_M) -> RecordedSession:
     """Open a raw robot recording and find its presses.
 
     Parameters

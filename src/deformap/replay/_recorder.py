@@ -27,8 +27,7 @@ class RecordingEnvironment:
     def __init__(self, env: Environment) -> None:
         if not isinstance(env, Environment):
             raise InvalidArgumentError(
-                f"`env` must implement the Environment protocol; got {type(env).__name__}"
-            )
+                f"`env` must implement the Environment protocol; got {type(env).__name__}")
         self._env = env
         self.observations: list[PointCloud] = []
         self.presses: list[PressObservation] = []

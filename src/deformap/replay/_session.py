@@ -134,8 +134,7 @@ class RecordedSession:
             raise FileFormatError(
                 f"{where}: the contact point ({point[0]:.4g}, {point[1]:.4g}) m lies more than "
                 f"{self.contact_gap_m} m outside the workspace "
-                f"{self.workspace.lower}..{self.workspace.upper}"
-            )
+                f"{self.workspace.lower}..{self.workspace.upper}")
         check_contact_gap(obs, self.contact_gap_m, where)
 
 
@@ -156,8 +155,7 @@ def check_contact_gap(obs: PressObservation, gap_m: float, where: str) -> None:
         raise FileFormatError(
             f"{where}: the contact point {np.round(point, 4).tolist()} m is {gap:.3g} m from "
             f"the nearest surface point of the cloud (limit {gap_m} m); tip and "
-            "cloud are probably in different frames or units"
-        )
+            "cloud are probably in different frames or units")
 
 
 def _read_yaml(file: Path) -> Any:
@@ -203,8 +201,7 @@ def load_session(
     """
     if not isinstance(path, (str, Path)):
         raise InvalidArgumentError(
-            f"`path` must be a str or pathlib.Path; got {type(path).__name__}"
-        )
+            f"`path` must be a str or pathlib.Path; got {type(path).__name__}")
     gap = check_positive("contact_gap_m", contact_gap_m)
     file = _session_file(Path(path))
     data = _read_yaml(file)

@@ -51,8 +51,7 @@ class GroundTruth:
         if labels.shape != (ys.size, xs.size) or labels.dtype.kind not in "iu":
             raise InvalidArgumentError(
                 f"`labels` must be ({ys.size}, {xs.size}) integers; got shape {labels.shape} "
-                f"and dtype {labels.dtype}"
-            )
+                f"and dtype {labels.dtype}")
         hard = check_array("hardness", self.hardness, (ys.size, xs.size), what="newtons",
                            finite=False)  # fmt: skip
         if np.any(hard <= 0) or np.any(np.isneginf(hard)):
@@ -63,8 +62,7 @@ class GroundTruth:
             if not same:
                 raise InvalidArgumentError(
                     f"`hardness` must be constant over each label; label {label} has "
-                    f"{np.unique(values).size} values"
-                )
+                    f"{np.unique(values).size} values")
         for name, value in (("xs", xs), ("ys", ys), ("labels", labels.astype(np.int64)),
                             ("hardness", hard)):  # fmt: skip
             value.setflags(write=False)

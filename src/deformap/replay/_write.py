@@ -48,16 +48,9 @@ def _floats(values: Any) -> list[float]:
     return [float(v) for v in np.asarray(values, dtype=float).ravel()]
 
 
-def _check_inputs(
-    folder: Any,
-    workspace: Any,
-    observation: Any,
-    presses: Any,
-    tip_radius_m: Any,
-    format: Any,
-    cloud_format: Any,
-    ground_truth: Any,
-) -> tuple[Path, list[PressObservation], float]:
+def _check_inputs(folder: Any, workspace: Any, observation: Any, presses: Any, tip_radius_m: Any,
+                  format: Any, cloud_format: Any,
+                  ground_truth: Any) -> tuple[Path, list[PressObservation], float]:
     if not isinstance(folder, (str, Path)):
         raise InvalidArgumentError(f"`folder` must be a str or Path; got {type(folder).__name__}")
     out = Path(folder)
@@ -65,20 +58,17 @@ def _check_inputs(
         raise InvalidArgumentError(f"`folder` {out} exists and is not an empty folder")
     if not isinstance(workspace, Workspace):
         raise InvalidArgumentError(
-            f"`workspace` must be a Workspace; got {type(workspace).__name__}"
-        )
+            f"`workspace` must be a Workspace; got {type(workspace).__name__}")
     if not isinstance(observation, PointCloud) or len(observation) == 0:
         raise InvalidArgumentError("`observation` must be a non-empty PointCloud")
     if observation.frame != "world":
         raise InvalidArgumentError(
-            f"`observation` must be in frame 'world'; got {observation.frame!r}"
-        )
+            f"`observation` must be in frame 'world'; got {observation.frame!r}")
     presses = list(presses)
     for i, obs in enumerate(presses):
         if not isinstance(obs, PressObservation):
             raise InvalidArgumentError(
-                f"`presses[{i}]` must be a PressObservation; got {type(obs).__name__}"
-            )
+                f"`presses[{i}]` must be a PressObservation; got {type(obs).__name__}")
         if obs.cloud.frame != "world":
             raise InvalidArgumentError(f"`presses[{i}].cloud` must be in frame 'world'")
     radii = {obs.contact.tip_radius_m for obs in presses}
@@ -86,39 +76,27 @@ def _check_inputs(
         if len(radii) != 1:
             raise InvalidArgumentError(
                 "`tip_radius_m` is needed: the presses do not give exactly one tip radius "
-                f"(got {sorted(radii)})"
-            )
+                f"(got {sorted(radii)})")
         tip_radius_m = radii.pop()
     tip = check_positive("tip_radius_m", tip_radius_m)
     if radii - {tip}:
         raise InvalidArgumentError(
-            f"every press must use `tip_radius_m` {tip}; got {sorted(radii)}"
-        )
+            f"every press must use `tip_radius_m` {tip}; got {sorted(radii)}")
     if format not in SESSION_FORMATS:
         raise InvalidArgumentError(f"`format` must be one of {SESSION_FORMATS}; got {format!r}")
     if cloud_format not in CLOUD_FORMATS:
         raise InvalidArgumentError(
-            f"`cloud_format` must be one of {CLOUD_FORMATS}; got {cloud_format!r}"
-        )
+            f"`cloud_format` must be one of {CLOUD_FORMATS}; got {cloud_format!r}")
     if ground_truth is not None and not isinstance(ground_truth, GroundTruth):
         raise InvalidArgumentError(
-            f"`ground_truth` must be a GroundTruth or None; got {type(ground_truth).__name__}"
-        )
+            f"`ground_truth` must be a GroundTruth or None; got {type(ground_truth).__name__}")
     return out, presses, tip
 
 
-def write_session(
-    folder: str | Path,
-    *,
-    workspace: Workspace,
-    observation: PointCloud,
-    presses: Sequence[PressObservation],
-    tip_radius_m: float | None = None,
-    ground_truth: GroundTruth | None = None,
-    source: dict[str, Any] | None = None,
-    format: str = "folder",
-    cloud_format: str = "pcd",
-) -> Path:
+def write_session(folder: str | Path, *, workspace: Workspace, observation: PointCloud,
+                  presses: Sequence[PressObservation], tip_radius_m: float | None = None,
+                  ground_truth: GroundTruth | None = None, source: dict[str, Any] | None = None,
+                  format: str = "folder", cloud_format: str = "pcd") -> Path:
     """Write a session that :func:`load_session` reads back exactly.
 
     ``session.yaml`` is written last, with ``n_pokes`` and the ``sha256`` manifest of every file
@@ -159,14 +137,10 @@ def write_session(
     out, presses, tip = _check_inputs(folder, workspace, observation, presses, tip_radius_m,
                                       format, cloud_format, ground_truth)  # fmt: skip
     out.mkdir(parents=True, exist_ok=True)
-    doc: dict[str, Any] = {
-        "format": FORMAT_NAME,
-        "version": FORMAT_VERSION,
-        "units": "m",
-        "frame": "world",
-        "workspace": {"lower": list(workspace.lower), "upper": list(workspace.upper)},
-        "probe": {"tip_radius_m": tip},
-    }
+    doc: dict[str, Any] = {"format": FORMAT_NAME, "version": FORMAT_VERSION, "units": "m",
+                           "frame": "world",
+                           "workspace": {"lower": list(workspace.lower), "upper": list(workspace.upper)},
+                           "probe": {"tip_radius_m": tip}}
     if source:
         doc["source"] = dict(source)
     if ground_truth is not None:
@@ -200,8 +174,7 @@ def write_session(
         doc["bag"] = "bag"
         pokes = [
             {"stamp_ns": s, "target_xy": _floats(o.target_xy), "force_n": float(o.force_n)}
-            for s, o in zip(stamps, presses, strict=True)
-        ]
+            for s, o in zip(stamps, presses, strict=True)]
     # The count and the manifest come before the pokes: a file cut in its poke list keeps them.
     doc["n_pokes"] = len(pokes)
     doc["sha256"] = manifest_of(out, (p for p in out.rglob("*") if p.is_file()))

@@ -30,17 +30,8 @@ from deformap.cloud.io._pointcloud2 import _to_cloud
 from deformap.cloud.io._ros import typestore
 from deformap.errors import FileFormatError, InvalidArgumentError
 
-__all__ = [
-    "CLOUD_TYPE",
-    "TF_STATIC_TOPIC",
-    "TF_TYPE",
-    "WRENCH_TYPE",
-    "StampedCloud",
-    "WrenchSeries",
-    "read_bag_clouds",
-    "read_bag_static_transform",
-    "read_bag_wrenches",
-]
+__all__ = ["CLOUD_TYPE", "TF_STATIC_TOPIC", "TF_TYPE", "WRENCH_TYPE", "StampedCloud",
+           "WrenchSeries", "read_bag_clouds", "read_bag_static_transform", "read_bag_wrenches"]
 
 CLOUD_TYPE = "sensor_msgs/msg/PointCloud2"
 WRENCH_TYPE = "geometry_msgs/msg/WrenchStamped"
@@ -173,19 +164,12 @@ def read_bag_static_transform(
     if target_frame not in seen:
         raise FileFormatError(
             f"{p}: {topic} does not connect frame {source_frame!r} to {target_frame!r} "
-            f"(frames: {sorted(edges)}); pass cam2world= instead"
-        )
+            f"(frames: {sorted(edges)}); pass cam2world= instead")
     return seen[target_frame]
 
 
-def read_bag_clouds(
-    path: str | Path,
-    topic: str,
-    *,
-    cam2world: Any = None,
-    world_frame: str = "world",
-    units: str = "m",
-) -> list[StampedCloud]:
+def read_bag_clouds(path: str | Path, topic: str, *, cam2world: Any = None,
+                    world_frame: str = "world", units: str = "m") -> list[StampedCloud]:
     """Read every ``sensor_msgs/msg/PointCloud2`` message of a topic.
 
     Parameters

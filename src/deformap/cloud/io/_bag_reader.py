@@ -22,15 +22,8 @@ from typing import Any
 from deformap.cloud.io._common import path_kind
 from deformap.errors import DeformapError, FileFormatError, InvalidArgumentError, missing_extra
 
-__all__ = [
-    "BAG_STORAGES",
-    "RawBagMessage",
-    "bag_error_text",
-    "bag_read_errors",
-    "check_db3_counts",
-    "check_mcap_crcs",
-    "iter_bag_messages",
-]
+__all__ = ["BAG_STORAGES", "RawBagMessage", "bag_error_text", "bag_read_errors",
+           "check_db3_counts", "check_mcap_crcs", "iter_bag_messages"]
 
 BAG_STORAGES = ("mcap", "sqlite3")
 
@@ -133,8 +126,7 @@ def iter_bag_messages(path: Any, topics: Mapping[str, str],
     """
     if not isinstance(path, (str, Path)):
         raise InvalidArgumentError(
-            f"`path` must be a str or pathlib.Path; got {type(path).__name__}"
-        )
+            f"`path` must be a str or pathlib.Path; got {type(path).__name__}")
     if not isinstance(topics, Mapping) or not topics:
         raise InvalidArgumentError(f"`topics` must be a non-empty mapping; got {topics!r}")
     rosbag2, p = _rosbag2(), Path(path)
@@ -161,14 +153,12 @@ def iter_bag_messages(path: Any, topics: Mapping[str, str],
                 if not conns:
                     raise FileFormatError(
                         f"{p}: bag has no topic {topic!r} (topics: {found}); expected one "
-                        f"carrying {msgtype}"
-                    )
+                        f"carrying {msgtype}")
                 wrong = [c.msgtype for c in conns if c.msgtype != msgtype]
                 if wrong:
                     raise FileFormatError(
                         f"{p}: topic {topic!r} carries {wrong[0] or repr(wrong[0])}, expected "
-                        f"{msgtype}"
-                    )
+                        f"{msgtype}")
             conns = [c for c in reader.connections if c.topic in wanted]
             counts: dict[str, int] = {}
             for conn, log_time, raw in reader.messages(connections=conns):
@@ -178,9 +168,7 @@ def iter_bag_messages(path: Any, topics: Mapping[str, str],
     except DeformapError:
         raise
     except errors as exc:
-        raise FileFormatError(
-            f"{p}: could not read {what}: {bag_error_text(exc)}"
-        ) from exc
+        raise FileFormatError(f"{p}: could not read {what}: {bag_error_text(exc)}") from exc
 
 
 def _check_row(path: Path, topic: str, number: int, log_time: Any, data: Any) -> None:

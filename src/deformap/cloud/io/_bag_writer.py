@@ -133,15 +133,11 @@ def bag_writer(path: str | Path, storage: str = "mcap") -> Iterator[Any]:
         fill_chunk_crcs(mcap)
 
 
-def write_bag(
-    path: str | Path,
-    *,
-    storage: str = "mcap",
-    clouds: dict[str, Sequence[tuple[int, PointCloud]]] | None = None,
-    wrenches: dict[str, WrenchSeries] | None = None,
-    static_transforms: Sequence[tuple[str, str, Any]] = (),
-    cloud_dtype: str = "float32",
-) -> None:
+def write_bag(path: str | Path, *, storage: str = "mcap",
+              clouds: dict[str, Sequence[tuple[int, PointCloud]]] | None = None,
+              wrenches: dict[str, WrenchSeries] | None = None,
+              static_transforms: Sequence[tuple[str, str, Any]] = (),
+              cloud_dtype: str = "float32") -> None:
     """Write clouds, wrenches and static transforms to a new ROS 2 bag (rosbag2 version 9).
 
     Parameters

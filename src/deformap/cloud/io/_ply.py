@@ -37,12 +37,10 @@ __all__ = ["PLY_FORMATS", "read_ply", "write_ply"]
 
 PLY_FORMATS = ("ascii", "binary_little_endian", "binary_big_endian")
 
-_PLY_TYPES = {
-    "char": "i1", "int8": "i1", "uchar": "u1", "uint8": "u1",
-    "short": "i2", "int16": "i2", "ushort": "u2", "uint16": "u2",
-    "int": "i4", "int32": "i4", "uint": "u4", "uint32": "u4",
-    "float": "f4", "float32": "f4", "double": "f8", "float64": "f8",
-}  # fmt: skip
+_PLY_TYPES = {"char": "i1", "int8": "i1", "uchar": "u1", "uint8": "u1",
+              "short": "i2", "int16": "i2", "ushort": "u2", "uint16": "u2",
+              "int": "i4", "int32": "i4", "uint": "u4", "uint32": "u4",
+              "float": "f4", "float32": "f4", "double": "f8", "float64": "f8"}  # fmt: skip
 _NUMPY_TO_PLY = {"i1": "char", "u1": "uchar", "i2": "short", "u2": "ushort", "i4": "int",
                  "u4": "uint", "f4": "float", "f8": "double"}  # fmt: skip
 _COLOR_NAMES = ("red", "green", "blue")
@@ -113,30 +111,26 @@ def _read_vertices(path: Path, data: bytes) -> NDArray[Any]:
         if len(lines) > total:
             raise FileFormatError(
                 f"{path}: PLY header declares {total} element rows, the ascii body holds "
-                f"{len(lines)}; the counts are wrong or the file is corrupted"
-            )
+                f"{len(lines)}; the counts are wrong or the file is corrupted")
         skip = sum(e.count for e in elements[:index])
         rows = lines[skip : skip + vertex.count]
         if len(rows) < vertex.count:
             raise FileFormatError(
-                f"{path}: PLY header says {vertex.count} vertices, the file holds {len(rows)}"
-            )
+                f"{path}: PLY header says {vertex.count} vertices, the file holds {len(rows)}")
         if vertex.count == 0:
             return np.empty(0, dtype=dtype)
         table = np.loadtxt(io.StringIO("\n".join(rows)), dtype=np.float64, ndmin=2, comments=None)
         if table.shape[1] != len(dtype.names or ()):
             raise FileFormatError(
                 f"{path}: PLY vertex rows have {table.shape[1]} values, the header declares "
-                f"{len(dtype.names or ())} properties"
-            )
+                f"{len(dtype.names or ())} properties")
         return _fill_ascii(path, table, dtype)
     offset = body_start
     for element in elements[:index]:
         if element.has_list:
             raise FileFormatError(
                 f"{path}: PLY element {element.name!r} before the vertices has a list property; "
-                "cannot skip it in a binary file"
-            )
+                "cannot skip it in a binary file")
         offset += element.count * _vertex_dtype(path, element, fmt).itemsize
     # Every byte must belong to an element: a lowered vertex count must not drop points silently.
     need = vertex.count * dtype.itemsize
@@ -217,8 +211,7 @@ def _fill_ascii(path: Path, table: NDArray[np.float64], dtype: np.dtype[Any]) ->
             kind = _NUMPY_TO_PLY[dtype[name].str[1:]]
             raise FileFormatError(
                 f"{path}: PLY vertex property {name!r} is declared {kind}, but vertex {row} "
-                f"holds {float(column[row]):g}, which {kind} cannot hold"
-            )
+                f"holds {float(column[row]):g}, which {kind} cannot hold")
     return out
 
 
@@ -252,15 +245,13 @@ def read_ply(
     missing = [axis for axis in "xyz" if axis not in names]
     if missing:
         raise FileFormatError(
-            f"{p}: PLY 'vertex' element has no property {missing[0]!r} (has: {list(names)})"
-        )
+            f"{p}: PLY 'vertex' element has no property {missing[0]!r} (has: {list(names)})")
     has_color = all(c in names for c in _COLOR_NAMES)
     partial = [c for c in _COLOR_NAMES if c in names]
     if partial and not has_color:
         raise FileFormatError(
             f"{p}: PLY 'vertex' element has colour properties {partial} but not "
-            f"{[c for c in _COLOR_NAMES if c not in names]}; a colour needs all three"
-        )
+            f"{[c for c in _COLOR_NAMES if c not in names]}; a colour needs all three")
     taken = {"x", "y", "z", *(_COLOR_NAMES if has_color else ())}
     # Widening a signalling NaN (a corrupted float) raises "invalid"; finish_cloud handles NaN.
     with np.errstate(invalid="ignore"):
@@ -272,13 +263,8 @@ def read_ply(
                         color_field="red/green/blue")  # fmt: skip
 
 
-def write_ply(
-    path: str | Path,
-    cloud: PointCloud,
-    *,
-    format: str = "binary_little_endian",
-    extra_fields: dict[str, Any] | None = None,
-) -> None:
+def write_ply(path: str | Path, cloud: PointCloud, *, format: str = "binary_little_endian",
+              extra_fields: dict[str, Any] | None = None) -> None:
     """Write a cloud as the ``vertex`` element of a PLY file.
 
     Parameters
@@ -304,8 +290,7 @@ def write_ply(
         if code not in _NUMPY_TO_PLY:
             raise InvalidArgumentError(
                 f"`extra_fields[{name!r}]` has dtype {values.dtype}, which PLY cannot store "
-                f"(use one of {sorted(_NUMPY_TO_PLY)})"
-            )
+                f"(use one of {sorted(_NUMPY_TO_PLY)})")
         fields.append((name, values))
     dtype = np.dtype([(name, order + values.dtype.str[1:]) for name, values in fields])
     table = np.empty(len(cloud), dtype=dtype)

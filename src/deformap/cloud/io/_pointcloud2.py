@@ -25,14 +25,8 @@ from deformap.cloud.io._common import check_colors, check_units, finish_cloud
 from deformap.cloud.io._ros import typestore
 from deformap.errors import FileFormatError, InvalidArgumentError
 
-__all__ = [
-    "array_to_pointcloud2",
-    "pointcloud2_colors",
-    "pointcloud2_structured",
-    "pointcloud2_to_array",
-    "pointcloud2_to_cloud",
-    "xyz_with_holes",
-]
+__all__ = ["array_to_pointcloud2", "pointcloud2_colors", "pointcloud2_structured",
+           "pointcloud2_to_array", "pointcloud2_to_cloud", "xyz_with_holes"]
 
 logger = logging.getLogger(__name__)
 
@@ -61,8 +55,7 @@ def _layout(msg: Any) -> tuple[np.dtype[Any], int, int, int, int]:
     if min(height, width, point_step, row_step) < 0:
         raise InvalidArgumentError(
             f"`msg` has a negative size: height={height}, width={width}, "
-            f"point_step={point_step}, row_step={row_step}"
-        )
+            f"point_step={point_step}, row_step={row_step}")
     names, formats, offsets = [], [], []
     for f in fields:
         code = _DATATYPES.get(int(f.datatype))
@@ -83,8 +76,7 @@ def _layout(msg: Any) -> tuple[np.dtype[Any], int, int, int, int]:
                       "itemsize": point_step})  # fmt: skip
     if height > 1 and row_step < width * point_step:
         raise InvalidArgumentError(
-            f"`msg` row_step {row_step} is shorter than width·point_step = {width * point_step}"
-        )
+            f"`msg` row_step {row_step} is shorter than width·point_step = {width * point_step}")
     return dtype, height, width, point_step, row_step
 
 
@@ -116,8 +108,7 @@ def pointcloud2_structured(msg: Any) -> NDArray[Any]:
     if data.size < need:
         raise InvalidArgumentError(
             f"`msg` data holds {data.size} bytes but {height}×{width} points of {point_step} bytes "
-            f"(row_step {row_step}) need {need}"
-        )
+            f"(row_step {row_step}) need {need}")
     # a message holds height·row_step bytes: more is data the header no longer counts (its
     # height or width lowered), which reading would drop silently
     most = max(height * row_step, need)
@@ -129,8 +120,7 @@ def pointcloud2_structured(msg: Any) -> NDArray[Any]:
     if row_step == width * point_step or height == 1:
         return np.frombuffer(data, dtype=dtype, count=n)
     rows = np.lib.stride_tricks.as_strided(
-        data, shape=(height, width * point_step), strides=(row_step, 1), writeable=False
-    )
+        data, shape=(height, width * point_step), strides=(row_step, 1), writeable=False)
     return np.ascontiguousarray(rows).view(dtype).reshape(-1)
 
 
@@ -173,13 +163,11 @@ def xyz_with_holes(msg: Any, table: NDArray[Any]) -> NDArray[np.float64]:
     for axis in "xyz":
         if axis not in fields:
             raise InvalidArgumentError(
-                f"`msg` has no field {axis!r} (fields: {[f.name for f in msg.fields]})"
-            )
+                f"`msg` has no field {axis!r} (fields: {[f.name for f in msg.fields]})")
         if int(fields[axis].datatype) not in _FLOAT_CODES or int(fields[axis].count) != 1:
             raise InvalidArgumentError(
                 f"`msg` field {axis!r} must be one FLOAT32 or FLOAT64; got datatype "
-                f"{fields[axis].datatype} with count {fields[axis].count}"
-            )
+                f"{fields[axis].datatype} with count {fields[axis].count}")
     xyz = np.empty((table.shape[0], 3))
     with np.errstate(invalid="ignore"):  # signalling NaNs in the holes widen to quiet ones
         for i, axis in enumerate("xyz"):
@@ -188,19 +176,12 @@ def xyz_with_holes(msg: Any, table: NDArray[Any]) -> NDArray[np.float64]:
         bad = int(np.count_nonzero(~np.isfinite(xyz).all(axis=1)))
         if bad:
             raise InvalidArgumentError(
-                f"`msg` says is_dense but {bad} of {xyz.shape[0]} points are NaN or infinite"
-            )
+                f"`msg` says is_dense but {bad} of {xyz.shape[0]} points are NaN or infinite")
     return xyz
 
 
-def array_to_pointcloud2(
-    points: Any,
-    *,
-    colors: Any = None,
-    frame_id: str = "world",
-    stamp_ns: int = 0,
-    dtype: str = "float32",
-) -> Any:
+def array_to_pointcloud2(points: Any, *, colors: Any = None, frame_id: str = "world",
+                         stamp_ns: int = 0, dtype: str = "float32") -> Any:
     """Build a ``sensor_msgs/msg/PointCloud2`` (rosbags message) from points.
 
     Parameters
@@ -246,13 +227,11 @@ def array_to_pointcloud2(
         table["rgb"] = (rgb[:, 0] << 16) | (rgb[:, 1] << 8) | rgb[:, 2]
     header = types["std_msgs/msg/Header"](
         stamp=types["builtin_interfaces/msg/Time"](sec=stamp // 10**9, nanosec=stamp % 10**9),
-        frame_id=frame_id,
-    )
+        frame_id=frame_id)
     return types["sensor_msgs/msg/PointCloud2"](
         header=header, height=1, width=pts.shape[0], fields=fields, is_bigendian=False,
         point_step=table.dtype.itemsize, row_step=table.nbytes, data=table.view(np.uint8),
-        is_dense=True,
-    )  # fmt: skip
+        is_dense=True)
 
 
 def _packed_colors(where: str, table: NDArray[Any], field: str) -> NDArray[np.uint8]:
@@ -261,8 +240,7 @@ def _packed_colors(where: str, table: NDArray[Any], field: str) -> NDArray[np.ui
         raise FileFormatError(
             f"{where}: colour field {field!r} must be one FLOAT32 or UINT32 word per point "
             f"(packed 0x00RRGGBB); got {column.dtype.itemsize}-byte {column.dtype.kind!r} values, "
-            f"count {1 if column.ndim == 1 else column.shape[1]}"
-        )
+            f"count {1 if column.ndim == 1 else column.shape[1]}")
     # the word's bits in the message's byte order; as a float they may be NaN (an alpha byte)
     word = np.ascontiguousarray(column).view(column.dtype.str[0] + "u4").astype(np.uint32)
     shifts = np.array([16, 8, 0], dtype=np.uint32)
@@ -275,8 +253,7 @@ def _separate_colors(where: str, table: NDArray[Any], present: list[str]) -> NDA
             kinds <= {"u1", "f4", "f8"}):  # fmt: skip
         raise FileFormatError(
             f"{where}: colour fields r, g, b must be all three, one UINT8 or FLOAT32 each, of "
-            f"one type; got {[(c, table[c].dtype.str[1:], table[c].shape[1:]) for c in present]}"
-        )
+            f"one type; got {[(c, table[c].dtype.str[1:], table[c].shape[1:]) for c in present]}")
     return np.column_stack([table[c] for c in present])
 
 
