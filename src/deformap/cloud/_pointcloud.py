@@ -21,17 +21,13 @@ class PointCloud:
     Parameters
     ----------
     points : (n, 3) float
-        Positions in metres, in the frame named by ``frame``; stored as float64. NaN and infinite
-        values are refused (the file readers drop them with ``drop_nan=True``).
+        Positions in metres, in the frame named by ``frame``; NaN and infinite values are refused.
     colors : (n, 3) float in [0, 1], optional
         RGB colours; integer input in [0, 255] is scaled to [0, 1].
     frame : str
         Name of the coordinate frame (``"world"`` for clouds that leave an ``Environment``).
 
-    Notes
-    -----
-    The arrays are stored read-only, so a cloud is shared without copies; operations return new
-    clouds. An empty cloud is a valid value; functions that need points refuse it.
+    The arrays are stored read-only float64; operations return new clouds. An empty cloud is valid.
     """
 
     points: NDArray[np.float64]

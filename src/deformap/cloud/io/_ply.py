@@ -1,11 +1,9 @@
 """PLY files (ascii, binary_little_endian, binary_big_endian), read and written with numpy.
 
-The ``vertex`` element must carry ``x``, ``y`` and ``z``; ``red``, ``green``, ``blue`` become the
-cloud's colours and every other scalar vertex property comes back as an extra field. Other elements
-(faces, ...) are skipped when they follow the vertices, or, in binary files, when they precede them
-and have no list properties. In a binary file every byte after the header must belong to a declared
-element (the elements after the vertices are walked to their end): a vertex count lowered by a
-corruption is refused, not read as fewer points.
+The ``vertex`` element must carry ``x``, ``y``, ``z``; ``red``, ``green``, ``blue`` are the colours
+and every other scalar vertex property an extra field. Other elements are skipped when they follow
+the vertices, or, in binary files, precede them without list properties. In a binary file every
+byte after the header must belong to a declared element, so a lowered vertex count is refused.
 
 References
 ----------
@@ -146,9 +144,9 @@ def _read_vertices(path: Path, data: bytes) -> NDArray[Any]:
 def _skip_binary_element(path: Path, data: bytes, offset: int, element: _Element, fmt: str) -> int:
     """Where the binary rows of ``element`` that start at ``offset`` end.
 
-    A row of fixed-size properties is skipped in one step. Rows with list properties are walked
-    with numpy when every row's lists have the first row's lengths (faces of a triangle mesh), and
-    row by row otherwise; a walk that runs past the end of the data stops there (truncated).
+    Fixed-size rows are skipped in one step; rows with lists with numpy when every row's lists have
+    the first row's lengths (a triangle mesh's faces), else row by row; a walk past the end of the
+    data stops there (truncated).
     """
     order = ">" if fmt == "binary_big_endian" else "<"
     if not element.has_list:
@@ -218,25 +216,9 @@ def _fill_ascii(path: Path, table: NDArray[np.float64], dtype: np.dtype[Any]) ->
 def read_ply(
     path: str | Path, *, units: str = "m", drop_nan: bool = False
 ) -> tuple[PointCloud, dict[str, NDArray[Any]]]:
-    """Read the vertices of a PLY file (ascii or binary, either byte order).
-
-    Parameters
-    ----------
-    path : str or Path
-    units : {"m", "mm"}
-        Units of the file's coordinates (see :func:`read_pcd`).
-    drop_nan : bool
-        Drop points with a NaN or infinite coordinate (logged) instead of refusing the file.
-
-    Returns
-    -------
-    cloud : PointCloud
-        ``x, y, z`` in metres; colours from ``red``, ``green``, ``blue`` (integers taken in
-        [0, 255], floats in [0, 1]; one or two of the three, a NaN or an out-of-range value is
-        refused, naming the properties).
-    extras : dict of str to (n,) array
-        Every other vertex property, in native byte order.
-    """
+    """Read the vertices of a PLY file (ascii or binary, either byte order), as :func:`read_pcd`
+    reads a PCD file: colours from ``red``, ``green``, ``blue`` (all three or none), the other vertex
+    properties as extras in native byte order."""
     scale = check_units(units)
     p = readable_path(path)
     with parse_errors(p, "the PLY file"):
@@ -265,18 +247,9 @@ def read_ply(
 
 def write_ply(path: str | Path, cloud: PointCloud, *, format: str = "binary_little_endian",
               extra_fields: dict[str, Any] | None = None) -> None:
-    """Write a cloud as the ``vertex`` element of a PLY file.
-
-    Parameters
-    ----------
-    path : str or Path
-        Where to write (overwritten).
-    cloud : PointCloud
-        x, y, z are written as ``double`` (exact round trip); colours as ``uchar`` red, green, blue.
-    format : {"ascii", "binary_little_endian", "binary_big_endian"}
-    extra_fields : dict of str to (n,) array, optional
-        More vertex properties (8-, 16-, 32-bit integers, float32 or float64).
-    """
+    """Write a cloud as the ``vertex`` element of a PLY file of ``format`` in ``PLY_FORMATS``:
+    x, y, z as ``double`` (exact round trip), colours as ``uchar``, ``extra_fields`` as more
+    properties (8- to 32-bit integers, float32 or float64)."""
     if format not in PLY_FORMATS:
         raise InvalidArgumentError(f"`format` must be one of {PLY_FORMATS}; got {format!r}")
     cloud, extras = _check_cloud_and_extras(cloud, extra_fields)
