@@ -1,11 +1,9 @@
-"""Recorded sessions (a folder of cloud files, or a ROS 2 bag) read back and fed, poke by poke, to
-the mapper the live loop uses.
+"""Recorded sessions (a folder of cloud files, or a ROS 2 bag) read back and fed, poke by poke,
+to the mapper the live loop uses.
 
-:func:`load_session` checks a session's ``session.yaml`` (``docs/recording-format.md``) and opens
-its data; each poke is read on demand, so a broken poke is reported on its own.
-:func:`load_raw_bag` opens a bag as a robot records it (:class:`RawBagConfig`) as a session of form
-``"raw"``. :func:`write_session` writes the format (``deformap record-sim``, through
-:class:`RecordingEnvironment`).
+:func:`load_session` checks ``session.yaml`` (``docs/recording-format.md``) and reads each poke on
+demand; :func:`load_raw_bag` opens a robot's own bag (:class:`RawBagConfig`) as a session of form
+``"raw"``; :func:`write_session` writes the format.
 """
 
 from __future__ import annotations

@@ -1,13 +1,10 @@
-"""The bag form of a session: a ROS 2 bag (sqlite3 or MCAP) on the topics of ``TOPICS``.
+"""The bag form of a session: a ROS 2 bag on the topics of ``TOPICS``.
 
-The messages of one poke share one header stamp, which ``session.yaml`` names (``stamp_ns``) next
-to what no standard message holds (the commanded target and force). The bag is indexed once; each
-message is decoded only when its poke is read, so a corrupted message breaks only its own poke.
-
-The force–travel record (``OPTIONAL_TOPICS``) is a ``std_msgs/msg/Float64MultiArray`` with two
-dimensions, ``samples`` (n) and ``travel_m,force_n`` (2), its data the n rows ``(travel, force)``
-row by row. That message has no header: the bag's log time of the message is the poke's stamp.
-A bag without the topic, or a poke without a message on it, has no record (``force_travel`` None).
+A poke's messages share one header stamp, which ``session.yaml`` names (``stamp_ns``) beside the
+command (target, force). Each message is decoded when its poke is read, so a corrupted message
+breaks only its own poke. The force–travel record (``OPTIONAL_TOPICS``) is a
+``Float64MultiArray`` of dimensions ``samples`` (n) × ``travel_m,force_n`` (2); having no header,
+it is logged at the poke's stamp. Without one a poke has no record.
 """
 
 from __future__ import annotations
@@ -83,7 +80,7 @@ class BagReader:
         return out
 
     def _force_travel(self, stamp: int) -> ForceTravel | None:
-        """The record whose message is logged at ``stamp``, or None when there is none."""
+        """The record logged at ``stamp``, or None."""
         topic, msgtype = OPTIONAL_TOPICS["force_travel"]
         where = f"{self.path} [{topic} logged at {stamp}]"
         raws = [r for r in self._raw[topic] if r.log_time_ns == stamp]
@@ -236,11 +233,8 @@ def force_travel_message(record: ForceTravel) -> Any:
 
 def write_session_bag(path: Path, *, storage: str, observation: PointCloud,
                       presses: Sequence[PressObservation], stamps_ns: Sequence[int]) -> None:
-    """Write the observation and the presses (world frame, float64) to a new bag at ``path``.
-
-    A cloud with colours gets a packed FLOAT32 ``rgb`` field (8 bits a channel); the robot's
-    points have none.
-    """
+    """Write the observation and the presses (world frame, float64; colours as a packed
+    ``rgb``, none for the robot's points) to a new bag at ``path``."""
     store = typestore()
     # the record's topic only where a press has one: a bag of presses without stays as before
     topics = dict(TOPICS)

@@ -1,13 +1,8 @@
-"""The ``session.yaml`` of a recorded session: its keys, parsed strictly.
+"""The ``session.yaml`` of a recorded session (``docs/recording-format.md``), parsed strictly.
 
-The format is documented for users in ``docs/recording-format.md``; this module is its reference.
-Keys are checked in two tiers, so that one broken poke does not hide the others:
-
-- the file as a whole (unknown or missing keys anywhere, a wrong format name or version, bad
-  workspace, probe, frame or units) raises :class:`~deformap.errors.ConfigError` when the session is
-  loaded;
-- the *values* of one poke's entry (a NaN tip centre, a zero force, a target of the wrong length)
-  are kept as that poke's error and raised only when that poke is read.
+The file as a whole (unknown or missing keys, format name or version, workspace, probe, frame,
+units) raises :class:`~deformap.errors.ConfigError` when loaded; the values of one poke's entry
+are kept as that poke's error and raised when it is read, so one broken poke hides no other.
 """
 
 from __future__ import annotations
@@ -49,12 +44,9 @@ TOPICS = {"observation": ("/deformap/observation", "sensor_msgs/msg/PointCloud2"
           "tip": ("/deformap/press/tip", "geometry_msgs/msg/PointStamped"),
           "robot": ("/deformap/press/robot", "sensor_msgs/msg/PointCloud2")}
 
-#: Topics of the bag form that a bag may lack (then no poke has what they carry). The force–travel
-#: record is a ``Float64MultiArray`` of ``n × 2`` rows ``(travel_m, force_n)``; the message has no
-#: header, so its bag log time is the poke's ``stamp_ns``.
-OPTIONAL_TOPICS = {
-    "force_travel": ("/deformap/press/force_travel", "std_msgs/msg/Float64MultiArray"),
-}
+#: Topics of the bag form that a bag may lack (then no poke has what they carry).
+OPTIONAL_TOPICS = {"force_travel": ("/deformap/press/force_travel",
+                                    "std_msgs/msg/Float64MultiArray")}
 
 _TOP_REQUIRED = {"format", "version", "workspace", "probe", "pokes"}
 _TOP_OPTIONAL = {"units", "frame", "cam2world", "ground_truth", "source", "observation", "bag",
@@ -67,28 +59,12 @@ _BAG_POKE_KEYS = {"stamp_ns", "target_xy", "force_n"}
 
 @dataclass(frozen=True, kw_only=True)
 class PokeSpec:
-    """One poke's entry in ``session.yaml``, with the values already checked.
+    """One poke's entry in ``session.yaml``, its values checked (world frame, SI).
 
-    Parameters
-    ----------
-    index : int
-        Position in the ``pokes`` list (0-based).
-    target_xy : (2,) float, metres or None
-    force_n : float or None
-        Commanded target and normal force.
-    cloud : Path or None
-        Folder form: the cloud seen while pressing.
-    tip_center : (3,) float, metres or None
-    force : (3,) float, newtons or None
-        Folder form: the measured contact (world frame, force pointing into the surface).
-    robot_points : Path or (m, 3) float or None
-        Folder form: a cloud file, or the points inline.
-    stamp_ns : int or None
-        Bag form: the header stamp shared by this poke's messages.
-    force_travel : ForceTravel or None
-        Folder form: the press's force–travel record, when the entry has one.
-    error : DeformapError or None
-        Why this entry cannot be used (raised when the poke is read).
+    ``index`` is its place in ``pokes`` (0-based); ``target_xy`` and ``force_n`` the command. The
+    folder form has ``cloud`` (a file), the contact ``tip_center`` and ``force``, ``robot_points``
+    (a file or inline points) and an optional ``force_travel``; the bag form the ``stamp_ns`` its
+    messages share. ``error`` says why the entry cannot be used (raised when the poke is read).
     """
 
     index: int
@@ -107,30 +83,11 @@ class PokeSpec:
 class SessionHeader:
     """What ``session.yaml`` says about the whole session.
 
-    Parameters
-    ----------
-    root : Path
-        The session folder; relative file names resolve against it.
-    form : {"folder", "bag"}
-    units : {"m", "mm"}
-        Units of the point coordinates in cloud files and PointCloud2 messages.
-    frame : str
-        The frame the clouds are stored in.
-    cam2world : (4, 4) float, "tf_static" or None
-        Maps clouds from ``frame`` to the world frame (``None`` when ``frame == "world"``).
-    workspace : Workspace
-    tip_radius_m : float
-    observation : Path or None
-        Folder form: the initial observation's cloud file.
-    bag : Path or None
-        Bag form: the rosbag2 folder or ``.mcap`` / ``.db3`` file.
-    ground_truth : Path or None
-    source : dict
-        Free-form provenance (scenario, seed, deformap version), copied into reports.
-    pokes : tuple of PokeSpec
-    sha256 : dict of Path to str
-        The manifest: each listed file's SHA-256 (hex), checked when the file is read. Empty
-        when ``session.yaml`` has none (sessions not written by ``record-sim``).
+    ``root`` is the session folder; ``form`` ``"folder"``, ``"bag"`` or ``"raw"``; ``units`` those of
+    the stored coordinates; ``cam2world`` maps clouds from ``frame`` to the world (a 4×4 matrix,
+    ``"tf_static"`` or None when ``frame == "world"``). ``observation`` (folder form) and ``bag``
+    name the data; ``source`` is free-form provenance copied into reports; ``sha256`` the manifest
+    (file → digest), empty when the file has none.
     """
 
     root: Path
@@ -263,13 +220,8 @@ def _workspace(file: Path, data: Any) -> Workspace:
 
 
 def parse_session_yaml(data: Any, file: Path) -> SessionHeader:
-    """Check the plain data of a ``session.yaml`` and return its header and poke entries.
-
-    Raises
-    ------
-    ConfigError
-        Naming the file and the key (``pokes[3].force``) on any schema problem.
-    """
+    """Check the plain data of a ``session.yaml``; a schema problem is a ConfigError naming the
+    file and the key (``pokes[3].force``)."""
     root = file.parent
     _check_keys(file, "(top level)", data, _TOP_REQUIRED, _TOP_OPTIONAL)
     if data["format"] != FORMAT_NAME:
@@ -317,8 +269,8 @@ def parse_session_yaml(data: Any, file: Path) -> SessionHeader:
 
 
 def _check_poke_count(file: Path, data: dict[str, Any], pokes: list[Any]) -> None:
-    """``n_pokes``, when given, must equal the entries of ``pokes``: a file cut at a poke
-    boundary is still valid YAML, and must not load as fewer pokes."""
+    """``n_pokes``, when given, must count the entries of ``pokes``: a file cut at a poke
+    boundary is still valid YAML."""
     if "n_pokes" not in data:
         logger.info("%s: no `n_pokes`; cannot check that the poke list is complete", file)
         return

@@ -1,10 +1,6 @@
-"""Ground truth of a session recorded from a simulation: region labels and hardness on a grid.
-
-Stored as ``ground_truth.npz`` (never pickled) with ``xs`` (nx,), ``ys`` (ny,) cell centres in
-metres, ``labels`` (ny, nx) integers and ``hardness`` (ny, nx) newtons (``inf`` for a rigid region,
-``nan`` where no region is). A real recording has none, and ``deformap map`` then reports no
-ground-truth metrics.
-"""
+"""Ground truth of a session recorded from a simulation, ``ground_truth.npz`` (never pickled):
+``xs`` (nx,), ``ys`` (ny,) cell centres [m], ``labels`` (ny, nx) integers and ``hardness``
+(ny, nx) [N] (``inf`` rigid, ``nan`` no region)."""
 
 from __future__ import annotations
 
@@ -25,16 +21,8 @@ __all__ = ["GroundTruth", "read_ground_truth", "write_ground_truth"]
 
 @dataclass(frozen=True, eq=False)
 class GroundTruth:
-    """Region labels and hardness on a regular grid, looked up at any points by nearest cell.
-
-    Parameters
-    ----------
-    xs : (nx,) float, metres, increasing
-    ys : (ny,) float, metres, increasing
-    labels : (ny, nx) int
-    hardness : (ny, nx) float, newtons
-        Constant over each label; ``inf`` for rigid, ``nan`` for no region (bare table).
-    """
+    """Region labels and hardness on a regular grid (``xs``, ``ys`` increasing), looked up by
+    nearest cell; ``hardness`` is constant over each label."""
 
     xs: NDArray[np.float64]
     ys: NDArray[np.float64]

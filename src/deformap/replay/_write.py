@@ -97,42 +97,26 @@ def write_session(folder: str | Path, *, workspace: Workspace, observation: Poin
                   presses: Sequence[PressObservation], tip_radius_m: float | None = None,
                   ground_truth: GroundTruth | None = None, source: dict[str, Any] | None = None,
                   format: str = "folder", cloud_format: str = "pcd") -> Path:
-    """Write a session that :func:`load_session` reads back exactly.
-
-    ``session.yaml`` is written last, with ``n_pokes`` and the ``sha256`` manifest of every file
-    written before it (``docs/recording-format.md``).
+    """Write a session that :func:`load_session` reads back exactly; returns its ``session.yaml``.
 
     Parameters
     ----------
     folder : str or Path
-        A new (or empty) folder; it receives ``session.yaml`` and the data.
-    workspace : Workspace
+        A new or empty folder.
     observation : PointCloud
         The initial observation, world frame, metres.
     presses : sequence of PressObservation
-        In order; clouds, robot points and force–travel records are written in float64 and read
-        back bit for bit. Cloud colours are written when a cloud has them: exactly in NPZ, to 8
-        bits a channel in PCD, PLY and bags (exact for multiples of 1/255).
+        In order; points and force–travel records are written as float64 and read back bit for bit,
+        colours exactly in NPZ and to 8 bits a channel in PCD, PLY and bags. A press with one hull
+        per part is written with its parts' common hull (with a warning).
     tip_radius_m : float, optional
         Defaults to the presses' (which must agree).
-    ground_truth : GroundTruth, optional
-        Written to ``ground_truth.npz``.
     source : dict, optional
-        Provenance copied into ``session.yaml`` (plain YAML data: scenario, seed, ...).
+        Provenance copied into ``session.yaml`` (plain YAML data).
     format : {"folder", "mcap", "sqlite3"}
-        Cloud files, or a ROS 2 bag in the ``bag`` sub-folder.
-    cloud_format : {"pcd", "ply", "npz"}
-        File type of the folder form's clouds (binary, float64).
+        Cloud files of ``cloud_format`` (binary, float64), or a ROS 2 bag in ``bag/``.
 
-    Returns
-    -------
-    Path
-        The ``session.yaml`` written.
-
-    Notes
-    -----
-    The format keeps one robot hull per poke: a press given one hull per part is written with the
-    points of all its parts (a warning says so).
+    ``session.yaml`` is written last, with ``n_pokes`` and the ``sha256`` manifest of every file.
     """
     out, presses, tip = _check_inputs(folder, workspace, observation, presses, tip_radius_m,
                                       format, cloud_format, ground_truth)  # fmt: skip
