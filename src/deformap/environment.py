@@ -1,11 +1,8 @@
 """The ``Environment`` protocol: all the exploration loop needs from a world or a robot.
 
-The simulated world (:mod:`deformap.world`) and a real robot adapter both implement it; the loop in
-:mod:`deformap.explore` never knows which one it drives. :class:`TactileContact` is defined in
-:mod:`deformap.mechanics` and re-exported here.
-
-Everything is SI and in the world frame: the table plane is ``z = 0``, ``z`` up, and clouds leave an
-environment already transformed by the camera's extrinsics (``cam2world``).
+The simulated world (:mod:`deformap.world`) and a robot adapter implement it; the loop never knows
+which one it drives. Everything is SI in the world frame (the table is ``z = 0``, ``z`` up), clouds
+included. :class:`TactileContact` comes from :mod:`deformap.mechanics`.
 
 References
 ----------
@@ -36,20 +33,14 @@ __all__ = ["FORCE_MISMATCH_ABS_N", "FORCE_MISMATCH_REL", "MAX_GRID_CELLS", "MAX_
            "PressObservation", "TactileContact", "Workspace"]
 
 
-#: Most cells of a :meth:`Workspace.grid` (200 MB per float map layer), refused before any array
-#: exists; the exploration's own budget is smaller.
+#: Most cells of a :meth:`Workspace.grid` (200 MB per float map layer).
 MAX_GRID_CELLS = 25_000_000
 
 
 @dataclass(frozen=True, kw_only=True)
 class Workspace:
-    """The axis-aligned rectangle ``[lower, upper]`` of the table to map, in metres.
-
-    Parameters
-    ----------
-    lower, upper : (2,) float
-        Corners ``(x_min, y_min)`` and ``(x_max, y_max)``; ``upper`` must exceed ``lower``.
-    """
+    """The axis-aligned rectangle ``[lower, upper]`` of the table to map: corners ``(x_min, y_min)``
+    and ``(x_max, y_max)`` in metres, ``upper`` above ``lower`` on both axes."""
 
     lower: tuple[float, float] = (0.0, 0.0)
     upper: tuple[float, float] = (0.60, 0.40)
@@ -81,12 +72,8 @@ class Workspace:
         return np.all((pts >= lo) & (pts <= hi), axis=1)
 
     def grid(self, spacing_m: float = 0.005) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """Cell-centre coordinates ``(xs, ys)`` of a regular grid covering the rectangle.
-
-        The grid has ``round(width / spacing)`` columns and ``round(depth / spacing)`` rows, so a
-        60×40 cm workspace at the paper's 0.5 cm gives 120×80 cells; more than
-        :data:`MAX_GRID_CELLS` are refused before anything is allocated.
-        """
+        """Cell centres ``(xs, ys)`` of a grid of ``round(width / spacing)`` × ``round(depth / spacing)``
+        cells over the rectangle; more than :data:`MAX_GRID_CELLS` are refused before any allocation."""
         step = check_positive("spacing_m", spacing_m)
         (x0, y0), (w, d) = self.lower, self.size
         nx, ny = max(1, round(w / step)), max(1, round(d / step))
@@ -102,48 +89,41 @@ class Workspace:
         return {"lower": list(self.lower), "upper": list(self.upper)}
 
 
-#: A travel sample may lie this far below the largest travel before it (encoder noise, not a
-#: retraction): ten standard deviations of arm encoders (about 0.05 mm), so a rigid press's noise
-#: stays inside it over thousands of samples while a half-millimetre slip is refused.
+#: How far [m] travel may fall below its largest value before (encoder noise, not a retraction):
+#: ten standard deviations of arm encoders.
 TRAVEL_BACKWARDS_TOLERANCE_M = 5e-4
 
-#: Largest travel accepted [m]: a 5 cm dent would put a 1 cm tip's stick into the foam, so larger
-#: numbers are millimetres (a record in millimetres of a dent under 0.05 mm reads as rigid).
+#: Largest travel accepted [m]: a 5 cm dent would put a 1 cm tip's stick into the foam.
 MAX_TRAVEL_M = 0.05
 
-#: The force must rise by more than this from the first sample to the last [N]: four times the
-#: 5 mN noise floor of a probe's force sensor, so that a flat noisy record is not a press.
+#: The force must rise by more than this [N] over a record: four times a probe sensor's noise.
 MIN_FORCE_RISE_N = 0.02
 
-#: A record's final force may differ from the commanded force by at most
-#: ``FORCE_MISMATCH_REL · force_n + FORCE_MISMATCH_ABS_N``: far beyond the controller's overshoot
-#: and the sensor's noise, so a record that misses it belongs to another press or is scaled wrong.
+#: A measured force may differ from the commanded by at most ``FORCE_MISMATCH_REL · force_n +
+#: FORCE_MISMATCH_ABS_N``: far beyond a controller's overshoot and a sensor's noise.
 FORCE_MISMATCH_REL = 0.25
 FORCE_MISMATCH_ABS_N = 0.05
 
 
+def _allowed_mismatch(force_n: float) -> float:
+    return FORCE_MISMATCH_REL * force_n + FORCE_MISMATCH_ABS_N
+
+
 @dataclass(frozen=True, kw_only=True)
 class ForceTravel:
-    """The press's force–travel record, from first contact to the commanded force.
-
-    Samples, in time order, of the probe's travel along the press direction since first contact and
-    of the normal force on the surface (a robot reads them from forward kinematics and its force
-    sensor, ``docs/robot.md``).
+    """The press's force–travel record, from first contact to the commanded force (a robot reads it
+    from forward kinematics and its force sensor, ``docs/robot.md``), ``n >= 3`` samples in time order.
 
     Parameters
     ----------
     travel_m : (n,) float, metres
-        Travel into the surface since first contact, about 0 at the first sample. It may fall back by
-        at most :data:`TRAVEL_BACKWARDS_TOLERANCE_M` below the largest travel before it and never
-        exceeds :data:`MAX_TRAVEL_M` in magnitude.
+        Travel along the press since first contact: about 0 at first, never more than
+        :data:`TRAVEL_BACKWARDS_TOLERANCE_M` below the largest before it, within :data:`MAX_TRAVEL_M`.
     force_n : (n,) float, newtons
-        The normal force on the surface (positive into it); the last sample is positive and exceeds
-        the first by more than :data:`MIN_FORCE_RISE_N`.
+        The normal force on the surface; the last sample positive and more than
+        :data:`MIN_FORCE_RISE_N` above the first.
 
-    Notes
-    -----
-    ``n >= 3``; the arrays are stored as read-only float64 copies. Every refusal is an
-    :class:`~deformap.errors.InvalidArgumentError` naming the field.
+    Stored as read-only float64 copies; a refusal is an InvalidArgumentError naming the field.
     """
 
     travel_m: NDArray[np.float64]
@@ -203,27 +183,25 @@ class ForceTravel:
 
 @dataclass(frozen=True, kw_only=True)
 class PressObservation:
-    """Everything one press returns.
+    """Everything one press returns (world frame, SI).
 
     Parameters
     ----------
     cloud : PointCloud
-        The cloud seen while pressing, world frame, with the robot's stick and hand in it.
+        The cloud seen while pressing, with the robot's stick and hand in it.
     contact : TactileContact
-        Tip position, measured force and tip radius at the commanded force; the force pushes into
-        the surface (negative z) and its magnitude lies within
-        ``FORCE_MISMATCH_REL · force_n + FORCE_MISMATCH_ABS_N`` of ``force_n``.
-    robot_points : (m, 3) float, metres, or a tuple of such arrays (one per part)
+        Tip, measured force and tip radius at the commanded force; the force pushes into the surface
+        (negative z) and its size is within ``FORCE_MISMATCH_REL · force_n + FORCE_MISMATCH_ABS_N``
+        of ``force_n``.
+    robot_points : (m, 3) float, metres, or a tuple of such arrays
         Points whose convex hull covers the stick and hand (at least 4, not coplanar), or one array
-        per part, each hull removed on its own so that a wide hand does not widen the hull down at
-        the surface; :attr:`robot_hulls` gives the tuple either way.
+        per part, each hull removed on its own (:attr:`robot_hulls` gives the tuple either way).
     target_xy : (2,) float, metres
-        The commanded target.
     force_n : float
-        The commanded normal force.
+        The commanded target and normal force.
     force_travel : ForceTravel or None
-        The press's force–travel record (None where the environment cannot provide it); its last
-        force lies within the same tolerance of ``force_n``.
+        The press's record where the environment provides one; its last force within the same
+        tolerance of ``force_n``.
     """
 
     cloud: PointCloud
@@ -258,8 +236,7 @@ class PressObservation:
         if not isinstance(record, ForceTravel):
             raise InvalidArgumentError(
                 f"`force_travel` must be a ForceTravel or None; got {type(record).__name__}")
-        final = float(record.force_n[-1])
-        allowed = FORCE_MISMATCH_REL * force_n + FORCE_MISMATCH_ABS_N
+        final, allowed = float(record.force_n[-1]), _allowed_mismatch(force_n)
         if abs(final - force_n) > allowed:
             raise InvalidArgumentError(
                 f"`force_travel` must end at the commanded force {force_n:.4g} N (within "
@@ -273,16 +250,13 @@ class PressObservation:
         return robot if isinstance(robot, tuple) else (robot,)
 
     def _check_contact_force(self, force_n: float) -> None:
-        """The measured contact force must be a press (into the surface, world z up) of about the
-        commanded size: a force pointing away from the surface, or far from the commanded one
-        (a sensor in other units, a wrong frame), is no observation of this press."""
+        """The measured force must push into the surface (world z up) at about the commanded size."""
         force = self.contact.force
         if force[2] >= 0.0:
             raise InvalidArgumentError(
                 "`contact.force` must push into the surface (negative z in the world frame, z up); "
                 f"got {tuple(float(f) for f in force)} N")
-        measured = self.contact.force_n
-        allowed = FORCE_MISMATCH_REL * force_n + FORCE_MISMATCH_ABS_N
+        measured, allowed = self.contact.force_n, _allowed_mismatch(force_n)
         if abs(measured - force_n) > allowed:
             raise InvalidArgumentError(
                 f"`contact.force` must be near the commanded force {force_n:.4g} N (within "
@@ -293,8 +267,8 @@ class PressObservation:
 class Environment(Protocol):
     """A surface that can be seen and pressed: a simulated world or a real robot.
 
-    Implementations refuse a target outside ``workspace``, a non-positive force and a second
-    ``press`` before ``release`` with a :class:`~deformap.errors.DeformapError`.
+    A target outside ``workspace``, a non-positive force and a second ``press`` before ``release``
+    are refused with a :class:`~deformap.errors.DeformapError`.
     """
 
     @property
