@@ -17,17 +17,19 @@ from dataclasses import Field, field, fields, is_dataclass
 from functools import cache
 from pathlib import Path
 from types import UnionType
-from typing import Any, Literal, Union, get_args, get_origin, get_type_hints
+from typing import Any, Literal, TypeVar, Union, get_args, get_origin, get_type_hints
 
 import numpy as np
 from numpy.typing import NDArray
 
 from deformap.errors import InvalidArgumentError
 
-__all__ = ["SettingError", "check_array", "check_finite_scalar", "check_in_range", "check_int",
-           "check_path", "check_points", "check_positive", "check_rigid_transform",
-           "check_settings", "check_slope_deg", "check_vector", "describe", "setting",
-           "setting_metadata"]
+__all__ = ["SettingError", "check_array", "check_finite_scalar", "check_in_range",
+           "check_instance", "check_int", "check_path", "check_points", "check_positive",
+           "check_rigid_transform", "check_settings", "check_slope_deg", "check_vector",
+           "describe", "setting", "setting_metadata"]
+
+_T = TypeVar("_T")
 
 
 def describe(value: Any) -> str:
@@ -86,6 +88,15 @@ def check_path(name: str, value: Any) -> Path:
         raise InvalidArgumentError(
             f"`{name}` must be a str or pathlib.Path; got {type(value).__name__}")
     return Path(value)
+
+
+def check_instance(name: str, value: Any, cls: type[_T]) -> _T:
+    """Validate an instance of ``cls``."""
+    if not isinstance(value, cls):
+        article = "an" if cls.__name__[0] in "AEIOU" else "a"
+        raise InvalidArgumentError(
+            f"`{name}` must be {article} {cls.__name__}; got {type(value).__name__}")
+    return value
 
 
 def check_points(name: str, value: Any, *, min_rows: int = 1) -> NDArray[np.float64]:

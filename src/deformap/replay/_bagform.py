@@ -93,8 +93,7 @@ class BagReader:
             msg = typestore().deserialize_cdr(raws[0].data, msgtype)
         except bag_read_errors() as exc:
             raise FileFormatError(
-                f"{where}: could not be decoded: {bag_error_text(exc, 120)}"
-            ) from None
+                f"{where}: could not be decoded: {bag_error_text(exc, 120)}") from None
         dims = [(str(d.label), int(d.size)) for d in msg.layout.dim]
         data = np.asarray(msg.data, dtype=float)
         if (len(dims) != 2 or (dims[0][0], dims[1][0]) != FORCE_TRAVEL_DIMS or dims[1][1] != 2
@@ -214,18 +213,12 @@ def _point_message(stamp_ns: int, point: Any) -> Any:
         header=header, point=types["geometry_msgs/msg/Point"](x=x, y=y, z=z))
 
 
-def _wrench_message(stamp_ns: int, force: Any) -> Any:
-    return wrench_message(stamp_ns, "world", force, np.zeros(3))
-
-
 def force_travel_message(record: ForceTravel) -> Any:
     """The record as a ``std_msgs/msg/Float64MultiArray`` (see the module docstring)."""
     types = typestore().types
-    n = len(record)
-    dims = [types["std_msgs/msg/MultiArrayDimension"](label=FORCE_TRAVEL_DIMS[0], size=n,
-                                                      stride=2 * n),
-            types["std_msgs/msg/MultiArrayDimension"](label=FORCE_TRAVEL_DIMS[1], size=2,
-                                                      stride=2)]  # fmt: skip
+    n, dim = len(record), types["std_msgs/msg/MultiArrayDimension"]
+    dims = [dim(label=FORCE_TRAVEL_DIMS[0], size=n, stride=2 * n),
+            dim(label=FORCE_TRAVEL_DIMS[1], size=2, stride=2)]
     layout = types["std_msgs/msg/MultiArrayLayout"](dim=dims, data_offset=0)
     data = np.column_stack([record.travel_m, record.force_n]).ravel()
     return types["std_msgs/msg/Float64MultiArray"](layout=layout, data=data)
@@ -247,17 +240,15 @@ def write_session_bag(path: Path, *, storage: str, observation: PointCloud,
         def put(key: str, stamp: int, msg: Any) -> None:
             writer.write(conns[key], stamp, store.serialize_cdr(msg, topics[key][1]))
 
-        put("observation", 0, array_to_pointcloud2(observation.points, colors=observation.colors,
-                                                   frame_id="world", stamp_ns=0,
-                                                   dtype="float64"))  # fmt: skip
+        def cloud(key: str, stamp: int, points: Any, colors: Any = None) -> None:
+            put(key, stamp, array_to_pointcloud2(points, colors=colors, frame_id="world",
+                                                 stamp_ns=stamp, dtype="float64"))
+
+        cloud("observation", 0, observation.points, observation.colors)
         for stamp, obs in zip(stamps_ns, presses, strict=True):
-            put("cloud", stamp, array_to_pointcloud2(obs.cloud.points, colors=obs.cloud.colors,
-                                                     frame_id="world", stamp_ns=stamp,
-                                                     dtype="float64"))  # fmt: skip
-            put("wrench", stamp, _wrench_message(stamp, obs.contact.force))
+            cloud("cloud", stamp, obs.cloud.points, obs.cloud.colors)
+            put("wrench", stamp, wrench_message(stamp, "world", obs.contact.force, np.zeros(3)))
             put("tip", stamp, _point_message(stamp, obs.contact.tip_center))
-            robot = np.vstack(obs.robot_hulls)  # one hull per poke: the parts' common one
-            put("robot", stamp, array_to_pointcloud2(robot, frame_id="world", stamp_ns=stamp,
-                                                     dtype="float64"))  # fmt: skip
+            cloud("robot", stamp, np.vstack(obs.robot_hulls))  # one hull: the parts' common one
             if obs.force_travel is not None:
                 put("force_travel", stamp, force_travel_message(obs.force_travel))

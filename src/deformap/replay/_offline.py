@@ -15,10 +15,10 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from deformap._validation import check_points, check_positive, check_vector
+from deformap._validation import check_instance, check_points, check_positive, check_vector
 from deformap.cloud import PointCloud
 from deformap.environment import PressObservation, TactileContact, Workspace
-from deformap.errors import DeformapError, InvalidArgumentError
+from deformap.errors import DeformapError
 from deformap.explore import (
     ExplorationConfig,
     ExplorationResult,
@@ -59,12 +59,8 @@ def map_session(session: RecordedSession, config: ExplorationConfig, *, rng: np.
     live run's generator gives its surface model. A poke that cannot be read, processed or added
     (any DeformapError) is logged and listed in ``skipped``. ``on_poke`` is called after each poke.
     """
-    if not isinstance(session, RecordedSession):
-        raise InvalidArgumentError(
-            f"`session` must be a RecordedSession; got {type(session).__name__}")
-    if not isinstance(config, ExplorationConfig):
-        raise InvalidArgumentError(
-            f"`config` must be an ExplorationConfig; got {type(config).__name__}")
+    check_instance("session", session, RecordedSession)
+    check_instance("config", config, ExplorationConfig)
     # explore() spawns max_pokes + 1 streams and fits the surface with the first; a spawned
     # child depends only on its position, so spawning one gives that same stream.
     run = MappingRun(session.workspace, config, session.observation, rng.spawn(1)[0])
@@ -101,11 +97,8 @@ def estimate_poke(before: PointCloud, after: PointCloud, contact: TactileContact
     (:func:`tip_sphere_points`); ``contact_gap_m`` as for :func:`~deformap.replay.load_session`.
     """
     for name, cloud in (("before", before), ("after", after)):
-        if not isinstance(cloud, PointCloud):
-            raise InvalidArgumentError(f"`{name}` must be a PointCloud; got {type(cloud).__name__}")
-    if not isinstance(contact, TactileContact):
-        raise InvalidArgumentError(
-            f"`contact` must be a TactileContact; got {type(contact).__name__}")
+        check_instance(name, cloud, PointCloud)
+    check_instance("contact", contact, TactileContact)
     robot = (tip_sphere_points(contact.tip_center, contact.tip_radius_m) if robot_points is None
              else check_points("robot_points", robot_points, min_rows=4))  # fmt: skip
     xy = contact.contact_point[:2]

@@ -6,9 +6,9 @@ from __future__ import annotations
 from pathlib import Path
 
 from deformap._config import config_to_dict
-from deformap._validation import check_positive
+from deformap._validation import check_instance, check_path, check_positive
 from deformap.cloud.io import path_kind
-from deformap.errors import FileFormatError, InvalidArgumentError
+from deformap.errors import FileFormatError
 from deformap.replay._format import SESSION_FILE, SessionHeader
 from deformap.replay._rawbag import RawBagReader
 from deformap.replay._rawconfig import RawBagConfig
@@ -44,13 +44,8 @@ def load_raw_bag(path: str | Path, config: RawBagConfig | None = None, *, defaul
     A bag missing or unreadable, lacking a topic or a press, or whose observation frames do not come
     before the first press, is a FileFormatError.
     """
-    if not isinstance(path, (str, Path)):
-        raise InvalidArgumentError(
-            f"`path` must be a str or pathlib.Path; got {type(path).__name__}")
-    cfg = RawBagConfig() if config is None else config
-    if not isinstance(cfg, RawBagConfig):
-        raise InvalidArgumentError(f"`config` must be a RawBagConfig; got {type(cfg).__name__}")
-    bag = Path(path)
+    bag = check_path("path", path)
+    cfg = check_instance("config", RawBagConfig() if config is None else config, RawBagConfig)
     if path_kind(bag) == "missing":
         raise FileFormatError(f"{bag}: no such bag")
     force = cfg.commanded_force(check_positive("default_force_n", default_force_n))

@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 
 from deformap._config import load_yaml
-from deformap._validation import check_int, check_positive
+from deformap._validation import check_int, check_path, check_positive
 from deformap.cloud import PointCloud, points_in_hull
 from deformap.cloud.io import path_kind
 from deformap.environment import PressObservation, TactileContact, Workspace
@@ -69,10 +69,6 @@ class RecordedSession:
 
     def __len__(self) -> int:
         return len(self.header.pokes)
-
-    @property
-    def n_pokes(self) -> int:
-        return len(self)
 
     def observation(self) -> PointCloud:
         """The initial observation of the undisturbed surface, world frame, metres."""
@@ -167,11 +163,9 @@ def load_session(
         The observation or the bag is missing, the bag lacks a topic, or the ground truth is
         unreadable.
     """
-    if not isinstance(path, (str, Path)):
-        raise InvalidArgumentError(
-            f"`path` must be a str or pathlib.Path; got {type(path).__name__}")
+    p = check_path("path", path)
     gap = check_positive("contact_gap_m", contact_gap_m)
-    file = _session_file(Path(path))
+    file = _session_file(p)
     data = _read_yaml(file)
     header = parse_session_yaml(data, file)
     reader = FolderReader(header) if header.form == "folder" else BagReader(header)

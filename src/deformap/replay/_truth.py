@@ -4,7 +4,6 @@
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -12,7 +11,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from deformap._validation import check_array
+from deformap._validation import check_array, check_instance
 from deformap.cloud.io import load_npz_arrays, path_kind
 from deformap.errors import FileFormatError, InvalidArgumentError
 
@@ -75,19 +74,10 @@ class GroundTruth:
         iy, ix = self._cells(xs, ys)
         return self.hardness[np.ix_(iy, ix)]
 
-    def hardness_by_label(self) -> dict[int, float]:
-        """Hardness of each label (``math.inf`` for rigid, ``nan`` for none)."""
-        out = {}
-        for label in np.unique(self.labels):
-            value = float(self.hardness[self.labels == label][0])
-            out[int(label)] = math.inf if np.isposinf(value) else value
-        return out
-
 
 def write_ground_truth(path: str | Path, truth: GroundTruth) -> None:
     """Write ``truth`` to an NPZ archive (compressed, no pickle)."""
-    if not isinstance(truth, GroundTruth):
-        raise InvalidArgumentError(f"`truth` must be a GroundTruth; got {type(truth).__name__}")
+    check_instance("truth", truth, GroundTruth)
     with open(path, "wb") as fh:
         np.savez_compressed(fh, xs=truth.xs, ys=truth.ys, labels=truth.labels,
                             hardness=truth.hardness)  # fmt: skip

@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 import yaml
 
-from deformap._validation import check_positive
+from deformap._validation import check_instance, check_positive
 from deformap.cloud import PointCloud
 from deformap.cloud.io import BAG_STORAGES, CLOUD_FORMATS, write_cloud
 from deformap.environment import PressObservation, Workspace
@@ -56,9 +56,7 @@ def _check_inputs(folder: Any, workspace: Any, observation: Any, presses: Any, t
     out = Path(folder)
     if out.exists() and (not out.is_dir() or any(out.iterdir())):
         raise InvalidArgumentError(f"`folder` {out} exists and is not an empty folder")
-    if not isinstance(workspace, Workspace):
-        raise InvalidArgumentError(
-            f"`workspace` must be a Workspace; got {type(workspace).__name__}")
+    check_instance("workspace", workspace, Workspace)
     if not isinstance(observation, PointCloud) or len(observation) == 0:
         raise InvalidArgumentError("`observation` must be a non-empty PointCloud")
     if observation.frame != "world":
@@ -66,9 +64,7 @@ def _check_inputs(folder: Any, workspace: Any, observation: Any, presses: Any, t
             f"`observation` must be in frame 'world'; got {observation.frame!r}")
     presses = list(presses)
     for i, obs in enumerate(presses):
-        if not isinstance(obs, PressObservation):
-            raise InvalidArgumentError(
-                f"`presses[{i}]` must be a PressObservation; got {type(obs).__name__}")
+        check_instance(f"presses[{i}]", obs, PressObservation)
         if obs.cloud.frame != "world":
             raise InvalidArgumentError(f"`presses[{i}].cloud` must be in frame 'world'")
     radii = {obs.contact.tip_radius_m for obs in presses}

@@ -92,8 +92,7 @@ def _messages(path: Any, topic: str, msgtype: str) -> Iterator[tuple[int, Any]]:
             msg = store.deserialize_cdr(raw.data, msgtype)
         except errors as exc:
             raise FileFormatError(
-                f"{Path(path)}: could not read topic {topic!r}: {bag_error_text(exc)}"
-            ) from exc
+                f"{Path(path)}: could not read topic {topic!r}: {bag_error_text(exc)}") from exc
         yield raw.log_time_ns, msg
 
 

@@ -118,8 +118,7 @@ def parse_errors(path: Path, what: str) -> Iterator[None]:
     except _PARSE_ERRORS as exc:
         detail = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
         raise FileFormatError(
-            f"{path}: could not read {what}: {type(exc).__name__}: {detail[:200]}"
-        ) from exc
+            f"{path}: could not read {what}: {type(exc).__name__}: {detail[:200]}") from exc
 
 
 def check_colors(where: Path | str, colors: NDArray[Any], field: str) -> NDArray[np.float64]:

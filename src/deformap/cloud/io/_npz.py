@@ -63,8 +63,7 @@ def _read_member(path: Path, archive: zipfile.ZipFile, info: zipfile.ZipInfo) ->
             detail = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
             raise FileFormatError(
                 f"{path}: NPZ member {info.filename!r}: expected a .npy header, got a malformed "
-                f"one ({detail[:120]})"
-            ) from None
+                f"one ({detail[:120]})") from None
         if dtype.hasobject:
             raise FileFormatError(
                 f"{path}: NPZ member {info.filename!r} holds Python objects (dtype {dtype}), "

@@ -20,6 +20,7 @@ from typing import Any, cast
 import numpy as np
 from numpy.typing import NDArray
 
+from deformap._validation import check_instance
 from deformap.cloud._pointcloud import PointCloud
 from deformap.cloud.io._common import (
     check_body_size,
@@ -234,8 +235,7 @@ def _check_cloud_and_extras(
     cloud: Any, extra_fields: dict[str, Any] | None
 ) -> tuple[PointCloud, dict[str, NDArray[Any]]]:
     """The writers' checks: a non-empty cloud and numeric 1-D extra fields."""
-    if not isinstance(cloud, PointCloud):
-        raise InvalidArgumentError(f"`cloud` must be a PointCloud; got {type(cloud).__name__}")
+    check_instance("cloud", cloud, PointCloud)
     if len(cloud) == 0:
         raise InvalidArgumentError("`cloud` must hold at least one point; got an empty cloud")
     extras: dict[str, NDArray[Any]] = {}
