@@ -111,19 +111,13 @@ def _allowed_mismatch(force_n: float) -> float:
 
 @dataclass(frozen=True, kw_only=True)
 class ForceTravel:
-    """The press's force–travel record, from first contact to the commanded force (a robot reads it
-    from forward kinematics and its force sensor, ``docs/robot.md``), ``n >= 3`` samples in time order.
+    """The press's force–travel record from first contact to the commanded force, ``n >= 3``
+    samples in time order (from forward kinematics and a force sensor, ``docs/robot.md``).
 
-    Parameters
-    ----------
-    travel_m : (n,) float, metres
-        Travel along the press since first contact: about 0 at first, never more than
-        :data:`TRAVEL_BACKWARDS_TOLERANCE_M` below the largest before it, within :data:`MAX_TRAVEL_M`.
-    force_n : (n,) float, newtons
-        The normal force on the surface; the last sample positive and more than
-        :data:`MIN_FORCE_RISE_N` above the first.
-
-    Stored as read-only float64 copies; a refusal is an InvalidArgumentError naming the field.
+    ``travel_m`` is the travel along the press since first contact [m]: about 0 at first, never more
+    than :data:`TRAVEL_BACKWARDS_TOLERANCE_M` below its largest before, within :data:`MAX_TRAVEL_M`.
+    ``force_n`` is the normal force on the surface [N], its last sample positive and more than
+    :data:`MIN_FORCE_RISE_N` above the first. Both are stored as read-only float64 copies.
     """
 
     travel_m: NDArray[np.float64]
@@ -185,23 +179,12 @@ class ForceTravel:
 class PressObservation:
     """Everything one press returns (world frame, SI).
 
-    Parameters
-    ----------
-    cloud : PointCloud
-        The cloud seen while pressing, with the robot's stick and hand in it.
-    contact : TactileContact
-        Tip, measured force and tip radius at the commanded force; the force pushes into the surface
-        (negative z) and its size is within ``FORCE_MISMATCH_REL · force_n + FORCE_MISMATCH_ABS_N``
-        of ``force_n``.
-    robot_points : (m, 3) float, metres, or a tuple of such arrays
-        Points whose convex hull covers the stick and hand (at least 4, not coplanar), or one array
-        per part, each hull removed on its own (:attr:`robot_hulls` gives the tuple either way).
-    target_xy : (2,) float, metres
-    force_n : float
-        The commanded target and normal force.
-    force_travel : ForceTravel or None
-        The press's record where the environment provides one; its last force within the same
-        tolerance of ``force_n``.
+    ``cloud`` is seen while pressing, the robot in it; ``contact`` (tip, measured force, tip radius)
+    pushes into the surface (negative z) within ``FORCE_MISMATCH_REL · force_n +
+    FORCE_MISMATCH_ABS_N`` of the commanded ``force_n`` at ``target_xy``, as does the last force of
+    ``force_travel`` (None where the environment has no record). ``robot_points`` ((m, 3), at least
+    4 not coplanar) span the stick and hand, or a tuple holds one such array per part, each hull
+    removed on its own (:attr:`robot_hulls` gives the tuple either way).
     """
 
     cloud: PointCloud

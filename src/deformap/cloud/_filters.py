@@ -57,16 +57,15 @@ def _mean_neighbour_distances(pts: NDArray[np.float64], k: int) -> NDArray[np.fl
 def statistical_outlier_mask(points: Any, k: int, std_ratio: float) -> NDArray[np.bool_]:
     """Mask of the points kept by Open3D's statistical outlier rule.
 
-    Each point's average distance to its ``k`` nearest neighbours (itself included, ``k >= 1``) is
-    kept when strictly below ``m + std_ratio · s`` (``std_ratio > 0``), with ``m`` the mean of the
-    averages and ``s`` their sample standard deviation. As in Open3D's code, so that results agree
-    point for point, a zero average counts in ``m`` but not in ``s`` and is never kept; with every
-    average equal, ``s = 0`` and every point is removed. ``points`` holds at least ``k`` (and 2).
+    A point is kept when its average distance to its ``k`` nearest neighbours (itself included) is
+    strictly below ``m + std_ratio · s``, ``m`` the mean of the averages and ``s`` their sample
+    standard deviation. As in Open3D's code, a zero average counts in ``m`` but not in ``s`` and is
+    never kept, and equal averages (``s = 0``) remove every point.
 
     References
     ----------
-    Open3D, ``PointCloud::RemoveStatisticalOutliers`` (``cpp/open3d/geometry/PointCloud.cpp``);
-    Rusu et al., "Towards 3D point cloud based object maps for household environments", 2008.
+    Open3D, ``PointCloud::RemoveStatisticalOutliers``; Rusu et al., "Towards 3D point cloud based
+    object maps for household environments", 2008.
     """
     k = check_int("k", k, minimum=1)
     ratio = check_finite_scalar("std_ratio", std_ratio)

@@ -16,16 +16,9 @@ __all__ = ["PointCloud"]
 
 @dataclass(frozen=True, eq=False)
 class PointCloud:
-    """Points in metres with optional per-point colours, validated on construction.
-
-    Parameters
-    ----------
-    points : (n, 3) float
-        Positions in metres, in the frame named by ``frame``; NaN and infinite values are refused.
-    colors : (n, 3) float in [0, 1], optional
-        RGB colours; integer input in [0, 255] is scaled to [0, 1].
-    frame : str
-        Name of the coordinate frame (``"world"`` for clouds that leave an ``Environment``).
+    """``points`` (n, 3) in metres in the frame named ``frame`` (``"world"`` for clouds that leave
+    an ``Environment``), with optional RGB ``colors`` (n, 3) in [0, 1] (integers in [0, 255] are
+    scaled); validated on construction, NaN and infinities refused.
 
     The arrays are stored read-only float64; operations return new clouds. An empty cloud is valid.
     """

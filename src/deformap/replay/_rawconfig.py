@@ -27,11 +27,10 @@ class HullPart:
     Parameters
     ----------
     shape : {"box", "cylinder", "cap"}
-        A box of extents ``size_m``; a cylinder along ``z`` of diameter ``size_m[0]`` and length
-        ``size_m[2]``; or the tip's upper half-sphere of radius ``size_m[0] / 2`` (the lower half is
-        in the dent); each centred at ``center_m``.
-    center_m : (3,) float, metres
-    size_m : (3,) float, metres
+        A box of extents ``size_m``, a cylinder along ``z`` (diameter ``size_m[0]``, length
+        ``size_m[2]``) or the tip's upper half-sphere (radius ``size_m[0] / 2``), centred at
+        ``center_m``.
+    center_m, size_m : (3,) float, metres
     """
 
     shape: Literal["box", "cylinder", "cap"] = "box"

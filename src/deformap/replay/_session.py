@@ -152,16 +152,10 @@ def load_session(
 ) -> RecordedSession:
     """Open a recorded session (its folder or ``session.yaml``) and check ``session.yaml``.
 
-    Pokes are read on demand by :meth:`RecordedSession.press_observation`, each refused when its
-    contact point is farther than ``contact_gap_m`` from every surface point.
-
-    Raises
-    ------
-    ConfigError
-        ``session.yaml`` is not valid YAML, has unknown or missing keys, or bad values.
-    FileFormatError
-        The observation or the bag is missing, the bag lacks a topic, or the ground truth is
-        unreadable.
+    Pokes are read on demand (:meth:`RecordedSession.press_observation`), each refused when its
+    contact point lies farther than ``contact_gap_m`` from every surface point. A ``session.yaml``
+    that is no valid YAML or has unknown, missing or bad keys is a ConfigError; a missing
+    observation or bag, a missing topic or an unreadable ground truth a FileFormatError.
     """
     p = check_path("path", path)
     gap = check_positive("contact_gap_m", contact_gap_m)

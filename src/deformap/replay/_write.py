@@ -95,24 +95,12 @@ def write_session(folder: str | Path, *, workspace: Workspace, observation: Poin
                   format: str = "folder", cloud_format: str = "pcd") -> Path:
     """Write a session that :func:`load_session` reads back exactly; returns its ``session.yaml``.
 
-    Parameters
-    ----------
-    folder : str or Path
-        A new or empty folder.
-    observation : PointCloud
-        The initial observation, world frame, metres.
-    presses : sequence of PressObservation
-        In order; points and force–travel records are written as float64 and read back bit for bit,
-        colours exactly in NPZ and to 8 bits a channel in PCD, PLY and bags. A press with one hull
-        per part is written with its parts' common hull (with a warning).
-    tip_radius_m : float, optional
-        Defaults to the presses' (which must agree).
-    source : dict, optional
-        Provenance copied into ``session.yaml`` (plain YAML data).
-    format : {"folder", "mcap", "sqlite3"}
-        Cloud files of ``cloud_format`` (binary, float64), or a ROS 2 bag in ``bag/``.
-
-    ``session.yaml`` is written last, with ``n_pokes`` and the ``sha256`` manifest of every file.
+    ``folder`` is new or empty. The ``observation`` and the ``presses`` (world frame, in order) are
+    written as float64 and read back bit for bit, colours exactly in NPZ and to 8 bits a channel in
+    PCD, PLY and bags; a press with one hull per part keeps its parts' common hull (with a warning).
+    ``tip_radius_m`` defaults to the presses' (which must agree); ``source`` is plain provenance data.
+    ``format`` ``"folder"`` writes cloud files of ``cloud_format``, ``"mcap"`` or ``"sqlite3"`` a ROS 2
+    bag in ``bag/``. ``session.yaml`` comes last, with ``n_pokes`` and every file's ``sha256``.
     """
     out, presses, tip = _check_inputs(folder, workspace, observation, presses, tip_radius_m,
                                       format, cloud_format, ground_truth)  # fmt: skip

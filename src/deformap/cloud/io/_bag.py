@@ -40,17 +40,8 @@ TF_STATIC_TOPIC = "/tf_static"
 
 @dataclass(frozen=True, kw_only=True)
 class StampedCloud:
-    """One PointCloud2 message read from a bag.
-
-    Parameters
-    ----------
-    stamp_ns, log_time_ns : int
-        The header's time and the bag's recording time, nanoseconds.
-    cloud : PointCloud
-        Metres, in frame ``"world"`` when a transform was applied, else in the header's frame.
-    n_dropped : int
-        Points dropped for a NaN or infinite coordinate (holes of an organised cloud).
-    """
+    """One PointCloud2 message read from a bag: header and log times [ns], the cloud (metres, in
+    ``"world"`` when transformed, else in the header's frame), and the NaN points dropped."""
 
     stamp_ns: int
     log_time_ns: int
@@ -60,16 +51,8 @@ class StampedCloud:
 
 @dataclass(frozen=True, kw_only=True)
 class WrenchSeries:
-    """A ``geometry_msgs/msg/WrenchStamped`` topic as arrays.
-
-    Parameters
-    ----------
-    stamp_ns : (n,) int64
-        Header times, nanoseconds.
-    force_n, torque_nm : (n, 3) float
-        Forces [N] and torques [N·m] in the sensor frame ``frame_id``, which all messages share.
-    frame_id : str
-    """
+    """A WrenchStamped topic: ``stamp_ns`` (n,) header times, ``force_n`` and ``torque_nm`` (n, 3)
+    in the sensor frame ``frame_id`` all its messages share."""
 
     stamp_ns: NDArray[np.int64]
     force_n: NDArray[np.float64]

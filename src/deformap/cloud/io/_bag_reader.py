@@ -79,18 +79,9 @@ def _zstd_errors() -> tuple[type[BaseException], ...]:
 
 @dataclass(frozen=True)
 class RawBagMessage:
-    """One message of a bag, not yet deserialised.
-
-    Attributes
-    ----------
-    topic : str
-    log_time_ns : int
-        When the bag recorded it, nanoseconds.
-    data : bytes or memoryview
-        The CDR bytes; a view may be valid only until the next message is read.
-    number : int
-        Its place among its topic's messages, from 1 (as errors name it).
-    """
+    """One message of a bag, not yet deserialised: its ``topic``, when the bag logged it
+    [ns], its CDR ``data`` (a view valid only until the next message is read) and its ``number``
+    among its topic's messages, from 1."""
 
     topic: str
     log_time_ns: int

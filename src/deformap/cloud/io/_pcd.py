@@ -147,24 +147,13 @@ def _pcd_colors(path: Path, pc_data: NDArray[Any], meta: Any, body: bytes
 
 def read_pcd(path: str | Path, *, units: str = "m", drop_nan: bool = False
              ) -> tuple[PointCloud, dict[str, NDArray[Any]]]:  # fmt: skip
-    """Read a PCD file (ascii, binary or binary_compressed).
+    """Read a PCD file (ascii, binary or binary_compressed): the cloud, and the other per-point
+    fields as extras in the file's dtype (COUNT > 1 as pypcd4's ``name__0000``, ...).
 
-    Parameters
-    ----------
-    path : str or Path
-    units : {"m", "mm"}
-        Units of the coordinates; a cloud read as metres that looks like millimetres is refused
-        (``MM_EXTENT_THRESHOLD``).
-    drop_nan : bool
-        Drop points with a NaN or infinite coordinate (logged) instead of refusing the file.
-
-    Returns
-    -------
-    cloud : PointCloud
-        ``x, y, z`` in metres; colours from a packed ``rgb`` or ``rgba`` field or from ``r``,
-        ``g``, ``b`` (NaN or out-of-range colours are refused, naming the field).
-    extras : dict of str to (n,) array
-        Every other per-point field in the file's dtype (COUNT > 1 as pypcd4's ``name__0000``...).
+    ``units`` are the coordinates' (``"m"`` or ``"mm"``; metres that look like millimetres are
+    refused, ``MM_EXTENT_THRESHOLD``); ``drop_nan`` drops (and logs) points with a NaN or infinite
+    coordinate instead of refusing the file. Colours come from a packed ``rgb`` or ``rgba`` field or
+    from ``r``, ``g``, ``b``; a NaN or out-of-range colour is refused, naming the field.
     """
     from pypcd4 import PointCloud as PcdCloud
     from pypcd4.pypcd4 import MetaData

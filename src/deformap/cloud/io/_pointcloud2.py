@@ -220,17 +220,11 @@ def pointcloud2_colors(msg: Any, *, where: str = "PointCloud2", table: Any = Non
                        valid: Any = None) -> NDArray[np.float64] | None:  # fmt: skip
     """``(height·width, 3)`` float64 colours in [0, 1] of a PointCloud2, or None without any.
 
-    Read from ``rgb`` as a FLOAT32 or UINT32 whose bits are ``0x00RRGGBB`` (realsense, Azure Kinect,
-    PCL's ``PointXYZRGB``), ``rgba`` ``0xAARRGGBB`` (alpha ignored), or separate ``r``, ``g``, ``b``
-    (UINT8 in [0, 255] or FLOAT32 in [0, 1]); a packed word is read for its bits. ``table`` is
-    ``pointcloud2_structured(msg)`` when the caller has it. Only the ``valid`` points' colours
-    (default all) are checked; the others' rows are NaN.
-
-    Raises
-    ------
-    FileFormatError
-        Naming ``where`` and the field: another type or count, only some of ``r``, ``g``, ``b``, or
-        a NaN or out-of-range colour on a valid point.
+    Read from ``rgb`` (FLOAT32 or UINT32 ``0x00RRGGBB``, read for its bits: realsense, Azure Kinect,
+    PCL), ``rgba`` (``0xAARRGGBB``, alpha ignored) or ``r``, ``g``, ``b`` (UINT8 in [0, 255] or
+    FLOAT32 in [0, 1]). ``table`` is ``pointcloud2_structured(msg)`` when the caller has it; only
+    the ``valid`` points' colours (default all) are checked, the others' rows are NaN. Another field
+    type or count, only some of ``r``, ``g``, ``b``, or a bad colour is a FileFormatError.
     """
     table = pointcloud2_structured(msg) if table is None else table
     names = table.dtype.names or ()
