@@ -110,8 +110,7 @@ def read_npz(path: str | Path, *, units: str = "m", drop_nan: bool = False,
              max_bytes: int = MAX_NPZ_BYTES) -> tuple[PointCloud, dict[str, NDArray[Any]]]:
     """Read an NPZ archive of ``points`` (n, 3) and optional ``colors`` (n, 3; integers in
     [0, 255] or floats in [0, 1]), as :func:`read_pcd` reads a PCD file; the extras are the other
-    1-D arrays of the cloud's length. Object arrays are refused (no pickle).
-    """
+    1-D arrays of the cloud's length. Object arrays are refused (no pickle)."""
     scale = check_units(units)
     p = readable_path(path)
     arrays = load_npz_arrays(p, "the NPZ archive", max_bytes=max_bytes)

@@ -117,8 +117,7 @@ def pointcloud2_structured(msg: Any) -> NDArray[Any]:
 def pointcloud2_to_array(msg: Any, *, with_count: bool = False) -> Any:
     """``(n, 3)`` float64 x, y, z (FLOAT32 or FLOAT64 at any offsets, either byte order) in the
     message's units and frame, and with ``with_count`` the number of points dropped for a NaN or
-    infinite coordinate (the holes of an organised cloud; refused when ``is_dense``).
-    """
+    infinite coordinate (the holes of an organised cloud; refused when ``is_dense``)."""
     xyz = xyz_with_holes(msg, pointcloud2_structured(msg))
     finite = np.isfinite(xyz).all(axis=1)
     dropped = int(xyz.shape[0] - np.count_nonzero(finite))
