@@ -18,12 +18,7 @@ from typing import Any, Protocol, runtime_checkable
 import numpy as np
 from numpy.typing import NDArray
 
-from deformap._validation import (
-    check_array,
-    check_points,
-    check_positive,
-    check_vector,
-)
+from deformap._validation import check_array, check_points, check_positive, check_vector
 from deformap.cloud import PointCloud, hull_parts
 from deformap.errors import InvalidArgumentError
 from deformap.mechanics import TactileContact

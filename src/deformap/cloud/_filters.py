@@ -134,9 +134,8 @@ def hull_parts(hull_points: Any) -> tuple[Any, ...] | None:
     return None
 
 
-def points_in_hull(
-    points: Any, hull_points: Any, *, tolerance_m: float = HULL_TOLERANCE_M
-) -> NDArray[np.bool_]:
+def points_in_hull(points: Any, hull_points: Any, *, tolerance_m: float = HULL_TOLERANCE_M
+                   ) -> NDArray[np.bool_]:  # fmt: skip
     """Mask of the points inside (or on) the convex hull of ``hull_points`` ((m, 3) metres, at
     least 4 points not on one plane), or of any hull of a tuple or list of such arrays (one per robot
     part); a point at most ``tolerance_m`` outside every facet plane counts as inside."""

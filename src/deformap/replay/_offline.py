@@ -19,13 +19,7 @@ from deformap._validation import check_instance, check_points, check_positive, c
 from deformap.cloud import PointCloud
 from deformap.environment import PressObservation, TactileContact, Workspace
 from deformap.errors import DeformapError
-from deformap.explore import (
-    ExplorationConfig,
-    ExplorationResult,
-    Mapper,
-    MappingRun,
-    PokeResult,
-)
+from deformap.explore import ExplorationConfig, ExplorationResult, Mapper, MappingRun, PokeResult
 from deformap.replay._session import DEFAULT_CONTACT_GAP_M, RecordedSession, check_contact_gap
 
 __all__ = ["ReplayResult", "estimate_poke", "map_session", "tip_sphere_points"]

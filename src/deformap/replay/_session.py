@@ -147,9 +147,8 @@ def _session_file(path: Path) -> Path:
     raise FileFormatError(f"{path}: no such session folder or file")
 
 
-def load_session(
-    path: str | Path, *, contact_gap_m: float = DEFAULT_CONTACT_GAP_M
-) -> RecordedSession:
+def load_session(path: str | Path, *, contact_gap_m: float = DEFAULT_CONTACT_GAP_M
+                 ) -> RecordedSession:  # fmt: skip
     """Open a recorded session (its folder or ``session.yaml``) and check ``session.yaml``.
 
     Pokes are read on demand (:meth:`RecordedSession.press_observation`), each refused when its

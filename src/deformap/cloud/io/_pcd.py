@@ -220,9 +220,8 @@ def write_pcd(path: str | Path, cloud: PointCloud, *, encoding: str = "binary",
     pc.save(Path(path), encoding=Encoding(encoding))
 
 
-def _check_cloud_and_extras(
-    cloud: Any, extra_fields: dict[str, Any] | None
-) -> tuple[PointCloud, dict[str, NDArray[Any]]]:
+def _check_cloud_and_extras(cloud: Any, extra_fields: dict[str, Any] | None
+                            ) -> tuple[PointCloud, dict[str, NDArray[Any]]]:  # fmt: skip
     """The writers' checks: a non-empty cloud and numeric 1-D extra fields."""
     check_instance("cloud", cloud, PointCloud)
     if len(cloud) == 0:

@@ -213,9 +213,8 @@ def _fill_ascii(path: Path, table: NDArray[np.float64], dtype: np.dtype[Any]) ->
     return out
 
 
-def read_ply(
-    path: str | Path, *, units: str = "m", drop_nan: bool = False
-) -> tuple[PointCloud, dict[str, NDArray[Any]]]:
+def read_ply(path: str | Path, *, units: str = "m", drop_nan: bool = False
+             ) -> tuple[PointCloud, dict[str, NDArray[Any]]]:  # fmt: skip
     """Read the vertices of a PLY file (ascii or binary, either byte order), as :func:`read_pcd`
     reads a PCD file: colours from ``red``, ``green``, ``blue`` (all three or none), the other vertex
     properties as extras in native byte order."""
