@@ -24,7 +24,8 @@ from deformap.cloud._pointcloud import PointCloud
 from deformap.errors import DeformapError, FileFormatError, InvalidArgumentError
 
 __all__ = ["MM_EXTENT_THRESHOLD", "UNITS", "check_body_size", "check_colors", "check_units",
-           "finish_cloud", "parse_errors", "path_kind", "readable_path"]
+           "finish_cloud", "pack_rgb", "parse_errors", "path_kind", "readable_path",
+           "unpack_rgb"]
 
 logger = logging.getLogger(__name__)
 
@@ -48,6 +49,17 @@ _PARSE_ERRORS: tuple[type[BaseException], ...] = (
 # 27/256 per byte, so 16 bytes of real binary data do with probability below 1e-15.
 _TEXT_BYTES = frozenset(b"0123456789+-.eEnaifNAIF \t\r\n")
 _TEXT_MIN_BYTES = 16
+
+
+def pack_rgb(colors: NDArray[np.float64]) -> NDArray[Any]:
+    """``0x00RRGGBB`` words of (n, 3) colours in [0, 1], 8 bits a channel."""
+    rgb = np.round(colors * 255).astype(np.uint32)
+    return (rgb[:, 0] << 16) | (rgb[:, 1] << 8) | rgb[:, 2]
+
+
+def unpack_rgb(words: NDArray[np.uint32]) -> NDArray[np.uint8]:
+    """(n, 3) uint8 R, G, B of ``0xAARRGGBB`` words (alpha ignored)."""
+    return ((words[:, None] >> np.array([16, 8, 0], dtype=np.uint32)) & 0xFF).astype(np.uint8)
 
 
 def check_units(units: Any) -> float:

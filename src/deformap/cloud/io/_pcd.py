@@ -26,8 +26,10 @@ from deformap.cloud.io._common import (
     check_body_size,
     check_units,
     finish_cloud,
+    pack_rgb,
     parse_errors,
     readable_path,
+    unpack_rgb,
 )
 from deformap.errors import FileFormatError, InvalidArgumentError
 
@@ -99,11 +101,6 @@ def _check_header_against_body(path: Path, meta: Any, body: bytes) -> None:
 _PACKED, _SEPARATE = ("rgb", "rgba"), ("r", "g", "b")  # colour fields, in the order looked for
 
 
-def _unpack(packed: NDArray[np.uint32]) -> NDArray[np.uint8]:
-    """(n, 3) uint8 R, G, B of ``0xAARRGGBB`` words (alpha ignored)."""
-    return ((packed[:, None] >> np.array([16, 8, 0], dtype=np.uint32)) & 0xFF).astype(np.uint8)
-
-
 def _pcd_colors(path: Path, pc_data: NDArray[Any], meta: Any, body: bytes
                 ) -> tuple[NDArray[Any] | None, str, tuple[str, ...]]:  # fmt: skip
     """The file's colours (not yet checked), the name of their field(s) and the fields taken.
@@ -140,9 +137,9 @@ def _pcd_colors(path: Path, pc_data: NDArray[Any], meta: Any, body: bytes
                 raise FileFormatError(
                     f"{path}: colour field {field!r} holds {values.min():.0f} to "
                     f"{values.max():.0f}; a packed word lies in [0, 2^32)")
-            return _unpack(values.astype(np.uint32)), field, (field,)
+            return unpack_rgb(values.astype(np.uint32)), field, (field,)
     word = values.dtype.str[0] + "u4"  # the same bytes as an unsigned word, NaN bits included
-    return _unpack(np.ascontiguousarray(values).view(word).astype(np.uint32)), field, (field,)
+    return unpack_rgb(np.ascontiguousarray(values).view(word).astype(np.uint32)), field, (field,)
 
 
 def read_pcd(path: str | Path, *, units: str = "m", drop_nan: bool = False
@@ -206,8 +203,7 @@ def write_pcd(path: str | Path, cloud: PointCloud, *, encoding: str = "binary",
     columns: list[NDArray[Any]] = [cloud.points[:, i].astype(dtype) for i in range(3)]
     names, types = ["x", "y", "z"], [np.dtype(dtype)] * 3
     if cloud.colors is not None:
-        rgb = np.round(cloud.colors * 255).astype(np.uint32)
-        packed = (rgb[:, 0] << 16) | (rgb[:, 1] << 8) | rgb[:, 2]
+        packed = pack_rgb(cloud.colors)
         # pypcd4 prints floats with "%.10f", which would turn packed-float bits into 0 in ascii.
         columns.append(packed if encoding == "ascii" else packed.view(np.float32))
         names.append("rgb")

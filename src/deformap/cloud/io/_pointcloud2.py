@@ -21,7 +21,7 @@ from numpy.typing import NDArray
 
 from deformap._validation import check_array, check_int, check_points
 from deformap.cloud._pointcloud import PointCloud
-from deformap.cloud.io._common import check_colors, check_units, finish_cloud
+from deformap.cloud.io._common import check_colors, check_units, finish_cloud, pack_rgb, unpack_rgb
 from deformap.cloud.io._ros import typestore
 from deformap.errors import FileFormatError, InvalidArgumentError
 
@@ -181,8 +181,7 @@ def array_to_pointcloud2(points: Any, *, colors: Any = None, frame_id: str = "wo
     for i, a in enumerate("xyz"):
         table[a] = pts[:, i]
     if colors is not None:
-        rgb = np.round(cols * 255).astype(np.uint32)
-        table["rgb"] = (rgb[:, 0] << 16) | (rgb[:, 1] << 8) | rgb[:, 2]
+        table["rgb"] = pack_rgb(cols)
     header = types["std_msgs/msg/Header"](
         stamp=types["builtin_interfaces/msg/Time"](sec=stamp // 10**9, nanosec=stamp % 10**9),
         frame_id=frame_id)
@@ -200,9 +199,7 @@ def _packed_colors(where: str, table: NDArray[Any], field: str) -> NDArray[np.ui
             f"(packed 0x00RRGGBB); got {column.dtype.itemsize}-byte {column.dtype.kind!r} values, "
             f"count {1 if column.ndim == 1 else column.shape[1]}")
     # the word's bits in the message's byte order; as a float they may be NaN (an alpha byte)
-    word = np.ascontiguousarray(column).view(column.dtype.str[0] + "u4").astype(np.uint32)
-    shifts = np.array([16, 8, 0], dtype=np.uint32)
-    return ((word[:, None] >> shifts) & 0xFF).astype(np.uint8)
+    return unpack_rgb(np.ascontiguousarray(column).view(column.dtype.str[0] + "u4").astype(np.uint32))
 
 
 def _separate_colors(where: str, table: NDArray[Any], present: list[str]) -> NDArray[Any]:
