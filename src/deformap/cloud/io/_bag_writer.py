@@ -120,17 +120,11 @@ def write_bag(path: str | Path, *, storage: str = "mcap",
               wrenches: dict[str, WrenchSeries] | None = None,
               static_transforms: Sequence[tuple[str, str, Any]] = (),
               cloud_dtype: str = "float32") -> None:
-    """Write clouds, wrenches and static transforms to a new ROS 2 bag folder (version 9).
-
-    Parameters
-    ----------
-    storage : {"mcap", "sqlite3"}
-    clouds : dict of topic to sequence of (stamp_ns, PointCloud), optional
-        Written as PointCloud2 with ``header.frame_id = cloud.frame``, coordinates as ``cloud_dtype``.
-    wrenches : dict of topic to WrenchSeries, optional
-    static_transforms : sequence of (parent, child, (4, 4) child2parent)
-        Written as one ``TFMessage`` on ``/tf_static`` at time 0.
-    """
+    """Write to a new ROS 2 bag folder (version 9, ``storage`` "mcap" or "sqlite3"): ``clouds``
+    (topic → (stamp_ns, PointCloud) pairs) as PointCloud2 in ``cloud.frame`` with coordinates as
+    ``cloud_dtype``, ``wrenches`` (topic → WrenchSeries) as WrenchStamped, and
+    ``static_transforms`` ((parent, child, 4×4 child2parent) triples) as one ``/tf_static``
+    TFMessage at time 0."""
     store = typestore()
     with bag_writer(path, storage) as writer:
         if static_transforms:
