@@ -1,10 +1,8 @@
 """Frozen settings dataclasses to and from plain dicts and YAML, strictly.
 
-Every component has one frozen, keyword-only dataclass of settings. This module turns any tree of
-them into plain data (for ``config.yaml`` next to each result) and back. Reading back refuses
-unknown keys itself and leaves every value to the dataclasses' own check
-(:func:`deformap._validation.check_settings`, the one rule set for Python and YAML alike); either
-refusal is a :class:`~deformap.errors.ConfigError` that names the field by its dotted path
+Reading back refuses unknown keys and leaves every value to the dataclasses' own check
+(:func:`~deformap._validation.check_settings`, one rule set for Python and YAML); either refusal
+is a :class:`~deformap.errors.ConfigError` naming the field's dotted path
 (``exploration.threshold``).
 """
 
@@ -27,8 +25,7 @@ import yaml
 from deformap._validation import SettingError, setting_metadata
 from deformap.errors import ConfigError, DeformapError
 
-#: Largest YAML file read (config, scenario, session): a session lists its pokes and files, never
-#: their data, so even thousands of pokes stay far below this.
+#: Largest YAML file read (config, scenario, session; a session lists files, not their data).
 MAX_YAML_BYTES = 16 * 2**20
 
 __all__ = ["config_from_dict", "config_to_dict", "described_yaml", "dump_yaml", "load_yaml",
@@ -53,8 +50,8 @@ def config_to_dict(obj: Any) -> Any:
 
 
 def _shape(value: Any, hint: Any, where: str) -> Any:
-    """Give plain data the shape ``hint`` asks for: a mapping becomes the nested settings dataclass,
-    a list a tuple. Nothing is judged here: the dataclass's own :func:`check_settings` does that."""
+    """Give plain data the shape ``hint`` asks for (mappings into nested settings dataclasses,
+    lists into tuples); the dataclass judges it."""
     origin = get_origin(hint)
     if origin in (typing.Union, types.UnionType):
         options = [a for a in get_args(hint) if a is not type(None)]
@@ -75,15 +72,9 @@ def _shape(value: Any, hint: Any, where: str) -> Any:
 def config_from_dict(cls: type[T], data: Any, *, where: str = "config") -> T:
     """Build the settings dataclass ``cls`` from plain data; missing keys keep their defaults.
 
-    The data is only shaped (mappings into nested dataclasses, lists into tuples) and handed to
-    the constructor, whose ``__post_init__`` checks every field (:func:`check_settings`): a value
-    is refused or accepted exactly as it would be from Python.
-
-    Raises
-    ------
-    ConfigError
-        On an unknown key, or a value the dataclass refuses; the message names the field's dotted
-        path (``config.exploration.touch.model``).
+    The data is only shaped and handed to the constructor, so a value is refused or accepted exactly
+    as from Python. An unknown key or a refused value is a ConfigError naming its dotted path
+    (``config.exploration.touch.model``).
     """
     if data is None:
         data = {}
@@ -96,8 +87,7 @@ def config_from_dict(cls: type[T], data: Any, *, where: str = "config") -> T:
     unknown = sorted(set(data) - set(fields))
     if unknown:
         raise ConfigError(
-            f"`{where}` has unknown key(s) {unknown}; known keys are {sorted(fields)}"
-        )
+            f"`{where}` has unknown key(s) {unknown}; known keys are {sorted(fields)}")
     hints = typing.get_type_hints(cls)
     kwargs = {name: _shape(value, hints[name], f"{where}.{name}") for name, value in data.items()}
     try:
@@ -111,8 +101,7 @@ def config_from_dict(cls: type[T], data: Any, *, where: str = "config") -> T:
 
 
 class _UniqueKeyLoader(yaml.SafeLoader):
-    """PyYAML's safe loader, refusing a mapping that repeats a key (PyYAML keeps the last one
-    silently: a session or config edited by hand would lose the first)."""
+    """PyYAML's safe loader, refusing a mapping that repeats a key (PyYAML keeps the last)."""
 
     def construct_mapping(self, node: yaml.MappingNode, deep: bool = False) -> dict[Any, Any]:
         seen: set[Any] = set()
@@ -132,11 +121,11 @@ class _UniqueKeyLoader(yaml.SafeLoader):
 
 def load_yaml(path: str | Path, *, what: str = "config file",
               unreadable: type[DeformapError] = ConfigError) -> Any:
-    """Read a YAML file safely (no arbitrary objects); errors name the file.
+    """Read a YAML file safely (plain data only); errors name the file.
 
     A file that cannot be read raises ``unreadable`` (``cannot read {what}``); bytes that are not
-    UTF-8 text, or text PyYAML cannot take (a syntax error, nesting too deep, an impossible date
-    such as 2020-02-30 from its timestamp constructor), raise :class:`ConfigError`.
+    UTF-8, or text PyYAML refuses (a syntax error, nesting too deep, an impossible date), raise
+    :class:`ConfigError`.
     """
     p = Path(path)
     try:
@@ -183,8 +172,8 @@ _ROLE = re.compile(r":[a-z]+:`~?([^`]+)`")  # :mod:`deformap.world` -> deformap.
 
 
 def _parameters_section(cls: type) -> dict[str, tuple[str, str]]:
-    """``name -> (type text, first sentence)`` from the numpydoc "Parameters" section of
-    ``cls``'s docstring; a line ``a, b : float`` documents both names."""
+    """``name -> (type text, first sentence)`` of the numpydoc "Parameters" section of ``cls``;
+    ``a, b : float`` documents both names."""
     lines = inspect.cleandoc(cls.__doc__ or "").splitlines()
     try:
         start = next(i for i in range(len(lines) - 1)
@@ -225,8 +214,7 @@ def _unit(name: str, kind: str) -> str | None:
 
 
 def _range(bounds: dict[str, Any]) -> str | None:
-    """The bounds of :func:`~deformap._validation.setting` as one interval, the tighter bound of
-    each side kept (``gt=0, ge=0.001`` is ``>= 0.001``)."""
+    """The :func:`~deformap._validation.setting` bounds as one interval, the tighter of each side."""
     low = max(((bounds[k], k == "gt") for k in ("gt", "ge") if k in bounds), default=None)
     high = min(((bounds[k], k == "le") for k in ("lt", "le") if k in bounds), default=None)
     if low is not None and high is not None:
@@ -258,14 +246,12 @@ def _facts(name: str, hint: Any, kind: str, bounds: dict[str, Any]) -> list[str]
 
 
 def setting_docs(cls: type, prefix: str = "") -> list[tuple[str, str | None, list[str]]]:
-    """Every setting of the settings dataclass ``cls``, nested ones included, in definition order:
-    ``(dotted name, one-line description or None, facts)``.
+    """``(dotted name, description or None, facts)`` of every setting of ``cls``, nested ones
+    included, in definition order.
 
-    The description is the field's ``setting(doc=...)``, else the first sentence of its entry in
-    the class docstring's "Parameters" section, else (for a nested settings dataclass) the first
-    line of that class's docstring. The facts are its unit (from the name's suffix, or the unit
-    word that ends its numpydoc type), its bounds as an interval, its ``Literal`` choices, and
-    whether it may be ``None``.
+    The description is the field's ``setting(doc=...)``, else the first sentence of its "Parameters"
+    entry, else (nested settings) its class docstring's first line. The facts are its unit (from the
+    name's suffix or its numpydoc type), bounds, ``Literal`` choices and whether it may be ``None``.
     """
     params = _parameters_section(cls)
     hints = typing.get_type_hints(cls)
@@ -286,11 +272,8 @@ def setting_docs(cls: type, prefix: str = "") -> list[tuple[str, str | None, lis
 
 
 def described_yaml(config: Any, *, width: int = 99) -> str:
-    """``config`` (a settings dataclass) as YAML with, above each setting, a comment: its
-    description, then its unit, range and choices (:func:`setting_docs`).
-
-    The comments are YAML comments, so the text loads back as :func:`dump_yaml`'s does.
-    """
+    """``config`` as YAML with a comment above each setting (:func:`setting_docs`); it loads
+    back as :func:`dump_yaml`'s text does."""
     docs = {name: (doc, facts) for name, doc, facts in setting_docs(type(config))}
     lines = [f"# {type(config).__name__}: every setting, with its description, unit and bounds."]
     _describe(config, "", docs, lines, width)

@@ -1,14 +1,10 @@
 """Writing files so that a kill or a power cut leaves the old file or the new one, never half.
 
-Every durable write of the package (the journal's header and rewrites, the files of a run folder,
-figures, recordings) goes through here: a temporary file beside the destination (same file
-system), fsynced, renamed onto it with :func:`os.replace`, and the folder fsynced so that the rename
-itself is durable.
-
-A destination that exists must be a regular file: renaming onto a FIFO, device or socket would
-replace that node with a plain file, onto a symbolic link would replace the link rather than write
-its target (``/dev/stdout``), and onto a folder fails late. Such a destination, or a path that
-names no file (``""``, ``.``), is refused before anything is written.
+Every durable write (journal header and rewrites, run-folder files, figures, recordings) goes to
+a temporary file beside the destination, fsynced, renamed onto it with :func:`os.replace`, the
+folder fsynced. A destination that exists must be a regular file (renaming onto a FIFO, device,
+socket, link or folder would replace the node, not write it); such a destination, or a path that
+names no file, is refused before anything is written.
 """
 
 from __future__ import annotations
@@ -30,14 +26,8 @@ _KINDS = ((stat.S_ISDIR, "a folder"), (stat.S_ISFIFO, "a FIFO"), (stat.S_ISCHR, 
 
 
 def check_destination(path: str | Path) -> Path:
-    """``path`` as a :class:`~pathlib.Path`, if a file may be written there by renaming onto it.
-
-    Raises
-    ------
-    InvalidArgumentError
-        The path names no file (empty, ``.`` or ``..``), or it exists as something other than a
-        regular file (a folder, FIFO, device, socket or symbolic link).
-    """
+    """``path`` as a :class:`~pathlib.Path` if a file may be written there by renaming onto it;
+    else an InvalidArgumentError (no file name, or an existing non-regular file)."""
     out = Path(path)
     if str(path) == "" or out.name in ("", ".", ".."):
         raise InvalidArgumentError(f"{str(path)!r}: expected the name of a file to write")
@@ -71,12 +61,8 @@ def replace_durably(tmp: Path, path: Path) -> None:
 
 @contextlib.contextmanager
 def atomic_path(path: str | Path) -> Iterator[Path]:
-    """Yield a temporary path beside ``path`` (same suffix) for a writer to create; when the
-    block ends without an error it is fsynced and renamed onto ``path``.
-
-    If the block raises, the temporary file is removed and ``path`` is left as it was. A
-    destination that is no regular file is refused first (:func:`check_destination`).
-    """
+    """Yield a temporary path beside ``path`` (same suffix) for a writer to create; when the block
+    ends without an error it is fsynced and renamed onto ``path``, else removed."""
     out = check_destination(path)
     # a hidden name unique to this write, created by the writer: open() honours the umask, so the
     # file gets the permissions a plain write would (mkstemp's are owner-only)

@@ -1,10 +1,5 @@
-"""Names of a package imported from their modules on first use.
-
-For packages whose modules pull in the simulated world or the whole estimator (slow to import),
-which a command such as ``deformap --help`` never needs: the package lists, per private module,
-the names it exports, and :func:`lazy_exports` gives it the module-level ``__getattr__`` and
-``__dir__`` (PEP 562) that import a module when one of its names is first asked for.
-"""
+"""Names of a package imported from their modules on first use (PEP 562), for packages slow to
+import that a command such as ``deformap --help`` never needs."""
 
 from __future__ import annotations
 

@@ -1,12 +1,10 @@
 """``check_*`` validators used at the public boundary, and the one validator of settings.
 
-The array and scalar validators return a clean value (arrays: float64, C-contiguous, a copy when
-they had to convert) or raise :class:`~deformap.errors.InvalidArgumentError` naming the argument,
-what was expected and what came; internal code calls them once at the entry of a public function.
-
-Every settings dataclass calls :func:`check_settings` first in its ``__post_init__``: each field is
-checked against its annotation and the bounds declared beside it with :func:`setting`, and a bad
-one raises :class:`SettingError` naming it. The YAML loader adds no rule of its own.
+A validator takes the argument's ``name`` as the caller wrote it and the ``value`` that came, and
+returns a clean value (arrays: float64, C-contiguous, a copy when converted) or raises
+:class:`~deformap.errors.InvalidArgumentError` naming the argument, what was expected and what
+came. Every settings dataclass calls :func:`check_settings` first in its ``__post_init__``; the
+YAML loader adds no rule of its own.
 """
 
 from __future__ import annotations
@@ -17,30 +15,21 @@ import sys
 from collections.abc import Sequence
 from dataclasses import Field, field, fields, is_dataclass
 from functools import cache
+from pathlib import Path
 from types import UnionType
-from typing import Any, Literal, Union, get_args, get_origin, get_type_hints
+from typing import Any, Literal, TypeVar, Union, get_args, get_origin, get_type_hints
 
 import numpy as np
 from numpy.typing import NDArray
 
 from deformap.errors import InvalidArgumentError
 
-__all__ = [
-    "SettingError",
-    "check_array",
-    "check_finite_scalar",
-    "check_in_range",
-    "check_int",
-    "check_points",
-    "check_positive",
-    "check_rigid_transform",
-    "check_settings",
-    "check_slope_deg",
-    "check_vector",
-    "describe",
-    "setting",
-    "setting_metadata",
-]
+__all__ = ["SettingError", "check_array", "check_finite_scalar", "check_in_range",
+           "check_instance", "check_int", "check_path", "check_points", "check_positive",
+           "check_rigid_transform", "check_settings", "check_slope_deg", "check_vector",
+           "describe", "setting", "setting_metadata"]
+
+_T = TypeVar("_T")
 
 
 def describe(value: Any) -> str:
@@ -60,32 +49,11 @@ def _shape_text(shape: Sequence[int | None]) -> str:
     return "(" + ", ".join(dims) + ("," if len(dims) == 1 else "") + ")"
 
 
-def check_array(
-    name: str,
-    value: Any,
-    shape: Sequence[int | None],
-    *,
-    what: str = "floats",
-    min_rows: int = 0,
-    finite: bool = True,
-) -> NDArray[np.float64]:
-    """Validate a float array of a given shape; ``None`` in ``shape`` means any size.
-
-    Parameters
-    ----------
-    name : str
-        The argument's name, as the caller wrote it.
-    value : array_like
-        What came.
-    shape : sequence of int or None
-        The expected shape; ``None`` matches any length on that axis.
-    what : str
-        Words for the unit or meaning, used in the message (``"points in metres"``).
-    min_rows : int
-        Smallest accepted length of the first axis.
-    finite : bool
-        Refuse NaN and infinite values.
-    """
+def check_array(name: str, value: Any, shape: Sequence[int | None], *, what: str = "floats",
+                min_rows: int = 0, finite: bool = True) -> NDArray[np.float64]:
+    """Validate a float array of ``shape`` (``None``: any length on that axis) with at least
+    ``min_rows`` rows, NaN and infinities refused when ``finite``; ``what`` names the unit or
+    meaning in the message (``"points in metres"``)."""
     expected = f"a {_shape_text(shape)} array of finite {what}"
     if isinstance(value, (str, bytes)) or value is None:
         raise InvalidArgumentError(f"`{name}` must be {expected}; got {describe(value)}")
@@ -105,15 +73,30 @@ def check_array(
         raise InvalidArgumentError(f"`{name}` must be {expected}; got shape {arr.shape}")
     if arr.ndim and arr.shape[0] < min_rows:
         raise InvalidArgumentError(
-            f"`{name}` must have at least {min_rows} rows; got {arr.shape[0]}"
-        )
+            f"`{name}` must have at least {min_rows} rows; got {arr.shape[0]}")
     arr = np.ascontiguousarray(arr, dtype=np.float64)
     if finite and not np.all(np.isfinite(arr)):
         bad = int(np.count_nonzero(~np.isfinite(arr)))
         raise InvalidArgumentError(
-            f"`{name}` must be {expected}; got {bad} NaN or infinite value(s)"
-        )
+            f"`{name}` must be {expected}; got {bad} NaN or infinite value(s)")
     return arr
+
+
+def check_path(name: str, value: Any) -> Path:
+    """Validate a file-system path given as a ``str`` or :class:`~pathlib.Path`."""
+    if not isinstance(value, (str, Path)):
+        raise InvalidArgumentError(
+            f"`{name}` must be a str or pathlib.Path; got {type(value).__name__}")
+    return Path(value)
+
+
+def check_instance(name: str, value: Any, cls: type[_T]) -> _T:
+    """Validate an instance of ``cls``."""
+    if not isinstance(value, cls):
+        article = "an" if cls.__name__[0] in "AEIOU" else "a"
+        raise InvalidArgumentError(
+            f"`{name}` must be {article} {cls.__name__}; got {type(value).__name__}")
+    return value
 
 
 def check_points(name: str, value: Any, *, min_rows: int = 1) -> NDArray[np.float64]:
@@ -158,14 +141,8 @@ def check_positive(name: str, value: Any, *, allow_zero: bool = False) -> float:
     return out
 
 
-def check_in_range(
-    name: str,
-    value: Any,
-    low: float,
-    high: float,
-    *,
-    closed_high: bool = False,
-) -> float:
+def check_in_range(name: str, value: Any, low: float, high: float, *,
+                   closed_high: bool = False) -> float:
     """Validate ``low <= value < high`` (``<= high`` with ``closed_high``)."""
     out = check_finite_scalar(name, value)
     ok = low <= out <= high if closed_high else low <= out < high
@@ -201,12 +178,9 @@ _BOUND_TEXT = {"gt": ">", "ge": ">=", "lt": "<", "le": "<="}
 
 
 class SettingError(InvalidArgumentError):
-    """A field of a settings dataclass has a bad value.
-
-    ``field`` is the field's name as the dataclass spells it (``"grid_spacing_m"``, or a dotted
-    name such as ``"touch.roi_size_m"`` for a rule over nested settings); ``detail`` says what was
-    expected and what came. The YAML loader prefixes ``field`` with the section's dotted path.
-    """
+    """A field of a settings dataclass has a bad value: ``field`` names it (dotted for a rule over
+    nested settings; the YAML loader prefixes the section's path), ``detail`` says what was expected
+    and what came."""
 
     def __init__(self, field: str, detail: str) -> None:
         super().__init__(f"`{field}` {detail}")
@@ -217,32 +191,15 @@ class SettingError(InvalidArgumentError):
         return (type(self), (self.field, self.detail))
 
 
-def setting(
-    default: Any,
-    *,
-    gt: float | None = None,
-    ge: float | None = None,
-    lt: float | None = None,
-    le: float | None = None,
-    finite: bool = True,
-    doc: str | None = None,
-) -> Any:
-    """A dataclass field whose bounds (and description) are declared beside it.
+def setting(default: Any, *, gt: float | None = None, ge: float | None = None,
+            lt: float | None = None, le: float | None = None, finite: bool = True,
+            doc: str | None = None) -> Any:
+    """A dataclass field whose bounds and description are declared beside it.
 
-    Parameters
-    ----------
-    default : object
-        The field's default (immutable: a number, a string, a tuple, ``None``).
-    gt, ge, lt, le : float, optional
-        Bounds ``value > gt``, ``value >= ge``, ``value < lt``, ``value <= le``; each one given is
-        checked, in that order, and the first one broken is reported. On a tuple they hold for
-        every entry; on an optional field, for a value that is not ``None``.
-    finite : bool
-        Refuse NaN and infinite values of a float field (the default).
-    doc : str, optional
-        One-line description of the setting, shown by ``deformap config dump``
-        (:func:`deformap._config.described_yaml`); without it the class docstring's "Parameters"
-        entry is used.
+    ``default`` is immutable. Each bound given (``value > gt``, ``>= ge``, ``< lt``, ``<= le``) is
+    checked in that order, on every entry of a tuple and on a value that is not ``None``; ``finite``
+    refuses NaN and infinities of a float. ``doc``, one line, is what ``deformap config dump`` shows
+    instead of the class docstring's "Parameters" entry.
     """
     bounds = {key: bound for key, bound in (("gt", gt), ("ge", ge), ("lt", lt), ("le", le))
               if bound is not None}
@@ -253,8 +210,7 @@ def setting(
 
 
 def setting_metadata(f: Field[Any]) -> tuple[dict[str, Any], str | None]:
-    """The bounds (``gt``, ``ge``, ``lt``, ``le``, ``finite``) and description that
-    :func:`setting` declared for the dataclass field ``f`` (no bounds and ``None`` without it)."""
+    """The bounds and description :func:`setting` declared for the field ``f``."""
     return dict(f.metadata.get(_BOUNDS, {"finite": True})), f.metadata.get(_DOC)
 
 
@@ -268,25 +224,12 @@ def _settings_fields(cls: Any) -> tuple[tuple[str, Any, dict[str, Any]], ...]:
 def check_settings(obj: Any) -> None:
     """Check every field of the settings dataclass ``obj`` against its annotation and bounds.
 
-    Every settings dataclass calls this first in its ``__post_init__``; the YAML loader
-    (:func:`deformap._config.config_from_dict`) only shapes plain data and constructs, so the same
-    rules hold from Python and from YAML. By annotation:
-
-    - ``bool``: ``True`` or ``False``; ``int``: an integer, not a bool; ``float``: a real number,
-      finite unless the field's ``setting(finite=False)`` says otherwise; ``str``: a string;
-    - ``Literal[...]``: one of its choices (the ``Literal`` is the one list of choices);
-    - ``tuple[X, Y]`` (fixed length) and ``tuple[X, ...]``: a sequence of such entries;
-    - ``X | None``: ``None`` or an ``X``; a dataclass: an instance of it (which checked itself);
-    - any other annotation (an array): left to the dataclass's own checks.
-
-    Then the bounds declared with :func:`setting`. Accepted values are stored in their canonical
-    type (a numpy or Python int in a float field becomes ``float``, a list or array in a tuple
-    field a ``tuple``), so that equal settings compare and serialise equal.
-
-    Raises
-    ------
-    SettingError
-        Naming the first bad field, what was expected and what came.
+    By annotation: ``bool``, ``int`` (not a bool), ``float`` (finite unless ``setting(finite=False)``),
+    ``str``; ``Literal[...]`` one of its choices; ``tuple[X, Y]`` and ``tuple[X, ...]`` a sequence of
+    such; ``X | None``; a dataclass an instance of it; any other annotation is left to the class's own
+    checks. Then the :func:`setting` bounds. Accepted values are stored in their canonical type (an
+    int in a float field as ``float``, a list in a tuple field as a ``tuple``), so that equal settings
+    compare and serialise equal. The first bad field raises :class:`SettingError`.
     """
     for name, hint, bounds in _settings_fields(obj.__class__):
         value = getattr(obj, name)

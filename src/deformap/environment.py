@@ -1,11 +1,8 @@
 """The ``Environment`` protocol: all the exploration loop needs from a world or a robot.
 
-The simulated world (:mod:`deformap.world`) and a real robot adapter both implement it; the loop in
-:mod:`deformap.explore` never knows which one it drives. :class:`TactileContact` is defined in
-:mod:`deformap.mechanics` and re-exported here.
-
-Everything is SI and in the world frame: the table plane is ``z = 0``, ``z`` up, and clouds leave an
-environment already transformed by the camera's extrinsics (``cam2world``).
+The simulated world (:mod:`deformap.world`) and a robot adapter implement it; the loop never knows
+which one it drives. Everything is SI in the world frame (the table is ``z = 0``, ``z`` up), clouds
+included. :class:`TactileContact` comes from :mod:`deformap.mechanics`.
 
 References
 ----------
@@ -21,45 +18,24 @@ from typing import Any, Protocol, runtime_checkable
 import numpy as np
 from numpy.typing import NDArray
 
-from deformap._validation import (
-    check_array,
-    check_points,
-    check_positive,
-    check_vector,
-)
+from deformap._validation import check_array, check_points, check_positive, check_vector
 from deformap.cloud import PointCloud, hull_parts
 from deformap.errors import InvalidArgumentError
 from deformap.mechanics import TactileContact
 
-__all__ = [
-    "FORCE_MISMATCH_ABS_N",
-    "FORCE_MISMATCH_REL",
-    "MAX_GRID_CELLS",
-    "MAX_TRAVEL_M",
-    "MIN_FORCE_RISE_N",
-    "TRAVEL_BACKWARDS_TOLERANCE_M",
-    "Environment",
-    "ForceTravel",
-    "PressObservation",
-    "TactileContact",
-    "Workspace",
-]
+__all__ = ["FORCE_MISMATCH_ABS_N", "FORCE_MISMATCH_REL", "MAX_GRID_CELLS", "MAX_TRAVEL_M",
+           "MIN_FORCE_RISE_N", "TRAVEL_BACKWARDS_TOLERANCE_M", "Environment", "ForceTravel",
+           "PressObservation", "TactileContact", "Workspace"]
 
 
-#: Most cells of a :meth:`Workspace.grid` (200 MB per float map layer), refused before any array
-#: exists; the exploration's own budget is smaller.
+#: Most cells of a :meth:`Workspace.grid` (200 MB per float map layer).
 MAX_GRID_CELLS = 25_000_000
 
 
 @dataclass(frozen=True, kw_only=True)
 class Workspace:
-    """The axis-aligned rectangle ``[lower, upper]`` of the table to map, in metres.
-
-    Parameters
-    ----------
-    lower, upper : (2,) float
-        Corners ``(x_min, y_min)`` and ``(x_max, y_max)``; ``upper`` must exceed ``lower``.
-    """
+    """The axis-aligned rectangle ``[lower, upper]`` of the table to map: corners ``(x_min, y_min)``
+    and ``(x_max, y_max)`` in metres, ``upper`` above ``lower`` on both axes."""
 
     lower: tuple[float, float] = (0.0, 0.0)
     upper: tuple[float, float] = (0.60, 0.40)
@@ -91,12 +67,8 @@ class Workspace:
         return np.all((pts >= lo) & (pts <= hi), axis=1)
 
     def grid(self, spacing_m: float = 0.005) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """Cell-centre coordinates ``(xs, ys)`` of a regular grid covering the rectangle.
-
-        The grid has ``round(width / spacing)`` columns and ``round(depth / spacing)`` rows, so a
-        60×40 cm workspace at the paper's 0.5 cm gives 120×80 cells; more than
-        :data:`MAX_GRID_CELLS` are refused before anything is allocated.
-        """
+        """Cell centres ``(xs, ys)`` of a grid of ``round(width / spacing)`` × ``round(depth / spacing)``
+        cells over the rectangle; more than :data:`MAX_GRID_CELLS` are refused before any allocation."""
         step = check_positive("spacing_m", spacing_m)
         (x0, y0), (w, d) = self.lower, self.size
         nx, ny = max(1, round(w / step)), max(1, round(d / step))
@@ -112,48 +84,35 @@ class Workspace:
         return {"lower": list(self.lower), "upper": list(self.upper)}
 
 
-#: A travel sample may lie this far below the largest travel before it (encoder noise, not a
-#: retraction): ten standard deviations of arm encoders (about 0.05 mm), so a rigid press's noise
-#: stays inside it over thousands of samples while a half-millimetre slip is refused.
+#: How far [m] travel may fall below its largest value before (encoder noise, not a retraction):
+#: ten standard deviations of arm encoders.
 TRAVEL_BACKWARDS_TOLERANCE_M = 5e-4
 
-#: Largest travel accepted [m]: a 5 cm dent would put a 1 cm tip's stick into the foam, so larger
-#: numbers are millimetres (a record in millimetres of a dent under 0.05 mm reads as rigid).
+#: Largest travel accepted [m]: a 5 cm dent would put a 1 cm tip's stick into the foam.
 MAX_TRAVEL_M = 0.05
 
-#: The force must rise by more than this from the first sample to the last [N]: four times the
-#: 5 mN noise floor of a probe's force sensor, so that a flat noisy record is not a press.
+#: The force must rise by more than this [N] over a record: four times a probe sensor's noise.
 MIN_FORCE_RISE_N = 0.02
 
-#: A record's final force may differ from the commanded force by at most
-#: ``FORCE_MISMATCH_REL · force_n + FORCE_MISMATCH_ABS_N``: far beyond the controller's overshoot
-#: and the sensor's noise, so a record that misses it belongs to another press or is scaled wrong.
+#: A measured force may differ from the commanded by at most ``FORCE_MISMATCH_REL · force_n +
+#: FORCE_MISMATCH_ABS_N``: far beyond a controller's overshoot and a sensor's noise.
 FORCE_MISMATCH_REL = 0.25
 FORCE_MISMATCH_ABS_N = 0.05
 
 
+def _allowed_mismatch(force_n: float) -> float:
+    return FORCE_MISMATCH_REL * force_n + FORCE_MISMATCH_ABS_N
+
+
 @dataclass(frozen=True, kw_only=True)
 class ForceTravel:
-    """The press's force–travel record, from first contact to the commanded force.
+    """The press's force–travel record from first contact to the commanded force, ``n >= 3``
+    samples in time order (from forward kinematics and a force sensor, ``docs/robot.md``).
 
-    Samples, in time order, of the probe's travel along the press direction since first contact and
-    of the normal force on the surface (a robot reads them from forward kinematics and its force
-    sensor, ``docs/robot.md``).
-
-    Parameters
-    ----------
-    travel_m : (n,) float, metres
-        Travel into the surface since first contact, about 0 at the first sample. It may fall back by
-        at most :data:`TRAVEL_BACKWARDS_TOLERANCE_M` below the largest travel before it and never
-        exceeds :data:`MAX_TRAVEL_M` in magnitude.
-    force_n : (n,) float, newtons
-        The normal force on the surface (positive into it); the last sample is positive and exceeds
-        the first by more than :data:`MIN_FORCE_RISE_N`.
-
-    Notes
-    -----
-    ``n >= 3``; the arrays are stored as read-only float64 copies. Every refusal is an
-    :class:`~deformap.errors.InvalidArgumentError` naming the field.
+    ``travel_m`` is the travel along the press since first contact [m]: about 0 at first, never more
+    than :data:`TRAVEL_BACKWARDS_TOLERANCE_M` below its largest before, within :data:`MAX_TRAVEL_M`.
+    ``force_n`` is the normal force on the surface [N], its last sample positive and more than
+    :data:`MIN_FORCE_RISE_N` above the first. Both are stored as read-only float64 copies.
     """
 
     travel_m: NDArray[np.float64]
@@ -167,41 +126,35 @@ class ForceTravel:
         if travel.shape != force.shape:
             raise InvalidArgumentError(
                 f"`force_n` must have one sample per `travel_m` sample ({travel.size}); "
-                f"got {force.size}"
-            )
+                f"got {force.size}")
         largest = float(np.max(np.abs(travel)))
         if largest > MAX_TRAVEL_M:
             raise InvalidArgumentError(
                 f"`travel_m` must be metres, at most {MAX_TRAVEL_M} m in magnitude (a press does "
-                f"not sink the tip that far; millimetres?); got {largest:.4g}"
-            )
+                f"not sink the tip that far; millimetres?); got {largest:.4g}")
         if abs(travel[0]) > TRAVEL_BACKWARDS_TOLERANCE_M:
             raise InvalidArgumentError(
                 f"`travel_m` must be the travel since first contact, its first sample 0 within "
                 f"{TRAVEL_BACKWARDS_TOLERANCE_M} m (encoder noise); got {travel[0]:.4g} m (an "
-                "absolute position?)"
-            )
+                "absolute position?)")
         if float(force.min()) < -MIN_FORCE_RISE_N:
             raise InvalidArgumentError(
                 f"`force_n` must be the force pressing the surface, >= 0 within "
                 f"{MIN_FORCE_RISE_N} N (sensor noise); got {float(force.min()):.4g} N (a sensor "
-                "not zeroed, or its reaction force not negated?)"
-            )
+                "not zeroed, or its reaction force not negated?)")
         behind = np.maximum.accumulate(travel) - travel
         worst = int(np.argmax(behind))
         if behind[worst] > TRAVEL_BACKWARDS_TOLERANCE_M:
             raise InvalidArgumentError(
                 f"`travel_m` must not go backwards by more than {TRAVEL_BACKWARDS_TOLERANCE_M} m "
                 f"(encoder noise); sample {worst} lies {behind[worst]:.4g} m below the largest "
-                "travel before it"
-            )
+                "travel before it")
         rise = float(force[-1] - force[0])
         if force[-1] <= 0.0 or rise <= MIN_FORCE_RISE_N:
             raise InvalidArgumentError(
                 f"`force_n` must rise from contact to the commanded force: the last sample "
                 f"positive and more than {MIN_FORCE_RISE_N} N above the first; got first "
-                f"{force[0]:.4g} N, last {force[-1]:.4g} N"
-            )
+                f"{force[0]:.4g} N, last {force[-1]:.4g} N")
         travel.setflags(write=False)
         force.setflags(write=False)
         object.__setattr__(self, "travel_m", travel)
@@ -219,27 +172,14 @@ class ForceTravel:
 
 @dataclass(frozen=True, kw_only=True)
 class PressObservation:
-    """Everything one press returns.
+    """Everything one press returns (world frame, SI).
 
-    Parameters
-    ----------
-    cloud : PointCloud
-        The cloud seen while pressing, world frame, with the robot's stick and hand in it.
-    contact : TactileContact
-        Tip position, measured force and tip radius at the commanded force; the force pushes into
-        the surface (negative z) and its magnitude lies within
-        ``FORCE_MISMATCH_REL · force_n + FORCE_MISMATCH_ABS_N`` of ``force_n``.
-    robot_points : (m, 3) float, metres, or a tuple of such arrays (one per part)
-        Points whose convex hull covers the stick and hand (at least 4, not coplanar), or one array
-        per part, each hull removed on its own so that a wide hand does not widen the hull down at
-        the surface; :attr:`robot_hulls` gives the tuple either way.
-    target_xy : (2,) float, metres
-        The commanded target.
-    force_n : float
-        The commanded normal force.
-    force_travel : ForceTravel or None
-        The press's force–travel record (None where the environment cannot provide it); its last
-        force lies within the same tolerance of ``force_n``.
+    ``cloud`` is seen while pressing, the robot in it; ``contact`` (tip, measured force, tip radius)
+    pushes into the surface (negative z) within ``FORCE_MISMATCH_REL · force_n +
+    FORCE_MISMATCH_ABS_N`` of the commanded ``force_n`` at ``target_xy``, as does the last force of
+    ``force_travel`` (None where the environment has no record). ``robot_points`` ((m, 3), at least
+    4 not coplanar) span the stick and hand, or a tuple holds one such array per part, each hull
+    removed on its own (:attr:`robot_hulls` gives the tuple either way).
     """
 
     cloud: PointCloud
@@ -254,8 +194,7 @@ class PressObservation:
             raise InvalidArgumentError(f"`cloud` must be a PointCloud; got {type(self.cloud)}")
         if not isinstance(self.contact, TactileContact):
             raise InvalidArgumentError(
-                f"`contact` must be a TactileContact; got {type(self.contact)}"
-            )
+                f"`contact` must be a TactileContact; got {type(self.contact)}")
         parts = hull_parts(self.robot_points)
         hulls = ((check_points("robot_points", self.robot_points, min_rows=4),) if parts is None
                  else tuple(check_points(f"robot_points[{i}]", part, min_rows=4)
@@ -274,15 +213,12 @@ class PressObservation:
             return
         if not isinstance(record, ForceTravel):
             raise InvalidArgumentError(
-                f"`force_travel` must be a ForceTravel or None; got {type(record).__name__}"
-            )
-        final = float(record.force_n[-1])
-        allowed = FORCE_MISMATCH_REL * force_n + FORCE_MISMATCH_ABS_N
+                f"`force_travel` must be a ForceTravel or None; got {type(record).__name__}")
+        final, allowed = float(record.force_n[-1]), _allowed_mismatch(force_n)
         if abs(final - force_n) > allowed:
             raise InvalidArgumentError(
                 f"`force_travel` must end at the commanded force {force_n:.4g} N (within "
-                f"{allowed:.3g} N); its last force is {final:.4g} N"
-            )
+                f"{allowed:.3g} N); its last force is {final:.4g} N")
 
 
     @property
@@ -292,16 +228,13 @@ class PressObservation:
         return robot if isinstance(robot, tuple) else (robot,)
 
     def _check_contact_force(self, force_n: float) -> None:
-        """The measured contact force must be a press (into the surface, world z up) of about the
-        commanded size: a force pointing away from the surface, or far from the commanded one
-        (a sensor in other units, a wrong frame), is no observation of this press."""
+        """The measured force must push into the surface (world z up) at about the commanded size."""
         force = self.contact.force
         if force[2] >= 0.0:
             raise InvalidArgumentError(
                 "`contact.force` must push into the surface (negative z in the world frame, z up); "
                 f"got {tuple(float(f) for f in force)} N")
-        measured = self.contact.force_n
-        allowed = FORCE_MISMATCH_REL * force_n + FORCE_MISMATCH_ABS_N
+        measured, allowed = self.contact.force_n, _allowed_mismatch(force_n)
         if abs(measured - force_n) > allowed:
             raise InvalidArgumentError(
                 f"`contact.force` must be near the commanded force {force_n:.4g} N (within "
@@ -312,8 +245,8 @@ class PressObservation:
 class Environment(Protocol):
     """A surface that can be seen and pressed: a simulated world or a real robot.
 
-    Implementations refuse a target outside ``workspace``, a non-positive force and a second
-    ``press`` before ``release`` with a :class:`~deformap.errors.DeformapError`.
+    A target outside ``workspace``, a non-positive force and a second ``press`` before ``release``
+    are refused with a :class:`~deformap.errors.DeformapError`.
     """
 
     @property

@@ -1,21 +1,13 @@
 """The one family of errors deformap raises at its public boundary.
 
-Every error names the argument (or file, field, topic), what was expected, and what came, so that a
-user can fix the call without reading our source. Each class also derives from the closest builtin
-(``ValueError``, ``RuntimeError``, ...) so that generic handlers keep working.
+Every error names the argument (or file, field, topic), what was expected and what came; each
+class also derives from the closest builtin (``ValueError``, ...) for generic handlers.
 """
 
 from __future__ import annotations
 
-__all__ = [
-    "ConfigError",
-    "DeformapError",
-    "EnvironmentStateError",
-    "FileFormatError",
-    "InvalidArgumentError",
-    "MissingDependencyError",
-    "NotPositiveDefiniteError",
-]
+__all__ = ["ConfigError", "DeformapError", "EnvironmentStateError", "FileFormatError",
+           "InvalidArgumentError", "MissingDependencyError", "NotPositiveDefiniteError"]
 
 
 class DeformapError(Exception):
@@ -47,18 +39,8 @@ class MissingDependencyError(DeformapError, ImportError):
 
 
 def missing_extra(module: str, extra: str, purpose: str) -> MissingDependencyError:
-    """Build the error for an optional dependency that is not installed.
-
-    Parameters
-    ----------
-    module : str
-        The import name that failed (``"rosbags"``).
-    extra : str
-        The deformap extra that provides it (``"ros"``).
-    purpose : str
-        What the user was trying to do (``"reading ROS 2 bags"``).
-    """
+    """The error for the optional ``module`` (``"rosbags"``) of the deformap ``extra``
+    (``"ros"``) missing while ``purpose`` (``"reading ROS 2 bags"``)."""
     return MissingDependencyError(
         f"{purpose} needs the optional package {module!r}, which is not installed; "
-        f"install it with: pip install 'deformap[{extra}]'"
-    )
+        f"install it with: pip install 'deformap[{extra}]'")

@@ -14,12 +14,12 @@ pytest.importorskip("rosbags")
 
 from rosbags.rosbag2 import StoragePlugin, Writer
 
-from deformap.cloud.io import array_to_pointcloud2, pointcloud2_structured
+from deformap.cloud.io import array_to_pointcloud2, pointcloud2_structured, wrench_message
 from deformap.cloud.io._ros import typestore
 from deformap.environment import ForceTravel
 from deformap.errors import ConfigError, FileFormatError
 from deformap.replay import OPTIONAL_TOPICS, TOPICS, load_session
-from deformap.replay._bagform import _point_message, _wrench_message, force_travel_message
+from deformap.replay._bagform import _point_message, force_travel_message
 
 
 def _write_variant(
@@ -70,7 +70,7 @@ def _write_variant(
             cloud = press.cloud.transformed(world2cam, cloud_frame)
             put("cloud", stamp, array_to_pointcloud2(cloud.points, frame_id=cloud_frame,
                                                      stamp_ns=stamp, dtype="float64"))  # fmt: skip
-            wrench = _wrench_message(stamp, press.contact.force)
+            wrench = wrench_message(stamp, "world", press.contact.force, np.zeros(3))
             wrench.header.frame_id = wrench_frame
             put("wrench", stamp, wrench)
             put("tip", stamp, _point_message(stamp, press.contact.tip_center))

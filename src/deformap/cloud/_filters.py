@@ -1,9 +1,8 @@
-"""Point filters: axis-aligned crop, statistical outlier removal, steep-face removal, convex-hull
-membership.
+"""Point filters: axis-aligned crop, statistical outliers, steep faces, convex-hull membership.
 
-Every filter takes ``points : (n, 3) float, metres`` and returns an ``(n,)`` boolean mask of the
-points to keep (or, for :func:`points_in_hull`, of the points inside), so that filters compose with
-``&`` and apply to a :class:`~deformap.cloud.PointCloud` through ``cloud.select(mask)``.
+Each takes ``points : (n, 3) float, metres`` and returns an ``(n,)`` boolean mask of the points to
+keep (for :func:`points_in_hull`, of those inside), so that masks compose with ``&`` and apply
+through ``cloud.select(mask)``.
 """
 
 from __future__ import annotations
@@ -23,47 +22,26 @@ from deformap._validation import (
 )
 from deformap.errors import InvalidArgumentError
 
-__all__ = [
-    "HULL_TOLERANCE_M",
-    "crop_box",
-    "height_field_mask",
-    "hull_parts",
-    "points_in_hull",
-    "statistical_outlier_mask",
-]
+__all__ = ["HULL_TOLERANCE_M", "crop_box", "height_field_mask", "hull_parts", "points_in_hull",
+           "statistical_outlier_mask"]
 
 logger = logging.getLogger(__name__)
 
-#: Slack in metres by which a point may lie outside a hull facet and still count as inside.
-#: Qhull's facet equations carry round-off of order ``1e-15 · extent``; 1 µm is far above that and
-#: far below any depth camera's resolution (millimetres), so points on the hull's surface count as
-#: inside while no real surface point is swallowed by it.
+#: How far [m] a point may lie outside a hull facet and count as inside: far above Qhull's
+#: round-off and far below a depth camera's resolution.
 HULL_TOLERANCE_M = 1e-6
 
 
 def crop_box(points: Any, lower: Any, upper: Any) -> NDArray[np.bool_]:
-    """Mask of the points inside an axis-aligned box (bounds included).
-
-    Parameters
-    ----------
-    points : (n, 3) float, metres
-        The cloud; an empty cloud gives an empty mask.
-    lower, upper : (3,) float, metres
-        Opposite corners of the box, ``lower <= upper`` on every axis.
-
-    Returns
-    -------
-    mask : (n,) bool
-        ``True`` where ``lower <= p <= upper`` holds on all three axes.
-    """
+    """Mask of the points inside the axis-aligned box ``lower <= p <= upper`` ((3,) metres each,
+    ``lower <= upper`` on every axis)."""
     pts = check_points("points", points, min_rows=0)
     lo = check_vector("lower", lower, 3, what="metres")
     hi = check_vector("upper", upper, 3, what="metres")
     if np.any(lo > hi):
         raise InvalidArgumentError(
             f"`lower` must be <= `upper` on every axis; got lower={lo.tolist()}, "
-            f"upper={hi.tolist()}"
-        )
+            f"upper={hi.tolist()}")
     return np.all((pts >= lo) & (pts <= hi), axis=1)
 
 
@@ -79,35 +57,15 @@ def _mean_neighbour_distances(pts: NDArray[np.float64], k: int) -> NDArray[np.fl
 def statistical_outlier_mask(points: Any, k: int, std_ratio: float) -> NDArray[np.bool_]:
     """Mask of the points kept by Open3D's statistical outlier rule.
 
-    For each point, average the distances to its ``k`` nearest neighbours, the point itself included.
-    With ``m`` the mean of those averages and ``s`` their sample standard deviation (ddof = 1), a point
-    is kept when its average is strictly below ``m + std_ratio · s``.
-
-    Parameters
-    ----------
-    points : (n, 3) float, metres
-        The cloud, with at least ``k`` points (and at least 2).
-    k : int
-        Number of neighbours, the point itself included (Open3D's ``nb_neighbors``), ``>= 1``.
-    std_ratio : float
-        Threshold in standard deviations, ``> 0``.
-
-    Returns
-    -------
-    mask : (n,) bool
-        ``True`` for the points to keep.
-
-    Notes
-    -----
-    As in Open3D's code, so that results agree point for point: a point whose average is exactly 0
-    (``k - 1`` exact duplicates, or ``k = 1``) counts in ``m`` but adds nothing to the squared
-    deviations of ``s``, and is never kept; with every average equal and non-zero, ``s = 0`` and every
-    point is removed.
+    A point is kept when its average distance to its ``k`` nearest neighbours (itself included) is
+    strictly below ``m + std_ratio · s``, ``m`` the mean of the averages and ``s`` their sample
+    standard deviation. As in Open3D's code, a zero average counts in ``m`` but not in ``s`` and is
+    never kept, and equal averages (``s = 0``) remove every point.
 
     References
     ----------
-    Open3D, ``PointCloud::RemoveStatisticalOutliers`` (``cpp/open3d/geometry/PointCloud.cpp``);
-    Rusu et al., "Towards 3D point cloud based object maps for household environments", 2008.
+    Open3D, ``PointCloud::RemoveStatisticalOutliers``; Rusu et al., "Towards 3D point cloud based
+    object maps for household environments", 2008.
     """
     k = check_int("k", k, minimum=1)
     ratio = check_finite_scalar("std_ratio", std_ratio)
@@ -118,8 +76,7 @@ def statistical_outlier_mask(points: Any, k: int, std_ratio: float) -> NDArray[n
     if n < max(k, 2):
         raise InvalidArgumentError(
             f"`points` must hold at least k={k} points (and at least 2) for the statistical "
-            f"outlier rule; got {n}"
-        )
+            f"outlier rule; got {n}")
     avg = _mean_neighbour_distances(pts, k)
     positive = avg > 0
     mean = avg.sum() / n
@@ -131,29 +88,12 @@ def statistical_outlier_mask(points: Any, k: int, std_ratio: float) -> NDArray[n
 
 
 def height_field_mask(points: Any, k: int = 20, max_slope_deg: float = 60.0) -> NDArray[np.bool_]:
-    """Mask of the points whose local surface is flat enough to belong to a height field.
+    """Mask of the points whose local surface is flat enough for a height field ``z = f(x, y)``.
 
-    A surface GP models ``z = f(x, y)``; a camera looking from the side also sees what is not a height
-    field (the vertical faces of blocks, flying pixels along the rays behind the robot's stick), which,
-    fitted as heights, make the GP ring across the map. A point is kept when the normal of the plane
-    fitted to its ``k`` nearest neighbours (the point included; PCA) is within ``max_slope_deg`` of
-    the vertical.
-
-    Parameters
-    ----------
-    points : (n, 3) float, metres
-        The cloud in a frame whose ``z`` points up (the world frame); at least ``k`` points.
-    k : int
-        Neighbours of the local plane fit, the point included, ``>= 3``.
-    max_slope_deg : float
-        Steepest surface kept, in degrees from horizontal, in ``(0, 90]`` (90 keeps everything).
-        60° keeps the walls of a probe's dent, with margin for the normals' noise, and removes
-        vertical faces and veils.
-
-    Returns
-    -------
-    mask : (n,) bool
-        ``True`` for the points to keep.
+    A point is kept when the normal of the plane fitted (PCA) to its ``k`` nearest neighbours (itself
+    included, ``k >= 3``) lies within ``max_slope_deg`` (in (0, 90]; 90 keeps all) of ``z``: vertical
+    faces and flying pixels, fitted as heights, would make a surface GP ring. 60° keeps a dent's walls,
+    with margin for the normals' noise, and removes vertical faces and veils.
 
     References
     ----------
@@ -168,8 +108,7 @@ def height_field_mask(points: Any, k: int = 20, max_slope_deg: float = 60.0) -> 
     n = pts.shape[0]
     if n < k:
         raise InvalidArgumentError(
-            f"`points` must hold at least k={k} points for the local plane fits; got {n}"
-        )
+            f"`points` must hold at least k={k} points for the local plane fits; got {n}")
     if slope == 90.0:
         return np.ones(n, dtype=bool)
     _, idx = cKDTree(pts).query(pts, k=k)
@@ -186,11 +125,8 @@ def height_field_mask(points: Any, k: int = 20, max_slope_deg: float = 60.0) -> 
 
 
 def hull_parts(hull_points: Any) -> tuple[Any, ...] | None:
-    """The parts of a robot given one convex hull per part, or None for a single hull.
-
-    A tuple or list whose every entry is two-dimensional (an ``(m_i, 3)`` array or nested list)
-    holds one hull per part; anything else (an ``(m, 3)`` array, a list of points) is one hull.
-    """
+    """The hulls of a tuple or list of 2-D entries (one ``(m_i, 3)`` hull per part), or None
+    for a single hull."""
     if isinstance(hull_points, (tuple, list)) and hull_points and all(
         np.ndim(part) == 2 for part in hull_points
     ):
@@ -198,30 +134,11 @@ def hull_parts(hull_points: Any) -> tuple[Any, ...] | None:
     return None
 
 
-def points_in_hull(
-    points: Any, hull_points: Any, *, tolerance_m: float = HULL_TOLERANCE_M
-) -> NDArray[np.bool_]:
-    """Mask of the points inside the convex hull of ``hull_points`` (surface included), or inside any of
-    the hulls when one hull per part is given.
-
-    Removes the robot from a cloud: ``cloud.select(~points_in_hull(...))``. One hull per part (stick,
-    hand) covers each part without the space between them.
-
-    Parameters
-    ----------
-    points : (n, 3) float, metres
-        The points to test; an empty array gives an empty mask.
-    hull_points : (m, 3) float, metres, or a tuple or list of such arrays (one per part)
-        At least 4 points per hull, not all on one plane.
-    tolerance_m : float
-        A point counts as inside when it lies at most this far outside every facet plane
-        (:data:`HULL_TOLERANCE_M`).
-
-    Returns
-    -------
-    mask : (n,) bool
-        ``True`` for the points inside or on the hull.
-    """
+def points_in_hull(points: Any, hull_points: Any, *, tolerance_m: float = HULL_TOLERANCE_M
+                   ) -> NDArray[np.bool_]:  # fmt: skip
+    """Mask of the points inside (or on) the convex hull of ``hull_points`` ((m, 3) metres, at
+    least 4 points not on one plane), or of any hull of a tuple or list of such arrays (one per robot
+    part); a point at most ``tolerance_m`` outside every facet plane counts as inside."""
     pts = check_points("points", points, min_rows=0)
     tol = check_finite_scalar("tolerance_m", tolerance_m)
     if tol < 0:
@@ -244,8 +161,7 @@ def _in_one_hull(pts: NDArray[np.float64], verts: NDArray[np.float64], tol: floa
     if singular[2] <= 1e-9 * max(singular[0], np.finfo(float).tiny):
         raise InvalidArgumentError(
             "`hull_points` must span a volume (at least 4 points, not all on one plane or line); "
-            f"got {verts.shape[0]} points whose spread is {singular.tolist()} along its axes"
-        )
+            f"got {verts.shape[0]} points whose spread is {singular.tolist()} along its axes")
     from scipy.spatial import ConvexHull, QhullError
 
     try:

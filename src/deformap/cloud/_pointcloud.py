@@ -16,22 +16,11 @@ __all__ = ["PointCloud"]
 
 @dataclass(frozen=True, eq=False)
 class PointCloud:
-    """Points in metres with optional per-point colours, validated on construction.
+    """``points`` (n, 3) in metres in the frame named ``frame`` (``"world"`` for clouds that leave
+    an ``Environment``), with optional RGB ``colors`` (n, 3) in [0, 1] (integers in [0, 255] are
+    scaled); validated on construction, NaN and infinities refused.
 
-    Parameters
-    ----------
-    points : (n, 3) float
-        Positions in metres, in the frame named by ``frame``; stored as float64. NaN and infinite
-        values are refused (the file readers drop them with ``drop_nan=True``).
-    colors : (n, 3) float in [0, 1], optional
-        RGB colours; integer input in [0, 255] is scaled to [0, 1].
-    frame : str
-        Name of the coordinate frame (``"world"`` for clouds that leave an ``Environment``).
-
-    Notes
-    -----
-    The arrays are stored read-only, so a cloud is shared without copies; operations return new
-    clouds. An empty cloud is a valid value; functions that need points refuse it.
+    The arrays are stored read-only float64; operations return new clouds. An empty cloud is valid.
     """
 
     points: NDArray[np.float64]
@@ -48,15 +37,13 @@ class PointCloud:
                 if raw.size and (raw.min() < 0 or raw.max() > 255):
                     raise InvalidArgumentError(
                         "`colors` given as integers must lie in [0, 255]; "
-                        f"got values from {raw.min()} to {raw.max()}"
-                    )
+                        f"got values from {raw.min()} to {raw.max()}")
                 raw = raw / 255.0
             cols = check_array("colors", raw, (pts.shape[0], 3), what="RGB values in [0, 1]")
             if cols.size and (cols.min() < 0.0 or cols.max() > 1.0):
                 raise InvalidArgumentError(
                     "`colors` must lie in [0, 1] (floats) or [0, 255] (integers); "
-                    f"got values from {cols.min():g} to {cols.max():g}"
-                )
+                    f"got values from {cols.min():g} to {cols.max():g}")
             cols.setflags(write=False)
             object.__setattr__(self, "colors", cols)
         if not isinstance(self.frame, str) or not self.frame:
@@ -80,12 +67,10 @@ class PointCloud:
         index = np.asarray(mask)
         if index.dtype == np.bool_ and index.shape != (len(self),):
             raise InvalidArgumentError(
-                f"`mask` must be a ({len(self)},) boolean array; got shape {index.shape}"
-            )
+                f"`mask` must be a ({len(self)},) boolean array; got shape {index.shape}")
         if index.dtype != np.bool_ and not np.issubdtype(index.dtype, np.integer):
             raise InvalidArgumentError(
-                f"`mask` must be booleans or integer indices; got dtype {index.dtype}"
-            )
+                f"`mask` must be booleans or integer indices; got dtype {index.dtype}")
         if index.dtype != np.bool_ and index.size and (
                 index.min() < -len(self) or index.max() >= len(self)):
             raise InvalidArgumentError(
@@ -108,8 +93,7 @@ class PointCloud:
         frames = {c.frame for c in clouds}
         if len(frames) != 1:
             raise InvalidArgumentError(
-                f"`clouds` must share one frame; got frames {sorted(frames)}"
-            )
+                f"`clouds` must share one frame; got frames {sorted(frames)}")
         pts = np.concatenate([c.points for c in clouds])
         have_colors = all(c.colors is not None for c in clouds)
         cols = np.concatenate([c.colors for c in clouds]) if have_colors else None

@@ -1,14 +1,11 @@
 """Tactile points: where the probe's spherical tip touches the surface while it presses.
 
 The paper adds ten points from the touch sensor to the cloud seen while pressing, because the tip
-and stick hide the dent being measured; they are "virtually generated considering the position and
-shape of the spherical surface of the sensor along with the contact force direction". Here they are
-points on the spherical cap of the tip that faces along the contact force.
-
-A sphere of radius ``R`` pressed ``δ`` into an elastic surface touches it within the Hertz contact
-radius ``a = √(R δ)`` (Johnson 1985, §4.2). :func:`contact_cap` gives that cap's half-angle
-``asin(a / R)`` and how many points keep the paper's density on it (ten on a 30° cap): points
-farther up the tip would lie above the real surface and make the dent look shallower.
+and stick hide the dent; they are "virtually generated considering the position and shape of the
+spherical surface of the sensor along with the contact force direction": here, points on the
+tip's cap that faces along the contact force. A sphere of radius ``R`` pressed ``δ`` deep touches
+within the Hertz contact radius ``a = √(R δ)`` (Johnson 1985, §4.2); :func:`contact_cap` gives
+that cap and how many points keep the paper's density on it (ten on a 30° cap).
 
 References
 ----------
@@ -29,10 +26,8 @@ from deformap.errors import InvalidArgumentError
 
 __all__ = ["DEFAULT_CAP_HALF_ANGLE_DEG", "contact_cap", "tactile_points"]
 
-#: Half-angle of the touching cap, measured at the tip's centre from the force direction.
-#: A 30° cap reaches ``r (1 - cos 30°) ≈ 0.13 r`` up from the pole: for a 1 cm tip that is 1.3 mm,
-#: the order of depth over which a soft surface wraps a pressing sphere beyond first contact. Points
-#: farther up the tip's side would claim contact where the surface has usually come away from it.
+#: Half-angle of the touching cap from the force direction: 30° reaches 0.13 r up from the pole,
+#: the depth over which a soft surface wraps a pressing sphere beyond first contact.
 DEFAULT_CAP_HALF_ANGLE_DEG = 30.0
 
 _GOLDEN_ANGLE = np.pi * (3.0 - np.sqrt(5.0))
@@ -49,27 +44,12 @@ def _orthonormal_frame(axis: NDArray[np.float64]) -> tuple[NDArray[np.float64], 
     return e1, e2
 
 
-def contact_cap(tip_radius_m: float, indentation_m: float,
-                n: int = 10) -> tuple[float, int]:
-    """The cap of the tip in contact at an indentation, and the points that sample it.
+def contact_cap(tip_radius_m: float, indentation_m: float, n: int = 10) -> tuple[float, int]:
+    """The cap of the tip (radius ``R > 0``) touching at an indentation ``δ >= 0``.
 
-    Parameters
-    ----------
-    tip_radius_m : float
-        Radius ``R`` of the tip, > 0.
-    indentation_m : float
-        How deep ``δ`` the tip sinks into the surface, >= 0.
-    n : int
-        Points on a cap of :data:`DEFAULT_CAP_HALF_ANGLE_DEG` (the paper's ten), >= 1.
-
-    Returns
-    -------
-    half_angle_deg : float
-        ``asin(min(a / R, 1))`` with the contact radius ``a = √(R δ)`` (module docstring); a
-        small positive angle when ``δ = 0`` (the pole alone touches).
-    count : int
-        Points on that cap at the density of ``n`` points on the default cap (the cap's area is
-        proportional to ``1 − cos θ``), rounded, between 1 (the pole) and ``n``.
+    Returns the half-angle ``asin(min(a / R, 1))`` in degrees (a small positive angle at ``δ = 0``),
+    and how many points sample it at the density of ``n`` points on the default cap (area
+    ``∝ 1 − cos θ``), rounded, between 1 and ``n``.
     """
     radius = check_positive("tip_radius_m", tip_radius_m)
     depth = check_positive("indentation_m", indentation_m, allow_zero=True)
@@ -81,35 +61,13 @@ def contact_cap(tip_radius_m: float, indentation_m: float,
     return half_angle, int(np.clip(round(most * area), 1, most))
 
 
-def tactile_points(
-    tip_center: Any,
-    force_vector: Any,
-    tip_radius_m: float,
-    n: int = 10,
-    *,
-    cap_half_angle_deg: float = DEFAULT_CAP_HALF_ANGLE_DEG,
-) -> NDArray[np.float64]:
-    """Deterministic points on the spherical cap of the probe tip that touches the surface.
+def tactile_points(tip_center: Any, force_vector: Any, tip_radius_m: float, n: int = 10, *,
+                   cap_half_angle_deg: float = DEFAULT_CAP_HALF_ANGLE_DEG) -> NDArray[np.float64]:
+    """Deterministic ``(n, 3)`` points (metres) on the cap of the tip that touches the surface.
 
-    Parameters
-    ----------
-    tip_center : (3,) float, metres
-        Centre of the spherical tip.
-    force_vector : (3,) float, newtons
-        Force the probe exerts on the surface (pointing into it); only its direction is used.
-    tip_radius_m : float
-        Radius of the tip, > 0.
-    n : int
-        Number of points, >= 1 (the paper uses 10).
-    cap_half_angle_deg : float
-        Half-angle of the cap, in (0, 90] degrees (default :data:`DEFAULT_CAP_HALF_ANGLE_DEG`).
-
-    Returns
-    -------
-    points : (n, 3) float, metres
-        The first point is the pole ``tip_center + r · u`` with ``u`` the unit force direction (the
-        deepest point of the tip). The other ``n - 1`` follow a golden-angle (Fibonacci) spiral
-        that is uniform in area over the cap, the last one on its rim.
+    The first is the pole ``tip_center + r · u``, ``u`` the unit direction of ``force_vector`` (the
+    force on the surface, newtons); the other ``n - 1`` follow a golden-angle spiral uniform in area
+    over the cap of ``cap_half_angle_deg`` (in (0, 90]), the last on its rim.
     """
     center = check_vector("tip_center", tip_center, 3, what="metres")
     force = check_vector("force_vector", force_vector, 3, what="newtons")
@@ -133,6 +91,5 @@ def tactile_points(
     directions = (
         cos_theta[:, None] * axis
         + (sin_theta * np.cos(phi))[:, None] * e1
-        + (sin_theta * np.sin(phi))[:, None] * e2
-    )
+        + (sin_theta * np.sin(phi))[:, None] * e2)
     return np.asarray(center + radius * directions)

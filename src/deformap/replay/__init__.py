@@ -1,11 +1,9 @@
-"""Recorded sessions (a folder of cloud files, or a ROS 2 bag) read back and fed, poke by poke, to
-the mapper the live loop uses.
+"""Recorded sessions (a folder of cloud files, or a ROS 2 bag) read back and fed, poke by poke,
+to the mapper the live loop uses.
 
-:func:`load_session` checks a session's ``session.yaml`` (``docs/recording-format.md``) and opens
-its data; each poke is read on demand, so a broken poke is reported on its own.
-:func:`load_raw_bag` opens a bag as a robot records it (:class:`RawBagConfig`) as a session of form
-``"raw"``. :func:`write_session` writes the format (``deformap record-sim``, through
-:class:`RecordingEnvironment`).
+:func:`load_session` checks ``session.yaml`` (``docs/recording-format.md``) and reads each poke on
+demand; :func:`load_raw_bag` opens a robot's own bag (:class:`RawBagConfig`) as a session of form
+``"raw"``; :func:`write_session` writes the format.
 """
 
 from __future__ import annotations
@@ -37,35 +35,12 @@ from deformap.replay._write import SESSION_FORMATS, write_session
 # that reading a session stays light.
 _OFFLINE = ("ReplayResult", "estimate_poke", "map_session", "tip_sphere_points")
 
-__all__ = [
-    "DEFAULT_CONTACT_GAP_M",
-    "DEFAULT_HULL",
-    "FORMAT_NAME",
-    "FORMAT_VERSION",
-    "OPTIONAL_TOPICS",
-    "RAW_CONFIG_NAME",
-    "RAW_SUFFIXES",
-    "SESSION_FILE",
-    "SESSION_FORMATS",
-    "TOPICS",
-    "GroundTruth",
-    "HullPart",
-    "RawBagConfig",
-    "RecordedSession",
-    "RecordingEnvironment",
-    "ReplayResult",
-    "estimate_poke",
-    "is_raw_bag",
-    "load_raw_bag",
-    "load_raw_config",
-    "load_session",
-    "map_session",
-    "raw_config_file",
-    "read_ground_truth",
-    "tip_sphere_points",
-    "write_ground_truth",
-    "write_session",
-]
+__all__ = ["DEFAULT_CONTACT_GAP_M", "DEFAULT_HULL", "FORMAT_NAME", "FORMAT_VERSION",
+           "OPTIONAL_TOPICS", "RAW_CONFIG_NAME", "RAW_SUFFIXES", "SESSION_FILE", "SESSION_FORMATS",
+           "TOPICS", "GroundTruth", "HullPart", "RawBagConfig", "RecordedSession",
+           "RecordingEnvironment", "ReplayResult", "estimate_poke", "is_raw_bag", "load_raw_bag",
+           "load_raw_config", "load_session", "map_session", "raw_config_file",
+           "read_ground_truth", "tip_sphere_points", "write_ground_truth", "write_session"]
 
 
 def __getattr__(name: str) -> Any:

@@ -1,13 +1,10 @@
-"""The bag form of a session: a ROS 2 bag (sqlite3 or MCAP) on the topics of ``TOPICS``.
+"""The bag form of a session: a ROS 2 bag on the topics of ``TOPICS``.
 
-The messages of one poke share one header stamp, which ``session.yaml`` names (``stamp_ns``) next
-to what no standard message holds (the commanded target and force). The bag is indexed once; each
-message is decoded only when its poke is read, so a corrupted message breaks only its own poke.
-
-The force–travel record (``OPTIONAL_TOPICS``) is a ``std_msgs/msg/Float64MultiArray`` with two
-dimensions, ``samples`` (n) and ``travel_m,force_n`` (2), its data the n rows ``(travel, force)``
-row by row. That message has no header: the bag's log time of the message is the poke's stamp.
-A bag without the topic, or a poke without a message on it, has no record (``force_travel`` None).
+A poke's messages share one header stamp, which ``session.yaml`` names (``stamp_ns``) beside the
+command (target, force). Each message is decoded when its poke is read, so a corrupted message
+breaks only its own poke. The force–travel record (``OPTIONAL_TOPICS``) is a
+``Float64MultiArray`` of dimensions ``samples`` (n) × ``travel_m,force_n`` (2); having no header,
+it is logged at the poke's stamp. Without one a poke has no record.
 """
 
 from __future__ import annotations
@@ -83,7 +80,7 @@ class BagReader:
         return out
 
     def _force_travel(self, stamp: int) -> ForceTravel | None:
-        """The record whose message is logged at ``stamp``, or None when there is none."""
+        """The record logged at ``stamp``, or None."""
         topic, msgtype = OPTIONAL_TOPICS["force_travel"]
         where = f"{self.path} [{topic} logged at {stamp}]"
         raws = [r for r in self._raw[topic] if r.log_time_ns == stamp]
@@ -91,14 +88,12 @@ class BagReader:
             return None
         if len(raws) > 1:
             raise FileFormatError(
-                f"{where}: {len(raws)} messages; a poke needs at most one force–travel record"
-            )
+                f"{where}: {len(raws)} messages; a poke needs at most one force–travel record")
         try:
             msg = typestore().deserialize_cdr(raws[0].data, msgtype)
         except bag_read_errors() as exc:
             raise FileFormatError(
-                f"{where}: could not be decoded: {bag_error_text(exc, 120)}"
-            ) from None
+                f"{where}: could not be decoded: {bag_error_text(exc, 120)}") from None
         dims = [(str(d.label), int(d.size)) for d in msg.layout.dim]
         data = np.asarray(msg.data, dtype=float)
         if (len(dims) != 2 or (dims[0][0], dims[1][0]) != FORCE_TRAVEL_DIMS or dims[1][1] != 2
@@ -106,8 +101,7 @@ class BagReader:
             raise FileFormatError(
                 f"{where}: layout must be {FORCE_TRAVEL_DIMS[0]!r} (n) × "
                 f"{FORCE_TRAVEL_DIMS[1]!r} (2) with 2n values from offset 0; got dims {dims}, "
-                f"offset {msg.layout.data_offset}, {data.size} values"
-            )
+                f"offset {msg.layout.data_offset}, {data.size} values")
         rows = data.reshape(-1, 2)
         try:
             return ForceTravel(travel_m=rows[:, 0], force_n=rows[:, 1])
@@ -131,8 +125,7 @@ class BagReader:
                     by_stamp.setdefault(stamp, msg)
                 except errors as exc:
                     self._undecodable.setdefault(topic, []).append(
-                        f"message {number + 1}: {bag_error_text(exc, 120)}"
-                    )
+                        f"message {number + 1}: {bag_error_text(exc, 120)}")
             decoded[key] = by_stamp
         self._decoded = decoded
         return decoded
@@ -144,22 +137,19 @@ class BagReader:
         if repeated:
             raise FileFormatError(
                 f"{self.path}: topic {topic!r} has {repeated} messages stamped {stamp}; "
-                "a poke needs exactly one on each topic"
-            )
+                "a poke needs exactly one on each topic")
         if msg is None:
             bad = self._undecodable.get(topic, [])
             note = f"; {len(bad)} message(s) there could not be decoded ({bad[0]})" if bad else ""
             raise FileFormatError(
-                f"{self.path}: topic {topic!r} has no message stamped {stamp}{note}"
-            )
+                f"{self.path}: topic {topic!r} has no message stamped {stamp}{note}")
         return msg
 
     def _cloud(self, msg: Any, where: str, frame: str, colors: bool = True) -> PointCloud:
         if msg.header.frame_id != frame:
             raise FileFormatError(
                 f"{where}: header.frame_id is {msg.header.frame_id!r} but the session's frame is "
-                f"{frame!r} (session.yaml `frame`)"
-            )
+                f"{frame!r} (session.yaml `frame`)")
         # holes of an organised cloud (is_dense false) are dropped with their colours
         cloud, _ = pointcloud2_to_cloud(msg, where=where, units=self.header.units, frame=frame,
                                         colors=colors)  # fmt: skip
@@ -183,8 +173,7 @@ class BagReader:
             bad = self._undecodable.get(topic, [])
             raise FileFormatError(
                 f"{self.path}: topic {topic!r} must hold exactly one message; got {count}"
-                + (f" ({len(bad)} could not be decoded: {bad[0]})" if bad else "")
-            )
+                + (f" ({len(bad)} could not be decoded: {bad[0]})" if bad else ""))
         where = f"{self.path} [{topic}]"
         return self._to_world(self._cloud(msgs[0], where, self.header.frame))
 
@@ -203,16 +192,14 @@ class BagReader:
             if msg.header.frame_id != "world":
                 raise FileFormatError(
                     f"{where(key)}: header.frame_id is {msg.header.frame_id!r}; the bag form "
-                    "stores contacts in the 'world' frame"
-                )
+                    "stores contacts in the 'world' frame")
         f, p = wrench.wrench.force, tip.point
         force = np.array([f.x, f.y, f.z], dtype=float)
         center = np.array([p.x, p.y, p.z], dtype=float)
         for key, value in (("wrench", force), ("tip", center)):
             if not np.isfinite(value).all():
                 raise FileFormatError(
-                    f"{where(key)}: holds NaN or infinite values {value.tolist()}"
-                )
+                    f"{where(key)}: holds NaN or infinite values {value.tolist()}")
         return PressParts(cloud, center, force, np.asarray(robot.points),
                           self._force_travel(stamp))
 
@@ -223,40 +210,24 @@ def _point_message(stamp_ns: int, point: Any) -> Any:
     header = types["std_msgs/msg/Header"](stamp=time, frame_id="world")
     x, y, z = (float(v) for v in point)
     return types["geometry_msgs/msg/PointStamped"](
-        header=header, point=types["geometry_msgs/msg/Point"](x=x, y=y, z=z)
-    )
-
-
-def _wrench_message(stamp_ns: int, force: Any) -> Any:
-    return wrench_message(stamp_ns, "world", force, np.zeros(3))
+        header=header, point=types["geometry_msgs/msg/Point"](x=x, y=y, z=z))
 
 
 def force_travel_message(record: ForceTravel) -> Any:
     """The record as a ``std_msgs/msg/Float64MultiArray`` (see the module docstring)."""
     types = typestore().types
-    n = len(record)
-    dims = [types["std_msgs/msg/MultiArrayDimension"](label=FORCE_TRAVEL_DIMS[0], size=n,
-                                                      stride=2 * n),
-            types["std_msgs/msg/MultiArrayDimension"](label=FORCE_TRAVEL_DIMS[1], size=2,
-                                                      stride=2)]  # fmt: skip
+    n, dim = len(record), types["std_msgs/msg/MultiArrayDimension"]
+    dims = [dim(label=FORCE_TRAVEL_DIMS[0], size=n, stride=2 * n),
+            dim(label=FORCE_TRAVEL_DIMS[1], size=2, stride=2)]
     layout = types["std_msgs/msg/MultiArrayLayout"](dim=dims, data_offset=0)
     data = np.column_stack([record.travel_m, record.force_n]).ravel()
     return types["std_msgs/msg/Float64MultiArray"](layout=layout, data=data)
 
 
-def write_session_bag(
-    path: Path,
-    *,
-    storage: str,
-    observation: PointCloud,
-    presses: Sequence[PressObservation],
-    stamps_ns: Sequence[int],
-) -> None:
-    """Write the observation and the presses (world frame, float64) to a new bag at ``path``.
-
-    A cloud with colours gets a packed FLOAT32 ``rgb`` field (8 bits a channel); the robot's
-    points have none.
-    """
+def write_session_bag(path: Path, *, storage: str, observation: PointCloud,
+                      presses: Sequence[PressObservation], stamps_ns: Sequence[int]) -> None:
+    """Write the observation and the presses (world frame, float64; colours as a packed
+    ``rgb``, none for the robot's points) to a new bag at ``path``."""
     store = typestore()
     # the record's topic only where a press has one: a bag of presses without stays as before
     topics = dict(TOPICS)
@@ -269,17 +240,15 @@ def write_session_bag(
         def put(key: str, stamp: int, msg: Any) -> None:
             writer.write(conns[key], stamp, store.serialize_cdr(msg, topics[key][1]))
 
-        put("observation", 0, array_to_pointcloud2(observation.points, colors=observation.colors,
-                                                   frame_id="world", stamp_ns=0,
-                                                   dtype="float64"))  # fmt: skip
+        def cloud(key: str, stamp: int, points: Any, colors: Any = None) -> None:
+            put(key, stamp, array_to_pointcloud2(points, colors=colors, frame_id="world",
+                                                 stamp_ns=stamp, dtype="float64"))
+
+        cloud("observation", 0, observation.points, observation.colors)
         for stamp, obs in zip(stamps_ns, presses, strict=True):
-            put("cloud", stamp, array_to_pointcloud2(obs.cloud.points, colors=obs.cloud.colors,
-                                                     frame_id="world", stamp_ns=stamp,
-                                                     dtype="float64"))  # fmt: skip
-            put("wrench", stamp, _wrench_message(stamp, obs.contact.force))
+            cloud("cloud", stamp, obs.cloud.points, obs.cloud.colors)
+            put("wrench", stamp, wrench_message(stamp, "world", obs.contact.force, np.zeros(3)))
             put("tip", stamp, _point_message(stamp, obs.contact.tip_center))
-            robot = np.vstack(obs.robot_hulls)  # one hull per poke: the parts' common one
-            put("robot", stamp, array_to_pointcloud2(robot, frame_id="world", stamp_ns=stamp,
-                                                     dtype="float64"))  # fmt: skip
+            cloud("robot", stamp, np.vstack(obs.robot_hulls))  # one hull: the parts' common one
             if obs.force_travel is not None:
                 put("force_travel", stamp, force_travel_message(obs.force_travel))

@@ -1,9 +1,8 @@
 """A session reads only inside its own folder.
 
-Every file a session names (in ``session.yaml``, and in a rosbag2 folder's ``metadata.yaml``) must
-be a relative name without ``..`` that, once symbolic links are resolved, lies inside the session
-folder, with no opt-out: a session is moved and shared as one folder, and a session that could name
-any path would let whoever wrote it make ``deformap map`` read any file the user can read.
+Every file a session names (in ``session.yaml`` and a rosbag2 ``metadata.yaml``) must be a
+relative name without ``..`` that, links resolved, lies inside the session folder, with no
+opt-out: otherwise whoever wrote a session could make ``deformap map`` read any file.
 """
 
 from __future__ import annotations
@@ -20,23 +19,8 @@ _RULE = "a session's files must lie inside its folder, named relative to it with
 
 
 def confined_path(where: str, value: Any, root: Path) -> Path:
-    """``root / value`` when ``value`` names a file inside the session folder ``root``.
-
-    Parameters
-    ----------
-    where : str
-        Names the entry in messages (``"session.yaml: `pokes[2].cloud`"``).
-    value : Any
-        The entry's value; a non-empty string.
-    root : Path
-        The session folder.
-
-    Raises
-    ------
-    ConfigError
-        The value is not a string, is absolute, has a ``..`` part, or resolves (through symbolic
-        links) outside ``root``.
-    """
+    """``root / value`` when ``value`` names a file inside the session folder ``root``; else a
+    ConfigError naming the entry ``where``."""
     if not isinstance(value, str) or not value.strip():
         raise ConfigError(f"{where} must be a file name (a string); got {value!r}")
     name = PurePath(value)
@@ -49,27 +33,14 @@ def confined_path(where: str, value: Any, root: Path) -> Path:
         raise ConfigError(f"{where} is {value!r:.120}, which cannot be resolved: {exc}") from None
     if not real.is_relative_to(base):
         raise ConfigError(
-            f"{where} is {value!r}, a link to {str(real)!r}, outside the session folder; {_RULE}"
-        )
+            f"{where} is {value!r}, a link to {str(real)!r}, outside the session folder; {_RULE}")
     return path
 
 
 def check_bag_confined(bag: Path) -> list[Path]:
-    """Refuse a rosbag2 folder whose ``metadata.yaml`` names storage files outside it.
-
-    ``bag`` itself has passed :func:`confined_path`, so what lies inside it lies inside the
-    session folder.
-
-    Returns
-    -------
-    list of Path
-        The files rosbags will open: the bag file itself, or ``metadata.yaml`` and the storage
-        files it lists.
-
-    rosbags opens ``bag / PurePath(name).name`` for each ``relative_file_paths`` entry, so a
-    ``../`` or absolute entry would silently read another file than the one named, and a storage
-    file may be a link out of the folder: both are refused, naming the entry.
-    """
+    """The files rosbags will open for the bag (a single file, or ``metadata.yaml`` and the
+    storage files it lists), each refused when outside the folder (rosbags opens the last part of
+    each name, so both the name and that part are checked)."""
     meta = bag / "metadata.yaml"
     if not bag.is_dir():
         return [bag]  # a single .mcap/.db3 file, already confined

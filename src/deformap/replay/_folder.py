@@ -34,8 +34,7 @@ def _to_world(cloud: PointCloud, header: SessionHeader) -> PointCloud:
         return cloud
     assert isinstance(header.cam2world, np.ndarray)  # parse_session_yaml guarantees it
     return PointCloud(cloud.points, cloud.colors, frame=header.frame).transformed(
-        header.cam2world, "world"
-    )
+        header.cam2world, "world")
 
 
 class FolderReader:
@@ -46,8 +45,7 @@ class FolderReader:
         assert header.observation is not None
         if path_kind(header.observation) != "file":
             raise FileFormatError(
-                f"{header.observation}: no such file (the session's `observation`)"
-            )
+                f"{header.observation}: no such file (the session's `observation`)")
 
     def observation(self) -> PointCloud:
         return _to_world(read_cloud(self._path(self.header.observation), units=self.header.units),

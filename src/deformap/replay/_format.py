@@ -1,13 +1,8 @@
-"""The ``session.yaml`` of a recorded session: its keys, parsed strictly.
+"""The ``session.yaml`` of a recorded session (``docs/recording-format.md``), parsed strictly.
 
-The format is documented for users in ``docs/recording-format.md``; this module is its reference.
-Keys are checked in two tiers, so that one broken poke does not hide the others:
-
-- the file as a whole (unknown or missing keys anywhere, a wrong format name or version, bad
-  workspace, probe, frame or units) raises :class:`~deformap.errors.ConfigError` when the session is
-  loaded;
-- the *values* of one poke's entry (a NaN tip centre, a zero force, a target of the wrong length)
-  are kept as that poke's error and raised only when that poke is read.
+The file as a whole (unknown or missing keys, format name or version, workspace, probe, frame,
+units) raises :class:`~deformap.errors.ConfigError` when loaded; the values of one poke's entry
+are kept as that poke's error and raised when it is read, so one broken poke hides no other.
 """
 
 from __future__ import annotations
@@ -33,16 +28,8 @@ from deformap.environment import ForceTravel, Workspace
 from deformap.errors import ConfigError, DeformapError
 from deformap.replay._confine import confined_path
 
-__all__ = [
-    "FORMAT_NAME",
-    "FORMAT_VERSION",
-    "OPTIONAL_TOPICS",
-    "SESSION_FILE",
-    "TOPICS",
-    "PokeSpec",
-    "SessionHeader",
-    "parse_session_yaml",
-]
+__all__ = ["FORMAT_NAME", "FORMAT_VERSION", "OPTIONAL_TOPICS", "SESSION_FILE", "TOPICS",
+           "PokeSpec", "SessionHeader", "parse_session_yaml"]
 
 logger = logging.getLogger(__name__)
 
@@ -51,20 +38,15 @@ FORMAT_VERSION = 1
 SESSION_FILE = "session.yaml"
 
 #: Topic names of the bag form and their message types.
-TOPICS = {
-    "observation": ("/deformap/observation", "sensor_msgs/msg/PointCloud2"),
-    "cloud": ("/deformap/press/cloud", "sensor_msgs/msg/PointCloud2"),
-    "wrench": ("/deformap/press/wrench", "geometry_msgs/msg/WrenchStamped"),
-    "tip": ("/deformap/press/tip", "geometry_msgs/msg/PointStamped"),
-    "robot": ("/deformap/press/robot", "sensor_msgs/msg/PointCloud2"),
-}
+TOPICS = {"observation": ("/deformap/observation", "sensor_msgs/msg/PointCloud2"),
+          "cloud": ("/deformap/press/cloud", "sensor_msgs/msg/PointCloud2"),
+          "wrench": ("/deformap/press/wrench", "geometry_msgs/msg/WrenchStamped"),
+          "tip": ("/deformap/press/tip", "geometry_msgs/msg/PointStamped"),
+          "robot": ("/deformap/press/robot", "sensor_msgs/msg/PointCloud2")}
 
-#: Topics of the bag form that a bag may lack (then no poke has what they carry). The force–travel
-#: record is a ``Float64MultiArray`` of ``n × 2`` rows ``(travel_m, force_n)``; the message has no
-#: header, so its bag log time is the poke's ``stamp_ns``.
-OPTIONAL_TOPICS = {
-    "force_travel": ("/deformap/press/force_travel", "std_msgs/msg/Float64MultiArray"),
-}
+#: Topics of the bag form that a bag may lack (then no poke has what they carry).
+OPTIONAL_TOPICS = {"force_travel": ("/deformap/press/force_travel",
+                                    "std_msgs/msg/Float64MultiArray")}
 
 _TOP_REQUIRED = {"format", "version", "workspace", "probe", "pokes"}
 _TOP_OPTIONAL = {"units", "frame", "cam2world", "ground_truth", "source", "observation", "bag",
@@ -77,28 +59,12 @@ _BAG_POKE_KEYS = {"stamp_ns", "target_xy", "force_n"}
 
 @dataclass(frozen=True, kw_only=True)
 class PokeSpec:
-    """One poke's entry in ``session.yaml``, with the values already checked.
+    """One poke's entry in ``session.yaml``, its values checked (world frame, SI).
 
-    Parameters
-    ----------
-    index : int
-        Position in the ``pokes`` list (0-based).
-    target_xy : (2,) float, metres or None
-    force_n : float or None
-        Commanded target and normal force.
-    cloud : Path or None
-        Folder form: the cloud seen while pressing.
-    tip_center : (3,) float, metres or None
-    force : (3,) float, newtons or None
-        Folder form: the measured contact (world frame, force pointing into the surface).
-    robot_points : Path or (m, 3) float or None
-        Folder form: a cloud file, or the points inline.
-    stamp_ns : int or None
-        Bag form: the header stamp shared by this poke's messages.
-    force_travel : ForceTravel or None
-        Folder form: the press's force–travel record, when the entry has one.
-    error : DeformapError or None
-        Why this entry cannot be used (raised when the poke is read).
+    ``index`` is its place in ``pokes`` (0-based); ``target_xy`` and ``force_n`` the command. The
+    folder form has ``cloud`` (a file), the contact ``tip_center`` and ``force``, ``robot_points``
+    (a file or inline points) and an optional ``force_travel``; the bag form the ``stamp_ns`` its
+    messages share. ``error`` says why the entry cannot be used (raised when the poke is read).
     """
 
     index: int
@@ -117,30 +83,11 @@ class PokeSpec:
 class SessionHeader:
     """What ``session.yaml`` says about the whole session.
 
-    Parameters
-    ----------
-    root : Path
-        The session folder; relative file names resolve against it.
-    form : {"folder", "bag"}
-    units : {"m", "mm"}
-        Units of the point coordinates in cloud files and PointCloud2 messages.
-    frame : str
-        The frame the clouds are stored in.
-    cam2world : (4, 4) float, "tf_static" or None
-        Maps clouds from ``frame`` to the world frame (``None`` when ``frame == "world"``).
-    workspace : Workspace
-    tip_radius_m : float
-    observation : Path or None
-        Folder form: the initial observation's cloud file.
-    bag : Path or None
-        Bag form: the rosbag2 folder or ``.mcap`` / ``.db3`` file.
-    ground_truth : Path or None
-    source : dict
-        Free-form provenance (scenario, seed, deformap version), copied into reports.
-    pokes : tuple of PokeSpec
-    sha256 : dict of Path to str
-        The manifest: each listed file's SHA-256 (hex), checked when the file is read. Empty
-        when ``session.yaml`` has none (sessions not written by ``record-sim``).
+    ``root`` is the session folder; ``form`` ``"folder"``, ``"bag"`` or ``"raw"``; ``units`` those of
+    the stored coordinates; ``cam2world`` maps clouds from ``frame`` to the world (a 4×4 matrix,
+    ``"tf_static"`` or None when ``frame == "world"``). ``observation`` (folder form) and ``bag``
+    name the data; ``source`` is free-form provenance copied into reports; ``sha256`` the manifest
+    (file → digest), empty when the file has none.
     """
 
     root: Path
@@ -170,8 +117,7 @@ def _check_keys(file: Path, key: str, data: Any, required: set[str], optional: s
     if unknown:
         raise ConfigError(
             f"{_where(file, key)} has unknown key(s) {unknown}; "
-            f"allowed: {sorted(required | optional)}"
-        )
+            f"allowed: {sorted(required | optional)}")
     missing = sorted(required - keys)
     if missing:
         raise ConfigError(f"{_where(file, key)} lacks required key(s) {missing}")
@@ -195,14 +141,12 @@ def _cam2world(file: Path, data: dict[str, Any], frame: str, form: str) -> Any:
         if raw is not None:
             raise ConfigError(
                 f"{_where(file, 'cam2world')} is given but `frame` is 'world': the clouds are "
-                "already in the world frame; remove one of the two"
-            )
+                "already in the world frame; remove one of the two")
         return None
     if raw is None:
         raise ConfigError(
             f"{_where(file, 'frame')} is {frame!r}, not 'world', so `cam2world` (a 4×4 "
-            "camera-to-world matrix) is required" + (" or 'tf_static'" if form == "bag" else "")
-        )
+            "camera-to-world matrix) is required" + (" or 'tf_static'" if form == "bag" else ""))
     if raw == "tf_static":
         if form != "bag":
             raise ConfigError(f"{_where(file, 'cam2world')}: 'tf_static' needs the bag form")
@@ -276,30 +220,22 @@ def _workspace(file: Path, data: Any) -> Workspace:
 
 
 def parse_session_yaml(data: Any, file: Path) -> SessionHeader:
-    """Check the plain data of a ``session.yaml`` and return its header and poke entries.
-
-    Raises
-    ------
-    ConfigError
-        Naming the file and the key (``pokes[3].force``) on any schema problem.
-    """
+    """Check the plain data of a ``session.yaml``; a schema problem is a ConfigError naming the
+    file and the key (``pokes[3].force``)."""
     root = file.parent
     _check_keys(file, "(top level)", data, _TOP_REQUIRED, _TOP_OPTIONAL)
     if data["format"] != FORMAT_NAME:
         raise ConfigError(
-            f"{_where(file, 'format')} must be {FORMAT_NAME!r}; got {data['format']!r}"
-        )
+            f"{_where(file, 'format')} must be {FORMAT_NAME!r}; got {data['format']!r}")
     if data["version"] != FORMAT_VERSION or isinstance(data["version"], bool):
         raise ConfigError(
             f"{_where(file, 'version')} must be {FORMAT_VERSION} (this deformap reads format "
-            f"version {FORMAT_VERSION}); got {data['version']!r}"
-        )
+            f"version {FORMAT_VERSION}); got {data['version']!r}")
     has_bag, has_obs = "bag" in data, "observation" in data
     if has_bag == has_obs:
         raise ConfigError(
             f"{file}: give exactly one of `observation` (folder form) and `bag` (bag form); "
-            f"got {'both' if has_bag else 'neither'}"
-        )
+            f"got {'both' if has_bag else 'neither'}")
     form = "bag" if has_bag else "folder"
     units = data.get("units", "m")
     if not isinstance(units, str) or units not in UNITS:
@@ -314,8 +250,7 @@ def parse_session_yaml(data: Any, file: Path) -> SessionHeader:
     source = data.get("source") or {}
     if not isinstance(source, dict):
         raise ConfigError(
-            f"{_where(file, 'source')} must be a mapping; got {type(source).__name__}"
-        )
+            f"{_where(file, 'source')} must be a mapping; got {type(source).__name__}")
     pokes = data["pokes"]
     if not isinstance(pokes, list):
         raise ConfigError(f"{_where(file, 'pokes')} must be a list; got {type(pokes).__name__}")
@@ -330,26 +265,22 @@ def parse_session_yaml(data: Any, file: Path) -> SessionHeader:
         bag=_file_name(file, "bag", data["bag"], root) if has_bag else None,
         ground_truth=None if truth is None else _file_name(file, "ground_truth", truth, root),
         source={str(k): v for k, v in source.items()},
-        pokes=tuple(_unique_stamps(file, specs)), sha256=digests,
-    )  # fmt: skip
+        pokes=tuple(_unique_stamps(file, specs)), sha256=digests)
 
 
 def _check_poke_count(file: Path, data: dict[str, Any], pokes: list[Any]) -> None:
-    """``n_pokes``, when given, must equal the entries of ``pokes``: a file cut at a poke
-    boundary is still valid YAML, and must not load as fewer pokes."""
+    """``n_pokes``, when given, must count the entries of ``pokes``: a file cut at a poke
+    boundary is still valid YAML."""
     if "n_pokes" not in data:
         logger.info("%s: no `n_pokes`; cannot check that the poke list is complete", file)
         return
     count = data["n_pokes"]
     if not isinstance(count, int) or isinstance(count, bool) or count < 0:
-        raise ConfigError(
-            f"{_where(file, 'n_pokes')} must be a whole number >= 0; got {count!r}"
-        )
+        raise ConfigError(f"{_where(file, 'n_pokes')} must be a whole number >= 0; got {count!r}")
     if count != len(pokes):
         raise ConfigError(
             f"{_where(file, 'n_pokes')} is {count} but `pokes` lists {len(pokes)} entries; "
-            "the file was cut or edited"
-        )
+            "the file was cut or edited")
 
 
 _HEX64 = re.compile(r"[0-9a-f]{64}")
@@ -362,16 +293,14 @@ def _manifest(file: Path, raw: Any, root: Path) -> dict[Path, str]:
     if not isinstance(raw, dict) or not raw:
         raise ConfigError(
             f"{_where(file, 'sha256')} must be a non-empty mapping of file name to SHA-256; "
-            f"got {raw!r:.80}"
-        )
+            f"got {raw!r:.80}")
     out = {}
     for name, digest in raw.items():
         key = f"sha256[{name!r}]"
         path = confined_path(_where(file, key), name, root)
         if not isinstance(digest, str) or not _HEX64.fullmatch(digest):
             raise ConfigError(
-                f"{_where(file, key)} must be 64 lowercase hex digits; got {digest!r:.80}"
-            )
+                f"{_where(file, key)} must be 64 lowercase hex digits; got {digest!r:.80}")
         out[path] = digest
     return out
 
@@ -385,8 +314,7 @@ def _unique_stamps(file: Path, specs: list[PokeSpec]) -> list[PokeSpec]:
             key = f"pokes[{spec.index}].stamp_ns"
             error = ConfigError(
                 f"{_where(file, key)} is {spec.stamp_ns}, already the stamp of "
-                f"`pokes[{first[spec.stamp_ns]}]`; each poke needs its own messages"
-            )
+                f"`pokes[{first[spec.stamp_ns]}]`; each poke needs its own messages")
             spec = PokeSpec(index=spec.index, error=error)
         elif spec.stamp_ns is not None:
             first[spec.stamp_ns] = spec.index

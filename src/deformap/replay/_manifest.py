@@ -1,12 +1,6 @@
-"""The ``sha256`` manifest of a session: a digest per file, written by ``write_session`` and checked
-when the file is read.
-
-Cloud files and bag payloads carry no checksum of their own, so a flipped byte in a stored float
-would change the data unnoticed. A file whose SHA-256 differs from the recorded one is refused,
-naming it, and so is a file the session reads that the manifest does not list (a manifest covers
-the whole session or nothing). A session without ``sha256`` (written by hand or another tool) is
-read unchecked.
-"""
+"""The ``sha256`` manifest of a session, written by ``write_session`` and checked as each file is
+read: a file whose digest differs, or that a manifest does not list, is refused. A session
+without one is read unchecked."""
 
 from __future__ import annotations
 
@@ -48,11 +42,9 @@ def verify_digest(header: SessionHeader, path: Path) -> None:
     if want is None:
         raise FileFormatError(
             f"{path}: not in the session's `sha256` manifest ({len(header.sha256)} files); "
-            "every file a session with a manifest reads must be listed"
-        )
+            "every file a session with a manifest reads must be listed")
     got = sha256_file(path)
     if got != want:
         raise FileFormatError(
             f"{path}: SHA-256 is {got[:16]}…, the session's manifest says {want[:16]}…; the "
-            "file changed after it was recorded"
-        )
+            "file changed after it was recorded")

@@ -1,9 +1,7 @@
 """Recorded pokes fed to the mapper the live loop uses: a whole session, or one poke on its own.
 
-The live loop (:func:`deformap.explore.explore`) initialises a :class:`~deformap.explore.Mapper`
-with the first observation, then makes each poke with :func:`deformap.explore.poke_step`. Here the
-same step is taken with what a session recorded, in its order, so a poke gives the same β whichever
-way it arrives (with the same seed for the surface fit).
+A session's pokes are taken, in order, by the step of the live loop
+(:class:`~deformap.explore.MappingRun`), so a poke gives the same β whichever way it arrives.
 """
 
 from __future__ import annotations
@@ -17,17 +15,11 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from deformap._validation import check_points, check_positive, check_vector
+from deformap._validation import check_instance, check_points, check_positive, check_vector
 from deformap.cloud import PointCloud
 from deformap.environment import PressObservation, TactileContact, Workspace
-from deformap.errors import DeformapError, InvalidArgumentError
-from deformap.explore import (
-    ExplorationConfig,
-    ExplorationResult,
-    Mapper,
-    MappingRun,
-    PokeResult,
-)
+from deformap.errors import DeformapError
+from deformap.explore import ExplorationConfig, ExplorationResult, Mapper, MappingRun, PokeResult
 from deformap.replay._session import DEFAULT_CONTACT_GAP_M, RecordedSession, check_contact_gap
 
 __all__ = ["ReplayResult", "estimate_poke", "map_session", "tip_sphere_points"]
@@ -40,63 +32,29 @@ END_OF_SESSION = "end-of-session"
 
 @dataclass
 class ReplayResult:
-    """What :func:`map_session` produced.
-
-    Attributes
-    ----------
-    result : ExplorationResult
-        What the mapper produced from every usable poke (``stop_reason`` is
-        ``"end-of-session"``), for the report and figure helpers the live run uses.
-    skipped : list of dict
-        ``{"index": i, "error": message}`` for each poke that could not be used, in order.
-    """
+    """What :func:`map_session` produced: the ``result`` of every usable poke (``stop_reason``
+    ``"end-of-session"``), and ``skipped``, ``{"index": i, "error": message}`` per unusable poke."""
 
     result: ExplorationResult
     skipped: list[dict[str, Any]] = field(default_factory=list)
 
     @property
     def warnings(self) -> list[str]:
-        """One line per skipped poke, for ``report.json``: numbered from 1 as the console, the
-        figures (``poke-01.png``) and a session's files are (``index`` stays 0-based)."""
+        """One line per skipped poke, numbered from 1 as the console and figures are."""
         return [f"poke {s['index'] + 1} skipped: {s['error']}" for s in self.skipped]
 
 
-def map_session(
-    session: RecordedSession,
-    config: ExplorationConfig,
-    *,
-    rng: np.random.Generator,
-    on_poke: Callable[[PokeResult], None] | None = None,
-) -> ReplayResult:
+def map_session(session: RecordedSession, config: ExplorationConfig, *, rng: np.random.Generator,
+                on_poke: Callable[[PokeResult], None] | None = None) -> ReplayResult:
     """Feed a session's pokes, in order, to a fresh mapper.
 
-    Parameters
-    ----------
-    session : RecordedSession
-    config : ExplorationConfig
-        Mapper settings. ``max_pokes``, ``threshold``, ``strategy`` and ``boundary_pokes`` do
-        not apply: every recorded poke is used, where it was made.
-    rng : numpy.random.Generator
-        Split as :func:`deformap.explore.explore` splits it (its first stream fits the surface),
-        so the live run's generator gives the live run's surface model.
-    on_poke : callable, optional
-        Called after each poke added (progress display).
-
-    Returns
-    -------
-    ReplayResult
-        A poke that cannot be read, processed or added to the β-field (any
-        :class:`~deformap.errors.DeformapError`) is logged, listed in ``skipped`` and left out;
-        the others still count.
+    ``config``'s ``max_pokes``, ``threshold``, ``strategy`` and ``boundary_pokes`` do not apply:
+    every recorded poke is used where it was made. ``rng`` is split as the live loop splits it, so the
+    live run's generator gives its surface model. A poke that cannot be read, processed or added
+    (any DeformapError) is logged and listed in ``skipped``. ``on_poke`` is called after each poke.
     """
-    if not isinstance(session, RecordedSession):
-        raise InvalidArgumentError(
-            f"`session` must be a RecordedSession; got {type(session).__name__}"
-        )
-    if not isinstance(config, ExplorationConfig):
-        raise InvalidArgumentError(
-            f"`config` must be an ExplorationConfig; got {type(config).__name__}"
-        )
+    check_instance("session", session, RecordedSession)
+    check_instance("config", config, ExplorationConfig)
     # explore() spawns max_pokes + 1 streams and fits the surface with the first; a spawned
     # child depends only on its position, so spawning one gives that same stream.
     run = MappingRun(session.workspace, config, session.observation, rng.spawn(1)[0])
@@ -116,61 +74,25 @@ def map_session(
 
 
 def tip_sphere_points(tip_center: Any, tip_radius_m: float) -> NDArray[np.float64]:
-    """``(6, 3)`` vertices of the octahedron inscribed in the tip's sphere.
-
-    The robot geometry known without a hull file: cloud points inside the tip cannot be surface.
-    """
+    """``(6, 3)`` vertices of the octahedron inscribed in the tip's sphere: robot points known
+    without a hull file."""
     center = check_vector("tip_center", tip_center, 3, what="metres")
     radius = check_positive("tip_radius_m", tip_radius_m)
     return center + radius * np.vstack([np.eye(3), -np.eye(3)])
 
 
-def estimate_poke(
-    before: PointCloud,
-    after: PointCloud,
-    contact: TactileContact,
-    config: ExplorationConfig,
-    *,
-    rng: np.random.Generator,
-    robot_points: Any = None,
-    contact_gap_m: float = DEFAULT_CONTACT_GAP_M,
-) -> PokeResult:
-    """β of one poke from the clouds before and while pressing.
+def estimate_poke(before: PointCloud, after: PointCloud, contact: TactileContact,
+                  config: ExplorationConfig, *, rng: np.random.Generator, robot_points: Any = None,
+                  contact_gap_m: float = DEFAULT_CONTACT_GAP_M) -> PokeResult:
+    """β of one poke from the world-frame clouds ``before`` and ``after`` (while pressing).
 
-    Parameters
-    ----------
-    before, after : PointCloud
-        World frame, metres: the undisturbed surface, and the surface while pressing.
-    contact : TactileContact
-        Tip centre, force on the surface and tip radius at the press.
-    config : ExplorationConfig
-        The surface GP, touch GP and shape-matching settings are used.
-    rng : numpy.random.Generator
-        For the surface fit.
-    robot_points : (m, 3) float, optional
-        Points whose convex hull covers stick and hand; default: the tip's sphere
-        (:func:`tip_sphere_points`).
-    contact_gap_m : float, metres
-        Refuse a contact point farther than this from every surface point of ``after`` (see
-        :data:`~deformap.replay.DEFAULT_CONTACT_GAP_M`).
-
-    Returns
-    -------
-    PokeResult
-        ``record`` holds β, its uncertainty and the E(β) curve; the arrays draw the poke figure.
-
-    Notes
-    -----
-    The mapper works on a workspace: here the square of side three ROIs centred on the contact,
-    so that the surface fit covers the ROI and its surroundings and nothing far away.
+    The surface, touch and shape-matching settings of ``config`` apply, over a workspace of three ROIs
+    square centred on the contact. ``robot_points`` default to the tip's sphere
+    (:func:`tip_sphere_points`); ``contact_gap_m`` as for :func:`~deformap.replay.load_session`.
     """
     for name, cloud in (("before", before), ("after", after)):
-        if not isinstance(cloud, PointCloud):
-            raise InvalidArgumentError(f"`{name}` must be a PointCloud; got {type(cloud).__name__}")
-    if not isinstance(contact, TactileContact):
-        raise InvalidArgumentError(
-            f"`contact` must be a TactileContact; got {type(contact).__name__}"
-        )
+        check_instance(name, cloud, PointCloud)
+    check_instance("contact", contact, TactileContact)
     robot = (tip_sphere_points(contact.tip_center, contact.tip_radius_m) if robot_points is None
              else check_points("robot_points", robot_points, min_rows=4))  # fmt: skip
     xy = contact.contact_point[:2]

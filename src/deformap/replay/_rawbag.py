@@ -1,14 +1,11 @@
 """A ROS 2 bag as a robot records it, read as a recorded session (``docs/robot.md``).
 
-The bag holds an organised ``sensor_msgs/msg/PointCloud2`` stream in the camera's frame, a
-``geometry_msgs/msg/WrenchStamped`` stream in the force sensor's frame and ``/tf`` with
-``/tf_static`` (:class:`~deformap.replay.RawBagConfig` names them). A first pass decodes the
-wrenches, the transforms and the clouds' stamps and finds the presses in the force stream
-(:func:`find_presses`); a second averages, pixel by pixel, the camera frames each press was held
-for and those of the observation (their colours too, over the same frames, when every frame has
-them), keeping at most one frame per press in memory. A press that
-cannot be read (no frame or transform within the stamp tolerance, a force that never reached the
-command or points away from the surface) is refused with one line naming it, the topic and the gap.
+The bag holds an organised PointCloud2 stream in the camera's frame, a WrenchStamped stream in the
+force sensor's frame, and ``/tf`` with ``/tf_static`` (:class:`~deformap.replay.RawBagConfig`).
+A first pass decodes the wrenches, transforms and the clouds' stamps and finds the presses in the
+force stream (:func:`find_presses`); a second averages, pixel by pixel, the frames each press was
+held for and the observation's (colours too, when every frame has them), one frame in memory at a
+time. A press that cannot be read is refused in one line naming it, the topic and the gap.
 """
 
 from __future__ import annotations
@@ -46,14 +43,12 @@ _CLOUD = "sensor_msgs/msg/PointCloud2"
 _WRENCH = "geometry_msgs/msg/WrenchStamped"
 _TF = "tf2_msgs/msg/TFMessage"
 
-#: Frames are averaged pixel by pixel only while the camera holds still: within 0.5 mm and
-#: 1 mrad of the pose at the middle frame (1 mrad moves a point 1 m away by 1 mm, below the depth
-#: noise of the cameras deformap is used with); a frame farther off is left out of the average.
+#: A frame is averaged only while the camera holds within these [m, rad] of its pose at the
+#: middle frame: 1 mrad moves a point 1 m away by 1 mm, below a depth camera's noise.
 STILL_M, STILL_RAD = 5e-4, 1e-3
 
-#: The largest force component a wrench message may hold [N]: beyond the range of any
-#: force–torque sensor (the largest read tens of kN), so a larger or non-finite value is a damaged
-#: message, refused before it is squared (a norm of 1e200 N overflows).
+#: The largest force component [N] a wrench may hold, beyond any force–torque sensor's range: a
+#: larger or non-finite one is a damaged message, refused before it is squared.
 MAX_FORCE_N = 1e6
 
 #: Points of a hull part's circle (cylinder, cap): 16 give a polygon within 2 % of the circle.
@@ -86,10 +81,8 @@ def hull_points(part: HullPart, rot: NDArray[np.float64], origin: NDArray[np.flo
 
 @dataclass
 class _Group:
-    """Frames averaged into one cloud: their indices, and the sums and count per pixel.
-
-    ``rgb`` sums the colours over the same frames as ``total``; it is None once a frame has none.
-    """
+    """Frames averaged into one cloud, with the per-pixel sums (``rgb`` None once a frame lacks
+    colours) and counts."""
 
     frames: list[int]
     cam_stamp: int
@@ -232,8 +225,7 @@ class RawBagReader:
             self._errors[press.index] = str(exc)
 
     def _still(self, frames: list[int], where: str) -> _Group:
-        """The frames whose camera pose is within :data:`STILL_M`, :data:`STILL_RAD` of the
-        middle one's."""
+        """The frames whose camera pose lies within ``STILL_M``, ``STILL_RAD`` of the middle one's."""
         stamps = self.cloud_ns[frames]
         rot, trans = self.tree.lookup(self.config.world_frame, self.camera_frame, stamps,
                                       what=f"{where} [{self.config.cloud_topic}]")  # fmt: skip

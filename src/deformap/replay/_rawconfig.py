@@ -1,14 +1,6 @@
-"""Settings of a raw robot recording: which topics and frames hold what, and the thresholds that
-find the presses in it (``docs/robot.md``).
-
-A raw recording is a ROS 2 bag as ``ros2 bag record`` writes it: an organised
-``sensor_msgs/msg/PointCloud2`` stream in the camera's optical frame,
-``geometry_msgs/msg/WrenchStamped`` in the force sensor's frame, and ``/tf`` and ``/tf_static``.
-:class:`RawBagConfig` names them, the commanded force and the thresholds (defaults: a RealSense
-driver and a force sensor on ``/ft_sensor/wrench``); :class:`HullPart` is one part of the robot's
-model in the tip's frame. The settings come from a YAML file beside the bag
-(:func:`raw_config_file`) and the command line, through the same constructor.
-"""
+"""Settings of a raw robot recording (``docs/robot.md``): which topics and frames hold what, and
+the thresholds that find its presses; read from a YAML file beside the bag
+(:func:`raw_config_file`) and the command line through the same constructor."""
 
 from __future__ import annotations
 
@@ -20,34 +12,25 @@ from deformap._config import config_from_dict, load_yaml
 from deformap._validation import check_settings, setting
 from deformap.errors import ConfigError
 
-__all__ = [
-    "DEFAULT_HULL",
-    "RAW_CONFIG_NAME",
-    "HullPart",
-    "RawBagConfig",
-    "load_raw_config",
-    "raw_config_file",
-]
+__all__ = ["DEFAULT_HULL", "RAW_CONFIG_NAME", "HullPart", "RawBagConfig", "load_raw_config",
+           "raw_config_file"]
 
-#: Name of the settings file inside a rosbag2 folder; beside a single ``NAME.mcap`` or
-#: ``NAME.db3`` file it is ``NAME.deformap.yaml``.
+#: The settings file inside a rosbag2 folder (``NAME.deformap.yaml`` beside a ``NAME.mcap``).
 RAW_CONFIG_NAME = "deformap.yaml"
 
 
 @dataclass(frozen=True, kw_only=True)
 class HullPart:
-    """One rigid part of the probe (stick, hand) in the tip's frame (origin at the tip's centre, ``z``
-    along the stick away from the surface), its convex hull removed from the press's cloud on its own.
+    """One rigid part of the probe in the tip's frame (origin at the tip's centre, ``z`` along the
+    stick away from the surface), its convex hull removed from the press's cloud on its own.
 
     Parameters
     ----------
     shape : {"box", "cylinder", "cap"}
-        ``box``: extents ``size_m`` centred at ``center_m``, axes those of the tip's frame;
-        ``cylinder``: along ``z``, diameter ``size_m[0]``, length ``size_m[2]``, centred at
-        ``center_m``; ``cap``: the tip's upper half-sphere (radius ``size_m[0] / 2``, centre
-        ``center_m``; the lower half is in the dent and must stay out of every hull).
-    center_m : (3,) float, metres
-    size_m : (3,) float, metres
+        A box of extents ``size_m``, a cylinder along ``z`` (diameter ``size_m[0]``, length
+        ``size_m[2]``) or the tip's upper half-sphere (radius ``size_m[0] / 2``), centred at
+        ``center_m``.
+    center_m, size_m : (3,) float, metres
     """
 
     shape: Literal["box", "cylinder", "cap"] = "box"
@@ -58,15 +41,11 @@ class HullPart:
         check_settings(self)
 
 
-#: The default probe: the paper's rigid 10 cm stick on the hand (Sec. V), as three parts: the
-#: tip's upper half (1 cm radius), the stick (12 mm thick, 10 cm long) and a hand box
-#: 8 × 6 × 10 cm on top of it. Give your own in ``hull`` (measure the parts and add a few
-#: millimetres so that depth noise on their edges goes too).
-DEFAULT_HULL = (
-    HullPart(shape="cap", center_m=(0.0, 0.0, 0.0), size_m=(0.02, 0.02, 0.02)),
-    HullPart(shape="cylinder", center_m=(0.0, 0.0, 0.05), size_m=(0.012, 0.012, 0.10)),
-    HullPart(shape="box", center_m=(0.0, 0.0, 0.15), size_m=(0.08, 0.06, 0.10)),
-)
+#: The default probe, the paper's 10 cm stick on the hand (Sec. V): the tip's upper half (1 cm
+#: radius), the stick (12 mm × 10 cm) and an 8 × 6 × 10 cm hand box.
+DEFAULT_HULL = (HullPart(shape="cap", center_m=(0.0, 0.0, 0.0), size_m=(0.02, 0.02, 0.02)),
+                HullPart(shape="cylinder", center_m=(0.0, 0.0, 0.05), size_m=(0.012, 0.012, 0.10)),
+                HullPart(shape="box", center_m=(0.0, 0.0, 0.15), size_m=(0.08, 0.06, 0.10)))
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -80,8 +59,7 @@ class RawBagConfig:
     world_frame : str
         The frame whose ``z = 0`` is the table, ``z`` up (the map's frame).
     tip_frame : str
-        The ``/tf`` frame at the centre of the probe's spherical tip, ``z`` along the stick away from
-        the surface (the press direction is its ``-z``).
+        The ``/tf`` frame at the centre of the probe's tip, ``z`` along the stick away from the surface.
     camera_frame, force_frame : str or None
         Override the clouds' and the wrenches' ``header.frame_id`` (None: use them).
     units : {"m", "mm"}
@@ -89,22 +67,17 @@ class RawBagConfig:
     force_n : float or None
         The commanded normal force [N]; None: the run configuration's ``exploration.force_n``.
     wrench_sign : {"reaction", "applied"}
-        ``"reaction"``: the sensor reports the force on the probe (negated here); ``"applied"``: the
-        force on the surface. A result that does not push into the surface is refused.
+        Whether the sensor reports the force on the probe (negated here) or on the surface.
     contact_force_n : float
-        A press starts at the first force sample above this [N] and ends when the force falls below
-        it; 0.02 N is four times the noise floor of the probe's sensor class.
+        A press lasts while the force exceeds this [N]; four times the noise of such sensors.
     hold_band : float
-        The hold is the longest run of samples within ``hold_band · force_n`` of the commanded force;
-        0.1 is four times such sensors' noise and tighter than the protocol's ``FORCE_MISMATCH_REL``.
+        The hold is the longest run within ``hold_band · force_n`` of the command; four times the noise.
     hold_min_s : float
         The shortest hold accepted [s]; 0.1 s gives a 30 Hz camera at least three frames.
     stamp_tolerance_s : float
-        A camera frame or transform farther than this in time from the moment wanted is not used [s];
-        0.05 s is 1.5 frame periods at 30 Hz, while a stalled stream leaves gaps of a second or more.
+        A frame or transform farther than this [s] from the moment wanted is not used; 1.5 frames.
     observation_time_s : float or None
-        When the observation's frame was taken, in seconds after the bag's start (its first camera or
-        force message); the nearest frame is taken. None: the first frame.
+        When the observation was taken [s after the bag's start]; None: the first frame.
     observation_frames : int
         Frames averaged for the observation, from the one picked (all before the first contact).
     workspace_lower, workspace_upper : (2,) float or None
@@ -163,22 +136,9 @@ def raw_config_file(bag: Path) -> Path:
 
 
 def load_raw_config(bag: Path, file: Path | None = None, **overrides: Any) -> RawBagConfig:
-    """The settings of the raw recording ``bag``.
-
-    Parameters
-    ----------
-    bag : Path
-    file : Path, optional
-        The settings YAML; default :func:`raw_config_file` of the bag, used when it exists.
-    **overrides
-        Settings given on the command line; they win over the file's. ``None`` values are left
-        out (an option not given).
-
-    Raises
-    ------
-    ConfigError
-        The file is not valid YAML, has an unknown key, or a value is refused (named by its key).
-    """
+    """The settings of the raw recording ``bag``: ``file`` (default :func:`raw_config_file`, used
+    when it exists), then the command line's ``overrides`` (None values left out); a refusal is a
+    ConfigError naming the file and key."""
     path = raw_config_file(bag) if file is None else file
     data: dict[str, Any] = {}
     if file is not None or path.is_file():

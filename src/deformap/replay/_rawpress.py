@@ -1,10 +1,6 @@
 """Presses found in a force stream: rise over the contact threshold, hold at the commanded force,
-release (``docs/robot.md``, "A bag as your robot records it").
-
-Pure arrays: the stream's times and force magnitudes in, one :class:`FoundPress` per press out.
-The force's magnitude finds the presses (it needs no frame); the normal component along the press
-direction, which needs the transforms, is taken per press by the reader.
-"""
+release (``docs/robot.md``). Pure arrays: times and force magnitudes in, one :class:`FoundPress`
+per press out."""
 
 from __future__ import annotations
 
@@ -18,20 +14,12 @@ __all__ = ["FoundPress", "find_presses"]
 
 @dataclass(frozen=True, kw_only=True)
 class FoundPress:
-    """One press of the force stream, as sample indices into it.
+    """One press, as sample indices into the force stream.
 
-    Parameters
-    ----------
-    index : int
-        The press's number (0-based, in time order).
-    start, end : int
-        The first sample over the contact threshold (first contact), and one past the last.
-    hold_start, hold_end : int
-        The hold (end exclusive): in the longest run of samples within the band around the
-        commanded force, from the first sample that reaches the run's mean force to the last;
-        both ``-1`` when the force never entered the band.
-    error : str or None
-        Why the press cannot be used (the force never reached the command, the hold was too short).
+    ``index`` numbers it (0-based, in time order); ``start`` is first contact and ``end`` one past the
+    last sample over the threshold. The hold ``[hold_start, hold_end)`` runs, in the longest run of
+    samples within the band around the commanded force, from the first sample reaching the run's mean
+    to the last (``-1`` when the force never entered the band). ``error`` says why it is unusable.
     """
 
     index: int
@@ -49,47 +37,16 @@ def _runs(mask: NDArray[np.bool_]) -> list[tuple[int, int]]:
                     strict=True))  # fmt: skip
 
 
-def find_presses(
-    times_ns: NDArray[np.int64],
-    force_n: NDArray[np.float64],
-    *,
-    commanded_n: float,
-    contact_n: float,
-    band: float,
-    hold_min_ns: int,
-    merge_ns: int,
-    topic: str,
-    origin_ns: int = 0,
-) -> list[FoundPress]:
-    """The presses of a force stream.
+def find_presses(times_ns: NDArray[np.int64], force_n: NDArray[np.float64], *, commanded_n: float,
+                 contact_n: float, band: float, hold_min_ns: int, merge_ns: int, topic: str,
+                 origin_ns: int = 0) -> list[FoundPress]:
+    """The presses of a force stream (``times_ns`` increasing, ``force_n`` magnitudes [N]), in
+    time order, a press that cannot be used carrying its error.
 
-    Parameters
-    ----------
-    times_ns : (n,) int
-        Sample times, increasing.
-    force_n : (n,) float
-        The force's magnitude at each sample [N].
-    commanded_n : float
-        The commanded force; the hold is within ``band · commanded_n`` of it.
-    contact_n : float
-        Contact threshold [N].
-    band : float
-    hold_min_ns : int
-        A run over the threshold shorter than this is noise (a spike) when it stays below the
-        commanded band, and a press too short to read (returned with its error) when it reaches
-        it; a hold shorter than this is refused.
-    merge_ns : int
-        Runs over the threshold closer than this in time are one press (noise around the
-        threshold at first contact).
-    topic : str
-        Names the stream in errors.
-    origin_ns : int
-        Times in errors are seconds after this one (the bag's start).
-
-    Returns
-    -------
-    list of FoundPress
-        In time order; a press with ``error`` set cannot be used and says why.
+    Runs over ``contact_n`` closer than ``merge_ns`` are one press; one shorter than ``hold_min_ns``
+    is a spike when it stays below the band ``commanded_n · (1 ± band)`` and a press too short when
+    it reaches it; a hold shorter than ``hold_min_ns`` is refused. ``topic`` names the stream and
+    times in errors are seconds after ``origin_ns``.
     """
     runs = _runs(force_n > contact_n)
     merged: list[list[int]] = []

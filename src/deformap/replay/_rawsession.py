@@ -1,19 +1,14 @@
-"""A raw robot recording opened as a :class:`~deformap.replay.RecordedSession` (form ``"raw"``).
-
-Its presses are found in the force stream when it is opened; each is read into a
-:class:`~deformap.environment.PressObservation` when asked for, as a session's pokes are, so the
-same mapper (:func:`~deformap.replay.map_session`) maps it and a press that cannot be used is
-skipped, named, on its own.
-"""
+"""A raw robot recording opened as a :class:`~deformap.replay.RecordedSession` of form ``"raw"``:
+its presses found when opened, each read when asked for, as a session's pokes are."""
 
 from __future__ import annotations
 
 from pathlib import Path
 
 from deformap._config import config_to_dict
-from deformap._validation import check_positive
+from deformap._validation import check_instance, check_path, check_positive
 from deformap.cloud.io import path_kind
-from deformap.errors import FileFormatError, InvalidArgumentError
+from deformap.errors import FileFormatError
 from deformap.replay._format import SESSION_FILE, SessionHeader
 from deformap.replay._rawbag import RawBagReader
 from deformap.replay._rawconfig import RawBagConfig
@@ -26,11 +21,8 @@ RAW_SUFFIXES = (".mcap", ".db3")
 
 
 def is_raw_bag(path: str | Path) -> bool:
-    """Whether ``path`` is a bag as a robot records it rather than a deformap session.
-
-    A ``.mcap`` or ``.db3`` file, or a rosbag2 folder (with ``metadata.yaml``) that has no
-    ``session.yaml``, is raw; a session folder or its ``session.yaml`` is not.
-    """
+    """Whether ``path`` is a bag as a robot records it: a ``.mcap`` or ``.db3`` file, or a rosbag2
+    folder (with ``metadata.yaml``) without ``session.yaml``."""
     p = Path(path)
     kind = path_kind(p)
     if kind == "file":
@@ -41,46 +33,19 @@ def is_raw_bag(path: str | Path) -> bool:
     return False
 
 
-def load_raw_bag(
-    path: str | Path,
-    config: RawBagConfig | None = None,
-    *,
-    default_force_n: float,
-    contact_gap_m: float = DEFAULT_CONTACT_GAP_M,
-) -> RecordedSession:
-    """Open a raw robot recording and find its presses.
+def load_raw_bag(path: str | Path, config: RawBagConfig | None = None, *, default_force_n: float,
+                 contact_gap_m: float = DEFAULT_CONTACT_GAP_M) -> RecordedSession:
+    """Open a raw robot recording (a ``.mcap`` / ``.db3`` file or a rosbag2 folder) and find its
+    presses: a session of form ``"raw"``, one poke per press.
 
-    Parameters
-    ----------
-    path : str or Path
-        The bag: a ``.mcap`` / ``.db3`` file or a rosbag2 folder.
-    config : RawBagConfig, optional
-        Its topics, frames and thresholds (default: ``RawBagConfig()``; see
-        :func:`~deformap.replay.load_raw_config` for the YAML beside the bag).
-    default_force_n : float
-        The commanded force when ``config.force_n`` is None (the run's ``exploration.force_n``).
-    contact_gap_m : float, metres
-        As for :func:`~deformap.replay.load_session`.
-
-    Returns
-    -------
-    RecordedSession
-        Form ``"raw"``, one poke per press found (a press that cannot be used is refused, naming
-        it, when read).
-
-    Raises
-    ------
-    FileFormatError
-        The bag is missing or unreadable, lacks a topic, has no press, or its observation frames
-        do not come before the first press.
+    ``config`` names its topics, frames and thresholds (default ``RawBagConfig()``; see
+    :func:`~deformap.replay.load_raw_config`); ``default_force_n`` is the commanded force when
+    ``config.force_n`` is None; ``contact_gap_m`` as for :func:`~deformap.replay.load_session`.
+    A bag missing or unreadable, lacking a topic or a press, or whose observation frames do not come
+    before the first press, is a FileFormatError.
     """
-    if not isinstance(path, (str, Path)):
-        raise InvalidArgumentError(
-            f"`path` must be a str or pathlib.Path; got {type(path).__name__}")
-    cfg = RawBagConfig() if config is None else config
-    if not isinstance(cfg, RawBagConfig):
-        raise InvalidArgumentError(f"`config` must be a RawBagConfig; got {type(cfg).__name__}")
-    bag = Path(path)
+    bag = check_path("path", path)
+    cfg = check_instance("config", RawBagConfig() if config is None else config, RawBagConfig)
     if path_kind(bag) == "missing":
         raise FileFormatError(f"{bag}: no such bag")
     force = cfg.commanded_force(check_positive("default_force_n", default_force_n))

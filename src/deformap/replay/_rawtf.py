@@ -1,10 +1,9 @@
 """The transforms of a raw recording (``/tf`` and ``/tf_static``), looked up at any time.
 
-Each ``geometry_msgs/msg/TransformStamped`` gives ``child2parent`` at its stamp. A lookup walks
-from each frame up to the root of its tree and composes the edges, each interpolated at the asked
-times: translation linearly, rotation by spherical linear interpolation of its quaternion
-(scipy's ``Slerp``), as ``tf2`` does. A time is answered only if a sample of every dynamic edge on
-the way lies within the tolerance of it; a static edge holds at all times.
+Each TransformStamped gives ``child2parent`` at its stamp. A lookup composes the edges from each
+frame up to their common ancestor, each interpolated at the times asked as ``tf2`` does
+(translation linearly, rotation by Slerp); a dynamic edge needs a sample within the tolerance of
+each time, a static one holds at all times.
 """
 
 from __future__ import annotations
@@ -19,8 +18,8 @@ from deformap.errors import FileFormatError
 
 __all__ = ["MAX_TRANSLATION_M", "TransformGap", "TransformTree"]
 
-#: The farthest a transform may move a frame [m]: beyond any robot's frame tree (a map frame in
-#: UTM coordinates holds a few 10⁶ m), so a larger or non-finite translation is a damaged message.
+#: The farthest [m] a transform may move a frame (a UTM map frame holds a few 10⁶ m): a larger
+#: or non-finite translation is a damaged message.
 MAX_TRANSLATION_M = 1e9
 
 
@@ -45,17 +44,9 @@ class _Series:
 
 
 class TransformTree:
-    """The frames of ``/tf`` and ``/tf_static`` and their transforms over time.
-
-    Parameters
-    ----------
-    topic : str
-        The dynamic topic's name, for messages (``"/tf"``).
-    tolerance_ns : int
-        Largest time between a wanted time and the nearest sample of a dynamic edge.
-    origin_ns : int
-        Times in messages are seconds after this one (the bag's start).
-    """
+    """The frames of ``/tf`` (``topic``, named in messages) and ``/tf_static`` over time;
+    ``tolerance_ns`` is the largest gap to a dynamic edge's nearest sample, and times in messages
+    are seconds after ``origin_ns``."""
 
     def __init__(self, topic: str, tolerance_ns: int, origin_ns: int = 0) -> None:
         self.topic = topic
@@ -154,15 +145,14 @@ class TransformTree:
 
     def lookup(self, target: str, source: str, times_ns: Any, *, what: str
                ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:  # fmt: skip
-        """``source2target`` at each time: rotations ``(n, 3, 3)`` and translations ``(n, 3)``.
-
-        ``p_target = R @ p_source + t``. ``what`` starts every refusal (the press and stream).
+        """``source2target`` at each time: rotations ``(n, 3, 3)`` and translations ``(n, 3)``,
+        ``p_target = R @ p_source + t``; ``what`` starts every refusal.
 
         Raises
         ------
         FileFormatError
-            A frame is unknown or the two are not connected; :class:`TransformGap` when a
-            dynamic edge has no sample within the tolerance of a time.
+            An unknown frame, or two frames not connected; :class:`TransformGap` when a dynamic edge has
+            no sample within the tolerance of a time.
         """
         times = np.atleast_1d(np.asarray(times_ns, dtype=np.int64))
         for frame in (target, source):

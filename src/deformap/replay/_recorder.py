@@ -12,23 +12,13 @@ __all__ = ["RecordingEnvironment"]
 
 
 class RecordingEnvironment:
-    """Pass every call through to ``env`` and keep each ``observe()`` and ``press()`` result.
-
-    The exploration loop drives it like any :class:`~deformap.environment.Environment`; afterwards
-    :attr:`observation` and :attr:`presses` hold exactly what the loop saw, ready for
-    :func:`~deformap.replay.write_session`.
-
-    Parameters
-    ----------
-    env : Environment
-        The environment to record (a simulated world or a robot).
-    """
+    """Pass every call through to ``env`` and keep each ``observe()`` and ``press()`` result,
+    ready for :func:`~deformap.replay.write_session`."""
 
     def __init__(self, env: Environment) -> None:
         if not isinstance(env, Environment):
             raise InvalidArgumentError(
-                f"`env` must implement the Environment protocol; got {type(env).__name__}"
-            )
+                f"`env` must implement the Environment protocol; got {type(env).__name__}")
         self._env = env
         self.observations: list[PointCloud] = []
         self.presses: list[PressObservation] = []

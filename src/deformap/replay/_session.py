@@ -1,10 +1,9 @@
 """A recorded session read back: ``load_session`` and ``RecordedSession``.
 
-A session is a folder holding ``session.yaml`` (see ``docs/recording-format.md``) and either one
-cloud file per observation (the folder form) or a ROS 2 bag (the bag form). Loading checks the
-whole ``session.yaml`` and the presence of the observation and the bag's topics; each poke is read,
-checked and turned into a :class:`~deformap.environment.PressObservation` only when asked for, so
-that one broken poke does not stop the others.
+A session is a folder of ``session.yaml`` (``docs/recording-format.md``) and either one cloud file
+per observation (folder form) or a ROS 2 bag (bag form). Loading checks the whole ``session.yaml``
+and opens the data; each poke is read and checked only when asked for, so that a broken poke is
+reported on its own.
 """
 
 from __future__ import annotations
@@ -17,7 +16,7 @@ from typing import Any
 import numpy as np
 
 from deformap._config import load_yaml
-from deformap._validation import check_int, check_positive
+from deformap._validation import check_int, check_path, check_positive
 from deformap.cloud import PointCloud, points_in_hull
 from deformap.cloud.io import path_kind
 from deformap.environment import PressObservation, TactileContact, Workspace
@@ -33,30 +32,16 @@ __all__ = ["DEFAULT_CONTACT_GAP_M", "RecordedSession", "check_contact_gap", "loa
 
 logger = logging.getLogger(__name__)
 
-#: A poke whose contact point lies farther than this from every surface point of its cloud (robot
-#: removed) is refused. The probe touches the surface, and the stick and hand hide at most a few
-#: centimetres around the tip, so genuine contacts have surface points well within 5 cm; a tip or a
-#: cloud in the wrong frame or units lands tens of centimetres (or metres) away.
+#: A poke whose contact point lies farther than this [m] from every surface point of its cloud
+#: is refused: the robot hides a few centimetres around the tip, while a tip or cloud in the
+#: wrong frame or units lands tens of centimetres away.
 DEFAULT_CONTACT_GAP_M = 0.05
 
 
 @dataclass(eq=False)
 class RecordedSession:
-    """A recorded session: its settings, and its observation and pokes read on demand.
-
-    Use :func:`load_session` to build one.
-
-    Attributes
-    ----------
-    path : Path
-        The session folder.
-    header : SessionHeader
-        Everything ``session.yaml`` says (form, units, frame, pokes' entries).
-    ground_truth : GroundTruth or None
-        Present for sessions recorded from a simulation.
-    contact_gap_m : float
-        See :data:`DEFAULT_CONTACT_GAP_M`.
-    """
+    """A recorded session: ``header`` (all ``session.yaml`` says), the optional ``ground_truth``,
+    and the observation and pokes read on demand (build one with :func:`load_session`)."""
 
     path: Path
     header: SessionHeader
@@ -85,22 +70,13 @@ class RecordedSession:
     def __len__(self) -> int:
         return len(self.header.pokes)
 
-    @property
-    def n_pokes(self) -> int:
-        return len(self)
-
     def observation(self) -> PointCloud:
         """The initial observation of the undisturbed surface, world frame, metres."""
         return self._reader.observation()
 
     def press_observation(self, index: int) -> PressObservation:
-        """Poke ``index`` (0-based, in recorded order) as the environment returned it.
-
-        Raises
-        ------
-        FileFormatError, ConfigError
-            Naming the file, key or topic of this poke and what is wrong with it.
-        """
+        """Poke ``index`` (0-based, in recorded order) as the environment returned it; a broken
+        poke raises FileFormatError or ConfigError naming its file, key or topic."""
         i = check_int("index", index, minimum=0)
         if i >= len(self):
             raise InvalidArgumentError(f"`index` must be < {len(self)} (the pokes); got {i}")
@@ -134,17 +110,13 @@ class RecordedSession:
             raise FileFormatError(
                 f"{where}: the contact point ({point[0]:.4g}, {point[1]:.4g}) m lies more than "
                 f"{self.contact_gap_m} m outside the workspace "
-                f"{self.workspace.lower}..{self.workspace.upper}"
-            )
+                f"{self.workspace.lower}..{self.workspace.upper}")
         check_contact_gap(obs, self.contact_gap_m, where)
 
 
 def check_contact_gap(obs: PressObservation, gap_m: float, where: str) -> None:
-    """Refuse a press whose contact point is farther than ``gap_m`` from every surface point.
-
-    Surface points are the press's cloud without the points inside the robot's hull. ``where``
-    starts the message (the file or poke).
-    """
+    """Refuse a press whose contact point lies farther than ``gap_m`` from every point of its
+    cloud outside the robot's hull; ``where`` starts the message."""
     point = obs.contact.contact_point
     pts = obs.cloud.points
     try:
@@ -156,8 +128,7 @@ def check_contact_gap(obs: PressObservation, gap_m: float, where: str) -> None:
         raise FileFormatError(
             f"{where}: the contact point {np.round(point, 4).tolist()} m is {gap:.3g} m from "
             f"the nearest surface point of the cloud (limit {gap_m} m); tip and "
-            "cloud are probably in different frames or units"
-        )
+            "cloud are probably in different frames or units")
 
 
 def _read_yaml(file: Path) -> Any:
@@ -176,37 +147,18 @@ def _session_file(path: Path) -> Path:
     raise FileFormatError(f"{path}: no such session folder or file")
 
 
-def load_session(
-    path: str | Path, *, contact_gap_m: float = DEFAULT_CONTACT_GAP_M
-) -> RecordedSession:
-    """Open a recorded session (folder or bag form) and check its ``session.yaml``.
+def load_session(path: str | Path, *, contact_gap_m: float = DEFAULT_CONTACT_GAP_M
+                 ) -> RecordedSession:  # fmt: skip
+    """Open a recorded session (its folder or ``session.yaml``) and check ``session.yaml``.
 
-    Parameters
-    ----------
-    path : str or Path
-        The session folder, or its ``session.yaml``.
-    contact_gap_m : float, metres
-        Refuse pokes whose contact point is farther than this from every surface point.
-
-    Returns
-    -------
-    RecordedSession
-        Pokes are read on demand with :meth:`RecordedSession.press_observation`.
-
-    Raises
-    ------
-    ConfigError
-        ``session.yaml`` is not valid YAML, has unknown or missing keys, or bad values.
-    FileFormatError
-        The observation file or the bag is missing, the bag lacks a topic, the ground truth is
-        unreadable.
+    Pokes are read on demand (:meth:`RecordedSession.press_observation`), each refused when its
+    contact point lies farther than ``contact_gap_m`` from every surface point. A ``session.yaml``
+    that is no valid YAML or has unknown, missing or bad keys is a ConfigError; a missing
+    observation or bag, a missing topic or an unreadable ground truth a FileFormatError.
     """
-    if not isinstance(path, (str, Path)):
-        raise InvalidArgumentError(
-            f"`path` must be a str or pathlib.Path; got {type(path).__name__}"
-        )
+    p = check_path("path", path)
     gap = check_positive("contact_gap_m", contact_gap_m)
-    file = _session_file(Path(path))
+    file = _session_file(p)
     data = _read_yaml(file)
     header = parse_session_yaml(data, file)
     reader = FolderReader(header) if header.form == "folder" else BagReader(header)

@@ -1,14 +1,9 @@
-"""Ground truth of a session recorded from a simulation: region labels and hardness on a grid.
-
-Stored as ``ground_truth.npz`` (never pickled) with ``xs`` (nx,), ``ys`` (ny,) cell centres in
-metres, ``labels`` (ny, nx) integers and ``hardness`` (ny, nx) newtons (``inf`` for a rigid region,
-``nan`` where no region is). A real recording has none, and ``deformap map`` then reports no
-ground-truth metrics.
-"""
+"""Ground truth of a session recorded from a simulation, ``ground_truth.npz`` (never pickled):
+``xs`` (nx,), ``ys`` (ny,) cell centres [m], ``labels`` (ny, nx) integers and ``hardness``
+(ny, nx) [N] (``inf`` rigid, ``nan`` no region)."""
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -16,7 +11,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from deformap._validation import check_array
+from deformap._validation import check_array, check_instance
 from deformap.cloud.io import load_npz_arrays, path_kind
 from deformap.errors import FileFormatError, InvalidArgumentError
 
@@ -25,16 +20,8 @@ __all__ = ["GroundTruth", "read_ground_truth", "write_ground_truth"]
 
 @dataclass(frozen=True, eq=False)
 class GroundTruth:
-    """Region labels and hardness on a regular grid, looked up at any points by nearest cell.
-
-    Parameters
-    ----------
-    xs : (nx,) float, metres, increasing
-    ys : (ny,) float, metres, increasing
-    labels : (ny, nx) int
-    hardness : (ny, nx) float, newtons
-        Constant over each label; ``inf`` for rigid, ``nan`` for no region (bare table).
-    """
+    """Region labels and hardness on a regular grid (``xs``, ``ys`` increasing), looked up by
+    nearest cell; ``hardness`` is constant over each label."""
 
     xs: NDArray[np.float64]
     ys: NDArray[np.float64]
@@ -51,8 +38,7 @@ class GroundTruth:
         if labels.shape != (ys.size, xs.size) or labels.dtype.kind not in "iu":
             raise InvalidArgumentError(
                 f"`labels` must be ({ys.size}, {xs.size}) integers; got shape {labels.shape} "
-                f"and dtype {labels.dtype}"
-            )
+                f"and dtype {labels.dtype}")
         hard = check_array("hardness", self.hardness, (ys.size, xs.size), what="newtons",
                            finite=False)  # fmt: skip
         if np.any(hard <= 0) or np.any(np.isneginf(hard)):
@@ -63,8 +49,7 @@ class GroundTruth:
             if not same:
                 raise InvalidArgumentError(
                     f"`hardness` must be constant over each label; label {label} has "
-                    f"{np.unique(values).size} values"
-                )
+                    f"{np.unique(values).size} values")
         for name, value in (("xs", xs), ("ys", ys), ("labels", labels.astype(np.int64)),
                             ("hardness", hard)):  # fmt: skip
             value.setflags(write=False)
@@ -89,19 +74,10 @@ class GroundTruth:
         iy, ix = self._cells(xs, ys)
         return self.hardness[np.ix_(iy, ix)]
 
-    def hardness_by_label(self) -> dict[int, float]:
-        """Hardness of each label (``math.inf`` for rigid, ``nan`` for none)."""
-        out = {}
-        for label in np.unique(self.labels):
-            value = float(self.hardness[self.labels == label][0])
-            out[int(label)] = math.inf if np.isposinf(value) else value
-        return out
-
 
 def write_ground_truth(path: str | Path, truth: GroundTruth) -> None:
     """Write ``truth`` to an NPZ archive (compressed, no pickle)."""
-    if not isinstance(truth, GroundTruth):
-        raise InvalidArgumentError(f"`truth` must be a GroundTruth; got {type(truth).__name__}")
+    check_instance("truth", truth, GroundTruth)
     with open(path, "wb") as fh:
         np.savez_compressed(fh, xs=truth.xs, ys=truth.ys, labels=truth.labels,
                             hardness=truth.hardness)  # fmt: skip

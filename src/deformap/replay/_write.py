@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 import yaml
 
-from deformap._validation import check_positive
+from deformap._validation import check_instance, check_positive
 from deformap.cloud import PointCloud
 from deformap.cloud.io import BAG_STORAGES, CLOUD_FORMATS, write_cloud
 from deformap.environment import PressObservation, Workspace
@@ -48,37 +48,23 @@ def _floats(values: Any) -> list[float]:
     return [float(v) for v in np.asarray(values, dtype=float).ravel()]
 
 
-def _check_inputs(
-    folder: Any,
-    workspace: Any,
-    observation: Any,
-    presses: Any,
-    tip_radius_m: Any,
-    format: Any,
-    cloud_format: Any,
-    ground_truth: Any,
-) -> tuple[Path, list[PressObservation], float]:
+def _check_inputs(folder: Any, workspace: Any, observation: Any, presses: Any, tip_radius_m: Any,
+                  format: Any, cloud_format: Any,
+                  ground_truth: Any) -> tuple[Path, list[PressObservation], float]:
     if not isinstance(folder, (str, Path)):
         raise InvalidArgumentError(f"`folder` must be a str or Path; got {type(folder).__name__}")
     out = Path(folder)
     if out.exists() and (not out.is_dir() or any(out.iterdir())):
         raise InvalidArgumentError(f"`folder` {out} exists and is not an empty folder")
-    if not isinstance(workspace, Workspace):
-        raise InvalidArgumentError(
-            f"`workspace` must be a Workspace; got {type(workspace).__name__}"
-        )
+    check_instance("workspace", workspace, Workspace)
     if not isinstance(observation, PointCloud) or len(observation) == 0:
         raise InvalidArgumentError("`observation` must be a non-empty PointCloud")
     if observation.frame != "world":
         raise InvalidArgumentError(
-            f"`observation` must be in frame 'world'; got {observation.frame!r}"
-        )
+            f"`observation` must be in frame 'world'; got {observation.frame!r}")
     presses = list(presses)
     for i, obs in enumerate(presses):
-        if not isinstance(obs, PressObservation):
-            raise InvalidArgumentError(
-                f"`presses[{i}]` must be a PressObservation; got {type(obs).__name__}"
-            )
+        check_instance(f"presses[{i}]", obs, PressObservation)
         if obs.cloud.frame != "world":
             raise InvalidArgumentError(f"`presses[{i}].cloud` must be in frame 'world'")
     radii = {obs.contact.tip_radius_m for obs in presses}
@@ -86,87 +72,43 @@ def _check_inputs(
         if len(radii) != 1:
             raise InvalidArgumentError(
                 "`tip_radius_m` is needed: the presses do not give exactly one tip radius "
-                f"(got {sorted(radii)})"
-            )
+                f"(got {sorted(radii)})")
         tip_radius_m = radii.pop()
     tip = check_positive("tip_radius_m", tip_radius_m)
     if radii - {tip}:
         raise InvalidArgumentError(
-            f"every press must use `tip_radius_m` {tip}; got {sorted(radii)}"
-        )
+            f"every press must use `tip_radius_m` {tip}; got {sorted(radii)}")
     if format not in SESSION_FORMATS:
         raise InvalidArgumentError(f"`format` must be one of {SESSION_FORMATS}; got {format!r}")
     if cloud_format not in CLOUD_FORMATS:
         raise InvalidArgumentError(
-            f"`cloud_format` must be one of {CLOUD_FORMATS}; got {cloud_format!r}"
-        )
+            f"`cloud_format` must be one of {CLOUD_FORMATS}; got {cloud_format!r}")
     if ground_truth is not None and not isinstance(ground_truth, GroundTruth):
         raise InvalidArgumentError(
-            f"`ground_truth` must be a GroundTruth or None; got {type(ground_truth).__name__}"
-        )
+            f"`ground_truth` must be a GroundTruth or None; got {type(ground_truth).__name__}")
     return out, presses, tip
 
 
-def write_session(
-    folder: str | Path,
-    *,
-    workspace: Workspace,
-    observation: PointCloud,
-    presses: Sequence[PressObservation],
-    tip_radius_m: float | None = None,
-    ground_truth: GroundTruth | None = None,
-    source: dict[str, Any] | None = None,
-    format: str = "folder",
-    cloud_format: str = "pcd",
-) -> Path:
-    """Write a session that :func:`load_session` reads back exactly.
+def write_session(folder: str | Path, *, workspace: Workspace, observation: PointCloud,
+                  presses: Sequence[PressObservation], tip_radius_m: float | None = None,
+                  ground_truth: GroundTruth | None = None, source: dict[str, Any] | None = None,
+                  format: str = "folder", cloud_format: str = "pcd") -> Path:
+    """Write a session that :func:`load_session` reads back exactly; returns its ``session.yaml``.
 
-    ``session.yaml`` is written last, with ``n_pokes`` and the ``sha256`` manifest of every file
-    written before it (``docs/recording-format.md``).
-
-    Parameters
-    ----------
-    folder : str or Path
-        A new (or empty) folder; it receives ``session.yaml`` and the data.
-    workspace : Workspace
-    observation : PointCloud
-        The initial observation, world frame, metres.
-    presses : sequence of PressObservation
-        In order; clouds, robot points and force–travel records are written in float64 and read
-        back bit for bit. Cloud colours are written when a cloud has them: exactly in NPZ, to 8
-        bits a channel in PCD, PLY and bags (exact for multiples of 1/255).
-    tip_radius_m : float, optional
-        Defaults to the presses' (which must agree).
-    ground_truth : GroundTruth, optional
-        Written to ``ground_truth.npz``.
-    source : dict, optional
-        Provenance copied into ``session.yaml`` (plain YAML data: scenario, seed, ...).
-    format : {"folder", "mcap", "sqlite3"}
-        Cloud files, or a ROS 2 bag in the ``bag`` sub-folder.
-    cloud_format : {"pcd", "ply", "npz"}
-        File type of the folder form's clouds (binary, float64).
-
-    Returns
-    -------
-    Path
-        The ``session.yaml`` written.
-
-    Notes
-    -----
-    The format keeps one robot hull per poke: a press given one hull per part is written with the
-    points of all its parts (a warning says so).
+    ``folder`` is new or empty. The ``observation`` and the ``presses`` (world frame, in order) are
+    written as float64 and read back bit for bit, colours exactly in NPZ and to 8 bits a channel in
+    PCD, PLY and bags; a press with one hull per part keeps its parts' common hull (with a warning).
+    ``tip_radius_m`` defaults to the presses' (which must agree); ``source`` is plain provenance data.
+    ``format`` ``"folder"`` writes cloud files of ``cloud_format``, ``"mcap"`` or ``"sqlite3"`` a ROS 2
+    bag in ``bag/``. ``session.yaml`` comes last, with ``n_pokes`` and every file's ``sha256``.
     """
     out, presses, tip = _check_inputs(folder, workspace, observation, presses, tip_radius_m,
                                       format, cloud_format, ground_truth)  # fmt: skip
     out.mkdir(parents=True, exist_ok=True)
-    doc: dict[str, Any] = {
-        "format": FORMAT_NAME,
-        "version": FORMAT_VERSION,
-        "units": "m",
-        "frame": "world",
-        "workspace": {"lower": list(workspace.lower), "upper": list(workspace.upper)},
-        "probe": {"tip_radius_m": tip},
-    }
+    doc: dict[str, Any] = {"format": FORMAT_NAME, "version": FORMAT_VERSION, "units": "m",
+                           "frame": "world",
+                           "workspace": {"lower": list(workspace.lower), "upper": list(workspace.upper)},
+                           "probe": {"tip_radius_m": tip}}
     if source:
         doc["source"] = dict(source)
     if ground_truth is not None:
@@ -200,8 +142,7 @@ def write_session(
         doc["bag"] = "bag"
         pokes = [
             {"stamp_ns": s, "target_xy": _floats(o.target_xy), "force_n": float(o.force_n)}
-            for s, o in zip(stamps, presses, strict=True)
-        ]
+            for s, o in zip(stamps, presses, strict=True)]
     # The count and the manifest come before the pokes: a file cut in its poke list keeps them.
     doc["n_pokes"] = len(pokes)
     doc["sha256"] = manifest_of(out, (p for p in out.rglob("*") if p.is_file()))

@@ -2,16 +2,15 @@
 
 Readers return clouds in metres and refuse what they cannot read faithfully (truncated or corrupt
 files, missing x/y/z, NaN points unless ``drop_nan=True``, empty clouds, clouds that look like
-millimetres unless ``units="mm"``) with a :class:`~deformap.errors.FileFormatError` naming the file.
-Every size a header declares is checked against the bytes present before anything is allocated,
-and a body larger than its header declares is refused, not cut. No file is read with pickle.
+millimetres unless ``units="mm"``) with one :class:`~deformap.errors.FileFormatError` naming the
+file. Every size a header declares is checked against the bytes present before anything is
+allocated, and a body larger than its header declares is refused, not cut. Nothing is unpickled.
 
-Formats: PCD (pypcd4), PLY (ascii and binary; numpy), NPZ (``points``, ``colors``; at most
-:data:`MAX_NPZ_BYTES` decompressed), and ROS 2 bags (sqlite3 and MCAP, through the optional
-``rosbags``, extra ``ros``) of ``sensor_msgs/msg/PointCloud2`` and
-``geometry_msgs/msg/WrenchStamped``. :func:`iter_bag_messages` is the one place a bag is read,
-:func:`bag_writer` the one place one is written. Colours (RGB in [0, 1]) are read from every
-format's usual fields and written whenever a cloud has them (``docs/recording-format.md``).
+Formats: PCD (pypcd4), PLY (numpy), NPZ (at most :data:`MAX_NPZ_BYTES` decompressed), and ROS 2
+bags (sqlite3 and MCAP, through the optional ``rosbags``, extra ``ros``) of PointCloud2 and
+WrenchStamped messages: :func:`iter_bag_messages` is the one bag reader, :func:`bag_writer` the
+one writer. Colours (RGB in [0, 1]) are read from every format's usual fields and written whenever
+a cloud has them (``docs/recording-format.md``).
 """
 
 from __future__ import annotations
@@ -46,41 +45,11 @@ from deformap.cloud.io._pointcloud2 import (
 from deformap.cloud.io._ros import ROS_DISTRO, typestore
 
 __all__ = [
-    "BAG_STORAGES",
-    "CLOUD_FORMATS",
-    "MAX_NPZ_BYTES",
-    "MM_EXTENT_THRESHOLD",
-    "PCD_ENCODINGS",
-    "PLY_FORMATS",
-    "ROS_DISTRO",
-    "UNITS",
-    "RawBagMessage",
-    "StampedCloud",
-    "WrenchSeries",
-    "array_to_pointcloud2",
-    "bag_error_text",
-    "bag_read_errors",
-    "bag_writer",
-    "fill_chunk_crcs",
-    "iter_bag_messages",
-    "load_npz_arrays",
-    "path_kind",
-    "pointcloud2_colors",
-    "pointcloud2_structured",
-    "pointcloud2_to_array",
-    "pointcloud2_to_cloud",
-    "read_bag_clouds",
-    "read_bag_static_transform",
-    "read_bag_wrenches",
-    "read_cloud",
-    "read_npz",
-    "read_pcd",
-    "read_ply",
-    "typestore",
-    "wrench_message",
-    "write_bag",
-    "write_cloud",
-    "write_npz",
-    "write_pcd",
-    "write_ply",
-]
+           "BAG_STORAGES", "CLOUD_FORMATS", "MAX_NPZ_BYTES", "MM_EXTENT_THRESHOLD", "PCD_ENCODINGS",
+           "PLY_FORMATS", "ROS_DISTRO", "UNITS", "RawBagMessage", "StampedCloud", "WrenchSeries",
+           "array_to_pointcloud2", "bag_error_text", "bag_read_errors", "bag_writer", "fill_chunk_crcs",
+           "iter_bag_messages", "load_npz_arrays", "path_kind", "pointcloud2_colors",
+           "pointcloud2_structured", "pointcloud2_to_array", "pointcloud2_to_cloud", "read_bag_clouds",
+           "read_bag_static_transform", "read_bag_wrenches", "read_cloud", "read_npz", "read_pcd",
+           "read_ply", "typestore", "wrench_message", "write_bag", "write_cloud", "write_npz",
+           "write_pcd", "write_ply"]

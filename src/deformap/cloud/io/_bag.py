@@ -1,9 +1,8 @@
-"""Typed messages of a ROS 2 bag: ``sensor_msgs/msg/PointCloud2`` topics read into
-:class:`~deformap.cloud.PointCloud`\\ s (in the world frame given a 4×4 ``cam2world``, or one
-composed from the bag's ``/tf_static``), ``geometry_msgs/msg/WrenchStamped`` topics into arrays.
+"""Typed messages of a ROS 2 bag: PointCloud2 topics read into clouds (in the world frame given a
+4×4 ``cam2world``, or one composed from the bag's ``/tf_static``), WrenchStamped topics into arrays.
 
-The bag is opened and read by :func:`~deformap.cloud.io._bag_reader.iter_bag_messages` (through
-the optional ``rosbags``, extra ``ros``; ROS itself is not needed); writing is in ``_bag_writer``.
+``path`` is the bag (a rosbag2 folder, ``.mcap`` or ``.db3``), read through
+:func:`~deformap.cloud.io.iter_bag_messages`.
 """
 
 from __future__ import annotations
@@ -30,17 +29,8 @@ from deformap.cloud.io._pointcloud2 import _to_cloud
 from deformap.cloud.io._ros import typestore
 from deformap.errors import FileFormatError, InvalidArgumentError
 
-__all__ = [
-    "CLOUD_TYPE",
-    "TF_STATIC_TOPIC",
-    "TF_TYPE",
-    "WRENCH_TYPE",
-    "StampedCloud",
-    "WrenchSeries",
-    "read_bag_clouds",
-    "read_bag_static_transform",
-    "read_bag_wrenches",
-]
+__all__ = ["CLOUD_TYPE", "TF_STATIC_TOPIC", "TF_TYPE", "WRENCH_TYPE", "StampedCloud",
+           "WrenchSeries", "read_bag_clouds", "read_bag_static_transform", "read_bag_wrenches"]
 
 CLOUD_TYPE = "sensor_msgs/msg/PointCloud2"
 WRENCH_TYPE = "geometry_msgs/msg/WrenchStamped"
@@ -50,20 +40,8 @@ TF_STATIC_TOPIC = "/tf_static"
 
 @dataclass(frozen=True, kw_only=True)
 class StampedCloud:
-    """One PointCloud2 message read from a bag.
-
-    Parameters
-    ----------
-    stamp_ns : int
-        The message header's time, nanoseconds.
-    log_time_ns : int
-        When the bag recorded it, nanoseconds.
-    cloud : PointCloud
-        Points in metres, in frame ``"world"`` when a transform was applied, else in the header's
-        frame.
-    n_dropped : int
-        Points with a NaN or infinite coordinate dropped (holes of an organised cloud).
-    """
+    """One PointCloud2 message read from a bag: header and log times [ns], the cloud (metres, in
+    ``"world"`` when transformed, else in the header's frame), and the NaN points dropped."""
 
     stamp_ns: int
     log_time_ns: int
@@ -73,19 +51,8 @@ class StampedCloud:
 
 @dataclass(frozen=True, kw_only=True)
 class WrenchSeries:
-    """A ``geometry_msgs/msg/WrenchStamped`` topic as arrays.
-
-    Parameters
-    ----------
-    stamp_ns : (n,) int64
-        Header times, nanoseconds.
-    force_n : (n, 3) float
-        Forces in newtons, in the sensor frame ``frame_id``.
-    torque_nm : (n, 3) float
-        Torques in newton-metres.
-    frame_id : str
-        The frame of the first message (all messages must share it).
-    """
+    """A WrenchStamped topic: ``stamp_ns`` (n,) header times, ``force_n`` and ``torque_nm`` (n, 3)
+    in the sensor frame ``frame_id`` all its messages share."""
 
     stamp_ns: NDArray[np.int64]
     force_n: NDArray[np.float64]
@@ -98,7 +65,7 @@ def _stamp_ns(header: Any) -> int:
 
 
 def _messages(path: Any, topic: str, msgtype: str) -> Iterator[tuple[int, Any]]:
-    """Yield (log time, deserialised message) of ``topic``; every failure names file and topic."""
+    """(log time, deserialised message) of ``topic``; every failure names file and topic."""
     if not isinstance(topic, str) or not topic:
         raise InvalidArgumentError(f"`topic` must be a non-empty str; got {topic!r}")
     _rosbag2()  # a missing extra is named for reading bags, before the typestore asks for it
@@ -108,8 +75,7 @@ def _messages(path: Any, topic: str, msgtype: str) -> Iterator[tuple[int, Any]]:
             msg = store.deserialize_cdr(raw.data, msgtype)
         except errors as exc:
             raise FileFormatError(
-                f"{Path(path)}: could not read topic {topic!r}: {bag_error_text(exc)}"
-            ) from exc
+                f"{Path(path)}: could not read topic {topic!r}: {bag_error_text(exc)}") from exc
         yield raw.log_time_ns, msg
 
 
@@ -130,22 +96,8 @@ def _transform_matrix(transform: Any) -> NDArray[np.float64]:
 def read_bag_static_transform(
     path: str | Path, source_frame: str, target_frame: str, *, topic: str = TF_STATIC_TOPIC
 ) -> NDArray[np.float64]:
-    """The 4×4 ``source2target`` transform composed from a bag's static transforms.
-
-    Parameters
-    ----------
-    path : str or Path
-        The bag (folder, ``.mcap`` or ``.db3``).
-    source_frame, target_frame : str
-        Frame names as in the messages (``"camera_depth_optical_frame"``, ``"world"``).
-    topic : str
-        The ``tf2_msgs/msg/TFMessage`` topic.
-
-    Returns
-    -------
-    source2target : (4, 4) float
-        Maps points in ``source_frame`` to ``target_frame``: ``p_t = T[:3, :3] p_s + T[:3, 3]``.
-    """
+    """The 4×4 ``source2target`` transform (``p_t = T[:3, :3] p_s + T[:3, 3]``)
+    composed from a bag's static transforms on ``topic``, between frames named as in the messages."""
     # Each TransformStamped gives child2parent; walk the tree in both directions.
     edges: dict[str, list[tuple[str, NDArray[np.float64]]]] = {}
     p = Path(path) if isinstance(path, (str, Path)) else path
@@ -173,40 +125,18 @@ def read_bag_static_transform(
     if target_frame not in seen:
         raise FileFormatError(
             f"{p}: {topic} does not connect frame {source_frame!r} to {target_frame!r} "
-            f"(frames: {sorted(edges)}); pass cam2world= instead"
-        )
+            f"(frames: {sorted(edges)}); pass cam2world= instead")
     return seen[target_frame]
 
 
-def read_bag_clouds(
-    path: str | Path,
-    topic: str,
-    *,
-    cam2world: Any = None,
-    world_frame: str = "world",
-    units: str = "m",
-) -> list[StampedCloud]:
-    """Read every ``sensor_msgs/msg/PointCloud2`` message of a topic.
+def read_bag_clouds(path: str | Path, topic: str, *, cam2world: Any = None,
+                    world_frame: str = "world", units: str = "m") -> list[StampedCloud]:
+    """Every PointCloud2 message of ``topic``, in the bag's order, as :class:`StampedCloud`.
 
-    Parameters
-    ----------
-    path : str or Path
-        The bag: a rosbag2 folder (with ``metadata.yaml``), or a single ``.mcap`` or ``.db3``.
-    topic : str
-    cam2world : None, (4, 4) float, or "tf_static"
-        ``None`` keeps each cloud in its header's frame; a matrix maps the clouds to the world
-        frame; ``"tf_static"`` composes that matrix from the bag's ``/tf_static`` for each
-        message's ``header.frame_id`` up to ``world_frame``.
-    world_frame : str
-        The target frame for ``"tf_static"``.
-    units : {"m", "mm"}
-        Units of the message coordinates; clouds that look like millimetres are refused as metres.
-
-    Returns
-    -------
-    list of StampedCloud
-        In the bag's order. NaN holes are dropped and counted in ``n_dropped``; a message with no
-        finite point is refused.
+    ``cam2world`` None keeps each cloud in its header's frame; a (4, 4) matrix maps them to the world
+    frame; ``"tf_static"`` composes it from the bag's ``/tf_static`` for each header's ``frame_id``
+    up to ``world_frame``. ``units`` are the coordinates'. NaN holes are dropped and counted; a
+    message with no finite point is refused.
     """
     scale = check_units(units)
     fixed = None
@@ -234,13 +164,7 @@ def read_bag_clouds(
 
 
 def read_bag_wrenches(path: str | Path, topic: str) -> WrenchSeries:
-    """Read a ``geometry_msgs/msg/WrenchStamped`` topic.
-
-    Returns
-    -------
-    WrenchSeries
-        Times, forces (N) and torques (N·m) in the sensor frame, in the bag's order.
-    """
+    """A ``geometry_msgs/msg/WrenchStamped`` topic as a :class:`WrenchSeries`, in the bag's order."""
     stamps, forces, torques, frames = [], [], [], set()
     for _, msg in _messages(path, topic, WRENCH_TYPE):
         stamps.append(_stamp_ns(msg.header))

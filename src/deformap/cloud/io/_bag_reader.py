@@ -1,10 +1,9 @@
 """The one ROS 2 bag reader: a bag (sqlite3 or MCAP) opened through the optional ``rosbags``
-package (extra ``ros``), its topics checked, its messages yielded raw in the bag's order.
+(extra ``ros``), its topics checked, its messages yielded raw in the bag's order.
 
-Before rosbags reads a file, what rosbags does not check is checked here: the CRC-32s an MCAP
-writer leaves over its summary and data sections (rosbags checks only each chunk's), and the
-per-topic message counts a sqlite3 bag's writer leaves in its ``metadata`` table (sqlite3 keeps
-no checksum). Whatever rosbags, its storage drivers or the CDR decoder raise on a damaged bag
+What rosbags does not check is checked first: the CRC-32s of an MCAP file's summary and data
+sections (rosbags checks only each chunk's), and the per-topic message counts in a sqlite3 bag's
+``metadata`` table. Whatever rosbags, its drivers or the CDR decoder raise on a damaged bag
 (:func:`bag_read_errors`) becomes one :class:`~deformap.errors.FileFormatError` naming the file.
 """
 
@@ -19,18 +18,12 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from deformap._validation import check_path
 from deformap.cloud.io._common import path_kind
 from deformap.errors import DeformapError, FileFormatError, InvalidArgumentError, missing_extra
 
-__all__ = [
-    "BAG_STORAGES",
-    "RawBagMessage",
-    "bag_error_text",
-    "bag_read_errors",
-    "check_db3_counts",
-    "check_mcap_crcs",
-    "iter_bag_messages",
-]
+__all__ = ["BAG_STORAGES", "RawBagMessage", "bag_error_text", "bag_read_errors",
+           "check_db3_counts", "check_mcap_crcs", "iter_bag_messages"]
 
 BAG_STORAGES = ("mcap", "sqlite3")
 
@@ -44,13 +37,9 @@ def _rosbag2() -> Any:
 
 
 def bag_read_errors() -> tuple[type[BaseException], ...]:
-    """What rosbags, its SQLite driver and the CDR decoder raise on a damaged bag.
-
-    Recent rosbags read sqlite3 bags through ``apsw`` (its ``CorruptError`` is not a
-    ``sqlite3.Error``); a corrupted length field can ask for an absurd allocation (MemoryError).
-    An MCAP chunk's compressed bytes are decompressed before its CRC is checked: damaged, they
-    raise the decompressor's own error (zstd's ``ZstdError``; lz4's is a ``RuntimeError``).
-    """
+    """What rosbags, its SQLite drivers (``apsw``'s errors included), the MCAP chunk
+    decompressors (zstd's ``ZstdError``, lz4's ``RuntimeError``) and the CDR decoder raise on a
+    damaged bag (a corrupted length may ask for an absurd allocation: MemoryError)."""
     from rosbags.serde import SerdeError
 
     errors: tuple[type[BaseException], ...] = (
@@ -66,22 +55,19 @@ def bag_read_errors() -> tuple[type[BaseException], ...]:
 
 
 def bag_error_text(exc: BaseException, limit: int = 200) -> str:
-    """``exc`` as ``"TypeName: message"`` on one line, the message cut at ``limit`` characters:
-    what a damaged bag's error says after the bag's name. rosbags passes on its drivers' and
-    parsers' messages as they come, some of several lines (a YAML parser's, pointing at the
-    column) that would break an error's one line.
+    """``exc`` as ``"TypeName: message"`` on one line, the message cut at ``limit`` characters.
 
-    :func:`bag_read_errors` takes ``RuntimeError`` for lz4's damaged-chunk error; its
-    subclasses ``NotImplementedError`` and ``RecursionError`` are a program's faults, not a bag's,
-    and are raised again here instead of being read as a damaged bag."""
+    ``NotImplementedError`` and ``RecursionError`` (``RuntimeError`` subclasses, a program's faults,
+    not a bag's) are raised again instead.
+    """
     if isinstance(exc, (NotImplementedError, RecursionError)):
         raise exc
     return f"{type(exc).__name__}: {' '.join(str(exc).split())[:limit]}"
 
 
 def _zstd_errors() -> tuple[type[BaseException], ...]:
-    """The ``ZstdError`` of the zstd module rosbags decompresses MCAP chunks with (the standard
-    library's from Python 3.14, else ``backports.zstd``), if it is there."""
+    """The ``ZstdError`` of the zstd module rosbags uses (``compression.zstd`` or
+    ``backports.zstd``), if it is there."""
     for name in ("compression.zstd", "backports.zstd"):
         try:
             module = importlib.import_module(name)
@@ -93,19 +79,9 @@ def _zstd_errors() -> tuple[type[BaseException], ...]:
 
 @dataclass(frozen=True)
 class RawBagMessage:
-    """One message of a bag, not yet deserialised.
-
-    Attributes
-    ----------
-    topic : str
-    log_time_ns : int
-        When the bag recorded it, nanoseconds.
-    data : bytes or memoryview
-        The CDR bytes (``typestore().deserialize_cdr(data, msgtype)`` decodes them); a view may
-        be valid only until the next message is read, so keep ``bytes(data)``.
-    number : int
-        Its place among its topic's messages in the bag's order, from 1 (as errors name it).
-    """
+    """One message of a bag, not yet deserialised: its ``topic``, when the bag logged it
+    [ns], its CDR ``data`` (a view valid only until the next message is read) and its ``number``
+    among its topic's messages, from 1."""
 
     topic: str
     log_time_ns: int
@@ -115,29 +91,16 @@ class RawBagMessage:
 
 def iter_bag_messages(path: Any, topics: Mapping[str, str],
                       optional: Mapping[str, str] | None = None) -> Iterator[RawBagMessage]:
-    """The messages of ``topics`` in a ROS 2 bag, in the bag's order: the one bag reader.
+    """The raw messages of ``topics`` (name → message type, at least one) in a ROS 2 bag
+    (a rosbag2 folder, ``.mcap`` or ``.db3``), in the bag's order.
 
-    Opens the bag (a rosbag2 folder, ``.mcap`` or ``.db3``) through rosbags, checks that each
-    topic is there and carries only its message type, and yields the raw messages. Whatever
-    rosbags or its storage drivers raise on a damaged bag (:func:`bag_read_errors`) becomes a
-    :class:`~deformap.errors.FileFormatError` that names the file.
-
-    Parameters
-    ----------
-    path : str or Path
-    topics : mapping of str to str
-        Topic name → message type (``"sensor_msgs/msg/PointCloud2"``); at least one.
-    optional : mapping of str to str, optional
-        Topics the bag may lack; when present, they must carry only their type, and their
-        messages are yielded with the others'.
+    Each topic must be there and carry only its type; ``optional`` topics may be missing. Whatever
+    rosbags raises on a damaged bag (:func:`bag_read_errors`) becomes a FileFormatError naming it.
     """
-    if not isinstance(path, (str, Path)):
-        raise InvalidArgumentError(
-            f"`path` must be a str or pathlib.Path; got {type(path).__name__}"
-        )
+    p = check_path("path", path)
     if not isinstance(topics, Mapping) or not topics:
         raise InvalidArgumentError(f"`topics` must be a non-empty mapping; got {topics!r}")
-    rosbag2, p = _rosbag2(), Path(path)
+    rosbag2 = _rosbag2()
     if path_kind(p) == "missing":
         raise FileFormatError(f"{p}: no such bag")
     if optional is not None and not isinstance(optional, Mapping):
@@ -161,14 +124,12 @@ def iter_bag_messages(path: Any, topics: Mapping[str, str],
                 if not conns:
                     raise FileFormatError(
                         f"{p}: bag has no topic {topic!r} (topics: {found}); expected one "
-                        f"carrying {msgtype}"
-                    )
+                        f"carrying {msgtype}")
                 wrong = [c.msgtype for c in conns if c.msgtype != msgtype]
                 if wrong:
                     raise FileFormatError(
                         f"{p}: topic {topic!r} carries {wrong[0] or repr(wrong[0])}, expected "
-                        f"{msgtype}"
-                    )
+                        f"{msgtype}")
             conns = [c for c in reader.connections if c.topic in wanted]
             counts: dict[str, int] = {}
             for conn, log_time, raw in reader.messages(connections=conns):
@@ -178,15 +139,12 @@ def iter_bag_messages(path: Any, topics: Mapping[str, str],
     except DeformapError:
         raise
     except errors as exc:
-        raise FileFormatError(
-            f"{p}: could not read {what}: {bag_error_text(exc)}"
-        ) from exc
+        raise FileFormatError(f"{p}: could not read {what}: {bag_error_text(exc)}") from exc
 
 
 def _check_row(path: Path, topic: str, number: int, log_time: Any, data: Any) -> None:
-    """A message's log time must be an integer and its data bytes. An sqlite3 bag stores any
-    type in any column: a number in ``data`` would otherwise be taken as that many zero bytes
-    (``bytes(10**12)`` allocates a terabyte), text as a string to encode."""
+    """Refuse a row whose log time is no integer or whose data is no bytes (sqlite3 stores any
+    type in any column: ``bytes(10**12)`` would allocate a terabyte)."""
     if not isinstance(data, (bytes, bytearray, memoryview)):
         what, value = "its data as bytes", data
     elif not isinstance(log_time, int) or isinstance(log_time, bool):
@@ -201,9 +159,7 @@ _MCAP_MAGIC = b"\x89MCAP0\r\n"
 _FOOTER = struct.Struct("<BQQQI")  # opcode 0x02, length 20, summary start, offsets start, CRC
 _DATA_END = struct.Struct("<BQI")  # opcode 0x0F, length 4, the data section's CRC
 _BLOCK = 1 << 20
-#: MCAP files whose CRCs were verified, a bag being read in passes: (path, inode, size, mtime,
-#: ctime) → None (a file rewritten in place changes its ctime too), the last
-#: :data:`_VERIFIED_KEPT` of them.
+#: The last MCAP files verified, as (path, inode, size, mtime, ctime), for bags read in passes.
 _VERIFIED: dict[tuple[str, int, int, int, int], None] = {}
 _VERIFIED_KEPT = 256
 
@@ -225,16 +181,13 @@ _DB3_METADATA_BYTES = 16 * 2**20
 
 def check_db3_counts(path: Path) -> None:
     """Compare each topic's messages in a sqlite3 bag with the count its writer left in the
-    bag's own ``metadata`` table (rosbag2 since Iron, and rosbags' writer, store the bag's
-    ``metadata.yaml`` there; rosbags counts the rows and does not read it). sqlite3 keeps no
-    checksum, so this is what tells a message row lost or repeated. A file that is no sqlite3
-    database, or one without that table (older bags), is not checked here.
+    bag's ``metadata`` table (rosbag2 since Iron; sqlite3 keeps no checksum, so this tells a row lost
+    or repeated). A file that is no sqlite3 database, or has no such table, is not checked here.
 
     Raises
     ------
     FileFormatError
-        A topic holds another number of messages than the metadata says, or the metadata is not
-        a rosbag2 metadata YAML: one line naming the file and what differs.
+        A topic's count differs from the metadata's, or the metadata is not rosbag2's YAML.
     """
     import yaml
 
@@ -281,17 +234,10 @@ def check_db3_counts(path: Path) -> None:
 
 
 def check_mcap_crcs(path: Path) -> None:
-    """Verify the CRC-32s an MCAP file's writer left in its footer (of the summary section: the
-    schemas, channels, chunk indexes and statistics a reader trusts) and in its ``DataEnd``
-    record (of the whole data section); rosbags checks only each chunk's. A CRC of zero (not
-    written) is not checked, nor is a file that is no MCAP or whose footer is damaged (the
-    reader refuses those itself).
-
-    Raises
-    ------
-    FileFormatError
-        A CRC does not match: one line naming the file, the section and both values.
-    """
+    """Verify the CRC-32s an MCAP file's writer left in its footer (over the summary
+    section) and its ``DataEnd`` record (over the data section). A zero CRC (not written), or a
+    file that is no MCAP or has a damaged footer (the reader refuses those), is not checked; a
+    mismatch is a FileFormatError naming the section and both values."""
     try:
         stat = path.stat()
     except OSError:

@@ -1,12 +1,8 @@
-"""Writing ROS 2 bags (sqlite3 or MCAP) of clouds, wrenches and static transforms.
+"""Writing ROS 2 bags (sqlite3 or MCAP) of clouds, wrenches and static transforms, for the tests
+and simulated recordings.
 
-Used by the tests and by simulated recordings, so that the bag-reading path runs on real files.
-
-MCAP chunks carry a CRC-32 of their records (the format's own integrity check, which rosbags'
-reader verifies when it is not zero); rosbags writes it as zero, so once its writer has closed
-the bag each chunk's CRC is filled in (:func:`fill_chunk_crcs`): a flipped byte in a stored cloud
-is then refused when read instead of being read as other data. sqlite3 bags have no such field;
-a session's manifest of SHA-256 digests covers both.
+rosbags writes each MCAP chunk's CRC-32 as zero; once its writer has closed the bag each CRC is
+filled in (:func:`fill_chunk_crcs`), so a flipped byte in a stored cloud is refused when read.
 """
 
 from __future__ import annotations
@@ -36,13 +32,12 @@ _CHUNK_CRC_AT = 24
 
 
 def fill_chunk_crcs(path: str | Path) -> int:
-    """Write each uncompressed chunk's CRC-32 into the MCAP file at ``path`` (where a writer left
-    it zero); returns how many were filled. A compressed chunk, or one whose CRC is set already,
-    is left as it is. The file is rewritten atomically.
+    """Write each uncompressed chunk's CRC-32 where a writer left it zero, rewriting the MCAP
+    file atomically; returns how many were filled.
 
-    Chunk record (MCAP specification): opcode ``0x06``, content length (u64), then message start
-    and end time and uncompressed size (u64 each), the uncompressed CRC (u32), the compression
-    (u32 length + name) and the records (u64 length + bytes); all little-endian.
+    A chunk record (MCAP specification): opcode ``0x06``, content length (u64), message start and end
+    time and uncompressed size (u64 each), the CRC (u32), the compression (u32 length + name) and the
+    records (u64 length + bytes); all little-endian.
     """
     data = bytearray(Path(path).read_bytes())
     if not data.startswith(_MCAP_MAGIC):
@@ -95,8 +90,7 @@ def _tf_message(transforms: Sequence[tuple[str, str, Any]]) -> Any:
 
 
 def wrench_message(stamp_ns: int, frame_id: str, force: Any, torque: Any) -> Any:
-    """A ``geometry_msgs/msg/WrenchStamped`` (rosbags message) of ``force`` (N) and ``torque``
-    (N·m), each ``(3,)``, stamped ``stamp_ns`` nanoseconds in frame ``frame_id``."""
+    """A rosbags ``WrenchStamped`` of ``force`` [N] and ``torque`` [N·m], each ``(3,)``."""
     types = typestore().types
     vec = types["geometry_msgs/msg/Vector3"]
     wrench = types["geometry_msgs/msg/Wrench"](force=vec(*map(float, force)),
@@ -106,20 +100,8 @@ def wrench_message(stamp_ns: int, frame_id: str, force: Any, torque: Any) -> Any
 
 @contextmanager
 def bag_writer(path: str | Path, storage: str = "mcap") -> Iterator[Any]:
-    """A rosbags ``Writer`` open on a new ROS 2 bag (rosbag2 version 9): the one bag writer.
-
-    Parameters
-    ----------
-    path : str or Path
-        The bag folder to create; it must not exist.
-    storage : {"mcap", "sqlite3"}
-
-    Yields
-    ------
-    rosbags.rosbag2.Writer
-        Add connections with ``typestore=typestore()`` and write serialised messages; the bag is
-        closed (its metadata written) when the block ends.
-    """
+    """A rosbags ``Writer`` on a new ROS 2 bag folder (rosbag2 version 9, ``storage`` "mcap" or
+    "sqlite3"): the one bag writer. The bag is closed and its chunk CRCs filled when the block ends."""
     rosbag2 = _rosbag2()
     if storage not in BAG_STORAGES:
         raise InvalidArgumentError(f"`storage` must be one of {BAG_STORAGES}; got {storage!r}")
@@ -133,31 +115,16 @@ def bag_writer(path: str | Path, storage: str = "mcap") -> Iterator[Any]:
         fill_chunk_crcs(mcap)
 
 
-def write_bag(
-    path: str | Path,
-    *,
-    storage: str = "mcap",
-    clouds: dict[str, Sequence[tuple[int, PointCloud]]] | None = None,
-    wrenches: dict[str, WrenchSeries] | None = None,
-    static_transforms: Sequence[tuple[str, str, Any]] = (),
-    cloud_dtype: str = "float32",
-) -> None:
-    """Write clouds, wrenches and static transforms to a new ROS 2 bag (rosbag2 version 9).
-
-    Parameters
-    ----------
-    path : str or Path
-        The bag folder to create; it must not exist.
-    storage : {"mcap", "sqlite3"}
-    clouds : dict of topic to sequence of (stamp_ns, PointCloud), optional
-        Written as ``sensor_msgs/msg/PointCloud2`` with ``header.frame_id = cloud.frame``.
-    wrenches : dict of topic to WrenchSeries, optional
-        Written as ``geometry_msgs/msg/WrenchStamped``.
-    static_transforms : sequence of (parent, child, (4, 4) child2parent)
-        Written as one ``tf2_msgs/msg/TFMessage`` on ``/tf_static`` at time 0.
-    cloud_dtype : {"float32", "float64"}
-        Storage of the cloud coordinates.
-    """
+def write_bag(path: str | Path, *, storage: str = "mcap",
+              clouds: dict[str, Sequence[tuple[int, PointCloud]]] | None = None,
+              wrenches: dict[str, WrenchSeries] | None = None,
+              static_transforms: Sequence[tuple[str, str, Any]] = (),
+              cloud_dtype: str = "float32") -> None:
+    """Write to a new ROS 2 bag folder (version 9, ``storage`` "mcap" or "sqlite3"): ``clouds``
+    (topic → (stamp_ns, PointCloud) pairs) as PointCloud2 in ``cloud.frame`` with coordinates as
+    ``cloud_dtype``, ``wrenches`` (topic → WrenchSeries) as WrenchStamped, and
+    ``static_transforms`` ((parent, child, 4×4 child2parent) triples) as one ``/tf_static``
+    TFMessage at time 0."""
     store = typestore()
     with bag_writer(path, storage) as writer:
         if static_transforms:

@@ -1,8 +1,7 @@
 """What every reader shares: path checks, the units rule, NaN handling, error wrapping.
 
-Readers turn whatever a broken file makes a parser raise into one
-:class:`~deformap.errors.FileFormatError` that names the file and what was wrong, so that callers
-(``deformap map`` skipping a broken poke) need to catch only the ``DeformapError`` family.
+Whatever a broken file makes a parser raise becomes one :class:`~deformap.errors.FileFormatError`
+naming the file, so callers catch only the ``DeformapError`` family.
 """
 
 from __future__ import annotations
@@ -20,59 +19,47 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from deformap._validation import check_path
 from deformap.cloud._pointcloud import PointCloud
 from deformap.errors import DeformapError, FileFormatError, InvalidArgumentError
 
-__all__ = [
-    "MM_EXTENT_THRESHOLD",
-    "UNITS",
-    "check_body_size",
-    "check_colors",
-    "check_units",
-    "finish_cloud",
-    "parse_errors",
-    "path_kind",
-    "readable_path",
-]
+__all__ = ["MM_EXTENT_THRESHOLD", "UNITS", "check_body_size", "check_colors", "check_units",
+           "finish_cloud", "pack_rgb", "parse_errors", "path_kind", "readable_path",
+           "unpack_rgb"]
 
 logger = logging.getLogger(__name__)
 
 #: Unit names accepted by the readers and the factor that turns them into metres.
 UNITS = {"m": 1.0, "mm": 1e-3}
 
-#: A cloud read as metres whose largest |coordinate| exceeds this many metres is taken to be in
-#: millimetres. A tabletop scene seen by a depth camera lies within a few metres of any sensible
-#: origin (consumer depth cameras stop at ~10 m), while the same scene in millimetres has
-#: coordinates in the hundreds. A millimetre cloud that spans less than 20 mm slips through; it is
-#: far smaller than any surface deformap maps.
+#: A cloud read as metres whose largest |coordinate| exceeds this is taken to be in millimetres:
+#: a tabletop scene lies within a few metres of any sensible origin, while in millimetres its
+#: coordinates reach the hundreds.
 MM_EXTENT_THRESHOLD = 20.0
 
-# What numpy, struct, zipfile, zlib, lzf and pydantic raise on malformed bytes. Anything else is a
-# bug of ours and must surface as such.
+# What numpy, struct, zipfile, zlib, lzf, pydantic and ast (a .npy header) raise on malformed
+# bytes; anything else is a bug of ours and must surface as such.
 _PARSE_ERRORS: tuple[type[BaseException], ...] = (
-    ValueError,
-    TypeError,
-    KeyError,
-    IndexError,
-    EOFError,
-    OverflowError,
-    MemoryError,
-    RuntimeError,
-    UnicodeDecodeError,
-    struct.error,
-    zipfile.BadZipFile,
-    zlib.error,
-    OSError,
-    SyntaxError,  # ast.literal_eval of a malformed .npy header
-    tokenize.TokenError,  # the same, when the header's brackets do not close
-)
+    ValueError, TypeError, KeyError, IndexError, EOFError, OverflowError, MemoryError,
+    RuntimeError, UnicodeDecodeError, struct.error, zipfile.BadZipFile, zlib.error, OSError,
+    SyntaxError, tokenize.TokenError)
 
-# Bytes of ascii numbers and their separators: a body made only of these is text.
+# Bytes of ascii numbers and separators. A binary body of at least _TEXT_MIN_BYTES made only of
+# them is an ascii body under a binary header: random float bits fall in the set with probability
+# 27/256 per byte, so 16 bytes of real binary data do with probability below 1e-15.
 _TEXT_BYTES = frozenset(b"0123456789+-.eEnaifNAIF \t\r\n")
-# A binary body at least this long and made only of those bytes is an ascii body under a binary
-# header: random float bits fall in that set with probability 27/256 per byte, so 16 bytes of real
-# binary data are all in it with probability below 1e-15.
 _TEXT_MIN_BYTES = 16
+
+
+def pack_rgb(colors: NDArray[np.float64]) -> NDArray[Any]:
+    """``0x00RRGGBB`` words of (n, 3) colours in [0, 1], 8 bits a channel."""
+    rgb = np.round(colors * 255).astype(np.uint32)
+    return (rgb[:, 0] << 16) | (rgb[:, 1] << 8) | rgb[:, 2]
+
+
+def unpack_rgb(words: NDArray[np.uint32]) -> NDArray[np.uint8]:
+    """(n, 3) uint8 R, G, B of ``0xAARRGGBB`` words (alpha ignored)."""
+    return ((words[:, None] >> np.array([16, 8, 0], dtype=np.uint32)) & 0xFF).astype(np.uint8)
 
 
 def check_units(units: Any) -> float:
@@ -82,64 +69,35 @@ def check_units(units: Any) -> float:
     return UNITS[units]
 
 
-def check_body_size(
-    path: Path,
-    what: str,
-    need: int,
-    body: bytes | memoryview | int,
-    *,
-    exact: bool = True,
-    text: bool = False,
-) -> None:
-    """Refuse a data section whose size disagrees with what its header declares.
+def check_body_size(path: Path, what: str, need: int, body: bytes | memoryview | int, *,
+                    exact: bool = True, text: bool = False) -> None:
+    """Refuse a data section of another size than the ``need`` bytes its header declares.
 
-    Called with the byte count the header implies *before* anything is allocated for the data, so
-    that a forged count cannot ask for gigabytes, a truncated file is refused and (``exact``) a count
-    lowered by corruption does not silently drop the surplus. Surplus ASCII whitespace is tolerated.
-
-    Parameters
-    ----------
-    path : Path
-        Named in the message.
-    what : str
-        The section and the header fields behind ``need`` (``"binary body of POINTS 50 × 24
-        bytes"``).
-    need : int
-        Bytes the header declares.
-    body : bytes or int
-        The bytes present for that section, or only their number (then any surplus is refused).
-    exact : bool
-        Refuse surplus bytes too (else only a shortfall).
-    text : bool
-        The section is text; a binary section made only of ascii numbers is refused as an ascii
-        body under a binary header.
+    Called before anything is allocated for the data, so a forged count cannot ask for gigabytes.
+    ``body`` is the bytes present (or only their number: then any surplus is refused); ``exact``
+    refuses surplus bytes that are not ASCII whitespace too; a ``text=False`` section made only
+    of ascii numbers is refused as an ascii body under a binary header. ``what`` names the
+    section in the message.
     """
     have = body if isinstance(body, int) else len(body)
     if (not text and not isinstance(body, int) and have >= _TEXT_MIN_BYTES
             and _TEXT_BYTES.issuperset(bytes(body[:4096]))):  # fmt: skip
         raise FileFormatError(
             f"{path}: {what}: expected {need} bytes of binary data, got {have} bytes of text "
-            "(an ascii body under a binary header?)"
-        )
+            "(an ascii body under a binary header?)")
     if have < need:
         raise FileFormatError(
             f"{path}: {what}: expected {need} bytes, the file holds {have}; the file is "
-            "truncated or the header's count is wrong"
-        )
+            "truncated or the header's count is wrong")
     if exact and have > need and (isinstance(body, int) or bytes(body[need:]).strip()):
         raise FileFormatError(
             f"{path}: {what}: expected {need} bytes, the file holds {have} ({have - need} "
-            "more); the header's count is too low or the file is corrupted"
-        )
+            "more); the header's count is too low or the file is corrupted")
 
 
 def path_kind(path: str | Path) -> str:
-    """``"file"``, ``"dir"``, ``"other"`` or ``"missing"``: what ``path`` names.
-
-    ``Path.is_file`` and its kin answer False for a missing path but raise OSError for a name the
-    system refuses (longer than 255 bytes, a parent without search permission); that is a
-    FileFormatError naming the path.
-    """
+    """``"file"``, ``"dir"``, ``"other"`` or ``"missing"``; a name the system refuses (too long,
+    no search permission) is a FileFormatError."""
     path = Path(path)
     try:
         if path.is_file():
@@ -153,11 +111,7 @@ def path_kind(path: str | Path) -> str:
 
 def readable_path(path: Any) -> Path:
     """Validate that ``path`` names an existing regular file."""
-    if not isinstance(path, (str, Path)):
-        raise InvalidArgumentError(
-            f"`path` must be a str or pathlib.Path; got {type(path).__name__}"
-        )
-    p = Path(path)
+    p = check_path("path", path)
     kind = path_kind(p)
     if kind == "missing":
         raise FileFormatError(f"{p}: no such file")
@@ -176,18 +130,12 @@ def parse_errors(path: Path, what: str) -> Iterator[None]:
     except _PARSE_ERRORS as exc:
         detail = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
         raise FileFormatError(
-            f"{path}: could not read {what}: {type(exc).__name__}: {detail[:200]}"
-        ) from exc
+            f"{path}: could not read {what}: {type(exc).__name__}: {detail[:200]}") from exc
 
 
 def check_colors(where: Path | str, colors: NDArray[Any], field: str) -> NDArray[np.float64]:
-    """``(n, 3)`` float64 colours in [0, 1] from a file's colour values, or a FileFormatError.
-
-    Integers are 8-bit channels, taken in [0, 255] and divided by 255; floats must already lie in
-    [0, 1]. A NaN, infinite or out-of-range value is refused with one line naming ``where``, the
-    colour ``field`` as the file names it (``"rgb"``, ``"red/green/blue"``) and the first bad point.
-    A constant, black or saturated colour is valid data.
-    """
+    """``(n, 3)`` float64 colours in [0, 1] from a file's integers in [0, 255] or floats in
+    [0, 1]; a NaN or out-of-range value is a FileFormatError naming ``field`` and the point."""
     raw = np.asarray(colors).reshape(-1, 3)
     kind = raw.dtype.kind
     if kind not in "iuf":
@@ -202,28 +150,18 @@ def check_colors(where: Path | str, colors: NDArray[Any], field: str) -> NDArray
         raise FileFormatError(
             f"{where}: colour field {field!r} of point {row} is ({shown}); {what} must lie in "
             f"[{low:g}, {high:g}] ({int(bad.sum())} of {len(values)} points are out of range "
-            "or NaN)"
-        )
+            "or NaN)")
     return values / 255.0 if kind in "iu" else values
 
 
-def finish_cloud(
-    path: Path | str,
-    xyz: NDArray[Any],
-    colors: NDArray[Any] | None,
-    extras: dict[str, NDArray[Any]],
-    *,
-    scale: float,
-    drop_nan: bool,
-    frame: str = "world",
-    color_field: str = "colors",
-) -> tuple[PointCloud, dict[str, NDArray[Any]]]:
-    """Apply the NaN policy and the units rule, and build the cloud.
+def finish_cloud(path: Path | str, xyz: NDArray[Any], colors: NDArray[Any] | None,
+                 extras: dict[str, NDArray[Any]], *, scale: float, drop_nan: bool,
+                 frame: str = "world", color_field: str = "colors"
+                 ) -> tuple[PointCloud, dict[str, NDArray[Any]]]:  # fmt: skip
+    """Apply the NaN policy, the colour check and the units rule, and build the cloud.
 
-    ``path`` names the source in messages (a file, or a bag with its topic and message index).
-    Rows with a NaN or infinite coordinate are refused, or dropped (with a warning in the log, and
-    from ``colors`` and ``extras`` alike) when ``drop_nan``. Empty results are refused. The colours
-    of the points kept are then checked by :func:`check_colors`, naming ``color_field``.
+    Rows with a NaN or infinite coordinate are refused, or with ``drop_nan`` dropped (logged)
+    from ``colors`` and ``extras`` too; an empty result is refused. ``path`` names the source.
     """
     # Widening a signalling NaN (a corrupted float32) raises "invalid"; NaN is handled just below.
     with np.errstate(invalid="ignore"):
@@ -236,11 +174,9 @@ def finish_cloud(
         if not drop_nan:
             raise FileFormatError(
                 f"{path}: {n_bad} of {xyz.shape[0]} points have a NaN or infinite x/y/z; "
-                "pass drop_nan=True to drop them"
-            )
+                "pass drop_nan=True to drop them")
         logger.warning(
-            "%s: dropped %d of %d points with NaN or infinite x/y/z", path, n_bad, xyz.shape[0]
-        )
+            "%s: dropped %d of %d points with NaN or infinite x/y/z", path, n_bad, xyz.shape[0])
         xyz = xyz[finite]
         colors = None if colors is None else colors[finite]
         extras = {k: v[finite] for k, v in extras.items()}
@@ -252,11 +188,9 @@ def finish_cloud(
     if scale == 1.0 and largest > MM_EXTENT_THRESHOLD:
         raise FileFormatError(
             f"{path}: coordinates reach {largest:.4g}, which looks like millimetres, not metres "
-            f"(limit {MM_EXTENT_THRESHOLD:g} m); pass units='mm' if the file is in millimetres"
-        )
-    xyz = xyz * scale
+            f"(limit {MM_EXTENT_THRESHOLD:g} m); pass units='mm' if the file is in millimetres")
     try:
-        cloud = PointCloud(xyz, colors, frame=frame)
+        cloud = PointCloud(xyz * scale, colors, frame=frame)
     except InvalidArgumentError as exc:
         raise FileFormatError(f"{path}: {exc}") from exc
     return cloud, extras

@@ -1,8 +1,8 @@
 """PCD files (ascii, binary, binary_compressed) through pypcd4.
 
-pypcd4 parses the header and the data; this module checks the header against the bytes that follow
-before pypcd4 allocates anything (a corrupted ``POINTS`` must not ask for terabytes), and checks
-what came back against the header (a truncated body must not become a shorter cloud).
+The header is checked against the bytes that follow before pypcd4 allocates anything (a corrupted
+``POINTS`` must not ask for terabytes), and what pypcd4 returns against the header (a truncated
+body must not become a shorter cloud).
 
 References
 ----------
@@ -20,13 +20,16 @@ from typing import Any, cast
 import numpy as np
 from numpy.typing import NDArray
 
+from deformap._validation import check_instance
 from deformap.cloud._pointcloud import PointCloud
 from deformap.cloud.io._common import (
     check_body_size,
     check_units,
     finish_cloud,
+    pack_rgb,
     parse_errors,
     readable_path,
+    unpack_rgb,
 )
 from deformap.errors import FileFormatError, InvalidArgumentError
 
@@ -52,23 +55,17 @@ def _split_header(data: bytes) -> tuple[list[str], int]:
 
 
 def _check_header_against_body(path: Path, meta: Any, body: bytes) -> None:
-    """Check every size the header declares against the body, before anything is allocated.
-
-    pypcd4 builds one numpy field per ``COUNT`` element and allocates ``POINTS`` records, so the
-    record size is computed here from ``SIZE`` × ``COUNT`` (Python integers) and checked against
-    the bytes present first: a ``COUNT 1000000000`` or a forged ``POINTS`` is refused at once.
-    """
+    """Check every size the header declares against the body, before pypcd4 allocates
+    ``POINTS`` records of ``SIZE`` × ``COUNT`` bytes."""
     n_fields = len(meta.fields)
     if not (len(meta.size) == len(meta.type) == len(meta.count) == n_fields):
         raise FileFormatError(
             f"{path}: header lists {n_fields} FIELDS but {len(meta.size)} SIZE, "
-            f"{len(meta.type)} TYPE and {len(meta.count)} COUNT entries"
-        )
+            f"{len(meta.type)} TYPE and {len(meta.count)} COUNT entries")
     if meta.points != meta.width * meta.height:
         raise FileFormatError(
             f"{path}: header says POINTS {meta.points} but WIDTH×HEIGHT is "
-            f"{meta.width}×{meta.height}"
-        )
+            f"{meta.width}×{meta.height}")
     if meta.points == 0:
         raise FileFormatError(f"{path}: header says POINTS 0: the cloud is empty")
     bad_size = [s for s in meta.size if s not in (1, 2, 4, 8)]
@@ -89,40 +86,30 @@ def _check_header_against_body(path: Path, meta: Any, body: bytes) -> None:
         return
     if len(body) < 8:
         raise FileFormatError(
-            f"{path}: {encoding} body: expected 8 bytes of sizes, the file holds {len(body)}"
-        )
+            f"{path}: {encoding} body: expected 8 bytes of sizes, the file holds {len(body)}")
     compressed, uncompressed = struct.unpack("<II", body[:8])
     # An LZF back-reference of 3 bytes expands to at most 264: a ratio above 88 is corrupt,
     # and checking it first keeps a forged size from allocating gigabytes.
     if uncompressed != need or uncompressed > 100 * compressed:
         raise FileFormatError(
             f"{path}: {what}: expected {need} uncompressed bytes, the size word says "
-            f"{uncompressed} (from {compressed} compressed)"
-        )
+            f"{uncompressed} (from {compressed} compressed)")
     check_body_size(path, f"{encoding} body of {compressed} compressed bytes + 8 size bytes",
                     compressed + 8, body)  # fmt: skip
 
 
-#: Colour fields a PCD may carry, in the order they are looked for.
-_PACKED, _SEPARATE = ("rgb", "rgba"), ("r", "g", "b")
-
-
-def _unpack(packed: NDArray[np.uint32]) -> NDArray[np.uint8]:
-    """(n, 3) uint8 R, G, B of ``0xAARRGGBB`` words (alpha ignored)."""
-    shifts = np.array([16, 8, 0], dtype=np.uint32)
-    return ((packed[:, None] >> shifts) & 0xFF).astype(np.uint8)
+_PACKED, _SEPARATE = ("rgb", "rgba"), ("r", "g", "b")  # colour fields, in the order looked for
 
 
 def _pcd_colors(path: Path, pc_data: NDArray[Any], meta: Any, body: bytes
                 ) -> tuple[NDArray[Any] | None, str, tuple[str, ...]]:  # fmt: skip
     """The file's colours (not yet checked), the name of their field(s) and the fields taken.
 
-    ``rgb`` (SIZE 4, TYPE F) holds the bits of ``0x00RRGGBB`` in a float, PCL's convention; as TYPE
-    U or I, or ``rgba`` (``0xAARRGGBB``), the word itself. PCL's ascii writer prints a float rgb's
-    bits as an unsigned integer even under TYPE F, so integer-valued floats in an ascii file are the
-    packed word (a float whose bits are ``0x00RRGGBB`` is < 1e-38, never an integer but 0); that
-    column is read again from ``body`` as float64, as float32 would round a word with an alpha
-    byte. Separate ``r``, ``g``, ``b`` fields are 8-bit integers or floats in [0, 1].
+    ``rgb`` (TYPE F) holds the bits of ``0x00RRGGBB`` in a float, PCL's convention; as TYPE U or
+    I, or ``rgba`` (``0xAARRGGBB``), the word itself. PCL's ascii writer prints a float rgb's
+    bits as an unsigned integer, so integer-valued floats in an ascii file are the packed word
+    (such bits as a float are < 1e-38), read again from ``body`` as float64 (float32 would round
+    a word with an alpha byte). Separate ``r``, ``g``, ``b`` are 8-bit integers or floats in [0, 1].
     """
     names = pc_data.dtype.names or ()
     field = next((c for c in _PACKED if c in names), None)
@@ -135,8 +122,7 @@ def _pcd_colors(path: Path, pc_data: NDArray[Any], meta: Any, body: bytes
         raise FileFormatError(
             f"{path}: colour field {field!r} must be one 4-byte word per point (packed "
             f"0x00RRGGBB); got {values.dtype.itemsize}-byte values, count "
-            f"{1 if values.ndim == 1 else values.shape[1]}"
-        )
+            f"{1 if values.ndim == 1 else values.shape[1]}")
     if values.dtype.kind == "f" and meta.data.value == "ascii":
         column = sum(meta.count[: meta.fields.index(field)])
         values = np.loadtxt(io.BytesIO(body), dtype=np.float64, usecols=column, ndmin=1,
@@ -145,43 +131,26 @@ def _pcd_colors(path: Path, pc_data: NDArray[Any], meta: Any, body: bytes
             row = int(np.argmax(~np.isfinite(values)))
             raise FileFormatError(
                 f"{path}: colour field {field!r} of point {row} is {values[row]}: an ascii file "
-                "holds the packed word as an integer"
-            )
+                "holds the packed word as an integer")
         if np.all(values == np.round(values)):
             if values.min() < 0 or values.max() > 0xFFFFFFFF:
                 raise FileFormatError(
                     f"{path}: colour field {field!r} holds {values.min():.0f} to "
-                    f"{values.max():.0f}; a packed word lies in [0, 2^32)"
-                )
-            return _unpack(values.astype(np.uint32)), field, (field,)
+                    f"{values.max():.0f}; a packed word lies in [0, 2^32)")
+            return unpack_rgb(values.astype(np.uint32)), field, (field,)
     word = values.dtype.str[0] + "u4"  # the same bytes as an unsigned word, NaN bits included
-    return _unpack(np.ascontiguousarray(values).view(word).astype(np.uint32)), field, (field,)
+    return unpack_rgb(np.ascontiguousarray(values).view(word).astype(np.uint32)), field, (field,)
 
 
-def read_pcd(
-    path: str | Path, *, units: str = "m", drop_nan: bool = False
-) -> tuple[PointCloud, dict[str, NDArray[Any]]]:
-    """Read a PCD file (ascii, binary or binary_compressed).
+def read_pcd(path: str | Path, *, units: str = "m", drop_nan: bool = False
+             ) -> tuple[PointCloud, dict[str, NDArray[Any]]]:  # fmt: skip
+    """Read a PCD file (ascii, binary or binary_compressed): the cloud, and the other per-point
+    fields as extras in the file's dtype (COUNT > 1 as pypcd4's ``name__0000``, ...).
 
-    Parameters
-    ----------
-    path : str or Path
-        The file.
-    units : {"m", "mm"}
-        Units of the file's coordinates; ``"mm"`` scales by 1e-3. A cloud read as metres whose
-        coordinates look like millimetres is refused (see ``MM_EXTENT_THRESHOLD``).
-    drop_nan : bool
-        Drop points with a NaN or infinite coordinate (logged) instead of refusing the file.
-
-    Returns
-    -------
-    cloud : PointCloud
-        ``x, y, z`` in metres, and colours from a packed ``rgb`` or ``rgba`` field, or from
-        ``r``, ``g``, ``b`` fields, when present (see ``_pcd_colors``); NaN or out-of-range
-        colours are refused, naming the field.
-    extras : dict of str to (n,) array
-        Every other per-point field, in the file's dtype (fields with COUNT > 1 as
-        ``name__0000``, ``name__0001``, ... as pypcd4 names them; padding fields left out).
+    ``units`` are the coordinates' (``"m"`` or ``"mm"``; metres that look like millimetres are
+    refused, ``MM_EXTENT_THRESHOLD``); ``drop_nan`` drops (and logs) points with a NaN or infinite
+    coordinate instead of refusing the file. Colours come from a packed ``rgb`` or ``rgba`` field or
+    from ``r``, ``g``, ``b``; a NaN or out-of-range colour is refused, naming the field.
     """
     from pypcd4 import PointCloud as PcdCloud
     from pypcd4.pypcd4 import MetaData
@@ -198,8 +167,7 @@ def read_pcd(
         pc_data = np.atleast_1d(PcdCloud.from_fileobj(cast(Any, io.BytesIO(data))).pc_data)
     if pc_data.shape[0] != meta.points:
         raise FileFormatError(
-            f"{p}: header says POINTS {meta.points} but the body holds {pc_data.shape[0]}"
-        )
+            f"{p}: header says POINTS {meta.points} but the body holds {pc_data.shape[0]}")
     names = pc_data.dtype.names or ()
     missing = [axis for axis in "xyz" if axis not in names]
     if missing:
@@ -210,36 +178,19 @@ def read_pcd(
     extras = {
         name: np.array(pc_data[name])
         for name in names
-        if name not in ("x", "y", "z", *taken) and not name.startswith(_PYPCD4_PADDING_PREFIX)
-    }
+        if name not in ("x", "y", "z", *taken) and not name.startswith(_PYPCD4_PADDING_PREFIX)}
     return finish_cloud(p, xyz, colors, extras, scale=scale, drop_nan=drop_nan,
                         color_field=color_field)  # fmt: skip
 
 
-def write_pcd(
-    path: str | Path,
-    cloud: PointCloud,
-    *,
-    encoding: str = "binary",
-    dtype: str = "float64",
-    extra_fields: dict[str, Any] | None = None,
-) -> None:
-    """Write a cloud to a PCD file.
+def write_pcd(path: str | Path, cloud: PointCloud, *, encoding: str = "binary",
+              dtype: str = "float64", extra_fields: dict[str, Any] | None = None) -> None:
+    """Write a cloud (metres) to a PCD file of ``encoding`` in ``PCD_ENCODINGS``.
 
-    Parameters
-    ----------
-    path : str or Path
-        Where to write (overwritten).
-    cloud : PointCloud
-        Points in metres; its colours, if any, go into a packed ``rgb`` field: float bits in
-        binary files (PCL's convention), an unsigned integer in ascii files.
-    encoding : {"ascii", "binary", "binary_compressed"}
-    dtype : {"float64", "float32"}
-        Storage type of x, y, z. float64 (the default) round-trips exactly in binary files
-        (pypcd4 prints ascii floats with 10 decimals, 1e-10 m); float32 is what most PCL tools
-        write and rounds to about 0.06 µm at 1 m.
-    extra_fields : dict of str to (n,) array, optional
-        More per-point fields, each a 1-D numeric array of the cloud's length.
+    Colours go into a packed ``rgb`` field: float bits in binary files (PCL's convention), an
+    unsigned integer in ascii. ``dtype`` (``"float64"`` or ``"float32"``) stores x, y, z; float64
+    by default as it round-trips exactly in binary files. ``extra_fields`` are more per-point
+    fields, 1-D numeric arrays of the cloud's length.
     """
     from pypcd4 import Encoding
     from pypcd4 import PointCloud as PcdCloud
@@ -252,8 +203,7 @@ def write_pcd(
     columns: list[NDArray[Any]] = [cloud.points[:, i].astype(dtype) for i in range(3)]
     names, types = ["x", "y", "z"], [np.dtype(dtype)] * 3
     if cloud.colors is not None:
-        rgb = np.round(cloud.colors * 255).astype(np.uint32)
-        packed = (rgb[:, 0] << 16) | (rgb[:, 1] << 8) | rgb[:, 2]
+        packed = pack_rgb(cloud.colors)
         # pypcd4 prints floats with "%.10f", which would turn packed-float bits into 0 in ascii.
         columns.append(packed if encoding == "ascii" else packed.view(np.float32))
         names.append("rgb")
@@ -266,12 +216,10 @@ def write_pcd(
     pc.save(Path(path), encoding=Encoding(encoding))
 
 
-def _check_cloud_and_extras(
-    cloud: Any, extra_fields: dict[str, Any] | None
-) -> tuple[PointCloud, dict[str, NDArray[Any]]]:
-    """Shared argument checks of the writers: a non-empty cloud and numeric 1-D extra fields."""
-    if not isinstance(cloud, PointCloud):
-        raise InvalidArgumentError(f"`cloud` must be a PointCloud; got {type(cloud).__name__}")
+def _check_cloud_and_extras(cloud: Any, extra_fields: dict[str, Any] | None
+                            ) -> tuple[PointCloud, dict[str, NDArray[Any]]]:  # fmt: skip
+    """The writers' checks: a non-empty cloud and numeric 1-D extra fields."""
+    check_instance("cloud", cloud, PointCloud)
     if len(cloud) == 0:
         raise InvalidArgumentError("`cloud` must hold at least one point; got an empty cloud")
     extras: dict[str, NDArray[Any]] = {}
@@ -281,12 +229,10 @@ def _check_cloud_and_extras(
         if not isinstance(name, str) or not name.isidentifier() or name in reserved:
             raise InvalidArgumentError(
                 f"`extra_fields` keys must be identifiers other than {sorted(reserved)}; "
-                f"got {name!r}"
-            )
+                f"got {name!r}")
         if arr.shape != (len(cloud),) or arr.dtype.kind not in "iuf" or arr.dtype == np.float16:
             raise InvalidArgumentError(
                 f"`extra_fields[{name!r}]` must be a ({len(cloud)},) numeric array; got shape "
-                f"{arr.shape} and dtype {arr.dtype}"
-            )
+                f"{arr.shape} and dtype {arr.dtype}")
         extras[name] = arr
     return cloud, extras

@@ -1,11 +1,9 @@
 """PLY files (ascii, binary_little_endian, binary_big_endian), read and written with numpy.
 
-The ``vertex`` element must carry ``x``, ``y`` and ``z``; ``red``, ``green``, ``blue`` become the
-cloud's colours and every other scalar vertex property comes back as an extra field. Other elements
-(faces, ...) are skipped when they follow the vertices, or, in binary files, when they precede them
-and have no list properties. In a binary file every byte after the header must belong to a declared
-element (the elements after the vertices are walked to their end): a vertex count lowered by a
-corruption is refused, not read as fewer points.
+The ``vertex`` element must carry ``x``, ``y``, ``z``; ``red``, ``green``, ``blue`` are the colours
+and every other scalar vertex property an extra field. Other elements are skipped when they follow
+the vertices, or, in binary files, precede them without list properties. In a binary file every
+byte after the header must belong to a declared element, so a lowered vertex count is refused.
 
 References
 ----------
@@ -37,12 +35,10 @@ __all__ = ["PLY_FORMATS", "read_ply", "write_ply"]
 
 PLY_FORMATS = ("ascii", "binary_little_endian", "binary_big_endian")
 
-_PLY_TYPES = {
-    "char": "i1", "int8": "i1", "uchar": "u1", "uint8": "u1",
-    "short": "i2", "int16": "i2", "ushort": "u2", "uint16": "u2",
-    "int": "i4", "int32": "i4", "uint": "u4", "uint32": "u4",
-    "float": "f4", "float32": "f4", "double": "f8", "float64": "f8",
-}  # fmt: skip
+_PLY_TYPES = {"char": "i1", "int8": "i1", "uchar": "u1", "uint8": "u1",
+              "short": "i2", "int16": "i2", "ushort": "u2", "uint16": "u2",
+              "int": "i4", "int32": "i4", "uint": "u4", "uint32": "u4",
+              "float": "f4", "float32": "f4", "double": "f8", "float64": "f8"}  # fmt: skip
 _NUMPY_TO_PLY = {"i1": "char", "u1": "uchar", "i2": "short", "u2": "ushort", "i4": "int",
                  "u4": "uint", "f4": "float", "f8": "double"}  # fmt: skip
 _COLOR_NAMES = ("red", "green", "blue")
@@ -113,30 +109,26 @@ def _read_vertices(path: Path, data: bytes) -> NDArray[Any]:
         if len(lines) > total:
             raise FileFormatError(
                 f"{path}: PLY header declares {total} element rows, the ascii body holds "
-                f"{len(lines)}; the counts are wrong or the file is corrupted"
-            )
+                f"{len(lines)}; the counts are wrong or the file is corrupted")
         skip = sum(e.count for e in elements[:index])
         rows = lines[skip : skip + vertex.count]
         if len(rows) < vertex.count:
             raise FileFormatError(
-                f"{path}: PLY header says {vertex.count} vertices, the file holds {len(rows)}"
-            )
+                f"{path}: PLY header says {vertex.count} vertices, the file holds {len(rows)}")
         if vertex.count == 0:
             return np.empty(0, dtype=dtype)
         table = np.loadtxt(io.StringIO("\n".join(rows)), dtype=np.float64, ndmin=2, comments=None)
         if table.shape[1] != len(dtype.names or ()):
             raise FileFormatError(
                 f"{path}: PLY vertex rows have {table.shape[1]} values, the header declares "
-                f"{len(dtype.names or ())} properties"
-            )
+                f"{len(dtype.names or ())} properties")
         return _fill_ascii(path, table, dtype)
     offset = body_start
     for element in elements[:index]:
         if element.has_list:
             raise FileFormatError(
                 f"{path}: PLY element {element.name!r} before the vertices has a list property; "
-                "cannot skip it in a binary file"
-            )
+                "cannot skip it in a binary file")
         offset += element.count * _vertex_dtype(path, element, fmt).itemsize
     # Every byte must belong to an element: a lowered vertex count must not drop points silently.
     need = vertex.count * dtype.itemsize
@@ -152,9 +144,9 @@ def _read_vertices(path: Path, data: bytes) -> NDArray[Any]:
 def _skip_binary_element(path: Path, data: bytes, offset: int, element: _Element, fmt: str) -> int:
     """Where the binary rows of ``element`` that start at ``offset`` end.
 
-    A row of fixed-size properties is skipped in one step. Rows with list properties are walked
-    with numpy when every row's lists have the first row's lengths (faces of a triangle mesh), and
-    row by row otherwise; a walk that runs past the end of the data stops there (truncated).
+    Fixed-size rows are skipped in one step; rows with lists with numpy when every row's lists have
+    the first row's lengths (a triangle mesh's faces), else row by row; a walk past the end of the
+    data stops there (truncated).
     """
     order = ">" if fmt == "binary_big_endian" else "<"
     if not element.has_list:
@@ -217,33 +209,15 @@ def _fill_ascii(path: Path, table: NDArray[np.float64], dtype: np.dtype[Any]) ->
             kind = _NUMPY_TO_PLY[dtype[name].str[1:]]
             raise FileFormatError(
                 f"{path}: PLY vertex property {name!r} is declared {kind}, but vertex {row} "
-                f"holds {float(column[row]):g}, which {kind} cannot hold"
-            )
+                f"holds {float(column[row]):g}, which {kind} cannot hold")
     return out
 
 
-def read_ply(
-    path: str | Path, *, units: str = "m", drop_nan: bool = False
-) -> tuple[PointCloud, dict[str, NDArray[Any]]]:
-    """Read the vertices of a PLY file (ascii or binary, either byte order).
-
-    Parameters
-    ----------
-    path : str or Path
-    units : {"m", "mm"}
-        Units of the file's coordinates (see :func:`read_pcd`).
-    drop_nan : bool
-        Drop points with a NaN or infinite coordinate (logged) instead of refusing the file.
-
-    Returns
-    -------
-    cloud : PointCloud
-        ``x, y, z`` in metres; colours from ``red``, ``green``, ``blue`` (integers taken in
-        [0, 255], floats in [0, 1]; one or two of the three, a NaN or an out-of-range value is
-        refused, naming the properties).
-    extras : dict of str to (n,) array
-        Every other vertex property, in native byte order.
-    """
+def read_ply(path: str | Path, *, units: str = "m", drop_nan: bool = False
+             ) -> tuple[PointCloud, dict[str, NDArray[Any]]]:  # fmt: skip
+    """Read the vertices of a PLY file (ascii or binary, either byte order), as :func:`read_pcd`
+    reads a PCD file: colours from ``red``, ``green``, ``blue`` (all three or none), the other vertex
+    properties as extras in native byte order."""
     scale = check_units(units)
     p = readable_path(path)
     with parse_errors(p, "the PLY file"):
@@ -252,15 +226,13 @@ def read_ply(
     missing = [axis for axis in "xyz" if axis not in names]
     if missing:
         raise FileFormatError(
-            f"{p}: PLY 'vertex' element has no property {missing[0]!r} (has: {list(names)})"
-        )
+            f"{p}: PLY 'vertex' element has no property {missing[0]!r} (has: {list(names)})")
     has_color = all(c in names for c in _COLOR_NAMES)
     partial = [c for c in _COLOR_NAMES if c in names]
     if partial and not has_color:
         raise FileFormatError(
             f"{p}: PLY 'vertex' element has colour properties {partial} but not "
-            f"{[c for c in _COLOR_NAMES if c not in names]}; a colour needs all three"
-        )
+            f"{[c for c in _COLOR_NAMES if c not in names]}; a colour needs all three")
     taken = {"x", "y", "z", *(_COLOR_NAMES if has_color else ())}
     # Widening a signalling NaN (a corrupted float) raises "invalid"; finish_cloud handles NaN.
     with np.errstate(invalid="ignore"):
@@ -272,25 +244,11 @@ def read_ply(
                         color_field="red/green/blue")  # fmt: skip
 
 
-def write_ply(
-    path: str | Path,
-    cloud: PointCloud,
-    *,
-    format: str = "binary_little_endian",
-    extra_fields: dict[str, Any] | None = None,
-) -> None:
-    """Write a cloud as the ``vertex`` element of a PLY file.
-
-    Parameters
-    ----------
-    path : str or Path
-        Where to write (overwritten).
-    cloud : PointCloud
-        x, y, z are written as ``double`` (exact round trip); colours as ``uchar`` red, green, blue.
-    format : {"ascii", "binary_little_endian", "binary_big_endian"}
-    extra_fields : dict of str to (n,) array, optional
-        More vertex properties (8-, 16-, 32-bit integers, float32 or float64).
-    """
+def write_ply(path: str | Path, cloud: PointCloud, *, format: str = "binary_little_endian",
+              extra_fields: dict[str, Any] | None = None) -> None:
+    """Write a cloud as the ``vertex`` element of a PLY file of ``format`` in ``PLY_FORMATS``:
+    x, y, z as ``double`` (exact round trip), colours as ``uchar``, ``extra_fields`` as more
+    properties (8- to 32-bit integers, float32 or float64)."""
     if format not in PLY_FORMATS:
         raise InvalidArgumentError(f"`format` must be one of {PLY_FORMATS}; got {format!r}")
     cloud, extras = _check_cloud_and_extras(cloud, extra_fields)
@@ -304,8 +262,7 @@ def write_ply(
         if code not in _NUMPY_TO_PLY:
             raise InvalidArgumentError(
                 f"`extra_fields[{name!r}]` has dtype {values.dtype}, which PLY cannot store "
-                f"(use one of {sorted(_NUMPY_TO_PLY)})"
-            )
+                f"(use one of {sorted(_NUMPY_TO_PLY)})")
         fields.append((name, values))
     dtype = np.dtype([(name, order + values.dtype.str[1:]) for name, values in fields])
     table = np.empty(len(cloud), dtype=dtype)

@@ -1,13 +1,13 @@
 """``sensor_msgs/msg/PointCloud2`` to and from arrays, for any field layout.
 
-A PointCloud2 is ``height`` rows of ``width`` points; each point is ``point_step`` bytes holding
-its fields at their ``offset``; rows start every ``row_step`` bytes (``>= width·point_step``: rows
-may be padded). Reading builds a numpy structured dtype with those offsets, so a 300,000-point
-message is viewed, not parsed field by field.
+A PointCloud2 is ``height`` rows of ``width`` points of ``point_step`` bytes, each field at its
+``offset``, rows every ``row_step`` bytes (rows may be padded). Reading views the data through a
+numpy structured dtype with those offsets. ``msg`` is a rosbags message or any object with its
+attributes (``data`` as bytes or uint8); ``where`` names it in errors.
 
 References
 ----------
-ROS 2 ``sensor_msgs/msg/PointCloud2`` and ``sensor_msgs/msg/PointField`` message definitions;
+ROS 2 ``sensor_msgs/msg/PointCloud2`` and ``sensor_msgs/msg/PointField``;
 ``sensor_msgs_py.point_cloud2`` (the reference reader).
 """
 
@@ -21,18 +21,12 @@ from numpy.typing import NDArray
 
 from deformap._validation import check_array, check_int, check_points
 from deformap.cloud._pointcloud import PointCloud
-from deformap.cloud.io._common import check_colors, check_units, finish_cloud
+from deformap.cloud.io._common import check_colors, check_units, finish_cloud, pack_rgb, unpack_rgb
 from deformap.cloud.io._ros import typestore
 from deformap.errors import FileFormatError, InvalidArgumentError
 
-__all__ = [
-    "array_to_pointcloud2",
-    "pointcloud2_colors",
-    "pointcloud2_structured",
-    "pointcloud2_to_array",
-    "pointcloud2_to_cloud",
-    "xyz_with_holes",
-]
+__all__ = ["array_to_pointcloud2", "pointcloud2_colors", "pointcloud2_structured",
+           "pointcloud2_to_array", "pointcloud2_to_cloud", "xyz_with_holes"]
 
 logger = logging.getLogger(__name__)
 
@@ -61,8 +55,7 @@ def _layout(msg: Any) -> tuple[np.dtype[Any], int, int, int, int]:
     if min(height, width, point_step, row_step) < 0:
         raise InvalidArgumentError(
             f"`msg` has a negative size: height={height}, width={width}, "
-            f"point_step={point_step}, row_step={row_step}"
-        )
+            f"point_step={point_step}, row_step={row_step}")
     names, formats, offsets = [], [], []
     for f in fields:
         code = _DATATYPES.get(int(f.datatype))
@@ -83,24 +76,13 @@ def _layout(msg: Any) -> tuple[np.dtype[Any], int, int, int, int]:
                       "itemsize": point_step})  # fmt: skip
     if height > 1 and row_step < width * point_step:
         raise InvalidArgumentError(
-            f"`msg` row_step {row_step} is shorter than width·point_step = {width * point_step}"
-        )
+            f"`msg` row_step {row_step} is shorter than width·point_step = {width * point_step}")
     return dtype, height, width, point_step, row_step
 
 
 def pointcloud2_structured(msg: Any) -> NDArray[Any]:
-    """View a PointCloud2's points as a structured array with one named field per PointField.
-
-    Parameters
-    ----------
-    msg : sensor_msgs/msg/PointCloud2
-        A rosbags message, or any object with the same attributes (``data`` as bytes or uint8).
-
-    Returns
-    -------
-    points : (height·width,) structured array
-        Fields in the message's byte order; padding between fields and rows skipped.
-    """
+    """``(height·width,)`` structured view of a PointCloud2's points, one field per PointField,
+    in the message's byte order (padding between fields and rows skipped)."""
     dtype, height, width, point_step, row_step = _layout(msg)
     data = _message_bytes(msg)
     n = height * width
@@ -116,8 +98,7 @@ def pointcloud2_structured(msg: Any) -> NDArray[Any]:
     if data.size < need:
         raise InvalidArgumentError(
             f"`msg` data holds {data.size} bytes but {height}×{width} points of {point_step} bytes "
-            f"(row_step {row_step}) need {need}"
-        )
+            f"(row_step {row_step}) need {need}")
     # a message holds height·row_step bytes: more is data the header no longer counts (its
     # height or width lowered), which reading would drop silently
     most = max(height * row_step, need)
@@ -129,31 +110,14 @@ def pointcloud2_structured(msg: Any) -> NDArray[Any]:
     if row_step == width * point_step or height == 1:
         return np.frombuffer(data, dtype=dtype, count=n)
     rows = np.lib.stride_tricks.as_strided(
-        data, shape=(height, width * point_step), strides=(row_step, 1), writeable=False
-    )
+        data, shape=(height, width * point_step), strides=(row_step, 1), writeable=False)
     return np.ascontiguousarray(rows).view(dtype).reshape(-1)
 
 
 def pointcloud2_to_array(msg: Any, *, with_count: bool = False) -> Any:
-    """``(n, 3)`` float64 x, y, z of a PointCloud2, with non-finite points dropped.
-
-    Parameters
-    ----------
-    msg : sensor_msgs/msg/PointCloud2
-        Any field layout: x, y, z as FLOAT32 or FLOAT64 at any offsets, padded points and rows,
-        either byte order. Points with a NaN or infinite coordinate (the holes of an organised
-        depth image, ``is_dense = False``) are dropped and counted; in a message that claims
-        ``is_dense = True`` they are refused.
-    with_count : bool
-        Also return how many points were dropped.
-
-    Returns
-    -------
-    points : (n, 3) float64
-        In the message's units and frame (``msg.header.frame_id``).
-    dropped : int
-        Only with ``with_count``.
-    """
+    """``(n, 3)`` float64 x, y, z (FLOAT32 or FLOAT64 at any offsets, either byte order) in the
+    message's units and frame, and with ``with_count`` the number of points dropped for a NaN or
+    infinite coordinate (the holes of an organised cloud; refused when ``is_dense``)."""
     xyz = xyz_with_holes(msg, pointcloud2_structured(msg))
     finite = np.isfinite(xyz).all(axis=1)
     dropped = int(xyz.shape[0] - np.count_nonzero(finite))
@@ -164,22 +128,17 @@ def pointcloud2_to_array(msg: Any, *, with_count: bool = False) -> Any:
 
 
 def xyz_with_holes(msg: Any, table: NDArray[Any]) -> NDArray[np.float64]:
-    """``(height·width, 3)`` float64 x, y, z of a viewed PointCloud2, NaN holes included.
-
-    Refuses missing or non-float x/y/z, and NaN or infinite points in a message that says
-    ``is_dense``.
-    """
+    """``(height·width, 3)`` float64 x, y, z of a viewed PointCloud2, NaN holes included;
+    missing or non-float x/y/z, and non-finite points when ``is_dense``, are refused."""
     fields = {f.name: f for f in msg.fields}
     for axis in "xyz":
         if axis not in fields:
             raise InvalidArgumentError(
-                f"`msg` has no field {axis!r} (fields: {[f.name for f in msg.fields]})"
-            )
+                f"`msg` has no field {axis!r} (fields: {[f.name for f in msg.fields]})")
         if int(fields[axis].datatype) not in _FLOAT_CODES or int(fields[axis].count) != 1:
             raise InvalidArgumentError(
                 f"`msg` field {axis!r} must be one FLOAT32 or FLOAT64; got datatype "
-                f"{fields[axis].datatype} with count {fields[axis].count}"
-            )
+                f"{fields[axis].datatype} with count {fields[axis].count}")
     xyz = np.empty((table.shape[0], 3))
     with np.errstate(invalid="ignore"):  # signalling NaNs in the holes widen to quiet ones
         for i, axis in enumerate("xyz"):
@@ -188,37 +147,17 @@ def xyz_with_holes(msg: Any, table: NDArray[Any]) -> NDArray[np.float64]:
         bad = int(np.count_nonzero(~np.isfinite(xyz).all(axis=1)))
         if bad:
             raise InvalidArgumentError(
-                f"`msg` says is_dense but {bad} of {xyz.shape[0]} points are NaN or infinite"
-            )
+                f"`msg` says is_dense but {bad} of {xyz.shape[0]} points are NaN or infinite")
     return xyz
 
 
-def array_to_pointcloud2(
-    points: Any,
-    *,
-    colors: Any = None,
-    frame_id: str = "world",
-    stamp_ns: int = 0,
-    dtype: str = "float32",
-) -> Any:
-    """Build a ``sensor_msgs/msg/PointCloud2`` (rosbags message) from points.
+def array_to_pointcloud2(points: Any, *, colors: Any = None, frame_id: str = "world",
+                         stamp_ns: int = 0, dtype: str = "float32") -> Any:
+    """An unorganised (height 1), dense, little-endian ``sensor_msgs/msg/PointCloud2``.
 
-    Parameters
-    ----------
-    points : (n, 3) float, metres
-    colors : (n, 3) float in [0, 1], optional
-        Packed into a FLOAT32 ``rgb`` field (the PCL/RViz convention).
-    frame_id : str
-        The header's frame.
-    stamp_ns : int
-        The header's time, in nanoseconds.
-    dtype : {"float32", "float64"}
-        Storage of x, y, z.
-
-    Returns
-    -------
-    msg : rosbags ``sensor_msgs__msg__PointCloud2``
-        An unorganised (height 1), dense, little-endian cloud.
+    ``points`` are (n, 3) metres stored as ``dtype`` (``"float32"`` or ``"float64"``); ``colors``,
+    (n, 3) in [0, 1], go into a packed FLOAT32 ``rgb`` field (the PCL/RViz convention); the header
+    gets ``frame_id`` and ``stamp_ns``.
     """
     pts = check_points("points", points, min_rows=0)
     stamp = check_int("stamp_ns", stamp_ns, minimum=0)
@@ -242,17 +181,14 @@ def array_to_pointcloud2(
     for i, a in enumerate("xyz"):
         table[a] = pts[:, i]
     if colors is not None:
-        rgb = np.round(cols * 255).astype(np.uint32)
-        table["rgb"] = (rgb[:, 0] << 16) | (rgb[:, 1] << 8) | rgb[:, 2]
+        table["rgb"] = pack_rgb(cols)
     header = types["std_msgs/msg/Header"](
         stamp=types["builtin_interfaces/msg/Time"](sec=stamp // 10**9, nanosec=stamp % 10**9),
-        frame_id=frame_id,
-    )
+        frame_id=frame_id)
     return types["sensor_msgs/msg/PointCloud2"](
         header=header, height=1, width=pts.shape[0], fields=fields, is_bigendian=False,
         point_step=table.dtype.itemsize, row_step=table.nbytes, data=table.view(np.uint8),
-        is_dense=True,
-    )  # fmt: skip
+        is_dense=True)
 
 
 def _packed_colors(where: str, table: NDArray[Any], field: str) -> NDArray[np.uint8]:
@@ -261,12 +197,9 @@ def _packed_colors(where: str, table: NDArray[Any], field: str) -> NDArray[np.ui
         raise FileFormatError(
             f"{where}: colour field {field!r} must be one FLOAT32 or UINT32 word per point "
             f"(packed 0x00RRGGBB); got {column.dtype.itemsize}-byte {column.dtype.kind!r} values, "
-            f"count {1 if column.ndim == 1 else column.shape[1]}"
-        )
+            f"count {1 if column.ndim == 1 else column.shape[1]}")
     # the word's bits in the message's byte order; as a float they may be NaN (an alpha byte)
-    word = np.ascontiguousarray(column).view(column.dtype.str[0] + "u4").astype(np.uint32)
-    shifts = np.array([16, 8, 0], dtype=np.uint32)
-    return ((word[:, None] >> shifts) & 0xFF).astype(np.uint8)
+    return unpack_rgb(np.ascontiguousarray(column).view(column.dtype.str[0] + "u4").astype(np.uint32))
 
 
 def _separate_colors(where: str, table: NDArray[Any], present: list[str]) -> NDArray[Any]:
@@ -275,8 +208,7 @@ def _separate_colors(where: str, table: NDArray[Any], present: list[str]) -> NDA
             kinds <= {"u1", "f4", "f8"}):  # fmt: skip
         raise FileFormatError(
             f"{where}: colour fields r, g, b must be all three, one UINT8 or FLOAT32 each, of "
-            f"one type; got {[(c, table[c].dtype.str[1:], table[c].shape[1:]) for c in present]}"
-        )
+            f"one type; got {[(c, table[c].dtype.str[1:], table[c].shape[1:]) for c in present]}")
     return np.column_stack([table[c] for c in present])
 
 
@@ -284,27 +216,11 @@ def pointcloud2_colors(msg: Any, *, where: str = "PointCloud2", table: Any = Non
                        valid: Any = None) -> NDArray[np.float64] | None:  # fmt: skip
     """``(height·width, 3)`` float64 colours in [0, 1] of a PointCloud2, or None without any.
 
-    The layouts ROS drivers publish are read: ``rgb`` as a FLOAT32 (realsense, Azure Kinect,
-    OpenNI, PCL's ``PointXYZRGB``) or UINT32 whose bits are ``0x00RRGGBB``, ``rgba`` as a UINT32
-    or FLOAT32 ``0xAARRGGBB`` (alpha ignored), or separate ``r``, ``g``, ``b`` fields, UINT8 (in
-    [0, 255]) or FLOAT32 (in [0, 1]). A packed word is read for its bits, never its float value.
-
-    Parameters
-    ----------
-    msg : sensor_msgs/msg/PointCloud2
-    where : str
-        Names the message in errors.
-    table : structured array, optional
-        ``pointcloud2_structured(msg)``, when the caller already has it.
-    valid : (height·width,) bool, optional
-        The points whose colours count (the finite ones); the others' rows are NaN and their
-        colour is not checked (a NaN hole drops its colour too). Default every point.
-
-    Raises
-    ------
-    FileFormatError
-        Naming ``where`` and the field: a colour field of another type or count, only some of
-        ``r``, ``g``, ``b``, or a NaN or out-of-range colour on a valid point.
+    Read from ``rgb`` (FLOAT32 or UINT32 ``0x00RRGGBB``, read for its bits: realsense, Azure Kinect,
+    PCL), ``rgba`` (``0xAARRGGBB``, alpha ignored) or ``r``, ``g``, ``b`` (UINT8 in [0, 255] or
+    FLOAT32 in [0, 1]). ``table`` is ``pointcloud2_structured(msg)`` when the caller has it; only
+    the ``valid`` points' colours (default all) are checked, the others' rows are NaN. Another field
+    type or count, only some of ``r``, ``g``, ``b``, or a bad colour is a FileFormatError.
     """
     table = pointcloud2_structured(msg) if table is None else table
     names = table.dtype.names or ()
@@ -339,30 +255,11 @@ def _to_cloud(msg: Any, where: str, scale: float, frame: str, colors: bool
 
 def pointcloud2_to_cloud(msg: Any, *, where: str, units: str = "m", frame: str | None = None,
                          colors: bool = True) -> tuple[PointCloud, int]:
-    """A deserialised ``sensor_msgs/msg/PointCloud2`` as a :class:`~deformap.cloud.PointCloud`.
+    """A PointCloud2 as a :class:`~deformap.cloud.PointCloud` under the file readers' rules,
+    and the number of points dropped for a non-finite coordinate.
 
-    The rules of the file readers apply: NaN or infinite points (the holes of an organised cloud)
-    are dropped and counted, an empty cloud and coordinates that look like millimetres read as
-    metres are refused.
-
-    Parameters
-    ----------
-    msg : rosbags PointCloud2 message
-    where : str
-        Names the message in errors (``"run.mcap [/camera message 3]"``).
-    units : {"m", "mm"}
-        Units of the coordinates.
-    frame : str, optional
-        The cloud's frame name; default the header's ``frame_id`` (``"sensor"`` when empty).
-    colors : bool
-        Read the message's colours when it has them (:func:`pointcloud2_colors`).
-
-    Returns
-    -------
-    cloud : PointCloud
-        Points in metres, with colours when the message has them and ``colors``.
-    n_dropped : int
-        Points dropped for a non-finite coordinate.
+    ``units`` are the coordinates'; ``frame`` defaults to the header's ``frame_id`` (``"sensor"``
+    when empty); ``colors`` reads the message's colours (:func:`pointcloud2_colors`).
     """
     scale = check_units(units)
     name = (msg.header.frame_id or "sensor") if frame is None else frame
