@@ -9,7 +9,6 @@ Shared parameters, in metres (or the units of the modelled value): ``length_scal
 
 from __future__ import annotations
 
-from deformap.gp._exact import cholesky_with_jitter
 from deformap.gp._field import AUTO_EXACT_MAX_POINTS, GaussianRandomField
 from deformap.gp._hyper import (
     GPHyperparameters,
@@ -26,7 +25,6 @@ __all__ = [
     "GaussianRandomField",
     "PosteriorDesign",
     "apply_smoother",
-    "cholesky_with_jitter",
     "default_bounds",
     "fit_hyperparameters",
     "grid_points",
