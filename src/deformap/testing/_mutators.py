@@ -54,14 +54,15 @@ def kinds_of(reader: str) -> tuple[str, ...]:
     return KINDS.get(reader) or KINDS[reader.split("-")[0]]
 
 
-
-# ----------------------------------------------------------------------------- files
-
-
 def _flip(data: bytes, rng: np.random.Generator) -> bytes:
-    out = bytearray(data)
     for _ in range(int(rng.integers(1, 5))):
-        out[int(rng.integers(len(out)))] ^= 1 << int(rng.integers(8))
+        data = _flip_at(data, int(rng.integers(len(data))), rng)
+    return data
+
+
+def _flip_at(data: bytes, at: int, rng: np.random.Generator) -> bytes:
+    out = bytearray(data)
+    out[at] ^= 1 << int(rng.integers(8))
     return bytes(out)
 
 
@@ -90,8 +91,8 @@ def _header_end(data: bytes) -> int:
 
 
 def _header(data: bytes, rng: np.random.Generator) -> bytes:
-    """Edit one header line: a token replaced (a number, or another word of the header), the
-    line dropped or repeated."""
+    """One header line's token replaced (a number, another word of the header), or the line
+    dropped or repeated."""
     end = _header_end(data)
     lines = data[:end].split(b"\n")
     i = int(rng.integers(len(lines)))
@@ -143,12 +144,7 @@ def _npz_member(data: bytes, rng: np.random.Generator, kind: str) -> bytes:
         for name in names:
             raw = src.read(name)
             if name == victim:
-                if kind == "npy-header":
-                    raw = _header_npy(raw, rng)
-                elif kind == "shape":
-                    raw = _shape_npy(raw, rng)
-                else:
-                    raw = FILE_MUTATORS[kind](raw, rng)
+                raw = {"npy-header": _header_npy, "shape": _shape_npy, **FILE_MUTATORS}[kind](raw, rng)
             dst.writestr(name, raw)
     return buf.getvalue()
 
@@ -170,9 +166,6 @@ def _shape_npy(raw: bytes, rng: np.random.Generator) -> bytes:
            b"-1, 3", b"10000000000000, 3"][int(rng.integers(9))]  # fmt: skip
     padded = match.group(0).replace(match.group(1), new)
     return raw.replace(match.group(0), padded, 1)
-
-
-# ----------------------------------------------------------------------------- sessions
 
 
 def _yaml_edit(text: str, rng: np.random.Generator) -> str:
@@ -220,11 +213,9 @@ def mutate_session(template: Path, out: Path, kind: str, rng: np.random.Generato
         os.symlink(outside, victim)
     else:
         victim = data_files[int(rng.integers(len(data_files)))]
-        name = ("flip", "truncate", "extend", "header", "count")[int(rng.integers(5))]
+        name = tuple(FILE_MUTATORS)[int(rng.integers(5))]
         victim.write_bytes(FILE_MUTATORS[name](victim.read_bytes(), rng))
 
-
-# ----------------------------------------------------------------------------- raw bags
 
 _MCAP_MAGIC = b"\x89MCAP0\r\n"
 
@@ -248,12 +239,6 @@ def _mcap_record(data: bytes, rng: np.random.Generator) -> bytes:
     if choice < 0.8:
         return data[:start] + data[end:]
     return data[:end] + data[start:]
-
-
-def _flip_at(data: bytes, at: int, rng: np.random.Generator) -> bytes:
-    out = bytearray(data)
-    out[at] ^= 1 << int(rng.integers(8))
-    return bytes(out)
 
 
 def _mcap_message(data: bytes, rng: np.random.Generator, kind: str) -> bytes:
