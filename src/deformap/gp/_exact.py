@@ -51,8 +51,7 @@ def cholesky_with_jitter(matrix: Array, *, jitter: float, max_jitter: float, wha
     raise NotPositiveDefiniteError(
         f"{what} is not positive definite even with jitter {max_jitter:g} × σe² added to its "
         "diagonal; increase `noise_std`, check for duplicate or nearly coincident points, or raise "
-        "`max_jitter`"
-    )
+        "`max_jitter`")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -73,8 +72,7 @@ def fit_exact(xy: Array, resid: Array, noise_var: Array, *, length_scale: float,
     kmat = _se(xy, xy, length_scale)
     kmat[np.diag_indices_from(kmat)] += noise_var / s2
     factor, used = cholesky_with_jitter(
-        kmat, jitter=jitter, max_jitter=max_jitter, what="the data covariance K + σn²I"
-    )
+        kmat, jitter=jitter, max_jitter=max_jitter, what="the data covariance K + σn²I")
     alpha = sla.cho_solve(factor, resid, check_finite=False)
     # The factor is of K/σe²: log|K| = log|K̂| + n log σe², and yᵀK⁻¹y = yᵀK̂⁻¹y / σe².
     n = resid.size

@@ -31,8 +31,8 @@ _LOG = logging.getLogger(__name__)
 #: cost follows the extent over σ_w while the exact fit grows as n³.
 AUTO_EXACT_MAX_POINTS = 1000
 _METHODS = ("auto", "exact", "grid")
-#: Range of every hyperparameter and per-point noise: their squares and ratios then stay far
-#: inside double precision, where the covariance neither overflows nor turns singular.
+#: Range of every hyperparameter and per-point noise, so that the covariance neither overflows nor
+#: turns singular in double precision.
 HYPERPARAMETER_RANGE = (1e-12, 1e12)
 
 
@@ -54,12 +54,9 @@ class GaussianRandomField:
 
     Parameters
     ----------
-    length_scale : float, metres
-        σ_w (no factor 2: √2 × scikit-learn's RBF ℓ).
-    signal_std : float, units of z
-        σₑ, the prior standard deviation around the mean.
-    noise_std : float, units of z
-        σₙ, the observation noise (used when ``fit`` gets no per-point noise).
+    length_scale, signal_std, noise_std : float
+        σ_w in metres (√2 × scikit-learn's RBF ℓ); σₑ and σₙ in units of z (σₙ where ``fit`` gets
+        no per-point noise).
     method : {"auto", "exact", "grid"}
         ``"exact"``: Cholesky of the n×n covariance, O(n³). ``"grid"``: DTC/SGPR with inducing
         points on a regular grid in Kronecker form (:mod:`deformap.gp._grid`), near-exact for the
@@ -70,20 +67,9 @@ class GaussianRandomField:
         Diagonal jitter relative to σₑ², escalated ×10 from ``jitter`` to ``max_jitter`` until the
         Cholesky factorisation succeeds; beyond it :class:`NotPositiveDefiniteError` is raised.
 
-    Attributes
-    ----------
-    xy_ : (n, 2) float
-        The training inputs.
-    mean_ : float
-        The constant prior mean.
-    method_ : str
-        ``"exact"`` or ``"grid"``, what ``auto`` resolved to.
-    jitter_used_ : float
-        The relative jitter the factorisation needed.
-    n_inducing_ : int
-        Number of inducing grid points (0 for the exact method).
-    log_marginal_likelihood_ : float or None
-        log p(z | hyperparameters) of the exact method (RW2006 Eq. 2.30); None for the grid.
+    A fit sets ``xy_`` (the inputs), ``mean_`` (the constant mean), ``method_`` (what ``auto``
+    resolved to), ``jitter_used_``, ``n_inducing_`` (0 for exact) and ``log_marginal_likelihood_``
+    (RW2006 Eq. 2.30; None for the grid).
 
     References
     ----------
@@ -104,8 +90,7 @@ class GaussianRandomField:
         self.noise_std = _hyperparameter("noise_std", noise_std)
         if method not in _METHODS:
             raise InvalidArgumentError(
-                f"`method` must be one of {_METHODS}; got {describe(method)}"
-            )
+                f"`method` must be one of {_METHODS}; got {describe(method)}")
         self.method = method
         self.inducing_spacing = (None if inducing_spacing is None
                                  else check_positive("inducing_spacing", inducing_spacing))
@@ -113,8 +98,7 @@ class GaussianRandomField:
         self.max_jitter = check_positive("max_jitter", max_jitter)
         if self.max_jitter < self.jitter:
             raise InvalidArgumentError(
-                f"`max_jitter` must be >= `jitter` ({self.jitter:g}); got {self.max_jitter:g}"
-            )
+                f"`max_jitter` must be >= `jitter` ({self.jitter:g}); got {self.max_jitter:g}")
         self._state: ExactState | GridState | None = None
 
     def get_params(self, deep: bool = True) -> dict[str, Any]:
@@ -149,8 +133,7 @@ class GaussianRandomField:
         vals = check_array("z", z, (None,), what="values", min_rows=1)
         if vals.size != pts.shape[0]:
             raise InvalidArgumentError(
-                f"`z` must have one value per row of `xy` ({pts.shape[0]}); got {vals.size}"
-            )
+                f"`z` must have one value per row of `xy` ({pts.shape[0]}); got {vals.size}")
         noise_var = self._noise(noise_std, pts.shape[0]) ** 2
         weights = 1.0 / noise_var
         self.mean_ = float(np.sum(weights * vals) / np.sum(weights))
@@ -194,8 +177,7 @@ class GaussianRandomField:
     def _fitted(self) -> ExactState | GridState:
         if self._state is None:
             raise InvalidArgumentError(
-                "this GaussianRandomField is not fitted yet; call `fit(xy, z)` before predicting"
-            )
+                "this GaussianRandomField is not fitted yet; call `fit(xy, z)` before predicting")
         return self._state
 
     def predict(self, xy: Any, return_std: bool = False) -> Array | tuple[Array, Array]:

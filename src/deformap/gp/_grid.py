@@ -135,8 +135,7 @@ def fit_grid(xy: Array, resid: Array, noise_var: Array, *, length_scale: float, 
         raise InvalidArgumentError(
             f"the grid method would need {m_total} inducing points (> {MAX_INDUCING}) for this "
             f"data extent; increase `inducing_spacing` (now {spacing:g} m) or `length_scale`, "
-            "or use method='exact'"
-        )
+            "or use method='exact'")
     a_is_x = nodes[0].size >= nodes[1].size
     ax_a, ax_b = (0, 1) if a_is_x else (1, 0)
     opts = {"length_scale": length_scale, "jitter": jitter, "max_jitter": max_jitter}
@@ -223,8 +222,7 @@ def _spread_cells(system: Array, gram: Array, h_nodes: Array) -> None:
     rb = gram.shape[1] // degree
     # half[c, r', b', a, b] = Σ_r E_c[r', b', r, b] H_c[r, a]
     half = np.matmul(
-        h_nodes.transpose(0, 2, 1)[:, None], gram.reshape(cells, degree * rb, degree, rb)
-    )
+        h_nodes.transpose(0, 2, 1)[:, None], gram.reshape(cells, degree * rb, degree, rb))
     # B[(a', b'), (a, b)] += Σ_{c, r'} H_c[r', a'] half[c, r', b', a, b]: one GEMM, written as
     # Bᵀ += halfᵀ H on the Fortran-ordered transpose so that it accumulates in place.
     target = system.reshape(ra, rb * ra * rb).T

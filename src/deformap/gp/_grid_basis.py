@@ -71,8 +71,7 @@ def axis_basis(lo: float, hi: float, nodes: Array, *, length_scale: float, jitte
     range (≥ 3 per node at the default spacing), enough for its variation on the node spacing.
     """
     chol, jit = cholesky_with_jitter(
-        _se_1d(nodes, nodes, length_scale), jitter=jitter, max_jitter=max_jitter, what=what
-    )
+        _se_1d(nodes, nodes, length_scale), jitter=jitter, max_jitter=max_jitter, what=what)
     count = max(2, math.ceil((hi - lo) / length_scale * _SAMPLES_PER_LENGTH) + 1)
     samples = np.linspace(lo, hi, count)
     white = sla.solve_triangular(
@@ -103,8 +102,7 @@ def chebyshev_degree(half_width: float, length_scale: float, tolerance: float) -
             math.log(2.0)
             + nodes * math.log(half_width / (2.0 * length_scale))
             - math.lgamma(nodes + 1)
-            + 0.5 * (math.lgamma(2 * nodes + 1) - math.lgamma(nodes + 1))
-        )
+            + 0.5 * (math.lgamma(2 * nodes + 1) - math.lgamma(nodes + 1)))
         if log_bound <= math.log(tolerance):
             return nodes
     raise AssertionError("unreachable: the bound falls below any tolerance for δ < σ_w")

@@ -51,8 +51,7 @@ def _lml_and_grad(theta: Array, d2: Array, resid: Array) -> tuple[float, Array]:
     except np.linalg.LinAlgError:
         raise NotPositiveDefiniteError(
             f"K + σn²I is not positive definite at σw={w:g}, σe={s:g}, σn={sn:g}; "
-            "raise the lower bound of `noise_std`"
-        ) from None
+            "raise the lower bound of `noise_std`") from None
     alpha = sla.cho_solve(factor, resid, check_finite=False)
     n = resid.size
     lml = -0.5 * resid @ alpha - np.sum(np.log(np.diag(factor[0]))) - 0.5 * n * np.log(2 * np.pi)
@@ -83,8 +82,7 @@ def _check_data(xy: Any, z: Any) -> tuple[Array, Array]:
     vals = check_array("z", z, (None,), what="values", min_rows=2)
     if vals.size != pts.shape[0]:
         raise InvalidArgumentError(
-            f"`z` must have one value per row of `xy` ({pts.shape[0]}); got {vals.size}"
-        )
+            f"`z` must have one value per row of `xy` ({pts.shape[0]}); got {vals.size}")
     return pts, vals
 
 
@@ -102,8 +100,7 @@ def default_bounds(xy: Any, z: Any) -> Array:
     """
     diag, spread = _diagonal_and_spread(np.asarray(xy, dtype=float), np.asarray(z, dtype=float))
     return np.array(
-        [[1e-3 * diag, 2.0 * diag], [1e-2 * spread, 1e2 * spread], [1e-4 * spread, 1e1 * spread]]
-    )
+        [[1e-3 * diag, 2.0 * diag], [1e-2 * spread, 1e2 * spread], [1e-4 * spread, 1e1 * spread]])
 
 
 def fit_hyperparameters(xy: Any, z: Any, *, rng: np.random.Generator,
@@ -154,8 +151,7 @@ def fit_hyperparameters(xy: Any, z: Any, *, rng: np.random.Generator,
     if not results:
         raise NotPositiveDefiniteError(
             "every start of the likelihood optimisation failed; raise the lower bound of "
-            "`noise_std` in `bounds`"
-        )
+            "`noise_std` in `bounds`")
     best = max(results, key=lambda r: r[0])
     w, s, sn = np.exp(best[1])
     _LOG.info("fitted σw=%.4g σe=%.4g σn=%.4g (lml %.4g)", w, s, sn, best[0])

@@ -55,23 +55,16 @@ def _per_candidate(name: str, value: Any, shape: tuple[int, ...], *, allow_zero:
 
 def variance_after_adding(variance: Any, covariance: Any, candidate_variance: Any,
                           noise_var: float | Array) -> Array:
-    """``(c, d)`` posterior variance on a domain after one more observation at each candidate.
+    """``(c, d)`` posterior variance on a domain after one more observation at each candidate:
+    row ``j`` is ``variance − covariance[j]² / (candidate_variance[j] + noise_var)``.
 
     Parameters
     ----------
-    variance : (d,) float
-        Posterior variance on the domain now.
-    covariance : (c, d) float
-        Posterior covariance between each candidate and the domain now.
-    candidate_variance : (c,) float
-        Posterior variance at each candidate now.
+    variance, covariance, candidate_variance : (d,), (c, d), (c,) float
+        The posterior now: variance on the domain, covariance between each candidate and the
+        domain, variance at each candidate.
     noise_var : float or (c,) float
         Noise variance (≥ 0) of the new observation, the same at every candidate or one each.
-
-    Returns
-    -------
-    (c, d) float
-        Row ``j``: ``variance − covariance[j]² / (candidate_variance[j] + noise_var)``.
     """
     var = np.asarray(variance, dtype=float)
     cov = np.asarray(covariance, dtype=float)
@@ -79,8 +72,7 @@ def variance_after_adding(variance: Any, covariance: Any, candidate_variance: An
     if cov.shape != (var_c.size, var.size):
         raise InvalidArgumentError(
             f"`covariance` must be (candidates, domain) = ({var_c.size}, {var.size}); "
-            f"got {cov.shape}"
-        )
+            f"got {cov.shape}")
     noise = _per_candidate("noise_var", noise_var, var_c.shape, allow_zero=True)
     return np.asarray(var[None, :] - cov**2 / (var_c + noise)[:, None])
 
@@ -94,14 +86,10 @@ class PosteriorDesign:
 
     Parameters
     ----------
-    observed_xy : (p, 2) float
-        Where the observations made are (``p`` may be 0).
-    observed_noise_std : (p,) float
-        Their noise standard deviations (> 0).
-    candidates : (c, 2) float
-        Places where an observation may be added.
-    domain : (d, 2) float
-        Where the posterior is wanted.
+    observed_xy, observed_noise_std : (p, 2), (p,) float
+        The observations made (``p`` may be 0) and their noise standard deviations (> 0).
+    candidates, domain : (c, 2), (d, 2) float
+        Places where an observation may be added; where the posterior is wanted.
     candidate_noise_std : float or (c,) float
         The noise standard deviation (> 0) of an observation at a candidate, the same at every
         candidate or one each.
@@ -130,17 +118,8 @@ class PosteriorDesign:
 
     def posterior(self, chosen: Sequence[int]) -> tuple[Array, Array, Array]:
         """The posterior given the observations made and the ``chosen`` candidates (indices,
-        each observed once with its ``candidate_noise_std``).
-
-        Returns
-        -------
-        variance : (d,) float
-            Posterior variance on the domain.
-        covariance : (c, d) float
-            Posterior covariance between each candidate and the domain.
-        candidate_variance : (c,) float
-            Posterior variance at each candidate.
-        """
+        each observed once): the variance ``(d,)`` on the domain, the covariance ``(c, d)``
+        between each candidate and the domain, and the variance ``(c,)`` at each candidate."""
         idx = np.asarray(chosen, dtype=np.int64).reshape(-1)
         n_candidates = self.k_cc.shape[0]
         if idx.size and (idx.min() < 0 or idx.max() >= n_candidates):
@@ -177,25 +156,11 @@ class PosteriorDesign:
 def apply_smoother(data_xy: Any, noise_std: Any, query_xy: Any, values: Any, *,
                    length_scale: float, signal_std: float, jitter: float = 1e-10,
                    max_jitter: float = 1e-4) -> Array:
-    """The GP mean's linear map applied to ``values``: ``K(query, data) (K + Σ)⁻¹ values``.
-
-    Parameters
-    ----------
-    data_xy : (n, 2) float
-        Where the data are.
-    noise_std : (n,) float
-        Their noise standard deviations (``Σ = diag(noise_std²)``).
-    query_xy : (q, 2) float
-    values : (n,) or (n, k) float
-        One or ``k`` data vectors.
-    jitter, max_jitter : float
-        Relative to σₑ², as in :class:`GaussianRandomField`.
-
-    Returns
-    -------
-    (q,) or (q, k) float
-        The posterior mean each data vector would give (zero prior mean).
-    """
+    """The GP mean's linear map applied to ``values``: ``K(query, data) (K + Σ)⁻¹ values``, the
+    ``(q,)`` or ``(q, k)`` posterior mean (zero prior mean) at ``query_xy`` ``(q, 2)`` that each
+    of the one or ``k`` data vectors ``values`` ``(n,)`` or ``(n, k)`` at ``data_xy`` ``(n, 2)``
+    would give, with noise ``Σ = diag(noise_std²)``; ``jitter`` and ``max_jitter`` as in
+    :class:`GaussianRandomField`."""
     data = check_array("data_xy", data_xy, (None, 2), what="metres", min_rows=1)
     noise = check_array("noise_std", noise_std, (data.shape[0],))
     query = check_array("query_xy", query_xy, (None, 2), what="metres")

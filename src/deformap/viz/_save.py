@@ -28,13 +28,11 @@ def save_figure(fig: Figure, path: str | Path, *, dpi: float, **savefig_kwargs: 
     if fmt not in supported:
         raise InvalidArgumentError(
             f"`path` must end in a figure format ({', '.join('.' + f for f in sorted(supported))}), "
-            f"got {str(out)!r}"
-        )
+            f"got {str(out)!r}")
     if not out.parent.is_dir():
         raise InvalidArgumentError(
             f"`path` must be in an existing folder, got {str(out)!r} "
-            f"({str(out.parent)!r} does not exist)"
-        )
+            f"({str(out.parent)!r} does not exist)")
     with atomic_path(out) as tmp, open(tmp, "xb") as fh:
         fig.savefig(fh, format=fmt, dpi=dpi, **savefig_kwargs)
     return out
