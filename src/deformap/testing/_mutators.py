@@ -32,17 +32,12 @@ KINDS: dict[str, tuple[str, ...]] = {
     "npz": ("flip", "truncate", "extend", "member-flip", "member-truncate", "member-extend",
             "member-npy-header", "member-shape"),
     "session": ("yaml", "file", "link"),
-    # the YAML a user writes: a run configuration (`deformap config dump`) and a scenario
     "config": ("yaml", "flip", "truncate"),
     "scenario": ("yaml", "flip", "truncate"),
-    # a bag as a robot records it (``deformap map BAG``): the MCAP's bytes, one of its records,
-    # one message's bytes in a bag rewritten so that every CRC matches, and the YAML beside it
+    # a bag as a robot records it: its bytes, one record, one message (the CRCs made to match),
+    # the settings YAML beside it; as sqlite3 (rosbag2's default before Iron) rows and topics too
     "raw-mcap": ("flip", "truncate", "extend", "record", "message-flip", "message-truncate",
                  "message-extend", "yaml"),
-    # the same bag as sqlite3 (``.db3``, rosbag2's default before Iron) written by rosbags: the
-    # file's bytes, one message row's data (sqlite3 has no CRC to make match), a message row
-    # deleted or repeated or its data or time given another SQL type, one field of a ``topics``
-    # row, and the YAML beside it
     "raw-db3": ("flip", "truncate", "extend", "message-flip", "message-truncate",
                 "message-extend", "row-delete", "row-repeat", "row-type", "topic", "yaml"),
 }
@@ -242,9 +237,8 @@ def _mcap_record(data: bytes, rng: np.random.Generator) -> bytes:
 
 
 def _mcap_message(data: bytes, rng: np.random.Generator, kind: str) -> bytes:
-    """Rewrite the MCAP with one message's bytes damaged (``kind``: flip, truncate, extend) and
-    every CRC computed anew: what only deformap's own checks can refuse. The topic is drawn
-    first, then one of its messages."""
+    """The MCAP rewritten with one message's bytes damaged (``kind``: flip, truncate, extend) and
+    every CRC computed anew; the topic is drawn first, then one of its messages."""
     from mcap.reader import make_reader
     from mcap.writer import Writer
 
@@ -273,11 +267,9 @@ def _mcap_message(data: bytes, rng: np.random.Generator, kind: str) -> bytes:
 
 
 def _db3_edit(bag: Path, kind: str, rng: np.random.Generator) -> None:
-    """Edit the sqlite3 bag in place through SQL: one message row's data damaged (``kind``:
-    message-flip, message-truncate, message-extend), the row deleted (row-delete) or inserted
-    again (row-repeat), its data or time given a value of another SQL type (row-type), or one
-    field of a ``topics`` row given another value (topic). The topic is drawn first, then one of
-    its messages."""
+    """Edit the sqlite3 bag in place through SQL (``kind``: message-flip, -truncate or -extend of
+    one row's data, row-delete, row-repeat, row-type: another SQL type in a row, topic: another
+    value in a ``topics`` row); the topic is drawn first, then one of its messages."""
     import sqlite3
 
     conn = sqlite3.connect(bag)
