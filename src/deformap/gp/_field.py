@@ -19,7 +19,7 @@ from deformap.gp._grid import (
     predict_grid_points,
     predict_on_grid,
 )
-from deformap.gp._kernels import grid_points
+from deformap.gp._kernels import _check_data, grid_points
 
 __all__ = ["AUTO_EXACT_MAX_POINTS", "GaussianRandomField"]
 
@@ -129,11 +129,7 @@ class GaussianRandomField:
 
         ``noise_std``: a float or ``(n,)`` per-point observation noise; default the constructor's.
         """
-        pts = check_array("xy", xy, (None, 2), what="coordinates in metres", min_rows=1)
-        vals = check_array("z", z, (None,), what="values", min_rows=1)
-        if vals.size != pts.shape[0]:
-            raise InvalidArgumentError(
-                f"`z` must have one value per row of `xy` ({pts.shape[0]}); got {vals.size}")
+        pts, vals = _check_data(xy, z, min_rows=1)
         noise_var = self._noise(noise_std, pts.shape[0]) ** 2
         weights = 1.0 / noise_var
         self.mean_ = float(np.sum(weights * vals) / np.sum(weights))

@@ -87,7 +87,7 @@ def grid_blas_threads() -> Iterator[None]:
 
 @dataclass(kw_only=True)
 class GridState:
-    """A fitted grid GP: the two axis bases, the factor of B, and α̂ = B⁻¹ b."""
+    """A fitted grid GP: the two axis bases, the factor of B, α̂ = B⁻¹ b and the ma·mb nodes."""
 
     axis_a: AxisBasis
     axis_b: AxisBasis
@@ -95,12 +95,8 @@ class GridState:
     factor: tuple[Array, bool]
     alpha: Array  # (ra, rb)
     jitter_used: float
+    n_inducing: int
     _b_inv: Array | None = field(default=None, repr=False)
-
-    @property
-    def n_inducing(self) -> int:
-        """Grid nodes ma·mb."""
-        return self.axis_a.nodes.size * self.axis_b.nodes.size
 
     def b_inv_blocks(self) -> Array:
         """``(ra (ra + 1) / 2, rb²)``: the (rb, rb) blocks B⁻¹[(a, ·), (a', ·)] for a ≥ a'
@@ -150,7 +146,7 @@ def fit_grid(xy: Array, resid: Array, noise_var: Array, *, length_scale: float, 
     factor = sla.cho_factor(system, lower=True, overwrite_a=True, check_finite=False)
     alpha = sla.cho_solve(factor, rhs.ravel(), check_finite=False).reshape(rhs.shape)
     return GridState(axis_a=basis_a, axis_b=basis_b, a_is_x=a_is_x, factor=factor, alpha=alpha,
-                     jitter_used=max(jit_a, jit_b))
+                     jitter_used=max(jit_a, jit_b), n_inducing=m_total)
 
 
 def _cell_layout(span: float, n: int, ra: int, rb: int, length_scale: float) -> tuple[int, int]:

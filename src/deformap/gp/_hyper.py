@@ -19,7 +19,7 @@ from scipy.optimize import minimize
 
 from deformap._validation import check_array, check_int, check_positive, describe
 from deformap.errors import InvalidArgumentError, NotPositiveDefiniteError
-from deformap.gp._kernels import _sqdist
+from deformap.gp._kernels import _check_data, _sqdist
 
 __all__ = ["GPHyperparameters", "default_bounds", "fit_hyperparameters", "log_marginal_likelihood"]
 
@@ -70,20 +70,11 @@ def log_marginal_likelihood(xy: Any, z: Any, *, length_scale: float, signal_std:
     """Exact log p(z | θ) of the constant-mean GP (data mean subtracted), RW2006 Eq. 2.30, for
     ``z (n,)`` at ``xy (n, 2)``; with ``eval_gradient`` also its gradient in
     (log σ_w, log σₑ, log σₙ), RW2006 Eq. 5.9."""
-    pts, vals = _check_data(xy, z)
+    pts, vals = _check_data(xy, z, min_rows=2)
     values = (length_scale, signal_std, noise_std)
     theta = np.log([check_positive(n, v) for n, v in zip(_NAMES, values, strict=True)])
     lml, grad = _lml_and_grad(theta, _sqdist(pts, pts), vals - vals.mean())
     return (lml, grad) if eval_gradient else lml
-
-
-def _check_data(xy: Any, z: Any) -> tuple[Array, Array]:
-    pts = check_array("xy", xy, (None, 2), what="coordinates in metres", min_rows=2)
-    vals = check_array("z", z, (None,), what="values", min_rows=2)
-    if vals.size != pts.shape[0]:
-        raise InvalidArgumentError(
-            f"`z` must have one value per row of `xy` ({pts.shape[0]}); got {vals.size}")
-    return pts, vals
 
 
 def _diagonal_and_spread(xy: Any, z: Any) -> tuple[float, float]:
@@ -106,7 +97,8 @@ def default_bounds(xy: Any, z: Any) -> Array:
 def fit_hyperparameters(xy: Any, z: Any, *, rng: np.random.Generator,
                         init: GPHyperparameters | None = None, n_restarts: int = 3,
                         max_points: int = 2000, bounds: Any = None) -> GPHyperparameters:  # fmt: skip
-    """Maximise the log marginal likelihood of ``z (n,)`` at ``xy (n, 2)`` over (σ_w, σₑ, σₙ).
+    """The (σ_w, σₑ, σₙ) of largest log marginal likelihood of ``z (n,)`` at ``xy (n, 2)``, with
+    that likelihood on the points used.
 
     Parameters
     ----------
@@ -115,18 +107,12 @@ def fit_hyperparameters(xy: Any, z: Any, *, rng: np.random.Generator,
     init : GPHyperparameters, optional
         First start; default (D/10, s, s/10), D the bounding-box diagonal, s the data's std.
     n_restarts : int
-        Further starts drawn log-uniformly within the bounds.
+        Further starts drawn log-uniformly within ``bounds`` ((3, 2) low and high of σ_w, σₑ,
+        σₙ; default :func:`default_bounds`).
     max_points : int
         At most this many points (a random subset) enter the O(n³) objective.
-    bounds : (3, 2) array_like, optional
-        (low, high) for (σ_w, σₑ, σₙ); default :func:`default_bounds`.
-
-    Returns
-    -------
-    GPHyperparameters
-        The best optimum, with its log marginal likelihood on the subset.
     """
-    pts, vals = _check_data(xy, z)
+    pts, vals = _check_data(xy, z, min_rows=2)
     if not isinstance(rng, np.random.Generator):
         raise InvalidArgumentError(f"`rng` must be a numpy.random.Generator; got {describe(rng)}")
     n_restarts = check_int("n_restarts", n_restarts, minimum=0)

@@ -14,10 +14,21 @@ import numpy as np
 from numpy.typing import NDArray
 
 from deformap._validation import check_array, check_positive
+from deformap.errors import InvalidArgumentError
 
 __all__ = ["grid_points", "squared_exponential"]
 
 Array = NDArray[np.float64]
+
+
+def _check_data(xy: Any, z: Any, *, min_rows: int) -> tuple[Array, Array]:
+    """Observations ``z (n,)`` at ``xy (n, 2)`` metres, at least ``min_rows`` of them."""
+    pts = check_array("xy", xy, (None, 2), what="coordinates in metres", min_rows=min_rows)
+    vals = check_array("z", z, (None,), what="values", min_rows=min_rows)
+    if vals.size != pts.shape[0]:
+        raise InvalidArgumentError(
+            f"`z` must have one value per row of `xy` ({pts.shape[0]}); got {vals.size}")
+    return pts, vals
 
 
 def _sqdist(x1: Array, x2: Array) -> Array:

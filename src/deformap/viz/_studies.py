@@ -70,16 +70,12 @@ def _plot_hardness(study: dict[str, Any]) -> Figure:
 
 def _conditions(study: dict[str, Any]) -> str:
     """The press force, foam thickness, camera and world physics the study ran under."""
-    parts = []
-    if study.get("force_n") is not None:
-        parts.append(f"force {study['force_n']:g} N")
-    if study.get("thickness_m") is not None:
-        parts.append(f"foam {study['thickness_m'] * 100:g} cm thick")
-    if study.get("camera"):
-        parts.append(f"camera {study['camera']}")
-    if study.get("physics"):
-        parts.append(f"physics {study['physics']}")
-    return ", ".join(parts)
+    force, thickness = study.get("force_n"), study.get("thickness_m")
+    parts = ["" if force is None else f"force {force:g} N",
+             "" if thickness is None else f"foam {thickness * 100:g} cm thick",
+             f"camera {study['camera']}" if study.get("camera") else "",
+             f"physics {study['physics']}" if study.get("physics") else ""]
+    return ", ".join(p for p in parts if p)
 
 
 def _hardness_ticks(ax: Axes, rows: list[dict[str, Any]], finite: list[float],
