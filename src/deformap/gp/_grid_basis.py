@@ -31,21 +31,21 @@ __all__: list[str] = []
 
 Array = NDArray[np.float64]
 
-#: Largest relative prior variance (fraction of σₑ²) the compressed features may miss at a data
-#: point, and twice the largest interpolation error of a data point's features. Both perturb the
-#: data's covariance by at most this much, the order of the grid's own Nyström residual at its edge
-#: (``_grid.GRID_MARGIN_FRACTION``).
+#: Largest prior variance (fraction of σₑ²) the compressed features may miss at a data point, and
+#: twice the largest interpolation error of its features: the order of the grid's own Nyström
+#: residual at its edge.
 FEATURE_TOLERANCE = 1e-8
 _SAMPLES_PER_LENGTH = 24
 
 
 @dataclass(frozen=True, kw_only=True)
 class AxisBasis:
-    """Inducing nodes of one axis, the Cholesky factor of their kernel matrix and the projection Q."""
+    """Inducing nodes ``(m,)`` of one axis, the lower Cholesky factor ``(m, m)`` of their kernel
+    matrix and the projection Q ``(m, r)`` with orthonormal columns."""
 
-    nodes: Array  # (m,)
-    chol: Array  # (m, m) lower
-    proj: Array  # (m, r), orthonormal columns
+    nodes: Array
+    chol: Array
+    proj: Array
     length_scale: float
 
     @property

@@ -81,28 +81,19 @@ def plot_poke(*, roi_xs: NDArray, roi_ys: NDArray, rest_z: NDArray, deformed_z: 
 
     Parameters
     ----------
-    roi_xs, roi_ys : (nx,), (ny,) float, metres
-        Grid of the region of interest around the contact.
-    rest_z, deformed_z : (ny, nx) float, metres
-        Heights before (surface GP) and while pressing (touch GP).
-    roi_points : (n, 3) float, metres
-        The cloud in the ROI while pressing, the robot removed.
-    tactile : (t, 3) float, metres
-        The tactile points added on the probe's tip.
-    betas, errors : (m,) float
-        The βs tried and their shape-matching error ε(β) in metres.
-    beta, beta_std : float
-        The estimate β̂ and its standard deviation.
+    roi_xs, roi_ys, rest_z, deformed_z : (nx,), (ny,), (ny, nx), (ny, nx) float, metres
+        The grid of the region of interest, the heights before (surface GP) and while pressing
+        (touch GP).
+    roi_points, tactile : (n, 3), (t, 3) float, metres
+        The cloud in the ROI while pressing (the robot removed) and the tactile points.
+    betas, errors, beta, beta_std : (m,), (m,) float, float, float
+        The βs tried, their error ε(β) in metres, the estimate β̂ and its standard deviation.
     simulated_z : (ny, nx) float, metres, optional
-        The shape-matching surface at β̂ (its particles' heights, on the ROI grid at rest); its
-        panel says "not simulated" without it.
+        The shape-matching surface at β̂ on the ROI grid ("not simulated" without it).
     path : str or Path, optional
         Where to write the figure (100 dpi); nothing is written without it.
-    force_travel : ((n,), (n,)) float, metres and newtons, optional
-        The press's record: the tip's travel since first contact and the force; the panel says
-        "no force–travel record" without it.
-    force_fit : (2, m) float, metres and newtons, optional
-        The contact model fitted to the record, travel and force, drawn over it.
+    force_travel, force_fit : ((n,), (n,)) and (2, m) float, metres and newtons, optional
+        The press's record (travel since first contact, force) and the contact model fitted to it.
     reading : str
         What the record read ("E = 9.7 ± 0.7 kPa", "rigid", or why none), in the panel's legend.
     """
