@@ -210,17 +210,15 @@ class Case:
     detail: str
 
 
-def run_mutants(n_mutants: int, seed: int, limit_s: float, work: Path,
-        readers: tuple[str, ...] | None = None) -> list[Case]:  # fmt: skip
+def run_mutants(n_mutants: int, seed: int, limit_s: float, work: Path) -> list[Case]:
     """Make the templates in ``work``, then ``n_mutants`` mutants spread over readers and kinds."""
     templates = make_templates(work / "templates")
-    names = [r for r in templates if readers is None or r in readers]
     worker = Worker(limit_s)
-    want = {r: read_snapshot(r, str(templates[r])) for r in names}
+    want = {r: read_snapshot(r, str(path)) for r, path in templates.items()}
     for r, (status, snap) in want.items():
         if status != "ok":
             raise RuntimeError(f"template {r} does not read: {snap}")
-    plan = [(r, k) for r in names for k in kinds_of(r)]
+    plan = [(r, k) for r in templates for k in kinds_of(r)]
     cases = []
     try:
         for index in range(n_mutants):
