@@ -19,20 +19,20 @@ from deformap.gp._grid import (
     predict_grid_points,
     predict_on_grid,
 )
+from deformap.gp._kernels import _check_data, grid_points
 
 __all__ = ["AUTO_EXACT_MAX_POINTS", "GaussianRandomField"]
+
+Array = NDArray[np.float64]
 
 _LOG = logging.getLogger(__name__)
 
 #: ``method="auto"`` uses the exact GP up to this many points and the grid GP above: the grid's
-#: cost follows the extent over σ_w while the exact fit grows as n³, so exact is cheaper only for
-#: small n (``deformap bench speed`` compares the two).
+#: cost follows the extent over σ_w while the exact fit grows as n³.
 AUTO_EXACT_MAX_POINTS = 1000
 _METHODS = ("auto", "exact", "grid")
-
-#: Range of every hyperparameter and per-point noise (in its own units). Their squares and
-#: ratios then stay far inside double precision (about 1e±308): outside it the covariance
-#: overflows to infinity or underflows to a singular matrix and predictions turn to NaN.
+#: Range of every hyperparameter and per-point noise, so that the covariance neither overflows nor
+#: turns singular in double precision.
 HYPERPARAMETER_RANGE = (1e-12, 1e12)
 
 
@@ -48,42 +48,28 @@ class GaussianRandomField:
     """GP regression of a scalar field z(x, y) with the paper's squared-exponential kernel.
 
     The prior is f ~ GP(m, k) with k(p, p') = σₑ² exp(−‖p − p'‖² / σ_w²) and a constant mean m, the
-    data mean (inverse-noise-variance weighted with per-point noise), subtracted before the fit and
-    added back to every prediction. Observations are z = f + ε, ε ~ N(0, σₙ²) (or per-point σₙ,ᵢ²).
+    data mean (inverse-noise-variance weighted), subtracted before the fit and added back to every
+    prediction. Observations are z = f + ε, ε ~ N(0, σₙ²) (or per-point σₙ,ᵢ²). The estimator
+    follows scikit-learn's API (``get_params``, ``set_params``, ``clone``).
 
     Parameters
     ----------
-    length_scale : float, metres
-        σ_w (no factor 2: √2 × scikit-learn's RBF ℓ).
-    signal_std : float, units of z
-        σₑ, the prior standard deviation around the mean.
-    noise_std : float, units of z
-        σₙ, the observation noise (used when ``fit`` gets no per-point noise).
+    length_scale, signal_std, noise_std : float
+        σ_w in metres (√2 × scikit-learn's RBF ℓ); σₑ and σₙ in units of z (σₙ where ``fit`` gets
+        no per-point noise).
     method : {"auto", "exact", "grid"}
-        ``"exact"``: Cholesky of the n×n covariance (RW2006 Alg. 2.1), O(n³). ``"grid"``: DTC/SGPR
-        with inducing points on a regular grid and Kronecker algebra, near-exact for the SE kernel at
-        the default spacing, its cost following the extent over σ_w rather than n
-        (:mod:`deformap.gp._grid`). ``"auto"``: exact up to ``AUTO_EXACT_MAX_POINTS`` points.
+        ``"exact"``: Cholesky of the n×n covariance, O(n³). ``"grid"``: DTC/SGPR with inducing
+        points on a regular grid in Kronecker form (:mod:`deformap.gp._grid`), near-exact for the
+        SE kernel at the default spacing. ``"auto"``: exact up to ``AUTO_EXACT_MAX_POINTS`` points.
     inducing_spacing : float, metres, optional
         Grid method's node spacing; default σ_w / 3.
     jitter, max_jitter : float
         Diagonal jitter relative to σₑ², escalated ×10 from ``jitter`` to ``max_jitter`` until the
         Cholesky factorisation succeeds; beyond it :class:`NotPositiveDefiniteError` is raised.
 
-    Attributes
-    ----------
-    xy_ : (n, 2) float
-        The training inputs.
-    mean_ : float
-        The constant prior mean that was subtracted.
-    method_ : str
-        ``"exact"`` or ``"grid"``, what ``auto`` resolved to.
-    jitter_used_ : float
-        The relative jitter the factorisation needed.
-    n_inducing_ : int
-        Number of inducing grid points (0 for the exact method).
-    log_marginal_likelihood_ : float or None
-        log p(z | hyperparameters) of the exact method (RW2006 Eq. 2.30); None for the grid method.
+    A fit sets ``xy_`` (the inputs), ``mean_`` (the constant mean), ``method_`` (what ``auto``
+    resolved to), ``jitter_used_``, ``n_inducing_`` (0 for exact) and ``log_marginal_likelihood_``
+    (RW2006 Eq. 2.30; None for the grid).
 
     References
     ----------
@@ -91,56 +77,36 @@ class GaussianRandomField:
     Rasmussen 2005; Titsias 2009.
     """
 
-    def __init__(
-        self,
-        *,
-        length_scale: float,
-        signal_std: float,
-        noise_std: float,
-        method: str = "auto",
-        inducing_spacing: float | None = None,
-        jitter: float = 1e-10,
-        max_jitter: float = 1e-4,
-    ) -> None:
-        self.length_scale = _hyperparameter("length_scale", length_scale)
-        self.signal_std = _hyperparameter("signal_std", signal_std)
-        self.noise_std = _hyperparameter("noise_std", noise_std)
-        if method not in _METHODS:
-            raise InvalidArgumentError(
-                f"`method` must be one of {_METHODS}; got {describe(method)}"
-            )
-        self.method = method
-        self.inducing_spacing = (
-            None
-            if inducing_spacing is None
-            else check_positive("inducing_spacing", inducing_spacing)
-        )
-        self.jitter = check_positive("jitter", jitter)
-        self.max_jitter = check_positive("max_jitter", max_jitter)
-        if self.max_jitter < self.jitter:
-            raise InvalidArgumentError(
-                f"`max_jitter` must be >= `jitter` ({self.jitter:g}); got {self.max_jitter:g}"
-            )
-        self._state: ExactState | GridState | None = None
-
     _PARAMS = ("length_scale", "signal_std", "noise_std", "method", "inducing_spacing", "jitter",
                "max_jitter")  # fmt: skip
     _FITTED = ("xy_", "mean_", "method_", "jitter_used_", "n_inducing_",
                "log_marginal_likelihood_")  # fmt: skip
 
+    def __init__(self, *, length_scale: float, signal_std: float, noise_std: float,
+                 method: str = "auto", inducing_spacing: float | None = None,
+                 jitter: float = 1e-10, max_jitter: float = 1e-4) -> None:  # fmt: skip
+        self.length_scale = _hyperparameter("length_scale", length_scale)
+        self.signal_std = _hyperparameter("signal_std", signal_std)
+        self.noise_std = _hyperparameter("noise_std", noise_std)
+        if method not in _METHODS:
+            raise InvalidArgumentError(
+                f"`method` must be one of {_METHODS}; got {describe(method)}")
+        self.method = method
+        self.inducing_spacing = (None if inducing_spacing is None
+                                 else check_positive("inducing_spacing", inducing_spacing))
+        self.jitter = check_positive("jitter", jitter)
+        self.max_jitter = check_positive("max_jitter", max_jitter)
+        if self.max_jitter < self.jitter:
+            raise InvalidArgumentError(
+                f"`max_jitter` must be >= `jitter` ({self.jitter:g}); got {self.max_jitter:g}")
+        self._state: ExactState | GridState | None = None
+
     def get_params(self, deep: bool = True) -> dict[str, Any]:
-        """The constructor's parameters, as scikit-learn's estimator API has them (``clone``
-        builds an unfitted copy from them); ``deep`` is accepted for that API (no parameter
-        is itself an estimator)."""
+        """The constructor's parameters (``deep`` is accepted for scikit-learn's API)."""
         return {name: getattr(self, name) for name in self._PARAMS}
 
     def set_params(self, **params: Any) -> GaussianRandomField:
-        """Set constructor parameters (scikit-learn's estimator API); returns ``self``.
-
-        They are checked as the constructor checks them, all before any is set (a bad one
-        leaves the field as it was). A fitted field is unfitted: its state was computed with
-        the old hyperparameters, so ``fit`` must be called again before predicting.
-        """
+        """Set constructor parameters, all checked before any is set; returns ``self``, unfitted."""
         unknown = sorted(set(params) - set(self._PARAMS))
         if unknown:
             raise InvalidArgumentError(
@@ -154,68 +120,34 @@ class GaussianRandomField:
         return self
 
     def __repr__(self) -> str:
-        return (
-            f"GaussianRandomField(length_scale={self.length_scale!r}, "
-            f"signal_std={self.signal_std!r}, noise_std={self.noise_std!r}, "
-            f"method={self.method!r})"
-        )
+        return (f"GaussianRandomField(length_scale={self.length_scale!r}, "
+                f"signal_std={self.signal_std!r}, noise_std={self.noise_std!r}, "
+                f"method={self.method!r})")
 
-    # ------------------------------------------------------------------ fitting
     def fit(self, xy: Any, z: Any, noise_std: Any = None) -> GaussianRandomField:
-        """Condition the field on observations.
+        """Condition the field on ``z (n,)`` observed at ``xy (n, 2)`` metres; returns ``self``.
 
-        Parameters
-        ----------
-        xy : (n, 2) float, metres
-        z : (n,) float
-        noise_std : float or (n,) float, optional
-            Per-point observation noise (heteroscedastic data); default the constructor's.
-
-        Returns
-        -------
-        self
+        ``noise_std``: a float or ``(n,)`` per-point observation noise; default the constructor's.
         """
-        pts = check_array("xy", xy, (None, 2), what="coordinates in metres", min_rows=1)
-        vals = check_array("z", z, (None,), what="values", min_rows=1)
-        if vals.size != pts.shape[0]:
-            raise InvalidArgumentError(
-                f"`z` must have one value per row of `xy` ({pts.shape[0]}); got {vals.size}"
-            )
-        noise = self._noise(noise_std, pts.shape[0])
-        noise_var = noise**2
+        pts, vals = _check_data(xy, z, min_rows=1)
+        noise_var = self._noise(noise_std, pts.shape[0]) ** 2
         weights = 1.0 / noise_var
         self.mean_ = float(np.sum(weights * vals) / np.sum(weights))
         resid = vals - self.mean_
         method = self.method
         if method == "auto":
             method = "exact" if pts.shape[0] <= AUTO_EXACT_MAX_POINTS else "grid"
+        hyper = {"length_scale": self.length_scale, "signal_std": self.signal_std,
+                 "jitter": self.jitter, "max_jitter": self.max_jitter}
         state: ExactState | GridState
         if method == "exact":
-            exact = fit_exact(
-                pts,
-                resid,
-                noise_var,
-                length_scale=self.length_scale,
-                signal_std=self.signal_std,
-                jitter=self.jitter,
-                max_jitter=self.max_jitter,
-            )
-            state = exact
+            state = fit_exact(pts, resid, noise_var, **hyper)
             self.n_inducing_ = 0
-            self.log_marginal_likelihood_: float | None = exact.log_marginal_likelihood
+            self.log_marginal_likelihood_: float | None = state.log_marginal_likelihood
         else:
             spacing = self.inducing_spacing or GRID_SPACING_FRACTION * self.length_scale
             with grid_blas_threads():
-                state = fit_grid(
-                    pts,
-                    resid,
-                    noise_var,
-                    length_scale=self.length_scale,
-                    signal_std=self.signal_std,
-                    spacing=spacing,
-                    jitter=self.jitter,
-                    max_jitter=self.max_jitter,
-                )
+                state = fit_grid(pts, resid, noise_var, spacing=spacing, **hyper)
             self.n_inducing_ = state.n_inducing
             self.log_marginal_likelihood_ = None
         _LOG.debug("fitted %s GP on %d points", method, pts.shape[0])
@@ -225,7 +157,7 @@ class GaussianRandomField:
         self.jitter_used_ = state.jitter_used
         return self
 
-    def _noise(self, noise_std: Any, n: int) -> NDArray[np.float64]:
+    def _noise(self, noise_std: Any, n: int) -> Array:
         if noise_std is None:
             return np.full(n, self.noise_std)
         if np.ndim(noise_std) == 0:
@@ -238,78 +170,42 @@ class GaussianRandomField:
                 f"{noise.max():g}")
         return noise
 
-    # --------------------------------------------------------------- prediction
     def _fitted(self) -> ExactState | GridState:
         if self._state is None:
             raise InvalidArgumentError(
-                "this GaussianRandomField is not fitted yet; call `fit(xy, z)` before predicting"
-            )
+                "this GaussianRandomField is not fitted yet; call `fit(xy, z)` before predicting")
         return self._state
 
-    def predict(
-        self, xy: Any, return_std: bool = False
-    ) -> NDArray[np.float64] | tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """Posterior mean (and std of the latent f, without noise) at points.
-
-        With the grid method the std costs O(M²) per point (M inducing points); for a regular
-        grid of points :meth:`predict_grid` is much faster.
-
-        Parameters
-        ----------
-        xy : (m, 2) float, metres
-        return_std : bool
-
-        Returns
-        -------
-        mean : (m,) float
-        std : (m,) float, only with ``return_std``
-        """
+    def predict(self, xy: Any, return_std: bool = False) -> Array | tuple[Array, Array]:
+        """Posterior mean ``(m,)`` at ``xy (m, 2)`` metres, and with ``return_std`` the latent f's
+        std ``(m,)`` (without noise); on a regular grid :meth:`predict_grid` is much faster."""
         state = self._fitted()
         pts = check_array("xy", xy, (None, 2), what="coordinates in metres")
-        hyper = {"length_scale": self.length_scale, "signal_std": self.signal_std}
+        s = self.signal_std
         if isinstance(state, ExactState):
-            mean, std = predict_exact(state, pts, return_std=return_std, **hyper)
+            mean, std = predict_exact(state, pts, length_scale=self.length_scale, signal_std=s,
+                                      return_std=return_std)  # fmt: skip
         else:
             with grid_blas_threads():
-                mean, std = predict_grid_points(
-                    state,
-                    pts,
-                    return_std=return_std,
-                    length_scale=self.length_scale,
-                    signal_std=self.signal_std,
-                )
+                mean, std = predict_grid_points(state, pts, signal_std=s, return_std=return_std)
         mean += self.mean_
         return (mean, std) if return_std and std is not None else mean
 
-    def predict_grid(
-        self, xs: Any, ys: Any, return_std: bool = False
-    ) -> NDArray[np.float64] | tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """Posterior mean (and latent std) on the regular grid ``xs × ys``.
-
-        Parameters
-        ----------
-        xs : (nx,) float, metres
-        ys : (ny,) float, metres
-        return_std : bool
-
-        Returns
-        -------
-        mean : (ny, nx) float
-            Row = y, column = x (``grid_points`` order reshaped).
-        std : (ny, nx) float, only with ``return_std``
-        """
+    def predict_grid(self, xs: Any, ys: Any, return_std: bool = False
+                     ) -> Array | tuple[Array, Array]:  # fmt: skip
+        """Posterior mean (and latent std) ``(ny, nx)`` on the grid ``xs (nx,) × ys (ny,)`` metres,
+        row = y, column = x (``grid_points`` order reshaped)."""
         state = self._fitted()
         x = check_array("xs", xs, (None,), what="x coordinates in metres", min_rows=1)
         y = check_array("ys", ys, (None,), what="y coordinates in metres", min_rows=1)
-        hyper = {"length_scale": self.length_scale, "signal_std": self.signal_std}
+        s = self.signal_std
         if isinstance(state, ExactState):
-            gx, gy = np.meshgrid(x, y)
-            pts = np.column_stack([gx.ravel(), gy.ravel()])
-            mean, std = predict_exact(state, pts, return_std=return_std, **hyper)
+            mean, std = predict_exact(state, grid_points(x, y), length_scale=self.length_scale,
+                                      signal_std=s, return_std=return_std)  # fmt: skip
             mean = mean.reshape(y.size, x.size)
             std = None if std is None else std.reshape(y.size, x.size)
         else:
             with grid_blas_threads():
-                mean, std = predict_on_grid(state, x, y, return_std=return_std, **hyper)
+                mean, std = predict_on_grid(state, x, y, signal_std=s, return_std=return_std)
         mean = mean + self.mean_
         return (mean, std) if return_std and std is not None else mean

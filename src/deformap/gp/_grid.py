@@ -46,26 +46,23 @@ from deformap.gp._grid_basis import (
 
 __all__ = ["GRID_BLAS_THREADS", "GRID_MARGIN_FRACTION", "GRID_SPACING_FRACTION", "MAX_INDUCING"]
 
+Array = NDArray[np.float64]
+
 _LOG = logging.getLogger(__name__)
 
 #: Default inducing spacing = σ_w × this: the SE spectrum exp(−σ_w²ω²/4) at the grid's Nyquist
 #: frequency π/h is exp(−π²·9/4) ≈ 2e-10, so the grid loses nothing a float64 Cholesky would keep.
 GRID_SPACING_FRACTION = 1.0 / 3.0
 #: Inducing nodes extend this many σ_w beyond the data's bounding box, which keeps the Nyström
-#: residual at the box's edge near round-off; the compression to the data's modes makes the extra
-#: nodes nearly free.
+#: residual at the box's edge near round-off.
 GRID_MARGIN_FRACTION = 1.0
-#: Largest number of grid nodes accepted (their 1-D factors are cheap; B is at most this size,
-#: 8·M² bytes = 1.2 GB).
+#: Largest number of grid nodes accepted (B is at most this size, 8·M² bytes = 1.2 GB).
 MAX_INDUCING = 12_000
-#: BLAS threads while the grid path runs (None: leave the process's setting), applied with
-#: threadpoolctl where installed: its many mid-sized BLAS calls each wait for all their threads, so
-#: one descheduled thread on a shared machine costs more than a second thread gains.
+#: BLAS threads while the grid path runs (None: leave the process's setting; needs threadpoolctl),
+#: because its many mid-sized BLAS calls each wait for all their threads.
 GRID_BLAS_THREADS: int | None = 1
 _BLOCK_BYTES = 32 * 2**20  # bound on the intermediate of one block of cells in the data term
-#: Candidate cell widths (× σ_w) for the interpolated data term; the cheapest by the flop model in
-#: :func:`_cell_layout` is used.
-_CELL_WIDTHS = tuple(k / 6.0 for k in range(1, 13))
+_CELL_WIDTHS = tuple(k / 6.0 for k in range(1, 13))  # candidates (× σ_w) for _cell_layout
 
 
 @functools.cache
@@ -90,30 +87,20 @@ def grid_blas_threads() -> Iterator[None]:
 
 @dataclass(kw_only=True)
 class GridState:
-    """A fitted grid GP: the two axis bases, the factor of B, and α̂ = B⁻¹ b."""
+    """A fitted grid GP: the two axis bases, the factor of B, α̂ = B⁻¹ b and the ma·mb nodes."""
 
     axis_a: AxisBasis
     axis_b: AxisBasis
     a_is_x: bool
-    factor: tuple[NDArray[np.float64], bool]
-    alpha: NDArray[np.float64]  # (ra, rb)
+    factor: tuple[Array, bool]
+    alpha: Array  # (ra, rb)
     jitter_used: float
-    _b_inv: NDArray[np.float64] | None = field(default=None, repr=False)
+    n_inducing: int
+    _b_inv: Array | None = field(default=None, repr=False)
 
-    @property
-    def n_inducing(self) -> int:
-        """Grid nodes ma·mb."""
-        return self.axis_a.nodes.size * self.axis_b.nodes.size
-
-    @property
-    def n_features(self) -> int:
-        """Compressed inducing features ra·rb, the size of B."""
-        return self.axis_a.rank * self.axis_b.rank
-
-    def b_inv_blocks(self) -> NDArray[np.float64]:
-        """The blocks B⁻¹[(a, ·), (a', ·)] for a ≥ a' (``tril_indices(ra)`` order), each (rb, rb)
-        flattened: ``(ra (ra + 1) / 2, rb²)``, computed once. B⁻¹ is symmetric, so the other
-        blocks are their transposes."""
+    def b_inv_blocks(self) -> Array:
+        """``(ra (ra + 1) / 2, rb²)``: the (rb, rb) blocks B⁻¹[(a, ·), (a', ·)] for a ≥ a'
+        (``tril_indices(ra)`` order) flattened, computed once; the others are their transposes."""
         if self._b_inv is None:
             inv, info = lapack.dpotri(self.factor[0], lower=1)  # fills the lower triangle only
             if info != 0:
@@ -127,24 +114,15 @@ class GridState:
         return self._b_inv
 
 
-def inducing_axis(lo: float, hi: float, spacing: float, margin: float) -> NDArray[np.float64]:
+def inducing_axis(lo: float, hi: float, spacing: float, margin: float) -> Array:
     """Regular nodes from ``lo − margin`` to at least ``hi + margin`` with step ``spacing``."""
     start = lo - margin
     count = math.ceil((hi + margin - start) / spacing - 1e-9) + 1
     return np.asarray(start + spacing * np.arange(count), dtype=np.float64)
 
 
-def fit_grid(
-    xy: NDArray[np.float64],
-    resid: NDArray[np.float64],
-    noise_var: NDArray[np.float64],
-    *,
-    length_scale: float,
-    signal_std: float,
-    spacing: float,
-    jitter: float,
-    max_jitter: float,
-) -> GridState:
+def fit_grid(xy: Array, resid: Array, noise_var: Array, *, length_scale: float, signal_std: float,
+             spacing: float, jitter: float, max_jitter: float) -> GridState:
     """Assemble B and b with the Khatri–Rao structure and factorise B."""
     margin = GRID_MARGIN_FRACTION * length_scale
     nodes = [inducing_axis(xy[:, d].min(), xy[:, d].max(), spacing, margin) for d in range(2)]
@@ -153,8 +131,7 @@ def fit_grid(
         raise InvalidArgumentError(
             f"the grid method would need {m_total} inducing points (> {MAX_INDUCING}) for this "
             f"data extent; increase `inducing_spacing` (now {spacing:g} m) or `length_scale`, "
-            "or use method='exact'"
-        )
+            "or use method='exact'")
     a_is_x = nodes[0].size >= nodes[1].size
     ax_a, ax_b = (0, 1) if a_is_x else (1, 0)
     opts = {"length_scale": length_scale, "jitter": jitter, "max_jitter": max_jitter}
@@ -168,14 +145,8 @@ def fit_grid(
     # B = I + σe² Hᵀ Λ⁻¹ H has eigenvalues >= 1: no jitter, and its inverse is well conditioned.
     factor = sla.cho_factor(system, lower=True, overwrite_a=True, check_finite=False)
     alpha = sla.cho_solve(factor, rhs.ravel(), check_finite=False).reshape(rhs.shape)
-    return GridState(
-        axis_a=basis_a,
-        axis_b=basis_b,
-        a_is_x=a_is_x,
-        factor=factor,
-        alpha=alpha,
-        jitter_used=max(jit_a, jit_b),
-    )
+    return GridState(axis_a=basis_a, axis_b=basis_b, a_is_x=a_is_x, factor=factor, alpha=alpha,
+                     jitter_used=max(jit_a, jit_b), n_inducing=m_total)
 
 
 def _cell_layout(span: float, n: int, ra: int, rb: int, length_scale: float) -> tuple[int, int]:
@@ -196,13 +167,8 @@ def _cell_layout(span: float, n: int, ra: int, rb: int, length_scale: float) -> 
     return best[1], best[2]
 
 
-def _data_terms(
-    coord_a: NDArray[np.float64],
-    hb: NDArray[np.float64],
-    weight: NDArray[np.float64],
-    weighted_resid: NDArray[np.float64],
-    basis_a: AxisBasis,
-) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+def _data_terms(coord_a: Array, hb: Array, weight: Array, weighted_resid: Array,
+                basis_a: AxisBasis) -> tuple[Array, Array]:
     """σe² Hᵀ Λ⁻¹ H (M, M) and σe² Hᵀ Λ⁻¹ r (ra, rb) for points at ``coord_a`` (n,) with ``hb``.
 
     Along axis ``a`` the points are binned into cells; within a cell h_a(t) = Σ_r ℓ_r(t) h_a(ξ_r)
@@ -245,45 +211,27 @@ def _data_terms(
     return system, rhs
 
 
-def _spread_cells(
-    system: NDArray[np.float64], gram: NDArray[np.float64], h_nodes: NDArray[np.float64]
-) -> None:
-    """Add Σ_c (H_c ⊗ I) E_c (H_c ⊗ I)ᵀ to ``system`` (M, M) in place.
-
-    ``gram`` (cells, R·rb, R·rb) holds the E_c, ``h_nodes`` (cells, R, ra) the H_c.
-    """
+def _spread_cells(system: Array, gram: Array, h_nodes: Array) -> None:
+    """Add Σ_c (H_c ⊗ I) E_c (H_c ⊗ I)ᵀ to ``system`` (M, M) in place, from the E_c in ``gram``
+    (cells, R·rb, R·rb) and the H_c in ``h_nodes`` (cells, R, ra)."""
     cells, degree, ra = h_nodes.shape
     rb = gram.shape[1] // degree
     # half[c, r', b', a, b] = Σ_r E_c[r', b', r, b] H_c[r, a]
     half = np.matmul(
-        h_nodes.transpose(0, 2, 1)[:, None], gram.reshape(cells, degree * rb, degree, rb)
-    )
+        h_nodes.transpose(0, 2, 1)[:, None], gram.reshape(cells, degree * rb, degree, rb))
     # B[(a', b'), (a, b)] += Σ_{c, r'} H_c[r', a'] half[c, r', b', a, b]: one GEMM, written as
     # Bᵀ += halfᵀ H on the Fortran-ordered transpose so that it accumulates in place.
     target = system.reshape(ra, rb * ra * rb).T
-    out = blas.dgemm(
-        1.0,
-        half.reshape(cells * degree, rb * ra * rb).T,
-        np.asfortranarray(h_nodes.reshape(cells * degree, ra)),
-        beta=1.0,
-        c=target,
-        overwrite_c=1,
-    )
+    out = blas.dgemm(1.0, half.reshape(cells * degree, rb * ra * rb).T,
+                     np.asfortranarray(h_nodes.reshape(cells * degree, ra)), beta=1.0, c=target,
+                     overwrite_c=1)  # fmt: skip
     if not np.shares_memory(out, system):  # the wrapper copied after all
         target[...] = out
 
 
-def predict_grid_points(
-    state: GridState,
-    points: NDArray[np.float64],
-    *,
-    length_scale: float,
-    signal_std: float,
-    return_std: bool,
-    chunk: int = 512,
-) -> tuple[NDArray[np.float64], NDArray[np.float64] | None]:
+def predict_grid_points(state: GridState, points: Array, *, signal_std: float, return_std: bool,
+                        chunk: int = 512) -> tuple[Array, Array | None]:  # fmt: skip
     """Mean (without the constant) and latent std at arbitrary ``(m, 2)`` points."""
-    del length_scale  # the bases carry it
     ax_a, ax_b = (0, 1) if state.a_is_x else (1, 0)
     ha = state.axis_a.features(points[:, ax_a])
     hb = state.axis_b.features(points[:, ax_b])
@@ -294,23 +242,15 @@ def predict_grid_points(
     low = state.factor[0]
     for s in range(0, points.shape[0], chunk):
         blk = slice(s, s + chunk)
-        rows = (ha[blk, :, None] * hb[blk, None, :]).reshape(-1, state.n_features)
+        rows = (ha[blk, :, None] * hb[blk, None, :]).reshape(-1, low.shape[0])
         v = sla.solve_triangular(low, rows.T, lower=True, check_finite=False)
         var[blk] += np.einsum("ij,ij->j", v, v)
     return mean, signal_std * np.sqrt(np.maximum(var, 0.0))
 
 
-def predict_on_grid(
-    state: GridState,
-    xs: NDArray[np.float64],
-    ys: NDArray[np.float64],
-    *,
-    length_scale: float,
-    signal_std: float,
-    return_std: bool,
-) -> tuple[NDArray[np.float64], NDArray[np.float64] | None]:
+def predict_on_grid(state: GridState, xs: Array, ys: Array, *, signal_std: float,
+                    return_std: bool) -> tuple[Array, Array | None]:  # fmt: skip
     """Mean and latent std on the grid ``xs × ys`` as ``(ny, nx)`` images, in Kronecker form."""
-    del length_scale  # the bases carry it
     ta, tb = (xs, ys) if state.a_is_x else (ys, xs)
     ha = state.axis_a.features(ta)  # (na*, ra)
     hb = state.axis_b.features(tb)  # (nb*, rb)

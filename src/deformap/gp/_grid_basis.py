@@ -29,56 +29,49 @@ from deformap.gp._kernels import _se_1d
 
 __all__: list[str] = []
 
-#: Largest relative prior variance (fraction of σₑ²) the compressed features may miss at a data
-#: point, and twice the largest interpolation error of a data point's features. Both perturb the
-#: data's covariance by at most this much, the order of the grid's own Nyström residual at its edge
-#: (``_grid.GRID_MARGIN_FRACTION``).
+Array = NDArray[np.float64]
+
+#: Largest prior variance (fraction of σₑ²) the compressed features may miss at a data point, and
+#: twice the largest interpolation error of its features: the order of the grid's own Nyström
+#: residual at its edge.
 FEATURE_TOLERANCE = 1e-8
 _SAMPLES_PER_LENGTH = 24
 
 
 @dataclass(frozen=True, kw_only=True)
 class AxisBasis:
-    """Inducing nodes of one axis, the Cholesky factor of their kernel matrix and the projection Q."""
+    """Inducing nodes ``(m,)`` of one axis, the lower Cholesky factor ``(m, m)`` of their kernel
+    matrix and the projection Q ``(m, r)`` with orthonormal columns."""
 
-    nodes: NDArray[np.float64]  # (m,)
-    chol: NDArray[np.float64]  # (m, m) lower
-    proj: NDArray[np.float64]  # (m, r), orthonormal columns
+    nodes: Array
+    chol: Array
+    proj: Array
     length_scale: float
 
     @property
     def rank(self) -> int:
         return int(self.proj.shape[1])
 
-    def whitened(self, coords: NDArray[np.float64]) -> NDArray[np.float64]:
+    def whitened(self, coords: Array) -> Array:
         """``(n, m)`` rows g(t) = L⁻¹ k₁(u, t) for coordinates ``(n,)``."""
         k_1d = _se_1d(coords, self.nodes, self.length_scale)
         return sla.solve_triangular(self.chol, k_1d.T, lower=True, check_finite=False).T
 
-    def features(self, coords: NDArray[np.float64]) -> NDArray[np.float64]:
+    def features(self, coords: Array) -> Array:
         """``(n, r)`` rows h(t) = Qᵀ g(t)."""
         return self.whitened(coords) @ self.proj
 
 
-def axis_basis(
-    lo: float,
-    hi: float,
-    nodes: NDArray[np.float64],
-    *,
-    length_scale: float,
-    jitter: float,
-    max_jitter: float,
-    what: str,
-) -> tuple[AxisBasis, float]:
-    """Factorise the nodes' kernel matrix and compress to the modes of the data range [lo, hi].
+def axis_basis(lo: float, hi: float, nodes: Array, *, length_scale: float, jitter: float,
+               max_jitter: float, what: str) -> tuple[AxisBasis, float]:  # fmt: skip
+    """The basis of ``nodes`` compressed to the modes of the data range [lo, hi], and the relative
+    jitter its Cholesky needed.
 
-    The residual ‖g(t)‖² − ‖h(t)‖² is checked at samples ``_SAMPLES_PER_LENGTH`` per σ_w apart
-    over the range; it varies on the scale of the grid spacing (≥ 3 samples per node).
-    Returns the basis and the relative jitter the Cholesky needed.
+    The residual ‖g(t)‖² − ‖h(t)‖² is checked at ``_SAMPLES_PER_LENGTH`` samples per σ_w over the
+    range (≥ 3 per node at the default spacing), enough for its variation on the node spacing.
     """
     chol, jit = cholesky_with_jitter(
-        _se_1d(nodes, nodes, length_scale), jitter=jitter, max_jitter=max_jitter, what=what
-    )
+        _se_1d(nodes, nodes, length_scale), jitter=jitter, max_jitter=max_jitter, what=what)
     count = max(2, math.ceil((hi - lo) / length_scale * _SAMPLES_PER_LENGTH) + 1)
     samples = np.linspace(lo, hi, count)
     white = sla.solve_triangular(
@@ -109,19 +102,18 @@ def chebyshev_degree(half_width: float, length_scale: float, tolerance: float) -
             math.log(2.0)
             + nodes * math.log(half_width / (2.0 * length_scale))
             - math.lgamma(nodes + 1)
-            + 0.5 * (math.lgamma(2 * nodes + 1) - math.lgamma(nodes + 1))
-        )
+            + 0.5 * (math.lgamma(2 * nodes + 1) - math.lgamma(nodes + 1)))
         if log_bound <= math.log(tolerance):
             return nodes
     raise AssertionError("unreachable: the bound falls below any tolerance for δ < σ_w")
 
 
-def chebyshev_points(count: int) -> NDArray[np.float64]:
+def chebyshev_points(count: int) -> Array:
     """The ``count`` roots of T_count on [−1, 1]."""
     return np.cos((2.0 * np.arange(count) + 1.0) * np.pi / (2.0 * count))
 
 
-def lagrange_weights(t: NDArray[np.float64], points: NDArray[np.float64]) -> NDArray[np.float64]:
+def lagrange_weights(t: Array, points: Array) -> Array:
     """``(n, R)`` Lagrange basis polynomials of ``points`` (R,) at ``t`` (n,), both in [−1, 1].
 
     The product form (prefix and suffix products of t − ξ_k), not the barycentric one, so that ``t``

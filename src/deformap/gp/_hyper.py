@@ -19,9 +19,11 @@ from scipy.optimize import minimize
 
 from deformap._validation import check_array, check_int, check_positive, describe
 from deformap.errors import InvalidArgumentError, NotPositiveDefiniteError
-from deformap.gp._kernels import _se_of_sqdist, _sqdist
+from deformap.gp._kernels import _check_data, _sqdist
 
 __all__ = ["GPHyperparameters", "default_bounds", "fit_hyperparameters", "log_marginal_likelihood"]
+
+Array = NDArray[np.float64]
 
 _LOG = logging.getLogger(__name__)
 _NAMES = ("length_scale", "signal_std", "noise_std")
@@ -29,19 +31,8 @@ _NAMES = ("length_scale", "signal_std", "noise_std")
 
 @dataclass(frozen=True)
 class GPHyperparameters:
-    """Kernel hyperparameters and the log marginal likelihood they reach.
-
-    Attributes
-    ----------
-    length_scale : float, metres
-        σ_w.
-    signal_std : float
-        σₑ.
-    noise_std : float
-        σₙ.
-    log_marginal_likelihood : float
-        log p(z | θ) on the points it was fitted on (nan when not evaluated).
-    """
+    """Kernel hyperparameters σ_w (metres), σₑ and σₙ (units of z), and the log marginal
+    likelihood log p(z | θ) they reach on the points they were fitted on (nan if not evaluated)."""
 
     length_scale: float
     signal_std: float
@@ -49,12 +40,10 @@ class GPHyperparameters:
     log_marginal_likelihood: float = float("nan")
 
 
-def _lml_and_grad(
-    theta: NDArray[np.float64], d2: NDArray[np.float64], resid: NDArray[np.float64]
-) -> tuple[float, NDArray[np.float64]]:
+def _lml_and_grad(theta: Array, d2: Array, resid: Array) -> tuple[float, Array]:
     """log p(r | θ) and its gradient in θ = log(σ_w, σₑ, σₙ); ``d2`` are squared distances."""
     w, s, sn = np.exp(theta)
-    unit = _se_of_sqdist(d2, w)  # the kernel of _kernels, on distances computed once
+    unit = np.exp(-d2 / w**2)  # the kernel of _kernels, on distances computed once
     kmat = s**2 * unit
     kmat[np.diag_indices_from(kmat)] += sn**2
     try:
@@ -62,115 +51,68 @@ def _lml_and_grad(
     except np.linalg.LinAlgError:
         raise NotPositiveDefiniteError(
             f"K + σn²I is not positive definite at σw={w:g}, σe={s:g}, σn={sn:g}; "
-            "raise the lower bound of `noise_std`"
-        ) from None
+            "raise the lower bound of `noise_std`") from None
     alpha = sla.cho_solve(factor, resid, check_finite=False)
     n = resid.size
     lml = -0.5 * resid @ alpha - np.sum(np.log(np.diag(factor[0]))) - 0.5 * n * np.log(2 * np.pi)
     inner = np.outer(alpha, alpha) - sla.cho_solve(factor, np.eye(n), check_finite=False)
-    grads = np.array(
-        [
-            0.5 * np.sum(inner * (s**2 * unit * 2.0 * d2 / w**2)),  # ∂K/∂log σw
-            0.5 * np.sum(inner * (2.0 * kmat - 2.0 * sn**2 * np.eye(n))),  # ∂K/∂log σe
-            0.5 * np.trace(inner) * 2.0 * sn**2,  # ∂K/∂log σn
-        ]
-    )
+    grads = np.array([
+        0.5 * np.sum(inner * (s**2 * unit * 2.0 * d2 / w**2)),  # ∂K/∂log σw
+        0.5 * np.sum(inner * (2.0 * kmat - 2.0 * sn**2 * np.eye(n))),  # ∂K/∂log σe
+        0.5 * np.trace(inner) * 2.0 * sn**2,  # ∂K/∂log σn
+    ])  # fmt: skip
     return float(lml), grads
 
 
-def log_marginal_likelihood(
-    xy: Any,
-    z: Any,
-    *,
-    length_scale: float,
-    signal_std: float,
-    noise_std: float,
-    eval_gradient: bool = False,
-) -> float | tuple[float, NDArray[np.float64]]:
-    """Exact log p(z | θ) of the constant-mean GP (the data mean subtracted), RW2006 Eq. 2.30.
-
-    Parameters
-    ----------
-    xy : (n, 2) float, metres
-    z : (n,) float
-    length_scale, signal_std, noise_std : float
-    eval_gradient : bool
-        Also return the gradient with respect to (log σ_w, log σₑ, log σₙ), RW2006 Eq. 5.9.
-    """
-    pts, vals = _check_data(xy, z)
-    theta = np.log(
-        [
-            check_positive(name, value)
-            for name, value in zip(_NAMES, (length_scale, signal_std, noise_std), strict=True)
-        ]
-    )
+def log_marginal_likelihood(xy: Any, z: Any, *, length_scale: float, signal_std: float,
+                            noise_std: float, eval_gradient: bool = False
+                            ) -> float | tuple[float, Array]:  # fmt: skip
+    """Exact log p(z | θ) of the constant-mean GP (data mean subtracted), RW2006 Eq. 2.30, for
+    ``z (n,)`` at ``xy (n, 2)``; with ``eval_gradient`` also its gradient in
+    (log σ_w, log σₑ, log σₙ), RW2006 Eq. 5.9."""
+    pts, vals = _check_data(xy, z, min_rows=2)
+    values = (length_scale, signal_std, noise_std)
+    theta = np.log([check_positive(n, v) for n, v in zip(_NAMES, values, strict=True)])
     lml, grad = _lml_and_grad(theta, _sqdist(pts, pts), vals - vals.mean())
     return (lml, grad) if eval_gradient else lml
 
 
-def _check_data(xy: Any, z: Any) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    pts = check_array("xy", xy, (None, 2), what="coordinates in metres", min_rows=2)
-    vals = check_array("z", z, (None,), what="values", min_rows=2)
-    if vals.size != pts.shape[0]:
-        raise InvalidArgumentError(
-            f"`z` must have one value per row of `xy` ({pts.shape[0]}); got {vals.size}"
-        )
-    return pts, vals
+def _diagonal_and_spread(xy: Any, z: Any) -> tuple[float, float]:
+    """The bounding-box diagonal D of ``xy`` and the std s of ``z``."""
+    return float(np.hypot(*np.ptp(xy, axis=0))), float(np.std(z))
 
 
-def default_bounds(xy: Any, z: Any) -> NDArray[np.float64]:
+def default_bounds(xy: Any, z: Any) -> Array:
     """``(3, 2)`` bounds (low, high) on (σ_w, σₑ, σₙ), scaled by the data ``xy (n, 2)``, ``z (n,)``.
 
     σ_w from 1/1000 to 2× the bounding-box diagonal D (shorter is unresolvable noise, longer a
     plane); σₑ from 1/100 to 100× the data's std s; σₙ from 1e-4 s (a near-interpolant that a
     Cholesky still factorises) to 10 s.
     """
-    xy = np.asarray(xy, dtype=float)
-    diag = float(np.hypot(*np.ptp(xy, axis=0)))
-    spread = float(np.std(np.asarray(z, dtype=float)))
+    diag, spread = _diagonal_and_spread(np.asarray(xy, dtype=float), np.asarray(z, dtype=float))
     return np.array(
-        [[1e-3 * diag, 2.0 * diag], [1e-2 * spread, 1e2 * spread], [1e-4 * spread, 1e1 * spread]]
-    )
+        [[1e-3 * diag, 2.0 * diag], [1e-2 * spread, 1e2 * spread], [1e-4 * spread, 1e1 * spread]])
 
 
-def fit_hyperparameters(
-    xy: Any,
-    z: Any,
-    *,
-    rng: np.random.Generator,
-    init: GPHyperparameters | None = None,
-    n_restarts: int = 3,
-    max_points: int = 2000,
-    bounds: Any = None,
-) -> GPHyperparameters:
-    """Maximise the log marginal likelihood over (σ_w, σₑ, σₙ).
+def fit_hyperparameters(xy: Any, z: Any, *, rng: np.random.Generator,
+                        init: GPHyperparameters | None = None, n_restarts: int = 3,
+                        max_points: int = 2000, bounds: Any = None) -> GPHyperparameters:  # fmt: skip
+    """The (σ_w, σₑ, σₙ) of largest log marginal likelihood of ``z (n,)`` at ``xy (n, 2)``, with
+    that likelihood on the points used.
 
     Parameters
     ----------
-    xy : (n, 2) float, metres
-    z : (n,) float
     rng : numpy.random.Generator
         Draws the subset and the restart points (same seed, same result).
     init : GPHyperparameters, optional
-        First starting point; without it the first start is (D/10, s, s/10) with D the
-        bounding-box diagonal and s the data's std.
+        First start; default (D/10, s, s/10), D the bounding-box diagonal, s the data's std.
     n_restarts : int
-        Further starts drawn log-uniformly within the bounds.
+        Further starts drawn log-uniformly within ``bounds`` ((3, 2) low and high of σ_w, σₑ,
+        σₙ; default :func:`default_bounds`).
     max_points : int
         At most this many points (a random subset) enter the O(n³) objective.
-    bounds : (3, 2) array_like, optional
-        (low, high) for (σ_w, σₑ, σₙ); default :func:`default_bounds`.
-
-    Returns
-    -------
-    GPHyperparameters
-        The best optimum, with its log marginal likelihood on the subset.
-
-    References
-    ----------
-    Rasmussen & Williams 2006, §5.4.1 and Eq. 5.9.
     """
-    pts, vals = _check_data(xy, z)
+    pts, vals = _check_data(xy, z, min_rows=2)
     if not isinstance(rng, np.random.Generator):
         raise InvalidArgumentError(f"`rng` must be a numpy.random.Generator; got {describe(rng)}")
     n_restarts = check_int("n_restarts", n_restarts, minimum=0)
@@ -191,30 +133,20 @@ def fit_hyperparameters(
     d2 = _sqdist(pts, pts)
     starts = [_first_start(init, pts, vals, log_box)]
     starts += [rng.uniform(log_box[:, 0], log_box[:, 1]) for _ in range(n_restarts)]
-    best: tuple[float, NDArray[np.float64]] | None = None
-    for theta0 in starts:
-        result = _optimise(theta0, d2, resid, log_box)
-        if result is not None and (best is None or result[0] > best[0]):
-            best = result
-    if best is None:
+    results = [r for r in (_optimise(t, d2, resid, log_box) for t in starts) if r is not None]
+    if not results:
         raise NotPositiveDefiniteError(
             "every start of the likelihood optimisation failed; raise the lower bound of "
-            "`noise_std` in `bounds`"
-        )
+            "`noise_std` in `bounds`")
+    best = max(results, key=lambda r: r[0])
     w, s, sn = np.exp(best[1])
     _LOG.info("fitted σw=%.4g σe=%.4g σn=%.4g (lml %.4g)", w, s, sn, best[0])
     return GPHyperparameters(float(w), float(s), float(sn), best[0])
 
 
-def _first_start(
-    init: GPHyperparameters | None,
-    xy: NDArray[np.float64],
-    z: NDArray[np.float64],
-    log_box: NDArray[np.float64],
-) -> NDArray[np.float64]:
+def _first_start(init: GPHyperparameters | None, xy: Array, z: Array, log_box: Array) -> Array:
     if init is None:
-        diag = float(np.hypot(*np.ptp(xy, axis=0)))
-        spread = float(np.std(z))
+        diag, spread = _diagonal_and_spread(xy, z)
         guess = np.array([diag / 10, spread, spread / 10])
     elif isinstance(init, GPHyperparameters):
         guess = np.array([check_positive(f"init.{name}", getattr(init, name)) for name in _NAMES])
@@ -223,13 +155,9 @@ def _first_start(
     return np.clip(np.log(guess), log_box[:, 0], log_box[:, 1])
 
 
-def _optimise(
-    theta0: NDArray[np.float64],
-    d2: NDArray[np.float64],
-    resid: NDArray[np.float64],
-    log_box: NDArray[np.float64],
-) -> tuple[float, NDArray[np.float64]] | None:
-    def objective(theta: NDArray[np.float64]) -> tuple[float, NDArray[np.float64]]:
+def _optimise(theta0: Array, d2: Array, resid: Array, log_box: Array
+              ) -> tuple[float, Array] | None:  # fmt: skip
+    def objective(theta: Array) -> tuple[float, Array]:
         try:
             lml, grad = _lml_and_grad(theta, d2, resid)
         except NotPositiveDefiniteError:

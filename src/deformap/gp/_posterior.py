@@ -1,13 +1,14 @@
 """Posterior algebra that needs no observed values: variance of a design, and the linear smoother.
 
-A Gaussian process's posterior covariance depends on where the observations are and on their
-noise, never on the values observed (RW2006 Eq. 2.24 and 2.26), so it can be computed for
-observations not yet made: :class:`PosteriorDesign` gives the posterior over a domain for the
-observations made plus any subset of candidate places, and :func:`variance_after_adding` the
-variance after one more observation at each candidate (an exact rank-one update,
+A GP's posterior covariance depends on where the observations are and on their noise, never on
+the values observed (RW2006 Eq. 2.24 and 2.26), so it can be computed for observations not yet
+made: :class:`PosteriorDesign` gives the posterior over a domain for the observations made plus
+any subset of candidate places, and :func:`variance_after_adding` the variance after one more
+observation at each candidate (an exact rank-one update,
 ``σ²ₐ(x) = σ²(x) − cov(c, x)² / (σ²(c) + σₙ²)``). The posterior mean is linear in the data,
-``m = K*ₓ (K + Σ)⁻¹ y`` (RW2006 §2.6): :func:`apply_smoother` applies that linear map to any
-vectors ``y`` (draws of noise, for instance) without forming it.
+``m = K*ₓ (K + Σ)⁻¹ y`` (RW2006 §2.6): :func:`apply_smoother` applies that map to any vectors
+``y`` (draws of noise, for instance) without forming it. Places are ``(n, 2)`` metres throughout;
+``length_scale`` and ``signal_std`` are the kernel's σ_w and σₑ (:func:`squared_exponential`).
 
 References
 ----------
@@ -34,26 +35,36 @@ __all__ = ["PosteriorDesign", "apply_smoother", "variance_after_adding"]
 Array = NDArray[np.float64]
 
 
+def _per_candidate(name: str, value: Any, shape: tuple[int, ...], *, allow_zero: bool) -> Array:
+    """``value``, a number or an array of ``shape``, as one finite number > 0 (or ≥ 0) per
+    candidate."""
+    size = int(np.prod(shape))
+    message = (f"`{name}` must be a number {'>=' if allow_zero else '>'} 0 or ({size},) of them; "
+               f"got {value!r}")
+    try:
+        out = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise InvalidArgumentError(message) from None
+    if out.ndim == 0:
+        return np.full(size, check_positive(name, float(out), allow_zero=allow_zero))
+    if (out.shape != shape or not np.all(np.isfinite(out))
+            or np.any(out < 0 if allow_zero else out <= 0)):
+        raise InvalidArgumentError(message)
+    return out
+
+
 def variance_after_adding(variance: Any, covariance: Any, candidate_variance: Any,
                           noise_var: float | Array) -> Array:
-    """Posterior variance over a domain after one more observation at each candidate.
+    """``(c, d)`` posterior variance on a domain after one more observation at each candidate:
+    row ``j`` is ``variance − covariance[j]² / (candidate_variance[j] + noise_var)``.
 
     Parameters
     ----------
-    variance : (d,) float
-        Posterior variance on the domain now.
-    covariance : (c, d) float
-        Posterior covariance between each candidate and the domain now.
-    candidate_variance : (c,) float
-        Posterior variance at each candidate now.
+    variance, covariance, candidate_variance : (d,), (c, d), (c,) float
+        The posterior now: variance on the domain, covariance between each candidate and the
+        domain, variance at each candidate.
     noise_var : float or (c,) float
-        Noise variance of the new observation (≥ 0), or of one at each candidate.
-
-    Returns
-    -------
-    (c, d) float
-        Row ``j``: the variance on the domain once candidate ``j`` is observed,
-        ``variance − covariance[j]² / (candidate_variance[j] + noise_var)``.
+        Noise variance (≥ 0) of the new observation, the same at every candidate or one each.
     """
     var = np.asarray(variance, dtype=float)
     cov = np.asarray(covariance, dtype=float)
@@ -61,19 +72,8 @@ def variance_after_adding(variance: Any, covariance: Any, candidate_variance: An
     if cov.shape != (var_c.size, var.size):
         raise InvalidArgumentError(
             f"`covariance` must be (candidates, domain) = ({var_c.size}, {var.size}); "
-            f"got {cov.shape}"
-        )
-    try:
-        noise = np.asarray(noise_var, dtype=float)
-    except (TypeError, ValueError):
-        raise InvalidArgumentError(
-            f"`noise_var` must be a number >= 0 or ({var_c.size},) of them; got {noise_var!r}"
-        ) from None
-    if noise.ndim == 0:
-        noise = np.full(var_c.size, check_positive("noise_var", float(noise), allow_zero=True))
-    elif noise.shape != var_c.shape or not np.all(np.isfinite(noise)) or np.any(noise < 0):
-        raise InvalidArgumentError(
-            f"`noise_var` must be a number >= 0 or ({var_c.size},) of them; got {noise_var!r}")
+            f"got {cov.shape}")
+    noise = _per_candidate("noise_var", noise_var, var_c.shape, allow_zero=True)
     return np.asarray(var[None, :] - cov**2 / (var_c + noise)[:, None])
 
 
@@ -86,18 +86,12 @@ class PosteriorDesign:
 
     Parameters
     ----------
-    observed_xy : (p, 2) float, metres
-        Where the observations made are (``p`` may be 0).
-    observed_noise_std : (p,) float
-        Their noise standard deviations (> 0).
-    candidates : (c, 2) float, metres
-        Places where an observation may be added.
-    domain : (d, 2) float, metres
-        Where the posterior is wanted.
-    length_scale, signal_std : float
-        The kernel (σ_w, σₑ) of :func:`squared_exponential`.
+    observed_xy, observed_noise_std : (p, 2), (p,) float
+        The observations made (``p`` may be 0) and their noise standard deviations (> 0).
+    candidates, domain : (c, 2), (d, 2) float
+        Places where an observation may be added; where the posterior is wanted.
     candidate_noise_std : float or (c,) float
-        The noise standard deviation of an observation at a candidate (> 0), the same at every
+        The noise standard deviation (> 0) of an observation at a candidate, the same at every
         candidate or one each.
     """
 
@@ -110,20 +104,8 @@ class PosteriorDesign:
                 f"`observed_noise_std` must be positive standard deviations; got {noise.min()!r}")
         cand = check_array("candidates", candidates, (None, 2), what="metres")
         dom = check_array("domain", domain, (None, 2), what="metres")
-        try:
-            new_noise = np.asarray(candidate_noise_std, dtype=float)
-        except (TypeError, ValueError):
-            raise InvalidArgumentError(
-                f"`candidate_noise_std` must be a number > 0 or ({cand.shape[0]},) of them; got "
-                f"{candidate_noise_std!r}") from None
-        if new_noise.ndim == 0:
-            new_noise = np.full(cand.shape[0], check_positive("candidate_noise_std",
-                                                              float(new_noise)))
-        elif (new_noise.shape != (cand.shape[0],) or not np.all(np.isfinite(new_noise))
-              or np.any(new_noise <= 0)):
-            raise InvalidArgumentError(
-                f"`candidate_noise_std` must be a number > 0 or ({cand.shape[0]},) of them; got "
-                f"{candidate_noise_std!r}")
+        new_noise = _per_candidate("candidate_noise_std", candidate_noise_std, (cand.shape[0],),
+                                   allow_zero=False)  # fmt: skip
         kern = {"length_scale": length_scale, "signal_std": signal_std}
         self.prior = check_positive("signal_std", signal_std) ** 2
         self.new_var = new_noise**2
@@ -134,32 +116,15 @@ class PosteriorDesign:
         self.k_cc = squared_exponential(cand, cand, **kern)
         self.k_cd = squared_exponential(cand, dom, **kern)
 
-    @property
-    def n_candidates(self) -> int:
-        """Number of candidates ``c``."""
-        return int(self.k_cc.shape[0])
-
     def posterior(self, chosen: Sequence[int]) -> tuple[Array, Array, Array]:
-        """The posterior given the observations made and the ``chosen`` candidates.
-
-        Parameters
-        ----------
-        chosen : sequence of int
-            Indices into the candidates, each observed once with its ``candidate_noise_std``.
-
-        Returns
-        -------
-        variance : (d,) float
-            Posterior variance on the domain.
-        covariance : (c, d) float
-            Posterior covariance between each candidate and the domain.
-        candidate_variance : (c,) float
-            Posterior variance at each candidate.
-        """
+        """The posterior given the observations made and the ``chosen`` candidates (indices,
+        each observed once): the variance ``(d,)`` on the domain, the covariance ``(c, d)``
+        between each candidate and the domain, and the variance ``(c,)`` at each candidate."""
         idx = np.asarray(chosen, dtype=np.int64).reshape(-1)
-        if idx.size and (idx.min() < 0 or idx.max() >= self.n_candidates):
+        n_candidates = self.k_cc.shape[0]
+        if idx.size and (idx.min() < 0 or idx.max() >= n_candidates):
             raise InvalidArgumentError(
-                f"`chosen` must index the {self.n_candidates} candidates; got {idx.tolist()}")
+                f"`chosen` must index the {n_candidates} candidates; got {idx.tolist()}")
         noise = np.concatenate([self.observed_noise**2, self.new_var[idx]])
         k_ss = np.block([[self.k_pp, self.k_pc[:, idx]],
                          [self.k_pc[:, idx].T, self.k_cc[np.ix_(idx, idx)]]])
@@ -191,27 +156,11 @@ class PosteriorDesign:
 def apply_smoother(data_xy: Any, noise_std: Any, query_xy: Any, values: Any, *,
                    length_scale: float, signal_std: float, jitter: float = 1e-10,
                    max_jitter: float = 1e-4) -> Array:
-    """The GP mean's linear map applied to ``values``: ``K(query, data) (K + Σ)⁻¹ values``.
-
-    Parameters
-    ----------
-    data_xy : (n, 2) float, metres
-        Where the data are.
-    noise_std : (n,) float
-        Their noise standard deviations (``Σ = diag(noise_std²)``).
-    query_xy : (q, 2) float, metres
-    values : (n,) or (n, k) float
-        One or ``k`` data vectors.
-    length_scale, signal_std : float
-        The kernel (σ_w, σₑ).
-    jitter, max_jitter : float
-        Relative to σₑ², as in :func:`cholesky_with_jitter`.
-
-    Returns
-    -------
-    (q,) or (q, k) float
-        The posterior mean each data vector would give (zero prior mean).
-    """
+    """The GP mean's linear map applied to ``values``: ``K(query, data) (K + Σ)⁻¹ values``, the
+    ``(q,)`` or ``(q, k)`` posterior mean (zero prior mean) at ``query_xy`` ``(q, 2)`` that each
+    of the one or ``k`` data vectors ``values`` ``(n,)`` or ``(n, k)`` at ``data_xy`` ``(n, 2)``
+    would give, with noise ``Σ = diag(noise_std²)``; ``jitter`` and ``max_jitter`` as in
+    :class:`GaussianRandomField`."""
     data = check_array("data_xy", data_xy, (None, 2), what="metres", min_rows=1)
     noise = check_array("noise_std", noise_std, (data.shape[0],))
     query = check_array("query_xy", query_xy, (None, 2), what="metres")

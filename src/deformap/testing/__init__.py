@@ -5,55 +5,21 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 
-from deformap.mechanics import (
-    INDENTER_AREA_M2,
-    elastic_dent,
-    hardness_to_youngs_modulus,
-    hertz_surface_deflection,
-)
+from deformap.mechanics import elastic_dent, hardness_to_youngs_modulus, hertz_surface_deflection
 
-__all__ = [
-    "FOAM_INDENTER_AREA_M2",
-    "assert_allclose_m",
-    "coarse_world",
-    "elastic_dent",
-    "flat_patch",
-    "hardness_to_modulus",
-    "hertz_surface_deflection",
-    "synthetic_poke",
-]
+__all__ = ["assert_allclose_m", "coarse_world", "elastic_dent", "hardness_to_modulus",
+           "hertz_surface_deflection", "synthetic_poke"]
+
+# Elastic dents, an analytic reference for the β estimation that is not shape matching, from
+# deformap.mechanics; hardness_to_modulus is its hardness_to_youngs_modulus.
+hardness_to_modulus = hardness_to_youngs_modulus
 
 
 def assert_allclose_m(actual: Any, desired: Any, *, atol_m: float, err_msg: str = "") -> None:
     """Assert two arrays of lengths agree within ``atol_m`` metres (absolute)."""
-    np.testing.assert_allclose(
-        np.asarray(actual, dtype=float), np.asarray(desired, dtype=float), rtol=0, atol=atol_m,
-        err_msg=err_msg,
-    )
-
-
-def flat_patch(n: int = 10, spacing_m: float = 0.005, height_m: float = 0.05) -> NDArray[np.float64]:
-    """``(n*n, 3)`` points of a flat square patch at ``height_m``, row-major in (y, x)."""
-    xs = (np.arange(n) - (n - 1) / 2) * spacing_m
-    gx, gy = np.meshgrid(xs, xs)
-    return np.column_stack([gx.ravel(), gy.ravel(), np.full(n * n, height_m)])
-
-
-# ---- elastic dents (an analytic reference for the β estimation; not shape matching) ----------
-# They live in deformap.mechanics; these names are kept for users' tests and the examples.
-
-FOAM_INDENTER_AREA_M2 = INDENTER_AREA_M2
-"""Area of the hardness test's indenter (ISO 2439, 323 cm²), as
-:data:`deformap.mechanics.INDENTER_AREA_M2`."""
-
-hardness_to_modulus = hardness_to_youngs_modulus
-"""Young's modulus (Pa) of a foam of hardness ``hardness_n`` (N at 40 % compression):
-:func:`deformap.mechanics.hardness_to_youngs_modulus`."""
-
-
-# ---- simulated world (deformap.world) ----
+    np.testing.assert_allclose(np.asarray(actual, dtype=float), np.asarray(desired, dtype=float),
+                               rtol=0, atol=atol_m, err_msg=err_msg)  # fmt: skip
 
 
 def coarse_world(scenario: str = "heterogeneous-60-110-rigid", seed: int = 0, **overrides: Any

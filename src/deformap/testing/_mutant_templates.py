@@ -13,8 +13,8 @@ import numpy as np
 
 __all__ = ["RAW_CHUNK_BYTES", "RAW_RATES_HZ", "make_templates"]
 
-#: The raw template's rates [Hz] (camera, /tf, force sensor) and chunk size: a few compressed
-#: chunks of a bag small enough to read in a few hundredths of a second.
+#: The raw template's rates [Hz] (camera, /tf, force sensor) and chunk size: a bag of a few
+#: compressed chunks that reads in a few hundredths of a second.
 RAW_RATES_HZ = (15.0, 25.0, 100.0)
 RAW_CHUNK_BYTES = 16 * 1024
 
@@ -101,35 +101,26 @@ def make_templates(root: Path) -> dict[str, Path]:
         import mcap_ros2.writer  # noqa: F401
     except ImportError:
         return out
-    out["raw-mcap"] = _raw_template(root / "raw", out["session-folder"])
-    out["raw-db3"] = _raw_db3_template(root / "raw-db3", out["raw-mcap"])
+    out["raw-mcap"], out["raw-db3"] = _raw_templates(root, out["session-folder"])
     return out
 
 
-def _raw_template(folder: Path, session_folder: Path) -> Path:
-    """The synthetic session's presses written as a robot records them, with its settings YAML
-    beside the bag (``NAME.deformap.yaml``); returns the bag."""
+def _raw_templates(root: Path, session_folder: Path) -> tuple[Path, Path]:
+    """The session's presses as a robot records them, and the same messages as a lone sqlite3
+    ``.db3`` written by rosbags (not deformap), each with the settings YAML beside it."""
     import yaml
 
     from deformap.replay import load_session
-    from deformap.testing.robotbag import raw_settings, write_raw_bag
+    from deformap.testing.robotbag import copy_to_db3, raw_settings, write_raw_bag
 
-    folder.mkdir()
+    (root / "raw").mkdir()
     session = load_session(session_folder)
     camera_hz, tf_hz, wrench_hz = RAW_RATES_HZ
-    bag = folder / "lab.mcap"
+    bag = root / "raw" / "lab.mcap"
     write_raw_bag(bag, session, camera_hz=camera_hz, tf_hz=tf_hz, wrench_hz=wrench_hz,
                   chunk_size=RAW_CHUNK_BYTES)  # fmt: skip
-    settings = raw_settings(session, force_n=1.0)
-    (folder / "lab.deformap.yaml").write_text(yaml.safe_dump(settings, sort_keys=False))
-    return bag
-
-
-def _raw_db3_template(folder: Path, mcap_bag: Path) -> Path:
-    """The raw MCAP bag's messages as a lone sqlite3 ``.db3``, written by rosbags' rosbag2
-    writer (not deformap's), with the same settings YAML beside it; returns the ``.db3``."""
-    from deformap.testing.robotbag import copy_to_db3
-
-    folder.mkdir()
-    shutil.copy(mcap_bag.with_name(f"{mcap_bag.stem}.deformap.yaml"), folder)
-    return copy_to_db3(mcap_bag, folder / "lab.db3")
+    settings = yaml.safe_dump(raw_settings(session, force_n=1.0), sort_keys=False)
+    (root / "raw" / "lab.deformap.yaml").write_text(settings)
+    (root / "raw-db3").mkdir()
+    shutil.copy(root / "raw" / "lab.deformap.yaml", root / "raw-db3")
+    return bag, copy_to_db3(bag, root / "raw-db3" / "lab.db3")

@@ -32,17 +32,12 @@ KINDS: dict[str, tuple[str, ...]] = {
     "npz": ("flip", "truncate", "extend", "member-flip", "member-truncate", "member-extend",
             "member-npy-header", "member-shape"),
     "session": ("yaml", "file", "link"),
-    # the YAML a user writes: a run configuration (`deformap config dump`) and a scenario
     "config": ("yaml", "flip", "truncate"),
     "scenario": ("yaml", "flip", "truncate"),
-    # a bag as a robot records it (``deformap map BAG``): the MCAP's bytes, one of its records,
-    # one message's bytes in a bag rewritten so that every CRC matches, and the YAML beside it
+    # a bag as a robot records it: its bytes, one record, one message (the CRCs made to match),
+    # the settings YAML beside it; as sqlite3 (rosbag2's default before Iron) rows and topics too
     "raw-mcap": ("flip", "truncate", "extend", "record", "message-flip", "message-truncate",
                  "message-extend", "yaml"),
-    # the same bag as sqlite3 (``.db3``, rosbag2's default before Iron) written by rosbags: the
-    # file's bytes, one message row's data (sqlite3 has no CRC to make match), a message row
-    # deleted or repeated or its data or time given another SQL type, one field of a ``topics``
-    # row, and the YAML beside it
     "raw-db3": ("flip", "truncate", "extend", "message-flip", "message-truncate",
                 "message-extend", "row-delete", "row-repeat", "row-type", "topic", "yaml"),
 }
@@ -54,14 +49,15 @@ def kinds_of(reader: str) -> tuple[str, ...]:
     return KINDS.get(reader) or KINDS[reader.split("-")[0]]
 
 
-
-# ----------------------------------------------------------------------------- files
-
-
 def _flip(data: bytes, rng: np.random.Generator) -> bytes:
-    out = bytearray(data)
     for _ in range(int(rng.integers(1, 5))):
-        out[int(rng.integers(len(out)))] ^= 1 << int(rng.integers(8))
+        data = _flip_at(data, int(rng.integers(len(data))), rng)
+    return data
+
+
+def _flip_at(data: bytes, at: int, rng: np.random.Generator) -> bytes:
+    out = bytearray(data)
+    out[at] ^= 1 << int(rng.integers(8))
     return bytes(out)
 
 
@@ -90,8 +86,8 @@ def _header_end(data: bytes) -> int:
 
 
 def _header(data: bytes, rng: np.random.Generator) -> bytes:
-    """Edit one header line: a token replaced (a number, or another word of the header), the
-    line dropped or repeated."""
+    """One header line's token replaced (a number, another word of the header), or the line
+    dropped or repeated."""
     end = _header_end(data)
     lines = data[:end].split(b"\n")
     i = int(rng.integers(len(lines)))
@@ -143,12 +139,7 @@ def _npz_member(data: bytes, rng: np.random.Generator, kind: str) -> bytes:
         for name in names:
             raw = src.read(name)
             if name == victim:
-                if kind == "npy-header":
-                    raw = _header_npy(raw, rng)
-                elif kind == "shape":
-                    raw = _shape_npy(raw, rng)
-                else:
-                    raw = FILE_MUTATORS[kind](raw, rng)
+                raw = {"npy-header": _header_npy, "shape": _shape_npy, **FILE_MUTATORS}[kind](raw, rng)
             dst.writestr(name, raw)
     return buf.getvalue()
 
@@ -170,9 +161,6 @@ def _shape_npy(raw: bytes, rng: np.random.Generator) -> bytes:
            b"-1, 3", b"10000000000000, 3"][int(rng.integers(9))]  # fmt: skip
     padded = match.group(0).replace(match.group(1), new)
     return raw.replace(match.group(0), padded, 1)
-
-
-# ----------------------------------------------------------------------------- sessions
 
 
 def _yaml_edit(text: str, rng: np.random.Generator) -> str:
@@ -220,11 +208,9 @@ def mutate_session(template: Path, out: Path, kind: str, rng: np.random.Generato
         os.symlink(outside, victim)
     else:
         victim = data_files[int(rng.integers(len(data_files)))]
-        name = ("flip", "truncate", "extend", "header", "count")[int(rng.integers(5))]
+        name = tuple(FILE_MUTATORS)[int(rng.integers(5))]
         victim.write_bytes(FILE_MUTATORS[name](victim.read_bytes(), rng))
 
-
-# ----------------------------------------------------------------------------- raw bags
 
 _MCAP_MAGIC = b"\x89MCAP0\r\n"
 
@@ -250,16 +236,9 @@ def _mcap_record(data: bytes, rng: np.random.Generator) -> bytes:
     return data[:end] + data[start:]
 
 
-def _flip_at(data: bytes, at: int, rng: np.random.Generator) -> bytes:
-    out = bytearray(data)
-    out[at] ^= 1 << int(rng.integers(8))
-    return bytes(out)
-
-
 def _mcap_message(data: bytes, rng: np.random.Generator, kind: str) -> bytes:
-    """Rewrite the MCAP with one message's bytes damaged (``kind``: flip, truncate, extend) and
-    every CRC computed anew: what only deformap's own checks can refuse. The topic is drawn
-    first, then one of its messages."""
+    """The MCAP rewritten with one message's bytes damaged (``kind``: flip, truncate, extend) and
+    every CRC computed anew; the topic is drawn first, then one of its messages."""
     from mcap.reader import make_reader
     from mcap.writer import Writer
 
@@ -288,11 +267,9 @@ def _mcap_message(data: bytes, rng: np.random.Generator, kind: str) -> bytes:
 
 
 def _db3_edit(bag: Path, kind: str, rng: np.random.Generator) -> None:
-    """Edit the sqlite3 bag in place through SQL: one message row's data damaged (``kind``:
-    message-flip, message-truncate, message-extend), the row deleted (row-delete) or inserted
-    again (row-repeat), its data or time given a value of another SQL type (row-type), or one
-    field of a ``topics`` row given another value (topic). The topic is drawn first, then one of
-    its messages."""
+    """Edit the sqlite3 bag in place through SQL (``kind``: message-flip, -truncate or -extend of
+    one row's data, row-delete, row-repeat, row-type: another SQL type in a row, topic: another
+    value in a ``topics`` row); the topic is drawn first, then one of its messages."""
     import sqlite3
 
     conn = sqlite3.connect(bag)

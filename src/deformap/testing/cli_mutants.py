@@ -1,23 +1,14 @@
 """Seeded hostile arguments for every option of every command, found from the Typer app itself,
 each run under a guard that stops it before its work: a test helper, run by
-``tests/robustness/test_cli_mutants.py`` (five per option) and ``benchmarks/robustness.py
---cli-mutants N`` (N in all).
+``tests/robustness/test_cli_mutants.py`` and ``benchmarks/robustness.py --cli-mutants N``.
 
-Values come from fixed pools — negative, zero, NaN, infinite, 400-digit, out-of-range and
-non-numeric numbers; empty, markup, over-long and traversing strings; a FIFO, ``/dev/zero``, a
-directory, a path under a file — and, once an option has had its share of them, from seeded
-generators of the same classes (numbers of any magnitude and spelling, strings of shell, markup
-and control characters, paths below a file or a FIFO, names over the file system's limit).
-
-So that no mutant runs real work, each invocation also carries a guard that any run refuses
-before its work: ``--out`` naming an existing file (a run folder is checked before any world is
-built), or, where the mutated option is ``--out`` or a command has none, ``--json`` naming an
-existing directory (checked while parsing); where the mutated option is the command's only guard,
-its values are only destinations no run may write to (a folder, a FIFO, a device, a path under a
-file, an over-long name). A command with neither is left out.
-
-Each must end with exit code 2 and one ``error:`` line (or the parser's usage box for a value of
-the wrong type): never a traceback, never a hang (a SIGALRM after :data:`HANG_LIMIT_S`).
+Values come from fixed pools (bad numbers, strings and paths), then from seeded generators of the
+same classes. The guard, which any run refuses before its work: ``--out`` naming an existing file,
+or, where the mutated option is ``--out`` or a command has none, ``--json`` naming an existing
+directory; where the mutated option is the command's only guard, its values are only
+destinations no run may write to (:data:`UNWRITABLE`). A command with neither is left out. Each
+must end with exit code 2 and one ``error:`` line (or the parser's usage box for a value of the
+wrong type): never a traceback, never a hang (a SIGALRM after :data:`HANG_LIMIT_S`).
 """
 
 from __future__ import annotations
@@ -245,13 +236,10 @@ def _names(option: str) -> tuple[str, ...]:
     return (option, f"`{bare}`", f"`{bare.replace('-', '_')}`", bare.replace("-", "_"))
 
 
-def _ending(result: Any, problem: str | None, mutant: CliMutant | None = None,
-            paths: dict[str, str] | None = None) -> str:
+def _ending(result: Any, problem: str | None, mutant: CliMutant, paths: dict[str, str]) -> str:
     if problem is None:
         if "Usage:" in result.output:
             return "usage"
-        if mutant is None or paths is None:
-            return "clean"
         line = next(x for x in result.output.splitlines() if x.startswith("error:"))
         guard = (paths["file"], paths["dir"])
         value = mutant.value if mutant.value.strip() and mutant.value not in guard else None

@@ -1,14 +1,6 @@
 """The figures of one poke: ``poke-NN.png`` (the paper's Fig. 4) and the error curve ε(β).
 
-``poke-NN.png`` has two rows. Above, the maps: the ROI before the poke (the surface GP) on a colour
-scale of its own, so that its relief shows; then, on one colour scale, the cloud while pressing
-with the tactile points, the observed dent (the touch GP) and the shape-matching surface at β̂.
-Below, the curves: a section through the contact with all three; the shape-matching error ε(β)
-with β̂ (ε, not E: E is Young's modulus); the press's force against the tip's travel with the
-contact model fitted to it and the modulus it gives. Every length is in millimetres; every panel
-names its axes and units; legends sit outside the axes, where they cover no data.
-
-Built on :class:`matplotlib.figure.Figure` without ``pyplot``; written atomically when given a path.
+Every length is drawn in millimetres; legends sit outside the axes, where they cover no data.
 """
 
 from __future__ import annotations
@@ -25,26 +17,17 @@ from deformap.viz._save import save_figure
 
 __all__ = ["plot_beta_curve", "plot_error_curve", "plot_poke"]
 
+#: The narrowest height span of the colour scale of the surface before the poke (metres): a depth
+#: camera's random error is about 1.6 mm · z² at range z (Khoshelham & Elberink 2012, Sensors 12(2),
+#: Fig. 9), so narrower relief is the surface GP's smoothing of noise.
 MIN_COLOUR_SPAN_M = 1e-3
-"""The narrowest height span a colour scale of the surface before the poke covers (metres). A
-structured-light depth camera's random error is about 1.6 mm · z² at range z in metres (Kinect v1,
-Khoshelham & Elberink 2012, Fig. 9; the world's camera model uses the same), so relief under a
-millimetre at a metre is the surface GP's smoothing of noise, which a narrower scale would paint as
-structure.
-
-References
-----------
-Khoshelham, K., Elberink, S. O. (2012). Accuracy and resolution of Kinect depth data for indoor
-mapping applications. Sensors 12(2), 1437–1454.
-"""
 
 _BELOW: dict[str, Any] = {"loc": "upper center", "bbox_to_anchor": (0.5, -0.2), "fontsize": 8,
                           "frameon": False}  # fmt: skip
 
 
 def plot_beta_curve(ax: Axes, betas: NDArray, errors: NDArray, beta_hat: float, std: float) -> None:
-    """Draw the shape-matching error ε(β) [mm] with the estimate and its uncertainty band on
-    ``ax``."""
+    """Draw the shape-matching error ε(β) [mm] with the estimate and its band on ``ax``."""
     order = np.argsort(betas)
     ax.plot(np.asarray(betas)[order], np.asarray(errors)[order] * 1e3, "-", color="k")
     ax.axvline(beta_hat, color="r", label=f"β̂ = {beta_hat:.3f} ± {std:.3f}")
@@ -54,29 +37,12 @@ def plot_beta_curve(ax: Axes, betas: NDArray, errors: NDArray, beta_hat: float, 
     ax.legend(fontsize=8)
 
 
-def plot_error_curve(
-    betas: NDArray[np.float64],
-    errors: NDArray[np.float64],
-    beta: float,
-    beta_std: float,
-    *,
-    title: str = "shape-matching error ε(β)",
-    path: str | Path | None = None,
-) -> Figure:
-    """A figure of its own holding :func:`plot_beta_curve`: ε(β), β̂ and its uncertainty band.
-
-    Parameters
-    ----------
-    betas, errors : (m,) float
-        The βs tried and their shape-matching error ε(β) in metres (drawn in millimetres), in any
-        order.
-    beta, beta_std : float
-        The estimate β̂ and its standard deviation.
-    title : str
-        The axes' title.
-    path : str or Path, optional
-        Where to write the figure (110 dpi, format from the suffix); nothing is written without it.
-    """
+def plot_error_curve(betas: NDArray, errors: NDArray, beta: float, beta_std: float, *,
+                     title: str = "shape-matching error ε(β)", path: str | Path | None = None
+                     ) -> Figure:  # fmt: skip
+    """:func:`plot_beta_curve` in a figure of its own: the βs tried ``(m,)`` in any order, their
+    error ε(β) ``(m,)`` in metres, the estimate β̂ and its standard deviation; written to ``path``
+    at 110 dpi when given."""
     fig = Figure(figsize=(5.0, 3.6), layout="constrained")
     ax = fig.subplots()
     plot_beta_curve(ax, betas, errors, beta, beta_std)
@@ -103,54 +69,31 @@ def _span(values: NDArray, minimum: float) -> tuple[float, float]:
     return low, high
 
 
-def plot_poke(
-    *,
-    roi_xs: NDArray[np.float64],
-    roi_ys: NDArray[np.float64],
-    rest_z: NDArray[np.float64],
-    deformed_z: NDArray[np.float64],
-    roi_points: NDArray[np.float64],
-    tactile: NDArray[np.float64],
-    betas: NDArray[np.float64],
-    errors: NDArray[np.float64],
-    beta: float,
-    beta_std: float,
-    simulated_z: NDArray[np.float64] | None = None,
-    title: str = "",
-    path: str | Path | None = None,
-    force_travel: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None,
-    force_fit: NDArray[np.float64] | None = None,
-    reading: str = "",
-) -> Figure:
-    """One poke's figure: the ROI before, the cloud while pressing, the observed dent and the
-    simulated one at β̂; a section through them, ε(β), and force against travel.
+def plot_poke(*, roi_xs: NDArray, roi_ys: NDArray, rest_z: NDArray, deformed_z: NDArray,
+              roi_points: NDArray, tactile: NDArray, betas: NDArray, errors: NDArray, beta: float,
+              beta_std: float, simulated_z: NDArray | None = None, title: str = "",
+              path: str | Path | None = None,
+              force_travel: tuple[NDArray, NDArray] | None = None,
+              force_fit: NDArray | None = None, reading: str = "") -> Figure:  # fmt: skip
+    """One poke's figure: above, the ROI before on a colour scale of its own (so that its relief
+    shows), then on one scale the cloud while pressing, the observed dent and the simulated one at
+    β̂; below, a section through them, ε(β), and force against travel.
 
     Parameters
     ----------
-    roi_xs, roi_ys : (nx,), (ny,) float, metres
-        Grid of the region of interest around the contact.
-    rest_z, deformed_z : (ny, nx) float, metres
-        Heights before (surface GP) and while pressing (touch GP).
-    roi_points : (n, 3) float, metres
-        The cloud in the ROI while pressing, the robot removed.
-    tactile : (t, 3) float, metres
-        The tactile points added on the probe's tip.
-    betas, errors : (m,) float
-        The βs tried and their shape-matching error ε(β) in metres.
-    beta, beta_std : float
-        The estimate β̂ and its standard deviation.
+    roi_xs, roi_ys, rest_z, deformed_z : (nx,), (ny,), (ny, nx), (ny, nx) float, metres
+        The grid of the region of interest, the heights before (surface GP) and while pressing
+        (touch GP).
+    roi_points, tactile : (n, 3), (t, 3) float, metres
+        The cloud in the ROI while pressing (the robot removed) and the tactile points.
+    betas, errors, beta, beta_std : (m,), (m,) float, float, float
+        The βs tried, their error ε(β) in metres, the estimate β̂ and its standard deviation.
     simulated_z : (ny, nx) float, metres, optional
-        The shape-matching surface at β̂ (its particles' heights, on the ROI grid at rest); its
-        panel says "not simulated" without it.
-    title : str
-        The figure's title.
+        The shape-matching surface at β̂ on the ROI grid ("not simulated" without it).
     path : str or Path, optional
-        Where to write the figure (100 dpi, format from the suffix); nothing is written without it.
-    force_travel : ((n,), (n,)) float, metres and newtons, optional
-        The press's record: the tip's travel since first contact and the force; the panel says
-        "no force–travel record" without it.
-    force_fit : (2, m) float, metres and newtons, optional
-        The contact model fitted to the record, travel and force, drawn over it.
+        Where to write the figure (100 dpi); nothing is written without it.
+    force_travel, force_fit : ((n,), (n,)) and (2, m) float, metres and newtons, optional
+        The press's record (travel since first contact, force) and the contact model fitted to it.
     reading : str
         What the record read ("E = 9.7 ± 0.7 kPa", "rigid", or why none), in the panel's legend.
     """

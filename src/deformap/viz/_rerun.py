@@ -1,17 +1,13 @@
 """A 3D recording of a run for the rerun viewer (extra ``rerun``): ``run.rrd``.
 
 Timeline ``poke``: step 0 holds the first observation, the surface GP's heightmap and the ground
-truth (when the world has one); step k holds the k-th press (cloud with the robot removed, tactile
-points, reconstructed dent, the robot's hull), the β-field as a coloured surface, and the maps and
-scalars as they evolve; the last step holds the regions.
-
-The maps are logged as values, not colours: ``maps/beta`` (β), ``maps/variance`` (of the map
-field), ``maps/modulus_kpa`` (the modulus field's median E in kPa) and ``maps/truth_hardness_n``
-(hardness in N; NaN where rigid or bare table) are :class:`rerun.Tensor` grids of ``(ny, nx)``
-cells, and ``maps/regions`` is a :class:`rerun.SegmentationImage` of the region labels whose
-annotation context names each region with its mean β. Every grid is stored top row first (row 0
-is the largest y), so that it shows with y up as in ``map.png``. A blueprint opens on the 3D scene
-beside the maps and the scalars' time series. Open it with ``rerun run.rrd``.
+truth; step k the k-th press (cloud with the robot removed, tactile points, dent, the robot's
+hull), the β-field as a coloured surface, and the maps and scalars as they evolve; the last step
+the regions. The maps are values, not colours: ``maps/beta``, ``maps/variance`` (of the map
+field), ``maps/modulus_kpa`` (median E) and ``maps/truth_hardness_n`` (NaN where rigid or bare
+table) are ``(ny, nx)`` :class:`rerun.Tensor` grids, ``maps/regions`` a
+:class:`rerun.SegmentationImage` whose annotation context names each region with its mean β; every
+grid is stored top row first (the largest y), so that it shows with y up as in ``map.png``.
 """
 
 from __future__ import annotations
@@ -28,12 +24,10 @@ from scipy.spatial import ConvexHull
 from deformap._files import atomic_path
 from deformap.errors import missing_extra
 
-__all__ = ["heightmap_mesh", "hull_mesh", "record_run"]
+__all__ = ["hull_mesh", "record_run"]
 
 
-def heightmap_mesh(
-    xs: NDArray[np.float64], ys: NDArray[np.float64], z: NDArray[np.float64]
-) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
+def _heightmap_mesh(xs: NDArray, ys: NDArray, z: NDArray) -> tuple[NDArray, NDArray[np.int64]]:
     """Vertices ``(ny*nx, 3)`` and triangles ``(2*(ny-1)*(nx-1), 3)`` of a heightmap grid."""
     gx, gy = np.meshgrid(xs, ys)
     vertices = np.column_stack([gx.ravel(), gy.ravel(), np.asarray(z).ravel()])
@@ -45,31 +39,24 @@ def heightmap_mesh(
     return vertices, triangles
 
 
-def _colors(values: NDArray[np.float64], cmap: str, lo: float, hi: float) -> NDArray[np.uint8]:
+def _colors(values: NDArray, cmap: str, lo: float, hi: float) -> NDArray[np.uint8]:
     scaled = np.clip((np.asarray(values, float) - lo) / max(hi - lo, 1e-12), 0.0, 1.0)
     return (colormaps[cmap](np.nan_to_num(scaled))[..., :3] * 255).astype(np.uint8)
 
 
-def record_run(path: str | Path, result: Any, *, initial_points: NDArray[np.float64],
-               truth_hardness: NDArray[np.float64] | None = None,
-               robot_points: Sequence[NDArray[np.float64] | None] | None = None) -> Path:
-    """Write ``run.rrd`` for an :class:`~deformap.explore.ExplorationResult`.
+def record_run(path: str | Path, result: Any, *, initial_points: NDArray,
+               truth_hardness: NDArray | None = None,
+               robot_points: Sequence[NDArray | None] | None = None) -> Path:
+    """Write the ``.rrd`` file ``path`` atomically for an ``ExplorationResult``; returns ``path``.
 
     Parameters
     ----------
-    path : str or Path
-        The ``.rrd`` file to write, atomically (under a temporary name, renamed once complete).
-    result : ExplorationResult
-        A finished exploration (its surface model, every poke and the β-field after each).
     initial_points : (n, 3) float, metres
         The first observation, as the camera saw it.
     truth_hardness : (ny, nx) float, optional
         Ground-truth hardness in newtons on the map's grid (``inf`` rigid, ``nan`` bare table).
     robot_points : sequence of (m, 3) float or None, optional
-        Per poke, points whose convex hull covers the robot at the press, logged as a mesh
-        ``world/press/robot_hull``; ``None`` for a poke without. ``explore --rerun`` gives the
-        simulated probe's points, rebuilt from the world at each contact; runs without a
-        simulated world (``map``, ``--environment``) log no hull.
+        Per poke, points whose convex hull covers the robot at the press (``None``: no hull).
     """
     try:
         import rerun as rr
@@ -97,7 +84,7 @@ def record_run(path: str | Path, result: Any, *, initial_points: NDArray[np.floa
     return out
 
 
-def hull_mesh(points: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.int64]]:
+def hull_mesh(points: NDArray) -> tuple[NDArray, NDArray[np.int64]]:
     """Vertices ``(v, 3)`` and triangles ``(t, 3)`` of the convex hull of ``points (m, 3)``."""
     hull = ConvexHull(points)
     index = np.full(len(points), -1, dtype=np.int64)
@@ -125,54 +112,37 @@ def _blueprint() -> Any:
     )  # the side and time panels stay open: the time panel steps through the pokes
 
 
-def _log_run(rec: Any, result: Any, pts: NDArray[np.float64]) -> None:
+def _log_run(rec: Any, result: Any, pts: NDArray) -> None:
     import rerun as rr
 
     rec.set_time("poke", sequence=0)
-    rec.log(
-        "world/observation",
-        rr.Points3D(pts, radii=0.0015, colors=_colors(pts[:, 2], "viridis", 0.0, 0.08)),
-    )
+    rec.log("world/observation",
+            rr.Points3D(pts, radii=0.0015, colors=_colors(pts[:, 2], "viridis", 0.0, 0.08)))
     surface_mesh = None
     if result.surface is not None:
-        surface_mesh = heightmap_mesh(result.xs, result.ys, result.surface.height)
+        surface_mesh = _heightmap_mesh(result.xs, result.ys, result.surface.height)
         vertices, triangles = surface_mesh
-        rec.log(
-            "world/surface",
-            rr.Mesh3D(
-                vertex_positions=vertices,
-                triangle_indices=triangles,
-                vertex_colors=_colors(vertices[:, 2], "viridis", 0, 0.08),
-            ),
-        )
+        rec.log("world/surface", rr.Mesh3D(
+            vertex_positions=vertices, triangle_indices=triangles,
+            vertex_colors=_colors(vertices[:, 2], "viridis", 0, 0.08)))
     for k, poke in enumerate(result.pokes, start=1):
         rec.set_time("poke", sequence=k)
         dent = poke.dent
         if dent is not None:
-            rec.log(
-                "world/press/cloud",
-                rr.Points3D(dent.roi_points, radii=0.001, colors=[200, 200, 200]),
-            )
-            rec.log(
-                "world/press/tactile", rr.Points3D(dent.tactile, radii=0.002, colors=[230, 40, 40])
-            )
-            v, t = heightmap_mesh(dent.roi_xs, dent.roi_ys, dent.deformed_z)
-            rec.log(
-                "world/press/dent",
-                rr.Mesh3D(vertex_positions=v, triangle_indices=t, vertex_colors=[60, 120, 230]),
-            )
+            rec.log("world/press/cloud",
+                    rr.Points3D(dent.roi_points, radii=0.001, colors=[200, 200, 200]))
+            rec.log("world/press/tactile",
+                    rr.Points3D(dent.tactile, radii=0.002, colors=[230, 40, 40]))
+            v, t = _heightmap_mesh(dent.roi_xs, dent.roi_ys, dent.deformed_z)
+            rec.log("world/press/dent",
+                    rr.Mesh3D(vertex_positions=v, triangle_indices=t, vertex_colors=[60, 120, 230]))
         field = result.beta_field_after(k)
         mean = field.mean
         if surface_mesh is not None:
             v, t = surface_mesh
-            rec.log(
-                "world/beta_field",
-                rr.Mesh3D(
-                    vertex_positions=v,
-                    triangle_indices=t,
-                    vertex_colors=_colors(mean.ravel(), "magma", 0, 1),
-                ),
-            )
+            rec.log("world/beta_field", rr.Mesh3D(
+                vertex_positions=v, triangle_indices=t,
+                vertex_colors=_colors(mean.ravel(), "magma", 0, 1)))
         rec.log("maps/beta", rr.Tensor(mean[::-1], dim_names=("y", "x"), value_range=(0.0, 1.0)))
         rec.log("metrics/beta", rr.Scalars(poke.record.beta))
         var = _map_variance(result, k, field.variance)
@@ -182,8 +152,7 @@ def _log_run(rec: Any, result: Any, pts: NDArray[np.float64]) -> None:
 
 
 def _map_variance(result: Any, k: int, beta_variance: NDArray) -> NDArray:
-    """The variance of the field the map runs on after ``k`` pokes (the β-field's, or the
-    modulus field's once it holds a poke when the map runs on it)."""
+    """The variance of the map field after ``k`` pokes (the modulus field's once it holds one)."""
     if getattr(getattr(result, "config", None), "field", "beta") == "modulus":
         field = result.modulus_field_after(k)
         if len(field.pokes):
@@ -192,8 +161,7 @@ def _map_variance(result: Any, k: int, beta_variance: NDArray) -> NDArray:
 
 
 def _log_regions(rec: Any, result: Any) -> None:
-    """The final regions as a segmentation image named by class (R1, R2, …: mean β over the
-    region's cells)."""
+    """The final regions as a segmentation image, each named R1, R2, … with its mean β."""
     import rerun as rr
 
     regions = getattr(result, "regions", None)
@@ -213,9 +181,8 @@ def _log_regions(rec: Any, result: Any) -> None:
 
 
 def _log_modulus(rec: Any, result: Any, k: int) -> None:
-    """The modulus field after ``k`` pokes: ``maps/modulus_kpa`` (the median E in kPa),
-    ``metrics/modulus_kpa`` (the poke's E, or its detection bound when rigid) and
-    ``metrics/modulus_max_variance`` (of ln E); nothing while no poke has a modulus."""
+    """The modulus field after ``k`` pokes (median E in kPa), the poke's E and the field's largest
+    variance of ln E; nothing while no poke has a modulus."""
     import rerun as rr
 
     field = result.modulus_field_after(k)

@@ -1,8 +1,7 @@
 """Figures of the studies: β against hardness (Fig. 5a) and fit error against cluster size (5b).
 
-Each function takes the study's result (as :func:`deformap.eval.hardness_study` and
-:func:`deformap.eval.cluster_size_study` return it), returns a :class:`matplotlib.figure.Figure`
-built without ``pyplot``, and, given ``path``, writes it there atomically at 110 dpi.
+Each takes the study's result as :mod:`deformap.eval` returns it and, given ``path``, writes the
+figure there at 110 dpi.
 """
 
 from __future__ import annotations
@@ -21,10 +20,9 @@ from deformap.viz._save import save_figure
 __all__ = ["plot_cluster_size_study", "plot_hardness_study"]
 
 _MARKERS, _LINES = "osv^<>", ("-", "--", "-.", ":")
+#: The factor between neighbouring protocols' x on the log hardness axis: about a marker's width,
+#: small beside the 1.4× or more between tested foams.
 _DODGE = 1.03
-"""The factor between neighbouring protocols' x on the log hardness axis: about a marker's width,
-enough to tell points apart where protocols read the same β, small beside the 1.4× or more between
-tested foams."""
 
 
 def _hardness_axis(rows: list[dict[str, Any]]) -> tuple[list[float], float]:
@@ -34,33 +32,24 @@ def _hardness_axis(rows: list[dict[str, Any]]) -> tuple[list[float], float]:
 
 
 def plot_hardness_study(study: dict[str, Any], *, path: str | Path | None = None) -> Figure:
-    """β and Young's modulus per foam, hardness decreasing to the right as in the paper; rigid at
-    left; the study's conditions (force, thickness, camera, physics) in the title.
+    """β per protocol beside the E read and the true E per foam (β alone when no row has a
+    modulus), hardness decreasing to the right as in the paper, rigid at the left; the study's
+    conditions (force, thickness, camera, physics) in the title.
 
-    Parameters
-    ----------
-    study : dict
-        ``{"rows": [{"protocol", "hardness_n" (None: rigid), "beta", "beta_std"}, ...]}``, each
-        row optionally with ``modulus_pa``, ``modulus_std_pa``, ``true_modulus_pa`` and
-        ``rigid``; optionally ``"monotone": {protocol: bool}``, marked in the legend, and the
-        conditions ``force_n``, ``thickness_m``, ``camera`` and ``physics``. Rows with
-        ``refused`` are not drawn. A study with a ``matrix`` (``deformap study hardness --full``)
-        is drawn by :func:`_plot_hardness_matrix` instead.
-    path : str or Path, optional
-        Where to write the figure; nothing is written without it.
-
-    Returns
-    -------
-    matplotlib.figure.Figure
-        β against hardness (one line per protocol) beside E against hardness (the force–travel
-        record's E, which no protocol changes, and the true E), or β alone when no row has a
-        modulus.
+    ``study`` is ``{"rows": [{"protocol", "hardness_n" (None: rigid), "beta", "beta_std"}, ...]}``,
+    each row optionally with ``modulus_pa``, ``modulus_std_pa``, ``true_modulus_pa``, ``rigid``
+    and ``refused`` (not drawn); optionally ``"monotone": {protocol: bool}``, marked in the
+    legend, and the conditions ``force_n``, ``thickness_m``, ``camera`` and ``physics``. A study
+    with a ``matrix`` (``deformap study hardness --full``) is drawn by
+    :func:`_plot_hardness_matrix` instead.
     """
-    if "matrix" in study:
-        fig = _plot_hardness_matrix(study)
-        if path is not None:
-            save_figure(fig, path, dpi=110)
-        return fig
+    fig = _plot_hardness_matrix(study) if "matrix" in study else _plot_hardness(study)
+    if path is not None:
+        save_figure(fig, path, dpi=110)
+    return fig
+
+
+def _plot_hardness(study: dict[str, Any]) -> Figure:
     rows = [r for r in study["rows"] if not r.get("refused")]
     finite, rigid_x = _hardness_axis(rows)
     with_modulus = any(r.get("modulus_pa") is not None or r.get("rigid") for r in rows)
@@ -76,23 +65,17 @@ def plot_hardness_study(study: dict[str, Any], *, path: str | Path | None = None
     conditions = _conditions(study)
     name = "β and E against hardness" if with_modulus else "β against hardness"
     fig.suptitle(name + (f" ({conditions})" if conditions else ""), fontsize=11)
-    if path is not None:
-        save_figure(fig, path, dpi=110)
     return fig
 
 
 def _conditions(study: dict[str, Any]) -> str:
     """The press force, foam thickness, camera and world physics the study ran under."""
-    parts = []
-    if study.get("force_n") is not None:
-        parts.append(f"force {study['force_n']:g} N")
-    if study.get("thickness_m") is not None:
-        parts.append(f"foam {study['thickness_m'] * 100:g} cm thick")
-    if study.get("camera"):
-        parts.append(f"camera {study['camera']}")
-    if study.get("physics"):
-        parts.append(f"physics {study['physics']}")
-    return ", ".join(parts)
+    force, thickness = study.get("force_n"), study.get("thickness_m")
+    parts = ["" if force is None else f"force {force:g} N",
+             "" if thickness is None else f"foam {thickness * 100:g} cm thick",
+             f"camera {study['camera']}" if study.get("camera") else "",
+             f"physics {study['physics']}" if study.get("physics") else ""]
+    return ", ".join(p for p in parts if p)
 
 
 def _hardness_ticks(ax: Axes, rows: list[dict[str, Any]], finite: list[float],
@@ -243,29 +226,16 @@ def _first_protocol(rows: list[dict[str, Any]]) -> str | None:
 
 
 def plot_cluster_size_study(study: dict[str, Any], *, path: str | Path | None = None) -> Figure:
-    """Shape-matching fit error min ε(β) against cluster size, one line per foam.
-
-    Parameters
-    ----------
-    study : dict
-        ``{"rows": [{"cluster_size", "hardness_n" (None: rigid), "fit_error_m"}, ...]}``.
-    path : str or Path, optional
-        Where to write the figure; nothing is written without it.
-    """
+    """Shape-matching fit error min ε(β) against cluster size, one line per foam, from
+    ``{"rows": [{"cluster_size", "hardness_n" (None: rigid), "fit_error_m"}, ...]}``."""
     rows = study["rows"]
     fig = Figure(figsize=(6.5, 4.2), layout="constrained")
     ax = fig.subplots()
     for hardness in dict.fromkeys(r["hardness_n"] for r in rows):
-        sub = sorted(
-            (r for r in rows if r["hardness_n"] == hardness), key=lambda r: r["cluster_size"]
-        )
-        label = "rigid" if hardness is None else f"{hardness:g} N"
-        ax.plot(
-            [r["cluster_size"] for r in sub],
-            [r["fit_error_m"] * 1e3 for r in sub],
-            marker="o",
-            label=label,
-        )
+        sub = sorted((r for r in rows if r["hardness_n"] == hardness),
+                     key=lambda r: r["cluster_size"])  # fmt: skip
+        ax.plot([r["cluster_size"] for r in sub], [r["fit_error_m"] * 1e3 for r in sub],
+                marker="o", label="rigid" if hardness is None else f"{hardness:g} N")
     ax.xaxis.set_major_locator(MaxNLocator(integer=True))
     ax.set_xlabel("cluster size k (k×k particles)")
     ax.set_ylabel("fit error min ε(β) [mm]")

@@ -1,10 +1,5 @@
 """Pictures of a world for a person to check it: layout, the camera's colour view, one observed
-cloud, one dent.
-
-Figures live in :mod:`deformap.viz`, a leaf: the world itself never imports matplotlib. They are
-built on :class:`matplotlib.figure.Figure` without ``pyplot`` and written atomically, so no backend
-is selected and no global state is touched.
-"""
+cloud, one dent (here, not in :mod:`deformap.world`, which never imports matplotlib)."""
 
 from __future__ import annotations
 
@@ -39,23 +34,21 @@ def _press_target(world: SimulatedWorld) -> np.ndarray:
 
 
 def show_world(world: SimulatedWorld, out: str | Path, *, force_n: float) -> list[Path]:
-    """Write ``layout.png``, ``rgb.png``, ``cloud.png`` and ``dent.png`` into ``out``; returns their
-    paths.
+    """Write ``layout.png``, ``rgb.png``, ``cloud.png`` and ``dent.png`` into the folder ``out``
+    (created if needed); returns their paths.
 
-    The folder is created if needed; each file is written atomically. ``layout.png`` colours each
-    foam block by its stiffness (:mod:`deformap.viz._style`: dark soft, light stiff) with a
+    ``layout.png`` colours each foam block by its stiffness (:mod:`deformap.viz._style`) with a
     colour bar in Young's modulus and hardness, rigid blocks grey; ``rgb.png`` shows the camera's
-    colour image and the coloured cloud of one observation from above; ``cloud.png`` observes the
-    world once (lengths in metres); ``dent.png`` presses the centroid of its softest foam block
-    once with ``force_n`` newtons and releases it (lengths in millimetres).
+    colour image and one observation's coloured cloud from above; ``cloud.png`` one observation
+    by height; ``dent.png`` presses the centroid of the softest foam block once with ``force_n``
+    newtons and releases it.
     """
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    return [save_figure(_layout_figure(world), out / "layout.png", dpi=120, bbox_inches="tight"),
-            save_figure(_rgb_figure(world), out / "rgb.png", dpi=120, bbox_inches="tight"),
-            save_figure(_cloud_figure(world), out / "cloud.png", dpi=120, bbox_inches="tight"),
-            save_figure(_dent_figure(world, force_n), out / "dent.png", dpi=120,
-                        bbox_inches="tight")]  # fmt: skip
+    figures = (("layout", _layout_figure), ("rgb", _rgb_figure), ("cloud", _cloud_figure),
+               ("dent", lambda w: _dent_figure(w, force_n)))  # fmt: skip
+    return [save_figure(draw(world), out / f"{name}.png", dpi=120, bbox_inches="tight")
+            for name, draw in figures]
 
 
 def _layout_figure(world: SimulatedWorld) -> Figure:
