@@ -6,13 +6,13 @@ family's arms (:meth:`~deformap.eval.WorldTask.arms`: ``ExplorationConfig.appear
 ``auto``, or ``auto`` alone) with every strategy × field, each from the same start (one first
 observation and one ``Mapper.initialise`` per arm, whose state every combination of the arm
 shares: the same cloud and the same stream give every combination the same surface model), poking
-to ``max_pokes``: once the map field's variance is under
-``T_h`` the remaining pokes go where a region boundary is least certain
-(``ExplorationConfig.boundary_pokes``), so every combination makes ``max_pokes`` pokes and the
-curves compare like with like; ``threshold`` in a row says whether the variance rule was met.
-Every cut (``region_labels``) asked for is scored on the same pokes: where the next poke goes
-does not depend on the cut (the targets read the classes of the pokes before any cut), so mapping
-once per cut would repeat the same pokes. After every poke it records (one row each per cut):
+to ``max_pokes``: once the map field's variance is under ``T_h`` the remaining pokes go where a
+region boundary is least certain (``ExplorationConfig.boundary_pokes``), so every combination
+makes ``max_pokes`` pokes and the curves compare like with like; ``threshold`` in a row says
+whether the variance rule was met. Every cut (``region_labels``) asked for is scored on the same
+pokes: where the next poke goes does not depend on the cut (the targets read the classes of the
+pokes before any cut), so mapping once per cut would repeat the same pokes. After every poke it
+records (one row each per cut):
 
 - ``accuracy``, ``mean_iou``, ``found``, ``true``, ``kendall_tau``
   (:func:`deformap.eval.region_scores`) of the map field's regions against the world's truth by
@@ -182,31 +182,25 @@ def run_world(task: WorldTask) -> WorldResult:
     rows: list[dict[str, Any]] = []
     pokes, fallback = {}, {}
     summary: dict[str, Any] = {}
+    explore_seq = np.random.SeedSequence([task.seed, task.index, 0]).spawn(2)[1]
     for appearance in task.appearances:
         draw, world, explore = _build_world(task, appearance)
-        summary = summary or draw.summary()
-        explore_seq = np.random.SeedSequence([task.seed, task.index, 0]).spawn(2)[1]
+        summary = summary or draw.summary()  # the same layout in every family
         cloud = world.observe()
-        truth: _Truth | None = None
-        for arm, prior in task.arms():
-            if arm != appearance:
-                continue
+        grid = MapGrid.build(world.workspace, explore)
+        truth = material_truth(world.scenario, grid.xs, grid.ys)
+        for prior in (p for a, p in task.arms() if a == appearance):
             armed = replace(explore, appearance=cast(Any, prior))
             start = _start(world, armed, cloud, np.random.default_rng(explore_seq))
-            if truth is None:
-                grid = MapGrid.build(world.workspace, armed)
-                truth = material_truth(world.scenario, grid.xs, grid.ys)
-            for strategy in task.strategies:
-                for field in task.fields:
-                    cfg = replace(armed, strategy=cast(Any, strategy), field=cast(Any, field))
-                    key = WorldResult.run_key(appearance, prior, strategy, field)
-                    mapped, pokes[key], beta = _map_one(world, draw, cfg, start, truth,
-                                                        task.seed, task.cuts)
-                    if beta is not None:
-                        fallback[key] = beta
-                    rows.extend({"world": task.index, "family": draw.family,
-                                 "appearance": appearance, "prior": prior,
-                                 "strategy": strategy, "field": field, **row}
-                                for row in mapped)  # fmt: skip
+            for strategy, field in ((s, f) for s in task.strategies for f in task.fields):
+                cfg = replace(armed, strategy=cast(Any, strategy), field=cast(Any, field))
+                key = WorldResult.run_key(appearance, prior, strategy, field)
+                mapped, pokes[key], beta = _map_one(world, draw, cfg, start, truth, task.seed,
+                                                    task.cuts)
+                if beta is not None:
+                    fallback[key] = beta
+                rows.extend({"world": task.index, "family": draw.family,
+                             "appearance": appearance, "prior": prior, "strategy": strategy,
+                             "field": field, **row} for row in mapped)  # fmt: skip
     return WorldResult(world=summary, rows=tuple(rows), pokes=pokes,
                        fallback_pokes=fallback, seconds=time.perf_counter() - t0)
