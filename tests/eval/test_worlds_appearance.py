@@ -165,7 +165,7 @@ def test_the_curves_are_drawn_per_appearance_family_blind_beside_the_prior() -> 
     lines = {ln.get_label(): ln for ln in panels[0].get_lines()}
     assert lines["paper/beta/nearest (the paper's strategy), blind"].get_linestyle() == ":"
     assert "paper/beta/nearest (the paper's strategy), prior" in lines
-    assert "blind (dotted)" in fig.get_suptitle()
+    assert "prior solid, blind dotted" in fig.get_suptitle()
 
 
 def test_the_command_shows_the_paired_table_and_refuses_a_bad_family(tmp_path) -> None:
