@@ -4,14 +4,14 @@
 family (:func:`deformap.eval.draw_world`: the same layout, painted) and maps it under each of the
 family's arms (:meth:`~deformap.eval.WorldTask.arms`: ``ExplorationConfig.appearance`` off and
 ``auto``, or ``auto`` alone) with every strategy × field, each from the same start (one first
-observation and one ``Mapper.initialise`` per arm, whose state every combination of the arm
-shares: the same cloud and the same stream give every combination the same surface model), poking
-to ``max_pokes``: once the map field's variance is under ``T_h`` the remaining pokes go where a
-region boundary is least certain (``ExplorationConfig.boundary_pokes``), so every combination
-makes ``max_pokes`` pokes and the curves compare like with like; ``threshold`` in a row says
-whether the variance rule was met. Every cut (``region_labels``) asked for is scored on the same
-pokes: where the next poke goes does not depend on the cut (the targets read the classes of the
-pokes before any cut), so mapping once per cut would repeat the same pokes. After every poke it
+observation and one ``Mapper.initialise`` per arm, whose state every combination of the arm starts
+from, copied: the same cloud and the same stream give every combination the same surface model),
+poking to ``max_pokes``: once the map field's variance is under ``T_h`` the remaining pokes go
+where a region boundary is least certain (``ExplorationConfig.boundary_pokes``), so every
+combination makes ``max_pokes`` pokes and the curves compare like with like; ``threshold`` in a row
+says whether the variance rule was met. Every cut (``region_labels``) asked for is scored on the
+same pokes: where the next poke goes does not depend on the cut (the targets read the classes of
+the pokes before any cut), so mapping once per cut would repeat the same pokes. After every poke it
 records (one row each per cut):
 
 - ``accuracy``, ``mean_iou``, ``found``, ``true``, ``kendall_tau``
@@ -36,6 +36,7 @@ runs.
 
 from __future__ import annotations
 
+import copy
 import time
 from collections.abc import Sequence
 from dataclasses import replace
@@ -103,7 +104,8 @@ def _map_one(world: SimulatedWorld, draw: WorldDraw, config: ExplorationConfig,
     field's pokes at the end (``poke_data``), and the β pokes of a run whose map field fell
     back to β at some poke (else ``None``)."""
     mapper = Mapper(world.workspace, config)
-    vars(mapper).update(start)  # the arm's combinations share what the first observation gave
+    # what the first observation gave, copied: one combination's mapping cannot change another's
+    vars(mapper).update(copy.deepcopy(start))
     streams = np.random.default_rng(np.random.SeedSequence([seed, draw.index, 1])).spawn(
         config.max_pokes + 1)
     rows: list[dict[str, Any]] = []
