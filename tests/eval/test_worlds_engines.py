@@ -91,11 +91,17 @@ def test_settings_are_checked_against_the_config_literals() -> None:
         WorldsBenchConfig(cuts=("voronoi",))
     with pytest.raises(InvalidArgumentError, match="`families` must be"):
         WorldsBenchConfig(families=())
+    with pytest.raises(InvalidArgumentError, match=r"`appearances` must be distinct names .* "
+                                                   r"got \['glossy'\] \(unknown\)"):
+        WorldsBenchConfig(appearances=("plain", "glossy"))
+    arms = WorldsBenchConfig(appearances=("split", "plain")).arms()
+    assert arms == (("split", "off"), ("split", "auto"), ("plain", "auto"))
     # the exploration settings the benchmark's axes set are its own
     for given, option in (({"strategy": "paper"}, "--strategies"),
                           ({"max_pokes": 3}, "--max-pokes"),
                           ({"region_labels": "isopleth"}, "--cuts"),
-                          ({"force_n": 0.4}, "none: each world")):
+                          ({"force_n": 0.4}, "none: each world"),
+                          ({"appearance": "off"}, "--appearance")):
         with pytest.raises(InvalidArgumentError, match=f"`exploration.{next(iter(given))}` is "
                                                        f"the benchmark's to set .option: {option}"):
             WorldsBenchConfig(exploration=ExplorationConfig(**given))
