@@ -118,8 +118,7 @@ def draw_world(seed: int, index: int, families: Sequence[str] = LAYOUT_FAMILIES,
                                p_rigid=P_RIGID, thickness_m=thickness,
                                appearance=appearance)  # fmt: skip
     return WorldDraw(index=index, family=family, appearance=appearance, physics=drawn,
-                     camera=camera,
-                     thickness_m=thickness, force_n=force, scenario=scenario)
+                     camera=camera, thickness_m=thickness, force_n=force, scenario=scenario)
 
 
 def material_truth(scenario: Scenario, xs: NDArray[np.float64], ys: NDArray[np.float64]
