@@ -44,7 +44,7 @@ def _oracle_rows(task: WorldTask, result: WorldResult) -> list[dict[str, Any]]:
     under = cKDTree(cells)
     rows = []
     for combo, data in result.pokes.items():
-        strategy, field = combo.split("/")
+        appearance, prior, strategy, field = combo.split("/")  # WorldResult.run_key
         xy = np.column_stack([data["x"], data["y"]])
         index = np.asarray(data["index"], dtype=np.int64)
         truth_at_poke = labels.reshape(-1)[under.query(xy)[1]] if len(xy) else index
@@ -56,7 +56,8 @@ def _oracle_rows(task: WorldTask, result: WorldResult) -> list[dict[str, Any]]:
             found = truth_at_poke[keep][nearest].reshape(labels.shape)
             # the map's "values" order the found classes as the materials are ordered
             scores = region_scores(found, labels, found.astype(float), hardness)
-            rows.append({"strategy": strategy, "field": field, "cut": "oracle", "poke": poke,
+            rows.append({"appearance": appearance, "prior": prior, "strategy": strategy,
+                         "field": field, "cut": "oracle", "poke": poke,
                          "accuracy": scores.accuracy, "modulus_error": None})
     return rows
 

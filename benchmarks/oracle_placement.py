@@ -160,8 +160,9 @@ def main() -> None:
         for placement in placements:
             family, curve = (greedy_curve(task) if placement == "layout"
                              else blind_curve(task, placement))
-            rows += [{"strategy": "oracle", "field": placement, "cut": "nearest", "poke": k + 1,
-                      "accuracy": a, "modulus_error": None} for k, a in enumerate(curve)]
+            rows += [{"appearance": "plain", "prior": "auto", "strategy": "oracle",
+                      "field": placement, "cut": "nearest", "poke": k + 1, "accuracy": a,
+                      "modulus_error": None} for k, a in enumerate(curve)]
         results.append(WorldResult(world={"index": index, "family": family}, rows=tuple(rows)))
     combos = [("oracle", placement, "nearest") for placement in placements]
     if run is not None:

@@ -58,7 +58,8 @@ def test_worlds_take_the_families_in_turn_and_are_drawn_from_seed_and_index() ->
 
 def _result(index: int, family: str, accuracy: dict[str, list[float]], status: str = "ok",
             modulus_error: float | None = 0.2) -> WorldResult:
-    rows = [{"strategy": name.split("/")[0], "field": name.split("/")[1], "cut": "isopleth",
+    rows = [{"appearance": "plain", "prior": "auto",
+             "strategy": name.split("/")[0], "field": name.split("/")[1], "cut": "isopleth",
              "poke": k + 1, "purpose": "variance", "map_field": name.split("/")[1],
              "threshold": False, "accuracy": a, "mean_iou": a, "found": 2, "true": 2,
              "kendall_tau": 1.0, "modulus_error": modulus_error, "beta_spread": 0.1,
@@ -221,7 +222,7 @@ def test_one_world_is_mapped_to_max_pokes_by_every_combination() -> None:
     assert rows[-1]["modulus_error"] is not None and rows[-1]["modulus_error"] >= 0
     assert np.isfinite([r["poke_s"] for r in rows]).all()
     for field in ("beta", "modulus"):
-        stored = result.pokes[f"paper/{field}"]
+        stored = result.pokes[f"plain/auto/paper/{field}"]
         assert sorted(stored) == ["index", "noise", "thickness", "value", "x", "y"]
         assert stored["thickness"] is not None and len(stored["thickness"]) == len(stored["x"])
         assert 1 <= len(stored["value"]) <= 2 and stored["index"] == sorted(stored["index"])
@@ -233,10 +234,10 @@ def test_one_world_is_mapped_to_max_pokes_by_every_combination() -> None:
 
 def test_a_stored_world_of_another_format_or_without_pokes_is_refused_in_one_line() -> None:
     stored = {"world": {"index": 0}, "rows": [], "pokes": {}, "fallback_pokes": {},
-              "pokes_format": 3, "seconds": 1.0, "status": "ok", "error": None}
+              "pokes_format": 4, "seconds": 1.0, "status": "ok", "error": None}
     assert WorldResult.from_dict(stored).status == "ok"
-    for data, message in (({**stored, "pokes_format": 2}, "`pokes_format` is 2; this version "
-                                                          "of deformap reads 3 only"),
+    for data, message in (({**stored, "pokes_format": 3}, "`pokes_format` is 3; this version "
+                                                          "of deformap reads 4 only"),
                           ({k: v for k, v in stored.items() if k != "pokes_format"},
                            "`pokes_format` is None"),
                           ({**stored, "pokes": None}, "`pokes` must be an object"),
@@ -338,14 +339,15 @@ def test_rescoring_merges_a_junction_class_within_the_stored_thickness_only() ->
     xs, ys = np.linspace(0.1, 0.5, 5), np.linspace(0.05, 0.35, 5)
     xy = np.array([(x, y) for y in ys for x in xs])
     value = np.log(np.where(xy[:, 0] < 0.25, 10e3, np.where(xy[:, 0] > 0.35, 40e3, 20e3)))
-    rows = [{"world": 0, "family": "l-shape", "strategy": "paper", "field": "modulus",
-             "cut": "nearest", "poke": k} for k in range(1, 26)]
+    rows = [{"world": 0, "family": "l-shape", "appearance": "plain", "prior": "auto",
+             "strategy": "paper", "field": "modulus", "cut": "nearest", "poke": k}
+            for k in range(1, 26)]
 
     def found(thickness, merge: bool) -> list[int]:
         pokes = {"x": xy[:, 0].tolist(), "y": xy[:, 1].tolist(), "value": value.tolist(),
                  "noise": [0.1] * 25, "index": list(range(25)), "thickness": thickness}
         result = WorldResult(world={"index": 0}, rows=tuple(rows),
-                             pokes={"paper/modulus": pokes})
+                             pokes={"plain/auto/paper/modulus": pokes})
         again = rescore_world(_rules(task, merge_seams=merge), result).rows
         return [r["found"] for r in again]
 
@@ -358,15 +360,17 @@ def test_rescoring_merges_a_junction_class_within_the_stored_thickness_only() ->
     close = np.log(np.where(xy[:, 0] < 0.3, 10e3, 12.2e3))
     pokes = {"x": xy[:, 0].tolist(), "y": xy[:, 1].tolist(), "value": close.tolist(),
              "noise": [0.1] * 25, "index": list(range(25)), "thickness": [0.03] * 25}
-    result = WorldResult(world={"index": 0}, rows=tuple(rows), pokes={"paper/modulus": pokes})
+    result = WorldResult(world={"index": 0}, rows=tuple(rows),
+                         pokes={"plain/auto/paper/modulus": pokes})
     by_value, by_place = (rescore_world(_rules(task, split_by_place=split), result).rows
                           for split in (False, True))
     assert by_value[-1]["found"] == 1 and by_place[-1]["found"] == 2
     assert by_place[-1]["accuracy"] > by_value[-1]["accuracy"]
     # a run that fell back to β from its third poke on needs its β pokes to be rescored
     fell = tuple({**r, "map_field": "modulus" if r["poke"] < 3 else "beta"} for r in rows)
-    with pytest.raises(InvalidArgumentError, match="stores no beta pokes of 'paper/modulus', "
-                                                   "whose map field was 'beta' at poke 3"):
+    with pytest.raises(InvalidArgumentError, match="stores no beta pokes of 'plain/auto/paper/"
+                                                   "modulus', whose map field was 'beta' at "
+                                                   "poke 3"):
         rescore_world(task, replace(result, rows=fell))
 
 
@@ -389,7 +393,8 @@ def test_a_run_that_fell_back_to_beta_is_rescored_on_its_stored_beta_pokes(monke
     result = _through_json(run_world(task))
     # the first poke had no modulus: the map field was β there, the modulus field after it
     assert [r["map_field"] for r in result.rows] == ["beta", "modulus", "modulus"]
-    beta, modulus = result.fallback_pokes["paper/modulus"], result.pokes["paper/modulus"]
+    beta = result.fallback_pokes["plain/auto/paper/modulus"]
+    modulus = result.pokes["plain/auto/paper/modulus"]
     assert beta["index"] == [0, 1, 2] and modulus["index"] == [1, 2]
     again = rescore_world(task, result)
     assert again.rows == result.rows  # to the bit, the β row included

@@ -65,11 +65,12 @@ def test_pool_and_dask_agree_byte_for_byte_apart_from_times_and_resume(tmp_path)
     # a folder of the format before: refused in one line naming both versions
     settings_file = tmp_path / "pool" / "bench.json"
     header = json.loads(settings_file.read_text())
-    assert header["format"] == 2 and header["settings"]["exploration"] == {}
+    assert header["format"] == 3 and header["settings"]["exploration"] == {}
+    assert header["settings"]["appearances"] == ["plain"]
     del header["format"]
     settings_file.write_text(json.dumps(header))
     with pytest.raises(ConfigError, match="is a worlds benchmark of format 1; this version of "
-                                          "deformap reads format 2 only"):
+                                          "deformap reads format 3 only"):
         bench_worlds(_config(worlds=2), tmp_path / "pool")
 
 
@@ -90,11 +91,17 @@ def test_settings_are_checked_against_the_config_literals() -> None:
         WorldsBenchConfig(cuts=("voronoi",))
     with pytest.raises(InvalidArgumentError, match="`families` must be"):
         WorldsBenchConfig(families=())
+    with pytest.raises(InvalidArgumentError, match=r"`appearances` must be distinct names .* "
+                                                   r"got \['glossy'\] \(unknown\)"):
+        WorldsBenchConfig(appearances=("plain", "glossy"))
+    arms = WorldsBenchConfig(appearances=("split", "plain")).arms()
+    assert arms == (("split", "off"), ("split", "auto"), ("plain", "auto"))
     # the exploration settings the benchmark's axes set are its own
     for given, option in (({"strategy": "paper"}, "--strategies"),
                           ({"max_pokes": 3}, "--max-pokes"),
                           ({"region_labels": "isopleth"}, "--cuts"),
-                          ({"force_n": 0.4}, "none: each world")):
+                          ({"force_n": 0.4}, "none: each world"),
+                          ({"appearance": "off"}, "--appearance")):
         with pytest.raises(InvalidArgumentError, match=f"`exploration.{next(iter(given))}` is "
                                                        f"the benchmark's to set .option: {option}"):
             WorldsBenchConfig(exploration=ExplorationConfig(**given))
@@ -151,34 +158,37 @@ def test_rescore_scores_other_cuts_on_the_stored_pokes_and_names_what_it_cannot(
     assert "world-00001.json is not a stored world: `pokes` must be an object" in result.output
     assert "Traceback" not in result.output and not (tmp_path / "third").exists()
     # damaged stored worlds: one line naming the file and what is wrong, before any folder
-    assert stored["pokes_format"] == POKES_FORMAT == 3
-    stored["pokes"] = {"paper/beta": {"x": [0.1], "y": [0.1, 0.2], "value": [1.0],
-                                      "noise": [0.1], "index": [0], "thickness": [0.05]}}
-    unthick = {"paper/beta": {k: v for k, v in stored["pokes"]["paper/beta"].items()
-                              if k != "thickness"}}
+    assert stored["pokes_format"] == POKES_FORMAT == 4
+    key = "plain/auto/paper/beta"
+    stored["pokes"] = {key: {"x": [0.1], "y": [0.1, 0.2], "value": [1.0], "noise": [0.1],
+                             "index": [0], "thickness": [0.05]}}
+    unthick = {key: {k: v for k, v in stored["pokes"][key].items() if k != "thickness"}}
     for damaged, why in (([1, 2], "expected an object"),
                          ({**stored, "world": {"index": "a"}}, "`world.index` must be"),
                          (stored, "columns of different lengths"),
-                         ({**stored, "pokes": {}}, "no stored pokes of 'paper/beta'"),
-                         ({**stored, "pokes_format": 4},
-                          "`pokes_format` is 4; this version of deformap reads 3 only"),
-                         ({**stored, "pokes_format": 2},
-                          "`pokes_format` is 2; this version of deformap reads 3 only"),
+                         ({**stored, "pokes": {}}, f"no stored pokes of '{key}'"),
+                         ({**stored, "pokes_format": 5},
+                          "`pokes_format` is 5; this version of deformap reads 4 only"),
+                         ({**stored, "pokes_format": 3},
+                          "`pokes_format` is 3; this version of deformap reads 4 only"),
                          ({**original, "fallback_pokes": []},
                           "`fallback_pokes` must be an object; got list"),
-                         ({**original, "fallback_pokes": {"paper/beta": {"x": [0.1]}}},
-                          "the fallback_pokes of 'paper/beta' must have lists"),
+                         ({**original, "fallback_pokes": {key: {"x": [0.1]}}},
+                          f"the fallback_pokes of '{key}' must have lists"),
                          ({**original, "rows": [{**r, "map_field": "hardness"}
                                                 for r in original["rows"]]},
                           "has `map_field` 'hardness', expected one of ['beta', 'modulus']"),
                          ({**original, "rows": [{**r, "map_field": "modulus"}
                                                 for r in original["rows"]]},
-                          "no stored fallback pokes of 'paper/beta', whose map field was "
+                          f"no stored fallback pokes of '{key}', whose map field was "
                           "'modulus' at poke 1"),
+                         ({**original, "rows": [{**r, "prior": "off"}
+                                                for r in original["rows"]]},
+                          "(plain/off) at poke 1 is not of this benchmark"),
                          ({**stored, "pokes_format": True}, "`pokes_format` is True"),
-                         ({**stored, "pokes_format": 3.0}, "`pokes_format` is 3.0"),
+                         ({**stored, "pokes_format": 4.0}, "`pokes_format` is 4.0"),
                          ({**stored, "pokes": unthick},
-                          "the pokes of 'paper/beta' must have lists")):
+                          f"the pokes of '{key}' must have lists")):
         world.write_text(json.dumps(damaged))
         result = runner.invoke(app, ["bench", "rescore", str(tmp_path / "src"), "--out",
                                      str(tmp_path / "third")])
@@ -194,7 +204,7 @@ def test_rescore_scores_other_cuts_on_the_stored_pokes_and_names_what_it_cannot(
     result = runner.invoke(app, ["bench", "rescore", str(tmp_path / "src"), "--out",
                                  str(tmp_path / "fifth")])
     assert result.exit_code == 2 and len(result.output.strip().splitlines()) == 1
-    assert "is a worlds benchmark of format 1; this version of deformap reads format 2 only" \
+    assert "is a worlds benchmark of format 1; this version of deformap reads format 3 only" \
         in result.output
 
 

@@ -176,6 +176,12 @@ def bench_worlds_command(
         help="World physics drawn from (linear-fem, stiffening-foam, stiffening-fem); "
              "default: all.",
         show_default=False)] = None,
+    appearances: Annotated[list[str] | None, typer.Option(
+        "--appearance", "--appearances",
+        help="Appearance families painting every world (plain, informative, textured, shared, "
+             "split, misleading); each but plain mapped twice, blind and with the appearance "
+             "prior; comma-separated (or repeated); default: plain.",
+        show_default=False)] = None,
     cuts: Annotated[list[str] | None, typer.Option(
         "--cuts", "--cut",
         help="Region labels (exploration.region_labels), each scored on the same pokes; "
@@ -194,12 +200,13 @@ def bench_worlds_command(
     json_path: JsonOption = None,
 ) -> None:
     """Map many seeded random worlds with every strategy × field; accuracy after every poke,
-    curves per layout family and the pokes a good map takes (resumes in its --out)."""
+    curves per layout family (or per appearance family, blind beside the prior) and the pokes a
+    good map takes (resumes in its --out)."""
     from deformap import run
 
     given: dict[str, Any] = {"families": _names(families), "strategies": _names(strategies),
                              "fields": _names(fields), "physics": _names(physics),
-                             "cuts": _names(cuts)}
+                             "cuts": _names(cuts), "appearances": _names(appearances)}
     exploration = run.exploration_with(run.parse_assignments(assignments or ()))
     config = run.WorldsBenchConfig(
         worlds=worlds, seed=seed, max_pokes=max_pokes, exploration=exploration, coarse=coarse,
@@ -231,9 +238,43 @@ def _show_worlds_summary(shown: Any, output: Any, worlds: int, max_pokes: int,
         ("strategy/field/cut", "worlds", "median pokes to 0.9", "mean", "to stay", "reach 0.9",
          "final accuracy", "E error"),
         rows))  # fmt: skip
+    _show_paired(shown, summary)
     shown.print(f"{output.computed} worlds computed in {output.seconds:.0f} s → {output.folder}",
                 highlight=False)
     emit_json(json_path, summary)
+
+
+def _cell(value: Any, spec: str) -> str:
+    return "–" if value is None else format(value, spec)
+
+
+def _arms(entry: dict[str, Any], key: str, spec: str) -> str:
+    """``blind / prior`` of one statistic of ``summary["appearance"]``'s ``entry``."""
+    return f"{_cell((entry['blind'] or {}).get(key), spec)} / {_cell(entry['prior'][key], spec)}"
+
+
+def _show_paired(shown: Any, summary: dict[str, Any]) -> None:
+    """The appearance families, where one was mapped blind beside the prior: one row per family ×
+    combination."""
+    families = summary.get("appearance", {})
+    if not any(e["blind"] for per in families.values() for e in per.values()):
+        return
+    rows = []
+    for family, per in families.items():
+        for name, e in per.items():
+            ci = e["mean_pokes_difference_ci95"]
+            rows.append((family, name, str(e["prior"]["worlds"]),
+                         _arms(e, "median_pokes_to_accuracy_0.9", "g"),
+                         _arms(e, "mean_pokes_to_accuracy_0.9", ".1f"),
+                         _cell(e["mean_pokes_difference"], "+.2f")
+                         + ("" if ci is None else f" ({ci[0]:+.2f} to {ci[1]:+.2f})"),
+                         _arms(e, "final_accuracy_median", ".3f"),
+                         _arms(e, "share_right_count", ".0%")))  # fmt: skip
+    shown.print(_table(
+        "appearance: blind / prior on the same worlds and presses (difference: prior − blind, "
+        "mean over worlds, 95 % t interval)",
+        ("appearance", "strategy/field/cut", "worlds", "median pokes to 0.9", "mean",
+         "difference", "final accuracy", "right count"), rows))  # fmt: skip
 
 
 @bench_app.command("rescore")

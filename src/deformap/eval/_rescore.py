@@ -30,7 +30,8 @@ def rescore_world(task: WorldTask, result: WorldResult) -> WorldResult:
     and exploration settings instead, on the pokes it stored (no press is made again).
 
     Only the settings that act after the pokes, on the map field and its regions (the cut,
-    ``merge_seams``, ``split_by_place``), are measured this way: the pokes are the run's, so a
+    ``merge_seams``, ``split_by_place``), are measured this way, and the map field is refitted
+    from the stored pokes alone: the pokes are the run's, so a
     setting that moves them would be scored on pokes it did not choose (the caller's to refuse).
 
     After ``k`` pokes the map field is the one of the stored pokes numbered below ``k`` (a poke
@@ -49,24 +50,28 @@ def rescore_world(task: WorldTask, result: WorldResult) -> WorldResult:
     if result.status != "ok":
         raise InvalidArgumentError(f"`result` of world {task.index} must be a finished world; "
                                    f"got status {result.status!r}")
-    draw = task.draw()  # the truth is the layout's: no world is built, nothing pressed
+    draw = task.draw()  # the truth is the layout's, whatever paints it: nothing is pressed
     explore = task.exploration_for(draw)
     grid = MapGrid.build(draw.scenario.workspace, explore)
     labels, hardness, _ = material_truth(draw.scenario, grid.xs, grid.ys)
-    head: dict[tuple[str, str, int], dict[str, Any]] = {}
+    head: dict[tuple[str, str, str, str, int], dict[str, Any]] = {}
     for row in result.rows:
-        head.setdefault((row["strategy"], row["field"], int(row["poke"])), row)
+        head.setdefault((row["appearance"], row["prior"], row["strategy"], row["field"],
+                         int(row["poke"])), row)
+    arms = task.arms()
     rows: list[dict[str, Any]] = []
-    for (strategy, field_name, poke), old in sorted(head.items(), key=lambda kv: (
-            task.strategies.index(kv[0][0]), task.fields.index(kv[0][1]), kv[0][2])):
+    for (appearance, prior, strategy, field_name, poke), old in sorted(
+            head.items(), key=lambda kv: (arms.index(kv[0][:2]), task.strategies.index(kv[0][2]),
+                                          task.fields.index(kv[0][3]), kv[0][4])):
         mapped = old.get("map_field", field_name)  # the field the run mapped on at this poke
         stored = result.pokes if mapped == field_name else result.fallback_pokes
-        combo = f"{strategy}/{field_name}"
-        if combo not in stored:
+        key = WorldResult.run_key(appearance, prior, strategy, field_name)
+        if key not in stored:
             raise InvalidArgumentError(f"world {task.index} stores no {mapped} pokes of "
-                                       f"{combo!r}, whose map field was {mapped!r} at poke {poke}")
-        config = replace(explore, strategy=cast(Any, strategy), field=cast(Any, mapped))
-        mean, pokes = _map_field(stored[combo], poke, config, grid)
+                                       f"{key!r}, whose map field was {mapped!r} at poke {poke}")
+        config = replace(explore, strategy=cast(Any, strategy), field=cast(Any, mapped),
+                         appearance=cast(Any, prior))
+        mean, pokes = _map_field(stored[key], poke, config, grid)
         sign = -1.0 if mapped == "modulus" else 1.0
         for cut in task.cuts:  # a finished world has a poke with a value at every k
             found = map_regions(mean, pokes, grid.cells_xy,

@@ -6,7 +6,14 @@ turn (so any run of ``n`` worlds spans them evenly), and draws the rest from
 (:func:`deformap.world.random_scenario`, hardness over :data:`HARDNESS_RANGE_N`, one material
 rigid with probability :data:`P_RIGID`), the world's physics (any of
 :data:`deformap.world.PHYSICS`), camera (every preset of :data:`deformap.world.CAMERA_PRESETS`),
-block thickness (:data:`THICKNESSES_M`) and press force (:data:`FORCES_N`).
+block thickness (:data:`THICKNESSES_M`) and press force (:data:`FORCES_N`). The appearance family
+(:data:`deformap.world.APPEARANCE_FAMILIES`) paints the layout from a generator of its own, so
+every family paints the same layout, materials and axes of a world index.
+
+A task maps each of its appearance families under one or two *arms* (:meth:`WorldTask.arms`): a
+painted family twice, paired on the same world, presses and streams, with the appearance prior
+off (the blind map) and on (``auto``); ``plain``, one look everywhere, once under ``auto``, so a
+benchmark of plain worlds maps each world once per combination.
 """
 
 from __future__ import annotations
@@ -22,6 +29,7 @@ from deformap._validation import check_settings, setting
 from deformap.errors import InvalidArgumentError
 from deformap.explore import ExplorationConfig
 from deformap.world import (
+    APPEARANCE_FAMILIES,
     CAMERA_PRESETS,
     LAYOUT_FAMILIES,
     PHYSICS,
@@ -33,6 +41,7 @@ from deformap.world import (
 __all__ = [
     "FORCES_N",
     "HARDNESS_RANGE_N",
+    "PRIORS",
     "P_RIGID",
     "THICKNESSES_M",
     "WorldDraw",
@@ -51,6 +60,8 @@ THICKNESSES_M = (0.03, 0.05, 0.10)
 FORCES_N = (0.4, 0.6, 0.8)
 #: Probability that one material of a benchmark world is a rigid board (the generator's default).
 P_RIGID = 0.25
+#: ``ExplorationConfig.appearance`` of the two arms of a painted world: the blind map, the prior.
+PRIORS = ("off", "auto")
 
 
 def choices(name: str) -> tuple[str, ...]:
@@ -65,6 +76,7 @@ class WorldDraw:
 
     index: int
     family: str
+    appearance: str
     physics: Physics
     camera: str
     thickness_m: float
@@ -82,9 +94,15 @@ class WorldDraw:
 
 
 def draw_world(seed: int, index: int, families: Sequence[str] = LAYOUT_FAMILIES,
-               physics: Sequence[str] = PHYSICS) -> WorldDraw:
+               physics: Sequence[str] = PHYSICS, appearance: str = "plain") -> WorldDraw:
     """The ``index``-th world of a benchmark seeded ``seed`` (module docstring); ``physics``
-    the world physics to draw from (all by default)."""
+    the world physics to draw from (all by default), ``appearance`` the family that paints it.
+
+    Raises
+    ------
+    InvalidArgumentError
+        No family, an unknown physics or an unknown appearance family.
+    """
     if not families:
         raise InvalidArgumentError("`families` must name at least one layout family; got none")
     if not physics or any(p not in PHYSICS for p in physics):
@@ -97,9 +115,10 @@ def draw_world(seed: int, index: int, families: Sequence[str] = LAYOUT_FAMILIES,
     thickness = float(rng.choice(THICKNESSES_M))
     force = float(rng.choice(FORCES_N))
     scenario = random_scenario(rng, family=family, hardness_range_n=HARDNESS_RANGE_N,
-                               p_rigid=P_RIGID, thickness_m=thickness)  # fmt: skip
-    return WorldDraw(index=index, family=family, physics=drawn, camera=camera,
-                     thickness_m=thickness, force_n=force, scenario=scenario)
+                               p_rigid=P_RIGID, thickness_m=thickness,
+                               appearance=appearance)  # fmt: skip
+    return WorldDraw(index=index, family=family, appearance=appearance, physics=drawn,
+                     camera=camera, thickness_m=thickness, force_n=force, scenario=scenario)
 
 
 def material_truth(scenario: Scenario, xs: NDArray[np.float64], ys: NDArray[np.float64]
@@ -132,6 +151,8 @@ class WorldTask:
         The world is the ``index``-th of the benchmark seeded ``seed`` (:func:`draw_world`).
     families, physics : tuple of str
         The layout families taken in turn and the world physics drawn from.
+    appearances : tuple of str
+        The appearance families the world is painted in, each mapped under its :meth:`arms`.
     strategies, fields : tuple of str
         ``ExplorationConfig.strategy`` and ``field`` values; every pair maps the world.
     cuts : tuple of str
@@ -150,6 +171,8 @@ class WorldTask:
     index: int = setting(0, ge=0)
     families: tuple[str, ...] = LAYOUT_FAMILIES
     physics: tuple[str, ...] = PHYSICS
+    # one look everywhere: a benchmark that names no appearance maps each world once
+    appearances: tuple[str, ...] = ("plain",)
     strategies: tuple[str, ...] = choices("strategy")
     fields: tuple[str, ...] = choices("field")
     cuts: tuple[str, ...] = choices("region_labels")
@@ -159,10 +182,22 @@ class WorldTask:
 
     def __post_init__(self) -> None:
         check_settings(self)
+        unknown = [a for a in self.appearances if a not in APPEARANCE_FAMILIES]
+        if not self.appearances or unknown or len(set(self.appearances)) < len(self.appearances):
+            raise InvalidArgumentError(f"`appearances` must be distinct names from "
+                                       f"{list(APPEARANCE_FAMILIES)}; got "
+                                       f"{list(self.appearances)}")
 
-    def draw(self) -> WorldDraw:
-        """The world this task maps (:func:`draw_world`)."""
-        return draw_world(self.seed, self.index, self.families, self.physics)
+    def draw(self, appearance: str = "plain") -> WorldDraw:
+        """The world this task maps, painted by ``appearance`` (:func:`draw_world`)."""
+        return draw_world(self.seed, self.index, self.families, self.physics, appearance)
+
+    def arms(self) -> tuple[tuple[str, str], ...]:
+        """``(appearance family, ExplorationConfig.appearance)`` of every mapping of the world,
+        in order: a painted family under each of :data:`PRIORS` (blind first), ``plain`` under
+        ``auto`` only (module docstring)."""
+        return tuple((a, p) for a in self.appearances
+                     for p in (PRIORS if a != "plain" else PRIORS[1:]))
 
     def exploration_for(self, draw: WorldDraw) -> ExplorationConfig:
         """The exploration settings of ``draw``: every poke up to ``max_pokes`` made (the ones

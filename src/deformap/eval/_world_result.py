@@ -18,11 +18,12 @@ from deformap.explore import PokeSet
 
 __all__ = ["POKES_FORMAT", "TIME_COLUMNS", "WorldResult", "poke_data", "row_values"]
 
-#: Version of a stored world's pokes: each map field's columns ``x``, ``y``, ``value``,
-#: ``noise``, ``index`` and ``thickness`` (:func:`poke_data`), and the β pokes of a modulus run
-#: that fell back (``fallback_pokes``). A reader refuses any other version rather than guess
+#: Version of a stored world's pokes: each mapping's (:meth:`WorldResult.run_key`) map-field
+#: columns ``x``, ``y``, ``value``, ``noise``, ``index`` and ``thickness`` (:func:`poke_data`),
+#: the β pokes of a modulus run that fell back (``fallback_pokes``), and rows that name their
+#: ``appearance`` family and ``prior``. A reader refuses any other version rather than guess
 #: what its columns mean.
-POKES_FORMAT = 3
+POKES_FORMAT = 4
 #: Columns of a row that hold wall times (the only ones two runs of one world may differ in).
 TIME_COLUMNS = ("poke_s", "elapsed_s")
 _POKE_COLUMNS = ("x", "y", "value", "noise", "index", "thickness")
@@ -57,13 +58,14 @@ class WorldResult:
     world : dict
         :meth:`deformap.eval.WorldDraw.summary` (a failed draw: ``index`` and ``family`` only).
     rows : tuple of dict
-        One per strategy × field × cut × poke, each naming them (``runs.csv``'s row columns).
+        One per arm × strategy × field × cut × poke, each naming them (``runs.csv``'s row
+        columns).
     pokes : dict
-        Each ``"strategy/field"``'s map field's pokes (:func:`poke_data`): what
+        Each mapping's map field's pokes (:func:`poke_data`) under its :meth:`run_key`: what
         :func:`deformap.eval.rescore_world` scores other cuts on.
     fallback_pokes : dict
-        The β pokes of each modulus ``"strategy/field"`` whose map field was β at some poke
-        (a row's ``map_field`` says at which).
+        The β pokes of each modulus mapping whose map field was β at some poke (a row's
+        ``map_field`` says at which).
     seconds : float or None
         The world's wall time, building included (``None`` for a failed world).
     status : {"ok", "failed"}
@@ -78,6 +80,12 @@ class WorldResult:
     seconds: float | None = None
     status: Literal["ok", "failed"] = "ok"
     error: str | None = None
+
+    @staticmethod
+    def run_key(appearance: str, prior: str, strategy: str, field: str) -> str:
+        """``appearance/prior/strategy/field``: one mapping of a world, the key of its stored
+        pokes."""
+        return f"{appearance}/{prior}/{strategy}/{field}"
 
     @property
     def index(self) -> int:

@@ -1,15 +1,18 @@
 """Many worlds: one seeded random world, every strategy × field mapped on it, scored after each poke.
 
-:func:`run_world` builds the world of a :class:`~deformap.eval.WorldTask` once
-(:func:`deformap.eval.draw_world`) and maps it with every strategy × field from the same surface
-model (one first observation and one fit: the same cloud and the same stream give every
-combination the same model), poking to ``max_pokes``: once the map field's variance is under
-``T_h`` the remaining pokes go where a region boundary is least certain
-(``ExplorationConfig.boundary_pokes``), so every combination makes ``max_pokes`` pokes and the
-curves compare like with like; ``threshold`` in a row says whether the variance rule was met.
-Every cut (``region_labels``) asked for is scored on the same pokes: where the next poke goes
-does not depend on the cut (the targets read the classes of the pokes before any cut), so mapping
-once per cut would repeat the same pokes. After every poke it records (one row each per cut):
+:func:`run_world` builds the world of a :class:`~deformap.eval.WorldTask` once per appearance
+family (:func:`deformap.eval.draw_world`: the same layout, painted) and maps it under each of the
+family's arms (:meth:`~deformap.eval.WorldTask.arms`: ``ExplorationConfig.appearance`` off and
+``auto``, or ``auto`` alone) with every strategy × field, each from the same start (one first
+observation and one ``Mapper.initialise`` per arm, whose state every combination of the arm starts
+from, copied: the same cloud and the same stream give every combination the same surface model),
+poking to ``max_pokes``: once the map field's variance is under ``T_h`` the remaining pokes go
+where a region boundary is least certain (``ExplorationConfig.boundary_pokes``), so every
+combination makes ``max_pokes`` pokes and the curves compare like with like; ``threshold`` in a row
+says whether the variance rule was met. Every cut (``region_labels``) asked for is scored on the
+same pokes: where the next poke goes does not depend on the cut (the targets read the classes of
+the pokes before any cut), so mapping once per cut would repeat the same pokes. After every poke it
+records (one row each per cut):
 
 - ``accuracy``, ``mean_iou``, ``found``, ``true``, ``kendall_tau``
   (:func:`deformap.eval.region_scores`) of the map field's regions against the world's truth by
@@ -24,12 +27,16 @@ once per cut would repeat the same pokes. After every poke it records (one row e
 - ``poke_s``: the poke's wall time (target, press, dent and estimate, fields), ``elapsed_s`` the
   combination's so far.
 
-Every number of a row is a function of the task, whatever process computes it; only the times
-differ between runs.
+A row names its ``appearance`` family and ``prior`` (the arm's ``ExplorationConfig.appearance``).
+The two arms of a painted family press the same world, and a press's noise is a function of its
+place and force, so the blind map and the prior differ only by what the prior does. Every number
+of a row is a function of the task, whatever process computes it; only the times differ between
+runs.
 """
 
 from __future__ import annotations
 
+import copy
 import time
 from collections.abc import Sequence
 from dataclasses import replace
@@ -39,11 +46,13 @@ from typing import Any, cast
 import numpy as np
 from numpy.typing import NDArray
 
+from deformap.cloud import PointCloud
 from deformap.eval._metrics import region_scores
 from deformap.eval._world_draw import WorldDraw, WorldTask, material_truth
 from deformap.eval._world_result import PokeData, WorldResult, poke_data
 from deformap.explore import (
     ExplorationConfig,
+    MapGrid,
     Mapper,
     PokeSet,
     RegionLabels,
@@ -87,15 +96,16 @@ def _scores(mapper: Mapper, truth: _Truth,
     return out
 
 
-def _map_one(world: SimulatedWorld, draw: WorldDraw, config: ExplorationConfig, surface: Any,
-             truth: _Truth, seed: int,
+def _map_one(world: SimulatedWorld, draw: WorldDraw, config: ExplorationConfig,
+             start: dict[str, Any], truth: _Truth, seed: int,
              cuts: Sequence[str]
              ) -> tuple[list[dict[str, Any]], dict[str, list[Any]], dict[str, list[Any]] | None]:
     """Map the world with one configuration to ``max_pokes``; one row per poke and cut, the
     field's pokes at the end (``poke_data``), and the β pokes of a run whose map field fell
     back to β at some poke (else ``None``)."""
     mapper = Mapper(world.workspace, config)
-    mapper.surface = surface  # the combinations share the first observation's model
+    # what the first observation gave, copied: one combination's mapping cannot change another's
+    vars(mapper).update(copy.deepcopy(start))
     streams = np.random.default_rng(np.random.SeedSequence([seed, draw.index, 1])).spawn(
         config.max_pokes + 1)
     rows: list[dict[str, Any]] = []
@@ -133,9 +143,11 @@ def _map_one(world: SimulatedWorld, draw: WorldDraw, config: ExplorationConfig, 
     return rows, data(stored), (data(beta) if fell_back else None)
 
 
-def _build_world(task: WorldTask) -> tuple[WorldDraw, SimulatedWorld, ExplorationConfig]:
-    """The world of ``task``, built, and the exploration settings it is mapped with."""
-    draw = task.draw()
+def _build_world(task: WorldTask, appearance: str
+                 ) -> tuple[WorldDraw, SimulatedWorld, ExplorationConfig]:
+    """The world of ``task`` painted by ``appearance``, built, and the exploration settings it is
+    mapped with."""
+    draw = task.draw(appearance)
     base = WorldConfig.coarse() if task.coarse else WorldConfig()
     config = replace(base, physics=draw.physics,
                      camera=replace(camera_preset(draw.camera), width=base.camera.width,
@@ -146,34 +158,51 @@ def _build_world(task: WorldTask) -> tuple[WorldDraw, SimulatedWorld, Exploratio
     return draw, world, task.exploration_for(draw)
 
 
+def _start(world: SimulatedWorld, config: ExplorationConfig, cloud: PointCloud,
+           rng: np.random.Generator) -> dict[str, Any]:
+    """What ``Mapper.initialise`` sets from the first observation under ``config`` (the surface
+    model and whatever else it derives from the cloud), for every combination to start from
+    without fitting it again."""
+    mapper = Mapper(world.workspace, config)
+    before = dict(vars(mapper))
+    mapper.initialise(cloud, rng)
+    return {k: v for k, v in vars(mapper).items() if k not in before or before[k] is not v}
+
+
 def run_world(task: WorldTask) -> WorldResult:
-    """Build the world of ``task`` and map it with every strategy × field (module docstring).
+    """Build the world of ``task`` and map it under every arm with every strategy × field
+    (module docstring).
 
     Returns
     -------
     WorldResult
-        One row per strategy × field × cut × poke, each combination's map-field pokes (and the
-        β pokes of a modulus run that fell back to β), and the world's wall time, building
-        included.
+        One row per arm × strategy × field × cut × poke, each mapping's map-field pokes (and the
+        β pokes of a modulus run that fell back to β) under :meth:`WorldResult.run_key`, and the
+        world's wall time, building included.
     """
     t0 = time.perf_counter()
-    draw, world, explore = _build_world(task)
-    explore_seq = np.random.SeedSequence([task.seed, task.index, 0]).spawn(2)[1]
-    first = Mapper(world.workspace, explore)
-    surface = first.initialise(world.observe(), np.random.default_rng(explore_seq))
-    truth = material_truth(world.scenario, first.grid.xs, first.grid.ys)
-    rows = []
+    rows: list[dict[str, Any]] = []
     pokes, fallback = {}, {}
-    for strategy in task.strategies:
-        for field in task.fields:
-            cfg = replace(explore, strategy=cast(Any, strategy), field=cast(Any, field))
-            combo = f"{strategy}/{field}"
-            mapped, pokes[combo], beta = _map_one(world, draw, cfg, surface, truth, task.seed,
-                                                  task.cuts)
-            if beta is not None:
-                fallback[combo] = beta
-            for row in mapped:
-                rows.append({"world": task.index, "family": draw.family, "strategy": strategy,
-                             "field": field, **row})  # fmt: skip
-    return WorldResult(world=draw.summary(), rows=tuple(rows), pokes=pokes,
+    summary: dict[str, Any] = {}
+    explore_seq = np.random.SeedSequence([task.seed, task.index, 0]).spawn(2)[1]
+    for appearance in task.appearances:
+        draw, world, explore = _build_world(task, appearance)
+        summary = summary or draw.summary()  # the same layout in every family
+        cloud = world.observe()
+        grid = MapGrid.build(world.workspace, explore)
+        truth = material_truth(world.scenario, grid.xs, grid.ys)
+        for prior in (p for a, p in task.arms() if a == appearance):
+            armed = replace(explore, appearance=cast(Any, prior))
+            start = _start(world, armed, cloud, np.random.default_rng(explore_seq))
+            for strategy, field in ((s, f) for s in task.strategies for f in task.fields):
+                cfg = replace(armed, strategy=cast(Any, strategy), field=cast(Any, field))
+                key = WorldResult.run_key(appearance, prior, strategy, field)
+                mapped, pokes[key], beta = _map_one(world, draw, cfg, start, truth, task.seed,
+                                                    task.cuts)
+                if beta is not None:
+                    fallback[key] = beta
+                rows.extend({"world": task.index, "family": draw.family,
+                             "appearance": appearance, "prior": prior, "strategy": strategy,
+                             "field": field, **row} for row in mapped)  # fmt: skip
+    return WorldResult(world=summary, rows=tuple(rows), pokes=pokes,
                        fallback_pokes=fallback, seconds=time.perf_counter() - t0)

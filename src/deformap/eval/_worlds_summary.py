@@ -24,6 +24,11 @@ Royston, P., Parmar, M. K. B. (2013). Restricted mean survival time: an alternat
 ratio for the design and analysis of randomized trials with a time-to-event outcome. BMC Medical
 Research Methodology 13, 152. Efron, B., Tibshirani, R. J. (1993). An Introduction to the
 Bootstrap, ch. 13 (percentile intervals).
+
+Appearance. Each row names its appearance family and ``prior`` (the arm's
+``ExplorationConfig.appearance``); ``strategies`` and the curves per layout family count each
+world once per appearance family, mapped with the prior (``auto``, the exploration's default);
+``appearance`` sets the blind map beside it per appearance family (:mod:`._worlds_paired`).
 """
 
 from __future__ import annotations
@@ -37,11 +42,15 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from deformap.errors import InvalidArgumentError
+from deformap.eval._world_draw import PRIORS
 from deformap.eval._world_result import WorldResult
+from deformap.eval._worlds_paired import arm_stats, markdown_paired, paired_difference
 
 __all__ = [
     "CSV_COLUMNS",
     "GOOD_ACCURACY",
+    "PLAIN_ARMS",
     "accuracy_curves",
     "combination_name",
     "markdown_summary",
@@ -52,13 +61,17 @@ __all__ = [
 
 #: The region accuracy a map must reach: the benchmark counts the pokes a good map takes.
 GOOD_ACCURACY = 0.9
+#: The arms of a benchmark of plain worlds (:meth:`deformap.eval.WorldTask.arms`).
+PLAIN_ARMS = (("plain", "auto"),)
+
+Arm = tuple[str, str]
 
 _WORLD_COLUMNS = ("physics", "camera", "thickness_m", "force_n")
-_ROW_COLUMNS = ("strategy", "field", "cut", "poke", "purpose", "map_field", "threshold",
-                "accuracy", "mean_iou", "found", "true", "kendall_tau", "modulus_error",
-                "beta_spread", "poke_s", "elapsed_s")  # fmt: skip
-#: Columns of ``runs.csv``: one row per world × strategy × field × cut × poke (a failed world: one row
-#: per combination, ``poke`` empty, ``status`` failed with its ``error``).
+_ROW_COLUMNS = ("appearance", "prior", "strategy", "field", "cut", "poke", "purpose",
+                "map_field", "threshold", "accuracy", "mean_iou", "found", "true", "kendall_tau",
+                "modulus_error", "beta_spread", "poke_s", "elapsed_s")  # fmt: skip
+#: Columns of ``runs.csv``: one row per world × arm × strategy × field × cut × poke (a failed world:
+#: one row per arm × combination, ``poke`` empty, ``status`` failed with its ``error``).
 CSV_COLUMNS = ("world", "family", *_WORLD_COLUMNS, *_ROW_COLUMNS, "status", "error")
 
 
@@ -75,9 +88,10 @@ def _cell(value: Any) -> str:
     return str(value)
 
 
-def runs_csv(results: Sequence[WorldResult], combinations: Sequence[tuple[str, str, str]]
-             ) -> str:
-    """``runs.csv`` of the worlds' results (in world order), as text."""
+def runs_csv(results: Sequence[WorldResult], combinations: Sequence[tuple[str, str, str]],
+             arms: Sequence[Arm] = PLAIN_ARMS) -> str:
+    """``runs.csv`` of the worlds' results (in world order), as text; ``arms`` the
+    ``(appearance, prior)`` each world was mapped under (a failed world's rows)."""
     buffer = io.StringIO()
     writer = csv.writer(buffer, lineterminator="\n")
     writer.writerow(CSV_COLUMNS)
@@ -85,9 +99,10 @@ def runs_csv(results: Sequence[WorldResult], combinations: Sequence[tuple[str, s
         world = result.world
         head = [world["index"], world["family"], *(world.get(k) for k in _WORLD_COLUMNS)]
         if result.status != "ok":
-            for strategy, field, cut in combinations:
-                writer.writerow([_cell(v) for v in (*head, strategy, field, cut)]
-                                + [""] * (len(_ROW_COLUMNS) - 3) + ["failed", result.error])
+            for arm in arms:
+                for combination in combinations:
+                    writer.writerow([_cell(v) for v in (*head, *arm, *combination)]
+                                    + [""] * (len(_ROW_COLUMNS) - 5) + ["failed", result.error])
             continue
         for row in result.rows:
             writer.writerow([_cell(v) for v in (*head, *(row[k] for k in _ROW_COLUMNS))]
@@ -109,19 +124,24 @@ def _series(rows: list[dict[str, Any]], key: str, max_pokes: int) -> NDArray[np.
 
 
 def _per_world(results: Sequence[WorldResult], combination: tuple[str, str, str],
-               max_pokes: int) -> list[dict[str, Any]]:
-    """One entry per world for one combination: family, accuracy and modulus-error series."""
+               max_pokes: int, arms: Sequence[Arm] = PLAIN_ARMS) -> list[dict[str, Any]]:
+    """One entry per world and arm for one combination: index, layout family, arm, accuracy
+    and modulus-error series, and whether the last map has the true region count."""
     out = []
     for result in results:
         world = result.world
-        if result.status != "ok":
-            out.append({"family": world["family"], "failed": True})
-            continue
-        rows = [r for r in result.rows
-                if (r["strategy"], r["field"], r["cut"]) == combination]  # fmt: skip
-        out.append({"family": world["family"], "failed": False,
-                    "accuracy": _series(rows, "accuracy", max_pokes),
-                    "modulus_error": _series(rows, "modulus_error", max_pokes)})  # fmt: skip
+        for appearance, prior in arms:
+            entry = {"index": int(world["index"]), "family": world["family"],
+                     "appearance": appearance, "prior": prior, "failed": True}
+            if result.status == "ok":
+                rows = [r for r in result.rows
+                        if (r["strategy"], r["field"], r["cut"]) == combination
+                        and (r["appearance"], r["prior"]) == (appearance, prior)]
+                found, true = (_series(rows, k, max_pokes)[-1] for k in ("found", "true"))
+                entry.update(failed=False, accuracy=_series(rows, "accuracy", max_pokes),
+                             modulus_error=_series(rows, "modulus_error", max_pokes),
+                             right_count=bool(found == true))
+            out.append(entry)
     return out
 
 
@@ -140,13 +160,13 @@ def _pokes_to_good(entry: dict[str, Any], max_pokes: int, *, stay: bool = False)
 
 
 def pokes_to_good(results: Sequence[WorldResult], combination: tuple[str, str, str],
-                  max_pokes: int) -> dict[int, int]:
-    """Each world's pokes to :data:`GOOD_ACCURACY` under one combination, by world index
-    (``max_pokes + 1`` where never, or where the world failed): what ``summary.json``'s medians
-    are taken over, for comparing two combinations world by world."""
-    entries = _per_world(results, combination, max_pokes)
-    return {int(r.world["index"]): _pokes_to_good(e, max_pokes)
-            for r, e in zip(results, entries, strict=True)}
+                  max_pokes: int, arm: Arm = PLAIN_ARMS[0]) -> dict[int, int]:
+    """Each world's pokes to :data:`GOOD_ACCURACY` under one combination and ``arm``
+    (``(appearance, prior)``), by world index (``max_pokes + 1`` where never, or where the world
+    failed): what ``summary.json``'s medians are taken over, for comparing two combinations
+    world by world."""
+    return {e["index"]: _pokes_to_good(e, max_pokes)
+            for e in _per_world(results, combination, max_pokes, [arm])}
 
 
 def _median(values: Sequence[float]) -> float | None:
@@ -194,20 +214,23 @@ def _stats(entries: list[dict[str, Any]], max_pokes: int) -> dict[str, Any]:
 
 
 def summarise_worlds(results: Sequence[WorldResult],
-                     combinations: Sequence[tuple[str, str, str]], max_pokes: int
-                     ) -> dict[str, Any]:
+                     combinations: Sequence[tuple[str, str, str]], max_pokes: int,
+                     arms: Sequence[Arm] = PLAIN_ARMS) -> dict[str, Any]:
     """``summary.json``: ``{"strategies": {NAME: {"median_pokes_to_accuracy_0.9",
     "final_accuracy_median", "modulus_error_median", "worlds", "by_family": {FAMILY: …}}}}``
     (NAME a :func:`combination_name`; each entry also has ``mean_pokes_to_accuracy_0.9``,
     ``median_pokes_ci95``, ``median_pokes_to_stay_0.9``, ``share_reaching_0.9`` and counts its
     ``failed`` worlds), with ``best`` (the fewest mean pokes, then the fewest median pokes, then
-    the highest final accuracy: module docstring), ``max_pokes`` and ``failed_worlds`` (index and
-    error of each world that failed twice)."""
+    the highest final accuracy: module docstring), ``max_pokes``, ``failed_worlds`` (index and
+    error of each world that failed twice) and ``appearance`` (:func:`_appearance`); ``arms``
+    the ``(appearance, prior)`` each world was mapped under, ``strategies`` counting each world
+    once per appearance family, under the prior."""
     # by index, whatever order the worlds finished in
     results = sorted(results, key=lambda r: int(r.world["index"]))
     strategies: dict[str, Any] = {}
+    own = [arm for arm in arms if arm[1] == PRIORS[1]]
     for combination in combinations:
-        entries = _per_world(results, combination, max_pokes)
+        entries = _per_world(results, combination, max_pokes, own)
         families = sorted({e["family"] for e in entries})
         strategies[combination_name(*combination)] = {
             **_stats(entries, max_pokes),
@@ -226,19 +249,59 @@ def summarise_worlds(results: Sequence[WorldResult],
     return {"strategies": strategies, "best": best, "max_pokes": max_pokes,
             "good_accuracy": GOOD_ACCURACY,
             "failed_worlds": [{"index": r.world["index"], "error": r.error}
-                              for r in results if r.status != "ok"]}  # fmt: skip
+                              for r in results if r.status != "ok"],
+            "appearance": _appearance(results, combinations, max_pokes, arms)}  # fmt: skip
+
+
+def _appearance(results: Sequence[WorldResult], combinations: Sequence[tuple[str, str, str]],
+                max_pokes: int, arms: Sequence[Arm]) -> dict[str, Any]:
+    """``{APPEARANCE: {NAME: {"blind": …, "prior": …, "paired_worlds",
+    "mean_pokes_difference", "mean_pokes_difference_ci95"}}}``: each arm's
+    :func:`~deformap.eval._worlds_paired.arm_stats` (``blind`` ``None`` for a family mapped
+    under the prior only) and the paired difference of the pokes to :data:`GOOD_ACCURACY`,
+    prior − blind, over the same worlds (:mod:`._worlds_paired`)."""
+    out: dict[str, Any] = {}
+    for appearance in dict.fromkeys(a for a, _ in arms):
+        per: dict[str, Any] = {}
+        for combination in combinations:
+            counts: dict[str, list[int]] = {}
+            entry: dict[str, Any] = {"blind": None}
+            for prior, name in zip(PRIORS, ("blind", "prior"), strict=True):
+                if (appearance, prior) not in arms:
+                    continue
+                entries = _per_world(results, combination, max_pokes, [(appearance, prior)])
+                done = [e for e in entries if not e["failed"]]
+                counts[name] = [_pokes_to_good(e, max_pokes) for e in entries]
+                entry[name] = arm_stats(counts[name], [float(e["accuracy"][-1]) for e in done],
+                                        [e["right_count"] for e in done])
+            entry.update(paired_difference(counts["prior"], counts["blind"]) if "blind" in counts
+                         else {"paired_worlds": 0, "mean_pokes_difference": None,
+                               "mean_pokes_difference_ci95": None})
+            per[combination_name(*combination)] = entry
+        out[appearance] = per
+    return out
 
 
 def accuracy_curves(results: Sequence[WorldResult],
-                    combinations: Sequence[tuple[str, str, str]], max_pokes: int
-                    ) -> dict[str, dict[str, NDArray[np.float64]]]:
-    """Per family (and ``"all"``), per combination: the ``(n_worlds, max_pokes)`` accuracies of
-    the worlds that ran (the figure's bands come from these)."""
+                    combinations: Sequence[tuple[str, str, str]], max_pokes: int, *,
+                    arms: Sequence[Arm] = PLAIN_ARMS, prior: str = PRIORS[1],
+                    by: str = "layout") -> dict[str, dict[str, NDArray[np.float64]]]:
+    """Per family, per combination: the ``(n_worlds, max_pokes)`` accuracies of the worlds that
+    ran under ``prior`` (``"off"``: the blind map, of the painted families of ``arms``), the
+    figure's bands come from these. ``by``: ``"layout"``, the layout families and ``"all"`` (each
+    world once per appearance family); ``"appearance"``, the appearance families."""
+    if by not in ("layout", "appearance"):
+        raise InvalidArgumentError(f"`by` must be 'layout' or 'appearance'; got {by!r}")
+    key = "family" if by == "layout" else "appearance"
+    chosen_arms = [arm for arm in arms if arm[1] == prior]
     out: dict[str, dict[str, NDArray[np.float64]]] = {}
     for combination in combinations:
-        entries = [e for e in _per_world(results, combination, max_pokes) if not e["failed"]]
-        for family in ["all", *sorted({e["family"] for e in entries})]:
-            chosen = [e["accuracy"] for e in entries if family in ("all", e["family"])]
+        entries = [e for e in _per_world(results, combination, max_pokes, chosen_arms)
+                   if not e["failed"]]
+        panels = (["all", *sorted({e[key] for e in entries})] if by == "layout"
+                  else list(dict.fromkeys(e[key] for e in entries)))
+        for family in panels:
+            chosen = [e["accuracy"] for e in entries if family in ("all", e[key])]
             out.setdefault(family, {})[combination_name(*combination)] = (
                 np.array(chosen).reshape(-1, max_pokes))
     return out
@@ -278,4 +341,5 @@ def markdown_summary(summary: dict[str, Any]) -> str:
                  "final accuracy and the modulus "
                  f"field's median relative E error after {k} pokes; the family columns are "
                  "median pokes to 0.9.")
-    return "\n".join(lines) + "\n"
+    paired = markdown_paired(summary)
+    return "\n".join(lines) + "\n" + ("\n" + paired if paired else "")

@@ -124,22 +124,26 @@ def load_worlds(folder: Path) -> tuple[WorldsBenchConfig, list[WorldResult]]:
 
 def _check_rows(path: Path, result: WorldResult, config: WorldsBenchConfig) -> None:
     """Refuse a finished world whose rows are not of the benchmark ``config`` (one line)."""
+    arms = config.task(result.index).arms()
     for row in result.rows:
         combo = f"{row.get('strategy')}/{row.get('field')}"
         if row.get("strategy") not in config.strategies or \
-                row.get("field") not in config.fields or not isinstance(row.get("poke"), int):
-            raise ConfigError(f"source: {path} is not a rescorable world: a row of {combo!r} at "
-                              f"poke {row.get('poke')!r} is not of this benchmark")
+                row.get("field") not in config.fields or not isinstance(row.get("poke"), int) \
+                or (row.get("appearance"), row.get("prior")) not in arms:
+            raise ConfigError(f"source: {path} is not a rescorable world: a row of {combo!r} "
+                              f"({row.get('appearance')}/{row.get('prior')}) at poke "
+                              f"{row.get('poke')!r} is not of this benchmark")
         mapped = row.get("map_field", row["field"])
         if mapped not in choices("field"):
             raise ConfigError(f"source: {path} is not a rescorable world: a row of {combo!r} at "
                               f"poke {row['poke']} has `map_field` {mapped!r}, expected one of "
                               f"{list(choices('field'))}")
         stored = result.pokes if mapped == row["field"] else result.fallback_pokes
-        if combo not in stored:
+        key = WorldResult.run_key(row["appearance"], row["prior"], row["strategy"], row["field"])
+        if key not in stored:
             raise ConfigError(f"source: {path} is not a rescorable world: no stored "
                               f"{'pokes' if mapped == row['field'] else 'fallback pokes'} of "
-                              f"{combo!r}, whose map field was {mapped!r} at poke {row['poke']}")
+                              f"{key!r}, whose map field was {mapped!r} at poke {row['poke']}")
 
 
 def rescore_worlds(source: Path, out: Path, *, cuts: Sequence[str] | None = None,

@@ -20,14 +20,14 @@ from deformap._validation import SettingError, check_settings, setting
 from deformap.errors import ConfigError
 from deformap.eval import WorldTask, choices
 from deformap.explore import ExplorationConfig
-from deformap.world import LAYOUT_FAMILIES, PHYSICS
+from deformap.world import APPEARANCE_FAMILIES, LAYOUT_FAMILIES, PHYSICS
 
 __all__ = ["WorldsBenchConfig", "exploration_changes", "exploration_with", "parse_assignments"]
 
 #: Exploration settings a benchmark sets itself, and the option that sets each.
 _AXES = {"strategy": "--strategies", "field": "--fields", "region_labels": "--cuts",
          "max_pokes": "--max-pokes", "boundary_pokes": "--max-pokes",
-         "force_n": "none: each world draws its own"}
+         "force_n": "none: each world draws its own", "appearance": "--appearance"}
 
 
 def parse_assignments(items: Iterable[str]) -> dict[str, Any]:
@@ -116,6 +116,9 @@ class WorldsBenchConfig:
         Layout families, taken in turn (:data:`deformap.world.LAYOUT_FAMILIES`).
     physics : tuple of str
         The world physics each world's is drawn from (:data:`deformap.world.PHYSICS`).
+    appearances : tuple of str
+        Appearance families (:data:`deformap.world.APPEARANCE_FAMILIES`), each painting every
+        world; a painted one mapped blind and with the prior (:meth:`arms`).
     strategies, fields : tuple of str
         ``ExplorationConfig.strategy`` and ``field`` values, every pair mapped on every world.
     cuts : tuple of str
@@ -124,8 +127,8 @@ class WorldsBenchConfig:
         Pokes per world and combination.
     exploration : ExplorationConfig
         Every other exploration setting (:func:`exploration_with`); the ones the axes above and
-        each world set (strategy, field, region_labels, max_pokes, boundary_pokes, force_n)
-        must keep their defaults.
+        each world set (strategy, field, region_labels, max_pokes, boundary_pokes, force_n,
+        appearance) must keep their defaults.
     coarse : bool
         The test mesh and camera (:meth:`deformap.world.WorldConfig.coarse`, about a third of a
         default world's cost) instead of the default world: a smoke run, whose 2 cm mesh reads
@@ -140,6 +143,8 @@ class WorldsBenchConfig:
     seed: int = setting(0, ge=0)
     families: tuple[str, ...] = LAYOUT_FAMILIES
     physics: tuple[str, ...] = PHYSICS
+    # one look everywhere: each world mapped once per combination
+    appearances: tuple[str, ...] = ("plain",)
     # every choice ExplorationConfig has, so a strategy or field added there is benchmarked too
     strategies: tuple[str, ...] = choices("strategy")
     fields: tuple[str, ...] = choices("field")
@@ -155,6 +160,7 @@ class WorldsBenchConfig:
         check_settings(self)
         for name, given, allowed in (("families", self.families, LAYOUT_FAMILIES),
                                      ("physics", self.physics, PHYSICS),
+                                     ("appearances", self.appearances, APPEARANCE_FAMILIES),
                                      ("strategies", self.strategies, choices("strategy")),
                                      ("fields", self.fields, choices("field")),
                                      ("cuts", self.cuts, choices("region_labels"))):
@@ -174,7 +180,8 @@ class WorldsBenchConfig:
     def result_settings(self) -> dict[str, Any]:
         """The settings a world's result depends on (``bench.json``; resuming compares them)."""
         return {"seed": self.seed, "families": list(self.families),
-                "physics": list(self.physics), "strategies": list(self.strategies),
+                "physics": list(self.physics), "appearances": list(self.appearances),
+                "strategies": list(self.strategies),
                 "fields": list(self.fields), "cuts": list(self.cuts),
                 "max_pokes": self.max_pokes,
                 "exploration": exploration_changes(self.exploration), "coarse": self.coarse}
@@ -182,9 +189,15 @@ class WorldsBenchConfig:
     def combinations(self) -> list[tuple[str, str, str]]:
         return [(s, f, c) for s in self.strategies for f in self.fields for c in self.cuts]
 
+    def arms(self) -> tuple[tuple[str, str], ...]:
+        """``(appearance family, ExplorationConfig.appearance)`` of each mapping of a world
+        (:meth:`deformap.eval.WorldTask.arms`)."""
+        return self.task(0).arms()
+
     def task(self, index: int) -> WorldTask:
         """The task of world ``index``."""
         return WorldTask(seed=self.seed, index=index, families=self.families,
-                         physics=self.physics, strategies=self.strategies, fields=self.fields,
+                         physics=self.physics, appearances=self.appearances,
+                         strategies=self.strategies, fields=self.fields,
                          cuts=self.cuts, max_pokes=self.max_pokes, coarse=self.coarse,
                          exploration=self.exploration)

@@ -41,14 +41,15 @@ BLAS_THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THR
 def task_data(task: WorldTask) -> dict[str, Any]:
     """``task`` as the plain data that crosses the process boundary (:func:`run_world_data`)."""
     return {"seed": task.seed, "index": task.index, "families": list(task.families),
-            "physics": list(task.physics), "strategies": list(task.strategies),
+            "physics": list(task.physics), "appearances": list(task.appearances),
+            "strategies": list(task.strategies),
             "fields": list(task.fields), "cuts": list(task.cuts), "max_pokes": task.max_pokes,
             "coarse": task.coarse, "exploration": exploration_changes(task.exploration)}
 
 
 def _task(data: dict[str, Any]) -> WorldTask:
     """The inverse of :func:`task_data`."""
-    lists = ("families", "physics", "strategies", "fields", "cuts")
+    lists = ("families", "physics", "appearances", "strategies", "fields", "cuts")
     given: dict[str, Any] = {k: tuple(v) if k in lists else v for k, v in data.items()
                              if k != "exploration"}
     return WorldTask(**given,

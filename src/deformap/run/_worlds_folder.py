@@ -1,9 +1,10 @@
 """The folder of a worlds benchmark: its ``bench.json``, one file per world, and the summary files.
 
 The folder holds ``bench.json`` (the settings, written first, with :data:`BENCH_FORMAT`),
-``worlds/world-NNNNN.json`` (one :class:`~deformap.eval.WorldResult` per world, written atomically
-as it arrives: a killed run loses at most the worlds in flight) and, rewritten after every world,
-``runs.csv``, ``summary.json``, ``summary.md`` and ``curves.png``. A folder of another format is
+``worlds/world-NNNNN.json`` (one :class:`~deformap.eval.WorldResult` per world, every appearance
+arm of it, written atomically as it arrives: a killed run loses at most the worlds in flight)
+and, rewritten after every world, ``runs.csv``, ``summary.json``, ``summary.md`` and
+``curves.png``. A folder of another format is
 refused in one line naming both versions: its worlds would be read with a meaning they lack.
 """
 
@@ -32,10 +33,11 @@ __all__ = ["BENCH_FORMAT", "SETTINGS_NAME", "finished_worlds", "read_bench", "re
            "start_folder", "world_path", "write_bench", "write_summary"]
 
 SETTINGS_NAME = "bench.json"
-#: Version of ``bench.json``'s settings: 2 records the exploration as the settings that differ
-#: from the defaults (``exploration``: dotted key → value); 1 (no ``format`` key) had one key
-#: per switch.
-BENCH_FORMAT = 2
+#: Version of a benchmark folder: 3 maps each world under appearance arms (``appearances`` in
+#: the settings; world files of ``pokes_format`` 4); 2 recorded the exploration as the settings
+#: that differ from the defaults (``exploration``: dotted key → value), its worlds unpainted;
+#: 1 (no ``format`` key) had one key per switch.
+BENCH_FORMAT = 3
 
 
 def world_path(folder: Path, index: int) -> Path:
@@ -135,16 +137,20 @@ def finished_worlds(folder: Path, worlds: int) -> dict[int, WorldResult]:
 def write_summary(folder: Path, config: WorldsBenchConfig, results: Sequence[WorldResult]
                   ) -> tuple[dict[str, Any], list[Path]]:
     """Write ``runs.csv``, ``summary.json``, ``summary.md`` and ``curves.png`` of ``results``;
-    return the summary and the files."""
-    combos = config.combinations()
-    summary = summarise_worlds(results, combos, config.max_pokes)
+    return the summary and the files. The figure's panels are the layout families, or, where a
+    family was mapped blind beside the prior, the appearance families with both."""
+    combos, arms, k = config.combinations(), config.arms(), config.max_pokes
+    summary = summarise_worlds(results, combos, k, arms=arms)
     summary["settings"] = {**config.result_settings(), "worlds": config.worlds}
-    files = [write_text(folder / "runs.csv", runs_csv(results, combos)),
+    files = [write_text(folder / "runs.csv", runs_csv(results, combos, arms)),
              write_text(folder / "summary.json", to_json(summary)),
              write_text(folder / "summary.md", markdown_summary(summary))]
-    curves = accuracy_curves(results, combos, config.max_pokes)
+    paired = any(prior == "off" for _, prior in arms)
+    by = "appearance" if paired else "layout"
+    curves = accuracy_curves(results, combos, k, arms=arms, by=by)
     if curves:
+        blind = accuracy_curves(results, combos, k, arms=arms, by=by, prior="off")
         plot_world_curves(curves, good_accuracy=summary["good_accuracy"],
-                          path=folder / "curves.png")
+                          path=folder / "curves.png", blind=blind if paired else None)
         files.append(folder / "curves.png")
     return summary, files

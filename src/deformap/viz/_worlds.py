@@ -1,11 +1,13 @@
-"""The many-worlds benchmark's figure: region accuracy against pokes, one panel per layout family.
+"""The many-worlds benchmark's figure: region accuracy against pokes, one panel per family.
 
 Each panel draws the few combinations (strategy/field/cut) with the highest mean accuracy over all
 worlds and pokes, and the paper's combination beside them, as the mean accuracy over the family's
 worlds after each poke; the same combinations in every panel, in one legend. A band of the mean's
 95 % confidence interval (mean ± 1.96 standard errors, a normal approximation: the worlds are
 independent draws) is drawn only over enough worlds for that approximation to mean something
-(``min_band_worlds``). The good-map level is a dashed line.
+(``min_band_worlds``). The good-map level is a dashed line. Given the blind map's curves beside
+the prior's (one panel per appearance family), each combination's blind curve is drawn dotted in
+its colour, without a band.
 """
 
 from __future__ import annotations
@@ -48,7 +50,7 @@ def _chosen(curves: Curves, best: int, paper: str) -> tuple[list[str], str | Non
 
 def plot_world_curves(curves: Curves, *, good_accuracy: float = 0.9,
                       path: str | Path | None = None, best: int = 3, min_band_worlds: int = 10,
-                      paper: str = PAPER_COMBINATION) -> Figure:
+                      paper: str = PAPER_COMBINATION, blind: Curves | None = None) -> Figure:
     """Accuracy against pokes of the best few combinations and the paper's, one panel per family
     (``"all"`` first).
 
@@ -69,6 +71,10 @@ def plot_world_curves(curves: Curves, *, good_accuracy: float = 0.9,
     paper : str
         The paper's combination, drawn black; without it in ``curves``, the best of its
         strategy's combinations.
+    blind : dict, optional
+        The same families and combinations mapped blind (``exploration.appearance`` off), each
+        drawn dotted beside its curve in ``curves`` (the prior's); the chosen combinations are
+        the prior's best.
     """
     families = sorted(curves, key=lambda f: (f != "all", f))
     top, theirs = _chosen(curves, best, paper)
@@ -85,7 +91,11 @@ def plot_world_curves(curves: Curves, *, good_accuracy: float = 0.9,
             if acc is not None and acc.size:
                 worlds = max(worlds, len(acc))
                 _curve(ax, acc, name, i, paper=None if name != theirs else name == paper,
-                       band=min_band_worlds)  # fmt: skip
+                       band=min_band_worlds, arm="prior" if blind is not None else None)
+            off = (blind or {}).get(family, {}).get(name)
+            if off is not None and off.size:
+                _curve(ax, off, name, i, paper=None if name != theirs else name == paper,
+                       band=0, arm="blind")
         ax.axhline(good_accuracy, color="0.3", ls="--", lw=0.8,
                    label=f"accuracy {good_accuracy:g} (a good map)")  # fmt: skip
         note = "" if worlds >= min_band_worlds else ", too few for a band"
@@ -105,27 +115,33 @@ def plot_world_curves(curves: Curves, *, good_accuracy: float = 0.9,
         fig.legend(handles, labels, loc="outside lower center", ncols=min(3, len(labels)),
                    fontsize=8, frameon=False)
     n_all = len({name for family in curves.values() for name in family})
+    arms = "" if blind is None else "with the appearance prior solid, blind dotted; "
     fig.suptitle(f"region accuracy against pokes, mean over worlds: the best {len(top)} of "
-                 f"{n_all} combinations by mean accuracy, and the paper's\n(95 % band where "
-                 f"{min_band_worlds} worlds or more)", fontsize=10)  # fmt: skip
+                 f"{n_all} combinations by mean accuracy, and the paper's\n({arms}95 % band "
+                 f"where {min_band_worlds} worlds or more)", fontsize=10)  # fmt: skip
     if path is not None:
         save_figure(fig, path, dpi=110)
     return fig
 
 
 def _curve(ax: Axes, acc: NDArray[np.float64], name: str, rank: int, *, paper: bool | None,
-           band: int) -> None:
+           band: int, arm: str | None = None) -> None:
     """One combination's mean accuracy after each poke, its 95 % band where at least ``band``
-    worlds count; the paper's (``paper`` True: its combination, False: its strategy's best)
-    black and dash-dotted, the others in the colour of their rank."""
+    worlds count (``band`` 0: none); the paper's (``paper`` True: its combination, False: its
+    strategy's best) black and dash-dotted, the others in the colour of their rank; ``arm``
+    ``"blind"`` dotted, and named in the label."""
     pokes = np.arange(1, acc.shape[1] + 1)
     mean = np.nanmean(acc, axis=0)
     colour, style = ("k", "-.") if paper is not None else (f"C{rank % 10}", "-")
     label = {None: f"{rank + 1}. {name}", True: f"{name} (the paper's)",
              False: f"{name} (the paper's strategy)"}[paper]  # fmt: skip
-    ax.plot(pokes, mean, color=colour, ls=style, lw=1.6, label=label)
+    if arm is not None:
+        label = f"{label}, {arm}"
+    # dotted and wider on top of the prior's, so that a blind curve equal to it still shows
+    ax.plot(pokes, mean, color=colour, ls=":" if arm == "blind" else style,
+            lw=2.6 if arm == "blind" else 1.6, label=label)
     counts = np.sum(np.isfinite(acc), axis=0)
-    if counts.min() >= max(band, 2):
+    if band and counts.min() >= max(band, 2):
         se = np.nanstd(acc, axis=0, ddof=1) / np.sqrt(counts)
         ax.fill_between(pokes, mean - _Z95 * se, np.minimum(1.0, mean + _Z95 * se),
                         color=colour, alpha=0.15, lw=0)  # fmt: skip
