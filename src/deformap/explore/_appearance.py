@@ -13,7 +13,8 @@ Built once from the cloud before the first poke (:func:`build_appearance`):
    segmentation reads the image in the image's own units. Segments are candidate regions, never
    decisions: the prior (:mod:`deformap.explore._appearance_prior`) weighs them by the pokes.
    Segments smaller than a dent's footprint are merged into a neighbour; what is still smaller
-   after masking is masked.
+   after masking is masked; a segment too thin for a dent (no cell half a footprint from its
+   edge: the strip of blended cells along a boundary) is merged into its most alike neighbour.
 4. Each segment's feature: the mean of its cells' channels, standardised per channel group
    (colour, texture, height) by the spread of the segment means, but never below that group's
    noise, so a flat channel (a plain world's colour, a flat table's height) is not inflated into
@@ -58,6 +59,8 @@ JND_DELTA_E = 1.0
 #: Felzenszwalb's scale in units of the image's noise: a boundary needs a step several noise
 #: standard deviations high along a segment's length, not one noisy cell.
 SEGMENT_SCALE = 300.0
+#: Most rounds of merging thin segments (each round at least halves a run of adjacent strips).
+MERGE_ROUNDS = 8
 #: Smallest noise a channel is divided by: CIELAB units, the texture's, and metres of height (a
 #: step under a millimetre is no edge a depth camera resolves).
 _NOISE_FLOORS = (JND_DELTA_E / 2, JND_DELTA_E / 2, 1e-3)
@@ -170,6 +173,45 @@ def _segment(channels: NDArray[np.float64], mask: NDArray[np.bool_], min_cells: 
     return np.where(raw >= 0, lookup[raw], -1).astype(np.int64)
 
 
+def _merge_thin(segments: NDArray[np.int64], channels: NDArray[np.float64],
+                min_depth_cells: float) -> NDArray[np.int64]:
+    """Each segment too thin for a dent (no cell ``min_depth_cells`` from its edge: a strip
+    along a boundary, where the cells blend two looks) merged into the adjacent segment whose mean
+    channels are nearest; labels ``0 ..`` in order again, ``-1`` kept."""
+    n = int(segments.max()) + 1
+    edge = np.zeros(segments.shape, dtype=bool)
+    for axis in (0, 1):
+        differs = np.diff(segments, axis=axis) != 0
+        lo = [slice(None)] * 2
+        hi = [slice(None)] * 2
+        lo[axis], hi[axis] = slice(None, -1), slice(1, None)
+        edge[tuple(lo)] |= differs
+        edge[tuple(hi)] |= differs
+    depth = ndi.distance_transform_edt(np.pad(~edge, 1, constant_values=False))[1:-1, 1:-1]
+    index = np.arange(n)
+    deepest = np.asarray(ndi.maximum(depth, segments, index), dtype=float)
+    means = np.stack([ndi.mean(channels[..., k], segments, index)
+                      for k in range(channels.shape[-1])], axis=-1)  # fmt: skip
+    thin = deepest < min_depth_cells
+    if not thin.any() or thin.all():
+        return segments
+    pairs: set[tuple[int, int]] = set()
+    for a, b in ((segments[:, :-1], segments[:, 1:]), (segments[:-1, :], segments[1:, :])):
+        touch = (a != b) & (a >= 0) & (b >= 0)
+        pairs.update(zip(a[touch].tolist(), b[touch].tolist(), strict=True))
+    target = index.copy()
+    for s in np.flatnonzero(thin):
+        near = {b for a, b in pairs if a == s} | {a for a, b in pairs if b == s}
+        wide = [k for k in near if not thin[k]]
+        # a strip among strips joins a strip (the next round sees what they made together)
+        choice = wide or [k for k in near if target[k] == k]
+        if choice:
+            target[s] = min(choice, key=lambda k: float(np.sum((means[k] - means[s]) ** 2)))
+    merged = np.where(segments >= 0, target[np.maximum(segments, 0)], -1)
+    _, relabelled = np.unique(merged, return_inverse=True)
+    return np.asarray(relabelled.reshape(segments.shape) - int((merged < 0).any()), dtype=np.int64)
+
+
 def _features(channels: NDArray[np.float64], noise: NDArray[np.float64],
               segments: NDArray[np.int64], n: int) -> NDArray[np.float64]:
     """``(n, 5)`` standardised segment means (module docstring, step 4); ``channels`` are in
@@ -251,6 +293,13 @@ def build_appearance(cloud: PointCloud, xs: NDArray[np.float64], ys: NDArray[np.
                        [_NOISE_FLOORS[0]] * 3 + list(_NOISE_FLOORS[1:]))  # fmt: skip
     min_cells = max(1, int(np.ceil(np.pi * (footprint_m / 2) ** 2 / spacing**2)))
     segments = _segment(channels / noise, mask, min_cells)
+    for _ in range(MERGE_ROUNDS):
+        if segments.max() < 0:
+            break
+        merged = _merge_thin(segments, channels / noise, footprint_m / (2 * spacing))
+        if merged.max() == segments.max():
+            break
+        segments = merged
     n = int(segments.max()) + 1
     if n == 0:
         return (f"no segment of the image is as large as a dent's footprint "

@@ -6,12 +6,12 @@ The kernel of a field with prior standard deviation σ and length scale ℓ (the
     k((x, a), (x', a')) = σ² [(1 − w) k_ℓ(x, x') + w k_L(x, x') k_app(a, a')],
 
 ``k_ℓ`` the blind field's squared exponential, ``k_app(a, a') = exp(−‖a − a'‖² / ℓ_a²)`` on the
-segments' standardised features (:mod:`deformap.explore._appearance`; a masked cell's look is its
-own), and ``k_L`` a squared exponential over the workspace's diagonal, so alike looks far apart
-couple a little less than alike looks side by side. At ``w = 0`` it is the blind kernel; at every
-``w`` the prior variance is σ², so ``T_h`` keeps its meaning. The blind part is kept as a sum, not
-a product ``k_ℓ · (1 − w + w k_app)``: a product only removes covariance, so a look could never
-make known a place the blind map does not already know.
+segments' standardised features (:mod:`deformap.explore._appearance`; a masked cell takes its
+nearest seen cell's), and ``k_L`` a squared exponential over the workspace's diagonal, so alike
+looks far apart couple a little less than alike looks side by side. At ``w = 0`` it is the blind
+kernel; at every ``w`` the prior variance is σ², so ``T_h`` keeps its meaning. The blind part is
+kept as a sum, not a product ``k_ℓ · (1 − w + w k_app)``: a product only removes covariance, so a
+look could never make known a place the blind map does not already know.
 
 ``w`` and ``ℓ_a`` are not fitted to a point: they range over a small grid (:data:`WEIGHTS` ×
 :data:`LOOK_SCALES`, ``w = 0`` the blind map; uniform over ``w``, then over ``ℓ_a``), each point's
@@ -36,6 +36,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg as sla
 from numpy.typing import NDArray
+from scipy import ndimage as ndi
 
 from deformap.explore._appearance import AppearanceImage
 from deformap.gp import cholesky_with_jitter, squared_exponential
@@ -68,6 +69,13 @@ class AppearancePrior:
         self.span_m = float(np.hypot(np.ptp(xs), np.ptp(ys))) or 1.0
         gx, gy = np.meshgrid(xs, ys)
         self.cells_xy = np.column_stack([gx.ravel(), gy.ravel()])
+        # a masked cell (unseen, hidden) is given its nearest seen cell's look: a place hidden by
+        # the robot is likeliest what surrounds it, and a cell with no look at all would be
+        # known only by the blind part of the kernel, never by its neighbours' pokes
+        seg = image.segments
+        nearest = ndi.distance_transform_edt(seg < 0, return_distances=False,
+                                             return_indices=True)  # fmt: skip
+        self._look = np.asarray(seg[nearest[0], nearest[1]].ravel(), dtype=np.int64)
 
     def cells_of(self, xy: Array) -> NDArray[np.int64]:
         """``(n,)`` flat index of the cell each of ``xy (n, 2)`` [m] lies in (nearest centre)."""
@@ -84,36 +92,22 @@ class AppearancePrior:
 
     def look_kernel(self, cells_a: NDArray[np.int64], cells_b: NDArray[np.int64],
                     look_scale: float) -> Array:
-        """``k_app`` between the looks of two sets of flat cells; 0 where either is masked."""
-        seg = self.image.segments.ravel()
-        sa, sb = seg[cells_a], seg[cells_b]
+        """``k_app`` between the looks of two sets of flat cells."""
         feats = self.image.features
-        fa, fb = feats[np.maximum(sa, 0)], feats[np.maximum(sb, 0)]
+        fa, fb = feats[self._look[cells_a]], feats[self._look[cells_b]]
         d2 = np.sum((fa[:, None, :] - fb[None, :, :]) ** 2, axis=-1)
-        seen = (sa[:, None] >= 0) & (sb[None, :] >= 0)
-        return np.where(seen, np.exp(-d2 / look_scale**2), 0.0)
+        return np.asarray(np.exp(-d2 / look_scale**2))
 
     def covariance(self, xy_a: Array, xy_b: Array, *, signal_std: float, length_scale: float,
                    weight: float, look_scale: float) -> Array:
         """``(a, b)`` the kernel (module docstring) between ``xy_a (a, 2)`` and ``xy_b (b, 2)``
-        [m], in the field's units squared.
-
-        A masked cell has no look: its features are the blind part's alone at full weight, so
-        it covaries ``k_ℓ`` with another masked cell and ``√(1 − w) k_ℓ`` with a seen one (an
-        inner product of feature maps, so the kernel stays positive semi-definite).
-        """
+        [m], in the field's units squared."""
         blind = squared_exponential(xy_a, xy_b, length_scale=length_scale, signal_std=1.0)
         if weight == 0.0:
             return np.asarray(signal_std**2 * blind)
-        cells_a, cells_b = self.cells_of(xy_a), self.cells_of(xy_b)
-        seg = self.image.segments.ravel()
-        keep = np.sqrt(1.0 - weight)
-        ca = np.where(seg[cells_a] >= 0, keep, 1.0)
-        cb = np.where(seg[cells_b] >= 0, keep, 1.0)
         near = squared_exponential(xy_a, xy_b, length_scale=self.span_m, signal_std=1.0)
-        look = self.look_kernel(cells_a, cells_b, look_scale)
-        return np.asarray(signal_std**2 * (ca[:, None] * cb[None, :] * blind
-                                           + weight * near * look))
+        look = self.look_kernel(self.cells_of(xy_a), self.cells_of(xy_b), look_scale)
+        return np.asarray(signal_std**2 * ((1.0 - weight) * blind + weight * near * look))
 
 
 @dataclass(frozen=True)

@@ -4,8 +4,9 @@ its own ``T_h``: :func:`deformap.explore.field_settings`), then the boundary pok
 and scores in :mod:`deformap.explore._acquisition`).
 
 Under an appearance prior (:mod:`deformap.explore._appearance_prior`) the looks come first: while
-the variance is above ``T_h``, the interior of the largest segment that holds no poke and is not
-yet known (:func:`segment_interior`); once it is under ``T_h``, a test of the hypothesis the map
+the variance is above ``T_h``, the interior of the largest segment whose look no poke has read
+(none in it, none within ``ℓ_a`` of its look) and that is not yet known
+(:func:`segment_interior`); once it is under ``T_h``, a test of the hypothesis the map
 rests on: in the largest segment with one poke, where the blind map (``w = 0``) is still above
 ``T_h``, so only the look vouches for the place, the place the blind map knows least (is the
 segment one material?). Each segment is tested once; a test the pokes contradict moves the
@@ -130,6 +131,19 @@ def _poked_segments(field: PokeField, segments: NDArray[np.int64]) -> NDArray[np
     return np.bincount(seg[seg >= 0], minlength=int(segments.max()) + 1)
 
 
+def _read_looks(field: PokeField, poked: NDArray[np.int64]) -> NDArray[np.bool_]:
+    """Which segments' looks a poke has read: a poked segment, or one whose look lies within
+    ``ℓ_a`` (the posterior's) of a poked segment's (``k_app ≥ 1/e``)."""
+    assert field.prior is not None
+    models = field.models
+    if models is None:
+        return poked > 0
+    feats = field.prior.image.features
+    d2 = np.sum((feats[:, None, :] - feats[None, poked > 0, :]) ** 2, axis=-1)
+    near = (d2 <= models.posterior.look_scale**2).any(axis=1)
+    return np.asarray((poked > 0) | near)
+
+
 def _look_target(grid: MapGrid, field: PokeField, config: ExplorationConfig, threshold: float,
                  done: bool) -> NDArray[np.float64] | None:
     """Where the looks say to poke next (module docstring), or ``None`` (the strategy's turn)."""
@@ -140,8 +154,9 @@ def _look_target(grid: MapGrid, field: PokeField, config: ExplorationConfig, thr
     stop = grid.stop_mask.reshape(grid.shape)
     if not done:
         above = (field.variance > threshold) & stop
+        read = _read_looks(field, poked)
         open_ = [s for s in np.argsort(-area, kind="stable")
-                 if poked[s] == 0 and above[segments == s].any()]
+                 if not read[s] and above[segments == s].any()]
         for s in open_:
             found = segment_interior(grid, segments, int(s))
             if found is not None and found[1] >= BOUNDARY_SPACING_ROI * config.touch.roi_size_m / 2:
