@@ -36,7 +36,7 @@ from deformap.explore._labels import map_regions
 from deformap.explore._modulus import ModulusField
 from deformap.explore._nugget import beta_pokes
 from deformap.explore._records import PokeRecord, PokeResult, Target
-from deformap.explore._result import ExplorationResult
+from deformap.explore._result import AppearanceOutcome, ExplorationResult
 from deformap.explore._surface import SurfaceModel, fit_surface
 from deformap.explore._targets import BOUNDARY_SPACING_ROI, choose_next, segment_interior
 
@@ -259,4 +259,7 @@ class Mapper:
             max_variance=self.max_variance(), stop_reason=stop_reason, timings=dict(timings),
             map_field_name=self.map_field_name, field_fallback=self.field_fallback,
             unread_places=self._choice.unread_places, stop_mask=self.choice_grid.stop_mask,
+            appearance=AppearanceOutcome.of(self.appearance, self.appearance_reason,
+                                            self.map_field),
+            prior=self.appearance,
         )  # fmt: skip
