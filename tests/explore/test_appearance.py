@@ -60,6 +60,7 @@ def test_the_same_cloud_gives_the_same_image() -> None:
 
 @pytest.mark.parametrize(("colour_of", "kw", "says"), [
     (lambda x, y: (0.5, 0.5, 0.5), {"noise": 0.0}, "all alike"),
+    (lambda x, y: (0.5, 0.5, 0.5), {"noise": 0.01}, "shows no layout"),
     (lambda x, y: (1.0, 1.0, 1.0), {"noise": 0.0}, "saturated"),
     (lambda x, y: (0.0, 0.0, 0.0), {"noise": 0.0}, "black"),
 ])

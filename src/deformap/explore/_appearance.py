@@ -22,7 +22,9 @@ Built once from the cloud before the first poke (:func:`build_appearance`):
 
 Where the image cannot carry a layout, :func:`build_appearance` returns the reason instead, and
 the map is the blind one: the cloud has no colour, colour covers too little of the map, the image
-is saturated or black, its colours are all alike, or no segment is as large as a dent.
+is saturated or black, its colours are all alike, no segment is as large as a dent, or the image
+is one segment, or its segments' looks differ by no more than its noise (a look everywhere
+alike says nothing of where materials change).
 
 References
 ----------
@@ -59,6 +61,8 @@ JND_DELTA_E = 1.0
 #: Felzenszwalb's scale in units of the image's noise: a boundary needs a step several noise
 #: standard deviations high along a segment's length, not one noisy cell.
 SEGMENT_SCALE = 300.0
+#: Felzenszwalb's Gaussian pre-smoothing [cells]: below a cell, so an edge stays within a cell.
+SEGMENT_SIGMA = 0.8
 #: Most rounds of merging thin segments (each round at least halves a run of adjacent strips).
 MERGE_ROUNDS = 8
 #: Smallest noise a channel is divided by: CIELAB units, the texture's, and metres of height (a
@@ -126,10 +130,12 @@ def _cell_colours(cloud: PointCloud, xs: NDArray[np.float64], ys: NDArray[np.flo
 
 
 def _noise(channel: NDArray[np.float64], mask: NDArray[np.bool_]) -> float:
-    """Robust noise standard deviation of a channel: the MAD of horizontally neighbouring seen
-    cells' differences, over √2 (a difference holds two cells' noise)."""
+    """Robust noise standard deviation of a channel as the segmentation sees it (smoothed by
+    :data:`SEGMENT_SIGMA` cells): the MAD of horizontally neighbouring seen cells' differences,
+    over √2 (a difference holds two cells' noise)."""
     both = mask[:, 1:] & mask[:, :-1]
-    diff = np.diff(channel, axis=1)[both]
+    smooth = ndi.gaussian_filter(_fill_unseen(channel[..., None], mask)[..., 0], SEGMENT_SIGMA)
+    diff = np.diff(smooth, axis=1)[both]
     if diff.size == 0:
         return 0.0
     return float(1.4826 * np.median(np.abs(diff - np.median(diff))) / np.sqrt(2.0))
@@ -163,7 +169,7 @@ def _segment(channels: NDArray[np.float64], mask: NDArray[np.bool_], min_cells: 
 
     with warnings.catch_warnings():  # five channels are meant as channels, not as a 3D image
         warnings.simplefilter("ignore", RuntimeWarning)
-        raw = felzenszwalb(_fill_unseen(channels, mask), scale=SEGMENT_SCALE, sigma=0.8,
+        raw = felzenszwalb(_fill_unseen(channels, mask), scale=SEGMENT_SCALE, sigma=SEGMENT_SIGMA,
                            min_size=min_cells, channel_axis=-1)  # fmt: skip
     raw = np.where(mask, raw, -1)
     labels, counts = np.unique(raw[raw >= 0], return_counts=True)
@@ -213,9 +219,10 @@ def _merge_thin(segments: NDArray[np.int64], channels: NDArray[np.float64],
 
 
 def _features(channels: NDArray[np.float64], noise: NDArray[np.float64],
-              segments: NDArray[np.int64], n: int) -> NDArray[np.float64]:
-    """``(n, 5)`` standardised segment means (module docstring, step 4); ``channels`` are in
-    their own units, ``noise (5,)`` each channel's noise."""
+              segments: NDArray[np.int64], n: int) -> tuple[NDArray[np.float64], bool]:
+    """``(n, 5)`` standardised segment means (module docstring, step 4), and whether any
+    channel group's spread of segment means exceeds its noise (the looks differ at all);
+    ``channels`` are in their own units, ``noise (5,)`` each channel's noise."""
     flat = segments.ravel()
     seen = flat >= 0
     values = channels.reshape(-1, channels.shape[-1])[seen]
@@ -229,12 +236,14 @@ def _features(channels: NDArray[np.float64], noise: NDArray[np.float64],
     weights = count / count.sum()
     centred = means - weights @ means
     out = np.empty_like(means)
+    differ = False
     for group in (slice(0, 3), slice(3, 4), slice(4, 5)):  # colour, texture, height
         spread = np.sqrt(float(weights @ np.sum(centred[:, group] ** 2, axis=1))
                          / (group.stop - group.start))  # fmt: skip
-        scale = max(spread, float(np.max(noise[group])))
-        out[:, group] = centred[:, group] / scale
-    return out
+        floor = float(np.max(noise[group]))
+        differ |= spread > floor
+        out[:, group] = centred[:, group] / max(spread, floor)
+    return out, differ
 
 
 def _unusable(lab: NDArray[np.float64], mask: NDArray[np.bool_]) -> str | None:
@@ -304,8 +313,12 @@ def build_appearance(cloud: PointCloud, xs: NDArray[np.float64], ys: NDArray[np.
     if n == 0:
         return (f"no segment of the image is as large as a dent's footprint "
                 f"({footprint_m * 100:.1f} cm across)")
+    if n == 1:
+        return "the image is one segment: it shows no layout"
     seen = segments >= 0
-    features = _features(channels, noise, segments, n)
+    features, differ = _features(channels, noise, segments, n)
+    if not differ:
+        return "the segments' looks differ by no more than the image's noise: it shows no layout"
     return AppearanceImage(lab=np.where(seen[..., None], lab, np.nan),
                            texture=np.where(seen, texture, np.nan), segments=segments,
                            features=features)  # fmt: skip
