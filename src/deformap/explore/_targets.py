@@ -4,13 +4,15 @@ its own ``T_h``: :func:`deformap.explore.field_settings`), then the boundary pok
 and scores in :mod:`deformap.explore._acquisition`).
 
 Under an appearance prior (:mod:`deformap.explore._appearance_prior`) the looks come first: while
-the variance is above ``T_h``, the interior of the largest segment whose look no poke has read
-(none in it, none within ``ℓ_a`` of its look) and that is not yet known
-(:func:`segment_interior`); once it is under ``T_h``, a test of the hypothesis the map
-rests on: in the largest segment with one poke, where the blind map (``w = 0``) is still above
-``T_h``, so only the look vouches for the place, the place the blind map knows least (is the
-segment one material?). Each segment is tested once; a test the pokes contradict moves the
-weight's posterior toward the blind map and its variance back above ``T_h``.
+the variance is above ``T_h``, the interior (:func:`segment_interior`) of the largest segment of
+the largest look no poke has read (a look: the segments within ``ℓ_a`` of it; read: a poke in
+one of them), if that look covers more than one poke does on the blind map
+(:func:`covered_area_m2`) and is not yet known; once it is under ``T_h``, a test of the
+hypothesis the map rests on: in the largest segment with one poke, where the blind map
+(``w = 0``) is still above ``T_h``, so only the look vouches for the place, the place the blind
+map knows least (is the segment one material?). Each segment is tested once; a test the pokes
+contradict moves the weight's posterior toward the blind map and its variance back above
+``T_h``.
 
 When only the edge band, where no poke fits, is still above ``T_h``, ``planned`` plans it like
 any other place; the other strategies poke the reachable cell of largest variance, the one nearest
@@ -28,6 +30,7 @@ from scipy import ndimage as ndi
 from scipy.spatial import cKDTree
 
 from deformap.explore._acquisition import boundary_score, choose_target
+from deformap.explore._appearance_prior import LOOK_SCALES
 from deformap.explore._classes import poke_classes
 from deformap.explore._config import ExplorationConfig, FieldName
 from deformap.explore._field import PokeField, PokeSet, field_settings
@@ -35,7 +38,8 @@ from deformap.explore._grid import MapGrid
 from deformap.explore._planning import PokePlan, plan_pokes
 from deformap.explore._records import Target
 
-__all__ = ["BOUNDARY_SPACING_ROI", "choose_next", "expected_noise", "segment_interior"]
+__all__ = ["BOUNDARY_SPACING_ROI", "choose_next", "covered_area_m2", "expected_noise",
+           "segment_interior"]
 
 logger = logging.getLogger(__name__)
 
@@ -131,17 +135,24 @@ def _poked_segments(field: PokeField, segments: NDArray[np.int64]) -> NDArray[np
     return np.bincount(seg[seg >= 0], minlength=int(segments.max()) + 1)
 
 
-def _read_looks(field: PokeField, poked: NDArray[np.int64]) -> NDArray[np.bool_]:
-    """Which segments' looks a poke has read: a poked segment, or one whose look lies within
-    ``ℓ_a`` (the posterior's) of a poked segment's (``k_app ≥ 1/e``)."""
+def _look_distance(field: PokeField) -> tuple[NDArray[np.float64], float]:
+    """``(n, n)`` squared distances between the segments' features and the squared ``ℓ_a`` that
+    makes two looks alike (the posterior's most probable; before any poke the grid's middle)."""
     assert field.prior is not None
-    models = field.models
-    if models is None:
-        return poked > 0
     feats = field.prior.image.features
-    d2 = np.sum((feats[:, None, :] - feats[None, poked > 0, :]) ** 2, axis=-1)
-    near = (d2 <= models.posterior.look_scale**2).any(axis=1)
-    return np.asarray((poked > 0) | near)
+    d2 = np.sum((feats[:, None, :] - feats[None, :, :]) ** 2, axis=-1)
+    models = field.models
+    scale = LOOK_SCALES[len(LOOK_SCALES) // 2] if models is None else models.posterior.look_scale
+    return d2, scale**2
+
+
+def covered_area_m2(config: ExplorationConfig, field: FieldName) -> float:
+    """The area [m²] one exact poke brings under ``T_h`` on the blind map: the disc where
+    ``σ² (1 − k²) ≤ T_h``, radius² ``−σ_w² ln(1 − T_h / σ²) / 2``; a look smaller than this
+    gains nothing from a poke placed by its look."""
+    cfg = field_settings(config, field)
+    ratio = min(cfg.threshold / cfg.signal_std**2, 1.0 - 1e-12)
+    return float(np.pi * -(cfg.length_scale_m**2) * np.log(1.0 - ratio) / 2.0)
 
 
 def _look_target(grid: MapGrid, field: PokeField, config: ExplorationConfig, threshold: float,
@@ -150,13 +161,17 @@ def _look_target(grid: MapGrid, field: PokeField, config: ExplorationConfig, thr
     assert field.prior is not None
     segments = field.prior.image.segments
     poked = _poked_segments(field, segments)
-    area = np.bincount(segments.ravel()[segments.ravel() >= 0], minlength=poked.size)
+    area = (np.bincount(segments.ravel()[segments.ravel() >= 0], minlength=poked.size)
+            * config.surface.grid_spacing_m**2)  # fmt: skip
     stop = grid.stop_mask.reshape(grid.shape)
     if not done:
+        d2, alike = _look_distance(field)
+        look_area = (d2 <= alike) @ area  # each segment's look: the area of every alike segment
+        read = (poked > 0) | ((d2[:, poked > 0] <= alike).any(axis=1))
         above = (field.variance > threshold) & stop
-        read = _read_looks(field, poked)
-        open_ = [s for s in np.argsort(-area, kind="stable")
-                 if not read[s] and above[segments == s].any()]
+        open_ = [s for s in np.lexsort((-area, -look_area))
+                 if not read[s] and look_area[s] >= covered_area_m2(config, field.name)
+                 and above[segments == s].any()]
         for s in open_:
             found = segment_interior(grid, segments, int(s))
             if found is not None and found[1] >= BOUNDARY_SPACING_ROI * config.touch.roi_size_m / 2:
