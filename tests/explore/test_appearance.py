@@ -192,3 +192,54 @@ def test_off_and_a_cloud_without_colour_give_the_same_map_byte_for_byte() -> Non
         assert a.variance.tobytes() == b.variance.tobytes()
     assert off.regions is not None and bare.regions is not None
     assert off.regions.labels.tobytes() == bare.regions.labels.tobytes()
+
+
+def test_the_deepest_reachable_place_of_a_segment_and_the_area_one_poke_covers() -> None:
+    from deformap.environment import Workspace
+    from deformap.explore import MapGrid
+    from deformap.explore._targets import covered_area_m2, segment_interior
+
+    config = ExplorationConfig()
+    grid = MapGrid.build(Workspace(lower=(0.0, 0.0), upper=(0.6, 0.4)), config)
+    segments = np.where(grid.cells_xy[:, 0] < 0.2, 0, 1).reshape(grid.shape)
+    found = segment_interior(grid, segments, 0)
+    assert found is not None
+    xy, depth = found
+    assert grid.target_mask[np.argmin(np.hypot(*(grid.cells_xy - xy).T))]
+    assert 0.09 < xy[0] < 0.11 and 0.09 < depth < 0.11  # the middle of the 20 cm strip
+    assert segment_interior(grid, segments, 2) is None
+    # σ² (1 − k²) = T_h at the disc's edge
+    beta = config.beta_field
+    r = np.sqrt(covered_area_m2(config, "beta") / np.pi)
+    k = np.exp(-(r**2) / beta.length_scale_m**2)
+    assert np.isclose(beta.signal_std**2 * (1 - k**2), config.threshold)
+
+
+@pytest.mark.slow
+def test_on_an_informative_world_the_look_earns_its_weight_and_the_map_beats_the_blind_one(
+        ) -> None:  # fmt: skip
+    from scipy.optimize import linear_sum_assignment
+
+    from deformap.world import SimulatedWorld, WorldConfig, random_scenario
+
+    def accuracy(pred, truth) -> float:
+        a = np.unique(pred, return_inverse=True)[1].ravel()
+        b = np.unique(truth, return_inverse=True)[1].ravel()
+        table = np.zeros((a.max() + 1, b.max() + 1))
+        np.add.at(table, (a, b), 1)
+        rows, cols = linear_sum_assignment(-table)
+        return float(table[rows, cols].sum() / a.size)
+
+    scores = {}
+    for use in ("auto", "off"):
+        world = SimulatedWorld(random_scenario(np.random.default_rng(3), appearance="informative"),
+                               config=WorldConfig.coarse(), rng=np.random.default_rng(0))
+        result = explore(world, ExplorationConfig(max_pokes=6, appearance=use),
+                         rng=np.random.default_rng(0))  # fmt: skip
+        assert result.regions is not None
+        scores[use] = (accuracy(result.regions.labels,
+                                world.ground_truth_labels(result.xs, result.ys)),
+                       result.appearance)  # fmt: skip
+    (acc_on, used), (acc_off, _) = scores["auto"], scores["off"]
+    assert used.used and used.weight is not None and used.weight > 0.7
+    assert acc_on > acc_off + 0.1
