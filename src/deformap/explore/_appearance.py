@@ -17,19 +17,21 @@ Built once from the cloud before the first poke (:func:`build_appearance`):
    edge: the strip of blended cells along a boundary) is merged into its most alike neighbour.
 4. Each segment's feature: the mean of its cells' channels, standardised per channel group
    (colour, texture, height) by the spread of the segment means, but never below that group's
-   noise, so a flat channel (a plain world's colour, a flat table's height) is not inflated into
-   a difference.
+   noise, nor, for colour and texture, below the just-noticeable difference: a flat channel (a
+   plain world's shading, a flat table's height) is not inflated into a difference.
 
 Where the image cannot carry a layout, :func:`build_appearance` returns the reason instead, and
 the map is the blind one: the cloud has no colour, colour covers too little of the map, the image
 is saturated or black, its colours are all alike, no segment is as large as a dent, or the image
-is one segment, or its segments' looks differ by no more than its noise (a look everywhere
-alike says nothing of where materials change).
+is one segment, or its segments' looks differ by no more than a just-noticeable difference or its
+noise (a look everywhere alike says nothing of where materials change).
 
 References
 ----------
 Felzenszwalb, P. F., Huttenlocher, D. P. (2004). Efficient graph-based image segmentation.
 IJCV 59(2), 167–181.
+Mahy, M., Van Eycken, L., Oosterlinck, A. (1994). Evaluation of uniform color spaces developed
+after the adoption of CIELAB and CIELUV. Color Research & Application 19(2), 105–121.
 """
 
 from __future__ import annotations
@@ -56,8 +58,13 @@ SATURATED_L, BLACK_L = 99.0, 1.0
 #: Largest share of saturated (or black) cells an image may have: beyond half, the colours show
 #: the exposure, not the surface.
 MAX_CLIPPED_FRACTION = 0.5
-#: A CIELAB difference below this (ΔE*ab = 1, the just-noticeable difference) is no difference.
-JND_DELTA_E = 1.0
+#: A CIELAB difference below this (ΔE*ab = 1) is no difference at all: an image whose colours
+#: span less shows nothing.
+SAME_DELTA_E = 1.0
+#: The just-noticeable CIELAB difference (ΔE*ab ≈ 2.3, Mahy et al. 1994): two looks whose colours
+#: (or textures, in L*) differ by less are one look to the eye, so the segments' spread of colour
+#: and texture is never standardised below it (shading and vignetting stay under it).
+JND_DELTA_E = 2.3
 #: Felzenszwalb's scale in units of the image's noise: a boundary needs a step several noise
 #: standard deviations high along a segment's length, not one noisy cell.
 SEGMENT_SCALE = 300.0
@@ -67,7 +74,7 @@ SEGMENT_SIGMA = 0.8
 MERGE_ROUNDS = 8
 #: Smallest noise a channel is divided by: CIELAB units, the texture's, and metres of height (a
 #: step under a millimetre is no edge a depth camera resolves).
-_NOISE_FLOORS = (JND_DELTA_E / 2, JND_DELTA_E / 2, 1e-3)
+_NOISE_FLOORS = (SAME_DELTA_E / 2, SAME_DELTA_E / 2, 1e-3)
 
 
 @dataclass(frozen=True, eq=False)
@@ -241,6 +248,8 @@ def _features(channels: NDArray[np.float64], noise: NDArray[np.float64],
         spread = np.sqrt(float(weights @ np.sum(centred[:, group] ** 2, axis=1))
                          / (group.stop - group.start))  # fmt: skip
         floor = float(np.max(noise[group]))
+        if group.start < 4:  # colour and texture: what the eye would tell apart
+            floor = max(floor, JND_DELTA_E)
         differ |= spread > floor
         out[:, group] = centred[:, group] / max(spread, floor)
     return out, differ
@@ -256,7 +265,7 @@ def _unusable(lab: NDArray[np.float64], mask: NDArray[np.bool_]) -> str | None:
         if clipped.mean() > MAX_CLIPPED_FRACTION:
             return f"the colour image is {what} in {100 * clipped.mean():.0f} % of the seen cells"
     seen = lab[mask]
-    if float(np.max(np.ptp(seen, axis=0))) < JND_DELTA_E:
+    if float(np.max(np.ptp(seen, axis=0))) < SAME_DELTA_E:
         return "the colours are all alike (within ΔE*ab = 1): they show no layout"
     return None
 
@@ -318,7 +327,8 @@ def build_appearance(cloud: PointCloud, xs: NDArray[np.float64], ys: NDArray[np.
     seen = segments >= 0
     features, differ = _features(channels, noise, segments, n)
     if not differ:
-        return "the segments' looks differ by no more than the image's noise: it shows no layout"
+        return ("the segments' looks differ by less than the eye or the camera's noise tells "
+                "apart: it shows no layout")
     return AppearanceImage(lab=np.where(seen[..., None], lab, np.nan),
                            texture=np.where(seen, texture, np.nan), segments=segments,
                            features=features)  # fmt: skip
