@@ -103,11 +103,6 @@ class AppearanceImage:
     def n_segments(self) -> int:
         return int(self.features.shape[0])
 
-    @property
-    def shape(self) -> tuple[int, int]:
-        """``(ny, nx)``."""
-        return (int(self.segments.shape[0]), int(self.segments.shape[1]))
-
     def rgb(self) -> NDArray[np.float64]:
         """``(ny, nx, 3)`` sRGB in [0, 1] of the cells' mean colour (masked cells black)."""
         from skimage.color import lab2rgb
