@@ -46,13 +46,14 @@ from deformap.explore._records import (
     Purpose,
     Target,
 )
-from deformap.explore._result import ExplorationResult, StopReason
+from deformap.explore._result import AppearanceOutcome, ExplorationResult, StopReason
 from deformap.explore._surface import SurfaceModel, fit_surface
 
 __all__ = [
     "JOURNAL_NAME",
     "PURPOSES",
     "STRATEGIES",
+    "AppearanceOutcome",
     "BetaField",
     "BetaFieldConfig",
     "ContactRecord",

@@ -155,8 +155,10 @@ class ExplorationConfig:
         (``field_fallback``).
     appearance : {"auto", "off"}
         Whether the map field uses the first observation's colours as a prior on the layout.
-        ``auto`` (default) uses them when the cloud has colour, its weight learned from the
-        pokes; ``off``, the blind map.
+        ``auto`` (default) uses them when the cloud has colour and the image shows a layout
+        (:mod:`deformap.explore._appearance`), their weight learned from the pokes and lost
+        where the pokes contradict them (:mod:`deformap.explore._appearance_prior`); ``off``,
+        the blind map.
     surface : SurfaceGPConfig
         The crop, filters and surface GP of the first observation.
     touch : TouchGPConfig

@@ -16,11 +16,12 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cached_property
-from typing import ClassVar
+from typing import ClassVar, Self
 
 import numpy as np
 from numpy.typing import NDArray
 
+from deformap.explore._appearance_prior import AppearanceModels, AppearancePrior
 from deformap.explore._config import (
     BetaFieldConfig,
     ExplorationConfig,
@@ -164,10 +165,15 @@ class PokeField:
     name : {"beta", "modulus"}
         Which field it is (:func:`field_settings` of that name gives its settings).
     mean, variance : (ny, nx) float
-        Posterior mean (NaN without pokes) and variance, computed once on first use.
+        Posterior mean (NaN without pokes) and variance, computed once on first use; under an
+        appearance prior (:meth:`with_prior`), the average over its weights
+        (:mod:`deformap.explore._appearance_prior`).
+    prior : AppearancePrior or None
+        The appearance prior the field uses (``None``: the blind field).
     """
 
     name: ClassVar[FieldName]
+    prior: AppearancePrior | None = None
 
     def __init__(self, pokes: PokeSet, xs: NDArray[np.float64], ys: NDArray[np.float64],
                  config: BetaFieldConfig | ModulusFieldConfig) -> None:
@@ -181,11 +187,33 @@ class PokeField:
                 noise_std=float(pokes.noise.min()), method="exact",
             ).fit(pokes.xy, pokes.values, noise_std=pokes.noise)  # fmt: skip
 
+    def with_prior(self, prior: AppearancePrior | None) -> Self:
+        """This field under the appearance prior ``prior`` (``None``: blind); call before the
+        field is first read. Returns ``self``."""
+        self.prior = prior
+        self.__dict__.pop("_grid", None)
+        self.__dict__.pop("models", None)
+        return self
+
+    @cached_property
+    def models(self) -> AppearanceModels | None:
+        """The field under each weight of the appearance prior and their posterior (``None``
+        when blind or without pokes)."""
+        if self.prior is None or not len(self.pokes):
+            return None
+        return AppearanceModels(self.prior, self.pokes.xy, self.pokes.values, self.pokes.noise,
+                                signal_std=self.config.signal_std,
+                                length_scale=self.config.length_scale_m)  # fmt: skip
+
     @cached_property
     def _grid(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        shape = (self.ys.size, self.xs.size)
         if self.gp is None:
-            shape = (self.ys.size, self.xs.size)
             return np.full(shape, np.nan), np.full(shape, self.config.signal_std**2)
+        if self.models is not None:
+            assert self.prior is not None
+            mean, var = self.models.predict(self.prior.cells_xy)
+            return mean.reshape(shape), var.reshape(shape)
         mean, std = self.gp.predict_grid(self.xs, self.ys, return_std=True)
         return mean, std**2
 

@@ -5,7 +5,9 @@ merged and classes split by place (:mod:`deformap.explore._places`), then each c
 - ``isopleth``, the paper's: a cell takes the band of the field's mean it falls in between the
   isopleths midway between neighbouring classes' means, so a region is a level set of the map.
 - ``nearest``, the default: a cell takes the class of the poke nearest to it
-  (:meth:`RegionMap.nearest_poke`). The isopleths of a field with a decimetre length scale are
+  (:meth:`RegionMap.nearest_poke`); under an appearance prior, of the poke it is most correlated
+  with under the prior's model-averaged kernel (:mod:`deformap.explore._appearance_prior`), which
+  at weight 0 is the nearest poke. The isopleths of a field with a decimetre length scale are
   smooth curves that revert towards the field's mean away from the pokes, and pokes placed to pin
   a boundary do not move them much; the nearest-poke labels of the same pokes follow the pokes.
 - ``indicator-kriging``: a cell takes its most probable class, each class's probability kriged
@@ -14,6 +16,8 @@ merged and classes split by place (:mod:`deformap.explore._places`), then each c
 """
 
 from __future__ import annotations
+
+from collections.abc import Callable
 
 import numpy as np
 from numpy.typing import NDArray
@@ -28,14 +32,18 @@ __all__ = ["map_regions"]
 
 
 def map_regions(mean: NDArray[np.float64], pokes: PokeSet, cells_xy: NDArray[np.float64],
-                config: ExplorationConfig, field: FieldName) -> RegionMap:
+                config: ExplorationConfig, field: FieldName, *,
+                correlation: Callable[[NDArray[np.float64]], NDArray[np.float64]] | None = None,
+                ) -> RegionMap:  # fmt: skip
     """The regions of the field ``field`` (the one mapped on, which after a fallback is not
     ``config.field``) with mean ``mean (ny, nx)`` fitted to ``pokes``, as the exploration
     settings ask: classes by
     :func:`deformap.explore.segment_regions` (``max_regions``, ``region_prior_dof``, the field's
     noise floor and smallest step), junctions merged (``merge_seams``) and classes split by place
     (``split_by_place``), cells labelled by isopleth, by nearest poke or by indicator kriging
-    (``region_labels``; ``cells_xy (ny · nx, 2)`` are the grid's cells)."""
+    (``region_labels``; ``cells_xy (ny · nx, 2)`` are the grid's cells). ``correlation``
+    (``cells (q, 2) -> (q, p)``, an appearance prior's) labels ``nearest`` by the most correlated
+    poke instead of the nearest one."""
     settings = field_settings(config, field)
     found = poke_classes(mean, pokes, config, field)
     if config.merge_seams and found.n_regions >= 3:
@@ -45,7 +53,12 @@ def map_regions(mean: NDArray[np.float64], pokes: PokeSet, cells_xy: NDArray[np.
                                np.maximum(pokes.noise, settings.noise_floor),
                                pokes.thickness, max_regions=config.max_regions)  # fmt: skip
     if config.region_labels == "nearest":
-        return found.nearest_poke(pokes.xy, cells_xy)
+        if correlation is None:
+            return found.nearest_poke(pokes.xy, cells_xy)
+        closest = np.argmax(correlation(cells_xy), axis=1)  # ties: the earliest poke
+        return RegionMap(labels=found.poke_labels[closest].reshape(found.labels.shape),
+                         levels=found.levels, class_betas=found.class_betas,
+                         poke_labels=found.poke_labels)
     if config.region_labels == "indicator-kriging":
         labels = indicator_labels(pokes.xy, found.poke_labels, pokes.noise, cells_xy,
                                   n_classes=found.n_regions, length_scale=settings.length_scale_m,

@@ -152,9 +152,8 @@ def explore(
         index = len(mapper.pokes)
         t_target = time.perf_counter()
         if index == 0:
-            first = config.first_target
-            xy = env.workspace.center if first is None else first
-            target: Target | None = Target(np.array(xy, dtype=float), "first")
+            target: Target | None = Target(np.array(mapper.first_target(), dtype=float),
+                                           "first")  # fmt: skip
         else:
             target = mapper.next_target(streams[index + 1])
         if target is None:

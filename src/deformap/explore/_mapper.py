@@ -24,6 +24,8 @@ import numpy as np
 from deformap.cloud import PointCloud
 from deformap.environment import PressObservation, Workspace
 from deformap.errors import EnvironmentStateError
+from deformap.explore._appearance import build_appearance
+from deformap.explore._appearance_prior import AppearancePrior
 from deformap.explore._choice import FieldChoice, choose_map_field, unread_radius_m
 from deformap.explore._classes import RegionMap
 from deformap.explore._config import ExplorationConfig, FieldName, check_exploration_budget
@@ -34,9 +36,9 @@ from deformap.explore._labels import map_regions
 from deformap.explore._modulus import ModulusField
 from deformap.explore._nugget import beta_pokes
 from deformap.explore._records import PokeRecord, PokeResult, Target
-from deformap.explore._result import ExplorationResult
+from deformap.explore._result import AppearanceOutcome, ExplorationResult
 from deformap.explore._surface import SurfaceModel, fit_surface
-from deformap.explore._targets import choose_next
+from deformap.explore._targets import BOUNDARY_SPACING_ROI, choose_next, segment_interior
 
 __all__ = ["Mapper"]
 
@@ -60,6 +62,8 @@ class Mapper:
         self.config = config
         self.grid = MapGrid.build(workspace, config)
         self.surface: SurfaceModel | None = None
+        self.appearance: AppearancePrior | None = None
+        self.appearance_reason: str | None = "no observation yet"
         self._pokes: list[PokeResult] = []
         self._beta_field: BetaField | None = None  # fitted when first asked for (`beta_field`)
         self._modulus = self._fit_modulus([])
@@ -118,18 +122,56 @@ class Mapper:
 
     def _fit_beta(self, pokes: list[PokeResult]) -> BetaField:
         return BetaField(beta_pokes([p.record for p in pokes], self.config), self.grid.xs,
-                         self.grid.ys, self.config.beta_field)
+                         self.grid.ys, self.config.beta_field).with_prior(self.appearance)
 
     def _fit_modulus(self, pokes: list[PokeResult]) -> ModulusField:
         return ModulusField.of_records([p.record for p in pokes], self.grid.xs, self.grid.ys,
                                        self.config.modulus_field,
-                                       self.config.stiffness.poisson_ratio)  # fmt: skip
+                                       self.config.stiffness.poisson_ratio,
+                                       ).with_prior(self.appearance)  # fmt: skip
 
     def initialise(self, cloud: PointCloud, rng: np.random.Generator) -> SurfaceModel:
-        """Fit the surface model to the first observation (:func:`fit_surface`)."""
+        """Fit the surface model to the first observation (:func:`fit_surface`) and, under
+        ``appearance: auto``, read its colours into the appearance prior
+        (:func:`deformap.explore._appearance.build_appearance`; the same cloud gives the same
+        prior, so a resumed or replayed run has the live run's)."""
         self.surface = fit_surface(cloud, self.workspace, self.grid.xs, self.grid.ys,
                                    self.config.surface, rng)  # fmt: skip
+        if self.config.appearance == "off":
+            self.appearance, self.appearance_reason = None, "exploration.appearance is off"
+        else:
+            image = build_appearance(cloud, self.grid.xs, self.grid.ys, self.surface.height,
+                                     self.footprint_m)  # fmt: skip
+            if isinstance(image, str):
+                self.appearance, self.appearance_reason = None, image
+                if cloud.colors is not None:
+                    logger.warning("the appearance prior is off: %s; the map is the blind one",
+                                   image)  # fmt: skip
+            else:
+                self.appearance = AppearancePrior(image, self.grid.xs, self.grid.ys)
+                self.appearance_reason = None
+        self._modulus = self._fit_modulus([])
         return self.surface
+
+    @property
+    def footprint_m(self) -> float:
+        """Width of a dent's footprint [m] (``BOUNDARY_SPACING_ROI`` ROIs): the smallest
+        segment the appearance image keeps."""
+        return BOUNDARY_SPACING_ROI * self.config.touch.roi_size_m
+
+    def first_target(self) -> tuple[float, float]:
+        """The first poke [m]: ``config.first_target`` if set; else, under the appearance
+        prior, the place deepest inside the largest segment; else the workspace's centre."""
+        if self.config.first_target is not None:
+            return self.config.first_target
+        if self.appearance is not None:
+            segments = self.appearance.image.segments
+            order = np.argsort(-np.bincount(segments[segments >= 0]), kind="stable")
+            for s in order:
+                found = segment_interior(self.grid, segments, int(s))
+                if found is not None:
+                    return (float(found[0][0]), float(found[0][1]))
+        return self.workspace.center
 
     def process_press(self, obs: PressObservation, index: int) -> PokeResult:
         """Reconstruct the dent of one press and estimate its β; the β-field is not touched."""
@@ -204,8 +246,9 @@ class Mapper:
         if not self._pokes:
             raise EnvironmentStateError("no poke yet: the field has no regions")
         field = self.map_field
+        correlation = None if field.models is None else field.models.correlation
         return map_regions(field.mean, field.pokes, self.grid.cells_xy, self.config,
-                           self.map_field_name)
+                           self.map_field_name, correlation=correlation)
 
     def result(self, stop_reason: str, timings: Mapping[str, float]) -> ExplorationResult:
         """What the exploration produced, with the β-field and regions read once."""
@@ -216,4 +259,7 @@ class Mapper:
             max_variance=self.max_variance(), stop_reason=stop_reason, timings=dict(timings),
             map_field_name=self.map_field_name, field_fallback=self.field_fallback,
             unread_places=self._choice.unread_places, stop_mask=self.choice_grid.stop_mask,
+            appearance=AppearanceOutcome.of(self.appearance, self.appearance_reason,
+                                            self.map_field),
+            prior=self.appearance,
         )  # fmt: skip

@@ -21,6 +21,7 @@ Fedorov, V. V. (1972). Theory of Optimal Experiments. Academic Press (the exchan
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -33,6 +34,9 @@ from deformap.gp import PosteriorDesign
 __all__ = ["PokePlan", "plan_pokes"]
 
 Array = NDArray[np.float64]
+#: ``(a (n, 2), b (m, 2)) -> (n, m)`` a prior covariance between places [m], in the field's units
+#: squared, its diagonal ``signal_std²``.
+Covariance = Callable[[Array, Array], Array]
 
 
 @dataclass(frozen=True)
@@ -55,6 +59,17 @@ class PokePlan:
     reaches: bool
 
 
+def _use_covariance(gp: PosteriorDesign, covariance: Covariance, poked_xy: Array,
+                    candidates: Array, domain: Array) -> None:
+    """Replace the design's kernel matrices by ``covariance``'s: its algebra (RW2006 Eq. 2.24)
+    holds for any prior covariance whose diagonal is its ``signal_std²``."""
+    gp.k_pp = covariance(poked_xy, poked_xy)
+    gp.k_pc = covariance(poked_xy, candidates)
+    gp.k_pd = covariance(poked_xy, domain)
+    gp.k_cc = covariance(candidates, candidates)
+    gp.k_cd = covariance(candidates, domain)
+
+
 def _best_addition(gp: PosteriorDesign, chosen: list[int], threshold: float
                    ) -> tuple[int, tuple[float, float]]:  # fmt: skip
     """The candidate not in ``chosen`` whose addition (an exact rank-one update of the posterior)
@@ -70,7 +85,8 @@ def _best_addition(gp: PosteriorDesign, chosen: list[int], threshold: float
 
 def plan_pokes(poked_xy: Array, poked_noise: Array, candidates: Array, domain: Array, *,
                signal_std: float, length_scale: float, new_noise: float | Array, threshold: float,
-               max_new: int, max_passes: int = 4) -> PokePlan:
+               max_new: int, max_passes: int = 4,
+               covariance: Covariance | None = None) -> PokePlan:
     """The fewest further pokes among ``candidates`` that bring the field's largest variance
     over ``domain`` to ``threshold`` or below (method: module docstring).
 
@@ -95,6 +111,9 @@ def plan_pokes(poked_xy: Array, poked_noise: Array, candidates: Array, domain: A
         Most further pokes to plan (at most one per candidate).
     max_passes : int
         Most exchange passes per plan size.
+    covariance : callable, optional
+        The prior covariance to plan with (an appearance prior's at its posterior-mean weight);
+        default the squared exponential of ``signal_std`` and ``length_scale``.
     """
     poked_xy = check_array("poked_xy", poked_xy, (None, 2), what="metres")
     poked_noise = check_array("poked_noise", poked_noise, (poked_xy.shape[0],))
@@ -117,6 +136,8 @@ def plan_pokes(poked_xy: Array, poked_noise: Array, candidates: Array, domain: A
     max_passes = check_int("max_passes", max_passes, minimum=0)
     gp = PosteriorDesign(poked_xy, poked_noise, candidates, domain, length_scale=length_scale,
                          signal_std=signal_std, candidate_noise_std=new_noise)
+    if covariance is not None:
+        _use_covariance(gp, covariance, poked_xy, candidates, domain)
     chosen: list[int] = []
     best = (np.inf, np.inf)
     for _ in range(min(max_new, candidates.shape[0])):

@@ -11,6 +11,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from deformap.environment import Workspace
+from deformap.explore._appearance import AppearanceImage
+from deformap.explore._appearance_prior import AppearancePrior
 from deformap.explore._classes import RegionMap
 from deformap.explore._config import ExplorationConfig, FieldName
 from deformap.explore._field import BetaField, PokeField
@@ -20,11 +22,66 @@ from deformap.explore._nugget import beta_pokes
 from deformap.explore._records import PokeResult
 from deformap.explore._surface import SurfaceModel
 
-__all__ = ["ExplorationResult", "StopReason"]
+__all__ = ["AppearanceOutcome", "ExplorationResult", "StopReason"]
 
 StopReason = Literal["threshold", "max_pokes", "end-of-session"]
 """``threshold``: the variance fell under ``T_h`` and no boundary poke was owed; ``max_pokes``:
 the poke limit came first; ``end-of-session``: a replayed session's pokes ran out."""
+
+
+@dataclass(frozen=True, kw_only=True, eq=False)
+class AppearanceOutcome:
+    """What the appearance prior did in a run (:mod:`deformap.explore._appearance_prior`).
+
+    Attributes
+    ----------
+    used : bool
+        Whether the map field used the prior.
+    reason : str or None
+        Why not (``exploration.appearance`` off, no colour, an image that cannot carry a layout).
+    weights, weight_posterior : tuple of float
+        The grid of the look's weight ``w`` and its posterior after the last poke (empty when
+        not used or without pokes).
+    weight : float or None
+        The posterior mean of ``w``.
+    look_scale : float or None
+        The most probable ``ℓ_a`` (standardised feature units).
+    n_segments : int
+        Segments of the appearance image (0 when not used).
+    image : AppearanceImage or None
+        The image and its segments.
+    """
+
+    used: bool
+    reason: str | None = None
+    weights: tuple[float, ...] = ()
+    weight_posterior: tuple[float, ...] = ()
+    weight: float | None = None
+    look_scale: float | None = None
+    n_segments: int = 0
+    image: AppearanceImage | None = None
+
+    @classmethod
+    def of(cls, prior: AppearancePrior | None, reason: str | None,
+           field: PokeField) -> AppearanceOutcome:
+        """The outcome of a run whose map field is ``field`` under ``prior`` (or ``reason``)."""
+        if prior is None:
+            return cls(used=False, reason=reason)
+        models = field.models
+        if models is None:
+            return cls(used=True, n_segments=prior.image.n_segments, image=prior.image)
+        values, probability = models.posterior.weight_distribution()
+        return cls(used=True, weights=tuple(float(v) for v in values),
+                   weight_posterior=tuple(float(p) for p in probability),
+                   weight=models.posterior.mean_weight, look_scale=models.posterior.look_scale,
+                   n_segments=prior.image.n_segments, image=prior.image)  # fmt: skip
+
+    def to_dict(self) -> dict[str, object]:
+        """The JSON form (no arrays): ``used``, ``reason``, ``weight``, ``weights``,
+        ``weight_posterior``, ``look_scale``, ``n_segments``."""
+        return {"used": self.used, "reason": self.reason, "weight": self.weight,
+                "weights": list(self.weights), "weight_posterior": list(self.weight_posterior),
+                "look_scale": self.look_scale, "n_segments": self.n_segments}  # fmt: skip
 
 
 @dataclass(frozen=True, kw_only=True, eq=False)
@@ -67,6 +124,10 @@ class ExplorationResult:
     stop_mask : (ny * nx,) bool or None
         The cells whose variance the stopping rule read: ``grid.stop_mask`` without those discs
         (``None``: ``grid.stop_mask``).
+    appearance : AppearanceOutcome
+        Whether the appearance prior was used, why not, and what it learned.
+    prior : AppearancePrior or None
+        The appearance prior the fields used (``None``: blind).
     """
 
     config: ExplorationConfig
@@ -84,6 +145,8 @@ class ExplorationResult:
     field_fallback: str | None = None
     unread_places: tuple[tuple[float, float], ...] = ()
     stop_mask: NDArray[np.bool_] | None = None
+    appearance: AppearanceOutcome = AppearanceOutcome(used=False)
+    prior: AppearancePrior | None = None
 
     @property
     def stop_cells(self) -> NDArray[np.bool_]:
@@ -113,7 +176,8 @@ class ExplorationResult:
         if n_pokes == len(self.pokes):
             return self.beta_field
         return BetaField(beta_pokes([p.record for p in self.pokes[:n_pokes]], self.config),
-                         self.grid.xs, self.grid.ys, self.config.beta_field)
+                         self.grid.xs, self.grid.ys, self.config.beta_field
+                         ).with_prior(self.prior)  # fmt: skip
 
     def modulus_field_after(self, n_pokes: int) -> ModulusField:
         """The modulus field as it was after the first ``n_pokes`` pokes."""
@@ -121,4 +185,5 @@ class ExplorationResult:
             return self.modulus_field
         return ModulusField.of_records([p.record for p in self.pokes[:n_pokes]], self.grid.xs,
                                        self.grid.ys, self.config.modulus_field,
-                                       self.config.stiffness.poisson_ratio)  # fmt: skip
+                                       self.config.stiffness.poisson_ratio,
+                                       ).with_prior(self.prior)  # fmt: skip

@@ -3,6 +3,17 @@
 its own ``T_h``: :func:`deformap.explore.field_settings`), then the boundary pokes (strategies
 and scores in :mod:`deformap.explore._acquisition`).
 
+Under an appearance prior (:mod:`deformap.explore._appearance_prior`) the looks come first: while
+the variance is above ``T_h``, the interior (:func:`segment_interior`) of the largest segment of
+the largest look no poke has read (a look: the segments within ``ℓ_a`` of it; read: a poke in
+one of them), if that look covers more than one poke does on the blind map
+(:func:`covered_area_m2`) and is not yet known; once it is under ``T_h``, a test of the
+hypothesis the map rests on: in the largest segment with one poke, where the blind map
+(``w = 0``) is still above ``T_h``, so only the look vouches for the place, the place the blind
+map knows least (is the segment one material?). Each segment is tested once; a test the pokes
+contradict moves the weight's posterior toward the blind map and its variance back above
+``T_h``.
+
 When only the edge band, where no poke fits, is still above ``T_h``, ``planned`` plans it like
 any other place; the other strategies poke the reachable cell of largest variance, the one nearest
 the band's worst corner (poking where one poke leaves the least largest variance instead is
@@ -15,9 +26,11 @@ import logging
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy import ndimage as ndi
 from scipy.spatial import cKDTree
 
 from deformap.explore._acquisition import boundary_score, choose_target
+from deformap.explore._appearance_prior import LOOK_SCALES
 from deformap.explore._classes import poke_classes
 from deformap.explore._config import ExplorationConfig, FieldName
 from deformap.explore._field import PokeField, PokeSet, field_settings
@@ -25,7 +38,8 @@ from deformap.explore._grid import MapGrid
 from deformap.explore._planning import PokePlan, plan_pokes
 from deformap.explore._records import Target
 
-__all__ = ["BOUNDARY_SPACING_ROI", "choose_next", "expected_noise"]
+__all__ = ["BOUNDARY_SPACING_ROI", "choose_next", "covered_area_m2", "expected_noise",
+           "segment_interior"]
 
 logger = logging.getLogger(__name__)
 
@@ -57,14 +71,16 @@ def expected_noise(candidates: NDArray[np.float64], pokes: PokeSet, config: Expl
 
 
 def _plan(grid: MapGrid, pokes: PokeSet, config: ExplorationConfig, n_made: int,
-          field: FieldName) -> PokePlan:
+          field: PokeField) -> PokePlan:
     """The plan with the fewest further pokes that brings the variance under ``T_h``."""
-    cfg = field_settings(config, field)
+    cfg = field_settings(config, field.name)
+    models = field.models
     return plan_pokes(
         pokes.xy, pokes.noise, grid.plan_candidates, grid.plan_domain,
         signal_std=cfg.signal_std, length_scale=cfg.length_scale_m,
-        new_noise=expected_noise(grid.plan_candidates, pokes, config, field),
+        new_noise=expected_noise(grid.plan_candidates, pokes, config, field.name),
         threshold=cfg.threshold, max_new=max(1, config.max_pokes - n_made),
+        covariance=None if models is None else models.covariance_at_mean,
     )  # fmt: skip
 
 
@@ -97,6 +113,85 @@ def _boundary(grid: MapGrid, field: PokeField, pokes: PokeSet,
     return np.array(cells[int(np.argmax(score))], dtype=float)
 
 
+def segment_interior(grid: MapGrid, segments: NDArray[np.int64], segment: int
+                     ) -> tuple[NDArray[np.float64], float] | None:  # fmt: skip
+    """The reachable cell deepest inside ``segment`` of ``segments (ny, nx)`` (the largest
+    distance to its edge, a distance transform) and that distance [m]; ``None`` when none of its
+    cells is reachable."""
+    inside = segments == segment
+    reach = inside & grid.target_mask.reshape(grid.shape)
+    if not reach.any():
+        return None
+    spacing = float(grid.xs[1] - grid.xs[0]) if grid.xs.size > 1 else 1.0
+    depth = ndi.distance_transform_edt(np.pad(inside, 1))[1:-1, 1:-1] * spacing
+    flat = int(np.argmax(np.where(reach, depth, -1.0)))
+    return np.array(grid.cells_xy[flat], dtype=float), float(depth.ravel()[flat])
+
+
+def _poked_segments(field: PokeField, segments: NDArray[np.int64]) -> NDArray[np.int64]:
+    """How many pokes each segment holds, ``(n_segments,)``."""
+    assert field.prior is not None
+    seg = segments.ravel()[field.prior.cells_of(field.pokes.xy)]
+    return np.bincount(seg[seg >= 0], minlength=int(segments.max()) + 1)
+
+
+def _look_distance(field: PokeField) -> tuple[NDArray[np.float64], float]:
+    """``(n, n)`` squared distances between the segments' features and the squared ``ℓ_a`` that
+    makes two looks alike (the posterior's most probable; before any poke the grid's middle)."""
+    assert field.prior is not None
+    feats = field.prior.image.features
+    d2 = np.sum((feats[:, None, :] - feats[None, :, :]) ** 2, axis=-1)
+    models = field.models
+    scale = LOOK_SCALES[len(LOOK_SCALES) // 2] if models is None else models.posterior.look_scale
+    return d2, scale**2
+
+
+def covered_area_m2(config: ExplorationConfig, field: FieldName) -> float:
+    """The area [m²] one exact poke brings under ``T_h`` on the blind map: the disc where
+    ``σ² (1 − k²) ≤ T_h``, radius² ``−σ_w² ln(1 − T_h / σ²) / 2``; a look smaller than this
+    gains nothing from a poke placed by its look."""
+    cfg = field_settings(config, field)
+    ratio = min(cfg.threshold / cfg.signal_std**2, 1.0 - 1e-12)
+    return float(np.pi * -(cfg.length_scale_m**2) * np.log(1.0 - ratio) / 2.0)
+
+
+def _look_target(grid: MapGrid, field: PokeField, config: ExplorationConfig, threshold: float,
+                 done: bool) -> NDArray[np.float64] | None:
+    """Where the looks say to poke next (module docstring), or ``None`` (the strategy's turn)."""
+    assert field.prior is not None
+    segments = field.prior.image.segments
+    poked = _poked_segments(field, segments)
+    area = (np.bincount(segments.ravel()[segments.ravel() >= 0], minlength=poked.size)
+            * config.surface.grid_spacing_m**2)  # fmt: skip
+    stop = grid.stop_mask.reshape(grid.shape)
+    if not done:
+        d2, alike = _look_distance(field)
+        look_area = (d2 <= alike) @ area  # each segment's look: the area of every alike segment
+        read = (poked > 0) | ((d2[:, poked > 0] <= alike).any(axis=1))
+        above = (field.variance > threshold) & stop
+        open_ = [s for s in np.lexsort((-area, -look_area))
+                 if not read[s] and look_area[s] >= covered_area_m2(config, field.name)
+                 and above[segments == s].any()]
+        for s in open_:
+            found = segment_interior(grid, segments, int(s))
+            if found is not None and found[1] >= BOUNDARY_SPACING_ROI * config.touch.roi_size_m / 2:
+                return found[0]
+        return None
+    models = field.models
+    if models is None:
+        return None
+    blind = models.blind_variance(grid.cells_xy).reshape(grid.shape)
+    for s in np.argsort(-area, kind="stable"):
+        if poked[s] != 1:
+            continue
+        vouched = (segments == s) & stop & (blind > threshold)
+        reach = vouched & grid.target_mask.reshape(grid.shape)
+        if reach.any():
+            flat = int(np.argmax(np.where(reach, blind, -np.inf)))
+            return np.array(grid.cells_xy[flat], dtype=float)
+    return None
+
+
 def choose_next(grid: MapGrid, field: PokeField, config: ExplorationConfig,
                 rng: np.random.Generator, *, boundary_owed: int,
                 n_made: int | None = None) -> Target | None:
@@ -122,7 +217,12 @@ def choose_next(grid: MapGrid, field: PokeField, config: ExplorationConfig,
     pokes = field.pokes
     variance = field.variance.ravel()
     threshold = field_settings(config, field.name).threshold
-    if variance[grid.stop_mask].max() <= threshold:
+    done = variance[grid.stop_mask].max() <= threshold
+    if field.prior is not None:
+        look = _look_target(grid, field, config, threshold, done)
+        if look is not None:
+            return Target(look, "variance")
+    if done:
         if boundary_owed == 0:
             return None
         xy = _boundary(grid, field, pokes, config)
@@ -137,7 +237,7 @@ def choose_next(grid: MapGrid, field: PokeField, config: ExplorationConfig,
 
     def planner() -> NDArray[np.float64]:
         made = len(pokes) if n_made is None else n_made  # the field may leave pokes out
-        plans.append(_plan(grid, pokes, config, made, field.name))
+        plans.append(_plan(grid, pokes, config, made, field))
         return np.array(plans[-1].targets[0], dtype=float)
 
     if reachable.max() <= threshold:  # only the edge band is left

@@ -65,6 +65,7 @@ def write_map_figures(
         levels = regions.levels if result.config.region_labels == "isopleth" else None
         modulus = result.modulus_field.median_pa if result.has_modulus else None
         values = _class_values(result)  # what report.json says of each region
+        image = result.appearance.image
         plot_map(result.xs, result.ys, beta=result.beta_field.mean,
                  variance=result.map_field.variance, contacts=contacts, labels=regions.labels,
                  levels=levels, truth_hardness=truth_hardness, threshold=threshold, title=title,
@@ -73,7 +74,9 @@ def write_map_figures(
                  purposes=[p.record.purpose for p in result.pokes],
                  variance_max=variance_max, class_betas=values["class_betas"],
                  class_modulus_pa=values["class_modulus_median_pa"],
-                 rigid_classes=rigid_regions(result))  # fmt: skip
+                 rigid_classes=rigid_regions(result),
+                 appearance_rgb=None if image is None else image.rgb(),
+                 appearance_segments=None if image is None else image.segments)  # fmt: skip
         written.append(folder / "map.png")
     if poke_figures:
         written += [write_poke_figure(folder, poke) for poke in result.pokes

@@ -21,6 +21,10 @@ ln E [ln Pa]:
   ``log_mean_ln_pa`` and ``log_std`` (posterior mean and standard deviation of ln E, rows along
   y), ``max_variance``, ``pokes`` (``log_modulus_ln_pa``, ``rigid``, ``used``,
   ``excluded_because``) and ``n_used``;
+- ``appearance``: whether the map used the camera's colours (``used``), why not (``reason``), the
+  look's learned weight (``weight``, the posterior mean; ``weights`` and ``weight_posterior``, its
+  grid and posterior), ``look_scale`` and ``n_segments``
+  (:class:`deformap.explore.AppearanceOutcome`);
 - ``true_regions`` (with a ground truth) and ``timings`` (the loop's, and per poke).
 
 Every report also names ``deformap`` (the version), ``seed`` and the effective ``config``; a live
@@ -67,6 +71,7 @@ SHARED_KEYS = (
     "beta_nugget",
     "regions",
     "modulus_field",
+    "appearance",
     "timings",
 )
 """The keys :func:`shared_report` always writes (``true_regions`` too, with a ground truth)."""
@@ -161,6 +166,7 @@ def shared_report(result: ExplorationResult, *, truth: Any = None) -> dict[str, 
         "beta_nugget": float(result.beta_field.pokes.nugget),
         "regions": regions,
         "modulus_field": modulus_report(result),
+        "appearance": result.appearance.to_dict(),
     }
     if truth is not None:
         report["true_regions"] = true_regions

@@ -118,9 +118,12 @@ def plot_map(
     class_betas: Sequence[float | None] | None = None,
     class_modulus_pa: Sequence[float | None] | None = None,
     rigid_classes: Collection[int] = (),
+    appearance_rgb: NDArray[np.float64] | None = None,
+    appearance_segments: NDArray[np.int64] | None = None,
 ) -> Figure:
-    """The map figure: ground truth (when given) | β-field | modulus field (when given) |
-    variance and contacts; the regions drawn on the field they were cut from.
+    """The map figure: ground truth (when given) | the camera's view with its segments (when
+    given) | β-field | modulus field (when given) | variance and contacts; the regions drawn on
+    the field they were cut from.
 
     Parameters
     ----------
@@ -165,6 +168,9 @@ def plot_map(
         modulus panels; without them, the median over the region's cells of the panel's field.
     rigid_classes : collection of int
         Regions whose pokes all read rigid: labelled "rigid", not with a number.
+    appearance_rgb, appearance_segments : (ny, nx, 3) float, (ny, nx) int, optional
+        The appearance prior's view of the map (sRGB in [0, 1]) and its segments (``-1``
+        masked), drawn with the segments' edges in white and the contacts.
 
     Returns
     -------
@@ -177,7 +183,8 @@ def plot_map(
         raise InvalidArgumentError(f"`variance_max` must be a number > 0; got {variance_max!r}")
     contacts = np.asarray(contacts, dtype=float).reshape(-1, 2)
     kinds = _purposes(len(contacts), purposes)
-    panels = 2 + (truth_hardness is not None) + (modulus_pa is not None)
+    panels = (2 + (truth_hardness is not None) + (modulus_pa is not None)
+              + (appearance_rgb is not None))  # fmt: skip
     fig = Figure(figsize=(5.2 * panels, 4.6), layout="constrained")
     axes = list(np.atleast_1d(fig.subplots(1, panels)))
     ext = _extent(xs, ys)
@@ -186,6 +193,10 @@ def plot_map(
     norm = modulus_norm(*(m for m in (kpa, truth_kpa) if m is not None))
     if truth_kpa is not None:
         _truth_panel(fig, axes.pop(0), xs, ys, ext, truth_kpa, norm)
+    if appearance_rgb is not None:
+        ax = axes.pop(0)
+        _appearance_panel(ax, ext, appearance_rgb, appearance_segments)
+        _contacts(ax, contacts, kinds)
     n_regions = "" if labels is None else f", {len(np.unique(labels))} region(s)"
     overlay = _Overlay(xs, ys, labels, levels, contacts, kinds, set(rigid_classes))
     ax = axes.pop(0)
@@ -217,6 +228,21 @@ def plot_map(
     if path is not None:
         save_figure(fig, path, dpi=110)
     return fig
+
+
+def _appearance_panel(ax: Axes, ext: Extent, rgb: NDArray, segments: NDArray | None) -> None:
+    """The camera's view on the map grid, the segments' edges in white."""
+    ax.imshow(np.clip(rgb, 0.0, 1.0), origin="lower", extent=ext, interpolation="nearest")
+    if segments is not None:
+        edge = np.zeros(segments.shape, dtype=bool)
+        edge[:, 1:] |= segments[:, 1:] != segments[:, :-1]
+        edge[1:, :] |= segments[1:, :] != segments[:-1, :]
+        overlay = np.zeros((*segments.shape, 4))
+        overlay[edge] = (1.0, 1.0, 1.0, 0.9)
+        ax.imshow(overlay, origin="lower", extent=ext, interpolation="nearest")
+        ax.set_title(f"camera view, {int(segments.max()) + 1} segment(s)")
+    else:
+        ax.set_title("camera view")
 
 
 def _truth_modulus_kpa(truth_hardness: NDArray) -> NDArray[np.float64]:
