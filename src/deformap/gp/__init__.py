@@ -9,6 +9,7 @@ Shared parameters, in metres (or the units of the modelled value): ``length_scal
 
 from __future__ import annotations
 
+from deformap.gp._exact import cholesky_with_jitter
 from deformap.gp._field import AUTO_EXACT_MAX_POINTS, GaussianRandomField
 from deformap.gp._hyper import (
     GPHyperparameters,
@@ -20,5 +21,5 @@ from deformap.gp._kernels import grid_points, squared_exponential
 from deformap.gp._posterior import PosteriorDesign, apply_smoother, variance_after_adding
 
 __all__ = ["AUTO_EXACT_MAX_POINTS", "GPHyperparameters", "GaussianRandomField", "PosteriorDesign",
-           "apply_smoother", "default_bounds", "fit_hyperparameters", "grid_points",
+           "apply_smoother", "cholesky_with_jitter", "default_bounds", "fit_hyperparameters", "grid_points",
            "log_marginal_likelihood", "squared_exponential", "variance_after_adding"]
