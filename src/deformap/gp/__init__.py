@@ -21,5 +21,5 @@ from deformap.gp._kernels import grid_points, squared_exponential
 from deformap.gp._posterior import PosteriorDesign, apply_smoother, variance_after_adding
 
 __all__ = ["AUTO_EXACT_MAX_POINTS", "GPHyperparameters", "GaussianRandomField", "PosteriorDesign",
-           "apply_smoother", "cholesky_with_jitter", "default_bounds", "fit_hyperparameters", "grid_points",
-           "log_marginal_likelihood", "squared_exponential", "variance_after_adding"]
+           "apply_smoother", "cholesky_with_jitter", "default_bounds", "fit_hyperparameters",
+           "grid_points", "log_marginal_likelihood", "squared_exponential", "variance_after_adding"]
