@@ -67,7 +67,7 @@ def test_the_budget_bounds_the_foundation_grid() -> None:
 def test_a_coarse_world_under_a_stiffening_physics_is_explored_end_to_end(physics) -> None:
     world = coarse_world("heterogeneous-60-110-rigid", seed=3, physics=physics)
     config = ExplorationConfig(
-        max_pokes=2, first_target=(0.1, 0.2),
+        max_pokes=2, first_target=(0.1, 0.2), appearance="off",  # the physics under test, not the look
         surface=SurfaceGPConfig(fit_hyperparameters=False, length_scale_m=0.05),
         beta_field=BetaFieldConfig(length_scale_m=0.1))
     result = explore(world, config, rng=np.random.default_rng(0))
