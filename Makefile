@@ -19,8 +19,11 @@ $(STAMP): pyproject.toml
 demo: $(STAMP)
 	$(VENV)/bin/deformap explore --scenario heterogeneous-60-110-rigid
 
+# The tests run in TEST_WORKERS processes, each with BLAS pinned to one thread (the machines are shared).
+TEST_WORKERS ?= 2
 test: $(STAMP)
-	$(PY) -m pytest -q -p no:cacheprovider
+	OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 MKL_NUM_THREADS=1 \
+		$(PY) -m pytest -q -p no:cacheprovider -n $(TEST_WORKERS)
 
 # Speed and memory tables, each with its baseline (benchmarks/README.md); JSON in benchmarks/results.
 bench: $(STAMP)
