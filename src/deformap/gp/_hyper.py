@@ -100,10 +100,9 @@ def fit_hyperparameters(xy: Any, z: Any, *, rng: np.random.Generator,
     rng : numpy.random.Generator
         Draws the subset and the restart points (same seed, same result).
     init : GPHyperparameters, optional
-        First start; default (D/10, s, s/10), D the bounding-box diagonal, s the data's std.
+        First start; default (D/10, s, s/10) in the terms of :func:`default_bounds`.
     n_restarts : int
-        Further starts drawn log-uniformly within ``bounds`` ((3, 2) low and high of σ_w, σₑ,
-        σₙ; default :func:`default_bounds`).
+        Further starts, log-uniform within ``bounds`` ((3, 2); default :func:`default_bounds`).
     max_points : int
         At most this many points (a random subset) enter the O(n³) objective.
     """

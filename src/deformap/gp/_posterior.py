@@ -51,17 +51,10 @@ def _per_candidate(name: str, value: Any, shape: tuple[int, ...], *, allow_zero:
 
 def variance_after_adding(variance: Any, covariance: Any, candidate_variance: Any,
                           noise_var: float | Array) -> Array:
-    """``(c, d)`` posterior variance on a domain after one more observation at each candidate:
-    row ``j`` is ``variance − covariance[j]² / (candidate_variance[j] + noise_var)``.
-
-    Parameters
-    ----------
-    variance, covariance, candidate_variance : (d,), (c, d), (c,) float
-        The posterior now: variance on the domain, covariance between each candidate and the
-        domain, variance at each candidate.
-    noise_var : float or (c,) float
-        Noise variance (≥ 0) of the new observation, the same at every candidate or one each.
-    """
+    """``(c, d)`` posterior variance on the domain after one more observation at each candidate,
+    row ``j`` ``variance − covariance[j]² / (candidate_variance[j] + noise_var)``, from the
+    posterior now: ``variance (d,)`` on the domain, ``covariance (c, d)`` between candidates and
+    domain, ``candidate_variance (c,)``; ``noise_var`` ≥ 0, one for all or ``(c,)``."""
     var = np.asarray(variance, dtype=float)
     cov = np.asarray(covariance, dtype=float)
     var_c = np.asarray(candidate_variance, dtype=float)

@@ -239,12 +239,10 @@ def estimate_beta(rest_xs: Any, rest_ys: Any, rest_z: Any, deformed_points: Any,
 
     Parameters
     ----------
-    rest_xs : (nx,) float, rest_ys : (ny,) float, rest_z : (ny, nx) float, metres
+    rest_xs, rest_ys, rest_z : (nx,), (ny,), (ny, nx) float, metres
         The ROI's heightmap before the poke; its edges are held fixed.
     deformed_points : (m, 3) float, metres
         The observed deformed surface X̄.
-    contact : TactileContact
-    config : ShapeMatchingConfig
     height_samples : (S, m) float, metres, optional
         S ≥ 2 vertical errors of ``deformed_points``: ``beta_std`` is β̂'s spread over them.
     """

@@ -7,7 +7,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from deformap._validation import check_array, check_positive
+from deformap._validation import check_array, check_instance, check_positive
 from deformap.errors import InvalidArgumentError
 from deformap.mechanics import TactileContact
 from deformap.msm._clusters import Clusters
@@ -35,11 +35,8 @@ def check_betas(betas: Any) -> Array:
 
 
 def _check_config(config: Any) -> ShapeMatchingConfig:
-    if config is None:
-        return ShapeMatchingConfig()
-    if not isinstance(config, ShapeMatchingConfig):
-        raise InvalidArgumentError(f"`config` must be a ShapeMatchingConfig; got {type(config)}")
-    return config
+    return ShapeMatchingConfig() if config is None else check_instance(
+        "config", config, ShapeMatchingConfig)
 
 
 def _check_rest(rest: Any, k: int) -> Array:
@@ -65,9 +62,7 @@ def shape_matching_goals(rest: Any, current: Any, betas: Any,
 
 def _check_contact(contact: Any, rest: Array, fixed: NDArray[np.bool_], spacing: float) -> int:
     """The flat index of the particle nearest the (checked) contact."""
-    if not isinstance(contact, TactileContact):
-        raise InvalidArgumentError(f"`contact` must be a TactileContact; got {type(contact)}")
-    cp = contact.contact_point
+    cp = check_instance("contact", contact, TactileContact).contact_point
     lo = rest[..., :2].reshape(-1, 2).min(axis=0) - spacing
     hi = rest[..., :2].reshape(-1, 2).max(axis=0) + spacing
     if np.any(cp[:2] < lo) or np.any(cp[:2] > hi):
