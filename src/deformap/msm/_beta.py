@@ -270,5 +270,4 @@ def estimate_beta(rest_xs: Any, rest_ys: Any, rest_z: Any, deformed_points: Any,
         beta=float(betas[best]), beta_std=beta_std, betas=betas, errors=errors, iterations=its,
         residual=res, converged=conv, tolerances=tols, protocol=cfg.contact, mode=cfg.mode,
         stiffness_n_per_m=model.stiffness,
-        surface=np.array(sweep.sims[float(betas[best])].positions[0]),
-    )
+        surface=np.array(sweep.sims[float(betas[best])].positions[0]))

@@ -84,8 +84,7 @@ class Clusters:
         """RMS radius ``√(Σ w |s|²)`` of each cluster (the trace of its rest moment)."""
         return np.asarray(np.sqrt(np.maximum(np.sum(self._moment[0], axis=1), 0.0)))
 
-    def _projection(self, q: Array, cutoff: Array,
-                    eig: tuple[Array, Array] | None = None) -> Array:
+    def _projection(self, q: Array, cutoff: Array, eig: tuple[Array, Array] | None = None) -> Array:
         """``Π[i, j] = q_iᵀ A_qq⁺ q_j w_j``, dropping eigenvalues of ``A_qq`` below ``cutoff``
         (``eig``: the eigen-decomposition of ``A_qq`` if already known)."""
         wq = self.w[..., None] * q

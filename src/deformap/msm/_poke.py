@@ -224,8 +224,7 @@ def calibrate_stiffness(eq0: Equilibrium, x_fixed: Array, weights: Array, contac
     k = f_mag / delta_ref  # a first guess: one particle carrying the whole load
     x0 = None
     for _ in range(8):
-        solution = eq0.solve(x_fixed, force, k, config.coarse_tol, config.max_iter, spacing,
-                             x0=x0)
+        solution = eq0.solve(x_fixed, force, k, config.coarse_tol, config.max_iter, spacing, x0=x0)
         x = solution[0]
         depth = float(np.sum(weights.ravel() * ((x[0].reshape(-1, 3) - rest) @ contact.direction)))
         ratio = depth / delta_ref

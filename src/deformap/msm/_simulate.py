@@ -165,15 +165,16 @@ class PokeModel:
 
     def calibrated(self, tol: float) -> tuple[PokeSimulation, Array] | None:
         """The calibration's converged β = 0 solve, if ``tol`` ≥ ``coarse_tol``; else ``None``."""
-        if self._calibrated is None or tol < self.cfg.coarse_tol or self.odds:
+        solution = self._calibrated
+        if solution is None or tol < self.cfg.coarse_tol or self.odds or not solution[3].all():
             return None
-        x, it, res, conv = self._calibrated
-        if not conv.all():
-            return None
-        sim = PokeSimulation(betas=np.zeros(1), positions=x[:, 0], iterations=it, residual=res,
-                             converged=conv, protocol=self.cfg.contact,
-                             stiffness_n_per_m=self.stiffness)
-        return sim, x
+        return self._result(np.zeros(1), *solution)
+
+    def _result(self, betas: Array, x: Array, it: NDArray[np.int64], res: Array,
+                conv: NDArray[np.bool_]) -> tuple[PokeSimulation, Array]:
+        return PokeSimulation(betas=betas, positions=x[:, 0], iterations=it, residual=res,
+                              converged=conv, protocol=self.cfg.contact,
+                              stiffness_n_per_m=self.stiffness), x
 
     def solve(self, betas: Array, x0: Array | None = None, tol: float | None = None, *,
               max_split: float = 0.0) -> tuple[PokeSimulation, Array]:
@@ -203,10 +204,7 @@ class PokeModel:
             x[moving], it[moving], res[moving], conv[moving] = eq.solve(
                 self.x_fixed, self.force, k, cfg.tol if tol is None else tol, cfg.max_iter,
                 self.spacing, x0=x0)
-        sim = PokeSimulation(betas=betas, positions=x[:, 0], iterations=it, residual=res,
-                             converged=conv, protocol=cfg.contact,
-                             stiffness_n_per_m=self.stiffness)
-        return sim, x
+        return self._result(betas, x, it, res, conv)
 
 
 def _body(p0: Array, masses: Array, fixed: NDArray[np.bool_], spacing: float,
