@@ -133,8 +133,7 @@ class PosteriorDesign:
     def variance_after_adding(self, chosen: Sequence[int]) -> Array:
         """``(c, d)`` variance on the domain after the ``chosen`` candidates and one more: row
         ``j`` adds candidate ``j`` (:func:`variance_after_adding` on :meth:`posterior`)."""
-        var_d, cov, var_c = self.posterior(chosen)
-        return variance_after_adding(var_d, cov, var_c, self.new_var)
+        return variance_after_adding(*self.posterior(chosen), self.new_var)
 
 
 def apply_smoother(data_xy: Any, noise_std: Any, query_xy: Any, values: Any, *,

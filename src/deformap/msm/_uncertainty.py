@@ -40,10 +40,8 @@ def parabola_vertex(x: NDArray[np.float64], e: NDArray[np.float64]
 def _tile_sums(distances: NDArray[np.float64], tile: int) -> NDArray[np.float64]:
     """``(B, ny, nx)`` → ``(B, n_tiles)`` sums over ``tile × tile`` blocks (edge blocks smaller)."""
     n_beta, ny, nx = distances.shape
-    rows = np.arange(ny) // tile
-    cols = np.arange(nx) // tile
-    n_cols = int(cols[-1]) + 1
-    index = (rows[:, None] * n_cols + cols[None, :]).ravel()
+    rows, cols = np.arange(ny) // tile, np.arange(nx) // tile
+    index = (rows[:, None] * (int(cols[-1]) + 1) + cols[None, :]).ravel()
     n_tiles = int(index.max()) + 1
     sums = np.zeros((n_beta, n_tiles))
     for b in range(n_beta):  # n_beta rows of one bincount each: cheap, and keeps memory flat
