@@ -7,16 +7,7 @@ from typing import Literal
 
 from deformap._validation import SettingError, check_settings, setting
 
-__all__ = ["BetaScale", "ContactProtocol", "DeformationMode", "ShapeMatchingConfig", "UncertaintyMethod"]
-
-#: Müller et al.'s deformation modes of a cluster.
-DeformationMode = Literal["quadratic", "linear", "rigid"]
-#: How the poke enters the simulation (see ``ShapeMatchingConfig.contact``).
-ContactProtocol = Literal["force", "pinned"]
-#: How ``beta_std`` is obtained (see ``ShapeMatchingConfig.uncertainty``).
-UncertaintyMethod = Literal["bootstrap", "tolerance"]
-#: What β = 0 is and where the reference sits (see ``ShapeMatchingConfig.beta_scale``).
-BetaScale = Literal["odds", "reference"]
+__all__ = ["ShapeMatchingConfig"]
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -65,9 +56,9 @@ class ShapeMatchingConfig:
         Tolerance on E(β) of the ``"tolerance"`` uncertainty, of the order of the touch GP's error.
     """
 
-    mode: DeformationMode = "quadratic"
+    mode: Literal["quadratic", "linear", "rigid"] = "quadratic"
     cluster_size: int = setting(3, ge=2)
-    contact: ContactProtocol = "force"
+    contact: Literal["force", "pinned"] = "force"
     n_beta: int = setting(10, ge=2, le=1000)
     refine: bool = True
     beta_resolution: float = setting(0.01, ge=1e-6, le=0.5)
@@ -76,9 +67,9 @@ class ShapeMatchingConfig:
     max_iter: int = setting(500, ge=1, le=100_000)
     regularization: float = setting(1e-3, ge=0.0, lt=1.0)
     reference_modulus_pa: float = setting(100e3, gt=0.0)
-    beta_scale: BetaScale = "odds"
+    beta_scale: Literal["odds", "reference"] = "odds"
     poisson_ratio: float = setting(0.5, ge=-1.0, le=0.5)  # the range of an isotropic solid
-    uncertainty: UncertaintyMethod = "bootstrap"
+    uncertainty: Literal["bootstrap", "tolerance"] = "bootstrap"
     bootstrap_tile_m: float = setting(0.02, gt=0.0)
     error_tolerance_m: float = setting(1e-4, gt=0.0)
     layers: int | None = setting(None, ge=0, le=32)
