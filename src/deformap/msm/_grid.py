@@ -45,9 +45,3 @@ class ParticleGrid:
         for arr in (rest, masses, fixed):
             arr.setflags(write=False)
         return cls(rest=rest, masses=masses, fixed=fixed, spacing_m=0.5 * (dx + dy))
-
-    @property
-    def shape(self) -> tuple[int, int]:
-        """``(ny, nx)``."""
-        return (int(self.rest.shape[0]), int(self.rest.shape[1]))
-

@@ -49,14 +49,13 @@ _MAX_WAIT_LOG2 = 6  # after n rejected Anderson steps, 2^min(n, 6) − 1 plain s
 class PokeSimulation:
     """Equilibria of one poke for ``betas (B,)``: surface ``positions (B, ny, nx, 3)`` metres, each
     β's ``iterations``, ``residual`` (last relative update) and ``converged`` flag
-    (:meth:`Equilibrium.solve`), the ``protocol`` and the calibrated spring ``stiffness_n_per_m``."""
+    (:meth:`Equilibrium.solve`), and the calibrated spring ``stiffness_n_per_m``."""
 
     betas: Array
     positions: Array
     iterations: NDArray[np.int64]
     residual: Array
     converged: NDArray[np.bool_]
-    protocol: str
     stiffness_n_per_m: float | None = None
 
 

@@ -173,8 +173,7 @@ class PokeModel:
     def _result(self, betas: Array, x: Array, it: NDArray[np.int64], res: Array,
                 conv: NDArray[np.bool_]) -> tuple[PokeSimulation, Array]:
         return PokeSimulation(betas=betas, positions=x[:, 0], iterations=it, residual=res,
-                              converged=conv, protocol=self.cfg.contact,
-                              stiffness_n_per_m=self.stiffness), x
+                              converged=conv, stiffness_n_per_m=self.stiffness), x
 
     def solve(self, betas: Array, x0: Array | None = None, tol: float | None = None, *,
               max_split: float = 0.0) -> tuple[PokeSimulation, Array]:
