@@ -212,8 +212,7 @@ def _spread_cells(system: Array, gram: Array, h_nodes: Array) -> None:
     # half[c, r', b', a, b] = Σ_r E_c[r', b', r, b] H_c[r, a]
     half = np.matmul(
         h_nodes.transpose(0, 2, 1)[:, None], gram.reshape(cells, degree * rb, degree, rb))
-    # B[(a', b'), (a, b)] += Σ_{c, r'} H_c[r', a'] half[c, r', b', a, b]: one GEMM, written as
-    # Bᵀ += halfᵀ H on the Fortran-ordered transpose so that it accumulates in place.
+    # B[(a', b'), (a, b)] += Σ_{c, r'} H_c[r', a'] half[c, r', b', a, b] as Bᵀ += halfᵀ H, in place
     target = system.reshape(ra, rb * ra * rb).T
     out = blas.dgemm(1.0, half.reshape(cells * degree, rb * ra * rb).T,
                      np.asfortranarray(h_nodes.reshape(cells * degree, ra)), beta=1.0, c=target,
@@ -251,9 +250,8 @@ def predict_on_grid(state: GridState, xs: Array, ys: Array, *, signal_std: float
     std = None
     if return_std:
         ra, rb = state.axis_a.rank, state.axis_b.rank
-        # T[q, (a, a')] = Σ_{b, b'} h_b[q, b] h_b[q, b'] B⁻¹[a, b, a', b'] for a ≥ a': one GEMM
-        # with inner dimension rb², then var[p, q] = Σ_{a, a'} h_a[p, a] h_a[p, a'] T[q, (a, a')],
-        # the pairs a > a' counted twice.
+        # T[q, (a, a')] = Σ_{b, b'} h_b[q, b] h_b[q, b'] B⁻¹[a, b, a', b'] for a ≥ a', then
+        # var[p, q] = Σ_{a, a'} h_a[p, a] h_a[p, a'] T[q, (a, a')], pairs a > a' counted twice
         rows, cols = np.tril_indices(ra)
         pairs_a = ha[:, rows] * ha[:, cols] * np.where(rows == cols, 1.0, 2.0)
         pairs_b = (hb[:, :, None] * hb[:, None, :]).reshape(hb.shape[0], rb * rb)

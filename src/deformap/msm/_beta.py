@@ -23,8 +23,7 @@ __all__ = ["BetaEstimate", "estimate_beta", "matching_error"]
 logger = logging.getLogger(__name__)
 Array = NDArray[np.float64]
 
-# largest contraction bound (β − β′) / (1 − β′) at which a β steps with a smaller β′'s
-# factorisation: a few iterations more save a factorisation
+# largest contraction (β − β′) / (1 − β′) at which β steps with β′'s factorisation (saves one)
 _MAX_SPLIT = 0.3
 _KEEP_FACTORS = 3  # banded factorisations a β search keeps (:attr:`StepMatrices.max_factors`)
 _TIE_M = 1e-9  # E values within a nanometre are ties (round-off): β̂ is the most rigid of them

@@ -62,8 +62,7 @@ class StepMatrices:
         self._perm = _band_order(fixed)
         self._unperm = np.argsort(self._perm)
         self._band_scale = self._scale[self._perm]
-        # S₀ = diag(m M) − diag(m) Σ_c W_c and S₁ = diag(m) Σ_c Π_c on the free particles, in
-        # band order; only the upper triangle is kept (they are symmetric)
+        # upper triangles of S₀ = diag(m M) − diag(m) Σ_c W_c and S₁ = diag(m) Σ_c Π_c, band order
         band_pos = np.full(n, -1, dtype=np.int64)
         band_pos[self.free[self._perm]] = np.arange(nf)
         ff = ~is_fixed[i] & ~is_fixed[j]

@@ -86,8 +86,7 @@ class RecordFit:
 
     def solve(self) -> float:
         f_max = float(self.force.max())
-        # the softest modulus keeps the largest force inside the table; the stiffest sinks the
-        # tip by a thousandth of the travel noise
+        # softest: the largest force inside the table; stiffest: a thousandth of the travel noise
         low = np.log(f_max / self.table.force_limit)
         high = np.log(f_max / float(layer_indentation_force(
             1e-3 * self.config.travel_noise_m, self.table.radius, self.table.thickness, 1.0,
