@@ -1,10 +1,8 @@
-"""Gaussian random fields: the paper's kernel, exact and grid-sparse GP regression,
-hyperparameter fitting by maximum marginal likelihood, and the posterior algebra that needs no
-observed values (the variance of a design of observations, the mean's linear smoother).
+"""Gaussian random fields: the paper's kernel, exact and grid-sparse GP regression, hyperparameters
+by maximum marginal likelihood, and the posterior algebra that needs no observed values.
 
-Shared parameters, in metres (or the units of the modelled value): ``length_scale`` σ_w and
-``signal_std`` σₑ of the kernel k = σₑ² exp(−‖xᵢ − xⱼ‖² / σ_w²) (no factor 2), and ``noise_std``
-σₙ of the observations.
+Shared parameters: ``length_scale`` σ_w (metres) and ``signal_std`` σₑ of the kernel
+k = σₑ² exp(−‖xᵢ − xⱼ‖² / σ_w²) (no factor 2), and ``noise_std`` σₙ (units of the value).
 """
 
 from __future__ import annotations

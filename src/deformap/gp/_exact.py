@@ -1,7 +1,5 @@
-"""Exact Gaussian-process regression by Cholesky factorisation (RW2006 Alg. 2.1).
-
-Everything here works on the unit-variance kernel K̂ = K / σₑ², so that the jitter is relative to
-the signal variance and means the same at any height scale.
+"""Exact Gaussian-process regression by Cholesky factorisation (RW2006 Alg. 2.1), on the
+unit-variance kernel K̂ = K / σₑ² so that the jitter is relative to the signal variance.
 """
 
 from __future__ import annotations
@@ -27,11 +25,8 @@ _CHUNK = 2048  # test points per block: bounds the (n, chunk) cross-covariance i
 
 def cholesky_with_jitter(matrix: Array, *, jitter: float, max_jitter: float, what: str
                          ) -> tuple[Factor, float]:  # fmt: skip
-    """Lower Cholesky factor (``cho_factor``'s) of ``matrix + j·I`` and the ``j`` it needed.
-
-    ``j`` goes ×10 from ``jitter`` to ``max_jitter``, relative to σₑ² (``matrix`` is scaled to a
-    unit prior diagonal); beyond it :class:`NotPositiveDefiniteError` says what to change.
-    """
+    """``cho_factor``'s lower factor of ``matrix + j·I`` and ``j``, ×10 from ``jitter`` to
+    ``max_jitter`` (relative to σₑ²); beyond it :class:`NotPositiveDefiniteError`."""
     diag = np.arange(matrix.shape[0])
     base = matrix[diag, diag].copy()
     j = jitter

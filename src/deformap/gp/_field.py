@@ -27,12 +27,10 @@ Array = NDArray[np.float64]
 
 _LOG = logging.getLogger(__name__)
 
-#: ``method="auto"`` uses the exact GP up to this many points and the grid GP above: the grid's
-#: cost follows the extent over σ_w while the exact fit grows as n³.
+#: ``method="auto"``'s largest exact fit: the exact cost grows as n³, the grid's with extent / σ_w.
 AUTO_EXACT_MAX_POINTS = 1000
 _METHODS = ("auto", "exact", "grid")
-#: Range of every hyperparameter and per-point noise, so that the covariance neither overflows nor
-#: turns singular in double precision.
+#: Range of every hyperparameter and noise: the covariance neither overflows nor turns singular.
 HYPERPARAMETER_RANGE = (1e-12, 1e12)
 
 
@@ -47,10 +45,9 @@ def _hyperparameter(name: str, value: Any) -> float:
 class GaussianRandomField:
     """GP regression of a scalar field z(x, y) with the paper's squared-exponential kernel.
 
-    The prior is f ~ GP(m, k) with k(p, p') = σₑ² exp(−‖p − p'‖² / σ_w²) and a constant mean m, the
-    data mean (inverse-noise-variance weighted), subtracted before the fit and added back to every
-    prediction. Observations are z = f + ε, ε ~ N(0, σₙ²) (or per-point σₙ,ᵢ²). The estimator
-    follows scikit-learn's API (``get_params``, ``set_params``, ``clone``).
+    f ~ GP(m, k) with a constant mean m, the inverse-noise-variance weighted data mean, subtracted
+    before the fit and added back to every prediction; z = f + ε, ε ~ N(0, σₙ²) (or per point).
+    scikit-learn's estimator API (``get_params``, ``set_params``, ``clone``).
 
     Parameters
     ----------
@@ -58,18 +55,15 @@ class GaussianRandomField:
         σ_w in metres (√2 × scikit-learn's RBF ℓ); σₑ and σₙ in units of z (σₙ where ``fit`` gets
         no per-point noise).
     method : {"auto", "exact", "grid"}
-        ``"exact"``: Cholesky of the n×n covariance, O(n³). ``"grid"``: DTC/SGPR with inducing
-        points on a regular grid in Kronecker form (:mod:`deformap.gp._grid`), near-exact for the
-        SE kernel at the default spacing. ``"auto"``: exact up to ``AUTO_EXACT_MAX_POINTS`` points.
+        ``"exact"``: Cholesky, O(n³); ``"grid"``: DTC/SGPR on a regular inducing grid
+        (:mod:`deformap.gp._grid`); ``"auto"``: exact up to ``AUTO_EXACT_MAX_POINTS`` points.
     inducing_spacing : float, metres, optional
         Grid method's node spacing; default σ_w / 3.
     jitter, max_jitter : float
-        Diagonal jitter relative to σₑ², escalated ×10 from ``jitter`` to ``max_jitter`` until the
-        Cholesky factorisation succeeds; beyond it :class:`NotPositiveDefiniteError` is raised.
+        Diagonal jitter relative to σₑ² (:func:`cholesky_with_jitter`).
 
-    A fit sets ``xy_`` (the inputs), ``mean_`` (the constant mean), ``method_`` (what ``auto``
-    resolved to), ``jitter_used_``, ``n_inducing_`` (0 for exact) and ``log_marginal_likelihood_``
-    (RW2006 Eq. 2.30; None for the grid).
+    A fit sets ``xy_``, ``mean_``, ``method_`` (what ``auto`` resolved to), ``jitter_used_``,
+    ``n_inducing_`` (0 for exact) and ``log_marginal_likelihood_`` (RW2006 Eq. 2.30; None for grid).
 
     References
     ----------
@@ -125,10 +119,8 @@ class GaussianRandomField:
                 f"method={self.method!r})")
 
     def fit(self, xy: Any, z: Any, noise_std: Any = None) -> GaussianRandomField:
-        """Condition the field on ``z (n,)`` observed at ``xy (n, 2)`` metres; returns ``self``.
-
-        ``noise_std``: a float or ``(n,)`` per-point observation noise; default the constructor's.
-        """
+        """Condition on ``z (n,)`` at ``xy (n, 2)`` metres with ``noise_std`` (float or ``(n,)``;
+        default the constructor's); returns ``self``."""
         pts, vals = _check_data(xy, z, min_rows=1)
         noise_var = self._noise(noise_std, pts.shape[0]) ** 2
         weights = 1.0 / noise_var

@@ -14,9 +14,8 @@ h(p) = h_a(p_a) ⊗ h_b(p_b) with h = Qᵀ L⁻¹ k, B = I + σₑ² Hᵀ Λ⁻�
     mean(p) = h(p)ᵀ B⁻¹ σₑ² Hᵀ Λ⁻¹ (z − z̄)
     var(p)  = σₑ² (1 − ‖h(p)‖² + h(p)ᵀ B⁻¹ h(p)).
 
-With the grid finer than the kernel's resolution the Nyström residual 1 − ‖g‖² is at round-off and
-DTC equals the exact GP. Axis ``a`` has more inducing nodes; the flattened feature index is
-``ia * rb + ib``.
+On a grid finer than the kernel's resolution the Nyström residual 1 − ‖g‖² is at round-off and
+DTC equals the exact GP. Axis ``a`` has more nodes; the flat feature index is ``ia * rb + ib``.
 """
 
 from __future__ import annotations
@@ -53,13 +52,12 @@ _LOG = logging.getLogger(__name__)
 #: Default inducing spacing = σ_w × this: the SE spectrum exp(−σ_w²ω²/4) at the grid's Nyquist
 #: frequency π/h is exp(−π²·9/4) ≈ 2e-10, so the grid loses nothing a float64 Cholesky would keep.
 GRID_SPACING_FRACTION = 1.0 / 3.0
-#: Inducing nodes extend this many σ_w beyond the data's bounding box, which keeps the Nyström
-#: residual at the box's edge near round-off.
+#: Inducing nodes extend this many σ_w beyond the data's box: the edge's Nyström residual stays low.
 GRID_MARGIN_FRACTION = 1.0
 #: Largest number of grid nodes accepted (B is at most this size, 8·M² bytes = 1.2 GB).
 MAX_INDUCING = 12_000
-#: BLAS threads while the grid path runs (None: leave the process's setting; needs threadpoolctl),
-#: because its many mid-sized BLAS calls each wait for all their threads.
+#: BLAS threads on the grid path (None: unchanged; needs threadpoolctl): its many mid-sized BLAS
+#: calls each wait for all their threads.
 GRID_BLAS_THREADS: int | None = 1
 _BLOCK_BYTES = 32 * 2**20  # bound on the intermediate of one block of cells in the data term
 _CELL_WIDTHS = tuple(k / 6.0 for k in range(1, 13))  # candidates (× σ_w) for _cell_layout
@@ -150,12 +148,8 @@ def fit_grid(xy: Array, resid: Array, noise_var: Array, *, length_scale: float, 
 
 
 def _cell_layout(span: float, n: int, ra: int, rb: int, length_scale: float) -> tuple[int, int]:
-    """``(cells, nodes per cell)`` that minimise the data term's flops over ``_CELL_WIDTHS``.
-
-    Per-cell Gram matrices cost 2n (R·rb)² and spreading them onto B costs 2 (ra·rb)² R per cell;
-    R follows from :func:`chebyshev_degree` at half the tolerance (the data covariance moves by
-    twice the feature error).
-    """
+    """``(cells, nodes per cell R)`` of least flops, 2n (R·rb)² + 2 (ra·rb)² R per cell, over
+    ``_CELL_WIDTHS``; R at half the tolerance (the covariance moves by twice the feature error)."""
     best: tuple[float, int, int] | None = None
     for width in _CELL_WIDTHS:
         cells = max(1, math.ceil(span / (width * length_scale) - 1e-9))
@@ -171,10 +165,9 @@ def _data_terms(coord_a: Array, hb: Array, weight: Array, weighted_resid: Array,
                 basis_a: AxisBasis) -> tuple[Array, Array]:
     """σe² Hᵀ Λ⁻¹ H (M, M) and σe² Hᵀ Λ⁻¹ r (ra, rb) for points at ``coord_a`` (n,) with ``hb``.
 
-    Along axis ``a`` the points are binned into cells; within a cell h_a(t) = Σ_r ℓ_r(t) h_a(ξ_r)
-    over the cell's Chebyshev nodes ξ, so the cell's share of the matrix is
-    (H_c ⊗ I) E_c (H_c ⊗ I)ᵀ with E_c = Σᵢ wᵢ (ℓᵢ ℓᵢᵀ) ⊗ (h_b,ᵢ h_b,ᵢᵀ), the Gram matrix of
-    (R·rb)-long rows, and the n per-point outer products of length M never appear.
+    Points are binned into cells along ``a``; within a cell h_a(t) = Σ_r ℓ_r(t) h_a(ξ_r) over its
+    Chebyshev nodes ξ, so its share is (H_c ⊗ I) E_c (H_c ⊗ I)ᵀ, E_c = Σᵢ wᵢ (ℓᵢ ℓᵢᵀ) ⊗ (h_b,ᵢ
+    h_b,ᵢᵀ), and no per-point outer product of length M is formed.
     """
     n, rb = hb.shape
     ra = basis_a.rank
@@ -219,8 +212,7 @@ def _spread_cells(system: Array, gram: Array, h_nodes: Array) -> None:
     # half[c, r', b', a, b] = Σ_r E_c[r', b', r, b] H_c[r, a]
     half = np.matmul(
         h_nodes.transpose(0, 2, 1)[:, None], gram.reshape(cells, degree * rb, degree, rb))
-    # B[(a', b'), (a, b)] += Σ_{c, r'} H_c[r', a'] half[c, r', b', a, b]: one GEMM, written as
-    # Bᵀ += halfᵀ H on the Fortran-ordered transpose so that it accumulates in place.
+    # B[(a', b'), (a, b)] += Σ_{c, r'} H_c[r', a'] half[c, r', b', a, b] as Bᵀ += halfᵀ H, in place
     target = system.reshape(ra, rb * ra * rb).T
     out = blas.dgemm(1.0, half.reshape(cells * degree, rb * ra * rb).T,
                      np.asfortranarray(h_nodes.reshape(cells * degree, ra)), beta=1.0, c=target,
@@ -258,9 +250,8 @@ def predict_on_grid(state: GridState, xs: Array, ys: Array, *, signal_std: float
     std = None
     if return_std:
         ra, rb = state.axis_a.rank, state.axis_b.rank
-        # T[q, (a, a')] = Σ_{b, b'} h_b[q, b] h_b[q, b'] B⁻¹[a, b, a', b'] for a ≥ a': one GEMM
-        # with inner dimension rb², then var[p, q] = Σ_{a, a'} h_a[p, a] h_a[p, a'] T[q, (a, a')],
-        # the pairs a > a' counted twice.
+        # T[q, (a, a')] = Σ_{b, b'} h_b[q, b] h_b[q, b'] B⁻¹[a, b, a', b'] for a ≥ a', then
+        # var[p, q] = Σ_{a, a'} h_a[p, a] h_a[p, a'] T[q, (a, a')], pairs a > a' counted twice
         rows, cols = np.tril_indices(ra)
         pairs_a = ha[:, rows] * ha[:, cols] * np.where(rows == cols, 1.0, 2.0)
         pairs_b = (hb[:, :, None] * hb[:, None, :]).reshape(hb.shape[0], rb * rb)

@@ -1,12 +1,10 @@
 """One-dimensional feature maps of the grid GP: whitening, compression and Chebyshev interpolation.
 
-Along one axis with inducing nodes ``u`` (m,) and K = k₁(u, u) = L Lᵀ, the whitened features of t
-are g(t) = L⁻¹ k₁(u, t) with prior N(0, I), so any orthonormal Q (m, r) gives features
-h(t) = Qᵀ g(t) with prior N(0, I) too, and DTC with them is exact up to ‖g(tᵢ)‖² − ‖h(tᵢ)‖². Q is
-taken from the eigenvectors of Σᵢ g(tᵢ) g(tᵢ)ᵀ, keeping the fewest that leave every data point a
-residual below ``FEATURE_TOLERANCE``. Along the longer axis the data's features are interpolated
-within short cells from R Chebyshev nodes (:func:`chebyshev_degree`), so that the n per-point outer
-products become products of size R.
+With nodes ``u`` (m,) and k₁(u, u) = L Lᵀ, the whitened features g(t) = L⁻¹ k₁(u, t) have prior
+N(0, I), and so do h(t) = Qᵀ g(t) for any orthonormal Q (m, r); DTC with h is exact up to
+‖g(tᵢ)‖² − ‖h(tᵢ)‖². Q holds the fewest leading eigenvectors of Σᵢ g(tᵢ) g(tᵢ)ᵀ that leave every
+point a residual below ``FEATURE_TOLERANCE``. Along the longer axis the features are interpolated
+within short cells from R Chebyshev nodes (:func:`chebyshev_degree`).
 
 References
 ----------
@@ -31,9 +29,8 @@ __all__: list[str] = []
 
 Array = NDArray[np.float64]
 
-#: Largest prior variance (fraction of σₑ²) the compressed features may miss at a data point, and
-#: twice the largest interpolation error of its features: the order of the grid's own Nyström
-#: residual at its edge.
+#: Largest prior variance (fraction of σₑ²) the features may miss at a point, and twice their
+#: interpolation error: the order of the grid's own Nyström residual at its edge.
 FEATURE_TOLERANCE = 1e-8
 _SAMPLES_PER_LENGTH = 24
 
@@ -65,18 +62,13 @@ class AxisBasis:
 def axis_basis(lo: float, hi: float, nodes: Array, *, length_scale: float, jitter: float,
                max_jitter: float, what: str) -> tuple[AxisBasis, float]:  # fmt: skip
     """The basis of ``nodes`` compressed to the modes of the data range [lo, hi], and the relative
-    jitter its Cholesky needed.
-
-    The residual ‖g(t)‖² − ‖h(t)‖² is checked at ``_SAMPLES_PER_LENGTH`` samples per σ_w over the
-    range (≥ 3 per node at the default spacing), enough for its variation on the node spacing.
-    """
+    jitter its Cholesky needed; residuals checked at ``_SAMPLES_PER_LENGTH`` samples per σ_w."""
     chol, jit = cholesky_with_jitter(
         _se_1d(nodes, nodes, length_scale), jitter=jitter, max_jitter=max_jitter, what=what)
     count = max(2, math.ceil((hi - lo) / length_scale * _SAMPLES_PER_LENGTH) + 1)
     samples = np.linspace(lo, hi, count)
-    white = sla.solve_triangular(
-        chol[0], _se_1d(samples, nodes, length_scale).T, lower=True, check_finite=False
-    ).T
+    white = sla.solve_triangular(chol[0], _se_1d(samples, nodes, length_scale).T, lower=True,
+                                 check_finite=False).T
     _, vecs = np.linalg.eigh(white.T @ white)
     vecs = vecs[:, ::-1]
     coeff = white @ vecs  # in a complete orthonormal basis the residuals are sums of squares
@@ -88,21 +80,14 @@ def axis_basis(lo: float, hi: float, nodes: Array, *, length_scale: float, jitte
 
 
 def chebyshev_degree(half_width: float, length_scale: float, tolerance: float) -> int:
-    """Fewest Chebyshev nodes R that interpolate h on a cell of half-width δ within ``tolerance``.
-
-    For nodes at the roots of T_R on [c − δ, c + δ], ‖h(t) − p(t)‖ ≤ 2 (δ/2)^R / R! · max ‖h⁽ᴿ⁾‖
-    (the Hermite–Genocchi form holds for vector-valued h), and ‖h⁽ᴿ⁾(t)‖² is a Nyström
-    approximation of the kernel's R-th derivative variance, so it is at most
-    ∂ᴿ∂'ᴿ k₁(t, t) = (2R)! / (R! σ_w^{2R}).
-    """
+    """Fewest Chebyshev nodes R that interpolate h on a cell of half-width δ within ``tolerance``:
+    ‖h − p‖ ≤ 2 (δ/2)^R / R! · max ‖h⁽ᴿ⁾‖ (Hermite–Genocchi), ‖h⁽ᴿ⁾‖² ≤ (2R)! / (R! σ_w^{2R})."""
     if half_width <= 0.0:
         return 1
     for nodes in range(1, 64):
-        log_bound = (
-            math.log(2.0)
-            + nodes * math.log(half_width / (2.0 * length_scale))
-            - math.lgamma(nodes + 1)
-            + 0.5 * (math.lgamma(2 * nodes + 1) - math.lgamma(nodes + 1)))
+        log_bound = (math.log(2.0) + nodes * math.log(half_width / (2.0 * length_scale))
+                     - math.lgamma(nodes + 1)
+                     + 0.5 * (math.lgamma(2 * nodes + 1) - math.lgamma(nodes + 1)))
         if log_bound <= math.log(tolerance):
             return nodes
     raise AssertionError("unreachable: the bound falls below any tolerance for δ < σ_w")
@@ -114,11 +99,8 @@ def chebyshev_points(count: int) -> Array:
 
 
 def lagrange_weights(t: Array, points: Array) -> Array:
-    """``(n, R)`` Lagrange basis polynomials of ``points`` (R,) at ``t`` (n,), both in [−1, 1].
-
-    The product form (prefix and suffix products of t − ξ_k), not the barycentric one, so that ``t``
-    may coincide with a node.
-    """
+    """``(n, R)`` Lagrange basis polynomials of ``points`` (R,) at ``t`` (n,), both in [−1, 1], in
+    product form (not barycentric), so that ``t`` may coincide with a node."""
     count = points.size
     diff = t[:, None] - points[None, :]
     left = np.ones((t.size, count))

@@ -31,8 +31,7 @@ _NAMES = ("length_scale", "signal_std", "noise_std")
 
 @dataclass(frozen=True)
 class GPHyperparameters:
-    """Kernel hyperparameters σ_w (metres), σₑ and σₙ (units of z), and the log marginal
-    likelihood log p(z | θ) they reach on the points they were fitted on (nan if not evaluated)."""
+    """σ_w (metres), σₑ and σₙ (units of z), and log p(z | θ) on the fitted points (nan if none)."""
 
     length_scale: float
     signal_std: float
@@ -83,12 +82,9 @@ def _diagonal_and_spread(xy: Any, z: Any) -> tuple[float, float]:
 
 
 def default_bounds(xy: Any, z: Any) -> Array:
-    """``(3, 2)`` bounds (low, high) on (σ_w, σₑ, σₙ), scaled by the data ``xy (n, 2)``, ``z (n,)``.
-
-    σ_w from 1/1000 to 2× the bounding-box diagonal D (shorter is unresolvable noise, longer a
-    plane); σₑ from 1/100 to 100× the data's std s; σₙ from 1e-4 s (a near-interpolant that a
-    Cholesky still factorises) to 10 s.
-    """
+    """``(3, 2)`` bounds (low, high) on (σ_w, σₑ, σₙ) for ``xy (n, 2)``, ``z (n,)``: σ_w in D/1000
+    to 2D, D the box diagonal (shorter is noise, longer a plane); σₑ in s/100 to 100s, s the std
+    of z; σₙ in 1e-4 s (a near-interpolant a Cholesky still factorises) to 10 s."""
     diag, spread = _diagonal_and_spread(np.asarray(xy, dtype=float), np.asarray(z, dtype=float))
     return np.array(
         [[1e-3 * diag, 2.0 * diag], [1e-2 * spread, 1e2 * spread], [1e-4 * spread, 1e1 * spread]])
@@ -97,18 +93,16 @@ def default_bounds(xy: Any, z: Any) -> Array:
 def fit_hyperparameters(xy: Any, z: Any, *, rng: np.random.Generator,
                         init: GPHyperparameters | None = None, n_restarts: int = 3,
                         max_points: int = 2000, bounds: Any = None) -> GPHyperparameters:  # fmt: skip
-    """The (σ_w, σₑ, σₙ) of largest log marginal likelihood of ``z (n,)`` at ``xy (n, 2)``, with
-    that likelihood on the points used.
+    """The (σ_w, σₑ, σₙ) of largest log marginal likelihood of ``z (n,)`` at ``xy (n, 2)``, and it.
 
     Parameters
     ----------
     rng : numpy.random.Generator
         Draws the subset and the restart points (same seed, same result).
     init : GPHyperparameters, optional
-        First start; default (D/10, s, s/10), D the bounding-box diagonal, s the data's std.
+        First start; default (D/10, s, s/10) in the terms of :func:`default_bounds`.
     n_restarts : int
-        Further starts drawn log-uniformly within ``bounds`` ((3, 2) low and high of σ_w, σₑ,
-        σₙ; default :func:`default_bounds`).
+        Further starts, log-uniform within ``bounds`` ((3, 2); default :func:`default_bounds`).
     max_points : int
         At most this many points (a random subset) enter the O(n³) objective.
     """

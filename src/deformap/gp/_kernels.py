@@ -1,9 +1,8 @@
 """The paper's squared-exponential kernel and the regular-grid helper.
 
-k(xᵢ, xⱼ) = σₑ² exp(−‖xᵢ − xⱼ‖² / σ_w²) (Caccamo et al. 2016), with *no* factor 2 in the
-denominator: σ_w is √2 times the ℓ of scikit-learn's ``RBF`` (RW2006 Eq. 2.31). The kernel is
-separable, k = σₑ² k₁(x, x') k₁(y, y') with k₁(a, b) = exp(−(a − b)² / σ_w²): the grid method
-(``_grid.py``) relies on that.
+k(xᵢ, xⱼ) = σₑ² exp(−‖xᵢ − xⱼ‖² / σ_w²) (Caccamo et al. 2016), no factor 2: σ_w is √2 × the ℓ of
+scikit-learn's ``RBF`` (RW2006 Eq. 2.31). It is separable, σₑ² k₁(x, x') k₁(y, y') with
+k₁(a, b) = exp(−(a − b)² / σ_w²), which the grid method relies on.
 """
 
 from __future__ import annotations
@@ -33,8 +32,7 @@ def _check_data(xy: Any, z: Any, *, min_rows: int) -> tuple[Array, Array]:
 
 def _sqdist(x1: Array, x2: Array) -> Array:
     """``(n, m)`` squared distances between ``(n, d)`` and ``(m, d)`` arrays."""
-    # Differences, not the expanded quadratic form: at 1e-10 relative accuracy the expansion
-    # cancels badly for coordinates far from the origin (0.6 m apart, σ_w a few cm).
+    # differences, not the expanded quadratic form, which cancels far from the origin
     d2 = (x1[:, 0, None] - x2[None, :, 0]) ** 2
     for axis in range(1, x1.shape[1]):
         d2 += (x1[:, axis, None] - x2[None, :, axis]) ** 2
@@ -52,10 +50,7 @@ def _se_1d(a: Array, b: Array, length_scale: float) -> Array:
 
 
 def squared_exponential(x1: Any, x2: Any, *, length_scale: float, signal_std: float) -> Array:
-    """The kernel matrix ``(n, m)`` between ``x1`` ``(n, 2)`` and ``x2`` ``(m, 2)`` (metres).
-
-    ``length_scale`` σ_w in metres, ``signal_std`` σₑ in the field's units.
-    """
+    """The kernel matrix ``(n, m)`` between ``x1 (n, 2)`` and ``x2 (m, 2)`` metres."""
     a = check_array("x1", x1, (None, 2), what="coordinates in metres")
     b = check_array("x2", x2, (None, 2), what="coordinates in metres")
     w = check_positive("length_scale", length_scale)
@@ -64,9 +59,8 @@ def squared_exponential(x1: Any, x2: Any, *, length_scale: float, signal_std: fl
 
 
 def grid_points(xs: Any, ys: Any) -> Array:
-    """``(ny*nx, 2)`` points of the grid ``xs (nx,) × ys (ny,)``: point ``iy * nx + ix`` is
-    ``(xs[ix], ys[iy])``, so ``values.reshape(ny, nx)`` is an image whose rows run along y, as
-    ``predict_grid`` returns it."""
+    """``(ny*nx, 2)`` points of the grid ``xs (nx,) × ys (ny,)``, point ``iy * nx + ix`` at
+    ``(xs[ix], ys[iy])``: ``values.reshape(ny, nx)`` is ``predict_grid``'s image."""
     x = check_array("xs", xs, (None,), what="x coordinates in metres", min_rows=1)
     y = check_array("ys", ys, (None,), what="y coordinates in metres", min_rows=1)
     gx, gy = np.meshgrid(x, y)

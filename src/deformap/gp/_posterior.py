@@ -1,14 +1,11 @@
 """Posterior algebra that needs no observed values: variance of a design, and the linear smoother.
 
-A GP's posterior covariance depends on where the observations are and on their noise, never on
-the values observed (RW2006 Eq. 2.24 and 2.26), so it can be computed for observations not yet
-made: :class:`PosteriorDesign` gives the posterior over a domain for the observations made plus
-any subset of candidate places, and :func:`variance_after_adding` the variance after one more
-observation at each candidate (an exact rank-one update,
-``σ²ₐ(x) = σ²(x) − cov(c, x)² / (σ²(c) + σₙ²)``). The posterior mean is linear in the data,
-``m = K*ₓ (K + Σ)⁻¹ y`` (RW2006 §2.6): :func:`apply_smoother` applies that map to any vectors
-``y`` (draws of noise, for instance) without forming it. Places are ``(n, 2)`` metres throughout;
-``length_scale`` and ``signal_std`` are the kernel's σ_w and σₑ (:func:`squared_exponential`).
+The posterior covariance depends on where the observations are and on their noise, not on their
+values (RW2006 Eq. 2.24, 2.26): :class:`PosteriorDesign` conditions on the observations made plus
+any subset of candidates, and :func:`variance_after_adding` adds one more at each candidate by the
+exact rank-one update ``σ²ₐ(x) = σ²(x) − cov(c, x)² / (σ²(c) + σₙ²)``. The mean is linear in the
+data, ``m = K*ₓ (K + Σ)⁻¹ y`` (RW2006 §2.6): :func:`apply_smoother` applies that map to any ``y``
+without forming it. Places are ``(n, 2)`` metres; ``length_scale`` σ_w, ``signal_std`` σₑ.
 
 References
 ----------
@@ -36,8 +33,7 @@ Array = NDArray[np.float64]
 
 
 def _per_candidate(name: str, value: Any, shape: tuple[int, ...], *, allow_zero: bool) -> Array:
-    """``value``, a number or an array of ``shape``, as one finite number > 0 (or ≥ 0) per
-    candidate."""
+    """``value``, a number or an array of ``shape``, as one finite number > 0 (≥ 0) per candidate."""
     size = int(np.prod(shape))
     message = (f"`{name}` must be a number {'>=' if allow_zero else '>'} 0 or ({size},) of them; "
                f"got {value!r}")
@@ -55,17 +51,10 @@ def _per_candidate(name: str, value: Any, shape: tuple[int, ...], *, allow_zero:
 
 def variance_after_adding(variance: Any, covariance: Any, candidate_variance: Any,
                           noise_var: float | Array) -> Array:
-    """``(c, d)`` posterior variance on a domain after one more observation at each candidate:
-    row ``j`` is ``variance − covariance[j]² / (candidate_variance[j] + noise_var)``.
-
-    Parameters
-    ----------
-    variance, covariance, candidate_variance : (d,), (c, d), (c,) float
-        The posterior now: variance on the domain, covariance between each candidate and the
-        domain, variance at each candidate.
-    noise_var : float or (c,) float
-        Noise variance (≥ 0) of the new observation, the same at every candidate or one each.
-    """
+    """``(c, d)`` posterior variance on the domain after one more observation at each candidate,
+    row ``j`` ``variance − covariance[j]² / (candidate_variance[j] + noise_var)``, from the
+    posterior now: ``variance (d,)`` on the domain, ``covariance (c, d)`` between candidates and
+    domain, ``candidate_variance (c,)``; ``noise_var`` ≥ 0, one for all or ``(c,)``."""
     var = np.asarray(variance, dtype=float)
     cov = np.asarray(covariance, dtype=float)
     var_c = np.asarray(candidate_variance, dtype=float)
@@ -78,11 +67,8 @@ def variance_after_adding(variance: Any, covariance: Any, candidate_variance: An
 
 
 class PosteriorDesign:
-    """A GP's posterior over a domain given noisy observations made and chosen candidates.
-
-    The kernel matrices between the observations made, the candidates and the domain are
-    computed once; :meth:`posterior` then conditions on the observations made plus any subset of
-    candidates, and :meth:`variance_after_adding` adds one candidate more to it, each in turn.
+    """A GP's posterior over a domain given noisy observations made and chosen candidates (the
+    kernel matrices between observations, candidates and domain are computed once).
 
     Parameters
     ----------
@@ -91,8 +77,7 @@ class PosteriorDesign:
     candidates, domain : (c, 2), (d, 2) float
         Places where an observation may be added; where the posterior is wanted.
     candidate_noise_std : float or (c,) float
-        The noise standard deviation (> 0) of an observation at a candidate, the same at every
-        candidate or one each.
+        Noise standard deviation (> 0) of an observation at each candidate, or one for all.
     """
 
     def __init__(self, observed_xy: Any, observed_noise_std: Any, candidates: Any, domain: Any,
@@ -131,8 +116,7 @@ class PosteriorDesign:
         if k_ss.size == 0:
             return (np.full(self.k_cd.shape[1], self.prior), self.k_cd.copy(),
                     np.full(self.k_cd.shape[0], self.prior))
-        # RW2006 Eq. 2.24 through the Cholesky factor of the covariance scaled to unit prior
-        # variance (the jitter is relative to σe²)
+        # RW2006 Eq. 2.24 on the covariance scaled to unit prior variance (jitter relative to σe²)
         (chol, lower), _ = cholesky_with_jitter((k_ss + np.diag(noise)) / self.prior,
                                                 jitter=1e-12, max_jitter=1e-6,
                                                 what="the covariance of the observations")
@@ -149,18 +133,15 @@ class PosteriorDesign:
     def variance_after_adding(self, chosen: Sequence[int]) -> Array:
         """``(c, d)`` variance on the domain after the ``chosen`` candidates and one more: row
         ``j`` adds candidate ``j`` (:func:`variance_after_adding` on :meth:`posterior`)."""
-        var_d, cov, var_c = self.posterior(chosen)
-        return variance_after_adding(var_d, cov, var_c, self.new_var)
+        return variance_after_adding(*self.posterior(chosen), self.new_var)
 
 
 def apply_smoother(data_xy: Any, noise_std: Any, query_xy: Any, values: Any, *,
                    length_scale: float, signal_std: float, jitter: float = 1e-10,
                    max_jitter: float = 1e-4) -> Array:
-    """The GP mean's linear map applied to ``values``: ``K(query, data) (K + Σ)⁻¹ values``, the
-    ``(q,)`` or ``(q, k)`` posterior mean (zero prior mean) at ``query_xy`` ``(q, 2)`` that each
-    of the one or ``k`` data vectors ``values`` ``(n,)`` or ``(n, k)`` at ``data_xy`` ``(n, 2)``
-    would give, with noise ``Σ = diag(noise_std²)``; ``jitter`` and ``max_jitter`` as in
-    :class:`GaussianRandomField`."""
+    """``K(query, data) (K + Σ)⁻¹ values``, ``Σ = diag(noise_std²)``: the ``(q,)`` or ``(q, k)``
+    zero-prior-mean posterior mean at ``query_xy (q, 2)`` of ``values (n,)`` or ``(n, k)`` observed
+    at ``data_xy (n, 2)``; ``jitter``, ``max_jitter`` as in :class:`GaussianRandomField`."""
     data = check_array("data_xy", data_xy, (None, 2), what="metres", min_rows=1)
     noise = check_array("noise_std", noise_std, (data.shape[0],))
     query = check_array("query_xy", query_xy, (None, 2), what="metres")

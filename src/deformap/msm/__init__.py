@@ -4,14 +4,11 @@ A poke is simulated for each β as the steady state of position-based shape matc
 (:func:`simulate_poke`); β̂ minimises the paper's E(β), the mean distance from the simulated
 surface to the observed deformed one (:func:`estimate_beta`).
 
-``ShapeMatchingConfig.contact``: ``"pinned"``, the paper's protocol, is the surface sheet with
-fixed edges and the particle nearest the contact pinned at its observed depth; ``"force"``
-(default) applies the measured force to the particles under the tip, with a spring stiffness
-``k`` calibrated so that the rigid-goal body dents like a Hertz half-space of
-``reference_modulus_pa``, on layers down to a fixed floor (a sheet fixed at its edges can only
-bend). ``beta_scale`` (force only): on ``"odds"`` β's springs are ``k / β``, so β = 0 is rigid
-(the paper's meaning) and β / (1 − β) the compliance against the reference; on ``"reference"``
-every β's springs are ``k`` and β = 0 is the reference body.
+``ShapeMatchingConfig.contact``: ``"pinned"`` (the paper's) pins the sheet's particle nearest the
+contact at its observed depth; ``"force"`` applies the measured force under the tip, on springs
+``k`` calibrated so that the rigid-goal body, layered down to a fixed floor, dents like a Hertz
+half-space of ``reference_modulus_pa``. ``beta_scale``: on ``"odds"`` β's springs are ``k / β``
+(β = 0 rigid, as in the paper); on ``"reference"`` they are ``k`` (β = 0 the reference body).
 
 References
 ----------

@@ -23,9 +23,7 @@ __all__ = ["BetaEstimate", "estimate_beta", "matching_error"]
 logger = logging.getLogger(__name__)
 Array = NDArray[np.float64]
 
-# a β steps with a smaller β's factorisation when the splitting's contraction bound
-# (β − β′) / (1 − β′) is at most this (:meth:`StepMatrices.solve`): removing 70 % of the error per
-# step costs a few iterations more and saves a factorisation
+# largest contraction (β − β′) / (1 − β′) at which β steps with β′'s factorisation (saves one)
 _MAX_SPLIT = 0.3
 _KEEP_FACTORS = 3  # banded factorisations a β search keeps (:attr:`StepMatrices.max_factors`)
 _TIE_M = 1e-9  # E values within a nanometre are ties (round-off): β̂ is the most rigid of them
@@ -33,14 +31,10 @@ _TIE_M = 1e-9  # E values within a nanometre are ties (round-off): β̂ is the m
 
 @dataclass(frozen=True, kw_only=True)
 class BetaEstimate:
-    """Result of :func:`estimate_beta`.
-
-    ``beta`` minimises E(β) over the converged β solved to ``config.tol`` (over all of them if
-    none converged; ties within 1 nm go to the most rigid); ``beta_std`` is at least
-    ``beta_resolution / √12``. ``betas (n,)``, sorted, and ``errors`` E(β) [m], with each β's last
-    solve (:class:`PokeSimulation`) and its ``tolerances``; ``stiffness_n_per_m`` the force
-    protocol's; ``surface (ny, nx, 3)`` [m] the simulated surface particles at β̂.
-    """
+    """Result of :func:`estimate_beta`: ``beta`` minimises E(β) over the converged β solved to
+    ``config.tol`` (all of them if none converged; ties within 1 nm to the most rigid), ``beta_std``
+    ≥ ``beta_resolution / √12``; ``betas (n,)`` sorted, ``errors`` E(β) [m], each β's last solve
+    (:class:`PokeSimulation`) and ``tolerances``; ``surface (ny, nx, 3)`` [m] the particles at β̂."""
 
     beta: float
     beta_std: float
@@ -79,9 +73,7 @@ class _Sweep:
 
     def __init__(self, model: PokeModel, tree: cKDTree):
         self.model, self.tree = model, tree
-        # the sweep moves on through β: a few factorisations kept suffice, and reusing their
-        # arrays spares the page faults of fresh memory
-        model.system.max_factors = _KEEP_FACTORS
+        model.system.max_factors = _KEEP_FACTORS  # the sweep moves on: reuse a few factors' arrays
         self.sims: dict[float, PokeSimulation] = {}
         self.errors: dict[float, float] = {}
         self.distances: dict[float, Array] = {}
@@ -113,9 +105,9 @@ class _Sweep:
             self._body[key] = body[0]
 
     def _start(self, beta: float) -> Array | None:
-        """Start for ``beta``: its own loose equilibrium; else linear in the dent's amplitude
-        (:meth:`PokeModel.amplitude`) through the two nearest solved β; else the nearest deformed
-        one (or the calibration's dent) scaled by amplitude; ``None`` when none is solved."""
+        """Start for ``beta``: its own loose equilibrium, else linear in :meth:`PokeModel.amplitude`
+        through the two nearest solved β, else the nearest deformed one (or the calibration's
+        dent) scaled by amplitude; ``None`` when none is solved."""
         if beta in self._body:
             return self._body[beta]
         if not self._body:
@@ -148,13 +140,9 @@ class _Sweep:
 
 def _refine(sweep: _Sweep, step: float, resolution: float, tol: float, *,
             odds: bool = False) -> None:
-    """Find the minimum of E on the ``resolution`` grid within one ``step`` of the best swept β.
-
-    E is unimodal there, so a grid point whose two neighbours are higher is the minimum. Each step
-    solves to ``tol`` the parabola's vertex (:func:`_vertex`) rounded to the grid, or, when that is
-    solved, the unsolved neighbour of the lowest point nearest the vertex; it stops when the
-    lowest point has both neighbours solved.
-    """
+    """Find the minimum of E (unimodal there) on the ``resolution`` grid within one ``step`` of the
+    best swept β: solve to ``tol`` the parabola's vertex (:func:`_vertex`) on the grid, or when
+    solved the lowest point's unsolved neighbour nearest it, until both neighbours are solved."""
     known = np.fromiter(sweep.errors, dtype=float)
     errs = np.fromiter(sweep.errors.values(), dtype=float)
     best = float(known[np.flatnonzero(errs <= errs.min() + _TIE_M)[0]])
@@ -186,12 +174,9 @@ def _refine(sweep: _Sweep, step: float, resolution: float, tol: float, *,
 
 
 def _vertex(betas: Array, errors: Array, *, odds: bool = False) -> float:
-    """β of the vertex of the parabola through the lowest of ``errors`` and its nearest
-    neighbours on either side (else the three nearest), or the lowest β when it has no minimum.
-
-    Fitted in ``v = 1 / (1 − β)`` (``β / (1 − β)`` with ``odds``), in which the dent deepens
-    about linearly: a parabola in β puts the vertex on the rigid side.
-    """
+    """β of the vertex of the parabola through the lowest of ``errors`` and its nearest neighbours
+    on either side (else the three nearest; the lowest β when it has no minimum), fitted in
+    ``1 / (1 − β)`` (``β / (1 − β)`` with ``odds``), where the dent deepens about linearly."""
     c = int(np.flatnonzero(errors <= errors.min() + _TIE_M)[0])
     left, right = betas < betas[c], betas > betas[c]
     if left.any() and right.any():
@@ -248,22 +233,17 @@ def _beta_std(betas: Array, errors: Array, tol: float, resolution: float) -> flo
 def estimate_beta(rest_xs: Any, rest_ys: Any, rest_z: Any, deformed_points: Any,
                   contact: TactileContact, config: ShapeMatchingConfig | None = None,
                   *, height_samples: Any = None) -> BetaEstimate:
-    """Estimate β for one poke (Caccamo et al. 2016, §III-C).
-
-    E(β) is evaluated on the sweep ``β_j = j / n_beta``, then (``refine``) on the
-    ``beta_resolution`` grid within one sweep step of the best β.
+    """Estimate β for one poke (Caccamo et al. 2016, §III-C): E(β) on the sweep ``β_j = j /
+    n_beta``, then (``refine``) on the ``beta_resolution`` grid within one step of the best β.
 
     Parameters
     ----------
-    rest_xs : (nx,) float, rest_ys : (ny,) float, rest_z : (ny, nx) float, metres
+    rest_xs, rest_ys, rest_z : (nx,), (ny,), (ny, nx) float, metres
         The ROI's heightmap before the poke; its edges are held fixed.
     deformed_points : (m, 3) float, metres
         The observed deformed surface X̄.
-    contact : TactileContact
-    config : ShapeMatchingConfig
     height_samples : (S, m) float, metres, optional
-        Vertical errors of ``deformed_points``, S ≥ 2: ``beta_std`` is then the spread of β̂ over
-        the surfaces they give (:func:`~deformap.msm._uncertainty.sample_beta_std`).
+        S ≥ 2 vertical errors of ``deformed_points``: ``beta_std`` is β̂'s spread over them.
     """
     cfg = _check_config(config)
     grid = ParticleGrid.from_heightmap(rest_xs, rest_ys, rest_z)
@@ -289,5 +269,4 @@ def estimate_beta(rest_xs: Any, rest_ys: Any, rest_z: Any, deformed_points: Any,
         beta=float(betas[best]), beta_std=beta_std, betas=betas, errors=errors, iterations=its,
         residual=res, converged=conv, tolerances=tols, protocol=cfg.contact, mode=cfg.mode,
         stiffness_n_per_m=model.stiffness,
-        surface=np.array(sweep.sims[float(betas[best])].positions[0]),
-    )
+        surface=np.array(sweep.sims[float(betas[best])].positions[0]))

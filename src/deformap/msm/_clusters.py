@@ -1,13 +1,10 @@
 """Overlapping k×k clusters of a particle grid and Müller's shape-matching goals, batched over β.
 
-Every window of the particle grid is a cluster. Cluster sums are box filters on strided window
-views, and their transposes ``k²`` shifted slice additions, batched over a leading β axis.
-
-Two details differ from a literal reading of Müller et al. (2005), so that its invariants hold
-exactly: the fit is written ``A q = s + Π (x − p⁰)``, ``Π`` the cluster's mass-weighted projection
-onto its feature span (Müller's ``A_pq A_qq⁻¹`` with an exact inverse; with the truncated one the
-rest shape stays a fixed point), and the quadratic features are centred on the cluster like ``s``
-(the goal ``T q̃ + t`` has no intercept, so β = 1 reproduces a quadratic deformation).
+Every window of the particle grid is a cluster; cluster sums are box filters, batched over β.
+Unlike a literal reading of Müller et al. (2005), so that its invariants hold exactly, the fit is
+``A q = s + Π (x − p⁰)`` with ``Π`` the mass-weighted projection onto the feature span (the rest
+shape stays a fixed point under truncation), and the quadratic features are centred like ``s``
+(so β = 1 reproduces a quadratic deformation).
 """
 
 from __future__ import annotations
@@ -28,9 +25,8 @@ def _cut(axis: int, start: int, stop: int) -> tuple[slice, ...]:
 
 
 class Clusters:
-    """Rest-shape data of all clusters of particles ``rest (*grid, 3)`` with ``masses (*grid)``
-    (``grid`` is ``(ny, nx)`` or ``(nz, ny, nx)``), one per ``window`` (e.g. ``(2, k, k)``);
-    ``mode`` and ``regularization`` as in :class:`ShapeMatchingConfig`."""
+    """Rest-shape data of the clusters, one per ``window`` (e.g. ``(2, k, k)``), of particles
+    ``rest (*grid, 3)``, ``masses (*grid)``; ``mode``, ``regularization`` as in the config."""
 
     def __init__(self, rest: Array, masses: Array, window: tuple[int, ...], mode: str,
                  regularization: float):
@@ -74,8 +70,8 @@ class Clusters:
         return out
 
     def features(self) -> tuple[Array, Array | None]:
-        """Centred features ``(C, km, 3)`` ``s / L`` and, in quadratic mode, ``(C, km, 6)`` the
-        quadratic terms ``sx², sy², sz², sx sy, sy sz, sz sx`` of ``s / L`` (centred)."""
+        """Features ``(C, km, 3)`` ``q = s / L`` and, if quadratic, ``(C, km, 6)`` the centred
+        ``qx², qy², qz², qx qy, qy qz, qz qx``."""
         q = self.s / np.maximum(self._radius(), np.finfo(float).tiny)[:, None, None]
         if self.mode != "quadratic":
             return q, None
@@ -88,8 +84,7 @@ class Clusters:
         """RMS radius ``√(Σ w |s|²)`` of each cluster (the trace of its rest moment)."""
         return np.asarray(np.sqrt(np.maximum(np.sum(self._moment[0], axis=1), 0.0)))
 
-    def _projection(self, q: Array, cutoff: Array,
-                    eig: tuple[Array, Array] | None = None) -> Array:
+    def _projection(self, q: Array, cutoff: Array, eig: tuple[Array, Array] | None = None) -> Array:
         """``Π[i, j] = q_iᵀ A_qq⁺ q_j w_j``, dropping eigenvalues of ``A_qq`` below ``cutoff``
         (``eig``: the eigen-decomposition of ``A_qq`` if already known)."""
         wq = self.w[..., None] * q
@@ -100,16 +95,13 @@ class Clusters:
         return np.asarray(q @ aqq_pinv @ np.swapaxes(wq, 1, 2))
 
     def _hat_matrices(self, regularization: float) -> Array:
-        """``(C, km, km)`` weighted least-squares projections onto the feature span: the linear
-        features, then the quadratic ones on what the linear fit leaves (block Gram–Schmidt, so a
-        truncated quadratic direction never spoils rigid and affine fits), each dropping
-        eigenvalues below ``regularization`` times the largest linear moment."""
+        """``(C, km, km)`` weighted projections onto the linear features, then the quadratic ones on
+        what the linear fit leaves (block Gram–Schmidt: rigid and affine fits stay exact), each
+        dropping eigenvalues below ``regularization`` times the largest linear moment."""
         _, quad = self.features()
         lam = self._moment[0]
-        # the linear fit on s itself: scale-free, and the rest moment is already decomposed
         hat = self._projection(self.s, regularization * lam[:, -1], self._moment)
         if quad is not None:
-            # the quadratic features are built from s / L: their cut-off in the same units
             cutoff = regularization * lam[:, -1] / np.maximum(self._radius(),
                                                               np.finfo(float).tiny) ** 2
             hat = hat + self._projection(quad - hat @ quad, cutoff)
@@ -151,8 +143,8 @@ class Clusters:
         self._t0c_t = np.ascontiguousarray(np.moveaxis(self._t0c, -1, 0))
 
     def rotation_term(self, x: Array) -> Array:
-        """``(1/M_i) Σ_{c∋i} R_c s_i^c`` ``(B, *grid, 3)`` for positions ``x (B, *grid, 3)``, by box
-        sums (``A_pq = Σ m x p⁰ᵀ / M − t t⁰ᵀ``) and spreads (``(Σ_c R_c) p⁰_i − Σ_c R_c t⁰_c``)."""
+        """``(1/M_i) Σ_{c∋i} R_c s_i^c`` ``(B, *grid, 3)`` at ``x (B, *grid, 3)`` by box sums
+        (``A_pq = Σ m x p⁰ᵀ / M − t t⁰ᵀ``) and spreads (``(Σ_c R_c) p⁰_i − Σ_c R_c t⁰_c``)."""
         if not hasattr(self, "_p0c"):
             self._prepare_box()
         if not np.any(self.planar):
@@ -207,8 +199,8 @@ class Clusters:
         self.v_axis = np.cross(self.normal, self.u_axis)
 
     def _polar(self, apq: Array) -> Array:
-        """Polar rotations of ``(B, C, 3, 3)`` cluster matrices; a planar cluster's ``A`` (``A n =
-        0``) gets ``ĉ nᵀ ‖A‖``, ``c = (A u) × (A v)``: full rank with the same rotation."""
+        """Polar rotations of ``(B, C, 3, 3)`` matrices; a planar cluster's ``A`` (``A n = 0``) gets
+        ``ĉ nᵀ ‖A‖``, ``c = (A u) × (A v)`` added: full rank, same rotation."""
         if np.any(self.planar):
             p = self.planar
             a = apq[:, p]

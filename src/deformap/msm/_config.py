@@ -7,16 +7,7 @@ from typing import Literal
 
 from deformap._validation import SettingError, check_settings, setting
 
-__all__ = ["BetaScale", "ContactProtocol", "DeformationMode", "ShapeMatchingConfig", "UncertaintyMethod"]
-
-#: Müller et al.'s deformation modes of a cluster.
-DeformationMode = Literal["quadratic", "linear", "rigid"]
-#: How the poke enters the simulation (see ``ShapeMatchingConfig.contact``).
-ContactProtocol = Literal["force", "pinned"]
-#: How ``beta_std`` is obtained (see ``ShapeMatchingConfig.uncertainty``).
-UncertaintyMethod = Literal["bootstrap", "tolerance"]
-#: What β = 0 is and where the reference sits (see ``ShapeMatchingConfig.beta_scale``).
-BetaScale = Literal["odds", "reference"]
+__all__ = ["ShapeMatchingConfig"]
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -30,32 +21,26 @@ class ShapeMatchingConfig:
     cluster_size : int
         Side ``k`` of the overlapping ``k × k`` particle clusters; 3 is the paper's best value.
     contact : {"force", "pinned"}
-        How the poke enters the simulation.
-        ``"force"`` simulates the dent's depth per newton instead of copying it (:mod:`deformap.msm`).
+        How the poke enters the simulation (:mod:`deformap.msm`).
     n_beta : int
-        Number of β of the coarse sweep ``β_j = j / n_beta`` over ``[0, 1)``.
-        E(β) is smooth, so 10 values bracket its minimum.
+        Number of β of the coarse sweep ``β_j = j / n_beta``; E(β) is smooth, so 10 bracket its minimum.
     refine : bool
         Refine β̂ around the sweep's minimum on the ``beta_resolution`` grid.
     beta_resolution : float
         Step of the local refinement (dimensionless).
     tol : float
-        Relative fixed-point tolerance of every β the refinement compares.
-        The largest particle update is compared with the largest displacement from rest.
+        Fixed-point tolerance of every β compared: largest update over largest displacement.
     sweep_tol : float
         Tolerance of the coarse sweep and the stiffness calibration under ``refine`` (≥ ``tol``).
-        The sweep only brackets the minimum; a swept β the refinement compares is solved again.
     max_iter : int
         Iteration cap; a β that hits it is reported as not converged.
     regularization : float
         Relative eigenvalue cut-off of each cluster's moment matrix.
-        It keeps the rest shape a fixed point and affine / quadratic deformations exact at β = 1.
     reference_modulus_pa : float, pascals
         Young's modulus of the half-space whose Hertz dent calibrates the spring stiffness ``k``.
         100 kPa lies above the stiffest polyurethane foams and below rubbers.
     beta_scale : {"odds", "reference"}
         What β = 0 is under the force protocol: the rigid body, or the reference body.
-        ``"odds"`` keeps the paper's meaning (:mod:`deformap.msm`).
     poisson_ratio : float
         Poisson's ratio of the reference half-space; it enters only through ``E / (1 − ν²)``.
     layers : int or None
@@ -65,33 +50,28 @@ class ShapeMatchingConfig:
         Ratio of successive layer spacings: fine under the surface where strains are large.
     uncertainty : {"bootstrap", "tolerance"}
         How ``beta_std`` is obtained: a paired block bootstrap, or E's tolerance interval.
-        See :mod:`deformap.msm._uncertainty`.
     bootstrap_tile_m : float, metres
-        Side of the resampled blocks.
-        2 cm, twice the tip radius and the touch GP's length scale, keeps neighbours together.
+        Side of the resampled blocks; 2 cm, twice the tip radius, keeps neighbours together.
     error_tolerance_m : float, metres
         Tolerance on E(β) of the ``"tolerance"`` uncertainty, of the order of the touch GP's error.
     """
 
-    mode: DeformationMode = "quadratic"
+    mode: Literal["quadratic", "linear", "rigid"] = "quadratic"
     cluster_size: int = setting(3, ge=2)
-    contact: ContactProtocol = "force"
-    # each β is one solve of the whole body; a step of 0.001 is finer than refinement needs
+    contact: Literal["force", "pinned"] = "force"
     n_beta: int = setting(10, ge=2, le=1000)
     refine: bool = True
     beta_resolution: float = setting(0.01, ge=1e-6, le=0.5)
     tol: float = setting(1e-6, ge=1e-14, lt=1.0)  # below 1e-14 is float64 rounding
     sweep_tol: float = setting(1e-4, ge=1e-14, lt=1.0)
-    # the cap bounds the time of a β that does not converge
     max_iter: int = setting(500, ge=1, le=100_000)
     regularization: float = setting(1e-3, ge=0.0, lt=1.0)
     reference_modulus_pa: float = setting(100e3, gt=0.0)
-    beta_scale: BetaScale = "odds"
+    beta_scale: Literal["odds", "reference"] = "odds"
     poisson_ratio: float = setting(0.5, ge=-1.0, le=0.5)  # the range of an isotropic solid
-    uncertainty: UncertaintyMethod = "bootstrap"
+    uncertainty: Literal["bootstrap", "tolerance"] = "bootstrap"
     bootstrap_tile_m: float = setting(0.02, gt=0.0)
     error_tolerance_m: float = setting(1e-4, gt=0.0)
-    # memory grows as the square of the layer count (each widens the linear system's band)
     layers: int | None = setting(None, ge=0, le=32)
     layer_growth: float = setting(2.0, ge=1.0, le=10.0)
 

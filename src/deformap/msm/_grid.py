@@ -15,7 +15,6 @@ __all__ = ["ParticleGrid"]
 
 
 def _check_axis(name: str, value: Any) -> NDArray[np.float64]:
-    """Validate a strictly increasing 1-D coordinate axis in metres, at least 3 values."""
     arr = check_array(name, value, (None,), what="coordinates in metres", min_rows=3)
     if np.any(np.diff(arr) <= 0):
         raise InvalidArgumentError(f"`{name}` must be strictly increasing; got {arr[:5]}...")
@@ -24,9 +23,8 @@ def _check_axis(name: str, value: Any) -> NDArray[np.float64]:
 
 @dataclass(frozen=True, kw_only=True)
 class ParticleGrid:
-    """Particles on a regular ``(ny, nx)`` grid, one per heightmap cell: rest positions
-    ``rest (ny, nx, 3)`` metres (row ``i`` at ``ys[i]``), equal ``masses`` ``Δx·Δy`` (only their
-    ratios matter), the ``fixed`` outer ring and the mean spacing ``spacing_m``."""
+    """One particle per heightmap cell: ``rest (ny, nx, 3)`` metres (row ``i`` at ``ys[i]``), equal
+    ``masses`` ``Δx·Δy``, the ``fixed`` outer ring and the mean spacing ``spacing_m``."""
 
     rest: NDArray[np.float64]
     masses: NDArray[np.float64]
@@ -47,9 +45,3 @@ class ParticleGrid:
         for arr in (rest, masses, fixed):
             arr.setflags(write=False)
         return cls(rest=rest, masses=masses, fixed=fixed, spacing_m=0.5 * (dx + dy))
-
-    @property
-    def shape(self) -> tuple[int, int]:
-        """``(ny, nx)``."""
-        return (int(self.rest.shape[0]), int(self.rest.shape[1]))
-

@@ -1,12 +1,10 @@
-"""The sparse linear part ``K_β`` of the local–global step: assembled once per ROI, one banded
-Cholesky factorisation per β.
+"""The sparse linear part ``K_β = I − M⁻¹ (Σ_c W_c + β Σ_c Π_c)`` of the local–global step
+(:mod:`deformap.msm._poke`), assembled once per ROI, one banded Cholesky factorisation per β.
 
-``K_β = I − M⁻¹ (Σ_c W_c + β Σ_c Π_c)`` on the free particles (:mod:`deformap.msm._poke`); ``W_c``
-and ``Π_c`` are mass-orthogonal projections, so ``S_β = diag(m M) K_β = S₀ − β S₁`` is symmetric,
-positive definite for β < 1, and banded when ordered row by row with the layer innermost. Both
-bands are assembled once; a β may also step with a smaller β′'s factorisation through the
-splitting ``S_β = S_β′ − (β − β′) S₁`` (:meth:`StepMatrices.solve`). A matrix that is not positive
-definite (never expected) falls back to SuperLU.
+``W_c``, ``Π_c`` are mass-orthogonal projections, so ``S_β = diag(m M) K_β = S₀ − β S₁`` is
+symmetric, positive definite for β < 1, and banded when ordered row by row, layer innermost. A β
+may step with a smaller β′'s factorisation through ``S_β = S_β′ − (β − β′) S₁``. A matrix that
+is not positive definite (never expected) falls back to SuperLU.
 """
 
 from __future__ import annotations
@@ -64,8 +62,7 @@ class StepMatrices:
         self._perm = _band_order(fixed)
         self._unperm = np.argsort(self._perm)
         self._band_scale = self._scale[self._perm]
-        # S₀ = diag(m M) − diag(m) Σ_c W_c and S₁ = diag(m) Σ_c Π_c on the free particles, in
-        # band order; only the upper triangle is kept (they are symmetric)
+        # upper triangles of S₀ = diag(m M) − diag(m) Σ_c W_c and S₁ = diag(m) Σ_c Π_c, band order
         band_pos = np.full(n, -1, dtype=np.int64)
         band_pos[self.free[self._perm]] = np.arange(nf)
         ff = ~is_fixed[i] & ~is_fixed[j]
@@ -73,8 +70,7 @@ class StepMatrices:
         up = br <= bc
         br, bc = br[up], bc[up]
         self._bw = int(np.max(bc - br)) if bc.size else 0
-        # the nonzeros of both bands as flat indices into a column-major (LAPACK) band array:
-        # entry S[i, j], i ≤ j, is band[bw + i − j, j]
+        # the bands' nonzeros as flat indices into LAPACK's band array: S[i, j] = band[bw + i − j, j]
         self._band_shape = (self._bw + 1, nf)
         diag = self._bw + (self._bw + 1) * np.arange(nf)
         at = np.concatenate([(self._bw + br - bc) + (self._bw + 1) * bc, diag])
@@ -85,16 +81,14 @@ class StepMatrices:
         self._band_v1 = np.bincount(slot, np.concatenate([vp[ff][up], zeros]),
                                     minlength=self._band_at.size)
         self._factors: dict[float, object] = {}
-        # at most this many factorisations are kept (None: all), the least recently used
-        # dropped first and its array reused
+        # factorisations kept (None: all); the least recently used is dropped, its array reused
         self.max_factors: int | None = None
         self._s1_mat: sp.csr_matrix | sp.dia_matrix | None = None
         self._pull: tuple[Array, Array, Array] | None = None
         self._pbtrs = get_lapack_funcs("pbtrs", (np.empty((1, 1)),))
 
     def pull(self, x_fixed: Array) -> tuple[Array, Array]:
-        """``(couple_w @ x_fixed, couple_p @ x_fixed)``, each ``(n_free, 3)`` (the fixed particles'
-        term is ``w + β p``), kept for the last ``x_fixed``."""
+        """``couple_w @ x_fixed`` and ``couple_p @ x_fixed`` (the fixed term is ``w + β p``), cached."""
         last = self._pull
         if last is None or not np.array_equal(last[0], x_fixed):
             x = np.array(x_fixed, dtype=float)
@@ -113,12 +107,9 @@ class StepMatrices:
 
     def solve(self, beta_fit: float, rhs: Array, *, factor_beta: float | None = None,
               x: Array | None = None) -> Array:
-        """``K_β⁻¹ rhs`` for ``rhs (n_free, 3)``, factorising ``K_β`` on first use.
-
-        With ``factor_beta = β′ < beta_fit`` and the free positions ``x (n_free, 3)``, the step
-        ``K_β′⁻¹ (rhs + (β − β′) M⁻¹ Σ_c Π_c x)`` of the splitting ``S_β = S_β′ − (β − β′) S₁``:
-        the same fixed point, contraction at most ``(β − β′) / (1 − β′)`` (``S₁ ≥ 0``, ``S_β > 0``).
-        """
+        """``K_β⁻¹ rhs`` for ``rhs (n_free, 3)``; with ``factor_beta = β′ < beta_fit`` and the free
+        positions ``x``, the split step ``K_β′⁻¹ (rhs + (β − β′) M⁻¹ Σ_c Π_c x)``: the same fixed
+        point, contraction at most ``(β − β′) / (1 − β′)`` (``S₁ ≥ 0``, ``S_β > 0``)."""
         beta = float(beta_fit)
         key = beta if factor_beta is None else float(factor_beta)
         fac = self._factor_of(key)
@@ -130,8 +121,7 @@ class StepMatrices:
                 raise InvalidArgumentError(
                     "a split step needs `factor_beta` <= `beta_fit` and the positions `x`")
             s1, xp = self._s1(), np.take(x, self._perm, axis=0)
-            # one column at a time: scipy's multi-vector sparse product is slower than three
-            # single-vector ones (the same sums, in the same order)
+            # per column: faster than scipy's multi-vector product (same sums, same order)
             for d in range(scaled.shape[1]):
                 scaled[:, d] += (beta - key) * (s1 @ xp[:, d])
         if isinstance(fac, np.ndarray):
@@ -143,8 +133,7 @@ class StepMatrices:
         return np.take(sol, self._unperm, axis=0)
 
     def band(self, beta_fit: float, out: Array | None = None) -> Array:
-        """``S_β = S₀ − β S₁`` in LAPACK's column-major upper band storage ``(bw + 1, n_free)``,
-        in band order (into ``out`` if given)."""
+        """``S_β = S₀ − β S₁`` in LAPACK's upper band storage ``(bw + 1, n_free)`` (into ``out``)."""
         if out is None:
             out = np.zeros(self._band_shape, order="F")
         else:
@@ -166,8 +155,7 @@ class StepMatrices:
         return fac
 
     def _s1(self) -> sp.csr_matrix | sp.dia_matrix:
-        """``S₁`` in band order as a full symmetric sparse matrix (built on first use): by
-        diagonals when its nonzeros lie on few of them, which multiplies faster; else CSR."""
+        """``S₁`` in band order, full and sparse: by diagonals when they are few (faster), else CSR."""
         if self._s1_mat is None:
             bw, n = self._bw, self._band_shape[1]
             nz = self._band_v1 != 0.0
@@ -181,8 +169,7 @@ class StepMatrices:
             offsets = np.unique(cols - rows)
             dense = offsets.size * n  # the entries of the diagonal storage
             if dense <= 2 * max(csr.nnz, 1):
-                with warnings.catch_warnings():  # the storage rule above is the efficiency
-                    # check; scipy's warns on any count of diagonals over 100 whatever the fill
+                with warnings.catch_warnings():  # scipy warns over 100 diagonals, any fill
                     warnings.simplefilter("ignore", sp.SparseEfficiencyWarning)
                     self._s1_mat = csr.todia()
             else:
@@ -213,9 +200,8 @@ class _SparseFallback:
 
 
 def _pair_sums(clusters: Clusters) -> tuple[NDArray[np.int64], NDArray[np.int64], Array, Array]:
-    """Particle pairs ``(i, j)`` sharing a cluster and their sums ``Σ_c m_i W_c[i, j]``,
-    ``Σ_c m_i Π_c[i, j]`` (zeros in rigid mode), each pair once; accumulated per grid offset of
-    the member pair on particle-shaped arrays."""
+    """Particle pairs ``(i, j)`` sharing a cluster, each once, with ``Σ_c m_i W_c[i, j]`` and
+    ``Σ_c m_i Π_c[i, j]`` (zeros if rigid), accumulated per offset of the member pair."""
     shape, window, cshape = clusters.shape, clusters.window, clusters.cshape
     members = np.array(list(np.ndindex(*window)))  # (km, nd) offsets in the window
     n_m, nd = members.shape

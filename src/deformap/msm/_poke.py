@@ -1,8 +1,7 @@
 """Static equilibrium of a shape-matching body under a poke, for many β at once.
 
-Position-based dynamics moves each free particle toward its goal,
-``x ← x + α (g(x) − x) + h² f / m``; its steady state is the fixed point ``x_i − g_i(x) = f_i / k``
-with ``k = α m / h²`` (N/m); time stepping reaches it like a diffusion, so it is solved directly.
+Position-based dynamics steps ``x ← x + α (g(x) − x) + h² f / m``; its steady state, the fixed
+point ``x_i − g_i(x) = f_i / k`` with ``k = α m / h²`` (N/m), is solved for directly.
 
 The goal of particle ``i`` in cluster ``c`` is
 ``g_i^c = t_c + (1 − β) R_c s_i + β (s_i + Π_c (x − p⁰))``, linear in ``x`` except for the rotation
@@ -12,9 +11,8 @@ The goal of particle ``i`` in cluster ``c`` is
 
 with ``M`` the number of clusters holding each particle, ``W_c`` the centre-of-mass rows and
 ``b_β`` the fixed particles' and the force's terms. ``K_β`` is factorised once per β
-(:mod:`deformap.msm._linsys`) and each iteration recomputes the rotations and back-substitutes (a
-local–global scheme like projective dynamics, Bouaziz et al. 2014, with the β-dependent part
-solved exactly), accelerated by Anderson mixing (Walker & Ni 2011).
+(:mod:`deformap.msm._linsys`); each iteration recomputes the rotations and back-substitutes (local–
+global like projective dynamics, Bouaziz et al. 2014), accelerated by Anderson mixing.
 
 References
 ----------
@@ -49,34 +47,22 @@ _MAX_WAIT_LOG2 = 6  # after n rejected Anderson steps, 2^min(n, 6) − 1 plain s
 
 @dataclass(frozen=True, kw_only=True)
 class PokeSimulation:
-    """Converged equilibria of one poke for ``B`` values of β.
-
-    Parameters
-    ----------
-    betas, iterations, residual, converged : (B,)
-        Each β's iterations, last relative update (largest move over largest displacement) and
-        whether it fell below the tolerance within ``config.max_iter`` (:meth:`Equilibrium.solve`).
-    positions : (B, ny, nx, 3) float, metres
-        Particle positions at equilibrium.
-    protocol : str
-    stiffness_n_per_m : float or None
-        Calibrated particle spring stiffness ``k`` (force protocol).
-    """
+    """Equilibria of one poke for ``betas (B,)``: surface ``positions (B, ny, nx, 3)`` metres, each
+    β's ``iterations``, ``residual`` (last relative update) and ``converged`` flag
+    (:meth:`Equilibrium.solve`), and the calibrated spring ``stiffness_n_per_m``."""
 
     betas: Array
     positions: Array
     iterations: NDArray[np.int64]
     residual: Array
     converged: NDArray[np.bool_]
-    protocol: str
     stiffness_n_per_m: float | None = None
 
 
 def force_weights(rest: Array, fixed: NDArray[np.bool_], contact: TactileContact,
                   spacing: float) -> Array:
-    """``(ny, nx)`` shares of the tactile force, summing to 1, on the free particles under the tip:
-    the Hertz profile ``√(1 − d²/ρ²)``, ``ρ = max(tip radius, spacing)`` so that particles always
-    carry the load."""
+    """``(ny, nx)`` shares of the force, summing to 1, on the free particles under the tip: Hertz's
+    ``√(1 − d²/ρ²)``, ``ρ = max(tip radius, spacing)`` so that some particle carries the load."""
     rho = max(contact.tip_radius_m, spacing)
     d2 = np.sum((rest[..., :2] - contact.contact_point[:2]) ** 2, axis=-1)
     w = np.sqrt(np.clip(1.0 - d2 / rho**2, 0.0, None))
@@ -92,7 +78,6 @@ class Equilibrium:
                  system: StepMatrices | None = None, max_split: float = 0.0,
                  load_scale: Array | None = None):
         self.cl, self.betas = clusters, np.asarray(betas, dtype=float)
-        # the share of the force each β's body carries
         self.load_scale = (np.ones_like(self.betas) if load_scale is None
                            else np.asarray(load_scale, dtype=float))
         self.system = StepMatrices(clusters, fixed) if system is None else system
@@ -101,8 +86,7 @@ class Equilibrium:
             self.rot_weight, self.fit_weight = np.ones_like(self.betas), np.zeros_like(self.betas)
         else:
             self.rot_weight, self.fit_weight = 1.0 - self.betas, self.betas.copy()
-        # the factorisation each β steps with (:meth:`StepMatrices.prepare`); the splitting's
-        # contraction bound ``split`` tightens the stopping test
+        # the factorisation each β steps with, and the splitting's contraction bound
         self.factor_beta = np.empty_like(self.fit_weight)
         for j in np.argsort(self.fit_weight, kind="stable"):
             self.factor_beta[j] = self.system.prepare(self.fit_weight[j], max_split)
@@ -125,17 +109,14 @@ class Equilibrium:
     def solve(self, x_fixed: Array, force: Array, stiffness: float, tol: float, max_iter: int,
               spacing: float, memory: int = 6, x0: Array | None = None,
               ) -> tuple[Array, NDArray[np.int64], Array, NDArray[np.bool_]]:
-        """Iterate ``x ← G(x)`` to its fixed point for every β, with Anderson acceleration.
+        """Iterate ``x ← G(x)`` to its fixed point for every β from ``x0 (B, *grid, 3)`` (default
+        rest), ``x_fixed (n_fix, 3)``, ``force (n, 3)`` newtons: positions ``(B, *grid, 3)``,
+        iterations, residuals ``max‖G(x) − x‖ / max‖G(x) − p⁰‖`` and converged flags.
 
-        ``x_fixed (n_fix, 3)`` the fixed particles; ``force (n, 3)`` newtons; ``x0 (B, *grid, 3)``
-        optional starting positions. Returns positions ``(B, ny, nx, 3)``, iterations, residuals
-        ``max‖G(x) − x‖ / max‖G(x) − p⁰‖`` and converged flags.
-
-        Anderson type II (``memory`` steps, Walker & Ni 2011) is safeguarded against the strongly
-        non-linear step map of clusters turning over: an extrapolation whose residual exceeds its
-        origin's is replaced by the plain step from there with a fresh history, and after ``n``
-        rejections in a row ``2^min(n, 6) − 1`` plain steps follow. A β stepping with a smaller
-        β's factorisation (contraction ``ρ``) stops at ``tol (1 − ρ)``.
+        Anderson type II (``memory`` steps, Walker & Ni 2011), safeguarded: an extrapolation whose
+        residual exceeds its origin's is replaced by the plain step from there with a fresh
+        history, and ``n`` rejections in a row add ``2^min(n, 6) − 1`` plain steps. A β stepping
+        with a smaller β's factorisation (contraction ``ρ``) stops at ``tol (1 − ρ)``.
         """
         cl, nb = self.cl, len(self.betas)
         rest = cl.rest.reshape(-1, 3)
@@ -231,12 +212,9 @@ Solution = tuple[Array, NDArray[np.int64], Array, NDArray[np.bool_]]
 def calibrate_stiffness(eq0: Equilibrium, x_fixed: Array, weights: Array, contact: TactileContact,
                         config: ShapeMatchingConfig, spacing: float,
                         ) -> tuple[float, Solution | None]:
-    """Spring stiffness ``k`` (N/m) such that the β = 0 body (``eq0``) dents like the reference
-    half-space, and the β = 0 solve at that ``k`` (``None`` if 8 steps did not match).
-
-    Secant iteration ``k ← k δ(k) / δ_Hertz(E_ref, F, tip)`` until the force-weighted depth of the
-    loaded particles matches the Hertz depth to 0.1 %, each solve to ``config.coarse_tol``.
-    """
+    """Spring stiffness ``k`` (N/m) at which the β = 0 body ``eq0`` dents like the reference
+    half-space, and its solve (``None`` if 8 steps did not match): ``k ← k δ(k) / δ_Hertz`` until
+    the force-weighted depth matches Hertz's (Johnson 1985) to 0.1 %, solves to ``coarse_tol``."""
     f_mag = contact.force_n
     force = weights.reshape(-1, 1) * contact.force[None, :]
     rest = eq0.cl.rest.reshape(-1, 3)
@@ -245,14 +223,12 @@ def calibrate_stiffness(eq0: Equilibrium, x_fixed: Array, weights: Array, contac
     k = f_mag / delta_ref  # a first guess: one particle carrying the whole load
     x0 = None
     for _ in range(8):
-        solution = eq0.solve(x_fixed, force, k, config.coarse_tol, config.max_iter, spacing,
-                             x0=x0)
+        solution = eq0.solve(x_fixed, force, k, config.coarse_tol, config.max_iter, spacing, x0=x0)
         x = solution[0]
         depth = float(np.sum(weights.ravel() * ((x[0].reshape(-1, 3) - rest) @ contact.direction)))
         ratio = depth / delta_ref
         if abs(ratio - 1.0) < 1e-3:
             return k, solution
-        k *= ratio  # secant on the (nearly 1/k) depth–stiffness relation
-        # displacements scale nearly as 1/k: start the next solve from the scaled equilibrium
+        k *= ratio  # depth ∝ 1/k nearly: the scaled equilibrium starts the next solve
         x0 = rest + (x.reshape(1, -1, 3) - rest) / ratio
     return k, None

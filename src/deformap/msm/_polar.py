@@ -1,6 +1,5 @@
-"""The rotation factor of the polar decomposition ``A = R S`` of batches of 3×3 matrices: the
-rotations of Müller et al.'s (2005) shape matching, by SVD (exact, any matrix) or by Higham's
-(1986) scaled Newton iteration from a closed-form start where that is safe.
+"""The rotation ``R`` of the polar decomposition ``A = R S`` of batches of 3×3 matrices (Müller et
+al. 2005), by SVD, or by Higham's (1986) scaled Newton iteration from a closed-form start.
 
 References
 ----------
@@ -29,12 +28,8 @@ def polar_rotation(a: Array) -> Array:
 
 
 def fast_polar_rotation(a: Array, *, tol: float = 1e-14, max_iter: int = 30) -> Array:
-    """``polar_rotation(a)`` by Higham's scaled Newton iteration where it is safe, SVD elsewhere.
-
-    ``X ← (γ X + X⁻ᵀ / γ) / 2`` with closed-form cofactors and ``γ = |det X|^(−1/3)``, quadratic
-    for ``det A > 0``; matrices with a small or negative relative determinant, or not converged,
-    get the SVD answer.
-    """
+    """``polar_rotation(a)`` by Higham's ``X ← (γ X + X⁻ᵀ / γ) / 2``, ``γ = |det X|^(−1/3)``; a small
+    or negative relative determinant, or no convergence, gets the SVD answer."""
     shape = a.shape
     m = np.ascontiguousarray(a.reshape(-1, 9).T)
     return np.asarray(polar_components(m, tol=tol, max_iter=max_iter).T.reshape(shape))
@@ -47,7 +42,7 @@ def polar_components(m: Array, *, tol: float = 1e-14, max_iter: int = 30) -> Arr
     cof0, det0 = _cofactors(x)
     safe = det0 > 1e-9  # scaled Newton copes with any positive det; flat ones go to SVD
     all_safe = bool(np.all(safe))
-    # started from the closed-form estimate R h(U) (h ≈ 1, SPD) Newton lands on R in a step or two
+    # from the closed-form estimate R h(U) (h ≈ 1, SPD) Newton lands on R in a step or two
     if all_safe:
         cur = _polar_start(x, cof0, det0)
     else:
@@ -81,10 +76,9 @@ def polar_components(m: Array, *, tol: float = 1e-14, max_iter: int = 30) -> Arr
 
 
 def _polar_start(x: Array, cof: Array, det: Array) -> Array:
-    """``R h(U)``, ``h(U) ≈ I`` SPD, for ``(9, n)`` row-major ``x = R U`` of unit norm and positive
-    determinant (``cof``, ``det`` from :func:`_cofactors`, overwritten): the closed form
-    ``R = [(I_U² − II_U) x + I_U cof(x) − x xᵀx] / (I_U II_U − det x)`` with the invariants of
-    ``U = √(xᵀx)``; inexact invariants leave an SPD factor that Newton removes."""
+    """``R h(U)``, ``h(U) ≈ I`` SPD, for ``(9, n)`` row-major ``x = R U``, unit norm, ``det > 0``
+    (``cof`` overwritten): ``R = [(I_U² − II_U) x + I_U cof(x) − x xᵀx] / (I_U II_U − det x)``
+    with the invariants of ``U = √(xᵀx)``."""
     a, b, c, d, e, f, g, h, i = x
     # invariants of C = xᵀx from sums of squares: tr C = ‖x‖² = 1, II_C = ‖cof x‖², det C = det²
     ii = np.sum(cof * cof, axis=0)
@@ -115,8 +109,7 @@ def _polar_start(x: Array, cof: Array, det: Array) -> Array:
 
 
 def _cofactors(m: Array) -> tuple[Array, Array]:
-    """Cofactor matrices ``(9, n)`` and determinants ``(n,)`` of ``(9, n)`` row-major 3×3
-    matrices (``X⁻ᵀ = cof(X) / det X``)."""
+    """Cofactors ``(9, n)`` and determinants ``(n,)`` of ``(9, n)`` row-major 3×3 matrices."""
     a, b, c, d, e, f, g, h, i = m
     cof = np.empty_like(m)
     for row, (p, q, r, t) in enumerate(((e, i, f, h), (f, g, d, i), (d, h, e, g),

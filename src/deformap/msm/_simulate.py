@@ -7,7 +7,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from deformap._validation import check_array, check_positive
+from deformap._validation import check_array, check_instance, check_positive
 from deformap.errors import InvalidArgumentError
 from deformap.mechanics import TactileContact
 from deformap.msm._clusters import Clusters
@@ -27,7 +27,6 @@ Array = NDArray[np.float64]
 
 
 def check_betas(betas: Any) -> Array:
-    """Validate a 1-D array of β values in ``[0, 1)``."""
     arr = check_array("betas", np.atleast_1d(betas), (None,), what="β values", min_rows=1)
     bad = (arr < 0.0) | (arr >= 1.0)
     if np.any(bad):
@@ -36,11 +35,8 @@ def check_betas(betas: Any) -> Array:
 
 
 def _check_config(config: Any) -> ShapeMatchingConfig:
-    if config is None:
-        return ShapeMatchingConfig()
-    if not isinstance(config, ShapeMatchingConfig):
-        raise InvalidArgumentError(f"`config` must be a ShapeMatchingConfig; got {type(config)}")
-    return config
+    return ShapeMatchingConfig() if config is None else check_instance(
+        "config", config, ShapeMatchingConfig)
 
 
 def _check_rest(rest: Any, k: int) -> Array:
@@ -53,13 +49,9 @@ def _check_rest(rest: Any, k: int) -> Array:
 
 def shape_matching_goals(rest: Any, current: Any, betas: Any,
                          config: ShapeMatchingConfig | None = None) -> Array:
-    """Müller's goals ``(B, ny, nx, 3)`` of particles at ``current (B, ny, nx, 3)`` for
-    ``betas (B,)`` in [0, 1), rest positions ``rest (ny, nx, 3)`` (equal masses), metres.
-
-    ``g_i = (1/M_i) Σ_{c∋i} [((1 − β) R_c + β A_c) s_i + t_c]`` over the ``M_i`` clusters holding
-    ``i`` (``A_c`` the linear or quadratic fit, ``R_c`` its rotation, alone in rigid mode);
-    Müller et al. (2005), Eqs. 7–9 and §4.3.
-    """
+    """Müller's goals ``(B, ny, nx, 3)`` of particles at ``current (B, ny, nx, 3)`` for ``betas
+    (B,)`` in [0, 1) and ``rest (ny, nx, 3)`` (equal masses), metres: ``g_i = (1/M_i) Σ_{c∋i}
+    [((1 − β) R_c + β A_c) s_i + t_c]`` (Müller et al. 2005, Eqs. 7–9, §4.3; rigid: ``R_c``)."""
     cfg = _check_config(config)
     p0 = _check_rest(rest, cfg.cluster_size)
     b = check_betas(betas)
@@ -69,10 +61,8 @@ def shape_matching_goals(rest: Any, current: Any, betas: Any,
 
 
 def _check_contact(contact: Any, rest: Array, fixed: NDArray[np.bool_], spacing: float) -> int:
-    """Validate the contact and return the flat index of the particle nearest to it."""
-    if not isinstance(contact, TactileContact):
-        raise InvalidArgumentError(f"`contact` must be a TactileContact; got {type(contact)}")
-    cp = contact.contact_point
+    """The flat index of the particle nearest the (checked) contact."""
+    cp = check_instance("contact", contact, TactileContact).contact_point
     lo = rest[..., :2].reshape(-1, 2).min(axis=0) - spacing
     hi = rest[..., :2].reshape(-1, 2).max(axis=0) + spacing
     if np.any(cp[:2] < lo) or np.any(cp[:2] > hi):
@@ -103,14 +93,10 @@ def _rest_height_at(rest: Array, xy: Array) -> float:
 def simulate_poke(rest: Any, masses: Any, fixed: Any, contact: TactileContact, betas: Any,
                   config: ShapeMatchingConfig | None = None, *,
                   stiffness_n_per_m: float | None = None) -> PokeSimulation:
-    """Converged static equilibrium of the shape-matching body under one poke, for every β.
-
-    ``rest (ny, nx, 3)`` metres, ``masses (ny, nx)`` and ``fixed (ny, nx)`` as in
-    :class:`ParticleGrid`; ``betas (B,)`` in [0, 1). ``"pinned"``: the free particle nearest the
-    contact is held at the observed indentation; ``"force"``: the force is shared by the particles
-    under the tip (:func:`force_weights`) on springs of :func:`calibrate_stiffness`'s ``k`` (or
-    ``stiffness_n_per_m``), divided by β on the ``"odds"`` scale.
-    """
+    """Static equilibrium under one poke for every β of ``betas (B,)`` in [0, 1); ``rest``,
+    ``masses``, ``fixed`` as in :class:`ParticleGrid`. ``"pinned"`` holds the particle nearest the
+    contact at the observed depth; ``"force"`` shares the force under the tip
+    (:func:`force_weights`) on springs of the calibrated ``k`` (or ``stiffness_n_per_m``)."""
     cfg = _check_config(config)
     p0 = _check_rest(rest, cfg.cluster_size)
     b = check_betas(betas)
@@ -119,8 +105,7 @@ def simulate_poke(rest: Any, masses: Any, fixed: Any, contact: TactileContact, b
 
 
 class PokeModel:
-    """One poke on one ROI, ready to be solved for any β (:func:`simulate_poke`): the body, its
-    clusters, ``K_β`` and the calibrated stiffness are shared by every :meth:`solve`."""
+    """One poke on one ROI whose body, clusters, ``K_β`` and stiffness every :meth:`solve` shares."""
 
     def __init__(self, rest: Any, masses: Any, fixed: Any, contact: TactileContact,
                  config: ShapeMatchingConfig, *, stiffness_n_per_m: float | None = None):
@@ -179,23 +164,21 @@ class PokeModel:
         return (beta if self.odds else 1.0) / (1.0 - beta)
 
     def calibrated(self, tol: float) -> tuple[PokeSimulation, Array] | None:
-        """The calibration's converged β = 0 equilibrium as :meth:`solve` returns it, if ``tol`` is
-        no tighter than ``coarse_tol``; else ``None``."""
-        if self._calibrated is None or tol < self.cfg.coarse_tol or self.odds:
+        """The calibration's converged β = 0 solve, if ``tol`` ≥ ``coarse_tol``; else ``None``."""
+        solution = self._calibrated
+        if solution is None or tol < self.cfg.coarse_tol or self.odds or not solution[3].all():
             return None
-        x, it, res, conv = self._calibrated
-        if not conv.all():
-            return None
-        sim = PokeSimulation(betas=np.zeros(1), positions=x[:, 0], iterations=it, residual=res,
-                             converged=conv, protocol=self.cfg.contact,
-                             stiffness_n_per_m=self.stiffness)
-        return sim, x
+        return self._result(np.zeros(1), *solution)
+
+    def _result(self, betas: Array, x: Array, it: NDArray[np.int64], res: Array,
+                conv: NDArray[np.bool_]) -> tuple[PokeSimulation, Array]:
+        return PokeSimulation(betas=betas, positions=x[:, 0], iterations=it, residual=res,
+                              converged=conv, stiffness_n_per_m=self.stiffness), x
 
     def solve(self, betas: Array, x0: Array | None = None, tol: float | None = None, *,
               max_split: float = 0.0) -> tuple[PokeSimulation, Array]:
-        """Equilibria for ``betas (B,)`` from ``x0 (B, *body, 3)`` (default: :attr:`start`, else
-        rest) to ``tol`` (default ``config.tol``; ``max_split``: :meth:`StepMatrices.prepare`):
-        the simulation of the surface layer, and the whole body's positions."""
+        """The surface's simulation and the body's positions for ``betas (B,)`` from ``x0 (B,
+        *body, 3)`` (default :attr:`start`, else rest) to ``tol`` (default ``config.tol``)."""
         cfg = self.cfg
         betas = np.asarray(betas, dtype=float)
         rest = self.clusters.rest
@@ -220,15 +203,12 @@ class PokeModel:
             x[moving], it[moving], res[moving], conv[moving] = eq.solve(
                 self.x_fixed, self.force, k, cfg.tol if tol is None else tol, cfg.max_iter,
                 self.spacing, x0=x0)
-        sim = PokeSimulation(betas=betas, positions=x[:, 0], iterations=it, residual=res,
-                             converged=conv, protocol=cfg.contact,
-                             stiffness_n_per_m=self.stiffness)
-        return sim, x
+        return self._result(betas, x, it, res, conv)
 
 
 def _body(p0: Array, masses: Array, fixed: NDArray[np.bool_], spacing: float,
           cfg: ShapeMatchingConfig) -> tuple[Array, Array, NDArray[np.bool_], tuple[int, ...]]:
-    """The simulated body: the surface sheet, or the surface over layers down to a fixed floor."""
+    """The body: the surface sheet, or the surface over layers down to a fixed floor."""
     k, layers = cfg.cluster_size, cfg.body_layers
     if layers == 0:
         return p0[None], masses[None], fixed[None], (1, k, k)

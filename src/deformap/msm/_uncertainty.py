@@ -1,9 +1,6 @@
-"""How well one poke pins down β: a paired block bootstrap of E(β) over the ROI, or E(β) against
-perturbed observations.
-
-E(β) is a mean over the ROI's particles; resampling whole tiles of particles (so correlated
-neighbours move together) and taking each resampled curve's argmin gives the spread of β̂ the
-observation supports (Künsch 1989; Efron & Tibshirani 1993, §8.6), with a fixed seed.
+"""How well one poke pins down β: a paired block bootstrap of E(β) over the ROI (resampling whole
+tiles of particles, so that correlated neighbours move together; Künsch 1989; Efron & Tibshirani
+1993, §8.6), or E(β) against perturbed observations.
 
 References
 ----------
@@ -43,10 +40,8 @@ def parabola_vertex(x: NDArray[np.float64], e: NDArray[np.float64]
 def _tile_sums(distances: NDArray[np.float64], tile: int) -> NDArray[np.float64]:
     """``(B, ny, nx)`` → ``(B, n_tiles)`` sums over ``tile × tile`` blocks (edge blocks smaller)."""
     n_beta, ny, nx = distances.shape
-    rows = np.arange(ny) // tile
-    cols = np.arange(nx) // tile
-    n_cols = int(cols[-1]) + 1
-    index = (rows[:, None] * n_cols + cols[None, :]).ravel()
+    rows, cols = np.arange(ny) // tile, np.arange(nx) // tile
+    index = (rows[:, None] * (int(cols[-1]) + 1) + cols[None, :]).ravel()
     n_tiles = int(index.max()) + 1
     sums = np.zeros((n_beta, n_tiles))
     for b in range(n_beta):  # n_beta rows of one bincount each: cheap, and keeps memory flat
@@ -56,11 +51,8 @@ def _tile_sums(distances: NDArray[np.float64], tile: int) -> NDArray[np.float64]
 
 def bootstrap_beta_std(betas: NDArray[np.float64], distances: NDArray[np.float64], *, tile: int,
                        resolution: float, n_boot: int = 256) -> float:
-    """Standard deviation of β̂ under ``n_boot`` resamples of ``tile × tile`` particle blocks.
-
-    ``betas (B,)`` increasing; ``distances (B, ny, nx)`` metres, each surface particle's distance
-    to the observed surface at each β; the result is at least ``resolution / √12``.
-    """
+    """Std of β̂ (≥ ``resolution / √12``) over ``n_boot`` resamples of ``tile × tile`` blocks of
+    ``distances (B, ny, nx)`` metres, particle to observed surface, at increasing ``betas (B,)``."""
     b = check_array("betas", betas, (None,), min_rows=2)
     d = check_array("distances", distances, (b.size, None, None), what="distances in metres")
     if np.any(np.diff(b) <= 0):
@@ -83,13 +75,9 @@ _CANDIDATES = 8  # nearest observed points per particle searched for a moved one
 def sample_beta_std(betas: NDArray[np.float64], positions: NDArray[np.float64],
                     observed: NDArray[np.float64], height_samples: NDArray[np.float64], *,
                     resolution: float) -> float:
-    """Standard deviation of β̂ over plausible observed surfaces (observation noise propagated).
-
-    Each row of ``height_samples (S, m)`` moves ``observed (m, 3)`` vertically; E(β) of the
-    simulated ``positions (B, ny, nx, 3)`` at ``betas (B,)`` (increasing) is re-evaluated against
-    the moved points, each particle's nearest sought among its 8 nearest unmoved ones, and the
-    spread of the argmins returned (at least ``resolution / √12``).
-    """
+    """Std of β̂ (≥ ``resolution / √12``) over ``observed (m, 3)`` moved vertically by each row of
+    ``height_samples (S, m)``: E(β) of ``positions (B, ny, nx, 3)`` at increasing ``betas (B,)``,
+    each particle's nearest sought among its 8 nearest unmoved points."""
     b = check_array("betas", betas, (None,), min_rows=2)
     if np.any(np.diff(b) <= 0):
         raise InvalidArgumentError("`betas` must be strictly increasing")
@@ -111,9 +99,8 @@ def sample_beta_std(betas: NDArray[np.float64], positions: NDArray[np.float64],
 
 
 def _argmins(betas: NDArray[np.float64], curves: NDArray[np.float64]) -> NDArray[np.float64]:
-    """Minimiser of each row of ``curves (S, B)``: the vertex of the parabola through its lowest
-    sample and the two beside it, in ``u = −log(1 − β)`` (stretching the soft end), kept between
-    those two."""
+    """Minimiser of each row of ``curves (S, B)``: the parabola's vertex through its lowest sample
+    and the two beside it, in ``u = −log(1 − β)``, kept between those two."""
     s_idx = np.arange(curves.shape[0])
     lowest = np.argmin(curves, axis=1)
     i = np.clip(lowest, 1, betas.size - 2)

@@ -27,7 +27,7 @@ class StiffnessConfig:
     poisson_ratio : float
         ``ν`` of the surface's material, an assumption (open-cell foam: 0.33).
     poisson_ratio_std : float
-        Uncertainty of that assumption, carried into σ(E) by a refit at ``ν ± poisson_ratio_std``.
+        Uncertainty of ν, carried into σ(E) by refits at ``ν ± poisson_ratio_std``.
         0.07 is the standard deviation of ν uniform over [0.2, 0.45]; 0 claims ν is known.
     travel_noise_m : float
         Standard deviation of one travel reading (encoders through kinematics).
@@ -39,7 +39,6 @@ class StiffnessConfig:
         How far, in standard deviations of a two-reading difference, travel or force may step back.
     force_tolerance_rel, force_tolerance_abs_n : float
         Allowed gap ``rel · F + abs`` (or three force σ) between the last and commanded force.
-        The rule of :class:`deformap.environment.PressObservation`, so a record it accepts is read.
     """
 
     poisson_ratio: float = setting(0.33, ge=0.0, le=0.5)
@@ -58,16 +57,12 @@ class StiffnessConfig:
 
 @dataclass(frozen=True, kw_only=True)
 class StiffnessEstimate:
-    """What one force–travel record says about the surface, in SI units; the read fields are
-    ``None`` when ``rigid`` (stiffer than the probe and arm can tell apart).
+    """What one force–travel record says, in SI units; the read fields are ``None`` when ``rigid``.
 
-    ``stiffness_n_per_m`` ``k = dF/dδ`` at the commanded force, ``modulus_pa`` E, and their
-    standard deviations; ``stiffness_lower_n_per_m`` a lower bound on ``k`` when rigid;
-    ``contact_offset_m`` the fitted ``δ₀``; ``depth_m`` the indentation ``δ_c`` at the commanded
-    force (when rigid, the travel span); ``max_chi`` ``√(R δ_c) / h`` (the model holds for
-    ``χ ≲ 1``); ``reduced_chi2`` the fit's χ² per degree of freedom; ``n_samples`` the samples
-    used; ``model`` :data:`LAYER_MODEL`; ``model_error_pa`` the model-error part of
-    ``modulus_std_pa`` (``None`` when rigid or under four samples).
+    ``stiffness_n_per_m`` ``k = dF/dδ`` at the commanded force, ``modulus_pa`` E, and their stds;
+    ``stiffness_lower_n_per_m`` a bound on ``k`` when rigid; ``contact_offset_m`` δ₀; ``depth_m``
+    δ_c (rigid: the travel span); ``max_chi`` ``√(R δ_c) / h``; ``reduced_chi2``; ``n_samples``
+    used; ``model_error_pa`` the model-error part of ``modulus_std_pa`` (None under four samples).
     """
 
     stiffness_n_per_m: float | None

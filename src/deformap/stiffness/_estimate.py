@@ -59,12 +59,11 @@ def _check_record(travel_m: Any, force_n: Any, config: StiffnessConfig,
 
 def _travel_span(travel: NDArray[np.float64], force: NDArray[np.float64], force_c: float,
                  sigma_t: float) -> tuple[float, float]:
-    """Travel gained from the first force to ``force_c`` by a straight line of travel against
-    force, and its standard deviation from the travel noise."""
+    """Travel gained from the first force to ``force_c`` on a line of travel against force, and
+    its standard deviation from the travel noise."""
     centred = force - force.mean()
     sxx = float(centred @ centred)
-    slope = float(centred @ travel) / sxx
-    span = slope * (force_c - force[0])
+    span = float(centred @ travel) / sxx * (force_c - force[0])
     return span, sigma_t * abs(force_c - force[0]) / np.sqrt(sxx)
 
 
@@ -86,20 +85,17 @@ def estimate_stiffness(travel_m: Any, force_n: Any, *, tip_radius_m: float, thic
                        config: StiffnessConfig | None = None) -> StiffnessEstimate:
     """Stiffness and Young's modulus with their uncertainties from one force–travel record.
 
-    ``travel_m (n,)`` [m], the probe's travel since first contact in time order, ``n >= 3``, and
-    ``force_n (n,)`` [N], rising from the contact threshold to the commanded force
-    ``commanded_force_n`` (default: the largest), which the last force must be near;
-    ``tip_radius_m`` the spherical tip's radius; ``thickness_m`` the layer's thickness at the
-    contact, in ``(0, 2]`` m, above the travel, with standard deviation ``thickness_std_m``
+    ``travel_m (n,)`` [m] since first contact, ``n >= 3``, and ``force_n (n,)`` [N] rising to
+    ``commanded_force_n`` (default the largest), which the last force must be near; the tip's
+    radius; the layer's thickness at the contact in ``(0, 2]`` m, above the travel, and its std
     (σ(E) includes a refit at ``h ± σ_h``).
 
     Raises
     ------
     InvalidArgumentError
-        Naming the argument: non-finite values, under three samples, a travel not starting at
-        contact, a negative force, travel or force stepping back beyond their noise, force not
-        rising, travel not below the thickness, a last force far from the commanded one, or a
-        record outside the contact model's range (:mod:`deformap.stiffness`, Range).
+        Naming the argument: a record that is not finite, too short, not from contact, negative,
+        stepping back beyond its noise, not rising, not below the thickness, not ending near the
+        commanded force, or outside the contact model's range (:mod:`deformap.stiffness`).
     """
     config = StiffnessConfig() if config is None else config
     radius = check_positive("tip_radius_m", tip_radius_m)
@@ -147,7 +143,7 @@ def estimate_stiffness(travel_m: Any, force_n: Any, *, tip_radius_m: float, thic
             f"{depth_c * 1e3:.3g} mm, more than its {2e3 * radius:.3g} mm diameter "
             f"(`tip_radius_m` {radius:g} m): the sphere is buried and what holds it above "
             f"presses the surface too")
-    if chi > _MAX_CHI or strain > _MAX_STRAIN or modulus <= 1.001 * table.low_bound:
+    if chi > _MAX_CHI or strain > _MAX_STRAIN or modulus <= 1.001 * fit.low_bound:
         raise InvalidArgumentError(
             f"`force_n`/`travel_m` leave the contact model's range (χ = {chi:.2f}, at most "
             f"{_MAX_CHI}; indentation {strain:.0%} of the {thickness:.3g} m layer, at most "

@@ -14,23 +14,19 @@ __all__ = ["LayerTable", "RecordFit", "fit_record", "model_error"]
 _EFFECTIVE_VARIANCE_ROUNDS = 4
 _MODULUS_GRID = 61
 _TABLE_SIZE = 800
-# the fit stays below the depth where the series' force turns down (and at most χ = 3, far past
-# the series' range), where the inverse's slope still means something
+# the table stops short of where the series' force turns down, and at most at χ = 3
 _CHI_FRACTION = 0.95
 _CHI_CAP = 3.0
-# the model-error test fits one modulus to each half of the record with one shared δ₀: three
-# parameters, at least one degree of freedom left (:mod:`deformap.stiffness`, Model error)
+# the model-error test's three parameters (two moduli, one δ₀) and one degree of freedom
 _MIN_PART_SAMPLES = 4
 _PART_ROUNDS = 8
 
 
 class LayerTable:
-    """``g(δ)``, the bonded-layer force at unit modulus, tabulated on ``[0, δ_lim]`` for its
-    inverse (``δ_lim`` short of where the series' force stops rising, at most the thickness)."""
+    """``g(δ)``, the bonded-layer force at unit modulus, tabulated on ``[0, δ_lim]`` for its inverse."""
 
     def __init__(self, radius: float, thickness: float, nu: float) -> None:
         self.radius, self.thickness, self.nu = radius, thickness, nu
-        self.low_bound = 0.0  # the softest modulus the fit may return (set by the fit)
         chi_lim = min(_CHI_FRACTION * layer_chi_limit(nu), _CHI_CAP)
         # nor deeper than the layer: with R < h that comes first (χ = √(R/h) < 1 at δ = h)
         self.depth_limit = min((chi_lim * thickness) ** 2 / radius, thickness)
@@ -69,11 +65,13 @@ class RecordFit:
     def depths(self, modulus: float) -> NDArray[np.float64]:
         return self.table.depth_at(self.force / modulus)
 
+    def _free_offset(self, modulus: float) -> float:
+        gap = self.depths(modulus) - self.travel
+        return float(self.weights @ gap / self.weights.sum())
+
     def offset(self, modulus: float) -> float:
         """The weighted least-squares ``δ₀`` at ``modulus``, at least ``−3 σ_t``."""
-        gap = self.depths(modulus) - self.travel
-        return max(float(self.weights @ gap / self.weights.sum()),
-                   -3.0 * self.config.travel_noise_m)
+        return max(self._free_offset(modulus), -3.0 * self.config.travel_noise_m)
 
     def chi2(self, log_modulus: float) -> float:
         modulus = float(np.exp(log_modulus))
@@ -88,8 +86,7 @@ class RecordFit:
 
     def solve(self) -> float:
         f_max = float(self.force.max())
-        # the softest modulus keeps the largest force inside the table; the stiffest sinks the
-        # tip by a thousandth of the travel noise
+        # softest: the largest force inside the table; stiffest: a thousandth of the travel noise
         low = np.log(f_max / self.table.force_limit)
         high = np.log(f_max / float(layer_indentation_force(
             1e-3 * self.config.travel_noise_m, self.table.radius, self.table.thickness, 1.0,
@@ -108,14 +105,12 @@ class RecordFit:
         return float(np.exp(log_modulus))
 
     def covariance(self, modulus: float) -> tuple[NDArray[np.float64], float]:
-        """Covariance of ``(E, δ₀)`` from the weighted residuals' Jacobian, Birge-scaled, and
-        the reduced χ²."""
+        """Birge-scaled covariance of ``(E, δ₀)`` from the weighted Jacobian, and the reduced χ²."""
         sw = np.sqrt(self.weights)
         depth = self.depths(modulus)
         # ∂δᵢ/∂E = −(Fᵢ / E²) / g'(δᵢ); the residual is t + δ₀ − δ
         d_depth = -(self.force / modulus**2) / self.table.slope(depth)
-        # columns in relative units (E's fraction, δ₀ in travel-noise units): the raw ones differ
-        # by ten orders of magnitude
+        # columns in relative units: the raw ones differ by ten orders of magnitude
         scale = np.array([modulus, self.config.travel_noise_m])
         jac = np.column_stack([-d_depth * sw, sw]) * scale
         if self.offset_clamped(modulus):  # δ₀ sits on its bound: not a free parameter there
@@ -129,8 +124,7 @@ class RecordFit:
 
     def offset_clamped(self, modulus: float) -> bool:
         """Whether the best ``δ₀`` at ``modulus`` lies on its ``−3 σ_t`` bound."""
-        gap = self.depths(modulus) - self.travel
-        return float(self.weights @ gap / self.weights.sum()) < -3.0 * self.config.travel_noise_m
+        return self._free_offset(modulus) < -3.0 * self.config.travel_noise_m
 
     def part_difference(self, modulus: float) -> tuple[float, float] | None:
         """``log E_hi − log E_lo`` of the two-part model and its standard deviation, or ``None``
@@ -184,7 +178,6 @@ def fit_record(travel: NDArray[np.float64], force: NDArray[np.float64], radius: 
     table = LayerTable(radius, thickness, config.poisson_ratio)
     fit = RecordFit(travel, force, table, config)
     modulus = fit.solve()
-    table.low_bound = fit.low_bound
     cov, chi2_red = fit.covariance(modulus)
     return modulus, fit.offset(modulus), cov, chi2_red, fit
 
