@@ -1,7 +1,5 @@
-"""The next place to poke: the configured strategy until the map field's variance is under
-``T_h`` (the β-field's, or the modulus field's under ``ExplorationConfig.field = "modulus"``, with
-its own ``T_h``: :func:`deformap.explore.field_settings`), then the boundary pokes (strategies
-and scores in :mod:`deformap.explore._acquisition`).
+"""The next place to poke: the configured strategy until the map field's variance is under its
+``T_h``, then the boundary pokes (strategies and scores in :mod:`deformap.explore._acquisition`).
 
 Under an appearance prior (:mod:`deformap.explore._appearance_prior`) the looks come first: while
 the variance is above ``T_h``, the interior (:func:`segment_interior`) of the largest segment of
@@ -50,14 +48,9 @@ closer pokes would measure much the same foam again."""
 
 def expected_noise(candidates: NDArray[np.float64], pokes: PokeSet, config: ExplorationConfig,
                    field: FieldName) -> NDArray[np.float64]:
-    """The β uncertainty a poke at each of ``candidates (c, 2)`` is expected to have: the largest
-    of the pokes already made within ``BOUNDARY_SPACING_ROI`` ROIs of it (a dent spreads a few
-    centimetres, so a press there measures that foam again, no better), else the map field's
-    noise floor (:func:`deformap.explore.field_settings` of ``field``)
-    with the map's nugget added in variance
-    (``pokes.nugget``: any press carries the scatter between places of one material). So the
-    target choice knows what a further press at a place can still reduce, and does not return to
-    a place whose readings are noisy expecting a reading at the floor."""
+    """``(c,)`` the uncertainty a poke at each of ``candidates (c, 2)`` is expected to have: the
+    largest of the pokes within ``BOUNDARY_SPACING_ROI`` ROIs of it (a press there measures that
+    foam again, no better), else the field's noise floor with ``pokes.nugget`` added in variance."""
     floor = float(np.hypot(field_settings(config, field).noise_floor, pokes.nugget))
     noise = np.full(len(candidates), floor)
     if len(pokes) == 0:
@@ -105,8 +98,7 @@ def _straddle(grid: MapGrid, field: PokeField, pokes: PokeSet, config: Explorati
 
 def _boundary(grid: MapGrid, field: PokeField, pokes: PokeSet,
               config: ExplorationConfig) -> NDArray[np.float64] | None:
-    """Where a region boundary is least certain (:func:`_straddle`); ``None`` when no place is
-    left."""
+    """Where a region boundary is least certain; ``None`` when no place is left."""
     cells, score = _straddle(grid, field, pokes, config)
     if score.size == 0:
         return None
@@ -195,25 +187,10 @@ def _look_target(grid: MapGrid, field: PokeField, config: ExplorationConfig, thr
 def choose_next(grid: MapGrid, field: PokeField, config: ExplorationConfig,
                 rng: np.random.Generator, *, boundary_owed: int,
                 n_made: int | None = None) -> Target | None:
-    """The next target after the pokes ``field`` was fitted to, or ``None`` when the variance is
-    under ``T_h`` and no boundary poke is owed or none has a place left.
-
-    Parameters
-    ----------
-    grid : MapGrid
-    field : PokeField
-        The current map field (the β-field or the modulus field; its ``pokes`` are the pokes it
-        holds), read with its own settings (:func:`deformap.explore.field_settings` of
-        ``field.name``).
-    config : ExplorationConfig
-    rng : numpy.random.Generator
-        This choice's stream (``paper`` draws from it).
-    boundary_owed : int
-        Boundary pokes still to make.
-    n_made : int, optional
-        Pokes made so far (the budget left is ``max_pokes`` less these); default: the pokes in
-        ``field``, which the modulus field may leave some out of.
-    """
+    """The next target after the pokes the map ``field`` was fitted to (read with its own
+    :func:`deformap.explore.field_settings`), or ``None`` when the variance is under ``T_h`` and
+    no boundary poke is owed or none has a place left; ``rng`` is this choice's stream,
+    ``n_made`` the pokes made so far (default: the field's, which may leave some out)."""
     pokes = field.pokes
     variance = field.variance.ravel()
     threshold = field_settings(config, field.name).threshold
