@@ -36,26 +36,10 @@ from deformap.explore._field_config import (
 from deformap.msm import ShapeMatchingConfig
 from deformap.stiffness import StiffnessConfig
 
-__all__ = [
-    "MAX_MAP_CELLS",
-    "MAX_PLAN_CELLS",
-    "MAX_ROI_BAND_BYTES",
-    "AppearanceUse",
-    "BetaFieldConfig",
-    "BetaUncertainty",
-    "DepthAnchor",
-    "ExplorationConfig",
-    "FieldName",
-    "ModulusFieldConfig",
-    "NuggetEstimate",
-    "RegionLabels",
-    "StopRegion",
-    "SurfaceGPConfig",
-    "TactileCap",
-    "TouchGPConfig",
-    "TouchModel",
-    "check_exploration_budget",
-]
+__all__ = ["MAX_MAP_CELLS", "MAX_PLAN_CELLS", "MAX_ROI_BAND_BYTES", "AppearanceUse",
+           "BetaFieldConfig", "BetaUncertainty", "DepthAnchor", "ExplorationConfig", "FieldName",
+           "ModulusFieldConfig", "NuggetEstimate", "RegionLabels", "StopRegion", "SurfaceGPConfig",
+           "TactileCap", "TouchGPConfig", "TouchModel", "check_exploration_budget"]
 
 #: Where the variance must fall below ``T_h`` (``ExplorationConfig.stop_region``).
 StopRegion = Literal["workspace", "targets"]
