@@ -41,25 +41,21 @@ from deformap.cloud import PointCloud
 __all__ = ["SURFACE_TOLERANCE_M", "AppearanceImage", "build_appearance"]
 
 #: A point further than this from the fitted surface [m] is not the surface's look (the robot, a
-#: block's side face): a centimetre is well above the depth camera's noise and below a tip.
+#: block's side face): well above the depth camera's noise and below a tip.
 SURFACE_TOLERANCE_M = 0.01
-#: Smallest share of the map's cells that must carry colour: with less, the segments would be
-#: islands and the prior would speak for cells it has not seen.
+#: Smallest share of the map's cells that must carry colour, so the prior speaks for seen cells.
 MIN_SEEN_FRACTION = 0.5
 #: CIELAB L* at or above which a cell is saturated, at or below which it is black.
 SATURATED_L, BLACK_L = 99.0, 1.0
-#: Largest share of saturated (or black) cells an image may have: beyond half, the colours show
-#: the exposure, not the surface.
+#: Largest share of saturated (or black) cells: beyond half, the colours show the exposure.
 MAX_CLIPPED_FRACTION = 0.5
-#: A CIELAB difference below this (ΔE*ab = 1) is no difference at all: an image whose colours
-#: span less shows nothing.
+#: A CIELAB difference below this (ΔE*ab = 1) is no difference at all.
 SAME_DELTA_E = 1.0
-#: The just-noticeable CIELAB difference (ΔE*ab ≈ 2.3, Mahy et al. 1994): two looks whose colours
-#: (or textures, in L*) differ by less are one look to the eye, so the segments' spread of colour
-#: and texture is never standardised below it (shading and vignetting stay under it).
+#: The just-noticeable CIELAB difference (ΔE*ab ≈ 2.3, Mahy et al. 1994): colour and texture
+#: spreads are never standardised below it, so shading and vignetting stay one look.
 JND_DELTA_E = 2.3
 #: Felzenszwalb's scale in units of the image's noise: a boundary needs a step several noise
-#: standard deviations high along a segment's length, not one noisy cell.
+#: standard deviations high along a segment, not one noisy cell.
 SEGMENT_SCALE = 300.0
 #: Felzenszwalb's Gaussian pre-smoothing [cells]: below a cell, so an edge stays within a cell.
 SEGMENT_SIGMA = 0.8
@@ -72,20 +68,10 @@ _NOISE_FLOORS = (SAME_DELTA_E / 2, SAME_DELTA_E / 2, 1e-3)
 
 @dataclass(frozen=True, eq=False)
 class AppearanceImage:
-    """The first observation's look on the map grid and its segments.
-
-    Attributes
-    ----------
-    lab : (ny, nx, 3) float
-        Mean colour per cell in CIELAB (L* in [0, 100]); NaN where masked.
-    texture : (ny, nx) float
-        Local standard deviation of L*; NaN where masked.
-    segments : (ny, nx) int
-        Segment of each cell, ``0 .. n_segments - 1``; ``-1`` where masked.
-    features : (n_segments, 5) float
-        Each segment's standardised features (mean L*, a*, b*; the spread of L* within it; mean
-        height), dimensionless.
-    """
+    """The first observation's look on the map grid and its segments: ``lab (ny, nx, 3)`` the
+    mean CIELAB colour per cell and ``texture (ny, nx)`` the local std of L* (NaN where masked);
+    ``segments (ny, nx)`` each cell's segment ``0 .. n_segments - 1`` (``-1`` masked);
+    ``features (n_segments, 5)`` the standardised mean L*, a*, b*, spread of L*, mean height."""
 
     lab: NDArray[np.float64]
     texture: NDArray[np.float64]

@@ -99,13 +99,8 @@ class AppearancePrior:
 
 @dataclass(frozen=True)
 class WeightPosterior:
-    """The posterior over the prior's grid of ``(w, ℓ_a)``.
-
-    Attributes
-    ----------
-    weights, look_scales, probability : (m,) float
-        Each grid point's ``w``, ``ℓ_a`` and posterior probability (summing to 1).
-    """
+    """The posterior over the prior's grid of ``(w, ℓ_a)``: each grid point's ``weights``,
+    ``look_scales`` and ``probability`` (summing to 1), ``(m,)`` each."""
 
     weights: Array
     look_scales: Array
@@ -173,9 +168,15 @@ class AppearanceModels:
                                      length_scale=self.length_scale, weight=weight,
                                      look_scale=scale)  # fmt: skip
 
+    def _variance(self, k: int, cross: Array) -> Array:
+        """``(q,)`` the posterior variance under grid point ``k`` given ``cross (q, p)``."""
+        s2 = self.signal_std**2
+        v = sla.solve_triangular(self._factors[k][0], cross.T / np.sqrt(s2), lower=True,
+                                 check_finite=False)  # fmt: skip
+        return np.asarray(np.maximum(s2 - np.sum(v**2, axis=0), 0.0))
+
     def predict(self, query: Array) -> tuple[Array, Array]:
         """``(mean, variance)`` at ``query (q, 2)`` [m]: the model average (module docstring)."""
-        s2 = self.signal_std**2
         first = np.zeros(query.shape[0])
         second = np.zeros(query.shape[0])
         exp_var = np.zeros(query.shape[0])
@@ -185,21 +186,14 @@ class AppearanceModels:
                 continue
             cross = self._cov(query, post.weights[k], post.look_scales[k])  # (q, p)
             mean = self.constant + cross @ self._alphas[k]
-            v = sla.solve_triangular(self._factors[k][0], cross.T / np.sqrt(s2), lower=True,
-                                     check_finite=False)  # fmt: skip
-            var = np.maximum(s2 - np.sum(v**2, axis=0), 0.0)
             first += prob * mean
             second += prob * mean**2
-            exp_var += prob * var
+            exp_var += prob * self._variance(k, cross)
         return first, exp_var + np.maximum(second - first**2, 0.0)
 
     def blind_variance(self, query: Array) -> Array:
         """``(q,)`` the variance at ``query`` under ``w = 0``, the blind map's."""
-        cross = self._cov(query, 0.0, LOOK_SCALES[0])
-        s2 = self.signal_std**2
-        v = sla.solve_triangular(self._factors[0][0], cross.T / np.sqrt(s2), lower=True,
-                                 check_finite=False)  # fmt: skip
-        return np.asarray(np.maximum(s2 - np.sum(v**2, axis=0), 0.0))
+        return self._variance(0, self._cov(query, 0.0, LOOK_SCALES[0]))
 
     def covariance_at_mean(self, xy_a: Array, xy_b: Array) -> Array:
         """The prior covariance at the posterior-mean ``w`` and the most probable ``ℓ_a``

@@ -1,16 +1,12 @@
 """Non-myopic poke planning: the fewest further pokes that bring the map field under ``T_h``.
 
-A GP's posterior variance depends on where the data are and on their noise, never on the values
-(RW2006 Eq. 2.26), so the pokes after which the largest variance over the domain falls below
-``T_h`` can be planned before any is made: a covering design, solved approximately over a grid of
-candidates for ``m = 1, 2, …`` pokes in turn. A design scores the variance above ``T_h`` summed
-over the domain, ties broken by the largest variance (the sum still falls when a move helps one
-corner and leaves the worst as it was). The plan for ``m`` is that for ``m − 1`` plus the best
-candidate, improved by exchange passes (Fedorov 1972) that move each planned poke to the
-candidate that best complements the others, until a pass moves none or after ``max_passes``;
-the first ``m`` whose plan reaches ``T_h`` is the plan. Planned pokes are assumed to have the
-noise ``_targets.expected_noise`` gives; a real poke often reports more, so the loop plans again
-after every poke.
+A GP's posterior variance does not depend on the values (RW2006 Eq. 2.26), so the pokes after
+which the largest variance over the domain falls below ``T_h`` can be planned before any is made:
+a covering design over a grid of candidates for ``m = 1, 2, …`` pokes in turn. A design scores
+the variance above ``T_h`` summed over the domain, ties broken by the largest variance. The plan
+for ``m`` is that for ``m − 1`` plus the best candidate, improved by exchange passes (Fedorov
+1972) that move each planned poke to the candidate that best complements the others; the first
+``m`` whose plan reaches ``T_h`` is the plan. The loop plans again after every poke.
 
 References
 ----------
