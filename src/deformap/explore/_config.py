@@ -5,13 +5,7 @@ Each Parameters entry is a one-line description with its unit (metres, newtons, 
 ln E with E in pascals), then the reason for its default. A setting in β units holds for the
 modulus field as the same fraction of its prior (:func:`deformap.explore.field_settings`).
 The ``MAX_*`` bounds refuse, before any work, settings whose matrices would not fit in memory.
-
-References
-----------
-Caccamo, S., Güler, P., Kjellström, H., Kragic, D. (2016). Active Perception and Modeling of
-Deformable Surfaces using Gaussian Processes and Position-based Dynamics. Humanoids.
-Gibson, L. J., Ashby, M. F. (1997). Cellular Solids, 2nd ed., ch. 5.
-Rasmussen, C. E., Williams, C. K. I. (2006). Gaussian Processes for Machine Learning, Sec. 5.4.
+"The paper": Caccamo et al. (2016), referenced in :mod:`deformap.explore._field_config`.
 """
 
 from __future__ import annotations

@@ -1,21 +1,15 @@
 """The next place to poke: the configured strategy until the map field's variance is under its
 ``T_h``, then the boundary pokes (strategies and scores in :mod:`deformap.explore._acquisition`).
 
-Under an appearance prior (:mod:`deformap.explore._appearance_prior`) the looks come first: while
-the variance is above ``T_h``, the interior (:func:`segment_interior`) of the largest segment of
-the largest look no poke has read (a look: the segments within ``ℓ_a`` of it; read: a poke in
-one of them), if that look covers more than one poke does on the blind map
-(:func:`covered_area_m2`) and is not yet known; once it is under ``T_h``, a test of the
-hypothesis the map rests on: in the largest segment with one poke, where the blind map
-(``w = 0``) is still above ``T_h``, so only the look vouches for the place, the place the blind
-map knows least (is the segment one material?). Each segment is tested once; a test the pokes
-contradict moves the weight's posterior toward the blind map and its variance back above
-``T_h``.
+Under an appearance prior the looks come first: while the variance is above ``T_h``, the interior
+(:func:`segment_interior`) of the largest segment of the largest look no poke has read (a look:
+the segments within ``ℓ_a`` of it), if that look covers more than one poke does on the blind map
+(:func:`covered_area_m2`) and is not yet known; once under ``T_h``, a test of the looks: in the
+largest segment with one poke, the place the blind map (``w = 0``) knows least while still above
+``T_h``. A test the pokes contradict moves the weight's posterior toward the blind map.
 
 When only the edge band, where no poke fits, is still above ``T_h``, ``planned`` plans it like
-any other place; the other strategies poke the reachable cell of largest variance, the one nearest
-the band's worst corner (poking where one poke leaves the least largest variance instead is
-myopic: it splits the difference between two corners).
+any other place; the other strategies poke the reachable cell of largest variance.
 """
 
 from __future__ import annotations
