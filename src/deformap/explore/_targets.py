@@ -90,15 +90,6 @@ def _straddle(grid: MapGrid, field: PokeField, pokes: PokeSet, config: Explorati
     return grid.cells_xy[allowed], score
 
 
-def _boundary(grid: MapGrid, field: PokeField, pokes: PokeSet,
-              config: ExplorationConfig) -> NDArray[np.float64] | None:
-    """Where a region boundary is least certain; ``None`` when no place is left."""
-    cells, score = _straddle(grid, field, pokes, config)
-    if score.size == 0:
-        return None
-    return np.array(cells[int(np.argmax(score))], dtype=float)
-
-
 def segment_interior(grid: MapGrid, segments: NDArray[np.int64], segment: int
                      ) -> tuple[NDArray[np.float64], float] | None:  # fmt: skip
     """The reachable cell deepest inside ``segment`` of ``segments (ny, nx)`` (the largest
@@ -196,13 +187,13 @@ def choose_next(grid: MapGrid, field: PokeField, config: ExplorationConfig,
     if done:
         if boundary_owed == 0:
             return None
-        xy = _boundary(grid, field, pokes, config)
-        if xy is None:
+        cells, score = _straddle(grid, field, pokes, config)
+        if score.size == 0:
             logger.warning("%d of %d boundary pokes left undone: no reachable place is %.3g m "
                            "from every poke", boundary_owed, config.boundary_pokes,
                            BOUNDARY_SPACING_ROI * config.touch.roi_size_m)  # fmt: skip
             return None
-        return Target(xy, "boundary")
+        return Target(np.array(cells[int(np.argmax(score))], dtype=float), "boundary")
     cells, reachable = grid.cells_xy[grid.target_mask], variance[grid.target_mask]
     plans: list[PokePlan] = []
 
