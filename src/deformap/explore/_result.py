@@ -1,5 +1,4 @@
-"""What an exploration (or a replayed session) produced: its pokes, the β-field and regions on
-the map's grid, and why it stopped — values, not the live mapper."""
+"""What an exploration (or a replayed session) produced, as values, not the live mapper."""
 
 from __future__ import annotations
 
