@@ -26,12 +26,7 @@ from deformap.explore._field import (
     field_settings,
 )
 from deformap.explore._grid import MapGrid
-from deformap.explore._journal import (
-    JOURNAL_NAME,
-    Journal,
-    JournalContents,
-    read_journal,
-)
+from deformap.explore._journal import JOURNAL_NAME, Journal, JournalContents, read_journal
 from deformap.explore._labels import map_regions
 from deformap.explore._loop import MappingRun, explore, poke_step
 from deformap.explore._mapper import Mapper
@@ -49,49 +44,12 @@ from deformap.explore._records import (
 from deformap.explore._result import AppearanceOutcome, ExplorationResult, StopReason
 from deformap.explore._surface import SurfaceModel, fit_surface
 
-__all__ = [
-    "JOURNAL_NAME",
-    "PURPOSES",
-    "STRATEGIES",
-    "AppearanceOutcome",
-    "BetaField",
-    "BetaFieldConfig",
-    "ContactRecord",
-    "Dent",
-    "ExplorationConfig",
-    "ExplorationResult",
-    "FieldName",
-    "FieldSettings",
-    "Journal",
-    "JournalContents",
-    "MapGrid",
-    "Mapper",
-    "MappingRun",
-    "ModulusField",
-    "ModulusFieldConfig",
-    "ModulusReading",
-    "PokeField",
-    "PokeRecord",
-    "PokeResult",
-    "PokeSet",
-    "PokeTimings",
-    "Purpose",
-    "RegionLabels",
-    "RegionMap",
-    "StopReason",
-    "SurfaceGPConfig",
-    "SurfaceModel",
-    "Target",
-    "TouchGPConfig",
-    "beta_noise_floor",
-    "check_exploration_budget",
-    "explore",
-    "field_settings",
-    "fit_surface",
-    "map_regions",
-    "measure_press",
-    "poke_step",
-    "read_journal",
-    "rigid_modulus_bound",
-    "segment_regions",
-]
+__all__ = ["JOURNAL_NAME", "PURPOSES", "STRATEGIES", "AppearanceOutcome", "BetaField",
+           "BetaFieldConfig", "ContactRecord", "Dent", "ExplorationConfig", "ExplorationResult",
+           "FieldName", "FieldSettings", "Journal", "JournalContents", "MapGrid", "Mapper",
+           "MappingRun", "ModulusField", "ModulusFieldConfig", "ModulusReading", "PokeField",
+           "PokeRecord", "PokeResult", "PokeSet", "PokeTimings", "Purpose", "RegionLabels",
+           "RegionMap", "StopReason", "SurfaceGPConfig", "SurfaceModel", "Target", "TouchGPConfig",
+           "beta_noise_floor", "check_exploration_budget", "explore", "field_settings",
+           "fit_surface", "map_regions", "measure_press", "poke_step", "read_journal",
+           "rigid_modulus_bound", "segment_regions"]

@@ -17,12 +17,9 @@ Strategies
     (a region not yet met is likeliest where the field is least known). Straddle rather than
     ILS-UCB (Garg et al. 2016) because it has no weight to choose: 1.96 is the 95 % band.
 
-Every strategy runs until the map field's variance is below ``T_h`` (the paper's stop). Then come
-the ``boundary_pokes``, if any: the variance criterion leaves the isopleths where the field's length
-scale smoothed them, so each boundary poke goes to the largest straddle score, as for ``level-set``,
-among the reachable cells at least ``_targets.BOUNDARY_SPACING_ROI`` ROIs from every poke (a
-closer dent would overlap an old one). The score reads the pokes' classes before any cut, so where
-the pokes go does not depend on ``region_labels``.
+Every strategy runs until the map field's variance is below ``T_h`` (the paper's stop). Then each
+of the ``boundary_pokes`` goes to the largest straddle score, as for ``level-set``, among the
+reachable cells at least ``_targets.BOUNDARY_SPACING_ROI`` ROIs from every poke.
 
 References
 ----------
@@ -55,39 +52,14 @@ Planner = Callable[[], NDArray[np.float64]]
 Scorer = Callable[[], tuple[NDArray[np.float64], NDArray[np.float64]]]
 
 
-def choose_target(
-    strategy: str,
-    cells_xy: NDArray[np.float64],
-    variance: NDArray[np.float64],
-    threshold: float,
-    rng: np.random.Generator,
-    *,
-    planner: Planner | None = None,
-    scorer: Scorer | None = None,
-) -> NDArray[np.float64] | None:
-    """Pick the next target, or ``None`` when no cell's variance exceeds ``threshold``.
-
-    Parameters
-    ----------
-    strategy : {"paper", "max-variance", "planned", "level-set"}
-    cells_xy : (n, 2) float, metres
-        Centres of the grid cells that may be poked.
-    variance : (n,) float
-        The map field's posterior variance at those cells.
-    threshold : float
-        ``T_h``: exploration stops when every cell's variance is at or below it.
-    rng : numpy.random.Generator
-        Used by ``paper``.
-    planner : callable, optional
-        Required by ``planned``.
-    scorer : callable, optional
-        Required by ``level-set``: its candidates and scores; the first of the largest score is
-        poked.
-    """
+def choose_target(strategy: str, cells_xy: NDArray[np.float64], variance: NDArray[np.float64],
+                  threshold: float, rng: np.random.Generator, *, planner: Planner | None = None,
+                  scorer: Scorer | None = None) -> NDArray[np.float64] | None:
+    """Pick the next target among the cells ``cells_xy (n, 2)`` [m] of map-field variance
+    ``variance (n,)``, or ``None`` when none exceeds ``threshold`` (``T_h``); ``rng`` is used by
+    ``paper``, ``planner`` required by ``planned``, ``scorer`` by ``level-set``."""
     if strategy not in STRATEGIES:
-        raise InvalidArgumentError(
-            f"`strategy` must be one of {list(STRATEGIES)}; got {strategy!r}"
-        )
+        raise InvalidArgumentError(f"`strategy` must be one of {list(STRATEGIES)}; got {strategy!r}")
     above = np.flatnonzero(variance > threshold)
     if above.size == 0:
         return None
@@ -107,11 +79,8 @@ def choose_target(
 
 def boundary_score(mean: NDArray[np.float64], std: NDArray[np.float64],
                    levels: NDArray[np.float64]) -> NDArray[np.float64]:
-    """Straddle score ``1.96 σ − min_l |μ − h_l|`` (Bryan et al. 2005) of cells.
-
-    ``mean`` and ``std`` ``(n,)`` are the map field's posterior at the cells, ``levels`` ``(m,)``
-    the isopleths; with no isopleth (one class) the score is ``std``. Returns ``(n,)``.
-    """
+    """``(n,)`` straddle score ``1.96 σ − min_l |μ − h_l|`` (Bryan et al. 2005) of cells of
+    posterior ``mean``, ``std (n,)`` and isopleths ``levels (m,)``; with none, ``std``."""
     if levels.size == 0:
         return np.asarray(std, dtype=float)
     gap = np.min(np.abs(mean[:, None] - levels[None, :]), axis=1)

@@ -2,29 +2,22 @@
 
 Built once from the cloud before the first poke (:func:`build_appearance`):
 
-1. Each map cell takes the mean sRGB of the cloud's points that fall in it and lie on the fitted
-   surface (within :data:`SURFACE_TOLERANCE_M` of its height: the robot and a block's side faces
-   are not the surface's look); a cell without such points is masked (unseen, or hidden).
-2. Channels per cell: the mean colour in CIELAB (perceptual: a Euclidean step is a colour
-   difference), a texture descriptor (the local standard deviation of L* over a window a dent
-   wide) and the surface model's height, whose steps are the depth edges.
-3. An over-segmentation (Felzenszwalb & Huttenlocher 2004, scikit-image) of the channels, each
-   divided by its own noise, a robust estimate from neighbouring cells' differences, so the
-   segmentation reads the image in the image's own units. Segments are candidate regions, never
-   decisions: the prior (:mod:`deformap.explore._appearance_prior`) weighs them by the pokes.
-   Segments smaller than a dent's footprint are merged into a neighbour; what is still smaller
-   after masking is masked; a segment too thin for a dent (no cell half a footprint from its
-   edge: the strip of blended cells along a boundary) is merged into its most alike neighbour.
-4. Each segment's feature: the mean of its cells' channels, standardised per channel group
-   (colour, texture, height) by the spread of the segment means, but never below that group's
-   noise, nor, for colour and texture, below the just-noticeable difference: a flat channel (a
-   plain world's shading, a flat table's height) is not inflated into a difference.
+1. Each map cell takes the mean sRGB of the cloud's points in it that lie on the fitted surface
+   (within :data:`SURFACE_TOLERANCE_M`); a cell without such points is masked.
+2. Channels per cell: the mean colour in CIELAB (a Euclidean step is a colour difference), the
+   local standard deviation of L* over a window a dent wide (texture), and the surface's height.
+3. A Felzenszwalb & Huttenlocher (2004) over-segmentation of the channels, each divided by its
+   robust noise. Segments are candidate regions the prior (:mod:`._appearance_prior`) weighs by
+   the pokes; those smaller than a dent's footprint are merged or masked, and one too thin for a
+   dent (no cell half a footprint from its edge) is merged into its most alike neighbour.
+4. Each segment's feature: its cells' mean channels, standardised per group (colour, texture,
+   height) by the spread of the segment means, never below the group's noise nor, for colour
+   and texture, the just-noticeable difference, so a flat channel is not inflated.
 
-Where the image cannot carry a layout, :func:`build_appearance` returns the reason instead, and
-the map is the blind one: the cloud has no colour, colour covers too little of the map, the image
-is saturated or black, its colours are all alike, no segment is as large as a dent, or the image
-is one segment, or its segments' looks differ by no more than a just-noticeable difference or its
-noise (a look everywhere alike says nothing of where materials change).
+Where the image cannot carry a layout (no colour, too little seen, saturated or black, colours
+all alike, no segment a dent wide, one segment, looks that differ by no more than a
+just-noticeable difference or the noise), :func:`build_appearance` returns the reason instead and
+the map is the blind one.
 
 References
 ----------
@@ -48,25 +41,21 @@ from deformap.cloud import PointCloud
 __all__ = ["SURFACE_TOLERANCE_M", "AppearanceImage", "build_appearance"]
 
 #: A point further than this from the fitted surface [m] is not the surface's look (the robot, a
-#: block's side face): a centimetre is well above the depth camera's noise and below a tip.
+#: block's side face): well above the depth camera's noise and below a tip.
 SURFACE_TOLERANCE_M = 0.01
-#: Smallest share of the map's cells that must carry colour: with less, the segments would be
-#: islands and the prior would speak for cells it has not seen.
+#: Smallest share of the map's cells that must carry colour, so the prior speaks for seen cells.
 MIN_SEEN_FRACTION = 0.5
 #: CIELAB L* at or above which a cell is saturated, at or below which it is black.
 SATURATED_L, BLACK_L = 99.0, 1.0
-#: Largest share of saturated (or black) cells an image may have: beyond half, the colours show
-#: the exposure, not the surface.
+#: Largest share of saturated (or black) cells: beyond half, the colours show the exposure.
 MAX_CLIPPED_FRACTION = 0.5
-#: A CIELAB difference below this (ΔE*ab = 1) is no difference at all: an image whose colours
-#: span less shows nothing.
+#: A CIELAB difference below this (ΔE*ab = 1) is no difference at all.
 SAME_DELTA_E = 1.0
-#: The just-noticeable CIELAB difference (ΔE*ab ≈ 2.3, Mahy et al. 1994): two looks whose colours
-#: (or textures, in L*) differ by less are one look to the eye, so the segments' spread of colour
-#: and texture is never standardised below it (shading and vignetting stay under it).
+#: The just-noticeable CIELAB difference (ΔE*ab ≈ 2.3, Mahy et al. 1994): colour and texture
+#: spreads are never standardised below it, so shading and vignetting stay one look.
 JND_DELTA_E = 2.3
 #: Felzenszwalb's scale in units of the image's noise: a boundary needs a step several noise
-#: standard deviations high along a segment's length, not one noisy cell.
+#: standard deviations high along a segment, not one noisy cell.
 SEGMENT_SCALE = 300.0
 #: Felzenszwalb's Gaussian pre-smoothing [cells]: below a cell, so an edge stays within a cell.
 SEGMENT_SIGMA = 0.8
@@ -79,20 +68,10 @@ _NOISE_FLOORS = (SAME_DELTA_E / 2, SAME_DELTA_E / 2, 1e-3)
 
 @dataclass(frozen=True, eq=False)
 class AppearanceImage:
-    """The first observation's look on the map grid and its segments.
-
-    Attributes
-    ----------
-    lab : (ny, nx, 3) float
-        Mean colour per cell in CIELAB (L* in [0, 100]); NaN where masked.
-    texture : (ny, nx) float
-        Local standard deviation of L*; NaN where masked.
-    segments : (ny, nx) int
-        Segment of each cell, ``0 .. n_segments - 1``; ``-1`` where masked.
-    features : (n_segments, 5) float
-        Each segment's standardised features (mean L*, a*, b*; the spread of L* within it; mean
-        height), dimensionless.
-    """
+    """The first observation's look on the map grid and its segments: ``lab (ny, nx, 3)`` the
+    mean CIELAB colour per cell and ``texture (ny, nx)`` the local std of L* (NaN where masked);
+    ``segments (ny, nx)`` each cell's segment ``0 .. n_segments - 1`` (``-1`` masked);
+    ``features (n_segments, 5)`` the standardised mean L*, a*, b*, spread of L*, mean height."""
 
     lab: NDArray[np.float64]
     texture: NDArray[np.float64]
@@ -132,9 +111,8 @@ def _cell_colours(cloud: PointCloud, xs: NDArray[np.float64], ys: NDArray[np.flo
 
 
 def _noise(channel: NDArray[np.float64], mask: NDArray[np.bool_]) -> float:
-    """Robust noise standard deviation of a channel as the segmentation sees it (smoothed by
-    :data:`SEGMENT_SIGMA` cells): the MAD of horizontally neighbouring seen cells' differences,
-    over √2 (a difference holds two cells' noise)."""
+    """Robust noise std of a channel smoothed as the segmentation sees it: the MAD of
+    horizontally neighbouring seen cells' differences, over √2."""
     both = mask[:, 1:] & mask[:, :-1]
     smooth = ndi.gaussian_filter(_fill_unseen(channel[..., None], mask)[..., 0], SEGMENT_SIGMA)
     diff = np.diff(smooth, axis=1)[both]
@@ -155,8 +133,7 @@ def _local_std(values: NDArray[np.float64], mask: NDArray[np.bool_], window: int
 
 
 def _fill_unseen(image: NDArray[np.float64], mask: NDArray[np.bool_]) -> NDArray[np.float64]:
-    """Each unseen cell takes its nearest seen cell's channels (the segmentation needs a full
-    image; the unseen cells are masked again after it)."""
+    """Each unseen cell takes its nearest seen cell's channels."""
     if mask.all():
         return image
     idx = ndi.distance_transform_edt(~mask, return_distances=False, return_indices=True)
@@ -183,9 +160,8 @@ def _segment(channels: NDArray[np.float64], mask: NDArray[np.bool_], min_cells: 
 
 def _merge_thin(segments: NDArray[np.int64], channels: NDArray[np.float64],
                 min_depth_cells: float) -> NDArray[np.int64]:
-    """Each segment too thin for a dent (no cell ``min_depth_cells`` from its edge: a strip
-    along a boundary, where the cells blend two looks) merged into the adjacent segment whose mean
-    channels are nearest; labels ``0 ..`` in order again, ``-1`` kept."""
+    """Each segment with no cell ``min_depth_cells`` from its edge merged into the adjacent
+    segment of nearest mean channels; labels ``0 ..`` in order again, ``-1`` kept."""
     n = int(segments.max()) + 1
     edge = np.zeros(segments.shape, dtype=bool)
     for axis in (0, 1):
@@ -223,8 +199,7 @@ def _merge_thin(segments: NDArray[np.int64], channels: NDArray[np.float64],
 def _features(channels: NDArray[np.float64], noise: NDArray[np.float64],
               segments: NDArray[np.int64], n: int) -> tuple[NDArray[np.float64], bool]:
     """``(n, 5)`` standardised segment means (module docstring, step 4), and whether any
-    channel group's spread of segment means exceeds its noise (the looks differ at all);
-    ``channels`` are in their own units, ``noise (5,)`` each channel's noise."""
+    channel group's spread exceeds its floor; ``noise (5,)`` each channel's noise."""
     flat = segments.ravel()
     seen = flat >= 0
     values = channels.reshape(-1, channels.shape[-1])[seen]
@@ -268,26 +243,10 @@ def _unusable(lab: NDArray[np.float64], mask: NDArray[np.bool_]) -> str | None:
 def build_appearance(cloud: PointCloud, xs: NDArray[np.float64], ys: NDArray[np.float64],
                      height: NDArray[np.float64], footprint_m: float
                      ) -> AppearanceImage | str:  # fmt: skip
-    """The appearance image of ``cloud`` on the grid ``xs``, ``ys`` (method: module docstring),
-    or why there is none.
-
-    Parameters
-    ----------
-    cloud : PointCloud
-        The first observation, metres; its ``colors`` (n, 3) sRGB in [0, 1].
-    xs : (nx,) float, ys : (ny,) float, metres
-        The map's cell centres (evenly spaced, the same spacing on both axes).
-    height : (ny, nx) float, metres
-        The surface model's height on the grid.
-    footprint_m : float
-        Width of a dent's footprint [m]: the texture window, and the smallest segment (a disc of
-        that diameter).
-
-    Returns
-    -------
-    AppearanceImage, or str
-        The image, or the one-line reason the map stays blind.
-    """
+    """The appearance image of ``cloud`` (sRGB ``colors`` in [0, 1]) on the evenly spaced grid
+    ``xs (nx,)``, ``ys (ny,)`` [m] with the surface's ``height (ny, nx)`` [m], or the one-line
+    reason there is none; ``footprint_m`` [m] is the texture window and the smallest segment's
+    diameter."""
     if cloud.colors is None:
         return "the cloud has no colour"
     from skimage.color import rgb2lab

@@ -6,20 +6,15 @@ The kernel of a field with prior standard deviation σ and length scale ℓ (the
     k((x, a), (x', a')) = σ² [(1 − w) k_ℓ(x, x') + w k_L(x, x') k_app(a, a')],
 
 ``k_ℓ`` the blind field's squared exponential, ``k_app(a, a') = exp(−‖a − a'‖² / ℓ_a²)`` on the
-segments' standardised features (:mod:`deformap.explore._appearance`; a masked cell takes its
-nearest seen cell's), and ``k_L`` a squared exponential over the workspace's diagonal, so alike
-looks far apart couple a little less than alike looks side by side. At ``w = 0`` it is the blind
-kernel; at every ``w`` the prior variance is σ², so ``T_h`` keeps its meaning. The blind part is
-kept as a sum, not a product ``k_ℓ · (1 − w + w k_app)``: a product only removes covariance, so a
-look could never make known a place the blind map does not already know.
+segments' standardised features (a masked cell takes its nearest seen cell's), and ``k_L`` a
+squared exponential over the workspace's diagonal. At ``w = 0`` it is the blind kernel; at every
+``w`` the prior variance is σ², so ``T_h`` keeps its meaning. It is a sum, not a product
+``k_ℓ · (1 − w + w k_app)``, because a product only removes covariance.
 
-``w`` and ``ℓ_a`` are not fitted to a point: they range over a small grid (:data:`WEIGHTS` ×
-:data:`LOOK_SCALES`, ``w = 0`` the blind map; uniform over ``w``, then over ``ℓ_a``), each point's
-posterior from the pokes' exact marginal likelihood under the field's own noise (RW2006 Eq. 2.30,
-the same constant mean as the blind field). The field on the grid is the Bayesian model average:
-the mixture's mean, and variance ``E[var] + Var[mean]``, so with few pokes the prior's own
-uncertainty keeps the variance up, and where the pokes contradict the looks the posterior moves
-to ``w = 0`` and the map returns to the blind one.
+``w`` and ``ℓ_a`` range over a small grid (:data:`WEIGHTS` × :data:`LOOK_SCALES`; uniform over
+``w``, then ``ℓ_a``), each point's posterior from the pokes' exact marginal likelihood (RW2006
+Eq. 2.30). The field on the grid is the Bayesian model average: the mixture's mean and variance
+``E[var] + Var[mean]``; where the pokes contradict the looks the posterior moves to ``w = 0``.
 
 References
 ----------
@@ -54,14 +49,7 @@ LOOK_SCALES = (0.5, 1.0, 2.0)
 
 
 class AppearancePrior:
-    """The look of every place on the map grid, and the kernel with its factor.
-
-    Parameters
-    ----------
-    image : AppearanceImage
-    xs : (nx,) float, ys : (ny,) float, metres
-        The grid the image is on.
-    """
+    """The look of every place on the grid ``xs``, ``ys`` [m] the ``image`` is on, and the kernel."""
 
     def __init__(self, image: AppearanceImage, xs: Array, ys: Array) -> None:
         self.image = image
@@ -69,9 +57,8 @@ class AppearancePrior:
         self.span_m = float(np.hypot(np.ptp(xs), np.ptp(ys))) or 1.0
         gx, gy = np.meshgrid(xs, ys)
         self.cells_xy = np.column_stack([gx.ravel(), gy.ravel()])
-        # a masked cell (unseen, hidden) is given its nearest seen cell's look: a place hidden by
-        # the robot is likeliest what surrounds it, and a cell with no look at all would be
-        # known only by the blind part of the kernel, never by its neighbours' pokes
+        # a masked cell takes its nearest seen cell's look: a place hidden by the robot is
+        # likeliest what surrounds it
         seg = image.segments
         nearest = ndi.distance_transform_edt(seg < 0, return_distances=False,
                                              return_indices=True)  # fmt: skip
@@ -112,13 +99,8 @@ class AppearancePrior:
 
 @dataclass(frozen=True)
 class WeightPosterior:
-    """The posterior over the prior's grid of ``(w, ℓ_a)``.
-
-    Attributes
-    ----------
-    weights, look_scales, probability : (m,) float
-        Each grid point's ``w``, ``ℓ_a`` and posterior probability (summing to 1).
-    """
+    """The posterior over the prior's grid of ``(w, ℓ_a)``: each grid point's ``weights``,
+    ``look_scales`` and ``probability`` (summing to 1), ``(m,)`` each."""
 
     weights: Array
     look_scales: Array
@@ -154,18 +136,9 @@ def _grid_points() -> tuple[Array, Array, Array]:
 
 
 class AppearanceModels:
-    """The field over some pokes under every ``(w, ℓ_a)`` of the grid, and their average.
-
-    Parameters
-    ----------
-    prior : AppearancePrior
-    xy : (p, 2) float, metres
-        The pokes (``p ≥ 1``).
-    values, noise : (p,) float
-        Their values and noise standard deviations, in the field's units.
-    signal_std, length_scale : float
-        The blind field's σ and ℓ [m].
-    """
+    """The field over the pokes ``xy (p ≥ 1, 2)`` [m] with ``values``, ``noise (p,)`` under every
+    ``(w, ℓ_a)`` of the grid, and their average; ``signal_std``, ``length_scale`` [m] the blind
+    field's σ and ℓ."""
 
     def __init__(self, prior: AppearancePrior, xy: Array, values: Array, noise: Array, *,
                  signal_std: float, length_scale: float) -> None:
@@ -195,9 +168,15 @@ class AppearanceModels:
                                      length_scale=self.length_scale, weight=weight,
                                      look_scale=scale)  # fmt: skip
 
+    def _variance(self, k: int, cross: Array) -> Array:
+        """``(q,)`` the posterior variance under grid point ``k`` given ``cross (q, p)``."""
+        s2 = self.signal_std**2
+        v = sla.solve_triangular(self._factors[k][0], cross.T / np.sqrt(s2), lower=True,
+                                 check_finite=False)  # fmt: skip
+        return np.asarray(np.maximum(s2 - np.sum(v**2, axis=0), 0.0))
+
     def predict(self, query: Array) -> tuple[Array, Array]:
         """``(mean, variance)`` at ``query (q, 2)`` [m]: the model average (module docstring)."""
-        s2 = self.signal_std**2
         first = np.zeros(query.shape[0])
         second = np.zeros(query.shape[0])
         exp_var = np.zeros(query.shape[0])
@@ -207,21 +186,14 @@ class AppearanceModels:
                 continue
             cross = self._cov(query, post.weights[k], post.look_scales[k])  # (q, p)
             mean = self.constant + cross @ self._alphas[k]
-            v = sla.solve_triangular(self._factors[k][0], cross.T / np.sqrt(s2), lower=True,
-                                     check_finite=False)  # fmt: skip
-            var = np.maximum(s2 - np.sum(v**2, axis=0), 0.0)
             first += prob * mean
             second += prob * mean**2
-            exp_var += prob * var
+            exp_var += prob * self._variance(k, cross)
         return first, exp_var + np.maximum(second - first**2, 0.0)
 
     def blind_variance(self, query: Array) -> Array:
         """``(q,)`` the variance at ``query`` under ``w = 0``, the blind map's."""
-        cross = self._cov(query, 0.0, LOOK_SCALES[0])
-        s2 = self.signal_std**2
-        v = sla.solve_triangular(self._factors[0][0], cross.T / np.sqrt(s2), lower=True,
-                                 check_finite=False)  # fmt: skip
-        return np.asarray(np.maximum(s2 - np.sum(v**2, axis=0), 0.0))
+        return self._variance(0, self._cov(query, 0.0, LOOK_SCALES[0]))
 
     def covariance_at_mean(self, xy_a: Array, xy_b: Array) -> Array:
         """The prior covariance at the posterior-mean ``w`` and the most probable ``ℓ_a``

@@ -1,10 +1,7 @@
-"""Which field a run maps on: the policy that, poke after poke, picks the β-field or the modulus
-field, never editing the settings (``ExplorationConfig.field`` stays what was asked for).
-
-Under ``field: modulus`` the run maps on the modulus field once a poke has a modulus, on the
-β-field before. A place whose modulus could not be read twice (two unread presses within
-:func:`unread_radius_m`) leaves the targets and the stopping rule (a disc about each such press);
-when no target would be left the run maps on the β-field for good.
+"""Which field a run maps on, poke after poke. Under ``field: modulus`` the run maps on the
+modulus field once a poke has a modulus, on the β-field before. A place whose modulus could not
+be read twice (two unread presses within :func:`unread_radius_m`) leaves the targets and the
+stopping rule; when no target would be left the run maps on the β-field for good.
 """
 
 from __future__ import annotations

@@ -49,13 +49,9 @@ REGION_Z = 2.0
 
 @dataclass(frozen=True)
 class RegionMap:
-    """Regions of a field on a grid.
-
-    ``labels (ny, nx)``: each cell's region, from the field's lowest band up; ``levels
-    (n_regions - 1,)``: the isopleths, increasing; ``class_betas (n_regions,)``: each class's mean
-    value (β, or ln E [ln Pa]); ``poke_labels (k,)``: each poke's class, in the order given (not
-    always the band its value falls in).
-    """
+    """Regions of a field on a grid: ``labels (ny, nx)`` each cell's region, from the lowest band
+    up; ``levels (n_regions - 1,)`` the isopleths, increasing; ``class_betas (n_regions,)`` each
+    class's mean (β, or ln E); ``poke_labels (k,)`` each poke's class, in the order given."""
 
     labels: NDArray[np.int64]
     levels: NDArray[np.float64]

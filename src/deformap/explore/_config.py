@@ -1,20 +1,11 @@
 """Settings of the mapper and the exploration loop: :class:`ExplorationConfig` gathers one frozen,
-keyword-only dataclass per component (the fields' in :mod:`deformap.explore._field_config`) and
-re-exports them.
+keyword-only dataclass per component (the fields' in :mod:`deformap.explore._field_config`).
 
-Each class's Parameters section describes every field: first a one-line description with its unit
-(lengths in metres, forces in newtons, β dimensionless in [0, 1), the modulus field in ln E with E
-in pascals), then the reason for its default. A setting given in β units holds for the modulus
-field as the same fraction of its prior: ``T_h`` of the prior variance, the regions' smallest step
-of the prior standard deviation (:func:`deformap.explore.field_settings`).
+Each Parameters entry is a one-line description with its unit (metres, newtons, β in [0, 1),
+ln E with E in pascals), then the reason for its default. A setting in β units holds for the
+modulus field as the same fraction of its prior (:func:`deformap.explore.field_settings`).
 The ``MAX_*`` bounds refuse, before any work, settings whose matrices would not fit in memory.
-
-References
-----------
-Caccamo, S., Güler, P., Kjellström, H., Kragic, D. (2016). Active Perception and Modeling of
-Deformable Surfaces using Gaussian Processes and Position-based Dynamics. Humanoids.
-Gibson, L. J., Ashby, M. F. (1997). Cellular Solids, 2nd ed., ch. 5.
-Rasmussen, C. E., Williams, C. K. I. (2006). Gaussian Processes for Machine Learning, Sec. 5.4.
+"The paper": Caccamo et al. (2016), referenced in :mod:`deformap.explore._field_config`.
 """
 
 from __future__ import annotations
@@ -39,26 +30,10 @@ from deformap.explore._field_config import (
 from deformap.msm import ShapeMatchingConfig
 from deformap.stiffness import StiffnessConfig
 
-__all__ = [
-    "MAX_MAP_CELLS",
-    "MAX_PLAN_CELLS",
-    "MAX_ROI_BAND_BYTES",
-    "AppearanceUse",
-    "BetaFieldConfig",
-    "BetaUncertainty",
-    "DepthAnchor",
-    "ExplorationConfig",
-    "FieldName",
-    "ModulusFieldConfig",
-    "NuggetEstimate",
-    "RegionLabels",
-    "StopRegion",
-    "SurfaceGPConfig",
-    "TactileCap",
-    "TouchGPConfig",
-    "TouchModel",
-    "check_exploration_budget",
-]
+__all__ = ["MAX_MAP_CELLS", "MAX_PLAN_CELLS", "MAX_ROI_BAND_BYTES", "AppearanceUse",
+           "BetaFieldConfig", "BetaUncertainty", "DepthAnchor", "ExplorationConfig", "FieldName",
+           "ModulusFieldConfig", "NuggetEstimate", "RegionLabels", "StopRegion", "SurfaceGPConfig",
+           "TactileCap", "TouchGPConfig", "TouchModel", "check_exploration_budget"]
 
 #: Where the variance must fall below ``T_h`` (``ExplorationConfig.stop_region``).
 StopRegion = Literal["workspace", "targets"]
@@ -93,72 +68,47 @@ class ExplorationConfig:
     ----------
     threshold : float
         ``T_h``, the largest map-field variance the stop cells may keep, in β².
-        The modulus field reads it as the same fraction of its prior variance; 0.06 is the
-        paper's.
+        The modulus field reads it as the same fraction of its prior variance; 0.06 is the paper's.
     max_pokes : int
         Most pokes of a run, boundary pokes included, a count.
     strategy : {"paper", "max-variance", "planned", "level-set"}
         How the next poke is chosen (:mod:`deformap.explore._acquisition`).
-        ``planned`` (default) takes the first of the fewest pokes, the centre included, that
-        bring every cell below ``T_h``.
     first_target : (2,) float or None
         The first poke's x, y, metres in the world frame; ``None``: the workspace's centre.
     stop_region : {"workspace", "targets"}
         Where the variance must fall below ``T_h``, the whole map or the targets.
-        ``workspace`` (default), every cell of the map; ``targets``, the cells a poke can be centred
-        on (half a ROI inside the edges), the paper's literal rule, which stops sooner and leaves
-        the edge band to extrapolation.
+        ``targets`` (half a ROI inside the edges) is the paper's rule, which leaves the edge band
+        to extrapolation.
     force_n : float
         Commanded normal force of every press, newtons.
-        0.6 N keeps the Hertz contact of a 1 cm tip on the tip for foams down to 60 N
-        (``F <= 4 E* R² / 3`` = 0.68 N) while denting them by millimetres, well above the
-        camera's noise.
+        0.6 N keeps the Hertz contact of a 1 cm tip on the tip for foams down to 60 N while
+        denting them by millimetres.
     max_regions : int
         Most regions the map field is cut into, a count (:mod:`deformap.explore._classes`).
     region_prior_dof : float
         Degrees of freedom the pokes' claimed uncertainties count for in the region test.
-        The test judges whether the values scatter more than one material's would; 7 is as
-        much as eight presses on one foam; 0 ignores the claims (scale-free).
+        7 is as much as eight presses on one foam; 0 ignores the claims (scale-free).
     region_labels : {"isopleth", "nearest", "indicator-kriging"}
-        How cells get their region once the classes are found.
-        See :mod:`deformap.explore._labels`: ``isopleth``, the paper's, by the band of the map
-        field's mean a cell falls in; ``nearest`` (default, the cut that counted the regions of
-        random worlds best), by the class of the nearest poke; ``indicator-kriging``, by the most
-        probable class, each class's probability kriged from the pokes' class indicators
-        (:mod:`deformap.explore._indicator`).
+        How cells get their region once the classes are found (:mod:`deformap.explore._labels`).
     merge_seams : bool
         Whether to merge the classes that lie on a seam between two others before labelling.
-        Every poke of such a class borders pokes of two others within twice the layer's thickness
-        (:mod:`deformap.explore._places`); on, because a press where two pieces meet reads
-        between or below both and would otherwise be a region of its own.
+        On, because a press where two pieces meet reads between both.
     split_by_place : bool
         Whether to split a class whose pokes form two places of different values, before merging.
-        It needs six pokes away from the other classes (:mod:`deformap.explore._places`);
-        on, because two materials closer than the region test's smallest step, side by side, are
-        otherwise one region.
+        On, because two close materials side by side are otherwise one region.
     boundary_pokes : int
         Pokes made after the variance has fallen below ``T_h``, a count.
-        Each goes where a region boundary is least certain (straddle score, Bryan et al. 2005;
-        :mod:`deformap.explore._acquisition`); 0, the paper's rule, stops there.
+        Each goes where a region boundary is least certain; 0, the paper's rule, stops there.
     beta_uncertainty : {"camera-noise", "shape-matching"}
         Where each poke's β uncertainty, its noise in the β-field, comes from.
-        ``camera-noise`` (default), the camera's noise measured in the ROI carried through the
-        touch GP and the estimate (``touch.noise_samples`` >= 2 draws), a repeatability at one
-        place; ``shape-matching``, the shape matcher's own (``shape_matching.uncertainty``;
-        ``touch.noise_samples`` must then be 0, so no setting is silently ignored).
+        ``camera-noise`` needs ``touch.noise_samples`` >= 2, ``shape-matching`` needs it 0.
     field : {"beta", "modulus"}
         The field the regions, the next-poke choice and the stop run on, β or ln E.
-        ``beta``, the paper's; ``modulus`` (default), in physical units and independent of the
-        camera. Under ``modulus`` a place whose modulus could not be read twice leaves the targets
-        and stop cells (``ExplorationResult.unread_places``); the run maps on ``beta`` while no
-        poke has a modulus, and for good once no target would be left, and says why
+        ``modulus`` is in physical units and maps on β while no poke has a modulus
         (``field_fallback``).
     appearance : {"auto", "off"}
         Whether the map field uses the first observation's colours as a prior on the layout.
-        ``auto`` (default) uses them when the cloud has colour and the image shows a layout
-        (:mod:`deformap.explore._appearance`), their weight learned from the pokes and lost
-        where the pokes contradict them (:mod:`deformap.explore._appearance_prior`); ``off``,
-        the blind map.
+        ``auto`` uses them when the image shows a layout (:mod:`deformap.explore._appearance`).
     surface : SurfaceGPConfig
         The crop, filters and surface GP of the first observation.
     touch : TouchGPConfig
@@ -166,13 +116,11 @@ class ExplorationConfig:
     beta_field : BetaFieldConfig
         Prior and noise of the β-field.
     modulus_field : ModulusFieldConfig
-        Prior of the modulus field.
-        It is computed whenever a poke has a modulus, whichever ``field`` is chosen.
+        Prior of the modulus field, computed whenever a poke has a modulus.
     shape_matching : ShapeMatchingConfig
         The shape-matching β estimate of each dent (:mod:`deformap.msm`).
     stiffness : StiffnessConfig
         Reading stiffness and Young's modulus from a press's force–travel record.
-        Used when the environment gives a record (:func:`deformap.stiffness.estimate_stiffness`).
     """
 
     threshold: float = setting(0.06, gt=0.0)
@@ -244,18 +192,8 @@ class ExplorationConfig:
 
 
 def check_exploration_budget(config: ExplorationConfig, workspace: Workspace) -> None:
-    """Refuse, before any work, an exploration whose maps of ``workspace`` would be absurdly large.
-
-    The bounds that depend on a single settings object hold from its construction; these depend
-    on the workspace too. The map grid (``Workspace.grid`` at ``surface.grid_spacing_m``) must
-    have at most :data:`MAX_MAP_CELLS` cells and, for ``planned``, the planner's 2 cm grid at
-    most :data:`MAX_PLAN_CELLS`.
-
-    Parameters
-    ----------
-    config : ExplorationConfig
-    workspace : Workspace
-        The rectangle to map (``Environment.workspace``).
+    """Refuse, before any work, an exploration whose map grid has over :data:`MAX_MAP_CELLS`
+    cells or, for ``planned``, whose 2 cm planning grid has over :data:`MAX_PLAN_CELLS`.
 
     Raises
     ------

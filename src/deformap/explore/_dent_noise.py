@@ -1,11 +1,9 @@
 """How much the camera's noise moves the reconstructed dent: the touch GP's smoother on noise.
 
-A poke's noise is how far β would move under another draw of the camera's noise. The GP's mean is
-linear in the data, ``m = W y`` with ``W = K*ₓ (K + Σ)⁻¹``, so the noise ``ε ~ N(0, Σ)`` leaves
-the error ``W ε``, drawn here without the data's values: the reconstruction's sampling spread, not
-the posterior (systematic errors are left to the nugget, :mod:`deformap.explore._nugget`). The
-camera's points are binned onto the ROI's grid (one observation per node, noise σₙ/√count); the
-tactile points enter as they are.
+The GP's mean is linear in the data, ``m = W y`` with ``W = K*ₓ (K + Σ)⁻¹``, so the noise
+``ε ~ N(0, Σ)`` leaves the error ``W ε``, drawn here without the data's values: the
+reconstruction's sampling spread, not the posterior. The camera's points are binned onto the
+ROI's grid (noise σₙ/√count per node); the tactile points enter as they are.
 
 References
 ----------
@@ -42,10 +40,9 @@ def dent_error_samples(xs: NDArray[np.float64], ys: NDArray[np.float64],
     gx_, gy_ = check_array("xs", xs, (None,), min_rows=2), check_array("ys", ys, (None,), min_rows=2)
     pts = check_array("points_xy", points_xy, (None, 2), what="positions in metres")
     extra = check_array("extra_xy", extra_xy, (None, 2), what="positions in metres")
-    check_positive("points_noise_m", points_noise_m)
-    check_positive("extra_noise_m", extra_noise_m)
-    check_positive("length_scale_m", length_scale_m)
-    check_positive("signal_std_m", signal_std_m)
+    for name, value in (("points_noise_m", points_noise_m), ("extra_noise_m", extra_noise_m),
+                        ("length_scale_m", length_scale_m), ("signal_std_m", signal_std_m)):
+        check_positive(name, value)
     check_int("n_samples", n_samples, minimum=2)
     if pts.shape[0] + extra.shape[0] == 0:
         raise InvalidArgumentError("`points_xy` and `extra_xy` are both empty: nothing was seen")

@@ -66,9 +66,7 @@ class FieldSettings:
 
 def beta_noise_floor(config: ExplorationConfig) -> float:
     """The smallest σ a poke's β is credited with: ``beta_field.noise_floor`` when set, else the
-    β grid's quantisation, ``shape_matching.beta_resolution / √12`` (the σ of a value known to
-    one step of the grid, what :func:`deformap.msm.estimate_beta` claims at least and a press read
-    rigid claims: :mod:`deformap.explore._dent`)."""
+    β grid's quantisation, ``shape_matching.beta_resolution / √12``."""
     floor = config.beta_field.noise_floor
     if floor is None:
         return float(config.shape_matching.beta_resolution / np.sqrt(12.0))
@@ -76,13 +74,8 @@ def beta_noise_floor(config: ExplorationConfig) -> float:
 
 
 def field_settings(config: ExplorationConfig, name: FieldName | None = None) -> FieldSettings:
-    """The settings of the field ``name`` (default: the one ``config.field`` chooses).
-
-    ``threshold`` (``T_h``) and the regions' smallest step are given in β units; the modulus field
-    takes them as the same fraction of its prior: ``T_h`` scaled by the ratio of the prior
-    variances, the step by the ratio of the prior standard deviations (``_config``'s docstring,
-    "Modulus field").
-    """
+    """The settings of the field ``name`` (default: ``config.field``); the modulus field scales
+    ``T_h`` by the ratio of the prior variances and the regions' step by that of the stds."""
     beta = config.beta_field
     if (name or config.field) == "beta":
         return FieldSettings("beta", beta.signal_std, beta.length_scale_m, beta_noise_floor(config),
@@ -98,16 +91,10 @@ def field_settings(config: ExplorationConfig, name: FieldName | None = None) -> 
 class PokeSet:
     """Where the pokes were and what they gave, as arrays.
 
-    ``xy (p, 2)`` metres, ``values (p,)`` the values the field is fitted to (β for the β-field,
-    ln E [ln Pa] for the modulus field), ``noise (p,)`` each poke's uncertainty raised to the
-    field's noise floor and, with a nugget, ``√(σ² + nugget²)`` (what the field and the planner
-    take as its noise), ``index (p,)`` the pokes' indices in their run (``PokeRecord.index``;
-    default ``0 .. p-1``; a session's skipped poke and the modulus field's pokes without a modulus
-    leave gaps), ``nugget`` the scatter between places of one material added to every poke's
-    noise (0: none; :func:`deformap.explore._nugget.with_nugget`), ``thickness (p,)`` the layer's
-    thickness at each poke in metres (:func:`layer_thickness`; ``None`` when not every poke has
-    one), which bounds how far a junction can reach a press
-    (:func:`deformap.explore._places.merge_seam_classes`).
+    ``xy (p, 2)`` metres; ``values (p,)`` β or ln E [ln Pa]; ``noise (p,)`` each poke's σ raised
+    to the field's floor and, with a nugget, ``√(σ² + nugget²)``; ``index (p,)`` the pokes'
+    ``PokeRecord.index`` (default ``0 .. p-1``); ``nugget`` the scatter between places of one
+    material (0: none); ``thickness (p,)`` the layer's thickness at each poke [m], or ``None``.
     """
 
     xy: NDArray[np.float64]
@@ -146,12 +133,8 @@ def layer_thickness(records: Sequence[PokeRecord]) -> NDArray[np.float64] | None
 
 class PokeField:
     """A Gaussian random field over the values of a set of pokes, read on the grid ``xs``, ``ys``
-    (no poke: the prior).
-
-    The prior mean is a constant, the pokes' inverse-noise-variance weighted mean
-    (:class:`deformap.gp.GaussianRandomField`), so far from every poke the field reverts to what
-    the pokes say on average, not to an arbitrary zero. Each poke's noise is ``pokes.noise``,
-    floor and nugget included.
+    (no poke: the prior). The prior mean is the pokes' inverse-noise-variance weighted mean, so
+    far from every poke the field reverts to what the pokes say on average.
 
     Parameters
     ----------
@@ -163,13 +146,9 @@ class PokeField:
     Attributes
     ----------
     name : {"beta", "modulus"}
-        Which field it is (:func:`field_settings` of that name gives its settings).
     mean, variance : (ny, nx) float
-        Posterior mean (NaN without pokes) and variance, computed once on first use; under an
-        appearance prior (:meth:`with_prior`), the average over its weights
-        (:mod:`deformap.explore._appearance_prior`).
-    prior : AppearancePrior or None
-        The appearance prior the field uses (``None``: the blind field).
+        Posterior mean (NaN without pokes) and variance, computed on first use; under an
+        appearance prior (:meth:`with_prior`; ``None``: blind), the average over its weights.
     """
 
     name: ClassVar[FieldName]
@@ -232,8 +211,7 @@ class PokeField:
 
 
 class BetaField(PokeField):
-    """The β-field ("GPR β-field"): the field over the pokes' βs. The mapper's pokes are
-    :func:`deformap.explore._nugget.beta_pokes` (each σ raised to the floor, plus the map's nugget)."""
+    """The β-field ("GPR β-field") over the pokes' βs (:func:`deformap.explore._nugget.beta_pokes`)."""
 
     name: ClassVar[FieldName] = "beta"
 

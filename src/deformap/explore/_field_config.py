@@ -31,9 +31,8 @@ NuggetEstimate = Literal["within-class", "off"]
 
 @dataclass(frozen=True, kw_only=True)
 class SurfaceGPConfig:
-    """Crop, outlier filter and the surface Gaussian random field ("GPR world"), whose
-    hyperparameters are fitted by maximum marginal likelihood (RW2006 Sec. 5.4) from the values
-    below.
+    """Crop, outlier filter and the surface Gaussian random field ("GPR world"), its
+    hyperparameters fitted by maximum marginal likelihood (RW2006 Sec. 5.4) from the values below.
 
     Parameters
     ----------
@@ -93,8 +92,7 @@ class SurfaceGPConfig:
 
 @dataclass(frozen=True, kw_only=True)
 class TouchGPConfig:
-    """The ROI around a poke, the robot's removal from it, and the touch GP ("GPR-touch") fitted
-    to the ROI of the cloud seen while pressing plus the tactile points.
+    """The ROI around a poke, the robot's removal from it, and the touch GP ("GPR-touch").
 
     Parameters
     ----------
@@ -109,8 +107,7 @@ class TouchGPConfig:
     tactile_noise_std_m : float
         Noise standard deviation of tactile points on the tip's proprioceptive pose, metres.
     tactile_cap : {"contact", "fixed"}
-        Which cap of the tip carries the tactile points.
-        ``contact`` touches at δ (:func:`deformap.cloud.contact_cap`); ``fixed`` is the paper's.
+        Which cap of the tip carries the tactile points (``fixed`` is the paper's 30°).
     depth_anchor : {"record", "tip"}
         Where the tactile points' depth comes from, the record or the tip.
         ``record``: the surface minus the record's indentation, blind to the tip's height error.
@@ -122,13 +119,11 @@ class TouchGPConfig:
         2 mm: proprioception and camera do not agree to the millimetre.
     tip_margin_m : float
         Margin beyond the tip's radius of the ball whose points are removed, metres.
-        The tactile points stand for what it hides.
     above_surface_m : float
         Height above the pre-poke surface above which points are removed, metres.
         A dent goes down, so 1 cm higher is the stick, the hand or a flying pixel.
     max_slope_deg : float
         Steepest surface kept in the ROI, degrees from the horizontal.
-        It removes the flying-pixel veils behind the stick below ``above_surface_m``.
     length_scale_m : float
         Length scale σ_w of the touch GP, metres.
         1 cm, the tip's radius: the dent cannot vary faster than the body pressing it.
@@ -138,7 +133,6 @@ class TouchGPConfig:
         Standard deviation of the camera's height noise in the ROI, metres.
     noise_samples : int
         Draws of the camera's noise carried through the touch GP for β's uncertainty, a count.
-        0 when ``ExplorationConfig.beta_uncertainty`` is ``shape-matching``, else at least 2.
     """
 
     roi_size_m: float = setting(0.12, gt=0.0)
@@ -167,8 +161,7 @@ class TouchGPConfig:
 
 @dataclass(frozen=True, kw_only=True)
 class BetaFieldConfig:
-    """Prior of the β-field, the Gaussian random field over the pokes' β (the paper's σe, σw, σn);
-    each poke's noise is ``√(σᵢ² + τ̂²)``, σᵢ its claimed σ at least ``noise_floor``.
+    """Prior of the β-field over the pokes' β (the paper's σe, σw, σn).
 
     Parameters
     ----------
@@ -180,10 +173,8 @@ class BetaFieldConfig:
         0.2 m, a third of a table, is the size of the pieces a robot is asked to tell apart.
     noise_floor : float or None
         Smallest claimed σ of a poke's β, dimensionless; ``None``: the β grid's quantisation.
-        The quantisation ``beta_resolution / √12`` is what every β̂'s σ already is at least.
     nugget : {"within-class", "off"}
-        How the nugget τ̂, in β units, is estimated.
-        ``within-class`` (:mod:`deformap.explore._nugget`) or ``off`` (τ̂ = 0).
+        How the nugget τ̂, in β units, is estimated (:mod:`deformap.explore._nugget`; off: 0).
     """
 
     signal_std: float = setting(0.3, gt=0.0)

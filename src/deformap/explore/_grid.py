@@ -1,7 +1,5 @@
 """The map's grid: every cell of the workspace, where a poke may go, where the variance must fall.
-
-Targets keep half a ROI inside the workspace, so each ROI lies on the surveyed surface, not over
-its edge. The planner (:mod:`deformap.explore._planning`) works on two coarser lattices of it.
+Targets keep half a ROI inside the workspace, so each ROI lies on the surveyed surface.
 """
 
 from __future__ import annotations

@@ -2,12 +2,11 @@
 
 The classes are the region test's; for each threshold ``k`` between classes (ordered by mean) the
 indicator ``I_k = [class ≤ k]`` of the pokes is kriged over the map (Journel 1983), estimating
-``P(class(x) ≤ k)``; a cell takes the class of largest probability. The kriging uses the map
-field's own covariance and each poke's noise, so the cut differs from the isopleths only in
-smoothing a poke's class instead of its value (a map has too few pokes to fit an indicator
-variogram); it is simple kriging about each indicator's share of the pokes. The estimates are
-clipped to [0, 1] and made non-decreasing in ``k`` (order-relation correction, Deutsch & Journel
-1998, GSLIB Sec. V.1.6); ties go to the lower class.
+``P(class(x) ≤ k)``; a cell takes the class of largest probability. It is simple kriging about
+each indicator's share of the pokes, with the map field's own covariance and each poke's noise (a
+map has too few pokes to fit an indicator variogram). The estimates are clipped to [0, 1] and
+made non-decreasing in ``k`` (order-relation correction, Deutsch & Journel 1998, GSLIB Sec.
+V.1.6); ties go to the lower class.
 
 References
 ----------
@@ -30,8 +29,7 @@ __all__ = ["class_probabilities", "indicator_labels"]
 
 
 def _order_relations(cdf: NDArray[np.float64]) -> NDArray[np.float64]:
-    """``cdf (q, m)`` clipped to [0, 1] and made non-decreasing along rows: the mean of the running
-    maximum from the left and the running minimum from the right."""
+    """``cdf (q, m)`` clipped to [0, 1], the mean of its running max and reversed running min."""
     clipped = np.clip(cdf, 0.0, 1.0)
     up = np.maximum.accumulate(clipped, axis=1)
     down = np.minimum.accumulate(clipped[:, ::-1], axis=1)[:, ::-1]

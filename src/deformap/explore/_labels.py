@@ -4,12 +4,9 @@ merged and classes split by place (:mod:`deformap.explore._places`), then each c
 
 - ``isopleth``, the paper's: a cell takes the band of the field's mean it falls in between the
   isopleths midway between neighbouring classes' means, so a region is a level set of the map.
-- ``nearest``, the default: a cell takes the class of the poke nearest to it
-  (:meth:`RegionMap.nearest_poke`); under an appearance prior, of the poke it is most correlated
-  with under the prior's model-averaged kernel (:mod:`deformap.explore._appearance_prior`), which
-  at weight 0 is the nearest poke. The isopleths of a field with a decimetre length scale are
-  smooth curves that revert towards the field's mean away from the pokes, and pokes placed to pin
-  a boundary do not move them much; the nearest-poke labels of the same pokes follow the pokes.
+- ``nearest``, the default: a cell takes the class of the poke nearest to it; under an appearance
+  prior, of the poke it is most correlated with under the prior's model-averaged kernel. Unlike
+  smooth isopleths, which revert to the field's mean away from the pokes, these follow the pokes.
 - ``indicator-kriging``: a cell takes its most probable class, each class's probability kriged
   from the pokes' class indicators with the map field's own covariance
   (:mod:`deformap.explore._indicator`).
@@ -35,15 +32,10 @@ def map_regions(mean: NDArray[np.float64], pokes: PokeSet, cells_xy: NDArray[np.
                 config: ExplorationConfig, field: FieldName, *,
                 correlation: Callable[[NDArray[np.float64]], NDArray[np.float64]] | None = None,
                 ) -> RegionMap:  # fmt: skip
-    """The regions of the field ``field`` (the one mapped on, which after a fallback is not
-    ``config.field``) with mean ``mean (ny, nx)`` fitted to ``pokes``, as the exploration
-    settings ask: classes by
-    :func:`deformap.explore.segment_regions` (``max_regions``, ``region_prior_dof``, the field's
-    noise floor and smallest step), junctions merged (``merge_seams``) and classes split by place
-    (``split_by_place``), cells labelled by isopleth, by nearest poke or by indicator kriging
-    (``region_labels``; ``cells_xy (ny · nx, 2)`` are the grid's cells). ``correlation``
-    (``cells (q, 2) -> (q, p)``, an appearance prior's) labels ``nearest`` by the most correlated
-    poke instead of the nearest one."""
+    """The regions of the map field ``field`` of mean ``mean (ny, nx)`` fitted to ``pokes``, as
+    the exploration settings ask (module docstring), on the grid's ``cells_xy (ny · nx, 2)``;
+    ``correlation`` (``cells (q, 2) -> (q, p)``, an appearance prior's) labels ``nearest`` by the
+    most correlated poke instead of the nearest one."""
     settings = field_settings(config, field)
     found = poke_classes(mean, pokes, config, field)
     if config.merge_seams and found.n_regions >= 3:

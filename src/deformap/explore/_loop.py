@@ -51,19 +51,9 @@ def poke_step(mapper: Mapper, index: int, acquire: Callable[[], PressObservation
 
 
 class MappingRun:
-    """What every exploration shares around its pokes, live or replayed: observe and fit the
-    surface model (timed), one :func:`poke_step` per poke (its environment time counted), and the
-    result with the run's timings.
-
-    Parameters
-    ----------
-    workspace : Workspace
-    config : ExplorationConfig
-    observe : callable
-        ``() -> PointCloud``, the first observation (``Environment.observe``, or a session's).
-    surface_rng : numpy.random.Generator
-        The stream that fits the surface model.
-    """
+    """What every exploration shares around its pokes, live or replayed: ``observe()`` the first
+    cloud and fit the surface model with ``surface_rng`` (timed), one :func:`poke_step` per poke,
+    and the result with the run's timings."""
 
     def __init__(self, workspace: Workspace, config: ExplorationConfig,
                  observe: Callable[[], PointCloud], surface_rng: np.random.Generator) -> None:
@@ -112,34 +102,16 @@ def _check_arguments(env: object, config: object, rng: object, journal: object, 
         raise InvalidArgumentError(f"`on_poke` must be callable or None; got {describe(on_poke)}")
 
 
-def explore(
-    env: Environment,
-    config: ExplorationConfig,
-    *,
-    rng: np.random.Generator,
-    journal: Journal | None = None,
-    done: Sequence[PokeRecord] = (),
-    on_poke: Callable[[PokeResult], None] | None = None,
-) -> ExplorationResult:
-    """Observe, then poke where the map field is least known until its variance is below ``T_h``,
-    then make the ``boundary_pokes`` (if any) where a region boundary is least certain.
+def explore(env: Environment, config: ExplorationConfig, *, rng: np.random.Generator,
+            journal: Journal | None = None, done: Sequence[PokeRecord] = (),
+            on_poke: Callable[[PokeResult], None] | None = None) -> ExplorationResult:
+    """Observe ``env``, then poke where the map field is least known until its variance is below
+    ``T_h``, then make the ``boundary_pokes`` (if any) where a region boundary is least certain.
 
-    Parameters
-    ----------
-    env : Environment
-        The world or robot to explore.
-    config : ExplorationConfig
-        Settings of the mapper and the loop.
-    rng : numpy.random.Generator
-        The run's randomness. It is split once into independent streams (one for the surface fit,
-        one per poke), so a resumed run draws exactly what the uninterrupted run drew.
-    journal : Journal, optional
-        Each completed poke is appended (and fsynced) before the next one starts.
-    done : sequence of PokeRecord
-        The pokes of a killed run, read from its journal (:meth:`PokeRecord.from_dict`): they
-        enter the fields without being pressed or estimated again.
-    on_poke : callable, optional
-        Called after each new poke (progress display).
+    ``rng`` is split once into streams (the surface fit, one per poke), so a resumed run draws
+    what the uninterrupted run drew; each poke is appended to ``journal`` before the next starts;
+    ``done`` (a killed run's journalled pokes) enter the fields without being pressed again;
+    ``on_poke`` is called after each new poke.
     """
     _check_arguments(env, config, rng, journal, done, on_poke)
     streams = rng.spawn(config.max_pokes + 1)
@@ -166,8 +138,7 @@ def explore(
         if on_poke is not None:
             on_poke(poke)
     else:
-        # the poke limit stopped it unless the map was done: variance under T_h and no boundary
-        # poke owed
+        # the poke limit stopped it unless the map was done
         if mapper.max_variance() <= mapper.threshold and mapper.boundary_owed() == 0:
             stop = "threshold"
     return run.result(stop)

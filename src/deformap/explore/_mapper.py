@@ -1,11 +1,6 @@
-"""The mapper: the state of one exploration, updated one poke at a time.
-
-It orchestrates the concepts of the paper's process flow, each in its own module: the surface
-model (:mod:`._surface`), the dent and its β (:mod:`._dent`), the β-field (:mod:`._field`), the
-choice of the next target (:mod:`._targets`), the field it maps on (:mod:`._choice`) and the
-regions (:mod:`._labels`). The live loop (:func:`deformap.explore.explore`) and a recorded
-session (:mod:`deformap.replay`) both feed it through :func:`deformap.explore.poke_step`, so a
-poke gives the same β whichever way it arrives.
+"""The mapper: the state of one exploration, updated one poke at a time, in the paper's process
+flow (surface, dent and β, fields, next target, regions). The live loop and a recorded session
+(:mod:`deformap.replay`) both feed it through :func:`deformap.explore.poke_step`.
 
 References
 ----------
@@ -46,15 +41,7 @@ logger = logging.getLogger(__name__)
 
 
 class Mapper:
-    """State of one exploration: the surface model, the pokes and the β-field over them.
-
-    Parameters
-    ----------
-    workspace : Workspace
-        The rectangle to map; the surface grid's spacing gives every map's cells.
-    config : ExplorationConfig
-        Settings of every stage.
-    """
+    """State of one exploration of ``workspace``: the surface model, the pokes and the fields."""
 
     def __init__(self, workspace: Workspace, config: ExplorationConfig) -> None:
         check_exploration_budget(config, workspace)
@@ -71,24 +58,20 @@ class Mapper:
 
     @property
     def pokes(self) -> tuple[PokeResult, ...]:
-        """The pokes in the β-field, in order."""
         return tuple(self._pokes)
 
     @property
     def map_field_name(self) -> FieldName:
-        """The field the run maps on now (:func:`deformap.explore._choice.choose_map_field`):
-        ``config.field``, or ``"beta"`` where a run that asked for the modulus field falls back."""
+        """``config.field``, or ``"beta"`` where a run that asked for the modulus falls back."""
         return self._choice.name
 
     @property
     def field_fallback(self) -> str | None:
-        """Why the run maps on β although ``config.field`` asked for the modulus (else None)."""
         return self._choice.fallback
 
     @property
     def unread_places(self) -> list[tuple[float, float]]:
-        """The presses [m] of the places the modulus could not be read twice at, left out of
-        the targets and the stopping rule."""
+        """The presses [m] where the modulus could not be read twice (out of the targets)."""
         return list(self._choice.unread_places)
 
     @property
@@ -98,26 +81,24 @@ class Mapper:
 
     @property
     def threshold(self) -> float:
-        """``T_h`` of the map field (:func:`deformap.explore.field_settings`)."""
+        """``T_h`` of the map field."""
         return field_settings(self.config, self.map_field_name).threshold
 
     @property
     def beta_field(self) -> BetaField:
-        """The current β-field, fitted on first use after a poke: under ``field: modulus`` the
-        loop does not need it, and its nugget costs a region test per poke."""
+        """The current β-field, fitted on first use (under ``field: modulus`` the loop does not
+        need it, and its nugget costs a region test per poke)."""
         if self._beta_field is None:
             self._beta_field = self._fit_beta(self._pokes)
         return self._beta_field
 
     @property
     def modulus_field(self) -> ModulusField:
-        """The current modulus field (the prior while no poke has a modulus)."""
         return self._modulus
 
     @property
     def map_field(self) -> PokeField:
-        """The field the regions, the next target and the stopping rule run on
-        (:attr:`map_field_name`); ``threshold`` is its ``T_h``."""
+        """The field the regions, the next target and the stopping rule run on."""
         return self._modulus if self.map_field_name == "modulus" else self.beta_field
 
     def _fit_beta(self, pokes: list[PokeResult]) -> BetaField:
@@ -131,17 +112,16 @@ class Mapper:
                                        ).with_prior(self.appearance)  # fmt: skip
 
     def initialise(self, cloud: PointCloud, rng: np.random.Generator) -> SurfaceModel:
-        """Fit the surface model to the first observation (:func:`fit_surface`) and, under
-        ``appearance: auto``, read its colours into the appearance prior
-        (:func:`deformap.explore._appearance.build_appearance`; the same cloud gives the same
-        prior, so a resumed or replayed run has the live run's)."""
+        """Fit the surface model to the first observation and, under ``appearance: auto``, read
+        its colours into the appearance prior (the same cloud gives the same prior)."""
         self.surface = fit_surface(cloud, self.workspace, self.grid.xs, self.grid.ys,
                                    self.config.surface, rng)  # fmt: skip
         if self.config.appearance == "off":
             self.appearance, self.appearance_reason = None, "exploration.appearance is off"
         else:
+            footprint_m = BOUNDARY_SPACING_ROI * self.config.touch.roi_size_m
             image = build_appearance(cloud, self.grid.xs, self.grid.ys, self.surface.height,
-                                     self.footprint_m)  # fmt: skip
+                                     footprint_m)  # fmt: skip
             if isinstance(image, str):
                 self.appearance, self.appearance_reason = None, image
                 if cloud.colors is not None:
@@ -152,12 +132,6 @@ class Mapper:
                 self.appearance_reason = None
         self._modulus = self._fit_modulus([])
         return self.surface
-
-    @property
-    def footprint_m(self) -> float:
-        """Width of a dent's footprint [m] (``BOUNDARY_SPACING_ROI`` ROIs): the smallest
-        segment the appearance image keeps."""
-        return BOUNDARY_SPACING_ROI * self.config.touch.roi_size_m
 
     def first_target(self) -> tuple[float, float]:
         """The first poke [m]: ``config.first_target`` if set; else, under the appearance
@@ -181,11 +155,8 @@ class Mapper:
 
     def add(self, poke: PokeResult, *, target: Target | None = None,
             timings: Mapping[str, float] | None = None) -> PokeResult:
-        """Add a processed (or journalled) poke to the β-field; return it as recorded there.
-
-        ``target`` (the live loop's) gives the record its purpose and plan; ``timings`` adds
-        stage times measured outside the mapper (``target_s``, ``environment_s``).
-        """
+        """Add a processed (or journalled) poke to the fields; return it as recorded there, with
+        ``target``'s purpose and plan and the stage ``timings`` measured outside the mapper."""
         t0 = time.perf_counter()
         pokes = [*self._pokes, poke]
         modulus = self._fit_modulus(pokes)
@@ -210,8 +181,8 @@ class Mapper:
         return added
 
     def _update_choice(self, records: list[PokeRecord], modulus: ModulusField) -> None:
-        """The field to map on after the latest of ``records`` (:func:`choose_map_field`), with
-        a warning for each place it leaves out and each new reason to fall back to β."""
+        """The field to map on after the latest of ``records``, warning of each place left out
+        and each new reason to fall back to β."""
         before = self._choice
         self._choice = choose_map_field(before, self.config.field, records, modulus, self.grid,
                                         unread_radius_m(self.config))  # fmt: skip
@@ -225,18 +196,16 @@ class Mapper:
             logger.warning("%s", fallback)
 
     def max_variance(self) -> float:
-        """The map field's largest variance where it must fall below ``threshold``
-        (``stop_region``)."""
+        """The map field's largest variance over the stop cells."""
         return self.map_field.max_variance(self.choice_grid.stop_mask)
 
     def boundary_owed(self) -> int:
-        """Boundary pokes still to make (``boundary_pokes`` less those made)."""
+        """Boundary pokes still to make."""
         made = sum(p.record.purpose == "boundary" for p in self._pokes)
         return max(0, self.config.boundary_pokes - made)
 
     def next_target(self, rng: np.random.Generator) -> Target | None:
-        """The next target (:func:`deformap.explore._targets.choose_next`), or ``None`` when the
-        map is done."""
+        """The next target, or ``None`` when the map is done."""
         return choose_next(self.choice_grid, self.map_field, self.config, rng,
                            boundary_owed=self.boundary_owed(),
                            n_made=len(self._pokes))  # fmt: skip

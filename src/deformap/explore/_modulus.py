@@ -1,11 +1,8 @@
 """The modulus field: a Gaussian random field over ln E (E in Pa) from the pokes' force–travel
-records, beside the β-field, both a :class:`deformap.explore.PokeField`.
-
-A poke with a modulus enters as ``ln E`` with σ ``σ_E / E`` (delta method), at least the field's
-floor. A *rigid* poke enters at its detection bound (:func:`rigid_modulus_bound`) with
-``rigid_log_std``, never a huge number that would drag the prior mean and every threshold. A poke
-without a usable record is left out; :attr:`ModulusField.readings` says which and why. The prior
-mean is the pokes' weighted mean, as for the β-field (empirical Bayes).
+records. A poke with a modulus enters as ``ln E`` with σ ``σ_E / E`` (delta method), at least the
+field's floor; a *rigid* poke at its detection bound (:func:`rigid_modulus_bound`) with
+``rigid_log_std``, never a huge number that would drag the prior mean; a poke without a usable
+record is left out (:attr:`ModulusField.readings` says why).
 """
 
 from __future__ import annotations

@@ -9,14 +9,10 @@ one-way random-effects model (Patterson & Thompson 1971; Harville 1977),
     ℓ_R(τ) = −½ Σ_c [ Σ_{i∈c} ln vᵢ + ln Σ_{i∈c} 1/vᵢ + Σ_{i∈c} (β̂ᵢ − μ̂_c)² / vᵢ ],  vᵢ = σᵢ² + τ²
 
 (μ̂_c the class's inverse-variance weighted mean), under a half-Cauchy prior on τ (Gelman 2006)
-scaled by the pokes' median σᵢ: the unexplained scatter is expected of the order of the explained,
-and the prior's mode τ = 0 gives τ̂ = 0 to pokes that scatter no more than they claim.
-
-The classes say which pokes are one material whatever their distance (the field's marginal
-likelihood identifies a nugget only from pokes closer than σ_w). Only classes of as many pokes as
-the region test examines count (a pair straddling two foams would read their step as scatter).
-Classes and τ depend on each other: :func:`with_nugget` alternates until the classes no longer
-change, at most :data:`MAX_ROUNDS` rounds.
+scaled by the pokes' median σᵢ, whose mode τ = 0 gives τ̂ = 0 to pokes that scatter no more than
+they claim. Only classes of as many pokes as the region test examines count. Classes and τ depend
+on each other: :func:`with_nugget` alternates until the classes no longer change, at most
+:data:`MAX_ROUNDS` rounds.
 
 References
 ----------
@@ -103,9 +99,8 @@ def estimate_nugget(beta: NDArray[np.float64], std: NDArray[np.float64],
 
 
 def with_nugget(pokes: PokeSet, config: ExplorationConfig) -> PokeSet:
-    """``pokes`` (β, noise at least the floor) with the map's nugget τ̂ added to every poke's noise,
-    ``√(σᵢ² + τ̂²)``, the classes those of :func:`deformap.explore.segment_regions` with the
-    β-field's settings (module docstring); unchanged under ``beta_field.nugget: off``."""
+    """``pokes`` with the map's nugget τ̂ added to every poke's noise, ``√(σᵢ² + τ̂²)`` (module
+    docstring); unchanged under ``beta_field.nugget: off``."""
     if config.beta_field.nugget == "off" or len(pokes) < 2:
         return pokes
     floor = beta_noise_floor(config)
@@ -127,6 +122,5 @@ def with_nugget(pokes: PokeSet, config: ExplorationConfig) -> PokeSet:
 
 
 def beta_pokes(records: Sequence[PokeRecord], config: ExplorationConfig) -> PokeSet:
-    """The pokes of the β-field as the mapper fits it: each poke's claimed σ raised to the floor
-    (:func:`deformap.explore.beta_noise_floor`), plus the map's nugget (:func:`with_nugget`)."""
+    """The β-field's pokes: each claimed σ raised to the floor, plus the map's nugget."""
     return with_nugget(PokeSet.of(records, beta_noise_floor(config)), config)

@@ -3,14 +3,12 @@ junction classes merged into their neighbours (:func:`merge_seam_classes`) and a
 where its pokes form two places (:func:`split_by_place`).
 
 Split by place: two materials closer than ``min_step`` stay one class by value, but their pokes
-form two *places*, while one material's scatter is spread at random. A class's best split by value
-into two parts (at least three pokes each, Fisher's split) is scored by the edges of the pokes'
-Delaunay graph it cuts (the join count, Cliff & Ord 1981) against :data:`PLACE_PERMUTATIONS`
-shuffles of the values over the places (fixed seed); fewer cut edges than shuffled values give
-(one-sided, 5 % shared by the classes tested in a round, Bonferroni) keeps the split, with no
-smallest step. Only the class's pokes farther than twice the layer's thickness from every other
-class's pokes take part (a press near a joint reads the joint); with six the test cannot reject.
-The other pokes join the part of their nearest tested poke; repeated until no class splits or
+form two *places*. A class's best split by value into two parts (at least three pokes each) is
+scored by the edges of the pokes' Delaunay graph it cuts (the join count, Cliff & Ord 1981)
+against :data:`PLACE_PERMUTATIONS` shuffles of the values (fixed seed); fewer cut edges than the
+shuffles give (one-sided, 5 % Bonferroni over the classes tested in a round) keeps the split.
+Only the class's pokes farther than twice the layer's thickness from every other class's take
+part; the others join the part of their nearest tested poke. Repeated until no class splits or
 ``max_regions`` are found.
 
 References
@@ -68,11 +66,10 @@ def merge_seam_classes(found: RegionMap, mean: NDArray[np.float64],
                        thickness_m: NDArray[np.float64] | None) -> RegionMap:
     """``found`` with its junction classes merged into their neighbours.
 
-    A press where two pieces meet reads neither (between them across a bonded seam, softer than
-    both beside a free face). A class is a junction when *every* one of its pokes is a natural
-    neighbour, within the joint's reach, of pokes of at least two other classes: each such poke
-    joins the neighbouring class whose mean is nearest its value, and the test repeats until no
-    class is a junction. Without every poke's thickness (``None``) nothing is merged.
+    A press where two pieces meet reads neither. A class is a junction when *every* one of its
+    pokes is a natural neighbour, within the joint's reach, of pokes of at least two other
+    classes: each such poke joins the neighbouring class of nearest mean, until no class is a
+    junction. Without every poke's thickness (``None``) nothing is merged.
     """
     if thickness_m is None:
         return found

@@ -1,16 +1,12 @@
 """Non-myopic poke planning: the fewest further pokes that bring the map field under ``T_h``.
 
-A GP's posterior variance depends on where the data are and on their noise, never on the values
-(RW2006 Eq. 2.26), so the pokes after which the largest variance over the domain falls below
-``T_h`` can be planned before any is made: a covering design, solved approximately over a grid of
-candidates for ``m = 1, 2, …`` pokes in turn. A design scores the variance above ``T_h`` summed
-over the domain, ties broken by the largest variance (the sum still falls when a move helps one
-corner and leaves the worst as it was). The plan for ``m`` is that for ``m − 1`` plus the best
-candidate, improved by exchange passes (Fedorov 1972) that move each planned poke to the
-candidate that best complements the others, until a pass moves none or after ``max_passes``;
-the first ``m`` whose plan reaches ``T_h`` is the plan. Planned pokes are assumed to have the
-noise ``_targets.expected_noise`` gives; a real poke often reports more, so the loop plans again
-after every poke.
+A GP's posterior variance does not depend on the values (RW2006 Eq. 2.26), so the pokes after
+which the largest variance over the domain falls below ``T_h`` can be planned before any is made:
+a covering design over a grid of candidates for ``m = 1, 2, …`` pokes in turn. A design scores
+the variance above ``T_h`` summed over the domain, ties broken by the largest variance. The plan
+for ``m`` is that for ``m − 1`` plus the best candidate, improved by exchange passes (Fedorov
+1972) that move each planned poke to the candidate that best complements the others; the first
+``m`` whose plan reaches ``T_h`` is the plan. The loop plans again after every poke.
 
 References
 ----------
@@ -50,8 +46,8 @@ class PokePlan:
     max_variance : float
         The largest variance over the domain once they are all made with their assumed noise.
     reaches : bool
-        Whether ``max_variance`` is at or below the threshold (``False`` when ``max_new``
-        pokes were not enough; ``targets`` then holds the best ``max_new`` found).
+        Whether ``max_variance`` is at or below the threshold (else ``targets`` is the best
+        ``max_new`` found).
     """
 
     targets: Array
@@ -61,8 +57,8 @@ class PokePlan:
 
 def _use_covariance(gp: PosteriorDesign, covariance: Covariance, poked_xy: Array,
                     candidates: Array, domain: Array) -> None:
-    """Replace the design's kernel matrices by ``covariance``'s: its algebra (RW2006 Eq. 2.24)
-    holds for any prior covariance whose diagonal is its ``signal_std²``."""
+    """Replace the design's kernel matrices by ``covariance``'s (its algebra holds for any prior
+    whose diagonal is ``signal_std²``)."""
     gp.k_pp = covariance(poked_xy, poked_xy)
     gp.k_pc = covariance(poked_xy, candidates)
     gp.k_pd = covariance(poked_xy, domain)
@@ -90,30 +86,11 @@ def plan_pokes(poked_xy: Array, poked_noise: Array, candidates: Array, domain: A
     """The fewest further pokes among ``candidates`` that bring the field's largest variance
     over ``domain`` to ``threshold`` or below (method: module docstring).
 
-    Parameters
-    ----------
-    poked_xy : (p, 2) float, metres
-        Where the pokes made so far were (``p`` may be 0).
-    poked_noise : (p,) float
-        Their standard deviations, as the field uses them.
-    candidates : (c, 2) float, metres
-        Where a poke may be planned.
-    domain : (d, 2) float, metres
-        Where the variance must fall below ``threshold``.
-    signal_std, length_scale : float
-        The field's prior standard deviation and length scale (metres).
-    new_noise : float or (c,) float
-        The standard deviation assumed for a poke planned at each candidate (one for all, or
-        one each).
-    threshold : float
-        ``T_h``.
-    max_new : int
-        Most further pokes to plan (at most one per candidate).
-    max_passes : int
-        Most exchange passes per plan size.
-    covariance : callable, optional
-        The prior covariance to plan with (an appearance prior's at its posterior-mean weight);
-        default the squared exponential of ``signal_std`` and ``length_scale``.
+    ``poked_xy (p, 2)`` [m] and ``poked_noise (p,)`` are the pokes so far (``p`` may be 0),
+    ``candidates (c, 2)`` and ``domain (d, 2)`` [m] where a poke may go and where the variance
+    must fall, ``new_noise`` (scalar or ``(c,)``) the σ assumed for a planned poke, ``max_new``
+    the most further pokes, ``max_passes`` the exchange passes per plan size, ``covariance`` the
+    prior (default the squared exponential of ``signal_std`` and ``length_scale`` [m]).
     """
     poked_xy = check_array("poked_xy", poked_xy, (None, 2), what="metres")
     poked_noise = check_array("poked_noise", poked_noise, (poked_xy.shape[0],))

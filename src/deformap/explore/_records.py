@@ -164,17 +164,13 @@ class PokeTimings:
 class PokeRecord:
     """What one poke gave: where, the contact, β with its uncertainty and E(β), and timings.
 
-    ``index`` from 0 in its run; ``target_xy`` and ``contact_xy`` [m] where the poke was aimed
-    and touched; ``force_n`` the commanded force; ``beta``, ``beta_std`` β̂ and its σ (before the
-    field's floor); ``betas``, ``errors`` the compared β and E(β) [m]; ``iterations``,
-    ``residual``, ``converged`` the solver's worst; ``n_roi_points`` the ROI's cloud points;
-    ``camera_noise_m`` the camera's measured noise. Optional (``None`` when not applicable): the
-    record's ``stiffness`` estimate, the ``layer_thickness_m`` it was read with, or why it gave
-    none (``stiffness_error``); the ``indentation_m`` the tactile points were placed for, whether
-    their depth came from the record (``depth_anchored``); whether the camera saw the dent
-    (``dent_visible``; ``False`` widens σ to a uniform β's); the ``purpose``; how many more pokes
-    a plan foresaw (``planned_after``); the largest field variance where it must fall under
-    ``T_h`` after this poke (``max_variance_after``).
+    ``index`` from 0 in its run; ``target_xy``, ``contact_xy`` [m] where it was aimed and touched;
+    ``beta``, ``beta_std`` β̂ and its σ (before the field's floor); ``betas``, ``errors`` the
+    compared β and E(β) [m]; ``iterations``, ``residual``, ``converged`` the solver's worst.
+    Optional (``None``: not applicable): the record's ``stiffness``, the ``layer_thickness_m`` it
+    was read with or ``stiffness_error``; the ``indentation_m`` of the tactile points and whether
+    it came from the record (``depth_anchored``); ``dent_visible``; ``purpose``;
+    ``planned_after``; the stop cells' largest variance after this poke (``max_variance_after``).
     """
 
     index: int

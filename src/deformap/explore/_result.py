@@ -1,5 +1,4 @@
-"""What an exploration (or a replayed session) produced: its pokes, the β-field and regions on
-the map's grid, and why it stopped — values, not the live mapper."""
+"""What an exploration (or a replayed session) produced, as values, not the live mapper."""
 
 from __future__ import annotations
 
@@ -36,20 +35,15 @@ class AppearanceOutcome:
     Attributes
     ----------
     used : bool
-        Whether the map field used the prior.
     reason : str or None
-        Why not (``exploration.appearance`` off, no colour, an image that cannot carry a layout).
+        Why the prior was not used.
     weights, weight_posterior : tuple of float
         The grid of the look's weight ``w`` and its posterior after the last poke (empty when
         not used or without pokes).
-    weight : float or None
-        The posterior mean of ``w``.
-    look_scale : float or None
-        The most probable ``ℓ_a`` (standardised feature units).
+    weight, look_scale : float or None
+        The posterior mean of ``w``; the most probable ``ℓ_a`` (standardised feature units).
     n_segments : int
-        Segments of the appearance image (0 when not used).
     image : AppearanceImage or None
-        The image and its segments.
     """
 
     used: bool
@@ -93,39 +87,29 @@ class ExplorationResult:
     config : ExplorationConfig
     workspace : Workspace
     grid : MapGrid
-        The map's cells; ``xs``, ``ys`` and every map below are on it.
+        The map's cells; every map below is on it.
     surface : SurfaceModel or None
     pokes : tuple of PokeResult
-        In order.
-    beta_field : BetaField
-        The β-field after the last poke (``beta_field.mean``, ``beta_field.variance``:
-        ``(ny, nx)``).
-    modulus_field : ModulusField
-        The modulus field over ln E after the last poke (the prior when no poke has a modulus;
-        ``modulus_field.readings`` says which pokes it holds and why the others are left out).
+    beta_field, modulus_field : BetaField, ModulusField
+        The fields after the last poke (the modulus field is its prior when no poke has a modulus).
     regions : RegionMap or None
-        The regions of the map field (``map_field``; ``None`` without pokes).
+        The regions of ``map_field`` (``None`` without pokes).
     max_variance : float
-        What the stopping rule compared with ``T_h`` (over ``stop_region``, in the map field's
-        units: :func:`deformap.explore.field_settings`).
+        What the stopping rule compared with ``T_h``, in the map field's units.
     stop_reason : str
         A :data:`StopReason`.
     timings : mapping of str to float
         ``total_s``, ``observe_s``, ``surface_gp_s``, ``environment_s``.
     map_field_name : {"beta", "modulus"}
-        The field the regions, the targets and the stopping rule ran on at the end: ``config.field``
-        (what was asked for), or ``"beta"`` where the run fell back (``field_fallback``).
+        The field the regions, targets and stop ran on at the end: ``config.field``, or ``"beta"``
+        where the run fell back (``field_fallback`` says why).
     field_fallback : str or None
-        Why the map is on the β-field although the run asked for the modulus field (no poke gave
-        a modulus, or no target would be left without the unread places).
     unread_places : tuple of (x, y)
-        The presses whose modulus could not be read at a place read twice in vain, whose discs
-        were taken out of the targets and the stopping rule, in the order found [m].
+        Presses [m] whose modulus could not be read twice, their discs taken out of the targets
+        and the stop cells.
     stop_mask : (ny * nx,) bool or None
-        The cells whose variance the stopping rule read: ``grid.stop_mask`` without those discs
-        (``None``: ``grid.stop_mask``).
+        The stop cells without those discs (``None``: ``grid.stop_mask``).
     appearance : AppearanceOutcome
-        Whether the appearance prior was used, why not, and what it learned.
     prior : AppearancePrior or None
         The appearance prior the fields used (``None``: blind).
     """

@@ -1,23 +1,15 @@
-"""The next place to poke: the configured strategy until the map field's variance is under
-``T_h`` (the β-field's, or the modulus field's under ``ExplorationConfig.field = "modulus"``, with
-its own ``T_h``: :func:`deformap.explore.field_settings`), then the boundary pokes (strategies
-and scores in :mod:`deformap.explore._acquisition`).
+"""The next place to poke: the configured strategy until the map field's variance is under its
+``T_h``, then the boundary pokes (strategies and scores in :mod:`deformap.explore._acquisition`).
 
-Under an appearance prior (:mod:`deformap.explore._appearance_prior`) the looks come first: while
-the variance is above ``T_h``, the interior (:func:`segment_interior`) of the largest segment of
-the largest look no poke has read (a look: the segments within ``ℓ_a`` of it; read: a poke in
-one of them), if that look covers more than one poke does on the blind map
-(:func:`covered_area_m2`) and is not yet known; once it is under ``T_h``, a test of the
-hypothesis the map rests on: in the largest segment with one poke, where the blind map
-(``w = 0``) is still above ``T_h``, so only the look vouches for the place, the place the blind
-map knows least (is the segment one material?). Each segment is tested once; a test the pokes
-contradict moves the weight's posterior toward the blind map and its variance back above
-``T_h``.
+Under an appearance prior the looks come first: while the variance is above ``T_h``, the interior
+(:func:`segment_interior`) of the largest segment of the largest look no poke has read (a look:
+the segments within ``ℓ_a`` of it), if that look covers more than one poke does on the blind map
+(:func:`covered_area_m2`) and is not yet known; once under ``T_h``, a test of the looks: in the
+largest segment with one poke, the place the blind map (``w = 0``) knows least while still above
+``T_h``. A test the pokes contradict moves the weight's posterior toward the blind map.
 
 When only the edge band, where no poke fits, is still above ``T_h``, ``planned`` plans it like
-any other place; the other strategies poke the reachable cell of largest variance, the one nearest
-the band's worst corner (poking where one poke leaves the least largest variance instead is
-myopic: it splits the difference between two corners).
+any other place; the other strategies poke the reachable cell of largest variance.
 """
 
 from __future__ import annotations
@@ -50,14 +42,9 @@ closer pokes would measure much the same foam again."""
 
 def expected_noise(candidates: NDArray[np.float64], pokes: PokeSet, config: ExplorationConfig,
                    field: FieldName) -> NDArray[np.float64]:
-    """The β uncertainty a poke at each of ``candidates (c, 2)`` is expected to have: the largest
-    of the pokes already made within ``BOUNDARY_SPACING_ROI`` ROIs of it (a dent spreads a few
-    centimetres, so a press there measures that foam again, no better), else the map field's
-    noise floor (:func:`deformap.explore.field_settings` of ``field``)
-    with the map's nugget added in variance
-    (``pokes.nugget``: any press carries the scatter between places of one material). So the
-    target choice knows what a further press at a place can still reduce, and does not return to
-    a place whose readings are noisy expecting a reading at the floor."""
+    """``(c,)`` the uncertainty a poke at each of ``candidates (c, 2)`` is expected to have: the
+    largest of the pokes within ``BOUNDARY_SPACING_ROI`` ROIs of it (a press there measures that
+    foam again, no better), else the field's noise floor with ``pokes.nugget`` added in variance."""
     floor = float(np.hypot(field_settings(config, field).noise_floor, pokes.nugget))
     noise = np.full(len(candidates), floor)
     if len(pokes) == 0:
@@ -101,16 +88,6 @@ def _straddle(grid: MapGrid, field: PokeField, pokes: PokeSet, config: Explorati
     classes = poke_classes(mean, pokes, config, field.name)
     score = boundary_score(mean.ravel()[allowed], np.sqrt(var[allowed]), classes.levels)
     return grid.cells_xy[allowed], score
-
-
-def _boundary(grid: MapGrid, field: PokeField, pokes: PokeSet,
-              config: ExplorationConfig) -> NDArray[np.float64] | None:
-    """Where a region boundary is least certain (:func:`_straddle`); ``None`` when no place is
-    left."""
-    cells, score = _straddle(grid, field, pokes, config)
-    if score.size == 0:
-        return None
-    return np.array(cells[int(np.argmax(score))], dtype=float)
 
 
 def segment_interior(grid: MapGrid, segments: NDArray[np.int64], segment: int
@@ -195,25 +172,10 @@ def _look_target(grid: MapGrid, field: PokeField, config: ExplorationConfig, thr
 def choose_next(grid: MapGrid, field: PokeField, config: ExplorationConfig,
                 rng: np.random.Generator, *, boundary_owed: int,
                 n_made: int | None = None) -> Target | None:
-    """The next target after the pokes ``field`` was fitted to, or ``None`` when the variance is
-    under ``T_h`` and no boundary poke is owed or none has a place left.
-
-    Parameters
-    ----------
-    grid : MapGrid
-    field : PokeField
-        The current map field (the β-field or the modulus field; its ``pokes`` are the pokes it
-        holds), read with its own settings (:func:`deformap.explore.field_settings` of
-        ``field.name``).
-    config : ExplorationConfig
-    rng : numpy.random.Generator
-        This choice's stream (``paper`` draws from it).
-    boundary_owed : int
-        Boundary pokes still to make.
-    n_made : int, optional
-        Pokes made so far (the budget left is ``max_pokes`` less these); default: the pokes in
-        ``field``, which the modulus field may leave some out of.
-    """
+    """The next target after the pokes the map ``field`` was fitted to (read with its own
+    :func:`deformap.explore.field_settings`), or ``None`` when the variance is under ``T_h`` and
+    no boundary poke is owed or none has a place left; ``rng`` is this choice's stream,
+    ``n_made`` the pokes made so far (default: the field's, which may leave some out)."""
     pokes = field.pokes
     variance = field.variance.ravel()
     threshold = field_settings(config, field.name).threshold
@@ -225,13 +187,13 @@ def choose_next(grid: MapGrid, field: PokeField, config: ExplorationConfig,
     if done:
         if boundary_owed == 0:
             return None
-        xy = _boundary(grid, field, pokes, config)
-        if xy is None:
+        cells, score = _straddle(grid, field, pokes, config)
+        if score.size == 0:
             logger.warning("%d of %d boundary pokes left undone: no reachable place is %.3g m "
                            "from every poke", boundary_owed, config.boundary_pokes,
                            BOUNDARY_SPACING_ROI * config.touch.roi_size_m)  # fmt: skip
             return None
-        return Target(xy, "boundary")
+        return Target(np.array(cells[int(np.argmax(score))], dtype=float), "boundary")
     cells, reachable = grid.cells_xy[grid.target_mask], variance[grid.target_mask]
     plans: list[PokePlan] = []
 
