@@ -26,7 +26,6 @@ from deformap.world._foundation import (
     MAX_NEWTON_STEPS,
     FoundationGrid,
     FoundationLayer,
-    NewtonResult,
     solve_press,
 )
 from deformap.world._scenario import Scenario
@@ -107,10 +106,6 @@ class StiffeningFoam(FoamMesh):
             densification_strain=densification_strain,
             stiffening_exponent=stiffening_exponent, shear=shear) for index in self.foam_blocks}
         self.shear = shear
-        # the last press's solve, layer and grid, for checks
-        self.last: NewtonResult | None = None
-        self.last_layer: FoundationLayer | None = None
-        self.last_grid: FoundationGrid | None = None
 
     @property
     def n_dofs(self) -> int:
@@ -182,7 +177,6 @@ class StiffeningFoam(FoamMesh):
             log.warning("foundation press at %s, %.3g N: the grid or the mode shape did not "
                         "settle in %d solves", target, force_n, _MAX_ROUNDS)
         assert grid is not None  # _MAX_ROUNDS ≥ 1
-        self.last, self.last_layer, self.last_grid = result, layer, grid
         return Dent(displacement=self._displace(layer, index, result.w, grid),
                     depth_m=result.depth_m, contact_radius_m=min(solved, tip_radius_m),
                     iterations=iterations)
