@@ -99,7 +99,6 @@ class StiffeningFoam(FoamMesh):
                  stiffening_exponent: float, shear: bool = True) -> None:
         super().__init__(scenario, element_size_m=element_size_m, top_layer_m=top_layer_m,
                          layer_growth=layer_growth)
-        self.poisson_ratio = poisson_ratio
         self.layers = {index: FoundationLayer(
             modulus_pa=scenario.blocks[index].modulus_pa, poisson_ratio=poisson_ratio,
             thickness_m=scenario.blocks[index].thickness_m,
