@@ -9,7 +9,7 @@ import math
 import numpy as np
 import pytest
 
-from deformap.world import Block, Scenario, SimulatedWorld, WorldConfig
+from deformap.world import Block, Scenario, SimulatedWorld, WorldConfig, _stiffening
 from deformap.world._foundation import FoundationGrid, FoundationLayer
 from deformap.world._stiffening import StiffeningFoam, graded_axis, max_grid_nodes
 
@@ -32,11 +32,30 @@ def _foam(hardness: float = 60.0, *, thickness: float = 0.05, exponent: float = 
                           densification_strain=0.95, stiffening_exponent=exponent, shear=shear)
 
 
+def _spy(monkeypatch: pytest.MonkeyPatch) -> dict:
+    """Record the last press's Newton result, and the layer and grid it was solved on."""
+    seen: dict = {}
+    solve, displace = _stiffening.solve_press, StiffeningFoam._displace
+
+    def spy_solve(*args, **kwargs):
+        seen["result"] = solve(*args, **kwargs)
+        return seen["result"]
+
+    def spy_displace(self, layer, index, w, grid):
+        seen["layer"], seen["grid"] = layer, grid
+        return displace(self, layer, index, w, grid)
+
+    monkeypatch.setattr(_stiffening, "solve_press", spy_solve)
+    monkeypatch.setattr(StiffeningFoam, "_displace", spy_displace)
+    return seen
+
+
 @pytest.mark.parametrize(("hardness", "force"), [(60.0, 0.02), (60.0, 0.6), (250.0, 3.0)])
-def test_newton_converges_and_the_contact_carries_the_commanded_force(hardness, force) -> None:
-    foam = _foam(hardness)
+def test_newton_converges_and_the_contact_carries_the_commanded_force(hardness, force,
+                                                                      monkeypatch) -> None:
+    foam, seen = _foam(hardness), _spy(monkeypatch)
     dent = foam.dent(CENTER, force, tip_radius_m=R)
-    result = foam.last
+    result = seen["result"]
     assert result is not None and result.converged
     assert result.residual_n <= 1e-8 * force
     assert result.contact_force_n.sum() == pytest.approx(force, rel=1e-8)
@@ -89,16 +108,16 @@ def test_the_layer_parameters_are_vlasovs() -> None:
     np.testing.assert_allclose(layer.pressure(w)[1], numeric, rtol=1e-5)
 
 
-def test_the_mode_shape_is_vallabhan_and_das_fixed_point() -> None:
-    foam = _foam(60.0)
+def test_the_mode_shape_is_vallabhan_and_das_fixed_point(monkeypatch) -> None:
+    foam, seen = _foam(60.0), _spy(monkeypatch)
     foam.dent(CENTER, 0.6, tip_radius_m=R)
-    layer, result = foam.last_layer, foam.last
+    layer, result = seen["layer"], seen["result"]
     assert layer is not None and result is not None and layer.decay > 1.0
     # the decay the solved deflection asks for is the one it was solved with (to the tolerance)
     grid_nodes = len(result.w)
     assert grid_nodes > 100
-    assert foam.last_grid is not None
-    assert layer.decay_for(result.w, foam.last_grid) == pytest.approx(layer.decay, rel=0.02)
+    assert seen["grid"] is not None
+    assert layer.decay_for(result.w, seen["grid"]) == pytest.approx(layer.decay, rel=0.02)
 
 
 def test_stiffening_makes_the_secant_stiffness_rise_with_force() -> None:
@@ -120,8 +139,8 @@ def test_softer_blocks_dent_deeper_and_thicker_ones_too() -> None:
     assert thick > thin
 
 
-def test_rigid_ground_does_not_dent_and_the_camera_sees_a_linear_column() -> None:
-    foam = _foam(60.0, rigid_half=True)
+def test_rigid_ground_does_not_dent_and_the_camera_sees_a_linear_column(monkeypatch) -> None:
+    foam, seen = _foam(60.0, rigid_half=True), _spy(monkeypatch)
     rigid = foam.dent(np.array([0.45, 0.2]), 0.6, tip_radius_m=R)
     assert rigid.depth_m == 0.0 and not np.any(rigid.displacement)
     dent = foam.dent(np.array([0.15, 0.2]), 0.6, tip_radius_m=R)
@@ -135,7 +154,7 @@ def test_rigid_ground_does_not_dent_and_the_camera_sees_a_linear_column() -> Non
     column = np.isclose(xyz[:, 0], xyz[top][np.argmin(u[:grid.n_nodes][top, 2]), 0]) & \
         np.isclose(xyz[:, 1], xyz[top][np.argmin(u[:grid.n_nodes][top, 2]), 1])
     uz, z = u[:grid.n_nodes][column, 2], xyz[column, 2]
-    layer = foam.last_layer
+    layer = seen["layer"]
     assert layer is not None
     np.testing.assert_allclose(uz, uz[np.argmax(z)] * layer.mode(z)[0], atol=1e-12)  # 0 at the
     assert uz[np.argmin(z)] == 0.0  # table, the top's deflection at the top

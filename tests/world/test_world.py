@@ -200,7 +200,7 @@ def test_ground_truth_on_any_grid(world) -> None:
     assert hardness[0].tolist() == [60.0, 110.0, np.inf, np.inf]
     modulus = world.ground_truth_modulus(xs, ys)
     assert modulus[0, 0] == pytest.approx(hardness_to_youngs_modulus(60.0))
-    assert world.region_names == ["foam-60", "foam-110", "rigid"]
+    assert world.scenario.region_names == ["foam-60", "foam-110", "rigid"]
     assert [r.rigid for r in world.regions] == [False, False, True]
 
 

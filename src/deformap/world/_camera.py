@@ -27,7 +27,6 @@ Goldman, D. B. (2010). Vignette and exposure calibration and compensation. IEEE 
 
 from __future__ import annotations
 
-import logging
 from collections.abc import Callable
 from dataclasses import dataclass
 from functools import partial
@@ -43,8 +42,6 @@ from deformap.world._appearance import linear_to_srgb
 from deformap.world._raycast import cast_rays
 
 __all__ = ["CAMERA_PRESETS", "CameraConfig", "DepthCamera", "Frame", "camera_preset"]
-
-log = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True, kw_only=True)

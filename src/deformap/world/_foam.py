@@ -141,8 +141,8 @@ class FoamModel(FoamMesh):
         target = np.asarray(target_xy, dtype=float).reshape(1, 2)
         if self._reach is None or not np.array_equal(self._reach[0], target[0]):
             self._columns.clear()  # another target's unit responses: a press starts afresh
-        index = int(self.scenario.labels(target[:, 0], target[:, 1])[0, 0])
-        if index not in self.bodies:
+        index = self.block_at(target[0])
+        if index is None:
             return Dent(displacement=self.zero_displacement(), depth_m=0.0,
                         contact_radius_m=0.0, iterations=0)
         top = tip_radius_m if not max_radius_m or max_radius_m <= 0.0 else min(

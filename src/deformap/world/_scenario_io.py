@@ -96,9 +96,9 @@ def _block(data: Any, where: str) -> Block:
             hardness_n=data.get("hardness_n"), youngs_modulus_pa=data.get("youngs_modulus_pa"),
             rigid=rigid, color=str(data.get("color", "#6b4f3a" if rigid else "#c8a165")),
             appearance=None if look is None else _appearance(look, f"{where}.appearance"))
+    except ConfigError:
+        raise
     except (TypeError, ValueError, DeformapError) as exc:
-        if isinstance(exc, ConfigError):
-            raise
         raise ConfigError(f"{where}: {exc}") from None
 
 
@@ -131,7 +131,7 @@ def parse_scenario(data: Any, *, source: str = "<scenario>") -> Scenario:
                               upper=tuple(ws.get("upper", (0.6, 0.4))))
         return Scenario(name=str(data["name"]), blocks=blocks, workspace=workspace,
                         description=str(data.get("description", "")), table_appearance=table_look)
+    except ConfigError:
+        raise
     except DeformapError as exc:
-        if isinstance(exc, ConfigError):
-            raise
         raise ConfigError(f"{source}: {exc}") from None

@@ -26,7 +26,6 @@ from deformap.world._foundation import (
     MAX_NEWTON_STEPS,
     FoundationGrid,
     FoundationLayer,
-    NewtonResult,
     solve_press,
 )
 from deformap.world._scenario import Scenario
@@ -100,17 +99,12 @@ class StiffeningFoam(FoamMesh):
                  stiffening_exponent: float, shear: bool = True) -> None:
         super().__init__(scenario, element_size_m=element_size_m, top_layer_m=top_layer_m,
                          layer_growth=layer_growth)
-        self.poisson_ratio = poisson_ratio
         self.layers = {index: FoundationLayer(
             modulus_pa=scenario.blocks[index].modulus_pa, poisson_ratio=poisson_ratio,
             thickness_m=scenario.blocks[index].thickness_m,
             densification_strain=densification_strain,
             stiffening_exponent=stiffening_exponent, shear=shear) for index in self.foam_blocks}
         self.shear = shear
-        # the last press's solve, layer and grid, for checks
-        self.last: NewtonResult | None = None
-        self.last_layer: FoundationLayer | None = None
-        self.last_grid: FoundationGrid | None = None
 
     @property
     def n_dofs(self) -> int:
@@ -182,7 +176,6 @@ class StiffeningFoam(FoamMesh):
             log.warning("foundation press at %s, %.3g N: the grid or the mode shape did not "
                         "settle in %d solves", target, force_n, _MAX_ROUNDS)
         assert grid is not None  # _MAX_ROUNDS ≥ 1
-        self.last, self.last_layer, self.last_grid = result, layer, grid
         return Dent(displacement=self._displace(layer, index, result.w, grid),
                     depth_m=result.depth_m, contact_radius_m=min(solved, tip_radius_m),
                     iterations=iterations)

@@ -150,10 +150,6 @@ class SimulatedWorld:
         return self.scenario.blocks
 
     @property
-    def region_names(self) -> list[str]:
-        return self.scenario.region_names
-
-    @property
     def n_dofs(self) -> int:
         return self.foam.n_dofs
 
