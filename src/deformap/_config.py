@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import dataclasses
 import inspect
-import logging
 import os
 import re
 import stat
@@ -30,8 +29,6 @@ MAX_YAML_BYTES = 16 * 2**20
 
 __all__ = ["config_from_dict", "config_to_dict", "described_yaml", "dump_yaml", "load_yaml",
            "setting_docs"]
-
-logger = logging.getLogger(__name__)
 
 T = TypeVar("T")
 

@@ -141,14 +141,11 @@ def check_positive(name: str, value: Any, *, allow_zero: bool = False) -> float:
     return out
 
 
-def check_in_range(name: str, value: Any, low: float, high: float, *,
-                   closed_high: bool = False) -> float:
-    """Validate ``low <= value < high`` (``<= high`` with ``closed_high``)."""
+def check_in_range(name: str, value: Any, low: float, high: float) -> float:
+    """Validate ``low <= value <= high``."""
     out = check_finite_scalar(name, value)
-    ok = low <= out <= high if closed_high else low <= out < high
-    if not ok:
-        interval = f"[{low}, {high}]" if closed_high else f"[{low}, {high})"
-        raise InvalidArgumentError(f"`{name}` must lie in {interval}; got {out}")
+    if not low <= out <= high:
+        raise InvalidArgumentError(f"`{name}` must lie in [{low}, {high}]; got {out}")
     return out
 
 
@@ -217,8 +214,7 @@ def setting_metadata(f: Field[Any]) -> tuple[dict[str, Any], str | None]:
 @cache
 def _settings_fields(cls: Any) -> tuple[tuple[str, Any, dict[str, Any]], ...]:
     hints = get_type_hints(cls)
-    return tuple((f.name, hints[f.name], dict(f.metadata.get(_BOUNDS, {"finite": True})))
-                 for f in fields(cls))
+    return tuple((f.name, hints[f.name], setting_metadata(f)[0]) for f in fields(cls))
 
 
 def check_settings(obj: Any) -> None:

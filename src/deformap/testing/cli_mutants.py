@@ -1,14 +1,12 @@
 """Seeded hostile arguments for every option of every command, found from the Typer app itself,
-each run under a guard that stops it before its work: a test helper, run by
-``tests/robustness/test_cli_mutants.py`` and ``benchmarks/robustness.py --cli-mutants N``.
+each run under a guard that stops it before its work: a test helper.
 
 Values come from fixed pools (bad numbers, strings and paths), then from seeded generators of the
-same classes. The guard, which any run refuses before its work: ``--out`` naming an existing file,
-or, where the mutated option is ``--out`` or a command has none, ``--json`` naming an existing
-directory; where the mutated option is the command's only guard, its values are only
-destinations no run may write to (:data:`UNWRITABLE`). A command with neither is left out. Each
-must end with exit code 2 and one ``error:`` line (or the parser's usage box for a value of the
-wrong type): never a traceback, never a hang (a SIGALRM after :data:`HANG_LIMIT_S`).
+same classes. The guard: ``--out`` naming an existing file, or, where the mutated option is
+``--out`` or a command has none, ``--json`` naming an existing directory; an option that is its
+command's only guard gets only :data:`UNWRITABLE` destinations; a command with neither is left
+out. Each must end with exit code 2 and one ``error:`` line (or the parser's usage box): never a
+traceback, never a hang (a SIGALRM after :data:`HANG_LIMIT_S`).
 """
 
 from __future__ import annotations

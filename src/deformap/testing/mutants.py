@@ -1,22 +1,17 @@
 """Seeded mutants of every reader's input, read in a worker process and classified: a test
-helper (``tests/robustness/test_reader_mutants.py``, ``benchmarks/robustness.py --mutants N``)
-that users' tests may run on their own readers' templates too.
+helper that users' tests may run on their own readers' templates too.
 
-The templates (:mod:`deformap.testing._mutant_templates`: a cloud in every file format, sessions,
-a run configuration, a scenario, a raw robot bag) are damaged by the seeded mutators of
+The templates (:mod:`deformap.testing._mutant_templates`) are damaged by the seeded mutators of
 :data:`KINDS` (:mod:`deformap.testing._mutators`). Each mutant is read as its reader reads it (a
-raw bag as ``deformap map BAG`` does), in a :class:`Worker` process under a per-case time limit,
+raw bag as ``deformap map BAG`` does) in a :class:`Worker` process under a per-case time limit,
 and counted (:func:`classify`) as:
 
 - ``clean``: refused with a DeformapError (a session: at load, or at least one of its reads);
 - ``same``: accepted, and the data read equal the template's;
-- ``changed``: accepted with other data, where no check could know (a flipped bit in a format
-  without checksum, an edited number in YAML a user writes, a raw bag's message damaged with its
-  CRCs made to match; in a ``.db3``, which has no checksum, bytes or a row edited in place);
+- ``changed``: accepted with other data, where no check could know (no checksum covers it);
 - ``silent``: accepted with other data where a check could have caught it: another number of
-  points or pokes, a structural mutant (:data:`STRUCTURAL`) accepted, a change to a file a
-  checksum covers (NPZ members, a session's manifest, a raw bag's CRCs), a ``.db3`` row deleted or
-  repeated (its metadata table counts the messages);
+  points or pokes, a :data:`STRUCTURAL` mutant accepted, a change a checksum covers, a ``.db3``
+  row deleted or repeated (its metadata table counts the messages);
 - ``traceback``: any other exception, or an error of several lines; ``hang``: over the time
   limit.
 """

@@ -1,20 +1,9 @@
-"""The map figure of a run, a :class:`matplotlib.figure.Figure` built without ``pyplot``.
+"""The map figure of a run (``map.png``, the paper's Fig. 6), built without ``pyplot``.
 
-``map.png`` follows the paper's Fig. 6: ground truth | β-field with region contours and the contacts
-| variance with the contacts; with a modulus field, a panel of E in kPa comes before the variance,
-which is the variance of the field the regions ran on. Stiffness has one colour direction in every
-panel (:mod:`deformap.viz._style`: dark soft, light stiff): the ground truth is drawn as Young's
-modulus on the modulus panel's log scale, rigid in grey. Each region is named R1, R2, … (as
-``pokes.csv`` numbers them) with the statistic ``report.json`` gives for it, or "rigid", at the
-cell deepest inside it that keeps the label clear of the pokes' marks; the pokes are numbered from
-1. One legend below the panels says which mark is the first poke, the later ones and the boundary
-pokes, which line is a region boundary and which the T_h contour, or that the variance is below
-(above) T_h everywhere when there is no contour. The poke figures are :mod:`deformap.viz._poke`.
-
-Every ``plot_*`` function returns its figure and, given ``path``, also writes it there atomically
-(a temporary file in the same folder, renamed onto ``path`` once complete). No backend is selected,
-``pyplot`` is never imported and no global state is touched, so the functions are safe in notebooks
-and GUI applications, which keep their own backend and display the returned figure their own way.
+Panels: ground truth | camera view | β-field | modulus field | variance, each when given. Stiffness
+has one colour direction in every panel (:mod:`deformap.viz._style`); regions are named R1, R2, …
+as ``pokes.csv`` numbers them, pokes from 1. ``plot_*`` functions return the figure and, given
+``path``, write it atomically; no backend is selected and no global state is touched.
 """
 
 from __future__ import annotations
@@ -121,61 +110,46 @@ def plot_map(
     appearance_rgb: NDArray[np.float64] | None = None,
     appearance_segments: NDArray[np.int64] | None = None,
 ) -> Figure:
-    """The map figure: ground truth (when given) | the camera's view with its segments (when
-    given) | β-field | modulus field (when given) | variance and contacts; the regions drawn on
-    the field they were cut from.
+    """The map figure: ground truth | camera view with its segments | β-field | modulus field |
+    variance and contacts (optional panels when given); regions drawn on the field cut from.
 
     Parameters
     ----------
     xs, ys : (nx,), (ny,) float, metres
         Grid of the maps.
-    beta : (ny, nx) float
-        β-field mean.
-    variance : (ny, nx) float
-        Variance of the field the regions ran on (``region_field``'s: β², or (ln E)²).
+    beta, variance : (ny, nx) float
+        β-field mean; variance of ``region_field``'s field (β², or (ln E)²).
     contacts : (k, 2) float, metres
-        Poked places in order; numbered from 1 on the map.
+        Poked places in order.
     labels, levels : optional
-        Region label map (label ``k`` is region R(k+1)) and the isopleths drawn as contours of
-        ``region_field``'s mean (β, or ln E of ``modulus_pa``); without ``levels``, the edges
-        between the labels are drawn (regions labelled by nearest poke). The other field's panel
-        shows the labels' edges.
+        Region label map (label ``k`` is R(k+1)) and the isopleths of ``region_field``'s mean;
+        without ``levels`` the labels' edges are drawn.
     truth_hardness : (ny, nx) float, optional
-        Ground-truth hardness in newtons (``inf`` rigid, ``nan`` bare table), drawn as Young's
-        modulus (:func:`deformap.world.hardness_to_youngs_modulus`) on the modulus panel's
-        colour scale; omitted without truth.
+        Ground-truth hardness [N] (``inf`` rigid, ``nan`` bare), drawn as E on the modulus scale.
     threshold : float, optional
-        The variance threshold T_h, drawn and labelled as a contour on the variance panel where
-        the field crosses it; where it does not, the legend says the variance is below (or
-        above) it everywhere.
+        T_h, drawn as a contour on the variance panel, or named in the legend when not crossed.
     title : str
         The figure's title.
     path : str or Path, optional
-        Where to write the figure (110 dpi, format from the suffix); nothing is written without it.
+        Where to write the figure (110 dpi, format from the suffix).
     modulus_pa : (ny, nx) float, optional
-        The modulus field's median E in pascals, drawn in kPa on a log colour scale.
+        The modulus field's median E [Pa], drawn in kPa on a log scale.
     region_field : {"beta", "modulus"}
         The field the regions were cut from (``modulus`` needs ``modulus_pa``).
     purposes : sequence of {"first", "variance", "boundary"} or None, optional
-        Each contact's purpose, which picks its mark (circle, triangle, square); without them the
-        first contact is the first poke and the others later pokes.
+        Each contact's purpose (its mark); default: first, then variance.
     variance_max : float, optional
-        The top of the variance colour scale (from 0), the same for every run drawn with it so
-        that runs compare; without it the scale spans 0 to this map's largest variance.
+        Top of the variance colour scale, fixed so that runs compare; default: this map's maximum.
     class_betas, class_modulus_pa : sequence of float or None, optional
-        Each region's β and E [Pa] as ``report.json`` gives them (``class_betas``, the mean β of
-        its pokes; ``class_modulus_median_pa``, the median E over its cells), written on the β and
-        modulus panels; without them, the median over the region's cells of the panel's field.
+        Each region's β and E [Pa] as ``report.json`` gives them; default: the median over its cells.
     rigid_classes : collection of int
-        Regions whose pokes all read rigid: labelled "rigid", not with a number.
+        Regions labelled "rigid".
     appearance_rgb, appearance_segments : (ny, nx, 3) float, (ny, nx) int, optional
-        The appearance prior's view of the map (sRGB in [0, 1]) and its segments (``-1``
-        masked), drawn with the segments' edges in white and the contacts.
+        The appearance prior's view (sRGB in [0, 1]) and its segments (``-1`` masked).
 
     Returns
     -------
     matplotlib.figure.Figure
-        The figure, one panel per map, each with its colour bar, and one legend below them.
     """
     if region_field == "modulus" and modulus_pa is None:
         raise ValueError("`modulus_pa` is required when `region_field` is 'modulus'")

@@ -1,13 +1,8 @@
 """The many-worlds benchmark's figure: region accuracy against pokes, one panel per family.
 
-Each panel draws the few combinations (strategy/field/cut) with the highest mean accuracy over all
-worlds and pokes, and the paper's combination beside them, as the mean accuracy over the family's
-worlds after each poke; the same combinations in every panel, in one legend. A band of the mean's
-95 % confidence interval (mean ± 1.96 standard errors, a normal approximation: the worlds are
-independent draws) is drawn only over enough worlds for that approximation to mean something
-(``min_band_worlds``). The good-map level is a dashed line. Given the blind map's curves beside
-the prior's (one panel per appearance family), each combination's blind curve is drawn dotted in
-its colour, without a band.
+Each panel draws the mean accuracy over the family's worlds after each poke of the best few
+combinations (strategy/field/cut) and the paper's, with a 95 % band (mean ± 1.96 standard errors,
+the worlds being independent draws) over enough worlds; blind curves, when given, dotted.
 """
 
 from __future__ import annotations
@@ -33,9 +28,7 @@ Curves = dict[str, dict[str, NDArray[np.float64]]]
 
 
 def _chosen(curves: Curves, best: int, paper: str) -> tuple[list[str], str | None]:
-    """The ``best`` combinations by mean accuracy over every world and poke (of ``"all"`` when
-    present, else of every family), and the paper's: ``paper`` when run, else the best of its
-    strategy's combinations, ``None`` when none ran."""
+    """The ``best`` combinations by mean accuracy, and the paper's (else its strategy's best)."""
     pooled = curves.get("all") or {
         name: np.concatenate([f[name] for f in curves.values() if name in f])
         for name in {n for f in curves.values() for n in f}}  # fmt: skip
@@ -62,19 +55,15 @@ def plot_world_curves(curves: Curves, *, good_accuracy: float = 0.9,
     good_accuracy : float
         Drawn as a dashed line.
     path : str or Path, optional
-        Where to write the figure (110 dpi); nothing is written without it.
+        Where to write the figure (110 dpi).
     best : int
         How many combinations to draw besides the paper's: a handful keeps the lines apart.
     min_band_worlds : int
-        The fewest worlds behind a mean for its 95 % band to be drawn: over fewer, the normal
-        approximation of the mean's spread is too rough to draw.
+        The fewest worlds for a 95 % band: over fewer the normal approximation is too rough.
     paper : str
-        The paper's combination, drawn black; without it in ``curves``, the best of its
-        strategy's combinations.
+        The paper's combination, drawn black (else its strategy's best).
     blind : dict, optional
-        The same families and combinations mapped blind (``exploration.appearance`` off), each
-        drawn dotted beside its curve in ``curves`` (the prior's); the chosen combinations are
-        the prior's best.
+        The same curves mapped blind (``exploration.appearance`` off), drawn dotted.
     """
     families = sorted(curves, key=lambda f: (f != "all", f))
     top, theirs = _chosen(curves, best, paper)
@@ -126,10 +115,8 @@ def plot_world_curves(curves: Curves, *, good_accuracy: float = 0.9,
 
 def _curve(ax: Axes, acc: NDArray[np.float64], name: str, rank: int, *, paper: bool | None,
            band: int, arm: str | None = None) -> None:
-    """One combination's mean accuracy after each poke, its 95 % band where at least ``band``
-    worlds count (``band`` 0: none); the paper's (``paper`` True: its combination, False: its
-    strategy's best) black and dash-dotted, the others in the colour of their rank; ``arm``
-    ``"blind"`` dotted, and named in the label."""
+    """One combination's mean accuracy after each poke, with its band over ``band`` worlds or more;
+    the paper's (``paper`` not None) black and dash-dotted, ``arm="blind"`` dotted."""
     pokes = np.arange(1, acc.shape[1] + 1)
     mean = np.nanmean(acc, axis=0)
     colour, style = ("k", "-.") if paper is not None else (f"C{rank % 10}", "-")

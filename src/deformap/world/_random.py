@@ -57,7 +57,7 @@ def random_scenario(rng: np.random.Generator, *, family: str = "cuts", n_regions
     if not 0 < h_lo < h_hi:
         raise InvalidArgumentError(
             f"`hardness_range_n` must be (low, high) with 0 < low < high; got {hardness_range_n}")
-    check_in_range("p_rigid", p_rigid, 0.0, 1.0, closed_high=True)
+    check_in_range("p_rigid", p_rigid, 0.0, 1.0)
     if appearance not in APPEARANCE_FAMILIES:
         raise InvalidArgumentError(
             f"`appearance` must be one of {list(APPEARANCE_FAMILIES)}; got {appearance!r}")
