@@ -26,10 +26,9 @@ from deformap.replay._rawconfig import (
     raw_config_file,
 )
 from deformap.replay._rawsession import RAW_SUFFIXES, is_raw_bag, load_raw_bag
-from deformap.replay._recorder import RecordingEnvironment
 from deformap.replay._session import DEFAULT_CONTACT_GAP_M, RecordedSession, load_session
 from deformap.replay._truth import GroundTruth, read_ground_truth, write_ground_truth
-from deformap.replay._write import SESSION_FORMATS, write_session
+from deformap.replay._write import SESSION_FORMATS, RecordingEnvironment, write_session
 
 # The offline mapper needs deformap.explore (and through it gp and msm): imported on first use, so
 # that reading a session stays light.

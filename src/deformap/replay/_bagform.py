@@ -10,7 +10,6 @@ it is logged at the poke's stamp. Without one a poke has no record.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -32,21 +31,13 @@ from deformap.cloud.io import (
 )
 from deformap.environment import ForceTravel, PressObservation
 from deformap.errors import DeformapError, FileFormatError
-from deformap.replay._confine import check_bag_confined
-from deformap.replay._folder import PressParts
-from deformap.replay._format import OPTIONAL_TOPICS, TOPICS, PokeSpec, SessionHeader
-from deformap.replay._manifest import verify_digest
+from deformap.replay._confine import check_bag_confined, verify_digest
+from deformap.replay._format import OPTIONAL_TOPICS, TOPICS, PokeSpec, PressParts, SessionHeader
 
 #: Labels of the record's two dimensions in its ``Float64MultiArray`` layout.
 FORCE_TRAVEL_DIMS = ("samples", "travel_m,force_n")
 
 __all__ = ["FORCE_TRAVEL_DIMS", "BagReader", "force_travel_message", "write_session_bag"]
-
-
-@dataclass
-class _Raw:
-    log_time_ns: int
-    data: bytes
 
 
 def _stamp(msg: Any) -> int:
@@ -64,33 +55,29 @@ class BagReader:
             raise FileFormatError(f"{self.path}: no such bag (the session's `bag`)")
         for file in check_bag_confined(self.path):
             if path_kind(file) == "file":  # a missing one: rosbags names it
-                verify_digest(header, file)
-        self._raw = self._index()
-        self._decoded: dict[str, dict[int, Any]] | None = None
-        self._undecodable: dict[str, list[str]] = {}
-        self._repeated: dict[str, dict[int, int]] = {}  # topic -> stamp -> messages sharing it
-        self._tf_static: NDArray[np.float64] | None = None
-
-    def _index(self) -> dict[str, list[_Raw]]:
-        every = {**TOPICS, **OPTIONAL_TOPICS}
-        out: dict[str, list[_Raw]] = {topic: [] for topic, _ in every.values()}
+                verify_digest(header.sha256, file)
+        # topic -> (log time, CDR bytes) of each message
+        self._raw: dict[str, list[tuple[int, bytes]]] = {
+            topic: [] for topic, _ in (*TOPICS.values(), *OPTIONAL_TOPICS.values())}
         for raw in iter_bag_messages(self.path, dict(TOPICS.values()),
                                      optional=dict(OPTIONAL_TOPICS.values())):  # fmt: skip
-            out[raw.topic].append(_Raw(raw.log_time_ns, bytes(raw.data)))
-        return out
+            self._raw[raw.topic].append((raw.log_time_ns, bytes(raw.data)))
+        self._decoded: dict[str, dict[int, list[Any]]] = {}  # key -> stamp -> messages
+        self._undecodable: dict[str, list[str]] = {}  # key -> why each message could not be
+        self._tf_static: NDArray[np.float64] | None = None
 
     def _force_travel(self, stamp: int) -> ForceTravel | None:
         """The record logged at ``stamp``, or None."""
         topic, msgtype = OPTIONAL_TOPICS["force_travel"]
         where = f"{self.path} [{topic} logged at {stamp}]"
-        raws = [r for r in self._raw[topic] if r.log_time_ns == stamp]
+        raws = [data for time, data in self._raw[topic] if time == stamp]
         if not raws:
             return None
         if len(raws) > 1:
             raise FileFormatError(
                 f"{where}: {len(raws)} messages; a poke needs at most one force–travel record")
         try:
-            msg = typestore().deserialize_cdr(raws[0].data, msgtype)
+            msg = typestore().deserialize_cdr(raws[0], msgtype)
         except bag_read_errors() as exc:
             raise FileFormatError(
                 f"{where}: could not be decoded: {bag_error_text(exc, 120)}") from None
@@ -108,42 +95,35 @@ class BagReader:
         except DeformapError as exc:
             raise FileFormatError(f"{where}: {exc}") from None
 
-    def _messages_by_stamp(self) -> dict[str, dict[int, Any]]:
-        if self._decoded is not None:
-            return self._decoded
-        store, errors = typestore(), bag_read_errors()
-        decoded: dict[str, dict[int, Any]] = {}
-        for key, (topic, msgtype) in TOPICS.items():
-            by_stamp: dict[int, Any] = {}
-            for number, raw in enumerate(self._raw[topic]):
+    def _by_stamp(self, key: str) -> dict[int, list[Any]]:
+        """The messages of ``TOPICS[key]`` by header stamp, decoded on first use; why each one
+        that could not be decoded failed goes to ``_undecodable``."""
+        if key not in self._decoded:
+            topic, msgtype = TOPICS[key]
+            store, errors = typestore(), bag_read_errors()
+            by_stamp: dict[int, list[Any]] = {}
+            bad = self._undecodable[key] = []
+            for number, (_, data) in enumerate(self._raw[topic], start=1):
                 try:
-                    msg = store.deserialize_cdr(raw.data, msgtype)
-                    stamp = _stamp(msg)
-                    if stamp in by_stamp:  # which one is the poke's? neither is kept silently
-                        counts = self._repeated.setdefault(topic, {})
-                        counts[stamp] = counts.get(stamp, 1) + 1
-                    by_stamp.setdefault(stamp, msg)
+                    msg = store.deserialize_cdr(data, msgtype)
+                    by_stamp.setdefault(_stamp(msg), []).append(msg)
                 except errors as exc:
-                    self._undecodable.setdefault(topic, []).append(
-                        f"message {number + 1}: {bag_error_text(exc, 120)}")
-            decoded[key] = by_stamp
-        self._decoded = decoded
-        return decoded
+                    bad.append(f"message {number}: {bag_error_text(exc, 120)}")
+            self._decoded[key] = by_stamp
+        return self._decoded[key]
 
     def _message(self, key: str, stamp: int) -> Any:
-        topic = TOPICS[key][0]
-        msg = self._messages_by_stamp()[key].get(stamp)
-        repeated = self._repeated.get(topic, {}).get(stamp)
-        if repeated:
+        topic, msgs = TOPICS[key][0], self._by_stamp(key).get(stamp, [])
+        if len(msgs) > 1:  # which one is the poke's? neither is kept silently
             raise FileFormatError(
-                f"{self.path}: topic {topic!r} has {repeated} messages stamped {stamp}; "
+                f"{self.path}: topic {topic!r} has {len(msgs)} messages stamped {stamp}; "
                 "a poke needs exactly one on each topic")
-        if msg is None:
-            bad = self._undecodable.get(topic, [])
+        if not msgs:
+            bad = self._undecodable[key]
             note = f"; {len(bad)} message(s) there could not be decoded ({bad[0]})" if bad else ""
             raise FileFormatError(
                 f"{self.path}: topic {topic!r} has no message stamped {stamp}{note}")
-        return msg
+        return msgs[0]
 
     def _cloud(self, msg: Any, where: str, frame: str, colors: bool = True) -> PointCloud:
         if msg.header.frame_id != frame:
@@ -167,13 +147,13 @@ class BagReader:
 
     def observation(self) -> PointCloud:
         topic = TOPICS["observation"][0]
-        msgs = list(self._messages_by_stamp()["observation"].values())
-        count = len(msgs) + sum(n - 1 for n in self._repeated.get(topic, {}).values())
-        if count != 1:
-            bad = self._undecodable.get(topic, [])
+        msgs = [msg for same in self._by_stamp("observation").values() for msg in same]
+        if len(msgs) != 1:
+            bad = self._undecodable["observation"]
             raise FileFormatError(
-                f"{self.path}: topic {topic!r} must hold exactly one message; got {count}"
+                f"{self.path}: topic {topic!r} must hold exactly one message; got {len(msgs)}"
                 + (f" ({len(bad)} could not be decoded: {bad[0]})" if bad else ""))
+
         where = f"{self.path} [{topic}]"
         return self._to_world(self._cloud(msgs[0], where, self.header.frame))
 

@@ -29,8 +29,7 @@ from deformap.cloud.io import (
 )
 from deformap.environment import ForceTravel, Workspace
 from deformap.errors import DeformapError, FileFormatError
-from deformap.replay._folder import PressParts
-from deformap.replay._format import PokeSpec
+from deformap.replay._format import PokeSpec, PressParts
 from deformap.replay._rawconfig import HullPart, RawBagConfig
 from deformap.replay._rawpress import FoundPress, find_presses
 from deformap.replay._rawtf import TransformTree

@@ -1,9 +1,9 @@
 """A recorded session read back: ``load_session`` and ``RecordedSession``.
 
 A session is a folder of ``session.yaml`` (``docs/recording-format.md``) and either one cloud file
-per observation (folder form) or a ROS 2 bag (bag form). Loading checks the whole ``session.yaml``
-and opens the data; each poke is read and checked only when asked for, so that a broken poke is
-reported on its own.
+per observation (folder form, read here; contacts in ``session.yaml``) or a ROS 2 bag (bag form).
+Loading checks the whole ``session.yaml`` and opens the data; each poke is read and checked only
+when asked for, so that a broken poke is reported on its own.
 """
 
 from __future__ import annotations
@@ -18,13 +18,18 @@ import numpy as np
 from deformap._config import load_yaml
 from deformap._validation import check_int, check_path, check_positive
 from deformap.cloud import PointCloud, points_in_hull
-from deformap.cloud.io import path_kind
+from deformap.cloud.io import path_kind, read_cloud
 from deformap.environment import PressObservation, TactileContact, Workspace
 from deformap.errors import DeformapError, FileFormatError, InvalidArgumentError
 from deformap.replay._bagform import BagReader
-from deformap.replay._folder import FolderReader
-from deformap.replay._format import SESSION_FILE, SessionHeader, parse_session_yaml
-from deformap.replay._manifest import verify_digest
+from deformap.replay._confine import verify_digest
+from deformap.replay._format import (
+    SESSION_FILE,
+    PokeSpec,
+    PressParts,
+    SessionHeader,
+    parse_session_yaml,
+)
 from deformap.replay._rawbag import RawBagReader
 from deformap.replay._truth import GroundTruth, read_ground_truth
 
@@ -36,6 +41,41 @@ logger = logging.getLogger(__name__)
 #: is refused: the robot hides a few centimetres around the tip, while a tip or cloud in the
 #: wrong frame or units lands tens of centimetres away.
 DEFAULT_CONTACT_GAP_M = 0.05
+
+
+class FolderReader:
+    """Reads the files a folder-form ``session.yaml`` names, one at a time."""
+
+    def __init__(self, header: SessionHeader) -> None:
+        self.header = header
+        assert header.observation is not None
+        if path_kind(header.observation) != "file":
+            raise FileFormatError(
+                f"{header.observation}: no such file (the session's `observation`)")
+
+    def _read(self, path: Path | None, to_world: bool = True) -> PointCloud:
+        assert path is not None
+        if path_kind(path) != "file":
+            raise FileFormatError(f"{path}: no such file")
+        verify_digest(self.header.sha256, path)
+        cloud = read_cloud(path, units=self.header.units)
+        if not to_world or self.header.frame == "world":
+            return cloud
+        assert isinstance(self.header.cam2world, np.ndarray)  # parse_session_yaml guarantees it
+        return PointCloud(cloud.points, cloud.colors, frame=self.header.frame).transformed(
+            self.header.cam2world, "world")
+
+    def observation(self) -> PointCloud:
+        return self._read(self.header.observation)
+
+    def press_parts(self, spec: PokeSpec) -> PressParts:
+        assert spec.cloud is not None and spec.tip_center is not None and spec.force is not None
+        cloud, robot = self._read(spec.cloud), spec.robot_points
+        if isinstance(robot, Path):
+            # Robot geometry comes from the robot model in the world (base) frame, not the camera's.
+            robot = np.asarray(self._read(robot, to_world=False).points)
+        assert robot is not None
+        return PressParts(cloud, spec.tip_center, spec.force, robot, spec.force_travel)
 
 
 @dataclass(eq=False)
@@ -165,7 +205,7 @@ def load_session(path: str | Path, *, contact_gap_m: float = DEFAULT_CONTACT_GAP
     truth = None
     if header.ground_truth is not None:
         if path_kind(header.ground_truth) == "file":
-            verify_digest(header, header.ground_truth)
+            verify_digest(header.sha256, header.ground_truth)
         truth = read_ground_truth(header.ground_truth)
     broken = [p.index for p in header.pokes if p.error is not None]
     if broken:

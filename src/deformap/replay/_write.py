@@ -1,4 +1,5 @@
-"""Writing a session (folder or bag form), as ``deformap record-sim`` does."""
+"""Writing a session (folder or bag form), as ``deformap record-sim`` does, from what a
+:class:`RecordingEnvironment` kept of an environment's answers."""
 
 from __future__ import annotations
 
@@ -13,14 +14,14 @@ import yaml
 from deformap._validation import check_instance, check_positive
 from deformap.cloud import PointCloud
 from deformap.cloud.io import BAG_STORAGES, CLOUD_FORMATS, write_cloud
-from deformap.environment import PressObservation, Workspace
-from deformap.errors import InvalidArgumentError
+from deformap.environment import Environment, PressObservation, Workspace
+from deformap.errors import EnvironmentStateError, InvalidArgumentError
 from deformap.replay._bagform import write_session_bag
+from deformap.replay._confine import manifest_of
 from deformap.replay._format import FORMAT_NAME, FORMAT_VERSION, SESSION_FILE
-from deformap.replay._manifest import manifest_of
 from deformap.replay._truth import GroundTruth, write_ground_truth
 
-__all__ = ["SESSION_FORMATS", "write_session"]
+__all__ = ["SESSION_FORMATS", "RecordingEnvironment", "write_session"]
 
 logger = logging.getLogger(__name__)
 
@@ -29,6 +30,43 @@ SESSION_FORMATS = ("folder", *BAG_STORAGES)
 
 #: Poke ``i`` (0-based) of a bag written here is stamped ``(i + 1)`` seconds; the observation 0.
 _STAMP_STEP_NS = 10**9
+
+
+class RecordingEnvironment:
+    """Pass every call through to ``env`` and keep each ``observe()`` and ``press()`` result,
+    ready for :func:`~deformap.replay.write_session`."""
+
+    def __init__(self, env: Environment) -> None:
+        if not isinstance(env, Environment):
+            raise InvalidArgumentError(
+                f"`env` must implement the Environment protocol; got {type(env).__name__}")
+        self._env = env
+        self.observations: list[PointCloud] = []
+        self.presses: list[PressObservation] = []
+
+    @property
+    def workspace(self) -> Workspace:
+        return self._env.workspace
+
+    @property
+    def observation(self) -> PointCloud:
+        """The first observation (the one the mapper is initialised with)."""
+        if not self.observations:
+            raise EnvironmentStateError("nothing recorded yet: `observe()` was never called")
+        return self.observations[0]
+
+    def observe(self) -> PointCloud:
+        cloud = self._env.observe()
+        self.observations.append(cloud)
+        return cloud
+
+    def press(self, target_xy: Any, force_n: float) -> PressObservation:
+        obs = self._env.press(target_xy, force_n)
+        self.presses.append(obs)
+        return obs
+
+    def release(self) -> None:
+        self._env.release()
 
 
 class _Dumper(yaml.SafeDumper):
