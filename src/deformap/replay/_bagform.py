@@ -22,6 +22,8 @@ from deformap.cloud.io import (
     bag_error_text,
     bag_read_errors,
     bag_writer,
+    header_message,
+    header_stamp_ns,
     iter_bag_messages,
     path_kind,
     pointcloud2_to_cloud,
@@ -39,9 +41,6 @@ FORCE_TRAVEL_DIMS = ("samples", "travel_m,force_n")
 
 __all__ = ["FORCE_TRAVEL_DIMS", "BagReader", "force_travel_message", "write_session_bag"]
 
-
-def _stamp(msg: Any) -> int:
-    return int(msg.header.stamp.sec) * 10**9 + int(msg.header.stamp.nanosec)
 
 
 class BagReader:
@@ -106,7 +105,7 @@ class BagReader:
             for number, (_, data) in enumerate(self._raw[topic], start=1):
                 try:
                     msg = store.deserialize_cdr(data, msgtype)
-                    by_stamp.setdefault(_stamp(msg), []).append(msg)
+                    by_stamp.setdefault(header_stamp_ns(msg.header), []).append(msg)
                 except errors as exc:
                     bad.append(f"message {number}: {bag_error_text(exc, 120)}")
             self._decoded[key] = by_stamp
@@ -186,11 +185,9 @@ class BagReader:
 
 def _point_message(stamp_ns: int, point: Any) -> Any:
     types = typestore().types
-    time = types["builtin_interfaces/msg/Time"](sec=stamp_ns // 10**9, nanosec=stamp_ns % 10**9)
-    header = types["std_msgs/msg/Header"](stamp=time, frame_id="world")
-    x, y, z = (float(v) for v in point)
-    return types["geometry_msgs/msg/PointStamped"](
-        header=header, point=types["geometry_msgs/msg/Point"](x=x, y=y, z=z))
+    xyz = types["geometry_msgs/msg/Point"](*map(float, point))
+    return types["geometry_msgs/msg/PointStamped"](header=header_message(stamp_ns, "world"),
+                                                   point=xyz)
 
 
 def force_travel_message(record: ForceTravel) -> Any:

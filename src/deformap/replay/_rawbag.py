@@ -22,6 +22,7 @@ from deformap.cloud import PointCloud
 from deformap.cloud.io import (
     bag_error_text,
     bag_read_errors,
+    header_stamp_ns,
     iter_bag_messages,
     pointcloud2_colors,
     pointcloud2_structured,
@@ -53,9 +54,6 @@ MAX_FORCE_N = 1e6
 #: Points of a hull part's circle (cylinder, cap): 16 give a polygon within 2 % of the circle.
 _CIRCLE = 16
 
-
-def _stamp(header: Any) -> int:
-    return int(header.stamp.sec) * 10**9 + int(header.stamp.nanosec)
 
 
 def hull_points(part: HullPart, rot: NDArray[np.float64], origin: NDArray[np.float64]
@@ -146,11 +144,11 @@ class RawBagReader:
                 raise FileFormatError(f"{where}: could not be decoded: "
                                       f"{bag_error_text(exc, 120)}") from None  # fmt: skip
             if raw.topic == cfg.cloud_topic:
-                stamps.append(_stamp(msg.header))
+                stamps.append(header_stamp_ns(msg.header))
                 frames.add(str(msg.header.frame_id))
             elif raw.topic == cfg.wrench_topic:
                 f = msg.wrench.force
-                w_ns.append(_stamp(msg.header))
+                w_ns.append(header_stamp_ns(msg.header))
                 w_force.append([float(f.x), float(f.y), float(f.z)])
                 w_frames.add(str(msg.header.frame_id))
             else:

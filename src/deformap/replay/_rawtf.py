@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from deformap.cloud.io import header_stamp_ns
 from deformap.errors import FileFormatError
 
 __all__ = ["MAX_TRANSLATION_M", "TransformGap", "TransformTree"]
@@ -75,8 +76,7 @@ class TransformTree:
                 raise FileFormatError(
                     f"{where}: frame {child!r} has two parents, {edge.parent!r} and {parent!r}")
             edge.static = edge.static and static
-            stamp = int(tf.header.stamp.sec) * 10**9 + int(tf.header.stamp.nanosec)
-            edge.stamps.append(stamp)
+            edge.stamps.append(header_stamp_ns(tf.header))
             edge.translations.append(trans)
             edge.quaternions.append(quat)
         self._series.clear()

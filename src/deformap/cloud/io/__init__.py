@@ -18,18 +18,23 @@ from __future__ import annotations
 from deformap.cloud.io._bag import (
     StampedCloud,
     WrenchSeries,
+    bag_writer,
     read_bag_clouds,
     read_bag_static_transform,
     read_bag_wrenches,
+    wrench_message,
+    write_bag,
 )
 from deformap.cloud.io._bag_reader import (
     BAG_STORAGES,
     RawBagMessage,
     bag_error_text,
     bag_read_errors,
+    header_message,
+    header_stamp_ns,
     iter_bag_messages,
+    typestore,
 )
-from deformap.cloud.io._bag_writer import bag_writer, fill_chunk_crcs, wrench_message, write_bag
 from deformap.cloud.io._common import MM_EXTENT_THRESHOLD, UNITS, path_kind
 from deformap.cloud.io._dispatch import CLOUD_FORMATS, read_cloud, write_cloud
 from deformap.cloud.io._npz import MAX_NPZ_BYTES, load_npz_arrays, read_npz, write_npz
@@ -42,14 +47,13 @@ from deformap.cloud.io._pointcloud2 import (
     pointcloud2_to_array,
     pointcloud2_to_cloud,
 )
-from deformap.cloud.io._ros import ROS_DISTRO, typestore
 
-__all__ = [
-           "BAG_STORAGES", "CLOUD_FORMATS", "MAX_NPZ_BYTES", "MM_EXTENT_THRESHOLD", "PCD_ENCODINGS",
-           "PLY_FORMATS", "ROS_DISTRO", "UNITS", "RawBagMessage", "StampedCloud", "WrenchSeries",
-           "array_to_pointcloud2", "bag_error_text", "bag_read_errors", "bag_writer", "fill_chunk_crcs",
-           "iter_bag_messages", "load_npz_arrays", "path_kind", "pointcloud2_colors",
-           "pointcloud2_structured", "pointcloud2_to_array", "pointcloud2_to_cloud", "read_bag_clouds",
+__all__ = ["BAG_STORAGES", "CLOUD_FORMATS", "MAX_NPZ_BYTES", "MM_EXTENT_THRESHOLD",
+           "PCD_ENCODINGS", "PLY_FORMATS", "UNITS", "RawBagMessage", "StampedCloud",
+           "WrenchSeries", "array_to_pointcloud2", "bag_error_text", "bag_read_errors",
+           "bag_writer", "header_message", "header_stamp_ns", "iter_bag_messages",
+           "load_npz_arrays", "path_kind", "pointcloud2_colors", "pointcloud2_structured",
+           "pointcloud2_to_array", "pointcloud2_to_cloud", "read_bag_clouds",
            "read_bag_static_transform", "read_bag_wrenches", "read_cloud", "read_npz", "read_pcd",
            "read_ply", "typestore", "wrench_message", "write_bag", "write_cloud", "write_npz",
            "write_pcd", "write_ply"]

@@ -15,6 +15,7 @@ import struct
 import zlib
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
+from functools import cache
 from pathlib import Path
 from typing import Any
 
@@ -22,10 +23,15 @@ from deformap._validation import check_path
 from deformap.cloud.io._common import path_kind
 from deformap.errors import DeformapError, FileFormatError, InvalidArgumentError, missing_extra
 
-__all__ = ["BAG_STORAGES", "RawBagMessage", "bag_error_text", "bag_read_errors",
-           "check_db3_counts", "check_mcap_crcs", "iter_bag_messages"]
+__all__ = ["BAG_STORAGES", "ROS_DISTRO", "RawBagMessage", "bag_error_text", "bag_read_errors",
+           "header_message", "header_stamp_ns", "iter_bag_messages", "typestore"]
+
 
 BAG_STORAGES = ("mcap", "sqlite3")
+
+#: The message definitions used to write and, for bags that carry none, read messages. The
+#: messages deformap uses (PointCloud2, WrenchStamped, TFMessage) are identical from Humble on.
+ROS_DISTRO = "ros2_humble"
 
 
 def _rosbag2() -> Any:
@@ -34,6 +40,28 @@ def _rosbag2() -> Any:
     except ImportError:
         raise missing_extra("rosbags", "ros", "reading ROS 2 bags") from None
     return rosbag2
+
+
+@cache
+def typestore() -> Any:
+    """Return rosbags' typestore for :data:`ROS_DISTRO`, or raise MissingDependencyError."""
+    try:
+        from rosbags.typesys import Stores, get_typestore
+    except ImportError:
+        raise missing_extra("rosbags", "ros", "reading and writing ROS 2 messages") from None
+    return get_typestore(Stores(ROS_DISTRO))
+
+
+def header_message(stamp_ns: int, frame_id: str) -> Any:
+    """A ``std_msgs/msg/Header`` of ``stamp_ns`` [ns] and ``frame_id``."""
+    types = typestore().types
+    time = types["builtin_interfaces/msg/Time"](sec=stamp_ns // 10**9, nanosec=stamp_ns % 10**9)
+    return types["std_msgs/msg/Header"](stamp=time, frame_id=frame_id)
+
+
+def header_stamp_ns(header: Any) -> int:
+    """The stamp [ns] of a ``std_msgs/msg/Header``."""
+    return int(header.stamp.sec) * 10**9 + int(header.stamp.nanosec)
 
 
 def bag_read_errors() -> tuple[type[BaseException], ...]:

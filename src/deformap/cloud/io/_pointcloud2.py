@@ -21,8 +21,8 @@ from numpy.typing import NDArray
 
 from deformap._validation import check_array, check_int, check_points
 from deformap.cloud._pointcloud import PointCloud
+from deformap.cloud.io._bag_reader import header_message, typestore
 from deformap.cloud.io._common import check_colors, check_units, finish_cloud, pack_rgb, unpack_rgb
-from deformap.cloud.io._ros import typestore
 from deformap.errors import FileFormatError, InvalidArgumentError
 
 __all__ = ["array_to_pointcloud2", "pointcloud2_colors", "pointcloud2_structured",
@@ -182,13 +182,11 @@ def array_to_pointcloud2(points: Any, *, colors: Any = None, frame_id: str = "wo
         table[a] = pts[:, i]
     if colors is not None:
         table["rgb"] = pack_rgb(cols)
-    header = types["std_msgs/msg/Header"](
-        stamp=types["builtin_interfaces/msg/Time"](sec=stamp // 10**9, nanosec=stamp % 10**9),
-        frame_id=frame_id)
     return types["sensor_msgs/msg/PointCloud2"](
-        header=header, height=1, width=pts.shape[0], fields=fields, is_bigendian=False,
-        point_step=table.dtype.itemsize, row_step=table.nbytes, data=table.view(np.uint8),
-        is_dense=True)
+        header=header_message(stamp, frame_id), height=1, width=pts.shape[0], fields=fields,
+        is_bigendian=False, point_step=table.dtype.itemsize, row_step=table.nbytes,
+        data=table.view(np.uint8), is_dense=True)
+
 
 
 def _packed_colors(where: str, table: NDArray[Any], field: str) -> NDArray[np.uint8]:
