@@ -45,15 +45,6 @@ def crop_box(points: Any, lower: Any, upper: Any) -> NDArray[np.bool_]:
     return np.all((pts >= lo) & (pts <= hi), axis=1)
 
 
-def _mean_neighbour_distances(pts: NDArray[np.float64], k: int) -> NDArray[np.float64]:
-    from scipy.spatial import cKDTree  # imported here: scipy.spatial is slow to import
-
-    # Open3D counts the point itself among its k neighbours (distance 0), so query k, not k + 1.
-    dist, _ = cKDTree(pts).query(pts, k=k)
-    dist = dist.reshape(pts.shape[0], k)
-    return np.asarray(dist.mean(axis=1))
-
-
 def statistical_outlier_mask(points: Any, k: int, std_ratio: float) -> NDArray[np.bool_]:
     """Mask of the points kept by Open3D's statistical outlier rule.
 
@@ -77,7 +68,10 @@ def statistical_outlier_mask(points: Any, k: int, std_ratio: float) -> NDArray[n
         raise InvalidArgumentError(
             f"`points` must hold at least k={k} points (and at least 2) for the statistical "
             f"outlier rule; got {n}")
-    avg = _mean_neighbour_distances(pts, k)
+    from scipy.spatial import cKDTree  # imported here: scipy.spatial is slow to import
+
+    # Open3D counts the point itself among its k neighbours (distance 0), so query k, not k + 1.
+    avg = cKDTree(pts).query(pts, k=k)[0].reshape(n, k).mean(axis=1)
     positive = avg > 0
     mean = avg.sum() / n
     std = np.sqrt(np.sum((avg[positive] - mean) ** 2) / (n - 1))
@@ -125,8 +119,7 @@ def height_field_mask(points: Any, k: int = 20, max_slope_deg: float = 60.0) -> 
 
 
 def hull_parts(hull_points: Any) -> tuple[Any, ...] | None:
-    """The hulls of a tuple or list of 2-D entries (one ``(m_i, 3)`` hull per part), or None
-    for a single hull."""
+    """The hulls of a tuple or list of 2-D entries (one ``(m_i, 3)`` hull per part), or None."""
     if isinstance(hull_points, (tuple, list)) and hull_points and all(
         np.ndim(part) == 2 for part in hull_points
     ):
@@ -148,8 +141,7 @@ def points_in_hull(points: Any, hull_points: Any, *, tolerance_m: float = HULL_T
         return _in_one_hull(pts, check_points("hull_points", hull_points, min_rows=4), tol)
     inside = np.zeros(pts.shape[0], dtype=bool)
     for i, part in enumerate(parts):
-        verts = check_points(f"hull_points[{i}]", part, min_rows=4)
-        inside |= _in_one_hull(pts, verts, tol)
+        inside |= _in_one_hull(pts, check_points(f"hull_points[{i}]", part, min_rows=4), tol)
     return inside
 
 

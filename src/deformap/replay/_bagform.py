@@ -42,7 +42,6 @@ FORCE_TRAVEL_DIMS = ("samples", "travel_m,force_n")
 __all__ = ["FORCE_TRAVEL_DIMS", "BagReader", "force_travel_message", "write_session_bag"]
 
 
-
 class BagReader:
     """Reads the poke messages of a bag-form session, each one when its poke is asked for."""
 

@@ -10,7 +10,6 @@ time. A press that cannot be read is refused in one line naming it, the topic an
 
 from __future__ import annotations
 
-import logging
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -37,8 +36,6 @@ from deformap.replay._rawtf import TransformTree
 
 __all__ = ["RawBagReader", "hull_points"]
 
-logger = logging.getLogger(__name__)
-
 _CLOUD = "sensor_msgs/msg/PointCloud2"
 _WRENCH = "geometry_msgs/msg/WrenchStamped"
 _TF = "tf2_msgs/msg/TFMessage"
@@ -53,7 +50,6 @@ MAX_FORCE_N = 1e6
 
 #: Points of a hull part's circle (cylinder, cap): 16 give a polygon within 2 % of the circle.
 _CIRCLE = 16
-
 
 
 def hull_points(part: HullPart, rot: NDArray[np.float64], origin: NDArray[np.float64]

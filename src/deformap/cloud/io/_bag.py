@@ -72,7 +72,6 @@ class WrenchSeries:
     frame_id: str
 
 
-
 def _messages(path: Any, topic: str, msgtype: str) -> Iterator[tuple[int, Any]]:
     """(log time, deserialised message) of ``topic``; every failure names file and topic."""
     if not isinstance(topic, str) or not topic:

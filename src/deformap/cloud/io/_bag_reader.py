@@ -64,22 +64,25 @@ def header_stamp_ns(header: Any) -> int:
     return int(header.stamp.sec) * 10**9 + int(header.stamp.nanosec)
 
 
+@cache
 def bag_read_errors() -> tuple[type[BaseException], ...]:
     """What rosbags, its SQLite drivers (``apsw``'s errors included), the MCAP chunk
     decompressors (zstd's ``ZstdError``, lz4's ``RuntimeError``) and the CDR decoder raise on a
     damaged bag (a corrupted length may ask for an absurd allocation: MemoryError)."""
     from rosbags.serde import SerdeError
 
-    errors: tuple[type[BaseException], ...] = (
+    errors: list[type[BaseException]] = [
         _rosbag2().ReaderError, SerdeError, sqlite3.Error, OSError, ValueError, KeyError,
         IndexError, TypeError, AssertionError, EOFError, struct.error, MemoryError,
-        OverflowError, UnicodeDecodeError, RuntimeError, *_zstd_errors(),
-    )  # fmt: skip
-    try:
-        import apsw
-    except ImportError:
-        return errors
-    return (*errors, apsw.Error)
+        OverflowError, UnicodeDecodeError, RuntimeError]  # fmt: skip
+    # the zstd module rosbags uses, whichever is installed, and apsw if it is
+    for module, name in (("compression.zstd", "ZstdError"), ("backports.zstd", "ZstdError"),
+                         ("apsw", "Error")):  # fmt: skip
+        try:
+            errors.append(getattr(importlib.import_module(module), name))
+        except ImportError:
+            continue
+    return tuple(errors)
 
 
 def bag_error_text(exc: BaseException, limit: int = 200) -> str:
@@ -91,18 +94,6 @@ def bag_error_text(exc: BaseException, limit: int = 200) -> str:
     if isinstance(exc, (NotImplementedError, RecursionError)):
         raise exc
     return f"{type(exc).__name__}: {' '.join(str(exc).split())[:limit]}"
-
-
-def _zstd_errors() -> tuple[type[BaseException], ...]:
-    """The ``ZstdError`` of the zstd module rosbags uses (``compression.zstd`` or
-    ``backports.zstd``), if it is there."""
-    for name in ("compression.zstd", "backports.zstd"):
-        try:
-            module = importlib.import_module(name)
-        except ImportError:
-            continue
-        return (module.ZstdError,)
-    return ()
 
 
 @dataclass(frozen=True)

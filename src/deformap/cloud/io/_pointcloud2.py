@@ -188,7 +188,6 @@ def array_to_pointcloud2(points: Any, *, colors: Any = None, frame_id: str = "wo
         data=table.view(np.uint8), is_dense=True)
 
 
-
 def _packed_colors(where: str, table: NDArray[Any], field: str) -> NDArray[np.uint8]:
     column = table[field]
     if column.ndim != 1 or column.dtype.itemsize != 4 or column.dtype.kind not in "fiu":
