@@ -14,9 +14,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from deformap._validation import (
-    check_finite_scalar,
     check_int,
     check_points,
+    check_positive,
     check_slope_deg,
     check_vector,
 )
@@ -59,9 +59,7 @@ def statistical_outlier_mask(points: Any, k: int, std_ratio: float) -> NDArray[n
     object maps for household environments", 2008.
     """
     k = check_int("k", k, minimum=1)
-    ratio = check_finite_scalar("std_ratio", std_ratio)
-    if ratio <= 0:
-        raise InvalidArgumentError(f"`std_ratio` must be > 0 (as in Open3D); got {ratio}")
+    ratio = check_positive("std_ratio", std_ratio)
     pts = check_points("points", points, min_rows=0)
     n = pts.shape[0]
     if n < max(k, 2):
@@ -133,9 +131,7 @@ def points_in_hull(points: Any, hull_points: Any, *, tolerance_m: float = HULL_T
     least 4 points not on one plane), or of any hull of a tuple or list of such arrays (one per robot
     part); a point at most ``tolerance_m`` outside every facet plane counts as inside."""
     pts = check_points("points", points, min_rows=0)
-    tol = check_finite_scalar("tolerance_m", tolerance_m)
-    if tol < 0:
-        raise InvalidArgumentError(f"`tolerance_m` must be >= 0; got {tol}")
+    tol = check_positive("tolerance_m", tolerance_m, allow_zero=True)
     parts = hull_parts(hull_points)
     if parts is None:
         return _in_one_hull(pts, check_points("hull_points", hull_points, min_rows=4), tol)

@@ -38,7 +38,7 @@ from deformap.cloud.io._bag_reader import (
     typestore,
 )
 from deformap.cloud.io._common import check_units
-from deformap.cloud.io._pointcloud2 import _to_cloud, array_to_pointcloud2
+from deformap.cloud.io._pointcloud2 import array_to_pointcloud2, pointcloud2_to_cloud
 from deformap.errors import FileFormatError, InvalidArgumentError
 
 __all__ = ["StampedCloud", "WrenchSeries", "bag_writer", "fill_chunk_crcs", "read_bag_clouds",
@@ -146,7 +146,7 @@ def read_bag_clouds(path: str | Path, topic: str, *, cam2world: Any = None,
     up to ``world_frame``. ``units`` are the coordinates'. NaN holes are dropped and counted; a
     message with no finite point is refused.
     """
-    scale = check_units(units)
+    check_units(units)  # refused before the bag is opened
     fixed = None
     if cam2world is not None and not (isinstance(cam2world, str) and cam2world == "tf_static"):
         fixed = check_array("cam2world", cam2world, (4, 4), what="homogeneous transform entries")
@@ -154,7 +154,7 @@ def read_bag_clouds(path: str | Path, topic: str, *, cam2world: Any = None,
     out = []
     for index, (log_time, msg) in enumerate(_messages(path, topic, CLOUD_TYPE)):
         where = f"{path} [{topic} message {index + 1}]"
-        cloud, dropped = _to_cloud(msg, where, scale, msg.header.frame_id or "sensor", True)
+        cloud, dropped = pointcloud2_to_cloud(msg, where=where, units=units)
         if fixed is not None:
             cloud = cloud.transformed(fixed, "world")
         elif cam2world is not None:

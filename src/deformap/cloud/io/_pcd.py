@@ -138,8 +138,7 @@ def _pcd_colors(path: Path, pc_data: NDArray[Any], meta: Any, body: bytes
                     f"{path}: colour field {field!r} holds {values.min():.0f} to "
                     f"{values.max():.0f}; a packed word lies in [0, 2^32)")
             return unpack_rgb(values.astype(np.uint32)), field, (field,)
-    word = values.dtype.str[0] + "u4"  # the same bytes as an unsigned word, NaN bits included
-    return unpack_rgb(np.ascontiguousarray(values).view(word).astype(np.uint32)), field, (field,)
+    return unpack_rgb(values), field, (field,)
 
 
 def read_pcd(path: str | Path, *, units: str = "m", drop_nan: bool = False
