@@ -25,8 +25,14 @@ from deformap.replay._rawconfig import (
     load_raw_config,
     raw_config_file,
 )
-from deformap.replay._rawsession import RAW_SUFFIXES, is_raw_bag, load_raw_bag
-from deformap.replay._session import DEFAULT_CONTACT_GAP_M, RecordedSession, load_session
+from deformap.replay._session import (
+    DEFAULT_CONTACT_GAP_M,
+    RAW_SUFFIXES,
+    RecordedSession,
+    is_raw_bag,
+    load_raw_bag,
+    load_session,
+)
 from deformap.replay._truth import GroundTruth, read_ground_truth, write_ground_truth
 from deformap.replay._write import SESSION_FORMATS, RecordingEnvironment, write_session
 

@@ -122,10 +122,6 @@ class RawBagConfig:
         if not self.hull:
             raise ConfigError("`hull` must hold at least one part (the stick); got none")
 
-    def commanded_force(self, default_n: float) -> float:
-        """The commanded force: ``force_n``, else ``default_n`` (the run's)."""
-        return default_n if self.force_n is None else self.force_n
-
 
 def raw_config_file(bag: Path) -> Path:
     """Where the settings of ``bag`` live: ``deformap.yaml`` inside a rosbag2 folder, or

@@ -1,16 +1,11 @@
-"""Point-cloud files and ROS 2 bags in and out.
+"""Point-cloud files (PCD, PLY, NPZ) and ROS 2 bags (sqlite3, MCAP; extra ``ros``) in and out.
 
 Readers return clouds in metres and refuse what they cannot read faithfully (truncated or corrupt
-files, missing x/y/z, NaN points unless ``drop_nan=True``, empty clouds, clouds that look like
-millimetres unless ``units="mm"``) with one :class:`~deformap.errors.FileFormatError` naming the
-file. Every size a header declares is checked against the bytes present before anything is
-allocated, and a body larger than its header declares is refused, not cut. Nothing is unpickled.
-
-Formats: PCD (pypcd4), PLY (numpy), NPZ (at most :data:`MAX_NPZ_BYTES` decompressed), and ROS 2
-bags (sqlite3 and MCAP, through the optional ``rosbags``, extra ``ros``) of PointCloud2 and
-WrenchStamped messages: :func:`iter_bag_messages` is the one bag reader, :func:`bag_writer` the
-one writer. Colours (RGB in [0, 1]) are read from every format's usual fields and written whenever
-a cloud has them (``docs/recording-format.md``).
+files, sizes a header declares that the bytes do not hold, missing x/y/z, NaN points unless
+``drop_nan=True``, empty clouds, metres that look like millimetres unless ``units="mm"``) with one
+:class:`~deformap.errors.FileFormatError` naming the file; nothing is unpickled.
+:func:`iter_bag_messages` is the one bag reader, :func:`bag_writer` the one writer. Colours (RGB in
+[0, 1]) are read from every format's usual fields and written whenever a cloud has them.
 """
 
 from __future__ import annotations
