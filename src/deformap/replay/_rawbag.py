@@ -26,6 +26,7 @@ from deformap.cloud.io import (
     pointcloud2_colors,
     pointcloud2_structured,
     typestore,
+    xyz_with_holes,
 )
 from deformap.environment import ForceTravel, Workspace
 from deformap.errors import DeformapError, FileFormatError
@@ -268,15 +269,9 @@ class RawBagReader:
         """The frame's points, NaN holes kept, and their colours (NaN at the holes) or None."""
         try:
             table = pointcloud2_structured(msg)
+            xyz = xyz_with_holes(msg, table)
         except DeformapError as exc:
-            raise FileFormatError(f"{where}: {exc}") from None
-        names = table.dtype.names or ()
-        if not all(a in names and table.dtype[a].kind == "f" for a in "xyz"):
-            raise FileFormatError(f"{where}: must have float fields x, y, z; got {list(names)}")
-        with np.errstate(invalid="ignore"):
-            xyz = np.column_stack([table[a].astype(np.float64) for a in "xyz"])
-        if bool(msg.is_dense) and not np.isfinite(xyz).all():
-            raise FileFormatError(f"{where}: says is_dense but holds NaN or infinite points")
+            raise FileFormatError(f"{where}: {str(exc).replace('`msg` ', '')}") from None
         rgb = pointcloud2_colors(msg, where=where, table=table, valid=np.isfinite(xyz).all(axis=1))
         return xyz * (1e-3 if self.config.units == "mm" else 1.0), rgb
 

@@ -41,6 +41,7 @@ from deformap.cloud.io._pointcloud2 import (
     pointcloud2_structured,
     pointcloud2_to_array,
     pointcloud2_to_cloud,
+    xyz_with_holes,
 )
 
 __all__ = ["BAG_STORAGES", "CLOUD_FORMATS", "MAX_NPZ_BYTES", "MM_EXTENT_THRESHOLD",
@@ -51,4 +52,4 @@ __all__ = ["BAG_STORAGES", "CLOUD_FORMATS", "MAX_NPZ_BYTES", "MM_EXTENT_THRESHOL
            "pointcloud2_to_array", "pointcloud2_to_cloud", "read_bag_clouds",
            "read_bag_static_transform", "read_bag_wrenches", "read_cloud", "read_npz", "read_pcd",
            "read_ply", "typestore", "wrench_message", "write_bag", "write_cloud", "write_npz",
-           "write_pcd", "write_ply"]
+           "write_pcd", "write_ply", "xyz_with_holes"]
