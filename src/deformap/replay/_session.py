@@ -101,9 +101,6 @@ class RecordedSession:
     def workspace(self) -> Workspace:
         return self.header.workspace
 
-    @property
-    def tip_radius_m(self) -> float:
-        return self.header.tip_radius_m
 
     @property
     def source(self) -> dict[str, Any]:
@@ -133,7 +130,7 @@ class RecordedSession:
                  else f"{self.path / SESSION_FILE}: poke {i}")  # fmt: skip
         try:
             contact = TactileContact(tip_center=parts.tip_center, force=parts.force,
-                                     tip_radius_m=self.tip_radius_m)  # fmt: skip
+                                     tip_radius_m=self.header.tip_radius_m)  # fmt: skip
             obs = PressObservation(cloud=parts.cloud, contact=contact,
                                    robot_points=parts.robot_points, target_xy=spec.target_xy,
                                    force_n=spec.force_n,

@@ -11,7 +11,7 @@ from typing import Any
 import numpy as np
 import yaml
 
-from deformap._validation import check_instance, check_positive
+from deformap._validation import check_instance, check_path, check_positive
 from deformap.cloud import PointCloud
 from deformap.cloud.io import BAG_STORAGES, CLOUD_FORMATS, write_cloud
 from deformap.environment import Environment, PressObservation, Workspace
@@ -89,9 +89,7 @@ def _floats(values: Any) -> list[float]:
 def _check_inputs(folder: Any, workspace: Any, observation: Any, presses: Any, tip_radius_m: Any,
                   format: Any, cloud_format: Any,
                   ground_truth: Any) -> tuple[Path, list[PressObservation], float]:
-    if not isinstance(folder, (str, Path)):
-        raise InvalidArgumentError(f"`folder` must be a str or Path; got {type(folder).__name__}")
-    out = Path(folder)
+    out = check_path("folder", folder)
     if out.exists() and (not out.is_dir() or any(out.iterdir())):
         raise InvalidArgumentError(f"`folder` {out} exists and is not an empty folder")
     check_instance("workspace", workspace, Workspace)
@@ -121,9 +119,8 @@ def _check_inputs(folder: Any, workspace: Any, observation: Any, presses: Any, t
     if cloud_format not in CLOUD_FORMATS:
         raise InvalidArgumentError(
             f"`cloud_format` must be one of {CLOUD_FORMATS}; got {cloud_format!r}")
-    if ground_truth is not None and not isinstance(ground_truth, GroundTruth):
-        raise InvalidArgumentError(
-            f"`ground_truth` must be a GroundTruth or None; got {type(ground_truth).__name__}")
+    if ground_truth is not None:
+        check_instance("ground_truth", ground_truth, GroundTruth)
     return out, presses, tip
 
 
@@ -143,10 +140,10 @@ def write_session(folder: str | Path, *, workspace: Workspace, observation: Poin
     out, presses, tip = _check_inputs(folder, workspace, observation, presses, tip_radius_m,
                                       format, cloud_format, ground_truth)  # fmt: skip
     out.mkdir(parents=True, exist_ok=True)
-    doc: dict[str, Any] = {"format": FORMAT_NAME, "version": FORMAT_VERSION, "units": "m",
-                           "frame": "world",
-                           "workspace": {"lower": list(workspace.lower), "upper": list(workspace.upper)},
-                           "probe": {"tip_radius_m": tip}}
+    doc: dict[str, Any] = {
+        "format": FORMAT_NAME, "version": FORMAT_VERSION, "units": "m", "frame": "world",
+        "workspace": {"lower": list(workspace.lower), "upper": list(workspace.upper)},
+        "probe": {"tip_radius_m": tip}}  # fmt: skip
     if source:
         doc["source"] = dict(source)
     if ground_truth is not None:
@@ -167,8 +164,7 @@ def write_session(folder: str | Path, *, workspace: Workspace, observation: Poin
             entry: dict[str, Any] = {
                 "cloud": cloud, "tip_center": _floats(obs.contact.tip_center),
                 "force": _floats(obs.contact.force), "target_xy": _floats(obs.target_xy),
-                "force_n": float(obs.force_n), "robot_points": robot,
-            }  # fmt: skip
+                "force_n": float(obs.force_n), "robot_points": robot}  # fmt: skip
             if obs.force_travel is not None:
                 entry["force_travel"] = {"travel_m": _floats(obs.force_travel.travel_m),
                                          "force_n": _floats(obs.force_travel.force_n)}
