@@ -151,9 +151,7 @@ class BagReader:
             raise FileFormatError(
                 f"{self.path}: topic {topic!r} must hold exactly one message; got {len(msgs)}"
                 + (f" ({len(bad)} could not be decoded: {bad[0]})" if bad else ""))
-
-        where = f"{self.path} [{topic}]"
-        return self._to_world(self._cloud(msgs[0], where, self.header.frame))
+        return self._to_world(self._cloud(msgs[0], f"{self.path} [{topic}]", self.header.frame))
 
     def press_parts(self, spec: PokeSpec) -> PressParts:
         assert spec.stamp_ns is not None
@@ -165,20 +163,19 @@ class BagReader:
         cloud = self._to_world(self._cloud(self._message("cloud", stamp), where("cloud"),
                                            self.header.frame))  # fmt: skip
         robot = self._cloud(self._message("robot", stamp), where("robot"), "world", colors=False)
-        wrench, tip = self._message("wrench", stamp), self._message("tip", stamp)
-        for key, msg in (("wrench", wrench), ("tip", tip)):
+        values = {}
+        for key in ("wrench", "tip"):
+            msg = self._message(key, stamp)
             if msg.header.frame_id != "world":
                 raise FileFormatError(
                     f"{where(key)}: header.frame_id is {msg.header.frame_id!r}; the bag form "
                     "stores contacts in the 'world' frame")
-        f, p = wrench.wrench.force, tip.point
-        force = np.array([f.x, f.y, f.z], dtype=float)
-        center = np.array([p.x, p.y, p.z], dtype=float)
-        for key, value in (("wrench", force), ("tip", center)):
-            if not np.isfinite(value).all():
+            vec = msg.wrench.force if key == "wrench" else msg.point
+            values[key] = np.array([vec.x, vec.y, vec.z], dtype=float)
+            if not np.isfinite(values[key]).all():
                 raise FileFormatError(
-                    f"{where(key)}: holds NaN or infinite values {value.tolist()}")
-        return PressParts(cloud, center, force, np.asarray(robot.points),
+                    f"{where(key)}: holds NaN or infinite values {values[key].tolist()}")
+        return PressParts(cloud, values["tip"], values["wrench"], np.asarray(robot.points),
                           self._force_travel(stamp))
 
 
