@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
+from deformap.cloud.io import TransformTree
 from deformap.errors import FileFormatError
 from deformap.replay._rawpress import find_presses
-from deformap.replay._rawtf import TransformTree
 
 
 def test_presses_are_found_from_rise_hold_and_release_and_spikes_are_noise() -> None:

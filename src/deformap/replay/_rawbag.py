@@ -19,6 +19,7 @@ from numpy.typing import NDArray
 
 from deformap.cloud import PointCloud
 from deformap.cloud.io import (
+    TransformTree,
     bag_error_text,
     bag_read_errors,
     header_stamp_ns,
@@ -33,7 +34,6 @@ from deformap.errors import DeformapError, FileFormatError
 from deformap.replay._format import PokeSpec, PressParts
 from deformap.replay._rawconfig import HullPart, RawBagConfig
 from deformap.replay._rawpress import FoundPress, find_presses
-from deformap.replay._rawtf import TransformTree
 
 __all__ = ["RawBagReader", "hull_points"]
 

@@ -43,13 +43,14 @@ from deformap.cloud.io._pointcloud2 import (
     pointcloud2_to_cloud,
     xyz_with_holes,
 )
+from deformap.cloud.io._tf import TransformTree
 
-__all__ = ["BAG_STORAGES", "CLOUD_FORMATS", "MAX_NPZ_BYTES", "MM_EXTENT_THRESHOLD",
-           "PCD_ENCODINGS", "PLY_FORMATS", "UNITS", "RawBagMessage", "StampedCloud",
-           "WrenchSeries", "array_to_pointcloud2", "bag_error_text", "bag_read_errors",
-           "bag_writer", "header_message", "header_stamp_ns", "iter_bag_messages",
-           "load_npz_arrays", "path_kind", "pointcloud2_colors", "pointcloud2_structured",
-           "pointcloud2_to_array", "pointcloud2_to_cloud", "read_bag_clouds",
-           "read_bag_static_transform", "read_bag_wrenches", "read_cloud", "read_npz", "read_pcd",
-           "read_ply", "typestore", "wrench_message", "write_bag", "write_cloud", "write_npz",
-           "write_pcd", "write_ply", "xyz_with_holes"]
+__all__ = ["BAG_STORAGES", "CLOUD_FORMATS", "MAX_NPZ_BYTES", "MM_EXTENT_THRESHOLD", "PCD_ENCODINGS",
+           "PLY_FORMATS", "UNITS", "RawBagMessage", "StampedCloud", "TransformTree", "WrenchSeries",
+           "array_to_pointcloud2", "bag_error_text", "bag_read_errors", "bag_writer",
+           "header_message", "header_stamp_ns", "iter_bag_messages", "load_npz_arrays", "path_kind",
+           "pointcloud2_colors", "pointcloud2_structured", "pointcloud2_to_array",
+           "pointcloud2_to_cloud", "read_bag_clouds", "read_bag_static_transform",
+           "read_bag_wrenches", "read_cloud", "read_npz", "read_pcd", "read_ply", "typestore",
+           "wrench_message", "write_bag", "write_cloud", "write_npz", "write_pcd", "write_ply",
+           "xyz_with_holes"]

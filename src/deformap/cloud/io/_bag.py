@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import struct
 import zlib
-from collections import deque
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -39,6 +38,7 @@ from deformap.cloud.io._bag_reader import (
 )
 from deformap.cloud.io._common import check_units
 from deformap.cloud.io._pointcloud2 import array_to_pointcloud2, pointcloud2_to_cloud
+from deformap.cloud.io._tf import TransformTree
 from deformap.errors import FileFormatError, InvalidArgumentError
 
 __all__ = ["StampedCloud", "WrenchSeries", "bag_writer", "fill_chunk_crcs", "read_bag_clouds",
@@ -87,54 +87,26 @@ def _messages(path: Any, topic: str, msgtype: str) -> Iterator[tuple[int, Any]]:
         yield raw.log_time_ns, msg
 
 
-def _transform_matrix(transform: Any) -> NDArray[np.float64]:
-    from scipy.spatial.transform import Rotation
-
-    q = transform.rotation
-    quat = np.array([q.x, q.y, q.z, q.w], dtype=float)
-    if not np.isfinite(quat).all() or abs(np.linalg.norm(quat) - 1.0) > 1e-3:
-        raise ValueError(f"rotation quaternion {quat.tolist()} is not a unit quaternion")
-    mat = np.eye(4)
-    mat[:3, :3] = Rotation.from_quat(quat).as_matrix()
-    t = transform.translation
-    mat[:3, 3] = [t.x, t.y, t.z]
-    return mat
-
-
 def read_bag_static_transform(
     path: str | Path, source_frame: str, target_frame: str, *, topic: str = TF_STATIC_TOPIC
 ) -> NDArray[np.float64]:
     """The 4×4 ``source2target`` transform (``p_t = T[:3, :3] p_s + T[:3, 3]``)
     composed from a bag's static transforms on ``topic``, between frames named as in the messages."""
-    # Each TransformStamped gives child2parent; walk the tree in both directions.
-    edges: dict[str, list[tuple[str, NDArray[np.float64]]]] = {}
     p = Path(path) if isinstance(path, (str, Path)) else path
+    tree = TransformTree(topic, 0)
     for _, msg in _messages(path, topic, TF_TYPE):
-        for tf in msg.transforms:
-            try:
-                child2parent = _transform_matrix(tf.transform)
-            except ValueError as exc:
-                raise FileFormatError(
-                    f"{p}: {topic} transform {tf.header.frame_id!r} -> {tf.child_frame_id!r}: {exc}"
-                ) from None
-            parent, child = tf.header.frame_id, tf.child_frame_id
-            edges.setdefault(child, []).append((parent, child2parent))
-            edges.setdefault(parent, []).append((child, np.asarray(np.linalg.inv(child2parent))))
+        tree.add(msg, static=True, where=f"{p}: {topic}")
+    out = np.eye(4)
     if source_frame == target_frame:
-        return np.eye(4)
-    seen = {source_frame: np.eye(4)}
-    queue = deque([source_frame])
-    while queue:
-        frame = queue.popleft()
-        for neighbour, frame2neighbour in edges.get(frame, []):
-            if neighbour not in seen:
-                seen[neighbour] = frame2neighbour @ seen[frame]
-                queue.append(neighbour)
-    if target_frame not in seen:
+        return out
+    try:
+        rot, trans = tree.lookup(target_frame, source_frame, 0, what=f"{p}: {topic}")
+    except FileFormatError:
         raise FileFormatError(
             f"{p}: {topic} does not connect frame {source_frame!r} to {target_frame!r} "
-            f"(frames: {sorted(edges)}); pass cam2world= instead")
-    return seen[target_frame]
+            f"(frames: {tree.frames}); pass cam2world= instead") from None
+    out[:3, :3], out[:3, 3] = rot[0], trans[0]
+    return out
 
 
 def read_bag_clouds(path: str | Path, topic: str, *, cam2world: Any = None,

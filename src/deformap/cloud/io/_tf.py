@@ -1,4 +1,4 @@
-"""The transforms of a raw recording (``/tf`` and ``/tf_static``), looked up at any time.
+"""The transforms of a bag (``/tf`` and ``/tf_static``), looked up at any time.
 
 Each TransformStamped gives ``child2parent`` at its stamp. A lookup composes the edges from each
 frame up to their common ancestor, each interpolated at the times asked as ``tf2`` does
@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from deformap.cloud.io import header_stamp_ns
+from deformap.cloud.io._bag_reader import header_stamp_ns
 from deformap.errors import FileFormatError
 
 __all__ = ["MAX_TRANSLATION_M", "TransformTree"]
@@ -76,6 +76,11 @@ class TransformTree:
             edge.translations.append(trans)
             edge.quaternions.append(quat)
         self._series.clear()
+
+    @property
+    def frames(self) -> list[str]:
+        """Every frame named, child or parent."""
+        return sorted(set(self._edges) | {e.parent for e in self._edges.values()})
 
     def _chain(self, frame: str) -> list[str]:
         """``frame`` and its ancestors up to the root."""
@@ -145,12 +150,11 @@ class TransformTree:
             within the tolerance of a time.
         """
         times = np.atleast_1d(np.asarray(times_ns, dtype=np.int64))
-        known = set(self._edges) | {e.parent for e in self._edges.values()}
         for frame in (target, source):
-            if frame not in known:
+            if frame not in self.frames:
                 raise FileFormatError(
                     f"{what}: no frame {frame!r} on {self.topic!r} or its static topic "
-                    f"(frames: {sorted(known)})")
+                    f"(frames: {self.frames})")
 
         up_source, up_target = self._chain(source), self._chain(target)
         if up_source[-1] != up_target[-1]:
