@@ -126,9 +126,7 @@ class RawBagConfig:
 def raw_config_file(bag: Path) -> Path:
     """Where the settings of ``bag`` live: ``deformap.yaml`` inside a rosbag2 folder, or
     ``NAME.deformap.yaml`` beside a ``NAME.mcap`` / ``NAME.db3`` file."""
-    if bag.is_dir():
-        return bag / RAW_CONFIG_NAME
-    return bag.with_name(f"{bag.stem}.{RAW_CONFIG_NAME}")
+    return bag / RAW_CONFIG_NAME if bag.is_dir() else bag.with_name(f"{bag.stem}.{RAW_CONFIG_NAME}")
 
 
 def load_raw_config(bag: Path, file: Path | None = None, **overrides: Any) -> RawBagConfig:
@@ -142,12 +140,8 @@ def load_raw_config(bag: Path, file: Path | None = None, **overrides: Any) -> Ra
         if loaded is not None and not isinstance(loaded, dict):
             raise ConfigError(f"{path}: must be a mapping of settings; got {type(loaded).__name__}")
         data = dict(loaded or {})
-    where = str(path) if data else "raw recording settings"
-    config = config_from_dict(RawBagConfig, data, where=where)
-    given = {k: v for k, v in overrides.items() if v is not None}
-    if not given:
-        return config
+    config = config_from_dict(RawBagConfig, data, where=str(path) if data else "raw recording settings")
     try:
-        return replace(config, **given)
+        return replace(config, **{k: v for k, v in overrides.items() if v is not None})
     except TypeError as exc:
         raise ConfigError(f"raw recording settings: {exc}") from None

@@ -1,12 +1,8 @@
-"""Typed messages of a ROS 2 bag: PointCloud2 topics read into clouds (in the world frame given a
-4×4 ``cam2world``, or one composed from the bag's ``/tf_static``), WrenchStamped topics into arrays;
-and bags of clouds, wrenches and static transforms written (sqlite3 or MCAP), for the tests and
-simulated recordings.
-
-``path`` is the bag (a rosbag2 folder, ``.mcap`` or ``.db3``), read through
-:func:`~deformap.cloud.io.iter_bag_messages`. rosbags writes each MCAP chunk's CRC-32 as zero; once
-its writer has closed the bag each CRC is filled in (:func:`fill_chunk_crcs`), so a flipped byte in
-a stored cloud is refused when read.
+"""Typed messages of a ROS 2 bag (``path``: a rosbag2 folder, ``.mcap`` or ``.db3``): PointCloud2
+topics read into clouds (in the world frame given a 4×4 ``cam2world`` or the bag's ``/tf_static``),
+WrenchStamped topics into arrays; and bags of clouds, wrenches and static transforms written.
+rosbags writes each MCAP chunk's CRC-32 as zero; :func:`bag_writer` fills them in once the bag is
+closed (:func:`fill_chunk_crcs`), so a flipped byte in a stored cloud is refused when read.
 """
 
 from __future__ import annotations
