@@ -61,7 +61,7 @@ class BagReader:
                                      optional=dict(OPTIONAL_TOPICS.values())):  # fmt: skip
             self._raw[raw.topic].append((raw.log_time_ns, bytes(raw.data)))
         self._decoded: dict[str, dict[int, list[Any]]] = {}  # key -> stamp -> messages
-        self._undecodable: dict[str, list[str]] = {}  # key -> why each message could not be
+        self._undecodable: dict[str, list[str]] = {}  # key -> why its messages failed to decode
         self._tf_static: NDArray[np.float64] | None = None
 
     def _force_travel(self, stamp: int) -> ForceTravel | None:

@@ -140,7 +140,8 @@ def load_raw_config(bag: Path, file: Path | None = None, **overrides: Any) -> Ra
         if loaded is not None and not isinstance(loaded, dict):
             raise ConfigError(f"{path}: must be a mapping of settings; got {type(loaded).__name__}")
         data = dict(loaded or {})
-    config = config_from_dict(RawBagConfig, data, where=str(path) if data else "raw recording settings")
+    where = str(path) if data else "raw recording settings"
+    config = config_from_dict(RawBagConfig, data, where=where)
     try:
         return replace(config, **{k: v for k, v in overrides.items() if v is not None})
     except TypeError as exc:
