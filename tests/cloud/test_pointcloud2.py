@@ -166,16 +166,16 @@ def test_array_to_pointcloud2_refuses_bad_arguments() -> None:
 
 
 def test_missing_rosbags_names_the_extra(monkeypatch: pytest.MonkeyPatch) -> None:
-    from deformap.cloud.io import _bag, _ros
+    from deformap.cloud.io import _bag, _bag_reader
 
     monkeypatch.setitem(sys.modules, "rosbags", None)
     monkeypatch.setitem(sys.modules, "rosbags.typesys", None)
     monkeypatch.setitem(sys.modules, "rosbags.rosbag2", None)
-    _ros.typestore.cache_clear()
+    _bag_reader.typestore.cache_clear()
     try:
         with pytest.raises(MissingDependencyError, match=r"pip install 'deformap\[ros\]'"):
             array_to_pointcloud2(np.zeros((1, 3)))
         with pytest.raises(MissingDependencyError, match="reading ROS 2 bags"):
             _bag.read_bag_wrenches("x", "/ft")
     finally:
-        _ros.typestore.cache_clear()
+        _bag_reader.typestore.cache_clear()

@@ -14,8 +14,12 @@ pytest.importorskip("rosbags")
 
 from rosbags.rosbag2 import StoragePlugin, Writer
 
-from deformap.cloud.io import array_to_pointcloud2, pointcloud2_structured, wrench_message
-from deformap.cloud.io._ros import typestore
+from deformap.cloud.io import (
+    array_to_pointcloud2,
+    pointcloud2_structured,
+    typestore,
+    wrench_message,
+)
 from deformap.environment import ForceTravel
 from deformap.errors import ConfigError, FileFormatError
 from deformap.replay import OPTIONAL_TOPICS, TOPICS, load_session
@@ -83,7 +87,7 @@ def _write_variant(
                 for msg in msgs:
                     writer.write(conn, (i + 1) * 10**9, store.serialize_cdr(msg, record_type))
         if static_cam2world is not None:
-            from deformap.cloud.io._bag_writer import _tf_message
+            from deformap.cloud.io._bag import _tf_message
 
             conn = writer.add_connection("/tf_static", "tf2_msgs/msg/TFMessage", typestore=store)
             msg = _tf_message([("world", cloud_frame, static_cam2world)])

@@ -138,7 +138,7 @@ def test_a_wrench_beyond_any_sensor_is_refused_without_overflow(session: Any,
 def test_a_quaternion_of_1e200_is_refused_without_overflow() -> None:
     from types import SimpleNamespace as NS
 
-    from deformap.replay._rawtf import TransformTree
+    from deformap.cloud.io import TransformTree
 
     tf = NS(header=NS(stamp=NS(sec=0, nanosec=0), frame_id="world"), child_frame_id="tool",
             transform=NS(translation=NS(x=0.0, y=0.0, z=0.0),

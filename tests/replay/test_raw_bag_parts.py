@@ -9,8 +9,9 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
+from deformap.cloud.io import TransformTree
+from deformap.errors import FileFormatError
 from deformap.replay._rawpress import find_presses
-from deformap.replay._rawtf import TransformGap, TransformTree
 
 
 def test_presses_are_found_from_rise_hold_and_release_and_spikes_are_noise() -> None:
@@ -56,7 +57,7 @@ def test_transforms_interpolate_in_time_and_refuse_a_gap() -> None:
     # and the inverse direction
     rot_inv, trans_inv = tree.lookup("tip", "world", [20_000_000], what="test")
     np.testing.assert_allclose(rot_inv[0] @ trans[0] + trans_inv[0], 0.0, atol=1e-12)
-    with pytest.raises(TransformGap, match=r"test: topic '/tf' .*'tool'.* \(nearest 0\.160 s"):
+    with pytest.raises(FileFormatError, match=r"test: topic '/tf' .*'tool'.* \(nearest 0\.160 s"):
         tree.lookup("world", "tip", [200_000_000], what="test")
 
 

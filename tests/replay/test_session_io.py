@@ -17,12 +17,12 @@ from deformap.replay import (
     FORMAT_VERSION,
     GroundTruth,
     RecordedSession,
+    RecordingEnvironment,
     load_session,
     read_ground_truth,
     write_ground_truth,
     write_session,
 )
-from deformap.replay._recorder import RecordingEnvironment
 
 FORMS = [("folder", "pcd"), ("folder", "ply"), ("folder", "npz")]
 BAGS = ["mcap", "sqlite3"]

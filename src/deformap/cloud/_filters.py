@@ -14,9 +14,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from deformap._validation import (
-    check_finite_scalar,
     check_int,
     check_points,
+    check_positive,
     check_slope_deg,
     check_vector,
 )
@@ -45,15 +45,6 @@ def crop_box(points: Any, lower: Any, upper: Any) -> NDArray[np.bool_]:
     return np.all((pts >= lo) & (pts <= hi), axis=1)
 
 
-def _mean_neighbour_distances(pts: NDArray[np.float64], k: int) -> NDArray[np.float64]:
-    from scipy.spatial import cKDTree  # imported here: scipy.spatial is slow to import
-
-    # Open3D counts the point itself among its k neighbours (distance 0), so query k, not k + 1.
-    dist, _ = cKDTree(pts).query(pts, k=k)
-    dist = dist.reshape(pts.shape[0], k)
-    return np.asarray(dist.mean(axis=1))
-
-
 def statistical_outlier_mask(points: Any, k: int, std_ratio: float) -> NDArray[np.bool_]:
     """Mask of the points kept by Open3D's statistical outlier rule.
 
@@ -68,16 +59,17 @@ def statistical_outlier_mask(points: Any, k: int, std_ratio: float) -> NDArray[n
     object maps for household environments", 2008.
     """
     k = check_int("k", k, minimum=1)
-    ratio = check_finite_scalar("std_ratio", std_ratio)
-    if ratio <= 0:
-        raise InvalidArgumentError(f"`std_ratio` must be > 0 (as in Open3D); got {ratio}")
+    ratio = check_positive("std_ratio", std_ratio)
     pts = check_points("points", points, min_rows=0)
     n = pts.shape[0]
     if n < max(k, 2):
         raise InvalidArgumentError(
             f"`points` must hold at least k={k} points (and at least 2) for the statistical "
             f"outlier rule; got {n}")
-    avg = _mean_neighbour_distances(pts, k)
+    from scipy.spatial import cKDTree  # imported here: scipy.spatial is slow to import
+
+    # Open3D counts the point itself among its k neighbours (distance 0), so query k, not k + 1.
+    avg = cKDTree(pts).query(pts, k=k)[0].reshape(n, k).mean(axis=1)
     positive = avg > 0
     mean = avg.sum() / n
     std = np.sqrt(np.sum((avg[positive] - mean) ** 2) / (n - 1))
@@ -125,8 +117,7 @@ def height_field_mask(points: Any, k: int = 20, max_slope_deg: float = 60.0) -> 
 
 
 def hull_parts(hull_points: Any) -> tuple[Any, ...] | None:
-    """The hulls of a tuple or list of 2-D entries (one ``(m_i, 3)`` hull per part), or None
-    for a single hull."""
+    """The hulls of a tuple or list of 2-D entries (one ``(m_i, 3)`` hull per part), or None."""
     if isinstance(hull_points, (tuple, list)) and hull_points and all(
         np.ndim(part) == 2 for part in hull_points
     ):
@@ -140,16 +131,13 @@ def points_in_hull(points: Any, hull_points: Any, *, tolerance_m: float = HULL_T
     least 4 points not on one plane), or of any hull of a tuple or list of such arrays (one per robot
     part); a point at most ``tolerance_m`` outside every facet plane counts as inside."""
     pts = check_points("points", points, min_rows=0)
-    tol = check_finite_scalar("tolerance_m", tolerance_m)
-    if tol < 0:
-        raise InvalidArgumentError(f"`tolerance_m` must be >= 0; got {tol}")
+    tol = check_positive("tolerance_m", tolerance_m, allow_zero=True)
     parts = hull_parts(hull_points)
     if parts is None:
         return _in_one_hull(pts, check_points("hull_points", hull_points, min_rows=4), tol)
     inside = np.zeros(pts.shape[0], dtype=bool)
     for i, part in enumerate(parts):
-        verts = check_points(f"hull_points[{i}]", part, min_rows=4)
-        inside |= _in_one_hull(pts, verts, tol)
+        inside |= _in_one_hull(pts, check_points(f"hull_points[{i}]", part, min_rows=4), tol)
     return inside
 
 

@@ -64,18 +64,17 @@ class PointCloud:
 
     def select(self, mask: Any) -> PointCloud:
         """Return the cloud of the points where ``mask`` (``(n,)`` bool, or indices) selects."""
-        index = np.asarray(mask)
-        if index.dtype == np.bool_ and index.shape != (len(self),):
-            raise InvalidArgumentError(
-                f"`mask` must be a ({len(self)},) boolean array; got shape {index.shape}")
-        if index.dtype != np.bool_ and not np.issubdtype(index.dtype, np.integer):
+        index, n = np.asarray(mask), len(self)
+        if index.dtype == np.bool_:
+            if index.shape != (n,):
+                raise InvalidArgumentError(
+                    f"`mask` must be a ({n},) boolean array; got shape {index.shape}")
+        elif not np.issubdtype(index.dtype, np.integer):
             raise InvalidArgumentError(
                 f"`mask` must be booleans or integer indices; got dtype {index.dtype}")
-        if index.dtype != np.bool_ and index.size and (
-                index.min() < -len(self) or index.max() >= len(self)):
-            raise InvalidArgumentError(
-                f"`mask` indices must lie in [-{len(self)}, {len(self) - 1}]; got "
-                f"{int(index.min())} to {int(index.max())}")
+        elif index.size and (index.min() < -n or index.max() >= n):
+            raise InvalidArgumentError(f"`mask` indices must lie in [-{n}, {n - 1}]; got "
+                                       f"{int(index.min())} to {int(index.max())}")
         colors = None if self.colors is None else self.colors[index]
         return PointCloud(self.points[index], colors, frame=self.frame)
 

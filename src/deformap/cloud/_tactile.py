@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from deformap._validation import check_finite_scalar, check_int, check_positive, check_vector
+from deformap._validation import check_int, check_positive, check_slope_deg, check_vector
 from deformap.errors import InvalidArgumentError
 
 __all__ = ["DEFAULT_CAP_HALF_ANGLE_DEG", "contact_cap", "tactile_points"]
@@ -32,16 +32,6 @@ DEFAULT_CAP_HALF_ANGLE_DEG = 30.0
 
 _GOLDEN_ANGLE = np.pi * (3.0 - np.sqrt(5.0))
 
-
-def _orthonormal_frame(axis: NDArray[np.float64]) -> tuple[NDArray[np.float64], ...]:
-    # Any fixed vector not parallel to the axis seeds the frame; picking the world axis least
-    # aligned with it keeps the cross product well conditioned.
-    seed = np.zeros(3)
-    seed[int(np.argmin(np.abs(axis)))] = 1.0
-    e1 = np.cross(axis, seed)
-    e1 /= np.linalg.norm(e1)
-    e2 = np.cross(axis, e1)
-    return e1, e2
 
 
 def contact_cap(tip_radius_m: float, indentation_m: float, n: int = 10) -> tuple[float, int]:
@@ -73,15 +63,18 @@ def tactile_points(tip_center: Any, force_vector: Any, tip_radius_m: float, n: i
     force = check_vector("force_vector", force_vector, 3, what="newtons")
     radius = check_positive("tip_radius_m", tip_radius_m)
     count = check_int("n", n, minimum=1)
-    half_angle = check_finite_scalar("cap_half_angle_deg", cap_half_angle_deg)
-    if not 0.0 < half_angle <= 90.0:
-        raise InvalidArgumentError(f"`cap_half_angle_deg` must lie in (0, 90]; got {half_angle}")
+    half_angle = check_slope_deg("cap_half_angle_deg", cap_half_angle_deg)
     norm = float(np.linalg.norm(force))
     if norm == 0.0:
         raise InvalidArgumentError("`force_vector` must be a non-zero vector; got (0, 0, 0)")
     axis = force / norm
-    e1, e2 = _orthonormal_frame(axis)
-
+    # A frame around the axis, seeded by the world axis least aligned with it (a well
+    # conditioned cross product).
+    seed = np.zeros(3)
+    seed[int(np.argmin(np.abs(axis)))] = 1.0
+    e1 = np.cross(axis, seed)
+    e1 /= np.linalg.norm(e1)
+    e2 = np.cross(axis, e1)
     i = np.arange(count, dtype=float)
     frac = i / (count - 1) if count > 1 else np.zeros(1)
     # Equal cap-area steps: the area of a cap of polar angle θ is proportional to 1 - cos θ.

@@ -8,44 +8,27 @@ demand; :func:`load_raw_bag` opens a robot's own bag (:class:`RawBagConfig`) as 
 
 from __future__ import annotations
 
-from typing import Any
-
-from deformap.replay._format import (
-    FORMAT_NAME,
-    FORMAT_VERSION,
-    OPTIONAL_TOPICS,
-    SESSION_FILE,
-    TOPICS,
-)
+from deformap._lazy import lazy_exports
+from deformap.replay._format import FORMAT_NAME, FORMAT_VERSION, OPTIONAL_TOPICS, TOPICS
 from deformap.replay._rawconfig import (
     DEFAULT_HULL,
-    RAW_CONFIG_NAME,
     HullPart,
     RawBagConfig,
     load_raw_config,
     raw_config_file,
 )
-from deformap.replay._rawsession import RAW_SUFFIXES, is_raw_bag, load_raw_bag
-from deformap.replay._recorder import RecordingEnvironment
-from deformap.replay._session import DEFAULT_CONTACT_GAP_M, RecordedSession, load_session
+from deformap.replay._session import RecordedSession, is_raw_bag, load_raw_bag, load_session
 from deformap.replay._truth import GroundTruth, read_ground_truth, write_ground_truth
-from deformap.replay._write import SESSION_FORMATS, write_session
+from deformap.replay._write import SESSION_FORMATS, RecordingEnvironment, write_session
 
-# The offline mapper needs deformap.explore (and through it gp and msm): imported on first use, so
-# that reading a session stays light.
-_OFFLINE = ("ReplayResult", "estimate_poke", "map_session", "tip_sphere_points")
-
-__all__ = ["DEFAULT_CONTACT_GAP_M", "DEFAULT_HULL", "FORMAT_NAME", "FORMAT_VERSION",
-           "OPTIONAL_TOPICS", "RAW_CONFIG_NAME", "RAW_SUFFIXES", "SESSION_FILE", "SESSION_FORMATS",
+__all__ = ["DEFAULT_HULL", "FORMAT_NAME", "FORMAT_VERSION", "OPTIONAL_TOPICS", "SESSION_FORMATS",
            "TOPICS", "GroundTruth", "HullPart", "RawBagConfig", "RecordedSession",
            "RecordingEnvironment", "ReplayResult", "estimate_poke", "is_raw_bag", "load_raw_bag",
            "load_raw_config", "load_session", "map_session", "raw_config_file",
            "read_ground_truth", "tip_sphere_points", "write_ground_truth", "write_session"]
 
-
-def __getattr__(name: str) -> Any:
-    if name in _OFFLINE:
-        from deformap.replay import _offline
-
-        return getattr(_offline, name)
-    raise AttributeError(f"module 'deformap.replay' has no attribute {name!r}")
+# The offline mapper needs deformap.explore (and through it gp and msm): imported on first use, so
+# that reading a session stays light.
+__getattr__, __dir__ = lazy_exports(
+    __name__, {"_offline": ("ReplayResult", "estimate_poke", "map_session", "tip_sphere_points")},
+    __all__, globals())

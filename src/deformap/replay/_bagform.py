@@ -10,7 +10,6 @@ it is logged at the poke's stamp. Without one a poke has no record.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -23,6 +22,8 @@ from deformap.cloud.io import (
     bag_error_text,
     bag_read_errors,
     bag_writer,
+    header_message,
+    header_stamp_ns,
     iter_bag_messages,
     path_kind,
     pointcloud2_to_cloud,
@@ -32,25 +33,13 @@ from deformap.cloud.io import (
 )
 from deformap.environment import ForceTravel, PressObservation
 from deformap.errors import DeformapError, FileFormatError
-from deformap.replay._confine import check_bag_confined
-from deformap.replay._folder import PressParts
-from deformap.replay._format import OPTIONAL_TOPICS, TOPICS, PokeSpec, SessionHeader
-from deformap.replay._manifest import verify_digest
+from deformap.replay._confine import check_bag_confined, verify_digest
+from deformap.replay._format import OPTIONAL_TOPICS, TOPICS, PokeSpec, PressParts, SessionHeader
 
 #: Labels of the record's two dimensions in its ``Float64MultiArray`` layout.
 FORCE_TRAVEL_DIMS = ("samples", "travel_m,force_n")
 
 __all__ = ["FORCE_TRAVEL_DIMS", "BagReader", "force_travel_message", "write_session_bag"]
-
-
-@dataclass
-class _Raw:
-    log_time_ns: int
-    data: bytes
-
-
-def _stamp(msg: Any) -> int:
-    return int(msg.header.stamp.sec) * 10**9 + int(msg.header.stamp.nanosec)
 
 
 class BagReader:
@@ -64,33 +53,29 @@ class BagReader:
             raise FileFormatError(f"{self.path}: no such bag (the session's `bag`)")
         for file in check_bag_confined(self.path):
             if path_kind(file) == "file":  # a missing one: rosbags names it
-                verify_digest(header, file)
-        self._raw = self._index()
-        self._decoded: dict[str, dict[int, Any]] | None = None
-        self._undecodable: dict[str, list[str]] = {}
-        self._repeated: dict[str, dict[int, int]] = {}  # topic -> stamp -> messages sharing it
-        self._tf_static: NDArray[np.float64] | None = None
-
-    def _index(self) -> dict[str, list[_Raw]]:
-        every = {**TOPICS, **OPTIONAL_TOPICS}
-        out: dict[str, list[_Raw]] = {topic: [] for topic, _ in every.values()}
+                verify_digest(header.sha256, file)
+        # topic -> (log time, CDR bytes) of each message
+        self._raw: dict[str, list[tuple[int, bytes]]] = {
+            topic: [] for topic, _ in (*TOPICS.values(), *OPTIONAL_TOPICS.values())}
         for raw in iter_bag_messages(self.path, dict(TOPICS.values()),
                                      optional=dict(OPTIONAL_TOPICS.values())):  # fmt: skip
-            out[raw.topic].append(_Raw(raw.log_time_ns, bytes(raw.data)))
-        return out
+            self._raw[raw.topic].append((raw.log_time_ns, bytes(raw.data)))
+        self._decoded: dict[str, dict[int, list[Any]]] = {}  # key -> stamp -> messages
+        self._undecodable: dict[str, list[str]] = {}  # key -> why its messages failed to decode
+        self._tf_static: NDArray[np.float64] | None = None
 
     def _force_travel(self, stamp: int) -> ForceTravel | None:
         """The record logged at ``stamp``, or None."""
         topic, msgtype = OPTIONAL_TOPICS["force_travel"]
         where = f"{self.path} [{topic} logged at {stamp}]"
-        raws = [r for r in self._raw[topic] if r.log_time_ns == stamp]
+        raws = [data for time, data in self._raw[topic] if time == stamp]
         if not raws:
             return None
         if len(raws) > 1:
             raise FileFormatError(
                 f"{where}: {len(raws)} messages; a poke needs at most one force–travel record")
         try:
-            msg = typestore().deserialize_cdr(raws[0].data, msgtype)
+            msg = typestore().deserialize_cdr(raws[0], msgtype)
         except bag_read_errors() as exc:
             raise FileFormatError(
                 f"{where}: could not be decoded: {bag_error_text(exc, 120)}") from None
@@ -108,42 +93,35 @@ class BagReader:
         except DeformapError as exc:
             raise FileFormatError(f"{where}: {exc}") from None
 
-    def _messages_by_stamp(self) -> dict[str, dict[int, Any]]:
-        if self._decoded is not None:
-            return self._decoded
-        store, errors = typestore(), bag_read_errors()
-        decoded: dict[str, dict[int, Any]] = {}
-        for key, (topic, msgtype) in TOPICS.items():
-            by_stamp: dict[int, Any] = {}
-            for number, raw in enumerate(self._raw[topic]):
+    def _by_stamp(self, key: str) -> dict[int, list[Any]]:
+        """The messages of ``TOPICS[key]`` by header stamp, decoded on first use; why each one
+        that could not be decoded failed goes to ``_undecodable``."""
+        if key not in self._decoded:
+            topic, msgtype = TOPICS[key]
+            store, errors = typestore(), bag_read_errors()
+            by_stamp: dict[int, list[Any]] = {}
+            bad = self._undecodable[key] = []
+            for number, (_, data) in enumerate(self._raw[topic], start=1):
                 try:
-                    msg = store.deserialize_cdr(raw.data, msgtype)
-                    stamp = _stamp(msg)
-                    if stamp in by_stamp:  # which one is the poke's? neither is kept silently
-                        counts = self._repeated.setdefault(topic, {})
-                        counts[stamp] = counts.get(stamp, 1) + 1
-                    by_stamp.setdefault(stamp, msg)
+                    msg = store.deserialize_cdr(data, msgtype)
+                    by_stamp.setdefault(header_stamp_ns(msg.header), []).append(msg)
                 except errors as exc:
-                    self._undecodable.setdefault(topic, []).append(
-                        f"message {number + 1}: {bag_error_text(exc, 120)}")
-            decoded[key] = by_stamp
-        self._decoded = decoded
-        return decoded
+                    bad.append(f"message {number}: {bag_error_text(exc, 120)}")
+            self._decoded[key] = by_stamp
+        return self._decoded[key]
 
     def _message(self, key: str, stamp: int) -> Any:
-        topic = TOPICS[key][0]
-        msg = self._messages_by_stamp()[key].get(stamp)
-        repeated = self._repeated.get(topic, {}).get(stamp)
-        if repeated:
+        topic, msgs = TOPICS[key][0], self._by_stamp(key).get(stamp, [])
+        if len(msgs) > 1:  # which one is the poke's? neither is kept silently
             raise FileFormatError(
-                f"{self.path}: topic {topic!r} has {repeated} messages stamped {stamp}; "
+                f"{self.path}: topic {topic!r} has {len(msgs)} messages stamped {stamp}; "
                 "a poke needs exactly one on each topic")
-        if msg is None:
-            bad = self._undecodable.get(topic, [])
+        if not msgs:
+            bad = self._undecodable[key]
             note = f"; {len(bad)} message(s) there could not be decoded ({bad[0]})" if bad else ""
             raise FileFormatError(
                 f"{self.path}: topic {topic!r} has no message stamped {stamp}{note}")
-        return msg
+        return msgs[0]
 
     def _cloud(self, msg: Any, where: str, frame: str, colors: bool = True) -> PointCloud:
         if msg.header.frame_id != frame:
@@ -167,15 +145,13 @@ class BagReader:
 
     def observation(self) -> PointCloud:
         topic = TOPICS["observation"][0]
-        msgs = list(self._messages_by_stamp()["observation"].values())
-        count = len(msgs) + sum(n - 1 for n in self._repeated.get(topic, {}).values())
-        if count != 1:
-            bad = self._undecodable.get(topic, [])
+        msgs = [msg for same in self._by_stamp("observation").values() for msg in same]
+        if len(msgs) != 1:
+            bad = self._undecodable["observation"]
             raise FileFormatError(
-                f"{self.path}: topic {topic!r} must hold exactly one message; got {count}"
+                f"{self.path}: topic {topic!r} must hold exactly one message; got {len(msgs)}"
                 + (f" ({len(bad)} could not be decoded: {bad[0]})" if bad else ""))
-        where = f"{self.path} [{topic}]"
-        return self._to_world(self._cloud(msgs[0], where, self.header.frame))
+        return self._to_world(self._cloud(msgs[0], f"{self.path} [{topic}]", self.header.frame))
 
     def press_parts(self, spec: PokeSpec) -> PressParts:
         assert spec.stamp_ns is not None
@@ -187,30 +163,27 @@ class BagReader:
         cloud = self._to_world(self._cloud(self._message("cloud", stamp), where("cloud"),
                                            self.header.frame))  # fmt: skip
         robot = self._cloud(self._message("robot", stamp), where("robot"), "world", colors=False)
-        wrench, tip = self._message("wrench", stamp), self._message("tip", stamp)
-        for key, msg in (("wrench", wrench), ("tip", tip)):
+        values = {}
+        for key in ("wrench", "tip"):
+            msg = self._message(key, stamp)
             if msg.header.frame_id != "world":
                 raise FileFormatError(
                     f"{where(key)}: header.frame_id is {msg.header.frame_id!r}; the bag form "
                     "stores contacts in the 'world' frame")
-        f, p = wrench.wrench.force, tip.point
-        force = np.array([f.x, f.y, f.z], dtype=float)
-        center = np.array([p.x, p.y, p.z], dtype=float)
-        for key, value in (("wrench", force), ("tip", center)):
-            if not np.isfinite(value).all():
+            vec = msg.wrench.force if key == "wrench" else msg.point
+            values[key] = np.array([vec.x, vec.y, vec.z], dtype=float)
+            if not np.isfinite(values[key]).all():
                 raise FileFormatError(
-                    f"{where(key)}: holds NaN or infinite values {value.tolist()}")
-        return PressParts(cloud, center, force, np.asarray(robot.points),
+                    f"{where(key)}: holds NaN or infinite values {values[key].tolist()}")
+        return PressParts(cloud, values["tip"], values["wrench"], np.asarray(robot.points),
                           self._force_travel(stamp))
 
 
 def _point_message(stamp_ns: int, point: Any) -> Any:
     types = typestore().types
-    time = types["builtin_interfaces/msg/Time"](sec=stamp_ns // 10**9, nanosec=stamp_ns % 10**9)
-    header = types["std_msgs/msg/Header"](stamp=time, frame_id="world")
-    x, y, z = (float(v) for v in point)
-    return types["geometry_msgs/msg/PointStamped"](
-        header=header, point=types["geometry_msgs/msg/Point"](x=x, y=y, z=z))
+    xyz = types["geometry_msgs/msg/Point"](*map(float, point))
+    return types["geometry_msgs/msg/PointStamped"](header=header_message(stamp_ns, "world"),
+                                                   point=xyz)
 
 
 def force_travel_message(record: ForceTravel) -> Any:

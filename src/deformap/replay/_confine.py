@@ -1,19 +1,23 @@
-"""A session reads only inside its own folder.
+"""A session reads only inside its own folder, and only the files it recorded.
 
 Every file a session names (in ``session.yaml`` and a rosbag2 ``metadata.yaml``) must be a
 relative name without ``..`` that, links resolved, lies inside the session folder, with no
-opt-out: otherwise whoever wrote a session could make ``deformap map`` read any file.
+opt-out: otherwise whoever wrote a session could make ``deformap map`` read any file. The
+``sha256`` manifest ``write_session`` leaves is checked as each file is read: a file whose digest
+differs, or that the manifest does not list, is refused; a session without one is read unchecked.
 """
 
 from __future__ import annotations
 
+import hashlib
+from collections.abc import Iterable
 from pathlib import Path, PurePath
 from typing import Any
 
 from deformap._config import load_yaml
 from deformap.errors import ConfigError, FileFormatError
 
-__all__ = ["check_bag_confined", "confined_path"]
+__all__ = ["check_bag_confined", "confined_path", "manifest_of", "sha256_file", "verify_digest"]
 
 _RULE = "a session's files must lie inside its folder, named relative to it without '..'"
 
@@ -59,3 +63,38 @@ def check_bag_confined(bag: Path) -> list[Path]:
         # What rosbags opens (the last part of the name) must stay inside too.
         out.append(confined_path(where, PurePath(value).name, bag))
     return out
+
+
+def sha256_file(path: Path) -> str:
+    """The SHA-256 of a file's bytes, as 64 lowercase hex digits."""
+    digest = hashlib.sha256()
+    try:
+        with open(path, "rb") as fh:
+            while chunk := fh.read(1 << 20):
+                digest.update(chunk)
+    except OSError as exc:
+        raise FileFormatError(f"{path}: cannot read it: {exc.strerror or exc}") from None
+    return digest.hexdigest()
+
+
+def manifest_of(root: Path, files: Iterable[Path]) -> dict[str, str]:
+    """``{name relative to root (posix): digest}`` of ``files``, sorted by name."""
+    return {p.relative_to(root).as_posix(): sha256_file(p)
+            for p in sorted(files, key=lambda p: p.relative_to(root).as_posix())}  # fmt: skip
+
+
+def verify_digest(manifest: dict[Path, str], path: Path) -> None:
+    """Refuse ``path`` when there is a ``manifest`` (path → digest) that does not list it or
+    disagrees."""
+    if not manifest:
+        return
+    want = manifest.get(path)
+    if want is None:
+        raise FileFormatError(
+            f"{path}: not in the session's `sha256` manifest ({len(manifest)} files); "
+            "every file a session with a manifest reads must be listed")
+    got = sha256_file(path)
+    if got != want:
+        raise FileFormatError(
+            f"{path}: SHA-256 is {got[:16]}…, the session's manifest says {want[:16]}…; the "
+            "file changed after it was recorded")

@@ -23,13 +23,14 @@ from deformap._validation import (
     check_rigid_transform,
     check_vector,
 )
+from deformap.cloud import PointCloud
 from deformap.cloud.io import UNITS
 from deformap.environment import ForceTravel, Workspace
 from deformap.errors import ConfigError, DeformapError
 from deformap.replay._confine import confined_path
 
 __all__ = ["FORMAT_NAME", "FORMAT_VERSION", "OPTIONAL_TOPICS", "SESSION_FILE", "TOPICS",
-           "PokeSpec", "SessionHeader", "parse_session_yaml"]
+           "PokeSpec", "PressParts", "SessionHeader", "parse_session_yaml"]
 
 logger = logging.getLogger(__name__)
 
@@ -52,8 +53,6 @@ _TOP_REQUIRED = {"format", "version", "workspace", "probe", "pokes"}
 _TOP_OPTIONAL = {"units", "frame", "cam2world", "ground_truth", "source", "observation", "bag",
                  "n_pokes", "sha256"}
 _FOLDER_POKE_KEYS = {"cloud", "tip_center", "force", "target_xy", "force_n", "robot_points"}
-_FOLDER_POKE_OPTIONAL = {"force_travel"}
-_FORCE_TRAVEL_KEYS = {"travel_m", "force_n"}
 _BAG_POKE_KEYS = {"stamp_ns", "target_xy", "force_n"}
 
 
@@ -105,11 +104,24 @@ class SessionHeader:
     sha256: dict[Path, str] = field(default_factory=dict)
 
 
+@dataclass(frozen=True)
+class PressParts:
+    """What one poke's files hold before it becomes a ``PressObservation`` (world frame, SI)."""
+
+    cloud: PointCloud
+    tip_center: NDArray[np.float64]
+    force: NDArray[np.float64]
+    robot_points: NDArray[np.float64] | tuple[NDArray[np.float64], ...]  # one hull, or per part
+    force_travel: ForceTravel | None = None
+
+
 def _where(file: Path, key: str) -> str:
     return f"{file}: `{key}`"
 
 
-def _check_keys(file: Path, key: str, data: Any, required: set[str], optional: set[str]) -> None:
+def _check_keys(file: Path, key: str, data: Any, required: set[str],
+                optional: frozenset[str] | set[str] = frozenset()) -> None:
+
     if not isinstance(data, dict):
         raise ConfigError(f"{_where(file, key)} must be a mapping; got {type(data).__name__}")
     keys = {str(k) for k in data}
@@ -123,16 +135,16 @@ def _check_keys(file: Path, key: str, data: Any, required: set[str], optional: s
         raise ConfigError(f"{_where(file, key)} lacks required key(s) {missing}")
 
 
+def _name(file: Path, key: str, value: Any, root: Path) -> Path:
+    return confined_path(_where(file, key), value, root)
+
+
 def _value(file: Path, key: str, check: Any, *args: Any, **kwargs: Any) -> Any:
     """Run a ``check_*`` validator and turn its refusal into a ConfigError naming the key."""
     try:
         return check(key, *args, **kwargs)
     except DeformapError as exc:
         raise ConfigError(f"{file}: {exc}") from None
-
-
-def _file_name(file: Path, key: str, value: Any, root: Path) -> Path:
-    return confined_path(_where(file, key), value, root)
 
 
 def _cam2world(file: Path, data: dict[str, Any], frame: str, form: str) -> Any:
@@ -151,25 +163,23 @@ def _cam2world(file: Path, data: dict[str, Any], frame: str, form: str) -> Any:
         if form != "bag":
             raise ConfigError(f"{_where(file, 'cam2world')}: 'tf_static' needs the bag form")
         return "tf_static"
-    mat = _value(file, "cam2world", check_rigid_transform, raw)
-    return mat
+    return _value(file, "cam2world", check_rigid_transform, raw)
 
 
 def _poke(file: Path, index: int, data: Any, form: str, root: Path) -> PokeSpec:
     key = f"pokes[{index}]"
-    if form == "folder":
-        _check_keys(file, key, data, _FOLDER_POKE_KEYS, _FOLDER_POKE_OPTIONAL)
-        if "force_travel" in data:
-            _check_keys(file, f"{key}.force_travel", data["force_travel"], _FORCE_TRAVEL_KEYS,
-                        set())  # fmt: skip
+    if form == "bag":
+        _check_keys(file, key, data, _BAG_POKE_KEYS)
     else:
-        _check_keys(file, key, data, _BAG_POKE_KEYS, set())
-    # Schema problems and names outside the session folder (above) fail the file; value
-    # problems (below) fail only this poke.
-    if form == "folder":
+        _check_keys(file, key, data, _FOLDER_POKE_KEYS, {"force_travel"})
+        if "force_travel" in data:
+            _check_keys(file, f"{key}.force_travel", data["force_travel"], {"travel_m", "force_n"})
+
+        # Schema problems and names outside the session folder fail the file; value problems
+        # (below) fail only this poke.
         for name in ("cloud", "robot_points"):
             if isinstance(data[name], str):
-                _file_name(file, f"{key}.{name}", data[name], root)
+                _name(file, f"{key}.{name}", data[name], root)
     try:
         target = _value(file, f"{key}.target_xy", check_vector, data["target_xy"], 2, what="metres")
         force_n = _value(file, f"{key}.force_n", check_positive, data["force_n"])
@@ -181,19 +191,18 @@ def _poke(file: Path, index: int, data: Any, form: str, root: Path) -> PokeSpec:
         force = _value(file, f"{key}.force", check_vector, data["force"], 3, what="newtons")
         if not np.any(force):
             raise ConfigError(f"{_where(file, key + '.force')} must be non-zero; got (0, 0, 0)")
-        cloud = _file_name(file, f"{key}.cloud", data["cloud"], root)
-        robot_raw = data["robot_points"]
-        robot: Path | NDArray[np.float64]
-        if isinstance(robot_raw, str):
-            robot = _file_name(file, f"{key}.robot_points", robot_raw, root)
-        else:
-            robot = _value(file, f"{key}.robot_points", check_array, robot_raw, (None, 3),
-                           what="points in metres", min_rows=4)  # fmt: skip
+        cloud = _name(file, f"{key}.cloud", data["cloud"], root)
+        robot = data["robot_points"]
+        robot = (_name(file, f"{key}.robot_points", robot, root) if isinstance(robot, str) else
+                 _value(file, f"{key}.robot_points", check_array, robot, (None, 3),
+                        what="points in metres", min_rows=4))  # fmt: skip
         record = None
         if "force_travel" in data:
             raw = data["force_travel"]
-            record = _value(file, f"{key}.force_travel", _force_travel, raw["travel_m"],
-                            raw["force_n"])  # fmt: skip
+            try:
+                record = ForceTravel(travel_m=raw["travel_m"], force_n=raw["force_n"])
+            except DeformapError as exc:
+                raise ConfigError(f"{_where(file, key + '.force_travel')}: {exc}") from None
         return PokeSpec(index=index, target_xy=target, force_n=force_n, cloud=cloud,
                         tip_center=center, force=force, robot_points=robot,
                         force_travel=record)  # fmt: skip
@@ -201,16 +210,8 @@ def _poke(file: Path, index: int, data: Any, form: str, root: Path) -> PokeSpec:
         return PokeSpec(index=index, error=exc)
 
 
-def _force_travel(name: str, travel: Any, force: Any) -> ForceTravel:
-    """A ``ForceTravel`` from plain data; its refusal names the entry and the field."""
-    try:
-        return ForceTravel(travel_m=travel, force_n=force)
-    except DeformapError as exc:
-        raise ConfigError(f"`{name}`: {exc}") from None
-
-
 def _workspace(file: Path, data: Any) -> Workspace:
-    _check_keys(file, "workspace", data, {"lower", "upper"}, set())
+    _check_keys(file, "workspace", data, {"lower", "upper"})
     lower = _value(file, "workspace.lower", check_vector, data["lower"], 2, what="metres")
     upper = _value(file, "workspace.upper", check_vector, data["upper"], 2, what="metres")
     try:
@@ -245,7 +246,7 @@ def parse_session_yaml(data: Any, file: Path) -> SessionHeader:
         raise ConfigError(f"{_where(file, 'frame')} must be a non-empty string; got {frame!r}")
     cam2world = _cam2world(file, data, frame, form)
     workspace = _workspace(file, data["workspace"])
-    _check_keys(file, "probe", data["probe"], {"tip_radius_m"}, set())
+    _check_keys(file, "probe", data["probe"], {"tip_radius_m"})
     tip = _value(file, "probe.tip_radius_m", check_positive, data["probe"]["tip_radius_m"])
     source = data.get("source") or {}
     if not isinstance(source, dict):
@@ -261,9 +262,9 @@ def parse_session_yaml(data: Any, file: Path) -> SessionHeader:
     return SessionHeader(
         root=root, form=form, units=units, frame=frame, cam2world=cam2world,
         workspace=workspace, tip_radius_m=tip,
-        observation=_file_name(file, "observation", data["observation"], root) if has_obs else None,
-        bag=_file_name(file, "bag", data["bag"], root) if has_bag else None,
-        ground_truth=None if truth is None else _file_name(file, "ground_truth", truth, root),
+        observation=_name(file, "observation", data["observation"], root) if has_obs else None,
+        bag=_name(file, "bag", data["bag"], root) if has_bag else None,
+        ground_truth=None if truth is None else _name(file, "ground_truth", truth, root),
         source={str(k): v for k, v in source.items()},
         pokes=tuple(_unique_stamps(file, specs)), sha256=digests)
 
@@ -308,15 +309,11 @@ def _manifest(file: Path, raw: Any, root: Path) -> dict[Path, str]:
 def _unique_stamps(file: Path, specs: list[PokeSpec]) -> list[PokeSpec]:
     """Refuse a bag-form poke whose ``stamp_ns`` an earlier poke has: it would read that poke."""
     first: dict[int, int] = {}
-    out = []
-    for spec in specs:
-        if spec.stamp_ns is not None and spec.stamp_ns in first:
-            key = f"pokes[{spec.index}].stamp_ns"
-            error = ConfigError(
-                f"{_where(file, key)} is {spec.stamp_ns}, already the stamp of "
-                f"`pokes[{first[spec.stamp_ns]}]`; each poke needs its own messages")
-            spec = PokeSpec(index=spec.index, error=error)
-        elif spec.stamp_ns is not None:
-            first[spec.stamp_ns] = spec.index
-        out.append(spec)
-    return out
+    for i, spec in enumerate(specs):
+        earlier = spec.index if spec.stamp_ns is None else first.setdefault(spec.stamp_ns, i)
+        if earlier != spec.index:
+            specs[i] = PokeSpec(index=i, error=ConfigError(
+                f"{_where(file, f'pokes[{i}].stamp_ns')} is {spec.stamp_ns}, already the stamp "
+                f"of `pokes[{earlier}]`; each poke needs its own messages"))
+    return specs
+

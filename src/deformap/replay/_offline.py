@@ -26,9 +26,6 @@ __all__ = ["ReplayResult", "estimate_poke", "map_session", "tip_sphere_points"]
 
 logger = logging.getLogger(__name__)
 
-#: The ``stop_reason`` of a replayed session: its recorded pokes ran out.
-END_OF_SESSION = "end-of-session"
-
 
 @dataclass
 class ReplayResult:
@@ -69,8 +66,7 @@ def map_session(session: RecordedSession, config: ExplorationConfig, *, rng: np.
             continue
         if on_poke is not None:
             on_poke(poke)
-    result = run.result(END_OF_SESSION)
-    return ReplayResult(result=result, skipped=skipped)
+    return ReplayResult(result=run.result("end-of-session"), skipped=skipped)
 
 
 def tip_sphere_points(tip_center: Any, tip_radius_m: float) -> NDArray[np.float64]:

@@ -10,7 +10,6 @@ time. A press that cannot be read is refused in one line naming it, the topic an
 
 from __future__ import annotations
 
-import logging
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -20,24 +19,23 @@ from numpy.typing import NDArray
 
 from deformap.cloud import PointCloud
 from deformap.cloud.io import (
+    TransformTree,
     bag_error_text,
     bag_read_errors,
+    header_stamp_ns,
     iter_bag_messages,
     pointcloud2_colors,
     pointcloud2_structured,
     typestore,
+    xyz_with_holes,
 )
 from deformap.environment import ForceTravel, Workspace
 from deformap.errors import DeformapError, FileFormatError
-from deformap.replay._folder import PressParts
-from deformap.replay._format import PokeSpec
+from deformap.replay._format import PokeSpec, PressParts
 from deformap.replay._rawconfig import HullPart, RawBagConfig
 from deformap.replay._rawpress import FoundPress, find_presses
-from deformap.replay._rawtf import TransformTree
 
 __all__ = ["RawBagReader", "hull_points"]
-
-logger = logging.getLogger(__name__)
 
 _CLOUD = "sensor_msgs/msg/PointCloud2"
 _WRENCH = "geometry_msgs/msg/WrenchStamped"
@@ -53,10 +51,6 @@ MAX_FORCE_N = 1e6
 
 #: Points of a hull part's circle (cylinder, cap): 16 give a polygon within 2 % of the circle.
 _CIRCLE = 16
-
-
-def _stamp(header: Any) -> int:
-    return int(header.stamp.sec) * 10**9 + int(header.stamp.nanosec)
 
 
 def hull_points(part: HullPart, rot: NDArray[np.float64], origin: NDArray[np.float64]
@@ -147,11 +141,11 @@ class RawBagReader:
                 raise FileFormatError(f"{where}: could not be decoded: "
                                       f"{bag_error_text(exc, 120)}") from None  # fmt: skip
             if raw.topic == cfg.cloud_topic:
-                stamps.append(_stamp(msg.header))
+                stamps.append(header_stamp_ns(msg.header))
                 frames.add(str(msg.header.frame_id))
             elif raw.topic == cfg.wrench_topic:
                 f = msg.wrench.force
-                w_ns.append(_stamp(msg.header))
+                w_ns.append(header_stamp_ns(msg.header))
                 w_force.append([float(f.x), float(f.y), float(f.z)])
                 w_frames.add(str(msg.header.frame_id))
             else:
@@ -275,15 +269,9 @@ class RawBagReader:
         """The frame's points, NaN holes kept, and their colours (NaN at the holes) or None."""
         try:
             table = pointcloud2_structured(msg)
+            xyz = xyz_with_holes(msg, table)
         except DeformapError as exc:
-            raise FileFormatError(f"{where}: {exc}") from None
-        names = table.dtype.names or ()
-        if not all(a in names and table.dtype[a].kind == "f" for a in "xyz"):
-            raise FileFormatError(f"{where}: must have float fields x, y, z; got {list(names)}")
-        with np.errstate(invalid="ignore"):
-            xyz = np.column_stack([table[a].astype(np.float64) for a in "xyz"])
-        if bool(msg.is_dense) and not np.isfinite(xyz).all():
-            raise FileFormatError(f"{where}: says is_dense but holds NaN or infinite points")
+            raise FileFormatError(f"{where}: {str(exc).replace('`msg` ', '')}") from None
         rgb = pointcloud2_colors(msg, where=where, table=table, valid=np.isfinite(xyz).all(axis=1))
         return xyz * (1e-3 if self.config.units == "mm" else 1.0), rgb
 

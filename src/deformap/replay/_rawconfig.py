@@ -122,17 +122,11 @@ class RawBagConfig:
         if not self.hull:
             raise ConfigError("`hull` must hold at least one part (the stick); got none")
 
-    def commanded_force(self, default_n: float) -> float:
-        """The commanded force: ``force_n``, else ``default_n`` (the run's)."""
-        return default_n if self.force_n is None else self.force_n
-
 
 def raw_config_file(bag: Path) -> Path:
     """Where the settings of ``bag`` live: ``deformap.yaml`` inside a rosbag2 folder, or
     ``NAME.deformap.yaml`` beside a ``NAME.mcap`` / ``NAME.db3`` file."""
-    if bag.is_dir():
-        return bag / RAW_CONFIG_NAME
-    return bag.with_name(f"{bag.stem}.{RAW_CONFIG_NAME}")
+    return bag / RAW_CONFIG_NAME if bag.is_dir() else bag.with_name(f"{bag.stem}.{RAW_CONFIG_NAME}")
 
 
 def load_raw_config(bag: Path, file: Path | None = None, **overrides: Any) -> RawBagConfig:
@@ -148,10 +142,7 @@ def load_raw_config(bag: Path, file: Path | None = None, **overrides: Any) -> Ra
         data = dict(loaded or {})
     where = str(path) if data else "raw recording settings"
     config = config_from_dict(RawBagConfig, data, where=where)
-    given = {k: v for k, v in overrides.items() if v is not None}
-    if not given:
-        return config
     try:
-        return replace(config, **given)
+        return replace(config, **{k: v for k, v in overrides.items() if v is not None})
     except TypeError as exc:
         raise ConfigError(f"raw recording settings: {exc}") from None

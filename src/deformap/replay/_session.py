@@ -1,9 +1,10 @@
-"""A recorded session read back: ``load_session`` and ``RecordedSession``.
+"""A recorded session read back: ``load_session``, ``load_raw_bag`` and ``RecordedSession``.
 
 A session is a folder of ``session.yaml`` (``docs/recording-format.md``) and either one cloud file
-per observation (folder form) or a ROS 2 bag (bag form). Loading checks the whole ``session.yaml``
-and opens the data; each poke is read and checked only when asked for, so that a broken poke is
-reported on its own.
+per observation (folder form, read here; contacts in ``session.yaml``) or a ROS 2 bag (bag form);
+a robot's own bag opens as a session of form ``"raw"``, one poke per press found. Loading checks
+the whole ``session.yaml`` and opens the data; each poke is read and checked only when asked for,
+so that a broken poke is reported on its own.
 """
 
 from __future__ import annotations
@@ -15,20 +16,27 @@ from typing import Any
 
 import numpy as np
 
-from deformap._config import load_yaml
-from deformap._validation import check_int, check_path, check_positive
+from deformap._config import config_to_dict, load_yaml
+from deformap._validation import check_instance, check_int, check_path, check_positive
 from deformap.cloud import PointCloud, points_in_hull
-from deformap.cloud.io import path_kind
+from deformap.cloud.io import path_kind, read_cloud
 from deformap.environment import PressObservation, TactileContact, Workspace
 from deformap.errors import DeformapError, FileFormatError, InvalidArgumentError
 from deformap.replay._bagform import BagReader
-from deformap.replay._folder import FolderReader
-from deformap.replay._format import SESSION_FILE, SessionHeader, parse_session_yaml
-from deformap.replay._manifest import verify_digest
+from deformap.replay._confine import verify_digest
+from deformap.replay._format import (
+    SESSION_FILE,
+    PokeSpec,
+    PressParts,
+    SessionHeader,
+    parse_session_yaml,
+)
 from deformap.replay._rawbag import RawBagReader
+from deformap.replay._rawconfig import RawBagConfig
 from deformap.replay._truth import GroundTruth, read_ground_truth
 
-__all__ = ["DEFAULT_CONTACT_GAP_M", "RecordedSession", "check_contact_gap", "load_session"]
+__all__ = ["DEFAULT_CONTACT_GAP_M", "RAW_SUFFIXES", "RecordedSession", "check_contact_gap",
+           "is_raw_bag", "load_raw_bag", "load_session"]
 
 logger = logging.getLogger(__name__)
 
@@ -36,6 +44,41 @@ logger = logging.getLogger(__name__)
 #: is refused: the robot hides a few centimetres around the tip, while a tip or cloud in the
 #: wrong frame or units lands tens of centimetres away.
 DEFAULT_CONTACT_GAP_M = 0.05
+
+
+class FolderReader:
+    """Reads the files a folder-form ``session.yaml`` names, one at a time."""
+
+    def __init__(self, header: SessionHeader) -> None:
+        self.header = header
+        assert header.observation is not None
+        if path_kind(header.observation) != "file":
+            raise FileFormatError(
+                f"{header.observation}: no such file (the session's `observation`)")
+
+    def _read(self, path: Path | None, to_world: bool = True) -> PointCloud:
+        assert path is not None
+        if path_kind(path) != "file":
+            raise FileFormatError(f"{path}: no such file")
+        verify_digest(self.header.sha256, path)
+        cloud = read_cloud(path, units=self.header.units)
+        if not to_world or self.header.frame == "world":
+            return cloud
+        assert isinstance(self.header.cam2world, np.ndarray)  # parse_session_yaml guarantees it
+        return PointCloud(cloud.points, cloud.colors, frame=self.header.frame).transformed(
+            self.header.cam2world, "world")
+
+    def observation(self) -> PointCloud:
+        return self._read(self.header.observation)
+
+    def press_parts(self, spec: PokeSpec) -> PressParts:
+        assert spec.cloud is not None and spec.tip_center is not None and spec.force is not None
+        cloud, robot = self._read(spec.cloud), spec.robot_points
+        if isinstance(robot, Path):
+            # Robot geometry comes from the robot model in the world (base) frame, not the camera's.
+            robot = np.asarray(self._read(robot, to_world=False).points)
+        assert robot is not None
+        return PressParts(cloud, spec.tip_center, spec.force, robot, spec.force_travel)
 
 
 @dataclass(eq=False)
@@ -58,9 +101,6 @@ class RecordedSession:
     def workspace(self) -> Workspace:
         return self.header.workspace
 
-    @property
-    def tip_radius_m(self) -> float:
-        return self.header.tip_radius_m
 
     @property
     def source(self) -> dict[str, Any]:
@@ -90,7 +130,7 @@ class RecordedSession:
                  else f"{self.path / SESSION_FILE}: poke {i}")  # fmt: skip
         try:
             contact = TactileContact(tip_center=parts.tip_center, force=parts.force,
-                                     tip_radius_m=self.tip_radius_m)  # fmt: skip
+                                     tip_radius_m=self.header.tip_radius_m)  # fmt: skip
             obs = PressObservation(cloud=parts.cloud, contact=contact,
                                    robot_points=parts.robot_points, target_xy=spec.target_xy,
                                    force_n=spec.force_n,
@@ -131,10 +171,6 @@ def check_contact_gap(obs: PressObservation, gap_m: float, where: str) -> None:
             "cloud are probably in different frames or units")
 
 
-def _read_yaml(file: Path) -> Any:
-    return load_yaml(file, what="the session file", unreadable=FileFormatError)
-
-
 def _session_file(path: Path) -> Path:
     kind = path_kind(path)
     if kind == "dir":
@@ -159,16 +195,59 @@ def load_session(path: str | Path, *, contact_gap_m: float = DEFAULT_CONTACT_GAP
     p = check_path("path", path)
     gap = check_positive("contact_gap_m", contact_gap_m)
     file = _session_file(p)
-    data = _read_yaml(file)
-    header = parse_session_yaml(data, file)
+    header = parse_session_yaml(
+        load_yaml(file, what="the session file", unreadable=FileFormatError), file)
     reader = FolderReader(header) if header.form == "folder" else BagReader(header)
     truth = None
     if header.ground_truth is not None:
         if path_kind(header.ground_truth) == "file":
-            verify_digest(header, header.ground_truth)
+            verify_digest(header.sha256, header.ground_truth)
         truth = read_ground_truth(header.ground_truth)
     broken = [p.index for p in header.pokes if p.error is not None]
     if broken:
         logger.warning("%s: poke(s) %s have bad entries and will be refused", file, broken)
     return RecordedSession(path=file.parent, header=header, ground_truth=truth,
                            contact_gap_m=gap, _reader=reader)  # fmt: skip
+
+
+#: Files that are a ROS 2 bag on their own (MCAP, sqlite3).
+RAW_SUFFIXES = (".mcap", ".db3")
+
+
+def is_raw_bag(path: str | Path) -> bool:
+    """Whether ``path`` is a bag as a robot records it: a ``.mcap`` or ``.db3`` file, or a rosbag2
+    folder (with ``metadata.yaml``) without ``session.yaml``."""
+    p = Path(path)
+    kind = path_kind(p)
+    if kind == "dir":
+        return path_kind(p / "metadata.yaml") == "file" and path_kind(p / SESSION_FILE) != "file"
+    return kind == "file" and p.suffix in RAW_SUFFIXES
+
+
+def load_raw_bag(path: str | Path, config: RawBagConfig | None = None, *, default_force_n: float,
+                 contact_gap_m: float = DEFAULT_CONTACT_GAP_M) -> RecordedSession:
+    """Open a raw robot recording (a ``.mcap`` / ``.db3`` file or a rosbag2 folder) and find its
+    presses: a session of form ``"raw"``, one poke per press.
+
+    ``config`` names its topics, frames and thresholds (default ``RawBagConfig()``; see
+    :func:`~deformap.replay.load_raw_config`); ``default_force_n`` is the commanded force when
+    ``config.force_n`` is None; ``contact_gap_m`` as for :func:`~deformap.replay.load_session`.
+    A bag missing or unreadable, lacking a topic or a press, or whose observation frames do not come
+    before the first press, is a FileFormatError.
+    """
+    bag = check_path("path", path)
+    cfg = check_instance("config", RawBagConfig() if config is None else config, RawBagConfig)
+    if path_kind(bag) == "missing":
+        raise FileFormatError(f"{bag}: no such bag")
+    default_n = check_positive("default_force_n", default_force_n)
+    force = default_n if cfg.force_n is None else cfg.force_n
+    reader = RawBagReader(bag, cfg, force)
+    header = SessionHeader(
+        root=bag if bag.is_dir() else bag.parent, form="raw", units=cfg.units,
+        frame=cfg.world_frame, cam2world=None, workspace=reader.workspace(),
+        tip_radius_m=cfg.tip_radius_m, observation=None, bag=bag, ground_truth=None,
+        source={"raw": config_to_dict(cfg), "force_n": force, "n_presses": len(reader.presses)},
+        pokes=reader.poke_specs())
+    return RecordedSession(path=bag, header=header, ground_truth=None,
+                           contact_gap_m=check_positive("contact_gap_m", contact_gap_m),
+                           _reader=reader)

@@ -45,8 +45,7 @@ class GroundTruth:
             raise InvalidArgumentError("`hardness` must be > 0 (inf for rigid, nan for none)")
         for label in np.unique(labels):
             values = hard[labels == label]
-            same = np.all(values == values[0]) or np.all(np.isnan(values))
-            if not same:
+            if not (np.all(values == values[0]) or np.all(np.isnan(values))):
                 raise InvalidArgumentError(
                     f"`hardness` must be constant over each label; label {label} has "
                     f"{np.unique(values).size} values")
@@ -55,24 +54,20 @@ class GroundTruth:
             value.setflags(write=False)
             object.__setattr__(self, name, value)
 
-    def _cells(self, xs: Any, ys: Any) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
+    def _cells(self, xs: Any, ys: Any) -> Any:
+        """``np.ix_`` of the stored cells nearest the grid ``xs`` × ``ys``."""
         qx = check_array("xs", xs, (None,), what="metres")
         qy = check_array("ys", ys, (None,), what="metres")
-
-        def nearest(axis: NDArray[np.float64], q: NDArray[np.float64]) -> NDArray[np.intp]:
-            return np.abs(axis[None, :] - q[:, None]).argmin(axis=1)
-
-        return nearest(self.ys, qy), nearest(self.xs, qx)
+        return np.ix_(np.abs(self.ys[None, :] - qy[:, None]).argmin(axis=1),
+                      np.abs(self.xs[None, :] - qx[:, None]).argmin(axis=1))
 
     def ground_truth_labels(self, xs: Any, ys: Any) -> NDArray[np.int64]:
         """``(ny, nx)`` labels at the grid ``xs`` × ``ys`` (nearest stored cell)."""
-        iy, ix = self._cells(xs, ys)
-        return self.labels[np.ix_(iy, ix)]
+        return self.labels[self._cells(xs, ys)]
 
     def ground_truth_hardness(self, xs: Any, ys: Any) -> NDArray[np.float64]:
         """``(ny, nx)`` hardness in newtons at the grid ``xs`` × ``ys`` (nearest stored cell)."""
-        iy, ix = self._cells(xs, ys)
-        return self.hardness[np.ix_(iy, ix)]
+        return self.hardness[self._cells(xs, ys)]
 
 
 def write_ground_truth(path: str | Path, truth: GroundTruth) -> None:

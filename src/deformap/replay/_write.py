@@ -1,4 +1,5 @@
-"""Writing a session (folder or bag form), as ``deformap record-sim`` does."""
+"""Writing a session (folder or bag form), as ``deformap record-sim`` does, from what a
+:class:`RecordingEnvironment` kept of an environment's answers."""
 
 from __future__ import annotations
 
@@ -10,17 +11,17 @@ from typing import Any
 import numpy as np
 import yaml
 
-from deformap._validation import check_instance, check_positive
+from deformap._validation import check_instance, check_path, check_positive
 from deformap.cloud import PointCloud
 from deformap.cloud.io import BAG_STORAGES, CLOUD_FORMATS, write_cloud
-from deformap.environment import PressObservation, Workspace
-from deformap.errors import InvalidArgumentError
+from deformap.environment import Environment, PressObservation, Workspace
+from deformap.errors import EnvironmentStateError, InvalidArgumentError
 from deformap.replay._bagform import write_session_bag
+from deformap.replay._confine import manifest_of
 from deformap.replay._format import FORMAT_NAME, FORMAT_VERSION, SESSION_FILE
-from deformap.replay._manifest import manifest_of
 from deformap.replay._truth import GroundTruth, write_ground_truth
 
-__all__ = ["SESSION_FORMATS", "write_session"]
+__all__ = ["SESSION_FORMATS", "RecordingEnvironment", "write_session"]
 
 logger = logging.getLogger(__name__)
 
@@ -29,6 +30,43 @@ SESSION_FORMATS = ("folder", *BAG_STORAGES)
 
 #: Poke ``i`` (0-based) of a bag written here is stamped ``(i + 1)`` seconds; the observation 0.
 _STAMP_STEP_NS = 10**9
+
+
+class RecordingEnvironment:
+    """Pass every call through to ``env`` and keep each ``observe()`` and ``press()`` result,
+    ready for :func:`~deformap.replay.write_session`."""
+
+    def __init__(self, env: Environment) -> None:
+        if not isinstance(env, Environment):
+            raise InvalidArgumentError(
+                f"`env` must implement the Environment protocol; got {type(env).__name__}")
+        self._env = env
+        self.observations: list[PointCloud] = []
+        self.presses: list[PressObservation] = []
+
+    @property
+    def workspace(self) -> Workspace:
+        return self._env.workspace
+
+    @property
+    def observation(self) -> PointCloud:
+        """The first observation (the one the mapper is initialised with)."""
+        if not self.observations:
+            raise EnvironmentStateError("nothing recorded yet: `observe()` was never called")
+        return self.observations[0]
+
+    def observe(self) -> PointCloud:
+        cloud = self._env.observe()
+        self.observations.append(cloud)
+        return cloud
+
+    def press(self, target_xy: Any, force_n: float) -> PressObservation:
+        obs = self._env.press(target_xy, force_n)
+        self.presses.append(obs)
+        return obs
+
+    def release(self) -> None:
+        self._env.release()
 
 
 class _Dumper(yaml.SafeDumper):
@@ -51,9 +89,7 @@ def _floats(values: Any) -> list[float]:
 def _check_inputs(folder: Any, workspace: Any, observation: Any, presses: Any, tip_radius_m: Any,
                   format: Any, cloud_format: Any,
                   ground_truth: Any) -> tuple[Path, list[PressObservation], float]:
-    if not isinstance(folder, (str, Path)):
-        raise InvalidArgumentError(f"`folder` must be a str or Path; got {type(folder).__name__}")
-    out = Path(folder)
+    out = check_path("folder", folder)
     if out.exists() and (not out.is_dir() or any(out.iterdir())):
         raise InvalidArgumentError(f"`folder` {out} exists and is not an empty folder")
     check_instance("workspace", workspace, Workspace)
@@ -83,9 +119,8 @@ def _check_inputs(folder: Any, workspace: Any, observation: Any, presses: Any, t
     if cloud_format not in CLOUD_FORMATS:
         raise InvalidArgumentError(
             f"`cloud_format` must be one of {CLOUD_FORMATS}; got {cloud_format!r}")
-    if ground_truth is not None and not isinstance(ground_truth, GroundTruth):
-        raise InvalidArgumentError(
-            f"`ground_truth` must be a GroundTruth or None; got {type(ground_truth).__name__}")
+    if ground_truth is not None:
+        check_instance("ground_truth", ground_truth, GroundTruth)
     return out, presses, tip
 
 
@@ -105,10 +140,10 @@ def write_session(folder: str | Path, *, workspace: Workspace, observation: Poin
     out, presses, tip = _check_inputs(folder, workspace, observation, presses, tip_radius_m,
                                       format, cloud_format, ground_truth)  # fmt: skip
     out.mkdir(parents=True, exist_ok=True)
-    doc: dict[str, Any] = {"format": FORMAT_NAME, "version": FORMAT_VERSION, "units": "m",
-                           "frame": "world",
-                           "workspace": {"lower": list(workspace.lower), "upper": list(workspace.upper)},
-                           "probe": {"tip_radius_m": tip}}
+    doc: dict[str, Any] = {
+        "format": FORMAT_NAME, "version": FORMAT_VERSION, "units": "m", "frame": "world",
+        "workspace": {"lower": list(workspace.lower), "upper": list(workspace.upper)},
+        "probe": {"tip_radius_m": tip}}  # fmt: skip
     if source:
         doc["source"] = dict(source)
     if ground_truth is not None:
@@ -129,8 +164,7 @@ def write_session(folder: str | Path, *, workspace: Workspace, observation: Poin
             entry: dict[str, Any] = {
                 "cloud": cloud, "tip_center": _floats(obs.contact.tip_center),
                 "force": _floats(obs.contact.force), "target_xy": _floats(obs.target_xy),
-                "force_n": float(obs.force_n), "robot_points": robot,
-            }  # fmt: skip
+                "force_n": float(obs.force_n), "robot_points": robot}  # fmt: skip
             if obs.force_travel is not None:
                 entry["force_travel"] = {"travel_m": _floats(obs.force_travel.travel_m),
                                          "force_n": _floats(obs.force_travel.force_n)}

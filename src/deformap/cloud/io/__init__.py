@@ -1,16 +1,11 @@
-"""Point-cloud files and ROS 2 bags in and out.
+"""Point-cloud files (PCD, PLY, NPZ) and ROS 2 bags (sqlite3, MCAP; extra ``ros``) in and out.
 
 Readers return clouds in metres and refuse what they cannot read faithfully (truncated or corrupt
-files, missing x/y/z, NaN points unless ``drop_nan=True``, empty clouds, clouds that look like
-millimetres unless ``units="mm"``) with one :class:`~deformap.errors.FileFormatError` naming the
-file. Every size a header declares is checked against the bytes present before anything is
-allocated, and a body larger than its header declares is refused, not cut. Nothing is unpickled.
-
-Formats: PCD (pypcd4), PLY (numpy), NPZ (at most :data:`MAX_NPZ_BYTES` decompressed), and ROS 2
-bags (sqlite3 and MCAP, through the optional ``rosbags``, extra ``ros``) of PointCloud2 and
-WrenchStamped messages: :func:`iter_bag_messages` is the one bag reader, :func:`bag_writer` the
-one writer. Colours (RGB in [0, 1]) are read from every format's usual fields and written whenever
-a cloud has them (``docs/recording-format.md``).
+files, sizes a header declares that the bytes do not hold, missing x/y/z, NaN points unless
+``drop_nan=True``, empty clouds, metres that look like millimetres unless ``units="mm"``) with one
+:class:`~deformap.errors.FileFormatError` naming the file; nothing is unpickled.
+:func:`iter_bag_messages` is the one bag reader, :func:`bag_writer` the one writer. Colours (RGB in
+[0, 1]) are read from every format's usual fields and written whenever a cloud has them.
 """
 
 from __future__ import annotations
@@ -18,18 +13,23 @@ from __future__ import annotations
 from deformap.cloud.io._bag import (
     StampedCloud,
     WrenchSeries,
+    bag_writer,
     read_bag_clouds,
     read_bag_static_transform,
     read_bag_wrenches,
+    wrench_message,
+    write_bag,
 )
 from deformap.cloud.io._bag_reader import (
     BAG_STORAGES,
     RawBagMessage,
     bag_error_text,
     bag_read_errors,
+    header_message,
+    header_stamp_ns,
     iter_bag_messages,
+    typestore,
 )
-from deformap.cloud.io._bag_writer import bag_writer, fill_chunk_crcs, wrench_message, write_bag
 from deformap.cloud.io._common import MM_EXTENT_THRESHOLD, UNITS, path_kind
 from deformap.cloud.io._dispatch import CLOUD_FORMATS, read_cloud, write_cloud
 from deformap.cloud.io._npz import MAX_NPZ_BYTES, load_npz_arrays, read_npz, write_npz
@@ -41,15 +41,16 @@ from deformap.cloud.io._pointcloud2 import (
     pointcloud2_structured,
     pointcloud2_to_array,
     pointcloud2_to_cloud,
+    xyz_with_holes,
 )
-from deformap.cloud.io._ros import ROS_DISTRO, typestore
+from deformap.cloud.io._tf import TransformTree
 
-__all__ = [
-           "BAG_STORAGES", "CLOUD_FORMATS", "MAX_NPZ_BYTES", "MM_EXTENT_THRESHOLD", "PCD_ENCODINGS",
-           "PLY_FORMATS", "ROS_DISTRO", "UNITS", "RawBagMessage", "StampedCloud", "WrenchSeries",
-           "array_to_pointcloud2", "bag_error_text", "bag_read_errors", "bag_writer", "fill_chunk_crcs",
-           "iter_bag_messages", "load_npz_arrays", "path_kind", "pointcloud2_colors",
-           "pointcloud2_structured", "pointcloud2_to_array", "pointcloud2_to_cloud", "read_bag_clouds",
-           "read_bag_static_transform", "read_bag_wrenches", "read_cloud", "read_npz", "read_pcd",
-           "read_ply", "typestore", "wrench_message", "write_bag", "write_cloud", "write_npz",
-           "write_pcd", "write_ply"]
+__all__ = ["BAG_STORAGES", "CLOUD_FORMATS", "MAX_NPZ_BYTES", "MM_EXTENT_THRESHOLD", "PCD_ENCODINGS",
+           "PLY_FORMATS", "UNITS", "RawBagMessage", "StampedCloud", "TransformTree", "WrenchSeries",
+           "array_to_pointcloud2", "bag_error_text", "bag_read_errors", "bag_writer",
+           "header_message", "header_stamp_ns", "iter_bag_messages", "load_npz_arrays", "path_kind",
+           "pointcloud2_colors", "pointcloud2_structured", "pointcloud2_to_array",
+           "pointcloud2_to_cloud", "read_bag_clouds", "read_bag_static_transform",
+           "read_bag_wrenches", "read_cloud", "read_npz", "read_pcd", "read_ply", "typestore",
+           "wrench_message", "write_bag", "write_cloud", "write_npz", "write_pcd", "write_ply",
+           "xyz_with_holes"]

@@ -15,6 +15,7 @@ import struct
 import zlib
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
+from functools import cache
 from pathlib import Path
 from typing import Any
 
@@ -22,10 +23,15 @@ from deformap._validation import check_path
 from deformap.cloud.io._common import path_kind
 from deformap.errors import DeformapError, FileFormatError, InvalidArgumentError, missing_extra
 
-__all__ = ["BAG_STORAGES", "RawBagMessage", "bag_error_text", "bag_read_errors",
-           "check_db3_counts", "check_mcap_crcs", "iter_bag_messages"]
+__all__ = ["BAG_STORAGES", "ROS_DISTRO", "RawBagMessage", "bag_error_text", "bag_read_errors",
+           "header_message", "header_stamp_ns", "iter_bag_messages", "typestore"]
+
 
 BAG_STORAGES = ("mcap", "sqlite3")
+
+#: The message definitions used to write and, for bags that carry none, read messages. The
+#: messages deformap uses (PointCloud2, WrenchStamped, TFMessage) are identical from Humble on.
+ROS_DISTRO = "ros2_humble"
 
 
 def _rosbag2() -> Any:
@@ -36,22 +42,47 @@ def _rosbag2() -> Any:
     return rosbag2
 
 
+@cache
+def typestore() -> Any:
+    """Return rosbags' typestore for :data:`ROS_DISTRO`, or raise MissingDependencyError."""
+    try:
+        from rosbags.typesys import Stores, get_typestore
+    except ImportError:
+        raise missing_extra("rosbags", "ros", "reading and writing ROS 2 messages") from None
+    return get_typestore(Stores(ROS_DISTRO))
+
+
+def header_message(stamp_ns: int, frame_id: str) -> Any:
+    """A ``std_msgs/msg/Header`` of ``stamp_ns`` [ns] and ``frame_id``."""
+    types = typestore().types
+    time = types["builtin_interfaces/msg/Time"](sec=stamp_ns // 10**9, nanosec=stamp_ns % 10**9)
+    return types["std_msgs/msg/Header"](stamp=time, frame_id=frame_id)
+
+
+def header_stamp_ns(header: Any) -> int:
+    """The stamp [ns] of a ``std_msgs/msg/Header``."""
+    return int(header.stamp.sec) * 10**9 + int(header.stamp.nanosec)
+
+
+@cache
 def bag_read_errors() -> tuple[type[BaseException], ...]:
     """What rosbags, its SQLite drivers (``apsw``'s errors included), the MCAP chunk
     decompressors (zstd's ``ZstdError``, lz4's ``RuntimeError``) and the CDR decoder raise on a
     damaged bag (a corrupted length may ask for an absurd allocation: MemoryError)."""
     from rosbags.serde import SerdeError
 
-    errors: tuple[type[BaseException], ...] = (
+    errors: list[type[BaseException]] = [
         _rosbag2().ReaderError, SerdeError, sqlite3.Error, OSError, ValueError, KeyError,
         IndexError, TypeError, AssertionError, EOFError, struct.error, MemoryError,
-        OverflowError, UnicodeDecodeError, RuntimeError, *_zstd_errors(),
-    )  # fmt: skip
-    try:
-        import apsw
-    except ImportError:
-        return errors
-    return (*errors, apsw.Error)
+        OverflowError, UnicodeDecodeError, RuntimeError]  # fmt: skip
+    # the zstd module rosbags uses, whichever is installed, and apsw if it is
+    for module, name in (("compression.zstd", "ZstdError"), ("backports.zstd", "ZstdError"),
+                         ("apsw", "Error")):  # fmt: skip
+        try:
+            errors.append(getattr(importlib.import_module(module), name))
+        except ImportError:
+            continue
+    return tuple(errors)
 
 
 def bag_error_text(exc: BaseException, limit: int = 200) -> str:
@@ -63,18 +94,6 @@ def bag_error_text(exc: BaseException, limit: int = 200) -> str:
     if isinstance(exc, (NotImplementedError, RecursionError)):
         raise exc
     return f"{type(exc).__name__}: {' '.join(str(exc).split())[:limit]}"
-
-
-def _zstd_errors() -> tuple[type[BaseException], ...]:
-    """The ``ZstdError`` of the zstd module rosbags uses (``compression.zstd`` or
-    ``backports.zstd``), if it is there."""
-    for name in ("compression.zstd", "backports.zstd"):
-        try:
-            module = importlib.import_module(name)
-        except ImportError:
-            continue
-        return (module.ZstdError,)
-    return ()
 
 
 @dataclass(frozen=True)

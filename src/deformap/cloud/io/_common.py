@@ -57,9 +57,11 @@ def pack_rgb(colors: NDArray[np.float64]) -> NDArray[Any]:
     return (rgb[:, 0] << 16) | (rgb[:, 1] << 8) | rgb[:, 2]
 
 
-def unpack_rgb(words: NDArray[np.uint32]) -> NDArray[np.uint8]:
-    """(n, 3) uint8 R, G, B of ``0xAARRGGBB`` words (alpha ignored)."""
-    return ((words[:, None] >> np.array([16, 8, 0], dtype=np.uint32)) & 0xFF).astype(np.uint8)
+def unpack_rgb(words: NDArray[Any]) -> NDArray[np.uint8]:
+    """(n, 3) uint8 R, G, B of ``0xAARRGGBB`` words (alpha ignored): any 4-byte values, read for
+    their bits in their byte order (a float word with an alpha byte may be NaN)."""
+    bits = np.ascontiguousarray(words).view(words.dtype.str[0] + "u4").astype(np.uint32)
+    return ((bits[:, None] >> np.array([16, 8, 0], dtype=np.uint32)) & 0xFF).astype(np.uint8)
 
 
 def check_units(units: Any) -> float:

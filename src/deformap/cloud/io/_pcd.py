@@ -138,8 +138,7 @@ def _pcd_colors(path: Path, pc_data: NDArray[Any], meta: Any, body: bytes
                     f"{path}: colour field {field!r} holds {values.min():.0f} to "
                     f"{values.max():.0f}; a packed word lies in [0, 2^32)")
             return unpack_rgb(values.astype(np.uint32)), field, (field,)
-    word = values.dtype.str[0] + "u4"  # the same bytes as an unsigned word, NaN bits included
-    return unpack_rgb(np.ascontiguousarray(values).view(word).astype(np.uint32)), field, (field,)
+    return unpack_rgb(values), field, (field,)
 
 
 def read_pcd(path: str | Path, *, units: str = "m", drop_nan: bool = False
@@ -200,19 +199,14 @@ def write_pcd(path: str | Path, cloud: PointCloud, *, encoding: str = "binary",
     if dtype not in ("float64", "float32"):
         raise InvalidArgumentError(f"`dtype` must be 'float64' or 'float32'; got {dtype!r}")
     cloud, extras = _check_cloud_and_extras(cloud, extra_fields)
-    columns: list[NDArray[Any]] = [cloud.points[:, i].astype(dtype) for i in range(3)]
-    names, types = ["x", "y", "z"], [np.dtype(dtype)] * 3
+    fields = {a: cloud.points[:, i].astype(dtype) for i, a in enumerate("xyz")}
     if cloud.colors is not None:
         packed = pack_rgb(cloud.colors)
         # pypcd4 prints floats with "%.10f", which would turn packed-float bits into 0 in ascii.
-        columns.append(packed if encoding == "ascii" else packed.view(np.float32))
-        names.append("rgb")
-        types.append(packed.dtype if encoding == "ascii" else np.dtype(np.float32))
-    for name, values in extras.items():
-        columns.append(values)
-        names.append(name)
-        types.append(values.dtype)
-    pc = PcdCloud.from_points(columns, tuple(names), tuple(types))
+        fields["rgb"] = packed if encoding == "ascii" else packed.view(np.float32)
+    fields.update(extras)  # their names are none of the above (_check_cloud_and_extras)
+    columns = list(fields.values())
+    pc = PcdCloud.from_points(columns, tuple(fields), tuple(c.dtype for c in columns))
     pc.save(Path(path), encoding=Encoding(encoding))
 
 

@@ -142,19 +142,18 @@ def _read_vertices(path: Path, data: bytes) -> NDArray[Any]:
 
 
 def _skip_binary_element(path: Path, data: bytes, offset: int, element: _Element, fmt: str) -> int:
-    """Where the binary rows of ``element`` that start at ``offset`` end.
-
-    Fixed-size rows are skipped in one step; rows with lists with numpy when every row's lists have
-    the first row's lengths (a triangle mesh's faces), else row by row; a walk past the end of the
-    data stops there (truncated).
-    """
+    """Where the binary rows of ``element`` that start at ``offset`` end: fixed-size rows in one
+    step, rows with lists one by one; a walk past the end of the data stops there (truncated)."""
     order = ">" if fmt == "binary_big_endian" else "<"
     if not element.has_list:
         return offset + element.count * _vertex_dtype(path, element, fmt).itemsize
     end = len(data)
-
-    def row_end(start: int) -> int:
-        at = start
+    if element.count == 0 or offset >= end:
+        return offset + element.count  # a row takes at least a byte: too short, or empty
+    at = offset
+    for _ in range(element.count):
+        if at >= end:
+            return at + 1  # past the end: the caller reports the shortfall
         for count_code, code in element.layout:
             if count_code and at + int(count_code[1]) <= end:
                 n = int(np.frombuffer(data, order + count_code, 1, at)[0])
@@ -164,31 +163,6 @@ def _skip_binary_element(path: Path, data: bytes, offset: int, element: _Element
                 at += int(count_code[1]) + n * int(code[1])
             else:
                 at += int(count_code[1]) if count_code else int(code[1])
-        return at
-
-    if element.count == 0 or offset >= end:
-        return offset + element.count  # a row takes at least a byte: too short, or empty
-    first = row_end(offset)
-    width = first - offset
-    if offset + width * element.count <= end:
-        # Uniform rows: every list-count word must then hold the first row's value.
-        view = np.frombuffer(data, np.uint8, width * element.count, offset).reshape(-1, width)
-        at, uniform = 0, True
-        for count_code, code in element.layout:
-            size = int(count_code[1]) if count_code else int(code[1])
-            if count_code:
-                words = view[:, at : at + size].copy().view(order + count_code).ravel()
-                uniform = uniform and bool(np.all(words == words[0]))
-                at += size + int(words[0]) * int(code[1])
-            else:
-                at += size
-        if uniform:
-            return offset + width * element.count
-    at = offset
-    for _ in range(element.count):
-        if at >= end:
-            return at + 1  # past the end: the caller reports the shortfall
-        at = row_end(at)
     return at
 
 

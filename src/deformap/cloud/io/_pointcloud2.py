@@ -21,8 +21,8 @@ from numpy.typing import NDArray
 
 from deformap._validation import check_array, check_int, check_points
 from deformap.cloud._pointcloud import PointCloud
+from deformap.cloud.io._bag_reader import header_message, typestore
 from deformap.cloud.io._common import check_colors, check_units, finish_cloud, pack_rgb, unpack_rgb
-from deformap.cloud.io._ros import typestore
 from deformap.errors import FileFormatError, InvalidArgumentError
 
 __all__ = ["array_to_pointcloud2", "pointcloud2_colors", "pointcloud2_structured",
@@ -182,13 +182,10 @@ def array_to_pointcloud2(points: Any, *, colors: Any = None, frame_id: str = "wo
         table[a] = pts[:, i]
     if colors is not None:
         table["rgb"] = pack_rgb(cols)
-    header = types["std_msgs/msg/Header"](
-        stamp=types["builtin_interfaces/msg/Time"](sec=stamp // 10**9, nanosec=stamp % 10**9),
-        frame_id=frame_id)
     return types["sensor_msgs/msg/PointCloud2"](
-        header=header, height=1, width=pts.shape[0], fields=fields, is_bigendian=False,
-        point_step=table.dtype.itemsize, row_step=table.nbytes, data=table.view(np.uint8),
-        is_dense=True)
+        header=header_message(stamp, frame_id), height=1, width=pts.shape[0], fields=fields,
+        is_bigendian=False, point_step=table.dtype.itemsize, row_step=table.nbytes,
+        data=table.view(np.uint8), is_dense=True)
 
 
 def _packed_colors(where: str, table: NDArray[Any], field: str) -> NDArray[np.uint8]:
@@ -198,8 +195,7 @@ def _packed_colors(where: str, table: NDArray[Any], field: str) -> NDArray[np.ui
             f"{where}: colour field {field!r} must be one FLOAT32 or UINT32 word per point "
             f"(packed 0x00RRGGBB); got {column.dtype.itemsize}-byte {column.dtype.kind!r} values, "
             f"count {1 if column.ndim == 1 else column.shape[1]}")
-    # the word's bits in the message's byte order; as a float they may be NaN (an alpha byte)
-    return unpack_rgb(np.ascontiguousarray(column).view(column.dtype.str[0] + "u4").astype(np.uint32))
+    return unpack_rgb(column)
 
 
 def _separate_colors(where: str, table: NDArray[Any], present: list[str]) -> NDArray[Any]:
@@ -238,21 +234,6 @@ def pointcloud2_colors(msg: Any, *, where: str = "PointCloud2", table: Any = Non
     return out
 
 
-def _to_cloud(msg: Any, where: str, scale: float, frame: str, colors: bool
-              ) -> tuple[PointCloud, int]:  # fmt: skip
-    try:
-        table = pointcloud2_structured(msg)
-        xyz = xyz_with_holes(msg, table)
-    except InvalidArgumentError as exc:
-        raise FileFormatError(f"{where}: {str(exc).replace('`msg` ', '')}") from None
-    finite = np.isfinite(xyz).all(axis=1)
-    rgb = pointcloud2_colors(msg, where=where, table=table, valid=finite) if colors else None
-    dropped = int(finite.size - finite.sum())
-    xyz, rgb = xyz[finite], None if rgb is None else rgb[finite]
-    cloud, _ = finish_cloud(where, xyz, rgb, {}, scale=scale, drop_nan=False, frame=frame)
-    return cloud, dropped
-
-
 def pointcloud2_to_cloud(msg: Any, *, where: str, units: str = "m", frame: str | None = None,
                          colors: bool = True) -> tuple[PointCloud, int]:
     """A PointCloud2 as a :class:`~deformap.cloud.PointCloud` under the file readers' rules,
@@ -262,5 +243,15 @@ def pointcloud2_to_cloud(msg: Any, *, where: str, units: str = "m", frame: str |
     when empty); ``colors`` reads the message's colours (:func:`pointcloud2_colors`).
     """
     scale = check_units(units)
-    name = (msg.header.frame_id or "sensor") if frame is None else frame
-    return _to_cloud(msg, where, scale, name, colors)
+    try:
+        table = pointcloud2_structured(msg)
+        xyz = xyz_with_holes(msg, table)
+    except InvalidArgumentError as exc:
+        raise FileFormatError(f"{where}: {str(exc).replace('`msg` ', '')}") from None
+    finite = np.isfinite(xyz).all(axis=1)
+    rgb = pointcloud2_colors(msg, where=where, table=table, valid=finite) if colors else None
+    dropped = int(finite.size - finite.sum())
+    xyz, rgb = xyz[finite], None if rgb is None else rgb[finite]
+    frame = (msg.header.frame_id or "sensor") if frame is None else frame
+    cloud, _ = finish_cloud(where, xyz, rgb, {}, scale=scale, drop_nan=False, frame=frame)
+    return cloud, dropped

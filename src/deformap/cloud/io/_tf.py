@@ -1,4 +1,4 @@
-"""The transforms of a raw recording (``/tf`` and ``/tf_static``), looked up at any time.
+"""The transforms of a bag (``/tf`` and ``/tf_static``), looked up at any time.
 
 Each TransformStamped gives ``child2parent`` at its stamp. A lookup composes the edges from each
 frame up to their common ancestor, each interpolated at the times asked as ``tf2`` does
@@ -14,17 +14,14 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from deformap.cloud.io._bag_reader import header_stamp_ns
 from deformap.errors import FileFormatError
 
-__all__ = ["MAX_TRANSLATION_M", "TransformGap", "TransformTree"]
+__all__ = ["MAX_TRANSLATION_M", "TransformTree"]
 
 #: The farthest [m] a transform may move a frame (a UTM map frame holds a few 10⁶ m): a larger
 #: or non-finite translation is a damaged message.
 MAX_TRANSLATION_M = 1e9
-
-
-class TransformGap(FileFormatError):
-    """No transform sample within the tolerance of a wanted time (names the frame and the gap)."""
 
 
 @dataclass
@@ -75,16 +72,15 @@ class TransformTree:
                 raise FileFormatError(
                     f"{where}: frame {child!r} has two parents, {edge.parent!r} and {parent!r}")
             edge.static = edge.static and static
-            stamp = int(tf.header.stamp.sec) * 10**9 + int(tf.header.stamp.nanosec)
-            edge.stamps.append(stamp)
+            edge.stamps.append(header_stamp_ns(tf.header))
             edge.translations.append(trans)
             edge.quaternions.append(quat)
         self._series.clear()
 
     @property
     def frames(self) -> list[str]:
-        names = set(self._edges) | {e.parent for e in self._edges.values()}
-        return sorted(names)
+        """Every frame named, child or parent."""
+        return sorted(set(self._edges) | {e.parent for e in self._edges.values()})
 
     def _chain(self, frame: str) -> list[str]:
         """``frame`` and its ancestors up to the root."""
@@ -115,12 +111,11 @@ class TransformTree:
 
         edge, series = self._edges[child], self._edge_series(child)
         n = times_ns.size
+        if not edge.static:
+            self._check_gap(child, series.stamps, times_ns, what)
         if edge.static or series.stamps.size == 1:
-            if not edge.static:
-                self._check_gap(child, series.stamps, times_ns, what)
             mat = series.rotations[-1].as_matrix()
             return np.broadcast_to(mat, (n, 3, 3)).copy(), np.tile(series.translations[-1], (n, 1))
-        self._check_gap(child, series.stamps, times_ns, what)
         t = np.clip(times_ns, series.stamps[0], series.stamps[-1])
         rel = (t - series.stamps[0]).astype(np.float64)
         knots = (series.stamps - series.stamps[0]).astype(np.float64)
@@ -137,7 +132,7 @@ class TransformTree:
         gap = np.minimum(np.abs(times - before), np.abs(times - after))
         worst = int(np.argmax(gap))
         if gap[worst] > self.tolerance_ns:
-            raise TransformGap(
+            raise FileFormatError(
                 f"{what}: topic {self.topic!r} has no transform {self._edges[child].parent!r} -> "
                 f"{child!r} within {self.tolerance_ns / 1e9:g} s of t = "
                 f"{(times[worst] - self.origin_ns) / 1e9:.3f} s "
@@ -151,15 +146,16 @@ class TransformTree:
         Raises
         ------
         FileFormatError
-            An unknown frame, or two frames not connected; :class:`TransformGap` when a dynamic edge has
-            no sample within the tolerance of a time.
+            An unknown frame, two frames not connected, or a dynamic edge without a sample
+            within the tolerance of a time.
         """
         times = np.atleast_1d(np.asarray(times_ns, dtype=np.int64))
         for frame in (target, source):
-            if frame not in self._edges and frame not in {e.parent for e in self._edges.values()}:
+            if frame not in self.frames:
                 raise FileFormatError(
                     f"{what}: no frame {frame!r} on {self.topic!r} or its static topic "
                     f"(frames: {self.frames})")
+
         up_source, up_target = self._chain(source), self._chain(target)
         if up_source[-1] != up_target[-1]:
             raise FileFormatError(
