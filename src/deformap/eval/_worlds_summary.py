@@ -45,7 +45,7 @@ from numpy.typing import NDArray
 from deformap.errors import InvalidArgumentError
 from deformap.eval._world_draw import PRIORS
 from deformap.eval._world_result import WorldResult
-from deformap.eval._worlds_paired import arm_stats, markdown_paired, paired_difference
+from deformap.eval._worlds_paired import _fmt, arm_stats, markdown_paired, paired_difference
 
 __all__ = [
     "CSV_COLUMNS",
@@ -305,10 +305,6 @@ def accuracy_curves(results: Sequence[WorldResult],
             out.setdefault(family, {})[combination_name(*combination)] = (
                 np.array(chosen).reshape(-1, max_pokes))
     return out
-
-
-def _fmt(value: Any, spec: str) -> str:
-    return "–" if value is None else format(value, spec)
 
 
 def _interval(ci: Sequence[float] | None) -> str:
