@@ -13,7 +13,7 @@ import logging
 import os
 import sys
 import tempfile
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from functools import wraps
 from pathlib import Path
 from typing import Annotated, Any, NoReturn, TypeVar
@@ -21,6 +21,7 @@ from typing import Annotated, Any, NoReturn, TypeVar
 import typer
 from rich.console import Console
 from rich.markup import escape
+from rich.table import Table
 from rich.text import Text
 from typer.core import TyperGroup
 
@@ -29,8 +30,9 @@ from deformap._files import check_destination
 from deformap.errors import ConfigError, DeformapError, InvalidArgumentError
 
 __all__ = [
-    "JsonOption", "VarianceMaxOption", "app", "check_positive_options", "console", "emit_json",
-    "err_console", "fail", "friendly_errors", "labelled", "out_console", "warn",
+    "JsonOption", "VarianceMaxOption", "app", "cell", "check_positive_options", "console",
+    "emit_json", "err_console", "fail", "friendly_errors", "labelled", "out_console", "table",
+    "warn",
 ]
 
 PIPE_WIDTH = 400
@@ -54,6 +56,25 @@ err_console = _console(stderr=True)
 def labelled(label: str, style: str, text: str) -> Text:
     """``label`` in ``style``, a space, then ``text`` as it is (no markup)."""
     return Text.assemble((label, style), " ", text)
+
+
+def cell(value: Any, spec: str) -> str:
+    """``value`` formatted by ``spec``; ``–`` for None."""
+    return "–" if value is None else format(value, spec)
+
+
+def table(title: str, columns: Sequence[str], rows: Sequence[Sequence[str]], *,
+          left: Sequence[str] = (), no_wrap: bool = True) -> Table:
+    """A table of ``rows``: the ``left`` columns (names, ``no_wrap``) left, the others right."""
+    out = Table(title=title)
+    for col in columns:
+        if col in left:
+            out.add_column(col, no_wrap=no_wrap)
+        else:
+            out.add_column(col, justify="right")
+    for row in rows:
+        out.add_row(*row)
+    return out
 
 
 def fail(message: str) -> NoReturn:

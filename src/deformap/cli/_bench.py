@@ -3,7 +3,6 @@
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from pathlib import Path
 from typing import Annotated, Any
 
@@ -12,7 +11,15 @@ import typer
 from rich.table import Table
 
 from deformap import eval as evaluation
-from deformap.cli._app import JsonOption, app, emit_json, friendly_errors, out_console
+from deformap.cli._app import (
+    JsonOption,
+    app,
+    cell,
+    emit_json,
+    friendly_errors,
+    out_console,
+    table,
+)
 from deformap.cli._progress import progress, run_hooks
 
 __all__ = ["bench_app"]
@@ -26,15 +33,6 @@ SeedOption = Annotated[int, typer.Option(help="Seed of the synthetic data.")]
 QuickOption = Annotated[bool, typer.Option(help="Smaller sizes (a smoke run).")]
 
 
-def _table(title: str, columns: Sequence[str], rows: Sequence[Sequence[str]]) -> Table:
-    table = Table(title=title)
-    for col in columns:
-        table.add_column(col, justify="right")
-    for row in rows:
-        table.add_row(*row)
-    return table
-
-
 @bench_app.command("speed")
 @friendly_errors
 def bench_speed(json_path: JsonOption = None, seed: SeedOption = 0, quick: QuickOption = False) -> None:
@@ -44,13 +42,13 @@ def bench_speed(json_path: JsonOption = None, seed: SeedOption = 0, quick: Quick
     with progress(shown, "timing the surface GP and the β sweep"):
         gp_rows = evaluation.bench_surface_gp((1000, 2000) if quick else (3000, 6000, 12000), rng=rng)
         sweep = evaluation.bench_beta_sweep(n_particles_side=20 if quick else 40, rng=rng)
-    shown.print(_table(
+    shown.print(table(
         "surface GP → mean and std on the 120×80 grid (σw 4 cm, σn 2 mm)",
         ("points", "exact [s]", "grid [s]", "speed-up", "max |Δmean| [µm]", "max Δstd [%]"),
         [(str(r["n_points"]), f"{r['exact_s']:.3f}", f"{r['grid_s']:.3f}", f"{r['speedup']:.0f}×",
           f"{r['max_mean_dev_m'] * 1e6:.2f}", f"{r['max_rel_std_dev'] * 100:.3f}") for r in gp_rows],
     ))  # fmt: skip
-    shown.print(_table(
+    shown.print(table(
         "β estimation (converged, 3×3 clusters)",
         ("β values", "particles", "batched [s]", "per-β loop [s]", "speed-up"),
         [(str(sweep["n_beta"]), str(sweep["n_particles"]), f"{sweep['batched_s']:.3f}",
@@ -85,7 +83,7 @@ def bench_world_command(
              f"≤ {goals[key]:g} s" if key in goals
              else "baseline of press_s" if key == "press_load_by_load_s" else "")
             for key, value in result.items() if key != "scenario"]  # fmt: skip
-    shown.print(_table(f"simulated world: {result['scenario']}", ("measure", "value", "goal"), rows))
+    shown.print(table(f"simulated world: {result['scenario']}", ("measure", "value", "goal"), rows))
     emit_json(json_path, result)
 
 
@@ -101,7 +99,7 @@ def bench_io_command(
         row = evaluation.bench_io(n_points=300_000, rng=np.random.default_rng(seed))
     rows = [(key, f"{value:.4f}") for key, value in row.items()
             if isinstance(value, float) and key != "goal_s"]  # fmt: skip
-    shown.print(_table("reading 300,000 points (best of repeats; goal < 0.5 s each)",
+    shown.print(table("reading 300,000 points (best of repeats; goal < 0.5 s each)",
                        ("what", "seconds"), rows))  # fmt: skip
     emit_json(json_path, row)
 
@@ -122,7 +120,7 @@ def _memory_table(title: str, rows: list[dict[str, Any]], size_label: str) -> Ta
         added = "n/a" if r["rss_added_mib"] is None else f"{r['rss_added_mib']:.1f}"
         cells.append((f"{r['size']:,}", r["case"].split("-", 1)[1], f"{r['traced_peak_mib']:.1f}",
                       added, f"{r['seconds']:.2f}", base_text, ratio))  # fmt: skip
-    return _table(title, (size_label, "path", "traced [MiB]", "RSS+ [MiB]", "time [s]",
+    return table(title, (size_label, "path", "traced [MiB]", "RSS+ [MiB]", "time [s]",
                           "baseline [MiB]", "vs baseline"), cells)  # fmt: skip
 
 
@@ -220,19 +218,13 @@ def bench_worlds_command(
 def _show_worlds_summary(shown: Any, output: Any, worlds: int, max_pokes: int,
                          json_path: Path | None) -> None:
     summary = output.summary
-    rows = []
-    for name, s in summary["strategies"].items():
-        pokes, stay = s["median_pokes_to_accuracy_0.9"], s["median_pokes_to_stay_0.9"]
-        final, error = s["final_accuracy_median"], s["modulus_error_median"]
-        mean = s.get("mean_pokes_to_accuracy_0.9")
-        rows.append((name + (" (best)" if name == summary["best"] else ""), str(s["worlds"]),
-                     "–" if pokes is None else f"{pokes:g}",
-                     "–" if mean is None else f"{mean:.1f}",
-                     "–" if stay is None else f"{stay:g}",
-                     "–" if s["share_reaching_0.9"] is None else f"{s['share_reaching_0.9']:.0%}",
-                     "–" if final is None else f"{final:.3f}",
-                     "–" if error is None else f"{error:.2f}"))  # fmt: skip
-    shown.print(_table(
+    rows = [(name + (" (best)" if name == summary["best"] else ""), str(s["worlds"]),
+             cell(s["median_pokes_to_accuracy_0.9"], "g"),
+             cell(s.get("mean_pokes_to_accuracy_0.9"), ".1f"),
+             cell(s["median_pokes_to_stay_0.9"], "g"), cell(s["share_reaching_0.9"], ".0%"),
+             cell(s["final_accuracy_median"], ".3f"), cell(s["modulus_error_median"], ".2f"))
+            for name, s in summary["strategies"].items()]  # fmt: skip
+    shown.print(table(
         f"{len(rows)} combinations over {worlds} worlds, {max_pokes} pokes "
         f"(a world never at 0.9 counts {max_pokes + 1}; best: fewest mean pokes)",
         ("strategy/field/cut", "worlds", "median pokes to 0.9", "mean", "to stay", "reach 0.9",
@@ -244,33 +236,17 @@ def _show_worlds_summary(shown: Any, output: Any, worlds: int, max_pokes: int,
     emit_json(json_path, summary)
 
 
-def _cell(value: Any, spec: str) -> str:
-    return "–" if value is None else format(value, spec)
-
-
-def _arms(entry: dict[str, Any], key: str, spec: str) -> str:
-    """``blind / prior`` of one statistic of ``summary["appearance"]``'s ``entry``."""
-    return f"{_cell((entry['blind'] or {}).get(key), spec)} / {_cell(entry['prior'][key], spec)}"
-
-
 def _show_paired(shown: Any, summary: dict[str, Any]) -> None:
     """The appearance families, where one was mapped blind beside the prior: one row per family ×
     combination."""
+    from deformap.eval._worlds_paired import paired_cells
+
     families = summary.get("appearance", {})
     if not any(e["blind"] for per in families.values() for e in per.values()):
         return
-    rows = []
-    for family, per in families.items():
-        for name, e in per.items():
-            ci = e["mean_pokes_difference_ci95"]
-            rows.append((family, name, str(e["prior"]["worlds"]),
-                         _arms(e, "median_pokes_to_accuracy_0.9", "g"),
-                         _arms(e, "mean_pokes_to_accuracy_0.9", ".1f"),
-                         _cell(e["mean_pokes_difference"], "+.2f")
-                         + ("" if ci is None else f" ({ci[0]:+.2f} to {ci[1]:+.2f})"),
-                         _arms(e, "final_accuracy_median", ".3f"),
-                         _arms(e, "share_right_count", ".0%")))  # fmt: skip
-    shown.print(_table(
+    rows = [(family, name, *paired_cells(e)) for family, per in families.items()
+            for name, e in per.items()]
+    shown.print(table(
         "appearance: blind / prior on the same worlds and presses (difference: prior − blind, "
         "mean over worlds, 95 % t interval)",
         ("appearance", "strategy/field/cut", "worlds", "median pokes to 0.9", "mean",

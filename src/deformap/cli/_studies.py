@@ -6,16 +6,17 @@ from pathlib import Path
 from typing import Annotated, Any
 
 import typer
-from rich.table import Table
 
 from deformap import run
 from deformap.cli._app import (
     JsonOption,
     app,
+    cell,
     check_positive_options,
     emit_json,
     friendly_errors,
     out_console,
+    table,
 )
 from deformap.cli._progress import progress, run_hooks
 from deformap.errors import InvalidArgumentError
@@ -105,20 +106,15 @@ def study_hardness(
 def _print_single(shown: Any, study: dict[str, Any]) -> None:
     """One condition's study: a row per protocol and foam, then what the checks found."""
     where = ", ".join(f"{study[k]}" for k in ("camera", "physics") if k in study)
-    table = Table(title=f"β and E against hardness{f' ({where})' if where else ''}")
-    table.add_column("protocol", no_wrap=True)  # the row's name, never cut
-    for col in ("hardness [N]", "β", "β spread", "β uncertainty", "fit error [mm]",
-                "E [kPa]", "true E [kPa]"):
-        table.add_column(col, justify="right")
-    for r in study["rows"]:
-        if r.get("refused"):
-            table.add_row(r["protocol"], _hardness(r["hardness_n"]), "refused", *["–"] * 4,
-                          _kpa(r, "true_modulus_pa"))  # fmt: skip
-            continue
-        table.add_row(r["protocol"], _hardness(r["hardness_n"]), f"{r['beta']:.3f}",
-                      f"{r['beta_std']:.3f}", f"{r['beta_estimate_std']:.3f}",
-                      f"{r['fit_error_m'] * 1e3:.3f}", _kpa(r), _kpa(r, "true_modulus_pa"))  # fmt: skip
-    shown.print(table)
+    rows = [(r["protocol"], _hardness(r["hardness_n"]), "refused", *["–"] * 4,
+             _kpa(r, "true_modulus_pa")) if r.get("refused")
+            else (r["protocol"], _hardness(r["hardness_n"]), f"{r['beta']:.3f}",
+                  f"{r['beta_std']:.3f}", f"{r['beta_estimate_std']:.3f}",
+                  f"{r['fit_error_m'] * 1e3:.3f}", _kpa(r), _kpa(r, "true_modulus_pa"))
+            for r in study["rows"]]  # fmt: skip
+    shown.print(table(f"β and E against hardness{f' ({where})' if where else ''}",
+                      ("protocol", "hardness [N]", "β", "β spread", "β uncertainty",
+                       "fit error [mm]", "E [kPa]", "true E [kPa]"), rows, left=("protocol",)))
     for reason in dict.fromkeys(r["refused"] for r in study["rows"] if r.get("refused")):
         shown.print(f"  refused: {reason}", highlight=False)
     for name, ok in study["monotone"].items():
@@ -132,41 +128,30 @@ def _print_single(shown: Any, study: dict[str, Any]) -> None:
                     "these checks", highlight=False)  # fmt: skip
 
 
-def _pct(value: float | None) -> str:
-    return "–" if value is None else f"{value:.1%}"
-
-
 def _yes(value: bool | None) -> str:
     return "–" if value is None else ("yes" if value else "NO")
 
 
 def _print_summary(shown: Any, study: dict[str, Any]) -> None:
     """The full study's summary: one line per condition, then one per physics."""
-    table = Table(title="E and β against hardness, per condition (force/quadratic rows)")
-    table.add_column("camera", no_wrap=True)
-    table.add_column("H [m]", justify="right")  # the foam's thickness
-    table.add_column("physics", no_wrap=True)
-    for col in ("median |E err|", "E within 2σ", "E monotone, rigid", "β monotone",
-                "β σ claimed / spread", "refused"):
-        table.add_column(col, justify="right")
-    for e in study["summary"]:
-        beta = ("–" if e["beta_claimed_std"] is None or e["beta_spread"] is None
-                else f"{e['beta_claimed_std']:.3f} / {e['beta_spread']:.3f}")  # fmt: skip
-        table.add_row(e["camera"], f"{e['thickness_m']:g}", e["physics"],
-                      _pct(e["modulus_median_abs_rel_error"]), _pct(e["modulus_within_2sigma"]),
-                      _yes(e["modulus_monotone"]), _yes(e["beta_monotone"]), beta,
-                      f"{e['n_refused']}")  # fmt: skip
-    shown.print(table)
-    overall = Table(title="over every condition, per physics")
-    for col in ("physics", "presses", "unread", "median |E err|", "E within 2σ",
-                "E monotone everywhere", "β monotone everywhere", "refused"):
-        overall.add_column(col, justify="left" if col == "physics" else "right")
-    for o in study["overall"]:
-        overall.add_row(o["physics"], f"{o['n_presses']}", f"{o['n_unread']}",
-                        _pct(o["modulus_median_abs_rel_error"]), _pct(o["modulus_within_2sigma"]),
-                        _yes(o["modulus_monotone"]), _yes(o["beta_monotone"]),
-                        f"{o['n_refused']}")  # fmt: skip
-    shown.print(overall)
+    rows = [(e["camera"], f"{e['thickness_m']:g}", e["physics"],
+             cell(e["modulus_median_abs_rel_error"], ".1%"), cell(e["modulus_within_2sigma"], ".1%"),
+             _yes(e["modulus_monotone"]), _yes(e["beta_monotone"]),
+             "–" if e["beta_claimed_std"] is None or e["beta_spread"] is None
+             else f"{e['beta_claimed_std']:.3f} / {e['beta_spread']:.3f}", f"{e['n_refused']}")
+            for e in study["summary"]]  # fmt: skip
+    shown.print(table("E and β against hardness, per condition (force/quadratic rows)",
+                      ("camera", "H [m]", "physics", "median |E err|", "E within 2σ",
+                       "E monotone, rigid", "β monotone", "β σ claimed / spread", "refused"),
+                      rows, left=("camera", "physics")))  # H: the foam's thickness
+    overall = [(o["physics"], f"{o['n_presses']}", f"{o['n_unread']}",
+                cell(o["modulus_median_abs_rel_error"], ".1%"),
+                cell(o["modulus_within_2sigma"], ".1%"), _yes(o["modulus_monotone"]),
+                _yes(o["beta_monotone"]), f"{o['n_refused']}") for o in study["overall"]]
+    shown.print(table("over every condition, per physics",
+                      ("physics", "presses", "unread", "median |E err|", "E within 2σ",
+                       "E monotone everywhere", "β monotone everywhere", "refused"),
+                      overall, left=("physics",), no_wrap=False))
 
 
 @study_app.command("cluster-size")
@@ -183,13 +168,10 @@ def study_cluster_size(
     shown = out_console(json_path)
     with progress(shown) as bar:
         output = run.run_cluster_size_study(out, seed=seed, coarse=coarse, hooks=run_hooks(bar))
-    table = Table(title="fit error against cluster size")
-    for col in ("k×k", "hardness [N]", "β", "fit error [mm]"):
-        table.add_column(col, justify="right")
-    for r in output.study["rows"]:
-        table.add_row(f"{r['cluster_size']}", _hardness(r["hardness_n"]), f"{r['beta']:.3f}",
-                      f"{r['fit_error_m'] * 1e3:.3f}")  # fmt: skip
-    shown.print(table)
+    rows = [(f"{r['cluster_size']}", _hardness(r["hardness_n"]), f"{r['beta']:.3f}",
+             f"{r['fit_error_m'] * 1e3:.3f}") for r in output.study["rows"]]
+    shown.print(table("fit error against cluster size",
+                      ("k×k", "hardness [N]", "β", "fit error [mm]"), rows))
     shown.print(f"wrote {' and '.join(map(str, output.files))}", highlight=False)
     emit_json(json_path, output.study)
 
@@ -215,7 +197,7 @@ def reproduce_command(
     shown = out_console(json_path)
 
     def show(row: dict[str, Any]) -> None:
-        tau = "–" if row["kendall_tau"] is None else f"{row['kendall_tau']:.2f}"
+        tau = cell(row["kendall_tau"], ".2f")
         shown.print(f"  {row['scenario']:<28} pokes {row['pokes']:>2}  regions "
                     f"{row['regions_found']}/{row['regions_true']}  accuracy {row['accuracy']:.3f}"
                     f"  τ {tau}  {row['time_s']:.1f} s", highlight=False)

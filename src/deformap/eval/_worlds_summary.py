@@ -45,7 +45,7 @@ from numpy.typing import NDArray
 from deformap.errors import InvalidArgumentError
 from deformap.eval._world_draw import PRIORS
 from deformap.eval._world_result import WorldResult
-from deformap.eval._worlds_paired import arm_stats, markdown_paired, paired_difference
+from deformap.eval._worlds_paired import _fmt, arm_stats, markdown_paired, paired_difference
 
 __all__ = [
     "CSV_COLUMNS",
@@ -216,15 +216,11 @@ def _stats(entries: list[dict[str, Any]], max_pokes: int) -> dict[str, Any]:
 def summarise_worlds(results: Sequence[WorldResult],
                      combinations: Sequence[tuple[str, str, str]], max_pokes: int,
                      arms: Sequence[Arm] = PLAIN_ARMS) -> dict[str, Any]:
-    """``summary.json``: ``{"strategies": {NAME: {"median_pokes_to_accuracy_0.9",
-    "final_accuracy_median", "modulus_error_median", "worlds", "by_family": {FAMILY: …}}}}``
-    (NAME a :func:`combination_name`; each entry also has ``mean_pokes_to_accuracy_0.9``,
-    ``median_pokes_ci95``, ``median_pokes_to_stay_0.9``, ``share_reaching_0.9`` and counts its
-    ``failed`` worlds), with ``best`` (the fewest mean pokes, then the fewest median pokes, then
-    the highest final accuracy: module docstring), ``max_pokes``, ``failed_worlds`` (index and
-    error of each world that failed twice) and ``appearance`` (:func:`_appearance`); ``arms``
-    the ``(appearance, prior)`` each world was mapped under, ``strategies`` counting each world
-    once per appearance family, under the prior."""
+    """``summary.json``: ``{"strategies": {NAME: {STAT: …, "by_family": {FAMILY: {STAT: …}}}}}``
+    (NAME a :func:`combination_name`, STAT the keys of :func:`_stats`) with ``best`` (module
+    docstring), ``max_pokes``, ``failed_worlds`` (index and error of each world that failed twice)
+    and ``appearance`` (:func:`_appearance`); ``arms`` the ``(appearance, prior)`` each world was
+    mapped under, ``strategies`` counting each world once per appearance family, under the prior."""
     # by index, whatever order the worlds finished in
     results = sorted(results, key=lambda r: int(r.world["index"]))
     strategies: dict[str, Any] = {}
@@ -305,10 +301,6 @@ def accuracy_curves(results: Sequence[WorldResult],
             out.setdefault(family, {})[combination_name(*combination)] = (
                 np.array(chosen).reshape(-1, max_pokes))
     return out
-
-
-def _fmt(value: Any, spec: str) -> str:
-    return "–" if value is None else format(value, spec)
 
 
 def _interval(ci: Sequence[float] | None) -> str:
