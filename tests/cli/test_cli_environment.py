@@ -89,7 +89,7 @@ def test_a_users_environment_is_explored_with_every_output(robot_folder: Path) -
     (["--environment", ".my_robot_env:make"], r"an absolute module name"),
     (["--environment", "my_broken_env:make"], r"cannot import 'my_broken_env' \(RuntimeError: "
                                               r"no driver"),
-    (["--environment", "my_robot_env:offline"], r"offline\(\) failed \(ConnectionError: robot"),
+    (["--environment", "my_robot_env:offline"], r"offline\(\) raised ConnectionError: robot offline"),
     (["--environment", "my_robot_env:make", "--env-arg", "scale=.nan"],
      r"--env-arg 'scale' must be finite"),
     (["--environment", "my_robot_env:make", "--scenario", "homogeneous-60"],
