@@ -190,3 +190,23 @@ def test_an_off_target_press_is_kept_with_a_warning_when_the_config_says_so(fold
     assert result.exit_code == 0, result.output
     assert "30.0 mm from the target (tolerance 5.0 mm" in result.stderr
     assert "kept (robot.off_target: warn)" in result.stderr
+
+
+def test_ctrl_c_while_the_robot_works_stops_as_cleanly() -> None:
+    import _thread
+    import threading
+
+    from deformap.run._robot import GuardedEnvironment, RobotConfig, RobotFault
+
+    env = GuardedEnvironment("lab.arm:make", RobotConfig(call_timeout_s=30.0))
+    done = threading.Event()
+
+    def slow_press() -> None:
+        _thread.interrupt_main()  # as Ctrl-C in the terminal, while the main thread waits
+        done.wait(10.0)
+
+    with pytest.raises(RobotFault, match=r"^--environment lab.arm:make: interrupted during "
+                                         r"press\(\)$") as info:  # fmt: skip
+        env.call("press()", slow_press)
+    done.set()
+    assert info.value.exit_code == 130

@@ -86,8 +86,11 @@ class GuardedEnvironment:
                 box["error"] = exc
 
         worker = threading.Thread(target=work, name=f"deformap robot {what}", daemon=True)
-        worker.start()
-        worker.join(self.config.call_timeout_s)
+        try:
+            worker.start()
+            worker.join(self.config.call_timeout_s)
+        except KeyboardInterrupt as exc:  # Ctrl-C while the robot works: the same clean stop
+            raise RobotFault(f"--environment {self.spec}: interrupted during {what}", exc) from None
         if worker.is_alive():
             raise RobotFault(f"--environment {self.spec}: {what} did not return within "
                              f"{self.config.call_timeout_s:g} s (robot.call_timeout_s); "
