@@ -31,6 +31,10 @@ def not_an_environment():
 def offline():
     raise ConnectionError("robot offline")
 
+def quits():
+    import sys
+    sys.exit(0)
+
 VALUE = 3
 '''
 
@@ -89,7 +93,8 @@ def test_a_users_environment_is_explored_with_every_output(robot_folder: Path) -
     (["--environment", ".my_robot_env:make"], r"an absolute module name"),
     (["--environment", "my_broken_env:make"], r"cannot import 'my_broken_env' \(RuntimeError: "
                                               r"no driver"),
-    (["--environment", "my_robot_env:offline"], r"offline\(\) failed \(ConnectionError: robot"),
+    (["--environment", "my_robot_env:offline"], r"offline\(\) raised ConnectionError: robot offline"),
+    (["--environment", "my_robot_env:quits"], r"quits\(\) called sys.exit\(0\)"),
     (["--environment", "my_robot_env:make", "--env-arg", "scale=.nan"],
      r"--env-arg 'scale' must be finite"),
     (["--environment", "my_robot_env:make", "--scenario", "homogeneous-60"],

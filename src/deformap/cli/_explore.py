@@ -17,11 +17,13 @@ from deformap.cli._app import (
     app,
     check_positive_options,
     emit_json,
+    err_console,
     friendly_errors,
+    labelled,
     out_console,
 )
 from deformap.cli._progress import modulus_text, progress, run_hooks
-from deformap.errors import ConfigError
+from deformap.errors import ConfigError, DeformapError
 
 if TYPE_CHECKING:  # the CLI loads the estimator only when a command runs
     from deformap.explore import PokeRecord
@@ -185,18 +187,23 @@ def _explore_environment(environment: str | None, env_args: list[str], scenario:
     if environment is None:
         raise ConfigError("--env-arg goes with --environment package.module:factory; got no "
                           "--environment")
-    if scenario is not None or resume is not None or rerun:
-        given = [n for n, v in (("--scenario", scenario), ("--resume", resume),
-                                ("--rerun", rerun)) if v]  # fmt: skip
+    if scenario is not None or rerun:
+        given = [n for n, v in (("--scenario", scenario), ("--rerun", rerun)) if v]
         raise ConfigError(f"--environment runs without {', '.join(given)}: a simulated world's "
-                          "options (resume and rerun recordings are for simulated runs)")
-    cfg = run.explore_run_config(config, overrides, None)
+                          "options (rerun recordings are for simulated runs)")
+    cfg = run.explore_run_config(config, overrides, resume)
     args = run.parse_env_args(env_args)
     shown = out_console(json_path)
-    with progress(shown) as bar:
-        report, folder = run.explore_environment(environment, args, cfg, out,
-                                                 hooks=run_hooks(bar, poke_row=poke_row),
-                                                 variance_max=variance_max)
+    try:
+        with progress(shown) as bar:
+            report, folder = run.explore_environment(
+                environment, args, cfg, resume or out, resume=resume is not None,
+                hooks=run_hooks(bar, poke_row=poke_row), variance_max=variance_max)
+    except DeformapError as exc:  # a KeyboardInterrupt in the robot's code: 130, as a shell's
+        if getattr(exc, "exit_code", 2) != 130:
+            raise
+        err_console.print(labelled("error:", "bold red", str(exc)), soft_wrap=True)
+        raise typer.Exit(130) from None
     regions = report["regions"]
     found = "no region map" if regions is None else f"{len(regions['class_betas'])} region(s)"
     shown.print(f"{report['n_pokes']} pokes (stopped by {report['stop_reason']}), {found}, "

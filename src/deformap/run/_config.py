@@ -18,6 +18,7 @@ from deformap.cloud.io import path_kind
 from deformap.errors import ConfigError
 from deformap.explore import ExplorationConfig
 from deformap.replay import RecordedSession
+from deformap.run._robot import RobotConfig
 from deformap.world import WorldConfig
 
 __all__ = [
@@ -45,12 +46,15 @@ class RunConfig:
         The simulated world's physics, camera and layout settings.
     exploration : ExplorationConfig
         The mapper's and the exploration loop's settings.
+    robot : RobotConfig
+        How ``explore --environment`` guards a user's robot.
     """
 
     scenario: str = "heterogeneous-60-110-rigid"
     seed: int = setting(0, ge=0)
     world: WorldConfig = field(default_factory=WorldConfig)
     exploration: ExplorationConfig = field(default_factory=ExplorationConfig)
+    robot: RobotConfig = field(default_factory=RobotConfig)
 
     def __post_init__(self) -> None:
         check_settings(self)

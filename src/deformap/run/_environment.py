@@ -3,7 +3,8 @@
 ``deformap explore --environment package.module:factory --env-arg key=value …`` imports
 ``package.module`` (installed, or in the current folder), calls ``factory(**args)`` with each
 value read as a YAML scalar, and explores what it returns as the simulated world is explored
-(the report without the ground-truth metrics). Importing runs the module's code, as any import.
+(the report without the ground-truth metrics), each call to the robot guarded
+(:mod:`deformap.run._robot`). Importing runs the module's code, as any import.
 """
 
 from __future__ import annotations
@@ -21,14 +22,22 @@ import yaml
 from deformap import __version__
 from deformap._config import config_to_dict
 from deformap._validation import check_positive
-from deformap.environment import Environment
 from deformap.errors import ConfigError
-from deformap.explore import Journal, check_exploration_budget, explore
+from deformap.explore import (
+    JOURNAL_NAME,
+    Journal,
+    PokeRecord,
+    check_exploration_budget,
+    explore,
+    read_journal,
+)
 from deformap.run._config import CONFIG_NAME, RunConfig, config_yaml, run_generators
+from deformap.run._explore import resume_journal
 from deformap.run._export import poke_writer, write_run_results
 from deformap.run._folder import create_run_folder, default_run_folder, write_text
 from deformap.run._hooks import NO_HOOKS, RunHooks, RunStart
 from deformap.run._report import shared_report
+from deformap.run._robot import GuardedEnvironment, RobotConfig, RobotFault
 
 __all__ = ["explore_environment", "load_environment", "parse_env_args"]
 
@@ -52,8 +61,10 @@ def parse_env_args(pairs: Sequence[str]) -> dict[str, Any]:
     return args
 
 
-def load_environment(spec: str, args: dict[str, Any]) -> Environment:
-    """Import ``package.module:factory`` and return ``factory(**args)``, an Environment."""
+def load_environment(spec: str, args: dict[str, Any],
+                     config: RobotConfig | None = None) -> GuardedEnvironment:
+    """Import ``package.module:factory`` and build ``factory(**args)``, guarded by ``config``
+    (:mod:`deformap.run._robot`); what does not load is a :class:`ConfigError`."""
     module_name, sep, attr = spec.partition(":")
     if not sep or not module_name or not attr or module_name.startswith("."):
         raise ConfigError(f"--environment must be package.module:factory (an absolute module "
@@ -62,55 +73,63 @@ def load_environment(spec: str, args: dict[str, Any]) -> Environment:
         sys.path.append(str(Path.cwd()))  # a module beside the user, after the installed ones
     try:
         module = importlib.import_module(module_name)
-    except Exception as exc:  # the user's module: whatever it raises is one line here
+    except (Exception, SystemExit) as exc:  # the user's module: whatever it raises is one line
         raise ConfigError(f"--environment {spec!r}: cannot import {module_name!r} "
                           f"({type(exc).__name__}: {exc})") from None
     factory = getattr(module, attr, None)
     if not callable(factory):
         raise ConfigError(f"--environment {spec!r}: {module_name!r} has no callable {attr!r}")
-    try:
-        env = factory(**args)
-    except TypeError as exc:
-        raise ConfigError(f"--environment {spec!r}: the --env-arg values do not fit {attr}(): "
-                          f"{exc}") from None
-    except Exception as exc:  # a robot that is offline, a driver that fails to start
-        raise ConfigError(f"--environment {spec!r}: {attr}() failed "
-                          f"({type(exc).__name__}: {exc})") from None
-    if not isinstance(env, Environment):
-        raise ConfigError(f"--environment {spec!r} must return an Environment (workspace, "
-                          f"observe, press, release); got {type(env).__name__}")
+    env = GuardedEnvironment(spec, config or RobotConfig())
+    env.build(factory, args)
     return env
 
 
 def explore_environment(spec: str, env_args: dict[str, Any], config: RunConfig,
-                        out: Path | None = None, *, figures: bool = True,
+                        out: Path | None = None, *, resume: bool = False, figures: bool = True,
                         hooks: RunHooks = NO_HOOKS, variance_max: float | None = None,
                         ) -> tuple[dict[str, Any], Path]:
     """Explore the Environment ``spec`` returns (module docstring); ``(report, folder)``.
 
     The run folder is new or empty (default ``runs/<factory>-explore-s<seed>-<time>``), made
-    after the environment is built, so that a spec that does not load leaves nothing behind;
-    ``variance_max`` fixes the top of ``map.png``'s variance scale. ``config.world`` and
-    ``config.scenario`` are not used.
+    after the environment is built, so that a spec that does not load leaves nothing behind; with
+    ``resume`` it is the folder of a run stopped there, whose journal must name the same
+    ``spec``, ``env_args`` and configuration (but ``config.robot``), checked before the robot is
+    built. ``variance_max`` fixes the top of ``map.png``'s variance scale. ``config.world`` and
+    ``config.scenario`` are not used. A robot that fails raises :class:`RobotFault` naming the
+    call, with every finished poke in the journal.
     """
     if variance_max is not None:  # before any work
         check_positive("variance_max", variance_max)
-    env = load_environment(spec, env_args)
-    check_exploration_budget(config.exploration, env.workspace)
-    folder = out or default_run_folder(spec.partition(":")[2], "explore", config.seed)
-    create_run_folder(folder, what="output")
-    write_text(folder / CONFIG_NAME, config_yaml(config))
+    if resume and out is None:
+        raise ConfigError("`out` must name the run folder to resume; got None")
     header = {"deformap": __version__, "config": config_to_dict(config), "environment": spec,
               "env_args": env_args}  # fmt: skip
-    journal = Journal.create(folder, header)
+    done: list[PokeRecord] = []
+    if resume:
+        assert out is not None
+        journal, done = resume_journal(out, config, header)
+    env = load_environment(spec, env_args, config.robot)
+    check_exploration_budget(config.exploration, env.workspace)
+    folder = out or default_run_folder(spec.partition(":")[2], "explore", config.seed)
+    if not resume:
+        create_run_folder(folder, what="output", resume_hint=True)
+    write_text(folder / CONFIG_NAME, config_yaml(config))  # on resume, restores a removed copy
+    if not resume:
+        journal = Journal.create(folder, header)
     hooks.start(RunStart(kind="explore", title=f"{spec} seed {config.seed}", folder=folder,
-                         total=config.exploration.max_pokes, done=0))  # fmt: skip
+                         total=config.exploration.max_pokes, done=len(done)))  # fmt: skip
     _, explore_rng = run_generators(config.seed)
 
     hooks.stage("exploring")
     t0 = time.perf_counter()
-    result = explore(env, config.exploration, rng=explore_rng, journal=journal,
-                     on_poke=poke_writer(folder, figures=figures, hooks=hooks))
+    try:
+        result = explore(env, config.exploration, rng=explore_rng, journal=journal, done=done,
+                         on_poke=poke_writer(folder, figures=figures, hooks=hooks))
+    except RobotFault as exc:
+        kept = len(read_journal(folder / JOURNAL_NAME).pokes)
+        raise RobotFault(f"{exc}; {kept} poke(s) kept in the journal: continue with `deformap "
+                         f"explore --resume {folder}` and the same --environment and --env-arg",
+                         exc.error) from None
     report = {"deformap": __version__, "environment": spec, "env_args": env_args,
               "seed": config.seed, "config": config_to_dict(config),
               **shared_report(result, truth=None)}  # fmt: skip

@@ -10,7 +10,7 @@ from __future__ import annotations
 import json
 import logging
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -60,21 +60,23 @@ class RunOutput:
 
 
 def _stored_if_same(out: Path, config: RunConfig, header: dict[str, Any]) -> dict[str, Any]:
-    """The journal's own header if it names this run in an older form (a configuration field
-    added since, read at its default), else ``header`` for :meth:`Journal.resume` to compare."""
+    """The journal's own header if it names this run: its configuration read back (a field added
+    since at its default) equals ``config`` but for the ``robot`` guard, which the pokes do not
+    depend on; else ``header`` for :meth:`Journal.resume` to compare."""
     try:
         stored = read_journal(out / JOURNAL_NAME).header
         same = (
             {k: v for k, v in stored.items() if k not in ("kind", "config")}
             == json.loads(json.dumps({k: v for k, v in header.items() if k != "config"}))
-            and config_from_dict(RunConfig, stored["config"], where="journal header") == config
+            and replace(config_from_dict(RunConfig, stored["config"], where="journal header"),
+                        robot=config.robot) == config
         )
     except (DeformapError, KeyError, TypeError):
         return header
     return {k: v for k, v in stored.items() if k != "kind"} if same else header
 
 
-def _resume_journal(
+def resume_journal(
     out: Path, config: RunConfig, header: dict[str, Any]
 ) -> tuple[Journal, list[PokeRecord]]:
     """The journal of the run in ``out`` and its pokes as records (a broken line refused before
@@ -144,7 +146,11 @@ def explore_scenario(config: RunConfig, out: Path | None = None, *, resume: bool
     header = {"deformap": __version__, "config": config_to_dict(config),
               "scenario": scenario.to_dict()}  # fmt: skip
     if resume:
-        journal, done = _resume_journal(folder, config, header)
+        if (folder / JOURNAL_NAME).is_file() and (
+                spec := read_journal(folder / JOURNAL_NAME).header.get("environment")):
+            raise ConfigError(f"cannot resume {str(folder)!r} as a simulated run: it explored "
+                              f"--environment {spec}; pass that and its --env-arg values again")
+        journal, done = resume_journal(folder, config, header)
         # matched the journal header; restores a copy a kill or a user removed
         write_text(folder / CONFIG_NAME, config_yaml(config))
     else:
