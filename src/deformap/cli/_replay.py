@@ -5,7 +5,7 @@ from __future__ import annotations
 import dataclasses
 import sys
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
@@ -152,6 +152,18 @@ def _three_numbers(option: str, values: tuple[str, str, str] | None, what: str
                                    f"{' '.join(values)}") from None
 
 
+def _stiffness_line(report: dict[str, Any]) -> str:
+    """One line on what the force–travel record gave: E with σ, rigid, or why none."""
+    est = report["stiffness"]
+    if est is None:
+        return f"E: none from the record ({report['stiffness_error']})"
+    if est["rigid"]:
+        return f"rigid: stiffness above {est['stiffness_lower_n_per_m']:.4g} N/m"
+    h = report["layer_thickness_m"]
+    return (f"E = {est['modulus_pa'] / 1e3:.4g} ± {est['modulus_std_pa'] / 1e3:.2g} kPa, "
+            f"k = {est['stiffness_n_per_m']:.4g} N/m (layer {h * 1e3:.1f} mm thick)")
+
+
 @app.command("estimate", context_settings={"ignore_unknown_options": True,
                                            "allow_extra_args": True})  # fmt: skip
 @friendly_errors
@@ -172,6 +184,9 @@ def estimate_command(
         "--tip-radius", help="Radius of the spherical tip, metres. [required]")] = None,
     robot_hull: Annotated[Path | None, typer.Option(
         "--robot-hull", help="Cloud file of points whose hull covers stick and hand.")] = None,
+    record: Annotated[Path | None, typer.Option(
+        "--record", help="The press's force–travel record, a CSV with columns travel_m (or "
+        "travel_mm) and force_n: adds its stiffness and E.")] = None,
     out: Annotated[Path | None, typer.Option(
         help="New folder for estimate.json, beta-curve.png, poke.png.")] = None,
     units: Annotated[str, typer.Option(help="Units of the cloud files: m | mm.")] = "m",
@@ -182,7 +197,8 @@ def estimate_command(
         "--json", help="Also write the result as JSON to this file (- for stdout; "
         "the default without --out).")] = None,
 ) -> None:
-    """β of one poke from two clouds and the tactile contact (world frame, SI units)."""
+    """β of one poke from two clouds and the tactile contact (world frame, SI units); with its
+    force–travel record also E."""
     tip_center = _three_numbers("--contact", contact, "the tip centre X Y Z in metres")
     force_n = _three_numbers("--force", force, "the force FX FY FZ in newtons")
     if tip_radius is None:
@@ -194,10 +210,13 @@ def estimate_command(
         json_path = Path("-")
     output = run.estimate_one_poke(
         before=before, after=after, tip_center=tip_center, force=force_n, tip_radius_m=tip_radius,
-        config=run.load_run_config(config), robot_hull=robot_hull, units=units, seed=seed, out=out)
+        config=run.load_run_config(config), robot_hull=robot_hull, record=record, units=units,
+        seed=seed, out=out)
     r = output.report
     shown = out_console(json_path)
     shown.print(f"β = {r['beta']:.3f} ± {r['beta_std']:.3f} ({r['n_roi_points']} ROI points)")
+    if record is not None:
+        shown.print(_stiffness_line(r))
     if output.folder is not None:
         shown.print(f"wrote {output.folder / 'estimate.json'}, beta-curve.png and poke.png")
     emit_json(json_path, r)

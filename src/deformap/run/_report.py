@@ -77,7 +77,8 @@ SHARED_KEYS = (
 """The keys :func:`shared_report` always writes (``true_regions`` too, with a ground truth)."""
 
 _ESTIMATE_KEYS = ("contact", "force_n", "betas", "errors", "converged", "iterations",
-                  "n_roi_points", "timings")  # fmt: skip
+                  "n_roi_points", "depth_anchored", "stiffness", "layer_thickness_m",
+                  "stiffness_error", "timings")  # fmt: skip
 
 
 def _finite(value: float | None) -> float | None:
@@ -241,7 +242,9 @@ def session_report(
 def estimate_report(
     before: Path, after: Path, contact: TactileContact, poke: PokeResult
 ) -> dict[str, Any]:
-    """``estimate.json``: β of one poke with its uncertainty and E(β) curve."""
+    """``estimate.json``: β of one poke with its uncertainty and E(β) curve; with a force–travel
+    record its ``stiffness`` (``None`` without one), the ``layer_thickness_m`` it was read with
+    and ``stiffness_error`` (why a record gave none)."""
     r = poke.record.to_dict()
     return {
         "before": str(before),
@@ -249,5 +252,5 @@ def estimate_report(
         "beta": r["beta"],
         "beta_std": r["beta_std"],
         "contact_point": contact.contact_point.tolist(),
-        **{k: r[k] for k in _ESTIMATE_KEYS},
+        **{k: r.get(k) for k in _ESTIMATE_KEYS},
     }
