@@ -27,8 +27,8 @@ from deformap.errors import ConfigError, DeformapError
 #: Largest YAML file read (config, scenario, session; a session lists files, not their data).
 MAX_YAML_BYTES = 16 * 2**20
 
-__all__ = ["config_from_dict", "config_to_dict", "described_yaml", "dump_yaml", "load_yaml",
-           "setting_docs"]
+__all__ = ["NoAliasDumper", "config_from_dict", "config_to_dict", "described_yaml", "dump_yaml",
+           "load_yaml", "parse_yaml", "setting_docs"]
 
 T = TypeVar("T")
 
@@ -97,8 +97,21 @@ def config_from_dict(cls: type[T], data: Any, *, where: str = "config") -> T:
         raise ConfigError(f"`{where}`: {exc}") from None
 
 
-class _UniqueKeyLoader(yaml.SafeLoader):
-    """PyYAML's safe loader, refusing a mapping that repeats a key (PyYAML keeps the last)."""
+class _StrictLoader(yaml.SafeLoader):
+    """PyYAML's safe loader, refusing anchors and aliases (``&name``, ``*name``) anywhere and a
+    mapping that repeats a key (PyYAML keeps the last).
+
+    Without aliases a document has at most as many nodes as its text has characters, so reading
+    it, and every walk over what it read, is bounded by the file's size: a nested alias bomb
+    ("billion laughs") is refused at its first anchor, before anything is built.
+    """
+
+    def compose_node(self, parent: Any, index: Any) -> Any:
+        event = self.peek_event()
+        if isinstance(event, yaml.AliasEvent) or getattr(event, "anchor", None) is not None:
+            mark = event.start_mark
+            raise _AliasRefused(f"line {mark.line + 1}, column {mark.column + 1}")
+        return super().compose_node(parent, index)
 
     def construct_mapping(self, node: yaml.MappingNode, deep: bool = False) -> dict[Any, Any]:
         seen: set[Any] = set()
@@ -116,13 +129,40 @@ class _UniqueKeyLoader(yaml.SafeLoader):
         return super().construct_mapping(node, deep=deep)
 
 
+class _AliasRefused(Exception):
+    """An anchor or alias met while composing (its place in the text)."""
+
+
+def parse_yaml(text: str, *, where: str) -> Any:
+    """Plain data of the YAML ``text`` (one document; mappings, lists and scalars only).
+
+    The one YAML reader of deformap: anchors and aliases are refused anywhere (so what is read is
+    bounded by the text's size), and so is a mapping that repeats a key. ``where`` names the text
+    in the message (a file's path, ``--set key``).
+
+    Raises
+    ------
+    ConfigError
+        One line naming ``where``: an anchor or alias (with its line), a syntax error, nesting too
+        deep, an impossible date, a repeated key.
+    """
+    try:
+        return yaml.load(text, Loader=_StrictLoader)  # a SafeLoader: plain data only
+    except _AliasRefused as exc:
+        raise ConfigError(
+            f"{where}: YAML anchors and aliases (&name, *name) are not accepted ({exc}); "
+            "write each value out in full") from None
+    except (yaml.YAMLError, RecursionError, ValueError) as exc:
+        detail = f"{type(exc).__name__}: {exc}".replace("\n", " ")[:300]
+        raise ConfigError(f"{where} is not valid YAML: {detail}") from None
+
+
 def load_yaml(path: str | Path, *, what: str = "config file",
               unreadable: type[DeformapError] = ConfigError) -> Any:
-    """Read a YAML file safely (plain data only); errors name the file.
+    """Read a YAML file through :func:`parse_yaml`; errors name the file.
 
     A file that cannot be read raises ``unreadable`` (``cannot read {what}``); bytes that are not
-    UTF-8, or text PyYAML refuses (a syntax error, nesting too deep, an impossible date), raise
-    :class:`ConfigError`.
+    UTF-8, or text :func:`parse_yaml` refuses, raise :class:`ConfigError`.
     """
     p = Path(path)
     try:
@@ -138,16 +178,22 @@ def load_yaml(path: str | Path, *, what: str = "config file",
         raise unreadable(f"cannot read {what} {str(p)!r}: {exc.strerror or exc}") from None
     except UnicodeDecodeError as exc:
         raise ConfigError(f"{str(p)!r} is not UTF-8 text (byte {exc.start})") from None
-    try:
-        return yaml.load(text, Loader=_UniqueKeyLoader)  # a SafeLoader: plain data only
-    except (yaml.YAMLError, RecursionError, ValueError) as exc:
-        detail = f"{type(exc).__name__}: {exc}".replace("\n", " ")[:300]
-        raise ConfigError(f"{str(p)!r} is not valid YAML: {detail}") from None
+    return parse_yaml(text, where=repr(str(p)))
+
+
+class NoAliasDumper(yaml.SafeDumper):
+    """PyYAML's safe dumper writing a value met twice in full each time, never as an anchor and
+    alias, so that :func:`parse_yaml` reads back what deformap writes."""
+
+    def ignore_aliases(self, data: Any) -> bool:
+        return True
 
 
 def dump_yaml(data: Any, path: str | Path | None = None) -> str:
-    """Write plain data as YAML (block style, keys in definition order); return the text."""
-    text = yaml.safe_dump(config_to_dict(data), sort_keys=False, default_flow_style=False)
+    """Write plain data as YAML (block style, keys in definition order, no aliases); return the
+    text."""
+    text = yaml.dump(config_to_dict(data), Dumper=NoAliasDumper, sort_keys=False,
+                     default_flow_style=False)
     if path is not None:
         Path(path).write_text(text, encoding="utf-8")
     return text
@@ -295,6 +341,6 @@ def _describe(obj: Any, prefix: str, docs: dict[str, tuple[str | None, list[str]
             lines.append(f"{indent}{f.name}:")
             _describe(value, name + ".", docs, lines, width)
             continue
-        text = yaml.safe_dump({f.name: config_to_dict(value)}, sort_keys=False,
-                              default_flow_style=False)
+        text = yaml.dump({f.name: config_to_dict(value)}, Dumper=NoAliasDumper, sort_keys=False,
+                         default_flow_style=False)
         lines.extend(indent + line for line in text.splitlines())

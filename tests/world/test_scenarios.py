@@ -65,6 +65,7 @@ def test_yaml_round_trip(tmp_path) -> None:
 
 GOOD = """
 name: custom
+workspace: {lower: [0.0, 0.0], upper: [0.7, 0.4]}
 blocks:
   - name: soft
     rect: [0.0, 0.0, 0.3, 0.4]

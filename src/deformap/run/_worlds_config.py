@@ -13,9 +13,7 @@ from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
-import yaml
-
-from deformap._config import config_from_dict, config_to_dict
+from deformap._config import config_from_dict, config_to_dict, parse_yaml
 from deformap._validation import SettingError, check_settings, setting
 from deformap.errors import ConfigError
 from deformap.eval import WorldTask, choices
@@ -49,8 +47,8 @@ def parse_assignments(items: Iterable[str]) -> dict[str, Any]:
         if key in out:
             raise ConfigError(f"--set {key} is given twice")
         try:
-            value = yaml.safe_load(text) if text.strip() else None
-        except yaml.YAMLError:
+            value = parse_yaml(text, where=f"--set {key}") if text.strip() else None
+        except ConfigError:
             value = {}  # refused below, in the same words
         if isinstance(value, dict | list):
             raise ConfigError(f"--set {key}: the value must be a scalar (a number, true/false, "
@@ -150,7 +148,7 @@ class WorldsBenchConfig:
     fields: tuple[str, ...] = choices("field")
     cuts: tuple[str, ...] = choices("region_labels")
     # every poke is a press and a β sweep per combination, hence fewer than a run's
-    max_pokes: int = setting(12, ge=1, le=1000)
+    max_pokes: int = setting(12, limit="pokes")
     exploration: ExplorationConfig = field(default_factory=ExplorationConfig)
     coarse: bool = False
     workers: int = setting(1, ge=1, le=1024)
