@@ -57,6 +57,36 @@ def parse_assignments(items: Iterable[str]) -> dict[str, Any]:
     return out
 
 
+#: Schemes of ``dask.distributed`` addresses a client reaches over a network (a bare
+#: ``host:port`` is ``tcp``); ``inproc`` names a scheduler inside the calling process.
+_SCHEDULER_SCHEMES = ("tcp", "tls", "ws", "wss", "ucx")
+
+
+def _check_address(address: str) -> None:
+    """A scheduler's address as ``[scheme://]host[:port]``, checked for its form only (whether a
+    scheduler answers there is :func:`deformap.run._worlds_engines.check_scheduler`'s)."""
+    scheme, sep, location = address.partition("://")
+    if not sep:
+        scheme, location = "tcp", address
+    host, colon, port = location.rpartition(":") if ":" in location else (location, "", "")
+    if not address.strip() or any(c.isspace() for c in address):
+        why = "an empty value" if not address.strip() else "blanks"
+        raise SettingError("scheduler", f"must be a Dask scheduler's address (tcp://host:8786); "
+                                        f"got {why}: {address!r}")
+    if scheme == "inproc":
+        raise SettingError("scheduler", f"must be a scheduler reachable over the network "
+                                        f"({', '.join(s + '://' for s in _SCHEDULER_SCHEMES)}); "
+                                        f"an inproc:// address names one inside this process; "
+                                        f"got {address!r}")
+    if scheme not in _SCHEDULER_SCHEMES:
+        raise SettingError("scheduler", f"must start with one of "
+                                        f"{', '.join(s + '://' for s in _SCHEDULER_SCHEMES)} "
+                                        f"(or be host:port); got {address!r}")
+    if not host.strip("[]") or (colon and not (port.isdigit() and 0 < int(port) < 65536)):
+        raise SettingError("scheduler", f"must name a host and a port from 1 to 65535 "
+                                        f"(tcp://host:8786); got {address!r}")
+
+
 def _flatten(data: Mapping[str, Any], prefix: str = "") -> dict[str, Any]:
     out: dict[str, Any] = {}
     for key, value in data.items():
@@ -156,6 +186,8 @@ class WorldsBenchConfig:
 
     def __post_init__(self) -> None:
         check_settings(self)
+        if self.scheduler is not None:
+            _check_address(self.scheduler)
         for name, given, allowed in (("families", self.families, LAYOUT_FAMILIES),
                                      ("physics", self.physics, PHYSICS),
                                      ("appearances", self.appearances, APPEARANCE_FAMILIES),
