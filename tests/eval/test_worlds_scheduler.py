@@ -16,8 +16,7 @@ import pytest
 
 from deformap._validation import SettingError
 from deformap.errors import ConfigError
-from deformap.run import WorldsBenchConfig, bench_worlds
-from deformap.run import _worlds_engines
+from deformap.run import WorldsBenchConfig, _worlds_engines, bench_worlds
 from deformap.run._worlds_engines import check_scheduler
 
 pytest.importorskip("distributed")
