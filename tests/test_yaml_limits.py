@@ -173,3 +173,25 @@ def test_dump_yaml_writes_a_shared_value_in_full() -> None:
     shared = [1.0, 2.0]
     text = dump_yaml({"a": shared, "b": shared})
     assert "&" not in text and parse_yaml(text, where="T") == {"a": shared, "b": shared}
+
+
+@pytest.mark.parametrize(("name", "head", "kind"), [
+    ("observation.pcd", b"# .PCD v0.7 - Point Cloud Data\nVERSION 0.7\n\x00\x93", "a PCD point cloud"),
+    ("cloud.txt", b"VERSION 0.7\nFIELDS x y z\n", "a PCD point cloud"),
+    ("cloud.ply", b"ply\nformat binary_little_endian 1.0\n\xff\xfe", "a PLY point cloud"),
+    ("bag.mcap", b"\x89MCAP0\r\n\x01\x02", "an MCAP file (a ROS 2 bag)"),
+    ("bag.db3", b"SQLite format 3\x00\x10\x00", "a sqlite3 database (a ROS 2 bag?)"),
+    ("truth.npz", b"PK\x03\x04\x14\x00", "a zip archive (an NPZ file?)"),
+])
+def test_a_data_file_read_as_yaml_is_named_for_what_it_is(tmp_path: Path, name: str, head: bytes,
+                                                          kind: str) -> None:
+    path = tmp_path / name
+    path.write_bytes(head)
+    with pytest.raises(ConfigError) as exc:
+        load_yaml(path, what="the session file")
+    assert str(exc.value) == f"{str(path)!r} is {kind}, not YAML (the session file)"
+
+
+def test_yaml_that_starts_like_a_header_word_is_still_yaml(tmp_path: Path) -> None:
+    path = _write(tmp_path, "VERSION: 2\nply: 1\n", "c.yaml")
+    assert load_yaml(path) == {"VERSION": 2, "ply": 1}

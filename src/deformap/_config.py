@@ -27,8 +27,8 @@ from deformap.errors import ConfigError, DeformapError
 #: Largest YAML file read (config, scenario, session; a session lists files, not their data).
 MAX_YAML_BYTES = 16 * 2**20
 
-__all__ = ["NoAliasDumper", "config_from_dict", "config_to_dict", "described_yaml", "dump_yaml",
-           "load_yaml", "parse_yaml", "setting_docs"]
+__all__ = ["NoAliasDumper", "config_from_dict", "config_to_dict", "data_file_kind",
+           "described_yaml", "dump_yaml", "load_yaml", "parse_yaml", "setting_docs"]
 
 T = TypeVar("T")
 
@@ -157,12 +157,34 @@ def parse_yaml(text: str, *, where: str) -> Any:
         raise ConfigError(f"{where} is not valid YAML: {detail}") from None
 
 
+#: Leading bytes (or, for text formats, the suffix) of data files a YAML file is mistaken for.
+_DATA_FILES = ((b"\x89MCAP", None, "an MCAP file (a ROS 2 bag)"),
+               (b"SQLite format 3\x00", None, "a sqlite3 database (a ROS 2 bag?)"),
+               (b"ply\n", ".ply", "a PLY point cloud"), (b"ply\r\n", ".ply", "a PLY point cloud"),
+               (b"# .PCD", ".pcd", "a PCD point cloud"), (b"VERSION 0.", ".pcd", "a PCD point cloud"),
+               (b"VERSION .", ".pcd", "a PCD point cloud"),
+               (b"\x93NUMPY", ".npy", "a NumPy array file"),
+               (b"PK\x03\x04", ".npz", "a zip archive (an NPZ file?)"),
+               (b"\x89PNG", ".png", "a PNG image"))
+
+
+def data_file_kind(path: Path, head: bytes) -> str | None:
+    """What the file ``path`` whose first bytes are ``head`` is, when it is one of the data files
+    deformap reads (a cloud, a bag, an array) rather than YAML; else None."""
+    suffix = path.suffix.lower()
+    for magic, known_suffix, kind in _DATA_FILES:
+        if head.startswith(magic) or (known_suffix is not None and suffix == known_suffix):
+            return kind
+    return None
+
+
 def load_yaml(path: str | Path, *, what: str = "config file",
               unreadable: type[DeformapError] = ConfigError) -> Any:
     """Read a YAML file through :func:`parse_yaml`; errors name the file.
 
-    A file that cannot be read raises ``unreadable`` (``cannot read {what}``); bytes that are not
-    UTF-8, or text :func:`parse_yaml` refuses, raise :class:`ConfigError`.
+    A file that cannot be read raises ``unreadable`` (``cannot read {what}``); a data file
+    (:func:`data_file_kind`: a cloud, a bag), bytes that are not UTF-8, or text
+    :func:`parse_yaml` refuses, raise :class:`ConfigError` (the first naming what the file is).
     """
     p = Path(path)
     try:
@@ -170,6 +192,9 @@ def load_yaml(path: str | Path, *, what: str = "config file",
             raise unreadable(f"cannot read {what} {str(p)!r}: not a regular file")
         with p.open("rb") as stream:
             raw = stream.read(MAX_YAML_BYTES + 1)
+        kind = data_file_kind(p, raw[:16])
+        if kind is not None:
+            raise ConfigError(f"{str(p)!r} is {kind}, not YAML ({what})")
         if len(raw) > MAX_YAML_BYTES:
             raise unreadable(f"cannot read {what} {str(p)!r}: larger than "
                              f"{MAX_YAML_BYTES // 2**20} MiB")

@@ -62,3 +62,19 @@ def test_what_deformap_writes_has_no_alias_and_reads_back(tmp_path: Path, synthe
     file = write_synthetic(tmp_path / "s", synthetic, source={"a": shared, "b": shared})
     assert "&" not in file.read_text() and "*id" not in file.read_text()
     assert load_session(file.parent).source == {"a": shared, "b": shared}
+
+
+def test_map_names_a_cloud_or_a_bag_given_as_the_session(session: Path, tmp_path: Path) -> None:
+    from typer.testing import CliRunner
+
+    from deformap.cli import app
+
+    bag = tmp_path / "robot.mcap"
+    bag.write_bytes(b"\x89MCAP0\r\n" + bytes(range(256)))
+    for given, args, kind in ((session.parent / "observation.pcd", [], "a PCD point cloud"),
+                              (bag, ["--layout", "session"], "an MCAP file (a ROS 2 bag)")):
+        out = tmp_path / f"out-{given.suffix[1:]}"
+        result = CliRunner().invoke(app, ["map", str(given), *args, "--out", str(out)])
+        assert result.exit_code == 2, result.output
+        assert f"is {kind}, not YAML (the session file)" in result.output
+        assert "UTF-8" not in result.output and not out.exists()
