@@ -45,3 +45,31 @@ def test_the_mutators_make_what_they_say() -> None:
     assert "&l0" in text and "*l0" in text
     cut = _mutators.FILE_MUTATORS["cut-number"](b"h\n1.25 2.5 3.125\n", rng)
     assert not cut.endswith(b"\n") and b"1.25 2.5 3.1" in cut and len(cut) < 15
+
+
+@pytest.mark.parametrize("args", [
+    ["explore", "--config", "{bomb}"],
+    ["explore", "-s", "{bomb}"],
+    ["record-sim", "-s", "{bomb}"],
+    ["world", "show", "{bomb}"],
+    ["bench", "worlds", "--set", "strategy=&a paper"],
+])
+def test_the_command_line_refuses_an_alias_bomb_before_any_work(tmp_path: Path,
+                                                                 args: list[str]) -> None:
+    import time
+
+    from typer.testing import CliRunner
+
+    from deformap.cli import app
+    from deformap.testing import cli_mutants
+
+    bomb = cli_mutants.hostile_paths(tmp_path)["alias-bomb"]
+    out = tmp_path / "out"
+    start = time.perf_counter()
+    result = CliRunner().invoke(app, [*(a.replace("{bomb}", bomb) for a in args),
+                                      "--out", str(out)])
+    assert time.perf_counter() - start < 5.0
+    assert result.exit_code == 2 and not out.exists(), result.output
+    errors = [line for line in result.output.splitlines() if line.startswith("error:")]
+    assert len(errors) == 1 and ("anchors and aliases" in errors[0]
+                                 or "must be a scalar" in errors[0]), result.output
