@@ -195,3 +195,13 @@ def test_a_data_file_read_as_yaml_is_named_for_what_it_is(tmp_path: Path, name: 
 def test_yaml_that_starts_like_a_header_word_is_still_yaml(tmp_path: Path) -> None:
     path = _write(tmp_path, "VERSION: 2\nply: 1\n", "c.yaml")
     assert load_yaml(path) == {"VERSION": 2, "ply": 1}
+
+
+def test_nesting_is_bounded_in_one_line() -> None:
+    from deformap._config import MAX_YAML_DEPTH
+
+    deep = MAX_YAML_DEPTH
+    assert parse_yaml("[" * deep + "]" * deep, where="T") is not None
+    for n in (deep + 1, 5000):  # 5000: PyYAML's own recursion would end in a RecursionError
+        with pytest.raises(ConfigError, match=f"^T: YAML nested deeper than {deep} levels"):
+            parse_yaml("a: " + "[" * n + "]" * n, where="T")

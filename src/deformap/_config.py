@@ -26,6 +26,9 @@ from deformap.errors import ConfigError, DeformapError
 
 #: Largest YAML file read (config, scenario, session; a session lists files, not their data).
 MAX_YAML_BYTES = 16 * 2**20
+#: Deepest nesting of mappings and lists read: a settings file nests a few levels, and every walk
+#: over what was read (its check, a report's JSON) recurses once per level.
+MAX_YAML_DEPTH = 64
 
 __all__ = ["NoAliasDumper", "config_from_dict", "config_to_dict", "data_file_kind",
            "described_yaml", "dump_yaml", "load_yaml", "parse_yaml", "setting_docs"]
@@ -108,10 +111,18 @@ class _StrictLoader(yaml.SafeLoader):
 
     def compose_node(self, parent: Any, index: Any) -> Any:
         event = self.peek_event()
+        mark = event.start_mark
+        where = f"line {mark.line + 1}, column {mark.column + 1}"
         if isinstance(event, yaml.AliasEvent) or getattr(event, "anchor", None) is not None:
-            mark = event.start_mark
-            raise _AliasRefused(f"line {mark.line + 1}, column {mark.column + 1}")
-        return super().compose_node(parent, index)
+            raise _AliasRefused(where)
+        depth = getattr(self, "_depth", 0) + 1
+        if depth > MAX_YAML_DEPTH:
+            raise _TooDeep(where)
+        self._depth = depth
+        try:
+            return super().compose_node(parent, index)
+        finally:
+            self._depth = depth - 1
 
     def construct_mapping(self, node: yaml.MappingNode, deep: bool = False) -> dict[Any, Any]:
         seen: set[Any] = set()
@@ -133,11 +144,16 @@ class _AliasRefused(Exception):
     """An anchor or alias met while composing (its place in the text)."""
 
 
+class _TooDeep(Exception):
+    """Nesting deeper than :data:`MAX_YAML_DEPTH` met while composing (its place in the text)."""
+
+
 def parse_yaml(text: str, *, where: str) -> Any:
     """Plain data of the YAML ``text`` (one document; mappings, lists and scalars only).
 
     The one YAML reader of deformap: anchors and aliases are refused anywhere (so what is read is
-    bounded by the text's size), and so is a mapping that repeats a key. ``where`` names the text
+    bounded by the text's size), and so are nesting deeper than :data:`MAX_YAML_DEPTH` and a
+    mapping that repeats a key. ``where`` names the text
     in the message (a file's path, ``--set key``).
 
     Raises
@@ -152,6 +168,9 @@ def parse_yaml(text: str, *, where: str) -> Any:
         raise ConfigError(
             f"{where}: YAML anchors and aliases (&name, *name) are not accepted ({exc}); "
             "write each value out in full") from None
+    except _TooDeep as exc:
+        raise ConfigError(f"{where}: YAML nested deeper than {MAX_YAML_DEPTH} levels ({exc})"
+                          ) from None
     except (yaml.YAMLError, RecursionError, ValueError) as exc:
         detail = f"{type(exc).__name__}: {exc}".replace("\n", " ")[:300]
         raise ConfigError(f"{where} is not valid YAML: {detail}") from None
