@@ -205,3 +205,14 @@ def test_nesting_is_bounded_in_one_line() -> None:
     for n in (deep + 1, 5000):  # 5000: PyYAML's own recursion would end in a RecursionError
         with pytest.raises(ConfigError, match=f"^T: YAML nested deeper than {deep} levels"):
             parse_yaml("a: " + "[" * n + "]" * n, where="T")
+
+
+def test_many_unknown_keys_are_named_in_a_short_line(tmp_path: Path) -> None:
+    keys = "".join(f"k{i}{'x' * 100}: 1\n" for i in range(10_000))
+    with pytest.raises(ConfigError) as exc:
+        load_run_config(_write(tmp_path, keys, "c.yaml"))
+    text = str(exc.value)
+    assert "and 9,995 more" in text and len(text) < 1000
+    with pytest.raises(ConfigError, match=r"unknown key\(s\) \['k0x.*and 9,995 more\]") as exc:
+        load_scenario(_write(tmp_path, SCENARIO + keys))
+    assert len(str(exc.value)) < 1000

@@ -31,7 +31,7 @@ MAX_YAML_BYTES = 16 * 2**20
 MAX_YAML_DEPTH = 64
 
 __all__ = ["NoAliasDumper", "config_from_dict", "config_to_dict", "data_file_kind",
-           "described_yaml", "dump_yaml", "load_yaml", "parse_yaml", "setting_docs"]
+           "described_yaml", "dump_yaml", "few", "load_yaml", "parse_yaml", "setting_docs"]
 
 T = TypeVar("T")
 
@@ -69,6 +69,13 @@ def _shape(value: Any, hint: Any, where: str) -> Any:
     return value
 
 
+def few(names: list[str], most: int = 5) -> str:
+    """``names`` as a list for a message: the first ``most``, each cut to 40 characters, and
+    how many more."""
+    shown = ", ".join(repr(n[:40]) for n in names[:most])
+    return f"[{shown}" + (f" and {len(names) - most:,} more]" if len(names) > most else "]")
+
+
 def config_from_dict(cls: type[T], data: Any, *, where: str = "config") -> T:
     """Build the settings dataclass ``cls`` from plain data; missing keys keep their defaults.
 
@@ -84,10 +91,10 @@ def config_from_dict(cls: type[T], data: Any, *, where: str = "config") -> T:
             shown = f"{type(data).__name__} of {len(str(data))} characters, {shown[:60]}…"
         raise ConfigError(f"`{where}` must be a mapping of settings; got {shown}")
     fields = {f.name: f for f in dataclasses.fields(cls) if f.init}  # type: ignore[arg-type]
-    unknown = sorted(set(data) - set(fields))
+    unknown = sorted(map(str, set(data) - set(fields)))
     if unknown:
         raise ConfigError(
-            f"`{where}` has unknown key(s) {unknown}; known keys are {sorted(fields)}")
+            f"`{where}` has unknown key(s) {few(unknown)}; known keys are {sorted(fields)}")
     hints = typing.get_type_hints(cls)
     kwargs = {name: _shape(value, hints[name], f"{where}.{name}") for name, value in data.items()}
     try:

@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from deformap._config import few
 from deformap._validation import (
     LIMITS,
     check_array,
@@ -130,7 +131,7 @@ def _check_keys(file: Path, key: str, data: Any, required: set[str],
     unknown = sorted(keys - required - optional)
     if unknown:
         raise ConfigError(
-            f"{_where(file, key)} has unknown key(s) {unknown}; "
+            f"{_where(file, key)} has unknown key(s) {few(unknown)}; "
             f"allowed: {sorted(required | optional)}")
     missing = sorted(required - keys)
     if missing:

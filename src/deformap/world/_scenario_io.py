@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from deformap._config import dump_yaml, load_yaml
+from deformap._config import dump_yaml, few, load_yaml
 from deformap.environment import Workspace
 from deformap.errors import ConfigError, DeformapError
 from deformap.world._appearance import Appearance, appearance_from_dict
@@ -63,9 +63,9 @@ def save_scenario(scenario: Scenario, path: str | Path) -> None:
 
 
 def _unknown(where: str, data: dict[str, Any], allowed: set[str]) -> None:
-    extra = sorted(set(data) - allowed)
+    extra = sorted(map(str, set(data) - allowed))
     if extra:
-        raise ConfigError(f"{where}: unknown key(s) {extra}; allowed: {sorted(allowed)}")
+        raise ConfigError(f"{where}: unknown key(s) {few(extra)}; allowed: {sorted(allowed)}")
 
 
 def _block(data: Any, where: str) -> Block:
