@@ -3,6 +3,7 @@ body must end at a line break after a last row of every declared value."""
 
 from __future__ import annotations
 
+import re
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -58,3 +59,16 @@ def test_trailing_blank_space_after_the_last_line_break_is_fine(tmp_path: Path, 
         path.write_bytes(path.read_bytes() + b"\n  \n")
     path.write_bytes(path.read_bytes().rstrip(b"\n") + b"\r\n")
     assert len(read(path)[0]) == 6
+
+
+@pytest.mark.parametrize(("name", "kind"), [("session.yaml", "a YAML file"),
+                                             ("robot.mcap", "a ROS 2 bag (MCAP"),
+                                             ("robot.db3", "a ROS 2 bag (sqlite3")])
+def test_a_session_or_bag_read_as_a_cloud_is_named_for_what_it_is(tmp_path: Path, name: str,
+                                                                   kind: str) -> None:
+    from deformap.cloud.io import read_cloud
+
+    path = tmp_path / name
+    path.write_bytes(b"x")
+    with pytest.raises(FileFormatError, match=rf"{name}: {re.escape(kind)}.*, not a point cloud"):
+        read_cloud(path)
