@@ -8,8 +8,12 @@ Each must load to a valid result or end in one clean error.
 
 The reader mutants, their templates, the worker process with its per-case time limit and the
 classification (``clean``, ``same``, ``changed``, ``silent``, ``traceback``, ``hang``) are
-:mod:`deformap.testing.mutants`'s; the command-line mutants (every option of every command given
-seeded hostile values under a guard that stops a run before its work) and their endings are
+:mod:`deformap.testing.mutants`'s; their kinds include nested YAML alias bombs in every YAML a
+user gives (``alias``: a session, a run configuration, a scenario, a raw bag's settings; one
+accepted counts as ``silent``) and ascii clouds cut inside their last number
+(``cut-number``); the command-line mutants (every option of every command given seeded hostile
+values, an alias-bomb YAML among the paths, under a guard that stops a run before its work) and
+their endings are
 :mod:`deformap.testing.cli_mutants`'s. This script runs any number of them and prints a table per
 reader and per value kind; it exits 1 when any traceback, hang, silent corruption or other ending
 is counted. From a source checkout the ``src/`` beside this folder is imported, installed

@@ -65,7 +65,7 @@ def _drop(key: str) -> Edit:
         (_set("workspace.upper", [0.6]), r"`workspace.upper` must be a \(2,\) array"),
         (_set("workspace.upper", [-1.0, 0.4]), "`workspace`.*must exceed"),
         (_set("workspace.depth", 1.0), r"`workspace` has unknown key\(s\) \['depth'\]"),
-        (_set("probe.tip_radius_m", -0.01), "`probe.tip_radius_m` must be > 0"),
+        (_set("probe.tip_radius_m", -0.01), "`probe.tip_radius_m` must be >= 1e-06"),
         (_set("probe", 0.01), "`probe` must be a mapping"),
         (_set("pokes", {"a": 1}), "`pokes` must be a list"),
         (_set("pokes.0.colour", 1), r"`pokes\[0\]` has unknown key\(s\) \['colour'\]"),

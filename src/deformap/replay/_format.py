@@ -16,9 +16,12 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from deformap._config import few
 from deformap._validation import (
+    LIMITS,
     check_array,
     check_int,
+    check_limit,
     check_positive,
     check_rigid_transform,
     check_vector,
@@ -128,7 +131,7 @@ def _check_keys(file: Path, key: str, data: Any, required: set[str],
     unknown = sorted(keys - required - optional)
     if unknown:
         raise ConfigError(
-            f"{_where(file, key)} has unknown key(s) {unknown}; "
+            f"{_where(file, key)} has unknown key(s) {few(unknown)}; "
             f"allowed: {sorted(required | optional)}")
     missing = sorted(required - keys)
     if missing:
@@ -247,7 +250,8 @@ def parse_session_yaml(data: Any, file: Path) -> SessionHeader:
     cam2world = _cam2world(file, data, frame, form)
     workspace = _workspace(file, data["workspace"])
     _check_keys(file, "probe", data["probe"], {"tip_radius_m"})
-    tip = _value(file, "probe.tip_radius_m", check_positive, data["probe"]["tip_radius_m"])
+    tip = _value(file, "probe.tip_radius_m", check_limit, data["probe"]["tip_radius_m"],
+                 "tip_radius_m")
     source = data.get("source") or {}
     if not isinstance(source, dict):
         raise ConfigError(
@@ -270,8 +274,14 @@ def parse_session_yaml(data: Any, file: Path) -> SessionHeader:
 
 
 def _check_poke_count(file: Path, data: dict[str, Any], pokes: list[Any]) -> None:
-    """``n_pokes``, when given, must count the entries of ``pokes``: a file cut at a poke
-    boundary is still valid YAML."""
+    """``pokes`` may list at most the pokes one map is made of (``LIMITS["pokes"]``, the cap of
+    ``exploration.max_pokes``); ``n_pokes``, when given, must count its entries: a file cut at a
+    poke boundary is still valid YAML."""
+    most = LIMITS["pokes"]["le"]
+    if len(pokes) > most:
+        raise ConfigError(
+            f"{_where(file, 'pokes')} lists {len(pokes):,} pokes; a map is made of at most "
+            f"{most:,} (as `exploration.max_pokes`): split the session")
     if "n_pokes" not in data:
         logger.info("%s: no `n_pokes`; cannot check that the poke list is complete", file)
         return

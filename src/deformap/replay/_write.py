@@ -70,7 +70,11 @@ class RecordingEnvironment:
 
 
 class _Dumper(yaml.SafeDumper):
-    """Vectors (lists of numbers) on one line; everything else in block style."""
+    """Vectors (lists of numbers) on one line; everything else in block style; a value met twice
+    written in full (the reader refuses aliases)."""
+
+    def ignore_aliases(self, data: Any) -> bool:
+        return True
 
 
 def _represent_list(dumper: yaml.SafeDumper, data: list[Any]) -> Any:

@@ -20,7 +20,7 @@ from deformap.eval import WorldResult, choices, rescore_world
 from deformap.run._folder import create_run_folder, default_run_folder, to_json, write_text
 from deformap.run._hooks import NO_HOOKS, RunHooks, RunStart
 from deformap.run._worlds_config import WorldsBenchConfig, exploration_changes, exploration_with
-from deformap.run._worlds_engines import world_results
+from deformap.run._worlds_engines import check_scheduler, world_results
 from deformap.run._worlds_folder import (
     SETTINGS_NAME,
     finished_worlds,
@@ -73,6 +73,8 @@ def bench_worlds(config: WorldsBenchConfig, out: Path | None = None, *,
     """
     if not isinstance(config, WorldsBenchConfig):
         raise ConfigError(f"`config` must be a WorldsBenchConfig; got {type(config).__name__}")
+    if config.scheduler is not None:
+        check_scheduler(config.scheduler)  # before the folder: nothing left by a wrong address
     folder = out or default_run_folder("worlds", "bench", config.seed)
     start_folder(config, folder)
     done = finished_worlds(folder, config.worlds)

@@ -91,7 +91,7 @@ class WorldConfig:
     top_layer_m: float = setting(0.005, gt=0.0, ge=0.001)
     layer_growth: float = setting(1.5, ge=1.0, le=10.0)
     poisson_ratio: float = setting(0.3, ge=0.0, lt=0.5)  # 0.5 makes the FEM's λ infinite
-    tip_radius_m: float = setting(0.01, gt=0.0)
+    tip_radius_m: float = setting(0.01, limit="tip_radius_m")
     stick_length_m: float = setting(0.10, gt=0.0)
     stick_radius_m: float = setting(0.006, gt=0.0)
     hand_size_m: tuple[float, float, float] = setting((0.08, 0.06, 0.10), gt=0.0)

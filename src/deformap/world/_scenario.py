@@ -169,8 +169,9 @@ class Block:
 class Scenario:
     """A named layout of blocks over a workspace.
 
-    ``blocks``: at least one, no two overlapping; ``workspace``: the rectangle to map, at most
-    :data:`MAX_EXTENT_M` on each side; ``table_appearance`` None: a darker warm grey.
+    ``blocks``: at least one, no two overlapping, each with some area inside ``workspace``;
+    ``workspace``: the rectangle to map, at most :data:`MAX_EXTENT_M` on each side;
+    ``table_appearance`` None: a darker warm grey.
     """
 
     name: str
@@ -189,6 +190,14 @@ class Scenario:
             raise SettingError(
                 "workspace", f"must span at most {MAX_EXTENT_M:g} m on each axis; got "
                 f"{size[0]:g} × {size[1]:g} m (scenario {self.name!r})")
+        (x0, y0), (x1, y1) = self.workspace.lower, self.workspace.upper
+        rect = rectangle(x0, y0, x1, y1)
+        for b in blocks:
+            if overlap_area(b.polygon, rect, b.holes) <= _OVERLAP_TOL_M2:
+                raise InvalidArgumentError(
+                    f"scenario {self.name!r}: block {b.name!r} lies wholly outside the workspace "
+                    f"[{x0:g}, {x1:g}] × [{y0:g}, {y1:g}] m; no poke could reach it: move the "
+                    "block or widen `workspace`")
         names = [b.name for b in blocks]
         if len(set(names)) != len(names):
             raise InvalidArgumentError(f"scenario {self.name!r} has repeated block names: {names}")

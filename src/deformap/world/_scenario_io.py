@@ -13,9 +13,8 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import yaml
 
-from deformap._config import load_yaml
+from deformap._config import dump_yaml, few, load_yaml
 from deformap.environment import Workspace
 from deformap.errors import ConfigError, DeformapError
 from deformap.world._appearance import Appearance, appearance_from_dict
@@ -60,13 +59,13 @@ def load_scenario(name_or_path: str | Path) -> Scenario:
 
 def save_scenario(scenario: Scenario, path: str | Path) -> None:
     """Write ``scenario`` as YAML that :func:`load_scenario` reads back to an equal scenario."""
-    Path(path).write_text(yaml.safe_dump(scenario.to_dict(), sort_keys=False))
+    dump_yaml(scenario.to_dict(), path)
 
 
 def _unknown(where: str, data: dict[str, Any], allowed: set[str]) -> None:
-    extra = sorted(set(data) - allowed)
+    extra = sorted(map(str, set(data) - allowed))
     if extra:
-        raise ConfigError(f"{where}: unknown key(s) {extra}; allowed: {sorted(allowed)}")
+        raise ConfigError(f"{where}: unknown key(s) {few(extra)}; allowed: {sorted(allowed)}")
 
 
 def _block(data: Any, where: str) -> Block:
@@ -90,11 +89,11 @@ def _block(data: Any, where: str) -> Block:
             raise ConfigError(f"{where}: `rigid` must be true or false; got {rigid!r}")
         look = data.get("appearance")
         return Block(
-            name=str(data.get("name", "")), polygon=poly,
+            name=data.get("name", ""), polygon=poly,
             holes=tuple(np.asarray(h, dtype=float) for h in data.get("holes", ())),
             thickness_m=data.get("thickness_m", 0.05),
             hardness_n=data.get("hardness_n"), youngs_modulus_pa=data.get("youngs_modulus_pa"),
-            rigid=rigid, color=str(data.get("color", "#6b4f3a" if rigid else "#c8a165")),
+            rigid=rigid, color=data.get("color", "#6b4f3a" if rigid else "#c8a165"),
             appearance=None if look is None else _appearance(look, f"{where}.appearance"))
     except ConfigError:
         raise
@@ -127,10 +126,12 @@ def parse_scenario(data: Any, *, source: str = "<scenario>") -> Scenario:
     table = data.get("table_appearance")
     table_look = None if table is None else _appearance(table, f"{source}: table_appearance")
     try:
-        workspace = Workspace(lower=tuple(ws.get("lower", (0.0, 0.0))),
-                              upper=tuple(ws.get("upper", (0.6, 0.4))))
-        return Scenario(name=str(data["name"]), blocks=blocks, workspace=workspace,
-                        description=str(data.get("description", "")), table_appearance=table_look)
+        workspace = Workspace(lower=ws.get("lower", (0.0, 0.0)), upper=ws.get("upper", (0.6, 0.4)))
+    except DeformapError as exc:
+        raise ConfigError(f"{source}: workspace: {exc}") from None
+    try:
+        return Scenario(name=data["name"], blocks=blocks, workspace=workspace,
+                        description=data.get("description", ""), table_appearance=table_look)
     except ConfigError:
         raise
     except DeformapError as exc:

@@ -24,6 +24,7 @@ from deformap._validation import check_instance
 from deformap.cloud._pointcloud import PointCloud
 from deformap.cloud.io._common import (
     check_body_size,
+    check_text_rows,
     check_units,
     finish_cloud,
     pack_rgb,
@@ -80,6 +81,7 @@ def _check_header_against_body(path: Path, meta: Any, body: bytes) -> None:
         # Each value takes at least one character and one separator.
         check_body_size(path, f"ascii body of POINTS {meta.points} × {values} values",
                         meta.points * values, body, exact=False, text=True)  # fmt: skip
+        check_text_rows(path, "the ascii body", body, values)
         return
     if encoding == "binary":
         check_body_size(path, what, need, body)

@@ -23,6 +23,7 @@ from numpy.typing import NDArray
 from deformap.cloud._pointcloud import PointCloud
 from deformap.cloud.io._common import (
     check_body_size,
+    check_text_rows,
     check_units,
     finish_cloud,
     parse_errors,
@@ -117,6 +118,12 @@ def _read_vertices(path: Path, data: bytes) -> NDArray[Any]:
                 f"{path}: PLY header says {vertex.count} vertices, the file holds {len(rows)}")
         if vertex.count == 0:
             return np.empty(0, dtype=dtype)
+        check_text_rows(path, "the ascii body", data[body_start:], None)
+        width, last = len(dtype.names or ()), len(rows[-1].split())
+        if last != width:  # a row short inside the body numpy refuses itself
+            raise FileFormatError(
+                f"{path}: PLY vertex {vertex.count - 1} (the last) holds {last} values where the "
+                f"header declares {width} properties: the file was cut or the row damaged")
         table = np.loadtxt(io.StringIO("\n".join(rows)), dtype=np.float64, ndmin=2, comments=None)
         if table.shape[1] != len(dtype.names or ()):
             raise FileFormatError(
