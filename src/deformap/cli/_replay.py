@@ -45,7 +45,12 @@ def record_sim_command(
         "--scenario", "-s", help="Built-in scenario name or YAML file.")],
     out: Annotated[Path | None, typer.Option(
         help="New session folder (default runs/<scenario>-record-s<seed>-<time>).")] = None,
-    format: Annotated[str, typer.Option("--format", help="folder | mcap | sqlite3.")] = "folder",
+    format: Annotated[str, typer.Option(
+        "--format", help="folder | mcap | sqlite3: a session; raw-mcap: the bag a robot "
+        "records (robot.mcap, and live.json with the live run's pokes).")] = "folder",
+    rig: Annotated[Path | None, typer.Option(
+        help="raw-mcap: YAML of the recording rig (rates, per-axis force noise, stamp skew, "
+             "force ramp or step, frame names; keys in docs/robot.md).")] = None,
     seed: Annotated[int | None, typer.Option(
         help="Seed of world noise and poke choice.",
         show_default=str(HELP_DEFAULTS["seed"]))] = None,
@@ -60,10 +65,12 @@ def record_sim_command(
     cfg = run.apply_overrides(run.load_run_config(config), overrides)
     shown = out_console(json_path)
     with progress(shown) as bar:
-        output = run.record_simulation(cfg, out, format=format,
+        output = run.record_simulation(cfg, out, format=format, rig=rig,
                                        hooks=run_hooks(bar, poke_row=poke_row))  # fmt: skip
     shown.print(f"wrote {output.session_file} ({output.n_pokes} pokes, {output.format} form)",
                 highlight=False)  # fmt: skip
+    if output.format == "raw-mcap":
+        shown.print(f"map it with: deformap map {output.session_file}", highlight=False)
     emit_json(json_path, dataclasses.asdict(output))  # the paths as strings
 
 

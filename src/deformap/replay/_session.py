@@ -104,8 +104,21 @@ class RecordedSession:
 
     @property
     def source(self) -> dict[str, Any]:
-        """Free-form provenance from ``session.yaml`` (scenario, seed, ...)."""
-        return dict(self.header.source)
+        """Free-form provenance from ``session.yaml`` (scenario, seed, ...); a raw bag's holds
+        what was found in it and, once its presses are read, ``presses``: what each one's entry
+        says beyond its β (:meth:`poke_notes`)."""
+        out = dict(self.header.source)
+        if isinstance(self._reader, RawBagReader) and self._reader.notes:
+            out["presses"] = {str(i + 1): dict(n) for i, n in sorted(self._reader.notes.items())}
+        return out
+
+    def poke_notes(self, index: int) -> dict[str, str]:
+        """What was noted while poke ``index`` was read: ``force_travel`` (why its record was not
+        used), ``disagreement`` (the record and the camera disagree), the camera's dent and the
+        record's travel; empty for a session."""
+        if isinstance(self._reader, RawBagReader):
+            return dict(self._reader.notes.get(index, {}))
+        return {}
 
     def __len__(self) -> int:
         return len(self.header.pokes)
@@ -211,12 +224,13 @@ def load_session(path: str | Path, *, contact_gap_m: float = DEFAULT_CONTACT_GAP
 
 
 #: Files that are a ROS 2 bag on their own (MCAP, sqlite3).
-RAW_SUFFIXES = (".mcap", ".db3")
+RAW_SUFFIXES = (".mcap", ".db3", ".bag")
 
 
 def is_raw_bag(path: str | Path) -> bool:
-    """Whether ``path`` is a bag as a robot records it: a ``.mcap`` or ``.db3`` file, or a rosbag2
-    folder (with ``metadata.yaml``) without ``session.yaml``."""
+    """Whether ``path`` is a bag as a robot records it: a ``.mcap`` or ``.db3`` file (or a ROS 1
+    ``.bag``, refused when opened), or a rosbag2 folder (with ``metadata.yaml``) without
+    ``session.yaml``."""
     p = Path(path)
     kind = path_kind(p)
     if kind == "dir":
@@ -242,12 +256,19 @@ def load_raw_bag(path: str | Path, config: RawBagConfig | None = None, *, defaul
     default_n = check_positive("default_force_n", default_force_n)
     force = default_n if cfg.force_n is None else cfg.force_n
     reader = RawBagReader(bag, cfg, force)
+    specs = reader.poke_specs()
+    workspace = reader.workspace([s.target_xy for s in specs if s.target_xy is not None])
+    reader.found["force_n"] = {"value": force, "from": "given" if cfg.force_n is not None else
+                               "the run configuration's exploration.force_n"}
+    for key, value in reader.found.items():
+        logger.info("%s: %s = %s (%s)", bag, key, value["value"], value["from"])
     header = SessionHeader(
         root=bag if bag.is_dir() else bag.parent, form="raw", units=cfg.units,
-        frame=cfg.world_frame, cam2world=None, workspace=reader.workspace(),
+        frame=str(reader.config.world_frame), cam2world=None, workspace=workspace,
         tip_radius_m=cfg.tip_radius_m, observation=None, bag=bag, ground_truth=None,
-        source={"raw": config_to_dict(cfg), "force_n": force, "n_presses": len(reader.presses)},
-        pokes=reader.poke_specs())
+        source={"raw": config_to_dict(cfg), "found": reader.found, "force_n": force,
+                "n_presses": len(reader.presses)},
+        pokes=specs)
     return RecordedSession(path=bag, header=header, ground_truth=None,
                            contact_gap_m=check_positive("contact_gap_m", contact_gap_m),
                            _reader=reader)
