@@ -95,14 +95,19 @@ def map_command(
         help="Raw bag: settings YAML (default: deformap.yaml in a rosbag2 folder, NAME.deformap"
              ".yaml beside NAME.mcap; keys in docs/robot.md).")] = None,
     cloud_topic: Annotated[str | None, typer.Option(
-        help="Raw bag: the organised PointCloud2 topic, default /camera/depth/color/points.")
+        help="Raw bag: the organised PointCloud2 topic; default: the bag's one such topic.")
     ] = None,
     wrench_topic: Annotated[str | None, typer.Option(
-        help="Raw bag: the WrenchStamped topic, default /ft_sensor/wrench.")] = None,
+        help="Raw bag: the WrenchStamped topic; default: the bag's one such topic.")] = None,
     world_frame: Annotated[str | None, typer.Option(
-        help="Raw bag: the table's frame, z up, default world.")] = None,
+        help="Raw bag: the table's frame, z up; default: world, else the camera's root frame.")
+    ] = None,
     tip_frame: Annotated[str | None, typer.Option(
-        help="Raw bag: the frame at the tip's centre, z along the stick, default tip.")] = None,
+        help="Raw bag: the frame at the tip's centre, z along the stick; default: found (the "
+             "lowest frame on the force sensor's rigid body, z up).")] = None,
+    force_frame: Annotated[str | None, typer.Option(
+        help="Raw bag: the force sensor's frame; default: the wrench's header.frame_id.")
+    ] = None,
     press_force: Annotated[float | None, typer.Option(
         help="Raw bag: the commanded force, N; default the run config's exploration.force_n.")
     ] = None,
@@ -117,7 +122,8 @@ def map_command(
                            variance_max=variance_max)
     cfg = None if config is None else run.load_run_config(config)
     raw_settings = {"cloud_topic": cloud_topic, "wrench_topic": wrench_topic,
-                    "world_frame": world_frame, "tip_frame": tip_frame, "force_n": press_force,
+                    "world_frame": world_frame, "tip_frame": tip_frame,
+                    "force_frame": force_frame, "force_n": press_force,
                     "stamp_tolerance_s": stamp_tolerance}  # fmt: skip
     shown = out_console(json_path)
     with progress(shown) as bar:
@@ -126,6 +132,9 @@ def map_command(
             hooks=run_hooks(bar, poke_row=poke_row), layout=layout,  # type: ignore[arg-type]
             raw_config=raw_config, raw_settings=raw_settings)
     report = output.report
+    read_with = report["source"].get("found") if report.get("form") == "raw" else None
+    for key, value in (read_with or {}).items():  # what the bag was read with, and why
+        shown.print(f"  {key}: {value['value']} ({value['from']})", highlight=False)
     for line in report["warnings"]:
         warn(line)  # once: the log line of a skipped poke printed it as it happened
     regions = report["regions"]

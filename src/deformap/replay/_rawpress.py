@@ -9,8 +9,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["CONTACT_NOISE_MULTIPLE", "FoundPress", "NoiseFloor", "block_means", "contact_threshold",
-           "find_presses", "noise_floor"]
+__all__ = ["CONTACT_NOISE_MULTIPLE", "FoundPress", "NoiseFloor", "block_means", "block_size",
+           "contact_threshold", "find_presses", "noise_floor", "onset"]
 
 #: The contact threshold is this many times the noise's rms magnitude: a sample of noise alone
 #: crosses it with probability below 6.4e-5 (P(|Z| > 4) with all the noise on one axis; far less
@@ -168,17 +168,22 @@ def find_presses(times_ns: NDArray[np.int64], force_n: NDArray[np.float64], *, c
     return presses
 
 
+def block_size(n: int, noise_n: float, rise_n: float) -> int:
+    """The fewest samples ``k`` whose mean rises, along a ramp of ``n`` samples rising by
+    ``rise_n``, by four times its noise (``noise_n / √k``) from one block to the next:
+    ``k = ⌈(4 n noise / rise)^(2/3)⌉``, between 1 and a third of the samples."""
+    if n < 3 or rise_n <= 0.0 or noise_n <= 0.0:
+        return 1
+    return max(1, min(int(np.ceil((4.0 * n * noise_n / rise_n) ** (2.0 / 3.0))), n // 3))
+
+
 def block_means(travel: NDArray[np.float64], force: NDArray[np.float64], noise_n: float
                 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:  # fmt: skip
     """A ramp's samples after the first (contact, kept as it is) averaged in consecutive blocks
-    of ``k``, the fewest that make the rise between two blocks at least four times the noise of a
-    block's mean force (``noise_n / √k``), so that noise cannot make the record step back:
-    ``k = ⌈(4 n noise / rise)^(2/3)⌉``, at most a third of the samples. Unchanged when ``k`` is 1."""
+    of :func:`block_size`, so that noise cannot make the record step back. Unchanged when the
+    block is one sample."""
     n = len(force) - 1
-    rise = float(force[-1] - force[0])
-    if n < 3 or rise <= 0.0 or noise_n <= 0.0:
-        return travel, force
-    k = min(int(np.ceil((4.0 * n * noise_n / rise) ** (2.0 / 3.0))), n // 3)
+    k = block_size(n, noise_n, float(force[-1] - force[0]))
     if k <= 1:
         return travel, force
     blocks = n // k
@@ -187,3 +192,20 @@ def block_means(travel: NDArray[np.float64], force: NDArray[np.float64], noise_n
     rest_t = travel[1 + skip:].reshape(blocks, k).mean(axis=1)
     rest_f = force[1 + skip:].reshape(blocks, k).mean(axis=1)
     return np.concatenate([travel[:1], rest_t]), np.concatenate([force[:1], rest_f])
+
+
+def onset(force: NDArray[np.float64], start: int, floor: int, noise: NoiseFloor, k: int) -> int:
+    """The sample of first contact: from ``start`` (the first over the contact threshold) back
+    towards ``floor``, the earliest sample whose ``k`` readings up to it, less the sensor's
+    ``baseline``, still average more than :data:`CONTACT_NOISE_MULTIPLE` times that mean's noise
+    (``rms / √k``): the foot of the ramp that the threshold on single samples cuts off. The
+    window looks back, so noise cannot put contact before the force began to rise."""
+    if noise.rms_n <= 0.0 or start - k <= floor:
+        return start
+    level = CONTACT_NOISE_MULTIPLE * noise.rms_n / np.sqrt(k)
+    seg = force[floor: start + 1] - noise.baseline
+    csum = np.concatenate([np.zeros((1, 3)), np.cumsum(seg, axis=0)])
+    i = start - floor  # the window of sample i is seg[i - k + 1 : i + 1]
+    while i - k >= 0 and float(np.linalg.norm((csum[i] - csum[i - k]) / k)) > level:
+        i -= 1
+    return floor + i
