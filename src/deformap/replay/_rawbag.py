@@ -580,7 +580,10 @@ class RawBagReader:
         if spec.index not in self._groups:
             raise FileFormatError(f"{where}: {self._errors.get(spec.index, 'no frame')}")
         cloud = self._cloud(self._groups[spec.index], where)
-        tip = tips[hold].mean(axis=0)
+        # the tip where it settled: the hold's last third (after a force step the tip still
+        # sinks early in the hold; after a ramp it is still throughout)
+        settled = max(1, (hold.stop - hold.start) // 3)
+        tip = tips[hold.stop - settled: hold.stop].mean(axis=0)
         robot = tuple(hull_points(p, r_tip[mid], tip) for p in cfg.hull)  # a hull per part
         notes = self.notes.setdefault(spec.index, {})
         record: ForceTravel | None = None
