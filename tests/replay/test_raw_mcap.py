@@ -286,3 +286,12 @@ def test_the_described_bag_maps_with_nothing_but_its_path(root: Path, tmp_path: 
     report = json.loads((out / "report.json").read_text())
     assert [p["rigid"] for p in live["pokes"]] == [False, True, False]
     _assert_like_live(report, live)
+
+
+def test_a_stamp_tolerance_that_joins_presses_is_refused(root: Path, tmp_path: Path) -> None:
+    bag, _ = _record(root, "base", {})
+    code, output, _ = _map(bag, tmp_path / "map", "--stamp-tolerance", "1e9")
+    assert code == 2
+    assert "--stamp-tolerance 1e+09 s" in output and "would join the presses" in output
+    code, output, report = _map(bag, tmp_path / "ok", "--stamp-tolerance", "0.1")
+    assert code == 0 and len(report["pokes"]) == 3, output

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import logging
 from dataclasses import dataclass, replace
+from itertools import pairwise
 from pathlib import Path
 from typing import Any
 
@@ -134,6 +135,7 @@ class RawBagReader:
             hold_min_ns=round(cfg.hold_min_s * 1e9),
             merge_ns=round(cfg.stamp_tolerance_s * 1e9), topic=self.wrench_topic,
             origin_ns=self.origin_ns)
+        self._check_merge(magnitude, contact_n)
         source = self.found["contact_force_n"]["from"]
         if self.presses and self.presses[0].start == 0:
             raise FileFormatError(
@@ -154,6 +156,24 @@ class RawBagReader:
                 self._plan_press(press)
         self._average()
         self._observation: PointCloud | None = None
+
+    def _check_merge(self, magnitude: NDArray[np.float64], contact_n: float) -> None:
+        """Refuse a ``stamp_tolerance_s`` that joins presses: one that holds the commanded force
+        twice, over the threshold apart, is two presses."""
+        cfg = self.config
+        apart = find_presses(self.wrench_ns, magnitude, commanded_n=self.commanded_n,
+                             contact_n=contact_n, band=cfg.hold_band,
+                             hold_min_ns=round(cfg.hold_min_s * 1e9), merge_ns=0,
+                             topic=self.wrench_topic, origin_ns=self.origin_ns)  # fmt: skip
+        held = [p for p in apart if p.hold_start >= 0]
+        for a, b in pairwise(held):
+            gap = (self.wrench_ns[b.start] - self.wrench_ns[a.end - 1]) / 1e9
+            if gap < cfg.stamp_tolerance_s:
+                raise FileFormatError(
+                    f"{self.path}: --stamp-tolerance {cfg.stamp_tolerance_s:g} s "
+                    f"(`stamp_tolerance_s`) would join the presses at t = "
+                    f"{self._s(self.wrench_ns[a.start])} and {self._s(self.wrench_ns[b.start])} s, "
+                    f"{gap:.3f} s apart; it must stay below the time between two presses")
 
     # -- what the bag holds, found once when it is opened ---------------------------------
 
