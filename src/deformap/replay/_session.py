@@ -108,17 +108,18 @@ class RecordedSession:
         what was found in it and, once its presses are read, ``presses``: what each one's entry
         says beyond its β (:meth:`poke_notes`)."""
         out = dict(self.header.source)
-        if isinstance(self._reader, RawBagReader) and self._reader.notes:
-            out["presses"] = {str(i + 1): dict(n) for i, n in sorted(self._reader.notes.items())}
+        notes = getattr(self._reader, "notes", None)
+        if notes:
+            out["presses"] = {str(i + 1): dict(n) for i, n in sorted(notes.items())}
         return out
 
     def poke_notes(self, index: int) -> dict[str, str]:
         """What was noted while poke ``index`` was read: ``force_travel`` (why its record was not
         used), ``disagreement`` (the record and the camera disagree), the camera's dent and the
-        record's travel; empty for a session."""
-        if isinstance(self._reader, RawBagReader):
-            return dict(self._reader.notes.get(index, {}))
-        return {}
+        record's travel; ``stamp_gaps_s``, topic → how far [s] the message used lies from the
+        poke's stamp (a bag-form session read with a stamp tolerance); else empty."""
+        notes = getattr(self._reader, "notes", None)
+        return dict(notes.get(index, {})) if notes else {}
 
     def __len__(self) -> int:
         return len(self.header.pokes)
@@ -196,21 +197,27 @@ def _session_file(path: Path) -> Path:
     raise FileFormatError(f"{path}: no such session folder or file")
 
 
-def load_session(path: str | Path, *, contact_gap_m: float = DEFAULT_CONTACT_GAP_M
-                 ) -> RecordedSession:  # fmt: skip
+def load_session(path: str | Path, *, contact_gap_m: float = DEFAULT_CONTACT_GAP_M,
+                 stamp_tolerance_s: float | None = None) -> RecordedSession:
     """Open a recorded session (its folder or ``session.yaml``) and check ``session.yaml``.
 
     Pokes are read on demand (:meth:`RecordedSession.press_observation`), each refused when its
-    contact point lies farther than ``contact_gap_m`` from every surface point. A ``session.yaml``
-    that is no valid YAML or has unknown, missing or bad keys is a ConfigError; a missing
-    observation or bag, a missing topic or an unreadable ground truth a FileFormatError.
+    contact point lies farther than ``contact_gap_m`` from every surface point. A bag-form poke
+    takes on each topic the message stamped ``stamp_ns``, or with ``stamp_tolerance_s`` the one
+    nearest it within that many seconds (the gap in :meth:`RecordedSession.poke_notes`); a
+    tolerance reaching half-way to another poke's stamp, or given to a folder-form session, is
+    refused. A ``session.yaml`` that is no valid YAML or has unknown, missing or bad keys is a
+    ConfigError; a missing observation or bag, a missing topic or an unreadable ground truth a
+    FileFormatError.
     """
     p = check_path("path", path)
     gap = check_positive("contact_gap_m", contact_gap_m)
     file = _session_file(p)
     header = parse_session_yaml(
         load_yaml(file, what="the session file", unreadable=FileFormatError), file)
-    reader = FolderReader(header) if header.form == "folder" else BagReader(header)
+    tolerance = _stamp_tolerance(file, header, stamp_tolerance_s)
+    reader = (FolderReader(header) if header.form == "folder"
+              else BagReader(header, tolerance))  # fmt: skip
     truth = None
     if header.ground_truth is not None:
         if path_kind(header.ground_truth) == "file":
@@ -221,6 +228,27 @@ def load_session(path: str | Path, *, contact_gap_m: float = DEFAULT_CONTACT_GAP
         logger.warning("%s: poke(s) %s have bad entries and will be refused", file, broken)
     return RecordedSession(path=file.parent, header=header, ground_truth=truth,
                            contact_gap_m=gap, _reader=reader)  # fmt: skip
+
+
+def _stamp_tolerance(file: Path, header: SessionHeader, tolerance_s: float | None) -> int:
+    """The stamp tolerance [ns] of a bag-form session: bounded by half the closest two pokes'
+    stamps, so that no message can be taken for two pokes."""
+    if tolerance_s is None:
+        return 0
+    tol = check_positive("stamp_tolerance_s", tolerance_s)
+    if header.form != "bag":
+        raise InvalidArgumentError(
+            f"{file}: --stamp-tolerance applies to bags (stamped messages); this session is of "
+            f"the {header.form} form")
+    stamps = sorted(s.stamp_ns for s in header.pokes if s.stamp_ns is not None)
+    gaps = np.diff(stamps)
+    if gaps.size and tol * 1e9 >= gaps.min() / 2:
+        k = int(np.argmin(gaps))
+        raise InvalidArgumentError(
+            f"{file}: --stamp-tolerance {tol:g} s reaches half-way from one poke's stamp to the "
+            f"next ({stamps[k]} and {stamps[k + 1]} ns, {gaps[k] / 1e9:g} s apart): a message "
+            "could be taken for two pokes; give less than half their distance")
+    return round(tol * 1e9)
 
 
 #: Files that are a ROS 2 bag on their own (MCAP, sqlite3).
