@@ -153,3 +153,41 @@ def test_a_frame_tf_static_does_not_resolve_is_named(
     _rewrite(folder / "bag", rename, static=[("world", "camera", np.eye(4))])
     with pytest.raises(DeformapError, match="'optoforce', which the bag's /tf_static does not"):
         load_session(folder).press_observation(0)
+
+
+def test_an_observation_stream_is_averaged_pixel_by_pixel(
+    tmp_path: Path, write_synthetic: Any, synthetic: Any
+) -> None:
+    from rosbags.rosbag2 import Reader
+
+    from deformap.cloud.io import bag_writer, typestore
+
+    folder = _session(tmp_path, write_synthetic, synthetic)
+    want = load_session(folder).observation()
+    store, bag, new = typestore(), folder / "bag", folder / "rewritten"
+    n = len(want) // 2 * 2  # an even count: two rows
+    with Reader(bag) as reader, bag_writer(new) as writer:
+        conns = {c.id: writer.add_connection(c.topic, c.msgtype, typestore=store)
+                 for c in reader.connections}  # fmt: skip
+        for conn, log_time, data in reader.messages():
+            if conn.topic != "/deformap/observation":
+                writer.write(conns[conn.id], log_time, data)
+                continue
+            for k, dz in enumerate((0.001, -0.001, 0.0)):  # three frames of one scene
+                msg = store.deserialize_cdr(data, conn.msgtype)
+                step = int(msg.point_step)
+                table = np.frombuffer(bytes(msg.data), dtype=np.float64).reshape(-1, step // 8)
+                table = table[:n].copy()
+                table[:, 2] += dz
+                if k == 2:
+                    table[::2, :3] = np.nan  # holes in the last frame only
+                msg.data = table.view(np.uint8).ravel()
+                msg.height, msg.width, msg.row_step = 2, n // 2, step * n // 2
+                msg.is_dense = False
+                msg.header.stamp.nanosec = k
+                writer.write(conns[conn.id], log_time + k,
+                             store.serialize_cdr(msg, conn.msgtype))
+    shutil.rmtree(bag)
+    new.rename(bag)
+    got = load_session(folder).observation()
+    np.testing.assert_allclose(got.points, want.points[:n], atol=1e-12)

@@ -112,8 +112,9 @@ def map_command(
         help="Raw bag: the commanded force, N; default the run config's exploration.force_n.")
     ] = None,
     stamp_tolerance: Annotated[float | None, typer.Option(
-        help="Raw bag: largest time between a press and its frame or transform, s; "
-             "default 0.05.")] = None,
+        help="Largest time between a press and its frame or transform (raw bag, default 0.05), "
+             "or a poke's stamp and its messages (bag-form session, default 0: exact), s.")
+    ] = None,
     json_path: JsonOption = None,
 ) -> None:
     """Map a recorded session (or a robot's raw bag): its pokes, in order, through the live

@@ -26,10 +26,13 @@ from deformap.cloud.io import (
     header_stamp_ns,
     iter_bag_messages,
     path_kind,
+    pointcloud2_colors,
+    pointcloud2_structured,
     pointcloud2_to_cloud,
     read_bag_static_transform,
     typestore,
     wrench_message,
+    xyz_with_holes,
 )
 from deformap.environment import ForceTravel, PressObservation
 from deformap.errors import DeformapError, FileFormatError
@@ -173,13 +176,58 @@ class BagReader:
 
     def observation(self) -> PointCloud:
         topic = TOPICS["observation"][0]
-        msgs = [msg for same in self._by_stamp("observation").values() for msg in same]
-        if len(msgs) != 1:
-            bad = self._undecodable["observation"]
+        msgs = [msg for _, same in sorted(self._by_stamp("observation").items()) for msg in same]
+        bad = self._undecodable["observation"]
+        if not msgs or bad:
             raise FileFormatError(
-                f"{self.path}: topic {topic!r} must hold exactly one message; got {len(msgs)}"
-                + (f" ({len(bad)} could not be decoded: {bad[0]})" if bad else ""))
-        return self._to_world(self._cloud(msgs[0], f"{self.path} [{topic}]", self.header.frame))
+                f"{self.path}: topic {topic!r} must hold at least one message, each readable; got "
+                f"{len(msgs)}" + (f" ({len(bad)} could not be decoded: {bad[0]})" if bad else ""))
+        if len(msgs) == 1:
+            return self._to_world(self._cloud(msgs[0], f"{self.path} [{topic}]",
+                                              self.header.frame))  # fmt: skip
+        return self._to_world(self._averaged(msgs, f"{self.path} [{topic}]"))
+
+    def _averaged(self, msgs: list[Any], where: str) -> PointCloud:
+        """A stream of organised clouds of one shape averaged pixel by pixel (NaN holes left
+        out; colours too when every frame has them), as a raw bag's observation is."""
+        shapes = {(int(m.height), int(m.width)) for m in msgs}
+        if len(shapes) != 1 or next(iter(shapes))[0] == 1:
+            raise FileFormatError(
+                f"{where}: {len(msgs)} messages; several are averaged pixel by pixel, so they "
+                f"must be organised clouds (height > 1) of one shape; got shapes {sorted(shapes)}")
+        total: NDArray[np.float64] | None = None
+        count: NDArray[np.int64] | None = None
+        rgb_sum: NDArray[np.float64] | None = None
+        colored = True
+        for n, msg in enumerate(msgs, start=1):
+            if msg.header.frame_id != self.header.frame:
+                raise FileFormatError(
+                    f"{where} message {n}: header.frame_id is {msg.header.frame_id!r} but the "
+                    f"session's frame is {self.header.frame!r} (session.yaml `frame`)")
+            try:
+                table = pointcloud2_structured(msg)
+                xyz = xyz_with_holes(msg, table)
+            except DeformapError as exc:
+                raise FileFormatError(f"{where} message {n}: {exc}") from None
+            ok = np.isfinite(xyz).all(axis=1)
+            rgb = pointcloud2_colors(msg, where=f"{where} message {n}", table=table, valid=ok)
+            if total is None or count is None:
+                total, count = np.zeros_like(xyz), np.zeros(len(xyz), dtype=np.int64)
+                rgb_sum = np.zeros_like(xyz)
+            total[ok] += xyz[ok]
+            count[ok] += 1
+            if rgb is None:
+                colored = False
+            elif rgb_sum is not None:
+                rgb_sum[ok] += rgb[ok]
+        assert total is not None and count is not None and rgb_sum is not None
+        seen = count > 0
+        if not seen.any():
+            raise FileFormatError(f"{where}: its {len(msgs)} messages hold no finite point")
+        scale = 1e-3 if self.header.units == "mm" else 1.0
+        colors = np.clip(rgb_sum[seen] / count[seen, None], 0, 1) if colored else None
+        return PointCloud(total[seen] / count[seen, None] * scale, colors,
+                          frame=self.header.frame)
 
     def press_parts(self, spec: PokeSpec) -> PressParts:
         assert spec.stamp_ns is not None
