@@ -288,6 +288,14 @@ def load_raw_bag(path: str | Path, config: RawBagConfig | None = None, *, defaul
     workspace = reader.workspace([s.target_xy for s in specs if s.target_xy is not None])
     reader.found["force_n"] = {"value": force, "from": "given" if cfg.force_n is not None else
                                "the run configuration's exploration.force_n"}
+    defaults = RawBagConfig()
+    for key in ("units", "wrench_sign", "tip_radius_m", "hull", "stamp_tolerance_s",
+                "hold_band", "hold_min_s", "observation_frames"):
+        value = getattr(cfg, key)
+        shown = (f"{len(value)} part(s): " + ", ".join(p.shape for p in value) if key == "hull"
+                 else value)  # fmt: skip
+        reader.found[key] = {"value": shown, "from": "assumed: the default (docs/robot.md)"
+                             if value == getattr(defaults, key) else "given"}
     for key, value in reader.found.items():
         logger.info("%s: %s = %s (%s)", bag, key, value["value"], value["from"])
     header = SessionHeader(
