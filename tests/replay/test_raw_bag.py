@@ -200,7 +200,7 @@ def test_a_tip_frame_whose_z_points_into_the_surface_is_named(
     code, output, _ = _map(raw_bag, tmp_path / "map", config_file, "--raw-config", str(settings))
     assert code == 2, output
     assert "'tool0'" in output and "`tip_frame` must have z along the stick" in output
-    assert "wrench_sign" not in output
+    assert not any("wrench_sign" in ln for ln in output.splitlines() if "press" in ln)
 
 
 def test_a_bad_yaml_key_is_named(raw_bag: Path, config_file: Path, tmp_path: Path) -> None:
