@@ -135,7 +135,6 @@ class RawBagReader:
             hold_min_ns=round(cfg.hold_min_s * 1e9),
             merge_ns=round(cfg.stamp_tolerance_s * 1e9), topic=self.wrench_topic,
             origin_ns=self.origin_ns)
-        self._check_merge(magnitude, contact_n)
         source = self.found["contact_force_n"]["from"]
         if self.presses and self.presses[0].start == 0:
             raise FileFormatError(
@@ -147,6 +146,7 @@ class RawBagReader:
                 f"{bag}: no press on {self.wrench_topic!r}: the force must stay above "
                 f"{contact_n:.4g} N ({source}) for {cfg.hold_min_s:g} s at least once; its "
                 f"largest is {float(magnitude.max()):.4g} N")
+        self._check_merge(magnitude, contact_n)
         self.config = cfg = self._tip(cfg)
         self._groups: dict[int, _Group] = {}
         self._errors: dict[int, str] = {}
