@@ -45,7 +45,12 @@ def record_sim_command(
         "--scenario", "-s", help="Built-in scenario name or YAML file.")],
     out: Annotated[Path | None, typer.Option(
         help="New session folder (default runs/<scenario>-record-s<seed>-<time>).")] = None,
-    format: Annotated[str, typer.Option("--format", help="folder | mcap | sqlite3.")] = "folder",
+    format: Annotated[str, typer.Option(
+        "--format", help="folder | mcap | sqlite3: a session; raw-mcap: the bag a robot "
+        "records (robot.mcap, and live.json with the live run's pokes).")] = "folder",
+    rig: Annotated[Path | None, typer.Option(
+        help="raw-mcap: YAML of the recording rig (rates, per-axis force noise, stamp skew, "
+             "force ramp or step, frame names; keys in docs/robot.md).")] = None,
     seed: Annotated[int | None, typer.Option(
         help="Seed of world noise and poke choice.",
         show_default=str(HELP_DEFAULTS["seed"]))] = None,
@@ -60,10 +65,12 @@ def record_sim_command(
     cfg = run.apply_overrides(run.load_run_config(config), overrides)
     shown = out_console(json_path)
     with progress(shown) as bar:
-        output = run.record_simulation(cfg, out, format=format,
+        output = run.record_simulation(cfg, out, format=format, rig=rig,
                                        hooks=run_hooks(bar, poke_row=poke_row))  # fmt: skip
     shown.print(f"wrote {output.session_file} ({output.n_pokes} pokes, {output.format} form)",
                 highlight=False)  # fmt: skip
+    if output.format == "raw-mcap":
+        shown.print(f"map it with: deformap map {output.session_file}", highlight=False)
     emit_json(json_path, dataclasses.asdict(output))  # the paths as strings
 
 
@@ -88,20 +95,26 @@ def map_command(
         help="Raw bag: settings YAML (default: deformap.yaml in a rosbag2 folder, NAME.deformap"
              ".yaml beside NAME.mcap; keys in docs/robot.md).")] = None,
     cloud_topic: Annotated[str | None, typer.Option(
-        help="Raw bag: the organised PointCloud2 topic, default /camera/depth/color/points.")
+        help="Raw bag: the organised PointCloud2 topic; default: the bag's one such topic.")
     ] = None,
     wrench_topic: Annotated[str | None, typer.Option(
-        help="Raw bag: the WrenchStamped topic, default /ft_sensor/wrench.")] = None,
+        help="Raw bag: the WrenchStamped topic; default: the bag's one such topic.")] = None,
     world_frame: Annotated[str | None, typer.Option(
-        help="Raw bag: the table's frame, z up, default world.")] = None,
+        help="Raw bag: the table's frame, z up; default: world, else the camera's root frame.")
+    ] = None,
     tip_frame: Annotated[str | None, typer.Option(
-        help="Raw bag: the frame at the tip's centre, z along the stick, default tip.")] = None,
+        help="Raw bag: the frame at the tip's centre, z along the stick; default: found (the "
+             "lowest frame on the force sensor's rigid body, z up).")] = None,
+    force_frame: Annotated[str | None, typer.Option(
+        help="Raw bag: the force sensor's frame; default: the wrench's header.frame_id.")
+    ] = None,
     press_force: Annotated[float | None, typer.Option(
         help="Raw bag: the commanded force, N; default the run config's exploration.force_n.")
     ] = None,
     stamp_tolerance: Annotated[float | None, typer.Option(
-        help="Raw bag: largest time between a press and its frame or transform, s; "
-             "default 0.05.")] = None,
+        help="Largest time between a press and its frame or transform (raw bag, default 0.05), "
+             "or a poke's stamp and its messages (bag-form session, default 0: exact), s.")
+    ] = None,
     json_path: JsonOption = None,
 ) -> None:
     """Map a recorded session (or a robot's raw bag): its pokes, in order, through the live
@@ -110,7 +123,8 @@ def map_command(
                            variance_max=variance_max)
     cfg = None if config is None else run.load_run_config(config)
     raw_settings = {"cloud_topic": cloud_topic, "wrench_topic": wrench_topic,
-                    "world_frame": world_frame, "tip_frame": tip_frame, "force_n": press_force,
+                    "world_frame": world_frame, "tip_frame": tip_frame,
+                    "force_frame": force_frame, "force_n": press_force,
                     "stamp_tolerance_s": stamp_tolerance}  # fmt: skip
     shown = out_console(json_path)
     with progress(shown) as bar:
@@ -119,6 +133,9 @@ def map_command(
             hooks=run_hooks(bar, poke_row=poke_row), layout=layout,  # type: ignore[arg-type]
             raw_config=raw_config, raw_settings=raw_settings)
     report = output.report
+    read_with = report["source"].get("found") if report.get("form") == "raw" else None
+    for key, value in (read_with or {}).items():  # what the bag was read with, and why
+        shown.print(f"  {key}: {value['value']} ({value['from']})", highlight=False)
     for line in report["warnings"]:
         warn(line)  # once: the log line of a skipped poke printed it as it happened
     regions = report["regions"]

@@ -26,10 +26,13 @@ from deformap.cloud.io import (
     header_stamp_ns,
     iter_bag_messages,
     path_kind,
+    pointcloud2_colors,
+    pointcloud2_structured,
     pointcloud2_to_cloud,
     read_bag_static_transform,
     typestore,
     wrench_message,
+    xyz_with_holes,
 )
 from deformap.environment import ForceTravel, PressObservation
 from deformap.errors import DeformapError, FileFormatError
@@ -45,10 +48,15 @@ __all__ = ["FORCE_TRAVEL_DIMS", "BagReader", "force_travel_message", "write_sess
 class BagReader:
     """Reads the poke messages of a bag-form session, each one when its poke is asked for."""
 
-    def __init__(self, header: SessionHeader) -> None:
+    def __init__(self, header: SessionHeader, stamp_tolerance_ns: int = 0) -> None:
         assert header.bag is not None
         self.header = header
         self.path = header.bag
+        #: a message stamped this far [ns] from its poke's ``stamp_ns`` still belongs to it
+        self.stamp_tolerance_ns = stamp_tolerance_ns
+        #: per poke (0-based): what its entry says beyond its β (``stamp_gaps_s``)
+        self.notes: dict[int, dict[str, Any]] = {}
+        self._to_world_of: dict[str, NDArray[np.float64]] = {}
         if path_kind(self.path) == "missing":
             raise FileFormatError(f"{self.path}: no such bag (the session's `bag`)")
         for file in check_bag_confined(self.path):
@@ -110,8 +118,17 @@ class BagReader:
             self._decoded[key] = by_stamp
         return self._decoded[key]
 
-    def _message(self, key: str, stamp: int) -> Any:
-        topic, msgs = TOPICS[key][0], self._by_stamp(key).get(stamp, [])
+    def _message(self, key: str, stamp: int, index: int = -1) -> Any:
+        by_stamp = self._by_stamp(key)
+        msgs = by_stamp.get(stamp, [])
+        if not msgs and self.stamp_tolerance_ns and by_stamp:
+            # the nearest stamp within the tolerance; the gap goes to the poke's entry
+            near = min(by_stamp, key=lambda s: abs(s - stamp))
+            if abs(near - stamp) <= self.stamp_tolerance_ns:
+                msgs = by_stamp[near]
+                gaps = self.notes.setdefault(index, {}).setdefault("stamp_gaps_s", {})
+                gaps[TOPICS[key][0]] = (near - stamp) / 1e9
+        topic = TOPICS[key][0]
         if len(msgs) > 1:  # which one is the poke's? neither is kept silently
             raise FileFormatError(
                 f"{self.path}: topic {topic!r} has {len(msgs)} messages stamped {stamp}; "
@@ -119,8 +136,10 @@ class BagReader:
         if not msgs:
             bad = self._undecodable[key]
             note = f"; {len(bad)} message(s) there could not be decoded ({bad[0]})" if bad else ""
+            within = (f" or within {self.stamp_tolerance_ns / 1e9:g} s (--stamp-tolerance)"
+                      if self.stamp_tolerance_ns else "")
             raise FileFormatError(
-                f"{self.path}: topic {topic!r} has no message stamped {stamp}{note}")
+                f"{self.path}: topic {topic!r} has no message stamped {stamp}{within}{note}")
         return msgs[0]
 
     def _cloud(self, msg: Any, where: str, frame: str, colors: bool = True) -> PointCloud:
@@ -132,6 +151,18 @@ class BagReader:
         cloud, _ = pointcloud2_to_cloud(msg, where=where, units=self.header.units, frame=frame,
                                         colors=colors)  # fmt: skip
         return cloud
+
+    def _static_to_world(self, frame: str, where: str) -> NDArray[np.float64]:
+        """``frame``'s 4×4 transform to ``world`` from the bag's ``/tf_static``; a frame it does
+        not resolve is refused naming the message."""
+        if frame not in self._to_world_of:
+            try:
+                self._to_world_of[frame] = read_bag_static_transform(self.path, frame, "world")
+            except FileFormatError as exc:
+                raise FileFormatError(
+                    f"{where}: header.frame_id is {frame!r}, which the bag's /tf_static does not "
+                    f"take to 'world' ({exc})") from None
+        return self._to_world_of[frame]
 
     def _to_world(self, cloud: PointCloud) -> PointCloud:
         cam2world = self.header.cam2world
@@ -145,13 +176,58 @@ class BagReader:
 
     def observation(self) -> PointCloud:
         topic = TOPICS["observation"][0]
-        msgs = [msg for same in self._by_stamp("observation").values() for msg in same]
-        if len(msgs) != 1:
-            bad = self._undecodable["observation"]
+        msgs = [msg for _, same in sorted(self._by_stamp("observation").items()) for msg in same]
+        bad = self._undecodable["observation"]
+        if not msgs or bad:
             raise FileFormatError(
-                f"{self.path}: topic {topic!r} must hold exactly one message; got {len(msgs)}"
-                + (f" ({len(bad)} could not be decoded: {bad[0]})" if bad else ""))
-        return self._to_world(self._cloud(msgs[0], f"{self.path} [{topic}]", self.header.frame))
+                f"{self.path}: topic {topic!r} must hold at least one message, each readable; got "
+                f"{len(msgs)}" + (f" ({len(bad)} could not be decoded: {bad[0]})" if bad else ""))
+        if len(msgs) == 1:
+            return self._to_world(self._cloud(msgs[0], f"{self.path} [{topic}]",
+                                              self.header.frame))  # fmt: skip
+        return self._to_world(self._averaged(msgs, f"{self.path} [{topic}]"))
+
+    def _averaged(self, msgs: list[Any], where: str) -> PointCloud:
+        """A stream of organised clouds of one shape averaged pixel by pixel (NaN holes left
+        out; colours too when every frame has them), as a raw bag's observation is."""
+        shapes = {(int(m.height), int(m.width)) for m in msgs}
+        if len(shapes) != 1 or next(iter(shapes))[0] == 1:
+            raise FileFormatError(
+                f"{where}: {len(msgs)} messages; several are averaged pixel by pixel, so they "
+                f"must be organised clouds (height > 1) of one shape; got shapes {sorted(shapes)}")
+        total: NDArray[np.float64] | None = None
+        count: NDArray[np.int64] | None = None
+        rgb_sum: NDArray[np.float64] | None = None
+        colored = True
+        for n, msg in enumerate(msgs, start=1):
+            if msg.header.frame_id != self.header.frame:
+                raise FileFormatError(
+                    f"{where} message {n}: header.frame_id is {msg.header.frame_id!r} but the "
+                    f"session's frame is {self.header.frame!r} (session.yaml `frame`)")
+            try:
+                table = pointcloud2_structured(msg)
+                xyz = xyz_with_holes(msg, table)
+            except DeformapError as exc:
+                raise FileFormatError(f"{where} message {n}: {exc}") from None
+            ok = np.isfinite(xyz).all(axis=1)
+            rgb = pointcloud2_colors(msg, where=f"{where} message {n}", table=table, valid=ok)
+            if total is None or count is None:
+                total, count = np.zeros_like(xyz), np.zeros(len(xyz), dtype=np.int64)
+                rgb_sum = np.zeros_like(xyz)
+            total[ok] += xyz[ok]
+            count[ok] += 1
+            if rgb is None:
+                colored = False
+            elif rgb_sum is not None:
+                rgb_sum[ok] += rgb[ok]
+        assert total is not None and count is not None and rgb_sum is not None
+        seen = count > 0
+        if not seen.any():
+            raise FileFormatError(f"{where}: its {len(msgs)} messages hold no finite point")
+        scale = 1e-3 if self.header.units == "mm" else 1.0
+        colors = np.clip(rgb_sum[seen] / count[seen, None], 0, 1) if colored else None
+        return PointCloud(total[seen] / count[seen, None] * scale, colors,
+                          frame=self.header.frame)
 
     def press_parts(self, spec: PokeSpec) -> PressParts:
         assert spec.stamp_ns is not None
@@ -160,21 +236,23 @@ class BagReader:
         def where(key: str) -> str:
             return f"{self.path} [{TOPICS[key][0]} stamped {stamp}]"
 
-        cloud = self._to_world(self._cloud(self._message("cloud", stamp), where("cloud"),
+        i = spec.index
+        cloud = self._to_world(self._cloud(self._message("cloud", stamp, i), where("cloud"),
                                            self.header.frame))  # fmt: skip
-        robot = self._cloud(self._message("robot", stamp), where("robot"), "world", colors=False)
+        robot = self._cloud(self._message("robot", stamp, i), where("robot"), "world",
+                            colors=False)  # fmt: skip
         values = {}
         for key in ("wrench", "tip"):
-            msg = self._message(key, stamp)
-            if msg.header.frame_id != "world":
-                raise FileFormatError(
-                    f"{where(key)}: header.frame_id is {msg.header.frame_id!r}; the bag form "
-                    "stores contacts in the 'world' frame")
+            msg = self._message(key, stamp, i)
             vec = msg.wrench.force if key == "wrench" else msg.point
             values[key] = np.array([vec.x, vec.y, vec.z], dtype=float)
             if not np.isfinite(values[key]).all():
                 raise FileFormatError(
                     f"{where(key)}: holds NaN or infinite values {values[key].tolist()}")
+            frame = str(msg.header.frame_id)
+            if frame != "world":  # a sensor's own frame: the bag's /tf_static takes it there
+                m = self._static_to_world(frame, where(key))
+                values[key] = m[:3, :3] @ values[key] + (m[:3, 3] if key == "tip" else 0.0)
         return PressParts(cloud, values["tip"], values["wrench"], np.asarray(robot.points),
                           self._force_travel(stamp))
 

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import partial
 from typing import Any
 
@@ -30,15 +30,20 @@ logger = logging.getLogger(__name__)
 @dataclass
 class ReplayResult:
     """What :func:`map_session` produced: the ``result`` of every usable poke (``stop_reason``
-    ``"end-of-session"``), and ``skipped``, ``{"index": i, "error": message}`` per unusable poke."""
+    ``"end-of-session"``), ``skipped``, ``{"index": i, "error": message}`` per unusable poke, and
+    ``notes``, ``{"index": i, "warning": message}`` per poke used with a warning (a raw bag's
+    record and camera that disagree)."""
 
     result: ExplorationResult
     skipped: list[dict[str, Any]] = field(default_factory=list)
+    notes: list[dict[str, Any]] = field(default_factory=list)
 
     @property
     def warnings(self) -> list[str]:
-        """One line per skipped poke, numbered from 1 as the console and figures are."""
-        return [f"poke {s['index'] + 1} skipped: {s['error']}" for s in self.skipped]
+        """One line per skipped poke or warning, numbered from 1 as the console and figures
+        are."""
+        return [*(f"poke {s['index'] + 1} skipped: {s['error']}" for s in self.skipped),
+                *(f"poke {n['index'] + 1}: {n['warning']}" for n in self.notes)]
 
 
 def map_session(session: RecordedSession, config: ExplorationConfig, *, rng: np.random.Generator,
@@ -56,6 +61,8 @@ def map_session(session: RecordedSession, config: ExplorationConfig, *, rng: np.
     # child depends only on its position, so spawning one gives that same stream.
     run = MappingRun(session.workspace, config, session.observation, rng.spawn(1)[0])
     skipped: list[dict[str, Any]] = []
+    notes: list[dict[str, Any]] = []
+    unread: dict[int, str] = {}
     for index in range(len(session)):
         try:
             # reading the session stands in for the environment of the live loop
@@ -64,9 +71,19 @@ def map_session(session: RecordedSession, config: ExplorationConfig, *, rng: np.
             logger.warning("poke %d skipped: %s", index + 1, exc)
             skipped.append({"index": index, "error": str(exc)})
             continue
+        found = session.poke_notes(index)
+        if "disagreement" in found:
+            notes.append({"index": index, "warning": found["disagreement"]})
+        if "force_travel" in found and poke.record.stiffness_error is None:
+            unread[index] = found["force_travel"]
         if on_poke is not None:
             on_poke(poke)
-    return ReplayResult(result=run.result("end-of-session"), skipped=skipped)
+    result = run.result("end-of-session")
+    if unread:  # the poke's own entry says why it has no modulus
+        pokes = tuple(replace(p, record=replace(p.record, stiffness_error=unread[p.record.index]))
+                      if p.record.index in unread else p for p in result.pokes)  # fmt: skip
+        result = replace(result, pokes=pokes)
+    return ReplayResult(result=result, skipped=skipped, notes=notes)
 
 
 def tip_sphere_points(tip_center: Any, tip_radius_m: float) -> NDArray[np.float64]:

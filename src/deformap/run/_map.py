@@ -147,11 +147,13 @@ def _open(path: Path, config: RunConfig | None, layout: str, raw_config: Path | 
         RawBagConfig(**given)
     raw = layout == "raw" or (layout == "auto" and is_raw_bag(path))
     if not raw:
-        if raw_config is not None or any(v is not None for v in raw_settings.values()):
+        tolerance = raw_settings.get("stamp_tolerance_s")  # every layout takes it
+        if raw_config is not None or any(v is not None for k, v in raw_settings.items()
+                                         if k != "stamp_tolerance_s"):
             raise InvalidArgumentError(
                 f"raw recording settings apply to a bag as a robot records it; {str(path)!r} is "
                 "read as a deformap session (pass --layout raw to read it as a raw bag)")
-        return load_session(path)
+        return load_session(path, stamp_tolerance_s=tolerance)
     settings = load_raw_config(path, raw_config, **raw_settings)
     force = (config or RunConfig()).exploration.force_n
     return load_raw_bag(path, settings, default_force_n=force)
