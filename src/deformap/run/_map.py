@@ -34,7 +34,7 @@ from deformap.run._config import (
 )
 from deformap.run._export import write_run_results
 from deformap.run._folder import (
-    create_run_folder,
+    claim_run_folder,
     default_run_folder,
     run_stem,
     write_text,
@@ -114,7 +114,9 @@ def map_recorded_session(
     ------
     ConfigError, FileFormatError
         The session cannot be loaded, its recorded configuration is malformed, or ``out`` is not
-        empty or not creatable (before any poke is mapped).
+        empty, not creatable or held by another run (before any poke is mapped).
+    FileWriteError
+        A file of the result could not be written (a full disk, a read-only file system, ...).
     """
     if variance_max is not None:  # before any work
         check_positive("variance_max", variance_max)
@@ -122,19 +124,19 @@ def map_recorded_session(
     cfg = session_run_config(recorded, config, seed)
     stem = recorded.path.name or "session"
     folder = out or default_run_folder(run_stem(stem), "map", cfg.seed)
-    create_run_folder(folder, what="result")
-    title = f"{recorded.path} ({len(recorded)} pokes, {recorded.form} form)"
-    hooks.start(RunStart(kind="map", title=title, folder=folder, total=len(recorded)))
-    _, explore_rng = run_generators(cfg.seed)
-    hooks.stage("mapping")
-    replay = map_session(recorded, cfg.exploration, rng=explore_rng,
-                         on_poke=lambda poke: hooks.poke(poke.record))  # fmt: skip
-    write_text(folder / CONFIG_NAME, config_yaml(cfg))
-    report = session_report(cfg, recorded, replay)
-    write_run_results(folder, replay.result, report, figures=figures,
-                      truth=recorded.ground_truth,
-                      title=f"{stem}: {len(replay.result.pokes)} pokes", hooks=hooks,
-                      variance_max=variance_max)  # fmt: skip
+    with claim_run_folder(folder, what="result"):
+        title = f"{recorded.path} ({len(recorded)} pokes, {recorded.form} form)"
+        hooks.start(RunStart(kind="map", title=title, folder=folder, total=len(recorded)))
+        _, explore_rng = run_generators(cfg.seed)
+        hooks.stage("mapping")
+        replay = map_session(recorded, cfg.exploration, rng=explore_rng,
+                             on_poke=lambda poke: hooks.poke(poke.record))  # fmt: skip
+        write_text(folder / CONFIG_NAME, config_yaml(cfg))
+        report = session_report(cfg, recorded, replay)
+        write_run_results(folder, replay.result, report, figures=figures,
+                          truth=recorded.ground_truth,
+                          title=f"{stem}: {len(replay.result.pokes)} pokes", hooks=hooks,
+                          variance_max=variance_max)  # fmt: skip
     return MapOutput(report=report, session=recorded, replay=replay, config=cfg, folder=folder)
 
 
