@@ -23,9 +23,9 @@ from deformap.stiffness import LAYER_MODEL, StiffnessEstimate
 __all__ = ["PURPOSES", "ContactRecord", "Dent", "PokeRecord", "PokeResult", "PokeTimings", "Purpose",
            "Target"]
 
-#: Why a place was poked: the first poke, the strategy's (until the variance is under ``T_h``), or
-#: a boundary poke after it.
-Purpose = Literal["first", "variance", "boundary"]
+#: Why a place was poked: the first poke, the strategy's (until the variance is under ``T_h``), a
+#: look the appearance prior asks to test, or a boundary poke after it.
+Purpose = Literal["first", "variance", "boundary", "appearance"]
 PURPOSES: tuple[str, ...] = get_args(Purpose)
 
 
