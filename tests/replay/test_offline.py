@@ -391,3 +391,18 @@ def test_recorded_world_presses_read_back_identical(tmp_path: Path, form: str) -
         assert want.force_travel is not None
         assert got.force_travel == want.force_travel
         assert np.array_equal(got.cloud.points, want.cloud.points)
+
+
+def test_map_rerun_writes_the_recording_of_the_mapped_session(recorded: Path, tmp_path: Path
+                                                              ) -> None:  # fmt: skip
+    pytest.importorskip("rerun")
+    from rerun.chunk import RrdReader
+
+    result = _cli("map", str(recorded), "--out", str(tmp_path / "m"), "--no-figures", "--rerun")
+    assert result.exit_code == 0, result.output
+    chunks = list(RrdReader(tmp_path / "m" / "run.rrd").stream())
+    entities = {str(c.entity_path) for c in chunks}
+    assert {"/world", "/world/observation", "/world/press/dent", "/maps/beta"} <= entities
+    beta = [c.to_record_batch() for c in chunks if str(c.entity_path) == "/metrics/beta"]
+    assert sum(b.num_rows for b in beta) == len(load_session(recorded))  # one row a poke
+    assert all({"poke", "time"} <= set(b.schema.names) for b in beta)

@@ -88,6 +88,8 @@ def map_command(
         help="Seed of the surface fit; default: the session's.")] = None,
     figures: Annotated[bool, typer.Option(help="Write map.png and poke-NN.png.")] = True,
     variance_max: VarianceMaxOption = None,
+    rerun: Annotated[bool, typer.Option("--rerun", help="Also write run.rrd (extra `rerun`).")
+                     ] = False,
     layout: Annotated[str, typer.Option(
         help="auto | session | raw: raw reads SESSION as a bag a robot recorded (camera, force "
              "sensor, /tf); auto tells them apart.")] = "auto",
@@ -131,7 +133,7 @@ def map_command(
         output = run.map_recorded_session(
             session, out, config=cfg, seed=seed, figures=figures, variance_max=variance_max,
             hooks=run_hooks(bar, poke_row=poke_row), layout=layout,  # type: ignore[arg-type]
-            raw_config=raw_config, raw_settings=raw_settings)
+            raw_config=raw_config, raw_settings=raw_settings, rerun=rerun)
     report = output.report
     read_with = report["source"].get("found") if report.get("form") == "raw" else None
     for key, value in (read_with or {}).items():  # what the bag was read with, and why

@@ -82,6 +82,7 @@ def map_recorded_session(
     raw_config: Path | None = None,
     raw_settings: dict[str, Any] | None = None,
     variance_max: float | None = None,
+    rerun: bool = False,
 ) -> MapOutput:
     """Map the session at ``session`` (its folder or its ``session.yaml``) into ``out``.
 
@@ -109,6 +110,8 @@ def map_recorded_session(
         ``replay.RawBagConfig`` settings that win over the file's (command-line options).
     variance_max : float, optional
         Top of ``map.png``'s variance colour scale (default: the map's own largest variance).
+    rerun : bool
+        Also write ``run.rrd``, the run as a rerun recording (extra ``rerun``).
 
     Raises
     ------
@@ -137,6 +140,10 @@ def map_recorded_session(
                           truth=recorded.ground_truth,
                           title=f"{stem}: {len(replay.result.pokes)} pokes", hooks=hooks,
                           variance_max=variance_max)  # fmt: skip
+        if rerun:
+            from deformap.run._figures import write_rerun
+
+            write_rerun(folder / "run.rrd", replay.result)
     return MapOutput(report=report, session=recorded, replay=replay, config=cfg, folder=folder)
 
 
