@@ -88,7 +88,7 @@ def load_environment(spec: str, args: dict[str, Any],
 def explore_environment(spec: str, env_args: dict[str, Any], config: RunConfig,
                         out: Path | None = None, *, resume: bool = False, figures: bool = True,
                         hooks: RunHooks = NO_HOOKS, variance_max: float | None = None,
-                        ) -> tuple[dict[str, Any], Path]:
+                        rerun: bool = False) -> tuple[dict[str, Any], Path]:
     """Explore the Environment ``spec`` returns (module docstring); ``(report, folder)``.
 
     The run folder is new or empty (default ``runs/<factory>-explore-s<seed>-<time>``), made
@@ -96,8 +96,8 @@ def explore_environment(spec: str, env_args: dict[str, Any], config: RunConfig,
     ``resume`` it is the folder of a run stopped there, whose journal must name the same
     ``spec``, ``env_args`` and configuration (but ``config.robot``), checked before the robot is
     built. ``variance_max`` fixes the top of ``map.png``'s variance scale. ``config.world`` and
-    ``config.scenario`` are not used. A robot that fails raises :class:`RobotFault` naming the
-    call, with every finished poke in the journal.
+    ``config.scenario`` are not used; ``rerun`` also writes ``run.rrd``. A robot that fails
+    raises :class:`RobotFault` naming the call, with every finished poke in the journal.
     """
     if variance_max is not None:  # before any work
         check_positive("variance_max", variance_max)
@@ -142,4 +142,8 @@ def explore_environment(spec: str, env_args: dict[str, Any], config: RunConfig,
         write_run_results(folder, result, report, figures=figures, poke_figures=False,
                           title=f"{spec}: {len(result.pokes)} pokes", hooks=hooks,
                           variance_max=variance_max)
+        if rerun:
+            from deformap.run._figures import write_rerun
+
+            write_rerun(folder / "run.rrd", result)
     return report, folder
