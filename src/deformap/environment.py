@@ -25,7 +25,7 @@ from deformap.mechanics import TactileContact
 
 __all__ = ["FORCE_MISMATCH_ABS_N", "FORCE_MISMATCH_REL", "MAX_GRID_CELLS", "MAX_TRAVEL_M",
            "MIN_FORCE_RISE_N", "TRAVEL_BACKWARDS_TOLERANCE_M", "Environment", "ForceTravel",
-           "PressObservation", "TactileContact", "Workspace"]
+           "PressObservation", "PressPhase", "TactileContact", "Workspace"]
 
 
 #: Most cells of a :meth:`Workspace.grid` (200 MB per float map layer).
@@ -104,6 +104,73 @@ def _allowed_mismatch(force_n: float) -> float:
     return FORCE_MISMATCH_REL * force_n + FORCE_MISMATCH_ABS_N
 
 
+def _check_times(name: str, value: Any, size: int, after: float | None) -> NDArray[np.float64]:
+    times = np.array(check_array(name, value, (size,), what="seconds"))
+    step = np.diff(times)
+    if step.size and float(step.min()) <= 0.0:
+        at = int(np.argmax(step <= 0.0)) + 1
+        raise InvalidArgumentError(
+            f"`{name}` must increase sample by sample; sample {at} ({times[at]:.6g} s) does not "
+            f"come after sample {at - 1} ({times[at - 1]:.6g} s)")
+    if after is not None and float(times[0]) < after:
+        raise InvalidArgumentError(
+            f"`{name}` must start at or after the stretch before it ends ({after:.6g} s); got "
+            f"{times[0]:.6g} s (time going backwards)")
+    times.setflags(write=False)
+    return times
+
+
+@dataclass(frozen=True, kw_only=True)
+class PressPhase:
+    """A stretch of a press after its loading ramp, ``n >= 2`` samples in time order: the hold
+    (the commanded force or position held) or the unloading branch (the tip retracting).
+
+    ``time_s`` is seconds on the ramp's clock, strictly increasing; ``travel_m`` the travel since
+    first contact [m] (as the ramp's, within :data:`MAX_TRAVEL_M`), ``force_n`` the normal force
+    [N], >= 0 within :data:`MIN_FORCE_RISE_N`. Stored as read-only float64 copies.
+    """
+
+    time_s: NDArray[np.float64]
+    travel_m: NDArray[np.float64]
+    force_n: NDArray[np.float64]
+
+    def __post_init__(self) -> None:
+        travel = np.array(check_array("travel_m", self.travel_m, (None,), what="metres", min_rows=2))
+        force = np.array(check_array("force_n", self.force_n, (travel.size,), what="newtons"))
+        times = _check_times("time_s", self.time_s, travel.size, None)
+        if float(np.max(np.abs(travel))) > MAX_TRAVEL_M:
+            raise InvalidArgumentError(
+                f"`travel_m` must be metres, at most {MAX_TRAVEL_M} m in magnitude; got "
+                f"{float(np.max(np.abs(travel))):.4g}")
+        if float(force.min()) < -MIN_FORCE_RISE_N:
+            raise InvalidArgumentError(
+                f"`force_n` must be the force pressing the surface, >= 0 within {MIN_FORCE_RISE_N} "
+                f"N; got {float(force.min()):.4g} N")
+        for name, arr in (("travel_m", travel), ("force_n", force)):
+            arr.setflags(write=False)
+            object.__setattr__(self, name, arr)
+        object.__setattr__(self, "time_s", times)
+
+    def __len__(self) -> int:
+        return int(self.travel_m.size)
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, PressPhase):
+            return NotImplemented
+        return all(np.array_equal(getattr(self, k), getattr(other, k))
+                   for k in ("time_s", "travel_m", "force_n"))
+
+
+def _same(a: PressPhase | NDArray[np.float64] | None,
+          b: PressPhase | NDArray[np.float64] | None) -> bool:
+    """Equality of two optional parts of a record (``None`` equals only ``None``)."""
+    if a is None or b is None:
+        return a is None and b is None
+    if isinstance(a, PressPhase) or isinstance(b, PressPhase):
+        return bool(a == b)
+    return bool(np.array_equal(a, b))
+
+
 @dataclass(frozen=True, kw_only=True)
 class ForceTravel:
     """The press's force–travel record from first contact to the commanded force, ``n >= 3``
@@ -113,10 +180,19 @@ class ForceTravel:
     than :data:`TRAVEL_BACKWARDS_TOLERANCE_M` below its largest before, within :data:`MAX_TRAVEL_M`.
     ``force_n`` is the normal force on the surface [N], its last sample positive and more than
     :data:`MIN_FORCE_RISE_N` above the first. Both are stored as read-only float64 copies.
+
+    Optional, for what the press did besides loading (``None``: the robot did not say): ``time_s``,
+    the ramp's sample times [s], strictly increasing; ``hold``, the samples while the commanded
+    force or position is held; ``unloading``, the samples as the tip retracts, whose force never
+    rises by more than :data:`MIN_FORCE_RISE_N`. A hold or unloading needs ``time_s``; each stretch
+    starts no earlier than the one before ends.
     """
 
     travel_m: NDArray[np.float64]
     force_n: NDArray[np.float64]
+    time_s: NDArray[np.float64] | None = None
+    hold: PressPhase | None = None
+    unloading: PressPhase | None = None
 
     def __post_init__(self) -> None:
         travel = np.array(check_array("travel_m", self.travel_m, (None,), what="metres",
@@ -159,6 +235,36 @@ class ForceTravel:
         force.setflags(write=False)
         object.__setattr__(self, "travel_m", travel)
         object.__setattr__(self, "force_n", force)
+        self._check_phases(travel.size)
+
+    def _check_phases(self, n: int) -> None:
+        if self.time_s is None:
+            if self.hold is not None or self.unloading is not None:
+                raise InvalidArgumentError(
+                    "`time_s` must be given with a hold or an unloading branch (their times are "
+                    "on the ramp's clock); got none")
+            return
+        times = _check_times("time_s", self.time_s, n, None)
+        object.__setattr__(self, "time_s", times)
+        end = float(times[-1])
+        for name in ("hold", "unloading"):
+            phase = getattr(self, name)
+            if phase is None:
+                continue
+            if not isinstance(phase, PressPhase):
+                raise InvalidArgumentError(f"`{name}` must be a PressPhase; got {type(phase)}")
+            _check_times(f"{name}.time_s", phase.time_s, len(phase), end)
+            end = float(phase.time_s[-1])
+        unloading = self.unloading
+        if unloading is not None:
+            lowest = np.minimum.accumulate(unloading.force_n)
+            rise = unloading.force_n - lowest
+            worst = int(np.argmax(rise))
+            if rise[worst] > MIN_FORCE_RISE_N:
+                raise InvalidArgumentError(
+                    f"`unloading.force_n` must fall as the tip retracts (no rise beyond "
+                    f"{MIN_FORCE_RISE_N} N); sample {worst} lies {rise[worst]:.4g} N above the "
+                    "lowest force before it")
 
     def __len__(self) -> int:
         return int(self.travel_m.size)
@@ -167,7 +273,9 @@ class ForceTravel:
         if not isinstance(other, ForceTravel):
             return NotImplemented
         return bool(np.array_equal(self.travel_m, other.travel_m)
-                    and np.array_equal(self.force_n, other.force_n))
+                    and np.array_equal(self.force_n, other.force_n)
+                    and all(_same(getattr(self, k), getattr(other, k))
+                            for k in ("time_s", "hold", "unloading")))
 
 
 @dataclass(frozen=True, kw_only=True)
