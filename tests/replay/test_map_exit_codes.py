@@ -67,7 +67,8 @@ def test_a_camera_only_session_maps_on_beta_and_says_so(tmp_path: Path, syntheti
     assert report["field"] == "beta" and report["n_pokes"] == 3
     assert report["field_fallback"].startswith("`exploration.field` 'modulus' fell back to 'beta'")
     assert report["field_fallback"] in report["warnings"]
-    assert "fell back to 'beta'" in result.output
+    # said once, though each of the three pokes gives the same reason
+    assert result.output.count("fell back to 'beta'") == 1
 
 
 def test_a_session_with_records_maps_on_the_modulus(tmp_path: Path, synthetic,  # type: ignore[no-untyped-def]

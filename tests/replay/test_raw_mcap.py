@@ -150,18 +150,16 @@ def test_a_tip_that_does_not_move_warns_and_no_foam_reads_rigid(root: Path,
     code, output, report = _map(bag, tmp_path / "map")
     assert code == 0, output
     soft = [i for i, p in enumerate(live["pokes"]) if not p["rigid"]]
-    assert soft, "the live run pressed no foam"
-    for i in soft:
-        poke = report["pokes"][i]
-        assert poke["beta"] > 0.3 and (poke.get("stiffness") or {}).get("rigid") is not True
-        assert "the record shows no travel" in report["source"]["presses"][str(i + 1)][
-            "disagreement"]
-        assert f"poke {i + 1}: the record shows no travel" in " ".join(report["warnings"])
-    rigid = [i for i, p in enumerate(live["pokes"]) if p["rigid"]]
-    for i in rigid:  # a rigid press: no travel and no dent, they agree
-        assert "disagreement" not in report["source"]["presses"][str(i + 1)]
-        assert report["pokes"][i]["stiffness"]["rigid"]
-    assert "the record shows no travel" in output
+    assert soft and len(soft) < len(live["pokes"]), "the live run pressed no foam, or only foam"
+    for i, poke in enumerate(report["pokes"]):
+        # a still tip's record cannot tell rigid from soft: no press is read from it
+        assert poke.get("stiffness") is None
+        assert "did not move at all" in report["source"]["presses"][str(i + 1)]["disagreement"]
+        assert f"poke {i + 1}: the tip frame 'tool_tip' did not move at all" in " ".join(
+            report["warnings"])
+    for i in soft:  # the camera alone reads the foam's dent
+        assert report["pokes"][i]["beta"] > 0.3
+    assert "did not move at all" in output
 
 
 @pytest.mark.parametrize(("name", "rig"), [

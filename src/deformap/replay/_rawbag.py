@@ -64,6 +64,10 @@ DENT_SIGMAS = 4.0
 #: eighth of δ or more on average (the visible part, outside the contact radius √(Rδ)).
 HERTZ_DISC_FRACTION = 0.125
 
+#: A tip frame whose poses through a press's rise all lie within this [m] did not move: a
+#: measured pose jitters by its encoders' noise (micrometres), a commanded one does not.
+STILL_TIP_M = 1e-9
+
 #: Points of a hull part's circle (cylinder, cap): 16 give a polygon within 2 % of the circle.
 _CIRCLE = 16
 
@@ -136,6 +140,7 @@ class RawBagReader(BagDiscovery):
                 f"largest is {float(magnitude.max()):.4g} N")
         self._check_merge(magnitude, contact_n)
         self.config = cfg = self._tip(cfg)
+        self.tip_still = self._tip_still()
         self._groups: dict[int, _Group] = {}
         self._errors: dict[int, str] = {}
         self._observation_group = self._plan_observation()
@@ -144,6 +149,22 @@ class RawBagReader(BagDiscovery):
                 self._plan_press(press)
         self._average()
         self._observation: PointCloud | None = None
+
+    def _tip_still(self) -> bool:
+        """Whether the tip frame stays within :data:`STILL_TIP_M` over the second half of every
+        usable press's rise (first contact to the hold): a commanded pose. A measured one moves
+        into a soft surface, or by its encoders' noise; a bag of presses on rigid surfaces only,
+        recorded without that noise, reads as still too, and loses its records, not its map."""
+        usable = [p for p in self.presses if p.error is None and p.hold_start > p.start + 1]
+        for press in usable:
+            stamps = self.wrench_ns[(press.start + press.hold_start) // 2: press.hold_start]
+            try:
+                _, tips = self.tree.lookup(self.world_frame, self.tip_frame, stamps, what="")
+            except DeformapError:
+                return False  # the press's own reading names what is missing
+            if float(np.ptp(tips, axis=0).max()) > STILL_TIP_M:
+                return False
+        return bool(usable)
 
     def _check_merge(self, magnitude: NDArray[np.float64], contact_n: float) -> None:
         """Refuse a ``stamp_tolerance_s`` that joins presses: one that holds the commanded force
@@ -441,12 +462,20 @@ class RawBagReader(BagDiscovery):
             # a force step, or a ramp the sensor's noise hides: the camera still reads the dent
             notes["force_travel"] = (f"the ramp's force–travel record cannot be read ({exc}); "
                                      "β from the camera alone, no modulus")
-        dent, dent_std = self._camera_dent(cloud, tip - cfg.tip_radius_m * direction, robot)
+        dent, dent_std = self._camera_dent(cloud, tip + cfg.tip_radius_m * direction, robot)
         moved = float(travel[-1]) if travel.size else 0.0
         notes["camera_dent_m"] = f"{dent:.5f} ± {dent_std:.5f}"
         notes["record_travel_m"] = f"{moved:.5f}"
         seen = dent > DENT_SIGMAS * dent_std and dent > TRAVEL_BACKWARDS_TOLERANCE_M
-        if record is not None and moved <= TRAVEL_BACKWARDS_TOLERANCE_M and seen:
+        if record is not None and self.tip_still:
+            notes["disagreement"] = (
+                f"the tip frame {self.tip_frame!r} did not move at all while the force rose, in "
+                "any press (not even by encoder noise: a commanded pose, not the measured one?); "
+                "its travel cannot tell a rigid surface from a soft one, so the record is "
+                "not used: β from the camera alone, no modulus")
+            notes["force_travel"] = notes["disagreement"]
+            record = None
+        elif record is not None and moved <= TRAVEL_BACKWARDS_TOLERANCE_M and seen:
             notes["disagreement"] = (
                 f"the record shows no travel ({moved * 1e3:.2f} mm) but the camera sees a dent of "
                 f"{dent * 1e3:.2f} ± {dent_std * 1e3:.2f} mm around the contact; is the tip frame "
