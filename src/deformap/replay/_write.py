@@ -11,13 +11,14 @@ from typing import Any
 import numpy as np
 import yaml
 
+from deformap._files import write_text_atomically
 from deformap._validation import check_instance, check_path, check_positive
 from deformap.cloud import PointCloud
 from deformap.cloud.io import BAG_STORAGES, CLOUD_FORMATS, write_cloud
 from deformap.environment import Environment, PressObservation, Workspace
 from deformap.errors import EnvironmentStateError, InvalidArgumentError
 from deformap.replay._bagform import write_session_bag
-from deformap.replay._confine import manifest_of
+from deformap.replay._confine import manifest_of, seal
 from deformap.replay._format import FORMAT_NAME, FORMAT_VERSION, SESSION_FILE
 from deformap.replay._truth import GroundTruth, write_ground_truth
 
@@ -139,7 +140,8 @@ def write_session(folder: str | Path, *, workspace: Workspace, observation: Poin
     PCD, PLY and bags; a press with one hull per part keeps its parts' common hull (with a warning).
     ``tip_radius_m`` defaults to the presses' (which must agree); ``source`` is plain provenance data.
     ``format`` ``"folder"`` writes cloud files of ``cloud_format``, ``"mcap"`` or ``"sqlite3"`` a ROS 2
-    bag in ``bag/``. ``session.yaml`` comes last, with ``n_pokes`` and every file's ``sha256``.
+    bag in ``bag/``. ``session.yaml`` comes last, with ``n_pokes``, every file's ``sha256`` and its
+    seal (:func:`~deformap.replay._confine.seal`).
     """
     out, presses, tip = _check_inputs(folder, workspace, observation, presses, tip_radius_m,
                                       format, cloud_format, ground_truth)  # fmt: skip
@@ -186,5 +188,5 @@ def write_session(folder: str | Path, *, workspace: Workspace, observation: Poin
     doc["sha256"] = manifest_of(out, (p for p in out.rglob("*") if p.is_file()))
     doc["pokes"] = pokes
     file = out / SESSION_FILE
-    file.write_text(yaml.dump(doc, Dumper=_Dumper, sort_keys=False), encoding="utf-8")
+    write_text_atomically(file, seal(yaml.dump(doc, Dumper=_Dumper, sort_keys=False)))
     return file
