@@ -21,7 +21,7 @@ import os
 from pathlib import Path
 from types import TracebackType
 
-from deformap._files import os_error_cause
+from deformap._files import LOCK_NAME, os_error_cause
 from deformap.errors import ConfigError, FileWriteError
 
 try:
@@ -33,9 +33,6 @@ __all__ = ["LOCK_NAME", "RunFolderLock", "folder_holder", "lock_run_folder"]
 
 logger = logging.getLogger(__name__)
 
-LOCK_NAME = ".deformap.lock"
-"""The lock file of a run folder, present while a run holds the folder (or left by a killed one,
-when it holds no lock)."""
 
 
 class RunFolderLock:

@@ -32,7 +32,13 @@ from deformap.replay import (
     write_session,
 )
 from deformap.run._config import RunConfig, run_generators
-from deformap.run._folder import create_run_folder, default_run_folder, run_stem, write_json
+from deformap.run._folder import (
+    atomic_path,
+    create_run_folder,
+    default_run_folder,
+    run_stem,
+    write_json,
+)
 from deformap.run._hooks import NO_HOOKS, RunHooks, RunStart
 from deformap.world import SimulatedWorld, load_scenario
 
@@ -94,7 +100,8 @@ def record_simulation(config: RunConfig, out: Path | None = None, *, format: str
         hooks.stage("writing the robot's bag")
         rig = rig or RigConfig()
         file = folder / "robot.mcap"
-        write_raw_mcap(file, env.observation, env.presses, rig, seed=config.seed)
+        with atomic_path(file) as tmp:
+            write_raw_mcap(tmp, env.observation, env.presses, rig, seed=config.seed)
         write_json(folder / "live.json", {**source, "rig": config_to_dict(rig),
                                           "pokes": [_live_poke(p.record) for p in result.pokes]})
         return RecordOutput(session_file=file, folder=folder, n_pokes=len(env.presses),
