@@ -226,9 +226,10 @@ def _concurrent_case(command: str, index: int, root: Path, config: Path) -> Mach
     if sorted(codes) == [0, 2]:
         refused = texts[codes.index(2)]
         other = procs[codes.index(0)].pid
-        if f"(PID {other})" in refused or "not empty" in refused \
-                or "written by another process" in refused:
-            return MachineCase("concurrent", command, 0, "clean")
+        if f"(PID {other})" in refused:
+            return MachineCase("concurrent", command, 0, "clean", "refused naming the PID")
+        if "not empty" in refused or "written by another process" in refused:
+            return MachineCase("concurrent", command, 0, "clean", "found the folder taken")
         return MachineCase("concurrent", command, 0, "other", refused.strip()[-300:])
     if codes == [0, 0] and command == "explore --resume":  # one after the other
         from deformap.explore import JOURNAL_NAME, read_journal
@@ -236,7 +237,7 @@ def _concurrent_case(command: str, index: int, root: Path, config: Path) -> Mach
         pokes = [p["index"] for p in read_journal(out / JOURNAL_NAME).pokes]
         ok = len(pokes) == len(set(pokes))
         return MachineCase("concurrent", command, 0, "clean" if ok else "silent",
-                           "" if ok else f"journal pokes {pokes}")
+                           "one after the other" if ok else f"journal pokes {pokes}")
     return MachineCase("concurrent", command, 0, "silent" if codes == [0, 0] else "other",
                        f"exit codes {codes}")
 
@@ -328,6 +329,9 @@ def main(argv: list[str] | None = None) -> int:
         print(("\n" if args.mutants or args.cli_mutants else "") + machine_table(machine))
         print(f"\n{len(machine)} machine-failure cases (seed {args.seed}) in "
               f"{time.perf_counter() - start:.0f} s")
+        for how in ("refused naming the PID", "found the folder taken", "one after the other"):
+            print(f"two at once, {how}: "
+                  f"{sum(c.cls == 'concurrent' and c.detail == how for c in machine)}")
         bad += [f"{c.ending}: {c.cls} {c.command} at write {c.at}: {c.detail}" for c in machine
                 if c.ending != "clean"]  # fmt: skip
     for line in bad[:20]:
