@@ -178,3 +178,22 @@ def test_a_world_over_its_budget_leaves_no_folder(tmp_path: Path, command: str) 
         else:
             record_simulation(config, out)
     assert not out.exists()
+
+
+def test_a_holder_that_has_not_yet_written_its_pid_is_waited_for(tmp_path: Path) -> None:
+    """Two runs started at once: the second may find the lock taken before the first has written
+    its PID into the file; it waits for the PID instead of saying "unknown"."""
+    import fcntl
+    import threading
+
+    folder = tmp_path / "out"
+    folder.mkdir()
+    fd = os.open(folder / LOCK_NAME, os.O_RDWR | os.O_CREAT)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        # as a new holder does, a moment later: a thread's own open file, so the lock conflicts
+        threading.Timer(0.1, os.pwrite, (fd, b"4242\n", 0)).start()
+        with pytest.raises(ConfigError, match=r"is in use by another deformap process \(PID 4242\)"):
+            claim_run_folder(folder, resume=True)
+    finally:
+        os.close(fd)

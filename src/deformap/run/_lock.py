@@ -18,6 +18,7 @@ from __future__ import annotations
 import contextlib
 import logging
 import os
+import time
 from pathlib import Path
 from types import TracebackType
 
@@ -65,13 +66,22 @@ class RunFolderLock:
         self.release()
 
 
+#: How long [s] to wait for a new holder to write its PID, which it does right after locking.
+_PID_WAIT_S = 0.5
+
+
 def _pid_in(fd: int) -> str:
-    """The PID a lock file holds, as text ("unknown" before its holder wrote it)."""
-    with contextlib.suppress(OSError):
-        text = os.pread(fd, 32, 0).decode("ascii", errors="replace").strip()
-        if text.isdigit():
-            return text
-    return "unknown"
+    """The PID a lock file holds, as text; a holder that has locked the file but not yet written
+    its PID is waited for up to :data:`_PID_WAIT_S` ("unknown" after that)."""
+    deadline = time.monotonic() + _PID_WAIT_S
+    while True:
+        with contextlib.suppress(OSError):
+            text = os.pread(fd, 32, 0).decode("ascii", errors="replace").strip()
+            if text.isdigit():
+                return text
+        if time.monotonic() >= deadline:
+            return "unknown"
+        time.sleep(0.01)
 
 
 def _in_use(folder: Path, what: str, pid: str) -> ConfigError:
