@@ -21,6 +21,7 @@ from typing import Any, Literal, TypeVar, get_args, get_origin
 
 import yaml
 
+from deformap._files import write_text_atomically
 from deformap._validation import SettingError, setting_metadata
 from deformap.errors import ConfigError, DeformapError
 
@@ -242,11 +243,12 @@ class NoAliasDumper(yaml.SafeDumper):
 
 def dump_yaml(data: Any, path: str | Path | None = None) -> str:
     """Write plain data as YAML (block style, keys in definition order, no aliases); return the
-    text."""
+    text. With ``path`` it is written there atomically (:mod:`deformap._files`: a failure is one
+    :class:`~deformap.errors.FileWriteError` naming the file, nothing half-written left)."""
     text = yaml.dump(config_to_dict(data), Dumper=NoAliasDumper, sort_keys=False,
                      default_flow_style=False)
     if path is not None:
-        Path(path).write_text(text, encoding="utf-8")
+        write_text_atomically(path, text)
     return text
 
 

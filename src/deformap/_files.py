@@ -25,9 +25,14 @@ from pathlib import Path
 
 from deformap.errors import FileWriteError, InvalidArgumentError
 
-__all__ = ["atomic_path", "check_destination", "is_temporary", "os_error_cause",
+__all__ = ["LOCK_NAME", "atomic_path", "check_destination", "is_temporary", "os_error_cause",
            "remove_temporaries", "replace_durably", "write_error", "write_text_atomically",
            "writing"]
+
+LOCK_NAME = ".deformap.lock"
+"""The lock file of a folder a deformap process writes (:mod:`deformap.run._lock`), present while
+a run holds the folder (or left by a killed one, when it holds no lock); no writer lists it among
+what it wrote."""
 
 _KINDS = ((stat.S_ISDIR, "a folder"), (stat.S_ISFIFO, "a FIFO"), (stat.S_ISCHR, "a device"),
           (stat.S_ISBLK, "a device"), (stat.S_ISSOCK, "a socket"),

@@ -17,7 +17,7 @@ runner = CliRunner()
 def test_a_session_with_no_usable_poke_exits_2_after_writing_its_report(
     tmp_path: Path, synthetic, write_synthetic  # type: ignore[no-untyped-def]
 ) -> None:
-    session = write_synthetic(tmp_path / "session", synthetic)
+    session = write_synthetic(tmp_path / "session", synthetic, sealed=False)
     for cloud in (tmp_path / "session").glob("poke-0[0-9].pcd"):
         cloud.unlink()
     out = tmp_path / "map"

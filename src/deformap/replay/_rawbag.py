@@ -10,6 +10,7 @@ time. A press that cannot be read is refused in one line naming it, the topic an
 
 from __future__ import annotations
 
+import hashlib
 import logging
 from dataclasses import dataclass
 from itertools import pairwise
@@ -194,6 +195,7 @@ class RawBagReader(BagDiscovery):
         w_force: list[list[float]] = []
         w_frames: set[str] = set()
         types = {**topics, **optional}
+        seen: dict[tuple[str, int, bytes], int] = {}  # (topic, stamp, digest) -> message number
         for raw in iter_bag_messages(self.path, topics, optional=optional):
             where = f"{self.path} [{raw.topic} message {raw.number}]"
             try:
@@ -201,6 +203,14 @@ class RawBagReader(BagDiscovery):
             except errors as exc:
                 raise FileFormatError(f"{where}: could not be decoded: "
                                       f"{bag_error_text(exc, 120)}") from None  # fmt: skip
+            if raw.topic in (self.cloud_topic, self.wrench_topic):
+                key = (raw.topic, header_stamp_ns(msg.header),
+                       hashlib.blake2b(bytes(raw.data), digest_size=16).digest())
+                first = seen.setdefault(key, raw.number)
+                if first != raw.number:  # it would count twice in a press's average
+                    raise FileFormatError(
+                        f"{where}: repeats message {first} byte for byte (same header stamp); "
+                        "the bag holds messages written twice")
             if raw.topic == self.cloud_topic:
                 stamps.append(header_stamp_ns(msg.header))
                 frames.add(str(msg.header.frame_id))

@@ -21,9 +21,14 @@ from deformap._validation import check_instance, check_int, check_path, check_po
 from deformap.cloud import PointCloud, points_in_hull
 from deformap.cloud.io import path_kind, read_cloud
 from deformap.environment import PressObservation, TactileContact, Workspace
-from deformap.errors import DeformapError, FileFormatError, InvalidArgumentError
+from deformap.errors import ConfigError, DeformapError, FileFormatError, InvalidArgumentError
 from deformap.replay._bagform import BagReader
-from deformap.replay._confine import verify_digest
+from deformap.replay._confine import (
+    check_manifest_complete,
+    check_no_links,
+    check_seal,
+    verify_digest,
+)
 from deformap.replay._format import (
     SESSION_FILE,
     PokeSpec,
@@ -215,6 +220,11 @@ def load_session(path: str | Path, *, contact_gap_m: float = DEFAULT_CONTACT_GAP
     file = _session_file(p)
     header = parse_session_yaml(
         load_yaml(file, what="the session file", unreadable=FileFormatError), file)
+    check_no_links(file.parent)
+    if file.is_symlink():
+        raise ConfigError(f"{file}: a symbolic link; name the session folder or its own file")
+    check_seal(file, header.sha256)
+    check_manifest_complete(file, header.sha256)
     tolerance = _stamp_tolerance(file, header, stamp_tolerance_s)
     reader = (FolderReader(header) if header.form == "folder"
               else BagReader(header, tolerance))  # fmt: skip

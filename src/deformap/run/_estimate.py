@@ -5,6 +5,7 @@ with a force–travel record also its stiffness and E, and write ``estimate.json
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import math
 from collections.abc import Sequence
@@ -20,7 +21,7 @@ from deformap.errors import DeformapError, FileFormatError, InvalidArgumentError
 from deformap.replay import estimate_poke
 from deformap.run._config import RunConfig
 from deformap.run._figures import write_estimate_figures
-from deformap.run._folder import create_run_folder, write_json
+from deformap.run._folder import claim_run_folder, write_json
 from deformap.run._report import estimate_report
 
 __all__ = ["EstimateOutput", "estimate_one_poke", "read_force_travel_csv"]
@@ -108,18 +109,19 @@ def estimate_one_poke(
     hull = None if robot_hull is None else read_cloud(robot_hull, units=units).points
     clouds = read_cloud(before, units=units), read_cloud(after, units=units)
     force_travel = None if record is None else read_force_travel_csv(record)
-    if out is not None:
-        create_run_folder(out, what="result")
-    try:
-        poke = estimate_poke(*clouds, contact, config.exploration,
-                             rng=np.random.default_rng(seed), robot_points=hull,
-                             force_travel=force_travel)  # fmt: skip
-    except InvalidArgumentError as exc:
-        if "`force_travel`" in str(exc):  # the record and --force are not one press
-            raise InvalidArgumentError(f"--record/--force: {exc}") from None
-        raise
-    report = estimate_report(before, after, contact, poke)
-    if out is not None:
-        write_json(out / "estimate.json", report)
-        write_estimate_figures(out, poke)
-    return EstimateOutput(report=report, folder=out)
+    with contextlib.ExitStack() as held:
+        if out is not None:  # held until the result is written
+            held.enter_context(claim_run_folder(out, what="result"))
+        try:
+            poke = estimate_poke(*clouds, contact, config.exploration,
+                                 rng=np.random.default_rng(seed), robot_points=hull,
+                                 force_travel=force_travel)  # fmt: skip
+        except InvalidArgumentError as exc:
+            if "`force_travel`" in str(exc):  # the record and --force are not one press
+                raise InvalidArgumentError(f"--record/--force: {exc}") from None
+            raise
+        report = estimate_report(before, after, contact, poke)
+        if out is not None:
+            write_json(out / "estimate.json", report)
+            write_estimate_figures(out, poke)
+        return EstimateOutput(report=report, folder=out)

@@ -44,7 +44,7 @@ from deformap.run._figures import poke_figure_path, write_poke_figure, write_rer
 from deformap.run._folder import claim_run_folder, default_run_folder, run_stem, write_text
 from deformap.run._hooks import NO_HOOKS, RunHooks, RunStart
 from deformap.run._report import live_report
-from deformap.world import SimulatedWorld, load_scenario
+from deformap.world import SimulatedWorld, check_world_budget, load_scenario
 
 __all__ = ["RunOutput", "explore_scenario"]
 
@@ -174,6 +174,7 @@ def explore_scenario(config: RunConfig, out: Path | None = None, *, resume: bool
         raise ConfigError("`out` must name the run folder to resume; got None")
     scenario = load_scenario(config.scenario)
     check_exploration_budget(config.exploration, scenario.workspace)  # before any folder or work
+    check_world_budget(config.world, scenario)
     folder = out or default_run_folder(run_stem(config.scenario), "explore", config.seed)
     header = {"deformap": __version__, "config": config_to_dict(config),
               "scenario": scenario.to_dict()}  # fmt: skip

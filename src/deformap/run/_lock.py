@@ -18,10 +18,11 @@ from __future__ import annotations
 import contextlib
 import logging
 import os
+import time
 from pathlib import Path
 from types import TracebackType
 
-from deformap._files import os_error_cause
+from deformap._files import LOCK_NAME, os_error_cause
 from deformap.errors import ConfigError, FileWriteError
 
 try:
@@ -33,9 +34,6 @@ __all__ = ["LOCK_NAME", "RunFolderLock", "folder_holder", "lock_run_folder"]
 
 logger = logging.getLogger(__name__)
 
-LOCK_NAME = ".deformap.lock"
-"""The lock file of a run folder, present while a run holds the folder (or left by a killed one,
-when it holds no lock)."""
 
 
 class RunFolderLock:
@@ -68,13 +66,22 @@ class RunFolderLock:
         self.release()
 
 
+#: How long [s] to wait for a new holder to write its PID, which it does right after locking.
+_PID_WAIT_S = 0.5
+
+
 def _pid_in(fd: int) -> str:
-    """The PID a lock file holds, as text ("unknown" before its holder wrote it)."""
-    with contextlib.suppress(OSError):
-        text = os.pread(fd, 32, 0).decode("ascii", errors="replace").strip()
-        if text.isdigit():
-            return text
-    return "unknown"
+    """The PID a lock file holds, as text; a holder that has locked the file but not yet written
+    its PID is waited for up to :data:`_PID_WAIT_S` ("unknown" after that)."""
+    deadline = time.monotonic() + _PID_WAIT_S
+    while True:
+        with contextlib.suppress(OSError):
+            text = os.pread(fd, 32, 0).decode("ascii", errors="replace").strip()
+            if text.isdigit():
+                return text
+        if time.monotonic() >= deadline:
+            return "unknown"
+        time.sleep(0.01)
 
 
 def _in_use(folder: Path, what: str, pid: str) -> ConfigError:

@@ -32,9 +32,15 @@ from deformap.replay import (
     write_session,
 )
 from deformap.run._config import RunConfig, run_generators
-from deformap.run._folder import create_run_folder, default_run_folder, run_stem, write_json
+from deformap.run._folder import (
+    atomic_path,
+    claim_run_folder,
+    default_run_folder,
+    run_stem,
+    write_json,
+)
 from deformap.run._hooks import NO_HOOKS, RunHooks, RunStart
-from deformap.world import SimulatedWorld, load_scenario
+from deformap.world import SimulatedWorld, check_world_budget, load_scenario
 
 __all__ = ["RECORD_FORMATS", "RecordOutput", "record_simulation"]
 
@@ -73,38 +79,40 @@ def record_simulation(config: RunConfig, out: Path | None = None, *, format: str
         rig = load_rig(rig)
     scenario = load_scenario(config.scenario)
     check_exploration_budget(config.exploration, scenario.workspace)  # before any folder or work
+    check_world_budget(config.world, scenario)
     folder = out or default_run_folder(run_stem(config.scenario), "record", config.seed)
-    create_run_folder(folder, what="session")
-    hooks.start(RunStart(kind="record", title=f"{config.scenario} seed {config.seed}",
-                         folder=folder, total=config.exploration.max_pokes))  # fmt: skip
-    hooks.stage("building the world")
-    world_rng, explore_rng = run_generators(config.seed)
-    world = SimulatedWorld(scenario, config=config.world, rng=world_rng)
-    env = RecordingEnvironment(world)
-    hooks.stage("exploring")
-    result = explore(env, config.exploration, rng=explore_rng,
-                     on_poke=lambda poke: hooks.poke(poke.record))  # fmt: skip
-    xs, ys = world.workspace.grid(config.exploration.surface.grid_spacing_m)
-    truth = GroundTruth(xs, ys, world.ground_truth_labels(xs, ys),
-                        world.ground_truth_hardness(xs, ys))
-    live_betas = [p.record.beta for p in result.pokes]
-    source = {"recorded_by": f"deformap {__version__} record-sim", "scenario": config.scenario,
-              "seed": config.seed, "live_betas": live_betas, "config": config_to_dict(config)}
-    if format == "raw-mcap":
-        hooks.stage("writing the robot's bag")
-        rig = rig or RigConfig()
-        file = folder / "robot.mcap"
-        write_raw_mcap(file, env.observation, env.presses, rig, seed=config.seed)
-        write_json(folder / "live.json", {**source, "rig": config_to_dict(rig),
-                                          "pokes": [_live_poke(p.record) for p in result.pokes]})
+    with claim_run_folder(folder, what="session"):
+        hooks.start(RunStart(kind="record", title=f"{config.scenario} seed {config.seed}",
+                             folder=folder, total=config.exploration.max_pokes))  # fmt: skip
+        hooks.stage("building the world")
+        world_rng, explore_rng = run_generators(config.seed)
+        world = SimulatedWorld(scenario, config=config.world, rng=world_rng)
+        env = RecordingEnvironment(world)
+        hooks.stage("exploring")
+        result = explore(env, config.exploration, rng=explore_rng,
+                         on_poke=lambda poke: hooks.poke(poke.record))  # fmt: skip
+        xs, ys = world.workspace.grid(config.exploration.surface.grid_spacing_m)
+        truth = GroundTruth(xs, ys, world.ground_truth_labels(xs, ys),
+                            world.ground_truth_hardness(xs, ys))
+        live_betas = [p.record.beta for p in result.pokes]
+        source = {"recorded_by": f"deformap {__version__} record-sim", "scenario": config.scenario,
+                  "seed": config.seed, "live_betas": live_betas, "config": config_to_dict(config)}
+        if format == "raw-mcap":
+            hooks.stage("writing the robot's bag")
+            rig = rig or RigConfig()
+            file = folder / "robot.mcap"
+            with atomic_path(file) as tmp:
+                write_raw_mcap(tmp, env.observation, env.presses, rig, seed=config.seed)
+            write_json(folder / "live.json", {**source, "rig": config_to_dict(rig),
+                                              "pokes": [_live_poke(p.record) for p in result.pokes]})
+            return RecordOutput(session_file=file, folder=folder, n_pokes=len(env.presses),
+                                format=format, live_betas=live_betas)  # fmt: skip
+        hooks.stage("writing the session")
+        file = write_session(folder, workspace=world.workspace, observation=env.observation,
+                             presses=env.presses, ground_truth=truth, source=source,
+                             format=format)  # fmt: skip
         return RecordOutput(session_file=file, folder=folder, n_pokes=len(env.presses),
                             format=format, live_betas=live_betas)  # fmt: skip
-    hooks.stage("writing the session")
-    file = write_session(folder, workspace=world.workspace, observation=env.observation,
-                         presses=env.presses, ground_truth=truth, source=source,
-                         format=format)  # fmt: skip
-    return RecordOutput(session_file=file, folder=folder, n_pokes=len(env.presses),
-                        format=format, live_betas=live_betas)  # fmt: skip
 
 
 def _live_poke(record: Any) -> dict[str, Any]:

@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from deformap._files import atomic_path
 from deformap.cloud._pointcloud import PointCloud
 from deformap.cloud.io._common import (
     check_body_size,
@@ -229,7 +230,8 @@ def write_ply(path: str | Path, cloud: PointCloud, *, format: str = "binary_litt
               extra_fields: dict[str, Any] | None = None) -> None:
     """Write a cloud as the ``vertex`` element of a PLY file of ``format`` in ``PLY_FORMATS``:
     x, y, z as ``double`` (exact round trip), colours as ``uchar``, ``extra_fields`` as more
-    properties (8- to 32-bit integers, float32 or float64)."""
+    properties (8- to 32-bit integers, float32 or float64). Written atomically
+    (:func:`deformap._files.atomic_path`)."""
     if format not in PLY_FORMATS:
         raise InvalidArgumentError(f"`format` must be one of {PLY_FORMATS}; got {format!r}")
     cloud, extras = _check_cloud_and_extras(cloud, extra_fields)
@@ -253,7 +255,7 @@ def write_ply(path: str | Path, cloud: PointCloud, *, format: str = "binary_litt
               f"element vertex {len(cloud)}"]  # fmt: skip
     header += [f"property {_NUMPY_TO_PLY[values.dtype.str[1:]]} {name}" for name, values in fields]
     header.append("end_header")
-    with open(path, "wb") as fh:
+    with atomic_path(path) as tmp, open(tmp, "xb") as fh:
         fh.write(("\n".join(header) + "\n").encode("ascii"))
         if format == "ascii":
             fmts = ["%.17g" if v.dtype.kind == "f" else "%d" for _, v in fields]
