@@ -11,6 +11,7 @@ from deformap.environment import (
     TIP_IN_VIEW_RADII,
     ForceTravel,
     PressObservation,
+    PressPhase,
     TactileContact,
 )
 from deformap.errors import InvalidArgumentError
@@ -64,3 +65,118 @@ def test_a_release_observation_with_the_tip_in_view_is_refused() -> None:
 def test_a_release_observation_that_is_not_a_cloud_is_refused() -> None:
     with pytest.raises(InvalidArgumentError, match="`released` must be a PointCloud"):
         _press(_surface(0.001).points)
+
+
+# --- sessions carry the record's time, hold and unloading and the cloud after release ----------
+
+def _phased(syn: object) -> list[PressObservation]:
+    """The synthetic presses, each record given times, a hold and an unloading and the first
+    press a cloud after release (the second keeps no record, as before)."""
+    from dataclasses import replace
+
+    out = []
+    for i, obs in enumerate(syn.presses):  # type: ignore[attr-defined]
+        record = obs.force_travel
+        if record is not None:
+            n, top = len(record), float(record.travel_m[-1])
+            record = ForceTravel(
+                travel_m=record.travel_m, force_n=record.force_n, time_s=np.linspace(0, 0.8, n),
+                hold=PressPhase(time_s=[0.9, 1.4, 2.0, 3.1], travel_m=[top] * 4,
+                                force_n=[1.0, 0.93, 0.9, 0.89]),
+                unloading=None if i else PressPhase(time_s=[3.2, 3.3, 3.4],
+                                                    travel_m=[top, top / 2, 1e-3],
+                                                    force_n=[0.85, 0.3, 0.0]))
+        released = None
+        if i == 0:
+            tip = obs.contact.tip_center
+            keep = np.linalg.norm(obs.cloud.points - tip, axis=1) > 1.5 * obs.contact.tip_radius_m
+            released = PointCloud(obs.cloud.points[keep & (obs.cloud.points[:, 2] < tip[2])])
+        out.append(replace(obs, force_travel=record, released=released))
+    return out
+
+
+@pytest.mark.parametrize("form", ["folder", "mcap"])
+def test_a_session_round_trips_the_phases_and_the_release(tmp_path, synthetic, form) -> None:
+    from deformap.replay import load_session, write_session
+
+    presses = _phased(synthetic)
+    write_session(tmp_path / "s", workspace=synthetic.workspace,
+                  observation=synthetic.observation, presses=presses, format=form)
+    session = load_session(tmp_path / "s")
+    for i, want in enumerate(presses):
+        got = session.press_observation(i)
+        assert got.force_travel == want.force_travel
+        if want.released is None:
+            assert got.released is None
+        else:
+            assert got.released is not None
+            assert np.array_equal(got.released.points, want.released.points)
+    assert presses[0].force_travel is not None and presses[0].force_travel.unloading is not None
+
+
+@pytest.mark.parametrize("form", ["folder", "mcap"])
+def test_a_session_without_phases_loads_as_before(tmp_path, synthetic, form) -> None:
+    from deformap.replay import load_session, write_session
+
+    write_session(tmp_path / "s", workspace=synthetic.workspace,
+                  observation=synthetic.observation, presses=synthetic.presses, format=form)
+    session = load_session(tmp_path / "s")
+    for i, want in enumerate(synthetic.presses):
+        got = session.press_observation(i)
+        assert got.force_travel == want.force_travel and got.released is None
+        if got.force_travel is not None:
+            assert got.force_travel.time_s is None and got.force_travel.hold is None
+
+
+def _edit(file, change) -> None:  # type: ignore[no-untyped-def]
+    import yaml
+
+    doc = yaml.safe_load(file.read_text())
+    del doc["n_pokes"], doc["sha256"]
+    change(doc["pokes"][0])
+    file.write_text(yaml.safe_dump(doc, sort_keys=False))
+
+
+@pytest.mark.parametrize(("change", "message"), [
+    (lambda p: p["force_travel"].update(time_s=p["force_travel"]["time_s"][::-1]),
+     r"pokes\[0\]\.force_travel`: `time_s` must increase"),
+    (lambda p: p["force_travel"]["hold"].update(time_s=[], travel_m=[], force_n=[]),
+     r"pokes\[0\]\.force_travel\.hold`: `travel_m` must have at least 2 rows"),
+    (lambda p: p["force_travel"]["unloading"].update(force_n=[0.3, 0.85, 0.0]),
+     r"pokes\[0\]\.force_travel`: `unloading\.force_n` must fall"),
+    (lambda p: p["force_travel"]["hold"].update(force_n=[1.0, float("nan"), 0.9, 0.89]),
+     r"pokes\[0\]\.force_travel\.hold`: `force_n`.*NaN"),
+])
+def test_a_session_with_an_impossible_phase_names_the_key(tmp_path, synthetic, change,
+                                                          message) -> None:
+    from deformap.errors import ConfigError
+    from deformap.replay import load_session, write_session
+
+    file = write_session(tmp_path / "s", workspace=synthetic.workspace,
+                         observation=synthetic.observation, presses=_phased(synthetic))
+    _edit(file, change)
+    session = load_session(tmp_path / "s")
+    with pytest.raises(ConfigError, match=message):
+        session.press_observation(0)
+    session.press_observation(2)  # one broken poke hides no other
+
+
+def test_a_session_with_the_tip_in_the_release_cloud_names_the_poke(tmp_path, synthetic) -> None:
+    from dataclasses import replace
+
+    from deformap.cloud.io import write_cloud
+    from deformap.errors import FileFormatError
+    from deformap.replay import load_session, write_session
+
+    presses = _phased(synthetic)
+    file = write_session(tmp_path / "s", workspace=synthetic.workspace,
+                         observation=synthetic.observation, presses=presses)
+    first = presses[0]
+    assert first.released is not None
+    tip = first.contact.tip_center + np.array([0.0, 0.0, 0.5 * first.contact.tip_radius_m])
+    write_cloud(tmp_path / "s" / "poke-01-released.pcd",
+                PointCloud(np.vstack([first.released.points, tip])))
+    _edit(file, lambda p: None)  # drop the manifest the edit broke
+    with pytest.raises(FileFormatError, match=r"poke 0: `released` must be seen once the tip"):
+        load_session(tmp_path / "s").press_observation(0)
+    assert replace(first, released=None).released is None
