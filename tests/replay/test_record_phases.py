@@ -87,10 +87,12 @@ def _phased(syn: object) -> list[PressObservation]:
                                                     travel_m=[top, top / 2, 1e-3],
                                                     force_n=[0.85, 0.3, 0.0]))
         released = None
-        if i == 0:
-            tip = obs.contact.tip_center
-            keep = np.linalg.norm(obs.cloud.points - tip, axis=1) > 1.5 * obs.contact.tip_radius_m
-            released = PointCloud(obs.cloud.points[keep & (obs.cloud.points[:, 2] < tip[2])])
+        if i == 0:  # a 1 mm grid around the press, its dent 1 mm deep
+            g = np.arange(-0.03, 0.03, 0.001)
+            gx, gy = (a.ravel() + c for a, c in zip(np.meshgrid(g, g), obs.target_xy, strict=True))
+            z = 0.05 - 0.001 * np.exp(-((gx - obs.target_xy[0]) ** 2
+                                        + (gy - obs.target_xy[1]) ** 2) / 0.015**2)
+            released = PointCloud(np.column_stack([gx, gy, z]))
         out.append(replace(obs, force_travel=record, released=released))
     return out
 
@@ -180,3 +182,43 @@ def test_a_session_with_the_tip_in_the_release_cloud_names_the_poke(tmp_path, sy
     with pytest.raises(FileFormatError, match=r"poke 0: `released` must be seen once the tip"):
         load_session(tmp_path / "s").press_observation(0)
     assert replace(first, released=None).released is None
+
+
+def test_the_map_of_a_phased_session_says_each_pokes_behaviour(tmp_path, synthetic) -> None:
+    import csv
+    import json
+
+    from typer.testing import CliRunner
+
+    from deformap.cli import app
+    from deformap.replay import write_session
+
+    presses = _phased(synthetic)
+    presses[2] = _ramp_only(presses[2])
+    write_session(tmp_path / "s", workspace=synthetic.workspace,
+                  observation=synthetic.observation, presses=presses)
+    out = tmp_path / "map"
+    result = CliRunner().invoke(app, ["map", str(tmp_path / "s"), "--out", str(out),
+                                      "--no-figures"])
+    assert result.exit_code == 0, result.output
+    pokes = json.loads((out / "report.json").read_text())["pokes"]
+    rows = list(csv.DictReader((out / "pokes.csv").open()))
+    assert len(pokes) == len(rows) == 3
+    first, second, third = (p["behaviour"] for p in pokes)
+    # the first: a hold that relaxes 11 % in 2 s with an unloading; the camera sees its dent
+    assert first["behaviour"] == "viscoelastic" and first["relaxation"] > 0.05
+    assert first["loss_ratio"] is not None and first["released_dent_m"] is not None
+    assert second["behaviour"] == "unknown" and second["evidence"] == "no force–travel record"
+    assert third == {**third, "behaviour": "unknown", "evidence": "no hold or unloading recorded"}
+    assert [r["behaviour"] for r in rows] == ["viscoelastic", "unknown", "unknown"]
+    assert float(rows[0]["relaxation"]) == pytest.approx(first["relaxation"])
+    assert rows[1]["relaxation"] == "" and rows[2]["loss_ratio"] == ""
+
+
+def _ramp_only(obs: PressObservation) -> PressObservation:
+    from dataclasses import replace
+
+    record = obs.force_travel
+    assert record is not None
+    return replace(obs, force_travel=ForceTravel(travel_m=record.travel_m,
+                                                 force_n=record.force_n))

@@ -241,3 +241,35 @@ def test_every_bad_record_is_refused_before_it_is_read(change: dict[str, object]
                                    force_n=[1.0] * 3)
             fields[key] = value
         press_behaviour(ForceTravel(**fields))  # type: ignore[arg-type]
+
+
+def test_a_poke_record_keeps_its_behaviour_through_the_journal() -> None:
+    import dataclasses
+    import json
+
+    from deformap.errors import FileFormatError
+    from deformap.explore import ContactRecord, PokeRecord, PokeTimings
+    from deformap.mechanics import TactileContact
+
+    behaviour = press_behaviour(_record(hold=_relaxing_hold(np.random.default_rng(0), 0.3, 2.0),
+                                        unloading=0.0005))
+    record = PokeRecord(
+        index=0, target_xy=(0.3, 0.2), contact_xy=(0.3, 0.2),
+        contact=ContactRecord.of(TactileContact(tip_center=[0.3, 0.2, 0.05], force=[0, 0, -1.0],
+                                                tip_radius_m=0.01)),
+        force_n=1.0, beta=0.5, beta_std=0.01, betas=(0.5,), errors=(1e-3,), iterations=1,
+        residual=0.0, converged=True, n_roi_points=10, camera_noise_m=None,
+        timings=PokeTimings(filter_s=0.1, touch_gp_s=0.1, beta_s=0.1), behaviour=behaviour)
+    data = json.loads(json.dumps(record.to_dict(), allow_nan=False))
+    assert data["behaviour"]["behaviour"] == "viscoelastic"
+    assert PokeRecord.from_dict(data) == record
+    old = dict(data)
+    del old["behaviour"]  # a journal written before behaviours: read back without one
+    assert PokeRecord.from_dict(old) == dataclasses.replace(record, behaviour=None)
+    for key, bad, message in (("behaviour", "elastic-ish", "`poke.behaviour.behaviour` must be"),
+                              ("relaxation", "0.3", "`poke.behaviour.relaxation` must be a"),
+                              ("relaxation_mode", "time", "`poke.behaviour.relaxation_mode`"),
+                              ("colour", 1, "unknown key")):
+        broken = {**data, "behaviour": {**data["behaviour"], key: bad}}
+        with pytest.raises(FileFormatError, match=message):
+            PokeRecord.from_dict(broken)

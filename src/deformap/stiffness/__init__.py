@@ -35,9 +35,15 @@ DerSimonian, R., Laird, N. (1986). Meta-analysis in clinical trials. Control. Cl
 
 from __future__ import annotations
 
-from deformap.stiffness._behaviour import BEHAVIOURS, PressBehaviour, press_behaviour, released_dent
+from deformap.stiffness._behaviour import (
+    BEHAVIOURS,
+    PressBehaviour,
+    observation_behaviour,
+    press_behaviour,
+    released_dent,
+)
 from deformap.stiffness._config import LAYER_MODEL, StiffnessConfig, StiffnessEstimate
 from deformap.stiffness._estimate import estimate_stiffness
 
 __all__ = ["BEHAVIOURS", "LAYER_MODEL", "PressBehaviour", "StiffnessConfig", "StiffnessEstimate",
-           "estimate_stiffness", "press_behaviour", "released_dent"]
+           "estimate_stiffness", "observation_behaviour", "press_behaviour", "released_dent"]

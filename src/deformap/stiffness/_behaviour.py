@@ -43,7 +43,7 @@ Anisotropy and the instantaneous against the relaxed modulus are not estimated h
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 from typing import Any, Literal
 
 import numpy as np
@@ -51,11 +51,12 @@ from numpy.typing import NDArray
 from scipy.optimize import least_squares
 
 from deformap.cloud import PointCloud
-from deformap.environment import ForceTravel, PressPhase
+from deformap.environment import ForceTravel, PressObservation, PressPhase
 from deformap.errors import InvalidArgumentError
 
 __all__ = ["BEHAVIOURS", "DENT_FLOOR_M", "LOSS_FLOOR", "MIN_FIT_SAMPLES", "N_SIGMA",
-           "RELAXATION_FLOOR", "Behaviour", "PressBehaviour", "press_behaviour", "released_dent"]
+           "RELAXATION_FLOOR", "Behaviour", "PressBehaviour", "observation_behaviour", "press_behaviour",
+           "released_dent"]
 
 Behaviour = Literal["elastic", "viscoelastic", "plastic", "unknown"]
 BEHAVIOURS: tuple[str, ...] = ("elastic", "viscoelastic", "plastic", "unknown")
@@ -142,7 +143,7 @@ def _ends(y: NDArray[np.float64], sigma: float) -> tuple[float, float, float]:
 def _fraction(start: float, end: float, grad: NDArray[np.float64], cov: NDArray[np.float64],
               mode: str) -> _Measure:
     value = 1.0 - end / start if mode == "force" else 1.0 - start / end
-    return _Measure(value, math.sqrt(max(0.0, float(grad @ cov @ grad))))
+    return _Measure(float(value), math.sqrt(max(0.0, float(grad @ cov @ grad))))
 
 
 def _hold(hold: PressPhase, sigma_f: float, sigma_t: float
@@ -195,7 +196,7 @@ def _hold(hold: PressPhase, sigma_f: float, sigma_t: float
     dy1 = np.array([1.0, decay, p[1] * decay * span / math.exp(p[2])])
     grad = (-dy1 / y0 + y1 * dy0 / y0**2) if mode == "force" else (-dy0 / y1 + y0 * dy1 / y1**2)
     fraction = _fraction(y0, y1, grad, cov, mode)
-    tau = math.exp(p[2])
+    tau = math.exp(float(p[2]))
     tau_m = _Measure(tau, tau * math.sqrt(max(0.0, float(cov[2, 2]))))
     if not (math.isfinite(fraction.value) and math.isfinite(fraction.sigma)):
         return plain, None, mode, "the hold's exponential fit gave no finite fraction"
@@ -389,13 +390,30 @@ def _classify(relax: _Measure | None, tau: _Measure | None, mode: str | None,
     evidence = "; ".join([why, *said, *notes])
     return PressBehaviour(
         behaviour=behaviour, evidence=evidence,
-        relaxation=None if relax is None else relax.value,
-        relaxation_sigma=None if relax is None else relax.sigma,
+        relaxation=None if relax is None else float(relax.value),
+        relaxation_sigma=None if relax is None else float(relax.sigma),
         relaxation_mode=None if relax is None else ("travel" if mode == "travel" else "force"),
-        tau_s=None if tau is None else tau.value, tau_sigma_s=None if tau is None else tau.sigma,
-        loss_ratio=None if loss is None else loss.value,
-        loss_ratio_sigma=None if loss is None else loss.sigma,
-        residual_dent_m=None if dent is None else dent.value,
-        residual_dent_sigma_m=None if dent is None else dent.sigma,
-        released_dent_m=None if cam is None else cam.value,
-        released_dent_sigma_m=None if cam is None else cam.sigma)
+        tau_s=None if tau is None else float(tau.value),
+        tau_sigma_s=None if tau is None else float(tau.sigma),
+        loss_ratio=None if loss is None else float(loss.value),
+        loss_ratio_sigma=None if loss is None else float(loss.sigma),
+        residual_dent_m=None if dent is None else float(dent.value),
+        residual_dent_sigma_m=None if dent is None else float(dent.sigma),
+        released_dent_m=None if cam is None else float(cam.value),
+        released_dent_sigma_m=None if cam is None else float(cam.sigma))
+
+
+def observation_behaviour(obs: PressObservation) -> PressBehaviour:
+    """:func:`press_behaviour` of a press: its record and, when it has one, the dent its cloud
+    after release keeps at the tip (:func:`released_dent`; why none could be had joins the
+    evidence)."""
+    if not isinstance(obs, PressObservation):
+        raise InvalidArgumentError(
+            f"`obs` must be a PressObservation; got {type(obs).__name__}")
+    if obs.released is None:
+        return press_behaviour(obs.force_travel)
+    dent = released_dent(obs.released, obs.contact.tip_center, obs.contact.tip_radius_m)
+    if isinstance(dent, str):
+        got = press_behaviour(obs.force_travel)
+        return replace(got, evidence=f"{got.evidence}; {dent}")
+    return press_behaviour(obs.force_travel, released=dent)
