@@ -222,3 +222,20 @@ def _ramp_only(obs: PressObservation) -> PressObservation:
     assert record is not None
     return replace(obs, force_travel=ForceTravel(travel_m=record.travel_m,
                                                  force_n=record.force_n))
+
+
+@pytest.mark.parametrize("codes", [[0, 0, 0, 2, 2, 1, 1], [0, 0, 0, 1, 1, 3, 3],
+                                   [1, 1, 0, 0, 0, 2, 2]])
+def test_a_bag_record_whose_phases_are_out_of_order_is_refused(codes: list[int]) -> None:
+    from deformap.errors import FileFormatError
+    from deformap.replay._bagform import _phased_record
+
+    rows = np.column_stack([np.arange(7) * 0.1, [0, 1e-3, 2e-3, 2e-3, 2e-3, 1e-3, 0],
+                            [0.02, 0.5, 1.0, 1.0, 1.0, 0.4, 0.0], codes])
+    with pytest.raises(FileFormatError, match=r"`phase` must be 0 \(ramp\), 1 \(hold\) or 2"):
+        _phased_record(rows)
+    good = rows.copy()
+    good[:, 3] = [0, 0, 0, 1, 1, 2, 2]
+    record = _phased_record(good)
+    assert record.hold is not None and len(record.hold) == 2
+    assert record.unloading is not None and record.unloading.force_n[-1] == 0.0

@@ -189,7 +189,7 @@ def _dented(depth_m: float, n: int = 12000, noise_m: float = 3e-4) -> PointCloud
 
 @pytest.mark.parametrize("depth_m", [0.0, 0.0005, 0.002])
 def test_the_camera_dent_after_release_is_measured(depth_m: float) -> None:
-    got = released_dent(_dented(depth_m), [0.3, 0.2, 0.056], 0.005)
+    got = released_dent(_dented(depth_m).points, [0.3, 0.2, 0.056], 0.005)
     assert isinstance(got, tuple)
     dent, sigma = got
     # the median within one tip radius of a Gaussian dent of width 6 mm reads a bit shallow
@@ -198,7 +198,7 @@ def test_the_camera_dent_after_release_is_measured(depth_m: float) -> None:
 
 
 def test_a_camera_dent_with_too_few_points_says_why() -> None:
-    got = released_dent(PointCloud(np.array([[0.3, 0.2, 0.05]])), [0.3, 0.2, 0.056], 0.005)
+    got = released_dent(np.array([[0.3, 0.2, 0.05]]), [0.3, 0.2, 0.056], 0.005)
     assert isinstance(got, str) and "needs 5 of each" in got
 
 
@@ -208,9 +208,17 @@ def test_a_bad_camera_dent_is_refused_naming_it(bad: tuple[float, float]) -> Non
         press_behaviour(_record(hold=True), released=bad)
 
 
-def test_a_record_of_the_wrong_type_is_refused() -> None:
+def test_a_record_of_the_wrong_type_or_with_nan_is_refused() -> None:
+    import types
+
     with pytest.raises(InvalidArgumentError, match="`record` must be a ForceTravel"):
         press_behaviour((np.zeros(3), np.ones(3)))  # type: ignore[arg-type]
+    hold = types.SimpleNamespace(time_s=np.array([1.0, np.nan]), travel_m=np.zeros(2),
+                                 force_n=np.ones(2))
+    unchecked = types.SimpleNamespace(travel_m=np.zeros(3), force_n=np.ones(3),
+                                      time_s=np.arange(3.0), hold=hold, unloading=None)
+    with pytest.raises(InvalidArgumentError, match=r"`record\.hold\.time_s` holds NaN"):
+        press_behaviour(unchecked)
 
 
 @pytest.mark.parametrize(("change", "field"), [

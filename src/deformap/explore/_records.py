@@ -6,6 +6,7 @@ and comes back through :meth:`PokeRecord.from_dict`, which refuses a line that i
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, fields
@@ -14,14 +15,21 @@ from typing import Any, Literal, get_args
 import numpy as np
 from numpy.typing import NDArray
 
-from deformap.environment import ForceTravel, TactileContact
+from deformap.environment import ForceTravel, PressObservation, TactileContact
 from deformap.errors import FileFormatError, InvalidArgumentError
 from deformap.explore._planning import PokePlan
 from deformap.msm import BetaEstimate
-from deformap.stiffness import BEHAVIOURS, LAYER_MODEL, PressBehaviour, StiffnessEstimate
+from deformap.stiffness import (
+    BEHAVIOURS,
+    LAYER_MODEL,
+    PressBehaviour,
+    StiffnessEstimate,
+    press_behaviour,
+    released_dent,
+)
 
 __all__ = ["PURPOSES", "ContactRecord", "Dent", "PokeRecord", "PokeResult", "PokeTimings", "Purpose",
-           "Target"]
+           "Target", "poke_behaviour"]
 
 #: Why a place was poked: the first poke, the strategy's (until the variance is under ``T_h``), a
 #: look the appearance prior asks to test, or a boundary poke after it.
@@ -258,6 +266,19 @@ class PokeRecord:
             planned_after=num("planned_after", int, True),
             max_variance_after=num("max_variance_after", optional=True),
             behaviour=_behaviour_from_dict(data.get("behaviour"), f"{where}.behaviour"))
+
+
+def poke_behaviour(obs: PressObservation) -> PressBehaviour:
+    """:func:`~deformap.stiffness.press_behaviour` of a press: its record and, when it has one,
+    the dent its cloud after release keeps at the tip (:func:`~deformap.stiffness.released_dent`;
+    why none could be had joins the evidence)."""
+    if obs.released is None:
+        return press_behaviour(obs.force_travel)
+    dent = released_dent(obs.released.points, obs.contact.tip_center, obs.contact.tip_radius_m)
+    if isinstance(dent, str):
+        got = press_behaviour(obs.force_travel)
+        return dataclasses.replace(got, evidence=f"{got.evidence}; {dent}")
+    return press_behaviour(obs.force_travel, released=dent)
 
 
 def _behaviour_from_dict(data: Any, where: str) -> PressBehaviour | None:

@@ -38,12 +38,21 @@ from __future__ import annotations
 from deformap.stiffness._behaviour import (
     BEHAVIOURS,
     PressBehaviour,
-    observation_behaviour,
+    PressRecord,
     press_behaviour,
     released_dent,
 )
 from deformap.stiffness._config import LAYER_MODEL, StiffnessConfig, StiffnessEstimate
 from deformap.stiffness._estimate import estimate_stiffness
 
-__all__ = ["BEHAVIOURS", "LAYER_MODEL", "PressBehaviour", "StiffnessConfig", "StiffnessEstimate",
-           "estimate_stiffness", "observation_behaviour", "press_behaviour", "released_dent"]
+__all__ = [
+    "BEHAVIOURS",
+    "LAYER_MODEL",
+    "PressBehaviour",
+    "PressRecord",
+    "StiffnessConfig",
+    "StiffnessEstimate",
+    "estimate_stiffness",
+    "press_behaviour",
+    "released_dent",
+]

@@ -43,19 +43,18 @@ Anisotropy and the instantaneous against the relaxed modulus are not estimated h
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, replace
-from typing import Any, Literal
+from dataclasses import asdict, dataclass
+from typing import Any, Literal, Protocol
 
 import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import least_squares
 
-from deformap.cloud import PointCloud
-from deformap.environment import ForceTravel, PressObservation, PressPhase
+from deformap._validation import check_points
 from deformap.errors import InvalidArgumentError
 
 __all__ = ["BEHAVIOURS", "DENT_FLOOR_M", "LOSS_FLOOR", "MIN_FIT_SAMPLES", "N_SIGMA",
-           "RELAXATION_FLOOR", "Behaviour", "PressBehaviour", "observation_behaviour", "press_behaviour",
+           "RELAXATION_FLOOR", "Behaviour", "PressBehaviour", "PressRecord", "press_behaviour",
            "released_dent"]
 
 Behaviour = Literal["elastic", "viscoelastic", "plastic", "unknown"]
@@ -77,6 +76,31 @@ DENT_FLOOR_M = 1e-4
 MIN_FIT_SAMPLES = 4
 
 _MAD = 1.4826
+
+
+class _Phase(Protocol):
+    time_s: NDArray[np.float64]
+    travel_m: NDArray[np.float64]
+    force_n: NDArray[np.float64]
+
+    def __len__(self) -> int: ...
+
+
+class PressRecord(Protocol):
+    """What :func:`press_behaviour` reads of a press's record: a
+    :class:`deformap.environment.ForceTravel` (checked there: times that increase, stretches with
+    samples, an unloading that falls, finite values)."""
+
+    @property
+    def travel_m(self) -> NDArray[np.float64]: ...
+    @property
+    def force_n(self) -> NDArray[np.float64]: ...
+    @property
+    def time_s(self) -> NDArray[np.float64] | None: ...
+    @property
+    def hold(self) -> Any: ...
+    @property
+    def unloading(self) -> Any: ...
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -146,7 +170,7 @@ def _fraction(start: float, end: float, grad: NDArray[np.float64], cov: NDArray[
     return _Measure(float(value), math.sqrt(max(0.0, float(grad @ cov @ grad))))
 
 
-def _hold(hold: PressPhase, sigma_f: float, sigma_t: float
+def _hold(hold: _Phase, sigma_f: float, sigma_t: float
           ) -> tuple[_Measure | None, _Measure | None, str, str]:
     """The hold's fraction and time constant, the mode, and a note on what could not be had."""
     f0, f1, sf = _ends(hold.force_n, sigma_f)
@@ -218,7 +242,7 @@ def _trapz_grad(x: NDArray[np.float64], y: NDArray[np.float64]
     return value, gx, gy
 
 
-def _loss(record: ForceTravel, sigma_f: float, sigma_t: float) -> _Measure | str:
+def _loss(record: PressRecord, sigma_f: float, sigma_t: float) -> _Measure | str:
     unloading = record.unloading
     assert unloading is not None
     parts = [(record.travel_m, record.force_n)]
@@ -241,7 +265,7 @@ def _loss(record: ForceTravel, sigma_f: float, sigma_t: float) -> _Measure | str
     return _Measure(ratio, math.sqrt(var))
 
 
-def _residual(unloading: PressPhase, sigma_f: float, sigma_t: float) -> _Measure | str:
+def _residual(unloading: _Phase, sigma_f: float, sigma_t: float) -> _Measure | str:
     f = np.asarray(unloading.force_n)
     t = np.asarray(unloading.travel_m)
     use = (f > N_SIGMA * sigma_f) & (f <= 0.5 * float(f.max()))
@@ -268,16 +292,17 @@ def _residual(unloading: PressPhase, sigma_f: float, sigma_t: float) -> _Measure
     return _Measure(value, sigma)
 
 
-def released_dent(cloud: PointCloud, tip_center: Any, tip_radius_m: float
+def released_dent(points: Any, tip_center: Any, tip_radius_m: float
                   ) -> tuple[float, float] | str:
-    """The dent [m] and its σ that the surface ``cloud`` seen after release keeps at the press
-    point (module docstring), or why it cannot be had (too few points near the press)."""
+    """The dent [m] and its σ that the surface seen after release, ``points`` ``(n, 3)`` (world
+    frame, z up), keeps at the press point (module docstring), or why it cannot be had (too few
+    points near the press)."""
     center = np.asarray(tip_center, dtype=np.float64)
     if not (center.shape == (3,) and np.all(np.isfinite(center))):
         raise InvalidArgumentError(f"`tip_center` must be 3 finite numbers; got {tip_center!r}")
     if not (math.isfinite(tip_radius_m) and tip_radius_m > 0.0):
         raise InvalidArgumentError(f"`tip_radius_m` must be positive; got {tip_radius_m!r}")
-    pts = cloud.points
+    pts = check_points("points", points, min_rows=0)
     r = np.linalg.norm(pts[:, :2] - center[:2], axis=1)
     inner = pts[r <= tip_radius_m, 2]
     ring = pts[(r >= 3.0 * tip_radius_m) & (r <= 5.0 * tip_radius_m), 2]
@@ -292,16 +317,15 @@ def released_dent(cloud: PointCloud, tip_center: Any, tip_radius_m: float
     return dent, math.hypot(median_se(inner), median_se(ring))
 
 
-def press_behaviour(record: ForceTravel | None, *,
+def press_behaviour(record: PressRecord | None, *,
                     released: tuple[float, float] | None = None) -> PressBehaviour:
     """The press's relaxation, loss, residual dent and class (module docstring).
 
     ``released`` is the camera's dent after release and its σ [m] (:func:`released_dent`), when
     one was seen. A record with no hold, no unloading and no camera dent is ``"unknown"``.
     """
-    if record is not None and not isinstance(record, ForceTravel):
-        raise InvalidArgumentError(
-            f"`record` must be a ForceTravel or None; got {type(record).__name__}")
+    if record is not None:
+        _check_record(record)
     cam: _Measure | None = None
     if released is not None:
         value, sigma = (float(v) for v in released)
@@ -403,17 +427,19 @@ def _classify(relax: _Measure | None, tau: _Measure | None, mode: str | None,
         released_dent_sigma_m=None if cam is None else float(cam.sigma))
 
 
-def observation_behaviour(obs: PressObservation) -> PressBehaviour:
-    """:func:`press_behaviour` of a press: its record and, when it has one, the dent its cloud
-    after release keeps at the tip (:func:`released_dent`; why none could be had joins the
-    evidence)."""
-    if not isinstance(obs, PressObservation):
+
+def _check_record(record: Any) -> None:
+    """A record must have a ForceTravel's parts, each finite (a ForceTravel checks the rest)."""
+    names = ("travel_m", "force_n", "time_s", "hold", "unloading")
+    if not all(hasattr(record, n) for n in names):
         raise InvalidArgumentError(
-            f"`obs` must be a PressObservation; got {type(obs).__name__}")
-    if obs.released is None:
-        return press_behaviour(obs.force_travel)
-    dent = released_dent(obs.released, obs.contact.tip_center, obs.contact.tip_radius_m)
-    if isinstance(dent, str):
-        got = press_behaviour(obs.force_travel)
-        return replace(got, evidence=f"{got.evidence}; {dent}")
-    return press_behaviour(obs.force_travel, released=dent)
+            f"`record` must be a ForceTravel or None; got {type(record).__name__}")
+    parts = [("", record)] + [(f"{n}.", getattr(record, n)) for n in ("hold", "unloading")]
+    for prefix, part in parts:
+        if part is None:
+            continue
+        for name in ("time_s", "travel_m", "force_n"):
+            values = getattr(part, name, None)
+            if values is not None and not np.all(np.isfinite(np.asarray(values, dtype=float))):
+                raise InvalidArgumentError(
+                    f"`record.{prefix}{name}` holds NaN or infinite values")
