@@ -24,8 +24,8 @@ from deformap.errors import InvalidArgumentError
 from deformap.mechanics import TactileContact
 
 __all__ = ["FORCE_MISMATCH_ABS_N", "FORCE_MISMATCH_REL", "MAX_GRID_CELLS", "MAX_TRAVEL_M",
-           "MIN_FORCE_RISE_N", "TRAVEL_BACKWARDS_TOLERANCE_M", "Environment", "ForceTravel",
-           "PressObservation", "PressPhase", "TactileContact", "Workspace"]
+           "MIN_FORCE_RISE_N", "TIP_IN_VIEW_RADII", "TRAVEL_BACKWARDS_TOLERANCE_M", "Environment",
+           "ForceTravel", "PressObservation", "PressPhase", "TactileContact", "Workspace"]
 
 
 #: Most cells of a :meth:`Workspace.grid` (200 MB per float map layer).
@@ -93,6 +93,10 @@ MAX_TRAVEL_M = 0.05
 
 #: The force must rise by more than this [N] over a record: four times a probe sensor's noise.
 MIN_FORCE_RISE_N = 0.02
+
+#: A point of the cloud after release within this many tip radii of the tip centre, and above it,
+#: is the tip itself (the tip's radius and a margin for depth noise).
+TIP_IN_VIEW_RADII = 1.1
 
 #: A measured force may differ from the commanded by at most ``FORCE_MISMATCH_REL · force_n +
 #: FORCE_MISMATCH_ABS_N``: far beyond a controller's overshoot and a sensor's noise.
@@ -288,6 +292,11 @@ class PressObservation:
     ``force_travel`` (None where the environment has no record). ``robot_points`` ((m, 3), at least
     4 not coplanar) span the stick and hand, or a tuple holds one such array per part, each hull
     removed on its own (:attr:`robot_hulls` gives the tuple either way).
+
+    ``released`` (optional) is the surface seen once the tip has left, for the dent the press
+    kept. A cloud with the tip still in view is refused: any point of it that lies within
+    :data:`TIP_IN_VIEW_RADII` tip radii of ``contact.tip_center`` and higher than the tip centre
+    (the upper half of the tip, what a camera above sees of it) counts as the tip.
     """
 
     cloud: PointCloud
@@ -296,6 +305,7 @@ class PressObservation:
     target_xy: NDArray[np.float64]
     force_n: float
     force_travel: ForceTravel | None = None
+    released: PointCloud | None = None
 
     def __post_init__(self) -> None:
         if not isinstance(self.cloud, PointCloud):
@@ -316,6 +326,7 @@ class PressObservation:
         force_n = check_positive("force_n", self.force_n)
         object.__setattr__(self, "force_n", force_n)
         self._check_contact_force(force_n)
+        self._check_released()
         record = self.force_travel
         if record is None:
             return
@@ -328,6 +339,23 @@ class PressObservation:
                 f"`force_travel` must end at the commanded force {force_n:.4g} N (within "
                 f"{allowed:.3g} N); its last force is {final:.4g} N")
 
+    def _check_released(self) -> None:
+        """The cloud after release must be a PointCloud with no point where the tip's top would be."""
+        released = self.released
+        if released is None:
+            return
+        if not isinstance(released, PointCloud):
+            raise InvalidArgumentError(
+                f"`released` must be a PointCloud or None; got {type(released).__name__}")
+        center, radius = self.contact.tip_center, self.contact.tip_radius_m
+        pts = released.points
+        near = np.linalg.norm(pts - center, axis=1) <= TIP_IN_VIEW_RADII * radius
+        tip = near & (pts[:, 2] > center[2])
+        if np.any(tip):
+            raise InvalidArgumentError(
+                f"`released` must be seen once the tip has left; {int(tip.sum())} of its points "
+                f"lie within {TIP_IN_VIEW_RADII} tip radii of the tip centre and above it (the "
+                "tip still in view)")
 
     @property
     def robot_hulls(self) -> tuple[NDArray[np.float64], ...]:

@@ -271,8 +271,10 @@ def _record(travel: Any = None, force: Any = None) -> dict[str, Any]:
     ("change", "match"),
     [
         (_set("pokes.1.force_travel", [1.0, 2.0]), r"`pokes\[1\].force_travel` must be a mapping"),
-        (_set("pokes.1.force_travel", {**_record(), "time_s": [0, 1, 2, 3, 4]}),
-         r"`pokes\[1\].force_travel` has unknown key\(s\) \['time_s'\]"),
+        (_set("pokes.1.force_travel", {**_record(), "speed": [0, 1, 2, 3, 4]}),
+         r"`pokes\[1\].force_travel` has unknown key\(s\) \['speed'\]"),
+        (_set("pokes.1.force_travel", {**_record(), "hold": {"time_s": [5, 6]}}),
+         r"`pokes\[1\].force_travel.hold` lacks required key\(s\) \['force_n', 'travel_m'\]"),
         (_set("pokes.1.force_travel", {"travel_m": _GOOD_TRAVEL}),
          r"`pokes\[1\].force_travel` lacks required key\(s\) \['force_n'\]"),
     ],

@@ -122,6 +122,25 @@ def test_raw_bag_maps_to_the_live_betas_and_moduli(
             assert raw_e["modulus_pa"] == pytest.approx(live_e.modulus_pa, rel=0.10)
 
 
+def test_a_raw_press_record_has_its_times_and_its_hold(
+        raw_bag: Path, live: tuple[RecordedSession, list[Any]]) -> None:
+    from deformap.replay import load_raw_bag, load_raw_config
+
+    force_n = live[0].press_observation(0).force_n
+    session = load_raw_bag(raw_bag, load_raw_config(raw_bag), default_force_n=force_n)
+    records = [session.press_observation(i).force_travel for i in range(len(session))]
+    assert sum(r is not None for r in records) >= 2
+    for record in records:
+        if record is None:
+            continue
+        assert record.time_s is not None and record.time_s[0] == 0.0  # first contact
+        assert record.time_s[-1] == pytest.approx(RAMP, rel=0.2)  # the robot's ramp takes RAMP s
+        assert record.hold is not None and record.unloading is None
+        assert record.hold.time_s[-1] - record.time_s[-1] == pytest.approx(HOLD, rel=0.2)
+        # the world holds the force: the hold's force stays at the ramp's last within 5 %
+        assert np.median(record.hold.force_n) == pytest.approx(record.force_n[-1], rel=0.05)
+
+
 def test_missing_topic_is_named(raw_bag: Path, live: tuple[RecordedSession, list[Any]],
                                 config_file: Path, tmp_path: Path) -> None:  # fmt: skip
     bag = tmp_path / "nowrench.mcap"

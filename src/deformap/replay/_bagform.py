@@ -3,8 +3,11 @@
 A poke's messages share one header stamp, which ``session.yaml`` names (``stamp_ns``) beside the
 command (target, force). Each message is decoded when its poke is read, so a corrupted message
 breaks only its own poke. The force–travel record (``OPTIONAL_TOPICS``) is a
-``Float64MultiArray`` of dimensions ``samples`` (n) × ``travel_m,force_n`` (2); having no header,
-it is logged at the poke's stamp. Without one a poke has no record.
+``Float64MultiArray`` of dimensions ``samples`` (n) × ``travel_m,force_n`` (2), or, for a record
+with its times, ``samples`` × ``time_s,travel_m,force_n,phase`` (4), ``phase`` 0 on the ramp, 1 in
+the hold and 2 while unloading, in that order; having no header, it is logged at the poke's stamp.
+Without one a poke has no record. The cloud after release (``OPTIONAL_TOPICS["released"]``) is a
+``PointCloud2`` stamped as the poke's other messages, in the session's frame.
 """
 
 from __future__ import annotations
@@ -34,15 +37,18 @@ from deformap.cloud.io import (
     wrench_message,
     xyz_with_holes,
 )
-from deformap.environment import ForceTravel, PressObservation
+from deformap.environment import ForceTravel, PressObservation, PressPhase
 from deformap.errors import DeformapError, FileFormatError
 from deformap.replay._confine import check_bag_confined, verify_digest
 from deformap.replay._format import OPTIONAL_TOPICS, TOPICS, PokeSpec, PressParts, SessionHeader
 
 #: Labels of the record's two dimensions in its ``Float64MultiArray`` layout.
 FORCE_TRAVEL_DIMS = ("samples", "travel_m,force_n")
+#: Labels of a record with times and phases (``phase``: 0 ramp, 1 hold, 2 unloading).
+FORCE_TRAVEL_PHASED_DIMS = ("samples", "time_s,travel_m,force_n,phase")
 
-__all__ = ["FORCE_TRAVEL_DIMS", "BagReader", "force_travel_message", "write_session_bag"]
+__all__ = ["FORCE_TRAVEL_DIMS", "FORCE_TRAVEL_PHASED_DIMS", "BagReader", "force_travel_message",
+           "write_session_bag"]
 
 
 class BagReader:
@@ -89,17 +95,42 @@ class BagReader:
                 f"{where}: could not be decoded: {bag_error_text(exc, 120)}") from None
         dims = [(str(d.label), int(d.size)) for d in msg.layout.dim]
         data = np.asarray(msg.data, dtype=float)
-        if (len(dims) != 2 or (dims[0][0], dims[1][0]) != FORCE_TRAVEL_DIMS or dims[1][1] != 2
-                or msg.layout.data_offset != 0 or data.size != 2 * dims[0][1]):
+        labels = tuple(d[0] for d in dims)
+        width = 4 if labels == FORCE_TRAVEL_PHASED_DIMS else 2
+        if (len(dims) != 2 or labels not in (FORCE_TRAVEL_DIMS, FORCE_TRAVEL_PHASED_DIMS)
+                or dims[1][1] != width or msg.layout.data_offset != 0
+                or data.size != width * dims[0][1]):
             raise FileFormatError(
                 f"{where}: layout must be {FORCE_TRAVEL_DIMS[0]!r} (n) × "
-                f"{FORCE_TRAVEL_DIMS[1]!r} (2) with 2n values from offset 0; got dims {dims}, "
-                f"offset {msg.layout.data_offset}, {data.size} values")
-        rows = data.reshape(-1, 2)
+                f"{FORCE_TRAVEL_DIMS[1]!r} (2) or {FORCE_TRAVEL_PHASED_DIMS[1]!r} (4) with 2n or "
+                f"4n values from offset 0; got dims {dims}, offset {msg.layout.data_offset}, "
+                f"{data.size} values")
+        rows = data.reshape(-1, width)
         try:
-            return ForceTravel(travel_m=rows[:, 0], force_n=rows[:, 1])
+            if width == 2:
+                return ForceTravel(travel_m=rows[:, 0], force_n=rows[:, 1])
+            return _phased_record(rows)
         except DeformapError as exc:
             raise FileFormatError(f"{where}: {exc}") from None
+
+    def _released(self, stamp: int) -> PointCloud | None:
+        """The cloud after release stamped ``stamp`` (world frame), or None."""
+        topic, msgtype = OPTIONAL_TOPICS["released"]
+        where = f"{self.path} [{topic} stamped {stamp}]"
+        found = []
+        for number, (_, data) in enumerate(self._raw[topic], start=1):
+            try:
+                msg = typestore().deserialize_cdr(data, msgtype)
+            except bag_read_errors() as exc:
+                raise FileFormatError(f"{self.path} [{topic}] message {number}: could not be "
+                                      f"decoded: {bag_error_text(exc, 120)}") from None
+            if header_stamp_ns(msg.header) == stamp:
+                found.append(msg)
+        if not found:
+            return None
+        if len(found) > 1:
+            raise FileFormatError(f"{where}: {len(found)} messages; a poke has at most one")
+        return self._to_world(self._cloud(found[0], where, self.header.frame))
 
     def _by_stamp(self, key: str) -> dict[int, list[Any]]:
         """The messages of ``TOPICS[key]`` by header stamp, decoded on first use; why each one
@@ -254,7 +285,24 @@ class BagReader:
                 m = self._static_to_world(frame, where(key))
                 values[key] = m[:3, :3] @ values[key] + (m[:3, 3] if key == "tip" else 0.0)
         return PressParts(cloud, values["tip"], values["wrench"], np.asarray(robot.points),
-                          self._force_travel(stamp))
+                          self._force_travel(stamp), self._released(stamp))
+
+
+def _phased_record(rows: NDArray[np.float64]) -> ForceTravel:
+    """A record from ``time_s, travel_m, force_n, phase`` rows (module docstring)."""
+    phase = rows[:, 3]
+    if not np.all(np.isin(phase, (0.0, 1.0, 2.0))) or np.any(np.diff(phase) < 0):
+        raise FileFormatError(
+            "`phase` must be 0 (ramp), 1 (hold) or 2 (unloading), in that order; got "
+            f"{len(phase)} rows whose codes run {phase[:12].tolist()}"
+            + (" ..." if len(phase) > 12 else ""))
+    parts = {}
+    for code, name in ((1.0, "hold"), (2.0, "unloading")):
+        sel = rows[phase == code]
+        if len(sel):
+            parts[name] = PressPhase(time_s=sel[:, 0], travel_m=sel[:, 1], force_n=sel[:, 2])
+    ramp = rows[phase == 0.0]
+    return ForceTravel(travel_m=ramp[:, 1], force_n=ramp[:, 2], time_s=ramp[:, 0], **parts)
 
 
 def _point_message(stamp_ns: int, point: Any) -> Any:
@@ -272,6 +320,19 @@ def force_travel_message(record: ForceTravel) -> Any:
             dim(label=FORCE_TRAVEL_DIMS[1], size=2, stride=2)]
     layout = types["std_msgs/msg/MultiArrayLayout"](dim=dims, data_offset=0)
     data = np.column_stack([record.travel_m, record.force_n]).ravel()
+    if record.time_s is not None:
+        blocks = [np.column_stack([record.time_s, record.travel_m, record.force_n,
+                                   np.zeros(n)])]
+        for code, phase in ((1.0, record.hold), (2.0, record.unloading)):
+            if phase is not None:
+                blocks.append(np.column_stack([phase.time_s, phase.travel_m, phase.force_n,
+                                               np.full(len(phase), code)]))
+        rows = np.vstack(blocks)
+        n = len(rows)
+        dims = [dim(label=FORCE_TRAVEL_PHASED_DIMS[0], size=n, stride=4 * n),
+                dim(label=FORCE_TRAVEL_PHASED_DIMS[1], size=4, stride=4)]
+        layout = types["std_msgs/msg/MultiArrayLayout"](dim=dims, data_offset=0)
+        data = rows.ravel()
     return types["std_msgs/msg/Float64MultiArray"](layout=layout, data=data)
 
 
@@ -283,7 +344,9 @@ def write_session_bag(path: Path, *, storage: str, observation: PointCloud,
     # the record's topic only where a press has one: a bag of presses without stays as before
     topics = dict(TOPICS)
     if any(obs.force_travel is not None for obs in presses):
-        topics.update(OPTIONAL_TOPICS)
+        topics["force_travel"] = OPTIONAL_TOPICS["force_travel"]
+    if any(obs.released is not None for obs in presses):
+        topics["released"] = OPTIONAL_TOPICS["released"]
     with bag_writer(path, storage) as writer:
         conns = {key: writer.add_connection(topic, msgtype, typestore=store)
                  for key, (topic, msgtype) in topics.items()}  # fmt: skip
@@ -303,3 +366,5 @@ def write_session_bag(path: Path, *, storage: str, observation: PointCloud,
             cloud("robot", stamp, np.vstack(obs.robot_hulls))  # one hull: the parts' common one
             if obs.force_travel is not None:
                 put("force_travel", stamp, force_travel_message(obs.force_travel))
+            if obs.released is not None:
+                cloud("released", stamp, obs.released.points, obs.released.colors)

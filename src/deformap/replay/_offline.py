@@ -96,10 +96,11 @@ def tip_sphere_points(tip_center: Any, tip_radius_m: float) -> NDArray[np.float6
 
 def estimate_poke(before: PointCloud, after: PointCloud, contact: TactileContact,
                   config: ExplorationConfig, *, rng: np.random.Generator, robot_points: Any = None,
-                  force_travel: ForceTravel | None = None,
+                  force_travel: ForceTravel | None = None, released: PointCloud | None = None,
                   contact_gap_m: float = DEFAULT_CONTACT_GAP_M) -> PokeResult:
     """β of one poke from the world-frame clouds ``before`` and ``after`` (while pressing), and with
-    the press's ``force_travel`` record its stiffness and E, read as the mapper reads a press.
+    the press's ``force_travel`` record its stiffness and E, read as the mapper reads a press
+    (``released``: the surface once the tip has left, for the dent it kept).
 
     The surface, touch and shape-matching settings of ``config`` apply, over a workspace of three ROIs
     square centred on the contact. ``robot_points`` default to the tip's sphere
@@ -114,7 +115,8 @@ def estimate_poke(before: PointCloud, after: PointCloud, contact: TactileContact
     half = 1.5 * config.touch.roi_size_m
     workspace = Workspace(lower=tuple(xy - half), upper=tuple(xy + half))
     obs = PressObservation(cloud=after, contact=contact, robot_points=robot, target_xy=xy,
-                           force_n=contact.force_n, force_travel=force_travel)  # fmt: skip
+                           force_n=contact.force_n, force_travel=force_travel,
+                           released=released)  # fmt: skip
     check_contact_gap(obs, check_positive("contact_gap_m", contact_gap_m), "`after` and `contact`")
     mapper = Mapper(workspace, config)
     mapper.initialise(before, rng)

@@ -32,17 +32,17 @@ from deformap.cloud.io import (
     typestore,
     xyz_with_holes,
 )
-from deformap.environment import TRAVEL_BACKWARDS_TOLERANCE_M, ForceTravel, Workspace
+from deformap.environment import TRAVEL_BACKWARDS_TOLERANCE_M, Workspace
 from deformap.errors import DeformapError, FileFormatError
 from deformap.replay._format import PokeSpec, PressParts
 from deformap.replay._rawconfig import WORKSPACE_MARGIN_RADII, HullPart, RawBagConfig
 from deformap.replay._rawfind import CLOUD_TYPE, TF_TYPE, WRENCH_TYPE, BagDiscovery
 from deformap.replay._rawpress import (
     FoundPress,
-    block_means,
     block_size,
     find_presses,
     onset,
+    press_record,
 )
 
 __all__ = ["DENT_SIGMAS", "RawBagReader", "hull_points"]
@@ -461,17 +461,12 @@ class RawBagReader(BagDiscovery):
         tip = tips[hold.stop - settled: hold.stop].mean(axis=0)
         robot = tuple(hull_points(p, r_tip[mid], tip) for p in cfg.hull)  # a hull per part
         notes = self.notes.setdefault(spec.index, {})
-        record: ForceTravel | None = None
         # the sensor's noise along the press: its per-axis σ seen along the direction
         along = r_force[mid].T @ direction
         noise = float(np.sqrt(np.sum((along * self.noise.std) ** 2)))
-        samples = block_means(travel, normal[ramp], noise)
-        try:
-            record = ForceTravel(travel_m=samples[0], force_n=samples[1])
-        except DeformapError as exc:
-            # a force step, or a ramp the sensor's noise hides: the camera still reads the dent
-            notes["force_travel"] = (f"the ramp's force–travel record cannot be read ({exc}); "
-                                     "β from the camera alone, no modulus")
+        seconds, held = (stamps - stamps[0]) / 1e9, slice(ramp.stop, hold.stop)
+        record = press_record(travel, normal[ramp], seconds[ramp], noise, notes,
+                              (seconds[held], (tips[held] - tips[0]) @ direction, normal[held]))
         dent, dent_std = self._camera_dent(cloud, tip + cfg.tip_radius_m * direction, robot)
         moved = float(travel[-1]) if travel.size else 0.0
         notes["camera_dent_m"] = f"{dent:.5f} ± {dent_std:.5f}"

@@ -1,16 +1,20 @@
 """Presses found in a force stream: rise over the contact threshold, hold at the commanded force,
 release (``docs/robot.md``). Pure arrays: times and force magnitudes in, one :class:`FoundPress`
-per press out."""
+per press out; a press's samples become its force–travel record (:func:`press_record`)."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
+from deformap.environment import ForceTravel, PressPhase
+from deformap.errors import DeformapError
+
 __all__ = ["CONTACT_NOISE_MULTIPLE", "FoundPress", "NoiseFloor", "block_means", "block_size",
-           "contact_threshold", "find_presses", "noise_floor", "onset"]
+           "contact_threshold", "find_presses", "noise_floor", "onset", "press_record"]
 
 #: The contact threshold is this many times the noise's rms magnitude: a sample of noise alone
 #: crosses it with probability below 6.4e-5 (P(|Z| > 4) with all the noise on one axis; far less
@@ -192,6 +196,36 @@ def block_means(travel: NDArray[np.float64], force: NDArray[np.float64], noise_n
     rest_t = travel[1 + skip:].reshape(blocks, k).mean(axis=1)
     rest_f = force[1 + skip:].reshape(blocks, k).mean(axis=1)
     return np.concatenate([travel[:1], rest_t]), np.concatenate([force[:1], rest_f])
+
+
+def press_record(travel: NDArray[np.float64], force: NDArray[np.float64],
+                 seconds: NDArray[np.float64], noise_n: float, notes: dict[str, Any],
+                 hold: tuple[NDArray[np.float64], ...]) -> ForceTravel | None:
+    """The record of a press: its ramp's ``travel``, ``force`` and ``seconds`` since first contact
+    (one per sample), averaged by :func:`block_means`, and as its hold the samples ``hold`` =
+    ``(seconds, travel, force)`` from the one after the ramp's last (the first to reach the force
+    held) to the end of the hold, as they are. No unloading: the record stops where the hold does.
+
+    Ramp samples the record refuses leave none, ``notes["force_travel"]`` saying why (β then comes
+    from the camera alone); times that do not increase (a repeated stamp) or a hold it refuses
+    leave the ramp alone, ``notes["record_times"]`` saying why."""
+    ramp_travel, ramp_force = block_means(travel, force, noise_n)
+    ramp_seconds = block_means(seconds, force, noise_n)[0]  # the same blocks
+    try:
+        ramp = ForceTravel(travel_m=ramp_travel, force_n=ramp_force)
+    except DeformapError as exc:
+        # a force step, or a ramp the sensor's noise hides: the camera still reads the dent
+        notes["force_travel"] = (f"the ramp's force–travel record cannot be read ({exc}); "
+                                 "β from the camera alone, no modulus")
+        return None
+    try:
+        phase = (PressPhase(time_s=hold[0], travel_m=hold[1], force_n=hold[2])
+                 if len(hold[0]) >= 2 else None)
+        return ForceTravel(travel_m=ramp.travel_m, force_n=ramp.force_n, time_s=ramp_seconds,
+                           hold=phase)
+    except DeformapError as exc:
+        notes["record_times"] = f"the record keeps its ramp alone, without times ({exc})"
+        return ramp
 
 
 def onset(force: NDArray[np.float64], start: int, floor: int, noise: NoiseFloor, k: int) -> int:

@@ -83,7 +83,8 @@ class FolderReader:
             # Robot geometry comes from the robot model in the world (base) frame, not the camera's.
             robot = np.asarray(self._read(robot, to_world=False).points)
         assert robot is not None
-        return PressParts(cloud, spec.tip_center, spec.force, robot, spec.force_travel)
+        released = None if spec.released is None else self._read(spec.released)
+        return PressParts(cloud, spec.tip_center, spec.force, robot, spec.force_travel, released)
 
 
 @dataclass(eq=False)
@@ -153,7 +154,8 @@ class RecordedSession:
             obs = PressObservation(cloud=parts.cloud, contact=contact,
                                    robot_points=parts.robot_points, target_xy=spec.target_xy,
                                    force_n=spec.force_n,
-                                   force_travel=parts.force_travel)  # fmt: skip
+                                   force_travel=parts.force_travel,
+                                   released=parts.released)  # fmt: skip
         except InvalidArgumentError as exc:
             raise FileFormatError(f"{where}: {exc}") from None
         self._check_contact(obs, where)

@@ -15,7 +15,7 @@ from deformap._files import LOCK_NAME, write_text_atomically, writing
 from deformap._validation import check_instance, check_path, check_positive
 from deformap.cloud import PointCloud
 from deformap.cloud.io import BAG_STORAGES, CLOUD_FORMATS, write_cloud
-from deformap.environment import Environment, PressObservation, Workspace
+from deformap.environment import Environment, ForceTravel, PressObservation, Workspace
 from deformap.errors import EnvironmentStateError, InvalidArgumentError
 from deformap.replay._bagform import write_session_bag
 from deformap.replay._confine import manifest_of, seal
@@ -129,6 +129,19 @@ def _check_inputs(folder: Any, workspace: Any, observation: Any, presses: Any, t
     return out, presses, tip
 
 
+def record_entry(record: ForceTravel) -> dict[str, Any]:
+    """A force–travel record as ``session.yaml``'s ``force_travel`` entry (parts it lacks left out)."""
+    entry: dict[str, Any] = {"travel_m": _floats(record.travel_m),
+                             "force_n": _floats(record.force_n)}
+    if record.time_s is not None:
+        entry["time_s"] = _floats(record.time_s)
+    for name in ("hold", "unloading"):
+        phase = getattr(record, name)
+        if phase is not None:
+            entry[name] = {k: _floats(getattr(phase, k)) for k in ("time_s", "travel_m", "force_n")}
+    return entry
+
+
 def write_session(folder: str | Path, *, workspace: Workspace, observation: PointCloud,
                   presses: Sequence[PressObservation], tip_radius_m: float | None = None,
                   ground_truth: GroundTruth | None = None, source: dict[str, Any] | None = None,
@@ -177,8 +190,10 @@ def write_session(folder: str | Path, *, workspace: Workspace, observation: Poin
                 "force": _floats(obs.contact.force), "target_xy": _floats(obs.target_xy),
                 "force_n": float(obs.force_n), "robot_points": robot}  # fmt: skip
             if obs.force_travel is not None:
-                entry["force_travel"] = {"travel_m": _floats(obs.force_travel.travel_m),
-                                         "force_n": _floats(obs.force_travel.force_n)}
+                entry["force_travel"] = record_entry(obs.force_travel)
+            if obs.released is not None:
+                entry["released"] = f"poke-{i:02d}-released.{cloud_format}"
+                write_cloud(out / entry["released"], obs.released)
             pokes.append(entry)
     else:
         stamps = [(i + 1) * _STAMP_STEP_NS for i in range(len(presses))]

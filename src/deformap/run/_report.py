@@ -4,7 +4,8 @@ Every report of a mapped surface (:func:`live_report`, :func:`session_report`) h
 that :func:`shared_report` builds; values of the map field (``field``) are in its units, β or
 ln E [ln Pa]:
 
-- ``pokes`` (one :meth:`deformap.explore.PokeRecord.to_dict` each), ``n_pokes``, ``stop_reason``;
+- ``pokes`` (one :meth:`deformap.explore.PokeRecord.to_dict` each, with its ``behaviour``: class,
+  evidence, relaxation, loss ratio and dents with their σ), ``n_pokes``, ``stop_reason``;
 - ``max_variance`` (what the stop compared with ``T_h``, over the stop cells) and
   ``max_variance_map`` (over the whole map);
 - ``beta_nugget``, the β-field's nugget τ̂ (:mod:`deformap.explore._nugget`; 0 when off);
@@ -78,7 +79,7 @@ SHARED_KEYS = (
 
 _ESTIMATE_KEYS = ("contact", "force_n", "betas", "errors", "converged", "iterations",
                   "n_roi_points", "depth_anchored", "stiffness", "layer_thickness_m",
-                  "stiffness_error", "timings")  # fmt: skip
+                  "stiffness_error", "behaviour", "timings")  # fmt: skip
 
 
 def _finite(value: float | None) -> float | None:
@@ -244,7 +245,8 @@ def estimate_report(
 ) -> dict[str, Any]:
     """``estimate.json``: β of one poke with its uncertainty and E(β) curve; with a force–travel
     record its ``stiffness`` (``None`` without one), the ``layer_thickness_m`` it was read with
-    and ``stiffness_error`` (why a record gave none)."""
+    and ``stiffness_error`` (why a record gave none); ``behaviour``, what the press reveals beyond
+    its stiffness."""
     r = poke.record.to_dict()
     return {
         "before": str(before),
