@@ -29,7 +29,13 @@ from deformap.errors import EnvironmentStateError, InvalidArgumentError
 from deformap.world._camera import DepthCamera, Frame
 from deformap.world._config import WorldConfig, check_world_budget
 from deformap.world._foam import Dent, FoamModel
-from deformap.world._force_travel import force_levels, simulated_force_travel
+from deformap.world._force_travel import (
+    PressSchedule,
+    force_levels,
+    press_schedule,
+    simulated_force_travel,
+    with_phases,
+)
 from deformap.world._looks import HAND, STICK, TABLE, TIP, SceneLooks
 from deformap.world._scenario import BARE_TABLE, Block, Scenario
 from deformap.world._stiffening import StiffeningFoam
@@ -196,19 +202,38 @@ class SimulatedWorld:
         final = dent if dent is not None else self.dent(target, force)
         levels = force_levels(c.contact_threshold_n, force, c.force_travel_levels,
                               c.force_travel_spacing)
+        schedule = press_schedule(levels, rate_n_per_s=c.ramp_rate_n_per_s, hold_s=c.hold_s,
+                                  unload=c.unload)
         depths = self._level_depths(target, levels, final)
         on = 1.0 if c.noise else 0.0
+        noise = dict(encoder_noise_m=c.encoder_noise_m * on,
+                     force_noise_rel=c.force_travel_noise_rel * on,
+                     force_noise_n=c.force_travel_noise_n * on)
+        key = self._press_key(target, force, 2)
         try:
-            return simulated_force_travel(
-                depths, levels, self._event_rng(*self._press_key(target, force, 2)),
-                encoder_noise_m=c.encoder_noise_m * on,
-                force_noise_rel=c.force_travel_noise_rel * on,
-                force_noise_n=c.force_travel_noise_n * on)
+            record = simulated_force_travel(depths, levels, self._event_rng(*key), **noise)
+            if not schedule.has_phases:
+                return record
+            hold, unloading = self._phase_depths(target, schedule, depths)
+            # the encoder's reading at first contact: the ramp stream's first draw
+            zero = depths[0] + self._event_rng(*key).normal(0.0, 1.0, size=depths.size)[0] * (
+                noise["encoder_noise_m"])
+            return with_phases(record, schedule, zero, hold, unloading,
+                               self._event_rng(*self._press_key(target, force, 4)), **noise)
         except InvalidArgumentError as err:
             log.warning("no force–travel record for the press at %s with %g N: the solved "
                         "indentations %s mm are not a press's (%s)", tuple(np.round(target, 4)),
                         force, np.round(depths * 1e3, 2).tolist(), err)
             return None
+
+    def _phase_depths(self, target: NDArray[np.float64], schedule: PressSchedule,
+                      depths: NDArray[np.float64]
+                      ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """The indentations during the hold and the unloading: an elastic block holds the last
+        level's and retraces the ramp's levels in reverse."""
+        hold = np.full(schedule.hold_times.size, depths[-1])
+        unloading = depths[-2::-1][:schedule.unload_times.size].copy()
+        return hold, unloading
 
     def _level_depths(self, target: NDArray[np.float64], levels: NDArray[np.float64],
                       final: Dent) -> NDArray[np.float64]:
