@@ -10,7 +10,8 @@ from deformap._validation import SettingError
 from deformap.errors import ConfigError, EnvironmentStateError, InvalidArgumentError
 from deformap.world import SimulatedWorld, WorldConfig
 from deformap.world._fem import FoamBody, HexGrid, graded_levels
-from deformap.world._materials import Orthotropic, Viscoelastic
+from deformap.world._materials import Orthotropic, Plastic, Viscoelastic
+from deformap.world._plastic import return_map
 from deformap.world._polygon import rectangle
 from deformap.world._scenario import Block, Scenario
 from deformap.world._scenario_io import parse_scenario
@@ -156,6 +157,9 @@ def test_scenario_yaml_materials_round_trip_and_ground_truth() -> None:
     ({"viscoelastic": 0.5}, "viscoelastic"),
     ({"anisotropy": {"ratio": 0.5}}, "ratio"),
     ({"anisotropy": {"ratio": 2, "axis_deg": float("nan")}}, "axis_deg"),
+    ({"plastic": {"yield_stress_pa": -1.0}}, "yield_stress_pa"),
+    ({"plastic": {"hardening_pa": 0.0}}, "hardening_pa"),
+    ({"plastic": {}, "viscoelastic": {}}, "neither viscoelastic"),
 ])
 def test_bad_material_keys_are_one_line_naming_the_key(block: dict, message: str) -> None:
     data = {"name": "bad", "blocks": [{"name": "b", "rect": [0, 0, 0.3, 0.3], "hardness_n": 60,
@@ -171,3 +175,47 @@ def test_materials_need_the_linear_fem_and_a_foam() -> None:
               anisotropy=Orthotropic(ratio=2.0))
     with pytest.raises(SettingError, match="physics"):
         _world(Viscoelastic(), physics="stiffening-fem")
+
+
+def test_radial_return_lands_on_the_hardened_yield_surface() -> None:
+    material = Plastic(yield_stress_pa=1000.0, hardening_pa=500.0)
+    shear = 2000.0
+    strain = np.zeros((2, 3, 3))
+    strain[:, 0, 1] = strain[:, 1, 0] = [0.1, 0.5]  # below and above yield in shear
+    plastic, alpha = return_map(strain, np.zeros((2, 3, 3)), np.zeros(2), shear_pa=shear,
+                                material=material)
+    assert np.all(plastic[0] == 0.0) and alpha[0] == 0.0  # q = sqrt(3)·2G·0.1 < 1000 Pa
+    s = 2.0 * shear * (strain[1] - plastic[1])
+    q = np.sqrt(1.5 * np.sum(s * s))
+    assert alpha[1] > 0.0 and q == pytest.approx(1000.0 + 500.0 * alpha[1], rel=1e-12)
+    assert np.trace(plastic[1]) == pytest.approx(0.0, abs=1e-15)
+
+
+def _plastic_world(yield_pa: float) -> SimulatedWorld:
+    block = Block(name="clay", polygon=rectangle(0.0, 0.0, 0.3, 0.3), hardness_n=60.0,
+                  plastic=Plastic(yield_stress_pa=yield_pa, hardening_pa=2000.0))
+    return SimulatedWorld(Scenario(name="p", blocks=(block,), workspace=_workspace()),
+                          config=WorldConfig.coarse(noise=False, unload=True, hold_s=1.0),
+                          rng=np.random.default_rng(2))
+
+
+def test_plastic_block_is_elastic_below_yield_and_keeps_a_dent_above() -> None:
+    elastic = _world(unload=True, hold_s=1.0).press(XY, FORCE).force_travel
+    stiff = _plastic_world(1e6)
+    below = stiff.press(XY, FORCE).force_travel
+    stiff.release()
+    assert elastic is not None and below is not None and below.unloading is not None
+    np.testing.assert_allclose(below.travel_m, elastic.travel_m, atol=0.02 * elastic.travel_m[-1])
+    assert abs(below.unloading.travel_m[-1]) < 1e-5
+    assert np.all(stiff.released_displacement() == 0.0)
+    soft = _plastic_world(500.0)
+    above = soft.press(XY, FORCE).force_travel
+    soft.release()
+    assert above is not None and above.unloading is not None and above.hold is not None
+    assert above.travel_m[-1] > 1.1 * elastic.travel_m[-1]  # yielding sinks the tip farther
+    np.testing.assert_array_equal(above.hold.travel_m, above.travel_m[-1])  # rate-independent
+    assert above.unloading.travel_m[-1] > 1e-3  # the tip leaves a dent behind it
+    residual = soft.released_displacement(10.0)
+    dent = -soft.foam.top_displacement(np.array([XY]), residual)[0, 2]
+    assert 1e-3 < dent < above.travel_m[-1]
+    assert soft.ground_truth_yield_stress([0.1, 0.4], [0.1])[0, 0] == 500.0

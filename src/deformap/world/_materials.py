@@ -1,4 +1,5 @@
-"""What a foam block is made of besides its modulus: viscoelastic relaxation and in-plane anisotropy.
+"""What a foam block is made of besides its modulus: viscoelastic relaxation, in-plane anisotropy
+and plasticity.
 
 A block's ``youngs_modulus_pa`` (or ``hardness_n``) is the instantaneous modulus ``E₀``. With
 :class:`Viscoelastic` it relaxes as the normalised Prony series (a generalised Maxwell solid)
@@ -10,7 +11,8 @@ stays constant). With :class:`Orthotropic` the block is stiffer along an in-plan
 moduli ``E₁ = ratio · E`` along the axis at ``axis_deg`` from x, ``E₂ = E₃ = E`` across it and
 vertically, and Huber's orthotropy for the rest (``ν_ij / E_i = ν / sqrt(E_i E_j)``,
 ``G_ij = sqrt(E_i E_j) / (2 (1 + ν))``), which is isotropic at ratio 1 and positive definite for
-every ratio when ``ν < 0.5``.
+every ratio when ``ν < 0.5``. With :class:`Plastic` it yields (von Mises, linear isotropic
+hardening; :mod:`deformap.world._plastic`) and keeps a dent after release.
 
 References
 ----------
@@ -28,7 +30,7 @@ from numpy.typing import NDArray
 
 from deformap._validation import SettingError, check_settings, setting
 
-__all__ = ["Orthotropic", "Viscoelastic", "orthotropic_stiffness"]
+__all__ = ["Orthotropic", "Plastic", "Viscoelastic", "orthotropic_stiffness"]
 
 _MAX_TERMS = 8  # Prony terms: more fit noise, not a foam
 
@@ -119,6 +121,31 @@ class Orthotropic:
 
     def to_dict(self) -> dict[str, Any]:
         return {"ratio": self.ratio, "axis_deg": self.axis_deg}
+
+
+@dataclass(frozen=True, kw_only=True)
+class Plastic:
+    """J2 plasticity with linear isotropic hardening (:mod:`deformap.world._plastic`).
+
+    Parameters
+    ----------
+    yield_stress_pa : float
+        Initial yield stress ``σ_y`` (von Mises), Pa.
+    hardening_pa : float
+        Linear isotropic hardening modulus ``H``: the yield stress grows by ``H`` per unit of
+        equivalent plastic strain, Pa.
+    """
+
+    # from a putty (10 Pa) to a stiff clay (10 MPa)
+    yield_stress_pa: float = setting(2000.0, ge=10.0, le=1e7, doc="yield stress, Pa")
+    # H > 0 keeps the initial-stress iterations contracting; 10 GPa is a metal's tangent
+    hardening_pa: float = setting(1000.0, gt=0.0, le=1e10, doc="hardening modulus, Pa")
+
+    def __post_init__(self) -> None:
+        check_settings(self)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"yield_stress_pa": self.yield_stress_pa, "hardening_pa": self.hardening_pa}
 
 
 def orthotropic_stiffness(ratio: float, axis_deg: float, nu: float) -> NDArray[np.float64]:

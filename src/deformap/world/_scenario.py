@@ -26,7 +26,7 @@ from deformap.environment import Workspace
 from deformap.errors import InvalidArgumentError
 from deformap.mechanics import hardness_to_youngs_modulus, youngs_modulus_to_hardness
 from deformap.world._appearance import Appearance, parse_color
-from deformap.world._materials import Orthotropic, Viscoelastic
+from deformap.world._materials import Orthotropic, Plastic, Viscoelastic
 from deformap.world._polygon import (
     is_simple,
     overlap_area,
@@ -69,6 +69,9 @@ class Block:
     anisotropy : Orthotropic or None
         The foam is stiffer along an in-plane axis (the modulus is then the soft one's); None:
         isotropic.
+    plastic : Plastic or None
+        The material yields and keeps a dent (neither viscoelastic nor anisotropic then); None:
+        elastic.
     """
 
     name: str
@@ -86,6 +89,7 @@ class Block:
     appearance: Appearance | None = None
     viscoelastic: Viscoelastic | None = None
     anisotropy: Orthotropic | None = None
+    plastic: Plastic | None = None
 
     def __post_init__(self) -> None:
         try:
@@ -133,10 +137,16 @@ class Block:
                 f"block {self.name!r} needs exactly one of `hardness_n`, `youngs_modulus_pa` or "
                 f"`rigid=True`; got hardness_n={self.hardness_n!r}, "
                 f"youngs_modulus_pa={self.youngs_modulus_pa!r}, rigid={self.rigid!r}")
-        if self.rigid and (self.viscoelastic is not None or self.anisotropy is not None):
+        materials = [k for k in ("viscoelastic", "anisotropy", "plastic")
+                     if getattr(self, k) is not None]
+        if self.rigid and materials:
             raise InvalidArgumentError(
-                f"block {self.name!r} is rigid: it can be neither `viscoelastic` nor "
-                "`anisotropy`; drop `rigid` or the material")
+                f"block {self.name!r} is rigid: it can have no `{materials[0]}`; drop `rigid` or "
+                "the material")
+        if self.plastic is not None and len(materials) > 1:
+            raise InvalidArgumentError(
+                f"block {self.name!r}: a `plastic` block can be neither viscoelastic nor "
+                f"anisotropic; got {materials}")
         if self.hardness_n is not None:
             object.__setattr__(self, "youngs_modulus_pa",
                                hardness_to_youngs_modulus(float(self.hardness_n)))
@@ -179,6 +189,8 @@ class Block:
             out["viscoelastic"] = self.viscoelastic.to_dict()
         if self.anisotropy is not None:
             out["anisotropy"] = self.anisotropy.to_dict()
+        if self.plastic is not None:
+            out["plastic"] = self.plastic.to_dict()
         return out
 
 

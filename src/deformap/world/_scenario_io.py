@@ -3,7 +3,8 @@
 A file holds ``name``, ``blocks`` (each with ``name``, one of ``rect`` or ``polygon``, optional
 ``holes``, one of ``hardness_n``, ``youngs_modulus_pa`` or ``rigid: true``, optional
 ``thickness_m``, ``color``, ``appearance``, ``viscoelastic`` (``relaxed_ratio``, ``times_s``,
-optional ``weights``) and ``anisotropy`` (``ratio``, ``axis_deg``)) and optionally
+optional ``weights``), ``anisotropy`` (``ratio``, ``axis_deg``) and ``plastic``
+(``yield_stress_pa``, ``hardening_pa``)) and optionally
 ``description``, ``workspace`` (``lower``, ``upper``) and ``table_appearance``; every key is
 checked, and ``docs/scenarios.md`` lists them all with their defaults.
 """
@@ -19,7 +20,7 @@ from deformap._config import dump_yaml, few, load_yaml
 from deformap.environment import Workspace
 from deformap.errors import ConfigError, DeformapError
 from deformap.world._appearance import Appearance, appearance_from_dict
-from deformap.world._materials import Orthotropic, Viscoelastic
+from deformap.world._materials import Orthotropic, Plastic, Viscoelastic
 from deformap.world._polygon import rectangle
 from deformap.world._scenario import Block, Scenario, builtin_scenarios
 
@@ -27,9 +28,10 @@ __all__ = ["list_scenarios", "load_scenario", "parse_scenario", "save_scenario"]
 
 _SCENARIO_KEYS = {"name", "description", "workspace", "blocks", "table_appearance"}
 _BLOCK_KEYS = {"name", "rect", "polygon", "holes", "hardness_n", "youngs_modulus_pa", "rigid",
-               "thickness_m", "color", "appearance", "viscoelastic", "anisotropy"}
+               "thickness_m", "color", "appearance", "viscoelastic", "anisotropy", "plastic"}
 _MATERIAL_KEYS = {"viscoelastic": {"relaxed_ratio", "times_s", "weights"},
-                  "anisotropy": {"ratio", "axis_deg"}}
+                  "anisotropy": {"ratio", "axis_deg"},
+                  "plastic": {"yield_stress_pa", "hardening_pa"}}
 _WORKSPACE_KEYS = {"lower", "upper"}
 
 
@@ -93,7 +95,8 @@ def _block(data: Any, where: str) -> Block:
             raise ConfigError(f"{where}: `rigid` must be true or false; got {rigid!r}")
         look = data.get("appearance")
         materials: dict[str, Any] = {}
-        for key, cls in (("viscoelastic", Viscoelastic), ("anisotropy", Orthotropic)):
+        for key, cls in (("viscoelastic", Viscoelastic), ("anisotropy", Orthotropic),
+                         ("plastic", Plastic)):
             if key in data:
                 part = data[key]
                 if not isinstance(part, dict):

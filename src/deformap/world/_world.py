@@ -42,6 +42,7 @@ from deformap.world._force_travel import (
     with_phases,
 )
 from deformap.world._looks import HAND, STICK, TABLE, TIP, SceneLooks
+from deformap.world._plastic import PlasticPress, plastic_press
 from deformap.world._scenario import BARE_TABLE, Block, Scenario
 from deformap.world._stiffening import StiffeningFoam
 from deformap.world._stiffening_fem import StiffeningFem
@@ -76,11 +77,11 @@ class SimulatedWorld:
         self.scenario = scenario
         self.config = config or WorldConfig()
         check_world_budget(self.config, scenario)
-        special = [b.name for b in scenario.blocks
-                   if b.viscoelastic is not None or b.anisotropy is not None]
+        special = [b.name for b in scenario.blocks if b.viscoelastic is not None
+                   or b.anisotropy is not None or b.plastic is not None]
         if special and self.config.physics != "linear-fem":
             raise SettingError(
-                "physics", f"must be 'linear-fem' for the viscoelastic or anisotropic blocks "
+                "physics", f"must be 'linear-fem' for the blocks of other materials "
                 f"{special}; got {self.config.physics!r}")
         self._noise_key = int(rng.integers(2**62))
         self._n_observed = 0
@@ -102,8 +103,8 @@ class SimulatedWorld:
         self.looks = SceneLooks(scenario, self.config)
         self._pressed: PressObservation | None = None
         self._displacement = self.foam.zero_displacement()
-        self._history: tuple[tuple[float, float, float], PressHistory] | None = None
-        self._left: PressHistory | None = None  # the last press released, if viscoelastic
+        self._history: tuple[tuple[float, float, float], PressHistory | PlasticPress] | None = None
+        self._left: PressHistory | PlasticPress | None = None  # the last press released
         self._released = False
 
     # ---- Environment protocol ----
@@ -163,7 +164,7 @@ class SimulatedWorld:
         """Lift the probe; the foam springs back (an elastic block at once; a viscoelastic one
         over time, :meth:`released_displacement`, and is at rest again by the next press)."""
         p = self._pressed
-        self._left = None if p is None else self._viscoelastic_press(p.target_xy, p.force_n)
+        self._left = None if p is None else self._material_press(p.target_xy, p.force_n)
         self._released = p is not None or self._released
         self._pressed = None
         self._displacement = self.foam.zero_displacement()
@@ -171,7 +172,8 @@ class SimulatedWorld:
     def released_displacement(self, after_s: float = 0.0) -> NDArray[np.float64]:
         """``(n_nodes, 3)`` displacement of the foam ``after_s`` seconds after the tip of the last
         released press left it: 0 for an elastic block; a viscoelastic one recovers in time
-        (:mod:`deformap.world._viscoelastic`, the tip leaving at the end of the protocol).
+        (:mod:`deformap.world._viscoelastic`, the tip leaving at the end of the protocol); a
+        plastic one keeps its residual dent (:mod:`deformap.world._plastic`).
 
         Raises
         ------
@@ -184,6 +186,8 @@ class SimulatedWorld:
                                         "then ask for the surface after release")
         if self._left is None:
             return self.foam.zero_displacement()
+        if isinstance(self._left, PlasticPress):
+            return self._left.residual.copy()
         return recovered(self._left.state, after)
 
     def observe_released(self, after_s: float = 0.0) -> PointCloud:
@@ -218,7 +222,7 @@ class SimulatedWorld:
         """
         target = check_vector("target_xy", target_xy, 2, what="metres")
         force = check_positive("force_n", force_n)
-        history = self._viscoelastic_press(target, force)
+        history = self._material_press(target, force)
         if history is not None:
             dent = history.held
         else:
@@ -253,7 +257,7 @@ class SimulatedWorld:
                               c.force_travel_spacing)
         schedule = press_schedule(levels, rate_n_per_s=c.ramp_rate_n_per_s, hold_s=c.hold_s,
                                   unload=c.unload)
-        history = self._viscoelastic_press(target, force)
+        history = self._material_press(target, force)
         depths = history.ramp if history is not None else self._level_depths(target, levels,
                                                                                final)
         on = 1.0 if c.noise else 0.0
@@ -265,8 +269,11 @@ class SimulatedWorld:
             record = simulated_force_travel(depths, levels, self._event_rng(*key), **noise)
             if not schedule.has_phases:
                 return record
-            hold, unloading = ((history.hold, history.unloading) if history is not None
-                               else self._phase_depths(schedule, depths))
+            hold, unloading = self._phase_depths(schedule, depths)
+            if isinstance(history, PressHistory):
+                hold, unloading = history.hold, history.unloading
+            elif history is not None:
+                unloading = history.unloading
             # the encoder's reading at first contact: the ramp stream's first draw
             zero = depths[0] + self._event_rng(*key).normal(0.0, 1.0, size=depths.size)[0] * (
                 noise["encoder_noise_m"])
@@ -278,13 +285,13 @@ class SimulatedWorld:
                         force, np.round(depths * 1e3, 2).tolist(), err)
             return None
 
-    def _viscoelastic_press(self, target: NDArray[np.float64], force: float
-                            ) -> PressHistory | None:
-        """The press solved in time on a viscoelastic block (None on any other ground), its
-        samples on the protocol's schedule; the last one is kept."""
+    def _material_press(self, target: NDArray[np.float64], force: float
+                        ) -> PressHistory | PlasticPress | None:
+        """The press solved through its load history on a viscoelastic or plastic block (None on
+        any other ground), its samples on the protocol's schedule; the last one is kept."""
         index = self.foam.block_at(target)
-        material = None if index is None else self.scenario.blocks[index].viscoelastic
-        if material is None:
+        block = None if index is None else self.scenario.blocks[index]
+        if block is None or (block.viscoelastic is None and block.plastic is None):
             return None
         key = (float(target[0]), float(target[1]), force)
         if self._history is not None and self._history[0] == key:
@@ -294,13 +301,20 @@ class SimulatedWorld:
                               c.force_travel_spacing)
         plan = press_schedule(levels, rate_n_per_s=c.ramp_rate_n_per_s, hold_s=c.hold_s,
                               unload=c.unload)
-        assert isinstance(self.foam, FoamModel)
-        history = press_history(
-            self.foam, material, target,
-            times=np.concatenate([plan.times, plan.hold_times, plan.unload_times]),
-            forces=np.concatenate([levels, np.full(plan.hold_times.size, force),
-                                   plan.unload_forces]),
-            n_ramp=levels.size, n_hold=plan.hold_times.size, tip_radius_m=c.tip_radius_m)
+        assert isinstance(self.foam, FoamModel) and index is not None
+        history: PressHistory | PlasticPress
+        if block.plastic is not None:
+            history = plastic_press(self.foam, index, block.plastic, target, levels=levels,
+                                    unload_forces=plan.unload_forces,
+                                    tip_radius_m=c.tip_radius_m)
+        else:
+            assert block.viscoelastic is not None
+            history = press_history(
+                self.foam, block.viscoelastic, target,
+                times=np.concatenate([plan.times, plan.hold_times, plan.unload_times]),
+                forces=np.concatenate([levels, np.full(plan.hold_times.size, force),
+                                       plan.unload_forces]),
+                n_ramp=levels.size, n_hold=plan.hold_times.size, tip_radius_m=c.tip_radius_m)
         self._history = (key, history)
         return history
 
@@ -367,6 +381,12 @@ class SimulatedWorld:
                 return np.nan
             return float(90.0 - (90.0 - b.anisotropy.axis_deg) % 180.0)
         return self.scenario.per_block(xs, ys, [axis(b) for b in self.regions], table=np.nan)
+
+    def ground_truth_yield_stress(self, xs: Any, ys: Any) -> NDArray[np.float64]:
+        """``(ny, nx)`` initial yield stress in Pa: ``inf`` where nothing yields (elastic and
+        rigid blocks, the bare table)."""
+        return self.scenario.per_block(xs, ys, [
+            np.inf if b.plastic is None else b.plastic.yield_stress_pa for b in self.regions])
 
     def surface_height(self, xs: Any, ys: Any, displacement: Any = None) -> NDArray[np.float64]:
         """``(ny, nx)`` height of the top surface in metres, deformed vertically by
