@@ -84,7 +84,7 @@ def test_viscoelastic_press_creeps_in_the_hold_shows_hysteresis_and_recovers() -
     # at each force the unloading branch lies deeper than the ramp: a loop of lost energy
     up = np.interp(record.unloading.force_n, record.force_n, record.travel_m)
     assert np.all(record.unloading.travel_m[:-1] > up[:-1] + 1e-3)
-    with pytest.raises(EnvironmentStateError, match="released"):
+    with pytest.raises(EnvironmentStateError, match="still pressing"):
         world.released_displacement()
     world.release()
     sunk = [-world.released_displacement(t)[:, 2].min() for t in (0.0, 1.0, 10.0)]
@@ -98,6 +98,8 @@ def test_viscoelastic_press_creeps_in_the_hold_shows_hysteresis_and_recovers() -
 
 def test_elastic_block_leaves_no_dent_after_release() -> None:
     world = _world()
+    with pytest.raises(EnvironmentStateError, match="no press has been released"):
+        world.observe_released()
     world.press(XY, FORCE)
     world.release()
     assert np.all(world.released_displacement(0.0) == 0.0)

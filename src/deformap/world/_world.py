@@ -178,9 +178,11 @@ class SimulatedWorld:
         Raises
         ------
         EnvironmentStateError
-            No press has been released yet.
+            No press has been released yet, or the probe is pressing.
         """
         after = check_positive("after_s", after_s, allow_zero=True)
+        if self._pressed is not None:
+            raise EnvironmentStateError("the probe is still pressing: call release() first")
         if not self._released:
             raise EnvironmentStateError("no press has been released yet: press(), release(), "
                                         "then ask for the surface after release")
