@@ -221,3 +221,19 @@ def test_plastic_block_is_elastic_below_yield_and_keeps_a_dent_above() -> None:
     dent = -soft.foam.top_displacement(np.array([XY]), residual)[0, 2]
     assert 1e-3 < dent < above.travel_m[-1]
     assert soft.ground_truth_yield_stress([0.1, 0.4], [0.1])[0, 0] == 500.0
+
+
+def test_held_strain_relaxes_along_the_prony_series() -> None:
+    """A displacement stepped and held: the stress ``g∞ u + Σ q_i`` (over ``K₀``) the recursive
+    update carries is ``G(t) / E₀`` of a two-term series, at every step size."""
+    material = Viscoelastic(relaxed_ratio=0.3, times_s=(0.5, 4.0), weights=(0.4, 0.6))
+    times = np.concatenate([[0.0], np.geomspace(0.01, 20.0, 40)])
+    state = MaxwellState(material, (1,))
+    stress = []
+    for k, t in enumerate(times):
+        _, _, decay, gamma = state.step(float(t - times[k - 1]) if k else 0.0)
+        state.commit(np.ones(1), decay, gamma)
+        stress.append(material.relaxed_ratio + state.q[:, 0].sum())
+    np.testing.assert_allclose(stress, material.relaxation(times), rtol=1e-12)
+    assert material.relaxation(0.0) == pytest.approx(1.0)
+    assert material.time_constant_s == pytest.approx(0.4 * 0.5 + 0.6 * 4.0)
