@@ -237,3 +237,28 @@ def test_held_strain_relaxes_along_the_prony_series() -> None:
     np.testing.assert_allclose(stress, material.relaxation(times), rtol=1e-12)
     assert material.relaxation(0.0) == pytest.approx(1.0)
     assert material.time_constant_s == pytest.approx(0.4 * 0.5 + 0.6 * 4.0)
+
+
+def test_contact_creep_follows_lee_radok_the_elastic_press_at_the_hereditary_force() -> None:
+    """While the contact grows, a linear viscoelastic press sinks as the elastic press under the
+    force ``E₀ ∫ J(t − s) dF(s)`` (Lee & Radok 1960): with the SLS creep compliance ``J`` and a
+    ramp at ``rate`` to a held force, that force has a closed form."""
+    g_inf, tau, rate = 0.5, 1.0, 4.0
+    world = _world(Viscoelastic(relaxed_ratio=g_inf, times_s=(tau,)), hold_s=3.0,
+                   ramp_rate_n_per_s=rate)
+    record = world.press(XY, FORCE).force_travel
+    assert record is not None and record.time_s is not None and record.hold is not None
+    contact = world.config.contact_threshold_n
+    ramp_s, tc, a = (FORCE - contact) / rate, tau / g_inf, 1.0 / g_inf - 1.0
+    times = np.concatenate([record.time_s, record.hold.time_s])
+    loaded = np.minimum(times, ramp_s)
+    hereditary = contact + rate * (loaded / g_inf - a * tc * (np.exp(-(times - loaded) / tc)
+                                                             - np.exp(-times / tc)))
+    elastic = _world()
+    expected = np.array([elastic.dent(XY, float(f)).depth_m for f in hereditary])
+    depth0 = expected[0]  # the record counts travel from first contact
+    sunk = np.concatenate([record.travel_m, record.hold.travel_m]) + depth0
+    n = record.time_s.size
+    np.testing.assert_allclose(sunk[1:n], expected[1:n], rtol=0.05)  # the patch's 2 % tolerance
+    np.testing.assert_allclose(sunk[n:], expected[n:], rtol=0.015)
+    assert expected[-1] > 1.3 * expected[n - 1]  # the hold's creep is what is being compared
