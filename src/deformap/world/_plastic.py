@@ -64,7 +64,7 @@ class _Zone:
 
     def __init__(self, body: FoamBody, target: NDArray[np.float64], reach_m: float) -> None:
         g = body.grid
-        dofs, grads, weights = [], [], []
+        dofs, grads, weights, centres = [], [], [], []
         depth_top = g.levels[-1]
         for k in range(g.nz):
             if depth_top - g.levels[k + 1] >= reach_m:
@@ -75,9 +75,14 @@ class _Zone:
             near = (np.abs(cx - target[0]) < reach_m) & (np.abs(cy - target[1]) < reach_m)
             dz = float(g.levels[k + 1] - g.levels[k])
             dofs.append(layer[near])
+            centres.append(np.column_stack([
+                cx[near] - target[0], cy[near] - target[1],
+                np.full(int(near.sum()), depth_top - 0.5 * (g.levels[k] + g.levels[k + 1]))]))
             grads.append(np.broadcast_to(_shape_gradients(g.dx, g.dy, dz),
                                          (int(near.sum()), 8, 8, 3)))
             weights.append(np.full(int(near.sum()), g.dx * g.dy * dz / 8.0))
+        self.reach_m = reach_m
+        self.centres = np.concatenate(centres)  # (m, 3) hex centres relative to the press
         self.dofs = np.concatenate(dofs)
         self.grads = np.concatenate(grads)  # (m, gauss, corner, 3)
         self.weights = np.concatenate(weights)
@@ -159,10 +164,20 @@ def plastic_press(foam: FoamModel, index: int, material: Plastic, target: NDArra
         if held is None and force == levels[-1]:
             held = dent
     assert held is not None
+    _check_zone(zone, alpha)
     residual = np.zeros((foam.n_nodes, 3))
     residual[off:off + n_nodes] = _plastic_displacement(body, zone, plastic, shear)
     return PlasticPress(ramp=np.array(depths[:levels.size]),
                         unloading=np.array(depths[levels.size:]), held=held, residual=residual)
+
+
+def _check_zone(zone: _Zone, alpha: NDArray[np.float64]) -> None:
+    """Warn when the yielded hexes reach the zone's outer quarter: the zone is too small."""
+    edge = np.max(np.abs(zone.centres), axis=1) > 0.75 * zone.reach_m
+    if np.any(alpha[edge] > 0.0):
+        log.warning("plastic press: the material yields within a quarter of the plastic zone's "
+                    "edge (%.3g m from the press); the elastic rest of the block bounds it",
+                    zone.reach_m)
 
 
 def _plastic_displacement(body: FoamBody, zone: _Zone, plastic: NDArray[np.float64],

@@ -53,6 +53,13 @@ class MaxwellState:
         self.u = np.zeros(shape)
         self.q = np.zeros((self.g.size, *shape))
 
+    def copy(self) -> MaxwellState:
+        """An independent copy of the state."""
+        out = MaxwellState.__new__(MaxwellState)
+        out.g, out.tau, out.g_inf = self.g, self.tau, self.g_inf
+        out.u, out.q = self.u.copy(), self.q.copy()
+        return out
+
     def step(self, dt: float) -> tuple[float, NDArray[np.float64], NDArray[np.float64],
                                        NDArray[np.float64]]:
         """For a step of ``dt`` seconds: the compliance ``1 / s``, the offset, each arm's decay and
@@ -130,9 +137,7 @@ def recovered(state: MaxwellState, after_s: float) -> NDArray[np.float64]:
     """The displacement ``after_s`` seconds after the tip left a body in ``state`` (unchanged):
     the load removed at once (the instantaneous elastic spring-back), then free recovery in steps
     of at most a quarter of the shortest relaxation time (at most :data:`MAX_RECOVERY_STEPS`)."""
-    free = MaxwellState.__new__(MaxwellState)
-    free.g, free.tau, free.g_inf = state.g, state.tau, state.g_inf
-    free.u, free.q = state.u.copy(), state.q.copy()
+    free = state.copy()
     free.advance_free(0.0)
     n = int(min(MAX_RECOVERY_STEPS, max(1, np.ceil(4.0 * after_s / float(np.min(free.tau))))))
     if after_s > 0.0:
