@@ -255,9 +255,9 @@ def dump_yaml(data: Any, path: str | Path | None = None) -> str:
 # -- the configuration reference: YAML with each setting's description, unit and bounds --------
 
 #: Unit of a setting by the suffix of its name, longest first.
-_UNIT_SUFFIXES = (("_n_per_m", "N/m"), ("_kpa", "kPa"), ("_deg", "degrees"), ("_rel", "fraction"),
-                  ("_pa", "Pa"), ("_mm", "mm"), ("_hz", "Hz"), ("_px", "pixels"), ("_m", "m"),
-                  ("_n", "N"), ("_s", "s"))
+_UNIT_SUFFIXES = (("_n_per_m", "N/m"), ("_n_per_s", "N/s"), ("_kpa", "kPa"), ("_deg", "degrees"),
+                  ("_rel", "fraction"), ("_pa", "Pa"), ("_mm", "mm"), ("_hz", "Hz"), ("_px", "pixels"),
+                  ("_m", "m"), ("_n", "N"), ("_s", "s"))
 #: Unit words a numpydoc type line may end with (``reference_modulus_pa : float, pascals``).
 _UNIT_WORDS = {"metres": "m", "meters": "m", "newtons": "N", "pascals": "Pa", "seconds": "s",
                "degrees": "degrees", "radians": "rad", "n/m": "N/m"}

@@ -2,9 +2,11 @@
 
 A file holds ``name``, ``blocks`` (each with ``name``, one of ``rect`` or ``polygon``, optional
 ``holes``, one of ``hardness_n``, ``youngs_modulus_pa`` or ``rigid: true``, optional
-``thickness_m``, ``color`` and ``appearance``) and optionally ``description``, ``workspace``
-(``lower``, ``upper``) and ``table_appearance``; every key is checked, and ``docs/scenarios.md``
-lists them all with their defaults.
+``thickness_m``, ``color``, ``appearance``, ``viscoelastic`` (``relaxed_ratio``, ``times_s``,
+optional ``weights``), ``anisotropy`` (``ratio``, ``axis_deg``) and ``plastic``
+(``yield_stress_pa``, ``hardening_pa``)) and optionally
+``description``, ``workspace`` (``lower``, ``upper``) and ``table_appearance``; every key is
+checked, and ``docs/scenarios.md`` lists them all with their defaults.
 """
 
 from __future__ import annotations
@@ -18,6 +20,7 @@ from deformap._config import dump_yaml, few, load_yaml
 from deformap.environment import Workspace
 from deformap.errors import ConfigError, DeformapError
 from deformap.world._appearance import Appearance, appearance_from_dict
+from deformap.world._materials import Orthotropic, Plastic, Viscoelastic
 from deformap.world._polygon import rectangle
 from deformap.world._scenario import Block, Scenario, builtin_scenarios
 
@@ -25,7 +28,10 @@ __all__ = ["list_scenarios", "load_scenario", "parse_scenario", "save_scenario"]
 
 _SCENARIO_KEYS = {"name", "description", "workspace", "blocks", "table_appearance"}
 _BLOCK_KEYS = {"name", "rect", "polygon", "holes", "hardness_n", "youngs_modulus_pa", "rigid",
-               "thickness_m", "color", "appearance"}
+               "thickness_m", "color", "appearance", "viscoelastic", "anisotropy", "plastic"}
+_MATERIAL_KEYS = {"viscoelastic": {"relaxed_ratio", "times_s", "weights"},
+                  "anisotropy": {"ratio", "axis_deg"},
+                  "plastic": {"yield_stress_pa", "hardening_pa"}}
 _WORKSPACE_KEYS = {"lower", "upper"}
 
 
@@ -88,13 +94,27 @@ def _block(data: Any, where: str) -> Block:
         if not isinstance(rigid, bool):
             raise ConfigError(f"{where}: `rigid` must be true or false; got {rigid!r}")
         look = data.get("appearance")
+        materials: dict[str, Any] = {}
+        for key, cls in (("viscoelastic", Viscoelastic), ("anisotropy", Orthotropic),
+                         ("plastic", Plastic)):
+            if key in data:
+                part = data[key]
+                if not isinstance(part, dict):
+                    raise ConfigError(f"{where}.{key}: must be a mapping with keys "
+                                      f"{sorted(_MATERIAL_KEYS[key])}; got {type(part).__name__}")
+                _unknown(f"{where}.{key}", part, _MATERIAL_KEYS[key])
+                try:
+                    materials[key] = cls(**part)
+                except (TypeError, ValueError, DeformapError) as exc:
+                    raise ConfigError(f"{where}.{key}: {exc}") from None
         return Block(
             name=data.get("name", ""), polygon=poly,
             holes=tuple(np.asarray(h, dtype=float) for h in data.get("holes", ())),
             thickness_m=data.get("thickness_m", 0.05),
             hardness_n=data.get("hardness_n"), youngs_modulus_pa=data.get("youngs_modulus_pa"),
             rigid=rigid, color=data.get("color", "#6b4f3a" if rigid else "#c8a165"),
-            appearance=None if look is None else _appearance(look, f"{where}.appearance"))
+            appearance=None if look is None else _appearance(look, f"{where}.appearance"),
+            **materials)
     except ConfigError:
         raise
     except (TypeError, ValueError, DeformapError) as exc:
