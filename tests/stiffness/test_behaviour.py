@@ -171,13 +171,14 @@ def test_a_noisy_hold_neither_shows_nor_rules_out_relaxation() -> None:
     assert got.behaviour == "unknown", got.evidence
 
 
-def test_an_unloading_that_never_leaves_its_noise_gives_no_dent_with_the_reason() -> None:
-    # the branch barely unloads: three samples, only one above 3 σ of the force noise
-    unload = PressPhase(time_s=[1.1, 1.2, 1.3], travel_m=[DEPTH, 0.003, 0.002],
-                        force_n=[1.0, 0.0, 0.0])
+def test_an_unloading_that_reaches_zero_force_reads_the_travel_where_contact_is_lost() -> None:
+    # after the force first reaches zero the tip retracts off the surface: its travel there is
+    # the tip's, not the dent's
+    unload = PressPhase(time_s=[1.1, 1.2, 1.3, 1.4], travel_m=[DEPTH, 0.003, 0.002, 0.0],
+                        force_n=[1.0, 0.4, 0.0, 0.0])
     got = press_behaviour(_record(unloading=unload))
-    assert got.residual_dent_m is None
-    assert "samples above its force noise" in got.evidence
+    assert got.residual_dent_m == pytest.approx(0.002)
+    assert got.residual_dent_sigma_m is not None and got.residual_dent_sigma_m < 1e-4
 
 
 def _dented(depth_m: float, n: int = 12000, noise_m: float = 3e-4) -> PointCloud:

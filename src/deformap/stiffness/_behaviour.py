@@ -24,10 +24,14 @@ unloading's last travel to zero at zero force adds nothing) over the work put in
 unloading, ``W = ∫ F dδ`` along ramp and hold. Its σ by linear propagation of ``σ_F``, ``σ_t``
 through both trapezoid sums.
 
-Residual dent: on the unloading samples with force between ``3 σ_F`` and half the branch's
-largest, the Hertz law ``F ∝ (δ − δ_r)^{3/2}`` is a straight line ``δ = δ_r + c F^{2/3}``; its
-intercept (least squares) is the travel at zero force, extrapolated when the branch stops above
-zero. Its σ is the intercept's, with the residual scatter (at least ``σ_t``). The camera's dent
+Residual dent: the unloading's travel at zero force. Where the branch reaches zero force (within
+``3 σ_F``), the travel of its first sample there, where the tip loses the surface (later samples
+follow the retracting tip, not the surface), σ = ``σ_t``: no contact law enters. Where it stops
+above zero, extrapolated: on the samples with force between
+``3 σ_F`` and half the branch's largest, the Hertz law ``F ∝ (δ − δ_r)^{3/2}`` is a straight line
+``δ = δ_r + c F^{2/3}``, whose intercept (least squares) is the travel at zero force, σ the
+intercept's with the residual scatter (at least ``σ_t``); a layer stiffening with depth bends that
+line, so the extrapolation is the rougher reading. The camera's dent
 (:func:`released_dent`) is the median height of the surface 3–5 tip radii from the press point
 less the median within one tip radius, σ from both medians' standard errors.
 

@@ -184,6 +184,9 @@ def loop_loss(record: PressRecord, sigma_f: float, sigma_t: float) -> Measure | 
 def zero_force_travel(unloading: _Phase, sigma_f: float, sigma_t: float) -> Measure | str:
     f = np.asarray(unloading.force_n)
     t = np.asarray(unloading.travel_m)
+    reached = np.flatnonzero(f <= N_SIGMA * sigma_f)
+    if reached.size and reached[0] > 0:  # contact lost here: the surface's height then
+        return Measure(float(t[reached[0]]), sigma_t)
     use = (f > N_SIGMA * sigma_f) & (f <= 0.5 * float(f.max()))
     if int(use.sum()) < 3:
         use = f > N_SIGMA * sigma_f
