@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from deformap.cloud import PointCloud, points_in_hull
+from deformap.cloud import PointCloud
 from deformap.cloud.io import (
     TransformTree,
     bag_error_text,
@@ -32,11 +32,12 @@ from deformap.cloud.io import (
     typestore,
     xyz_with_holes,
 )
-from deformap.environment import TRAVEL_BACKWARDS_TOLERANCE_M, Workspace
+from deformap.environment import Workspace
 from deformap.errors import DeformapError, FileFormatError
 from deformap.replay._format import PokeSpec, PressParts
+from deformap.replay._rawcheck import CameraCheck
 from deformap.replay._rawconfig import WORKSPACE_MARGIN_RADII, HullPart, RawBagConfig
-from deformap.replay._rawfind import CLOUD_TYPE, TF_TYPE, WRENCH_TYPE, BagDiscovery
+from deformap.replay._rawfind import CLOUD_TYPE, TF_TYPE, WRENCH_TYPE
 from deformap.replay._rawpress import (
     FoundPress,
     block_size,
@@ -45,7 +46,7 @@ from deformap.replay._rawpress import (
     press_record,
 )
 
-__all__ = ["DENT_SIGMAS", "RawBagReader", "hull_points"]
+__all__ = ["RawBagReader", "hull_points"]
 
 logger = logging.getLogger(__name__)
 
@@ -57,17 +58,6 @@ STILL_M, STILL_RAD = 5e-4, 1e-3
 #: The largest force component [N] a wrench may hold, beyond any force–torque sensor's range: a
 #: larger or non-finite one is a damaged message, refused before it is squared.
 MAX_FORCE_N = 1e6
-
-#: A dent the camera sees lies this many of its σ below the observation (a 1e-4 chance of noise).
-DENT_SIGMAS = 4.0
-
-#: A Hertz dent of travel δ sinks the surface within two tip radii of the contact by about an
-#: eighth of δ or more on average (the visible part, outside the contact radius √(Rδ)).
-HERTZ_DISC_FRACTION = 0.125
-
-#: A tip frame whose poses through a press's rise all lie within this [m] did not move: a
-#: measured pose jitters by its encoders' noise (micrometres), a commanded one does not.
-STILL_TIP_M = 1e-9
 
 #: Points of a hull part's circle (cylinder, cap): 16 give a polygon within 2 % of the circle.
 _CIRCLE = 16
@@ -106,7 +96,7 @@ class _Group:
     rgb: NDArray[np.float64] | None = None
 
 
-class RawBagReader(BagDiscovery):
+class RawBagReader(CameraCheck):
     """Reads a raw recording: finds its presses, averages their frames, builds each press."""
 
     def __init__(self, bag: Path, config: RawBagConfig, commanded_n: float) -> None:
@@ -150,22 +140,6 @@ class RawBagReader(BagDiscovery):
                 self._plan_press(press)
         self._average()
         self._observation: PointCloud | None = None
-
-    def _tip_still(self) -> bool:
-        """Whether the tip frame stays within :data:`STILL_TIP_M` over the second half of every
-        usable press's rise (first contact to the hold): a commanded pose. A measured one moves
-        into a soft surface, or by its encoders' noise; a bag of presses on rigid surfaces only,
-        recorded without that noise, reads as still too, and loses its records, not its map."""
-        usable = [p for p in self.presses if p.error is None and p.hold_start > p.start + 1]
-        for press in usable:
-            stamps = self.wrench_ns[(press.start + press.hold_start) // 2: press.hold_start]
-            try:
-                _, tips = self.tree.lookup(self.world_frame, self.tip_frame, stamps, what="")
-            except DeformapError:
-                return False  # the press's own reading names what is missing
-            if float(np.ptp(tips, axis=0).max()) > STILL_TIP_M:
-                return False
-        return bool(usable)
 
     def _check_merge(self, magnitude: NDArray[np.float64], contact_n: float) -> None:
         """Refuse a ``stamp_tolerance_s`` that joins presses: one that holds the commanded force
@@ -467,61 +441,8 @@ class RawBagReader(BagDiscovery):
         seconds, held = (stamps - stamps[0]) / 1e9, slice(ramp.stop, hold.stop)
         record = press_record(travel, normal[ramp], seconds[ramp], noise, notes,
                               (seconds[held], (tips[held] - tips[0]) @ direction, normal[held]))
-        dent, dent_std = self._camera_dent(cloud, tip + cfg.tip_radius_m * direction, robot)
-        moved = float(travel[-1]) if travel.size else 0.0
-        notes["camera_dent_m"] = f"{dent:.5f} ± {dent_std:.5f}"
-        notes["record_travel_m"] = f"{moved:.5f}"
-        seen = dent > DENT_SIGMAS * dent_std and dent > TRAVEL_BACKWARDS_TOLERANCE_M
-        if record is not None and self.tip_still:
-            notes["disagreement"] = (
-                f"the tip frame {self.tip_frame!r} did not move at all while the force rose, in "
-                "any press (not even by encoder noise: a commanded pose, not the measured one?); "
-                "its travel cannot tell a rigid surface from a soft one, so the record is "
-                "not used: β from the camera alone, no modulus")
-            notes["force_travel"] = notes["disagreement"]
-            record = None
-        elif record is not None and moved <= TRAVEL_BACKWARDS_TOLERANCE_M and seen:
-            notes["disagreement"] = (
-                f"the record shows no travel ({moved * 1e3:.2f} mm) but the camera sees a dent of "
-                f"{dent * 1e3:.2f} ± {dent_std * 1e3:.2f} mm around the contact; is the tip frame "
-                f"{self.tip_frame!r} the measured pose (a commanded one does not move)? The "
-                "record is not used: β from the camera alone, no modulus")
-            notes["force_travel"] = notes["disagreement"]
-            record = None
-        elif record is not None and moved > 4 * TRAVEL_BACKWARDS_TOLERANCE_M and (
-                dent + DENT_SIGMAS * dent_std < moved * HERTZ_DISC_FRACTION / 2):
-            notes["disagreement"] = (
-                f"the record shows {moved * 1e3:.2f} mm of travel but the camera sees no dent "
-                f"({dent * 1e3:.2f} ± {dent_std * 1e3:.2f} mm) within two tip radii of the "
-                "contact: a camera too coarse to see it there, or its extrinsics or the tip frame "
-                "are off")
+        record = self.against_camera(notes, record, travel, cloud,
+                                     tip + cfg.tip_radius_m * direction, robot)
         if "disagreement" in notes:  # a warning in the report (map_session), said once
             logger.info("%s: %s", where, notes["disagreement"])
         return PressParts(cloud, tip, force, robot, record)
-
-    def _camera_dent(self, cloud: PointCloud, contact: NDArray[np.float64],
-                     robot: tuple[NDArray[np.float64], ...]) -> tuple[float, float]:
-        """How far [m] the camera sees the surface sink within two tip radii of ``contact``, and
-        its σ: each point of ``cloud`` there (below the tip's top, outside the robot's hulls)
-        paired with the observation's point nearest in ``x``–``y`` (the same surface patch for a
-        still camera); the mean of their height differences, a fifth cut off at each end (the
-        robot's edges, a block's side), σ that mean's (a mean, not a median: a depth camera's
-        heights come in disparity steps of millimetres, which a median keeps)."""
-        from scipy.spatial import cKDTree
-
-        radius, before = self.config.tip_radius_m, self.observation().points
-        pts = cloud.points
-        r = np.linalg.norm(pts[:, :2] - contact[:2], axis=1)
-        # below the tip's top: what is higher there is the probe, the hand or the arm
-        near = pts[(r <= 2 * radius) & (pts[:, 2] <= contact[2] + 2 * radius)]
-        if len(near):
-            near = near[~points_in_hull(near, robot)]
-        if len(near) < 3:
-            return 0.0, float("inf")
-        gap, j = cKDTree(before[:, :2]).query(near[:, :2])
-        dz = np.sort((before[j, 2] - near[:, 2])[gap <= radius / 2])
-        cut = len(dz) // 5
-        kept = dz[cut: len(dz) - cut]
-        if len(kept) < 3:
-            return 0.0, float("inf")
-        return float(kept.mean()), float(kept.std(ddof=1) / np.sqrt(len(kept)))
