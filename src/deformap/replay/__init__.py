@@ -17,6 +17,7 @@ from deformap.replay._rawconfig import (
     load_raw_config,
     raw_config_file,
 )
+from deformap.replay._rawrig import RigConfig, load_rig
 from deformap.replay._rawwrite import (
     APPROACH,
     FIRST_PRESS_S,
@@ -27,8 +28,6 @@ from deformap.replay._rawwrite import (
     T0_NS,
     RawMessage,
     RawPress,
-    RigConfig,
-    load_rig,
     raw_messages,
     raw_timeline,
     write_raw_mcap,
