@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import hashlib
 import logging
-from dataclasses import dataclass
 from itertools import pairwise
 from pathlib import Path
 from typing import Any
@@ -27,17 +26,15 @@ from deformap.cloud.io import (
     bag_read_errors,
     header_stamp_ns,
     iter_bag_messages,
-    pointcloud2_colors,
-    pointcloud2_structured,
     typestore,
-    xyz_with_holes,
 )
 from deformap.environment import Workspace
 from deformap.errors import DeformapError, FileFormatError
 from deformap.replay._format import PokeSpec, PressParts
 from deformap.replay._rawcheck import CameraCheck
-from deformap.replay._rawconfig import WORKSPACE_MARGIN_RADII, HullPart, RawBagConfig
+from deformap.replay._rawconfig import WORKSPACE_MARGIN_RADII, RawBagConfig, hull_points
 from deformap.replay._rawfind import CLOUD_TYPE, TF_TYPE, WRENCH_TYPE
+from deformap.replay._rawframes import FrameGroup, average_frames, group_points
 from deformap.replay._rawpress import (
     FoundPress,
     block_size,
@@ -46,7 +43,7 @@ from deformap.replay._rawpress import (
     press_record,
 )
 
-__all__ = ["RawBagReader", "hull_points"]
+__all__ = ["RawBagReader"]
 
 logger = logging.getLogger(__name__)
 
@@ -58,43 +55,6 @@ STILL_M, STILL_RAD = 5e-4, 1e-3
 #: The largest force component [N] a wrench may hold, beyond any force–torque sensor's range: a
 #: larger or non-finite one is a damaged message, refused before it is squared.
 MAX_FORCE_N = 1e6
-
-#: Points of a hull part's circle (cylinder, cap): 16 give a polygon within 2 % of the circle.
-_CIRCLE = 16
-
-
-def hull_points(part: HullPart, rot: NDArray[np.float64], origin: NDArray[np.float64]
-                ) -> NDArray[np.float64]:  # fmt: skip
-    """``(m, 3)`` world points whose convex hull is ``part`` at the tip pose ``rot``, ``origin``."""
-    c, (sx, sy, sz) = np.asarray(part.center_m), part.size_m
-    if part.shape == "box":
-        local = np.array([[x * sx, y * sy, z * sz] for x in (-0.5, 0.5) for y in (-0.5, 0.5)
-                          for z in (-0.5, 0.5)])  # fmt: skip
-    else:
-        az = np.linspace(0.0, 2 * np.pi, _CIRCLE, endpoint=False)
-        ring = np.column_stack([np.cos(az), np.sin(az), np.zeros_like(az)]) * (sx / 2)
-        if part.shape == "cylinder":
-            half = np.array([0.0, 0.0, sz / 2])
-            local = np.vstack([ring - half, ring + half])
-        else:  # cap: the upper half-sphere, as rings at 0°, 30°, 60° and the pole
-            r = sx / 2
-            local = np.vstack([ring * np.cos(a) + [0, 0, r * np.sin(a)]
-                               for a in (0.0, np.pi / 6, np.pi / 3)] + [[[0, 0, r]]])
-    return np.asarray((local + c) @ rot.T + origin)
-
-
-@dataclass
-class _Group:
-    """Frames averaged into one cloud, with the per-pixel sums (``rgb`` None once a frame lacks
-    colours) and counts."""
-
-    frames: list[int]
-    cam_stamp: int
-    shape: tuple[int, int] | None = None
-    total: NDArray[np.float64] | None = None
-    count: NDArray[np.int64] | None = None
-    rgb: NDArray[np.float64] | None = None
-
 
 class RawBagReader(CameraCheck):
     """Reads a raw recording: finds its presses, averages their frames, builds each press."""
@@ -132,7 +92,7 @@ class RawBagReader(CameraCheck):
         self._check_merge(magnitude, contact_n)
         self.config = cfg = self._tip(cfg)
         self.tip_still = self._tip_still()
-        self._groups: dict[int, _Group] = {}
+        self._groups: dict[int, FrameGroup] = {}
         self._errors: dict[int, str] = {}
         self._observation_group = self._plan_observation()
         for press in self.presses:
@@ -230,7 +190,7 @@ class RawBagReader(CameraCheck):
 
     # -- which frames -----------------------------------------------------------------------
 
-    def _plan_observation(self) -> _Group:
+    def _plan_observation(self) -> FrameGroup:
         cfg, first_contact = self.config, int(self.wrench_ns[self.presses[0].start])
         order = np.argsort(self.cloud_ns, kind="stable")
         times = self.cloud_ns[order]
@@ -268,7 +228,7 @@ class RawBagReader(CameraCheck):
         except DeformapError as exc:
             self._errors[press.index] = str(exc)
 
-    def _still(self, frames: list[int], where: str) -> _Group:
+    def _still(self, frames: list[int], where: str) -> FrameGroup:
         """The frames whose camera pose lies within ``STILL_M``, ``STILL_RAD`` of the middle one's."""
         stamps = self.cloud_ns[frames]
         rot, trans = self.tree.lookup(self.world_frame, self.camera_frame, stamps,
@@ -277,61 +237,16 @@ class RawBagReader(CameraCheck):
         angle = np.arccos(np.clip((np.einsum("nij,ij->n", rot, rot[mid]) - 1) / 2, -1.0, 1.0))
         still = (np.linalg.norm(trans - trans[mid], axis=1) <= STILL_M) & (angle <= STILL_RAD)
         kept = [f for f, s in zip(frames, still, strict=True) if s]
-        return _Group(frames=kept, cam_stamp=int(stamps[mid]))
+        return FrameGroup(frames=kept, cam_stamp=int(stamps[mid]))
 
     # -- second pass: the average of each group ----------------------------------------------
 
     def _average(self) -> None:
-        groups = [self._observation_group, *self._groups.values()]
-        wanted: dict[int, list[_Group]] = {}
-        for group in groups:
-            for frame in group.frames:
-                wanted.setdefault(frame, []).append(group)
-        store, errors = typestore(), bag_read_errors()
-        for raw in iter_bag_messages(self.path, {self.cloud_topic: CLOUD_TYPE}):
-            number = raw.number - 1  # the frame index the groups name
-            if number not in wanted:
-                continue
-            where = f"{self.path} [{self.cloud_topic} message {raw.number}]"
-            try:
-                msg = store.deserialize_cdr(bytes(raw.data), CLOUD_TYPE)
-                xyz, rgb = self._xyz(msg, where)
-            except errors as exc:
-                raise FileFormatError(f"{where}: could not be decoded: "
-                                      f"{bag_error_text(exc, 120)}") from None  # fmt: skip
-            shape = (int(msg.height), int(msg.width))
-            ok = np.isfinite(xyz).all(axis=1)
-            for group in wanted[number]:
-                if group.total is None or group.count is None:
-                    group.shape, group.total = shape, np.zeros_like(xyz)
-                    group.count = np.zeros(xyz.shape[0], dtype=np.int64)
-                    group.rgb = None if rgb is None else np.zeros_like(xyz)
-                elif shape != group.shape or shape[0] == 1:
-                    continue  # another layout, or an unorganised cloud: no pixel to average
-                group.total[ok] += xyz[ok]
-                group.count[ok] += 1
-                if group.rgb is not None and rgb is not None:
-                    group.rgb[ok] += rgb[ok]
-                else:
-                    group.rgb = None
+        average_frames(self.path, self.cloud_topic, [self._observation_group, *self._groups.values()],
+                       1e-3 if self.config.units == "mm" else 1.0)
 
-    def _xyz(self, msg: Any, where: str) -> tuple[NDArray[np.float64], NDArray[np.float64] | None]:
-        """The frame's points, NaN holes kept, and their colours (NaN at the holes) or None."""
-        try:
-            table = pointcloud2_structured(msg)
-            xyz = xyz_with_holes(msg, table)
-        except DeformapError as exc:
-            raise FileFormatError(f"{where}: {str(exc).replace('`msg` ', '')}") from None
-        rgb = pointcloud2_colors(msg, where=where, table=table, valid=np.isfinite(xyz).all(axis=1))
-        return xyz * (1e-3 if self.config.units == "mm" else 1.0), rgb
-
-    def _cloud(self, group: _Group, where: str) -> PointCloud:
-        if group.total is None or group.count is None or not group.count.any():
-            raise FileFormatError(f"{where}: topic {self.cloud_topic!r}: its frames hold "
-                                  "no finite point")  # fmt: skip
-        seen = group.count > 0
-        cam = group.total[seen] / group.count[seen, None]
-        rgb = None if group.rgb is None else np.clip(group.rgb[seen] / group.count[seen, None], 0, 1)
+    def _cloud(self, group: FrameGroup, where: str) -> PointCloud:
+        cam, rgb = group_points(group, self.cloud_topic, where)
         rot, trans = self.tree.lookup(self.world_frame, self.camera_frame, group.cam_stamp,
                                       what=f"{where} [{self.cloud_topic}]")  # fmt: skip
         return PointCloud(cam @ rot[0].T + trans[0], rgb)

@@ -8,12 +8,23 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, Literal
 
+import numpy as np
+from numpy.typing import NDArray
+
 from deformap._config import config_from_dict, load_yaml
 from deformap._validation import check_settings, setting
 from deformap.errors import ConfigError
 
-__all__ = ["DEFAULT_HULL", "RAW_CONFIG_NAME", "WORKSPACE_MARGIN_RADII", "HullPart",
-           "RawBagConfig", "load_raw_config", "raw_config_file"]
+__all__ = [
+    "DEFAULT_HULL",
+    "RAW_CONFIG_NAME",
+    "WORKSPACE_MARGIN_RADII",
+    "HullPart",
+    "RawBagConfig",
+    "hull_points",
+    "load_raw_config",
+    "raw_config_file",
+]
 
 #: The settings file inside a rosbag2 folder (``NAME.deformap.yaml`` beside a ``NAME.mcap``).
 RAW_CONFIG_NAME = "deformap.yaml"
@@ -162,3 +173,27 @@ def load_raw_config(bag: Path, file: Path | None = None, **overrides: Any) -> Ra
         return replace(config, **{k: v for k, v in overrides.items() if v is not None})
     except TypeError as exc:
         raise ConfigError(f"raw recording settings: {exc}") from None
+
+
+#: Points of a hull part's circle (cylinder, cap): 16 give a polygon within 2 % of the circle.
+_CIRCLE = 16
+
+
+def hull_points(part: HullPart, rot: NDArray[np.float64], origin: NDArray[np.float64]
+                ) -> NDArray[np.float64]:  # fmt: skip
+    """``(m, 3)`` world points whose convex hull is ``part`` at the tip pose ``rot``, ``origin``."""
+    c, (sx, sy, sz) = np.asarray(part.center_m), part.size_m
+    if part.shape == "box":
+        local = np.array([[x * sx, y * sy, z * sz] for x in (-0.5, 0.5) for y in (-0.5, 0.5)
+                          for z in (-0.5, 0.5)])  # fmt: skip
+    else:
+        az = np.linspace(0.0, 2 * np.pi, _CIRCLE, endpoint=False)
+        ring = np.column_stack([np.cos(az), np.sin(az), np.zeros_like(az)]) * (sx / 2)
+        if part.shape == "cylinder":
+            half = np.array([0.0, 0.0, sz / 2])
+            local = np.vstack([ring - half, ring + half])
+        else:  # cap: the upper half-sphere, as rings at 0°, 30°, 60° and the pole
+            r = sx / 2
+            local = np.vstack([ring * np.cos(a) + [0, 0, r * np.sin(a)]
+                               for a in (0.0, np.pi / 6, np.pi / 3)] + [[[0, 0, r]]])
+    return np.asarray((local + c) @ rot.T + origin)
