@@ -142,18 +142,16 @@ class PressPhase:
         travel = np.array(check_array("travel_m", self.travel_m, (None,), what="metres", min_rows=2))
         force = np.array(check_array("force_n", self.force_n, (travel.size,), what="newtons"))
         times = _check_times("time_s", self.time_s, travel.size, None)
-        if float(np.max(np.abs(travel))) > MAX_TRAVEL_M:
-            raise InvalidArgumentError(
-                f"`travel_m` must be metres, at most {MAX_TRAVEL_M} m in magnitude; got "
-                f"{float(np.max(np.abs(travel))):.4g}")
+        if (largest := float(np.max(np.abs(travel)))) > MAX_TRAVEL_M:
+            raise InvalidArgumentError(f"`travel_m` must be metres, at most {MAX_TRAVEL_M} m in "
+                                       f"magnitude; got {largest:.4g}")
         if float(force.min()) < -MIN_FORCE_RISE_N:
             raise InvalidArgumentError(
                 f"`force_n` must be the force pressing the surface, >= 0 within {MIN_FORCE_RISE_N} "
                 f"N; got {float(force.min()):.4g} N")
-        for name, arr in (("travel_m", travel), ("force_n", force)):
+        for name, arr in (("travel_m", travel), ("force_n", force), ("time_s", times)):
             arr.setflags(write=False)
             object.__setattr__(self, name, arr)
-        object.__setattr__(self, "time_s", times)
 
     def __len__(self) -> int:
         return int(self.travel_m.size)
@@ -170,9 +168,8 @@ def _same(a: PressPhase | NDArray[np.float64] | None,
     """Equality of two optional parts of a record (``None`` equals only ``None``)."""
     if a is None or b is None:
         return a is None and b is None
-    if isinstance(a, PressPhase) or isinstance(b, PressPhase):
-        return bool(a == b)
-    return bool(np.array_equal(a, b))
+    return bool(a == b) if isinstance(a, PressPhase) or isinstance(b, PressPhase) else bool(
+        np.array_equal(a, b))
 
 
 @dataclass(frozen=True, kw_only=True)
