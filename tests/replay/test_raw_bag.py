@@ -263,3 +263,23 @@ def test_a_sensor_not_zeroed_is_refused_when_the_bag_is_opened(
     code, output, _ = _map(bag, tmp_path / "map", config_file)
     assert code == 2
     assert "from its first sample" in output and "not zeroed" in output
+
+
+def test_more_presses_than_one_map_holds_are_refused_naming_the_bag(
+    raw_bag: Path, config_file: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from deformap._validation import LIMITS
+
+    monkeypatch.setitem(LIMITS["pokes"], "le", POKES - 1)  # the bag's presses, one too many
+    code, output, _ = _map(raw_bag, tmp_path / "map", config_file)
+    assert code == 2
+    assert f"{POKES:,} presses found" in output and "lab.mcap" in output
+    assert "Traceback" not in output
+
+
+def test_a_tip_radius_beyond_a_probe_is_refused_naming_the_setting() -> None:
+    from deformap.errors import DeformapError
+    from deformap.replay._rawconfig import RawBagConfig
+
+    with pytest.raises(DeformapError, match="tip_radius_m"):
+        RawBagConfig(tip_radius_m=1e-300)

@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from deformap._validation import LIMITS
 from deformap.cloud import PointCloud
 from deformap.cloud.io import (
     TransformTree,
@@ -89,6 +90,11 @@ class RawBagReader(CameraCheck):
                 f"{bag}: no press on {self.wrench_topic!r}: the force must stay above "
                 f"{contact_n:.4g} N ({source}) for {cfg.hold_min_s:g} s at least once; its "
                 f"largest is {float(magnitude.max()):.4g} N")
+        most = LIMITS["pokes"]["le"]
+        if len(self.presses) > most:
+            raise FileFormatError(
+                f"{bag}: {len(self.presses):,} presses found on {self.wrench_topic!r}, more than the "
+                f"{most:,} pokes one map is made of; split the recording")
         self._check_merge(magnitude, contact_n)
         self.config = cfg = self._tip(cfg)
         self.tip_still = self._tip_still()

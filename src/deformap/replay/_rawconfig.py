@@ -134,7 +134,7 @@ class RawBagConfig:
     observation_frames: int = setting(1, ge=1)
     workspace_lower: tuple[float, float] | None = None
     workspace_upper: tuple[float, float] | None = None
-    tip_radius_m: float = setting(0.01, gt=0.0)
+    tip_radius_m: float = setting(0.01, limit="tip_radius_m")
     hull: tuple[HullPart, ...] = field(default=DEFAULT_HULL)
 
     def __post_init__(self) -> None:

@@ -21,6 +21,7 @@ import logging
 from collections import OrderedDict
 from dataclasses import dataclass
 from functools import lru_cache
+from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
@@ -57,12 +58,20 @@ def graded_levels(thickness_m: float, top_m: float, growth: float) -> NDArray[np
 def unit_hex_stiffness(dx: float, dy: float, dz: float, nu: float) -> NDArray[np.float64]:
     """``(24, 24)`` stiffness of a ``dx × dy × dz`` trilinear hex with E = 1 Pa, by scikit-fem,
     ordered ``3 c + component`` with corner ``c = ci + 2 cj + 4 ck``."""
-    from skfem import Basis, BilinearForm, ElementHex1, ElementVectorH1, MeshHex, asm
+    from skfem import BilinearForm
     from skfem.models.elasticity import lame_parameters, linear_elasticity
+
+    form: BilinearForm = linear_elasticity(*lame_parameters(1.0, nu))
+    return _hex_matrix(dx, dy, dz, form)
+
+
+def _hex_matrix(dx: float, dy: float, dz: float, form: Any) -> NDArray[np.float64]:
+    """The 24×24 matrix of bilinear ``form`` on one ``dx×dy×dz`` hex (scikit-fem), its rows and
+    columns in this module's corner order (3 per corner), read-only."""
+    from skfem import Basis, ElementHex1, ElementVectorH1, MeshHex, asm
 
     mesh = MeshHex.init_tensor(np.array([0.0, dx]), np.array([0.0, dy]), np.array([0.0, dz]))
     basis = Basis(mesh, ElementVectorH1(ElementHex1()))
-    form: BilinearForm = linear_elasticity(*lame_parameters(1.0, nu))
     k = asm(form, basis).toarray()
     corner_of_node = np.rint(mesh.p.T / np.array([dx, dy, dz])).astype(int)
     ours = corner_of_node[:, 0] + 2 * corner_of_node[:, 1] + 4 * corner_of_node[:, 2]
@@ -70,7 +79,7 @@ def unit_hex_stiffness(dx: float, dy: float, dz: float, nu: float) -> NDArray[np
     perm[(3 * ours[:, None] + np.arange(3)).ravel()] = np.asarray(basis.nodal_dofs).T.ravel()
     out = k[np.ix_(perm, perm)]
     out.setflags(write=False)
-    return out
+    return np.asarray(out)
 
 
 @lru_cache(maxsize=256)
@@ -78,7 +87,7 @@ def orthotropic_hex_stiffness(dx: float, dy: float, dz: float, nu: float, ratio:
                               axis_deg: float) -> NDArray[np.float64]:
     """As :func:`unit_hex_stiffness`, of the rotated orthotropic material at unit soft modulus
     (:func:`~deformap.world._materials.orthotropic_stiffness`), by scikit-fem."""
-    from skfem import Basis, BilinearForm, ElementHex1, ElementVectorH1, MeshHex, asm
+    from skfem import BilinearForm
     from skfem.helpers import ddot, sym_grad
 
     from deformap.world._materials import orthotropic_stiffness
@@ -89,16 +98,7 @@ def orthotropic_hex_stiffness(dx: float, dy: float, dz: float, nu: float, ratio:
     def form(u, v, _):
         return ddot(np.einsum("ijkl,kl...->ij...", tensor, sym_grad(u)), sym_grad(v))
 
-    mesh = MeshHex.init_tensor(np.array([0.0, dx]), np.array([0.0, dy]), np.array([0.0, dz]))
-    basis = Basis(mesh, ElementVectorH1(ElementHex1()))
-    k = asm(form, basis).toarray()
-    corner_of_node = np.rint(mesh.p.T / np.array([dx, dy, dz])).astype(int)
-    ours = corner_of_node[:, 0] + 2 * corner_of_node[:, 1] + 4 * corner_of_node[:, 2]
-    perm = np.empty(24, dtype=int)
-    perm[(3 * ours[:, None] + np.arange(3)).ravel()] = np.asarray(basis.nodal_dofs).T.ravel()
-    out = k[np.ix_(perm, perm)]
-    out.setflags(write=False)
-    return out
+    return _hex_matrix(dx, dy, dz, form)
 
 
 @dataclass(frozen=True, kw_only=True)
