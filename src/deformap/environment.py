@@ -19,7 +19,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from deformap._validation import check_array, check_points, check_positive, check_vector
-from deformap.cloud import PointCloud, hull_parts
+from deformap.cloud import PointCloud, hull_parts, tip_in_view
 from deformap.errors import InvalidArgumentError
 from deformap.mechanics import TactileContact
 
@@ -94,8 +94,8 @@ MAX_TRAVEL_M = 0.05
 #: The force must rise by more than this [N] over a record: four times a probe sensor's noise.
 MIN_FORCE_RISE_N = 0.02
 
-#: A point of the cloud after release within this many tip radii of the tip centre, and above it,
-#: is the tip itself (the tip's radius and a margin for depth noise).
+#: A point of the cloud after release within this many tip radii of the tip centre may be the tip
+#: itself (the tip's radius and a margin for depth noise; :class:`PressObservation`).
 TIP_IN_VIEW_RADII = 1.1
 
 #: A measured force may differ from the commanded by at most ``FORCE_MISMATCH_REL · force_n +
@@ -291,9 +291,10 @@ class PressObservation:
     removed on its own (:attr:`robot_hulls` gives the tuple either way).
 
     ``released`` (optional) is the surface seen once the tip has left, for the dent the press
-    kept. A cloud with the tip still in view is refused: any point of it that lies within
-    :data:`TIP_IN_VIEW_RADII` tip radii of ``contact.tip_center`` and higher than the tip centre
-    (the upper half of the tip, what a camera above sees of it) counts as the tip.
+    kept. A cloud with the tip still in view is refused: its points within
+    :data:`TIP_IN_VIEW_RADII` tip radii of ``contact.tip_center`` and more than half a radius
+    above it (the tip's top, what a camera above sees of it) are the tip when their median height
+    stands more than a quarter radius above the surface 2–3 radii away (its 90th percentile).
     """
 
     cloud: PointCloud
@@ -344,15 +345,13 @@ class PressObservation:
         if not isinstance(released, PointCloud):
             raise InvalidArgumentError(
                 f"`released` must be a PointCloud or None; got {type(released).__name__}")
-        center, radius = self.contact.tip_center, self.contact.tip_radius_m
-        pts = released.points
-        near = np.linalg.norm(pts - center, axis=1) <= TIP_IN_VIEW_RADII * radius
-        tip = near & (pts[:, 2] > center[2])
-        if np.any(tip):
+        shown = tip_in_view(released.points, self.contact.tip_center, self.contact.tip_radius_m,
+                            within_radii=TIP_IN_VIEW_RADII)
+        if shown:
             raise InvalidArgumentError(
-                f"`released` must be seen once the tip has left; {int(tip.sum())} of its points "
-                f"lie within {TIP_IN_VIEW_RADII} tip radii of the tip centre and above it (the "
-                "tip still in view)")
+                f"`released` must be seen once the tip has left; {shown} of its points lie within "
+                f"{TIP_IN_VIEW_RADII} tip radii of the tip centre, on its top (the tip still in "
+                "view)")
 
     @property
     def robot_hulls(self) -> tuple[NDArray[np.float64], ...]:

@@ -62,6 +62,14 @@ def test_a_release_observation_with_the_tip_in_view_is_refused() -> None:
     _press(PointCloud(np.vstack([_surface(0.001).points, outside])))
 
 
+def test_a_deep_press_whose_surface_rebounds_above_the_tip_centre_is_kept() -> None:
+    # the tip sank 1.7 radii: the surface it left (a 2 mm dent kept) lies above the tip's centre,
+    # but does not stand above the surface around it as the tip's top would
+    deep = _surface(0.002, n=2000).points + np.array([0.0, 0.0, TIP[2] + 0.7 * RADIUS - 0.05])
+    assert np.any(deep[np.linalg.norm(deep - TIP, axis=1) < RADIUS, 2] > TIP[2] + RADIUS / 2)
+    assert _press(PointCloud(deep)).released is not None
+
+
 def test_a_release_observation_that_is_not_a_cloud_is_refused() -> None:
     with pytest.raises(InvalidArgumentError, match="`released` must be a PointCloud"):
         _press(_surface(0.001).points)
@@ -175,7 +183,7 @@ def test_a_session_with_the_tip_in_the_release_cloud_names_the_poke(tmp_path, sy
                          observation=synthetic.observation, presses=presses)
     first = presses[0]
     assert first.released is not None
-    tip = first.contact.tip_center + np.array([0.0, 0.0, 0.5 * first.contact.tip_radius_m])
+    tip = first.contact.tip_center + np.array([0.0, 0.0, 0.9 * first.contact.tip_radius_m])
     write_cloud(tmp_path / "s" / "poke-01-released.pcd",
                 PointCloud(np.vstack([first.released.points, tip])))
     _edit(file, lambda p: None)  # drop the manifest the edit broke

@@ -262,3 +262,27 @@ def test_contact_creep_follows_lee_radok_the_elastic_press_at_the_hereditary_for
     np.testing.assert_allclose(sunk[1:n], expected[1:n], rtol=0.05)  # the patch's 2 % tolerance
     np.testing.assert_allclose(sunk[n:], expected[n:], rtol=0.015)
     assert expected[-1] > 1.3 * expected[n - 1]  # the hold's creep is what is being compared
+
+
+def test_a_press_that_unloads_carries_the_surface_the_tip_left() -> None:
+    from deformap.stiffness import released_dent
+
+    LIGHT = 1.4  # a dent shallower than the tip's radius: the surface rebounds below its centre
+
+    assert _world().press(XY, LIGHT).released is None  # no unloading asked: none seen
+    elastic = _world(unload=True).press(XY, LIGHT)
+    soft = _plastic_world(500.0)
+    plastic = soft.press(XY, LIGHT)
+    dents = []
+    for obs in (elastic, plastic):
+        assert obs.released is not None and len(obs.released) > 100
+        dent = released_dent(obs.released.points, obs.contact.tip_center, obs.contact.tip_radius_m)
+        assert not isinstance(dent, str), dent
+        dents.append(dent)
+    # the camera's reading of the dent left: none on the elastic block, the plastic one's kept
+    (flat, flat_std), (kept, kept_std) = dents
+    assert abs(flat) < 3 * flat_std + 5e-4
+    residual = soft.foam.top_displacement(np.array([XY]), soft._left_displacement(
+        soft._material_press(np.array(XY), LIGHT), 0.0))[0, 2]
+    assert -residual > 1e-4  # yielded: a tenth of a millimetre kept at least
+    assert kept > 3 * kept_std and kept == pytest.approx(-residual, rel=0.3)

@@ -25,7 +25,7 @@ from numpy.typing import NDArray
 from deformap.environment import ForceTravel, PressPhase
 from deformap.world._config import RecordSpacing
 
-__all__ = ["PressSchedule", "force_levels", "press_schedule", "simulated_force_travel",
+__all__ = ["PressSchedule", "elastic_phases", "force_levels", "press_schedule", "simulated_force_travel",
            "with_phases"]
 
 
@@ -83,6 +83,15 @@ def press_schedule(levels: NDArray[np.float64], *, rate_n_per_s: float, hold_s: 
     unload_times = end + (levels[-1] - forces) / rate_n_per_s
     return PressSchedule(levels=levels, times=times, hold_times=hold,
                          unload_times=unload_times, unload_forces=forces)
+
+
+def elastic_phases(schedule: PressSchedule, depths: NDArray[np.float64]
+                   ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:  # fmt: skip
+    """The indentations of an elastic block during the hold and the unloading of ``schedule``:
+    it holds the last level's and retraces the ramp's levels (``depths``) in reverse."""
+    hold = np.full(schedule.hold_times.size, depths[-1])
+    unloading = depths[-2::-1][:schedule.unload_times.size].copy()
+    return hold, unloading
 
 
 def with_phases(record: ForceTravel, schedule: PressSchedule, zero_m: float,

@@ -34,7 +34,7 @@ from deformap.world._camera import DepthCamera, Frame
 from deformap.world._config import WorldConfig, check_world_budget
 from deformap.world._foam import Dent, FoamModel
 from deformap.world._force_travel import (
-    PressSchedule,
+    elastic_phases,
     force_levels,
     press_schedule,
     simulated_force_travel,
@@ -157,7 +157,8 @@ class SimulatedWorld(WorldTruth):
         self._pressed = PressObservation(
             cloud=cloud, contact=contact, target_xy=target, force_n=force,
             robot_points=self.config.probe.robot_points(tip_center, _UP),
-            force_travel=self.force_travel(target, force, dent))
+            force_travel=self.force_travel(target, force, dent),
+            released=self._released_cloud(target, force) if self.config.unload else None)
         return self._pressed
 
     def release(self) -> None:
@@ -184,13 +185,22 @@ class SimulatedWorld(WorldTruth):
         if self._pressed is not None:
             raise EnvironmentStateError("the probe is still pressing: call release() first")
         if not self._released:
-            raise EnvironmentStateError("no press has been released yet: press(), release(), "
-                                        "then ask for the surface after release")
-        if self._left is None:
-            return self.foam.zero_displacement()
-        if isinstance(self._left, PlasticPress):
-            return self._left.residual.copy()
-        return recovered(self._left.state, after)
+            raise EnvironmentStateError("no press has been released yet: press(), release(), then "
+                                        "ask for the surface after release")
+        return self._left_displacement(self._left, after)
+
+    def _left_displacement(self, left: PressHistory | PlasticPress | None, after_s: float
+                           ) -> NDArray[np.float64]:
+        if isinstance(left, PlasticPress):
+            return left.residual.copy()
+        return self.foam.zero_displacement() if left is None else recovered(left.state, after_s)
+
+    def _released_cloud(self, target: NDArray[np.float64], force: float) -> PointCloud:
+        """The frame the camera takes as the tip leaves at the end of the protocol's unloading
+        (the press's :attr:`PressObservation.released`)."""
+        u = self._left_displacement(self._material_press(target, force), 0.0)
+        key = self._press_key(target, force, 5)
+        return self._capture(u, None, self._event_rng(*key), key)
 
     def observe_released(self, after_s: float = 0.0) -> PointCloud:
         """One depth frame ``after_s`` seconds after the tip of the last released press left
@@ -266,7 +276,7 @@ class SimulatedWorld(WorldTruth):
             record = simulated_force_travel(depths, levels, self._event_rng(*key), **noise)
             if not schedule.has_phases:
                 return record
-            hold, unloading = self._phase_depths(schedule, depths)
+            hold, unloading = elastic_phases(schedule, depths)
             if isinstance(history, PressHistory):
                 hold, unloading = history.hold, history.unloading
             elif history is not None:
@@ -314,14 +324,6 @@ class SimulatedWorld(WorldTruth):
                 n_ramp=levels.size, n_hold=plan.hold_times.size, tip_radius_m=c.tip_radius_m)
         self._history = (key, history)
         return history
-
-    def _phase_depths(self, schedule: PressSchedule, depths: NDArray[np.float64]
-                      ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """The indentations during the hold and the unloading: an elastic block holds the last
-        level's and retraces the ramp's levels in reverse."""
-        hold = np.full(schedule.hold_times.size, depths[-1])
-        unloading = depths[-2::-1][:schedule.unload_times.size].copy()
-        return hold, unloading
 
     def _level_depths(self, target: NDArray[np.float64], levels: NDArray[np.float64],
                       final: Dent) -> NDArray[np.float64]:
