@@ -282,3 +282,14 @@ def test_a_poke_record_keeps_its_behaviour_through_the_journal() -> None:
         broken = {**data, "behaviour": {**data["behaviour"], key: bad}}
         with pytest.raises(FileFormatError, match=message):
             PokeRecord.from_dict(broken)
+
+
+def test_a_camera_too_coarse_to_rule_out_a_dent_does_not_veto_the_record() -> None:
+    # an elastic record, and a camera whose dent reading (0.1 ± 0.3 mm) can neither show nor rule
+    # out a tenth of a millimetre: the record's sharper reading decides
+    record = _record(0, hold=True, unloading=0.0)
+    assert press_behaviour(record).behaviour == "elastic"
+    got = press_behaviour(record, released=(1e-4, 3e-4))
+    assert got.behaviour == "elastic", got.evidence
+    # a camera that shows a dent is heard
+    assert press_behaviour(record, released=(2e-3, 1e-4)).behaviour != "elastic"

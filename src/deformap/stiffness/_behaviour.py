@@ -39,7 +39,8 @@ Class: a quantity *shows* a behaviour when it exceeds :data:`N_SIGMA` of its σ 
 floor; it *rules it out* when it lies below the floor by two of its σ. Viscoelastic: the hold
 relaxes or creeps; or, with no hold, the loop has loss but no dent remains. Plastic: a dent
 remains (record or camera) while a hold shows no relaxation; or a loss with a hold that shows
-none. Elastic: every quantity the record holds rules its behaviour out, and the record holds an
+none. No dent remains when neither dent reading shows one and the sharper of them rules it out.
+Elastic: every quantity the record holds rules its behaviour out, and the record holds an
 unloading branch or a hold with a camera dent. Anything else is ``"unknown"`` with the reason.
 Anisotropy and the instantaneous against the relaxed modulus are not estimated here.
 """
@@ -216,7 +217,10 @@ def _classify(relax: Measure | None, tau: Measure | None, mode: str | None,
     lossless = loss is not None and loss.rules_out(LOSS_FLOOR)
     dents = [m for m in (dent, cam) if m is not None]
     kept = any(m.shows(DENT_FLOOR_M) for m in dents)
-    no_dent = bool(dents) and all(m.rules_out(DENT_FLOOR_M) for m in dents)
+    # no dent: none shows one, and the sharpest reading rules it out (a camera too coarse to
+    # rule out a tenth of a millimetre does not veto the record's travel at zero force)
+    no_dent = bool(dents) and not kept and min(dents, key=lambda m: m.sigma).rules_out(
+        DENT_FLOOR_M)
     behaviour: Behaviour
     why: str
     if relaxes:
