@@ -24,9 +24,11 @@ runner = CliRunner()
 SKEW_NS = 1_500_000  # 1.5 ms
 
 
-def _rewrite(bag: Path, edit: Callable[[str, Any], Any], static: list[Any] | None = None) -> None:
+def _rewrite(bag: Path, edit: Callable[[str, Any], Any], static: list[Any] | None = None,
+             moving: list[Any] | None = None) -> None:
     """Copy ``bag`` message by message through ``edit(topic, msg)``, with ``static``
-    ``(parent, child, 4×4)`` transforms on ``/tf_static``; replace it."""
+    ``(parent, child, 4×4)`` transforms on ``/tf_static`` and ``moving`` ``(stamp_ns, parent,
+    child, 4×4)`` ones on ``/tf``; replace it."""
     from rosbags.rosbag2 import Reader
 
     from deformap.cloud.io import bag_writer, typestore
@@ -43,6 +45,13 @@ def _rewrite(bag: Path, edit: Callable[[str, Any], Any], static: list[Any] | Non
             tf = writer.add_connection("/tf_static", "tf2_msgs/msg/TFMessage", typestore=store)
             writer.write(tf, 0, store.serialize_cdr(_tf_message(static),
                                                     "tf2_msgs/msg/TFMessage"))
+        if moving:
+            tf = writer.add_connection("/tf", "tf2_msgs/msg/TFMessage", typestore=store)
+            for stamp, parent, child, matrix in moving:
+                msg = _tf_message([(parent, child, matrix)])
+                msg.transforms[0].header.stamp.sec = stamp // 10**9
+                msg.transforms[0].header.stamp.nanosec = stamp % 10**9
+                writer.write(tf, stamp, store.serialize_cdr(msg, "tf2_msgs/msg/TFMessage"))
     shutil.rmtree(bag)
     new.rename(bag)
 
@@ -140,6 +149,48 @@ def test_a_wrench_and_tip_in_a_frame_of_tf_static_are_taken_to_the_world(
         np.testing.assert_allclose(got.tip_center, want[i].tip_center, atol=1e-9)
 
 
+def test_a_wrench_and_tip_in_a_moving_sensor_frame_are_taken_to_the_world_by_tf(
+    tmp_path: Path, write_synthetic: Any, synthetic: Any
+) -> None:
+    from scipy.spatial.transform import Rotation
+
+    from deformap.cloud.io import header_stamp_ns
+
+    folder = _session(tmp_path, write_synthetic, synthetic)
+    exact = load_session(folder)
+    want = [exact.press_observation(i).contact for i in range(len(exact))]
+    poses: dict[int, np.ndarray] = {}  # the sensor's pose at each press, another each time
+
+    def pose(stamp: int) -> np.ndarray:
+        if stamp not in poses:
+            m = np.eye(4)
+            m[:3, :3] = Rotation.from_euler("zx", [30 + 40 * len(poses), 180], degrees=True
+                                            ).as_matrix()
+            m[:3, 3] = [0.1 * len(poses), -0.2, 0.3]
+            poses[stamp] = m
+        return poses[stamp]
+
+    def to_sensor(topic: str, msg: Any) -> Any:
+        if topic in ("/deformap/press/wrench", "/deformap/press/tip"):
+            inv = np.linalg.inv(pose(header_stamp_ns(msg.header)))
+            v = msg.wrench.force if topic.endswith("wrench") else msg.point
+            moved = inv[:3, :3] @ [v.x, v.y, v.z] + (inv[:3, 3] if topic.endswith("tip") else 0)
+            v.x, v.y, v.z = moved
+            msg.header.frame_id = "ft_sensor"
+        return msg
+
+    _rewrite(folder / "bag", to_sensor, static=[("world", "camera", np.eye(4))],
+             moving=[])  # the poses are known only once the messages are read: a second pass
+    _rewrite(folder / "bag", lambda topic, msg: msg,
+             moving=[(s, "world", "ft_sensor", m) for s, m in poses.items()])
+    assert len({round(float(m[0, 3]), 3) for m in poses.values()}) == len(poses) > 1
+    session = load_session(folder)
+    for i in range(len(session)):
+        got = session.press_observation(i).contact
+        np.testing.assert_allclose(got.force, want[i].force, atol=1e-9)
+        np.testing.assert_allclose(got.tip_center, want[i].tip_center, atol=1e-9)
+
+
 def test_a_frame_tf_static_does_not_resolve_is_named(
     tmp_path: Path, write_synthetic: Any, synthetic: Any
 ) -> None:
@@ -151,7 +202,7 @@ def test_a_frame_tf_static_does_not_resolve_is_named(
         return msg
 
     _rewrite(folder / "bag", rename, static=[("world", "camera", np.eye(4))])
-    with pytest.raises(DeformapError, match="'optoforce', which the bag's /tf_static does not"):
+    with pytest.raises(DeformapError, match="'optoforce', which the bag's /tf and /tf_static do"):
         load_session(folder).press_observation(0)
 
 

@@ -21,6 +21,7 @@ from numpy.typing import NDArray
 
 from deformap.cloud import PointCloud
 from deformap.cloud.io import (
+    TransformTree,
     array_to_pointcloud2,
     bag_error_text,
     bag_read_errors,
@@ -33,6 +34,7 @@ from deformap.cloud.io import (
     pointcloud2_structured,
     pointcloud2_to_cloud,
     read_bag_static_transform,
+    read_bag_transforms,
     typestore,
     wrench_message,
     xyz_with_holes,
@@ -62,7 +64,6 @@ class BagReader:
         self.stamp_tolerance_ns = stamp_tolerance_ns
         #: per poke (0-based): what its entry says beyond its β (``stamp_gaps_s``)
         self.notes: dict[int, dict[str, Any]] = {}
-        self._to_world_of: dict[str, NDArray[np.float64]] = {}
         if path_kind(self.path) == "missing":
             raise FileFormatError(f"{self.path}: no such bag (the session's `bag`)")
         for file in check_bag_confined(self.path):
@@ -77,6 +78,7 @@ class BagReader:
         self._decoded: dict[str, dict[int, list[Any]]] = {}  # key -> stamp -> messages
         self._undecodable: dict[str, list[str]] = {}  # key -> why its messages failed to decode
         self._tf_static: NDArray[np.float64] | None = None
+        self._tree: TransformTree | None = None  # /tf and /tf_static, read on first use
 
     def _force_travel(self, stamp: int) -> ForceTravel | None:
         """The record logged at ``stamp``, or None."""
@@ -183,17 +185,20 @@ class BagReader:
                                         colors=colors)  # fmt: skip
         return cloud
 
-    def _static_to_world(self, frame: str, where: str) -> NDArray[np.float64]:
-        """``frame``'s 4×4 transform to ``world`` from the bag's ``/tf_static``; a frame it does
-        not resolve is refused naming the message."""
-        if frame not in self._to_world_of:
-            try:
-                self._to_world_of[frame] = read_bag_static_transform(self.path, frame, "world")
-            except FileFormatError as exc:
-                raise FileFormatError(
-                    f"{where}: header.frame_id is {frame!r}, which the bag's /tf_static does not "
-                    f"take to 'world' ({exc})") from None
-        return self._to_world_of[frame]
+    def _frame_to_world(self, frame: str, stamp_ns: int, where: str
+                        ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:  # fmt: skip
+        """``frame``'s rotation and translation to ``world`` at ``stamp_ns`` (a message's header
+        stamp), from the bag's ``/tf`` and ``/tf_static`` within the stamp tolerance; a frame they
+        do not resolve there is refused naming the message."""
+        try:
+            if self._tree is None:
+                self._tree = read_bag_transforms(self.path, tolerance_ns=self.stamp_tolerance_ns)
+            rot, trans = self._tree.lookup("world", frame, stamp_ns, what=where)
+        except FileFormatError as exc:
+            raise FileFormatError(
+                f"{where}: header.frame_id is {frame!r}, which the bag's /tf and /tf_static do "
+                f"not take to 'world' at its stamp, within --stamp-tolerance ({exc})") from None
+        return rot[0], trans[0]
 
     def _to_world(self, cloud: PointCloud) -> PointCloud:
         cam2world = self.header.cam2world
@@ -281,9 +286,9 @@ class BagReader:
                 raise FileFormatError(
                     f"{where(key)}: holds NaN or infinite values {values[key].tolist()}")
             frame = str(msg.header.frame_id)
-            if frame != "world":  # a sensor's own frame: the bag's /tf_static takes it there
-                m = self._static_to_world(frame, where(key))
-                values[key] = m[:3, :3] @ values[key] + (m[:3, 3] if key == "tip" else 0.0)
+            if frame != "world":  # a sensor's own frame: the bag's /tf and /tf_static take it there
+                rot, trans = self._frame_to_world(frame, header_stamp_ns(msg.header), where(key))
+                values[key] = rot @ values[key] + (trans if key == "tip" else 0.0)
         return PressParts(cloud, values["tip"], values["wrench"], np.asarray(robot.points),
                           self._force_travel(stamp), self._released(stamp))
 
