@@ -141,3 +141,27 @@ def test_a_session_whose_disk_fills_names_the_file_and_is_no_session(tmp_path: P
     assert sorted(os.listdir(out)) == ["ground_truth.npz"]  # whole, and no session.yaml
     with pytest.raises(DeformapError, match="not a session folder"):
         load_session(out)
+
+
+def test_a_bag_whose_disk_fills_leaves_no_bag_cut_short(tmp_path: Path, monkeypatch) -> None:  # type: ignore[no-untyped-def]
+    pytest.importorskip("rosbags")
+    import deformap.replay._write as write_module
+    from deformap.environment import Workspace
+    from deformap.replay import write_session
+
+    real = write_module.write_session_bag
+
+    def full_halfway(path: Path, **kwargs):  # type: ignore[no-untyped-def]
+        real(path, **kwargs)  # the whole bag, then the disk is full before it is in place
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(write_module, "write_session_bag", full_halfway)
+    out = tmp_path / "session"
+    with pytest.raises(FileWriteError, match=r"cannot write '.*bag': no space left"):
+        write_session(out, workspace=Workspace(), observation=_CLOUD, presses=[],
+                      tip_radius_m=0.01, format="mcap")  # fmt: skip
+    assert os.listdir(out) == []  # no bag under its name, no staging folder left
+    monkeypatch.undo()
+    write_session(out, workspace=Workspace(), observation=_CLOUD, presses=[],
+                  tip_radius_m=0.01, format="mcap")  # fmt: skip
+    assert sorted(os.listdir(out)) == ["bag", "session.yaml"]

@@ -4,6 +4,8 @@
 from __future__ import annotations
 
 import logging
+import os
+import shutil
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -157,8 +159,7 @@ def write_session(folder: str | Path, *, workspace: Workspace, observation: Poin
     bag in ``bag/``. ``session.yaml`` comes last, with ``n_pokes``, every file's ``sha256`` and its
     seal (:func:`~deformap.replay._confine.seal`). Every file is written atomically: a failed write
     is one :class:`~deformap.errors.FileWriteError` naming the file, and leaves no file cut short
-    under its name (a bag's folder is written in place: without ``session.yaml`` the folder is no
-    session).
+    under its name (a bag is written in a folder beside and renamed into place).
     """
     out, presses, tip = _check_inputs(folder, workspace, observation, presses, tip_radius_m,
                                       format, cloud_format, ground_truth)  # fmt: skip
@@ -197,9 +198,15 @@ def write_session(folder: str | Path, *, workspace: Workspace, observation: Poin
             pokes.append(entry)
     else:
         stamps = [(i + 1) * _STAMP_STEP_NS for i in range(len(presses))]
+        # written beside, then renamed into place: a failed write leaves no bag cut short
+        staging = out / f".bag-{os.getpid()}.partial"
         with writing(out / "bag"):
-            write_session_bag(out / "bag", storage=format, observation=observation,
-                              presses=presses, stamps_ns=stamps)  # fmt: skip
+            try:
+                write_session_bag(staging / "bag", storage=format, observation=observation,
+                                  presses=presses, stamps_ns=stamps)  # fmt: skip
+                os.replace(staging / "bag", out / "bag")
+            finally:
+                shutil.rmtree(staging, ignore_errors=True)
         doc["bag"] = "bag"
         pokes = [
             {"stamp_ns": s, "target_xy": _floats(o.target_xy), "force_n": float(o.force_n)}
