@@ -117,6 +117,25 @@ def test_map_takes_the_stamp_tolerance_for_a_session(
     assert result.exit_code == 2 and "--stamp-tolerance 1e+09 s" in result.output
 
 
+def _into_sensor(topic: str, msg: Any, sensor2world: np.ndarray) -> Any:
+    """A press's wrench (rotated) or tip (moved) given in the frame ``ft_sensor`` at
+    ``sensor2world`` instead of ``world``; other messages as they are."""
+    if topic in ("/deformap/press/wrench", "/deformap/press/tip"):
+        inv = np.linalg.inv(sensor2world)
+        v = msg.wrench.force if topic.endswith("wrench") else msg.point
+        v.x, v.y, v.z = inv[:3, :3] @ [v.x, v.y, v.z] + (inv[:3, 3] if topic.endswith("tip") else 0)
+        msg.header.frame_id = "ft_sensor"
+    return msg
+
+
+def _assert_contacts(folder: Path, want: list[Any]) -> None:
+    session = load_session(folder)
+    for i in range(len(session)):
+        got = session.press_observation(i).contact
+        np.testing.assert_allclose(got.force, want[i].force, atol=1e-9)
+        np.testing.assert_allclose(got.tip_center, want[i].tip_center, atol=1e-9)
+
+
 def test_a_wrench_and_tip_in_a_frame_of_tf_static_are_taken_to_the_world(
     tmp_path: Path, write_synthetic: Any, synthetic: Any
 ) -> None:
@@ -128,25 +147,10 @@ def test_a_wrench_and_tip_in_a_frame_of_tf_static_are_taken_to_the_world(
     sensor2world = np.eye(4)
     sensor2world[:3, :3] = Rotation.from_euler("zx", [30, 180], degrees=True).as_matrix()
     sensor2world[:3, 3] = [0.1, -0.2, 0.3]
-    world2sensor = np.linalg.inv(sensor2world)
 
-    def to_sensor(topic: str, msg: Any) -> Any:
-        if topic == "/deformap/press/wrench":
-            f = msg.wrench.force
-            f.x, f.y, f.z = world2sensor[:3, :3] @ [f.x, f.y, f.z]
-            msg.header.frame_id = "ft_sensor"
-        elif topic == "/deformap/press/tip":
-            p = msg.point
-            p.x, p.y, p.z = world2sensor[:3, :3] @ [p.x, p.y, p.z] + world2sensor[:3, 3]
-            msg.header.frame_id = "ft_sensor"
-        return msg
-
-    _rewrite(folder / "bag", to_sensor, static=[("world", "ft_sensor", sensor2world)])
-    session = load_session(folder)
-    for i in range(len(session)):
-        got = session.press_observation(i).contact
-        np.testing.assert_allclose(got.force, want[i].force, atol=1e-9)
-        np.testing.assert_allclose(got.tip_center, want[i].tip_center, atol=1e-9)
+    _rewrite(folder / "bag", lambda topic, msg: _into_sensor(topic, msg, sensor2world),
+             static=[("world", "ft_sensor", sensor2world)])
+    _assert_contacts(folder, want)
 
 
 def test_a_wrench_and_tip_in_a_moving_sensor_frame_are_taken_to_the_world_by_tf(
@@ -172,11 +176,7 @@ def test_a_wrench_and_tip_in_a_moving_sensor_frame_are_taken_to_the_world_by_tf(
 
     def to_sensor(topic: str, msg: Any) -> Any:
         if topic in ("/deformap/press/wrench", "/deformap/press/tip"):
-            inv = np.linalg.inv(pose(header_stamp_ns(msg.header)))
-            v = msg.wrench.force if topic.endswith("wrench") else msg.point
-            moved = inv[:3, :3] @ [v.x, v.y, v.z] + (inv[:3, 3] if topic.endswith("tip") else 0)
-            v.x, v.y, v.z = moved
-            msg.header.frame_id = "ft_sensor"
+            return _into_sensor(topic, msg, pose(header_stamp_ns(msg.header)))
         return msg
 
     _rewrite(folder / "bag", to_sensor, static=[("world", "camera", np.eye(4))],
@@ -184,11 +184,7 @@ def test_a_wrench_and_tip_in_a_moving_sensor_frame_are_taken_to_the_world_by_tf(
     _rewrite(folder / "bag", lambda topic, msg: msg,
              moving=[(s, "world", "ft_sensor", m) for s, m in poses.items()])
     assert len({round(float(m[0, 3]), 3) for m in poses.values()}) == len(poses) > 1
-    session = load_session(folder)
-    for i in range(len(session)):
-        got = session.press_observation(i).contact
-        np.testing.assert_allclose(got.force, want[i].force, atol=1e-9)
-        np.testing.assert_allclose(got.tip_center, want[i].tip_center, atol=1e-9)
+    _assert_contacts(folder, want)
 
 
 def test_a_frame_tf_static_does_not_resolve_is_named(
