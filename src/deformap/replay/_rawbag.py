@@ -37,6 +37,7 @@ from deformap.replay._rawconfig import WORKSPACE_MARGIN_RADII, RawBagConfig, hul
 from deformap.replay._rawfind import CLOUD_TYPE, TF_TYPE, WRENCH_TYPE
 from deformap.replay._rawframes import FrameGroup, average_frames, group_points
 from deformap.replay._rawpress import (
+    CONTACT_NOISE_MULTIPLE,
     FoundPress,
     block_size,
     find_presses,
@@ -317,7 +318,8 @@ class RawBagReader(CameraCheck):
         k = block_size(press.hold_start - press.start, self.noise.rms_n, self.commanded_n)
         first = onset(self.wrench_force, press.start,
                       self.presses[press.index - 1].end if press.index else 0, self.noise, k)
-        span = slice(first, press.hold_end)
+        # to the last sample over the contact threshold: the unloading, when the tip let go slowly
+        span = slice(first, press.end)
         stamps = self.wrench_ns[span]
         r_force, _ = self.tree.lookup(self.world_frame, self.force_frame, stamps,
                                       what=f"{where} [{self.wrench_topic}]")  # fmt: skip
@@ -359,9 +361,16 @@ class RawBagReader(CameraCheck):
         # the sensor's noise along the press: its per-axis σ seen along the direction
         along = r_force[mid].T @ direction
         noise = float(np.sqrt(np.sum((along * self.noise.std) ** 2)))
-        seconds, held = (stamps - stamps[0]) / 1e9, slice(ramp.stop, hold.stop)
+        seconds = (stamps - stamps[0]) / 1e9
+        # the unloading: after the last sample still at the force held (within the noise's
+        # contact multiple), to the last over the contact threshold
+        level = float(normal[hold].mean()) - CONTACT_NOISE_MULTIPLE * noise
+        at_level = np.flatnonzero(normal[hold.start:] >= level)
+        falls = hold.start + (int(at_level[-1]) + 1 if at_level.size else 0)
+        held, unloading = slice(ramp.stop, hold.stop), slice(max(falls, hold.stop), len(stamps))
         record = press_record(travel, normal[ramp], seconds[ramp], noise, notes,
-                              (seconds[held], (tips[held] - tips[0]) @ direction, normal[held]))
+                              *((seconds[s], (tips[s] - tips[0]) @ direction, normal[s])
+                                for s in (held, unloading)))
         record = self.against_camera(notes, record, travel, cloud,
                                      tip + cfg.tip_radius_m * direction, robot)
         if "disagreement" in notes:  # a warning in the report (map_session), said once

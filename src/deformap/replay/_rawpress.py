@@ -200,15 +200,19 @@ def block_means(travel: NDArray[np.float64], force: NDArray[np.float64], noise_n
 
 def press_record(travel: NDArray[np.float64], force: NDArray[np.float64],
                  seconds: NDArray[np.float64], noise_n: float, notes: dict[str, Any],
-                 hold: tuple[NDArray[np.float64], ...]) -> ForceTravel | None:
+                 hold: tuple[NDArray[np.float64], ...],
+                 unloading: tuple[NDArray[np.float64], ...]) -> ForceTravel | None:
     """The record of a press: its ramp's ``travel``, ``force`` and ``seconds`` since first contact
-    (one per sample), averaged by :func:`block_means`, and as its hold the samples ``hold`` =
+    (one per sample), averaged by :func:`block_means`; as its hold the samples ``hold`` =
     ``(seconds, travel, force)`` from the one after the ramp's last (the first to reach the force
-    held) to the end of the hold, as they are. No unloading: the record stops where the hold does.
+    held) to the end of the hold, as they are; as its unloading the samples ``unloading`` after the
+    hold still over the contact threshold (the same form), averaged in blocks from the last one
+    back, when there are at least three blocks (a tip that let go at once gives none).
 
     Ramp samples the record refuses leave none, ``notes["force_travel"]`` saying why (β then comes
     from the camera alone); times that do not increase (a repeated stamp) or a hold it refuses
-    leave the ramp alone, ``notes["record_times"]`` saying why."""
+    leave the ramp alone, ``notes["record_times"]`` saying why; an unloading it refuses (a force
+    that rises as the tip retracts) leaves the ramp and hold, ``notes["unloading"]`` saying why."""
     ramp_travel, ramp_force = block_means(travel, force, noise_n)
     ramp_seconds = block_means(seconds, force, noise_n)[0]  # the same blocks
     try:
@@ -221,11 +225,27 @@ def press_record(travel: NDArray[np.float64], force: NDArray[np.float64],
     try:
         phase = (PressPhase(time_s=hold[0], travel_m=hold[1], force_n=hold[2])
                  if len(hold[0]) >= 2 else None)
-        return ForceTravel(travel_m=ramp.travel_m, force_n=ramp.force_n, time_s=ramp_seconds,
-                           hold=phase)
+        timed = ForceTravel(travel_m=ramp.travel_m, force_n=ramp.force_n, time_s=ramp_seconds,
+                            hold=phase)
     except DeformapError as exc:
         notes["record_times"] = f"the record keeps its ramp alone, without times ({exc})"
         return ramp
+    # the unloading read backwards is a ramp: the same blocks, from the lowest force up
+    back = [a[::-1] for a in unloading]
+    if back[2].size < 3:
+        return timed
+    down_travel, down_force = block_means(back[1], back[2], noise_n)
+    if down_force.size < 3:
+        return timed
+    down_seconds = block_means(back[0], back[2], noise_n)[0]
+    try:
+        return ForceTravel(travel_m=timed.travel_m, force_n=timed.force_n, time_s=timed.time_s,
+                           hold=timed.hold, unloading=PressPhase(
+                               time_s=down_seconds[::-1], travel_m=down_travel[::-1],
+                               force_n=down_force[::-1]))
+    except DeformapError as exc:
+        notes["unloading"] = f"the record keeps its ramp and hold, without the unloading ({exc})"
+        return timed
 
 
 def onset(force: NDArray[np.float64], start: int, floor: int, noise: NoiseFloor, k: int) -> int:

@@ -13,7 +13,11 @@ clock skew, force profile and frame names: the imperfections a real recording ha
 
 Each press runs approach (0.2 s), ramp from contact to the force (0.4 s; a ``step`` profile jumps
 to the force at contact), hold (0.3 s), release (0.15 s) and a pause (0.15 s); the camera sees the
-press's cloud from contact to the end of the release, the undisturbed surface otherwise.
+press's cloud from contact to the end of the release, the undisturbed surface otherwise. A record
+with a hold replays it (its travel and force on its own clock) instead of the 0.3 s at the force;
+one with an unloading branch replays it after the hold. The release lifts the tip with the force
+already at zero: the surface lets go between two samples, as it does when the arm retracts faster
+than the surface recovers, so only a recorded unloading branch gives the bag one.
 """
 
 from __future__ import annotations
@@ -68,7 +72,46 @@ class RawPress:
 
     @property
     def hold_s(self) -> tuple[float, float]:
-        return self.contact_s + RAMP, self.contact_s + RAMP + HOLD
+        """Start and end of the hold: the record's own hold's length, else :data:`HOLD`."""
+        hold = self._phase("hold")
+        return self.contact_s + RAMP, self.contact_s + RAMP + (HOLD if hold is None else hold[0][-1])
+
+    @property
+    def release_s(self) -> float:
+        """Start of the release: the end of the hold, or of the unloading branch replayed after it."""
+        unloading = self._phase("unloading")
+        return self.hold_s[1] + (0.0 if unloading is None else unloading[0][-1])
+
+    @property
+    def end_s(self) -> float:
+        """End of the press: release and pause done."""
+        return self.release_s + RELEASE + PAUSE
+
+    def _phase(self, name: str) -> tuple[NDArray[np.float64], ...] | None:
+        """``(seconds since the stretch began, travel since contact, force)`` of the record's
+        hold or unloading, its first sample the one before the stretch (the ramp's or the hold's
+        last), or ``None`` when the record has none."""
+        record = self.obs.force_travel
+        phase = None if record is None else getattr(record, name)
+        if record is None or phase is None or record.time_s is None:
+            return None
+        before = record.hold if name == "unloading" and record.hold is not None else record
+        t0, d0, f0 = (float(before.time_s[-1]), float(before.travel_m[-1]),  # type: ignore[index]
+                      float(before.force_n[-1]))
+        return (np.concatenate([[0.0], phase.time_s - t0]),
+                np.concatenate([[d0], phase.travel_m]) - float(record.travel_m[0]),
+                np.concatenate([[f0], phase.force_n]))
+
+    def replayed(self, t: float) -> tuple[float, float] | None:
+        """Travel since contact [m] and force [N] the record's hold or unloading gives at ``t``
+        [s on the bag's timeline], or ``None`` outside them or where the record has none."""
+        for name, start, end in (("hold", *self.hold_s), ("unloading", self.hold_s[1],
+                                                          self.release_s)):
+            phase = self._phase(name)
+            if phase is not None and start <= t <= end:
+                return (float(np.interp(t - start, phase[0], phase[1])),
+                        float(np.interp(t - start, phase[0], phase[2])))
+        return None
 
     def lift(self) -> float:
         """The tip's travel from contact to the hold [m] (its record's)."""
@@ -79,7 +122,12 @@ class RawPress:
 def raw_timeline(presses: Sequence[PressObservation]) -> list[RawPress]:
     """The presses, one after the other from :data:`FIRST_PRESS_S`."""
     step = APPROACH + RAMP + HOLD + RELEASE + PAUSE
-    return [RawPress(obs, FIRST_PRESS_S + i * step) for i, obs in enumerate(presses)]
+    timeline: list[RawPress] = []
+    longer = 0.0  # what the presses so far ran over the plain step (their holds and unloadings)
+    for i, obs in enumerate(presses):
+        timeline.append(RawPress(obs, FIRST_PRESS_S + i * step + longer))
+        longer += timeline[-1].end_s - timeline[-1].start_s - step
+    return timeline
 
 
 # -- the rig's geometry ----------------------------------------------------------------------------
@@ -123,11 +171,11 @@ def _tip_position(presses: list[RawPress], t: float, tip_moves: bool) -> NDArray
                 return above
             prev = presses[k - 1]
             prev_above = prev.obs.contact.tip_center + (prev.lift() + 0.05) * up
-            w = np.clip((t - prev.hold_s[1] - RELEASE) / PAUSE, 0.0, 1.0)
+            w = np.clip((t - prev.release_s - RELEASE) / PAUSE, 0.0, 1.0)
             return np.asarray(prev_above + w * (above - prev_above))
         if t < p.contact_s:
             return np.asarray(above + (t - p.start_s) / APPROACH * (contact - above))
-        if not tip_moves and t <= p.hold_s[1]:
+        if not tip_moves and t <= p.release_s:
             return np.asarray(contact)
         if t < p.hold_s[0]:
             record = p.obs.force_travel
@@ -136,11 +184,13 @@ def _tip_position(presses: list[RawPress], t: float, tip_moves: bool) -> NDArray
             u = _ramp_u(p, np.array([t]))
             travel = np.interp(u, np.arange(len(record)), record.travel_m)[0]
             return np.asarray(contact - (travel - record.travel_m[0]) * up)
-        if t <= p.hold_s[1]:
-            return np.asarray(hold)
-        if t <= p.hold_s[1] + RELEASE:
-            start = contact if not tip_moves else hold
-            return np.asarray(start + (t - p.hold_s[1]) / RELEASE * (above - start))
+        if t <= p.release_s:
+            replayed = p.replayed(t)
+            return np.asarray(hold if replayed is None else contact - replayed[0] * up)
+        if t <= p.release_s + RELEASE:
+            left = p.replayed(p.release_s)
+            start = contact if not tip_moves else hold if left is None else contact - left[0] * up
+            return np.asarray(start + (t - p.release_s) / RELEASE * (above - start))
     last = presses[-1]
     return np.asarray(last.obs.contact.tip_center + (last.lift() + 0.05) * up)
 
@@ -165,9 +215,12 @@ def _force_on_surface(presses: list[RawPress], t: NDArray[np.float64],
         else:
             mags = np.interp(_ramp_u(p, t[ramp]), np.arange(len(record)), record.force_n)
             out[ramp] = mags[:, None] * unit
-        out[(t >= p.hold_s[0]) & (t <= p.hold_s[1])] = f
-        rel = (t > p.hold_s[1]) & (t < p.hold_s[1] + RELEASE)
-        out[rel] = (1 - (t[rel] - p.hold_s[1]) / RELEASE)[:, None] * f
+        after = np.flatnonzero((t >= p.hold_s[0]) & (t <= p.release_s))
+        out[after] = f
+        for i in after:  # the record's hold and unloading, where it has them
+            replayed = p.replayed(float(t[i]))
+            if replayed is not None:
+                out[i] = replayed[1] * unit
     return out
 
 
@@ -230,7 +283,7 @@ def raw_messages(observation: PointCloud, presses: Sequence[PressObservation], r
         raise InvalidArgumentError("`presses` must hold at least one press; got none")
     rng = np.random.default_rng(seed)
     timeline = raw_timeline(presses)
-    end_s = timeline[-1].hold_s[1] + RELEASE + PAUSE
+    end_s = timeline[-1].end_s
     optical2world = camera_optical2world()
     colored = [observation] + [p.cloud for p in presses]
     clouds = [np.asarray(c.points) for c in colored]
@@ -257,7 +310,7 @@ def raw_messages(observation: PointCloud, presses: Sequence[PressObservation], r
     jitter = 0.1 / rig.camera_hz
     for n, t in enumerate(np.arange(0.0, end_s, 1 / rig.camera_hz)):
         stamp = float(t + rng.uniform(-jitter, jitter))
-        held = [k for k, p in enumerate(timeline) if p.contact_s <= stamp <= p.hold_s[1] + RELEASE]
+        held = [k for k, p in enumerate(timeline) if p.contact_s <= stamp <= p.release_s + RELEASE]
         which = held[0] + 1 if held else 0
         grid = grids[which].copy()
         blank = layouts[which]
