@@ -25,7 +25,12 @@ def bench_world(*, scenario: str = "heterogeneous-60-110-rigid", rng: np.random.
     ``press_s``, ``observe_s`` (medians, seconds), ``n_dofs``, ``n_points`` and
     ``n_points_on_area`` of one observation, ``scenario``, ``element_size_m``,
     ``press_load_by_load_s`` (the linear FEM solving each load as it comes, the baseline; None
-    for another physics), ``poke_compute_s`` and ``poke_compute_camera_only_s`` (its baseline).
+    for another physics), ``poke_compute_s`` (the blind map, ``appearance: off``) beside
+    ``poke_compute_camera_only_s`` (no record), ``poke_compute_prior_s`` (the appearance prior
+    on, None when the cloud has no colour) and ``poke_compute_phases_s`` (records with a 2 s hold
+    and an unloading branch, from a second world of the same scenario);
+    ``initialise_s`` (the surface model alone) beside ``initialise_appearance_s`` (with the
+    appearance image, its segments and the prior read from the observation's colours).
     """
     cfg = config or WorldConfig()
     sc = load_scenario(scenario)
@@ -39,14 +44,28 @@ def bench_world(*, scenario: str = "heterogeneous-60-110-rigid", rng: np.random.
         observe_times.append(time.perf_counter() - t0)
     presses, press_times = _timed_presses(world)
     load_by_load = _press_load_by_load(world)
-    with_record, camera_only = _poke_compute(sc.workspace, cloud, presses, rng)
+    seed = int(rng.integers(2**32))
+    blind = ExplorationConfig(appearance="off")
+    timed = {"poke_compute_s": _poke_compute(sc.workspace, cloud, presses, blind, seed),
+             "poke_compute_camera_only_s": _poke_compute(
+                 sc.workspace, cloud, [dataclasses.replace(p, force_travel=None) for p in presses],
+                 dataclasses.replace(blind, field="beta"), seed),
+             "poke_compute_prior_s": None if cloud.colors is None else _poke_compute(
+                 sc.workspace, cloud, presses, ExplorationConfig(appearance="auto"), seed)}
+    phased = SimulatedWorld(sc, config=dataclasses.replace(cfg, hold_s=2.0, unload=True),
+                            rng=np.random.default_rng(seed))  # fmt: skip
+    timed["poke_compute_phases_s"] = _poke_compute(sc.workspace, cloud,
+                                                   _timed_presses(phased)[0], blind, seed)
     return {
         "scenario": sc.name, "element_size_m": cfg.element_size_m, "construction_s": construction,
         "press_s": float(np.median(press_times)), "press_load_by_load_s": load_by_load,
         "observe_s": float(np.median(observe_times)), "n_dofs": world.n_dofs,
         "n_points": len(cloud),
         "n_points_on_area": int(np.count_nonzero(sc.workspace.contains(cloud.xy))),
-        "poke_compute_s": with_record, "poke_compute_camera_only_s": camera_only,
+        **timed,
+        "initialise_s": _initialise(sc.workspace, cloud, blind, seed),
+        "initialise_appearance_s": None if cloud.colors is None else _initialise(
+            sc.workspace, cloud, ExplorationConfig(appearance="auto"), seed),
     }  # fmt: skip
 
 
@@ -75,20 +94,26 @@ def _press_load_by_load(world: Any) -> float | None:
         foam.max_unit_columns = kept
 
 
-def _poke_compute(workspace: Any, cloud: Any, presses: list[Any], rng: np.random.Generator
-                  ) -> tuple[float, float]:
-    """Median compute of one poke (dent, β, the force–travel reading, the map field updated) on
-    the presses, with their records and, the baseline, without them (mapped on the β-field)."""
-    medians = []
-    for keep_record in (True, False):
-        # without records the map is on β (no fallback warning in a benchmark's output)
-        mapper = Mapper(workspace, ExplorationConfig(field="modulus" if keep_record else "beta"))
-        mapper.initialise(cloud, np.random.default_rng(rng.integers(2**32)))
-        times = []
-        for index, obs in enumerate(presses):
-            press = obs if keep_record else dataclasses.replace(obs, force_travel=None)
-            t0 = time.perf_counter()
-            mapper.add(mapper.process_press(press, index))
-            times.append(time.perf_counter() - t0)
-        medians.append(float(np.median(times)))
-    return medians[0], medians[1]
+def _initialise(workspace: Any, cloud: Any, config: ExplorationConfig, seed: int) -> float:
+    """Median of three :meth:`Mapper.initialise` on the observation under ``config``."""
+    times = []
+    for _ in range(3):
+        mapper = Mapper(workspace, config)
+        t0 = time.perf_counter()
+        mapper.initialise(cloud, np.random.default_rng(seed))
+        times.append(time.perf_counter() - t0)
+    return float(np.median(times))
+
+
+def _poke_compute(workspace: Any, cloud: Any, presses: list[Any], config: ExplorationConfig,
+                  seed: int) -> float:
+    """Median compute of one poke (dent, β, the force–travel reading and what the press reveals,
+    the map field updated) on the presses, under ``config``."""
+    mapper = Mapper(workspace, config)
+    mapper.initialise(cloud, np.random.default_rng(seed))
+    times = []
+    for index, press in enumerate(presses):
+        t0 = time.perf_counter()
+        mapper.add(mapper.process_press(press, index))
+        times.append(time.perf_counter() - t0)
+    return float(np.median(times))
