@@ -5,7 +5,12 @@ viscoelastic, a standard linear solid with g∞ = 0.5 and τ = 1 s; plastic, yie
 2 kPa). The baseline is the truth of each press, in the same run.
 
     OMP_NUM_THREADS=1 PYTHONPATH=src python benchmarks/behaviour_matrix.py \
-        [--cameras primesense kinect-v1 realsense-d435] [--thickness 0.03 0.1] [--force 0.6]
+        [--cameras primesense kinect-v1 realsense-d435] [--thickness 0.03 0.1] [--force 0.6] \
+        [--levels 8]
+
+``--levels`` is the record's load levels per branch (``WorldConfig.force_travel_levels``; the
+world's default 8; a robot sampling at 100 Hz records about 30 over a 0.3 s ramp). Each press's
+line gives its class; the table counts them.
 """
 
 from __future__ import annotations
@@ -45,6 +50,7 @@ def main() -> None:
     parser.add_argument("--cameras", nargs="+", default=["primesense", "kinect-v1", "realsense-d435"])
     parser.add_argument("--thickness", nargs="+", type=float, default=[0.03, 0.1])
     parser.add_argument("--force", type=float, default=0.6)
+    parser.add_argument("--levels", type=int, default=8)
     args = parser.parse_args()
     counts: Counter[tuple[str, str]] = Counter()
     with tempfile.TemporaryDirectory() as tmp:
@@ -52,7 +58,8 @@ def main() -> None:
             for thickness in args.thickness:
                 world = SimulatedWorld(_scenario(thickness, Path(tmp)),
                                        config=WorldConfig(hold_s=3.0, unload=True,
-                                                          camera=camera_preset(camera)),
+                                                          camera=camera_preset(camera),
+                                                          force_travel_levels=args.levels),
                                        rng=np.random.default_rng(1))
                 row = []
                 for xy, truth in PRESSES:
