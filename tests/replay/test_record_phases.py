@@ -221,6 +221,12 @@ def test_the_map_of_a_phased_session_says_each_pokes_behaviour(tmp_path, synthet
     assert [r["behaviour"] for r in rows] == ["viscoelastic", "unknown", "unknown"]
     assert float(rows[0]["relaxation"]) == pytest.approx(first["relaxation"])
     assert rows[1]["relaxation"] == "" and rows[2]["loss_ratio"] == ""
+    # the ramp's modulus is the instantaneous one; the hold's relaxation gives the relaxed one
+    e0, e1 = first["modulus_instantaneous_pa"], first["modulus_relaxed_pa"]
+    assert e0 == pytest.approx(pokes[0]["stiffness"]["modulus_pa"])
+    assert e1 == pytest.approx(e0 * (1.0 - first["relaxation"]) ** (
+        1.5 if first["relaxation_mode"] == "travel" else 1.0))
+    assert float(rows[0]["modulus_relaxed_pa"]) == pytest.approx(e1)
 
 
 def _ramp_only(obs: PressObservation) -> PressObservation:

@@ -300,3 +300,61 @@ def test_a_camera_too_coarse_to_rule_out_a_dent_does_not_veto_the_record() -> No
     assert got.behaviour == "elastic", got.evidence
     # a camera that shows a dent is heard
     assert press_behaviour(record, released=(2e-3, 1e-4)).behaviour != "elastic"
+
+
+def test_a_hold_where_neither_moves_is_read_as_a_held_force() -> None:
+    # the force scatters more than the travel but neither trends: the robot holds the force
+    rng = np.random.default_rng(8)
+    n = 12
+    hold = PressPhase(time_s=1.0 + 0.25 * np.arange(1, n + 1),
+                      travel_m=DEPTH + rng.normal(0, ST, n), force_n=1.0 + rng.normal(0, 0.02, n))
+    got = press_behaviour(_record(hold=hold, unloading=_unloading(rng, 0.0, 4.5)))
+    assert got.relaxation_mode == "travel"
+    assert got.tau_s is None and "moves within its noise" in got.evidence
+    assert got.behaviour != "viscoelastic", got.evidence
+
+
+def test_the_record_dent_floor_is_what_a_drifting_sensor_zero_moves() -> None:
+    from deformap.stiffness._behaviour import (
+        DENT_FLOOR_M,
+        RELAXATION_FLOOR,
+        record_dent_floor,
+    )
+    record = _record(hold=True)
+    largest = max(float(record.travel_m.max()), float(record.hold.travel_m.max()))
+    assert record_dent_floor(record) == pytest.approx(RELAXATION_FLOOR ** (2 / 3) * largest)
+    shallow = ForceTravel(travel_m=[0.0, 1e-4, 2e-4], force_n=[0.0, 0.5, 1.0])
+    assert record_dent_floor(shallow) == DENT_FLOOR_M
+
+
+def test_a_branch_off_the_contact_law_widens_the_dent_sigma() -> None:
+    rng = np.random.default_rng(6)
+    clean = _unloading(rng, 0.001, 1.0)
+    wavy = PressPhase(time_s=clean.time_s, force_n=clean.force_n,
+                      travel_m=clean.travel_m + 3e-4 * np.sin(np.linspace(0, 9, len(clean))))
+    a = press_behaviour(_record(unloading=clean))
+    b = press_behaviour(_record(unloading=wavy))
+    assert a.residual_dent_sigma_m is not None and b.residual_dent_sigma_m is not None
+    assert b.residual_dent_sigma_m > 4 * a.residual_dent_sigma_m
+
+
+@pytest.mark.parametrize("creep", [False, True])
+def test_the_relaxed_modulus_follows_from_the_instantaneous_and_the_hold(creep: bool) -> None:
+    hold = _relaxing_hold(np.random.default_rng(2), 0.3, 1.0, creep=creep)
+    got = press_behaviour(_record(hold=hold, unloading=0.0), modulus=(50e3, 2e3))
+    assert got.modulus_instantaneous_pa == 50e3 and got.modulus_instantaneous_sigma_pa == 2e3
+    assert got.relaxation is not None and got.modulus_relaxed_pa is not None
+    # position held: the force (so E) falls by the fraction, 0.3 (1 − e^{-10}); force held: the
+    # travel grows by 1 / (1 − 0.3) and as E^(-2/3) (Hertz), so E falls to 0.7^(3/2)
+    assert got.modulus_relaxed_pa / 50e3 == pytest.approx(0.7**1.5 if creep else 0.7, abs=0.03)
+    assert got.modulus_relaxed_sigma_pa is not None
+    assert 2e3 * 0.5 <= got.modulus_relaxed_sigma_pa < 0.1 * got.modulus_relaxed_pa
+    assert got.to_dict()["modulus_relaxed_pa"] == got.modulus_relaxed_pa
+
+
+def test_a_modulus_without_a_hold_is_only_the_instantaneous_and_a_bad_one_is_refused() -> None:
+    got = press_behaviour(_record(unloading=0.0), modulus=(50e3, 2e3))
+    assert got.modulus_instantaneous_pa == 50e3 and got.modulus_relaxed_pa is None
+    for bad in [(0.0, 1.0), (float("nan"), 1.0), (5e4, -1.0)]:
+        with pytest.raises(InvalidArgumentError, match="`modulus`"):
+            press_behaviour(_record(unloading=0.0), modulus=bad)

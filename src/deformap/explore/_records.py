@@ -268,17 +268,23 @@ class PokeRecord:
             behaviour=_behaviour_from_dict(data.get("behaviour"), f"{where}.behaviour"))
 
 
-def poke_behaviour(obs: PressObservation) -> PressBehaviour:
+def poke_behaviour(obs: PressObservation, stiffness: StiffnessEstimate | None = None
+                   ) -> PressBehaviour:
     """:func:`~deformap.stiffness.press_behaviour` of a press: its record and, when it has one,
     the dent its cloud after release keeps at the tip (:func:`~deformap.stiffness.released_dent`;
-    why none could be had joins the evidence)."""
+    why none could be had joins the evidence); with ``stiffness`` (the record's estimate, not
+    rigid) its modulus as the instantaneous one."""
+    modulus = None
+    if (stiffness is not None and not stiffness.rigid and stiffness.modulus_pa is not None
+            and stiffness.modulus_pa > 0.0):
+        modulus = (float(stiffness.modulus_pa), float(stiffness.modulus_std_pa or 0.0))
     if obs.released is None:
-        return press_behaviour(obs.force_travel)
+        return press_behaviour(obs.force_travel, modulus=modulus)
     dent = released_dent(obs.released.points, obs.contact.tip_center, obs.contact.tip_radius_m)
     if isinstance(dent, str):
-        got = press_behaviour(obs.force_travel)
+        got = press_behaviour(obs.force_travel, modulus=modulus)
         return dataclasses.replace(got, evidence=f"{got.evidence}; {dent}")
-    return press_behaviour(obs.force_travel, released=dent)
+    return press_behaviour(obs.force_travel, released=dent, modulus=modulus)
 
 
 def _behaviour_from_dict(data: Any, where: str) -> PressBehaviour | None:

@@ -52,13 +52,16 @@ none. No dent remains when neither dent reading shows one and one of them rules 
 against its floor: the camera's :data:`DENT_FLOOR_M`, the record's :func:`record_dent_floor`.
 Elastic: every quantity the record holds rules its behaviour out, and the record holds an
 unloading branch or a hold with a camera dent. Anything else is ``"unknown"`` with the reason.
-Anisotropy and the instantaneous against the relaxed modulus are not estimated here.
+
+Moduli: the loading ramp's E, given by the caller (:mod:`deformap.stiffness`'s estimate), is the
+instantaneous one; the relaxed one follows from it and the hold's fraction
+(:func:`relaxed_modulus`).
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 from typing import Any, Literal
 
 import numpy as np
@@ -82,7 +85,7 @@ from deformap.stiffness._phases import (
 
 __all__ = ["BEHAVIOURS", "DENT_FLOOR_M", "LOSS_FLOOR", "MIN_FIT_SAMPLES", "N_SIGMA",
            "RELAXATION_FLOOR", "Behaviour", "PressBehaviour", "PressRecord", "press_behaviour",
-           "record_dent_floor", "released_dent"]
+           "record_dent_floor", "relaxed_modulus", "released_dent"]
 
 Behaviour = Literal["elastic", "viscoelastic", "plastic", "unknown"]
 BEHAVIOURS: tuple[str, ...] = ("elastic", "viscoelastic", "plastic", "unknown")
@@ -121,8 +124,10 @@ class PressBehaviour:
     with the position held; ``"travel"``: creep ``1 − t_start/t_end`` with the force held), ``tau_s``
     its time constant [s]; ``loss_ratio`` the hysteresis energy over the loading energy;
     ``residual_dent_m`` the unloading's travel at zero force [m]; ``released_dent_m`` the dent the
-    camera sees after release [m]. ``behaviour`` is the class and ``evidence`` the tests that gave
-    it, or why it is ``"unknown"``.
+    camera sees after release [m]. ``modulus_instantaneous_pa`` is the loading ramp's Young's
+    modulus (the modulus at the press's speed, given to :func:`press_behaviour`),
+    ``modulus_relaxed_pa`` the modulus at the hold's end (:func:`relaxed_modulus`). ``behaviour`` is
+    the class and ``evidence`` the tests that gave it, or why it is ``"unknown"``.
     """
 
     behaviour: Behaviour
@@ -138,6 +143,10 @@ class PressBehaviour:
     residual_dent_sigma_m: float | None = None
     released_dent_m: float | None = None
     released_dent_sigma_m: float | None = None
+    modulus_instantaneous_pa: float | None = None
+    modulus_instantaneous_sigma_pa: float | None = None
+    modulus_relaxed_pa: float | None = None
+    modulus_relaxed_sigma_pa: float | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """Plain data (JSON): every field, ``None`` for what the record could not give."""
@@ -171,12 +180,47 @@ def released_dent(points: Any, tip_center: Any, tip_radius_m: float
 
 
 def press_behaviour(record: PressRecord | None, *,
-                    released: tuple[float, float] | None = None) -> PressBehaviour:
+                    released: tuple[float, float] | None = None,
+                    modulus: tuple[float, float] | None = None) -> PressBehaviour:
     """The press's relaxation, loss, residual dent and class (module docstring).
 
     ``released`` is the camera's dent after release and its σ [m] (:func:`released_dent`), when
-    one was seen. A record with no hold, no unloading and no camera dent is ``"unknown"``.
+    one was seen; ``modulus`` the Young's modulus the loading ramp gave and its σ [Pa], when it
+    gave one: it is the instantaneous modulus, and with a hold's fraction gives the relaxed one
+    (:func:`relaxed_modulus`). A record with no hold, no unloading and no camera dent is
+    ``"unknown"``.
     """
+    got = _press_behaviour(record, released)
+    if modulus is None:
+        return got
+    e, e_sigma = (float(v) for v in modulus)
+    if not (math.isfinite(e) and e > 0.0 and math.isfinite(e_sigma) and e_sigma >= 0.0):
+        raise InvalidArgumentError(
+            f"`modulus` must be a positive finite modulus and a σ >= 0 [Pa]; got {modulus!r}")
+    relaxed = relaxed_modulus(e, e_sigma, got)
+    return replace(got, modulus_instantaneous_pa=e, modulus_instantaneous_sigma_pa=e_sigma,
+                   modulus_relaxed_pa=None if relaxed is None else relaxed[0],
+                   modulus_relaxed_sigma_pa=None if relaxed is None else relaxed[1])
+
+
+def relaxed_modulus(modulus_pa: float, sigma_pa: float, behaviour: PressBehaviour
+                    ) -> tuple[float, float] | None:
+    """The modulus at the hold's end [Pa] and its σ, from the instantaneous one and the hold's
+    fraction ``f``: position held (``relaxation_mode`` ``"force"``), the force falls with the
+    modulus, ``E∞ = E₀ (1 − f)``; force held (``"travel"``, creep), the travel under a fixed
+    force goes as ``E^(−2/3)`` (Hertz), ``E∞ = E₀ (1 − f)^(3/2)``. σ by linear propagation of
+    both σ. ``None`` without a fraction, or with one of 1 or more."""
+    f, f_sigma = behaviour.relaxation, behaviour.relaxation_sigma
+    if f is None or f_sigma is None or f >= 1.0:
+        return None
+    power = 1.5 if behaviour.relaxation_mode == "travel" else 1.0
+    value = modulus_pa * (1.0 - f) ** power
+    rel = math.hypot(sigma_pa / modulus_pa, power * f_sigma / (1.0 - f))
+    return value, value * rel
+
+
+def _press_behaviour(record: PressRecord | None, released: tuple[float, float] | None
+                     ) -> PressBehaviour:
     if record is not None:
         _check_record(record)
     cam: Measure | None = None
