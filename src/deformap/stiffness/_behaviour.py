@@ -53,6 +53,9 @@ against its floor: the camera's :data:`DENT_FLOOR_M`, the record's :func:`record
 Elastic: every quantity the record holds rules its behaviour out, and the record holds an
 unloading branch or a hold with a camera dent. Anything else is ``"unknown"`` with the reason.
 
+Anisotropy: from the dent's shape in the cloud during the press
+(:mod:`deformap.stiffness._anisotropy`), its own class ``isotropy`` beside ``behaviour``.
+
 Moduli: the loading ramp's E, given by the caller (:mod:`deformap.stiffness`'s estimate), is the
 instantaneous one; the relaxed one follows from it and the hold's fraction
 (:func:`relaxed_modulus`).
@@ -69,6 +72,7 @@ from numpy.typing import NDArray
 
 from deformap._validation import check_points
 from deformap.errors import InvalidArgumentError
+from deformap.stiffness._anisotropy import Anisotropy, Isotropy
 from deformap.stiffness._phases import (
     MAD_TO_SIGMA,
     MIN_FIT_SAMPLES,
@@ -126,8 +130,13 @@ class PressBehaviour:
     ``residual_dent_m`` the unloading's travel at zero force [m]; ``released_dent_m`` the dent the
     camera sees after release [m]. ``modulus_instantaneous_pa`` is the loading ramp's Young's
     modulus (the modulus at the press's speed, given to :func:`press_behaviour`),
-    ``modulus_relaxed_pa`` the modulus at the hold's end (:func:`relaxed_modulus`). ``behaviour`` is
-    the class and ``evidence`` the tests that gave it, or why it is ``"unknown"``.
+    ``modulus_relaxed_pa`` the modulus at the hold's end (:func:`relaxed_modulus`).
+    ``anisotropy_ratio`` is the in-plane stiff-over-soft ratio the dent's shape shows,
+    ``anisotropy_axis_deg`` its stiff axis [degrees from x, in (−90, 90]], and ``isotropy``
+    (``"isotropic"``, ``"anisotropic"``, ``"unknown"``) their class
+    (:func:`~deformap.stiffness._anisotropy.dent_anisotropy`); ``None`` where no cloud during the
+    press was read. ``behaviour`` is the class and ``evidence`` the tests that gave it, or why it
+    is ``"unknown"``.
     """
 
     behaviour: Behaviour
@@ -147,6 +156,11 @@ class PressBehaviour:
     modulus_instantaneous_sigma_pa: float | None = None
     modulus_relaxed_pa: float | None = None
     modulus_relaxed_sigma_pa: float | None = None
+    isotropy: Isotropy | None = None
+    anisotropy_ratio: float | None = None
+    anisotropy_ratio_sigma: float | None = None
+    anisotropy_axis_deg: float | None = None
+    anisotropy_axis_sigma_deg: float | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """Plain data (JSON): every field, ``None`` for what the record could not give."""
@@ -181,16 +195,26 @@ def released_dent(points: Any, tip_center: Any, tip_radius_m: float
 
 def press_behaviour(record: PressRecord | None, *,
                     released: tuple[float, float] | None = None,
-                    modulus: tuple[float, float] | None = None) -> PressBehaviour:
+                    modulus: tuple[float, float] | None = None,
+                    anisotropy: Anisotropy | str | None = None) -> PressBehaviour:
     """The press's relaxation, loss, residual dent and class (module docstring).
 
     ``released`` is the camera's dent after release and its σ [m] (:func:`released_dent`), when
     one was seen; ``modulus`` the Young's modulus the loading ramp gave and its σ [Pa], when it
     gave one: it is the instantaneous modulus, and with a hold's fraction gives the relaxed one
-    (:func:`relaxed_modulus`). A record with no hold, no unloading and no camera dent is
-    ``"unknown"``.
+    (:func:`relaxed_modulus`); ``anisotropy`` what the dent's shape during the press shows
+    (:func:`~deformap.stiffness._anisotropy.dent_anisotropy`), or why it showed nothing (joins
+    the evidence). A record with no hold, no unloading and no camera dent is ``"unknown"``.
     """
     got = _press_behaviour(record, released)
+    if isinstance(anisotropy, str):
+        got = replace(got, evidence=f"{got.evidence}; {anisotropy}")
+    elif anisotropy is not None:
+        got = replace(got, evidence=f"{got.evidence}; {anisotropy.evidence}",
+                      isotropy=anisotropy.isotropy, anisotropy_ratio=anisotropy.ratio,
+                      anisotropy_ratio_sigma=anisotropy.ratio_sigma,
+                      anisotropy_axis_deg=anisotropy.axis_deg,
+                      anisotropy_axis_sigma_deg=anisotropy.axis_sigma_deg)
     if modulus is None:
         return got
     e, e_sigma = (float(v) for v in modulus)
