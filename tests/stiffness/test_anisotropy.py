@@ -70,3 +70,11 @@ def test_too_few_points_or_a_flat_surface_say_why_and_bad_input_is_refused() -> 
         dent_anisotropy(flat, TIP, -1.0)
     with pytest.raises(InvalidArgumentError):
         dent_anisotropy(np.full((100, 3), np.nan), TIP, R)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_a_surface_of_noise_gives_a_reason_or_a_class_never_an_error(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    pts = np.column_stack([rng.uniform(0.23, 0.37, (400, 2)), rng.uniform(0.0, 0.1, 400)])
+    got = dent_anisotropy(pts, TIP, R)
+    assert isinstance(got, str) or got.isotropy in ("isotropic", "anisotropic", "unknown")

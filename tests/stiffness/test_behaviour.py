@@ -303,11 +303,13 @@ def test_a_camera_too_coarse_to_rule_out_a_dent_does_not_veto_the_record() -> No
 
 
 def test_a_hold_where_neither_moves_is_read_as_a_held_force() -> None:
-    # the force scatters more than the travel but neither trends: the robot holds the force
+    # the force scatters without a trend and the travel barely moves: neither trends beyond its
+    # noise, so the robot is taken to hold the force (and the travel to be what would creep)
     rng = np.random.default_rng(8)
     n = 12
     hold = PressPhase(time_s=1.0 + 0.25 * np.arange(1, n + 1),
-                      travel_m=DEPTH + rng.normal(0, ST, n), force_n=1.0 + rng.normal(0, 0.02, n))
+                      travel_m=DEPTH + rng.normal(0, ST / 4, n),
+                      force_n=1.0 + rng.normal(0, 0.02, n))
     got = press_behaviour(_record(hold=hold, unloading=_unloading(rng, 0.0, 4.5)))
     assert got.relaxation_mode == "travel"
     assert got.tau_s is None and "moves within its noise" in got.evidence

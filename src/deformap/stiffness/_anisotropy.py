@@ -67,15 +67,20 @@ def _model(p: NDArray[np.float64], q: NDArray[np.float64]) -> NDArray[np.float64
     c, s = math.cos(theta), math.sin(theta)
     u = c * q[:, 0] + s * q[:, 1]
     v = -s * q[:, 0] + c * q[:, 1]
-    rho = np.sqrt((u / math.exp(l1)) ** 2 + (v / math.exp(l2)) ** 2)
+    rho = np.sqrt((u / np.exp(l1)) ** 2 + (v / np.exp(l2)) ** 2)
     return np.asarray(z0 - amplitude * np.exp(-rho))
 
 
-def _fit(q: NDArray[np.float64], z: NDArray[np.float64], start: NDArray[np.float64]
-         ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]] | None:
+def _fit(q: NDArray[np.float64], z: NDArray[np.float64], start: NDArray[np.float64],
+         radius: float) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]] | None:
+    # lengths from a tenth of the tip's radius to the fitted window's ten times over
+    low, high = math.log(0.1 * radius), math.log(10.0 * _OUTER_RADII * radius)
+    bounds = ([-np.inf, 0.0, low, low, -np.inf], [np.inf, np.inf, high, high, np.inf])
+    start = np.clip(start, [-np.inf, 0.0, low, low, -np.inf], [np.inf, np.inf, high, high, np.inf])
     try:
-        fit = least_squares(lambda p: _model(p, q) - z, start, method="lm")
-    except (ValueError, np.linalg.LinAlgError):
+        with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
+            fit = least_squares(lambda p: _model(p, q) - z, start, bounds=bounds, method="trf")
+    except (ValueError, np.linalg.LinAlgError, OverflowError, FloatingPointError):
         return None
     if not fit.success or not np.all(np.isfinite(fit.x)):
         return None
@@ -110,13 +115,13 @@ def dent_anisotropy(points: Any, tip_center: Any, tip_radius_m: float) -> Anisot
     z_far = float(np.median(z[far])) if far.any() else float(np.max(z))
     start = np.array([z_far, max(z_far - float(np.min(z)), 1e-4),
                       math.log(tip_radius_m), math.log(tip_radius_m), 0.3])
-    got = _fit(q, z, start)
+    got = _fit(q, z, start, tip_radius_m)
     if got is not None:
         resid = got[2]
         scale = MAD_TO_SIGMA * float(np.median(np.abs(resid - np.median(resid))))
         keep = np.abs(resid) <= CLIP_SIGMAS * max(scale, 1e-12)
         if int(keep.sum()) >= _MIN_POINTS:
-            got = _fit(q[keep], z[keep], got[0])
+            got = _fit(q[keep], z[keep], got[0], tip_radius_m)
     if got is None:
         return "the dent's shape fit did not converge"
     p, cov, _ = got

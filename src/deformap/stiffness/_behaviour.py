@@ -11,17 +11,18 @@ itself, ``1.4826 · MAD(Δ²x) / √6`` of the second differences within each st
 unloading) pooled, which a smooth trend barely touches.
 
 Hold: the ramp's last sample (where the commanded force is reached) starts it. Straight lines
-through the force and the travel of the whole stretch (least squares, the larger of the pooled and
-the hold's own noise: a force sensor's grows with the load) say which moves: the held quantity is
-the one whose line changes less in units of its σ; when neither changes by :data:`N_SIGMA` of its σ
-the force is taken as held (docs/robot.md: the press holds the commanded force under force
-control) and the travel is what would creep. The moving one is fitted, least squares, with
-``y(t) = y∞ + A e^{−(t−t₀)/τ}`` (``t₀`` the stretch's first sample, ``log τ`` the parameter). Force
-moving (position held): the relaxation fraction is ``1 − F(t_end)/F(t₀)``; travel moving (force
-held): the creep fraction ``1 − t(t₀)/t(t_end)``, both from the fitted curve, their σ by the delta
-method on the fit's covariance ``s² (JᵀJ)⁻¹``; ``τ`` and its σ from the same covariance. A stretch
-that moves within its noise, one of fewer than :data:`MIN_FIT_SAMPLES` samples, or one whose fit
-does not converge gives the fraction between the ends of its straight line and no ``τ``.
+through the force and the travel of the whole stretch (least squares; for the force the larger of
+the pooled and the hold's own noise, as a force sensor's grows with the load) say which moves: the
+held quantity is the one whose line changes less in units of its σ; when neither changes by
+:data:`N_SIGMA` of its σ the force is taken as held (docs/robot.md: the press holds the commanded
+force under force control) and the travel is what would creep. The moving one is fitted, least
+squares, with ``y(t) = y∞ + A e^{−(t−t₀)/τ}`` (``t₀`` the stretch's first sample, ``log τ`` the
+parameter). Force moving (position held): the relaxation fraction is ``1 − F(t_end)/F(t₀)``; travel
+moving (force held): the creep fraction ``1 − t(t₀)/t(t_end)``, both from the fitted curve, their σ
+by the delta method on the fit's covariance ``s² (JᵀJ)⁻¹``; ``τ`` and its σ from the same
+covariance. A stretch that moves within its noise, one of fewer than :data:`MIN_FIT_SAMPLES`
+samples, or one whose fit does not converge gives the fraction between the ends of its straight
+line and no ``τ``.
 
 Loss ratio: the path ramp → hold → unloading, ``L = ∮ F dδ`` (trapezoids; the return from the
 unloading's last travel to zero at zero force adds nothing) over the work put in before

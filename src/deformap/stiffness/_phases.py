@@ -120,7 +120,6 @@ def hold_travel(hold: _Phase, sigma_t: float) -> Measure:
     """The travel the hold added, end less start of a straight line through its samples."""
     t = np.asarray(hold.time_s - hold.time_s[0])
     travel = np.asarray(hold.travel_m)
-    sigma_t = max(sigma_t, noise([travel]))
     a, b, cov = _line(t, travel, sigma_t)
     return Measure(b - a, math.sqrt(max(cov[0, 0] + cov[1, 1] - 2.0 * cov[0, 1], 0.0)))
 
@@ -131,8 +130,8 @@ def hold_fraction(hold: _Phase, sigma_f: float, sigma_t: float
     t = np.asarray(hold.time_s - hold.time_s[0])
     force, travel = np.asarray(hold.force_n), np.asarray(hold.travel_m)
     # a force sensor's noise grows with the load: the hold's own, when larger than the pooled
+    # (the encoders' does not: the travel's stays pooled)
     sigma_f = max(sigma_f, noise([force]))
-    sigma_t = max(sigma_t, noise([travel]))
     lines = {"force": _line(t, force, sigma_f), "travel": _line(t, travel, sigma_t)}
 
     def z(name: str) -> float:
