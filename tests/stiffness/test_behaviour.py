@@ -266,9 +266,14 @@ def test_a_poke_record_keeps_its_behaviour_through_the_journal() -> None:
     from deformap.errors import FileFormatError
     from deformap.explore import ContactRecord, PokeRecord, PokeTimings
     from deformap.mechanics import TactileContact
+    from deformap.stiffness._anisotropy import Anisotropy
 
+    shape = Anisotropy(ratio=2.0, ratio_sigma=0.1, axis_deg=30.0, axis_sigma_deg=2.0,
+                       isotropy="anisotropic", evidence="the dent reaches farther one way")
     behaviour = press_behaviour(_record(hold=_relaxing_hold(np.random.default_rng(0), 0.3, 2.0),
-                                        unloading=0.0005))
+                                        unloading=0.0005), modulus=(5e4, 1e3), anisotropy=shape)
+    assert behaviour.isotropy == "anisotropic" and behaviour.anisotropy_axis_deg == 30.0
+    assert behaviour.modulus_relaxed_pa is not None
     record = PokeRecord(
         index=0, target_xy=(0.3, 0.2), contact_xy=(0.3, 0.2),
         contact=ContactRecord.of(TactileContact(tip_center=[0.3, 0.2, 0.05], force=[0, 0, -1.0],
@@ -285,6 +290,7 @@ def test_a_poke_record_keeps_its_behaviour_through_the_journal() -> None:
     for key, bad, message in (("behaviour", "elastic-ish", "`poke.behaviour.behaviour` must be"),
                               ("relaxation", "0.3", "`poke.behaviour.relaxation` must be a"),
                               ("relaxation_mode", "time", "`poke.behaviour.relaxation_mode`"),
+                              ("isotropy", "round", "`poke.behaviour.isotropy`"),
                               ("colour", 1, "unknown key")):
         broken = {**data, "behaviour": {**data["behaviour"], key: bad}}
         with pytest.raises(FileFormatError, match=message):
