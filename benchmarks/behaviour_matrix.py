@@ -29,6 +29,7 @@ import numpy as np
 import yaml
 
 from deformap.explore import poke_behaviour
+from deformap.stiffness import estimate_stiffness
 from deformap.world import SimulatedWorld, WorldConfig, camera_preset, load_scenario
 
 ANISOTROPIC = [((0.1, 0.2), 1.0, None), ((0.1, 0.1), 1.0, None), ((0.3, 0.2), 1.5, 30.0),
@@ -114,6 +115,7 @@ def main() -> None:
     args = parser.parse_args()
     counts: Counter[tuple[str, str]] = Counter()
     dent_errors: dict[str, list[float]] = {"elastic": [], "viscoelastic": [], "plastic": []}
+    moduli: dict[str, list[tuple[float, float]]] = {"elastic": [], "viscoelastic": [], "plastic": []}
     with tempfile.TemporaryDirectory() as tmp:
         for c, camera in enumerate(args.cameras):
             for thickness in args.thickness:
@@ -125,8 +127,24 @@ def main() -> None:
                                        rng=np.random.default_rng([1, c]))
                 row = []
                 for xy, truth in PRESSES:
-                    got = poke_behaviour(world.press(xy, args.force))
+                    obs = world.press(xy, args.force)
+                    record = obs.force_travel
+                    assert record is not None
+                    stiffness = estimate_stiffness(record.travel_m, record.force_n,
+                                                   tip_radius_m=obs.contact.tip_radius_m,
+                                                   thickness_m=thickness,
+                                                   commanded_force_n=obs.force_n)
+                    got = poke_behaviour(obs, stiffness)
                     read = got.behaviour
+                    if got.modulus_instantaneous_pa and got.modulus_relaxed_pa and record.hold:
+                        # the world's modulus, and its relaxed value at the hold's end
+                        e0 = float(world.ground_truth_modulus(*np.array(xy)[:, None])[0, 0])
+                        block = world.scenario.blocks[int(world.ground_truth_labels(
+                            *np.array(xy)[:, None])[0, 0])]
+                        late = (1.0 if block.viscoelastic is None else
+                                float(block.viscoelastic.relaxation(float(record.hold.time_s[-1]))))
+                        moduli[truth].append((got.modulus_instantaneous_pa / e0,
+                                              got.modulus_relaxed_pa / (e0 * late)))
                     world.release()
                     kept = -float(np.min(world.released_displacement(0.0)[:, 2]))
                     if got.residual_dent_m is not None:
@@ -144,6 +162,11 @@ def main() -> None:
         if errors:
             print(f"{truth}: residual dent error median {np.median(errors) * 1e3:.2f} mm, "
                   f"largest {np.max(errors) * 1e3:.2f} mm ({len(errors)} presses)")
+    for truth, pairs in moduli.items():
+        if pairs:
+            inst, relaxed = np.median(np.array(pairs), axis=0)
+            print(f"{truth}: median E_instantaneous / E₀ {inst:.2f}, E_relaxed / E(hold's end) "
+                  f"{relaxed:.2f} ({len(pairs)} presses)")
     if not args.no_anisotropy:
         print()
         with tempfile.TemporaryDirectory() as tmp:
