@@ -28,7 +28,7 @@ from deformap.stiffness import (
     press_behaviour,
     released_dent,
 )
-from deformap.stiffness._anisotropy import dent_anisotropy
+from deformap.stiffness._anisotropy import ANISOTROPY_WINDOW_RADII, dent_anisotropy
 
 __all__ = ["PURPOSES", "ContactRecord", "Dent", "PokeRecord", "PokeResult", "PokeTimings", "Purpose",
            "Target", "poke_behaviour"]
@@ -286,6 +286,10 @@ def poke_behaviour(obs: PressObservation, stiffness: StiffnessEstimate | None = 
         modulus = (float(stiffness.modulus_pa), float(stiffness.modulus_std_pa or 0.0))
     contact = obs.contact
     pts = obs.cloud.points
+    # the window the dent's shape is read in (the probe's points tested only there)
+    near = (np.linalg.norm(pts[:, :2] - contact.tip_center[:2], axis=1)
+            <= ANISOTROPY_WINDOW_RADII * contact.tip_radius_m)
+    pts = pts[near]
     probe = points_in_hull(pts, obs.robot_points, tolerance_m=_PROBE_MARGIN_M)
     probe |= np.linalg.norm(pts - contact.tip_center, axis=1) < contact.tip_radius_m + _PROBE_MARGIN_M
     shape = dent_anisotropy(pts[~probe], contact.tip_center, contact.tip_radius_m)

@@ -34,7 +34,8 @@ from deformap._validation import check_points
 from deformap.errors import InvalidArgumentError
 from deformap.stiffness._phases import MAD_TO_SIGMA, N_SIGMA
 
-__all__ = ["ANISOTROPY_FLOOR", "CLIP_SIGMAS", "Anisotropy", "Isotropy", "dent_anisotropy"]
+__all__ = ["ANISOTROPY_FLOOR", "ANISOTROPY_WINDOW_RADII", "CLIP_SIGMAS", "Anisotropy", "Isotropy",
+           "dent_anisotropy"]
 
 Isotropy = Literal["isotropic", "anisotropic", "unknown"]
 
@@ -45,7 +46,9 @@ ANISOTROPY_FLOOR = 1.2
 #: Residuals beyond this many robust σ of the first fit (flying pixels, the probe's edge) are
 #: dropped before the second.
 CLIP_SIGMAS = 4.0
-_INNER_RADII, _OUTER_RADII = 1.2, 6.0
+#: The dent's shape is read this many tip radii around the tip, and from 1.2 of them out.
+ANISOTROPY_WINDOW_RADII = 6.0
+_INNER_RADII, _OUTER_RADII = 1.2, ANISOTROPY_WINDOW_RADII
 _MIN_POINTS = 50
 
 
