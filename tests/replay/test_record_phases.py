@@ -216,11 +216,20 @@ def test_the_map_of_a_phased_session_says_each_pokes_behaviour(tmp_path, synthet
     # the first: a hold that relaxes 11 % in 2 s with an unloading; the camera sees its dent
     assert first["behaviour"] == "viscoelastic" and first["relaxation"] > 0.05
     assert first["loss_ratio"] is not None and first["released_dent_m"] is not None
-    assert second["behaviour"] == "unknown" and second["evidence"] == "no force–travel record"
-    assert third == {**third, "behaviour": "unknown", "evidence": "no hold or unloading recorded"}
+    # (the dent's shape during the press, read or why not, follows in the evidence)
+    assert second["behaviour"] == "unknown"
+    assert second["evidence"].startswith("no force–travel record")
+    assert third["behaviour"] == "unknown"
+    assert third["evidence"].startswith("no hold or unloading recorded")
     assert [r["behaviour"] for r in rows] == ["viscoelastic", "unknown", "unknown"]
     assert float(rows[0]["relaxation"]) == pytest.approx(first["relaxation"])
     assert rows[1]["relaxation"] == "" and rows[2]["loss_ratio"] == ""
+    # the ramp's modulus is the instantaneous one; the hold's relaxation gives the relaxed one
+    e0, e1 = first["modulus_instantaneous_pa"], first["modulus_relaxed_pa"]
+    assert e0 == pytest.approx(pokes[0]["stiffness"]["modulus_pa"])
+    assert e1 == pytest.approx(e0 * (1.0 - first["relaxation"]) ** (
+        1.5 if first["relaxation_mode"] == "travel" else 1.0))
+    assert float(rows[0]["modulus_relaxed_pa"]) == pytest.approx(e1)
 
 
 def _ramp_only(obs: PressObservation) -> PressObservation:

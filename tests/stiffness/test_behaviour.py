@@ -19,13 +19,13 @@ SF, ST = 0.004, 2e-5  # force and travel noise
 
 def _ramp(rng: np.random.Generator, n: int = 30) -> tuple[np.ndarray, ...]:
     travel = np.linspace(0.0, DEPTH, n)
-    force = K * travel**1.5 + 0.02
+    force = K * travel**1.5
     return (np.abs(travel + rng.normal(0, ST, n)) * (np.arange(n) > 0),
-            force + rng.normal(0, SF, n), np.linspace(0.0, 1.0, n))
+            np.maximum(force + rng.normal(0, SF, n), 0.0), np.linspace(0.0, 1.0, n))
 
 
 def _unloading(rng: np.random.Generator, residual_m: float, start_s: float, n: int = 30,
-               stop_n: float = 0.0, top_n: float = 1.02) -> PressPhase:
+               stop_n: float = 0.0, top_n: float = 1.0) -> PressPhase:
     """Hertz unloading from ``top_n`` to ``stop_n`` newtons that leaves ``residual_m``."""
     k = top_n / (DEPTH - residual_m) ** 1.5
     force = np.linspace(top_n, stop_n, n)
@@ -37,13 +37,14 @@ def _unloading(rng: np.random.Generator, residual_m: float, start_s: float, n: i
 
 def _relaxing_hold(rng: np.random.Generator, fraction: float, tau_s: float, n: int = 50,
                    span_s: float = 10.0, creep: bool = False) -> PressPhase:
-    t = np.linspace(0.0, span_s, n)
+    # the material relaxes from the ramp's end (t = 0, its last sample); the hold's samples follow
+    t = np.linspace(0.05, span_s, n)
     shape = 1.0 - fraction * (1.0 - np.exp(-t / tau_s))
     if creep:  # force held, travel grows: t_start / t(t) = shape
-        travel, force = DEPTH / shape, np.full(n, 1.02)
+        travel, force = DEPTH / shape, np.full(n, 1.0)
     else:
-        travel, force = np.full(n, DEPTH), 1.02 * shape
-    return PressPhase(time_s=1.05 + t, travel_m=travel + rng.normal(0, ST, n),
+        travel, force = np.full(n, DEPTH), 1.0 * shape
+    return PressPhase(time_s=1.0 + t, travel_m=travel + rng.normal(0, ST, n),
                       force_n=force + rng.normal(0, SF, n))
 
 
@@ -94,10 +95,10 @@ def test_the_relaxation_sigma_covers_the_truth_over_seeds() -> None:
 
 @pytest.mark.parametrize("residual_m", [0.0005, 0.001, 0.002])
 def test_a_hysteresis_loop_gives_its_known_loss(residual_m: float) -> None:
-    # loading W = K δm^2.5 / 2.5 (+ 0.02 N offset); returned W' = F_m (δm − δr) / 2.5
+    # loading W = K δm^2.5 / 2.5; returned W' = F_m (δm − δr) / 2.5
     got = press_behaviour(_record(unloading=residual_m))
-    w_in = K * DEPTH**2.5 / 2.5 + 0.02 * DEPTH
-    w_back = 1.02 * (DEPTH - residual_m) / 2.5
+    w_in = K * DEPTH**2.5 / 2.5
+    w_back = 1.0 * (DEPTH - residual_m) / 2.5
     true = 1.0 - w_back / w_in
     assert got.loss_ratio is not None and got.loss_ratio_sigma is not None
     assert abs(got.loss_ratio - true) < max(3 * got.loss_ratio_sigma, 0.01)
@@ -155,10 +156,11 @@ def test_a_ramp_only_or_no_record_is_unknown_never_elastic(record: str | None) -
 
 def test_a_short_hold_gives_a_fraction_but_no_time_constant() -> None:
     rng = np.random.default_rng(0)
-    hold = PressPhase(time_s=[1.1, 2.0, 3.0], travel_m=[DEPTH] * 3, force_n=[1.02, 0.8, 0.7])
+    # two samples after the ramp's last: three in all, too few for the exponential
+    hold = PressPhase(time_s=[2.0, 3.0], travel_m=[DEPTH] * 2, force_n=[0.8, 0.7])
     got = press_behaviour(_record(hold=hold, unloading=_unloading(rng, 0.0, 3.0, top_n=0.7)))
     assert got.tau_s is None and "needs 4" in got.evidence
-    assert got.relaxation is not None and abs(got.relaxation - (1 - 0.7 / 1.02)) < 0.01
+    assert got.relaxation is not None and abs(got.relaxation - (1 - 0.7 / 1.0)) < 0.01
     assert got.behaviour == "viscoelastic"
 
 
@@ -171,14 +173,19 @@ def test_a_noisy_hold_neither_shows_nor_rules_out_relaxation() -> None:
     assert got.behaviour == "unknown", got.evidence
 
 
-def test_an_unloading_that_reaches_zero_force_reads_the_travel_where_contact_is_lost() -> None:
-    # after the force first reaches zero the tip retracts off the surface: its travel there is
-    # the tip's, not the dent's
-    unload = PressPhase(time_s=[1.1, 1.2, 1.3, 1.4], travel_m=[DEPTH, 0.003, 0.002, 0.0],
-                        force_n=[1.0, 0.4, 0.0, 0.0])
-    got = press_behaviour(_record(unloading=unload))
-    assert got.residual_dent_m == pytest.approx(0.002)
-    assert got.residual_dent_sigma_m is not None and got.residual_dent_sigma_m < 1e-4
+def test_the_samples_after_contact_is_lost_do_not_move_the_dent() -> None:
+    # after the force reaches zero the tip retracts off the surface: its travel there is the
+    # tip's, not the dent's
+    unload = _unloading(np.random.default_rng(5), 0.001, 1.0)
+    tail = PressPhase(time_s=np.concatenate([unload.time_s, 2.0 + 0.1 * np.arange(1, 6)]),
+                      travel_m=np.concatenate([unload.travel_m, 0.001 - 4e-4 * np.arange(1, 6)]),
+                      force_n=np.concatenate([unload.force_n, np.zeros(5)]))
+    plain = press_behaviour(_record(unloading=unload))
+    got = press_behaviour(_record(unloading=tail))
+    # the same reading (the pooled noise estimate alone moves with the extra samples)
+    assert got.residual_dent_m is not None and plain.residual_dent_m is not None
+    assert got.residual_dent_m == pytest.approx(plain.residual_dent_m, abs=2e-6)
+    assert abs(got.residual_dent_m - 0.001) < 1e-4
 
 
 def _dented(depth_m: float, n: int = 12000, noise_m: float = 3e-4) -> PointCloud:
@@ -259,9 +266,14 @@ def test_a_poke_record_keeps_its_behaviour_through_the_journal() -> None:
     from deformap.errors import FileFormatError
     from deformap.explore import ContactRecord, PokeRecord, PokeTimings
     from deformap.mechanics import TactileContact
+    from deformap.stiffness._anisotropy import Anisotropy
 
+    shape = Anisotropy(ratio=2.0, ratio_sigma=0.1, axis_deg=30.0, axis_sigma_deg=2.0,
+                       isotropy="anisotropic", evidence="the dent reaches farther one way")
     behaviour = press_behaviour(_record(hold=_relaxing_hold(np.random.default_rng(0), 0.3, 2.0),
-                                        unloading=0.0005))
+                                        unloading=0.0005), modulus=(5e4, 1e3), anisotropy=shape)
+    assert behaviour.isotropy == "anisotropic" and behaviour.anisotropy_axis_deg == 30.0
+    assert behaviour.modulus_relaxed_pa is not None
     record = PokeRecord(
         index=0, target_xy=(0.3, 0.2), contact_xy=(0.3, 0.2),
         contact=ContactRecord.of(TactileContact(tip_center=[0.3, 0.2, 0.05], force=[0, 0, -1.0],
@@ -278,6 +290,7 @@ def test_a_poke_record_keeps_its_behaviour_through_the_journal() -> None:
     for key, bad, message in (("behaviour", "elastic-ish", "`poke.behaviour.behaviour` must be"),
                               ("relaxation", "0.3", "`poke.behaviour.relaxation` must be a"),
                               ("relaxation_mode", "time", "`poke.behaviour.relaxation_mode`"),
+                              ("isotropy", "round", "`poke.behaviour.isotropy`"),
                               ("colour", 1, "unknown key")):
         broken = {**data, "behaviour": {**data["behaviour"], key: bad}}
         with pytest.raises(FileFormatError, match=message):
@@ -293,3 +306,63 @@ def test_a_camera_too_coarse_to_rule_out_a_dent_does_not_veto_the_record() -> No
     assert got.behaviour == "elastic", got.evidence
     # a camera that shows a dent is heard
     assert press_behaviour(record, released=(2e-3, 1e-4)).behaviour != "elastic"
+
+
+def test_a_hold_where_neither_moves_is_read_as_a_held_force() -> None:
+    # the force scatters without a trend and the travel barely moves: neither trends beyond its
+    # noise, so the robot is taken to hold the force (and the travel to be what would creep)
+    rng = np.random.default_rng(8)
+    n = 12
+    hold = PressPhase(time_s=1.0 + 0.25 * np.arange(1, n + 1),
+                      travel_m=DEPTH + rng.normal(0, ST / 4, n),
+                      force_n=1.0 + rng.normal(0, 0.02, n))
+    got = press_behaviour(_record(hold=hold, unloading=_unloading(rng, 0.0, 4.5)))
+    assert got.relaxation_mode == "travel"
+    assert got.tau_s is None and "moves within its noise" in got.evidence
+    assert got.behaviour != "viscoelastic", got.evidence
+
+
+def test_the_record_dent_floor_is_what_a_drifting_sensor_zero_moves() -> None:
+    from deformap.stiffness._behaviour import (
+        DENT_FLOOR_M,
+        RELAXATION_FLOOR,
+        record_dent_floor,
+    )
+    record = _record(hold=True)
+    largest = max(float(record.travel_m.max()), float(record.hold.travel_m.max()))
+    assert record_dent_floor(record) == pytest.approx(RELAXATION_FLOOR ** (2 / 3) * largest)
+    shallow = ForceTravel(travel_m=[0.0, 1e-4, 2e-4], force_n=[0.0, 0.5, 1.0])
+    assert record_dent_floor(shallow) == DENT_FLOOR_M
+
+
+def test_a_branch_off_the_contact_law_widens_the_dent_sigma() -> None:
+    rng = np.random.default_rng(6)
+    clean = _unloading(rng, 0.001, 1.0)
+    wavy = PressPhase(time_s=clean.time_s, force_n=clean.force_n,
+                      travel_m=clean.travel_m + 3e-4 * np.sin(np.linspace(0, 9, len(clean))))
+    a = press_behaviour(_record(unloading=clean))
+    b = press_behaviour(_record(unloading=wavy))
+    assert a.residual_dent_sigma_m is not None and b.residual_dent_sigma_m is not None
+    assert b.residual_dent_sigma_m > 4 * a.residual_dent_sigma_m
+
+
+@pytest.mark.parametrize("creep", [False, True])
+def test_the_relaxed_modulus_follows_from_the_instantaneous_and_the_hold(creep: bool) -> None:
+    hold = _relaxing_hold(np.random.default_rng(2), 0.3, 1.0, creep=creep)
+    got = press_behaviour(_record(hold=hold, unloading=0.0), modulus=(50e3, 2e3))
+    assert got.modulus_instantaneous_pa == 50e3 and got.modulus_instantaneous_sigma_pa == 2e3
+    assert got.relaxation is not None and got.modulus_relaxed_pa is not None
+    # position held: the force (so E) falls by the fraction, 0.3 (1 − e^{-10}); force held: the
+    # travel grows by 1 / (1 − 0.3) and as E^(-2/3) (Hertz), so E falls to 0.7^(3/2)
+    assert got.modulus_relaxed_pa / 50e3 == pytest.approx(0.7**1.5 if creep else 0.7, abs=0.03)
+    assert got.modulus_relaxed_sigma_pa is not None
+    assert 2e3 * 0.5 <= got.modulus_relaxed_sigma_pa < 0.1 * got.modulus_relaxed_pa
+    assert got.to_dict()["modulus_relaxed_pa"] == got.modulus_relaxed_pa
+
+
+def test_a_modulus_without_a_hold_is_only_the_instantaneous_and_a_bad_one_is_refused() -> None:
+    got = press_behaviour(_record(unloading=0.0), modulus=(50e3, 2e3))
+    assert got.modulus_instantaneous_pa == 50e3 and got.modulus_relaxed_pa is None
+    for bad in [(0.0, 1.0), (float("nan"), 1.0), (5e4, -1.0)]:
+        with pytest.raises(InvalidArgumentError, match="`modulus`"):
+            press_behaviour(_record(unloading=0.0), modulus=bad)

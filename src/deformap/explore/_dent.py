@@ -223,7 +223,7 @@ def measure_press(obs: PressObservation, index: int, surface: SurfaceModel,
                             stiffness_s=None if obs.force_travel is None else t_stiff),
         stiffness=stiffness, layer_thickness_m=thickness, stiffness_error=stiffness_error,
         indentation_m=depth, depth_anchored=anchored_noise is not None, dent_visible=visible,
-        behaviour=poke_behaviour(obs),
+        behaviour=poke_behaviour(obs, stiffness),
     )
     dent = Dent(roi_xs, roi_ys, rest_z, deformed_z, roi, tactile, obs.force_travel,
                 _force_fit(obs, stiffness, thickness, config))

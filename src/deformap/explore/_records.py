@@ -15,6 +15,7 @@ from typing import Any, Literal, get_args
 import numpy as np
 from numpy.typing import NDArray
 
+from deformap.cloud import points_in_hull
 from deformap.environment import ForceTravel, PressObservation, TactileContact
 from deformap.errors import FileFormatError, InvalidArgumentError
 from deformap.explore._planning import PokePlan
@@ -27,9 +28,13 @@ from deformap.stiffness import (
     press_behaviour,
     released_dent,
 )
+from deformap.stiffness._anisotropy import ANISOTROPY_WINDOW_RADII, dent_anisotropy
 
 __all__ = ["PURPOSES", "ContactRecord", "Dent", "PokeRecord", "PokeResult", "PokeTimings", "Purpose",
            "Target", "poke_behaviour"]
+
+#: Margin [m] around the probe's hull and tip ball within which cloud points are the probe's.
+_PROBE_MARGIN_M = 0.003
 
 #: Why a place was poked: the first poke, the strategy's (until the variance is under ``T_h``), a
 #: look the appearance prior asks to test, or a boundary poke after it.
@@ -268,17 +273,33 @@ class PokeRecord:
             behaviour=_behaviour_from_dict(data.get("behaviour"), f"{where}.behaviour"))
 
 
-def poke_behaviour(obs: PressObservation) -> PressBehaviour:
+def poke_behaviour(obs: PressObservation, stiffness: StiffnessEstimate | None = None
+                   ) -> PressBehaviour:
     """:func:`~deformap.stiffness.press_behaviour` of a press: its record and, when it has one,
     the dent its cloud after release keeps at the tip (:func:`~deformap.stiffness.released_dent`;
-    why none could be had joins the evidence)."""
+    why none could be had joins the evidence); the anisotropy its cloud during the press shows,
+    the probe's own points (its hull and tip ball with 3 mm) left out; with ``stiffness`` (the
+    record's estimate, not rigid) its modulus as the instantaneous one."""
+    modulus = None
+    if (stiffness is not None and not stiffness.rigid and stiffness.modulus_pa is not None
+            and stiffness.modulus_pa > 0.0):
+        modulus = (float(stiffness.modulus_pa), float(stiffness.modulus_std_pa or 0.0))
+    contact = obs.contact
+    pts = obs.cloud.points
+    # the window the dent's shape is read in (the probe's points tested only there)
+    near = (np.linalg.norm(pts[:, :2] - contact.tip_center[:2], axis=1)
+            <= ANISOTROPY_WINDOW_RADII * contact.tip_radius_m)
+    pts = pts[near]
+    probe = points_in_hull(pts, obs.robot_points, tolerance_m=_PROBE_MARGIN_M)
+    probe |= np.linalg.norm(pts - contact.tip_center, axis=1) < contact.tip_radius_m + _PROBE_MARGIN_M
+    shape = dent_anisotropy(pts[~probe], contact.tip_center, contact.tip_radius_m)
     if obs.released is None:
-        return press_behaviour(obs.force_travel)
-    dent = released_dent(obs.released.points, obs.contact.tip_center, obs.contact.tip_radius_m)
+        return press_behaviour(obs.force_travel, modulus=modulus, anisotropy=shape)
+    dent = released_dent(obs.released.points, contact.tip_center, contact.tip_radius_m)
     if isinstance(dent, str):
-        got = press_behaviour(obs.force_travel)
+        got = press_behaviour(obs.force_travel, modulus=modulus, anisotropy=shape)
         return dataclasses.replace(got, evidence=f"{got.evidence}; {dent}")
-    return press_behaviour(obs.force_travel, released=dent)
+    return press_behaviour(obs.force_travel, released=dent, modulus=modulus, anisotropy=shape)
 
 
 def _behaviour_from_dict(data: Any, where: str) -> PressBehaviour | None:
@@ -287,6 +308,10 @@ def _behaviour_from_dict(data: Any, where: str) -> PressBehaviour | None:
         return None
     data = _mapping(data, where, PressBehaviour)
     kind, mode = data.get("behaviour"), data.get("relaxation_mode")
+    isotropy = data.get("isotropy")
+    if isotropy not in (None, "isotropic", "anisotropic", "unknown"):
+        raise FileFormatError(f"`{where}.isotropy` must be 'isotropic', 'anisotropic', 'unknown' "
+                              f"or null; got {isotropy!r}")  # fmt: skip
     if kind not in BEHAVIOURS:
         raise FileFormatError(f"`{where}.behaviour` must be one of {list(BEHAVIOURS)}; "
                               f"got {kind!r}")  # fmt: skip
@@ -297,8 +322,9 @@ def _behaviour_from_dict(data: Any, where: str) -> PressBehaviour | None:
     if evidence is None:
         raise FileFormatError(f"`{where}` has no `evidence`")
     numbers = {f.name: _number(data, f.name, where, optional=True) for f in fields(PressBehaviour)
-               if f.name not in ("behaviour", "evidence", "relaxation_mode")}
-    return PressBehaviour(behaviour=kind, evidence=evidence, relaxation_mode=mode, **numbers)
+               if f.name not in ("behaviour", "evidence", "relaxation_mode", "isotropy")}
+    return PressBehaviour(behaviour=kind, evidence=evidence, relaxation_mode=mode,
+                          isotropy=isotropy, **numbers)
 
 
 @dataclass(frozen=True, eq=False)

@@ -38,7 +38,7 @@ POKES_CSV_COLUMNS = (
     "force_n", "beta", "beta_std", "stiffness_n_per_m", "stiffness_std_n_per_m", "modulus_pa",
     "modulus_std_pa", "rigid", "region", "behaviour", "relaxation", "relaxation_std", "tau_s",
     "tau_std_s", "loss_ratio", "loss_ratio_std", "residual_dent_m", "residual_dent_std_m",
-    "released_dent_m", "released_dent_std_m",
+    "released_dent_m", "released_dent_std_m", "modulus_instantaneous_pa", "modulus_relaxed_pa",
 )  # fmt: skip
 
 
@@ -89,11 +89,12 @@ def _write_pokes_csv(path: Path, result: ExplorationResult) -> None:
             _cell(s and s.modulus_pa), _cell(s and s.modulus_std_pa),
             "" if s is None else s.rigid,
             "" if r.index not in region_of else region_of[r.index] + 1,
-            *(("",) * 11 if b is None else (
+            *(("",) * 13 if b is None else (
                 b.behaviour, _cell(b.relaxation), _cell(b.relaxation_sigma), _cell(b.tau_s),
                 _cell(b.tau_sigma_s), _cell(b.loss_ratio), _cell(b.loss_ratio_sigma),
                 _cell(b.residual_dent_m), _cell(b.residual_dent_sigma_m),
-                _cell(b.released_dent_m), _cell(b.released_dent_sigma_m))),
+                _cell(b.released_dent_m), _cell(b.released_dent_sigma_m),
+                _cell(b.modulus_instantaneous_pa), _cell(b.modulus_relaxed_pa))),
         ])  # fmt: skip
     write_text_atomically(path, text.getvalue())
 

@@ -10,45 +10,62 @@ Noise: the force's and the travel's sample noise ``σ_F``, ``σ_t`` are estimate
 itself, ``1.4826 · MAD(Δ²x) / √6`` of the second differences within each stretch (ramp, hold,
 unloading) pooled, which a smooth trend barely touches.
 
-Hold: the held quantity is the one that moves less in units of its noise (first and last fifth of
-the hold compared); the other one is fitted, least squares, with ``y(t) = y∞ + A e^{−(t−t₀)/τ}``
-(``t₀`` the hold's first sample, ``log τ`` the parameter). Force moving (position held): the
-relaxation fraction is ``1 − F(t_end)/F(t₀)``; travel moving (force held): the creep fraction
-``1 − t(t₀)/t(t_end)``, both from the fitted curve, their σ by the delta method on the fit's
-covariance ``s² (JᵀJ)⁻¹``; ``τ`` and its σ from the same covariance. A hold of fewer than
-:data:`MIN_FIT_SAMPLES` samples, or one whose fit does not converge, gives the fraction from the
-means of its first and last fifth and no ``τ``.
+Hold: the ramp's last sample (where the commanded force is reached) starts it. Straight lines
+through the force and the travel of the whole stretch (least squares; for the force the larger of
+the pooled and the hold's own noise, as a force sensor's grows with the load) say which moves: the
+held quantity is the one whose line changes less in units of its σ; when neither changes by
+:data:`N_SIGMA` of its σ the force is taken as held (docs/robot.md: the press holds the commanded
+force under force control) and the travel is what would creep. The moving one is fitted, least
+squares, with ``y(t) = y∞ + A e^{−(t−t₀)/τ}`` (``t₀`` the stretch's first sample, ``log τ`` the
+parameter). Force moving (position held): the relaxation fraction is ``1 − F(t_end)/F(t₀)``; travel
+moving (force held): the creep fraction ``1 − t(t₀)/t(t_end)``, both from the fitted curve, their σ
+by the delta method on the fit's covariance ``s² (JᵀJ)⁻¹``; ``τ`` and its σ from the same
+covariance. A stretch that moves within its noise, one of fewer than :data:`MIN_FIT_SAMPLES`
+samples, or one whose fit does not converge gives the fraction between the ends of its straight
+line and no ``τ``.
 
 Loss ratio: the path ramp → hold → unloading, ``L = ∮ F dδ`` (trapezoids; the return from the
 unloading's last travel to zero at zero force adds nothing) over the work put in before
 unloading, ``W = ∫ F dδ`` along ramp and hold. Its σ by linear propagation of ``σ_F``, ``σ_t``
 through both trapezoid sums.
 
-Residual dent: the unloading's travel at zero force. Where the branch reaches zero force (within
-``3 σ_F``), the travel of its first sample there, where the tip loses the surface (later samples
-follow the retracting tip, not the surface), σ = ``σ_t``: no contact law enters. Where it stops
-above zero, extrapolated: on the samples with force between
-``3 σ_F`` and half the branch's largest, the Hertz law ``F ∝ (δ − δ_r)^{3/2}`` is a straight line
-``δ = δ_r + c F^{2/3}``, whose intercept (least squares) is the travel at zero force, σ the
-intercept's with the residual scatter (at least ``σ_t``); a layer stiffening with depth bends that
-line, so the extrapolation is the rougher reading. The camera's dent
-(:func:`released_dent`) is the median height of the surface 3–5 tip radii from the press point
-less the median within one tip radius, σ from both medians' standard errors.
+Residual dent: the unloading's travel at zero force less the loading's, from the gap between the
+two branches at the same force. Each unloading sample within the ramp's range of force (and above
+``N_SIGMA σ_F``) is set against the ramp's travel at its force (interpolated linearly in
+``x = F^{2/3}``). In the contact law's linearised form, ``δ = a + c x`` near zero force (Hertz),
+the loading and the unloading are lines that meet at the top but for the hold's creep ``C``, so
+the gap is ``r (1 − x/x_top) + C x/x_top``, ``x_top`` the unloading's first sample; ``r``, the dent,
+is its weighted least-squares coefficient, ``C`` the travel the hold's straight line adds. A sample's
+variance is ``2 σ_t² + 2 (σ_F dt/dF)²`` (both readings' travel and force noise, the force's through
+the ramp's local slope); ``r``'s σ is the fit's, widened by ``√(χ²/dof)`` when the samples scatter
+more than that (a branch that does not follow the linearised law), plus ``C``'s carried through.
+Every sample of the branch enters, not one near zero force, where the contact law's steepness
+turns the force noise into large travel errors; samples after contact is lost (force below the
+ramp's first) are left out. The camera's dent (:func:`released_dent`) is the median height of
+the surface 3–5 tip radii from the press point less the median within one tip radius, σ from both
+medians' standard errors.
 
 Class: a quantity *shows* a behaviour when it exceeds :data:`N_SIGMA` of its σ and its physical
 floor; it *rules it out* when it lies below the floor by two of its σ. Viscoelastic: the hold
 relaxes or creeps; or, with no hold, the loop has loss but no dent remains. Plastic: a dent
 remains (record or camera) while a hold shows no relaxation; or a loss with a hold that shows
-none. No dent remains when neither dent reading shows one and the sharper of them rules it out.
+none. No dent remains when neither dent reading shows one and one of them rules it out, each
+against its floor: the camera's :data:`DENT_FLOOR_M`, the record's :func:`record_dent_floor`.
 Elastic: every quantity the record holds rules its behaviour out, and the record holds an
 unloading branch or a hold with a camera dent. Anything else is ``"unknown"`` with the reason.
-Anisotropy and the instantaneous against the relaxed modulus are not estimated here.
+
+Anisotropy: from the dent's shape in the cloud during the press
+(:mod:`deformap.stiffness._anisotropy`), its own class ``isotropy`` beside ``behaviour``.
+
+Moduli: the loading ramp's E, given by the caller (:mod:`deformap.stiffness`'s estimate), is the
+instantaneous one; the relaxed one follows from it and the hold's fraction
+(:func:`relaxed_modulus`).
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 from typing import Any, Literal
 
 import numpy as np
@@ -56,6 +73,7 @@ from numpy.typing import NDArray
 
 from deformap._validation import check_points
 from deformap.errors import InvalidArgumentError
+from deformap.stiffness._anisotropy import Anisotropy, Isotropy
 from deformap.stiffness._phases import (
     MAD_TO_SIGMA,
     MIN_FIT_SAMPLES,
@@ -63,6 +81,8 @@ from deformap.stiffness._phases import (
     Measure,
     PressRecord,
     hold_fraction,
+    hold_travel,
+    hold_with_start,
     loop_loss,
     noise,
     zero_force_travel,
@@ -70,7 +90,7 @@ from deformap.stiffness._phases import (
 
 __all__ = ["BEHAVIOURS", "DENT_FLOOR_M", "LOSS_FLOOR", "MIN_FIT_SAMPLES", "N_SIGMA",
            "RELAXATION_FLOOR", "Behaviour", "PressBehaviour", "PressRecord", "press_behaviour",
-           "released_dent"]
+           "record_dent_floor", "relaxed_modulus", "released_dent"]
 
 Behaviour = Literal["elastic", "viscoelastic", "plastic", "unknown"]
 BEHAVIOURS: tuple[str, ...] = ("elastic", "viscoelastic", "plastic", "unknown")
@@ -87,6 +107,19 @@ LOSS_FLOOR = 0.05
 DENT_FLOOR_M = 1e-4
 
 
+def record_dent_floor(record: PressRecord) -> float:
+    """Smallest dent [m] the record's travel at zero force can take as the material's: at least
+    :data:`DENT_FLOOR_M`, and the travel that a force of :data:`RELAXATION_FLOOR` of the press's
+    largest moves the tip on a Hertz contact, ``RELAXATION_FLOOR^(2/3)`` of the largest travel:
+    the force sensor's zero drifting by that much between first contact and release (the drift
+    :data:`RELAXATION_FLOOR` allows) shifts where the force reads zero by up to that travel."""
+    parts = [np.asarray(record.travel_m)]
+    if record.hold is not None:
+        parts.append(np.asarray(record.hold.travel_m))
+    largest = max(float(np.max(p)) for p in parts)
+    return max(DENT_FLOOR_M, RELAXATION_FLOOR ** (2.0 / 3.0) * largest)
+
+
 @dataclass(frozen=True, kw_only=True)
 class PressBehaviour:
     """What one press reveals, each quantity with its standard error (``None`` where the record
@@ -96,8 +129,15 @@ class PressBehaviour:
     with the position held; ``"travel"``: creep ``1 − t_start/t_end`` with the force held), ``tau_s``
     its time constant [s]; ``loss_ratio`` the hysteresis energy over the loading energy;
     ``residual_dent_m`` the unloading's travel at zero force [m]; ``released_dent_m`` the dent the
-    camera sees after release [m]. ``behaviour`` is the class and ``evidence`` the tests that gave
-    it, or why it is ``"unknown"``.
+    camera sees after release [m]. ``modulus_instantaneous_pa`` is the loading ramp's Young's
+    modulus (the modulus at the press's speed, given to :func:`press_behaviour`),
+    ``modulus_relaxed_pa`` the modulus at the hold's end (:func:`relaxed_modulus`).
+    ``anisotropy_ratio`` is the in-plane stiff-over-soft ratio the dent's shape shows,
+    ``anisotropy_axis_deg`` its stiff axis [degrees from x, in (−90, 90]], and ``isotropy``
+    (``"isotropic"``, ``"anisotropic"``, ``"unknown"``) their class
+    (:func:`~deformap.stiffness._anisotropy.dent_anisotropy`); ``None`` where no cloud during the
+    press was read. ``behaviour`` is the class and ``evidence`` the tests that gave it, or why it
+    is ``"unknown"``.
     """
 
     behaviour: Behaviour
@@ -113,6 +153,15 @@ class PressBehaviour:
     residual_dent_sigma_m: float | None = None
     released_dent_m: float | None = None
     released_dent_sigma_m: float | None = None
+    modulus_instantaneous_pa: float | None = None
+    modulus_instantaneous_sigma_pa: float | None = None
+    modulus_relaxed_pa: float | None = None
+    modulus_relaxed_sigma_pa: float | None = None
+    isotropy: Isotropy | None = None
+    anisotropy_ratio: float | None = None
+    anisotropy_ratio_sigma: float | None = None
+    anisotropy_axis_deg: float | None = None
+    anisotropy_axis_sigma_deg: float | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """Plain data (JSON): every field, ``None`` for what the record could not give."""
@@ -146,12 +195,57 @@ def released_dent(points: Any, tip_center: Any, tip_radius_m: float
 
 
 def press_behaviour(record: PressRecord | None, *,
-                    released: tuple[float, float] | None = None) -> PressBehaviour:
+                    released: tuple[float, float] | None = None,
+                    modulus: tuple[float, float] | None = None,
+                    anisotropy: Anisotropy | str | None = None) -> PressBehaviour:
     """The press's relaxation, loss, residual dent and class (module docstring).
 
     ``released`` is the camera's dent after release and its σ [m] (:func:`released_dent`), when
-    one was seen. A record with no hold, no unloading and no camera dent is ``"unknown"``.
+    one was seen; ``modulus`` the Young's modulus the loading ramp gave and its σ [Pa], when it
+    gave one: it is the instantaneous modulus, and with a hold's fraction gives the relaxed one
+    (:func:`relaxed_modulus`); ``anisotropy`` what the dent's shape during the press shows
+    (:func:`~deformap.stiffness._anisotropy.dent_anisotropy`), or why it showed nothing (joins
+    the evidence). A record with no hold, no unloading and no camera dent is ``"unknown"``.
     """
+    got = _press_behaviour(record, released)
+    if isinstance(anisotropy, str):
+        got = replace(got, evidence=f"{got.evidence}; {anisotropy}")
+    elif anisotropy is not None:
+        got = replace(got, evidence=f"{got.evidence}; {anisotropy.evidence}",
+                      isotropy=anisotropy.isotropy, anisotropy_ratio=anisotropy.ratio,
+                      anisotropy_ratio_sigma=anisotropy.ratio_sigma,
+                      anisotropy_axis_deg=anisotropy.axis_deg,
+                      anisotropy_axis_sigma_deg=anisotropy.axis_sigma_deg)
+    if modulus is None:
+        return got
+    e, e_sigma = (float(v) for v in modulus)
+    if not (math.isfinite(e) and e > 0.0 and math.isfinite(e_sigma) and e_sigma >= 0.0):
+        raise InvalidArgumentError(
+            f"`modulus` must be a positive finite modulus and a σ >= 0 [Pa]; got {modulus!r}")
+    relaxed = relaxed_modulus(e, e_sigma, got)
+    return replace(got, modulus_instantaneous_pa=e, modulus_instantaneous_sigma_pa=e_sigma,
+                   modulus_relaxed_pa=None if relaxed is None else relaxed[0],
+                   modulus_relaxed_sigma_pa=None if relaxed is None else relaxed[1])
+
+
+def relaxed_modulus(modulus_pa: float, sigma_pa: float, behaviour: PressBehaviour
+                    ) -> tuple[float, float] | None:
+    """The modulus at the hold's end [Pa] and its σ, from the instantaneous one and the hold's
+    fraction ``f``: position held (``relaxation_mode`` ``"force"``), the force falls with the
+    modulus, ``E∞ = E₀ (1 − f)``; force held (``"travel"``, creep), the travel under a fixed
+    force goes as ``E^(−2/3)`` (Hertz), ``E∞ = E₀ (1 − f)^(3/2)``. σ by linear propagation of
+    both σ. ``None`` without a fraction, or with one of 1 or more."""
+    f, f_sigma = behaviour.relaxation, behaviour.relaxation_sigma
+    if f is None or f_sigma is None or f >= 1.0:
+        return None
+    power = 1.5 if behaviour.relaxation_mode == "travel" else 1.0
+    value = modulus_pa * (1.0 - f) ** power
+    rel = math.hypot(sigma_pa / modulus_pa, power * f_sigma / (1.0 - f))
+    return value, value * rel
+
+
+def _press_behaviour(record: PressRecord | None, released: tuple[float, float] | None
+                     ) -> PressBehaviour:
     if record is not None:
         _check_record(record)
     cam: Measure | None = None
@@ -179,7 +273,7 @@ def press_behaviour(record: PressRecord | None, *,
     relax = tau = None
     mode: str | None = None
     if hold is not None:
-        relax, tau, mode, note = hold_fraction(hold, sigma_f, sigma_t)
+        relax, tau, mode, note = hold_fraction(hold_with_start(record), sigma_f, sigma_t)
         if note:
             notes.append(note)
     loss = dent = None
@@ -189,19 +283,21 @@ def press_behaviour(record: PressRecord | None, *,
             notes.append(got)
         else:
             loss = got
-        res = zero_force_travel(unloading, sigma_f, sigma_t)
+        creep = None if hold is None else hold_travel(hold_with_start(record), sigma_t)
+        res = zero_force_travel(record, sigma_f, sigma_t, creep)
         if isinstance(res, str):
             notes.append(res)
         else:
             dent = res
     return _classify(relax, tau, mode, loss, dent, cam, notes=notes,
-                     has_hold=hold is not None, has_unloading=unloading is not None)
+                     has_hold=hold is not None, has_unloading=unloading is not None,
+                     dent_floor=record_dent_floor(record))
 
 
 def _classify(relax: Measure | None, tau: Measure | None, mode: str | None,
               loss: Measure | None, dent: Measure | None, cam: Measure | None, *,
-              notes: list[str], has_hold: bool = False, has_unloading: bool = False
-              ) -> PressBehaviour:
+              notes: list[str], has_hold: bool = False, has_unloading: bool = False,
+              dent_floor: float = DENT_FLOOR_M) -> PressBehaviour:
     said: list[str] = []
     if relax is not None:
         said.append(relax.text("creep" if mode == "travel" else "relaxation"))
@@ -215,12 +311,11 @@ def _classify(relax: Measure | None, tau: Measure | None, mode: str | None,
     still = relax is not None and relax.rules_out(RELAXATION_FLOOR)
     lossy = loss is not None and loss.shows(LOSS_FLOOR)
     lossless = loss is not None and loss.rules_out(LOSS_FLOOR)
-    dents = [m for m in (dent, cam) if m is not None]
-    kept = any(m.shows(DENT_FLOOR_M) for m in dents)
-    # no dent: none shows one, and the sharpest reading rules it out (a camera too coarse to
-    # rule out a tenth of a millimetre does not veto the record's travel at zero force)
-    no_dent = bool(dents) and not kept and min(dents, key=lambda m: m.sigma).rules_out(
-        DENT_FLOOR_M)
+    dents = [(m, floor) for m, floor in ((dent, dent_floor), (cam, DENT_FLOOR_M)) if m is not None]
+    kept = any(m.shows(floor) for m, floor in dents)
+    # no dent: none shows one, and one rules it out (a camera too coarse to rule out a tenth of a
+    # millimetre does not veto the record's travel at zero force)
+    no_dent = not kept and any(m.rules_out(floor) for m, floor in dents)
     behaviour: Behaviour
     why: str
     if relaxes:
@@ -237,7 +332,7 @@ def _classify(relax: Measure | None, tau: Measure | None, mode: str | None,
             (has_unloading or has_hold):
         behaviour, why = "elastic", (f"relaxation, loss and dent all below their floors "
                                      f"({RELAXATION_FLOOR:g}, {LOSS_FLOOR:g}, "
-                                     f"{DENT_FLOOR_M * 1e3:g} mm) by 2 σ")
+                                     f"{dent_floor * 1e3:.2g} mm) by 2 σ")
     else:
         behaviour, why = "unknown", "the record neither shows nor rules out each behaviour"
         if not said:

@@ -12,7 +12,8 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import least_squares
 
-__all__ = ["MAD_TO_SIGMA", "MIN_FIT_SAMPLES", "N_SIGMA", "Measure", "PressRecord", "hold_fraction",
+__all__ = ["MAD_TO_SIGMA", "MIN_FIT_SAMPLES", "N_SIGMA", "Measure", "PressRecord", "Stretch",
+           "hold_fraction", "hold_travel", "hold_with_start",
            "loop_loss", "noise", "zero_force_travel"]
 
 #: A quantity shows a behaviour only beyond this many of its standard errors.
@@ -74,38 +75,88 @@ def noise(parts: list[NDArray[np.float64]]) -> float:
     return float(MAD_TO_SIGMA * np.median(np.abs(np.concatenate(diffs))) / math.sqrt(6.0))
 
 
-def _ends(y: NDArray[np.float64], sigma: float) -> tuple[float, float, float]:
-    """Means of the first and last fifth of ``y`` and the σ of each mean."""
-    k = max(1, y.size // 5)
-    return float(y[:k].mean()), float(y[-k:].mean()), sigma / math.sqrt(k)
-
-
 def _fraction(start: float, end: float, grad: NDArray[np.float64], cov: NDArray[np.float64],
               mode: str) -> Measure:
     value = 1.0 - end / start if mode == "force" else 1.0 - start / end
     return Measure(float(value), math.sqrt(max(0.0, float(grad @ cov @ grad))))
 
 
+@dataclass(frozen=True)
+class Stretch:
+    """Samples of one stretch of a press (a hold with the ramp's last sample before it)."""
+
+    time_s: NDArray[np.float64]
+    travel_m: NDArray[np.float64]
+    force_n: NDArray[np.float64]
+
+    def __len__(self) -> int:
+        return int(self.travel_m.size)
+
+
+def hold_with_start(record: PressRecord) -> Any:
+    """The record's hold, the ramp's last sample (where the commanded force is reached and the
+    hold begins) put before it when the ramp has times; the hold alone otherwise."""
+    hold = record.hold
+    if hold is None or record.time_s is None:
+        return hold
+    return Stretch(time_s=np.concatenate([[float(record.time_s[-1])], hold.time_s]),
+                   travel_m=np.concatenate([[float(record.travel_m[-1])], hold.travel_m]),
+                   force_n=np.concatenate([[float(record.force_n[-1])], hold.force_n]))
+
+
+def _line(t: NDArray[np.float64], y: NDArray[np.float64], sigma: float
+          ) -> tuple[float, float, NDArray[np.float64]]:
+    """A straight line's values at the stretch's first and last time, fitted to all its samples
+    (least squares), and their covariance with the sample noise ``sigma``."""
+    span = float(t[-1] - t[0])
+    design = np.column_stack([np.ones(t.size), (t - t[0]) / span])
+    coef, *_ = np.linalg.lstsq(design, y, rcond=None)
+    to_ends = np.array([[1.0, 0.0], [1.0, 1.0]])
+    cov = to_ends @ np.linalg.inv(design.T @ design) @ to_ends.T * sigma**2
+    return float(coef[0]), float(coef[0] + coef[1]), cov
+
+
+def hold_travel(hold: _Phase, sigma_t: float) -> Measure:
+    """The travel the hold added, end less start of a straight line through its samples."""
+    t = np.asarray(hold.time_s - hold.time_s[0])
+    travel = np.asarray(hold.travel_m)
+    a, b, cov = _line(t, travel, sigma_t)
+    return Measure(b - a, math.sqrt(max(cov[0, 0] + cov[1, 1] - 2.0 * cov[0, 1], 0.0)))
+
+
 def hold_fraction(hold: _Phase, sigma_f: float, sigma_t: float
-          ) -> tuple[Measure | None, Measure | None, str, str]:
+                  ) -> tuple[Measure | None, Measure | None, str, str]:
     """The hold's fraction and time constant, the mode, and a note on what could not be had."""
-    f0, f1, sf = _ends(hold.force_n, sigma_f)
-    t0, t1, st = _ends(hold.travel_m, sigma_t)
-    z_force = abs(f1 - f0) / max(sf, 1e-300)
-    z_travel = abs(t1 - t0) / max(st, 1e-300)
-    mode = "travel" if z_travel > z_force else "force"
-    y = np.asarray(hold.force_n if mode == "force" else hold.travel_m)
+    t = np.asarray(hold.time_s - hold.time_s[0])
+    force, travel = np.asarray(hold.force_n), np.asarray(hold.travel_m)
+    # a force sensor's noise grows with the load: the hold's own, when larger than the pooled
+    # (the encoders' does not: the travel's stays pooled)
+    sigma_f = max(sigma_f, noise([force]))
+    lines = {"force": _line(t, force, sigma_f), "travel": _line(t, travel, sigma_t)}
+
+    def z(name: str) -> float:
+        a, b, cov = lines[name]
+        return abs(b - a) / max(math.sqrt(max(cov[0, 0] + cov[1, 1] - 2 * cov[0, 1], 0.0)),
+                                1e-300)
+
+    # neither moving beyond its noise: the force is the held one (docs/robot.md: the press holds
+    # the commanded force under force control), so the travel is what would creep
+    moving = max(z("force"), z("travel")) > N_SIGMA
+    mode = "travel" if (z("travel") > z("force") or not moving) else "force"
+    y = force if mode == "force" else travel
     sigma = sigma_f if mode == "force" else sigma_t
-    a, b, s_end = (f0, f1, sf) if mode == "force" else (t0, t1, st)
+    a, b, cov_ab = lines[mode]
     if b <= 0.0 or a <= 0.0:
         return None, None, mode, f"the hold's {mode} is not positive"
-    # fallback: fraction from the stretch's ends
+    # fallback: the fraction between the ends of a straight line through the whole stretch
     g = np.array([b / a**2, -1.0 / a]) if mode == "force" else np.array([-1.0 / b, a / b**2])
-    plain = _fraction(a, b, g, np.eye(2) * s_end**2, mode)
+    plain = _fraction(a, b, g, cov_ab, mode)
     if len(hold) < MIN_FIT_SAMPLES:
         return plain, None, mode, (f"a hold of {len(hold)} samples gives no time constant "
                                    f"(needs {MIN_FIT_SAMPLES})")
-    t = np.asarray(hold.time_s - hold.time_s[0])
+    if not moving:
+        return plain, None, mode, (f"the hold moves within its noise ({N_SIGMA:g} σ): no time "
+                                   "constant")
     span = float(t[-1])
 
     def model(p: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -181,31 +232,44 @@ def loop_loss(record: PressRecord, sigma_f: float, sigma_t: float) -> Measure | 
     return Measure(ratio, math.sqrt(var))
 
 
-def zero_force_travel(unloading: _Phase, sigma_f: float, sigma_t: float) -> Measure | str:
-    f = np.asarray(unloading.force_n)
-    t = np.asarray(unloading.travel_m)
-    reached = np.flatnonzero(f <= N_SIGMA * sigma_f)
-    if reached.size and reached[0] > 0:  # contact lost here: the surface's height then
-        return Measure(float(t[reached[0]]), sigma_t)
-    use = (f > N_SIGMA * sigma_f) & (f <= 0.5 * float(f.max()))
-    if int(use.sum()) < 3:
-        use = f > N_SIGMA * sigma_f
-    n = int(use.sum())
-    if n < 2:
-        return (f"the unloading branch has {n} samples above its force noise "
-                f"({N_SIGMA:g} σ = {N_SIGMA * sigma_f:.2g} N); needs 2")
-    x = f[use] ** (2.0 / 3.0)
-    yv = t[use]
-    design = np.column_stack([np.ones(n), x])
-    coef, *_ = np.linalg.lstsq(design, yv, rcond=None)
-    resid = yv - design @ coef
-    s2 = float(resid @ resid) / (n - 2) if n > 2 else 0.0
-    s2 = max(s2, sigma_t**2)
-    try:
-        cov = np.linalg.inv(design.T @ design) * s2
-    except np.linalg.LinAlgError:
-        return "the unloading branch's force does not vary (no line to extrapolate)"
-    value, sigma = float(coef[0]), math.sqrt(max(0.0, float(cov[0, 0])))
-    if not (math.isfinite(value) and math.isfinite(sigma)):
+def zero_force_travel(record: PressRecord, sigma_f: float, sigma_t: float,
+                      creep: Measure | None = None) -> Measure | str:
+    """The unloading's travel at zero force less the loading's (module docstring of
+    :mod:`deformap.stiffness._behaviour`); ``creep`` is the travel the hold added (0 without)."""
+    unloading = record.unloading
+    assert unloading is not None
+    f, t = np.asarray(unloading.force_n), np.asarray(unloading.travel_m)
+    lf, lt = np.asarray(record.force_n), np.asarray(record.travel_m)
+    order = np.argsort(lf, kind="stable")
+    x_l = np.maximum(lf[order], 0.0) ** (2.0 / 3.0)
+    t_l = lt[order]
+    x = np.maximum(f, 0.0) ** (2.0 / 3.0)
+    # the unloading's samples within the ramp's range of force, above its noise
+    use = (f >= max(float(lf.min()), N_SIGMA * sigma_f)) & (
+        f <= float(lf.max()) + N_SIGMA * sigma_f)
+    if int(use.sum()) < 2:
+        return (f"the unloading branch has {int(use.sum())} samples within the ramp's range of "
+                f"force and above its noise ({N_SIGMA:g} σ = {N_SIGMA * sigma_f:.2g} N); needs 2")
+    x, t = x[use], t[use]
+    gap = t - np.interp(x, x_l, t_l)  # unloading less loading at the same force
+    # the loading's local slope dt/dF there: the force noise of both readings moves the gap
+    j = np.clip(np.searchsorted(x_l, x), 1, x_l.size - 1)
+    f_l = np.maximum(lf[order], 0.0)
+    slope = (t_l[j] - t_l[j - 1]) / np.maximum(f_l[j] - f_l[j - 1], 1e-12)
+    var = 2.0 * sigma_t**2 + 2.0 * (slope * sigma_f) ** 2
+    top = float(np.max(np.maximum(f, 0.0) ** (2.0 / 3.0)))
+    u = x / top
+    c = Measure(0.0, 0.0) if creep is None else creep
+    weight = 1.0 - u
+    if float(np.sum(weight**2 / var)) <= 0.0:
+        return "the unloading branch has no samples below its top force (no dent to read)"
+    y = gap - c.value * u
+    info = float(np.sum(weight**2 / var))
+    value = float(np.sum(weight * y / var)) / info
+    resid = y - value * weight
+    dof = y.size - 1
+    misfit = float(np.sum(resid**2 / var)) / dof if dof > 0 else 1.0
+    sigma2 = max(misfit, 1.0) / info + (c.sigma * float(np.sum(weight * u / var)) / info) ** 2
+    if not (math.isfinite(value) and math.isfinite(sigma2)):
         return "the unloading branch gave no finite travel at zero force"
-    return Measure(value, sigma)
+    return Measure(value, math.sqrt(sigma2))
