@@ -29,7 +29,7 @@ def test_the_behaviour_panel_colours_each_region_by_its_class() -> None:
     fig = plot_map(XS, YS, **_kwargs(behaviour_class=classes, behaviour_names=NAMES))
     panels = [ax for ax in fig.axes if ax.get_label() != "<colorbar>"]
     assert [ax.get_title() for ax in panels] == [
-        "β-field, 3 region(s)", "behaviour class by region (from the presses)",
+        "β-field, 3 region(s)", "behaviour by region (presses)",
         "β-field variance and contacts"]
     panel = panels[1]
     assert (panel.get_xlabel(), panel.get_ylabel()) == ("x [m]", "y [m]")

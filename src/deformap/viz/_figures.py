@@ -230,7 +230,8 @@ def plot_map(
 def _behaviour_panel(fig: Figure, ax: Axes, ext: Extent, classes: NDArray, names: list[str],
                      overlay: _Overlay) -> None:
     """Each cell's behaviour class in its colour (the classes present on the map, named on a
-    categorical colour bar), the regions' outlines and names, and the pokes."""
+    categorical colour bar), the regions' outlines (black, apart from every class colour) and
+    names, and the pokes."""
     present = sorted({int(k) for k in np.unique(classes) if k >= 0})
     if not present:
         ax.set_title("behaviour: no region")
@@ -245,9 +246,12 @@ def _behaviour_panel(fig: Figure, ax: Axes, ext: Extent, classes: NDArray, names
     bar = fig.colorbar(im, ax=ax, ticks=np.arange(len(present)))
     bar.ax.set_yticklabels([names[k] for k in present])
     bar.ax.tick_params(length=0)
-    ax.set_title("behaviour class by region (from the presses)")
+    ax.set_title("behaviour by region (presses)")
     labels = overlay.labels
-    _regions(ax, overlay.xs, overlay.ys, image, labels, None, main=False)
+    if labels is not None and np.ptp(labels) > 0:  # black: the red boundary would vanish here
+        for label in np.unique(labels):
+            ax.contour(overlay.xs, overlay.ys, (labels == label).astype(float), levels=[0.5],
+                       colors="k", linewidths=1.5)  # fmt: skip
     _contacts(ax, overlay.contacts, overlay.kinds)
     if labels is None:
         return
