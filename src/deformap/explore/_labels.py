@@ -76,7 +76,7 @@ def _bands_by_behaviour(by_value: RegionMap, found: RegionMap, poke_xy: NDArray[
     """``found`` (``by_value``'s classes split by behaviour) with each cell in the band of a
     value class labelled by that class's part its nearest poke of the class is in."""
     bands = by_value.labels.reshape(-1)
-    labels = np.empty_like(bands)
+    labels = found.labels.reshape(-1).copy()  # every band has pokes: each cell is relabelled
     for c in range(by_value.n_regions):
         cells = np.flatnonzero(bands == c)
         members = np.flatnonzero(by_value.poke_labels == c)
