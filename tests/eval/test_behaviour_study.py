@@ -80,7 +80,7 @@ def test_study_behaviour_writes_its_confusion_matrix(tmp_path: Path) -> None:
     assert [m["kind"] for m in study["matrix"]["materials"]] == ["viscoelastic"]
     assert study["n_presses"] == len(study["rows"]) == 3
     for row in study["rows"]:
-        assert row["truth"] == "viscoelastic" and row["read"] in BEHAVIOUR_READS
+        assert row["truth"] == row["kind"] == "viscoelastic" and row["read"] in BEHAVIOUR_READS
         assert row["evidence"] and row["true"]["relaxation_fraction"] == pytest.approx(0.5)
         assert row["true"]["relaxation_time_s"] == pytest.approx(1.0)
         assert set(row["quantities"]) >= {"relaxation", "tau_s", "loss_ratio", "residual_dent_m"}

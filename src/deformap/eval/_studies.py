@@ -370,6 +370,11 @@ class BehaviourMaterial:
             return "viscoelastic"
         return "plastic" if self.plastic is not None else "elastic"
 
+    @property
+    def kind(self) -> str:
+        """Its truth class, or ``"anisotropic"`` for an anisotropic foam."""
+        return "anisotropic" if self.anisotropy is not None else self.truth
+
 
 def _elastic(hardness_n: float) -> BehaviourMaterial:
     return BehaviourMaterial(f"elastic {hardness_n:g} N", hardness_n)
@@ -439,7 +444,8 @@ def behaviour_presses(material: BehaviourMaterial, *, world_config: WorldConfig,
                       ) -> list[dict[str, Any]]:
     """Press one block of ``material`` at ``positions`` with ``force_n`` under ``world_config``
     (its hold and unloading) and read each press's behaviour
-    (:func:`deformap.explore.poke_behaviour`): one row a press with the material, the truth class
+    (:func:`deformap.explore.poke_behaviour`): one row a press with the material and its
+    ``kind`` (:attr:`BehaviourMaterial.kind`), the truth class
     ``truth``, the class read ``read``, its ``evidence``, every quantity of
     :class:`~deformap.stiffness.PressBehaviour` under ``quantities`` and the world's own
     parameters under ``true``."""
@@ -450,7 +456,8 @@ def behaviour_presses(material: BehaviourMaterial, *, world_config: WorldConfig,
         read = poke_behaviour(world.press(np.asarray(xy, dtype=float), force_n))
         world.release()
         quantities = {k: v for k, v in read.to_dict().items() if k not in ("behaviour", "evidence")}
-        rows.append({"material": material.name, "hardness_n": material.hardness_n,
+        rows.append({"material": material.name, "kind": material.kind,
+                     "hardness_n": material.hardness_n,
                      "xy_m": [float(xy[0]), float(xy[1])], "truth": material.truth,
                      "read": read.behaviour, "evidence": read.evidence,
                      "quantities": quantities, "true": _truth_at(world, xy)})

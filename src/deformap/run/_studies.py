@@ -26,7 +26,6 @@ from deformap.eval import (
     PROTOCOLS,
     QUICK_BEHAVIOUR_MATERIALS,
     STUDY_PROTOCOLS,
-    BehaviourMaterial,
     FoamPresses,
     behaviour_presses,
     behaviour_summary,
@@ -285,10 +284,6 @@ BEHAVIOUR_KINDS: tuple[str, ...] = ("elastic", "viscoelastic", "plastic", "aniso
 """The kinds of material a behaviour study can be limited to."""
 
 
-def _kind(material: BehaviourMaterial) -> str:
-    return "anisotropic" if material.anisotropy is not None else material.truth
-
-
 def run_behaviour_study(
     out: Path | None = None, *, seed: int = 0, full: bool = False,
     cameras: Sequence[str] | None = None, thicknesses_m: Sequence[float] | None = None,
@@ -324,7 +319,7 @@ def run_behaviour_study(
             f"kinds: expected one or more of {', '.join(BEHAVIOUR_KINDS)}, got "
             f"{', '.join(map(repr, unknown)) if unknown else 'none'}")
     materials = [m for m in (FULL_BEHAVIOUR_MATERIALS if full else QUICK_BEHAVIOUR_MATERIALS)
-                 if kinds is None or _kind(m) in kinds]
+                 if kinds is None or m.kind in kinds]
     checked = _checked([(c, h, "linear-fem") for c in chosen_cameras for h in chosen_thicknesses])
     for _, thickness, _ in checked:
         for material in materials:
@@ -357,7 +352,7 @@ def run_behaviour_study(
         rows = [row for condition in checked for row in by_condition[condition]]
         study = {"matrix": {"cameras": list(dict.fromkeys(c[0] for c in checked)),
                             "thicknesses_m": sorted({c[1] for c in checked}),
-                            "materials": [{"name": m.name, "truth": m.truth, "kind": _kind(m)}
+                            "materials": [{"name": m.name, "truth": m.truth, "kind": m.kind}
                                           for m in materials],
                             "hold_s": BEHAVIOUR_HOLD_S, "force_n": force, "seed": seed,
                             "coarse": coarse},
