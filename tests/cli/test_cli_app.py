@@ -32,7 +32,8 @@ def test_every_command_group_is_registered() -> None:
                  "config", "study", "world"):  # fmt: skip
         assert name in result.output
     for group, names in (("bench", ("speed", "world", "io", "memory", "worlds", "rescore")),
-                         ("study", ("hardness", "cluster-size")), ("world", ("show",))):  # fmt: skip
+                         ("study", ("hardness", "cluster-size", "behaviour")),
+                         ("world", ("show",))):  # fmt: skip
         result = runner.invoke(app, [group, "--help"])
         assert result.exit_code == 0 and all(n in result.output for n in names), result.output
 
@@ -40,7 +41,8 @@ def test_every_command_group_is_registered() -> None:
 def test_every_command_with_a_seed_refuses_a_negative_one_before_running(tmp_path: Path) -> None:
     commands = [["explore", "-s", "heterogeneous-60-150"], ["record-sim", "-s", "homogeneous-60"],
                 ["map", str(tmp_path)], ["reproduce"], ["study", "hardness"],
-                ["study", "cluster-size"], ["world", "show", "homogeneous-60", "--out",
+                ["study", "cluster-size"], ["study", "behaviour"],
+                ["world", "show", "homogeneous-60", "--out",
                                             str(tmp_path / "w")],
                 ["bench", "world"], ["bench", "io"], ["bench", "speed"], ["bench", "memory"],
                 ["bench", "worlds", "--out", str(tmp_path / "b")]]

@@ -1,4 +1,5 @@
-"""``deformap study hardness``, ``deformap study cluster-size`` and ``deformap reproduce``."""
+"""``deformap study hardness``, ``deformap study cluster-size``, ``deformap study behaviour`` and
+``deformap reproduce``."""
 
 from __future__ import annotations
 
@@ -26,7 +27,8 @@ __all__ = ["study_app"]
 STUDY_HARDNESSES_HELP = "30, 60, 110, 150, 250 and rigid"
 """``deformap.eval.DEFAULT_HARDNESSES`` as ``--help`` shows it, written out (a test compares)."""
 
-study_app = typer.Typer(help="Studies on homogeneous simulated foams (the paper's Fig. 5).")
+study_app = typer.Typer(help="Studies on homogeneous simulated foams (the paper's Fig. 5, and "
+                        "what a press reveals beyond its stiffness).")
 app.add_typer(study_app, name="study")
 
 CoarseOption = Annotated[bool, typer.Option(help="Coarse FEM mesh (quick look).")]
@@ -174,6 +176,55 @@ def study_cluster_size(
                       ("k×k", "hardness [N]", "β", "fit error [mm]"), rows))
     shown.print(f"wrote {' and '.join(map(str, output.files))}", highlight=False)
     emit_json(json_path, output.study)
+
+
+@study_app.command("behaviour")
+@friendly_errors
+def study_behaviour(
+    out: Annotated[Path | None, typer.Option(
+        help="New folder for behaviour.png and behaviour.json "
+        "(default runs/behaviour-study-s<seed>-<time>).")] = None,
+    seed: SeedOption = 0,
+    full: Annotated[bool, typer.Option(
+        help="The whole matrix: elastic foams 30-250 N, viscoelastic (g∞ 0.5, 0.8 × τ 0.5, 2 s), "
+        "plastic (yield 1, 3 kPa), anisotropic (ratio 1.5, 3) × every camera preset × "
+        "thickness 0.03, 0.10 m; --camera or --thickness given pins that axis.")] = False,
+    camera: Annotated[list[str] | None, typer.Option(
+        help="Camera preset (repeat): primesense | kinect-v1 | realsense-d435 (default "
+        "primesense; with --full every preset).")] = None,
+    thickness: Annotated[list[float] | None, typer.Option(
+        help="Foam thickness in metres (repeat; default 0.03, with --full 0.03 and 0.10).")
+    ] = None,
+    kind: Annotated[list[str] | None, typer.Option(
+        help="Only these materials (repeat): elastic | viscoelastic | plastic | anisotropic.")
+    ] = None,
+    force: Annotated[float | None, typer.Option(help="Press force in N (default 0.6).")] = None,
+    coarse: CoarseOption = False,
+    json_path: JsonOption = None,
+) -> None:
+    """The behaviour class each press reads (held 3 s, unloaded) against the material's own: a
+    confusion matrix."""
+    shown = out_console(json_path)
+    with progress(shown) as bar:
+        output = run.run_behaviour_study(out, seed=seed, full=full, cameras=camera,
+                                         thicknesses_m=thickness, kinds=kind, force_n=force,
+                                         coarse=coarse, hooks=run_hooks(bar))  # fmt: skip
+    study = output.study
+    reads = list(next(iter(study["confusion"].values())))
+    rows = [(truth, *(f"{counts[r]}" for r in reads), f"{sum(counts.values())}")
+            for truth, counts in study["confusion"].items()]
+    shown.print(table("behaviour read against the world's truth (presses)",
+                      ("truth", *(f"read {r}" for r in reads), "presses"), rows,
+                      left=("truth",)))
+    for c in study["by_condition"]:
+        shown.print(f"  {c['camera']}, {c['thickness_m']:g} m: {c['n_presses']} presses, "
+                    f"right {cell(c['right'], '.1%')}, elastic flagged otherwise "
+                    f"{cell(c['elastic_flagged'], '.1%')}", highlight=False)
+    shown.print(f"  all: {study['n_presses']} presses, right {cell(study['right'], '.1%')}, "
+                f"elastic flagged otherwise {cell(study['elastic_flagged'], '.1%')}, unknown "
+                f"{cell(study['unknown'], '.1%')}", highlight=False)
+    shown.print(f"wrote {' and '.join(map(str, output.files))}", highlight=False)
+    emit_json(json_path, study)
 
 
 @app.command("reproduce")

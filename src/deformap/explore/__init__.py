@@ -5,7 +5,7 @@ that drives an ``Environment`` with it, the typed poke records and the session j
 from __future__ import annotations
 
 from deformap.explore._acquisition import STRATEGIES
-from deformap.explore._classes import RegionMap, segment_regions
+from deformap.explore._classes import RegionMap, class_behaviours, segment_regions
 from deformap.explore._config import (
     BetaFieldConfig,
     ExplorationConfig,
@@ -51,6 +51,6 @@ __all__ = ["JOURNAL_NAME", "PURPOSES", "STRATEGIES", "AppearanceOutcome", "BetaF
            "MappingRun", "ModulusField", "ModulusFieldConfig", "ModulusReading", "PokeField",
            "PokeRecord", "PokeResult", "PokeSet", "PokeTimings", "Purpose", "RegionLabels",
            "RegionMap", "StopReason", "SurfaceGPConfig", "SurfaceModel", "Target", "TouchGPConfig",
-           "beta_noise_floor", "check_exploration_budget", "explore", "field_settings",
-           "fit_surface", "map_regions", "measure_press", "poke_behaviour", "poke_step", "read_journal",
-           "rigid_modulus_bound", "segment_regions"]
+           "beta_noise_floor", "check_exploration_budget", "class_behaviours", "explore",
+           "field_settings", "fit_surface", "map_regions", "measure_press", "poke_behaviour",
+           "poke_step", "read_journal", "rigid_modulus_bound", "segment_regions"]

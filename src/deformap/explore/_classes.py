@@ -20,6 +20,13 @@ between classes) by divisive splitting with a calibrated test:
 The isopleth between two neighbouring classes is the midpoint of their means; cells are labelled
 by the band of the field's mean they fall in.
 
+Behaviour (:func:`split_by_behaviour`, after the value test): two pokes whose presses read
+different known behaviours (elastic, viscoelastic, plastic) are never one class, whatever their
+values. A class whose pokes read several known behaviours is split into one class per behaviour;
+a poke of unknown behaviour (or none read) is compatible with any and joins the part of the
+nearest poke of its class with a known behaviour (ties: the earliest). Such a split may leave more
+than ``max_regions`` classes: the value test's limit does not merge what the presses tell apart.
+
 References
 ----------
 Fisher, W. D. (1958). On grouping for maximum homogeneity. JASA 53(284), 789–798.
@@ -29,6 +36,7 @@ expression in microarray experiments. Stat. Appl. Genet. Mol. Biol. 3(1), Articl
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from itertools import pairwise
 
@@ -36,15 +44,20 @@ import numpy as np
 from numpy.typing import NDArray
 
 from deformap._validation import check_array, check_int, check_positive
+from deformap.errors import InvalidArgumentError
 from deformap.explore._config import ExplorationConfig, FieldName
 from deformap.explore._field import PokeSet, field_settings
 
-__all__ = ["REGION_Z", "RegionMap", "poke_classes", "ranked", "segment_regions", "separated"]
+__all__ = ["KNOWN_BEHAVIOURS", "REGION_Z", "RegionMap", "class_behaviours", "poke_classes",
+           "ranked", "segment_regions", "separated", "split_by_behaviour"]
 
 _NULL_SAMPLES = 4000
 _NULL_SEED = 20161115
 #: The value test's z (:func:`segment_regions`): standard errors between two parts' means.
 REGION_Z = 2.0
+#: The behaviours a press can show that tell two pokes apart; any other reading ("unknown", or
+#: none) is compatible with every class.
+KNOWN_BEHAVIOURS: tuple[str, ...] = ("elastic", "viscoelastic", "plastic")
 
 
 @dataclass(frozen=True)
@@ -210,3 +223,74 @@ def poke_classes(mean: NDArray[np.float64], pokes: PokeSet, config: ExplorationC
     return segment_regions(mean, pokes.values, pokes.noise, floor=cfg.noise_floor,
                            min_step=cfg.min_step, max_regions=config.max_regions,
                            prior_dof=config.region_prior_dof)  # fmt: skip
+
+
+def _check_behaviours(behaviours: Sequence[str | None], n: int) -> list[str | None]:
+    items = list(behaviours)
+    if len(items) != n:
+        raise InvalidArgumentError(
+            f"`behaviours` must have one entry per poke ({n}); got {len(items)}")
+    for b in items:
+        if b is not None and not isinstance(b, str):
+            raise InvalidArgumentError(f"`behaviours` must hold text or None; got {b!r}")
+    return items
+
+
+def split_by_behaviour(found: RegionMap, mean: NDArray[np.float64], poke_xy: NDArray[np.float64],
+                       poke_value: NDArray[np.float64],
+                       behaviours: Sequence[str | None]) -> RegionMap:
+    """``found`` with each class whose pokes read several known behaviours split into one class
+    per behaviour, the pokes of unknown behaviour joining their nearest known poke's part (module
+    docstring); ``found`` itself when no class needs it. ``behaviours (k,)`` each poke's class
+    (:data:`KNOWN_BEHAVIOURS`; anything else is unknown), in the pokes' order; the new classes are
+    ranked by mean (:func:`ranked`), so their labels on the grid are bands of ``mean`` until the
+    caller labels the cells."""
+    labels = found.poke_labels
+    values = check_array("poke_value", poke_value, (labels.size,))
+    xy = check_array("poke_xy", poke_xy, (labels.size, 2), what="metres")
+    kinds = [b if b in KNOWN_BEHAVIOURS else None
+             for b in _check_behaviours(behaviours, labels.size)]
+    groups: list[NDArray[np.int64]] = []
+    for c in range(found.n_regions):
+        members = np.flatnonzero(labels == c)
+        known = [int(i) for i in members if kinds[i] is not None]
+        if len({kinds[i] for i in known}) < 2:
+            if members.size:
+                groups.append(members)
+            continue
+        anchors = np.array(known, dtype=np.int64)
+        part = {}
+        for i in members.tolist():
+            if kinds[i] is not None:
+                part[i] = kinds[i]
+            else:  # argmin keeps the earliest of a tie
+                near = anchors[np.argmin(np.sum((xy[anchors] - xy[i]) ** 2, axis=1))]
+                part[i] = kinds[int(near)]
+        for kind in KNOWN_BEHAVIOURS:
+            mine = np.array([i for i in members.tolist() if part[i] == kind], dtype=np.int64)
+            if mine.size:
+                groups.append(mine)
+    if len(groups) == found.n_regions:
+        return found
+    return ranked(mean, values, groups, np.arange(labels.size))
+
+
+def class_behaviours(poke_labels: NDArray[np.int64], behaviours: Sequence[str | None],
+                     n_classes: int) -> list[tuple[str, int]]:
+    """Each class's behaviour and how many of its pokes show it: the known behaviour its pokes
+    agree on; ``"unknown"`` (0) when none of them reads one; ``"mixed"`` (the count of the most
+    frequent) when they read several (regions cut without :func:`split_by_behaviour`)."""
+    labels = np.asarray(poke_labels, dtype=np.int64).reshape(-1)
+    kinds = _check_behaviours(behaviours, labels.size)
+    out = []
+    for c in range(n_classes):
+        known = [kinds[i] for i in np.flatnonzero(labels == c) if kinds[i] in KNOWN_BEHAVIOURS]
+        counts = {k: known.count(k) for k in KNOWN_BEHAVIOURS if k in known}
+        if not counts:
+            out.append(("unknown", 0))
+        elif len(counts) == 1:
+            (kind, count), = counts.items()
+            out.append((kind, count))
+        else:
+            out.append(("mixed", max(counts.values())))
+    return out

@@ -211,13 +211,17 @@ class Mapper:
                            n_made=len(self._pokes))  # fmt: skip
 
     def regions(self) -> RegionMap:
-        """Cut the current map field into regions (:func:`map_regions`)."""
+        """Cut the current map field into regions (:func:`map_regions`, with each poke's
+        behaviour class)."""
         if not self._pokes:
             raise EnvironmentStateError("no poke yet: the field has no regions")
         field = self.map_field
         correlation = None if field.models is None else field.models.correlation
+        read = {p.record.index: p.record.behaviour for p in self._pokes}
+        index = field.pokes.index if field.pokes.index is not None else range(len(field.pokes))
+        behaviours = [None if (b := read.get(int(i))) is None else b.behaviour for i in index]
         return map_regions(field.mean, field.pokes, self.grid.cells_xy, self.config,
-                           self.map_field_name, correlation=correlation)
+                           self.map_field_name, correlation=correlation, behaviours=behaviours)
 
     def result(self, stop_reason: str, timings: Mapping[str, float]) -> ExplorationResult:
         """What the exploration produced, with the β-field and regions read once."""

@@ -35,8 +35,10 @@ if TYPE_CHECKING:
     from deformap.run._reproduce import ReproduceOutput, reproduce
     from deformap.run._robot import RobotConfig
     from deformap.run._studies import (
+        BEHAVIOUR_KINDS,
         CLUSTER_SIZE_FOAMS,
         StudyOutput,
+        run_behaviour_study,
         run_cluster_size_study,
         run_hardness_study,
     )
@@ -64,8 +66,8 @@ _MODULES: dict[str, tuple[str, ...]] = {
     "_record": ("RecordOutput", "record_simulation"),
     "_reproduce": ("ReproduceOutput", "reproduce"),
     "_robot": ("RobotConfig",),
-    "_studies": ("CLUSTER_SIZE_FOAMS", "StudyOutput", "run_cluster_size_study",
-                "run_hardness_study"),
+    "_studies": ("BEHAVIOUR_KINDS", "CLUSTER_SIZE_FOAMS", "StudyOutput", "run_behaviour_study",
+                 "run_cluster_size_study", "run_hardness_study"),
     "_world": ("ScenarioSummary", "scenario_summaries", "show_scenario"),
     "_worlds": ("RESCORABLE", "WorldsOutput", "bench_worlds", "load_worlds", "rescore_worlds"),
     "_worlds_config": ("WorldsBenchConfig", "exploration_with", "parse_assignments"),
@@ -73,14 +75,14 @@ _MODULES: dict[str, tuple[str, ...]] = {
 }  # fmt: skip
 
 __all__ = [
-    "BLAS_THREAD_VARIABLES", "CLUSTER_SIZE_FOAMS", "CONFIG_NAME", "POKES_CSV_COLUMNS", "RESCORABLE",
-    "RUNS_ROOT", "EstimateOutput", "MapOutput", "RecordOutput", "ReproduceOutput", "RobotConfig",
-    "RunConfig", "RunHooks", "RunOutput", "RunOverrides", "RunStart", "ScenarioSummary", "StudyOutput",
-    "WorldsBenchConfig", "WorldsOutput", "apply_overrides", "bench_worlds", "config_yaml",
+    "BEHAVIOUR_KINDS", "BLAS_THREAD_VARIABLES", "CLUSTER_SIZE_FOAMS", "CONFIG_NAME", "POKES_CSV_COLUMNS",
+    "RESCORABLE", "RUNS_ROOT", "EstimateOutput", "MapOutput", "RecordOutput", "ReproduceOutput",
+    "RobotConfig", "RunConfig", "RunHooks", "RunOutput", "RunOverrides", "RunStart", "ScenarioSummary",
+    "StudyOutput", "WorldsBenchConfig", "WorldsOutput", "apply_overrides", "bench_worlds", "config_yaml",
     "default_run_folder", "estimate_one_poke", "exploration_with", "explore_environment",
-    "explore_run_config", "explore_scenario", "load_run_config", "load_worlds",
-    "map_recorded_session", "parse_assignments", "parse_env_args", "record_simulation", "reproduce",
-    "rescore_worlds", "resume_run_config", "run_cluster_size_study", "run_generators",
+    "explore_run_config", "explore_scenario", "load_run_config", "load_worlds", "map_recorded_session",
+    "parse_assignments", "parse_env_args", "record_simulation", "reproduce", "rescore_worlds",
+    "resume_run_config", "run_behaviour_study", "run_cluster_size_study", "run_generators",
     "run_hardness_study", "scenario_summaries", "show_scenario",
 ]
 

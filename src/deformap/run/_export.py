@@ -4,7 +4,11 @@
 (nx,)`` and ``ys_m (ny,)``, the cells' centres in the world frame (``frame``, ``units``);
 ``beta_mean``, ``beta_std``; the modulus field's ``modulus_median_pa`` (exp of the mean of ln E),
 ``log_modulus_mean``, ``log_modulus_std`` (NaN when no poke gave a modulus); ``region_labels``
-(label ``k`` is region ``R(k+1)``, -1 without a region map) and the ``field`` they were cut from.
+(label ``k`` is region ``R(k+1)``, -1 without a region map) and the ``field`` they were cut from;
+the behaviour by region (:func:`deformap.run._report.behaviour_grids`): ``behaviour_class`` (an
+index into ``behaviour_names``, -1 without a region map) and the medians ``relaxation``,
+``relaxation_tau_s`` [s], ``loss_ratio``, ``residual_dent_m``, ``released_dent_m`` [m] over each
+region's pokes that give them (NaN elsewhere).
 
 ``pokes.csv``: the columns :data:`POKES_CSV_COLUMNS`, ``poke`` numbered from 1 (``report.json``'s
 ``index`` + 1), the contact where the tip touched, ``tip_center_z_m`` at the commanded force, the
@@ -30,6 +34,7 @@ from deformap.explore import ExplorationResult, PokeResult, field_settings
 from deformap.run._figures import write_map_figures, write_poke_figure
 from deformap.run._folder import write_json
 from deformap.run._hooks import NO_HOOKS, RunHooks
+from deformap.run._report import BEHAVIOUR_NAMES, BEHAVIOUR_QUANTITIES, behaviour_grids
 
 __all__ = ["POKES_CSV_COLUMNS", "poke_writer", "write_run_results"]
 
@@ -50,7 +55,9 @@ def _write_map_npz(path: Path, result: ExplorationResult) -> None:
     arrays: dict[str, Any] = {
         "xs_m": result.xs, "ys_m": result.ys,
         "frame": np.array("world"),
-        "units": np.array("xs_m, ys_m: m; beta: 1; modulus_median_pa: Pa; log_modulus: ln Pa"),
+        "units": np.array("xs_m, ys_m: m; beta: 1; modulus_median_pa: Pa; log_modulus: ln Pa; "
+                          "relaxation, loss_ratio: 1; relaxation_tau_s: s; residual_dent_m, "
+                          "released_dent_m: m"),
         "beta_mean": result.beta_field.mean, "beta_std": np.sqrt(result.beta_field.variance),
         "modulus_median_pa": modulus.median_pa if result.has_modulus else nan,
         "log_modulus_mean": modulus.mean if result.has_modulus else nan,
@@ -58,6 +65,10 @@ def _write_map_npz(path: Path, result: ExplorationResult) -> None:
         "region_labels": (result.regions.labels if result.regions is not None
                           else np.full(shape, -1, dtype=np.int64)),
         "field": np.array(result.map_field_name),
+        "behaviour_names": np.array(BEHAVIOUR_NAMES),
+        "behaviour_class": np.full(shape, -1, dtype=np.int64),
+        **{key: nan for key in BEHAVIOUR_QUANTITIES},
+        **behaviour_grids(result),
     }  # fmt: skip
     with atomic_path(path) as tmp, open(tmp, "wb") as fh:
         np.savez_compressed(fh, **arrays)

@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 
 from deformap.explore import ExplorationResult, PokeResult
-from deformap.run._report import _class_values
+from deformap.run._report import BEHAVIOUR_NAMES, _class_values, behaviour_grids
 
 __all__ = ["poke_figure_path", "rigid_regions", "write_estimate_figures", "write_map_figures",
            "write_poke_figure", "write_rerun"]
@@ -30,8 +30,9 @@ def write_map_figures(
     poke_figures: bool = True,
     variance_max: float | None = None,
 ) -> list[Path]:
-    """``map.png`` (when there is a poke) and, with ``poke_figures``, one ``poke-NN.png`` per
-    poke processed here (:func:`write_poke_figure`).
+    """``map.png`` (when there is a poke; with a behaviour panel when some poke read a known
+    behaviour) and, with ``poke_figures``, one ``poke-NN.png`` per poke processed here
+    (:func:`write_poke_figure`).
 
     Parameters
     ----------
@@ -62,10 +63,17 @@ def write_map_figures(
     if regions is not None:
         contacts = np.array([p.xy for p in result.pokes])
         truth_hardness = None if truth is None else truth.ground_truth_hardness(result.xs, result.ys)
-        levels = regions.levels if result.config.region_labels == "isopleth" else None
+        # isopleths unless a class split by behaviour made the regions no level set
+        bands = np.searchsorted(regions.levels, result.map_field.mean, side="right")
+        levels = (regions.levels if result.config.region_labels == "isopleth"
+                  and np.array_equal(bands, regions.labels) else None)  # fmt: skip
         modulus = result.modulus_field.median_pa if result.has_modulus else None
         values = _class_values(result)  # what report.json says of each region
         image = result.appearance.image
+        # the behaviour panel only when some poke read a behaviour
+        known = any(p.record.behaviour is not None and p.record.behaviour.behaviour != "unknown"
+                    for p in result.pokes)
+        behaviour = behaviour_grids(result)["behaviour_class"] if known else None
         plot_map(result.xs, result.ys, beta=result.beta_field.mean,
                  variance=result.map_field.variance, contacts=contacts, labels=regions.labels,
                  levels=levels, truth_hardness=truth_hardness, threshold=threshold, title=title,
@@ -76,7 +84,8 @@ def write_map_figures(
                  class_modulus_pa=values["class_modulus_median_pa"],
                  rigid_classes=rigid_regions(result),
                  appearance_rgb=None if image is None else image.rgb(),
-                 appearance_segments=None if image is None else image.segments)  # fmt: skip
+                 appearance_segments=None if image is None else image.segments,
+                 behaviour_class=behaviour, behaviour_names=BEHAVIOUR_NAMES)  # fmt: skip
         written.append(folder / "map.png")
     if poke_figures:
         written += [write_poke_figure(folder, poke) for poke in result.pokes

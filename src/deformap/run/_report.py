@@ -15,7 +15,11 @@ ln E [ln Pa]:
   modulus could not be read twice, left out of the targets and the stop cells);
 - ``regions``: ``levels``, ``class_values``, ``class_betas`` (each class's mean poke β),
   ``class_modulus_median_pa`` (median E [Pa] over each region's cells, ``None`` without a
-  modulus), ``poke_labels`` of the pokes ``poke_indices``, ``labels_by``, and with a ground truth
+  modulus), ``class_behaviours`` (the behaviour class each region's pokes agree on:
+  ``elastic``, ``viscoelastic`` or ``plastic``; ``unknown`` when none of them reads one,
+  ``mixed`` when they read several), ``class_behaviour_pokes`` (how many of its pokes read that
+  behaviour: the evidence; for ``mixed`` the most frequent one's count), ``class_n_pokes``,
+  ``poke_labels`` of the pokes ``poke_indices``, ``labels_by``, and with a ground truth
   the scores of :func:`deformap.eval.region_scores` (the ordering scores read the modulus field
   as ``−ln E``, which grows with softness as β does);
 - ``modulus_field`` (``None`` while no poke has a modulus): ``xs_m``, ``ys_m``,
@@ -45,13 +49,15 @@ from deformap import __version__
 from deformap._config import config_to_dict
 from deformap.environment import TactileContact
 from deformap.eval import ordering_scores, region_scores
-from deformap.explore import ExplorationResult, PokeResult, field_settings
+from deformap.explore import ExplorationResult, PokeResult, class_behaviours, field_settings
 from deformap.replay import RecordedSession, ReplayResult
 from deformap.run._config import RunConfig
 from deformap.world import SimulatedWorld
 
 __all__ = [
+    "BEHAVIOUR_NAMES",
     "SHARED_KEYS",
+    "behaviour_grids",
     "estimate_report",
     "live_report",
     "modulus_report",
@@ -106,6 +112,58 @@ def _class_values(result: ExplorationResult) -> dict[str, Any]:
     return {"class_betas": class_betas, "class_modulus_median_pa": medians}
 
 
+#: The behaviour classes of a region, in the order of ``map.npz``'s ``behaviour_class`` indices.
+BEHAVIOUR_NAMES: tuple[str, ...] = ("elastic", "viscoelastic", "plastic", "unknown", "mixed")
+
+#: ``map.npz``'s per-cell behaviour quantities: each the median over the region's pokes that give
+#: it, of this :class:`~deformap.stiffness.PressBehaviour` field.
+BEHAVIOUR_QUANTITIES: dict[str, str] = {
+    "relaxation": "relaxation", "relaxation_tau_s": "tau_s", "loss_ratio": "loss_ratio",
+    "residual_dent_m": "residual_dent_m", "released_dent_m": "released_dent_m"}
+
+
+def behaviour_grids(result: ExplorationResult) -> dict[str, Any]:
+    """The behaviour on the map grid, by the region labelling (``None`` without regions):
+    ``behaviour_class (ny, nx)`` each cell's region's class as an index into
+    :data:`BEHAVIOUR_NAMES` (:func:`region_behaviours`), and per :data:`BEHAVIOUR_QUANTITIES` key a
+    ``(ny, nx)`` grid of the median over the region's pokes that give it (NaN where none does)."""
+    found = result.regions
+    if found is None:
+        return {}
+    field = result.map_field
+    read = {p.record.index: p.record.behaviour for p in result.pokes}
+    index = np.arange(len(field.pokes)) if field.pokes.index is None else field.pokes.index
+    behaviours = [read.get(int(i)) for i in index]
+    kinds = region_behaviours(result)["class_behaviours"]
+    lookup = np.array([BEHAVIOUR_NAMES.index(k) for k in kinds], dtype=np.int64)
+    out: dict[str, Any] = {"behaviour_class": lookup[found.labels]}
+    for key, name in BEHAVIOUR_QUANTITIES.items():
+        per_class = np.full(found.n_regions, np.nan)
+        for k in range(found.n_regions):
+            values = [getattr(b, name) for b, label in zip(behaviours, found.poke_labels,
+                                                            strict=True)
+                      if label == k and b is not None and getattr(b, name) is not None]
+            if values:
+                per_class[k] = float(np.median(values))
+        out[key] = per_class[found.labels]
+    return out
+
+
+def region_behaviours(result: ExplorationResult) -> dict[str, list[Any]]:
+    """Each found region's behaviour class, its evidence and its pokes (module docstring)."""
+    found = result.regions
+    assert found is not None
+    field = result.map_field
+    read = {p.record.index: p.record.behaviour for p in result.pokes}
+    index = np.arange(len(field.pokes)) if field.pokes.index is None else field.pokes.index
+    kinds = [None if (b := read.get(int(i))) is None else b.behaviour for i in index]
+    agreed = class_behaviours(found.poke_labels, kinds, found.n_regions)
+    return {"class_behaviours": [kind for kind, _ in agreed],
+            "class_behaviour_pokes": [count for _, count in agreed],
+            "class_n_pokes": np.bincount(found.poke_labels,
+                                         minlength=found.n_regions).tolist()}
+
+
 def _regions(result: ExplorationResult, truth: Any) -> tuple[dict[str, Any], list[Any] | None]:
     """``regions`` and ``true_regions`` (``None`` without a ground truth) of a mapped surface."""
     found = result.regions
@@ -115,7 +173,7 @@ def _regions(result: ExplorationResult, truth: Any) -> tuple[dict[str, Any], lis
     # only separate the classes' values
     regions: dict[str, Any] = {"levels": found.levels.tolist(),
                                "class_values": found.class_betas.tolist(),
-                               **_class_values(result),
+                               **_class_values(result), **region_behaviours(result),
                                "poke_labels": found.poke_labels.tolist(),
                                # the pokes poke_labels speak of (the map field may leave some out)
                                "poke_indices": [int(i) for i in (field.pokes.index if

@@ -1,7 +1,9 @@
 """The studies on homogeneous simulated foams (the paper's Fig. 5), each into its own folder:
-``hardness.json`` and ``.png`` (β against hardness per contact protocol), or
-``cluster-size.json`` and ``.png`` (fit error against cluster size). The numbers come from
-:mod:`deformap.eval`; this module builds the worlds, writes the files and reports progress.
+``hardness.json`` and ``.png`` (β against hardness per contact protocol),
+``cluster-size.json`` and ``.png`` (fit error against cluster size), or ``behaviour.json`` and
+``.png`` (the behaviour class each press reads against the material's, a confusion matrix). The
+numbers come from :mod:`deformap.eval`; this module builds the worlds, writes the files and
+reports progress.
 """
 
 from __future__ import annotations
@@ -20,14 +22,19 @@ from deformap.environment import Workspace
 from deformap.errors import InvalidArgumentError
 from deformap.eval import (
     DEFAULT_HARDNESSES,
+    FULL_BEHAVIOUR_MATERIALS,
     PROTOCOLS,
+    QUICK_BEHAVIOUR_MATERIALS,
     STUDY_PROTOCOLS,
     FoamPresses,
+    behaviour_presses,
+    behaviour_summary,
     block_scenario,
     cluster_size_study,
     collect_presses,
     hardness_study,
     hardness_summary,
+    material_scenario,
 )
 from deformap.explore import ExplorationConfig
 from deformap.run._folder import claim_run_folder, default_run_folder, write_json
@@ -42,8 +49,10 @@ from deformap.world import (
 )
 
 __all__ = [
-    "CLUSTER_SIZE_FOAMS", "FULL_CAMERAS", "FULL_ELEMENT_SIZE_M", "FULL_PHYSICS",
-    "FULL_THICKNESSES_M", "StudyOutput", "run_cluster_size_study", "run_hardness_study",
+    "BEHAVIOUR_FULL_THICKNESSES_M", "BEHAVIOUR_HOLD_S", "BEHAVIOUR_KINDS", "BEHAVIOUR_THICKNESS_M",
+    "CLUSTER_SIZE_FOAMS",
+    "FULL_CAMERAS", "FULL_ELEMENT_SIZE_M", "FULL_PHYSICS", "FULL_THICKNESSES_M", "StudyOutput",
+    "run_behaviour_study", "run_cluster_size_study", "run_hardness_study",
 ]
 
 CLUSTER_SIZE_FOAMS: tuple[float, ...] = (60.0, 110.0, 150.0)
@@ -258,3 +267,95 @@ def run_cluster_size_study(out: Path | None = None, *, seed: int = 0, coarse: bo
         study = cluster_size_study(presses)
         files = _write(folder, "cluster-size", study, plot_cluster_size_study)
         return StudyOutput(study=study, folder=folder, files=files)
+
+
+BEHAVIOUR_HOLD_S = 3.0
+"""How long each press of the behaviour study holds its force, seconds: a few of the slower
+relaxation times the study's materials have, long enough for their creep to show."""
+
+BEHAVIOUR_THICKNESS_M = 0.03
+"""The quick behaviour study's foam thickness, metres (the thinner of
+:data:`BEHAVIOUR_FULL_THICKNESSES_M`: the quicker FEM)."""
+
+BEHAVIOUR_FULL_THICKNESSES_M: tuple[float, ...] = (0.03, 0.10)
+"""The thicknesses of ``study behaviour --full``, metres."""
+
+BEHAVIOUR_KINDS: tuple[str, ...] = ("elastic", "viscoelastic", "plastic", "anisotropic")
+"""The kinds of material a behaviour study can be limited to."""
+
+
+def run_behaviour_study(
+    out: Path | None = None, *, seed: int = 0, full: bool = False,
+    cameras: Sequence[str] | None = None, thicknesses_m: Sequence[float] | None = None,
+    kinds: Sequence[str] | None = None, force_n: float | None = None, coarse: bool = False,
+    hooks: RunHooks = NO_HOOKS,
+) -> StudyOutput:  # fmt: skip
+    """The behaviour class each press reads against its material's
+    (:func:`deformap.eval.behaviour_presses`, :func:`~deformap.eval.behaviour_summary`) into
+    ``out`` (new or empty; default stem ``behaviour``): ``behaviour.json`` and the confusion
+    matrix ``behaviour.png``.
+
+    Every material (:data:`~deformap.eval.QUICK_BEHAVIOUR_MATERIALS`, or with ``full``
+    :data:`~deformap.eval.FULL_BEHAVIOUR_MATERIALS`; only those of ``kinds``, of
+    :data:`BEHAVIOUR_KINDS`, where given) is a block over the workspace pressed at three places,
+    each press held :data:`BEHAVIOUR_HOLD_S` and unloaded, under every camera preset ``cameras``
+    (default primesense; with ``full`` every preset) and thickness ``thicknesses_m`` (default
+    :data:`BEHAVIOUR_THICKNESS_M`; with ``full`` :data:`BEHAVIOUR_FULL_THICKNESSES_M`), each
+    world's noise from ``seed``. ``force_n`` defaults to the exploration's.
+
+    The JSON has ``matrix`` (the conditions, materials, hold and force), ``rows`` (one a press:
+    ``camera``, ``thickness_m``, ``material``, ``truth``, ``read``, ``evidence``, ``quantities``
+    and the world's ``true`` parameters) and the summary's ``confusion``, ``right``,
+    ``elastic_flagged``, ``unknown``, ``by_condition`` and ``by_material``.
+    """
+    from deformap.viz import plot_behaviour_study  # matplotlib: only when a study is drawn
+
+    chosen_cameras = list(cameras or (FULL_CAMERAS if full else ("primesense",)))
+    chosen_thicknesses = [float(h) for h in (
+        thicknesses_m or (BEHAVIOUR_FULL_THICKNESSES_M if full else (BEHAVIOUR_THICKNESS_M,)))]
+    unknown = [k for k in (kinds or ()) if k not in BEHAVIOUR_KINDS]
+    if unknown or (kinds is not None and not kinds):
+        raise InvalidArgumentError(
+            f"kinds: expected one or more of {', '.join(BEHAVIOUR_KINDS)}, got "
+            f"{', '.join(map(repr, unknown)) if unknown else 'none'}")
+    materials = [m for m in (FULL_BEHAVIOUR_MATERIALS if full else QUICK_BEHAVIOUR_MATERIALS)
+                 if kinds is None or m.kind in kinds]
+    checked = _checked([(c, h, "linear-fem") for c in chosen_cameras for h in chosen_thicknesses])
+    for _, thickness, _ in checked:
+        for material in materials:
+            material_scenario(material, Workspace(), thickness)
+    _check_press((), force_n)
+    force = _force(force_n)
+    folder = out or default_run_folder("behaviour", "study", seed)
+    with claim_run_folder(folder, what="study"):
+        hooks.start(RunStart(kind="study", title=f"behaviour study, seed {seed}", folder=folder,
+                             total=len(materials) * len(checked)))  # fmt: skip
+        streams = dict(zip(checked, np.random.default_rng(seed).spawn(len(checked)), strict=True))
+        by_condition: dict[tuple[str, float, str], list[dict[str, Any]]] = {}
+        # thickness first: the FEM's factorisation depends on the block's mesh only, shared by
+        # the cameras (deformap.world._fem); the rows are written in the matrix's own order
+        for condition in sorted(checked, key=lambda c: c[1]):
+            name, thickness, _ = condition
+            hooks.stage(f"pressing the materials: {name}, {thickness:g} m")
+            world = _study_world("linear-fem", coarse=coarse, element_size_m=None)
+            world = dataclasses.replace(world, camera=camera_preset(name),
+                                        hold_s=BEHAVIOUR_HOLD_S, unload=True)
+            rows = []
+            for material, rng in zip(materials, streams[condition].spawn(len(materials)),
+                                     strict=True):
+                rows += [{"camera": name, "thickness_m": thickness, **row}
+                         for row in behaviour_presses(material, world_config=world,
+                                                      force_n=force, rng=rng,
+                                                      thickness_m=thickness)]
+                hooks.step(f"pressed {material.name}")
+            by_condition[condition] = rows
+        rows = [row for condition in checked for row in by_condition[condition]]
+        study = {"matrix": {"cameras": list(dict.fromkeys(c[0] for c in checked)),
+                            "thicknesses_m": sorted({c[1] for c in checked}),
+                            "materials": [{"name": m.name, "truth": m.truth, "kind": m.kind}
+                                          for m in materials],
+                            "hold_s": BEHAVIOUR_HOLD_S, "force_n": force, "seed": seed,
+                            "coarse": coarse},
+                 "rows": rows, **behaviour_summary(rows)}  # fmt: skip
+        return StudyOutput(study=study, folder=folder,
+                           files=_write(folder, "behaviour", study, plot_behaviour_study))

@@ -1,6 +1,7 @@
 """The map figure of a run (``map.png``, the paper's Fig. 6), built without ``pyplot``.
 
-Panels: ground truth | camera view | β-field | modulus field | variance, each when given. Stiffness
+Panels: ground truth | camera view | β-field | modulus field | behaviour | variance, each when
+given. Stiffness
 has one colour direction in every panel (:mod:`deformap.viz._style`); regions are named R1, R2, …
 as ``pokes.csv`` numbers them, pokes from 1. ``plot_*`` functions return the figure and, given
 ``path``, write it atomically; no backend is selected and no global state is touched.
@@ -14,7 +15,7 @@ from pathlib import Path
 import numpy as np
 from matplotlib import patheffects
 from matplotlib.axes import Axes
-from matplotlib.colors import ListedColormap, LogNorm
+from matplotlib.colors import BoundaryNorm, ListedColormap, LogNorm
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.ticker import FuncFormatter
@@ -26,7 +27,7 @@ from deformap.viz._save import save_figure
 from deformap.viz._style import BETA_CMAP, RIGID_COLOUR, STIFFNESS_CMAP, modulus_norm
 from deformap.world import hardness_to_youngs_modulus
 
-__all__ = ["plot_map"]
+__all__ = ["BEHAVIOUR_COLOURS", "plot_map"]
 
 # marker per poke purpose: the first poke, the pokes the variance chose, the pokes testing a look
 # (appearance prior), the boundary pokes
@@ -39,6 +40,10 @@ _PANEL_PX = 400.0
 """About how many pixels a map panel's axes span across (5.2 in at 110 dpi, less its colour bar):
 the scale by which a region's label is kept clear of the pokes' marks."""
 Extent = tuple[float, float, float, float]
+#: The behaviour panel's colours, one per class (categorical, apart from every stiffness colour
+#: map's ends): elastic blue, viscoelastic orange, plastic red, unknown pale grey, mixed purple.
+BEHAVIOUR_COLOURS = {"elastic": "#1f77b4", "viscoelastic": "#ff7f0e", "plastic": "#d62728",
+                     "unknown": "#d9d9d9", "mixed": "#9467bd"}
 
 
 def _extent(xs: NDArray, ys: NDArray) -> Extent:
@@ -111,6 +116,8 @@ def plot_map(
     rigid_classes: Collection[int] = (),
     appearance_rgb: NDArray[np.float64] | None = None,
     appearance_segments: NDArray[np.int64] | None = None,
+    behaviour_class: NDArray[np.int64] | None = None,
+    behaviour_names: Sequence[str] = (),
 ) -> Figure:
     """The map figure: ground truth | camera view with its segments | β-field | modulus field |
     variance and contacts (optional panels when given); regions drawn on the field cut from.
@@ -148,6 +155,9 @@ def plot_map(
         Regions labelled "rigid".
     appearance_rgb, appearance_segments : (ny, nx, 3) float, (ny, nx) int, optional
         The appearance prior's view (sRGB in [0, 1]) and its segments (``-1`` masked).
+    behaviour_class : (ny, nx) int, optional
+        Each cell's behaviour class, an index into ``behaviour_names`` (names of
+        :data:`BEHAVIOUR_COLOURS`; ``-1`` none), drawn in categorical colours with the regions.
 
     Returns
     -------
@@ -159,8 +169,17 @@ def plot_map(
         raise InvalidArgumentError(f"`variance_max` must be a number > 0; got {variance_max!r}")
     contacts = np.asarray(contacts, dtype=float).reshape(-1, 2)
     kinds = _purposes(len(contacts), purposes)
+    if behaviour_class is not None:
+        behaviour_class = np.asarray(behaviour_class)
+        unnamed = [n for n in behaviour_names if n not in BEHAVIOUR_COLOURS]
+        if behaviour_class.shape != np.shape(beta) or unnamed or (
+                behaviour_class.size and int(behaviour_class.max()) >= len(behaviour_names)):
+            raise InvalidArgumentError(
+                f"`behaviour_class` must be a grid of the map's shape {np.shape(beta)} indexing "
+                f"`behaviour_names` (of {sorted(BEHAVIOUR_COLOURS)}); got shape "
+                f"{behaviour_class.shape} and names {list(behaviour_names)}")
     panels = (2 + (truth_hardness is not None) + (modulus_pa is not None)
-              + (appearance_rgb is not None))  # fmt: skip
+              + (appearance_rgb is not None) + (behaviour_class is not None))  # fmt: skip
     fig = Figure(figsize=(5.2 * panels, 4.6), layout="constrained")
     axes = list(np.atleast_1d(fig.subplots(1, panels)))
     ext = _extent(xs, ys)
@@ -189,6 +208,8 @@ def plot_map(
             None if v is None else float(np.log(v)) for v in class_modulus_pa]  # fmt: skip
         overlay.draw(ax, np.log(kpa * 1e3), moduli, main=region_field == "modulus",
                      name=lambda v: f"E = {np.exp(v) / 1e3:.3g} kPa")  # fmt: skip
+    if behaviour_class is not None:
+        _behaviour_panel(fig, axes.pop(0), ext, behaviour_class, list(behaviour_names), overlay)
     ax = axes.pop(0)
     note = _variance_panel(fig, ax, xs, ys, ext, variance, threshold, variance_max,
                            modulus=region_field == "modulus")  # fmt: skip
@@ -204,6 +225,44 @@ def plot_map(
     if path is not None:
         save_figure(fig, path, dpi=110)
     return fig
+
+
+def _behaviour_panel(fig: Figure, ax: Axes, ext: Extent, classes: NDArray, names: list[str],
+                     overlay: _Overlay) -> None:
+    """Each cell's behaviour class in its colour (the classes present on the map, named on a
+    categorical colour bar), the regions' outlines (black, apart from every class colour) and
+    names, and the pokes."""
+    present = sorted({int(k) for k in np.unique(classes) if k >= 0})
+    if not present:
+        ax.set_title("behaviour: no region")
+        return
+    image = np.full(classes.shape, np.nan)
+    for slot, k in enumerate(present):
+        image[classes == k] = slot
+    cmap = ListedColormap([BEHAVIOUR_COLOURS[names[k]] for k in present])
+    norm = BoundaryNorm(np.arange(len(present) + 1) - 0.5, len(present))
+    im = ax.imshow(image, origin="lower", extent=ext, cmap=cmap, norm=norm,
+                   interpolation="nearest")  # fmt: skip
+    bar = fig.colorbar(im, ax=ax, ticks=np.arange(len(present)))
+    bar.ax.set_yticklabels([names[k] for k in present])
+    bar.ax.tick_params(length=0)
+    ax.set_title("behaviour by region (presses)")
+    labels = overlay.labels
+    if labels is not None and np.ptp(labels) > 0:  # black: the red boundary would vanish here
+        for label in np.unique(labels):
+            ax.contour(overlay.xs, overlay.ys, (labels == label).astype(float), levels=[0.5],
+                       colors="k", linewidths=1.5)  # fmt: skip
+    _contacts(ax, overlay.contacts, overlay.kinds)
+    if labels is None:
+        return
+    for k in (int(k) for k in np.unique(labels) if k >= 0):
+        cells = classes[labels == k]
+        if not cells.size or cells[0] < 0:
+            continue
+        text = f"R{k + 1}: {names[int(cells[0])]}"
+        x, y = _label_place(overlay.xs, overlay.ys, labels == k, overlay.contacts, len(text))
+        ax.text(x, y, text, ha="center", va="center", fontsize=8,
+                bbox={"boxstyle": "round,pad=0.2", "fc": "w", "ec": "0.5", "alpha": 0.85})
 
 
 def _appearance_panel(ax: Axes, ext: Extent, rgb: NDArray, segments: NDArray | None) -> None:

@@ -1,4 +1,5 @@
-"""Figures of the studies: β against hardness (Fig. 5a) and fit error against cluster size (5b).
+"""Figures of the studies: β against hardness (Fig. 5a), fit error against cluster size (5b), and
+the behaviour study's confusion matrix.
 
 Each takes the study's result as :mod:`deformap.eval` returns it and, given ``path``, writes the
 figure there at 110 dpi.
@@ -17,7 +18,7 @@ from matplotlib.ticker import FixedLocator, FuncFormatter, MaxNLocator, NullLoca
 
 from deformap.viz._save import save_figure
 
-__all__ = ["plot_cluster_size_study", "plot_hardness_study"]
+__all__ = ["plot_behaviour_study", "plot_cluster_size_study", "plot_hardness_study"]
 
 _MARKERS, _LINES = "osv^<>", ("-", "--", "-.", ":")
 #: The factor between neighbouring protocols' x on the log hardness axis: about a marker's width,
@@ -241,6 +242,53 @@ def plot_cluster_size_study(study: dict[str, Any], *, path: str | Path | None = 
     ax.set_ylabel("fit error min ε(β) [mm]")
     ax.set_title("shape-matching fit error against cluster size")
     ax.legend(fontsize=8)
+    if path is not None:
+        save_figure(fig, path, dpi=110)
+    return fig
+
+
+def plot_behaviour_study(study: dict[str, Any], *, path: str | Path | None = None) -> Figure:
+    """The behaviour study's confusion matrix: one row per true class, one column per class read
+    (``unknown`` last), each cell's count and its share of the row, coloured by that share; the
+    share read right, the elastic presses flagged otherwise and the conditions in the title.
+
+    ``study`` is :func:`deformap.eval.behaviour_summary`'s result (``confusion``, ``n_presses``,
+    ``right``, ``elastic_flagged``), optionally with a ``matrix`` (``cameras``,
+    ``thicknesses_m``, ``hold_s``, ``force_n``) naming the conditions.
+    """
+    confusion: dict[str, dict[str, int]] = study["confusion"]
+    truths = list(confusion)
+    reads = list(next(iter(confusion.values()))) if confusion else []
+    counts = np.array([[confusion[t][r] for r in reads] for t in truths], dtype=float)
+    totals = counts.sum(axis=1, keepdims=True)
+    share = np.divide(counts, totals, out=np.zeros_like(counts), where=totals > 0)
+    fig = Figure(figsize=(7.4, 4.6), layout="constrained")
+    ax = fig.subplots()
+    im = ax.imshow(share, cmap="Blues", vmin=0.0, vmax=1.0)
+    fig.colorbar(im, ax=ax, label="share of the true class's presses")
+    for i, j in itertools.product(range(len(truths)), range(len(reads))):
+        ax.text(j, i, f"{int(counts[i, j])}\n({share[i, j]:.0%})", ha="center", va="center",
+                fontsize=9, color="w" if share[i, j] > 0.6 else "k")
+    ax.set_xticks(range(len(reads)), reads)
+    ax.set_yticks(range(len(truths)),
+                  [f"{t} ({int(n)})" for t, n in zip(truths, totals[:, 0], strict=True)])
+    ax.set_xlabel("class read from the press")
+    ax.set_ylabel("true class (presses)")
+    right, flagged = study.get("right"), study.get("elastic_flagged")
+    head = f"{study.get('n_presses', int(counts.sum()))} presses"
+    if right is not None:
+        head += f", {right:.0%} read right"
+    if flagged is not None:
+        head += f", elastic flagged otherwise {flagged:.0%}"
+    matrix = study.get("matrix") or {}
+    conditions = ", ".join(p for p in (
+        f"cameras {', '.join(matrix['cameras'])}" if matrix.get("cameras") else "",
+        "foam " + ", ".join(f"{h * 100:g}" for h in matrix["thicknesses_m"]) + " cm thick"
+        if matrix.get("thicknesses_m") else "",
+        f"hold {matrix['hold_s']:g} s" if matrix.get("hold_s") is not None else "",
+        f"force {matrix['force_n']:g} N" if matrix.get("force_n") is not None else "") if p)
+    ax.set_title(f"behaviour read against the world's truth: {head}"
+                 + (f"\n{conditions}" if conditions else ""), fontsize=10)
     if path is not None:
         save_figure(fig, path, dpi=110)
     return fig

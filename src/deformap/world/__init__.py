@@ -22,6 +22,7 @@ from deformap.world._camera import CAMERA_PRESETS, CameraConfig, camera_preset
 from deformap.world._config import PHYSICS, Physics, WorldConfig, check_world_budget
 from deformap.world._foam import Dent
 from deformap.world._layouts import LAYOUT_FAMILIES, LayoutFamily
+from deformap.world._materials import Orthotropic, Plastic, Viscoelastic
 from deformap.world._paint import APPEARANCE_FAMILIES, AppearanceFamily
 from deformap.world._probe import ProbeGeometry
 from deformap.world._random import random_scenario
@@ -32,7 +33,8 @@ from deformap.world._world import MIN_RECORD_FORCE_N, SimulatedWorld
 __all__ = [
     "APPEARANCE_FAMILIES", "BARE_TABLE", "CAMERA_PRESETS", "LAYOUT_FAMILIES", "MIN_RECORD_FORCE_N",
     "PHYSICS", "Appearance", "AppearanceFamily", "Block", "CameraConfig", "Dent", "LayoutFamily",
-    "Physics", "ProbeGeometry", "Scenario", "SimulatedWorld", "Split", "WorldConfig",
+    "Orthotropic", "Physics", "Plastic", "ProbeGeometry", "Scenario", "SimulatedWorld", "Split",
+    "Viscoelastic", "WorldConfig",
     "camera_preset", "check_world_budget", "hardness_to_youngs_modulus", "hertz_contact_radius",
     "hertz_indentation", "hertz_pressure_samples", "list_scenarios", "load_scenario",
     "random_scenario", "save_scenario", "youngs_modulus_to_hardness",
