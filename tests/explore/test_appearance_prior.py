@@ -12,7 +12,7 @@ from deformap.cloud import PointCloud
 from deformap.errors import InvalidArgumentError
 from deformap.explore import BetaFieldConfig, ExplorationConfig, PokeSet, explore
 from deformap.explore._appearance import AppearanceImage, build_appearance
-from deformap.explore._appearance_prior import AppearanceModels, AppearancePrior
+from deformap.explore._appearance_prior import BLIND_PRIOR, AppearanceModels, AppearancePrior
 from deformap.explore._field import BetaField
 from deformap.gp import GaussianRandomField
 
@@ -107,7 +107,7 @@ def test_pokes_that_agree_with_the_looks_raise_the_weight_and_contradicting_ones
     image = _image()
     assert isinstance(image, AppearanceImage)
     xy = [(0.03, 0.03), (0.12, 0.17), (0.18, 0.03), (0.27, 0.17)]
-    prior_mean = float(np.mean([0.0, 0.5, 0.8, 0.95]))
+    prior_mean = (1 - BLIND_PRIOR) * float(np.mean([0.5, 0.8, 0.95]))
     agree = _models(image, xy, [0.2, 0.2, 0.7, 0.7]).posterior
     one_look_two_materials = _models(image, xy, [0.2, 0.7, 0.2, 0.7]).posterior
     assert agree.mean_weight > prior_mean + 0.1

@@ -84,11 +84,14 @@ def _scores(mapper: Mapper, truth: _Truth,
     spreads = [float(np.std(beta[(labels == k) & foam])) for k in np.unique(labels[foam])]
     shared = {"modulus_error": modulus_error,
               "beta_spread": float(np.mean(spreads)) if spreads else None}
+    # the map the mapper draws: under the appearance prior, `nearest` labels each cell by its
+    # most correlated poke (Mapper.regions)
+    correlation = None if field.models is None else field.models.correlation
     out = {}
     for cut in cuts:
         found = map_regions(field.mean, field.pokes, mapper.grid.cells_xy,
                             replace(mapper.config, region_labels=cast(RegionLabels, cut)),
-                            field.name)  # fmt: skip
+                            field.name, correlation=correlation)  # fmt: skip
         scores = region_scores(found.labels, labels, sign * field.mean, hardness)
         out[cut] = {"accuracy": scores.accuracy, "mean_iou": scores.mean_iou,
                     "found": scores.found, "true": scores.true,

@@ -111,11 +111,12 @@ def _cell_colours(cloud: PointCloud, xs: NDArray[np.float64], ys: NDArray[np.flo
 
 
 def _noise(channel: NDArray[np.float64], mask: NDArray[np.bool_]) -> float:
-    """Robust noise std of a channel smoothed as the segmentation sees it: the MAD of
-    horizontally neighbouring seen cells' differences, over √2."""
+    """Robust std of a channel's cell-to-cell scatter (the camera's noise and the finest
+    texture): the MAD of horizontally neighbouring seen cells' differences, over √2, on the
+    cells as measured (a smoothed or filled cell shares its neighbours' values, which would
+    understate the scatter and split one look into many, or chain two looks into one)."""
     both = mask[:, 1:] & mask[:, :-1]
-    smooth = ndi.gaussian_filter(_fill_unseen(channel[..., None], mask)[..., 0], SEGMENT_SIGMA)
-    diff = np.diff(smooth, axis=1)[both]
+    diff = np.diff(channel, axis=1)[both]
     if diff.size == 0:
         return 0.0
     return float(1.4826 * np.median(np.abs(diff - np.median(diff))) / np.sqrt(2.0))

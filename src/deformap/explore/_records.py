@@ -25,7 +25,7 @@ __all__ = ["PURPOSES", "ContactRecord", "Dent", "PokeRecord", "PokeResult", "Pok
 
 #: Why a place was poked: the first poke, the strategy's (until the variance is under ``T_h``), or
 #: a boundary poke after it.
-Purpose = Literal["first", "variance", "boundary"]
+Purpose = Literal["first", "variance", "boundary", "appearance"]
 PURPOSES: tuple[str, ...] = get_args(Purpose)
 
 

@@ -183,7 +183,7 @@ def choose_next(grid: MapGrid, field: PokeField, config: ExplorationConfig,
     if field.prior is not None:
         look = _look_target(grid, field, config, threshold, done)
         if look is not None:
-            return Target(look, "variance")
+            return Target(look, "appearance")
     if done:
         if boundary_owed == 0:
             return None
