@@ -26,7 +26,7 @@ from deformap.explore import (
     TouchGPConfig,
 )
 from deformap.msm import ShapeMatchingConfig
-from deformap.run import RunConfig
+from deformap.run import RobotConfig, RunConfig
 from deformap.stiffness import StiffnessConfig
 from deformap.world import CameraConfig, WorldConfig
 
@@ -43,6 +43,7 @@ SECTIONS: dict[type, str] = {
     StiffnessConfig: "exploration.stiffness",
     WorldConfig: "world",
     CameraConfig: "world.camera",
+    RobotConfig: "robot",
 }
 
 

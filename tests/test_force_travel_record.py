@@ -14,6 +14,7 @@ from deformap.environment import (
     TRAVEL_BACKWARDS_TOLERANCE_M,
     ForceTravel,
     PressObservation,
+    PressPhase,
     TactileContact,
 )
 from deformap.errors import InvalidArgumentError
@@ -136,3 +137,55 @@ def test_a_force_that_was_not_zeroed_or_points_away_is_refused() -> None:
     ForceTravel(travel_m=TRAVEL, force_n=FORCE - 0.05 - 0.9 * MIN_FORCE_RISE_N)  # noise at 0
     with pytest.raises(InvalidArgumentError, match=r"`force_n` must be the force pressing"):
         ForceTravel(travel_m=TRAVEL, force_n=FORCE - 0.5)
+
+
+# the hold and the unloading branch: time on the ramp's clock, each stretch after the one before
+RAMP_T = np.linspace(0.0, 0.8, 9)
+HOLD = dict(time_s=[0.9, 1.4, 1.9], travel_m=[0.0041, 0.0043, 0.0044], force_n=[0.6, 0.6, 0.6])
+UNLOAD = dict(time_s=[2.0, 2.1, 2.2], travel_m=[0.004, 0.002, 0.0005], force_n=[0.5, 0.2, 0.0])
+
+
+def _full(**change: object) -> ForceTravel:
+    fields: dict[str, object] = dict(travel_m=TRAVEL, force_n=FORCE, time_s=RAMP_T,
+                                     hold=PressPhase(**HOLD), unloading=PressPhase(**UNLOAD))
+    fields.update(change)
+    return ForceTravel(**fields)  # type: ignore[arg-type]
+
+
+def test_a_record_with_hold_and_unloading_is_kept_and_compared_whole() -> None:
+    record = _full()
+    assert record.hold is not None and len(record.hold) == 3
+    assert record.unloading is not None and not record.unloading.force_n.flags.writeable
+    assert record == _full()
+    assert record != _full(unloading=None)
+    assert record != ForceTravel(travel_m=TRAVEL, force_n=FORCE)
+
+
+@pytest.mark.parametrize(("change", "field"), [
+    (dict(time_s=RAMP_T[::-1]), "`time_s` must increase"),
+    (dict(time_s=RAMP_T[:5]), "`time_s`"),
+    (dict(hold=PressPhase(**{**HOLD, "time_s": [0.5, 1.4, 1.9]})), "`hold.time_s` must start"),
+    (dict(unloading=PressPhase(**{**UNLOAD, "time_s": [1.5, 1.6, 1.7]})),
+     "`unloading.time_s` must start"),
+    (dict(unloading=PressPhase(**{**UNLOAD, "force_n": [0.2, 0.5, 0.0]})),
+     "`unloading.force_n` must fall"),
+    (dict(time_s=None), "`time_s` must be given"),
+])
+def test_a_record_whose_time_or_unloading_is_impossible_is_refused(change: dict[str, object],
+                                                                   field: str) -> None:
+    with pytest.raises(InvalidArgumentError, match=field.replace("(", r"\(")):
+        _full(**change)
+
+
+@pytest.mark.parametrize(("change", "field"), [
+    (dict(time_s=[0.9]), "`travel_m` must have the shape|`time_s`"),
+    (dict(time_s=[], travel_m=[], force_n=[]), "`travel_m` must have at least 2 rows"),
+    (dict(force_n=[0.6, float("nan"), 0.6]), "`force_n`.*NaN"),
+    (dict(time_s=[0.9, float("inf"), 1.9]), "`time_s`.*NaN or infinite"),
+    (dict(travel_m=[0.0041, 0.0043, 4.4]), "`travel_m` must be metres"),
+    (dict(force_n=[0.6, -0.5, 0.6]), "`force_n` must be the force pressing"),
+])
+def test_a_stretch_with_no_samples_or_bad_values_is_refused(change: dict[str, object],
+                                                            field: str) -> None:
+    with pytest.raises(InvalidArgumentError, match=field):
+        PressPhase(**{**HOLD, **change})  # type: ignore[arg-type]

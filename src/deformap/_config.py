@@ -21,14 +21,18 @@ from typing import Any, Literal, TypeVar, get_args, get_origin
 
 import yaml
 
+from deformap._files import write_text_atomically
 from deformap._validation import SettingError, setting_metadata
 from deformap.errors import ConfigError, DeformapError
 
 #: Largest YAML file read (config, scenario, session; a session lists files, not their data).
 MAX_YAML_BYTES = 16 * 2**20
+#: Deepest nesting of mappings and lists read: a settings file nests a few levels, and every walk
+#: over what was read (its check, a report's JSON) recurses once per level.
+MAX_YAML_DEPTH = 64
 
-__all__ = ["config_from_dict", "config_to_dict", "described_yaml", "dump_yaml", "load_yaml",
-           "setting_docs"]
+__all__ = ["NoAliasDumper", "config_from_dict", "config_to_dict", "data_file_kind",
+           "described_yaml", "dump_yaml", "few", "load_yaml", "parse_yaml", "setting_docs"]
 
 T = TypeVar("T")
 
@@ -66,6 +70,13 @@ def _shape(value: Any, hint: Any, where: str) -> Any:
     return value
 
 
+def few(names: list[str], most: int = 5) -> str:
+    """``names`` as a list for a message: the first ``most``, each cut to 40 characters, and
+    how many more."""
+    shown = ", ".join(repr(n[:40]) for n in names[:most])
+    return f"[{shown}" + (f" and {len(names) - most:,} more]" if len(names) > most else "]")
+
+
 def config_from_dict(cls: type[T], data: Any, *, where: str = "config") -> T:
     """Build the settings dataclass ``cls`` from plain data; missing keys keep their defaults.
 
@@ -81,10 +92,10 @@ def config_from_dict(cls: type[T], data: Any, *, where: str = "config") -> T:
             shown = f"{type(data).__name__} of {len(str(data))} characters, {shown[:60]}…"
         raise ConfigError(f"`{where}` must be a mapping of settings; got {shown}")
     fields = {f.name: f for f in dataclasses.fields(cls) if f.init}  # type: ignore[arg-type]
-    unknown = sorted(set(data) - set(fields))
+    unknown = sorted(map(str, set(data) - set(fields)))
     if unknown:
         raise ConfigError(
-            f"`{where}` has unknown key(s) {unknown}; known keys are {sorted(fields)}")
+            f"`{where}` has unknown key(s) {few(unknown)}; known keys are {sorted(fields)}")
     hints = typing.get_type_hints(cls)
     kwargs = {name: _shape(value, hints[name], f"{where}.{name}") for name, value in data.items()}
     try:
@@ -97,8 +108,29 @@ def config_from_dict(cls: type[T], data: Any, *, where: str = "config") -> T:
         raise ConfigError(f"`{where}`: {exc}") from None
 
 
-class _UniqueKeyLoader(yaml.SafeLoader):
-    """PyYAML's safe loader, refusing a mapping that repeats a key (PyYAML keeps the last)."""
+class _StrictLoader(yaml.SafeLoader):
+    """PyYAML's safe loader, refusing anchors and aliases (``&name``, ``*name``) anywhere and a
+    mapping that repeats a key (PyYAML keeps the last).
+
+    Without aliases a document has at most as many nodes as its text has characters, so reading
+    it, and every walk over what it read, is bounded by the file's size: a nested alias bomb
+    ("billion laughs") is refused at its first anchor, before anything is built.
+    """
+
+    def compose_node(self, parent: Any, index: Any) -> Any:
+        event = self.peek_event()
+        mark = event.start_mark
+        where = f"line {mark.line + 1}, column {mark.column + 1}"
+        if isinstance(event, yaml.AliasEvent) or getattr(event, "anchor", None) is not None:
+            raise _AliasRefused(where)
+        depth = getattr(self, "_depth", 0) + 1
+        if depth > MAX_YAML_DEPTH:
+            raise _TooDeep(where)
+        self._depth = depth
+        try:
+            return super().compose_node(parent, index)
+        finally:
+            self._depth = depth - 1
 
     def construct_mapping(self, node: yaml.MappingNode, deep: bool = False) -> dict[Any, Any]:
         seen: set[Any] = set()
@@ -116,13 +148,70 @@ class _UniqueKeyLoader(yaml.SafeLoader):
         return super().construct_mapping(node, deep=deep)
 
 
+class _AliasRefused(Exception):
+    """An anchor or alias met while composing (its place in the text)."""
+
+
+class _TooDeep(Exception):
+    """Nesting deeper than :data:`MAX_YAML_DEPTH` met while composing (its place in the text)."""
+
+
+def parse_yaml(text: str, *, where: str) -> Any:
+    """Plain data of the YAML ``text`` (one document; mappings, lists and scalars only).
+
+    The one YAML reader of deformap: anchors and aliases are refused anywhere (so what is read is
+    bounded by the text's size), and so are nesting deeper than :data:`MAX_YAML_DEPTH` and a
+    mapping that repeats a key. ``where`` names the text
+    in the message (a file's path, ``--set key``).
+
+    Raises
+    ------
+    ConfigError
+        One line naming ``where``: an anchor or alias (with its line), a syntax error, nesting too
+        deep, an impossible date, a repeated key.
+    """
+    try:
+        return yaml.load(text, Loader=_StrictLoader)  # a SafeLoader: plain data only
+    except _AliasRefused as exc:
+        raise ConfigError(
+            f"{where}: YAML anchors and aliases (&name, *name) are not accepted ({exc}); "
+            "write each value out in full") from None
+    except _TooDeep as exc:
+        raise ConfigError(f"{where}: YAML nested deeper than {MAX_YAML_DEPTH} levels ({exc})"
+                          ) from None
+    except (yaml.YAMLError, RecursionError, ValueError) as exc:
+        detail = f"{type(exc).__name__}: {exc}".replace("\n", " ")[:300]
+        raise ConfigError(f"{where} is not valid YAML: {detail}") from None
+
+
+#: Leading bytes (or, for text formats, the suffix) of data files a YAML file is mistaken for.
+_DATA_FILES = ((b"\x89MCAP", None, "an MCAP file (a ROS 2 bag)"),
+               (b"SQLite format 3\x00", None, "a sqlite3 database (a ROS 2 bag?)"),
+               (b"ply\n", ".ply", "a PLY point cloud"), (b"ply\r\n", ".ply", "a PLY point cloud"),
+               (b"# .PCD", ".pcd", "a PCD point cloud"), (b"VERSION 0.", ".pcd", "a PCD point cloud"),
+               (b"VERSION .", ".pcd", "a PCD point cloud"),
+               (b"\x93NUMPY", ".npy", "a NumPy array file"),
+               (b"PK\x03\x04", ".npz", "a zip archive (an NPZ file?)"),
+               (b"\x89PNG", ".png", "a PNG image"))
+
+
+def data_file_kind(path: Path, head: bytes) -> str | None:
+    """What the file ``path`` whose first bytes are ``head`` is, when it is one of the data files
+    deformap reads (a cloud, a bag, an array) rather than YAML; else None."""
+    suffix = path.suffix.lower()
+    for magic, known_suffix, kind in _DATA_FILES:
+        if head.startswith(magic) or (known_suffix is not None and suffix == known_suffix):
+            return kind
+    return None
+
+
 def load_yaml(path: str | Path, *, what: str = "config file",
               unreadable: type[DeformapError] = ConfigError) -> Any:
-    """Read a YAML file safely (plain data only); errors name the file.
+    """Read a YAML file through :func:`parse_yaml`; errors name the file.
 
-    A file that cannot be read raises ``unreadable`` (``cannot read {what}``); bytes that are not
-    UTF-8, or text PyYAML refuses (a syntax error, nesting too deep, an impossible date), raise
-    :class:`ConfigError`.
+    A file that cannot be read raises ``unreadable`` (``cannot read {what}``); a data file
+    (:func:`data_file_kind`: a cloud, a bag), bytes that are not UTF-8, or text
+    :func:`parse_yaml` refuses, raise :class:`ConfigError` (the first naming what the file is).
     """
     p = Path(path)
     try:
@@ -130,6 +219,9 @@ def load_yaml(path: str | Path, *, what: str = "config file",
             raise unreadable(f"cannot read {what} {str(p)!r}: not a regular file")
         with p.open("rb") as stream:
             raw = stream.read(MAX_YAML_BYTES + 1)
+        kind = data_file_kind(p, raw[:16])
+        if kind is not None:
+            raise ConfigError(f"{str(p)!r} is {kind}, not YAML ({what})")
         if len(raw) > MAX_YAML_BYTES:
             raise unreadable(f"cannot read {what} {str(p)!r}: larger than "
                              f"{MAX_YAML_BYTES // 2**20} MiB")
@@ -138,27 +230,34 @@ def load_yaml(path: str | Path, *, what: str = "config file",
         raise unreadable(f"cannot read {what} {str(p)!r}: {exc.strerror or exc}") from None
     except UnicodeDecodeError as exc:
         raise ConfigError(f"{str(p)!r} is not UTF-8 text (byte {exc.start})") from None
-    try:
-        return yaml.load(text, Loader=_UniqueKeyLoader)  # a SafeLoader: plain data only
-    except (yaml.YAMLError, RecursionError, ValueError) as exc:
-        detail = f"{type(exc).__name__}: {exc}".replace("\n", " ")[:300]
-        raise ConfigError(f"{str(p)!r} is not valid YAML: {detail}") from None
+    return parse_yaml(text, where=repr(str(p)))
+
+
+class NoAliasDumper(yaml.SafeDumper):
+    """PyYAML's safe dumper writing a value met twice in full each time, never as an anchor and
+    alias, so that :func:`parse_yaml` reads back what deformap writes."""
+
+    def ignore_aliases(self, data: Any) -> bool:
+        return True
 
 
 def dump_yaml(data: Any, path: str | Path | None = None) -> str:
-    """Write plain data as YAML (block style, keys in definition order); return the text."""
-    text = yaml.safe_dump(config_to_dict(data), sort_keys=False, default_flow_style=False)
+    """Write plain data as YAML (block style, keys in definition order, no aliases); return the
+    text. With ``path`` it is written there atomically (:mod:`deformap._files`: a failure is one
+    :class:`~deformap.errors.FileWriteError` naming the file, nothing half-written left)."""
+    text = yaml.dump(config_to_dict(data), Dumper=NoAliasDumper, sort_keys=False,
+                     default_flow_style=False)
     if path is not None:
-        Path(path).write_text(text, encoding="utf-8")
+        write_text_atomically(path, text)
     return text
 
 
 # -- the configuration reference: YAML with each setting's description, unit and bounds --------
 
 #: Unit of a setting by the suffix of its name, longest first.
-_UNIT_SUFFIXES = (("_n_per_m", "N/m"), ("_kpa", "kPa"), ("_deg", "degrees"), ("_rel", "fraction"),
-                  ("_pa", "Pa"), ("_mm", "mm"), ("_hz", "Hz"), ("_px", "pixels"), ("_m", "m"),
-                  ("_n", "N"), ("_s", "s"))
+_UNIT_SUFFIXES = (("_n_per_m", "N/m"), ("_n_per_s", "N/s"), ("_kpa", "kPa"), ("_deg", "degrees"),
+                  ("_rel", "fraction"), ("_pa", "Pa"), ("_mm", "mm"), ("_hz", "Hz"), ("_px", "pixels"),
+                  ("_m", "m"), ("_n", "N"), ("_s", "s"))
 #: Unit words a numpydoc type line may end with (``reference_modulus_pa : float, pascals``).
 _UNIT_WORDS = {"metres": "m", "meters": "m", "newtons": "N", "pascals": "Pa", "seconds": "s",
                "degrees": "degrees", "radians": "rad", "n/m": "N/m"}
@@ -295,6 +394,6 @@ def _describe(obj: Any, prefix: str, docs: dict[str, tuple[str | None, list[str]
             lines.append(f"{indent}{f.name}:")
             _describe(value, name + ".", docs, lines, width)
             continue
-        text = yaml.safe_dump({f.name: config_to_dict(value)}, sort_keys=False,
-                              default_flow_style=False)
+        text = yaml.dump({f.name: config_to_dict(value)}, Dumper=NoAliasDumper, sort_keys=False,
+                         default_flow_style=False)
         lines.extend(indent + line for line in text.splitlines())

@@ -24,10 +24,10 @@ from numpy.typing import NDArray
 
 from deformap.errors import InvalidArgumentError
 
-__all__ = ["SettingError", "check_array", "check_finite_scalar", "check_in_range",
-           "check_instance", "check_int", "check_path", "check_points", "check_positive",
-           "check_rigid_transform", "check_settings", "check_slope_deg", "check_vector",
-           "describe", "setting", "setting_metadata"]
+__all__ = ["LIMITS", "SettingError", "check_array", "check_finite_scalar", "check_in_range",
+           "check_instance", "check_int", "check_limit", "check_path", "check_points",
+           "check_positive", "check_rigid_transform", "check_settings", "check_slope_deg",
+           "check_vector", "describe", "setting", "setting_metadata"]
 
 _T = TypeVar("_T")
 
@@ -188,18 +188,34 @@ class SettingError(InvalidArgumentError):
         return (type(self), (self.field, self.detail))
 
 
+#: Physical bounds of quantities that several settings and files give, each with the reason a
+#: message states: ``setting(..., limit=NAME)`` and :func:`check_limit` read them from here, so a
+#: probe's tip or a session's pokes obey one rule wherever they come from.
+LIMITS: dict[str, dict[str, Any]] = {
+    # below a micrometre no camera sees the dent and Hertz contact's radius underflows; a metre is
+    # no probe an arm holds
+    "tip_radius_m": {"ge": 1e-6, "le": 1.0,
+                     "why": "a probe's spherical tip, from a micrometre to a metre"},
+    # every poke is a press and a β sweep (seconds), and the fields' and the planner's matrices grow
+    # with the pokes
+    "pokes": {"ge": 1, "le": 1000, "why": "the pokes one map is made of"},
+}
+
+
 def setting(default: Any, *, gt: float | None = None, ge: float | None = None,
             lt: float | None = None, le: float | None = None, finite: bool = True,
-            doc: str | None = None) -> Any:
+            doc: str | None = None, limit: str | None = None) -> Any:
     """A dataclass field whose bounds and description are declared beside it.
 
     ``default`` is immutable. Each bound given (``value > gt``, ``>= ge``, ``< lt``, ``<= le``) is
     checked in that order, on every entry of a tuple and on a value that is not ``None``; ``finite``
-    refuses NaN and infinities of a float. ``doc``, one line, is what ``deformap config dump`` shows
-    instead of the class docstring's "Parameters" entry.
+    refuses NaN and infinities of a float. ``limit`` names an entry of :data:`LIMITS` whose bounds
+    (and reason, in the message) apply besides. ``doc``, one line, is what ``deformap config dump``
+    shows instead of the class docstring's "Parameters" entry.
     """
-    bounds = {key: bound for key, bound in (("gt", gt), ("ge", ge), ("lt", lt), ("le", le))
-              if bound is not None}
+    bounds: dict[str, Any] = dict(LIMITS[limit]) if limit is not None else {}
+    bounds.update({key: bound for key, bound in (("gt", gt), ("ge", ge), ("lt", lt), ("le", le))
+                   if bound is not None})
     metadata: dict[str, Any] = {_BOUNDS: {"finite": finite, **bounds}}
     if doc is not None:
         metadata[_DOC] = doc
@@ -315,5 +331,22 @@ def _check_bounds(name: str, value: float, bounds: dict[str, Any], kind: str) ->
                        ("le", operator.le)):
         bound = bounds.get(key)
         if bound is not None and not holds(value, bound):
-            raise SettingError(name, f"must be {kind}{_BOUND_TEXT[key]} {bound:g}; got {value!r}")
+            why = f" ({bounds['why']})" if "why" in bounds else ""
+            raise SettingError(
+                name, f"must be {kind}{_BOUND_TEXT[key]} {bound:g}{why}; got {value!r}")
     return value
+
+
+def check_limit(name: str, value: Any, limit: str) -> Any:
+    """Validate a number read outside a settings dataclass (a session file's entry, a count)
+    against the :data:`LIMITS` entry ``limit``, by the rules of :func:`check_settings`: a real
+    number (an integer where the limit's bounds are integers), finite, within the bounds.
+
+    Raises
+    ------
+    SettingError
+        Naming ``name``, the bound with its reason, and what came.
+    """
+    bounds = LIMITS[limit]
+    integral = all(isinstance(bounds[k], int) for k in _BOUND_TEXT if k in bounds)
+    return _check_value(name, value, int if integral else float, {"finite": True, **bounds})

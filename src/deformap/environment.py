@@ -19,13 +19,13 @@ import numpy as np
 from numpy.typing import NDArray
 
 from deformap._validation import check_array, check_points, check_positive, check_vector
-from deformap.cloud import PointCloud, hull_parts
+from deformap.cloud import PointCloud, hull_parts, tip_in_view
 from deformap.errors import InvalidArgumentError
 from deformap.mechanics import TactileContact
 
 __all__ = ["FORCE_MISMATCH_ABS_N", "FORCE_MISMATCH_REL", "MAX_GRID_CELLS", "MAX_TRAVEL_M",
-           "MIN_FORCE_RISE_N", "TRAVEL_BACKWARDS_TOLERANCE_M", "Environment", "ForceTravel",
-           "PressObservation", "TactileContact", "Workspace"]
+           "MIN_FORCE_RISE_N", "TIP_IN_VIEW_RADII", "TRAVEL_BACKWARDS_TOLERANCE_M", "Environment",
+           "ForceTravel", "PressObservation", "PressPhase", "TactileContact", "Workspace"]
 
 
 #: Most cells of a :meth:`Workspace.grid` (200 MB per float map layer).
@@ -94,6 +94,10 @@ MAX_TRAVEL_M = 0.05
 #: The force must rise by more than this [N] over a record: four times a probe sensor's noise.
 MIN_FORCE_RISE_N = 0.02
 
+#: A point of the cloud after release within this many tip radii of the tip centre may be the tip
+#: itself (the tip's radius and a margin for depth noise; :class:`PressObservation`).
+TIP_IN_VIEW_RADII = 1.1
+
 #: A measured force may differ from the commanded by at most ``FORCE_MISMATCH_REL · force_n +
 #: FORCE_MISMATCH_ABS_N``: far beyond a controller's overshoot and a sensor's noise.
 FORCE_MISMATCH_REL = 0.25
@@ -102,6 +106,70 @@ FORCE_MISMATCH_ABS_N = 0.05
 
 def _allowed_mismatch(force_n: float) -> float:
     return FORCE_MISMATCH_REL * force_n + FORCE_MISMATCH_ABS_N
+
+
+def _check_times(name: str, value: Any, size: int, after: float | None) -> NDArray[np.float64]:
+    times = np.array(check_array(name, value, (size,), what="seconds"))
+    step = np.diff(times)
+    if step.size and float(step.min()) <= 0.0:
+        at = int(np.argmax(step <= 0.0)) + 1
+        raise InvalidArgumentError(
+            f"`{name}` must increase sample by sample; sample {at} ({times[at]:.6g} s) does not "
+            f"come after sample {at - 1} ({times[at - 1]:.6g} s)")
+    if after is not None and float(times[0]) < after:
+        raise InvalidArgumentError(
+            f"`{name}` must start at or after the stretch before it ends ({after:.6g} s); got "
+            f"{times[0]:.6g} s (time going backwards)")
+    times.setflags(write=False)
+    return times
+
+
+@dataclass(frozen=True, kw_only=True)
+class PressPhase:
+    """A stretch of a press after its loading ramp, ``n >= 2`` samples in time order: the hold
+    (the commanded force or position held) or the unloading branch (the tip retracting).
+
+    ``time_s`` is seconds on the ramp's clock, strictly increasing; ``travel_m`` the travel since
+    first contact [m] (as the ramp's, within :data:`MAX_TRAVEL_M`), ``force_n`` the normal force
+    [N], >= 0 within :data:`MIN_FORCE_RISE_N`. Stored as read-only float64 copies.
+    """
+
+    time_s: NDArray[np.float64]
+    travel_m: NDArray[np.float64]
+    force_n: NDArray[np.float64]
+
+    def __post_init__(self) -> None:
+        travel = np.array(check_array("travel_m", self.travel_m, (None,), what="metres", min_rows=2))
+        force = np.array(check_array("force_n", self.force_n, (travel.size,), what="newtons"))
+        times = _check_times("time_s", self.time_s, travel.size, None)
+        if (largest := float(np.max(np.abs(travel)))) > MAX_TRAVEL_M:
+            raise InvalidArgumentError(f"`travel_m` must be metres, at most {MAX_TRAVEL_M} m in "
+                                       f"magnitude; got {largest:.4g}")
+        if float(force.min()) < -MIN_FORCE_RISE_N:
+            raise InvalidArgumentError(
+                f"`force_n` must be the force pressing the surface, >= 0 within {MIN_FORCE_RISE_N} "
+                f"N; got {float(force.min()):.4g} N")
+        for name, arr in (("travel_m", travel), ("force_n", force), ("time_s", times)):
+            arr.setflags(write=False)
+            object.__setattr__(self, name, arr)
+
+    def __len__(self) -> int:
+        return int(self.travel_m.size)
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, PressPhase):
+            return NotImplemented
+        return all(np.array_equal(getattr(self, k), getattr(other, k))
+                   for k in ("time_s", "travel_m", "force_n"))
+
+
+def _same(a: PressPhase | NDArray[np.float64] | None,
+          b: PressPhase | NDArray[np.float64] | None) -> bool:
+    """Equality of two optional parts of a record (``None`` equals only ``None``)."""
+    if a is None or b is None:
+        return a is None and b is None
+    return bool(a == b) if isinstance(a, PressPhase) or isinstance(b, PressPhase) else bool(
+        np.array_equal(a, b))
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -113,10 +181,19 @@ class ForceTravel:
     than :data:`TRAVEL_BACKWARDS_TOLERANCE_M` below its largest before, within :data:`MAX_TRAVEL_M`.
     ``force_n`` is the normal force on the surface [N], its last sample positive and more than
     :data:`MIN_FORCE_RISE_N` above the first. Both are stored as read-only float64 copies.
+
+    Optional, for what the press did besides loading (``None``: the robot did not say): ``time_s``,
+    the ramp's sample times [s], strictly increasing; ``hold``, the samples while the commanded
+    force or position is held; ``unloading``, the samples as the tip retracts, whose force never
+    rises by more than :data:`MIN_FORCE_RISE_N`. A hold or unloading needs ``time_s``; each stretch
+    starts no earlier than the one before ends.
     """
 
     travel_m: NDArray[np.float64]
     force_n: NDArray[np.float64]
+    time_s: NDArray[np.float64] | None = None
+    hold: PressPhase | None = None
+    unloading: PressPhase | None = None
 
     def __post_init__(self) -> None:
         travel = np.array(check_array("travel_m", self.travel_m, (None,), what="metres",
@@ -159,6 +236,36 @@ class ForceTravel:
         force.setflags(write=False)
         object.__setattr__(self, "travel_m", travel)
         object.__setattr__(self, "force_n", force)
+        self._check_phases(travel.size)
+
+    def _check_phases(self, n: int) -> None:
+        if self.time_s is None:
+            if self.hold is not None or self.unloading is not None:
+                raise InvalidArgumentError(
+                    "`time_s` must be given with a hold or an unloading branch (their times are "
+                    "on the ramp's clock); got none")
+            return
+        times = _check_times("time_s", self.time_s, n, None)
+        object.__setattr__(self, "time_s", times)
+        end = float(times[-1])
+        for name in ("hold", "unloading"):
+            phase = getattr(self, name)
+            if phase is None:
+                continue
+            if not isinstance(phase, PressPhase):
+                raise InvalidArgumentError(f"`{name}` must be a PressPhase; got {type(phase)}")
+            _check_times(f"{name}.time_s", phase.time_s, len(phase), end)
+            end = float(phase.time_s[-1])
+        unloading = self.unloading
+        if unloading is not None:
+            lowest = np.minimum.accumulate(unloading.force_n)
+            rise = unloading.force_n - lowest
+            worst = int(np.argmax(rise))
+            if rise[worst] > MIN_FORCE_RISE_N:
+                raise InvalidArgumentError(
+                    f"`unloading.force_n` must fall as the tip retracts (no rise beyond "
+                    f"{MIN_FORCE_RISE_N} N); sample {worst} lies {rise[worst]:.4g} N above the "
+                    "lowest force before it")
 
     def __len__(self) -> int:
         return int(self.travel_m.size)
@@ -167,7 +274,9 @@ class ForceTravel:
         if not isinstance(other, ForceTravel):
             return NotImplemented
         return bool(np.array_equal(self.travel_m, other.travel_m)
-                    and np.array_equal(self.force_n, other.force_n))
+                    and np.array_equal(self.force_n, other.force_n)
+                    and all(_same(getattr(self, k), getattr(other, k))
+                            for k in ("time_s", "hold", "unloading")))
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -180,6 +289,12 @@ class PressObservation:
     ``force_travel`` (None where the environment has no record). ``robot_points`` ((m, 3), at least
     4 not coplanar) span the stick and hand, or a tuple holds one such array per part, each hull
     removed on its own (:attr:`robot_hulls` gives the tuple either way).
+
+    ``released`` (optional) is the surface seen once the tip has left, for the dent the press
+    kept. A cloud with the tip still in view is refused: its points within
+    :data:`TIP_IN_VIEW_RADII` tip radii of ``contact.tip_center`` and more than half a radius
+    above it (the tip's top, what a camera above sees of it) are the tip when their median height
+    stands more than a quarter radius above the surface 2–3 radii away (its 90th percentile).
     """
 
     cloud: PointCloud
@@ -188,6 +303,7 @@ class PressObservation:
     target_xy: NDArray[np.float64]
     force_n: float
     force_travel: ForceTravel | None = None
+    released: PointCloud | None = None
 
     def __post_init__(self) -> None:
         if not isinstance(self.cloud, PointCloud):
@@ -208,6 +324,7 @@ class PressObservation:
         force_n = check_positive("force_n", self.force_n)
         object.__setattr__(self, "force_n", force_n)
         self._check_contact_force(force_n)
+        self._check_released()
         record = self.force_travel
         if record is None:
             return
@@ -220,6 +337,21 @@ class PressObservation:
                 f"`force_travel` must end at the commanded force {force_n:.4g} N (within "
                 f"{allowed:.3g} N); its last force is {final:.4g} N")
 
+    def _check_released(self) -> None:
+        """The cloud after release must be a PointCloud with no point where the tip's top would be."""
+        released = self.released
+        if released is None:
+            return
+        if not isinstance(released, PointCloud):
+            raise InvalidArgumentError(
+                f"`released` must be a PointCloud or None; got {type(released).__name__}")
+        shown = tip_in_view(released.points, self.contact.tip_center, self.contact.tip_radius_m,
+                            within_radii=TIP_IN_VIEW_RADII)
+        if shown:
+            raise InvalidArgumentError(
+                f"`released` must be seen once the tip has left; {shown} of its points lie within "
+                f"{TIP_IN_VIEW_RADII} tip radii of the tip centre, on its top (the tip still in "
+                "view)")
 
     @property
     def robot_hulls(self) -> tuple[NDArray[np.float64], ...]:

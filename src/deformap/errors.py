@@ -7,7 +7,8 @@ class also derives from the closest builtin (``ValueError``, ...) for generic ha
 from __future__ import annotations
 
 __all__ = ["ConfigError", "DeformapError", "EnvironmentStateError", "FileFormatError",
-           "InvalidArgumentError", "MissingDependencyError", "NotPositiveDefiniteError"]
+           "FileWriteError", "InvalidArgumentError", "MissingDependencyError",
+           "NotPositiveDefiniteError"]
 
 
 class DeformapError(Exception):
@@ -24,6 +25,11 @@ class NotPositiveDefiniteError(DeformapError, ArithmeticError):
 
 class FileFormatError(DeformapError, ValueError):
     """A file is missing, truncated, corrupted, or lacks a required field."""
+
+
+class FileWriteError(DeformapError, OSError):
+    """A file could not be written (no space left, a read-only file system, a quota, no
+    permission); the message names the file and the cause, ``errno`` is the system's."""
 
 
 class ConfigError(DeformapError, ValueError):

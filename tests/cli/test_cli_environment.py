@@ -55,10 +55,14 @@ def robot_folder(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
 
 def test_a_users_environment_is_explored_with_every_output(robot_folder: Path) -> None:
     out = robot_folder / "run"
+    import importlib.util
+
+    rerun = ["--rerun"] if importlib.util.find_spec("rerun") else []  # the `rerun` extra
     result = runner.invoke(app, ["explore", "--environment", "my_robot_env:make", "--env-arg",
                                  "seed=1", "--env-arg", "scale=0.5", "--config", "small.yaml",
-                                 "--out", str(out)])  # fmt: skip
+                                 "--out", str(out), *rerun])  # fmt: skip
     assert result.exit_code == 0, result.output
+    assert (out / "run.rrd").is_file() == bool(rerun)
     import my_robot_env  # type: ignore[import-not-found]
 
     assert my_robot_env.CALLS == [("heterogeneous-60-150", 1, 0.5)]  # YAML scalars: int, float

@@ -227,3 +227,21 @@ def test_a_painted_benchmark_is_written_and_rescored_to_the_bit(tmp_path) -> Non
     assert blind(rescored) == blind(rows) and len(blind(rows)) == 4
     assert [(r["world"], r["prior"], r["poke"]) for r in rescored] == [
         (r["world"], r["prior"], r["poke"]) for r in rows]
+
+
+def test_the_prior_arm_is_scored_on_the_map_the_mapper_draws(monkeypatch) -> None:
+    """Under the prior, ``nearest`` labels each cell by its most correlated poke
+    (``Mapper.regions``); the bench must score that map, not the blind labelling."""
+    import deformap.eval._worlds as worlds
+
+    calls: list[bool] = []
+    real = worlds.map_regions
+
+    def spy(*args, correlation=None, **kwargs):
+        calls.append(correlation is not None)
+        return real(*args, correlation=correlation, **kwargs)
+
+    monkeypatch.setattr(worlds, "map_regions", spy)
+    run_world(_task(appearances=("informative",), max_pokes=3))
+    # blind first (three pokes, no correlation), then the prior's (with the looks' correlation)
+    assert calls[:3] == [False] * 3 and len(calls) == 6 and all(calls[4:])

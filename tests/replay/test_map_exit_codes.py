@@ -17,7 +17,7 @@ runner = CliRunner()
 def test_a_session_with_no_usable_poke_exits_2_after_writing_its_report(
     tmp_path: Path, synthetic, write_synthetic  # type: ignore[no-untyped-def]
 ) -> None:
-    session = write_synthetic(tmp_path / "session", synthetic)
+    session = write_synthetic(tmp_path / "session", synthetic, sealed=False)
     for cloud in (tmp_path / "session").glob("poke-0[0-9].pcd"):
         cloud.unlink()
     out = tmp_path / "map"
@@ -67,7 +67,8 @@ def test_a_camera_only_session_maps_on_beta_and_says_so(tmp_path: Path, syntheti
     assert report["field"] == "beta" and report["n_pokes"] == 3
     assert report["field_fallback"].startswith("`exploration.field` 'modulus' fell back to 'beta'")
     assert report["field_fallback"] in report["warnings"]
-    assert "fell back to 'beta'" in result.output
+    # said once, though each of the three pokes gives the same reason
+    assert result.output.count("fell back to 'beta'") == 1
 
 
 def test_a_session_with_records_maps_on_the_modulus(tmp_path: Path, synthetic,  # type: ignore[no-untyped-def]

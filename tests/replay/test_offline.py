@@ -174,7 +174,7 @@ def test_session_without_ground_truth_has_no_metrics(recorded: Path, tmp_path: P
     shutil.copytree(recorded, session)
     (session / "ground_truth.npz").unlink()
     doc = yaml.safe_load((session / "session.yaml").read_text())
-    del doc["ground_truth"], doc["n_pokes"]  # edited by hand: no longer 3 pokes
+    del doc["ground_truth"], doc["n_pokes"], doc["sha256"]  # edited by hand: 1 poke, no truth
     doc["pokes"] = doc["pokes"][:1]
     (session / "session.yaml").write_text(yaml.safe_dump(doc))
     result = _cli("map", str(session), "--out", str(tmp_path / "map"))
@@ -254,6 +254,70 @@ def test_estimate_agrees_with_the_mapper(recorded: Path, live: dict[str, Any], c
         "beta-curve.png", "estimate.json", "poke.png"]  # fmt: skip
 
 
+def _write_record(path: Path, travel_m: Any, force_n: Any, header: str = "time_s,travel_mm,force_n"
+                  ) -> Path:  # fmt: skip
+    rows = [header] + [f"{0.01 * i:.2f},{1e3 * float(t)!r},{float(f)!r}" for i, (t, f) in
+                       enumerate(zip(travel_m, force_n, strict=True))]  # fmt: skip
+    path.write_text("\n".join(rows) + "\n")
+    return path
+
+
+def test_estimate_with_a_force_travel_record_gives_the_mappers_modulus(
+        recorded: Path, live: dict[str, Any], config_file: Path, tmp_path: Path) -> None:
+    session = load_session(recorded)
+    press = session.press_observation(0)
+    assert press.force_travel is not None
+    write_cloud(tmp_path / "before.ply", session.observation())
+    write_cloud(tmp_path / "after.npz", press.cloud)
+    record = _write_record(tmp_path / "press.csv", press.force_travel.travel_m,
+                           press.force_travel.force_n)  # fmt: skip
+    c = press.contact
+    args = ["estimate", "--before", str(tmp_path / "before.ply"),
+            "--after", str(tmp_path / "after.npz"), "--contact", *map(repr, c.tip_center.tolist()),
+            "--force", *map(repr, c.force.tolist()), "--tip-radius", repr(c.tip_radius_m),
+            "--config", str(config_file)]  # fmt: skip
+    result = _cli(*args, "--record", str(record), "--json", str(tmp_path / "e.json"))
+    assert result.exit_code == 0, result.output
+    est = json.loads((tmp_path / "e.json").read_text())
+    mapped = live["pokes"][0]
+    # the same record read as the mapper reads it; the layer's thickness comes from a surface fit
+    # over the poke's surroundings only, so E agrees to the thickness's effect, not to the bit
+    assert est["depth_anchored"] is True and est["stiffness"]["rigid"] is False
+    assert est["stiffness"]["modulus_pa"] == pytest.approx(mapped["stiffness"]["modulus_pa"], rel=0.02)
+    assert est["layer_thickness_m"] == pytest.approx(mapped["layer_thickness_m"], abs=1e-3)
+    assert abs(est["beta"] - mapped["beta"]) <= 1.0 / N_BETA + 1e-12
+    assert "E = " in result.output and "kPa" in result.output
+    # without the record: no modulus, said so in the report
+    result = _cli(*args, "--json", str(tmp_path / "b.json"))
+    bare = json.loads((tmp_path / "b.json").read_text())
+    assert result.exit_code == 0 and bare["stiffness"] is None and bare["depth_anchored"] is False
+    # a record of another press (ending far from --force) is refused naming both options
+    result = _cli(*args, "--record", str(_write_record(
+        tmp_path / "other.csv", press.force_travel.travel_m, 2.0 * press.force_travel.force_n)))
+    assert result.exit_code == 2 and "--record/--force" in result.output, result.output
+
+
+@pytest.mark.parametrize(
+    ("text", "match"),
+    [
+        ("travel_m,force\n0,0\n", "must name one travel column (travel_m or travel_mm) and force_n"),
+        ("travel_m,force_n\n", "no samples below the header"),
+        ("travel_m,force_n\n0,0\n0.001,x\n", "row 3 must hold a number"),
+        ("travel_m,force_n\n0,0\n0.001,nan\n", "row 3 holds a NaN"),
+        ("travel_m,force_n\n0,0\n0.002,0.3\n0.001,0.6\n", "`travel_m` must not go back"),
+        ("\xff\xfe", "cannot read this force–travel record"),
+    ],
+)
+def test_estimate_refuses_a_bad_force_travel_record(tmp_path: Path, text: str, match: str) -> None:
+    write_cloud(tmp_path / "c.pcd", PointCloud(np.random.default_rng(0).uniform(0, 0.3, (50, 3))))
+    (tmp_path / "r.csv").write_bytes(text.encode("latin-1"))
+    result = _cli("estimate", "--before", str(tmp_path / "c.pcd"), "--after",
+                  str(tmp_path / "c.pcd"), "--contact", "0.1", "0.1", "0.05", "--force", "0", "0",
+                  "-0.6", "--tip-radius", "0.01", "--record", str(tmp_path / "r.csv"))  # fmt: skip
+    assert result.exit_code == 2, result.output
+    assert "r.csv" in result.output and match in " ".join(result.output.split()), result.output
+
+
 @pytest.mark.parametrize(
     ("args", "match"),
     [
@@ -327,3 +391,18 @@ def test_recorded_world_presses_read_back_identical(tmp_path: Path, form: str) -
         assert want.force_travel is not None
         assert got.force_travel == want.force_travel
         assert np.array_equal(got.cloud.points, want.cloud.points)
+
+
+def test_map_rerun_writes_the_recording_of_the_mapped_session(recorded: Path, tmp_path: Path
+                                                              ) -> None:  # fmt: skip
+    pytest.importorskip("rerun")
+    from rerun.chunk import RrdReader
+
+    result = _cli("map", str(recorded), "--out", str(tmp_path / "m"), "--no-figures", "--rerun")
+    assert result.exit_code == 0, result.output
+    chunks = list(RrdReader(tmp_path / "m" / "run.rrd").stream())
+    entities = {str(c.entity_path) for c in chunks}
+    assert {"/world", "/world/observation", "/world/press/dent", "/maps/beta"} <= entities
+    beta = [c.to_record_batch() for c in chunks if str(c.entity_path) == "/metrics/beta"]
+    assert sum(b.num_rows for b in beta) == len(load_session(recorded))  # one row a poke
+    assert all({"poke", "time"} <= set(b.schema.names) for b in beta)

@@ -16,7 +16,7 @@ from deformap.cloud import PointCloud, points_in_hull
 from deformap.environment import PressObservation, TactileContact
 from deformap.errors import InvalidArgumentError
 from deformap.replay import DEFAULT_HULL, HullPart, load_session, write_session
-from deformap.replay._rawbag import hull_points
+from deformap.replay._rawconfig import hull_points
 
 TIP = np.array([0.3, 0.2, 0.06])
 

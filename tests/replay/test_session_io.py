@@ -109,7 +109,7 @@ def test_camera_frame_folder_is_mapped_to_world(tmp_path: Path, synthetic, write
 
 
 def test_inline_robot_points(tmp_path: Path, synthetic, write_synthetic) -> None:
-    file = write_synthetic(tmp_path / "s", synthetic)
+    file = write_synthetic(tmp_path / "s", synthetic, sealed=False)
     doc = yaml.safe_load(file.read_text())
     doc["pokes"][0]["robot_points"] = synthetic.presses[0].robot_points.tolist()
     file.write_text(yaml.safe_dump(doc))

@@ -47,6 +47,15 @@ def test_record_run_writes_a_recording_rerun_can_read(tmp_path) -> None:
     views = {e for e in layout if e.startswith("/view/") and e.count("/") == 2}
     # the 3D scene, four maps, the regions and the time series, in three containers
     assert len(views) == 7 and sum(e.startswith("/container/") for e in layout) == 3
+    # a Z-up world; each step on both timelines, the time rising with the pokes' own timings
+    assert "ViewCoordinates:xyz" in columns["/world"]
+    batches = [c.to_record_batch() for c in reader.stream() if str(c.entity_path) == "/metrics/beta"]
+    assert all({"poke", "time"} <= set(b.schema.names) for b in batches)
+    times = [int(t) for b in batches for t in b.column("time").cast("int64").to_pylist()]  # ns
+    assert len(times) == 2 and 0 < times[0] < times[1]
+    spent = [p.record.timings.compute_s + (p.record.timings.environment_s or 0.0)
+             for p in result.pokes]  # fmt: skip
+    assert times[1] / 1e9 == pytest.approx(sum(spent), rel=1e-6)
     # without a world: no ground truth, no robot hull
     assert "/maps/truth_hardness_n" not in entities and "/world/press/robot_hull" not in entities
 

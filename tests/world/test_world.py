@@ -265,7 +265,7 @@ def test_noise_switch_turns_off_camera_and_force_noise() -> None:
     np.testing.assert_allclose(obs.cloud.z[far], 0.05, atol=1e-6)
     with pytest.raises(InvalidArgumentError, match="`hand_size_m`"):
         WorldConfig(hand_size_m=(0.1, 0.0, 0.1))
-    with pytest.raises(InvalidArgumentError, match="`tip_radius_m` must be > 0"):
+    with pytest.raises(InvalidArgumentError, match="`tip_radius_m` must be >= 1e-06"):
         WorldConfig(tip_radius_m=-0.01)
 
 

@@ -1,7 +1,8 @@
 """What every command shares: the ``deformap`` app, its consoles, one-line errors and ``--json``.
 
-Every command turns a :class:`~deformap.errors.DeformapError` into one line on stderr and exit
-code 2: a user sees what to fix, never a traceback. ``--json FILE`` means the same in every
+Every command turns a :class:`~deformap.errors.DeformapError` (and an :class:`OSError`: a full
+disk, a read-only folder) into one line on stderr and exit code 2: a user sees what to fix, never
+a traceback. ``--json FILE`` means the same in every
 command that has it: also write the command's result as JSON to ``FILE`` (atomically); ``-``
 writes it to stdout, and the tables and progress then go to stderr.
 """
@@ -26,7 +27,7 @@ from rich.text import Text
 from typer.core import TyperGroup
 
 from deformap import __version__
-from deformap._files import check_destination
+from deformap._files import check_destination, os_error_cause
 from deformap.errors import ConfigError, DeformapError, InvalidArgumentError
 
 __all__ = [
@@ -163,8 +164,9 @@ F = TypeVar("F", bound=Callable[..., Any])
 
 
 def friendly_errors(func: F) -> F:
-    """Turn a DeformapError into a one-line message and exit code 2; refuse a negative
-    ``--seed`` (every command that has one) before the command runs."""
+    """Turn a DeformapError, or an OSError that none stood for (a write the machine refused in
+    code outside deformap's write path), into a one-line message and exit code 2; refuse a
+    negative ``--seed`` (every command that has one) before the command runs."""
 
     @wraps(func)
     def wrapper(*args: Any, **kwargs: Any) -> Any:
@@ -175,8 +177,18 @@ def friendly_errors(func: F) -> F:
             return func(*args, **kwargs)
         except DeformapError as exc:
             fail(str(exc))
+        except OSError as exc:  # what the machine refused outside deformap's own write path
+            fail(os_error_line(exc))
 
     return wrapper  # type: ignore[return-value]
+
+
+def os_error_line(error: OSError) -> str:
+    """One line for an :class:`OSError` no deformap error stood for: the file it names (both, for
+    a rename) and the cause."""
+    names = [str(n) for n in (error.filename, error.filename2) if n is not None]
+    where = " → ".join(repr(n) for n in names)
+    return f"{where}: {os_error_cause(error)}" if where else os_error_cause(error)
 
 
 def _to_stdout(json_path: Path | None) -> bool:
@@ -199,9 +211,9 @@ def emit_json(json_path: Path | None, data: Any) -> None:
         return
     try:
         json_path.parent.mkdir(parents=True, exist_ok=True)
-        write_json(json_path, data)
     except OSError as exc:
-        raise ConfigError(f"cannot write --json {str(json_path)!r}: {exc.strerror or exc}") from None
+        raise ConfigError(f"cannot write --json {str(json_path)!r}: {os_error_cause(exc)}") from None
+    write_json(json_path, data)  # a failure is one line naming the file (deformap._files)
     out_console(json_path).print(f"wrote {json_path}", highlight=False)
 
 

@@ -239,7 +239,7 @@ def _show_worlds_summary(shown: Any, output: Any, worlds: int, max_pokes: int,
 def _show_paired(shown: Any, summary: dict[str, Any]) -> None:
     """The appearance families, where one was mapped blind beside the prior: one row per family ×
     combination."""
-    from deformap.eval._worlds_paired import paired_cells
+    from deformap.eval import paired_cells
 
     families = summary.get("appearance", {})
     if not any(e["blind"] for per in families.values() for e in per.values()):

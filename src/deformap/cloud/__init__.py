@@ -15,8 +15,13 @@ from deformap.cloud._filters import (
     statistical_outlier_mask,
 )
 from deformap.cloud._pointcloud import PointCloud
-from deformap.cloud._tactile import DEFAULT_CAP_HALF_ANGLE_DEG, contact_cap, tactile_points
+from deformap.cloud._tactile import (
+    DEFAULT_CAP_HALF_ANGLE_DEG,
+    contact_cap,
+    tactile_points,
+    tip_in_view,
+)
 
 __all__ = ["DEFAULT_CAP_HALF_ANGLE_DEG", "HULL_TOLERANCE_M", "PointCloud", "contact_cap",
            "crop_box", "height_field_mask", "hull_parts", "points_in_hull",
-           "statistical_outlier_mask", "tactile_points"]
+           "statistical_outlier_mask", "tactile_points", "tip_in_view"]

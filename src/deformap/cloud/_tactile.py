@@ -24,7 +24,7 @@ from numpy.typing import NDArray
 from deformap._validation import check_int, check_positive, check_slope_deg, check_vector
 from deformap.errors import InvalidArgumentError
 
-__all__ = ["DEFAULT_CAP_HALF_ANGLE_DEG", "contact_cap", "tactile_points"]
+__all__ = ["DEFAULT_CAP_HALF_ANGLE_DEG", "contact_cap", "tactile_points", "tip_in_view"]
 
 #: Half-angle of the touching cap from the force direction: 30° reaches 0.13 r up from the pole,
 #: the depth over which a soft surface wraps a pressing sphere beyond first contact.
@@ -86,3 +86,23 @@ def tactile_points(tip_center: Any, force_vector: Any, tip_radius_m: float, n: i
         + (sin_theta * np.cos(phi))[:, None] * e1
         + (sin_theta * np.sin(phi))[:, None] * e2)
     return np.asarray(center + radius * directions)
+
+
+def tip_in_view(points: NDArray[np.float64], tip_center: NDArray[np.float64], tip_radius_m: float,
+                *, within_radii: float) -> int:
+    """How many of ``points`` ``(n, 3)`` (z up) are the top of a spherical tip at ``tip_center``;
+    0 when the tip is not in view. The candidates lie within ``within_radii`` radii of the centre
+    and more than half a radius above it (what a camera above sees of a tip); they are the tip
+    when their median height stands more than a quarter radius above the surface 2–3 radii away
+    (its 90th percentile): a deep press's surface rebounds above the tip's centre but never stands
+    above the surface around it, as the tip's top does."""
+    radius = tip_radius_m
+    near = np.linalg.norm(points - tip_center, axis=1) <= within_radii * radius
+    top = near & (points[:, 2] > tip_center[2] + radius / 2)
+    if not np.any(top):
+        return 0
+    r = np.linalg.norm(points[:, :2] - tip_center[:2], axis=1)
+    ring = points[(r >= 2 * radius) & (r <= 3 * radius), 2]
+    if ring.size and float(np.median(points[top, 2])) <= float(np.quantile(ring, 0.9)) + radius / 4:
+        return 0
+    return int(top.sum())

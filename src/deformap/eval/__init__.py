@@ -46,6 +46,7 @@ if TYPE_CHECKING:
     )
     from deformap.eval._world_result import POKES_FORMAT, TIME_COLUMNS, WorldResult, row_values
     from deformap.eval._worlds import run_world
+    from deformap.eval._worlds_paired import paired_cells
     from deformap.eval._worlds_summary import (
         CSV_COLUMNS,
         GOOD_ACCURACY,
@@ -73,6 +74,7 @@ _MODULES = {
                     "choices", "draw_world", "material_truth"),
     "_world_result": ("POKES_FORMAT", "TIME_COLUMNS", "WorldResult", "row_values"),
     "_worlds": ("run_world",),
+    "_worlds_paired": ("paired_cells",),
     "_worlds_summary": ("CSV_COLUMNS", "GOOD_ACCURACY", "accuracy_curves", "combination_name",
                         "markdown_summary", "pokes_to_good", "runs_csv", "summarise_worlds"),
 }  # fmt: skip
@@ -85,7 +87,8 @@ __all__ = [
     "bench_beta_sweep", "bench_io", "bench_memory", "bench_surface_gp", "bench_world",
     "block_scenario", "choices", "cluster_size_study", "collect_presses", "combination_name",
     "draw_world", "hardness_study", "hardness_summary", "markdown_summary", "markdown_table",
-    "material_truth", "measure_case", "ordering_scores", "pokes_to_good", "region_scores",
+    "material_truth", "measure_case", "ordering_scores", "paired_cells", "pokes_to_good",
+    "region_scores",
     "rescore_world", "row_values", "run_world", "runs_csv", "summarise_worlds", "table_row",
 ]
 

@@ -40,6 +40,7 @@ from deformap.explore._records import (
     PokeTimings,
     Purpose,
     Target,
+    poke_behaviour,
 )
 from deformap.explore._result import AppearanceOutcome, ExplorationResult, StopReason
 from deformap.explore._surface import SurfaceModel, fit_surface
@@ -51,5 +52,5 @@ __all__ = ["JOURNAL_NAME", "PURPOSES", "STRATEGIES", "AppearanceOutcome", "BetaF
            "PokeRecord", "PokeResult", "PokeSet", "PokeTimings", "Purpose", "RegionLabels",
            "RegionMap", "StopReason", "SurfaceGPConfig", "SurfaceModel", "Target", "TouchGPConfig",
            "beta_noise_floor", "check_exploration_budget", "explore", "field_settings",
-           "fit_surface", "map_regions", "measure_press", "poke_step", "read_journal",
+           "fit_surface", "map_regions", "measure_press", "poke_behaviour", "poke_step", "read_journal",
            "rigid_modulus_bound", "segment_regions"]

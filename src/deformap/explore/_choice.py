@@ -77,7 +77,10 @@ def choose_map_field(previous: FieldChoice, requested: FieldName, records: Seque
     why = choice.given_up
     if why is None and not len(modulus.pokes):
         why = f"poke {records[-1].index + 1} gave no modulus ({modulus.readings[-1].excluded})"
-    fallback = None if why is None else f"`exploration.field` 'modulus' fell back to 'beta': {why}"
+    # the fall-back names its first reason while it lasts (the same reason at a later poke is
+    # not news)
+    fallback = (None if why is None else previous.fallback
+                or f"`exploration.field` 'modulus' fell back to 'beta': {why}")
     return FieldChoice(name="modulus" if fallback is None else "beta", grid=choice.grid,
                        fallback=fallback, unread_places=choice.unread_places,
                        given_up=choice.given_up)

@@ -124,9 +124,7 @@ class ExplorationConfig:
     """
 
     threshold: float = setting(0.06, gt=0.0)
-    # every poke is a press and a β sweep (seconds), and the β-field's and the planner's matrices
-    # grow with the pokes
-    max_pokes: int = setting(12, ge=1, le=1000)
+    max_pokes: int = setting(12, limit="pokes")
     strategy: Strategy = "planned"
     first_target: tuple[float, float] | None = None
     stop_region: StopRegion = "workspace"
@@ -192,18 +190,28 @@ class ExplorationConfig:
 
 
 def check_exploration_budget(config: ExplorationConfig, workspace: Workspace) -> None:
-    """Refuse, before any work, an exploration whose map grid has over :data:`MAX_MAP_CELLS`
-    cells or, for ``planned``, whose 2 cm planning grid has over :data:`MAX_PLAN_CELLS`.
+    """Refuse, before any work, an exploration whose ``first_target`` lies outside ``workspace``,
+    whose map grid has over :data:`MAX_MAP_CELLS` cells or, for ``planned``, whose 2 cm planning
+    grid has over :data:`MAX_PLAN_CELLS`.
 
     Raises
     ------
     SettingError
-        Naming ``surface.grid_spacing_m`` or ``strategy``, the cells asked for and the limit.
+        Naming ``first_target``, ``surface.grid_spacing_m`` or ``strategy``, what came and the
+        limit.
     """
     if not isinstance(config, ExplorationConfig):
         raise SettingError("config", f"must be an ExplorationConfig; got {type(config).__name__}")
     if not isinstance(workspace, Workspace):
         raise SettingError("workspace", f"must be a Workspace; got {type(workspace).__name__}")
+    if config.first_target is not None:
+        (x, y), (x0, y0), (x1, y1) = config.first_target, workspace.lower, workspace.upper
+        if not (x0 <= x <= x1 and y0 <= y <= y1):
+            raise SettingError(
+                "first_target",
+                f"must lie inside the workspace [{x0:g}, {x1:g}] × [{y0:g}, {y1:g}] m; got "
+                f"({x:g}, {y:g})",
+            )
     (width, depth), spacing = workspace.size, config.surface.grid_spacing_m
     cells = max(1, round(width / spacing)) * max(1, round(depth / spacing))
     area = f"a {width:g} × {depth:g} m workspace"

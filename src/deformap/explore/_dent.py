@@ -30,7 +30,14 @@ from deformap.environment import PressObservation, TactileContact
 from deformap.errors import DeformapError
 from deformap.explore._config import ExplorationConfig
 from deformap.explore._dent_noise import dent_error_samples
-from deformap.explore._records import ContactRecord, Dent, PokeRecord, PokeResult, PokeTimings
+from deformap.explore._records import (
+    ContactRecord,
+    Dent,
+    PokeRecord,
+    PokeResult,
+    PokeTimings,
+    poke_behaviour,
+)
 from deformap.explore._surface import SurfaceModel, crop_to
 from deformap.gp import GaussianRandomField
 from deformap.mechanics import layer_indentation_force
@@ -216,6 +223,7 @@ def measure_press(obs: PressObservation, index: int, surface: SurfaceModel,
                             stiffness_s=None if obs.force_travel is None else t_stiff),
         stiffness=stiffness, layer_thickness_m=thickness, stiffness_error=stiffness_error,
         indentation_m=depth, depth_anchored=anchored_noise is not None, dent_visible=visible,
+        behaviour=poke_behaviour(obs),
     )
     dent = Dent(roi_xs, roi_ys, rest_z, deformed_z, roi, tactile, obs.force_travel,
                 _force_fit(obs, stiffness, thickness, config))

@@ -2,11 +2,14 @@
 
 The first line is a header holding the run's identity; each later line is one poke, synced to disk
 before the loop moves on, so a killed run loses at most the poke in progress. Reading drops a last
-line cut mid-write.
+line cut mid-write. A line whose write fails (a full disk) is cut off again and the failure raised
+as one :class:`~deformap.errors.FileWriteError` line, so the journal still holds whole lines only.
 """
 
 from __future__ import annotations
 
+import contextlib
+import errno
 import json
 import logging
 import os
@@ -14,7 +17,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from deformap._files import atomic_path
+from deformap._files import atomic_path, writing
 from deformap.errors import ConfigError, FileFormatError
 
 __all__ = ["JOURNAL_NAME", "Journal", "JournalContents", "read_journal"]
@@ -75,7 +78,8 @@ class Journal:
         """Start a journal holding ``header`` (written atomically); :class:`FileExistsError` if
         the folder has one."""
         path = Path(folder) / JOURNAL_NAME
-        path.parent.mkdir(parents=True, exist_ok=True)
+        with writing(path):
+            path.parent.mkdir(parents=True, exist_ok=True)
         if path.exists():
             raise FileExistsError(f"{str(path)!r} already exists")
         journal = cls(path)
@@ -99,8 +103,27 @@ class Journal:
         return journal, contents
 
     def append(self, record: dict[str, Any]) -> None:
-        with open(self.path, "a", encoding="utf-8") as fh:
-            self._write(fh, {"kind": "poke", **record})
+        """Add ``record`` as one poke line, synced to disk; a line whose write fails is cut off
+        (the file keeps its earlier lines) and :class:`FileWriteError` names the journal."""
+        line = (json.dumps({"kind": "poke", **record}, allow_nan=False) + "\n").encode("utf-8")
+        with writing(self.path):
+            fd = os.open(self.path, os.O_WRONLY | os.O_APPEND | os.O_CREAT, 0o666)
+            try:
+                start = os.fstat(fd).st_size
+                try:
+                    view = memoryview(line)
+                    while view:
+                        written = os.write(fd, view)
+                        if written == 0:  # nothing taken: the device is full
+                            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+                        view = view[written:]
+                    os.fsync(fd)
+                except OSError:
+                    with contextlib.suppress(OSError):  # shrinking needs no space
+                        os.ftruncate(fd, start)
+                    raise
+            finally:
+                os.close(fd)
 
     def _rewrite(self, contents: JournalContents) -> None:
         with atomic_path(self.path) as tmp, open(tmp, "w", encoding="utf-8") as fh:

@@ -6,6 +6,7 @@ and comes back through :meth:`PokeRecord.from_dict`, which refuses a line that i
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, fields
@@ -14,17 +15,24 @@ from typing import Any, Literal, get_args
 import numpy as np
 from numpy.typing import NDArray
 
-from deformap.environment import ForceTravel, TactileContact
+from deformap.environment import ForceTravel, PressObservation, TactileContact
 from deformap.errors import FileFormatError, InvalidArgumentError
 from deformap.explore._planning import PokePlan
 from deformap.msm import BetaEstimate
-from deformap.stiffness import LAYER_MODEL, StiffnessEstimate
+from deformap.stiffness import (
+    BEHAVIOURS,
+    LAYER_MODEL,
+    PressBehaviour,
+    StiffnessEstimate,
+    press_behaviour,
+    released_dent,
+)
 
 __all__ = ["PURPOSES", "ContactRecord", "Dent", "PokeRecord", "PokeResult", "PokeTimings", "Purpose",
-           "Target"]
+           "Target", "poke_behaviour"]
 
-#: Why a place was poked: the first poke, the strategy's (until the variance is under ``T_h``), or
-#: a boundary poke after it.
+#: Why a place was poked: the first poke, the strategy's (until the variance is under ``T_h``), a
+#: look the appearance prior asks to test, or a boundary poke after it.
 Purpose = Literal["first", "variance", "boundary", "appearance"]
 PURPOSES: tuple[str, ...] = get_args(Purpose)
 
@@ -170,7 +178,9 @@ class PokeRecord:
     Optional (``None``: not applicable): the record's ``stiffness``, the ``layer_thickness_m`` it
     was read with or ``stiffness_error``; the ``indentation_m`` of the tactile points and whether
     it came from the record (``depth_anchored``); ``dent_visible``; ``purpose``;
-    ``planned_after``; the stop cells' largest variance after this poke (``max_variance_after``).
+    ``planned_after``; the stop cells' largest variance after this poke (``max_variance_after``);
+    what the press reveals beyond its stiffness (``behaviour``, :func:`~deformap.stiffness.
+    press_behaviour`: ``"unknown"`` with the reason for a record of the ramp alone).
     """
 
     index: int
@@ -197,6 +207,7 @@ class PokeRecord:
     purpose: Purpose | None = None
     planned_after: int | None = None
     max_variance_after: float | None = None
+    behaviour: PressBehaviour | None = None
 
     @property
     def xy(self) -> NDArray[np.float64]:
@@ -214,6 +225,8 @@ class PokeRecord:
                 value = value.to_dict()
             elif isinstance(value, StiffnessEstimate):
                 value = {g.name: getattr(value, g.name) for g in fields(value)}
+            elif isinstance(value, PressBehaviour):
+                value = value.to_dict()
             if value is not None or f.name == "camera_noise_m":
                 out[f.name] = value
         return out
@@ -251,7 +264,41 @@ class PokeRecord:
             depth_anchored=num("depth_anchored", bool, True),
             dent_visible=num("dent_visible", bool, True), purpose=purpose,
             planned_after=num("planned_after", int, True),
-            max_variance_after=num("max_variance_after", optional=True))
+            max_variance_after=num("max_variance_after", optional=True),
+            behaviour=_behaviour_from_dict(data.get("behaviour"), f"{where}.behaviour"))
+
+
+def poke_behaviour(obs: PressObservation) -> PressBehaviour:
+    """:func:`~deformap.stiffness.press_behaviour` of a press: its record and, when it has one,
+    the dent its cloud after release keeps at the tip (:func:`~deformap.stiffness.released_dent`;
+    why none could be had joins the evidence)."""
+    if obs.released is None:
+        return press_behaviour(obs.force_travel)
+    dent = released_dent(obs.released.points, obs.contact.tip_center, obs.contact.tip_radius_m)
+    if isinstance(dent, str):
+        got = press_behaviour(obs.force_travel)
+        return dataclasses.replace(got, evidence=f"{got.evidence}; {dent}")
+    return press_behaviour(obs.force_travel, released=dent)
+
+
+def _behaviour_from_dict(data: Any, where: str) -> PressBehaviour | None:
+    """A poke's ``behaviour`` entry (absent in journals written before it existed)."""
+    if data is None:
+        return None
+    data = _mapping(data, where, PressBehaviour)
+    kind, mode = data.get("behaviour"), data.get("relaxation_mode")
+    if kind not in BEHAVIOURS:
+        raise FileFormatError(f"`{where}.behaviour` must be one of {list(BEHAVIOURS)}; "
+                              f"got {kind!r}")  # fmt: skip
+    if mode not in (None, "force", "travel"):
+        raise FileFormatError(f"`{where}.relaxation_mode` must be 'force', 'travel' or null; "
+                              f"got {mode!r}")  # fmt: skip
+    evidence = _text(data, "evidence", where)
+    if evidence is None:
+        raise FileFormatError(f"`{where}` has no `evidence`")
+    numbers = {f.name: _number(data, f.name, where, optional=True) for f in fields(PressBehaviour)
+               if f.name not in ("behaviour", "evidence", "relaxation_mode")}
+    return PressBehaviour(behaviour=kind, evidence=evidence, relaxation_mode=mode, **numbers)
 
 
 @dataclass(frozen=True, eq=False)

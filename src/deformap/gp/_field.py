@@ -19,7 +19,7 @@ from deformap.gp._grid import (
     predict_grid_points,
     predict_on_grid,
 )
-from deformap.gp._kernels import _check_data, grid_points
+from deformap.gp._kernels import _check_data, check_allocation, grid_points
 
 __all__ = ["AUTO_EXACT_MAX_POINTS", "GaussianRandomField"]
 
@@ -133,6 +133,9 @@ class GaussianRandomField:
                  "jitter": self.jitter, "max_jitter": self.max_jitter}
         state: ExactState | GridState
         if method == "exact":
+            n = pts.shape[0]
+            check_allocation("GaussianRandomField.fit(xy, z) with method 'exact'", (n, n),
+                             copies=3)  # the kernel, its Cholesky factor and a difference
             state = fit_exact(pts, resid, noise_var, **hyper)
             self.n_inducing_ = 0
             self.log_marginal_likelihood_: float | None = state.log_marginal_likelihood
@@ -190,6 +193,9 @@ class GaussianRandomField:
         state = self._fitted()
         x = check_array("xs", xs, (None,), what="x coordinates in metres", min_rows=1)
         y = check_array("ys", ys, (None,), what="y coordinates in metres", min_rows=1)
+        # the points (2 columns), mean and std per cell, and the std's intermediate images
+        check_allocation("GaussianRandomField.predict_grid(xs, ys)", (y.size, x.size),
+                         copies=6 if return_std else 3)
         s = self.signal_std
         if isinstance(state, ExactState):
             mean, std = predict_exact(state, grid_points(x, y), length_scale=self.length_scale,

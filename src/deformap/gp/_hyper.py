@@ -19,7 +19,7 @@ from scipy.optimize import minimize
 
 from deformap._validation import check_array, check_int, check_positive, describe
 from deformap.errors import InvalidArgumentError, NotPositiveDefiniteError
-from deformap.gp._kernels import _check_data, _sqdist
+from deformap.gp._kernels import _check_data, _sqdist, check_allocation
 
 __all__ = ["GPHyperparameters", "default_bounds", "fit_hyperparameters", "log_marginal_likelihood"]
 
@@ -70,6 +70,8 @@ def log_marginal_likelihood(xy: Any, z: Any, *, length_scale: float, signal_std:
     ``z (n,)`` at ``xy (n, 2)``; with ``eval_gradient`` also its gradient in
     (log σ_w, log σₑ, log σₙ), RW2006 Eq. 5.9."""
     pts, vals = _check_data(xy, z, min_rows=2)
+    # the distances, the kernel, K + Σ's factor, its inverse and the gradient's products
+    check_allocation("log_marginal_likelihood(xy, z)", (pts.shape[0], pts.shape[0]), copies=6)
     values = (length_scale, signal_std, noise_std)
     theta = np.log([check_positive(n, v) for n, v in zip(_NAMES, values, strict=True)])
     lml, grad = _lml_and_grad(theta, _sqdist(pts, pts), vals - vals.mean())
@@ -124,6 +126,7 @@ def fit_hyperparameters(xy: Any, z: Any, *, rng: np.random.Generator,
             raise InvalidArgumentError(f"`bounds` must have 0 < low <= high per row; got {box}")
     log_box = np.log(box)
     resid = vals - vals.mean()
+    check_allocation("fit_hyperparameters(xy, z) on `max_points`", (pts.shape[0],) * 2, copies=6)
     d2 = _sqdist(pts, pts)
     starts = [_first_start(init, pts, vals, log_box)]
     starts += [rng.uniform(log_box[:, 0], log_box[:, 1]) for _ in range(n_restarts)]

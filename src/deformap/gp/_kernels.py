@@ -15,9 +15,26 @@ from numpy.typing import NDArray
 from deformap._validation import check_array, check_positive
 from deformap.errors import InvalidArgumentError
 
-__all__ = ["grid_points", "squared_exponential"]
+__all__ = ["MAX_ALLOCATION_BYTES", "check_allocation", "grid_points", "squared_exponential"]
 
 Array = NDArray[np.float64]
+
+#: Most bytes one call of a public function of :mod:`deformap.gp` may allocate for its arrays,
+#: checked before it allocates them: far above a map's (a million cells is 8 MB a layer, a
+#: thousand pokes' covariance 8 MB), far below what a mistaken size asks for.
+MAX_ALLOCATION_BYTES = 8 * 2**30
+
+
+def check_allocation(what: str, shape: tuple[int, ...], *, copies: int = 1) -> None:
+    """Refuse, before it is allocated, ``copies`` float64 arrays of ``shape`` (the largest a
+    call holds at once) beyond :data:`MAX_ALLOCATION_BYTES`, in one line naming ``what`` (the
+    call and its arguments), the shape and the size."""
+    need = 8 * copies * int(np.prod([int(n) for n in shape], dtype=object))
+    if need > MAX_ALLOCATION_BYTES:
+        dims = " × ".join(f"{int(n):,}" for n in shape)
+        raise InvalidArgumentError(
+            f"{what} needs {need / 2**30:,.1f} GiB ({copies} float64 array(s) of {dims}); at "
+            f"most {MAX_ALLOCATION_BYTES / 2**30:g} GiB: use a coarser grid or fewer points")
 
 
 def _check_data(xy: Any, z: Any, *, min_rows: int) -> tuple[Array, Array]:
@@ -55,6 +72,7 @@ def squared_exponential(x1: Any, x2: Any, *, length_scale: float, signal_std: fl
     b = check_array("x2", x2, (None, 2), what="coordinates in metres")
     w = check_positive("length_scale", length_scale)
     s = check_positive("signal_std", signal_std)
+    check_allocation("squared_exponential(x1, x2)", (a.shape[0], b.shape[0]), copies=2)
     return s**2 * _se(a, b, w)
 
 
@@ -63,5 +81,6 @@ def grid_points(xs: Any, ys: Any) -> Array:
     ``(xs[ix], ys[iy])``: ``values.reshape(ny, nx)`` is ``predict_grid``'s image."""
     x = check_array("xs", xs, (None,), what="x coordinates in metres", min_rows=1)
     y = check_array("ys", ys, (None,), what="y coordinates in metres", min_rows=1)
+    check_allocation("grid_points(xs, ys)", (y.size, x.size), copies=4)
     gx, gy = np.meshgrid(x, y)
     return np.column_stack([gx.ravel(), gy.ravel()])

@@ -25,7 +25,7 @@ from numpy.typing import NDArray
 from deformap._validation import check_array, check_positive
 from deformap.errors import InvalidArgumentError
 from deformap.gp._exact import cholesky_with_jitter
-from deformap.gp._kernels import _se, squared_exponential
+from deformap.gp._kernels import _se, check_allocation, squared_exponential
 
 __all__ = ["PosteriorDesign", "apply_smoother", "variance_after_adding"]
 
@@ -92,6 +92,9 @@ class PosteriorDesign:
         new_noise = _per_candidate("candidate_noise_std", candidate_noise_std, (cand.shape[0],),
                                    allow_zero=False)  # fmt: skip
         kern = {"length_scale": length_scale, "signal_std": signal_std}
+        p, c, d = xy.shape[0], cand.shape[0], dom.shape[0]
+        check_allocation("PosteriorDesign(observed_xy, candidates, domain)",
+                         (p * p + p * c + p * d + c * c + 2 * c * d,))  # kernels, a posterior
         self.prior = check_positive("signal_std", signal_std) ** 2
         self.new_var = new_noise**2
         self.observed_noise = noise
@@ -151,6 +154,8 @@ def apply_smoother(data_xy: Any, noise_std: Any, query_xy: Any, values: Any, *,
             f"`values` must be ({data.shape[0]},) or ({data.shape[0]}, k); got {vals.shape}")
     w = check_positive("length_scale", length_scale)
     s = check_positive("signal_std", signal_std)
+    n, q = data.shape[0], query.shape[0]
+    check_allocation("apply_smoother(data_xy, query_xy)", (n * n * 3 + q * n * 2,))
     # the unit-variance kernel and the noise in units of σe: the σe² of K* and of K cancel
     gram = _se(data, data, w) + np.diag((noise / s) ** 2)
     factor, _ = cholesky_with_jitter(gram, jitter=jitter, max_jitter=max_jitter,

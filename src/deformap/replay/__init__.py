@@ -17,15 +17,64 @@ from deformap.replay._rawconfig import (
     load_raw_config,
     raw_config_file,
 )
+from deformap.replay._rawrig import RigConfig, load_rig
+from deformap.replay._rawwrite import (
+    APPROACH,
+    FIRST_PRESS_S,
+    HOLD,
+    PAUSE,
+    RAMP,
+    RELEASE,
+    T0_NS,
+    RawMessage,
+    RawPress,
+    raw_messages,
+    raw_timeline,
+    write_raw_mcap,
+)
 from deformap.replay._session import RecordedSession, is_raw_bag, load_raw_bag, load_session
 from deformap.replay._truth import GroundTruth, read_ground_truth, write_ground_truth
 from deformap.replay._write import SESSION_FORMATS, RecordingEnvironment, write_session
 
-__all__ = ["DEFAULT_HULL", "FORMAT_NAME", "FORMAT_VERSION", "OPTIONAL_TOPICS", "SESSION_FORMATS",
-           "TOPICS", "GroundTruth", "HullPart", "RawBagConfig", "RecordedSession",
-           "RecordingEnvironment", "ReplayResult", "estimate_poke", "is_raw_bag", "load_raw_bag",
-           "load_raw_config", "load_session", "map_session", "raw_config_file",
-           "read_ground_truth", "tip_sphere_points", "write_ground_truth", "write_session"]
+__all__ = [
+    "APPROACH",
+    "DEFAULT_HULL",
+    "FIRST_PRESS_S",
+    "FORMAT_NAME",
+    "FORMAT_VERSION",
+    "HOLD",
+    "OPTIONAL_TOPICS",
+    "PAUSE",
+    "RAMP",
+    "RELEASE",
+    "SESSION_FORMATS",
+    "T0_NS",
+    "TOPICS",
+    "GroundTruth",
+    "HullPart",
+    "RawBagConfig",
+    "RawMessage",
+    "RawPress",
+    "RecordedSession",
+    "RecordingEnvironment",
+    "ReplayResult",
+    "RigConfig",
+    "estimate_poke",
+    "is_raw_bag",
+    "load_raw_bag",
+    "load_raw_config",
+    "load_rig",
+    "load_session",
+    "map_session",
+    "raw_config_file",
+    "raw_messages",
+    "raw_timeline",
+    "read_ground_truth",
+    "tip_sphere_points",
+    "write_ground_truth",
+    "write_raw_mcap",
+    "write_session",
+]
 
 # The offline mapper needs deformap.explore (and through it gp and msm): imported on first use, so
 # that reading a session stays light.

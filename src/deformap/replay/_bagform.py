@@ -3,8 +3,11 @@
 A poke's messages share one header stamp, which ``session.yaml`` names (``stamp_ns``) beside the
 command (target, force). Each message is decoded when its poke is read, so a corrupted message
 breaks only its own poke. The force–travel record (``OPTIONAL_TOPICS``) is a
-``Float64MultiArray`` of dimensions ``samples`` (n) × ``travel_m,force_n`` (2); having no header,
-it is logged at the poke's stamp. Without one a poke has no record.
+``Float64MultiArray`` of dimensions ``samples`` (n) × ``travel_m,force_n`` (2), or, for a record
+with its times, ``samples`` × ``time_s,travel_m,force_n,phase`` (4), ``phase`` 0 on the ramp, 1 in
+the hold and 2 while unloading, in that order; having no header, it is logged at the poke's stamp.
+Without one a poke has no record. The cloud after release (``OPTIONAL_TOPICS["released"]``) is a
+``PointCloud2`` stamped as the poke's other messages, in the session's frame.
 """
 
 from __future__ import annotations
@@ -18,6 +21,7 @@ from numpy.typing import NDArray
 
 from deformap.cloud import PointCloud
 from deformap.cloud.io import (
+    TransformTree,
     array_to_pointcloud2,
     bag_error_text,
     bag_read_errors,
@@ -26,29 +30,40 @@ from deformap.cloud.io import (
     header_stamp_ns,
     iter_bag_messages,
     path_kind,
+    pointcloud2_colors,
+    pointcloud2_structured,
     pointcloud2_to_cloud,
     read_bag_static_transform,
+    read_bag_transforms,
     typestore,
     wrench_message,
+    xyz_with_holes,
 )
-from deformap.environment import ForceTravel, PressObservation
+from deformap.environment import ForceTravel, PressObservation, PressPhase
 from deformap.errors import DeformapError, FileFormatError
 from deformap.replay._confine import check_bag_confined, verify_digest
 from deformap.replay._format import OPTIONAL_TOPICS, TOPICS, PokeSpec, PressParts, SessionHeader
 
 #: Labels of the record's two dimensions in its ``Float64MultiArray`` layout.
 FORCE_TRAVEL_DIMS = ("samples", "travel_m,force_n")
+#: Labels of a record with times and phases (``phase``: 0 ramp, 1 hold, 2 unloading).
+FORCE_TRAVEL_PHASED_DIMS = ("samples", "time_s,travel_m,force_n,phase")
 
-__all__ = ["FORCE_TRAVEL_DIMS", "BagReader", "force_travel_message", "write_session_bag"]
+__all__ = ["FORCE_TRAVEL_DIMS", "FORCE_TRAVEL_PHASED_DIMS", "BagReader", "force_travel_message",
+           "write_session_bag"]
 
 
 class BagReader:
     """Reads the poke messages of a bag-form session, each one when its poke is asked for."""
 
-    def __init__(self, header: SessionHeader) -> None:
+    def __init__(self, header: SessionHeader, stamp_tolerance_ns: int = 0) -> None:
         assert header.bag is not None
         self.header = header
         self.path = header.bag
+        #: a message stamped this far [ns] from its poke's ``stamp_ns`` still belongs to it
+        self.stamp_tolerance_ns = stamp_tolerance_ns
+        #: per poke (0-based): what its entry says beyond its β (``stamp_gaps_s``)
+        self.notes: dict[int, dict[str, Any]] = {}
         if path_kind(self.path) == "missing":
             raise FileFormatError(f"{self.path}: no such bag (the session's `bag`)")
         for file in check_bag_confined(self.path):
@@ -63,6 +78,7 @@ class BagReader:
         self._decoded: dict[str, dict[int, list[Any]]] = {}  # key -> stamp -> messages
         self._undecodable: dict[str, list[str]] = {}  # key -> why its messages failed to decode
         self._tf_static: NDArray[np.float64] | None = None
+        self._tree: TransformTree | None = None  # /tf and /tf_static, read on first use
 
     def _force_travel(self, stamp: int) -> ForceTravel | None:
         """The record logged at ``stamp``, or None."""
@@ -81,17 +97,42 @@ class BagReader:
                 f"{where}: could not be decoded: {bag_error_text(exc, 120)}") from None
         dims = [(str(d.label), int(d.size)) for d in msg.layout.dim]
         data = np.asarray(msg.data, dtype=float)
-        if (len(dims) != 2 or (dims[0][0], dims[1][0]) != FORCE_TRAVEL_DIMS or dims[1][1] != 2
-                or msg.layout.data_offset != 0 or data.size != 2 * dims[0][1]):
+        labels = tuple(d[0] for d in dims)
+        width = 4 if labels == FORCE_TRAVEL_PHASED_DIMS else 2
+        if (len(dims) != 2 or labels not in (FORCE_TRAVEL_DIMS, FORCE_TRAVEL_PHASED_DIMS)
+                or dims[1][1] != width or msg.layout.data_offset != 0
+                or data.size != width * dims[0][1]):
             raise FileFormatError(
                 f"{where}: layout must be {FORCE_TRAVEL_DIMS[0]!r} (n) × "
-                f"{FORCE_TRAVEL_DIMS[1]!r} (2) with 2n values from offset 0; got dims {dims}, "
-                f"offset {msg.layout.data_offset}, {data.size} values")
-        rows = data.reshape(-1, 2)
+                f"{FORCE_TRAVEL_DIMS[1]!r} (2) or {FORCE_TRAVEL_PHASED_DIMS[1]!r} (4) with 2n or "
+                f"4n values from offset 0; got dims {dims}, offset {msg.layout.data_offset}, "
+                f"{data.size} values")
+        rows = data.reshape(-1, width)
         try:
-            return ForceTravel(travel_m=rows[:, 0], force_n=rows[:, 1])
+            if width == 2:
+                return ForceTravel(travel_m=rows[:, 0], force_n=rows[:, 1])
+            return _phased_record(rows)
         except DeformapError as exc:
             raise FileFormatError(f"{where}: {exc}") from None
+
+    def _released(self, stamp: int) -> PointCloud | None:
+        """The cloud after release stamped ``stamp`` (world frame), or None."""
+        topic, msgtype = OPTIONAL_TOPICS["released"]
+        where = f"{self.path} [{topic} stamped {stamp}]"
+        found = []
+        for number, (_, data) in enumerate(self._raw[topic], start=1):
+            try:
+                msg = typestore().deserialize_cdr(data, msgtype)
+            except bag_read_errors() as exc:
+                raise FileFormatError(f"{self.path} [{topic}] message {number}: could not be "
+                                      f"decoded: {bag_error_text(exc, 120)}") from None
+            if header_stamp_ns(msg.header) == stamp:
+                found.append(msg)
+        if not found:
+            return None
+        if len(found) > 1:
+            raise FileFormatError(f"{where}: {len(found)} messages; a poke has at most one")
+        return self._to_world(self._cloud(found[0], where, self.header.frame))
 
     def _by_stamp(self, key: str) -> dict[int, list[Any]]:
         """The messages of ``TOPICS[key]`` by header stamp, decoded on first use; why each one
@@ -110,8 +151,17 @@ class BagReader:
             self._decoded[key] = by_stamp
         return self._decoded[key]
 
-    def _message(self, key: str, stamp: int) -> Any:
-        topic, msgs = TOPICS[key][0], self._by_stamp(key).get(stamp, [])
+    def _message(self, key: str, stamp: int, index: int = -1) -> Any:
+        by_stamp = self._by_stamp(key)
+        msgs = by_stamp.get(stamp, [])
+        if not msgs and self.stamp_tolerance_ns and by_stamp:
+            # the nearest stamp within the tolerance; the gap goes to the poke's entry
+            near = min(by_stamp, key=lambda s: abs(s - stamp))
+            if abs(near - stamp) <= self.stamp_tolerance_ns:
+                msgs = by_stamp[near]
+                gaps = self.notes.setdefault(index, {}).setdefault("stamp_gaps_s", {})
+                gaps[TOPICS[key][0]] = (near - stamp) / 1e9
+        topic = TOPICS[key][0]
         if len(msgs) > 1:  # which one is the poke's? neither is kept silently
             raise FileFormatError(
                 f"{self.path}: topic {topic!r} has {len(msgs)} messages stamped {stamp}; "
@@ -119,8 +169,10 @@ class BagReader:
         if not msgs:
             bad = self._undecodable[key]
             note = f"; {len(bad)} message(s) there could not be decoded ({bad[0]})" if bad else ""
+            within = (f" or within {self.stamp_tolerance_ns / 1e9:g} s (--stamp-tolerance)"
+                      if self.stamp_tolerance_ns else "")
             raise FileFormatError(
-                f"{self.path}: topic {topic!r} has no message stamped {stamp}{note}")
+                f"{self.path}: topic {topic!r} has no message stamped {stamp}{within}{note}")
         return msgs[0]
 
     def _cloud(self, msg: Any, where: str, frame: str, colors: bool = True) -> PointCloud:
@@ -132,6 +184,21 @@ class BagReader:
         cloud, _ = pointcloud2_to_cloud(msg, where=where, units=self.header.units, frame=frame,
                                         colors=colors)  # fmt: skip
         return cloud
+
+    def _frame_to_world(self, frame: str, stamp_ns: int, where: str
+                        ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:  # fmt: skip
+        """``frame``'s rotation and translation to ``world`` at ``stamp_ns`` (a message's header
+        stamp), from the bag's ``/tf`` and ``/tf_static`` within the stamp tolerance; a frame they
+        do not resolve there is refused naming the message."""
+        try:
+            if self._tree is None:
+                self._tree = read_bag_transforms(self.path, tolerance_ns=self.stamp_tolerance_ns)
+            rot, trans = self._tree.lookup("world", frame, stamp_ns, what=where)
+        except FileFormatError as exc:
+            raise FileFormatError(
+                f"{where}: header.frame_id is {frame!r}, which the bag's /tf and /tf_static do "
+                f"not take to 'world' at its stamp, within --stamp-tolerance ({exc})") from None
+        return rot[0], trans[0]
 
     def _to_world(self, cloud: PointCloud) -> PointCloud:
         cam2world = self.header.cam2world
@@ -145,13 +212,58 @@ class BagReader:
 
     def observation(self) -> PointCloud:
         topic = TOPICS["observation"][0]
-        msgs = [msg for same in self._by_stamp("observation").values() for msg in same]
-        if len(msgs) != 1:
-            bad = self._undecodable["observation"]
+        msgs = [msg for _, same in sorted(self._by_stamp("observation").items()) for msg in same]
+        bad = self._undecodable["observation"]
+        if not msgs or bad:
             raise FileFormatError(
-                f"{self.path}: topic {topic!r} must hold exactly one message; got {len(msgs)}"
-                + (f" ({len(bad)} could not be decoded: {bad[0]})" if bad else ""))
-        return self._to_world(self._cloud(msgs[0], f"{self.path} [{topic}]", self.header.frame))
+                f"{self.path}: topic {topic!r} must hold at least one message, each readable; got "
+                f"{len(msgs)}" + (f" ({len(bad)} could not be decoded: {bad[0]})" if bad else ""))
+        if len(msgs) == 1:
+            return self._to_world(self._cloud(msgs[0], f"{self.path} [{topic}]",
+                                              self.header.frame))  # fmt: skip
+        return self._to_world(self._averaged(msgs, f"{self.path} [{topic}]"))
+
+    def _averaged(self, msgs: list[Any], where: str) -> PointCloud:
+        """A stream of organised clouds of one shape averaged pixel by pixel (NaN holes left
+        out; colours too when every frame has them), as a raw bag's observation is."""
+        shapes = {(int(m.height), int(m.width)) for m in msgs}
+        if len(shapes) != 1 or next(iter(shapes))[0] == 1:
+            raise FileFormatError(
+                f"{where}: {len(msgs)} messages; several are averaged pixel by pixel, so they "
+                f"must be organised clouds (height > 1) of one shape; got shapes {sorted(shapes)}")
+        total: NDArray[np.float64] | None = None
+        count: NDArray[np.int64] | None = None
+        rgb_sum: NDArray[np.float64] | None = None
+        colored = True
+        for n, msg in enumerate(msgs, start=1):
+            if msg.header.frame_id != self.header.frame:
+                raise FileFormatError(
+                    f"{where} message {n}: header.frame_id is {msg.header.frame_id!r} but the "
+                    f"session's frame is {self.header.frame!r} (session.yaml `frame`)")
+            try:
+                table = pointcloud2_structured(msg)
+                xyz = xyz_with_holes(msg, table)
+            except DeformapError as exc:
+                raise FileFormatError(f"{where} message {n}: {exc}") from None
+            ok = np.isfinite(xyz).all(axis=1)
+            rgb = pointcloud2_colors(msg, where=f"{where} message {n}", table=table, valid=ok)
+            if total is None or count is None:
+                total, count = np.zeros_like(xyz), np.zeros(len(xyz), dtype=np.int64)
+                rgb_sum = np.zeros_like(xyz)
+            total[ok] += xyz[ok]
+            count[ok] += 1
+            if rgb is None:
+                colored = False
+            elif rgb_sum is not None:
+                rgb_sum[ok] += rgb[ok]
+        assert total is not None and count is not None and rgb_sum is not None
+        seen = count > 0
+        if not seen.any():
+            raise FileFormatError(f"{where}: its {len(msgs)} messages hold no finite point")
+        scale = 1e-3 if self.header.units == "mm" else 1.0
+        colors = np.clip(rgb_sum[seen] / count[seen, None], 0, 1) if colored else None
+        return PointCloud(total[seen] / count[seen, None] * scale, colors,
+                          frame=self.header.frame)
 
     def press_parts(self, spec: PokeSpec) -> PressParts:
         assert spec.stamp_ns is not None
@@ -160,23 +272,42 @@ class BagReader:
         def where(key: str) -> str:
             return f"{self.path} [{TOPICS[key][0]} stamped {stamp}]"
 
-        cloud = self._to_world(self._cloud(self._message("cloud", stamp), where("cloud"),
+        i = spec.index
+        cloud = self._to_world(self._cloud(self._message("cloud", stamp, i), where("cloud"),
                                            self.header.frame))  # fmt: skip
-        robot = self._cloud(self._message("robot", stamp), where("robot"), "world", colors=False)
+        robot = self._cloud(self._message("robot", stamp, i), where("robot"), "world",
+                            colors=False)  # fmt: skip
         values = {}
         for key in ("wrench", "tip"):
-            msg = self._message(key, stamp)
-            if msg.header.frame_id != "world":
-                raise FileFormatError(
-                    f"{where(key)}: header.frame_id is {msg.header.frame_id!r}; the bag form "
-                    "stores contacts in the 'world' frame")
+            msg = self._message(key, stamp, i)
             vec = msg.wrench.force if key == "wrench" else msg.point
             values[key] = np.array([vec.x, vec.y, vec.z], dtype=float)
             if not np.isfinite(values[key]).all():
                 raise FileFormatError(
                     f"{where(key)}: holds NaN or infinite values {values[key].tolist()}")
+            frame = str(msg.header.frame_id)
+            if frame != "world":  # a sensor's own frame: the bag's /tf and /tf_static take it there
+                rot, trans = self._frame_to_world(frame, header_stamp_ns(msg.header), where(key))
+                values[key] = rot @ values[key] + (trans if key == "tip" else 0.0)
         return PressParts(cloud, values["tip"], values["wrench"], np.asarray(robot.points),
-                          self._force_travel(stamp))
+                          self._force_travel(stamp), self._released(stamp))
+
+
+def _phased_record(rows: NDArray[np.float64]) -> ForceTravel:
+    """A record from ``time_s, travel_m, force_n, phase`` rows (module docstring)."""
+    phase = rows[:, 3]
+    if not np.all(np.isin(phase, (0.0, 1.0, 2.0))) or np.any(np.diff(phase) < 0):
+        raise FileFormatError(
+            "`phase` must be 0 (ramp), 1 (hold) or 2 (unloading), in that order; got "
+            f"{len(phase)} rows whose codes run {phase[:12].tolist()}"
+            + (" ..." if len(phase) > 12 else ""))
+    parts = {}
+    for code, name in ((1.0, "hold"), (2.0, "unloading")):
+        sel = rows[phase == code]
+        if len(sel):
+            parts[name] = PressPhase(time_s=sel[:, 0], travel_m=sel[:, 1], force_n=sel[:, 2])
+    ramp = rows[phase == 0.0]
+    return ForceTravel(travel_m=ramp[:, 1], force_n=ramp[:, 2], time_s=ramp[:, 0], **parts)
 
 
 def _point_message(stamp_ns: int, point: Any) -> Any:
@@ -194,6 +325,19 @@ def force_travel_message(record: ForceTravel) -> Any:
             dim(label=FORCE_TRAVEL_DIMS[1], size=2, stride=2)]
     layout = types["std_msgs/msg/MultiArrayLayout"](dim=dims, data_offset=0)
     data = np.column_stack([record.travel_m, record.force_n]).ravel()
+    if record.time_s is not None:
+        blocks = [np.column_stack([record.time_s, record.travel_m, record.force_n,
+                                   np.zeros(n)])]
+        for code, phase in ((1.0, record.hold), (2.0, record.unloading)):
+            if phase is not None:
+                blocks.append(np.column_stack([phase.time_s, phase.travel_m, phase.force_n,
+                                               np.full(len(phase), code)]))
+        rows = np.vstack(blocks)
+        n = len(rows)
+        dims = [dim(label=FORCE_TRAVEL_PHASED_DIMS[0], size=n, stride=4 * n),
+                dim(label=FORCE_TRAVEL_PHASED_DIMS[1], size=4, stride=4)]
+        layout = types["std_msgs/msg/MultiArrayLayout"](dim=dims, data_offset=0)
+        data = rows.ravel()
     return types["std_msgs/msg/Float64MultiArray"](layout=layout, data=data)
 
 
@@ -205,7 +349,9 @@ def write_session_bag(path: Path, *, storage: str, observation: PointCloud,
     # the record's topic only where a press has one: a bag of presses without stays as before
     topics = dict(TOPICS)
     if any(obs.force_travel is not None for obs in presses):
-        topics.update(OPTIONAL_TOPICS)
+        topics["force_travel"] = OPTIONAL_TOPICS["force_travel"]
+    if any(obs.released is not None for obs in presses):
+        topics["released"] = OPTIONAL_TOPICS["released"]
     with bag_writer(path, storage) as writer:
         conns = {key: writer.add_connection(topic, msgtype, typestore=store)
                  for key, (topic, msgtype) in topics.items()}  # fmt: skip
@@ -225,3 +371,5 @@ def write_session_bag(path: Path, *, storage: str, observation: PointCloud,
             cloud("robot", stamp, np.vstack(obs.robot_hulls))  # one hull: the parts' common one
             if obs.force_travel is not None:
                 put("force_travel", stamp, force_travel_message(obs.force_travel))
+            if obs.released is not None:
+                cloud("released", stamp, obs.released.points, obs.released.colors)

@@ -16,16 +16,19 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from deformap._config import few
 from deformap._validation import (
+    LIMITS,
     check_array,
     check_int,
+    check_limit,
     check_positive,
     check_rigid_transform,
     check_vector,
 )
 from deformap.cloud import PointCloud
 from deformap.cloud.io import UNITS
-from deformap.environment import ForceTravel, Workspace
+from deformap.environment import ForceTravel, PressPhase, Workspace
 from deformap.errors import ConfigError, DeformapError
 from deformap.replay._confine import confined_path
 
@@ -47,13 +50,17 @@ TOPICS = {"observation": ("/deformap/observation", "sensor_msgs/msg/PointCloud2"
 
 #: Topics of the bag form that a bag may lack (then no poke has what they carry).
 OPTIONAL_TOPICS = {"force_travel": ("/deformap/press/force_travel",
-                                    "std_msgs/msg/Float64MultiArray")}
+                                    "std_msgs/msg/Float64MultiArray"),
+                   "released": ("/deformap/press/released", "sensor_msgs/msg/PointCloud2")}
 
 _TOP_REQUIRED = {"format", "version", "workspace", "probe", "pokes"}
 _TOP_OPTIONAL = {"units", "frame", "cam2world", "ground_truth", "source", "observation", "bag",
                  "n_pokes", "sha256"}
 _FOLDER_POKE_KEYS = {"cloud", "tip_center", "force", "target_xy", "force_n", "robot_points"}
 _BAG_POKE_KEYS = {"stamp_ns", "target_xy", "force_n"}
+_RECORD_KEYS = {"travel_m", "force_n"}
+_RECORD_OPTIONAL = {"time_s", "hold", "unloading"}
+_PHASE_KEYS = {"time_s", "travel_m", "force_n"}
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -62,7 +69,9 @@ class PokeSpec:
 
     ``index`` is its place in ``pokes`` (0-based); ``target_xy`` and ``force_n`` the command. The
     folder form has ``cloud`` (a file), the contact ``tip_center`` and ``force``, ``robot_points``
-    (a file or inline points) and an optional ``force_travel``; the bag form the ``stamp_ns`` its
+    (a file or inline points), an optional ``force_travel`` (with, optionally, its ``time_s``,
+    ``hold`` and ``unloading``) and an optional ``released`` (a cloud file of the surface once the
+    tip has left); the bag form the ``stamp_ns`` its
     messages share. ``error`` says why the entry cannot be used (raised when the poke is read).
     """
 
@@ -75,6 +84,7 @@ class PokeSpec:
     robot_points: Path | NDArray[np.float64] | None = None
     stamp_ns: int | None = None
     force_travel: ForceTravel | None = None
+    released: Path | None = None
     error: DeformapError | None = None
 
 
@@ -113,6 +123,7 @@ class PressParts:
     force: NDArray[np.float64]
     robot_points: NDArray[np.float64] | tuple[NDArray[np.float64], ...]  # one hull, or per part
     force_travel: ForceTravel | None = None
+    released: PointCloud | None = None
 
 
 def _where(file: Path, key: str) -> str:
@@ -128,7 +139,7 @@ def _check_keys(file: Path, key: str, data: Any, required: set[str],
     unknown = sorted(keys - required - optional)
     if unknown:
         raise ConfigError(
-            f"{_where(file, key)} has unknown key(s) {unknown}; "
+            f"{_where(file, key)} has unknown key(s) {few(unknown)}; "
             f"allowed: {sorted(required | optional)}")
     missing = sorted(required - keys)
     if missing:
@@ -171,9 +182,15 @@ def _poke(file: Path, index: int, data: Any, form: str, root: Path) -> PokeSpec:
     if form == "bag":
         _check_keys(file, key, data, _BAG_POKE_KEYS)
     else:
-        _check_keys(file, key, data, _FOLDER_POKE_KEYS, {"force_travel"})
+        _check_keys(file, key, data, _FOLDER_POKE_KEYS, {"force_travel", "released"})
         if "force_travel" in data:
-            _check_keys(file, f"{key}.force_travel", data["force_travel"], {"travel_m", "force_n"})
+            raw = data["force_travel"]
+            _check_keys(file, f"{key}.force_travel", raw, _RECORD_KEYS, _RECORD_OPTIONAL)
+            for phase in ("hold", "unloading"):
+                if phase in raw:
+                    _check_keys(file, f"{key}.force_travel.{phase}", raw[phase], _PHASE_KEYS)
+        if isinstance(data.get("released"), str):
+            _name(file, f"{key}.released", data["released"], root)
 
         # Schema problems and names outside the session folder fail the file; value problems
         # (below) fail only this poke.
@@ -198,16 +215,31 @@ def _poke(file: Path, index: int, data: Any, form: str, root: Path) -> PokeSpec:
                         what="points in metres", min_rows=4))  # fmt: skip
         record = None
         if "force_travel" in data:
-            raw = data["force_travel"]
-            try:
-                record = ForceTravel(travel_m=raw["travel_m"], force_n=raw["force_n"])
-            except DeformapError as exc:
-                raise ConfigError(f"{_where(file, key + '.force_travel')}: {exc}") from None
+            record = _record(file, key + ".force_travel", data["force_travel"])
+        released = None
+        if "released" in data:
+            released = _name(file, f"{key}.released", data["released"], root)
         return PokeSpec(index=index, target_xy=target, force_n=force_n, cloud=cloud,
                         tip_center=center, force=force, robot_points=robot,
-                        force_travel=record)  # fmt: skip
+                        force_travel=record, released=released)  # fmt: skip
     except ConfigError as exc:
         return PokeSpec(index=index, error=exc)
+
+
+def _record(file: Path, key: str, raw: dict[str, Any]) -> ForceTravel:
+    """The ``force_travel`` entry (keys checked) as a record; its values' refusal names the key."""
+    name = key
+    try:
+        phases = {}
+        for phase in ("hold", "unloading"):
+            if phase in raw:
+                name = f"{key}.{phase}"
+                phases[phase] = PressPhase(**{k: raw[phase][k] for k in _PHASE_KEYS})
+        name = key
+        return ForceTravel(travel_m=raw["travel_m"], force_n=raw["force_n"],
+                           time_s=raw.get("time_s"), **phases)
+    except DeformapError as exc:
+        raise ConfigError(f"{_where(file, name)}: {exc}") from None
 
 
 def _workspace(file: Path, data: Any) -> Workspace:
@@ -247,7 +279,8 @@ def parse_session_yaml(data: Any, file: Path) -> SessionHeader:
     cam2world = _cam2world(file, data, frame, form)
     workspace = _workspace(file, data["workspace"])
     _check_keys(file, "probe", data["probe"], {"tip_radius_m"})
-    tip = _value(file, "probe.tip_radius_m", check_positive, data["probe"]["tip_radius_m"])
+    tip = _value(file, "probe.tip_radius_m", check_limit, data["probe"]["tip_radius_m"],
+                 "tip_radius_m")
     source = data.get("source") or {}
     if not isinstance(source, dict):
         raise ConfigError(
@@ -270,8 +303,14 @@ def parse_session_yaml(data: Any, file: Path) -> SessionHeader:
 
 
 def _check_poke_count(file: Path, data: dict[str, Any], pokes: list[Any]) -> None:
-    """``n_pokes``, when given, must count the entries of ``pokes``: a file cut at a poke
-    boundary is still valid YAML."""
+    """``pokes`` may list at most the pokes one map is made of (``LIMITS["pokes"]``, the cap of
+    ``exploration.max_pokes``); ``n_pokes``, when given, must count its entries: a file cut at a
+    poke boundary is still valid YAML."""
+    most = LIMITS["pokes"]["le"]
+    if len(pokes) > most:
+        raise ConfigError(
+            f"{_where(file, 'pokes')} lists {len(pokes):,} pokes; a map is made of at most "
+            f"{most:,} (as `exploration.max_pokes`): split the session")
     if "n_pokes" not in data:
         logger.info("%s: no `n_pokes`; cannot check that the poke list is complete", file)
         return

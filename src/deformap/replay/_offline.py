@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import partial
 from typing import Any
 
@@ -17,7 +17,7 @@ from numpy.typing import NDArray
 
 from deformap._validation import check_instance, check_points, check_positive, check_vector
 from deformap.cloud import PointCloud
-from deformap.environment import PressObservation, TactileContact, Workspace
+from deformap.environment import ForceTravel, PressObservation, TactileContact, Workspace
 from deformap.errors import DeformapError
 from deformap.explore import ExplorationConfig, ExplorationResult, Mapper, MappingRun, PokeResult
 from deformap.replay._session import DEFAULT_CONTACT_GAP_M, RecordedSession, check_contact_gap
@@ -30,15 +30,20 @@ logger = logging.getLogger(__name__)
 @dataclass
 class ReplayResult:
     """What :func:`map_session` produced: the ``result`` of every usable poke (``stop_reason``
-    ``"end-of-session"``), and ``skipped``, ``{"index": i, "error": message}`` per unusable poke."""
+    ``"end-of-session"``), ``skipped``, ``{"index": i, "error": message}`` per unusable poke, and
+    ``notes``, ``{"index": i, "warning": message}`` per poke used with a warning (a raw bag's
+    record and camera that disagree)."""
 
     result: ExplorationResult
     skipped: list[dict[str, Any]] = field(default_factory=list)
+    notes: list[dict[str, Any]] = field(default_factory=list)
 
     @property
     def warnings(self) -> list[str]:
-        """One line per skipped poke, numbered from 1 as the console and figures are."""
-        return [f"poke {s['index'] + 1} skipped: {s['error']}" for s in self.skipped]
+        """One line per skipped poke or warning, numbered from 1 as the console and figures
+        are."""
+        return [*(f"poke {s['index'] + 1} skipped: {s['error']}" for s in self.skipped),
+                *(f"poke {n['index'] + 1}: {n['warning']}" for n in self.notes)]
 
 
 def map_session(session: RecordedSession, config: ExplorationConfig, *, rng: np.random.Generator,
@@ -56,6 +61,8 @@ def map_session(session: RecordedSession, config: ExplorationConfig, *, rng: np.
     # child depends only on its position, so spawning one gives that same stream.
     run = MappingRun(session.workspace, config, session.observation, rng.spawn(1)[0])
     skipped: list[dict[str, Any]] = []
+    notes: list[dict[str, Any]] = []
+    unread: dict[int, str] = {}
     for index in range(len(session)):
         try:
             # reading the session stands in for the environment of the live loop
@@ -64,9 +71,19 @@ def map_session(session: RecordedSession, config: ExplorationConfig, *, rng: np.
             logger.warning("poke %d skipped: %s", index + 1, exc)
             skipped.append({"index": index, "error": str(exc)})
             continue
+        found = session.poke_notes(index)
+        if "disagreement" in found:
+            notes.append({"index": index, "warning": found["disagreement"]})
+        if "force_travel" in found and poke.record.stiffness_error is None:
+            unread[index] = found["force_travel"]
         if on_poke is not None:
             on_poke(poke)
-    return ReplayResult(result=run.result("end-of-session"), skipped=skipped)
+    result = run.result("end-of-session")
+    if unread:  # the poke's own entry says why it has no modulus
+        pokes = tuple(replace(p, record=replace(p.record, stiffness_error=unread[p.record.index]))
+                      if p.record.index in unread else p for p in result.pokes)  # fmt: skip
+        result = replace(result, pokes=pokes)
+    return ReplayResult(result=result, skipped=skipped, notes=notes)
 
 
 def tip_sphere_points(tip_center: Any, tip_radius_m: float) -> NDArray[np.float64]:
@@ -79,8 +96,11 @@ def tip_sphere_points(tip_center: Any, tip_radius_m: float) -> NDArray[np.float6
 
 def estimate_poke(before: PointCloud, after: PointCloud, contact: TactileContact,
                   config: ExplorationConfig, *, rng: np.random.Generator, robot_points: Any = None,
+                  force_travel: ForceTravel | None = None, released: PointCloud | None = None,
                   contact_gap_m: float = DEFAULT_CONTACT_GAP_M) -> PokeResult:
-    """β of one poke from the world-frame clouds ``before`` and ``after`` (while pressing).
+    """β of one poke from the world-frame clouds ``before`` and ``after`` (while pressing), and with
+    the press's ``force_travel`` record its stiffness and E, read as the mapper reads a press
+    (``released``: the surface once the tip has left, for the dent it kept).
 
     The surface, touch and shape-matching settings of ``config`` apply, over a workspace of three ROIs
     square centred on the contact. ``robot_points`` default to the tip's sphere
@@ -95,7 +115,8 @@ def estimate_poke(before: PointCloud, after: PointCloud, contact: TactileContact
     half = 1.5 * config.touch.roi_size_m
     workspace = Workspace(lower=tuple(xy - half), upper=tuple(xy + half))
     obs = PressObservation(cloud=after, contact=contact, robot_points=robot, target_xy=xy,
-                           force_n=contact.force_n)  # fmt: skip
+                           force_n=contact.force_n, force_travel=force_travel,
+                           released=released)  # fmt: skip
     check_contact_gap(obs, check_positive("contact_gap_m", contact_gap_m), "`after` and `contact`")
     mapper = Mapper(workspace, config)
     mapper.initialise(before, rng)

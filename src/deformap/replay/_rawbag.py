@@ -10,13 +10,16 @@ time. A press that cannot be read is refused in one line naming it, the topic an
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import hashlib
+import logging
+from itertools import pairwise
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
+from deformap._validation import LIMITS
 from deformap.cloud import PointCloud
 from deformap.cloud.io import (
     TransformTree,
@@ -24,22 +27,27 @@ from deformap.cloud.io import (
     bag_read_errors,
     header_stamp_ns,
     iter_bag_messages,
-    pointcloud2_colors,
-    pointcloud2_structured,
     typestore,
-    xyz_with_holes,
 )
-from deformap.environment import ForceTravel, Workspace
+from deformap.environment import Workspace
 from deformap.errors import DeformapError, FileFormatError
 from deformap.replay._format import PokeSpec, PressParts
-from deformap.replay._rawconfig import HullPart, RawBagConfig
-from deformap.replay._rawpress import FoundPress, find_presses
+from deformap.replay._rawcheck import CameraCheck
+from deformap.replay._rawconfig import WORKSPACE_MARGIN_RADII, RawBagConfig, hull_points
+from deformap.replay._rawfind import CLOUD_TYPE, TF_TYPE, WRENCH_TYPE
+from deformap.replay._rawframes import FrameGroup, average_frames, group_points
+from deformap.replay._rawpress import (
+    FoundPress,
+    block_size,
+    find_presses,
+    onset,
+    press_record,
+)
 
-__all__ = ["RawBagReader", "hull_points"]
+__all__ = ["RawBagReader"]
 
-_CLOUD = "sensor_msgs/msg/PointCloud2"
-_WRENCH = "geometry_msgs/msg/WrenchStamped"
-_TF = "tf2_msgs/msg/TFMessage"
+logger = logging.getLogger(__name__)
+
 
 #: A frame is averaged only while the camera holds within these [m, rad] of its pose at the
 #: middle frame: 1 mrad moves a point 1 m away by 1 mm, below a depth camera's noise.
@@ -49,90 +57,85 @@ STILL_M, STILL_RAD = 5e-4, 1e-3
 #: larger or non-finite one is a damaged message, refused before it is squared.
 MAX_FORCE_N = 1e6
 
-#: Points of a hull part's circle (cylinder, cap): 16 give a polygon within 2 % of the circle.
-_CIRCLE = 16
-
-
-def hull_points(part: HullPart, rot: NDArray[np.float64], origin: NDArray[np.float64]
-                ) -> NDArray[np.float64]:  # fmt: skip
-    """``(m, 3)`` world points whose convex hull is ``part`` at the tip pose ``rot``, ``origin``."""
-    c, (sx, sy, sz) = np.asarray(part.center_m), part.size_m
-    if part.shape == "box":
-        local = np.array([[x * sx, y * sy, z * sz] for x in (-0.5, 0.5) for y in (-0.5, 0.5)
-                          for z in (-0.5, 0.5)])  # fmt: skip
-    else:
-        az = np.linspace(0.0, 2 * np.pi, _CIRCLE, endpoint=False)
-        ring = np.column_stack([np.cos(az), np.sin(az), np.zeros_like(az)]) * (sx / 2)
-        if part.shape == "cylinder":
-            half = np.array([0.0, 0.0, sz / 2])
-            local = np.vstack([ring - half, ring + half])
-        else:  # cap: the upper half-sphere, as rings at 0°, 30°, 60° and the pole
-            r = sx / 2
-            local = np.vstack([ring * np.cos(a) + [0, 0, r * np.sin(a)]
-                               for a in (0.0, np.pi / 6, np.pi / 3)] + [[[0, 0, r]]])
-    return np.asarray((local + c) @ rot.T + origin)
-
-
-@dataclass
-class _Group:
-    """Frames averaged into one cloud, with the per-pixel sums (``rgb`` None once a frame lacks
-    colours) and counts."""
-
-    frames: list[int]
-    cam_stamp: int
-    shape: tuple[int, int] | None = None
-    total: NDArray[np.float64] | None = None
-    count: NDArray[np.int64] | None = None
-    rgb: NDArray[np.float64] | None = None
-
-
-class RawBagReader:
+class RawBagReader(CameraCheck):
     """Reads a raw recording: finds its presses, averages their frames, builds each press."""
 
     def __init__(self, bag: Path, config: RawBagConfig, commanded_n: float) -> None:
-        self.path, self.config, self.commanded_n = bag, config, commanded_n
-        cfg = config
-        self.tree = TransformTree(cfg.tf_topic, round(cfg.stamp_tolerance_s * 1e9))
+        self.path, self.commanded_n = bag, commanded_n
+        #: every value found in the bag or assumed, ``{key: {"value": v, "from": why}}``
+        self.found: dict[str, dict[str, Any]] = {}
+        #: per press (0-based): what the report says of it beyond its β (``force_travel``, ...)
+        self.notes: dict[int, dict[str, str]] = {}
+        self.config = config = self._topics(config)
+        self.tree = TransformTree(config.tf_topic, round(config.stamp_tolerance_s * 1e9))
         self._index()
         self.origin_ns = self.tree.origin_ns = int(min(self.cloud_ns.min(), self.wrench_ns[0]))
+        self.config = cfg = self._frames(self.config)
+        magnitude = np.linalg.norm(self.wrench_force, axis=1)
+        contact_n = self._threshold(cfg)
         self.presses = find_presses(
-            self.wrench_ns, np.linalg.norm(self.wrench_force, axis=1), commanded_n=commanded_n,
-            contact_n=cfg.contact_force_n, band=cfg.hold_band,
+            self.wrench_ns, magnitude, commanded_n=commanded_n,
+            contact_n=contact_n, band=cfg.hold_band,
             hold_min_ns=round(cfg.hold_min_s * 1e9),
-            merge_ns=round(cfg.stamp_tolerance_s * 1e9), topic=cfg.wrench_topic,
+            merge_ns=round(cfg.stamp_tolerance_s * 1e9), topic=self.wrench_topic,
             origin_ns=self.origin_ns)
+        source = self.found["contact_force_n"]["from"]
         if self.presses and self.presses[0].start == 0:
-            first = float(np.linalg.norm(self.wrench_force[0]))
             raise FileFormatError(
-                f"{bag}: topic {cfg.wrench_topic!r} reads {first:.4g} N from its first sample, over "
-                f"the contact threshold {cfg.contact_force_n:g} N (`contact_force_n`): a sensor "
+                f"{bag}: topic {self.wrench_topic!r} reads {magnitude[0]:.4g} N from its first "
+                f"sample, over the contact threshold {contact_n:.4g} N ({source}): a sensor "
                 "not zeroed with the probe free, or a recording started during a press")
         if not self.presses:
-            peak = float(np.max(np.linalg.norm(self.wrench_force, axis=1)))
             raise FileFormatError(
-                f"{bag}: no press on {cfg.wrench_topic!r}: the force must stay above "
-                f"{cfg.contact_force_n:g} N (`contact_force_n`) for {cfg.hold_min_s:g} s at least "
-                f"once; its largest is {peak:.4g} N")
-        self._groups: dict[int, _Group] = {}
+                f"{bag}: no press on {self.wrench_topic!r}: the force must stay above "
+                f"{contact_n:.4g} N ({source}) for {cfg.hold_min_s:g} s at least once; its "
+                f"largest is {float(magnitude.max()):.4g} N")
+        most = LIMITS["pokes"]["le"]
+        if len(self.presses) > most:
+            raise FileFormatError(
+                f"{bag}: {len(self.presses):,} presses found on {self.wrench_topic!r}, more than the "
+                f"{most:,} pokes one map is made of; split the recording")
+        self._check_merge(magnitude, contact_n)
+        self.config = cfg = self._tip(cfg)
+        self.tip_still = self._tip_still()
+        self._groups: dict[int, FrameGroup] = {}
         self._errors: dict[int, str] = {}
         self._observation_group = self._plan_observation()
         for press in self.presses:
             if press.error is None:
                 self._plan_press(press)
         self._average()
+        self._observation: PointCloud | None = None
 
-    # -- first pass -------------------------------------------------------------------------
+    def _check_merge(self, magnitude: NDArray[np.float64], contact_n: float) -> None:
+        """Refuse a ``stamp_tolerance_s`` that joins presses: one that holds the commanded force
+        twice, over the threshold apart, is two presses."""
+        cfg = self.config
+        apart = find_presses(self.wrench_ns, magnitude, commanded_n=self.commanded_n,
+                             contact_n=contact_n, band=cfg.hold_band,
+                             hold_min_ns=round(cfg.hold_min_s * 1e9), merge_ns=0,
+                             topic=self.wrench_topic, origin_ns=self.origin_ns)  # fmt: skip
+        held = [p for p in apart if p.hold_start >= 0]
+        for a, b in pairwise(held):
+            gap = (self.wrench_ns[b.start] - self.wrench_ns[a.end - 1]) / 1e9
+            if gap < cfg.stamp_tolerance_s:
+                raise FileFormatError(
+                    f"{self.path}: --stamp-tolerance {cfg.stamp_tolerance_s:g} s "
+                    f"(`stamp_tolerance_s`) would join the presses at t = "
+                    f"{self._s(self.wrench_ns[a.start])} and {self._s(self.wrench_ns[b.start])} s, "
+                    f"{gap:.3f} s apart; it must stay below the time between two presses")
 
     def _index(self) -> None:
         cfg, store, errors = self.config, typestore(), bag_read_errors()
-        topics = {cfg.cloud_topic: _CLOUD, cfg.wrench_topic: _WRENCH, cfg.tf_topic: _TF}
-        optional = {cfg.tf_static_topic: _TF}
+        topics = {self.cloud_topic: CLOUD_TYPE, self.wrench_topic: WRENCH_TYPE, cfg.tf_topic: TF_TYPE}
+        optional = {cfg.tf_static_topic: TF_TYPE}
         stamps: list[int] = []
         frames: set[str] = set()
         w_ns: list[int] = []
         w_force: list[list[float]] = []
         w_frames: set[str] = set()
         types = {**topics, **optional}
+        seen: dict[tuple[str, int, bytes], int] = {}  # (topic, stamp, digest) -> message number
         for raw in iter_bag_messages(self.path, topics, optional=optional):
             where = f"{self.path} [{raw.topic} message {raw.number}]"
             try:
@@ -140,10 +143,18 @@ class RawBagReader:
             except errors as exc:
                 raise FileFormatError(f"{where}: could not be decoded: "
                                       f"{bag_error_text(exc, 120)}") from None  # fmt: skip
-            if raw.topic == cfg.cloud_topic:
+            if raw.topic in (self.cloud_topic, self.wrench_topic):
+                key = (raw.topic, header_stamp_ns(msg.header),
+                       hashlib.blake2b(bytes(raw.data), digest_size=16).digest())
+                first = seen.setdefault(key, raw.number)
+                if first != raw.number:  # it would count twice in a press's average
+                    raise FileFormatError(
+                        f"{where}: repeats message {first} byte for byte (same header stamp); "
+                        "the bag holds messages written twice")
+            if raw.topic == self.cloud_topic:
                 stamps.append(header_stamp_ns(msg.header))
                 frames.add(str(msg.header.frame_id))
-            elif raw.topic == cfg.wrench_topic:
+            elif raw.topic == self.wrench_topic:
                 f = msg.wrench.force
                 w_ns.append(header_stamp_ns(msg.header))
                 w_force.append([float(f.x), float(f.y), float(f.z)])
@@ -151,11 +162,16 @@ class RawBagReader:
             else:
                 self.tree.add(msg, static=raw.topic == cfg.tf_static_topic and
                               raw.topic != cfg.tf_topic, where=where)  # fmt: skip
-        for topic, count in ((cfg.cloud_topic, len(stamps)), (cfg.wrench_topic, len(w_ns))):
-            if count == 0:
+        for topic, got in ((self.cloud_topic, stamps), (self.wrench_topic, w_ns)):
+            if not got:
                 raise FileFormatError(f"{self.path}: topic {topic!r} has no messages")
-        self.camera_frame = cfg.camera_frame or self._one_frame(frames, cfg.cloud_topic)
-        self.force_frame = cfg.force_frame or self._one_frame(w_frames, cfg.wrench_topic)
+            if len(got) > 1 and not any(got):
+                raise FileFormatError(
+                    f"{self.path}: topic {topic!r}: every header stamp of its {len(got)} messages "
+                    "is zero; its driver did not stamp them, and deformap pairs the camera, the "
+                    "force and /tf by their header stamps")
+        self.camera_frame = cfg.camera_frame or self._one_frame(frames, self.cloud_topic)
+        self.force_frame = cfg.force_frame or self._one_frame(w_frames, self.wrench_topic)
         order = np.argsort(np.asarray(w_ns, dtype=np.int64), kind="stable")
         self.wrench_ns = np.asarray(w_ns, dtype=np.int64)[order]
         self.wrench_force = np.asarray(w_force, dtype=np.float64)[order]
@@ -163,7 +179,7 @@ class RawBagReader:
         if bad.any():
             first = int(order[np.flatnonzero(bad)[0]])
             raise FileFormatError(
-                f"{self.path} [{cfg.wrench_topic} message {first + 1}]: force "
+                f"{self.path} [{self.wrench_topic} message {first + 1}]: force "
                 f"{w_force[first]} N: expected finite components within ±{MAX_FORCE_N:g} N "
                 "(no force sensor reads more: a damaged message)")
         self.cloud_ns = np.asarray(stamps, dtype=np.int64)
@@ -180,7 +196,7 @@ class RawBagReader:
 
     # -- which frames -----------------------------------------------------------------------
 
-    def _plan_observation(self) -> _Group:
+    def _plan_observation(self) -> FrameGroup:
         cfg, first_contact = self.config, int(self.wrench_ns[self.presses[0].start])
         order = np.argsort(self.cloud_ns, kind="stable")
         times = self.cloud_ns[order]
@@ -193,7 +209,7 @@ class RawBagReader:
         if last >= first_contact or len(chosen) < cfg.observation_frames:
             raise FileFormatError(
                 f"{self.path}: the observation's {cfg.observation_frames} frame(s) on "
-                f"{cfg.cloud_topic!r} from t = {self._s(times[pick])} s must all come before the "
+                f"{self.cloud_topic!r} from t = {self._s(times[pick])} s must all come before the "
                 f"first contact at t = {self._s(first_contact)} s (`observation_time_s`, "
                 "`observation_frames`)")
         return self._still(chosen, f"{self.path}: the observation")
@@ -208,7 +224,7 @@ class RawBagReader:
             nearest = int(np.argmin(gap))
             if gap[nearest] > round(cfg.stamp_tolerance_s * 1e9):
                 self._errors[press.index] = (
-                    f"{where}: topic {cfg.cloud_topic!r} has no frame within "
+                    f"{where}: topic {self.cloud_topic!r} has no frame within "
                     f"{cfg.stamp_tolerance_s:g} s of the hold (nearest {gap[nearest] / 1e9:.3f} s "
                     "away)")
                 return
@@ -218,86 +234,57 @@ class RawBagReader:
         except DeformapError as exc:
             self._errors[press.index] = str(exc)
 
-    def _still(self, frames: list[int], where: str) -> _Group:
+    def _still(self, frames: list[int], where: str) -> FrameGroup:
         """The frames whose camera pose lies within ``STILL_M``, ``STILL_RAD`` of the middle one's."""
         stamps = self.cloud_ns[frames]
-        rot, trans = self.tree.lookup(self.config.world_frame, self.camera_frame, stamps,
-                                      what=f"{where} [{self.config.cloud_topic}]")  # fmt: skip
+        rot, trans = self.tree.lookup(self.world_frame, self.camera_frame, stamps,
+                                      what=f"{where} [{self.cloud_topic}]")  # fmt: skip
         mid = len(frames) // 2
         angle = np.arccos(np.clip((np.einsum("nij,ij->n", rot, rot[mid]) - 1) / 2, -1.0, 1.0))
         still = (np.linalg.norm(trans - trans[mid], axis=1) <= STILL_M) & (angle <= STILL_RAD)
         kept = [f for f, s in zip(frames, still, strict=True) if s]
-        return _Group(frames=kept, cam_stamp=int(stamps[mid]))
+        return FrameGroup(frames=kept, cam_stamp=int(stamps[mid]))
 
     # -- second pass: the average of each group ----------------------------------------------
 
     def _average(self) -> None:
-        groups = [self._observation_group, *self._groups.values()]
-        wanted: dict[int, list[_Group]] = {}
-        for group in groups:
-            for frame in group.frames:
-                wanted.setdefault(frame, []).append(group)
-        cfg, store, errors = self.config, typestore(), bag_read_errors()
-        for raw in iter_bag_messages(self.path, {cfg.cloud_topic: _CLOUD}):
-            number = raw.number - 1  # the frame index the groups name
-            if number not in wanted:
-                continue
-            where = f"{self.path} [{cfg.cloud_topic} message {raw.number}]"
-            try:
-                msg = store.deserialize_cdr(bytes(raw.data), _CLOUD)
-                xyz, rgb = self._xyz(msg, where)
-            except errors as exc:
-                raise FileFormatError(f"{where}: could not be decoded: "
-                                      f"{bag_error_text(exc, 120)}") from None  # fmt: skip
-            shape = (int(msg.height), int(msg.width))
-            ok = np.isfinite(xyz).all(axis=1)
-            for group in wanted[number]:
-                if group.total is None or group.count is None:
-                    group.shape, group.total = shape, np.zeros_like(xyz)
-                    group.count = np.zeros(xyz.shape[0], dtype=np.int64)
-                    group.rgb = None if rgb is None else np.zeros_like(xyz)
-                elif shape != group.shape or shape[0] == 1:
-                    continue  # another layout, or an unorganised cloud: no pixel to average
-                group.total[ok] += xyz[ok]
-                group.count[ok] += 1
-                if group.rgb is not None and rgb is not None:
-                    group.rgb[ok] += rgb[ok]
-                else:
-                    group.rgb = None
+        average_frames(self.path, self.cloud_topic, [self._observation_group, *self._groups.values()],
+                       1e-3 if self.config.units == "mm" else 1.0)
 
-    def _xyz(self, msg: Any, where: str) -> tuple[NDArray[np.float64], NDArray[np.float64] | None]:
-        """The frame's points, NaN holes kept, and their colours (NaN at the holes) or None."""
-        try:
-            table = pointcloud2_structured(msg)
-            xyz = xyz_with_holes(msg, table)
-        except DeformapError as exc:
-            raise FileFormatError(f"{where}: {str(exc).replace('`msg` ', '')}") from None
-        rgb = pointcloud2_colors(msg, where=where, table=table, valid=np.isfinite(xyz).all(axis=1))
-        return xyz * (1e-3 if self.config.units == "mm" else 1.0), rgb
-
-    def _cloud(self, group: _Group, where: str) -> PointCloud:
-        if group.total is None or group.count is None or not group.count.any():
-            raise FileFormatError(f"{where}: topic {self.config.cloud_topic!r}: its frames hold "
-                                  "no finite point")  # fmt: skip
-        seen = group.count > 0
-        cam = group.total[seen] / group.count[seen, None]
-        rgb = None if group.rgb is None else np.clip(group.rgb[seen] / group.count[seen, None], 0, 1)
-        rot, trans = self.tree.lookup(self.config.world_frame, self.camera_frame, group.cam_stamp,
-                                      what=f"{where} [{self.config.cloud_topic}]")  # fmt: skip
+    def _cloud(self, group: FrameGroup, where: str) -> PointCloud:
+        cam, rgb = group_points(group, self.cloud_topic, where)
+        rot, trans = self.tree.lookup(self.world_frame, self.camera_frame, group.cam_stamp,
+                                      what=f"{where} [{self.cloud_topic}]")  # fmt: skip
         return PointCloud(cam @ rot[0].T + trans[0], rgb)
 
     # -- what the session asks for -----------------------------------------------------------
 
     def observation(self) -> PointCloud:
-        return self._cloud(self._observation_group, f"{self.path}: the observation")
+        if self._observation is None:
+            self._observation = self._cloud(self._observation_group, f"{self.path}: the observation")
+        return self._observation
 
-    def workspace(self) -> Workspace:
+    def workspace(self, targets: list[NDArray[np.float64]]) -> Workspace:
+        """The given rectangle, or the ``targets``' surroundings within the observation's extent."""
         cfg = self.config
         if cfg.workspace_lower is not None and cfg.workspace_upper is not None:
+            self._note("workspace", [list(cfg.workspace_lower), list(cfg.workspace_upper)], "given")
             return Workspace(lower=cfg.workspace_lower, upper=cfg.workspace_upper)
         pts = self.observation().points
         lo, hi = pts[:, :2].min(axis=0), pts[:, :2].max(axis=0)
-        return Workspace(lower=(float(lo[0]), float(lo[1])), upper=(float(hi[0]), float(hi[1])))
+        why = "the observation's x–y extent (no press usable)"
+        if targets:
+            margin = WORKSPACE_MARGIN_RADII * cfg.tip_radius_m
+            xy = np.array(targets)
+            lo = np.maximum(lo, xy.min(axis=0) - margin)
+            hi = np.minimum(hi, xy.max(axis=0) + margin)
+            why = (f"assumed: the presses' bounding box grown by {WORKSPACE_MARGIN_RADII:g} tip "
+                   f"radii ({margin:g} m), within the observation's extent; set "
+                   "`workspace_lower`, `workspace_upper` to map more")
+        ws = Workspace(lower=(float(lo[0]), float(lo[1])), upper=(float(hi[0]), float(hi[1])))
+        self._note("workspace", [[round(v, 4) for v in ws.lower], [round(v, 4) for v in ws.upper]],
+                   why)
+        return ws
 
     def poke_specs(self) -> tuple[PokeSpec, ...]:
         """One entry per press found; a press that cannot be used carries its error."""
@@ -310,7 +297,7 @@ class RawBagReader:
                 stamp = int(self.wrench_ns[(press.hold_start + press.hold_end) // 2])
                 try:
                     _, tip = self.tree.lookup(
-                        self.config.world_frame, self.config.tip_frame, stamp,
+                        self.world_frame, self.tip_frame, stamp,
                         what=f"press {press.index + 1} [{self.config.tf_topic}, the tip]")
                     target = tip[0, :2]
                 except DeformapError as exc:
@@ -326,21 +313,25 @@ class RawBagReader:
         where = (f"{self.path}: press {press.index + 1} (hold t = "
                  f"{self._s(self.wrench_ns[press.hold_start])}–"
                  f"{self._s(self.wrench_ns[press.hold_end - 1])} s)")
-        span = slice(press.start, press.hold_end)
+        # first contact: the foot of the ramp under the threshold, found on block means
+        k = block_size(press.hold_start - press.start, self.noise.rms_n, self.commanded_n)
+        first = onset(self.wrench_force, press.start,
+                      self.presses[press.index - 1].end if press.index else 0, self.noise, k)
+        span = slice(first, press.hold_end)
         stamps = self.wrench_ns[span]
-        r_force, _ = self.tree.lookup(cfg.world_frame, self.force_frame, stamps,
-                                      what=f"{where} [{cfg.wrench_topic}]")  # fmt: skip
+        r_force, _ = self.tree.lookup(self.world_frame, self.force_frame, stamps,
+                                      what=f"{where} [{self.wrench_topic}]")  # fmt: skip
         sign = -1.0 if cfg.wrench_sign == "reaction" else 1.0
         forces = sign * np.einsum("nij,nj->ni", r_force, self.wrench_force[span])
-        r_tip, tips = self.tree.lookup(cfg.world_frame, cfg.tip_frame, stamps,
+        r_tip, tips = self.tree.lookup(self.world_frame, self.tip_frame, stamps,
                                        what=f"{where} [{cfg.tf_topic}, the tip]")  # fmt: skip
-        hold = slice(press.hold_start - press.start, press.hold_end - press.start)
+        hold = slice(press.hold_start - first, press.hold_end - first)
         mid = (hold.start + hold.stop) // 2
         direction = -r_tip[mid][:, 2]  # the press goes along the tip frame's -z
         if direction[2] >= 0.0:  # the press must go down, into the table's surface
             raise FileFormatError(
-                f"{where}: the tip frame {cfg.tip_frame!r}'s −z points "
-                f"{np.round(direction, 3).tolist()} in {cfg.world_frame!r}, not down into the "
+                f"{where}: the tip frame {self.tip_frame!r}'s −z points "
+                f"{np.round(direction, 3).tolist()} in {self.world_frame!r}, not down into the "
                 f"surface; `tip_frame` must have z along the stick, away from the surface "
                 f"(docs/robot.md)")
         force = forces[hold].mean(axis=0)
@@ -356,13 +347,23 @@ class RawBagReader:
         reached = np.flatnonzero(normal[: hold.stop] >= float(normal[hold].mean()))
         ramp = slice(0, int(reached[0]) + 1 if reached.size else hold.start + 1)
         travel = (tips[ramp] - tips[0]) @ direction
-        try:
-            record = ForceTravel(travel_m=travel, force_n=normal[ramp])
-        except DeformapError as exc:
-            raise FileFormatError(f"{where}: the force–travel record of the ramp: {exc}") from None
         if spec.index not in self._groups:
             raise FileFormatError(f"{where}: {self._errors.get(spec.index, 'no frame')}")
         cloud = self._cloud(self._groups[spec.index], where)
-        tip = tips[hold].mean(axis=0)
+        # the tip where it settled: the hold's last third (after a force step the tip still
+        # sinks early in the hold; after a ramp it is still throughout)
+        settled = max(1, (hold.stop - hold.start) // 3)
+        tip = tips[hold.stop - settled: hold.stop].mean(axis=0)
         robot = tuple(hull_points(p, r_tip[mid], tip) for p in cfg.hull)  # a hull per part
+        notes = self.notes.setdefault(spec.index, {})
+        # the sensor's noise along the press: its per-axis σ seen along the direction
+        along = r_force[mid].T @ direction
+        noise = float(np.sqrt(np.sum((along * self.noise.std) ** 2)))
+        seconds, held = (stamps - stamps[0]) / 1e9, slice(ramp.stop, hold.stop)
+        record = press_record(travel, normal[ramp], seconds[ramp], noise, notes,
+                              (seconds[held], (tips[held] - tips[0]) @ direction, normal[held]))
+        record = self.against_camera(notes, record, travel, cloud,
+                                     tip + cfg.tip_radius_m * direction, robot)
+        if "disagreement" in notes:  # a warning in the report (map_session), said once
+            logger.info("%s: %s", where, notes["disagreement"])
         return PressParts(cloud, tip, force, robot, record)

@@ -21,9 +21,14 @@ from deformap._validation import check_instance, check_int, check_path, check_po
 from deformap.cloud import PointCloud, points_in_hull
 from deformap.cloud.io import path_kind, read_cloud
 from deformap.environment import PressObservation, TactileContact, Workspace
-from deformap.errors import DeformapError, FileFormatError, InvalidArgumentError
+from deformap.errors import ConfigError, DeformapError, FileFormatError, InvalidArgumentError
 from deformap.replay._bagform import BagReader
-from deformap.replay._confine import verify_digest
+from deformap.replay._confine import (
+    check_manifest_complete,
+    check_no_links,
+    check_seal,
+    verify_digest,
+)
 from deformap.replay._format import (
     SESSION_FILE,
     PokeSpec,
@@ -78,7 +83,8 @@ class FolderReader:
             # Robot geometry comes from the robot model in the world (base) frame, not the camera's.
             robot = np.asarray(self._read(robot, to_world=False).points)
         assert robot is not None
-        return PressParts(cloud, spec.tip_center, spec.force, robot, spec.force_travel)
+        released = None if spec.released is None else self._read(spec.released)
+        return PressParts(cloud, spec.tip_center, spec.force, robot, spec.force_travel, released)
 
 
 @dataclass(eq=False)
@@ -104,8 +110,22 @@ class RecordedSession:
 
     @property
     def source(self) -> dict[str, Any]:
-        """Free-form provenance from ``session.yaml`` (scenario, seed, ...)."""
-        return dict(self.header.source)
+        """Free-form provenance from ``session.yaml`` (scenario, seed, ...); a raw bag's holds
+        what was found in it and, once its presses are read, ``presses``: what each one's entry
+        says beyond its β (:meth:`poke_notes`)."""
+        out = dict(self.header.source)
+        notes = getattr(self._reader, "notes", None)
+        if notes:
+            out["presses"] = {str(i + 1): dict(n) for i, n in sorted(notes.items())}
+        return out
+
+    def poke_notes(self, index: int) -> dict[str, str]:
+        """What was noted while poke ``index`` was read: ``force_travel`` (why its record was not
+        used), ``disagreement`` (the record and the camera disagree), the camera's dent and the
+        record's travel; ``stamp_gaps_s``, topic → how far [s] the message used lies from the
+        poke's stamp (a bag-form session read with a stamp tolerance); else empty."""
+        notes = getattr(self._reader, "notes", None)
+        return dict(notes.get(index, {})) if notes else {}
 
     def __len__(self) -> int:
         return len(self.header.pokes)
@@ -134,7 +154,8 @@ class RecordedSession:
             obs = PressObservation(cloud=parts.cloud, contact=contact,
                                    robot_points=parts.robot_points, target_xy=spec.target_xy,
                                    force_n=spec.force_n,
-                                   force_travel=parts.force_travel)  # fmt: skip
+                                   force_travel=parts.force_travel,
+                                   released=parts.released)  # fmt: skip
         except InvalidArgumentError as exc:
             raise FileFormatError(f"{where}: {exc}") from None
         self._check_contact(obs, where)
@@ -183,21 +204,32 @@ def _session_file(path: Path) -> Path:
     raise FileFormatError(f"{path}: no such session folder or file")
 
 
-def load_session(path: str | Path, *, contact_gap_m: float = DEFAULT_CONTACT_GAP_M
-                 ) -> RecordedSession:  # fmt: skip
+def load_session(path: str | Path, *, contact_gap_m: float = DEFAULT_CONTACT_GAP_M,
+                 stamp_tolerance_s: float | None = None) -> RecordedSession:
     """Open a recorded session (its folder or ``session.yaml``) and check ``session.yaml``.
 
     Pokes are read on demand (:meth:`RecordedSession.press_observation`), each refused when its
-    contact point lies farther than ``contact_gap_m`` from every surface point. A ``session.yaml``
-    that is no valid YAML or has unknown, missing or bad keys is a ConfigError; a missing
-    observation or bag, a missing topic or an unreadable ground truth a FileFormatError.
+    contact point lies farther than ``contact_gap_m`` from every surface point. A bag-form poke
+    takes on each topic the message stamped ``stamp_ns``, or with ``stamp_tolerance_s`` the one
+    nearest it within that many seconds (the gap in :meth:`RecordedSession.poke_notes`); a
+    tolerance reaching half-way to another poke's stamp, or given to a folder-form session, is
+    refused. A ``session.yaml`` that is no valid YAML or has unknown, missing or bad keys is a
+    ConfigError; a missing observation or bag, a missing topic or an unreadable ground truth a
+    FileFormatError.
     """
     p = check_path("path", path)
     gap = check_positive("contact_gap_m", contact_gap_m)
     file = _session_file(p)
     header = parse_session_yaml(
         load_yaml(file, what="the session file", unreadable=FileFormatError), file)
-    reader = FolderReader(header) if header.form == "folder" else BagReader(header)
+    check_no_links(file.parent)
+    if file.is_symlink():
+        raise ConfigError(f"{file}: a symbolic link; name the session folder or its own file")
+    check_seal(file, header.sha256)
+    check_manifest_complete(file, header.sha256)
+    tolerance = _stamp_tolerance(file, header, stamp_tolerance_s)
+    reader = (FolderReader(header) if header.form == "folder"
+              else BagReader(header, tolerance))  # fmt: skip
     truth = None
     if header.ground_truth is not None:
         if path_kind(header.ground_truth) == "file":
@@ -210,13 +242,35 @@ def load_session(path: str | Path, *, contact_gap_m: float = DEFAULT_CONTACT_GAP
                            contact_gap_m=gap, _reader=reader)  # fmt: skip
 
 
+def _stamp_tolerance(file: Path, header: SessionHeader, tolerance_s: float | None) -> int:
+    """The stamp tolerance [ns] of a bag-form session: bounded by half the closest two pokes'
+    stamps, so that no message can be taken for two pokes."""
+    if tolerance_s is None:
+        return 0
+    tol = check_positive("stamp_tolerance_s", tolerance_s)
+    if header.form != "bag":
+        raise InvalidArgumentError(
+            f"{file}: --stamp-tolerance applies to bags (stamped messages); this session is of "
+            f"the {header.form} form")
+    stamps = sorted(s.stamp_ns for s in header.pokes if s.stamp_ns is not None)
+    gaps = np.diff(stamps)
+    if gaps.size and tol * 1e9 >= gaps.min() / 2:
+        k = int(np.argmin(gaps))
+        raise InvalidArgumentError(
+            f"{file}: --stamp-tolerance {tol:g} s reaches half-way from one poke's stamp to the "
+            f"next ({stamps[k]} and {stamps[k + 1]} ns, {gaps[k] / 1e9:g} s apart): a message "
+            "could be taken for two pokes; give less than half their distance")
+    return round(tol * 1e9)
+
+
 #: Files that are a ROS 2 bag on their own (MCAP, sqlite3).
-RAW_SUFFIXES = (".mcap", ".db3")
+RAW_SUFFIXES = (".mcap", ".db3", ".bag")
 
 
 def is_raw_bag(path: str | Path) -> bool:
-    """Whether ``path`` is a bag as a robot records it: a ``.mcap`` or ``.db3`` file, or a rosbag2
-    folder (with ``metadata.yaml``) without ``session.yaml``."""
+    """Whether ``path`` is a bag as a robot records it: a ``.mcap`` or ``.db3`` file (or a ROS 1
+    ``.bag``, refused when opened), or a rosbag2 folder (with ``metadata.yaml``) without
+    ``session.yaml``."""
     p = Path(path)
     kind = path_kind(p)
     if kind == "dir":
@@ -242,12 +296,27 @@ def load_raw_bag(path: str | Path, config: RawBagConfig | None = None, *, defaul
     default_n = check_positive("default_force_n", default_force_n)
     force = default_n if cfg.force_n is None else cfg.force_n
     reader = RawBagReader(bag, cfg, force)
+    specs = reader.poke_specs()
+    workspace = reader.workspace([s.target_xy for s in specs if s.target_xy is not None])
+    reader.found["force_n"] = {"value": force, "from": "given" if cfg.force_n is not None else
+                               "the run configuration's exploration.force_n"}
+    defaults = RawBagConfig()
+    for key in ("units", "wrench_sign", "tip_radius_m", "hull", "stamp_tolerance_s",
+                "hold_band", "hold_min_s", "observation_frames"):
+        value = getattr(cfg, key)
+        shown = (f"{len(value)} part(s): " + ", ".join(p.shape for p in value) if key == "hull"
+                 else value)  # fmt: skip
+        reader.found[key] = {"value": shown, "from": "assumed: the default (docs/robot.md)"
+                             if value == getattr(defaults, key) else "given"}
+    for key, value in reader.found.items():
+        logger.info("%s: %s = %s (%s)", bag, key, value["value"], value["from"])
     header = SessionHeader(
         root=bag if bag.is_dir() else bag.parent, form="raw", units=cfg.units,
-        frame=cfg.world_frame, cam2world=None, workspace=reader.workspace(),
+        frame=str(reader.config.world_frame), cam2world=None, workspace=workspace,
         tip_radius_m=cfg.tip_radius_m, observation=None, bag=bag, ground_truth=None,
-        source={"raw": config_to_dict(cfg), "force_n": force, "n_presses": len(reader.presses)},
-        pokes=reader.poke_specs())
+        source={"raw": config_to_dict(cfg), "found": reader.found, "force_n": force,
+                "n_presses": len(reader.presses)},
+        pokes=specs)
     return RecordedSession(path=bag, header=header, ground_truth=None,
                            contact_gap_m=check_positive("contact_gap_m", contact_gap_m),
                            _reader=reader)

@@ -11,6 +11,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from deformap._files import atomic_path
 from deformap._validation import check_array, check_instance
 from deformap.cloud.io import load_npz_arrays, path_kind
 from deformap.errors import FileFormatError, InvalidArgumentError
@@ -71,9 +72,10 @@ class GroundTruth:
 
 
 def write_ground_truth(path: str | Path, truth: GroundTruth) -> None:
-    """Write ``truth`` to an NPZ archive (compressed, no pickle)."""
+    """Write ``truth`` to an NPZ archive (compressed, no pickle), atomically
+    (:func:`deformap._files.atomic_path`)."""
     check_instance("truth", truth, GroundTruth)
-    with open(path, "wb") as fh:
+    with atomic_path(path) as tmp, open(tmp, "xb") as fh:
         np.savez_compressed(fh, xs=truth.xs, ys=truth.ys, labels=truth.labels,
                             hardness=truth.hardness)  # fmt: skip
 

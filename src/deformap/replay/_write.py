@@ -4,6 +4,8 @@
 from __future__ import annotations
 
 import logging
+import os
+import shutil
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -11,13 +13,14 @@ from typing import Any
 import numpy as np
 import yaml
 
+from deformap._files import LOCK_NAME, write_text_atomically, writing
 from deformap._validation import check_instance, check_path, check_positive
 from deformap.cloud import PointCloud
 from deformap.cloud.io import BAG_STORAGES, CLOUD_FORMATS, write_cloud
-from deformap.environment import Environment, PressObservation, Workspace
+from deformap.environment import Environment, ForceTravel, PressObservation, Workspace
 from deformap.errors import EnvironmentStateError, InvalidArgumentError
 from deformap.replay._bagform import write_session_bag
-from deformap.replay._confine import manifest_of
+from deformap.replay._confine import manifest_of, seal
 from deformap.replay._format import FORMAT_NAME, FORMAT_VERSION, SESSION_FILE
 from deformap.replay._truth import GroundTruth, write_ground_truth
 
@@ -70,7 +73,11 @@ class RecordingEnvironment:
 
 
 class _Dumper(yaml.SafeDumper):
-    """Vectors (lists of numbers) on one line; everything else in block style."""
+    """Vectors (lists of numbers) on one line; everything else in block style; a value met twice
+    written in full (the reader refuses aliases)."""
+
+    def ignore_aliases(self, data: Any) -> bool:
+        return True
 
 
 def _represent_list(dumper: yaml.SafeDumper, data: list[Any]) -> Any:
@@ -90,7 +97,7 @@ def _check_inputs(folder: Any, workspace: Any, observation: Any, presses: Any, t
                   format: Any, cloud_format: Any,
                   ground_truth: Any) -> tuple[Path, list[PressObservation], float]:
     out = check_path("folder", folder)
-    if out.exists() and (not out.is_dir() or any(out.iterdir())):
+    if out.exists() and (not out.is_dir() or any(p.name != LOCK_NAME for p in out.iterdir())):
         raise InvalidArgumentError(f"`folder` {out} exists and is not an empty folder")
     check_instance("workspace", workspace, Workspace)
     if not isinstance(observation, PointCloud) or len(observation) == 0:
@@ -124,22 +131,40 @@ def _check_inputs(folder: Any, workspace: Any, observation: Any, presses: Any, t
     return out, presses, tip
 
 
+def record_entry(record: ForceTravel) -> dict[str, Any]:
+    """A force–travel record as ``session.yaml``'s ``force_travel`` entry (parts it lacks left out)."""
+    entry: dict[str, Any] = {"travel_m": _floats(record.travel_m),
+                             "force_n": _floats(record.force_n)}
+    if record.time_s is not None:
+        entry["time_s"] = _floats(record.time_s)
+    for name in ("hold", "unloading"):
+        phase = getattr(record, name)
+        if phase is not None:
+            entry[name] = {k: _floats(getattr(phase, k)) for k in ("time_s", "travel_m", "force_n")}
+    return entry
+
+
 def write_session(folder: str | Path, *, workspace: Workspace, observation: PointCloud,
                   presses: Sequence[PressObservation], tip_radius_m: float | None = None,
                   ground_truth: GroundTruth | None = None, source: dict[str, Any] | None = None,
                   format: str = "folder", cloud_format: str = "pcd") -> Path:
     """Write a session that :func:`load_session` reads back exactly; returns its ``session.yaml``.
 
-    ``folder`` is new or empty. The ``observation`` and the ``presses`` (world frame, in order) are
+    ``folder`` is new or empty (but for a lock file, :data:`deformap._files.LOCK_NAME`, of the
+    process writing it). The ``observation`` and the ``presses`` (world frame, in order) are
     written as float64 and read back bit for bit, colours exactly in NPZ and to 8 bits a channel in
     PCD, PLY and bags; a press with one hull per part keeps its parts' common hull (with a warning).
     ``tip_radius_m`` defaults to the presses' (which must agree); ``source`` is plain provenance data.
     ``format`` ``"folder"`` writes cloud files of ``cloud_format``, ``"mcap"`` or ``"sqlite3"`` a ROS 2
-    bag in ``bag/``. ``session.yaml`` comes last, with ``n_pokes`` and every file's ``sha256``.
+    bag in ``bag/``. ``session.yaml`` comes last, with ``n_pokes``, every file's ``sha256`` and its
+    seal (:func:`~deformap.replay._confine.seal`). Every file is written atomically: a failed write
+    is one :class:`~deformap.errors.FileWriteError` naming the file, and leaves no file cut short
+    under its name (a bag is written in a folder beside and renamed into place).
     """
     out, presses, tip = _check_inputs(folder, workspace, observation, presses, tip_radius_m,
                                       format, cloud_format, ground_truth)  # fmt: skip
-    out.mkdir(parents=True, exist_ok=True)
+    with writing(out):
+        out.mkdir(parents=True, exist_ok=True)
     doc: dict[str, Any] = {
         "format": FORMAT_NAME, "version": FORMAT_VERSION, "units": "m", "frame": "world",
         "workspace": {"lower": list(workspace.lower), "upper": list(workspace.upper)},
@@ -166,21 +191,31 @@ def write_session(folder: str | Path, *, workspace: Workspace, observation: Poin
                 "force": _floats(obs.contact.force), "target_xy": _floats(obs.target_xy),
                 "force_n": float(obs.force_n), "robot_points": robot}  # fmt: skip
             if obs.force_travel is not None:
-                entry["force_travel"] = {"travel_m": _floats(obs.force_travel.travel_m),
-                                         "force_n": _floats(obs.force_travel.force_n)}
+                entry["force_travel"] = record_entry(obs.force_travel)
+            if obs.released is not None:
+                entry["released"] = f"poke-{i:02d}-released.{cloud_format}"
+                write_cloud(out / entry["released"], obs.released)
             pokes.append(entry)
     else:
         stamps = [(i + 1) * _STAMP_STEP_NS for i in range(len(presses))]
-        write_session_bag(out / "bag", storage=format, observation=observation,
-                          presses=presses, stamps_ns=stamps)  # fmt: skip
+        # written beside, then renamed into place: a failed write leaves no bag cut short
+        staging = out / f".bag-{os.getpid()}.partial"
+        with writing(out / "bag"):
+            try:
+                write_session_bag(staging / "bag", storage=format, observation=observation,
+                                  presses=presses, stamps_ns=stamps)  # fmt: skip
+                os.replace(staging / "bag", out / "bag")
+            finally:
+                shutil.rmtree(staging, ignore_errors=True)
         doc["bag"] = "bag"
         pokes = [
             {"stamp_ns": s, "target_xy": _floats(o.target_xy), "force_n": float(o.force_n)}
             for s, o in zip(stamps, presses, strict=True)]
     # The count and the manifest come before the pokes: a file cut in its poke list keeps them.
     doc["n_pokes"] = len(pokes)
-    doc["sha256"] = manifest_of(out, (p for p in out.rglob("*") if p.is_file()))
+    doc["sha256"] = manifest_of(out, (p for p in out.rglob("*")
+                                      if p.is_file() and p.name != LOCK_NAME))
     doc["pokes"] = pokes
     file = out / SESSION_FILE
-    file.write_text(yaml.dump(doc, Dumper=_Dumper, sort_keys=False), encoding="utf-8")
+    write_text_atomically(file, seal(yaml.dump(doc, Dumper=_Dumper, sort_keys=False)))
     return file

@@ -33,6 +33,7 @@ if TYPE_CHECKING:
     from deformap.run._map import MapOutput, map_recorded_session
     from deformap.run._record import RecordOutput, record_simulation
     from deformap.run._reproduce import ReproduceOutput, reproduce
+    from deformap.run._robot import RobotConfig
     from deformap.run._studies import (
         CLUSTER_SIZE_FOAMS,
         StudyOutput,
@@ -62,6 +63,7 @@ _MODULES: dict[str, tuple[str, ...]] = {
     "_map": ("MapOutput", "map_recorded_session"),
     "_record": ("RecordOutput", "record_simulation"),
     "_reproduce": ("ReproduceOutput", "reproduce"),
+    "_robot": ("RobotConfig",),
     "_studies": ("CLUSTER_SIZE_FOAMS", "StudyOutput", "run_cluster_size_study",
                 "run_hardness_study"),
     "_world": ("ScenarioSummary", "scenario_summaries", "show_scenario"),
@@ -72,8 +74,8 @@ _MODULES: dict[str, tuple[str, ...]] = {
 
 __all__ = [
     "BLAS_THREAD_VARIABLES", "CLUSTER_SIZE_FOAMS", "CONFIG_NAME", "POKES_CSV_COLUMNS", "RESCORABLE",
-    "RUNS_ROOT", "EstimateOutput", "MapOutput", "RecordOutput", "ReproduceOutput", "RunConfig",
-    "RunHooks", "RunOutput", "RunOverrides", "RunStart", "ScenarioSummary", "StudyOutput",
+    "RUNS_ROOT", "EstimateOutput", "MapOutput", "RecordOutput", "ReproduceOutput", "RobotConfig",
+    "RunConfig", "RunHooks", "RunOutput", "RunOverrides", "RunStart", "ScenarioSummary", "StudyOutput",
     "WorldsBenchConfig", "WorldsOutput", "apply_overrides", "bench_worlds", "config_yaml",
     "default_run_folder", "estimate_one_poke", "exploration_with", "explore_environment",
     "explore_run_config", "explore_scenario", "load_run_config", "load_worlds",

@@ -9,6 +9,7 @@ value read as a YAML scalar, and explores what it returns as the simulated world
 
 from __future__ import annotations
 
+import contextlib
 import importlib
 import math
 import sys
@@ -32,9 +33,9 @@ from deformap.explore import (
     read_journal,
 )
 from deformap.run._config import CONFIG_NAME, RunConfig, config_yaml, run_generators
-from deformap.run._explore import resume_journal
+from deformap.run._explore import resume_hint_on_failure, resume_journal
 from deformap.run._export import poke_writer, write_run_results
-from deformap.run._folder import create_run_folder, default_run_folder, write_text
+from deformap.run._folder import claim_run_folder, default_run_folder, write_text
 from deformap.run._hooks import NO_HOOKS, RunHooks, RunStart
 from deformap.run._report import shared_report
 from deformap.run._robot import GuardedEnvironment, RobotConfig, RobotFault
@@ -87,7 +88,7 @@ def load_environment(spec: str, args: dict[str, Any],
 def explore_environment(spec: str, env_args: dict[str, Any], config: RunConfig,
                         out: Path | None = None, *, resume: bool = False, figures: bool = True,
                         hooks: RunHooks = NO_HOOKS, variance_max: float | None = None,
-                        ) -> tuple[dict[str, Any], Path]:
+                        rerun: bool = False) -> tuple[dict[str, Any], Path]:
     """Explore the Environment ``spec`` returns (module docstring); ``(report, folder)``.
 
     The run folder is new or empty (default ``runs/<factory>-explore-s<seed>-<time>``), made
@@ -95,8 +96,8 @@ def explore_environment(spec: str, env_args: dict[str, Any], config: RunConfig,
     ``resume`` it is the folder of a run stopped there, whose journal must name the same
     ``spec``, ``env_args`` and configuration (but ``config.robot``), checked before the robot is
     built. ``variance_max`` fixes the top of ``map.png``'s variance scale. ``config.world`` and
-    ``config.scenario`` are not used. A robot that fails raises :class:`RobotFault` naming the
-    call, with every finished poke in the journal.
+    ``config.scenario`` are not used; ``rerun`` also writes ``run.rrd``. A robot that fails
+    raises :class:`RobotFault` naming the call, with every finished poke in the journal.
     """
     if variance_max is not None:  # before any work
         check_positive("variance_max", variance_max)
@@ -105,36 +106,44 @@ def explore_environment(spec: str, env_args: dict[str, Any], config: RunConfig,
     header = {"deformap": __version__, "config": config_to_dict(config), "environment": spec,
               "env_args": env_args}  # fmt: skip
     done: list[PokeRecord] = []
-    if resume:
-        assert out is not None
-        journal, done = resume_journal(out, config, header)
-    env = load_environment(spec, env_args, config.robot)
-    check_exploration_budget(config.exploration, env.workspace)
-    folder = out or default_run_folder(spec.partition(":")[2], "explore", config.seed)
-    if not resume:
-        create_run_folder(folder, what="output", resume_hint=True)
-    write_text(folder / CONFIG_NAME, config_yaml(config))  # on resume, restores a removed copy
-    if not resume:
-        journal = Journal.create(folder, header)
-    hooks.start(RunStart(kind="explore", title=f"{spec} seed {config.seed}", folder=folder,
-                         total=config.exploration.max_pokes, done=len(done)))  # fmt: skip
-    _, explore_rng = run_generators(config.seed)
+    again = " and the same --environment and --env-arg"
+    with contextlib.ExitStack() as held:
+        if resume:
+            assert out is not None
+            held.enter_context(claim_run_folder(out, resume=True))
+            held.enter_context(resume_hint_on_failure(out, again))
+            journal, done = resume_journal(out, config, header)
+        env = load_environment(spec, env_args, config.robot)
+        check_exploration_budget(config.exploration, env.workspace)
+        folder = out or default_run_folder(spec.partition(":")[2], "explore", config.seed)
+        if not resume:
+            held.enter_context(claim_run_folder(folder, what="output", resume_hint=True))
+            held.enter_context(resume_hint_on_failure(folder, again))
+        write_text(folder / CONFIG_NAME, config_yaml(config))  # on resume, restores a removed copy
+        if not resume:
+            journal = Journal.create(folder, header)
+        hooks.start(RunStart(kind="explore", title=f"{spec} seed {config.seed}", folder=folder,
+                             total=config.exploration.max_pokes, done=len(done)))  # fmt: skip
+        _, explore_rng = run_generators(config.seed)
 
-    hooks.stage("exploring")
-    t0 = time.perf_counter()
-    try:
-        result = explore(env, config.exploration, rng=explore_rng, journal=journal, done=done,
-                         on_poke=poke_writer(folder, figures=figures, hooks=hooks))
-    except RobotFault as exc:
-        kept = len(read_journal(folder / JOURNAL_NAME).pokes)
-        raise RobotFault(f"{exc}; {kept} poke(s) kept in the journal: continue with `deformap "
-                         f"explore --resume {folder}` and the same --environment and --env-arg",
-                         exc.error) from None
-    report = {"deformap": __version__, "environment": spec, "env_args": env_args,
-              "seed": config.seed, "config": config_to_dict(config),
-              **shared_report(result, truth=None)}  # fmt: skip
-    report["timings"]["wall_s"] = time.perf_counter() - t0
-    write_run_results(folder, result, report, figures=figures, poke_figures=False,
-                      title=f"{spec}: {len(result.pokes)} pokes", hooks=hooks,
-                      variance_max=variance_max)
+        hooks.stage("exploring")
+        t0 = time.perf_counter()
+        try:
+            result = explore(env, config.exploration, rng=explore_rng, journal=journal, done=done,
+                             on_poke=poke_writer(folder, figures=figures, hooks=hooks))
+        except RobotFault as exc:
+            kept = len(read_journal(folder / JOURNAL_NAME).pokes)
+            raise RobotFault(f"{exc}; {kept} poke(s) kept in the journal: continue with "
+                             f"`deformap explore --resume {folder}`{again}", exc.error) from None
+        report = {"deformap": __version__, "environment": spec, "env_args": env_args,
+                  "seed": config.seed, "config": config_to_dict(config),
+                  **shared_report(result, truth=None)}  # fmt: skip
+        report["timings"]["wall_s"] = time.perf_counter() - t0
+        write_run_results(folder, result, report, figures=figures, poke_figures=False,
+                          title=f"{spec}: {len(result.pokes)} pokes", hooks=hooks,
+                          variance_max=variance_max)
+        if rerun:
+            from deformap.run._figures import write_rerun
+
+            write_rerun(folder / "run.rrd", result)
     return report, folder

@@ -8,8 +8,10 @@
 
 ``pokes.csv``: the columns :data:`POKES_CSV_COLUMNS`, ``poke`` numbered from 1 (``report.json``'s
 ``index`` + 1), the contact where the tip touched, ``tip_center_z_m`` at the commanded force, the
-force–travel reading (empty without one) and ``region`` (``region_labels`` + 1; empty where the
-map field left the poke out). :func:`write_run_results` writes every mapping workflow's results:
+force–travel reading (empty without one), ``region`` (``region_labels`` + 1; empty where the
+map field left the poke out) and what the press reveals beyond its stiffness (``behaviour`` and
+the quantities of :class:`deformap.stiffness.PressBehaviour` with their σ; empty where the press
+could not give them). :func:`write_run_results` writes every mapping workflow's results:
 ``report.json``, these two files and the figures, each atomically.
 """
 
@@ -34,7 +36,9 @@ __all__ = ["POKES_CSV_COLUMNS", "poke_writer", "write_run_results"]
 POKES_CSV_COLUMNS = (
     "poke", "purpose", "target_x_m", "target_y_m", "contact_x_m", "contact_y_m", "tip_center_z_m",
     "force_n", "beta", "beta_std", "stiffness_n_per_m", "stiffness_std_n_per_m", "modulus_pa",
-    "modulus_std_pa", "rigid", "region",
+    "modulus_std_pa", "rigid", "region", "behaviour", "relaxation", "relaxation_std", "tau_s",
+    "tau_std_s", "loss_ratio", "loss_ratio_std", "residual_dent_m", "residual_dent_std_m",
+    "released_dent_m", "released_dent_std_m",
 )  # fmt: skip
 
 
@@ -77,6 +81,7 @@ def _write_pokes_csv(path: Path, result: ExplorationResult) -> None:
     for poke in result.pokes:
         r = poke.record
         s = r.stiffness
+        b = r.behaviour
         writer.writerow([
             r.index + 1, _cell(r.purpose), *(float(v) for v in r.target_xy),
             *(float(v) for v in r.contact_xy), r.contact.tip_center[2], r.force_n, r.beta,
@@ -84,6 +89,11 @@ def _write_pokes_csv(path: Path, result: ExplorationResult) -> None:
             _cell(s and s.modulus_pa), _cell(s and s.modulus_std_pa),
             "" if s is None else s.rigid,
             "" if r.index not in region_of else region_of[r.index] + 1,
+            *(("",) * 11 if b is None else (
+                b.behaviour, _cell(b.relaxation), _cell(b.relaxation_sigma), _cell(b.tau_s),
+                _cell(b.tau_sigma_s), _cell(b.loss_ratio), _cell(b.loss_ratio_sigma),
+                _cell(b.residual_dent_m), _cell(b.residual_dent_sigma_m),
+                _cell(b.released_dent_m), _cell(b.released_dent_sigma_m))),
         ])  # fmt: skip
     write_text_atomically(path, text.getvalue())
 

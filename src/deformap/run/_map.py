@@ -34,7 +34,7 @@ from deformap.run._config import (
 )
 from deformap.run._export import write_run_results
 from deformap.run._folder import (
-    create_run_folder,
+    claim_run_folder,
     default_run_folder,
     run_stem,
     write_text,
@@ -82,6 +82,7 @@ def map_recorded_session(
     raw_config: Path | None = None,
     raw_settings: dict[str, Any] | None = None,
     variance_max: float | None = None,
+    rerun: bool = False,
 ) -> MapOutput:
     """Map the session at ``session`` (its folder or its ``session.yaml``) into ``out``.
 
@@ -109,12 +110,16 @@ def map_recorded_session(
         ``replay.RawBagConfig`` settings that win over the file's (command-line options).
     variance_max : float, optional
         Top of ``map.png``'s variance colour scale (default: the map's own largest variance).
+    rerun : bool
+        Also write ``run.rrd``, the run as a rerun recording (extra ``rerun``).
 
     Raises
     ------
     ConfigError, FileFormatError
         The session cannot be loaded, its recorded configuration is malformed, or ``out`` is not
-        empty or not creatable (before any poke is mapped).
+        empty, not creatable or held by another run (before any poke is mapped).
+    FileWriteError
+        A file of the result could not be written (a full disk, a read-only file system, ...).
     """
     if variance_max is not None:  # before any work
         check_positive("variance_max", variance_max)
@@ -122,19 +127,23 @@ def map_recorded_session(
     cfg = session_run_config(recorded, config, seed)
     stem = recorded.path.name or "session"
     folder = out or default_run_folder(run_stem(stem), "map", cfg.seed)
-    create_run_folder(folder, what="result")
-    title = f"{recorded.path} ({len(recorded)} pokes, {recorded.form} form)"
-    hooks.start(RunStart(kind="map", title=title, folder=folder, total=len(recorded)))
-    _, explore_rng = run_generators(cfg.seed)
-    hooks.stage("mapping")
-    replay = map_session(recorded, cfg.exploration, rng=explore_rng,
-                         on_poke=lambda poke: hooks.poke(poke.record))  # fmt: skip
-    write_text(folder / CONFIG_NAME, config_yaml(cfg))
-    report = session_report(cfg, recorded, replay)
-    write_run_results(folder, replay.result, report, figures=figures,
-                      truth=recorded.ground_truth,
-                      title=f"{stem}: {len(replay.result.pokes)} pokes", hooks=hooks,
-                      variance_max=variance_max)  # fmt: skip
+    with claim_run_folder(folder, what="result"):
+        title = f"{recorded.path} ({len(recorded)} pokes, {recorded.form} form)"
+        hooks.start(RunStart(kind="map", title=title, folder=folder, total=len(recorded)))
+        _, explore_rng = run_generators(cfg.seed)
+        hooks.stage("mapping")
+        replay = map_session(recorded, cfg.exploration, rng=explore_rng,
+                             on_poke=lambda poke: hooks.poke(poke.record))  # fmt: skip
+        write_text(folder / CONFIG_NAME, config_yaml(cfg))
+        report = session_report(cfg, recorded, replay)
+        write_run_results(folder, replay.result, report, figures=figures,
+                          truth=recorded.ground_truth,
+                          title=f"{stem}: {len(replay.result.pokes)} pokes", hooks=hooks,
+                          variance_max=variance_max)  # fmt: skip
+        if rerun:
+            from deformap.run._figures import write_rerun
+
+            write_rerun(folder / "run.rrd", replay.result)
     return MapOutput(report=report, session=recorded, replay=replay, config=cfg, folder=folder)
 
 
@@ -147,11 +156,13 @@ def _open(path: Path, config: RunConfig | None, layout: str, raw_config: Path | 
         RawBagConfig(**given)
     raw = layout == "raw" or (layout == "auto" and is_raw_bag(path))
     if not raw:
-        if raw_config is not None or any(v is not None for v in raw_settings.values()):
+        tolerance = raw_settings.get("stamp_tolerance_s")  # every layout takes it
+        if raw_config is not None or any(v is not None for k, v in raw_settings.items()
+                                         if k != "stamp_tolerance_s"):
             raise InvalidArgumentError(
                 f"raw recording settings apply to a bag as a robot records it; {str(path)!r} is "
                 "read as a deformap session (pass --layout raw to read it as a raw bag)")
-        return load_session(path)
+        return load_session(path, stamp_tolerance_s=tolerance)
     settings = load_raw_config(path, raw_config, **raw_settings)
     force = (config or RunConfig()).exploration.force_n
     return load_raw_bag(path, settings, default_force_n=force)

@@ -4,7 +4,8 @@ Every report of a mapped surface (:func:`live_report`, :func:`session_report`) h
 that :func:`shared_report` builds; values of the map field (``field``) are in its units, β or
 ln E [ln Pa]:
 
-- ``pokes`` (one :meth:`deformap.explore.PokeRecord.to_dict` each), ``n_pokes``, ``stop_reason``;
+- ``pokes`` (one :meth:`deformap.explore.PokeRecord.to_dict` each, with its ``behaviour``: class,
+  evidence, relaxation, loss ratio and dents with their σ), ``n_pokes``, ``stop_reason``;
 - ``max_variance`` (what the stop compared with ``T_h``, over the stop cells) and
   ``max_variance_map`` (over the whole map);
 - ``beta_nugget``, the β-field's nugget τ̂ (:mod:`deformap.explore._nugget`; 0 when off);
@@ -77,7 +78,8 @@ SHARED_KEYS = (
 """The keys :func:`shared_report` always writes (``true_regions`` too, with a ground truth)."""
 
 _ESTIMATE_KEYS = ("contact", "force_n", "betas", "errors", "converged", "iterations",
-                  "n_roi_points", "timings")  # fmt: skip
+                  "n_roi_points", "depth_anchored", "stiffness", "layer_thickness_m",
+                  "stiffness_error", "behaviour", "timings")  # fmt: skip
 
 
 def _finite(value: float | None) -> float | None:
@@ -241,7 +243,10 @@ def session_report(
 def estimate_report(
     before: Path, after: Path, contact: TactileContact, poke: PokeResult
 ) -> dict[str, Any]:
-    """``estimate.json``: β of one poke with its uncertainty and E(β) curve."""
+    """``estimate.json``: β of one poke with its uncertainty and E(β) curve; with a force–travel
+    record its ``stiffness`` (``None`` without one), the ``layer_thickness_m`` it was read with
+    and ``stiffness_error`` (why a record gave none); ``behaviour``, what the press reveals beyond
+    its stiffness."""
     r = poke.record.to_dict()
     return {
         "before": str(before),
@@ -249,5 +254,5 @@ def estimate_report(
         "beta": r["beta"],
         "beta_std": r["beta_std"],
         "contact_point": contact.contact_point.tolist(),
-        **{k: r[k] for k in _ESTIMATE_KEYS},
+        **{k: r.get(k) for k in _ESTIMATE_KEYS},
     }

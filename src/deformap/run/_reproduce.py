@@ -17,7 +17,7 @@ from deformap.eval import PAPER_TABLE_I, markdown_table, table_row
 from deformap.run._config import RunConfig
 from deformap.run._explore import explore_scenario
 from deformap.run._folder import (
-    create_run_folder,
+    claim_run_folder,
     default_run_folder,
     run_stem,
     write_json,
@@ -61,22 +61,22 @@ def reproduce(out: Path | None = None, *, base: RunConfig | None = None,
     for name in names:  # an unknown scenario fails here, before any folder or run
         load_scenario(name)
     folder = out or default_run_folder("table-i", "reproduce", base.seed)
-    create_run_folder(folder, what="reproduction")
-    hooks.start(RunStart(kind="reproduce", title=f"{len(names)} scenarios, seed {base.seed}",
-                         folder=folder, total=len(names)))  # fmt: skip
-    rows = []
-    for name, stem in zip(names, stems, strict=True):
-        cfg = dataclasses.replace(base, scenario=name)
-        hooks.stage(name)
-        inner = RunHooks(on_stage=functools.partial(_scenario_stage, hooks, name))
-        report = explore_scenario(cfg, folder / stem, figures=figures, hooks=inner).report
-        row = table_row(name, report, threshold=cfg.exploration.threshold)
-        rows.append(row)
-        if on_run is not None:
-            on_run(row)
-        hooks.step(name)
-    table = {"seed": base.seed, "strategy": base.exploration.strategy, "rows": rows}
-    markdown = markdown_table(table)
-    write_json(folder / "table.json", table)
-    write_text(folder / "table.md", markdown)
-    return ReproduceOutput(table=table, markdown=markdown, folder=folder)
+    with claim_run_folder(folder, what="reproduction"):
+        hooks.start(RunStart(kind="reproduce", title=f"{len(names)} scenarios, seed {base.seed}",
+                             folder=folder, total=len(names)))  # fmt: skip
+        rows = []
+        for name, stem in zip(names, stems, strict=True):
+            cfg = dataclasses.replace(base, scenario=name)
+            hooks.stage(name)
+            inner = RunHooks(on_stage=functools.partial(_scenario_stage, hooks, name))
+            report = explore_scenario(cfg, folder / stem, figures=figures, hooks=inner).report
+            row = table_row(name, report, threshold=cfg.exploration.threshold)
+            rows.append(row)
+            if on_run is not None:
+                on_run(row)
+            hooks.step(name)
+        table = {"seed": base.seed, "strategy": base.exploration.strategy, "rows": rows}
+        markdown = markdown_table(table)
+        write_json(folder / "table.json", table)
+        write_text(folder / "table.md", markdown)
+        return ReproduceOutput(table=table, markdown=markdown, folder=folder)

@@ -30,7 +30,7 @@ from deformap.eval import (
     hardness_summary,
 )
 from deformap.explore import ExplorationConfig
-from deformap.run._folder import create_run_folder, default_run_folder, write_json
+from deformap.run._folder import claim_run_folder, default_run_folder, write_json
 from deformap.run._hooks import NO_HOOKS, RunHooks, RunStart
 from deformap.world import (
     MIN_RECORD_FORCE_N,
@@ -157,41 +157,42 @@ def run_hardness_study(
     if element_size_m is not None:  # nor a mesh it would refuse
         _check_study_mesh(element_size_m, sorted({c[1] for c in checked}),
                          list(dict.fromkeys(c[2] for c in checked)))
-    folder = create_run_folder(out or default_run_folder("hardness", "study", seed), what="study")
-    hooks.start(RunStart(kind="study", title=f"hardness study, seed {seed}", folder=folder,
-                         total=len(foams) * len(checked)))  # fmt: skip
-    by_condition: dict[tuple[str, float, str], list[dict[str, Any]]] = {}
-    single: dict[str, Any] = {}
-    # the element size the worlds have (the same under every physics)
-    mesh_m = _study_world("linear-fem", coarse=coarse, element_size_m=element_size_m
-                          ).element_size_m
-    # thickness first: the FEM's factorisation depends on the block's mesh only (one per
-    # thickness, shared by the cameras and the two FEM physics, deformap.world._fem); the rows
-    # are written in the matrix's own order below, whatever order they were pressed in
-    for name, thickness, physics_name in sorted(checked, key=lambda c: c[1]):
-        hooks.stage(f"pressing the foams: {name}, {thickness:g} m, {physics_name}")
-        presses = _foams(foams, seed=seed, coarse=coarse, hooks=hooks, camera=name,
-                         thickness_m=thickness, force_n=force_n, physics=physics_name,
-                         element_size_m=element_size_m)  # fmt: skip
-        hooks.stage(f"estimating β per protocol: {name}, {thickness:g} m, {physics_name}")
-        pressed = [f.presses[0].force_n for f in presses if f.presses]
-        condition = {"camera": name, "thickness_m": thickness,
-                     "force_n": pressed[0] if pressed else _force(force_n),
-                     "physics": physics_name}  # fmt: skip
-        single = {**condition, "element_size_m": mesh_m,
-                  **hardness_study(presses, protocols=chosen)}
-        by_condition[(name, thickness, physics_name)] = [{**row, **condition}
-                                                         for row in single["rows"]]
-    rows = [row for condition in checked for row in by_condition[condition]]
-    study = {**(single if not full else {"matrix": {
-        "cameras": list(dict.fromkeys(c[0] for c in checked)),
-        "thicknesses_m": sorted({c[1] for c in checked}),
-        "physics": list(dict.fromkeys(c[2] for c in checked)),
-        "force_n": _force(force_n), "seed": seed, "coarse": coarse,
-        "element_size_m": mesh_m}}),
-        "rows": rows, **hardness_summary(rows)}  # fmt: skip
-    return StudyOutput(study=study, folder=folder,
-                       files=_write(folder, "hardness", study, plot_hardness_study))  # fmt: skip
+    folder = out or default_run_folder("hardness", "study", seed)
+    with claim_run_folder(folder, what="study"):
+        hooks.start(RunStart(kind="study", title=f"hardness study, seed {seed}", folder=folder,
+                             total=len(foams) * len(checked)))  # fmt: skip
+        by_condition: dict[tuple[str, float, str], list[dict[str, Any]]] = {}
+        single: dict[str, Any] = {}
+        # the element size the worlds have (the same under every physics)
+        mesh_m = _study_world("linear-fem", coarse=coarse, element_size_m=element_size_m
+                              ).element_size_m
+        # thickness first: the FEM's factorisation depends on the block's mesh only (one per
+        # thickness, shared by the cameras and the two FEM physics, deformap.world._fem); the rows
+        # are written in the matrix's own order below, whatever order they were pressed in
+        for name, thickness, physics_name in sorted(checked, key=lambda c: c[1]):
+            hooks.stage(f"pressing the foams: {name}, {thickness:g} m, {physics_name}")
+            presses = _foams(foams, seed=seed, coarse=coarse, hooks=hooks, camera=name,
+                             thickness_m=thickness, force_n=force_n, physics=physics_name,
+                             element_size_m=element_size_m)  # fmt: skip
+            hooks.stage(f"estimating β per protocol: {name}, {thickness:g} m, {physics_name}")
+            pressed = [f.presses[0].force_n for f in presses if f.presses]
+            condition = {"camera": name, "thickness_m": thickness,
+                         "force_n": pressed[0] if pressed else _force(force_n),
+                         "physics": physics_name}  # fmt: skip
+            single = {**condition, "element_size_m": mesh_m,
+                      **hardness_study(presses, protocols=chosen)}
+            by_condition[(name, thickness, physics_name)] = [{**row, **condition}
+                                                             for row in single["rows"]]
+        rows = [row for condition in checked for row in by_condition[condition]]
+        study = {**(single if not full else {"matrix": {
+            "cameras": list(dict.fromkeys(c[0] for c in checked)),
+            "thicknesses_m": sorted({c[1] for c in checked}),
+            "physics": list(dict.fromkeys(c[2] for c in checked)),
+            "force_n": _force(force_n), "seed": seed, "coarse": coarse,
+            "element_size_m": mesh_m}}),
+            "rows": rows, **hardness_summary(rows)}  # fmt: skip
+        return StudyOutput(study=study, folder=folder,
+                           files=_write(folder, "hardness", study, plot_hardness_study))  # fmt: skip
 
 
 def _checked(conditions: Sequence[tuple[str, float, str]]) -> list[tuple[str, float, Physics]]:
@@ -246,14 +247,14 @@ def run_cluster_size_study(out: Path | None = None, *, seed: int = 0, coarse: bo
     """
     from deformap.viz import plot_cluster_size_study  # matplotlib: only when a study is drawn
 
-    folder = create_run_folder(out or default_run_folder("cluster-size", "study", seed),
-                               what="study")  # fmt: skip
-    foams = (*CLUSTER_SIZE_FOAMS, None)
-    hooks.start(RunStart(kind="study", title=f"cluster-size study, seed {seed}", folder=folder,
-                         total=len(foams)))  # fmt: skip
-    hooks.stage("pressing the foams")
-    presses = _foams(foams, seed=seed, coarse=coarse, hooks=hooks)
-    hooks.stage("estimating β per cluster size")
-    study = cluster_size_study(presses)
-    return StudyOutput(study=study, folder=folder,
-                       files=_write(folder, "cluster-size", study, plot_cluster_size_study))  # fmt: skip
+    folder = out or default_run_folder("cluster-size", "study", seed)
+    with claim_run_folder(folder, what="study"):
+        foams = (*CLUSTER_SIZE_FOAMS, None)
+        hooks.start(RunStart(kind="study", title=f"cluster-size study, seed {seed}", folder=folder,
+                             total=len(foams)))  # fmt: skip
+        hooks.stage("pressing the foams")
+        presses = _foams(foams, seed=seed, coarse=coarse, hooks=hooks)
+        hooks.stage("estimating β per cluster size")
+        study = cluster_size_study(presses)
+        files = _write(folder, "cluster-size", study, plot_cluster_size_study)
+        return StudyOutput(study=study, folder=folder, files=files)

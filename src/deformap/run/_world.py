@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from deformap.explore import ExplorationConfig
-from deformap.run._folder import create_run_folder
+from deformap.run._folder import claim_run_folder
 from deformap.run._hooks import NO_HOOKS, RunHooks, RunStart
 from deformap.world import SimulatedWorld, WorldConfig, list_scenarios, load_scenario
 
@@ -49,10 +49,10 @@ def show_scenario(name: str, out: Path, *, seed: int = 0, coarse: bool = False,
     from deformap.viz import show_world  # matplotlib: only when pictures are drawn
 
     scenario = load_scenario(name)
-    create_run_folder(out, what="picture")
-    hooks.start(RunStart(kind="world", title=f"{name} seed {seed}", folder=out))
-    hooks.stage("building the world")
-    config = WorldConfig.coarse() if coarse else WorldConfig()
-    world = SimulatedWorld(scenario, config=config, rng=np.random.default_rng(seed))
-    hooks.stage("drawing")
-    return show_world(world, out, force_n=force_n)
+    with claim_run_folder(out, what="picture"):
+        hooks.start(RunStart(kind="world", title=f"{name} seed {seed}", folder=out))
+        hooks.stage("building the world")
+        config = WorldConfig.coarse() if coarse else WorldConfig()
+        world = SimulatedWorld(scenario, config=config, rng=np.random.default_rng(seed))
+        hooks.stage("drawing")
+        return show_world(world, out, force_n=force_n)

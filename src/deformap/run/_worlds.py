@@ -17,10 +17,10 @@ from typing import Any
 
 from deformap.errors import ConfigError, InvalidArgumentError
 from deformap.eval import WorldResult, choices, rescore_world
-from deformap.run._folder import create_run_folder, default_run_folder, to_json, write_text
+from deformap.run._folder import claim_run_folder, default_run_folder, to_json, write_text
 from deformap.run._hooks import NO_HOOKS, RunHooks, RunStart
 from deformap.run._worlds_config import WorldsBenchConfig, exploration_changes, exploration_with
-from deformap.run._worlds_engines import world_results
+from deformap.run._worlds_engines import check_scheduler, world_results
 from deformap.run._worlds_folder import (
     SETTINGS_NAME,
     finished_worlds,
@@ -73,36 +73,40 @@ def bench_worlds(config: WorldsBenchConfig, out: Path | None = None, *,
     """
     if not isinstance(config, WorldsBenchConfig):
         raise ConfigError(f"`config` must be a WorldsBenchConfig; got {type(config).__name__}")
+    if config.scheduler is not None:
+        check_scheduler(config.scheduler)  # before the folder: nothing left by a wrong address
     folder = out or default_run_folder("worlds", "bench", config.seed)
-    start_folder(config, folder)
-    done = finished_worlds(folder, config.worlds)
-    results = dict(done)
-    engine = (f"Dask at {config.scheduler}" if config.scheduler
-              else f"{config.workers} local process{'es' if config.workers > 1 else ''}")
-    hooks.start(RunStart(kind="bench worlds", folder=folder, total=config.worlds, done=len(done),
-                         title=f"{config.worlds} worlds, seed {config.seed}, {engine}"))
-    tasks = [config.task(i) for i in range(config.worlds) if i not in done]
-    t0 = time.perf_counter()
-    stream = world_results(tasks, workers=config.workers, scheduler=config.scheduler)
-    computed = 0
-    summary, files = write_summary(folder, config, list(results.values())) if done else ({}, [])
-    for result in stream:
-        write_text(world_path(folder, result.index), to_json(result.to_dict()))
-        results[result.index] = result
-        computed += 1
-        summary, files = write_summary(folder, config, list(results.values()))
-        elapsed = time.perf_counter() - t0
-        rate = computed / elapsed * 3600.0
-        left = (len(tasks) - computed) / rate * 3600.0 if rate > 0 else float("nan")
-        what = (f"{result.seconds:.0f} s" if result.status == "ok"
-                else f"FAILED: {result.error}")
-        hooks.step(f"world {result.index} ({result.world['family']}): {what} · "
-                   f"{len(results)}/{config.worlds} done · {rate:.1f} worlds/h · "
-                   f"{left / 60:.0f} min left")
-    if not tasks and not files:
-        summary, files = write_summary(folder, config, list(results.values()))
-    return WorldsOutput(summary=summary, folder=folder, files=[folder / SETTINGS_NAME, *files],
-                        computed=computed, seconds=time.perf_counter() - t0)
+    with claim_run_folder(folder, resume=(folder / SETTINGS_NAME).is_file(),
+                          what="benchmark"):
+        start_folder(config, folder)
+        done = finished_worlds(folder, config.worlds)
+        results = dict(done)
+        engine = (f"Dask at {config.scheduler}" if config.scheduler
+                  else f"{config.workers} local process{'es' if config.workers > 1 else ''}")
+        hooks.start(RunStart(kind="bench worlds", folder=folder, total=config.worlds, done=len(done),
+                             title=f"{config.worlds} worlds, seed {config.seed}, {engine}"))
+        tasks = [config.task(i) for i in range(config.worlds) if i not in done]
+        t0 = time.perf_counter()
+        stream = world_results(tasks, workers=config.workers, scheduler=config.scheduler)
+        computed = 0
+        summary, files = write_summary(folder, config, list(results.values())) if done else ({}, [])
+        for result in stream:
+            write_text(world_path(folder, result.index), to_json(result.to_dict()))
+            results[result.index] = result
+            computed += 1
+            summary, files = write_summary(folder, config, list(results.values()))
+            elapsed = time.perf_counter() - t0
+            rate = computed / elapsed * 3600.0
+            left = (len(tasks) - computed) / rate * 3600.0 if rate > 0 else float("nan")
+            what = (f"{result.seconds:.0f} s" if result.status == "ok"
+                    else f"FAILED: {result.error}")
+            hooks.step(f"world {result.index} ({result.world['family']}): {what} · "
+                       f"{len(results)}/{config.worlds} done · {rate:.1f} worlds/h · "
+                       f"{left / 60:.0f} min left")
+        if not tasks and not files:
+            summary, files = write_summary(folder, config, list(results.values()))
+        return WorldsOutput(summary=summary, folder=folder, files=[folder / SETTINGS_NAME, *files],
+                            computed=computed, seconds=time.perf_counter() - t0)
 
 
 def load_worlds(folder: Path) -> tuple[WorldsBenchConfig, list[WorldResult]]:
@@ -185,20 +189,20 @@ def rescore_worlds(source: Path, out: Path, *, cuts: Sequence[str] | None = None
         raise ConfigError(f"source: {source} must hold finished worlds with their pokes stored; "
                           f"got none")
     folder = Path(out)
-    create_run_folder(folder, what="benchmark")
-    write_bench(folder, config, rescored_from=str(source))
-    (folder / "worlds").mkdir(exist_ok=True)
-    hooks.start(RunStart(kind="bench rescore", folder=folder, total=len(results), done=0,
-                         title=f"{len(results)} worlds of {source} rescored"))
-    t0 = time.perf_counter()
-    rescored = []
-    for result in results:
-        again = result if result.status != "ok" else rescore_world(
-            config.task(result.index), result)
-        write_text(world_path(folder, result.index), to_json(again.to_dict()))
-        rescored.append(again)
-        hooks.step(f"world {result.index} ({result.world.get('family')}) · {len(rescored)}/"
-                   f"{len(results)} done")
-    summary, files = write_summary(folder, config, rescored)
-    return WorldsOutput(summary=summary, folder=folder, files=[folder / SETTINGS_NAME, *files],
-                        computed=len(rescored), seconds=time.perf_counter() - t0)
+    with claim_run_folder(folder, what="benchmark"):
+        write_bench(folder, config, rescored_from=str(source))
+        (folder / "worlds").mkdir(exist_ok=True)
+        hooks.start(RunStart(kind="bench rescore", folder=folder, total=len(results), done=0,
+                             title=f"{len(results)} worlds of {source} rescored"))
+        t0 = time.perf_counter()
+        rescored = []
+        for result in results:
+            again = result if result.status != "ok" else rescore_world(
+                config.task(result.index), result)
+            write_text(world_path(folder, result.index), to_json(again.to_dict()))
+            rescored.append(again)
+            hooks.step(f"world {result.index} ({result.world.get('family')}) · {len(rescored)}/"
+                       f"{len(results)} done")
+        summary, files = write_summary(folder, config, rescored)
+        return WorldsOutput(summary=summary, folder=folder, files=[folder / SETTINGS_NAME, *files],
+                            computed=len(rescored), seconds=time.perf_counter() - t0)

@@ -13,9 +13,7 @@ from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
-import yaml
-
-from deformap._config import config_from_dict, config_to_dict
+from deformap._config import config_from_dict, config_to_dict, parse_yaml
 from deformap._validation import SettingError, check_settings, setting
 from deformap.errors import ConfigError
 from deformap.eval import WorldTask, choices
@@ -49,14 +47,44 @@ def parse_assignments(items: Iterable[str]) -> dict[str, Any]:
         if key in out:
             raise ConfigError(f"--set {key} is given twice")
         try:
-            value = yaml.safe_load(text) if text.strip() else None
-        except yaml.YAMLError:
+            value = parse_yaml(text, where=f"--set {key}") if text.strip() else None
+        except ConfigError:
             value = {}  # refused below, in the same words
         if isinstance(value, dict | list):
             raise ConfigError(f"--set {key}: the value must be a scalar (a number, true/false, "
                               f"null or a name); got {text!r}")
         out[key] = value
     return out
+
+
+#: Schemes of ``dask.distributed`` addresses a client reaches over a network (a bare
+#: ``host:port`` is ``tcp``); ``inproc`` names a scheduler inside the calling process.
+_SCHEDULER_SCHEMES = ("tcp", "tls", "ws", "wss", "ucx")
+
+
+def _check_address(address: str) -> None:
+    """A scheduler's address as ``[scheme://]host[:port]``, checked for its form only (whether a
+    scheduler answers there is :func:`deformap.run._worlds_engines.check_scheduler`'s)."""
+    scheme, sep, location = address.partition("://")
+    if not sep:
+        scheme, location = "tcp", address
+    host, colon, port = location.rpartition(":") if ":" in location else (location, "", "")
+    if not address.strip() or any(c.isspace() for c in address):
+        why = "an empty value" if not address.strip() else "blanks"
+        raise SettingError("scheduler", f"must be a Dask scheduler's address (tcp://host:8786); "
+                                        f"got {why}: {address!r}")
+    if scheme == "inproc":
+        raise SettingError("scheduler", f"must be a scheduler reachable over the network "
+                                        f"({', '.join(s + '://' for s in _SCHEDULER_SCHEMES)}); "
+                                        f"an inproc:// address names one inside this process; "
+                                        f"got {address!r}")
+    if scheme not in _SCHEDULER_SCHEMES:
+        raise SettingError("scheduler", f"must start with one of "
+                                        f"{', '.join(s + '://' for s in _SCHEDULER_SCHEMES)} "
+                                        f"(or be host:port); got {address!r}")
+    if not host.strip("[]") or (colon and not (port.isdigit() and 0 < int(port) < 65536)):
+        raise SettingError("scheduler", f"must name a host and a port from 1 to 65535 "
+                                        f"(tcp://host:8786); got {address!r}")
 
 
 def _flatten(data: Mapping[str, Any], prefix: str = "") -> dict[str, Any]:
@@ -150,7 +178,7 @@ class WorldsBenchConfig:
     fields: tuple[str, ...] = choices("field")
     cuts: tuple[str, ...] = choices("region_labels")
     # every poke is a press and a β sweep per combination, hence fewer than a run's
-    max_pokes: int = setting(12, ge=1, le=1000)
+    max_pokes: int = setting(12, limit="pokes")
     exploration: ExplorationConfig = field(default_factory=ExplorationConfig)
     coarse: bool = False
     workers: int = setting(1, ge=1, le=1024)
@@ -158,6 +186,8 @@ class WorldsBenchConfig:
 
     def __post_init__(self) -> None:
         check_settings(self)
+        if self.scheduler is not None:
+            _check_address(self.scheduler)
         for name, given, allowed in (("families", self.families, LAYOUT_FAMILIES),
                                      ("physics", self.physics, PHYSICS),
                                      ("appearances", self.appearances, APPEARANCE_FAMILIES),

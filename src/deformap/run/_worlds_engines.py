@@ -14,6 +14,7 @@ world per core.
 
 from __future__ import annotations
 
+import asyncio
 import contextlib
 import logging
 import multiprocessing
@@ -21,14 +22,21 @@ import os
 import threading
 import time
 from collections.abc import Iterator, Sequence
-from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
+from concurrent.futures import (
+    FIRST_COMPLETED,
+    Future,
+    ProcessPoolExecutor,
+    ThreadPoolExecutor,
+    wait,
+)
 from typing import Any
 
 from deformap.errors import ConfigError
 from deformap.eval import WorldResult, WorldTask, draw_world, run_world
 from deformap.run._worlds_config import exploration_changes, exploration_with
 
-__all__ = ["BLAS_THREAD_VARIABLES", "task_data", "worker_pool", "world_results"]
+__all__ = ["BLAS_THREAD_VARIABLES", "SCHEDULER_TIMEOUT_S", "check_scheduler", "task_data",
+           "worker_pool", "world_results"]
 
 logger = logging.getLogger(__name__)
 
@@ -36,6 +44,10 @@ logger = logging.getLogger(__name__)
 #: scipy start with; each is set to 1 for the local pool's workers.
 BLAS_THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS",
                          "BLIS_NUM_THREADS", "VECLIB_MAXIMUM_THREADS", "NUMEXPR_NUM_THREADS")
+
+#: Seconds a scheduler has to accept the connection and say who it is (:func:`check_scheduler`);
+#: a scheduler on a busy network answers within one.
+SCHEDULER_TIMEOUT_S = 10.0
 
 
 def task_data(task: WorldTask) -> dict[str, Any]:
@@ -148,18 +160,76 @@ def _local_results(tasks: Sequence[dict[str, Any]], workers: int) -> Iterator[Wo
         pool.shutdown()
 
 
-def _dask_results(tasks: Sequence[dict[str, Any]], address: str) -> Iterator[WorldResult]:
-    """Results as they finish on a ``dask.distributed`` cluster; each task retried once."""
+async def _identify(address: str, timeout_s: float) -> tuple[Any, Any]:
+    """What the server at ``address`` answers to Dask's ``identity`` and ``versions``."""
+    from distributed.comm import connect
+
+    comm = await connect(address, timeout=timeout_s)
     try:
-        from dask.distributed import Client, as_completed
+        await comm.write({"op": "identity", "reply": True})
+        identity = await comm.read()
+        await comm.write({"op": "versions", "reply": True})
+        return identity, await comm.read()
+    finally:
+        comm.abort()
+
+
+def check_scheduler(address: str) -> str:
+    """Connect to ``address`` and require a Dask scheduler there, all within
+    :data:`SCHEDULER_TIMEOUT_S`: it must answer Dask's ``identity`` as a ``Scheduler`` and its
+    ``versions``. Returns the ``distributed`` version it reports.
+
+    The whole exchange runs under one time limit, on its own event loop in a helper thread, so a
+    server that accepts and then says nothing, or sends bytes that are no Dask message, ends in
+    one line rather than a hang or an allocation of whatever size its bytes spell.
+
+    Raises
+    ------
+    ConfigError
+        dask is not installed; nothing answers at ``address``; the answer is no Dask scheduler's.
+    """
+    try:
+        import distributed  # noqa: F401
     except ImportError:
         raise ConfigError("--scheduler needs dask.distributed; install it with "
                           "pip install 'deformap[dask]'") from None
+    where, limit = f"--scheduler {address!r}", SCHEDULER_TIMEOUT_S
+    quiet = logging.getLogger("distributed")
+    level = quiet.level
+    quiet.setLevel(logging.CRITICAL)  # a refused handshake is ours to report, in one line
     try:
-        client = Client(address, timeout="20s")
-    except (OSError, TimeoutError, ValueError) as exc:
-        raise ConfigError(f"--scheduler: cannot reach a Dask scheduler at {address!r}: "
-                          f"{exc}".splitlines()[0]) from None
+        with ThreadPoolExecutor(1) as pool:
+            identity, versions = pool.submit(
+                asyncio.run, asyncio.wait_for(_identify(address, limit), limit)).result()
+    except TimeoutError:
+        raise ConfigError(f"{where}: no Dask scheduler answered within {limit:g} s") from None
+    except OSError as exc:  # refused, unreachable (distributed's CommClosedError too)
+        detail = str(exc).splitlines()[0][:160] if str(exc) else type(exc).__name__
+        raise ConfigError(f"{where}: cannot reach a Dask scheduler there: {detail}") from None
+    except Exception as exc:  # bytes that are no Dask message: its reader's own errors
+        raise ConfigError(f"{where} answered, but not as a Dask scheduler "
+                          f"({type(exc).__name__}: {str(exc)[:100]})".replace("\n", " ")) from None
+    finally:
+        quiet.setLevel(level)
+    kind = identity.get("type") if isinstance(identity, dict) else None
+    packages = versions.get("packages") if isinstance(versions, dict) else None
+    if kind != "Scheduler" or not isinstance(packages, dict) or "distributed" not in packages:
+        raise ConfigError(f"{where} answered, but not as a Dask scheduler (identity "
+                          f"{str(kind)[:40]!r}, no distributed version)")
+    return str(packages["distributed"])
+
+
+def _dask_results(tasks: Sequence[dict[str, Any]], address: str) -> Iterator[WorldResult]:
+    """Results as they finish on a ``dask.distributed`` cluster; each task retried once."""
+    version = check_scheduler(address)
+    from dask.distributed import Client, as_completed
+
+    logger.info("Dask scheduler at %s, distributed %s", address, version)
+    try:
+        client = Client(address, timeout=f"{SCHEDULER_TIMEOUT_S:g}s")
+    except Exception as exc:  # it answered a moment ago: whatever its client raises, one line
+        raise ConfigError(f"--scheduler {address!r}: cannot connect a Dask client: "
+                          f"{type(exc).__name__}: {exc}".splitlines()[0]) from None
     with client:
         stamp = time.time_ns()
         futures = {}
@@ -188,4 +258,5 @@ def world_results(tasks: Sequence[WorldTask], *, workers: int = 1,
         The scheduler cannot be reached, or dask is not installed.
     """
     data = [task_data(t) for t in tasks]
-    return _dask_results(data, scheduler) if scheduler else _local_results(data, workers)
+    return (_dask_results(data, scheduler) if scheduler is not None
+            else _local_results(data, workers))

@@ -25,7 +25,7 @@ from deformap.eval import (
     runs_csv,
     summarise_worlds,
 )
-from deformap.run._folder import create_run_folder, to_json, write_text
+from deformap.run._folder import to_json, write_text
 from deformap.run._worlds_config import WorldsBenchConfig, exploration_with
 from deformap.viz import plot_world_curves
 
@@ -89,7 +89,9 @@ def read_bench(folder: Path, *, what: str = "source") -> WorldsBenchConfig:
 
 
 def start_folder(config: WorldsBenchConfig, folder: Path) -> None:
-    """Create ``folder`` for ``config``, or check that it holds the same benchmark to resume.
+    """Start the benchmark ``config`` in ``folder`` (created and locked by the caller,
+    :func:`~deformap.run._folder.claim_run_folder`), or check that it holds the same benchmark to
+    resume.
 
     Raises
     ------
@@ -107,7 +109,6 @@ def start_folder(config: WorldsBenchConfig, folder: Path) -> None:
                 f"--out {str(folder)!r} holds a worlds benchmark with other settings "
                 f"({differ}); choose another --out or the same settings")
     else:
-        create_run_folder(folder, what="benchmark")
         write_bench(folder, config)
     (folder / "worlds").mkdir(exist_ok=True)
 

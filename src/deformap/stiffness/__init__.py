@@ -35,7 +35,24 @@ DerSimonian, R., Laird, N. (1986). Meta-analysis in clinical trials. Control. Cl
 
 from __future__ import annotations
 
+from deformap.stiffness._behaviour import (
+    BEHAVIOURS,
+    PressBehaviour,
+    PressRecord,
+    press_behaviour,
+    released_dent,
+)
 from deformap.stiffness._config import LAYER_MODEL, StiffnessConfig, StiffnessEstimate
 from deformap.stiffness._estimate import estimate_stiffness
 
-__all__ = ["LAYER_MODEL", "StiffnessConfig", "StiffnessEstimate", "estimate_stiffness"]
+__all__ = [
+    "BEHAVIOURS",
+    "LAYER_MODEL",
+    "PressBehaviour",
+    "PressRecord",
+    "StiffnessConfig",
+    "StiffnessEstimate",
+    "estimate_stiffness",
+    "press_behaviour",
+    "released_dent",
+]

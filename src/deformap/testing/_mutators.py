@@ -20,7 +20,8 @@ import numpy as np
 
 from deformap.testing._mutant_templates import RAW_CHUNK_BYTES
 
-__all__ = ["FILE_MUTATORS", "KINDS", "kinds_of", "mutate_file", "mutate_raw", "mutate_session"]
+__all__ = ["FILE_MUTATORS", "KINDS", "alias_bomb", "kinds_of", "mutate_file", "mutate_raw",
+           "mutate_session"]
 
 Mutator = Callable[[bytes, np.random.Generator], bytes]
 
@@ -29,17 +30,22 @@ Mutator = Callable[[bytes, np.random.Generator], bytes]
 KINDS: dict[str, tuple[str, ...]] = {
     "pcd": ("flip", "truncate", "extend", "header", "count"),
     "ply": ("flip", "truncate", "extend", "header", "count"),
+    # an ascii body also cut inside its last number
+    "pcd-ascii": ("flip", "truncate", "extend", "header", "count", "cut-number"),
+    "ply-ascii": ("flip", "truncate", "extend", "header", "count", "cut-number"),
     "npz": ("flip", "truncate", "extend", "member-flip", "member-truncate", "member-extend",
             "member-npy-header", "member-shape"),
-    "session": ("yaml", "file", "link"),
-    "config": ("yaml", "flip", "truncate"),
-    "scenario": ("yaml", "flip", "truncate"),
+    # "alias": a value replaced by a nested YAML alias bomb
+    "session": ("yaml", "file", "link", "alias"),
+    "config": ("yaml", "flip", "truncate", "alias"),
+    "scenario": ("yaml", "flip", "truncate", "alias"),
     # a bag as a robot records it: its bytes, one record, one message (the CRCs made to match),
     # the settings YAML beside it; as sqlite3 (rosbag2's default before Iron) rows and topics too
     "raw-mcap": ("flip", "truncate", "extend", "record", "message-flip", "message-truncate",
-                 "message-extend", "yaml"),
+                 "message-extend", "yaml", "alias"),
     "raw-db3": ("flip", "truncate", "extend", "message-flip", "message-truncate",
-                "message-extend", "row-delete", "row-repeat", "row-type", "topic", "yaml"),
+                "message-extend", "row-delete", "row-repeat", "row-type", "topic", "yaml",
+                "alias"),
 }
 
 
@@ -123,8 +129,20 @@ def _count(data: bytes, rng: np.random.Generator) -> bytes:
     return out
 
 
+def _cut_number(data: bytes, rng: np.random.Generator) -> bytes:
+    """An ascii file cut inside its last number (between two of its digits): no line break
+    after the last row, and the number shorter."""
+    body = data.rstrip()
+    start = max(body.rfind(b"\n"), body.rfind(b" "), body.rfind(b"\t")) + 1
+    inside = [start + m.start() + 1 for m in re.finditer(rb"(?=\d\d)", body[start:])]
+    if not inside:
+        return body
+    return body[: inside[int(rng.integers(len(inside)))]]
+
+
 FILE_MUTATORS: dict[str, Mutator] = {
     "flip": _flip, "truncate": _truncate, "extend": _extend, "header": _header, "count": _count,
+    "cut-number": _cut_number,
 }  # fmt: skip
 
 
@@ -194,13 +212,40 @@ def _yaml_edit(text: str, rng: np.random.Generator) -> str:
     return "\n".join(lines)
 
 
+def alias_bomb(depth: int = 9, width: int = 9) -> str:
+    """A flow sequence of YAML anchors, each level ``width`` aliases of the one before ("billion
+    laughs"): a few hundred characters that expand to ``width ** depth`` strings."""
+    levels = ["&l0 [" + ", ".join(["lol"] * width) + "]"]
+    for i in range(1, depth):
+        levels.append(f"&l{i} [" + ", ".join([f"*l{i - 1}"] * width) + "]")
+    return "[" + ", ".join(levels) + "]"
+
+
+_KEY_LINE = re.compile(r"^(\s*(?:- )?[A-Za-z_][\w.]*:)[ \t]+\S.*$")
+
+
+def _alias_edit(text: str, rng: np.random.Generator) -> str:
+    """The value of a random ``key: value`` line replaced by :func:`alias_bomb` (a plain anchor
+    and its alias elsewhere when no line has a value)."""
+    lines = text.split("\n")
+    keyed = [i for i, line in enumerate(lines) if _KEY_LINE.match(line)]
+    if not keyed:
+        return "&a " + text
+    i = keyed[int(rng.integers(len(keyed)))]
+    key = _KEY_LINE.match(lines[i]).group(1)  # type: ignore[union-attr]
+    depth, width = int(rng.integers(2, 10)), int(rng.integers(2, 10))
+    lines[i] = f"{key} {alias_bomb(depth, width)}"
+    return "\n".join(lines)
+
+
 def mutate_session(template: Path, out: Path, kind: str, rng: np.random.Generator) -> None:
     """Copy the session folder ``template`` to ``out`` and damage it (``kind``)."""
     shutil.copytree(template, out, symlinks=True)
     data_files = sorted(p for p in out.rglob("*") if p.is_file() and p.name != "session.yaml")
-    if kind == "yaml":
+    if kind in ("yaml", "alias"):
         file = out / "session.yaml"
-        file.write_text(_yaml_edit(file.read_text(), rng))
+        edit = _yaml_edit if kind == "yaml" else _alias_edit
+        file.write_text(edit(file.read_text(), rng))
     elif kind == "link":
         victim = data_files[int(rng.integers(len(data_files)))]
         outside = out.parent / f"{out.name}-outside-{victim.name}"
@@ -318,9 +363,10 @@ def mutate_raw(template: Path, out: Path, kind: str, rng: np.random.Generator) -
     and damage the bag or, for ``yaml``, the settings; returns the damaged bag's path."""
     shutil.copytree(template.parent, out)
     bag = out / template.name
-    if kind == "yaml":
+    if kind in ("yaml", "alias"):
         settings = bag.with_name(f"{bag.stem}.deformap.yaml")
-        settings.write_text(_yaml_edit(settings.read_text(), rng))
+        edit = _yaml_edit if kind == "yaml" else _alias_edit
+        settings.write_text(edit(settings.read_text(), rng))
     elif bag.suffix == ".db3" and kind not in FILE_MUTATORS:
         _db3_edit(bag, kind, rng)
     elif kind == "record":
@@ -336,6 +382,7 @@ def mutate_file(data: bytes, kind: str, rng: np.random.Generator) -> bytes:
     """One file mutant: a ``FILE_MUTATORS`` kind, or ``member-KIND`` inside an NPZ member."""
     if kind.startswith("member-"):
         return _npz_member(data, rng, kind.removeprefix("member-"))
-    if kind == "yaml":
-        return _yaml_edit(data.decode("utf-8"), rng).encode("utf-8")
+    if kind in ("yaml", "alias"):
+        edit = _yaml_edit if kind == "yaml" else _alias_edit
+        return edit(data.decode("utf-8"), rng).encode("utf-8")
     return FILE_MUTATORS[kind](data, rng)

@@ -24,6 +24,7 @@ import typer
 from typer.testing import CliRunner
 
 from deformap.cli import app
+from deformap.testing._mutators import alias_bomb
 from deformap.testing.mutants import count_table
 
 __all__ = ["ENDINGS", "HANG_LIMIT_S", "CliCase", "CliMutant", "alarm_handler", "argv",
@@ -65,10 +66,13 @@ def positional(command: Any) -> list[Any]:
 
 
 def hostile_paths(root: Path) -> dict[str, str]:
-    """A file, a folder, a FIFO under ``root``; a path under the file, ``/dev/zero`` and a
-    300-character name."""
+    """A file, a folder, a FIFO under ``root``; a path under the file, ``/dev/zero``, a
+    300-character name, and a YAML file whose known keys hold a nested alias bomb (a run
+    configuration's and a scenario's at once)."""
     a_file = root / "a-file.txt"
     a_file.write_text("not a run folder\n")
+    bomb = root / "alias-bomb.yaml"
+    bomb.write_text(f"name: {alias_bomb()}\nexploration:\n  strategy: {alias_bomb()}\n")
     a_dir = root / "a-dir"
     a_dir.mkdir()
     (a_dir / "inside.txt").write_text("x\n")
@@ -76,7 +80,7 @@ def hostile_paths(root: Path) -> dict[str, str]:
     os.mkfifo(fifo)
     return {"file": str(a_file), "dir": str(a_dir), "fifo": str(fifo),
             "under-file": str(a_file / "sub"), "zero": "/dev/zero",
-            "long": str(root / ("n" * 300))}  # fmt: skip
+            "long": str(root / ("n" * 300)), "alias-bomb": str(bomb)}  # fmt: skip
 
 
 @dataclass(frozen=True)

@@ -10,7 +10,8 @@ and counted (:func:`classify`) as:
 - ``same``: accepted, and the data read equal the template's;
 - ``changed``: accepted with other data, where no check could know (no checksum covers it);
 - ``silent``: accepted with other data where a check could have caught it: another number of
-  points or pokes, a :data:`STRUCTURAL` mutant accepted, a change a checksum covers, a ``.db3``
+  points or pokes, a :data:`STRUCTURAL` mutant accepted, a :data:`REFUSED` mutant (a YAML alias
+  bomb) accepted at all, a change a checksum covers, a ``.db3``
   row deleted or repeated (its metadata table counts the messages);
 - ``traceback``: any other exception, or an error of several lines; ``hang``: over the time
   limit.
@@ -33,14 +34,16 @@ import numpy as np
 from deformap.testing._mutant_templates import make_templates
 from deformap.testing._mutators import KINDS, kinds_of, mutate_file, mutate_raw, mutate_session
 
-__all__ = ["KINDS", "OUTCOMES", "STRUCTURAL", "Case", "Worker", "classify", "count_table",
-           "read_snapshot", "run_mutants", "table"]
+__all__ = ["KINDS", "OUTCOMES", "REFUSED", "STRUCTURAL", "Case", "Worker", "classify",
+           "count_table", "read_snapshot", "run_mutants", "table"]
 
 #: How a mutant read is counted (module docstring), in the tables' order.
 OUTCOMES = ("clean", "same", "changed", "silent", "traceback", "hang")
 #: Mutations that change a file's length or a declared size: accepted as other data, ``silent``.
 STRUCTURAL = {"truncate", "count", "extend", "member-truncate", "member-extend", "member-shape",
-              "message-truncate", "message-extend"}  # fmt: skip
+              "message-truncate", "message-extend", "cut-number"}  # fmt: skip
+#: Mutations every reader must refuse: accepted at all, they are ``silent``.
+REFUSED = {"alias"}
 
 
 def _digest(*arrays: Any) -> str:
@@ -119,6 +122,8 @@ def classify(reader: str, kind: str, status: str, got: Any, want: Any) -> str:
     """One of :data:`OUTCOMES` for a mutant read (``want``: the template's snapshot)."""
     if status != "ok":
         return status
+    if kind in REFUSED:
+        return "silent"
     if got == want:
         return "same"
     if reader in ("config", "scenario"):  # text a user edits: another valid value is theirs

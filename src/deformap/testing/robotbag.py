@@ -15,19 +15,23 @@ import dataclasses
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-from scipy.spatial.transform import Rotation
-
-from deformap.environment import PressObservation
-from deformap.replay import RecordedSession
+from deformap.replay import (
+    APPROACH,
+    FIRST_PRESS_S,
+    HOLD,
+    PAUSE,
+    RAMP,
+    RELEASE,
+    T0_NS,
+    RawPress,
+    RecordedSession,
+    RigConfig,
+    raw_messages,
+    raw_timeline,
+)
 
 __all__ = ["APPROACH", "FIRST_PRESS_S", "HOLD", "MSGDEFS", "PAUSE", "RAMP", "RELEASE", "T0_NS",
-           "Press", "copy_to_db3", "raw_settings", "write_raw_bag"]
-
-T0_NS = 1_700_000_000 * 10**9  # a realistic epoch stamp
-#: Timeline of one press [s]: approach, ramp from contact to the force, hold, release, pause.
-APPROACH, RAMP, HOLD, RELEASE, PAUSE = 0.2, 0.4, 0.3, 0.15, 0.15
-FIRST_PRESS_S = 0.3
+           "TEST_RIG", "RawPress", "copy_to_db3", "raw_settings", "write_raw_bag"]
 
 # -- message definitions, as ROS 2 ships them (dependencies after the ==== lines) -----------------
 _SEP = "\n" + "=" * 80 + "\n"
@@ -54,150 +58,8 @@ MSGDEFS = {
         + "MSG: geometry_msgs/Quaternion\nfloat64 x\nfloat64 y\nfloat64 z\nfloat64 w"),
 }  # fmt: skip
 
-
-def _header(t_s: float, frame: str) -> dict[str, Any]:
-    ns = T0_NS + round(t_s * 1e9)
-    return {"stamp": {"sec": ns // 10**9, "nanosec": ns % 10**9}, "frame_id": frame}
-
-
-def _pose(rot: np.ndarray, trans: Any) -> np.ndarray:
-    m = np.eye(4)
-    m[:3, :3], m[:3, 3] = rot, trans
-    return m
-
-
-def _tf(t_s: float, parent: str, child: str, m: np.ndarray) -> dict[str, Any]:
-    x, y, z, w = Rotation.from_matrix(m[:3, :3]).as_quat()
-    tx, ty, tz = m[:3, 3]
-    return {"header": _header(t_s, parent), "child_frame_id": child,
-            "transform": {"translation": {"x": tx, "y": ty, "z": tz},
-                          "rotation": {"x": x, "y": y, "z": z, "w": w}}}  # fmt: skip
-
-
-# -- the rig: camera mount, arm base, tool, tip and sensor --------------------------------------
-def _camera_optical2world() -> np.ndarray:
-    eye, target = np.array([0.30, -0.35, 0.65]), np.array([0.30, 0.20, 0.0])
-    z = (target - eye) / np.linalg.norm(target - eye)
-    x = np.cross(z, [0.0, 0.0, 1.0])
-    x /= np.linalg.norm(x)
-    return _pose(np.column_stack([x, np.cross(z, x), z]), eye)
-
-
-OPTICAL2LINK = _pose(np.array([[0.0, 0.0, 1.0], [-1.0, 0.0, 0.0], [0.0, -1.0, 0.0]]), [0, 0, 0])
-BASE2WORLD = _pose(Rotation.from_euler("z", 180, degrees=True).as_matrix(), [0.3, 0.7, 0.0])
-TIP2TOOL = _pose(Rotation.from_euler("x", 180, degrees=True).as_matrix(), [0.0, 0.0, 0.15])
-SENSOR2TIP = _pose(Rotation.from_euler("zx", [90, 180], degrees=True).as_matrix(), [0, 0, 0.1])
-TIP_YAW = Rotation.from_euler("z", 30, degrees=True).as_matrix()  # the tip's z stays up
-
-
-@dataclasses.dataclass
-class Press:
-    obs: PressObservation
-    start_s: float
-
-    @property
-    def contact_s(self) -> float:
-        return self.start_s + APPROACH
-
-    @property
-    def hold_s(self) -> tuple[float, float]:
-        return self.contact_s + RAMP, self.contact_s + RAMP + HOLD
-
-    def lift(self) -> float:
-        assert self.obs.force_travel is not None
-        return float(self.obs.force_travel.travel_m[-1] - self.obs.force_travel.travel_m[0])
-
-
-def _timeline(session: RecordedSession) -> list[Press]:
-    step = APPROACH + RAMP + HOLD + RELEASE + PAUSE
-    return [Press(session.press_observation(i), FIRST_PRESS_S + i * step)
-            for i in range(len(session))]
-
-
-def _ramp_u(press: Press, t: np.ndarray) -> np.ndarray:
-    """Position in the force–travel record (sample index, fractional) at times within the ramp."""
-    assert press.obs.force_travel is not None
-    n = len(press.obs.force_travel)
-    return np.clip((t - press.contact_s) / RAMP, 0.0, 1.0) * (n - 1)
-
-
-def _tip_position(presses: list[Press], t: float) -> np.ndarray:
-    """The tip's centre: over each target, down 5 cm, along the record's travel, hold, up."""
-    up = np.array([0.0, 0.0, 1.0])
-    for k, p in enumerate(presses):
-        hold = p.obs.contact.tip_center
-        contact = hold + p.lift() * up
-        above = contact + 0.05 * up
-        if t < p.start_s:  # moving from the last press to above this one
-            if k == 0:
-                return above
-            prev = presses[k - 1]
-            prev_above = prev.obs.contact.tip_center + (prev.lift() + 0.05) * up
-            w = np.clip((t - prev.hold_s[1] - RELEASE) / PAUSE, 0.0, 1.0)
-            return prev_above + w * (above - prev_above)
-        if t < p.contact_s:
-            return above + (t - p.start_s) / APPROACH * (contact - above)
-        if t < p.hold_s[0]:
-            record = p.obs.force_travel
-            assert record is not None
-            u = _ramp_u(p, np.array([t]))
-            travel = np.interp(u, np.arange(len(record)), record.travel_m)[0]
-            return contact - (travel - record.travel_m[0]) * up
-        if t <= p.hold_s[1]:
-            return hold
-        if t <= p.hold_s[1] + RELEASE:
-            return hold + (t - p.hold_s[1]) / RELEASE * (above - hold)
-    last = presses[-1]
-    return last.obs.contact.tip_center + (last.lift() + 0.05) * up
-
-
-def _force_on_surface(presses: list[Press], t: np.ndarray) -> np.ndarray:
-    """``(n, 3)`` world force the probe exerts on the surface at the times."""
-    out = np.zeros((t.size, 3))
-    for p in presses:
-        f = p.obs.contact.force
-        unit = f / np.linalg.norm(f)
-        record = p.obs.force_travel
-        assert record is not None
-        ramp = (t >= p.contact_s) & (t < p.hold_s[0])
-        mags = np.interp(_ramp_u(p, t[ramp]), np.arange(len(record)), record.force_n)
-        out[ramp] = mags[:, None] * unit
-        out[(t >= p.hold_s[0]) & (t <= p.hold_s[1])] = f
-        rel = (t > p.hold_s[1]) & (t < p.hold_s[1] + RELEASE)
-        out[rel] = (1 - (t[rel] - p.hold_s[1]) / RELEASE)[:, None] * f
-    return out
-
-
-def _organised(points_world: np.ndarray, optical2world: np.ndarray, pixels: np.ndarray,
-               shape: tuple[int, int]) -> np.ndarray:  # fmt: skip
-    """``(h·w, 3)`` float32 camera-frame points on the given (sorted) pixels, NaN elsewhere."""
-    cam = (points_world - optical2world[:3, 3]) @ optical2world[:3, :3]
-    grid = np.full((shape[0] * shape[1], 3), np.nan, dtype=np.float32)
-    grid[pixels] = cam.astype(np.float32)
-    return grid
-
-
-def _packed(colors: np.ndarray | None, pixels: np.ndarray, n: int) -> np.ndarray:
-    """``(n,)`` uint32 ``0x00RRGGBB`` words: ``colors`` on ``pixels``, grey without colours."""
-    words = np.full(n, 0x808080, dtype=np.uint32)
-    if colors is not None:
-        rgb = np.round(colors * 255).astype(np.uint32)
-        words[pixels] = (rgb[:, 0] << 16) | (rgb[:, 1] << 8) | rgb[:, 2]
-    return words
-
-
-def _cloud_msg(t_s: float, grid: np.ndarray, shape: tuple[int, int],
-               words: np.ndarray) -> dict[str, Any]:  # fmt: skip
-    table = np.zeros(grid.shape[0], dtype=[("x", "<f4"), ("y", "<f4"), ("z", "<f4"),
-                                           ("rgb", "<f4")])  # fmt: skip
-    for i, a in enumerate("xyz"):
-        table[a] = grid[:, i]
-    table["rgb"] = words.view(np.float32)  # the bits, as the drivers publish them
-    fields = [{"name": a, "offset": 4 * i, "datatype": 7, "count": 1}
-              for i, a in enumerate(["x", "y", "z", "rgb"])]  # fmt: skip
-    return {"header": _header(t_s, "camera_depth_optical_frame"), "height": shape[0],
-            "width": shape[1], "fields": fields, "is_bigendian": False, "point_step": 16,
-            "row_step": 16 * shape[1], "data": table.tobytes(), "is_dense": False}  # fmt: skip
+#: The rig these tests record: a 2 mN sensor, the tip frame named ``probe_tip``.
+TEST_RIG = RigConfig(force_noise_n=(0.002, 0.002, 0.002), tip_frame="probe_tip", colors=False)
 
 
 def write_raw_bag(path: Path, session: RecordedSession, *, seed: int = 0,
@@ -205,7 +67,7 @@ def write_raw_bag(path: Path, session: RecordedSession, *, seed: int = 0,
                   tf_gap_s: tuple[float, float] | None = None, bias_n: float = 0.0,
                   camera_hz: float = 30.0, tf_hz: float = 50.0, wrench_hz: float = 500.0,
                   chunk_size: int = 1024 * 1024, compression: str = "zstd",
-                  colors: bool = False) -> list[Press]:  # fmt: skip
+                  colors: bool = False, rig: RigConfig | None = None) -> list[RawPress]:  # fmt: skip
     """Write ``session``'s presses as a robot's drivers record them; return the timeline.
 
     ``drop`` leaves topics out; ``camera_gap_s`` and ``tf_gap_s`` leave out the camera's frames
@@ -213,76 +75,32 @@ def write_raw_bag(path: Path, session: RecordedSession, *, seed: int = 0,
     sensor not zeroed); the rates are the camera's, the arm's ``/tf`` and the force sensor's
     [Hz]; ``chunk_size`` and ``compression`` (``"zstd"``, ``"lz4"`` or ``"none"``) the writer's
     chunks', each with its CRC-32. The packed ``rgb`` field is grey, or with ``colors`` the
-    session clouds' own colours (which they must have), rounded to 8 bits a channel.
+    session clouds' own colours (which they must have), rounded to 8 bits a channel. ``rig``
+    replaces :data:`TEST_RIG` (then the rates, ``bias_n`` and ``colors`` are its own).
     """
     import mcap_ros2.writer as mcap_ros2_writer
     from mcap.writer import CompressionType
 
-    rng = np.random.default_rng(seed)
-    presses = _timeline(session)
-    end_s = presses[-1].hold_s[1] + RELEASE + PAUSE
-    optical2world = _camera_optical2world()
-    colored = [session.observation()] + [p.obs.cloud for p in presses]
-    clouds = [c.points for c in colored]
-    width = 128
-    height = -(-max(len(c) for c in clouds) * 5 // 4 // width)  # a quarter more pixels: holes
-    shape = (height, width)
-    layouts = [np.sort(rng.choice(height * width, len(c), replace=False)) for c in clouds]
-    grids = [_organised(c, optical2world, px, shape) for c, px in zip(clouds, layouts, strict=True)]
-    if colors and any(c.colors is None for c in colored):
-        raise ValueError("`colors=True` needs a session whose clouds have colours")
-    words = [_packed(c.colors if colors else None, px, height * width)
-             for c, px in zip(colored, layouts, strict=True)]  # fmt: skip
+    observation = session.observation()
+    presses = [session.press_observation(i) for i in range(len(session))]
+    if rig is None:
+        if colors and (observation.colors is None or any(p.cloud.colors is None for p in presses)):
+            raise ValueError("`colors=True` needs a session whose clouds have colours")
+        rig = dataclasses.replace(TEST_RIG, camera_hz=camera_hz, tf_hz=tf_hz,
+                                  wrench_hz=wrench_hz, force_bias_n=bias_n, colors=colors)
     writer = mcap_ros2_writer.Writer(str(path), chunk_size=chunk_size,
                                      compression=CompressionType[compression.upper()])
     schemas = {name: writer.register_msgdef(name, text) for name, text in MSGDEFS.items()}
-
-    def put(topic: str, kind: str, msg: dict[str, Any], t_s: float) -> None:
-        if topic not in drop:
-            writer.write_message(topic, schemas[kind], msg, log_time=T0_NS + round(t_s * 1e9))
-
-    static = [_tf(0.0, "world", "camera_link", optical2world @ np.linalg.inv(OPTICAL2LINK)),
-              _tf(0.0, "camera_link", "camera_depth_optical_frame", OPTICAL2LINK),
-              _tf(0.0, "world", "base_link", BASE2WORLD),
-              _tf(0.0, "tool0", "probe_tip", TIP2TOOL),
-              _tf(0.0, "probe_tip", "ft_sensor", SENSOR2TIP)]  # fmt: skip
-    put("/tf_static", "tf2_msgs/msg/TFMessage", {"transforms": static}, 0.0)
-    # the camera (30 Hz): the observation, or from contact to release the press's cloud (each
-    # pixel blanked in one frame of nine at most, so the per-pixel mean gives every point back)
-    for n, t in enumerate(np.arange(0.0, end_s, 1 / camera_hz)):
-        stamp = t + rng.uniform(-0.003, 0.003)
-        if camera_gap_s is not None and camera_gap_s[0] <= stamp <= camera_gap_s[1]:
+    gaps = {rig.cloud_topic: camera_gap_s, "/tf": tf_gap_s}
+    for msg in raw_messages(observation, presses, rig, seed=seed):
+        gap = gaps.get(msg.topic)
+        t_s = (msg.log_time_ns - T0_NS) / 1e9
+        if msg.topic in drop or (gap is not None and gap[0] <= t_s <= gap[1]):
             continue
-        held = [k for k, p in enumerate(presses) if p.contact_s <= stamp <= p.hold_s[1] + RELEASE]
-        which = held[0] + 1 if held else 0
-        grid = grids[which].copy()
-        blank = layouts[which]
-        grid[blank[(np.arange(blank.size) * 7 + n) % 9 == 0][::3]] = np.nan
-        put("/camera/depth/color/points", "sensor_msgs/msg/PointCloud2",
-            _cloud_msg(stamp, grid, shape, words[which]), stamp)
-    # the arm (50 Hz): base_link -> tool0 carries the tip along the press
-    for t in np.arange(0.0, end_s, 1 / tf_hz):
-        stamp = t + rng.uniform(-0.002, 0.002)
-        if tf_gap_s is not None and tf_gap_s[0] <= stamp <= tf_gap_s[1]:
-            continue
-        tip2world = _pose(TIP_YAW, _tip_position(presses, stamp))
-        tool2base = np.linalg.inv(BASE2WORLD) @ tip2world @ np.linalg.inv(TIP2TOOL)
-        put("/tf", "tf2_msgs/msg/TFMessage",
-            {"transforms": [_tf(stamp, "base_link", "tool0", tool2base)]}, stamp)
-    # the force sensor (500 Hz): the reaction (the surface on the probe) in its own frame
-    times = np.arange(0.0, end_s, 1 / wrench_hz)
-    times = times + rng.uniform(-4e-4, 4e-4, times.size)
-    force = _force_on_surface(presses, times) + rng.normal(0.0, 0.002, (times.size, 3))
-    force[:, 2] -= bias_n  # a sensor not zeroed
-    sensor2world = TIP_YAW @ SENSOR2TIP[:3, :3]
-    reaction = -force @ sensor2world  # = (sensor2world.T @ -f) row by row
-    for t, f in zip(times, reaction, strict=True):
-        put("/ft_sensor/wrench", "geometry_msgs/msg/WrenchStamped", {
-            "header": _header(t, "ft_sensor"),
-            "wrench": {"force": dict(zip("xyz", f.tolist(), strict=True)),
-                       "torque": {"x": 0.0, "y": 0.0, "z": 0.0}}}, t)  # fmt: skip
+        writer.write_message(msg.topic, schemas[msg.msgtype], msg.fields,
+                             log_time=msg.log_time_ns)  # fmt: skip
     writer.finish()
-    return presses
+    return raw_timeline(presses)
 
 
 def copy_to_db3(bag: Path, db3: Path) -> Path:

@@ -28,8 +28,10 @@ from deformap.world import hardness_to_youngs_modulus
 
 __all__ = ["plot_map"]
 
-# marker per poke purpose: the first poke, the pokes the variance chose, the boundary pokes
+# marker per poke purpose: the first poke, the pokes the variance chose, the pokes testing a look
+# (appearance prior), the boundary pokes
 _MARKS = {"first": ("o", "first poke"), "variance": ("^", "later pokes"),
+          "appearance": ("D", "pokes testing a look"),
           "boundary": ("s", "boundary pokes")}  # fmt: skip
 _HALO = [patheffects.withStroke(linewidth=3.5, foreground="w")]
 _REGION_COLOUR, _THRESHOLD_COLOUR = "r", "tab:orange"
@@ -136,7 +138,7 @@ def plot_map(
         The modulus field's median E [Pa], drawn in kPa on a log scale.
     region_field : {"beta", "modulus"}
         The field the regions were cut from (``modulus`` needs ``modulus_pa``).
-    purposes : sequence of {"first", "variance", "boundary"} or None, optional
+    purposes : sequence of {"first", "variance", "appearance", "boundary"} or None, optional
         Each contact's purpose (its mark); default: first, then variance.
     variance_max : float, optional
         Top of the variance colour scale, fixed so that runs compare; default: this map's maximum.

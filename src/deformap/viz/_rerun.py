@@ -1,13 +1,15 @@
 """A 3D recording of a run for the rerun viewer (extra ``rerun``): ``run.rrd``.
 
-Timeline ``poke``: step 0 holds the first observation, the surface GP's heightmap and the ground
-truth; step k the k-th press (cloud with the robot removed, tactile points, dent, the robot's
-hull), the β-field as a coloured surface, and the maps and scalars as they evolve; the last step
-the regions. The maps are values, not colours: ``maps/beta``, ``maps/variance`` (of the map
-field), ``maps/modulus_kpa`` (median E) and ``maps/truth_hardness_n`` (NaN where rigid or bare
-table) are ``(ny, nx)`` :class:`rerun.Tensor` grids, ``maps/regions`` a
-:class:`rerun.SegmentationImage` whose annotation context names each region with its mean β; every
-grid is stored top row first (the largest y), so that it shows with y up as in ``map.png``.
+Timelines ``poke`` and ``time`` (seconds since the run began: each poke's compute and the
+environment's time, summed from its timings), in a Z-up world frame: step 0 holds the first
+observation, the surface GP's heightmap and the ground truth; step k the k-th press (cloud with the
+robot removed, tactile points, dent, the robot's hull), the β-field as a coloured surface, and the
+maps and scalars as they evolve; the last step the regions. The maps are values, not colours:
+``maps/beta``, ``maps/variance`` (of the map field), ``maps/modulus_kpa`` (median E) and
+``maps/truth_hardness_n`` (NaN where rigid or bare table) are ``(ny, nx)`` :class:`rerun.Tensor`
+grids, ``maps/regions`` a :class:`rerun.SegmentationImage` whose annotation context names each
+region with its mean β; every grid is stored top row first (the largest y), so that it shows with y
+up as in ``map.png``.
 """
 
 from __future__ import annotations
@@ -66,22 +68,38 @@ def record_run(path: str | Path, result: Any, *, initial_points: NDArray,
     with atomic_path(out) as tmp:
         rec = rr.RecordingStream("deformap")
         rec.save(tmp, default_blueprint=_blueprint())
-        _log_run(rec, result, np.asarray(initial_points))
+        times = _poke_times(result)
+        _log_run(rec, result, np.asarray(initial_points), times)
         if truth_hardness is not None:
-            rec.set_time("poke", sequence=0)
+            _at(rec, 0, times)
             truth = np.where(np.isinf(truth_hardness), np.nan, truth_hardness)
             rec.log("maps/truth_hardness_n", rr.Tensor(truth[::-1], dim_names=("y", "x")))
         for k, points in enumerate(robot_points or (), start=1):
             if points is not None:
-                rec.set_time("poke", sequence=k)
+                _at(rec, k, times)
                 vertices, triangles = hull_mesh(np.asarray(points, dtype=float))
                 rec.log("world/press/robot_hull", rr.Mesh3D(
                     vertex_positions=vertices, triangle_indices=triangles,
                     albedo_factor=[120, 120, 120, 110]))  # fmt: skip
-        _log_regions(rec, result)
+        _log_regions(rec, result, times)
         rec.flush()
         rec.disconnect()  # closes the file
     return out
+
+
+def _poke_times(result: Any) -> list[float]:
+    """Seconds since the run began at each step: 0 for the observation, then after each poke."""
+    times = [0.0]
+    for poke in getattr(result, "pokes", ()):
+        t = getattr(poke.record, "timings", None)
+        times.append(times[-1] + (0.0 if t is None else t.compute_s + (t.environment_s or 0.0)))
+    return times
+
+
+def _at(rec: Any, k: int, times: Sequence[float]) -> None:
+    """Log what follows at step ``k`` of both timelines."""
+    rec.set_time("poke", sequence=k)
+    rec.set_time("time", duration=times[min(k, len(times) - 1)])
 
 
 def hull_mesh(points: NDArray) -> tuple[NDArray, NDArray[np.int64]]:
@@ -112,10 +130,11 @@ def _blueprint() -> Any:
     )  # the side and time panels stay open: the time panel steps through the pokes
 
 
-def _log_run(rec: Any, result: Any, pts: NDArray) -> None:
+def _log_run(rec: Any, result: Any, pts: NDArray, times: Sequence[float]) -> None:
     import rerun as rr
 
-    rec.set_time("poke", sequence=0)
+    rec.log("world", rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
+    _at(rec, 0, times)
     rec.log("world/observation",
             rr.Points3D(pts, radii=0.0015, colors=_colors(pts[:, 2], "viridis", 0.0, 0.08)))
     surface_mesh = None
@@ -126,7 +145,7 @@ def _log_run(rec: Any, result: Any, pts: NDArray) -> None:
             vertex_positions=vertices, triangle_indices=triangles,
             vertex_colors=_colors(vertices[:, 2], "viridis", 0, 0.08)))
     for k, poke in enumerate(result.pokes, start=1):
-        rec.set_time("poke", sequence=k)
+        _at(rec, k, times)
         dent = poke.dent
         if dent is not None:
             rec.log("world/press/cloud",
@@ -160,14 +179,14 @@ def _map_variance(result: Any, k: int, beta_variance: NDArray) -> NDArray:
     return np.asarray(beta_variance)
 
 
-def _log_regions(rec: Any, result: Any) -> None:
+def _log_regions(rec: Any, result: Any, times: Sequence[float]) -> None:
     """The final regions as a segmentation image, each named R1, R2, … with its mean β."""
     import rerun as rr
 
     regions = getattr(result, "regions", None)
     if regions is None:
         return
-    rec.set_time("poke", sequence=len(result.pokes))
+    _at(rec, len(result.pokes), times)
     labels = np.asarray(regions.labels)
     mean = np.asarray(result.beta_field.mean)
     infos = []

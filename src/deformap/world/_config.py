@@ -65,6 +65,14 @@ class WorldConfig:
     force_travel_spacing : {"force", "travel"}
         How the record's samples are spaced (:data:`RecordSpacing`): evenly in force, or evenly in
         travel.
+    ramp_rate_n_per_s : float
+        Probe protocol: the rate at which the commanded force rises on the loading ramp (a
+        load-controlled press) and falls on the unloading branch.
+    hold_s : float
+        Probe protocol: how long the commanded force is held after the ramp (the record's hold:
+        the travel creeps on a viscoelastic block); 0: no hold recorded.
+    unload : bool
+        Probe protocol: record the unloading branch (the force falling back to contact).
     contact_threshold_n : float
         The force at which the probe detects contact: the record's first sample, where travel starts.
     encoder_noise_m : float
@@ -91,7 +99,7 @@ class WorldConfig:
     top_layer_m: float = setting(0.005, gt=0.0, ge=0.001)
     layer_growth: float = setting(1.5, ge=1.0, le=10.0)
     poisson_ratio: float = setting(0.3, ge=0.0, lt=0.5)  # 0.5 makes the FEM's λ infinite
-    tip_radius_m: float = setting(0.01, gt=0.0)
+    tip_radius_m: float = setting(0.01, limit="tip_radius_m")
     stick_length_m: float = setting(0.10, gt=0.0)
     stick_radius_m: float = setting(0.006, gt=0.0)
     hand_size_m: tuple[float, float, float] = setting((0.08, 0.06, 0.10), gt=0.0)
@@ -100,6 +108,10 @@ class WorldConfig:
     # 8 levels resolve the curvature of a sphere's F ∝ δ^(3/2); each level costs one press solve
     force_travel_levels: int = setting(8, ge=2, le=1000)
     force_travel_spacing: RecordSpacing = "force"
+    # a hand-held press gauge loads at about 1–10 N/s; 1 kN/s is an impact, not a press
+    ramp_rate_n_per_s: float = setting(2.0, gt=0.0, le=1000.0)
+    hold_s: float = setting(0.0, ge=0.0, le=600.0)  # ten minutes: longer is a creep test
+    unload: bool = False
     contact_threshold_n: float = setting(0.02, gt=0.0, le=0.1)
     encoder_noise_m: float = setting(5e-5, ge=0.0, le=1e-3)  # arm encoders: about 0.05 mm
     force_travel_noise_rel: float = setting(0.01, ge=0.0, le=0.1)  # force sensors: 1 % + 5 mN

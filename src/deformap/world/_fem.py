@@ -21,6 +21,7 @@ import logging
 from collections import OrderedDict
 from dataclasses import dataclass
 from functools import lru_cache
+from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
@@ -29,7 +30,8 @@ from scipy.sparse.linalg import SuperLU, splu
 
 from deformap.errors import NotPositiveDefiniteError
 
-__all__ = ["FoamBody", "HexGrid", "graded_levels", "unit_hex_stiffness"]
+__all__ = ["FoamBody", "HexGrid", "graded_levels", "orthotropic_hex_stiffness",
+           "unit_hex_stiffness"]
 
 log = logging.getLogger(__name__)
 
@@ -56,12 +58,20 @@ def graded_levels(thickness_m: float, top_m: float, growth: float) -> NDArray[np
 def unit_hex_stiffness(dx: float, dy: float, dz: float, nu: float) -> NDArray[np.float64]:
     """``(24, 24)`` stiffness of a ``dx × dy × dz`` trilinear hex with E = 1 Pa, by scikit-fem,
     ordered ``3 c + component`` with corner ``c = ci + 2 cj + 4 ck``."""
-    from skfem import Basis, BilinearForm, ElementHex1, ElementVectorH1, MeshHex, asm
+    from skfem import BilinearForm
     from skfem.models.elasticity import lame_parameters, linear_elasticity
+
+    form: BilinearForm = linear_elasticity(*lame_parameters(1.0, nu))
+    return _hex_matrix(dx, dy, dz, form)
+
+
+def _hex_matrix(dx: float, dy: float, dz: float, form: Any) -> NDArray[np.float64]:
+    """The 24×24 matrix of bilinear ``form`` on one ``dx×dy×dz`` hex (scikit-fem), its rows and
+    columns in this module's corner order (3 per corner), read-only."""
+    from skfem import Basis, ElementHex1, ElementVectorH1, MeshHex, asm
 
     mesh = MeshHex.init_tensor(np.array([0.0, dx]), np.array([0.0, dy]), np.array([0.0, dz]))
     basis = Basis(mesh, ElementVectorH1(ElementHex1()))
-    form: BilinearForm = linear_elasticity(*lame_parameters(1.0, nu))
     k = asm(form, basis).toarray()
     corner_of_node = np.rint(mesh.p.T / np.array([dx, dy, dz])).astype(int)
     ours = corner_of_node[:, 0] + 2 * corner_of_node[:, 1] + 4 * corner_of_node[:, 2]
@@ -69,7 +79,26 @@ def unit_hex_stiffness(dx: float, dy: float, dz: float, nu: float) -> NDArray[np
     perm[(3 * ours[:, None] + np.arange(3)).ravel()] = np.asarray(basis.nodal_dofs).T.ravel()
     out = k[np.ix_(perm, perm)]
     out.setflags(write=False)
-    return out
+    return np.asarray(out)
+
+
+@lru_cache(maxsize=256)
+def orthotropic_hex_stiffness(dx: float, dy: float, dz: float, nu: float, ratio: float,
+                              axis_deg: float) -> NDArray[np.float64]:
+    """As :func:`unit_hex_stiffness`, of the rotated orthotropic material at unit soft modulus
+    (:func:`~deformap.world._materials.orthotropic_stiffness`), by scikit-fem."""
+    from skfem import BilinearForm
+    from skfem.helpers import ddot, sym_grad
+
+    from deformap.world._materials import orthotropic_stiffness
+
+    tensor = orthotropic_stiffness(ratio, axis_deg, nu)
+
+    @BilinearForm
+    def form(u, v, _):
+        return ddot(np.einsum("ijkl,kl...->ij...", tensor, sym_grad(u)), sym_grad(v))
+
+    return _hex_matrix(dx, dy, dz, form)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -147,15 +176,19 @@ class HexGrid:
 class FoamBody:
     """One elastic block: its mesh, stiffness factorised once, and solves for nodal loads.
 
-    ``modulus_pa`` is Young's modulus, one or ``(nz, ny, nx)`` per element; ``symmetry`` names
+    ``anisotropy`` ``(ratio, axis_deg)``: an in-plane orthotropic material
+    (:class:`~deformap.world._materials.Orthotropic`) whose soft modulus is ``modulus_pa``; None:
+    isotropic. ``modulus_pa`` is Young's modulus, one or ``(nz, ny, nx)`` per element; ``symmetry`` names
     the planes ``"x_min"``/``"y_min"`` of the box held in their normal direction (a quarter of a
     symmetric problem).
     """
 
     def __init__(self, grid: HexGrid, modulus_pa: float | NDArray[np.float64], *,
-                 poisson_ratio: float, symmetry: tuple[str, ...] = ()) -> None:
+                 poisson_ratio: float, symmetry: tuple[str, ...] = (),
+                 anisotropy: tuple[float, float] | None = None) -> None:
         self.grid = grid
         self.poisson_ratio = poisson_ratio
+        self.anisotropy = anisotropy
         self.modulus = np.broadcast_to(np.asarray(modulus_pa, dtype=float),
                                        (grid.nz, grid.ny, grid.nx))
         self.free = self._free_dofs(symmetry)
@@ -187,7 +220,7 @@ class FoamBody:
         """What the unit-modulus stiffness depends on: the mesh, ``ν`` and the held planes."""
         g = self.grid
         head = np.array([*np.asarray(g.origin, dtype=float), g.dx, g.dy, g.nx, g.ny,
-                         self.poisson_ratio], dtype=float)
+                         self.poisson_ratio, *(self.anisotropy or (np.nan, np.nan))], dtype=float)
         return b"|".join([head.tobytes(), np.asarray(g.levels, dtype=float).tobytes(),
                           np.packbits(np.asarray(g.active, dtype=bool)).tobytes(),
                           ",".join(sorted(symmetry)).encode()])
@@ -212,8 +245,10 @@ class FoamBody:
         n = 3 * g.n_nodes
         total = sp.csr_matrix((n, n))
         for k in range(g.nz):
-            ke = unit_hex_stiffness(g.dx, g.dy, float(g.levels[k + 1] - g.levels[k]),
-                                    self.poisson_ratio)
+            dz = float(g.levels[k + 1] - g.levels[k])
+            ke = (unit_hex_stiffness(g.dx, g.dy, dz, self.poisson_ratio) if self.anisotropy is None
+                  else orthotropic_hex_stiffness(g.dx, g.dy, dz, self.poisson_ratio,
+                                                 *self.anisotropy))
             dofs, jj, ii = self.element_dofs(k)
             vals = modulus[k, jj, ii][:, None] * ke.ravel()[None, :]
             rows = np.repeat(dofs, 24, axis=1).ravel()

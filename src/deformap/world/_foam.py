@@ -41,12 +41,15 @@ _TOLERANCE = 0.02  # relative change of the patch radius that ends them
 class Dent:
     """The foam's response to one press: the ``(n_nodes, 3)`` ``displacement`` (metres) of every
     mesh node (all bodies stacked), the tip's indentation ``depth_m`` below the rest surface, the
-    loaded patch's ``contact_radius_m`` (both 0 on rigid ground) and the solves it took."""
+    loaded patch's ``contact_radius_m`` (both 0 on rigid ground) and the solves it took;
+    ``solved``, where given, is the FEM's displacement before the contact disc is put on the tip's
+    cap (what a time-stepping material carries to its next step)."""
 
     displacement: NDArray[np.float64]
     depth_m: float
     contact_radius_m: float
     iterations: int
+    solved: NDArray[np.float64] | None = None
 
 
 def block_grid(block: Block, *, element_size_m: float, top_layer_m: float,
@@ -59,6 +62,11 @@ def block_grid(block: Block, *, element_size_m: float, top_layer_m: float,
     active = block.contains(np.column_stack([cx.ravel(), cy.ravel()])).reshape(ny, nx)
     levels = graded_levels(block.thickness_m, min(top_layer_m, block.thickness_m), layer_growth)
     return HexGrid(origin=lo.copy(), dx=dx, dy=dy, nx=nx, ny=ny, levels=levels, active=active)
+
+
+def _anisotropy(block: Block) -> tuple[float, float] | None:
+    a = block.anisotropy
+    return None if a is None else (a.ratio, a.axis_deg)
 
 
 class FoamMesh:
@@ -116,7 +124,7 @@ class FoamModel(FoamMesh):
         self.poisson_ratio = poisson_ratio
         self.bodies: dict[int, FoamBody] = {
             index: FoamBody(self.grids[index], scenario.blocks[index].modulus_pa,
-                            poisson_ratio=poisson_ratio)
+                            poisson_ratio=poisson_ratio, anisotropy=_anisotropy(scenario.blocks[index]))
             for index in self.foam_blocks}
         self.max_unit_columns = MAX_UNIT_COLUMNS
         # the press's unit responses per body: (K⁻¹ columns, column of each free unknown or -1)
@@ -134,10 +142,15 @@ class FoamModel(FoamMesh):
         self._reach = None
 
     def dent(self, target_xy: NDArray[np.float64], force_n: float, *, tip_radius_m: float,
-             initial_radius_m: float | None = None, max_radius_m: float | None = None) -> Dent:
+             initial_radius_m: float | None = None, max_radius_m: float | None = None,
+             compliance: float = 1.0, offset: NDArray[np.float64] | None = None) -> Dent:
         """Solve the press of ``force_n`` newtons at ``target_xy`` (module docstring), the patch
         iteration started at ``initial_radius_m`` (default Hertz's) and bounded by
-        ``max_radius_m`` (default the tip's radius)."""
+        ``max_radius_m`` (default the tip's radius).
+
+        A time step of a viscoelastic block (:mod:`deformap.world._viscoelastic`) solves
+        ``u = compliance · K₀⁻¹ f + offset``: its algorithmic compliance and the displacement its
+        internal variables leave; the defaults are the elastic press."""
         target = np.asarray(target_xy, dtype=float).reshape(1, 2)
         if self._reach is None or not np.array_equal(self._reach[0], target[0]):
             self._columns.clear()  # another target's unit responses: a press starts afresh
@@ -150,12 +163,16 @@ class FoamModel(FoamMesh):
         if initial_radius_m is not None and initial_radius_m > 0.0:
             a = min(float(initial_radius_m), top)
         else:
-            modulus = self.scenario.blocks[index].modulus_pa
+            modulus = self.scenario.blocks[index].modulus_pa / compliance
             a = min(hertz_contact_radius(force_n, tip_radius_m, modulus, self.poisson_ratio), top)
         self._reach = (target[0].copy(), float(top))
         low, high = 0.0, top  # the fixed point lies in [low, high]
         for iteration in range(1, _MAX_ITERATIONS + 1):
             u, points, forces = self._solve_patch(target[0], a, force_n)
+            if compliance != 1.0:
+                u *= compliance
+            if offset is not None:
+                u += offset
             mean_u = -float(forces @ self.top_displacement(points, u)[:, 2]) / force_n
             depth = max(0.0, mean_u + 0.2 * a * a / tip_radius_m)
             consistent = float(np.sqrt(tip_radius_m * depth))  # the radius this sink touches
@@ -171,8 +188,10 @@ class FoamModel(FoamMesh):
             if converged or iteration == _MAX_ITERATIONS:
                 break
             a = a_new
+        solved = u.copy() if offset is not None else None
         self._conform_to_tip(u, target[0], a, depth, tip_radius_m)
-        return Dent(displacement=u, depth_m=depth, contact_radius_m=float(a), iterations=iteration)
+        return Dent(displacement=u, depth_m=depth, contact_radius_m=float(a), iterations=iteration,
+                    solved=solved)
 
     def _conform_to_tip(self, u: NDArray[np.float64], center: NDArray[np.float64], radius: float,
                         depth: float, tip_radius_m: float) -> None:

@@ -6,17 +6,27 @@ direction and the normal force (``docs/robot.md``). The world solves a press at 
 ``k`` is the dent depth ``δ(F_k)``. The encoders read the tip's position with an error of
 ``encoder_noise_m`` and the travel is counted from first contact (the first travel is exactly 0);
 the force sensor reads ``F_k`` with an error of ``rel · F_k + abs`` (one standard deviation).
+
+The probe's protocol (:class:`~deformap.world._config.WorldConfig`) may add sample times, a hold
+and an unloading branch (:func:`press_schedule`). The ramp is load-controlled: the force rises at
+``ramp_rate_n_per_s``, so level ``k`` is reached at ``(F_k − F_0) / rate``; the hold keeps the
+commanded force for ``hold_s`` (travel may creep), sampled ``n_levels`` times evenly; the unloading
+branch lowers the force through the ramp's levels, in reverse, at the same rate. The phases' noise
+is drawn from a stream of their own, after the ramp's, so the ramp is the record without them.
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass, replace
+
 import numpy as np
 from numpy.typing import NDArray
 
-from deformap.environment import ForceTravel
+from deformap.environment import ForceTravel, PressPhase
 from deformap.world._config import RecordSpacing
 
-__all__ = ["force_levels", "simulated_force_travel"]
+__all__ = ["PressSchedule", "elastic_phases", "force_levels", "press_schedule", "simulated_force_travel",
+           "with_phases"]
 
 
 def force_levels(contact_n: float, force_n: float, n_levels: int,
@@ -43,3 +53,67 @@ def simulated_force_travel(depths: NDArray[np.float64], levels: NDArray[np.float
     force = levels + rng.normal(0.0, 1.0, size=levels.size) * (
         force_noise_rel * levels + force_noise_n)
     return ForceTravel(travel_m=position - position[0], force_n=force)
+
+
+@dataclass(frozen=True, kw_only=True)
+class PressSchedule:
+    """When each sample of a press is taken: the ramp's ``times`` ``(n,)`` (seconds from first
+    contact) at its ``levels``; the hold's times ``(m,)`` (empty: none) at the last level; the
+    unloading's times and forces (empty: none)."""
+
+    levels: NDArray[np.float64]
+    times: NDArray[np.float64]
+    hold_times: NDArray[np.float64]
+    unload_times: NDArray[np.float64]
+    unload_forces: NDArray[np.float64]
+
+    @property
+    def has_phases(self) -> bool:
+        return bool(self.hold_times.size or self.unload_times.size)
+
+
+def press_schedule(levels: NDArray[np.float64], *, rate_n_per_s: float, hold_s: float,
+                   unload: bool) -> PressSchedule:
+    """The protocol's sample times for a ramp through ``levels`` (module docstring)."""
+    times = (levels - levels[0]) / rate_n_per_s
+    n = levels.size - 1
+    hold = times[-1] + hold_s * np.arange(1, n + 1) / n if hold_s > 0.0 else np.zeros(0)
+    end = hold[-1] if hold.size else times[-1]
+    forces = levels[-2::-1].copy() if unload else np.zeros(0)
+    unload_times = end + (levels[-1] - forces) / rate_n_per_s
+    return PressSchedule(levels=levels, times=times, hold_times=hold,
+                         unload_times=unload_times, unload_forces=forces)
+
+
+def elastic_phases(schedule: PressSchedule, depths: NDArray[np.float64]
+                   ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:  # fmt: skip
+    """The indentations of an elastic block during the hold and the unloading of ``schedule``:
+    it holds the last level's and retraces the ramp's levels (``depths``) in reverse."""
+    hold = np.full(schedule.hold_times.size, depths[-1])
+    unloading = depths[-2::-1][:schedule.unload_times.size].copy()
+    return hold, unloading
+
+
+def with_phases(record: ForceTravel, schedule: PressSchedule, zero_m: float,
+                hold_depths: NDArray[np.float64], unload_depths: NDArray[np.float64],
+                rng: np.random.Generator, *, encoder_noise_m: float, force_noise_rel: float,
+                force_noise_n: float) -> ForceTravel:
+    """``record`` with the schedule's times, hold and unloading, whose true indentations are
+    ``hold_depths`` and ``unload_depths``; travel is counted from ``zero_m``, the encoder's reading
+    at first contact. The unloading force is recorded as its running minimum: the controller
+    retracts until the force has fallen to each level, so sensor noise never shows as a rise."""
+    phases: dict[str, PressPhase] = {}
+    for name, times, depths, forces in (
+            ("hold", schedule.hold_times, hold_depths,
+             np.full(schedule.hold_times.size, schedule.levels[-1])),
+            ("unloading", schedule.unload_times, unload_depths, schedule.unload_forces)):
+        if not times.size:
+            continue
+        travel = depths + rng.normal(0.0, 1.0, size=depths.size) * encoder_noise_m - zero_m
+        force = forces + rng.normal(0.0, 1.0, size=forces.size) * (
+            force_noise_rel * forces + force_noise_n)
+        if name == "unloading":
+            force = np.minimum.accumulate(np.maximum(force, 0.0))
+        phases[name] = PressPhase(time_s=times, travel_m=travel, force_n=force)
+    return replace(record, time_s=schedule.times, hold=phases.get("hold"),
+                   unloading=phases.get("unloading"))

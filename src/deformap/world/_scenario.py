@@ -26,6 +26,7 @@ from deformap.environment import Workspace
 from deformap.errors import InvalidArgumentError
 from deformap.mechanics import hardness_to_youngs_modulus, youngs_modulus_to_hardness
 from deformap.world._appearance import Appearance, parse_color
+from deformap.world._materials import Orthotropic, Plastic, Viscoelastic
 from deformap.world._polygon import (
     is_simple,
     overlap_area,
@@ -62,6 +63,15 @@ class Block:
         Matplotlib colour for figures.
     appearance : Appearance or None
         How the camera sees the block; None: neutral grey and plain.
+    viscoelastic : Viscoelastic or None
+        The foam relaxes (a Prony series; the modulus is then the instantaneous one); None:
+        elastic.
+    anisotropy : Orthotropic or None
+        The foam is stiffer along an in-plane axis (the modulus is then the soft one's); None:
+        isotropic.
+    plastic : Plastic or None
+        The material yields and keeps a dent (neither viscoelastic nor anisotropic then); None:
+        elastic.
     """
 
     name: str
@@ -77,6 +87,9 @@ class Block:
     rigid: bool = False
     color: str = "#c8a165"
     appearance: Appearance | None = None
+    viscoelastic: Viscoelastic | None = None
+    anisotropy: Orthotropic | None = None
+    plastic: Plastic | None = None
 
     def __post_init__(self) -> None:
         try:
@@ -124,6 +137,16 @@ class Block:
                 f"block {self.name!r} needs exactly one of `hardness_n`, `youngs_modulus_pa` or "
                 f"`rigid=True`; got hardness_n={self.hardness_n!r}, "
                 f"youngs_modulus_pa={self.youngs_modulus_pa!r}, rigid={self.rigid!r}")
+        materials = [k for k in ("viscoelastic", "anisotropy", "plastic")
+                     if getattr(self, k) is not None]
+        if self.rigid and materials:
+            raise InvalidArgumentError(
+                f"block {self.name!r} is rigid: it can have no `{materials[0]}`; drop `rigid` or "
+                "the material")
+        if self.plastic is not None and len(materials) > 1:
+            raise InvalidArgumentError(
+                f"block {self.name!r}: a `plastic` block can be neither viscoelastic nor "
+                f"anisotropic; got {materials}")
         if self.hardness_n is not None:
             object.__setattr__(self, "youngs_modulus_pa",
                                hardness_to_youngs_modulus(float(self.hardness_n)))
@@ -162,6 +185,12 @@ class Block:
         out.update(thickness_m=self.thickness_m, color=self.color)
         if self.appearance is not None:
             out["appearance"] = self.appearance.to_dict()
+        if self.viscoelastic is not None:
+            out["viscoelastic"] = self.viscoelastic.to_dict()
+        if self.anisotropy is not None:
+            out["anisotropy"] = self.anisotropy.to_dict()
+        if self.plastic is not None:
+            out["plastic"] = self.plastic.to_dict()
         return out
 
 
@@ -169,8 +198,9 @@ class Block:
 class Scenario:
     """A named layout of blocks over a workspace.
 
-    ``blocks``: at least one, no two overlapping; ``workspace``: the rectangle to map, at most
-    :data:`MAX_EXTENT_M` on each side; ``table_appearance`` None: a darker warm grey.
+    ``blocks``: at least one, no two overlapping, each with some area inside ``workspace``;
+    ``workspace``: the rectangle to map, at most :data:`MAX_EXTENT_M` on each side;
+    ``table_appearance`` None: a darker warm grey.
     """
 
     name: str
@@ -189,6 +219,14 @@ class Scenario:
             raise SettingError(
                 "workspace", f"must span at most {MAX_EXTENT_M:g} m on each axis; got "
                 f"{size[0]:g} × {size[1]:g} m (scenario {self.name!r})")
+        (x0, y0), (x1, y1) = self.workspace.lower, self.workspace.upper
+        rect = rectangle(x0, y0, x1, y1)
+        for b in blocks:
+            if overlap_area(b.polygon, rect, b.holes) <= _OVERLAP_TOL_M2:
+                raise InvalidArgumentError(
+                    f"scenario {self.name!r}: block {b.name!r} lies wholly outside the workspace "
+                    f"[{x0:g}, {x1:g}] × [{y0:g}, {y1:g}] m; no poke could reach it: move the "
+                    "block or widen `workspace`")
         names = [b.name for b in blocks]
         if len(set(names)) != len(names):
             raise InvalidArgumentError(f"scenario {self.name!r} has repeated block names: {names}")

@@ -2,9 +2,11 @@
 
 A file holds ``name``, ``blocks`` (each with ``name``, one of ``rect`` or ``polygon``, optional
 ``holes``, one of ``hardness_n``, ``youngs_modulus_pa`` or ``rigid: true``, optional
-``thickness_m``, ``color`` and ``appearance``) and optionally ``description``, ``workspace``
-(``lower``, ``upper``) and ``table_appearance``; every key is checked, and ``docs/scenarios.md``
-lists them all with their defaults.
+``thickness_m``, ``color``, ``appearance``, ``viscoelastic`` (``relaxed_ratio``, ``times_s``,
+optional ``weights``), ``anisotropy`` (``ratio``, ``axis_deg``) and ``plastic``
+(``yield_stress_pa``, ``hardening_pa``)) and optionally
+``description``, ``workspace`` (``lower``, ``upper``) and ``table_appearance``; every key is
+checked, and ``docs/scenarios.md`` lists them all with their defaults.
 """
 
 from __future__ import annotations
@@ -13,12 +15,12 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import yaml
 
-from deformap._config import load_yaml
+from deformap._config import dump_yaml, few, load_yaml
 from deformap.environment import Workspace
 from deformap.errors import ConfigError, DeformapError
 from deformap.world._appearance import Appearance, appearance_from_dict
+from deformap.world._materials import Orthotropic, Plastic, Viscoelastic
 from deformap.world._polygon import rectangle
 from deformap.world._scenario import Block, Scenario, builtin_scenarios
 
@@ -26,7 +28,10 @@ __all__ = ["list_scenarios", "load_scenario", "parse_scenario", "save_scenario"]
 
 _SCENARIO_KEYS = {"name", "description", "workspace", "blocks", "table_appearance"}
 _BLOCK_KEYS = {"name", "rect", "polygon", "holes", "hardness_n", "youngs_modulus_pa", "rigid",
-               "thickness_m", "color", "appearance"}
+               "thickness_m", "color", "appearance", "viscoelastic", "anisotropy", "plastic"}
+_MATERIAL_KEYS = {"viscoelastic": {"relaxed_ratio", "times_s", "weights"},
+                  "anisotropy": {"ratio", "axis_deg"},
+                  "plastic": {"yield_stress_pa", "hardening_pa"}}
 _WORKSPACE_KEYS = {"lower", "upper"}
 
 
@@ -60,13 +65,13 @@ def load_scenario(name_or_path: str | Path) -> Scenario:
 
 def save_scenario(scenario: Scenario, path: str | Path) -> None:
     """Write ``scenario`` as YAML that :func:`load_scenario` reads back to an equal scenario."""
-    Path(path).write_text(yaml.safe_dump(scenario.to_dict(), sort_keys=False))
+    dump_yaml(scenario.to_dict(), path)
 
 
 def _unknown(where: str, data: dict[str, Any], allowed: set[str]) -> None:
-    extra = sorted(set(data) - allowed)
+    extra = sorted(map(str, set(data) - allowed))
     if extra:
-        raise ConfigError(f"{where}: unknown key(s) {extra}; allowed: {sorted(allowed)}")
+        raise ConfigError(f"{where}: unknown key(s) {few(extra)}; allowed: {sorted(allowed)}")
 
 
 def _block(data: Any, where: str) -> Block:
@@ -89,13 +94,27 @@ def _block(data: Any, where: str) -> Block:
         if not isinstance(rigid, bool):
             raise ConfigError(f"{where}: `rigid` must be true or false; got {rigid!r}")
         look = data.get("appearance")
+        materials: dict[str, Any] = {}
+        for key, cls in (("viscoelastic", Viscoelastic), ("anisotropy", Orthotropic),
+                         ("plastic", Plastic)):
+            if key in data:
+                part = data[key]
+                if not isinstance(part, dict):
+                    raise ConfigError(f"{where}.{key}: must be a mapping with keys "
+                                      f"{sorted(_MATERIAL_KEYS[key])}; got {type(part).__name__}")
+                _unknown(f"{where}.{key}", part, _MATERIAL_KEYS[key])
+                try:
+                    materials[key] = cls(**part)
+                except (TypeError, ValueError, DeformapError) as exc:
+                    raise ConfigError(f"{where}.{key}: {exc}") from None
         return Block(
-            name=str(data.get("name", "")), polygon=poly,
+            name=data.get("name", ""), polygon=poly,
             holes=tuple(np.asarray(h, dtype=float) for h in data.get("holes", ())),
             thickness_m=data.get("thickness_m", 0.05),
             hardness_n=data.get("hardness_n"), youngs_modulus_pa=data.get("youngs_modulus_pa"),
-            rigid=rigid, color=str(data.get("color", "#6b4f3a" if rigid else "#c8a165")),
-            appearance=None if look is None else _appearance(look, f"{where}.appearance"))
+            rigid=rigid, color=data.get("color", "#6b4f3a" if rigid else "#c8a165"),
+            appearance=None if look is None else _appearance(look, f"{where}.appearance"),
+            **materials)
     except ConfigError:
         raise
     except (TypeError, ValueError, DeformapError) as exc:
@@ -127,10 +146,12 @@ def parse_scenario(data: Any, *, source: str = "<scenario>") -> Scenario:
     table = data.get("table_appearance")
     table_look = None if table is None else _appearance(table, f"{source}: table_appearance")
     try:
-        workspace = Workspace(lower=tuple(ws.get("lower", (0.0, 0.0))),
-                              upper=tuple(ws.get("upper", (0.6, 0.4))))
-        return Scenario(name=str(data["name"]), blocks=blocks, workspace=workspace,
-                        description=str(data.get("description", "")), table_appearance=table_look)
+        workspace = Workspace(lower=ws.get("lower", (0.0, 0.0)), upper=ws.get("upper", (0.6, 0.4)))
+    except DeformapError as exc:
+        raise ConfigError(f"{source}: workspace: {exc}") from None
+    try:
+        return Scenario(name=data["name"], blocks=blocks, workspace=workspace,
+                        description=data.get("description", ""), table_appearance=table_look)
     except ConfigError:
         raise
     except DeformapError as exc:

@@ -16,7 +16,11 @@ import numpy as np
 import trimesh
 from numpy.typing import NDArray
 
-from deformap._validation import check_array, check_positive, check_vector
+from deformap._validation import (
+    SettingError,
+    check_positive,
+    check_vector,
+)
 from deformap.cloud import PointCloud
 from deformap.environment import (
     MIN_FORCE_RISE_N,
@@ -29,11 +33,20 @@ from deformap.errors import EnvironmentStateError, InvalidArgumentError
 from deformap.world._camera import DepthCamera, Frame
 from deformap.world._config import WorldConfig, check_world_budget
 from deformap.world._foam import Dent, FoamModel
-from deformap.world._force_travel import force_levels, simulated_force_travel
+from deformap.world._force_travel import (
+    elastic_phases,
+    force_levels,
+    press_schedule,
+    simulated_force_travel,
+    with_phases,
+)
 from deformap.world._looks import HAND, STICK, TABLE, TIP, SceneLooks
-from deformap.world._scenario import BARE_TABLE, Block, Scenario
+from deformap.world._plastic import PlasticPress, plastic_press
+from deformap.world._scenario import BARE_TABLE, Scenario
 from deformap.world._stiffening import StiffeningFoam
 from deformap.world._stiffening_fem import StiffeningFem
+from deformap.world._truth import WorldTruth
+from deformap.world._viscoelastic import PressHistory, press_history, recovered
 
 __all__ = ["MIN_RECORD_FORCE_N", "SimulatedWorld"]
 
@@ -47,7 +60,7 @@ _UP = np.array([0.0, 0.0, 1.0])
 MIN_RECORD_FORCE_N = 0.1 + 5 * MIN_FORCE_RISE_N
 
 
-class SimulatedWorld:
+class SimulatedWorld(WorldTruth):
     """A scenario on a table, seen by a depth camera and pressed by a force-controlled probe.
 
     One number is drawn from ``rng`` at construction; each event (the n-th observation at rest; a
@@ -64,6 +77,12 @@ class SimulatedWorld:
         self.scenario = scenario
         self.config = config or WorldConfig()
         check_world_budget(self.config, scenario)
+        special = [b.name for b in scenario.blocks if b.viscoelastic is not None
+                   or b.anisotropy is not None or b.plastic is not None]
+        if special and self.config.physics != "linear-fem":
+            raise SettingError(
+                "physics", f"must be 'linear-fem' for the blocks of other materials "
+                f"{special}; got {self.config.physics!r}")
         self._noise_key = int(rng.integers(2**62))
         self._n_observed = 0
         c = self.config
@@ -84,6 +103,9 @@ class SimulatedWorld:
         self.looks = SceneLooks(scenario, self.config)
         self._pressed: PressObservation | None = None
         self._displacement = self.foam.zero_displacement()
+        self._history: tuple[tuple[float, float, float], PressHistory | PlasticPress] | None = None
+        self._left: PressHistory | PlasticPress | None = None  # the last press released
+        self._released = False
 
     # ---- Environment protocol ----
     @property
@@ -135,20 +157,60 @@ class SimulatedWorld:
         self._pressed = PressObservation(
             cloud=cloud, contact=contact, target_xy=target, force_n=force,
             robot_points=self.config.probe.robot_points(tip_center, _UP),
-            force_travel=self.force_travel(target, force, dent))
+            force_travel=self.force_travel(target, force, dent),
+            released=self._released_cloud(target, force) if self.config.unload else None)
         return self._pressed
 
     def release(self) -> None:
-        """Lift the probe; the foam springs back (no physics of the world has memory)."""
+        """Lift the probe; the foam springs back (an elastic block at once; a viscoelastic one
+        over time, :meth:`released_displacement`, and is at rest again by the next press)."""
+        p = self._pressed
+        self._left = None if p is None else self._material_press(p.target_xy, p.force_n)
+        self._released = p is not None or self._released
         self._pressed = None
         self._displacement = self.foam.zero_displacement()
 
-    # ---- physics and ground truth ----
-    @property
-    def regions(self) -> tuple[Block, ...]:
-        """The blocks, in label order (``.name``, ``.hardness``, ``.modulus_pa``, ``.rigid``)."""
-        return self.scenario.blocks
+    def released_displacement(self, after_s: float = 0.0) -> NDArray[np.float64]:
+        """``(n_nodes, 3)`` displacement of the foam ``after_s`` seconds after the tip of the last
+        released press left it: 0 for an elastic block; a viscoelastic one recovers in time
+        (:mod:`deformap.world._viscoelastic`, the tip leaving at the end of the protocol); a
+        plastic one keeps its residual dent (:mod:`deformap.world._plastic`).
 
+        Raises
+        ------
+        EnvironmentStateError
+            No press has been released yet, or the probe is pressing.
+        """
+        after = check_positive("after_s", after_s, allow_zero=True)
+        if self._pressed is not None:
+            raise EnvironmentStateError("the probe is still pressing: call release() first")
+        if not self._released:
+            raise EnvironmentStateError("no press has been released yet: press(), release(), then "
+                                        "ask for the surface after release")
+        return self._left_displacement(self._left, after)
+
+    def _left_displacement(self, left: PressHistory | PlasticPress | None, after_s: float
+                           ) -> NDArray[np.float64]:
+        if isinstance(left, PlasticPress):
+            return left.residual.copy()
+        return self.foam.zero_displacement() if left is None else recovered(left.state, after_s)
+
+    def _released_cloud(self, target: NDArray[np.float64], force: float) -> PointCloud:
+        """The frame the camera takes as the tip leaves at the end of the protocol's unloading
+        (the press's :attr:`PressObservation.released`)."""
+        u = self._left_displacement(self._material_press(target, force), 0.0)
+        key = self._press_key(target, force, 5)
+        return self._capture(u, None, self._event_rng(*key), key)
+
+    def observe_released(self, after_s: float = 0.0) -> PointCloud:
+        """One depth frame ``after_s`` seconds after the tip of the last released press left
+        (:meth:`released_displacement`), world frame, noise from a stream keyed by the time."""
+        u = self.released_displacement(after_s)
+        key = (4, round(after_s * 1e6), self._n_observed)
+        self._n_observed += 1
+        return self._capture(u, None, self._event_rng(*key), key)
+
+    # ---- physics and ground truth ----
     @property
     def n_dofs(self) -> int:
         return self.foam.n_dofs
@@ -167,8 +229,12 @@ class SimulatedWorld:
         """
         target = check_vector("target_xy", target_xy, 2, what="metres")
         force = check_positive("force_n", force_n)
-        self.foam.forget()  # a press is solved the same whatever was pressed before
-        dent = self.foam.dent(target, force, tip_radius_m=self.config.tip_radius_m)
+        history = self._material_press(target, force)
+        if history is not None:
+            dent = history.held
+        else:
+            self.foam.forget()  # a press is solved the same whatever was pressed before
+            dent = self.foam.dent(target, force, tip_radius_m=self.config.tip_radius_m)
         label = int(self.scenario.labels(target[:1], target[1:])[0, 0])
         if label >= 0 and dent.depth_m >= self.scenario.blocks[label].thickness_m:
             block = self.scenario.blocks[label]
@@ -196,19 +262,68 @@ class SimulatedWorld:
         final = dent if dent is not None else self.dent(target, force)
         levels = force_levels(c.contact_threshold_n, force, c.force_travel_levels,
                               c.force_travel_spacing)
-        depths = self._level_depths(target, levels, final)
+        schedule = press_schedule(levels, rate_n_per_s=c.ramp_rate_n_per_s, hold_s=c.hold_s,
+                                  unload=c.unload)
+        history = self._material_press(target, force)
+        depths = history.ramp if history is not None else self._level_depths(target, levels,
+                                                                               final)
         on = 1.0 if c.noise else 0.0
+        noise = dict(encoder_noise_m=c.encoder_noise_m * on,
+                     force_noise_rel=c.force_travel_noise_rel * on,
+                     force_noise_n=c.force_travel_noise_n * on)
+        key = self._press_key(target, force, 2)
         try:
-            return simulated_force_travel(
-                depths, levels, self._event_rng(*self._press_key(target, force, 2)),
-                encoder_noise_m=c.encoder_noise_m * on,
-                force_noise_rel=c.force_travel_noise_rel * on,
-                force_noise_n=c.force_travel_noise_n * on)
+            record = simulated_force_travel(depths, levels, self._event_rng(*key), **noise)
+            if not schedule.has_phases:
+                return record
+            hold, unloading = elastic_phases(schedule, depths)
+            if isinstance(history, PressHistory):
+                hold, unloading = history.hold, history.unloading
+            elif history is not None:
+                unloading = history.unloading
+            # the encoder's reading at first contact: the ramp stream's first draw
+            zero = depths[0] + self._event_rng(*key).normal(0.0, 1.0, size=depths.size)[0] * (
+                noise["encoder_noise_m"])
+            return with_phases(record, schedule, zero, hold, unloading,
+                               self._event_rng(*self._press_key(target, force, 4)), **noise)
         except InvalidArgumentError as err:
             log.warning("no force–travel record for the press at %s with %g N: the solved "
                         "indentations %s mm are not a press's (%s)", tuple(np.round(target, 4)),
                         force, np.round(depths * 1e3, 2).tolist(), err)
             return None
+
+    def _material_press(self, target: NDArray[np.float64], force: float
+                        ) -> PressHistory | PlasticPress | None:
+        """The press solved through its load history on a viscoelastic or plastic block (None on
+        any other ground), its samples on the protocol's schedule; the last one is kept."""
+        index = self.foam.block_at(target)
+        block = None if index is None else self.scenario.blocks[index]
+        if block is None or (block.viscoelastic is None and block.plastic is None):
+            return None
+        key = (float(target[0]), float(target[1]), force)
+        if self._history is not None and self._history[0] == key:
+            return self._history[1]
+        c = self.config
+        levels = force_levels(c.contact_threshold_n, force, c.force_travel_levels,
+                              c.force_travel_spacing)
+        plan = press_schedule(levels, rate_n_per_s=c.ramp_rate_n_per_s, hold_s=c.hold_s,
+                              unload=c.unload)
+        assert isinstance(self.foam, FoamModel) and index is not None
+        history: PressHistory | PlasticPress
+        if block.plastic is not None:
+            history = plastic_press(self.foam, index, block.plastic, target, levels=levels,
+                                    unload_forces=plan.unload_forces,
+                                    tip_radius_m=c.tip_radius_m)
+        else:
+            assert block.viscoelastic is not None
+            history = press_history(
+                self.foam, block.viscoelastic, target,
+                times=np.concatenate([plan.times, plan.hold_times, plan.unload_times]),
+                forces=np.concatenate([levels, np.full(plan.hold_times.size, force),
+                                       plan.unload_forces]),
+                n_ramp=levels.size, n_hold=plan.hold_times.size, tip_radius_m=c.tip_radius_m)
+        self._history = (key, history)
+        return history
 
     def _level_depths(self, target: NDArray[np.float64], levels: NDArray[np.float64],
                       final: Dent) -> NDArray[np.float64]:
@@ -223,31 +338,6 @@ class SimulatedWorld:
                                    initial_radius_m=start, max_radius_m=patch.contact_radius_m)
             depths[k] = patch.depth_m
         return depths
-
-    def ground_truth_labels(self, xs: Any, ys: Any) -> NDArray[np.int64]:
-        """``(ny, nx)`` block index at ``(xs[j], ys[i])``; ``-1`` on the bare table."""
-        return self.scenario.labels(xs, ys)
-
-    def ground_truth_hardness(self, xs: Any, ys: Any) -> NDArray[np.float64]:
-        """``(ny, nx)`` hardness in N; ``inf`` on rigid blocks and the bare table."""
-        return self.scenario.per_block(xs, ys, [b.hardness for b in self.regions])
-
-    def ground_truth_modulus(self, xs: Any, ys: Any) -> NDArray[np.float64]:
-        """``(ny, nx)`` Young's modulus in Pa; ``inf`` on rigid blocks and the bare table."""
-        return self.scenario.per_block(xs, ys, [b.modulus_pa for b in self.regions])
-
-    def surface_height(self, xs: Any, ys: Any, displacement: Any = None) -> NDArray[np.float64]:
-        """``(ny, nx)`` height of the top surface in metres, deformed vertically by
-        ``displacement`` (``Dent.displacement``, ``(n_nodes, 3)``; None: the rest shape)."""
-        labels = self.ground_truth_labels(xs, ys)
-        thickness = np.array([b.thickness_m for b in self.regions] + [0.0])
-        height = thickness[labels]  # label -1 picks the table's 0
-        if displacement is not None:
-            u = check_array("displacement", displacement, (self.foam.n_nodes, 3), what="metres")
-            gx, gy = np.meshgrid(np.asarray(xs, float), np.asarray(ys, float))
-            uz = self.foam.top_displacement(np.column_stack([gx.ravel(), gy.ravel()]), u)[:, 2]
-            height = height + uz.reshape(height.shape) * (labels >= 0)
-        return np.asarray(height)
 
     # ---- internals ----
     def _tip_center(self, target: NDArray[np.float64], dent: Dent) -> NDArray[np.float64]:

@@ -16,6 +16,7 @@ from deformap.cloud.io._bag import (
     bag_writer,
     read_bag_clouds,
     read_bag_static_transform,
+    read_bag_transforms,
     read_bag_wrenches,
     wrench_message,
     write_bag,
@@ -25,6 +26,7 @@ from deformap.cloud.io._bag_reader import (
     RawBagMessage,
     bag_error_text,
     bag_read_errors,
+    bag_topics,
     header_message,
     header_stamp_ns,
     iter_bag_messages,
@@ -47,10 +49,10 @@ from deformap.cloud.io._tf import TransformTree
 
 __all__ = ["BAG_STORAGES", "CLOUD_FORMATS", "MAX_NPZ_BYTES", "MM_EXTENT_THRESHOLD", "PCD_ENCODINGS",
            "PLY_FORMATS", "UNITS", "RawBagMessage", "StampedCloud", "TransformTree", "WrenchSeries",
-           "array_to_pointcloud2", "bag_error_text", "bag_read_errors", "bag_writer",
+           "array_to_pointcloud2", "bag_error_text", "bag_read_errors", "bag_topics", "bag_writer",
            "header_message", "header_stamp_ns", "iter_bag_messages", "load_npz_arrays", "path_kind",
            "pointcloud2_colors", "pointcloud2_structured", "pointcloud2_to_array",
-           "pointcloud2_to_cloud", "read_bag_clouds", "read_bag_static_transform",
+           "pointcloud2_to_cloud", "read_bag_clouds", "read_bag_static_transform", "read_bag_transforms",
            "read_bag_wrenches", "read_cloud", "read_npz", "read_pcd", "read_ply", "typestore",
            "wrench_message", "write_bag", "write_cloud", "write_npz", "write_pcd", "write_ply",
            "xyz_with_holes"]

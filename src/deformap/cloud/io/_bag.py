@@ -38,12 +38,14 @@ from deformap.cloud.io._tf import TransformTree
 from deformap.errors import FileFormatError, InvalidArgumentError
 
 __all__ = ["StampedCloud", "WrenchSeries", "bag_writer", "fill_chunk_crcs", "read_bag_clouds",
-           "read_bag_static_transform", "read_bag_wrenches", "wrench_message", "write_bag"]
+           "read_bag_static_transform", "read_bag_transforms", "read_bag_wrenches",
+           "wrench_message", "write_bag"]
 
 CLOUD_TYPE = "sensor_msgs/msg/PointCloud2"
 WRENCH_TYPE = "geometry_msgs/msg/WrenchStamped"
 TF_TYPE = "tf2_msgs/msg/TFMessage"
 TF_STATIC_TOPIC = "/tf_static"
+TF_TOPIC = "/tf"
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -103,6 +105,23 @@ def read_bag_static_transform(
             f"(frames: {tree.frames}); pass cam2world= instead") from None
     out[:3, :3], out[:3, 3] = rot[0], trans[0]
     return out
+
+
+def read_bag_transforms(path: str | Path, *, tolerance_ns: int) -> TransformTree:
+    """A bag's ``/tf_static`` and ``/tf`` (this one may be missing) as one
+    :class:`~deformap.cloud.io.TransformTree`, looked up at header stamps [ns] within
+    ``tolerance_ns`` of a dynamic edge's nearest sample."""
+    p = Path(path)
+    tree = TransformTree(TF_TOPIC, tolerance_ns)
+    store, errors = typestore(), bag_read_errors()
+    for raw in iter_bag_messages(p, {TF_STATIC_TOPIC: TF_TYPE}, optional={TF_TOPIC: TF_TYPE}):
+        try:
+            msg = store.deserialize_cdr(raw.data, TF_TYPE)
+        except errors as exc:
+            raise FileFormatError(
+                f"{p}: could not read topic {raw.topic!r}: {bag_error_text(exc)}") from exc
+        tree.add(msg, static=raw.topic == TF_STATIC_TOPIC, where=f"{p}: {raw.topic}")
+    return tree
 
 
 def read_bag_clouds(path: str | Path, topic: str, *, cam2world: Any = None,

@@ -24,6 +24,7 @@ from deformap.cloud.io._common import path_kind
 from deformap.errors import DeformapError, FileFormatError, InvalidArgumentError, missing_extra
 
 __all__ = ["BAG_STORAGES", "ROS_DISTRO", "RawBagMessage", "bag_error_text", "bag_read_errors",
+           "bag_topics",
            "header_message", "header_stamp_ns", "iter_bag_messages", "typestore"]
 
 
@@ -159,6 +160,34 @@ def iter_bag_messages(path: Any, topics: Mapping[str, str],
         raise
     except errors as exc:
         raise FileFormatError(f"{p}: could not read {what}: {bag_error_text(exc)}") from exc
+
+
+def bag_topics(path: Any) -> dict[str, tuple[str, int]]:
+    """``{topic: (message type, message count)}`` of a ROS 2 bag, from its connections (a topic
+    written with two types is named with both, joined by `` | ``). A missing or unreadable bag is
+    a FileFormatError naming it."""
+    p = check_path("path", path)
+    rosbag2 = _rosbag2()
+    if path_kind(p) == "missing":
+        raise FileFormatError(f"{p}: no such bag")
+    if p.suffix == ".bag" and path_kind(p) == "file":
+        raise FileFormatError(
+            f"{p}: a ROS 1 bag; deformap reads ROS 2 bags only (.mcap, .db3 or a rosbag2 folder): "
+            "convert it with `rosbags-convert --src FILE.bag --dst FOLDER`")
+    out: dict[str, tuple[str, int]] = {}
+    try:
+        with rosbag2.Reader(p) as reader:
+            for conn in reader.connections:
+                kind, count = out.get(conn.topic, ("", 0))
+                kinds = [k for k in kind.split(" | ") if k]
+                if conn.msgtype not in kinds:
+                    kinds.append(str(conn.msgtype))
+                out[conn.topic] = (" | ".join(kinds), count + int(conn.msgcount or 0))
+    except DeformapError:
+        raise
+    except bag_read_errors() as exc:
+        raise FileFormatError(f"{p}: could not read the bag: {bag_error_text(exc)}") from exc
+    return out
 
 
 def _check_row(path: Path, topic: str, number: int, log_time: Any, data: Any) -> None:

@@ -23,7 +23,8 @@ from deformap._validation import check_path
 from deformap.cloud._pointcloud import PointCloud
 from deformap.errors import DeformapError, FileFormatError, InvalidArgumentError
 
-__all__ = ["MM_EXTENT_THRESHOLD", "UNITS", "check_body_size", "check_colors", "check_units",
+__all__ = ["MM_EXTENT_THRESHOLD", "UNITS", "check_body_size", "check_colors", "check_text_rows",
+           "check_units",
            "finish_cloud", "pack_rgb", "parse_errors", "path_kind", "readable_path",
            "unpack_rgb"]
 
@@ -95,6 +96,27 @@ def check_body_size(path: Path, what: str, need: int, body: bytes | memoryview |
         raise FileFormatError(
             f"{path}: {what}: expected {need} bytes, the file holds {have} ({have - need} "
             "more); the header's count is too low or the file is corrupted")
+
+
+def check_text_rows(path: Path, what: str, body: bytes, values: int | None) -> None:
+    """Refuse an ascii body cut short: one that does not end at a line break after its last row
+    (a file cut inside its last number would read as another, shorter number), or whose last row
+    holds other than ``values`` values (``None``: not checked, the last row being another
+    element's). Spaces and tabs after the last line break are allowed; ``what`` names the body.
+    """
+    if not body.rstrip(b" \t").endswith(b"\n"):
+        tail = body.rstrip()[-24:].decode("ascii", "replace")
+        raise FileFormatError(
+            f"{path}: {what} does not end at a line break after its last row (it ends in "
+            f"{tail!r}): the file was cut, perhaps inside its last number")
+    if values is None:
+        return
+    rows = body.rstrip()
+    last = rows[rows.rfind(b"\n") + 1:].split()
+    if len(last) != values:
+        raise FileFormatError(
+            f"{path}: {what}: its last row holds {len(last)} values where the header declares "
+            f"{values}: the file was cut or the row damaged")
 
 
 def path_kind(path: str | Path) -> str:

@@ -27,10 +27,20 @@ def _format_of(path: Path, format: str | None) -> str:
         return format
     suffix = path.suffix.lower().lstrip(".")
     if suffix not in CLOUD_FORMATS:
-        raise FileFormatError(
-            f"{path}: unknown point-cloud suffix {path.suffix!r}; expected one of "
-            f"{['.' + f for f in CLOUD_FORMATS]} (or pass format=)")
+        expected = f"expected one of {['.' + f for f in CLOUD_FORMATS]} (or pass format=)"
+        other = _NOT_CLOUDS.get(suffix)
+        if other is not None:
+            raise FileFormatError(f"{path}: {other}, not a point cloud; {expected}")
+        raise FileFormatError(f"{path}: unknown point-cloud suffix {path.suffix!r}; {expected}")
     return suffix
+
+
+#: Files deformap reads that are no point cloud, by suffix: what each is, for the message.
+_NOT_CLOUDS = {"yaml": "a YAML file (a session, run or scenario file?)",
+               "yml": "a YAML file (a session, run or scenario file?)",
+               "mcap": "a ROS 2 bag (MCAP; `deformap map` reads it)",
+               "db3": "a ROS 2 bag (sqlite3; `deformap map` reads it)",
+               "json": "a JSON file (a report?)", "jsonl": "a journal (JSON lines)"}
 
 
 def read_cloud(path: str | Path, *, units: str = "m", drop_nan: bool = False,

@@ -12,6 +12,7 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import NDArray
 
+from deformap._files import atomic_path
 from deformap._validation import check_int
 from deformap.cloud._pointcloud import PointCloud
 from deformap.cloud.io._common import (
@@ -135,11 +136,12 @@ def read_npz(path: str | Path, *, units: str = "m", drop_nan: bool = False,
 def write_npz(path: str | Path, cloud: PointCloud, *, compressed: bool = True,
               extra_fields: dict[str, Any] | None = None) -> None:
     """Write ``points``, ``colors`` (when the cloud has them) and ``extra_fields`` (per-point
-    arrays) to an NPZ archive at exactly ``path``, zip-deflated when ``compressed``."""
+    arrays) to an NPZ archive at exactly ``path``, zip-deflated when ``compressed``; atomically
+    (:func:`deformap._files.atomic_path`)."""
     cloud, extras = _check_cloud_and_extras(cloud, extra_fields)
     arrays: dict[str, NDArray[Any]] = {"points": np.asarray(cloud.points), **extras}
     if cloud.colors is not None:
         arrays["colors"] = np.asarray(cloud.colors)
     save = np.savez_compressed if compressed else np.savez
-    with open(path, "wb") as fh:
+    with atomic_path(path) as tmp, open(tmp, "xb") as fh:
         save(fh, **arrays)  # type: ignore[arg-type]  # numpy's stub types **kwds as allow_pickle

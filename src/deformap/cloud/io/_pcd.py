@@ -20,10 +20,12 @@ from typing import Any, cast
 import numpy as np
 from numpy.typing import NDArray
 
+from deformap._files import atomic_path
 from deformap._validation import check_instance
 from deformap.cloud._pointcloud import PointCloud
 from deformap.cloud.io._common import (
     check_body_size,
+    check_text_rows,
     check_units,
     finish_cloud,
     pack_rgb,
@@ -80,6 +82,7 @@ def _check_header_against_body(path: Path, meta: Any, body: bytes) -> None:
         # Each value takes at least one character and one separator.
         check_body_size(path, f"ascii body of POINTS {meta.points} × {values} values",
                         meta.points * values, body, exact=False, text=True)  # fmt: skip
+        check_text_rows(path, "the ascii body", body, values)
         return
     if encoding == "binary":
         check_body_size(path, what, need, body)
@@ -189,7 +192,8 @@ def write_pcd(path: str | Path, cloud: PointCloud, *, encoding: str = "binary",
     Colours go into a packed ``rgb`` field: float bits in binary files (PCL's convention), an
     unsigned integer in ascii. ``dtype`` (``"float64"`` or ``"float32"``) stores x, y, z; float64
     by default as it round-trips exactly in binary files. ``extra_fields`` are more per-point
-    fields, 1-D numeric arrays of the cloud's length.
+    fields, 1-D numeric arrays of the cloud's length. Written atomically
+    (:func:`deformap._files.atomic_path`).
     """
     from pypcd4 import Encoding
     from pypcd4 import PointCloud as PcdCloud
@@ -207,7 +211,8 @@ def write_pcd(path: str | Path, cloud: PointCloud, *, encoding: str = "binary",
     fields.update(extras)  # their names are none of the above (_check_cloud_and_extras)
     columns = list(fields.values())
     pc = PcdCloud.from_points(columns, tuple(fields), tuple(c.dtype for c in columns))
-    pc.save(Path(path), encoding=Encoding(encoding))
+    with atomic_path(path) as tmp, open(tmp, "xb") as fh:
+        pc.save(fh, encoding=Encoding(encoding))
 
 
 def _check_cloud_and_extras(cloud: Any, extra_fields: dict[str, Any] | None

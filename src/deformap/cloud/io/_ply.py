@@ -20,9 +20,11 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from deformap._files import atomic_path
 from deformap.cloud._pointcloud import PointCloud
 from deformap.cloud.io._common import (
     check_body_size,
+    check_text_rows,
     check_units,
     finish_cloud,
     parse_errors,
@@ -117,6 +119,12 @@ def _read_vertices(path: Path, data: bytes) -> NDArray[Any]:
                 f"{path}: PLY header says {vertex.count} vertices, the file holds {len(rows)}")
         if vertex.count == 0:
             return np.empty(0, dtype=dtype)
+        check_text_rows(path, "the ascii body", data[body_start:], None)
+        width, last = len(dtype.names or ()), len(rows[-1].split())
+        if last != width:  # a row short inside the body numpy refuses itself
+            raise FileFormatError(
+                f"{path}: PLY vertex {vertex.count - 1} (the last) holds {last} values where the "
+                f"header declares {width} properties: the file was cut or the row damaged")
         table = np.loadtxt(io.StringIO("\n".join(rows)), dtype=np.float64, ndmin=2, comments=None)
         if table.shape[1] != len(dtype.names or ()):
             raise FileFormatError(
@@ -222,7 +230,8 @@ def write_ply(path: str | Path, cloud: PointCloud, *, format: str = "binary_litt
               extra_fields: dict[str, Any] | None = None) -> None:
     """Write a cloud as the ``vertex`` element of a PLY file of ``format`` in ``PLY_FORMATS``:
     x, y, z as ``double`` (exact round trip), colours as ``uchar``, ``extra_fields`` as more
-    properties (8- to 32-bit integers, float32 or float64)."""
+    properties (8- to 32-bit integers, float32 or float64). Written atomically
+    (:func:`deformap._files.atomic_path`)."""
     if format not in PLY_FORMATS:
         raise InvalidArgumentError(f"`format` must be one of {PLY_FORMATS}; got {format!r}")
     cloud, extras = _check_cloud_and_extras(cloud, extra_fields)
@@ -246,7 +255,7 @@ def write_ply(path: str | Path, cloud: PointCloud, *, format: str = "binary_litt
               f"element vertex {len(cloud)}"]  # fmt: skip
     header += [f"property {_NUMPY_TO_PLY[values.dtype.str[1:]]} {name}" for name, values in fields]
     header.append("end_header")
-    with open(path, "wb") as fh:
+    with atomic_path(path) as tmp, open(tmp, "xb") as fh:
         fh.write(("\n".join(header) + "\n").encode("ascii"))
         if format == "ascii":
             fmts = ["%.17g" if v.dtype.kind == "f" else "%d" for _, v in fields]

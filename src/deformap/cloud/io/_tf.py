@@ -82,6 +82,28 @@ class TransformTree:
         """Every frame named, child or parent."""
         return sorted(set(self._edges) | {e.parent for e in self._edges.values()})
 
+    def rigid_group(self, frame: str) -> list[str]:
+        """The frames joined to ``frame`` by static transforms only (``frame`` included): the
+        parts of one rigid body, in name order."""
+        group, todo = {frame}, [frame]
+        while todo:
+            f = todo.pop()
+            near = [e.parent for c, e in self._edges.items() if c == f and e.static]
+            near += [c for c, e in self._edges.items() if e.parent == f and e.static]
+            for g in near:
+                if g not in group:
+                    group.add(g)
+                    todo.append(g)
+        return sorted(group)
+
+    def moves(self, frame: str) -> bool:
+        """Whether a dynamic transform lies between ``frame`` and its root."""
+        return any(not self._edges[c].static for c in self._chain(frame)[:-1])
+
+    def root(self, frame: str) -> str:
+        """The topmost ancestor of ``frame``."""
+        return self._chain(frame)[-1]
+
     def _chain(self, frame: str) -> list[str]:
         """``frame`` and its ancestors up to the root."""
         chain = [frame]

@@ -1,0 +1,276 @@
+"""What one press reveals beyond its stiffness: relaxation, hysteresis, a kept dent, and a class.
+
+From a :class:`~deformap.environment.ForceTravel` (and, optionally, the depth of the dent the
+camera sees after release), :func:`press_behaviour` returns each quantity with a standard error
+and a behaviour class, every threshold a multiple of the record's own noise or a stated physical
+floor. A quantity the record cannot give is ``None``; the class is then ``"unknown"`` with the
+reason, never ``"elastic"`` by default.
+
+Noise: the force's and the travel's sample noise ``σ_F``, ``σ_t`` are estimated from the record
+itself, ``1.4826 · MAD(Δ²x) / √6`` of the second differences within each stretch (ramp, hold,
+unloading) pooled, which a smooth trend barely touches.
+
+Hold: the held quantity is the one that moves less in units of its noise (first and last fifth of
+the hold compared); the other one is fitted, least squares, with ``y(t) = y∞ + A e^{−(t−t₀)/τ}``
+(``t₀`` the hold's first sample, ``log τ`` the parameter). Force moving (position held): the
+relaxation fraction is ``1 − F(t_end)/F(t₀)``; travel moving (force held): the creep fraction
+``1 − t(t₀)/t(t_end)``, both from the fitted curve, their σ by the delta method on the fit's
+covariance ``s² (JᵀJ)⁻¹``; ``τ`` and its σ from the same covariance. A hold of fewer than
+:data:`MIN_FIT_SAMPLES` samples, or one whose fit does not converge, gives the fraction from the
+means of its first and last fifth and no ``τ``.
+
+Loss ratio: the path ramp → hold → unloading, ``L = ∮ F dδ`` (trapezoids; the return from the
+unloading's last travel to zero at zero force adds nothing) over the work put in before
+unloading, ``W = ∫ F dδ`` along ramp and hold. Its σ by linear propagation of ``σ_F``, ``σ_t``
+through both trapezoid sums.
+
+Residual dent: the unloading's travel at zero force. Where the branch reaches zero force (within
+``3 σ_F``), the travel of its first sample there, where the tip loses the surface (later samples
+follow the retracting tip, not the surface), σ = ``σ_t``: no contact law enters. Where it stops
+above zero, extrapolated: on the samples with force between
+``3 σ_F`` and half the branch's largest, the Hertz law ``F ∝ (δ − δ_r)^{3/2}`` is a straight line
+``δ = δ_r + c F^{2/3}``, whose intercept (least squares) is the travel at zero force, σ the
+intercept's with the residual scatter (at least ``σ_t``); a layer stiffening with depth bends that
+line, so the extrapolation is the rougher reading. The camera's dent
+(:func:`released_dent`) is the median height of the surface 3–5 tip radii from the press point
+less the median within one tip radius, σ from both medians' standard errors.
+
+Class: a quantity *shows* a behaviour when it exceeds :data:`N_SIGMA` of its σ and its physical
+floor; it *rules it out* when it lies below the floor by two of its σ. Viscoelastic: the hold
+relaxes or creeps; or, with no hold, the loop has loss but no dent remains. Plastic: a dent
+remains (record or camera) while a hold shows no relaxation; or a loss with a hold that shows
+none. No dent remains when neither dent reading shows one and the sharper of them rules it out.
+Elastic: every quantity the record holds rules its behaviour out, and the record holds an
+unloading branch or a hold with a camera dent. Anything else is ``"unknown"`` with the reason.
+Anisotropy and the instantaneous against the relaxed modulus are not estimated here.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+from typing import Any, Literal
+
+import numpy as np
+from numpy.typing import NDArray
+
+from deformap._validation import check_points
+from deformap.errors import InvalidArgumentError
+from deformap.stiffness._phases import (
+    MAD_TO_SIGMA,
+    MIN_FIT_SAMPLES,
+    N_SIGMA,
+    Measure,
+    PressRecord,
+    hold_fraction,
+    loop_loss,
+    noise,
+    zero_force_travel,
+)
+
+__all__ = ["BEHAVIOURS", "DENT_FLOOR_M", "LOSS_FLOOR", "MIN_FIT_SAMPLES", "N_SIGMA",
+           "RELAXATION_FLOOR", "Behaviour", "PressBehaviour", "PressRecord", "press_behaviour",
+           "released_dent"]
+
+Behaviour = Literal["elastic", "viscoelastic", "plastic", "unknown"]
+BEHAVIOURS: tuple[str, ...] = ("elastic", "viscoelastic", "plastic", "unknown")
+
+#: Smallest relaxation (or creep) fraction taken as the material's: a strain-gauge force sensor
+#: and an arm's position loop drift by up to about 1–2 % of the load over a hold.
+RELAXATION_FLOOR = 0.02
+#: Smallest loss ratio taken as the material's: tip friction and the sensor's own hysteresis
+#: (a few per cent of the load) close no loop of an ideal elastic press.
+LOSS_FLOOR = 0.05
+#: Smallest kept dent [m] taken as the material's: a tenth of a millimetre, about what the tip's
+#: contact settles by as the force reaches zero and below what a depth camera resolves at arm's
+#: length.
+DENT_FLOOR_M = 1e-4
+
+
+@dataclass(frozen=True, kw_only=True)
+class PressBehaviour:
+    """What one press reveals, each quantity with its standard error (``None`` where the record
+    cannot give it).
+
+    ``relaxation`` is the hold's fraction (``relaxation_mode`` ``"force"``: ``1 − F_end/F_start``
+    with the position held; ``"travel"``: creep ``1 − t_start/t_end`` with the force held), ``tau_s``
+    its time constant [s]; ``loss_ratio`` the hysteresis energy over the loading energy;
+    ``residual_dent_m`` the unloading's travel at zero force [m]; ``released_dent_m`` the dent the
+    camera sees after release [m]. ``behaviour`` is the class and ``evidence`` the tests that gave
+    it, or why it is ``"unknown"``.
+    """
+
+    behaviour: Behaviour
+    evidence: str
+    relaxation: float | None = None
+    relaxation_sigma: float | None = None
+    relaxation_mode: Literal["force", "travel"] | None = None
+    tau_s: float | None = None
+    tau_sigma_s: float | None = None
+    loss_ratio: float | None = None
+    loss_ratio_sigma: float | None = None
+    residual_dent_m: float | None = None
+    residual_dent_sigma_m: float | None = None
+    released_dent_m: float | None = None
+    released_dent_sigma_m: float | None = None
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain data (JSON): every field, ``None`` for what the record could not give."""
+        return asdict(self)
+
+
+
+def released_dent(points: Any, tip_center: Any, tip_radius_m: float
+                  ) -> tuple[float, float] | str:
+    """The dent [m] and its σ that the surface seen after release, ``points`` ``(n, 3)`` (world
+    frame, z up), keeps at the press point (module docstring), or why it cannot be had (too few
+    points near the press)."""
+    center = np.asarray(tip_center, dtype=np.float64)
+    if not (center.shape == (3,) and np.all(np.isfinite(center))):
+        raise InvalidArgumentError(f"`tip_center` must be 3 finite numbers; got {tip_center!r}")
+    if not (math.isfinite(tip_radius_m) and tip_radius_m > 0.0):
+        raise InvalidArgumentError(f"`tip_radius_m` must be positive; got {tip_radius_m!r}")
+    pts = check_points("points", points, min_rows=0)
+    r = np.linalg.norm(pts[:, :2] - center[:2], axis=1)
+    inner = pts[r <= tip_radius_m, 2]
+    ring = pts[(r >= 3.0 * tip_radius_m) & (r <= 5.0 * tip_radius_m), 2]
+    if inner.size < 5 or ring.size < 5:
+        return (f"the surface after release has {inner.size} points within one tip radius of "
+                f"the press and {ring.size} 3–5 radii away; needs 5 of each")
+
+    def median_se(z: NDArray[np.float64]) -> float:
+        return float(1.2533 * MAD_TO_SIGMA * np.median(np.abs(z - np.median(z))) / math.sqrt(z.size))
+
+    dent = float(np.median(ring) - np.median(inner))
+    return dent, math.hypot(median_se(inner), median_se(ring))
+
+
+def press_behaviour(record: PressRecord | None, *,
+                    released: tuple[float, float] | None = None) -> PressBehaviour:
+    """The press's relaxation, loss, residual dent and class (module docstring).
+
+    ``released`` is the camera's dent after release and its σ [m] (:func:`released_dent`), when
+    one was seen. A record with no hold, no unloading and no camera dent is ``"unknown"``.
+    """
+    if record is not None:
+        _check_record(record)
+    cam: Measure | None = None
+    if released is not None:
+        value, sigma = (float(v) for v in released)
+        if not (math.isfinite(value) and math.isfinite(sigma) and sigma >= 0.0):
+            raise InvalidArgumentError(
+                f"`released` must be a finite dent and a σ >= 0 [m]; got {released!r}")
+        cam = Measure(value, sigma)
+    if record is None:
+        if cam is None:
+            return PressBehaviour(behaviour="unknown", evidence="no force–travel record")
+        return _classify(None, None, None, None, None, cam, notes=["no force–travel record"])
+    hold, unloading = record.hold, record.unloading
+    if hold is None and unloading is None and cam is None:
+        return PressBehaviour(behaviour="unknown", evidence="no hold or unloading recorded")
+    force_parts = [np.asarray(record.force_n)]
+    travel_parts = [np.asarray(record.travel_m)]
+    for phase in (hold, unloading):
+        if phase is not None:
+            force_parts.append(np.asarray(phase.force_n))
+            travel_parts.append(np.asarray(phase.travel_m))
+    sigma_f, sigma_t = noise(force_parts), noise(travel_parts)
+    notes: list[str] = []
+    relax = tau = None
+    mode: str | None = None
+    if hold is not None:
+        relax, tau, mode, note = hold_fraction(hold, sigma_f, sigma_t)
+        if note:
+            notes.append(note)
+    loss = dent = None
+    if unloading is not None:
+        got = loop_loss(record, sigma_f, sigma_t)
+        if isinstance(got, str):
+            notes.append(got)
+        else:
+            loss = got
+        res = zero_force_travel(unloading, sigma_f, sigma_t)
+        if isinstance(res, str):
+            notes.append(res)
+        else:
+            dent = res
+    return _classify(relax, tau, mode, loss, dent, cam, notes=notes,
+                     has_hold=hold is not None, has_unloading=unloading is not None)
+
+
+def _classify(relax: Measure | None, tau: Measure | None, mode: str | None,
+              loss: Measure | None, dent: Measure | None, cam: Measure | None, *,
+              notes: list[str], has_hold: bool = False, has_unloading: bool = False
+              ) -> PressBehaviour:
+    said: list[str] = []
+    if relax is not None:
+        said.append(relax.text("creep" if mode == "travel" else "relaxation"))
+    if loss is not None:
+        said.append(loss.text("loss ratio"))
+    if dent is not None:
+        said.append(dent.text("dent at zero force", 1e3, " mm"))
+    if cam is not None:
+        said.append(cam.text("dent after release", 1e3, " mm"))
+    relaxes = relax is not None and relax.shows(RELAXATION_FLOOR)
+    still = relax is not None and relax.rules_out(RELAXATION_FLOOR)
+    lossy = loss is not None and loss.shows(LOSS_FLOOR)
+    lossless = loss is not None and loss.rules_out(LOSS_FLOOR)
+    dents = [m for m in (dent, cam) if m is not None]
+    kept = any(m.shows(DENT_FLOOR_M) for m in dents)
+    # no dent: none shows one, and the sharpest reading rules it out (a camera too coarse to
+    # rule out a tenth of a millimetre does not veto the record's travel at zero force)
+    no_dent = bool(dents) and not kept and min(dents, key=lambda m: m.sigma).rules_out(
+        DENT_FLOOR_M)
+    behaviour: Behaviour
+    why: str
+    if relaxes:
+        behaviour, why = "viscoelastic", "the hold relaxes"
+    elif kept and still:
+        behaviour, why = "plastic", "a dent remains and the hold shows no relaxation"
+    elif lossy and still:
+        behaviour, why = "plastic", "the loop loses energy and the hold shows no relaxation"
+    elif lossy and no_dent and not has_hold:
+        behaviour, why = "viscoelastic", "the loop loses energy and no dent remains"
+    elif kept and not has_hold:
+        behaviour, why = "unknown", "a dent remains, but with no hold creep cannot be told from yield"
+    elif (still or not has_hold) and no_dent and (lossless or not has_unloading) and \
+            (has_unloading or has_hold):
+        behaviour, why = "elastic", (f"relaxation, loss and dent all below their floors "
+                                     f"({RELAXATION_FLOOR:g}, {LOSS_FLOOR:g}, "
+                                     f"{DENT_FLOOR_M * 1e3:g} mm) by 2 σ")
+    else:
+        behaviour, why = "unknown", "the record neither shows nor rules out each behaviour"
+        if not said:
+            why = "the record gives no relaxation, loss or dent"
+    evidence = "; ".join([why, *said, *notes])
+    return PressBehaviour(
+        behaviour=behaviour, evidence=evidence,
+        relaxation=None if relax is None else float(relax.value),
+        relaxation_sigma=None if relax is None else float(relax.sigma),
+        relaxation_mode=None if relax is None else ("travel" if mode == "travel" else "force"),
+        tau_s=None if tau is None else float(tau.value),
+        tau_sigma_s=None if tau is None else float(tau.sigma),
+        loss_ratio=None if loss is None else float(loss.value),
+        loss_ratio_sigma=None if loss is None else float(loss.sigma),
+        residual_dent_m=None if dent is None else float(dent.value),
+        residual_dent_sigma_m=None if dent is None else float(dent.sigma),
+        released_dent_m=None if cam is None else float(cam.value),
+        released_dent_sigma_m=None if cam is None else float(cam.sigma))
+
+
+
+def _check_record(record: Any) -> None:
+    """A record must have a ForceTravel's parts, each finite (a ForceTravel checks the rest)."""
+    names = ("travel_m", "force_n", "time_s", "hold", "unloading")
+    if not all(hasattr(record, n) for n in names):
+        raise InvalidArgumentError(
+            f"`record` must be a ForceTravel or None; got {type(record).__name__}")
+    parts = [("", record)] + [(f"{n}.", getattr(record, n)) for n in ("hold", "unloading")]
+    for prefix, part in parts:
+        if part is None:
+            continue
+        for name in ("time_s", "travel_m", "force_n"):
+            values = getattr(part, name, None)
+            if values is not None and not np.all(np.isfinite(np.asarray(values, dtype=float))):
+                raise InvalidArgumentError(
+                    f"`record.{prefix}{name}` holds NaN or infinite values")

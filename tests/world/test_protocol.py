@@ -1,0 +1,51 @@
+"""The probe's protocol in the world's config: sample times, a force hold and an unloading branch."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from deformap._validation import SettingError
+from deformap.world import SimulatedWorld, WorldConfig, load_scenario
+
+XY, FORCE = (0.3, 0.2), 2.0
+
+
+def _record(**protocol: object):  # type: ignore[no-untyped-def]
+    world = SimulatedWorld(load_scenario("homogeneous-60"),
+                           config=WorldConfig.coarse(**protocol), rng=np.random.default_rng(3))
+    record = world.press(XY, FORCE).force_travel
+    world.release()
+    assert record is not None
+    return record
+
+
+def test_default_protocol_records_the_ramp_alone_and_the_phases_leave_it_unchanged() -> None:
+    plain = _record()
+    assert plain.time_s is None and plain.hold is None and plain.unloading is None
+    full = _record(hold_s=4.0, unload=True, ramp_rate_n_per_s=4.0)
+    np.testing.assert_array_equal(full.travel_m, plain.travel_m)
+    np.testing.assert_array_equal(full.force_n, plain.force_n)
+    # load-controlled at 4 N/s: the ramp takes (F − F_contact) / rate
+    assert full.time_s is not None and full.hold is not None and full.unloading is not None
+    assert full.time_s[-1] == pytest.approx((FORCE - 0.02) / 4.0)
+    assert full.hold.time_s[-1] == pytest.approx(full.time_s[-1] + 4.0)
+    assert full.unloading.time_s[-1] == pytest.approx(full.hold.time_s[-1] + (FORCE - 0.02) / 4.0)
+
+
+def test_elastic_block_holds_flat_and_unloads_along_the_ramp() -> None:
+    exact = _record(hold_s=2.0, unload=True, noise=False)
+    assert exact.hold is not None and exact.unloading is not None
+    np.testing.assert_array_equal(exact.hold.travel_m, exact.travel_m[-1])
+    np.testing.assert_array_equal(exact.hold.force_n, FORCE)
+    np.testing.assert_array_equal(exact.unloading.force_n, exact.force_n[-2::-1])
+    np.testing.assert_allclose(exact.unloading.travel_m, exact.travel_m[-2::-1], atol=1e-12)
+    only_hold = _record(hold_s=2.0, noise=False)
+    assert only_hold.hold is not None and only_hold.unloading is None
+
+
+@pytest.mark.parametrize(("field", "value"), [("hold_s", -1.0), ("ramp_rate_n_per_s", 0.0),
+                                              ("hold_s", float("nan"))])
+def test_bad_protocol_names_the_setting(field: str, value: float) -> None:
+    with pytest.raises(SettingError, match=field):
+        WorldConfig(**{field: value})
