@@ -37,7 +37,8 @@ from scipy import ndimage as ndi
 from deformap.explore._appearance import AppearanceImage
 from deformap.gp import cholesky_with_jitter, squared_exponential
 
-__all__ = ["BLIND_PRIOR", "LOOK_SCALES", "WEIGHTS", "AppearanceModels", "AppearancePrior", "WeightPosterior"]
+__all__ = ["BLIND_PRIOR", "LOOK_SCALES", "WEIGHTS", "AppearanceModels", "AppearancePrior",
+           "WeightPosterior"]
 
 Array = NDArray[np.float64]
 

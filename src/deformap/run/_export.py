@@ -5,6 +5,10 @@
 ``beta_mean``, ``beta_std``; the modulus field's ``modulus_median_pa`` (exp of the mean of ln E),
 ``log_modulus_mean``, ``log_modulus_std`` (NaN when no poke gave a modulus); ``region_labels``
 (label ``k`` is region ``R(k+1)``, -1 without a region map) and the ``field`` they were cut from.
+The appearance prior's input: ``appearance_lab (ny, nx, 3)``, each cell's mean colour in CIELAB
+(L* 0–100, a*, b*; NaN where no colour was seen or the prior was not used) and
+``appearance_segments (ny, nx)`` int, each cell's segment ``0 ..`` (``-1`` where masked or the
+prior was not used).
 
 ``pokes.csv``: the columns :data:`POKES_CSV_COLUMNS`, ``poke`` numbered from 1 (``report.json``'s
 ``index`` + 1), the contact where the tip touched, ``tip_center_z_m`` at the commanded force, the
@@ -59,6 +63,13 @@ def _write_map_npz(path: Path, result: ExplorationResult) -> None:
                           else np.full(shape, -1, dtype=np.int64)),
         "field": np.array(result.map_field_name),
     }  # fmt: skip
+    # the appearance prior's image and segments (NaN / -1 everywhere without one)
+    image = result.appearance.image
+    arrays["appearance_lab"] = (np.full((*shape, 3), np.nan) if image is None
+                                else np.asarray(image.lab, dtype=float))  # fmt: skip
+    arrays["appearance_segments"] = (np.full(shape, -1, dtype=np.int64) if image is None
+                                     else np.asarray(image.segments, dtype=np.int64))  # fmt: skip
+    arrays["units"] = np.array(f"{arrays['units']}; appearance_lab: CIELAB")
     with atomic_path(path) as tmp, open(tmp, "wb") as fh:
         np.savez_compressed(fh, **arrays)
 
