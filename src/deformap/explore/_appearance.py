@@ -9,7 +9,9 @@ Built once from the cloud before the first poke (:func:`build_appearance`):
 3. A Felzenszwalb & Huttenlocher (2004) over-segmentation of the channels, each divided by its
    robust noise. Segments are candidate regions the prior (:mod:`._appearance_prior`) weighs by
    the pokes; those smaller than a dent's footprint are merged or masked, and one too thin for a
-   dent (no cell half a footprint from its edge) is merged into its most alike neighbour.
+   dent (no cell half a footprint from its edge) is merged into its most alike neighbour; a
+   masked cell counts there as its nearest seen cell's segment, so the rows a camera leaves
+   unseen are no edges and a strip of mixed colour along a boundary is no look of its own.
 4. Each segment's feature: its cells' mean channels, standardised per group (colour, texture,
    height) by the spread of the segment means, never below the group's noise nor, for colour
    and texture, the just-noticeable difference, so a flat channel is not inflated.
@@ -111,11 +113,12 @@ def _cell_colours(cloud: PointCloud, xs: NDArray[np.float64], ys: NDArray[np.flo
 
 
 def _noise(channel: NDArray[np.float64], mask: NDArray[np.bool_]) -> float:
-    """Robust noise std of a channel smoothed as the segmentation sees it: the MAD of
-    horizontally neighbouring seen cells' differences, over √2."""
+    """Robust std of a channel's cell-to-cell scatter (the camera's noise and the finest
+    texture): the MAD of horizontally neighbouring seen cells' differences, over √2, on the
+    cells as measured (a smoothed or filled cell shares its neighbours' values, which would
+    understate the scatter and split one look into many, or chain two looks into one)."""
     both = mask[:, 1:] & mask[:, :-1]
-    smooth = ndi.gaussian_filter(_fill_unseen(channel[..., None], mask)[..., 0], SEGMENT_SIGMA)
-    diff = np.diff(smooth, axis=1)[both]
+    diff = np.diff(channel, axis=1)[both]
     if diff.size == 0:
         return 0.0
     return float(1.4826 * np.median(np.abs(diff - np.median(diff))) / np.sqrt(2.0))
@@ -163,9 +166,16 @@ def _merge_thin(segments: NDArray[np.int64], channels: NDArray[np.float64],
     """Each segment with no cell ``min_depth_cells`` from its edge merged into the adjacent
     segment of nearest mean channels; labels ``0 ..`` in order again, ``-1`` kept."""
     n = int(segments.max()) + 1
+    # depth on the segments a dent meets: a masked cell (a gap between the camera's rows, the
+    # robot's shadow) takes its nearest seen cell's segment, so a gap is no edge
+    seen = segments >= 0
+    filled = segments
+    if not seen.all():
+        nearest = ndi.distance_transform_edt(~seen, return_distances=False, return_indices=True)
+        filled = segments[nearest[0], nearest[1]]
     edge = np.zeros(segments.shape, dtype=bool)
     for axis in (0, 1):
-        differs = np.diff(segments, axis=axis) != 0
+        differs = np.diff(filled, axis=axis) != 0
         lo = [slice(None)] * 2
         hi = [slice(None)] * 2
         lo[axis], hi[axis] = slice(None, -1), slice(1, None)
@@ -173,14 +183,14 @@ def _merge_thin(segments: NDArray[np.int64], channels: NDArray[np.float64],
         edge[tuple(hi)] |= differs
     depth = ndi.distance_transform_edt(np.pad(~edge, 1, constant_values=False))[1:-1, 1:-1]
     index = np.arange(n)
-    deepest = np.asarray(ndi.maximum(depth, segments, index), dtype=float)
+    deepest = np.asarray(ndi.maximum(depth, filled, index), dtype=float)
     means = np.stack([ndi.mean(channels[..., k], segments, index)
                       for k in range(channels.shape[-1])], axis=-1)  # fmt: skip
     thin = deepest < min_depth_cells
     if not thin.any() or thin.all():
         return segments
     pairs: set[tuple[int, int]] = set()
-    for a, b in ((segments[:, :-1], segments[:, 1:]), (segments[:-1, :], segments[1:, :])):
+    for a, b in ((filled[:, :-1], filled[:, 1:]), (filled[:-1, :], filled[1:, :])):
         touch = (a != b) & (a >= 0) & (b >= 0)
         pairs.update(zip(a[touch].tolist(), b[touch].tolist(), strict=True))
     target = index.copy()

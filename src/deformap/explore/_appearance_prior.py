@@ -11,8 +11,9 @@ squared exponential over the workspace's diagonal. At ``w = 0`` it is the blind 
 ``w`` the prior variance is σ², so ``T_h`` keeps its meaning. It is a sum, not a product
 ``k_ℓ · (1 − w + w k_app)``, because a product only removes covariance.
 
-``w`` and ``ℓ_a`` range over a small grid (:data:`WEIGHTS` × :data:`LOOK_SCALES`; uniform over
-``w``, then ``ℓ_a``), each point's posterior from the pokes' exact marginal likelihood (RW2006
+``w`` and ``ℓ_a`` range over a small grid (:data:`WEIGHTS` × :data:`LOOK_SCALES`; one half on
+``w = 0``, the blind map, the other half uniform over the weights above 0, then ``ℓ_a``: a
+spike-and-slab prior), each point's posterior from the pokes' exact marginal likelihood (RW2006
 Eq. 2.30). The field on the grid is the Bayesian model average: the mixture's mean and variance
 ``E[var] + Var[mean]``; where the pokes contradict the looks the posterior moves to ``w = 0``.
 
@@ -36,13 +37,18 @@ from scipy import ndimage as ndi
 from deformap.explore._appearance import AppearanceImage
 from deformap.gp import cholesky_with_jitter, squared_exponential
 
-__all__ = ["LOOK_SCALES", "WEIGHTS", "AppearanceModels", "AppearancePrior", "WeightPosterior"]
+__all__ = ["BLIND_PRIOR", "LOOK_SCALES", "WEIGHTS", "AppearanceModels", "AppearancePrior",
+           "WeightPosterior"]
 
 Array = NDArray[np.float64]
 
 #: The weights ``w`` of the look: 0 the blind map; up to 0.95, never 1, so the blind part always
 #: lets two places of one look differ.
 WEIGHTS = (0.0, 0.5, 0.8, 0.95)
+#: The prior probability of ``w = 0``: the two hypotheses, the looks follow the materials or
+#: they do not, equally likely before any poke, so the map leans on the looks only as far as
+#: the pokes' Bayes factor for them says.
+BLIND_PRIOR = 0.5
 #: The look length scales ``ℓ_a``, in units of the segments' standardised features: from looks a
 #: noise apart to looks of the image's whole spread.
 LOOK_SCALES = (0.5, 1.0, 2.0)
@@ -124,14 +130,15 @@ class WeightPosterior:
 
 
 def _grid_points() -> tuple[Array, Array, Array]:
-    """The grid's ``w``, ``ℓ_a`` and prior probability (uniform over ``w``, then ``ℓ_a``)."""
-    w, la, p = [], [], []
-    for weight in WEIGHTS:
-        scales = LOOK_SCALES if weight > 0 else (LOOK_SCALES[0],)
-        for scale in scales:
+    """The grid's ``w``, ``ℓ_a`` and prior probability: :data:`BLIND_PRIOR` on ``w = 0``, the
+    rest uniform over the weights above 0, then over ``ℓ_a``."""
+    w, la, p = [0.0], [LOOK_SCALES[0]], [BLIND_PRIOR]
+    looked = [weight for weight in WEIGHTS if weight > 0]
+    for weight in looked:
+        for scale in LOOK_SCALES:
             w.append(weight)
             la.append(scale)
-            p.append(1.0 / (len(WEIGHTS) * len(scales)))
+            p.append((1.0 - BLIND_PRIOR) / (len(looked) * len(LOOK_SCALES)))
     return np.array(w), np.array(la), np.array(p)
 
 

@@ -9,6 +9,10 @@ the behaviour by region (:func:`deformap.run._report.behaviour_grids`): ``behavi
 index into ``behaviour_names``, -1 without a region map) and the medians ``relaxation``,
 ``relaxation_tau_s`` [s], ``loss_ratio``, ``residual_dent_m``, ``released_dent_m`` [m] over each
 region's pokes that give them (NaN elsewhere).
+The appearance prior's input: ``appearance_lab (ny, nx, 3)``, each cell's mean colour in CIELAB
+(L* 0–100, a*, b*; NaN where no colour was seen or the prior was not used) and
+``appearance_segments (ny, nx)`` int, each cell's segment ``0 ..`` (``-1`` where masked or the
+prior was not used).
 
 ``pokes.csv``: the columns :data:`POKES_CSV_COLUMNS`, ``poke`` numbered from 1 (``report.json``'s
 ``index`` + 1), the contact where the tip touched, ``tip_center_z_m`` at the commanded force, the
@@ -70,6 +74,13 @@ def _write_map_npz(path: Path, result: ExplorationResult) -> None:
         **{key: nan for key in BEHAVIOUR_QUANTITIES},
         **behaviour_grids(result),
     }  # fmt: skip
+    # the appearance prior's image and segments (NaN / -1 everywhere without one)
+    image = result.appearance.image
+    arrays["appearance_lab"] = (np.full((*shape, 3), np.nan) if image is None
+                                else np.asarray(image.lab, dtype=float))  # fmt: skip
+    arrays["appearance_segments"] = (np.full(shape, -1, dtype=np.int64) if image is None
+                                     else np.asarray(image.segments, dtype=np.int64))  # fmt: skip
+    arrays["units"] = np.array(f"{arrays['units']}; appearance_lab: CIELAB")
     with atomic_path(path) as tmp, open(tmp, "wb") as fh:
         np.savez_compressed(fh, **arrays)
 
