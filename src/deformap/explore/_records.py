@@ -21,14 +21,15 @@ from deformap.errors import FileFormatError, InvalidArgumentError
 from deformap.explore._planning import PokePlan
 from deformap.msm import BetaEstimate
 from deformap.stiffness import (
+    ANISOTROPY_WINDOW_RADII,
     BEHAVIOURS,
     LAYER_MODEL,
     PressBehaviour,
     StiffnessEstimate,
+    dent_anisotropy,
     press_behaviour,
     released_dent,
 )
-from deformap.stiffness._anisotropy import ANISOTROPY_WINDOW_RADII, dent_anisotropy
 
 __all__ = ["PURPOSES", "ContactRecord", "Dent", "PokeRecord", "PokeResult", "PokeTimings", "Purpose",
            "Target", "poke_behaviour"]

@@ -35,6 +35,7 @@ DerSimonian, R., Laird, N. (1986). Meta-analysis in clinical trials. Control. Cl
 
 from __future__ import annotations
 
+from deformap.stiffness._anisotropy import ANISOTROPY_WINDOW_RADII, dent_anisotropy
 from deformap.stiffness._behaviour import (
     BEHAVIOURS,
     PressBehaviour,
@@ -46,12 +47,14 @@ from deformap.stiffness._config import LAYER_MODEL, StiffnessConfig, StiffnessEs
 from deformap.stiffness._estimate import estimate_stiffness
 
 __all__ = [
+    "ANISOTROPY_WINDOW_RADII",
     "BEHAVIOURS",
     "LAYER_MODEL",
     "PressBehaviour",
     "PressRecord",
     "StiffnessConfig",
     "StiffnessEstimate",
+    "dent_anisotropy",
     "estimate_stiffness",
     "press_behaviour",
     "released_dent",
