@@ -12,6 +12,16 @@ from typing import TYPE_CHECKING
 from deformap._lazy import lazy_exports
 
 if TYPE_CHECKING:
+    from deformap.eval._behaviour_study import (
+        BEHAVIOUR_READS,
+        BEHAVIOUR_TRUTHS,
+        FULL_BEHAVIOUR_MATERIALS,
+        QUICK_BEHAVIOUR_MATERIALS,
+        BehaviourMaterial,
+        behaviour_presses,
+        behaviour_summary,
+        material_scenario,
+    )
     from deformap.eval._bench_gp import bench_surface_gp
     from deformap.eval._bench_io import IO_GOAL_S, bench_io
     from deformap.eval._bench_memory import bench_memory, measure_case
@@ -20,26 +30,18 @@ if TYPE_CHECKING:
     from deformap.eval._metrics import OrderingScores, RegionScores, ordering_scores, region_scores
     from deformap.eval._rescore import rescore_world
     from deformap.eval._studies import (
-        BEHAVIOUR_READS,
-        BEHAVIOUR_TRUTHS,
         DEFAULT_HARDNESSES,
         DEFAULT_POSITIONS,
         DEFAULT_PROTOCOL,
-        FULL_BEHAVIOUR_MATERIALS,
         PAPER_PROTOCOL,
         PROTOCOLS,
-        QUICK_BEHAVIOUR_MATERIALS,
         STUDY_PROTOCOLS,
-        BehaviourMaterial,
         FoamPresses,
-        behaviour_presses,
-        behaviour_summary,
         block_scenario,
         cluster_size_study,
         collect_presses,
         hardness_study,
         hardness_summary,
-        material_scenario,
     )
     from deformap.eval._table_i import PAPER_TABLE_I, markdown_table, table_row
     from deformap.eval._world_draw import (
@@ -73,12 +75,12 @@ _MODULES = {
     "_bench_msm": ("bench_beta_sweep",),
     "_bench_world": ("bench_world",),
     "_metrics": ("OrderingScores", "RegionScores", "ordering_scores", "region_scores"),
-    "_studies": ("BEHAVIOUR_READS", "BEHAVIOUR_TRUTHS", "DEFAULT_HARDNESSES", "DEFAULT_POSITIONS",
-                 "DEFAULT_PROTOCOL", "FULL_BEHAVIOUR_MATERIALS", "PAPER_PROTOCOL", "PROTOCOLS",
-                 "QUICK_BEHAVIOUR_MATERIALS", "STUDY_PROTOCOLS", "BehaviourMaterial",
-                 "FoamPresses", "behaviour_presses", "behaviour_summary", "block_scenario",
-                 "cluster_size_study", "collect_presses", "hardness_study", "hardness_summary",
-                 "material_scenario"),
+    "_behaviour_study": ("BEHAVIOUR_READS", "BEHAVIOUR_TRUTHS", "FULL_BEHAVIOUR_MATERIALS",
+                         "QUICK_BEHAVIOUR_MATERIALS", "BehaviourMaterial", "behaviour_presses",
+                         "behaviour_summary", "material_scenario"),
+    "_studies": ("DEFAULT_HARDNESSES", "DEFAULT_POSITIONS", "DEFAULT_PROTOCOL", "PAPER_PROTOCOL",
+                 "PROTOCOLS", "STUDY_PROTOCOLS", "FoamPresses", "block_scenario",
+                 "cluster_size_study", "collect_presses", "hardness_study", "hardness_summary"),
     "_table_i": ("PAPER_TABLE_I", "markdown_table", "table_row"),
     "_rescore": ("rescore_world",),
     "_world_draw": ("FORCES_N", "HARDNESS_RANGE_N", "THICKNESSES_M", "WorldDraw", "WorldTask",

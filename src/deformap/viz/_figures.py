@@ -9,11 +9,10 @@ as ``pokes.csv`` numbers them, pokes from 1. ``plot_*`` functions return the fig
 
 from __future__ import annotations
 
-from collections.abc import Callable, Collection, Sequence
+from collections.abc import Collection, Sequence
 from pathlib import Path
 
 import numpy as np
-from matplotlib import patheffects
 from matplotlib.axes import Axes
 from matplotlib.colors import BoundaryNorm, ListedColormap, LogNorm
 from matplotlib.figure import Figure
@@ -23,67 +22,37 @@ from numpy.typing import NDArray
 from scipy.ndimage import distance_transform_edt
 
 from deformap.errors import InvalidArgumentError
+from deformap.viz._overlay import (
+    MARKS,
+    REGION_COLOUR,
+    Extent,
+    Overlay,
+    draw_pokes,
+    extent,
+    label_place,
+    poke_purposes,
+)
 from deformap.viz._save import save_figure
 from deformap.viz._style import BETA_CMAP, RIGID_COLOUR, STIFFNESS_CMAP, modulus_norm
 from deformap.world import hardness_to_youngs_modulus
 
 __all__ = ["BEHAVIOUR_COLOURS", "plot_map"]
 
-# marker per poke purpose: the first poke, the pokes the variance chose, the pokes testing a look
-# (appearance prior), the boundary pokes
-_MARKS = {"first": ("o", "first poke"), "variance": ("^", "later pokes"),
-          "appearance": ("D", "pokes testing a look"),
-          "boundary": ("s", "boundary pokes")}  # fmt: skip
-_HALO = [patheffects.withStroke(linewidth=3.5, foreground="w")]
-_REGION_COLOUR, _THRESHOLD_COLOUR = "r", "tab:orange"
-_PANEL_PX = 400.0
-"""About how many pixels a map panel's axes span across (5.2 in at 110 dpi, less its colour bar):
-the scale by which a region's label is kept clear of the pokes' marks."""
-Extent = tuple[float, float, float, float]
+_THRESHOLD_COLOUR = "tab:orange"
 #: The behaviour panel's colours, one per class (categorical, apart from every stiffness colour
 #: map's ends): elastic blue, viscoelastic orange, plastic red, unknown pale grey, mixed purple.
 BEHAVIOUR_COLOURS = {"elastic": "#1f77b4", "viscoelastic": "#ff7f0e", "plastic": "#d62728",
                      "unknown": "#d9d9d9", "mixed": "#9467bd"}
 
 
-def _extent(xs: NDArray, ys: NDArray) -> Extent:
-    dx = (xs[1] - xs[0]) / 2 if xs.size > 1 else 0.0025
-    dy = (ys[1] - ys[0]) / 2 if ys.size > 1 else 0.0025
-    return (float(xs[0] - dx), float(xs[-1] + dx), float(ys[0] - dy), float(ys[-1] + dy))
-
-
-def _purposes(n: int, purposes: Sequence[str | None] | None) -> list[str]:
-    """Each contact's purpose; without them the first is ``first`` and the rest ``variance``."""
-    if purposes is None:
-        return ["first"] + ["variance"] * (n - 1) if n else []
-    if len(purposes) != n:
-        raise InvalidArgumentError(
-            f"`purposes` must have one entry per contact ({n}); got {len(purposes)}")
-    return [p if p in _MARKS else ("first" if i == 0 else "variance")
-            for i, p in enumerate(purposes)]  # fmt: skip
-
-
-def _contacts(ax: Axes, contacts: NDArray[np.float64], purposes: list[str]) -> None:
-    """The pokes, marked by purpose and numbered from 1: black with a white halo, readable on
-    the dark end of a colour map as on the light one."""
-    for purpose, (marker, _) in _MARKS.items():
-        mine = [i for i, p in enumerate(purposes) if p == purpose]
-        if mine:
-            ax.plot(contacts[mine, 0], contacts[mine, 1], marker, mfc="none", mec="k",
-                    ms=10 if marker == "o" else 9, mew=2, path_effects=_HALO, linestyle="none")
-    for i, (x, y) in enumerate(contacts):
-        ax.annotate(str(i + 1), (x, y), xytext=(6, 6), textcoords="offset points", fontsize=8,
-                    path_effects=[patheffects.withStroke(linewidth=2.5, foreground="w")])
-
-
 def _legend(fig: Figure, purposes: list[str], *, regions: bool, threshold: float | None,
             note: str | None) -> None:
     """One legend below the panels (inside, it would cover a map); ``note`` (no T_h contour) as
     an entry without a mark."""
-    handles = [Line2D([], [], marker=_MARKS[p][0], mfc="none", mec="k", mew=2, ms=9, ls="none",
-                      label=_MARKS[p][1]) for p in _MARKS if p in purposes]  # fmt: skip
+    handles = [Line2D([], [], marker=MARKS[p][0], mfc="none", mec="k", mew=2, ms=9, ls="none",
+                      label=MARKS[p][1]) for p in MARKS if p in purposes]  # fmt: skip
     if regions:
-        handles.append(Line2D([], [], color=_REGION_COLOUR, lw=2, label="region boundary"))
+        handles.append(Line2D([], [], color=REGION_COLOUR, lw=2, label="region boundary"))
     if threshold is not None:
         handles.append(Line2D([], [], color=_THRESHOLD_COLOUR, lw=1.5,
                               label=f"variance = T_h ({threshold:.4g})"))
@@ -168,7 +137,7 @@ def plot_map(
     if variance_max is not None and not variance_max > 0:  # NaN too
         raise InvalidArgumentError(f"`variance_max` must be a number > 0; got {variance_max!r}")
     contacts = np.asarray(contacts, dtype=float).reshape(-1, 2)
-    kinds = _purposes(len(contacts), purposes)
+    kinds = poke_purposes(len(contacts), purposes)
     if behaviour_class is not None:
         behaviour_class = np.asarray(behaviour_class)
         unnamed = [n for n in behaviour_names if n not in BEHAVIOUR_COLOURS]
@@ -182,7 +151,7 @@ def plot_map(
               + (appearance_rgb is not None) + (behaviour_class is not None))  # fmt: skip
     fig = Figure(figsize=(5.2 * panels, 4.6), layout="constrained")
     axes = list(np.atleast_1d(fig.subplots(1, panels)))
-    ext = _extent(xs, ys)
+    ext = extent(xs, ys)
     truth_kpa = None if truth_hardness is None else _truth_modulus_kpa(truth_hardness)
     kpa = None if modulus_pa is None else np.asarray(modulus_pa, dtype=float) / 1e3
     norm = modulus_norm(*(m for m in (kpa, truth_kpa) if m is not None))
@@ -191,9 +160,9 @@ def plot_map(
     if appearance_rgb is not None:
         ax = axes.pop(0)
         _appearance_panel(ax, ext, appearance_rgb, appearance_segments)
-        _contacts(ax, contacts, kinds)
+        draw_pokes(ax, contacts, kinds)
     n_regions = "" if labels is None else f", {len(np.unique(labels))} region(s)"
-    overlay = _Overlay(xs, ys, labels, levels, contacts, kinds, set(rigid_classes))
+    overlay = Overlay(xs, ys, labels, levels, contacts, kinds, set(rigid_classes))
     ax = axes.pop(0)
     im = ax.imshow(beta, origin="lower", extent=ext, cmap=BETA_CMAP, vmin=0.0, vmax=1.0)
     fig.colorbar(im, ax=ax, label="β (deformability) [–]; 1 soft, 0 stiff")
@@ -213,7 +182,7 @@ def plot_map(
     ax = axes.pop(0)
     note = _variance_panel(fig, ax, xs, ys, ext, variance, threshold, variance_max,
                            modulus=region_field == "modulus")  # fmt: skip
-    _contacts(ax, contacts, kinds)
+    draw_pokes(ax, contacts, kinds)
     for a in fig.axes:
         if a.get_label() != "<colorbar>":
             a.set_xlabel("x [m]")
@@ -228,7 +197,7 @@ def plot_map(
 
 
 def _behaviour_panel(fig: Figure, ax: Axes, ext: Extent, classes: NDArray, names: list[str],
-                     overlay: _Overlay) -> None:
+                     overlay: Overlay) -> None:
     """Each cell's behaviour class in its colour (the classes present on the map, named on a
     categorical colour bar), the regions' outlines (black, apart from every class colour) and
     names, and the pokes."""
@@ -252,7 +221,7 @@ def _behaviour_panel(fig: Figure, ax: Axes, ext: Extent, classes: NDArray, names
         for label in np.unique(labels):
             ax.contour(overlay.xs, overlay.ys, (labels == label).astype(float), levels=[0.5],
                        colors="k", linewidths=1.5)  # fmt: skip
-    _contacts(ax, overlay.contacts, overlay.kinds)
+    draw_pokes(ax, overlay.contacts, overlay.kinds)
     if labels is None:
         return
     for k in (int(k) for k in np.unique(labels) if k >= 0):
@@ -260,7 +229,7 @@ def _behaviour_panel(fig: Figure, ax: Axes, ext: Extent, classes: NDArray, names
         if not cells.size or cells[0] < 0:
             continue
         text = f"R{k + 1}: {names[int(cells[0])]}"
-        x, y = _label_place(overlay.xs, overlay.ys, labels == k, overlay.contacts, len(text))
+        x, y = label_place(overlay.xs, overlay.ys, labels == k, overlay.contacts, len(text))
         ax.text(x, y, text, ha="center", va="center", fontsize=8,
                 bbox={"boxstyle": "round,pad=0.2", "fc": "w", "ec": "0.5", "alpha": 0.85})
 
@@ -348,74 +317,3 @@ def _variance_panel(fig: Figure, ax: Axes, xs: NDArray, ys: NDArray, ext: Extent
     return note
 
 
-class _Overlay:
-    """What every field panel draws over its image: the regions, the pokes and the regions'
-    names with their values."""
-
-    def __init__(self, xs: NDArray, ys: NDArray, labels: NDArray | None, levels: NDArray | None,
-                 contacts: NDArray, kinds: list[str], rigid: set[int]) -> None:
-        self.xs, self.ys, self.labels, self.levels = xs, ys, labels, levels
-        self.contacts, self.kinds, self.rigid = contacts, kinds, rigid
-
-    def draw(self, ax: Axes, values: NDArray, given: Sequence[float | None] | None, *,
-             main: bool, name: Callable[[float], str]) -> None:
-        """The regions (the isopleths of ``values`` when cut from this field, ``main``), the
-        pokes, and each region's name with ``given[k]`` (else the median of ``values`` over its
-        cells) or "rigid"."""
-        _regions(ax, self.xs, self.ys, values, self.labels, self.levels if main else None,
-                 main=main)  # fmt: skip
-        _contacts(ax, self.contacts, self.kinds)
-        if self.labels is None:
-            return
-        texts = {}
-        for k in (int(k) for k in np.unique(self.labels) if k >= 0):
-            value = given[k] if given is not None and k < len(given) else None
-            if value is None:
-                cells = values[(self.labels == k) & np.isfinite(values)]
-                value = float(np.median(cells)) if cells.size else None
-            if k in self.rigid:
-                texts[k] = f"R{k + 1}: rigid"
-            elif value is not None:
-                texts[k] = f"R{k + 1}: {name(value)}"
-        for k, text in texts.items():
-            x, y = _label_place(self.xs, self.ys, self.labels == k, self.contacts, len(text))
-            ax.text(x, y, text, ha="center", va="center", fontsize=8,
-                    bbox={"boxstyle": "round,pad=0.2", "fc": "w", "ec": "0.5", "alpha": 0.85})
-
-
-def _label_place(xs: NDArray, ys: NDArray, region: NDArray, contacts: NDArray,
-                 n_chars: int) -> tuple[float, float]:
-    """Where a region's label of ``n_chars`` characters goes: the cell deepest inside the region
-    (farthest from its edge, the map's border counting as one: inside however the region is
-    shaped, where a centroid may fall outside) among those where the label's box clears every
-    poke's mark and number; the deepest cell when none does."""
-    depth = distance_transform_edt(np.pad(region, 1))[1:-1, 1:-1]
-    px = (xs[-1] - xs[0]) / _PANEL_PX if xs.size > 1 else 1e-3  # metres per pixel
-    # at 110 dpi a poke takes its mark (10 px about it) and its number (up to 20 px right of it
-    # and 23 px above); the label's box is 8-point characters about 6.5 px wide, 20 px high;
-    # 4 px apart
-    half_w, half_h = n_chars * 3.25 + 4.0 + 4.0, 10.0 + 4.0
-    gx, gy = np.meshgrid(xs, ys)
-    clear = region.copy()
-    for cx, cy in contacts:
-        dx, dy = (gx - cx) / px, (gy - cy) / px
-        clear &= ~((dx > -10.0 - half_w) & (dx < 20.0 + half_w)
-                   & (dy > -10.0 - half_h) & (dy < 23.0 + half_h))
-    score = np.where(clear, depth, -1.0) if clear.any() else depth
-    iy, ix = np.unravel_index(int(np.argmax(score)), score.shape)
-    return float(xs[ix]), float(ys[iy])
-
-
-def _regions(ax: Axes, xs: NDArray, ys: NDArray, values: NDArray, labels: NDArray | None,
-             levels: NDArray | None, *, main: bool) -> None:
-    """The regions on one field's panel: its isopleths ``levels`` when given, else the labels'
-    outlines (dashed on the panel of the field they were not cut from)."""
-    if levels is not None and len(levels):
-        ax.contour(xs, ys, values, levels=np.sort(levels), colors=_REGION_COLOUR, linewidths=2)
-    elif labels is not None and np.ptp(labels) > 0:
-        # each region's outline (contours of the label values would draw two lines where
-        # regions 0 and 2 meet)
-        for label in np.unique(labels):
-            ax.contour(xs, ys, (labels == label).astype(float), levels=[0.5],
-                       colors=_REGION_COLOUR, linewidths=2 if main else 1,
-                       linestyles="solid" if main else "dashed")  # fmt: skip

@@ -13,6 +13,7 @@ from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 from numpy.typing import NDArray
 
+from deformap.viz._overlay import extent
 from deformap.viz._save import save_figure
 
 __all__ = ["plot_beta_curve", "plot_error_curve", "plot_poke"]
@@ -50,12 +51,6 @@ def plot_error_curve(betas: NDArray, errors: NDArray, beta: float, beta_std: flo
     if path is not None:
         save_figure(fig, path, dpi=110)
     return fig
-
-
-def _extent(xs: NDArray, ys: NDArray) -> tuple[float, float, float, float]:
-    dx = (xs[1] - xs[0]) / 2 if xs.size > 1 else 0.0025
-    dy = (ys[1] - ys[0]) / 2 if ys.size > 1 else 0.0025
-    return (xs[0] - dx, xs[-1] + dx, ys[0] - dy, ys[-1] + dy)
 
 
 def _span(values: NDArray, minimum: float) -> tuple[float, float]:
@@ -102,7 +97,7 @@ def plot_poke(*, roi_xs: NDArray, roi_ys: NDArray, rest_z: NDArray, deformed_z: 
     before, cloud, observed, simulated = top.subplots(1, 4)
     section, curve, press = bottom.subplots(1, 3)
     mm = 1e3
-    ext = tuple(v * mm for v in _extent(roi_xs, roi_ys))
+    ext = tuple(v * mm for v in extent(roi_xs, roi_ys))
     low, high = _span(rest_z, MIN_COLOUR_SPAN_M)
     im = before.imshow(rest_z * mm, origin="lower", extent=ext, vmin=low * mm, vmax=high * mm,
                        cmap="viridis")  # fmt: skip

@@ -1,0 +1,179 @@
+"""The behaviour study: blocks of elastic, viscoelastic, plastic and anisotropic foam pressed
+with a hold and an unloading branch, the behaviour class each press reads
+(:func:`deformap.explore.poke_behaviour`) against the material's own (:func:`behaviour_presses`,
+:func:`behaviour_summary`)."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from deformap.environment import Workspace
+from deformap.eval._studies import DEFAULT_POSITIONS, fraction
+from deformap.explore import poke_behaviour
+from deformap.world import (
+    Block,
+    Orthotropic,
+    Plastic,
+    Scenario,
+    SimulatedWorld,
+    Viscoelastic,
+    WorldConfig,
+)
+
+__all__ = ["BEHAVIOUR_READS", "BEHAVIOUR_TRUTHS", "FULL_BEHAVIOUR_MATERIALS",
+           "QUICK_BEHAVIOUR_MATERIALS", "BehaviourMaterial", "behaviour_presses",
+           "behaviour_summary", "material_scenario"]
+
+
+BEHAVIOUR_TRUTHS: tuple[str, ...] = ("elastic", "viscoelastic", "plastic")
+"""The behaviour classes a simulated material has (an anisotropic foam is elastic)."""
+
+BEHAVIOUR_READS: tuple[str, ...] = ("elastic", "viscoelastic", "plastic", "unknown")
+"""What a press can read (:class:`deformap.stiffness.PressBehaviour`'s classes)."""
+
+
+@dataclass(frozen=True)
+class BehaviourMaterial:
+    """One material of the behaviour study: a foam of ``hardness_n`` newtons (its instantaneous
+    modulus when viscoelastic), elastic unless it relaxes, yields or is anisotropic."""
+
+    name: str
+    hardness_n: float
+    viscoelastic: Viscoelastic | None = None
+    plastic: Plastic | None = None
+    anisotropy: Orthotropic | None = None
+
+    @property
+    def truth(self) -> str:
+        """The behaviour class the press should read."""
+        if self.viscoelastic is not None and self.viscoelastic.relaxed_ratio < 1.0:
+            return "viscoelastic"
+        return "plastic" if self.plastic is not None else "elastic"
+
+    @property
+    def kind(self) -> str:
+        """Its truth class, or ``"anisotropic"`` for an anisotropic foam."""
+        return "anisotropic" if self.anisotropy is not None else self.truth
+
+
+def _elastic(hardness_n: float) -> BehaviourMaterial:
+    return BehaviourMaterial(f"elastic {hardness_n:g} N", hardness_n)
+
+
+def _memory(relaxed_ratio: float, tau_s: float) -> BehaviourMaterial:
+    return BehaviourMaterial(f"viscoelastic g∞ {relaxed_ratio:g} τ {tau_s:g} s", 60.0,
+                             viscoelastic=Viscoelastic(relaxed_ratio=relaxed_ratio,
+                                                       times_s=(tau_s,)))
+
+
+def _clay(yield_pa: float) -> BehaviourMaterial:
+    return BehaviourMaterial(f"plastic yield {yield_pa:g} Pa", 60.0,
+                             plastic=Plastic(yield_stress_pa=yield_pa, hardening_pa=2000.0))
+
+
+def _ribbed(ratio: float) -> BehaviourMaterial:
+    return BehaviourMaterial(f"anisotropic {ratio:g}", 60.0,
+                             anisotropy=Orthotropic(ratio=ratio, axis_deg=30.0))
+
+
+QUICK_BEHAVIOUR_MATERIALS: tuple[BehaviourMaterial, ...] = (
+    _elastic(60.0), _memory(0.5, 1.0), _clay(1000.0), _ribbed(3.0))
+"""The quick study's materials: one of each kind, 60 N."""
+
+FULL_BEHAVIOUR_MATERIALS: tuple[BehaviourMaterial, ...] = (
+    *(_elastic(h) for h in (30.0, 60.0, 110.0, 150.0, 250.0)),
+    *(_memory(g, tau) for g in (0.5, 0.8) for tau in (0.5, 2.0)),
+    *(_clay(y) for y in (1000.0, 3000.0)),
+    *(_ribbed(r) for r in (1.5, 3.0)))
+"""The full study's materials: elastic foams 30–250 N; viscoelastic at relaxed/instantaneous
+ratios 0.5 and 0.8 and relaxation times 0.5 and 2 s; plastic at yield stresses 1 and 3 kPa
+(hardening 2 kPa); anisotropic at ratios 1.5 and 3 (stiff axis 30° from x); all but the
+elastic ones 60 N."""
+
+
+def material_scenario(material: BehaviourMaterial, workspace: Workspace,
+                      thickness_m: float = 0.05) -> Scenario:
+    """One block of ``material`` over ``workspace``, ``thickness_m`` thick."""
+    (x0, y0), (x1, y1) = workspace.lower, workspace.upper
+    polygon = np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]])
+    block = Block(name=material.name, polygon=polygon, hardness_n=material.hardness_n,
+                  thickness_m=thickness_m, viscoelastic=material.viscoelastic,
+                  plastic=material.plastic, anisotropy=material.anisotropy)
+    return Scenario(name=f"behaviour-{material.name}", blocks=(block,), workspace=workspace)
+
+
+def _truth_at(world: SimulatedWorld, xy: tuple[float, float]) -> dict[str, Any]:
+    """The world's own material parameters under a press (``None`` where it has none)."""
+    xs, ys = np.array([xy[0]]), np.array([xy[1]])
+
+    def value(grid: Any) -> float | None:
+        v = float(np.asarray(grid)[0, 0])
+        return v if math.isfinite(v) else None
+
+    return {"relaxation_fraction": value(world.ground_truth_relaxation_fraction(xs, ys)),
+            "relaxation_time_s": value(world.ground_truth_relaxation_time(xs, ys)),
+            "anisotropy_ratio": value(world.ground_truth_anisotropy_ratio(xs, ys)),
+            "anisotropy_axis_deg": value(world.ground_truth_anisotropy_axis(xs, ys)),
+            "yield_stress_pa": value(world.ground_truth_yield_stress(xs, ys)),
+            "modulus_pa": value(world.ground_truth_modulus(xs, ys))}
+
+
+def behaviour_presses(material: BehaviourMaterial, *, world_config: WorldConfig,
+                      force_n: float, rng: np.random.Generator, thickness_m: float = 0.05,
+                      positions: Sequence[tuple[float, float]] = DEFAULT_POSITIONS
+                      ) -> list[dict[str, Any]]:
+    """Press one block of ``material`` at ``positions`` with ``force_n`` under ``world_config``
+    (its hold and unloading) and read each press's behaviour
+    (:func:`deformap.explore.poke_behaviour`): one row a press with the material and its
+    ``kind`` (:attr:`BehaviourMaterial.kind`), the truth class
+    ``truth``, the class read ``read``, its ``evidence``, every quantity of
+    :class:`~deformap.stiffness.PressBehaviour` under ``quantities`` and the world's own
+    parameters under ``true``."""
+    world = SimulatedWorld(material_scenario(material, Workspace(), thickness_m),
+                           config=world_config, rng=rng)
+    rows = []
+    for xy in positions:
+        read = poke_behaviour(world.press(np.asarray(xy, dtype=float), force_n))
+        world.release()
+        quantities = {k: v for k, v in read.to_dict().items() if k not in ("behaviour", "evidence")}
+        rows.append({"material": material.name, "kind": material.kind,
+                     "hardness_n": material.hardness_n,
+                     "xy_m": [float(xy[0]), float(xy[1])], "truth": material.truth,
+                     "read": read.behaviour, "evidence": read.evidence,
+                     "quantities": quantities, "true": _truth_at(world, xy)})
+    return rows
+
+
+def behaviour_summary(rows: Sequence[dict[str, Any]]) -> dict[str, Any]:
+    """What a behaviour study's press rows say: ``confusion`` (``{truth: {read: count}}`` over
+    :data:`BEHAVIOUR_TRUTHS` × :data:`BEHAVIOUR_READS`), ``n_presses``, ``right`` (the fraction
+    read as their truth), ``elastic_flagged`` (of the elastic presses, the fraction read
+    viscoelastic or plastic), ``unknown`` (the fraction read unknown), and ``by_condition`` and
+    ``by_material`` (the same counts per ``camera``/``thickness_m`` and per material)."""
+    def counts(group: Sequence[dict[str, Any]]) -> dict[str, Any]:
+        confusion = {t: dict.fromkeys(BEHAVIOUR_READS, 0) for t in BEHAVIOUR_TRUTHS}
+        for row in group:
+            confusion[row["truth"]][row["read"]] += 1
+        elastic = sum(confusion["elastic"].values())
+        n = len(group)
+        return {"n_presses": n, "confusion": confusion,
+                "right": fraction(sum(confusion[t][t] for t in BEHAVIOUR_TRUTHS), n),
+                "elastic_flagged": fraction(confusion["elastic"]["viscoelastic"]
+                                             + confusion["elastic"]["plastic"], elastic),
+                "unknown": fraction(sum(c["unknown"] for c in confusion.values()), n)}
+
+    by_condition: dict[tuple[Any, Any], list[dict[str, Any]]] = {}
+    by_material: dict[str, list[dict[str, Any]]] = {}
+    for row in rows:
+        by_condition.setdefault((row.get("camera"), row.get("thickness_m")), []).append(row)
+        by_material.setdefault(row["material"], []).append(row)
+    return {**counts(rows),
+            "by_condition": [{"camera": c, "thickness_m": h, **counts(g)}
+                             for (c, h), g in by_condition.items()],
+            "by_material": [{"material": m, "truth": g[0]["truth"], **counts(g)}
+                            for m, g in by_material.items()]}
