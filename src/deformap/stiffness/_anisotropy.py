@@ -30,9 +30,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import least_squares
 
-from deformap._validation import check_points
-from deformap.errors import InvalidArgumentError
-from deformap.stiffness._phases import MAD_TO_SIGMA, N_SIGMA
+from deformap.stiffness._phases import MAD_TO_SIGMA, N_SIGMA, press_surface
 
 __all__ = ["ANISOTROPY_FLOOR", "ANISOTROPY_WINDOW_RADII", "CLIP_SIGMAS", "Anisotropy", "Isotropy",
            "dent_anisotropy"]
@@ -101,12 +99,7 @@ def dent_anisotropy(points: Any, tip_center: Any, tip_radius_m: float) -> Anisot
     """The ratio, stiff axis and class the dent in ``points`` ``(n, 3)`` (the surface during the
     press, world frame, z up, the probe's own points removed) shows around the tip at
     ``tip_center`` (module docstring), or why none could be had."""
-    center = np.asarray(tip_center, dtype=np.float64)
-    if not (center.shape == (3,) and np.all(np.isfinite(center))):
-        raise InvalidArgumentError(f"`tip_center` must be 3 finite numbers; got {tip_center!r}")
-    if not (math.isfinite(tip_radius_m) and tip_radius_m > 0.0):
-        raise InvalidArgumentError(f"`tip_radius_m` must be positive; got {tip_radius_m!r}")
-    pts = check_points("points", points, min_rows=0)
+    pts, center = press_surface(points, tip_center, tip_radius_m)
     q = pts[:, :2] - center[:2]
     r = np.linalg.norm(q, axis=1)
     use = (r >= _INNER_RADII * tip_radius_m) & (r <= _OUTER_RADII * tip_radius_m)

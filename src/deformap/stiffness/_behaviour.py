@@ -71,7 +71,6 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import NDArray
 
-from deformap._validation import check_points
 from deformap.errors import InvalidArgumentError
 from deformap.stiffness._anisotropy import Anisotropy, Isotropy
 from deformap.stiffness._phases import (
@@ -85,6 +84,7 @@ from deformap.stiffness._phases import (
     hold_with_start,
     loop_loss,
     noise,
+    press_surface,
     zero_force_travel,
 )
 
@@ -174,12 +174,7 @@ def released_dent(points: Any, tip_center: Any, tip_radius_m: float
     """The dent [m] and its σ that the surface seen after release, ``points`` ``(n, 3)`` (world
     frame, z up), keeps at the press point (module docstring), or why it cannot be had (too few
     points near the press)."""
-    center = np.asarray(tip_center, dtype=np.float64)
-    if not (center.shape == (3,) and np.all(np.isfinite(center))):
-        raise InvalidArgumentError(f"`tip_center` must be 3 finite numbers; got {tip_center!r}")
-    if not (math.isfinite(tip_radius_m) and tip_radius_m > 0.0):
-        raise InvalidArgumentError(f"`tip_radius_m` must be positive; got {tip_radius_m!r}")
-    pts = check_points("points", points, min_rows=0)
+    pts, center = press_surface(points, tip_center, tip_radius_m)
     r = np.linalg.norm(pts[:, :2] - center[:2], axis=1)
     inner = pts[r <= tip_radius_m, 2]
     ring = pts[(r >= 3.0 * tip_radius_m) & (r <= 5.0 * tip_radius_m), 2]

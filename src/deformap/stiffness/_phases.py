@@ -12,9 +12,24 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import least_squares
 
-__all__ = ["MAD_TO_SIGMA", "MIN_FIT_SAMPLES", "N_SIGMA", "Measure", "PressRecord", "Stretch",
-           "hold_fraction", "hold_travel", "hold_with_start",
-           "loop_loss", "noise", "zero_force_travel"]
+from deformap._validation import check_points
+from deformap.errors import InvalidArgumentError
+
+__all__ = [
+    "MAD_TO_SIGMA",
+    "MIN_FIT_SAMPLES",
+    "N_SIGMA",
+    "Measure",
+    "PressRecord",
+    "Stretch",
+    "hold_fraction",
+    "hold_travel",
+    "hold_with_start",
+    "loop_loss",
+    "noise",
+    "press_surface",
+    "zero_force_travel",
+]
 
 #: A quantity shows a behaviour only beyond this many of its standard errors.
 N_SIGMA = 3.0
@@ -273,3 +288,15 @@ def zero_force_travel(record: PressRecord, sigma_f: float, sigma_t: float,
     if not (math.isfinite(value) and math.isfinite(sigma2)):
         return "the unloading branch gave no finite travel at zero force"
     return Measure(value, math.sqrt(sigma2))
+
+
+def press_surface(points: Any, tip_center: Any, tip_radius_m: float
+                  ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """A surface read about a press, checked: ``points`` ``(n, 3)`` (world frame, z up) and the
+    tip's centre ``(3,)``, both float64; the tip radius must be positive."""
+    center = np.asarray(tip_center, dtype=np.float64)
+    if not (center.shape == (3,) and np.all(np.isfinite(center))):
+        raise InvalidArgumentError(f"`tip_center` must be 3 finite numbers; got {tip_center!r}")
+    if not (math.isfinite(tip_radius_m) and tip_radius_m > 0.0):
+        raise InvalidArgumentError(f"`tip_radius_m` must be positive; got {tip_radius_m!r}")
+    return check_points("points", points, min_rows=0), center
