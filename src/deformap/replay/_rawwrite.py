@@ -26,6 +26,7 @@ import shutil
 import tempfile
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
+from functools import cached_property
 from pathlib import Path
 from typing import Any
 
@@ -88,9 +89,16 @@ class RawPress:
         return self.release_s + RELEASE + PAUSE
 
     def _phase(self, name: str) -> tuple[NDArray[np.float64], ...] | None:
-        """``(seconds since the stretch began, travel since contact, force)`` of the record's
-        hold or unloading, its first sample the one before the stretch (the ramp's or the hold's
-        last), or ``None`` when the record has none."""
+        return self._phases[name]
+
+    @cached_property
+    def _phases(self) -> dict[str, tuple[NDArray[np.float64], ...] | None]:
+        """For ``"hold"`` and ``"unloading"``: ``(seconds since the stretch began, travel since
+        contact, force)`` of the record's stretch, its first sample the one before the stretch (the
+        ramp's or the hold's last), or ``None`` when the record has none (built once a press)."""
+        return {name: self._stretch(name) for name in ("hold", "unloading")}
+
+    def _stretch(self, name: str) -> tuple[NDArray[np.float64], ...] | None:
         record = self.obs.force_travel
         phase = None if record is None else getattr(record, name)
         if record is None or phase is None or record.time_s is None:
