@@ -4,14 +4,16 @@ with a hold and an unloading branch, the behaviour class each press reads
 :func:`behaviour_summary`).
 
 The truth of a press is what the world's material did under that press: viscoelastic for a block
-that relaxes; plastic for a block that yields when the dent the world keeps after release (the
-deepest point of its surface) exceeds the record's resolvable floor
-(:func:`deformap.stiffness.record_dent_floor`), else elastic (the press did not yield, and
-behaved elastically); elastic otherwise (an anisotropic foam too). The quantities read are set
-against the world's: the hold's creep fraction against that of the world's noise-free record of
-the same press (``1 − δ(hold's start)/δ(hold's end)``), the time constant against the standard
-linear solid's creep time under a held force ``τ/g∞`` (one relaxation time), the residual dent
-against the world's kept dent."""
+that relaxes; plastic for a block that yields when the dent the press leaves exceeds the
+record's resolvable floor (:func:`deformap.stiffness.record_dent_floor`), else elastic (the press
+did not yield beyond it, and behaved elastically); elastic otherwise (an anisotropic foam too).
+The dent a press leaves is how far below the top the tip's sphere, lowered at the press point,
+rests on the surface the world keeps after release (``tip_rest_dent_m``; the deepest point of
+that surface is ``kept_dent_m``). The quantities read are set against the world's: the hold's
+creep fraction against that of the world's noise-free record of the same press
+(``1 − δ(hold's start)/δ(hold's end)``), the time constant against the standard linear solid's
+creep time under a held force ``τ/g∞`` (one relaxation time), the residual dent against the
+dent the press leaves (elastic and plastic blocks: a viscoelastic dent recovers in time)."""
 
 from __future__ import annotations
 
@@ -21,6 +23,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+from scipy.interpolate import LinearNDInterpolator
 
 from deformap.environment import Workspace
 from deformap.eval._studies import DEFAULT_POSITIONS, fraction
@@ -134,6 +137,24 @@ def _truth_at(world: SimulatedWorld, xy: tuple[float, float]) -> dict[str, Any]:
             "modulus_pa": value(world.ground_truth_modulus(xs, ys))}
 
 
+def _tip_rest_dent(world: SimulatedWorld, xy: tuple[float, float], u: Any, radius_m: float,
+                   thickness_m: float) -> float:
+    """How far below the block's top the tip's sphere (``radius_m``), lowered at ``xy`` onto the
+    top surface displaced by ``u`` ``(n_nodes, 3)``, rests with no force: the lowest sphere that
+    no point of the surface (linear between its nodes, read every 0.25 mm) enters."""
+    nodes = world.foam.rest_nodes
+    top = nodes[:, 2] >= thickness_m - 1e-9
+    near = top & (np.hypot(nodes[:, 0] - xy[0], nodes[:, 1] - xy[1]) <= 2.0 * radius_m)
+    surface = LinearNDInterpolator((nodes + u)[near, :2], (nodes + u)[near, 2])
+    g = np.arange(-radius_m, radius_m + 1e-9, 2.5e-4)
+    dx, dy = (a.ravel() for a in np.meshgrid(g, g))
+    r2 = dx**2 + dy**2
+    inside = r2 < radius_m**2
+    z = surface(xy[0] + dx[inside], xy[1] + dy[inside])
+    bottom = np.nanmax(z - radius_m + np.sqrt(radius_m**2 - r2[inside]))
+    return max(0.0, thickness_m - float(bottom))
+
+
 def behaviour_presses(material: BehaviourMaterial, *, world_config: WorldConfig,
                       force_n: float, rng: np.random.Generator, thickness_m: float = 0.05,
                       positions: Sequence[tuple[float, float]] = DEFAULT_POSITIONS
@@ -151,21 +172,23 @@ def behaviour_presses(material: BehaviourMaterial, *, world_config: WorldConfig,
     for xy in positions:
         obs = world.press(np.asarray(xy, dtype=float), force_n)
         read = poke_behaviour(obs)
-        creep = None
+        creep: float | None = 0.0  # the world's elastic and plastic blocks are rate-independent
         if material.viscoelastic is not None:  # its solved history is kept: no second solve
             exact = world.force_travel(obs.target_xy, force_n, exact=True)
-            if exact is not None and exact.hold is not None:
-                creep = 1.0 - float(exact.travel_m[-1]) / float(exact.hold.travel_m[-1])
+            creep = None if exact is None or exact.hold is None else (
+                1.0 - float(exact.travel_m[-1]) / float(exact.hold.travel_m[-1]))
         world.release()
-        kept = max(0.0, -float(np.min(world.released_displacement(0.0)[:, 2])))
+        u = world.released_displacement(0.0)
+        kept = max(0.0, -float(np.min(u[:, 2])))
+        rest = _tip_rest_dent(world, xy, u, obs.contact.tip_radius_m, thickness_m) if kept else 0.0
         truth = material.truth
         if truth == "plastic" and (obs.force_travel is None
-                                   or kept <= record_dent_floor(obs.force_travel)):
+                                   or rest <= record_dent_floor(obs.force_travel)):
             truth = "elastic"  # it did not yield beyond what the record resolves
         quantities = {k: v for k, v in read.to_dict().items() if k not in ("behaviour", "evidence")}
         true = _truth_at(world, xy)
         visco = material.viscoelastic
-        true.update(creep_fraction=creep, kept_dent_m=kept, creep_time_s=(
+        true.update(creep_fraction=creep, kept_dent_m=kept, tip_rest_dent_m=rest, creep_time_s=(
             None if visco is None or len(visco.times_s) != 1
             else float(visco.times_s[0]) / visco.relaxed_ratio))
         rows.append({"material": material.name, "kind": material.kind,
@@ -192,8 +215,10 @@ def _errors(group: Sequence[dict[str, Any]]) -> dict[str, Any]:
             pairs["relaxation"].append(q["relaxation"] - true["creep_fraction"])
         if q.get("tau_s") is not None and true.get("creep_time_s"):
             pairs["tau"].append(q["tau_s"] / true["creep_time_s"] - 1.0)
-        if q.get("residual_dent_m") is not None and true.get("kept_dent_m") is not None:
-            pairs["residual_dent"].append(q["residual_dent_m"] - true["kept_dent_m"])
+        # a viscoelastic dent recovers in time: no residual dent to set the reading against
+        if (q.get("residual_dent_m") is not None and true.get("tip_rest_dent_m") is not None
+                and row.get("kind") != "viscoelastic"):
+            pairs["residual_dent"].append(q["residual_dent_m"] - true["tip_rest_dent_m"])
     out: dict[str, Any] = {}
     for name, errors in pairs.items():
         err = np.abs(np.array(errors))
