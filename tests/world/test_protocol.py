@@ -65,3 +65,31 @@ def test_elastic_block_holds_flat_and_unloads_along_the_ramp() -> None:
 def test_bad_protocol_names_the_setting(field: str, value: float) -> None:
     with pytest.raises(SettingError, match=field):
         WorldConfig(**{field: value})
+
+
+def test_the_sensors_read_a_viscoelastic_hold_between_the_solved_steps() -> None:
+    """At the sensors' rate the hold creeps sample by sample; where a sample falls on a solved
+    time it is the solved indentation (a world read at the solved schedule's rate)."""
+    from deformap.environment import Workspace
+    from deformap.world import Block, Scenario, Viscoelastic
+
+    block = Block(name="memory", polygon=np.array([[0, 0], [0.3, 0], [0.3, 0.3], [0, 0.3]]),
+                  hardness_n=60.0, viscoelastic=Viscoelastic(relaxed_ratio=0.5, times_s=(1.0,)))
+    scenario = Scenario(name="m", blocks=(block,),
+                        workspace=Workspace(lower=(0.0, 0.0), upper=(0.3, 0.3)))
+
+    def record(rate: float):  # type: ignore[no-untyped-def]
+        config = WorldConfig.coarse(noise=False, hold_s=2.0, unload=True, sample_rate_hz=rate)
+        got = SimulatedWorld(scenario, config=config, rng=np.random.default_rng(0)).press(
+            (0.15, 0.15), FORCE).force_travel
+        assert got is not None and got.hold is not None and got.unloading is not None
+        return got
+
+    dense, solved = record(100.0), record(4.0)  # 4 Hz over 2 s: the solved 8 hold samples
+    assert len(dense.hold) == 200 and len(solved.hold) == 8 and len(solved.unloading) == 8
+    np.testing.assert_array_equal(dense.travel_m, solved.travel_m)
+    at = np.searchsorted(dense.hold.time_s, solved.hold.time_s - 1e-9)
+    np.testing.assert_allclose(dense.hold.time_s[at], solved.hold.time_s, atol=1e-12)
+    np.testing.assert_allclose(dense.hold.travel_m[at], solved.hold.travel_m, atol=1e-12)
+    assert np.all(np.diff(dense.hold.travel_m) > 0.0)  # it creeps between the solved samples
+    assert dense.unloading.travel_m[-1] == pytest.approx(solved.unloading.travel_m[-1], abs=1e-12)
