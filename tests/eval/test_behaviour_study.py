@@ -66,6 +66,7 @@ def test_the_summary_sets_each_reading_against_the_worlds() -> None:
     assert errors["relaxation"]["n"] == 3 and errors["relaxation"]["within"] == 2
     assert errors["relaxation"]["largest"] == pytest.approx(0.08)
     assert errors["tau"]["n"] == 2 and errors["tau"]["within"] == 1  # 25 % and 10 % off
+    assert errors["tau"]["tolerance"] == 0.20
     assert errors["tau"]["median"] == pytest.approx(0.175)
     # a viscoelastic dent recovers in time: only the plastic press's is set against the world's
     assert errors["residual_dent"]["n"] == 1 and errors["residual_dent"]["within"] == 1
@@ -135,6 +136,10 @@ def test_study_behaviour_writes_its_confusion_matrix(tmp_path: Path) -> None:
         assert set(row["quantities"]) >= {"relaxation", "tau_s", "loss_ratio", "residual_dent_m"}
     assert sum(study["confusion"]["viscoelastic"].values()) == 3
     assert "behaviour read against the world's truth" in result.output
+    errors = study["errors"]
+    assert (errors["relaxation"]["n"], errors["tau"]["n"], errors["residual_dent"]["n"]) == (3, 3, 0)
+    assert (f"relaxation within 0.05 {errors['relaxation']['within']}/3, time constant within "
+            f"20% {errors['tau']['within']}/3, residual dent within 0.3 mm 0/0") in result.output
     with Image.open(out / "behaviour.png") as image:
         assert image.format == "PNG" and image.size[0] > 300
 
