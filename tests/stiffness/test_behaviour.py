@@ -366,3 +366,25 @@ def test_a_modulus_without_a_hold_is_only_the_instantaneous_and_a_bad_one_is_ref
     for bad in [(0.0, 1.0), (float("nan"), 1.0), (5e4, -1.0)]:
         with pytest.raises(InvalidArgumentError, match="`modulus`"):
             press_behaviour(_record(unloading=0.0), modulus=bad)
+
+
+@pytest.mark.filterwarnings("error::RuntimeWarning")
+@pytest.mark.parametrize("residual_m", [0.0, 1e-3])
+def test_a_noise_free_record_gives_its_dent(residual_m: float) -> None:
+    """A record without noise (a simulation's, noise off: a long still hold makes the pooled
+    noise exactly 0) weighs its unloading samples alike."""
+    travel = np.linspace(0.0, DEPTH, 30)
+    force = K * travel**1.5
+    force[0] = 0.02  # contact
+    k = 1.0 / (DEPTH - residual_m) ** 1.5
+    down = np.linspace(1.0, 0.02, 30)
+    hold = PressPhase(time_s=1.0 + np.linspace(0.01, 3.0, 300), travel_m=np.full(300, DEPTH),
+                      force_n=np.full(300, 1.0))
+    record = ForceTravel(travel_m=travel, force_n=force, time_s=np.linspace(0.0, 1.0, 30),
+                         hold=hold,
+                         unloading=PressPhase(time_s=4.0 + np.linspace(0.05, 1.0, 30),
+                                              travel_m=residual_m + (down / k) ** (2 / 3),
+                                              force_n=down))
+    got = press_behaviour(record)
+    assert got.residual_dent_m == pytest.approx(residual_m, abs=5e-5)
+    assert got.residual_dent_sigma_m is not None and math.isfinite(got.residual_dent_sigma_m)

@@ -35,17 +35,61 @@ def test_default_protocol_records_the_ramp_alone_and_the_phases_leave_it_unchang
 
 def test_elastic_block_holds_flat_and_unloads_along_the_ramp() -> None:
     exact = _record(hold_s=2.0, unload=True, noise=False)
-    assert exact.hold is not None and exact.unloading is not None
+    assert exact.hold is not None and exact.unloading is not None and exact.time_s is not None
+    # the sensors read the hold and the unloading at the default 100 Hz
+    rate = WorldConfig().sample_rate_hz
+    assert len(exact.hold) == round(2.0 * rate) and len(exact.unloading) == round(
+        (FORCE - 0.02) / 2.0 * rate)
+    np.testing.assert_allclose(np.diff(exact.hold.time_s), 1.0 / rate)
+    np.testing.assert_allclose(np.diff(exact.unloading.time_s), 1.0 / rate)
     np.testing.assert_array_equal(exact.hold.travel_m, exact.travel_m[-1])
     np.testing.assert_array_equal(exact.hold.force_n, FORCE)
-    np.testing.assert_array_equal(exact.unloading.force_n, exact.force_n[-2::-1])
-    np.testing.assert_allclose(exact.unloading.travel_m, exact.travel_m[-2::-1], atol=1e-12)
+    # the force falls at the ramp's rate down to contact; where it passes a ramp level the
+    # travel lies between the ramp's at the levels on either side (an elastic block retraces
+    # its loading) and is the ramp's first at contact
+    np.testing.assert_allclose(exact.unloading.force_n,
+                               FORCE - 2.0 * (exact.unloading.time_s - exact.hold.time_s[-1]))
+    assert exact.unloading.force_n[-1] == pytest.approx(0.02)
+    above = np.searchsorted(exact.force_n, exact.unloading.force_n - 1e-12)
+    assert np.all(exact.unloading.travel_m <= exact.travel_m[above] + 1e-12)
+    assert np.all(exact.unloading.travel_m >= exact.travel_m[np.maximum(above - 1, 0)] - 1e-12)
+    assert exact.unloading.travel_m[-1] == pytest.approx(exact.travel_m[0], abs=1e-12)
+    assert np.all(np.diff(exact.unloading.travel_m) <= 0.0)
     only_hold = _record(hold_s=2.0, noise=False)
     assert only_hold.hold is not None and only_hold.unloading is None
 
 
 @pytest.mark.parametrize(("field", "value"), [("hold_s", -1.0), ("ramp_rate_n_per_s", 0.0),
-                                              ("hold_s", float("nan"))])
+                                              ("hold_s", float("nan")), ("sample_rate_hz", 0.0),
+                                              ("sample_rate_hz", float("inf"))])
 def test_bad_protocol_names_the_setting(field: str, value: float) -> None:
     with pytest.raises(SettingError, match=field):
         WorldConfig(**{field: value})
+
+
+def test_the_sensors_read_a_viscoelastic_hold_between_the_solved_steps() -> None:
+    """At the sensors' rate the hold creeps sample by sample; where a sample falls on a solved
+    time it is the solved indentation (a world read at the solved schedule's rate)."""
+    from deformap.environment import Workspace
+    from deformap.world import Block, Scenario, Viscoelastic
+
+    block = Block(name="memory", polygon=np.array([[0, 0], [0.3, 0], [0.3, 0.3], [0, 0.3]]),
+                  hardness_n=60.0, viscoelastic=Viscoelastic(relaxed_ratio=0.5, times_s=(1.0,)))
+    scenario = Scenario(name="m", blocks=(block,),
+                        workspace=Workspace(lower=(0.0, 0.0), upper=(0.3, 0.3)))
+
+    def record(rate: float):  # type: ignore[no-untyped-def]
+        config = WorldConfig.coarse(noise=False, hold_s=2.0, unload=True, sample_rate_hz=rate)
+        got = SimulatedWorld(scenario, config=config, rng=np.random.default_rng(0)).press(
+            (0.15, 0.15), FORCE).force_travel
+        assert got is not None and got.hold is not None and got.unloading is not None
+        return got
+
+    dense, solved = record(100.0), record(4.0)  # 4 Hz over 2 s: the solved 8 hold samples
+    assert len(dense.hold) == 200 and len(solved.hold) == 8 and len(solved.unloading) == 8
+    np.testing.assert_array_equal(dense.travel_m, solved.travel_m)
+    at = np.searchsorted(dense.hold.time_s, solved.hold.time_s - 1e-9)
+    np.testing.assert_allclose(dense.hold.time_s[at], solved.hold.time_s, atol=1e-12)
+    np.testing.assert_allclose(dense.hold.travel_m[at], solved.hold.travel_m, atol=1e-12)
+    assert np.all(np.diff(dense.hold.travel_m) > 0.0)  # it creeps between the solved samples
+    assert dense.unloading.travel_m[-1] == pytest.approx(solved.unloading.travel_m[-1], abs=1e-12)

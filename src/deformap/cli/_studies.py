@@ -223,6 +223,12 @@ def study_behaviour(
     shown.print(f"  all: {study['n_presses']} presses, right {cell(study['right'], '.1%')}, "
                 f"elastic flagged otherwise {cell(study['elastic_flagged'], '.1%')}, unknown "
                 f"{cell(study['unknown'], '.1%')}", highlight=False)
+    e = study["errors"]
+    shown.print(f"  against the world's: relaxation within {e['relaxation']['tolerance']:g} "
+                f"{e['relaxation']['within']}/{e['relaxation']['n']}, time constant within "
+                f"{e['tau']['tolerance']:.0%} {e['tau']['within']}/{e['tau']['n']}, residual "
+                f"dent within {e['residual_dent']['tolerance'] * 1e3:g} mm "
+                f"{e['residual_dent']['within']}/{e['residual_dent']['n']}", highlight=False)
     shown.print(f"wrote {' and '.join(map(str, output.files))}", highlight=False)
     emit_json(json_path, study)
 

@@ -14,6 +14,7 @@ from deformap._lazy import lazy_exports
 if TYPE_CHECKING:
     from deformap.eval._behaviour_study import (
         BEHAVIOUR_READS,
+        BEHAVIOUR_TOLERANCES,
         BEHAVIOUR_TRUTHS,
         FULL_BEHAVIOUR_MATERIALS,
         QUICK_BEHAVIOUR_MATERIALS,
@@ -75,9 +76,10 @@ _MODULES = {
     "_bench_msm": ("bench_beta_sweep",),
     "_bench_world": ("bench_world",),
     "_metrics": ("OrderingScores", "RegionScores", "ordering_scores", "region_scores"),
-    "_behaviour_study": ("BEHAVIOUR_READS", "BEHAVIOUR_TRUTHS", "FULL_BEHAVIOUR_MATERIALS",
-                         "QUICK_BEHAVIOUR_MATERIALS", "BehaviourMaterial", "behaviour_presses",
-                         "behaviour_summary", "material_scenario"),
+    "_behaviour_study": ("BEHAVIOUR_READS", "BEHAVIOUR_TOLERANCES", "BEHAVIOUR_TRUTHS",
+                         "FULL_BEHAVIOUR_MATERIALS", "QUICK_BEHAVIOUR_MATERIALS",
+                         "BehaviourMaterial", "behaviour_presses", "behaviour_summary",
+                         "material_scenario"),
     "_studies": ("DEFAULT_HARDNESSES", "DEFAULT_POSITIONS", "DEFAULT_PROTOCOL", "PAPER_PROTOCOL",
                  "PROTOCOLS", "STUDY_PROTOCOLS", "FoamPresses", "block_scenario",
                  "cluster_size_study", "collect_presses", "hardness_study", "hardness_summary"),
@@ -94,6 +96,7 @@ _MODULES = {
 
 __all__ = [
     "BEHAVIOUR_READS",
+    "BEHAVIOUR_TOLERANCES",
     "BEHAVIOUR_TRUTHS",
     "CSV_COLUMNS",
     "DEFAULT_HARDNESSES",

@@ -41,6 +41,7 @@ from deformap.stiffness._behaviour import (
     PressBehaviour,
     PressRecord,
     press_behaviour,
+    record_dent_floor,
     released_dent,
 )
 from deformap.stiffness._config import LAYER_MODEL, StiffnessConfig, StiffnessEstimate
@@ -57,5 +58,6 @@ __all__ = [
     "dent_anisotropy",
     "estimate_stiffness",
     "press_behaviour",
+    "record_dent_floor",
     "released_dent",
 ]

@@ -271,7 +271,9 @@ def zero_force_travel(record: PressRecord, sigma_f: float, sigma_t: float,
     j = np.clip(np.searchsorted(x_l, x), 1, x_l.size - 1)
     f_l = np.maximum(lf[order], 0.0)
     slope = (t_l[j] - t_l[j - 1]) / np.maximum(f_l[j] - f_l[j - 1], 1e-12)
-    var = 2.0 * sigma_t**2 + 2.0 * (slope * sigma_f) ** 2
+    # a noise-free record (a simulation without noise) weighs its samples alike: the floor is
+    # far below any sensor's (1e-15 m), so a real record's weights are its own
+    var = np.maximum(2.0 * sigma_t**2 + 2.0 * (slope * sigma_f) ** 2, 1e-30)
     top = float(np.max(np.maximum(f, 0.0) ** (2.0 / 3.0)))
     u = x / top
     c = Measure(0.0, 0.0) if creep is None else creep

@@ -71,6 +71,10 @@ class WorldConfig:
     hold_s : float
         Probe protocol: how long the commanded force is held after the ramp (the record's hold:
         the travel creeps on a viscoelastic block); 0: no hold recorded.
+    sample_rate_hz : float
+        The rate at which the force sensor and the encoders are read during the hold and the
+        unloading (never fewer samples than the ramp's levels); the ramp keeps its
+        ``force_travel_levels`` levels, each a press solve.
     unload : bool
         Probe protocol: record the unloading branch (the force falling back to contact).
     contact_threshold_n : float
@@ -111,6 +115,9 @@ class WorldConfig:
     # a hand-held press gauge loads at about 1–10 N/s; 1 kN/s is an impact, not a press
     ramp_rate_n_per_s: float = setting(2.0, gt=0.0, le=1000.0)
     hold_s: float = setting(0.0, ge=0.0, le=600.0)  # ten minutes: longer is a creep test
+    # 100 Hz: the Robotiq FT 300's data output rate (its datasheet); arms' F/T streams run at
+    # hundreds of Hz to 1 kHz (docs/robot.md), so this is the slow end
+    sample_rate_hz: float = setting(100.0, gt=0.0, le=10000.0)
     unload: bool = False
     contact_threshold_n: float = setting(0.02, gt=0.0, le=0.1)
     encoder_noise_m: float = setting(5e-5, ge=0.0, le=1e-3)  # arm encoders: about 0.05 mm

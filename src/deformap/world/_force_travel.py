@@ -10,8 +10,12 @@ the force sensor reads ``F_k`` with an error of ``rel · F_k + abs`` (one standa
 The probe's protocol (:class:`~deformap.world._config.WorldConfig`) may add sample times, a hold
 and an unloading branch (:func:`press_schedule`). The ramp is load-controlled: the force rises at
 ``ramp_rate_n_per_s``, so level ``k`` is reached at ``(F_k − F_0) / rate``; the hold keeps the
-commanded force for ``hold_s`` (travel may creep), sampled ``n_levels`` times evenly; the unloading
-branch lowers the force through the ramp's levels, in reverse, at the same rate. The phases' noise
+commanded force for ``hold_s`` (travel may creep); the unloading branch lowers the force from the
+commanded one to the contact threshold at the same rate. The world's physics solves the hold at
+``n_levels`` evenly spaced times and the unloading at the ramp's levels in reverse (the solved
+schedule); the sensors read the hold and the unloading at their own rate, ``sample_rate_hz``
+(the sensor schedule, never fewer samples than the solved one), each sample's true indentation
+read between the solved ones by the material's own law (:func:`phase_depths`). The phases' noise
 is drawn from a stream of their own, after the ramp's, so the ramp is the record without them.
 """
 
@@ -24,9 +28,11 @@ from numpy.typing import NDArray
 
 from deformap.environment import ForceTravel, PressPhase
 from deformap.world._config import RecordSpacing
+from deformap.world._plastic import PlasticPress
+from deformap.world._viscoelastic import PressHistory
 
-__all__ = ["PressSchedule", "elastic_phases", "force_levels", "press_schedule", "simulated_force_travel",
-           "with_phases"]
+__all__ = ["PressSchedule", "between_levels", "force_levels", "phase_depths", "press_schedule",
+           "simulated_force_travel", "with_phases"]
 
 
 def force_levels(contact_n: float, force_n: float, n_levels: int,
@@ -73,25 +79,58 @@ class PressSchedule:
 
 
 def press_schedule(levels: NDArray[np.float64], *, rate_n_per_s: float, hold_s: float,
-                   unload: bool) -> PressSchedule:
-    """The protocol's sample times for a ramp through ``levels`` (module docstring)."""
+                   unload: bool, sample_rate_hz: float | None = None) -> PressSchedule:
+    """The protocol's sample times for a ramp through ``levels`` (module docstring): the solved
+    schedule, or with ``sample_rate_hz`` the sensors' (the hold and the unloading sampled at that
+    rate, never fewer samples than the ramp's levels above contact)."""
     times = (levels - levels[0]) / rate_n_per_s
     n = levels.size - 1
-    hold = times[-1] + hold_s * np.arange(1, n + 1) / n if hold_s > 0.0 else np.zeros(0)
+    n_hold = n if sample_rate_hz is None else max(n, round(hold_s * sample_rate_hz))
+    hold = times[-1] + hold_s * np.arange(1, n_hold + 1) / n_hold if hold_s > 0.0 else np.zeros(0)
     end = hold[-1] if hold.size else times[-1]
-    forces = levels[-2::-1].copy() if unload else np.zeros(0)
+    if not unload:
+        forces = np.zeros(0)
+    elif sample_rate_hz is None:
+        forces = levels[-2::-1].copy()
+    else:
+        n_unload = max(n, round((levels[-1] - levels[0]) / rate_n_per_s * sample_rate_hz))
+        forces = levels[-1] - (levels[-1] - levels[0]) * np.arange(1, n_unload + 1) / n_unload
+        forces[-1] = levels[0]  # down to contact exactly, as the solved branch
     unload_times = end + (levels[-1] - forces) / rate_n_per_s
     return PressSchedule(levels=levels, times=times, hold_times=hold,
                          unload_times=unload_times, unload_forces=forces)
 
 
-def elastic_phases(schedule: PressSchedule, depths: NDArray[np.float64]
-                   ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:  # fmt: skip
-    """The indentations of an elastic block during the hold and the unloading of ``schedule``:
-    it holds the last level's and retraces the ramp's levels (``depths``) in reverse."""
-    hold = np.full(schedule.hold_times.size, depths[-1])
-    unloading = depths[-2::-1][:schedule.unload_times.size].copy()
-    return hold, unloading
+def between_levels(forces: NDArray[np.float64], level_forces: NDArray[np.float64],
+                   level_depths: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The indentation at ``forces`` from the indentations solved at ``level_forces``, linear in
+    ``F^(2/3)`` between neighbouring levels: the sphere's contact law ``δ = a + c F^(2/3)``
+    (Hertz; ``a`` a dent already kept) over each interval."""
+    x = np.maximum(level_forces, 0.0) ** (2.0 / 3.0)
+    order = np.argsort(x, kind="stable")
+    return np.interp(np.maximum(forces, 0.0) ** (2.0 / 3.0), x[order], level_depths[order])
+
+
+def phase_depths(solved: PressSchedule, sensor: PressSchedule, depths: NDArray[np.float64],
+                 history: PressHistory | PlasticPress | None
+                 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:  # fmt: skip
+    """The true indentations at the ``sensor`` schedule's hold and unloading samples, from the
+    ramp's ``depths`` and the press's ``history`` solved on the ``solved`` schedule (``None``:
+    an elastic block). Elastic: the hold keeps the last level's indentation and the unloading
+    retraces the ramp's levels. Plastic (rate-independent): the hold keeps it too and the
+    unloading follows its own solved levels. Both read between levels by
+    :func:`between_levels`. Viscoelastic: linear in time between the time steps of the solve,
+    the strain's own form over a step in its recursive update
+    (:mod:`deformap.world._viscoelastic`)."""
+    if isinstance(history, PressHistory):
+        return (np.interp(sensor.hold_times, history.step_times, history.step_depths),
+                np.interp(sensor.unload_times, history.step_times, history.step_depths))
+    hold = np.full(sensor.hold_times.size, depths[-1])
+    if history is None:
+        return hold, between_levels(sensor.unload_forces, solved.levels, depths)
+    forces = np.concatenate([solved.levels[-1:], solved.unload_forces])
+    solved_depths = np.concatenate([depths[-1:], history.unloading])
+    return hold, between_levels(sensor.unload_forces, forces, solved_depths)
 
 
 def with_phases(record: ForceTravel, schedule: PressSchedule, zero_m: float,

@@ -34,8 +34,8 @@ from deformap.world._camera import DepthCamera, Frame
 from deformap.world._config import WorldConfig, check_world_budget
 from deformap.world._foam import Dent, FoamModel
 from deformap.world._force_travel import (
-    elastic_phases,
     force_levels,
+    phase_depths,
     press_schedule,
     simulated_force_travel,
     with_phases,
@@ -245,9 +245,10 @@ class SimulatedWorld(WorldTruth):
                 "less force")
         return dent
 
-    def force_travel(self, target_xy: Any, force_n: float, dent: Dent | None = None
-                     ) -> ForceTravel | None:
-        """The force–travel record of the press at ``target_xy`` with ``force_n`` newtons.
+    def force_travel(self, target_xy: Any, force_n: float, dent: Dent | None = None, *,
+                     exact: bool = False) -> ForceTravel | None:
+        """The force–travel record of the press at ``target_xy`` with ``force_n`` newtons (with
+        ``exact``, without noise: the world's true indentations, for evaluation).
 
         One press solve per load level (:mod:`deformap.world._force_travel`), ``dent`` (the
         press's own solve) the last. None under :data:`MIN_RECORD_FORCE_N`, and, with a warning,
@@ -267,24 +268,21 @@ class SimulatedWorld(WorldTruth):
         history = self._material_press(target, force)
         depths = history.ramp if history is not None else self._level_depths(target, levels,
                                                                                final)
-        on = 1.0 if c.noise else 0.0
-        noise = dict(encoder_noise_m=c.encoder_noise_m * on,
-                     force_noise_rel=c.force_travel_noise_rel * on,
-                     force_noise_n=c.force_travel_noise_n * on)
+        on = 1.0 if c.noise and not exact else 0.0
+        noise = dict(encoder_noise_m=c.encoder_noise_m * on, force_noise_n=c.force_travel_noise_n
+                     * on, force_noise_rel=c.force_travel_noise_rel * on)
         key = self._press_key(target, force, 2)
         try:
             record = simulated_force_travel(depths, levels, self._event_rng(*key), **noise)
             if not schedule.has_phases:
                 return record
-            hold, unloading = elastic_phases(schedule, depths)
-            if isinstance(history, PressHistory):
-                hold, unloading = history.hold, history.unloading
-            elif history is not None:
-                unloading = history.unloading
+            sensor = press_schedule(levels, rate_n_per_s=c.ramp_rate_n_per_s, hold_s=c.hold_s,
+                                    unload=c.unload, sample_rate_hz=c.sample_rate_hz)
+            hold, unloading = phase_depths(schedule, sensor, depths, history)
             # the encoder's reading at first contact: the ramp stream's first draw
             zero = depths[0] + self._event_rng(*key).normal(0.0, 1.0, size=depths.size)[0] * (
                 noise["encoder_noise_m"])
-            return with_phases(record, schedule, zero, hold, unloading,
+            return with_phases(record, sensor, zero, hold, unloading,
                                self._event_rng(*self._press_key(target, force, 4)), **noise)
         except InvalidArgumentError as err:
             log.warning("no force–travel record for the press at %s with %g N: the solved "
