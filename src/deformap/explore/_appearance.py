@@ -14,7 +14,9 @@ Built once from the cloud before the first poke (:func:`build_appearance`):
    unseen are no edges and a strip of mixed colour along a boundary is no look of its own.
 4. Each segment's feature: its cells' mean channels, standardised per group (colour, texture,
    height) by the spread of the segment means, never below the group's noise nor, for colour
-   and texture, the just-noticeable difference, so a flat channel is not inflated.
+   and texture, the just-noticeable difference, so a flat channel is not inflated. The looks
+   differ when, in some group, the root-mean-square distance between the looks of two cells
+   drawn at random (a colour difference ΔE*ab for colour) exceeds that floor.
 
 Where the image cannot carry a layout (no colour, too little seen, saturated or black, colours
 all alike, no segment a dent wide, one segment, looks that differ by no more than a
@@ -230,7 +232,11 @@ def _features(channels: NDArray[np.float64], noise: NDArray[np.float64],
         floor = float(np.max(noise[group]))
         if group.start < 4:  # colour and texture: what the eye would tell apart
             floor = max(floor, JND_DELTA_E)
-        differ |= spread > floor
+        # the looks differ when two places drawn at random differ by more than the floor, as a
+        # distance over the group's channels (ΔE*ab for colour; RMS over pairs of cells): the
+        # per-channel spread above is ΔE / (2√3) for two equal looks, so it hid looks up to
+        # 2√3 · JND ≈ 8 apart
+        differ |= float(np.sqrt(2.0 * weights @ np.sum(centred[:, group] ** 2, axis=1))) > floor
         out[:, group] = centred[:, group] / max(spread, floor)
     return out, differ
 
