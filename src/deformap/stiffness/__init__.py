@@ -43,13 +43,25 @@ from deformap.stiffness._behaviour import (
     press_behaviour,
     released_dent,
 )
-from deformap.stiffness._config import LAYER_MODEL, StiffnessConfig, StiffnessEstimate
+from deformap.stiffness._config import (
+    FIT_P_VALUE,
+    LAYER_MODEL,
+    ContactModelFit,
+    StiffnessConfig,
+    StiffnessEstimate,
+)
+from deformap.stiffness._dent_evidence import DentSamples
 from deformap.stiffness._estimate import estimate_stiffness
+from deformap.stiffness._tables import CONTACT_MODELS
 
 __all__ = [
     "ANISOTROPY_WINDOW_RADII",
     "BEHAVIOURS",
+    "CONTACT_MODELS",
+    "FIT_P_VALUE",
     "LAYER_MODEL",
+    "ContactModelFit",
+    "DentSamples",
     "PressBehaviour",
     "PressRecord",
     "StiffnessConfig",
