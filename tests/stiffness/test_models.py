@@ -23,7 +23,7 @@ H = 0.05  # the layer's thickness [m]
 E = 2e4  # the modulus the records are made with [Pa]
 F_C = 0.6  # the commanded force [N]
 CAMERA_NOISE = 5e-4  # per cloud point [m]: a sensor at close range
-KNOWN = StiffnessConfig(poisson_ratio_std=0.0)
+KNOWN = StiffnessConfig(poisson_ratio_std=0.0, contact_models=CONTACT_MODELS)
 
 
 def _record(model: str, rng: np.random.Generator, n: int = 9) -> tuple[np.ndarray, np.ndarray]:

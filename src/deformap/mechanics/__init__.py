@@ -2,8 +2,8 @@
 elastic layer and on a two-parameter (Vlasov) foundation, foam hardness.
 
 The physics both the simulated world and the estimator use (SI units); it imports numpy, scipy's
-special functions and the validators only, so that ``world`` can use it without the estimator. Each module gives its
-references.
+special functions and the validators only, so that ``world`` can use it without the estimator.
+Each module gives its references.
 """
 
 from __future__ import annotations

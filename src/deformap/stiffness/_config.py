@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Literal
 
 import numpy as np
 from numpy.typing import NDArray
@@ -12,6 +13,9 @@ from deformap.errors import InvalidArgumentError
 
 __all__ = ["FIT_P_VALUE", "LAYER_MODEL", "MIN_SAMPLES", "ContactModelFit", "StiffnessConfig",
            "StiffnessEstimate", "force_std"]
+
+#: A contact model a record is compared against (:mod:`deformap.stiffness`, Contact models).
+ContactModel = Literal["bonded-layer", "half-space", "foundation"]
 
 #: The contact model's name in :attr:`StiffnessEstimate.model`.
 LAYER_MODEL = "sphere-on-bonded-layer (Hertz + Dimitriadis 2002)"
@@ -43,6 +47,13 @@ class StiffnessConfig:
         How far, in standard deviations of a two-reading difference, travel or force may step back.
     force_tolerance_rel, force_tolerance_abs_n : float
         Allowed gap ``rel · F + abs`` (or three force σ) between the last and commanded force.
+    contact_models : tuple of str
+        The contact models E is averaged over: ``bonded-layer`` (the reference, always in) and
+        any of ``half-space`` and ``foundation``. By default the layer and the foundation, the
+        two kinematics a foam on a table may follow; ``half-space`` is for a layer whose base
+        is not known to be there (with the base known, neither a record nor a dent tells the
+        two apart, and the half-space would only pull E away from the layer it is). A user who
+        knows the surface's kinematics (a gel bonded to glass) names only its model.
     """
 
     poisson_ratio: float = setting(0.33, ge=0.0, le=0.5)
@@ -54,9 +65,15 @@ class StiffnessConfig:
     backwards_sigmas: float = setting(4.0, gt=0.0)
     force_tolerance_rel: float = setting(0.25, ge=0.0, le=1.0)
     force_tolerance_abs_n: float = setting(0.05, ge=0.0)
+    contact_models: tuple[ContactModel, ...] = ("bonded-layer", "foundation")
 
     def __post_init__(self) -> None:
         check_settings(self)
+        if "bonded-layer" not in self.contact_models or len(set(self.contact_models)) != len(
+                self.contact_models):
+            raise InvalidArgumentError(
+                f"`contact_models` must hold `bonded-layer` (the reference model) and each model "
+                f"once; got {list(self.contact_models)}")
 
 
 @dataclass(frozen=True, kw_only=True)

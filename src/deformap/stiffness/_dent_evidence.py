@@ -92,9 +92,6 @@ def dent_chi2(dent: DentSamples, models: list[tuple[str, ContactTable, float]], 
     ``m / τ`` points count, and what the best model misses counts as correlated error too.
     """
     m = dent.radius_m.size
-    import os
-    if os.environ.get("DENT_DEBUG"):
-        print("DENTIN", m, len(models), file=open("/tmp/models_meas/" + os.environ["DENT_DEBUG"] + "", "a"))
     if m < 3 or len(models) < 2:
         return np.zeros(len(models))
     residuals = []
@@ -102,16 +99,10 @@ def dent_chi2(dent: DentSamples, models: list[tuple[str, ContactTable, float]], 
         res = dent.sink_m - _predicted(table, name, depth, radius, thickness, nu, dent.radius_m)
         residuals.append(res - np.median(res))
     spread = np.array([float(np.median(np.abs(r))) for r in residuals])
-    best = residuals[int(np.argmin(spread))]
     scatter = max(_MAD_TO_STD * float(spread.min()), 1e-6)
     # flying pixels: beyond 5 σ a point is no sample of the sink (its residual is clipped)
     clipped = [np.clip(r, -5.0 * scatter, 5.0 * scatter) for r in residuals]
     sq = np.array([float(r @ r) for r in clipped])
     tau = _correlation_factor(clipped[int(np.argmin(spread))], dent.offset_m,
                               dent.correlation_length_m, scatter)
-    import os
-    if os.environ.get("DENT_DEBUG"):
-        print("DENTDBG", file=open("/tmp/models_meas/" + os.environ["DENT_DEBUG"] + "", "a"), *(m, round(tau, 2), round(scatter * 1e3, 3),
-              [(n[:4], round(d * 1e3, 2)) for n, _, d in models],
-              np.round(sq / scatter**2, 1).tolist()))
     return np.asarray(sq / scatter**2 / tau)

@@ -10,11 +10,11 @@ from numpy.typing import NDArray
 
 from deformap._validation import check_array, check_positive
 from deformap.errors import InvalidArgumentError
-from deformap.stiffness._config import MIN_SAMPLES, StiffnessConfig, StiffnessEstimate, force_std
 from deformap.stiffness._compare import average_models, read_model
+from deformap.stiffness._config import MIN_SAMPLES, StiffnessConfig, StiffnessEstimate, force_std
 from deformap.stiffness._dent_evidence import DentSamples, dent_chi2
 from deformap.stiffness._fit import fit_record
-from deformap.stiffness._tables import BONDED_LAYER, CONTACT_MODELS, FOUNDATION
+from deformap.stiffness._tables import BONDED_LAYER, FOUNDATION
 
 __all__ = ["estimate_stiffness"]
 
@@ -160,7 +160,7 @@ def estimate_stiffness(travel_m: Any, force_n: Any, *, tip_radius_m: float, thic
     readings = [read_model(BONDED_LAYER, travel, force, radius, thickness, thickness_std,
                            force_c, config, fitted=(modulus, cov, chi2_red, fit))]
     readings += [read_model(name, travel, force, radius, thickness, thickness_std, force_c,
-                            config) for name in CONTACT_MODELS if name != BONDED_LAYER
+                            config) for name in config.contact_models if name != BONDED_LAYER
                  and (name != FOUNDATION or config.poisson_ratio <= _MAX_FOUNDATION_NU)]
     in_range = [r for r in readings if r is not None]
     if dent is not None:  # the dent's shape: evidence beside the record's own fit

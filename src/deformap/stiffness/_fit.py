@@ -1,4 +1,5 @@
-"""A force–travel record's fit under one contact model and its two-part model-error test (:mod:`deformap.stiffness`)."""
+"""A force–travel record's fit under one contact model and its two-part model-error test
+(:mod:`deformap.stiffness`)."""
 
 from __future__ import annotations
 
