@@ -29,8 +29,10 @@ is its χ² under the effective variance plus, when the camera's points about th
 Hertz's for the elastic models) at its depth at ``F_c``, with a free offset, σ from the best
 model's MAD, and divided by the points' correlation factor ``τ`` (batch means over cells of the
 touch model's length scale; Thiébaux & Zwiers 1984), so that ``m / τ`` points count. Weights
-``wᵢ ∝ exp(−½ Δevidenceᵢ / ĉ)`` (quasi-likelihood AIC with equal parameter counts, ``ĉ`` the
-best record fit's reduced χ², at least 1; Burnham & Anderson 2002) give ``E = Σ wᵢ Eᵢ`` and
+``wᵢ ∝ exp(−½ Δevidenceᵢ)``, the record's χ² over ``ĉ`` (quasi-likelihood AIC with equal
+parameter counts, ``ĉ`` the best record fit's reduced χ², at least 1; Burnham & Anderson 2002)
+and counted at ``n (1 − ρ) / (1 + ρ)`` samples (``ρ`` the best fit's lag-1 residual
+correlation: a record sampled faster than it varies gains nothing by it), give ``E = Σ wᵢ Eᵢ`` and
 ``σ² = Σ wᵢ σᵢ² + Σ wᵢ (Eᵢ − E)²``, ``k`` likewise: a near-tie widens σ over both models
 rather than jumping between them. The record must lie in the bonded layer's range (Range);
 ``δ₀``, ``δ_c`` and ``χ`` are that model's.
@@ -53,6 +55,8 @@ Burnham, K. P., Anderson, D. R. (2002). Model Selection and Multimodel Inference
 Thiébaux, H. J., Zwiers, F. W. (1984). The interpretation and estimation of effective sample
 size. J. Climate Appl. Meteor. 23(5), 800–811.
 Vlasov, V. Z., Leontiev, N. N. (1966). Beams, Plates and Shells on Elastic Foundations.
+Bayley, G. V., Hammersley, J. M. (1946). The "effective" number of independent observations in
+an autocorrelated time series. Suppl. J. R. Stat. Soc. 8(2), 184–197.
 """
 
 from __future__ import annotations

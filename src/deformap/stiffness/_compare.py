@@ -37,6 +37,7 @@ class ModelReading:
     depth: float
     table: ContactTable
     evidence: float
+    lag_correlation: float
 
 
 def _stiffness_at(fit: RecordFit, modulus: float, force_c: float) -> float:
@@ -81,24 +82,34 @@ def read_model(name: str, travel: NDArray[np.float64], force: NDArray[np.float64
     dk_de = (_stiffness_at(fit, modulus + step, force_c)
              - _stiffness_at(fit, modulus - step, force_c)) / (2.0 * step)
     chi2 = float(chi2_red * dof) if dof > 0 else 0.0
+    # the record's residuals in units of their σ, in order of travel: their lag-1 correlation
+    z = (travel + fit.offset(modulus) - fit.depths(modulus)) * np.sqrt(fit.weights)
+    lag = float(z[1:] @ z[:-1]) / float(z @ z) if float(z @ z) > 0 else 0.0
     return ModelReading(name=name, modulus=modulus, variance=variance, error=error, chi2=chi2,
                         dof=dof, stiffness=_stiffness_at(fit, modulus, force_c), dk_de=dk_de,
                         depth=float(fit.table.depth_at(np.array([force_c / modulus]))[0]),
-                        table=fit.table, evidence=chi2)
+                        table=fit.table, evidence=chi2, lag_correlation=lag)
 
 
 def average_models(readings: list[ModelReading]
                    ) -> tuple[float, float, float, float, float | None, tuple[ContactModelFit, ...]]:
     """``(E, σ_E, k, σ_k, model error, fits)``: the models' average with quasi-likelihood Akaike
     weights (Burnham & Anderson 2002, §2.5 and §4.3; every model has the parameters ``E`` and
-    ``δ₀``, so ``ΔQAIC = Δχ² / ĉ`` over each model's ``evidence``, with ``ĉ`` the best record
-    fit's reduced χ², at least 1), and the variance of the average: the weighted variances plus
-    the weighted spread of the models."""
+    ``δ₀``, so ``ΔQAIC = Δχ² / ĉ`` with ``ĉ`` the best record fit's reduced χ², at least 1), and
+    the variance of the average: the weighted variances plus the weighted spread of the models.
+
+    The record's χ² counts its samples as ``n (1 − ρ) / (1 + ρ)`` independent ones, ``ρ`` the
+    lag-1 correlation of the best fit's residuals (an AR(1) sequence's effective size; Bayley &
+    Hammersley 1946): a record sampled faster than it varies gains no evidence by it. Each
+    model's ``evidence`` beyond its record (the dent's χ²) adds to it."""
     chi2 = np.array([r.chi2 for r in readings])
-    evidence = np.array([r.evidence for r in readings])
+    dent = np.array([r.evidence - r.chi2 for r in readings])
     dofs = np.array([max(r.dof, 1) for r in readings])
-    c_hat = max(1.0, float(np.min(chi2 / dofs)))
-    w = np.exp(-0.5 * (evidence - evidence.min()) / c_hat)
+    best = int(np.argmin(chi2))
+    rho = min(max(readings[best].lag_correlation, 0.0), 0.99)
+    c_hat = max(1.0, float(chi2[best] / dofs[best]))
+    evidence = chi2 * (1.0 - rho) / (1.0 + rho) / c_hat + dent
+    w = np.exp(-0.5 * (evidence - evidence.min()))
     w = w / w.sum()
     moduli = np.array([r.modulus for r in readings])
     variances = np.array([r.variance for r in readings])
