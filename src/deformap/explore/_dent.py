@@ -58,14 +58,17 @@ _FLANK_TIP_RADII = 2.0
 
 def _force_fit(obs: PressObservation, stiffness: StiffnessEstimate | None,
                thickness: float | None, config: ExplorationConfig) -> NDArray[np.float64] | None:
-    """``(2, 60)`` travel [m] and force ``E g(t + δ₀)`` [N] of the fitted model, or ``None``."""
+    """``(2, 60)`` travel [m] and force ``E g(t + δ₀)`` [N] of the fitted bonded-layer model (its
+    own ``E``, whose ``δ₀`` the estimate carries), or ``None``."""
     record = obs.force_travel
     if record is None or stiffness is None or stiffness.modulus_pa is None or thickness is None:
         return None
+    modulus = next((f.modulus_pa for f in stiffness.model_fits if f.name == "bonded-layer"),
+                   stiffness.modulus_pa)
     travel = np.linspace(0.0, float(np.max(record.travel_m)), 60)
     depth = np.maximum(travel + (stiffness.contact_offset_m or 0.0), 0.0)
-    force = layer_indentation_force(depth, obs.contact.tip_radius_m, thickness,
-                                    stiffness.modulus_pa, config.stiffness.poisson_ratio)
+    force = layer_indentation_force(depth, obs.contact.tip_radius_m, thickness, modulus,
+                                    config.stiffness.poisson_ratio)
     return np.vstack([travel, force])
 
 
