@@ -12,12 +12,9 @@ from scipy.stats import chi2 as chi2_dist
 
 from deformap.stiffness._config import ContactModelFit, StiffnessConfig
 from deformap.stiffness._fit import RecordFit, fit_record, model_error
-from deformap.stiffness._tables import HALF_SPACE, ContactTable
+from deformap.stiffness._tables import FOUNDATION, HALF_SPACE, MAX_FOUNDATION_NU, ContactTable
 
 __all__ = ["ModelReading", "average_models", "read_model"]
-
-# the foundation's spring needs a compressible layer: ν is held below this in its ν refits
-_MAX_FOUNDATION_NU = 0.49
 
 
 @dataclass(frozen=True)
@@ -67,7 +64,7 @@ def read_model(name: str, travel: NDArray[np.float64], force: NDArray[np.float64
                              config, name)[0] for d in (-thickness_std, thickness_std)]
         variance += ((moduli[1] - moduli[0]) / 2.0) ** 2
     if config.poisson_ratio_std > 0:  # the material's ν is assumed, not measured: its spread too
-        top = 0.5 if name != "foundation" else _MAX_FOUNDATION_NU
+        top = MAX_FOUNDATION_NU if name == FOUNDATION else 0.5
         nus = [min(max(config.poisson_ratio + d, 0.0), top)
                for d in (-config.poisson_ratio_std, config.poisson_ratio_std)]
         if nus[1] > nus[0]:

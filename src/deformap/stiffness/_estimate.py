@@ -14,7 +14,7 @@ from deformap.stiffness._compare import average_models, read_model
 from deformap.stiffness._config import MIN_SAMPLES, StiffnessConfig, StiffnessEstimate, force_std
 from deformap.stiffness._dent_evidence import DentSamples, dent_chi2
 from deformap.stiffness._fit import fit_record
-from deformap.stiffness._tables import BONDED_LAYER, FOUNDATION
+from deformap.stiffness._tables import BONDED_LAYER, FOUNDATION, MAX_FOUNDATION_NU
 
 __all__ = ["estimate_stiffness"]
 
@@ -24,8 +24,6 @@ _MAX_THICKNESS_M = 2.0
 # collapse plateau (Gibson & Ashby, ch. 5)
 _MAX_CHI = 1.0
 _MAX_STRAIN = 0.5
-# an incompressible layer has no foundation spring (M → ∞): that model is left out near ν = 0.5
-_MAX_FOUNDATION_NU = 0.49
 
 
 def _check_record(travel_m: Any, force_n: Any, config: StiffnessConfig,
@@ -161,7 +159,7 @@ def estimate_stiffness(travel_m: Any, force_n: Any, *, tip_radius_m: float, thic
                            force_c, config, fitted=(modulus, cov, chi2_red, fit))]
     readings += [read_model(name, travel, force, radius, thickness, thickness_std, force_c,
                             config) for name in config.contact_models if name != BONDED_LAYER
-                 and (name != FOUNDATION or config.poisson_ratio <= _MAX_FOUNDATION_NU)]
+                 and (name != FOUNDATION or config.poisson_ratio <= MAX_FOUNDATION_NU)]
     in_range = [r for r in readings if r is not None]
     if dent is not None:  # the dent's shape: evidence beside the record's own fit
         extra = dent_chi2(dent, [(r.name, r.table, r.depth) for r in in_range], radius,

@@ -13,8 +13,8 @@ from deformap.mechanics import (
     layer_indentation_stiffness,
 )
 
-__all__ = ["BONDED_LAYER", "CONTACT_MODELS", "FOUNDATION", "HALF_SPACE", "ContactTable",
-           "contact_table"]
+__all__ = ["BONDED_LAYER", "CONTACT_MODELS", "FOUNDATION", "HALF_SPACE", "MAX_FOUNDATION_NU",
+           "ContactTable", "contact_table"]
 
 #: The bonded elastic layer (Hertz + Dimitriadis et al. 2002): the reference model, whose range
 #: a record must lie in.
@@ -25,6 +25,9 @@ HALF_SPACE = "half-space"
 FOUNDATION = "foundation"
 #: Every model a record is compared against, the reference first.
 CONTACT_MODELS: tuple[str, ...] = (BONDED_LAYER, HALF_SPACE, FOUNDATION)
+#: The foundation's spring needs a compressible layer (``M → ∞`` as ``ν → 0.5``): above this ``ν``
+#: the model is left out, and its ``ν`` refits stop here.
+MAX_FOUNDATION_NU = 0.49
 
 _TABLE_SIZE = 800
 # the layer's table stops short of where the series' force turns down, and at most at χ = 3
