@@ -62,29 +62,50 @@ def _moments(decay: NDArray[np.float64], thickness: float
     return slope2, value2
 
 
+def _decay_map(decay: NDArray[np.float64], a: NDArray[np.float64], radius: float, h: float,
+               shear_over_m: float) -> NDArray[np.float64]:
+    """Vallabhan & Das's ``γ`` of the surface that the mode of decay ``decay`` gives."""
+    slope2, value2 = _moments(decay, h)
+    ell = np.sqrt(shear_over_m * value2 / slope2)
+    x = a / ell
+    c1 = a / radius * ell  # C K₁(x) = −ℓ w'(a)
+    w_a = c1 * k0e(x) / k1e(x)
+    depth = a * a / (2.0 * radius) + w_a
+    # ∫ w² r dr and ∫ |w'|² r dr inside (the cap) and outside (C K₀, closed forms)
+    in_sq = radius / 3.0 * (depth**3 - w_a**3)
+    in_grad = a**4 / (4.0 * radius**2)
+    out_sq = ell**2 * x * x / 2.0 * (c1 * c1 - w_a * w_a)
+    out_grad = x * x / 2.0 * (w_a * w_a - c1 * c1) + x * w_a * c1
+    return np.asarray(h * np.sqrt(shear_over_m * (in_grad + out_grad) / (in_sq + out_sq)))
+
+
 def _solve(a: NDArray[np.float64], radius: float, h: float, nu: float
            ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
-    """``ℓ`` [m], ``k / E`` [1/m] and ``G_p / E`` [m] at contact radii ``a`` (module docstring)."""
+    """``ℓ`` [m], ``k / E`` [1/m] and ``G_p / E`` [m] at contact radii ``a`` (module docstring).
+
+    ``γ`` is the root of ``f(x) = log Γ(eˣ) − x``, ``Γ`` the map :func:`_decay_map`, from the
+    larger of ``Γ(0)`` and the deep layer's ``γ`` (``ℓ ≈ a``): one fixed-point round, then
+    secant steps in ``x``, each at most four fixed-point steps long (a safeguard where ``f`` is
+    flat), until every entry's step is below ``10⁻¹²``."""
     shear_over_m = (1.0 - 2.0 * nu) / (2.0 * (1.0 - nu))  # G / M
-    decay = np.zeros_like(a)
+
+    def f(x: NDArray[np.float64]) -> NDArray[np.float64]:
+        return np.asarray(np.log(_decay_map(np.exp(x), a, radius, h, shear_over_m)) - x)
+
+    x0 = np.maximum(np.log(_decay_map(np.zeros_like(a), a, radius, h, shear_over_m)),
+                    np.log(np.sqrt(shear_over_m) * h / a))
+    f0 = f(x0)
+    x1 = x0 + f0
     for _ in range(_DECAY_ROUNDS):
-        slope2, value2 = _moments(decay, h)
-        ell = np.sqrt(shear_over_m * value2 / slope2)
-        x = a / ell
-        c1 = a / radius * ell  # C K₁(x) = −ℓ w'(a)
-        w_a = c1 * k0e(x) / k1e(x)
-        depth = a * a / (2.0 * radius) + w_a
-        # ∫ w² r dr and ∫ |w'|² r dr inside (the cap) and outside (C K₀, closed forms)
-        in_sq = radius / 3.0 * (depth**3 - w_a**3)
-        in_grad = a**4 / (4.0 * radius**2)
-        out_sq = ell**2 * x * x / 2.0 * (c1 * c1 - w_a * w_a)
-        out_grad = x * x / 2.0 * (w_a * w_a - c1 * c1) + x * w_a * c1
-        new = h * np.sqrt(shear_over_m * (in_grad + out_grad) / (in_sq + out_sq))
-        done = np.max(np.abs(new - decay)) < 1e-10 * max(1.0, float(np.max(new)))
-        decay = new if done else 0.5 * (decay + new)
-        if done:
+        f1 = f(x1)
+        moved = x1 != x0
+        slope = np.where(moved, (f1 - f0) / np.where(moved, x1 - x0, 1.0), -1.0)
+        slope = np.where(slope < 0.0, slope, -1.0)  # no secant: a fixed-point step
+        step = np.clip(-f1 / slope, -4.0 * np.abs(f1), 4.0 * np.abs(f1))
+        x0, f0, x1 = x1, f1, x1 + step
+        if np.max(np.abs(step)) < 1e-12:
             break
-    slope2, value2 = _moments(decay, h)
+    slope2, value2 = _moments(np.exp(x1), h)
     spring = (1.0 - nu) / ((1.0 + nu) * (1.0 - 2.0 * nu)) * slope2
     shear = value2 / (2.0 * (1.0 + nu))
     return np.sqrt(shear / spring), spring, shear

@@ -41,9 +41,15 @@ class RecordFit:
         return max(self._free_offset(modulus), -3.0 * self.config.travel_noise_m)
 
     def chi2(self, log_modulus: float) -> float:
-        modulus = float(np.exp(log_modulus))
-        r = self.travel + self.offset(modulus) - self.depths(modulus)
-        return float(self.weights @ (r * r))
+        return float(self.chi2_grid(np.array([log_modulus]))[0])
+
+    def chi2_grid(self, log_moduli: NDArray[np.float64]) -> NDArray[np.float64]:
+        """The weighted χ² at each of ``log_moduli`` (δ₀ at its best, as :meth:`offset`)."""
+        gap = self.table.depth_at(self.force / np.exp(log_moduli)[:, None]) - self.travel
+        offset = np.maximum(gap @ self.weights / self.weights.sum(),
+                            -3.0 * self.config.travel_noise_m)
+        r = offset[:, None] - gap
+        return np.asarray((r * r) @ self.weights)
 
     def reweight(self, modulus: float) -> None:
         """Each sample's variance: the travel's plus the force's carried through ``g⁻¹``."""
@@ -61,7 +67,7 @@ class RecordFit:
         log_modulus = low
         for _ in range(_EFFECTIVE_VARIANCE_ROUNDS):
             grid = np.linspace(low, high, _MODULUS_GRID)
-            values = [self.chi2(x) for x in grid]
+            values = self.chi2_grid(grid)
             best = int(np.argmin(values))
             lo, hi = grid[max(best - 1, 0)], grid[min(best + 1, grid.size - 1)]
             found = minimize_scalar(self.chi2, bounds=(lo, hi), method="bounded",
