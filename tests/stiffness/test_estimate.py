@@ -89,7 +89,10 @@ def layer_estimates() -> list[tuple[float, StiffnessEstimate]]:
 
 #: The records below are made with the estimator's own ν: its uncertainty is left out, so that
 #: σ is checked against the sensor noise alone.
-NU_KNOWN = StiffnessConfig(poisson_ratio_std=0.0)
+# the records below are made with the bonded layer's law: these tests read them with that model
+# alone (the comparison of models is tests/stiffness/test_models.py)
+LAYER_ONLY = StiffnessConfig(contact_models=("bonded-layer",))
+NU_KNOWN = StiffnessConfig(poisson_ratio_std=0.0, contact_models=("bonded-layer",))
 
 
 def test_modulus_on_the_contact_model_is_accurate(layer_estimates):
@@ -256,7 +259,8 @@ def test_half_space_physics_read_as_a_layer():
         travel, measured = synthetic_record(rng, half_space_law(modulus), force, n)
         if not in_range(travel, 0.10):
             continue
-        est = estimate_stiffness(travel, measured, tip_radius_m=R, thickness_m=0.10)
+        est = estimate_stiffness(travel, measured, tip_radius_m=R, thickness_m=0.10,
+                                 config=LAYER_ONLY)
         assert est.modulus_pa is not None and est.max_chi is not None
         errors.append(est.modulus_pa / modulus - 1.0)
         predicted.append(1.0 / float(layer_correction(est.max_chi, NU)) - 1.0)
@@ -362,7 +366,8 @@ def test_sigma_carries_the_unknown_poisson_ratio() -> None:
         travel, measured = synthetic_record(rng, law, force, n)
         if not in_range(travel, thickness):
             continue
-        full = estimate_stiffness(travel, measured, tip_radius_m=R, thickness_m=thickness)
+        full = estimate_stiffness(travel, measured, tip_radius_m=R, thickness_m=thickness,
+                                  config=LAYER_ONLY)
         noise = estimate_stiffness(travel, measured, tip_radius_m=R, thickness_m=thickness,
                                    config=NU_KNOWN)
         assert full.modulus_pa == noise.modulus_pa  # the estimate itself does not change
@@ -419,7 +424,8 @@ def test_model_error_is_zero_on_a_noise_free_model_record():
     levels = np.linspace(CONTACT_THRESHOLD_N, 1.0, 9)
     law = layer_law(2e4, 0.05)
     depth = np.array([_depth_for(f, law) for f in levels])
-    est = estimate_stiffness(depth - depth[0], levels, tip_radius_m=R, thickness_m=0.05)
+    est = estimate_stiffness(depth - depth[0], levels, tip_radius_m=R, thickness_m=0.05,
+                             config=LAYER_ONLY)
     assert est.model_error_pa == 0.0
     assert est.modulus_pa == pytest.approx(2e4, rel=1e-3)
 
@@ -427,8 +433,8 @@ def test_model_error_is_zero_on_a_noise_free_model_record():
 def test_model_error_is_not_tested_on_three_samples():
     rng = np.random.default_rng(29)
     travel, measured = synthetic_record(rng, layer_law(2e4, 0.05), 2.0, 3)
-    assert estimate_stiffness(travel, measured, tip_radius_m=R, thickness_m=0.05
-                              ).model_error_pa is None
+    assert estimate_stiffness(travel, measured, tip_radius_m=R, thickness_m=0.05,
+                              config=LAYER_ONLY).model_error_pa is None
 
 
 def _stiffer_core(modulus: float, thickness: float, jump: float) -> tuple[Law, Law]:

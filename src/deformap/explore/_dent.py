@@ -42,7 +42,7 @@ from deformap.explore._surface import SurfaceModel, crop_to
 from deformap.gp import GaussianRandomField
 from deformap.mechanics import layer_indentation_force
 from deformap.msm import estimate_beta
-from deformap.stiffness import StiffnessEstimate, estimate_stiffness
+from deformap.stiffness import DentSamples, StiffnessEstimate, estimate_stiffness
 
 __all__ = ["dent_visible", "measure_press", "roi_grid"]
 
@@ -58,14 +58,17 @@ _FLANK_TIP_RADII = 2.0
 
 def _force_fit(obs: PressObservation, stiffness: StiffnessEstimate | None,
                thickness: float | None, config: ExplorationConfig) -> NDArray[np.float64] | None:
-    """``(2, 60)`` travel [m] and force ``E g(t + δ₀)`` [N] of the fitted model, or ``None``."""
+    """``(2, 60)`` travel [m] and force ``E g(t + δ₀)`` [N] of the fitted bonded-layer model (its
+    own ``E``, whose ``δ₀`` the estimate carries), or ``None``."""
     record = obs.force_travel
     if record is None or stiffness is None or stiffness.modulus_pa is None or thickness is None:
         return None
+    modulus = next((f.modulus_pa for f in stiffness.model_fits if f.name == "bonded-layer"),
+                   stiffness.modulus_pa)
     travel = np.linspace(0.0, float(np.max(record.travel_m)), 60)
     depth = np.maximum(travel + (stiffness.contact_offset_m or 0.0), 0.0)
-    force = layer_indentation_force(depth, obs.contact.tip_radius_m, thickness,
-                                    stiffness.modulus_pa, config.stiffness.poisson_ratio)
+    force = layer_indentation_force(depth, obs.contact.tip_radius_m, thickness, modulus,
+                                    config.stiffness.poisson_ratio)
     return np.vstack([travel, force])
 
 
@@ -102,14 +105,18 @@ def _roi_points(obs: PressObservation, surface: SurfaceModel, config: Exploratio
     return pts[on_surface], rest_at[on_surface]
 
 
-def _stiffness(obs: PressObservation, surface: SurfaceModel, config: ExplorationConfig
+def _stiffness(obs: PressObservation, surface: SurfaceModel, config: ExplorationConfig,
+               roi: NDArray[np.float64], rest_at: NDArray[np.float64],
                ) -> tuple[StiffnessEstimate | None, float | None, str | None]:
     """The force–travel record's estimate, the layer thickness it was read with (the surface's
-    height above z = 0 at the contact), and why a record gave none; all ``None`` without one."""
+    height above z = 0 at the contact), and why a record gave none; all ``None`` without one.
+    The ROI's points (``roi``, the surface at rest under them ``rest_at``) give the dent's
+    shape, their correlation tested over the touch model's length scale."""
     record = obs.force_travel
     if record is None:
         return None, None, None
     center = obs.contact.contact_point[:2]
+    dent = DentSamples.of(roi[:, :2] - center, rest_at - roi[:, 2], config.touch.length_scale_m)
     mean, std = surface.gp.predict(center[None, :], return_std=True)
     thickness = float(np.asarray(mean).reshape(-1)[0])
     try:
@@ -117,7 +124,7 @@ def _stiffness(obs: PressObservation, surface: SurfaceModel, config: Exploration
                                       tip_radius_m=obs.contact.tip_radius_m,
                                       thickness_m=thickness, commanded_force_n=obs.force_n,
                                       thickness_std_m=float(np.asarray(std).reshape(-1)[0]),
-                                      config=config.stiffness)  # fmt: skip
+                                      config=config.stiffness, dent=dent)  # fmt: skip
     except DeformapError as exc:
         logger.warning("force–travel record not used (the camera alone reads this poke): %s", exc)
         return None, thickness, str(exc)
@@ -167,7 +174,7 @@ def measure_press(obs: PressObservation, index: int, surface: SurfaceModel,
     roi_xs, roi_ys = roi_grid(center, cfg.roi_size_m, config.surface.grid_spacing_m)
     roi, rest_at = _roi_points(obs, surface, config)
     t_stiff = time.perf_counter()
-    stiffness, thickness, stiffness_error = _stiffness(obs, surface, config)
+    stiffness, thickness, stiffness_error = _stiffness(obs, surface, config, roi, rest_at)
     t_stiff = time.perf_counter() - t_stiff
     depth, anchored_noise, anchored = _indentation(obs, surface, config, stiffness)
     half_angle, n_tactile = (contact_cap(contact.tip_radius_m, depth, cfg.n_tactile)

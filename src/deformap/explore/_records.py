@@ -24,6 +24,7 @@ from deformap.stiffness import (
     ANISOTROPY_WINDOW_RADII,
     BEHAVIOURS,
     LAYER_MODEL,
+    ContactModelFit,
     PressBehaviour,
     StiffnessEstimate,
     dent_anisotropy,
@@ -101,14 +102,24 @@ def _stiffness_from_dict(data: Any, where: str) -> StiffnessEstimate | None:
     data = _mapping(data, where, StiffnessEstimate)
     names = {f.name for f in fields(StiffnessEstimate)}
     numbers = {n: _number(data, n, where, optional=True)
-               for n in names - {"rigid", "n_samples", "model", "depth_m"}}  # fmt: skip
+               for n in names - {"rigid", "n_samples", "model", "depth_m", "model_fits"}}  # fmt: skip
     model = _text(data, "model", where)
+    listed = data.get("model_fits") or []
+    if not isinstance(listed, list):
+        raise FileFormatError(f"`{where}.model_fits` must be a list; got {listed!r}")
     try:
+        fits = []
+        for i, item in enumerate(listed):
+            at = f"{where}.model_fits[{i}]"
+            item = _mapping(item, at, ContactModelFit)
+            fits.append(ContactModelFit(name=_text(item, "name", at) or "", **{
+                n: _number(item, n, at) for n in
+                ("modulus_pa", "modulus_std_pa", "reduced_chi2", "p_value", "weight")}))
         return StiffnessEstimate(
             **numbers, depth_m=_number(data, "depth_m", where),
             rigid=_number(data, "rigid", where, kind=bool),
             n_samples=_number(data, "n_samples", where, kind=int),
-            model=LAYER_MODEL if model is None else model)
+            model=LAYER_MODEL if model is None else model, model_fits=tuple(fits))
     except InvalidArgumentError as exc:
         raise FileFormatError(f"`{where}`: {exc}") from None
 
@@ -231,6 +242,7 @@ class PokeRecord:
                 value = value.to_dict()
             elif isinstance(value, StiffnessEstimate):
                 value = {g.name: getattr(value, g.name) for g in fields(value)}
+                value["model_fits"] = [dataclasses.asdict(m) for m in value["model_fits"]]
             elif isinstance(value, PressBehaviour):
                 value = value.to_dict()
             if value is not None or f.name == "camera_noise_m":

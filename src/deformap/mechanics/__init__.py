@@ -1,14 +1,15 @@
 """Contact mechanics: the tactile contact, Hertz contact of the probe's sphere, a sphere on a bonded
-elastic layer, foam hardness.
+elastic layer and on a two-parameter (Vlasov) foundation, foam hardness.
 
-The physics both the simulated world and the estimator use (SI units); it imports numpy and the
-validators only, so that ``world`` can use it without the estimator. Each module gives its
-references.
+The physics both the simulated world and the estimator use (SI units); it imports numpy, scipy's
+special functions and the validators only, so that ``world`` can use it without the estimator.
+Each module gives its references.
 """
 
 from __future__ import annotations
 
 from deformap.mechanics._contact import TactileContact
+from deformap.mechanics._foundation import foundation_indentation, foundation_surface_deflection
 from deformap.mechanics._hardness import (
     INDENTATION_STRAIN,
     INDENTER_AREA_M2,
@@ -33,6 +34,7 @@ from deformap.mechanics._layer import (
 
 __all__ = [
     "INDENTATION_STRAIN", "INDENTER_AREA_M2", "TactileContact", "elastic_dent",
+    "foundation_indentation", "foundation_surface_deflection",
     "hardness_to_youngs_modulus", "hertz_contact_radius", "hertz_indentation",
     "hertz_pressure_samples", "hertz_surface_deflection", "layer_chi_limit", "layer_correction",
     "layer_correction_coefficients", "layer_indentation_force", "layer_indentation_stiffness",

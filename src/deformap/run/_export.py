@@ -19,8 +19,10 @@ prior was not used).
 force–travel reading (empty without one), ``region`` (``region_labels`` + 1; empty where the
 map field left the poke out) and what the press reveals beyond its stiffness (``behaviour`` and
 the quantities of :class:`deformap.stiffness.PressBehaviour` with their σ; empty where the press
-could not give them). :func:`write_run_results` writes every mapping workflow's results:
-``report.json``, these two files and the figures, each atomically.
+could not give them), then ``contact_model`` (the contact model of largest weight in E's average)
+and ``models_fitting`` (the models the record is consistent with, ``;``-joined; see
+:class:`deformap.stiffness.ContactModelFit`). :func:`write_run_results` writes every mapping
+workflow's results: ``report.json``, these two files and the figures, each atomically.
 """
 
 from __future__ import annotations
@@ -48,6 +50,7 @@ POKES_CSV_COLUMNS = (
     "modulus_std_pa", "rigid", "region", "behaviour", "relaxation", "relaxation_std", "tau_s",
     "tau_std_s", "loss_ratio", "loss_ratio_std", "residual_dent_m", "residual_dent_std_m",
     "released_dent_m", "released_dent_std_m", "modulus_instantaneous_pa", "modulus_relaxed_pa",
+    "contact_model", "models_fitting",
 )  # fmt: skip
 
 
@@ -89,6 +92,15 @@ def _cell(value: Any) -> Any:
     return "" if value is None else value
 
 
+def _model_cells(s: Any) -> tuple[str, str]:
+    """``contact_model`` (the model of largest weight) and ``models_fitting`` (``;``-joined) of a
+    poke's stiffness estimate, or ``None``."""
+    if s is None or not s.model_fits:
+        return "", ""
+    top = max(s.model_fits, key=lambda f: f.weight)
+    return top.name, ";".join(f.name for f in s.model_fits if f.fits)
+
+
 def _write_pokes_csv(path: Path, result: ExplorationResult) -> None:
     """``pokes.csv`` of ``result`` (module docstring)."""
     region_of: dict[int, int] = {}
@@ -117,6 +129,7 @@ def _write_pokes_csv(path: Path, result: ExplorationResult) -> None:
                 _cell(b.residual_dent_m), _cell(b.residual_dent_sigma_m),
                 _cell(b.released_dent_m), _cell(b.released_dent_sigma_m),
                 _cell(b.modulus_instantaneous_pa), _cell(b.modulus_relaxed_pa))),
+            *_model_cells(s),
         ])  # fmt: skip
     write_text_atomically(path, text.getvalue())
 

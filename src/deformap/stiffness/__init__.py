@@ -1,4 +1,5 @@
-"""Stiffness and Young's modulus in physical units from a press's force–travel record.
+"""Stiffness and Young's modulus in physical units from a press's force–travel record and the
+contact model it follows.
 
 A record holds, from first contact to the commanded force ``F_c``, the probe's travel ``t`` [m]
 and the normal force ``F`` [N]. :func:`estimate_stiffness` returns ``k = dF/dδ`` [N/m] at ``F_c``
@@ -18,6 +19,24 @@ Model error: one modulus for the record's lower half and one for its upper half,
 with ``D`` their log-difference and ``σ_D`` its std, ``σ_model = E √max(0, D² − σ_D²) / 2``
 (DerSimonian & Laird 1986) joins ``E``'s variance in quadrature (from four samples).
 
+Contact models (``StiffnessConfig.contact_models``): besides the bonded layer, the same record
+is fitted, each as ``F = E · gᵢ(δ)`` by the fit above with its own ``δ₀`` and σ terms, by a
+sphere on a two-parameter (Vlasov) foundation (:func:`deformap.mechanics.foundation_indentation`:
+a layer that deforms only vertically, spring and shear from ``E``, ``ν`` and ``h``) and, when
+asked, on Hertz's half-space. A model *fits* when its χ² has ``p > 0.01``. Each model's evidence
+is its χ² under the effective variance plus, when the camera's points about the press are given
+(:class:`DentSamples`), the χ² of the dent's shape: the model's surface (the foundation's own,
+Hertz's for the elastic models) at its depth at ``F_c``, with a free offset, σ from the best
+model's MAD, and divided by the points' correlation factor ``τ`` (batch means over cells of the
+touch model's length scale; Thiébaux & Zwiers 1984), so that ``m / τ`` points count. Weights
+``wᵢ ∝ exp(−½ Δevidenceᵢ)``, the record's χ² over ``ĉ`` (quasi-likelihood AIC with equal
+parameter counts, ``ĉ`` the best record fit's reduced χ², at least 1; Burnham & Anderson 2002)
+and counted at ``n (1 − ρ) / (1 + ρ)`` samples (``ρ`` the best fit's lag-1 residual
+correlation: a record sampled faster than it varies gains nothing by it), give ``E = Σ wᵢ Eᵢ`` and
+``σ² = Σ wᵢ σᵢ² + Σ wᵢ (Eᵢ − E)²``, ``k`` likewise: a near-tie widens σ over both models
+rather than jumping between them. The record must lie in the bonded layer's range (Range);
+``δ₀``, ``δ_c`` and ``χ`` are that model's.
+
 Range: samples whose fitted indentation exceeds ``R`` are left out and the record refitted (at
 least three kept); ``δ_c > 2R``, ``χ = √(Rδ_c)/h > 1`` or ``δ_c > h / 2`` is refused. Rigid: a
 straight line of travel against force gains less than ``rigid_travel_sigmas`` travel noises up
@@ -31,6 +50,13 @@ Gibson, L. J., Ashby, M. F. (1997). Cellular Solids, 2nd ed., ch. 5. Cambridge U
 Orear, J. (1982). Least squares when both variables have uncertainties. Am. J. Phys. 50(10).
 Birge, R. T. (1932). The calculation of errors by the method of least squares. Phys. Rev. 40.
 DerSimonian, R., Laird, N. (1986). Meta-analysis in clinical trials. Control. Clin. Trials 7(3).
+Burnham, K. P., Anderson, D. R. (2002). Model Selection and Multimodel Inference, 2nd ed.,
+§2.5 (QAIC) and §4.3 (model-averaged estimates and their variance). Springer.
+Thiébaux, H. J., Zwiers, F. W. (1984). The interpretation and estimation of effective sample
+size. J. Climate Appl. Meteor. 23(5), 800–811.
+Vlasov, V. Z., Leontiev, N. N. (1966). Beams, Plates and Shells on Elastic Foundations.
+Bayley, G. V., Hammersley, J. M. (1946). The "effective" number of independent observations in
+an autocorrelated time series. Suppl. J. R. Stat. Soc. 8(2), 184–197.
 """
 
 from __future__ import annotations
@@ -44,13 +70,25 @@ from deformap.stiffness._behaviour import (
     record_dent_floor,
     released_dent,
 )
-from deformap.stiffness._config import LAYER_MODEL, StiffnessConfig, StiffnessEstimate
+from deformap.stiffness._config import (
+    FIT_P_VALUE,
+    LAYER_MODEL,
+    ContactModelFit,
+    StiffnessConfig,
+    StiffnessEstimate,
+)
+from deformap.stiffness._dent_evidence import DentSamples
 from deformap.stiffness._estimate import estimate_stiffness
+from deformap.stiffness._tables import CONTACT_MODELS
 
 __all__ = [
     "ANISOTROPY_WINDOW_RADII",
     "BEHAVIOURS",
+    "CONTACT_MODELS",
+    "FIT_P_VALUE",
     "LAYER_MODEL",
+    "ContactModelFit",
+    "DentSamples",
     "PressBehaviour",
     "PressRecord",
     "StiffnessConfig",

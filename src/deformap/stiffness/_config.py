@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Literal
 
 import numpy as np
 from numpy.typing import NDArray
@@ -10,12 +11,19 @@ from numpy.typing import NDArray
 from deformap._validation import check_settings, setting
 from deformap.errors import InvalidArgumentError
 
-__all__ = ["LAYER_MODEL", "MIN_SAMPLES", "StiffnessConfig", "StiffnessEstimate", "force_std"]
+__all__ = ["FIT_P_VALUE", "LAYER_MODEL", "MIN_SAMPLES", "ContactModelFit", "StiffnessConfig",
+           "StiffnessEstimate", "force_std"]
+
+#: A contact model a record is compared against (:mod:`deformap.stiffness`, Contact models).
+ContactModel = Literal["bonded-layer", "half-space", "foundation"]
 
 #: The contact model's name in :attr:`StiffnessEstimate.model`.
 LAYER_MODEL = "sphere-on-bonded-layer (Hertz + Dimitriadis 2002)"
 #: Fewest samples a record needs: the fit has two parameters, E and δ₀.
 MIN_SAMPLES = 3
+#: A contact model *fits* a record when its χ² under the effective variance is at least this
+#: likely under the record's noise (the usual 1 % test level; the weights do not use it).
+FIT_P_VALUE = 0.01
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -39,6 +47,13 @@ class StiffnessConfig:
         How far, in standard deviations of a two-reading difference, travel or force may step back.
     force_tolerance_rel, force_tolerance_abs_n : float
         Allowed gap ``rel · F + abs`` (or three force σ) between the last and commanded force.
+    contact_models : tuple of str
+        The contact models E is averaged over: ``bonded-layer`` (the reference, always in) and
+        any of ``half-space`` and ``foundation``. By default the layer and the foundation, the
+        two kinematics a foam on a table may follow; ``half-space`` is for a layer whose base
+        is not known to be there (with the base known, neither a record nor a dent tells the
+        two apart, and the half-space would only pull E away from the layer it is). A user who
+        knows the surface's kinematics (a gel bonded to glass) names only its model.
     """
 
     poisson_ratio: float = setting(0.33, ge=0.0, le=0.5)
@@ -50,9 +65,50 @@ class StiffnessConfig:
     backwards_sigmas: float = setting(4.0, gt=0.0)
     force_tolerance_rel: float = setting(0.25, ge=0.0, le=1.0)
     force_tolerance_abs_n: float = setting(0.05, ge=0.0)
+    contact_models: tuple[ContactModel, ...] = ("bonded-layer", "foundation")
 
     def __post_init__(self) -> None:
         check_settings(self)
+        if "bonded-layer" not in self.contact_models or len(set(self.contact_models)) != len(
+                self.contact_models):
+            raise InvalidArgumentError(
+                f"`contact_models` must hold `bonded-layer` (the reference model) and each model "
+                f"once; got {list(self.contact_models)}")
+
+
+@dataclass(frozen=True, kw_only=True)
+class ContactModelFit:
+    """One contact model's reading of a record (:mod:`deformap.stiffness`, Contact models).
+
+    ``name`` the model; ``modulus_pa`` its E and ``modulus_std_pa`` its σ (its own fit, model
+    error, thickness and ν terms); ``reduced_chi2`` its χ² per degree of freedom under the
+    effective variance and ``p_value`` that χ²'s upper tail; ``weight`` its share of the model
+    average (the weights of one record sum to 1).
+    """
+
+    name: str
+    modulus_pa: float
+    modulus_std_pa: float
+    reduced_chi2: float
+    p_value: float
+    weight: float
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.name, str) or not self.name:
+            raise InvalidArgumentError(f"`name` must be a model's name; got {self.name!r}")
+        for n in ("modulus_pa", "modulus_std_pa", "reduced_chi2", "p_value", "weight"):
+            v = getattr(self, n)
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not np.isfinite(v) \
+                    or v < 0 or (n == "modulus_pa" and v == 0) or (n in ("p_value", "weight")
+                                                                    and v > 1):
+                raise InvalidArgumentError(
+                    f"`{n}` must be a finite number >= 0 (a modulus > 0, a p-value or weight "
+                    f"<= 1); got {v!r}")
+
+    @property
+    def fits(self) -> bool:
+        """Whether the record is consistent with this model: ``p_value > FIT_P_VALUE``."""
+        return self.p_value > FIT_P_VALUE
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -62,7 +118,11 @@ class StiffnessEstimate:
     ``stiffness_n_per_m`` ``k = dF/dδ`` at the commanded force, ``modulus_pa`` E, and their stds;
     ``stiffness_lower_n_per_m`` a bound on ``k`` when rigid; ``contact_offset_m`` δ₀; ``depth_m``
     δ_c (rigid: the travel span); ``max_chi`` ``√(R δ_c) / h``; ``reduced_chi2``; ``n_samples``
-    used; ``model_error_pa`` the model-error part of ``modulus_std_pa`` (None under four samples).
+    used; ``model_error_pa`` the model-error part of ``modulus_std_pa``: each model's two-part
+    term and the spread between the models (None under four samples with one model in range).
+    ``model`` names the reference model, whose range the record must lie in and whose δ₀, δ_c and
+    ``χ`` these are; ``model_fits`` each contact model in its range, the reference first
+    (:class:`ContactModelFit`; E and k are their weighted average).
     """
 
     stiffness_n_per_m: float | None
@@ -78,6 +138,7 @@ class StiffnessEstimate:
     n_samples: int
     model: str = LAYER_MODEL
     model_error_pa: float | None = None
+    model_fits: tuple[ContactModelFit, ...] = ()
 
     def __post_init__(self) -> None:
         if self.model != LAYER_MODEL:
@@ -103,6 +164,14 @@ class StiffnessEstimate:
                 np.isfinite(self.model_error_pa) and self.model_error_pa >= 0):
             raise InvalidArgumentError(
                 f"`model_error_pa` must be None or finite and >= 0; got {self.model_error_pa!r}")
+        if not isinstance(self.model_fits, tuple) or not all(
+                isinstance(f, ContactModelFit) for f in self.model_fits) or (
+                self.rigid and self.model_fits):
+            raise InvalidArgumentError(
+                "`model_fits` must be a tuple of ContactModelFit, empty when rigid")
+        if self.model_fits and abs(sum(f.weight for f in self.model_fits) - 1.0) > 1e-6:
+            raise InvalidArgumentError(
+                f"`model_fits`' weights must sum to 1; got {[f.weight for f in self.model_fits]}")
 
 def force_std(force: NDArray[np.float64], config: StiffnessConfig) -> NDArray[np.float64]:
     """Standard deviation [N] of each force reading: ``force_noise_rel · |F| + force_noise_abs_n``."""

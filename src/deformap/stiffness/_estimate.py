@@ -10,8 +10,11 @@ from numpy.typing import NDArray
 
 from deformap._validation import check_array, check_positive
 from deformap.errors import InvalidArgumentError
+from deformap.stiffness._compare import average_models, read_model
 from deformap.stiffness._config import MIN_SAMPLES, StiffnessConfig, StiffnessEstimate, force_std
-from deformap.stiffness._fit import fit_record, model_error
+from deformap.stiffness._dent_evidence import DentSamples, dent_chi2
+from deformap.stiffness._fit import fit_record
+from deformap.stiffness._tables import BONDED_LAYER, FOUNDATION, MAX_FOUNDATION_NU
 
 __all__ = ["estimate_stiffness"]
 
@@ -82,13 +85,15 @@ def _check_thickness(thickness_m: float, travel: NDArray[np.float64]) -> float:
 
 def estimate_stiffness(travel_m: Any, force_n: Any, *, tip_radius_m: float, thickness_m: float,
                        commanded_force_n: float | None = None, thickness_std_m: float = 0.0,
-                       config: StiffnessConfig | None = None) -> StiffnessEstimate:
+                       config: StiffnessConfig | None = None,
+                       dent: DentSamples | None = None) -> StiffnessEstimate:
     """Stiffness and Young's modulus with their uncertainties from one force–travel record.
 
     ``travel_m (n,)`` [m] since first contact, ``n >= 3``, and ``force_n (n,)`` [N] rising to
     ``commanded_force_n`` (default the largest), which the last force must be near; the tip's
     radius; the layer's thickness at the contact in ``(0, 2]`` m, above the travel, and its std
-    (σ(E) includes a refit at ``h ± σ_h``).
+    (σ(E) includes a refit at ``h ± σ_h``); optionally the ``dent`` the camera saw, whose shape
+    joins the record's fit as evidence between the contact models (:mod:`deformap.stiffness`).
 
     Raises
     ------
@@ -121,7 +126,8 @@ def estimate_stiffness(travel_m: Any, force_n: Any, *, tip_radius_m: float, thic
             reduced_chi2=None, rigid=True, n_samples=int(travel.size))
     thickness = _check_thickness(thickness_m, travel)
     thickness_std = check_positive("thickness_std_m", thickness_std_m, allow_zero=True)
-    modulus, offset, cov, chi2_red, fit = fit_record(travel, force, radius, thickness, config)
+    modulus, offset, cov, chi2_red, fit = fit_record(travel, force, radius, thickness, config,
+                                                     BONDED_LAYER)
     for _ in range(2):  # keep the samples within the sphere's range (:mod:`deformap.stiffness`)
         within = int(np.count_nonzero(np.cumprod(travel + offset <= radius)))
         if within == travel.size:
@@ -132,9 +138,9 @@ def estimate_stiffness(travel_m: Any, force_n: Any, *, tip_radius_m: float, thic
                 f"lie within the tip's {radius * 1e3:.3g} mm radius (`tip_radius_m`), "
                 f"{MIN_SAMPLES} needed; deeper, the sphere's contact is no Hertz cap")
         travel, force = travel[:within], force[:within]
-        modulus, offset, cov, chi2_red, fit = fit_record(travel, force, radius, thickness, config)
-    table = fit.table
-    depth_c = float(table.depth_at(np.array([force_c / modulus]))[0])
+        modulus, offset, cov, chi2_red, fit = fit_record(travel, force, radius, thickness, config,
+                                                         BONDED_LAYER)
+    depth_c = float(fit.table.depth_at(np.array([force_c / modulus]))[0])
     chi = float(np.sqrt(radius * depth_c) / thickness)
     strain = depth_c / thickness
     if depth_c > 2.0 * radius:
@@ -148,33 +154,22 @@ def estimate_stiffness(travel_m: Any, force_n: Any, *, tip_radius_m: float, thic
             f"`force_n`/`travel_m` leave the contact model's range (χ = {chi:.2f}, at most "
             f"{_MAX_CHI}; indentation {strain:.0%} of the {thickness:.3g} m layer, at most "
             f"{_MAX_STRAIN:.0%}): the tip presses too deep into this layer to read its modulus")
-    modulus_var = max(cov[0, 0], 0.0)
-    error_pa = model_error(fit, modulus)  # what the record shows the model misses
-    if error_pa is not None:
-        modulus_var += error_pa**2
-    if thickness_std > 0:  # the layer's thickness is read from the surface model: its error too
-        moduli = [fit_record(travel, force, radius, max(thickness + d, 1.01 * travel.max()),
-                             config)[0] for d in (-thickness_std, thickness_std)]
-        modulus_var += ((moduli[1] - moduli[0]) / 2.0) ** 2
-    if config.poisson_ratio_std > 0:  # the material's ν is assumed, not measured: its spread too
-        nus = [min(max(config.poisson_ratio + d, 0.0), 0.5)
-               for d in (-config.poisson_ratio_std, config.poisson_ratio_std)]
-        moduli = [fit_record(travel, force, radius, thickness,
-                       dataclasses.replace(config, poisson_ratio=nu))[0] for nu in nus]
-        # the slope over the span actually taken (ν is clamped to [0, 0.5] at the ends)
-        slope = (moduli[1] - moduli[0]) / (nus[1] - nus[0])
-        modulus_var += (slope * config.poisson_ratio_std) ** 2
-    modulus_std = float(np.sqrt(modulus_var))
-
-    def stiffness_at(e: float) -> float:
-        return float(e * table.slope(table.depth_at(np.array([force_c / e])))[0])
-
-    step = 1e-4 * modulus
-    dk_de = (stiffness_at(modulus + step) - stiffness_at(modulus - step)) / (2.0 * step)
+    # the reference model in range, then every other model the record lies in the range of
+    readings = [read_model(BONDED_LAYER, travel, force, radius, thickness, thickness_std,
+                           force_c, config, fitted=(modulus, cov, chi2_red, fit))]
+    readings += [read_model(name, travel, force, radius, thickness, thickness_std, force_c,
+                            config) for name in config.contact_models if name != BONDED_LAYER
+                 and (name != FOUNDATION or config.poisson_ratio <= MAX_FOUNDATION_NU)]
+    in_range = [r for r in readings if r is not None]
+    if dent is not None:  # the dent's shape: evidence beside the record's own fit
+        extra = dent_chi2(dent, [(r.name, r.table, r.depth) for r in in_range], radius,
+                          thickness, config.poisson_ratio)
+        in_range = [dataclasses.replace(r, evidence=r.chi2 + float(x))
+                    for r, x in zip(in_range, extra, strict=True)]
+    modulus, modulus_std, stiffness, stiffness_std, error_pa, fits = average_models(in_range)
     return StiffnessEstimate(
-        stiffness_n_per_m=stiffness_at(modulus),
-        stiffness_std_n_per_m=float(abs(dk_de) * modulus_std), stiffness_lower_n_per_m=None,
-        modulus_pa=modulus, modulus_std_pa=modulus_std, model_error_pa=error_pa,
-        contact_offset_m=offset, depth_m=depth_c, max_chi=chi,
+        stiffness_n_per_m=stiffness, stiffness_std_n_per_m=stiffness_std,
+        stiffness_lower_n_per_m=None, modulus_pa=modulus, modulus_std_pa=modulus_std,
+        model_error_pa=error_pa, contact_offset_m=offset, depth_m=depth_c, max_chi=chi,
         reduced_chi2=None if np.isnan(chi2_red) else float(chi2_red), rigid=False,
-        n_samples=int(travel.size))
+        n_samples=int(travel.size), model_fits=fits)

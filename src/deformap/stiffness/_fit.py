@@ -1,4 +1,5 @@
-"""The force–travel record's fit and its two-part model-error test (:mod:`deformap.stiffness`)."""
+"""A force–travel record's fit under one contact model and its two-part model-error test
+(:mod:`deformap.stiffness`)."""
 
 from __future__ import annotations
 
@@ -6,57 +7,23 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import minimize_scalar
 
-from deformap.mechanics import layer_chi_limit, layer_indentation_force, layer_indentation_stiffness
 from deformap.stiffness._config import StiffnessConfig, force_std
+from deformap.stiffness._tables import ContactTable, contact_table
 
-__all__ = ["LayerTable", "RecordFit", "fit_record", "model_error"]
+__all__ = ["RecordFit", "fit_record", "model_error"]
 
 _EFFECTIVE_VARIANCE_ROUNDS = 4
 _MODULUS_GRID = 61
-_TABLE_SIZE = 800
-# the table stops short of where the series' force turns down, and at most at χ = 3
-_CHI_FRACTION = 0.95
-_CHI_CAP = 3.0
 # the model-error test's three parameters (two moduli, one δ₀) and one degree of freedom
 _MIN_PART_SAMPLES = 4
 _PART_ROUNDS = 8
-
-
-class LayerTable:
-    """``g(δ)``, the bonded-layer force at unit modulus, tabulated on ``[0, δ_lim]`` for its inverse."""
-
-    def __init__(self, radius: float, thickness: float, nu: float) -> None:
-        self.radius, self.thickness, self.nu = radius, thickness, nu
-        chi_lim = min(_CHI_FRACTION * layer_chi_limit(nu), _CHI_CAP)
-        # nor deeper than the layer: with R < h that comes first (χ = √(R/h) < 1 at δ = h)
-        self.depth_limit = min((chi_lim * thickness) ** 2 / radius, thickness)
-        self.depth = self.depth_limit * np.geomspace(1e-9, 1.0, _TABLE_SIZE)
-        self.log_depth = np.log(self.depth)
-        self.log_force = np.log(layer_indentation_force(self.depth, radius, thickness, 1.0, nu))
-
-    @property
-    def force_limit(self) -> float:
-        """``g(δ_lim)``: the largest force per pascal the table holds."""
-        return float(np.exp(self.log_force[-1]))
-
-    def depth_at(self, force_per_pa: NDArray[np.float64]) -> NDArray[np.float64]:
-        """``g⁻¹``: log–log interpolation, Hertz's ``δ ∝ F^(2/3)`` below the table."""
-        u = np.log(np.maximum(force_per_pa, 1e-300))
-        below = self.log_depth[0] + (u - self.log_force[0]) / 1.5
-        inside = np.interp(u, self.log_force, self.log_depth)
-        return np.asarray(np.exp(np.where(u < self.log_force[0], below, inside)))
-
-    def slope(self, depth: NDArray[np.float64]) -> NDArray[np.float64]:
-        """``g'(δ)`` at unit modulus, N/m per Pa."""
-        return layer_indentation_stiffness(np.maximum(depth, self.depth[0]), self.radius,
-                                           self.thickness, 1.0, self.nu)
 
 
 class RecordFit:
     """Effective-variance weighted least squares of ``t = g⁻¹(F / E) − δ₀``."""
 
     def __init__(self, travel: NDArray[np.float64], force: NDArray[np.float64],
-                 table: LayerTable, config: StiffnessConfig) -> None:
+                 table: ContactTable, config: StiffnessConfig) -> None:
         self.travel, self.force, self.table, self.config = travel, force, table, config
         self.force_std = force_std(force, config)
         self.weights = np.full(travel.size, 1.0 / config.travel_noise_m**2)
@@ -74,9 +41,15 @@ class RecordFit:
         return max(self._free_offset(modulus), -3.0 * self.config.travel_noise_m)
 
     def chi2(self, log_modulus: float) -> float:
-        modulus = float(np.exp(log_modulus))
-        r = self.travel + self.offset(modulus) - self.depths(modulus)
-        return float(self.weights @ (r * r))
+        return float(self.chi2_grid(np.array([log_modulus]))[0])
+
+    def chi2_grid(self, log_moduli: NDArray[np.float64]) -> NDArray[np.float64]:
+        """The weighted χ² at each of ``log_moduli`` (δ₀ at its best, as :meth:`offset`)."""
+        gap = self.table.depth_at(self.force / np.exp(log_moduli)[:, None]) - self.travel
+        offset = np.maximum(gap @ self.weights / self.weights.sum(),
+                            -3.0 * self.config.travel_noise_m)
+        r = offset[:, None] - gap
+        return np.asarray((r * r) @ self.weights)
 
     def reweight(self, modulus: float) -> None:
         """Each sample's variance: the travel's plus the force's carried through ``g⁻¹``."""
@@ -88,14 +61,13 @@ class RecordFit:
         f_max = float(self.force.max())
         # softest: the largest force inside the table; stiffest: a thousandth of the travel noise
         low = np.log(f_max / self.table.force_limit)
-        high = np.log(f_max / float(layer_indentation_force(
-            1e-3 * self.config.travel_noise_m, self.table.radius, self.table.thickness, 1.0,
-            self.table.nu)))
+        high = np.log(f_max / float(self.table.force_at(
+            np.array([1e-3 * self.config.travel_noise_m]))[0]))
         self.low_bound = float(np.exp(low))
         log_modulus = low
         for _ in range(_EFFECTIVE_VARIANCE_ROUNDS):
             grid = np.linspace(low, high, _MODULUS_GRID)
-            values = [self.chi2(x) for x in grid]
+            values = self.chi2_grid(grid)
             best = int(np.argmin(values))
             lo, hi = grid[max(best - 1, 0)], grid[min(best + 1, grid.size - 1)]
             found = minimize_scalar(self.chi2, bounds=(lo, hi), method="bounded",
@@ -172,10 +144,11 @@ class RecordFit:
 
 
 def fit_record(travel: NDArray[np.float64], force: NDArray[np.float64], radius: float,
-               thickness: float, config: StiffnessConfig
+               thickness: float, config: StiffnessConfig, model: str
                ) -> tuple[float, float, NDArray[np.float64], float, RecordFit]:
-    """``(E, δ₀, cov(E, δ₀), reduced χ², fit)`` of the record on a layer of ``thickness``."""
-    table = LayerTable(radius, thickness, config.poisson_ratio)
+    """``(E, δ₀, cov(E, δ₀), reduced χ², fit)`` of the record under contact ``model`` on a layer
+    of ``thickness``."""
+    table = contact_table(model, radius, thickness, config.poisson_ratio)
     fit = RecordFit(travel, force, table, config)
     modulus = fit.solve()
     cov, chi2_red = fit.covariance(modulus)

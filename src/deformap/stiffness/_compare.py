@@ -1,0 +1,128 @@
+"""Each contact model's reading of one record and their smooth average (:mod:`deformap.stiffness`,
+Contact models)."""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.stats import chi2 as chi2_dist
+
+from deformap.stiffness._config import ContactModelFit, StiffnessConfig
+from deformap.stiffness._fit import RecordFit, fit_record, model_error
+from deformap.stiffness._tables import FOUNDATION, HALF_SPACE, MAX_FOUNDATION_NU, ContactTable
+
+__all__ = ["ModelReading", "average_models", "read_model"]
+
+
+@dataclass(frozen=True)
+class ModelReading:
+    """One model's ``E``, its σ² (fit, model error, thickness, ν), the model-error part, the
+    record's χ² and its degrees of freedom, ``k`` with ``dk/dE`` and the depth ``δ_c`` at the
+    commanded force, its table, and the evidence (χ²) that counts in its weight."""
+
+    name: str
+    modulus: float
+    variance: float
+    error: float | None
+    chi2: float
+    dof: int
+    stiffness: float
+    dk_de: float
+    depth: float
+    table: ContactTable
+    evidence: float
+    lag_correlation: float
+
+
+def _stiffness_at(fit: RecordFit, modulus: float, force_c: float) -> float:
+    table = fit.table
+    return float(modulus * table.slope(table.depth_at(np.array([force_c / modulus])))[0])
+
+
+def read_model(name: str, travel: NDArray[np.float64], force: NDArray[np.float64], radius: float,
+               thickness: float, thickness_std: float, force_c: float, config: StiffnessConfig,
+               fitted: tuple[float, NDArray[np.float64], float, RecordFit] | None = None,
+               ) -> ModelReading | None:
+    """``name``'s reading of the record, or ``None`` when the record leaves its table (softer
+    than the model holds at the commanded force). ``fitted`` ``(E, cov, reduced χ², fit)``
+    reuses a fit already made."""
+    if fitted is None:
+        modulus, _, cov, chi2_red, fit = fit_record(travel, force, radius, thickness, config, name)
+    else:
+        modulus, cov, chi2_red, fit = fitted
+    if modulus <= 1.001 * fit.low_bound or force_c / modulus > fit.table.force_limit:
+        return None
+    variance = max(float(cov[0, 0]), 0.0)
+    error = model_error(fit, modulus)  # what the record shows the model misses
+    if error is not None:
+        variance += error**2
+    if thickness_std > 0 and name != HALF_SPACE:  # the thickness is read from the surface model
+        moduli = [fit_record(travel, force, radius, max(thickness + d, 1.01 * travel.max()),
+                             config, name)[0] for d in (-thickness_std, thickness_std)]
+        variance += ((moduli[1] - moduli[0]) / 2.0) ** 2
+    if config.poisson_ratio_std > 0:  # the material's ν is assumed, not measured: its spread too
+        top = MAX_FOUNDATION_NU if name == FOUNDATION else 0.5
+        nus = [min(max(config.poisson_ratio + d, 0.0), top)
+               for d in (-config.poisson_ratio_std, config.poisson_ratio_std)]
+        if nus[1] > nus[0]:
+            moduli = [fit_record(travel, force, radius, thickness,
+                                 dataclasses.replace(config, poisson_ratio=nu), name)[0]
+                      for nu in nus]
+            # the slope over the span actually taken (ν is clamped at the ends)
+            slope = (moduli[1] - moduli[0]) / (nus[1] - nus[0])
+            variance += (slope * config.poisson_ratio_std) ** 2
+    dof = travel.size - (1 if fit.offset_clamped(modulus) else 2)
+    step = 1e-4 * modulus
+    dk_de = (_stiffness_at(fit, modulus + step, force_c)
+             - _stiffness_at(fit, modulus - step, force_c)) / (2.0 * step)
+    chi2 = float(chi2_red * dof) if dof > 0 else 0.0
+    # the record's residuals in units of their σ, in order of travel: their lag-1 correlation
+    z = (travel + fit.offset(modulus) - fit.depths(modulus)) * np.sqrt(fit.weights)
+    lag = float(z[1:] @ z[:-1]) / float(z @ z) if float(z @ z) > 0 else 0.0
+    return ModelReading(name=name, modulus=modulus, variance=variance, error=error, chi2=chi2,
+                        dof=dof, stiffness=_stiffness_at(fit, modulus, force_c), dk_de=dk_de,
+                        depth=float(fit.table.depth_at(np.array([force_c / modulus]))[0]),
+                        table=fit.table, evidence=chi2, lag_correlation=lag)
+
+
+def average_models(readings: list[ModelReading]
+                   ) -> tuple[float, float, float, float, float | None, tuple[ContactModelFit, ...]]:
+    """``(E, σ_E, k, σ_k, model error, fits)``: the models' average with quasi-likelihood Akaike
+    weights (Burnham & Anderson 2002, §2.5 and §4.3; every model has the parameters ``E`` and
+    ``δ₀``, so ``ΔQAIC = Δχ² / ĉ`` with ``ĉ`` the best record fit's reduced χ², at least 1), and
+    the variance of the average: the weighted variances plus the weighted spread of the models.
+
+    The record's χ² counts its samples as ``n (1 − ρ) / (1 + ρ)`` independent ones, ``ρ`` the
+    lag-1 correlation of the best fit's residuals (an AR(1) sequence's effective size; Bayley &
+    Hammersley 1946): a record sampled faster than it varies gains no evidence by it. Each
+    model's ``evidence`` beyond its record (the dent's χ²) adds to it."""
+    chi2 = np.array([r.chi2 for r in readings])
+    dent = np.array([r.evidence - r.chi2 for r in readings])
+    dofs = np.array([max(r.dof, 1) for r in readings])
+    best = int(np.argmin(chi2))
+    rho = min(max(readings[best].lag_correlation, 0.0), 0.99)
+    c_hat = max(1.0, float(chi2[best] / dofs[best]))
+    evidence = chi2 * (1.0 - rho) / (1.0 + rho) / c_hat + dent
+    w = np.exp(-0.5 * (evidence - evidence.min()))
+    w = w / w.sum()
+    moduli = np.array([r.modulus for r in readings])
+    variances = np.array([r.variance for r in readings])
+    stiff = np.array([r.stiffness for r in readings])
+    modulus = float(w @ moduli)
+    spread = float(w @ (moduli - modulus) ** 2)
+    modulus_std = float(np.sqrt(w @ variances + spread))
+    stiffness = float(w @ stiff)
+    stiffness_var = float(w @ (np.array([r.dk_de for r in readings]) ** 2 * variances)
+                          + w @ (stiff - stiffness) ** 2)
+    errors = [r.error for r in readings]
+    model_err = None if all(e is None for e in errors) and len(readings) == 1 else float(
+        np.sqrt(w @ np.array([0.0 if e is None else e * e for e in errors]) + spread))
+    fits = tuple(ContactModelFit(
+        name=r.name, modulus_pa=r.modulus, modulus_std_pa=float(np.sqrt(r.variance)),
+        reduced_chi2=float(r.chi2 / max(r.dof, 1)),
+        p_value=float(chi2_dist.sf(r.chi2, r.dof)) if r.dof > 0 else 1.0,
+        weight=float(wi)) for r, wi in zip(readings, w, strict=True))
+    return modulus, modulus_std, stiffness, float(np.sqrt(stiffness_var)), model_err, fits
