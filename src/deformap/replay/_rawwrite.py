@@ -13,11 +13,10 @@ clock skew, force profile and frame names: the imperfections a real recording ha
 
 Each press runs approach (0.2 s), ramp from contact to the force (0.4 s; a ``step`` profile jumps
 to the force at contact), hold (0.3 s), release (0.15 s) and a pause (0.15 s); the camera sees the
-press's cloud from contact to the end of the release, the undisturbed surface otherwise. A record
-with a hold replays it (its travel and force on its own clock) instead of the 0.3 s at the force;
-one with an unloading branch replays it after the hold. The release lifts the tip with the force
-already at zero: the surface lets go between two samples, as it does when the arm retracts faster
-than the surface recovers, so only a recorded unloading branch gives the bag one.
+press's cloud from contact to the end of the release, the undisturbed surface otherwise. A record's
+hold replays (its own clock) instead of the 0.3 s at the force, and its unloading after the hold;
+without one the force is zero when the tip lifts (as when an arm retracts faster than the surface
+recovers), so only a recorded unloading branch gives the bag one.
 """
 
 from __future__ import annotations
@@ -74,22 +73,19 @@ class RawPress:
     @property
     def hold_s(self) -> tuple[float, float]:
         """Start and end of the hold: the record's own hold's length, else :data:`HOLD`."""
-        hold = self._phase("hold")
+        hold = self._phases["hold"]
         return self.contact_s + RAMP, self.contact_s + RAMP + (HOLD if hold is None else hold[0][-1])
 
     @property
     def release_s(self) -> float:
         """Start of the release: the end of the hold, or of the unloading branch replayed after it."""
-        unloading = self._phase("unloading")
+        unloading = self._phases["unloading"]
         return self.hold_s[1] + (0.0 if unloading is None else unloading[0][-1])
 
     @property
     def end_s(self) -> float:
         """End of the press: release and pause done."""
         return self.release_s + RELEASE + PAUSE
-
-    def _phase(self, name: str) -> tuple[NDArray[np.float64], ...] | None:
-        return self._phases[name]
 
     @cached_property
     def _phases(self) -> dict[str, tuple[NDArray[np.float64], ...] | None]:
@@ -115,7 +111,7 @@ class RawPress:
         [s on the bag's timeline], or ``None`` outside them or where the record has none."""
         for name, start, end in (("hold", *self.hold_s), ("unloading", self.hold_s[1],
                                                           self.release_s)):
-            phase = self._phase(name)
+            phase = self._phases[name]
             if phase is not None and start <= t <= end:
                 return (float(np.interp(t - start, phase[0], phase[1])),
                         float(np.interp(t - start, phase[0], phase[2])))
@@ -138,7 +134,6 @@ def raw_timeline(presses: Sequence[PressObservation]) -> list[RawPress]:
     return timeline
 
 
-# -- the rig's geometry ----------------------------------------------------------------------------
 def _pose(rot: NDArray[np.float64], trans: Any) -> NDArray[np.float64]:
     m = np.eye(4)
     m[:3, :3], m[:3, 3] = rot, trans
