@@ -1,8 +1,11 @@
 """The modulus field: a Gaussian random field over ln E (E in Pa) from the pokes' force–travel
 records. A poke with a modulus enters as ``ln E`` with σ ``σ_E / E`` (delta method), at least the
-field's floor; a *rigid* poke at its detection bound (:func:`rigid_modulus_bound`) with
-``rigid_log_std``, never a huge number that would drag the prior mean; a poke without a usable
-record is left out (:attr:`ModulusField.readings` says why).
+field's floor, ``σ_E`` the reference contact model's own (the bonded layer's: the spread between
+contact models in the estimate's σ is a factor on E shared by the pokes of one surface, a
+constant in ln E, which the field's mean takes up, not noise between the pokes); a *rigid* poke
+at its detection bound (:func:`rigid_modulus_bound`) with ``rigid_log_std``, never a huge number
+that would drag the prior mean; a poke without a usable record is left out
+(:attr:`ModulusField.readings` says why).
 """
 
 from __future__ import annotations
@@ -72,8 +75,11 @@ def modulus_reading(record: PokeRecord, config: ModulusFieldConfig,
         bound = rigid_modulus_bound(record, poisson_ratio)
         return ModulusReading(record.index, float(np.log(bound)), config.rigid_log_std, True, None)
     assert estimate.modulus_pa is not None and estimate.modulus_std_pa is not None
+    # the reference contact model's own σ: the spread between models is a factor on E that the
+    # pokes of one surface share, a constant in ln E that the field's mean takes up
+    std = estimate.model_fits[0].modulus_std_pa if estimate.model_fits else estimate.modulus_std_pa
     return ModulusReading(record.index, float(np.log(estimate.modulus_pa)),
-                          float(estimate.modulus_std_pa / estimate.modulus_pa), False, None)
+                          float(std / estimate.modulus_pa), False, None)
 
 
 class ModulusField(PokeField):

@@ -32,9 +32,11 @@ touch model's length scale; Thiébaux & Zwiers 1984), so that ``m / τ`` points 
 ``wᵢ ∝ exp(−½ Δevidenceᵢ)``, the record's χ² over ``ĉ`` (quasi-likelihood AIC with equal
 parameter counts, ``ĉ`` the best record fit's reduced χ², at least 1; Burnham & Anderson 2002)
 and counted at ``n (1 − ρ) / (1 + ρ)`` samples (``ρ`` the best fit's lag-1 residual
-correlation: a record sampled faster than it varies gains nothing by it), give ``E = Σ wᵢ Eᵢ`` and
-``σ² = Σ wᵢ σᵢ² + Σ wᵢ (Eᵢ − E)²``, ``k`` likewise: a near-tie widens σ over both models
-rather than jumping between them. The record must lie in the bonded layer's range (Range);
+correlation: a record sampled faster than it varies gains nothing by it). ``E`` stays the bonded
+layer's and ``σ² = Σ wᵢ σᵢ² + Σ wᵢ (Eᵢ − E)²``, the second moment about it of the models'
+mixture (``k`` likewise): a model that fits better widens σ toward its own ``E`` and never moves
+``E``, so two samplings of one press, or two presses of one material, that weigh the models
+differently read the same ``E``. The record must lie in the bonded layer's range (Range);
 ``δ₀``, ``δ_c`` and ``χ`` are that model's.
 
 Range: samples whose fitted indentation exceeds ``R`` are left out and the record refitted (at

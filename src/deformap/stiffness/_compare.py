@@ -12,7 +12,13 @@ from scipy.stats import chi2 as chi2_dist
 
 from deformap.stiffness._config import ContactModelFit, StiffnessConfig
 from deformap.stiffness._fit import RecordFit, fit_record, model_error
-from deformap.stiffness._tables import FOUNDATION, HALF_SPACE, MAX_FOUNDATION_NU, ContactTable
+from deformap.stiffness._tables import (
+    BONDED_LAYER,
+    FOUNDATION,
+    HALF_SPACE,
+    MAX_FOUNDATION_NU,
+    ContactTable,
+)
 
 __all__ = ["ModelReading", "average_models", "read_model"]
 
@@ -90,10 +96,12 @@ def read_model(name: str, travel: NDArray[np.float64], force: NDArray[np.float64
 
 def average_models(readings: list[ModelReading]
                    ) -> tuple[float, float, float, float, float | None, tuple[ContactModelFit, ...]]:
-    """``(E, σ_E, k, σ_k, model error, fits)``: the models' average with quasi-likelihood Akaike
-    weights (Burnham & Anderson 2002, §2.5 and §4.3; every model has the parameters ``E`` and
-    ``δ₀``, so ``ΔQAIC = Δχ² / ĉ`` with ``ĉ`` the best record fit's reduced χ², at least 1), and
-    the variance of the average: the weighted variances plus the weighted spread of the models.
+    """``(E, σ_E, k, σ_k, model error, fits)``: ``E`` and ``k`` the reference model's (the bonded
+    layer's), their variance the second moment about it of the models' mixture under
+    quasi-likelihood Akaike weights (Burnham & Anderson 2002, §2.5 and §4.3; every model has the
+    parameters ``E`` and ``δ₀``, so ``ΔQAIC = Δχ² / ĉ`` with ``ĉ`` the best record fit's reduced
+    χ², at least 1): ``Σ wᵢ σᵢ² + Σ wᵢ (Eᵢ − E)²``. A model's weight moves σ, never ``E``, so
+    two samplings of one press that weigh the models differently read the same ``E``.
 
     The record's χ² counts its samples as ``n (1 − ρ) / (1 + ρ)`` independent ones, ``ρ`` the
     lag-1 correlation of the best fit's residuals (an AR(1) sequence's effective size; Bayley &
@@ -111,10 +119,12 @@ def average_models(readings: list[ModelReading]
     moduli = np.array([r.modulus for r in readings])
     variances = np.array([r.variance for r in readings])
     stiff = np.array([r.stiffness for r in readings])
-    modulus = float(w @ moduli)
+    # E and k are the reference model's, their variance the models' mixture's second moment about it
+    ref = [r.name for r in readings].index(BONDED_LAYER)
+    modulus = float(moduli[ref])
     spread = float(w @ (moduli - modulus) ** 2)
     modulus_std = float(np.sqrt(w @ variances + spread))
-    stiffness = float(w @ stiff)
+    stiffness = float(stiff[ref])
     stiffness_var = float(w @ (np.array([r.dk_de for r in readings]) ** 2 * variances)
                           + w @ (stiff - stiffness) ** 2)
     errors = [r.error for r in readings]
