@@ -48,12 +48,14 @@ class StiffnessConfig:
     force_tolerance_rel, force_tolerance_abs_n : float
         Allowed gap ``rel · F + abs`` (or three force σ) between the last and commanded force.
     contact_models : tuple of str
-        The contact models E is averaged over: ``bonded-layer`` (the reference, always in) and
-        any of ``half-space`` and ``foundation``. By default the layer and the foundation, the
-        two kinematics a foam on a table may follow; ``half-space`` is for a layer whose base
-        is not known to be there (with the base known, neither a record nor a dent tells the
-        two apart, and the half-space would only pull E away from the layer it is). A user who
-        knows the surface's kinematics (a gel bonded to glass) names only its model.
+        The contact models whose spread widens E's σ: ``bonded-layer`` (the reference, whose E
+        is reported, always in) and any of ``half-space`` and ``foundation``. By default the
+        layer and the foundation, the two kinematics a foam on a table may follow;
+        ``half-space`` is for a layer whose base is not known to be there (with the base known,
+        neither a record nor a dent tells the two apart, and the half-space would only widen σ
+        by the layer's correction). A user who
+        knows the surface is a bonded elastic layer (a gel bonded to glass) names only
+        ``bonded-layer``.
     """
 
     poisson_ratio: float = setting(0.33, ge=0.0, le=0.5)
