@@ -160,6 +160,10 @@ def estimate_stiffness(travel_m: Any, force_n: Any, *, tip_radius_m: float, thic
     readings += [read_model(name, travel, force, radius, thickness, thickness_std, force_c,
                             config) for name in config.contact_models if name != BONDED_LAYER
                  and (name != FOUNDATION or config.poisson_ratio <= MAX_FOUNDATION_NU)]
+    if readings[0] is None:  # E is the reference model's: it must hold the record (Range)
+        raise InvalidArgumentError(
+            "`force_n`/`travel_m` leave the contact model's range: the commanded force lies "
+            "beyond the bonded layer's table at the modulus the record reads")
     in_range = [r for r in readings if r is not None]
     if dent is not None:  # the dent's shape: evidence beside the record's own fit
         extra = dent_chi2(dent, [(r.name, r.table, r.depth) for r in in_range], radius,
