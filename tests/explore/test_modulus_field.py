@@ -25,7 +25,7 @@ from deformap.explore import (
 from deformap.explore._choice import unread_radius_m
 from deformap.explore._modulus import modulus_reading
 from deformap.explore._targets import BOUNDARY_SPACING_ROI
-from deformap.stiffness import StiffnessEstimate
+from deformap.stiffness import ContactModelFit, StiffnessEstimate
 from deformap.testing import synthetic_poke
 
 CONFIG = ModulusFieldConfig()
@@ -80,6 +80,19 @@ def test_a_pokes_relative_error_is_its_noise_raised_to_the_floor() -> None:
     field = _field([_poke((0.1, 0.1), _soft(1e4, 0.02), 0),
                     _poke((0.5, 0.3), _soft(1e4, 0.4), 1)])
     assert field.pokes.noise.tolist() == pytest.approx([CONFIG.noise_floor, 0.4])
+
+
+def test_a_poke_enters_with_its_reference_models_sigma_not_the_models_spread() -> None:
+    # the foundation listed first, as a report may hold it: the bonded layer is found by name
+    fits = (ContactModelFit(name="foundation", modulus_pa=7e3, modulus_std_pa=400.0,
+                            reduced_chi2=1.0, p_value=0.5, weight=0.6),
+            ContactModelFit(name="bonded-layer", modulus_pa=1e4, modulus_std_pa=500.0,
+                            reduced_chi2=1.1, p_value=0.4, weight=0.4))
+    estimate = dataclasses.replace(_soft(1e4, 0.25), model_fits=fits)
+    reading = modulus_reading(_poke((0.3, 0.2), estimate).record, CONFIG, NU)
+    assert reading.log_std == pytest.approx(500.0 / 1e4)  # not the estimate's 0.25
+    assert modulus_reading(_poke((0.3, 0.2), _soft(1e4, 0.25)).record, CONFIG,
+                           NU).log_std == pytest.approx(0.25)  # no models: the estimate's σ
 
 
 def test_a_rigid_poke_sits_at_its_detection_bound_not_at_a_huge_number() -> None:

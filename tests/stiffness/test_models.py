@@ -93,9 +93,8 @@ def test_a_record_between_two_models_gives_a_sigma_covering_both():
     assert high > 1.2 * low  # the two models read this record differently
     assert est.modulus_pa == fits["bonded-layer"].modulus_pa
     assert 0.2 < fits["foundation"].weight < 0.8  # neither model is ruled out
-    assert est.modulus_pa - 2 * est.modulus_std_pa <= low
-    assert est.modulus_pa + 2 * est.modulus_std_pa >= high
-    assert sum(f.weight for f in est.model_fits) == pytest.approx(1.0)
+    assert est.modulus_pa - 2 * est.modulus_std_pa <= min(f.modulus_pa for f in est.model_fits)
+    assert est.modulus_pa + 2 * est.modulus_std_pa >= max(f.modulus_pa for f in est.model_fits)
 
 
 def test_the_weights_move_smoothly_with_the_dent():
@@ -118,6 +117,7 @@ def test_the_weights_move_smoothly_with_the_dent():
         stds.append(est.modulus_std_pa)
         weights.append(next(f.weight for f in est.model_fits if f.name == "foundation"))
     assert weights[0] < 0.5 < weights[-1]
+    assert np.all(np.abs(np.diff(weights)) < 0.5)  # no jump from one model to the other
     assert np.ptp(moduli) == 0.0
     assert stds[-1] > 2.0 * stds[0]
     foundation_e = next(f.modulus_pa for f in est.model_fits if f.name == "foundation")

@@ -1,10 +1,13 @@
 """The modulus field: a Gaussian random field over ln E (E in Pa) from the pokes' force–travel
 records. A poke with a modulus enters as ``ln E`` with σ ``σ_E / E`` (delta method), at least the
-field's floor, ``σ_E`` the reference contact model's own (the bonded layer's: the spread between
-contact models in the estimate's σ is a factor on E shared by the pokes of one surface, a
-constant in ln E, which the field's mean takes up, not noise between the pokes); a *rigid* poke
-at its detection bound (:func:`rigid_modulus_bound`) with ``rigid_log_std``, never a huge number
-that would drag the prior mean; a poke without a usable record is left out
+field's floor, ``σ_E`` the reference contact model's own (the bonded layer's). The spread
+between contact models in the estimate's σ is left out of the field and so of its σ: it is
+taken as a bias that moves the pokes of one material alike (it does not scatter one material's
+pokes), which holds where one model wins on all of them; it is not a constant across materials
+(a foundation-like foam's bias grows with its stiffness), and each poke's own
+``stiffness.modulus_std_pa`` keeps it. A *rigid* poke enters at its detection bound
+(:func:`rigid_modulus_bound`) with ``rigid_log_std``, never a huge number that would drag the
+prior mean; a poke without a usable record is left out
 (:attr:`ModulusField.readings` says why).
 """
 
@@ -75,9 +78,9 @@ def modulus_reading(record: PokeRecord, config: ModulusFieldConfig,
         bound = rigid_modulus_bound(record, poisson_ratio)
         return ModulusReading(record.index, float(np.log(bound)), config.rigid_log_std, True, None)
     assert estimate.modulus_pa is not None and estimate.modulus_std_pa is not None
-    # the reference contact model's own σ: the spread between models is a factor on E that the
-    # pokes of one surface share, a constant in ln E that the field's mean takes up
-    std = estimate.model_fits[0].modulus_std_pa if estimate.model_fits else estimate.modulus_std_pa
+    # the reference contact model's own σ (module docstring): the models' spread is left out
+    std = next((f.modulus_std_pa for f in estimate.model_fits if f.name == "bonded-layer"),
+               estimate.modulus_std_pa)
     return ModulusReading(record.index, float(np.log(estimate.modulus_pa)),
                           float(std / estimate.modulus_pa), False, None)
 
@@ -109,7 +112,8 @@ class ModulusField(PokeField):
 
     @property
     def std(self) -> NDArray[np.float64]:
-        """Posterior standard deviation of ln E on the grid."""
+        """Posterior standard deviation of ln E on the grid (without the contact models' spread:
+        module docstring)."""
         return np.sqrt(self.variance)
 
     @cached_property

@@ -19,7 +19,7 @@ prior was not used).
 force–travel reading (empty without one), ``region`` (``region_labels`` + 1; empty where the
 map field left the poke out) and what the press reveals beyond its stiffness (``behaviour`` and
 the quantities of :class:`deformap.stiffness.PressBehaviour` with their σ; empty where the press
-could not give them), then ``contact_model`` (the contact model of largest weight in E's average)
+could not give them), then ``contact_model`` (the contact model of largest weight in σ's mixture)
 and ``models_fitting`` (the models the record is consistent with, ``;``-joined; see
 :class:`deformap.stiffness.ContactModelFit`). :func:`write_run_results` writes every mapping
 workflow's results: ``report.json``, these two files and the figures, each atomically.

@@ -53,7 +53,8 @@ Orear, J. (1982). Least squares when both variables have uncertainties. Am. J. P
 Birge, R. T. (1932). The calculation of errors by the method of least squares. Phys. Rev. 40.
 DerSimonian, R., Laird, N. (1986). Meta-analysis in clinical trials. Control. Clin. Trials 7(3).
 Burnham, K. P., Anderson, D. R. (2002). Model Selection and Multimodel Inference, 2nd ed.,
-§2.5 (QAIC) and §4.3 (model-averaged estimates and their variance). Springer.
+§2.5 (QAIC) and §4.3 (a model mixture's variance; here its second moment is taken about the
+reference model's E rather than about the average). Springer.
 Thiébaux, H. J., Zwiers, F. W. (1984). The interpretation and estimation of effective sample
 size. J. Climate Appl. Meteor. 23(5), 800–811.
 Vlasov, V. Z., Leontiev, N. N. (1966). Beams, Plates and Shells on Elastic Foundations.

@@ -84,8 +84,8 @@ class ContactModelFit:
 
     ``name`` the model; ``modulus_pa`` its E and ``modulus_std_pa`` its σ (its own fit, model
     error, thickness and ν terms); ``reduced_chi2`` its χ² per degree of freedom under the
-    effective variance and ``p_value`` that χ²'s upper tail; ``weight`` its share of the model
-    average (the weights of one record sum to 1).
+    effective variance and ``p_value`` that χ²'s upper tail; ``weight`` its share of the models'
+    mixture whose second moment about the reference's E is σ² (the weights sum to 1).
     """
 
     name: str
@@ -124,7 +124,7 @@ class StiffnessEstimate:
     term and the spread between the models (None under four samples with one model in range).
     ``model`` names the reference model, whose range the record must lie in and whose δ₀, δ_c and
     ``χ`` these are; ``model_fits`` each contact model in its range, the reference first
-    (:class:`ContactModelFit`; E and k are their weighted average).
+    (:class:`ContactModelFit`; E and k are the reference's, the weights set their σ).
     """
 
     stiffness_n_per_m: float | None
