@@ -11,7 +11,7 @@ from numpy.typing import NDArray
 
 from deformap._validation import check_array, check_positive
 from deformap.errors import InvalidArgumentError
-from deformap.mechanics import foundation_surface_deflection
+from deformap.mechanics import foundation_surface_deflection, hertz_surface_deflection
 from deformap.stiffness._tables import FOUNDATION, ContactTable
 
 __all__ = ["DentSamples", "dent_chi2"]
@@ -75,10 +75,8 @@ def _predicted(table: ContactTable, model: str, depth: float, radius: float, thi
         a = float(np.interp(np.log(depth), table.log_depth, np.log(table.contact_radius)))
         return foundation_surface_deflection(r, min(float(np.exp(a)), radius), radius, thickness,
                                              nu)
-    a = np.sqrt(radius * depth)
-    rho = np.maximum(r / a, 1.0)
-    outside = depth / np.pi * ((2.0 - rho**2) * np.arcsin(1.0 / rho) + np.sqrt(rho**2 - 1.0))
-    return np.asarray(np.where(r <= a, depth - r * r / (2.0 * radius), outside))
+    # Hertz's sphere at depth δ_c: the force that sinks it there at E* = 1 (E = 1, ν = 0)
+    return hertz_surface_deflection(r, 4.0 / 3.0 * np.sqrt(radius) * depth**1.5, radius, 1.0, 0.0)
 
 
 def dent_chi2(dent: DentSamples, models: list[tuple[str, ContactTable, float]], radius: float,
