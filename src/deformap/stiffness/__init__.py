@@ -25,8 +25,9 @@ sphere on a two-parameter (Vlasov) foundation (:func:`deformap.mechanics.foundat
 a layer that deforms only vertically, spring and shear from ``E``, ``ν`` and ``h``) and, when
 asked, on Hertz's half-space. A model *fits* when its χ² has ``p > 0.01``. Each model's evidence
 is its χ² under the effective variance plus, when the camera's points about the press are given
-(:class:`DentSamples`), the χ² of the dent's shape: the model's surface (the foundation's own,
-Hertz's for the elastic models) at its depth at ``F_c``, with a free offset, σ from the best
+(:class:`DentSamples`), the χ² of the dent's shape: the model's own surface (the foundation's,
+the bonded layer's of thickness ``h``, :func:`deformap.mechanics.layer_surface_deflection`, or
+Hertz's half-space) at its depth at ``F_c``, with a free offset, σ from the best
 model's MAD, and divided by the points' correlation factor ``τ`` (batch means over cells of the
 touch model's length scale; Thiébaux & Zwiers 1984), so that ``m / τ`` points count. Weights
 ``wᵢ ∝ exp(−½ Δevidenceᵢ)``, the record's χ² over ``ĉ`` (quasi-likelihood AIC with equal

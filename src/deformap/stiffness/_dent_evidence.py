@@ -11,8 +11,12 @@ from numpy.typing import NDArray
 
 from deformap._validation import check_array, check_positive
 from deformap.errors import InvalidArgumentError
-from deformap.mechanics import foundation_surface_deflection, hertz_surface_deflection
-from deformap.stiffness._tables import FOUNDATION, ContactTable
+from deformap.mechanics import (
+    foundation_surface_deflection,
+    hertz_surface_deflection,
+    layer_surface_deflection,
+)
+from deformap.stiffness._tables import BONDED_LAYER, FOUNDATION, ContactTable
 
 __all__ = ["DentSamples", "dent_chi2"]
 
@@ -68,13 +72,15 @@ def _correlation_factor(residual: NDArray[np.float64], offset: NDArray[np.float6
 
 def _predicted(table: ContactTable, model: str, depth: float, radius: float, thickness: float,
                nu: float, r: NDArray[np.float64]) -> NDArray[np.float64]:
-    """The model's sink at ``r`` for its depth ``δ_c`` at the commanded force: the foundation's
-    own surface, and for the elastic models Hertz's (Johnson 1985, §3.4; the bonded layer's
-    surface outside the contact is taken as the half-space's)."""
+    """The model's sink at ``r`` for its depth ``δ_c`` at the commanded force: each model's own
+    surface (the foundation's, the bonded layer's of its thickness, Hertz's half-space;
+    :mod:`deformap.mechanics`)."""
     if model == FOUNDATION and table.contact_radius is not None:
         a = float(np.interp(np.log(depth), table.log_depth, np.log(table.contact_radius)))
         return foundation_surface_deflection(r, min(float(np.exp(a)), radius), radius, thickness,
                                              nu)
+    if model == BONDED_LAYER:
+        return layer_surface_deflection(r, depth, radius, thickness, nu)
     # Hertz's sphere at depth δ_c: the force that sinks it there at E* = 1 (E = 1, ν = 0)
     return hertz_surface_deflection(r, 4.0 / 3.0 * np.sqrt(radius) * depth**1.5, radius, 1.0, 0.0)
 
