@@ -13,10 +13,10 @@ press, in the same run.
         [--cameras primesense kinect-v1 realsense-d435] [--thickness 0.03 0.1] [--force 0.6] \
         [--levels 8] [--no-anisotropy]
 
-``--levels`` is the record's load levels on the ramp (``WorldConfig.force_travel_levels``; the
-world's default 8; a robot sampling at 100 Hz records about 30 over a 0.3 s ramp); the hold and
-the unloading are read at ``WorldConfig.sample_rate_hz``. Each press's line gives its class; the
-table counts them.
+``--levels`` is the load levels the world solves the ramp at (``WorldConfig.force_travel_levels``;
+the world's default 8); the ramp, the hold and the unloading are read between them at
+``WorldConfig.sample_rate_hz`` (100 Hz: about 30 ramp samples over a 0.3 s ramp). Each press's
+line gives its class; the table counts them.
 """
 
 from __future__ import annotations

@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import numpy as np
 import pytest
 from PIL import Image
 from typer.testing import CliRunner
@@ -15,13 +16,17 @@ from deformap.eval import (
     BEHAVIOUR_READS,
     BEHAVIOUR_TOLERANCES,
     BEHAVIOUR_TRUTHS,
+    DEFAULT_POSITIONS,
     FULL_BEHAVIOUR_MATERIALS,
     QUICK_BEHAVIOUR_MATERIALS,
+    BehaviourMaterial,
+    behaviour_presses,
     behaviour_summary,
 )
 from deformap.run import run_behaviour_study
 from deformap.stiffness._behaviour import RELAXATION_FLOOR
 from deformap.viz import plot_behaviour_study
+from deformap.world import Viscoelastic, WorldConfig
 
 runner = CliRunner()
 
@@ -96,6 +101,23 @@ def test_a_small_seeded_study_reads_each_press_as_its_world_did(tmp_path: Path) 
     assert study["confusion"]["viscoelastic"]["viscoelastic"] == 3
     assert study["elastic_flagged"] == 0.0
     assert study["errors"]["relaxation"]["within"] == study["errors"]["relaxation"]["n"] == 12
+
+
+@pytest.mark.parametrize("relaxed_ratio", [0.5, 0.9])
+def test_a_relaxation_time_as_long_as_the_ramp_reads_viscoelastic(relaxed_ratio: float) -> None:
+    """τ 0.3 s against the 0.29 s ramp of a 0.6 N press at 2 N/s, held 3 s and unloaded: part of
+    the relaxation happens on the ramp and the hold still shows the rest, so neither the loss's
+    bound by the hold's creep nor any other rule reads it elastic."""
+    material = BehaviourMaterial(f"memory τ 0.3 s g∞ {relaxed_ratio:g}", 60.0, viscoelastic=(
+        Viscoelastic(relaxed_ratio=relaxed_ratio, times_s=(0.3,))))
+    config = WorldConfig.coarse(hold_s=3.0, unload=True)
+    rows = behaviour_presses(material, world_config=config, force_n=0.6,
+                             rng=np.random.default_rng(11), thickness_m=0.03,
+                             positions=DEFAULT_POSITIONS[:2])
+    for row in rows:
+        assert row["truth"] == "viscoelastic"
+        assert row["read"] == "viscoelastic", row["evidence"]
+        assert abs(row["quantities"]["relaxation"] - row["true"]["creep_fraction"]) <= 0.05
 
 
 def test_the_matrices_hold_the_issues_materials() -> None:

@@ -31,23 +31,51 @@ def _press(world: SimulatedWorld, xy: tuple[float, float], force_n: float = 0.6)
     return obs.force_travel
 
 
-def test_noise_free_record_is_the_fem_descent_from_contact(exact) -> None:
+def test_noise_free_record_is_the_fem_descent_from_contact_read_at_the_sensors_rate(exact) -> None:
+    """0.82 N at 2 N/s: a 0.4 s ramp, 40 sensor intervals at 100 Hz, so every fifth sample falls
+    on one of the 8 solved levels, and is that level's solve; the samples between follow the
+    levels' law and the travel never falls."""
     c = exact.config
-    record = _press(exact, SOFT)
-    levels = np.linspace(c.contact_threshold_n, 0.6, c.force_travel_levels + 1)
-    assert len(record) == c.force_travel_levels + 1 >= 9
-    np.testing.assert_array_equal(record.force_n, levels)
+    record = _press(exact, SOFT, 0.82)
+    n = round((0.82 - c.contact_threshold_n) / c.ramp_rate_n_per_s * c.sample_rate_hz)
+    assert n == 40 and len(record) == n + 1
+    np.testing.assert_allclose(record.force_n, np.linspace(c.contact_threshold_n, 0.82, n + 1),
+                               rtol=0, atol=1e-15)
+    levels = np.linspace(c.contact_threshold_n, 0.82, c.force_travel_levels + 1)
     # each level is the world's press solve at that force (its patch iteration warm-started,
     # so it agrees with a cold-started solve to the iteration's tolerance, not to the bit)
     depths = np.array([exact.dent(SOFT, f).depth_m for f in levels])
-    np.testing.assert_allclose(record.travel_m, depths - depths[0], rtol=0,
-                               atol=0.01 * depths[-1])
-    assert record.travel_m[0] == 0.0 and np.all(np.diff(record.travel_m) > 0)
+    at_levels = record.travel_m[:: n // c.force_travel_levels]
+    np.testing.assert_allclose(at_levels, depths - depths[0], rtol=0, atol=0.01 * depths[-1])
     # exactly the world's level solves, the last being the press's own dent
-    dent = exact.dent(SOFT, 0.6)
+    dent = exact.dent(SOFT, 0.82)
     solved = exact._level_depths(np.array(SOFT), levels, dent)
     assert solved[-1] == dent.depth_m
-    np.testing.assert_array_equal(record.travel_m, solved - solved[0])
+    np.testing.assert_allclose(at_levels, solved - solved[0], rtol=0, atol=1e-15)
+    assert record.travel_m[0] == 0.0 and np.all(np.diff(record.travel_m) > 0)
+    # between two levels the travel lies between theirs
+    between = record.travel_m[1:5]
+    assert np.all((between > at_levels[0]) & (between < at_levels[1]))
+
+
+def test_the_sensors_read_the_ramp_at_their_rate_never_below_the_solved_levels() -> None:
+    """The sample count is the rate times the ramp's duration, whatever the solved levels; a rate
+    too slow for the levels gives the levels' own samples."""
+    def record(**settings: object) -> ForceTravel:
+        w = SimulatedWorld(load_scenario(SCENARIO), config=WorldConfig.coarse(**settings),
+                           rng=np.random.default_rng(7))
+        return _press(w, SOFT, 0.6)
+
+    seconds = (0.6 - 0.02) / 2.0
+    for rate in (100.0, 250.0):
+        for levels in (4, 8):
+            got = record(sample_rate_hz=rate, force_travel_levels=levels, noise=False)
+            assert len(got) == round(seconds * rate) + 1
+            np.testing.assert_allclose(np.diff(got.force_n), 2.0 / rate, rtol=0.01)
+            assert np.all(np.diff(got.travel_m) > 0) and got.force_n[-1] == 0.6
+    slow = record(sample_rate_hz=5.0, noise=False)
+    assert len(slow) == WorldConfig().force_travel_levels + 1
+    np.testing.assert_allclose(slow.force_n, np.linspace(0.02, 0.6, 9), rtol=0, atol=1e-15)
 
 
 def test_softer_foam_travels_farther_and_rigid_not_at_all(exact) -> None:
@@ -103,7 +131,8 @@ def test_record_draws_leave_every_other_draw_of_the_press_unchanged() -> None:
     b = run(force_travel_levels=20, encoder_noise_m=1e-4, force_travel_noise_rel=0.05)
     for x, y in zip(a[:-1], b[:-1], strict=True):
         np.testing.assert_array_equal(x, y)
-    assert a[-1].shape != b[-1].shape
+    # read at the sensors' rate, the record has as many samples; its readings differ
+    assert a[-1].shape == b[-1].shape and not np.array_equal(a[-1], b[-1])
 
 
 def test_a_press_too_light_to_record_gives_none(world) -> None:
@@ -132,40 +161,6 @@ def test_a_press_whose_levels_do_not_make_a_record_gives_none_and_says_so(
     assert obs.force_travel is None
     assert "no force–travel record" in caplog.text and "backwards" in caplog.text
     monkeypatch.undo()
-    assert _press(exact, HARD).travel_m.size == exact.config.force_travel_levels + 1
-
-
-def test_levels_spaced_evenly_in_travel_for_a_hertz_contact() -> None:
-    from deformap.world._force_travel import force_levels
-
-    levels = force_levels(0.02, 0.8, 8, "travel")
-    assert levels[0] == 0.02 and levels[-1] == 0.8
-    assert np.all(np.diff(levels) > 0)
-    # Hertz: δ ∝ F^(2/3), so the travel grows evenly when F^(2/3) does
-    np.testing.assert_allclose(np.diff(levels ** (2.0 / 3.0)),
-                               (0.8 ** (2.0 / 3.0) - 0.02 ** (2.0 / 3.0)) / 8, rtol=1e-12)
-    np.testing.assert_array_equal(force_levels(0.02, 0.8, 8), np.linspace(0.02, 0.8, 9))
-    with pytest.raises(ValueError, match="`spacing` must be 'force' or 'travel'; got 'time'"):
-        force_levels(0.02, 0.8, 8, "time")
-
-
-def test_a_record_spaced_in_travel_samples_the_start_of_the_press_more_densely() -> None:
-    """The same press, recorded at forces even in travel: the first sample past contact comes at
-    a smaller force and travel, and the ends are the same."""
-    worlds = {s: SimulatedWorld(load_scenario(SCENARIO),
-                                config=WorldConfig.coarse(noise=False, force_travel_spacing=s),
-                                rng=np.random.default_rng(7)) for s in ("force", "travel")}
-    force, travel = (_press(worlds[s], SOFT) for s in ("force", "travel"))
-    assert travel.force_n[-1] == pytest.approx(force.force_n[-1], rel=1e-12)
-    # the contact sample's depth is solved from another level above it (to the patch's tolerance)
-    assert travel.travel_m[-1] == pytest.approx(force.travel_m[-1], rel=1e-3)
-    assert travel.force_n[1] < force.force_n[1] and travel.travel_m[1] < force.travel_m[1]
-    assert np.all(np.diff(travel.travel_m) > 0) and np.all(np.diff(travel.force_n) > 0)
-
-
-def test_the_record_spacing_is_a_checked_setting() -> None:
-    from deformap.errors import InvalidArgumentError
-
-    with pytest.raises(InvalidArgumentError,
-                       match="`force_travel_spacing` must be one of \\['force', 'travel'\\]"):
-        WorldConfig(force_travel_spacing="time")  # type: ignore[arg-type]
+    c = exact.config
+    assert _press(exact, HARD).travel_m.size == round(
+        (0.6 - c.contact_threshold_n) / c.ramp_rate_n_per_s * c.sample_rate_hz) + 1

@@ -1,5 +1,6 @@
 """Appearance leaves geometry alone: the points, the press and its force–travel record of a small
-seeded world are byte for byte those of the world before it rendered colour (commit 03972c1)."""
+seeded world are byte for byte those of the world before it rendered colour (commit 03972c1; the
+record's since the sensors read the ramp at their rate, branch h-ramp)."""
 
 from __future__ import annotations
 
@@ -11,10 +12,11 @@ import pytest
 from deformap.world import CameraConfig, SimulatedWorld, WorldConfig, load_scenario, random_scenario
 
 # sha256 (first 16 hex digits) of the float64 bytes, computed with the code at commit 03972c1
+# (the record's, with the code that reads the ramp at the sensors' rate)
 _OBSERVE = "c2b9e85d51093383"
 _PRESS_CLOUD = "9dd202ee92a403db"
 _CONTACT = "fc4d81500bdcc497"
-_FORCE_TRAVEL = "605f2f49f7a7f7bb"
+_FORCE_TRAVEL = "d5f85eb3b8b213b6"  # the ramp read at 100 Hz (30 samples), branch h-ramp
 _OBSERVE_PRESSED = "8650a342df53a090"
 _RANDOM_POLYGONS = "51d861bba4a897e1"
 

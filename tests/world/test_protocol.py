@@ -23,10 +23,12 @@ def _record(**protocol: object):  # type: ignore[no-untyped-def]
 def test_default_protocol_records_the_ramp_alone_and_the_phases_leave_it_unchanged() -> None:
     plain = _record()
     assert plain.time_s is None and plain.hold is None and plain.unloading is None
+    np.testing.assert_array_equal(_record(hold_s=4.0, unload=True).travel_m, plain.travel_m)
     full = _record(hold_s=4.0, unload=True, ramp_rate_n_per_s=4.0)
-    np.testing.assert_array_equal(full.travel_m, plain.travel_m)
-    np.testing.assert_array_equal(full.force_n, plain.force_n)
-    # load-controlled at 4 N/s: the ramp takes (F − F_contact) / rate
+    # load-controlled at 4 N/s: the ramp takes (F − F_contact) / rate, read at 100 Hz
+    rate = WorldConfig().sample_rate_hz
+    assert len(full) == round((FORCE - 0.02) / 4.0 * rate) + 1
+    assert len(plain) == round((FORCE - 0.02) / 2.0 * rate) + 1
     assert full.time_s is not None and full.hold is not None and full.unloading is not None
     assert full.time_s[-1] == pytest.approx((FORCE - 0.02) / 4.0)
     assert full.hold.time_s[-1] == pytest.approx(full.time_s[-1] + 4.0)
@@ -87,7 +89,14 @@ def test_the_sensors_read_a_viscoelastic_hold_between_the_solved_steps() -> None
 
     dense, solved = record(100.0), record(4.0)  # 4 Hz over 2 s: the solved 8 hold samples
     assert len(dense.hold) == 200 and len(solved.hold) == 8 and len(solved.unloading) == 8
-    np.testing.assert_array_equal(dense.travel_m, solved.travel_m)
+    assert len(solved) == 9 and len(dense) == 100  # the 0.99 s ramp: its levels; at 100 Hz
+    # the ramp read between its solved steps: it starts and ends on them, never falls, and
+    # each sample lies between the solved samples on either side of its force
+    assert dense.travel_m[-1] == pytest.approx(solved.travel_m[-1], abs=1e-12)
+    assert np.all(np.diff(dense.travel_m) > 0.0)
+    above = np.searchsorted(solved.force_n, dense.force_n - 1e-12)
+    assert np.all(dense.travel_m <= solved.travel_m[above] + 1e-12)
+    assert np.all(dense.travel_m >= solved.travel_m[np.maximum(above - 1, 0)] - 1e-12)
     at = np.searchsorted(dense.hold.time_s, solved.hold.time_s - 1e-9)
     np.testing.assert_allclose(dense.hold.time_s[at], solved.hold.time_s, atol=1e-12)
     np.testing.assert_allclose(dense.hold.travel_m[at], solved.hold.travel_m, atol=1e-12)

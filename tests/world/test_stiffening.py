@@ -182,7 +182,9 @@ def test_the_world_under_the_second_physics_records_force_against_travel() -> No
                            rng=np.random.default_rng(0))
     obs = world.press(CENTER, 0.6)
     record = obs.force_travel
-    assert record is not None and len(record) == world.config.force_travel_levels + 1
+    c = world.config
+    assert record is not None and len(record) == round(
+        (0.6 - c.contact_threshold_n) / c.ramp_rate_n_per_s * c.sample_rate_hz) + 1
     assert record.travel_m[0] == 0.0 and np.all(np.diff(record.travel_m) > 0)
     depth = world.dent(CENTER, 0.6).depth_m
     first = world.dent(CENTER, world.config.contact_threshold_n).depth_m

@@ -139,7 +139,9 @@ def _world(seed: int = 0, noise: bool = False, **overrides: object) -> Simulated
 def test_the_record_is_monotone_deterministic_and_stiffer_than_the_fems() -> None:
     world = _world()
     record = world.force_travel(CENTER, 0.6)
-    assert record is not None and record.travel_m.size == world.config.force_travel_levels + 1
+    c = world.config
+    assert record is not None and record.travel_m.size == round(
+        (0.6 - c.contact_threshold_n) / c.ramp_rate_n_per_s * c.sample_rate_hz) + 1
     assert record.travel_m[0] == 0.0 and np.all(np.diff(record.travel_m) > 0)
     assert np.all(np.diff(record.force_n) > 0)
     fem = SimulatedWorld(_scenario(), config=WorldConfig.coarse(noise=False),

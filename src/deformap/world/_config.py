@@ -17,15 +17,11 @@ from deformap.world._probe import ProbeGeometry
 from deformap.world._scenario import Scenario
 from deformap.world._stiffening import max_grid_nodes
 
-__all__ = ["MAX_FEM_UNKNOWNS", "PHYSICS", "Physics", "RecordSpacing", "WorldConfig",
-           "check_world_budget"]
+__all__ = ["MAX_FEM_UNKNOWNS", "PHYSICS", "Physics", "WorldConfig", "check_world_budget"]
 
 #: The world's contact physics (``WorldConfig.physics``).
 Physics = Literal["linear-fem", "stiffening-foam", "stiffening-fem"]
 PHYSICS: tuple[str, ...] = get_args(Physics)
-#: How a force–travel record's samples are spaced
-#: (:func:`~deformap.world._force_travel.force_levels`).
-RecordSpacing = Literal["force", "travel"]
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -60,11 +56,9 @@ class WorldConfig:
     force_noise_n : float
         Standard deviation per axis of the force sensor's noise (Optoforce-class resolution).
     force_travel_levels : int
-        Load levels of the press's force–travel record above contact (the record has one more
-        sample), each solved by the world's physics (:mod:`deformap.world._force_travel`).
-    force_travel_spacing : {"force", "travel"}
-        How the record's samples are spaced (:data:`RecordSpacing`): evenly in force, or evenly in
-        travel.
+        Load levels above contact, evenly spaced in force, at which the world's physics solves a
+        press (one press solve each, :mod:`deformap.world._force_travel`); the sensors read the
+        record between them at ``sample_rate_hz``, never fewer samples per stretch than these.
     ramp_rate_n_per_s : float
         Probe protocol: the rate at which the commanded force rises on the loading ramp (a
         load-controlled press) and falls on the unloading branch.
@@ -72,9 +66,10 @@ class WorldConfig:
         Probe protocol: how long the commanded force is held after the ramp (the record's hold:
         the travel creeps on a viscoelastic block); 0: no hold recorded.
     sample_rate_hz : float
-        The rate at which the force sensor and the encoders are read during the hold and the
-        unloading (never fewer samples than the ramp's levels); the ramp keeps its
-        ``force_travel_levels`` levels, each a press solve.
+        The rate at which the force sensor and the encoders are read on the ramp, the hold and
+        the unloading (never fewer samples per stretch than ``force_travel_levels``): a ramp of
+        ``(F − contact_threshold_n) / ramp_rate_n_per_s`` seconds gives that times this rate
+        samples after the first. No sample costs a press solve of its own.
     unload : bool
         Probe protocol: record the unloading branch (the force falling back to contact).
     contact_threshold_n : float
@@ -111,7 +106,6 @@ class WorldConfig:
     force_noise_n: float = setting(0.01, ge=0.0, le=0.02)
     # 8 levels resolve the curvature of a sphere's F ∝ δ^(3/2); each level costs one press solve
     force_travel_levels: int = setting(8, ge=2, le=1000)
-    force_travel_spacing: RecordSpacing = "force"
     # a hand-held press gauge loads at about 1–10 N/s; 1 kN/s is an impact, not a press
     ramp_rate_n_per_s: float = setting(2.0, gt=0.0, le=1000.0)
     hold_s: float = setting(0.0, ge=0.0, le=600.0)  # ten minutes: longer is a creep test

@@ -89,12 +89,14 @@ class PressHistory:
     """A viscoelastic press: the true indentation at each sample of the ramp, the hold and the
     unloading (metres), the dent at the end of the hold (what the camera sees while pressing),
     the state when the tip leaves and the time the tip left (seconds on the ramp's clock);
-    ``step_times`` and ``step_depths`` the time and indentation at every time step solved."""
+    ``step_times``, ``step_forces`` and ``step_depths`` the time, force and indentation at every
+    time step solved."""
 
     ramp: NDArray[np.float64]
     hold: NDArray[np.float64]
     unloading: NDArray[np.float64]
     step_times: NDArray[np.float64]
+    step_forces: NDArray[np.float64]
     step_depths: NDArray[np.float64]
     held: Dent
     state: MaxwellState
@@ -113,7 +115,7 @@ def press_history(foam: FoamModel, material: Viscoelastic, target: NDArray[np.fl
     held: Dent | None = None
     radius: float | None = None
     t_prev, f_prev = 0.0, 0.0
-    steps: list[tuple[float, float]] = []
+    steps: list[tuple[float, float, float]] = []
     foam.forget()
     for k, (t, f) in enumerate(zip(times, forces, strict=True)):
         span = float(t - t_prev) if k else 0.0
@@ -127,7 +129,7 @@ def press_history(foam: FoamModel, material: Viscoelastic, target: NDArray[np.fl
             assert dent.solved is not None
             state.commit(dent.solved, decay, gamma)
             radius = dent.contact_radius_m or None
-            steps.append((t_prev + span * j / n_sub if k else float(t), dent.depth_m))
+            steps.append((t_prev + span * j / n_sub if k else float(t), force, dent.depth_m))
         depths[k] = dent.depth_m
         if k == n_ramp + n_hold - 1:
             held = dent
@@ -136,7 +138,8 @@ def press_history(foam: FoamModel, material: Viscoelastic, target: NDArray[np.fl
     return PressHistory(ramp=depths[:n_ramp], hold=depths[n_ramp:n_ramp + n_hold],
                         unloading=depths[n_ramp + n_hold:], held=held, state=state,
                         left_s=float(times[-1]), step_times=np.array([p[0] for p in steps]),
-                        step_depths=np.array([p[1] for p in steps]))
+                        step_forces=np.array([p[1] for p in steps]),
+                        step_depths=np.array([p[2] for p in steps]))
 
 
 def recovered(state: MaxwellState, after_s: float) -> NDArray[np.float64]:

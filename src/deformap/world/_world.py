@@ -35,8 +35,8 @@ from deformap.world._config import WorldConfig, check_world_budget
 from deformap.world._foam import Dent, FoamModel
 from deformap.world._force_travel import (
     force_levels,
-    phase_depths,
     press_schedule,
+    sensor_depths,
     simulated_force_travel,
     with_phases,
 )
@@ -251,7 +251,8 @@ class SimulatedWorld(WorldTruth):
         ``exact``, without noise: the world's true indentations, for evaluation).
 
         One press solve per load level (:mod:`deformap.world._force_travel`), ``dent`` (the
-        press's own solve) the last. None under :data:`MIN_RECORD_FORCE_N`, and, with a warning,
+        press's own solve) the last; the sensors read the ramp between the levels at
+        ``sample_rate_hz``. None under :data:`MIN_RECORD_FORCE_N`, and, with a warning,
         where the solved indentations make no record (by a seam the FEM's indentation can fall
         from one level to the next): that press is read by the camera alone.
         """
@@ -261,10 +262,11 @@ class SimulatedWorld(WorldTruth):
             return None
         c = self.config
         final = dent if dent is not None else self.dent(target, force)
-        levels = force_levels(c.contact_threshold_n, force, c.force_travel_levels,
-                              c.force_travel_spacing)
+        levels = force_levels(c.contact_threshold_n, force, c.force_travel_levels)
         schedule = press_schedule(levels, rate_n_per_s=c.ramp_rate_n_per_s, hold_s=c.hold_s,
                                   unload=c.unload)
+        sensor = press_schedule(levels, rate_n_per_s=c.ramp_rate_n_per_s, hold_s=c.hold_s,
+                                unload=c.unload, sample_rate_hz=c.sample_rate_hz)
         history = self._material_press(target, force)
         depths = history.ramp if history is not None else self._level_depths(target, levels,
                                                                                final)
@@ -273,14 +275,12 @@ class SimulatedWorld(WorldTruth):
                      * on, force_noise_rel=c.force_travel_noise_rel * on)
         key = self._press_key(target, force, 2)
         try:
-            record = simulated_force_travel(depths, levels, self._event_rng(*key), **noise)
-            if not schedule.has_phases:
+            ramp, hold, unloading = sensor_depths(schedule, sensor, depths, history)
+            record = simulated_force_travel(ramp, sensor.levels, self._event_rng(*key), **noise)
+            if not sensor.has_phases:
                 return record
-            sensor = press_schedule(levels, rate_n_per_s=c.ramp_rate_n_per_s, hold_s=c.hold_s,
-                                    unload=c.unload, sample_rate_hz=c.sample_rate_hz)
-            hold, unloading = phase_depths(schedule, sensor, depths, history)
             # the encoder's reading at first contact: the ramp stream's first draw
-            zero = depths[0] + self._event_rng(*key).normal(0.0, 1.0, size=depths.size)[0] * (
+            zero = ramp[0] + self._event_rng(*key).normal(0.0, 1.0, size=ramp.size)[0] * (
                 noise["encoder_noise_m"])
             return with_phases(record, sensor, zero, hold, unloading,
                                self._event_rng(*self._press_key(target, force, 4)), **noise)
@@ -302,8 +302,7 @@ class SimulatedWorld(WorldTruth):
         if self._history is not None and self._history[0] == key:
             return self._history[1]
         c = self.config
-        levels = force_levels(c.contact_threshold_n, force, c.force_travel_levels,
-                              c.force_travel_spacing)
+        levels = force_levels(c.contact_threshold_n, force, c.force_travel_levels)
         plan = press_schedule(levels, rate_n_per_s=c.ramp_rate_n_per_s, hold_s=c.hold_s,
                               unload=c.unload)
         assert isinstance(self.foam, FoamModel) and index is not None
