@@ -59,6 +59,11 @@ def test_a_footprint_is_inside_its_segment_only_a_radius_from_every_other_segmen
     # the workspace's border is no edge, and one segment has no edge at all
     assert inside[0, 0] and inside[-1, -1]
     assert footprint_inside(np.zeros((4, 5), dtype=np.int64), spacing, 0.015).all()
+    # two segments of one look are one: only the edge to the third, unlike look counts
+    three = np.where(XS[None, :] < 0.1, 0, looks + 1) * np.ones((YS.size, 1), dtype=np.int64)
+    alike = np.array([[True, True, False], [True, True, False], [False, False, True]])
+    assert not footprint_inside(three, spacing, 0.015)[:, np.abs(XS - 0.1) < 0.015].all()
+    assert np.array_equal(footprint_inside(three, spacing, 0.015, alike), inside)
 
 
 def test_where_the_pokes_favour_the_looks_the_boundary_poke_keeps_its_dent_off_the_edge() -> None:

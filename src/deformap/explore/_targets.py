@@ -10,10 +10,10 @@ largest segment with one poke, the place the blind map (``w = 0``) knows least w
 
 Where the prior holds (the pokes make the looks more probable than the blind map, the weight's
 posterior above one half on ``w > 0``), no target's footprint (a dent's, the segmentation's
-``BOUNDARY_SPACING_ROI`` ROIs across) crosses an edge between segments (:func:`footprint_inside`):
-the boundary is then the image's, a dent across it reads between two materials, and the pokes
-test the looks inside their segments. Where no such place is left, or the prior does not hold,
-every reachable place may be poked.
+``BOUNDARY_SPACING_ROI`` ROIs across) meets a segment of another look (farther than ``ℓ_a``;
+:func:`footprint_inside`): the boundary is then the image's, a dent across it reads between two
+materials, and the pokes test the looks inside them. Where no such place is left, or the prior
+does not hold, every reachable place may be poked.
 
 When only the edge band, where no poke fits, is still above ``T_h``, ``planned`` plans it like
 any other place; the other strategies poke the reachable cell of largest variance.
@@ -113,25 +113,29 @@ def segment_interior(grid: MapGrid, segments: NDArray[np.int64], segment: int
     return np.array(grid.cells_xy[flat], dtype=float), float(depth.ravel()[flat])
 
 
-def footprint_inside(looks: NDArray[np.int64], spacing_m: float, radius_m: float
-                     ) -> NDArray[np.bool_]:  # fmt: skip
-    """``(ny, nx)`` whether a disc of ``radius_m`` [m] centred on each cell lies within the cell's
-    own segment of ``looks (ny, nx)`` (every cell's segment, none masked), cells ``spacing_m``
-    apart: its distance to the nearest cell of another segment, less half a cell (the edge lies
-    between the two), is at least ``radius_m``. The workspace's border is no edge."""
+def footprint_inside(looks: NDArray[np.int64], spacing_m: float, radius_m: float,
+                     alike: NDArray[np.bool_] | None = None) -> NDArray[np.bool_]:
+    """``(ny, nx)`` whether a disc of ``radius_m`` [m] centred on each cell meets no segment of
+    another look: ``looks (ny, nx)`` each cell's segment (none masked), cells ``spacing_m``
+    apart, ``alike (n, n)`` which segments share a look (default: each only itself). A cell's
+    distance to the nearest cell of a segment unlike its own, less half a cell (the edge lies
+    between the two), must be at least ``radius_m``. The workspace's border is no edge."""
+    n = int(looks.max()) + 1
+    same = np.eye(n, dtype=bool) if alike is None else np.asarray(alike, dtype=bool)
     inside = np.ones(looks.shape, dtype=bool)
     for s in np.unique(looks):
         mine = looks == s
-        if mine.all():
-            break
-        depth = ndi.distance_transform_edt(mine) * spacing_m - spacing_m / 2
+        kin = same[s][looks]
+        if kin.all():
+            continue
+        depth = ndi.distance_transform_edt(kin) * spacing_m - spacing_m / 2
         inside[mine] = depth[mine] >= radius_m
     return inside
 
 
 def _interior_grid(grid: MapGrid, field: PokeField, config: ExplorationConfig) -> MapGrid:
-    """``grid`` with the targets whose footprint crosses a segment edge taken out, where the
-    prior holds (module docstring); ``grid`` itself where it does not or no place would be left."""
+    """``grid`` with the targets whose footprint meets another look taken out, where the prior
+    holds (module docstring); ``grid`` itself where it does not or no place would be left."""
     models = field.models
     if field.prior is None or models is None:
         return grid
@@ -140,8 +144,8 @@ def _interior_grid(grid: MapGrid, field: PokeField, config: ExplorationConfig) -
         return grid
     spacing = float(grid.xs[1] - grid.xs[0]) if grid.xs.size > 1 else 1.0
     radius = BOUNDARY_SPACING_ROI * config.touch.roi_size_m / 2
-    looks = field.prior.looks
-    inside = footprint_inside(looks, spacing, radius).ravel()
+    d2, alike = _look_distance(field)
+    inside = footprint_inside(field.prior.looks, spacing, radius, d2 <= alike).ravel()
     target = grid.target_mask & inside
     candidates = grid.plan_candidates[inside[field.prior.cells_of(grid.plan_candidates)]]
     if not target.any() or not len(candidates):
