@@ -19,8 +19,7 @@ EDGE_X = 0.15
 RED, BLUE = (0.8, 0.2, 0.2), (0.2, 0.3, 0.8)
 # a high T_h: the variance rule is met, so the next poke is a boundary poke
 CONFIG = ExplorationConfig(field="beta", threshold=0.5, boundary_pokes=1)
-# the dent's radius and half a footprint for where the image's edge lies
-MARGIN = BOUNDARY_SPACING_ROI * CONFIG.touch.roi_size_m
+RADIUS = BOUNDARY_SPACING_ROI * CONFIG.touch.roi_size_m / 2
 XY = [(0.06, 0.06), (0.07, 0.14), (0.23, 0.06), (0.24, 0.14)]
 
 
@@ -72,10 +71,10 @@ def test_where_the_pokes_favour_the_looks_the_boundary_poke_keeps_its_dent_off_t
     values = [0.2, 0.21, 0.8, 0.79]
     blind_xy, _ = _next(values, None)
     # the blind map's least certain boundary is the classes' edge, within a dent of the looks'
-    assert abs(blind_xy[0] - EDGE_X) < MARGIN / 2
+    assert abs(blind_xy[0] - EDGE_X) < RADIUS
     xy, looked = _next(values, prior)
     assert looked > 0.5
-    assert abs(xy[0] - EDGE_X) >= MARGIN
+    assert abs(xy[0] - EDGE_X) >= RADIUS
 
 
 def test_where_the_pokes_contradict_the_looks_every_place_may_be_poked() -> None:

@@ -11,8 +11,7 @@ largest segment with one poke, the place the blind map (``w = 0``) knows least w
 Where the prior holds (the pokes make the looks more probable than the blind map, the weight's
 posterior above one half on ``w > 0``), no target's footprint (a dent's, the segmentation's
 ``BOUNDARY_SPACING_ROI`` ROIs across) meets a segment of another look (farther than ``ℓ_a``;
-:func:`footprint_inside`), its edge taken as known to half a footprint (the thin strips the
-segmentation merges): the boundary is then the image's, a dent across it reads between two
+:func:`footprint_inside`): the boundary is then the image's, a dent across it reads between two
 materials, and the pokes test the looks inside them. Where no such place is left, or the prior
 does not hold, every reachable place may be poked.
 
@@ -144,12 +143,9 @@ def _interior_grid(grid: MapGrid, field: PokeField, config: ExplorationConfig) -
     if probability[values > 0].sum() <= 0.5:
         return grid
     spacing = float(grid.xs[1] - grid.xs[0]) if grid.xs.size > 1 else 1.0
-    # the dent's radius, and half a footprint more: a strip of mixed colour along a boundary up
-    # to a footprint wide is merged into one side (build_appearance), so an edge may lie that
-    # far from the true one
-    margin = BOUNDARY_SPACING_ROI * config.touch.roi_size_m
+    radius = BOUNDARY_SPACING_ROI * config.touch.roi_size_m / 2
     d2, alike = _look_distance(field)
-    inside = footprint_inside(field.prior.looks, spacing, margin, d2 <= alike).ravel()
+    inside = footprint_inside(field.prior.looks, spacing, radius, d2 <= alike).ravel()
     target = grid.target_mask & inside
     candidates = grid.plan_candidates[inside[field.prior.cells_of(grid.plan_candidates)]]
     if not target.any() or not len(candidates):
