@@ -8,12 +8,13 @@ the segments within ``ℓ_a`` of it), if that look covers more than one poke doe
 largest segment with one poke, the place the blind map (``w = 0``) knows least while still above
 ``T_h``. A test the pokes contradict moves the weight's posterior toward the blind map.
 
-Where the prior holds (the pokes make the looks more probable than the blind map, the weight's
-posterior above one half on ``w > 0``), no target's footprint (a dent's, the segmentation's
-``BOUNDARY_SPACING_ROI`` ROIs across) meets a segment of another look (farther than ``ℓ_a``;
-:func:`footprint_inside`): the boundary is then the image's, a dent across it reads between two
-materials, and the pokes test the looks inside them. Where no such place is left, or the prior
-does not hold, every reachable place may be poked.
+Once under ``T_h``, where the prior holds (the pokes make the looks more probable than the blind
+map, the weight's posterior above one half on ``w > 0``), no target's footprint (a dent's, the
+segmentation's ``BOUNDARY_SPACING_ROI`` ROIs across) meets a segment of another look (farther
+than ``ℓ_a``; :func:`footprint_inside`): the boundary is then the image's, a dent across it reads
+between two materials, and the boundary pokes and the tests of the looks poke inside the looks.
+Where no such place is left, or the prior does not hold, every reachable place may be poked.
+Above ``T_h`` the targets seek the least known places, not edges, and are left as they are.
 
 When only the edge band, where no poke fits, is still above ``T_h``, ``planned`` plans it like
 any other place; the other strategies poke the reachable cell of largest variance.
@@ -228,7 +229,8 @@ def choose_next(grid: MapGrid, field: PokeField, config: ExplorationConfig,
     variance = field.variance.ravel()
     threshold = field_settings(config, field.name).threshold
     done = variance[grid.stop_mask].max() <= threshold
-    grid = _interior_grid(grid, field, config)
+    if done:  # the pokes that seek edges: boundary pokes and the tests of the looks
+        grid = _interior_grid(grid, field, config)
     if field.prior is not None:
         look = _look_target(grid, field, config, threshold, done)
         if look is not None:
