@@ -4,6 +4,8 @@ do not, every place may be poked."""
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 
 from deformap.cloud import PointCloud
@@ -86,3 +88,19 @@ def test_where_the_pokes_contradict_the_looks_every_place_may_be_poked() -> None
     assert looked <= 0.5
     blind_xy, _ = _next(values, None)
     assert np.allclose(xy, blind_xy, atol=0.005)
+
+
+def test_above_the_threshold_the_targets_are_left_as_the_strategy_chose_them() -> None:
+    # max-variance under the prior: the least known place is the looks' edge, where the model
+    # average's two hypotheses disagree most; above T_h it is poked as chosen
+    config = dataclasses.replace(CONFIG, threshold=0.001, strategy="max-variance")
+    grid = MapGrid.build(Workspace(lower=(0.0, 0.0), upper=(0.3, 0.2)), config)
+    xy = np.array([(0.083, 0.115), (0.055, 0.145), (0.063, 0.085), (0.243, 0.126)])
+    pokes = PokeSet(xy, np.array([0.2, 0.21, 0.19, 0.8]), np.full(4, 0.02))
+    field = BetaField(pokes, XS, YS, BetaFieldConfig(length_scale_m=0.05)).with_prior(_prior())
+    assert field.models is not None
+    w, p = field.models.posterior.weight_distribution()
+    assert p[w > 0].sum() > 0.5
+    target = choose_next(grid, field, config, np.random.default_rng(0), boundary_owed=1)
+    assert target is not None and target.purpose == "variance"
+    assert abs(target.xy[0] - EDGE_X) < RADIUS
