@@ -1,6 +1,6 @@
-"""Targets under the appearance prior: where the pokes make the looks the likelier hypothesis, no
-dent is placed across an edge between segments (it would read between two materials); where they
-do not, every place may be poked."""
+"""Targets under the appearance prior: once the variance is under T_h, where the pokes make the
+looks the likelier hypothesis, no dent is placed across an edge between two looks (it would read
+between two materials); where they do not, and above T_h, every place may be poked."""
 
 from __future__ import annotations
 
