@@ -70,6 +70,11 @@ class AppearancePrior:
                                              return_indices=True)  # fmt: skip
         self._look = np.asarray(seg[nearest[0], nearest[1]].ravel(), dtype=np.int64)
 
+    @property
+    def looks(self) -> NDArray[np.int64]:
+        """``(ny, nx)`` each cell's segment, a masked cell its nearest seen cell's."""
+        return self._look.reshape(self.image.segments.shape)
+
     def cells_of(self, xy: Array) -> NDArray[np.int64]:
         """``(n,)`` flat index of the cell each of ``xy (n, 2)`` [m] lies in (nearest centre)."""
         xy = np.asarray(xy, dtype=float).reshape(-1, 2)

@@ -8,6 +8,14 @@ the segments within ``ℓ_a`` of it), if that look covers more than one poke doe
 largest segment with one poke, the place the blind map (``w = 0``) knows least while still above
 ``T_h``. A test the pokes contradict moves the weight's posterior toward the blind map.
 
+Once under ``T_h``, where the prior holds (the pokes make the looks more probable than the blind
+map, the weight's posterior above one half on ``w > 0``), no target's footprint (a dent's, the
+segmentation's ``BOUNDARY_SPACING_ROI`` ROIs across) meets a segment of another look (farther
+than ``ℓ_a``; :func:`footprint_inside`): the boundary is then the image's, a dent across it reads
+between two materials, and the boundary pokes and the tests of the looks poke inside the looks.
+Where no such place is left, or the prior does not hold, every reachable place may be poked.
+Above ``T_h`` the targets seek the least known places, not edges, and are left as they are.
+
 When only the edge band, where no poke fits, is still above ``T_h``, ``planned`` plans it like
 any other place; the other strategies poke the reachable cell of largest variance.
 """
@@ -15,6 +23,7 @@ any other place; the other strategies poke the reachable cell of largest varianc
 from __future__ import annotations
 
 import logging
+from dataclasses import replace
 
 import numpy as np
 from numpy.typing import NDArray
@@ -31,7 +40,7 @@ from deformap.explore._planning import PokePlan, plan_pokes
 from deformap.explore._records import Target
 
 __all__ = ["BOUNDARY_SPACING_ROI", "choose_next", "covered_area_m2", "expected_noise",
-           "segment_interior"]
+           "footprint_inside", "segment_interior"]
 
 logger = logging.getLogger(__name__)
 
@@ -103,6 +112,46 @@ def segment_interior(grid: MapGrid, segments: NDArray[np.int64], segment: int
     depth = ndi.distance_transform_edt(np.pad(inside, 1))[1:-1, 1:-1] * spacing
     flat = int(np.argmax(np.where(reach, depth, -1.0)))
     return np.array(grid.cells_xy[flat], dtype=float), float(depth.ravel()[flat])
+
+
+def footprint_inside(looks: NDArray[np.int64], spacing_m: float, radius_m: float,
+                     alike: NDArray[np.bool_] | None = None) -> NDArray[np.bool_]:
+    """``(ny, nx)`` whether a disc of ``radius_m`` [m] centred on each cell meets no segment of
+    another look: ``looks (ny, nx)`` each cell's segment (none masked), cells ``spacing_m``
+    apart, ``alike (n, n)`` which segments share a look (default: each only itself). A cell's
+    distance to the nearest cell of a segment unlike its own, less half a cell (the edge lies
+    between the two), must be at least ``radius_m``. The workspace's border is no edge."""
+    n = int(looks.max()) + 1
+    same = np.eye(n, dtype=bool) if alike is None else np.asarray(alike, dtype=bool)
+    inside = np.ones(looks.shape, dtype=bool)
+    for s in np.unique(looks):
+        mine = looks == s
+        kin = same[s][looks]
+        if kin.all():
+            continue
+        depth = ndi.distance_transform_edt(kin) * spacing_m - spacing_m / 2
+        inside[mine] = depth[mine] >= radius_m
+    return inside
+
+
+def _interior_grid(grid: MapGrid, field: PokeField, config: ExplorationConfig) -> MapGrid:
+    """``grid`` with the targets whose footprint meets another look taken out, where the prior
+    holds (module docstring); ``grid`` itself where it does not or no place would be left."""
+    models = field.models
+    if field.prior is None or models is None:
+        return grid
+    values, probability = models.posterior.weight_distribution()
+    if probability[values > 0].sum() <= 0.5:
+        return grid
+    spacing = float(grid.xs[1] - grid.xs[0]) if grid.xs.size > 1 else 1.0
+    radius = BOUNDARY_SPACING_ROI * config.touch.roi_size_m / 2
+    d2, alike = _look_distance(field)
+    inside = footprint_inside(field.prior.looks, spacing, radius, d2 <= alike).ravel()
+    target = grid.target_mask & inside
+    candidates = grid.plan_candidates[inside[field.prior.cells_of(grid.plan_candidates)]]
+    if not target.any() or not len(candidates):
+        return grid
+    return replace(grid, target_mask=target, plan_candidates=candidates)
 
 
 def _poked_segments(field: PokeField, segments: NDArray[np.int64]) -> NDArray[np.int64]:
@@ -180,6 +229,8 @@ def choose_next(grid: MapGrid, field: PokeField, config: ExplorationConfig,
     variance = field.variance.ravel()
     threshold = field_settings(config, field.name).threshold
     done = variance[grid.stop_mask].max() <= threshold
+    if done:  # the pokes that seek edges: boundary pokes and the tests of the looks
+        grid = _interior_grid(grid, field, config)
     if field.prior is not None:
         look = _look_target(grid, field, config, threshold, done)
         if look is not None:
