@@ -106,8 +106,7 @@ def test_a_small_seeded_study_reads_each_press_as_its_world_did(tmp_path: Path) 
 @pytest.mark.parametrize("relaxed_ratio", [0.5, 0.9])
 def test_a_relaxation_time_as_long_as_the_ramp_reads_viscoelastic(relaxed_ratio: float) -> None:
     """τ 0.3 s against the 0.29 s ramp of a 0.6 N press at 2 N/s, held 3 s and unloaded: part of
-    the relaxation happens on the ramp and the hold still shows the rest, so neither the loss's
-    bound by the hold's creep nor any other rule reads it elastic."""
+    the relaxation happens on the ramp and the hold still shows the rest: it reads viscoelastic."""
     material = BehaviourMaterial(f"memory τ 0.3 s g∞ {relaxed_ratio:g}", 60.0, viscoelastic=(
         Viscoelastic(relaxed_ratio=relaxed_ratio, times_s=(0.3,))))
     config = WorldConfig.coarse(hold_s=3.0, unload=True)

@@ -52,16 +52,7 @@ remains (record or camera) while a hold shows no relaxation; or a loss with a ho
 none. No dent remains when neither dent reading shows one and one of them rules it out, each
 against its floor: the camera's :data:`DENT_FLOOR_M`, the record's :func:`record_dent_floor`.
 Elastic: every quantity the record holds rules its behaviour out, and the record holds an
-unloading branch or a hold with a camera dent. Elastic too, the loss ratio unresolved (it neither
-shows a loss nor rules one out): a loop loses energy by relaxation at the press's time scales or
-by yield, and a press can rule out both without the loop. Yield is ruled out by no dent remaining;
-relaxation by a hold under the held force, at least as long as the ramp and the unloading
-together, whose creep is ruled out below :data:`LOSS_FLOOR` / :data:`LOSS_PER_CREEP` by 2σ. For a
-linear viscoelastic solid pressed by a sphere (Lee & Radok 1960) under this protocol, a relaxation
-time far shorter than the ramp leaves a creep the hold reads, and one far longer than the hold
-creeps over the hold at least as much as over the loop, so the loop's loss ratio is at most
-:data:`LOSS_PER_CREEP` times the hold's creep fraction: an unresolved loss is then below its floor
-whatever the loop's noise. Anything else is ``"unknown"`` with the reason.
+unloading branch or a hold with a camera dent. Anything else is ``"unknown"`` with the reason.
 
 Anisotropy: from the dent's shape in the cloud during the press
 (:mod:`deformap.stiffness._anisotropy`), its own class ``isotropy`` beside ``behaviour``.
@@ -69,9 +60,6 @@ Anisotropy: from the dent's shape in the cloud during the press
 Moduli: the loading ramp's E, given by the caller (:mod:`deformap.stiffness`'s estimate), is the
 instantaneous one; the relaxed one follows from it and the hold's fraction
 (:func:`relaxed_modulus`).
-
-Lee, E. H., Radok, J. R. M. (1960). The contact problem for viscoelastic bodies. J. Appl. Mech.
-27(3), 438–444.
 """
 
 from __future__ import annotations
@@ -98,9 +86,9 @@ from deformap.stiffness._phases import (
     zero_force_travel,
 )
 
-__all__ = ["BEHAVIOURS", "DENT_FLOOR_M", "LOSS_FLOOR", "LOSS_PER_CREEP", "MIN_FIT_SAMPLES",
-           "N_SIGMA", "RELAXATION_FLOOR", "Behaviour", "PressBehaviour", "PressRecord",
-           "press_behaviour", "record_dent_floor", "relaxed_modulus", "released_dent"]
+__all__ = ["BEHAVIOURS", "DENT_FLOOR_M", "LOSS_FLOOR", "MIN_FIT_SAMPLES", "N_SIGMA",
+           "RELAXATION_FLOOR", "Behaviour", "PressBehaviour", "PressRecord", "press_behaviour",
+           "record_dent_floor", "relaxed_modulus", "released_dent"]
 
 Behaviour = Literal["elastic", "viscoelastic", "plastic", "unknown"]
 BEHAVIOURS: tuple[str, ...] = ("elastic", "viscoelastic", "plastic", "unknown")
@@ -111,14 +99,6 @@ RELAXATION_FLOOR = 0.02
 #: Smallest loss ratio taken as the material's: tip friction and the sensor's own hysteresis
 #: (a few per cent of the load) close no loop of an ideal elastic press.
 LOSS_FLOOR = 0.05
-#: Largest loss ratio per hold creep fraction of a standard linear solid pressed by a sphere
-#: (Lee & Radok 1960: ``δ^(3/2) ∝ ∫ J(t − s) dF(s)``) under a load-controlled ramp from zero
-#: force, a hold at least as long as the ramp and the unloading, and the unloading: the limit of
-#: a relaxation time far shorter than the ramp, where both are proportional to the lag the ramp
-#: leaves, ``5 / (2/3)``; every other relaxation time and relaxed ratio gives less (4 for a linear
-#: contact law), and a Prony series' arms add to first order in both.
-#: ``tests/stiffness/test_behaviour_loss_bound.py`` integrates it.
-LOSS_PER_CREEP = 7.5
 #: Smallest kept dent [m] taken as the material's: a tenth of a millimetre, about what the tip's
 #: contact settles by as the force reaches zero and below what a depth camera resolves at arm's
 #: length.
@@ -284,25 +264,13 @@ def _press_behaviour(record: PressRecord | None, released: tuple[float, float] |
             dent = res
     return _classify(relax, tau, mode, loss, dent, cam, notes=notes,
                      has_hold=hold is not None, has_unloading=unloading is not None,
-                     dent_floor=record_dent_floor(record), hold_spans_loop=_hold_spans_loop(record))
-
-
-def _hold_spans_loop(record: PressRecord) -> bool:
-    """Whether the record's hold lasts at least as long as its ramp and its unloading together
-    (both stretches and the ramp's times recorded)."""
-    hold, unloading, times = record.hold, record.unloading, record.time_s
-    if hold is None or unloading is None or times is None:
-        return False
-    ramp_end = float(times[-1])
-    hold_s = float(hold.time_s[-1]) - ramp_end
-    loop_s = ramp_end - float(times[0]) + float(unloading.time_s[-1]) - float(hold.time_s[-1])
-    return hold_s >= loop_s
+                     dent_floor=record_dent_floor(record))
 
 
 def _classify(relax: Measure | None, tau: Measure | None, mode: str | None,
               loss: Measure | None, dent: Measure | None, cam: Measure | None, *,
               notes: list[str], has_hold: bool = False, has_unloading: bool = False,
-              dent_floor: float = DENT_FLOOR_M, hold_spans_loop: bool = False) -> PressBehaviour:
+              dent_floor: float = DENT_FLOOR_M) -> PressBehaviour:
     said: list[str] = []
     if relax is not None:
         said.append(relax.text("creep" if mode == "travel" else "relaxation"))
@@ -321,11 +289,6 @@ def _classify(relax: Measure | None, tau: Measure | None, mode: str | None,
     # no dent: none shows one, and one rules it out (a camera too coarse to rule out a tenth of a
     # millimetre does not veto the record's travel at zero force)
     no_dent = not kept and any(m.rules_out(floor) for m, floor in dents)
-    # the loop's relaxation bounded by the hold's creep (module docstring): force held, a hold
-    # as long as the loop, its creep below the floor's share by 2 σ
-    creep_floor = LOSS_FLOOR / LOSS_PER_CREEP
-    no_relaxation = (hold_spans_loop and relax is not None and mode == "travel"
-                     and relax.rules_out(creep_floor))
     behaviour: Behaviour
     why: str
     if relaxes:
@@ -343,11 +306,6 @@ def _classify(relax: Measure | None, tau: Measure | None, mode: str | None,
         behaviour, why = "elastic", (f"relaxation, loss and dent all below their floors "
                                      f"({RELAXATION_FLOOR:g}, {LOSS_FLOOR:g}, "
                                      f"{dent_floor * 1e3:.2g} mm) by 2 σ")
-    elif no_relaxation and no_dent and not lossy:
-        behaviour, why = "elastic", (
-            f"no creep over a hold as long as the loop (below {creep_floor:.2g} by 2 σ) and no "
-            f"dent (below {dent_floor * 1e3:.2g} mm by 2 σ): the loop cannot lose "
-            f"{LOSS_FLOOR:g} by relaxation or yield")
     else:
         behaviour, why = "unknown", "the record neither shows nor rules out each behaviour"
         if not said:
