@@ -1,6 +1,6 @@
 """The bonded layer's surface about a sphere (Lebedev & Ufliand's kernel under Hertz's pressure):
-Hertz's surface on a deep layer, the constrained modulus's local sink on a thin one, the kernel's
-link to the force series' α₀, bad input."""
+Hertz's surface on a deep layer, a narrower dent on a thinner one, the kernel's link to the
+force series' α₀, bad input."""
 
 from __future__ import annotations
 
@@ -30,17 +30,11 @@ def test_a_deep_layer_has_hertz_surface() -> None:
     np.testing.assert_allclose(layer, hertz, rtol=0, atol=1e-4 * depth)
 
 
-def test_a_thin_layer_sinks_where_it_is_pressed() -> None:
-    # a ≫ h: each column is compressed by the pressure above it, w ∝ √(1 − r²/a²), and the surface
-    # outside the contact hardly moves
-    depth, h = 0.004, 0.0005
+def test_the_surface_vanishes_a_few_layers_out_and_far_points_cost_nothing() -> None:
+    depth, h = 0.005, 0.03
     a = np.sqrt(R * depth)
-    r = np.linspace(0.0, 2.0 * a, 41)
-    w = layer_surface_deflection(r, depth, R, h, 0.3)
-    local = depth * np.sqrt(np.clip(1.0 - (r / a) ** 2, 0.0, None))
-    inside = r < 0.8 * a
-    np.testing.assert_allclose(w[inside], local[inside], rtol=0.03)
-    assert np.all(np.abs(w[r > 1.5 * a]) < 0.02 * depth)
+    w = layer_surface_deflection([a + 2 * h, a + 10 * h, 1e9], depth, R, h, 0.3)
+    assert abs(w[0]) < 1e-3 * depth and abs(w[1]) < 1e-4 * depth and w[2] == 0.0
 
 
 def test_a_thinner_layer_has_a_narrower_dent() -> None:
@@ -65,3 +59,7 @@ def test_bad_input_names_the_field() -> None:
         layer_surface_deflection([0.0], 1e-3, R, 0.05, 0.6)
     with pytest.raises(InvalidArgumentError, match="`r`"):
         layer_surface_deflection([np.nan], 1e-3, R, 0.05, 0.3)
+    # a contact hundreds of layers wide is outside the first-order picture: refused, not a
+    # quadrature of millions of points
+    with pytest.raises(InvalidArgumentError, match="thickness_m"):
+        layer_surface_deflection([0.1], 1e-3, R, 1e-5, 0.3)

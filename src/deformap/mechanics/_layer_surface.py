@@ -19,6 +19,13 @@ half-space's deflection the base takes away:
 ``w_H`` Hertz's surface for contact radius ``a`` (Johnson 1985, §3.4). The profile is scaled to
 the depth ``δ`` at its centre: the shape is the layer's, the depth the caller's.
 
+Hertz's pressure under the sphere is the first-order picture: it holds while the contact is small
+against the layer, ``χ = a / h ≲ 1`` (where the bonded layer's force series holds); beyond, the
+shape is approximate, and past :data:`MAX_CHI` (a contact many layers wide, where the sphere would
+pass through the surface drawn) the function refuses. The layer's sink decays within a few ``h``
+outside the contact (the kernel's deficit ``1 − L`` vanishes there), so it is taken as zero beyond
+``a +`` :data:`_FAR_LAYERS` ``h``, which also bounds the quadrature.
+
 References
 ----------
 Lebedev, N. N., Ufliand, Ia. S. (1958). Axisymmetric contact problem for an elastic layer.
@@ -41,7 +48,7 @@ from deformap._validation import check_positive
 from deformap.errors import InvalidArgumentError
 from deformap.mechanics._hertz import hertz_surface_deflection
 
-__all__ = ["layer_surface_deflection"]
+__all__ = ["MAX_CHI", "layer_surface_deflection"]
 
 # ξh up to 30 (1 − L < 1e-22 beyond), in steps of at most 0.05 and at least 16 a period of
 # J₀(ξr) at the farthest point (the trapezoid rule)
@@ -50,6 +57,13 @@ _U_STEP = 0.05
 _STEPS_PER_PERIOD = 16
 # the correction is evaluated on this many radii out to the farthest point and interpolated
 _RADII = 64
+#: Largest contact radius over thickness drawn: ten layers wide is far outside the first-order
+#: picture, and the quadrature grows as ``χ``.
+MAX_CHI = 10.0
+# the sink is taken as zero beyond a + 20 h: a bonded layer's surface load spreads over a few h
+# (1 − L(u) vanishes as e^(−2u) for u ≫ 1), and the quadrature's residual there is far below
+# the camera's resolution
+_FAR_LAYERS = 20.0
 
 
 def _kernel_deficit(u: NDArray[np.float64], nu: float) -> NDArray[np.float64]:
@@ -85,6 +99,13 @@ def layer_surface_deflection(r: Any, depth_m: float, tip_radius_m: float, thickn
     if not np.all(np.isfinite(r)):
         raise InvalidArgumentError("`r` must hold finite distances in metres")
     a = np.sqrt(radius * depth)
+    if a / h > MAX_CHI:
+        raise InvalidArgumentError(
+            f"the contact radius √(R·depth) = {a * 1e3:.3g} mm is {a / h:.3g} times "
+            f"`thickness_m` ({h:g} m); the layer's surface is drawn up to {MAX_CHI:g}")
+    far = a + _FAR_LAYERS * h
+    beyond = r > far
+    r = np.where(beyond, far, r)
     # Hertz's sphere at depth δ: the force that sinks it there at E* = 1 (E = 1, ν = 0)
     hertz = hertz_surface_deflection(r, 4.0 / 3.0 * np.sqrt(radius) * depth**1.5, radius, 1.0,
                                      0.0)
@@ -95,4 +116,4 @@ def layer_surface_deflection(r: Any, depth_m: float, tip_radius_m: float, thickn
     integrand = weight[None, :] * j0(np.outer(radii, u) / h)
     correction = 4.0 * a**3 / (np.pi * radius * h) * np.trapezoid(integrand, u, axis=1)
     w = hertz - np.interp(r, radii, correction)
-    return np.asarray(w * depth / (depth - correction[0]))
+    return np.asarray(np.where(beyond, 0.0, w * depth / (depth - correction[0])))
