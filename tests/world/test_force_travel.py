@@ -6,7 +6,9 @@ import numpy as np
 import pytest
 
 from deformap.environment import ForceTravel
+from deformap.errors import InvalidArgumentError
 from deformap.world import MIN_RECORD_FORCE_N, SimulatedWorld, WorldConfig, load_scenario
+from deformap.world._force_travel import force_levels, press_schedule
 
 SCENARIO = "heterogeneous-60-110-rigid"  # foam 60 N at x < 0.2, 110 N up to 0.4, then rigid
 SOFT, HARD, RIGID = (0.1, 0.2), (0.3, 0.2), (0.55, 0.2)
@@ -164,3 +166,15 @@ def test_a_press_whose_levels_do_not_make_a_record_gives_none_and_says_so(
     c = exact.config
     assert _press(exact, HARD).travel_m.size == round(
         (0.6 - c.contact_threshold_n) / c.ramp_rate_n_per_s * c.sample_rate_hz) + 1
+
+
+def test_a_protocol_whose_record_would_not_fit_is_refused_naming_its_settings() -> None:
+    levels = force_levels(0.02, 250.0, 8)
+    with pytest.raises(InvalidArgumentError, match="sample_rate_hz.*ramp_rate_n_per_s"):
+        press_schedule(levels, rate_n_per_s=1e-4, hold_s=0.0, unload=False,
+                       sample_rate_hz=10_000.0)
+    with pytest.raises(InvalidArgumentError, match="hold"):
+        press_schedule(levels, rate_n_per_s=2.0, hold_s=600.0, unload=False,
+                       sample_rate_hz=10_000.0)
+    ok = press_schedule(levels, rate_n_per_s=2.0, hold_s=3.0, unload=True, sample_rate_hz=100.0)
+    assert ok.hold_times.size == 300

@@ -30,10 +30,11 @@ import numpy as np
 from numpy.typing import NDArray
 
 from deformap.environment import ForceTravel, PressPhase
+from deformap.errors import InvalidArgumentError
 from deformap.world._plastic import PlasticPress
 from deformap.world._viscoelastic import PressHistory
 
-__all__ = ["PressSchedule", "between_levels", "force_levels", "press_schedule", "sensor_depths",
+__all__ = ["MAX_STRETCH_SAMPLES", "PressSchedule", "between_levels", "force_levels", "press_schedule", "sensor_depths",
            "simulated_force_travel", "with_phases"]
 
 
@@ -73,6 +74,23 @@ class PressSchedule:
         return bool(self.hold_times.size or self.unload_times.size)
 
 
+#: Most samples one stretch of a record (ramp, hold or unloading) may hold: 100 s at 10 kHz, a
+#: creep test's length at a fast sensor's rate; more is a protocol mistyped, not a press.
+MAX_STRETCH_SAMPLES = 1_000_000
+
+
+def _stretch(seconds: float, sample_rate_hz: float, n_levels: int, what: str) -> int:
+    """Samples of a stretch ``seconds`` long at ``sample_rate_hz`` (never fewer than the solved
+    levels), or a clear error naming the settings that made it too long."""
+    n = max(n_levels, round(seconds * sample_rate_hz))
+    if n > MAX_STRETCH_SAMPLES:
+        raise InvalidArgumentError(
+            f"the press's {what} would hold {n} samples ({seconds:.3g} s at `sample_rate_hz` "
+            f"{sample_rate_hz:g}); at most {MAX_STRETCH_SAMPLES}: lower `sample_rate_hz`, or "
+            f"raise `ramp_rate_n_per_s` / shorten `hold_s`")
+    return n
+
+
 def _falling(top: float, bottom: float, n: int) -> NDArray[np.float64]:
     """``n`` forces after ``top``, evenly spaced down to ``bottom`` (exactly, the last)."""
     forces = top - (top - bottom) * np.arange(1, n + 1) / n
@@ -91,11 +109,11 @@ def press_schedule(levels: NDArray[np.float64], *, rate_n_per_s: float, hold_s: 
     if sample_rate_hz is None:
         forces = levels
     else:
-        n_ramp = max(n, round(ramp_s * sample_rate_hz))
+        n_ramp = _stretch(ramp_s, sample_rate_hz, n, "loading ramp")
         forces = levels[0] + (levels[-1] - levels[0]) * np.arange(n_ramp + 1) / n_ramp
         forces[-1] = levels[-1]  # the commanded force exactly, as the solved ramp
     times = (forces - levels[0]) / rate_n_per_s
-    n_hold = n if sample_rate_hz is None else max(n, round(hold_s * sample_rate_hz))
+    n_hold = n if sample_rate_hz is None else _stretch(hold_s, sample_rate_hz, n, "hold")
     hold = times[-1] + hold_s * np.arange(1, n_hold + 1) / n_hold if hold_s > 0.0 else np.zeros(0)
     end = hold[-1] if hold.size else times[-1]
     if not unload:
@@ -103,7 +121,7 @@ def press_schedule(levels: NDArray[np.float64], *, rate_n_per_s: float, hold_s: 
     elif sample_rate_hz is None:
         down = levels[-2::-1].copy()
     else:
-        down = _falling(levels[-1], levels[0], max(n, round(ramp_s * sample_rate_hz)))
+        down = _falling(levels[-1], levels[0], _stretch(ramp_s, sample_rate_hz, n, "unloading"))
     unload_times = end + (levels[-1] - down) / rate_n_per_s
     return PressSchedule(levels=forces, times=times, hold_times=hold,
                          unload_times=unload_times, unload_forces=down)
