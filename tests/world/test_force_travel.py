@@ -170,7 +170,7 @@ def test_a_press_whose_levels_do_not_make_a_record_gives_none_and_says_so(
 
 def test_a_protocol_whose_record_would_not_fit_is_refused_naming_its_settings() -> None:
     levels = force_levels(0.02, 250.0, 8)
-    with pytest.raises(InvalidArgumentError, match="sample_rate_hz.*ramp_rate_n_per_s"):
+    with pytest.raises(InvalidArgumentError, match=r"sample_rate_hz.*ramp_rate_n_per_s"):
         press_schedule(levels, rate_n_per_s=1e-4, hold_s=0.0, unload=False,
                        sample_rate_hz=10_000.0)
     with pytest.raises(InvalidArgumentError, match="hold"):

@@ -34,8 +34,8 @@ from deformap.errors import InvalidArgumentError
 from deformap.world._plastic import PlasticPress
 from deformap.world._viscoelastic import PressHistory
 
-__all__ = ["MAX_STRETCH_SAMPLES", "PressSchedule", "between_levels", "force_levels", "press_schedule", "sensor_depths",
-           "simulated_force_travel", "with_phases"]
+__all__ = ["MAX_STRETCH_SAMPLES", "PressSchedule", "between_levels", "force_levels",
+           "press_schedule", "sensor_depths", "simulated_force_travel", "with_phases"]
 
 
 def force_levels(contact_n: float, force_n: float, n_levels: int) -> NDArray[np.float64]:
