@@ -213,6 +213,17 @@ def test_a_setting_of_a_pre_release_file_is_refused_in_one_line() -> None:
         config_from_dict(RunConfig, older)
 
 
+def test_a_retired_world_key_is_refused_saying_why_it_went() -> None:
+    from deformap.run import RunConfig
+
+    with pytest.raises(ConfigError) as caught:
+        config_from_dict(RunConfig, {"world": {"force_travel_spacing": "force"}})
+    message = str(caught.value)
+    assert "\n" not in message
+    assert message.startswith("`config.world.force_travel_spacing` was retired: ")
+    assert "sample_rate_hz" in message and message.endswith("delete it")
+
+
 def test_a_file_that_sets_a_removed_exploration_switch_is_refused_in_one_line() -> None:
     from deformap.run import RunConfig
 

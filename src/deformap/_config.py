@@ -1,9 +1,9 @@
 """Frozen settings dataclasses to and from plain dicts and YAML, strictly.
 
-Reading back refuses unknown keys and leaves every value to the dataclasses' own check
-(:func:`~deformap._validation.check_settings`, one rule set for Python and YAML); either refusal
-is a :class:`~deformap.errors.ConfigError` naming the field's dotted path
-(``exploration.threshold``).
+Reading back refuses unknown keys (a class's ``RETIRED_KEYS`` say why a removed one went) and
+leaves every value to the dataclasses' own check (:func:`~deformap._validation.check_settings`, one
+rule set for Python and YAML); either refusal is a :class:`~deformap.errors.ConfigError` naming the
+field's dotted path (``exploration.threshold``).
 """
 
 from __future__ import annotations
@@ -33,7 +33,6 @@ MAX_YAML_DEPTH = 64
 
 __all__ = ["NoAliasDumper", "config_from_dict", "config_to_dict", "data_file_kind",
            "described_yaml", "dump_yaml", "few", "load_yaml", "parse_yaml", "setting_docs"]
-
 T = TypeVar("T")
 
 
@@ -93,6 +92,8 @@ def config_from_dict(cls: type[T], data: Any, *, where: str = "config") -> T:
         raise ConfigError(f"`{where}` must be a mapping of settings; got {shown}")
     fields = {f.name: f for f in dataclasses.fields(cls) if f.init}  # type: ignore[arg-type]
     unknown = sorted(map(str, set(data) - set(fields)))
+    for key in (k for k in unknown if k in getattr(cls, "RETIRED_KEYS", {})):  # why it went
+        raise ConfigError(f"`{where}.{key}` was retired: {cls.RETIRED_KEYS[key]}; delete it")  # type: ignore[attr-defined]
     if unknown:
         raise ConfigError(
             f"`{where}` has unknown key(s) {few(unknown)}; known keys are {sorted(fields)}")

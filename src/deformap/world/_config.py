@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any, Literal, get_args
+from typing import Any, ClassVar, Literal, get_args
 
 import numpy as np
 
@@ -87,6 +87,11 @@ class WorldConfig:
     table_margin_m : float
         How far the table extends beyond the workspace on every side.
     """
+
+    #: Keys a release removed, and why (a run config or journal written before refuses with it).
+    RETIRED_KEYS: ClassVar[dict[str, str]] = {
+        "force_travel_spacing": "the record's samples are the sensors', evenly in time at "
+                                "`sample_rate_hz` on a load-controlled ramp"}
 
     physics: Physics = "linear-fem"
     densification_strain: float = setting(0.95, gt=0.0, le=1.0)  # a strain: at most full collapse
