@@ -90,9 +90,8 @@ def test_each_models_own_press_gives_it_the_largest_weight_and_e_within_2_sigma(
 
 def test_a_thin_bonded_layers_own_dent_gives_the_layer_its_weight():
     # on a 3 cm layer the base narrows the dent well inside Hertz's half-space surface, to nearly
-    # the foundation's: drawn as Hertz's, the layer's dent lost to the foundation's (weight ≈ 1
-    # on every seed here, σ 4–7× the layer alone's); drawn as the layer's own surface, the
-    # layer's press and dent give the layer the larger weight and E within 2σ
+    # the foundation's; drawn as the layer's own surface, the layer's press and dent give the
+    # layer the larger weight and E within 2σ (docs/results.md, the contact models)
     config = StiffnessConfig(poisson_ratio_std=0.0)
     alone = StiffnessConfig(poisson_ratio_std=0.0, contact_models=("bonded-layer",))
     won = 0

@@ -16,7 +16,7 @@ from deformap.world import CameraConfig, SimulatedWorld, WorldConfig, load_scena
 _OBSERVE = "c2b9e85d51093383"
 _PRESS_CLOUD = "9dd202ee92a403db"
 _CONTACT = "fc4d81500bdcc497"
-_FORCE_TRAVEL = "d5f85eb3b8b213b6"  # the ramp read at 100 Hz (30 samples), branch h-ramp
+_FORCE_TRAVEL = "d5f85eb3b8b213b6"  # the ramp read at the sensors' rate (100 Hz)
 _OBSERVE_PRESSED = "8650a342df53a090"
 _RANDOM_POLYGONS = "51d861bba4a897e1"
 
