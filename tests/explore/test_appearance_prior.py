@@ -231,4 +231,3 @@ def test_on_an_informative_world_the_prior_is_used_and_its_weight_is_learned_bet
     # pokes it does in three and not in the other three
     assert used.used and used.image is not None and used.n_segments > 1
     assert used.weight is not None and 0.0 < used.weight < 0.95
-    assert sum(used.weight_posterior) == pytest.approx(1.0)
