@@ -69,10 +69,12 @@ from dataclasses import asdict, dataclass, replace
 from typing import Any, Literal
 
 import numpy as np
+from numpy.typing import NDArray
 
 from deformap.errors import InvalidArgumentError
 from deformap.stiffness._anisotropy import Anisotropy, Isotropy
 from deformap.stiffness._phases import (
+    MAD_TO_SIGMA,
     MIN_FIT_SAMPLES,
     N_SIGMA,
     Measure,
@@ -82,7 +84,7 @@ from deformap.stiffness._phases import (
     hold_with_start,
     loop_loss,
     noise,
-    released_dent,
+    press_surface,
     zero_force_travel,
 )
 
@@ -165,6 +167,26 @@ class PressBehaviour:
         """Plain data (JSON): every field, ``None`` for what the record could not give."""
         return asdict(self)
 
+
+
+def released_dent(points: Any, tip_center: Any, tip_radius_m: float
+                  ) -> tuple[float, float] | str:
+    """The dent [m] and its σ that the surface seen after release, ``points`` ``(n, 3)`` (world
+    frame, z up), keeps at the press point (module docstring), or why it cannot be had (too few
+    points near the press)."""
+    pts, center = press_surface(points, tip_center, tip_radius_m)
+    r = np.linalg.norm(pts[:, :2] - center[:2], axis=1)
+    inner = pts[r <= tip_radius_m, 2]
+    ring = pts[(r >= 3.0 * tip_radius_m) & (r <= 5.0 * tip_radius_m), 2]
+    if inner.size < 5 or ring.size < 5:
+        return (f"the surface after release has {inner.size} points within one tip radius of "
+                f"the press and {ring.size} 3–5 radii away; needs 5 of each")
+
+    def median_se(z: NDArray[np.float64]) -> float:
+        return float(1.2533 * MAD_TO_SIGMA * np.median(np.abs(z - np.median(z))) / math.sqrt(z.size))
+
+    dent = float(np.median(ring) - np.median(inner))
+    return dent, math.hypot(median_se(inner), median_se(ring))
 
 
 def press_behaviour(record: PressRecord | None, *,

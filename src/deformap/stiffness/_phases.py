@@ -1,7 +1,6 @@
 """The stretches of one press read for :mod:`deformap.stiffness._behaviour`: the record's noise,
-the hold's exponential fit, the loop's loss, the unloading's travel at zero force and the camera's
-dent after release, each a value with its standard error (the algorithms are stated in that
-module's docstring)."""
+the hold's exponential fit, the loop's loss and the unloading's travel at zero force, each a value
+with its standard error (the algorithms are stated in that module's docstring)."""
 
 from __future__ import annotations
 
@@ -29,7 +28,6 @@ __all__ = [
     "loop_loss",
     "noise",
     "press_surface",
-    "released_dent",
     "zero_force_travel",
 ]
 
@@ -304,23 +302,3 @@ def press_surface(points: Any, tip_center: Any, tip_radius_m: float
     if not (math.isfinite(tip_radius_m) and tip_radius_m > 0.0):
         raise InvalidArgumentError(f"`tip_radius_m` must be positive; got {tip_radius_m!r}")
     return check_points("points", points, min_rows=0), center
-
-
-def released_dent(points: Any, tip_center: Any, tip_radius_m: float
-                  ) -> tuple[float, float] | str:
-    """The dent [m] and its σ that the surface seen after release, ``points`` ``(n, 3)`` (world
-    frame, z up), keeps at the press point (module docstring), or why it cannot be had (too few
-    points near the press)."""
-    pts, center = press_surface(points, tip_center, tip_radius_m)
-    r = np.linalg.norm(pts[:, :2] - center[:2], axis=1)
-    inner = pts[r <= tip_radius_m, 2]
-    ring = pts[(r >= 3.0 * tip_radius_m) & (r <= 5.0 * tip_radius_m), 2]
-    if inner.size < 5 or ring.size < 5:
-        return (f"the surface after release has {inner.size} points within one tip radius of "
-                f"the press and {ring.size} 3–5 radii away; needs 5 of each")
-
-    def median_se(z: NDArray[np.float64]) -> float:
-        return float(1.2533 * MAD_TO_SIGMA * np.median(np.abs(z - np.median(z))) / math.sqrt(z.size))
-
-    dent = float(np.median(ring) - np.median(inner))
-    return dent, math.hypot(median_se(inner), median_se(ring))
