@@ -17,6 +17,7 @@ from deformap.mechanics import (
     hertz_contact_radius,
     hertz_indentation,
     hertz_pressure_samples,
+    hertz_surface_at_depth,
     hertz_surface_deflection,
     reduced_modulus,
 )
@@ -102,3 +103,13 @@ def test_the_old_homes_are_the_same_objects() -> None:
     assert deformap.world.hertz_indentation is hertz_indentation
     assert deformap.world.hertz_contact_radius is hertz_contact_radius
     assert deformap.world.hardness_to_youngs_modulus is hardness_to_youngs_modulus
+
+
+def test_the_surface_at_a_depth_is_hertz_surface_of_any_modulus_that_sinks_that_deep() -> None:
+    force, radius, modulus, nu = 0.6, 0.01, 40e3, 0.3
+    r = np.linspace(0.0, 0.04, 41)
+    surface = hertz_surface_deflection(r, force, radius, modulus, nu)
+    depth = hertz_indentation(force, radius, modulus, nu)
+    at_depth = hertz_surface_at_depth(r, depth, radius)
+    assert at_depth[0] == pytest.approx(depth, rel=1e-12)
+    np.testing.assert_allclose(at_depth, surface, rtol=1e-10, atol=0.0)

@@ -21,6 +21,7 @@ from deformap.mechanics._hertz import (
     hertz_contact_radius,
     hertz_indentation,
     hertz_pressure_samples,
+    hertz_surface_at_depth,
     hertz_surface_deflection,
     reduced_modulus,
 )
@@ -37,7 +38,8 @@ __all__ = [
     "INDENTATION_STRAIN", "INDENTER_AREA_M2", "TactileContact", "elastic_dent",
     "foundation_indentation", "foundation_surface_deflection",
     "hardness_to_youngs_modulus", "hertz_contact_radius", "hertz_indentation",
-    "hertz_pressure_samples", "hertz_surface_deflection", "layer_chi_limit", "layer_correction",
+    "hertz_pressure_samples", "hertz_surface_at_depth", "hertz_surface_deflection",
+    "layer_chi_limit", "layer_correction",
     "layer_correction_coefficients", "layer_indentation_force", "layer_indentation_stiffness",
     "layer_surface_deflection", "reduced_modulus", "youngs_modulus_to_hardness",
 ]

@@ -28,7 +28,7 @@ from deformap.errors import InvalidArgumentError
 from deformap.mechanics._contact import TactileContact
 
 __all__ = ["elastic_dent", "hertz_contact_radius", "hertz_indentation", "hertz_pressure_samples",
-           "hertz_surface_deflection", "reduced_modulus"]
+           "hertz_surface_at_depth", "hertz_surface_deflection", "reduced_modulus"]
 
 
 def reduced_modulus(youngs_modulus_pa: float, poisson_ratio: float) -> float:
@@ -73,6 +73,14 @@ def hertz_surface_deflection(r: Any, force_n: float, tip_radius_m: float, modulu
     outside = p0 / (2 * a * e_star) * ((2 * a * a - ro * ro) * np.arcsin(a / ro)
                                        + a * np.sqrt(ro * ro - a * a))
     return np.asarray(np.where(r <= a, inside, outside))
+
+
+def hertz_surface_at_depth(r: Any, depth_m: float, tip_radius_m: float) -> NDArray[np.float64]:
+    """Hertz's surface (:func:`hertz_surface_deflection`) about a sphere sunk ``depth_m``: its
+    shape does not depend on the modulus, so the force that sinks the sphere that deep at
+    ``E* = 1`` (``F = 4/3 √R δ^(3/2)``, ``E = 1``, ``ν = 0``) draws it."""
+    force = 4.0 / 3.0 * np.sqrt(tip_radius_m) * depth_m**1.5
+    return hertz_surface_deflection(r, force, tip_radius_m, 1.0, 0.0)
 
 
 def hertz_pressure_samples(center_xy: NDArray[np.float64], radius_m: float, force_n: float,

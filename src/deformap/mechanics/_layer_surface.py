@@ -46,7 +46,7 @@ from scipy.special import j0
 
 from deformap._validation import check_positive
 from deformap.errors import InvalidArgumentError
-from deformap.mechanics._hertz import hertz_surface_deflection
+from deformap.mechanics._hertz import hertz_surface_at_depth
 
 __all__ = ["MAX_CHI", "layer_surface_deflection"]
 
@@ -106,9 +106,7 @@ def layer_surface_deflection(r: Any, depth_m: float, tip_radius_m: float, thickn
     far = a + _FAR_LAYERS * h
     beyond = r > far
     r = np.where(beyond, far, r)
-    # Hertz's sphere at depth δ: the force that sinks it there at E* = 1 (E = 1, ν = 0)
-    hertz = hertz_surface_deflection(r, 4.0 / 3.0 * np.sqrt(radius) * depth**1.5, radius, 1.0,
-                                     0.0)
+    hertz = hertz_surface_at_depth(r, depth, radius)
     radii = np.linspace(0.0, max(float(r.max(initial=0.0)), a), _RADII)
     step = min(_U_STEP, 2.0 * np.pi * h / (_STEPS_PER_PERIOD * max(float(radii[-1]), h)))
     u = np.linspace(0.0, _U_MAX, int(np.ceil(_U_MAX / step)) + 1)

@@ -13,7 +13,7 @@ from deformap._validation import check_array, check_positive
 from deformap.errors import InvalidArgumentError
 from deformap.mechanics import (
     foundation_surface_deflection,
-    hertz_surface_deflection,
+    hertz_surface_at_depth,
     layer_surface_deflection,
 )
 from deformap.stiffness._tables import BONDED_LAYER, FOUNDATION, ContactTable
@@ -81,8 +81,7 @@ def _predicted(table: ContactTable, model: str, depth: float, radius: float, thi
                                              nu)
     if model == BONDED_LAYER:
         return layer_surface_deflection(r, depth, radius, thickness, nu)
-    # Hertz's sphere at depth δ_c: the force that sinks it there at E* = 1 (E = 1, ν = 0)
-    return hertz_surface_deflection(r, 4.0 / 3.0 * np.sqrt(radius) * depth**1.5, radius, 1.0, 0.0)
+    return hertz_surface_at_depth(r, depth, radius)
 
 
 def dent_chi2(dent: DentSamples, models: list[tuple[str, ContactTable, float]], radius: float,
