@@ -202,7 +202,7 @@ def study_behaviour(
     coarse: CoarseOption = False,
     json_path: JsonOption = None,
 ) -> None:
-    """The behaviour class each press reads (held 3 s, unloaded) against the material's own: a
+    """The behaviour class each press reads (held 12 s, unloaded) against the material's own: a
     confusion matrix."""
     shown = out_console(json_path)
     with progress(shown) as bar:

@@ -269,9 +269,11 @@ def run_cluster_size_study(out: Path | None = None, *, seed: int = 0, coarse: bo
         return StudyOutput(study=study, folder=folder, files=files)
 
 
-BEHAVIOUR_HOLD_S = 3.0
-"""How long each press of the behaviour study holds its force, seconds: a few of the slower
-relaxation times the study's materials have, long enough for their creep to show."""
+BEHAVIOUR_HOLD_S = 12.0
+"""How long each press of the behaviour study holds its force, seconds: three creep times of the
+slowest memory foam of the study (a standard linear solid creeps under a held force with
+``τ / g∞``, 4 s for ``τ`` 2 s and ``g∞`` 0.5), so that its time constant is read, not only its
+creep."""
 
 BEHAVIOUR_THICKNESS_M = 0.03
 """The quick behaviour study's foam thickness, metres (the thinner of
