@@ -135,7 +135,7 @@ def model_weights(readings: list[ModelReading]) -> NDArray[np.float64]:
     (the in-sample quasi-likelihood in place of the leave-one-out density: equal parameters).
 
     Evidence: quasi-likelihood AIC (Burnham & Anderson 2002, §2.5; every model has the
-    parameters ``E`` and ``δ₀``, so ``ΔQAIC = Δχ²``), the record's χ² over ``ĉ`` (the best
+    parameters ``E`` and ``δ₀``, so the penalties cancel), the record's χ² over ``ĉ`` (the best
     record fit's reduced χ², at least 1) and counted at ``n (1 − ρ) / (1 + ρ)`` samples, ``ρ``
     the lag-1 correlation of the best fit's residuals (an AR(1) sequence's effective size;
     Bayley & Hammersley 1946), plus the dent's χ² over its correlation factor ``τ``. Weights
