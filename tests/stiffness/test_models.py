@@ -157,6 +157,34 @@ def test_the_weights_move_smoothly_with_the_dent():
     assert moduli[-1] - 2.0 * stds[-1] <= foundation_e
 
 
+def test_a_dent_between_two_models_leaves_both_their_weight():
+    # the dent halfway between the layer's surface and the foundation's: each point's evidence
+    # favours one model or the other by the camera's noise alone, so the sum's difference is a
+    # draw of mean zero whose scatter the points themselves show; a weight near 1 for either
+    # model would claim a difference the press does not hold (pseudo-BMA+, module docstring)
+    config = StiffnessConfig(poisson_ratio_std=0.0)
+    layer, found = (contact_table(m, R, H, 0.33) for m in ("bonded-layer", "foundation"))
+    depth = float(layer.depth_at(np.array([F_C / E]))[0])
+    g = np.arange(-0.05, 0.0501, 0.002)
+    xy = np.stack(np.meshgrid(g, g), axis=-1).reshape(-1, 2)
+    r = np.hypot(xy[:, 0], xy[:, 1])
+    keep = r > 1.5 * np.sqrt(R * depth)
+    a = float(np.interp(depth, found.depth, found.contact_radius))
+    sink = 0.5 * (layer_surface_deflection(r[keep], depth, R, H, 0.33)
+                  + foundation_surface_deflection(r[keep], a, R, H, 0.33))
+    shared = 0
+    for seed in range(12):
+        rng = np.random.default_rng(seed)
+        travel, force = _record("bonded-layer", rng)
+        noisy = sink + rng.normal(0.0, CAMERA_NOISE, sink.size)
+        est = estimate_stiffness(travel, force, tip_radius_m=R, thickness_m=H,
+                                 commanded_force_n=F_C, config=config,
+                                 dent=DentSamples.of(xy[keep], noisy, 0.01))
+        weight = next(f.weight for f in est.model_fits if f.name == "foundation")
+        shared += 0.1 < weight < 0.9
+    assert shared >= 9  # the Akaike weights alone: 5 of 12
+
+
 def test_the_foundation_model_is_winkler_without_shear_and_rises_with_contact():
     a = np.geomspace(1e-4, R, 50)
     depth, force = foundation_indentation(a, R, H, E, 0.33)

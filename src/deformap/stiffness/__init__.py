@@ -29,11 +29,16 @@ is its χ² under the effective variance plus, when the camera's points about th
 the bonded layer's of thickness ``h``, :func:`deformap.mechanics.layer_surface_deflection`, or
 Hertz's half-space) at its depth at ``F_c``, with a free offset, σ from the best
 model's MAD, and divided by the points' correlation factor ``τ`` (batch means over cells of the
-touch model's length scale; Thiébaux & Zwiers 1984), so that ``m / τ`` points count. Weights
-``wᵢ ∝ exp(−½ Δevidenceᵢ)``, the record's χ² over ``ĉ`` (quasi-likelihood AIC with equal
-parameter counts, ``ĉ`` the best record fit's reduced χ², at least 1; Burnham & Anderson 2002)
-and counted at ``n (1 − ρ) / (1 + ρ)`` samples (``ρ`` the best fit's lag-1 residual
-correlation: a record sampled faster than it varies gains nothing by it). ``E`` stays the bonded
+touch model's length scale; Thiébaux & Zwiers 1984), so that ``m / τ`` points count. The
+evidence is quasi-likelihood AIC with equal parameter counts, the record's χ² over ``ĉ`` (the
+best record fit's reduced χ², at least 1; Burnham & Anderson 2002) and counted at
+``n (1 − ρ) / (1 + ρ)`` samples (``ρ`` the best fit's lag-1 residual correlation: a record
+sampled faster than it varies gains nothing by it). Weights are pseudo-BMA+ (Yao et al. 2018):
+``wᵢ = E[softmax(−½ (evidence + u))ᵢ]``, ``u`` the evidence's sampling error, normal with the
+covariance the Bayesian bootstrap gives over the record's samples and the dent's points (each
+one's χ² term under every model, counted at the part's effective size): a difference in
+evidence within the scatter its own terms show leaves both models weight, one far beyond it
+gives the Akaike weight ``∝ exp(−½ Δevidence)``. ``E`` stays the bonded
 layer's and ``σ² = Σ wᵢ σᵢ² + Σ wᵢ (Eᵢ − E)²``, the second moment about it of the models'
 mixture (``k`` likewise): a model that fits better widens σ toward its own ``E`` and never moves
 ``E``, so two samplings of one press, or two presses of one material, that weigh the models
@@ -58,6 +63,8 @@ Burnham, K. P., Anderson, D. R. (2002). Model Selection and Multimodel Inference
 reference model's E rather than about the average). Springer.
 Thiébaux, H. J., Zwiers, F. W. (1984). The interpretation and estimation of effective sample
 size. J. Climate Appl. Meteor. 23(5), 800–811.
+Yao, Y., Vehtari, A., Simpson, D., Gelman, A. (2018). Using stacking to average Bayesian
+predictive distributions. Bayesian Analysis 13(3), 917–1007 (pseudo-BMA+).
 Vlasov, V. Z., Leontiev, N. N. (1966). Beams, Plates and Shells on Elastic Foundations.
 Bayley, G. V., Hammersley, J. M. (1946). The "effective" number of independent observations in
 an autocorrelated time series. Suppl. J. R. Stat. Soc. 8(2), 184–197.

@@ -20,14 +20,22 @@ from deformap.stiffness._tables import (
     ContactTable,
 )
 
-__all__ = ["ModelReading", "average_models", "read_model"]
+__all__ = ["ModelReading", "average_models", "model_weights", "read_model"]
+
+# the grid along each principal axis of the evidence's covariance (two axes at most with three
+# models): ±6 σ in steps of σ / 20, the expected weights to about 1e-3 whatever the σ
+_NORMAL_REACH = 6.0
+_NORMAL_NODES = 241
 
 
 @dataclass(frozen=True)
 class ModelReading:
     """One model's ``E``, its σ² (fit, model error, thickness, ν), the model-error part, the
     record's χ² and its degrees of freedom, ``k`` with ``dk/dE`` and the depth ``δ_c`` at the
-    commanded force, its table, and the evidence (χ²) that counts in its weight."""
+    commanded force, its table, the record's χ² terms (each sample's squared residual over its
+    variance, in order of travel, their lag-1 correlation) and the dent's χ² terms with the
+    dent's correlation factor ``τ`` (none without a dent): the evidence that counts in its
+    weight."""
 
     name: str
     modulus: float
@@ -39,8 +47,10 @@ class ModelReading:
     dk_de: float
     depth: float
     table: ContactTable
-    evidence: float
+    record_terms: NDArray[np.float64]
     lag_correlation: float
+    dent_terms: NDArray[np.float64] = dataclasses.field(default_factory=lambda: np.zeros(0))
+    dent_tau: float = 1.0
 
 
 def _stiffness_at(fit: RecordFit, modulus: float, force_c: float) -> float:
@@ -91,31 +101,78 @@ def read_model(name: str, travel: NDArray[np.float64], force: NDArray[np.float64
     return ModelReading(name=name, modulus=modulus, variance=variance, error=error, chi2=chi2,
                         dof=dof, stiffness=_stiffness_at(fit, modulus, force_c), dk_de=dk_de,
                         depth=float(fit.table.depth_at(np.array([force_c / modulus]))[0]),
-                        table=fit.table, evidence=chi2, lag_correlation=lag)
+                        table=fit.table, record_terms=np.asarray(z * z), lag_correlation=lag)
+
+
+def _expected_softmax(log_weights: NDArray[np.float64], cov: NDArray[np.float64]
+                      ) -> NDArray[np.float64]:
+    """``E[softmax(l + u)]`` for ``u ~ N(0, cov)``: the normal's density on an even grid (to
+    ±6 σ) along each principal axis of the contrasts ``uₖ − u₀`` (a shift common to all models
+    moves no weight); ``cov = 0`` gives the softmax itself."""
+    k = log_weights.size
+    contrast = np.hstack([-np.ones((k - 1, 1)), np.eye(k - 1)])
+    values, vectors = np.linalg.eigh(contrast @ cov @ contrast.T)
+    keep = values > 1e-12
+    if not np.any(keep):
+        e = np.exp(log_weights - log_weights.max())
+        return np.asarray(e / e.sum())
+    # (models, axes): model 0 is the contrasts' origin
+    axes = np.vstack([np.zeros((1, int(keep.sum()))), vectors[:, keep] * np.sqrt(values[keep])])
+    nodes = np.linspace(-_NORMAL_REACH, _NORMAL_REACH, _NORMAL_NODES)
+    node_weights = np.exp(-0.5 * nodes**2)
+    node_weights /= node_weights.sum()
+    dims = axes.shape[1]
+    grid = np.stack(np.meshgrid(*([nodes] * dims), indexing="ij"), -1).reshape(-1, dims)
+    mass = np.prod(np.stack(np.meshgrid(*([node_weights] * dims), indexing="ij"), -1
+                            ).reshape(-1, dims), axis=1)
+    shifted = log_weights[None, :] + grid @ axes.T
+    e = np.exp(shifted - shifted.max(axis=1, keepdims=True))
+    return np.asarray(mass @ (e / e.sum(axis=1, keepdims=True)))
+
+
+def model_weights(readings: list[ModelReading]) -> NDArray[np.float64]:
+    """Each model's weight: pseudo-BMA+ (Yao et al. 2018) over the record's and the dent's χ²
+    (the in-sample quasi-likelihood in place of the leave-one-out density: equal parameters).
+
+    Evidence: quasi-likelihood AIC (Burnham & Anderson 2002, §2.5; every model has the
+    parameters ``E`` and ``δ₀``, so the penalties cancel), the record's χ² over ``ĉ`` (the best
+    record fit's reduced χ², at least 1) and counted at ``n (1 − ρ) / (1 + ρ)`` samples, ``ρ``
+    the lag-1 correlation of the best fit's residuals (an AR(1) sequence's effective size;
+    Bayley & Hammersley 1946), plus the dent's χ² over its correlation factor ``τ``. Weights
+    ``E[softmax(−½ (evidence + u))]`` with ``u`` the evidence's sampling error: normal with the
+    covariance the Bayesian bootstrap over the samples gives (each part's per-sample χ² terms,
+    their sample covariance between models, scaled as the part is and over its effective
+    samples). Two models whose evidence differs by less than the points' own scatter of that
+    difference keep both their weight; a difference many times that scatter gives the Akaike
+    weight ``∝ exp(−½ ΔQAIC)``."""
+    dofs = np.array([max(r.dof, 1) for r in readings])
+    chi2 = np.array([r.chi2 for r in readings])
+    best = int(np.argmin(chi2))
+    rho = min(max(readings[best].lag_correlation, 0.0), 0.99)
+    c_hat = max(1.0, float(chi2[best] / dofs[best]))
+    count = (1.0 - rho) / (1.0 + rho)  # the record's effective samples per sample
+    # (terms (models, n), scale on the evidence, effective samples per sample) per part
+    parts = [(np.array([r.record_terms for r in readings]), count / c_hat, count)]
+    if readings[0].dent_terms.size:
+        tau = readings[0].dent_tau
+        parts.append((np.array([r.dent_terms for r in readings]), 1.0 / tau, 1.0 / tau))
+    evidence = sum(scale * terms.sum(axis=1) for terms, scale, _ in parts)
+    cov = np.zeros((len(readings), len(readings)))
+    for terms, scale, per_sample in parts:
+        centred = terms - terms.mean(axis=1, keepdims=True)
+        cov += scale**2 / per_sample * (centred @ centred.T)
+    # the log-likelihood is −½ χ²: its covariance a quarter of the evidence's
+    return _expected_softmax(-0.5 * np.asarray(evidence), 0.25 * cov)
 
 
 def average_models(readings: list[ModelReading]
                    ) -> tuple[float, float, float, float, float | None, tuple[ContactModelFit, ...]]:
     """``(E, σ_E, k, σ_k, model error, fits)``: ``E`` and ``k`` the reference model's (the bonded
-    layer's), their variance the second moment about it of the models' mixture under
-    quasi-likelihood Akaike weights (Burnham & Anderson 2002, §2.5 and §4.3; every model has the
-    parameters ``E`` and ``δ₀``, so ``ΔQAIC = Δχ² / ĉ`` with ``ĉ`` the best record fit's reduced
-    χ², at least 1): ``Σ wᵢ σᵢ² + Σ wᵢ (Eᵢ − E)²``. A model's weight moves σ, never ``E``, so
-    two samplings of one press that weigh the models differently read the same ``E``.
-
-    The record's χ² counts its samples as ``n (1 − ρ) / (1 + ρ)`` independent ones, ``ρ`` the
-    lag-1 correlation of the best fit's residuals (an AR(1) sequence's effective size; Bayley &
-    Hammersley 1946): a record sampled faster than it varies gains no evidence by it. Each
-    model's ``evidence`` beyond its record (the dent's χ²) adds to it."""
-    chi2 = np.array([r.chi2 for r in readings])
-    dent = np.array([r.evidence - r.chi2 for r in readings])
-    dofs = np.array([max(r.dof, 1) for r in readings])
-    best = int(np.argmin(chi2))
-    rho = min(max(readings[best].lag_correlation, 0.0), 0.99)
-    c_hat = max(1.0, float(chi2[best] / dofs[best]))
-    evidence = chi2 * (1.0 - rho) / (1.0 + rho) / c_hat + dent
-    w = np.exp(-0.5 * (evidence - evidence.min()))
-    w = w / w.sum()
+    layer's), their variance the second moment about it of the models' mixture under the
+    weights of :func:`model_weights`: ``Σ wᵢ σᵢ² + Σ wᵢ (Eᵢ − E)²`` (Burnham & Anderson 2002,
+    §4.3, the moment taken about the reference model's ``E``). A model's weight moves σ, never
+    ``E``, so two samplings of one press that weigh the models differently read the same ``E``."""
+    w = model_weights(readings)
     moduli = np.array([r.modulus for r in readings])
     variances = np.array([r.variance for r in readings])
     stiff = np.array([r.stiffness for r in readings])

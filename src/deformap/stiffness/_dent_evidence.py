@@ -18,7 +18,7 @@ from deformap.mechanics import (
 )
 from deformap.stiffness._tables import BONDED_LAYER, FOUNDATION, ContactTable
 
-__all__ = ["DentSamples", "dent_chi2"]
+__all__ = ["DentSamples", "dent_terms"]
 
 _MAD_TO_STD = 1.4826
 
@@ -30,7 +30,7 @@ class DentSamples:
     ``offset_m (m, 2)`` each point's horizontal offset [m] from the contact's centre;
     ``sink_m (m,)`` how far below the surface at rest it lies [m]; ``correlation_length_m`` the
     size of the cells over which the points' errors are tested for correlation (class
-    docstring of :func:`dent_chi2`).
+    docstring of :func:`dent_terms`).
     """
 
     offset_m: NDArray[np.float64]
@@ -84,19 +84,21 @@ def _predicted(table: ContactTable, model: str, depth: float, radius: float, thi
     return hertz_surface_at_depth(r, depth, radius)
 
 
-def dent_chi2(dent: DentSamples, models: list[tuple[str, ContactTable, float]], radius: float,
-              thickness: float, nu: float) -> NDArray[np.float64]:
-    """Each model's χ² of the sink, ``(models,)``, counted at the effective sample size.
+def dent_terms(dent: DentSamples, models: list[tuple[str, ContactTable, float]], radius: float,
+               thickness: float, nu: float) -> tuple[NDArray[np.float64], float]:
+    """Each model's χ² terms of the sink, ``(models, m)``, and the points' correlation factor ``τ``.
 
     ``models`` holds ``(name, table, δ_c)``. Each model's sink is compared with a free offset
     (the surface at rest is itself an estimate); the points' scatter ``σ`` is the MAD of the best
-    model's residuals, common to all; χ² is divided by the correlation factor ``τ`` of those
-    residuals over cells of ``correlation_length_m`` (:func:`_correlation_factor`), so that
-    ``m / τ`` points count, and what the best model misses counts as correlated error too.
+    model's residuals, common to all; a term is a point's squared residual over ``σ²``, clipped
+    at 5 σ (flying pixels). ``τ`` is the correlation factor of the best model's residuals over
+    cells of ``correlation_length_m`` (:func:`_correlation_factor`): ``m / τ`` points count, so
+    the dent's χ² is the terms' sum over ``τ``, and what the best model misses counts as
+    correlated error too. Fewer than 3 points, or one model, give no terms (``(models, 0)``).
     """
     m = dent.radius_m.size
     if m < 3 or len(models) < 2:
-        return np.zeros(len(models))
+        return np.zeros((len(models), 0)), 1.0
     residuals = []
     for name, table, depth in models:
         res = dent.sink_m - _predicted(table, name, depth, radius, thickness, nu, dent.radius_m)
@@ -104,8 +106,7 @@ def dent_chi2(dent: DentSamples, models: list[tuple[str, ContactTable, float]], 
     spread = np.array([float(np.median(np.abs(r))) for r in residuals])
     scatter = max(_MAD_TO_STD * float(spread.min()), 1e-6)
     # flying pixels: beyond 5 σ a point is no sample of the sink (its residual is clipped)
-    clipped = [np.clip(r, -5.0 * scatter, 5.0 * scatter) for r in residuals]
-    sq = np.array([float(r @ r) for r in clipped])
+    clipped = np.array([np.clip(r, -5.0 * scatter, 5.0 * scatter) for r in residuals])
     tau = _correlation_factor(clipped[int(np.argmin(spread))], dent.offset_m,
                               dent.correlation_length_m, scatter)
-    return np.asarray(sq / scatter**2 / tau)
+    return np.asarray(clipped**2 / scatter**2), tau

@@ -12,7 +12,7 @@ from deformap._validation import check_array, check_positive
 from deformap.errors import InvalidArgumentError
 from deformap.stiffness._compare import average_models, read_model
 from deformap.stiffness._config import MIN_SAMPLES, StiffnessConfig, StiffnessEstimate, force_std
-from deformap.stiffness._dent_evidence import DentSamples, dent_chi2
+from deformap.stiffness._dent_evidence import DentSamples, dent_terms
 from deformap.stiffness._fit import fit_record
 from deformap.stiffness._tables import BONDED_LAYER, FOUNDATION, MAX_FOUNDATION_NU
 
@@ -166,10 +166,10 @@ def estimate_stiffness(travel_m: Any, force_n: Any, *, tip_radius_m: float, thic
             "beyond the bonded layer's table at the modulus the record reads")
     in_range = [r for r in readings if r is not None]
     if dent is not None:  # the dent's shape: evidence beside the record's own fit
-        extra = dent_chi2(dent, [(r.name, r.table, r.depth) for r in in_range], radius,
-                          thickness, config.poisson_ratio)
-        in_range = [dataclasses.replace(r, evidence=r.chi2 + float(x))
-                    for r, x in zip(in_range, extra, strict=True)]
+        terms, tau = dent_terms(dent, [(r.name, r.table, r.depth) for r in in_range], radius,
+                                thickness, config.poisson_ratio)
+        in_range = [dataclasses.replace(r, dent_terms=t, dent_tau=tau)
+                    for r, t in zip(in_range, terms, strict=True)]
     modulus, modulus_std, stiffness, stiffness_std, error_pa, fits = average_models(in_range)
     return StiffnessEstimate(
         stiffness_n_per_m=stiffness, stiffness_std_n_per_m=stiffness_std,
