@@ -36,7 +36,11 @@ line and no ``τ``.
 Loss ratio: the path ramp → hold → unloading, ``L = ∮ F dδ`` (trapezoids; the return from the
 unloading's last travel to zero at zero force adds nothing) over the work put in before
 unloading, ``W = ∫ F dδ`` along ramp and hold. Its σ by linear propagation of each sample's
-``σ_F(F)`` at its force and of ``σ_t`` through both trapezoid sums.
+``σ_F(F)`` at its force and of ``σ_t`` through both trapezoid sums, the gradients taken at the
+noisy samples; ``L − R W`` is bilinear in travel and force, and those gradients each carry the
+product of the two noises (the travel's steps under the force's noise, the force's steps under
+the travel's), which the ratio carries once: one copy, ``σ_t² Σ_ij (∂²/∂δ_i ∂F_j)² σ_F,j²``, is
+taken back.
 
 Residual dent: the unloading's travel at zero force less the loading's, from the gap between the
 two branches at the same force. Each unloading sample within the ramp's range of force (and above

@@ -308,8 +308,18 @@ def loop_loss(record: PressRecord, sigma_f: ForceNoise, sigma_t: float) -> Measu
     gy = gy_l.copy()
     gx[:n_in] -= ratio * gx_w
     gy[:n_in] -= ratio * gy_w
-    var = (sigma_t**2 * float(gx @ gx) + float(np.sum((sigma_f.at(y) * gy) ** 2))) / work**2
-    return Measure(ratio, math.sqrt(var))
+    s2 = sigma_f.at(y) ** 2
+    # L − R W is bilinear in the travels and the forces, ``Σ_s w_s (y_s + y_{s+1})(x_{s+1} − x_s)/2``
+    # (w_s = 1 − R on the loading's segments, 1 after): the gradients at the noisy samples each
+    # carry the product of the two noises once, which the loss carries once in all; one is taken
+    # back, ``σ_t² Σ_ij A_ij² σ_F,j²`` with ``A = ∂²/∂x ∂y``
+    w = np.ones(x.size - 1)
+    w[:n_in - 1] = 1.0 - ratio
+    steps = np.diff(np.concatenate([[0.0], w, [0.0]]))
+    product = 0.25 * sigma_t**2 * (float(np.sum(w**2 * (s2[:-1] + s2[1:])))
+                                   + float(np.sum(steps**2 * s2)))
+    var = sigma_t**2 * float(gx @ gx) + float(np.sum(s2 * gy**2)) - product
+    return Measure(ratio, math.sqrt(max(var, 0.0)) / work)
 
 
 def zero_force_travel(record: PressRecord, sigma_f: ForceNoise, sigma_t: float,
