@@ -1,12 +1,12 @@
 """Whether the standard errors a press's behaviour claims match the spread of its values: over
 ``--seeds`` worlds per material and thickness (seeds 100, 101, …; one press each at the behaviour
-study's first place, 0.6 N, held 3 s and unloaded, the PrimeSense preset), the loss ratio, the
-travel at zero force (the dent) and the hold's creep fraction are read from each noisy record,
-and the spread of the values (their standard deviation over the worlds) is set against the median
-σ they claim. Three readings of the same records in the same run: "main", the baseline, as main
-(d4f59f9) reads them (one pooled force noise ``σ_F`` of every stretch's second differences; the
-loss's σ propagated at the noisy samples); "pooled + product", the pooled ``σ_F`` with the
-product of the two noises counted once in the loss's σ (the loss only); "load", as
+study's first place, 0.6 N, held 3 s (the study's hold at d4f59f9) and unloaded, the PrimeSense
+preset), the loss ratio, the travel at zero force (the dent) and the hold's creep fraction are read
+from each noisy record, and the spread of the values (their standard deviation over the worlds) is
+set against the median σ they claim. Three readings of the same records in the same run: "main",
+the baseline, as main (d4f59f9) reads them (one pooled force noise ``σ_F`` of every stretch's
+second differences; the loss's σ propagated at the noisy samples); "pooled + product", the pooled
+``σ_F`` with the product of the two noises counted once in the loss's σ (the loss only); "load", as
 :func:`deformap.stiffness.press_behaviour` now reads them, the force noise a function of the load
 (``σ_F(F)² = a² + (b F)²``, :func:`deformap.stiffness._phases.force_noise`) and the product term
 counted once. The creep's σ is the hold's exponential fit's, which none changes. ``exact`` is the
@@ -42,7 +42,7 @@ from deformap.stiffness._phases import (
 from deformap.world import SimulatedWorld, WorldConfig, camera_preset
 
 MATERIALS = ["elastic 30 N", "elastic 250 N", "viscoelastic g∞ 0.8 τ 2 s", "plastic yield 3000 Pa"]
-HOLD_S = 3.0  # the behaviour study's hold (deformap.run's BEHAVIOUR_HOLD_S)
+HOLD_S = 3.0  # held 3 s: the behaviour study's hold (BEHAVIOUR_HOLD_S) at d4f59f9, where it was measured
 FORCE_N = 0.6
 
 
