@@ -8,7 +8,16 @@ reason, never ``"elastic"`` by default.
 
 Noise: the force's and the travel's sample noise ``σ_F``, ``σ_t`` are estimated from the record
 itself, ``1.4826 · MAD(Δ²x) / √6`` of the second differences within each stretch (ramp, hold,
-unloading) pooled, which a smooth trend barely touches.
+unloading) pooled, which a smooth trend barely touches. A force sensor's noise grows with the
+load, so the loss and the dent take it as a function of the force, ``σ_F(F)² = a² + (b F)²``,
+fitted to the same second differences: on a load-controlled press the ramp and the unloading are
+linear in time and the hold constant, so ``E[(Δ²F)²] = 6 σ_F(F)²`` at each interior sample's force
+``F``; ``a²``, ``b²`` are the normal likelihood's weighted least squares of ``(Δ²F)²/6`` on
+``[1, F²]`` (weights ``1/σ_F(F)⁴``, iterated from the pooled constant), each pass leaving out the
+differences beyond 4 of their model σ. A record that cannot fit it (fewer than
+:data:`MIN_NOISE_DIFFERENCES` differences, one force only, or ``b² < 0``) keeps the pooled
+constant; ``a² < 0`` gives ``a = 0``. The travel's noise (the encoders') does not grow with the
+load and stays pooled; the hold takes its own stretch's force noise (below).
 
 Hold: the ramp's last sample (where the commanded force is reached) starts it. Straight lines
 through the force and the travel of the whole stretch (least squares; for the force the larger of
@@ -26,17 +35,21 @@ line and no ``τ``.
 
 Loss ratio: the path ramp → hold → unloading, ``L = ∮ F dδ`` (trapezoids; the return from the
 unloading's last travel to zero at zero force adds nothing) over the work put in before
-unloading, ``W = ∫ F dδ`` along ramp and hold. Its σ by linear propagation of ``σ_F``, ``σ_t``
-through both trapezoid sums.
+unloading, ``W = ∫ F dδ`` along ramp and hold. Its σ by linear propagation of each sample's
+``σ_F(F)`` at its force and of ``σ_t`` through both trapezoid sums, the gradients taken at the
+noisy samples; ``L − R W`` is bilinear in travel and force, and those gradients each carry the
+product of the two noises (the travel's steps under the force's noise, the force's steps under
+the travel's), which the ratio carries once: one copy, ``σ_t² Σ_ij (∂²/∂δ_i ∂F_j)² σ_F,j²``, is
+taken back.
 
 Residual dent: the unloading's travel at zero force less the loading's, from the gap between the
 two branches at the same force. Each unloading sample within the ramp's range of force (and above
-``N_SIGMA σ_F``) is set against the ramp's travel at its force (interpolated linearly in
+``N_SIGMA σ_F(F)``) is set against the ramp's travel at its force (interpolated linearly in
 ``x = F^{2/3}``). In the contact law's linearised form, ``δ = a + c x`` near zero force (Hertz),
 the loading and the unloading are lines that meet at the top but for the hold's creep ``C``, so
 the gap is ``r (1 − x/x_top) + C x/x_top``, ``x_top`` the unloading's first sample; ``r``, the dent,
 is its weighted least-squares coefficient, ``C`` the travel the hold's straight line adds. A sample's
-variance is ``2 σ_t² + 2 (σ_F dt/dF)²`` (both readings' travel and force noise, the force's through
+variance is ``2 σ_t² + 2 (σ_F(F) dt/dF)²`` (both readings' travel and force noise, the force's through
 the ramp's local slope); ``r``'s σ is the fit's, widened by ``√(χ²/dof)`` when the samples scatter
 more than that (a branch that does not follow the linearised law), plus ``C``'s carried through.
 Every sample of the branch enters, not one near zero force, where the contact law's steepness
@@ -76,9 +89,11 @@ from deformap.stiffness._anisotropy import Anisotropy, Isotropy
 from deformap.stiffness._phases import (
     MAD_TO_SIGMA,
     MIN_FIT_SAMPLES,
+    MIN_NOISE_DIFFERENCES,
     N_SIGMA,
     Measure,
     PressRecord,
+    force_noise,
     hold_fraction,
     hold_travel,
     hold_with_start,
@@ -88,7 +103,8 @@ from deformap.stiffness._phases import (
     zero_force_travel,
 )
 
-__all__ = ["BEHAVIOURS", "DENT_FLOOR_M", "LOSS_FLOOR", "MIN_FIT_SAMPLES", "N_SIGMA",
+__all__ = ["BEHAVIOURS", "DENT_FLOOR_M", "LOSS_FLOOR", "MIN_FIT_SAMPLES",
+           "MIN_NOISE_DIFFERENCES", "N_SIGMA",
            "RELAXATION_FLOOR", "Behaviour", "PressBehaviour", "PressRecord", "press_behaviour",
            "record_dent_floor", "relaxed_modulus", "released_dent"]
 
@@ -264,6 +280,7 @@ def _press_behaviour(record: PressRecord | None, released: tuple[float, float] |
             force_parts.append(np.asarray(phase.force_n))
             travel_parts.append(np.asarray(phase.travel_m))
     sigma_f, sigma_t = noise(force_parts), noise(travel_parts)
+    load_noise = force_noise(force_parts)
     notes: list[str] = []
     relax = tau = None
     mode: str | None = None
@@ -273,13 +290,13 @@ def _press_behaviour(record: PressRecord | None, released: tuple[float, float] |
             notes.append(note)
     loss = dent = None
     if unloading is not None:
-        got = loop_loss(record, sigma_f, sigma_t)
+        got = loop_loss(record, load_noise, sigma_t)
         if isinstance(got, str):
             notes.append(got)
         else:
             loss = got
         creep = None if hold is None else hold_travel(hold_with_start(record), sigma_t)
-        res = zero_force_travel(record, sigma_f, sigma_t, creep)
+        res = zero_force_travel(record, load_noise, sigma_t, creep)
         if isinstance(res, str):
             notes.append(res)
         else:

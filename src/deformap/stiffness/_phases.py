@@ -18,10 +18,13 @@ from deformap.errors import InvalidArgumentError
 __all__ = [
     "MAD_TO_SIGMA",
     "MIN_FIT_SAMPLES",
+    "MIN_NOISE_DIFFERENCES",
     "N_SIGMA",
+    "ForceNoise",
     "Measure",
     "PressRecord",
     "Stretch",
+    "force_noise",
     "hold_fraction",
     "hold_travel",
     "hold_with_start",
@@ -38,6 +41,12 @@ MIN_FIT_SAMPLES = 4
 
 #: A normal sample's standard deviation over its median absolute deviation.
 MAD_TO_SIGMA = 1.4826
+#: Fewest second differences for the load-dependent force noise (two parameters, five per
+#: parameter); fewer keep the pooled constant.
+MIN_NOISE_DIFFERENCES = 10
+#: A second difference beyond this many of its model σ is left out of the force noise fit: a
+#: normal draw lies there once in about 16 000.
+_NOISE_TRIM_SIGMA = 4.0
 
 
 class _Phase(Protocol):
@@ -88,6 +97,60 @@ def noise(parts: list[NDArray[np.float64]]) -> float:
     if not diffs:
         return 0.0
     return float(MAD_TO_SIGMA * np.median(np.abs(np.concatenate(diffs))) / math.sqrt(6.0))
+
+
+@dataclass(frozen=True)
+class ForceNoise:
+    """A force sensor's sample noise at force ``F``: ``σ_F(F) = √(a² + (b F)²)`` [N]."""
+
+    a: float
+    b: float = 0.0
+
+    def at(self, force: Any) -> NDArray[np.float64]:
+        f = np.maximum(np.asarray(force, dtype=np.float64), 0.0)
+        return np.asarray(np.sqrt(self.a**2 + (self.b * f) ** 2))
+
+
+def force_noise(parts: list[NDArray[np.float64]]) -> ForceNoise:
+    """The force's sample noise as a function of the load, ``σ_F(F)² = a² + (b F)²``, fitted to the
+    squared second differences of each stretch (module docstring of
+    :mod:`deformap.stiffness._behaviour`); the pooled constant (:func:`noise`) when the record
+    cannot fit it."""
+    pooled = ForceNoise(noise(parts))
+    usable = [p for p in parts if p.size >= 3]
+    if not usable or pooled.a <= 0.0:
+        return pooled
+    # E[(F₋ − 2F + F₊)²] = σ₋² + 4σ² + σ₊² ≈ 6 σ²(F) where the trend is linear in time
+    y = np.concatenate([np.diff(p, n=2) ** 2 / 6.0 for p in usable])
+    f2 = np.concatenate([np.maximum(p[1:-1], 0.0) ** 2 for p in usable])
+    model = pooled
+    keep = np.ones(y.size, dtype=bool)
+    for _ in range(50):
+        var = model.at(np.sqrt(f2)) ** 2
+        keep = y <= _NOISE_TRIM_SIGMA**2 * var
+        if int(keep.sum()) < MIN_NOISE_DIFFERENCES:
+            return pooled
+        # weighted least squares of y on [1, F²], weights 1/var² (y's variance is 2 var²):
+        # the normal likelihood's scoring step
+        w = keep / np.maximum(var, 1e-300) ** 2
+        design = np.column_stack([np.ones(y.size), f2])
+        normal = design.T @ (design * w[:, None])
+        if np.linalg.cond(normal) > 1e12:  # one force only: a and b cannot be told apart
+            return pooled
+        a2, b2 = np.linalg.solve(normal, design.T @ (w * y))
+        if b2 < 0.0:
+            return pooled
+        if a2 < 0.0:
+            a2, b2 = 0.0, float(np.sum(w * f2 * y) / np.sum(w * f2 * f2))
+        new = ForceNoise(math.sqrt(a2), math.sqrt(b2))
+        done = abs(new.a - model.a) + abs(new.b - model.b) * math.sqrt(float(f2.max())) \
+            <= 1e-9 * (model.a + model.b * math.sqrt(float(f2.max())))
+        model = new
+        if done:
+            break
+    if not (math.isfinite(model.a) and math.isfinite(model.b)) or model.a + model.b <= 0.0:
+        return pooled
+    return model
 
 
 def _fraction(start: float, end: float, grad: NDArray[np.float64], cov: NDArray[np.float64],
@@ -224,7 +287,9 @@ def _trapz_grad(x: NDArray[np.float64], y: NDArray[np.float64]
     return value, gx, gy
 
 
-def loop_loss(record: PressRecord, sigma_f: float, sigma_t: float) -> Measure | str:
+def loop_loss(record: PressRecord, sigma_f: ForceNoise, sigma_t: float) -> Measure | str:
+    """The loop's loss over the work put in, its σ from each sample's force noise at its force
+    and the travel's (module docstring of :mod:`deformap.stiffness._behaviour`)."""
     unloading = record.unloading
     assert unloading is not None
     parts = [(record.travel_m, record.force_n)]
@@ -243,11 +308,21 @@ def loop_loss(record: PressRecord, sigma_f: float, sigma_t: float) -> Measure | 
     gy = gy_l.copy()
     gx[:n_in] -= ratio * gx_w
     gy[:n_in] -= ratio * gy_w
-    var = (sigma_t**2 * float(gx @ gx) + sigma_f**2 * float(gy @ gy)) / work**2
-    return Measure(ratio, math.sqrt(var))
+    s2 = sigma_f.at(y) ** 2
+    # L − R W is bilinear in the travels and the forces, ``Σ_s w_s (y_s + y_{s+1})(x_{s+1} − x_s)/2``
+    # (w_s = 1 − R on the loading's segments, 1 after): the gradients at the noisy samples each
+    # carry the product of the two noises once, which the loss carries once in all; one is taken
+    # back, ``σ_t² Σ_ij A_ij² σ_F,j²`` with ``A = ∂²/∂x ∂y``
+    w = np.ones(x.size - 1)
+    w[:n_in - 1] = 1.0 - ratio
+    steps = np.diff(np.concatenate([[0.0], w, [0.0]]))
+    product = 0.25 * sigma_t**2 * (float(np.sum(w**2 * (s2[:-1] + s2[1:])))
+                                   + float(np.sum(steps**2 * s2)))
+    var = sigma_t**2 * float(gx @ gx) + float(np.sum(s2 * gy**2)) - product
+    return Measure(ratio, math.sqrt(max(var, 0.0)) / work)
 
 
-def zero_force_travel(record: PressRecord, sigma_f: float, sigma_t: float,
+def zero_force_travel(record: PressRecord, sigma_f: ForceNoise, sigma_t: float,
                       creep: Measure | None = None) -> Measure | str:
     """The unloading's travel at zero force less the loading's (module docstring of
     :mod:`deformap.stiffness._behaviour`); ``creep`` is the travel the hold added (0 without)."""
@@ -259,13 +334,16 @@ def zero_force_travel(record: PressRecord, sigma_f: float, sigma_t: float,
     x_l = np.maximum(lf[order], 0.0) ** (2.0 / 3.0)
     t_l = lt[order]
     x = np.maximum(f, 0.0) ** (2.0 / 3.0)
-    # the unloading's samples within the ramp's range of force, above its noise
-    use = (f >= max(float(lf.min()), N_SIGMA * sigma_f)) & (
-        f <= float(lf.max()) + N_SIGMA * sigma_f)
+    s_f = sigma_f.at(f)
+    # the unloading's samples within the ramp's range of force, above their noise
+    use = (f >= np.maximum(float(lf.min()), N_SIGMA * s_f)) & (
+        f <= float(lf.max()) + N_SIGMA * s_f)
     if int(use.sum()) < 2:
+        floor = N_SIGMA * float(sigma_f.at(0.0))
         return (f"the unloading branch has {int(use.sum())} samples within the ramp's range of "
-                f"force and above its noise ({N_SIGMA:g} σ = {N_SIGMA * sigma_f:.2g} N); needs 2")
-    x, t = x[use], t[use]
+                f"force and above its noise ({N_SIGMA:g} σ = {floor:.2g} N at zero force); "
+                "needs 2")
+    x, t, s_f = x[use], t[use], s_f[use]
     gap = t - np.interp(x, x_l, t_l)  # unloading less loading at the same force
     # the loading's local slope dt/dF there: the force noise of both readings moves the gap
     j = np.clip(np.searchsorted(x_l, x), 1, x_l.size - 1)
@@ -273,7 +351,7 @@ def zero_force_travel(record: PressRecord, sigma_f: float, sigma_t: float,
     slope = (t_l[j] - t_l[j - 1]) / np.maximum(f_l[j] - f_l[j - 1], 1e-12)
     # a noise-free record (a simulation without noise) weighs its samples alike: the floor is
     # far below any sensor's (1e-15 m), so a real record's weights are its own
-    var = np.maximum(2.0 * sigma_t**2 + 2.0 * (slope * sigma_f) ** 2, 1e-30)
+    var = np.maximum(2.0 * sigma_t**2 + 2.0 * (slope * s_f) ** 2, 1e-30)
     top = float(np.max(np.maximum(f, 0.0) ** (2.0 / 3.0)))
     u = x / top
     c = Measure(0.0, 0.0) if creep is None else creep

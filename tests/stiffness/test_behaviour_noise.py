@@ -1,0 +1,96 @@
+"""The force noise that grows with the load (:func:`deformap.stiffness._phases.force_noise`) and
+the loss σ it gives, on synthetic records with known noise."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from deformap.environment import ForceTravel, PressPhase
+from deformap.stiffness import press_behaviour
+from deformap.stiffness._phases import ForceNoise, force_noise, loop_loss, noise
+
+DEPTH = 0.003  # 3 mm of travel to 0.6 N
+TOP = 0.6
+ST = 5e-5  # the travel's noise [m]
+
+
+def _sigma(force: np.ndarray, a: float, b: float) -> np.ndarray:
+    return np.sqrt(a**2 + (b * force) ** 2)
+
+
+def _stretches(n_ramp: int, n_hold: int) -> list[np.ndarray]:
+    """A load-controlled press's true forces: a ramp, a hold, an unloading."""
+    ramp = np.linspace(0.05, TOP, n_ramp)
+    return [ramp, np.full(n_hold, TOP), ramp[::-1].copy()]
+
+
+def test_the_load_dependent_noise_recovers_a_known_a_and_b() -> None:
+    rng = np.random.default_rng(3)
+    a, b = 0.004, 0.02
+    parts = [f + rng.normal(size=f.size) * _sigma(f, a, b) for f in _stretches(2000, 2000)]
+    got = force_noise(parts)
+    assert got.a == pytest.approx(a, rel=0.15)
+    assert got.b == pytest.approx(b, rel=0.1)
+    # the pooled constant lies between the smallest and the largest of the record's noise
+    assert a < noise(parts) < float(_sigma(np.array(TOP), a, b))
+
+
+def test_a_noise_that_does_not_grow_keeps_a_constant_and_falls_back_when_it_cannot_fit() -> None:
+    rng = np.random.default_rng(4)
+    parts = [f + rng.normal(size=f.size) * 0.01 for f in _stretches(2000, 2000)]
+    got = force_noise(parts)
+    assert got.a == pytest.approx(0.01, rel=0.05)
+    assert float(got.at(TOP)) == pytest.approx(0.01, rel=0.05)
+    # one force only (a hold): a and b cannot be told apart; too few samples: the pooled constant
+    hold = [TOP + rng.normal(size=300) * 0.01]
+    assert force_noise(hold) == ForceNoise(noise(hold))
+    short = [TOP + rng.normal(size=6) * 0.01, np.linspace(0.1, 0.5, 5)]
+    assert force_noise(short) == ForceNoise(noise(short))
+    assert force_noise([np.zeros(50)]) == ForceNoise(0.0)
+
+
+def _record(rng: np.random.Generator, a: float, b: float) -> ForceTravel:
+    """An elastic Hertz press (no loss) of 28 ramp, 300 hold and 28 unloading samples, its force
+    noise ``√(a² + (b F)²)``."""
+    ramp, hold, unload = _stretches(28, 300)
+
+    def travel(f: np.ndarray) -> np.ndarray:
+        return np.asarray(DEPTH * ((f / TOP) ** (2.0 / 3.0) - (ramp[0] / TOP) ** (2.0 / 3.0)))
+
+    def read(f: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        return (travel(f) + rng.normal(size=f.size) * ST,
+                np.maximum(f + rng.normal(size=f.size) * _sigma(f, a, b), 0.0))
+
+    (t0, f0), (t1, f1), (t2, f2) = read(ramp), read(hold), read(unload)
+    f2 = np.minimum.accumulate(f2)  # the controller retracts until the force falls to each level
+    zero = t0[0]  # the travel is counted from the encoders' reading at first contact
+    dt = 0.01
+    times = np.arange(28) * dt
+    return ForceTravel(travel_m=t0 - zero, force_n=f0, time_s=times,
+                       hold=PressPhase(time_s=times[-1] + dt * np.arange(1, 301),
+                                       travel_m=t1 - zero, force_n=f1),
+                       unloading=PressPhase(time_s=times[-1] + dt * np.arange(301, 329),
+                                            travel_m=t2 - zero, force_n=f2))
+
+
+def test_the_loss_sigma_matches_its_spread_when_the_noise_grows_with_the_load() -> None:
+    rng = np.random.default_rng(5)
+    # the force noise at the top ten times that at contact: a pooled constant (mostly the hold's)
+    # claims the ramp's and the unloading's force noise too large
+    a, b = 0.003, 0.03
+    records = [_record(rng, a, b) for _ in range(200)]
+    got = [press_behaviour(r) for r in records]
+    loss = np.array([g.loss_ratio for g in got], dtype=float)
+    sigma = np.array([g.loss_ratio_sigma for g in got], dtype=float)
+    spread = float(np.std(loss, ddof=1))
+    assert abs(float(np.mean(loss))) < 3.0 * spread / np.sqrt(loss.size)  # no loss: elastic
+    assert spread / float(np.median(sigma)) == pytest.approx(1.0, abs=0.2)
+    pooled = []
+    for r in records:
+        parts = [r.force_n, r.hold.force_n, r.unloading.force_n]
+        sigma_t = noise([r.travel_m, r.hold.travel_m, r.unloading.travel_m])
+        m = loop_loss(r, ForceNoise(noise(parts)), sigma_t)
+        assert not isinstance(m, str)
+        pooled.append(m.sigma)
+    assert spread / float(np.median(pooled)) < spread / float(np.median(sigma)) - 0.05
