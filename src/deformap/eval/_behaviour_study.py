@@ -5,11 +5,8 @@ with a hold and an unloading branch, the behaviour class each press reads
 
 The truth of a press is what the world's material did under that press: viscoelastic for a block
 that relaxes; plastic for a block that yields when the dent the press leaves exceeds the
-smallest dent taken as a material's (:data:`deformap.stiffness.DENT_FLOOR_M`), else elastic (the
-press did not yield, or by less than any reading takes as a dent); elastic otherwise (an
-anisotropic foam too). A yield between that floor and what the force–travel record resolves
-(:func:`deformap.stiffness.record_dent_floor`) is plastic: a reading may call it unknown, and
-"elastic" there counts as wrong.
+record's resolvable floor (:func:`deformap.stiffness.record_dent_floor`), else elastic (the press
+did not yield beyond it, and behaved elastically); elastic otherwise (an anisotropic foam too).
 The dent a press leaves is how far below the top the tip's sphere, lowered at the press point,
 rests on the surface the world keeps after release (``tip_rest_dent_m``; the deepest point of
 that surface is ``kept_dent_m``). The quantities read are set against the world's: the hold's
@@ -31,7 +28,7 @@ from scipy.interpolate import LinearNDInterpolator
 from deformap.environment import Workspace
 from deformap.eval._studies import DEFAULT_POSITIONS, fraction
 from deformap.explore import poke_behaviour
-from deformap.stiffness import DENT_FLOOR_M
+from deformap.stiffness import record_dent_floor
 from deformap.world import (
     Block,
     Orthotropic,
@@ -185,8 +182,9 @@ def behaviour_presses(material: BehaviourMaterial, *, world_config: WorldConfig,
         kept = max(0.0, -float(np.min(u[:, 2])))
         rest = _tip_rest_dent(world, xy, u, obs.contact.tip_radius_m, thickness_m) if kept else 0.0
         truth = material.truth
-        if truth == "plastic" and rest <= DENT_FLOOR_M:
-            truth = "elastic"  # it did not yield by a dent any reading takes as one
+        if truth == "plastic" and (obs.force_travel is None
+                                   or rest <= record_dent_floor(obs.force_travel)):
+            truth = "elastic"  # it did not yield beyond what the record resolves
         quantities = {k: v for k, v in read.to_dict().items() if k not in ("behaviour", "evidence")}
         true = _truth_at(world, xy)
         visco = material.viscoelastic

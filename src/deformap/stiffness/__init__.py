@@ -75,7 +75,6 @@ from __future__ import annotations
 from deformap.stiffness._anisotropy import ANISOTROPY_WINDOW_RADII, dent_anisotropy
 from deformap.stiffness._behaviour import (
     BEHAVIOURS,
-    DENT_FLOOR_M,
     PressBehaviour,
     PressRecord,
     press_behaviour,
@@ -97,7 +96,6 @@ __all__ = [
     "ANISOTROPY_WINDOW_RADII",
     "BEHAVIOURS",
     "CONTACT_MODELS",
-    "DENT_FLOOR_M",
     "FIT_P_VALUE",
     "LAYER_MODEL",
     "ContactModelFit",

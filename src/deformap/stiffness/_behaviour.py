@@ -35,7 +35,11 @@ line and no ``τ``.
 
 Loss ratio: the path ramp → hold → unloading, ``L = ∮ F dδ`` (trapezoids; the return from the
 unloading's last travel to zero at zero force adds nothing) over the work put in before
-unloading, ``W = ∫ F dδ`` along ramp and hold. Its σ by linear propagation of each sample's
+unloading, ``W = ∫ F dδ`` along ramp and hold. The hold enters by its last sample alone: over a
+hold that keeps the force, ``∫ F dδ`` is ``F Δδ`` (over one that keeps the position, zero), which
+the one segment from the ramp's last sample to the hold's last gives, while each interior sample
+would add the product of its force and travel noises, a variance that grows with the hold's
+length and tells nothing of the loop. Its σ by linear propagation of each sample's
 ``σ_F(F)`` at its force and of ``σ_t`` through both trapezoid sums, the gradients taken at the
 noisy samples; ``L − R W`` is bilinear in travel and force, and those gradients each carry the
 product of the two noises (the travel's steps under the force's noise, the force's steps under

@@ -293,8 +293,8 @@ def loop_loss(record: PressRecord, sigma_f: ForceNoise, sigma_t: float) -> Measu
     unloading = record.unloading
     assert unloading is not None
     parts = [(record.travel_m, record.force_n)]
-    if record.hold is not None:
-        parts.append((record.hold.travel_m, record.hold.force_n))
+    if record.hold is not None:  # its last sample only (module docstring)
+        parts.append((record.hold.travel_m[-1:], record.hold.force_n[-1:]))
     n_in = sum(p[0].size for p in parts)
     parts.append((unloading.travel_m, unloading.force_n))
     x = np.concatenate([p[0] for p in parts])
