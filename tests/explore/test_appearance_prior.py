@@ -115,31 +115,6 @@ def test_pokes_that_agree_with_the_looks_raise_the_weight_and_contradicting_ones
     assert np.isclose(agree.probability.sum(), 1.0)
 
 
-def test_a_dent_across_the_edge_reads_both_looks_so_a_value_between_them_keeps_the_weight(
-        ) -> None:  # fmt: skip
-    image = _image()
-    assert isinstance(image, AppearanceImage)
-    inside = [(0.05, 0.05), (0.05, 0.15), (0.25, 0.05), (0.25, 0.15)]
-    values = [0.2, 0.2, 0.7, 0.7]
-    edge = [*inside, (0.15, 0.10)]  # the red | blue edge at x = 0.15 runs through its footprint
-
-    def weight(xy, vals, radius: float) -> float:
-        prior = AppearancePrior(image, XS, YS, dent_radius_m=radius)
-        return AppearanceModels(prior, np.asarray(xy, float), np.asarray(vals, float),
-                                np.full(len(xy), 0.02), signal_std=0.3,
-                                length_scale=0.05).posterior.mean_weight  # fmt: skip
-
-    share = AppearancePrior(image, XS, YS, dent_radius_m=FOOTPRINT_M / 2).dent_looks(
-        np.array([(0.15, 0.10)]))[0]
-    red = np.unique(image.segments[:, XS < 0.14])
-    assert np.isclose(share.sum(), 1.0) and 0.3 < share[red].sum() < 0.7
-    before = weight(inside, values, FOOTPRINT_M / 2)
-    # the dent reads between the two materials: over its footprint that agrees with the looks;
-    # read as its centre cell's look alone it contradicts them
-    assert weight(edge, [*values, 0.45], FOOTPRINT_M / 2) > before
-    assert weight(edge, [*values, 0.45], 0.0) < before - 0.05
-
-
 def test_at_weight_zero_the_prior_is_the_blind_field_and_the_average_variance_is_bounded(
         ) -> None:  # fmt: skip
     image = _image()

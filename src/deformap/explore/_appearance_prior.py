@@ -7,16 +7,14 @@ The kernel of a field with prior standard deviation σ and length scale ℓ (the
 
 ``k_ℓ`` the blind field's squared exponential, ``k_app(a, a') = exp(−‖a − a'‖² / ℓ_a²)`` on the
 segments' standardised features (a masked cell takes its nearest seen cell's), and ``k_L`` a
-squared exponential over the workspace's diagonal. At ``w = 0`` it is the blind kernel; at every
-``w`` the prior variance of a place is σ², so ``T_h`` keeps its meaning. It is a sum, not a
-product ``k_ℓ · (1 − w + w k_app)``, because a product only removes covariance.
-
-A poke reads the material under its dent, not at a point: its look is the average of ``k_app``
-over the cells of its dent's footprint (a disc of ``dent_radius_m``), so a dent across an image
-edge is correlated with each side by the share of its footprint there, and a value between the
-two sides is no contradiction of the looks. The average of a kernel over footprints is a kernel;
-a dent inside one segment is that segment's look exactly. The places the map is read at, and the
-planner's places, are points.
+squared exponential over the workspace's diagonal. A poke reads the material under its dent, not
+at a point: its look is the average of ``k_app`` over the cells of its dent's footprint (a disc of
+``dent_radius_m``), so a dent across an image edge is correlated with each side by the share of
+its footprint there, and a value between the two sides is no contradiction of the looks. The
+average of a kernel over footprints is a kernel; a dent inside one segment is that segment's
+look exactly. The places the map is read at, and the planner's places, are points. At ``w = 0`` it is the blind kernel; at every
+``w`` the prior variance is σ², so ``T_h`` keeps its meaning. It is a sum, not a product
+``k_ℓ · (1 − w + w k_app)``, because a product only removes covariance.
 
 ``w`` and ``ℓ_a`` range over a small grid (:data:`WEIGHTS` × :data:`LOOK_SCALES`; one half on
 ``w = 0``, the blind map, the other half uniform over the weights above 0, then ``ℓ_a``: a
