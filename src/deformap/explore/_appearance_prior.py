@@ -7,12 +7,7 @@ The kernel of a field with prior standard deviation σ and length scale ℓ (the
 
 ``k_ℓ`` the blind field's squared exponential, ``k_app(a, a') = exp(−‖a − a'‖² / ℓ_a²)`` on the
 segments' standardised features (a masked cell takes its nearest seen cell's), and ``k_L`` a
-squared exponential over the workspace's diagonal. A poke reads the material under its dent, not
-at a point: its look is the average of ``k_app`` over the cells of its dent's footprint (a disc of
-``dent_radius_m``), so a dent across an image edge is correlated with each side by the share of
-its footprint there, and a value between the two sides is no contradiction of the looks. The
-average of a kernel over footprints is a kernel; a dent inside one segment is that segment's
-look exactly. The places the map is read at, and the planner's places, are points. At ``w = 0`` it is the blind kernel; at every
+squared exponential over the workspace's diagonal. At ``w = 0`` it is the blind kernel; at every
 ``w`` the prior variance is σ², so ``T_h`` keeps its meaning. It is a sum, not a product
 ``k_ℓ · (1 − w + w k_app)``, because a product only removes covariance.
 
@@ -60,20 +55,11 @@ LOOK_SCALES = (0.5, 1.0, 2.0)
 
 
 class AppearancePrior:
-    """The look of every place on the grid ``xs``, ``ys`` [m] the ``image`` is on, and the kernel;
-    ``dent_radius_m`` [m] the radius of a poke's footprint (0: a poke reads its cell only)."""
+    """The look of every place on the grid ``xs``, ``ys`` [m] the ``image`` is on, and the kernel."""
 
-    def __init__(self, image: AppearanceImage, xs: Array, ys: Array, *,
-                 dent_radius_m: float = 0.0) -> None:
+    def __init__(self, image: AppearanceImage, xs: Array, ys: Array) -> None:
         self.image = image
         self.xs, self.ys = xs, ys
-        dx = float(xs[1] - xs[0]) if xs.size > 1 else 0.0
-        dy = float(ys[1] - ys[0]) if ys.size > 1 else 0.0
-        ri = int(dent_radius_m // dy) if dy > 0 else 0
-        rj = int(dent_radius_m // dx) if dx > 0 else 0
-        oi, oj = np.meshgrid(np.arange(-ri, ri + 1), np.arange(-rj, rj + 1), indexing="ij")
-        disc = (oi * dy) ** 2 + (oj * dx) ** 2 <= dent_radius_m**2
-        self._dent = (oi[disc], oj[disc])  # the footprint's cell offsets, (0, 0) among them
         self.span_m = float(np.hypot(np.ptp(xs), np.ptp(ys))) or 1.0
         gx, gy = np.meshgrid(xs, ys)
         self.cells_xy = np.column_stack([gx.ravel(), gy.ravel()])
@@ -102,43 +88,23 @@ class AppearancePrior:
             iy[:] = 0
         return np.asarray(iy * self.xs.size + ix, dtype=np.int64)
 
-    def dent_looks(self, xy: Array) -> Array:
-        """``(n, n_segments)`` the share of each segment's look in the footprint of a dent at each
-        of ``xy (n, 2)`` [m] (the footprint's cells on the grid; a row sums to 1)."""
-        ny, nx = self.image.segments.shape
-        iy, ix = np.divmod(self.cells_of(xy), nx)
-        rows = iy[:, None] + self._dent[0][None, :]
-        cols = ix[:, None] + self._dent[1][None, :]
-        on = (rows >= 0) & (rows < ny) & (cols >= 0) & (cols < nx)
-        looks = self._look[np.where(on, rows, 0) * nx + np.where(on, cols, 0)]
-        share = np.zeros((iy.size, self.image.features.shape[0]))
-        np.add.at(share, (np.broadcast_to(np.arange(iy.size)[:, None], on.shape)[on], looks[on]),
-                  1.0)  # fmt: skip
-        return np.asarray(share / share.sum(axis=1, keepdims=True))
-
-    def look_kernel(self, xy_a: Array, xy_b: Array, look_scale: float, *,
-                    dent_a: bool = False, dent_b: bool = False) -> Array:
-        """``(a, b)`` ``k_app`` between the places ``xy_a (a, 2)`` and ``xy_b (b, 2)`` [m]; a set
-        marked ``dent_*`` are pokes, read over their footprint (module docstring)."""
+    def look_kernel(self, cells_a: NDArray[np.int64], cells_b: NDArray[np.int64],
+                    look_scale: float) -> Array:
+        """``k_app`` between the looks of two sets of flat cells."""
         feats = self.image.features
-        d2 = np.sum((feats[:, None, :] - feats[None, :, :]) ** 2, axis=-1)
-        between = np.exp(-d2 / look_scale**2)  # (n_segments, n_segments)
-        left = self.dent_looks(xy_a) @ between if dent_a else between[self._look[self.cells_of(xy_a)]]
-        if dent_b:
-            return np.asarray(left @ self.dent_looks(xy_b).T)
-        return np.asarray(left[:, self._look[self.cells_of(xy_b)]])
+        fa, fb = feats[self._look[cells_a]], feats[self._look[cells_b]]
+        d2 = np.sum((fa[:, None, :] - fb[None, :, :]) ** 2, axis=-1)
+        return np.asarray(np.exp(-d2 / look_scale**2))
 
     def covariance(self, xy_a: Array, xy_b: Array, *, signal_std: float, length_scale: float,
-                   weight: float, look_scale: float, dent_a: bool = False,
-                   dent_b: bool = False) -> Array:
+                   weight: float, look_scale: float) -> Array:
         """``(a, b)`` the kernel (module docstring) between ``xy_a (a, 2)`` and ``xy_b (b, 2)``
-        [m], in the field's units squared; ``dent_*``: that set are pokes (read over their
-        footprint), else points."""
+        [m], in the field's units squared."""
         blind = squared_exponential(xy_a, xy_b, length_scale=length_scale, signal_std=1.0)
         if weight == 0.0:
             return np.asarray(signal_std**2 * blind)
         near = squared_exponential(xy_a, xy_b, length_scale=self.span_m, signal_std=1.0)
-        look = self.look_kernel(xy_a, xy_b, look_scale, dent_a=dent_a, dent_b=dent_b)
+        look = self.look_kernel(self.cells_of(xy_a), self.cells_of(xy_b), look_scale)
         return np.asarray(signal_std**2 * ((1.0 - weight) * blind + weight * near * look))
 
 
@@ -196,7 +162,7 @@ class AppearanceModels:
         w, la, prior_p = _grid_points()
         self._factors, self._alphas, lml = [], [], []
         for weight, scale in zip(w, la, strict=True):
-            gram = self._cov(self.xy, weight, scale, dent=True) / signal_std**2
+            gram = self._cov(self.xy, weight, scale) / signal_std**2
             gram[np.diag_indices_from(gram)] += (noise / signal_std) ** 2
             factor, _ = cholesky_with_jitter(gram, jitter=1e-10, max_jitter=1e-4,
                                              what="the pokes' covariance under the look prior")
@@ -209,11 +175,10 @@ class AppearanceModels:
         prob = np.exp(log_post - log_post.max())
         self.posterior = WeightPosterior(w, la, prob / prob.sum())
 
-    def _cov(self, query: Array, weight: float, scale: float, *, dent: bool = False) -> Array:
-        """The kernel between ``query`` (points, or pokes when ``dent``) and the pokes."""
+    def _cov(self, query: Array, weight: float, scale: float) -> Array:
         return self.prior.covariance(query, self.xy, signal_std=self.signal_std,
                                      length_scale=self.length_scale, weight=weight,
-                                     look_scale=scale, dent_a=dent, dent_b=True)  # fmt: skip
+                                     look_scale=scale)  # fmt: skip
 
     def _variance(self, k: int, cross: Array) -> Array:
         """``(q,)`` the posterior variance under grid point ``k`` given ``cross (q, p)``."""

@@ -128,8 +128,7 @@ class Mapper:
                     logger.warning("the appearance prior is off: %s; the map is the blind one",
                                    image)  # fmt: skip
             else:
-                self.appearance = AppearancePrior(image, self.grid.xs, self.grid.ys,
-                                                  dent_radius_m=footprint_m / 2)
+                self.appearance = AppearancePrior(image, self.grid.xs, self.grid.ys)
                 self.appearance_reason = None
         self._modulus = self._fit_modulus([])
         return self.surface
