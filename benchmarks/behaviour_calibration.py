@@ -1,19 +1,21 @@
 """Whether the standard errors a press's behaviour claims match the spread of its values: over
 ``--seeds`` worlds per material and thickness (seeds 100, 101, …; one press each at the behaviour
-study's first place, 0.6 N, held 3 s (the study's hold at d4f59f9) and unloaded, the PrimeSense
-preset), the loss ratio, the travel at zero force (the dent) and the hold's creep fraction are read
-from each noisy record, and the spread of the values (their standard deviation over the worlds) is
-set against the median σ they claim. Three readings of the same records in the same run: "main",
-the baseline, as main (d4f59f9) reads them (one pooled force noise ``σ_F`` of every stretch's
-second differences; the loss's σ propagated at the noisy samples); "pooled + product", the pooled
-``σ_F`` with the product of the two noises counted once in the loss's σ (the loss only); "load", as
-:func:`deformap.stiffness.press_behaviour` now reads them, the force noise a function of the load
-(``σ_F(F)² = a² + (b F)²``, :func:`deformap.stiffness._phases.force_noise`) and the product term
-counted once. The creep's σ is the hold's exponential fit's, which none changes. ``exact`` is the
-value the noise-free record gives, ``mean`` the mean of the "load" values.
+study's first place, 0.6 N, held ``--hold`` seconds (default the study's hold) and unloaded, the
+PrimeSense preset), the loss ratio, the travel at zero force (the dent) and the hold's creep
+fraction are read from each noisy record, and the spread of the values (their standard deviation
+over the worlds) is set against the median σ they claim. Three readings of the same records in the
+same run: "main", the baseline, as main (d4f59f9) reads them (one pooled force noise ``σ_F`` of
+every stretch's second differences; the loss along every sample of the hold, its σ propagated at
+the noisy samples); "pooled + product", the pooled ``σ_F`` with the product of the two noises
+counted once in the loss's σ (the loss only); "load", as :func:`deformap.stiffness.press_behaviour`
+now reads them, the force noise a function of the load (``σ_F(F)² = a² + (b F)²``,
+:func:`deformap.stiffness._phases.force_noise`) and the product term counted once. The creep's σ is
+the hold's exponential fit's, which none changes. The last two read the loss along the hold's last
+sample alone, as the shipped reading does. ``exact`` is the value the noise-free record
+gives, ``mean`` the mean of the "load" values.
 
     OMP_NUM_THREADS=1 PYTHONPATH=src python benchmarks/behaviour_calibration.py \
-        [--seeds 30] [--thickness 0.03 0.1] [--materials "elastic 30 N" ...]
+        [--seeds 30] [--thickness 0.03 0.1] [--hold 12] [--materials "elastic 30 N" ...]
 
 A ratio spread/claimed above 1 is a σ that undercovers.
 """
@@ -28,6 +30,7 @@ import numpy as np
 
 from deformap.environment import ForceTravel, Workspace
 from deformap.eval import DEFAULT_POSITIONS, FULL_BEHAVIOUR_MATERIALS, material_scenario
+from deformap.run._studies import BEHAVIOUR_HOLD_S  # the study's own hold
 from deformap.stiffness._phases import (
     ForceNoise,
     _trapz_grad,
@@ -42,13 +45,12 @@ from deformap.stiffness._phases import (
 from deformap.world import SimulatedWorld, WorldConfig, camera_preset
 
 MATERIALS = ["elastic 30 N", "elastic 250 N", "viscoelastic g∞ 0.8 τ 2 s", "plastic yield 3000 Pa"]
-HOLD_S = 3.0  # held 3 s: the behaviour study's hold (BEHAVIOUR_HOLD_S) at d4f59f9, where it was measured
 FORCE_N = 0.6
 
 
-def _main_loss_sigma(record: ForceTravel, sigma_f: float, sigma_t: float) -> float:
-    """The loss ratio's σ as main (d4f59f9) gave it: one pooled σ_F, linear propagation at the
-    noisy samples, no product term taken back."""
+def _main_loss(record: ForceTravel, sigma_f: float, sigma_t: float) -> tuple[float, float]:
+    """The loss ratio and its σ as main (d4f59f9) gave them: every sample of the hold, one pooled
+    σ_F, linear propagation at the noisy samples, no product term taken back."""
     parts: list[Any] = [record, record.hold, record.unloading]
     x = np.concatenate([np.asarray(p.travel_m) for p in parts])
     y = np.concatenate([np.asarray(p.force_n) for p in parts])
@@ -57,7 +59,7 @@ def _main_loss_sigma(record: ForceTravel, sigma_f: float, sigma_t: float) -> flo
     work, gx_w, gy_w = _trapz_grad(x[:n_in], y[:n_in])
     gx[:n_in] -= loop / work * gx_w
     gy[:n_in] -= loop / work * gy_w
-    return float(np.sqrt(sigma_t**2 * (gx @ gx) + sigma_f**2 * (gy @ gy)) / work)
+    return loop / work, float(np.sqrt(sigma_t**2 * (gx @ gx) + sigma_f**2 * (gy @ gy)) / work)
 
 
 def _read(record: ForceTravel, noisy: bool) -> dict[str, list[tuple[float, float]]]:
@@ -78,7 +80,7 @@ def _read(record: ForceTravel, noisy: bool) -> dict[str, list[tuple[float, float
                  else zero_force_travel(record, model, sigma_t, creep))
             got.append((np.nan, np.nan) if isinstance(m, str) else (m.value, m.sigma))
         if name == "loss":
-            got.insert(0, (got[0][0], _main_loss_sigma(record, sigma_f, sigma_t)))
+            got.insert(0, _main_loss(record, sigma_f, sigma_t))
         else:
             got.insert(0, got[0])
         out[name] = got
@@ -91,10 +93,11 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--seeds", type=int, default=30)
     parser.add_argument("--thickness", type=float, nargs="+", default=[0.03, 0.1])
+    parser.add_argument("--hold", type=float, default=BEHAVIOUR_HOLD_S)
     parser.add_argument("--materials", nargs="+", default=MATERIALS)
     args = parser.parse_args()
     by_name = {m.name: m for m in FULL_BEHAVIOUR_MATERIALS}
-    config = WorldConfig(camera=camera_preset("primesense"), hold_s=HOLD_S, unload=True)
+    config = WorldConfig(camera=camera_preset("primesense"), hold_s=args.hold, unload=True)
     xy = np.asarray(DEFAULT_POSITIONS[0])
     print("| material | thickness | quantity | exact | mean | spread | claimed main | "
           "spread/claimed main | claimed pooled + product | spread/claimed | spread load | "
