@@ -94,3 +94,72 @@ def test_the_loss_sigma_matches_its_spread_when_the_noise_grows_with_the_load() 
         assert not isinstance(m, str)
         pooled.append(m.sigma)
     assert spread / float(np.median(pooled)) < spread / float(np.median(sigma)) - 0.05
+
+
+def test_a_clamped_zero_force_tail_or_a_large_scale_does_not_break_the_noise_fit() -> None:
+    """An unloading whose force is clamped at zero (a run of exact zeros) fits or falls back to
+    the pooled constant, finite, never a numpy error; the fit does not depend on the force's unit."""
+    rng = np.random.default_rng(6)
+    parts = [f + rng.normal(size=f.size) * 0.01 * f for f in _stretches(400, 1200)]
+    parts[2] = np.concatenate([np.maximum(parts[2], 0.0), np.zeros(10)])
+    got = force_noise(parts)
+    assert np.isfinite(got.a) and np.isfinite(got.b) and got.a > 0.0
+    noisy = [f + rng.normal(size=f.size) * _sigma(f, 0.005, 0.01) for f in _stretches(400, 1200)]
+    small, large = force_noise(noisy), force_noise([1000.0 * f for f in noisy])
+    assert large.a == pytest.approx(1000.0 * small.a, rel=1e-6)
+    assert large.b == pytest.approx(small.b, rel=1e-6)
+
+
+def _held(n_hold: int, rng: np.random.Generator | None, creep: float = 0.0,
+          relax: float = 0.0) -> ForceTravel:
+    """A Hertz loading to 0.6 N, a hold of ``n_hold`` samples over 12 s in which the travel creeps
+    by ``creep`` of it and the force relaxes by ``relax`` of it, and a Hertz unloading from there."""
+    ramp = np.linspace(0.05, TOP, 30)
+    t_hold = np.linspace(0.0, 12.0, n_hold + 1)[1:]
+    d_hold = DEPTH * (1.0 + creep * (1.0 - np.exp(-t_hold / 3.0)))
+    f_hold = TOP * (1.0 - relax * (1.0 - np.exp(-t_hold / 0.3)))
+    down = np.linspace(float(f_hold[-1]), 0.05, 30)
+    d_down = d_hold[-1] * (down / f_hold[-1]) ** (2.0 / 3.0)
+    zero = DEPTH * (ramp[0] / TOP) ** (2.0 / 3.0)  # travel counted from first contact
+    d_ramp = DEPTH * (ramp / TOP) ** (2.0 / 3.0) - zero
+    d_hold, d_down = d_hold - zero, d_down - zero
+
+    def noisy(x: np.ndarray, s: float) -> np.ndarray:
+        return x if rng is None else x + rng.normal(size=x.size) * s
+
+    return ForceTravel(travel_m=noisy(d_ramp, ST), force_n=noisy(ramp, 0.005),
+                       time_s=np.arange(30) * 0.01,
+                       hold=PressPhase(time_s=0.29 + t_hold, travel_m=noisy(d_hold, ST),
+                                       force_n=noisy(f_hold, 0.005)),
+                       unloading=PressPhase(time_s=12.3 + np.arange(30) * 0.01,
+                                            travel_m=noisy(d_down, ST), force_n=noisy(down, 0.005)))
+
+
+def test_the_loss_sigma_does_not_grow_with_a_held_forces_hold() -> None:
+    """A hold that keeps the force enters the loss by its last sample: 300 or 1200 samples of it
+    give the same σ (each interior sample would add the product of its two noises)."""
+    rng = np.random.default_rng(7)
+    sigma = {}
+    for n in (300, 1200):
+        got = [loop_loss(r, ForceNoise(0.005), ST) for r in (_held(n, rng) for _ in range(20))]
+        sigma[n] = float(np.median([m.sigma for m in got if not isinstance(m, str)]))
+    assert sigma[1200] == pytest.approx(sigma[300], rel=0.05)
+
+
+def test_a_hold_where_force_and_travel_both_move_enters_the_loss_by_every_sample() -> None:
+    """Noise-free: a hold in which the force relaxes while the travel creeps is integrated along
+    its samples (the trapezoid over the whole loop); one that keeps the force gives F Δδ exactly."""
+    both = _held(1200, None, creep=0.1, relax=0.2)
+    x = np.concatenate([both.travel_m, both.hold.travel_m, both.unloading.travel_m])
+    y = np.concatenate([both.force_n, both.hold.force_n, both.unloading.force_n])
+    n_in = both.travel_m.size + both.hold.travel_m.size
+    whole = float(np.trapezoid(y, x)) / float(np.trapezoid(y[:n_in], x[:n_in]))
+    got = loop_loss(both, ForceNoise(0.005), ST)
+    assert not isinstance(got, str) and got.value == pytest.approx(whole, rel=1e-9)
+    held = _held(1200, None, creep=0.1)
+    x = np.concatenate([held.travel_m, held.hold.travel_m, held.unloading.travel_m])
+    y = np.concatenate([held.force_n, held.hold.force_n, held.unloading.force_n])
+    n_in = held.travel_m.size + held.hold.travel_m.size
+    whole = float(np.trapezoid(y, x)) / float(np.trapezoid(y[:n_in], x[:n_in]))
+    got = loop_loss(held, ForceNoise(0.005), ST)
+    assert not isinstance(got, str) and got.value == pytest.approx(whole, rel=1e-9)

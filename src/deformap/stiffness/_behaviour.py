@@ -15,9 +15,10 @@ linear in time and the hold constant, so ``E[(Δ²F)²] = 6 σ_F(F)²`` at each 
 ``F``; ``a²``, ``b²`` are the normal likelihood's weighted least squares of ``(Δ²F)²/6`` on
 ``[1, F²]`` (weights ``1/σ_F(F)⁴``, iterated from the pooled constant), each pass leaving out the
 differences beyond 4 of their model σ. A record that cannot fit it (fewer than
-:data:`MIN_NOISE_DIFFERENCES` differences, one force only, or ``b² < 0``) keeps the pooled
-constant; ``a² < 0`` gives ``a = 0``. The travel's noise (the encoders') does not grow with the
-load and stays pooled; the hold takes its own stretch's force noise (below).
+:data:`MIN_NOISE_DIFFERENCES` differences, one force only, ``b² < 0`` or ``a² ≤ 0``: a sensor
+with no noise at zero load is none a record can show) keeps the pooled constant. The travel's
+noise (the encoders') does not grow with the load and stays pooled; the hold takes its own
+stretch's force noise (below).
 
 Hold: the ramp's last sample (where the commanded force is reached) starts it. Straight lines
 through the force and the travel of the whole stretch (least squares; for the force the larger of
@@ -35,11 +36,12 @@ line and no ``τ``.
 
 Loss ratio: the path ramp → hold → unloading, ``L = ∮ F dδ`` (trapezoids; the return from the
 unloading's last travel to zero at zero force adds nothing) over the work put in before
-unloading, ``W = ∫ F dδ`` along ramp and hold. The hold enters by its last sample alone: over a
-hold that keeps the force, ``∫ F dδ`` is ``F Δδ`` (over one that keeps the position, zero), which
-the one segment from the ramp's last sample to the hold's last gives, while each interior sample
-would add the product of its force and travel noises, a variance that grows with the hold's
-length and tells nothing of the loop. Its σ by linear propagation of each sample's
+unloading, ``W = ∫ F dδ`` along ramp and hold. Where the hold keeps the force or the position
+(the straight line through one of them changes by less than :data:`N_SIGMA` of its σ) it enters
+by its last sample alone: ``∫ F dδ`` over it is then ``F Δδ`` (or zero), which the one segment from
+the ramp's last sample to the hold's last gives, while each interior sample would add the product
+of its force and travel noises, a variance that grows with the hold's length and tells nothing of
+the loop; a hold where both move enters by every sample. Its σ by linear propagation of each sample's
 ``σ_F(F)`` at its force and of ``σ_t`` through both trapezoid sums, the gradients taken at the
 noisy samples; ``L − R W`` is bilinear in travel and force, and those gradients each carry the
 product of the two noises (the travel's steps under the force's noise, the force's steps under

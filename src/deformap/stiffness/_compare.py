@@ -23,7 +23,8 @@ from deformap.stiffness._tables import (
 __all__ = ["ModelReading", "average_models", "model_weights", "read_model"]
 
 # the grid along each principal axis of the evidence's covariance (two axes at most with three
-# models): ±6 σ in steps of σ / 20, the expected weights to about 1e-3 whatever the σ
+# models): ±6 σ in steps of σ / 20, which resolves the softmax while a step moves its log-weights
+# by well under one, not for a σ of hundreds in log-weight units
 _NORMAL_REACH = 6.0
 _NORMAL_NODES = 241
 

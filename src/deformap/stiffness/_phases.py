@@ -123,28 +123,32 @@ def force_noise(parts: list[NDArray[np.float64]]) -> ForceNoise:
     # E[(F₋ − 2F + F₊)²] = σ₋² + 4σ² + σ₊² ≈ 6 σ²(F) where the trend is linear in time
     y = np.concatenate([np.diff(p, n=2) ** 2 / 6.0 for p in usable])
     f2 = np.concatenate([np.maximum(p[1:-1], 0.0) ** 2 for p in usable])
+    top = float(f2.max())
+    if top <= 0.0:  # no load anywhere: nothing for b to grow with
+        return pooled
+    u = f2 / top  # the load's share of its largest, so the design's scale is the record's own
     model = pooled
-    keep = np.ones(y.size, dtype=bool)
     for _ in range(50):
         var = model.at(np.sqrt(f2)) ** 2
         keep = y <= _NOISE_TRIM_SIGMA**2 * var
         if int(keep.sum()) < MIN_NOISE_DIFFERENCES:
             return pooled
         # weighted least squares of y on [1, F²], weights 1/var² (y's variance is 2 var²):
-        # the normal likelihood's scoring step
-        w = keep / np.maximum(var, 1e-300) ** 2
-        design = np.column_stack([np.ones(y.size), f2])
+        # the normal likelihood's scoring step; var > 0 as a > 0 below
+        w = keep / var**2
+        design = np.column_stack([np.ones(y.size), u])
         normal = design.T @ (design * w[:, None])
         if np.linalg.cond(normal) > 1e12:  # one force only: a and b cannot be told apart
             return pooled
-        a2, b2 = np.linalg.solve(normal, design.T @ (w * y))
-        if b2 < 0.0:
+        try:
+            a2, c2 = np.linalg.solve(normal, design.T @ (w * y))
+        except np.linalg.LinAlgError:
             return pooled
-        if a2 < 0.0:
-            a2, b2 = 0.0, float(np.sum(w * f2 * y) / np.sum(w * f2 * f2))
-        new = ForceNoise(math.sqrt(a2), math.sqrt(b2))
-        done = abs(new.a - model.a) + abs(new.b - model.b) * math.sqrt(float(f2.max())) \
-            <= 1e-9 * (model.a + model.b * math.sqrt(float(f2.max())))
+        if not (a2 > 0.0 and c2 >= 0.0):  # no floor or no growth the record shows: the pooled
+            return pooled
+        new = ForceNoise(math.sqrt(a2), math.sqrt(c2 / top))
+        done = abs(new.a - model.a) + abs(new.b - model.b) * math.sqrt(top) \
+            <= 1e-9 * (model.a + model.b * math.sqrt(top))
         model = new
         if done:
             break
@@ -192,6 +196,13 @@ def _line(t: NDArray[np.float64], y: NDArray[np.float64], sigma: float
     to_ends = np.array([[1.0, 0.0], [1.0, 1.0]])
     cov = to_ends @ np.linalg.inv(design.T @ design) @ to_ends.T * sigma**2
     return float(coef[0]), float(coef[0] + coef[1]), cov
+
+
+def _moves(t: NDArray[np.float64], y: NDArray[np.float64], sigma: float) -> bool:
+    """Whether a stretch's straight line changes by more than :data:`N_SIGMA` of its σ."""
+    start, end, cov = _line(t, y, sigma)
+    return abs(end - start) > N_SIGMA * math.sqrt(max(cov[0, 0] + cov[1, 1] - 2.0 * cov[0, 1],
+                                                      0.0))
 
 
 def hold_travel(hold: _Phase, sigma_t: float) -> Measure:
@@ -293,8 +304,13 @@ def loop_loss(record: PressRecord, sigma_f: ForceNoise, sigma_t: float) -> Measu
     unloading = record.unloading
     assert unloading is not None
     parts = [(record.travel_m, record.force_n)]
-    if record.hold is not None:  # its last sample only (module docstring)
-        parts.append((record.hold.travel_m[-1:], record.hold.force_n[-1:]))
+    hold = record.hold
+    if hold is not None:  # its last sample alone where one of the two is held (module docstring)
+        t, d, f = (np.asarray(v, dtype=np.float64) for v in (hold.time_s, hold.travel_m,
+                                                              hold.force_n))
+        both = t.size >= 3 and t[-1] > t[0] and _moves(t, d, sigma_t) and _moves(
+            t, f, float(sigma_f.at(float(np.mean(f)))))
+        parts.append((d, f) if both else (d[-1:], f[-1:]))
     n_in = sum(p[0].size for p in parts)
     parts.append((unloading.travel_m, unloading.force_n))
     x = np.concatenate([p[0] for p in parts])
