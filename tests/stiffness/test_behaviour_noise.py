@@ -146,20 +146,18 @@ def test_the_loss_sigma_does_not_grow_with_a_held_forces_hold() -> None:
     assert sigma[1200] == pytest.approx(sigma[300], rel=0.05)
 
 
+def _whole_loop(record: ForceTravel) -> float:
+    """The loss along every sample of the loop (trapezoids), the hold's interior included."""
+    x = np.concatenate([record.travel_m, record.hold.travel_m, record.unloading.travel_m])
+    y = np.concatenate([record.force_n, record.hold.force_n, record.unloading.force_n])
+    n_in = record.travel_m.size + record.hold.travel_m.size
+    return float(np.trapezoid(y, x)) / float(np.trapezoid(y[:n_in], x[:n_in]))
+
+
 def test_a_hold_where_force_and_travel_both_move_enters_the_loss_by_every_sample() -> None:
     """Noise-free: a hold in which the force relaxes while the travel creeps is integrated along
     its samples (the trapezoid over the whole loop); one that keeps the force gives F Δδ exactly."""
-    both = _held(1200, None, creep=0.1, relax=0.2)
-    x = np.concatenate([both.travel_m, both.hold.travel_m, both.unloading.travel_m])
-    y = np.concatenate([both.force_n, both.hold.force_n, both.unloading.force_n])
-    n_in = both.travel_m.size + both.hold.travel_m.size
-    whole = float(np.trapezoid(y, x)) / float(np.trapezoid(y[:n_in], x[:n_in]))
-    got = loop_loss(both, ForceNoise(0.005), ST)
-    assert not isinstance(got, str) and got.value == pytest.approx(whole, rel=1e-9)
-    held = _held(1200, None, creep=0.1)
-    x = np.concatenate([held.travel_m, held.hold.travel_m, held.unloading.travel_m])
-    y = np.concatenate([held.force_n, held.hold.force_n, held.unloading.force_n])
-    n_in = held.travel_m.size + held.hold.travel_m.size
-    whole = float(np.trapezoid(y, x)) / float(np.trapezoid(y[:n_in], x[:n_in]))
-    got = loop_loss(held, ForceNoise(0.005), ST)
-    assert not isinstance(got, str) and got.value == pytest.approx(whole, rel=1e-9)
+    for record in (_held(1200, None, creep=0.1, relax=0.2), _held(1200, None, creep=0.1)):
+        got = loop_loss(record, ForceNoise(0.005), ST)
+        assert not isinstance(got, str)
+        assert got.value == pytest.approx(_whole_loop(record), rel=1e-9)
