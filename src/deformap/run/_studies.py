@@ -269,10 +269,11 @@ def run_cluster_size_study(out: Path | None = None, *, seed: int = 0, coarse: bo
         return StudyOutput(study=study, folder=folder, files=files)
 
 
-BEHAVIOUR_HOLD_S = 12.0
+BEHAVIOUR_HOLD_S = 3.0 * max(max(m.viscoelastic.times_s) / m.viscoelastic.relaxed_ratio
+                             for m in FULL_BEHAVIOUR_MATERIALS if m.viscoelastic is not None)
 """How long each press of the behaviour study holds its force, seconds: three creep times of the
-slowest memory foam of the study (a standard linear solid creeps under a held force with
-``τ / g∞``, 4 s for ``τ`` 2 s and ``g∞`` 0.5), so that its time constant is read, not only its
+slowest memory foam of :data:`~deformap.eval.FULL_BEHAVIOUR_MATERIALS` (a standard linear solid
+creeps under a held force with ``τ / g∞``), so that its time constant is read, not only its
 creep."""
 
 BEHAVIOUR_THICKNESS_M = 0.03

@@ -286,7 +286,6 @@ def _press_behaviour(record: PressRecord | None, released: tuple[float, float] |
             force_parts.append(np.asarray(phase.force_n))
             travel_parts.append(np.asarray(phase.travel_m))
     sigma_f, sigma_t = noise(force_parts), noise(travel_parts)
-    load_noise = force_noise(force_parts)
     notes: list[str] = []
     relax = tau = None
     mode: str | None = None
@@ -296,6 +295,7 @@ def _press_behaviour(record: PressRecord | None, released: tuple[float, float] |
             notes.append(note)
     loss = dent = None
     if unloading is not None:
+        load_noise = force_noise(force_parts)  # the loss and the dent are its only readers
         got = loop_loss(record, load_noise, sigma_t)
         if isinstance(got, str):
             notes.append(got)

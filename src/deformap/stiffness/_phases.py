@@ -152,9 +152,7 @@ def force_noise(parts: list[NDArray[np.float64]]) -> ForceNoise:
         model = new
         if done:
             break
-    if not (math.isfinite(model.a) and math.isfinite(model.b)) or model.a + model.b <= 0.0:
-        return pooled
-    return model
+    return model if math.isfinite(model.a) and math.isfinite(model.b) else pooled
 
 
 def _fraction(start: float, end: float, grad: NDArray[np.float64], cov: NDArray[np.float64],
